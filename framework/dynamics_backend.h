@@ -1,0 +1,40 @@
+// The interface every dynamics engine implements (Box2D, ODE, kinematic).
+//
+// A backend mirrors the scene's shapes and joints into its engine at Build(),
+// steps them, and writes back the world poses and velocities of the bodies it
+// simulates (Scene::SetSimulatedState) and the positions/velocities of the
+// joints it drives. Engine types never leave the module.
+#pragma once
+
+#include <memory>
+#include <string>
+
+namespace swarmsim {
+
+class Scene;
+class StateHasher;
+
+struct DynamicsSettings {
+  double gravity = 9.81;  // m/s^2, magnitude; 2D backends use it for ground friction
+};
+
+class DynamicsBackend {
+ public:
+  virtual ~DynamicsBackend() = default;
+
+  // Creates engine bodies for every shape and joint in the scene. Called once
+  // at start, after the world is placed.
+  virtual void Build(const Scene& scene, const DynamicsSettings& settings) = 0;
+  // Advances `substeps` steps of `dt` seconds each, reading joint targets
+  // from the scene and writing simulated poses, velocities and joint states.
+  // Must be deterministic: same inputs, same outputs, bit for bit.
+  virtual void Step(Scene* scene, double dt, int substeps) = 0;
+  // Folds any engine state that is not mirrored in the scene and changes the
+  // future (warm-start caches, contact state) into the hash. May do nothing
+  // when the engine is rebuilt identically from the scene.
+  virtual void HashState(StateHasher* /*hasher*/) const {}
+  // Number of bodies the engine simulates (for summaries).
+  virtual int body_count() const = 0;
+};
+
+}  // namespace swarmsim

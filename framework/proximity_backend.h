@@ -1,0 +1,31 @@
+// The interface of the proximity module: ray sensors against the static
+// environment and against other robots.
+#pragma once
+
+namespace swarmsim {
+
+class Scene;
+
+struct ProximitySettings {
+  double octree_resolution = 0.05;  // m, voxel size of the static environment's octree
+};
+
+class ProximityBackend {
+ public:
+  virtual ~ProximityBackend() = default;
+
+  // Indexes the static environment (shapes that belong to no robot and are
+  // not dynamic). Called once at start.
+  virtual void Build(const Scene& scene, const ProximitySettings& settings) = 0;
+  // Rebuilds per-step acceleration structures (the spatial grid of robots)
+  // from the current poses. Called once per step before Sense().
+  virtual void Update(const Scene& scene) = 0;
+  // Fills the readings of every proximity sensor of model instance
+  // `instance`. Called concurrently for different instances: it must only
+  // write those sensors' readings.
+  virtual void SenseInstance(Scene* scene, int instance) const = 0;
+  // Fills the readings of sensors that belong to no robot.
+  virtual void SenseSceneSensors(Scene* scene) const = 0;
+};
+
+}  // namespace swarmsim

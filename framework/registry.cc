@@ -1,0 +1,52 @@
+#include "framework/registry.h"
+
+#include "framework/dynamics_backend.h"
+#include "framework/error.h"
+#include "framework/proximity_backend.h"
+
+namespace swarmsim {
+
+void ModuleRegistry::RegisterDynamics(ModuleInfo info, DynamicsFactory factory) {
+  info.kind = "dynamics";
+  dynamics_.emplace_back(info.name, std::move(factory));
+  modules_.push_back(std::move(info));
+}
+
+void ModuleRegistry::RegisterProximity(ModuleInfo info, ProximityFactory factory) {
+  info.kind = "proximity";
+  proximity_.emplace_back(info.name, std::move(factory));
+  modules_.push_back(std::move(info));
+}
+
+template <typename Factories>
+static std::string Known(const Factories& factories) {
+  std::string out;
+  for (const auto& [name, f] : factories) out += (out.empty() ? "" : ", ") + name;
+  return out.empty() ? "(none)" : out;
+}
+
+std::unique_ptr<DynamicsBackend> ModuleRegistry::MakeDynamics(const std::string& name) const {
+  for (const auto& [n, f] : dynamics_)
+    if (n == name) return f();
+  throw Error("unknown physics backend '" + name + "' (available: " + Known(dynamics_) + ")");
+}
+
+std::unique_ptr<ProximityBackend> ModuleRegistry::MakeProximity(const std::string& name) const {
+  for (const auto& [n, f] : proximity_)
+    if (n == name) return f();
+  throw Error("unknown proximity module '" + name + "' (available: " + Known(proximity_) + ")");
+}
+
+bool ModuleRegistry::HasDynamics(const std::string& name) const {
+  for (const auto& [n, f] : dynamics_)
+    if (n == name) return true;
+  return false;
+}
+
+std::vector<std::string> ModuleRegistry::DynamicsNames() const {
+  std::vector<std::string> out;
+  for (const auto& [n, f] : dynamics_) out.push_back(n);
+  return out;
+}
+
+}  // namespace swarmsim

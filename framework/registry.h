@@ -1,0 +1,47 @@
+// The module registry: every calculation module (dynamics engines, sensors,
+// later plugins) registers here by name with a version and a one-line
+// description, so the program can list what it has (`swarmsim modules`).
+// The registry is an ordinary object (no globals): the program builds one
+// and hands it to each World.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace swarmsim {
+
+class DynamicsBackend;
+class ProximityBackend;
+
+struct ModuleInfo {
+  std::string kind;  // "dynamics", "proximity", ...
+  std::string name;  // e.g. "box2d"
+  std::string version;
+  std::string description;  // one line
+};
+
+class ModuleRegistry {
+ public:
+  using DynamicsFactory = std::function<std::unique_ptr<DynamicsBackend>()>;
+  using ProximityFactory = std::function<std::unique_ptr<ProximityBackend>()>;
+
+  void RegisterDynamics(ModuleInfo info, DynamicsFactory factory);
+  void RegisterProximity(ModuleInfo info, ProximityFactory factory);
+
+  // Throw swarmsim::Error listing what is available when `name` is unknown.
+  std::unique_ptr<DynamicsBackend> MakeDynamics(const std::string& name) const;
+  std::unique_ptr<ProximityBackend> MakeProximity(const std::string& name) const;
+  bool HasDynamics(const std::string& name) const;
+  std::vector<std::string> DynamicsNames() const;
+
+  const std::vector<ModuleInfo>& modules() const { return modules_; }
+
+ private:
+  std::vector<ModuleInfo> modules_;
+  std::vector<std::pair<std::string, DynamicsFactory>> dynamics_;
+  std::vector<std::pair<std::string, ProximityFactory>> proximity_;
+};
+
+}  // namespace swarmsim

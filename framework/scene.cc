@@ -1,0 +1,624 @@
+#include "framework/scene.h"
+
+#include <algorithm>
+#include <charconv>
+#include <unordered_map>
+
+#include "framework/error.h"
+
+namespace swarmsim {
+
+const char* ToString(ObjectType type) {
+  switch (type) {
+    case ObjectType::kDummy: return "dummy";
+    case ObjectType::kShape: return "shape";
+    case ObjectType::kJoint: return "joint";
+    case ObjectType::kProximitySensor: return "proximity_sensor";
+  }
+  return "?";
+}
+
+const char* ToString(ShapeKind kind) {
+  switch (kind) {
+    case ShapeKind::kBox: return "box";
+    case ShapeKind::kCylinder: return "cylinder";
+    case ShapeKind::kSphere: return "sphere";
+  }
+  return "?";
+}
+
+const char* ToString(JointType type) {
+  return type == JointType::kRevolute ? "revolute" : "prismatic";
+}
+
+const char* ToString(JointMode mode) {
+  switch (mode) {
+    case JointMode::kPassive: return "passive";
+    case JointMode::kVelocity: return "velocity";
+    case JointMode::kPosition: return "position";
+  }
+  return "?";
+}
+
+double ShapeData::BoundingRadius() const {
+  switch (kind) {
+    case ShapeKind::kBox: return 0.5 * std::sqrt(size.x * size.x + size.y * size.y);
+    case ShapeKind::kCylinder:
+    case ShapeKind::kSphere: return size.x;
+  }
+  return 0;
+}
+
+Pose JointData::Motion() const {
+  if (type == JointType::kRevolute) return {{}, Quat::FromAxisAngle({0, 0, 1}, position)};
+  return {{0, 0, position}, {}};
+}
+
+Scene::Scene() = default;
+Scene::~Scene() = default;
+
+// --- Slots ----------------------------------------------------------------------
+
+uint32_t Scene::AllocateSlot(std::string name, ObjectId parent, const Pose& X_PO,
+                             ObjectType type) {
+  int32_t parent_slot = -1;
+  if (!parent.IsNull()) parent_slot = static_cast<int32_t>(SlotOf(parent, "parent object"));
+  uint32_t slot;
+  if (!free_slots_.empty()) {
+    // Reuse the lowest free slot so that slot order stays deterministic.
+    auto it = std::min_element(free_slots_.begin(), free_slots_.end());
+    slot = *it;
+    free_slots_.erase(it);
+  } else {
+    slot = static_cast<uint32_t>(generation_.size());
+    X_PO_.emplace_back();
+    X_WO_.emplace_back();
+    v_WO_.emplace_back();
+    w_WO_.emplace_back();
+    parent_.push_back(-1);
+    first_child_.push_back(-1);
+    last_child_.push_back(-1);
+    next_sibling_.push_back(-1);
+    prev_sibling_.push_back(-1);
+    type_.push_back(type);
+    row_.push_back(0);
+    instance_.push_back(-1);
+    simulated_.push_back(0);
+    generation_.push_back(0);
+    alive_.push_back(0);
+    model_root_.push_back(0);
+    name_.emplace_back();
+    script_.push_back(-1);
+    linked_dummy_.push_back(-1);
+  }
+  X_PO_[slot] = X_PO;
+  v_WO_[slot] = {};
+  w_WO_[slot] = {};
+  type_[slot] = type;
+  row_[slot] = 0;
+  simulated_[slot] = 0;
+  alive_[slot] = 1;
+  model_root_[slot] = 0;
+  name_[slot] = std::move(name);
+  script_[slot] = -1;
+  linked_dummy_[slot] = -1;
+  parent_[slot] = -1;
+  first_child_[slot] = last_child_[slot] = next_sibling_[slot] = prev_sibling_[slot] = -1;
+  instance_[slot] = parent_slot >= 0 ? instance_[parent_slot] : -1;
+  if (parent_slot >= 0) LinkChild(static_cast<uint32_t>(parent_slot), slot);
+  X_WO_[slot] = parent_slot >= 0 ? ChildFrameAt(static_cast<uint32_t>(parent_slot)) * X_PO : X_PO;
+  if (instance_[slot] >= 0) RebuildInstanceObjects(instance_[slot]);
+  ++object_count_;
+  ++structure_version_;
+  order_dirty_ = true;
+  return slot;
+}
+
+template <typename T>
+static void SwapRemoveRow(std::vector<T>* table, std::vector<uint32_t>* owners, uint32_t row,
+                          std::vector<uint32_t>* row_of_slot) {
+  const uint32_t last = static_cast<uint32_t>(table->size() - 1);
+  if (row != last) {
+    (*table)[row] = std::move((*table)[last]);
+    (*owners)[row] = (*owners)[last];
+    (*row_of_slot)[(*owners)[row]] = row;
+  }
+  table->pop_back();
+  owners->pop_back();
+}
+
+void Scene::FreeSlot(uint32_t slot) {
+  switch (type_[slot]) {
+    case ObjectType::kShape: SwapRemoveRow(&shapes_, &shape_owner_, row_[slot], &row_); break;
+    case ObjectType::kJoint: SwapRemoveRow(&joints_, &joint_owner_, row_[slot], &row_); break;
+    case ObjectType::kProximitySensor:
+      SwapRemoveRow(&proximity_sensors_, &proximity_sensor_owner_, row_[slot], &row_);
+      break;
+    case ObjectType::kDummy: break;
+  }
+  if (script_[slot] >= 0) scripts_[script_[slot]] = {};
+  // Unlink any dummy linked to this one.
+  if (linked_dummy_[slot] >= 0 && linked_dummy_[linked_dummy_[slot]] == static_cast<int32_t>(slot))
+    linked_dummy_[linked_dummy_[slot]] = -1;
+  alive_[slot] = 0;
+  ++generation_[slot];
+  name_[slot].clear();
+  name_[slot].shrink_to_fit();
+  free_slots_.push_back(slot);
+  --object_count_;
+}
+
+ObjectId Scene::AddDummy(std::string name, ObjectId parent, const Pose& X_PO) {
+  const uint32_t slot = AllocateSlot(std::move(name), parent, X_PO, ObjectType::kDummy);
+  return IdAt(slot);
+}
+
+ObjectId Scene::AddShape(std::string name, ObjectId parent, const Pose& X_PO,
+                         const ShapeData& shape) {
+  const uint32_t slot = AllocateSlot(std::move(name), parent, X_PO, ObjectType::kShape);
+  row_[slot] = static_cast<uint32_t>(shapes_.size());
+  shapes_.push_back(shape);
+  shape_owner_.push_back(slot);
+  return IdAt(slot);
+}
+
+ObjectId Scene::AddJoint(std::string name, ObjectId parent, const Pose& X_PO,
+                         const JointData& joint) {
+  const uint32_t slot = AllocateSlot(std::move(name), parent, X_PO, ObjectType::kJoint);
+  row_[slot] = static_cast<uint32_t>(joints_.size());
+  joints_.push_back(joint);
+  joint_owner_.push_back(slot);
+  return IdAt(slot);
+}
+
+ObjectId Scene::AddProximitySensor(std::string name, ObjectId parent, const Pose& X_PO,
+                                   const ProximitySensorData& sensor) {
+  const uint32_t slot = AllocateSlot(std::move(name), parent, X_PO, ObjectType::kProximitySensor);
+  row_[slot] = static_cast<uint32_t>(proximity_sensors_.size());
+  proximity_sensors_.push_back(sensor);
+  proximity_sensor_owner_.push_back(slot);
+  return IdAt(slot);
+}
+
+// --- Tree links -------------------------------------------------------------------
+
+void Scene::LinkChild(uint32_t parent, uint32_t child) {
+  parent_[child] = static_cast<int32_t>(parent);
+  prev_sibling_[child] = last_child_[parent];
+  next_sibling_[child] = -1;
+  if (last_child_[parent] >= 0) next_sibling_[last_child_[parent]] = static_cast<int32_t>(child);
+  else first_child_[parent] = static_cast<int32_t>(child);
+  last_child_[parent] = static_cast<int32_t>(child);
+}
+
+void Scene::UnlinkChild(uint32_t child) {
+  const int32_t parent = parent_[child];
+  if (parent < 0) return;
+  if (prev_sibling_[child] >= 0) next_sibling_[prev_sibling_[child]] = next_sibling_[child];
+  else first_child_[parent] = next_sibling_[child];
+  if (next_sibling_[child] >= 0) prev_sibling_[next_sibling_[child]] = prev_sibling_[child];
+  else last_child_[parent] = prev_sibling_[child];
+  parent_[child] = -1;
+  prev_sibling_[child] = next_sibling_[child] = -1;
+}
+
+void Scene::CollectSubtree(uint32_t slot, std::vector<uint32_t>* out) const {
+  // Iterative DFS pre-order, children in insertion order.
+  std::vector<uint32_t> stack{slot};
+  while (!stack.empty()) {
+    const uint32_t s = stack.back();
+    stack.pop_back();
+    out->push_back(s);
+    const size_t mark = stack.size();
+    for (int32_t c = first_child_[s]; c >= 0; c = next_sibling_[c]) stack.push_back(c);
+    std::reverse(stack.begin() + static_cast<std::ptrdiff_t>(mark), stack.end());
+  }
+}
+
+void Scene::RemoveSubtree(ObjectId root) {
+  const uint32_t slot = SlotOf(root);
+  std::vector<uint32_t> doomed;
+  CollectSubtree(slot, &doomed);
+  UnlinkChild(slot);
+  for (uint32_t s : doomed) {
+    if (model_root_[s] && instance_[s] >= 0 && instances_[instance_[s]].root == IdAt(s)) {
+      instances_[instance_[s]].alive = false;
+      instances_[instance_[s]].objects.clear();
+    }
+  }
+  const int inst = instance_[slot];
+  for (uint32_t s : doomed) FreeSlot(s);
+  if (inst >= 0 && instances_[inst].alive) RebuildInstanceObjects(inst);
+  ++structure_version_;
+  order_dirty_ = true;
+}
+
+void Scene::SetParent(ObjectId id, ObjectId new_parent, bool keep_world_pose) {
+  const uint32_t slot = SlotOf(id);
+  int32_t parent_slot = -1;
+  if (!new_parent.IsNull()) {
+    parent_slot = static_cast<int32_t>(SlotOf(new_parent, "parent object"));
+    for (int32_t a = parent_slot; a >= 0; a = parent_[a])
+      if (a == static_cast<int32_t>(slot))
+        throw Error("cannot make '" + name_[slot] + "' a child of its own descendant '" +
+                    name_[parent_slot] + "'");
+  }
+  const Pose X_WO = X_WO_[slot];
+  UnlinkChild(slot);
+  if (parent_slot >= 0) LinkChild(static_cast<uint32_t>(parent_slot), slot);
+  if (keep_world_pose) {
+    X_PO_[slot] = parent_slot >= 0 ? ChildFrameAt(parent_slot).Inverse() * X_WO : X_WO;
+  }
+  ++structure_version_;
+  order_dirty_ = true;
+  RefreshSubtree(slot);
+}
+
+ObjectId Scene::parent(ObjectId id) const {
+  const int32_t p = parent_[SlotOf(id)];
+  return p >= 0 ? IdAt(static_cast<uint32_t>(p)) : ObjectId{};
+}
+
+std::vector<ObjectId> Scene::children(ObjectId id) const {
+  std::vector<ObjectId> out;
+  for (int32_t c = first_child_[SlotOf(id)]; c >= 0; c = next_sibling_[c])
+    out.push_back(IdAt(static_cast<uint32_t>(c)));
+  return out;
+}
+
+void Scene::set_name(ObjectId id, std::string name) { name_[SlotOf(id)] = std::move(name); }
+
+// --- Validity -----------------------------------------------------------------------
+
+bool Scene::IsValid(ObjectId id) const {
+  if (id.IsNull() || id.index() >= generation_.size()) return false;
+  return alive_[id.index()] && generation_[id.index()] == id.generation;
+}
+
+uint32_t Scene::SlotOf(ObjectId id, std::string_view what) const {
+  if (IsValid(id)) return id.index();
+  std::string msg(what);
+  if (id.IsNull()) throw Error(msg + " handle is null");
+  if (id.index() >= generation_.size())
+    throw Error(msg + " handle " + std::to_string(id.ToInteger()) + " does not exist");
+  throw Error(msg + " handle " + std::to_string(id.ToInteger()) +
+              " is stale: the object was removed");
+}
+
+// --- Duplication ----------------------------------------------------------------------
+
+uint32_t Scene::CopyObject(uint32_t src, int32_t new_parent) {
+  const ObjectId parent = new_parent >= 0 ? IdAt(static_cast<uint32_t>(new_parent)) : ObjectId{};
+  // Copy the name and pose first: AllocateSlot may grow (and move) the arrays.
+  std::string name = name_[src];
+  const Pose X_PO = X_PO_[src];
+  ObjectId copy;
+  switch (type_[src]) {
+    case ObjectType::kDummy: copy = AddDummy(std::move(name), parent, X_PO); break;
+    case ObjectType::kShape: {
+      const ShapeData data = shapes_[row_[src]];
+      copy = AddShape(std::move(name), parent, X_PO, data);
+      break;
+    }
+    case ObjectType::kJoint: {
+      const JointData data = joints_[row_[src]];
+      copy = AddJoint(std::move(name), parent, X_PO, data);
+      break;
+    }
+    case ObjectType::kProximitySensor: {
+      const ProximitySensorData data = proximity_sensors_[row_[src]];
+      copy = AddProximitySensor(std::move(name), parent, X_PO, data);
+      break;
+    }
+  }
+  const uint32_t slot = copy.index();
+  v_WO_[slot] = v_WO_[src];
+  w_WO_[slot] = w_WO_[src];
+  model_root_[slot] = model_root_[src];
+  if (script_[src] >= 0 && scripts_[script_[src]].source) {
+    const ScriptAttachment attachment = scripts_[script_[src]];
+    script_[slot] = static_cast<int32_t>(scripts_.size());
+    scripts_.push_back(attachment);
+  }
+  return slot;
+}
+
+ObjectId Scene::DuplicateSubtree(ObjectId root, ObjectId new_parent) {
+  const uint32_t root_slot = SlotOf(root);
+  int32_t parent_slot = -1;
+  if (!new_parent.IsNull()) parent_slot = static_cast<int32_t>(SlotOf(new_parent, "parent object"));
+  std::vector<uint32_t> sources;
+  CollectSubtree(root_slot, &sources);
+  // Pre-order guarantees a parent is copied before its children.
+  std::unordered_map<uint32_t, uint32_t> copy_of;
+  copy_of.reserve(sources.size());
+  for (uint32_t src : sources) {
+    const int32_t p = src == root_slot ? parent_slot : static_cast<int32_t>(copy_of.at(parent_[src]));
+    copy_of[src] = CopyObject(src, p);
+  }
+  // Remap internal references: a link inside the subtree points at the copy;
+  // a link to an object outside stays as it was.
+  for (uint32_t src : sources) {
+    const int32_t link = linked_dummy_[src];
+    if (link < 0) continue;
+    auto it = copy_of.find(static_cast<uint32_t>(link));
+    linked_dummy_[copy_of[src]] = it != copy_of.end() ? static_cast<int32_t>(it->second) : link;
+  }
+  const uint32_t copy_root = copy_of.at(root_slot);
+  RefreshSubtree(copy_root);
+  // A copy of a whole robot is a new robot.
+  const int src_instance = instance_[root_slot];
+  if (model_root_[root_slot] && src_instance >= 0 && instances_[src_instance].root == root &&
+      instance_[copy_root] < 0) {
+    const std::string model_name = instances_[src_instance].model_name;
+    MakeModelInstance(IdAt(copy_root), model_name,
+                      model_name + "#" + std::to_string(instances_.size()));
+  }
+  return IdAt(copy_root);
+}
+
+// --- Poses ---------------------------------------------------------------------------
+
+Pose Scene::ChildFrameAt(uint32_t slot) const {
+  if (type_[slot] == ObjectType::kJoint) return X_WO_[slot] * joints_[row_[slot]].Motion();
+  return X_WO_[slot];
+}
+
+void Scene::RefreshSubtree(uint32_t slot) {
+  std::vector<uint32_t> sub;
+  CollectSubtree(slot, &sub);
+  for (uint32_t s : sub) {
+    const int32_t p = parent_[s];
+    X_WO_[s] = p >= 0 ? ChildFrameAt(static_cast<uint32_t>(p)) * X_PO_[s] : X_PO_[s];
+  }
+}
+
+void Scene::SetLocalPose(ObjectId id, const Pose& X_PO) {
+  const uint32_t slot = SlotOf(id);
+  X_PO_[slot] = X_PO;
+  RefreshSubtree(slot);
+}
+
+void Scene::SetWorldPose(ObjectId id, const Pose& X_WO) {
+  const uint32_t slot = SlotOf(id);
+  const int32_t p = parent_[slot];
+  X_PO_[slot] = p >= 0 ? ChildFrameAt(static_cast<uint32_t>(p)).Inverse() * X_WO : X_WO;
+  RefreshSubtree(slot);
+}
+
+void Scene::SetSimulatedState(uint32_t slot, const Pose& X_WO, const Vec3& v_WO,
+                              const Vec3& w_WO) {
+  X_WO_[slot] = X_WO;
+  v_WO_[slot] = v_WO;
+  w_WO_[slot] = w_WO;
+  simulated_[slot] = 1;
+}
+
+void Scene::RebuildOrder() const {
+  order_.clear();
+  order_.reserve(object_count_);
+  for (uint32_t s = 0; s < generation_.size(); ++s)
+    if (alive_[s] && parent_[s] < 0) CollectSubtree(s, &order_);
+  order_dirty_ = false;
+}
+
+static inline void UpdateOne(uint32_t s, const std::vector<int32_t>& parent_of,
+                             std::vector<uint8_t>* simulated, std::vector<Pose>* X_PO,
+                             std::vector<Pose>* X_WO, const Scene& scene) {
+  const int32_t p = parent_of[s];
+  if ((*simulated)[s]) {
+    // The backend owns X_WO; derive the local pose from it.
+    (*X_PO)[s] = p >= 0 ? scene.ChildFrameAt(static_cast<uint32_t>(p)).Inverse() * (*X_WO)[s]
+                        : (*X_WO)[s];
+    (*simulated)[s] = 0;
+  } else {
+    (*X_WO)[s] = p >= 0 ? scene.ChildFrameAt(static_cast<uint32_t>(p)) * (*X_PO)[s] : (*X_PO)[s];
+  }
+}
+
+void Scene::UpdateWorldPoses() {
+  if (order_dirty_) RebuildOrder();
+  for (uint32_t s : order_) UpdateOne(s, parent_, &simulated_, &X_PO_, &X_WO_, *this);
+}
+
+void Scene::UpdateWorldPoses(int instance) {
+  const ModelInstance& inst = instances_.at(instance);
+  // The root's parent (if any) is outside the instance and is up to date.
+  for (uint32_t s : inst.objects) UpdateOne(s, parent_, &simulated_, &X_PO_, &X_WO_, *this);
+}
+
+// --- Typed data ----------------------------------------------------------------------------
+
+static void ExpectType(const Scene& scene, uint32_t slot, ObjectType want) {
+  if (scene.type_at(slot) != want)
+    throw Error("object '" + scene.name_at(slot) + "' is a " + ToString(scene.type_at(slot)) +
+                ", not a " + ToString(want));
+}
+
+const ShapeData& Scene::shape(ObjectId id) const {
+  const uint32_t s = SlotOf(id, "shape");
+  ExpectType(*this, s, ObjectType::kShape);
+  return shapes_[row_[s]];
+}
+ShapeData& Scene::mutable_shape(ObjectId id) {
+  const uint32_t s = SlotOf(id, "shape");
+  ExpectType(*this, s, ObjectType::kShape);
+  return shapes_[row_[s]];
+}
+const JointData& Scene::joint(ObjectId id) const {
+  const uint32_t s = SlotOf(id, "joint");
+  ExpectType(*this, s, ObjectType::kJoint);
+  return joints_[row_[s]];
+}
+JointData& Scene::mutable_joint(ObjectId id) {
+  const uint32_t s = SlotOf(id, "joint");
+  ExpectType(*this, s, ObjectType::kJoint);
+  return joints_[row_[s]];
+}
+const ProximitySensorData& Scene::proximity_sensor(ObjectId id) const {
+  const uint32_t s = SlotOf(id, "proximity sensor");
+  ExpectType(*this, s, ObjectType::kProximitySensor);
+  return proximity_sensors_[row_[s]];
+}
+ProximitySensorData& Scene::mutable_proximity_sensor(ObjectId id) {
+  const uint32_t s = SlotOf(id, "proximity sensor");
+  ExpectType(*this, s, ObjectType::kProximitySensor);
+  return proximity_sensors_[row_[s]];
+}
+
+void Scene::LinkDummies(ObjectId a, ObjectId b) {
+  const uint32_t sa = SlotOf(a, "dummy"), sb = SlotOf(b, "dummy");
+  ExpectType(*this, sa, ObjectType::kDummy);
+  ExpectType(*this, sb, ObjectType::kDummy);
+  linked_dummy_[sa] = static_cast<int32_t>(sb);
+  linked_dummy_[sb] = static_cast<int32_t>(sa);
+}
+
+ObjectId Scene::linked_dummy(ObjectId id) const {
+  const int32_t l = linked_dummy_[SlotOf(id, "dummy")];
+  return l >= 0 ? IdAt(static_cast<uint32_t>(l)) : ObjectId{};
+}
+
+// --- Scripts ------------------------------------------------------------------------------
+
+void Scene::AttachScript(ObjectId id, std::shared_ptr<const ScriptSource> source) {
+  const uint32_t slot = SlotOf(id);
+  if (script_[slot] < 0) {
+    script_[slot] = static_cast<int32_t>(scripts_.size());
+    scripts_.emplace_back();
+  }
+  scripts_[script_[slot]] = {std::move(source), true};
+}
+
+const ScriptAttachment* Scene::script(ObjectId id) const { return script_at(SlotOf(id)); }
+
+const ScriptAttachment* Scene::script_at(uint32_t slot) const {
+  const int32_t i = script_[slot];
+  return i >= 0 && scripts_[i].source ? &scripts_[i] : nullptr;
+}
+
+// --- Models -------------------------------------------------------------------------------
+
+void Scene::RebuildInstanceObjects(int instance) {
+  ModelInstance& inst = instances_[instance];
+  inst.objects.clear();
+  CollectSubtree(inst.root.index(), &inst.objects);
+}
+
+int Scene::MakeModelInstance(ObjectId root, std::string model_name, std::string instance_name) {
+  const uint32_t slot = SlotOf(root, "model root");
+  model_root_[slot] = 1;
+  for (int32_t a = parent_[slot]; a >= 0; a = parent_[a])
+    if (model_root_[a]) return instance_[a];  // nested model: part of its ancestor's instance
+  const int index = static_cast<int>(instances_.size());
+  instances_.push_back({std::move(instance_name), std::move(model_name), root, true, {}});
+  RebuildInstanceObjects(index);
+  for (uint32_t s : instances_[index].objects) instance_[s] = index;
+  return index;
+}
+
+// --- Paths --------------------------------------------------------------------------------
+
+std::string Scene::PathOf(ObjectId id) const {
+  std::vector<uint32_t> chain;
+  for (int32_t s = static_cast<int32_t>(SlotOf(id)); s >= 0; s = parent_[s])
+    chain.push_back(static_cast<uint32_t>(s));
+  std::string path;
+  for (auto it = chain.rbegin(); it != chain.rend(); ++it) path += "/" + name_[*it];
+  return path;
+}
+
+namespace {
+
+struct PathElement {
+  std::string_view name;
+  int index = -1;  // -1: the first match
+};
+
+// Parses "a/b[2]/c" into elements; throws on a malformed index.
+std::vector<PathElement> SplitPath(std::string_view path, std::string_view full) {
+  std::vector<PathElement> out;
+  while (!path.empty()) {
+    const size_t slash = path.find('/');
+    std::string_view part = path.substr(0, slash);
+    path = slash == std::string_view::npos ? std::string_view{} : path.substr(slash + 1);
+    if (part.empty()) continue;
+    PathElement e{part, -1};
+    if (part.back() == ']') {
+      const size_t open = part.rfind('[');
+      if (open == std::string_view::npos)
+        throw Error("malformed object path '" + std::string(full) + "': missing '['");
+      std::string_view digits = part.substr(open + 1, part.size() - open - 2);
+      int value = 0;
+      auto [ptr, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
+      if (ec != std::errc() || ptr != digits.data() + digits.size() || value < 0)
+        throw Error("malformed object path '" + std::string(full) + "': index '" +
+                    std::string(digits) + "' is not a non-negative integer");
+      e.name = part.substr(0, open);
+      e.index = value;
+    }
+    out.push_back(e);
+  }
+  return out;
+}
+
+}  // namespace
+
+ObjectId Scene::FindObject(std::string_view path, ObjectId from) const {
+  const std::string_view full = path;
+  std::vector<uint32_t> scope;  // candidate subtree roots whose descendants are searched
+  bool search_descendants = true;
+  if (path.starts_with("./") || path == ".") {
+    if (!IsValid(from)) return {};
+    scope.push_back(from.index());
+    path.remove_prefix(path.size() >= 2 ? 2 : 1);
+  } else if (path.starts_with(":/") || path == ":") {
+    if (!IsValid(from)) return {};
+    int32_t root = static_cast<int32_t>(from.index());
+    for (int32_t a = root; a >= 0; a = parent_[a])
+      if (model_root_[a]) { root = a; break; }
+    scope.push_back(static_cast<uint32_t>(root));
+    path.remove_prefix(path.size() >= 2 ? 2 : 1);
+  } else if (path.starts_with("/")) {
+    path.remove_prefix(1);
+    search_descendants = false;  // first element is a root object
+  } else {
+    throw Error("malformed object path '" + std::string(full) +
+                "': start with '/' (absolute), './' (below this object) or ':/' (in this model)");
+  }
+  const std::vector<PathElement> elements = SplitPath(path, full);
+  if (elements.empty()) return scope.empty() ? ObjectId{} : IdAt(scope.front());
+
+  // First element: roots (absolute) or any descendant of the scope.
+  std::vector<uint32_t> candidates;
+  if (!search_descendants) {
+    if (order_dirty_) RebuildOrder();
+    for (uint32_t s = 0; s < generation_.size(); ++s)
+      if (alive_[s] && parent_[s] < 0) candidates.push_back(s);
+  } else {
+    std::vector<uint32_t> sub;
+    CollectSubtree(scope.front(), &sub);
+    candidates.assign(sub.begin() + 1, sub.end());
+  }
+  int32_t current = -1;
+  for (size_t k = 0; k < elements.size(); ++k) {
+    const PathElement& e = elements[k];
+    if (k > 0) {
+      // Following elements: descendants of the current match, hierarchy order.
+      std::vector<uint32_t> sub;
+      CollectSubtree(static_cast<uint32_t>(current), &sub);
+      candidates.assign(sub.begin() + 1, sub.end());
+    }
+    int seen = 0;
+    current = -1;
+    const int want = e.index < 0 ? 0 : e.index;
+    for (uint32_t c : candidates) {
+      if (name_[c] != e.name) continue;
+      if (seen++ == want) { current = static_cast<int32_t>(c); break; }
+    }
+    if (current < 0) return {};
+  }
+  return IdAt(static_cast<uint32_t>(current));
+}
+
+}  // namespace swarmsim

@@ -1,0 +1,259 @@
+// The scene: a tree of objects in world-owned storage.
+//
+// Objects are referred to by ObjectId {index1, generation}. Per-object hot
+// data (poses, velocities, parent links) lives in dense arrays indexed by slot;
+// type-specific data lives in one dense table per type (shapes, joints,
+// proximity sensors), each row pointing back at its object. Names, scripts and
+// model bookkeeping are cold arrays.
+//
+// A model is a subtree whose root is marked as a model. Each top-level model
+// copy is a *model instance* (a robot): the unit of parallelism and of random
+// streams. DuplicateSubtree copies rows, not assets (script sources are shared).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "framework/handle.h"
+#include "framework/math.h"
+
+namespace swarmsim {
+
+enum class ObjectType : uint8_t { kDummy, kShape, kJoint, kProximitySensor };
+const char* ToString(ObjectType type);
+
+enum class ShapeKind : uint8_t { kBox, kCylinder, kSphere };
+const char* ToString(ShapeKind kind);
+
+// Geometry is centred on the shape's frame; a cylinder's axis is its z axis.
+struct ShapeData {
+  ShapeKind kind = ShapeKind::kBox;
+  Vec3 size{0.1, 0.1, 0.1};  // box: full extents (x, y, z) m; cylinder: (radius, -, height); sphere: (radius, -, -)
+  bool dynamic = false;      // simulated by the dynamics backend, else static or kinematic
+  double mass = 1.0;         // kg, dynamic shapes only
+  double friction = 0.7;     // Coulomb coefficient
+  double restitution = 0.0;
+  Vec3 color{0.7, 0.7, 0.7};  // RGB in [0, 1]
+
+  // Radius of the shape's footprint circle in its xy plane (for broad phases).
+  double BoundingRadius() const;
+};
+
+enum class JointType : uint8_t { kRevolute, kPrismatic };
+enum class JointMode : uint8_t { kPassive, kVelocity, kPosition };
+const char* ToString(JointType type);
+const char* ToString(JointMode mode);
+
+// A joint moves its children along/about its own z axis (V-REP's convention):
+// X_W(child) = X_WJ * Motion(position) * X_J(child).
+struct JointData {
+  JointType type = JointType::kRevolute;
+  JointMode mode = JointMode::kVelocity;
+  double position = 0;         // rad or m
+  double velocity = 0;         // rad/s or m/s
+  double target_velocity = 0;  // velocity mode
+  double target_position = 0;  // position mode
+  double max_force = 10;       // N or N m
+  double max_velocity = 10;    // rad/s or m/s, position mode
+
+  Pose Motion() const;  // transform produced by `position` about/along z
+};
+
+// A ray proximity sensor looking along its +z axis (V-REP's convention).
+struct ProximitySensorData {
+  double range = 0.1;  // m
+  // Reading, written in the sense phase:
+  bool detected = false;
+  double distance = 0;      // m, along the ray
+  Vec3 p_SD;                // detected point in the sensor frame
+  ObjectId detected_object; // shape that was hit
+};
+
+// A script attached to an object. The source is shared by all copies.
+struct ScriptSource {
+  std::string path;     // file the code came from (for messages)
+  std::string code;
+};
+struct ScriptAttachment {
+  std::shared_ptr<const ScriptSource> source;
+  bool enabled = true;
+};
+
+// A top-level model copy: one robot.
+struct ModelInstance {
+  std::string name;        // e.g. "footbot#12"
+  std::string model_name;  // e.g. "footbot"
+  ObjectId root;
+  bool alive = true;
+  std::vector<uint32_t> objects;  // slots of the instance's objects, hierarchy (DFS pre-)order
+};
+
+class Scene {
+ public:
+  Scene();
+  ~Scene();
+  Scene(const Scene&) = delete;
+  Scene& operator=(const Scene&) = delete;
+
+  // --- Creation and deletion --------------------------------------------------
+  // `parent` may be null (a root). X_PO is the pose of the new object in its parent.
+  ObjectId AddDummy(std::string name, ObjectId parent, const Pose& X_PO);
+  ObjectId AddShape(std::string name, ObjectId parent, const Pose& X_PO, const ShapeData& shape);
+  ObjectId AddJoint(std::string name, ObjectId parent, const Pose& X_PO, const JointData& joint);
+  ObjectId AddProximitySensor(std::string name, ObjectId parent, const Pose& X_PO,
+                              const ProximitySensorData& sensor);
+  // Removes an object and all its descendants (their handles become stale).
+  void RemoveSubtree(ObjectId root);
+  // Copies a subtree under `new_parent` (null: a new root), with its scripts,
+  // model marks and internal references (dummy links) remapped to the copy.
+  // Returns the copy's root.
+  ObjectId DuplicateSubtree(ObjectId root, ObjectId new_parent);
+  void SetParent(ObjectId id, ObjectId new_parent, bool keep_world_pose);
+
+  // --- Validity ---------------------------------------------------------------
+  bool IsValid(ObjectId id) const;
+  // Slot of a valid handle; throws swarmsim::Error naming `what` for a null,
+  // stale or out-of-range one.
+  uint32_t SlotOf(ObjectId id, std::string_view what = "object") const;
+  ObjectId IdAt(uint32_t slot) const { return {slot + 1, generation_[slot]}; }
+  uint32_t slot_count() const { return static_cast<uint32_t>(generation_.size()); }
+  bool alive_at(uint32_t slot) const { return alive_[slot] != 0; }
+  size_t object_count() const { return object_count_; }
+
+  // --- Tree -------------------------------------------------------------------
+  ObjectId parent(ObjectId id) const;
+  std::vector<ObjectId> children(ObjectId id) const;
+  int32_t parent_at(uint32_t slot) const { return parent_[slot]; }
+  const std::string& name(ObjectId id) const { return name_[SlotOf(id)]; }
+  const std::string& name_at(uint32_t slot) const { return name_[slot]; }
+  void set_name(ObjectId id, std::string name);
+  ObjectType type(ObjectId id) const { return type_[SlotOf(id)]; }
+  ObjectType type_at(uint32_t slot) const { return type_[slot]; }
+  // Path lookup, CoppeliaSim style. Absolute: "/robot/leftMotor"; relative to
+  // `from`: "./leftMotor" (a descendant of `from`), ":/sensor" (a descendant
+  // of `from`'s model root). "name[k]" picks the k-th (0-based) match of a
+  // repeated name in hierarchy order. Returns null when nothing matches.
+  ObjectId FindObject(std::string_view path, ObjectId from = {}) const;
+  // Slash-separated path from the root, e.g. "/footbot#3/leftMotor".
+  std::string PathOf(ObjectId id) const;
+
+  // --- Poses and velocities (hot, by slot) ------------------------------------
+  const Pose& local_pose_at(uint32_t slot) const { return X_PO_[slot]; }
+  const Pose& world_pose_at(uint32_t slot) const { return X_WO_[slot]; }
+  const Vec3& linear_velocity_at(uint32_t slot) const { return v_WO_[slot]; }
+  const Vec3& angular_velocity_at(uint32_t slot) const { return w_WO_[slot]; }
+  Pose world_pose(ObjectId id) const { return X_WO_[SlotOf(id)]; }
+  Pose local_pose(ObjectId id) const { return X_PO_[SlotOf(id)]; }
+  // Sets X_PO and refreshes the world poses of the object and its subtree.
+  void SetLocalPose(ObjectId id, const Pose& X_PO);
+  void SetWorldPose(ObjectId id, const Pose& X_WO);
+  // Dynamics backends write world poses and velocities of simulated bodies.
+  // Call UpdateWorldPoses() afterwards to refresh local poses and descendants.
+  void SetSimulatedState(uint32_t slot, const Pose& X_WO, const Vec3& v_WO, const Vec3& w_WO);
+  // Recomputes world poses top-down (the pose of each simulated body is kept
+  // and its local pose derived from it).
+  void UpdateWorldPoses();
+  // Same, for one model instance's objects only (thread-safe across instances).
+  void UpdateWorldPoses(int instance);
+  // Pose of the frame children of `slot` hang from: X_WO, times the joint
+  // motion if the object is a joint.
+  Pose ChildFrameAt(uint32_t slot) const;
+
+  // --- Typed data ---------------------------------------------------------------
+  const ShapeData& shape(ObjectId id) const;
+  ShapeData& mutable_shape(ObjectId id);
+  const JointData& joint(ObjectId id) const;
+  JointData& mutable_joint(ObjectId id);
+  const ProximitySensorData& proximity_sensor(ObjectId id) const;
+  ProximitySensorData& mutable_proximity_sensor(ObjectId id);
+  // Dense typed tables. Row r belongs to the object at slot *_owner()[r].
+  std::span<ShapeData> shapes() { return shapes_; }
+  std::span<const ShapeData> shapes() const { return shapes_; }
+  std::span<const uint32_t> shape_owners() const { return shape_owner_; }
+  std::span<JointData> joints() { return joints_; }
+  std::span<const JointData> joints() const { return joints_; }
+  std::span<const uint32_t> joint_owners() const { return joint_owner_; }
+  std::span<ProximitySensorData> proximity_sensors() { return proximity_sensors_; }
+  std::span<const ProximitySensorData> proximity_sensors() const { return proximity_sensors_; }
+  std::span<const uint32_t> proximity_sensor_owners() const { return proximity_sensor_owner_; }
+  // Row of the object's typed data (shape, joint or sensor table), by slot.
+  uint32_t row_at(uint32_t slot) const { return row_[slot]; }
+
+  // Dummy links (V-REP's dummy-dummy link, used by IK tip/target pairs).
+  void LinkDummies(ObjectId a, ObjectId b);
+  ObjectId linked_dummy(ObjectId id) const;
+
+  // --- Scripts ------------------------------------------------------------------
+  void AttachScript(ObjectId id, std::shared_ptr<const ScriptSource> source);
+  // Null if the object has no script.
+  const ScriptAttachment* script(ObjectId id) const;
+  const ScriptAttachment* script_at(uint32_t slot) const;
+
+  // --- Models -------------------------------------------------------------------
+  // Marks `root` as a model. A model root with no model ancestor becomes a
+  // model instance (robot) with the next instance index and the given name.
+  int MakeModelInstance(ObjectId root, std::string model_name, std::string instance_name);
+  std::span<const ModelInstance> instances() const { return instances_; }
+  const ModelInstance& instance(int index) const { return instances_.at(index); }
+  // Instance index of the object's model, or -1 for scene objects.
+  int instance_of_at(uint32_t slot) const { return instance_[slot]; }
+  int instance_of(ObjectId id) const { return instance_[SlotOf(id)]; }
+  bool is_model_root(ObjectId id) const { return model_root_[SlotOf(id)] != 0; }
+
+  // Monotonic counter bumped on every structural change (add, remove, reparent).
+  uint64_t structure_version() const { return structure_version_; }
+
+ private:
+  uint32_t AllocateSlot(std::string name, ObjectId parent, const Pose& X_PO, ObjectType type);
+  void FreeSlot(uint32_t slot);
+  void LinkChild(uint32_t parent, uint32_t child);
+  void UnlinkChild(uint32_t child);
+  void RefreshSubtree(uint32_t slot);
+  void RebuildOrder() const;
+  void RebuildInstanceObjects(int instance);
+  void CollectSubtree(uint32_t slot, std::vector<uint32_t>* out) const;
+  uint32_t CopyObject(uint32_t src, int32_t new_parent);
+
+  // Per slot, hot.
+  std::vector<Pose> X_PO_;    // pose in parent (slots)
+  std::vector<Pose> X_WO_;    // pose in world, cached (slots)
+  std::vector<Vec3> v_WO_;    // linear velocity in world (slots)
+  std::vector<Vec3> w_WO_;    // angular velocity in world (slots)
+  std::vector<int32_t> parent_;  // parent slot or -1 (slots)
+  std::vector<int32_t> first_child_, last_child_, next_sibling_, prev_sibling_;  // (slots)
+  std::vector<ObjectType> type_;  // (slots)
+  std::vector<uint32_t> row_;     // row in the type's table (slots)
+  std::vector<int32_t> instance_; // model instance or -1 (slots)
+  std::vector<uint8_t> simulated_;  // pose owned by a dynamics backend this step (slots)
+  // Per slot, cold.
+  std::vector<uint32_t> generation_;
+  std::vector<uint8_t> alive_;
+  std::vector<uint8_t> model_root_;
+  std::vector<std::string> name_;
+  std::vector<int32_t> script_;        // index into scripts_ or -1
+  std::vector<int32_t> linked_dummy_;  // slot or -1
+  std::vector<uint32_t> free_slots_;
+  size_t object_count_ = 0;
+
+  // Typed tables.
+  std::vector<ShapeData> shapes_;
+  std::vector<uint32_t> shape_owner_;
+  std::vector<JointData> joints_;
+  std::vector<uint32_t> joint_owner_;
+  std::vector<ProximitySensorData> proximity_sensors_;
+  std::vector<uint32_t> proximity_sensor_owner_;
+
+  std::vector<ScriptAttachment> scripts_;
+  std::vector<ModelInstance> instances_;
+
+  // Topological order of all live slots (parents first), rebuilt lazily.
+  mutable std::vector<uint32_t> order_;
+  mutable bool order_dirty_ = true;
+  uint64_t structure_version_ = 0;
+};
+
+}  // namespace swarmsim

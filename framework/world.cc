@@ -1,0 +1,333 @@
+#include "framework/world.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include "framework/dynamics_backend.h"
+#include "framework/error.h"
+#include "framework/proximity_backend.h"
+#include "framework/registry.h"
+#include "framework/scheduler.h"
+#include "framework/script_host.h"
+#include "framework/state_hash.h"
+
+namespace swarmsim {
+
+namespace {
+
+// Robots per task in the parallel phases: big enough to amortise the task
+// overhead (a robot's sense + control is a few microseconds), small enough
+// to balance two to eight workers.
+constexpr int64_t kRobotGrain = 16;
+
+class PhaseTimer {
+ public:
+  explicit PhaseTimer(double* total) : total_(total), start_(std::chrono::steady_clock::now()) {}
+  ~PhaseTimer() {
+    *total_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  }
+
+ private:
+  double* total_;
+  std::chrono::steady_clock::time_point start_;
+};
+
+bool IsFinite(const Pose& X) {
+  return std::isfinite(X.p.x) && std::isfinite(X.p.y) && std::isfinite(X.p.z) &&
+         std::isfinite(X.q.w) && std::isfinite(X.q.x) && std::isfinite(X.q.y) &&
+         std::isfinite(X.q.z);
+}
+
+}  // namespace
+
+const char* ToString(Phase phase) {
+  switch (phase) {
+    case Phase::kSense: return "sense";
+    case Phase::kControl: return "control";
+    case Phase::kActuate: return "actuate";
+    case Phase::kPhysics: return "physics";
+    case Phase::kRecord: return "record";
+    case Phase::kCount: break;
+  }
+  return "?";
+}
+
+std::string ParamToString(const ParamValue& value) {
+  if (const double* d = std::get_if<double>(&value)) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.17g", *d);
+    return buf;
+  }
+  if (const bool* b = std::get_if<bool>(&value)) return *b ? "true" : "false";
+  return std::get<std::string>(value);
+}
+
+World::World(const WorldSettings& settings, const ModuleRegistry& registry)
+    : settings_(settings),
+      registry_(registry),
+      scheduler_(std::make_unique<TaskScheduler>(settings.threads)),
+      log_sink_([](std::string_view line) {
+        std::fwrite(line.data(), 1, line.size(), stdout);
+        std::fputc('\n', stdout);
+      }) {
+  if (!(settings_.time_step > 0) || !std::isfinite(settings_.time_step))
+    throw Error("time step must be a positive number of seconds");
+  if (settings_.physics_substeps < 1) throw Error("physics substeps must be at least 1");
+  // Validate the backend name now, so a typo fails before any work is done.
+  if (!registry_.HasDynamics(settings_.physics)) registry_.MakeDynamics(settings_.physics);
+}
+
+World::~World() {
+  try {
+    Stop();
+  } catch (...) {
+    // A failing sysCall_cleanup cannot be reported from a destructor.
+  }
+}
+
+int World::robot_count() const { return static_cast<int>(scene_.instances().size()); }
+int World::threads() const { return scheduler_->threads(); }
+
+void World::Log(std::string_view line) const { log_sink_(line); }
+
+void World::AddObserver(std::unique_ptr<Observer> observer) {
+  observers_.push_back(std::move(observer));
+}
+
+std::vector<MetricSample> World::TakeMetrics() {
+  std::vector<MetricSample> out;
+  out.swap(metrics_);
+  return out;
+}
+
+size_t World::script_memory_bytes() const { return scripts_ ? scripts_->MemoryBytes() : 0; }
+
+const ParamValue* World::FindParameter(int instance, std::string_view name) const {
+  if (instance >= 0 && instance < static_cast<int>(runtimes_.size()) &&
+      runtimes_[instance].parameters) {
+    const ParameterSet& own = *runtimes_[instance].parameters;
+    if (auto it = own.find(name); it != own.end()) return &it->second;
+  }
+  if (auto it = parameters_.find(name); it != parameters_.end()) return &it->second;
+  return nullptr;
+}
+
+void World::EnsureRuntimes() {
+  // One runtime per robot, its random stream keyed by (seed, robot index).
+  // The scene runtime uses stream 2^63 so it never collides with a robot.
+  while (runtimes_.size() < scene_.instances().size()) {
+    RobotRuntime r;
+    r.rng = Rng(settings_.seed, runtimes_.size());
+    runtimes_.push_back(std::move(r));
+  }
+  scene_runtime_.rng = Rng(settings_.seed, uint64_t{1} << 63);
+}
+
+void World::SetInstanceParameters(int instance, SharedParameters parameters) {
+  EnsureRuntimes();
+  runtimes_.at(instance).parameters = std::move(parameters);
+}
+
+void World::Start() {
+  if (started_) return;
+  EnsureRuntimes();
+  scene_.UpdateWorldPoses();
+  dynamics_ = registry_.MakeDynamics(settings_.physics);
+  DynamicsSettings dynamics_settings;
+  dynamics_settings.gravity = settings_.gravity;
+  dynamics_->Build(scene_, dynamics_settings);
+  proximity_ = registry_.MakeProximity("proximity");
+  ProximitySettings proximity_settings;
+  proximity_settings.octree_resolution = settings_.octree_resolution;
+  proximity_->Build(scene_, proximity_settings);
+  scripts_ = std::make_unique<ScriptHost>(this);
+  started_ = true;
+  try {
+    scripts_->Start();
+    FlushRobotBuffers();
+  } catch (...) {
+    failed_ = true;
+    throw;
+  }
+}
+
+void World::Step() {
+  if (!started_) Start();
+  if (failed_) throw Error("the world stopped after an error and cannot be stepped again");
+  if (stopped_) throw Error("the world was stopped and cannot be stepped again");
+  try {
+    // 1. sense: sensors read the state left by the last physics step.
+    { PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kSense)]); Sense(); }
+    // 2. control: scripts, one robot per task, hierarchy order within a robot.
+    { PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kControl)]); Control(); }
+    // 3. actuate: deferred writes, joint targets.
+    { PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kActuate)]); Actuate(); }
+    // 4. physics: the dynamics backend advances the simulated bodies.
+    { PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kPhysics)]); Physics(); }
+    // 5. record: observers append to their streams.
+    { PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kRecord)]); Record(); }
+  } catch (...) {
+    failed_ = true;
+    throw;
+  }
+}
+
+void World::Sense() {
+  proximity_->Update(scene_);
+  const auto& instances = scene_.instances();
+  scheduler_->ParallelFor(0, static_cast<int64_t>(instances.size()), kRobotGrain,
+                          [&](int64_t begin, int64_t end) {
+                            for (int64_t r = begin; r < end; ++r)
+                              if (instances[r].alive)
+                                proximity_->SenseInstance(&scene_, static_cast<int>(r));
+                          });
+  proximity_->SenseSceneSensors(&scene_);
+}
+
+void World::Control() {
+  const auto& instances = scene_.instances();
+  scheduler_->ParallelFor(0, static_cast<int64_t>(instances.size()), kRobotGrain,
+                          [&](int64_t begin, int64_t end) {
+                            for (int64_t r = begin; r < end; ++r) {
+                              if (!instances[r].alive) continue;
+                              try {
+                                scripts_->RunInstance(static_cast<int>(r));
+                              } catch (const std::exception& e) {
+                                runtimes_[r].error = e.what();
+                              }
+                            }
+                          });
+  try {
+    scripts_->RunSceneScripts();
+  } catch (const std::exception& e) {
+    scene_runtime_.error = e.what();
+  }
+  FlushRobotBuffers();
+}
+
+void World::FlushRobotBuffers() {
+  // Logs and metrics in robot order, then the scene's; the lowest robot's
+  // error wins, so the report does not depend on the thread count.
+  std::string first_error;
+  auto flush = [&](RobotRuntime& rt) {
+    for (const std::string& line : rt.log) log_sink_(line);
+    rt.log.clear();
+    for (MetricSample& m : rt.metrics) metrics_.push_back(std::move(m));
+    rt.metrics.clear();
+    if (!rt.error.empty() && first_error.empty()) first_error = rt.error;
+    rt.error.clear();
+  };
+  for (RobotRuntime& rt : runtimes_) flush(rt);
+  flush(scene_runtime_);
+  if (!first_error.empty()) throw Error(first_error);
+}
+
+void World::Actuate() {
+  // Writes to other robots' objects, in handle order (stable for equal handles).
+  std::vector<DeferredWrite> writes;
+  for (RobotRuntime& rt : runtimes_) {
+    writes.insert(writes.end(), rt.deferred.begin(), rt.deferred.end());
+    rt.deferred.clear();
+  }
+  writes.insert(writes.end(), scene_runtime_.deferred.begin(), scene_runtime_.deferred.end());
+  scene_runtime_.deferred.clear();
+  std::stable_sort(writes.begin(), writes.end(),
+                   [](const DeferredWrite& a, const DeferredWrite& b) { return a.object < b.object; });
+  for (const DeferredWrite& w : writes) {
+    if (!scene_.IsValid(w.object)) continue;  // removed meanwhile
+    JointData& j = scene_.mutable_joint(w.object);
+    if (w.kind == DeferredWrite::Kind::kJointTargetVelocity) j.target_velocity = w.value;
+    else j.target_position = w.value;
+  }
+  // Joints move kinematically toward their targets over the control step:
+  // velocity mode at the target velocity, position mode at up to max_velocity.
+  const double dt = settings_.time_step;
+  for (JointData& j : scene_.joints()) {
+    switch (j.mode) {
+      case JointMode::kVelocity:
+        j.velocity = j.target_velocity;
+        j.position += j.velocity * dt;
+        break;
+      case JointMode::kPosition: {
+        const double error = j.target_position - j.position;
+        const double step = std::clamp(error, -j.max_velocity * dt, j.max_velocity * dt);
+        j.velocity = step / dt;
+        j.position += step;
+        break;
+      }
+      case JointMode::kPassive: break;
+    }
+  }
+}
+
+void World::Physics() {
+  dynamics_->Step(&scene_, settings_.time_step / settings_.physics_substeps,
+                  settings_.physics_substeps);
+  scene_.UpdateWorldPoses();
+  ++step_count_;
+  time_ = static_cast<double>(step_count_) * settings_.time_step;
+  // NaNs out of physics are a user-visible error, not garbage in the outputs.
+  for (uint32_t row = 0; row < scene_.shapes().size(); ++row) {
+    const uint32_t slot = scene_.shape_owners()[row];
+    if (!scene_.shapes()[row].dynamic) continue;
+    const Pose& X = scene_.world_pose_at(slot);
+    if (!IsFinite(X))
+      throw Error("physics produced a non-finite pose for '" + scene_.PathOf(scene_.IdAt(slot)) +
+                  "' at step " + std::to_string(step_count_) +
+                  " (check masses, sizes and joint targets)");
+  }
+}
+
+void World::Record() {
+  for (auto& observer : observers_) observer->Record(*this, &metrics_);
+}
+
+void World::Stop() {
+  if (stopped_ || !started_) return;
+  stopped_ = true;
+  if (scripts_) {
+    scripts_->Stop();
+    try {
+      FlushRobotBuffers();
+    } catch (...) {
+      throw;
+    }
+  }
+}
+
+uint64_t World::StateHash() const {
+  StateHasher h;
+  h.AddValue(step_count_);
+  h.AddValue(time_);
+  for (uint32_t s = 0; s < scene_.slot_count(); ++s) {
+    if (!scene_.alive_at(s)) continue;
+    h.AddValue(s);
+    h.AddValue(scene_.world_pose_at(s));
+    h.AddValue(scene_.linear_velocity_at(s));
+    h.AddValue(scene_.angular_velocity_at(s));
+  }
+  for (size_t r = 0; r < scene_.joints().size(); ++r) {
+    const JointData& j = scene_.joints()[r];
+    h.AddValue(scene_.joint_owners()[r]);
+    h.AddValue(j.position);
+    h.AddValue(j.velocity);
+    h.AddValue(j.target_velocity);
+    h.AddValue(j.target_position);
+  }
+  for (size_t r = 0; r < scene_.proximity_sensors().size(); ++r) {
+    const ProximitySensorData& p = scene_.proximity_sensors()[r];
+    h.AddValue(scene_.proximity_sensor_owners()[r]);
+    h.AddValue(p.detected);
+    h.AddValue(p.distance);
+    h.AddValue(p.p_SD);
+    h.AddValue(p.detected_object);
+  }
+  for (const RobotRuntime& rt : runtimes_) h.Add(rt.rng.state(), 4 * sizeof(uint64_t));
+  h.Add(scene_runtime_.rng.state(), 4 * sizeof(uint64_t));
+  if (dynamics_) dynamics_->HashState(&h);
+  return h.Digest();
+}
+
+}  // namespace swarmsim

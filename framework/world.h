@@ -1,0 +1,173 @@
+// The world: a scene, its calculation modules and its scripts, stepped in
+// the five phases of DESIGN.md. A World is an ordinary object owned by its
+// caller; one process can hold many.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "framework/parameters.h"
+#include "framework/random.h"
+#include "framework/scene.h"
+
+namespace swarmsim {
+
+class DynamicsBackend;
+class ModuleRegistry;
+class ProximityBackend;
+class ScriptHost;
+class TaskScheduler;
+class World;
+
+struct WorldSettings {
+  std::string file;                 // world file, for messages ("" for worlds built in code)
+  std::filesystem::path directory;  // folder scripts are resolved against
+  std::string physics = "box2d";    // dynamics backend, by registered name
+  double time_step = 0.1;           // s, one control step
+  int physics_substeps = 10;        // physics steps per control step
+  uint64_t seed = 1;
+  int threads = 0;                  // <= 0: all cores
+  double gravity = 9.81;            // m/s^2
+  double octree_resolution = 0.05;  // m
+};
+
+// A value recorded by a script (sim.recordMetric) or by an observer.
+struct MetricSample {
+  int64_t step = 0;
+  double time = 0;
+  int instance = -1;  // robot index, -1 for swarm-level metrics
+  std::string name;
+  double value = 0;
+};
+
+// A write by one robot's script to another robot's object, applied after the
+// control phase in handle order.
+struct DeferredWrite {
+  enum class Kind : uint8_t { kJointTargetVelocity, kJointTargetPosition };
+  ObjectId object;
+  Kind kind;
+  double value;
+};
+
+// Per-robot runtime state. Only the worker running that robot touches it
+// during a phase; the world merges the buffers after the phase, in robot order.
+struct RobotRuntime {
+  Rng rng;
+  SharedParameters parameters;          // the instance's model parameters
+  std::vector<std::string> log;         // lines printed during the phase
+  std::vector<MetricSample> metrics;    // samples recorded this step
+  std::vector<DeferredWrite> deferred;  // writes to other robots' objects
+  std::string error;                    // a script error in this phase
+};
+
+// A calculation object that observes the world in the record phase
+// (minimum distance, swarm metrics, graphs).
+class Observer {
+ public:
+  virtual ~Observer() = default;
+  virtual void Record(const World& world, std::vector<MetricSample>* out) = 0;
+};
+
+// Wall-clock seconds spent in each phase, summed over the run.
+enum class Phase { kSense, kControl, kActuate, kPhysics, kRecord, kCount };
+const char* ToString(Phase phase);
+using PhaseTimes = std::array<double, static_cast<size_t>(Phase::kCount)>;
+
+class World {
+ public:
+  World(const WorldSettings& settings, const ModuleRegistry& registry);
+  ~World();
+  World(const World&) = delete;
+  World& operator=(const World&) = delete;
+
+  const WorldSettings& settings() const { return settings_; }
+  Scene& scene() { return scene_; }
+  const Scene& scene() const { return scene_; }
+
+  // --- Parameters ---------------------------------------------------------------
+  ParameterSet& parameters() { return parameters_; }
+  const ParameterSet& parameters() const { return parameters_; }
+  // A parameter as a script sees it: the robot's model parameter if it has
+  // one of that name, else the world parameter. Null if neither exists.
+  const ParamValue* FindParameter(int instance, std::string_view name) const;
+  // Sets the model parameters of a robot (call after the robot is created).
+  void SetInstanceParameters(int instance, SharedParameters parameters);
+
+  // --- Lifecycle ------------------------------------------------------------------
+  // Builds the dynamics and proximity modules from the placed scene and runs
+  // every script's sysCall_init. Throws swarmsim::Error on bad input.
+  void Start();
+  // One control step: sense, control, actuate, physics, record. Throws
+  // swarmsim::Error on a script error or a non-finite physics state; the
+  // world is then stopped and may not be stepped again.
+  void Step();
+  // Runs sysCall_cleanup. Called by the destructor if not called before.
+  void Stop();
+  bool started() const { return started_; }
+
+  int64_t step_count() const { return step_count_; }
+  double time() const { return time_; }
+  int robot_count() const;
+  int threads() const;
+
+  // Hash of every object's pose and velocity, joint states, sensor
+  // readings, random streams and time. Equal hashes, equal futures.
+  uint64_t StateHash() const;
+
+  // --- Outputs ----------------------------------------------------------------------
+  // Script `print` lines are passed here, prefixed by the robot instance
+  // name, in robot order after each phase. Default: standard output.
+  void set_log_sink(std::function<void(std::string_view)> sink) { log_sink_ = std::move(sink); }
+  void Log(std::string_view line) const;
+  void AddObserver(std::unique_ptr<Observer> observer);
+  // Metric samples recorded since the last call, in (step, robot, order) order.
+  std::vector<MetricSample> TakeMetrics();
+  const PhaseTimes& phase_times() const { return phase_times_; }
+
+  // --- For modules and the script host -----------------------------------------------
+  RobotRuntime& runtime(int instance) { return runtimes_.at(instance); }
+  RobotRuntime& scene_runtime() { return scene_runtime_; }
+  TaskScheduler& scheduler() { return *scheduler_; }
+  const ModuleRegistry& registry() const { return registry_; }
+  DynamicsBackend* dynamics() { return dynamics_.get(); }
+  ProximityBackend* proximity() { return proximity_.get(); }
+  ScriptHost* scripts() { return scripts_.get(); }
+  size_t script_memory_bytes() const;
+
+ private:
+  void Sense();
+  void Control();
+  void Actuate();
+  void Physics();
+  void Record();
+  void EnsureRuntimes();
+  void FlushRobotBuffers();
+
+  WorldSettings settings_;
+  const ModuleRegistry& registry_;
+  Scene scene_;
+  ParameterSet parameters_;
+  std::unique_ptr<TaskScheduler> scheduler_;
+  std::unique_ptr<DynamicsBackend> dynamics_;
+  std::unique_ptr<ProximityBackend> proximity_;
+  std::unique_ptr<ScriptHost> scripts_;
+  std::vector<RobotRuntime> runtimes_;
+  RobotRuntime scene_runtime_;
+  std::vector<std::unique_ptr<Observer>> observers_;
+  std::vector<MetricSample> metrics_;
+  std::function<void(std::string_view)> log_sink_;
+  PhaseTimes phase_times_{};
+  int64_t step_count_ = 0;
+  double time_ = 0;
+  bool started_ = false;
+  bool stopped_ = false;
+  bool failed_ = false;
+};
+
+}  // namespace swarmsim

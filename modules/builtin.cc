@@ -1,0 +1,14 @@
+#include "modules/builtin.h"
+
+#include "framework/registry.h"
+#include "modules/dynamics/box2d/box2d_backend.h"
+#include "modules/proximity/proximity.h"
+
+namespace swarmsim {
+
+void RegisterBuiltinModules(ModuleRegistry* registry) {
+  registry->RegisterDynamics(box2d::ModuleInfo(), [] { return box2d::MakeBackend(); });
+  registry->RegisterProximity(proximity::ModuleInfo(), [] { return proximity::MakeBackend(); });
+}
+
+}  // namespace swarmsim
