@@ -1,1 +1,169 @@
-int main() { return 0; }
+// The swarmsim command-line program.
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <iostream>
+
+#include "framework/error.h"
+#include "framework/registry.h"
+#include "modules/builtin.h"
+#include "swarm/bench.h"
+#include "swarm/runner.h"
+#include "swarm/version.h"
+#include "swarm/world_loader.h"
+
+namespace swarmsim {
+namespace {
+
+constexpr int kExitRunError = 1;  // the run failed (script error, physics, outputs)
+constexpr int kExitBadInput = 2;  // bad command line or world file
+
+std::vector<std::pair<std::string, std::string>> ParseSets(const std::vector<std::string>& sets) {
+  std::vector<std::pair<std::string, std::string>> out;
+  for (const std::string& s : sets) {
+    const size_t eq = s.find('=');
+    if (eq == std::string::npos || eq == 0)
+      throw Error("--set expects name=value, got '" + s + "'");
+    out.emplace_back(s.substr(0, eq), s.substr(eq + 1));
+  }
+  return out;
+}
+
+int Main(int argc, char** argv) {
+  CLI::App app{"swarmsim " + std::string(Version()) +
+               ": a headless, swarm-scale robot simulator.\n"
+               "Lua-controlled robot models, copied by the thousand, stepped in parallel."};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", Version());
+
+  // run
+  CLI::App* run = app.add_subcommand("run", "Run a world and print a summary");
+  std::string world_file;
+  int64_t steps = -1;
+  double duration = -1;
+  int threads = 0;
+  std::optional<uint64_t> seed;
+  std::vector<std::string> sets;
+  std::string out_dir;
+  bool hash = false, quiet = false;
+  run->add_option("world", world_file, "World file (YAML)")->required();
+  auto* steps_opt = run->add_option("--steps", steps, "Number of control steps to run")
+                        ->check(CLI::NonNegativeNumber);
+  run->add_option("--duration", duration, "Simulated seconds to run")
+      ->check(CLI::NonNegativeNumber)
+      ->excludes(steps_opt);
+  run->add_option("--threads", threads, "Worker threads (default: all cores)")
+      ->check(CLI::PositiveNumber);
+  run->add_option("--seed", seed, "Random seed (overrides the world's)");
+  run->add_option("--set", sets, "Override a parameter: name=value or model.name=value")
+      ->allow_extra_args(false);
+  run->add_option("--out", out_dir, "Write summary.json and metrics.csv to this folder");
+  run->add_flag("--hash", hash, "Print the final state hash");
+  run->add_flag("--quiet", quiet, "No progress bar and no summary table");
+
+  // bench
+  CLI::App* bench = app.add_subcommand("bench", "Measure robot-ticks/s over robots x threads");
+  BenchOptions bench_options;
+  std::string bench_child_config;
+  int bench_child_robots = 0, bench_child_threads = 1;
+  bench->add_option("--robots", bench_options.robots, "Robot counts, e.g. 100,1000,10000")
+      ->delimiter(',');
+  bench->add_option("--threads", bench_options.threads, "Thread counts, e.g. 1,2")->delimiter(',');
+  bench->add_option("--steps", bench_options.steps, "Measured steps per configuration")
+      ->check(CLI::PositiveNumber);
+  bench->add_option("--csv", bench_options.csv, "Write one CSV row per measurement");
+  bench->add_option("--world", bench_options.world, "World to measure");
+  bench->add_option("--child", bench_child_config)->group("");  // internal: one config
+  bench->add_option("--child-robots", bench_child_robots)->group("");
+  bench->add_option("--child-threads", bench_child_threads)->group("");
+
+  CLI::App* modules = app.add_subcommand("modules", "List the registered modules");
+  CLI::App* version = app.add_subcommand("version", "Print the version");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return kExitBadInput;
+  }
+
+  ModuleRegistry registry;
+  RegisterBuiltinModules(&registry);
+
+  if (*version) {
+    std::cout << "swarmsim " << Version() << "\n";
+    return 0;
+  }
+  if (*modules) {
+    for (const ModuleInfo& m : registry.modules())
+      std::cout << m.kind << "\t" << m.name << "\t" << m.version << "\t" << m.description << "\n";
+    return 0;
+  }
+  if (*bench) {
+    bench_options.self_exe = "/proc/self/exe";
+    if (!bench_child_config.empty())
+      return RunBenchChild(bench_options, bench_child_config, bench_child_robots,
+                           bench_child_threads, std::cout);
+    return RunBench(bench_options, std::cout, std::cerr);
+  }
+
+  // run
+  LoadOptions load;
+  load.overrides = ParseSets(sets);
+  load.seed = seed;
+  load.threads = threads;
+  LoadedWorld loaded;
+  try {
+    loaded = LoadWorld(world_file, load, registry);
+  } catch (const Error& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return kExitBadInput;
+  }
+  RunOptions options;
+  if (steps >= 0) {
+    options.steps = steps;
+  } else if (duration >= 0) {
+    options.steps = static_cast<int64_t>(std::llround(duration / loaded.world->settings().time_step));
+  } else if (loaded.steps) {
+    options.steps = *loaded.steps;
+  } else {
+    std::cerr << "error: " << world_file
+              << " gives no run length; pass --steps N or --duration SECONDS\n";
+    return kExitBadInput;
+  }
+  if (!out_dir.empty()) options.out_dir = out_dir;
+  options.print_hash = hash;
+  options.quiet = quiet;
+  options.world_file = world_file;
+  for (int i = 0; i < argc; ++i) options.command_line += (i ? " " : "") + std::string(argv[i]);
+  const RunResult result = RunWorld(loaded.world.get(), options, std::cout, std::cerr);
+  if (!result.ok) {
+    std::cerr << "error: " << result.error << "\n";
+    if (options.out_dir)
+      std::cerr << "outputs up to step " << result.steps << " are in " << options.out_dir->string()
+                << "\n";
+    return kExitRunError;
+  }
+  return 0;
+}
+
+}  // namespace
+}  // namespace swarmsim
+
+int main(int argc, char** argv) {
+  try {
+    return swarmsim::Main(argc, argv);
+  } catch (const swarmsim::Error& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 1;
+  }
+}

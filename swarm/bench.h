@@ -1,0 +1,45 @@
+// `swarmsim bench`: whole-run scaling over robot counts and thread counts.
+#pragma once
+
+#include <cstdint>
+#include <iosfwd>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace swarmsim {
+
+struct BenchOptions {
+  std::string world = "worlds/diffusion.yaml";
+  std::vector<int> robots{100, 1000, 10000};
+  std::vector<int> threads{1, 2};
+  int64_t steps = 200;       // measured steps per configuration
+  int64_t warmup_steps = 20; // unmeasured steps first (wheel commands settle)
+  std::optional<std::string> csv;
+  std::string self_exe;      // this program, re-run once per configuration
+};
+
+// One measured configuration (one CSV row).
+struct BenchRow {
+  std::string config;  // "diffusion" or "box2d-only"
+  int robots = 0;
+  int threads = 0;
+  int64_t steps = 0;
+  double wall_s = 0;
+  double robot_ticks_per_s = 0;
+  double us_per_tick[5] = {0, 0, 0, 0, 0};  // sense, control, actuate, physics, record
+  double peak_rss_mb = 0;
+  double kb_per_robot = 0;
+};
+
+// Runs every configuration, each in a fresh child process (clean peak memory,
+// no cache warmed by the previous one), prints the table to `out` and writes
+// the CSV. Returns the process exit code.
+int RunBench(const BenchOptions& options, std::ostream& out, std::ostream& err);
+
+// The child side: measures one configuration in this process and prints one
+// CSV row (no header) to `out`. `config` is "diffusion" or "box2d-only".
+int RunBenchChild(const BenchOptions& options, const std::string& config, int robots,
+                  int threads, std::ostream& out);
+
+}  // namespace swarmsim

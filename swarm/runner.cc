@@ -1,0 +1,216 @@
+#include "swarm/runner.h"
+
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "framework/error.h"
+#include "framework/state_hash.h"
+#include "swarm/version.h"
+
+namespace swarmsim {
+
+double PeakRssMb() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Streams metric samples to metrics.csv in tidy (long) form, one row per
+// sample: step,time,robot,metric,value. `robot` is empty for swarm metrics.
+class MetricsWriter {
+ public:
+  MetricsWriter(const std::filesystem::path& path, const World& world) : world_(world) {
+    file_.open(path);
+    if (!file_) throw Error("cannot write '" + path.string() + "'");
+    file_ << "step,time,robot,metric,value\n";
+    file_ << std::setprecision(10);
+  }
+  void Write(const std::vector<MetricSample>& samples) {
+    for (const MetricSample& m : samples) {
+      file_ << m.step << ',' << m.time << ',';
+      if (m.instance >= 0) file_ << world_.scene().instance(m.instance).name;
+      file_ << ',' << m.name << ',' << m.value << '\n';
+    }
+  }
+  void Flush() { file_.flush(); }
+
+ private:
+  const World& world_;
+  std::ofstream file_;
+};
+
+// A progress bar on a terminal; a plain line every 10% otherwise.
+class Progress {
+ public:
+  Progress(std::ostream& os, int64_t total, bool enabled, bool tty)
+      : os_(os), total_(total), enabled_(enabled), tty_(tty), start_(Clock::now()) {}
+
+  void Update(int64_t done, double sim_time) {
+    if (!enabled_ || total_ <= 0) return;
+    const auto now = Clock::now();
+    const int decile = static_cast<int>(10 * done / total_);
+    if (tty_) {
+      if (done != total_ && now - last_ < std::chrono::milliseconds(100)) return;
+    } else if (decile == last_decile_) {
+      return;
+    }
+    last_ = now;
+    last_decile_ = decile;
+    const double wall = std::chrono::duration<double>(now - start_).count();
+    const double frac = static_cast<double>(done) / static_cast<double>(total_);
+    const double eta = done > 0 ? wall * (1 - frac) / frac : 0;
+    std::ostringstream line;
+    line << std::fixed << std::setprecision(1);
+    if (tty_) {
+      constexpr int kWidth = 30;
+      const int filled = static_cast<int>(frac * kWidth);
+      line << "\r[" << std::string(filled, '#') << std::string(kWidth - filled, ' ') << "] ";
+    }
+    line << std::setw(3) << static_cast<int>(100 * frac) << "%  step " << done << "/" << total_
+         << "  sim " << sim_time << " s  " << (wall > 0 ? sim_time / wall : 0) << "x real time"
+         << "  ETA " << eta << " s";
+    os_ << line.str() << (tty_ ? "" : "\n") << std::flush;
+  }
+  void Finish() {
+    if (enabled_ && tty_) os_ << "\n" << std::flush;
+  }
+
+ private:
+  std::ostream& os_;
+  int64_t total_;
+  bool enabled_;
+  bool tty_;
+  Clock::time_point start_;
+  Clock::time_point last_{};
+  int last_decile_ = -1;
+};
+
+std::string Fixed(double v, int digits) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(digits) << v;
+  return s.str();
+}
+
+}  // namespace
+
+RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
+                   std::ostream& progress_stream) {
+  RunResult result;
+  std::unique_ptr<MetricsWriter> metrics;
+  const auto start = Clock::now();
+  const bool tty = isatty(STDERR_FILENO) && &progress_stream == &std::cerr;
+  Progress progress(progress_stream, options.steps, !options.quiet, tty);
+  try {
+    if (options.out_dir) {
+      std::error_code ec;
+      std::filesystem::create_directories(*options.out_dir, ec);
+      if (ec)
+        throw Error("cannot create output folder '" + options.out_dir->string() +
+                    "': " + ec.message());
+      metrics = std::make_unique<MetricsWriter>(*options.out_dir / "metrics.csv", *world);
+    }
+    world->Start();
+    if (metrics) metrics->Write(world->TakeMetrics());
+    for (int64_t i = 0; i < options.steps; ++i) {
+      world->Step();
+      ++result.steps;
+      if (metrics) metrics->Write(world->TakeMetrics());
+      progress.Update(result.steps, world->time());
+    }
+    world->Stop();
+    if (metrics) metrics->Write(world->TakeMetrics());
+    result.ok = true;
+  } catch (const std::exception& e) {
+    result.error = e.what();
+    if (metrics) metrics->Write(world->TakeMetrics());  // whatever was recorded before the error
+  }
+  progress.Finish();
+  if (metrics) metrics->Flush();
+  result.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  result.state_hash = world->StateHash();
+  result.peak_rss_mb = PeakRssMb();
+
+  // The summary.
+  const int robots = world->robot_count();
+  const double sim_time = world->time();
+  const double robot_ticks = static_cast<double>(robots) * static_cast<double>(result.steps);
+  const double rtf = result.wall_seconds > 0 ? sim_time / result.wall_seconds : 0;
+  const double ticks_per_s = result.wall_seconds > 0 ? robot_ticks / result.wall_seconds : 0;
+  if (!options.quiet) {
+    out << "robots          " << robots << "\n"
+        << "steps           " << result.steps << " (time step " << world->settings().time_step
+        << " s, " << world->settings().physics_substeps << " physics substeps)\n"
+        << "simulated time  " << Fixed(sim_time, 2) << " s\n"
+        << "wall time       " << Fixed(result.wall_seconds, 3) << " s on " << world->threads()
+        << (world->threads() == 1 ? " thread\n" : " threads\n")
+        << "real-time factor " << Fixed(rtf, 1) << "x\n"
+        << "robot-ticks/s   " << Fixed(ticks_per_s, 0) << "\n"
+        << "peak memory     " << Fixed(result.peak_rss_mb, 1) << " MiB\n"
+        << "time per phase  (ms total, us per robot-tick)\n";
+    for (size_t p = 0; p < static_cast<size_t>(Phase::kCount); ++p) {
+      const double t = world->phase_times()[p];
+      out << "  " << std::left << std::setw(9) << ToString(static_cast<Phase>(p)) << std::right
+          << std::setw(10) << Fixed(1e3 * t, 1) << std::setw(10)
+          << Fixed(robot_ticks > 0 ? 1e6 * t / robot_ticks : 0, 3) << "\n";
+    }
+  }
+  if (options.print_hash) out << "state-hash: " << StateHasher::ToHex(result.state_hash) << "\n";
+  out << std::flush;
+
+  if (options.out_dir) {
+    nlohmann::json j;
+    j["swarmsim_version"] = Version();
+    j["world"] = options.world_file;
+    j["command"] = options.command_line;
+    j["status"] = result.ok ? "ok" : "error";
+    if (!result.ok) j["error"] = result.error;
+    j["seed"] = world->settings().seed;
+    j["threads"] = world->threads();
+    j["physics"] = world->settings().physics;
+    j["robots"] = robots;
+    j["steps"] = result.steps;
+    j["time_step"] = world->settings().time_step;
+    j["physics_substeps"] = world->settings().physics_substeps;
+    j["simulated_time"] = sim_time;
+    j["wall_time"] = result.wall_seconds;
+    j["real_time_factor"] = rtf;
+    j["robot_ticks_per_s"] = ticks_per_s;
+    j["peak_rss_mb"] = result.peak_rss_mb;
+    j["state_hash"] = StateHasher::ToHex(result.state_hash);
+    nlohmann::json phases;
+    for (size_t p = 0; p < static_cast<size_t>(Phase::kCount); ++p)
+      phases[ToString(static_cast<Phase>(p))] = world->phase_times()[p];
+    j["phase_seconds"] = phases;
+    nlohmann::json params;
+    for (const auto& [name, value] : world->parameters()) {
+      if (const double* d = std::get_if<double>(&value)) params[name] = *d;
+      else if (const bool* b = std::get_if<bool>(&value)) params[name] = *b;
+      else params[name] = std::get<std::string>(value);
+    }
+    j["parameters"] = params;
+    std::ofstream f(*options.out_dir / "summary.json");
+    f << j.dump(2) << "\n";
+    if (!f) {
+      if (result.ok) {
+        result.ok = false;
+        result.error = "cannot write '" + (*options.out_dir / "summary.json").string() + "'";
+      }
+    }
+  }
+  return result;
+}
+
+}  // namespace swarmsim

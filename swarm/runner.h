@@ -1,0 +1,42 @@
+// Runs a world for a number of steps: progress, summary, outputs.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <iosfwd>
+#include <optional>
+#include <string>
+
+#include "framework/world.h"
+
+namespace swarmsim {
+
+struct RunOptions {
+  int64_t steps = 0;
+  std::optional<std::filesystem::path> out_dir;  // summary.json, metrics.csv
+  bool print_hash = false;
+  bool quiet = false;      // no progress, no summary table (errors still go to stderr)
+  std::string world_file;  // for the summary
+  std::string command_line;
+};
+
+struct RunResult {
+  bool ok = false;
+  std::string error;  // the message when !ok
+  int64_t steps = 0;  // steps completed
+  double wall_seconds = 0;
+  uint64_t state_hash = 0;
+  double peak_rss_mb = 0;
+};
+
+// Steps `world` (starting it if needed), printing progress to `progress`
+// (a bar on a terminal, plain lines otherwise) and the summary to `out`.
+// Outputs are written as the run goes, so a failing run keeps everything up
+// to the failure; the summary records the error. Never throws for user errors.
+RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
+                   std::ostream& progress);
+
+// Peak resident set size of this process, in MiB.
+double PeakRssMb();
+
+}  // namespace swarmsim
