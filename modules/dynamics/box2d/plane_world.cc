@@ -1,0 +1,543 @@
+#include "modules/dynamics/box2d/plane_world.h"
+
+#include <box2d/b2_body.h>
+#include <box2d/b2_circle_shape.h>
+#include <box2d/b2_contact.h>
+#include <box2d/b2_fixture.h>
+#include <box2d/b2_friction_joint.h>
+#include <box2d/b2_polygon_shape.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "framework/error.h"
+#include "framework/scene.h"
+#include "framework/state_hash.h"
+
+namespace swarmsim::box2d {
+
+namespace {
+
+// A wheel axis counts as horizontal when its vertical component is below this
+// (about 0.06 degrees of tilt).
+constexpr double kHorizontalTolerance = 1e-3;
+// A shape whose z axis is this close to vertical is "upright".
+constexpr double kUprightTolerance = 1e-6;
+// Static shapes must reach this far into the dynamic shapes' height range to
+// be obstacles (a floor whose top touches the robots' bottom is not one), m.
+constexpr double kHeightOverlap = 1e-3;
+// Restitution applies above this approach speed, m/s (Box2D's default is
+// 1 unit/s, i.e. 0.1 m/s at the default scale; keep that whatever the scale).
+constexpr double kRestitutionThreshold = 0.1;
+// Traction passes stop when no wheel's impulse changes by more than this
+// fraction of its Coulomb limit.
+constexpr double kConverged = 1e-6;
+
+// Height range [lo, hi] of a shape at pose X_WS, m.
+struct HeightRange {
+  double lo, hi;
+};
+HeightRange CalcHeightRange(const ShapeData& shape, const Pose& X_WS) {
+  const double z = X_WS.p.z;
+  if (shape.kind == ShapeKind::kSphere) return {z - shape.size.x, z + shape.size.x};
+  // Half extents along the shape's axes; the vertical extent is the sum of
+  // their projections on world z.
+  const Vec3 half = shape.kind == ShapeKind::kBox
+                        ? shape.size * 0.5
+                        : Vec3{shape.size.x, shape.size.x, shape.size.z * 0.5};
+  const Vec3 ax = X_WS.q.Rotate({1, 0, 0}), ay = X_WS.q.Rotate({0, 1, 0}),
+             az = X_WS.q.Rotate({0, 0, 1});
+  double h;
+  if (shape.kind == ShapeKind::kBox) {
+    h = half.x * std::abs(ax.z) + half.y * std::abs(ay.z) + half.z * std::abs(az.z);
+  } else {  // cylinder: the axis part plus the disc's radius across
+    h = half.z * std::abs(az.z) + shape.size.x * std::sqrt(std::max(0.0, 1 - az.z * az.z));
+  }
+  return {z - h, z + h};
+}
+
+bool IsUpright(const Pose& X_WS) {
+  return std::abs(X_WS.q.Rotate({0, 0, 1}).z) > 1 - kUprightTolerance;
+}
+
+// Area-preserving footprint radius of a shape, m.
+double FootprintRadius(const ShapeData& shape) {
+  if (shape.kind == ShapeKind::kBox) return std::sqrt(shape.size.x * shape.size.y / M_PI);
+  return shape.size.x;
+}
+
+// Moment of inertia about the vertical axis through the centre, kg m^2.
+double CalcInertia(const ShapeData& shape) {
+  const double m = shape.mass;
+  switch (shape.kind) {
+    case ShapeKind::kBox:
+      return m * (shape.size.x * shape.size.x + shape.size.y * shape.size.y) / 12;
+    case ShapeKind::kCylinder: return 0.5 * m * shape.size.x * shape.size.x;
+    case ShapeKind::kSphere: return 0.4 * m * shape.size.x * shape.size.x;
+  }
+  return 0;
+}
+
+// A rectangle of half extents (hx, hy) units, shrunk by the polygon skin so
+// that the collision surface is the real face (when the box is big enough).
+void SetSkinnedBox(double hx, double hy, const b2Vec2& center, double angle, b2PolygonShape* out) {
+  const double r = b2_polygonRadius;
+  if (hx > 2 * r && hy > 2 * r) {
+    hx -= r;
+    hy -= r;
+  }
+  out->SetAsBox(static_cast<float>(hx), static_cast<float>(hy), center, static_cast<float>(angle));
+}
+
+std::string PathAt(const Scene& scene, uint32_t slot) { return scene.PathOf(scene.IdAt(slot)); }
+
+void ThrowIfNotFinite(const Scene& scene, uint32_t slot, const Pose& X) {
+  const double values[] = {X.p.x, X.p.y, X.p.z, X.q.w, X.q.x, X.q.y, X.q.z};
+  for (double v : values)
+    if (!std::isfinite(v))
+      throw Error("box2d: shape '" + PathAt(scene, slot) + "' has a non-finite pose");
+}
+
+}  // namespace
+
+PlaneWorld::PlaneWorld(const Options& options, const DynamicsSettings& settings)
+    : options_(options), settings_(settings), scale_(options.length_scale) {
+  if (!(scale_ > 0) || !std::isfinite(scale_))
+    throw Error("box2d: length_scale must be a positive number, got " + std::to_string(scale_));
+  // Gravity only sets ground friction here; zero makes the ground frictionless.
+  if (!(settings_.gravity >= 0) || !std::isfinite(settings_.gravity))
+    throw Error("box2d: gravity must be a non-negative number (it sets ground friction), got " +
+                std::to_string(settings_.gravity));
+}
+
+PlaneWorld::~PlaneWorld() = default;
+
+void PlaneWorld::Build(const Scene& scene) {
+  world_ = std::make_unique<b2World>(b2Vec2(0, 0));  // top-down: no gravity in the plane
+  bodies_.clear();
+  body_poses_.clear();
+  wheeled_.clear();
+  wheels_.clear();
+  const double L = scale_;
+  const double g = settings_.gravity;
+
+  b2BodyDef ground_def;
+  ground_ = world_->CreateBody(&ground_def);
+
+  const uint32_t slots = scene.slot_count();
+  auto shape_at = [&](uint32_t s) -> const ShapeData* {
+    if (!scene.alive_at(s) || scene.type_at(s) != ObjectType::kShape) return nullptr;
+    return &scene.shapes()[scene.row_at(s)];
+  };
+
+  // 1. A body per dynamic shape, in slot order.
+  std::vector<int32_t> body_of(slots, -1);            // body index of a dynamic shape (slots)
+  std::vector<double> inverse_mass, inverse_inertia;  // (bodies), Box2D units
+  double dynamic_lo = std::numeric_limits<double>::infinity();
+  double dynamic_hi = -dynamic_lo;
+  for (uint32_t s = 0; s < slots; ++s) {
+    const ShapeData* shape = shape_at(s);
+    if (!shape || !shape->dynamic) continue;
+    const Pose& X_WS = scene.world_pose_at(s);
+    ThrowIfNotFinite(scene, s, X_WS);
+    const bool box = shape->kind == ShapeKind::kBox;
+    if (!(shape->mass > 0) || !(shape->size.x > 0) || (box && !(shape->size.y > 0)) ||
+        !std::isfinite(shape->mass))
+      throw Error("box2d: dynamic shape '" + PathAt(scene, s) +
+                  "' needs a positive mass and size (mass " + std::to_string(shape->mass) +
+                  " kg, size x " + std::to_string(shape->size.x) + " m)");
+    const HeightRange range = CalcHeightRange(*shape, X_WS);
+    dynamic_lo = std::min(dynamic_lo, range.lo);
+    dynamic_hi = std::max(dynamic_hi, range.hi);
+
+    const double yaw = X_WS.q.Yaw();
+    b2BodyDef def;
+    def.type = b2_dynamicBody;
+    def.position.Set(static_cast<float>(X_WS.p.x * L), static_cast<float>(X_WS.p.y * L));
+    def.angle = static_cast<float>(yaw);
+    const Vec3& v_WS = scene.linear_velocity_at(s);
+    def.linearVelocity.Set(static_cast<float>(v_WS.x * L), static_cast<float>(v_WS.y * L));
+    def.angularVelocity = static_cast<float>(scene.angular_velocity_at(s).z);
+    b2Body* body = world_->CreateBody(&def);
+
+    // The fixture's density gives the body the shape's mass (Box2D ignores
+    // the polygon skin in its mass); the inertia is then set to the real
+    // shape's below.
+    b2FixtureDef fixture;
+    fixture.friction = static_cast<float>(shape->friction);
+    fixture.restitution = static_cast<float>(shape->restitution);
+    fixture.restitutionThreshold = static_cast<float>(kRestitutionThreshold * L);
+    b2CircleShape circle;
+    b2PolygonShape polygon;
+    if (box) {
+      SetSkinnedBox(0.5 * shape->size.x * L, 0.5 * shape->size.y * L, b2Vec2(0, 0), 0, &polygon);
+      b2MassData unit;
+      polygon.ComputeMass(&unit, 1.0f);
+      fixture.shape = &polygon;
+      fixture.density = static_cast<float>(shape->mass / unit.mass);
+    } else {
+      circle.m_radius = static_cast<float>(shape->size.x * L);
+      fixture.shape = &circle;
+      fixture.density =
+          static_cast<float>(shape->mass / (M_PI * circle.m_radius * circle.m_radius));
+    }
+    body->CreateFixture(&fixture);
+    b2MassData mass;
+    mass.mass = static_cast<float>(shape->mass);
+    mass.center.SetZero();
+    mass.I = static_cast<float>(CalcInertia(*shape) * L * L);
+    body->SetMassData(&mass);
+
+    body_of[s] = static_cast<int32_t>(bodies_.size());
+    PlaneBody plane_body;
+    plane_body.body = body;
+    plane_body.slot = s;
+    bodies_.push_back(plane_body);
+    PlaneBodyPose pose;
+    pose.z = X_WS.p.z;
+    pose.q_tilt = (Quat::FromYaw(-yaw) * X_WS.q).Normalized();
+    pose.X_WB_last = X_WS;
+    body_poses_.push_back(pose);
+    inverse_mass.push_back(1.0 / body->GetMass());
+    inverse_inertia.push_back(1.0 / body->GetInertia());
+  }
+  // Nearest dynamic ancestor of a slot (its body), or -1.
+  auto dynamic_ancestor = [&](uint32_t s) -> int32_t {
+    for (int32_t p = scene.parent_at(s); p >= 0; p = scene.parent_at(static_cast<uint32_t>(p)))
+      if (body_of[p] >= 0) return body_of[p];
+    return -1;
+  };
+
+  // 2. Obstacles: non-dynamic shapes that are not parts of a body, projected
+  // to the plane, as fixtures of the ground body.
+  for (uint32_t s = 0; s < slots && !bodies_.empty(); ++s) {
+    const ShapeData* shape = shape_at(s);
+    if (!shape || shape->dynamic || dynamic_ancestor(s) >= 0) continue;
+    const Pose& X_WS = scene.world_pose_at(s);
+    ThrowIfNotFinite(scene, s, X_WS);
+    const HeightRange range = CalcHeightRange(*shape, X_WS);
+    if (range.hi <= dynamic_lo + kHeightOverlap || range.lo >= dynamic_hi - kHeightOverlap)
+      continue;
+    b2FixtureDef fixture;
+    fixture.friction = static_cast<float>(shape->friction);
+    fixture.restitution = static_cast<float>(shape->restitution);
+    fixture.restitutionThreshold = static_cast<float>(kRestitutionThreshold * L);
+    const b2Vec2 center(static_cast<float>(X_WS.p.x * L), static_cast<float>(X_WS.p.y * L));
+    b2CircleShape circle;
+    b2PolygonShape polygon;
+    const bool round = shape->kind == ShapeKind::kSphere ||
+                       (shape->kind == ShapeKind::kCylinder && IsUpright(X_WS));
+    if (round) {
+      if (!(shape->size.x > 0)) continue;
+      circle.m_p = center;
+      circle.m_radius = static_cast<float>(shape->size.x * L);
+      fixture.shape = &circle;
+    } else {
+      // Box extents; a lying cylinder is taken as its bounding box.
+      const Vec3 size = shape->kind == ShapeKind::kBox
+                            ? shape->size
+                            : Vec3{2 * shape->size.x, 2 * shape->size.x, shape->size.z};
+      if (!(size.x > 0 && size.y > 0 && size.z >= 0)) continue;
+      if (IsUpright(X_WS)) {
+        SetSkinnedBox(0.5 * size.x * L, 0.5 * size.y * L, center, X_WS.q.Yaw(), &polygon);
+      } else {
+        // Tilted: the convex hull of the eight projected corners (no skin
+        // correction). Skip a footprint with no area (a vertical sheet seen edge on).
+        const Vec3 ax = X_WS.q.Rotate({1, 0, 0}), ay = X_WS.q.Rotate({0, 1, 0}),
+                   az = X_WS.q.Rotate({0, 0, 1});
+        const double area = size.y * size.z * std::abs(ax.z) + size.x * size.z * std::abs(ay.z) +
+                            size.x * size.y * std::abs(az.z);
+        if (area * L * L < 4 * b2_linearSlop * b2_linearSlop) continue;
+        b2Vec2 corners[8];
+        for (int i = 0; i < 8; ++i) {
+          const Vec3 p_SC{(i & 1 ? 0.5 : -0.5) * size.x, (i & 2 ? 0.5 : -0.5) * size.y,
+                          (i & 4 ? 0.5 : -0.5) * size.z};
+          const Vec3 p_WC = X_WS * p_SC;
+          corners[i].Set(static_cast<float>(p_WC.x * L), static_cast<float>(p_WC.y * L));
+        }
+        polygon.Set(corners, 8);
+      }
+      fixture.shape = &polygon;
+    }
+    ground_->CreateFixture(&fixture);
+  }
+
+  // 3. Wheels: velocity-mode revolute joints under a body, with a horizontal
+  // axis and a round child, in slot order, then grouped by body.
+  for (uint32_t s = 0; s < slots; ++s) {
+    if (!scene.alive_at(s) || scene.type_at(s) != ObjectType::kJoint) continue;
+    const JointData& joint = scene.joints()[scene.row_at(s)];
+    if (joint.type != JointType::kRevolute || joint.mode != JointMode::kVelocity) continue;
+    const int32_t b = dynamic_ancestor(s);
+    if (b < 0) continue;
+    // The first non-dynamic round child is the wheel.
+    const ShapeData* wheel_shape = nullptr;
+    for (ObjectId child : scene.children(scene.IdAt(s))) {
+      const ShapeData* shape = shape_at(child.index());
+      if (shape && !shape->dynamic && shape->kind != ShapeKind::kBox && shape->size.x > 0) {
+        wheel_shape = shape;
+        break;
+      }
+    }
+    if (!wheel_shape) continue;
+    const double radius = wheel_shape->size.x;
+    // Joint position and axis in the body's plane frame (yaw only).
+    const PlaneBody& body = bodies_[b];
+    const Pose& X_WB = scene.world_pose_at(body.slot);
+    const Pose& X_WJ = scene.world_pose_at(s);
+    const Quat q_PW = Quat::FromYaw(-X_WB.q.Yaw());
+    const Vec3 p_BJ = q_PW.Rotate(X_WJ.p - X_WB.p);
+    const Vec3 axis = q_PW.Rotate(X_WJ.q.Rotate({0, 0, 1}));
+    if (std::abs(axis.z) > kHorizontalTolerance) continue;
+    const Vec3 forward = axis.Cross({0, 0, 1}).Normalized();  // (a_y, -a_x, 0)
+    PlaneWheel wheel;
+    wheel.body = static_cast<uint32_t>(b);
+    wheel.joint_slot = s;
+    wheel.p_x = p_BJ.x * L;
+    wheel.p_y = p_BJ.y * L;
+    wheel.f_x = forward.x;
+    wheel.f_y = forward.y;
+    wheel.radius_m = radius;
+    wheel.coulomb_rate = wheel_shape->friction;  // times m g / n below
+    wheel.motor_rate = std::max(0.0, joint.max_force) / radius * L;
+    // Inverse effective mass at the contact point: K = [m^-1 + I^-1 py^2, -I^-1 px py;
+    // -I^-1 px py, m^-1 + I^-1 px^2], inverted.
+    const double im = inverse_mass[b], ii = inverse_inertia[b];
+    const double k11 = im + ii * wheel.p_y * wheel.p_y, k22 = im + ii * wheel.p_x * wheel.p_x;
+    const double k12 = -ii * wheel.p_x * wheel.p_y;
+    const double det = k11 * k22 - k12 * k12;
+    wheel.k_xx = k22 / det;
+    wheel.k_xy = -k12 / det;
+    wheel.k_yy = k11 / det;
+    wheels_.push_back(wheel);
+  }
+  std::stable_sort(wheels_.begin(), wheels_.end(),
+                   [](const PlaneWheel& a, const PlaneWheel& b) { return a.body < b.body; });
+  for (uint32_t w = 0; w < wheels_.size(); ++w) {
+    PlaneBody& body = bodies_[wheels_[w].body];
+    if (body.wheel_count == 0) body.first_wheel = w;
+    ++body.wheel_count;
+  }
+  for (uint32_t b = 0; b < bodies_.size(); ++b) {
+    PlaneBody& body = bodies_[b];
+    const ShapeData& shape = scene.shapes()[scene.row_at(body.slot)];
+    if (body.wheel_count > 0) {
+      // Each wheel carries an equal share of the weight.
+      wheeled_.push_back(b);
+      const double load = shape.mass * g / body.wheel_count;
+      for (uint32_t w = body.first_wheel; w < body.first_wheel + body.wheel_count; ++w)
+        wheels_[w].coulomb_rate *= load * L;
+      continue;
+    }
+    // 4. No wheels: Coulomb friction with the ground (a disc of uniform
+    // pressure resists turning with 2/3 mu m g r).
+    b2FrictionJointDef def;
+    def.Initialize(ground_, body.body, body.body->GetWorldCenter());
+    const double force = shape.friction * shape.mass * g;
+    def.maxForce = static_cast<float>(force * L);
+    def.maxTorque = static_cast<float>(2.0 / 3.0 * force * FootprintRadius(shape) * L * L);
+    world_->CreateJoint(&def);
+  }
+}
+
+void PlaneWorld::SyncTeleports(const Scene& scene) {
+  const double L = scale_;
+  for (size_t b = 0; b < bodies_.size(); ++b) {
+    PlaneBodyPose& pose = body_poses_[b];
+    const Pose& X_WB = scene.world_pose_at(bodies_[b].slot);
+    if (X_WB == pose.X_WB_last) continue;
+    const double yaw = X_WB.q.Yaw();
+    b2Body* body = bodies_[b].body;
+    body->SetTransform(b2Vec2(static_cast<float>(X_WB.p.x * L), static_cast<float>(X_WB.p.y * L)),
+                       static_cast<float>(yaw));
+    body->SetAwake(true);
+    bodies_[b].dv_x = bodies_[b].dv_y = bodies_[b].dw = 0;
+    pose.z = X_WB.p.z;
+    pose.q_tilt = (Quat::FromYaw(-yaw) * X_WB.q).Normalized();
+    pose.X_WB_last = X_WB;
+  }
+}
+
+void PlaneWorld::ReadWheelCommands(const Scene& scene) {
+  for (uint32_t b : wheeled_) bodies_[b].commanded = false;
+  for (PlaneWheel& wheel : wheels_) {
+    const JointData& joint = scene.joints()[scene.row_at(wheel.joint_slot)];
+    const double target = joint.mode == JointMode::kVelocity ? joint.target_velocity : 0.0;
+    wheel.surface_speed = target * wheel.radius_m * scale_;
+    if (target != 0) bodies_[wheel.body].commanded = true;
+  }
+}
+
+namespace {
+
+// Projected Gauss-Seidel over one body's wheels. (vx, vy, w) is the body
+// velocity in its plane frame and (dx, dy, dw) what contacts changed it by
+// in the last step, Box2D units. Each wheel gets the impulse that makes its
+// contact point move at the desired velocity, its accumulated impulse
+// clamped to its Coulomb circle and then to its motor limit along forward.
+// Leaves the impulses in wheel->acc_*.
+//
+// The contact change, projected on the wheel's forward direction, counts as
+// velocity the wheel must make up (a warm start): without it a robot pushing
+// an object lags one step of contact impulse behind its command. Only the
+// forward part: sideways, the same feedback would keep adding a wall's
+// push-back to the error and leave a saturated wheel no grip to slide along
+// the wall with.
+void SolveWheels(PlaneWheel* first, PlaneWheel* last, double im, double ii, double dt, int passes,
+                 double vx, double vy, double w, double dx, double dy, double dw) {
+  for (PlaneWheel* wheel = first; wheel != last; ++wheel) {
+    wheel->acc_x = wheel->acc_y = 0;
+    const double cx = dx - dw * wheel->p_y, cy = dy + dw * wheel->p_x;
+    wheel->lag = cx * wheel->f_x + cy * wheel->f_y;
+  }
+  for (int pass = 0; pass < passes; ++pass) {
+    bool converged = true;
+    for (PlaneWheel* wheel = first; wheel != last; ++wheel) {
+      // Velocity error at the contact point: desired (forward at the surface
+      // speed, nothing sideways) minus actual and the predicted lag.
+      const double forward = wheel->surface_speed - wheel->lag;
+      const double ex = forward * wheel->f_x - (vx - w * wheel->p_y);
+      const double ey = forward * wheel->f_y - (vy + w * wheel->p_x);
+      const double old_x = wheel->acc_x, old_y = wheel->acc_y;
+      double ax = old_x + wheel->k_xx * ex + wheel->k_xy * ey;
+      double ay = old_y + wheel->k_xy * ex + wheel->k_yy * ey;
+      // Coulomb limit on the whole, then the motor limit on the forward part.
+      const double limit = wheel->coulomb_rate * dt;
+      const double norm2 = ax * ax + ay * ay;
+      if (norm2 > limit * limit) {
+        const double k = limit / std::sqrt(norm2);
+        ax *= k;
+        ay *= k;
+      }
+      const double motor = wheel->motor_rate * dt;
+      const double along = ax * wheel->f_x + ay * wheel->f_y;
+      const double excess = along > motor ? along - motor : (along < -motor ? along + motor : 0);
+      ax -= excess * wheel->f_x;
+      ay -= excess * wheel->f_y;
+      wheel->acc_x = ax;
+      wheel->acc_y = ay;
+      const double ix = ax - old_x, iy = ay - old_y;
+      vx += im * ix;
+      vy += im * iy;
+      w += ii * (wheel->p_x * iy - wheel->p_y * ix);
+      if (std::abs(ix) + std::abs(iy) > kConverged * limit) converged = false;
+    }
+    // A robot driving freely at its command needs one pass.
+    if (converged) break;
+  }
+}
+
+}  // namespace
+
+void PlaneWorld::ApplyTraction(double dt) {
+  const int passes = std::max(1, options_.traction_iterations);
+  for (uint32_t b : wheeled_) {
+    PlaneBody& plane_body = bodies_[b];
+    b2Body* body = plane_body.body;
+    // A commanded robot stays awake; an idle one at rest may sleep.
+    if (plane_body.commanded) {
+      body->SetAwake(true);
+    } else if (!body->IsAwake()) {
+      plane_body.v_traction.SetZero();  // asleep: at rest
+      plane_body.w_traction = 0;
+      plane_body.dv_x = plane_body.dv_y = plane_body.dw = 0;
+      continue;
+    }
+    const double im = body->GetMass() > 0 ? 1.0 / body->GetMass() : 0.0;
+    const double ii = body->GetInertia() > 0 ? 1.0 / body->GetInertia() : 0.0;
+    const b2Rot& rot = body->GetTransform().q;
+    const double c = rot.c, s = rot.s;
+    PlaneWheel* const first = wheels_.data() + plane_body.first_wheel;
+    PlaneWheel* const last = first + plane_body.wheel_count;
+    // Velocity and last step's contact change, in the body's plane frame.
+    const b2Vec2& v = body->GetLinearVelocity();
+    const double dv_x = plane_body.dv_x, dv_y = plane_body.dv_y;
+    SolveWheels(first, last, im, ii, dt, passes, c * v.x + s * v.y, -s * v.x + c * v.y,
+                body->GetAngularVelocity(), c * dv_x + s * dv_y, -s * dv_x + c * dv_y,
+                plane_body.dw);
+    // Apply the total to the body, in the world frame.
+    double px = 0, py = 0, angular = 0;
+    for (const PlaneWheel* wheel = first; wheel != last; ++wheel) {
+      px += wheel->acc_x;
+      py += wheel->acc_y;
+      angular += wheel->p_x * wheel->acc_y - wheel->p_y * wheel->acc_x;
+    }
+    if (px != 0 || py != 0 || angular != 0) {
+      body->ApplyLinearImpulseToCenter(
+          b2Vec2(static_cast<float>(c * px - s * py), static_cast<float>(s * px + c * py)), false);
+      body->ApplyAngularImpulse(static_cast<float>(angular), false);
+    }
+    plane_body.v_traction = body->GetLinearVelocity();
+    plane_body.w_traction = body->GetAngularVelocity();
+  }
+}
+
+void PlaneWorld::Substep(double dt) {
+  ApplyTraction(dt);
+  world_->Step(static_cast<float>(dt), options_.velocity_iterations, options_.position_iterations);
+  // What the step (contacts) did to each wheeled body's velocity.
+  for (uint32_t b : wheeled_) {
+    PlaneBody& plane_body = bodies_[b];
+    const b2Body* body = plane_body.body;
+    if (!body->IsAwake()) {
+      plane_body.dv_x = plane_body.dv_y = plane_body.dw = 0;
+      continue;
+    }
+    const b2Vec2& v = body->GetLinearVelocity();
+    plane_body.dv_x = v.x - plane_body.v_traction.x;
+    plane_body.dv_y = v.y - plane_body.v_traction.y;
+    plane_body.dw = body->GetAngularVelocity() - plane_body.w_traction;
+  }
+}
+
+void PlaneWorld::WriteBack(Scene* scene) {
+  const double inv_L = 1.0 / scale_;
+  for (size_t b = 0; b < bodies_.size(); ++b) {
+    const b2Body* body = bodies_[b].body;
+    PlaneBodyPose& pose = body_poses_[b];
+    const b2Transform& X = body->GetTransform();
+    const double yaw = std::atan2(static_cast<double>(X.q.s), static_cast<double>(X.q.c));
+    Pose X_WB;
+    X_WB.p = {X.p.x * inv_L, X.p.y * inv_L, pose.z};
+    X_WB.q = Quat::FromYaw(yaw) * pose.q_tilt;
+    const b2Vec2& v = body->GetLinearVelocity();
+    scene->SetSimulatedState(bodies_[b].slot, X_WB, {v.x * inv_L, v.y * inv_L, 0},
+                             {0, 0, body->GetAngularVelocity()});
+    pose.X_WB_last = X_WB;
+  }
+}
+
+void PlaneWorld::Hash(StateHasher* hasher) const {
+  // Bodies: float state (unwrapped angle included) and sleep state.
+  for (const PlaneBody& plane_body : bodies_) {
+    const b2Body* body = plane_body.body;
+    hasher->AddValue(body->GetPosition().x);
+    hasher->AddValue(body->GetPosition().y);
+    hasher->AddValue(body->GetAngle());
+    hasher->AddValue(body->GetLinearVelocity().x);
+    hasher->AddValue(body->GetLinearVelocity().y);
+    hasher->AddValue(body->GetAngularVelocity());
+    hasher->AddValue(static_cast<uint8_t>(body->IsAwake()));
+  }
+  // Contacts: the warm-start impulses.
+  for (const b2Contact* contact = world_->GetContactList(); contact; contact = contact->GetNext()) {
+    const b2Manifold* manifold = contact->GetManifold();
+    hasher->AddValue(static_cast<uint8_t>(contact->IsTouching()));
+    hasher->AddValue(manifold->pointCount);
+    for (int i = 0; i < manifold->pointCount; ++i) {
+      hasher->AddValue(manifold->points[i].normalImpulse);
+      hasher->AddValue(manifold->points[i].tangentImpulse);
+    }
+  }
+  // Ground friction joints: their warm-start impulses.
+  for (const b2Joint* joint = world_->GetJointList(); joint; joint = joint->GetNext()) {
+    const b2Vec2 force = joint->GetReactionForce(1.0f);
+    hasher->AddValue(force.x);
+    hasher->AddValue(force.y);
+    hasher->AddValue(joint->GetReactionTorque(1.0f));
+  }
+}
+
+}  // namespace swarmsim::box2d

@@ -1,0 +1,105 @@
+// The Box2D world behind the box2d backend: the scene projected to the plane,
+// plus the wheel traction model. Shared by the backend and TimeBareLoop so
+// that both do the same physics work. Internal: Box2D types stay in this
+// folder (see box2d_backend.h for the model and the units).
+#pragma once
+
+#include <box2d/b2_world.h>
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "framework/dynamics_backend.h"
+#include "framework/math.h"
+#include "modules/dynamics/box2d/box2d_backend.h"
+
+namespace swarmsim {
+class Scene;
+class StateHasher;
+}  // namespace swarmsim
+
+namespace swarmsim::box2d {
+
+// One simulated body: a dynamic shape.
+struct PlaneBody {  // 64 bytes
+  b2Body* body = nullptr;
+  uint32_t slot = 0;         // scene slot of the dynamic shape
+  uint32_t first_wheel = 0;  // wheels_[first_wheel, first_wheel + wheel_count)
+  uint32_t wheel_count = 0;
+  bool commanded = false;  // some wheel has a nonzero command this step
+  // Wheeled bodies: velocity after the traction impulses, and the change the
+  // Box2D step (contacts) made to it, world frame, Box2D units. The next
+  // traction solve aims at the velocity *after* that change (a warm start), so
+  // a robot pushing an object keeps its speed instead of lagging one step's
+  // contact impulse behind.
+  b2Vec2 v_traction{0, 0};
+  float w_traction = 0;
+  float dv_x = 0, dv_y = 0, dw = 0;
+};
+
+// What the scene does not hold about a body: the part of its pose the plane
+// does not simulate, and the pose last written (to notice teleports).
+struct PlaneBodyPose {  // 96 bytes
+  double z = 0;         // m, kept
+  Quat q_tilt;          // roll and pitch, kept: q_WB = FromYaw(yaw) * q_tilt
+  Pose X_WB_last;       // pose last written to (or read from) the scene
+};
+
+// A wheel driving a body; everything in Box2D units and the body's plane
+// frame (origin at the body's centre, x along its heading).
+struct PlaneWheel {                     // 120 bytes
+  uint32_t body = 0;                    // index into bodies
+  uint32_t joint_slot = 0;              // scene slot of the revolute joint
+  double p_x = 0, p_y = 0;              // contact point
+  double f_x = 0, f_y = 0;              // unit forward direction (axis x up)
+  double k_xx = 0, k_xy = 0, k_yy = 0;  // inverse of the 2x2 effective mass at p
+  double radius_m = 0;                  // wheel radius, m
+  double coulomb_rate = 0;              // mu m g / n_wheels (impulse per second)
+  double motor_rate = 0;                // max_force / R (impulse per second)
+  double surface_speed = 0;             // command: target_velocity * R, units/s
+  double lag = 0;                       // contact velocity change along forward, last step
+  double acc_x = 0, acc_y = 0;          // impulse accumulated in the current substep
+};
+
+class PlaneWorld {
+ public:
+  PlaneWorld(const Options& options, const DynamicsSettings& settings);
+  ~PlaneWorld();
+  PlaneWorld(const PlaneWorld&) = delete;
+  PlaneWorld& operator=(const PlaneWorld&) = delete;
+
+  // Builds bodies, ground fixtures, wheels and ground friction from the scene
+  // (discarding any previous world). Body velocities come from the scene.
+  void Build(const Scene& scene);
+  // Moves bodies whose scene pose differs from the last one written (set from
+  // outside since the last step).
+  void SyncTeleports(const Scene& scene);
+  // Reads each wheel's target velocity from its joint.
+  void ReadWheelCommands(const Scene& scene);
+  // One Box2D step of dt seconds: traction impulses, b2World::Step, then the
+  // contact-made velocity change of each wheeled body.
+  void Substep(double dt);
+  // Writes body poses and velocities. Wheel joint positions are not written:
+  // World::Actuate already advances every velocity-mode joint kinematically.
+  void WriteBack(Scene* scene);
+  void Hash(StateHasher* hasher) const;
+
+  int body_count() const { return static_cast<int>(bodies_.size()); }
+  int wheel_count() const { return static_cast<int>(wheels_.size()); }
+
+ private:
+  void ApplyTraction(double dt);
+
+  Options options_;
+  DynamicsSettings settings_;
+  double scale_;  // Box2D units per metre
+  std::unique_ptr<b2World> world_;
+  b2Body* ground_ = nullptr;
+  std::vector<PlaneBody> bodies_;          // (bodies), slot order
+  std::vector<PlaneBodyPose> body_poses_;  // (bodies)
+  std::vector<uint32_t> wheeled_;          // bodies with wheels, ascending
+  std::vector<PlaneWheel> wheels_;         // (wheels), grouped by body
+};
+
+}  // namespace swarmsim::box2d
