@@ -3,6 +3,7 @@
 // perhaps reused) has a stale generation and is rejected by every API entry.
 #pragma once
 
+#include <compare>
 #include <cstdint>
 
 namespace swarmsim {

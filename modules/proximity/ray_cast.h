@@ -1,0 +1,56 @@
+// Exact ray-primitive tests and the small geometric helpers the proximity
+// module builds its indexes with. No OctoMap here: this file is testable on
+// its own.
+//
+// Conventions. A ray is an origin, a unit direction and a length; a hit is
+// the smallest t in [0, length] at which the ray is in the (closed) solid.
+// A ray that starts inside or on a solid therefore hits it at t = 0: a sensor
+// pushed into a wall reads "detected, distance 0" rather than seeing out of it.
+#pragma once
+
+#include <compare>  // framework/handle.h uses operator<=> without including <compare>
+#include <cstdint>
+
+#include "framework/handle.h"
+#include "framework/math.h"
+#include "framework/scene.h"
+
+namespace swarmsim::proximity {
+
+// Ray tests in the primitive's own frame (centred, cylinder axis = z).
+// Each returns true and sets *t (0 <= *t <= max_t) for the nearest hit.
+bool RayBox(const Vec3& o, const Vec3& d, const Vec3& half_size, double max_t, double* t);
+bool RayCylinder(const Vec3& o, const Vec3& d, double radius, double half_height, double max_t,
+                 double* t);
+bool RaySphere(const Vec3& o, const Vec3& d, double radius, double max_t, double* t);
+
+// A shape frozen at a world pose, ready for ray tests.
+struct PlacedShape {  // 104 bytes
+  Pose X_WS;          // pose of the shape in the world
+  Pose X_SW;          // its inverse, for taking rays into the shape frame
+  Vec3 half_size;  // box: half extents; cylinder: (radius, radius, half height); sphere: (r, r, r)
+  ObjectId id;     // the shape's object
+  int32_t instance;  // model instance (robot) or -1
+  ShapeKind kind;
+};
+
+PlacedShape PlaceShape(const ShapeData& shape, const Pose& X_WS, ObjectId id, int instance);
+
+// The nearest hit of the world ray (p_W, unit d_W, length max_t) on the shape.
+bool RayCast(const PlacedShape& shape, const Vec3& p_W, const Vec3& d_W, double max_t, double* t);
+
+// World axis-aligned bounding box of the shape.
+void WorldBounds(const PlacedShape& shape, Vec3* lo, Vec3* hi);
+
+// Radius about the shape origin's (x, y) that contains the shape's footprint
+// in the world xy plane. ShapeData::BoundingRadius when the shape stands
+// upright; the 3D bounding-sphere radius when it is tilted.
+double WorldFootprintRadius(const ShapeData& shape, const Pose& X_WS);
+
+// Conservative overlap: false only if the shape, grown by `margin`, misses
+// the axis-aligned cube (centre, half edge `half`). Exact for boxes and
+// spheres; for cylinders, the cube must touch both the cylinder's bounding
+// box and a capsule around its axis.
+bool MayOverlapCube(const PlacedShape& shape, const Vec3& centre, double half, double margin);
+
+}  // namespace swarmsim::proximity

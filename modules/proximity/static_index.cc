@@ -1,0 +1,303 @@
+#include "modules/proximity/static_index.h"
+
+#include <octomap/OcTree.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "framework/error.h"
+#include "framework/scene.h"
+
+namespace swarmsim::proximity {
+namespace {
+
+constexpr int kKeyOffset = 32768;  // octomap's tree_max_val for a depth-16 tree
+constexpr int kMaxKey = 65535;
+constexpr int kBucketShift = 2;   // a bucket is 4x4x4 voxels
+constexpr int kTreeSize = 65536;  // keys per axis
+constexpr int kTreeDepth = 16;
+constexpr double kMaxVoxelTests = 2e8;  // guards Build against absurd resolutions
+constexpr int kTestedCapacity = 16;     // shapes remembered per ray to avoid retesting
+
+uint64_t PackBucket(int bx, int by, int bz) {
+  return (static_cast<uint64_t>(bx) << 32) | (static_cast<uint64_t>(by) << 16) |
+         static_cast<uint64_t>(bz);
+}
+
+double Axis(const Vec3& v, int i) { return i == 0 ? v.x : i == 1 ? v.y : v.z; }
+
+// Intersects [*t_lo, *t_hi] with the t where lo <= o + t d <= hi.
+bool ClipSlab(double o, double d, double lo, double hi, double* t_lo, double* t_hi) {
+  if (d == 0) return o >= lo && o <= hi;
+  double t1 = (lo - o) / d, t2 = (hi - o) / d;
+  if (t1 > t2) std::swap(t1, t2);
+  *t_lo = std::max(*t_lo, t1);
+  *t_hi = std::min(*t_hi, t2);
+  return *t_lo <= *t_hi;
+}
+
+}  // namespace
+
+StaticIndex::StaticIndex() = default;
+StaticIndex::~StaticIndex() = default;
+
+double StaticIndex::RawKey(double coordinate) const {
+  return std::floor(coordinate * inv_resolution_) + kKeyOffset;
+}
+
+size_t StaticIndex::octree_node_count() const { return tree_ ? tree_->size() : 0; }
+
+void StaticIndex::Build(const Scene& scene, double resolution) {
+  if (!(resolution > 0) || !std::isfinite(resolution)) {
+    std::ostringstream m;
+    m << "proximity: octree_resolution must be a positive number of metres, got " << resolution;
+    throw Error(m.str());
+  }
+  resolution_ = resolution;
+  inv_resolution_ = 1 / resolution;
+  tree_ = std::make_unique<octomap::OcTree>(resolution);
+  shapes_.clear();
+  buckets_.clear();
+  bucket_shapes_.clear();
+
+  // The static shapes, in slot order (independent of table history).
+  const auto shape_rows = scene.shapes();
+  const auto owners = scene.shape_owners();
+  for (size_t r = 0; r < shape_rows.size(); ++r) {
+    const uint32_t slot = owners[r];
+    if (!scene.alive_at(slot) || scene.instance_of_at(slot) >= 0 || shape_rows[r].dynamic) continue;
+    shapes_.push_back(PlaceShape(shape_rows[r], scene.world_pose_at(slot), scene.IdAt(slot), -1));
+  }
+  std::sort(shapes_.begin(), shapes_.end(),
+            [](const PlacedShape& a, const PlacedShape& b) { return a.id.index1 < b.id.index1; });
+
+  // Mark the voxels each shape may overlap; remember the buckets it touches.
+  const float occupied = tree_->getClampingThresMaxLog();
+  const double margin = resolution * 1e-6;  // grows shapes a hair: robust on voxel faces
+  const double half = resolution / 2;
+  std::vector<std::pair<uint64_t, uint32_t>> touches;  // (bucket, shape)
+  for (int i = 0; i < 3; ++i) occupied_keys_.lo[i] = kMaxKey, occupied_keys_.hi[i] = 0;
+  double voxel_tests = 0;
+  for (uint32_t s = 0; s < shapes_.size(); ++s) {
+    const PlacedShape& shape = shapes_[s];
+    Vec3 lo, hi;
+    WorldBounds(shape, &lo, &hi);
+    double klo[3], khi[3];
+    for (int i = 0; i < 3; ++i) {
+      klo[i] = RawKey(Axis(lo, i) - margin);
+      khi[i] = RawKey(Axis(hi, i) + margin);
+    }
+    const double reach = kKeyOffset * resolution;
+    for (int i = 0; i < 3; ++i)
+      if (!(klo[i] >= 0 && khi[i] <= kMaxKey)) {
+        std::ostringstream m;
+        m << "proximity: static shape '" << scene.PathOf(shape.id)
+          << "' lies outside the octree's reach (|x|, |y|, |z| < " << reach
+          << " m at octree_resolution " << resolution
+          << " m), or has a non-finite pose or size; move it or use a coarser resolution";
+        throw Error(m.str());
+      }
+    voxel_tests += (khi[0] - klo[0] + 1) * (khi[1] - klo[1] + 1) * (khi[2] - klo[2] + 1);
+    if (voxel_tests > kMaxVoxelTests) {
+      std::ostringstream m;
+      m << "proximity: the static environment spans more than " << kMaxVoxelTests
+        << " voxels at octree_resolution " << resolution << " m (at shape '"
+        << scene.PathOf(shape.id) << "'); use a coarser resolution";
+      throw Error(m.str());
+    }
+    int k0[3], k1[3];
+    for (int i = 0; i < 3; ++i) k0[i] = static_cast<int>(klo[i]), k1[i] = static_cast<int>(khi[i]);
+    for (int bx = k0[0] >> kBucketShift; bx <= k1[0] >> kBucketShift; ++bx)
+      for (int by = k0[1] >> kBucketShift; by <= k1[1] >> kBucketShift; ++by)
+        for (int bz = k0[2] >> kBucketShift; bz <= k1[2] >> kBucketShift; ++bz) {
+          bool touched = false;
+          const int b[3] = {bx, by, bz};
+          int v0[3], v1[3];
+          for (int i = 0; i < 3; ++i) {
+            v0[i] = std::max(b[i] << kBucketShift, k0[i]);
+            v1[i] = std::min((b[i] << kBucketShift) + (1 << kBucketShift) - 1, k1[i]);
+          }
+          for (int x = v0[0]; x <= v1[0]; ++x)
+            for (int y = v0[1]; y <= v1[1]; ++y)
+              for (int z = v0[2]; z <= v1[2]; ++z) {
+                const Vec3 centre{(x - kKeyOffset + 0.5) * resolution,
+                                  (y - kKeyOffset + 0.5) * resolution,
+                                  (z - kKeyOffset + 0.5) * resolution};
+                if (!MayOverlapCube(shape, centre, half, margin)) continue;
+                tree_->setNodeValue(octomap::OcTreeKey(x, y, z), occupied, /*lazy_eval=*/true);
+                touched = true;
+                const int k[3] = {x, y, z};
+                for (int i = 0; i < 3; ++i) {
+                  occupied_keys_.lo[i] = std::min(occupied_keys_.lo[i], k[i]);
+                  occupied_keys_.hi[i] = std::max(occupied_keys_.hi[i], k[i]);
+                }
+              }
+          if (touched) touches.emplace_back(PackBucket(bx, by, bz), s);
+        }
+  }
+  tree_->updateInnerOccupancy();
+  tree_->prune();
+
+  // Bucket -> shapes, as ranges of one flat array.
+  std::sort(touches.begin(), touches.end());
+  touches.erase(std::unique(touches.begin(), touches.end()), touches.end());
+  bucket_shapes_.reserve(touches.size());
+  buckets_.reserve(touches.size());
+  for (size_t e = 0; e < touches.size();) {
+    const uint64_t bucket = touches[e].first;
+    const uint32_t begin = static_cast<uint32_t>(bucket_shapes_.size());
+    for (; e < touches.size() && touches[e].first == bucket; ++e)
+      bucket_shapes_.push_back(touches[e].second);
+    buckets_.emplace(bucket, std::make_pair(begin, static_cast<uint32_t>(bucket_shapes_.size())));
+  }
+
+  occupied_lo_ = {(occupied_keys_.lo[0] - kKeyOffset) * resolution,
+                  (occupied_keys_.lo[1] - kKeyOffset) * resolution,
+                  (occupied_keys_.lo[2] - kKeyOffset) * resolution};
+  occupied_hi_ = {(occupied_keys_.hi[0] + 1 - kKeyOffset) * resolution,
+                  (occupied_keys_.hi[1] + 1 - kKeyOffset) * resolution,
+                  (occupied_keys_.hi[2] + 1 - kKeyOffset) * resolution};
+}
+
+bool StaticIndex::AnyOccupiedIn(const octomap::OcTreeNode* node, const int origin[3], int size,
+                                const KeyBox& box) const {
+  if (!tree_->isNodeOccupied(node)) return false;
+  if (!tree_->nodeHasChildren(node)) return true;  // a voxel, or a pruned occupied block
+  const int half = size / 2;
+  for (unsigned int c = 0; c < 8; ++c) {
+    if (!tree_->nodeChildExists(node, c)) continue;
+    const int child[3] = {origin[0] + ((c & 1) ? half : 0), origin[1] + ((c & 2) ? half : 0),
+                          origin[2] + ((c & 4) ? half : 0)};
+    bool overlaps = true;
+    for (int i = 0; i < 3; ++i)
+      overlaps = overlaps && child[i] <= box.hi[i] && child[i] + half - 1 >= box.lo[i];
+    if (overlaps && AnyOccupiedIn(tree_->getNodeChild(node, c), child, half, box)) return true;
+  }
+  return false;
+}
+
+bool StaticIndex::AnyOccupied(const Vec3& lo, const Vec3& hi) const {
+  if (shapes_.empty() || tree_->getRoot() == nullptr) return false;
+  KeyBox box;
+  for (int i = 0; i < 3; ++i) {
+    // (Written so that NaN bounds answer "no".)
+    if (!(Axis(lo, i) <= Axis(occupied_hi_, i) && Axis(hi, i) >= Axis(occupied_lo_, i)))
+      return false;
+    box.lo[i] = static_cast<int>(std::max(RawKey(Axis(lo, i)), double(occupied_keys_.lo[i])));
+    box.hi[i] = static_cast<int>(std::min(RawKey(Axis(hi, i)), double(occupied_keys_.hi[i])));
+  }
+  const int origin[3] = {0, 0, 0};
+  return AnyOccupiedIn(tree_->getRoot(), origin, kTreeSize, box);
+}
+
+const octomap::OcTreeNode* StaticIndex::Descend(const octomap::OcTreeNode* node, int bit,
+                                                const int key[3]) const {
+  for (; bit >= 0; --bit) {
+    const unsigned int child =
+        ((key[0] >> bit) & 1) | (((key[1] >> bit) & 1) << 1) | (((key[2] >> bit) & 1) << 2);
+    if (!tree_->nodeChildExists(node, child)) return tree_->nodeHasChildren(node) ? nullptr : node;
+    node = tree_->getNodeChild(node, child);
+  }
+  return node;
+}
+
+const octomap::OcTreeNode* StaticIndex::CommonAncestor(const int lo[3], const int hi[3],
+                                                       int* bit) const {
+  const octomap::OcTreeNode* node = tree_->getRoot();
+  if (node == nullptr) return nullptr;
+  // Keys of the box agree on every bit above the highest differing one.
+  const unsigned int differ = (lo[0] ^ hi[0]) | (lo[1] ^ hi[1]) | (lo[2] ^ hi[2]);
+  const int free_bits = differ == 0 ? 0 : 32 - __builtin_clz(differ);
+  for (*bit = kTreeDepth - 1; *bit >= free_bits; --*bit) {
+    const unsigned int child =
+        ((lo[0] >> *bit) & 1) | (((lo[1] >> *bit) & 1) << 1) | (((lo[2] >> *bit) & 1) << 2);
+    if (!tree_->nodeChildExists(node, child))
+      return tree_->nodeHasChildren(node) ? nullptr : node;  // empty, or a pruned full block
+    node = tree_->getNodeChild(node, child);
+  }
+  return node;
+}
+
+bool StaticIndex::CastRay(const Vec3& p_W, const Vec3& d_W, double max_t,
+                          std::span<const ObjectId> skip, double* t, uint32_t* shape) const {
+  if (shapes_.empty()) return false;
+  // Clip the ray to the box of occupied voxels.
+  double t0 = 0, t1 = max_t;
+  for (int i = 0; i < 3; ++i)
+    if (!ClipSlab(Axis(p_W, i), Axis(d_W, i), Axis(occupied_lo_, i), Axis(occupied_hi_, i), &t0,
+                  &t1))
+      return false;
+  if (!(t0 <= t1)) return false;
+
+  // Key box of the clipped segment, one voxel wider for rounding.
+  const double p[3] = {p_W.x, p_W.y, p_W.z}, d[3] = {d_W.x, d_W.y, d_W.z};
+  int box_lo[3], box_hi[3];
+  for (int i = 0; i < 3; ++i) {
+    const double lo = double(occupied_keys_.lo[i]), hi = double(occupied_keys_.hi[i]);
+    const double a = std::clamp(RawKey(p[i] + d[i] * t0), lo, hi);
+    const double b = std::clamp(RawKey(p[i] + d[i] * t1), lo, hi);
+    box_lo[i] = std::max(static_cast<int>(std::min(a, b)) - 1, 0);
+    box_hi[i] = std::min(static_cast<int>(std::max(a, b)) + 1, kMaxKey);
+  }
+  // The deepest octree node holding that box; none means no occupied voxel on the ray.
+  int bit;
+  const octomap::OcTreeNode* top = CommonAncestor(box_lo, box_hi, &bit);
+  if (top == nullptr) return false;
+
+  // 3D DDA (Amanatides & Woo) over voxel keys, from the clipped entry point.
+  int key[3], step[3];
+  double t_max[3], t_delta[3];
+  for (int i = 0; i < 3; ++i) {
+    const double entry = RawKey(p[i] + d[i] * t0);
+    key[i] = static_cast<int>(
+        std::clamp(entry, double(occupied_keys_.lo[i]), double(occupied_keys_.hi[i])));
+    step[i] = d[i] > 0 ? 1 : d[i] < 0 ? -1 : 0;
+    if (step[i] == 0) {
+      t_max[i] = t_delta[i] = std::numeric_limits<double>::infinity();
+      continue;
+    }
+    const double face = (key[i] + (step[i] > 0 ? 1 : 0) - kKeyOffset) * resolution_;
+    t_max[i] = (face - p[i]) / d[i];
+    t_delta[i] = resolution_ / std::abs(d[i]);
+  }
+
+  double best = std::numeric_limits<double>::infinity();
+  uint32_t best_shape = 0;
+  uint32_t tested[kTestedCapacity];
+  int tested_count = 0;
+  for (;;) {
+    // An occupied voxel: test its bucket's shapes exactly (once per ray).
+    const octomap::OcTreeNode* node = Descend(top, bit, key);
+    if (node != nullptr && tree_->isNodeOccupied(node)) {
+      const auto it = buckets_.find(
+          PackBucket(key[0] >> kBucketShift, key[1] >> kBucketShift, key[2] >> kBucketShift));
+      if (it != buckets_.end()) {
+        for (uint32_t e = it->second.first; e < it->second.second; ++e) {
+          const uint32_t s = bucket_shapes_[e];
+          if (std::find(tested, tested + tested_count, s) != tested + tested_count) continue;
+          if (tested_count < kTestedCapacity) tested[tested_count++] = s;
+          if (std::find(skip.begin(), skip.end(), shapes_[s].id) != skip.end()) continue;
+          double hit;
+          if (RayCast(shapes_[s], p_W, d_W, max_t, &hit) && hit < best) best = hit, best_shape = s;
+        }
+      }
+    }
+    // Next voxel; stop past the clipped ray or past the best hit so far.
+    const int axis =
+        t_max[0] <= t_max[1] ? (t_max[0] <= t_max[2] ? 0 : 2) : (t_max[1] <= t_max[2] ? 1 : 2);
+    if (!(t_max[axis] <= std::min(best, t1))) break;
+    key[axis] += step[axis];
+    if (key[axis] < std::max(box_lo[axis], occupied_keys_.lo[axis]) ||
+        key[axis] > std::min(box_hi[axis], occupied_keys_.hi[axis]))
+      break;
+    t_max[axis] += t_delta[axis];
+  }
+  if (!(best <= max_t)) return false;
+  *t = best;
+  *shape = best_shape;
+  return true;
+}
+
+}  // namespace swarmsim::proximity

@@ -1,0 +1,457 @@
+#include "modules/proximity/proximity.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <random>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "framework/error.h"
+#include "framework/scene.h"
+#include "modules/proximity/ray_cast.h"
+
+namespace swarmsim::proximity {
+namespace {
+
+constexpr double kTol = 1e-9;
+
+ShapeData Box(double x, double y, double z) {
+  ShapeData s;
+  s.kind = ShapeKind::kBox;
+  s.size = {x, y, z};
+  return s;
+}
+ShapeData Cylinder(double radius, double height) {
+  ShapeData s;
+  s.kind = ShapeKind::kCylinder;
+  s.size = {radius, 0, height};
+  return s;
+}
+ShapeData Sphere(double radius) {
+  ShapeData s;
+  s.kind = ShapeKind::kSphere;
+  s.size = {radius, 0, 0};
+  return s;
+}
+
+// Orientation whose z axis points along heading `yaw` in the xy plane.
+Quat LookAlong(double yaw) { return Quat::FromYaw(yaw) * Quat::FromAxisAngle({0, 1, 0}, M_PI / 2); }
+Pose Looking(const Vec3& p, double yaw) { return {p, LookAlong(yaw)}; }
+
+ProximitySensorData Ray(double range) {
+  ProximitySensorData d;
+  d.range = range;
+  return d;
+}
+
+struct Robot {
+  ObjectId root, body;
+  std::vector<ObjectId> sensors;
+  int instance = -1;
+};
+
+// A robot: a dummy root at X_WR, an upright cylinder body (radius, height
+// 0.12, base on the floor) and sensors at the given poses in the root frame.
+Robot AddRobot(Scene* scene, const Pose& X_WR, double body_radius,
+               const std::vector<Pose>& sensor_poses, double range) {
+  Robot robot;
+  const int k = static_cast<int>(scene->instances().size());
+  robot.root = scene->AddDummy("bot", {}, X_WR);
+  robot.body = scene->AddShape("body", robot.root, {{0, 0, 0.06}, {}}, Cylinder(body_radius, 0.12));
+  for (const Pose& X_RS : sensor_poses)
+    robot.sensors.push_back(scene->AddProximitySensor("sensor", robot.root, X_RS, Ray(range)));
+  robot.instance = scene->MakeModelInstance(robot.root, "bot", "bot#" + std::to_string(k));
+  return robot;
+}
+
+// A scene, the backend, and the calls World::Sense makes.
+class ProximityTest : public ::testing::Test {
+ protected:
+  void Start(double resolution = 0.05) {
+    scene_.UpdateWorldPoses();
+    ProximitySettings settings;
+    settings.octree_resolution = resolution;
+    backend_ = MakeBackend();
+    backend_->Build(scene_, settings);
+  }
+  void Sense() {
+    scene_.UpdateWorldPoses();
+    backend_->Update(scene_);
+    for (size_t i = 0; i < scene_.instances().size(); ++i)
+      backend_->SenseInstance(&scene_, static_cast<int>(i));
+    backend_->SenseSceneSensors(&scene_);
+  }
+  const ProximitySensorData& Reading(ObjectId sensor) { return scene_.proximity_sensor(sensor); }
+  void ExpectHit(ObjectId sensor, double distance, ObjectId object) {
+    const ProximitySensorData& r = Reading(sensor);
+    EXPECT_TRUE(r.detected);
+    EXPECT_NEAR(r.distance, distance, kTol);
+    EXPECT_NEAR(r.p_SD.x, 0, kTol);
+    EXPECT_NEAR(r.p_SD.y, 0, kTol);
+    EXPECT_NEAR(r.p_SD.z, distance, kTol);
+    EXPECT_EQ(r.detected_object, object);
+  }
+  void ExpectNothing(ObjectId sensor) {
+    const ProximitySensorData& r = Reading(sensor);
+    EXPECT_FALSE(r.detected);
+    EXPECT_EQ(r.distance, 0);
+    EXPECT_EQ(r.p_SD, Vec3{});
+    EXPECT_TRUE(r.detected_object.IsNull());
+  }
+
+  Scene scene_;
+  std::unique_ptr<ProximityBackend> backend_;
+};
+
+TEST(ProximityModuleTest, RegistersAsProximity) {
+  const auto info = ModuleInfo();
+  EXPECT_EQ(info.kind, "proximity");
+  EXPECT_EQ(info.name, "proximity");
+  EXPECT_FALSE(info.version.empty());
+  EXPECT_FALSE(info.description.empty());
+  EXPECT_NE(MakeBackend(), nullptr);
+}
+
+// --- The static environment (octree) -------------------------------------------------
+
+TEST_F(ProximityTest, WallFaceAlongX) {
+  // A box wall whose near face is at x = 0.95 (its centre at x = 1).
+  const ObjectId wall = scene_.AddShape("wall", {}, {{1.0, 0, 0}, {}}, Box(0.1, 2, 1));
+  const ObjectId sensor = scene_.AddProximitySensor("s", {}, Looking({0, 0, 0}, 0), Ray(2));
+  Start();
+  Sense();
+  ExpectHit(sensor, 0.95, wall);
+}
+
+TEST_F(ProximityTest, DistancesAreNotQuantisedToVoxels) {
+  // Neither the face (x = 0.9321) nor the sensor (x = 0.0123) lies on the
+  // 0.05 m voxel grid; the reading must be exact, and equal at any resolution.
+  scene_.AddShape("wall", {}, {{0.9321 + 0.25, 0.01, 0.013}, {}}, Box(0.5, 2, 1));
+  const ObjectId sensor =
+      scene_.AddProximitySensor("s", {}, Looking({0.0123, 0.0071, 0.0312}, 0), Ray(2));
+  for (double resolution : {0.05, 0.2, 0.013}) {
+    Start(resolution);
+    Sense();
+    EXPECT_NEAR(Reading(sensor).distance, 0.9321 - 0.0123, kTol) << resolution;
+  }
+}
+
+TEST_F(ProximityTest, BoxRotated30DegreesAboutZ) {
+  // Box centred at (1, 0), half extents (0.1, 0.3), turned 30 degrees. In the
+  // box frame the ray meets the face x' = -0.1 where (t - 1) cos 30 = -0.1,
+  // at y' = 0.1 tan 30 (well inside |y'| <= 0.3): t = 1 - 0.1 / cos 30.
+  const ObjectId box =
+      scene_.AddShape("box", {}, {{1, 0, 0}, Quat::FromYaw(M_PI / 6)}, Box(0.2, 0.6, 0.5));
+  const ObjectId sensor = scene_.AddProximitySensor("s", {}, Looking({0, 0, 0}, 0), Ray(2));
+  Start();
+  Sense();
+  ExpectHit(sensor, 1 - 0.1 / std::cos(M_PI / 6), box);
+}
+
+TEST_F(ProximityTest, VerticalCylinder) {
+  const ObjectId post = scene_.AddShape("post", {}, {{1.3, 0, 0.2}, {}}, Cylinder(0.2, 1));
+  const ObjectId offset = scene_.AddShape("post2", {}, {{1.3, 2.1, 0.2}, {}}, Cylinder(0.2, 1));
+  const ObjectId centred = scene_.AddProximitySensor("s", {}, Looking({0, 0, 0}, 0), Ray(2));
+  // 0.1 m beside the second post's axis: t = d - sqrt(r^2 - 0.1^2).
+  const ObjectId beside = scene_.AddProximitySensor("s2", {}, Looking({0, 2.0, 0}, 0), Ray(2));
+  Start();
+  Sense();
+  ExpectHit(centred, 1.3 - 0.2, post);
+  ExpectHit(beside, 1.3 - std::sqrt(0.2 * 0.2 - 0.1 * 0.1), offset);
+}
+
+TEST_F(ProximityTest, CylinderCapFromBelow) {
+  // A sensor looking straight up at a horizontal disc (cylinder lying flat).
+  const ObjectId disc = scene_.AddShape("disc", {}, {{0.02, 0, 0.5}, {}}, Cylinder(0.3, 0.1));
+  const ObjectId up = scene_.AddProximitySensor("up", {}, {{0, 0, 0}, {}}, Ray(1));
+  Start();
+  Sense();
+  ExpectHit(up, 0.45, disc);
+}
+
+TEST_F(ProximityTest, Sphere) {
+  const ObjectId ball = scene_.AddShape("ball", {}, {{0.7, 0, 0.1}, {}}, Sphere(0.15));
+  const ObjectId sensor = scene_.AddProximitySensor("s", {}, Looking({0, 0, 0}, 0), Ray(1));
+  Start();
+  Sense();
+  ExpectHit(sensor, 0.7 - std::sqrt(0.15 * 0.15 - 0.1 * 0.1), ball);
+}
+
+TEST_F(ProximityTest, RayJustBesideAShapeSeesNothing) {
+  // The box's lower face is 1e-7 m above the ray; the twin box is 1e-7 m into it.
+  scene_.AddShape("miss", {}, {{1, 0.1 + 1e-7, 0}, {}}, Box(0.2, 0.2, 0.2));
+  const ObjectId hit = scene_.AddShape("hit", {}, {{1, 5 + 0.1 - 1e-7, 0}, {}}, Box(0.2, 0.2, 0.2));
+  const ObjectId past = scene_.AddProximitySensor("a", {}, Looking({0, 0, 0}, 0), Ray(2));
+  const ObjectId grazing = scene_.AddProximitySensor("b", {}, Looking({0, 5, 0}, 0), Ray(2));
+  Start();
+  Sense();
+  ExpectNothing(past);
+  ExpectHit(grazing, 0.9, hit);
+}
+
+TEST_F(ProximityTest, OutOfRangeSeesNothing) {
+  const ObjectId wall = scene_.AddShape("wall", {}, {{1.0, 0, 0}, {}}, Box(0.1, 2, 1));
+  const ObjectId short_ray = scene_.AddProximitySensor("a", {}, Looking({0, 0, 0}, 0), Ray(0.9));
+  const ObjectId exact = scene_.AddProximitySensor("b", {}, Looking({0, 0.5, 0}, 0), Ray(0.95));
+  const ObjectId away = scene_.AddProximitySensor("c", {}, Looking({0, -0.5, 0}, M_PI), Ray(5));
+  Start();
+  Sense();
+  ExpectNothing(short_ray);
+  ExpectHit(exact, 0.95, wall);  // the range is inclusive
+  ExpectNothing(away);
+}
+
+TEST_F(ProximityTest, NearestOfTwoObstacles) {
+  scene_.AddShape("far", {}, {{1.0, 0, 0}, {}}, Box(0.1, 2, 1));
+  const ObjectId near = scene_.AddShape("near", {}, {{0.5, 0, 0}, {}}, Sphere(0.05));
+  const ObjectId sensor = scene_.AddProximitySensor("s", {}, Looking({0, 0, 0}, 0), Ray(2));
+  Start();
+  Sense();
+  ExpectHit(sensor, 0.45, near);
+}
+
+TEST_F(ProximityTest, RayStartingInsideAWallReadsZero) {
+  const ObjectId wall = scene_.AddShape("wall", {}, {{0, 0, 0}, {}}, Box(0.4, 0.4, 0.4));
+  const ObjectId sensor = scene_.AddProximitySensor("s", {}, Looking({0.1, 0, 0}, 0), Ray(1));
+  Start();
+  Sense();
+  ExpectHit(sensor, 0, wall);
+}
+
+TEST_F(ProximityTest, SceneSensorIgnoresTheShapeItIsMountedOn) {
+  const ObjectId wall = scene_.AddShape("wall", {}, {{0, 0, 0}, {}}, Box(0.2, 2, 1));
+  scene_.AddShape("other", {}, {{1.0, 0, 0}, {}}, Box(0.1, 2, 1));
+  // Mounted on the wall's face, looking away from it, and into it.
+  const ObjectId out = scene_.AddProximitySensor("out", wall, Looking({0.1, 0, 0}, 0), Ray(2));
+  const ObjectId in = scene_.AddProximitySensor("in", wall, Looking({0.1, 0, 0}, M_PI), Ray(2));
+  Start();
+  Sense();
+  EXPECT_NEAR(Reading(out).distance, 0.95 - 0.1, kTol);
+  ExpectNothing(in);
+}
+
+TEST_F(ProximityTest, BadSettingsAndFarShapesAreUserErrors) {
+  scene_.AddShape("wall", {}, {{1.0, 0, 0}, {}}, Box(0.1, 2, 1));
+  EXPECT_THROW(Start(0), Error);
+  EXPECT_THROW(Start(-1), Error);
+  scene_.AddShape("far away", {}, {{5000, 0, 0}, {}}, Box(0.1, 2, 1));
+  EXPECT_THROW(Start(0.05), Error);  // the octree reaches +-1638 m at 0.05 m
+  EXPECT_NO_THROW(Start(0.5));
+}
+
+// --- Robots (spatial grid) --------------------------------------------------------
+
+TEST_F(ProximityTest, OwnBodyIsNotDetected) {
+  // Sensors on the body surface, and one at the body's centre (inside it).
+  const Robot robot = AddRobot(
+      &scene_, {}, 0.085, {Looking({0.085, 0, 0.06}, 0), Looking({0, 0, 0.06}, M_PI / 2)}, 0.1);
+  Start();
+  Sense();
+  ExpectNothing(robot.sensors[0]);
+  ExpectNothing(robot.sensors[1]);
+}
+
+TEST_F(ProximityTest, OtherRobotDetectedAtExactDistance) {
+  const Robot a = AddRobot(&scene_, {}, 0.085, {Looking({0.085, 0, 0.06}, 0)}, 0.2);
+  const Robot b = AddRobot(&scene_, {{0.3, 0, 0}, Quat::FromYaw(M_PI)}, 0.085,
+                           {Looking({0.085, 0, 0.06}, 0)}, 0.2);
+  Start();
+  Sense();
+  ExpectHit(a.sensors[0], 0.3 - 2 * 0.085, b.body);
+  ExpectHit(b.sensors[0], 0.3 - 2 * 0.085, a.body);
+  // B drives 0.05 m away: the next step's reading follows.
+  scene_.SetLocalPose(b.root, {{0.35, 0, 0}, Quat::FromYaw(M_PI)});
+  Sense();
+  ExpectHit(a.sensors[0], 0.35 - 2 * 0.085, b.body);
+  // And out of range.
+  scene_.SetLocalPose(b.root, {{0.5, 0, 0}, Quat::FromYaw(M_PI)});
+  Sense();
+  ExpectNothing(a.sensors[0]);
+}
+
+TEST_F(ProximityTest, NearestOfRobotAndWall) {
+  scene_.AddShape("wall", {}, {{1.0, 0, 0}, {}}, Box(0.1, 2, 1));
+  const Robot a = AddRobot(&scene_, {}, 0.085, {Looking({0.085, 0, 0.06}, 0)}, 2);
+  const Robot b = AddRobot(&scene_, {{0.6, 0, 0}, {}}, 0.085, {}, 0.2);
+  Start();
+  Sense();
+  ExpectHit(a.sensors[0], 0.6 - 0.085 - 0.085, b.body);
+  scene_.SetLocalPose(b.root, {{0.6, 3, 0}, {}});
+  Sense();
+  ExpectHit(a.sensors[0], 0.95 - 0.085, scene_.FindObject("/wall"));
+}
+
+TEST_F(ProximityTest, SceneSensorSeesRobotsAndDynamicShapes) {
+  const Robot bot = AddRobot(&scene_, {{1, 0, 0}, {}}, 0.1, {}, 0.1);
+  ShapeData crate = Box(0.2, 0.2, 0.2);
+  crate.dynamic = true;
+  const ObjectId box = scene_.AddShape("crate", {}, {{0, 1, 0.1}, {}}, crate);
+  const ObjectId east = scene_.AddProximitySensor("east", {}, Looking({0, 0, 0.05}, 0), Ray(2));
+  const ObjectId north =
+      scene_.AddProximitySensor("north", {}, Looking({0, 0, 0.05}, M_PI / 2), Ray(2));
+  Start();
+  Sense();
+  ExpectHit(east, 0.9, bot.body);
+  ExpectHit(north, 0.9, box);
+  // The dynamic crate moves (it is not frozen into the octree).
+  scene_.SetLocalPose(box, {{0, 1.5, 0.1}, {}});
+  Sense();
+  ExpectHit(north, 1.4, box);
+}
+
+TEST_F(ProximityTest, TiltedRobotShapeStillFoundByTheGrid) {
+  // A long box lying along the ray direction, tilted: its world footprint
+  // reaches far beyond ShapeData::BoundingRadius about its origin.
+  const ObjectId root = scene_.AddDummy("bot", {}, {{1.0, 0, 0}, {}});
+  const ObjectId plank = scene_.AddShape(
+      "plank", root, {{0, 0, 0}, Quat::FromAxisAngle({0, 1, 0}, M_PI / 2)}, Box(0.1, 0.1, 1.6));
+  scene_.MakeModelInstance(root, "bot", "bot#0");
+  const ObjectId sensor = scene_.AddProximitySensor("s", {}, Looking({-0.5, 0, 0}, 0), Ray(1));
+  Start();
+  Sense();
+  ExpectHit(sensor, 0.7, plank);
+}
+
+// --- Cross-checks ---------------------------------------------------------------------
+
+// Random static shapes (arbitrary 3D orientations) and random rays: the
+// octree path must agree exactly with testing every shape.
+TEST_F(ProximityTest, MatchesBruteForceOnRandomScenes) {
+  std::mt19937_64 rng(1234);
+  std::uniform_real_distribution<double> pos(-2, 2), size(0.02, 0.6), angle(-M_PI, M_PI);
+  std::vector<PlacedShape> all;
+  for (int i = 0; i < 60; ++i) {
+    ShapeData shape = i % 3 == 0   ? Box(size(rng), size(rng), size(rng))
+                      : i % 3 == 1 ? Cylinder(size(rng) / 2, size(rng))
+                                   : Sphere(size(rng) / 2);
+    const Pose X_WS{{pos(rng), pos(rng), pos(rng) / 4},
+                    Quat::FromRollPitchYaw(angle(rng), angle(rng), angle(rng))};
+    all.push_back(PlaceShape(shape, X_WS, scene_.AddShape("o", {}, X_WS, shape), -1));
+  }
+  std::vector<ObjectId> sensors;
+  std::vector<Pose> poses;
+  for (int i = 0; i < 3000; ++i) {
+    poses.push_back({{pos(rng), pos(rng), pos(rng) / 4},
+                     Quat::FromRollPitchYaw(angle(rng), angle(rng), angle(rng))});
+    sensors.push_back(scene_.AddProximitySensor("s", {}, poses.back(), Ray(1.5)));
+  }
+  for (double resolution : {0.05, 0.17}) {
+    Start(resolution);
+    Sense();
+    int detections = 0;
+    for (size_t i = 0; i < sensors.size(); ++i) {
+      const Vec3 p = poses[i].p, d = poses[i].q.Rotate({0, 0, 1});
+      double best = INFINITY, t;
+      ObjectId id;
+      for (const PlacedShape& s : all)
+        if (RayCast(s, p, d, 1.5, &t) && t < best) best = t, id = s.id;
+      const ProximitySensorData& r = Reading(sensors[i]);
+      ASSERT_EQ(r.detected, std::isfinite(best)) << "sensor " << i << " at res " << resolution;
+      if (!r.detected) continue;
+      ++detections;
+      EXPECT_NEAR(r.distance, best, 1e-12);
+      EXPECT_EQ(r.detected_object, id);
+    }
+    EXPECT_GT(detections, 300);
+  }
+}
+
+// A crowded arena: readings match brute force, and SenseInstance from
+// several threads at once gives the serial readings.
+TEST_F(ProximityTest, SwarmMatchesBruteForceAndConcurrentSensingMatchesSerial) {
+  std::mt19937_64 rng(99);
+  std::uniform_real_distribution<double> pos(0.2, 9.8), yaw(-M_PI, M_PI);
+  std::vector<Pose> ring;
+  for (int k = 0; k < 24; ++k) {
+    const double a = 2 * M_PI * k / 24;
+    ring.push_back(Looking({0.085 * std::cos(a), 0.085 * std::sin(a), 0.06}, a));
+  }
+  for (int i = 0; i < 300; ++i)
+    AddRobot(&scene_, {{pos(rng), pos(rng), 0}, Quat::FromYaw(yaw(rng))}, 0.085, ring, 0.3);
+  for (int side = 0; side < 4; ++side) {
+    const double a = side * M_PI / 2;
+    scene_.AddShape("wall", {},
+                    {{5 + 5.05 * std::cos(a), 5 + 5.05 * std::sin(a), 0.1}, Quat::FromYaw(a)},
+                    Box(0.1, 10.2, 0.2));
+  }
+  Start();
+  Sense();
+  std::vector<ProximitySensorData> serial(scene_.proximity_sensors().begin(),
+                                          scene_.proximity_sensors().end());
+  // Serial readings agree with testing every shape but the robot's own.
+  std::vector<PlacedShape> all;
+  for (size_t r = 0; r < scene_.shapes().size(); ++r) {
+    const uint32_t slot = scene_.shape_owners()[r];
+    all.push_back(PlaceShape(scene_.shapes()[r], scene_.world_pose_at(slot), scene_.IdAt(slot),
+                             scene_.instance_of_at(slot)));
+  }
+  int detected = 0;
+  for (size_t row = 0; row < serial.size(); ++row) {
+    const uint32_t slot = scene_.proximity_sensor_owners()[row];
+    const Pose& X_WS = scene_.world_pose_at(slot);
+    const Vec3 d = X_WS.q.Rotate({0, 0, 1});
+    double best = INFINITY, t;
+    ObjectId id;
+    for (const PlacedShape& s : all)
+      if (s.instance != scene_.instance_of_at(slot) && RayCast(s, X_WS.p, d, 0.3, &t) && t < best)
+        best = t, id = s.id;
+    ASSERT_EQ(serial[row].detected, std::isfinite(best)) << row;
+    if (!serial[row].detected) continue;
+    ++detected;
+    EXPECT_NEAR(serial[row].distance, best, 1e-12);
+    EXPECT_EQ(serial[row].detected_object, id);
+  }
+  EXPECT_GT(detected, 50);
+  for (auto& r : scene_.proximity_sensors()) r = Ray(r.range);  // clear the readings
+  std::vector<std::thread> threads;
+  const int n = static_cast<int>(scene_.instances().size());
+  for (int t = 0; t < 4; ++t)
+    threads.emplace_back([&, t] {
+      for (int i = t; i < n; i += 4) backend_->SenseInstance(&scene_, i);
+    });
+  for (auto& t : threads) t.join();
+  for (size_t row = 0; row < serial.size(); ++row) {
+    const ProximitySensorData& r = scene_.proximity_sensors()[row];
+    ASSERT_EQ(r.detected, serial[row].detected) << row;
+    ASSERT_EQ(r.distance, serial[row].distance) << row;
+    ASSERT_EQ(r.detected_object, serial[row].detected_object) << row;
+  }
+}
+
+// --- The primitives on their own -------------------------------------------------------
+
+TEST(RayPrimitivesTest, InsideStartsHitAtZero) {
+  double t = -1;
+  EXPECT_TRUE(RayBox({0, 0, 0}, {1, 0, 0}, {1, 1, 1}, 5, &t));
+  EXPECT_EQ(t, 0);
+  EXPECT_TRUE(RayCylinder({0.1, 0, 0.2}, {0, 0, 1}, 0.5, 0.5, 5, &t));
+  EXPECT_EQ(t, 0);
+  EXPECT_TRUE(RaySphere({0, 0.2, 0}, {0, 1, 0}, 0.5, 5, &t));
+  EXPECT_EQ(t, 0);
+}
+
+TEST(RayPrimitivesTest, BehindAndParallelRaysMiss) {
+  double t;
+  EXPECT_FALSE(RayBox({2, 0, 0}, {1, 0, 0}, {1, 1, 1}, 5, &t));         // pointing away
+  EXPECT_FALSE(RayBox({-2, 1.5, 0}, {1, 0, 0}, {1, 1, 1}, 5, &t));      // parallel, outside
+  EXPECT_FALSE(RayCylinder({-2, 0, 0.6}, {1, 0, 0}, 0.5, 0.5, 5, &t));  // above the top cap
+  EXPECT_FALSE(RayCylinder({0.6, 0, -3}, {0, 0, 1}, 0.5, 0.5, 5, &t));  // along the axis, outside
+  EXPECT_FALSE(RaySphere({-2, 0.51, 0}, {1, 0, 0}, 0.5, 5, &t));
+}
+
+TEST(RayPrimitivesTest, CapsSidesAndTangents) {
+  double t;
+  ASSERT_TRUE(RayCylinder({0.2, 0.1, -3}, {0, 0, 1}, 0.5, 0.5, 5, &t));  // bottom cap
+  EXPECT_NEAR(t, 2.5, 1e-15);
+  const Vec3 diagonal = Vec3{1, 0, 1}.Normalized();  // enters through the side
+  ASSERT_TRUE(RayCylinder({-1.5, 0, -1.0}, diagonal, 0.5, 0.5, 5, &t));
+  EXPECT_NEAR(t, std::sqrt(2.0), 1e-12);
+  ASSERT_TRUE(RaySphere({-2, 0.5, 0}, {1, 0, 0}, 0.5, 5, &t));  // tangent: touching counts
+  EXPECT_NEAR(t, 2, 1e-12);
+}
+
+}  // namespace
+}  // namespace swarmsim::proximity
