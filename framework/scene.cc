@@ -592,7 +592,6 @@ ObjectId Scene::FindObject(std::string_view path, ObjectId from) const {
   // First element: roots (absolute) or any descendant of the scope.
   std::vector<uint32_t> candidates;
   if (!search_descendants) {
-    if (order_dirty_) RebuildOrder();
     for (uint32_t s = 0; s < generation_.size(); ++s)
       if (alive_[s] && parent_[s] < 0) candidates.push_back(s);
   } else {

@@ -1,0 +1,114 @@
+// Values in world and model files: literal numbers, booleans and strings,
+// parameter references ("$robots") and Lua expressions ("= sqrt(robots)"),
+// checked against what each key expects.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "framework/math.h"
+#include "framework/parameters.h"
+#include "swarm/loader_yaml.h"
+
+namespace swarmsim::loader {
+
+// The names a value may refer to: a model's parameters (if any) shadow the
+// world's, as World::FindParameter does for scripts.
+struct Scope {
+  const ParameterSet* world = nullptr;
+  const ParameterSet* model = nullptr;
+
+  const ParamValue* Find(std::string_view name) const;
+  std::vector<std::string> Names() const;
+};
+
+// A small sandboxed Lua state for "= expression" values. Its globals are the
+// scope's parameters and the math library (sqrt, floor, pi, ...; not random,
+// which would break determinism). No other library: no I/O, no os, no load.
+// An instruction budget and a memory cap turn runaway expressions into errors.
+class Expressions {
+ public:
+  Expressions();
+  ~Expressions();
+  Expressions(const Expressions&) = delete;
+  Expressions& operator=(const Expressions&) = delete;
+
+  // The value of `expression`; throws swarmsim::Error with a message without
+  // position (the caller adds file:line:column) on any failure.
+  ParamValue Evaluate(std::string_view expression, const Scope& scope);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Bounds for a number read from a file.
+struct NumberRule {
+  const char* text;  // what is expected, for messages: "a positive number"
+  double min;
+  double max;
+  bool min_exclusive = false;
+};
+// Largest length or coordinate accepted, m: keeps geometry (and placement
+// grids) far from overflow.
+inline constexpr double kMaxLength = 1e6;
+inline constexpr NumberRule kAnyNumber{"a number", -1e300, 1e300};
+inline constexpr NumberRule kCoordinate{"a number of metres", -kMaxLength, kMaxLength};
+inline constexpr NumberRule kPositiveLength{"a positive number", 0, kMaxLength, true};
+inline constexpr NumberRule kNonNegativeLength{"a non-negative number", 0, kMaxLength};
+inline constexpr NumberRule kPositive{"a positive number", 0, 1e300, true};
+inline constexpr NumberRule kNonNegative{"a non-negative number", 0, 1e300};
+inline constexpr NumberRule kFraction{"a number from 0 to 1", 0, 1};
+inline constexpr NumberRule kAngleDeg{"an angle in degrees", -1e6, 1e6};
+
+// Reads typed values from fields of one file, in one scope.
+class ValueReader {
+ public:
+  ValueReader(const YamlFile& file, Expressions* expressions, Scope scope)
+      : file_(file), expressions_(expressions), scope_(scope) {}
+
+  const YamlFile& file() const { return file_; }
+  const Scope& scope() const { return scope_; }
+
+  // The value of a scalar field: a literal (number if it reads as one,
+  // true/false, else a string), "$name" or "= expression".
+  ParamValue Resolve(const Field& field) const;
+
+  double Number(const Field& field, const NumberRule& rule) const;
+  int64_t Integer(const Field& field, int64_t min, int64_t max) const;
+  uint64_t Seed(const Field& field) const;
+  bool Bool(const Field& field) const;
+  std::string String(const Field& field) const;
+  // One of `choices`, with a suggestion for a near miss.
+  std::string Choice(const Field& field, const std::vector<std::string>& choices) const;
+  // A list of `min_count`..`max_count` numbers.
+  std::vector<double> Numbers(const Field& field, size_t min_count, size_t max_count,
+                              const NumberRule& rule) const;
+  Vec3 Vector3(const Field& field, const NumberRule& rule) const;
+
+  [[noreturn]] void Fail(const Field& field, const std::string& message) const {
+    file_.Fail(field.mark, message);
+  }
+
+ private:
+  // "(got ...)" for a resolved value: the literal, or the value and where it came from.
+  std::string Got(const Field& field, const ParamValue& value) const;
+
+  const YamlFile& file_;
+  Expressions* expressions_;
+  Scope scope_;
+};
+
+// A literal scalar as a value: a number if the text reads as a finite
+// number, true/false, else the text (used for --set values too).
+ParamValue ParseScalar(std::string_view text, bool quoted);
+// Shortest text that reads back as the same double ("0.1", not "0.10000000000000001").
+std::string FormatNumber(double value);
+// "a number", "a boolean", "a string".
+const char* TypeName(const ParamValue& value);
+
+}  // namespace swarmsim::loader

@@ -1,0 +1,631 @@
+#include "swarm/world_loader.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "framework/error.h"
+#include "framework/registry.h"
+#include "swarm/loader_model.h"
+#include "swarm/loader_values.h"
+#include "swarm/loader_yaml.h"
+#include "swarm/placement.h"
+
+namespace swarmsim {
+
+namespace fs = std::filesystem;
+using loader::Field;
+using loader::Fields;
+using loader::ModelFile;
+using loader::ObjectSpec;
+using loader::ValueReader;
+using loader::YamlFile;
+
+namespace {
+
+constexpr int64_t kMaxCount = 1000000;  // copies per models entry
+constexpr double kDegToRad = M_PI / 180.0;
+
+const std::vector<std::string> kTopKeys = {"simulation", "parameters", "arena",
+                                           "obstacles",  "models",     "metrics"};
+
+// One --set, split into its target.
+struct Override {
+  std::string text;   // "name=value", for messages
+  std::string model;  // "" for a world parameter
+  std::string name;
+  std::string value;
+  bool used = false;
+};
+
+// A --set value with the type of the parameter it replaces: a string
+// parameter takes the text as is; a number or boolean must read as one.
+ParamValue CoerceOverride(const Override& o, const ParamValue& declared,
+                          const std::string& declared_where) {
+  const ParamValue parsed = loader::ParseScalar(o.value, false);
+  if (std::holds_alternative<std::string>(declared)) return o.value;
+  if (parsed.index() == declared.index()) return parsed;
+  throw Error("--set " + o.text + ": parameter '" + (o.model.empty() ? "" : o.model + ".") +
+              o.name + "' is " + loader::TypeName(declared) + " (" + declared_where + "), got \"" +
+              o.value + "\"");
+}
+
+std::vector<Override> SplitOverrides(const LoadOptions& options) {
+  std::vector<Override> out;
+  for (const auto& [name, value] : options.overrides) {
+    Override o{name + "=" + value, "", name, value};
+    if (const size_t dot = name.find('.'); dot != std::string::npos) {
+      o.model = name.substr(0, dot);
+      o.name = name.substr(dot + 1);
+    }
+    if (o.name.empty() || (o.model.empty() && name.find('.') != std::string::npos))
+      throw Error("--set " + o.text + ": expected name=value or model.name=value");
+    out.push_back(std::move(o));
+  }
+  return out;
+}
+
+// How one `models:` entry places its copies.
+struct EntryPlan {
+  Field field;
+  const ModelFile* model = nullptr;
+  std::shared_ptr<ParameterSet> parameters;
+  ObjectSpec spec;
+  loader::Footprint footprint;
+  // Either one copy at a fixed pose, or `count` distributed copies.
+  bool distribute = false;
+  Pose fixed_pose;
+  Field position_field;
+  Field count_field;
+  int64_t count = 1;
+  Region2 region;
+  std::string region_text;  // "the arena", "the region [..] - [..]"
+  double clearance = 0;
+  std::optional<double> heading;
+  std::vector<Placement2> placements;
+};
+
+class WorldLoader {
+ public:
+  WorldLoader(const fs::path& file, const LoadOptions& options, const ModuleRegistry& registry)
+      : path_(file), options_(options), registry_(registry) {}
+
+  LoadedWorld Load();
+
+ private:
+  void ReadParameters(const Fields& top);
+  void ReadModelEntries(const Fields& top);
+  void CheckOverrides();
+  WorldSettings ReadSimulation(const Fields& top, std::optional<int64_t>* steps);
+  void BuildArena(const Fields& top, World* world);
+  void BuildObstacles(const Fields& top, World* world);
+  void AddObstacleFootprint(const ShapeData& shape, const Pose& X_WO);
+  void ResolveEntry(EntryPlan* entry);
+  void PlaceEntries();
+  void BuildCopies(World* world);
+  std::vector<SwarmMetricSpec> ReadMetrics(const Fields& top, World* world);
+
+  const ModelFile& LoadModel(const Field& field, const std::string& text);
+  ValueReader WorldValues() const {
+    return ValueReader(*file_, &expressions_, {&parameters_, nullptr});
+  }
+
+  fs::path path_;
+  const LoadOptions& options_;
+  const ModuleRegistry& registry_;
+  std::unique_ptr<YamlFile> file_;
+  mutable loader::Expressions expressions_;
+  loader::ScriptCache scripts_;
+  std::vector<Override> overrides_;
+  ParameterSet parameters_;
+  std::map<std::string, Field> parameter_fields_;  // where each world parameter is set
+  std::map<fs::path, std::unique_ptr<ModelFile>> models_;
+  std::vector<EntryPlan> entries_;
+  std::optional<Region2> arena_;
+  std::unique_ptr<Placer> placer_;
+};
+
+LoadedWorld WorldLoader::Load() {
+  file_ = std::make_unique<YamlFile>(
+      YamlFile::Load(path_, "world file", "", loader::DisplayPath(path_)));
+  const YamlFile& f = *file_;
+  const Field root{
+      "world", f.root(), f.root().Mark().is_null() ? YAML::Mark() : f.root().Mark(), {}};
+  if (!f.root().IsMap())
+    f.Fail(root.mark,
+           "a world file must be a mapping with keys such as 'simulation', 'arena' and "
+           "'models' (got " +
+               loader::Describe(f.root()) + ")");
+  Fields top(f, root, "the world file");
+  top.Expect(kTopKeys);
+  overrides_ = SplitOverrides(options_);
+
+  // Parameters first: every other value may use them.
+  ReadParameters(top);
+  ReadModelEntries(top);
+  CheckOverrides();
+
+  LoadedWorld out;
+  out.file = path_;
+  WorldSettings settings = ReadSimulation(top, &out.steps);
+  out.world = std::make_unique<World>(settings, registry_);
+  World* world = out.world.get();
+  for (const auto& [name, value] : parameters_) world->parameters()[name] = value;
+
+  placer_ = std::make_unique<Placer>(settings.seed);
+  BuildArena(top, world);
+  BuildObstacles(top, world);
+  for (EntryPlan& entry : entries_) ResolveEntry(&entry);
+  PlaceEntries();
+  BuildCopies(world);
+  out.metrics = ReadMetrics(top, world);
+  return out;
+}
+
+// --- Parameters ----------------------------------------------------------------------
+
+void WorldLoader::ReadParameters(const Fields& top) {
+  const Field params = top.Get("parameters");
+  if (!params.present()) return;
+  Fields fields(*file_, params, "'parameters'");
+  // In file order: a parameter's expression may use the ones above it.
+  for (const Field& p : fields.fields()) {
+    if (!loader::IsParameterName(p.name))
+      file_->Fail(p.key_mark,
+                  "parameter name '" + p.name +
+                      "' must be a Lua identifier (letters, digits, '_'; not a keyword)");
+    if (!p.node.IsScalar() || !p.present())
+      file_->Fail(p.mark, "parameter '" + p.name + "' must be a number, true/false or text (got " +
+                              loader::Describe(p.node) + ")");
+    ParamValue value = WorldValues().Resolve(p);
+    for (Override& o : overrides_) {
+      if (!o.model.empty() || o.name != p.name) continue;
+      value = CoerceOverride(o, value, file_->Where(p.mark));
+      o.used = true;
+    }
+    parameters_[p.name] = value;
+    parameter_fields_.emplace(p.name, p);
+  }
+}
+
+const ModelFile& WorldLoader::LoadModel(const Field& field, const std::string& text) {
+  const fs::path path = path_.parent_path() / text;
+  std::error_code ec;
+  fs::path key = fs::weakly_canonical(path, ec);
+  if (ec) key = path.lexically_normal();
+  auto it = models_.find(key);
+  if (it == models_.end()) {
+    const std::string where = file_->Where(field.mark);
+    auto model = std::make_unique<ModelFile>(
+        loader::ReadModelFile(YamlFile::Load(path, "model file", where, text), where));
+    it = models_.emplace(key, std::move(model)).first;
+  }
+  return *it->second;
+}
+
+void WorldLoader::ReadModelEntries(const Fields& top) {
+  for (const Field& element : loader::ListElements(*file_, top.Get("models"), "model entries")) {
+    Fields entry(*file_, element, "a models entry");
+    const Field model = entry.Require("model");
+    if (!model.node.IsScalar())
+      file_->Fail(model.mark,
+                  "'model' must be the path of a model file, e.g. models/footbot.yaml "
+                  "(got " +
+                      loader::Describe(model.node) + ")");
+    EntryPlan plan;
+    plan.field = element;
+    plan.model = &LoadModel(model, model.node.Scalar());
+    entries_.push_back(std::move(plan));
+  }
+}
+
+void WorldLoader::CheckOverrides() {
+  // Every --set must name a parameter; the suggestion spans world and model ones.
+  std::vector<std::string> known;
+  for (const auto& [name, value] : parameters_) known.push_back(name);
+  for (const auto& [path, model] : models_)
+    for (const auto& p : model->parameters) known.push_back(model->name + "." + p.name);
+  for (Override& o : overrides_) {
+    if (o.used) continue;
+    if (o.model.empty()) {
+      // A model parameter given without its model: point at the full name.
+      for (const std::string& k : known)
+        if (k.ends_with("." + o.name))
+          throw Error("--set " + o.text + ": no world parameter '" + o.name + "' in " +
+                      file_->name() + "; did you mean '" + k + "'?");
+      throw Error("--set " + o.text + ": no parameter '" + o.name + "' in " + file_->name() +
+                  loader::Suggest(o.name, known));
+    }
+    const ModelFile* model = nullptr;
+    for (const auto& [path, m] : models_)
+      if (m->name == o.model) model = m.get();
+    const std::string full = o.model + "." + o.name;
+    if (!model)
+      throw Error("--set " + o.text + ": no model '" + o.model + "' in " + file_->name() +
+                  loader::Suggest(full, known));
+    bool found = false;
+    for (const auto& p : model->parameters) found |= p.name == o.name;
+    if (!found)
+      throw Error("--set " + o.text + ": model '" + o.model + "' has no parameter '" + o.name +
+                  "'" + loader::Suggest(full, known));
+  }
+}
+
+// --- Simulation ----------------------------------------------------------------------
+
+WorldSettings WorldLoader::ReadSimulation(const Fields& top, std::optional<int64_t>* steps) {
+  WorldSettings s;
+  s.file = file_->name();
+  std::error_code ec;
+  s.directory = fs::absolute(path_, ec).parent_path();
+  s.threads = options_.threads;
+  const ValueReader values = WorldValues();
+  const Field sim = top.Get("simulation");
+  if (sim.present()) {
+    Fields f(*file_, sim, "'simulation'");
+    f.Expect({"physics", "time_step", "physics_substeps", "seed", "duration", "steps", "gravity",
+              "octree_resolution"});
+    {
+      // The default backend must exist too (a test registry may lack it).
+      const Field physics =
+          f.Has("physics") ? f.Get("physics") : Field{"physics", {}, sim.mark, sim.mark};
+      if (f.Has("physics")) s.physics = values.String(physics);
+      if (!registry_.HasDynamics(s.physics)) {
+        const std::vector<std::string> names = registry_.DynamicsNames();
+        std::string list;
+        for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
+        const std::string hint = loader::Suggest(s.physics, names);
+        values.Fail(physics, (f.Has("physics") ? "unknown" : "the default") +
+                                 std::string(" physics backend '") + s.physics + "'" +
+                                 (hint.starts_with(";") ? hint : "") +
+                                 " (available: " + (list.empty() ? "none" : list) + ")");
+      }
+    }
+    if (f.Has("time_step"))
+      s.time_step =
+          values.Number(f.Get("time_step"), {"a positive number of seconds", 0, 3600, true});
+    if (f.Has("physics_substeps"))
+      s.physics_substeps = static_cast<int>(values.Integer(f.Get("physics_substeps"), 1, 1000));
+    if (f.Has("seed")) s.seed = values.Seed(f.Get("seed"));
+    if (f.Has("gravity"))
+      s.gravity = values.Number(f.Get("gravity"), {"a non-negative number (m/s^2)", 0, 1e4});
+    if (f.Has("octree_resolution"))
+      s.octree_resolution = values.Number(f.Get("octree_resolution"), loader::kPositiveLength);
+    if (f.Has("duration") && f.Has("steps"))
+      values.Fail(f.Get("steps"), "give either 'duration' (seconds) or 'steps', not both");
+    if (f.Has("steps")) *steps = values.Integer(f.Get("steps"), 0, int64_t{1} << 40);
+    if (f.Has("duration")) {
+      const double duration =
+          values.Number(f.Get("duration"), {"a positive number of seconds", 0, 1e9, true});
+      const double n = std::round(duration / s.time_step);
+      if (n > static_cast<double>(int64_t{1} << 40))
+        values.Fail(f.Get("duration"), "'duration' is too many steps of 'time_step'");
+      *steps = static_cast<int64_t>(n);
+    }
+  }
+  if (!registry_.HasDynamics(s.physics))
+    file_->Fail(top.mark(),
+                "the world names no 'simulation: {physics: ...}' and the default backend '" +
+                    s.physics + "' is not available");
+  if (options_.seed) s.seed = *options_.seed;
+  return s;
+}
+
+// --- Arena and obstacles ------------------------------------------------------------------
+
+void WorldLoader::AddObstacleFootprint(const ShapeData& shape, const Pose& X_WO) {
+  Obstacle2 o;
+  o.x = X_WO.p.x;
+  o.y = X_WO.p.y;
+  const Vec3 z = X_WO.q.Rotate({0, 0, 1});
+  if (shape.kind == ShapeKind::kSphere ||
+      (shape.kind == ShapeKind::kCylinder && std::abs(z.z) > 1 - 1e-9)) {
+    o.kind = Obstacle2::Kind::kCircle;
+    o.radius = shape.size.x;
+  } else if (shape.kind == ShapeKind::kBox && std::abs(z.z) > 1 - 1e-9) {
+    o.kind = Obstacle2::Kind::kBox;
+    o.half_x = shape.size.x / 2;
+    o.half_y = shape.size.y / 2;
+    o.yaw = X_WO.q.Yaw();
+  } else {
+    // Tilted: the plane box around the rotated shape (conservative).
+    const Vec3 half = shape.kind == ShapeKind::kBox
+                          ? shape.size * 0.5
+                          : Vec3{shape.size.x, shape.size.x, shape.size.z / 2};
+    const Vec3 cx = X_WO.q.Rotate({half.x, 0, 0}), cy = X_WO.q.Rotate({0, half.y, 0}),
+               cz = X_WO.q.Rotate({0, 0, half.z});
+    o.kind = Obstacle2::Kind::kBox;
+    o.half_x = std::abs(cx.x) + std::abs(cy.x) + std::abs(cz.x);
+    o.half_y = std::abs(cx.y) + std::abs(cy.y) + std::abs(cz.y);
+  }
+  placer_->AddObstacle(o);
+}
+
+void WorldLoader::BuildArena(const Fields& top, World* world) {
+  const Field arena = top.Get("arena");
+  if (!arena.present()) return;
+  const ValueReader values = WorldValues();
+  Fields f(*file_, arena, "'arena'");
+  f.Expect({"size", "wall_thickness", "wall_height"});
+  const Field size = f.Require("size");
+  double w, h;
+  if (size.node.IsSequence()) {
+    const std::vector<double> v = values.Numbers(size, 2, 2, loader::kPositiveLength);
+    w = v[0], h = v[1];
+  } else {
+    w = h =
+        values.Number(size, {"a positive number or [width, depth]", 0, loader::kMaxLength, true});
+  }
+  const double t = f.Has("wall_thickness")
+                       ? values.Number(f.Get("wall_thickness"), loader::kPositiveLength)
+                       : 0.1;
+  const double height =
+      f.Has("wall_height") ? values.Number(f.Get("wall_height"), loader::kPositiveLength) : 0.2;
+  arena_ = Region2{-w / 2, -h / 2, w / 2, h / 2};
+  // Four static walls around the inner area; the north and south ones span the corners.
+  struct Wall {
+    const char* name;
+    Vec3 p, size;
+  };
+  const Wall walls[] = {
+      {"wall_north", {0, h / 2 + t / 2, height / 2}, {w + 2 * t, t, height}},
+      {"wall_south", {0, -h / 2 - t / 2, height / 2}, {w + 2 * t, t, height}},
+      {"wall_east", {w / 2 + t / 2, 0, height / 2}, {t, h, height}},
+      {"wall_west", {-w / 2 - t / 2, 0, height / 2}, {t, h, height}},
+  };
+  for (const Wall& wall : walls) {
+    ShapeData shape;
+    shape.kind = ShapeKind::kBox;
+    shape.size = wall.size;
+    shape.dynamic = false;
+    const Pose X_WO{wall.p, {}};
+    world->scene().AddShape(wall.name, {}, X_WO, shape);
+    AddObstacleFootprint(shape, X_WO);
+  }
+}
+
+void WorldLoader::BuildObstacles(const Fields& top, World* world) {
+  const ValueReader values = WorldValues();
+  std::vector<std::string> keys = loader::ShapeKeys();
+  keys.insert(keys.end(), loader::PoseKeys().begin(), loader::PoseKeys().end());
+  keys.push_back("name");
+  int index = 0;
+  for (const Field& element : loader::ListElements(*file_, top.Get("obstacles"), "obstacles")) {
+    Fields f(*file_, element, "obstacle " + std::to_string(index));
+    f.Expect(keys);
+    std::string name = "obstacle_" + std::to_string(index);
+    if (f.Has("name")) name = values.String(f.Get("name"));
+    const ShapeData shape = loader::ReadShape(values, f);
+    const Pose X_WO = loader::ReadPose(values, f);
+    world->scene().AddShape(name, {}, X_WO, shape);
+    AddObstacleFootprint(shape, X_WO);
+    ++index;
+  }
+}
+
+// --- Models ------------------------------------------------------------------------------
+
+void WorldLoader::ResolveEntry(EntryPlan* entry) {
+  const ModelFile& model = *entry->model;
+  const ValueReader world_values = WorldValues();
+  Fields f(*file_, entry->field, "the models entry for '" + model.name + "'");
+  f.Expect(
+      {"model", "count", "distribute", "position", "heading_deg", "orientation_deg", "parameters"});
+
+  // Model parameters: declared defaults, then this entry's values, then --set.
+  auto params = std::make_shared<ParameterSet>();
+  std::map<std::string, std::string> declared_where;
+  std::vector<std::string> names;
+  {
+    const ValueReader defaults(model.file, &expressions_, {&parameters_, nullptr});
+    for (const auto& decl : model.parameters) {
+      (*params)[decl.name] = defaults.Resolve(decl.default_value);
+      declared_where[decl.name] = model.file.Where(decl.default_value.mark);
+      names.push_back(decl.name);
+    }
+  }
+  if (f.Has("parameters")) {
+    Fields given(*file_, f.Get("parameters"), "the parameters of model '" + model.name + "'");
+    for (const Field& p : given.fields()) {
+      auto it = params->find(p.name);
+      if (it == params->end())
+        file_->Fail(p.key_mark,
+                    "model '" + model.name + "' has no parameter '" + p.name + "'" +
+                        (names.empty() ? " (it declares none)" : loader::Suggest(p.name, names)));
+      const ParamValue value = world_values.Resolve(p);
+      if (value.index() != it->second.index() && !std::holds_alternative<std::string>(it->second))
+        file_->Fail(p.mark, "parameter '" + p.name + "' of model '" + model.name + "' is " +
+                                loader::TypeName(it->second) + " (" + declared_where[p.name] +
+                                "), got " + loader::Describe(p.node));
+      it->second = std::holds_alternative<std::string>(it->second)
+                       ? ParamValue(ParamToString(value))
+                       : value;
+    }
+  }
+  for (Override& o : overrides_) {
+    if (o.model != model.name) continue;
+    auto it = params->find(o.name);
+    it->second = CoerceOverride(o, it->second, declared_where[o.name]);
+  }
+  entry->parameters = params;
+
+  // The model's objects, in a scope where its parameters shadow the world's.
+  const ValueReader model_values(model.file, &expressions_, {&parameters_, params.get()});
+  entry->spec = loader::ResolveModel(model, model_values, &scripts_);
+  entry->footprint = loader::ComputeFootprint(entry->spec);
+
+  // Placement: distributed copies or one placed copy.
+  if (f.Has("distribute")) {
+    for (const char* key : {"position", "heading_deg", "orientation_deg"})
+      if (f.Has(key))
+        file_->Fail(f.Get(key).key_mark,
+                    "'" + std::string(key) +
+                        "' places a single copy; it cannot be combined with "
+                        "'distribute' (use distribute.heading_deg for a fixed heading)");
+    entry->distribute = true;
+    entry->count_field = f.Require("count");
+    entry->count = world_values.Integer(entry->count_field, 0, kMaxCount);
+    Fields d(*file_, f.Get("distribute"), "'distribute'");
+    d.Expect({"region", "clearance", "heading_deg"});
+    const Field region = d.Get("region");
+    if (!region.present() || (region.node.IsScalar() && world_values.String(region) == "arena")) {
+      if (!arena_)
+        file_->Fail(region.present() ? region.mark : d.mark(),
+                    "distributing in the arena needs an 'arena' in the world; or give "
+                    "'region: {min: [x, y], max: [x, y]}'");
+      entry->region = *arena_;
+      entry->region_text = "the arena";
+    } else if (region.node.IsMap()) {
+      Fields r(*file_, region, "'region'");
+      r.Expect({"min", "max"});
+      const std::vector<double> lo =
+          world_values.Numbers(r.Require("min"), 2, 2, loader::kCoordinate);
+      const std::vector<double> hi =
+          world_values.Numbers(r.Require("max"), 2, 2, loader::kCoordinate);
+      if (!(lo[0] < hi[0] && lo[1] < hi[1]))
+        file_->Fail(r.Get("max").mark, "'region' needs max greater than min in x and in y");
+      entry->region = {lo[0], lo[1], hi[0], hi[1]};
+      using loader::FormatNumber;
+      entry->region_text = "the region from [" + FormatNumber(lo[0]) + ", " + FormatNumber(lo[1]) +
+                           "] to [" + FormatNumber(hi[0]) + ", " + FormatNumber(hi[1]) + "]";
+    } else {
+      file_->Fail(region.mark, "'region' must be 'arena' or {min: [x, y], max: [x, y]} (got " +
+                                   loader::Describe(region.node) + ")");
+    }
+    if (d.Has("clearance"))
+      entry->clearance = world_values.Number(d.Get("clearance"), loader::kNonNegativeLength);
+    if (d.Has("heading_deg"))
+      entry->heading = world_values.Number(d.Get("heading_deg"), loader::kAngleDeg) * kDegToRad;
+    const double r = entry->footprint.radius;
+    if (entry->count > 0 && (entry->region.max_x - entry->region.min_x < 2 * r ||
+                             entry->region.max_y - entry->region.min_y < 2 * r))
+      file_->Fail(entry->count_field.mark, "the region is too small for one " + model.name +
+                                               " (footprint radius " + loader::FormatNumber(r) +
+                                               " m)");
+  } else {
+    if (!f.Has("position"))
+      file_->Fail(f.mark(),
+                  "a models entry needs 'distribute' (with 'count') to spread copies, or "
+                  "'position: [x, y]' for a single copy");
+    if (f.Has("count")) {
+      entry->count_field = f.Get("count");
+      if (world_values.Integer(entry->count_field, 0, kMaxCount) != 1)
+        file_->Fail(entry->count_field.mark, "'count' other than 1 needs 'distribute'");
+    }
+    const Field position = f.Get("position");
+    entry->position_field = position;
+    const std::vector<double> p = world_values.Numbers(position, 2, 3, loader::kCoordinate);
+    entry->fixed_pose.q = loader::ReadOrientation(world_values, f);
+    entry->fixed_pose.p = {p[0], p[1], p.size() == 3 ? p[2] : -entry->footprint.bottom};
+    entry->count = 1;
+  }
+}
+
+void WorldLoader::PlaceEntries() {
+  // Fixed copies first, so distributed ones keep clear of them wherever they are listed.
+  for (EntryPlan& e : entries_) {
+    if (e.distribute) continue;
+    const Pose& X = e.fixed_pose;
+    if (!placer_->IsFree(X.p.x, X.p.y, e.footprint.radius, 0))
+      file_->Fail(e.position_field.mark,
+                  "this " + e.model->name + " at [" + loader::FormatNumber(X.p.x) + ", " +
+                      loader::FormatNumber(X.p.y) +
+                      "] overlaps a wall, an obstacle or another placed copy");
+    placer_->AddBody(X.p.x, X.p.y, e.footprint.radius);
+  }
+  uint64_t stream = 0;
+  for (EntryPlan& e : entries_) {
+    if (!e.distribute) continue;
+    e.placements = placer_->Distribute(e.region, e.count, e.footprint.radius, e.clearance, stream++,
+                                       e.heading);
+    if (static_cast<int64_t>(e.placements.size()) < e.count)
+      file_->Fail(e.count_field.mark,
+                  "cannot place " + std::to_string(e.count) + " " + e.model->name + " copies in " +
+                      e.region_text + " without overlap (placed " +
+                      std::to_string(e.placements.size()) + "); enlarge the " +
+                      (e.region_text == "the arena" ? "arena" : "region") + " or reduce count");
+  }
+}
+
+void WorldLoader::BuildCopies(World* world) {
+  Scene& scene = world->scene();
+  for (EntryPlan& e : entries_) {
+    std::vector<Pose> poses;
+    if (!e.distribute) {
+      poses.push_back(e.fixed_pose);
+    } else {
+      for (const Placement2& p : e.placements)
+        poses.push_back({{p.x, p.y, -e.footprint.bottom}, Quat::FromYaw(p.yaw)});
+    }
+    if (poses.empty()) continue;
+    // The first copy from the description, the others duplicated from it
+    // (rows copied, scripts shared); each copy is a robot named model#index.
+    const ObjectId first = loader::AddToScene(e.spec, {}, &scene);
+    const std::string& name = e.model->name;
+    for (size_t k = 0; k < poses.size(); ++k) {
+      ObjectId root = first;
+      int instance;
+      if (k == 0) {
+        instance = scene.MakeModelInstance(first, name,
+                                           name + "#" + std::to_string(scene.instances().size()));
+      } else {
+        root = scene.DuplicateSubtree(first, {});
+        instance = scene.instance_of(root);
+      }
+      scene.set_name(root, scene.instance(instance).name);
+      scene.SetWorldPose(root, poses[k] * e.spec.X_PO);
+      world->SetInstanceParameters(instance, e.parameters);
+    }
+  }
+}
+
+// --- Metrics -------------------------------------------------------------------------------
+
+std::vector<SwarmMetricSpec> WorldLoader::ReadMetrics(const Fields& top, World* world) {
+  std::vector<SwarmMetricSpec> out;
+  const ValueReader values = WorldValues();
+  std::vector<std::string> known;
+  for (const auto& [name, description] : KnownSwarmMetrics()) known.push_back(name);
+  for (const Field& element : loader::ListElements(*file_, top.Get("metrics"), "metrics")) {
+    SwarmMetricSpec spec;
+    Field name_field = element;
+    if (element.node.IsMap()) {
+      Fields f(*file_, element, "a metric");
+      f.Expect({"name", "every"});
+      name_field = f.Require("name");
+      if (f.Has("every"))
+        spec.every_steps = static_cast<int>(values.Integer(f.Get("every"), 1, 1 << 30));
+    }
+    name_field.name = "name";
+    spec.name = values.String(name_field);
+    if (std::find(known.begin(), known.end(), spec.name) == known.end())
+      file_->Fail(name_field.mark,
+                  "unknown metric '" + spec.name + "'" + loader::Suggest(spec.name, known));
+    try {
+      world->AddObserver(MakeSwarmMetric(spec));
+    } catch (const Error& e) {
+      file_->Fail(name_field.mark, e.what());
+    }
+    out.push_back(spec);
+  }
+  return out;
+}
+
+}  // namespace
+
+LoadedWorld LoadWorld(const fs::path& file, const LoadOptions& options,
+                      const ModuleRegistry& registry) {
+  WorldLoader loader(file, options, registry);
+  try {
+    return loader.Load();
+  } catch (const Error&) {
+    throw;
+  } catch (const YAML::Exception& e) {
+    // A yaml-cpp conversion the checks above missed: still a message, never a crash.
+    throw Error(loader::DisplayPath(file) + ": " + e.what());
+  } catch (const std::bad_alloc&) {
+    throw Error(loader::DisplayPath(file) + ": out of memory while loading the world");
+  }
+}
+
+}  // namespace swarmsim
