@@ -3,7 +3,12 @@
 // One lua_State per model instance (robot); each script attached to an
 // object of the robot is a separate environment in it. Scripts outside any
 // model share one scene state that runs on the calling thread. Lua types
-// stay inside the host's .cc files.
+// stay inside the host's .cc files (lua_api.h is internal to them).
+//
+// The sim.* API is in lua_api_*.cc, one file per area; each function's
+// comment is its reference. A Lua error becomes a swarmsim::Error reading
+// "footbot#12: scripts/x.lua:23: <message> [in sysCall_actuation of
+// /footbot#12/body]".
 #pragma once
 
 #include <cstddef>
@@ -20,9 +25,11 @@ class ScriptHost {
   ScriptHost(const ScriptHost&) = delete;
   ScriptHost& operator=(const ScriptHost&) = delete;
 
-  // Creates the Lua states, loads every attached script and runs their
-  // sysCall_init, robots in index order, scripts in hierarchy order.
-  // Throws swarmsim::Error on a script error.
+  // Creates the Lua states, loads every enabled script and runs its body,
+  // then every sysCall_init, each robot's scripts in hierarchy order; then
+  // the scene's scripts likewise. Robots start in parallel (each touches
+  // only its own state); their prints and errors come out in robot order.
+  // Throws swarmsim::Error on a script error (the lowest robot's).
   void Start();
   // Control phase of one robot: sysCall_sensing of each of its scripts in
   // hierarchy order, then sysCall_actuation likewise. Safe to call
@@ -31,10 +38,12 @@ class ScriptHost {
   void RunInstance(int instance);
   // Control phase of the scripts outside any model, on the calling thread.
   void RunSceneScripts();
-  // sysCall_cleanup of every script; closes the states. Safe to call twice.
+  // sysCall_cleanup of every script whose sysCall_init returned; closes the
+  // states. Throws the lowest robot's cleanup error. Safe to call twice.
   void Stop();
 
-  // Bytes held by all Lua states (for the memory figures).
+  // Bytes held by all Lua states, as Lua counts them (lua_gc LUA_GCCOUNT;
+  // malloc's own overhead is not included).
   size_t MemoryBytes() const;
 
  private:

@@ -1,0 +1,103 @@
+// Internal to the Lua host: included only by script_host.cc and lua_*.cc.
+//
+// The per-state context every sim.* function reads, helpers shared by the
+// API areas, and the list of API areas. The rest of swarmsim never sees a
+// lua_State.
+//
+// Lua is the Debian C++ build (liblua5.4-c++): compiled as C++, so a Lua
+// error is a C++ throw and RAII holds in API functions, but with C linkage,
+// so its headers are included through lua.hpp (extern "C").
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <exception>
+#include <string>
+
+#include "framework/handle.h"
+#include "lua.hpp"
+
+namespace swarmsim {
+
+class Scene;
+class World;
+struct RobotRuntime;
+
+// What a sim.* function needs to know about its caller. One per lua_State,
+// reached through lua_getextraspace (coroutines inherit it). The host sets
+// the script fields before each callback.
+struct LuaContext {
+  World* world = nullptr;
+  Scene* scene = nullptr;
+  RobotRuntime* runtime = nullptr;  // the robot's, or the world's scene runtime
+  int instance = -1;                // robot index; -1 for the scene state
+  std::string name;                 // "footbot#12", or "scene"
+  std::string log_prefix;           // "[footbot#12] ", or "[scene] "
+  // The script being run.
+  ObjectId script_object;
+  int script_env_ref = LUA_NOREF;  // its environment table, in the registry
+};
+
+inline LuaContext& Context(lua_State* L) {
+  return **static_cast<LuaContext**>(lua_getextraspace(L));
+}
+inline void SetContext(lua_State* L, LuaContext* context) {
+  *static_cast<LuaContext**>(lua_getextraspace(L)) = context;
+}
+
+// Raises a Lua error "file:line: message" located at the Lua caller of the
+// running C function.
+[[noreturn]] void RaiseError(lua_State* L, const std::string& message);
+
+// A function name as a template argument: Guarded<F, "sim.getObject">.
+template <size_t N>
+struct FunctionName {
+  constexpr FunctionName(const char (&name)[N]) {  // NOLINT: implicit on purpose
+    for (size_t i = 0; i < N; ++i) text[i] = name[i];
+  }
+  char text[N];
+};
+
+// Runs an API function, turning a C++ exception (swarmsim::Error from the
+// Scene, std::bad_alloc, ...) into a Lua error "file:line: name: message" at
+// the caller's line. Without this, Lua's own catch(...) would swallow the
+// message. Lua's own errors (a thrown lua_longjmp*) pass through untouched.
+template <lua_CFunction F, FunctionName kName>
+int Guarded(lua_State* L) {
+  std::string message;
+  try {
+    return F(L);
+  } catch (const std::exception& e) {
+    message = std::string(kName.text) + ": " + e.what();
+  }
+  RaiseError(L, message);
+}
+
+// An object handle argument (an integer, ObjectId::ToInteger()).
+inline ObjectId CheckObject(lua_State* L, int arg) {
+  return ObjectId::FromInteger(luaL_checkinteger(L, arg));
+}
+// The optional "relative to" argument: nil or sim.handle_world give null.
+ObjectId OptRelativeTo(lua_State* L, int arg);
+
+// Pushes a new array {v[0], ..., v[n-1]}.
+void PushNumberArray(lua_State* L, const double* v, int n);
+
+// Each API area adds its functions to the `sim` table on top of the stack
+// (and, for base-library replacements such as print, to the globals).
+void RegisterObjectsApi(lua_State* L);
+void RegisterJointsApi(lua_State* L);
+void RegisterSensorsApi(lua_State* L);
+void RegisterSimApi(lua_State* L);
+
+// Creates the global `sim` table and calls every Register...Api above.
+void RegisterAllApis(lua_State* L);
+
+// Opens the safe standard libraries (base without file access or binary
+// chunks, string, table, math, coroutine, utf8) into the globals.
+void OpenSafeLibraries(lua_State* L);
+
+// Constant shared with scripts.
+constexpr lua_Integer kHandleWorld = -1;
+
+}  // namespace swarmsim

@@ -1,0 +1,116 @@
+// sim.* joints: targets (writes) and states (reads).
+//
+// A script writes its own robot's joints directly (only its worker touches
+// them). A write to another robot's joint, or from a robot to a scene joint,
+// is queued in RobotRuntime::deferred and applied by the World after the
+// control phase in handle order, so the result does not depend on which
+// robot ran first. Scene scripts run alone and write directly.
+#include <cmath>
+#include <string>
+
+#include "framework/error.h"
+#include "framework/lua_api.h"
+#include "framework/scene.h"
+#include "framework/world.h"
+
+namespace swarmsim {
+namespace {
+
+bool OwnsJoint(const LuaContext& c, uint32_t slot) {
+  return c.instance < 0 || c.scene->instance_of_at(slot) == c.instance;
+}
+
+// The joint at argument 1, validated (a wrong type or a stale handle throws
+// with the Scene's message).
+JointData& CheckJoint(lua_State* L, uint32_t* slot) {
+  Scene& scene = *Context(L).scene;
+  const ObjectId id = CheckObject(L, 1);
+  scene.joint(id);  // validates
+  *slot = id.index();
+  return scene.joints()[scene.row_at(*slot)];
+}
+
+void SetJointTarget(lua_State* L, DeferredWrite::Kind kind) {
+  const LuaContext& c = Context(L);
+  uint32_t slot = 0;
+  JointData& joint = CheckJoint(L, &slot);
+  const double value = luaL_checknumber(L, 2);
+  if (!std::isfinite(value)) throw Error("the target is not a finite number");
+  if (OwnsJoint(c, slot)) {
+    if (kind == DeferredWrite::Kind::kJointTargetVelocity)
+      joint.target_velocity = value;
+    else
+      joint.target_position = value;
+  } else {
+    c.runtime->deferred.push_back({c.scene->IdAt(slot), kind, value});
+  }
+}
+
+// sim.setJointTargetVelocity(h, v): rad/s or m/s, velocity-mode joints.
+int SetJointTargetVelocity(lua_State* L) {
+  SetJointTarget(L, DeferredWrite::Kind::kJointTargetVelocity);
+  return 0;
+}
+
+// sim.setJointTargetPosition(h, p): rad or m, position-mode joints.
+int SetJointTargetPosition(lua_State* L) {
+  SetJointTarget(L, DeferredWrite::Kind::kJointTargetPosition);
+  return 0;
+}
+
+// sim.getJointPosition(h) -> rad or m, as of the start of the phase.
+int GetJointPosition(lua_State* L) {
+  uint32_t slot = 0;
+  lua_pushnumber(L, CheckJoint(L, &slot).position);
+  return 1;
+}
+
+// sim.getJointVelocity(h) -> rad/s or m/s, as of the start of the phase.
+int GetJointVelocity(lua_State* L) {
+  uint32_t slot = 0;
+  lua_pushnumber(L, CheckJoint(L, &slot).velocity);
+  return 1;
+}
+
+// Targets change during the control phase, so only the joint's own robot
+// (or a scene script) may read them: anything else would race with the
+// owner and depend on the thread schedule.
+double ReadOwnTarget(lua_State* L, DeferredWrite::Kind kind) {
+  const LuaContext& c = Context(L);
+  uint32_t slot = 0;
+  const JointData& joint = CheckJoint(L, &slot);
+  if (!OwnsJoint(c, slot))
+    throw Error("joint '" + c.scene->PathOf(c.scene->IdAt(slot)) +
+                "' belongs to another robot; only its own scripts can read its target");
+  return kind == DeferredWrite::Kind::kJointTargetVelocity ? joint.target_velocity
+                                                           : joint.target_position;
+}
+
+// sim.getJointTargetVelocity(h) -> the target set so far (own robot only).
+int GetJointTargetVelocity(lua_State* L) {
+  lua_pushnumber(L, ReadOwnTarget(L, DeferredWrite::Kind::kJointTargetVelocity));
+  return 1;
+}
+
+// sim.getJointTargetPosition(h) -> the target set so far (own robot only).
+int GetJointTargetPosition(lua_State* L) {
+  lua_pushnumber(L, ReadOwnTarget(L, DeferredWrite::Kind::kJointTargetPosition));
+  return 1;
+}
+
+}  // namespace
+
+void RegisterJointsApi(lua_State* L) {
+  static constexpr luaL_Reg kFunctions[] = {
+      {"setJointTargetVelocity", Guarded<SetJointTargetVelocity, "sim.setJointTargetVelocity">},
+      {"setJointTargetPosition", Guarded<SetJointTargetPosition, "sim.setJointTargetPosition">},
+      {"getJointPosition", Guarded<GetJointPosition, "sim.getJointPosition">},
+      {"getJointVelocity", Guarded<GetJointVelocity, "sim.getJointVelocity">},
+      {"getJointTargetVelocity", Guarded<GetJointTargetVelocity, "sim.getJointTargetVelocity">},
+      {"getJointTargetPosition", Guarded<GetJointTargetPosition, "sim.getJointTargetPosition">},
+      {nullptr, nullptr},
+  };
+  luaL_setfuncs(L, kFunctions, 0);
+}
+
+}  // namespace swarmsim

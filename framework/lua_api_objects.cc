@@ -1,0 +1,109 @@
+// sim.* objects: lookup by path, names, the tree, poses.
+//
+// Poses are read from the scene as it was at the start of the control
+// phase (nothing moves objects during it), so any robot may read any object.
+#include <string>
+
+#include "framework/error.h"
+#include "framework/lua_api.h"
+#include "framework/scene.h"
+
+namespace swarmsim {
+namespace {
+
+// sim.getObject(path [, {noError = true}]) -> handle (or -1 with noError).
+// Paths as Scene::FindObject: '.', './a/b', ':/a', '/a/b', 'name[k]'.
+int GetObject(lua_State* L) {
+  const LuaContext& c = Context(L);
+  size_t length = 0;
+  const char* path = luaL_checklstring(L, 1, &length);
+  bool no_error = false;
+  if (lua_istable(L, 2)) {
+    lua_getfield(L, 2, "noError");
+    no_error = lua_toboolean(L, -1);
+    lua_pop(L, 1);
+  } else if (!lua_isnoneornil(L, 2)) {
+    luaL_typeerror(L, 2, "table of options");
+  }
+  // A malformed path throws even with noError: it is a mistake in the script.
+  const ObjectId id = c.scene->FindObject({path, length}, c.script_object);
+  if (!id.IsNull()) {
+    lua_pushinteger(L, id.ToInteger());
+    return 1;
+  }
+  if (no_error) {
+    lua_pushinteger(L, -1);
+    return 1;
+  }
+  throw Error("no object at path '" + std::string(path, length) + "' (looked up from " +
+              c.scene->PathOf(c.script_object) + ")");
+}
+
+// Pose of the object at argument 1 in the frame of the object at argument 2
+// (world if absent or sim.handle_world).
+Pose RelativePose(lua_State* L) {
+  const Scene& scene = *Context(L).scene;
+  const Pose& X_WO = scene.world_pose_at(scene.SlotOf(CheckObject(L, 1)));
+  const ObjectId relative_to = OptRelativeTo(L, 2);
+  if (relative_to.IsNull()) return X_WO;
+  const Pose& X_WR = scene.world_pose_at(scene.SlotOf(relative_to, "relative-to object"));
+  return X_WR.Inverse() * X_WO;
+}
+
+// sim.getObjectPose(h [, relTo]) -> {x, y, z, qx, qy, qz, qw} (CoppeliaSim order).
+int GetObjectPose(lua_State* L) {
+  const Pose X = RelativePose(L);
+  const double v[7] = {X.p.x, X.p.y, X.p.z, X.q.x, X.q.y, X.q.z, X.q.w};
+  PushNumberArray(L, v, 7);
+  return 1;
+}
+
+// sim.getObjectPosition(h [, relTo]) -> {x, y, z}.
+int GetObjectPosition(lua_State* L) {
+  const Pose X = RelativePose(L);
+  const double v[3] = {X.p.x, X.p.y, X.p.z};
+  PushNumberArray(L, v, 3);
+  return 1;
+}
+
+// sim.getObjectOrientation(h [, relTo]) -> {roll, pitch, yaw}, radians.
+// Unlike CoppeliaSim's Euler angles, these are extrinsic roll (x), pitch (y),
+// yaw (z) with R = Rz(yaw) Ry(pitch) Rx(roll), as Quat::RollPitchYaw; for a
+// robot on the floor, yaw is its heading.
+int GetObjectOrientation(lua_State* L) {
+  const Vec3 rpy = RelativePose(L).q.RollPitchYaw();
+  const double v[3] = {rpy.x, rpy.y, rpy.z};
+  PushNumberArray(L, v, 3);
+  return 1;
+}
+
+// sim.getObjectName(h) -> name.
+int GetObjectName(lua_State* L) {
+  const std::string& name = Context(L).scene->name(CheckObject(L, 1));
+  lua_pushlstring(L, name.data(), name.size());
+  return 1;
+}
+
+// sim.getObjectParent(h) -> parent handle, or -1 for a root.
+int GetObjectParent(lua_State* L) {
+  const ObjectId parent = Context(L).scene->parent(CheckObject(L, 1));
+  lua_pushinteger(L, parent.IsNull() ? -1 : parent.ToInteger());
+  return 1;
+}
+
+}  // namespace
+
+void RegisterObjectsApi(lua_State* L) {
+  static constexpr luaL_Reg kFunctions[] = {
+      {"getObject", Guarded<GetObject, "sim.getObject">},
+      {"getObjectPose", Guarded<GetObjectPose, "sim.getObjectPose">},
+      {"getObjectPosition", Guarded<GetObjectPosition, "sim.getObjectPosition">},
+      {"getObjectOrientation", Guarded<GetObjectOrientation, "sim.getObjectOrientation">},
+      {"getObjectName", Guarded<GetObjectName, "sim.getObjectName">},
+      {"getObjectParent", Guarded<GetObjectParent, "sim.getObjectParent">},
+      {nullptr, nullptr},
+  };
+  luaL_setfuncs(L, kFunctions, 0);
+}
+
+}  // namespace swarmsim

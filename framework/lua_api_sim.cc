@@ -1,0 +1,122 @@
+// sim.* simulation: time, parameters, random numbers, metrics, the robot's
+// identity, and print.
+#include <string>
+#include <string_view>
+#include <variant>
+
+#include "framework/error.h"
+#include "framework/lua_api.h"
+#include "framework/world.h"
+
+namespace swarmsim {
+namespace {
+
+// sim.getSimulationTime() -> s, at the start of the current step.
+int GetSimulationTime(lua_State* L) {
+  lua_pushnumber(L, Context(L).world->time());
+  return 1;
+}
+
+// sim.getTimeStep() -> s, one control step.
+int GetTimeStep(lua_State* L) {
+  lua_pushnumber(L, Context(L).world->settings().time_step);
+  return 1;
+}
+
+// sim.random() -> uniform in [0, 1) from the robot's own stream: the same
+// numbers whatever the thread count.
+int Random(lua_State* L) {
+  lua_pushnumber(L, Context(L).runtime->rng.Uniform());
+  return 1;
+}
+
+// sim.getParam(name [, default]) -> number, boolean or string: the robot's
+// model parameter, else the world parameter, else the default.
+int GetParam(lua_State* L) {
+  const LuaContext& c = Context(L);
+  size_t length = 0;
+  const char* name = luaL_checklstring(L, 1, &length);
+  const ParamValue* value = c.world->FindParameter(c.instance, {name, length});
+  if (value == nullptr) {
+    if (lua_gettop(L) >= 2) {
+      lua_settop(L, 2);
+      return 1;
+    }
+    throw Error("no parameter '" + std::string(name, length) +
+                "': set it in the world's or the model's parameters, or give a default");
+  }
+  if (const double* d = std::get_if<double>(value))
+    lua_pushnumber(L, *d);
+  else if (const bool* b = std::get_if<bool>(value))
+    lua_pushboolean(L, *b);
+  else {
+    const std::string& s = std::get<std::string>(*value);
+    lua_pushlstring(L, s.data(), s.size());
+  }
+  return 1;
+}
+
+// sim.recordMetric(name, value): a sample of this step for this robot; the
+// World collects them in robot order (World::TakeMetrics, metrics.csv).
+int RecordMetric(lua_State* L) {
+  const LuaContext& c = Context(L);
+  size_t length = 0;
+  const char* name = luaL_checklstring(L, 1, &length);
+  const double value = luaL_checknumber(L, 2);
+  c.runtime->metrics.push_back(
+      {c.world->step_count(), c.world->time(), c.instance, std::string(name, length), value});
+  return 0;
+}
+
+// sim.getRobotIndex() -> the robot's instance index (0-based); -1 in a scene script.
+int GetRobotIndex(lua_State* L) {
+  lua_pushinteger(L, Context(L).instance);
+  return 1;
+}
+
+// sim.getRobotName() -> e.g. "footbot#12"; nil in a scene script.
+int GetRobotName(lua_State* L) {
+  const LuaContext& c = Context(L);
+  if (c.instance < 0)
+    lua_pushnil(L);
+  else
+    lua_pushlstring(L, c.name.data(), c.name.size());
+  return 1;
+}
+
+// print(...): one line in the run's log, "[footbot#12] a\tb" (scene scripts:
+// "[scene] "), written out after the phase in robot order.
+int Print(lua_State* L) {
+  const LuaContext& c = Context(L);
+  const int n = lua_gettop(L);
+  std::string line = c.log_prefix;
+  for (int i = 1; i <= n; ++i) {
+    size_t length = 0;
+    const char* text = luaL_tolstring(L, i, &length);  // honours __tostring
+    if (i > 1) line += '\t';
+    line.append(text, length);
+    lua_pop(L, 1);
+  }
+  c.runtime->log.push_back(std::move(line));
+  return 0;
+}
+
+}  // namespace
+
+void RegisterSimApi(lua_State* L) {
+  static constexpr luaL_Reg kFunctions[] = {
+      {"getSimulationTime", Guarded<GetSimulationTime, "sim.getSimulationTime">},
+      {"getTimeStep", Guarded<GetTimeStep, "sim.getTimeStep">},
+      {"random", Guarded<Random, "sim.random">},
+      {"getParam", Guarded<GetParam, "sim.getParam">},
+      {"recordMetric", Guarded<RecordMetric, "sim.recordMetric">},
+      {"getRobotIndex", Guarded<GetRobotIndex, "sim.getRobotIndex">},
+      {"getRobotName", Guarded<GetRobotName, "sim.getRobotName">},
+      {nullptr, nullptr},
+  };
+  luaL_setfuncs(L, kFunctions, 0);
+  lua_pushcfunction(L, (Guarded<Print, "print">));
+  lua_setglobal(L, "print");
+}
+
+}  // namespace swarmsim

@@ -1,0 +1,588 @@
+#include "framework/script_host.h"
+
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "framework/error.h"
+#include "framework/world.h"
+#include "tests/framework/fakes.h"
+
+namespace swarmsim {
+namespace {
+
+std::shared_ptr<const ScriptSource> Source(std::string path, std::string code) {
+  return std::make_shared<const ScriptSource>(ScriptSource{std::move(path), std::move(code)});
+}
+
+// A world with null modules whose script output lands in `log`.
+class ScriptWorld {
+ public:
+  explicit ScriptWorld(int threads = 1, uint64_t seed = 1) : registry_(testing::NullRegistry()) {
+    WorldSettings settings;
+    settings.physics = "null";
+    settings.time_step = 0.1;
+    settings.threads = threads;
+    settings.seed = seed;
+    world_ = std::make_unique<World>(settings, registry_);
+    world_->set_log_sink([this](std::string_view line) { log.emplace_back(line); });
+  }
+  World& world() { return *world_; }
+  Scene& scene() { return world_->scene(); }
+
+  // A robot: a root dummy named like the instance (model root) carrying a
+  // `body` shape with joints `leftMotor` and `rightMotor`; `code` attached to
+  // the body unless empty. Returns the body.
+  ObjectId AddRobot(const std::string& name, const std::string& code,
+                    const std::string& path = "scripts/robot.lua") {
+    const ObjectId root = scene().AddDummy(name, {}, {{next_x_, 0, 0}, {}});
+    next_x_ += 1;
+    const ObjectId body = scene().AddShape("body", root, {}, {});
+    scene().AddJoint("leftMotor", body, {{0, 0.05, 0}, {}}, {});
+    scene().AddJoint("rightMotor", body, {{0, -0.05, 0}, {}}, {});
+    scene().MakeModelInstance(root, "bot", name);
+    if (!code.empty()) scene().AttachScript(body, Source(path, code));
+    return body;
+  }
+  ObjectId Joint(const std::string& path) { return scene().FindObject(path); }
+
+  std::vector<std::string> log;
+
+ private:
+  ModuleRegistry registry_;
+  std::unique_ptr<World> world_;
+  double next_x_ = 0;
+};
+
+// The message of the swarmsim::Error thrown by `f`, or "" if none.
+template <typename F>
+std::string ErrorOf(F&& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+#define EXPECT_CONTAINS(haystack, needle) \
+  EXPECT_NE(std::string(haystack).find(needle), std::string::npos) << (haystack)
+
+// --- Callbacks ------------------------------------------------------------------------
+
+TEST(ScriptHostTest, CallbacksRunInOrderAcrossSteps) {
+  ScriptWorld w;
+  w.AddRobot("bot#0", R"(
+    print('body')
+    function sysCall_init() print('init', sim.getSimulationTime()) end
+    function sysCall_sensing() print('sensing', sim.getSimulationTime()) end
+    function sysCall_actuation() print('actuation', sim.getSimulationTime()) end
+    function sysCall_cleanup() print('cleanup') end
+  )");
+  w.world().Start();
+  w.world().Step();
+  w.world().Step();
+  w.world().Stop();
+  const std::vector<std::string> expected = {"[bot#0] body",         "[bot#0] init\t0.0",
+                                             "[bot#0] sensing\t0.0", "[bot#0] actuation\t0.0",
+                                             "[bot#0] sensing\t0.1", "[bot#0] actuation\t0.1",
+                                             "[bot#0] cleanup"};
+  EXPECT_EQ(w.log, expected);
+}
+
+TEST(ScriptHostTest, ScriptsRunParentBeforeChildSiblingsInCreationOrder) {
+  ScriptWorld w;
+  const std::string code = R"(
+    local me = sim.getObjectName(sim.getObject('.'))
+    function sysCall_init() print('init ' .. me) end
+    function sysCall_actuation() print('act ' .. me) end
+  )";
+  Scene& s = w.scene();
+  const ObjectId root = s.AddDummy("root", {}, {});
+  const ObjectId a = s.AddDummy("a", root, {});
+  const ObjectId c = s.AddDummy("c", root, {});
+  const ObjectId b = s.AddDummy("b", a, {});  // created after c, but a's child
+  s.MakeModelInstance(root, "tree", "tree#0");
+  for (ObjectId id : {c, b, root, a}) s.AttachScript(id, Source("scripts/tree.lua", code));
+  w.world().Start();
+  w.world().Step();
+  const std::vector<std::string> expected = {
+      "[tree#0] init root", "[tree#0] init a", "[tree#0] init b", "[tree#0] init c",
+      "[tree#0] act root",  "[tree#0] act a",  "[tree#0] act b",  "[tree#0] act c"};
+  EXPECT_EQ(w.log, expected);
+}
+
+TEST(ScriptHostTest, MissingCallbacksAreSkippedAndDisabledScriptsDoNotRun) {
+  ScriptWorld w;
+  const ObjectId body = w.AddRobot("bot#0", "function sysCall_init() print('on') end");
+  const ObjectId eye = w.scene().AddDummy("eye", body, {});
+  w.scene().AttachScript(eye, Source("scripts/eye.lua", "print('eye body')"));
+  // Scene has no setter yet for ScriptAttachment::enabled (the world loader
+  // will need one); flip it the blunt way.
+  const_cast<ScriptAttachment*>(w.scene().script(eye))->enabled = false;
+  w.world().Start();
+  w.world().Step();
+  EXPECT_EQ(w.log, std::vector<std::string>{"[bot#0] on"});
+}
+
+// --- Environments and sandbox ---------------------------------------------------------
+
+TEST(ScriptHostTest, EachScriptHasItsOwnGlobalsAndOnlySafeLibraries) {
+  ScriptWorld w;
+  const ObjectId body = w.AddRobot("bot#0", R"(
+    secret = 42
+    _G.also_secret = 1
+    load('loaded = 7')()
+    function sysCall_init() print('a', secret, loaded) end
+  )");
+  const ObjectId eye = w.scene().AddDummy("eye", body, {});
+  w.scene().AttachScript(eye, Source("scripts/eye.lua", R"(
+    function sysCall_init()
+      print('b', secret, also_secret, loaded)
+      print(type(io), type(os), type(package), type(debug), type(dofile), type(loadfile),
+            type(string.dump), type(('').dump), type(require), type(math.pow))
+      print(type(sim), type(math.sin), type(string.format), type(table.insert),
+            type(coroutine.wrap), type(utf8.char), type(pcall), ('abc'):upper())
+      print(load(string.char(27) .. 'Lua'))
+      print(pcall(collectgarbage, 'stop'))
+    end
+  )"));
+  w.world().Start();
+  ASSERT_EQ(w.log.size(), 6u);
+  EXPECT_EQ(w.log[0], "[bot#0] a\t42\t7");
+  EXPECT_EQ(w.log[1], "[bot#0] b\tnil\tnil\tnil");
+  EXPECT_EQ(w.log[2], "[bot#0] nil\tnil\tnil\tnil\tnil\tnil\tnil\tnil\tnil\tnil");
+  EXPECT_EQ(w.log[3],
+            "[bot#0] table\tfunction\tfunction\tfunction\tfunction\tfunction\tfunction\tABC");
+  EXPECT_CONTAINS(w.log[4], "[bot#0] nil\t");
+  EXPECT_CONTAINS(w.log[4], "binary chunk");
+  EXPECT_CONTAINS(w.log[5], "[bot#0] false\t");
+}
+
+TEST(ScriptHostTest, CoroutinesSeeTheirScriptsContext) {
+  ScriptWorld w;
+  w.AddRobot("bot#0", R"(
+    function sysCall_init()
+      local co = coroutine.wrap(function() coroutine.yield(sim.getObjectName(sim.getObject('.'))) end)
+      print(co(), sim.getRobotName(), sim.getRobotIndex())
+    end
+  )");
+  w.world().Start();
+  EXPECT_EQ(w.log, std::vector<std::string>{"[bot#0] body\tbot#0\t0"});
+}
+
+// --- Errors -------------------------------------------------------------------------------
+
+TEST(ScriptHostTest, RuntimeErrorNamesRobotFileLineAndCallbackAndStopsTheWorld) {
+  ScriptWorld w;
+  w.AddRobot("bot#0", "function sysCall_actuation() end");
+  w.AddRobot("bot#1", "function sysCall_actuation()\n  local wheel = 1\n  local v = speed * 2\nend",
+             "scripts/broken.lua");
+  w.world().Start();
+  const std::string msg = ErrorOf([&] { w.world().Step(); });
+  EXPECT_CONTAINS(msg,
+                  "bot#1: scripts/broken.lua:3: attempt to perform arithmetic on a nil value "
+                  "(global 'speed') [in sysCall_actuation of /bot#1/body]");
+  EXPECT_CONTAINS(ErrorOf([&] { w.world().Step(); }), "cannot be stepped again");
+}
+
+TEST(ScriptHostTest, TheLowestRobotsErrorIsReportedWhateverTheThreadCount) {
+  for (int threads : {1, 2}) {
+    ScriptWorld w(threads);
+    for (int r = 0; r < 40; ++r)
+      w.AddRobot("bot#" + std::to_string(r),
+                 r < 17 ? "function sysCall_sensing() end"
+                        : "function sysCall_sensing() error('boom') end",
+                 "scripts/r" + std::to_string(r) + ".lua");
+    w.world().Start();
+    const std::string msg = ErrorOf([&] { w.world().Step(); });
+    EXPECT_CONTAINS(msg, "bot#17: scripts/r17.lua:1: boom [in sysCall_sensing of /bot#17/body]");
+  }
+}
+
+TEST(ScriptHostTest, SyntaxErrorNamesRobotFileAndLine) {
+  ScriptWorld w;
+  w.AddRobot("bot#0", "function sysCall_init()\n  local x = = 1\nend", "scripts/syntax.lua");
+  const std::string msg = ErrorOf([&] { w.world().Start(); });
+  EXPECT_CONTAINS(msg, "bot#0: scripts/syntax.lua:2: unexpected symbol near '='");
+  EXPECT_CONTAINS(msg, "[in loading the script of /bot#0/body]");
+  EXPECT_THROW(w.world().Step(), Error);
+}
+
+TEST(ScriptHostTest, UnclosedFunctionIsReportedAsInTheFile) {
+  ScriptWorld w;
+  w.AddRobot("bot#0", "function sysCall_init()\n  print(1)\n", "scripts/open.lua");
+  EXPECT_CONTAINS(ErrorOf([&] { w.world().Start(); }),
+                  "scripts/open.lua:3: 'end' expected (to close 'function' at line 1) near <eof>");
+}
+
+TEST(ScriptHostTest, ScriptCannotCloseItsWrapperEarly) {
+  ScriptWorld w;
+  w.AddRobot("bot#0", "end, function() print('escaped')", "scripts/sneaky.lua");
+  EXPECT_CONTAINS(ErrorOf([&] { w.world().Start(); }), "bot#0: scripts/sneaky.lua:1:");
+}
+
+TEST(ScriptHostTest, ErrorsInsideSimCallsCarryTheCallersLine) {
+  struct Case {
+    std::string call;
+    std::string message;
+  };
+  const std::vector<Case> cases = {
+      {"sim.setJointTargetVelocity(sim.getObject('.'), 1)",
+       "sim.setJointTargetVelocity: object 'body' is a shape, not a joint"},
+      {"sim.readProximitySensor(123456)",
+       "sim.readProximitySensor: proximity sensor handle 123456 does not exist"},
+      {"sim.getObject('./nope')",
+       "sim.getObject: no object at path './nope' (looked up from /bot#0/body)"},
+      {"sim.getObject('nope')", "sim.getObject: malformed object path 'nope'"},
+      {"sim.getParam('gain')", "sim.getParam: no parameter 'gain'"},
+      {"sim.setJointTargetVelocity(sim.getObject('./leftMotor'), 0/0)",
+       "sim.setJointTargetVelocity: the target is not a finite number"},
+      {"sim.getObjectPose('x')", "bad argument #1 to 'getObjectPose'"},
+  };
+  for (const Case& c : cases) {
+    ScriptWorld w;
+    w.AddRobot("bot#0", "function sysCall_sensing()\n\n  local r = " + c.call + "\nend",
+               "scripts/call.lua");
+    w.world().Start();
+    const std::string msg = ErrorOf([&] { w.world().Step(); });
+    EXPECT_CONTAINS(msg, "bot#0: scripts/call.lua:3: " + c.message);
+    EXPECT_CONTAINS(msg, "[in sysCall_sensing of /bot#0/body]");
+  }
+}
+
+TEST(ScriptHostTest, StaleHandleIsAnError) {
+  ScriptWorld w;
+  w.AddRobot("bot#0", R"(
+    function sysCall_init() eye = sim.getObject('./eye') end
+    function sysCall_actuation() sim.getObjectPose(eye) end
+  )",
+             "scripts/stale.lua");
+  const ObjectId eye = w.scene().AddDummy("eye", w.scene().FindObject("/bot#0/body"), {});
+  w.world().Start();
+  w.world().Step();
+  w.scene().RemoveSubtree(eye);
+  EXPECT_CONTAINS(ErrorOf([&] { w.world().Step(); }),
+                  "scripts/stale.lua:3: sim.getObjectPose: "
+                  "object handle " +
+                      std::to_string(eye.ToInteger()) + " is stale");
+}
+
+TEST(ScriptHostTest, CleanupErrorIsReportedByStop) {
+  ScriptWorld w;
+  w.AddRobot("bot#0", "function sysCall_cleanup()\n  error('bye')\nend", "scripts/c.lua");
+  w.world().Start();
+  EXPECT_CONTAINS(ErrorOf([&] { w.world().Stop(); }),
+                  "bot#0: scripts/c.lua:2: bye [in sysCall_cleanup of /bot#0/body]");
+}
+
+// --- Objects --------------------------------------------------------------------------------
+
+TEST(ScriptHostTest, DuplicatedModelsFindTheirOwnObjects) {
+  ScriptWorld w;
+  const ObjectId body = w.AddRobot("bot#0", R"(
+    local left, right, me
+    function sysCall_init()
+      left = sim.getObject('./leftMotor')
+      right = sim.getObject(':/rightMotor')
+      me = sim.getObject('.')
+      assert(sim.getObject('./motor', {noError = true}) == -1)
+      assert(sim.getObjectParent(left) == me)
+      assert(sim.getObjectParent(sim.getObjectParent(me)) == -1)
+    end
+    function sysCall_actuation()
+      sim.setJointTargetVelocity(left, sim.getRobotIndex() + 1)
+      sim.setJointTargetVelocity(right, -(sim.getRobotIndex() + 1))
+    end
+  )");
+  const ObjectId root = w.scene().parent(body);
+  w.scene().DuplicateSubtree(root, {});
+  w.scene().DuplicateSubtree(root, {});
+  ASSERT_EQ(w.world().robot_count(), 3);
+  w.world().Step();
+  for (int r = 0; r < 3; ++r) {
+    const ObjectId root = w.scene().instance(r).root;
+    EXPECT_EQ(w.scene().joint(w.scene().FindObject("./body/leftMotor", root)).velocity, r + 1.0);
+    EXPECT_EQ(w.scene().joint(w.scene().FindObject("./body/rightMotor", root)).velocity,
+              -(r + 1.0));
+  }
+}
+
+TEST(ScriptHostTest, RepeatedNamesAreIndexed) {
+  ScriptWorld w;
+  const ObjectId body = w.AddRobot("bot#0", R"(
+    function sysCall_init()
+      for i = 0, 2 do
+        local h = sim.getObject('./prox[' .. i .. ']')
+        print(sim.getObjectName(h), sim.getObjectPosition(h, sim.getObject('.'))[2])
+      end
+      print(sim.getObject('./prox[3]', {noError = true}))
+    end
+  )");
+  for (int i = 0; i < 3; ++i) w.scene().AddProximitySensor("prox", body, {{0, 0.5 * i, 0}, {}}, {});
+  w.world().Start();
+  const std::vector<std::string> expected = {"[bot#0] prox\t0.0", "[bot#0] prox\t0.5",
+                                             "[bot#0] prox\t1.0", "[bot#0] -1"};
+  EXPECT_EQ(w.log, expected);
+}
+
+TEST(ScriptHostTest, PosesInWorldAndRelativeFrames) {
+  ScriptWorld w;
+  const ObjectId body = w.scene().AddDummy("base", {}, {{1, 2, 0}, Quat::FromYaw(M_PI / 2)});
+  w.scene().AddDummy("tip", body, {{0.5, 0, 0.25}, {}});
+  w.scene().MakeModelInstance(body, "arm", "arm#0");
+  w.scene().AttachScript(body, Source("scripts/pose.lua", R"(
+    function sysCall_init()
+      local tip, me = sim.getObject('./tip'), sim.getObject('.')
+      local function show(t) local s = {} for i, v in ipairs(t) do s[i] = string.format('%.3f', v) end return table.concat(s, ' ') end
+      print(show(sim.getObjectPosition(tip)))
+      print(show(sim.getObjectPosition(tip, me)))
+      print(show(sim.getObjectPose(tip, sim.handle_world)))
+      print(show(sim.getObjectOrientation(tip)))
+      print(show(sim.getObjectOrientation(me, tip)))
+    end
+  )"));
+  w.world().Start();
+  const double h = std::sqrt(0.5);
+  char pose[200];
+  std::snprintf(pose, sizeof pose, "[arm#0] 1.000 2.500 0.250 0.000 0.000 %.3f %.3f", h, h);
+  const std::vector<std::string> expected = {
+      "[arm#0] 1.000 2.500 0.250", "[arm#0] 0.500 0.000 0.250", pose, "[arm#0] 0.000 0.000 1.571",
+      "[arm#0] 0.000 0.000 0.000"};
+  EXPECT_EQ(w.log, expected);
+}
+
+// --- Joints ---------------------------------------------------------------------------------
+
+TEST(ScriptHostTest, WritesToAnotherRobotsJointAreDeferredToAfterThePhase) {
+  ScriptWorld w;
+  // bot#0 runs first (one thread) and writes bot#1's motor; bot#1 must not
+  // see it during the same phase, but its own writes at once.
+  w.AddRobot("bot#0", R"(
+    function sysCall_sensing()
+      sim.setJointTargetVelocity(sim.getObject('/bot#1/body/leftMotor'), 5)
+    end
+  )");
+  w.AddRobot("bot#1", R"(
+    local left, right
+    function sysCall_init() left, right = sim.getObject('./leftMotor'), sim.getObject('./rightMotor') end
+    function sysCall_actuation()
+      sim.setJointTargetVelocity(right, 3)
+      sim.recordMetric('left_target', sim.getJointTargetVelocity(left))
+      sim.recordMetric('right_target', sim.getJointTargetVelocity(right))
+      sim.recordMetric('left_velocity', sim.getJointVelocity(left))
+    end
+  )");
+  w.world().Start();
+  w.world().Step();
+  auto metrics = w.world().TakeMetrics();
+  ASSERT_EQ(metrics.size(), 3u);
+  EXPECT_EQ(metrics[0].value, 0.0);  // not yet: deferred
+  EXPECT_EQ(metrics[1].value, 3.0);  // own write: immediate
+  EXPECT_EQ(metrics[2].value, 0.0);
+  EXPECT_EQ(w.scene().joint(w.Joint("/bot#1/body/leftMotor")).target_velocity, 5.0);
+  w.world().Step();
+  metrics = w.world().TakeMetrics();
+  ASSERT_EQ(metrics.size(), 3u);
+  EXPECT_EQ(metrics[0].value, 5.0);  // applied after the first phase
+  EXPECT_EQ(metrics[2].value, 5.0);
+}
+
+TEST(ScriptHostTest, ReadingAnotherRobotsJointTargetIsAnError) {
+  ScriptWorld w;
+  w.AddRobot("bot#0",
+             "function sysCall_sensing()\n  "
+             "sim.getJointTargetVelocity(sim.getObject('/bot#1/body/leftMotor'))\nend",
+             "scripts/peek.lua");
+  w.AddRobot("bot#1", "");
+  w.world().Start();
+  EXPECT_CONTAINS(ErrorOf([&] { w.world().Step(); }),
+                  "scripts/peek.lua:2: sim.getJointTargetVelocity: joint '/bot#1/body/leftMotor' "
+                  "belongs to another robot");
+}
+
+TEST(ScriptHostTest, SceneScriptsRunAfterRobotsAndWriteDirectly) {
+  ScriptWorld w;
+  w.AddRobot("bot#0", "function sysCall_actuation() print('robot') end");
+  const ObjectId floor = w.scene().AddDummy("floor", {}, {});
+  w.scene().AttachScript(floor, Source("scripts/main.lua", R"(
+    function sysCall_init() print('scene init', sim.getRobotIndex(), sim.getRobotName()) end
+    function sysCall_actuation()
+      local m = sim.getObject('/bot#0/body/leftMotor')
+      sim.setJointTargetVelocity(m, 2)
+      print('scene', sim.getJointTargetVelocity(m))
+    end
+  )"));
+  w.world().Start();
+  w.world().Step();
+  const std::vector<std::string> expected = {"[scene] scene init\t-1\tnil", "[bot#0] robot",
+                                             "[scene] scene\t2.0"};
+  EXPECT_EQ(w.log, expected);
+  EXPECT_EQ(w.scene().joint(w.Joint("/bot#0/body/leftMotor")).velocity, 2.0);
+}
+
+TEST(ScriptHostTest, SceneScriptErrorNamesTheScene) {
+  ScriptWorld w;
+  const ObjectId floor = w.scene().AddDummy("floor", {}, {});
+  w.scene().AttachScript(floor,
+                         Source("scripts/main.lua", "function sysCall_actuation()\n  x()\nend"));
+  w.world().Start();
+  EXPECT_CONTAINS(ErrorOf([&] { w.world().Step(); }),
+                  "scene: scripts/main.lua:2: attempt to call a nil value (global 'x') "
+                  "[in sysCall_actuation of /floor]");
+}
+
+// --- Sensors --------------------------------------------------------------------------------
+
+TEST(ScriptHostTest, ReadProximitySensorReturnsTheReading) {
+  ScriptWorld w;
+  const ObjectId body = w.AddRobot("bot#0", R"(
+    function sysCall_sensing()
+      for i = 0, 1 do
+        local h = sim.getObject('./prox[' .. i .. ']')
+        print(select('#', sim.readProximitySensor(h)))
+        local detected, distance, point, object = sim.readProximitySensor(h)
+        if detected == 1 then
+          print(detected, distance, point[1], point[2], point[3], sim.getObjectName(object))
+        else
+          print(detected)
+        end
+      end
+    end
+  )");
+  const ObjectId wall = w.scene().AddShape("wall", {}, {}, {});
+  const ObjectId p0 = w.scene().AddProximitySensor("prox", body, {}, {});
+  w.scene().AddProximitySensor("prox", body, {}, {});
+  ProximitySensorData& reading = w.scene().mutable_proximity_sensor(p0);
+  reading.detected = true;
+  reading.distance = 0.0625;
+  reading.p_SD = {0, 0, 0.0625};
+  reading.detected_object = wall;
+  w.world().Start();
+  w.world().Step();  // the null proximity module leaves the readings alone
+  const std::vector<std::string> expected = {
+      "[bot#0] 4", "[bot#0] 1\t0.0625\t0.0\t0.0\t0.0625\twall", "[bot#0] 1", "[bot#0] 0"};
+  EXPECT_EQ(w.log, expected);
+}
+
+// --- Simulation -----------------------------------------------------------------------------
+
+TEST(ScriptHostTest, PrintWritesOnePrefixedTabSeparatedLine) {
+  ScriptWorld w;
+  w.AddRobot(
+      "bot#0",
+      R"(print('a', 1, 2.5, nil, true, setmetatable({}, {__tostring = function() return 'obj' end})))");
+  w.world().Start();
+  EXPECT_EQ(w.log, std::vector<std::string>{"[bot#0] a\t1\t2.5\tnil\ttrue\tobj"});
+}
+
+TEST(ScriptHostTest, RecordedMetricsReachTheWorld) {
+  ScriptWorld w;
+  w.AddRobot("bot#0", "function sysCall_actuation() sim.recordMetric('speed', 1.5) end");
+  w.AddRobot("bot#1", "function sysCall_actuation() sim.recordMetric('speed', 2.5) end");
+  w.world().Start();
+  w.world().Step();
+  w.world().Step();
+  const std::vector<MetricSample> metrics = w.world().TakeMetrics();
+  ASSERT_EQ(metrics.size(), 4u);
+  EXPECT_EQ(metrics[0].step, 0);
+  EXPECT_EQ(metrics[0].instance, 0);
+  EXPECT_EQ(metrics[0].name, "speed");
+  EXPECT_EQ(metrics[0].value, 1.5);
+  EXPECT_EQ(metrics[1].instance, 1);
+  EXPECT_EQ(metrics[1].value, 2.5);
+  EXPECT_EQ(metrics[3].step, 1);
+  EXPECT_DOUBLE_EQ(metrics[3].time, 0.1);
+  EXPECT_EQ(metrics[3].instance, 1);
+}
+
+TEST(ScriptHostTest, RandomNumbersArePerRobotAndReproducible) {
+  auto run = [](uint64_t seed) {
+    ScriptWorld w(2, seed);
+    for (int r = 0; r < 3; ++r)
+      w.AddRobot("bot#" + std::to_string(r), R"(
+        function sysCall_actuation()
+          sim.recordMetric('sim', sim.random())
+          sim.recordMetric('lua', math.random())
+        end
+      )");
+    w.world().Start();
+    w.world().Step();
+    w.world().Step();
+    std::vector<double> values;
+    for (const MetricSample& m : w.world().TakeMetrics()) values.push_back(m.value);
+    return values;
+  };
+  const std::vector<double> a = run(7), b = run(7), c = run(8);
+  ASSERT_EQ(a.size(), 12u);
+  EXPECT_EQ(a, b);
+  EXPECT_NE(a, c);
+  // Robots draw different numbers (step 0: robot 0, 1, 2; sim then lua).
+  EXPECT_NE(a[0], a[2]);
+  EXPECT_NE(a[2], a[4]);
+  EXPECT_NE(a[1], a[3]);
+  for (double v : a) {
+    EXPECT_GE(v, 0.0);
+    EXPECT_LT(v, 1.0);
+  }
+}
+
+TEST(ScriptHostTest, ParametersComeFromTheRobotThenTheWorldThenTheDefault) {
+  ScriptWorld w;
+  const std::string code = R"(
+    function sysCall_init()
+      print(sim.getParam('speed'), sim.getParam('name'), sim.getParam('fast'),
+            sim.getParam('missing', 3), sim.getParam('missing', nil))
+    end
+  )";
+  w.AddRobot("bot#0", code);
+  w.AddRobot("bot#1", code);
+  w.world().parameters()["speed"] = 0.5;
+  w.world().parameters()["name"] = std::string("world");
+  w.world().parameters()["fast"] = false;
+  auto own = std::make_shared<ParameterSet>();
+  (*own)["speed"] = 2.0;
+  (*own)["fast"] = true;
+  w.world().SetInstanceParameters(1, own);
+  w.world().Start();
+  const std::vector<std::string> expected = {"[bot#0] 0.5\tworld\tfalse\t3\tnil",
+                                             "[bot#1] 2.0\tworld\ttrue\t3\tnil"};
+  EXPECT_EQ(w.log, expected);
+}
+
+TEST(ScriptHostTest, SameStateWhateverTheThreadCount) {
+  auto run = [](int threads) {
+    ScriptWorld w(threads, 42);
+    for (int r = 0; r < 50; ++r)
+      w.AddRobot("bot#" + std::to_string(r), R"(
+        local left, right
+        function sysCall_init() left, right = sim.getObject('./leftMotor'), sim.getObject('./rightMotor') end
+        function sysCall_actuation()
+          sim.setJointTargetVelocity(left, sim.random())
+          sim.setJointTargetVelocity(right, math.random() - 0.5)
+          -- and a write to a neighbour, deferred
+          local other = sim.getObject('/bot#' .. ((sim.getRobotIndex() + 1) % 50) .. '/body/rightMotor')
+          if sim.random() < 0.1 then sim.setJointTargetVelocity(other, 1) end
+        end
+      )");
+    w.world().Start();
+    for (int i = 0; i < 10; ++i) w.world().Step();
+    return w.world().StateHash();
+  };
+  EXPECT_EQ(run(1), run(2));
+}
+
+TEST(ScriptHostTest, MemoryIsReportedAndReleasedAtStop) {
+  ScriptWorld w;
+  w.AddRobot("bot#0", "function sysCall_actuation() end");
+  w.AddRobot("bot#1", "");
+  w.world().Start();
+  EXPECT_GT(w.world().script_memory_bytes(), 1000u);
+  w.world().Stop();
+  EXPECT_EQ(w.world().script_memory_bytes(), 0u);
+}
+
+}  // namespace
+}  // namespace swarmsim
