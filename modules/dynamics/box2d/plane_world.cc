@@ -102,8 +102,13 @@ void ThrowIfNotFinite(const Scene& scene, uint32_t slot, const Pose& X) {
 
 }  // namespace
 
+bool Box2dTimerIsOverridden();  // b2_timer_override.cc
+
 PlaneWorld::PlaneWorld(const Options& options, const DynamicsSettings& settings)
     : options_(options), settings_(settings), scale_(options.length_scale) {
+  // Keeps the free-timer definitions linked in (see b2_timer_override.cc).
+  static const bool timers_free = Box2dTimerIsOverridden();
+  (void)timers_free;
   if (!(scale_ > 0) || !std::isfinite(scale_))
     throw Error("box2d: length_scale must be a positive number, got " + std::to_string(scale_));
   // Gravity only sets ground friction here; zero makes the ground frictionless.
