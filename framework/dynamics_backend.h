@@ -33,6 +33,10 @@ class DynamicsBackend {
   // future (warm-start caches, contact state) into the hash. May do nothing
   // when the engine is rebuilt identically from the scene.
   virtual void HashState(StateHasher* /*hasher*/) const {}
+  // Sets JointData::simulated on the joints whose position and velocity the
+  // engine integrates (World::Actuate then skips them). Called after Build;
+  // a backend that rebuilds itself in Step marks them again there.
+  virtual void MarkSimulatedJoints(Scene* /*scene*/) const {}
   // Number of bodies the engine simulates (for summaries).
   virtual int body_count() const = 0;
 };

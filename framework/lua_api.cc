@@ -33,6 +33,9 @@ void RegisterAllApis(lua_State* L) {
       RegisterObjectsApi,  // lua_api_objects.cc: lookup, names, tree, poses
       RegisterJointsApi,   // lua_api_joints.cc: joint targets and states
       RegisterSensorsApi,  // lua_api_sensors.cc: proximity sensors
+      RegisterMessagesApi, // lua_api_messages.cc: messages, signals, packing
+      RegisterControlApi,  // script_host.cc: child scripts, threads, main-script handlers
+      RegisterDynamicsApi,  // lua_api_dynamics.cc: dynamic/kinematic switch, joint forces
   };
   lua_newtable(L);
   lua_pushinteger(L, kHandleWorld);

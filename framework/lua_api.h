@@ -23,6 +23,12 @@ class Scene;
 class World;
 struct RobotRuntime;
 
+// A script's read position in its robot's inbox (sim.receiveMessage).
+struct ScriptMailbox {
+  uint64_t round = 0;  // World::message_round() the position refers to
+  uint32_t next = 0;   // next inbox entry to look at
+};
+
 // What a sim.* function needs to know about its caller. One per lua_State,
 // reached through lua_getextraspace (coroutines inherit it). The host sets
 // the script fields before each callback.
@@ -36,6 +42,13 @@ struct LuaContext {
   // The script being run.
   ObjectId script_object;
   int script_env_ref = LUA_NOREF;  // its environment table, in the registry
+  ScriptMailbox* mailbox = nullptr;
+  void* host_state = nullptr;  // the host's ScriptState (script_host.cc)
+  void* host_script = nullptr; // the host's Script being run (script_host.cc)
+  bool is_main = false;        // the main script's state
+  bool in_sensing = false;     // running a sysCall_sensing (sim.handleChildScript follows it)
+  int64_t slice_fires = 0;     // time-slice hook calls since the thread was resumed
+  std::string pending_error;   // a World error raised through the main script, verbatim
 };
 
 inline LuaContext& Context(lua_State* L) {
@@ -89,6 +102,9 @@ void RegisterObjectsApi(lua_State* L);
 void RegisterJointsApi(lua_State* L);
 void RegisterSensorsApi(lua_State* L);
 void RegisterSimApi(lua_State* L);
+void RegisterMessagesApi(lua_State* L);
+void RegisterControlApi(lua_State* L);
+void RegisterDynamicsApi(lua_State* L);
 
 // Creates the global `sim` table and calls every Register...Api above.
 void RegisterAllApis(lua_State* L);

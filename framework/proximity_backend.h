@@ -2,6 +2,8 @@
 // environment and against other robots.
 #pragma once
 
+#include "framework/math.h"
+
 namespace swarmsim {
 
 class Scene;
@@ -26,6 +28,13 @@ class ProximityBackend {
   virtual void SenseInstance(Scene* scene, int instance) const = 0;
   // Fills the readings of sensors that belong to no robot.
   virtual void SenseSceneSensors(Scene* scene) const = 0;
+  // Does a static shape cross the segment a-b (world frame, m)? Used for
+  // line-of-sight messages. Thread-safe. Default: nothing blocks.
+  virtual bool SegmentBlocked(const Vec3& a_W, const Vec3& b_W) const {
+    (void)a_W;
+    (void)b_W;
+    return false;
+  }
 };
 
 }  // namespace swarmsim

@@ -23,12 +23,19 @@ const char* ToString(ShapeKind kind) {
     case ShapeKind::kBox: return "box";
     case ShapeKind::kCylinder: return "cylinder";
     case ShapeKind::kSphere: return "sphere";
+    case ShapeKind::kCapsule: return "capsule";
   }
   return "?";
 }
 
 const char* ToString(JointType type) {
-  return type == JointType::kRevolute ? "revolute" : "prismatic";
+  switch (type) {
+    case JointType::kRevolute: return "revolute";
+    case JointType::kPrismatic: return "prismatic";
+    case JointType::kSpherical: return "spherical";
+    case JointType::kFixed: return "fixed";
+  }
+  return "?";
 }
 
 const char* ToString(JointMode mode) {
@@ -36,6 +43,7 @@ const char* ToString(JointMode mode) {
     case JointMode::kPassive: return "passive";
     case JointMode::kVelocity: return "velocity";
     case JointMode::kPosition: return "position";
+    case JointMode::kForce: return "force";
   }
   return "?";
 }
@@ -44,14 +52,20 @@ double ShapeData::BoundingRadius() const {
   switch (kind) {
     case ShapeKind::kBox: return 0.5 * std::sqrt(size.x * size.x + size.y * size.y);
     case ShapeKind::kCylinder:
+    case ShapeKind::kCapsule:
     case ShapeKind::kSphere: return size.x;
   }
   return 0;
 }
 
 Pose JointData::Motion() const {
-  if (type == JointType::kRevolute) return {{}, Quat::FromAxisAngle({0, 0, 1}, position)};
-  return {{0, 0, position}, {}};
+  switch (type) {
+    case JointType::kRevolute: return {{}, Quat::FromAxisAngle({0, 0, 1}, position)};
+    case JointType::kPrismatic: return {{0, 0, position}, {}};
+    case JointType::kSpherical: return {{}, ball};
+    case JointType::kFixed: break;
+  }
+  return {};
 }
 
 Scene::Scene() = default;
@@ -394,12 +408,37 @@ void Scene::SetSimulatedState(uint32_t slot, const Pose& X_WO, const Vec3& v_WO,
   simulated_[slot] = 1;
 }
 
+static inline void UpdateOne(uint32_t s, const std::vector<int32_t>& parent_of,
+                             std::vector<uint8_t>* simulated, std::vector<Pose>* X_PO,
+                             std::vector<Pose>* X_WO, const Scene& scene);
+
 void Scene::RebuildOrder() const {
   order_.clear();
   order_.reserve(object_count_);
   for (uint32_t s = 0; s < generation_.size(); ++s)
     if (alive_[s] && parent_[s] < 0) CollectSubtree(s, &order_);
+  scene_order_.clear();
+  instances_independent_ = true;
+  for (uint32_t s : order_) {
+    const int32_t p = parent_[s];
+    if (instance_[s] < 0) {
+      scene_order_.push_back(s);
+      if (p >= 0 && instance_[p] >= 0) instances_independent_ = false;  // hangs from a robot
+    } else if (p >= 0 && instance_[p] != instance_[s]) {
+      instances_independent_ = false;  // a robot mounted on something else
+    }
+  }
   order_dirty_ = false;
+}
+
+bool Scene::InstancesAreIndependent() const {
+  if (order_dirty_) RebuildOrder();
+  return instances_independent_;
+}
+
+void Scene::UpdateSceneObjectPoses() {
+  if (order_dirty_) RebuildOrder();
+  for (uint32_t s : scene_order_) UpdateOne(s, parent_, &simulated_, &X_PO_, &X_WO_, *this);
 }
 
 static inline void UpdateOne(uint32_t s, const std::vector<int32_t>& parent_of,
@@ -445,6 +484,12 @@ ShapeData& Scene::mutable_shape(ObjectId id) {
   ExpectType(*this, s, ObjectType::kShape);
   return shapes_[row_[s]];
 }
+void Scene::SetShapeDynamic(ObjectId id, bool dynamic) {
+  ShapeData& shape = mutable_shape(id);
+  if (shape.dynamic == dynamic) return;
+  shape.dynamic = dynamic;
+  ++structure_version_;
+}
 const JointData& Scene::joint(ObjectId id) const {
   const uint32_t s = SlotOf(id, "joint");
   ExpectType(*this, s, ObjectType::kJoint);
@@ -481,13 +526,14 @@ ObjectId Scene::linked_dummy(ObjectId id) const {
 
 // --- Scripts ------------------------------------------------------------------------------
 
-void Scene::AttachScript(ObjectId id, std::shared_ptr<const ScriptSource> source) {
+void Scene::AttachScript(ObjectId id, std::shared_ptr<const ScriptSource> source,
+                         bool explicit_handling) {
   const uint32_t slot = SlotOf(id);
   if (script_[slot] < 0) {
     script_[slot] = static_cast<int32_t>(scripts_.size());
     scripts_.emplace_back();
   }
-  scripts_[script_[slot]] = {std::move(source), true};
+  scripts_[script_[slot]] = {std::move(source), true, explicit_handling};
 }
 
 const ScriptAttachment* Scene::script(ObjectId id) const { return script_at(SlotOf(id)); }

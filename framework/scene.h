@@ -26,13 +26,16 @@ namespace swarmsim {
 enum class ObjectType : uint8_t { kDummy, kShape, kJoint, kProximitySensor };
 const char* ToString(ObjectType type);
 
-enum class ShapeKind : uint8_t { kBox, kCylinder, kSphere };
+enum class ShapeKind : uint8_t { kBox, kCylinder, kSphere, kCapsule };
 const char* ToString(ShapeKind kind);
 
 // Geometry is centred on the shape's frame; a cylinder's axis is its z axis.
+// A capsule is a cylinder with hemispherical caps along z; its height is the
+// total length, caps included (>= 2 radius), so its bounding cylinder has the
+// same size (modules that lack exact capsule code use that).
 struct ShapeData {
   ShapeKind kind = ShapeKind::kBox;
-  Vec3 size{0.1, 0.1, 0.1};  // box: full extents (x, y, z) m; cylinder: (radius, -, height); sphere: (radius, -, -)
+  Vec3 size{0.1, 0.1, 0.1};  // box: full extents (x, y, z) m; cylinder, capsule: (radius, -, height); sphere: (radius, -, -)
   bool dynamic = false;      // simulated by the dynamics backend, else static or kinematic
   double mass = 1.0;         // kg, dynamic shapes only
   double friction = 0.7;     // Coulomb coefficient
@@ -43,13 +46,16 @@ struct ShapeData {
   double BoundingRadius() const;
 };
 
-enum class JointType : uint8_t { kRevolute, kPrismatic };
-enum class JointMode : uint8_t { kPassive, kVelocity, kPosition };
+enum class JointType : uint8_t { kRevolute, kPrismatic, kSpherical, kFixed };
+// kForce: the joint applies target_force (N or N m) and moves only if a
+// dynamics backend simulates it.
+enum class JointMode : uint8_t { kPassive, kVelocity, kPosition, kForce };
 const char* ToString(JointType type);
 const char* ToString(JointMode mode);
 
 // A joint moves its children along/about its own z axis (V-REP's convention):
-// X_W(child) = X_WJ * Motion(position) * X_J(child).
+// X_W(child) = X_WJ * Motion(position) * X_J(child). A spherical joint turns
+// them by `ball` (position and velocity unused); a fixed joint does not move.
 struct JointData {
   JointType type = JointType::kRevolute;
   JointMode mode = JointMode::kVelocity;
@@ -59,6 +65,13 @@ struct JointData {
   double target_position = 0;  // position mode
   double max_force = 10;       // N or N m
   double max_velocity = 10;    // rad/s or m/s, position mode
+  double target_force = 0;     // N or N m, force mode
+  double min_position = -INFINITY;  // limits, rad or m (infinite: unlimited)
+  double max_position = INFINITY;
+  Quat ball;                   // spherical joints: rotation of the children
+  // Set by a dynamics backend that integrates this joint's position and
+  // velocity itself; World::Actuate then leaves them alone.
+  bool simulated = false;
 
   Pose Motion() const;  // transform produced by `position` about/along z
 };
@@ -81,6 +94,8 @@ struct ScriptSource {
 struct ScriptAttachment {
   std::shared_ptr<const ScriptSource> source;
   bool enabled = true;
+  // Runs only when an ancestor's script calls sim.handleChildScript(handle, ...).
+  bool explicit_handling = false;
 };
 
 // A top-level model copy: one robot.
@@ -159,6 +174,12 @@ class Scene {
   void UpdateWorldPoses();
   // Same, for one model instance's objects only (thread-safe across instances).
   void UpdateWorldPoses(int instance);
+  // Same, for the objects outside every instance (on the calling thread).
+  void UpdateSceneObjectPoses();
+  // True when robots hang from no scene object and no scene object hangs from
+  // a robot: then UpdateWorldPoses() equals UpdateWorldPoses(i) for every
+  // instance i (in any order, concurrently) followed by UpdateSceneObjectPoses().
+  bool InstancesAreIndependent() const;
   // Pose of the frame children of `slot` hang from: X_WO, times the joint
   // motion if the object is a joint.
   Pose ChildFrameAt(uint32_t slot) const;
@@ -166,6 +187,10 @@ class Scene {
   // --- Typed data ---------------------------------------------------------------
   const ShapeData& shape(ObjectId id) const;
   ShapeData& mutable_shape(ObjectId id);
+  // Switches a shape between dynamic and kinematic/static (hybrid
+  // simulation). Counts as a structural change, so dynamics backends rebuild
+  // (taking velocities from the scene). Not thread-safe: call between phases.
+  void SetShapeDynamic(ObjectId id, bool dynamic);
   const JointData& joint(ObjectId id) const;
   JointData& mutable_joint(ObjectId id);
   const ProximitySensorData& proximity_sensor(ObjectId id) const;
@@ -188,7 +213,8 @@ class Scene {
   ObjectId linked_dummy(ObjectId id) const;
 
   // --- Scripts ------------------------------------------------------------------
-  void AttachScript(ObjectId id, std::shared_ptr<const ScriptSource> source);
+  void AttachScript(ObjectId id, std::shared_ptr<const ScriptSource> source,
+                    bool explicit_handling = false);
   // Null if the object has no script.
   const ScriptAttachment* script(ObjectId id) const;
   const ScriptAttachment* script_at(uint32_t slot) const;
@@ -252,6 +278,8 @@ class Scene {
 
   // Topological order of all live slots (parents first), rebuilt lazily.
   mutable std::vector<uint32_t> order_;
+  mutable std::vector<uint32_t> scene_order_;  // order_ without instance objects
+  mutable bool instances_independent_ = true;
   mutable bool order_dirty_ = true;
   uint64_t structure_version_ = 0;
 };

@@ -1,17 +1,26 @@
 #include "framework/scheduler.h"
 
 #include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/global_control.h>
 #include <oneapi/tbb/info.h>
 #include <oneapi/tbb/parallel_for.h>
 #include <oneapi/tbb/partitioner.h>
 #include <oneapi/tbb/task_arena.h>
 
+#include <algorithm>
 #include <thread>
 
 namespace swarmsim {
 
 struct TaskScheduler::Impl {
-  explicit Impl(int threads) : arena(threads) {}
+  // TBB caps its worker pool at the core count; asking for more threads than
+  // cores (to test determinism at 4 threads on 2 cores, say) raises the cap
+  // for as long as this scheduler lives.
+  explicit Impl(int threads)
+      : allow(oneapi::tbb::global_control::max_allowed_parallelism,
+              static_cast<size_t>(std::max(threads, HardwareThreads()))),
+        arena(threads) {}
+  oneapi::tbb::global_control allow;
   oneapi::tbb::task_arena arena;
 };
 

@@ -7,9 +7,21 @@
 // `function(_ENV, ...) <code> end` and called once per script with that
 // script's environment; the callbacks it defines are looked up once, kept as
 // registry references, and called without string lookups every step.
+//
+// Child scripts run in hierarchy order (a parent's before its descendants',
+// siblings in scene order). An explicit script runs only when an ancestor's
+// script calls sim.handleChildScript(handle, ...). A script defining
+// sysCall_thread runs it as a coroutine, resumed once a step with the
+// actuation callbacks until it yields (sim.step/sim.switchThread) or its
+// time slice runs out: a count hook that yields, so the slice is a number of
+// Lua instructions (kInstructionsPerMs per millisecond of
+// sim.setThreadSwitchTiming) and results do not depend on machine speed.
+// Every non-threaded callback runs under an instruction budget (count hook
+// that raises an error).
 #include "framework/script_host.h"
 
 #include <algorithm>
+#include <climits>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -24,9 +36,17 @@
 namespace swarmsim {
 namespace {
 
-enum Callback : int { kInit, kSensing, kActuation, kCleanup, kCallbackCount };
-constexpr const char* kCallbackNames[kCallbackCount] = {"sysCall_init", "sysCall_sensing",
-                                                        "sysCall_actuation", "sysCall_cleanup"};
+enum Callback : int { kInit, kSensing, kActuation, kCleanup, kThread, kStep, kCallbackCount };
+constexpr const char* kCallbackNames[kCallbackCount] = {
+    "sysCall_init", "sysCall_sensing", "sysCall_actuation", "sysCall_cleanup", "sysCall_thread",
+    "sysCall_step"};
+
+// Lua instructions per millisecond of thread time slice: PUC Lua 5.4 runs
+// roughly 100 to 300 million simple VM instructions a second on a current
+// core, so 100,000 per ms errs on the short side. The default slice, 2 ms
+// (CoppeliaSim's), is 200,000 instructions.
+constexpr int64_t kInstructionsPerMs = 100'000;
+constexpr int kDefaultSliceInstructions = 200'000;
 
 // Robots started per task: starting one compiles its scripts and runs their
 // bodies and sysCall_init, a few tens of microseconds.
@@ -35,13 +55,22 @@ constexpr int64_t kStartGrain = 4;
 // Registry key of the metatable shared by the script environments of a state.
 const char kEnvironmentMetatableKey = 0;
 
-// A script attached to one object.
-struct Script {  // 36 bytes
+// A script attached to one object (or the main script: no object).
+struct Script {  // 88 bytes
   uint32_t slot = 0;
   ObjectId object;
+  const ScriptSource* source = nullptr;
   int env_ref = LUA_NOREF;  // environment table, in the registry
-  int callbacks[kCallbackCount] = {LUA_NOREF, LUA_NOREF, LUA_NOREF, LUA_NOREF};
+  int callbacks[kCallbackCount] = {LUA_NOREF, LUA_NOREF, LUA_NOREF,
+                                   LUA_NOREF, LUA_NOREF, LUA_NOREF};
   bool initialized = false;  // sysCall_init returned: sysCall_cleanup is due
+  bool explicit_handling = false;  // runs only through sim.handleChildScript
+  bool disabled = false;           // failed under on_script_error: disable_script
+  bool running = false;            // inside a call (no re-entry through handleChildScript)
+  lua_State* thread = nullptr;     // sysCall_thread's coroutine, while it runs
+  int thread_ref = LUA_NOREF;      // keeps `thread` alive, in the registry
+  int slice_instructions = kDefaultSliceInstructions;
+  ScriptMailbox mailbox;
 };
 
 // One lua_State and its scripts: a robot's, or the scene's.
@@ -79,24 +108,120 @@ std::string ErrorText(lua_State* L, int status) {
                                    std::string_view what) {
   lua_settop(state.L, 0);
   const Scene& scene = *state.context.scene;
-  const std::string path = scene.IsValid(object) ? scene.PathOf(object) : std::string("?");
+  const std::string path = scene.IsValid(object) ? scene.PathOf(object)
+                           : state.context.is_main ? std::string("the main script")
+                                                   : std::string("?");
   throw Error(state.context.name + ": " + message + " [in " + std::string(what) + " of " + path +
               "]");
 }
 
-// Calls the function below `nargs` arguments on the stack as `script`.
-// Throws swarmsim::Error naming the robot, file:line, `what` and the object.
-void Call(ScriptState& state, const Script& script, int nargs, std::string_view what) {
+// "file:line: " of the Lua function a hook interrupted, or "".
+std::string HookWhere(lua_State* L, lua_Debug* ar) {
+  if (lua_getinfo(L, "Sl", ar) == 0 || ar->currentline <= 0) return "";
+  return std::string(ar->short_src) + ":" + std::to_string(ar->currentline) + ": ";
+}
+
+// Count hook of non-threaded callbacks: the budget is used up.
+void BudgetHook(lua_State* L, lua_Debug* ar) {
+  const std::string message =
+      HookWhere(L, ar) + "the callback ran more than " +
+      std::to_string(Context(L).world->settings().instruction_budget) +
+      " Lua instructions without returning (an endless loop?); if the work is real, raise "
+      "simulation.instruction_budget";
+  lua_pushlstring(L, message.data(), message.size());
+  lua_error(L);
+}
+
+// Count hook of threads: the time slice is used up; yield if Lua can.
+// Inside a call that cannot yield (a C function calling Lua, e.g. a
+// table.sort comparator), the instruction budget applies instead.
+void SliceHook(lua_State* L, lua_Debug* ar) {
+  if (lua_isyieldable(L)) {
+    lua_yield(L, 0);
+    return;
+  }
+  LuaContext& c = Context(L);
+  const int64_t budget = c.world->settings().instruction_budget;
+  const int count = lua_gethookcount(L);
+  if (budget > 0 && ++c.slice_fires * count > budget) {
+    const std::string message = HookWhere(L, ar) + "the thread ran more than " +
+                                std::to_string(budget) +
+                                " Lua instructions inside a call that cannot yield";
+    lua_pushlstring(L, message.data(), message.size());
+    lua_error(L);
+  }
+}
+
+void SetBudget(lua_State* L, const LuaContext& c) {
+  const int64_t budget = c.world->settings().instruction_budget;
+  if (budget > 0)
+    lua_sethook(L, BudgetHook, LUA_MASKCOUNT, static_cast<int>(std::min<int64_t>(budget, INT_MAX)));
+}
+
+void SetCurrent(ScriptState& state, Script& script) {
   state.context.script_object = script.object;
   state.context.script_env_ref = script.env_ref;
-  const int status = lua_pcall(state.L, nargs, 0, 0);
-  if (status != LUA_OK) ThrowScriptError(state, script.object, ErrorText(state.L, status), what);
+  state.context.mailbox = &script.mailbox;
+  state.context.host_script = &script;
 }
+
+// Calls the function below `nargs` arguments on the stack as `script`,
+// under the instruction budget. Throws swarmsim::Error naming the robot,
+// file:line, `what` and the object.
+void Call(ScriptState& state, Script& script, int nargs, std::string_view what) {
+  SetCurrent(state, script);
+  SetBudget(state.L, state.context);
+  script.running = true;
+  const int status = lua_pcall(state.L, nargs, 0, 0);
+  script.running = false;
+  if (status != LUA_OK) {
+    if (!state.context.pending_error.empty()) {
+      // A World error passed up through the main script: report it as is.
+      std::string error;
+      error.swap(state.context.pending_error);
+      lua_settop(state.L, 0);
+      throw Error(error);
+    }
+    ThrowScriptError(state, script.object, ErrorText(state.L, status), what);
+  }
+}
+
+// Under on_script_error: disable_script, disables `script` and logs `error`
+// once; returns false (the caller rethrows) under stop, and for the main script.
+bool Disable(ScriptState& state, Script& script, const std::string& error) {
+  if (state.context.world->settings().on_script_error != ScriptErrorPolicy::kDisableScript ||
+      state.context.is_main)
+    return false;
+  script.disabled = true;
+  state.context.runtime->log.push_back("error, script disabled: " + error);
+  return true;
+}
+
+// sim.wait and sim.waitUntil, in Lua over sim.step (threaded scripts only).
+constexpr char kThreadHelpers[] = R"(local sim = ...
+local step, now = sim.step, sim.getSimulationTime
+function sim.wait(seconds)
+  local t_end = now() + seconds - 1e-9
+  while now() < t_end do step() end
+end
+function sim.waitUntil(condition, timeout)
+  local t_end = timeout and now() + timeout - 1e-9
+  while not condition() do
+    if t_end and now() >= t_end then return false end
+    step()
+  end
+  return true
+end
+)";
 
 // Protected part of creating a state. Arguments: two integers seeding math.random.
 int SetUpState(lua_State* L) {
   OpenSafeLibraries(L);
   RegisterAllApis(L);
+  if (luaL_loadbufferx(L, kThreadHelpers, sizeof kThreadHelpers - 1, "=sim", "t") != LUA_OK)
+    lua_error(L);
+  lua_getglobal(L, "sim");
+  lua_call(L, 1, 0);
   // Lua's own math.random, reproducible per robot.
   lua_getglobal(L, LUA_MATHLIBNAME);
   lua_getfield(L, -1, "randomseed");
@@ -168,6 +293,8 @@ int FindCallback(lua_State* L, const Script& script, const char* name) {
 }
 
 bool Runs(const Scene& scene, const Script& script) {
+  if (script.disabled) return false;
+  if (script.slot == UINT32_MAX) return true;  // the main script
   if (!scene.IsValid(script.object)) return false;
   const ScriptAttachment* attachment = scene.script_at(script.slot);
   return attachment != nullptr && attachment->enabled;
@@ -176,13 +303,26 @@ bool Runs(const Scene& scene, const Script& script) {
 // A state for the enabled scripts on `slots` (hierarchy order), or null if
 // there are none.
 std::unique_ptr<ScriptState> NewState(World* world, int instance, RobotRuntime* runtime,
-                                      std::string name, const std::vector<uint32_t>& slots) {
+                                      std::string name, const std::vector<uint32_t>& slots,
+                                      const ScriptSource* main_source = nullptr) {
   Scene& scene = world->scene();
   auto state = std::make_unique<ScriptState>();
   for (uint32_t slot : slots) {
     const ScriptAttachment* attachment = scene.script_at(slot);
     if (attachment == nullptr || !attachment->enabled) continue;
-    state->scripts.push_back({slot, scene.IdAt(slot)});
+    Script script;
+    script.slot = slot;
+    script.object = scene.IdAt(slot);
+    script.source = attachment->source.get();
+    script.explicit_handling = attachment->explicit_handling;
+    state->scripts.push_back(script);
+  }
+  if (main_source != nullptr) {
+    Script script;
+    script.slot = UINT32_MAX;
+    script.source = main_source;
+    state->scripts.push_back(script);
+    state->context.is_main = true;
   }
   if (state->scripts.empty()) return nullptr;
   LuaContext& c = state->context;
@@ -192,6 +332,7 @@ std::unique_ptr<ScriptState> NewState(World* world, int instance, RobotRuntime* 
   c.instance = instance;
   c.log_prefix = "[" + name + "] ";
   c.name = std::move(name);
+  c.host_state = state.get();
   lua_State* L = luaL_newstate();
   if (L == nullptr) throw Error(c.name + ": not enough memory for a Lua state");
   state->L = L;
@@ -208,11 +349,10 @@ std::unique_ptr<ScriptState> NewState(World* world, int instance, RobotRuntime* 
 // Runs every script's body, then every sysCall_init, in hierarchy order.
 void Initialize(ScriptState* state) {
   lua_State* L = state->L;
-  const Scene& scene = *state->context.scene;
   // Bodies. Each distinct source is compiled once for the state.
   std::vector<std::pair<const ScriptSource*, int>> factories;
   for (Script& script : state->scripts) {
-    const ScriptSource& source = *scene.script_at(script.slot)->source;
+    const ScriptSource& source = *script.source;
     auto it = std::find_if(factories.begin(), factories.end(),
                            [&](const auto& f) { return f.first == &source; });
     if (it == factories.end()) {
@@ -244,11 +384,22 @@ void Initialize(ScriptState* state) {
     if (const int init = FindCallback(L, script, kCallbackNames[kInit]); init != LUA_NOREF) {
       lua_rawgeti(L, LUA_REGISTRYINDEX, init);
       luaL_unref(L, LUA_REGISTRYINDEX, init);
-      Call(*state, script, 0, kCallbackNames[kInit]);
+      try {
+        Call(*state, script, 0, kCallbackNames[kInit]);
+      } catch (const Error& e) {
+        if (!Disable(*state, script, e.what())) throw;
+        continue;
+      }
     }
     script.initialized = true;
-    for (int callback : {kSensing, kActuation, kCleanup})
+    for (int callback : {kSensing, kActuation, kCleanup, kThread, kStep})
       script.callbacks[callback] = FindCallback(L, script, kCallbackNames[callback]);
+    // sysCall_thread becomes a coroutine, first resumed in the first step.
+    if (script.callbacks[kThread] != LUA_NOREF && !state->context.is_main) {
+      script.thread = lua_newthread(L);
+      script.thread_ref = luaL_ref(L, LUA_REGISTRYINDEX);
+      lua_rawgeti(script.thread, LUA_REGISTRYINDEX, script.callbacks[kThread]);
+    }
   }
   // Generational collection keeps a robot's heap within ~20% of what it
   // holds (the incremental default lets it double between cycles: 10,000
@@ -260,13 +411,46 @@ void Initialize(ScriptState* state) {
   lua_gc(L, LUA_GCSTEP, 0);
 }
 
+// Resumes a script's thread until it yields, returns or fails.
+void ResumeThread(ScriptState* state, Script& script) {
+  lua_State* co = script.thread;
+  SetCurrent(*state, script);
+  state->context.slice_fires = 0;
+  lua_sethook(co, SliceHook, LUA_MASKCOUNT, script.slice_instructions);
+  int results = 0;
+  script.running = true;
+  const int status = lua_resume(co, state->L, 0, &results);
+  script.running = false;
+  if (status == LUA_YIELD) {
+    lua_pop(co, results);
+    return;
+  }
+  std::string error;
+  if (status != LUA_OK) error = ErrorText(co, status);
+  // Finished or failed: the coroutine is not resumed again.
+  lua_settop(co, 0);
+  luaL_unref(state->L, LUA_REGISTRYINDEX, script.thread_ref);
+  script.thread = nullptr;
+  script.thread_ref = LUA_NOREF;
+  if (!error.empty()) ThrowScriptError(*state, script.object, std::move(error), "sysCall_thread");
+}
+
+// One callback of every script in hierarchy order (explicit ones are left
+// to their ancestors); with the actuation callbacks, the threads.
 void RunCallback(ScriptState* state, Callback callback) {
   const Scene& scene = *state->context.scene;
-  for (const Script& script : state->scripts) {
-    const int ref = script.callbacks[callback];
-    if (ref == LUA_NOREF || !Runs(scene, script)) continue;
-    lua_rawgeti(state->L, LUA_REGISTRYINDEX, ref);
-    Call(*state, script, 0, kCallbackNames[callback]);
+  state->context.in_sensing = callback == kSensing;
+  for (Script& script : state->scripts) {
+    if (script.explicit_handling || !Runs(scene, script)) continue;
+    try {
+      if (const int ref = script.callbacks[callback]; ref != LUA_NOREF) {
+        lua_rawgeti(state->L, LUA_REGISTRYINDEX, ref);
+        Call(*state, script, 0, kCallbackNames[callback]);
+      }
+      if (callback == kActuation && script.thread != nullptr) ResumeThread(state, script);
+    } catch (const Error& e) {
+      if (!Disable(*state, script, e.what())) throw;
+    }
   }
 }
 
@@ -274,8 +458,9 @@ void RunCallback(ScriptState* state, Callback callback) {
 // gets its cleanup; the first error is thrown afterwards.
 void Cleanup(ScriptState* state) {
   std::string first_error;
-  for (const Script& script : state->scripts) {
-    if (!script.initialized || script.callbacks[kCleanup] == LUA_NOREF) continue;
+  for (Script& script : state->scripts) {
+    if (!script.initialized || script.disabled || script.callbacks[kCleanup] == LUA_NOREF)
+      continue;
     lua_rawgeti(state->L, LUA_REGISTRYINDEX, script.callbacks[kCleanup]);
     try {
       Call(*state, script, 0, kCallbackNames[kCleanup]);
@@ -312,12 +497,140 @@ std::vector<uint32_t> SceneObjectSlots(const Scene& scene) {
   return out;
 }
 
+// --- sim.* functions that need the host's scripts ----------------------------------
+
+// Is `object` a strict descendant of `ancestor`?
+bool IsDescendant(const Scene& scene, ObjectId object, ObjectId ancestor) {
+  for (ObjectId p = scene.parent(object); !p.IsNull(); p = scene.parent(p))
+    if (p == ancestor) return true;
+  return false;
+}
+
+// sim.handleChildScript(handle, ...) -> the script's return values. Runs the
+// explicit script on object `handle` (a descendant of the caller's object,
+// in the same model): its sysCall_sensing when called from a sensing
+// callback, else its sysCall_actuation, with the given arguments.
+int HandleChildScript(lua_State* L) {
+  LuaContext& c = Context(L);
+  ScriptState& state = *static_cast<ScriptState*>(c.host_state);
+  Script* caller = static_cast<Script*>(c.host_script);
+  const ObjectId target = CheckObject(L, 1);
+  const Scene& scene = *c.scene;
+  const std::string path = scene.PathOf(target);  // throws for a stale handle
+  auto it = std::find_if(state.scripts.begin(), state.scripts.end(),
+                         [&](const Script& s) { return s.object == target; });
+  if (it == state.scripts.end())
+    throw Error("no script of this model is attached to '" + path + "'");
+  Script& script = *it;
+  if (!script.explicit_handling)
+    throw Error("the script of '" + path +
+                "' is not explicit: it runs by itself (mark it 'explicit: true' in the model)");
+  if (caller == nullptr || !IsDescendant(scene, target, caller->object))
+    throw Error("'" + path + "' is not a descendant of the calling script's object");
+  if (script.running) throw Error("the script of '" + path + "' is already running");
+  if (!script.initialized || !Runs(scene, script)) return 0;
+  const Callback callback = c.in_sensing ? kSensing : kActuation;
+  if (script.callbacks[callback] == LUA_NOREF) return 0;
+  // Call it with the arguments after the handle; return all it returns.
+  const int nargs = lua_gettop(L) - 1;
+  lua_rawgeti(L, LUA_REGISTRYINDEX, script.callbacks[callback]);
+  lua_insert(L, 2);
+  SetCurrent(state, script);
+  SetBudget(L, c);
+  script.running = true;
+  const int status = lua_pcall(L, nargs, LUA_MULTRET, 0);
+  script.running = false;
+  SetCurrent(state, *caller);
+  if (status != LUA_OK) {
+    std::string error = ErrorText(L, status) + " (in " + kCallbackNames[callback] +
+                        " of the explicit script of " + path + ")";
+    lua_pop(L, 1);
+    if (Disable(state, script, c.name + ": " + error)) return 0;
+    lua_pushlstring(L, error.data(), error.size());
+    lua_error(L);
+  }
+  return lua_gettop(L) - 1;
+}
+
+// sim.step() / sim.switchThread(): a threaded script gives up the rest of
+// this step; it resumes in the next one.
+int SwitchThread(lua_State* L) {
+  if (!lua_isyieldable(L))
+    RaiseError(L, "sim.step: only a threaded script (sysCall_thread) can yield");
+  return lua_yield(L, 0);
+}
+
+// sim.setThreadSwitchTiming(ms): the thread's time slice per step, after
+// which it is switched out automatically. Deterministic: measured as
+// ms x 100,000 Lua instructions, not wall time.
+int SetThreadSwitchTiming(lua_State* L) {
+  LuaContext& c = Context(L);
+  const double ms = luaL_checknumber(L, 1);
+  if (!(ms > 0)) throw Error("the time slice must be a positive number of milliseconds");
+  Script* script = static_cast<Script*>(c.host_script);
+  if (script == nullptr) return 0;
+  script->slice_instructions = static_cast<int>(
+      std::clamp<double>(ms * kInstructionsPerMs, 1000, static_cast<double>(INT_MAX)));
+  if (script->thread == L)
+    lua_sethook(L, SliceHook, LUA_MASKCOUNT, script->slice_instructions);
+  return 0;
+}
+
+// The main script's handlers: the phases of a step, robots in parallel.
+template <void (*F)(World*)>
+int MainHandler(lua_State* L) {
+  LuaContext& c = Context(L);
+  if (!c.is_main) throw Error("only the world's main script may run the phases");
+  try {
+    F(c.world);
+  } catch (const std::exception& e) {
+    c.pending_error = e.what();
+  }
+  if (!c.pending_error.empty()) RaiseError(L, "stopped by an error");
+  return 0;
+}
+void Sensing(World* w) { w->HandleSensing(); }
+void Actuation(World* w) { w->HandleActuation(); }
+void Dynamics(World* w) { w->HandleDynamics(); }
+
+// sim.handleChildScripts([pass]): the child scripts of every robot, then the
+// scene's. pass: 'sensing', 'actuation' (with the threads) or 'all' (default).
+int HandleChildScripts(lua_State* L) {
+  static const char* const kPasses[] = {"sensing", "actuation", "all", nullptr};
+  const ScriptPass pass = static_cast<ScriptPass>(luaL_checkoption(L, 1, "all", kPasses));
+  LuaContext& c = Context(L);
+  if (!c.is_main) throw Error("only the world's main script may run the phases");
+  try {
+    c.world->HandleChildScripts(pass);
+  } catch (const std::exception& e) {
+    c.pending_error = e.what();
+  }
+  if (!c.pending_error.empty()) RaiseError(L, "stopped by an error");
+  return 0;
+}
+
 }  // namespace
+
+void RegisterControlApi(lua_State* L) {
+  static constexpr luaL_Reg kFunctions[] = {
+      {"handleChildScript", Guarded<HandleChildScript, "sim.handleChildScript">},
+      {"step", SwitchThread},
+      {"switchThread", SwitchThread},
+      {"setThreadSwitchTiming", Guarded<SetThreadSwitchTiming, "sim.setThreadSwitchTiming">},
+      {"handleSensing", Guarded<MainHandler<Sensing>, "sim.handleSensing">},
+      {"handleChildScripts", Guarded<HandleChildScripts, "sim.handleChildScripts">},
+      {"handleActuation", Guarded<MainHandler<Actuation>, "sim.handleActuation">},
+      {"handleDynamics", Guarded<MainHandler<Dynamics>, "sim.handleDynamics">},
+      {nullptr, nullptr},
+  };
+  luaL_setfuncs(L, kFunctions, 0);
+}
 
 struct ScriptHost::Impl {
   World* world;
   std::vector<std::unique_ptr<ScriptState>> robots;  // by instance; null: no scripts
   std::unique_ptr<ScriptState> scene;                // null: no scene scripts
+  std::unique_ptr<ScriptState> main;                 // null: the default main script
   bool started = false;
   bool stopped = false;
 };
@@ -354,22 +667,42 @@ void ScriptHost::Start() {
   // Then the scene's scripts, on this thread.
   h.scene = NewState(&world, -1, &world.scene_runtime(), "scene", SceneObjectSlots(scene));
   if (h.scene) Initialize(h.scene.get());
+  // Last, the world's own main script, in a state of its own.
+  if (const auto& source = world.settings().main_script) {
+    h.main = NewState(&world, -1, &world.scene_runtime(), "main", {}, source.get());
+    Initialize(h.main.get());
+    if (h.main->scripts[0].callbacks[kStep] == LUA_NOREF)
+      throw Error("main: " + source->path +
+                  ": the main script must define sysCall_step() (it runs one step: "
+                  "sim.handleSensing(), sim.handleChildScripts(), sim.handleActuation(), "
+                  "sim.handleDynamics())");
+  }
 }
 
-void ScriptHost::RunInstance(int instance) {
+bool ScriptHost::has_main_script() const { return impl_->main != nullptr; }
+
+void ScriptHost::RunMainScript() {
+  Impl& h = *impl_;
+  if (h.stopped || !h.main) return;
+  Script& script = h.main->scripts[0];
+  lua_rawgeti(h.main->L, LUA_REGISTRYINDEX, script.callbacks[kStep]);
+  Call(*h.main, script, 0, kCallbackNames[kStep]);
+}
+
+void ScriptHost::RunInstance(int instance, ScriptPass pass) {
   Impl& h = *impl_;
   if (h.stopped || instance < 0 || instance >= static_cast<int>(h.robots.size())) return;
   ScriptState* state = h.robots[instance].get();
   if (state == nullptr) return;
-  RunCallback(state, kSensing);
-  RunCallback(state, kActuation);
+  if (pass != ScriptPass::kActuation) RunCallback(state, kSensing);
+  if (pass != ScriptPass::kSensing) RunCallback(state, kActuation);
 }
 
-void ScriptHost::RunSceneScripts() {
+void ScriptHost::RunSceneScripts(ScriptPass pass) {
   Impl& h = *impl_;
   if (h.stopped || !h.scene) return;
-  RunCallback(h.scene.get(), kSensing);
-  RunCallback(h.scene.get(), kActuation);
+  if (pass != ScriptPass::kActuation) RunCallback(h.scene.get(), kSensing);
+  if (pass != ScriptPass::kSensing) RunCallback(h.scene.get(), kActuation);
 }
 
 void ScriptHost::Stop() {
@@ -390,20 +723,21 @@ void ScriptHost::Stop() {
       h.robots[r].reset();
     }
   });
-  if (h.scene) {
+  for (std::unique_ptr<ScriptState>* state : {&h.scene, &h.main}) {
+    if (!*state) continue;
     try {
-      Cleanup(h.scene.get());
+      Cleanup(state->get());
     } catch (const std::exception& e) {
-      errors[robot_count] = e.what();
+      if (errors[robot_count].empty()) errors[robot_count] = e.what();
     }
-    h.scene.reset();
+    state->reset();
   }
   for (const std::string& error : errors)
     if (!error.empty()) throw Error(error);
 }
 
 size_t ScriptHost::MemoryBytes() const {
-  size_t total = StateBytes(impl_->scene.get());
+  size_t total = StateBytes(impl_->scene.get()) + StateBytes(impl_->main.get());
   for (const auto& state : impl_->robots) total += StateBytes(state.get());
   return total;
 }

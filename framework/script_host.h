@@ -14,9 +14,9 @@
 #include <cstddef>
 #include <memory>
 
-namespace swarmsim {
+#include "framework/world.h"
 
-class World;
+namespace swarmsim {
 
 class ScriptHost {
  public:
@@ -35,9 +35,16 @@ class ScriptHost {
   // hierarchy order, then sysCall_actuation likewise. Safe to call
   // concurrently for different robots. Throws swarmsim::Error naming the
   // robot, script file and line on a Lua error.
-  void RunInstance(int instance);
+  // A pass runs only the sensing or the actuation callbacks (threads are
+  // resumed with the actuation callbacks). Explicit scripts are skipped.
+  void RunInstance(int instance, ScriptPass pass = ScriptPass::kAll);
   // Control phase of the scripts outside any model, on the calling thread.
-  void RunSceneScripts();
+  void RunSceneScripts(ScriptPass pass = ScriptPass::kAll);
+  // The world's own main script (WorldSettings::main_script), if any: its
+  // sysCall_step runs one step on the calling thread, calling the World's
+  // handlers through sim.handleSensing(), sim.handleChildScripts(), ...
+  bool has_main_script() const;
+  void RunMainScript();
   // sysCall_cleanup of every script whose sysCall_init returned; closes the
   // states. Throws the lowest robot's cleanup error. Safe to call twice.
   void Stop();

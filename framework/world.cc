@@ -138,6 +138,7 @@ void World::Start() {
   DynamicsSettings dynamics_settings;
   dynamics_settings.gravity = settings_.gravity;
   dynamics_->Build(scene_, dynamics_settings);
+  dynamics_->MarkSimulatedJoints(&scene_);
   proximity_ = registry_.MakeProximity("proximity");
   ProximitySettings proximity_settings;
   proximity_settings.octree_resolution = settings_.octree_resolution;
@@ -158,6 +159,15 @@ void World::Step() {
   if (failed_) throw Error("the world stopped after an error and cannot be stepped again");
   if (stopped_) throw Error("the world was stopped and cannot be stepped again");
   try {
+    // 0. messages and signals sent in the last step become visible.
+    { PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kControl)]); DeliverMessages(); }
+    if (scripts_->has_main_script()) {
+      // 1-4. the world's own main script runs the phases (sim.handleSensing(), ...).
+      dynamics_handled_ = false;
+      scripts_->RunMainScript();
+      if (!dynamics_handled_)
+        throw Error("the main script's sysCall_step must call sim.handleDynamics() once per step");
+    } else {
     // 1. sense: sensors read the state left by the last physics step.
     { PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kSense)]); Sense(); }
     // 2. control: scripts, one robot per task, hierarchy order within a robot.
@@ -166,6 +176,7 @@ void World::Step() {
     { PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kActuate)]); Actuate(); }
     // 4. physics: the dynamics backend advances the simulated bodies.
     { PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kPhysics)]); Physics(); }
+    }
     // 5. record: observers append to their streams.
     { PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kRecord)]); Record(); }
   } catch (...) {
@@ -186,21 +197,43 @@ void World::Sense() {
   proximity_->SenseSceneSensors(&scene_);
 }
 
-void World::Control() {
+void World::HandleSensing() {
+  PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kSense)]);
+  Sense();
+}
+void World::HandleChildScripts(ScriptPass pass) {
+  PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kControl)]);
+  // What the main script printed so far comes first.
+  for (const std::string& line : scene_runtime_.log) log_sink_(line);
+  scene_runtime_.log.clear();
+  Control(pass);
+}
+void World::HandleActuation() {
+  PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kActuate)]);
+  Actuate();
+}
+void World::HandleDynamics() {
+  if (dynamics_handled_) throw Error("sim.handleDynamics() may run only once per step");
+  dynamics_handled_ = true;
+  PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kPhysics)]);
+  Physics();
+}
+
+void World::Control(ScriptPass pass) {
   const auto& instances = scene_.instances();
   scheduler_->ParallelFor(0, static_cast<int64_t>(instances.size()), kRobotGrain,
                           [&](int64_t begin, int64_t end) {
                             for (int64_t r = begin; r < end; ++r) {
                               if (!instances[r].alive) continue;
                               try {
-                                scripts_->RunInstance(static_cast<int>(r));
+                                scripts_->RunInstance(static_cast<int>(r), pass);
                               } catch (const std::exception& e) {
                                 runtimes_[r].error = e.what();
                               }
                             }
                           });
   try {
-    scripts_->RunSceneScripts();
+    scripts_->RunSceneScripts(pass);
   } catch (const std::exception& e) {
     scene_runtime_.error = e.what();
   }
@@ -237,6 +270,10 @@ void World::Actuate() {
                    [](const DeferredWrite& a, const DeferredWrite& b) { return a.object < b.object; });
   for (const DeferredWrite& w : writes) {
     if (!scene_.IsValid(w.object)) continue;  // removed meanwhile
+    if (w.kind == DeferredWrite::Kind::kShapeDynamic) {
+      scene_.SetShapeDynamic(w.object, w.value != 0);
+      continue;
+    }
     JointData& j = scene_.mutable_joint(w.object);
     if (w.kind == DeferredWrite::Kind::kJointTargetVelocity) j.target_velocity = w.value;
     else j.target_position = w.value;
@@ -245,6 +282,7 @@ void World::Actuate() {
   // velocity mode at the target velocity, position mode at up to max_velocity.
   const double dt = settings_.time_step;
   for (JointData& j : scene_.joints()) {
+    if (j.simulated) continue;  // the dynamics backend integrates it
     switch (j.mode) {
       case JointMode::kVelocity:
         j.velocity = j.target_velocity;
@@ -257,7 +295,8 @@ void World::Actuate() {
         j.position += step;
         break;
       }
-      case JointMode::kPassive: break;
+      case JointMode::kPassive:
+      case JointMode::kForce: break;
     }
   }
 }
@@ -265,7 +304,18 @@ void World::Actuate() {
 void World::Physics() {
   dynamics_->Step(&scene_, settings_.time_step / settings_.physics_substeps,
                   settings_.physics_substeps);
-  scene_.UpdateWorldPoses();
+  // Objects carried by the simulated bodies follow them: each robot's
+  // subtree on its own worker, then the scene's objects.
+  if (scene_.InstancesAreIndependent()) {
+    const int64_t n = static_cast<int64_t>(scene_.instances().size());
+    scheduler_->ParallelFor(0, n, kRobotGrain, [&](int64_t begin, int64_t end) {
+      for (int64_t r = begin; r < end; ++r)
+        if (scene_.instances()[r].alive) scene_.UpdateWorldPoses(static_cast<int>(r));
+    });
+    scene_.UpdateSceneObjectPoses();
+  } else {
+    scene_.UpdateWorldPoses();
+  }
   ++step_count_;
   time_ = static_cast<double>(step_count_) * settings_.time_step;
   // NaNs out of physics are a user-visible error, not garbage in the outputs.

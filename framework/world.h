@@ -7,7 +7,9 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -15,6 +17,7 @@
 #include "framework/parameters.h"
 #include "framework/random.h"
 #include "framework/scene.h"
+#include "framework/spatial_grid.h"
 
 namespace swarmsim {
 
@@ -24,6 +27,15 @@ class ProximityBackend;
 class ScriptHost;
 class TaskScheduler;
 class World;
+
+// What a world does when a script fails (world setting on_script_error).
+enum class ScriptErrorPolicy : uint8_t {
+  kStop,           // end the run with the error (nonzero exit, outputs so far kept)
+  kDisableScript,  // log the error once, disable that script instance, go on
+};
+
+// Which child-script callbacks a pass of the control phase runs.
+enum class ScriptPass : uint8_t { kSensing, kActuation, kAll };
 
 struct WorldSettings {
   std::string file;                 // world file, for messages ("" for worlds built in code)
@@ -35,6 +47,33 @@ struct WorldSettings {
   int threads = 0;                  // <= 0: all cores
   double gravity = 9.81;            // m/s^2
   double octree_resolution = 0.05;  // m
+  // The world's own main script (null: the default step). Its sysCall_step
+  // runs the phases through sim.handleSensing(), sim.handleChildScripts(), ...
+  std::shared_ptr<const ScriptSource> main_script;
+  // Lua instructions one non-threaded callback may run before it is stopped
+  // with an error (0: no limit).
+  int64_t instruction_budget = 100'000'000;
+  ScriptErrorPolicy on_script_error = ScriptErrorPolicy::kStop;
+};
+
+// A message sent by a script (sim.send*Message), delivered at the start of
+// the next step in sender-handle order.
+enum class MessageScope : uint8_t { kGlobal, kLocal, kDirect, kRange };
+struct Message {
+  std::string data;
+  ObjectId sender;          // object carrying the sending script
+  ObjectId target;          // kDirect: object carrying the receiving script
+  int sender_instance = -1; // robot of the sender, -1 for the scene
+  double range = 0;         // m, kRange
+  MessageScope scope = MessageScope::kGlobal;
+  bool line_of_sight = false;  // kRange: only receivers the static environment does not hide
+};
+// One message in a robot's inbox.
+struct ReceivedMessage {  // 24 bytes
+  uint32_t message = 0;   // index into World::messages()
+  float distance = 0;     // m, from the receiver's model root to the sender
+  float bearing = 0;      // rad, of the sender in the receiver's root frame (0 = +x, CCW)
+  bool has_geometry = false;  // false for scene receivers
 };
 
 // A value recorded by a script (sim.recordMetric) or by an observer.
@@ -49,7 +88,8 @@ struct MetricSample {
 // A write by one robot's script to another robot's object, applied after the
 // control phase in handle order.
 struct DeferredWrite {
-  enum class Kind : uint8_t { kJointTargetVelocity, kJointTargetPosition };
+  // kShapeDynamic: value 1 makes the shape dynamic, 0 kinematic (sim.setObjectDynamic).
+  enum class Kind : uint8_t { kJointTargetVelocity, kJointTargetPosition, kShapeDynamic };
   ObjectId object;
   Kind kind;
   double value;
@@ -64,6 +104,10 @@ struct RobotRuntime {
   std::vector<MetricSample> metrics;    // samples recorded this step
   std::vector<DeferredWrite> deferred;  // writes to other robots' objects
   std::string error;                    // a script error in this phase
+  std::vector<Message> outbox;          // messages sent this step
+  std::vector<ReceivedMessage> inbox;   // messages delivered this step, sender-handle order
+  // sim.setSignal/clearSignal writes (nullopt clears), applied at the next step.
+  std::vector<std::pair<std::string, std::optional<ParamValue>>> signal_writes;
 };
 
 // A calculation object that observes the world in the record phase
@@ -140,13 +184,30 @@ class World {
   ScriptHost* scripts() { return scripts_.get(); }
   size_t script_memory_bytes() const;
 
+  // --- Main-script handlers ---------------------------------------------------------
+  // The phases of the default step, for a world's own main script
+  // (sim.handleSensing(), ...). Robots fan out in parallel inside each.
+  void HandleSensing();
+  void HandleChildScripts(ScriptPass pass);
+  void HandleActuation();
+  void HandleDynamics();
+
+  // --- Messages and signals ------------------------------------------------------------
+  // Messages delivered this step (RobotRuntime::inbox indexes into it).
+  const std::vector<Message>& messages() const { return messages_; }
+  // Bumped each time the inboxes are refilled.
+  uint64_t message_round() const { return message_round_; }
+  // Signal values as of the start of this step.
+  const std::map<std::string, ParamValue, std::less<>>& signals() const { return signals_; }
+
  private:
   void Sense();
-  void Control();
+  void Control(ScriptPass pass = ScriptPass::kAll);
   void Actuate();
   void Physics();
   void Record();
   void EnsureRuntimes();
+  void DeliverMessages();  // world_messages.cc
   void FlushRobotBuffers();
 
   WorldSettings settings_;
@@ -163,6 +224,15 @@ class World {
   std::vector<MetricSample> metrics_;
   std::function<void(std::string_view)> log_sink_;
   PhaseTimes phase_times_{};
+  std::vector<Message> messages_;
+  uint64_t message_round_ = 0;
+  std::map<std::string, ParamValue, std::less<>> signals_;
+  SpatialGrid message_grid_;                  // range messages, rebuilt each step
+  std::vector<uint32_t> message_bucket_start_;  // local/direct messages per robot (robots + 2)
+  std::vector<uint32_t> message_bucket_;        // message indices, grouped by receiving robot
+  std::vector<uint32_t> global_messages_;       // indices of global messages
+  std::vector<Vec3> message_origin_;            // sender position per message (messages)
+  bool dynamics_handled_ = false;  // sim.handleDynamics() ran this step
   int64_t step_count_ = 0;
   double time_ = 0;
   bool started_ = false;

@@ -25,7 +25,7 @@ const std::vector<std::string> kCommonKeys = {
     "name", "type", "position", "orientation_deg", "heading_deg", "children", "script"};
 const std::vector<std::string> kJointKeys = {
     "joint",           "mode", "max_force", "max_velocity", "target_velocity", "target_position",
-    "initial_position"};
+    "initial_position", "target_force", "limits"};
 const std::vector<std::string> kSensorKeys = {"range"};
 const std::vector<std::string> kRingKeys = {"name",   "type",  "count",          "radius",
                                             "height", "range", "start_angle_deg"};
@@ -110,7 +110,14 @@ struct Builder {
     }
     Count(field, 1);
     if (named.Has("script")) {
-      const Field script = named.Get("script");
+      // script: file.lua, or script: {file: file.lua, explicit: true}.
+      Field script = named.Get("script");
+      if (script.node.IsMap()) {
+        Fields s(values.file(), script, "'script'");
+        s.Expect({"file", "explicit"});
+        if (s.Has("explicit")) spec.script_explicit = values.Bool(s.Get("explicit"));
+        script = s.Require("file");
+      }
       const std::string text = values.String(script);
       if (text.empty()) values.Fail(script, "'script' must be a file name");
       spec.script = scripts->Get(model.file.path().parent_path() / text,
@@ -123,15 +130,30 @@ struct Builder {
 
   JointData Joint(const Fields& f) {
     JointData j;
-    if (f.Has("joint"))
-      j.type = values.Choice(f.Get("joint"), {"revolute", "prismatic"}) == "revolute"
-                   ? JointType::kRevolute
-                   : JointType::kPrismatic;
+    if (f.Has("joint")) {
+      const std::string type =
+          values.Choice(f.Get("joint"), {"revolute", "prismatic", "spherical", "fixed"});
+      j.type = type == "revolute"    ? JointType::kRevolute
+               : type == "prismatic" ? JointType::kPrismatic
+               : type == "spherical" ? JointType::kSpherical
+                                     : JointType::kFixed;
+    }
     if (f.Has("mode")) {
-      const std::string mode = values.Choice(f.Get("mode"), {"passive", "velocity", "position"});
+      const std::string mode =
+          values.Choice(f.Get("mode"), {"passive", "velocity", "position", "force"});
       j.mode = mode == "passive"    ? JointMode::kPassive
                : mode == "velocity" ? JointMode::kVelocity
-                                    : JointMode::kPosition;
+               : mode == "position" ? JointMode::kPosition
+                                    : JointMode::kForce;
+    }
+    if (f.Has("target_force")) j.target_force = values.Number(f.Get("target_force"), kAnyNumber);
+    if (f.Has("limits")) {
+      // [min, max] in rad or m, like initial_position.
+      const Field limits = f.Get("limits");
+      const std::vector<double> v = values.Numbers(limits, 2, 2, kAnyNumber);
+      if (!(v[0] <= v[1])) values.Fail(limits, "'limits' must be [min, max] with min <= max");
+      j.min_position = v[0];
+      j.max_position = v[1];
     }
     if (f.Has("max_force")) j.max_force = values.Number(f.Get("max_force"), kPositive);
     if (f.Has("max_velocity")) j.max_velocity = values.Number(f.Get("max_velocity"), kPositive);
@@ -204,7 +226,8 @@ const std::vector<std::string>& PoseKeys() {
 
 ShapeData ReadShape(const ValueReader& values, const Fields& f) {
   ShapeData s;
-  const std::string kind = values.Choice(f.Require("shape"), {"box", "cylinder", "sphere"});
+  const std::string kind =
+      values.Choice(f.Require("shape"), {"box", "cylinder", "sphere", "capsule"});
   // Each kind takes its own size keys; a key of another kind is a mistake.
   auto forbid = [&](const char* key, const char* hint) {
     if (f.Has(key))
@@ -216,11 +239,15 @@ ShapeData ReadShape(const ValueReader& values, const Fields& f) {
     forbid("radius", "a box takes 'size: [x, y, z]'");
     forbid("height", "a box takes 'size: [x, y, z]'");
     s.size = values.Vector3(f.Require("size"), kPositiveLength);
-  } else if (kind == "cylinder") {
-    s.kind = ShapeKind::kCylinder;
-    forbid("size", "a cylinder takes 'radius' and 'height'");
+  } else if (kind == "cylinder" || kind == "capsule") {
+    s.kind = kind == "cylinder" ? ShapeKind::kCylinder : ShapeKind::kCapsule;
+    forbid("size", kind == "cylinder" ? "a cylinder takes 'radius' and 'height'"
+                                      : "a capsule takes 'radius' and 'height' (caps included)");
     s.size = {values.Number(f.Require("radius"), kPositiveLength), 0,
               values.Number(f.Require("height"), kPositiveLength)};
+    if (kind == "capsule" && s.size.z < 2 * s.size.x)
+      values.Fail(f.Get("height"), "a capsule's height includes its caps: it must be at least "
+                                   "twice its radius");
   } else {
     s.kind = ShapeKind::kSphere;
     forbid("size", "a sphere takes 'radius'");
@@ -358,7 +385,7 @@ ObjectId AddToScene(const ObjectSpec& spec, ObjectId parent, Scene* scene) {
       break;
     case ObjectType::kDummy: id = scene->AddDummy(spec.name, parent, spec.X_PO); break;
   }
-  if (spec.script) scene->AttachScript(id, spec.script);
+  if (spec.script) scene->AttachScript(id, spec.script, spec.script_explicit);
   for (const ObjectSpec& child : spec.children) AddToScene(child, id, scene);
   return id;
 }
@@ -372,7 +399,8 @@ void Accumulate(const ObjectSpec& spec, const Pose& X_RP, Footprint* fp, bool* a
     Vec3 half;  // half extents in the shape's frame
     switch (s.kind) {
       case ShapeKind::kBox: half = s.size * 0.5; break;
-      case ShapeKind::kCylinder: half = {s.size.x, s.size.x, s.size.z / 2}; break;
+      case ShapeKind::kCylinder:
+      case ShapeKind::kCapsule: half = {s.size.x, s.size.x, s.size.z / 2}; break;
       case ShapeKind::kSphere: half = {s.size.x, s.size.x, s.size.x}; break;
     }
     // Axis-aligned half extents of the rotated shape, in the root's frame.

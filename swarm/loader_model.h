@@ -25,6 +25,7 @@ struct ObjectSpec {
   JointData joint;
   ProximitySensorData sensor;
   std::shared_ptr<const ScriptSource> script;
+  bool script_explicit = false;  // script: {file: ..., explicit: true}
   std::vector<ObjectSpec> children;
 };
 

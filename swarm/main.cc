@@ -8,7 +8,11 @@
 #include "framework/registry.h"
 #include "modules/builtin.h"
 #include "swarm/bench.h"
+#include "swarm/bench_scaling.h"
+#include "swarm/report.h"
+#include "swarm/results_merge.h"
 #include "swarm/runner.h"
+#include "swarm/sweep.h"
 #include "swarm/version.h"
 #include "swarm/world_loader.h"
 
@@ -76,6 +80,67 @@ int Main(int argc, char** argv) {
   bench->add_option("--child", bench_child_config)->group("");  // internal: one config
   bench->add_option("--child-robots", bench_child_robots)->group("");
   bench->add_option("--child-threads", bench_child_threads)->group("");
+  ScalingOptions scaling_options;  // bench --scaling (issue 5)
+  bool bench_scaling = false;
+  bench->add_flag("--scaling", bench_scaling,
+                  "Speed-up over threads 1..cores and sweep --jobs 1..cores; CSV + PNG");
+  bench->add_option("--jobs", scaling_options.jobs, "With --scaling: sweep jobs, e.g. 1,2")
+      ->delimiter(',');
+  bench->add_option("--sweep-runs", scaling_options.sweep_runs, "With --scaling: runs per sweep")
+      ->check(CLI::PositiveNumber);
+  bench->add_option("--plot", scaling_options.plot, "With --scaling: the PNG plot")
+      ->capture_default_str();
+
+  // sweep, report, merge (issue 5)
+  CLI::App* sweep = app.add_subcommand("sweep", "Run a world over a grid of parameters x seeds");
+  SweepOptions sweep_options;
+  std::string sweep_shard;
+  int64_t sweep_steps = -1;
+  double sweep_duration = -1;
+  sweep->add_option("world", sweep_options.world, "World file (YAML)")->required();
+  sweep->add_option("--param", sweep_options.params,
+                    "NAME=SPEC: a list 100,200,400, a range A:B:N or a log range log:A:B:N")
+      ->allow_extra_args(false);
+  sweep->add_option("--seeds", sweep_options.seeds, "K (seeds 1..K), A-B, or a list 3,7,11")
+      ->capture_default_str();
+  auto* sweep_steps_opt = sweep->add_option("--steps", sweep_steps, "Control steps per run")
+                              ->check(CLI::NonNegativeNumber);
+  sweep->add_option("--duration", sweep_duration, "Simulated seconds per run")
+      ->check(CLI::NonNegativeNumber)
+      ->excludes(sweep_steps_opt);
+  sweep->add_option("--jobs", sweep_options.jobs, "Concurrent runs (default: all cores)")
+      ->check(CLI::PositiveNumber);
+  sweep->add_option("--threads", sweep_options.threads_per_run, "Threads per run")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  sweep->add_option("--timeout", sweep_options.timeout_s, "Per-run time limit, s (0: none)")
+      ->check(CLI::NonNegativeNumber);
+  sweep->add_option("--db", sweep_options.db, "Results database (SQLite)")->required();
+  sweep->add_flag("--allow-changed-world", sweep_options.allow_changed_world,
+                  "Resume even though the world file changed since the sweep began");
+  sweep->add_flag("--retry-failed", sweep_options.retry_failed, "Run failed runs again");
+  sweep->add_option("--shard", sweep_shard, "i/n: only runs with id % n == i (Slurm arrays)");
+  sweep->add_flag("--mpi", sweep_options.mpi, "Share the runs between MPI ranks (under mpirun)");
+  sweep->add_flag("--quiet", sweep_options.quiet, "No progress");
+
+  CLI::App* report = app.add_subcommand("report", "Tables, CSV and a plot from a sweep database");
+  ReportOptions report_options;
+  std::string report_csv, report_plot;
+  report->add_option("db", report_options.db, "Results database")->required();
+  report->add_option("--x", report_options.x, "Parameter on the x axis");
+  report->add_option("--y", report_options.y, "Metric");
+  report->add_option("--by", report_options.by, "One plot line per value of this parameter");
+  report->add_option("--csv", report_csv, "Write one row per run");
+  report->add_option("--plot", report_plot, "Write a PNG plot (gnuplot)");
+
+  CLI::App* merge = app.add_subcommand("merge", "Merge sweep databases (shards) into one");
+  std::string merge_out;
+  std::vector<std::string> merge_inputs;
+  bool merge_allow_changed = false;
+  merge->add_option("out", merge_out, "Output database (created if missing)")->required();
+  merge->add_option("inputs", merge_inputs, "Input databases")->required();
+  merge->add_flag("--allow-changed-world", merge_allow_changed,
+                  "Merge runs made with different versions of the world file");
 
   CLI::App* modules = app.add_subcommand("modules", "List the registered modules");
   CLI::App* version = app.add_subcommand("version", "Print the version");
@@ -105,8 +170,29 @@ int Main(int argc, char** argv) {
       std::cout << m.kind << "\t" << m.name << "\t" << m.version << "\t" << m.description << "\n";
     return 0;
   }
+  if (*sweep) {
+    if (sweep_steps >= 0) sweep_options.steps = sweep_steps;
+    if (sweep_duration >= 0) sweep_options.duration = sweep_duration;
+    if (!sweep_shard.empty())
+      ParseShard(sweep_shard, &sweep_options.shard_index, &sweep_options.shard_count);
+    for (int i = 0; i < argc; ++i)
+      sweep_options.command_line += (i ? " " : "") + std::string(argv[i]);
+    return RunSweep(sweep_options, std::cout, std::cerr);
+  }
+  if (*report) {
+    if (!report_csv.empty()) report_options.csv = report_csv;
+    if (!report_plot.empty()) report_options.plot = report_plot;
+    return RunReport(report_options, std::cout, std::cerr);
+  }
+  if (*merge) return RunMerge(merge_out, merge_inputs, merge_allow_changed, std::cout, std::cerr);
   if (*bench) {
     bench_options.self_exe = "/proc/self/exe";
+    if (bench_scaling) {
+      scaling_options.bench = bench_options;
+      scaling_options.threads_given = bench->count("--threads") > 0;
+      if (bench_options.csv) scaling_options.csv = *bench_options.csv;
+      return RunScalingBench(scaling_options, std::cout, std::cerr);
+    }
     if (!bench_child_config.empty())
       return RunBenchChild(bench_options, bench_child_config, bench_child_robots,
                            bench_child_threads, std::cout);

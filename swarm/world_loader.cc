@@ -264,7 +264,20 @@ WorldSettings WorldLoader::ReadSimulation(const Fields& top, std::optional<int64
   if (sim.present()) {
     Fields f(*file_, sim, "'simulation'");
     f.Expect({"physics", "time_step", "physics_substeps", "seed", "duration", "steps", "gravity",
-              "octree_resolution"});
+              "octree_resolution", "main_script", "instruction_budget", "on_script_error"});
+    if (f.Has("main_script")) {
+      const Field main = f.Get("main_script");
+      const std::string text = values.String(main);
+      if (text.empty()) values.Fail(main, "'main_script' must be a file name");
+      s.main_script = scripts_.Get(path_.parent_path() / text, file_->Where(main.mark), text);
+    }
+    if (f.Has("instruction_budget"))
+      s.instruction_budget = values.Integer(f.Get("instruction_budget"), 0, int64_t{1} << 40);
+    if (f.Has("on_script_error"))
+      s.on_script_error = values.Choice(f.Get("on_script_error"), {"stop", "disable_script"}) ==
+                                  "stop"
+                              ? ScriptErrorPolicy::kStop
+                              : ScriptErrorPolicy::kDisableScript;
     {
       // The default backend must exist too (a test registry may lack it).
       const Field physics =

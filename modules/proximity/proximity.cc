@@ -80,6 +80,15 @@ class OctreeGridProximity final : public ProximityBackend {
     SenseRays(rays, instance, {}, scene);
   }
 
+  bool SegmentBlocked(const Vec3& a_W, const Vec3& b_W) const override {
+    const Vec3 d = b_W - a_W;
+    const double length = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+    if (!(length > 0) || static_.empty()) return false;
+    double t = 0;
+    uint32_t shape = 0;
+    return static_.CastRay(a_W, d * (1 / length), length, {}, &t, &shape);
+  }
+
   void SenseSceneSensors(Scene* scene) const override {
     thread_local std::vector<ObjectId> mounts;
     const auto owners = scene->proximity_sensor_owners();

@@ -78,6 +78,7 @@ PlacedShape PlaceShape(const ShapeData& shape, const Pose& X_WS, ObjectId id, in
   switch (shape.kind) {
     case ShapeKind::kBox: placed.half_size = shape.size * 0.5; break;
     case ShapeKind::kCylinder:
+    case ShapeKind::kCapsule:  // approximated by its bounding cylinder
       placed.half_size = {shape.size.x, shape.size.x, shape.size.z * 0.5};
       break;
     case ShapeKind::kSphere: placed.half_size = {shape.size.x, shape.size.x, shape.size.x}; break;
@@ -91,6 +92,7 @@ bool RayCast(const PlacedShape& shape, const Vec3& p_W, const Vec3& d_W, double 
   switch (shape.kind) {
     case ShapeKind::kBox: return RayBox(o, d, shape.half_size, max_t, t);
     case ShapeKind::kCylinder:
+    case ShapeKind::kCapsule:
       return RayCylinder(o, d, shape.half_size.x, shape.half_size.z, max_t, t);
     case ShapeKind::kSphere: return RaySphere(o, d, shape.half_size.x, max_t, t);
   }
@@ -103,7 +105,7 @@ void WorldBounds(const PlacedShape& shape, Vec3* lo, Vec3* hi) {
   Vec3 extent;
   if (shape.kind == ShapeKind::kSphere) {
     extent = h;
-  } else if (shape.kind == ShapeKind::kCylinder) {
+  } else if (shape.kind == ShapeKind::kCylinder || shape.kind == ShapeKind::kCapsule) {
     // A disc of radius r perpendicular to the axis a reaches r sqrt(1 - a_i^2) along axis i.
     const Vec3 a = q.Rotate({0, 0, 1});
     auto reach = [&](double ai) {
@@ -125,7 +127,8 @@ double WorldFootprintRadius(const ShapeData& shape, const Pose& X_WS) {
   if (std::abs(axis.z) >= 1 - 1e-12) return shape.BoundingRadius();  // upright
   switch (shape.kind) {
     case ShapeKind::kBox: return 0.5 * shape.size.Norm();
-    case ShapeKind::kCylinder: return std::hypot(shape.size.x, 0.5 * shape.size.z);
+    case ShapeKind::kCylinder:
+    case ShapeKind::kCapsule: return std::hypot(shape.size.x, 0.5 * shape.size.z);
     case ShapeKind::kSphere: return shape.size.x;
   }
   return 0;
@@ -187,7 +190,8 @@ bool MayOverlapCube(const PlacedShape& shape, const Vec3& centre, double half, d
       const double reach = shape.half_size.x + margin;
       return gap.SquaredNorm() <= reach * reach;
     }
-    case ShapeKind::kCylinder: {
+    case ShapeKind::kCylinder:
+    case ShapeKind::kCapsule: {
       if (!CubeMeetsBox(centre, half, shape.X_WS, shape.half_size, margin)) return false;
       // The cube's centre must lie within r + its half diagonal of the axis segment.
       const Vec3 c = shape.X_SW * centre;

@@ -74,7 +74,8 @@ double CalcInertia(const ShapeData& shape) {
   switch (shape.kind) {
     case ShapeKind::kBox:
       return m * (shape.size.x * shape.size.x + shape.size.y * shape.size.y) / 12;
-    case ShapeKind::kCylinder: return 0.5 * m * shape.size.x * shape.size.x;
+    case ShapeKind::kCylinder:
+    case ShapeKind::kCapsule: return 0.5 * m * shape.size.x * shape.size.x;  // capsule: as its cylinder
     case ShapeKind::kSphere: return 0.4 * m * shape.size.x * shape.size.x;
   }
   return 0;
@@ -233,7 +234,8 @@ void PlaneWorld::Build(const Scene& scene) {
     b2CircleShape circle;
     b2PolygonShape polygon;
     const bool round = shape->kind == ShapeKind::kSphere ||
-                       (shape->kind == ShapeKind::kCylinder && IsUpright(X_WS));
+                       ((shape->kind == ShapeKind::kCylinder || shape->kind == ShapeKind::kCapsule) &&
+                        IsUpright(X_WS));
     if (round) {
       if (!(shape->size.x > 0)) continue;
       circle.m_p = center;

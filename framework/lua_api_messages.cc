@@ -1,0 +1,328 @@
+// sim.* messages, signals and packing.
+//
+// Messages (delivered at the start of the next step, in sender-handle order):
+//   sim.sendGlobalMessage(data)          every script of the world but the sender
+//   sim.sendLocalMessage(data)           the other scripts of the sender's model
+//   sim.sendDirectMessage(handle, data)  the script attached to object `handle`
+//   sim.sendRangeMessage(data, range [, lineOfSight])
+//                                        the robots whose model root is within
+//                                        `range` m of the sender (optionally
+//                                        only those no static shape hides)
+//   sim.receiveMessage() -> data, sender, distance, bearing  (nil when done)
+// Signals (scene-wide; a value set in step t is seen from step t+1; the last
+// writer in robot order wins): sim.setSignal, sim.getSignal, sim.clearSignal.
+// Packing numbers into message strings: sim.packFloats / unpackFloats
+// (float32), packDoubles / unpackDoubles, packInt32s / unpackInt32s,
+// packTable / unpackTable (nested tables of numbers, strings, booleans).
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <string>
+
+#include "framework/error.h"
+#include "framework/lua_api.h"
+#include "framework/world.h"
+
+namespace swarmsim {
+namespace {
+
+constexpr size_t kMaxMessageBytes = 1 << 20;
+
+std::string CheckData(lua_State* L, int arg) {
+  if (lua_type(L, arg) != LUA_TSTRING)
+    throw Error(std::string("the message must be a string (got ") + luaL_typename(L, arg) +
+                "); pack numbers with sim.packFloats or tables with sim.packTable");
+  size_t length = 0;
+  const char* data = lua_tolstring(L, arg, &length);
+  if (length > kMaxMessageBytes) throw Error("a message may hold at most 1 MiB");
+  return std::string(data, length);
+}
+
+void Send(lua_State* L, MessageScope scope, std::string data, ObjectId target = {},
+          double range = 0, bool line_of_sight = false) {
+  LuaContext& c = Context(L);
+  Message m;
+  m.data = std::move(data);
+  m.sender = c.script_object;
+  m.target = target;
+  m.sender_instance = c.instance;
+  m.range = range;
+  m.scope = scope;
+  m.line_of_sight = line_of_sight;
+  c.runtime->outbox.push_back(std::move(m));
+}
+
+int SendGlobalMessage(lua_State* L) {
+  Send(L, MessageScope::kGlobal, CheckData(L, 1));
+  return 0;
+}
+int SendLocalMessage(lua_State* L) {
+  Send(L, MessageScope::kLocal, CheckData(L, 1));
+  return 0;
+}
+int SendDirectMessage(lua_State* L) {
+  const ObjectId target = CheckObject(L, 1);
+  const Scene& scene = *Context(L).scene;
+  if (!scene.IsValid(target) || scene.script(target) == nullptr)
+    throw Error("object " + std::to_string(target.ToInteger()) + " carries no script");
+  Send(L, MessageScope::kDirect, CheckData(L, 2), target);
+  return 0;
+}
+int SendRangeMessage(lua_State* L) {
+  std::string data = CheckData(L, 1);
+  const double range = luaL_checknumber(L, 2);
+  if (!(range >= 0) || !std::isfinite(range))
+    throw Error("the range must be a non-negative number of metres");
+  Send(L, MessageScope::kRange, std::move(data), {}, range, lua_toboolean(L, 3) != 0);
+  return 0;
+}
+
+int ReceiveMessage(lua_State* L) {
+  LuaContext& c = Context(L);
+  if (c.mailbox == nullptr) return 0;
+  ScriptMailbox& mailbox = *c.mailbox;
+  if (mailbox.round != c.world->message_round()) mailbox = {c.world->message_round(), 0};
+  const std::vector<ReceivedMessage>& inbox = c.runtime->inbox;
+  const std::vector<Message>& messages = c.world->messages();
+  while (mailbox.next < inbox.size()) {
+    const ReceivedMessage& r = inbox[mailbox.next++];
+    const Message& m = messages[r.message];
+    if (m.scope == MessageScope::kDirect ? m.target != c.script_object
+                                         : m.sender == c.script_object)
+      continue;
+    lua_pushlstring(L, m.data.data(), m.data.size());
+    lua_pushinteger(L, m.sender.ToInteger());
+    if (!r.has_geometry) return 2;
+    lua_pushnumber(L, r.distance);
+    lua_pushnumber(L, r.bearing);
+    return 4;
+  }
+  return 0;
+}
+
+// --- Signals ---------------------------------------------------------------------------
+
+int SetSignal(lua_State* L) {
+  LuaContext& c = Context(L);
+  std::string name = luaL_checkstring(L, 1);
+  switch (lua_type(L, 2)) {
+    case LUA_TNUMBER: c.runtime->signal_writes.emplace_back(std::move(name), lua_tonumber(L, 2)); break;
+    case LUA_TBOOLEAN:
+      c.runtime->signal_writes.emplace_back(std::move(name), lua_toboolean(L, 2) != 0);
+      break;
+    case LUA_TSTRING:
+      c.runtime->signal_writes.emplace_back(std::move(name), std::string(lua_tostring(L, 2)));
+      break;
+    case LUA_TNIL: c.runtime->signal_writes.emplace_back(std::move(name), std::nullopt); break;
+    default:
+      throw Error(std::string("a signal is a number, boolean or string (got ") +
+                  luaL_typename(L, 2) + ")");
+  }
+  return 0;
+}
+int ClearSignal(lua_State* L) {
+  Context(L).runtime->signal_writes.emplace_back(luaL_checkstring(L, 1), std::nullopt);
+  return 0;
+}
+int GetSignal(lua_State* L) {
+  size_t length = 0;
+  const char* name = luaL_checklstring(L, 1, &length);
+  const auto& signals = Context(L).world->signals();
+  auto it = signals.find(std::string_view(name, length));
+  if (it == signals.end()) {
+    lua_pushnil(L);
+    return 1;
+  }
+  if (const double* d = std::get_if<double>(&it->second))
+    lua_pushnumber(L, *d);
+  else if (const bool* b = std::get_if<bool>(&it->second))
+    lua_pushboolean(L, *b);
+  else
+    lua_pushlstring(L, std::get<std::string>(it->second).data(),
+                    std::get<std::string>(it->second).size());
+  return 1;
+}
+
+// --- Packing ---------------------------------------------------------------------------
+
+template <typename T>
+int PackArray(lua_State* L) {
+  luaL_checktype(L, 1, LUA_TTABLE);
+  const lua_Integer n = luaL_len(L, 1);
+  std::string out(static_cast<size_t>(n) * sizeof(T), '\0');
+  for (lua_Integer i = 1; i <= n; ++i) {
+    lua_rawgeti(L, 1, i);
+    T v;
+    if constexpr (std::is_integral_v<T>) {
+      int ok = 0;
+      const lua_Integer x = lua_tointegerx(L, -1, &ok);
+      if (!ok || x < INT32_MIN || x > INT32_MAX)
+        throw Error("element " + std::to_string(i) + " is not a 32-bit integer");
+      v = static_cast<T>(x);
+    } else {
+      int ok = 0;
+      v = static_cast<T>(lua_tonumberx(L, -1, &ok));
+      if (!ok) throw Error("element " + std::to_string(i) + " is not a number");
+    }
+    lua_pop(L, 1);
+    std::memcpy(out.data() + (i - 1) * sizeof(T), &v, sizeof(T));
+  }
+  lua_pushlstring(L, out.data(), out.size());
+  return 1;
+}
+
+template <typename T>
+int UnpackArray(lua_State* L) {
+  size_t length = 0;
+  const char* data = luaL_checklstring(L, 1, &length);
+  if (length % sizeof(T) != 0)
+    throw Error("the string's length (" + std::to_string(length) + ") is not a multiple of " +
+                std::to_string(sizeof(T)));
+  const int n = static_cast<int>(length / sizeof(T));
+  lua_createtable(L, n, 0);
+  for (int i = 0; i < n; ++i) {
+    T v;
+    std::memcpy(&v, data + i * sizeof(T), sizeof(T));
+    if constexpr (std::is_integral_v<T>)
+      lua_pushinteger(L, v);
+    else
+      lua_pushnumber(L, v);
+    lua_rawseti(L, -2, i + 1);
+  }
+  return 1;
+}
+
+// packTable format: a tag byte per value: 'n' double, 'i' int64, 's' u32
+// length + bytes, 'T'/'F' booleans, 't' u32 pair count + key/value pairs.
+constexpr int kMaxTableDepth = 32;
+
+void PackValue(lua_State* L, int index, int depth, std::string* out) {
+  auto append = [out](const void* p, size_t n) { out->append(static_cast<const char*>(p), n); };
+  switch (lua_type(L, index)) {
+    case LUA_TNUMBER:
+      if (lua_isinteger(L, index)) {
+        const int64_t v = lua_tointeger(L, index);
+        out->push_back('i');
+        append(&v, sizeof v);
+      } else {
+        const double v = lua_tonumber(L, index);
+        out->push_back('n');
+        append(&v, sizeof v);
+      }
+      break;
+    case LUA_TBOOLEAN: out->push_back(lua_toboolean(L, index) ? 'T' : 'F'); break;
+    case LUA_TSTRING: {
+      size_t length = 0;
+      const char* s = lua_tolstring(L, index, &length);
+      const uint32_t n = static_cast<uint32_t>(length);
+      out->push_back('s');
+      append(&n, sizeof n);
+      append(s, length);
+      break;
+    }
+    case LUA_TTABLE: {
+      if (depth >= kMaxTableDepth) throw Error("the table is nested too deeply (or has a cycle)");
+      index = lua_absindex(L, index);
+      uint32_t count = 0;
+      for (lua_pushnil(L); lua_next(L, index) != 0; lua_pop(L, 1)) ++count;
+      out->push_back('t');
+      append(&count, sizeof count);
+      for (lua_pushnil(L); lua_next(L, index) != 0; lua_pop(L, 1)) {
+        PackValue(L, -2, depth + 1, out);
+        PackValue(L, -1, depth + 1, out);
+      }
+      break;
+    }
+    default:
+      throw Error(std::string("cannot pack a ") + luaL_typename(L, index) +
+                  " (numbers, strings, booleans and tables only)");
+  }
+}
+
+int PackTable(lua_State* L) {
+  luaL_checktype(L, 1, LUA_TTABLE);
+  std::string out;
+  PackValue(L, 1, 0, &out);
+  lua_pushlstring(L, out.data(), out.size());
+  return 1;
+}
+
+struct Reader {
+  const char* p;
+  const char* end;
+  void Read(void* v, size_t n) {
+    if (static_cast<size_t>(end - p) < n) throw Error("the string is not a packed table");
+    std::memcpy(v, p, n);
+    p += n;
+  }
+};
+
+void UnpackValue(lua_State* L, Reader* r, int depth) {
+  if (depth > kMaxTableDepth) throw Error("the packed table is nested too deeply");
+  luaL_checkstack(L, 4, "unpackTable");
+  char tag = 0;
+  r->Read(&tag, 1);
+  switch (tag) {
+    case 'n': { double v; r->Read(&v, sizeof v); lua_pushnumber(L, v); break; }
+    case 'i': { int64_t v; r->Read(&v, sizeof v); lua_pushinteger(L, v); break; }
+    case 'T': lua_pushboolean(L, 1); break;
+    case 'F': lua_pushboolean(L, 0); break;
+    case 's': {
+      uint32_t n = 0;
+      r->Read(&n, sizeof n);
+      if (static_cast<size_t>(r->end - r->p) < n) throw Error("the string is not a packed table");
+      lua_pushlstring(L, r->p, n);
+      r->p += n;
+      break;
+    }
+    case 't': {
+      uint32_t count = 0;
+      r->Read(&count, sizeof count);
+      lua_createtable(L, 0, 0);
+      for (uint32_t i = 0; i < count; ++i) {
+        UnpackValue(L, r, depth + 1);
+        UnpackValue(L, r, depth + 1);
+        if (lua_isnil(L, -2)) throw Error("the string is not a packed table");
+        lua_rawset(L, -3);
+      }
+      break;
+    }
+    default: throw Error("the string is not a packed table");
+  }
+}
+
+int UnpackTable(lua_State* L) {
+  size_t length = 0;
+  const char* data = luaL_checklstring(L, 1, &length);
+  Reader r{data, data + length};
+  UnpackValue(L, &r, 0);
+  if (r.p != r.end || !lua_istable(L, -1)) throw Error("the string is not a packed table");
+  return 1;
+}
+
+}  // namespace
+
+void RegisterMessagesApi(lua_State* L) {
+  static constexpr luaL_Reg kFunctions[] = {
+      {"sendGlobalMessage", Guarded<SendGlobalMessage, "sim.sendGlobalMessage">},
+      {"sendLocalMessage", Guarded<SendLocalMessage, "sim.sendLocalMessage">},
+      {"sendDirectMessage", Guarded<SendDirectMessage, "sim.sendDirectMessage">},
+      {"sendRangeMessage", Guarded<SendRangeMessage, "sim.sendRangeMessage">},
+      {"receiveMessage", Guarded<ReceiveMessage, "sim.receiveMessage">},
+      {"setSignal", Guarded<SetSignal, "sim.setSignal">},
+      {"getSignal", Guarded<GetSignal, "sim.getSignal">},
+      {"clearSignal", Guarded<ClearSignal, "sim.clearSignal">},
+      {"packFloats", Guarded<PackArray<float>, "sim.packFloats">},
+      {"unpackFloats", Guarded<UnpackArray<float>, "sim.unpackFloats">},
+      {"packDoubles", Guarded<PackArray<double>, "sim.packDoubles">},
+      {"unpackDoubles", Guarded<UnpackArray<double>, "sim.unpackDoubles">},
+      {"packInt32s", Guarded<PackArray<int32_t>, "sim.packInt32s">},
+      {"unpackInt32s", Guarded<UnpackArray<int32_t>, "sim.unpackInt32s">},
+      {"packTable", Guarded<PackTable, "sim.packTable">},
+      {"unpackTable", Guarded<UnpackTable, "sim.unpackTable">},
+      {nullptr, nullptr},
+  };
+  luaL_setfuncs(L, kFunctions, 0);
+}
+
+}  // namespace swarmsim

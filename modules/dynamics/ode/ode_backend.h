@@ -1,0 +1,86 @@
+// ODE 0.16 (double precision) dynamics: 3D rigid bodies, joints and contacts.
+//
+// What becomes what (Build, in scene slot order):
+//   - Each dynamic shape (ShapeData::dynamic) is an ODE body at its world
+//     pose with the shape's mass and the solid shape's inertia, and one geom
+//     (box, sphere, cylinder or capsule; ODE's axes match ours: z is the
+//     cylinder/capsule axis).
+//   - A non-dynamic shape whose nearest dynamic ancestor is reached without
+//     crossing a joint is a *part* of that body: an extra geom at its offset,
+//     adding no mass.
+//   - Any other non-dynamic shape inside a model, or below a joint, is a
+//     *kinematic* body: scripts, IK or kinematic joints move it in the scene
+//     and the backend pushes that motion into ODE each step (pose
+//     interpolated over the substeps, velocity from the pose change), so
+//     dynamic bodies collide with it as with a moving, unstoppable object.
+//   - Other non-dynamic shapes (walls, tables, floor slabs outside models) are
+//     static geoms, placed at Build time.
+//   - With Options::ground_plane, the plane z = 0 is a static geom.
+//   - A joint J whose subtree holds a dynamic shape B, reached without
+//     crossing another joint, is an ODE joint between B and J's nearest
+//     dynamic (or kinematic) ancestor body A, or the static world if there is
+//     none: revolute -> hinge, prismatic -> slider, both along J's z axis;
+//     spherical -> ball; fixed -> fixed. Such joints are *simulated*
+//     (JointData::simulated): ODE integrates their position and velocity and
+//     World::Actuate leaves them alone. Joints with no dynamic child stay
+//     kinematic (moved by World::Actuate). Modes: passive (free, limits
+//     only), velocity (motor to target_velocity with max_force), position
+//     (servo: motor velocity 0.5 error / dt clamped to max_velocity, with
+//     max_force), force (target_force applied each substep). Limits
+//     (min/max_position) become ODE stops. Revolute positions are unwrapped
+//     (a wheel's angle keeps growing).
+//
+// Contacts: up to Options::max_contacts per geom pair, friction the geometric
+// mean of the two shapes' (pyramid approximation), restitution the larger of
+// the two (above 0.1 m/s). No contacts between geoms of one model instance
+// (no self-collision), between geoms of one body, between bodies joined by a
+// joint, or between two non-dynamic geoms.
+//
+// Hybrid simulation: Scene::SetShapeDynamic (sim.setObjectDynamic) is a
+// structural change; the backend then rebuilds from the scene, velocities
+// included. A script that sets a dynamic body's pose teleports it.
+//
+// Threads and determinism. Each backend owns its ODE world, collision space
+// (a hash space, deterministic for a given insertion order) and its own
+// self-threaded step implementation (worlds sharing ODE's default one crash
+// when stepped from two threads). ODE's random generator (used by the
+// quickstep solver) is process-global: Build seeds it with Options::seed, so
+// a run is repeatable, but two ODE worlds stepped concurrently in one process
+// are not (sweeps use processes). The scene's thread count does not matter:
+// the physics phase runs on one thread.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+
+#include "framework/dynamics_backend.h"
+#include "framework/registry.h"
+
+namespace swarmsim {
+class Scene;
+}
+
+namespace swarmsim::ode {
+
+struct Options {
+  int iterations = 40;         // quickstep iterations; 0: dWorldStep (exact, slower)
+  int max_contacts = 4;        // contact points per geom pair
+  bool ground_plane = true;    // a static plane at z = 0
+  double ground_friction = 1;  // Coulomb coefficient of the ground plane
+  double erp = 0.2;            // ODE's error reduction parameter
+  double cfm = 1e-6;           // ODE's constraint force mixing
+  uint32_t seed = 1;           // ODE's global random generator, at Build
+};
+
+swarmsim::ModuleInfo ModuleInfo();
+std::unique_ptr<DynamicsBackend> MakeBackend();
+std::unique_ptr<DynamicsBackend> MakeBackend(const Options& options);
+
+// ODE alone, for the bench's `ode-only` row: builds the same ODE world from
+// `scene`, reads the joint commands once, then runs steps x substeps ODE
+// steps of `dt` (collision + solver) with no scene write-back. Returns the
+// wall-clock seconds spent stepping.
+double TimeBareLoop(const Scene& scene, double dt, int substeps, int steps,
+                    const Options& options = {}, const DynamicsSettings& settings = {});
+
+}  // namespace swarmsim::ode

@@ -1,0 +1,489 @@
+#include "modules/dynamics/ode/ode_world.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <mutex>
+#include <string>
+
+#include "framework/error.h"
+#include "framework/scene.h"
+#include "framework/state_hash.h"
+
+namespace swarmsim::ode {
+
+namespace {
+
+// Restitution applies above this approach speed, m/s (as in the Box2D backend).
+constexpr double kBounceVelocity = 0.1;
+// Position servo: motor velocity = kServoGain * error / dt (clamped).
+constexpr double kServoGain = 0.5;
+
+void InitOdeOnce() {
+  static std::once_flag once;
+  std::call_once(once, [] { dInitODE2(0); });
+}
+
+std::string PathAt(const Scene& scene, uint32_t slot) { return scene.PathOf(scene.IdAt(slot)); }
+
+bool IsFinite(const Pose& X) {
+  return std::isfinite(X.p.x) && std::isfinite(X.p.y) && std::isfinite(X.p.z) &&
+         std::isfinite(X.q.w) && std::isfinite(X.q.x) && std::isfinite(X.q.y) &&
+         std::isfinite(X.q.z);
+}
+
+void SetBodyPose(dBodyID body, const Pose& X) {
+  dBodySetPosition(body, X.p.x, X.p.y, X.p.z);
+  const dQuaternion q = {X.q.w, X.q.x, X.q.y, X.q.z};
+  dBodySetQuaternion(body, q);
+}
+
+Pose BodyPose(dBodyID body) {
+  const dReal* p = dBodyGetPosition(body);
+  const dReal* q = dBodyGetQuaternion(body);
+  return {{p[0], p[1], p[2]}, {q[0], q[1], q[2], q[3]}};
+}
+
+Vec3 ToVec3(const dReal* v) { return {v[0], v[1], v[2]}; }
+
+// A geom for the shape, or null if its size cannot make one.
+dGeomID MakeGeom(dSpaceID space, const ShapeData& shape) {
+  const Vec3& s = shape.size;
+  switch (shape.kind) {
+    case ShapeKind::kBox:
+      if (!(s.x > 0 && s.y > 0 && s.z > 0)) return nullptr;
+      return dCreateBox(space, s.x, s.y, s.z);
+    case ShapeKind::kSphere:
+      if (!(s.x > 0)) return nullptr;
+      return dCreateSphere(space, s.x);
+    case ShapeKind::kCylinder:
+      if (!(s.x > 0 && s.z > 0)) return nullptr;
+      return dCreateCylinder(space, s.x, s.z);
+    case ShapeKind::kCapsule:
+      if (!(s.x > 0)) return nullptr;
+      return dCreateCapsule(space, s.x, std::max(0.0, s.z - 2 * s.x));
+  }
+  return nullptr;
+}
+
+// Mass and inertia of the solid shape, about its centre, in its frame.
+dMass CalcMass(const ShapeData& shape) {
+  dMass m;
+  const Vec3& s = shape.size;
+  switch (shape.kind) {
+    case ShapeKind::kBox: dMassSetBoxTotal(&m, shape.mass, s.x, s.y, s.z); break;
+    case ShapeKind::kSphere: dMassSetSphereTotal(&m, shape.mass, s.x); break;
+    case ShapeKind::kCylinder: dMassSetCylinderTotal(&m, shape.mass, 3, s.x, s.z); break;
+    case ShapeKind::kCapsule:
+      dMassSetCapsuleTotal(&m, shape.mass, 3, s.x, std::max(0.0, s.z - 2 * s.x));
+      break;
+  }
+  return m;
+}
+
+double WrapAngle(double a) {
+  while (a > M_PI) a -= 2 * M_PI;
+  while (a <= -M_PI) a += 2 * M_PI;
+  return a;
+}
+
+// Angular velocity that turns q_from into q_to in `duration` seconds.
+Vec3 AngularVelocity(const Quat& q_from, const Quat& q_to, double duration) {
+  Quat dq = (q_to * q_from.Conjugate()).Normalized();
+  if (dq.w < 0) dq = {-dq.w, -dq.x, -dq.y, -dq.z};
+  const Vec3 v{dq.x, dq.y, dq.z};
+  const double s = v.Norm();
+  if (s < 1e-15) return {};
+  return v * (2 * std::atan2(s, dq.w) / (s * duration));
+}
+
+Pose Interpolate(const Pose& a, const Pose& b, double f) {
+  Quat qb = b.q;
+  if (a.q.w * qb.w + a.q.x * qb.x + a.q.y * qb.y + a.q.z * qb.z < 0) qb = {-qb.w, -qb.x, -qb.y, -qb.z};
+  const Quat q{a.q.w + (qb.w - a.q.w) * f, a.q.x + (qb.x - a.q.x) * f, a.q.y + (qb.y - a.q.y) * f,
+               a.q.z + (qb.z - a.q.z) * f};
+  return {a.p + (b.p - a.p) * f, q.Normalized()};
+}
+
+}  // namespace
+
+OdeWorld::OdeWorld(const Options& options, const DynamicsSettings& settings)
+    : options_(options), settings_(settings) {
+  if (!std::isfinite(settings_.gravity))
+    throw Error("ode: gravity must be a finite number, got " + std::to_string(settings_.gravity));
+  if (options_.max_contacts < 1 || options_.iterations < 0)
+    throw Error("ode: max_contacts must be >= 1 and iterations >= 0");
+  InitOdeOnce();
+  contact_buffer_.resize(static_cast<size_t>(options_.max_contacts));
+}
+
+OdeWorld::~OdeWorld() { Clear(); }
+
+void OdeWorld::Clear() {
+  if (contacts_) dJointGroupDestroy(contacts_);
+  if (space_) dSpaceDestroy(space_);  // destroys its geoms
+  if (world_) {
+    dWorldSetStepThreadingImplementation(world_, nullptr, nullptr);
+    dWorldDestroy(world_);  // destroys bodies and joints
+  }
+  if (threading_) dThreadingFreeImplementation(threading_);
+  contacts_ = nullptr;
+  space_ = nullptr;
+  world_ = nullptr;
+  threading_ = nullptr;
+  bodies_.clear();
+  kinematic_.clear();
+  joints_.clear();
+  geom_info_.clear();
+  commands_.clear();
+}
+
+void OdeWorld::AddGeom(dGeomID geom, int32_t instance, double friction, double restitution) {
+  geom_info_.push_back({instance, friction, restitution});
+  dGeomSetData(geom, reinterpret_cast<void*>(static_cast<uintptr_t>(geom_info_.size())));
+}
+
+void OdeWorld::Build(const Scene& scene) {
+  Clear();
+  dAllocateODEDataForThread(dAllocateMaskAll);
+  dRandSetSeed(options_.seed);
+  world_ = dWorldCreate();
+  threading_ = dThreadingAllocateSelfThreadedImplementation();
+  dWorldSetStepThreadingImplementation(world_, dThreadingImplementationGetFunctions(threading_),
+                                       threading_);
+  dWorldSetGravity(world_, 0, 0, -settings_.gravity);
+  dWorldSetERP(world_, options_.erp);
+  dWorldSetCFM(world_, options_.cfm);
+  dWorldSetQuickStepNumIterations(world_, std::max(1, options_.iterations));
+  dWorldSetContactSurfaceLayer(world_, 1e-4);
+  dWorldSetContactMaxCorrectingVel(world_, 10);
+  space_ = dHashSpaceCreate(nullptr);
+  contacts_ = dJointGroupCreate(0);
+  if (options_.ground_plane) {
+    AddGeom(dCreatePlane(space_, 0, 0, 1, 0), -1, options_.ground_friction, 0);
+  }
+
+  const uint32_t slots = scene.slot_count();
+  auto shape_at = [&](uint32_t s) -> const ShapeData* {
+    if (!scene.alive_at(s) || scene.type_at(s) != ObjectType::kShape) return nullptr;
+    return &scene.shapes()[scene.row_at(s)];
+  };
+
+  // 1. A body per dynamic shape, in slot order.
+  std::vector<dBodyID> body_of(slots, nullptr);  // dynamic or kinematic body (slots)
+  for (uint32_t s = 0; s < slots; ++s) {
+    const ShapeData* shape = shape_at(s);
+    if (!shape || !shape->dynamic) continue;
+    const Pose& X_WS = scene.world_pose_at(s);
+    if (!IsFinite(X_WS)) throw Error("ode: shape '" + PathAt(scene, s) + "' has a non-finite pose");
+    if (!(shape->mass > 0) || !std::isfinite(shape->mass))
+      throw Error("ode: dynamic shape '" + PathAt(scene, s) + "' needs a positive mass (got " +
+                  std::to_string(shape->mass) + " kg)");
+    dGeomID geom = MakeGeom(space_, *shape);
+    if (!geom)
+      throw Error("ode: dynamic shape '" + PathAt(scene, s) + "' needs a positive size");
+    dBodyID body = dBodyCreate(world_);
+    SetBodyPose(body, X_WS);
+    const Vec3& v = scene.linear_velocity_at(s);
+    const Vec3& w = scene.angular_velocity_at(s);
+    dBodySetLinearVel(body, v.x, v.y, v.z);
+    dBodySetAngularVel(body, w.x, w.y, w.z);
+    const dMass mass = CalcMass(*shape);
+    dBodySetMass(body, &mass);
+    dGeomSetBody(geom, body);
+    AddGeom(geom, scene.instance_of_at(s), shape->friction, shape->restitution);
+    body_of[s] = body;
+    bodies_.push_back({body, s, X_WS});
+  }
+
+  // 2. Non-dynamic shapes: parts of a body, kinematic bodies or static geoms.
+  for (uint32_t s = 0; s < slots; ++s) {
+    const ShapeData* shape = shape_at(s);
+    if (!shape || shape->dynamic) continue;
+    const Pose& X_WS = scene.world_pose_at(s);
+    if (!IsFinite(X_WS)) throw Error("ode: shape '" + PathAt(scene, s) + "' has a non-finite pose");
+    dBodyID carrier = nullptr;
+    bool below_joint = false;
+    for (int32_t p = scene.parent_at(s); p >= 0; p = scene.parent_at(static_cast<uint32_t>(p))) {
+      const uint32_t ps = static_cast<uint32_t>(p);
+      if (scene.type_at(ps) == ObjectType::kJoint) below_joint = true;
+      const ShapeData* ancestor = shape_at(ps);
+      if (ancestor && ancestor->dynamic) {
+        if (!below_joint) carrier = body_of[ps];
+        break;
+      }
+    }
+    dGeomID geom = MakeGeom(space_, *shape);
+    if (!geom) continue;  // a zero-size decoration: nothing to collide with
+    AddGeom(geom, scene.instance_of_at(s), shape->friction, shape->restitution);
+    if (carrier) {
+      dGeomSetBody(geom, carrier);
+      dGeomSetOffsetWorldPosition(geom, X_WS.p.x, X_WS.p.y, X_WS.p.z);
+      const dQuaternion q = {X_WS.q.w, X_WS.q.x, X_WS.q.y, X_WS.q.z};
+      dGeomSetOffsetWorldQuaternion(geom, q);
+    } else if (below_joint || scene.instance_of_at(s) >= 0) {
+      dBodyID body = dBodyCreate(world_);
+      dBodySetKinematic(body);
+      SetBodyPose(body, X_WS);
+      dGeomSetBody(geom, body);
+      body_of[s] = body;
+      kinematic_.push_back({body, s, X_WS, X_WS, {}, {}});
+    } else {
+      dGeomSetPosition(geom, X_WS.p.x, X_WS.p.y, X_WS.p.z);
+      const dQuaternion q = {X_WS.q.w, X_WS.q.x, X_WS.q.y, X_WS.q.z};
+      dGeomSetQuaternion(geom, q);
+    }
+  }
+
+  // 3. Joints with a dynamic child body, in slot order.
+  for (uint32_t s = 0; s < slots; ++s) {
+    if (!scene.alive_at(s) || scene.type_at(s) != ObjectType::kJoint) continue;
+    const uint32_t row = scene.row_at(s);
+    const JointData& data = scene.joints()[row];
+    // Child: the first dynamic shape below, not across another joint.
+    dBodyID child = nullptr;
+    std::vector<uint32_t> stack;
+    for (ObjectId c : scene.children(scene.IdAt(s))) stack.push_back(c.index());
+    std::reverse(stack.begin(), stack.end());
+    while (!stack.empty() && !child) {
+      const uint32_t c = stack.back();
+      stack.pop_back();
+      if (scene.type_at(c) == ObjectType::kJoint) continue;
+      const ShapeData* shape = shape_at(c);
+      if (shape && shape->dynamic) {
+        child = body_of[c];
+        break;
+      }
+      std::vector<ObjectId> grand = scene.children(scene.IdAt(c));
+      for (auto it = grand.rbegin(); it != grand.rend(); ++it) stack.push_back(it->index());
+    }
+    if (!child) continue;  // stays kinematic
+    // Parent: the nearest body above (dynamic or kinematic), else the world.
+    dBodyID parent = nullptr;
+    for (int32_t p = scene.parent_at(s); p >= 0; p = scene.parent_at(static_cast<uint32_t>(p))) {
+      if (body_of[p]) {
+        parent = body_of[p];
+        break;
+      }
+    }
+    const Pose& X_WJ = scene.world_pose_at(s);
+    const Vec3 axis = X_WJ.q.Rotate({0, 0, 1});
+    SimJoint j{};
+    j.slot = s;
+    j.row = row;
+    j.offset = data.position;
+    j.position = data.position;
+    j.parent_body = parent;
+    j.child_body = child;
+    j.X_AJ = parent ? BodyPose(parent).Inverse() * X_WJ : X_WJ;
+    j.q_JB0 = X_WJ.q.Conjugate() * BodyPose(child).q;
+    j.ball0 = data.ball;
+    switch (data.type) {
+      case JointType::kRevolute:
+        j.joint = dJointCreateHinge(world_, nullptr);
+        dJointAttach(j.joint, child, parent);
+        dJointSetHingeAnchor(j.joint, X_WJ.p.x, X_WJ.p.y, X_WJ.p.z);
+        dJointSetHingeAxis(j.joint, axis.x, axis.y, axis.z);
+        // ODE's stops live in (-pi, pi] around the Build position.
+        if (data.min_position - j.offset >= -M_PI && data.max_position - j.offset <= M_PI) {
+          dJointSetHingeParam(j.joint, dParamLoStop, data.min_position - j.offset);
+          dJointSetHingeParam(j.joint, dParamHiStop, data.max_position - j.offset);
+        }
+        j.last_angle = dJointGetHingeAngle(j.joint);
+        break;
+      case JointType::kPrismatic:
+        j.joint = dJointCreateSlider(world_, nullptr);
+        dJointAttach(j.joint, child, parent);
+        dJointSetSliderAxis(j.joint, axis.x, axis.y, axis.z);
+        if (std::isfinite(data.min_position))
+          dJointSetSliderParam(j.joint, dParamLoStop, data.min_position - j.offset);
+        if (std::isfinite(data.max_position))
+          dJointSetSliderParam(j.joint, dParamHiStop, data.max_position - j.offset);
+        break;
+      case JointType::kSpherical:
+        j.joint = dJointCreateBall(world_, nullptr);
+        dJointAttach(j.joint, child, parent);
+        dJointSetBallAnchor(j.joint, X_WJ.p.x, X_WJ.p.y, X_WJ.p.z);
+        break;
+      case JointType::kFixed:
+        j.joint = dJointCreateFixed(world_, nullptr);
+        dJointAttach(j.joint, child, parent);
+        dJointSetFixed(j.joint);
+        break;
+    }
+    joints_.push_back(j);
+  }
+  commands_.assign(joints_.size(), JointData{});
+}
+
+void OdeWorld::MarkJoints(Scene* scene) const {
+  for (JointData& j : scene->joints()) j.simulated = false;
+  for (const SimJoint& j : joints_) scene->joints()[j.row].simulated = true;
+}
+
+void OdeWorld::SyncFromScene(const Scene& scene, double duration) {
+  dAllocateODEDataForThread(dAllocateMaskAll);
+  // Bodies moved by a script since the last write-back: teleport them.
+  for (DynamicBody& b : bodies_) {
+    const Pose& X_WB = scene.world_pose_at(b.slot);
+    if (X_WB == b.X_WB_written) continue;
+    SetBodyPose(b.body, X_WB);
+    const Vec3& v = scene.linear_velocity_at(b.slot);
+    const Vec3& w = scene.angular_velocity_at(b.slot);
+    dBodySetLinearVel(b.body, v.x, v.y, v.z);
+    dBodySetAngularVel(b.body, w.x, w.y, w.z);
+    b.X_WB_written = X_WB;
+  }
+  // Kinematic bodies go from where they were to where the scene has them.
+  for (KinematicBody& k : kinematic_) {
+    k.X_WB_from = k.X_WB_to;
+    k.X_WB_to = scene.world_pose_at(k.slot);
+    k.v_WB = (k.X_WB_to.p - k.X_WB_from.p) / duration;
+    k.w_WB = AngularVelocity(k.X_WB_from.q, k.X_WB_to.q, duration);
+  }
+}
+
+void OdeWorld::ReadJointCommands(const Scene& scene) {
+  for (size_t k = 0; k < joints_.size(); ++k) commands_[k] = scene.joints()[joints_[k].row];
+}
+
+void OdeWorld::ApplyMotors(double dt) {
+  for (size_t k = 0; k < joints_.size(); ++k) {
+    const SimJoint& j = joints_[k];
+    const JointData& c = commands_[k];
+    const bool hinge = c.type == JointType::kRevolute;
+    if (!hinge && c.type != JointType::kPrismatic) continue;
+    double velocity = 0, max_force = 0;
+    switch (c.mode) {
+      case JointMode::kVelocity:
+        velocity = c.target_velocity;
+        max_force = c.max_force;
+        break;
+      case JointMode::kPosition:
+        velocity = std::clamp(kServoGain * (c.target_position - j.position) / dt, -c.max_velocity,
+                              c.max_velocity);
+        max_force = c.max_force;
+        break;
+      case JointMode::kForce:
+        if (hinge) dJointAddHingeTorque(j.joint, c.target_force);
+        else dJointAddSliderForce(j.joint, c.target_force);
+        break;
+      case JointMode::kPassive: break;
+    }
+    if (hinge) {
+      dJointSetHingeParam(j.joint, dParamVel, velocity);
+      dJointSetHingeParam(j.joint, dParamFMax, max_force);
+    } else {
+      dJointSetSliderParam(j.joint, dParamVel, velocity);
+      dJointSetSliderParam(j.joint, dParamFMax, max_force);
+    }
+  }
+}
+
+void OdeWorld::TrackJointPositions() {
+  for (size_t k = 0; k < joints_.size(); ++k) {
+    SimJoint& j = joints_[k];
+    switch (commands_[k].type) {
+      case JointType::kRevolute: {
+        const double a = dJointGetHingeAngle(j.joint);
+        j.position += WrapAngle(a - j.last_angle);
+        j.last_angle = a;
+        break;
+      }
+      case JointType::kPrismatic: j.position = j.offset + dJointGetSliderPosition(j.joint); break;
+      case JointType::kSpherical:
+      case JointType::kFixed: break;
+    }
+  }
+}
+
+void OdeWorld::Substep(double dt, double fraction) {
+  step_dt_ = dt;
+  for (KinematicBody& k : kinematic_) {
+    SetBodyPose(k.body, Interpolate(k.X_WB_from, k.X_WB_to, fraction));
+    dBodySetLinearVel(k.body, k.v_WB.x, k.v_WB.y, k.v_WB.z);
+    dBodySetAngularVel(k.body, k.w_WB.x, k.w_WB.y, k.w_WB.z);
+  }
+  ApplyMotors(dt);
+  dSpaceCollide(space_, this, &OdeWorld::NearCallback);
+  if (options_.iterations > 0) dWorldQuickStep(world_, dt);
+  else dWorldStep(world_, dt);
+  dJointGroupEmpty(contacts_);
+  TrackJointPositions();
+}
+
+void OdeWorld::NearCallback(void* data, dGeomID a, dGeomID b) {
+  static_cast<OdeWorld*>(data)->Collide(a, b);
+}
+
+void OdeWorld::Collide(dGeomID a, dGeomID b) {
+  dBodyID ba = dGeomGetBody(a), bb = dGeomGetBody(b);
+  const bool dynamic_a = ba && !dBodyIsKinematic(ba);
+  const bool dynamic_b = bb && !dBodyIsKinematic(bb);
+  if (!dynamic_a && !dynamic_b) return;
+  if (ba == bb) return;
+  const GeomInfo& ia = geom_info_[reinterpret_cast<uintptr_t>(dGeomGetData(a)) - 1];
+  const GeomInfo& ib = geom_info_[reinterpret_cast<uintptr_t>(dGeomGetData(b)) - 1];
+  if (ia.instance >= 0 && ia.instance == ib.instance) return;
+  if (ba && bb && dAreConnectedExcluding(ba, bb, dJointTypeContact)) return;
+  const int n = dCollide(a, b, options_.max_contacts, &contact_buffer_[0].geom, sizeof(dContact));
+  const double mu = std::sqrt(ia.friction * ib.friction);
+  const double bounce = std::max(ia.restitution, ib.restitution);
+  for (int i = 0; i < n; ++i) {
+    dContact& c = contact_buffer_[i];
+    c.surface.mode = dContactApprox1 | (bounce > 0 ? dContactBounce : 0);
+    c.surface.mu = mu;
+    c.surface.bounce = bounce;
+    c.surface.bounce_vel = kBounceVelocity;
+    dJointID joint = dJointCreateContact(world_, contacts_, &c);
+    dJointAttach(joint, ba, bb);
+  }
+}
+
+void OdeWorld::WriteBack(Scene* scene) {
+  for (KinematicBody& k : kinematic_) SetBodyPose(k.body, k.X_WB_to);
+  for (DynamicBody& b : bodies_) {
+    const Pose X_WB = BodyPose(b.body);
+    scene->SetSimulatedState(b.slot, X_WB, ToVec3(dBodyGetLinearVel(b.body)),
+                             ToVec3(dBodyGetAngularVel(b.body)));
+    b.X_WB_written = X_WB;
+  }
+  for (size_t k = 0; k < joints_.size(); ++k) {
+    const SimJoint& j = joints_[k];
+    JointData& data = scene->joints()[j.row];
+    switch (commands_[k].type) {
+      case JointType::kRevolute:
+        data.position = j.position;
+        data.velocity = dJointGetHingeAngleRate(j.joint);
+        break;
+      case JointType::kPrismatic:
+        data.position = j.position;
+        data.velocity = dJointGetSliderPositionRate(j.joint);
+        break;
+      case JointType::kSpherical: {
+        const Pose X_WJ = j.parent_body ? BodyPose(j.parent_body) * j.X_AJ : j.X_AJ;
+        const Quat q_JB = X_WJ.q.Conjugate() * BodyPose(j.child_body).q;
+        data.ball = (q_JB * j.q_JB0.Conjugate() * j.ball0).Normalized();
+        break;
+      }
+      case JointType::kFixed: break;
+    }
+  }
+}
+
+void OdeWorld::Hash(StateHasher* hasher) const {
+  for (const DynamicBody& b : bodies_) {
+    hasher->AddValue(BodyPose(b.body));
+    hasher->AddValue(ToVec3(dBodyGetLinearVel(b.body)));
+    hasher->AddValue(ToVec3(dBodyGetAngularVel(b.body)));
+  }
+  for (const KinematicBody& k : kinematic_) hasher->AddValue(k.X_WB_to);
+  for (const SimJoint& j : joints_) {
+    hasher->AddValue(j.position);
+    hasher->AddValue(j.last_angle);
+  }
+  const uint64_t seed = dRandGetSeed();
+  hasher->AddValue(seed);
+}
+
+}  // namespace swarmsim::ode

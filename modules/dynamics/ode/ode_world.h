@@ -1,0 +1,102 @@
+// The ODE world behind the backend: bodies, geoms and joints mirrored from
+// a scene. Internal to the module; see ode_backend.h for the rules.
+#pragma once
+
+#include <ode/ode.h>
+
+#include <cstdint>
+#include <vector>
+
+#include "framework/dynamics_backend.h"
+#include "framework/math.h"
+#include "framework/scene.h"
+#include "modules/dynamics/ode/ode_backend.h"
+
+namespace swarmsim {
+class Scene;
+class StateHasher;
+}  // namespace swarmsim
+
+namespace swarmsim::ode {
+
+// A dynamic body: one per dynamic shape.
+struct DynamicBody {  // 72 bytes
+  dBodyID body;
+  uint32_t slot;
+  Pose X_WB_written;  // pose last written to the scene (detects teleports)
+};
+
+// A non-dynamic shape moved by the scene and pushed into ODE.
+struct KinematicBody {  // 128 bytes
+  dBodyID body;
+  uint32_t slot;
+  Pose X_WB_from, X_WB_to;  // pose at the start and end of the current step
+  Vec3 v_WB, w_WB;
+};
+
+struct SimJoint {
+  dJointID joint;
+  uint32_t slot;        // scene slot of the joint object
+  uint32_t row;         // row in Scene::joints()
+  double offset;        // scene position at Build (ODE measures from there)
+  double last_angle;    // last raw hinge angle, for unwrapping
+  double position;      // unwrapped position, rad or m
+  dBodyID parent_body;  // A, or null for the static world
+  Pose X_AJ;            // joint frame in A (in the world if A is null)
+  Quat q_JB0, ball0;    // spherical: child rotation in J and ball at Build
+  dBodyID child_body;
+};
+
+// Per geom: owner info for the contact filter and materials.
+struct GeomInfo {  // 24 bytes
+  int32_t instance;  // model instance or -1
+  double friction;
+  double restitution;
+};
+
+class OdeWorld {
+ public:
+  OdeWorld(const Options& options, const DynamicsSettings& settings);
+  ~OdeWorld();
+  OdeWorld(const OdeWorld&) = delete;
+  OdeWorld& operator=(const OdeWorld&) = delete;
+
+  void Build(const Scene& scene);
+  void MarkJoints(Scene* scene) const;
+  // Moves bodies teleported by scripts and reads the kinematic bodies' new
+  // poses (to be reached over `duration` seconds).
+  void SyncFromScene(const Scene& scene, double duration);
+  // Sets motors from the joint commands (targets, forces).
+  void ReadJointCommands(const Scene& scene);
+  // One ODE step of `dt`; `fraction` (0..1] is how far through the control
+  // step its end is (kinematic bodies are placed accordingly).
+  void Substep(double dt, double fraction);
+  void WriteBack(Scene* scene);
+  void Hash(StateHasher* hasher) const;
+  int body_count() const { return static_cast<int>(bodies_.size()); }
+
+ private:
+  void Clear();
+  void AddGeom(dGeomID geom, int32_t instance, double friction, double restitution);
+  void ApplyMotors(double dt);
+  void TrackJointPositions();
+  static void NearCallback(void* data, dGeomID a, dGeomID b);
+  void Collide(dGeomID a, dGeomID b);
+
+  Options options_;
+  DynamicsSettings settings_;
+  dWorldID world_ = nullptr;
+  dSpaceID space_ = nullptr;
+  dJointGroupID contacts_ = nullptr;
+  dThreadingImplementationID threading_ = nullptr;
+  std::vector<DynamicBody> bodies_;
+  std::vector<KinematicBody> kinematic_;
+  std::vector<SimJoint> joints_;
+  std::vector<GeomInfo> geom_info_;  // indexed by the geom's data (index + 1)
+  std::vector<dContact> contact_buffer_;
+  // Joint commands, read once per control step (rows of joints_).
+  std::vector<JointData> commands_;
+  double step_dt_ = 0;  // substep length, for the servo
+};
+
+}  // namespace swarmsim::ode

@@ -1,0 +1,182 @@
+#include "swarm/sweep.h"
+
+#include <unistd.h>
+
+#include <deque>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <thread>
+
+#include "framework/error.h"
+#include "framework/registry.h"
+#include "modules/builtin.h"
+#include "swarm/sweep_mpi.h"
+#include "swarm/sweep_progress.h"
+#include "swarm/version.h"
+#include "swarm/world_loader.h"
+
+namespace swarmsim {
+namespace {
+
+// Loads the world once with the first run's parameters, so that a misspelt
+// --param or a bad value is one clear error instead of every run failing.
+void CheckWorld(const SweepOptions& o, const GridRun& first) {
+  ModuleRegistry registry;
+  RegisterBuiltinModules(&registry);
+  LoadOptions load;
+  load.overrides = first.params;
+  load.seed = first.seed;
+  load.threads = 1;
+  LoadedWorld loaded = LoadWorld(o.world, load, registry);
+  if (!o.steps && !o.duration && !loaded.steps)
+    throw Error(o.world + " gives no run length; pass --steps N or --duration SECONDS");
+}
+
+WorkerConfig MakeWorkerConfig(const SweepOptions& o) {
+  WorkerConfig c;
+  c.self_exe = o.self_exe;
+  c.world = o.world;
+  c.steps = o.steps;
+  c.duration = o.duration;
+  c.threads_per_run = o.threads_per_run;
+  c.timeout_s = o.timeout_s;
+  c.scratch = std::filesystem::temp_directory_path() /
+              ("swarmsim-sweep-" + std::to_string(getpid()));
+  return c;
+}
+
+}  // namespace
+
+void ParseShard(const std::string& text, int* index, int* count) {
+  const size_t slash = text.find('/');
+  try {
+    if (slash == std::string::npos) throw std::invalid_argument("");
+    size_t a = 0, b = 0;
+    *index = std::stoi(text.substr(0, slash), &a);
+    *count = std::stoi(text.substr(slash + 1), &b);
+    if (a != slash || b != text.size() - slash - 1) throw std::invalid_argument("");
+  } catch (const std::exception&) {
+    throw Error("--shard expects i/n (e.g. 0/10 for the first of 10 shards), got '" + text + "'");
+  }
+  if (*count < 1 || *index < 0 || *index >= *count)
+    throw Error("--shard " + text + ": need 0 <= i < n");
+}
+
+std::string WorldFileHash(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) throw Error("cannot read world file '" + path + "'");
+  std::ostringstream s;
+  s << f.rdbuf();
+  // FNV-1a, 64 bits: a change detector, not a security hash.
+  uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : s.str()) h = (h ^ c) * 1099511628211ull;
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
+std::string SweepSpace(const std::vector<ParamSpec>& params, const std::vector<uint64_t>& seeds,
+                       const std::optional<int64_t>& steps, const std::optional<double>& duration) {
+  nlohmann::json j;
+  j["params"] = nlohmann::json::array();
+  for (const ParamSpec& p : params)
+    j["params"].push_back({{"name", p.name}, {"spec", p.spec}, {"kind", p.kind}, {"values", p.values}});
+  j["seeds"] = seeds;
+  j["steps"] = steps ? nlohmann::json(*steps) : nlohmann::json(nullptr);
+  j["duration"] = duration ? nlohmann::json(*duration) : nlohmann::json(nullptr);
+  return j.dump();
+}
+
+int RunSweep(const SweepOptions& options, std::ostream& out, std::ostream& err) {
+  if (options.mpi) return RunSweepMpi(options, out, err);
+  return CoordinateSweep(options, nullptr, out, err);
+}
+
+int CoordinateSweep(const SweepOptions& o, RemoteWorkers* remote, std::ostream& out,
+                    std::ostream& err) {
+  // The grid and the sweep's identity.
+  std::vector<ParamSpec> params;
+  for (const std::string& p : o.params) params.push_back(ParseParamSpec(p));
+  const std::vector<uint64_t> seeds = ParseSeeds(o.seeds);
+  const std::vector<GridRun> grid = ExpandGrid(params, seeds);
+  const std::string world_hash = WorldFileHash(o.world);
+  const std::string space = SweepSpace(params, seeds, o.steps, o.duration);
+  if (o.db.empty()) throw Error("sweep needs --db FILE for the results");
+
+  ResultsDb db(o.db);
+  if (std::optional<SweepRecord> existing = db.ReadSweep()) {
+    if (existing->space_json != space)
+      throw Error("'" + o.db + "' holds another sweep (different parameters, seeds or run " +
+                  "length); resume it with the same command or use another --db");
+    if (existing->world_hash != world_hash) {
+      if (!o.allow_changed_world)
+        throw Error("world file '" + o.world + "' has changed since this sweep began (" +
+                    existing->started_at + "); its runs would mix two worlds. Pass " +
+                    "--allow-changed-world to continue anyway, or use another --db");
+      err << "warning: world file changed since the sweep began; continuing as asked\n";
+      db.SetWorldHash(world_hash);
+    }
+    if (const int64_t n = db.ResetInterrupted(); n > 0)
+      err << "resuming: " << n << " run" << (n == 1 ? " was" : "s were")
+          << " in progress when the sweep stopped; running again\n";
+  } else {
+    CheckWorld(o, grid.front());
+    SweepRecord record{o.world, world_hash, space, UtcNow(), Version(), o.command_line};
+    db.CreateSweep(record, grid);
+  }
+  if (o.retry_failed) {
+    if (const int64_t n = db.ResetFailed(); n > 0) err << "retrying " << n << " failed runs\n";
+  }
+
+  // This shard's pending runs.
+  std::deque<GridRun> pending;
+  for (GridRun& r : db.PendingRuns())
+    if (r.id % o.shard_count == o.shard_index) pending.push_back(std::move(r));
+  const RunCounts before = db.Counts();
+  const int64_t shard_total =
+      o.shard_count == 1 ? before.total
+                         : (before.total - o.shard_index + o.shard_count - 1) / o.shard_count;
+  const int64_t already = shard_total - static_cast<int64_t>(pending.size());
+  const int jobs = o.jobs > 0 ? o.jobs
+                              : (remote ? 1 : std::max(1u, std::thread::hardware_concurrency()));
+  if (!o.quiet)
+    err << "sweep: " << before.total << " runs (" << grid.size() / seeds.size() << " points x "
+        << seeds.size() << " seeds)"
+        << (o.shard_count > 1 ? ", shard " + std::to_string(o.shard_index) + "/" +
+                                    std::to_string(o.shard_count)
+                              : std::string())
+        << ", " << already << " already finished, " << pending.size() << " to run on " << jobs
+        << (jobs == 1 ? " job" : " jobs") << (remote ? " here plus the other ranks" : "")
+        << "\n";
+
+  SweepProgress progress(err, shard_total, already, isatty(STDERR_FILENO) != 0, !o.quiet);
+  RunPool pool(MakeWorkerConfig(o), jobs);
+  const std::string me = WorkerName();
+  auto next = [&]() -> std::optional<GridRun> {
+    if (pending.empty()) return std::nullopt;
+    GridRun r = std::move(pending.front());
+    pending.pop_front();
+    db.Claim(r.id, me);
+    return r;
+  };
+  auto running = [&] { return pool.active() + (remote ? remote->Running() : 0); };
+  auto done = [&](RunOutcome outcome) {
+    db.Complete(outcome);
+    progress.RunEnded(outcome.id, outcome.ok, outcome.error, running());
+  };
+  while (!pending.empty() || pool.active() > 0 || (remote && remote->Busy())) {
+    while (pool.HasFreeSlot() && !pending.empty()) pool.Start(*next());
+    if (remote) remote->Service(next, done);
+    for (RunOutcome& outcome : pool.Poll(remote ? 0.002 : 0.5)) done(std::move(outcome));
+  }
+  progress.Finish();
+  const RunCounts after = db.Counts();
+  out << "sweep: " << after.ok << " ok, " << after.failed << " failed, "
+      << after.pending + after.running << " not run, of " << after.total << " runs; results in "
+      << o.db << "\n";
+  return 0;
+}
+
+}  // namespace swarmsim

@@ -1,0 +1,379 @@
+// Distributed control: explicit child scripts, threaded scripts, the
+// instruction budget and error policies, the main script, messages,
+// signals and packing.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "framework/error.h"
+#include "framework/world.h"
+#include "tests/framework/fakes.h"
+
+namespace swarmsim {
+namespace {
+
+std::shared_ptr<const ScriptSource> Source(std::string path, std::string code) {
+  return std::make_shared<const ScriptSource>(ScriptSource{std::move(path), std::move(code)});
+}
+
+// A world with null modules whose script output lands in `log`.
+class ScriptWorld {
+ public:
+  explicit ScriptWorld(int threads = 1, WorldSettings settings = {},
+                       ModuleRegistry registry = testing::NullRegistry())
+      : registry_(std::move(registry)) {
+    settings.physics = "null";
+    settings.time_step = 0.1;
+    settings.threads = threads;
+    world_ = std::make_unique<World>(settings, registry_);
+    world_->set_log_sink([this](std::string_view line) { log.emplace_back(line); });
+  }
+  World& world() { return *world_; }
+  Scene& scene() { return world_->scene(); }
+
+  // A robot: root dummy at (x, y) with heading `yaw` carrying a `body`
+  // dummy with `code` attached (unless empty). Returns the body.
+  ObjectId AddRobot(const std::string& name, const std::string& code, double x = 0,
+                    double y = 0, double yaw = 0) {
+    const ObjectId root = scene().AddDummy(name, {}, {{x, y, 0}, Quat::FromAxisAngle({0, 0, 1}, yaw)});
+    const ObjectId body = scene().AddDummy("body", root, {});
+    scene().MakeModelInstance(root, "bot", name);
+    if (!code.empty()) scene().AttachScript(body, Source("scripts/robot.lua", code));
+    return body;
+  }
+  void Steps(int n) {
+    for (int i = 0; i < n; ++i) world_->Step();
+  }
+  std::vector<std::string> log;
+
+ private:
+  ModuleRegistry registry_;
+  std::unique_ptr<World> world_;
+};
+
+template <typename F>
+std::string ErrorOf(F&& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+#define EXPECT_CONTAINS(haystack, needle) \
+  EXPECT_NE(std::string(haystack).find(needle), std::string::npos) << (haystack)
+
+// --- Child scripts ------------------------------------------------------------------------
+
+TEST(ScriptControlTest, ExplicitScriptRunsOnlyWhenItsParentCallsItAndReturnsValues) {
+  ScriptWorld w;
+  const ObjectId body = w.AddRobot("bot#0", R"(
+    function sysCall_actuation()
+      print('parent before')
+      local a, b = sim.handleChildScript(sim.getObject('./arm'), 3, 'x')
+      print('parent got', a, b)
+    end
+  )");
+  const ObjectId arm = w.scene().AddDummy("arm", body, {});
+  const ObjectId hand = w.scene().AddDummy("hand", arm, {});
+  w.scene().AttachScript(arm, Source("scripts/arm.lua", R"(
+    function sysCall_actuation(n, s)
+      print('arm', n, s)
+      return n * 2, s .. '!'
+    end
+  )"), /*explicit_handling=*/true);
+  w.scene().AttachScript(hand, Source("scripts/hand.lua", R"(
+    function sysCall_actuation() print('hand (implicit, after its parents)') end
+  )"));
+  w.Steps(1);
+  const std::vector<std::string> expected = {
+      "[bot#0] parent before", "[bot#0] arm\t3\tx", "[bot#0] parent got\t6\tx!",
+      "[bot#0] hand (implicit, after its parents)"};
+  EXPECT_EQ(w.log, expected);
+}
+
+TEST(ScriptControlTest, HandleChildScriptRefusesNonExplicitAndNonDescendantScripts) {
+  ScriptWorld w;
+  const ObjectId body = w.AddRobot("bot#0", R"(
+    function sysCall_actuation() sim.handleChildScript(sim.getObject('./eye')) end
+  )");
+  const ObjectId eye = w.scene().AddDummy("eye", body, {});
+  w.scene().AttachScript(eye, Source("scripts/eye.lua", "function sysCall_actuation() end"));
+  EXPECT_CONTAINS(ErrorOf([&] { w.Steps(1); }), "is not explicit");
+  ScriptWorld v;
+  const ObjectId body2 = v.AddRobot("bot#0", R"(
+    function sysCall_actuation() sim.handleChildScript(sim.getObject('./other')) end
+  )");
+  v.scene().AddDummy("other", body2, {});
+  EXPECT_CONTAINS(ErrorOf([&] { v.Steps(1); }), "no script of this model");
+}
+
+// --- Threaded scripts ----------------------------------------------------------------------
+
+TEST(ScriptControlTest, ThreadedScriptWaitsAndStepsAndGetsCleanup) {
+  ScriptWorld w;
+  w.AddRobot("bot#0", R"(
+    function sysCall_thread()
+      print('start', sim.getSimulationTime())
+      sim.step()
+      print('next', sim.getSimulationTime())
+      sim.wait(0.3)
+      print('waited', sim.getSimulationTime())
+      sim.waitUntil(function() return sim.getSimulationTime() > 0.75 end)
+      print('until', sim.getSimulationTime())
+      while true do sim.switchThread() end
+    end
+    function sysCall_cleanup() print('cleanup') end
+  )");
+  w.Steps(10);
+  w.world().Stop();
+  const std::vector<std::string> expected = {"[bot#0] start\t0.0", "[bot#0] next\t0.1",
+                                             "[bot#0] waited\t0.4", "[bot#0] until\t0.8",
+                                             "[bot#0] cleanup"};
+  EXPECT_EQ(w.log, expected);
+}
+
+TEST(ScriptControlTest, ThreadThatNeverYieldsIsSwitchedOutEachStep) {
+  ScriptWorld w;
+  w.AddRobot("bot#0", R"(
+    n = 0
+    function sysCall_thread()
+      sim.setThreadSwitchTiming(1)  -- 100,000 instructions
+      while true do n = n + 1 end
+    end
+    function sysCall_sensing() print(n > 0) end
+  )");
+  w.Steps(3);  // completes: the slice yields the loop
+  EXPECT_EQ(w.log, (std::vector<std::string>{"[bot#0] false", "[bot#0] true", "[bot#0] true"}));
+}
+
+TEST(ScriptControlTest, ThreadSlicesAreDeterministic) {
+  auto run = [](int threads) {
+    ScriptWorld w(threads);
+    for (int r = 0; r < 8; ++r)
+      w.AddRobot("bot#" + std::to_string(r), R"(
+        n = 0
+        function sysCall_thread() while true do n = n + 1 end end
+        function sysCall_sensing() sim.recordMetric('n', n) end
+      )", r);
+    w.Steps(4);
+    std::vector<double> values;
+    for (const MetricSample& m : w.world().TakeMetrics()) values.push_back(m.value);
+    return values;
+  };
+  const std::vector<double> one = run(1);
+  EXPECT_GT(one.back(), 0);
+  EXPECT_EQ(one, run(2));
+}
+
+TEST(ScriptControlTest, StepOutsideAThreadIsAnError) {
+  ScriptWorld w;
+  w.AddRobot("bot#0", "function sysCall_actuation() sim.step() end");
+  EXPECT_CONTAINS(ErrorOf([&] { w.Steps(1); }), "only a threaded script");
+}
+
+// --- Budget and error policy ---------------------------------------------------------------
+
+TEST(ScriptControlTest, EndlessLoopBecomesAnErrorNamingRobotScriptAndLine) {
+  WorldSettings settings;
+  settings.instruction_budget = 1'000'000;
+  ScriptWorld w(1, settings);
+  w.AddRobot("bot#0", "function sysCall_actuation()\n  while true do end\nend\n");
+  const std::string error = ErrorOf([&] { w.Steps(1); });
+  EXPECT_CONTAINS(error, "bot#0: scripts/robot.lua:2: ");
+  EXPECT_CONTAINS(error, "more than 1000000 Lua instructions");
+  EXPECT_CONTAINS(error, "[in sysCall_actuation of /bot#0/body]");
+}
+
+TEST(ScriptControlTest, StopPolicyEndsTheRunWithTheFaultyRobotNamed) {
+  ScriptWorld w(2);
+  for (int r = 0; r < 1000; ++r)
+    w.AddRobot("bot#" + std::to_string(r),
+               r == 617 ? "function sysCall_actuation() error('boom') end"
+                        : "function sysCall_actuation() end",
+               r);
+  const std::string error = ErrorOf([&] { w.Steps(1); });
+  EXPECT_CONTAINS(error, "bot#617: scripts/robot.lua:1: boom [in sysCall_actuation of /bot#617/body]");
+}
+
+TEST(ScriptControlTest, DisableScriptPolicyLogsOnceAndTheSwarmGoesOn) {
+  WorldSettings settings;
+  settings.on_script_error = ScriptErrorPolicy::kDisableScript;
+  settings.instruction_budget = 100'000;
+  ScriptWorld w(2, settings);
+  for (int r = 0; r < 1000; ++r)
+    w.AddRobot("bot#" + std::to_string(r),
+               r == 617 ? "function sysCall_actuation()\n  while true do end\nend"
+                        : "function sysCall_actuation() sim.recordMetric('alive', 1) end",
+               r);
+  w.Steps(3);
+  ASSERT_EQ(w.log.size(), 1u);
+  EXPECT_CONTAINS(w.log[0], "script disabled: bot#617: scripts/robot.lua:2:");
+  EXPECT_CONTAINS(w.log[0], "[in sysCall_actuation of /bot#617/body]");
+  EXPECT_EQ(w.world().TakeMetrics().size(), 3u * 999u);
+}
+
+// --- Main script ---------------------------------------------------------------------------
+
+TEST(ScriptControlTest, WorldMainScriptRunsThePhases) {
+  WorldSettings settings;
+  settings.main_script = Source("main.lua", R"(
+    function sysCall_step()
+      print('main', sim.getSimulationTime())
+      sim.handleSensing()
+      sim.handleChildScripts('actuation')
+      sim.handleChildScripts('sensing')
+      sim.handleActuation()
+      sim.handleDynamics()
+    end
+  )");
+  ScriptWorld w(1, settings);
+  w.AddRobot("bot#0", R"(
+    function sysCall_sensing() print('sensing') end
+    function sysCall_actuation() print('actuation') end
+  )");
+  w.Steps(2);
+  const std::vector<std::string> expected = {
+      "[main] main\t0.0",  "[bot#0] actuation", "[bot#0] sensing",
+      "[main] main\t0.1",  "[bot#0] actuation", "[bot#0] sensing"};
+  EXPECT_EQ(w.log, expected);
+  EXPECT_DOUBLE_EQ(w.world().time(), 0.2);
+}
+
+TEST(ScriptControlTest, MainScriptMustStepTheDynamicsAndChildrenCannotRunPhases) {
+  WorldSettings settings;
+  settings.main_script = Source("main.lua", "function sysCall_step() sim.handleSensing() end");
+  ScriptWorld w(1, settings);
+  EXPECT_CONTAINS(ErrorOf([&] { w.Steps(1); }), "must call sim.handleDynamics()");
+  ScriptWorld v;
+  v.AddRobot("bot#0", "function sysCall_actuation() sim.handleDynamics() end");
+  EXPECT_CONTAINS(ErrorOf([&] { v.Steps(1); }), "only the world's main script");
+}
+
+// --- Messages ------------------------------------------------------------------------------
+
+// A robot that sends what `send` says in step 0 and prints everything it receives.
+std::string Receiver(const std::string& send) {
+  return R"(
+    function sysCall_actuation()
+      if sim.getSimulationTime() == 0 then )" + send + R"( end
+      while true do
+        local data, sender, distance, bearing = sim.receiveMessage()
+        if not data then break end
+        print(data, sim.getObjectName(sim.getObjectParent(sender)),
+              distance and string.format('%.2f %.2f', distance, bearing) or '-')
+      end
+    end
+  )";
+}
+
+TEST(ScriptControlTest, MessageScopesReachExactlyTheirReceiversAtTheNextStep) {
+  ScriptWorld w;
+  const ObjectId a = w.AddRobot("a", Receiver("sim.sendGlobalMessage('g')"), 0, 0);
+  // b's body script sends local + direct; its eye script receives.
+  const ObjectId b = w.AddRobot("b", Receiver(R"(
+      sim.sendLocalMessage('l')
+      sim.sendDirectMessage(sim.getObject('/a/body'), 'd'))"), 1, 0, M_PI / 2);
+  const ObjectId eye = w.scene().AddDummy("eye", b, {});
+  w.scene().AttachScript(eye, Source("scripts/eye.lua", Receiver("")));
+  w.AddRobot("c", Receiver("sim.sendRangeMessage('r', 1.5)"), 0, 1);
+  (void)a;
+  w.Steps(1);
+  EXPECT_TRUE(w.log.empty());  // nothing delivered in the step it was sent
+  w.Steps(1);
+  // Sender-handle order (a's body, b's body, c's body); b faces +y, so a
+  // (at -x from b) is at bearing +pi/2 in b's frame.
+  const std::vector<std::string> expected = {
+      "[a] d\tb\t1.00 0.00", "[a] r\tc\t1.00 1.57",  "[b] g\ta\t1.00 1.57",
+      "[b] r\tc\t1.41 0.79", "[b] g\ta\t1.00 1.57",  "[b] l\tb\t0.00 0.00",
+      "[b] r\tc\t1.41 0.79", "[c] g\ta\t1.00 -1.57"};
+  EXPECT_EQ(w.log, expected);
+}
+
+TEST(ScriptControlTest, RangeMessagesHonourRangeAndLineOfSight) {
+  // A proximity module in which the segment crossing x = 0.5 is blocked.
+  class Wall : public testing::NullProximity {
+   public:
+    bool SegmentBlocked(const Vec3& a, const Vec3& b) const override {
+      return (a.x - 0.5) * (b.x - 0.5) < 0;
+    }
+  };
+  ModuleRegistry walled;
+  walled.RegisterDynamics({"", "null", "1", ""}, [] { return std::make_unique<testing::NullDynamics>(); });
+  walled.RegisterProximity({"", "proximity", "1", ""}, [] { return std::make_unique<Wall>(); });
+  ScriptWorld w(1, {}, std::move(walled));
+  w.AddRobot("s", Receiver("sim.sendRangeMessage('open', 2); sim.sendRangeMessage('los', 2, true)"), 0, 0);
+  w.AddRobot("near", Receiver(""), 0, 1.9);
+  w.AddRobot("behind", Receiver(""), 1, 0);
+  w.AddRobot("far", Receiver(""), 0, -2.1);
+  w.Steps(2);
+  const std::vector<std::string> expected = {
+      "[near] open\ts\t1.90 -1.57", "[near] los\ts\t1.90 -1.57", "[behind] open\ts\t1.00 3.14"};
+  EXPECT_EQ(w.log, expected);
+}
+
+TEST(ScriptControlTest, RangeMessagingIsTheSameAtAnyThreadCount) {
+  auto run = [](int threads) {
+    ScriptWorld w(threads);
+    for (int r = 0; r < 300; ++r)
+      w.AddRobot("bot#" + std::to_string(r), R"(
+        function sysCall_actuation()
+          local sum = 0
+          while true do
+            local data, sender, d, b = sim.receiveMessage()
+            if not data then break end
+            sum = sum * 1.0001 + sim.unpackFloats(data)[1] + d + b
+          end
+          sim.recordMetric('sum', sum)
+          sim.sendRangeMessage(sim.packFloats({sim.random()}), 0.5)
+        end
+      )", (r % 20) * 0.3, (r / 20) * 0.3);
+    w.Steps(3);
+    std::vector<double> v;
+    for (const MetricSample& m : w.world().TakeMetrics()) v.push_back(m.value);
+    return v;
+  };
+  const std::vector<double> one = run(1);
+  EXPECT_EQ(one, run(2));
+  EXPECT_EQ(one, run(4));
+}
+
+// --- Signals and packing -------------------------------------------------------------------
+
+TEST(ScriptControlTest, SignalsAreVisibleFromTheNextStepAndTheLastRobotWins) {
+  ScriptWorld w(2);
+  for (int r = 0; r < 40; ++r)
+    w.AddRobot("bot#" + std::to_string(r), R"(
+      function sysCall_actuation()
+        if sim.getRobotIndex() == 0 then print(sim.getSignal('who'), sim.getSignal('flag')) end
+        sim.setSignal('who', sim.getRobotIndex())
+        if sim.getSimulationTime() > 0.05 then sim.clearSignal('flag') else sim.setSignal('flag', true) end
+      end
+    )", r);
+  w.Steps(3);
+  EXPECT_EQ(w.log, (std::vector<std::string>{"[bot#0] nil\tnil", "[bot#0] 39.0\ttrue",
+                                             "[bot#0] 39.0\tnil"}));
+}
+
+TEST(ScriptControlTest, PackAndUnpackRoundTrip) {
+  ScriptWorld w;
+  w.AddRobot("bot#0", R"(
+    local f = sim.unpackFloats(sim.packFloats({1.5, -2}))
+    local d = sim.unpackDoubles(sim.packDoubles({0.1}))
+    local i = sim.unpackInt32s(sim.packInt32s({-7, 2147483647}))
+    local t = sim.unpackTable(sim.packTable({1, 'two', x = {y = true}, [3] = 0.25}))
+    print(#sim.packFloats({1, 2, 3}), f[1], f[2], d[1], i[1], i[2], t[1], t[2], t.x.y, t[3])
+    print(pcall(sim.unpackTable, 'garbage'))
+  )");
+  w.world().Start();
+  ASSERT_EQ(w.log.size(), 2u);
+  EXPECT_EQ(w.log[0], "[bot#0] 12\t1.5\t-2.0\t0.1\t-7\t2147483647\t1\ttwo\ttrue\t0.25");
+  EXPECT_CONTAINS(w.log[1], "not a packed table");
+}
+
+}  // namespace
+}  // namespace swarmsim
