@@ -1,7 +1,107 @@
 // The sim.* API: helpers shared by the API areas, and the one list of areas.
 #include "framework/lua_api.h"
 
+#include <algorithm>
+#include <string>
+#include <vector>
+
 namespace swarmsim {
+
+namespace {
+
+// One sim.* entry: a C function or a constant.
+struct SimEntry {
+  std::string name;
+  int type = LUA_TNIL;
+  lua_CFunction function = nullptr;
+  lua_Integer integer = 0;
+  lua_Number number = 0;
+  bool is_integer = false;
+  std::string text;
+  bool boolean = false;
+};
+
+void RegisterAreas(lua_State* L);
+
+// Every sim.* entry, by name, and the globals the areas define. Built once per process from a scratch state:
+// the API areas keep registering the usual way (luaL_setfuncs), and each
+// robot's state fills its own `sim` table lazily from this list. A robot
+// then holds only the functions its scripts use, instead of a hash table of
+// ~100 entries (about 2-4 KiB per robot at 10,000 robots).
+struct ApiTables {
+  std::vector<SimEntry> sim;  // sorted by name
+  std::vector<std::pair<std::string, lua_CFunction>> globals;  // e.g. print
+};
+
+const ApiTables& Tables() {
+  static const ApiTables tables = [] {
+    ApiTables t;
+    std::vector<SimEntry>& out = t.sim;
+    lua_State* L = luaL_newstate();  // no libraries: its globals are what the areas set
+    lua_newtable(L);
+    RegisterAreas(L);
+    lua_pushglobaltable(L);
+    lua_pushnil(L);
+    while (lua_next(L, -2) != 0) {
+      if (lua_type(L, -2) == LUA_TSTRING && lua_tocfunction(L, -1) != nullptr)
+        t.globals.emplace_back(lua_tostring(L, -2), lua_tocfunction(L, -1));
+      lua_pop(L, 1);
+    }
+    lua_pop(L, 1);
+    lua_pushnil(L);
+    while (lua_next(L, -2) != 0) {
+      if (lua_type(L, -2) == LUA_TSTRING) {
+        SimEntry e;
+        e.name = lua_tostring(L, -2);
+        e.type = lua_type(L, -1);
+        switch (e.type) {
+          case LUA_TFUNCTION: e.function = lua_tocfunction(L, -1); break;
+          case LUA_TNUMBER:
+            e.is_integer = lua_isinteger(L, -1);
+            e.integer = lua_tointeger(L, -1);
+            e.number = lua_tonumber(L, -1);
+            break;
+          case LUA_TSTRING: e.text = lua_tostring(L, -1); break;
+          case LUA_TBOOLEAN: e.boolean = lua_toboolean(L, -1); break;
+          default: break;
+        }
+        if (e.type != LUA_TFUNCTION || e.function != nullptr) out.push_back(std::move(e));
+      }
+      lua_pop(L, 1);
+    }
+    lua_close(L);
+    std::sort(out.begin(), out.end(),
+              [](const SimEntry& a, const SimEntry& b) { return a.name < b.name; });
+    return t;
+  }();
+  return tables;
+}
+
+// __index of a robot's `sim` table: fetch the entry, keep it in the table.
+int LazySimIndex(lua_State* L) {
+  if (lua_type(L, 2) != LUA_TSTRING) return 0;
+  const std::string_view key = lua_tostring(L, 2);
+  const std::vector<SimEntry>& entries = Tables().sim;
+  auto it = std::lower_bound(entries.begin(), entries.end(), key,
+                             [](const SimEntry& e, std::string_view k) { return e.name < k; });
+  if (it == entries.end() || it->name != key) return 0;
+  switch (it->type) {
+    case LUA_TFUNCTION: lua_pushcfunction(L, it->function); break;
+    case LUA_TNUMBER:
+      if (it->is_integer) lua_pushinteger(L, it->integer);
+      else lua_pushnumber(L, it->number);
+      break;
+    case LUA_TSTRING: lua_pushlstring(L, it->text.data(), it->text.size()); break;
+    case LUA_TBOOLEAN: lua_pushboolean(L, it->boolean); break;
+    default: return 0;
+  }
+  lua_pushvalue(L, 2);
+  lua_pushvalue(L, -2);
+  lua_rawset(L, 1);
+  return 1;
+}
+
+}  // namespace
 
 void RaiseError(lua_State* L, const std::string& message) {
   luaL_where(L, 1);
@@ -26,7 +126,8 @@ void PushNumberArray(lua_State* L, const double* v, int n) {
   }
 }
 
-void RegisterAllApis(lua_State* L) {
+namespace {
+void RegisterAreas(lua_State* L) {
   // One API area per file; a new area adds one line here.
   static constexpr void (*kAreas[])(lua_State*) = {
       RegisterSimApi,      // lua_api_sim.cc: time, parameters, random, metrics, print
@@ -36,12 +137,27 @@ void RegisterAllApis(lua_State* L) {
       RegisterMessagesApi, // lua_api_messages.cc: messages, signals, packing
       RegisterControlApi,  // script_host.cc: child scripts, threads, main-script handlers
       RegisterDynamicsApi,  // lua_api_dynamics.cc: dynamic/kinematic switch, joint forces
+      RegisterIkApi,        // lua_api_ik.cc: IK groups
+      RegisterForceSensorApi,  // lua_api_force.cc: force sensors
+      RegisterPaintApi,  // lua_api_paint.cc: paint nozzles
   };
-  lua_newtable(L);
   lua_pushinteger(L, kHandleWorld);
   lua_setfield(L, -2, "handle_world");
   for (auto area : kAreas) area(L);
+}
+}  // namespace
+
+void RegisterAllApis(lua_State* L) {
+  lua_newtable(L);  // sim, filled on first use of each name
+  lua_createtable(L, 0, 1);
+  lua_pushcfunction(L, LazySimIndex);
+  lua_setfield(L, -2, "__index");
+  lua_setmetatable(L, -2);
   lua_setglobal(L, "sim");
+  for (const auto& [name, function] : Tables().globals) {
+    lua_pushcfunction(L, function);
+    lua_setglobal(L, name.c_str());
+  }
 }
 
 }  // namespace swarmsim

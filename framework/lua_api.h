@@ -105,6 +105,9 @@ void RegisterSimApi(lua_State* L);
 void RegisterMessagesApi(lua_State* L);
 void RegisterControlApi(lua_State* L);
 void RegisterDynamicsApi(lua_State* L);
+void RegisterIkApi(lua_State* L);
+void RegisterForceSensorApi(lua_State* L);
+void RegisterPaintApi(lua_State* L);
 
 // Creates the global `sim` table and calls every Register...Api above.
 void RegisterAllApis(lua_State* L);

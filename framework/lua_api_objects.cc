@@ -2,11 +2,13 @@
 //
 // Poses are read from the scene as it was at the start of the control
 // phase (nothing moves objects during it), so any robot may read any object.
+#include <cmath>
 #include <string>
 
 #include "framework/error.h"
 #include "framework/lua_api.h"
 #include "framework/scene.h"
+#include "framework/world.h"
 
 namespace swarmsim {
 namespace {
@@ -91,6 +93,51 @@ int GetObjectParent(lua_State* L) {
   return 1;
 }
 
+// Reads a number array of length n at `arg`.
+void CheckNumbers(lua_State* L, int arg, double* out, int n) {
+  luaL_checktype(L, arg, LUA_TTABLE);
+  for (int i = 0; i < n; ++i) {
+    lua_rawgeti(L, arg, i + 1);
+    int ok = 0;
+    out[i] = lua_tonumberx(L, -1, &ok);
+    lua_pop(L, 1);
+    if (!ok || !std::isfinite(out[i]))
+      throw Error("expected a table of " + std::to_string(n) + " finite numbers");
+  }
+}
+
+// sim.setObjectPose(h, {x, y, z, qx, qy, qz, qw} [, relTo]) and
+// sim.setObjectPosition(h, {x, y, z} [, relTo]) (the older argument order
+// (h, relTo, values) works too). The move is queued and applied after the
+// control phase in handle order, like writes to other robots, so every
+// script reads the poses of the start of the phase.
+int SetObjectPoseOrPosition(lua_State* L, bool position_only) {
+  const LuaContext& c = Context(L);
+  const ObjectId id = CheckObject(L, 1);
+  const uint32_t slot = c.scene->SlotOf(id);
+  const bool new_order = lua_istable(L, 2);
+  const int values_arg = new_order ? 2 : 3, relative_arg = new_order ? 3 : 2;
+  double v[7];
+  CheckNumbers(L, values_arg, v, position_only ? 3 : 7);
+  const ObjectId relative_to = OptRelativeTo(L, relative_arg);
+  const Pose X_WR = relative_to.IsNull()
+                        ? Pose{}
+                        : c.scene->world_pose_at(c.scene->SlotOf(relative_to, "relative-to object"));
+  Pose X_WO = c.scene->world_pose_at(slot);
+  if (position_only) {
+    X_WO.p = X_WR * Vec3{v[0], v[1], v[2]};
+  } else {
+    const Quat q = Quat{v[6], v[3], v[4], v[5]}.Normalized();
+    X_WO = X_WR * Pose{{v[0], v[1], v[2]}, q};
+  }
+  DeferredWrite w{id, DeferredWrite::Kind::kObjectPose, 0};
+  w.pose = X_WO;
+  c.runtime->deferred.push_back(w);
+  return 0;
+}
+int SetObjectPose(lua_State* L) { return SetObjectPoseOrPosition(L, false); }
+int SetObjectPosition(lua_State* L) { return SetObjectPoseOrPosition(L, true); }
+
 }  // namespace
 
 void RegisterObjectsApi(lua_State* L) {
@@ -101,6 +148,8 @@ void RegisterObjectsApi(lua_State* L) {
       {"getObjectOrientation", Guarded<GetObjectOrientation, "sim.getObjectOrientation">},
       {"getObjectName", Guarded<GetObjectName, "sim.getObjectName">},
       {"getObjectParent", Guarded<GetObjectParent, "sim.getObjectParent">},
+      {"setObjectPose", Guarded<SetObjectPose, "sim.setObjectPose">},
+      {"setObjectPosition", Guarded<SetObjectPosition, "sim.setObjectPosition">},
       {nullptr, nullptr},
   };
   luaL_setfuncs(L, kFunctions, 0);

@@ -1,5 +1,6 @@
 #include "framework/registry.h"
 
+#include "framework/calculation_module.h"
 #include "framework/dynamics_backend.h"
 #include "framework/error.h"
 #include "framework/proximity_backend.h"
@@ -15,6 +16,12 @@ void ModuleRegistry::RegisterDynamics(ModuleInfo info, DynamicsFactory factory) 
 void ModuleRegistry::RegisterProximity(ModuleInfo info, ProximityFactory factory) {
   info.kind = "proximity";
   proximity_.emplace_back(info.name, std::move(factory));
+  modules_.push_back(std::move(info));
+}
+
+void ModuleRegistry::RegisterCalculation(ModuleInfo info, CalculationFactory factory) {
+  info.kind = "calculation";
+  calculation_.emplace_back(info.name, std::move(factory));
   modules_.push_back(std::move(info));
 }
 
@@ -35,6 +42,12 @@ std::unique_ptr<ProximityBackend> ModuleRegistry::MakeProximity(const std::strin
   for (const auto& [n, f] : proximity_)
     if (n == name) return f();
   throw Error("unknown proximity module '" + name + "' (available: " + Known(proximity_) + ")");
+}
+
+std::unique_ptr<CalculationModule> ModuleRegistry::MakeCalculation(const std::string& name) const {
+  for (const auto& [n, f] : calculation_)
+    if (n == name) return f();
+  throw Error("unknown calculation module '" + name + "' (available: " + Known(calculation_) + ")");
 }
 
 bool ModuleRegistry::HasDynamics(const std::string& name) const {

@@ -12,6 +12,7 @@
 
 namespace swarmsim {
 
+class CalculationModule;
 class DynamicsBackend;
 class ProximityBackend;
 
@@ -26,13 +27,17 @@ class ModuleRegistry {
  public:
   using DynamicsFactory = std::function<std::unique_ptr<DynamicsBackend>()>;
   using ProximityFactory = std::function<std::unique_ptr<ProximityBackend>()>;
+  using CalculationFactory = std::function<std::unique_ptr<CalculationModule>()>;
 
   void RegisterDynamics(ModuleInfo info, DynamicsFactory factory);
   void RegisterProximity(ModuleInfo info, ProximityFactory factory);
+  // Calculation modules (IK groups, ...): kind "calculation".
+  void RegisterCalculation(ModuleInfo info, CalculationFactory factory);
 
   // Throw swarmsim::Error listing what is available when `name` is unknown.
   std::unique_ptr<DynamicsBackend> MakeDynamics(const std::string& name) const;
   std::unique_ptr<ProximityBackend> MakeProximity(const std::string& name) const;
+  std::unique_ptr<CalculationModule> MakeCalculation(const std::string& name) const;
   bool HasDynamics(const std::string& name) const;
   std::vector<std::string> DynamicsNames() const;
 
@@ -42,6 +47,7 @@ class ModuleRegistry {
   std::vector<ModuleInfo> modules_;
   std::vector<std::pair<std::string, DynamicsFactory>> dynamics_;
   std::vector<std::pair<std::string, ProximityFactory>> proximity_;
+  std::vector<std::pair<std::string, CalculationFactory>> calculation_;
 };
 
 }  // namespace swarmsim

@@ -14,6 +14,8 @@ const char* ToString(ObjectType type) {
     case ObjectType::kShape: return "shape";
     case ObjectType::kJoint: return "joint";
     case ObjectType::kProximitySensor: return "proximity_sensor";
+    case ObjectType::kForceSensor: return "force_sensor";
+    case ObjectType::kPaintNozzle: return "paint_nozzle";
   }
   return "?";
 }
@@ -148,6 +150,12 @@ void Scene::FreeSlot(uint32_t slot) {
     case ObjectType::kProximitySensor:
       SwapRemoveRow(&proximity_sensors_, &proximity_sensor_owner_, row_[slot], &row_);
       break;
+    case ObjectType::kForceSensor:
+      SwapRemoveRow(&force_sensors_, &force_sensor_owner_, row_[slot], &row_);
+      break;
+    case ObjectType::kPaintNozzle:
+      SwapRemoveRow(&paint_nozzles_, &paint_nozzle_owner_, row_[slot], &row_);
+      break;
     case ObjectType::kDummy: break;
   }
   if (script_[slot] >= 0) scripts_[script_[slot]] = {};
@@ -191,6 +199,24 @@ ObjectId Scene::AddProximitySensor(std::string name, ObjectId parent, const Pose
   row_[slot] = static_cast<uint32_t>(proximity_sensors_.size());
   proximity_sensors_.push_back(sensor);
   proximity_sensor_owner_.push_back(slot);
+  return IdAt(slot);
+}
+
+ObjectId Scene::AddForceSensor(std::string name, ObjectId parent, const Pose& X_PO,
+                               const ForceSensorData& sensor) {
+  const uint32_t slot = AllocateSlot(std::move(name), parent, X_PO, ObjectType::kForceSensor);
+  row_[slot] = static_cast<uint32_t>(force_sensors_.size());
+  force_sensors_.push_back(sensor);
+  force_sensor_owner_.push_back(slot);
+  return IdAt(slot);
+}
+
+ObjectId Scene::AddPaintNozzle(std::string name, ObjectId parent, const Pose& X_PO,
+                               const PaintNozzleData& nozzle) {
+  const uint32_t slot = AllocateSlot(std::move(name), parent, X_PO, ObjectType::kPaintNozzle);
+  row_[slot] = static_cast<uint32_t>(paint_nozzles_.size());
+  paint_nozzles_.push_back(nozzle);
+  paint_nozzle_owner_.push_back(slot);
   return IdAt(slot);
 }
 
@@ -240,6 +266,7 @@ void Scene::RemoveSubtree(ObjectId root) {
       instances_[instance_[s]].objects.clear();
     }
   }
+  for (SceneListener* l : listeners_) l->OnSubtreeRemoved(*this, doomed);
   const int inst = instance_[slot];
   for (uint32_t s : doomed) FreeSlot(s);
   if (inst >= 0 && instances_[inst].alive) RebuildInstanceObjects(inst);
@@ -324,6 +351,22 @@ uint32_t Scene::CopyObject(uint32_t src, int32_t new_parent) {
       copy = AddProximitySensor(std::move(name), parent, X_PO, data);
       break;
     }
+    case ObjectType::kForceSensor: {
+      // The copy starts from the settings, unbroken and with no reading.
+      const ForceSensorData& src_data = force_sensors_[row_[src]];
+      ForceSensorData data;
+      data.filter_samples = src_data.filter_samples;
+      data.force_threshold = src_data.force_threshold;
+      data.torque_threshold = src_data.torque_threshold;
+      data.break_after = src_data.break_after;
+      copy = AddForceSensor(std::move(name), parent, X_PO, data);
+      break;
+    }
+    case ObjectType::kPaintNozzle: {
+      const PaintNozzleData data = paint_nozzles_[row_[src]];
+      copy = AddPaintNozzle(std::move(name), parent, X_PO, data);
+      break;
+    }
   }
   const uint32_t slot = copy.index();
   v_WO_[slot] = v_WO_[src];
@@ -335,6 +378,37 @@ uint32_t Scene::CopyObject(uint32_t src, int32_t new_parent) {
     scripts_.push_back(attachment);
   }
   return slot;
+}
+
+void Scene::ReserveForCopies(ObjectId root, size_t copies) {
+  std::vector<uint32_t> sub;
+  CollectSubtree(SlotOf(root), &sub);
+  size_t shapes = 0, joints = 0, sensors = 0, scripts = 0;
+  for (uint32_t s : sub) {
+    shapes += type_[s] == ObjectType::kShape;
+    joints += type_[s] == ObjectType::kJoint;
+    sensors += type_[s] == ObjectType::kProximitySensor;
+    scripts += script_[s] >= 0;
+  }
+  const size_t slots = generation_.size() + sub.size() * copies;
+  for (auto* v : {&X_PO_, &X_WO_}) v->reserve(slots);
+  for (auto* v : {&v_WO_, &w_WO_}) v->reserve(slots);
+  for (auto* v : {&parent_, &first_child_, &last_child_, &next_sibling_, &prev_sibling_, &instance_,
+                  &script_, &linked_dummy_})
+    v->reserve(slots);
+  for (auto* v : {&simulated_, &alive_, &model_root_}) v->reserve(slots);
+  type_.reserve(slots);
+  row_.reserve(slots);
+  generation_.reserve(slots);
+  name_.reserve(slots);
+  shapes_.reserve(shapes_.size() + shapes * copies);
+  shape_owner_.reserve(shapes_.capacity());
+  joints_.reserve(joints_.size() + joints * copies);
+  joint_owner_.reserve(joints_.capacity());
+  proximity_sensors_.reserve(proximity_sensors_.size() + sensors * copies);
+  proximity_sensor_owner_.reserve(proximity_sensors_.capacity());
+  scripts_.reserve(scripts_.size() + scripts * copies);
+  instances_.reserve(instances_.size() + copies);
 }
 
 ObjectId Scene::DuplicateSubtree(ObjectId root, ObjectId new_parent) {
@@ -367,6 +441,12 @@ ObjectId Scene::DuplicateSubtree(ObjectId root, ObjectId new_parent) {
     const std::string model_name = instances_[src_instance].model_name;
     MakeModelInstance(IdAt(copy_root), model_name,
                       model_name + "#" + std::to_string(instances_.size()));
+  }
+  if (!listeners_.empty()) {
+    std::vector<uint32_t> copies;
+    copies.reserve(sources.size());
+    for (uint32_t src : sources) copies.push_back(copy_of.at(src));
+    for (SceneListener* l : listeners_) l->OnSubtreeDuplicated(*this, sources, copies);
   }
   return IdAt(copy_root);
 }
@@ -504,6 +584,26 @@ const ProximitySensorData& Scene::proximity_sensor(ObjectId id) const {
   const uint32_t s = SlotOf(id, "proximity sensor");
   ExpectType(*this, s, ObjectType::kProximitySensor);
   return proximity_sensors_[row_[s]];
+}
+const ForceSensorData& Scene::force_sensor(ObjectId id) const {
+  const uint32_t s = SlotOf(id, "force sensor");
+  ExpectType(*this, s, ObjectType::kForceSensor);
+  return force_sensors_[row_[s]];
+}
+ForceSensorData& Scene::mutable_force_sensor(ObjectId id) {
+  const uint32_t s = SlotOf(id, "force sensor");
+  ExpectType(*this, s, ObjectType::kForceSensor);
+  return force_sensors_[row_[s]];
+}
+const PaintNozzleData& Scene::paint_nozzle(ObjectId id) const {
+  const uint32_t s = SlotOf(id, "paint nozzle");
+  ExpectType(*this, s, ObjectType::kPaintNozzle);
+  return paint_nozzles_[row_[s]];
+}
+PaintNozzleData& Scene::mutable_paint_nozzle(ObjectId id) {
+  const uint32_t s = SlotOf(id, "paint nozzle");
+  ExpectType(*this, s, ObjectType::kPaintNozzle);
+  return paint_nozzles_[row_[s]];
 }
 ProximitySensorData& Scene::mutable_proximity_sensor(ObjectId id) {
   const uint32_t s = SlotOf(id, "proximity sensor");

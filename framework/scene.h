@@ -18,12 +18,14 @@
 #include <string_view>
 #include <vector>
 
+#include "framework/force_sensor.h"
 #include "framework/handle.h"
 #include "framework/math.h"
+#include "framework/paint_nozzle.h"
 
 namespace swarmsim {
 
-enum class ObjectType : uint8_t { kDummy, kShape, kJoint, kProximitySensor };
+enum class ObjectType : uint8_t { kDummy, kShape, kJoint, kProximitySensor, kForceSensor, kPaintNozzle };
 const char* ToString(ObjectType type);
 
 enum class ShapeKind : uint8_t { kBox, kCylinder, kSphere, kCapsule };
@@ -107,6 +109,21 @@ struct ModelInstance {
   std::vector<uint32_t> objects;  // slots of the instance's objects, hierarchy (DFS pre-)order
 };
 
+class Scene;
+
+// Calculation objects that refer to scene objects (IK groups, ...) follow
+// them through duplication and removal (Scene::AddListener).
+class SceneListener {
+ public:
+  virtual ~SceneListener() = default;
+  // sources[i] was copied to copies[i] (slots, hierarchy order); the copy
+  // is complete (a copied robot is already an instance).
+  virtual void OnSubtreeDuplicated(const Scene& scene, std::span<const uint32_t> sources,
+                                   std::span<const uint32_t> copies) = 0;
+  // `slots` are about to be freed.
+  virtual void OnSubtreeRemoved(const Scene& scene, std::span<const uint32_t> slots) = 0;
+};
+
 class Scene {
  public:
   Scene();
@@ -121,6 +138,12 @@ class Scene {
   ObjectId AddJoint(std::string name, ObjectId parent, const Pose& X_PO, const JointData& joint);
   ObjectId AddProximitySensor(std::string name, ObjectId parent, const Pose& X_PO,
                               const ProximitySensorData& sensor);
+  // A force sensor links its parent shape to the first dynamic shape below it
+  // (framework/force_sensor.h); a paint nozzle marks the floor (paint_nozzle.h).
+  ObjectId AddForceSensor(std::string name, ObjectId parent, const Pose& X_PO,
+                          const ForceSensorData& sensor);
+  ObjectId AddPaintNozzle(std::string name, ObjectId parent, const Pose& X_PO,
+                          const PaintNozzleData& nozzle);
   // Removes an object and all its descendants (their handles become stale).
   void RemoveSubtree(ObjectId root);
   // Copies a subtree under `new_parent` (null: a new root), with its scripts,
@@ -128,6 +151,12 @@ class Scene {
   // Returns the copy's root.
   ObjectId DuplicateSubtree(ObjectId root, ObjectId new_parent);
   void SetParent(ObjectId id, ObjectId new_parent, bool keep_world_pose);
+  // Listeners are told of duplications and removals; not owned.
+  void AddListener(SceneListener* listener) { listeners_.push_back(listener); }
+  // Reserves room for `copies` more duplicates of the subtree at `root`, so
+  // placing ten thousand robots grows no array (and peak memory stays at
+  // what the robots use).
+  void ReserveForCopies(ObjectId root, size_t copies);
 
   // --- Validity ---------------------------------------------------------------
   bool IsValid(ObjectId id) const;
@@ -205,6 +234,15 @@ class Scene {
   std::span<ProximitySensorData> proximity_sensors() { return proximity_sensors_; }
   std::span<const ProximitySensorData> proximity_sensors() const { return proximity_sensors_; }
   std::span<const uint32_t> proximity_sensor_owners() const { return proximity_sensor_owner_; }
+  const ForceSensorData& force_sensor(ObjectId id) const;
+  ForceSensorData& mutable_force_sensor(ObjectId id);
+  std::span<ForceSensorData> force_sensors() { return force_sensors_; }
+  std::span<const ForceSensorData> force_sensors() const { return force_sensors_; }
+  std::span<const uint32_t> force_sensor_owners() const { return force_sensor_owner_; }
+  const PaintNozzleData& paint_nozzle(ObjectId id) const;
+  PaintNozzleData& mutable_paint_nozzle(ObjectId id);
+  std::span<const PaintNozzleData> paint_nozzles() const { return paint_nozzles_; }
+  std::span<const uint32_t> paint_nozzle_owners() const { return paint_nozzle_owner_; }
   // Row of the object's typed data (shape, joint or sensor table), by slot.
   uint32_t row_at(uint32_t slot) const { return row_[slot]; }
 
@@ -272,6 +310,10 @@ class Scene {
   std::vector<uint32_t> joint_owner_;
   std::vector<ProximitySensorData> proximity_sensors_;
   std::vector<uint32_t> proximity_sensor_owner_;
+  std::vector<ForceSensorData> force_sensors_;
+  std::vector<uint32_t> force_sensor_owner_;
+  std::vector<PaintNozzleData> paint_nozzles_;
+  std::vector<uint32_t> paint_nozzle_owner_;
 
   std::vector<ScriptAttachment> scripts_;
   std::vector<ModelInstance> instances_;
@@ -282,6 +324,7 @@ class Scene {
   mutable bool instances_independent_ = true;
   mutable bool order_dirty_ = true;
   uint64_t structure_version_ = 0;
+  std::vector<SceneListener*> listeners_;
 };
 
 }  // namespace swarmsim

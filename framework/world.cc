@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "framework/calculation_module.h"
 #include "framework/dynamics_backend.h"
 #include "framework/error.h"
 #include "framework/proximity_backend.h"
@@ -100,6 +101,19 @@ std::vector<MetricSample> World::TakeMetrics() {
   std::vector<MetricSample> out;
   out.swap(metrics_);
   return out;
+}
+
+CalculationModule* World::calculation(const std::string& name) {
+  if (CalculationModule* existing = find_calculation(name)) return existing;
+  calculations_.emplace_back(name, registry_.MakeCalculation(name));
+  scene_.AddListener(calculations_.back().second.get());
+  return calculations_.back().second.get();
+}
+
+CalculationModule* World::find_calculation(const std::string& name) const {
+  for (const auto& [n, module] : calculations_)
+    if (n == name) return module.get();
+  return nullptr;
 }
 
 size_t World::script_memory_bytes() const { return scripts_ ? scripts_->MemoryBytes() : 0; }
@@ -270,6 +284,10 @@ void World::Actuate() {
                    [](const DeferredWrite& a, const DeferredWrite& b) { return a.object < b.object; });
   for (const DeferredWrite& w : writes) {
     if (!scene_.IsValid(w.object)) continue;  // removed meanwhile
+    if (w.kind == DeferredWrite::Kind::kObjectPose) {
+      scene_.SetWorldPose(w.object, w.pose);
+      continue;
+    }
     if (w.kind == DeferredWrite::Kind::kShapeDynamic) {
       scene_.SetShapeDynamic(w.object, w.value != 0);
       continue;
@@ -278,6 +296,8 @@ void World::Actuate() {
     if (w.kind == DeferredWrite::Kind::kJointTargetVelocity) j.target_velocity = w.value;
     else j.target_position = w.value;
   }
+  // Calculation objects (IK groups, ...) set joint positions and targets.
+  for (auto& [name, module] : calculations_) module->Actuate(this);
   // Joints move kinematically toward their targets over the control step:
   // velocity mode at the target velocity, position mode at up to max_velocity.
   const double dt = settings_.time_step;
@@ -339,11 +359,7 @@ void World::Stop() {
   stopped_ = true;
   if (scripts_) {
     scripts_->Stop();
-    try {
-      FlushRobotBuffers();
-    } catch (...) {
-      throw;
-    }
+    FlushRobotBuffers();  // cleanup's prints and errors
   }
 }
 
@@ -374,9 +390,18 @@ uint64_t World::StateHash() const {
     h.AddValue(p.p_SD);
     h.AddValue(p.detected_object);
   }
+  for (size_t r = 0; r < scene_.force_sensors().size(); ++r) {
+    const ForceSensorData& f = scene_.force_sensors()[r];
+    h.AddValue(scene_.force_sensor_owners()[r]);
+    h.AddValue(f.broken);
+    h.AddValue(f.violations);
+    h.AddValue(f.force);
+    h.AddValue(f.torque);
+  }
   for (const RobotRuntime& rt : runtimes_) h.Add(rt.rng.state(), 4 * sizeof(uint64_t));
   h.Add(scene_runtime_.rng.state(), 4 * sizeof(uint64_t));
   if (dynamics_) dynamics_->HashState(&h);
+  for (const auto& [name, module] : calculations_) module->HashState(&h);
   return h.Digest();
 }
 

@@ -21,6 +21,7 @@
 
 namespace swarmsim {
 
+class CalculationModule;
 class DynamicsBackend;
 class ModuleRegistry;
 class ProximityBackend;
@@ -89,10 +90,12 @@ struct MetricSample {
 // control phase in handle order.
 struct DeferredWrite {
   // kShapeDynamic: value 1 makes the shape dynamic, 0 kinematic (sim.setObjectDynamic).
-  enum class Kind : uint8_t { kJointTargetVelocity, kJointTargetPosition, kShapeDynamic };
+  // kObjectPose: the object moves to world pose `pose` (sim.setObjectPose/Position).
+  enum class Kind : uint8_t { kJointTargetVelocity, kJointTargetPosition, kShapeDynamic, kObjectPose };
   ObjectId object;
   Kind kind;
   double value;
+  Pose pose = {};
 };
 
 // Per-robot runtime state. Only the worker running that robot touches it
@@ -182,6 +185,12 @@ class World {
   DynamicsBackend* dynamics() { return dynamics_.get(); }
   ProximityBackend* proximity() { return proximity_.get(); }
   ScriptHost* scripts() { return scripts_.get(); }
+  // The calculation module registered as `name` (e.g. "ik"), created on
+  // first use and run in each actuate phase from then on. Call before the
+  // model copies it serves are duplicated, so it follows them.
+  CalculationModule* calculation(const std::string& name);
+  // Null if not created.
+  CalculationModule* find_calculation(const std::string& name) const;
   size_t script_memory_bytes() const;
 
   // --- Main-script handlers ---------------------------------------------------------
@@ -221,6 +230,7 @@ class World {
   std::vector<RobotRuntime> runtimes_;
   RobotRuntime scene_runtime_;
   std::vector<std::unique_ptr<Observer>> observers_;
+  std::vector<std::pair<std::string, std::unique_ptr<CalculationModule>>> calculations_;
   std::vector<MetricSample> metrics_;
   std::function<void(std::string_view)> log_sink_;
   PhaseTimes phase_times_{};

@@ -4,6 +4,7 @@
 #include "modules/dynamics/box2d/box2d_backend.h"
 #include "modules/dynamics/kinematic/kinematic_backend.h"
 #include "modules/dynamics/ode/ode_backend.h"
+#include "modules/kinematics/ik_groups.h"
 #include "modules/proximity/proximity.h"
 
 namespace swarmsim {
@@ -13,6 +14,7 @@ void RegisterBuiltinModules(ModuleRegistry* registry) {
   registry->RegisterDynamics(ode::ModuleInfo(), [] { return ode::MakeBackend(); });
   registry->RegisterDynamics(kinematic::ModuleInfo(), [] { return kinematic::MakeBackend(); });
   registry->RegisterProximity(proximity::ModuleInfo(), [] { return proximity::MakeBackend(); });
+  registry->RegisterCalculation(kinematics::IkModuleInfo(), [] { return kinematics::MakeIkGroups(); });
 }
 
 }  // namespace swarmsim

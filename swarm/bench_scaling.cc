@@ -19,8 +19,8 @@ namespace swarmsim {
 namespace {
 
 struct Point {
-  std::string kind;  // "robots=N" (threads) or "sweep" (jobs)
-  int workers = 0;   // threads or jobs
+  std::string kind;       // "robots=N" (threads) or "sweep" (jobs)
+  int workers = 0;        // threads or jobs
   double throughput = 0;  // robot-ticks/s or runs/min
   double speedup = 0;
 };
@@ -86,19 +86,21 @@ int RunScalingBench(ScalingOptions o, std::ostream& out, std::ostream& err) {
   out << "\n== sweep throughput: " << o.sweep_runs << " runs of " << o.bench.world << " ("
       << o.sweep_robots << " robots, " << o.sweep_steps << " steps, 1 thread each)\n"
       << std::setw(6) << "jobs" << std::setw(10) << "wall s" << std::setw(12) << "runs/min"
-      << std::setw(10) << "speed-up" << "\n";
+      << std::setw(10) << "speed-up"
+      << "\n";
   out << std::flush;
   double base_rate = 0;
   bool ok = bench_code == 0;
   for (int jobs : o.jobs) {
     const std::string db = (scratch / ("sweep-" + std::to_string(jobs) + ".db")).string();
     const auto start = std::chrono::steady_clock::now();
-    const int code = RunQuiet({o.bench.self_exe, "sweep", o.bench.world, "--param",
-                               "robots=" + std::to_string(o.sweep_robots), "--seeds",
-                               std::to_string(o.sweep_runs), "--steps",
-                               std::to_string(o.sweep_steps), "--jobs", std::to_string(jobs),
-                               "--quiet", "--db", db});
-    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const int code =
+        RunQuiet({o.bench.self_exe, "sweep", o.bench.world, "--param",
+                  "robots=" + std::to_string(o.sweep_robots), "--seeds",
+                  std::to_string(o.sweep_runs), "--steps", std::to_string(o.sweep_steps), "--jobs",
+                  std::to_string(jobs), "--quiet", "--db", db});
+    const double wall =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (code != 0) {
       err << "bench: sweep with --jobs " << jobs << " failed (exit " << code << ")\n";
       ok = false;

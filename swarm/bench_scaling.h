@@ -12,10 +12,10 @@
 namespace swarmsim {
 
 struct ScalingOptions {
-  BenchOptions bench;               // world, robots, threads, steps; csv unused
-  bool threads_given = false;       // else threads 1 .. cores
-  std::vector<int> jobs;            // empty: 1 .. cores
-  int sweep_runs = 16;              // runs per sweep measurement
+  BenchOptions bench;          // world, robots, threads, steps; csv unused
+  bool threads_given = false;  // else threads 1 .. cores
+  std::vector<int> jobs;       // empty: 1 .. cores
+  int sweep_runs = 16;         // runs per sweep measurement
   int sweep_robots = 100;
   int sweep_steps = 200;
   std::string csv = "scaling.csv";

@@ -19,14 +19,18 @@ constexpr int64_t kMaxRingCount = 1024;
 
 constexpr double kDegToRad = M_PI / 180.0;
 
-const std::vector<std::string> kObjectTypes = {"shape", "joint", "dummy", "proximity_sensor",
-                                               "proximity_ring"};
+const std::vector<std::string> kObjectTypes = {"shape",          "joint",        "dummy",
+                                               "proximity_sensor", "proximity_ring", "force_sensor",
+                                               "paint_nozzle"};
 const std::vector<std::string> kCommonKeys = {
     "name", "type", "position", "orientation_deg", "heading_deg", "children", "script"};
 const std::vector<std::string> kJointKeys = {
     "joint",           "mode", "max_force", "max_velocity", "target_velocity", "target_position",
     "initial_position", "target_force", "limits"};
 const std::vector<std::string> kSensorKeys = {"range"};
+const std::vector<std::string> kForceSensorKeys = {"filter_samples", "force_threshold",
+                                                   "torque_threshold", "break_after"};
+const std::vector<std::string> kPaintNozzleKeys = {"color", "radius", "enabled"};
 const std::vector<std::string> kRingKeys = {"name",   "type",  "count",          "radius",
                                             "height", "range", "start_angle_deg"};
 
@@ -104,6 +108,17 @@ struct Builder {
       spec.type = ObjectType::kProximitySensor;
       if (named.Has("range"))
         spec.sensor.range = values.Number(named.Get("range"), kPositiveLength);
+    } else if (type == "force_sensor") {
+      named.Expect(Concat({&kCommonKeys, &kForceSensorKeys}));
+      spec.type = ObjectType::kForceSensor;
+      spec.force_sensor = ForceSensor(named);
+    } else if (type == "paint_nozzle") {
+      named.Expect(Concat({&kCommonKeys, &kPaintNozzleKeys}));
+      spec.type = ObjectType::kPaintNozzle;
+      if (named.Has("color")) spec.paint_nozzle.color = values.Vector3(named.Get("color"), kFraction);
+      if (named.Has("radius"))
+        spec.paint_nozzle.radius = values.Number(named.Get("radius"), kPositiveLength);
+      if (named.Has("enabled")) spec.paint_nozzle.enabled = values.Bool(named.Get("enabled"));
     } else {
       named.Expect(kCommonKeys);
       spec.type = ObjectType::kDummy;
@@ -126,6 +141,19 @@ struct Builder {
     for (const Field& child : ListElements(values.file(), named.Get("children"), "objects"))
       Object(child, depth + 1, false, &spec.children);
     out->push_back(std::move(spec));
+  }
+
+  ForceSensorData ForceSensor(const Fields& f) {
+    ForceSensorData s;
+    if (f.Has("filter_samples"))
+      s.filter_samples = static_cast<int>(values.Integer(f.Get("filter_samples"), 1, 1000));
+    if (f.Has("force_threshold"))
+      s.force_threshold = values.Number(f.Get("force_threshold"), kPositive);
+    if (f.Has("torque_threshold"))
+      s.torque_threshold = values.Number(f.Get("torque_threshold"), kPositive);
+    if (f.Has("break_after"))
+      s.break_after = static_cast<int>(values.Integer(f.Get("break_after"), 1, 1000000));
+    return s;
   }
 
   JointData Joint(const Fields& f) {
@@ -299,7 +327,7 @@ bool IsParameterName(std::string_view name) {
 }
 
 ModelFile ReadModelFile(YamlFile file, const std::string& used_by) {
-  ModelFile model{std::move(file), {}, {}, {}};
+  ModelFile model{std::move(file), {}, {}, {}, {}};
   const YamlFile& f = model.file;
   Field top{"model file", f.root(), f.root().Mark().is_null() ? YAML::Mark() : f.root().Mark(), {}};
   if (!f.root().IsMap())
@@ -307,7 +335,8 @@ ModelFile ReadModelFile(YamlFile file, const std::string& used_by) {
            "a model file must be a mapping with 'model', 'parameters' and 'objects' (got " +
                Describe(f.root()) + "; used by " + used_by + ")");
   Fields fields(f, top, "the model file");
-  fields.Expect({"model", "description", "parameters", "objects"});
+  fields.Expect({"model", "description", "parameters", "objects", "ik_groups"});
+  model.ik_groups = fields.Get("ik_groups");
   const Field name_field = fields.Require("model");
   if (!name_field.node.IsScalar())
     f.Fail(name_field.mark,
@@ -382,6 +411,12 @@ ObjectId AddToScene(const ObjectSpec& spec, ObjectId parent, Scene* scene) {
     case ObjectType::kJoint: id = scene->AddJoint(spec.name, parent, spec.X_PO, spec.joint); break;
     case ObjectType::kProximitySensor:
       id = scene->AddProximitySensor(spec.name, parent, spec.X_PO, spec.sensor);
+      break;
+    case ObjectType::kForceSensor:
+      id = scene->AddForceSensor(spec.name, parent, spec.X_PO, spec.force_sensor);
+      break;
+    case ObjectType::kPaintNozzle:
+      id = scene->AddPaintNozzle(spec.name, parent, spec.X_PO, spec.paint_nozzle);
       break;
     case ObjectType::kDummy: id = scene->AddDummy(spec.name, parent, spec.X_PO); break;
   }

@@ -24,6 +24,8 @@ struct ObjectSpec {
   ShapeData shape;
   JointData joint;
   ProximitySensorData sensor;
+  ForceSensorData force_sensor;
+  PaintNozzleData paint_nozzle;
   std::shared_ptr<const ScriptSource> script;
   bool script_explicit = false;  // script: {file: ..., explicit: true}
   std::vector<ObjectSpec> children;
@@ -55,6 +57,7 @@ struct ModelFile {
   std::string name;  // "footbot"
   std::vector<ModelParameterDecl> parameters;
   Field root;  // the root object
+  Field ik_groups;  // IK groups (swarm/loader_ik.h), not present if none
 };
 
 // `used_by` (file:line:column of the reference) is named when the file is

@@ -2,6 +2,7 @@
 
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -9,7 +10,6 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <set>
-#include <algorithm>
 #include <sstream>
 
 #include "framework/error.h"
@@ -77,8 +77,10 @@ void Plot(const ReportData& data, const ReportOptions& o, const std::string& x,
          << "set xlabel " << GnuplotQuote(x) << " noenhanced\n"
          << "set ylabel " << GnuplotQuote(y) << " noenhanced\n"
          << "set grid\nset offsets 0, 0, graph 0.05, graph 0.05\n";
-  if (o.by.empty()) script << "set key off\n";
-  else script << "set key outside right top noenhanced title " << GnuplotQuote(o.by) << "\n";
+  if (o.by.empty())
+    script << "set key off\n";
+  else
+    script << "set key outside right top noenhanced title " << GnuplotQuote(o.by) << "\n";
   const bool log_x = data.param_kind.count(x) && data.param_kind.at(x) == "log" && numeric_x;
   // Lines of different --by values are dodged sideways by 1% of the x span so
   // their error bars do not hide each other; the x range hugs the data.
@@ -125,10 +127,9 @@ void Plot(const ReportData& data, const ReportOptions& o, const std::string& x,
     if (!open || key.first != current) {
       if (open) script << "EOD\n";
       script << "$d" << block << " << EOD\n";
-      lines.push_back("$d" + std::to_string(block) + " using " +
-                      (numeric_x ? "1:2:3:4" : "0:2:3:4:xtic(1)") +
-                      " with yerrorlines lw 2 pt 7 ps 1.2 title " +
-                      GnuplotQuote(o.by.empty() ? y : key.first));
+      lines.push_back(
+          "$d" + std::to_string(block) + " using " + (numeric_x ? "1:2:3:4" : "0:2:3:4:xtic(1)") +
+          " with yerrorlines lw 2 pt 7 ps 1.2 title " + GnuplotQuote(o.by.empty() ? y : key.first));
       ++block;
       current = key.first;
       open = true;
@@ -136,8 +137,8 @@ void Plot(const ReportData& data, const ReportOptions& o, const std::string& x,
     const Summary s = Summarize(values);
     const double lo = std::isnan(s.ci_low) ? s.mean : s.ci_low;
     const double hi = std::isnan(s.ci_high) ? s.mean : s.ci_high;
-    script << dodged(key.second, block - 1) << " " << Num(s.mean, 10) << " " << Num(lo, 10) << " " << Num(hi, 10)
-           << "\n";
+    script << dodged(key.second, block - 1) << " " << Num(s.mean, 10) << " " << Num(lo, 10) << " "
+           << Num(hi, 10) << "\n";
   }
   script << "EOD\nplot ";
   for (size_t i = 0; i < lines.size(); ++i) script << (i ? ", \\\n     " : "") << lines[i];
@@ -194,8 +195,7 @@ ReportData LoadReport(const std::string& db_path) {
   std::set<std::string> metrics;
   SqliteStatement m(&db, "SELECT run, metric, value FROM final_metrics");
   while (m.Step()) {
-    d.runs[index.at(m.Int(0))].metrics[m.Text(1)] =
-        m.IsNull(2) ? std::nan("") : m.Double(2);
+    d.runs[index.at(m.Int(0))].metrics[m.Text(1)] = m.IsNull(2) ? std::nan("") : m.Double(2);
     metrics.insert(m.Text(1));
   }
   d.metric_names.assign(metrics.begin(), metrics.end());
@@ -234,8 +234,8 @@ int RunReport(const ReportOptions& o, std::ostream& out, std::ostream& err) {
     if (!name->empty() && !d.param_names.empty() &&
         std::find(d.param_names.begin(), d.param_names.end(), *name) == d.param_names.end())
       throw Error("'" + *name + "' is not a parameter of this sweep");
-  if (!o.y.empty() && std::find(d.metric_names.begin(), d.metric_names.end(), o.y) ==
-                          d.metric_names.end())
+  if (!o.y.empty() &&
+      std::find(d.metric_names.begin(), d.metric_names.end(), o.y) == d.metric_names.end())
     throw Error("no run recorded metric '" + o.y + "'");
   std::vector<std::string> metrics = o.y.empty() ? d.metric_names : std::vector{o.y};
 

@@ -34,7 +34,7 @@ struct ReportRun {
 
 struct ReportData {
   std::string world, started_at, version;
-  std::vector<std::string> param_names;  // in --param order
+  std::vector<std::string> param_names;           // in --param order
   std::map<std::string, std::string> param_kind;  // list | linear | log
   std::vector<std::string> metric_names;          // sorted
   std::vector<ReportRun> runs;                    // by id

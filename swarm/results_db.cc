@@ -51,8 +51,8 @@ ResultsDb::ResultsDb(const std::filesystem::path& path, bool read_only) : db_(pa
 std::optional<SweepRecord> ResultsDb::ReadSweep() {
   SqliteStatement has(&db_, "SELECT count(*) FROM sqlite_master WHERE name = 'sweep'");
   if (!has.Step() || has.Int(0) == 0) return std::nullopt;
-  SqliteStatement q(&db_,
-                    "SELECT world_path, world_hash, space, started_at, version, command FROM sweep");
+  SqliteStatement q(
+      &db_, "SELECT world_path, world_hash, space, started_at, version, command FROM sweep");
   if (!q.Step()) return std::nullopt;
   return SweepRecord{q.Text(0), q.Text(1), q.Text(2), q.Text(3), q.Text(4), q.Text(5)};
 }
@@ -71,7 +71,8 @@ void ResultsDb::CreateSweep(const SweepRecord& sweep, const std::vector<GridRun>
     for (const auto& [name, value] : run.params) params[name] = value;
     r.Bind(1, run.id).Bind(2, run.point).Bind(3, static_cast<int64_t>(run.seed));
     r.Bind(4, params.dump()).Run();
-    for (const auto& [name, value] : run.params) p.Bind(1, run.id).Bind(2, name).Bind(3, value).Run();
+    for (const auto& [name, value] : run.params)
+      p.Bind(1, run.id).Bind(2, name).Bind(3, value).Run();
   }
   txn.Commit();
 }
@@ -107,26 +108,28 @@ RunCounts ResultsDb::Counts() {
     const std::string status = q.Text(0);
     const int64_t n = q.Int(1);
     c.total += n;
-    if (status == "pending") c.pending = n;
-    else if (status == "running") c.running = n;
-    else if (status == "ok") c.ok = n;
-    else if (status == "failed") c.failed = n;
+    if (status == "pending")
+      c.pending = n;
+    else if (status == "running")
+      c.running = n;
+    else if (status == "ok")
+      c.ok = n;
+    else if (status == "failed")
+      c.failed = n;
   }
   return c;
 }
 
 std::vector<GridRun> ResultsDb::PendingRuns() {
   std::vector<GridRun> runs;
-  SqliteStatement q(&db_,
-                    "SELECT id, point, seed, params FROM runs WHERE status = 'pending' ORDER BY id");
+  SqliteStatement q(
+      &db_, "SELECT id, point, seed, params FROM runs WHERE status = 'pending' ORDER BY id");
   SqliteStatement p(&db_, "SELECT name, value FROM run_params WHERE run = ?");
   while (q.Step()) {
     GridRun r;
     r.id = q.Int(0);
     r.point = q.Int(1);
     r.seed = static_cast<uint64_t>(q.Int(2));
-    // --param order, as stored in the JSON text (nlohmann sorts keys; run_params keeps none),
-    // so take the order from the space instead when it matters; values are what count here.
     p.Bind(1, r.id);
     while (p.Step()) r.params.emplace_back(p.Text(0), p.Text(1));
     p.Reset();
@@ -152,16 +155,23 @@ void ResultsDb::Complete(const RunOutcome& o) {
                     "UPDATE runs SET status = ?, error = ?, wall_s = ?, steps = ?, robots = ?, "
                     "state_hash = ?, worker = coalesce(?, worker), finished_at = ? WHERE id = ?");
   u.Bind(1, std::string(o.ok ? "ok" : "failed"));
-  if (o.ok) u.BindNull(2);
-  else u.Bind(2, o.error);
+  if (o.ok)
+    u.BindNull(2);
+  else
+    u.Bind(2, o.error);
   u.Bind(3, o.wall_s).Bind(4, o.steps).Bind(5, o.robots);
-  if (o.state_hash.empty()) u.BindNull(6);
-  else u.Bind(6, o.state_hash);
-  if (o.worker.empty()) u.BindNull(7);
-  else u.Bind(7, o.worker);
+  if (o.state_hash.empty())
+    u.BindNull(6);
+  else
+    u.Bind(6, o.state_hash);
+  if (o.worker.empty())
+    u.BindNull(7);
+  else
+    u.Bind(7, o.worker);
   u.Bind(8, UtcNow()).Bind(9, o.id).Run();
   SqliteStatement m(&db_, "INSERT INTO final_metrics (run, metric, value) VALUES (?, ?, ?)");
-  for (const auto& [name, value] : o.final_metrics) m.Bind(1, o.id).Bind(2, name).Bind(3, value).Run();
+  for (const auto& [name, value] : o.final_metrics)
+    m.Bind(1, o.id).Bind(2, name).Bind(3, value).Run();
   SqliteStatement s(&db_,
                     "INSERT INTO series (run, metric, step, time, value) VALUES (?, ?, ?, ?, ?)");
   for (const SeriesPoint& p : o.series)

@@ -110,6 +110,7 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
                    std::ostream& progress_stream) {
   RunResult result;
   std::unique_ptr<MetricsWriter> metrics;
+  double lua_kib = 0;
   const auto start = Clock::now();
   const bool tty = isatty(STDERR_FILENO) && &progress_stream == &std::cerr;
   Progress progress(progress_stream, options.steps, !options.quiet, tty);
@@ -130,6 +131,7 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
       if (metrics) metrics->Write(world->TakeMetrics());
       progress.Update(result.steps, world->time());
     }
+    lua_kib = static_cast<double>(world->script_memory_bytes()) / 1024.0;  // before the states close
     world->Stop();
     if (metrics) metrics->Write(world->TakeMetrics());
     result.ok = true;
@@ -158,7 +160,9 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
         << (world->threads() == 1 ? " thread\n" : " threads\n")
         << "real-time factor " << Fixed(rtf, 1) << "x\n"
         << "robot-ticks/s   " << Fixed(ticks_per_s, 0) << "\n"
-        << "peak memory     " << Fixed(result.peak_rss_mb, 1) << " MiB\n"
+        << "peak memory     " << Fixed(result.peak_rss_mb, 1) << " MiB ("
+        << Fixed(robots > 0 ? result.peak_rss_mb * 1024 / robots : 0, 1) << " KiB per robot, of which Lua "
+        << Fixed(robots > 0 ? lua_kib / robots : 0, 1) << ")\n"
         << "time per phase  (ms total, us per robot-tick)\n";
     for (size_t p = 0; p < static_cast<size_t>(Phase::kCount); ++p) {
       const double t = world->phase_times()[p];
@@ -189,6 +193,7 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
     j["real_time_factor"] = rtf;
     j["robot_ticks_per_s"] = ticks_per_s;
     j["peak_rss_mb"] = result.peak_rss_mb;
+    j["lua_memory_kib"] = lua_kib;
     j["state_hash"] = StateHasher::ToHex(result.state_hash);
     nlohmann::json phases;
     for (size_t p = 0; p < static_cast<size_t>(Phase::kCount); ++p)

@@ -16,8 +16,8 @@ double StudentT975(int64_t df);
 struct Summary {
   int64_t n = 0;
   double mean = 0;
-  double sd = 0;       // sample standard deviation (n - 1); NaN for n < 2
-  double ci_low = 0;   // mean -/+ t(0.975, n-1) sd / sqrt(n); NaN for n < 2
+  double sd = 0;      // sample standard deviation (n - 1); NaN for n < 2
+  double ci_low = 0;  // mean -/+ t(0.975, n-1) sd / sqrt(n); NaN for n < 2
   double ci_high = 0;
 };
 

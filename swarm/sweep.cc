@@ -42,8 +42,8 @@ WorkerConfig MakeWorkerConfig(const SweepOptions& o) {
   c.duration = o.duration;
   c.threads_per_run = o.threads_per_run;
   c.timeout_s = o.timeout_s;
-  c.scratch = std::filesystem::temp_directory_path() /
-              ("swarmsim-sweep-" + std::to_string(getpid()));
+  c.scratch =
+      std::filesystem::temp_directory_path() / ("swarmsim-sweep-" + std::to_string(getpid()));
   return c;
 }
 
@@ -82,7 +82,8 @@ std::string SweepSpace(const std::vector<ParamSpec>& params, const std::vector<u
   nlohmann::json j;
   j["params"] = nlohmann::json::array();
   for (const ParamSpec& p : params)
-    j["params"].push_back({{"name", p.name}, {"spec", p.spec}, {"kind", p.kind}, {"values", p.values}});
+    j["params"].push_back(
+        {{"name", p.name}, {"spec", p.spec}, {"kind", p.kind}, {"values", p.values}});
   j["seeds"] = seeds;
   j["steps"] = steps ? nlohmann::json(*steps) : nlohmann::json(nullptr);
   j["duration"] = duration ? nlohmann::json(*duration) : nlohmann::json(nullptr);
@@ -105,6 +106,8 @@ int CoordinateSweep(const SweepOptions& o, RemoteWorkers* remote, std::ostream& 
   const std::string space = SweepSpace(params, seeds, o.steps, o.duration);
   if (o.db.empty()) throw Error("sweep needs --db FILE for the results");
 
+  // A new sweep: check the world and parameters before creating the database.
+  if (!std::filesystem::exists(o.db)) CheckWorld(o, grid.front());
   ResultsDb db(o.db);
   if (std::optional<SweepRecord> existing = db.ReadSweep()) {
     if (existing->space_json != space)
@@ -122,7 +125,6 @@ int CoordinateSweep(const SweepOptions& o, RemoteWorkers* remote, std::ostream& 
       err << "resuming: " << n << " run" << (n == 1 ? " was" : "s were")
           << " in progress when the sweep stopped; running again\n";
   } else {
-    CheckWorld(o, grid.front());
     SweepRecord record{o.world, world_hash, space, UtcNow(), Version(), o.command_line};
     db.CreateSweep(record, grid);
   }
@@ -139,17 +141,16 @@ int CoordinateSweep(const SweepOptions& o, RemoteWorkers* remote, std::ostream& 
       o.shard_count == 1 ? before.total
                          : (before.total - o.shard_index + o.shard_count - 1) / o.shard_count;
   const int64_t already = shard_total - static_cast<int64_t>(pending.size());
-  const int jobs = o.jobs > 0 ? o.jobs
-                              : (remote ? 1 : std::max(1u, std::thread::hardware_concurrency()));
+  const int jobs =
+      o.jobs > 0 ? o.jobs : (remote ? 1 : std::max(1u, std::thread::hardware_concurrency()));
   if (!o.quiet)
     err << "sweep: " << before.total << " runs (" << grid.size() / seeds.size() << " points x "
         << seeds.size() << " seeds)"
-        << (o.shard_count > 1 ? ", shard " + std::to_string(o.shard_index) + "/" +
-                                    std::to_string(o.shard_count)
-                              : std::string())
+        << (o.shard_count > 1
+                ? ", shard " + std::to_string(o.shard_index) + "/" + std::to_string(o.shard_count)
+                : std::string())
         << ", " << already << " already finished, " << pending.size() << " to run on " << jobs
-        << (jobs == 1 ? " job" : " jobs") << (remote ? " here plus the other ranks" : "")
-        << "\n";
+        << (jobs == 1 ? " job" : " jobs") << (remote ? " here plus the other ranks" : "") << "\n";
 
   SweepProgress progress(err, shard_total, already, isatty(STDERR_FILENO) != 0, !o.quiet);
   RunPool pool(MakeWorkerConfig(o), jobs);

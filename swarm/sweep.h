@@ -21,9 +21,9 @@ struct SweepOptions {
   std::string seeds = "1";          // K, A-B or a list
   std::optional<int64_t> steps;
   std::optional<double> duration;
-  int jobs = 0;                     // concurrent runs; <= 0: all cores (1 per rank with --mpi)
+  int jobs = 0;  // concurrent runs; <= 0: all cores (1 per rank with --mpi)
   int threads_per_run = 1;
-  double timeout_s = 0;             // per run; 0: none
+  double timeout_s = 0;  // per run; 0: none
   std::string db;
   bool allow_changed_world = false;
   bool retry_failed = false;

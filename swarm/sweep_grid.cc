@@ -73,8 +73,7 @@ ParamSpec ParseParamSpec(const std::string& name_equals_spec) {
     const int64_t n = ToCount(f[2], context);
     if (n == 1 && a != b) throw Error(context + ": one value from A to B needs A = B");
     p.kind = is_log ? "log" : "linear";
-    if (is_log && (a <= 0 || b <= 0))
-      throw Error(context + ": a log range needs A > 0 and B > 0");
+    if (is_log && (a <= 0 || b <= 0)) throw Error(context + ": a log range needs A > 0 and B > 0");
     for (int64_t i = 0; i < n; ++i) {
       const double t = n == 1 ? 0.0 : static_cast<double>(i) / static_cast<double>(n - 1);
       double v = is_log ? std::pow(10.0, std::log10(a) + t * (std::log10(b) - std::log10(a)))

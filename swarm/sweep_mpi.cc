@@ -19,8 +19,9 @@ namespace swarmsim {
 
 bool MpiAvailable() { return false; }
 int RunSweepMpi(const SweepOptions&, std::ostream&, std::ostream&) {
-  throw Error("this swarmsim was built without MPI (install libopenmpi-dev and rebuild); "
-              "use --shard i/n and `swarmsim merge` instead");
+  throw Error(
+      "this swarmsim was built without MPI (install libopenmpi-dev and rebuild); "
+      "use --shard i/n and `swarmsim merge` instead");
 }
 
 #else
@@ -32,8 +33,8 @@ constexpr int kTagRun = 2;      // 0 -> worker: a run (JSON)
 constexpr int kTagStop = 3;     // 0 -> worker: no more runs
 
 nlohmann::json ToJson(const RunOutcome& o) {
-  nlohmann::json j{{"id", o.id},         {"ok", o.ok},         {"error", o.error},
-                   {"wall_s", o.wall_s}, {"steps", o.steps},   {"robots", o.robots},
+  nlohmann::json j{{"id", o.id},           {"ok", o.ok},         {"error", o.error},
+                   {"wall_s", o.wall_s},   {"steps", o.steps},   {"robots", o.robots},
                    {"hash", o.state_hash}, {"worker", o.worker}, {"final", o.final_metrics}};
   nlohmann::json s = nlohmann::json::array();
   for (const SeriesPoint& p : o.series) s.push_back({p.metric, p.step, p.time, p.value});
@@ -51,10 +52,10 @@ RunOutcome FromJson(const nlohmann::json& j) {
   o.robots = j.at("robots");
   o.state_hash = j.at("hash");
   o.worker = j.at("worker");
-  o.final_metrics = j.at("final").get<std::map<std::string, double>>();
+  o.final_metrics = j.at("final").get<std::map<std::string, double> >();
   for (const auto& p : j.at("series"))
-    o.series.push_back({p[0].get<std::string>(), p[1].get<int64_t>(), p[2].get<double>(),
-                        p[3].get<double>()});
+    o.series.push_back(
+        {p[0].get<std::string>(), p[1].get<int64_t>(), p[2].get<double>(), p[3].get<double>()});
   return o;
 }
 
@@ -97,9 +98,11 @@ class MpiWorkers : public RemoteWorkers {
       if (std::optional<GridRun> run = next()) {
         nlohmann::json params = nlohmann::json::array();
         for (const auto& [name, value] : run->params) params.push_back({name, value});
-        Send(nlohmann::json{{"id", run->id}, {"point", run->point}, {"seed", run->seed},
-                            {"params", params}}.dump(),
-             from, kTagRun);
+        Send(
+            nlohmann::json{
+                {"id", run->id}, {"point", run->point}, {"seed", run->seed}, {"params", params}}
+                .dump(),
+            from, kTagRun);
         holding_[static_cast<size_t>(from)] = true;
         ++running_;
       } else {
@@ -126,8 +129,8 @@ int WorkerLoop(const SweepOptions& o) {
   config.duration = o.duration;
   config.threads_per_run = o.threads_per_run;
   config.timeout_s = o.timeout_s;
-  config.scratch = std::filesystem::temp_directory_path() /
-                   ("swarmsim-sweep-" + std::to_string(getpid()));
+  config.scratch =
+      std::filesystem::temp_directory_path() / ("swarmsim-sweep-" + std::to_string(getpid()));
   RunPool pool(config, 1);
   std::string result;
   while (true) {

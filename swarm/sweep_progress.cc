@@ -10,9 +10,12 @@ namespace {
 std::string Duration(double s) {
   std::ostringstream o;
   const int64_t t = static_cast<int64_t>(s + 0.5);
-  if (t >= 3600) o << t / 3600 << "h" << std::setw(2) << std::setfill('0') << (t % 3600) / 60 << "m";
-  else if (t >= 60) o << t / 60 << "m" << std::setw(2) << std::setfill('0') << t % 60 << "s";
-  else o << t << "s";
+  if (t >= 3600)
+    o << t / 3600 << "h" << std::setw(2) << std::setfill('0') << (t % 3600) / 60 << "m";
+  else if (t >= 60)
+    o << t / 60 << "m" << std::setw(2) << std::setfill('0') << t % 60 << "s";
+  else
+    o << t << "s";
   return o.str();
 }
 
@@ -20,7 +23,11 @@ std::string Duration(double s) {
 
 SweepProgress::SweepProgress(std::ostream& os, int64_t total, int64_t already, bool tty,
                              bool enabled)
-    : os_(os), total_(total), already_(already), tty_(tty), enabled_(enabled),
+    : os_(os),
+      total_(total),
+      already_(already),
+      tty_(tty),
+      enabled_(enabled),
       start_(std::chrono::steady_clock::now()) {}
 
 void SweepProgress::RunEnded(int64_t id, bool ok, const std::string& error, int running) {

@@ -35,7 +35,8 @@ std::string Tail(const std::string& text, int lines) {
   while (std::getline(s, line))
     if (!line.empty()) all.push_back(line);
   std::string out;
-  for (size_t i = all.size() > static_cast<size_t>(lines) ? all.size() - lines : 0; i < all.size(); ++i)
+  for (size_t i = all.size() > static_cast<size_t>(lines) ? all.size() - lines : 0; i < all.size();
+       ++i)
     out += (out.empty() ? "" : " | ") + all[i];
   return out;
 }
@@ -63,8 +64,8 @@ void ReadMetrics(const std::filesystem::path& path, RunOutcome* out) {
     // step,time,robot,metric,value: robot names hold no commas but split from both ends anyway.
     const size_t c1 = line.find(','), c2 = line.find(',', c1 + 1);
     const size_t c4 = line.rfind(','), c3 = line.rfind(',', c4 - 1);
-    if (c1 == std::string::npos || c2 == std::string::npos || c3 == std::string::npos ||
-        c3 < c2 || c4 == c3)
+    if (c1 == std::string::npos || c2 == std::string::npos || c3 == std::string::npos || c3 < c2 ||
+        c4 == c3)
       continue;
     try {
       Acc& a = acc[Key{line.substr(c3 + 1, c4 - c3 - 1), std::stoll(line.substr(0, c1))}];
@@ -141,9 +142,12 @@ RunOutcome CollectRun(int64_t id, const std::filesystem::path& out_dir, int wait
     o.error = "crashed: killed by signal " + std::to_string(sig) + " (" + strsignal(sig) + ")";
     if (!err.empty()) o.error += ": " + err;
   } else if (!WIFEXITED(wait_status) || WEXITSTATUS(wait_status) != 0) {
-    if (have_summary && summary.contains("error")) o.error = summary["error"].get<std::string>();
-    else if (!err.empty()) o.error = err;
-    else o.error = "exit status " + std::to_string(WEXITSTATUS(wait_status));
+    if (have_summary && summary.contains("error"))
+      o.error = summary["error"].get<std::string>();
+    else if (!err.empty())
+      o.error = err;
+    else
+      o.error = "exit status " + std::to_string(WEXITSTATUS(wait_status));
     if (WIFEXITED(wait_status) && WEXITSTATUS(wait_status) == 127 && err.empty())
       o.error = "cannot start the worker program";
   } else if (!have_summary || summary.value("status", std::string()) != "ok") {
@@ -161,6 +165,16 @@ RunPool::RunPool(const WorkerConfig& config, int slots)
   sigaddset(&block, SIGCHLD);
   restore_mask_ = pthread_sigmask(SIG_BLOCK, &block, reinterpret_cast<sigset_t*>(old_mask_)) == 0;
   std::filesystem::create_directories(config_.scratch);
+  // Scratch folders of sweeps that were killed (their process is gone).
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(config_.scratch.parent_path(), ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind("swarmsim-sweep-", 0) != 0) continue;
+    const std::string pid = name.substr(15);
+    if (pid.empty() || pid.find_first_not_of("0123456789") != std::string::npos) continue;
+    if (kill(static_cast<pid_t>(std::stol(pid)), 0) == -1 && errno == ESRCH)
+      std::filesystem::remove_all(entry.path(), ec);
+  }
 }
 
 RunPool::~RunPool() {
@@ -227,8 +241,9 @@ std::vector<RunOutcome> RunPool::Poll(double wait_s) {
                                      std::chrono::duration<double>(std::max(0.0, wait_s)));
   if (config_.timeout_s > 0)
     for (const Active& a : active_)
-      deadline = std::min(deadline, a.start + std::chrono::duration_cast<Clock::duration>(
-                                                  std::chrono::duration<double>(config_.timeout_s)));
+      deadline =
+          std::min(deadline, a.start + std::chrono::duration_cast<Clock::duration>(
+                                           std::chrono::duration<double>(config_.timeout_s)));
   const double wait = std::chrono::duration<double>(deadline - Clock::now()).count();
   if (wait > 0) {
     sigset_t chld;

@@ -21,8 +21,8 @@ struct WorkerConfig {
   std::optional<int64_t> steps;    // --steps, else
   std::optional<double> duration;  // --duration, else the world's own length
   int threads_per_run = 1;
-  double timeout_s = 0;            // per run; 0: no limit
-  std::filesystem::path scratch;   // run outputs go to scratch/run-<id>, removed after reading
+  double timeout_s = 0;           // per run; 0: no limit
+  std::filesystem::path scratch;  // run outputs go to scratch/run-<id>, removed after reading
 };
 
 // The command line that runs `run` (without the program name): also what

@@ -6,6 +6,7 @@
 
 #include "framework/error.h"
 #include "framework/registry.h"
+#include "swarm/loader_ik.h"
 #include "swarm/loader_model.h"
 #include "swarm/loader_values.h"
 #include "swarm/loader_yaml.h"
@@ -83,6 +84,7 @@ struct EntryPlan {
   double clearance = 0;
   std::optional<double> heading;
   std::vector<Placement2> placements;
+  std::vector<loader::IkGroupDef> ik_groups;
 };
 
 class WorldLoader {
@@ -466,6 +468,7 @@ void WorldLoader::ResolveEntry(EntryPlan* entry) {
   const ValueReader model_values(model.file, &expressions_, {&parameters_, params.get()});
   entry->spec = loader::ResolveModel(model, model_values, &scripts_);
   entry->footprint = loader::ComputeFootprint(entry->spec);
+  entry->ik_groups = loader::ReadIkGroups(model, model_values);
 
   // Placement: distributed copies or one placed copy.
   if (f.Has("distribute")) {
@@ -574,6 +577,7 @@ void WorldLoader::BuildCopies(World* world) {
     // The first copy from the description, the others duplicated from it
     // (rows copied, scripts shared); each copy is a robot named model#index.
     const ObjectId first = loader::AddToScene(e.spec, {}, &scene);
+    scene.ReserveForCopies(first, poses.size() - 1);
     const std::string& name = e.model->name;
     for (size_t k = 0; k < poses.size(); ++k) {
       ObjectId root = first;
@@ -581,6 +585,8 @@ void WorldLoader::BuildCopies(World* world) {
       if (k == 0) {
         instance = scene.MakeModelInstance(first, name,
                                            name + "#" + std::to_string(scene.instances().size()));
+        // IK groups of the first copy; duplicates get theirs from the "ik" module.
+        loader::AddIkGroups(*e.model, e.ik_groups, e.spec, first, world);
       } else {
         root = scene.DuplicateSubtree(first, {});
         instance = scene.instance_of(root);

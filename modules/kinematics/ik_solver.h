@@ -55,7 +55,13 @@ class IkProblem {
  public:
   // Returns the element index.
   int AddElement(Chain chain, const Pose& X_WTarget, uint8_t constraints = kPose);
+  // An element whose target hangs below the same base through joints (a
+  // closed chain): the target moves with q too; its chain's joints are
+  // unknowns as well. Both chains start at the same base.
+  int AddClosedElement(Chain tip_chain, Chain target_chain, uint8_t constraints = kPose);
   void set_target(int element, const Pose& X_WTarget) { elements_.at(element).X_WTarget = X_WTarget; }
+  // Moving bases: the world pose of an element's base (both its chains).
+  void set_base_pose(int element, const Pose& X_WBase);
   const Chain& chain(int element) const { return elements_.at(element).chain; }
 
   // The unknowns: scene slots of the joints, in column order.
@@ -74,9 +80,13 @@ class IkProblem {
   struct Element {
     Chain chain;
     Pose X_WTarget;
-    uint8_t constraints;
+    uint8_t constraints = kPose;
     std::vector<int> columns;  // per chain joint
+    bool closed = false;       // target_chain gives the target
+    Chain target_chain;
+    std::vector<int> target_columns;  // per target chain joint
   };
+  int AddColumn(const ChainJoint& joint);
   std::vector<Element> elements_;
   std::vector<uint32_t> slots_;
   std::vector<double> weights_, min_, max_;

@@ -1,5 +1,7 @@
 // Sweep grids (parameter specs, seeds, cartesian product) and the report's
 // statistics (Student t, mean, sd, 95% CI) against known values.
+#include "swarm/sweep_grid.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -7,7 +9,6 @@
 
 #include "framework/error.h"
 #include "swarm/stats.h"
-#include "swarm/sweep_grid.h"
 
 namespace swarmsim {
 namespace {
@@ -82,7 +83,7 @@ TEST(StatsTest, StudentTAgainstKnownValues) {
   EXPECT_NEAR(StudentT975(10), 2.2281389, 1e-6);
   EXPECT_NEAR(StudentT975(19), 2.0930241, 1e-6);
   EXPECT_NEAR(StudentT975(30), 2.0422725, 1e-6);
-  EXPECT_NEAR(StudentT975(33), 2.0345153, 2e-4);   // interpolated
+  EXPECT_NEAR(StudentT975(33), 2.0345153, 2e-4);  // interpolated
   EXPECT_NEAR(StudentT975(75), 1.9921022, 2e-4);
   EXPECT_NEAR(StudentT975(250), 1.9694984, 2e-4);
   EXPECT_NEAR(StudentT975(2000), 1.9611508, 2e-4);

@@ -70,8 +70,8 @@ std::map<int64_t, RunRow> ReadRuns(const fs::path& db_path) {
                     "SELECT id, status, coalesce(error, ''), coalesce(state_hash, ''), attempts, "
                     "coalesce(finished_at, ''), seed FROM runs");
   while (q.Step())
-    runs[q.Int(0)] = {q.Text(1), q.Text(2), q.Text(3), q.Text(5), q.Int(4), {},
-                      static_cast<uint64_t>(q.Int(6))};
+    runs[q.Int(0)] = {
+        q.Text(1), q.Text(2), q.Text(3), q.Text(5), q.Int(4), {}, static_cast<uint64_t>(q.Int(6))};
   SqliteStatement p(&db, "SELECT run, name, value FROM run_params");
   while (p.Step()) runs[p.Int(0)].params[p.Text(1)] = p.Text(2);
   return runs;
@@ -109,8 +109,9 @@ TEST(SweepTest, FailedRunsAndTimeoutsAreRecordedAndTheSweepGoesOn) {
   EXPECT_EQ(ok, 2);
   EXPECT_EQ(lua, 2);      // fail_at=0.2, spin=0
   EXPECT_EQ(timeout, 4);  // spin=1e9: the first step never ends, fail_at or not
-  EXPECT_EQ(Count(db, "SELECT count(*) FROM final_metrics JOIN runs ON id = run "
-                      "WHERE metric = 'x' AND status = 'ok'"),
+  EXPECT_EQ(Count(db,
+                  "SELECT count(*) FROM final_metrics JOIN runs ON id = run "
+                  "WHERE metric = 'x' AND status = 'ok'"),
             2);
   fs::remove_all(dir);
 }
@@ -119,10 +120,10 @@ TEST(SweepTest, KilledWithSigkillAndResumedEveryRunExactlyOnce) {
   const fs::path dir = TempDir("kill");
   const fs::path db = dir / "r.db";
   // 30 runs of ~20 ms each on 2 jobs.
-  const std::vector<std::string> args{SWARMSIM_BINARY, "sweep",  kWorld,     "--param",
-                                      "robots=2,3,4",  "--param", "spin=20000", "--seeds",
-                                      "10",             "--steps", "20",         "--jobs",
-                                      "2",             "--quiet", "--db",       db.string()};
+  const std::vector<std::string> args{
+      SWARMSIM_BINARY, "sweep",    kWorld,    "--param", "robots=2,3,4", "--param", "spin=20000",
+      "--seeds",       "10",       "--steps", "20",      "--jobs",       "2",       "--quiet",
+      "--db",          db.string()};
   std::map<int64_t, RunRow> before;
   for (int kill_round = 0; kill_round < 3; ++kill_round) {
     fflush(nullptr);
@@ -197,30 +198,33 @@ TEST(SweepTest, SameSeedSameHashAsRunAndChangedWorldIsRefused) {
     fs::copy_file(fs::path(SWARMSIM_SOURCE_DIR) / "tests/data/sweep" / f, dir / f);
   const std::string world = (dir / "sweep.yaml").string();
   const fs::path db = dir / "r.db";
-  Result r = RunProgram("sweep " + world + " --param robots=2,5 --seeds 3-4 --steps 12 --quiet --db " +
-                        db.string());
+  Result r = RunProgram("sweep " + world +
+                        " --param robots=2,5 --seeds 3-4 --steps 12 --quiet --db " + db.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto runs = ReadRuns(db);
   ASSERT_EQ(runs.size(), 4u);
   for (const auto& [id, run] : runs) {
-    Result single = RunProgram("run " + world + " --set robots=" + run.params.at("robots") +
-                               " --seed " + std::to_string(run.seed) +
-                               " --steps 12 --threads 2 --hash --quiet");
+    Result single =
+        RunProgram("run " + world + " --set robots=" + run.params.at("robots") + " --seed " +
+                   std::to_string(run.seed) + " --steps 12 --threads 2 --hash --quiet");
     const size_t at = single.output.find("state-hash: ");
     ASSERT_NE(at, std::string::npos) << single.output;
     EXPECT_EQ(single.output.substr(at + 12, 16), run.hash) << "run " << id;
   }
   // A finished sweep run again does nothing.
-  r = RunProgram("sweep " + world + " --param robots=2,5 --seeds 3-4 --steps 12 --db " + db.string());
+  r = RunProgram("sweep " + world + " --param robots=2,5 --seeds 3-4 --steps 12 --db " +
+                 db.string());
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("4 already finished, 0 to run"), std::string::npos) << r.output;
   // Another grid on the same database is refused.
-  r = RunProgram("sweep " + world + " --param robots=2,6 --seeds 3-4 --steps 12 --db " + db.string());
+  r = RunProgram("sweep " + world + " --param robots=2,6 --seeds 3-4 --steps 12 --db " +
+                 db.string());
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("another sweep"), std::string::npos) << r.output;
   // An edited world file is refused unless asked.
   std::ofstream(world, std::ios::app) << "# edited\n";
-  r = RunProgram("sweep " + world + " --param robots=2,5 --seeds 3-4 --steps 12 --db " + db.string());
+  r = RunProgram("sweep " + world + " --param robots=2,5 --seeds 3-4 --steps 12 --db " +
+                 db.string());
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("has changed since this sweep began"), std::string::npos) << r.output;
   r = RunProgram("sweep " + world + " --param robots=2,5 --seeds 3-4 --steps 12 " +
@@ -276,7 +280,8 @@ TEST(SweepTest, ReportTableCsvColumnsAndPlot) {
 TEST(SweepTest, ShardsMergeIntoTheWholeSweep) {
   const fs::path dir = TempDir("shard");
   const std::string grid = " --param robots=2,3,4 --seeds 2 --steps 8 --quiet ";
-  ASSERT_EQ(RunProgram("sweep " + kWorld + grid + "--db " + (dir / "all.db").string()).exit_code, 0);
+  ASSERT_EQ(RunProgram("sweep " + kWorld + grid + "--db " + (dir / "all.db").string()).exit_code,
+            0);
   for (int i = 0; i < 2; ++i) {
     const std::string shard = std::to_string(i);
     Result r = RunProgram("sweep " + kWorld + grid + "--shard " + shard + "/2 --db " +
@@ -305,7 +310,8 @@ TEST(SweepTest, MpiTwoRanksGiveTheLocalResults) {
     GTEST_SKIP() << "mpirun not found (install openmpi-bin): MPI sweep not tested";
   const fs::path dir = TempDir("mpi");
   const std::string grid = " --param robots=2,3 --seeds 3 --steps 8 --quiet ";
-  ASSERT_EQ(RunProgram("sweep " + kWorld + grid + "--db " + (dir / "local.db").string()).exit_code, 0);
+  ASSERT_EQ(RunProgram("sweep " + kWorld + grid + "--db " + (dir / "local.db").string()).exit_code,
+            0);
   Result r = RunCommand("mpirun --allow-run-as-root --oversubscribe -np 2 " +
                         std::string(SWARMSIM_BINARY) + " sweep " + kWorld + grid + "--mpi --db " +
                         (dir / "mpi.db").string());

@@ -126,6 +126,7 @@ void PlaneWorld::Build(const Scene& scene) {
   body_poses_.clear();
   wheeled_.clear();
   wheels_.clear();
+  force_sensors_.clear();
   const double L = scale_;
   const double g = settings_.gravity;
 
@@ -347,6 +348,8 @@ void PlaneWorld::Build(const Scene& scene) {
     def.maxTorque = static_cast<float>(2.0 / 3.0 * force * FootprintRadius(shape) * L * L);
     world_->CreateJoint(&def);
   }
+  // 5. Force sensors.
+  if (!scene.force_sensors().empty()) BuildForceSensors(scene, body_of);
 }
 
 void PlaneWorld::SyncTeleports(const Scene& scene) {
@@ -482,6 +485,7 @@ void PlaneWorld::ApplyTraction(double dt) {
 }
 
 void PlaneWorld::Substep(double dt) {
+  last_dt_ = dt;
   ApplyTraction(dt);
   world_->Step(static_cast<float>(dt), options_.velocity_iterations, options_.position_iterations);
   // What the step (contacts) did to each wheeled body's velocity.
@@ -500,6 +504,7 @@ void PlaneWorld::Substep(double dt) {
 }
 
 void PlaneWorld::WriteBack(Scene* scene) {
+  if (!force_sensors_.empty()) ReadForceSensors(scene);
   const double inv_L = 1.0 / scale_;
   for (size_t b = 0; b < bodies_.size(); ++b) {
     const b2Body* body = bodies_[b].body;

@@ -90,6 +90,10 @@ class PlaneWorld {
 
  private:
   void ApplyTraction(double dt);
+  // Weld joints for the scene's force sensors (plane_force_sensors.cc).
+  void BuildForceSensors(const Scene& scene, const std::vector<int32_t>& body_of);
+  // Samples each weld's reaction and breaks links over their threshold.
+  void ReadForceSensors(Scene* scene);
 
   Options options_;
   DynamicsSettings settings_;
@@ -100,6 +104,14 @@ class PlaneWorld {
   std::vector<PlaneBodyPose> body_poses_;  // (bodies)
   std::vector<uint32_t> wheeled_;          // bodies with wheels, ascending
   std::vector<PlaneWheel> wheels_;         // (wheels), grouped by body
+  // Force sensors: weld joint (null once broken), scene row, sensor slot.
+  struct PlaneForceSensor {
+    b2Joint* weld;
+    uint32_t row;
+    uint32_t slot;
+  };
+  std::vector<PlaneForceSensor> force_sensors_;
+  double last_dt_ = 0;  // s, of the last substep (for reaction forces)
 };
 
 }  // namespace swarmsim::box2d

@@ -134,6 +134,8 @@ void OdeWorld::Clear() {
   bodies_.clear();
   kinematic_.clear();
   joints_.clear();
+  force_sensors_.clear();
+  feedback_.clear();
   geom_info_.clear();
   commands_.clear();
 }
@@ -206,7 +208,8 @@ void OdeWorld::Build(const Scene& scene) {
     bool below_joint = false;
     for (int32_t p = scene.parent_at(s); p >= 0; p = scene.parent_at(static_cast<uint32_t>(p))) {
       const uint32_t ps = static_cast<uint32_t>(p);
-      if (scene.type_at(ps) == ObjectType::kJoint) below_joint = true;
+      if (scene.type_at(ps) == ObjectType::kJoint || scene.type_at(ps) == ObjectType::kForceSensor)
+        below_joint = true;
       const ShapeData* ancestor = shape_at(ps);
       if (ancestor && ancestor->dynamic) {
         if (!below_joint) carrier = body_of[ps];
@@ -248,7 +251,8 @@ void OdeWorld::Build(const Scene& scene) {
     while (!stack.empty() && !child) {
       const uint32_t c = stack.back();
       stack.pop_back();
-      if (scene.type_at(c) == ObjectType::kJoint) continue;
+      if (scene.type_at(c) == ObjectType::kJoint || scene.type_at(c) == ObjectType::kForceSensor)
+        continue;
       const ShapeData* shape = shape_at(c);
       if (shape && shape->dynamic) {
         child = body_of[c];
@@ -313,6 +317,8 @@ void OdeWorld::Build(const Scene& scene) {
     }
     joints_.push_back(j);
   }
+  // 4. Force sensors.
+  if (!scene.force_sensors().empty()) BuildForceSensors(scene, body_of);
   commands_.assign(joints_.size(), JointData{});
 }
 
@@ -441,6 +447,7 @@ void OdeWorld::Collide(dGeomID a, dGeomID b) {
 }
 
 void OdeWorld::WriteBack(Scene* scene) {
+  if (!force_sensors_.empty()) ReadForceSensors(scene);
   for (KinematicBody& k : kinematic_) SetBodyPose(k.body, k.X_WB_to);
   for (DynamicBody& b : bodies_) {
     const Pose X_WB = BodyPose(b.body);

@@ -5,6 +5,7 @@
 #include <ode/ode.h>
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "framework/dynamics_backend.h"
@@ -47,6 +48,16 @@ struct SimJoint {
   dBodyID child_body;
 };
 
+// A force sensor: a fixed joint with feedback between its child body and the
+// nearest body above (or the world). ode_force_sensors.cc.
+struct SimForceSensor {
+  dJointID joint;     // null once broken
+  uint32_t row;       // row in Scene::force_sensors()
+  dBodyID child_body; // body 1 of the joint
+  Pose X_BS;          // sensor frame in the child body
+  dJointFeedback* feedback;
+};
+
 // Per geom: owner info for the contact filter and materials.
 struct GeomInfo {  // 24 bytes
   int32_t instance;  // model instance or -1
@@ -77,6 +88,10 @@ class OdeWorld {
 
  private:
   void Clear();
+  // Fixed joints with feedback for the scene's force sensors (ode_force_sensors.cc).
+  void BuildForceSensors(const Scene& scene, const std::vector<dBodyID>& body_of);
+  // Samples each sensor's joint feedback and breaks links over their threshold.
+  void ReadForceSensors(Scene* scene);
   void AddGeom(dGeomID geom, int32_t instance, double friction, double restitution);
   void ApplyMotors(double dt);
   void TrackJointPositions();
@@ -92,6 +107,8 @@ class OdeWorld {
   std::vector<DynamicBody> bodies_;
   std::vector<KinematicBody> kinematic_;
   std::vector<SimJoint> joints_;
+  std::vector<SimForceSensor> force_sensors_;
+  std::vector<std::unique_ptr<dJointFeedback>> feedback_;  // (force_sensors_), stable addresses
   std::vector<GeomInfo> geom_info_;  // indexed by the geom's data (index + 1)
   std::vector<dContact> contact_buffer_;
   // Joint commands, read once per control step (rows of joints_).

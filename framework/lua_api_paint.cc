@@ -1,0 +1,57 @@
+// sim.* paint nozzles (framework/paint_nozzle.h; the layer is modules/paint).
+//
+// The paint layer reads nozzles in the record phase, after every script has
+// run, so a robot's writes to its own nozzles are race-free. Writing another
+// robot's nozzle would depend on the order robots run in, so it is an error.
+#include <cmath>
+#include <string>
+
+#include "framework/error.h"
+#include "framework/lua_api.h"
+#include "framework/scene.h"
+
+namespace swarmsim {
+namespace {
+
+// sim.setPaintNozzle(h, enabled [, {r, g, b}]): switches a paint nozzle on or
+// off and optionally sets its colour (each component 0..1).
+int SetPaintNozzle(lua_State* L) {
+  const LuaContext& c = Context(L);
+  Scene& scene = *c.scene;
+  const ObjectId id = CheckObject(L, 1);
+  PaintNozzleData& nozzle = scene.mutable_paint_nozzle(id);
+  if (c.instance >= 0 && scene.instance_of(id) != c.instance)
+    throw Error("a robot's script may set only its own paint nozzles ('" + scene.PathOf(id) +
+                "' belongs to another robot or to the scene)");
+  luaL_checktype(L, 2, LUA_TBOOLEAN);
+  const bool enabled = lua_toboolean(L, 2) != 0;
+  Vec3 color = nozzle.color;
+  if (!lua_isnoneornil(L, 3)) {
+    luaL_checktype(L, 3, LUA_TTABLE);
+    double rgb[3];
+    for (int i = 0; i < 3; ++i) {
+      lua_rawgeti(L, 3, i + 1);
+      int ok = 0;
+      rgb[i] = lua_tonumberx(L, -1, &ok);
+      lua_pop(L, 1);
+      if (!ok || !(rgb[i] >= 0 && rgb[i] <= 1))
+        throw Error("the colour must be {r, g, b} with each component between 0 and 1");
+    }
+    color = {rgb[0], rgb[1], rgb[2]};
+  }
+  nozzle.enabled = enabled;
+  nozzle.color = color;
+  return 0;
+}
+
+}  // namespace
+
+void RegisterPaintApi(lua_State* L) {
+  static constexpr luaL_Reg kFunctions[] = {
+      {"setPaintNozzle", Guarded<SetPaintNozzle, "sim.setPaintNozzle">},
+      {nullptr, nullptr},
+  };
+  luaL_setfuncs(L, kFunctions, 0);
+}
+
+}  // namespace swarmsim

@@ -1,0 +1,89 @@
+// Force sensors in ODE: a fixed joint with dJointSetFeedback per sensor.
+#include <algorithm>
+#include <vector>
+
+#include "framework/force_sensor.h"
+#include "framework/scene.h"
+#include "modules/dynamics/ode/ode_world.h"
+
+namespace swarmsim::ode {
+
+namespace {
+
+Pose BodyPoseOf(dBodyID body) {
+  const dReal* p = dBodyGetPosition(body);
+  const dReal* q = dBodyGetQuaternion(body);
+  return {{p[0], p[1], p[2]}, {q[0], q[1], q[2], q[3]}};
+}
+
+}  // namespace
+
+void OdeWorld::BuildForceSensors(const Scene& scene, const std::vector<dBodyID>& body_of) {
+  const auto owners = scene.force_sensor_owners();
+  // Slot order, like the joints, so the ODE joint list is the same every build.
+  std::vector<uint32_t> rows(owners.size());
+  for (uint32_t r = 0; r < rows.size(); ++r) rows[r] = r;
+  std::sort(rows.begin(), rows.end(), [&](uint32_t a, uint32_t b) { return owners[a] < owners[b]; });
+  for (uint32_t row : rows) {
+    const uint32_t s = owners[row];
+    if (scene.force_sensors()[row].broken) continue;
+    // Child: the first dynamic shape below, not across a joint or another sensor.
+    dBodyID child = nullptr;
+    std::vector<uint32_t> stack;
+    std::vector<ObjectId> kids = scene.children(scene.IdAt(s));
+    for (auto it = kids.rbegin(); it != kids.rend(); ++it) stack.push_back(it->index());
+    while (!stack.empty() && !child) {
+      const uint32_t c = stack.back();
+      stack.pop_back();
+      const ObjectType type = scene.type_at(c);
+      if (type == ObjectType::kJoint || type == ObjectType::kForceSensor) continue;
+      if (type == ObjectType::kShape && scene.shapes()[scene.row_at(c)].dynamic) {
+        child = body_of[c];
+        break;
+      }
+      std::vector<ObjectId> grand = scene.children(scene.IdAt(c));
+      for (auto it = grand.rbegin(); it != grand.rend(); ++it) stack.push_back(it->index());
+    }
+    if (!child) continue;  // nothing dynamic to hold: no reading
+    dBodyID parent = nullptr;
+    for (int32_t p = scene.parent_at(s); p >= 0; p = scene.parent_at(static_cast<uint32_t>(p)))
+      if (body_of[p]) {
+        parent = body_of[p];
+        break;
+      }
+    SimForceSensor f{};
+    f.row = row;
+    f.child_body = child;
+    f.X_BS = BodyPoseOf(child).Inverse() * scene.world_pose_at(s);
+    feedback_.push_back(std::make_unique<dJointFeedback>());
+    f.feedback = feedback_.back().get();
+    f.joint = dJointCreateFixed(world_, nullptr);
+    dJointAttach(f.joint, child, parent);
+    dJointSetFixed(f.joint);
+    dJointSetFeedback(f.joint, f.feedback);
+    force_sensors_.push_back(f);
+  }
+}
+
+void OdeWorld::ReadForceSensors(Scene* scene) {
+  for (SimForceSensor& f : force_sensors_) {
+    if (!f.joint) continue;
+    // Feedback of the last substep: force and torque (about the child's
+    // centre of mass) that the joint applies to the child, world frame.
+    const Vec3 f_W{f.feedback->f1[0], f.feedback->f1[1], f.feedback->f1[2]};
+    const Vec3 t_com_W{f.feedback->t1[0], f.feedback->t1[1], f.feedback->t1[2]};
+    const Pose X_WB = BodyPoseOf(f.child_body);
+    const Pose X_WS = X_WB * f.X_BS;
+    // About the sensor origin: t_S = t_com + (p_com - p_S) x f.
+    const Vec3 t_W = t_com_W + (X_WB.p - X_WS.p).Cross(f_W);
+    const Quat q_SW = X_WS.q.Conjugate();
+    ForceSensorData& data = scene->force_sensors()[f.row];
+    if (RecordForceSensorSample(&data, q_SW.Rotate(f_W), q_SW.Rotate(t_W))) {
+      dJointAttach(f.joint, nullptr, nullptr);
+      dJointDestroy(f.joint);
+      f.joint = nullptr;
+    }
+  }
+}
+
+}  // namespace swarmsim::ode

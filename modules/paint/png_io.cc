@@ -1,0 +1,47 @@
+#include "modules/paint/png_io.h"
+
+#include <png.h>
+
+#include <cstring>
+#include <string>
+
+#include "framework/error.h"
+
+namespace swarmsim::paint {
+
+void WritePng(const std::filesystem::path& path, int width, int height,
+              const std::vector<uint8_t>& rgb) {
+  SWARMSIM_CHECK(rgb.size() == static_cast<size_t>(width) * height * 3, "paint: image size");
+  png_image image;
+  std::memset(&image, 0, sizeof image);
+  image.version = PNG_IMAGE_VERSION;
+  image.width = static_cast<png_uint_32>(width);
+  image.height = static_cast<png_uint_32>(height);
+  image.format = PNG_FORMAT_RGB;
+  if (!png_image_write_to_file(&image, path.c_str(), 0, rgb.data(), 0, nullptr)) {
+    const std::string why = image.message;
+    png_image_free(&image);
+    throw Error("cannot write '" + path.string() + "': " + why);
+  }
+}
+
+RgbImage ReadPng(const std::filesystem::path& path) {
+  png_image image;
+  std::memset(&image, 0, sizeof image);
+  image.version = PNG_IMAGE_VERSION;
+  if (!png_image_begin_read_from_file(&image, path.c_str()))
+    throw Error("cannot read '" + path.string() + "': " + image.message);
+  image.format = PNG_FORMAT_RGB;
+  RgbImage out;
+  out.width = static_cast<int>(image.width);
+  out.height = static_cast<int>(image.height);
+  out.rgb.resize(PNG_IMAGE_SIZE(image));
+  if (!png_image_finish_read(&image, nullptr, out.rgb.data(), 0, nullptr)) {
+    const std::string why = image.message;
+    png_image_free(&image);
+    throw Error("cannot read '" + path.string() + "': " + why);
+  }
+  return out;
+}
+
+}  // namespace swarmsim::paint
