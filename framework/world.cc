@@ -97,6 +97,10 @@ void World::AddObserver(std::unique_ptr<Observer> observer) {
   observers_.push_back(std::move(observer));
 }
 
+void World::WriteOutputs(const std::filesystem::path& dir) const {
+  for (const auto& observer : observers_) observer->WriteOutputs(dir);
+}
+
 std::vector<MetricSample> World::TakeMetrics() {
   std::vector<MetricSample> out;
   out.swap(metrics_);
@@ -182,14 +186,14 @@ void World::Step() {
       if (!dynamics_handled_)
         throw Error("the main script's sysCall_step must call sim.handleDynamics() once per step");
     } else {
-    // 1. sense: sensors read the state left by the last physics step.
-    { PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kSense)]); Sense(); }
-    // 2. control: scripts, one robot per task, hierarchy order within a robot.
-    { PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kControl)]); Control(); }
-    // 3. actuate: deferred writes, joint targets.
-    { PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kActuate)]); Actuate(); }
-    // 4. physics: the dynamics backend advances the simulated bodies.
-    { PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kPhysics)]); Physics(); }
+      // 1. sense: sensors read the state left by the last physics step.
+      { PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kSense)]); Sense(); }
+      // 2. control: scripts, one robot per task, hierarchy order within a robot.
+      { PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kControl)]); Control(); }
+      // 3. actuate: deferred writes, joint targets, calculation modules (IK).
+      { PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kActuate)]); Actuate(); }
+      // 4. physics: the dynamics backend advances the simulated bodies.
+      { PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kPhysics)]); Physics(); }
     }
     // 5. record: observers append to their streams.
     { PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kRecord)]); Record(); }

@@ -55,6 +55,12 @@ struct WorldSettings {
   // with an error (0: no limit).
   int64_t instruction_budget = 100'000'000;
   ScriptErrorPolicy on_script_error = ScriptErrorPolicy::kStop;
+  // Sandbox (framework/lua_sandbox.cc): scripts may read files under
+  // `directory` and write files under `output_directory` (the run's --out;
+  // empty: no writing). trust_scripts (--trust-scripts) gives them Lua's
+  // full standard libraries instead.
+  std::filesystem::path output_directory;
+  bool trust_scripts = false;
 };
 
 // A message sent by a script (sim.send*Message), delivered at the start of
@@ -119,6 +125,9 @@ class Observer {
  public:
   virtual ~Observer() = default;
   virtual void Record(const World& world, std::vector<MetricSample>* out) = 0;
+  // Writes the observer's files (e.g. paint.png) into the run's output folder
+  // at the end of a run. Throws swarmsim::Error if it cannot.
+  virtual void WriteOutputs(const std::filesystem::path& /*dir*/) const {}
 };
 
 // Wall-clock seconds spent in each phase, summed over the run.
@@ -173,6 +182,8 @@ class World {
   void set_log_sink(std::function<void(std::string_view)> sink) { log_sink_ = std::move(sink); }
   void Log(std::string_view line) const;
   void AddObserver(std::unique_ptr<Observer> observer);
+  // Every observer's WriteOutputs(dir), in the order they were added.
+  void WriteOutputs(const std::filesystem::path& dir) const;
   // Metric samples recorded since the last call, in (step, robot, order) order.
   std::vector<MetricSample> TakeMetrics();
   const PhaseTimes& phase_times() const { return phase_times_; }

@@ -19,6 +19,27 @@
 namespace swarmsim {
 namespace {
 
+// CLI11's own range checks print the whole double range; these say it plainly.
+CLI::Validator NumberCheck(bool allow_zero) {
+  return CLI::Validator(
+      [allow_zero](std::string& text) -> std::string {
+        double value = 0;
+        try {
+          size_t used = 0;
+          value = std::stod(text, &used);
+          if (used != text.size()) throw std::invalid_argument(text);
+        } catch (const std::exception&) {
+          return "expected a number, got '" + text + "'";
+        }
+        if (allow_zero ? !(value >= 0) : !(value > 0))
+          return std::string("must be ") + (allow_zero ? ">= 0" : "> 0") + ", got " + text;
+        return "";
+      },
+      allow_zero ? "NUMBER >= 0" : "NUMBER > 0");
+}
+const CLI::Validator kNonNegative = NumberCheck(true);
+const CLI::Validator kPositive = NumberCheck(false);
+
 constexpr int kExitRunError = 1;  // the run failed (script error, physics, outputs)
 constexpr int kExitBadInput = 2;  // bad command line or world file
 
@@ -52,12 +73,12 @@ int Main(int argc, char** argv) {
   bool hash = false, quiet = false;
   run->add_option("world", world_file, "World file (YAML)")->required();
   auto* steps_opt = run->add_option("--steps", steps, "Number of control steps to run")
-                        ->check(CLI::NonNegativeNumber);
+                        ->check(kNonNegative);
   run->add_option("--duration", duration, "Simulated seconds to run")
-      ->check(CLI::NonNegativeNumber)
+      ->check(kNonNegative)
       ->excludes(steps_opt);
   run->add_option("--threads", threads, "Worker threads (default: all cores)")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   run->add_option("--seed", seed, "Random seed (overrides the world's)");
   run->add_option("--set", sets, "Override a parameter: name=value or model.name=value")
       ->allow_extra_args(false);
@@ -74,7 +95,7 @@ int Main(int argc, char** argv) {
       ->delimiter(',');
   bench->add_option("--threads", bench_options.threads, "Thread counts, e.g. 1,2")->delimiter(',');
   bench->add_option("--steps", bench_options.steps, "Measured steps per configuration")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   bench->add_option("--csv", bench_options.csv, "Write one CSV row per measurement");
   bench->add_option("--world", bench_options.world, "World to measure");
   bench->add_option("--child", bench_child_config)->group("");  // internal: one config
@@ -87,7 +108,7 @@ int Main(int argc, char** argv) {
   bench->add_option("--jobs", scaling_options.jobs, "With --scaling: sweep jobs, e.g. 1,2")
       ->delimiter(',');
   bench->add_option("--sweep-runs", scaling_options.sweep_runs, "With --scaling: runs per sweep")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   bench->add_option("--plot", scaling_options.plot, "With --scaling: the PNG plot")
       ->capture_default_str();
 
@@ -104,17 +125,17 @@ int Main(int argc, char** argv) {
   sweep->add_option("--seeds", sweep_options.seeds, "K (seeds 1..K), A-B, or a list 3,7,11")
       ->capture_default_str();
   auto* sweep_steps_opt = sweep->add_option("--steps", sweep_steps, "Control steps per run")
-                              ->check(CLI::NonNegativeNumber);
+                              ->check(kNonNegative);
   sweep->add_option("--duration", sweep_duration, "Simulated seconds per run")
-      ->check(CLI::NonNegativeNumber)
+      ->check(kNonNegative)
       ->excludes(sweep_steps_opt);
   sweep->add_option("--jobs", sweep_options.jobs, "Concurrent runs (default: all cores)")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   sweep->add_option("--threads", sweep_options.threads_per_run, "Threads per run")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
   sweep->add_option("--timeout", sweep_options.timeout_s, "Per-run time limit, s (0: none)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(kNonNegative);
   sweep->add_option("--db", sweep_options.db, "Results database (SQLite)")->required();
   sweep->add_flag("--allow-changed-world", sweep_options.allow_changed_world,
                   "Resume even though the world file changed since the sweep began");

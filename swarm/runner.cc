@@ -141,6 +141,17 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
   }
   progress.Finish();
   if (metrics) metrics->Flush();
+  // Observers' files (paint.png), also after an error: the outputs so far.
+  if (options.out_dir && world->started()) {
+    try {
+      world->WriteOutputs(*options.out_dir);
+    } catch (const std::exception& e) {
+      if (result.ok) {
+        result.ok = false;
+        result.error = e.what();
+      }
+    }
+  }
   result.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
   result.state_hash = world->StateHash();
   result.peak_rss_mb = PeakRssMb();

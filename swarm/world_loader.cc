@@ -8,6 +8,7 @@
 #include "framework/registry.h"
 #include "swarm/loader_ik.h"
 #include "swarm/loader_model.h"
+#include "swarm/loader_paint.h"
 #include "swarm/loader_values.h"
 #include "swarm/loader_yaml.h"
 #include "swarm/placement.h"
@@ -28,7 +29,7 @@ constexpr int64_t kMaxCount = 1000000;  // copies per models entry
 constexpr double kDegToRad = M_PI / 180.0;
 
 const std::vector<std::string> kTopKeys = {"simulation", "parameters", "arena",
-                                           "obstacles",  "models",     "metrics"};
+                                           "obstacles",  "models",     "metrics", "paint"};
 
 // One --set, split into its target.
 struct Override {
@@ -161,6 +162,7 @@ LoadedWorld WorldLoader::Load() {
   PlaceEntries();
   BuildCopies(world);
   out.metrics = ReadMetrics(top, world);
+  loader::AddPaintLayer(f, root, top.Get("paint"), WorldValues(), arena_, world);
   return out;
 }
 

@@ -1,0 +1,71 @@
+// The floor paint layer (the paper's paint nozzle; pheromone-like trails for
+// swarms): a raster of the floor that every enabled paint nozzle marks in
+// the record phase, written to the run's output folder as paint.png.
+//
+// Each step, each robot's nozzles stamp into that robot's own stroke buffer
+// (robots in parallel); the buffers are then applied in robot order, then
+// the scene's nozzles, so where strokes overlap the highest robot's colour
+// wins whatever the thread count. A nozzle paints the pixels whose centres
+// lie within its radius of its (x, y), when it is above the floor (z >= 0);
+// parts of the disc outside the area are dropped.
+//
+// Image: row 0 is the area's +y edge (north up), column 0 its -x edge; pixel
+// (c, r) covers x in min_x + [c, c + 1) res and y in max_y - [r + 1, r) res.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <vector>
+
+#include "framework/math.h"
+#include "framework/world.h"
+
+namespace swarmsim::paint {
+
+struct PaintSettings {
+  double resolution = 0.01;            // m, side of one pixel
+  double min_x = -1, min_y = -1;       // m, the floor area covered
+  double max_x = 1, max_y = 1;
+  Vec3 background{1, 1, 1};            // RGB in [0, 1], unpainted floor
+};
+
+class PaintLayer final : public Observer {
+ public:
+  // Throws swarmsim::Error for a bad resolution or area, or an image over
+  // 100 megapixels.
+  PaintLayer(World* world, const PaintSettings& settings);
+
+  void Record(const World& world, std::vector<MetricSample>* out) override;
+  // Writes paint.png into `dir`.
+  void WriteOutputs(const std::filesystem::path& dir) const override;
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  const std::vector<uint8_t>& rgb() const { return rgb_; }  // (height x width x 3)
+  bool painted(int column, int row) const { return painted_[row * width_ + column] != 0; }
+  int64_t painted_count() const;
+  // Pixel centre in the world frame (z = 0).
+  Vec3 PixelCentre(int column, int row) const;
+
+ private:
+  struct Stroke {  // 8 bytes
+    uint32_t pixel;
+    uint8_t r, g, b;
+  };
+  void RefreshNozzles(const Scene& scene);
+  void Stamp(const Scene& scene, uint32_t slot, std::vector<Stroke>* out) const;
+  void Apply(std::vector<Stroke>* strokes);
+
+  World* world_;
+  PaintSettings settings_;
+  int width_ = 0, height_ = 0;
+  std::vector<uint8_t> rgb_;      // (height x width x 3)
+  std::vector<uint8_t> painted_;  // (height x width)
+  uint64_t nozzles_version_ = ~uint64_t{0};
+  std::vector<std::vector<uint32_t>> robot_nozzles_;  // nozzle slots per robot (robots)
+  std::vector<uint32_t> scene_nozzles_;               // slots of nozzles outside robots
+  std::vector<std::vector<Stroke>> strokes_;          // per robot, this step (robots)
+  std::vector<Stroke> scene_strokes_;
+};
+
+}  // namespace swarmsim::paint
