@@ -115,6 +115,9 @@ void RegisterAllApis(lua_State* L);
 // Opens the safe standard libraries (base without file access or binary
 // chunks, string, table, math, coroutine, utf8) into the globals.
 void OpenSafeLibraries(lua_State* L);
+// The libraries of a script state: the safe ones plus the sandboxed io,
+// os, require (lua_sandbox.cc), or all of Lua's under trust_scripts.
+void OpenSandbox(lua_State* L);
 
 // Constant shared with scripts.
 constexpr lua_Integer kHandleWorld = -1;

@@ -1,11 +1,26 @@
-// The libraries a script sees: Lua's base library without file access or
-// binary chunks, and string, table, math, coroutine, utf8. No io, os,
-// package or debug. (The full sandbox -- instruction budgets, a trusted mode
-// -- is a later issue; this opens no holes in the meantime.)
+// The libraries a script sees (the sandbox): Lua's base library without
+// binary chunks, and string, table, math, coroutine, utf8. Filled in on
+// first use (a global miss), so a robot that does not use them pays nothing:
+//   io       open/lines/type/close only: read under the world's folder,
+//            write under the run's output folder (--out); '..' and symlinks
+//            leading out are refused;
+//   require  Lua modules from the world's folder and the scripts/ folders
+//            inside and beside it, cached per state (per robot);
+//   os       clock, time, date, difftime only.
+// Everything else (os.execute, io.popen, package.loadlib, debug, dofile,
+// loadfile, binary chunks) raises "file:line: os.execute is not allowed
+// ...". --trust-scripts (WorldSettings::trust_scripts) opens the full
+// standard libraries instead.
+#include <algorithm>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <initializer_list>
+#include <sstream>
+#include <string_view>
 
 #include "framework/lua_api.h"
+#include "framework/world.h"
 
 namespace swarmsim {
 namespace {
@@ -15,6 +30,9 @@ namespace {
 // globals, so a loaded chunk cannot leak globals into other scripts.
 int SafeLoad(lua_State* L) {
   const int n = lua_gettop(L);
+  if (lua_type(L, 1) == LUA_TSTRING && lua_tostring(L, 1)[0] == LUA_SIGNATURE[0])
+    RaiseError(L, "load: binary chunks are not allowed in a sandboxed script (run with "
+                  "--trust-scripts to lift the sandbox)");
   lua_settop(L, 4);
   lua_pushliteral(L, "t");
   lua_replace(L, 3);
@@ -72,7 +90,221 @@ void Wrap(lua_State* L, const char* name, lua_CFunction wrapper) {
   lua_setglobal(L, name);
 }
 
+namespace fs = std::filesystem;
+
+[[noreturn]] void Refuse(lua_State* L, const std::string& what) {
+  RaiseError(L, what + " is not allowed in a sandboxed script (run with --trust-scripts to lift "
+                       "the sandbox)");
+}
+
+// __index of a restricted library table: a missing field is refused by name.
+int RefuseField(lua_State* L) {
+  const char* library = lua_tostring(L, lua_upvalueindex(1));
+  const char* field = lua_type(L, 2) == LUA_TSTRING ? lua_tostring(L, 2) : "?";
+  Refuse(L, std::string(library) + "." + field);
+}
+
+// A table whose missing fields are refused; left on the stack.
+void NewRestrictedTable(lua_State* L, const char* library, int fields) {
+  lua_createtable(L, 0, fields);
+  lua_createtable(L, 0, 1);
+  lua_pushstring(L, library);
+  lua_pushcclosure(L, RefuseField, 1);
+  lua_setfield(L, -2, "__index");
+  lua_setmetatable(L, -2);
+}
+
+// Does `path` (canonical) lie inside `root` (canonical)?
+bool IsInside(const fs::path& path, const fs::path& root) {
+  auto p = path.begin();
+  for (auto r = root.begin(); r != root.end(); ++r, ++p) {
+    if (r->empty()) continue;  // a trailing separator
+    if (p == path.end() || *p != *r) return false;
+  }
+  return true;
+}
+
+fs::path Canonical(const fs::path& path) {
+  std::error_code ec;
+  fs::path out = fs::weakly_canonical(path, ec);
+  return ec ? path.lexically_normal() : out;
+}
+
+// The file `text` names, checked against the sandbox: relative paths are
+// taken from the world's folder (reading) or the output folder (writing).
+std::string CheckedPath(lua_State* L, const char* function, const std::string& text, bool write) {
+  const WorldSettings& settings = Context(L).world->settings();
+  for (const fs::path& part : fs::path(text))
+    if (part == "..")
+      RaiseError(L, std::string(function) + ": '..' is not allowed in a path ('" + text +
+                        "'); scripts are sandboxed (run with --trust-scripts to lift it)");
+  fs::path root = write ? settings.output_directory : settings.directory;
+  if (root.empty())
+    RaiseError(L, std::string(function) + ": cannot write '" + text +
+                      "': the run has no output folder (swarmsim run --out DIR)");
+  root = Canonical(fs::absolute(root));
+  const fs::path path = fs::path(text).is_absolute() ? fs::path(text) : root / text;
+  // Symlinks are resolved first: one inside the folder pointing out is refused.
+  if (!IsInside(Canonical(path), root))
+    RaiseError(L, std::string(function) + ": '" + text + "' is outside the " +
+                      (write ? "run's output folder" : "world's folder") + " (" + root.string() +
+                      "); scripts are sandboxed (run with --trust-scripts to lift it)");
+  return path.string();
+}
+
+// io.open(path [, mode]): the original, on a checked path.
+int SafeOpen(lua_State* L) {
+  const std::string text = luaL_checkstring(L, 1);
+  const std::string mode = luaL_optstring(L, 2, "r");
+  const bool write = mode != "r" && mode != "rb";
+  const std::string path = CheckedPath(L, "io.open", text, write);
+  lua_settop(L, 0);
+  lua_pushvalue(L, lua_upvalueindex(1));
+  lua_pushstring(L, path.c_str());
+  lua_pushstring(L, mode.c_str());
+  lua_call(L, 2, LUA_MULTRET);
+  return lua_gettop(L);
+}
+
+// io.lines(path, ...): reading only, never standard input.
+int SafeLines(lua_State* L) {
+  if (lua_isnoneornil(L, 1)) Refuse(L, "io.lines() on standard input");
+  const std::string path = CheckedPath(L, "io.lines", luaL_checkstring(L, 1), false);
+  lua_pushstring(L, path.c_str());
+  lua_replace(L, 1);
+  lua_pushvalue(L, lua_upvalueindex(1));
+  lua_insert(L, 1);
+  lua_call(L, lua_gettop(L) - 1, LUA_MULTRET);
+  return lua_gettop(L);
+}
+
+// Registry key of a state's table of required modules.
+const char kModulesKey = 0;
+const char kLoadingSentinel = 0;
+
+// require(name): a Lua module (name.lua, dots for folders) from the world's
+// folder, then its scripts/ folder, then the scripts/ folder beside it. Run
+// once per state in an environment of its own; its result is cached.
+int SafeRequire(lua_State* L) {
+  const std::string name = luaL_checkstring(L, 1);
+  lua_settop(L, 1);
+  lua_rawgetp(L, LUA_REGISTRYINDEX, &kModulesKey);  // 2: the cache
+  if (lua_isnil(L, 2)) {
+    lua_pop(L, 1);
+    lua_newtable(L);
+    lua_pushvalue(L, -1);
+    lua_rawsetp(L, LUA_REGISTRYINDEX, &kModulesKey);
+  }
+  lua_getfield(L, 2, name.c_str());
+  if (lua_touserdata(L, -1) == &kLoadingSentinel)
+    RaiseError(L, "require: module '" + name + "' requires itself (a loop)");
+  if (!lua_isnil(L, -1)) return 1;
+  lua_pop(L, 1);
+  if (name.empty() || name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                                             "0123456789_.-") != std::string::npos ||
+      name.find("..") != std::string::npos || name.front() == '.')
+    RaiseError(L, "require: '" + name +
+                      "' is not a module name (letters, digits, '_', '-', and '.' for folders)");
+  std::string relative = name;
+  std::replace(relative.begin(), relative.end(), '.', '/');
+  relative += ".lua";
+  const fs::path world = Canonical(fs::absolute(Context(L).world->settings().directory));
+  std::string searched;
+  for (const fs::path& root : {world, world / "scripts", world.parent_path() / "scripts"}) {
+    const fs::path candidate = root / relative;
+    searched += "\n\t" + candidate.string();
+    std::error_code ec;
+    if (!fs::is_regular_file(candidate, ec)) continue;
+    if (!IsInside(Canonical(candidate), Canonical(root))) continue;  // a symlink leading out
+    std::ifstream in(candidate, std::ios::binary);
+    std::stringstream code;
+    code << in.rdbuf();
+    const std::string text = code.str();
+    std::string chunkname(1, '@');
+    chunkname += candidate.lexically_normal().native();
+    if (luaL_loadbufferx(L, text.data(), text.size(), chunkname.c_str(), "t") != LUA_OK)
+      lua_error(L);
+    // Its own environment: module globals do not leak into the scripts.
+    lua_newtable(L);
+    lua_createtable(L, 0, 1);
+    lua_pushglobaltable(L);
+    lua_setfield(L, -2, "__index");
+    lua_setmetatable(L, -2);
+    lua_setupvalue(L, -2, 1);
+    lua_pushlightuserdata(L, const_cast<char*>(&kLoadingSentinel));
+    lua_setfield(L, 2, name.c_str());
+    lua_pushvalue(L, 1);
+    lua_pushstring(L, candidate.c_str());
+    lua_call(L, 2, 1);
+    if (lua_isnil(L, -1)) {
+      lua_pop(L, 1);
+      lua_pushboolean(L, 1);
+    }
+    lua_pushvalue(L, -1);
+    lua_setfield(L, 2, name.c_str());
+    return 1;
+  }
+  RaiseError(L, "require: module '" + name + "' not found; looked for:" + searched);
+}
+
+int RefuseFunction(lua_State* L) { Refuse(L, lua_tostring(L, lua_upvalueindex(1))); }
+
+// __index of the globals: builds the restricted libraries on first use and
+// refuses the forbidden ones. Other names are nil as usual.
+int SandboxGlobalIndex(lua_State* L) {
+  if (lua_type(L, 2) != LUA_TSTRING) return 0;
+  const std::string_view key = lua_tostring(L, 2);
+  if (key == "io") {
+    luaL_requiref(L, LUA_IOLIBNAME, luaopen_io, 0);
+    NewRestrictedTable(L, "io", 4);
+    lua_getfield(L, -2, "open");
+    lua_pushcclosure(L, Guarded<SafeOpen, "io.open">, 1);
+    lua_setfield(L, -2, "open");
+    lua_getfield(L, -2, "lines");
+    lua_pushcclosure(L, Guarded<SafeLines, "io.lines">, 1);
+    lua_setfield(L, -2, "lines");
+    for (const char* kept : {"type", "close"}) {
+      lua_getfield(L, -2, kept);
+      lua_setfield(L, -2, kept);
+    }
+  } else if (key == "os") {
+    luaL_requiref(L, LUA_OSLIBNAME, luaopen_os, 0);
+    NewRestrictedTable(L, "os", 4);
+    for (const char* kept : {"clock", "time", "date", "difftime"}) {
+      lua_getfield(L, -2, kept);
+      lua_setfield(L, -2, kept);
+    }
+  } else if (key == "require") {
+    lua_pushcfunction(L, (Guarded<SafeRequire, "require">));
+  } else if (key == "package" || key == "debug") {
+    NewRestrictedTable(L, key == "package" ? "package" : "debug", 0);
+  } else if (key == "dofile" || key == "loadfile") {
+    lua_pushvalue(L, 2);
+    lua_pushcclosure(L, RefuseFunction, 1);
+  } else {
+    return 0;
+  }
+  lua_pushvalue(L, 2);
+  lua_pushvalue(L, -2);
+  lua_rawset(L, 1);
+  return 1;
+}
+
 }  // namespace
+
+void OpenSandbox(lua_State* L) {
+  if (Context(L).world != nullptr && Context(L).world->settings().trust_scripts) {
+    luaL_openlibs(L);
+    return;
+  }
+  OpenSafeLibraries(L);
+  lua_pushglobaltable(L);
+  lua_createtable(L, 0, 1);
+  lua_pushcfunction(L, SandboxGlobalIndex);
+  lua_setfield(L, -2, "__index");
+  lua_setmetatable(L, -2);
+  lua_pop(L, 1);
+}
 
 void OpenSafeLibraries(lua_State* L) {
   static constexpr luaL_Reg kLibraries[] = {

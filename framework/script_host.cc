@@ -216,7 +216,7 @@ end
 
 // Protected part of creating a state. Arguments: two integers seeding math.random.
 int SetUpState(lua_State* L) {
-  OpenSafeLibraries(L);
+  OpenSandbox(L);
   RegisterAllApis(L);
   if (luaL_loadbufferx(L, kThreadHelpers, sizeof kThreadHelpers - 1, "=sim", "t") != LUA_OK)
     lua_error(L);
@@ -437,7 +437,17 @@ void ResumeThread(ScriptState* state, Script& script) {
 
 // One callback of every script in hierarchy order (explicit ones are left
 // to their ancestors); with the actuation callbacks, the threads.
-void RunCallback(ScriptState* state, Callback callback) {
+// `args` (from sim.handleChildScripts) are passed to each callback.
+void PushArgs(lua_State* L, const std::vector<ParamValue>& args) {
+  for (const ParamValue& v : args) {
+    if (const double* d = std::get_if<double>(&v)) lua_pushnumber(L, *d);
+    else if (const bool* b = std::get_if<bool>(&v)) lua_pushboolean(L, *b);
+    else lua_pushstring(L, std::get<std::string>(v).c_str());
+  }
+}
+
+void RunCallback(ScriptState* state, Callback callback,
+                 const std::vector<ParamValue>& args = {}) {
   const Scene& scene = *state->context.scene;
   state->context.in_sensing = callback == kSensing;
   for (Script& script : state->scripts) {
@@ -445,7 +455,8 @@ void RunCallback(ScriptState* state, Callback callback) {
     try {
       if (const int ref = script.callbacks[callback]; ref != LUA_NOREF) {
         lua_rawgeti(state->L, LUA_REGISTRYINDEX, ref);
-        Call(*state, script, 0, kCallbackNames[callback]);
+        PushArgs(state->L, args);
+        Call(*state, script, static_cast<int>(args.size()), kCallbackNames[callback]);
       }
       if (callback == kActuation && script.thread != nullptr) ResumeThread(state, script);
     } catch (const Error& e) {
@@ -593,18 +604,34 @@ void Sensing(World* w) { w->HandleSensing(); }
 void Actuation(World* w) { w->HandleActuation(); }
 void Dynamics(World* w) { w->HandleDynamics(); }
 
-// sim.handleChildScripts([pass]): the child scripts of every robot, then the
-// scene's. pass: 'sensing', 'actuation' (with the threads) or 'all' (default).
+// sim.handleChildScripts([pass [, ...]]): the child scripts of every robot,
+// then the scene's. pass: 'sensing', 'actuation' (with the threads) or 'all'
+// (default). Further arguments (numbers, booleans, strings: the states are
+// separate) are passed to every sysCall_sensing / sysCall_actuation called.
 int HandleChildScripts(lua_State* L) {
   static const char* const kPasses[] = {"sensing", "actuation", "all", nullptr};
   const ScriptPass pass = static_cast<ScriptPass>(luaL_checkoption(L, 1, "all", kPasses));
   LuaContext& c = Context(L);
   if (!c.is_main) throw Error("only the world's main script may run the phases");
+  std::vector<ParamValue> args;
+  for (int i = 2; i <= lua_gettop(L); ++i) {
+    switch (lua_type(L, i)) {
+      case LUA_TNUMBER: args.emplace_back(lua_tonumber(L, i)); break;
+      case LUA_TBOOLEAN: args.emplace_back(static_cast<bool>(lua_toboolean(L, i))); break;
+      case LUA_TSTRING: args.emplace_back(std::string(lua_tostring(L, i))); break;
+      default:
+        throw Error("argument " + std::to_string(i) +
+                    " must be a number, boolean or string (each robot has its own Lua state; "
+                    "pack tables with sim.packTable), got " + luaL_typename(L, i));
+    }
+  }
+  c.world->scripts()->SetChildScriptArguments(std::move(args));
   try {
     c.world->HandleChildScripts(pass);
   } catch (const std::exception& e) {
     c.pending_error = e.what();
   }
+  c.world->scripts()->SetChildScriptArguments({});
   if (!c.pending_error.empty()) RaiseError(L, "stopped by an error");
   return 0;
 }
@@ -631,6 +658,7 @@ struct ScriptHost::Impl {
   std::vector<std::unique_ptr<ScriptState>> robots;  // by instance; null: no scripts
   std::unique_ptr<ScriptState> scene;                // null: no scene scripts
   std::unique_ptr<ScriptState> main;                 // null: the default main script
+  std::vector<ParamValue> child_args;                // of the running sim.handleChildScripts
   bool started = false;
   bool stopped = false;
 };
@@ -694,15 +722,19 @@ void ScriptHost::RunInstance(int instance, ScriptPass pass) {
   if (h.stopped || instance < 0 || instance >= static_cast<int>(h.robots.size())) return;
   ScriptState* state = h.robots[instance].get();
   if (state == nullptr) return;
-  if (pass != ScriptPass::kActuation) RunCallback(state, kSensing);
-  if (pass != ScriptPass::kSensing) RunCallback(state, kActuation);
+  if (pass != ScriptPass::kActuation) RunCallback(state, kSensing, h.child_args);
+  if (pass != ScriptPass::kSensing) RunCallback(state, kActuation, h.child_args);
 }
 
 void ScriptHost::RunSceneScripts(ScriptPass pass) {
   Impl& h = *impl_;
   if (h.stopped || !h.scene) return;
-  if (pass != ScriptPass::kActuation) RunCallback(h.scene.get(), kSensing);
-  if (pass != ScriptPass::kSensing) RunCallback(h.scene.get(), kActuation);
+  if (pass != ScriptPass::kActuation) RunCallback(h.scene.get(), kSensing, h.child_args);
+  if (pass != ScriptPass::kSensing) RunCallback(h.scene.get(), kActuation, h.child_args);
+}
+
+void ScriptHost::SetChildScriptArguments(std::vector<ParamValue> args) {
+  impl_->child_args = std::move(args);
 }
 
 void ScriptHost::Stop() {

@@ -13,6 +13,7 @@
 
 #include <cstddef>
 #include <memory>
+#include <vector>
 
 #include "framework/world.h"
 
@@ -45,6 +46,9 @@ class ScriptHost {
   // handlers through sim.handleSensing(), sim.handleChildScripts(), ...
   bool has_main_script() const;
   void RunMainScript();
+  // Arguments sim.handleChildScripts(pass, ...) passes to the child
+  // callbacks it runs (empty outside such a call).
+  void SetChildScriptArguments(std::vector<ParamValue> args);
   // sysCall_cleanup of every script whose sysCall_init returned; closes the
   // states. Throws the lowest robot's cleanup error. Safe to call twice.
   void Stop();

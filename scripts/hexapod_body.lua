@@ -43,5 +43,10 @@ function sysCall_actuation()
   table.insert(history_y, 1, along * dir_y)
   table.insert(history_z, 1, up)
   history_x[length + 1], history_y[length + 1], history_z[length + 1] = nil, nil, nil
-  sim.sendLocalMessage(sim.packTable({x = history_x, y = history_y, z = history_z, delay = delay}))
+  -- One flat float array: delay, n, then the n x, y and z entries.
+  local data = {delay, length}
+  for i = 1, length do
+    data[2 + i], data[2 + length + i], data[2 + 2 * length + i] = history_x[i], history_y[i], history_z[i]
+  end
+  sim.sendLocalMessage(sim.packFloats(data))
 end

@@ -24,8 +24,10 @@ function sysCall_actuation()
     data = d
   end
   if data == nil then return end
-  local m = sim.unpackTable(data)
-  local i = 1 + module_pos * m.delay
-  sim.setObjectPosition(target, {foot_original[1] + m.x[i], foot_original[2] + m.y[i],
-                                 foot_original[3] + m.z[i]}, base)
+  -- delay, n, then n x, n y and n z entries (hexapod_body.lua), newest first.
+  local m = sim.unpackFloats(data)
+  local delay, n = m[1], m[2]
+  local i = 2 + module_pos * delay + 1
+  sim.setObjectPosition(target, {foot_original[1] + m[i], foot_original[2] + m[i + n],
+                                 foot_original[3] + m[i + 2 * n]}, base)
 end

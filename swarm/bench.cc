@@ -14,6 +14,7 @@
 #include "framework/registry.h"
 #include "modules/builtin.h"
 #include "modules/dynamics/box2d/box2d_backend.h"
+#include "modules/dynamics/ode/ode_backend.h"
 #include "swarm/runner.h"
 #include "swarm/world_loader.h"
 
@@ -85,7 +86,7 @@ bool RunChild(const std::vector<std::string>& args, std::string* output, int* st
 
 int RunBenchChild(const BenchOptions& options, const std::string& config, int robots,
                   int threads, std::ostream& out) {
-  if (config != "diffusion" && config != "box2d-only")
+  if (config != "diffusion" && config != "box2d-only" && config != "ode-only")
     throw Error("unknown bench configuration '" + config + "'");
   ModuleRegistry registry;
   RegisterBuiltinModules(&registry);
@@ -103,7 +104,7 @@ int RunBenchChild(const BenchOptions& options, const std::string& config, int ro
   BenchRow row;
   row.config = config;
   row.robots = world.robot_count();
-  row.threads = config == "box2d-only" ? 1 : world.threads();
+  row.threads = config == "box2d-only" || config == "ode-only" ? 1 : world.threads();
   row.steps = options.steps;
   const double ticks = static_cast<double>(row.robots) * static_cast<double>(options.steps);
   if (config == "diffusion") {
@@ -112,6 +113,15 @@ int RunBenchChild(const BenchOptions& options, const std::string& config, int ro
     for (int64_t i = 0; i < options.steps; ++i) world.Step();
     row.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     for (int p = 0; p < 5; ++p) row.us_per_tick[p] = 1e6 * (world.phase_times()[p] - before[p]) / ticks;
+  } else if (config == "ode-only") {
+    // The same bodies and joint commands through ODE alone (collision + solver).
+    const WorldSettings& s = world.settings();
+    DynamicsSettings dynamics;
+    dynamics.gravity = s.gravity;
+    row.wall_s = ode::TimeBareLoop(world.scene(), s.time_step / s.physics_substeps,
+                                   s.physics_substeps, static_cast<int>(options.steps), {},
+                                   dynamics);
+    row.us_per_tick[static_cast<int>(Phase::kPhysics)] = 1e6 * row.wall_s / ticks;
   } else {
     // The same bodies and wheel commands through Box2D alone.
     const WorldSettings& s = world.settings();
@@ -169,9 +179,19 @@ int RunBench(const BenchOptions& options, std::ostream& out, std::ostream& err) 
     return true;
   };
   bool ok = true;
+  // The bare-engine row matches the world's backend: ode-only for an ODE world.
+  std::string bare = "box2d-only";
+  {
+    ModuleRegistry registry;
+    RegisterBuiltinModules(&registry);
+    LoadOptions load;
+    load.overrides = {{"robots", "1"}};
+    if (LoadWorld(options.world, load, registry).world->settings().physics == "ode")
+      bare = "ode-only";
+  }
   for (int robots : options.robots) {
     for (int threads : options.threads) ok = measure("diffusion", robots, threads) && ok;
-    ok = measure("box2d-only", robots, 1) && ok;
+    ok = measure(bare, robots, 1) && ok;
   }
   out << "\nphase columns: microseconds per robot-tick (a tick = one robot for one control step)\n";
   return ok ? 0 : 1;

@@ -362,7 +362,25 @@ ModelFile ReadModelFile(YamlFile file, const std::string& used_by) {
       ModelParameterDecl decl{p.name, p, "", "", p.key_mark};
       if (p.node.IsMap()) {
         Fields d(f, p, "parameter '" + p.name + "'");
-        d.Expect({"default", "unit", "description"});
+        d.Expect({"default", "unit", "description", "range"});
+        if (d.Has("range")) {
+          const Field range = d.Get("range");
+          const ParamValue lo = range.node.IsSequence() && range.node.size() == 2 &&
+                                        range.node[0].IsScalar()
+                                    ? ParseScalar(range.node[0].Scalar(), false)
+                                    : ParamValue(std::string());
+          const ParamValue hi = range.node.IsSequence() && range.node.size() == 2 &&
+                                        range.node[1].IsScalar()
+                                    ? ParseScalar(range.node[1].Scalar(), false)
+                                    : ParamValue(std::string());
+          if (!std::holds_alternative<double>(lo) || !std::holds_alternative<double>(hi) ||
+              !(std::get<double>(lo) <= std::get<double>(hi)))
+            f.Fail(range.mark, "'range' must be [min, max], two numbers with min <= max (got " +
+                                   Describe(range.node) + ")");
+          decl.has_range = true;
+          decl.min = std::get<double>(lo);
+          decl.max = std::get<double>(hi);
+        }
         decl.default_value = d.Require("default");
         decl.default_value.name = p.name;
         for (const char* key : {"unit", "description"})
@@ -372,7 +390,7 @@ ModelFile ReadModelFile(YamlFile file, const std::string& used_by) {
         decl.description = d.Get("description").node.Scalar();
       } else if (!p.node.IsScalar() || !p.present()) {
         f.Fail(p.mark, "parameter '" + p.name +
-                           "' must be a value or {default, unit, description} (got " +
+                           "' must be a value or {default, unit, range, description} (got " +
                            Describe(p.node) + ")");
       }
       model.parameters.push_back(std::move(decl));

@@ -49,6 +49,9 @@ struct ModelParameterDecl {
   std::string unit;
   std::string description;
   YAML::Mark mark;
+  // range: [min, max] (numbers only): every value given is checked.
+  bool has_range = false;
+  double min = 0, max = 0;
 };
 
 // A model file, checked but not resolved.

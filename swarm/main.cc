@@ -71,6 +71,7 @@ int Main(int argc, char** argv) {
   std::vector<std::string> sets;
   std::string out_dir;
   bool hash = false, quiet = false;
+  bool trust_scripts = false;
   run->add_option("world", world_file, "World file (YAML)")->required();
   auto* steps_opt = run->add_option("--steps", steps, "Number of control steps to run")
                         ->check(kNonNegative);
@@ -85,6 +86,8 @@ int Main(int argc, char** argv) {
   run->add_option("--out", out_dir, "Write summary.json and metrics.csv to this folder");
   run->add_flag("--hash", hash, "Print the final state hash");
   run->add_flag("--quiet", quiet, "No progress bar and no summary table");
+  run->add_flag("--trust-scripts", trust_scripts,
+                "Lift the script sandbox: full Lua libraries (os, io, debug, package)");
 
   // bench
   CLI::App* bench = app.add_subcommand("bench", "Measure robot-ticks/s over robots x threads");
@@ -225,6 +228,8 @@ int Main(int argc, char** argv) {
   load.overrides = ParseSets(sets);
   load.seed = seed;
   load.threads = threads;
+  if (!out_dir.empty()) load.output_directory = out_dir;
+  load.trust_scripts = trust_scripts;
   LoadedWorld loaded;
   try {
     loaded = LoadWorld(world_file, load, registry);

@@ -86,7 +86,28 @@ struct EntryPlan {
   std::optional<double> heading;
   std::vector<Placement2> placements;
   std::vector<loader::IkGroupDef> ik_groups;
+  // instances: [{index, parameters}]: copies with their own values.
+  std::vector<std::pair<int64_t, std::shared_ptr<ParameterSet>>> instance_parameters;
 };
+
+// A parameter value outside its declared range: the message, or "".
+std::string RangeError(const loader::ModelParameterDecl& decl, const std::string& model,
+                       const ParamValue& value) {
+  if (!decl.has_range) return "";
+  const double* v = std::get_if<double>(&value);
+  if (v != nullptr && *v >= decl.min && *v <= decl.max) return "";
+  return "parameter '" + decl.name + "' of model '" + model + "' must be within [" +
+         loader::FormatNumber(decl.min) + ", " + loader::FormatNumber(decl.max) + "]" +
+         (decl.unit.empty() ? "" : " " + decl.unit) + " (got " + ParamToString(value) + ")";
+}
+
+// The script files of a model's objects, in tree order, once each.
+void CollectScripts(const ObjectSpec& spec, std::vector<std::string>* out) {
+  if (spec.script &&
+      std::find(out->begin(), out->end(), spec.script->path) == out->end())
+    out->push_back(spec.script->path);
+  for (const ObjectSpec& child : spec.children) CollectScripts(child, out);
+}
 
 class WorldLoader {
  public:
@@ -107,6 +128,7 @@ class WorldLoader {
   void PlaceEntries();
   void BuildCopies(World* world);
   std::vector<SwarmMetricSpec> ReadMetrics(const Fields& top, World* world);
+  std::vector<ModelSummary> Summarize() const;
 
   const ModelFile& LoadModel(const Field& field, const std::string& text);
   ValueReader WorldValues() const {
@@ -162,6 +184,7 @@ LoadedWorld WorldLoader::Load() {
   PlaceEntries();
   BuildCopies(world);
   out.metrics = ReadMetrics(top, world);
+  out.models = Summarize();
   loader::AddPaintLayer(f, root, top.Get("paint"), WorldValues(), arena_, world);
   return out;
 }
@@ -263,6 +286,8 @@ WorldSettings WorldLoader::ReadSimulation(const Fields& top, std::optional<int64
   std::error_code ec;
   s.directory = fs::absolute(path_, ec).parent_path();
   s.threads = options_.threads;
+  s.output_directory = options_.output_directory;
+  s.trust_scripts = options_.trust_scripts;
   const ValueReader values = WorldValues();
   const Field sim = top.Get("simulation");
   if (sim.present()) {
@@ -426,8 +451,8 @@ void WorldLoader::ResolveEntry(EntryPlan* entry) {
   const ModelFile& model = *entry->model;
   const ValueReader world_values = WorldValues();
   Fields f(*file_, entry->field, "the models entry for '" + model.name + "'");
-  f.Expect(
-      {"model", "count", "distribute", "position", "heading_deg", "orientation_deg", "parameters"});
+  f.Expect({"model", "count", "distribute", "position", "heading_deg", "orientation_deg",
+            "parameters", "instances"});
 
   // Model parameters: declared defaults, then this entry's values, then --set.
   auto params = std::make_shared<ParameterSet>();
@@ -441,11 +466,12 @@ void WorldLoader::ResolveEntry(EntryPlan* entry) {
       names.push_back(decl.name);
     }
   }
-  if (f.Has("parameters")) {
-    Fields given(*file_, f.Get("parameters"), "the parameters of model '" + model.name + "'");
+  // Values given in the world file (the entry's, or one instance's) over `set`.
+  auto apply = [&](const Field& field, ParameterSet* set) {
+    Fields given(*file_, field, "the parameters of model '" + model.name + "'");
     for (const Field& p : given.fields()) {
-      auto it = params->find(p.name);
-      if (it == params->end())
+      auto it = set->find(p.name);
+      if (it == set->end())
         file_->Fail(p.key_mark,
                     "model '" + model.name + "' has no parameter '" + p.name + "'" +
                         (names.empty() ? " (it declares none)" : loader::Suggest(p.name, names)));
@@ -457,14 +483,43 @@ void WorldLoader::ResolveEntry(EntryPlan* entry) {
       it->second = std::holds_alternative<std::string>(it->second)
                        ? ParamValue(ParamToString(value))
                        : value;
+      for (const auto& decl : model.parameters)
+        if (decl.name == p.name)
+          if (std::string e = RangeError(decl, model.name, it->second); !e.empty())
+            file_->Fail(p.mark, e);
     }
-  }
+  };
+  for (const auto& decl : model.parameters)
+    if (std::string e = RangeError(decl, model.name, (*params)[decl.name]); !e.empty())
+      model.file.Fail(decl.default_value.mark, "the default of " + e);
+  if (f.Has("parameters")) apply(f.Get("parameters"), params.get());
   for (Override& o : overrides_) {
     if (o.model != model.name) continue;
     auto it = params->find(o.name);
     it->second = CoerceOverride(o, it->second, declared_where[o.name]);
+    for (const auto& decl : model.parameters)
+      if (decl.name == o.name)
+        if (std::string e = RangeError(decl, model.name, it->second); !e.empty())
+          throw Error("--set " + o.text + ": " + e + " (declared at " + declared_where[o.name] +
+                      ")");
   }
   entry->parameters = params;
+  // Copies with their own values: over the entry's, before --set (which
+  // sets every copy of the model).
+  for (const Field& element : loader::ListElements(*file_, f.Get("instances"), "instances")) {
+    Fields inst(*file_, element, "an instances entry");
+    inst.Expect({"index", "parameters"});
+    const int64_t index = world_values.Integer(inst.Require("index"), 0, kMaxCount - 1);
+    for (const auto& [other, set] : entry->instance_parameters)
+      if (other == index)
+        file_->Fail(inst.Get("index").mark,
+                    "copy " + std::to_string(index) + " is given twice in 'instances'");
+    auto own = std::make_shared<ParameterSet>(*params);
+    apply(inst.Require("parameters"), own.get());
+    for (Override& o : overrides_)
+      if (o.model == model.name) (*own)[o.name] = (*params)[o.name];
+    entry->instance_parameters.emplace_back(index, std::move(own));
+  }
 
   // The model's objects, in a scope where its parameters shadow the world's.
   const ValueReader model_values(model.file, &expressions_, {&parameters_, params.get()});
@@ -537,6 +592,12 @@ void WorldLoader::ResolveEntry(EntryPlan* entry) {
     entry->fixed_pose.p = {p[0], p[1], p.size() == 3 ? p[2] : -entry->footprint.bottom};
     entry->count = 1;
   }
+  for (const Field& element : loader::ListElements(*file_, f.Get("instances"), "instances")) {
+    const Field index = Fields(*file_, element, "an instances entry").Get("index");
+    if (world_values.Integer(index, 0, kMaxCount - 1) >= entry->count)
+      file_->Fail(index.mark, "'index' must be below the entry's count (" +
+                                  std::to_string(entry->count) + "): copies are numbered from 0");
+  }
 }
 
 void WorldLoader::PlaceEntries() {
@@ -595,9 +656,45 @@ void WorldLoader::BuildCopies(World* world) {
       }
       scene.set_name(root, scene.instance(instance).name);
       scene.SetWorldPose(root, poses[k] * e.spec.X_PO);
-      world->SetInstanceParameters(instance, e.parameters);
+      SharedParameters parameters = e.parameters;
+      for (const auto& [index, own] : e.instance_parameters)
+        if (index == static_cast<int64_t>(k)) parameters = own;
+      world->SetInstanceParameters(instance, parameters);
     }
   }
+}
+
+std::vector<ModelSummary> WorldLoader::Summarize() const {
+  std::vector<ModelSummary> out;
+  for (const EntryPlan& e : entries_) {
+    ModelSummary m;
+    m.name = e.model->name;
+    m.file = e.model->file.name();
+    m.count = e.count;
+    const ValueReader defaults(e.model->file, &expressions_, {&parameters_, nullptr});
+    for (const auto& decl : e.model->parameters) {
+      ParameterSummary p;
+      p.name = decl.name;
+      p.value = ParamToString(e.parameters->at(decl.name));
+      p.default_value = ParamToString(defaults.Resolve(decl.default_value));
+      p.unit = decl.unit;
+      p.description = decl.description;
+      if (decl.has_range)
+        p.range = "[" + loader::FormatNumber(decl.min) + ", " + loader::FormatNumber(decl.max) + "]";
+      m.parameters.push_back(std::move(p));
+    }
+    for (const auto& [index, own] : e.instance_parameters) {
+      std::string text;
+      for (const auto& [name, value] : *own)
+        if (!(value == e.parameters->at(name)))
+          text += (text.empty() ? "" : ", ") + name + "=" + ParamToString(value);
+      m.instances.emplace_back(index, text);
+    }
+    CollectScripts(e.spec, &m.scripts);
+    m.ik_groups = static_cast<int>(e.ik_groups.size());
+    out.push_back(std::move(m));
+  }
+  return out;
 }
 
 // --- Metrics -------------------------------------------------------------------------------

@@ -30,6 +30,24 @@ struct LoadOptions {
   std::vector<std::pair<std::string, std::string>> overrides;
   std::optional<uint64_t> seed;  // --seed: replaces simulation.seed
   int threads = 0;               // --threads: <= 0 all cores
+  // The run's output folder (--out), where sandboxed scripts may write;
+  // --trust-scripts lifts the sandbox (WorldSettings).
+  std::filesystem::path output_directory;
+  bool trust_scripts = false;
+};
+
+// What `swarmsim describe` lists about one `models:` entry.
+struct ParameterSummary {
+  std::string name, value, default_value, unit, range, description;  // range: "[a, b]" or ""
+};
+struct ModelSummary {
+  std::string name;  // "footbot"
+  std::string file;  // the model file, as the world names it
+  int64_t count = 0;
+  std::vector<ParameterSummary> parameters;             // values of every copy (after --set)
+  std::vector<std::pair<int64_t, std::string>> instances;  // copy index -> "name=value, ..."
+  std::vector<std::string> scripts;                      // script files, tree order
+  int ik_groups = 0;
 };
 
 struct LoadedWorld {
@@ -40,6 +58,8 @@ struct LoadedWorld {
   std::optional<int64_t> steps;
   // The swarm metrics the world asked for (already added to the world as observers).
   std::vector<SwarmMetricSpec> metrics;
+  // The models entries, for `swarmsim describe`.
+  std::vector<ModelSummary> models;
 };
 
 // Reads `file`, resolves parameters (after `options.overrides`), builds the

@@ -244,6 +244,34 @@ TEST(ScriptControlTest, WorldMainScriptRunsThePhases) {
   EXPECT_DOUBLE_EQ(w.world().time(), 0.2);
 }
 
+TEST(ScriptControlTest, HandleChildScriptsForwardsExtraArguments) {
+  WorldSettings settings;
+  settings.main_script = Source("main.lua", R"(
+    function sysCall_step()
+      sim.handleSensing()
+      sim.handleChildScripts('sensing', 'gain', 2.5, true)
+      sim.handleChildScripts('actuation')
+      sim.handleActuation()
+      sim.handleDynamics()
+    end
+  )");
+  ScriptWorld w(2, settings);
+  for (int r = 0; r < 3; ++r)
+    w.AddRobot("bot#" + std::to_string(r), R"(
+      function sysCall_sensing(name, value, flag) print(name, value, flag) end
+      function sysCall_actuation(...) print('actuation', select('#', ...)) end
+    )", r);
+  w.Steps(1);
+  const std::vector<std::string> expected = {
+      "[bot#0] gain\t2.5\ttrue", "[bot#1] gain\t2.5\ttrue", "[bot#2] gain\t2.5\ttrue",
+      "[bot#0] actuation\t0",    "[bot#1] actuation\t0",    "[bot#2] actuation\t0"};
+  EXPECT_EQ(w.log, expected);
+  WorldSettings bad;
+  bad.main_script = Source("main.lua", "function sysCall_step() sim.handleChildScripts('all', {}) end");
+  ScriptWorld v(1, bad);
+  EXPECT_CONTAINS(ErrorOf([&] { v.Steps(1); }), "main.lua:1: sim.handleChildScripts: argument 2 must be");
+}
+
 TEST(ScriptControlTest, MainScriptMustStepTheDynamicsAndChildrenCannotRunPhases) {
   WorldSettings settings;
   settings.main_script = Source("main.lua", "function sysCall_step() sim.handleSensing() end");

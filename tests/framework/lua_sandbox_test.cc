@@ -1,0 +1,156 @@
+// The script sandbox: each escape is refused with a message naming the
+// robot, script file and line; files only under the world's folder (read)
+// and the output folder (write); require from the world's folders;
+// trust_scripts lifts it.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "framework/error.h"
+#include "framework/world.h"
+#include "tests/framework/fakes.h"
+
+namespace swarmsim {
+namespace {
+
+namespace fs = std::filesystem;
+
+#define EXPECT_CONTAINS(haystack, needle) \
+  EXPECT_NE(std::string(haystack).find(needle), std::string::npos) << (haystack)
+
+// A temporary world folder with world/, world/scripts/ and out/.
+class SandboxTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    root_ = fs::temp_directory_path() /
+            ("swarmsim_sandbox_" + std::to_string(::getpid()) + "_" +
+             ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(root_);
+    fs::create_directories(root_ / "world" / "scripts");
+    fs::create_directories(root_ / "out");
+    Write(root_ / "world" / "data.txt", "hello\n");
+    Write(root_ / "secret.txt", "secret\n");
+  }
+  void TearDown() override { fs::remove_all(root_); }
+  static void Write(const fs::path& path, const std::string& text) { std::ofstream(path) << text; }
+
+  // Runs `code` as one robot's script for one step; returns the error ("" if none).
+  std::string Run(const std::string& code, bool with_out = true, bool trust = false) {
+    WorldSettings settings;
+    settings.physics = "null";
+    settings.directory = root_ / "world";
+    if (with_out) settings.output_directory = root_ / "out";
+    settings.trust_scripts = trust;
+    registry_ = testing::NullRegistry();
+    World world(settings, registry_);
+    log_.clear();
+    world.set_log_sink([this](std::string_view line) { log_.emplace_back(line); });
+    const ObjectId root = world.scene().AddDummy("bot#0", {}, {});
+    world.scene().MakeModelInstance(root, "bot", "bot#0");
+    world.scene().AttachScript(
+        root, std::make_shared<const ScriptSource>(ScriptSource{"scripts/robot.lua", code}));
+    try {
+      world.Start();
+      world.Step();
+      world.Stop();
+    } catch (const Error& e) {
+      return e.what();
+    }
+    return "";
+  }
+  std::string Log() const {
+    std::string out;
+    for (const std::string& line : log_) out += line + "\n";
+    return out;
+  }
+
+  fs::path root_;
+  ModuleRegistry registry_;
+  std::vector<std::string> log_;
+};
+
+TEST_F(SandboxTest, ForbiddenFunctionsAreRefusedWithScriptAndLine) {
+  const std::vector<std::pair<std::string, std::string>> escapes = {
+      {"os.execute('true')", "os.execute is not allowed"},
+      {"io.popen('ls')", "io.popen is not allowed"},
+      {"package.loadlib('libc.so.6', 'system')", "package.loadlib is not allowed"},
+      {"debug.getinfo(1)", "debug.getinfo is not allowed"},
+      {"dofile('/etc/passwd')", "dofile is not allowed"},
+      {"loadfile('/etc/passwd')", "loadfile is not allowed"},
+      {"os.getenv('HOME')", "os.getenv is not allowed"},
+      {"io.lines()", "io.lines() on standard input is not allowed"},
+      {"load('\\27LuaT\\0')", "binary chunks are not allowed"},
+  };
+  for (const auto& [call, message] : escapes) {
+    const std::string error = Run("\nfunction sysCall_init()\n  " + call + "\nend\n");
+    EXPECT_CONTAINS(error, message);
+    EXPECT_CONTAINS(error, "bot#0: scripts/robot.lua:3:");
+    EXPECT_CONTAINS(error, "--trust-scripts");
+  }
+  // string.dump is gone; harmless os functions stay.
+  EXPECT_EQ(Run("assert(string.dump == nil); assert(os.clock() >= 0)"), "");
+}
+
+TEST_F(SandboxTest, ReadsOnlyUnderTheWorldFolder) {
+  EXPECT_EQ(Run("local f = assert(io.open('data.txt')); assert(f:read('l') == 'hello'); f:close()"
+                "\nfor l in io.lines('data.txt') do assert(l == 'hello') end"),
+            "");
+  EXPECT_CONTAINS(Run("io.open('../secret.txt')"), "'..' is not allowed in a path");
+  EXPECT_CONTAINS(Run("io.open('" + (root_ / "secret.txt").string() + "')"),
+                  "is outside the world's folder");
+  EXPECT_CONTAINS(Run("io.open('/etc/passwd')"), "is outside the world's folder");
+  // A symlink inside the folder that leads out.
+  fs::create_symlink(root_ / "secret.txt", root_ / "world" / "link.txt");
+  EXPECT_CONTAINS(Run("io.open('link.txt')"), "is outside the world's folder");
+  // Reading from the output folder is not allowed either; a missing file is nil, message.
+  EXPECT_EQ(Run("local f, e = io.open('missing.txt'); assert(f == nil and e:find('missing'))"), "");
+}
+
+TEST_F(SandboxTest, WritesOnlyUnderTheOutputFolder) {
+  EXPECT_EQ(Run("local f = assert(io.open('log.txt', 'w')); f:write('x=1'); f:close()"), "");
+  std::ifstream in(root_ / "out" / "log.txt");
+  std::string text;
+  std::getline(in, text);
+  EXPECT_EQ(text, "x=1");
+  EXPECT_CONTAINS(Run("io.open('" + (root_ / "world" / "data.txt").string() + "', 'a')"),
+                  "is outside the run's output folder");
+  EXPECT_CONTAINS(Run("io.open('../world/data.txt', 'w')"), "'..' is not allowed");
+  EXPECT_CONTAINS(Run("io.open('log.txt', 'w')", /*with_out=*/false),
+                  "the run has no output folder (swarmsim run --out DIR)");
+  fs::create_symlink(root_ / "world", root_ / "out" / "sneaky");
+  EXPECT_CONTAINS(Run("io.open('sneaky/data.txt', 'w')"), "is outside the run's output folder");
+}
+
+TEST_F(SandboxTest, RequireLoadsModulesFromTheWorldFoldersOncePerState) {
+  Write(root_ / "world" / "scripts" / "util.lua",
+        "count = (count or 0) + 1\nprint('loading util')\n"
+        "return {twice = function(x) return 2 * x end}\n");
+  Write(root_ / "world" / "helpers.lua", "local u = require('util') return {four = u.twice(2)}\n");
+  EXPECT_EQ(Run("local u = require('util'); local h = require('helpers')\n"
+                "assert(u == require('util')); assert(h.four == 4); assert(count == nil)"),
+            "");
+  EXPECT_EQ(Log(), "[bot#0] loading util\n");
+  EXPECT_CONTAINS(Run("\nrequire('nothere')"), "scripts/robot.lua:2: require: module 'nothere' "
+                                               "not found; looked for:");
+  EXPECT_CONTAINS(Run("require('../secret')"), "is not a module name");
+  Write(root_ / "world" / "bad.lua", "os.execute('true')\n");
+  EXPECT_CONTAINS(Run("require('bad')"), "bad.lua:1: os.execute is not allowed");
+  fs::create_symlink(root_ / "secret.txt", root_ / "world" / "leak.lua");
+  EXPECT_CONTAINS(Run("require('leak')"), "module 'leak' not found");
+}
+
+TEST_F(SandboxTest, TrustScriptsGivesTheFullLibraries) {
+  EXPECT_EQ(Run("assert(type(os.execute) == 'function' and type(io.popen) == 'function' and "
+                "type(debug.getinfo) == 'function' and type(package.loadlib) == 'function')",
+                true, /*trust=*/true),
+            "");
+  EXPECT_CONTAINS(Run("assert(type(os.execute) == 'function')"), "os.execute is not allowed");
+}
+
+}  // namespace
+}  // namespace swarmsim

@@ -1,0 +1,182 @@
+// IK groups as calculation objects: solved in the actuate phase, copied and
+// removed with their model, the same whatever the thread count; several
+// tips and closed chains.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "framework/ik_groups.h"
+#include "framework/registry.h"
+#include "framework/world.h"
+#include "modules/builtin.h"
+
+namespace swarmsim {
+namespace {
+
+const ModuleRegistry& Registry() {
+  static ModuleRegistry* registry = [] {
+    auto* r = new ModuleRegistry;
+    RegisterBuiltinModules(r);
+    return r;
+  }();
+  return *registry;
+}
+
+std::unique_ptr<World> MakeWorld(int threads) {
+  WorldSettings settings;
+  settings.physics = "kinematic";
+  settings.threads = threads;
+  settings.time_step = 0.05;
+  auto world = std::make_unique<World>(settings, Registry());
+  world->set_log_sink([](std::string_view) {});
+  return world;
+}
+
+// A planar 2-link arm (links 0.5 m and 0.4 m, joints about z) as a model
+// rooted at a dummy, with a target dummy under the root.
+struct Arm {
+  ObjectId root, j1, j2, tip, target;
+};
+Arm AddArm(Scene* scene, const Pose& X_WRoot) {
+  Arm a;
+  JointData joint;
+  joint.mode = JointMode::kPassive;
+  a.root = scene->AddDummy("arm", {}, X_WRoot);
+  a.j1 = scene->AddJoint("j1", a.root, {}, joint);
+  joint.position = 0.3;  // away from the straight singularity
+  a.j2 = scene->AddJoint("j2", a.j1, {{0.5, 0, 0}, {}}, joint);
+  a.tip = scene->AddDummy("tip", a.j2, {{0.4, 0, 0}, {}});
+  a.target = scene->AddDummy("target", a.root, {{0.6, 0.3, 0}, {}});
+  scene->MakeModelInstance(a.root, "arm", "arm#" + std::to_string(scene->instances().size()));
+  return a;
+}
+
+IkGroups* Ik(World* world) { return dynamic_cast<IkGroups*>(world->calculation(kIkModuleName)); }
+
+IkGroupSpec ArmGroup(const Arm& a) {
+  IkGroupSpec spec;
+  spec.name = "reach";
+  spec.tips.push_back({a.tip, a.target, {}, kIkX | kIkY});
+  spec.max_iterations = 50;
+  spec.position_tolerance = 1e-6;
+  return spec;
+}
+
+double Distance(const Scene& scene, ObjectId a, ObjectId b) {
+  return (scene.world_pose(a).p - scene.world_pose(b).p).Norm();
+}
+
+TEST(IkGroupsTest, SolvedInTheActuatePhase) {
+  auto world = MakeWorld(1);
+  const Arm arm = AddArm(&world->scene(), {});
+  IkGroups* ik = Ik(world.get());
+  const int h = ik->AddGroup(world->scene(), ArmGroup(arm));
+  world->Start();
+  world->Step();
+  EXPECT_EQ(ik->last_status(h), IkStatus::kSolved);
+  EXPECT_LT(Distance(world->scene(), arm.tip, arm.target), 1e-5);
+}
+
+TEST(IkGroupsTest, DuplicatedModelsGroupSolvesForTheCopyAndIsRemovedWithIt) {
+  auto world = MakeWorld(1);
+  Scene& scene = world->scene();
+  const Arm arm = AddArm(&scene, {});
+  IkGroups* ik = Ik(world.get());
+  ik->AddGroup(scene, ArmGroup(arm));
+  const ObjectId copy = scene.DuplicateSubtree(arm.root, {});
+  scene.SetWorldPose(copy, {{3, 0, 0}, Quat::FromYaw(1.0)});
+  const int copy_instance = scene.instance_of(copy);
+  ASSERT_EQ(ik->live_group_count(), 2);
+  const int copy_group = ik->FindGroup("reach", copy_instance);
+  ASSERT_NE(copy_group, 0);
+  // The copy refers to its own tip and target, not the original's.
+  const ObjectId copy_tip = scene.FindObject("./tip", copy);
+  const ObjectId copy_target = scene.FindObject("./target", copy);
+  EXPECT_EQ(ik->spec(copy_group).tips[0].tip, copy_tip);
+  EXPECT_EQ(ik->spec(copy_group).tips[0].target, copy_target);
+  scene.SetLocalPose(copy_target, {{0.2, -0.5, 0}, {}});
+  world->Start();
+  world->Step();
+  EXPECT_LT(Distance(scene, arm.tip, arm.target), 1e-5);
+  EXPECT_LT(Distance(scene, copy_tip, copy_target), 1e-5);
+  // Deleting the copy deletes its group; the original's still works.
+  scene.RemoveSubtree(copy);
+  EXPECT_EQ(ik->live_group_count(), 1);
+  EXPECT_FALSE(ik->IsLive(copy_group));
+  scene.SetLocalPose(arm.target, {{0.1, 0.7, 0}, {}});
+  world->Step();
+  EXPECT_LT(Distance(scene, arm.tip, arm.target), 1e-5);
+}
+
+TEST(IkGroupsTest, ParallelSolveEqualsSerial) {
+  std::vector<double> positions[2];
+  for (int threads : {1, 2}) {
+    auto world = MakeWorld(threads);
+    Scene& scene = world->scene();
+    const Arm arm = AddArm(&scene, {});
+    Ik(world.get())->AddGroup(scene, ArmGroup(arm));
+    std::vector<ObjectId> targets;
+    for (int i = 1; i < 64; ++i) {
+      const ObjectId copy = scene.DuplicateSubtree(arm.root, {});
+      scene.SetWorldPose(copy, {{2.0 * i, 0, 0}, {}});
+      scene.SetLocalPose(scene.FindObject("./target", copy),
+                         {{0.3 + 0.005 * i, 0.2 + 0.007 * i, 0}, {}});
+    }
+    world->Start();
+    for (int s = 0; s < 3; ++s) world->Step();
+    for (const JointData& j : scene.joints()) positions[threads - 1].push_back(j.position);
+  }
+  ASSERT_EQ(positions[0].size(), 128u);
+  EXPECT_EQ(positions[0], positions[1]);  // bit for bit
+}
+
+TEST(IkGroupsTest, SeveralTipsAndAClosedChain) {
+  auto world = MakeWorld(1);
+  Scene& scene = world->scene();
+  // Two arms on one base: arm A's tip must meet a dummy on arm B (a closed
+  // chain: both arms' joints move), and arm B's tip a fixed target.
+  JointData joint;
+  joint.mode = JointMode::kPassive;
+  const ObjectId root = scene.AddDummy("base", {}, {});
+  const ObjectId a1 = scene.AddJoint("a1", root, {}, joint);
+  joint.position = 0.4;
+  const ObjectId a2 = scene.AddJoint("a2", a1, {{0.5, 0, 0}, {}}, joint);
+  const ObjectId tip_a = scene.AddDummy("tipA", a2, {{0.5, 0, 0}, {}});
+  joint.position = -0.4;
+  const ObjectId b1 = scene.AddJoint("b1", root, {{0, 0.6, 0}, {}}, joint);
+  const ObjectId b2 = scene.AddJoint("b2", b1, {{0.5, 0, 0}, {}}, joint);
+  const ObjectId tip_b = scene.AddDummy("tipB", b2, {{0.5, 0, 0}, {}});
+  const ObjectId mid_b = scene.AddDummy("midB", b1, {{0.5, 0, 0}, {}});  // on arm B
+  const ObjectId fixed = scene.AddDummy("fixed", root, {{0.9, 0.8, 0}, {}});
+  scene.MakeModelInstance(root, "pair", "pair#0");
+  IkGroupSpec spec;
+  spec.name = "pair";
+  spec.tips.push_back({tip_a, mid_b, {}, kIkX | kIkY});
+  spec.tips.push_back({tip_b, fixed, {}, kIkX | kIkY});
+  spec.max_iterations = 100;
+  spec.position_tolerance = 1e-6;
+  IkGroups* ik = Ik(world.get());
+  const int h = ik->AddGroup(scene, spec);
+  (void)b2;
+  EXPECT_EQ(ik->Handle(h, &scene), IkStatus::kSolved);
+  EXPECT_LT(Distance(scene, tip_a, mid_b), 1e-5);
+  EXPECT_LT(Distance(scene, tip_b, fixed), 1e-5);
+}
+
+TEST(IkGroupsTest, ConditionalSolvingLeavesJointsOfAnUnreachableTarget) {
+  auto world = MakeWorld(1);
+  Scene& scene = world->scene();
+  const Arm arm = AddArm(&scene, {});
+  scene.SetLocalPose(arm.target, {{5, 0, 0}, {}});  // beyond reach (0.9 m)
+  IkGroupSpec spec = ArmGroup(arm);
+  spec.conditional = true;
+  IkGroups* ik = Ik(world.get());
+  const int h = ik->AddGroup(scene, spec);
+  EXPECT_EQ(ik->Handle(h, &scene), IkStatus::kFailed);
+  EXPECT_EQ(scene.joint(arm.j1).position, 0.0);
+  EXPECT_EQ(scene.joint(arm.j2).position, 0.3);
+}
+
+}  // namespace
+}  // namespace swarmsim

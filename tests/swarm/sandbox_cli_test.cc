@@ -1,0 +1,97 @@
+// The script sandbox as a user meets it: each escape, tried from a world
+// file through the program, ends the run with a message naming the robot,
+// script and line; --out makes a writable folder; --trust-scripts lifts it.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Result {
+  int exit_code = -1;
+  std::string output;
+};
+
+Result RunProgram(const std::string& args) {
+  const std::string cmd = std::string(SWARMSIM_BINARY) + " " + args + " 2>&1";
+  Result r;
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (!pipe) return r;
+  std::array<char, 4096> buf;
+  size_t n;
+  while ((n = fread(buf.data(), 1, buf.size(), pipe)) > 0) r.output.append(buf.data(), n);
+  const int status = pclose(pipe);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  return r;
+}
+
+// A world folder whose one robot runs `code` in sysCall_init (line 2).
+fs::path MakeWorld(const std::string& code) {
+  const fs::path dir = fs::temp_directory_path() / ("swarmsim_sandbox_cli_" +
+                                                    std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "world.yaml") << "simulation: {physics: kinematic, time_step: 0.1}\n"
+                                       "models:\n  - {model: probe.yaml, position: [0, 0]}\n";
+  std::ofstream(dir / "probe.yaml") << "model: probe\n"
+                                       "objects: {name: body, type: dummy, script: probe.lua}\n";
+  std::ofstream(dir / "probe.lua") << "function sysCall_init()\n  " << code << "\nend\n";
+  std::ofstream(dir / "data.txt") << "42\n";
+  return dir;
+}
+
+TEST(SandboxCliTest, EachEscapeFromAWorldFileIsRefusedWithScriptAndLine) {
+  const std::vector<std::pair<std::string, std::string>> escapes = {
+      {"os.execute('touch /tmp/swarmsim_pwned')", "os.execute is not allowed"},
+      {"io.popen('ls')", "io.popen is not allowed"},
+      {"package.loadlib('libc.so.6', 'system')", "package.loadlib is not allowed"},
+      {"debug.sethook()", "debug.sethook is not allowed"},
+      {"load(string.char(27) .. 'LuaT')", "binary chunks are not allowed"},
+      {"io.open('/etc/passwd')", "is outside the world's folder"},
+      {"io.open('../x.txt')", "'..' is not allowed in a path"},
+      {"io.open('x.txt', 'w')", "the run has no output folder"},
+      {"require('os_tools')", "module 'os_tools' not found"},
+  };
+  for (const auto& [code, message] : escapes) {
+    const fs::path dir = MakeWorld(code);
+    const Result r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 2 --quiet");
+    EXPECT_EQ(r.exit_code, 1) << code << "\n" << r.output;
+    EXPECT_NE(r.output.find(message), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("probe#0: "), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("probe.lua:2:"), std::string::npos) << r.output;
+    fs::remove_all(dir);
+  }
+  EXPECT_FALSE(fs::exists("/tmp/swarmsim_pwned"));
+}
+
+TEST(SandboxCliTest, OutFolderIsWritableAndTrustScriptsLiftsTheSandbox) {
+  fs::path dir = MakeWorld(
+      "local v = io.open('data.txt'):read('n'); local f = assert(io.open('copy.txt', 'w')); "
+      "f:write(v * 2); f:close()");
+  Result r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 1 --quiet --out " +
+                        (dir / "out").string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream copy(dir / "out" / "copy.txt");
+  std::string text;
+  std::getline(copy, text);
+  EXPECT_EQ(text, "84");
+  fs::remove_all(dir);
+
+  dir = MakeWorld("assert(type(os.execute) == 'function' and type(debug.getinfo) == 'function')");
+  r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 1 --quiet --trust-scripts");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 1 --quiet");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  fs::remove_all(dir);
+}
+
+}  // namespace
