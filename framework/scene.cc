@@ -26,6 +26,7 @@ const char* ToString(ShapeKind kind) {
     case ShapeKind::kCylinder: return "cylinder";
     case ShapeKind::kSphere: return "sphere";
     case ShapeKind::kCapsule: return "capsule";
+    case ShapeKind::kMesh: return "mesh";
   }
   return "?";
 }
@@ -56,6 +57,7 @@ double ShapeData::BoundingRadius() const {
     case ShapeKind::kCylinder:
     case ShapeKind::kCapsule:
     case ShapeKind::kSphere: return size.x;
+    case ShapeKind::kMesh: return mesh ? mesh->footprint_radius() : 0.5 * std::hypot(size.x, size.y);
   }
   return 0;
 }

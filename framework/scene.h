@@ -21,6 +21,7 @@
 #include "framework/force_sensor.h"
 #include "framework/handle.h"
 #include "framework/math.h"
+#include "framework/mesh.h"
 #include "framework/paint_nozzle.h"
 
 namespace swarmsim {
@@ -28,13 +29,17 @@ namespace swarmsim {
 enum class ObjectType : uint8_t { kDummy, kShape, kJoint, kProximitySensor, kForceSensor, kPaintNozzle };
 const char* ToString(ObjectType type);
 
-enum class ShapeKind : uint8_t { kBox, kCylinder, kSphere, kCapsule };
+enum class ShapeKind : uint8_t { kBox, kCylinder, kSphere, kCapsule, kMesh };
 const char* ToString(ShapeKind kind);
 
 // Geometry is centred on the shape's frame; a cylinder's axis is its z axis.
 // A capsule is a cylinder with hemispherical caps along z; its height is the
 // total length, caps included (>= 2 radius), so its bounding cylinder has the
 // same size (modules that lack exact capsule code use that).
+// A mesh is a shared, immutable triangle mesh (framework/mesh.h) in the
+// shape's frame; its `size` holds the full extents of the smallest box
+// centred on the frame that contains it, so box-based fallbacks stay
+// conservative.
 struct ShapeData {
   ShapeKind kind = ShapeKind::kBox;
   Vec3 size{0.1, 0.1, 0.1};  // box: full extents (x, y, z) m; cylinder, capsule: (radius, -, height); sphere: (radius, -, -)
@@ -43,6 +48,7 @@ struct ShapeData {
   double friction = 0.7;     // Coulomb coefficient
   double restitution = 0.0;
   Vec3 color{0.7, 0.7, 0.7};  // RGB in [0, 1]
+  std::shared_ptr<const TriangleMesh> mesh;  // kMesh: the asset (shared by copies), else null
 
   // Radius of the shape's footprint circle in its xy plane (for broad phases).
   double BoundingRadius() const;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <limits>
 
 #include "framework/error.h"
 
@@ -54,6 +55,7 @@ struct Builder {
   const ValueReader& values;
   ScriptCache* scripts;
   int objects = 0;
+  MeshCache* meshes = nullptr;
 
   void Count(const Field& field, int n) {
     objects += n;
@@ -98,7 +100,7 @@ struct Builder {
     if (type == "shape") {
       named.Expect(Concat({&kCommonKeys, &ShapeKeys()}));
       spec.type = ObjectType::kShape;
-      spec.shape = ReadShape(values, named);
+      spec.shape = ReadShape(values, named, meshes);
     } else if (type == "joint") {
       named.Expect(Concat({&kCommonKeys, &kJointKeys}));
       spec.type = ObjectType::kJoint;
@@ -243,7 +245,8 @@ std::shared_ptr<const ScriptSource> ScriptCache::Get(const fs::path& path, const
 
 const std::vector<std::string>& ShapeKeys() {
   static const std::vector<std::string> keys = {
-      "shape", "size", "radius", "height", "dynamic", "mass", "friction", "restitution", "color"};
+      "shape", "size", "radius", "height", "dynamic", "mass", "friction", "restitution", "color",
+      "file", "scale"};
   return keys;
 }
 
@@ -252,17 +255,34 @@ const std::vector<std::string>& PoseKeys() {
   return keys;
 }
 
-ShapeData ReadShape(const ValueReader& values, const Fields& f) {
+ShapeData ReadShape(const ValueReader& values, const Fields& f, MeshCache* meshes) {
   ShapeData s;
   const std::string kind =
-      values.Choice(f.Require("shape"), {"box", "cylinder", "sphere", "capsule"});
+      values.Choice(f.Require("shape"), {"box", "cylinder", "sphere", "capsule", "mesh"});
   // Each kind takes its own size keys; a key of another kind is a mistake.
   auto forbid = [&](const char* key, const char* hint) {
     if (f.Has(key))
       values.file().Fail(f.Get(key).key_mark, "'" + std::string(key) + "' does not apply to a " +
                                                   kind + " (" + hint + ")");
   };
-  if (kind == "box") {
+  if (kind != "mesh") {
+    forbid("file", "only a mesh takes 'file: part.stl'");
+    forbid("scale", "only a mesh takes 'scale: [sx, sy, sz]'");
+  }
+  if (kind == "mesh") {
+    s.kind = ShapeKind::kMesh;
+    for (const char* key : {"size", "radius", "height"})
+      forbid(key, "a mesh takes 'file: part.stl|part.obj' and optionally 'scale: [sx, sy, sz]'");
+    const Field file = f.Require("file");
+    const std::string text = values.String(file);
+    if (text.empty()) values.Fail(file, "'file' must be a mesh file name (.stl or .obj)");
+    const Vec3 scale = f.Has("scale") ? values.Vector3(f.Get("scale"), kPositive) : Vec3{1, 1, 1};
+    MeshCache local;
+    if (!meshes) meshes = &local;
+    s.mesh = meshes->Get(values.file().path().parent_path() / text, scale,
+                         values.file().Where(file.mark), text);
+    s.size = s.mesh->CenteredExtents();
+  } else if (kind == "box") {
     s.kind = ShapeKind::kBox;
     forbid("radius", "a box takes 'size: [x, y, z]'");
     forbid("height", "a box takes 'size: [x, y, z]'");
@@ -413,8 +433,9 @@ ModelFile ReadModelFile(YamlFile file, const std::string& used_by) {
   return model;
 }
 
-ObjectSpec ResolveModel(const ModelFile& model, const ValueReader& values, ScriptCache* scripts) {
-  Builder builder{model, values, scripts};
+ObjectSpec ResolveModel(const ModelFile& model, const ValueReader& values, ScriptCache* scripts,
+                        MeshCache* meshes) {
+  Builder builder{model, values, scripts, 0, meshes};
   std::vector<ObjectSpec> out;
   builder.Object(model.root, 0, true, &out);
   return std::move(out.front());
@@ -455,6 +476,7 @@ void Accumulate(const ObjectSpec& spec, const Pose& X_RP, Footprint* fp, bool* a
       case ShapeKind::kCylinder:
       case ShapeKind::kCapsule: half = {s.size.x, s.size.x, s.size.z / 2}; break;
       case ShapeKind::kSphere: half = {s.size.x, s.size.x, s.size.x}; break;
+      case ShapeKind::kMesh: half = s.size * 0.5; break;  // a centred box around it
     }
     // Axis-aligned half extents of the rotated shape, in the root's frame.
     const Vec3 cx = X_RO.q.Rotate({half.x, 0, 0}), cy = X_RO.q.Rotate({0, half.y, 0}),
@@ -471,7 +493,16 @@ void Accumulate(const ObjectSpec& spec, const Pose& X_RP, Footprint* fp, bool* a
     } else {
       radius = std::hypot(std::abs(X_RO.p.x) + e.x, std::abs(X_RO.p.y) + e.y);
     }
-    const double bottom = X_RO.p.z - e.z;
+    double bottom = X_RO.p.z - e.z;
+    if (s.kind == ShapeKind::kMesh && s.mesh) {  // exact over its vertices
+      radius = 0;
+      bottom = std::numeric_limits<double>::infinity();
+      for (const Vec3& v : s.mesh->vertices()) {
+        const Vec3 p = X_RO * v;
+        radius = std::max(radius, std::hypot(p.x, p.y));
+        bottom = std::min(bottom, p.z);
+      }
+    }
     if (!*any) {
       fp->radius = radius;
       fp->bottom = bottom;

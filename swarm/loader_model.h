@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "framework/scene.h"
+#include "swarm/loader_mesh.h"
 #include "swarm/loader_values.h"
 #include "swarm/loader_yaml.h"
 
@@ -72,11 +73,14 @@ bool IsParameterName(std::string_view name);
 
 // The root object of `model`, values resolved by `values` (whose scope holds
 // the world's and this entry's model parameters). Scripts resolve against
-// the model file's folder.
-ObjectSpec ResolveModel(const ModelFile& model, const ValueReader& values, ScriptCache* scripts);
+// the model file's folder, and so do mesh files (read once through `meshes`;
+// null: a cache of this call's own).
+ObjectSpec ResolveModel(const ModelFile& model, const ValueReader& values, ScriptCache* scripts,
+                        MeshCache* meshes = nullptr);
 
-// Shape keys and object poses, shared with the world's obstacles.
-ShapeData ReadShape(const ValueReader& values, const Fields& fields);
+// Shape keys and object poses, shared with the world's obstacles. A mesh's
+// file is relative to the file being read; `meshes` null: no sharing.
+ShapeData ReadShape(const ValueReader& values, const Fields& fields, MeshCache* meshes = nullptr);
 Pose ReadPose(const ValueReader& values, const Fields& fields);
 // orientation_deg: [roll, pitch, yaw] or heading_deg (identity if neither).
 Quat ReadOrientation(const ValueReader& values, const Fields& fields);

@@ -54,6 +54,39 @@ std::vector<std::pair<std::string, std::string>> ParseSets(const std::vector<std
   return out;
 }
 
+// swarmsim describe: the world's settings, then each models entry.
+void PrintDescription(const LoadedWorld& w, std::ostream& out) {
+  const WorldSettings& s = w.world->settings();
+  out << "world: " << s.file << "\n"
+      << "physics: " << s.physics << ", time step " << s.time_step << " s, seed " << s.seed
+      << "\n"
+      << "main script: " << (s.main_script ? s.main_script->path : "(default step)") << "\n";
+  if (!w.world->parameters().empty()) {
+    out << "world parameters:\n";
+    for (const auto& [name, value] : w.world->parameters())
+      out << "  " << name << " = " << ParamToString(value) << "\n";
+  }
+  for (const ModelSummary& m : w.models) {
+    out << "\nmodel " << m.name << " (" << m.file << "): " << m.count
+        << (m.count == 1 ? " copy" : " copies") << "\n";
+    for (const std::string& script : m.scripts) out << "  script: " << script << "\n";
+    if (m.ik_groups > 0) out << "  module: ik (" << m.ik_groups << " IK groups)\n";
+    if (m.parameters.empty()) out << "  parameters: none\n";
+    for (const ParameterSummary& p : m.parameters) {
+      out << "  " << m.name << "." << p.name << " = " << p.value;
+      if (!p.unit.empty()) out << " " << p.unit;
+      out << "  (default " << p.default_value;
+      if (!p.range.empty()) out << ", range " << p.range;
+      out << ")";
+      if (!p.description.empty()) out << "  " << p.description;
+      out << "\n";
+    }
+    for (const auto& [index, values] : m.instances)
+      out << "  copy " << index << " of this entry: " << (values.empty() ? "(as above)" : values)
+          << "\n";
+  }
+}
+
 int Main(int argc, char** argv) {
   CLI::App app{"swarmsim " + std::string(Version()) +
                ": a headless, swarm-scale robot simulator.\n"
@@ -167,6 +200,13 @@ int Main(int argc, char** argv) {
                   "Merge runs made with different versions of the world file");
 
   CLI::App* modules = app.add_subcommand("modules", "List the registered modules");
+  CLI::App* describe =
+      app.add_subcommand("describe", "List a world's models, their parameters and scripts");
+  std::string describe_world;
+  std::vector<std::string> describe_sets;
+  describe->add_option("world", describe_world, "World file (YAML)")->required();
+  describe->add_option("--set", describe_sets, "Override a parameter: name=value or model.name=value")
+      ->allow_extra_args(false);
   CLI::App* version = app.add_subcommand("version", "Print the version");
 
   try {
@@ -187,6 +227,18 @@ int Main(int argc, char** argv) {
 
   if (*version) {
     std::cout << "swarmsim " << Version() << "\n";
+    return 0;
+  }
+  if (*describe) {
+    LoadOptions describe_load;
+    describe_load.overrides = ParseSets(describe_sets);
+    try {
+      const LoadedWorld w = LoadWorld(describe_world, describe_load, registry);
+      PrintDescription(w, std::cout);
+    } catch (const Error& e) {
+      std::cerr << "error: " << e.what() << "\n";
+      return kExitBadInput;
+    }
     return 0;
   }
   if (*modules) {

@@ -90,6 +90,12 @@ struct EntryPlan {
   std::vector<std::pair<int64_t, std::shared_ptr<ParameterSet>>> instance_parameters;
 };
 
+// A value as a user writes it (0.2, not 0.20000000000000001).
+std::string ShowValue(const ParamValue& value) {
+  if (const double* d = std::get_if<double>(&value)) return loader::FormatNumber(*d);
+  return ParamToString(value);
+}
+
 // A parameter value outside its declared range: the message, or "".
 std::string RangeError(const loader::ModelParameterDecl& decl, const std::string& model,
                        const ParamValue& value) {
@@ -98,7 +104,7 @@ std::string RangeError(const loader::ModelParameterDecl& decl, const std::string
   if (v != nullptr && *v >= decl.min && *v <= decl.max) return "";
   return "parameter '" + decl.name + "' of model '" + model + "' must be within [" +
          loader::FormatNumber(decl.min) + ", " + loader::FormatNumber(decl.max) + "]" +
-         (decl.unit.empty() ? "" : " " + decl.unit) + " (got " + ParamToString(value) + ")";
+         (decl.unit.empty() ? "" : " " + decl.unit) + " (got " + ShowValue(value) + ")";
 }
 
 // The script files of a model's objects, in tree order, once each.
@@ -141,6 +147,7 @@ class WorldLoader {
   std::unique_ptr<YamlFile> file_;
   mutable loader::Expressions expressions_;
   loader::ScriptCache scripts_;
+  loader::MeshCache meshes_;  // each mesh file read once per world
   std::vector<Override> overrides_;
   ParameterSet parameters_;
   std::map<std::string, Field> parameter_fields_;  // where each world parameter is set
@@ -369,6 +376,19 @@ void WorldLoader::AddObstacleFootprint(const ShapeData& shape, const Pose& X_WO)
     o.half_x = shape.size.x / 2;
     o.half_y = shape.size.y / 2;
     o.yaw = X_WO.q.Yaw();
+  } else if (shape.kind == ShapeKind::kMesh && shape.mesh) {
+    // The plane box around the projected vertices (conservative).
+    double lo_x = INFINITY, lo_y = INFINITY, hi_x = -INFINITY, hi_y = -INFINITY;
+    for (const Vec3& v : shape.mesh->vertices()) {
+      const Vec3 p = X_WO * v;
+      lo_x = std::min(lo_x, p.x), lo_y = std::min(lo_y, p.y);
+      hi_x = std::max(hi_x, p.x), hi_y = std::max(hi_y, p.y);
+    }
+    o.kind = Obstacle2::Kind::kBox;
+    o.x = (lo_x + hi_x) / 2;
+    o.y = (lo_y + hi_y) / 2;
+    o.half_x = (hi_x - lo_x) / 2;
+    o.half_y = (hi_y - lo_y) / 2;
   } else {
     // Tilted: the plane box around the rotated shape (conservative).
     const Vec3 half = shape.kind == ShapeKind::kBox
@@ -437,7 +457,7 @@ void WorldLoader::BuildObstacles(const Fields& top, World* world) {
     f.Expect(keys);
     std::string name = "obstacle_" + std::to_string(index);
     if (f.Has("name")) name = values.String(f.Get("name"));
-    const ShapeData shape = loader::ReadShape(values, f);
+    const ShapeData shape = loader::ReadShape(values, f, &meshes_);
     const Pose X_WO = loader::ReadPose(values, f);
     world->scene().AddShape(name, {}, X_WO, shape);
     AddObstacleFootprint(shape, X_WO);
@@ -523,7 +543,7 @@ void WorldLoader::ResolveEntry(EntryPlan* entry) {
 
   // The model's objects, in a scope where its parameters shadow the world's.
   const ValueReader model_values(model.file, &expressions_, {&parameters_, params.get()});
-  entry->spec = loader::ResolveModel(model, model_values, &scripts_);
+  entry->spec = loader::ResolveModel(model, model_values, &scripts_, &meshes_);
   entry->footprint = loader::ComputeFootprint(entry->spec);
   entry->ik_groups = loader::ReadIkGroups(model, model_values);
 
@@ -675,8 +695,8 @@ std::vector<ModelSummary> WorldLoader::Summarize() const {
     for (const auto& decl : e.model->parameters) {
       ParameterSummary p;
       p.name = decl.name;
-      p.value = ParamToString(e.parameters->at(decl.name));
-      p.default_value = ParamToString(defaults.Resolve(decl.default_value));
+      p.value = ShowValue(e.parameters->at(decl.name));
+      p.default_value = ShowValue(defaults.Resolve(decl.default_value));
       p.unit = decl.unit;
       p.description = decl.description;
       if (decl.has_range)
@@ -687,7 +707,7 @@ std::vector<ModelSummary> WorldLoader::Summarize() const {
       std::string text;
       for (const auto& [name, value] : *own)
         if (!(value == e.parameters->at(name)))
-          text += (text.empty() ? "" : ", ") + name + "=" + ParamToString(value);
+          text += (text.empty() ? "" : ", ") + name + "=" + ShowValue(value);
       m.instances.emplace_back(index, text);
     }
     CollectScripts(e.spec, &m.scripts);

@@ -82,6 +82,10 @@ PlacedShape PlaceShape(const ShapeData& shape, const Pose& X_WS, ObjectId id, in
       placed.half_size = {shape.size.x, shape.size.x, shape.size.z * 0.5};
       break;
     case ShapeKind::kSphere: placed.half_size = {shape.size.x, shape.size.x, shape.size.x}; break;
+    case ShapeKind::kMesh:
+      placed.mesh = shape.mesh.get();
+      placed.half_size = placed.mesh ? (placed.mesh->hi() - placed.mesh->lo()) * 0.5 : Vec3{};
+      break;
   }
   return placed;
 }
@@ -95,6 +99,7 @@ bool RayCast(const PlacedShape& shape, const Vec3& p_W, const Vec3& d_W, double 
     case ShapeKind::kCapsule:
       return RayCylinder(o, d, shape.half_size.x, shape.half_size.z, max_t, t);
     case ShapeKind::kSphere: return RaySphere(o, d, shape.half_size.x, max_t, t);
+    case ShapeKind::kMesh: return shape.mesh && shape.mesh->RayCast(o, d, max_t, t);
   }
   return false;
 }
@@ -103,6 +108,9 @@ void WorldBounds(const PlacedShape& shape, Vec3* lo, Vec3* hi) {
   const Quat& q = shape.X_WS.q;
   const Vec3& h = shape.half_size;
   Vec3 extent;
+  Vec3 p_WC = shape.X_WS.p;  // centre of the bounds
+  if (shape.kind == ShapeKind::kMesh && shape.mesh)
+    p_WC = shape.X_WS * ((shape.mesh->lo() + shape.mesh->hi()) * 0.5);
   if (shape.kind == ShapeKind::kSphere) {
     extent = h;
   } else if (shape.kind == ShapeKind::kCylinder || shape.kind == ShapeKind::kCapsule) {
@@ -118,8 +126,8 @@ void WorldBounds(const PlacedShape& shape, Vec3* lo, Vec3* hi) {
               std::abs(ax.y) * h.x + std::abs(ay.y) * h.y + std::abs(az.y) * h.z,
               std::abs(ax.z) * h.x + std::abs(ay.z) * h.y + std::abs(az.z) * h.z};
   }
-  *lo = shape.X_WS.p - extent;
-  *hi = shape.X_WS.p + extent;
+  *lo = p_WC - extent;
+  *hi = p_WC + extent;
 }
 
 double WorldFootprintRadius(const ShapeData& shape, const Pose& X_WS) {
@@ -130,6 +138,7 @@ double WorldFootprintRadius(const ShapeData& shape, const Pose& X_WS) {
     case ShapeKind::kCylinder:
     case ShapeKind::kCapsule: return std::hypot(shape.size.x, 0.5 * shape.size.z);
     case ShapeKind::kSphere: return shape.size.x;
+    case ShapeKind::kMesh: return shape.mesh ? shape.mesh->bounding_radius() : 0;
   }
   return 0;
 }
@@ -198,6 +207,13 @@ bool MayOverlapCube(const PlacedShape& shape, const Vec3& centre, double half, d
       const double dz = std::max(std::abs(c.z) - shape.half_size.z, 0.0);
       const double reach = shape.half_size.x + std::sqrt(3.0) * half + margin;
       return c.x * c.x + c.y * c.y + dz * dz <= reach * reach;
+    }
+    case ShapeKind::kMesh: {
+      if (!shape.mesh) return false;
+      // The cube must meet the mesh's bounds, and its bounding sphere a triangle.
+      const Pose X_WC{shape.X_WS * ((shape.mesh->lo() + shape.mesh->hi()) * 0.5), shape.X_WS.q};
+      if (!CubeMeetsBox(centre, half, X_WC, shape.half_size, margin)) return false;
+      return shape.mesh->AnyTriangleWithin(shape.X_SW * centre, std::sqrt(3.0) * half + margin);
     }
   }
   return true;

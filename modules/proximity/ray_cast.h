@@ -32,6 +32,9 @@ struct PlacedShape {  // 104 bytes
   ObjectId id;     // the shape's object
   int32_t instance;  // model instance (robot) or -1
   ShapeKind kind;
+  // Mesh: the asset (kept alive by the scene, or by the static index), and
+  // half_size is half its bounds' extents, centred at mesh->lo()..hi().
+  const TriangleMesh* mesh = nullptr;
 };
 
 PlacedShape PlaceShape(const ShapeData& shape, const Pose& X_WS, ObjectId id, int instance);

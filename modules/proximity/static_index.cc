@@ -59,6 +59,7 @@ void StaticIndex::Build(const Scene& scene, double resolution) {
   inv_resolution_ = 1 / resolution;
   tree_ = std::make_unique<octomap::OcTree>(resolution);
   shapes_.clear();
+  meshes_.clear();
   buckets_.clear();
   bucket_shapes_.clear();
 
@@ -69,6 +70,7 @@ void StaticIndex::Build(const Scene& scene, double resolution) {
     const uint32_t slot = owners[r];
     if (!scene.alive_at(slot) || scene.instance_of_at(slot) >= 0 || shape_rows[r].dynamic) continue;
     shapes_.push_back(PlaceShape(shape_rows[r], scene.world_pose_at(slot), scene.IdAt(slot), -1));
+    if (shape_rows[r].mesh) meshes_.push_back(shape_rows[r].mesh);
   }
   std::sort(shapes_.begin(), shapes_.end(),
             [](const PlacedShape& a, const PlacedShape& b) { return a.id.index1 < b.id.index1; });

@@ -80,6 +80,8 @@ class StaticIndex {
   double resolution_ = 0.05;
   double inv_resolution_ = 20;
   std::vector<PlacedShape> shapes_;  // the static shapes (static shapes)
+  // Meshes of the static shapes, kept alive while shapes_ points at them (static meshes).
+  std::vector<std::shared_ptr<const TriangleMesh>> meshes_;
   // Bucket key -> [begin, end) in bucket_shapes_.
   std::unordered_map<uint64_t, std::pair<uint32_t, uint32_t>> buckets_;
   std::vector<uint32_t> bucket_shapes_;  // shape indices, ascending per bucket

@@ -117,14 +117,14 @@ TEST_F(LoaderIkTest, ScriptsHandleTheirOwnGroupExplicitly) {
 TEST_F(LoaderIkTest, MistakesNameTheLineAndTheNearestName) {
   const std::string bad_path =
       ErrorOf("  - {name: reach, tips: [{tip: j1/j2/tpi, target: target}]}\n");
-  EXPECT_NE(bad_path.find("arm.yaml:19:"), std::string::npos) << bad_path;
+  EXPECT_NE(bad_path.find("arm.yaml:20:"), std::string::npos) << bad_path;
   EXPECT_NE(bad_path.find("no object 'j1/j2/tpi'"), std::string::npos) << bad_path;
   EXPECT_NE(bad_path.find("did you mean 'j1/j2/tip'"), std::string::npos) << bad_path;
   const std::string bad_key = ErrorOf("  - {name: reach, dampnig: 1, tips: []}\n");
   EXPECT_NE(bad_key.find("did you mean 'damping'"), std::string::npos) << bad_key;
   const std::string bad_constraint =
       ErrorOf("  - {name: reach, tips: [{tip: j1/j2/tip, target: target, constraints: [x, yy]}]}\n");
-  EXPECT_NE(bad_constraint.find("arm.yaml:19:"), std::string::npos) << bad_constraint;
+  EXPECT_NE(bad_constraint.find("arm.yaml:20:"), std::string::npos) << bad_constraint;
   const std::string no_joints = ErrorOf("  - {name: reach, tips: [{tip: target, target: j1/j2/tip}]}\n");
   EXPECT_NE(no_joints.find("no joint between"), std::string::npos) << no_joints;
 }

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include "framework/error.h"
 #include "framework/scene.h"
@@ -41,6 +42,15 @@ struct HeightRange {
 };
 HeightRange CalcHeightRange(const ShapeData& shape, const Pose& X_WS) {
   const double z = X_WS.p.z;
+  if (shape.kind == ShapeKind::kMesh && shape.mesh) {  // exact over the vertices
+    HeightRange range{std::numeric_limits<double>::infinity(),
+                      -std::numeric_limits<double>::infinity()};
+    for (const Vec3& v : shape.mesh->vertices()) {
+      const double vz = (X_WS * v).z;
+      range = {std::min(range.lo, vz), std::max(range.hi, vz)};
+    }
+    return range;
+  }
   if (shape.kind == ShapeKind::kSphere) return {z - shape.size.x, z + shape.size.x};
   // Half extents along the shape's axes; the vertical extent is the sum of
   // their projections on world z.
@@ -65,6 +75,10 @@ bool IsUpright(const Pose& X_WS) {
 // Area-preserving footprint radius of a shape, m.
 double FootprintRadius(const ShapeData& shape) {
   if (shape.kind == ShapeKind::kBox) return std::sqrt(shape.size.x * shape.size.y / M_PI);
+  if (shape.kind == ShapeKind::kMesh && shape.mesh) {  // of its bounding box
+    const Vec3 e = shape.mesh->hi() - shape.mesh->lo();
+    return std::sqrt(e.x * e.y / M_PI);
+  }
   return shape.size.x;
 }
 
@@ -77,6 +91,12 @@ double CalcInertia(const ShapeData& shape) {
     case ShapeKind::kCylinder:
     case ShapeKind::kCapsule: return 0.5 * m * shape.size.x * shape.size.x;  // capsule: as its cylinder
     case ShapeKind::kSphere: return 0.4 * m * shape.size.x * shape.size.x;
+    case ShapeKind::kMesh: {  // its bounding box's, about the shape's origin
+      const Vec3 lo = shape.mesh ? shape.mesh->lo() : shape.size * -0.5;
+      const Vec3 hi = shape.mesh ? shape.mesh->hi() : shape.size * 0.5;
+      const Vec3 e = hi - lo, c = (lo + hi) * 0.5;
+      return m * (e.x * e.x + e.y * e.y) / 12 + m * (c.x * c.x + c.y * c.y);
+    }
   }
   return 0;
 }
@@ -90,6 +110,65 @@ void SetSkinnedBox(double hx, double hy, const b2Vec2& center, double angle, b2P
     hy -= r;
   }
   out->SetAsBox(static_cast<float>(hx), static_cast<float>(hy), center, static_cast<float>(angle));
+}
+
+// A mesh in the plane: the convex hull of its vertices projected by X (mesh
+// frame -> plane frame, metres), in Box2D units, as convex polygons of at
+// most b2_maxPolygonVertices (a fan cut of the hull: exact, not simplified).
+// No skin correction: the collision surface is the hull grown by
+// b2_polygonRadius. False when the hull has no area.
+bool MeshPolygons(const TriangleMesh& mesh, const Pose& X, double L,
+                  std::vector<b2PolygonShape>* out) {
+  struct P {
+    double x, y;
+  };
+  std::vector<P> points;
+  points.reserve(mesh.vertices().size());
+  for (const Vec3& v : mesh.vertices()) {
+    const Vec3 p = X * v;
+    points.push_back({p.x * L, p.y * L});
+  }
+  std::sort(points.begin(), points.end(),
+            [](const P& a, const P& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
+  // Andrew's monotone chain, counter-clockwise, collinear points dropped.
+  auto cross = [](const P& o, const P& a, const P& b) {
+    return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
+  };
+  std::vector<P> hull(2 * points.size() + 1);
+  size_t k = 0;
+  for (size_t i = 0; i < points.size(); ++i) {
+    while (k >= 2 && cross(hull[k - 2], hull[k - 1], points[i]) <= 0) --k;
+    hull[k++] = points[i];
+  }
+  for (size_t i = points.size() - 1, lower = k + 1; i-- > 0;) {
+    while (k >= lower && cross(hull[k - 2], hull[k - 1], points[i]) <= 0) --k;
+    hull[k++] = points[i];
+  }
+  hull.resize(k > 0 ? k - 1 : 0);
+  // Drop vertices Box2D would weld (closer than a linear slop).
+  const double weld = b2_linearSlop;
+  std::vector<b2Vec2> kept;
+  for (const P& p : hull) {
+    if (!kept.empty() && std::hypot(p.x - kept.back().x, p.y - kept.back().y) < weld) continue;
+    kept.emplace_back(static_cast<float>(p.x), static_cast<float>(p.y));
+  }
+  while (kept.size() > 1 && b2Distance(kept.front(), kept.back()) < weld) kept.pop_back();
+  if (kept.size() < 3) return false;
+  double area = 0;
+  for (size_t i = 0; i < kept.size(); ++i)
+    area += b2Cross(kept[i], kept[(i + 1) % kept.size()]);
+  if (area * 0.5 < 4 * b2_linearSlop * b2_linearSlop) return false;
+  // Fan pieces: vertex 0 with up to 7 consecutive others.
+  const size_t n = kept.size();
+  for (size_t j = 1; j + 1 < n; j += b2_maxPolygonVertices - 2) {
+    b2Vec2 piece[b2_maxPolygonVertices];
+    int count = 0;
+    piece[count++] = kept[0];
+    for (size_t i = j; i < n && count < b2_maxPolygonVertices; ++i) piece[count++] = kept[i];
+    out->emplace_back();
+    out->back().Set(piece, count);
+  }
+  return true;
 }
 
 std::string PathAt(const Scene& scene, uint32_t slot) { return scene.PathOf(scene.IdAt(slot)); }
@@ -178,7 +257,20 @@ void PlaneWorld::Build(const Scene& scene) {
     fixture.restitutionThreshold = static_cast<float>(kRestitutionThreshold * L);
     b2CircleShape circle;
     b2PolygonShape polygon;
-    if (box) {
+    std::vector<b2PolygonShape> pieces;  // a mesh's hull
+    if (shape->kind == ShapeKind::kMesh) {
+      // In the body's plane frame: the shape's tilt applied, its yaw not.
+      const Pose X_PS{{}, (Quat::FromYaw(-yaw) * X_WS.q).Normalized()};
+      if (!shape->mesh || !MeshPolygons(*shape->mesh, X_PS, L, &pieces))
+        throw Error("box2d: dynamic mesh '" + PathAt(scene, s) +
+                    "' has no area seen from above (its hull in the plane is degenerate)");
+      fixture.density = 1;  // the mass is set below
+      for (size_t i = 0; i + 1 < pieces.size(); ++i) {
+        fixture.shape = &pieces[i];
+        body->CreateFixture(&fixture);
+      }
+      fixture.shape = &pieces.back();
+    } else if (box) {
       SetSkinnedBox(0.5 * shape->size.x * L, 0.5 * shape->size.y * L, b2Vec2(0, 0), 0, &polygon);
       b2MassData unit;
       polygon.ComputeMass(&unit, 1.0f);
@@ -237,6 +329,16 @@ void PlaneWorld::Build(const Scene& scene) {
     const bool round = shape->kind == ShapeKind::kSphere ||
                        ((shape->kind == ShapeKind::kCylinder || shape->kind == ShapeKind::kCapsule) &&
                         IsUpright(X_WS));
+    if (shape->kind == ShapeKind::kMesh) {
+      // The hull of the vertices projected to the plane, in pieces.
+      std::vector<b2PolygonShape> pieces;
+      if (!shape->mesh || !MeshPolygons(*shape->mesh, X_WS, L, &pieces)) continue;
+      for (const b2PolygonShape& piece : pieces) {
+        fixture.shape = &piece;
+        ground_->CreateFixture(&fixture);
+      }
+      continue;
+    }
     if (round) {
       if (!(shape->size.x > 0)) continue;
       circle.m_p = center;
@@ -284,7 +386,8 @@ void PlaneWorld::Build(const Scene& scene) {
     const ShapeData* wheel_shape = nullptr;
     for (ObjectId child : scene.children(scene.IdAt(s))) {
       const ShapeData* shape = shape_at(child.index());
-      if (shape && !shape->dynamic && shape->kind != ShapeKind::kBox && shape->size.x > 0) {
+      if (shape && !shape->dynamic && shape->kind != ShapeKind::kBox &&
+          shape->kind != ShapeKind::kMesh && shape->size.x > 0) {
         wheel_shape = shape;
         break;
       }

@@ -46,8 +46,9 @@ Pose BodyPose(dBodyID body) {
 
 Vec3 ToVec3(const dReal* v) { return {v[0], v[1], v[2]}; }
 
-// A geom for the shape, or null if its size cannot make one.
-dGeomID MakeGeom(dSpaceID space, const ShapeData& shape) {
+// A geom for the shape, or null if its size cannot make one. `mesh_data`:
+// the trimesh data of a mesh shape.
+dGeomID MakeGeom(dSpaceID space, const ShapeData& shape, dTriMeshDataID mesh_data) {
   const Vec3& s = shape.size;
   switch (shape.kind) {
     case ShapeKind::kBox:
@@ -62,6 +63,9 @@ dGeomID MakeGeom(dSpaceID space, const ShapeData& shape) {
     case ShapeKind::kCapsule:
       if (!(s.x > 0)) return nullptr;
       return dCreateCapsule(space, s.x, std::max(0.0, s.z - 2 * s.x));
+    case ShapeKind::kMesh:
+      if (!mesh_data) return nullptr;
+      return dCreateTriMesh(space, mesh_data, nullptr, nullptr, nullptr);
   }
   return nullptr;
 }
@@ -77,6 +81,20 @@ dMass CalcMass(const ShapeData& shape) {
     case ShapeKind::kCapsule:
       dMassSetCapsuleTotal(&m, shape.mass, 3, s.x, std::max(0.0, s.z - 2 * s.x));
       break;
+    case ShapeKind::kMesh: {
+      // The mass sits at the shape's origin (ODE wants it at the body's
+      // origin: put a mesh's origin at its centre of mass); the inertia is
+      // that of the mesh's bounding box, about the origin (the box's own
+      // inertia plus the parallel-axis term of its offset).
+      const Vec3 lo = shape.mesh ? shape.mesh->lo() : s * -0.5;
+      const Vec3 hi = shape.mesh ? shape.mesh->hi() : s * 0.5;
+      const Vec3 e = hi - lo, c = (lo + hi) * 0.5;
+      dMassSetBoxTotal(&m, shape.mass, std::max(e.x, 1e-9), std::max(e.y, 1e-9),
+                       std::max(e.z, 1e-9));
+      dMassTranslate(&m, c.x, c.y, c.z);
+      m.c[0] = m.c[1] = m.c[2] = 0;
+      break;
+    }
   }
   return m;
 }
@@ -127,6 +145,8 @@ void OdeWorld::Clear() {
     dWorldDestroy(world_);  // destroys bodies and joints
   }
   if (threading_) dThreadingFreeImplementation(threading_);
+  for (auto& [mesh, data] : meshes_) dGeomTriMeshDataDestroy(data);  // after their geoms
+  meshes_.clear();
   contacts_ = nullptr;
   space_ = nullptr;
   world_ = nullptr;
@@ -143,6 +163,22 @@ void OdeWorld::Clear() {
 void OdeWorld::AddGeom(dGeomID geom, int32_t instance, double friction, double restitution) {
   geom_info_.push_back({instance, friction, restitution});
   dGeomSetData(geom, reinterpret_cast<void*>(static_cast<uintptr_t>(geom_info_.size())));
+}
+
+dTriMeshDataID OdeWorld::MeshData(const std::shared_ptr<const TriangleMesh>& mesh) {
+  static_assert(sizeof(dTriIndex) == sizeof(uint32_t) && sizeof(MeshTriangle) == 12 &&
+                sizeof(Vec3) == 3 * sizeof(double));
+  if (!mesh) return nullptr;
+  for (const auto& [known, data] : meshes_)
+    if (known == mesh) return data;
+  // Few distinct meshes per world: a linear search is fine.
+  dTriMeshDataID data = dGeomTriMeshDataCreate();
+  dGeomTriMeshDataBuildDouble(data, mesh->vertices().data(), sizeof(Vec3),
+                              static_cast<int>(mesh->vertices().size()),
+                              mesh->triangles().data(),
+                              static_cast<int>(3 * mesh->triangles().size()), sizeof(MeshTriangle));
+  meshes_.emplace_back(mesh, data);
+  return data;
 }
 
 void OdeWorld::Build(const Scene& scene) {
@@ -181,7 +217,7 @@ void OdeWorld::Build(const Scene& scene) {
     if (!(shape->mass > 0) || !std::isfinite(shape->mass))
       throw Error("ode: dynamic shape '" + PathAt(scene, s) + "' needs a positive mass (got " +
                   std::to_string(shape->mass) + " kg)");
-    dGeomID geom = MakeGeom(space_, *shape);
+    dGeomID geom = MakeGeom(space_, *shape, MeshData(shape->mesh));
     if (!geom)
       throw Error("ode: dynamic shape '" + PathAt(scene, s) + "' needs a positive size");
     dBodyID body = dBodyCreate(world_);
@@ -216,7 +252,7 @@ void OdeWorld::Build(const Scene& scene) {
         break;
       }
     }
-    dGeomID geom = MakeGeom(space_, *shape);
+    dGeomID geom = MakeGeom(space_, *shape, MeshData(shape->mesh));
     if (!geom) continue;  // a zero-size decoration: nothing to collide with
     AddGeom(geom, scene.instance_of_at(s), shape->friction, shape->restitution);
     if (carrier) {

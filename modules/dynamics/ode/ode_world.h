@@ -93,6 +93,8 @@ class OdeWorld {
   // Samples each sensor's joint feedback and breaks links over their threshold.
   void ReadForceSensors(Scene* scene);
   void AddGeom(dGeomID geom, int32_t instance, double friction, double restitution);
+  // ODE's trimesh data for a mesh asset, made once per world (ode_world.cc).
+  dTriMeshDataID MeshData(const std::shared_ptr<const TriangleMesh>& mesh);
   void ApplyMotors(double dt);
   void TrackJointPositions();
   static void NearCallback(void* data, dGeomID a, dGeomID b);
@@ -111,6 +113,8 @@ class OdeWorld {
   std::vector<std::unique_ptr<dJointFeedback>> feedback_;  // (force_sensors_), stable addresses
   std::vector<GeomInfo> geom_info_;  // indexed by the geom's data (index + 1)
   std::vector<dContact> contact_buffer_;
+  // Mesh assets in use and their trimesh data (ODE reads the asset's arrays in place).
+  std::vector<std::pair<std::shared_ptr<const TriangleMesh>, dTriMeshDataID>> meshes_;
   // Joint commands, read once per control step (rows of joints_).
   std::vector<JointData> commands_;
   double step_dt_ = 0;  // substep length, for the servo

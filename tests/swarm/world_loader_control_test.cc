@@ -1,0 +1,152 @@
+// World-file keys of distributed control: simulation.main_script /
+// instruction_budget / on_script_error, per-copy parameters (instances:),
+// parameter ranges, --set, and `swarmsim describe`.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <string>
+
+#include "framework/error.h"
+#include "framework/registry.h"
+#include "framework/world.h"
+#include "swarm/world_loader.h"
+#include "tests/framework/fakes.h"
+
+namespace swarmsim {
+namespace {
+
+namespace fs = std::filesystem;
+
+#define EXPECT_CONTAINS(haystack, needle) \
+  EXPECT_NE(std::string(haystack).find(needle), std::string::npos) << (haystack)
+
+class ControlLoaderTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("swarmsim_control_loader_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    Write("bot.yaml",
+          "model: bot\n"
+          "parameters:\n"
+          "  speed: {default: 0.1, unit: m/s, range: [0, 0.5], description: forward speed}\n"
+          "  label: {default: plain}\n"
+          "objects: {name: body, type: dummy, script: bot.lua}\n");
+    Write("bot.lua", "function sysCall_init() end\n");
+    Write("main.lua", "function sysCall_step() sim.handleDynamics() end\n");
+    registry_.RegisterDynamics({"", "null", "1", "test"},
+                               [] { return std::make_unique<testing::NullDynamics>(); });
+    registry_.RegisterProximity({"", "proximity", "1", "test"},
+                                [] { return std::make_unique<testing::NullProximity>(); });
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  void Write(const std::string& name, const std::string& text) { std::ofstream(dir_ / name) << text; }
+  LoadedWorld Load(const std::string& world, LoadOptions options = {}) {
+    Write("world.yaml", world);
+    return LoadWorld(dir_ / "world.yaml", options, registry_);
+  }
+  std::string ErrorOf(const std::string& world, LoadOptions options = {}) {
+    try {
+      Load(world, options);
+    } catch (const Error& e) {
+      return e.what();
+    }
+    return "NO ERROR";
+  }
+  fs::path dir_;
+  ModuleRegistry registry_;
+};
+
+const char kThree[] =
+    "simulation: {physics: null}\n"
+    "models:\n"
+    "  - model: bot.yaml\n"
+    "    count: 3\n"
+    "    distribute: {region: {min: [-5, -5], max: [5, 5]}}\n"
+    "    parameters: {speed: 0.2}\n"
+    "    instances:\n"
+    "      - {index: 1, parameters: {speed: 0.4, label: special}}\n";
+
+TEST_F(ControlLoaderTest, SimulationControlKeys) {
+  LoadedWorld w = Load(
+      "simulation: {physics: null, main_script: main.lua, instruction_budget: 5000, "
+      "on_script_error: disable_script}\n");
+  EXPECT_EQ(w.world->settings().instruction_budget, 5000);
+  EXPECT_EQ(w.world->settings().on_script_error, ScriptErrorPolicy::kDisableScript);
+  ASSERT_TRUE(w.world->settings().main_script);
+  EXPECT_CONTAINS(w.world->settings().main_script->code, "sim.handleDynamics()");
+  LoadedWorld d = Load("simulation: {physics: null}\n");
+  EXPECT_EQ(d.world->settings().on_script_error, ScriptErrorPolicy::kStop);
+  EXPECT_FALSE(d.world->settings().main_script);
+  EXPECT_CONTAINS(ErrorOf("simulation: {physics: null, on_script_error: ignore}\n"),
+                  "world.yaml:1:48:");
+  EXPECT_CONTAINS(ErrorOf("simulation: {physics: null, instruction_budget: -1}\n"),
+                  "world.yaml:1:51:");
+  EXPECT_CONTAINS(ErrorOf("simulation: {physics: null, main_script: nothere.lua}\n"),
+                  "nothere.lua");
+}
+
+TEST_F(ControlLoaderTest, PerCopyParametersOverrideTheEntrysAndSetAppliesToAll) {
+  LoadedWorld w = Load(kThree);
+  const World& world = *w.world;
+  EXPECT_EQ(std::get<double>(*world.FindParameter(0, "speed")), 0.2);
+  EXPECT_EQ(std::get<double>(*world.FindParameter(1, "speed")), 0.4);
+  EXPECT_EQ(std::get<std::string>(*world.FindParameter(1, "label")), "special");
+  EXPECT_EQ(std::get<double>(*world.FindParameter(2, "speed")), 0.2);
+  LoadOptions set;
+  set.overrides = {{"bot.speed", "0.3"}};
+  LoadedWorld s = Load(kThree, set);
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(std::get<double>(*s.world->FindParameter(i, "speed")), 0.3);
+  EXPECT_EQ(std::get<std::string>(*s.world->FindParameter(1, "label")), "special");
+  ASSERT_EQ(w.models.size(), 1u);
+  EXPECT_EQ(w.models[0].instances[0].second, "label=special, speed=0.4");
+}
+
+TEST_F(ControlLoaderTest, RangesAndInstanceMistakesNameFileLineAndColumn) {
+  std::string bad = kThree;
+  bad.replace(bad.find("speed: 0.4"), 10, "speed: 0.9");
+  EXPECT_CONTAINS(ErrorOf(bad), "world.yaml:8:42: parameter 'speed' of model 'bot' must be within "
+                                "[0, 0.5] m/s (got 0.9)");
+  bad = kThree;
+  bad.replace(bad.find("index: 1"), 8, "index: 3");
+  EXPECT_CONTAINS(ErrorOf(bad), "world.yaml:8:17: 'index' must be below the entry's count (3)");
+  bad = kThree;
+  bad.replace(bad.find("label: special"), 14, "colour: red");
+  EXPECT_CONTAINS(ErrorOf(bad), "model 'bot' has no parameter 'colour'");
+  LoadOptions set;
+  set.overrides = {{"bot.speed", "2"}};
+  EXPECT_CONTAINS(ErrorOf(kThree, set), "--set bot.speed=2: parameter 'speed' of model 'bot' "
+                                        "must be within [0, 0.5]");
+  Write("bot.yaml", "model: bot\nparameters:\n  speed: {default: 0.1, range: [1]}\n"
+                    "objects: {name: body, type: dummy}\n");
+  EXPECT_CONTAINS(ErrorOf(kThree), "bot.yaml:3:37: 'range' must be [min, max]");
+}
+
+TEST_F(ControlLoaderTest, DescribeListsModelsParametersAndScripts) {
+  Write("world.yaml", kThree);
+  const std::string cmd = std::string(SWARMSIM_BINARY) + " describe " +
+                          (dir_ / "world.yaml").string() + " --set bot.speed=0.25 2>&1";
+  FILE* pipe = popen(cmd.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string out;
+  std::array<char, 4096> buf;
+  size_t n;
+  while ((n = fread(buf.data(), 1, buf.size(), pipe)) > 0) out.append(buf.data(), n);
+  const int status = pclose(pipe);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << out;
+  EXPECT_CONTAINS(out, "model bot (");
+  EXPECT_CONTAINS(out, "3 copies");
+  EXPECT_CONTAINS(out, "script: ");
+  EXPECT_CONTAINS(out, "bot.lua");
+  EXPECT_CONTAINS(out, "bot.speed = 0.25 m/s  (default 0.1, range [0, 0.5])  forward speed");
+  EXPECT_CONTAINS(out, "copy 1 of this entry: label=special");
+}
+
+}  // namespace
+}  // namespace swarmsim
