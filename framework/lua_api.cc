@@ -84,7 +84,14 @@ int LazySimIndex(lua_State* L) {
   const std::vector<SimEntry>& entries = Tables().sim;
   auto it = std::lower_bound(entries.begin(), entries.end(), key,
                              [](const SimEntry& e, std::string_view k) { return e.name < k; });
-  if (it == entries.end() || it->name != key) return 0;
+  if (it == entries.end() || it->name != key) {
+    // A plugin's command (lua_api_plugins.cc), kept like the others.
+    if (!PushPluginCommand(L, key)) return 0;
+    lua_pushvalue(L, 2);
+    lua_pushvalue(L, -2);
+    lua_rawset(L, 1);
+    return 1;
+  }
   switch (it->type) {
     case LUA_TFUNCTION: lua_pushcfunction(L, it->function); break;
     case LUA_TNUMBER:

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <exception>
 #include <string>
+#include <string_view>
 
 #include "framework/handle.h"
 #include "lua.hpp"
@@ -108,6 +109,10 @@ void RegisterDynamicsApi(lua_State* L);
 void RegisterIkApi(lua_State* L);
 void RegisterForceSensorApi(lua_State* L);
 void RegisterPaintApi(lua_State* L);
+
+// Pushes the plugin command `name` (registered in the world's
+// ModuleRegistry) as a function and returns true; false if there is none.
+bool PushPluginCommand(lua_State* L, std::string_view name);
 
 // Creates the global `sim` table and calls every Register...Api above.
 void RegisterAllApis(lua_State* L);

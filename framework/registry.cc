@@ -1,5 +1,7 @@
 #include "framework/registry.h"
 
+#include <cctype>
+
 #include "framework/calculation_module.h"
 #include "framework/dynamics_backend.h"
 #include "framework/error.h"
@@ -23,6 +25,26 @@ void ModuleRegistry::RegisterCalculation(ModuleInfo info, CalculationFactory fac
   info.kind = "calculation";
   calculation_.emplace_back(info.name, std::move(factory));
   modules_.push_back(std::move(info));
+}
+
+void ModuleRegistry::RegisterScriptCommand(ModuleInfo info, ScriptCommand command) {
+  const std::string& n = command.name;
+  const bool identifier =
+      !n.empty() && !std::isdigit(static_cast<unsigned char>(n[0])) &&
+      n.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") ==
+          std::string::npos;
+  if (!identifier) throw Error("script command name '" + n + "' is not a Lua identifier");
+  if (FindScriptCommand(n) != nullptr)
+    throw Error("script command '" + n + "' is registered twice");
+  info.kind = "command";
+  modules_.push_back(std::move(info));
+  commands_.push_back(std::make_shared<const ScriptCommand>(std::move(command)));
+}
+
+const ScriptCommand* ModuleRegistry::FindScriptCommand(std::string_view name) const {
+  for (const auto& c : commands_)
+    if (c->name == name) return c.get();
+  return nullptr;
 }
 
 template <typename Factories>

@@ -8,13 +8,24 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
+
+#include "framework/plugin_api.h"
 
 namespace swarmsim {
 
 class CalculationModule;
 class DynamicsBackend;
 class ProximityBackend;
+
+// A script command registered by a plugin (framework/plugin_api.h): sim.<name>.
+struct ScriptCommand {
+  std::string name;
+  std::string description;
+  SwarmsimCommand function = nullptr;
+  void* user_data = nullptr;
+};
 
 struct ModuleInfo {
   std::string kind;  // "dynamics", "proximity", ...
@@ -33,6 +44,11 @@ class ModuleRegistry {
   void RegisterProximity(ModuleInfo info, ProximityFactory factory);
   // Calculation modules (IK groups, ...): kind "calculation".
   void RegisterCalculation(ModuleInfo info, CalculationFactory factory);
+  // Script commands (plugins): kind "command". Throws swarmsim::Error if the
+  // name is not a Lua identifier or is already a command.
+  void RegisterScriptCommand(ModuleInfo info, ScriptCommand command);
+  // Null if no command has that name.
+  const ScriptCommand* FindScriptCommand(std::string_view name) const;
 
   // Throw swarmsim::Error listing what is available when `name` is unknown.
   std::unique_ptr<DynamicsBackend> MakeDynamics(const std::string& name) const;
@@ -48,6 +64,7 @@ class ModuleRegistry {
   std::vector<std::pair<std::string, DynamicsFactory>> dynamics_;
   std::vector<std::pair<std::string, ProximityFactory>> proximity_;
   std::vector<std::pair<std::string, CalculationFactory>> calculation_;
+  std::vector<std::shared_ptr<const ScriptCommand>> commands_;  // stable addresses (Lua keeps pointers)
 };
 
 }  // namespace swarmsim

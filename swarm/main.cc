@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "framework/error.h"
+#include "framework/plugin_loader.h"
 #include "framework/registry.h"
 #include "modules/builtin.h"
 #include "swarm/bench.h"
@@ -105,6 +106,7 @@ int Main(int argc, char** argv) {
   std::string out_dir;
   bool hash = false, quiet = false;
   bool trust_scripts = false;
+  std::vector<std::string> plugins;
   run->add_option("world", world_file, "World file (YAML)")->required();
   auto* steps_opt = run->add_option("--steps", steps, "Number of control steps to run")
                         ->check(kNonNegative);
@@ -119,6 +121,8 @@ int Main(int argc, char** argv) {
   run->add_option("--out", out_dir, "Write summary.json and metrics.csv to this folder");
   run->add_flag("--hash", hash, "Print the final state hash");
   run->add_flag("--quiet", quiet, "No progress bar and no summary table");
+  run->add_option("--plugin", plugins, "Load a plugin (shared library) before the world")
+      ->allow_extra_args(false);
   run->add_flag("--trust-scripts", trust_scripts,
                 "Lift the script sandbox: full Lua libraries (os, io, debug, package)");
 
@@ -284,6 +288,7 @@ int Main(int argc, char** argv) {
   load.trust_scripts = trust_scripts;
   LoadedWorld loaded;
   try {
+    for (const std::string& plugin : plugins) LoadPlugin(plugin, &registry);
     loaded = LoadWorld(world_file, load, registry);
   } catch (const Error& e) {
     std::cerr << "error: " << e.what() << "\n";

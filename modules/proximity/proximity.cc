@@ -170,8 +170,8 @@ class OctreeGridProximity final : public ProximityBackend {
 
 swarmsim::ModuleInfo ModuleInfo() {
   return {"proximity", "proximity", "1.0.0",
-          "ray proximity sensors: exact distances to boxes, cylinders and spheres; static "
-          "environment in an OctoMap octree, robots through a spatial grid"};
+          "ray proximity sensors: exact distances to boxes, cylinders, spheres and triangle "
+          "meshes; static environment in an OctoMap octree, robots through a spatial grid"};
 }
 
 std::unique_ptr<ProximityBackend> MakeBackend() { return std::make_unique<OctreeGridProximity>(); }

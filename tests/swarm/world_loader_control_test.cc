@@ -40,7 +40,7 @@ class ControlLoaderTest : public ::testing::Test {
           "objects: {name: body, type: dummy, script: bot.lua}\n");
     Write("bot.lua", "function sysCall_init() end\n");
     Write("main.lua", "function sysCall_step() sim.handleDynamics() end\n");
-    registry_.RegisterDynamics({"", "null", "1", "test"},
+    registry_.RegisterDynamics({"", "kinematic", "1", "test"},
                                [] { return std::make_unique<testing::NullDynamics>(); });
     registry_.RegisterProximity({"", "proximity", "1", "test"},
                                 [] { return std::make_unique<testing::NullProximity>(); });
@@ -64,7 +64,7 @@ class ControlLoaderTest : public ::testing::Test {
 };
 
 const char kThree[] =
-    "simulation: {physics: null}\n"
+    "simulation: {physics: kinematic}\n"
     "models:\n"
     "  - model: bot.yaml\n"
     "    count: 3\n"
@@ -75,20 +75,20 @@ const char kThree[] =
 
 TEST_F(ControlLoaderTest, SimulationControlKeys) {
   LoadedWorld w = Load(
-      "simulation: {physics: null, main_script: main.lua, instruction_budget: 5000, "
+      "simulation: {physics: kinematic, main_script: main.lua, instruction_budget: 5000, "
       "on_script_error: disable_script}\n");
   EXPECT_EQ(w.world->settings().instruction_budget, 5000);
   EXPECT_EQ(w.world->settings().on_script_error, ScriptErrorPolicy::kDisableScript);
   ASSERT_TRUE(w.world->settings().main_script);
   EXPECT_CONTAINS(w.world->settings().main_script->code, "sim.handleDynamics()");
-  LoadedWorld d = Load("simulation: {physics: null}\n");
+  LoadedWorld d = Load("simulation: {physics: kinematic}\n");
   EXPECT_EQ(d.world->settings().on_script_error, ScriptErrorPolicy::kStop);
   EXPECT_FALSE(d.world->settings().main_script);
-  EXPECT_CONTAINS(ErrorOf("simulation: {physics: null, on_script_error: ignore}\n"),
-                  "world.yaml:1:48:");
-  EXPECT_CONTAINS(ErrorOf("simulation: {physics: null, instruction_budget: -1}\n"),
+  EXPECT_CONTAINS(ErrorOf("simulation: {physics: kinematic, on_script_error: ignore}\n"),
                   "world.yaml:1:51:");
-  EXPECT_CONTAINS(ErrorOf("simulation: {physics: null, main_script: nothere.lua}\n"),
+  EXPECT_CONTAINS(ErrorOf("simulation: {physics: kinematic, instruction_budget: -1}\n"),
+                  "world.yaml:1:54:");
+  EXPECT_CONTAINS(ErrorOf("simulation: {physics: kinematic, main_script: nothere.lua}\n"),
                   "nothere.lua");
 }
 
@@ -111,7 +111,7 @@ TEST_F(ControlLoaderTest, PerCopyParametersOverrideTheEntrysAndSetAppliesToAll) 
 TEST_F(ControlLoaderTest, RangesAndInstanceMistakesNameFileLineAndColumn) {
   std::string bad = kThree;
   bad.replace(bad.find("speed: 0.4"), 10, "speed: 0.9");
-  EXPECT_CONTAINS(ErrorOf(bad), "world.yaml:8:42: parameter 'speed' of model 'bot' must be within "
+  EXPECT_CONTAINS(ErrorOf(bad), "world.yaml:8:40: parameter 'speed' of model 'bot' must be within "
                                 "[0, 0.5] m/s (got 0.9)");
   bad = kThree;
   bad.replace(bad.find("index: 1"), 8, "index: 3");
@@ -125,7 +125,7 @@ TEST_F(ControlLoaderTest, RangesAndInstanceMistakesNameFileLineAndColumn) {
                                         "must be within [0, 0.5]");
   Write("bot.yaml", "model: bot\nparameters:\n  speed: {default: 0.1, range: [1]}\n"
                     "objects: {name: body, type: dummy}\n");
-  EXPECT_CONTAINS(ErrorOf(kThree), "bot.yaml:3:37: 'range' must be [min, max]");
+  EXPECT_CONTAINS(ErrorOf(kThree), "bot.yaml:3:32: 'range' must be [min, max]");
 }
 
 TEST_F(ControlLoaderTest, DescribeListsModelsParametersAndScripts) {

@@ -446,6 +446,7 @@ void PlaneWorld::Build(const Scene& scene) {
     // pressure resists turning with 2/3 mu m g r).
     b2FrictionJointDef def;
     def.Initialize(ground_, body.body, body.body->GetWorldCenter());
+    def.collideConnected = true;  // the obstacles are ground fixtures: still walls to it
     const double force = shape.friction * shape.mass * g;
     def.maxForce = static_cast<float>(force * L);
     def.maxTorque = static_cast<float>(2.0 / 3.0 * force * FootprintRadius(shape) * L * L);

@@ -47,7 +47,13 @@
 // quickstep solver) is process-global: Build seeds it with Options::seed, so
 // a run is repeatable, but two ODE worlds stepped concurrently in one process
 // are not (sweeps use processes). The scene's thread count does not matter:
-// the physics phase runs on one thread.
+// the physics phase runs on one thread. That matters for meshes too: Debian's
+// ODE trimesh collision (OPCODE) is not thread-safe.
+//
+// Meshes. A mesh shape is a dTriMesh geom; its trimesh data is made once per
+// asset per world and reads the shared asset's arrays in place. A dynamic
+// mesh's mass sits at the shape's origin, with its bounding box's inertia
+// about that origin (ode_world.cc, CalcMass).
 #pragma once
 
 #include <cstdint>

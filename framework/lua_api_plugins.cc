@@ -1,0 +1,103 @@
+// Plugin script commands (framework/plugin_api.h) as sim.* functions: the
+// arguments and results cross as SwarmsimValue, never as Lua values.
+#include <string>
+#include <vector>
+
+#include "framework/lua_api.h"
+#include "framework/registry.h"
+#include "framework/world.h"
+
+namespace swarmsim {
+namespace {
+
+constexpr int kMaxResults = 16;
+
+double WorldTime(void* world) { return static_cast<World*>(world)->time(); }
+
+int ObjectPosition(void* world, int64_t object, double out[3]) {
+  const Scene& scene = static_cast<World*>(world)->scene();
+  const ObjectId id = ObjectId::FromInteger(object);
+  if (!scene.IsValid(id)) return 0;
+  const Vec3 p = scene.world_pose(id).p;
+  out[0] = p.x, out[1] = p.y, out[2] = p.z;
+  return 1;
+}
+
+int NumberParameter(void* world, int robot, const char* name, double* out) {
+  const ParamValue* v = static_cast<World*>(world)->FindParameter(robot, name);
+  if (v == nullptr || !std::holds_alternative<double>(*v)) return 0;
+  *out = std::get<double>(*v);
+  return 1;
+}
+
+constexpr SwarmsimWorldApi kWorldApi = {WorldTime, ObjectPosition, NumberParameter};
+
+// The closure every plugin command becomes; upvalue 1: its ScriptCommand.
+int CallPluginCommand(lua_State* L) {
+  const auto* command = static_cast<const ScriptCommand*>(lua_touserdata(L, lua_upvalueindex(1)));
+  LuaContext& c = Context(L);
+  const int n = lua_gettop(L);
+  std::vector<SwarmsimValue> args(n);
+  std::vector<std::vector<double>> arrays;
+  arrays.reserve(n);
+  for (int i = 1; i <= n; ++i) {
+    SwarmsimValue& v = args[i - 1];
+    v = {};
+    switch (lua_type(L, i)) {
+      case LUA_TNIL: break;
+      case LUA_TNUMBER: v.type = kSwarmsimNumber, v.number = lua_tonumber(L, i); break;
+      case LUA_TBOOLEAN: v.type = kSwarmsimNumber, v.number = lua_toboolean(L, i); break;
+      case LUA_TSTRING: v.type = kSwarmsimString, v.text = lua_tolstring(L, i, &v.size); break;
+      case LUA_TTABLE: {
+        std::vector<double>& a = arrays.emplace_back(luaL_len(L, i));
+        for (size_t k = 0; k < a.size(); ++k) {
+          lua_rawgeti(L, i, static_cast<lua_Integer>(k + 1));
+          if (!lua_isnumber(L, -1))
+            RaiseError(L, "sim." + command->name + ": argument " + std::to_string(i) +
+                              " must be an array of numbers");
+          a[k] = lua_tonumber(L, -1);
+          lua_pop(L, 1);
+        }
+        v.type = kSwarmsimNumbers, v.numbers = a.data(), v.size = a.size();
+        break;
+      }
+      default:
+        RaiseError(L, "sim." + command->name + ": argument " + std::to_string(i) +
+                          " must be a number, string or array of numbers, got " +
+                          luaL_typename(L, i));
+    }
+  }
+  const SwarmsimCallContext context{c.instance,
+                                    c.script_object.IsNull() ? 0 : c.script_object.ToInteger(),
+                                    c.world, &kWorldApi};
+  SwarmsimValue results[kMaxResults] = {};
+  char error[512] = {0};
+  const int count = command->function(&context, args.data(), n, results, kMaxResults, error,
+                                      sizeof error, command->user_data);
+  if (count < 0 || count > kMaxResults)
+    RaiseError(L, "sim." + command->name + ": " + (error[0] ? error : "the plugin command failed"));
+  for (int i = 0; i < count; ++i) {
+    const SwarmsimValue& r = results[i];
+    switch (r.type) {
+      case kSwarmsimNumber: lua_pushnumber(L, r.number); break;
+      case kSwarmsimString: lua_pushlstring(L, r.text != nullptr ? r.text : "", r.size); break;
+      case kSwarmsimNumbers: PushNumberArray(L, r.numbers, static_cast<int>(r.size)); break;
+      default: lua_pushnil(L); break;
+    }
+  }
+  return count;
+}
+
+}  // namespace
+
+bool PushPluginCommand(lua_State* L, std::string_view name) {
+  const LuaContext& c = Context(L);
+  if (c.world == nullptr) return false;
+  const ScriptCommand* command = c.world->registry().FindScriptCommand(name);
+  if (command == nullptr) return false;
+  lua_pushlightuserdata(L, const_cast<ScriptCommand*>(command));
+  lua_pushcclosure(L, CallPluginCommand, 1);
+  return true;
+}
+
+}  // namespace swarmsim

@@ -1,0 +1,77 @@
+// Plugins: the example plugin's commands called from Lua through the
+// registry; clear errors for a missing file, a library that is not a
+// plugin, and an ABI mismatch.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "framework/error.h"
+#include "framework/plugin_loader.h"
+#include "framework/world.h"
+#include "tests/framework/fakes.h"
+
+namespace swarmsim {
+namespace {
+
+#define EXPECT_CONTAINS(haystack, needle) \
+  EXPECT_NE(std::string(haystack).find(needle), std::string::npos) << (haystack)
+
+std::string PluginPath(const std::string& name) {
+  return (std::filesystem::path(SWARMSIM_BINARY).parent_path() / "plugins" / name).string();
+}
+
+template <typename F>
+std::string ErrorOf(F&& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "NO ERROR";
+}
+
+TEST(PluginTest, CommandsAreCalledFromLuaWithNumbersArraysAndContext) {
+  ModuleRegistry registry = testing::NullRegistry();
+  LoadPlugin(PluginPath("example_plugin.so"), &registry);
+  ASSERT_NE(registry.FindScriptCommand("exampleSum"), nullptr);
+  WorldSettings settings;
+  settings.physics = "null";
+  World world(settings, registry);
+  std::vector<std::string> log;
+  world.set_log_sink([&](std::string_view line) { log.emplace_back(line); });
+  for (int r = 0; r < 2; ++r) {
+    const ObjectId root = world.scene().AddDummy("bot", {}, {{1.0 + r, 2, 0}, {}});
+    world.scene().MakeModelInstance(root, "bot", "bot#" + std::to_string(r));
+    world.scene().AttachScript(root, std::make_shared<const ScriptSource>(ScriptSource{
+                                         "robot.lua", R"(
+function sysCall_actuation()
+  local p, robot = sim.exampleWhereAmI()
+  print(sim.exampleSum(1, 2, {3, 4}), p[1], p[2], robot)
+  sim.exampleSum('x')
+end)"}));
+  }
+  world.Start();
+  const std::string error = ErrorOf([&] { world.Step(); });
+  EXPECT_CONTAINS(error, "bot#0: robot.lua:5: sim.exampleSum: argument 1 must be a number");
+  const std::vector<std::string> expected = {"[bot#0] 10.0\t1.0\t2.0\t0.0",
+                                             "[bot#1] 10.0\t2.0\t2.0\t1.0"};
+  EXPECT_EQ(log, expected);
+}
+
+TEST(PluginTest, LoadErrorsNameThePathAndTheProblem) {
+  ModuleRegistry registry;
+  EXPECT_CONTAINS(ErrorOf([&] { LoadPlugin("/nonexistent/p.so", &registry); }),
+                  "cannot load plugin '/nonexistent/p.so': ");
+  EXPECT_CONTAINS(ErrorOf([&] { LoadPlugin(PluginPath("wrong_abi_plugin.so"), &registry); }),
+                  "was built for plugin ABI version 2, this swarmsim has version 1");
+  EXPECT_CONTAINS(ErrorOf([&] { LoadPlugin("libm.so.6", &registry); }), "cannot load plugin");
+  LoadPlugin(PluginPath("example_plugin.so"), &registry);
+  EXPECT_CONTAINS(ErrorOf([&] { LoadPlugin(PluginPath("example_plugin.so"), &registry); }),
+                  "script command 'exampleSum' is registered twice");
+}
+
+}  // namespace
+}  // namespace swarmsim
