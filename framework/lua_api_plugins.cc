@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "framework/lua_api.h"
+#include "framework/plugin_world_api.h"
 #include "framework/registry.h"
 #include "framework/world.h"
 
@@ -11,26 +12,6 @@ namespace swarmsim {
 namespace {
 
 constexpr int kMaxResults = 16;
-
-double WorldTime(void* world) { return static_cast<World*>(world)->time(); }
-
-int ObjectPosition(void* world, int64_t object, double out[3]) {
-  const Scene& scene = static_cast<World*>(world)->scene();
-  const ObjectId id = ObjectId::FromInteger(object);
-  if (!scene.IsValid(id)) return 0;
-  const Vec3 p = scene.world_pose(id).p;
-  out[0] = p.x, out[1] = p.y, out[2] = p.z;
-  return 1;
-}
-
-int NumberParameter(void* world, int robot, const char* name, double* out) {
-  const ParamValue* v = static_cast<World*>(world)->FindParameter(robot, name);
-  if (v == nullptr || !std::holds_alternative<double>(*v)) return 0;
-  *out = std::get<double>(*v);
-  return 1;
-}
-
-constexpr SwarmsimWorldApi kWorldApi = {WorldTime, ObjectPosition, NumberParameter};
 
 // The closure every plugin command becomes; upvalue 1: its ScriptCommand.
 int CallPluginCommand(lua_State* L) {
@@ -69,7 +50,7 @@ int CallPluginCommand(lua_State* L) {
   }
   const SwarmsimCallContext context{c.instance,
                                     c.script_object.IsNull() ? 0 : c.script_object.ToInteger(),
-                                    c.world, &kWorldApi};
+                                    c.world, PluginWorldApi()};
   SwarmsimValue results[kMaxResults] = {};
   char error[512] = {0};
   const int count = command->function(&context, args.data(), n, results, kMaxResults, error,

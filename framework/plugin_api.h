@@ -7,7 +7,8 @@
 //   extern "C" int swarmsim_plugin_register(const SwarmsimRegistrar* r) { ...; return 0; }
 //
 // and registers script commands through the registrar: a command `name`
-// is called from Lua as sim.name(...). Arguments and results are numbers,
+// is called from Lua as sim.name(...); and per-phase callbacks, which the
+// world runs at fixed points of each step (SwarmsimPhase). Arguments and results are numbers,
 // strings and number arrays (SwarmsimValue); no Lua type crosses this
 // interface. Everything here is plain C, so a plugin built with another
 // compiler works as long as the ABI version matches; the version changes
@@ -18,7 +19,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#define SWARMSIM_PLUGIN_ABI_VERSION 1
+#define SWARMSIM_PLUGIN_ABI_VERSION 2
 
 #ifdef __cplusplus
 extern "C" {
@@ -44,6 +45,22 @@ typedef struct SwarmsimWorldApi {
   int (*object_position)(void* world, int64_t object, double out[3]);
   // A number parameter as sim.getParam sees it for `robot`; returns 0 if none.
   int (*number_parameter)(void* world, int robot, const char* name, double* out);
+  // --- ABI 2 ---
+  // Object `path` (sim.getObject syntax: "./a", ":/a", "/a/b", "name[k]") relative
+  // to object `from` (0: absolute paths only) into *out; returns 0 if none.
+  int (*find_object)(void* world, int64_t from, const char* path, int64_t* out);
+  // Model root of robot `robot`; 0 if there is no such live robot.
+  int64_t (*robot_root)(void* world, int robot);
+  // Last reading of a proximity sensor: 1 and the distance (m) if it detects
+  // something, 0 if not, -1 if `sensor` is not a proximity sensor.
+  int (*read_proximity_sensor)(void* world, int64_t sensor, double* distance);
+  // Sets a velocity-mode joint's target velocity (rad/s or m/s). `robot` must
+  // be the caller's (a command passes context->robot; a phase callback may act
+  // for any robot) and own the joint; returns 0 otherwise.
+  int (*set_joint_target_velocity)(void* world, int robot, int64_t joint, double velocity);
+  // Step count and number of robots (robot indices are 0..count-1).
+  int64_t (*step_count)(void* world);
+  int (*robot_count)(void* world);
 } SwarmsimWorldApi;
 
 // Who is calling: the robot and the script's object.
@@ -62,6 +79,25 @@ typedef int (*SwarmsimCommand)(const SwarmsimCallContext* context, const Swarmsi
                                int arg_count, SwarmsimValue* results, int max_results,
                                char* error, size_t error_size, void* user_data);
 
+// Points of a step where a plugin's phase callbacks run (ABI 2). With a
+// world's own main script, "control" means each sim.handleChildScripts call
+// and "physics" sim.handleDynamics.
+enum SwarmsimPhase {
+  kSwarmsimAfterSense = 0,     // sensors have read the state
+  kSwarmsimBeforeControl = 1,  // before the child scripts run
+  kSwarmsimAfterControl = 2,   // after them, before deferred writes and joint motion
+  kSwarmsimAfterPhysics = 3,   // after the dynamics step (poses are current)
+  kSwarmsimPhaseCount = 4
+};
+
+// A phase callback. Whole-world callbacks run once per phase on the calling
+// thread with context->robot == -1; per-robot ones run once for every live
+// robot, robots concurrently (context->robot is the robot; touch only its
+// objects). Return 0, or -1 after writing a message into `error`: the run
+// stops with it.
+typedef int (*SwarmsimPhaseCallback)(const SwarmsimCallContext* context, char* error,
+                                     size_t error_size, void* user_data);
+
 typedef struct SwarmsimRegistrar {
   void* impl;
   // Registers sim.<name>; returns 0, or -1 if the name is taken or invalid.
@@ -69,6 +105,12 @@ typedef struct SwarmsimRegistrar {
                      SwarmsimCommand command, void* user_data);
   // The plugin's name, version and one-line description (swarmsim modules).
   void (*set_info)(void* impl, const char* name, const char* version, const char* description);
+  // --- ABI 2 ---
+  // Registers a callback for `phase` (SwarmsimPhase); per_robot: see
+  // SwarmsimPhaseCallback. Callbacks of one phase run in registration order.
+  // Returns 0, or -1 for an unknown phase or a null callback.
+  int (*add_phase_callback)(void* impl, int phase, int per_robot, SwarmsimPhaseCallback callback,
+                            void* user_data);
 } SwarmsimRegistrar;
 
 // The two entry points a plugin exports.

@@ -2,6 +2,8 @@
 
 #include <dlfcn.h>
 
+#include <filesystem>
+
 #include "framework/error.h"
 #include "framework/plugin_api.h"
 #include "framework/registry.h"
@@ -13,8 +15,30 @@ namespace {
 struct Registration {
   ModuleInfo info;
   std::vector<ScriptCommand> commands;
+  std::vector<PhaseCallback> callbacks;
   std::string error;
 };
+
+const char* PhaseName(int phase) {
+  switch (phase) {
+    case kSwarmsimAfterSense: return "after_sense";
+    case kSwarmsimBeforeControl: return "before_control";
+    case kSwarmsimAfterControl: return "after_control";
+    case kSwarmsimAfterPhysics: return "after_physics";
+  }
+  return "?";
+}
+
+int AddPhaseCallback(void* impl, int phase, int per_robot, SwarmsimPhaseCallback callback,
+                     void* user_data) {
+  auto* r = static_cast<Registration*>(impl);
+  if (phase < 0 || phase >= kSwarmsimPhaseCount || callback == nullptr) {
+    r->error = "add_phase_callback needs a phase (SwarmsimPhase) and a function";
+    return -1;
+  }
+  r->callbacks.push_back({PhaseName(phase), phase, per_robot != 0, callback, user_data});
+  return 0;
+}
 
 int AddCommand(void* impl, const char* name, const char* description, SwarmsimCommand command,
                void* user_data) {
@@ -59,7 +83,7 @@ void LoadPlugin(const std::string& path, ModuleRegistry* registry) {
   Registration r;
   r.info.name.assign(path);
   r.info.version.assign("unversioned");
-  const SwarmsimRegistrar registrar{&r, AddCommand, SetInfo};
+  const SwarmsimRegistrar registrar{&r, AddCommand, SetInfo, AddPhaseCallback};
   if (do_register(&registrar) != 0 || !r.error.empty()) {
     std::string message = "plugin '" + path + "' failed to register";
     if (!r.error.empty()) message.append(": ").append(r.error);
@@ -75,6 +99,17 @@ void LoadPlugin(const std::string& path, ModuleRegistry* registry) {
       throw Error("plugin '" + path + "': " + e.what());
     }
   }
+  for (PhaseCallback& callback : r.callbacks) {
+    ModuleInfo info = r.info;
+    info.name = r.info.name + ":" + callback.name;
+    info.description = std::string(callback.per_robot ? "per-robot" : "whole-world") +
+                       " callback, " + callback.name;
+    callback.name = info.name;
+    registry->RegisterPhaseCallback(info, std::move(callback));
+  }
+  std::error_code ec;
+  const std::filesystem::path canonical = std::filesystem::weakly_canonical(name, ec);
+  registry->AddPluginPath(ec ? name : canonical.string());
 }
 
 }  // namespace swarmsim

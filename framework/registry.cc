@@ -47,6 +47,20 @@ const ScriptCommand* ModuleRegistry::FindScriptCommand(std::string_view name) co
   return nullptr;
 }
 
+void ModuleRegistry::RegisterPhaseCallback(ModuleInfo info, PhaseCallback callback) {
+  if (callback.phase < 0 || callback.phase >= kSwarmsimPhaseCount || callback.function == nullptr)
+    throw Error("phase callback '" + callback.name + "' has an unknown phase or no function");
+  info.kind = "callback";
+  modules_.push_back(std::move(info));
+  phase_callbacks_.push_back(std::move(callback));
+}
+
+bool ModuleRegistry::HasPlugin(std::string_view path) const {
+  for (const std::string& p : plugin_paths_)
+    if (p == path) return true;
+  return false;
+}
+
 template <typename Factories>
 static std::string Known(const Factories& factories) {
   std::string out;

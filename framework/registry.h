@@ -27,6 +27,15 @@ struct ScriptCommand {
   void* user_data = nullptr;
 };
 
+// A per-phase callback registered by a plugin (framework/plugin_api.h).
+struct PhaseCallback {
+  std::string name;  // "plugin:phase", for messages
+  int phase = 0;     // SwarmsimPhase
+  bool per_robot = false;
+  SwarmsimPhaseCallback function = nullptr;
+  void* user_data = nullptr;
+};
+
 struct ModuleInfo {
   std::string kind;  // "dynamics", "proximity", ...
   std::string name;  // e.g. "box2d"
@@ -49,6 +58,12 @@ class ModuleRegistry {
   void RegisterScriptCommand(ModuleInfo info, ScriptCommand command);
   // Null if no command has that name.
   const ScriptCommand* FindScriptCommand(std::string_view name) const;
+  // Phase callbacks (plugins): kind "callback".
+  void RegisterPhaseCallback(ModuleInfo info, PhaseCallback callback);
+  const std::vector<PhaseCallback>& phase_callbacks() const { return phase_callbacks_; }
+  // Plugins loaded into this registry, by canonical path (LoadPlugin records them).
+  void AddPluginPath(std::string path) { plugin_paths_.push_back(std::move(path)); }
+  bool HasPlugin(std::string_view path) const;
 
   // Throw swarmsim::Error listing what is available when `name` is unknown.
   std::unique_ptr<DynamicsBackend> MakeDynamics(const std::string& name) const;
@@ -65,6 +80,8 @@ class ModuleRegistry {
   std::vector<std::pair<std::string, ProximityFactory>> proximity_;
   std::vector<std::pair<std::string, CalculationFactory>> calculation_;
   std::vector<std::shared_ptr<const ScriptCommand>> commands_;  // stable addresses (Lua keeps pointers)
+  std::vector<PhaseCallback> phase_callbacks_;
+  std::vector<std::string> plugin_paths_;
 };
 
 }  // namespace swarmsim

@@ -8,6 +8,7 @@
 #include "framework/calculation_module.h"
 #include "framework/dynamics_backend.h"
 #include "framework/error.h"
+#include "framework/plugin_world_api.h"
 #include "framework/proximity_backend.h"
 #include "framework/registry.h"
 #include "framework/scheduler.h"
@@ -78,6 +79,43 @@ World::World(const WorldSettings& settings, const ModuleRegistry& registry)
   if (settings_.physics_substeps < 1) throw Error("physics substeps must be at least 1");
   // Validate the backend name now, so a typo fails before any work is done.
   if (!registry_.HasDynamics(settings_.physics)) registry_.MakeDynamics(settings_.physics);
+  for (const PhaseCallback& callback : registry_.phase_callbacks())
+    phase_callbacks_.at(callback.phase).push_back(&callback);
+}
+
+World::World(const WorldSettings& settings, std::shared_ptr<const ModuleRegistry> registry)
+    : World(settings, *registry) {
+  owned_registry_ = std::move(registry);
+}
+
+void World::CallPhaseCallbacks(int phase) {
+  // Whole-world callbacks on this thread, per-robot ones fanned out over the
+  // robots; the lowest robot's error wins, whatever the thread count.
+  auto call = [&](const PhaseCallback& callback, int robot, std::string* error) {
+    const SwarmsimCallContext context{robot, 0, this, PluginWorldApi()};
+    char message[512] = {0};
+    if (callback.function(&context, message, sizeof message, callback.user_data) != 0)
+      *error = callback.name + (robot >= 0 ? " (robot " + scene_.instance(robot).name + ")" : "") +
+               ": " + (message[0] ? message : "the plugin callback failed");
+  };
+  for (const PhaseCallback* callback : phase_callbacks_[phase]) {
+    std::string error;
+    if (!callback->per_robot) {
+      call(*callback, -1, &error);
+    } else {
+      const auto& instances = scene_.instances();
+      std::vector<std::string> errors(instances.size());
+      scheduler_->ParallelFor(0, static_cast<int64_t>(instances.size()), kRobotGrain,
+                              [&](int64_t begin, int64_t end) {
+                                for (int64_t r = begin; r < end; ++r)
+                                  if (instances[r].alive)
+                                    call(*callback, static_cast<int>(r), &errors[r]);
+                              });
+      for (std::string& e : errors)
+        if (!e.empty() && error.empty()) error = std::move(e);
+    }
+    if (!error.empty()) throw Error(error);
+  }
 }
 
 World::~World() {
@@ -213,6 +251,7 @@ void World::Sense() {
                                 proximity_->SenseInstance(&scene_, static_cast<int>(r));
                           });
   proximity_->SenseSceneSensors(&scene_);
+  RunPhaseCallbacks(kSwarmsimAfterSense);
 }
 
 void World::HandleSensing() {
@@ -238,6 +277,7 @@ void World::HandleDynamics() {
 }
 
 void World::Control(ScriptPass pass) {
+  RunPhaseCallbacks(kSwarmsimBeforeControl);
   const auto& instances = scene_.instances();
   scheduler_->ParallelFor(0, static_cast<int64_t>(instances.size()), kRobotGrain,
                           [&](int64_t begin, int64_t end) {
@@ -256,6 +296,7 @@ void World::Control(ScriptPass pass) {
     scene_runtime_.error = e.what();
   }
   FlushRobotBuffers();
+  RunPhaseCallbacks(kSwarmsimAfterControl);
 }
 
 void World::FlushRobotBuffers() {
@@ -352,6 +393,7 @@ void World::Physics() {
                   "' at step " + std::to_string(step_count_) +
                   " (check masses, sizes and joint targets)");
   }
+  RunPhaseCallbacks(kSwarmsimAfterPhysics);
 }
 
 void World::Record() {

@@ -24,6 +24,7 @@ namespace swarmsim {
 class CalculationModule;
 class DynamicsBackend;
 class ModuleRegistry;
+struct PhaseCallback;
 class ProximityBackend;
 class ScriptHost;
 class TaskScheduler;
@@ -138,6 +139,9 @@ using PhaseTimes = std::array<double, static_cast<size_t>(Phase::kCount)>;
 class World {
  public:
   World(const WorldSettings& settings, const ModuleRegistry& registry);
+  // Same, keeping `registry` alive as long as the world (a world file's
+  // plugins register into a registry of the world's own).
+  World(const WorldSettings& settings, std::shared_ptr<const ModuleRegistry> registry);
   ~World();
   World(const World&) = delete;
   World& operator=(const World&) = delete;
@@ -229,9 +233,16 @@ class World {
   void EnsureRuntimes();
   void DeliverMessages();  // world_messages.cc
   void FlushRobotBuffers();
+  // Plugin phase callbacks (SwarmsimPhase); nothing at all when none is registered.
+  void RunPhaseCallbacks(int phase) {
+    if (!phase_callbacks_[phase].empty()) CallPhaseCallbacks(phase);
+  }
+  void CallPhaseCallbacks(int phase);
 
   WorldSettings settings_;
   const ModuleRegistry& registry_;
+  std::shared_ptr<const ModuleRegistry> owned_registry_;  // null unless given by shared_ptr
+  std::array<std::vector<const PhaseCallback*>, 4> phase_callbacks_;  // by SwarmsimPhase
   Scene scene_;
   ParameterSet parameters_;
   std::unique_ptr<TaskScheduler> scheduler_;

@@ -44,6 +44,15 @@ const CLI::Validator kPositive = NumberCheck(false);
 constexpr int kExitRunError = 1;  // the run failed (script error, physics, outputs)
 constexpr int kExitBadInput = 2;  // bad command line or world file
 
+// Where a world's `plugins: [name]` are looked for: plugins/ beside the
+// program (the build tree), and lib/swarmsim/plugins of an installed one.
+std::vector<std::filesystem::path> PluginDirectories() {
+  std::error_code ec;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (ec) return {};
+  return {exe.parent_path() / "plugins", exe.parent_path().parent_path() / "lib/swarmsim/plugins"};
+}
+
 std::vector<std::pair<std::string, std::string>> ParseSets(const std::vector<std::string>& sets) {
   std::vector<std::pair<std::string, std::string>> out;
   for (const std::string& s : sets) {
@@ -236,6 +245,7 @@ int Main(int argc, char** argv) {
   if (*describe) {
     LoadOptions describe_load;
     describe_load.overrides = ParseSets(describe_sets);
+    describe_load.plugin_directories = PluginDirectories();
     try {
       const LoadedWorld w = LoadWorld(describe_world, describe_load, registry);
       PrintDescription(w, std::cout);
@@ -286,6 +296,7 @@ int Main(int argc, char** argv) {
   load.threads = threads;
   if (!out_dir.empty()) load.output_directory = out_dir;
   load.trust_scripts = trust_scripts;
+  load.plugin_directories = PluginDirectories();
   LoadedWorld loaded;
   try {
     for (const std::string& plugin : plugins) LoadPlugin(plugin, &registry);

@@ -5,6 +5,7 @@
 #include <map>
 
 #include "framework/error.h"
+#include "framework/plugin_loader.h"
 #include "framework/registry.h"
 #include "swarm/loader_ik.h"
 #include "swarm/loader_model.h"
@@ -29,7 +30,8 @@ constexpr int64_t kMaxCount = 1000000;  // copies per models entry
 constexpr double kDegToRad = M_PI / 180.0;
 
 const std::vector<std::string> kTopKeys = {"simulation", "parameters", "arena",
-                                           "obstacles",  "models",     "metrics", "paint"};
+                                           "obstacles",  "models",     "metrics", "paint",
+                                           "plugins"};
 
 // One --set, split into its target.
 struct Override {
@@ -124,6 +126,7 @@ class WorldLoader {
 
  private:
   void ReadParameters(const Fields& top);
+  std::shared_ptr<const ModuleRegistry> LoadPlugins(const Fields& top);
   void ReadModelEntries(const Fields& top);
   void CheckOverrides();
   WorldSettings ReadSimulation(const Fields& top, std::optional<int64_t>* steps);
@@ -180,7 +183,10 @@ LoadedWorld WorldLoader::Load() {
   LoadedWorld out;
   out.file = path_;
   WorldSettings settings = ReadSimulation(top, &out.steps);
-  out.world = std::make_unique<World>(settings, registry_);
+  if (std::shared_ptr<const ModuleRegistry> own = LoadPlugins(top))
+    out.world = std::make_unique<World>(settings, std::move(own));
+  else
+    out.world = std::make_unique<World>(settings, registry_);
   World* world = out.world.get();
   for (const auto& [name, value] : parameters_) world->parameters()[name] = value;
 
@@ -220,6 +226,44 @@ void WorldLoader::ReadParameters(const Fields& top) {
     parameters_[p.name] = value;
     parameter_fields_.emplace(p.name, p);
   }
+}
+
+// plugins: [name or path, ...]: a path (with '/' or ending in .so) is relative
+// to the world file; a bare name is NAME.so in the world's folder, then in
+// LoadOptions::plugin_directories. Null when the world names none.
+std::shared_ptr<const ModuleRegistry> WorldLoader::LoadPlugins(const Fields& top) {
+  const std::vector<Field> list = loader::ListElements(*file_, top.Get("plugins"), "plugins");
+  if (list.empty()) return nullptr;
+  auto registry = std::make_shared<ModuleRegistry>(registry_);
+  const ValueReader values = WorldValues();
+  for (const Field& element : list) {
+    const std::string text = values.String(element);
+    if (text.empty()) values.Fail(element, "a plugin must be a file or library name");
+    std::vector<fs::path> candidates;
+    if (text.find('/') != std::string::npos || text.ends_with(".so")) {
+      candidates.push_back(path_.parent_path() / text);
+    } else {
+      candidates.push_back(path_.parent_path() / (text + ".so"));
+      for (const fs::path& dir : options_.plugin_directories) candidates.push_back(dir / (text + ".so"));
+    }
+    std::error_code ec;
+    const auto found = std::find_if(candidates.begin(), candidates.end(),
+                                    [&](const fs::path& p) { return fs::is_regular_file(p, ec); });
+    if (found == candidates.end()) {
+      std::string tried;
+      for (const fs::path& p : candidates) tried += (tried.empty() ? "" : ", ") + p.string();
+      values.Fail(element, "plugin '" + text + "' not found (looked for " + tried + ")");
+    }
+    // Loaded already (--plugin): its commands are there.
+    const fs::path canonical = fs::weakly_canonical(*found, ec);
+    if (registry->HasPlugin(ec ? found->string() : canonical.string())) continue;
+    try {
+      LoadPlugin(found->string(), registry.get());
+    } catch (const Error& e) {
+      values.Fail(element, e.what());
+    }
+  }
+  return registry;
 }
 
 const ModelFile& WorldLoader::LoadModel(const Field& field, const std::string& text) {

@@ -34,6 +34,10 @@ struct LoadOptions {
   // --trust-scripts lifts the sandbox (WorldSettings).
   std::filesystem::path output_directory;
   bool trust_scripts = false;
+  // Folders searched for a plugin the world names without a path
+  // (`plugins: [example_plugin]` -> example_plugin.so); the program passes
+  // the `plugins/` folder beside its executable.
+  std::vector<std::filesystem::path> plugin_directories;
 };
 
 // What `swarmsim describe` lists about one `models:` entry.
@@ -63,7 +67,9 @@ struct LoadedWorld {
 };
 
 // Reads `file`, resolves parameters (after `options.overrides`), builds the
-// arena, obstacles and model copies, and adds the metrics. Throws
+// arena, obstacles and model copies, and adds the metrics. A world naming
+// `plugins` gets a registry of its own (a copy of `registry` plus the
+// plugins), which the World keeps alive. Throws
 // swarmsim::Error on any mistake in the files or the options.
 LoadedWorld LoadWorld(const std::filesystem::path& file, const LoadOptions& options,
                       const ModuleRegistry& registry);

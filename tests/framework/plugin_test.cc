@@ -66,11 +66,42 @@ TEST(PluginTest, LoadErrorsNameThePathAndTheProblem) {
   EXPECT_CONTAINS(ErrorOf([&] { LoadPlugin("/nonexistent/p.so", &registry); }),
                   "cannot load plugin '/nonexistent/p.so': ");
   EXPECT_CONTAINS(ErrorOf([&] { LoadPlugin(PluginPath("wrong_abi_plugin.so"), &registry); }),
-                  "was built for plugin ABI version 2, this swarmsim has version 1");
+                  "was built for plugin ABI version 3, this swarmsim has version 2");
   EXPECT_CONTAINS(ErrorOf([&] { LoadPlugin("libm.so.6", &registry); }), "cannot load plugin");
   LoadPlugin(PluginPath("example_plugin.so"), &registry);
   EXPECT_CONTAINS(ErrorOf([&] { LoadPlugin(PluginPath("example_plugin.so"), &registry); }),
                   "script command 'exampleSum' is registered twice");
+}
+
+TEST(PluginTest, PhaseCallbacksRunAtTheirPointsOfTheStep) {
+  ModuleRegistry registry = testing::NullRegistry();
+  LoadPlugin(PluginPath("example_plugin.so"), &registry);
+  EXPECT_EQ(registry.phase_callbacks().size(), 5u);  // Steer + 4 counters
+  WorldSettings settings;
+  settings.physics = "null";
+  World world(settings, registry);
+  std::vector<std::string> log;
+  world.set_log_sink([&](std::string_view line) { log.emplace_back(line); });
+  const ObjectId root = world.scene().AddDummy("bot", {}, {});
+  world.scene().MakeModelInstance(root, "bot", "bot#0");
+  world.scene().AttachScript(root, std::make_shared<const ScriptSource>(ScriptSource{"robot.lua", R"(
+function sysCall_actuation()
+  print(table.concat(sim.examplePhaseCounts(), ' '))
+end)"}));
+  for (int i = 0; i < 3; ++i) world.Step();
+  // In step k (from 0) the script runs after sense and before-control of
+  // step k, after control and physics of steps 0..k-1.
+  const std::vector<std::string> expected = {"[bot#0] 1.0 1.0 0.0 0.0", "[bot#0] 2.0 2.0 1.0 1.0",
+                                             "[bot#0] 3.0 3.0 2.0 2.0"};
+  EXPECT_EQ(log, expected);
+  // A robot without motors cannot use robotMoveAndAvoidObstacles.
+  World other(settings, registry);
+  const ObjectId bot = other.scene().AddDummy("bot", {}, {});
+  other.scene().MakeModelInstance(bot, "bot", "bot#0");
+  other.scene().AttachScript(bot, std::make_shared<const ScriptSource>(ScriptSource{
+                                      "robot.lua", "sim.robotMoveAndAvoidObstacles(1)"}));
+  EXPECT_CONTAINS(ErrorOf([&] { other.Start(); }),
+                  "sim.robotMoveAndAvoidObstacles: the robot has no :/leftMotor and :/rightMotor");
 }
 
 }  // namespace

@@ -1,8 +1,15 @@
 // The example worlds of issue 3: each runs, does what its README line says,
 // and gives the same state hash at 1, 2 and 4 threads.
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -54,6 +61,102 @@ TEST(ExamplesTest, FirefliesSynchroniseAndAreIndependentOfThreadCount) {
     for (size_t i = 0; i < one.metrics.size(); ++i)
       EXPECT_EQ(other.metrics[i].value, one.metrics[i].value) << i;
   }
+}
+
+// Values of one metric, in recorded order.
+std::vector<double> Values(const std::vector<MetricSample>& metrics, const std::string& name,
+                           int instance = -1) {
+  std::vector<double> out;
+  for (const MetricSample& m : metrics)
+    if (m.name == name && m.instance == instance) out.push_back(m.value);
+  return out;
+}
+
+TEST(ExamplesTest, FlockingAlignsHeadingsAndIsIndependentOfThreadCount) {
+  const WorldRun one = RunWorld("flocking.yaml", 1, 300);
+  const std::vector<double> alignment = Values(one.metrics, "alignment");
+  const std::vector<double> cohesion = Values(one.metrics, "cohesion");
+  // Step 0, then every 10 steps (the main script's samples of the last step
+  // are collected with the next step's).
+  ASSERT_GE(alignment.size(), 30u);
+  ASSERT_EQ(cohesion.size(), alignment.size());
+  // Random headings at the start; one direction after 30 s, still together.
+  EXPECT_LT(alignment.front(), 0.6);
+  EXPECT_GT(alignment.back(), 0.95);
+  EXPECT_LT(cohesion.back(), 1.5 * cohesion.front());
+  for (int threads : {2, 4}) {
+    const WorldRun other = RunWorld("flocking.yaml", threads, 300);
+    EXPECT_EQ(other.hash, one.hash) << threads << " threads";
+    EXPECT_EQ(Values(other.metrics, "alignment"), alignment) << threads << " threads";
+  }
+}
+
+TEST(ExamplesTest, ThreadedArmsCycleWithWaitsAndAreIndependentOfThreadCount) {
+  const WorldRun one = RunWorld("threaded_arms.yaml", 1, 600);
+  // A cycle takes 2 x 0.8 s (finger) + 2 x 0.5 s (holds) + 2 x pi/2 s
+  // (shoulder) = 5.74 s plus step rounding, after a 0..1 s start delay:
+  // every arm finishes 4 or 5 cycles in 30 s, numbered 1, 2, ...
+  for (int arm = 0; arm < 16; ++arm) {
+    const std::vector<double> cycles = Values(one.metrics, "cycles", arm);
+    ASSERT_GE(cycles.size(), 4u) << "arm " << arm;
+    ASSERT_LE(cycles.size(), 5u) << "arm " << arm;
+    for (size_t i = 0; i < cycles.size(); ++i) EXPECT_EQ(cycles[i], i + 1.0);
+  }
+  for (const MetricSample& m : one.metrics) {
+    if (m.value == 1) {
+      EXPECT_GE(m.time, 5.74) << m.instance;
+    }
+  }
+  for (int threads : {2, 4}) {
+    const WorldRun other = RunWorld("threaded_arms.yaml", threads, 600);
+    EXPECT_EQ(other.hash, one.hash) << threads << " threads";
+    ASSERT_EQ(other.metrics.size(), one.metrics.size());
+    for (size_t i = 0; i < one.metrics.size(); ++i)
+      EXPECT_EQ(other.metrics[i].step, one.metrics[i].step) << i;
+  }
+}
+
+// Runs the program; returns its exit status and standard output.
+std::pair<int, std::string> RunProgram(const std::string& args) {
+  const std::string cmd = std::string(SWARMSIM_BINARY) + " " + args + " 2>&1";
+  FILE* pipe = popen(cmd.c_str(), "r");
+  std::string out;
+  char buffer[4096];
+  while (size_t n = fread(buffer, 1, sizeof buffer, pipe)) out.append(buffer, n);
+  const int status = pclose(pipe);
+  return {WEXITSTATUS(status), out};
+}
+
+TEST(ExamplesTest, PluginDemoRunsThroughTheProgramWithTheWorldsPlugin) {
+  // plugins: [example_plugin] is found in plugins/ beside the program.
+  const std::string world = std::string(SWARMSIM_SOURCE_DIR) + "/worlds/plugin_demo.yaml";
+  const std::filesystem::path out =
+      std::filesystem::temp_directory_path() / ("swarmsim_plugin_demo_" + std::to_string(getpid()));
+  std::string hash;
+  for (int threads : {1, 2, 4}) {
+    const auto [status, text] = RunProgram("run " + world + " --quiet --hash --threads " +
+                                           std::to_string(threads) + " --out " + out.string());
+    ASSERT_EQ(status, 0) << text;
+    const std::string line = text.substr(text.find("state-hash: "));
+    if (hash.empty()) hash = line;
+    EXPECT_EQ(line, hash) << threads << " threads";
+  }
+  // Each robot drove 5 legs of 5 s at 0.05 m/s, turning away from walls,
+  // the pillar and each other: after the last leg it is away from its start.
+  std::ifstream csv(out / "metrics.csv");
+  std::map<std::string, double> last;
+  std::string row;
+  while (std::getline(csv, row)) {
+    std::vector<std::string> cells;
+    std::stringstream ss(row);
+    for (std::string cell; std::getline(ss, cell, ',');) cells.push_back(cell);
+    if (cells.size() == 5 && cells[3] == "distance") last[cells[2]] = std::stod(cells[4]);
+  }
+  EXPECT_EQ(last.size(), 20u);
+  int away = 0;
+  for (const auto& [robot, distance] : last) away += distance > 0.1;
+  EXPECT_GE(away, 15);
+  std::filesystem::remove_all(out);
 }
 
 }  // namespace

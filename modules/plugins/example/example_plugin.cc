@@ -1,11 +1,35 @@
-// An example plugin (framework/plugin_api.h): two script commands.
+// An example plugin (framework/plugin_api.h).
+// Script commands:
 //   sim.exampleSum(a, b, ...) or sim.exampleSum({a, b, ...}) -> the sum
 //   sim.exampleWhereAmI() -> {x, y, z} of the calling script's object, and the robot index
+//   sim.robotMoveAndAvoidObstacles(duration [, speed]) -> end time (s)
+//       the paper's high-level command (V-REP §3.3): the calling robot drives
+//       at `speed` m/s (default: its wheel_speed parameter, else 0.05) for
+//       `duration` s, turning away from what its proximity sensors see, then
+//       stops. It returns at once; a threaded script waits with
+//       sim.wait(duration) or sim.waitUntil(function() return
+//       not sim.robotIsMoving() end). The robot needs ./leftMotor and
+//       ./rightMotor (velocity joints, axles along +y) and proximity sensors
+//       named prox (ring, prox[0] ahead), as worlds/models/footbot.yaml.
+//   sim.robotIsMoving() -> 1 while the command above runs, else nil
+//   sim.examplePhaseCounts() -> {after_sense, before_control, after_control,
+//       after_physics}: how often each phase callback has run in this world
+// Phase callbacks: a per-robot after_control callback steers every robot
+// that runs robotMoveAndAvoidObstacles (robots in parallel); whole-world
+// callbacks count the phases.
+#include <atomic>
+#include <cmath>
 #include <cstdio>
+#include <map>
+#include <mutex>
+#include <utility>
+#include <vector>
 
 #include "framework/plugin_api.h"
 
 namespace {
+
+SwarmsimValue Number(double x) { return {kSwarmsimNumber, x, nullptr, nullptr, 0}; }
 
 int Sum(const SwarmsimCallContext*, const SwarmsimValue* args, int n, SwarmsimValue* results,
         int, char* error, size_t error_size, void*) {
@@ -20,7 +44,7 @@ int Sum(const SwarmsimCallContext*, const SwarmsimValue* args, int n, SwarmsimVa
       return -1;
     }
   }
-  results[0] = {kSwarmsimNumber, sum, nullptr, nullptr, 0};
+  results[0] = Number(sum);
   return 1;
 }
 
@@ -32,8 +56,146 @@ int WhereAmI(const SwarmsimCallContext* c, const SwarmsimValue*, int, SwarmsimVa
     return -1;
   }
   results[0] = {kSwarmsimNumbers, 0, nullptr, p, 3};
-  results[1] = {kSwarmsimNumber, static_cast<double>(c->robot), nullptr, nullptr, 0};
+  results[1] = Number(static_cast<double>(c->robot));
   return 2;
+}
+
+// --- robotMoveAndAvoidObstacles ------------------------------------------------------
+
+constexpr int kMaxSensors = 64;
+constexpr double kHalfAxle = 0.07;  // m, wheel to body centre (foot-bot)
+
+// One robot's running command.
+struct Behaviour {
+  double start_time = 0, end_time = 0;  // s
+  double wheel_speed = 0;               // rad/s
+  double wheel_radius = 0.029;          // m
+  int64_t left = 0, right = 0;
+  std::vector<int64_t> sensors;  // prox[0..], evenly spaced counter-clockwise from ahead
+};
+
+std::mutex g_mutex;
+std::map<std::pair<const void*, int>, Behaviour> g_behaviours;  // (world, robot)
+std::atomic<int> g_running{0};  // entries in g_behaviours, to skip the lock when 0
+
+int MoveAndAvoid(const SwarmsimCallContext* c, const SwarmsimValue* args, int n,
+                 SwarmsimValue* results, int, char* error, size_t error_size, void*) {
+  if (n < 1 || args[0].type != kSwarmsimNumber || !(args[0].number >= 0)) {
+    std::snprintf(error, error_size, "expected (duration [, speed]): seconds >= 0");
+    return -1;
+  }
+  if (c->robot < 0) {
+    std::snprintf(error, error_size, "only a robot's script can drive it");
+    return -1;
+  }
+  const SwarmsimWorldApi& api = *c->api;
+  Behaviour b;
+  if (!api.find_object(c->world, c->script_object, ":/leftMotor", &b.left) ||
+      !api.find_object(c->world, c->script_object, ":/rightMotor", &b.right)) {
+    std::snprintf(error, error_size, "the robot has no :/leftMotor and :/rightMotor joints");
+    return -1;
+  }
+  for (int k = 0; k < kMaxSensors; ++k) {
+    char path[32];
+    std::snprintf(path, sizeof path, ":/prox[%d]", k);
+    int64_t h = 0;
+    if (!api.find_object(c->world, c->script_object, path, &h)) break;
+    b.sensors.push_back(h);
+  }
+  double speed = 0.05;
+  api.number_parameter(c->world, c->robot, "wheel_speed", &speed);
+  if (n >= 2 && args[1].type == kSwarmsimNumber) speed = args[1].number;
+  api.number_parameter(c->world, c->robot, "wheel_radius", &b.wheel_radius);
+  b.wheel_speed = speed / b.wheel_radius;
+  b.start_time = api.time(c->world);
+  b.end_time = b.start_time + args[0].number;
+  {
+    std::lock_guard lock(g_mutex);
+    if (g_behaviours.insert_or_assign({c->world, c->robot}, std::move(b)).second) ++g_running;
+  }
+  results[0] = Number(api.time(c->world) + args[0].number);
+  return 1;
+}
+
+int IsMoving(const SwarmsimCallContext* c, const SwarmsimValue*, int, SwarmsimValue* results, int,
+             char*, size_t, void*) {
+  std::lock_guard lock(g_mutex);
+  results[0] = g_behaviours.count({c->world, c->robot}) ? Number(1) : SwarmsimValue{};
+  return 1;
+}
+
+// Per robot, after its scripts ran: steer while the command runs, then stop.
+int Steer(const SwarmsimCallContext* c, char*, size_t, void*) {
+  if (g_running.load(std::memory_order_relaxed) == 0) return 0;
+  const SwarmsimWorldApi& api = *c->api;
+  Behaviour b;
+  {
+    std::lock_guard lock(g_mutex);
+    auto it = g_behaviours.find({c->world, c->robot});
+    if (it == g_behaviours.end()) return 0;
+    const double now = api.time(c->world);
+    if (now >= it->second.end_time || now < it->second.start_time /* an older world's */) {
+      api.set_joint_target_velocity(c->world, c->robot, it->second.left, 0);
+      api.set_joint_target_velocity(c->world, c->robot, it->second.right, 0);
+      g_behaviours.erase(it);
+      --g_running;
+      return 0;
+    }
+    b = it->second;
+  }
+  // Sum of the readings as vectors toward what each sensor sees (nearer
+  // counts more), as the diffusion controller: turn away from it.
+  double x = 0, y = 0;
+  const double count = static_cast<double>(b.sensors.size());
+  for (size_t i = 0; i < b.sensors.size(); ++i) {
+    double distance = 0;
+    if (api.read_proximity_sensor(c->world, b.sensors[i], &distance) == 1) {
+      const double a = 2 * M_PI * static_cast<double>(i) / count;
+      const double value = 1 / (1 + 10 * distance);
+      x += value * std::cos(a), y += value * std::sin(a);
+    }
+  }
+  double left = b.wheel_speed, right = b.wheel_speed;
+  if (x * x + y * y > 0) {
+    const double angle = std::atan2(y, x);
+    const double turn = 2.0;  // rad/s
+    if (std::abs(angle) < M_PI / 2) {
+      // Something ahead: turn on the spot away from it.
+      const double w = (angle > 0 ? -turn : turn) * kHalfAxle / b.wheel_radius;
+      left = -w, right = w;
+    }
+  }
+  api.set_joint_target_velocity(c->world, c->robot, b.left, left);
+  api.set_joint_target_velocity(c->world, c->robot, b.right, right);
+  return 0;
+}
+
+// --- Phase counts ----------------------------------------------------------------------
+
+std::mutex g_count_mutex;
+std::map<const void*, std::vector<double>> g_counts;  // world -> count per phase
+
+int CountPhase(const SwarmsimCallContext* c, char*, size_t, void* phase) {
+  const int p = static_cast<int>(reinterpret_cast<intptr_t>(phase));
+  std::lock_guard lock(g_count_mutex);
+  std::vector<double>& counts = g_counts[c->world];
+  // A new world at the same address starts afresh.
+  if (p == kSwarmsimAfterSense && c->api->step_count(c->world) == 0) counts.clear();
+  counts.resize(kSwarmsimPhaseCount);
+  counts[p] += 1;
+  return 0;
+}
+
+int PhaseCounts(const SwarmsimCallContext* c, const SwarmsimValue*, int, SwarmsimValue* results,
+                int, char*, size_t, void*) {
+  thread_local std::vector<double> out;
+  {
+    std::lock_guard lock(g_count_mutex);
+    out = g_counts[c->world];
+  }
+  out.resize(kSwarmsimPhaseCount);
+  results[0] = {kSwarmsimNumbers, 0, nullptr, out.data(), out.size()};
+  return 1;
 }
 
 }  // namespace
@@ -41,9 +203,26 @@ int WhereAmI(const SwarmsimCallContext* c, const SwarmsimValue*, int, SwarmsimVa
 extern "C" int swarmsim_plugin_abi_version(void) { return SWARMSIM_PLUGIN_ABI_VERSION; }
 
 extern "C" int swarmsim_plugin_register(const SwarmsimRegistrar* r) {
-  r->set_info(r->impl, "example", "1.0", "example plugin: exampleSum, exampleWhereAmI");
-  if (r->add_command(r->impl, "exampleSum", "sum of numbers and number arrays", Sum, nullptr) != 0)
-    return -1;
-  return r->add_command(r->impl, "exampleWhereAmI", "position of the calling script's object",
-                        WhereAmI, nullptr);
+  r->set_info(r->impl, "example", "2.0",
+              "example plugin: exampleSum, exampleWhereAmI, robotMoveAndAvoidObstacles");
+  struct Command {
+    const char* name;
+    const char* description;
+    SwarmsimCommand function;
+  };
+  const Command commands[] = {
+      {"exampleSum", "sum of numbers and number arrays", Sum},
+      {"exampleWhereAmI", "position of the calling script's object", WhereAmI},
+      {"robotMoveAndAvoidObstacles", "drive for a duration, avoiding obstacles", MoveAndAvoid},
+      {"robotIsMoving", "true while robotMoveAndAvoidObstacles runs", IsMoving},
+      {"examplePhaseCounts", "how often each phase callback ran", PhaseCounts},
+  };
+  for (const Command& c : commands)
+    if (r->add_command(r->impl, c.name, c.description, c.function, nullptr) != 0) return -1;
+  if (r->add_phase_callback(r->impl, kSwarmsimAfterControl, 1, Steer, nullptr) != 0) return -1;
+  for (intptr_t phase = 0; phase < kSwarmsimPhaseCount; ++phase)
+    if (r->add_phase_callback(r->impl, static_cast<int>(phase), 0, CountPhase,
+                              reinterpret_cast<void*>(phase)) != 0)
+      return -1;
+  return 0;
 }
