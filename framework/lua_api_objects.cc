@@ -138,6 +138,34 @@ int SetObjectPoseOrPosition(lua_State* L, bool position_only) {
 int SetObjectPose(lua_State* L) { return SetObjectPoseOrPosition(L, false); }
 int SetObjectPosition(lua_State* L) { return SetObjectPoseOrPosition(L, true); }
 
+// sim.getObjectSizeFactor(h) -> the object's accumulated scale (1 unless it
+// or an ancestor was placed scaled or rescaled), as of the start of the phase.
+int GetObjectSizeFactor(lua_State* L) {
+  const LuaContext& c = Context(L);
+  lua_pushnumber(L, c.scene->size_factor(CheckObject(L, 1)));
+  return 1;
+}
+
+// sim.setObjectSizeFactor(h, f): rescales h's subtree about h so that h's
+// size factor becomes f (Scene::ScaleSubtree; worlds/README.md lists what
+// scales). Queued and applied after the control phase in handle order, like
+// sim.setObjectPose; the dynamics backend rebuilds at the next physics step.
+// A robot's scripts may rescale only their own robot's objects.
+int SetObjectSizeFactor(lua_State* L) {
+  const LuaContext& c = Context(L);
+  const ObjectId id = CheckObject(L, 1);
+  c.scene->SlotOf(id);
+  const double f = luaL_checknumber(L, 2);
+  if (!std::isfinite(f) || !(f > 0) || f > 1e3)
+    throw Error("the size factor must be a finite number above 0 and at most 1000");
+  if (c.instance >= 0 && c.scene->instance_of(id) != c.instance)
+    throw Error("object '" + c.scene->PathOf(id) +
+                "' belongs to another robot or the scene; a robot's scripts can rescale only "
+                "their own robot");
+  c.runtime->deferred.push_back({id, DeferredWrite::Kind::kSizeFactor, f});
+  return 0;
+}
+
 }  // namespace
 
 void RegisterObjectsApi(lua_State* L) {
@@ -150,6 +178,8 @@ void RegisterObjectsApi(lua_State* L) {
       {"getObjectParent", Guarded<GetObjectParent, "sim.getObjectParent">},
       {"setObjectPose", Guarded<SetObjectPose, "sim.setObjectPose">},
       {"setObjectPosition", Guarded<SetObjectPosition, "sim.setObjectPosition">},
+      {"getObjectSizeFactor", Guarded<GetObjectSizeFactor, "sim.getObjectSizeFactor">},
+      {"setObjectSizeFactor", Guarded<SetObjectSizeFactor, "sim.setObjectSizeFactor">},
       {nullptr, nullptr},
   };
   luaL_setfuncs(L, kFunctions, 0);

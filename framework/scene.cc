@@ -108,6 +108,7 @@ uint32_t Scene::AllocateSlot(std::string name, ObjectId parent, const Pose& X_PO
     name_.emplace_back();
     script_.push_back(-1);
     linked_dummy_.push_back(-1);
+    size_factor_.push_back(1);
   }
   X_PO_[slot] = X_PO;
   v_WO_[slot] = {};
@@ -120,6 +121,7 @@ uint32_t Scene::AllocateSlot(std::string name, ObjectId parent, const Pose& X_PO
   name_[slot] = std::move(name);
   script_[slot] = -1;
   linked_dummy_[slot] = -1;
+  size_factor_[slot] = 1;
   parent_[slot] = -1;
   first_child_[slot] = last_child_[slot] = next_sibling_[slot] = prev_sibling_[slot] = -1;
   instance_[slot] = parent_slot >= 0 ? instance_[parent_slot] : -1;
@@ -374,6 +376,7 @@ uint32_t Scene::CopyObject(uint32_t src, int32_t new_parent) {
   v_WO_[slot] = v_WO_[src];
   w_WO_[slot] = w_WO_[src];
   model_root_[slot] = model_root_[src];
+  size_factor_[slot] = size_factor_[src];
   if (script_[src] >= 0 && scripts_[script_[src]].source) {
     const ScriptAttachment attachment = scripts_[script_[src]];
     script_[slot] = static_cast<int32_t>(scripts_.size());
@@ -398,6 +401,7 @@ void Scene::ReserveForCopies(ObjectId root, size_t copies) {
   for (auto* v : {&parent_, &first_child_, &last_child_, &next_sibling_, &prev_sibling_, &instance_,
                   &script_, &linked_dummy_})
     v->reserve(slots);
+  size_factor_.reserve(slots);
   for (auto* v : {&simulated_, &alive_, &model_root_}) v->reserve(slots);
   type_.reserve(slots);
   row_.reserve(slots);
@@ -451,6 +455,78 @@ ObjectId Scene::DuplicateSubtree(ObjectId root, ObjectId new_parent) {
     for (SceneListener* l : listeners_) l->OnSubtreeDuplicated(*this, sources, copies);
   }
   return IdAt(copy_root);
+}
+
+// --- Size factor ---------------------------------------------------------------------
+
+void Scene::ScaleSubtree(ObjectId root, double s) {
+  const uint32_t root_slot = SlotOf(root);
+  if (!std::isfinite(s) || !(s > 0))
+    throw Error("cannot scale '" + name_[root_slot] + "' by " + std::to_string(s) +
+                ": the factor must be a finite number above 0");
+  if (s == 1) return;
+  const double s3 = s * s * s, s4 = s3 * s;
+  std::vector<uint32_t> sub;
+  CollectSubtree(root_slot, &sub);
+  // Scaled mesh assets, one per original within this call.
+  std::unordered_map<const TriangleMesh*, std::shared_ptr<const TriangleMesh>> scaled_meshes;
+  for (uint32_t slot : sub) {
+    size_factor_[slot] *= s;
+    if (slot != root_slot) X_PO_[slot].p = X_PO_[slot].p * s;
+    switch (type_[slot]) {
+      case ObjectType::kDummy: break;
+      case ObjectType::kShape: {
+        ShapeData& shape = shapes_[row_[slot]];
+        shape.size = shape.size * s;
+        shape.mass *= s3;
+        if (shape.mesh) {
+          auto& scaled = scaled_meshes[shape.mesh.get()];
+          if (!scaled) {
+            std::vector<Vec3> vertices(shape.mesh->vertices().begin(),
+                                       shape.mesh->vertices().end());
+            for (Vec3& v : vertices) v = v * s;
+            std::vector<MeshTriangle> triangles(shape.mesh->triangles().begin(),
+                                                shape.mesh->triangles().end());
+            scaled = std::make_shared<const TriangleMesh>(shape.mesh->name(), std::move(vertices),
+                                                          std::move(triangles));
+          }
+          shape.mesh = scaled;
+          shape.size = scaled->CenteredExtents();
+        }
+        break;
+      }
+      case ObjectType::kJoint: {
+        JointData& j = joints_[row_[slot]];
+        if (j.type == JointType::kPrismatic) {  // lengths x s, forces (N) x s^3
+          for (double* v : {&j.position, &j.velocity, &j.target_velocity, &j.target_position,
+                            &j.max_velocity, &j.min_position, &j.max_position})
+            *v *= s;
+          j.max_force *= s3;
+          j.target_force *= s3;
+        } else {  // angles unchanged, torques (N m) x s^4
+          j.max_force *= s4;
+          j.target_force *= s4;
+        }
+        break;
+      }
+      case ObjectType::kProximitySensor: {
+        ProximitySensorData& p = proximity_sensors_[row_[slot]];
+        p.range *= s;
+        p.distance *= s;
+        p.p_SD = p.p_SD * s;
+        break;
+      }
+      case ObjectType::kForceSensor: {
+        ForceSensorData& f = force_sensors_[row_[slot]];
+        f.force_threshold *= s3;
+        f.torque_threshold *= s4;
+        break;
+      }
+      case ObjectType::kPaintNozzle: paint_nozzles_[row_[slot]].radius *= s; break;
+    }
+  }
+  RefreshSubtree(root_slot);
+  ++structure_version_;
 }
 
 // --- Poses ---------------------------------------------------------------------------

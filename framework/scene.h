@@ -274,6 +274,21 @@ class Scene {
   int instance_of(ObjectId id) const { return instance_[SlotOf(id)]; }
   bool is_model_root(ObjectId id) const { return model_root_[SlotOf(id)] != 0; }
 
+  // --- Size factor (V-REP's) -----------------------------------------------------
+  // Accumulated scale of the object: 1 unless it or an ancestor was scaled;
+  // copied with duplication.
+  double size_factor(ObjectId id) const { return size_factor_[SlotOf(id)]; }
+  double size_factor_at(uint32_t slot) const { return size_factor_[slot]; }
+  // Scales the subtree at `root` by `s` (finite, > 0) about the root's frame:
+  // descendants' local positions, shape sizes, prismatic joint positions,
+  // limits and speeds, sensor ranges and nozzle radii x s; masses and forces
+  // x s^3, torques x s^4 (uniform density: under gravity the scaled robot
+  // accelerates as the original). The size factor of every object in the
+  // subtree is multiplied by s. A mesh shape gets a scaled copy of its asset
+  // (one per asset per call: copies duplicated afterwards share it). A
+  // structural change: dynamics backends rebuild. Not thread-safe.
+  void ScaleSubtree(ObjectId root, double s);
+
   // Monotonic counter bumped on every structural change (add, remove, reparent).
   uint64_t structure_version() const { return structure_version_; }
 
@@ -306,6 +321,7 @@ class Scene {
   std::vector<std::string> name_;
   std::vector<int32_t> script_;        // index into scripts_ or -1
   std::vector<int32_t> linked_dummy_;  // slot or -1
+  std::vector<double> size_factor_;    // accumulated scale, 1 by default
   std::vector<uint32_t> free_slots_;
   size_t object_count_ = 0;
 

@@ -337,6 +337,10 @@ void World::Actuate() {
       scene_.SetShapeDynamic(w.object, w.value != 0);
       continue;
     }
+    if (w.kind == DeferredWrite::Kind::kSizeFactor) {
+      scene_.ScaleSubtree(w.object, w.value / scene_.size_factor(w.object));
+      continue;
+    }
     JointData& j = scene_.mutable_joint(w.object);
     if (w.kind == DeferredWrite::Kind::kJointTargetVelocity) j.target_velocity = w.value;
     else j.target_position = w.value;

@@ -98,7 +98,15 @@ struct MetricSample {
 struct DeferredWrite {
   // kShapeDynamic: value 1 makes the shape dynamic, 0 kinematic (sim.setObjectDynamic).
   // kObjectPose: the object moves to world pose `pose` (sim.setObjectPose/Position).
-  enum class Kind : uint8_t { kJointTargetVelocity, kJointTargetPosition, kShapeDynamic, kObjectPose };
+  // kSizeFactor: the object's subtree is rescaled so that its size factor
+  // becomes `value` (sim.setObjectSizeFactor, Scene::ScaleSubtree).
+  enum class Kind : uint8_t {
+    kJointTargetVelocity,
+    kJointTargetPosition,
+    kShapeDynamic,
+    kObjectPose,
+    kSizeFactor
+  };
   ObjectId object;
   Kind kind;
   double value;

@@ -75,7 +75,8 @@ struct EntryPlan {
   const ModelFile* model = nullptr;
   std::shared_ptr<ParameterSet> parameters;
   ObjectSpec spec;
-  loader::Footprint footprint;
+  loader::Footprint footprint;  // of the scaled model
+  double scale = 1;             // size factor of every copy (`scale:`)
   // Either one copy at a fixed pose, or `count` distributed copies.
   bool distribute = false;
   Pose fixed_pose;
@@ -516,7 +517,7 @@ void WorldLoader::ResolveEntry(EntryPlan* entry) {
   const ValueReader world_values = WorldValues();
   Fields f(*file_, entry->field, "the models entry for '" + model.name + "'");
   f.Expect({"model", "count", "distribute", "position", "heading_deg", "orientation_deg",
-            "parameters", "instances"});
+            "parameters", "instances", "scale"});
 
   // Model parameters: declared defaults, then this entry's values, then --set.
   auto params = std::make_shared<ParameterSet>();
@@ -589,6 +590,13 @@ void WorldLoader::ResolveEntry(EntryPlan* entry) {
   const ValueReader model_values(model.file, &expressions_, {&parameters_, params.get()});
   entry->spec = loader::ResolveModel(model, model_values, &scripts_, &meshes_);
   entry->footprint = loader::ComputeFootprint(entry->spec);
+  if (f.Has("scale")) {
+    // Every length of the model scales, so its footprint does too.
+    static constexpr loader::NumberRule kScale{"a positive number", 0, 1e3, true};
+    entry->scale = world_values.Number(f.Get("scale"), kScale);
+    entry->footprint.radius *= entry->scale;
+    entry->footprint.bottom *= entry->scale;
+  }
   entry->ik_groups = loader::ReadIkGroups(model, model_values);
 
   // Placement: distributed copies or one placed copy.
@@ -704,6 +712,13 @@ void WorldLoader::BuildCopies(World* world) {
     // The first copy from the description, the others duplicated from it
     // (rows copied, scripts shared); each copy is a robot named model#index.
     const ObjectId first = loader::AddToScene(e.spec, {}, &scene);
+    // Scaled once, before duplication: copies share the scaled mesh assets.
+    // The model frame scales too (the root's offset in it).
+    Pose X_MR = e.spec.X_PO;
+    if (e.scale != 1) {
+      scene.ScaleSubtree(first, e.scale);
+      X_MR.p = X_MR.p * e.scale;
+    }
     scene.ReserveForCopies(first, poses.size() - 1);
     const std::string& name = e.model->name;
     for (size_t k = 0; k < poses.size(); ++k) {
@@ -719,7 +734,7 @@ void WorldLoader::BuildCopies(World* world) {
         instance = scene.instance_of(root);
       }
       scene.set_name(root, scene.instance(instance).name);
-      scene.SetWorldPose(root, poses[k] * e.spec.X_PO);
+      scene.SetWorldPose(root, poses[k] * X_MR);
       SharedParameters parameters = e.parameters;
       for (const auto& [index, own] : e.instance_parameters)
         if (index == static_cast<int64_t>(k)) parameters = own;
