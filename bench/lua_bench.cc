@@ -161,7 +161,11 @@ void BM_SwarmStep(benchmark::State& state) {
       (b.world->phase_times()[static_cast<size_t>(Phase::kControl)] - control_before) /
       (static_cast<double>(state.iterations()) * robots);
 }
-BENCHMARK(BM_SwarmStep)->Args({1000, 1})->Args({10000, 1})->Args({10000, 2})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_SwarmStep)
+    ->Args({1000, 1})
+    ->Args({10000, 1})
+    ->Args({10000, 2})
+    ->Unit(benchmark::kMillisecond);
 
 // Memory of Arg robots running the diffusion controller, after 20 steps
 // with 3 sensors detecting: Lua's own count (lua_gc LUA_GCCOUNT) and what

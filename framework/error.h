@@ -29,7 +29,7 @@ class InternalError : public std::logic_error {
 
 }  // namespace swarmsim
 
-#define SWARMSIM_CHECK(condition, message)                                           \
-  do {                                                                               \
+#define SWARMSIM_CHECK(condition, message)                                                      \
+  do {                                                                                          \
     if (!(condition)) ::swarmsim::ThrowCheckFailure(#condition, __FILE__, __LINE__, (message)); \
   } while (false)

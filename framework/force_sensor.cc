@@ -31,7 +31,8 @@ bool RecordForceSensorSample(ForceSensorData* s, const Vec3& force_S, const Vec3
     s->force = f * inv;
     s->torque = t * inv;
   }
-  const bool violated = s->force.Norm() > s->force_threshold || s->torque.Norm() > s->torque_threshold;
+  const bool violated =
+      s->force.Norm() > s->force_threshold || s->torque.Norm() > s->torque_threshold;
   s->violations = violated ? s->violations + 1 : 0;
   if (s->violations >= std::max(1, s->break_after)) {
     s->broken = true;

@@ -18,10 +18,10 @@ namespace swarmsim {
 
 struct ForceSensorData {
   // Settings.
-  int filter_samples = 1;               // readings are the mean of the last N samples (1..1000)
-  double force_threshold = INFINITY;    // N, |F| above it counts as a violation
-  double torque_threshold = INFINITY;   // N m, |T| above it counts as a violation
-  int break_after = 1;                  // consecutive violating steps that break the link
+  int filter_samples = 1;              // readings are the mean of the last N samples (1..1000)
+  double force_threshold = INFINITY;   // N, |F| above it counts as a violation
+  double torque_threshold = INFINITY;  // N m, |T| above it counts as a violation
+  int break_after = 1;                 // consecutive violating steps that break the link
   // State, written by the dynamics backend in the physics phase.
   bool has_reading = false;  // a backend simulates the link and sampled it
   bool broken = false;       // the link broke: parent and child move apart

@@ -8,7 +8,7 @@
 
 namespace swarmsim {
 
-struct ObjectId {  // 8 bytes
+struct ObjectId {           // 8 bytes
   uint32_t index1 = 0;      // slot + 1; 0 means null
   uint32_t generation = 0;  // bumped each time the slot is freed
 

@@ -30,8 +30,14 @@ enum class IkMode : uint8_t {
 
 // Constraint bits (same values as kinematics::IkConstraint).
 enum IkConstraintBits : uint8_t {
-  kIkX = 1, kIkY = 2, kIkZ = 4, kIkAlpha = 8, kIkBeta = 16, kIkGamma = 32,
-  kIkPosition = 7, kIkPose = 63,
+  kIkX = 1,
+  kIkY = 2,
+  kIkZ = 4,
+  kIkAlpha = 8,
+  kIkBeta = 16,
+  kIkGamma = 32,
+  kIkPosition = 7,
+  kIkPose = 63,
 };
 
 struct IkTipSpec {
@@ -50,7 +56,7 @@ struct IkGroupSpec {
   double orientation_tolerance = 1e-3;  // rad
   double max_step = 0.2;                // rad or m per iteration and joint
   bool conditional = false;  // apply only when solved, else leave the joints as they were
-  bool automatic = true;     // solved each step in the actuate phase (else only by sim.handleIkGroup)
+  bool automatic = true;  // solved each step in the actuate phase (else only by sim.handleIkGroup)
   std::vector<std::pair<ObjectId, double>> weights;  // per joint, default 1
 };
 

@@ -23,13 +23,12 @@ struct SimEntry {
 
 void RegisterAreas(lua_State* L);
 
-// Every sim.* entry, by name, and the globals the areas define. Built once per process from a scratch state:
-// the API areas keep registering the usual way (luaL_setfuncs), and each
-// robot's state fills its own `sim` table lazily from this list. A robot
-// then holds only the functions its scripts use, instead of a hash table of
-// ~100 entries (about 2-4 KiB per robot at 10,000 robots).
+// Every sim.* entry, by name, and the globals the areas define. Built once per process from a
+// scratch state: the API areas keep registering the usual way (luaL_setfuncs), and each robot's
+// state fills its own `sim` table lazily from this list. A robot then holds only the functions its
+// scripts use, instead of a hash table of ~100 entries (about 2-4 KiB per robot at 10,000 robots).
 struct ApiTables {
-  std::vector<SimEntry> sim;  // sorted by name
+  std::vector<SimEntry> sim;                                   // sorted by name
   std::vector<std::pair<std::string, lua_CFunction>> globals;  // e.g. print
 };
 
@@ -95,8 +94,10 @@ int LazySimIndex(lua_State* L) {
   switch (it->type) {
     case LUA_TFUNCTION: lua_pushcfunction(L, it->function); break;
     case LUA_TNUMBER:
-      if (it->is_integer) lua_pushinteger(L, it->integer);
-      else lua_pushnumber(L, it->number);
+      if (it->is_integer)
+        lua_pushinteger(L, it->integer);
+      else
+        lua_pushnumber(L, it->number);
       break;
     case LUA_TSTRING: lua_pushlstring(L, it->text.data(), it->text.size()); break;
     case LUA_TBOOLEAN: lua_pushboolean(L, it->boolean); break;
@@ -137,16 +138,16 @@ namespace {
 void RegisterAreas(lua_State* L) {
   // One API area per file; a new area adds one line here.
   static constexpr void (*kAreas[])(lua_State*) = {
-      RegisterSimApi,      // lua_api_sim.cc: time, parameters, random, metrics, print
-      RegisterObjectsApi,  // lua_api_objects.cc: lookup, names, tree, poses
-      RegisterJointsApi,   // lua_api_joints.cc: joint targets and states
-      RegisterSensorsApi,  // lua_api_sensors.cc: proximity sensors
-      RegisterMessagesApi, // lua_api_messages.cc: messages, signals, packing
-      RegisterControlApi,  // script_host.cc: child scripts, threads, main-script handlers
-      RegisterDynamicsApi,  // lua_api_dynamics.cc: dynamic/kinematic switch, joint forces
-      RegisterIkApi,        // lua_api_ik.cc: IK groups
+      RegisterSimApi,          // lua_api_sim.cc: time, parameters, random, metrics, print
+      RegisterObjectsApi,      // lua_api_objects.cc: lookup, names, tree, poses
+      RegisterJointsApi,       // lua_api_joints.cc: joint targets and states
+      RegisterSensorsApi,      // lua_api_sensors.cc: proximity sensors
+      RegisterMessagesApi,     // lua_api_messages.cc: messages, signals, packing
+      RegisterControlApi,      // script_host.cc: child scripts, threads, main-script handlers
+      RegisterDynamicsApi,     // lua_api_dynamics.cc: dynamic/kinematic switch, joint forces
+      RegisterIkApi,           // lua_api_ik.cc: IK groups
       RegisterForceSensorApi,  // lua_api_force.cc: force sensors
-      RegisterPaintApi,  // lua_api_paint.cc: paint nozzles
+      RegisterPaintApi,        // lua_api_paint.cc: paint nozzles
   };
   lua_pushinteger(L, kHandleWorld);
   lua_setfield(L, -2, "handle_world");

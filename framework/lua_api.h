@@ -44,12 +44,12 @@ struct LuaContext {
   ObjectId script_object;
   int script_env_ref = LUA_NOREF;  // its environment table, in the registry
   ScriptMailbox* mailbox = nullptr;
-  void* host_state = nullptr;  // the host's ScriptState (script_host.cc)
-  void* host_script = nullptr; // the host's Script being run (script_host.cc)
-  bool is_main = false;        // the main script's state
-  bool in_sensing = false;     // running a sysCall_sensing (sim.handleChildScript follows it)
-  int64_t slice_fires = 0;     // time-slice hook calls since the thread was resumed
-  std::string pending_error;   // a World error raised through the main script, verbatim
+  void* host_state = nullptr;   // the host's ScriptState (script_host.cc)
+  void* host_script = nullptr;  // the host's Script being run (script_host.cc)
+  bool is_main = false;         // the main script's state
+  bool in_sensing = false;      // running a sysCall_sensing (sim.handleChildScript follows it)
+  int64_t slice_fires = 0;      // time-slice hook calls since the thread was resumed
+  std::string pending_error;    // a World error raised through the main script, verbatim
 };
 
 inline LuaContext& Context(lua_State* L) {

@@ -106,7 +106,9 @@ int SetSignal(lua_State* L) {
   LuaContext& c = Context(L);
   std::string name = luaL_checkstring(L, 1);
   switch (lua_type(L, 2)) {
-    case LUA_TNUMBER: c.runtime->signal_writes.emplace_back(std::move(name), lua_tonumber(L, 2)); break;
+    case LUA_TNUMBER:
+      c.runtime->signal_writes.emplace_back(std::move(name), lua_tonumber(L, 2));
+      break;
     case LUA_TBOOLEAN:
       c.runtime->signal_writes.emplace_back(std::move(name), lua_toboolean(L, 2) != 0);
       break;
@@ -263,8 +265,18 @@ void UnpackValue(lua_State* L, Reader* r, int depth) {
   char tag = 0;
   r->Read(&tag, 1);
   switch (tag) {
-    case 'n': { double v; r->Read(&v, sizeof v); lua_pushnumber(L, v); break; }
-    case 'i': { int64_t v; r->Read(&v, sizeof v); lua_pushinteger(L, v); break; }
+    case 'n': {
+      double v;
+      r->Read(&v, sizeof v);
+      lua_pushnumber(L, v);
+      break;
+    }
+    case 'i': {
+      int64_t v;
+      r->Read(&v, sizeof v);
+      lua_pushinteger(L, v);
+      break;
+    }
     case 'T': lua_pushboolean(L, 1); break;
     case 'F': lua_pushboolean(L, 0); break;
     case 's': {

@@ -120,9 +120,10 @@ int SetObjectPoseOrPosition(lua_State* L, bool position_only) {
   double v[7];
   CheckNumbers(L, values_arg, v, position_only ? 3 : 7);
   const ObjectId relative_to = OptRelativeTo(L, relative_arg);
-  const Pose X_WR = relative_to.IsNull()
-                        ? Pose{}
-                        : c.scene->world_pose_at(c.scene->SlotOf(relative_to, "relative-to object"));
+  const Pose X_WR =
+      relative_to.IsNull()
+          ? Pose{}
+          : c.scene->world_pose_at(c.scene->SlotOf(relative_to, "relative-to object"));
   Pose X_WO = c.scene->world_pose_at(slot);
   if (position_only) {
     X_WO.p = X_WR * Vec3{v[0], v[1], v[2]};

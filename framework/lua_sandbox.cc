@@ -31,8 +31,9 @@ namespace {
 int SafeLoad(lua_State* L) {
   const int n = lua_gettop(L);
   if (lua_type(L, 1) == LUA_TSTRING && lua_tostring(L, 1)[0] == LUA_SIGNATURE[0])
-    RaiseError(L, "load: binary chunks are not allowed in a sandboxed script (run with "
-                  "--trust-scripts to lift the sandbox)");
+    RaiseError(L,
+               "load: binary chunks are not allowed in a sandboxed script (run with "
+               "--trust-scripts to lift the sandbox)");
   lua_settop(L, 4);
   lua_pushliteral(L, "t");
   lua_replace(L, 3);
@@ -93,8 +94,9 @@ void Wrap(lua_State* L, const char* name, lua_CFunction wrapper) {
 namespace fs = std::filesystem;
 
 [[noreturn]] void Refuse(lua_State* L, const std::string& what) {
-  RaiseError(L, what + " is not allowed in a sandboxed script (run with --trust-scripts to lift "
-                       "the sandbox)");
+  RaiseError(L, what +
+                    " is not allowed in a sandboxed script (run with --trust-scripts to lift "
+                    "the sandbox)");
 }
 
 // __index of a restricted library table: a missing field is refused by name.
@@ -200,8 +202,9 @@ int SafeRequire(lua_State* L) {
     RaiseError(L, "require: module '" + name + "' requires itself (a loop)");
   if (!lua_isnil(L, -1)) return 1;
   lua_pop(L, 1);
-  if (name.empty() || name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
-                                             "0123456789_.-") != std::string::npos ||
+  if (name.empty() ||
+      name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                             "0123456789_.-") != std::string::npos ||
       name.find("..") != std::string::npos || name.front() == '.')
     RaiseError(L, "require: '" + name +
                       "' is not a module name (letters, digits, '_', '-', and '.' for folders)");

@@ -262,8 +262,8 @@ bool TriangleMesh::AnyTriangleWithin(const Vec3& p, double radius) const {
     if (node.count > 0) {
       for (uint32_t i = node.first; i < node.first + node.count; ++i) {
         const MeshTriangle& tri = triangles_[i];
-        const Vec3 c = ClosestOnTriangle(p, vertices_[tri.v[0]], vertices_[tri.v[1]],
-                                         vertices_[tri.v[2]]);
+        const Vec3 c =
+            ClosestOnTriangle(p, vertices_[tri.v[0]], vertices_[tri.v[1]], vertices_[tri.v[2]]);
         if ((c - p).SquaredNorm() <= r2) return true;
       }
       continue;

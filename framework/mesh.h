@@ -41,8 +41,7 @@ class TriangleMesh {
   // Builds the asset and its BVH. Throws swarmsim::Error (naming `name`) for
   // no triangles, an index out of range or a non-finite vertex. Triangles
   // whose corners coincide are dropped; the others are reordered by the BVH.
-  TriangleMesh(std::string name, std::vector<Vec3> vertices,
-               std::vector<MeshTriangle> triangles);
+  TriangleMesh(std::string name, std::vector<Vec3> vertices, std::vector<MeshTriangle> triangles);
 
   const std::string& name() const { return name_; }  // the file, for messages
   std::span<const Vec3> vertices() const { return vertices_; }
@@ -72,9 +71,9 @@ class TriangleMesh {
   bool NearestHit(const Vec3& o, const Vec3& d, double max_t, double* t, bool* entering) const;
 
   std::string name_;
-  std::vector<Vec3> vertices_;            // (vertices)
-  std::vector<MeshTriangle> triangles_;   // (triangles), BVH order
-  std::vector<MeshBvhNode> nodes_;        // (nodes), root first
+  std::vector<Vec3> vertices_;           // (vertices)
+  std::vector<MeshTriangle> triangles_;  // (triangles), BVH order
+  std::vector<MeshBvhNode> nodes_;       // (nodes), root first
   Vec3 lo_, hi_;
   bool closed_ = false;
   double footprint_radius_ = 0;

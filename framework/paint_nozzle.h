@@ -6,7 +6,7 @@
 
 namespace swarmsim {
 
-struct PaintNozzleData {  // 40 bytes
+struct PaintNozzleData {      // 40 bytes
   Vec3 color{0.1, 0.1, 0.8};  // RGB in [0, 1]
   double radius = 0.02;       // m, of the painted disc
   bool enabled = true;

@@ -25,7 +25,12 @@
 extern "C" {
 #endif
 
-enum SwarmsimValueType { kSwarmsimNil = 0, kSwarmsimNumber = 1, kSwarmsimString = 2, kSwarmsimNumbers = 3 };
+enum SwarmsimValueType {
+  kSwarmsimNil = 0,
+  kSwarmsimNumber = 1,
+  kSwarmsimString = 2,
+  kSwarmsimNumbers = 3
+};
 
 // One argument or result. Strings and arrays are not owned: arguments live
 // for the call; results must stay valid until the command returns to
@@ -65,9 +70,10 @@ typedef struct SwarmsimWorldApi {
 
 // Who is calling: the robot and the script's object.
 typedef struct SwarmsimCallContext {
-  int robot;              // model instance index; -1 for scene and main scripts
-  int64_t script_object;  // the calling script's object handle (as Lua sees it); 0 for the main script
-  void* world;            // pass to the functions of `api`
+  int robot;  // model instance index; -1 for scene and main scripts
+  int64_t
+      script_object;  // the calling script's object handle (as Lua sees it); 0 for the main script
+  void* world;        // pass to the functions of `api`
   const SwarmsimWorldApi* api;
 } SwarmsimCallContext;
 
@@ -76,8 +82,8 @@ typedef struct SwarmsimCallContext {
 // the script then fails at the calling line with that message.
 // Commands of different robots run concurrently: keep them thread-safe.
 typedef int (*SwarmsimCommand)(const SwarmsimCallContext* context, const SwarmsimValue* args,
-                               int arg_count, SwarmsimValue* results, int max_results,
-                               char* error, size_t error_size, void* user_data);
+                               int arg_count, SwarmsimValue* results, int max_results, char* error,
+                               size_t error_size, void* user_data);
 
 // Points of a step where a plugin's phase callbacks run (ABI 2). With a
 // world's own main script, "control" means each sim.handleChildScripts call
@@ -101,8 +107,8 @@ typedef int (*SwarmsimPhaseCallback)(const SwarmsimCallContext* context, char* e
 typedef struct SwarmsimRegistrar {
   void* impl;
   // Registers sim.<name>; returns 0, or -1 if the name is taken or invalid.
-  int (*add_command)(void* impl, const char* name, const char* description,
-                     SwarmsimCommand command, void* user_data);
+  int (*add_command)(void* impl, const char* name, const char* description, SwarmsimCommand command,
+                     void* user_data);
   // The plugin's name, version and one-line description (swarmsim modules).
   void (*set_info)(void* impl, const char* name, const char* version, const char* description);
   // --- ABI 2 ---

@@ -39,7 +39,8 @@ int64_t Rng::UniformInt(int64_t lo, int64_t hi) {
   // Rejection sampling: no modulo bias.
   const uint64_t limit = UINT64_MAX - UINT64_MAX % span;
   uint64_t r;
-  do r = NextU64(); while (r >= limit);
+  do r = NextU64();
+  while (r >= limit);
   return lo + static_cast<int64_t>(r % span);
 }
 

@@ -79,7 +79,8 @@ class ModuleRegistry {
   std::vector<std::pair<std::string, DynamicsFactory>> dynamics_;
   std::vector<std::pair<std::string, ProximityFactory>> proximity_;
   std::vector<std::pair<std::string, CalculationFactory>> calculation_;
-  std::vector<std::shared_ptr<const ScriptCommand>> commands_;  // stable addresses (Lua keeps pointers)
+  std::vector<std::shared_ptr<const ScriptCommand>>
+      commands_;  // stable addresses (Lua keeps pointers)
   std::vector<PhaseCallback> phase_callbacks_;
   std::vector<std::string> plugin_paths_;
 };

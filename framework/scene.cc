@@ -57,7 +57,8 @@ double ShapeData::BoundingRadius() const {
     case ShapeKind::kCylinder:
     case ShapeKind::kCapsule:
     case ShapeKind::kSphere: return size.x;
-    case ShapeKind::kMesh: return mesh ? mesh->footprint_radius() : 0.5 * std::hypot(size.x, size.y);
+    case ShapeKind::kMesh:
+      return mesh ? mesh->footprint_radius() : 0.5 * std::hypot(size.x, size.y);
   }
   return 0;
 }
@@ -77,8 +78,7 @@ Scene::~Scene() = default;
 
 // --- Slots ----------------------------------------------------------------------
 
-uint32_t Scene::AllocateSlot(std::string name, ObjectId parent, const Pose& X_PO,
-                             ObjectType type) {
+uint32_t Scene::AllocateSlot(std::string name, ObjectId parent, const Pose& X_PO, ObjectType type) {
   int32_t parent_slot = -1;
   if (!parent.IsNull()) parent_slot = static_cast<int32_t>(SlotOf(parent, "parent object"));
   uint32_t slot;
@@ -230,18 +230,24 @@ void Scene::LinkChild(uint32_t parent, uint32_t child) {
   parent_[child] = static_cast<int32_t>(parent);
   prev_sibling_[child] = last_child_[parent];
   next_sibling_[child] = -1;
-  if (last_child_[parent] >= 0) next_sibling_[last_child_[parent]] = static_cast<int32_t>(child);
-  else first_child_[parent] = static_cast<int32_t>(child);
+  if (last_child_[parent] >= 0)
+    next_sibling_[last_child_[parent]] = static_cast<int32_t>(child);
+  else
+    first_child_[parent] = static_cast<int32_t>(child);
   last_child_[parent] = static_cast<int32_t>(child);
 }
 
 void Scene::UnlinkChild(uint32_t child) {
   const int32_t parent = parent_[child];
   if (parent < 0) return;
-  if (prev_sibling_[child] >= 0) next_sibling_[prev_sibling_[child]] = next_sibling_[child];
-  else first_child_[parent] = next_sibling_[child];
-  if (next_sibling_[child] >= 0) prev_sibling_[next_sibling_[child]] = prev_sibling_[child];
-  else last_child_[parent] = prev_sibling_[child];
+  if (prev_sibling_[child] >= 0)
+    next_sibling_[prev_sibling_[child]] = next_sibling_[child];
+  else
+    first_child_[parent] = next_sibling_[child];
+  if (next_sibling_[child] >= 0)
+    prev_sibling_[next_sibling_[child]] = prev_sibling_[child];
+  else
+    last_child_[parent] = prev_sibling_[child];
   parent_[child] = -1;
   prev_sibling_[child] = next_sibling_[child] = -1;
 }
@@ -427,7 +433,8 @@ ObjectId Scene::DuplicateSubtree(ObjectId root, ObjectId new_parent) {
   std::unordered_map<uint32_t, uint32_t> copy_of;
   copy_of.reserve(sources.size());
   for (uint32_t src : sources) {
-    const int32_t p = src == root_slot ? parent_slot : static_cast<int32_t>(copy_of.at(parent_[src]));
+    const int32_t p =
+        src == root_slot ? parent_slot : static_cast<int32_t>(copy_of.at(parent_[src]));
     copy_of[src] = CopyObject(src, p);
   }
   // Remap internal references: a link inside the subtree points at the copy;
@@ -558,8 +565,7 @@ void Scene::SetWorldPose(ObjectId id, const Pose& X_WO) {
   RefreshSubtree(slot);
 }
 
-void Scene::SetSimulatedState(uint32_t slot, const Pose& X_WO, const Vec3& v_WO,
-                              const Vec3& w_WO) {
+void Scene::SetSimulatedState(uint32_t slot, const Pose& X_WO, const Vec3& v_WO, const Vec3& w_WO) {
   X_WO_[slot] = X_WO;
   v_WO_[slot] = v_WO;
   w_WO_[slot] = w_WO;
@@ -605,8 +611,8 @@ static inline void UpdateOne(uint32_t s, const std::vector<int32_t>& parent_of,
   const int32_t p = parent_of[s];
   if ((*simulated)[s]) {
     // The backend owns X_WO; derive the local pose from it.
-    (*X_PO)[s] = p >= 0 ? scene.ChildFrameAt(static_cast<uint32_t>(p)).Inverse() * (*X_WO)[s]
-                        : (*X_WO)[s];
+    (*X_PO)[s] =
+        p >= 0 ? scene.ChildFrameAt(static_cast<uint32_t>(p)).Inverse() * (*X_WO)[s] : (*X_WO)[s];
     (*simulated)[s] = 0;
   } else {
     (*X_WO)[s] = p >= 0 ? scene.ChildFrameAt(static_cast<uint32_t>(p)) * (*X_PO)[s] : (*X_PO)[s];
@@ -800,7 +806,10 @@ ObjectId Scene::FindObject(std::string_view path, ObjectId from) const {
     if (!IsValid(from)) return {};
     int32_t root = static_cast<int32_t>(from.index());
     for (int32_t a = root; a >= 0; a = parent_[a])
-      if (model_root_[a]) { root = a; break; }
+      if (model_root_[a]) {
+        root = a;
+        break;
+      }
     scope.push_back(static_cast<uint32_t>(root));
     path.remove_prefix(path.size() >= 2 ? 2 : 1);
   } else if (path.starts_with("/")) {
@@ -837,7 +846,10 @@ ObjectId Scene::FindObject(std::string_view path, ObjectId from) const {
     const int want = e.index < 0 ? 0 : e.index;
     for (uint32_t c : candidates) {
       if (name_[c] != e.name) continue;
-      if (seen++ == want) { current = static_cast<int32_t>(c); break; }
+      if (seen++ == want) {
+        current = static_cast<int32_t>(c);
+        break;
+      }
     }
     if (current < 0) return {};
   }

@@ -26,7 +26,14 @@
 
 namespace swarmsim {
 
-enum class ObjectType : uint8_t { kDummy, kShape, kJoint, kProximitySensor, kForceSensor, kPaintNozzle };
+enum class ObjectType : uint8_t {
+  kDummy,
+  kShape,
+  kJoint,
+  kProximitySensor,
+  kForceSensor,
+  kPaintNozzle
+};
 const char* ToString(ObjectType type);
 
 enum class ShapeKind : uint8_t { kBox, kCylinder, kSphere, kCapsule, kMesh };
@@ -42,12 +49,13 @@ const char* ToString(ShapeKind kind);
 // conservative.
 struct ShapeData {
   ShapeKind kind = ShapeKind::kBox;
-  Vec3 size{0.1, 0.1, 0.1};  // box: full extents (x, y, z) m; cylinder, capsule: (radius, -, height); sphere: (radius, -, -)
+  Vec3 size{0.1, 0.1, 0.1};  // box: full extents (x, y, z) m; cylinder, capsule: (radius, -,
+                             // height); sphere: (radius, -, -)
   bool dynamic = false;      // simulated by the dynamics backend, else static or kinematic
   double mass = 1.0;         // kg, dynamic shapes only
   double friction = 0.7;     // Coulomb coefficient
   double restitution = 0.0;
-  Vec3 color{0.7, 0.7, 0.7};  // RGB in [0, 1]
+  Vec3 color{0.7, 0.7, 0.7};                 // RGB in [0, 1]
   std::shared_ptr<const TriangleMesh> mesh;  // kMesh: the asset (shared by copies), else null
 
   // Radius of the shape's footprint circle in its xy plane (for broad phases).
@@ -67,16 +75,16 @@ const char* ToString(JointMode mode);
 struct JointData {
   JointType type = JointType::kRevolute;
   JointMode mode = JointMode::kVelocity;
-  double position = 0;         // rad or m
-  double velocity = 0;         // rad/s or m/s
-  double target_velocity = 0;  // velocity mode
-  double target_position = 0;  // position mode
-  double max_force = 10;       // N or N m
-  double max_velocity = 10;    // rad/s or m/s, position mode
-  double target_force = 0;     // N or N m, force mode
+  double position = 0;              // rad or m
+  double velocity = 0;              // rad/s or m/s
+  double target_velocity = 0;       // velocity mode
+  double target_position = 0;       // position mode
+  double max_force = 10;            // N or N m
+  double max_velocity = 10;         // rad/s or m/s, position mode
+  double target_force = 0;          // N or N m, force mode
   double min_position = -INFINITY;  // limits, rad or m (infinite: unlimited)
   double max_position = INFINITY;
-  Quat ball;                   // spherical joints: rotation of the children
+  Quat ball;  // spherical joints: rotation of the children
   // Set by a dynamics backend that integrates this joint's position and
   // velocity itself; World::Actuate then leaves them alone.
   bool simulated = false;
@@ -89,14 +97,14 @@ struct ProximitySensorData {
   double range = 0.1;  // m
   // Reading, written in the sense phase:
   bool detected = false;
-  double distance = 0;      // m, along the ray
-  Vec3 p_SD;                // detected point in the sensor frame
-  ObjectId detected_object; // shape that was hit
+  double distance = 0;       // m, along the ray
+  Vec3 p_SD;                 // detected point in the sensor frame
+  ObjectId detected_object;  // shape that was hit
 };
 
 // A script attached to an object. The source is shared by all copies.
 struct ScriptSource {
-  std::string path;     // file the code came from (for messages)
+  std::string path;  // file the code came from (for messages)
   std::string code;
 };
 struct ScriptAttachment {
@@ -304,15 +312,15 @@ class Scene {
   uint32_t CopyObject(uint32_t src, int32_t new_parent);
 
   // Per slot, hot.
-  std::vector<Pose> X_PO_;    // pose in parent (slots)
-  std::vector<Pose> X_WO_;    // pose in world, cached (slots)
-  std::vector<Vec3> v_WO_;    // linear velocity in world (slots)
-  std::vector<Vec3> w_WO_;    // angular velocity in world (slots)
+  std::vector<Pose> X_PO_;       // pose in parent (slots)
+  std::vector<Pose> X_WO_;       // pose in world, cached (slots)
+  std::vector<Vec3> v_WO_;       // linear velocity in world (slots)
+  std::vector<Vec3> w_WO_;       // angular velocity in world (slots)
   std::vector<int32_t> parent_;  // parent slot or -1 (slots)
   std::vector<int32_t> first_child_, last_child_, next_sibling_, prev_sibling_;  // (slots)
-  std::vector<ObjectType> type_;  // (slots)
-  std::vector<uint32_t> row_;     // row in the type's table (slots)
-  std::vector<int32_t> instance_; // model instance or -1 (slots)
+  std::vector<ObjectType> type_;                                                 // (slots)
+  std::vector<uint32_t> row_;       // row in the type's table (slots)
+  std::vector<int32_t> instance_;   // model instance or -1 (slots)
   std::vector<uint8_t> simulated_;  // pose owned by a dynamics backend this step (slots)
   // Per slot, cold.
   std::vector<uint32_t> generation_;

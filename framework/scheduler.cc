@@ -29,8 +29,7 @@ int TaskScheduler::HardwareThreads() {
   return n > 0 ? n : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
 }
 
-TaskScheduler::TaskScheduler(int threads)
-    : threads_(threads > 0 ? threads : HardwareThreads()) {
+TaskScheduler::TaskScheduler(int threads) : threads_(threads > 0 ? threads : HardwareThreads()) {
   if (threads_ > 1) impl_ = std::make_unique<Impl>(threads_);
 }
 

@@ -37,9 +37,9 @@ namespace swarmsim {
 namespace {
 
 enum Callback : int { kInit, kSensing, kActuation, kCleanup, kThread, kStep, kCallbackCount };
-constexpr const char* kCallbackNames[kCallbackCount] = {
-    "sysCall_init", "sysCall_sensing", "sysCall_actuation", "sysCall_cleanup", "sysCall_thread",
-    "sysCall_step"};
+constexpr const char* kCallbackNames[kCallbackCount] = {"sysCall_init",      "sysCall_sensing",
+                                                        "sysCall_actuation", "sysCall_cleanup",
+                                                        "sysCall_thread",    "sysCall_step"};
 
 // Lua instructions per millisecond of thread time slice: PUC Lua 5.4 runs
 // roughly 100 to 300 million simple VM instructions a second on a current
@@ -63,7 +63,7 @@ struct Script {  // 88 bytes
   int env_ref = LUA_NOREF;  // environment table, in the registry
   int callbacks[kCallbackCount] = {LUA_NOREF, LUA_NOREF, LUA_NOREF,
                                    LUA_NOREF, LUA_NOREF, LUA_NOREF};
-  bool initialized = false;  // sysCall_init returned: sysCall_cleanup is due
+  bool initialized = false;        // sysCall_init returned: sysCall_cleanup is due
   bool explicit_handling = false;  // runs only through sim.handleChildScript
   bool disabled = false;           // failed under on_script_error: disable_script
   bool running = false;            // inside a call (no re-entry through handleChildScript)
@@ -108,7 +108,7 @@ std::string ErrorText(lua_State* L, int status) {
                                    std::string_view what) {
   lua_settop(state.L, 0);
   const Scene& scene = *state.context.scene;
-  const std::string path = scene.IsValid(object) ? scene.PathOf(object)
+  const std::string path = scene.IsValid(object)   ? scene.PathOf(object)
                            : state.context.is_main ? std::string("the main script")
                                                    : std::string("?");
   throw Error(state.context.name + ": " + message + " [in " + std::string(what) + " of " + path +
@@ -440,14 +440,16 @@ void ResumeThread(ScriptState* state, Script& script) {
 // `args` (from sim.handleChildScripts) are passed to each callback.
 void PushArgs(lua_State* L, const std::vector<ParamValue>& args) {
   for (const ParamValue& v : args) {
-    if (const double* d = std::get_if<double>(&v)) lua_pushnumber(L, *d);
-    else if (const bool* b = std::get_if<bool>(&v)) lua_pushboolean(L, *b);
-    else lua_pushstring(L, std::get<std::string>(v).c_str());
+    if (const double* d = std::get_if<double>(&v))
+      lua_pushnumber(L, *d);
+    else if (const bool* b = std::get_if<bool>(&v))
+      lua_pushboolean(L, *b);
+    else
+      lua_pushstring(L, std::get<std::string>(v).c_str());
   }
 }
 
-void RunCallback(ScriptState* state, Callback callback,
-                 const std::vector<ParamValue>& args = {}) {
+void RunCallback(ScriptState* state, Callback callback, const std::vector<ParamValue>& args = {}) {
   const Scene& scene = *state->context.scene;
   state->context.in_sensing = callback == kSensing;
   for (Script& script : state->scripts) {
@@ -470,8 +472,7 @@ void RunCallback(ScriptState* state, Callback callback,
 void Cleanup(ScriptState* state) {
   std::string first_error;
   for (Script& script : state->scripts) {
-    if (!script.initialized || script.disabled || script.callbacks[kCleanup] == LUA_NOREF)
-      continue;
+    if (!script.initialized || script.disabled || script.callbacks[kCleanup] == LUA_NOREF) continue;
     lua_rawgeti(state->L, LUA_REGISTRYINDEX, script.callbacks[kCleanup]);
     try {
       Call(*state, script, 0, kCallbackNames[kCleanup]);
@@ -582,8 +583,7 @@ int SetThreadSwitchTiming(lua_State* L) {
   if (script == nullptr) return 0;
   script->slice_instructions = static_cast<int>(
       std::clamp<double>(ms * kInstructionsPerMs, 1000, static_cast<double>(INT_MAX)));
-  if (script->thread == L)
-    lua_sethook(L, SliceHook, LUA_MASKCOUNT, script->slice_instructions);
+  if (script->thread == L) lua_sethook(L, SliceHook, LUA_MASKCOUNT, script->slice_instructions);
   return 0;
 }
 
@@ -622,7 +622,8 @@ int HandleChildScripts(lua_State* L) {
       default:
         throw Error("argument " + std::to_string(i) +
                     " must be a number, boolean or string (each robot has its own Lua state; "
-                    "pack tables with sim.packTable), got " + luaL_typename(L, i));
+                    "pack tables with sim.packTable), got " +
+                    luaL_typename(L, i));
     }
   }
   c.world->scripts()->SetChildScriptArguments(std::move(args));

@@ -16,7 +16,9 @@ class StateHasher {
 
   void Add(const void* data, size_t bytes);
   template <typename T>
-  void AddValue(const T& value) { Add(&value, sizeof(T)); }
+  void AddValue(const T& value) {
+    Add(&value, sizeof(T));
+  }
   uint64_t Digest() const;
 
   static std::string ToHex(uint64_t hash);  // 16 lowercase hex digits

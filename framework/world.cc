@@ -216,7 +216,10 @@ void World::Step() {
   if (stopped_) throw Error("the world was stopped and cannot be stepped again");
   try {
     // 0. messages and signals sent in the last step become visible.
-    { PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kControl)]); DeliverMessages(); }
+    {
+      PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kControl)]);
+      DeliverMessages();
+    }
     if (scripts_->has_main_script()) {
       // 1-4. the world's own main script runs the phases (sim.handleSensing(), ...).
       dynamics_handled_ = false;
@@ -225,16 +228,31 @@ void World::Step() {
         throw Error("the main script's sysCall_step must call sim.handleDynamics() once per step");
     } else {
       // 1. sense: sensors read the state left by the last physics step.
-      { PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kSense)]); Sense(); }
+      {
+        PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kSense)]);
+        Sense();
+      }
       // 2. control: scripts, one robot per task, hierarchy order within a robot.
-      { PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kControl)]); Control(); }
+      {
+        PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kControl)]);
+        Control();
+      }
       // 3. actuate: deferred writes, joint targets, calculation modules (IK).
-      { PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kActuate)]); Actuate(); }
+      {
+        PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kActuate)]);
+        Actuate();
+      }
       // 4. physics: the dynamics backend advances the simulated bodies.
-      { PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kPhysics)]); Physics(); }
+      {
+        PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kPhysics)]);
+        Physics();
+      }
     }
     // 5. record: observers append to their streams.
-    { PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kRecord)]); Record(); }
+    {
+      PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kRecord)]);
+      Record();
+    }
   } catch (...) {
     failed_ = true;
     throw;
@@ -325,8 +343,9 @@ void World::Actuate() {
   }
   writes.insert(writes.end(), scene_runtime_.deferred.begin(), scene_runtime_.deferred.end());
   scene_runtime_.deferred.clear();
-  std::stable_sort(writes.begin(), writes.end(),
-                   [](const DeferredWrite& a, const DeferredWrite& b) { return a.object < b.object; });
+  std::stable_sort(
+      writes.begin(), writes.end(),
+      [](const DeferredWrite& a, const DeferredWrite& b) { return a.object < b.object; });
   for (const DeferredWrite& w : writes) {
     if (!scene_.IsValid(w.object)) continue;  // removed meanwhile
     if (w.kind == DeferredWrite::Kind::kObjectPose) {
@@ -342,8 +361,10 @@ void World::Actuate() {
       continue;
     }
     JointData& j = scene_.mutable_joint(w.object);
-    if (w.kind == DeferredWrite::Kind::kJointTargetVelocity) j.target_velocity = w.value;
-    else j.target_position = w.value;
+    if (w.kind == DeferredWrite::Kind::kJointTargetVelocity)
+      j.target_velocity = w.value;
+    else
+      j.target_position = w.value;
   }
   // Calculation objects (IK groups, ...) set joint positions and targets.
   for (auto& [name, module] : calculations_) module->Actuate(this);

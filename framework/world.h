@@ -69,18 +69,18 @@ struct WorldSettings {
 enum class MessageScope : uint8_t { kGlobal, kLocal, kDirect, kRange };
 struct Message {
   std::string data;
-  ObjectId sender;          // object carrying the sending script
-  ObjectId target;          // kDirect: object carrying the receiving script
-  int sender_instance = -1; // robot of the sender, -1 for the scene
-  double range = 0;         // m, kRange
+  ObjectId sender;           // object carrying the sending script
+  ObjectId target;           // kDirect: object carrying the receiving script
+  int sender_instance = -1;  // robot of the sender, -1 for the scene
+  double range = 0;          // m, kRange
   MessageScope scope = MessageScope::kGlobal;
   bool line_of_sight = false;  // kRange: only receivers the static environment does not hide
 };
 // One message in a robot's inbox.
-struct ReceivedMessage {  // 24 bytes
-  uint32_t message = 0;   // index into World::messages()
-  float distance = 0;     // m, from the receiver's model root to the sender
-  float bearing = 0;      // rad, of the sender in the receiver's root frame (0 = +x, CCW)
+struct ReceivedMessage {      // 24 bytes
+  uint32_t message = 0;       // index into World::messages()
+  float distance = 0;         // m, from the receiver's model root to the sender
+  float bearing = 0;          // rad, of the sender in the receiver's root frame (0 = +x, CCW)
   bool has_geometry = false;  // false for scene receivers
 };
 
@@ -267,12 +267,12 @@ class World {
   std::vector<Message> messages_;
   uint64_t message_round_ = 0;
   std::map<std::string, ParamValue, std::less<>> signals_;
-  SpatialGrid message_grid_;                  // range messages, rebuilt each step
+  SpatialGrid message_grid_;                    // range messages, rebuilt each step
   std::vector<uint32_t> message_bucket_start_;  // local/direct messages per robot (robots + 2)
   std::vector<uint32_t> message_bucket_;        // message indices, grouped by receiving robot
   std::vector<uint32_t> global_messages_;       // indices of global messages
   std::vector<Vec3> message_origin_;            // sender position per message (messages)
-  bool dynamics_handled_ = false;  // sim.handleDynamics() ran this step
+  bool dynamics_handled_ = false;               // sim.handleDynamics() ran this step
   int64_t step_count_ = 0;
   double time_ = 0;
   bool started_ = false;

@@ -141,11 +141,12 @@ void World::DeliverMessages() {
   std::vector<ReceivedMessage>& scene_inbox = scene_runtime_.inbox;
   scene_inbox.clear();
   for (uint32_t m : global_messages_) scene_inbox.push_back({m, 0, 0, false});
-  for (uint32_t e = message_bucket_start_[scene_bucket]; e < message_bucket_start_[scene_bucket + 1];
-       ++e)
+  for (uint32_t e = message_bucket_start_[scene_bucket];
+       e < message_bucket_start_[scene_bucket + 1]; ++e)
     scene_inbox.push_back({message_bucket_[e], 0, 0, false});
-  std::sort(scene_inbox.begin(), scene_inbox.end(),
-            [](const ReceivedMessage& a, const ReceivedMessage& b) { return a.message < b.message; });
+  std::sort(
+      scene_inbox.begin(), scene_inbox.end(),
+      [](const ReceivedMessage& a, const ReceivedMessage& b) { return a.message < b.message; });
 }
 
 }  // namespace swarmsim

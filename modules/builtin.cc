@@ -14,7 +14,8 @@ void RegisterBuiltinModules(ModuleRegistry* registry) {
   registry->RegisterDynamics(ode::ModuleInfo(), [] { return ode::MakeBackend(); });
   registry->RegisterDynamics(kinematic::ModuleInfo(), [] { return kinematic::MakeBackend(); });
   registry->RegisterProximity(proximity::ModuleInfo(), [] { return proximity::MakeBackend(); });
-  registry->RegisterCalculation(kinematics::IkModuleInfo(), [] { return kinematics::MakeIkGroups(); });
+  registry->RegisterCalculation(kinematics::IkModuleInfo(),
+                                [] { return kinematics::MakeIkGroups(); });
 }
 
 }  // namespace swarmsim

@@ -84,8 +84,8 @@ bool RunChild(const std::vector<std::string>& args, std::string* output, int* st
 
 }  // namespace
 
-int RunBenchChild(const BenchOptions& options, const std::string& config, int robots,
-                  int threads, std::ostream& out) {
+int RunBenchChild(const BenchOptions& options, const std::string& config, int robots, int threads,
+                  std::ostream& out) {
   if (config != "diffusion" && config != "box2d-only" && config != "ode-only")
     throw Error("unknown bench configuration '" + config + "'");
   ModuleRegistry registry;
@@ -112,15 +112,16 @@ int RunBenchChild(const BenchOptions& options, const std::string& config, int ro
     const auto start = std::chrono::steady_clock::now();
     for (int64_t i = 0; i < options.steps; ++i) world.Step();
     row.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    for (int p = 0; p < 5; ++p) row.us_per_tick[p] = 1e6 * (world.phase_times()[p] - before[p]) / ticks;
+    for (int p = 0; p < 5; ++p)
+      row.us_per_tick[p] = 1e6 * (world.phase_times()[p] - before[p]) / ticks;
   } else if (config == "ode-only") {
     // The same bodies and joint commands through ODE alone (collision + solver).
     const WorldSettings& s = world.settings();
     DynamicsSettings dynamics;
     dynamics.gravity = s.gravity;
-    row.wall_s = ode::TimeBareLoop(world.scene(), s.time_step / s.physics_substeps,
-                                   s.physics_substeps, static_cast<int>(options.steps), {},
-                                   dynamics);
+    row.wall_s =
+        ode::TimeBareLoop(world.scene(), s.time_step / s.physics_substeps, s.physics_substeps,
+                          static_cast<int>(options.steps), {}, dynamics);
     row.us_per_tick[static_cast<int>(Phase::kPhysics)] = 1e6 * row.wall_s / ticks;
   } else {
     // The same bodies and wheel commands through Box2D alone.
@@ -154,10 +155,12 @@ int RunBench(const BenchOptions& options, std::ostream& out, std::ostream& err) 
       << std::string(12 + 8 + 8 + 14 + 9 * 5 + 10 + 9, '-') << "\n"
       << std::flush;
   auto measure = [&](const std::string& config, int robots, int threads) {
-    std::vector<std::string> args{options.self_exe, "bench", "--child", config,
-                                  "--child-robots", std::to_string(robots), "--child-threads",
-                                  std::to_string(threads), "--steps",
-                                  std::to_string(options.steps), "--world", options.world};
+    std::vector<std::string> args{options.self_exe,  "bench",
+                                  "--child",         config,
+                                  "--child-robots",  std::to_string(robots),
+                                  "--child-threads", std::to_string(threads),
+                                  "--steps",         std::to_string(options.steps),
+                                  "--world",         options.world};
     std::string output;
     int status = 0;
     BenchRow row;

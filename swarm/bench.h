@@ -13,10 +13,10 @@ struct BenchOptions {
   std::string world = "worlds/diffusion.yaml";
   std::vector<int> robots{100, 1000, 10000};
   std::vector<int> threads{1, 2};
-  int64_t steps = 200;       // measured steps per configuration
-  int64_t warmup_steps = 20; // unmeasured steps first (wheel commands settle)
+  int64_t steps = 200;        // measured steps per configuration
+  int64_t warmup_steps = 20;  // unmeasured steps first (wheel commands settle)
   std::optional<std::string> csv;
-  std::string self_exe;      // this program, re-run once per configuration
+  std::string self_exe;  // this program, re-run once per configuration
 };
 
 // One measured configuration (one CSV row).
@@ -39,7 +39,7 @@ int RunBench(const BenchOptions& options, std::ostream& out, std::ostream& err);
 
 // The child side: measures one configuration in this process and prints one
 // CSV row (no header) to `out`. `config` is "diffusion" or "box2d-only".
-int RunBenchChild(const BenchOptions& options, const std::string& config, int robots,
-                  int threads, std::ostream& out);
+int RunBenchChild(const BenchOptions& options, const std::string& config, int robots, int threads,
+                  std::ostream& out);
 
 }  // namespace swarmsim

@@ -8,8 +8,8 @@
 namespace swarmsim::loader {
 namespace {
 
-const std::vector<std::string> kConstraintNames = {"x", "y", "z", "alpha", "beta", "gamma",
-                                                   "position", "pose"};
+const std::vector<std::string> kConstraintNames = {"x",    "y",     "z",        "alpha",
+                                                   "beta", "gamma", "position", "pose"};
 
 uint8_t ConstraintBit(const std::string& name) {
   if (name == "position") return kIkPosition;
@@ -25,11 +25,13 @@ uint8_t ReadConstraints(const ValueReader& values, const Field& field) {
   uint8_t bits = 0;
   for (const Field& e : ListElements(values.file(), field, "constraints"))
     bits |= ConstraintBit(values.Choice(e, kConstraintNames));
-  if (bits == 0) values.Fail(field, "'constraints' needs at least one of x, y, z, alpha, beta, gamma");
+  if (bits == 0)
+    values.Fail(field, "'constraints' needs at least one of x, y, z, alpha, beta, gamma");
   return bits;
 }
 
-void CollectPaths(const ObjectSpec& spec, const std::string& prefix, std::vector<std::string>* out) {
+void CollectPaths(const ObjectSpec& spec, const std::string& prefix,
+                  std::vector<std::string>* out) {
   for (const ObjectSpec& child : spec.children) {
     const std::string path = prefix.empty() ? child.name : prefix + "/" + child.name;
     out->push_back(path);
@@ -44,8 +46,8 @@ std::vector<IkGroupDef> ReadIkGroups(const ModelFile& model, const ValueReader& 
   std::set<std::string> names;
   for (const Field& element : ListElements(model.file, model.ik_groups, "IK groups")) {
     Fields f(model.file, element, "an IK group of model '" + model.name + "'");
-    f.Expect({"name", "tips", "mode", "damping", "iterations", "tolerance",
-              "orientation_tolerance", "max_step", "conditional", "automatic", "weights"});
+    f.Expect({"name", "tips", "mode", "damping", "iterations", "tolerance", "orientation_tolerance",
+              "max_step", "conditional", "automatic", "weights"});
     IkGroupDef def;
     def.field = element;
     IkGroupSpec& s = def.spec;

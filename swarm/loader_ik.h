@@ -22,8 +22,8 @@ struct IkTipDef {
 };
 
 struct IkGroupDef {
-  Field field;                 // the group's mapping, for messages
-  IkGroupSpec spec;            // settings; objects filled in by AddIkGroups
+  Field field;       // the group's mapping, for messages
+  IkGroupSpec spec;  // settings; objects filled in by AddIkGroups
   std::vector<IkTipDef> tips;
   std::vector<std::pair<Field, double>> weights;  // joint path, weight
 };

@@ -1,10 +1,10 @@
 #include "swarm/loader_mesh.h"
 
-#include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
 #include <algorithm>
+#include <assimp/Importer.hpp>
 #include <cctype>
 
 #include "framework/error.h"
@@ -88,8 +88,7 @@ std::shared_ptr<const MeshCache::Welded> ReadMeshFile(const fs::path& path,
       out->triangles.push_back(tri);
     }
   }
-  if (out->triangles.empty())
-    throw Error(prefix + "mesh file '" + text + "' has no triangles");
+  if (out->triangles.empty()) throw Error(prefix + "mesh file '" + text + "' has no triangles");
   return out;
 }
 

@@ -20,14 +20,20 @@ constexpr int64_t kMaxRingCount = 1024;
 
 constexpr double kDegToRad = M_PI / 180.0;
 
-const std::vector<std::string> kObjectTypes = {"shape",          "joint",        "dummy",
-                                               "proximity_sensor", "proximity_ring", "force_sensor",
-                                               "paint_nozzle"};
+const std::vector<std::string> kObjectTypes = {
+    "shape",          "joint",        "dummy",       "proximity_sensor",
+    "proximity_ring", "force_sensor", "paint_nozzle"};
 const std::vector<std::string> kCommonKeys = {
     "name", "type", "position", "orientation_deg", "heading_deg", "children", "script"};
-const std::vector<std::string> kJointKeys = {
-    "joint",           "mode", "max_force", "max_velocity", "target_velocity", "target_position",
-    "initial_position", "target_force", "limits"};
+const std::vector<std::string> kJointKeys = {"joint",
+                                             "mode",
+                                             "max_force",
+                                             "max_velocity",
+                                             "target_velocity",
+                                             "target_position",
+                                             "initial_position",
+                                             "target_force",
+                                             "limits"};
 const std::vector<std::string> kSensorKeys = {"range"};
 const std::vector<std::string> kForceSensorKeys = {"filter_samples", "force_threshold",
                                                    "torque_threshold", "break_after"};
@@ -117,7 +123,8 @@ struct Builder {
     } else if (type == "paint_nozzle") {
       named.Expect(Concat({&kCommonKeys, &kPaintNozzleKeys}));
       spec.type = ObjectType::kPaintNozzle;
-      if (named.Has("color")) spec.paint_nozzle.color = values.Vector3(named.Get("color"), kFraction);
+      if (named.Has("color"))
+        spec.paint_nozzle.color = values.Vector3(named.Get("color"), kFraction);
       if (named.Has("radius"))
         spec.paint_nozzle.radius = values.Number(named.Get("radius"), kPositiveLength);
       if (named.Has("enabled")) spec.paint_nozzle.enabled = values.Bool(named.Get("enabled"));
@@ -244,9 +251,9 @@ std::shared_ptr<const ScriptSource> ScriptCache::Get(const fs::path& path, const
 // --- Shapes and poses ----------------------------------------------------------------
 
 const std::vector<std::string>& ShapeKeys() {
-  static const std::vector<std::string> keys = {
-      "shape", "size", "radius", "height", "dynamic", "mass", "friction", "restitution", "color",
-      "file", "scale"};
+  static const std::vector<std::string> keys = {"shape",   "size", "radius",   "height",
+                                                "dynamic", "mass", "friction", "restitution",
+                                                "color",   "file", "scale"};
   return keys;
 }
 
@@ -294,8 +301,9 @@ ShapeData ReadShape(const ValueReader& values, const Fields& f, MeshCache* meshe
     s.size = {values.Number(f.Require("radius"), kPositiveLength), 0,
               values.Number(f.Require("height"), kPositiveLength)};
     if (kind == "capsule" && s.size.z < 2 * s.size.x)
-      values.Fail(f.Get("height"), "a capsule's height includes its caps: it must be at least "
-                                   "twice its radius");
+      values.Fail(f.Get("height"),
+                  "a capsule's height includes its caps: it must be at least "
+                  "twice its radius");
   } else {
     s.kind = ShapeKind::kSphere;
     forbid("size", "a sphere takes 'radius'");
@@ -385,14 +393,14 @@ ModelFile ReadModelFile(YamlFile file, const std::string& used_by) {
         d.Expect({"default", "unit", "description", "range"});
         if (d.Has("range")) {
           const Field range = d.Get("range");
-          const ParamValue lo = range.node.IsSequence() && range.node.size() == 2 &&
-                                        range.node[0].IsScalar()
-                                    ? ParseScalar(range.node[0].Scalar(), false)
-                                    : ParamValue(std::string());
-          const ParamValue hi = range.node.IsSequence() && range.node.size() == 2 &&
-                                        range.node[1].IsScalar()
-                                    ? ParseScalar(range.node[1].Scalar(), false)
-                                    : ParamValue(std::string());
+          const ParamValue lo =
+              range.node.IsSequence() && range.node.size() == 2 && range.node[0].IsScalar()
+                  ? ParseScalar(range.node[0].Scalar(), false)
+                  : ParamValue(std::string());
+          const ParamValue hi =
+              range.node.IsSequence() && range.node.size() == 2 && range.node[1].IsScalar()
+                  ? ParseScalar(range.node[1].Scalar(), false)
+                  : ParamValue(std::string());
           if (!std::holds_alternative<double>(lo) || !std::holds_alternative<double>(hi) ||
               !(std::get<double>(lo) <= std::get<double>(hi)))
             f.Fail(range.mark, "'range' must be [min, max], two numbers with min <= max (got " +

@@ -60,7 +60,7 @@ struct ModelFile {
   YamlFile file;
   std::string name;  // "footbot"
   std::vector<ModelParameterDecl> parameters;
-  Field root;  // the root object
+  Field root;       // the root object
   Field ik_groups;  // IK groups (swarm/loader_ik.h), not present if none
 };
 

@@ -26,8 +26,8 @@ void AddPaintLayer(const YamlFile& file, const Field& top_field, const Field& pa
     if (f.Has("area")) {
       const Field area = f.Get("area");
       if (!area.node.IsMap())
-        file.Fail(area.mark, "'area' must be {min: [x, y], max: [x, y]} (got " +
-                                 Describe(area.node) + ")");
+        file.Fail(area.mark,
+                  "'area' must be {min: [x, y], max: [x, y]} (got " + Describe(area.node) + ")");
       Fields a(file, area, "'area'");
       a.Expect({"min", "max"});
       const std::vector<double> lo = values.Numbers(a.Require("min"), 2, 2, kCoordinate);

@@ -68,8 +68,7 @@ std::vector<std::pair<std::string, std::string>> ParseSets(const std::vector<std
 void PrintDescription(const LoadedWorld& w, std::ostream& out) {
   const WorldSettings& s = w.world->settings();
   out << "world: " << s.file << "\n"
-      << "physics: " << s.physics << ", time step " << s.time_step << " s, seed " << s.seed
-      << "\n"
+      << "physics: " << s.physics << ", time step " << s.time_step << " s, seed " << s.seed << "\n"
       << "main script: " << (s.main_script ? s.main_script->path : "(default step)") << "\n";
   if (!w.world->parameters().empty()) {
     out << "world parameters:\n";
@@ -117,13 +116,12 @@ int Main(int argc, char** argv) {
   bool trust_scripts = false;
   std::vector<std::string> plugins;
   run->add_option("world", world_file, "World file (YAML)")->required();
-  auto* steps_opt = run->add_option("--steps", steps, "Number of control steps to run")
-                        ->check(kNonNegative);
+  auto* steps_opt =
+      run->add_option("--steps", steps, "Number of control steps to run")->check(kNonNegative);
   run->add_option("--duration", duration, "Simulated seconds to run")
       ->check(kNonNegative)
       ->excludes(steps_opt);
-  run->add_option("--threads", threads, "Worker threads (default: all cores)")
-      ->check(kPositive);
+  run->add_option("--threads", threads, "Worker threads (default: all cores)")->check(kPositive);
   run->add_option("--seed", seed, "Random seed (overrides the world's)");
   run->add_option("--set", sets, "Override a parameter: name=value or model.name=value")
       ->allow_extra_args(false);
@@ -168,13 +166,14 @@ int Main(int argc, char** argv) {
   int64_t sweep_steps = -1;
   double sweep_duration = -1;
   sweep->add_option("world", sweep_options.world, "World file (YAML)")->required();
-  sweep->add_option("--param", sweep_options.params,
-                    "NAME=SPEC: a list 100,200,400, a range A:B:N or a log range log:A:B:N")
+  sweep
+      ->add_option("--param", sweep_options.params,
+                   "NAME=SPEC: a list 100,200,400, a range A:B:N or a log range log:A:B:N")
       ->allow_extra_args(false);
   sweep->add_option("--seeds", sweep_options.seeds, "K (seeds 1..K), A-B, or a list 3,7,11")
       ->capture_default_str();
-  auto* sweep_steps_opt = sweep->add_option("--steps", sweep_steps, "Control steps per run")
-                              ->check(kNonNegative);
+  auto* sweep_steps_opt =
+      sweep->add_option("--steps", sweep_steps, "Control steps per run")->check(kNonNegative);
   sweep->add_option("--duration", sweep_duration, "Simulated seconds per run")
       ->check(kNonNegative)
       ->excludes(sweep_steps_opt);
@@ -218,7 +217,8 @@ int Main(int argc, char** argv) {
   std::string describe_world;
   std::vector<std::string> describe_sets;
   describe->add_option("world", describe_world, "World file (YAML)")->required();
-  describe->add_option("--set", describe_sets, "Override a parameter: name=value or model.name=value")
+  describe
+      ->add_option("--set", describe_sets, "Override a parameter: name=value or model.name=value")
       ->allow_extra_args(false);
   CLI::App* version = app.add_subcommand("version", "Print the version");
 
@@ -309,7 +309,8 @@ int Main(int argc, char** argv) {
   if (steps >= 0) {
     options.steps = steps;
   } else if (duration >= 0) {
-    options.steps = static_cast<int64_t>(std::llround(duration / loaded.world->settings().time_step));
+    options.steps =
+        static_cast<int64_t>(std::llround(duration / loaded.world->settings().time_step));
   } else if (loaded.steps) {
     options.steps = *loaded.steps;
   } else {

@@ -97,7 +97,8 @@ std::unique_ptr<Observer> MakeSwarmMetric(const SwarmMetricSpec& spec) {
     return std::make_unique<MeanNearestNeighborDistance>(spec.every_steps);
   if (spec.name == "covered_area") return std::make_unique<CoveredArea>(spec.every_steps);
   std::string known;
-  for (const auto& [name, description] : KnownSwarmMetrics()) known += (known.empty() ? "" : ", ") + name;
+  for (const auto& [name, description] : KnownSwarmMetrics())
+    known += (known.empty() ? "" : ", ") + name;
   throw Error("unknown metric '" + spec.name + "' (known: " + known + ")");
 }
 

@@ -131,7 +131,8 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
       if (metrics) metrics->Write(world->TakeMetrics());
       progress.Update(result.steps, world->time());
     }
-    lua_kib = static_cast<double>(world->script_memory_bytes()) / 1024.0;  // before the states close
+    lua_kib =
+        static_cast<double>(world->script_memory_bytes()) / 1024.0;  // before the states close
     world->Stop();
     if (metrics) metrics->Write(world->TakeMetrics());
     result.ok = true;
@@ -168,12 +169,12 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
         << " s, " << world->settings().physics_substeps << " physics substeps)\n"
         << "simulated time  " << Fixed(sim_time, 2) << " s\n"
         << "wall time       " << Fixed(result.wall_seconds, 3) << " s on " << world->threads()
-        << (world->threads() == 1 ? " thread\n" : " threads\n")
-        << "real-time factor " << Fixed(rtf, 1) << "x\n"
+        << (world->threads() == 1 ? " thread\n" : " threads\n") << "real-time factor "
+        << Fixed(rtf, 1) << "x\n"
         << "robot-ticks/s   " << Fixed(ticks_per_s, 0) << "\n"
         << "peak memory     " << Fixed(result.peak_rss_mb, 1) << " MiB ("
-        << Fixed(robots > 0 ? result.peak_rss_mb * 1024 / robots : 0, 1) << " KiB per robot, of which Lua "
-        << Fixed(robots > 0 ? lua_kib / robots : 0, 1) << ")\n"
+        << Fixed(robots > 0 ? result.peak_rss_mb * 1024 / robots : 0, 1)
+        << " KiB per robot, of which Lua " << Fixed(robots > 0 ? lua_kib / robots : 0, 1) << ")\n"
         << "time per phase  (ms total, us per robot-tick)\n";
     for (size_t p = 0; p < static_cast<size_t>(Phase::kCount); ++p) {
       const double t = world->phase_times()[p];
@@ -212,9 +213,12 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
     j["phase_seconds"] = phases;
     nlohmann::json params;
     for (const auto& [name, value] : world->parameters()) {
-      if (const double* d = std::get_if<double>(&value)) params[name] = *d;
-      else if (const bool* b = std::get_if<bool>(&value)) params[name] = *b;
-      else params[name] = std::get<std::string>(value);
+      if (const double* d = std::get_if<double>(&value))
+        params[name] = *d;
+      else if (const bool* b = std::get_if<bool>(&value))
+        params[name] = *b;
+      else
+        params[name] = std::get<std::string>(value);
     }
     j["parameters"] = params;
     std::ofstream f(*options.out_dir / "summary.json");

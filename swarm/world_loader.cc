@@ -29,9 +29,8 @@ namespace {
 constexpr int64_t kMaxCount = 1000000;  // copies per models entry
 constexpr double kDegToRad = M_PI / 180.0;
 
-const std::vector<std::string> kTopKeys = {"simulation", "parameters", "arena",
-                                           "obstacles",  "models",     "metrics", "paint",
-                                           "plugins"};
+const std::vector<std::string> kTopKeys = {"simulation", "parameters", "arena", "obstacles",
+                                           "models",     "metrics",    "paint", "plugins"};
 
 // One --set, split into its target.
 struct Override {
@@ -112,8 +111,7 @@ std::string RangeError(const loader::ModelParameterDecl& decl, const std::string
 
 // The script files of a model's objects, in tree order, once each.
 void CollectScripts(const ObjectSpec& spec, std::vector<std::string>* out) {
-  if (spec.script &&
-      std::find(out->begin(), out->end(), spec.script->path) == out->end())
+  if (spec.script && std::find(out->begin(), out->end(), spec.script->path) == out->end())
     out->push_back(spec.script->path);
   for (const ObjectSpec& child : spec.children) CollectScripts(child, out);
 }
@@ -245,7 +243,8 @@ std::shared_ptr<const ModuleRegistry> WorldLoader::LoadPlugins(const Fields& top
       candidates.push_back(path_.parent_path() / text);
     } else {
       candidates.push_back(path_.parent_path() / (text + ".so"));
-      for (const fs::path& dir : options_.plugin_directories) candidates.push_back(dir / (text + ".so"));
+      for (const fs::path& dir : options_.plugin_directories)
+        candidates.push_back(dir / (text + ".so"));
     }
     std::error_code ec;
     const auto found = std::find_if(candidates.begin(), candidates.end(),
@@ -355,10 +354,10 @@ WorldSettings WorldLoader::ReadSimulation(const Fields& top, std::optional<int64
     if (f.Has("instruction_budget"))
       s.instruction_budget = values.Integer(f.Get("instruction_budget"), 0, int64_t{1} << 40);
     if (f.Has("on_script_error"))
-      s.on_script_error = values.Choice(f.Get("on_script_error"), {"stop", "disable_script"}) ==
-                                  "stop"
-                              ? ScriptErrorPolicy::kStop
-                              : ScriptErrorPolicy::kDisableScript;
+      s.on_script_error =
+          values.Choice(f.Get("on_script_error"), {"stop", "disable_script"}) == "stop"
+              ? ScriptErrorPolicy::kStop
+              : ScriptErrorPolicy::kDisableScript;
     {
       // The default backend must exist too (a test registry may lack it).
       const Field physics =
@@ -759,7 +758,8 @@ std::vector<ModelSummary> WorldLoader::Summarize() const {
       p.unit = decl.unit;
       p.description = decl.description;
       if (decl.has_range)
-        p.range = "[" + loader::FormatNumber(decl.min) + ", " + loader::FormatNumber(decl.max) + "]";
+        p.range =
+            "[" + loader::FormatNumber(decl.min) + ", " + loader::FormatNumber(decl.max) + "]";
       m.parameters.push_back(std::move(p));
     }
     for (const auto& [index, own] : e.instance_parameters) {

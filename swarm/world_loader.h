@@ -48,9 +48,9 @@ struct ModelSummary {
   std::string name;  // "footbot"
   std::string file;  // the model file, as the world names it
   int64_t count = 0;
-  std::vector<ParameterSummary> parameters;             // values of every copy (after --set)
+  std::vector<ParameterSummary> parameters;                // values of every copy (after --set)
   std::vector<std::pair<int64_t, std::string>> instances;  // copy index -> "name=value, ..."
-  std::vector<std::string> scripts;                      // script files, tree order
+  std::vector<std::string> scripts;                        // script files, tree order
   int ik_groups = 0;
 };
 

@@ -9,7 +9,8 @@ namespace swarmsim::kinematics {
 
 Chain Chain::FromScene(const Scene& scene, ObjectId base, ObjectId tip) {
   const uint32_t tip_slot = scene.SlotOf(tip, "IK tip");
-  const int32_t base_slot = base.IsNull() ? -1 : static_cast<int32_t>(scene.SlotOf(base, "IK base"));
+  const int32_t base_slot =
+      base.IsNull() ? -1 : static_cast<int32_t>(scene.SlotOf(base, "IK base"));
   // Path from the tip up to (not including) the base.
   std::vector<uint32_t> path;
   int32_t s = static_cast<int32_t>(tip_slot);
@@ -30,8 +31,8 @@ Chain Chain::FromScene(const Scene& scene, ObjectId base, ObjectId tip) {
     if (scene.type_at(slot) != ObjectType::kJoint) continue;
     const JointData& j = scene.joints()[scene.row_at(slot)];
     if (j.type == JointType::kRevolute || j.type == JointType::kPrismatic) {
-      chain.joints_.push_back({X_acc, j.type == JointType::kPrismatic, j.min_position,
-                               j.max_position, slot});
+      chain.joints_.push_back(
+          {X_acc, j.type == JointType::kPrismatic, j.min_position, j.max_position, slot});
       X_acc = Pose{};
     } else {
       X_acc = X_acc * j.Motion();  // fixed, or spherical frozen at its rotation

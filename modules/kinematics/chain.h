@@ -25,10 +25,10 @@
 namespace swarmsim::kinematics {
 
 struct ChainJoint {  // 88 bytes
-  Pose X_before;      // constant transform from the previous joint's moved frame (or the base)
-  bool prismatic;     // else revolute
+  Pose X_before;     // constant transform from the previous joint's moved frame (or the base)
+  bool prismatic;    // else revolute
   double min_position, max_position;  // limits, rad or m
-  uint32_t slot;      // the joint's scene slot
+  uint32_t slot;                      // the joint's scene slot
 };
 
 class Chain {

@@ -25,13 +25,14 @@ struct Group {
   // Built from the scene on first use and after structural changes.
   uint64_t built_version = ~uint64_t{0};
   std::optional<IkProblem> problem;
-  std::vector<int32_t> base_slot;    // per tip, -1: the world
-  std::vector<int32_t> fixed_target; // per tip: target slot read each solve, -1: closed chain
+  std::vector<int32_t> base_slot;     // per tip, -1: the world
+  std::vector<int32_t> fixed_target;  // per tip: target slot read each solve, -1: closed chain
 };
 
 bool IsAncestor(const Scene& scene, int32_t ancestor, uint32_t slot) {
   if (ancestor < 0) return true;
-  for (int32_t s = static_cast<int32_t>(slot); s >= 0; s = scene.parent_at(static_cast<uint32_t>(s)))
+  for (int32_t s = static_cast<int32_t>(slot); s >= 0;
+       s = scene.parent_at(static_cast<uint32_t>(s)))
     if (s == ancestor) return true;
   return false;
 }
@@ -75,8 +76,8 @@ class IkGroupsImpl final : public IkGroups {
   const IkGroupSpec& spec(int handle) const override { return At(handle).spec; }
   IkStatus last_status(int handle) const override { return At(handle).last; }
   int live_group_count() const override {
-    return static_cast<int>(std::count_if(groups_.begin(), groups_.end(),
-                                          [](const Group& g) { return g.alive; }));
+    return static_cast<int>(
+        std::count_if(groups_.begin(), groups_.end(), [](const Group& g) { return g.alive; }));
   }
 
   IkStatus Handle(int handle, Scene* scene) override {
@@ -98,8 +99,10 @@ class IkGroupsImpl final : public IkGroups {
         Solve(&g, &scene);
         // Direct mode: later groups of the robot see the new poses.
         if (g.spec.mode != IkMode::kDirect) continue;
-        if (independent) scene.UpdateWorldPoses(r);
-        else scene.UpdateWorldPoses();
+        if (independent)
+          scene.UpdateWorldPoses(r);
+        else
+          scene.UpdateWorldPoses();
       }
     };
     const int64_t n = static_cast<int64_t>(by_instance_.size());
@@ -164,7 +167,8 @@ class IkGroupsImpl final : public IkGroups {
     for (Group& g : groups_) {
       if (!g.alive) continue;
       bool remove = false;
-      for (const IkTipSpec& t : g.spec.tips) remove |= gone(t.tip) || gone(t.target) || gone(t.base);
+      for (const IkTipSpec& t : g.spec.tips)
+        remove |= gone(t.tip) || gone(t.target) || gone(t.base);
       for (const auto& [joint, weight] : g.spec.weights) remove |= gone(joint);
       if (remove) {
         g.alive = false;
@@ -176,8 +180,9 @@ class IkGroupsImpl final : public IkGroups {
 
  private:
   Group& At(int handle) {
-    if (!IsLive(handle)) throw Error("no IK group with handle " + std::to_string(handle) +
-                                     " (it was removed with its model, or never existed)");
+    if (!IsLive(handle))
+      throw Error("no IK group with handle " + std::to_string(handle) +
+                  " (it was removed with its model, or never existed)");
     return groups_[handle - 1];
   }
   const Group& At(int handle) const { return const_cast<IkGroupsImpl*>(this)->At(handle); }
@@ -191,8 +196,8 @@ class IkGroupsImpl final : public IkGroups {
       const ObjectId base_id = base >= 0 ? scene.IdAt(static_cast<uint32_t>(base)) : ObjectId{};
       Chain tip_chain = Chain::FromScene(scene, base_id, t.tip);
       if (tip_chain.dof() == 0)
-        throw Error("IK group '" + g->spec.name + "': no joint between '" +
-                    scene.PathOf(base_id) + "' and the tip '" + scene.PathOf(t.tip) + "'");
+        throw Error("IK group '" + g->spec.name + "': no joint between '" + scene.PathOf(base_id) +
+                    "' and the tip '" + scene.PathOf(t.tip) + "'");
       const uint32_t target_slot = scene.SlotOf(t.target, "IK target");
       Chain target_chain;
       const bool below_base = base >= 0 && IsAncestor(scene, base, target_slot);
@@ -258,8 +263,10 @@ class IkGroupsImpl final : public IkGroups {
   }
 
   static void RefreshPoses(int instance, Scene* scene) {
-    if (instance >= 0 && scene->InstancesAreIndependent()) scene->UpdateWorldPoses(instance);
-    else scene->UpdateWorldPoses();
+    if (instance >= 0 && scene->InstancesAreIndependent())
+      scene->UpdateWorldPoses(instance);
+    else
+      scene->UpdateWorldPoses();
   }
 
   void RebuildByInstance(const Scene& scene) {
@@ -269,8 +276,10 @@ class IkGroupsImpl final : public IkGroups {
     for (size_t i = 0; i < groups_.size(); ++i) {
       const Group& g = groups_[i];
       if (!g.alive || !g.spec.automatic) continue;
-      if (g.instance >= 0) by_instance_[g.instance].push_back(static_cast<int>(i) + 1);
-      else scene_groups_.push_back(static_cast<int>(i) + 1);
+      if (g.instance >= 0)
+        by_instance_[g.instance].push_back(static_cast<int>(i) + 1);
+      else
+        scene_groups_.push_back(static_cast<int>(i) + 1);
     }
     by_instance_dirty_ = false;
   }

@@ -75,14 +75,16 @@ std::vector<double> IkProblem::ReadPositions(const Scene& scene) const {
 }
 
 void IkProblem::WritePositions(std::span<const double> q, Scene* scene) const {
-  for (size_t i = 0; i < slots_.size(); ++i) scene->joints()[scene->row_at(slots_[i])].position = q[i];
+  for (size_t i = 0; i < slots_.size(); ++i)
+    scene->joints()[scene->row_at(slots_[i])].position = q[i];
 }
 
 IkResult IkProblem::Solve(const IkSettings& settings, std::vector<double>* q_io) const {
   const int n = dof();
   SWARMSIM_CHECK(static_cast<int>(q_io->size()) == n, "IK: q has the wrong size");
   int rows = 0;
-  for (const Element& e : elements_) rows += std::popcount(static_cast<unsigned>(e.constraints & kPose));
+  for (const Element& e : elements_)
+    rows += std::popcount(static_cast<unsigned>(e.constraints & kPose));
   std::vector<double> q = *q_io;
   std::vector<double> q_chain;
   Pose X_WJ[kMaxIkDof], X_WJt[kMaxIkDof];

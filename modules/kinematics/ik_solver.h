@@ -26,19 +26,24 @@
 namespace swarmsim::kinematics {
 
 enum IkConstraint : uint8_t {
-  kX = 1, kY = 2, kZ = 4, kAlpha = 8, kBeta = 16, kGamma = 32,
+  kX = 1,
+  kY = 2,
+  kZ = 4,
+  kAlpha = 8,
+  kBeta = 16,
+  kGamma = 32,
   kPosition = kX | kY | kZ,
   kOrientation = kAlpha | kBeta | kGamma,
   kPose = kPosition | kOrientation,
 };
 
 struct IkSettings {
-  double damping = 1e-3;               // lambda
+  double damping = 1e-3;  // lambda
   int max_iterations = 30;
-  double position_tolerance = 1e-5;    // m
-  double orientation_tolerance = 1e-4; // rad
-  double max_step = 0.4;               // rad or m per iteration and joint
-  bool apply_only_when_solved = true;  // conditional solving
+  double position_tolerance = 1e-5;     // m
+  double orientation_tolerance = 1e-4;  // rad
+  double max_step = 0.4;                // rad or m per iteration and joint
+  bool apply_only_when_solved = true;   // conditional solving
 };
 
 struct IkResult {
@@ -59,7 +64,9 @@ class IkProblem {
   // closed chain): the target moves with q too; its chain's joints are
   // unknowns as well. Both chains start at the same base.
   int AddClosedElement(Chain tip_chain, Chain target_chain, uint8_t constraints = kPose);
-  void set_target(int element, const Pose& X_WTarget) { elements_.at(element).X_WTarget = X_WTarget; }
+  void set_target(int element, const Pose& X_WTarget) {
+    elements_.at(element).X_WTarget = X_WTarget;
+  }
   // Moving bases: the world pose of an element's base (both its chains).
   void set_base_pose(int element, const Pose& X_WBase);
   const Chain& chain(int element) const { return elements_.at(element).chain; }

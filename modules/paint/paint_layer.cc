@@ -16,7 +16,9 @@ namespace {
 constexpr double kMaxPixels = 100e6;
 constexpr int64_t kRobotGrain = 16;
 
-uint8_t ToByte(double c) { return static_cast<uint8_t>(std::lround(std::clamp(c, 0.0, 1.0) * 255)); }
+uint8_t ToByte(double c) {
+  return static_cast<uint8_t>(std::lround(std::clamp(c, 0.0, 1.0) * 255));
+}
 
 }  // namespace
 
@@ -40,7 +42,8 @@ PaintLayer::PaintLayer(World* world, const PaintSettings& settings)
   rgb_.resize(3 * n);
   const uint8_t bg[3] = {ToByte(settings_.background.x), ToByte(settings_.background.y),
                          ToByte(settings_.background.z)};
-  for (size_t p = 0; p < n; ++p) std::copy(bg, bg + 3, rgb_.begin() + static_cast<ptrdiff_t>(3 * p));
+  for (size_t p = 0; p < n; ++p)
+    std::copy(bg, bg + 3, rgb_.begin() + static_cast<ptrdiff_t>(3 * p));
 }
 
 Vec3 PaintLayer::PixelCentre(int column, int row) const {
@@ -64,8 +67,10 @@ void PaintLayer::RefreshNozzles(const Scene& scene) {
   std::sort(slots.begin(), slots.end());
   for (uint32_t slot : slots) {
     const int instance = scene.instance_of_at(slot);
-    if (instance >= 0) robot_nozzles_[instance].push_back(slot);
-    else scene_nozzles_.push_back(slot);
+    if (instance >= 0)
+      robot_nozzles_[instance].push_back(slot);
+    else
+      scene_nozzles_.push_back(slot);
   }
 }
 

@@ -23,10 +23,10 @@
 namespace swarmsim::paint {
 
 struct PaintSettings {
-  double resolution = 0.01;            // m, side of one pixel
-  double min_x = -1, min_y = -1;       // m, the floor area covered
+  double resolution = 0.01;       // m, side of one pixel
+  double min_x = -1, min_y = -1;  // m, the floor area covered
   double max_x = 1, max_y = 1;
-  Vec3 background{1, 1, 1};            // RGB in [0, 1], unpainted floor
+  Vec3 background{1, 1, 1};  // RGB in [0, 1], unpainted floor
 };
 
 class PaintLayer final : public Observer {

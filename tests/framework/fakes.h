@@ -30,7 +30,8 @@ class NullProximity : public ProximityBackend {
 // A registry with "null" dynamics and "proximity" (null) modules.
 inline ModuleRegistry NullRegistry() {
   ModuleRegistry r;
-  r.RegisterDynamics({"", "null", "1", "moves nothing"}, [] { return std::make_unique<NullDynamics>(); });
+  r.RegisterDynamics({"", "null", "1", "moves nothing"},
+                     [] { return std::make_unique<NullDynamics>(); });
   r.RegisterProximity({"", "proximity", "1", "detects nothing"},
                       [] { return std::make_unique<NullProximity>(); });
   return r;

@@ -135,8 +135,9 @@ TEST_F(SandboxTest, RequireLoadsModulesFromTheWorldFoldersOncePerState) {
                 "assert(u == require('util')); assert(h.four == 4); assert(count == nil)"),
             "");
   EXPECT_EQ(Log(), "[bot#0] loading util\n");
-  EXPECT_CONTAINS(Run("\nrequire('nothere')"), "scripts/robot.lua:2: require: module 'nothere' "
-                                               "not found; looked for:");
+  EXPECT_CONTAINS(Run("\nrequire('nothere')"),
+                  "scripts/robot.lua:2: require: module 'nothere' "
+                  "not found; looked for:");
   EXPECT_CONTAINS(Run("require('../secret')"), "is not a module name");
   Write(root_ / "world" / "bad.lua", "os.execute('true')\n");
   EXPECT_CONTAINS(Run("require('bad')"), "bad.lua:1: os.execute is not allowed");

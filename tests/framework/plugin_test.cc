@@ -45,8 +45,8 @@ TEST(PluginTest, CommandsAreCalledFromLuaWithNumbersArraysAndContext) {
   for (int r = 0; r < 2; ++r) {
     const ObjectId root = world.scene().AddDummy("bot", {}, {{1.0 + r, 2, 0}, {}});
     world.scene().MakeModelInstance(root, "bot", "bot#" + std::to_string(r));
-    world.scene().AttachScript(root, std::make_shared<const ScriptSource>(ScriptSource{
-                                         "robot.lua", R"(
+    world.scene().AttachScript(root,
+                               std::make_shared<const ScriptSource>(ScriptSource{"robot.lua", R"(
 function sysCall_actuation()
   local p, robot = sim.exampleWhereAmI()
   print(sim.exampleSum(1, 2, {3, 4}), p[1], p[2], robot)
@@ -84,7 +84,8 @@ TEST(PluginTest, PhaseCallbacksRunAtTheirPointsOfTheStep) {
   world.set_log_sink([&](std::string_view line) { log.emplace_back(line); });
   const ObjectId root = world.scene().AddDummy("bot", {}, {});
   world.scene().MakeModelInstance(root, "bot", "bot#0");
-  world.scene().AttachScript(root, std::make_shared<const ScriptSource>(ScriptSource{"robot.lua", R"(
+  world.scene().AttachScript(root,
+                             std::make_shared<const ScriptSource>(ScriptSource{"robot.lua", R"(
 function sysCall_actuation()
   print(table.concat(sim.examplePhaseCounts(), ' '))
 end)"}));

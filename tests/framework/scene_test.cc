@@ -91,7 +91,8 @@ TEST(SceneTest, JointMotionMovesChildren) {
 
   JointData p;
   p.type = JointType::kPrismatic;
-  const ObjectId slider = scene.AddJoint("s", {}, {{0, 0, 0}, Quat::FromAxisAngle({0, 1, 0}, M_PI / 2)}, p);
+  const ObjectId slider =
+      scene.AddJoint("s", {}, {{0, 0, 0}, Quat::FromAxisAngle({0, 1, 0}, M_PI / 2)}, p);
   const ObjectId carriage = scene.AddDummy("c", slider, {});
   scene.mutable_joint(slider).position = 0.25;  // along the joint's z, i.e. world +x
   scene.UpdateWorldPoses();

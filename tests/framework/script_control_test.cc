@@ -36,9 +36,10 @@ class ScriptWorld {
 
   // A robot: root dummy at (x, y) with heading `yaw` carrying a `body`
   // dummy with `code` attached (unless empty). Returns the body.
-  ObjectId AddRobot(const std::string& name, const std::string& code, double x = 0,
-                    double y = 0, double yaw = 0) {
-    const ObjectId root = scene().AddDummy(name, {}, {{x, y, 0}, Quat::FromAxisAngle({0, 0, 1}, yaw)});
+  ObjectId AddRobot(const std::string& name, const std::string& code, double x = 0, double y = 0,
+                    double yaw = 0) {
+    const ObjectId root =
+        scene().AddDummy(name, {}, {{x, y, 0}, Quat::FromAxisAngle({0, 0, 1}, yaw)});
     const ObjectId body = scene().AddDummy("body", root, {});
     scene().MakeModelInstance(root, "bot", name);
     if (!code.empty()) scene().AttachScript(body, Source("scripts/robot.lua", code));
@@ -85,14 +86,15 @@ TEST(ScriptControlTest, ExplicitScriptRunsOnlyWhenItsParentCallsItAndReturnsValu
       print('arm', n, s)
       return n * 2, s .. '!'
     end
-  )"), /*explicit_handling=*/true);
+  )"),
+                         /*explicit_handling=*/true);
   w.scene().AttachScript(hand, Source("scripts/hand.lua", R"(
     function sysCall_actuation() print('hand (implicit, after its parents)') end
   )"));
   w.Steps(1);
-  const std::vector<std::string> expected = {
-      "[bot#0] parent before", "[bot#0] arm\t3\tx", "[bot#0] parent got\t6\tx!",
-      "[bot#0] hand (implicit, after its parents)"};
+  const std::vector<std::string> expected = {"[bot#0] parent before", "[bot#0] arm\t3\tx",
+                                             "[bot#0] parent got\t6\tx!",
+                                             "[bot#0] hand (implicit, after its parents)"};
   EXPECT_EQ(w.log, expected);
 }
 
@@ -159,7 +161,8 @@ TEST(ScriptControlTest, ThreadSlicesAreDeterministic) {
         n = 0
         function sysCall_thread() while true do n = n + 1 end end
         function sysCall_sensing() sim.recordMetric('n', n) end
-      )", r);
+      )",
+                 r);
     w.Steps(4);
     std::vector<double> values;
     for (const MetricSample& m : w.world().TakeMetrics()) values.push_back(m.value);
@@ -197,7 +200,8 @@ TEST(ScriptControlTest, StopPolicyEndsTheRunWithTheFaultyRobotNamed) {
                         : "function sysCall_actuation() end",
                r);
   const std::string error = ErrorOf([&] { w.Steps(1); });
-  EXPECT_CONTAINS(error, "bot#617: scripts/robot.lua:1: boom [in sysCall_actuation of /bot#617/body]");
+  EXPECT_CONTAINS(error,
+                  "bot#617: scripts/robot.lua:1: boom [in sysCall_actuation of /bot#617/body]");
 }
 
 TEST(ScriptControlTest, DisableScriptPolicyLogsOnceAndTheSwarmGoesOn) {
@@ -237,9 +241,9 @@ TEST(ScriptControlTest, WorldMainScriptRunsThePhases) {
     function sysCall_actuation() print('actuation') end
   )");
   w.Steps(2);
-  const std::vector<std::string> expected = {
-      "[main] main\t0.0",  "[bot#0] actuation", "[bot#0] sensing",
-      "[main] main\t0.1",  "[bot#0] actuation", "[bot#0] sensing"};
+  const std::vector<std::string> expected = {"[main] main\t0.0",  "[bot#0] actuation",
+                                             "[bot#0] sensing",   "[main] main\t0.1",
+                                             "[bot#0] actuation", "[bot#0] sensing"};
   EXPECT_EQ(w.log, expected);
   EXPECT_DOUBLE_EQ(w.world().time(), 0.2);
 }
@@ -260,16 +264,19 @@ TEST(ScriptControlTest, HandleChildScriptsForwardsExtraArguments) {
     w.AddRobot("bot#" + std::to_string(r), R"(
       function sysCall_sensing(name, value, flag) print(name, value, flag) end
       function sysCall_actuation(...) print('actuation', select('#', ...)) end
-    )", r);
+    )",
+               r);
   w.Steps(1);
-  const std::vector<std::string> expected = {
-      "[bot#0] gain\t2.5\ttrue", "[bot#1] gain\t2.5\ttrue", "[bot#2] gain\t2.5\ttrue",
-      "[bot#0] actuation\t0",    "[bot#1] actuation\t0",    "[bot#2] actuation\t0"};
+  const std::vector<std::string> expected = {"[bot#0] gain\t2.5\ttrue", "[bot#1] gain\t2.5\ttrue",
+                                             "[bot#2] gain\t2.5\ttrue", "[bot#0] actuation\t0",
+                                             "[bot#1] actuation\t0",    "[bot#2] actuation\t0"};
   EXPECT_EQ(w.log, expected);
   WorldSettings bad;
-  bad.main_script = Source("main.lua", "function sysCall_step() sim.handleChildScripts('all', {}) end");
+  bad.main_script =
+      Source("main.lua", "function sysCall_step() sim.handleChildScripts('all', {}) end");
   ScriptWorld v(1, bad);
-  EXPECT_CONTAINS(ErrorOf([&] { v.Steps(1); }), "main.lua:1: sim.handleChildScripts: argument 2 must be");
+  EXPECT_CONTAINS(ErrorOf([&] { v.Steps(1); }),
+                  "main.lua:1: sim.handleChildScripts: argument 2 must be");
 }
 
 TEST(ScriptControlTest, MainScriptMustStepTheDynamicsAndChildrenCannotRunPhases) {
@@ -288,7 +295,8 @@ TEST(ScriptControlTest, MainScriptMustStepTheDynamicsAndChildrenCannotRunPhases)
 std::string Receiver(const std::string& send) {
   return R"(
     function sysCall_actuation()
-      if sim.getSimulationTime() == 0 then )" + send + R"( end
+      if sim.getSimulationTime() == 0 then )" +
+         send + R"( end
       while true do
         local data, sender, distance, bearing = sim.receiveMessage()
         if not data then break end
@@ -305,7 +313,8 @@ TEST(ScriptControlTest, MessageScopesReachExactlyTheirReceiversAtTheNextStep) {
   // b's body script sends local + direct; its eye script receives.
   const ObjectId b = w.AddRobot("b", Receiver(R"(
       sim.sendLocalMessage('l')
-      sim.sendDirectMessage(sim.getObject('/a/body'), 'd'))"), 1, 0, M_PI / 2);
+      sim.sendDirectMessage(sim.getObject('/a/body'), 'd'))"),
+                                1, 0, M_PI / 2);
   const ObjectId eye = w.scene().AddDummy("eye", b, {});
   w.scene().AttachScript(eye, Source("scripts/eye.lua", Receiver("")));
   w.AddRobot("c", Receiver("sim.sendRangeMessage('r', 1.5)"), 0, 1);
@@ -316,9 +325,8 @@ TEST(ScriptControlTest, MessageScopesReachExactlyTheirReceiversAtTheNextStep) {
   // Sender-handle order (a's body, b's body, c's body); b faces +y, so a
   // (at -x from b) is at bearing +pi/2 in b's frame.
   const std::vector<std::string> expected = {
-      "[a] d\tb\t1.00 0.00", "[a] r\tc\t1.00 1.57",  "[b] g\ta\t1.00 1.57",
-      "[b] r\tc\t1.41 0.79", "[b] g\ta\t1.00 1.57",  "[b] l\tb\t0.00 0.00",
-      "[b] r\tc\t1.41 0.79", "[c] g\ta\t1.00 -1.57"};
+      "[a] d\tb\t1.00 0.00", "[a] r\tc\t1.00 1.57", "[b] g\ta\t1.00 1.57", "[b] r\tc\t1.41 0.79",
+      "[b] g\ta\t1.00 1.57", "[b] l\tb\t0.00 0.00", "[b] r\tc\t1.41 0.79", "[c] g\ta\t1.00 -1.57"};
   EXPECT_EQ(w.log, expected);
 }
 
@@ -331,10 +339,12 @@ TEST(ScriptControlTest, RangeMessagesHonourRangeAndLineOfSight) {
     }
   };
   ModuleRegistry walled;
-  walled.RegisterDynamics({"", "null", "1", ""}, [] { return std::make_unique<testing::NullDynamics>(); });
+  walled.RegisterDynamics({"", "null", "1", ""},
+                          [] { return std::make_unique<testing::NullDynamics>(); });
   walled.RegisterProximity({"", "proximity", "1", ""}, [] { return std::make_unique<Wall>(); });
   ScriptWorld w(1, {}, std::move(walled));
-  w.AddRobot("s", Receiver("sim.sendRangeMessage('open', 2); sim.sendRangeMessage('los', 2, true)"), 0, 0);
+  w.AddRobot("s", Receiver("sim.sendRangeMessage('open', 2); sim.sendRangeMessage('los', 2, true)"),
+             0, 0);
   w.AddRobot("near", Receiver(""), 0, 1.9);
   w.AddRobot("behind", Receiver(""), 1, 0);
   w.AddRobot("far", Receiver(""), 0, -2.1);
@@ -359,7 +369,8 @@ TEST(ScriptControlTest, RangeMessagingIsTheSameAtAnyThreadCount) {
           sim.recordMetric('sum', sum)
           sim.sendRangeMessage(sim.packFloats({sim.random()}), 0.5)
         end
-      )", (r % 20) * 0.3, (r / 20) * 0.3);
+      )",
+                 (r % 20) * 0.3, (r / 20) * 0.3);
     w.Steps(3);
     std::vector<double> v;
     for (const MetricSample& m : w.world().TakeMetrics()) v.push_back(m.value);
@@ -381,7 +392,8 @@ TEST(ScriptControlTest, SignalsAreVisibleFromTheNextStepAndTheLastRobotWins) {
         sim.setSignal('who', sim.getRobotIndex())
         if sim.getSimulationTime() > 0.05 then sim.clearSignal('flag') else sim.setSignal('flag', true) end
       end
-    )", r);
+    )",
+               r);
   w.Steps(3);
   EXPECT_EQ(w.log, (std::vector<std::string>{"[bot#0] nil\tnil", "[bot#0] 39.0\ttrue",
                                              "[bot#0] 39.0\tnil"}));

@@ -36,8 +36,10 @@ class ConveyorDynamics : public DynamicsBackend {
 
 ModuleRegistry MakeRegistry() {
   ModuleRegistry r = testing::NullRegistry();
-  r.RegisterDynamics({"", "conveyor", "1", ""}, [] { return std::make_unique<ConveyorDynamics>(false); });
-  r.RegisterDynamics({"", "explode", "1", ""}, [] { return std::make_unique<ConveyorDynamics>(true); });
+  r.RegisterDynamics({"", "conveyor", "1", ""},
+                     [] { return std::make_unique<ConveyorDynamics>(false); });
+  r.RegisterDynamics({"", "explode", "1", ""},
+                     [] { return std::make_unique<ConveyorDynamics>(true); });
   return r;
 }
 

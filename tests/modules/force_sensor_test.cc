@@ -78,8 +78,8 @@ TEST(ForceSensorTest, ReadsWeightOfHangingMassInOde) {
 
 TEST(ForceSensorTest, TorqueOfOffsetMassAboutSensorOrigin) {
   Fixture f;
-  const ObjectId beam =
-      f.scene().AddShape("beam", {}, {{0, 0, 2}, {}}, Shape(ShapeKind::kBox, {0.2, 0.2, 0.05}, false));
+  const ObjectId beam = f.scene().AddShape("beam", {}, {{0, 0, 2}, {}},
+                                           Shape(ShapeKind::kBox, {0.2, 0.2, 0.05}, false));
   const ObjectId sensor = f.scene().AddForceSensor("sensor", beam, {{0, 0, -0.05}, {}}, {});
   // Mass 0.2 m out along +x: gravity pulls it down, the sensor holds it
   // with torque r x F = (0.2, 0, 0) x (0, 0, m g) = (0, -0.2 m g, 0).

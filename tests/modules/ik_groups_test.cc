@@ -1,12 +1,13 @@
 // IK groups as calculation objects: solved in the actuate phase, copied and
 // removed with their model, the same whatever the thread count; several
 // tips and closed chains.
+#include "framework/ik_groups.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <string>
 
-#include "framework/ik_groups.h"
 #include "framework/registry.h"
 #include "framework/world.h"
 #include "modules/builtin.h"

@@ -1,6 +1,8 @@
 // Forward kinematics against closed forms and the UR5's published DH
 // kinematics; IK by damped least squares: reach, limits, conditional
 // solving, constraint subsets, several tips, redundancy.
+#include "tests/modules/kinematics_test.h"
+
 #include <gtest/gtest.h>
 
 #include <random>
@@ -8,7 +10,6 @@
 #include "framework/error.h"
 #include "modules/kinematics/chain.h"
 #include "modules/kinematics/ik_solver.h"
-#include "tests/modules/kinematics_test.h"
 
 namespace swarmsim::kinematics {
 namespace {
@@ -116,8 +117,8 @@ TEST(InverseKinematics, Ur5ReachesNearbyTargetsAndWritesTheScene) {
     const IkResult r = ik.Solve({}, &q);
     const Pose X = ik.chain(0).CalcTipPose(q);
     const Pose X_target = ik.chain(0).CalcTipPose(goal);
-    const double dq = std::abs(X.q.w * X_target.q.w + X.q.x * X_target.q.x +
-                               X.q.y * X_target.q.y + X.q.z * X_target.q.z);
+    const double dq = std::abs(X.q.w * X_target.q.w + X.q.x * X_target.q.x + X.q.y * X_target.q.y +
+                               X.q.z * X_target.q.z);
     if (r.solved && (X.p - X_target.p).Norm() <= 1e-4 && 2 * std::acos(std::min(1.0, dq)) <= 1e-3)
       ++reached;
   }

@@ -32,8 +32,9 @@ inline Ur5 AddUr5(Scene* scene, const Pose& X_WBase = {}) {
     j.mode = JointMode::kPassive;
     const ObjectId joint = scene->AddJoint("joint" + std::to_string(i + 1), parent, {}, j);
     arm.joints.push_back(joint);
-    parent = scene->AddDummy("link" + std::to_string(i + 1), joint,
-                             {{kUr5A[i], 0, kUr5D[i]}, Quat::FromAxisAngle({1, 0, 0}, kUr5Alpha[i])});
+    parent =
+        scene->AddDummy("link" + std::to_string(i + 1), joint,
+                        {{kUr5A[i], 0, kUr5D[i]}, Quat::FromAxisAngle({1, 0, 0}, kUr5Alpha[i])});
   }
   arm.tip = scene->AddDummy("tip", parent, {});
   return arm;

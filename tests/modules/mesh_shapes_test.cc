@@ -122,9 +122,8 @@ TEST_P(MeshProximity, RayBesideTheMeshMisses) {
   const bool robot = GetParam();
   // A 0.2 m mesh cube at the origin; rays along +x passing 1 mm beside it.
   const Quat along_x = Quat::FromAxisAngle({0, 1, 0}, M_PI / 2);
-  const std::vector<Pose> poses = {{{-0.5, 0.101, 0}, along_x},
-                                   {{-0.5, 0, 0.101}, along_x},
-                                   {{-0.5, 0, 0.099}, along_x}};
+  const std::vector<Pose> poses = {
+      {{-0.5, 0.101, 0}, along_x}, {{-0.5, 0, 0.101}, along_x}, {{-0.5, 0, 0.099}, along_x}};
   const auto r = Readings(Mesh(BoxMesh({0.2, 0.2, 0.2})), {{0, 0, 0}, {}}, robot, poses);
   EXPECT_FALSE(r[0].detected);
   EXPECT_FALSE(r[1].detected);

@@ -223,8 +223,8 @@ TEST(OdeBackend, SphericalJointSwingsAndReportsItsRotation) {
 TEST(OdeBackend, FixedJointKeepsTwoFallingBodiesTogether) {
   Fixture f(0.005, 2);
   const ObjectId a = f.scene().AddShape("a", {}, {{0, 0, 1}, {}}, Box({0.2, 0.2, 0.2}, true));
-  const ObjectId j =
-      f.scene().AddJoint("weld", a, {{0.1, 0, 0}, {}}, Joint(JointType::kFixed, JointMode::kPassive));
+  const ObjectId j = f.scene().AddJoint("weld", a, {{0.1, 0, 0}, {}},
+                                        Joint(JointType::kFixed, JointMode::kPassive));
   const ObjectId b = f.scene().AddShape("b", j, {{0.1, 0, 0}, {}}, Box({0.2, 0.2, 0.2}, true));
   for (int i = 0; i < 40; ++i) f.world->Step();
   const Pose X_AB = f.scene().world_pose(a).Inverse() * f.scene().world_pose(b);
@@ -240,7 +240,8 @@ struct Wheeled {
 Wheeled AddWheeledRobot(Scene* scene, const Vec3& at, double omega) {
   Wheeled r;
   const double R = 0.05;
-  r.chassis = scene->AddShape("chassis", {}, {at + Vec3{0, 0, R}, {}}, Box({0.3, 0.2, 0.05}, true, 2));
+  r.chassis =
+      scene->AddShape("chassis", {}, {at + Vec3{0, 0, R}, {}}, Box({0.3, 0.2, 0.05}, true, 2));
   ShapeData caster = Sphere(0.025, false);
   caster.friction = 0;
   scene->AddShape("caster", r.chassis, {{-0.12, 0, -0.025}, {}}, caster);
@@ -256,8 +257,8 @@ Wheeled AddWheeledRobot(Scene* scene, const Vec3& at, double omega) {
     m.max_force = 5;
     // Joint z along +y (left) or -y (right): Rx(-90 deg) turns z onto +y.
     const Quat q = Quat::FromAxisAngle({1, 0, 0}, -side * M_PI / 2);
-    const ObjectId motor = scene->AddJoint(side > 0 ? "left" : "right", r.chassis,
-                                           {{0.05, side * 0.13, 0}, q}, m);
+    const ObjectId motor =
+        scene->AddJoint(side > 0 ? "left" : "right", r.chassis, {{0.05, side * 0.13, 0}, q}, m);
     scene->AddShape("wheel", motor, {}, wheel);
     (side > 0 ? r.left : r.right) = motor;
   }
@@ -305,7 +306,7 @@ TEST(OdeBackend, KinematicPlatformLiftsADynamicBall) {
   f.scene().AddShape("platform", j, {}, Box({1, 1, 0.05}, false));
   const ObjectId ball = f.scene().AddShape("ball", {}, {{0, 0, 0.2}, {}}, Sphere(0.075, true));
   f.world->Start();
-  EXPECT_FALSE(f.scene().joint(j).simulated);  // no dynamic child: kinematic
+  EXPECT_FALSE(f.scene().joint(j).simulated);     // no dynamic child: kinematic
   for (int i = 0; i < 100; ++i) f.world->Step();  // platform top rises 0.2 m to 0.325
   EXPECT_NEAR(f.scene().joint(j).position, 0.2, 1e-9);
   EXPECT_NEAR(f.scene().world_pose(ball).p.z, 0.325 + 0.2 + 0.075 - 0.2, 0.01);
@@ -313,7 +314,8 @@ TEST(OdeBackend, KinematicPlatformLiftsADynamicBall) {
 
 TEST(OdeBackend, HybridSwitchMakesAKinematicBoxFallAndStopsItAgain) {
   Fixture f(0.01, 2);
-  const ObjectId crate = f.scene().AddShape("crate", {}, {{0, 0, 1}, {}}, Box({0.1, 0.1, 0.1}, false));
+  const ObjectId crate =
+      f.scene().AddShape("crate", {}, {{0, 0, 1}, {}}, Box({0.1, 0.1, 0.1}, false));
   for (int i = 0; i < 20; ++i) f.world->Step();
   EXPECT_DOUBLE_EQ(f.scene().world_pose(crate).p.z, 1.0);  // static: held in the air
   f.scene().SetShapeDynamic(crate, true);
@@ -332,8 +334,10 @@ TEST(OdeBackend, ScriptReleasesARobotsBoxWithSetObjectDynamic) {
   // A gripper-like robot holds a kinematic box; its script releases it at
   // t = 0.2 s, after which it falls to the ground.
   Fixture f(0.01, 2);
-  const ObjectId base = f.scene().AddShape("base", {}, {{0, 0, 0.05}, {}}, Box({0.1, 0.1, 0.1}, false));
-  const ObjectId crate = f.scene().AddShape("crate", {}, {{1, 0, 0.5}, {}}, Box({0.1, 0.1, 0.1}, false));
+  const ObjectId base =
+      f.scene().AddShape("base", {}, {{0, 0, 0.05}, {}}, Box({0.1, 0.1, 0.1}, false));
+  const ObjectId crate =
+      f.scene().AddShape("crate", {}, {{1, 0, 0.5}, {}}, Box({0.1, 0.1, 0.1}, false));
   f.scene().MakeModelInstance(base, "robot", "robot#0");
   const std::string code = R"(
     function sysCall_init() crate = sim.getObject('/crate') end
@@ -342,7 +346,8 @@ TEST(OdeBackend, ScriptReleasesARobotsBoxWithSetObjectDynamic) {
         sim.setObjectDynamic(crate, true)
       end
     end)";
-  f.scene().AttachScript(base, std::make_shared<const ScriptSource>(ScriptSource{"release.lua", code}));
+  f.scene().AttachScript(base,
+                         std::make_shared<const ScriptSource>(ScriptSource{"release.lua", code}));
   for (int i = 0; i < 20; ++i) f.world->Step();
   EXPECT_DOUBLE_EQ(f.scene().world_pose(crate).p.z, 0.5);
   for (int i = 0; i < 100; ++i) f.world->Step();

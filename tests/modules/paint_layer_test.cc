@@ -141,16 +141,15 @@ std::vector<uint8_t> PaintCircles(int threads) {
   for (int step = 0; step < 40; ++step) {
     for (int i = 0; i < 64; ++i) {
       const double a = 0.1 * step + i;
-      f.scene().SetWorldPose(bots[i], {{0.2 * std::cos(a) + 0.003 * i, 0.15 * std::sin(a), 0.1}, {}});
+      f.scene().SetWorldPose(bots[i],
+                             {{0.2 * std::cos(a) + 0.003 * i, 0.15 * std::sin(a), 0.1}, {}});
     }
     f.world->Step();
   }
   return f.layer->rgb();
 }
 
-TEST(PaintLayerTest, SameImageAtOneAndTwoThreads) {
-  EXPECT_EQ(PaintCircles(1), PaintCircles(2));
-}
+TEST(PaintLayerTest, SameImageAtOneAndTwoThreads) { EXPECT_EQ(PaintCircles(1), PaintCircles(2)); }
 
 }  // namespace
 }  // namespace swarmsim::paint

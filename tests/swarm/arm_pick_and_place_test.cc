@@ -22,8 +22,8 @@ std::unique_ptr<World> RunArm(int threads, int steps) {
   }();
   LoadOptions options;
   options.threads = threads;
-  LoadedWorld loaded = LoadWorld(std::string(SWARMSIM_SOURCE_DIR) + "/worlds/arm_pick_and_place.yaml",
-                                 options, *registry);
+  LoadedWorld loaded = LoadWorld(
+      std::string(SWARMSIM_SOURCE_DIR) + "/worlds/arm_pick_and_place.yaml", options, *registry);
   loaded.world->set_log_sink([](std::string_view) {});
   for (int i = 0; i < steps; ++i) loaded.world->Step();
   return std::move(loaded.world);

@@ -37,8 +37,8 @@ std::string Data(const std::string& name) {
 }
 
 fs::path TempDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("swarmsim_cli_" + name + "_" +
-                                                    std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("swarmsim_cli_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   return dir;
 }
@@ -86,14 +86,20 @@ TEST(CliTest, TypoInWorldNamesLineAndSuggests) {
 
 TEST(CliTest, RunWritesSummaryAndMetricsAndHashIsStable) {
   const fs::path out = TempDir("ok");
-  Result r = RunProgram("run " + Data("ok.yaml") + " --steps 20 --threads 2 --hash --out " + out.string());
+  Result r =
+      RunProgram("run " + Data("ok.yaml") + " --steps 20 --threads 2 --hash --out " + out.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("robot-ticks/s"), std::string::npos) << r.output;
   const std::string hash = HashOf(r.output);
   ASSERT_EQ(hash.size(), 16u) << r.output;
   // Same hash on one thread; another seed gives another.
-  EXPECT_EQ(HashOf(RunProgram("run " + Data("ok.yaml") + " --steps 20 --threads 1 --hash --quiet").output), hash);
-  EXPECT_NE(HashOf(RunProgram("run " + Data("ok.yaml") + " --steps 20 --seed 99 --hash --quiet").output), hash);
+  EXPECT_EQ(
+      HashOf(
+          RunProgram("run " + Data("ok.yaml") + " --steps 20 --threads 1 --hash --quiet").output),
+      hash);
+  EXPECT_NE(
+      HashOf(RunProgram("run " + Data("ok.yaml") + " --steps 20 --seed 99 --hash --quiet").output),
+      hash);
 
   std::ifstream summary_file(out / "summary.json");
   ASSERT_TRUE(summary_file.good());

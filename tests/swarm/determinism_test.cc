@@ -16,8 +16,8 @@ uint64_t RunDiffusion(int robots, int threads, uint64_t seed, int steps) {
   options.overrides = {{"robots", std::to_string(robots)}};
   options.seed = seed;
   options.threads = threads;
-  LoadedWorld loaded = LoadWorld(std::string(SWARMSIM_SOURCE_DIR) + "/worlds/diffusion.yaml",
-                                 options, registry);
+  LoadedWorld loaded =
+      LoadWorld(std::string(SWARMSIM_SOURCE_DIR) + "/worlds/diffusion.yaml", options, registry);
   loaded.world->set_log_sink([](std::string_view) {});
   loaded.world->Start();
   for (int i = 0; i < steps; ++i) loaded.world->Step();
@@ -39,8 +39,8 @@ TEST(DeterminismTest, RobotsActuallyMoveSoTheHashMeansSomething) {
   LoadOptions options;
   options.overrides = {{"robots", "50"}};
   options.threads = 2;
-  LoadedWorld loaded = LoadWorld(std::string(SWARMSIM_SOURCE_DIR) + "/worlds/diffusion.yaml",
-                                 options, registry);
+  LoadedWorld loaded =
+      LoadWorld(std::string(SWARMSIM_SOURCE_DIR) + "/worlds/diffusion.yaml", options, registry);
   World& world = *loaded.world;
   world.set_log_sink([](std::string_view) {});
   world.Start();

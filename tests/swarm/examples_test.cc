@@ -27,7 +27,7 @@ struct WorldRun {
 };
 
 WorldRun RunWorld(const std::string& name, int threads, int steps,
-             std::vector<std::pair<std::string, std::string>> overrides = {}) {
+                  std::vector<std::pair<std::string, std::string>> overrides = {}) {
   ModuleRegistry registry;
   RegisterBuiltinModules(&registry);
   LoadOptions options;

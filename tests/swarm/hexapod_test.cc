@@ -39,7 +39,7 @@ TEST(HexapodTest, WalksAtLeastOneBodyLengthIn20Seconds) {
   const ObjectId body = scene.instance(0).root;
   const Vec3 start = scene.world_pose(body).p;
   const double body_length = 2 * scene.shape(body).size.x;  // body diameter, 0.24 m
-  for (int i = 0; i < 1000; ++i) world.Step();  // 20 s
+  for (int i = 0; i < 1000; ++i) world.Step();              // 20 s
   const Vec3 end = scene.world_pose(body).p;
   const double advance = end.x - start.x;
   RecordProperty("advance_m", std::to_string(advance));

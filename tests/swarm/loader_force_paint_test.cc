@@ -56,10 +56,11 @@ class LoaderForcePaintTest : public ::testing::Test {
               "        - {name: load, type: shape, shape: sphere, radius: 0.05, dynamic: true,\n"
               "           mass: 2, position: [0, 0, -0.25]}\n"
               "    - {name: pen, type: paint_nozzle, color: [1, 0, 0], radius: 0.05}\n");
-    const fs::path world = Write(
-        "world.yaml", "simulation: {physics: ode, time_step: 0.01, physics_substeps: 2}\n"
-                      "arena: {size: 2}\n" + extra_world +
-                      "models: [{model: hanger.yaml, position: [0, 0, 2]}]\n");
+    const fs::path world =
+        Write("world.yaml",
+              "simulation: {physics: ode, time_step: 0.01, physics_substeps: 2}\n"
+              "arena: {size: 2}\n" +
+                  extra_world + "models: [{model: hanger.yaml, position: [0, 0, 2]}]\n");
     return LoadWorld(world, {}, registry_);
   }
   ModuleRegistry registry_;

@@ -56,15 +56,14 @@ class LoaderIkTest : public ::testing::Test {
   void Write(const std::string& name, const std::string& text) {
     std::ofstream(dir_ / name, std::ios::binary) << text;
   }
-  LoadedWorld Load(const std::string& groups, const std::string& script = "",
-                   int count = 3) {
+  LoadedWorld Load(const std::string& groups, const std::string& script = "", int count = 3) {
     Write("arm.yaml", std::string(kArm) + groups);
     Write("arm.lua", script);
     Write("world.yaml",
           "simulation: {physics: kinematic, time_step: 0.05}\n"
           "arena: {size: 20}\n"
-          "models: [{model: arm.yaml, count: " + std::to_string(count) +
-              ", distribute: {region: arena}}]\n");
+          "models: [{model: arm.yaml, count: " +
+              std::to_string(count) + ", distribute: {region: arena}}]\n");
     LoadedWorld loaded = LoadWorld(dir_ / "world.yaml", {}, registry_);
     loaded.world->set_log_sink([this](std::string_view line) { log_ += std::string(line) + "\n"; });
     return loaded;
@@ -95,7 +94,8 @@ TEST_F(LoaderIkTest, EveryCopyGetsItsGroupAndItSolvesEachStep) {
   const Scene& scene = world.scene();
   for (int r = 0; r < 3; ++r) {
     const ObjectId root = scene.instance(r).root;
-    const ObjectId tip = scene.FindObject("./tip", root), target = scene.FindObject("./target", root);
+    const ObjectId tip = scene.FindObject("./tip", root),
+                   target = scene.FindObject("./target", root);
     EXPECT_LT((scene.world_pose(tip).p - scene.world_pose(target).p).Norm(), 1e-5) << r;
     EXPECT_EQ(scene.linked_dummy(tip), target);
   }
@@ -122,10 +122,11 @@ TEST_F(LoaderIkTest, MistakesNameTheLineAndTheNearestName) {
   EXPECT_NE(bad_path.find("did you mean 'j1/j2/tip'"), std::string::npos) << bad_path;
   const std::string bad_key = ErrorOf("  - {name: reach, dampnig: 1, tips: []}\n");
   EXPECT_NE(bad_key.find("did you mean 'damping'"), std::string::npos) << bad_key;
-  const std::string bad_constraint =
-      ErrorOf("  - {name: reach, tips: [{tip: j1/j2/tip, target: target, constraints: [x, yy]}]}\n");
+  const std::string bad_constraint = ErrorOf(
+      "  - {name: reach, tips: [{tip: j1/j2/tip, target: target, constraints: [x, yy]}]}\n");
   EXPECT_NE(bad_constraint.find("arm.yaml:20:"), std::string::npos) << bad_constraint;
-  const std::string no_joints = ErrorOf("  - {name: reach, tips: [{tip: target, target: j1/j2/tip}]}\n");
+  const std::string no_joints =
+      ErrorOf("  - {name: reach, tips: [{tip: target, target: j1/j2/tip}]}\n");
   EXPECT_NE(no_joints.find("no joint between"), std::string::npos) << no_joints;
 }
 

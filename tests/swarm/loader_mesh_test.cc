@@ -42,11 +42,12 @@ class LoaderMeshTest : public ::testing::Test {
   // A world with `count` copies of models/bot.yaml, whose body shape has `shape_keys`.
   LoadedWorld Load(const std::string& shape_keys, int count = 1,
                    const std::string& obstacles = "") {
-    Write("models/bot.yaml", "model: bot\n"
-                             "objects:\n"
-                             "  name: body\n"
-                             "  type: shape\n" +
-                                 shape_keys);
+    Write("models/bot.yaml",
+          "model: bot\n"
+          "objects:\n"
+          "  name: body\n"
+          "  type: shape\n" +
+              shape_keys);
     const fs::path world = Write(
         "world.yaml", "simulation: {physics: ode, time_step: 0.01}\n" + obstacles +
                           "models: [{model: models/bot.yaml, count: " + std::to_string(count) +

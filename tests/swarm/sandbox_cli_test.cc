@@ -36,8 +36,8 @@ Result RunProgram(const std::string& args) {
 
 // A world folder whose one robot runs `code` in sysCall_init (line 2).
 fs::path MakeWorld(const std::string& code) {
-  const fs::path dir = fs::temp_directory_path() / ("swarmsim_sandbox_cli_" +
-                                                    std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("swarmsim_sandbox_cli_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   std::ofstream(dir / "world.yaml") << "simulation: {physics: kinematic, time_step: 0.1}\n"

@@ -37,9 +37,10 @@ class WorldLoader3dTest : public ::testing::Test {
   // Loads world.yaml placing one copy of arm.yaml (with `model` as its text).
   LoadedWorld LoadArm(const std::string& model, const std::string& physics = "ode") {
     Write("arm.yaml", model);
-    const fs::path world = Write("world.yaml", "simulation: {physics: " + physics +
-                                                   ", time_step: 0.01, physics_substeps: 2}\n"
-                                                   "models: [{model: arm.yaml, position: [0, 0]}]\n");
+    const fs::path world =
+        Write("world.yaml", "simulation: {physics: " + physics +
+                                ", time_step: 0.01, physics_substeps: 2}\n"
+                                "models: [{model: arm.yaml, position: [0, 0]}]\n");
     return LoadWorld(world, {}, registry_);
   }
   std::string ErrorOf(const std::string& model) {

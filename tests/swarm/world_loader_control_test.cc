@@ -46,7 +46,9 @@ class ControlLoaderTest : public ::testing::Test {
                                 [] { return std::make_unique<testing::NullProximity>(); });
   }
   void TearDown() override { fs::remove_all(dir_); }
-  void Write(const std::string& name, const std::string& text) { std::ofstream(dir_ / name) << text; }
+  void Write(const std::string& name, const std::string& text) {
+    std::ofstream(dir_ / name) << text;
+  }
   LoadedWorld Load(const std::string& world, LoadOptions options = {}) {
     Write("world.yaml", world);
     return LoadWorld(dir_ / "world.yaml", options, registry_);
@@ -111,8 +113,9 @@ TEST_F(ControlLoaderTest, PerCopyParametersOverrideTheEntrysAndSetAppliesToAll) 
 TEST_F(ControlLoaderTest, RangesAndInstanceMistakesNameFileLineAndColumn) {
   std::string bad = kThree;
   bad.replace(bad.find("speed: 0.4"), 10, "speed: 0.9");
-  EXPECT_CONTAINS(ErrorOf(bad), "world.yaml:8:40: parameter 'speed' of model 'bot' must be within "
-                                "[0, 0.5] m/s (got 0.9)");
+  EXPECT_CONTAINS(ErrorOf(bad),
+                  "world.yaml:8:40: parameter 'speed' of model 'bot' must be within "
+                  "[0, 0.5] m/s (got 0.9)");
   bad = kThree;
   bad.replace(bad.find("index: 1"), 8, "index: 3");
   EXPECT_CONTAINS(ErrorOf(bad), "world.yaml:8:17: 'index' must be below the entry's count (3)");
@@ -121,10 +124,12 @@ TEST_F(ControlLoaderTest, RangesAndInstanceMistakesNameFileLineAndColumn) {
   EXPECT_CONTAINS(ErrorOf(bad), "model 'bot' has no parameter 'colour'");
   LoadOptions set;
   set.overrides = {{"bot.speed", "2"}};
-  EXPECT_CONTAINS(ErrorOf(kThree, set), "--set bot.speed=2: parameter 'speed' of model 'bot' "
-                                        "must be within [0, 0.5]");
-  Write("bot.yaml", "model: bot\nparameters:\n  speed: {default: 0.1, range: [1]}\n"
-                    "objects: {name: body, type: dummy}\n");
+  EXPECT_CONTAINS(ErrorOf(kThree, set),
+                  "--set bot.speed=2: parameter 'speed' of model 'bot' "
+                  "must be within [0, 0.5]");
+  Write("bot.yaml",
+        "model: bot\nparameters:\n  speed: {default: 0.1, range: [1]}\n"
+        "objects: {name: body, type: dummy}\n");
   EXPECT_CONTAINS(ErrorOf(kThree), "bot.yaml:3:32: 'range' must be [min, max]");
 }
 

@@ -15,7 +15,8 @@ void PlaneWorld::BuildForceSensors(const Scene& scene, const std::vector<int32_t
   const auto owners = scene.force_sensor_owners();
   std::vector<uint32_t> rows(owners.size());
   for (uint32_t r = 0; r < rows.size(); ++r) rows[r] = r;
-  std::sort(rows.begin(), rows.end(), [&](uint32_t a, uint32_t b) { return owners[a] < owners[b]; });
+  std::sort(rows.begin(), rows.end(),
+            [&](uint32_t a, uint32_t b) { return owners[a] < owners[b]; });
   for (uint32_t row : rows) {
     const uint32_t s = owners[row];
     if (scene.force_sensors()[row].broken) continue;
@@ -45,8 +46,9 @@ void PlaneWorld::BuildForceSensors(const Scene& scene, const std::vector<int32_t
       }
     const Vec3& p_WS = scene.world_pose_at(s).p;
     b2WeldJointDef def;
-    def.Initialize(parent, bodies_[child].body,
-                   b2Vec2(static_cast<float>(p_WS.x * scale_), static_cast<float>(p_WS.y * scale_)));
+    def.Initialize(
+        parent, bodies_[child].body,
+        b2Vec2(static_cast<float>(p_WS.x * scale_), static_cast<float>(p_WS.y * scale_)));
     force_sensors_.push_back({world_->CreateJoint(&def), row, s});
   }
 }

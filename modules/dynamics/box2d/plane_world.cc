@@ -89,7 +89,8 @@ double CalcInertia(const ShapeData& shape) {
     case ShapeKind::kBox:
       return m * (shape.size.x * shape.size.x + shape.size.y * shape.size.y) / 12;
     case ShapeKind::kCylinder:
-    case ShapeKind::kCapsule: return 0.5 * m * shape.size.x * shape.size.x;  // capsule: as its cylinder
+    case ShapeKind::kCapsule:
+      return 0.5 * m * shape.size.x * shape.size.x;  // capsule: as its cylinder
     case ShapeKind::kSphere: return 0.4 * m * shape.size.x * shape.size.x;
     case ShapeKind::kMesh: {  // its bounding box's, about the shape's origin
       const Vec3 lo = shape.mesh ? shape.mesh->lo() : shape.size * -0.5;
@@ -155,8 +156,7 @@ bool MeshPolygons(const TriangleMesh& mesh, const Pose& X, double L,
   while (kept.size() > 1 && b2Distance(kept.front(), kept.back()) < weld) kept.pop_back();
   if (kept.size() < 3) return false;
   double area = 0;
-  for (size_t i = 0; i < kept.size(); ++i)
-    area += b2Cross(kept[i], kept[(i + 1) % kept.size()]);
+  for (size_t i = 0; i < kept.size(); ++i) area += b2Cross(kept[i], kept[(i + 1) % kept.size()]);
   if (area * 0.5 < 4 * b2_linearSlop * b2_linearSlop) return false;
   // Fan pieces: vertex 0 with up to 7 consecutive others.
   const size_t n = kept.size();
@@ -326,9 +326,10 @@ void PlaneWorld::Build(const Scene& scene) {
     const b2Vec2 center(static_cast<float>(X_WS.p.x * L), static_cast<float>(X_WS.p.y * L));
     b2CircleShape circle;
     b2PolygonShape polygon;
-    const bool round = shape->kind == ShapeKind::kSphere ||
-                       ((shape->kind == ShapeKind::kCylinder || shape->kind == ShapeKind::kCapsule) &&
-                        IsUpright(X_WS));
+    const bool round =
+        shape->kind == ShapeKind::kSphere ||
+        ((shape->kind == ShapeKind::kCylinder || shape->kind == ShapeKind::kCapsule) &&
+         IsUpright(X_WS));
     if (shape->kind == ShapeKind::kMesh) {
       // The hull of the vertices projected to the plane, in pieces.
       std::vector<b2PolygonShape> pieces;

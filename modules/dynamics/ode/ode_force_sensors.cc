@@ -23,7 +23,8 @@ void OdeWorld::BuildForceSensors(const Scene& scene, const std::vector<dBodyID>&
   // Slot order, like the joints, so the ODE joint list is the same every build.
   std::vector<uint32_t> rows(owners.size());
   for (uint32_t r = 0; r < rows.size(); ++r) rows[r] = r;
-  std::sort(rows.begin(), rows.end(), [&](uint32_t a, uint32_t b) { return owners[a] < owners[b]; });
+  std::sort(rows.begin(), rows.end(),
+            [&](uint32_t a, uint32_t b) { return owners[a] < owners[b]; });
   for (uint32_t row : rows) {
     const uint32_t s = owners[row];
     if (scene.force_sensors()[row].broken) continue;

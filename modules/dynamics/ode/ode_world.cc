@@ -117,7 +117,8 @@ Vec3 AngularVelocity(const Quat& q_from, const Quat& q_to, double duration) {
 
 Pose Interpolate(const Pose& a, const Pose& b, double f) {
   Quat qb = b.q;
-  if (a.q.w * qb.w + a.q.x * qb.x + a.q.y * qb.y + a.q.z * qb.z < 0) qb = {-qb.w, -qb.x, -qb.y, -qb.z};
+  if (a.q.w * qb.w + a.q.x * qb.x + a.q.y * qb.y + a.q.z * qb.z < 0)
+    qb = {-qb.w, -qb.x, -qb.y, -qb.z};
   const Quat q{a.q.w + (qb.w - a.q.w) * f, a.q.x + (qb.x - a.q.x) * f, a.q.y + (qb.y - a.q.y) * f,
                a.q.z + (qb.z - a.q.z) * f};
   return {a.p + (b.p - a.p) * f, q.Normalized()};
@@ -174,8 +175,7 @@ dTriMeshDataID OdeWorld::MeshData(const std::shared_ptr<const TriangleMesh>& mes
   // Few distinct meshes per world: a linear search is fine.
   dTriMeshDataID data = dGeomTriMeshDataCreate();
   dGeomTriMeshDataBuildDouble(data, mesh->vertices().data(), sizeof(Vec3),
-                              static_cast<int>(mesh->vertices().size()),
-                              mesh->triangles().data(),
+                              static_cast<int>(mesh->vertices().size()), mesh->triangles().data(),
                               static_cast<int>(3 * mesh->triangles().size()), sizeof(MeshTriangle));
   meshes_.emplace_back(mesh, data);
   return data;
@@ -218,8 +218,7 @@ void OdeWorld::Build(const Scene& scene) {
       throw Error("ode: dynamic shape '" + PathAt(scene, s) + "' needs a positive mass (got " +
                   std::to_string(shape->mass) + " kg)");
     dGeomID geom = MakeGeom(space_, *shape, MeshData(shape->mesh));
-    if (!geom)
-      throw Error("ode: dynamic shape '" + PathAt(scene, s) + "' needs a positive size");
+    if (!geom) throw Error("ode: dynamic shape '" + PathAt(scene, s) + "' needs a positive size");
     dBodyID body = dBodyCreate(world_);
     SetBodyPose(body, X_WS);
     const Vec3& v = scene.linear_velocity_at(s);
@@ -407,8 +406,10 @@ void OdeWorld::ApplyMotors(double dt) {
         max_force = c.max_force;
         break;
       case JointMode::kForce:
-        if (hinge) dJointAddHingeTorque(j.joint, c.target_force);
-        else dJointAddSliderForce(j.joint, c.target_force);
+        if (hinge)
+          dJointAddHingeTorque(j.joint, c.target_force);
+        else
+          dJointAddSliderForce(j.joint, c.target_force);
         break;
       case JointMode::kPassive: break;
     }
@@ -448,8 +449,10 @@ void OdeWorld::Substep(double dt, double fraction) {
   }
   ApplyMotors(dt);
   dSpaceCollide(space_, this, &OdeWorld::NearCallback);
-  if (options_.iterations > 0) dWorldQuickStep(world_, dt);
-  else dWorldStep(world_, dt);
+  if (options_.iterations > 0)
+    dWorldQuickStep(world_, dt);
+  else
+    dWorldStep(world_, dt);
   dJointGroupEmpty(contacts_);
   TrackJointPositions();
 }

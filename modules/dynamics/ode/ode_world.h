@@ -51,15 +51,15 @@ struct SimJoint {
 // A force sensor: a fixed joint with feedback between its child body and the
 // nearest body above (or the world). ode_force_sensors.cc.
 struct SimForceSensor {
-  dJointID joint;     // null once broken
-  uint32_t row;       // row in Scene::force_sensors()
-  dBodyID child_body; // body 1 of the joint
-  Pose X_BS;          // sensor frame in the child body
+  dJointID joint;      // null once broken
+  uint32_t row;        // row in Scene::force_sensors()
+  dBodyID child_body;  // body 1 of the joint
+  Pose X_BS;           // sensor frame in the child body
   dJointFeedback* feedback;
 };
 
 // Per geom: owner info for the contact filter and materials.
-struct GeomInfo {  // 24 bytes
+struct GeomInfo {    // 24 bytes
   int32_t instance;  // model instance or -1
   double friction;
   double restitution;
@@ -111,7 +111,7 @@ class OdeWorld {
   std::vector<SimJoint> joints_;
   std::vector<SimForceSensor> force_sensors_;
   std::vector<std::unique_ptr<dJointFeedback>> feedback_;  // (force_sensors_), stable addresses
-  std::vector<GeomInfo> geom_info_;  // indexed by the geom's data (index + 1)
+  std::vector<GeomInfo> geom_info_;                        // indexed by the geom's data (index + 1)
   std::vector<dContact> contact_buffer_;
   // Mesh assets in use and their trimesh data (ODE reads the asset's arrays in place).
   std::vector<std::pair<std::shared_ptr<const TriangleMesh>, dTriMeshDataID>> meshes_;

@@ -31,8 +31,8 @@ namespace {
 
 SwarmsimValue Number(double x) { return {kSwarmsimNumber, x, nullptr, nullptr, 0}; }
 
-int Sum(const SwarmsimCallContext*, const SwarmsimValue* args, int n, SwarmsimValue* results,
-        int, char* error, size_t error_size, void*) {
+int Sum(const SwarmsimCallContext*, const SwarmsimValue* args, int n, SwarmsimValue* results, int,
+        char* error, size_t error_size, void*) {
   double sum = 0;
   for (int i = 0; i < n; ++i) {
     if (args[i].type == kSwarmsimNumber) {
@@ -40,7 +40,8 @@ int Sum(const SwarmsimCallContext*, const SwarmsimValue* args, int n, SwarmsimVa
     } else if (args[i].type == kSwarmsimNumbers) {
       for (size_t k = 0; k < args[i].size; ++k) sum += args[i].numbers[k];
     } else {
-      std::snprintf(error, error_size, "argument %d must be a number or an array of numbers", i + 1);
+      std::snprintf(error, error_size, "argument %d must be a number or an array of numbers",
+                    i + 1);
       return -1;
     }
   }
