@@ -148,6 +148,7 @@ void RegisterAreas(lua_State* L) {
       RegisterIkApi,           // lua_api_ik.cc: IK groups
       RegisterForceSensorApi,  // lua_api_force.cc: force sensors
       RegisterPaintApi,        // lua_api_paint.cc: paint nozzles
+      RegisterCustomDataApi,   // lua_api_custom_data.cc: custom data blocks
   };
   lua_pushinteger(L, kHandleWorld);
   lua_setfield(L, -2, "handle_world");

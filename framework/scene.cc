@@ -108,6 +108,7 @@ uint32_t Scene::AllocateSlot(std::string name, ObjectId parent, const Pose& X_PO
     name_.emplace_back();
     script_.push_back(-1);
     linked_dummy_.push_back(-1);
+    custom_data_.emplace_back();
     size_factor_.push_back(1);
   }
   X_PO_[slot] = X_PO;
@@ -121,6 +122,7 @@ uint32_t Scene::AllocateSlot(std::string name, ObjectId parent, const Pose& X_PO
   name_[slot] = std::move(name);
   script_[slot] = -1;
   linked_dummy_[slot] = -1;
+  custom_data_[slot].reset();
   size_factor_[slot] = 1;
   parent_[slot] = -1;
   first_child_[slot] = last_child_[slot] = next_sibling_[slot] = prev_sibling_[slot] = -1;
@@ -167,6 +169,7 @@ void Scene::FreeSlot(uint32_t slot) {
   if (linked_dummy_[slot] >= 0 && linked_dummy_[linked_dummy_[slot]] == static_cast<int32_t>(slot))
     linked_dummy_[linked_dummy_[slot]] = -1;
   alive_[slot] = 0;
+  custom_data_[slot].reset();
   ++generation_[slot];
   name_[slot].clear();
   name_[slot].shrink_to_fit();
@@ -383,6 +386,8 @@ uint32_t Scene::CopyObject(uint32_t src, int32_t new_parent) {
   w_WO_[slot] = w_WO_[src];
   model_root_[slot] = model_root_[src];
   size_factor_[slot] = size_factor_[src];
+  if (custom_data_[src])
+    custom_data_[slot] = std::make_unique<std::map<std::string, std::string>>(*custom_data_[src]);
   if (script_[src] >= 0 && scripts_[script_[src]].source) {
     const ScriptAttachment attachment = scripts_[script_[src]];
     script_[slot] = static_cast<int32_t>(scripts_.size());
@@ -409,6 +414,7 @@ void Scene::ReserveForCopies(ObjectId root, size_t copies) {
     v->reserve(slots);
   size_factor_.reserve(slots);
   for (auto* v : {&simulated_, &alive_, &model_root_}) v->reserve(slots);
+  custom_data_.reserve(slots);
   type_.reserve(slots);
   row_.reserve(slots);
   generation_.reserve(slots);
@@ -701,6 +707,23 @@ void Scene::LinkDummies(ObjectId a, ObjectId b) {
   ExpectType(*this, sb, ObjectType::kDummy);
   linked_dummy_[sa] = static_cast<int32_t>(sb);
   linked_dummy_[sb] = static_cast<int32_t>(sa);
+}
+
+void Scene::WriteCustomData(ObjectId id, const std::string& tag, std::string data) {
+  auto& blocks = custom_data_[SlotOf(id)];
+  if (data.empty()) {
+    if (blocks) blocks->erase(tag);
+    return;
+  }
+  if (!blocks) blocks = std::make_unique<std::map<std::string, std::string>>();
+  (*blocks)[tag] = std::move(data);
+}
+
+const std::string* Scene::ReadCustomData(ObjectId id, const std::string& tag) const {
+  const auto& blocks = custom_data_[SlotOf(id)];
+  if (!blocks) return nullptr;
+  auto it = blocks->find(tag);
+  return it == blocks->end() ? nullptr : &it->second;
 }
 
 ObjectId Scene::linked_dummy(ObjectId id) const {

@@ -12,6 +12,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <span>
 #include <string>
@@ -264,6 +265,12 @@ class Scene {
   void LinkDummies(ObjectId a, ObjectId b);
   ObjectId linked_dummy(ObjectId id) const;
 
+  // Custom data: named byte strings attached to an object (CoppeliaSim's
+  // custom data blocks), copied with the object when its model is duplicated.
+  // Empty `data` removes the entry. Returns null when there is none.
+  void WriteCustomData(ObjectId id, const std::string& tag, std::string data);
+  const std::string* ReadCustomData(ObjectId id, const std::string& tag) const;
+
   // --- Scripts ------------------------------------------------------------------
   void AttachScript(ObjectId id, std::shared_ptr<const ScriptSource> source,
                     bool explicit_handling = false);
@@ -329,7 +336,9 @@ class Scene {
   std::vector<std::string> name_;
   std::vector<int32_t> script_;        // index into scripts_ or -1
   std::vector<int32_t> linked_dummy_;  // slot or -1
-  std::vector<double> size_factor_;    // accumulated scale, 1 by default
+  // Custom data per slot, allocated only for objects that have some.
+  std::vector<std::unique_ptr<std::map<std::string, std::string>>> custom_data_;
+  std::vector<double> size_factor_;  // accumulated scale, 1 by default
   std::vector<uint32_t> free_slots_;
   size_t object_count_ = 0;
 

@@ -126,6 +126,14 @@ struct RobotRuntime {
   std::vector<ReceivedMessage> inbox;   // messages delivered this step, sender-handle order
   // sim.setSignal/clearSignal writes (nullopt clears), applied at the next step.
   std::vector<std::pair<std::string, std::optional<ParamValue>>> signal_writes;
+  // sim.writeCustomDataBlock writes (object, tag, data; empty data removes),
+  // applied at the next step like signals.
+  struct CustomDataWrite {
+    ObjectId object;
+    std::string tag;
+    std::string data;
+  };
+  std::vector<CustomDataWrite> custom_data_writes;
 };
 
 // A calculation object that observes the world in the record phase

@@ -36,6 +36,15 @@ void World::DeliverMessages() {
   };
   for (RobotRuntime& rt : runtimes_) apply_signals(rt);
   apply_signals(scene_runtime_);
+  // Custom data written last step, robots in index order, then the scene's
+  // scripts (the last write of a tag wins); objects removed since are skipped.
+  auto apply_custom_data = [&](RobotRuntime& rt) {
+    for (RobotRuntime::CustomDataWrite& w : rt.custom_data_writes)
+      if (scene_.IsValid(w.object)) scene_.WriteCustomData(w.object, w.tag, std::move(w.data));
+    rt.custom_data_writes.clear();
+  };
+  for (RobotRuntime& rt : runtimes_) apply_custom_data(rt);
+  apply_custom_data(scene_runtime_);
 
   // Gather in robot order, then the scene's; order by sender handle.
   ++message_round_;

@@ -415,5 +415,38 @@ TEST(ScriptControlTest, PackAndUnpackRoundTrip) {
   EXPECT_CONTAINS(w.log[1], "not a packed table");
 }
 
+TEST(ScriptControlTest, CustomDataIsSeenNextStepAndCopiedWithTheModel) {
+  ScriptWorld w(2);
+  // Robot 0 writes a block on its own body and on robot 1's; robot 1 reads both.
+  const ObjectId body0 = w.AddRobot("bot#0", R"(
+    function sysCall_actuation()
+      local t = sim.getSimulationTime()
+      sim.writeCustomDataBlock(sim.getObject('.'), 'mood', t < 0.05 and 'calm' or nil)
+      sim.writeCustomDataBlock(sim.getObject('/bot#1/body'), 'note', sim.packFloats({t}))
+    end
+  )");
+  w.AddRobot("bot#1", R"(
+    function sysCall_actuation()
+      local note = sim.readCustomDataBlock(sim.getObject('.'), 'note')
+      print(sim.readCustomDataBlock(sim.getObject('/bot#0/body'), 'mood'),
+            note and sim.unpackFloats(note)[1])
+    end
+  )",
+             1);
+  w.Steps(3);
+  EXPECT_EQ(w.log, (std::vector<std::string>{"[bot#1] nil	nil", "[bot#1] calm	0.0",
+                                             "[bot#1] nil	0.10000000149012"}));
+  // A copy of the model carries the block with it; the original keeps its own.
+  w.scene().WriteCustomData(body0, "serial", "A-17");
+  const ObjectId root0 = w.scene().parent(body0);
+  const ObjectId copy = w.scene().DuplicateSubtree(root0, {});
+  const ObjectId copy_body = w.scene().FindObject("./body", copy);
+  ASSERT_NE(w.scene().ReadCustomData(copy_body, "serial"), nullptr);
+  EXPECT_EQ(*w.scene().ReadCustomData(copy_body, "serial"), "A-17");
+  w.scene().WriteCustomData(copy_body, "serial", "");
+  EXPECT_EQ(w.scene().ReadCustomData(copy_body, "serial"), nullptr);
+  EXPECT_EQ(*w.scene().ReadCustomData(body0, "serial"), "A-17");
+}
+
 }  // namespace
 }  // namespace swarmsim

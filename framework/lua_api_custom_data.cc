@@ -1,0 +1,53 @@
+// sim.* custom data: named data blocks attached to objects, copied with their
+// model (CoppeliaSim's custom data blocks).
+//
+//   sim.writeCustomDataBlock(h, tag, data)  data: a string (use sim.packFloats
+//       etc. for numbers); nil or '' removes the block. Seen from the next step.
+//   sim.readCustomDataBlock(h, tag) -> data or nil
+//
+// Writes wait for the start of the next step, like signals, so every script
+// reads the blocks as they were when the step began, whatever the thread
+// count; writes to one block in one step: the highest robot index wins, then
+// scene scripts.
+#include "framework/lua_api.h"
+#include "framework/scene.h"
+#include "framework/world.h"
+
+namespace swarmsim {
+namespace {
+
+int WriteCustomDataBlock(lua_State* L) {
+  const LuaContext& c = Context(L);
+  const ObjectId id = CheckObject(L, 1);
+  c.scene->SlotOf(id);  // a bad handle is an error now, not a silent no-op later
+  std::string tag = luaL_checkstring(L, 2);
+  size_t size = 0;
+  const char* data = lua_isnoneornil(L, 3) ? "" : luaL_checklstring(L, 3, &size);
+  c.runtime->custom_data_writes.push_back({id, std::move(tag), std::string(data, size)});
+  return 0;
+}
+
+int ReadCustomDataBlock(lua_State* L) {
+  const LuaContext& c = Context(L);
+  const ObjectId id = CheckObject(L, 1);
+  const std::string* data = c.scene->ReadCustomData(id, luaL_checkstring(L, 2));
+  if (data == nullptr) {
+    lua_pushnil(L);
+  } else {
+    lua_pushlstring(L, data->data(), data->size());
+  }
+  return 1;
+}
+
+}  // namespace
+
+void RegisterCustomDataApi(lua_State* L) {
+  static constexpr luaL_Reg kFunctions[] = {
+      {"writeCustomDataBlock", Guarded<WriteCustomDataBlock, "sim.writeCustomDataBlock">},
+      {"readCustomDataBlock", Guarded<ReadCustomDataBlock, "sim.readCustomDataBlock">},
+      {nullptr, nullptr},
+  };
+  luaL_setfuncs(L, kFunctions, 0);
+}
+
+}  // namespace swarmsim
