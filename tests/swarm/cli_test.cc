@@ -10,27 +10,14 @@
 #include <sstream>
 #include <string>
 
+#include "tests/swarm/run_program.h"
+
 namespace {
 
 namespace fs = std::filesystem;
 
-struct Result {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr together
-};
-
-Result RunProgram(const std::string& args) {
-  const std::string cmd = std::string(SWARMSIM_BINARY) + " " + args + " 2>&1";
-  Result r;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (!pipe) return r;
-  std::array<char, 4096> buf;
-  size_t n;
-  while ((n = fread(buf.data(), 1, buf.size(), pipe)) > 0) r.output.append(buf.data(), n);
-  const int status = pclose(pipe);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  return r;
-}
+using Result = swarmsim::testing::CommandResult;
+using swarmsim::testing::RunProgram;
 
 std::string Data(const std::string& name) {
   return std::string(SWARMSIM_SOURCE_DIR) + "/tests/data/cli/" + name;

@@ -17,6 +17,7 @@
 #include "framework/world.h"
 #include "modules/builtin.h"
 #include "swarm/world_loader.h"
+#include "tests/swarm/run_program.h"
 
 namespace swarmsim {
 namespace {
@@ -116,17 +117,6 @@ TEST(ExamplesTest, ThreadedArmsCycleWithWaitsAndAreIndependentOfThreadCount) {
   }
 }
 
-// Runs the program; returns its exit status and standard output.
-std::pair<int, std::string> RunProgram(const std::string& args) {
-  const std::string cmd = std::string(SWARMSIM_BINARY) + " " + args + " 2>&1";
-  FILE* pipe = popen(cmd.c_str(), "r");
-  std::string out;
-  char buffer[4096];
-  while (size_t n = fread(buffer, 1, sizeof buffer, pipe)) out.append(buffer, n);
-  const int status = pclose(pipe);
-  return {WEXITSTATUS(status), out};
-}
-
 TEST(ExamplesTest, PluginDemoRunsThroughTheProgramWithTheWorldsPlugin) {
   // plugins: [example_plugin] is found in plugins/ beside the program.
   const std::string world = std::string(SWARMSIM_SOURCE_DIR) + "/worlds/plugin_demo.yaml";
@@ -134,8 +124,9 @@ TEST(ExamplesTest, PluginDemoRunsThroughTheProgramWithTheWorldsPlugin) {
       std::filesystem::temp_directory_path() / ("swarmsim_plugin_demo_" + std::to_string(getpid()));
   std::string hash;
   for (int threads : {1, 2, 4}) {
-    const auto [status, text] = RunProgram("run " + world + " --quiet --hash --threads " +
-                                           std::to_string(threads) + " --out " + out.string());
+    const auto [status, text] =
+        swarmsim::testing::RunProgram("run " + world + " --quiet --hash --threads " +
+                                      std::to_string(threads) + " --out " + out.string());
     ASSERT_EQ(status, 0) << text;
     const std::string line = text.substr(text.find("state-hash: "));
     if (hash.empty()) hash = line;

@@ -19,32 +19,16 @@
 #include <thread>
 
 #include "swarm/sqlite_db.h"
+#include "tests/swarm/run_program.h"
 
 namespace swarmsim {
 namespace {
 
 namespace fs = std::filesystem;
 
-struct Result {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr together
-};
-
-Result RunCommand(const std::string& cmd) {
-  Result r;
-  FILE* pipe = popen((cmd + " 2>&1").c_str(), "r");
-  if (!pipe) return r;
-  std::array<char, 4096> buf;
-  size_t n;
-  while ((n = fread(buf.data(), 1, buf.size(), pipe)) > 0) r.output.append(buf.data(), n);
-  const int status = pclose(pipe);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  return r;
-}
-
-Result RunProgram(const std::string& args) {
-  return RunCommand(std::string(SWARMSIM_BINARY) + " " + args);
-}
+using Result = swarmsim::testing::CommandResult;
+using swarmsim::testing::RunCommand;
+using swarmsim::testing::RunProgram;
 
 const std::string kWorld = std::string(SWARMSIM_SOURCE_DIR) + "/tests/data/sweep/sweep.yaml";
 

@@ -1,0 +1,34 @@
+// Runs shell commands and the swarmsim program from tests, as a user would.
+#pragma once
+
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <string>
+
+namespace swarmsim::testing {
+
+struct CommandResult {
+  int exit_code = -1;  // 128 + signal number when the command was killed
+  std::string output;  // stdout and stderr together
+};
+
+inline CommandResult RunCommand(const std::string& command) {
+  CommandResult r;
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  if (!pipe) return r;
+  std::array<char, 4096> buf;
+  size_t n;
+  while ((n = fread(buf.data(), 1, buf.size(), pipe)) > 0) r.output.append(buf.data(), n);
+  const int status = pclose(pipe);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  return r;
+}
+
+// `build/swarmsim ARGS` (the binary this test tree was built with).
+inline CommandResult RunProgram(const std::string& args) {
+  return RunCommand(std::string(SWARMSIM_BINARY) + " " + args);
+}
+
+}  // namespace swarmsim::testing
