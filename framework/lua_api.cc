@@ -149,6 +149,7 @@ void RegisterAreas(lua_State* L) {
       RegisterForceSensorApi,  // lua_api_force.cc: force sensors
       RegisterPaintApi,        // lua_api_paint.cc: paint nozzles
       RegisterCustomDataApi,   // lua_api_custom_data.cc: custom data blocks
+      RegisterPluginApi,       // lua_api_plugins.cc: plugin sensors
   };
   lua_pushinteger(L, kHandleWorld);
   lua_setfield(L, -2, "handle_world");

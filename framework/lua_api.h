@@ -110,6 +110,7 @@ void RegisterIkApi(lua_State* L);
 void RegisterForceSensorApi(lua_State* L);
 void RegisterPaintApi(lua_State* L);
 void RegisterCustomDataApi(lua_State* L);
+void RegisterPluginApi(lua_State* L);
 
 // Pushes the plugin command `name` (registered in the world's
 // ModuleRegistry) as a function and returns true; false if there is none.

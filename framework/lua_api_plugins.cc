@@ -1,5 +1,6 @@
 // Plugin script commands (framework/plugin_api.h) as sim.* functions: the
-// arguments and results cross as SwarmsimValue, never as Lua values.
+// arguments and results cross as SwarmsimValue, never as Lua values; and
+// sim.readPluginSensor for the plugin sensor types.
 #include <string>
 #include <vector>
 
@@ -69,7 +70,30 @@ int CallPluginCommand(lua_State* L) {
   return count;
 }
 
+// sim.readPluginSensor(h) -> the sensor's last reading, an array of
+// numbers, or nil before its first sense phase. Readings are written in the
+// sense phase only, so any robot may read any sensor.
+int ReadPluginSensor(lua_State* L) {
+  const LuaContext& c = Context(L);
+  if (c.world == nullptr) RaiseError(L, "sim.readPluginSensor: no world");
+  std::span<const double> values;
+  if (!c.world->PluginSensorReading(CheckObject(L, 1), &values)) {
+    lua_pushnil(L);
+    return 1;
+  }
+  PushNumberArray(L, values.data(), static_cast<int>(values.size()));
+  return 1;
+}
+
 }  // namespace
+
+void RegisterPluginApi(lua_State* L) {
+  static constexpr luaL_Reg kFunctions[] = {
+      {"readPluginSensor", Guarded<ReadPluginSensor, "sim.readPluginSensor">},
+      {nullptr, nullptr},
+  };
+  luaL_setfuncs(L, kFunctions, 0);
+}
 
 bool PushPluginCommand(lua_State* L, std::string_view name) {
   const LuaContext& c = Context(L);

@@ -8,7 +8,8 @@
 //
 // and registers script commands through the registrar: a command `name`
 // is called from Lua as sim.name(...); and per-phase callbacks, which the
-// world runs at fixed points of each step (SwarmsimPhase). Arguments and results are numbers,
+// world runs at fixed points of each step (SwarmsimPhase); and sensor types
+// (ABI 3), read by scripts with sim.readPluginSensor. Arguments and results are numbers,
 // strings and number arrays (SwarmsimValue); no Lua type crosses this
 // interface. Everything here is plain C, so a plugin built with another
 // compiler works as long as the ABI version matches; the version changes
@@ -19,7 +20,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#define SWARMSIM_PLUGIN_ABI_VERSION 2
+#define SWARMSIM_PLUGIN_ABI_VERSION 3
 
 #ifdef __cplusplus
 extern "C" {
@@ -104,6 +105,21 @@ enum SwarmsimPhase {
 typedef int (*SwarmsimPhaseCallback)(const SwarmsimCallContext* context, char* error,
                                      size_t error_size, void* user_data);
 
+// Most numbers one plugin sensor reading holds (ABI 3).
+#define SWARMSIM_SENSOR_MAX_VALUES 16
+
+// The sense function of a plugin sensor type (ABI 3). Models declare such
+// sensors as objects {type: plugin_sensor, sensor: NAME, name: ...}; in the
+// sense phase, before the after_sense callbacks, it runs once for every
+// such object of every live robot, robots concurrently (context->robot is
+// the robot, -1 for an object outside every robot; context->script_object
+// is 0). It writes its reading into values[0..max_values) and returns how
+// many it wrote, or -1 after writing a message into `error`: the run stops
+// with it. Scripts get the reading with sim.readPluginSensor(sensor).
+typedef int (*SwarmsimSensorFunction)(const SwarmsimCallContext* context, int64_t sensor,
+                                      double* values, int max_values, char* error,
+                                      size_t error_size, void* user_data);
+
 typedef struct SwarmsimRegistrar {
   void* impl;
   // Registers sim.<name>; returns 0, or -1 if the name is taken or invalid.
@@ -117,6 +133,11 @@ typedef struct SwarmsimRegistrar {
   // Returns 0, or -1 for an unknown phase or a null callback.
   int (*add_phase_callback)(void* impl, int phase, int per_robot, SwarmsimPhaseCallback callback,
                             void* user_data);
+  // --- ABI 3 ---
+  // Registers the sensor type `name` (see SwarmsimSensorFunction); returns 0,
+  // or -1 for a missing name or function.
+  int (*add_sensor_type)(void* impl, const char* name, const char* description,
+                         SwarmsimSensorFunction sense, void* user_data);
 } SwarmsimRegistrar;
 
 // The two entry points a plugin exports.

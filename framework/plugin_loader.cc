@@ -16,6 +16,7 @@ struct Registration {
   ModuleInfo info;
   std::vector<ScriptCommand> commands;
   std::vector<PhaseCallback> callbacks;
+  std::vector<PluginSensorType> sensors;
   std::string error;
 };
 
@@ -51,6 +52,17 @@ int AddCommand(void* impl, const char* name, const char* description, SwarmsimCo
   return 0;
 }
 
+int AddSensorType(void* impl, const char* name, const char* description,
+                  SwarmsimSensorFunction sense, void* user_data) {
+  auto* r = static_cast<Registration*>(impl);
+  if (name == nullptr || name[0] == 0 || sense == nullptr) {
+    r->error = "add_sensor_type needs a name and a function";
+    return -1;
+  }
+  r->sensors.push_back({name, description != nullptr ? description : "", sense, user_data});
+  return 0;
+}
+
 void SetInfo(void* impl, const char* name, const char* version, const char* description) {
   auto* r = static_cast<Registration*>(impl);
   if (name != nullptr) r->info.name = name;
@@ -83,7 +95,7 @@ void LoadPlugin(const std::string& path, ModuleRegistry* registry) {
   Registration r;
   r.info.name.assign(path);
   r.info.version.assign("unversioned");
-  const SwarmsimRegistrar registrar{&r, AddCommand, SetInfo, AddPhaseCallback};
+  const SwarmsimRegistrar registrar{&r, AddCommand, SetInfo, AddPhaseCallback, AddSensorType};
   if (do_register(&registrar) != 0 || !r.error.empty()) {
     std::string message = "plugin '" + path + "' failed to register";
     if (!r.error.empty()) message.append(": ").append(r.error);
@@ -106,6 +118,16 @@ void LoadPlugin(const std::string& path, ModuleRegistry* registry) {
                        " callback, " + callback.name;
     callback.name = info.name;
     registry->RegisterPhaseCallback(info, std::move(callback));
+  }
+  for (PluginSensorType& sensor : r.sensors) {
+    ModuleInfo info = r.info;
+    info.name = r.info.name + ":" + sensor.name;
+    info.description = sensor.description;
+    try {
+      registry->RegisterPluginSensor(info, std::move(sensor));
+    } catch (const Error& e) {
+      throw Error("plugin '" + path + "': " + e.what());
+    }
   }
   std::error_code ec;
   const std::filesystem::path canonical = std::filesystem::weakly_canonical(name, ec);

@@ -55,6 +55,22 @@ void ModuleRegistry::RegisterPhaseCallback(ModuleInfo info, PhaseCallback callba
   phase_callbacks_.push_back(std::move(callback));
 }
 
+void ModuleRegistry::RegisterPluginSensor(ModuleInfo info, PluginSensorType type) {
+  if (type.name.empty() || type.function == nullptr)
+    throw Error("a plugin sensor type needs a name and a sense function");
+  if (FindPluginSensor(type.name) != nullptr)
+    throw Error("plugin sensor type '" + type.name + "' is registered twice");
+  info.kind = "sensor";
+  modules_.push_back(std::move(info));
+  plugin_sensors_.push_back(std::move(type));
+}
+
+const PluginSensorType* ModuleRegistry::FindPluginSensor(std::string_view name) const {
+  for (const PluginSensorType& t : plugin_sensors_)
+    if (t.name == name) return &t;
+  return nullptr;
+}
+
 bool ModuleRegistry::HasPlugin(std::string_view path) const {
   for (const std::string& p : plugin_paths_)
     if (p == path) return true;

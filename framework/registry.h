@@ -36,6 +36,16 @@ struct PhaseCallback {
   void* user_data = nullptr;
 };
 
+// A sensor type registered by a plugin (framework/plugin_api.h). Its objects
+// are dummies whose custom data kPluginSensorTag holds the type's name.
+struct PluginSensorType {
+  std::string name;  // as models write it: {type: plugin_sensor, sensor: NAME}
+  std::string description;
+  SwarmsimSensorFunction function = nullptr;
+  void* user_data = nullptr;
+};
+inline constexpr const char* kPluginSensorTag = "swarmsim.plugin_sensor";
+
 struct ModuleInfo {
   std::string kind;  // "dynamics", "proximity", ...
   std::string name;  // e.g. "box2d"
@@ -61,6 +71,11 @@ class ModuleRegistry {
   // Phase callbacks (plugins): kind "callback".
   void RegisterPhaseCallback(ModuleInfo info, PhaseCallback callback);
   const std::vector<PhaseCallback>& phase_callbacks() const { return phase_callbacks_; }
+  // Plugin sensor types: kind "sensor". Throws swarmsim::Error if the name is taken.
+  void RegisterPluginSensor(ModuleInfo info, PluginSensorType type);
+  // Null if no sensor type has that name.
+  const PluginSensorType* FindPluginSensor(std::string_view name) const;
+  const std::vector<PluginSensorType>& plugin_sensors() const { return plugin_sensors_; }
   // Plugins loaded into this registry, by canonical path (LoadPlugin records them).
   void AddPluginPath(std::string path) { plugin_paths_.push_back(std::move(path)); }
   bool HasPlugin(std::string_view path) const;
@@ -82,6 +97,7 @@ class ModuleRegistry {
   std::vector<std::shared_ptr<const ScriptCommand>>
       commands_;  // stable addresses (Lua keeps pointers)
   std::vector<PhaseCallback> phase_callbacks_;
+  std::vector<PluginSensorType> plugin_sensors_;
   std::vector<std::string> plugin_paths_;
 };
 

@@ -81,6 +81,7 @@ World::World(const WorldSettings& settings, const ModuleRegistry& registry)
   if (!registry_.HasDynamics(settings_.physics)) registry_.MakeDynamics(settings_.physics);
   for (const PhaseCallback& callback : registry_.phase_callbacks())
     phase_callbacks_.at(callback.phase).push_back(&callback);
+  has_plugin_sensor_types_ = !registry_.plugin_sensors().empty();
 }
 
 World::World(const WorldSettings& settings, std::shared_ptr<const ModuleRegistry> registry)
@@ -269,6 +270,7 @@ void World::Sense() {
                                 proximity_->SenseInstance(&scene_, static_cast<int>(r));
                           });
   proximity_->SenseSceneSensors(&scene_);
+  if (has_plugin_sensor_types_) SensePluginSensors();
   RunPhaseCallbacks(kSwarmsimAfterSense);
 }
 

@@ -10,6 +10,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -25,6 +26,7 @@ class CalculationModule;
 class DynamicsBackend;
 class ModuleRegistry;
 struct PhaseCallback;
+struct PluginSensorType;
 class ProximityBackend;
 class ScriptHost;
 class TaskScheduler;
@@ -232,6 +234,11 @@ class World {
   void HandleActuation();
   void HandleDynamics();
 
+  // --- Plugin sensors (framework/plugin_api.h) -------------------------------------------
+  // The last reading of plugin sensor `id` into *values: false before its
+  // first sense. Throws swarmsim::Error if `id` is not a plugin sensor.
+  bool PluginSensorReading(ObjectId id, std::span<const double>* values) const;
+
   // --- Messages and signals ------------------------------------------------------------
   // Messages delivered this step (RobotRuntime::inbox indexes into it).
   const std::vector<Message>& messages() const { return messages_; }
@@ -254,11 +261,27 @@ class World {
     if (!phase_callbacks_[phase].empty()) CallPhaseCallbacks(phase);
   }
   void CallPhaseCallbacks(int phase);
+  // Plugin sensors: sensed in the sense phase when the registry has sensor
+  // types (world_plugin_sensors.cc); the table is rebuilt when the scene's
+  // structure changes.
+  struct PluginSensorState {
+    ObjectId id;
+    const PluginSensorType* type = nullptr;
+    int count = -1;                   // values in the last reading; -1 before the first
+    std::array<double, 16> values{};  // SWARMSIM_SENSOR_MAX_VALUES
+  };
+  void SensePluginSensors();
+  void IndexPluginSensors();
 
   WorldSettings settings_;
   const ModuleRegistry& registry_;
   std::shared_ptr<const ModuleRegistry> owned_registry_;  // null unless given by shared_ptr
   std::array<std::vector<const PhaseCallback*>, 4> phase_callbacks_;  // by SwarmsimPhase
+  bool has_plugin_sensor_types_ = false;
+  std::vector<PluginSensorState> plugin_sensors_;  // robot by robot, then the scene's
+  std::vector<uint32_t> plugin_sensor_start_;      // robots + 2: robot r's are [r], [r + 1)
+  std::vector<int32_t> plugin_sensor_of_slot_;     // index into plugin_sensors_ or -1 (slots)
+  uint64_t plugin_sensor_version_ = UINT64_MAX;    // scene structure they were indexed at
   Scene scene_;
   ParameterSet parameters_;
   std::unique_ptr<TaskScheduler> scheduler_;

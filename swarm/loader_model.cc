@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "framework/error.h"
+#include "framework/registry.h"
 
 namespace swarmsim::loader {
 
@@ -21,8 +22,8 @@ constexpr int64_t kMaxRingCount = 1024;
 constexpr double kDegToRad = M_PI / 180.0;
 
 const std::vector<std::string> kObjectTypes = {
-    "shape",          "joint",        "dummy",       "proximity_sensor",
-    "proximity_ring", "force_sensor", "paint_nozzle"};
+    "shape",          "joint",        "dummy",        "proximity_sensor",
+    "proximity_ring", "force_sensor", "paint_nozzle", "plugin_sensor"};
 const std::vector<std::string> kCommonKeys = {
     "name", "type", "position", "orientation_deg", "heading_deg", "children", "script"};
 const std::vector<std::string> kJointKeys = {"joint",
@@ -38,6 +39,7 @@ const std::vector<std::string> kSensorKeys = {"range"};
 const std::vector<std::string> kForceSensorKeys = {"filter_samples", "force_threshold",
                                                    "torque_threshold", "break_after"};
 const std::vector<std::string> kPaintNozzleKeys = {"color", "radius", "enabled"};
+const std::vector<std::string> kPluginSensorKeys = {"sensor"};
 const std::vector<std::string> kRingKeys = {"name",   "type",  "count",          "radius",
                                             "height", "range", "start_angle_deg"};
 
@@ -62,6 +64,7 @@ struct Builder {
   ScriptCache* scripts;
   int objects = 0;
   MeshCache* meshes = nullptr;
+  const ModuleRegistry* registry = nullptr;
 
   void Count(const Field& field, int n) {
     objects += n;
@@ -128,6 +131,10 @@ struct Builder {
       if (named.Has("radius"))
         spec.paint_nozzle.radius = values.Number(named.Get("radius"), kPositiveLength);
       if (named.Has("enabled")) spec.paint_nozzle.enabled = values.Bool(named.Get("enabled"));
+    } else if (type == "plugin_sensor") {
+      named.Expect(Concat({&kCommonKeys, &kPluginSensorKeys}));
+      spec.type = ObjectType::kDummy;
+      spec.plugin_sensor = PluginSensor(named.Require("sensor"));
     } else {
       named.Expect(kCommonKeys);
       spec.type = ObjectType::kDummy;
@@ -150,6 +157,23 @@ struct Builder {
     for (const Field& child : ListElements(values.file(), named.Get("children"), "objects"))
       Object(child, depth + 1, false, &spec.children);
     out->push_back(std::move(spec));
+  }
+
+  // sensor: NAME of a sensor type a loaded plugin registers.
+  std::string PluginSensor(const Field& field) {
+    const std::string name = values.String(field);
+    std::vector<std::string> known;
+    if (registry != nullptr) {
+      if (registry->FindPluginSensor(name) != nullptr) return name;
+      for (const PluginSensorType& t : registry->plugin_sensors()) known.push_back(t.name);
+    }
+    if (known.empty())
+      values.Fail(field, "unknown plugin sensor type '" + name +
+                             "': no loaded plugin registers sensor types (plugins: [...])");
+    std::string list;
+    for (const std::string& k : known) list += (list.empty() ? "" : ", ") + k;
+    values.Fail(field, "unknown plugin sensor type '" + name + "' (registered: " + list + ")" +
+                           Suggest(name, known));
   }
 
   ForceSensorData ForceSensor(const Fields& f) {
@@ -442,8 +466,8 @@ ModelFile ReadModelFile(YamlFile file, const std::string& used_by) {
 }
 
 ObjectSpec ResolveModel(const ModelFile& model, const ValueReader& values, ScriptCache* scripts,
-                        MeshCache* meshes) {
-  Builder builder{model, values, scripts, 0, meshes};
+                        MeshCache* meshes, const ModuleRegistry* registry) {
+  Builder builder{model, values, scripts, 0, meshes, registry};
   std::vector<ObjectSpec> out;
   builder.Object(model.root, 0, true, &out);
   return std::move(out.front());
@@ -467,6 +491,7 @@ ObjectId AddToScene(const ObjectSpec& spec, ObjectId parent, Scene* scene) {
       break;
     case ObjectType::kDummy: id = scene->AddDummy(spec.name, parent, spec.X_PO); break;
   }
+  if (!spec.plugin_sensor.empty()) scene->WriteCustomData(id, kPluginSensorTag, spec.plugin_sensor);
   if (spec.script) scene->AttachScript(id, spec.script, spec.script_explicit);
   for (const ObjectSpec& child : spec.children) AddToScene(child, id, scene);
   return id;

@@ -15,6 +15,10 @@
 #include "swarm/loader_values.h"
 #include "swarm/loader_yaml.h"
 
+namespace swarmsim {
+class ModuleRegistry;
+}  // namespace swarmsim
+
 namespace swarmsim::loader {
 
 // One object with its values resolved, and its children.
@@ -27,6 +31,7 @@ struct ObjectSpec {
   ProximitySensorData sensor;
   ForceSensorData force_sensor;
   PaintNozzleData paint_nozzle;
+  std::string plugin_sensor;  // type: plugin_sensor: the sensor type (a kDummy tagged with it)
   std::shared_ptr<const ScriptSource> script;
   bool script_explicit = false;  // script: {file: ..., explicit: true}
   std::vector<ObjectSpec> children;
@@ -74,9 +79,10 @@ bool IsParameterName(std::string_view name);
 // The root object of `model`, values resolved by `values` (whose scope holds
 // the world's and this entry's model parameters). Scripts resolve against
 // the model file's folder, and so do mesh files (read once through `meshes`;
-// null: a cache of this call's own).
+// null: a cache of this call's own). Plugin sensor types are looked up in
+// `registry` (null: there are none).
 ObjectSpec ResolveModel(const ModelFile& model, const ValueReader& values, ScriptCache* scripts,
-                        MeshCache* meshes = nullptr);
+                        MeshCache* meshes = nullptr, const ModuleRegistry* registry = nullptr);
 
 // Shape keys and object poses, shared with the world's obstacles. A mesh's
 // file is relative to the file being read; `meshes` null: no sharing.

@@ -146,6 +146,7 @@ class WorldLoader {
   fs::path path_;
   const LoadOptions& options_;
   const ModuleRegistry& registry_;
+  const ModuleRegistry* world_registry_ = nullptr;  // registry_ plus the world's plugins
   std::unique_ptr<YamlFile> file_;
   mutable loader::Expressions expressions_;
   loader::ScriptCache scripts_;
@@ -187,6 +188,7 @@ LoadedWorld WorldLoader::Load() {
   else
     out.world = std::make_unique<World>(settings, registry_);
   World* world = out.world.get();
+  world_registry_ = &world->registry();
   for (const auto& [name, value] : parameters_) world->parameters()[name] = value;
 
   placer_ = std::make_unique<Placer>(settings.seed);
@@ -587,7 +589,7 @@ void WorldLoader::ResolveEntry(EntryPlan* entry) {
 
   // The model's objects, in a scope where its parameters shadow the world's.
   const ValueReader model_values(model.file, &expressions_, {&parameters_, params.get()});
-  entry->spec = loader::ResolveModel(model, model_values, &scripts_, &meshes_);
+  entry->spec = loader::ResolveModel(model, model_values, &scripts_, &meshes_, world_registry_);
   entry->footprint = loader::ComputeFootprint(entry->spec);
   if (f.Has("scale")) {
     // Every length of the model scales, so its footprint does too.

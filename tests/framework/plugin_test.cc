@@ -66,7 +66,7 @@ TEST(PluginTest, LoadErrorsNameThePathAndTheProblem) {
   EXPECT_CONTAINS(ErrorOf([&] { LoadPlugin("/nonexistent/p.so", &registry); }),
                   "cannot load plugin '/nonexistent/p.so': ");
   EXPECT_CONTAINS(ErrorOf([&] { LoadPlugin(PluginPath("wrong_abi_plugin.so"), &registry); }),
-                  "was built for plugin ABI version 3, this swarmsim has version 2");
+                  "was built for plugin ABI version 4, this swarmsim has version 3");
   EXPECT_CONTAINS(ErrorOf([&] { LoadPlugin("libm.so.6", &registry); }), "cannot load plugin");
   LoadPlugin(PluginPath("example_plugin.so"), &registry);
   EXPECT_CONTAINS(ErrorOf([&] { LoadPlugin(PluginPath("example_plugin.so"), &registry); }),

@@ -150,5 +150,69 @@ TEST(ExamplesTest, PluginDemoRunsThroughTheProgramWithTheWorldsPlugin) {
   std::filesystem::remove_all(out);
 }
 
+TEST(ExamplesTest, PluginLightSensorReadsTheLightThroughTheProgram) {
+  // The example plugin's `light` sensor type: four per puck, sensed robots in
+  // parallel; the scripts check every reading against their own calculation.
+  const std::string world = std::string(SWARMSIM_SOURCE_DIR) + "/worlds/plugin_light.yaml";
+  const std::filesystem::path out = std::filesystem::temp_directory_path() /
+                                    ("swarmsim_plugin_light_" + std::to_string(getpid()));
+  std::string hash;
+  for (int threads : {1, 2}) {
+    const auto [status, text] =
+        swarmsim::testing::RunProgram("run " + world + " --quiet --hash --threads " +
+                                      std::to_string(threads) + " --out " + out.string());
+    ASSERT_EQ(status, 0) << text;
+    const std::string line = text.substr(text.find("state-hash: "));
+    if (hash.empty()) hash = line;
+    EXPECT_EQ(line, hash) << threads << " threads";
+  }
+  std::ifstream csv(out / "metrics.csv");
+  std::map<std::string, std::vector<double>> intensity;
+  int unsensed = 0, checked = 0;
+  std::string row;
+  while (std::getline(csv, row)) {
+    std::vector<std::string> cells;
+    std::stringstream ss(row);
+    for (std::string cell; std::getline(ss, cell, ',');) cells.push_back(cell);
+    if (cells.size() != 5) continue;
+    if (cells[3] == "unsensed") unsensed += std::stod(cells[4]) == 1;
+    if (cells[3] == "reading_error") {
+      EXPECT_LE(std::stod(cells[4]), 1e-12) << row;
+      ++checked;
+    }
+    if (cells[3] == "intensity") intensity[cells[2]].push_back(std::stod(cells[4]));
+  }
+  EXPECT_EQ(unsensed, 20);       // nil before the first sense phase
+  EXPECT_EQ(checked, 20 * 100);  // every robot, every step
+  ASSERT_EQ(intensity.size(), 20u);
+  int brighter = 0;
+  for (const auto& [robot, values] : intensity) brighter += values.back() > values.front();
+  EXPECT_GE(brighter, 18);  // they climbed toward the light
+  std::filesystem::remove_all(out);
+}
+
+TEST(ExamplesTest, UnknownPluginSensorTypeIsALoadErrorWithASuggestion) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                    ("swarmsim_plugin_sensor_" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "bot.yaml") << "model: bot\n"
+                                     "objects:\n"
+                                     "  type: dummy\n"
+                                     "  children:\n"
+                                     "    - {name: eye, type: plugin_sensor, sensor: lihgt}\n";
+  std::ofstream(dir / "world.yaml") << "plugins: [example_plugin]\n"
+                                       "models:\n"
+                                       "  - {model: bot.yaml, count: 1, position: [0, 0, 0]}\n";
+  const auto [status, text] =
+      swarmsim::testing::RunProgram("run " + (dir / "world.yaml").string() + " --steps 1");
+  EXPECT_NE(status, 0);
+  EXPECT_NE(text.find("bot.yaml:5:"), std::string::npos) << text;
+  EXPECT_NE(text.find("unknown plugin sensor type 'lihgt' (registered: light); did you mean "
+                      "'light'?"),
+            std::string::npos)
+      << text;
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace swarmsim

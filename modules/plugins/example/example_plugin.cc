@@ -17,6 +17,10 @@
 // Phase callbacks: a per-robot after_control callback steers every robot
 // that runs robotMoveAndAvoidObstacles (robots in parallel); whole-world
 // callbacks count the phases.
+// Sensor type `light` ({type: plugin_sensor, sensor: light} in a model):
+// reading {intensity, distance}, distance (m) from the sensor to the light
+// at the parameters (light_x, light_y, light_z) (default 0, 0, 1), and
+// intensity = light_power / (1 + distance^2) (light_power default 1).
 #include <atomic>
 #include <cmath>
 #include <cstdio>
@@ -199,13 +203,36 @@ int PhaseCounts(const SwarmsimCallContext* c, const SwarmsimValue*, int, Swarmsi
   return 1;
 }
 
+// --- Light sensor ----------------------------------------------------------------------
+
+int SenseLight(const SwarmsimCallContext* c, int64_t sensor, double* values, int max_values,
+               char* error, size_t error_size, void*) {
+  const SwarmsimWorldApi& api = *c->api;
+  double p[3];
+  if (max_values < 2 || !api.object_position(c->world, sensor, p)) {
+    std::snprintf(error, error_size, "the sensor object is gone");
+    return -1;
+  }
+  double light[3] = {0, 0, 1}, power = 1;
+  api.number_parameter(c->world, c->robot, "light_x", &light[0]);
+  api.number_parameter(c->world, c->robot, "light_y", &light[1]);
+  api.number_parameter(c->world, c->robot, "light_z", &light[2]);
+  api.number_parameter(c->world, c->robot, "light_power", &power);
+  const double d =
+      std::sqrt((p[0] - light[0]) * (p[0] - light[0]) + (p[1] - light[1]) * (p[1] - light[1]) +
+                (p[2] - light[2]) * (p[2] - light[2]));
+  values[0] = power / (1 + d * d);
+  values[1] = d;
+  return 2;
+}
+
 }  // namespace
 
 extern "C" int swarmsim_plugin_abi_version(void) { return SWARMSIM_PLUGIN_ABI_VERSION; }
 
 extern "C" int swarmsim_plugin_register(const SwarmsimRegistrar* r) {
-  r->set_info(r->impl, "example", "2.0",
-              "example plugin: exampleSum, exampleWhereAmI, robotMoveAndAvoidObstacles");
+  r->set_info(r->impl, "example", "3.0",
+              "example plugin: exampleSum, exampleWhereAmI, robotMoveAndAvoidObstacles, light");
   struct Command {
     const char* name;
     const char* description;
@@ -225,5 +252,8 @@ extern "C" int swarmsim_plugin_register(const SwarmsimRegistrar* r) {
     if (r->add_phase_callback(r->impl, static_cast<int>(phase), 0, CountPhase,
                               reinterpret_cast<void*>(phase)) != 0)
       return -1;
+  if (r->add_sensor_type(r->impl, "light", "{intensity, distance} from the light_x/y/z parameters",
+                         SenseLight, nullptr) != 0)
+    return -1;
   return 0;
 }
