@@ -2,6 +2,8 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <cmath>
+#include <filesystem>
 #include <iostream>
 
 #include "framework/error.h"
@@ -121,7 +123,18 @@ int Main(int argc, char** argv) {
   run->add_option("--duration", duration, "Simulated seconds to run")
       ->check(kNonNegative)
       ->excludes(steps_opt);
-  run->add_option("--threads", threads, "Worker threads (default: all cores)")->check(kPositive);
+  run->add_option("--threads", threads, "Worker threads (default: all cores)")
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {
+            try {
+              size_t used = 0;
+              const long n = std::stol(text, &used);
+              if (used == text.size() && n >= 1 && n <= 1024) return "";
+            } catch (const std::exception&) {
+            }
+            return "expected a whole number from 1 to 1024, got '" + text + "'";
+          },
+          "1..1024"));
   run->add_option("--seed", seed, "Random seed (overrides the world's)");
   run->add_option("--set", sets, "Override a parameter: name=value or model.name=value")
       ->allow_extra_args(false);
@@ -309,8 +322,13 @@ int Main(int argc, char** argv) {
   if (steps >= 0) {
     options.steps = steps;
   } else if (duration >= 0) {
-    options.steps =
-        static_cast<int64_t>(std::llround(duration / loaded.world->settings().time_step));
+    const double step_count = std::round(duration / loaded.world->settings().time_step);
+    if (!(step_count <= 1e15)) {
+      std::cerr << "error: --duration " << duration << " s is " << step_count << " steps of "
+                << loaded.world->settings().time_step << " s; at most 1e15 steps\n";
+      return kExitBadInput;
+    }
+    options.steps = static_cast<int64_t>(step_count);
   } else if (loaded.steps) {
     options.steps = *loaded.steps;
   } else {
@@ -326,7 +344,7 @@ int Main(int argc, char** argv) {
   const RunResult result = RunWorld(loaded.world.get(), options, std::cout, std::cerr);
   if (!result.ok) {
     std::cerr << "error: " << result.error << "\n";
-    if (options.out_dir)
+    if (options.out_dir && std::filesystem::is_directory(*options.out_dir))
       std::cerr << "outputs up to step " << result.steps << " are in " << options.out_dir->string()
                 << "\n";
     return kExitRunError;

@@ -58,6 +58,18 @@ TEST(CliTest, UnknownFlagIsAClearErrorWithNonzeroExit) {
   EXPECT_NE(bad_set.output.find("name=value"), std::string::npos) << bad_set.output;
 }
 
+TEST(CliTest, OutOfRangeNumbersAreClearErrors) {
+  Result huge = RunProgram("run " + Data("ok.yaml") + " --duration 1e300");
+  EXPECT_EQ(huge.exit_code, 2);
+  EXPECT_NE(huge.output.find("at most 1e15 steps"), std::string::npos) << huge.output;
+  Result threads = RunProgram("run " + Data("ok.yaml") + " --threads 100000 --steps 1");
+  EXPECT_EQ(threads.exit_code, 2);
+  EXPECT_NE(threads.output.find("1 to 1024"), std::string::npos) << threads.output;
+  Result negative = RunProgram("run " + Data("ok.yaml") + " --steps -1");
+  EXPECT_EQ(negative.exit_code, 2);
+  EXPECT_NE(negative.output.find("must be >= 0"), std::string::npos) << negative.output;
+}
+
 TEST(CliTest, MissingWorldFileIsNamed) {
   Result r = RunProgram("run /nonexistent/world.yaml --steps 1");
   EXPECT_EQ(r.exit_code, 2);
