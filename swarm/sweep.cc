@@ -34,6 +34,8 @@ void CheckWorld(const SweepOptions& o, const GridRun& first) {
     throw Error(o.world + " gives no run length; pass --steps N or --duration SECONDS");
 }
 
+}  // namespace
+
 WorkerConfig MakeWorkerConfig(const SweepOptions& o) {
   WorkerConfig c;
   c.self_exe = o.self_exe;
@@ -46,8 +48,6 @@ WorkerConfig MakeWorkerConfig(const SweepOptions& o) {
       std::filesystem::temp_directory_path() / ("swarmsim-sweep-" + std::to_string(getpid()));
   return c;
 }
-
-}  // namespace
 
 void ParseShard(const std::string& text, int* index, int* count) {
   const size_t slash = text.find('/');

@@ -34,6 +34,9 @@ struct SweepOptions {
   std::string command_line;
 };
 
+// How the worker processes of a sweep run (shared by local and MPI sweeps).
+WorkerConfig MakeWorkerConfig(const SweepOptions& options);
+
 // Parses "i/n" (0 <= i < n). Throws swarmsim::Error.
 void ParseShard(const std::string& text, int* index, int* count);
 

@@ -122,15 +122,7 @@ class MpiWorkers : public RemoteWorkers {
 
 // A rank other than 0: ask for a run, run it, send the result with the next request.
 int WorkerLoop(const SweepOptions& o) {
-  WorkerConfig config;
-  config.self_exe = o.self_exe;
-  config.world = o.world;
-  config.steps = o.steps;
-  config.duration = o.duration;
-  config.threads_per_run = o.threads_per_run;
-  config.timeout_s = o.timeout_s;
-  config.scratch =
-      std::filesystem::temp_directory_path() / ("swarmsim-sweep-" + std::to_string(getpid()));
+  const WorkerConfig config = MakeWorkerConfig(o);
   RunPool pool(config, 1);
   std::string result;
   while (true) {
