@@ -5,6 +5,7 @@
 #include <unordered_map>
 
 #include "framework/error.h"
+#include "framework/state_hash.h"
 
 namespace swarmsim {
 
@@ -724,6 +725,18 @@ const std::string* Scene::ReadCustomData(ObjectId id, const std::string& tag) co
   if (!blocks) return nullptr;
   auto it = blocks->find(tag);
   return it == blocks->end() ? nullptr : &it->second;
+}
+
+void Scene::HashCustomData(uint32_t slot, StateHasher* hasher) const {
+  const auto& blocks = custom_data_[slot];
+  if (!blocks) return;
+  hasher->AddValue(slot);
+  for (const auto& [tag, data] : *blocks) {
+    hasher->AddValue(tag.size());
+    hasher->Add(tag.data(), tag.size());
+    hasher->AddValue(data.size());
+    hasher->Add(data.data(), data.size());
+  }
 }
 
 ObjectId Scene::linked_dummy(ObjectId id) const {

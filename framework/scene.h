@@ -27,6 +27,8 @@
 
 namespace swarmsim {
 
+class StateHasher;
+
 enum class ObjectType : uint8_t {
   kDummy,
   kShape,
@@ -270,6 +272,8 @@ class Scene {
   // Empty `data` removes the entry. Returns null when there is none.
   void WriteCustomData(ObjectId id, const std::string& tag, std::string data);
   const std::string* ReadCustomData(ObjectId id, const std::string& tag) const;
+  // Folds the slot's custom data blocks (if any) into a state hash.
+  void HashCustomData(uint32_t slot, StateHasher* hasher) const;
 
   // --- Scripts ------------------------------------------------------------------
   void AttachScript(ObjectId id, std::shared_ptr<const ScriptSource> source,

@@ -473,6 +473,38 @@ uint64_t World::StateHash() const {
   }
   for (const RobotRuntime& rt : runtimes_) h.Add(rt.rng.state(), 4 * sizeof(uint64_t));
   h.Add(scene_runtime_.rng.state(), 4 * sizeof(uint64_t));
+  // What scripts left for the next step: signals, messages not yet delivered,
+  // custom data blocks.
+  auto add_text = [&h](const std::string& text) {
+    h.AddValue(text.size());
+    h.Add(text.data(), text.size());
+  };
+  for (const auto& [name, value] : signals_) {
+    add_text(name);
+    add_text(ParamToString(value));
+  }
+  auto add_pending = [&](const RobotRuntime& rt) {
+    for (const Message& m : rt.outbox) {
+      add_text(m.data);
+      h.AddValue(m.sender);
+      h.AddValue(m.target);
+      h.AddValue(m.range);
+      h.AddValue(m.scope);
+    }
+    for (const auto& [name, value] : rt.signal_writes) {
+      add_text(name);
+      add_text(value ? ParamToString(*value) : std::string("<cleared>"));
+    }
+    for (const RobotRuntime::CustomDataWrite& w : rt.custom_data_writes) {
+      h.AddValue(w.object);
+      add_text(w.tag);
+      add_text(w.data);
+    }
+  };
+  for (const RobotRuntime& rt : runtimes_) add_pending(rt);
+  add_pending(scene_runtime_);
+  for (uint32_t s = 0; s < scene_.slot_count(); ++s)
+    if (scene_.alive_at(s)) scene_.HashCustomData(s, &h);
   if (dynamics_) dynamics_->HashState(&h);
   for (const auto& [name, module] : calculations_) module->HashState(&h);
   return h.Digest();

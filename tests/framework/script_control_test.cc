@@ -448,5 +448,22 @@ TEST(ScriptControlTest, CustomDataIsSeenNextStepAndCopiedWithTheModel) {
   EXPECT_EQ(*w.scene().ReadCustomData(body0, "serial"), "A-17");
 }
 
+TEST(ScriptControlTest, StateHashCoversWhatScriptsLeaveForTheNextStep) {
+  // Identical worlds except for what a script leaves pending at the end of a
+  // step: a signal, an undelivered message, a custom data block. Each changes
+  // the future, so each must change the hash.
+  auto hash_after = [](const std::string& action) {
+    ScriptWorld w;
+    w.AddRobot("bot#0", "function sysCall_actuation() " + action + " end");
+    w.Steps(2);
+    return w.world().StateHash();
+  };
+  const uint64_t nothing = hash_after("");
+  EXPECT_EQ(hash_after(""), nothing);
+  EXPECT_NE(hash_after("sim.setSignal('s', 1)"), nothing);
+  EXPECT_NE(hash_after("sim.sendGlobalMessage('hi')"), nothing);
+  EXPECT_NE(hash_after("sim.writeCustomDataBlock(sim.getObject('.'), 't', 'x')"), nothing);
+}
+
 }  // namespace
 }  // namespace swarmsim
