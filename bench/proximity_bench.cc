@@ -8,6 +8,8 @@
 //
 //   BM_SenseRobot     one robot's 24-ray read (SenseInstance), cycling over all robots
 //   BM_SenseNearWall  the same, over the robots within reach of a wall only
+//   BM_SenseAlone     the same, over the robots with nothing within reach (the early-out)
+//   ..._CastAll       the same three with the early-out off: every ray cast
 //   BM_Update         the per-step grid rebuild, reported per robot
 //   BM_Build          indexing the walls into the octree (once per run)
 //   BM_GridBuild      SpatialGrid::Build alone, per item (1 item per m^2)
@@ -40,7 +42,9 @@ constexpr double kRange = 0.1;
 struct Swarm {
   Scene scene;
   std::unique_ptr<ProximityBackend> backend;
-  std::vector<int> near_wall;  // instances whose rays may reach a wall
+  std::unique_ptr<ProximityBackend> cast_all;  // the early-out off
+  std::vector<int> near_wall;                  // instances whose rays may reach a wall
+  std::vector<int> alone;  // instances with no wall and no other robot within reach
   int robots = 0;
 };
 
@@ -92,17 +96,31 @@ Swarm& GetSwarm(int n) {
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> jitter(-0.4 * cell, 0.4 * cell), yaw(-M_PI, M_PI);
   const double reach = kBodyRadius + kRange;
+  std::vector<std::pair<double, double>> centres;
   for (int i = 0; i < n; ++i) {
     const double x = (i % per_row + 0.5) * cell + jitter(rng);  // from the arena's corner
     const double y = (i / per_row + 0.5) * cell + jitter(rng);
     AddRobot(&swarm.scene, {{x - side / 2, y - side / 2, 0}, Quat::FromYaw(yaw(rng))}, i);
     if (std::min({x, y, side - x, side - y}) <= reach) swarm.near_wall.push_back(i);
+    centres.emplace_back(x, y);
+  }
+  // Alone: farther than reach + a body radius (with room) from walls and robots.
+  const double alone = reach + kBodyRadius + 0.05;
+  for (int i = 0; i < n; ++i) {
+    const auto [x, y] = centres[i];
+    bool near = std::min({x, y, side - x, side - y}) <= alone;
+    for (int j = 0; j < n && !near; ++j)
+      near = j != i && std::hypot(centres[j].first - x, centres[j].second - y) <= alone;
+    if (!near) swarm.alone.push_back(i);
   }
   swarm.robots = n;
   swarm.scene.UpdateWorldPoses();
   swarm.backend = proximity::MakeBackend();
   swarm.backend->Build(swarm.scene, ProximitySettings{});
   swarm.backend->Update(swarm.scene);
+  swarm.cast_all = proximity::MakeBackend({.early_out = false});
+  swarm.cast_all->Build(swarm.scene, ProximitySettings{});
+  swarm.cast_all->Update(swarm.scene);
   return swarm;
 }
 
@@ -113,28 +131,40 @@ void SetPerRobotCounters(benchmark::State& state, double robots) {
       robots * kRaysPerRobot, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
-void BM_SenseRobot(benchmark::State& state) {
+// One robot's read per iteration, cycling over `robots` (all if empty).
+void SenseRobots(benchmark::State& state, bool early_out, const std::vector<int>* robots) {
   Swarm& swarm = GetSwarm(static_cast<int>(state.range(0)));
-  int robot = 0;
+  const ProximityBackend& backend = early_out ? *swarm.backend : *swarm.cast_all;
+  const size_t count = robots ? robots->size() : size_t(swarm.robots);
+  if (count == 0) {
+    state.SkipWithError("no such robots");
+    return;
+  }
+  size_t k = 0;
   for (auto _ : state) {
-    swarm.backend->SenseInstance(&swarm.scene, robot);
-    if (++robot == swarm.robots) robot = 0;
+    backend.SenseInstance(&swarm.scene, robots ? (*robots)[k] : static_cast<int>(k));
+    if (++k == count) k = 0;
   }
   int detected = 0;
   for (const auto& r : swarm.scene.proximity_sensors()) detected += r.detected;
   SetPerRobotCounters(state, double(state.iterations()));
   state.counters["detected_rays"] = detected;
+  state.counters["robots"] = double(count);
 }
 
+void BM_SenseRobot(benchmark::State& state) { SenseRobots(state, true, nullptr); }
+void BM_SenseRobot_CastAll(benchmark::State& state) { SenseRobots(state, false, nullptr); }
 void BM_SenseNearWall(benchmark::State& state) {
-  Swarm& swarm = GetSwarm(static_cast<int>(state.range(0)));
-  size_t k = 0;
-  for (auto _ : state) {
-    swarm.backend->SenseInstance(&swarm.scene, swarm.near_wall[k]);
-    if (++k == swarm.near_wall.size()) k = 0;
-  }
-  SetPerRobotCounters(state, double(state.iterations()));
-  state.counters["robots"] = double(swarm.near_wall.size());
+  SenseRobots(state, true, &GetSwarm(static_cast<int>(state.range(0))).near_wall);
+}
+void BM_SenseNearWall_CastAll(benchmark::State& state) {
+  SenseRobots(state, false, &GetSwarm(static_cast<int>(state.range(0))).near_wall);
+}
+void BM_SenseAlone(benchmark::State& state) {
+  SenseRobots(state, true, &GetSwarm(static_cast<int>(state.range(0))).alone);
+}
+void BM_SenseAlone_CastAll(benchmark::State& state) {
+  SenseRobots(state, false, &GetSwarm(static_cast<int>(state.range(0))).alone);
 }
 
 void BM_Update(benchmark::State& state) {
@@ -191,7 +221,11 @@ void BM_GridQuery(benchmark::State& state) {
 }
 
 BENCHMARK(BM_SenseRobot)->Arg(100)->Arg(1000)->Arg(10000);
+BENCHMARK(BM_SenseRobot_CastAll)->Arg(100)->Arg(1000)->Arg(10000);
 BENCHMARK(BM_SenseNearWall)->Arg(100)->Arg(1000)->Arg(10000);
+BENCHMARK(BM_SenseNearWall_CastAll)->Arg(100)->Arg(1000)->Arg(10000);
+BENCHMARK(BM_SenseAlone)->Arg(100)->Arg(1000)->Arg(10000);
+BENCHMARK(BM_SenseAlone_CastAll)->Arg(100)->Arg(1000)->Arg(10000);
 BENCHMARK(BM_Update)->Arg(100)->Arg(1000)->Arg(10000);
 BENCHMARK(BM_Build)->Arg(100)->Arg(1000)->Arg(10000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_GridBuild)->Arg(100)->Arg(1000)->Arg(10000)->Arg(100000);

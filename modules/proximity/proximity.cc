@@ -1,6 +1,6 @@
 // The proximity backend: ray sensors against the static environment (an
 // OctoMap octree built once, see static_index.h) and against robots and
-// dynamic shapes (a spatial grid rebuilt every step).
+// dynamic shapes (a grid of their footprints rebuilt every step).
 //
 // Detection rules:
 // - A sensor is a ray from its origin along its +z axis, of length `range`.
@@ -12,9 +12,25 @@
 // - Static shapes (no robot, not dynamic) are frozen at Build(): moving one
 //   later, or adding one, is not seen. Make such a shape dynamic or part of
 //   a model if it moves.
+//
+// The early-out. Most robots of a swarm have nothing within reach, and each
+// of their rays would find nothing. CastAll() is the reference: every ray
+// built and cast, with one static test (StaticIndex::AnyOccupied) and one
+// grid query per robot. SenseBatch() writes the same bits, skipping only
+// work whose result is known to be "nothing":
+// - The box that grows each sensor's origin by its range (and by a margin
+//   far above rounding) holds every ray segment. If the static index's
+//   coarse map has nothing in it and the footprint grid no other robot's
+//   shape, every ray reads "nothing" without being built.
+// - Otherwise a ray is built and cast only if its own box (of its segment,
+//   or of its origin's ball) meets another robot's footprint or holds an
+//   occupied voxel: a static cast walks only voxels along its segment and
+//   tests shapes only in occupied ones.
+// Every test is conservative and only grows with the box.
 #include "modules/proximity/proximity.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <span>
@@ -22,6 +38,7 @@
 
 #include "framework/scene.h"
 #include "framework/spatial_grid.h"
+#include "modules/proximity/footprint_grid.h"
 #include "modules/proximity/ray_cast.h"
 #include "modules/proximity/static_index.h"
 
@@ -35,6 +52,11 @@ struct SensorRay {  // 64 bytes
   uint32_t row;     // row in Scene::proximity_sensors()
 };
 
+struct SensorRef {  // 8 bytes
+  uint32_t slot;    // the sensor object
+  uint32_t row;     // its row in Scene::proximity_sensors()
+};
+
 SensorRay MakeRay(const Scene& scene, uint32_t slot) {
   const Pose& X_WS = scene.world_pose_at(slot);
   const uint32_t row = scene.row_at(slot);
@@ -45,8 +67,39 @@ SensorRay MakeRay(const Scene& scene, uint32_t slot) {
   return {X_WS.p, d, scene.proximity_sensors()[row].range, row};
 }
 
+// The rays of `sensors`, in order (written field by field: copying a fresh
+// SensorRay whole stalls on store forwarding).
+void MakeRays(const Scene& scene, std::span<const SensorRef> sensors,
+              std::vector<SensorRay>* rays) {
+  rays->resize(sensors.size());
+  for (size_t i = 0; i < sensors.size(); ++i) {
+    const SensorRay ray = MakeRay(scene, sensors[i].slot);
+    SensorRay& out = (*rays)[i];
+    out.p_W.x = ray.p_W.x, out.p_W.y = ray.p_W.y, out.p_W.z = ray.p_W.z;
+    out.d_W.x = ray.d_W.x, out.d_W.y = ray.d_W.y, out.d_W.z = ray.d_W.z;
+    out.range = ray.range, out.row = ray.row;
+  }
+}
+
+// The reading of a ray that found nothing.
+void ReadNothing(ProximitySensorData* reading) {
+  reading->detected = false;
+  reading->distance = 0;
+  reading->p_SD = {0, 0, 0};
+  reading->detected_object = ObjectId{};
+}
+
+// Zero if and only if the reading is ReadNothing's, bit for bit.
+uint64_t NothingBits(const ProximitySensorData& reading) {
+  return uint64_t{reading.detected} | std::bit_cast<uint64_t>(reading.distance) |
+         std::bit_cast<uint64_t>(reading.p_SD.x) | std::bit_cast<uint64_t>(reading.p_SD.y) |
+         std::bit_cast<uint64_t>(reading.p_SD.z) | std::bit_cast<uint64_t>(reading.detected_object);
+}
+
 class OctreeGridProximity final : public ProximityBackend {
  public:
+  explicit OctreeGridProximity(const BackendOptions& options) : options_(options) {}
+
   void Build(const Scene& scene, const ProximitySettings& settings) override {
     static_.Build(scene, settings.octree_resolution);
     Update(scene);
@@ -56,28 +109,59 @@ class OctreeGridProximity final : public ProximityBackend {
   // their footprints. Buffers keep their capacity: no allocation once warm.
   void Update(const Scene& scene) override {
     moving_.clear();
-    items_.clear();
+    footprints_.clear();
+    squares_.clear();
+    instances_.clear();
+    ids_.clear();
     const auto shapes = scene.shapes();
     const auto owners = scene.shape_owners();
+    footprint_memos_.resize(shapes.size());
     for (size_t r = 0; r < shapes.size(); ++r) {
+      // The poses of a big swarm outgrow the cache, and shape rows stride
+      // through them: ask for one a few rows ahead.
+      constexpr size_t kAhead = 8;
+      if (r + kAhead < shapes.size()) __builtin_prefetch(&scene.world_pose_at(owners[r + kAhead]));
       const uint32_t slot = owners[r];
       const int instance = scene.instance_of_at(slot);
       if (instance < 0 && !shapes[r].dynamic) continue;
       const Pose& X_WS = scene.world_pose_at(slot);
-      items_.push_back({X_WS.p.x, X_WS.p.y, WorldFootprintRadius(shapes[r], X_WS),
-                        static_cast<uint32_t>(moving_.size())});
-      moving_.push_back(PlaceShape(shapes[r], X_WS, scene.IdAt(slot), instance));
+      const ObjectId id = scene.IdAt(slot);
+      const double x = X_WS.p.x, y = X_WS.p.y;
+      const double radius = WorldFootprintRadius(shapes[r], X_WS, &footprint_memos_[r]);
+      const uint32_t index = static_cast<uint32_t>(moving_.size());
+      footprints_.push_back({x, y, radius, index});
+      // Its bounding square, grown by the margin (the rounding of the exact
+      // tests is relative to the footprint's coordinates too).
+      const double half = radius + kReachMargin * (std::abs(x) + std::abs(y) + radius);
+      squares_.push_back({x - half, y - half, x + half, y + half});
+      instances_.push_back(instance);
+      ids_.push_back(id);
+      moving_.push_back(PlaceShape(shapes[r], X_WS, id, instance));
     }
-    grid_.Build(items_);
+    // The early-out's own broad phase, or (casting every ray) the spatial grid.
+    if (options_.early_out) {
+      footprint_grid_.Build(squares_, instances_, ids_);
+    } else {
+      grid_.Build(footprints_);
+    }
+    if (!SensorListsCurrent(scene)) ListSensors(scene);
   }
 
   void SenseInstance(Scene* scene, int instance) const override {
-    thread_local std::vector<SensorRay> rays;
-    rays.clear();
+    if (SensorListsCurrent(*scene)) {
+      const size_t i = static_cast<size_t>(instance);
+      SenseBatch({instance_sensors_.data() + instance_sensor_start_[i],
+                  instance_sensors_.data() + instance_sensor_start_[i + 1]},
+                 instance, {}, scene);
+      return;
+    }
+    // The scene changed since Update(): find the sensors the slow way.
+    thread_local std::vector<SensorRef> sensors;
+    sensors.clear();
     for (uint32_t slot : scene->instance(instance).objects)
       if (scene->type_at(slot) == ObjectType::kProximitySensor)
-        rays.push_back(MakeRay(*scene, slot));
-    SenseRays(rays, instance, {}, scene);
+        sensors.push_back({slot, scene->row_at(slot)});
+    SenseBatch(sensors, instance, {}, scene);
   }
 
   bool SegmentBlocked(const Vec3& a_W, const Vec3& b_W) const override {
@@ -90,80 +174,277 @@ class OctreeGridProximity final : public ProximityBackend {
   }
 
   void SenseSceneSensors(Scene* scene) const override {
-    thread_local std::vector<ObjectId> mounts;
-    const auto owners = scene->proximity_sensor_owners();
-    for (size_t row = 0; row < owners.size(); ++row) {
-      const uint32_t slot = owners[row];
-      if (scene->instance_of_at(slot) >= 0) continue;
-      // The shapes the sensor hangs from are not obstacles to it.
-      mounts.clear();
-      for (int32_t a = scene->parent_at(slot); a >= 0; a = scene->parent_at(a))
-        if (scene->type_at(a) == ObjectType::kShape) mounts.push_back(scene->IdAt(a));
-      const SensorRay ray = MakeRay(*scene, slot);
-      SenseRays({&ray, 1}, -1, mounts, scene);
+    if (SensorListsCurrent(*scene)) {
+      for (const SensorRef& sensor : scene_sensors_) SenseSceneSensor(sensor, scene);
+      return;
     }
+    const auto owners = scene->proximity_sensor_owners();
+    for (size_t row = 0; row < owners.size(); ++row)
+      if (scene->instance_of_at(owners[row]) < 0)
+        SenseSceneSensor({owners[row], static_cast<uint32_t>(row)}, scene);
   }
 
  private:
-  // Reads a batch of rays of one robot (`instance`, or -1 for scene sensors)
-  // with one static early-out and one grid query for the whole batch.
-  void SenseRays(std::span<const SensorRay> rays, int instance, std::span<const ObjectId> skip,
-                 Scene* scene) const {
-    if (rays.empty()) return;
-    // Bounds of all the batch's ray segments.
+  // Are the sensor lists of ListSensors() those of the scene as it is now?
+  // Every change that adds, removes or moves a sensor between robots bumps
+  // the structure version or adds an instance.
+  bool SensorListsCurrent(const Scene& scene) const {
+    return listed_version_ == scene.structure_version() &&
+           listed_instances_ == scene.instances().size();
+  }
+
+  // Lists each robot's sensors (hierarchy order) and the sensors of no robot.
+  void ListSensors(const Scene& scene) {
+    const auto& instances = scene.instances();
+    instance_sensor_start_.assign(1, 0);
+    instance_sensors_.clear();
+    for (const ModelInstance& instance : instances) {
+      for (uint32_t slot : instance.objects)
+        if (scene.type_at(slot) == ObjectType::kProximitySensor)
+          instance_sensors_.push_back({slot, scene.row_at(slot)});
+      instance_sensor_start_.push_back(static_cast<uint32_t>(instance_sensors_.size()));
+    }
+    scene_sensors_.clear();
+    const auto owners = scene.proximity_sensor_owners();
+    for (size_t row = 0; row < owners.size(); ++row)
+      if (scene.instance_of_at(owners[row]) < 0)
+        scene_sensors_.push_back({owners[row], static_cast<uint32_t>(row)});
+    listed_version_ = scene.structure_version();
+    listed_instances_ = instances.size();
+  }
+
+  void SenseSceneSensor(const SensorRef& sensor, Scene* scene) const {
+    thread_local std::vector<ObjectId> mounts;
+    // The shapes the sensor hangs from are not obstacles to it.
+    mounts.clear();
+    for (int32_t a = scene->parent_at(sensor.slot); a >= 0; a = scene->parent_at(a))
+      if (scene->type_at(a) == ObjectType::kShape) mounts.push_back(scene->IdAt(a));
+    SenseBatch({&sensor, 1}, -1, mounts, scene);
+  }
+
+  // Reads the sensors of one robot (`instance`, or -1 for a scene sensor):
+  // the same readings as CastAll, casting only the rays that may see
+  // something.
+  void SenseBatch(std::span<const SensorRef> sensors, int instance, std::span<const ObjectId> skip,
+                  Scene* scene) const {
+    if (sensors.empty()) return;
+    if (!options_.early_out) return CastAll(sensors, instance, skip, scene);
+    // The box of all the sensors' reach: their origins' box grown by the
+    // longest range and the margin. Stand aside (cast) if an origin or a
+    // range is not finite, or a quaternion is so far from unit (|q|^2 >
+    // 2e307) that MakeRay's rotation could overflow: then `sum` is not finite.
     constexpr double kInf = std::numeric_limits<double>::infinity();
-    Vec3 lo{kInf, kInf, kInf}, hi{-kInf, -kInf, -kInf};
+    double lo_x = kInf, lo_y = kInf, lo_z = kInf, hi_x = -kInf, hi_y = -kInf, hi_z = -kInf;
+    double longest = 0, sum = 0;
+    uint64_t written = 0;  // zero if every reading already reads "nothing"
+    const auto readings = scene->proximity_sensors();
+    for (const SensorRef& sensor : sensors) {
+      const Pose& X_WS = scene->world_pose_at(sensor.slot);
+      const double x = X_WS.p.x, y = X_WS.p.y, z = X_WS.p.z;
+      const ProximitySensorData& reading = readings[sensor.row];
+      const double range = reading.range;
+      lo_x = std::min(lo_x, x), lo_y = std::min(lo_y, y), lo_z = std::min(lo_z, z);
+      hi_x = std::max(hi_x, x), hi_y = std::max(hi_y, y), hi_z = std::max(hi_z, z);
+      longest = std::max(longest, range);
+      const Quat& q = X_WS.q;
+      sum += ((x + y) + (z + range)) + 4 * ((q.w * q.w + q.x * q.x) + (q.y * q.y + q.z * q.z));
+      written |= NothingBits(reading);
+    }
+    if (!std::isfinite(sum)) return CastAll(sensors, instance, skip, scene);
+    // margin: at least kReachMargin (range + |p|_1) for every sensor.
+    const double margin =
+        kReachMargin * (longest + std::abs(lo_x) + std::abs(lo_y) + std::abs(lo_z) +
+                        std::abs(hi_x) + std::abs(hi_y) + std::abs(hi_z));
+    const double reach = longest + margin;
+    const Vec3 lo{lo_x - reach, lo_y - reach, lo_z - reach};
+    const Vec3 hi{hi_x + reach, hi_y + reach, hi_z + reach};
+    // It holds CastAll's batch box, and both tests only grow with the box:
+    // if neither finds anything, CastAll finds nothing for any ray.
+    bool near_static = static_.MayBeOccupied(lo, hi);
+    const Aabb2 box{lo.x, lo.y, hi.x, hi.y};
+    const bool near_robot = footprint_grid_.AnyOther(box, instance, skip);
+    if (!near_static && !near_robot) {
+      if (written != 0)
+        for (const SensorRef& sensor : sensors) ReadNothing(&readings[sensor.row]);
+      return;
+    }
+    // The other robots' shapes near the batch, with their footprints' squares.
+    thread_local std::vector<uint32_t> candidates;
+    thread_local std::vector<Aabb2> squares;
+    candidates.clear();
+    squares.clear();
+    if (near_robot) {
+      Candidates(box, instance, skip, &candidates);
+      for (uint32_t c : candidates) squares.push_back(squares_[c]);
+    }
+    // Near a wall: CastAll's own test, on its exact batch box, decides
+    // whether rays are cast against the static index at all.
+    thread_local std::vector<SensorRay> rays;
+    rays.clear();
+    if (near_static) {
+      MakeRays(*scene, sensors, &rays);
+      Vec3 ray_lo, ray_hi;
+      RayBounds(rays, &ray_lo, &ray_hi);
+      near_static = AnyOccupied(ray_lo, ray_hi);
+    }
+    for (size_t i = 0; i < sensors.size(); ++i) {
+      const SensorRef& sensor = sensors[i];
+      // The ray's box: of its segment if built, else of the ball of radius
+      // range about its origin (range >= 0 and |d| <= 1 + 1e-14 make the
+      // segment lie in it); grown by at least the margin.
+      Vec3 a, b;
+      if (!rays.empty()) {
+        SegmentBox(rays[i], &a, &b);
+      } else {
+        const Vec3& p = scene->world_pose_at(sensor.slot).p;
+        const double range = readings[sensor.row].range;
+        const double r = (range > 0 ? range : 0) + margin;
+        a = {p.x - r, p.y - r, p.z - r};
+        b = {p.x + r, p.y + r, p.z + r};
+      }
+      // A static cast walks only voxels within the ray's segment box (grown
+      // by a rounding margin), testing shapes only in occupied ones: with no
+      // occupied voxel there it finds nothing. (A non-finite direction: cast.
+      // Where the coarse map is not exact, the cast itself skips the rest.)
+      const bool static_in_reach =
+          near_static && (!FiniteDirection(rays[i]) || static_.MayBeOccupied(a, b));
+      // Another robot's shape is tested only if its footprint meets the
+      // ray's box; then the footprint's square meets this bigger one (the
+      // margin covers the rounding of both tests).
+      const bool robot_in_reach = std::any_of(squares.begin(), squares.end(), [&](const Aabb2& q) {
+        return q.max_x >= a.x && q.min_x <= b.x && q.max_y >= a.y && q.min_y <= b.y;
+      });
+      if (!static_in_reach && !robot_in_reach) {
+        ReadNothing(&readings[sensor.row]);
+        continue;
+      }
+      SenseRay(rays.empty() ? MakeRay(*scene, sensor.slot) : rays[i], static_in_reach, candidates,
+               skip, scene);
+    }
+  }
+
+  // Margin, relative to the coordinates and the range, by which the boxes of
+  // the early-out exceed the rays: far above rounding (1e-16 relative per
+  // operation, 1e-11 over the longest voxel walk) and far below what a robot
+  // would notice.
+  static constexpr double kReachMargin = 1e-7;
+
+  // StaticIndex::AnyOccupied, asking the coarse map first.
+  bool AnyOccupied(const Vec3& lo, const Vec3& hi) const {
+    if (!static_.MayBeOccupied(lo, hi)) return false;
+    return static_.coarse_map_is_exact() || static_.AnyOccupied(lo, hi);
+  }
+
+  static bool FiniteDirection(const SensorRay& ray) {
+    return std::isfinite(ray.d_W.x + ray.d_W.y + ray.d_W.z);
+  }
+
+  // The box of a ray's segment (of the origin alone if the range is
+  // negative), grown by kReachMargin. The origin and range are finite.
+  static void SegmentBox(const SensorRay& ray, Vec3* lo, Vec3* hi) {
+    const double r = ray.range > 0 ? ray.range : 0;
+    const Vec3 end = ray.p_W + ray.d_W * r;
+    const double m =
+        kReachMargin * (r + std::abs(ray.p_W.x) + std::abs(ray.p_W.y) + std::abs(ray.p_W.z));
+    *lo = {std::min(ray.p_W.x, end.x) - m, std::min(ray.p_W.y, end.y) - m,
+           std::min(ray.p_W.z, end.z) - m};
+    *hi = {std::max(ray.p_W.x, end.x) + m, std::max(ray.p_W.y, end.y) + m,
+           std::max(ray.p_W.z, end.z) + m};
+  }
+
+  // Bounds of all the batch's ray segments.
+  static void RayBounds(std::span<const SensorRay> rays, Vec3* lo, Vec3* hi) {
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    *lo = {kInf, kInf, kInf};
+    *hi = {-kInf, -kInf, -kInf};
     auto grow = [&](const Vec3& p) {
-      lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
-      hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+      *lo = {std::min(lo->x, p.x), std::min(lo->y, p.y), std::min(lo->z, p.z)};
+      *hi = {std::max(hi->x, p.x), std::max(hi->y, p.y), std::max(hi->z, p.z)};
     };
     for (const SensorRay& ray : rays) {
       grow(ray.p_W);
       grow(ray.p_W + ray.d_W * std::max(ray.range, 0.0));
     }
+  }
+
+  // Robot and dynamic shapes whose footprint meets `box`, but for the
+  // robot's own (`instance`) and those in `skip`; ascending. With the
+  // early-out, those whose footprint's square meets it: a superset, which
+  // SenseRay narrows down exactly as it does the grid's answer.
+  void Candidates(const Aabb2& box, int instance, std::span<const ObjectId> skip,
+                  std::vector<uint32_t>* out) const {
+    if (options_.early_out) return footprint_grid_.Others(box, instance, skip, out);
+    grid_.QueryAabb(box, out);
+    size_t kept = 0;
+    for (uint32_t c : *out) {
+      const PlacedShape& shape = moving_[c];
+      if (instance >= 0 && shape.instance == instance) continue;
+      if (std::find(skip.begin(), skip.end(), shape.id) != skip.end()) continue;
+      (*out)[kept++] = c;
+    }
+    out->resize(kept);
+  }
+
+  // Casts every ray of a batch, with one static test and one grid query
+  // for the whole batch (the reference the early-out must match).
+  void CastAll(std::span<const SensorRef> sensors, int instance, std::span<const ObjectId> skip,
+               Scene* scene) const {
+    thread_local std::vector<SensorRay> rays;
+    MakeRays(*scene, sensors, &rays);
+    Vec3 lo, hi;
+    RayBounds(rays, &lo, &hi);
     // Most batches of a swarm are nowhere near a wall.
     const bool near_static = static_.AnyOccupied(lo, hi);
     // Shapes of other robots (and dynamic shapes) whose footprint meets the batch.
     thread_local std::vector<uint32_t> candidates;
-    grid_.QueryAabb({lo.x, lo.y, hi.x, hi.y}, &candidates);
-    size_t kept = 0;
-    for (uint32_t c : candidates) {
-      const PlacedShape& shape = moving_[c];
-      if (instance >= 0 && shape.instance == instance) continue;
-      if (std::find(skip.begin(), skip.end(), shape.id) != skip.end()) continue;
-      candidates[kept++] = c;
-    }
-    candidates.resize(kept);
-
-    for (const SensorRay& ray : rays) {
-      double best = kInf;
-      ObjectId hit;
-      if (ray.range >= 0) {
-        double t;
-        uint32_t s;
-        if (near_static && static_.CastRay(ray.p_W, ray.d_W, ray.range, skip, &t, &s))
-          best = t, hit = static_.shapes()[s].id;
-        const Vec3 end = ray.p_W + ray.d_W * ray.range;
-        const Aabb2 box{std::min(ray.p_W.x, end.x), std::min(ray.p_W.y, end.y),
-                        std::max(ray.p_W.x, end.x), std::max(ray.p_W.y, end.y)};
-        for (uint32_t c : candidates) {
-          if (!SpatialGrid::CircleIntersectsAabb(items_[c], box)) continue;
-          if (RayCast(moving_[c], ray.p_W, ray.d_W, ray.range, &t) && t < best)
-            best = t, hit = moving_[c].id;
-        }
-      }
-      ProximitySensorData& reading = scene->proximity_sensors()[ray.row];
-      reading.detected = best <= ray.range;
-      reading.distance = reading.detected ? best : 0;
-      reading.p_SD = {0, 0, reading.distance};
-      reading.detected_object = reading.detected ? hit : ObjectId{};
-    }
+    Candidates({lo.x, lo.y, hi.x, hi.y}, instance, skip, &candidates);
+    for (const SensorRay& ray : rays) SenseRay(ray, near_static, candidates, skip, scene);
   }
 
+  // Casts one ray: against the static index if `near_static`, and against
+  // the candidates whose footprint meets the ray's box. `candidates` may be
+  // any superset (ascending) of those: the others are not tested.
+  void SenseRay(const SensorRay& ray, bool near_static, std::span<const uint32_t> candidates,
+                std::span<const ObjectId> skip, Scene* scene) const {
+    double best = std::numeric_limits<double>::infinity();
+    ObjectId hit;
+    if (ray.range >= 0) {
+      double t;
+      uint32_t s;
+      if (near_static && static_.CastRay(ray.p_W, ray.d_W, ray.range, skip, &t, &s))
+        best = t, hit = static_.shapes()[s].id;
+      const Vec3 end = ray.p_W + ray.d_W * ray.range;
+      const Aabb2 box{std::min(ray.p_W.x, end.x), std::min(ray.p_W.y, end.y),
+                      std::max(ray.p_W.x, end.x), std::max(ray.p_W.y, end.y)};
+      for (uint32_t c : candidates) {
+        if (!SpatialGrid::CircleIntersectsAabb(footprints_[c], box)) continue;
+        if (RayCast(moving_[c], ray.p_W, ray.d_W, ray.range, &t) && t < best)
+          best = t, hit = moving_[c].id;
+      }
+    }
+    ProximitySensorData& reading = scene->proximity_sensors()[ray.row];
+    reading.detected = best <= ray.range;
+    reading.distance = reading.detected ? best : 0;
+    reading.p_SD = {0, 0, reading.distance};
+    reading.detected_object = reading.detected ? hit : ObjectId{};
+  }
+
+  BackendOptions options_;
   StaticIndex static_;
-  std::vector<PlacedShape> moving_;  // robot and dynamic shapes, by shape row order (moving)
-  std::vector<GridItem> items_;      // their footprints; item i is moving_[i] (moving)
-  SpatialGrid grid_;
+  std::vector<PlacedShape> moving_;   // robot and dynamic shapes, by shape row order (moving)
+  std::vector<GridItem> footprints_;  // their footprints, item i: moving_[i] (moving)
+  std::vector<Aabb2> squares_;        // bounding squares, grown (moving)
+  std::vector<int32_t> instances_;    // moving_[i].instance (moving)
+  std::vector<ObjectId> ids_;         // moving_[i].id (moving)
+  std::vector<FootprintMemo> footprint_memos_;  // by shape row (shapes)
+  FootprintGrid footprint_grid_;                // with the early-out
+  SpatialGrid grid_;                            // casting every ray
+  // The sensors by owner, as of ListSensors() (see SensorListsCurrent).
+  std::vector<uint32_t> instance_sensor_start_;  // first of each instance's sensors (instances + 1)
+  std::vector<SensorRef> instance_sensors_;      // robot sensors, grouped by instance
+  std::vector<SensorRef> scene_sensors_;         // sensors of no robot, by row
+  uint64_t listed_version_ = ~uint64_t{0};
+  size_t listed_instances_ = 0;
 };
 
 }  // namespace
@@ -174,6 +455,8 @@ swarmsim::ModuleInfo ModuleInfo() {
           "meshes; static environment in an OctoMap octree, robots through a spatial grid"};
 }
 
-std::unique_ptr<ProximityBackend> MakeBackend() { return std::make_unique<OctreeGridProximity>(); }
+std::unique_ptr<ProximityBackend> MakeBackend(const BackendOptions& options) {
+  return std::make_unique<OctreeGridProximity>(options);
+}
 
 }  // namespace swarmsim::proximity

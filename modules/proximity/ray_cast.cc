@@ -131,12 +131,20 @@ void WorldBounds(const PlacedShape& shape, Vec3* lo, Vec3* hi) {
 }
 
 double WorldFootprintRadius(const ShapeData& shape, const Pose& X_WS) {
+  return WorldFootprintRadius(shape, X_WS, nullptr);
+}
+
+double WorldFootprintRadius(const ShapeData& shape, const Pose& X_WS, FootprintMemo* memo) {
   const Vec3 axis = X_WS.q.Rotate({0, 0, 1});
   if (std::abs(axis.z) >= 1 - 1e-12) return shape.BoundingRadius();  // upright
   switch (shape.kind) {
     case ShapeKind::kBox: return 0.5 * shape.size.Norm();
     case ShapeKind::kCylinder:
-    case ShapeKind::kCapsule: return std::hypot(shape.size.x, 0.5 * shape.size.z);
+    case ShapeKind::kCapsule:
+      if (memo == nullptr) return std::hypot(shape.size.x, 0.5 * shape.size.z);
+      if (!(memo->size_x == shape.size.x && memo->size_z == shape.size.z))
+        *memo = {shape.size.x, shape.size.z, std::hypot(shape.size.x, 0.5 * shape.size.z)};
+      return memo->radius;
     case ShapeKind::kSphere: return shape.size.x;
     case ShapeKind::kMesh: return shape.mesh ? shape.mesh->bounding_radius() : 0;
   }

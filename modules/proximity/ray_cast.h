@@ -8,6 +8,7 @@
 // pushed into a wall reads "detected, distance 0" rather than seeing out of it.
 #pragma once
 
+#include <cmath>
 #include <compare>  // framework/handle.h uses operator<=> without including <compare>
 #include <cstdint>
 
@@ -49,6 +50,14 @@ void WorldBounds(const PlacedShape& shape, Vec3* lo, Vec3* hi);
 // in the world xy plane. ShapeData::BoundingRadius when the shape stands
 // upright; the 3D bounding-sphere radius when it is tilted.
 double WorldFootprintRadius(const ShapeData& shape, const Pose& X_WS);
+
+// The same, remembering the one costly case (a tilted cylinder's hypot) in
+// `memo` for a caller that asks about the same shape every step.
+struct FootprintMemo {                // 24 bytes
+  double size_x = NAN, size_z = NAN;  // the cylinder's size the radius is for
+  double radius = 0;
+};
+double WorldFootprintRadius(const ShapeData& shape, const Pose& X_WS, FootprintMemo* memo);
 
 // Conservative overlap: false only if the shape, grown by `margin`, misses
 // the axis-aligned cube (centre, half edge `half`). Exact for boxes and

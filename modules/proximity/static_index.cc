@@ -20,6 +20,9 @@ constexpr int kTreeSize = 65536;  // keys per axis
 constexpr int kTreeDepth = 16;
 constexpr double kMaxVoxelTests = 2e8;  // guards Build against absurd resolutions
 constexpr int kTestedCapacity = 16;     // shapes remembered per ray to avoid retesting
+constexpr int kCoarseZCells = 16;       // bits in a column mask
+constexpr int kBlockShift = 3;          // a block is 8 x 8 columns
+constexpr int64_t kMaxCoarseColumns = int64_t{1} << 21;  // 4 MiB of column masks at most
 
 uint64_t PackBucket(int bx, int by, int bz) {
   return (static_cast<uint64_t>(bx) << 32) | (static_cast<uint64_t>(by) << 16) |
@@ -47,6 +50,14 @@ double StaticIndex::RawKey(double coordinate) const {
   return std::floor(coordinate * inv_resolution_) + kKeyOffset;
 }
 
+int StaticIndex::ClampedKey(double coordinate) const {
+  // floor() by truncation, in a range where int holds it exactly; values
+  // beyond clamp to keys beyond every voxel, as RawKey's would be.
+  const double scaled = std::clamp(coordinate * inv_resolution_, -1e9, 1e9);
+  const int truncated = static_cast<int>(scaled);
+  return truncated - (scaled < truncated ? 1 : 0) + kKeyOffset;
+}
+
 size_t StaticIndex::octree_node_count() const { return tree_ ? tree_->size() : 0; }
 
 void StaticIndex::Build(const Scene& scene, double resolution) {
@@ -62,6 +73,8 @@ void StaticIndex::Build(const Scene& scene, double resolution) {
   meshes_.clear();
   buckets_.clear();
   bucket_shapes_.clear();
+  coarse_.clear();
+  blocks_.clear();
 
   // The static shapes, in slot order (independent of table history).
   const auto shape_rows = scene.shapes();
@@ -161,6 +174,114 @@ void StaticIndex::Build(const Scene& scene, double resolution) {
   occupied_hi_ = {(occupied_keys_.hi[0] + 1 - kKeyOffset) * resolution,
                   (occupied_keys_.hi[1] + 1 - kKeyOffset) * resolution,
                   (occupied_keys_.hi[2] + 1 - kKeyOffset) * resolution};
+  BuildCoarseMap();
+}
+
+void StaticIndex::BuildCoarseMap() {
+  coarse_.clear();
+  blocks_.clear();
+  if (shapes_.empty() || tree_->getRoot() == nullptr) return;  // AnyOccupied: always false
+  // Finest cells that fit: z in one 64-bit mask, the (x, y) columns in the budget.
+  int span[3];
+  for (int i = 0; i < 3; ++i) span[i] = occupied_keys_.hi[i] - occupied_keys_.lo[i] + 1;
+  auto cells = [&](int i, int shift) { return ((span[i] - 1) >> shift) + 1; };
+  int shift_z = 0, shift_xy = 0;
+  while (cells(2, shift_z) > kCoarseZCells) ++shift_z;
+  while (int64_t{cells(0, shift_xy)} * cells(1, shift_xy) > kMaxCoarseColumns) ++shift_xy;
+  coarse_shift_[0] = coarse_shift_[1] = shift_xy;
+  coarse_shift_[2] = shift_z;
+  for (int i = 0; i < 3; ++i) coarse_size_[i] = cells(i, coarse_shift_[i]);
+  for (int i = 0; i < 2; ++i) block_count_[i] = ((coarse_size_[i] - 1) >> kBlockShift) + 1;
+  coarse_.assign(size_t(block_count_[0]) * size_t(block_count_[1]) << (2 * kBlockShift), 0);
+  const int origin[3] = {0, 0, 0};
+  MarkCoarse(tree_->getRoot(), origin, kTreeSize);
+  blocks_.assign(size_t(block_count_[0]) * size_t(block_count_[1]), 0);
+  for (int x = 0; x < coarse_size_[0]; ++x)
+    for (int y = 0; y < coarse_size_[1]; ++y)
+      blocks_[size_t(x >> kBlockShift) * block_count_[1] + (y >> kBlockShift)] |=
+          coarse_[ColumnIndex(x, y)];
+}
+
+bool StaticIndex::CoarseCellOccupied(const int key[3]) const {
+  int cell[3];
+  for (int i = 0; i < 3; ++i) cell[i] = (key[i] - occupied_keys_.lo[i]) >> coarse_shift_[i];
+  return (coarse_[ColumnIndex(cell[0], cell[1])] >> cell[2]) & 1;
+}
+
+size_t StaticIndex::ColumnIndex(int x, int y) const {
+  constexpr int kMask = (1 << kBlockShift) - 1;
+  const size_t block = size_t(x >> kBlockShift) * block_count_[1] + (y >> kBlockShift);
+  return (block << (2 * kBlockShift)) | size_t((x & kMask) << kBlockShift | (y & kMask));
+}
+
+void StaticIndex::MarkCoarse(const octomap::OcTreeNode* node, const int origin[3], int size) {
+  // The same walk as AnyOccupiedIn: an occupied node without children is a
+  // voxel or a pruned occupied block.
+  if (!tree_->isNodeOccupied(node)) return;
+  if (tree_->nodeHasChildren(node)) {
+    const int half = size / 2;
+    for (unsigned int c = 0; c < 8; ++c) {
+      if (!tree_->nodeChildExists(node, c)) continue;
+      const int child[3] = {origin[0] + ((c & 1) ? half : 0), origin[1] + ((c & 2) ? half : 0),
+                            origin[2] + ((c & 4) ? half : 0)};
+      MarkCoarse(tree_->getNodeChild(node, c), child, half);
+    }
+    return;
+  }
+  int lo[3], hi[3];
+  for (int i = 0; i < 3; ++i) {
+    const int a = std::max(origin[i], occupied_keys_.lo[i]);
+    const int b = std::min(origin[i] + size - 1, occupied_keys_.hi[i]);
+    if (a > b) return;  // (no occupied voxel lies outside occupied_keys_)
+    lo[i] = (a - occupied_keys_.lo[i]) >> coarse_shift_[i];
+    hi[i] = (b - occupied_keys_.lo[i]) >> coarse_shift_[i];
+  }
+  uint16_t z_mask = 0;
+  for (int z = lo[2]; z <= hi[2]; ++z) z_mask |= uint16_t(1u << z);
+  for (int x = lo[0]; x <= hi[0]; ++x)
+    for (int y = lo[1]; y <= hi[1]; ++y) coarse_[ColumnIndex(x, y)] |= z_mask;
+}
+
+bool StaticIndex::MayBeOccupied(const Vec3& lo, const Vec3& hi) const {
+  if (coarse_.empty()) return false;  // no occupied voxel
+  const double box_lo[3] = {lo.x, lo.y, lo.z}, box_hi[3] = {hi.x, hi.y, hi.z};
+  const double occupied_lo[3] = {occupied_lo_.x, occupied_lo_.y, occupied_lo_.z};
+  const double occupied_hi[3] = {occupied_hi_.x, occupied_hi_.y, occupied_hi_.z};
+  int cell_lo[3], cell_hi[3];
+  for (int i = 0; i < 3; ++i) {
+    // AnyOccupied's box test and key box (written so that NaN bounds answer
+    // "no", as there). A key box the clamp turns inside out holds no
+    // occupied voxel: every one lies within occupied_keys_.
+    if (!(box_lo[i] <= occupied_hi[i] && box_hi[i] >= occupied_lo[i])) return false;
+    const int key_lo = occupied_keys_.lo[i], key_hi = occupied_keys_.hi[i];
+    const int a = std::max(ClampedKey(box_lo[i]), key_lo);
+    const int b = std::min(ClampedKey(box_hi[i]), key_hi);
+    if (a > b) return false;
+    cell_lo[i] = (a - key_lo) >> coarse_shift_[i];
+    cell_hi[i] = (b - key_lo) >> coarse_shift_[i];
+  }
+  const int z_cells = cell_hi[2] - cell_lo[2] + 1;
+  const uint16_t z_mask =
+      uint16_t((z_cells >= kCoarseZCells ? 0xffffu : (1u << z_cells) - 1) << cell_lo[2]);
+  // Blocks first: most boxes are far from every wall.
+  for (int bx = cell_lo[0] >> kBlockShift; bx <= cell_hi[0] >> kBlockShift; ++bx)
+    for (int by = cell_lo[1] >> kBlockShift; by <= cell_hi[1] >> kBlockShift; ++by) {
+      const size_t block = size_t(bx) * block_count_[1] + by;
+      if (!(blocks_[block] & z_mask)) continue;
+      // The block's columns, x-major, 8 per row.
+      constexpr int kMask = (1 << kBlockShift) - 1;
+      const uint16_t* columns = &coarse_[block << (2 * kBlockShift)];
+      const int x0 = std::max(cell_lo[0], bx << kBlockShift) & kMask;
+      const int x1 = std::min(cell_hi[0], ((bx + 1) << kBlockShift) - 1) & kMask;
+      const int y0 = std::max(cell_lo[1], by << kBlockShift) & kMask;
+      const int y1 = std::min(cell_hi[1], ((by + 1) << kBlockShift) - 1) & kMask;
+      for (int x = x0; x <= x1; ++x) {
+        const uint16_t* row = columns + (x << kBlockShift);
+        for (int y = y0; y <= y1; ++y)
+          if (row[y] & z_mask) return true;
+      }
+    }
+  return false;
 }
 
 bool StaticIndex::AnyOccupiedIn(const octomap::OcTreeNode* node, const int origin[3], int size,
@@ -243,10 +364,11 @@ bool StaticIndex::CastRay(const Vec3& p_W, const Vec3& d_W, double max_t,
     box_lo[i] = std::max(static_cast<int>(std::min(a, b)) - 1, 0);
     box_hi[i] = std::min(static_cast<int>(std::max(a, b)) + 1, kMaxKey);
   }
-  // The deepest octree node holding that box; none means no occupied voxel on the ray.
-  int bit;
-  const octomap::OcTreeNode* top = CommonAncestor(box_lo, box_hi, &bit);
-  if (top == nullptr) return false;
+  // The deepest octree node holding that box (none means no occupied voxel
+  // on the ray): found at the first voxel the coarse map does not rule out.
+  int bit = 0;
+  const octomap::OcTreeNode* top = nullptr;
+  bool top_found = false;
 
   // 3D DDA (Amanatides & Woo) over voxel keys, from the clipped entry point.
   int key[3], step[3];
@@ -271,7 +393,16 @@ bool StaticIndex::CastRay(const Vec3& p_W, const Vec3& d_W, double max_t,
   int tested_count = 0;
   for (;;) {
     // An occupied voxel: test its bucket's shapes exactly (once per ray).
-    const octomap::OcTreeNode* node = Descend(top, bit, key);
+    // (Where the coarse map has nothing, Descend would find nothing.)
+    const octomap::OcTreeNode* node = nullptr;
+    if (CoarseCellOccupied(key)) {
+      if (!top_found) {
+        top = CommonAncestor(box_lo, box_hi, &bit);
+        top_found = true;
+        if (top == nullptr) return false;
+      }
+      node = Descend(top, bit, key);
+    }
     if (node != nullptr && tree_->isNodeOccupied(node)) {
       const auto it = buckets_.find(
           PackBucket(key[0] >> kBucketShift, key[1] >> kBucketShift, key[2] >> kBucketShift));

@@ -11,6 +11,11 @@
 // occupied voxel tests the bucket's shapes exactly; the nearest exact hit
 // wins, so distances are exact to the geometry, not to the voxel size.
 //
+// A coarse occupancy map, built once from the octree's occupied leaves,
+// answers "may anything static be in this box?" with a few bit tests: it
+// lets a robot far from every wall skip its rays without an octree descent,
+// and lets a ray skip the octree where it crosses only empty cells.
+//
 // Internal to modules/proximity (OctoMap types stay in this module).
 #pragma once
 
@@ -54,6 +59,14 @@ class StaticIndex {
   // May any occupied voxel meet the world box [lo, hi]? Cheap descent of the
   // octree: most sensors of a swarm are far from every wall.
   bool AnyOccupied(const Vec3& lo, const Vec3& hi) const;
+  // Conservative and cheaper still: false only if AnyOccupied(lo', hi') is
+  // false for every box [lo', hi'] inside [lo, hi]. Reads the coarse map only.
+  bool MayBeOccupied(const Vec3& lo, const Vec3& hi) const;
+  // Is the coarse map at voxel resolution, so that MayBeOccupied is
+  // AnyOccupied (for static geometry within about 1,400 x 1,400 x 16 voxels)?
+  bool coarse_map_is_exact() const {
+    return coarse_shift_[0] == 0 && coarse_shift_[1] == 0 && coarse_shift_[2] == 0;
+  }
 
   // Nearest exact hit of the ray (p_W, unit d_W, length max_t) on a static
   // shape not listed in `skip`. Sets *t and *shape (index into shapes()).
@@ -75,6 +88,19 @@ class StaticIndex {
   const octomap::OcTreeNode* CommonAncestor(const int lo[3], const int hi[3], int* bit) const;
   // Voxel key of a coordinate, unclamped (may fall outside 0..65535).
   double RawKey(double coordinate) const;
+  // The same, clamped to +-1e9 (cheaper; equal to RawKey between). Not NaN.
+  int ClampedKey(double coordinate) const;
+  // Builds coarse_ from the octree (end of Build).
+  void BuildCoarseMap();
+  // Index of coarse column (x, y) in coarse_: the 64 columns of a block are
+  // contiguous (two cache lines).
+  size_t ColumnIndex(int x, int y) const;
+  // Does the coarse cell of voxel `key` (within occupied_keys_) hold part of
+  // an occupied leaf?
+  bool CoarseCellOccupied(const int key[3]) const;
+  // Marks the coarse cells of the occupied leaves under `node` (key cube
+  // `origin`, edge `size`), as AnyOccupiedIn would find them.
+  void MarkCoarse(const octomap::OcTreeNode* node, const int origin[3], int size);
 
   std::unique_ptr<octomap::OcTree> tree_;
   double resolution_ = 0.05;
@@ -87,6 +113,17 @@ class StaticIndex {
   std::vector<uint32_t> bucket_shapes_;  // shape indices, ascending per bucket
   KeyBox occupied_keys_{};               // key bounds of the occupied voxels
   Vec3 occupied_lo_, occupied_hi_;       // the same, in metres
+  // Coarse occupancy map. A coarse cell holds the voxel keys k with
+  // (k - occupied_keys_.lo) >> coarse_shift_ equal per axis; a bit is set if
+  // an occupied leaf (voxel or pruned block) meets the cell. One 16-bit mask
+  // over z per (x, y) column, grouped in blocks of 8 x 8 columns (see
+  // ColumnIndex); and per block the OR of its masks, small enough to stay
+  // in cache.
+  std::vector<uint16_t> coarse_;  // (block_count_[0] x block_count_[1] x 64)
+  std::vector<uint16_t> blocks_;  // (block_count_[0] x block_count_[1])
+  int coarse_shift_[3] = {0, 0, 0};
+  int coarse_size_[3] = {0, 0, 0};  // cells per axis
+  int block_count_[2] = {0, 0};
 };
 
 }  // namespace swarmsim::proximity

@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
+#include <cstring>
 #include <memory>
 #include <random>
 #include <string>
@@ -12,6 +14,7 @@
 #include "framework/error.h"
 #include "framework/scene.h"
 #include "modules/proximity/ray_cast.h"
+#include "modules/proximity/static_index.h"
 
 namespace swarmsim::proximity {
 namespace {
@@ -418,6 +421,269 @@ TEST_F(ProximityTest, SwarmMatchesBruteForceAndConcurrentSensingMatchesSerial) {
     ASSERT_EQ(r.detected, serial[row].detected) << row;
     ASSERT_EQ(r.distance, serial[row].distance) << row;
     ASSERT_EQ(r.detected_object, serial[row].detected_object) << row;
+  }
+}
+
+// --- The early-out: skipped rays read exactly what cast rays read -------------------
+
+// Same bits: a reading the early-out forgot to write, or wrote as "nothing"
+// where a cast would have found something, shows up here.
+bool SameBits(const ProximitySensorData& a, const ProximitySensorData& b) {
+  return a.detected == b.detected &&
+         std::bit_cast<uint64_t>(a.distance) == std::bit_cast<uint64_t>(b.distance) &&
+         std::bit_cast<uint64_t>(a.p_SD.x) == std::bit_cast<uint64_t>(b.p_SD.x) &&
+         std::bit_cast<uint64_t>(a.p_SD.y) == std::bit_cast<uint64_t>(b.p_SD.y) &&
+         std::bit_cast<uint64_t>(a.p_SD.z) == std::bit_cast<uint64_t>(b.p_SD.z) &&
+         a.detected_object == b.detected_object;
+}
+
+// A scene read twice per step: by the backend with the early-out and by one
+// that casts every ray. Each pass starts from scribbled readings.
+struct TwinBackends {
+  void Start(double resolution = 0.05) {
+    scene.UpdateWorldPoses();
+    ProximitySettings settings;
+    settings.octree_resolution = resolution;
+    early_out = MakeBackend();
+    early_out->Build(scene, settings);
+    cast_all = MakeBackend({.early_out = false});
+    cast_all->Build(scene, settings);
+  }
+  void Pass(ProximityBackend* backend) {
+    for (ProximitySensorData& r : scene.proximity_sensors()) {
+      r.detected = true;
+      r.distance = -7;
+      r.p_SD = {1, 2, 3};
+      r.detected_object = ObjectId{12345, 6};
+    }
+    backend->Update(scene);
+    for (size_t i = 0; i < scene.instances().size(); ++i)
+      if (scene.instances()[i].alive) backend->SenseInstance(&scene, static_cast<int>(i));
+    backend->SenseSceneSensors(&scene);
+  }
+  // Reads with both backends; expects the same bits; returns the detections.
+  int SenseBoth() {
+    scene.UpdateWorldPoses();
+    Pass(cast_all.get());
+    const std::vector<ProximitySensorData> expected(scene.proximity_sensors().begin(),
+                                                    scene.proximity_sensors().end());
+    Pass(early_out.get());
+    int detected = 0, mismatches = 0;
+    for (size_t row = 0; row < expected.size(); ++row) {
+      const ProximitySensorData& got = scene.proximity_sensors()[row];
+      detected += expected[row].detected;
+      if (SameBits(got, expected[row]) || ++mismatches > 5) continue;
+      ADD_FAILURE() << "sensor row " << row << " ("
+                    << scene.PathOf(scene.IdAt(scene.proximity_sensor_owners()[row]))
+                    << "): early-out detected " << got.detected << " at " << got.distance
+                    << ", casting every ray detected " << expected[row].detected << " at "
+                    << expected[row].distance;
+    }
+    EXPECT_EQ(mismatches, 0);
+    return detected;
+  }
+  const ProximitySensorData& Reading(ObjectId sensor) { return scene.proximity_sensor(sensor); }
+
+  Scene scene;
+  std::unique_ptr<ProximityBackend> early_out, cast_all;
+};
+
+// Random 3D scenes: static shapes in any orientation (and sometimes a
+// floor), robots at random heights and tilts with a ring of sensors plus
+// off-centre, tilted, zero- and negative-range sensors, dynamic crates and
+// scene sensors (one mounted on a crate). Robots move between steps.
+TEST(EarlyOutTest, MatchesCastingEveryRayOnRandomScenes) {
+  std::mt19937_64 rng(2024);
+  std::uniform_real_distribution<double> unit(0, 1), angle(-M_PI, M_PI);
+  auto uniform = [&](double lo, double hi) { return lo + (hi - lo) * unit(rng); };
+  int total_detected = 0, total_sensors = 0;
+  for (int scene_index = 0; scene_index < 12; ++scene_index) {
+    SCOPED_TRACE(scene_index);
+    TwinBackends twin;
+    Scene& scene = twin.scene;
+    const bool floor = scene_index % 3 == 0;
+    const bool tilted = scene_index % 2 == 1;
+    if (floor) scene.AddShape("floor", {}, {{0, 0, -0.05}, {}}, Box(6, 6, 0.1));
+    for (int i = 0; i < 25; ++i) {
+      const ShapeData shape = i % 3 == 0
+                                  ? Box(uniform(0.02, 0.5), uniform(0.02, 0.5), uniform(0.05, 0.4))
+                              : i % 3 == 1 ? Cylinder(uniform(0.02, 0.2), uniform(0.05, 0.4))
+                                           : Sphere(uniform(0.02, 0.2));
+      const Quat q = tilted ? Quat::FromRollPitchYaw(angle(rng), angle(rng), angle(rng))
+                            : Quat::FromYaw(angle(rng));
+      scene.AddShape("obstacle", {}, {{uniform(-2, 2), uniform(-2, 2), uniform(0, 0.3)}, q}, shape);
+    }
+    std::vector<Robot> robots;
+    for (int i = 0; i < 60; ++i) {
+      std::vector<Pose> sensors;
+      for (int k = 0; k < 8; ++k) {
+        const double a = 2 * M_PI * k / 8;
+        sensors.push_back(Looking({0.085 * std::cos(a), 0.085 * std::sin(a), 0.06}, a));
+      }
+      // Off-centre and tilted: looking down at the floor, up, anywhere.
+      sensors.push_back({{0.05, -0.03, 0.1}, Quat::FromRollPitchYaw(0, M_PI * 0.8, angle(rng))});
+      sensors.push_back({{-0.04, 0.02, 0.12}, Quat::FromYaw(angle(rng))});
+      sensors.push_back({{uniform(-0.1, 0.1), uniform(-0.1, 0.1), uniform(0, 0.2)},
+                         Quat::FromRollPitchYaw(angle(rng), angle(rng), angle(rng))});
+      const double height = floor ? uniform(0, 0.3) : 0;
+      const Quat q =
+          tilted ? Quat::FromRollPitchYaw(uniform(-0.5, 0.5), uniform(-0.5, 0.5), angle(rng))
+                 : Quat::FromYaw(angle(rng));
+      robots.push_back(AddRobot(&scene, {{uniform(-2.2, 2.2), uniform(-2.2, 2.2), height}, q},
+                                0.085, sensors, uniform(0.02, 0.3)));
+      // A tilted wheel: its footprint is not its bounding radius.
+      scene.AddShape("wheel", robots.back().body,
+                     {{0, 0.07, -0.03}, Quat::FromAxisAngle({1, 0, 0}, M_PI / 2)},
+                     Cylinder(0.03, 0.02));
+      if (i % 10 == 0) scene.mutable_proximity_sensor(robots.back().sensors[9]).range = 0;
+      if (i % 10 == 1) scene.mutable_proximity_sensor(robots.back().sensors[9]).range = -1;
+    }
+    ShapeData crate = Box(0.15, 0.15, 0.15);
+    crate.dynamic = true;
+    std::vector<ObjectId> crates;
+    for (int i = 0; i < 4; ++i)
+      crates.push_back(scene.AddShape(
+          "crate", {}, {{uniform(-2, 2), uniform(-2, 2), 0.075}, Quat::FromYaw(angle(rng))},
+          crate));
+    scene.AddProximitySensor("on_crate", crates[0], Looking({0.075, 0, 0}, 0), Ray(0.5));
+    scene.AddProximitySensor("into_crate", crates[0], Looking({0.075, 0, 0}, M_PI), Ray(0.5));
+    for (int i = 0; i < 6; ++i)
+      scene.AddProximitySensor("free", {},
+                               {{uniform(-2, 2), uniform(-2, 2), uniform(0, 0.3)},
+                                Quat::FromRollPitchYaw(angle(rng), angle(rng), angle(rng))},
+                               Ray(uniform(0.05, 0.5)));
+    twin.Start(scene_index % 4 == 3 ? 0.13 : 0.05);
+    for (int step = 0; step < 3; ++step) {
+      total_detected += twin.SenseBoth();
+      total_sensors += static_cast<int>(scene.proximity_sensors().size());
+      // Each robot moves a little; some bump into their neighbours.
+      for (const Robot& robot : robots) {
+        Pose X = scene.world_pose(robot.root);
+        X.p = X.p + Vec3{uniform(-0.05, 0.05), uniform(-0.05, 0.05), 0};
+        X.q = Quat::FromYaw(uniform(-0.3, 0.3)) * X.q;
+        scene.SetLocalPose(robot.root, X);
+      }
+      scene.SetLocalPose(crates[1], {{uniform(-2, 2), uniform(-2, 2), 0.075}, {}});
+    }
+    if (::testing::Test::HasFailure()) break;
+  }
+  // Enough of both kinds for the comparison to mean something.
+  EXPECT_GT(total_detected, total_sensors / 20);
+  EXPECT_LT(total_detected, total_sensors / 2);
+}
+
+void ExpectReading(const ProximitySensorData& r, bool detected, double distance, ObjectId object) {
+  EXPECT_EQ(r.detected, detected);
+  EXPECT_NEAR(r.distance, detected ? distance : 0, kTol);
+  EXPECT_EQ(r.detected_object, detected ? object : ObjectId{});
+}
+
+// Obstacles at the very edge of reach, just inside and just outside: a wall,
+// another robot's body, and a floor under a tilted sensor of a raised robot.
+TEST(EarlyOutTest, MatchesCastingEveryRayAtTheEdgeOfReach) {
+  const double range = 0.1, rim = 0.085;
+  for (double gap : {-1e-6, -1e-9, -1e-12, 0.0, 1e-12, 1e-9, 1e-6}) {
+    SCOPED_TRACE(gap);
+    const bool inside = gap <= -1e-9, outside = gap >= 1e-9;  // else: either, but the same
+    {
+      // A wall whose face is `gap` beyond the end of the ray.
+      TwinBackends twin;
+      const ObjectId wall = twin.scene.AddShape(
+          "wall", {}, {{rim + range + gap + 0.05, 0, 0.1}, {}}, Box(0.1, 2, 0.2));
+      const Robot a = AddRobot(&twin.scene, {}, rim, {Looking({rim, 0, 0.06}, 0)}, range);
+      twin.Start();
+      twin.SenseBoth();
+      if (inside || outside) ExpectReading(twin.Reading(a.sensors[0]), inside, range + gap, wall);
+    }
+    {
+      // Another robot whose body is `gap` beyond the end of the ray.
+      TwinBackends twin;
+      const Robot a = AddRobot(&twin.scene, {}, rim, {Looking({rim, 0, 0.06}, 0)}, range);
+      const Robot b = AddRobot(&twin.scene, {{2 * rim + range + gap, 0, 0}, {}}, rim, {}, range);
+      twin.Start();
+      twin.SenseBoth();
+      if (inside || outside) ExpectReading(twin.Reading(a.sensors[0]), inside, range + gap, b.body);
+    }
+    {
+      // A robot raised 0.3 m: a sensor 45 degrees down sees the floor (top at
+      // z = 0) `gap` beyond its reach; its level sensor sees nothing.
+      TwinBackends twin;
+      const ObjectId floor = twin.scene.AddShape("floor", {}, {{0, 0, -0.05}, {}}, Box(4, 4, 0.1));
+      const double distance = 0.3 * std::sqrt(2.0);
+      const Robot a = AddRobot(
+          &twin.scene, {{0.3, -0.2, 0.3}, {}}, rim,
+          {{{0, 0, 0}, Quat::FromAxisAngle({0, 1, 0}, M_PI * 0.75)}, Looking({rim, 0, 0}, 0)},
+          distance - gap);
+      twin.Start();
+      twin.SenseBoth();
+      if (inside || outside) ExpectReading(twin.Reading(a.sensors[0]), inside, distance, floor);
+      ExpectReading(twin.Reading(a.sensors[1]), false, 0, {});
+    }
+  }
+}
+
+// Robots and sensors added, copied and removed after the start are read
+// (the backend keeps its sensor lists in step with the scene).
+TEST(EarlyOutTest, RobotsAddedOrRemovedAfterTheStartAreRead) {
+  TwinBackends twin;
+  Scene& scene = twin.scene;
+  const ObjectId wall = scene.AddShape("wall", {}, {{1.0, 0, 0.1}, {}}, Box(0.1, 2, 0.2));
+  const Robot a = AddRobot(&scene, {{0.8, 0, 0}, {}}, 0.085, {Looking({0.085, 0, 0.06}, 0)}, 0.1);
+  twin.Start();
+  twin.SenseBoth();
+  ExpectReading(twin.Reading(a.sensors[0]), true, 0.95 - 0.885, wall);
+  // Added after the start, and read without an Update (as a plugin might).
+  const Robot b = AddRobot(&scene, {{0.8, 0.5, 0}, {}}, 0.085, {Looking({0.085, 0, 0.06}, 0)}, 0.1);
+  scene.UpdateWorldPoses();
+  twin.early_out->SenseInstance(&scene, b.instance);
+  ExpectReading(twin.Reading(b.sensors[0]), true, 0.95 - 0.885, wall);
+  twin.SenseBoth();
+  ExpectReading(twin.Reading(b.sensors[0]), true, 0.95 - 0.885, wall);
+  // A sensor added to a robot that has been read.
+  const ObjectId extra =
+      scene.AddProximitySensor("extra", a.root, Looking({0.085, 0.02, 0.06}, 0), Ray(0.1));
+  twin.SenseBoth();
+  ExpectReading(twin.Reading(extra), true, 0.95 - 0.885, wall);
+  // A copy of b, then a removed: the copy reads, b still reads.
+  const ObjectId copy = scene.DuplicateSubtree(b.root, {});
+  scene.SetLocalPose(copy, {{0.81, -0.5, 0}, {}});
+  scene.RemoveSubtree(a.root);
+  twin.SenseBoth();
+  ExpectReading(twin.Reading(b.sensors[0]), true, 0.95 - 0.885, wall);
+  ExpectReading(twin.Reading(scene.FindObject("./sensor", copy)), true, 0.95 - 0.895, wall);
+}
+
+// The coarse map never says "nothing" where the octree has an occupied voxel.
+TEST(StaticIndexTest, CoarseMapIsConservative) {
+  std::mt19937_64 rng(77);
+  std::uniform_real_distribution<double> pos(-3, 3), size(0.01, 0.8), angle(-M_PI, M_PI),
+      extent(0, 0.5);
+  Scene scene;
+  for (int i = 0; i < 40; ++i) {
+    const ShapeData shape = i % 3 == 0   ? Box(size(rng), size(rng), size(rng))
+                            : i % 3 == 1 ? Cylinder(size(rng) / 2, size(rng))
+                                         : Sphere(size(rng) / 2);
+    scene.AddShape("o", {},
+                   {{pos(rng), pos(rng), pos(rng) / 2},
+                    Quat::FromRollPitchYaw(angle(rng), angle(rng), angle(rng))},
+                   shape);
+  }
+  scene.UpdateWorldPoses();
+  for (double resolution : {0.05, 0.011, 0.3}) {
+    StaticIndex index;
+    index.Build(scene, resolution);
+    int occupied = 0, ruled_out = 0;
+    for (int i = 0; i < 20000; ++i) {
+      const Vec3 lo{pos(rng) * 1.2, pos(rng) * 1.2, pos(rng) / 2};
+      const Vec3 hi = lo + Vec3{extent(rng), extent(rng), extent(rng)} * (i % 2 ? 0.2 : 1);
+      const bool any = index.AnyOccupied(lo, hi);
+      const bool may = index.MayBeOccupied(lo, hi);
+      ASSERT_TRUE(may || !any) << "box " << i << " at resolution " << resolution;
+      occupied += any;
+      ruled_out += !may;
+    }
+    EXPECT_GT(occupied, 1000) << resolution;
+    EXPECT_GT(ruled_out, 1000) << resolution;
   }
 }
 
