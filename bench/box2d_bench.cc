@@ -6,6 +6,13 @@
 // 10 = the backend's default). Counter ns_per_robot_substep is what to
 // compare; on a busy machine run with --benchmark_repetitions=5 and read the
 // _min rows.
+//
+// BM_PhysicsPhase and BM_PoseUpdate time what World::Physics does per
+// control step for foot-bot-like robots (body, two wheel joints with their
+// wheels, a ring of 24 proximity sensors): the backend's 10 substeps with
+// write-back, then the post-physics world pose update of every robot's
+// subtree; BM_PoseUpdate times that update alone (counter
+// ns_per_robot_tick). Compare BM_PhysicsPhase with BM_Box2dBareSubstep x 10.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -53,8 +60,19 @@ void AddRobot(Scene* scene, int index, double x, double y) {
   scene->mutable_joint(right).target_velocity = -0.03 / 0.029;
 }
 
+// The foot-bot's ring of 24 proximity sensors, rays outwards.
+void AddProximityRing(Scene* scene, ObjectId body) {
+  ProximitySensorData sensor;
+  for (int i = 0; i < 24; ++i) {
+    const double a = i * M_PI / 12;
+    const Quat q_BS = Quat::FromYaw(a) * Quat::FromAxisAngle({0, 1, 0}, M_PI / 2);
+    scene->AddProximitySensor("prox", body,
+                              {{0.085 * std::cos(a), 0.085 * std::sin(a), -0.013}, q_BS}, sensor);
+  }
+}
+
 // n robots on a square grid, 1 m apart, in an arena with four walls.
-std::unique_ptr<Scene> MakeSwarm(int n) {
+std::unique_ptr<Scene> MakeSwarm(int n, bool proximity_ring = false) {
   auto scene = std::make_unique<Scene>();
   const int side = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(n))));
   const double extent = side;  // m
@@ -67,7 +85,10 @@ std::unique_ptr<Scene> MakeSwarm(int n) {
     const Vec3 p = vertical ? Vec3{offset, extent / 2, 0.1} : Vec3{extent / 2, offset, 0.1};
     scene->AddShape("wall", {}, {p, {}}, wall);
   }
-  for (int i = 0; i < n; ++i) AddRobot(scene.get(), i, 0.5 + i % side, 0.5 + i / side);
+  for (int i = 0; i < n; ++i) {
+    AddRobot(scene.get(), i, 0.5 + i % side, 0.5 + i / side);
+    if (proximity_ring) AddProximityRing(scene.get(), scene->instances().back().root);
+  }
   return scene;
 }
 
@@ -133,6 +154,69 @@ void BM_Box2dBareSubstep(benchmark::State& state) {
               static_cast<double>(n) * substeps * static_cast<double>(state.iterations()));
 }
 
+// World::Physics's post-physics update: each robot's subtree, then the rest.
+void UpdatePoses(Scene* scene) {
+  for (int r = 0; r < static_cast<int>(scene->instances().size()); ++r) scene->UpdateWorldPoses(r);
+  scene->UpdateSceneObjectPoses();
+}
+
+constexpr int kSubstepsPerTick = 10;
+
+// One control step of the physics phase: 10 substeps, write-back, pose update.
+void BM_PhysicsPhase(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  auto scene = MakeSwarm(n, /*proximity_ring=*/true);
+  auto backend = MakeBackend();
+  backend->Build(*scene, {});
+  for (int i = 0; i < 10; ++i) {  // settle
+    backend->Step(scene.get(), kDt, kSubstepsPerTick);
+    UpdatePoses(scene.get());
+  }
+  double wall_s = 0;
+  const double cpu_start = ThreadCpuSeconds();
+  for (auto _ : state) {
+    const auto start = std::chrono::steady_clock::now();
+    backend->Step(scene.get(), kDt, kSubstepsPerTick);
+    UpdatePoses(scene.get());
+    const double s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    state.SetIterationTime(s);
+    wall_s += s;
+  }
+  const double ticks = static_cast<double>(n) * static_cast<double>(state.iterations());
+  state.counters["ns_per_robot_tick"] = 1e9 * wall_s / ticks;
+  state.counters["cpu_ns_per_robot_tick"] = 1e9 * (ThreadCpuSeconds() - cpu_start) / ticks;
+}
+
+// The post-physics pose update alone (bodies flagged as simulated, as after
+// a backend step).
+void BM_PoseUpdate(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  auto scene = MakeSwarm(n, /*proximity_ring=*/true);
+  auto backend = MakeBackend();
+  backend->Build(*scene, {});
+  backend->Step(scene.get(), kDt, kSubstepsPerTick);
+  UpdatePoses(scene.get());
+  std::vector<uint32_t> bodies;
+  for (const ModelInstance& instance : scene->instances()) bodies.push_back(instance.root.index());
+  double wall_s = 0;
+  const double cpu_start = ThreadCpuSeconds();
+  for (auto _ : state) {
+    const auto start = std::chrono::steady_clock::now();
+    for (uint32_t slot : bodies)
+      scene->SetSimulatedState(slot, scene->world_pose_at(slot), scene->linear_velocity_at(slot),
+                               scene->angular_velocity_at(slot));
+    UpdatePoses(scene.get());
+    const double s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    state.SetIterationTime(s);
+    wall_s += s;
+  }
+  const double ticks = static_cast<double>(n) * static_cast<double>(state.iterations());
+  state.counters["ns_per_robot_tick"] = 1e9 * wall_s / ticks;
+  state.counters["cpu_ns_per_robot_tick"] = 1e9 * (ThreadCpuSeconds() - cpu_start) / ticks;
+}
+
 double Min(const std::vector<double>& v) { return *std::min_element(v.begin(), v.end()); }
 
 void SwarmArgs(benchmark::internal::Benchmark* b) {
@@ -142,8 +226,16 @@ void SwarmArgs(benchmark::internal::Benchmark* b) {
   b->UseManualTime()->Unit(benchmark::kMicrosecond)->ComputeStatistics("min", Min);
 }
 
+void RobotArgs(benchmark::internal::Benchmark* b) {
+  for (int64_t n : {100, 1000, 10000}) b->Arg(n);
+  b->ArgNames({"robots"});
+  b->UseManualTime()->Unit(benchmark::kMicrosecond)->ComputeStatistics("min", Min);
+}
+
 BENCHMARK(BM_Box2dBackendSubstep)->Apply(SwarmArgs);
 BENCHMARK(BM_Box2dBareSubstep)->Apply(SwarmArgs);
+BENCHMARK(BM_PhysicsPhase)->Apply(RobotArgs);
+BENCHMARK(BM_PoseUpdate)->Apply(RobotArgs);
 
 }  // namespace
 }  // namespace swarmsim::box2d

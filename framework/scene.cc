@@ -572,17 +572,6 @@ void Scene::SetWorldPose(ObjectId id, const Pose& X_WO) {
   RefreshSubtree(slot);
 }
 
-void Scene::SetSimulatedState(uint32_t slot, const Pose& X_WO, const Vec3& v_WO, const Vec3& w_WO) {
-  X_WO_[slot] = X_WO;
-  v_WO_[slot] = v_WO;
-  w_WO_[slot] = w_WO;
-  simulated_[slot] = 1;
-}
-
-static inline void UpdateOne(uint32_t s, const std::vector<int32_t>& parent_of,
-                             std::vector<uint8_t>* simulated, std::vector<Pose>* X_PO,
-                             std::vector<Pose>* X_WO, const Scene& scene);
-
 void Scene::RebuildOrder() const {
   order_.clear();
   order_.reserve(object_count_);
@@ -607,34 +596,53 @@ bool Scene::InstancesAreIndependent() const {
   return instances_independent_;
 }
 
-void Scene::UpdateSceneObjectPoses() {
-  if (order_dirty_) RebuildOrder();
-  for (uint32_t s : scene_order_) UpdateOne(s, parent_, &simulated_, &X_PO_, &X_WO_, *this);
+void Scene::UpdatePoses(std::span<const uint32_t> slots) {
+  // Raw pointers: no bounds or handle checks in the loop (every slot in an
+  // order list is alive, its parent too).
+  const int32_t* const parent = parent_.data();
+  const ObjectType* const type = type_.data();
+  const uint32_t* const row = row_.data();
+  const JointData* const joints = joints_.data();
+  uint8_t* const simulated = simulated_.data();
+  Pose* const X_PO = X_PO_.data();
+  Pose* const X_WO = X_WO_.data();
+  // X_WF: the frame children of `frame_slot` hang from (ChildFrameAt), kept
+  // across siblings. The 24 sensors of a ring under one body read it once,
+  // and a joint's motion (its sin/cos) is computed once for all its
+  // children. It is dropped when `frame_slot` itself is updated, so it is
+  // always what ChildFrameAt would return at that point.
+  int32_t frame_slot = -1;
+  Pose X_WF;
+  for (const uint32_t s : slots) {
+    const int32_t p = parent[s];
+    if (p >= 0 && p != frame_slot) {
+      X_WF = type[p] == ObjectType::kJoint ? X_WO[p] * joints[row[p]].Motion() : X_WO[p];
+      frame_slot = p;
+    }
+    if (simulated[s]) {
+      // The backend owns X_WO; derive the local pose from it.
+      X_PO[s] = p >= 0 ? X_WF.Inverse() * X_WO[s] : X_WO[s];
+      simulated[s] = 0;
+    } else {
+      X_WO[s] = p >= 0 ? X_WF * X_PO[s] : X_PO[s];
+    }
+    if (static_cast<int32_t>(s) == frame_slot) frame_slot = -1;
+  }
 }
 
-static inline void UpdateOne(uint32_t s, const std::vector<int32_t>& parent_of,
-                             std::vector<uint8_t>* simulated, std::vector<Pose>* X_PO,
-                             std::vector<Pose>* X_WO, const Scene& scene) {
-  const int32_t p = parent_of[s];
-  if ((*simulated)[s]) {
-    // The backend owns X_WO; derive the local pose from it.
-    (*X_PO)[s] =
-        p >= 0 ? scene.ChildFrameAt(static_cast<uint32_t>(p)).Inverse() * (*X_WO)[s] : (*X_WO)[s];
-    (*simulated)[s] = 0;
-  } else {
-    (*X_WO)[s] = p >= 0 ? scene.ChildFrameAt(static_cast<uint32_t>(p)) * (*X_PO)[s] : (*X_PO)[s];
-  }
+void Scene::UpdateSceneObjectPoses() {
+  if (order_dirty_) RebuildOrder();
+  UpdatePoses(scene_order_);
 }
 
 void Scene::UpdateWorldPoses() {
   if (order_dirty_) RebuildOrder();
-  for (uint32_t s : order_) UpdateOne(s, parent_, &simulated_, &X_PO_, &X_WO_, *this);
+  UpdatePoses(order_);
 }
 
 void Scene::UpdateWorldPoses(int instance) {
-  const ModelInstance& inst = instances_.at(instance);
   // The root's parent (if any) is outside the instance and is up to date.
-  for (uint32_t s : inst.objects) UpdateOne(s, parent_, &simulated_, &X_PO_, &X_WO_, *this);
+  UpdatePoses(instances_.at(instance).objects);
 }
 
 // --- Typed data ----------------------------------------------------------------------------

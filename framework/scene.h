@@ -214,7 +214,13 @@ class Scene {
   void SetWorldPose(ObjectId id, const Pose& X_WO);
   // Dynamics backends write world poses and velocities of simulated bodies.
   // Call UpdateWorldPoses() afterwards to refresh local poses and descendants.
-  void SetSimulatedState(uint32_t slot, const Pose& X_WO, const Vec3& v_WO, const Vec3& w_WO);
+  // Inline: a backend calls it for every body every step.
+  void SetSimulatedState(uint32_t slot, const Pose& X_WO, const Vec3& v_WO, const Vec3& w_WO) {
+    X_WO_[slot] = X_WO;
+    v_WO_[slot] = v_WO;
+    w_WO_[slot] = w_WO;
+    simulated_[slot] = 1;
+  }
   // Recomputes world poses top-down (the pose of each simulated body is kept
   // and its local pose derived from it).
   void UpdateWorldPoses();
@@ -317,6 +323,8 @@ class Scene {
   void LinkChild(uint32_t parent, uint32_t child);
   void UnlinkChild(uint32_t child);
   void RefreshSubtree(uint32_t slot);
+  // UpdateWorldPoses over `slots` (parents before children).
+  void UpdatePoses(std::span<const uint32_t> slots);
   void RebuildOrder() const;
   void RebuildInstanceObjects(int instance);
   void CollectSubtree(uint32_t slot, std::vector<uint32_t>* out) const;

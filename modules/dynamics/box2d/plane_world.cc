@@ -8,8 +8,10 @@
 #include <box2d/b2_polygon_shape.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -173,6 +175,13 @@ bool MeshPolygons(const TriangleMesh& mesh, const Pose& X, double L,
 
 std::string PathAt(const Scene& scene, uint32_t slot) { return scene.PathOf(scene.IdAt(slot)); }
 
+// True when `q` is (s, c) bit for bit (so +0 and -0 differ: atan2 tells them
+// apart) and not NaN (the "not known" mark).
+bool SameRotation(const b2Rot& q, float s, float c) {
+  return q.s == s && q.c == c && std::bit_cast<uint32_t>(q.s) == std::bit_cast<uint32_t>(s) &&
+         std::bit_cast<uint32_t>(q.c) == std::bit_cast<uint32_t>(c);
+}
+
 void ThrowIfNotFinite(const Scene& scene, uint32_t slot, const Pose& X) {
   const double values[] = {X.p.x, X.p.y, X.p.z, X.q.w, X.q.x, X.q.y, X.q.z};
   for (double v : values)
@@ -219,8 +228,7 @@ void PlaneWorld::Build(const Scene& scene) {
   };
 
   // 1. A body per dynamic shape, in slot order.
-  std::vector<int32_t> body_of(slots, -1);            // body index of a dynamic shape (slots)
-  std::vector<double> inverse_mass, inverse_inertia;  // (bodies), Box2D units
+  std::vector<int32_t> body_of(slots, -1);  // body index of a dynamic shape (slots)
   double dynamic_lo = std::numeric_limits<double>::infinity();
   double dynamic_hi = -dynamic_lo;
   for (uint32_t s = 0; s < slots; ++s) {
@@ -293,14 +301,14 @@ void PlaneWorld::Build(const Scene& scene) {
     PlaneBody plane_body;
     plane_body.body = body;
     plane_body.slot = s;
+    plane_body.inverse_mass = body->GetMass() > 0 ? 1.0 / body->GetMass() : 0.0;
+    plane_body.inverse_inertia = body->GetInertia() > 0 ? 1.0 / body->GetInertia() : 0.0;
     bodies_.push_back(plane_body);
     PlaneBodyPose pose;
     pose.z = X_WS.p.z;
     pose.q_tilt = (Quat::FromYaw(-yaw) * X_WS.q).Normalized();
     pose.X_WB_last = X_WS;
     body_poses_.push_back(pose);
-    inverse_mass.push_back(1.0 / body->GetMass());
-    inverse_inertia.push_back(1.0 / body->GetInertia());
   }
   // Nearest dynamic ancestor of a slot (its body), or -1.
   auto dynamic_ancestor = [&](uint32_t s) -> int32_t {
@@ -416,7 +424,7 @@ void PlaneWorld::Build(const Scene& scene) {
     wheel.motor_rate = std::max(0.0, joint.max_force) / radius * L;
     // Inverse effective mass at the contact point: K = [m^-1 + I^-1 py^2, -I^-1 px py;
     // -I^-1 px py, m^-1 + I^-1 px^2], inverted.
-    const double im = inverse_mass[b], ii = inverse_inertia[b];
+    const double im = body.inverse_mass, ii = body.inverse_inertia;
     const double k11 = im + ii * wheel.p_y * wheel.p_y, k22 = im + ii * wheel.p_x * wheel.p_x;
     const double k12 = -ii * wheel.p_x * wheel.p_y;
     const double det = k11 * k22 - k12 * k12;
@@ -472,6 +480,7 @@ void PlaneWorld::SyncTeleports(const Scene& scene) {
     pose.z = X_WB.p.z;
     pose.q_tilt = (Quat::FromYaw(-yaw) * X_WB.q).Normalized();
     pose.X_WB_last = X_WB;
+    pose.rot_s = pose.rot_c = std::numeric_limits<float>::quiet_NaN();  // not from Box2D
   }
 }
 
@@ -487,68 +496,79 @@ void PlaneWorld::ReadWheelCommands(const Scene& scene) {
 
 namespace {
 
-// Projected Gauss-Seidel over one body's wheels. (vx, vy, w) is the body
-// velocity in its plane frame and (dx, dy, dw) what contacts changed it by
-// in the last step, Box2D units. Each wheel gets the impulse that makes its
-// contact point move at the desired velocity, its accumulated impulse
-// clamped to its Coulomb circle and then to its motor limit along forward.
-// Leaves the impulses in wheel->acc_*.
-//
-// The contact change, projected on the wheel's forward direction, counts as
-// velocity the wheel must make up (a warm start): without it a robot pushing
-// an object lags one step of contact impulse behind its command. Only the
-// forward part: sideways, the same feedback would keep adding a wall's
-// push-back to the error and leave a saturated wheel no grip to slide along
-// the wall with.
-void SolveWheels(PlaneWheel* first, PlaneWheel* last, double im, double ii, double dt, int passes,
-                 double vx, double vy, double w, double dx, double dy, double dw) {
+// Projected Gauss-Seidel over one body's wheels: one pass. (vx, vy, w) in
+// `solve` is the body velocity in its plane frame, Box2D units. Each wheel
+// gets the impulse that makes its contact point move at the desired
+// velocity, its accumulated impulse clamped to its Coulomb circle and then to
+// its motor limit along forward. Leaves the impulses in wheel->acc_*. True
+// when no impulse changed by more than kConverged of its Coulomb limit (a
+// robot driving freely at its command needs one pass).
+bool SolveWheelsPass(PlaneWheel* first, PlaneWheel* last, double dt, TractionSolve* solve) {
+  const double im = solve->inverse_mass, ii = solve->inverse_inertia;
+  double vx = solve->vx, vy = solve->vy, w = solve->w;
+  bool converged = true;
   for (PlaneWheel* wheel = first; wheel != last; ++wheel) {
-    wheel->acc_x = wheel->acc_y = 0;
-    const double cx = dx - dw * wheel->p_y, cy = dy + dw * wheel->p_x;
-    wheel->lag = cx * wheel->f_x + cy * wheel->f_y;
-  }
-  for (int pass = 0; pass < passes; ++pass) {
-    bool converged = true;
-    for (PlaneWheel* wheel = first; wheel != last; ++wheel) {
-      // Velocity error at the contact point: desired (forward at the surface
-      // speed, nothing sideways) minus actual and the predicted lag.
-      const double forward = wheel->surface_speed - wheel->lag;
-      const double ex = forward * wheel->f_x - (vx - w * wheel->p_y);
-      const double ey = forward * wheel->f_y - (vy + w * wheel->p_x);
-      const double old_x = wheel->acc_x, old_y = wheel->acc_y;
-      double ax = old_x + wheel->k_xx * ex + wheel->k_xy * ey;
-      double ay = old_y + wheel->k_xy * ex + wheel->k_yy * ey;
-      // Coulomb limit on the whole, then the motor limit on the forward part.
-      const double limit = wheel->coulomb_rate * dt;
-      const double norm2 = ax * ax + ay * ay;
-      if (norm2 > limit * limit) {
-        const double k = limit / std::sqrt(norm2);
-        ax *= k;
-        ay *= k;
-      }
-      const double motor = wheel->motor_rate * dt;
-      const double along = ax * wheel->f_x + ay * wheel->f_y;
-      const double excess = along > motor ? along - motor : (along < -motor ? along + motor : 0);
-      ax -= excess * wheel->f_x;
-      ay -= excess * wheel->f_y;
-      wheel->acc_x = ax;
-      wheel->acc_y = ay;
-      const double ix = ax - old_x, iy = ay - old_y;
-      vx += im * ix;
-      vy += im * iy;
-      w += ii * (wheel->p_x * iy - wheel->p_y * ix);
-      if (std::abs(ix) + std::abs(iy) > kConverged * limit) converged = false;
+    // Velocity error at the contact point: desired (forward at the surface
+    // speed, nothing sideways) minus actual and the predicted lag.
+    const double forward = wheel->surface_speed - wheel->lag;
+    const double ex = forward * wheel->f_x - (vx - w * wheel->p_y);
+    const double ey = forward * wheel->f_y - (vy + w * wheel->p_x);
+    const double old_x = wheel->acc_x, old_y = wheel->acc_y;
+    double ax = old_x + wheel->k_xx * ex + wheel->k_xy * ey;
+    double ay = old_y + wheel->k_xy * ex + wheel->k_yy * ey;
+    // Coulomb limit on the whole, then the motor limit on the forward part.
+    const double limit = wheel->coulomb_rate * dt;
+    const double norm2 = ax * ax + ay * ay;
+    if (norm2 > limit * limit) {
+      const double k = limit / std::sqrt(norm2);
+      ax *= k;
+      ay *= k;
     }
-    // A robot driving freely at its command needs one pass.
-    if (converged) break;
+    const double motor = wheel->motor_rate * dt;
+    const double along = ax * wheel->f_x + ay * wheel->f_y;
+    const double excess = along > motor ? along - motor : (along < -motor ? along + motor : 0);
+    ax -= excess * wheel->f_x;
+    ay -= excess * wheel->f_y;
+    wheel->acc_x = ax;
+    wheel->acc_y = ay;
+    const double ix = ax - old_x, iy = ay - old_y;
+    vx += im * ix;
+    vy += im * iy;
+    w += ii * (wheel->p_x * iy - wheel->p_y * ix);
+    if (std::abs(ix) + std::abs(iy) > kConverged * limit) converged = false;
   }
+  solve->vx = vx;
+  solve->vy = vy;
+  solve->w = w;
+  return converged;
 }
 
 }  // namespace
 
 void PlaneWorld::ApplyTraction(double dt) {
+  // Wheeled bodies go through in blocks of kTractionBlock: the block's
+  // Gauss-Seidel passes interleave its bodies (see 2. below), and a block's
+  // Box2D bodies and wheels are still in cache when the impulses are applied.
+  for (size_t next = 0; next < wheeled_.size();) {
+    const size_t end = std::min(wheeled_.size(), next + kTractionBlock);
+    ApplyTraction(std::span<const uint32_t>(wheeled_).subspan(next, end - next), dt);
+    next = end;
+  }
+}
+
+void PlaneWorld::ApplyTraction(std::span<const uint32_t> wheeled, double dt) {
   const int passes = std::max(1, options_.traction_iterations);
-  for (uint32_t b : wheeled_) {
+  // 1. Each awake body's velocity and last step's contact change, in its
+  // plane frame. The contact change, projected on each wheel's forward
+  // direction, counts as velocity the wheel must make up (a warm start):
+  // without it a robot pushing an object lags one step of contact impulse
+  // behind its command. Only the forward part: sideways, the same feedback
+  // would keep adding a wall's push-back to the error and leave a saturated
+  // wheel no grip to slide along the wall with.
+  //   (Fields are written in place: a struct built on the stack and copied
+  // in was read back before its stores had landed, a stall per body.)
+  size_t count = 0;
+  for (uint32_t b : wheeled) {
     PlaneBody& plane_body = bodies_[b];
     b2Body* body = plane_body.body;
     // A commanded robot stays awake; an idle one at rest may sleep.
@@ -560,21 +580,54 @@ void PlaneWorld::ApplyTraction(double dt) {
       plane_body.dv_x = plane_body.dv_y = plane_body.dw = 0;
       continue;
     }
-    const double im = body->GetMass() > 0 ? 1.0 / body->GetMass() : 0.0;
-    const double ii = body->GetInertia() > 0 ? 1.0 / body->GetInertia() : 0.0;
     const b2Rot& rot = body->GetTransform().q;
     const double c = rot.c, s = rot.s;
-    PlaneWheel* const first = wheels_.data() + plane_body.first_wheel;
-    PlaneWheel* const last = first + plane_body.wheel_count;
-    // Velocity and last step's contact change, in the body's plane frame.
     const b2Vec2& v = body->GetLinearVelocity();
+    TractionSolve& solve = traction_[count++];
+    solve.body = b;
+    solve.converged = false;
+    solve.c = c;
+    solve.s = s;
+    solve.inverse_mass = plane_body.inverse_mass;
+    solve.inverse_inertia = plane_body.inverse_inertia;
+    solve.vx = c * v.x + s * v.y;
+    solve.vy = -s * v.x + c * v.y;
+    solve.w = body->GetAngularVelocity();
     const double dv_x = plane_body.dv_x, dv_y = plane_body.dv_y;
-    SolveWheels(first, last, im, ii, dt, passes, c * v.x + s * v.y, -s * v.x + c * v.y,
-                body->GetAngularVelocity(), c * dv_x + s * dv_y, -s * dv_x + c * dv_y,
-                plane_body.dw);
-    // Apply the total to the body, in the world frame.
+    const double dx = c * dv_x + s * dv_y, dy = -s * dv_x + c * dv_y, dw = plane_body.dw;
+    PlaneWheel* const first = wheels_.data() + plane_body.first_wheel;
+    for (PlaneWheel* wheel = first; wheel != first + plane_body.wheel_count; ++wheel) {
+      wheel->acc_x = wheel->acc_y = 0;
+      const double cx = dx - dw * wheel->p_y, cy = dy + dw * wheel->p_x;
+      wheel->lag = cx * wheel->f_x + cy * wheel->f_y;
+    }
+  }
+  const std::span<TractionSolve> solves(traction_.data(), count);
+  // 2. Gauss-Seidel passes, each over the bodies not yet converged. A body's
+  // pass is a chain of dependent multiply-adds; bodies are independent, so
+  // looping over bodies inside a pass lets the CPU overlap their chains
+  // (solving one body to convergence before the next kept it waiting on one
+  // chain at a time). Each body's arithmetic, and so every result, is the
+  // same either way.
+  for (int pass = 0; pass < passes; ++pass) {
+    bool all_converged = true;
+    for (TractionSolve& solve : solves) {
+      if (solve.converged) continue;
+      const PlaneBody& plane_body = bodies_[solve.body];
+      PlaneWheel* const first = wheels_.data() + plane_body.first_wheel;
+      solve.converged = SolveWheelsPass(first, first + plane_body.wheel_count, dt, &solve);
+      all_converged = all_converged && solve.converged;
+    }
+    if (all_converged) break;
+  }
+  // 3. Apply each body's total to it, in the world frame.
+  for (const TractionSolve& solve : solves) {
+    PlaneBody& plane_body = bodies_[solve.body];
+    b2Body* body = plane_body.body;
+    const double c = solve.c, s = solve.s;
+    const PlaneWheel* const first = wheels_.data() + plane_body.first_wheel;
     double px = 0, py = 0, angular = 0;
-    for (const PlaneWheel* wheel = first; wheel != last; ++wheel) {
+    for (const PlaneWheel* wheel = first; wheel != first + plane_body.wheel_count; ++wheel) {
       px += wheel->acc_x;
       py += wheel->acc_y;
       angular += wheel->p_x * wheel->acc_y - wheel->p_y * wheel->acc_x;
@@ -615,10 +668,19 @@ void PlaneWorld::WriteBack(Scene* scene) {
     const b2Body* body = bodies_[b].body;
     PlaneBodyPose& pose = body_poses_[b];
     const b2Transform& X = body->GetTransform();
-    const double yaw = std::atan2(static_cast<double>(X.q.s), static_cast<double>(X.q.c));
     Pose X_WB;
     X_WB.p = {X.p.x * inv_L, X.p.y * inv_L, pose.z};
-    X_WB.q = Quat::FromYaw(yaw) * pose.q_tilt;
+    if (SameRotation(X.q, pose.rot_s, pose.rot_c)) {
+      // Not turned since the last write (a robot driving straight, a body
+      // at rest: most of them in a diffusion run): the same rotation as
+      // then, without the atan2 and sin/cos.
+      X_WB.q = pose.X_WB_last.q;
+    } else {
+      const double yaw = std::atan2(static_cast<double>(X.q.s), static_cast<double>(X.q.c));
+      X_WB.q = Quat::FromYaw(yaw) * pose.q_tilt;
+      pose.rot_s = X.q.s;
+      pose.rot_c = X.q.c;
+    }
     const b2Vec2& v = body->GetLinearVelocity();
     scene->SetSimulatedState(bodies_[b].slot, X_WB, {v.x * inv_L, v.y * inv_L, 0},
                              {0, 0, body->GetAngularVelocity()});

@@ -6,8 +6,11 @@
 
 #include <box2d/b2_world.h>
 
+#include <array>
 #include <cstdint>
+#include <limits>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "framework/dynamics_backend.h"
@@ -28,6 +31,8 @@ struct PlaneBody {  // 64 bytes
   uint32_t first_wheel = 0;  // wheels_[first_wheel, first_wheel + wheel_count)
   uint32_t wheel_count = 0;
   bool commanded = false;  // some wheel has a nonzero command this step
+  // Box2D units, fixed at Build (not divided out again every substep).
+  double inverse_mass = 0, inverse_inertia = 0;
   // Wheeled bodies: velocity after the traction impulses, and the change the
   // Box2D step (contacts) made to it, world frame, Box2D units. The next
   // traction solve aims at the velocity *after* that change (a warm start), so
@@ -40,10 +45,14 @@ struct PlaneBody {  // 64 bytes
 
 // What the scene does not hold about a body: the part of its pose the plane
 // does not simulate, and the pose last written (to notice teleports).
-struct PlaneBodyPose {  // 96 bytes
+struct PlaneBodyPose {  // 104 bytes
   double z = 0;         // m, kept
   Quat q_tilt;          // roll and pitch, kept: q_WB = FromYaw(yaw) * q_tilt
   Pose X_WB_last;       // pose last written to (or read from) the scene
+  // Box2D rotation (sin, cos) that X_WB_last.q was computed from; NaN when
+  // X_WB_last was read from the scene instead (at Build, after a teleport).
+  float rot_s = std::numeric_limits<float>::quiet_NaN();
+  float rot_c = std::numeric_limits<float>::quiet_NaN();
 };
 
 // A wheel driving a body; everything in Box2D units and the body's plane
@@ -60,6 +69,16 @@ struct PlaneWheel {                     // 120 bytes
   double surface_speed = 0;             // command: target_velocity * R, units/s
   double lag = 0;                       // contact velocity change along forward, last step
   double acc_x = 0, acc_y = 0;          // impulse accumulated in the current substep
+};
+
+// A wheeled body's traction solve in progress (PlaneWorld::ApplyTraction).
+struct TractionSolve {      // 64 bytes
+  uint32_t body = 0;        // index into bodies
+  bool converged = false;   // its last pass changed no impulse
+  double c = 1, s = 0;      // heading: cos, sin
+  double inverse_mass = 0;  // Box2D units
+  double inverse_inertia = 0;
+  double vx = 0, vy = 0, w = 0;  // velocity, body plane frame, Box2D units
 };
 
 class PlaneWorld {
@@ -89,7 +108,10 @@ class PlaneWorld {
   int wheel_count() const { return static_cast<int>(wheels_.size()); }
 
  private:
+  // Traction impulses for every awake wheeled body, in blocks of
+  // kTractionBlock bodies (the second form does one block).
   void ApplyTraction(double dt);
+  void ApplyTraction(std::span<const uint32_t> wheeled, double dt);
   // Weld joints for the scene's force sensors (plane_force_sensors.cc).
   void BuildForceSensors(const Scene& scene, const std::vector<int32_t>& body_of);
   // Samples each weld's reaction and breaks links over their threshold.
@@ -104,6 +126,8 @@ class PlaneWorld {
   std::vector<PlaneBodyPose> body_poses_;  // (bodies)
   std::vector<uint32_t> wheeled_;          // bodies with wheels, ascending
   std::vector<PlaneWheel> wheels_;         // (wheels), grouped by body
+  static constexpr size_t kTractionBlock = 64;
+  std::array<TractionSolve, kTractionBlock> traction_;  // ApplyTraction scratch, one block
   // Force sensors: weld joint (null once broken), scene row, sensor slot.
   struct PlaneForceSensor {
     b2Joint* weld;
