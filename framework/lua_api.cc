@@ -2,8 +2,12 @@
 #include "framework/lua_api.h"
 
 #include <algorithm>
+#include <cstdio>
+#include <cstring>
 #include <string>
 #include <vector>
+
+#include "framework/error.h"
 
 namespace swarmsim {
 
@@ -111,17 +115,78 @@ int LazySimIndex(lua_State* L) {
 
 }  // namespace
 
-void RaiseError(lua_State* L, const std::string& message) {
+void RaiseError(lua_State*, const std::string& message) { throw LuaError(message); }
+
+int CallProtected(lua_State* L, lua_CFunction f, const char* name) noexcept {
+  // The message is built in a plain buffer: nothing with a destructor may be
+  // alive when the caller raises the Lua error.
+  char message[4096];
+  const auto format = [&](const char* prefix, const char* what) {
+    if (prefix[0] != '\0')
+      std::snprintf(message, sizeof message, "%s: %s", prefix, what);
+    else
+      std::snprintf(message, sizeof message, "%s", what);
+  };
+  try {
+    return f(L);
+  } catch (const LuaErrorOnStack&) {
+    return -1;
+  } catch (const LuaError& e) {
+    format("", e.what());
+  } catch (const std::exception& e) {
+    format(name, e.what());
+  } catch (...) {
+    format(name, "unknown C++ exception");
+  }
   luaL_where(L, 1);
-  lua_pushlstring(L, message.data(), message.size());
+  lua_pushstring(L, message);
   lua_concat(L, 2);
-  lua_error(L);
-  __builtin_unreachable();  // lua_error throws
+  return -1;
+}
+
+namespace {
+[[noreturn]] void ArgError(lua_State* L, int arg, const char* expected) {
+  throw Error("bad argument #" + std::to_string(arg) + " (" + expected + " expected, got " +
+              luaL_typename(L, arg) + ")");
+}
+}  // namespace
+
+lua_Integer ArgInteger(lua_State* L, int arg) {
+  int ok = 0;
+  const lua_Integer value = lua_tointegerx(L, arg, &ok);
+  if (ok) return value;
+  if (lua_isnumber(L, arg))
+    throw Error("bad argument #" + std::to_string(arg) + " (number has no integer representation)");
+  ArgError(L, arg, "number");
+}
+
+lua_Number ArgNumber(lua_State* L, int arg) {
+  int ok = 0;
+  const lua_Number value = lua_tonumberx(L, arg, &ok);
+  if (!ok) ArgError(L, arg, "number");
+  return value;
+}
+
+const char* ArgString(lua_State* L, int arg, size_t* length) {
+  const char* text = lua_tolstring(L, arg, length);
+  if (text == nullptr) ArgError(L, arg, "string");
+  return text;
+}
+
+void ArgType(lua_State* L, int arg, int type) {
+  if (lua_type(L, arg) != type) ArgError(L, arg, lua_typename(L, type));
+}
+
+int ArgOption(lua_State* L, int arg, const char* def, const char* const options[]) {
+  const char* name = def != nullptr && lua_isnoneornil(L, arg) ? def : ArgString(L, arg);
+  for (int i = 0; options[i] != nullptr; ++i)
+    if (std::strcmp(options[i], name) == 0) return i;
+  throw Error("bad argument #" + std::to_string(arg) + " (invalid option '" + name + "')");
 }
 
 ObjectId OptRelativeTo(lua_State* L, int arg) {
   if (lua_isnoneornil(L, arg)) return {};
-  const lua_Integer h = luaL_checkinteger(L, arg);
+  const lua_Integer h = ArgInteger(L, arg);
   if (h == kHandleWorld) return {};
   return ObjectId::FromInteger(h);
 }
@@ -160,7 +225,7 @@ void RegisterAreas(lua_State* L) {
 void RegisterAllApis(lua_State* L) {
   lua_newtable(L);  // sim, filled on first use of each name
   lua_createtable(L, 0, 1);
-  lua_pushcfunction(L, LazySimIndex);
+  lua_pushcfunction(L, (Guarded<LazySimIndex, "sim">));
   lua_setfield(L, -2, "__index");
   lua_setmetatable(L, -2);
   lua_setglobal(L, "sim");

@@ -4,14 +4,21 @@
 // API areas, and the list of API areas. The rest of swarmsim never sees a
 // lua_State.
 //
-// Lua is the Debian C++ build (liblua5.4-c++): compiled as C++, so a Lua
-// error is a C++ throw and RAII holds in API functions, but with C linkage,
-// so its headers are included through lua.hpp (extern "C").
+// Lua is Debian's C build (liblua5.4): a Lua error or a coroutine yield is a
+// longjmp (a yield costs ~70 ns; the C++ build's throw costs ~3 us). A
+// longjmp skips C++ destructors, so every C function Lua calls is wrapped in
+// Guarded<> and reports errors by throwing C++ exceptions (RaiseError, the
+// Arg* checks below, swarmsim::Error from the Scene); Guarded turns them
+// into the Lua error once no C++ object is alive. Inside a guarded
+// function, never call what can raise a Lua error (luaL_check*,
+// luaL_error, lua_call of user code, metamethod-invoking gets/sets) while a
+// C++ object with a destructor is alive.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 #include <exception>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 
@@ -59,9 +66,22 @@ inline void SetContext(lua_State* L, LuaContext* context) {
   *static_cast<LuaContext**>(lua_getextraspace(L)) = context;
 }
 
-// Raises a Lua error "file:line: message" located at the Lua caller of the
-// running C function.
+// Thrown by guarded functions: a Lua error "file:line: message" located at
+// the Lua caller of the running C function, without Guarded's name prefix.
+struct LuaError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+// Thrown by guarded functions when the Lua error value is already on top of
+// the stack (from a lua_pcall of user code): raised as it is.
+struct LuaErrorOnStack {};
+
+// Throws LuaError(message); only inside a guarded function.
 [[noreturn]] void RaiseError(lua_State* L, const std::string& message);
+
+// Runs `f`; if it throws, leaves the error value on the stack and returns -1
+// (a std::exception becomes "file:line: name: what", with no prefix for an
+// empty name or a LuaError). Out of line: the C++ handlers live in one place.
+int CallProtected(lua_State* L, lua_CFunction f, const char* name) noexcept;
 
 // A function name as a template argument: Guarded<F, "sim.getObject">.
 template <size_t N>
@@ -72,24 +92,28 @@ struct FunctionName {
   char text[N];
 };
 
-// Runs an API function, turning a C++ exception (swarmsim::Error from the
-// Scene, std::bad_alloc, ...) into a Lua error "file:line: name: message" at
-// the caller's line. Without this, Lua's own catch(...) would swallow the
-// message. Lua's own errors (a thrown lua_longjmp*) pass through untouched.
+// Every C function Lua calls: runs F, and raises what it threw as a Lua
+// error after every C++ object of F is destroyed.
 template <lua_CFunction F, FunctionName kName>
 int Guarded(lua_State* L) {
-  std::string message;
-  try {
-    return F(L);
-  } catch (const std::exception& e) {
-    message = std::string(kName.text) + ": " + e.what();
-  }
-  RaiseError(L, message);
+  const int results = CallProtected(L, F, kName.text);
+  return results >= 0 ? results : lua_error(L);
 }
+
+// Argument checks for guarded functions: like luaL_check*, but they throw,
+// so the error message is "name: bad argument #2 (number expected, got nil)".
+lua_Integer ArgInteger(lua_State* L, int arg);
+lua_Number ArgNumber(lua_State* L, int arg);
+// A string (a number is converted in place, as luaL_checklstring does).
+const char* ArgString(lua_State* L, int arg, size_t* length = nullptr);
+void ArgType(lua_State* L, int arg, int type);
+// The index of `arg` (a string) in the null-terminated `options`; `def` if
+// the argument is absent and def is not null.
+int ArgOption(lua_State* L, int arg, const char* def, const char* const options[]);
 
 // An object handle argument (an integer, ObjectId::ToInteger()).
 inline ObjectId CheckObject(lua_State* L, int arg) {
-  return ObjectId::FromInteger(luaL_checkinteger(L, arg));
+  return ObjectId::FromInteger(ArgInteger(L, arg));
 }
 // The optional "relative to" argument: nil or sim.handle_world give null.
 ObjectId OptRelativeTo(lua_State* L, int arg);

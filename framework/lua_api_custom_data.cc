@@ -20,9 +20,9 @@ int WriteCustomDataBlock(lua_State* L) {
   const LuaContext& c = Context(L);
   const ObjectId id = CheckObject(L, 1);
   c.scene->SlotOf(id);  // a bad handle is an error now, not a silent no-op later
-  std::string tag = luaL_checkstring(L, 2);
+  std::string tag = ArgString(L, 2);
   size_t size = 0;
-  const char* data = lua_isnoneornil(L, 3) ? "" : luaL_checklstring(L, 3, &size);
+  const char* data = lua_isnoneornil(L, 3) ? "" : ArgString(L, 3, &size);
   c.runtime->custom_data_writes.push_back({id, std::move(tag), std::string(data, size)});
   return 0;
 }
@@ -30,7 +30,7 @@ int WriteCustomDataBlock(lua_State* L) {
 int ReadCustomDataBlock(lua_State* L) {
   const LuaContext& c = Context(L);
   const ObjectId id = CheckObject(L, 1);
-  const std::string* data = c.scene->ReadCustomData(id, luaL_checkstring(L, 2));
+  const std::string* data = c.scene->ReadCustomData(id, ArgString(L, 2));
   if (data == nullptr) {
     lua_pushnil(L);
   } else {

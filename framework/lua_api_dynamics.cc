@@ -22,7 +22,7 @@ namespace {
 int SetObjectDynamic(lua_State* L) {
   const LuaContext& c = Context(L);
   const ObjectId id = CheckObject(L, 1);
-  luaL_checktype(L, 2, LUA_TBOOLEAN);
+  ArgType(L, 2, LUA_TBOOLEAN);
   c.scene->shape(id);  // validates: a shape, not stale
   c.runtime->deferred.push_back(
       {id, DeferredWrite::Kind::kShapeDynamic, lua_toboolean(L, 2) ? 1.0 : 0.0});
@@ -41,7 +41,7 @@ int IsObjectDynamic(lua_State* L) {
 int SetJointTargetForce(lua_State* L) {
   const LuaContext& c = Context(L);
   const ObjectId id = CheckObject(L, 1);
-  const double value = luaL_checknumber(L, 2);
+  const double value = ArgNumber(L, 2);
   JointData& joint = c.scene->mutable_joint(id);
   if (!std::isfinite(value)) throw Error("the force is not a finite number");
   if (c.instance >= 0 && c.scene->instance_of(id) != c.instance)

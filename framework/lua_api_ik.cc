@@ -23,7 +23,7 @@ IkGroups* Module(const LuaContext& c, bool required) {
 }
 
 int CheckGroup(lua_State* L, const LuaContext& c, IkGroups* module) {
-  const lua_Integer h = luaL_checkinteger(L, 1);
+  const lua_Integer h = ArgInteger(L, 1);
   if (!module->IsLive(static_cast<int>(h)))
     throw Error("no IK group with handle " + std::to_string(h) +
                 " (it was removed with its model, or never existed)");
@@ -35,10 +35,11 @@ int CheckGroup(lua_State* L, const LuaContext& c, IkGroups* module) {
 
 int GetIkGroup(lua_State* L) {
   const LuaContext& c = Context(L);
-  const std::string name = luaL_checkstring(L, 1);
+  const std::string name = ArgString(L, 1);
   bool no_error = false;
   if (lua_istable(L, 2)) {
-    lua_getfield(L, 2, "noError");
+    lua_pushliteral(L, "noError");  // raw: no metamethod may raise here
+    lua_rawget(L, 2);
     no_error = lua_toboolean(L, -1);
     lua_pop(L, 1);
   }

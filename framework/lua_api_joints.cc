@@ -34,7 +34,7 @@ void SetJointTarget(lua_State* L, DeferredWrite::Kind kind) {
   const LuaContext& c = Context(L);
   uint32_t slot = 0;
   JointData& joint = CheckJoint(L, &slot);
-  const double value = luaL_checknumber(L, 2);
+  const double value = ArgNumber(L, 2);
   if (!std::isfinite(value)) throw Error("the target is not a finite number");
   if (OwnsJoint(c, slot)) {
     if (kind == DeferredWrite::Kind::kJointTargetVelocity)

@@ -70,7 +70,7 @@ int SendDirectMessage(lua_State* L) {
 }
 int SendRangeMessage(lua_State* L) {
   std::string data = CheckData(L, 1);
-  const double range = luaL_checknumber(L, 2);
+  const double range = ArgNumber(L, 2);
   if (!(range >= 0) || !std::isfinite(range))
     throw Error("the range must be a non-negative number of metres");
   Send(L, MessageScope::kRange, std::move(data), {}, range, lua_toboolean(L, 3) != 0);
@@ -104,7 +104,7 @@ int ReceiveMessage(lua_State* L) {
 
 int SetSignal(lua_State* L) {
   LuaContext& c = Context(L);
-  std::string name = luaL_checkstring(L, 1);
+  std::string name = ArgString(L, 1);
   switch (lua_type(L, 2)) {
     case LUA_TNUMBER:
       c.runtime->signal_writes.emplace_back(std::move(name), lua_tonumber(L, 2));
@@ -123,12 +123,12 @@ int SetSignal(lua_State* L) {
   return 0;
 }
 int ClearSignal(lua_State* L) {
-  Context(L).runtime->signal_writes.emplace_back(luaL_checkstring(L, 1), std::nullopt);
+  Context(L).runtime->signal_writes.emplace_back(ArgString(L, 1), std::nullopt);
   return 0;
 }
 int GetSignal(lua_State* L) {
   size_t length = 0;
-  const char* name = luaL_checklstring(L, 1, &length);
+  const char* name = ArgString(L, 1, &length);
   const auto& signals = Context(L).world->signals();
   auto it = signals.find(std::string_view(name, length));
   if (it == signals.end()) {
@@ -149,8 +149,8 @@ int GetSignal(lua_State* L) {
 
 template <typename T>
 int PackArray(lua_State* L) {
-  luaL_checktype(L, 1, LUA_TTABLE);
-  const lua_Integer n = luaL_len(L, 1);
+  ArgType(L, 1, LUA_TTABLE);
+  const lua_Integer n = static_cast<lua_Integer>(lua_rawlen(L, 1));
   std::string out(static_cast<size_t>(n) * sizeof(T), '\0');
   for (lua_Integer i = 1; i <= n; ++i) {
     lua_rawgeti(L, 1, i);
@@ -176,7 +176,7 @@ int PackArray(lua_State* L) {
 template <typename T>
 int UnpackArray(lua_State* L) {
   size_t length = 0;
-  const char* data = luaL_checklstring(L, 1, &length);
+  const char* data = ArgString(L, 1, &length);
   if (length % sizeof(T) != 0)
     throw Error("the string's length (" + std::to_string(length) + ") is not a multiple of " +
                 std::to_string(sizeof(T)));
@@ -242,7 +242,7 @@ void PackValue(lua_State* L, int index, int depth, std::string* out) {
 }
 
 int PackTable(lua_State* L) {
-  luaL_checktype(L, 1, LUA_TTABLE);
+  ArgType(L, 1, LUA_TTABLE);
   std::string out;
   PackValue(L, 1, 0, &out);
   lua_pushlstring(L, out.data(), out.size());
@@ -261,7 +261,7 @@ struct Reader {
 
 void UnpackValue(lua_State* L, Reader* r, int depth) {
   if (depth > kMaxTableDepth) throw Error("the packed table is nested too deeply");
-  luaL_checkstack(L, 4, "unpackTable");
+  if (!lua_checkstack(L, 4)) throw Error("the packed table is too deep for the Lua stack");
   char tag = 0;
   r->Read(&tag, 1);
   switch (tag) {
@@ -305,7 +305,7 @@ void UnpackValue(lua_State* L, Reader* r, int depth) {
 
 int UnpackTable(lua_State* L) {
   size_t length = 0;
-  const char* data = luaL_checklstring(L, 1, &length);
+  const char* data = ArgString(L, 1, &length);
   Reader r{data, data + length};
   UnpackValue(L, &r, 0);
   if (r.p != r.end || !lua_istable(L, -1)) throw Error("the string is not a packed table");

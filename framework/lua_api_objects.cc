@@ -18,14 +18,16 @@ namespace {
 int GetObject(lua_State* L) {
   const LuaContext& c = Context(L);
   size_t length = 0;
-  const char* path = luaL_checklstring(L, 1, &length);
+  const char* path = ArgString(L, 1, &length);
   bool no_error = false;
   if (lua_istable(L, 2)) {
-    lua_getfield(L, 2, "noError");
+    lua_pushliteral(L, "noError");  // raw: no metamethod may raise here
+    lua_rawget(L, 2);
     no_error = lua_toboolean(L, -1);
     lua_pop(L, 1);
   } else if (!lua_isnoneornil(L, 2)) {
-    luaL_typeerror(L, 2, "table of options");
+    throw Error(std::string("bad argument #2 (table of options expected, got ") +
+                luaL_typename(L, 2) + ")");
   }
   // A malformed path throws even with noError: it is a mistake in the script.
   const ObjectId id = c.scene->FindObject({path, length}, c.script_object);
@@ -95,7 +97,7 @@ int GetObjectParent(lua_State* L) {
 
 // Reads a number array of length n at `arg`.
 void CheckNumbers(lua_State* L, int arg, double* out, int n) {
-  luaL_checktype(L, arg, LUA_TTABLE);
+  ArgType(L, arg, LUA_TTABLE);
   for (int i = 0; i < n; ++i) {
     lua_rawgeti(L, arg, i + 1);
     int ok = 0;
@@ -156,7 +158,7 @@ int SetObjectSizeFactor(lua_State* L) {
   const LuaContext& c = Context(L);
   const ObjectId id = CheckObject(L, 1);
   c.scene->SlotOf(id);
-  const double f = luaL_checknumber(L, 2);
+  const double f = ArgNumber(L, 2);
   if (!std::isfinite(f) || !(f > 0) || f > 1e3)
     throw Error("the size factor must be a finite number above 0 and at most 1000");
   if (c.instance >= 0 && c.scene->instance_of(id) != c.instance)

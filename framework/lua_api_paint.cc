@@ -23,11 +23,11 @@ int SetPaintNozzle(lua_State* L) {
   if (c.instance >= 0 && scene.instance_of(id) != c.instance)
     throw Error("a robot's script may set only its own paint nozzles ('" + scene.PathOf(id) +
                 "' belongs to another robot or to the scene)");
-  luaL_checktype(L, 2, LUA_TBOOLEAN);
+  ArgType(L, 2, LUA_TBOOLEAN);
   const bool enabled = lua_toboolean(L, 2) != 0;
   Vec3 color = nozzle.color;
   if (!lua_isnoneornil(L, 3)) {
-    luaL_checktype(L, 3, LUA_TTABLE);
+    ArgType(L, 3, LUA_TTABLE);
     double rgb[3];
     for (int i = 0; i < 3; ++i) {
       lua_rawgeti(L, 3, i + 1);

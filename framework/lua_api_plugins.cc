@@ -31,7 +31,7 @@ int CallPluginCommand(lua_State* L) {
       case LUA_TBOOLEAN: v.type = kSwarmsimNumber, v.number = lua_toboolean(L, i); break;
       case LUA_TSTRING: v.type = kSwarmsimString, v.text = lua_tolstring(L, i, &v.size); break;
       case LUA_TTABLE: {
-        std::vector<double>& a = arrays.emplace_back(luaL_len(L, i));
+        std::vector<double>& a = arrays.emplace_back(lua_rawlen(L, i));
         for (size_t k = 0; k < a.size(); ++k) {
           lua_rawgeti(L, i, static_cast<lua_Integer>(k + 1));
           if (!lua_isnumber(L, -1))
@@ -101,7 +101,7 @@ bool PushPluginCommand(lua_State* L, std::string_view name) {
   const ScriptCommand* command = c.world->registry().FindScriptCommand(name);
   if (command == nullptr) return false;
   lua_pushlightuserdata(L, const_cast<ScriptCommand*>(command));
-  lua_pushcclosure(L, CallPluginCommand, 1);
+  lua_pushcclosure(L, (Guarded<CallPluginCommand, "">), 1);
   return true;
 }
 

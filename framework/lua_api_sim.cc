@@ -35,7 +35,7 @@ int Random(lua_State* L) {
 int GetParam(lua_State* L) {
   const LuaContext& c = Context(L);
   size_t length = 0;
-  const char* name = luaL_checklstring(L, 1, &length);
+  const char* name = ArgString(L, 1, &length);
   const ParamValue* value = c.world->FindParameter(c.instance, {name, length});
   if (value == nullptr) {
     if (lua_gettop(L) >= 2) {
@@ -61,8 +61,8 @@ int GetParam(lua_State* L) {
 int RecordMetric(lua_State* L) {
   const LuaContext& c = Context(L);
   size_t length = 0;
-  const char* name = luaL_checklstring(L, 1, &length);
-  const double value = luaL_checknumber(L, 2);
+  const char* name = ArgString(L, 1, &length);
+  const double value = ArgNumber(L, 2);
   c.runtime->metrics.push_back(
       {c.world->step_count(), c.world->time(), c.instance, std::string(name, length), value});
   return 0;
@@ -89,13 +89,16 @@ int GetRobotName(lua_State* L) {
 int Print(lua_State* L) {
   const LuaContext& c = Context(L);
   const int n = lua_gettop(L);
+  // Every argument to a string first: __tostring may raise a Lua error,
+  // which must not jump over `line`.
+  if (!lua_checkstack(L, n)) throw Error("too many arguments");
+  for (int i = 1; i <= n; ++i) luaL_tolstring(L, i, nullptr);  // honours __tostring
   std::string line = c.log_prefix;
   for (int i = 1; i <= n; ++i) {
     size_t length = 0;
-    const char* text = luaL_tolstring(L, i, &length);  // honours __tostring
+    const char* text = lua_tolstring(L, n + i, &length);
     if (i > 1) line += '\t';
     line.append(text, length);
-    lua_pop(L, 1);
   }
   c.runtime->log.push_back(std::move(line));
   return 0;

@@ -51,7 +51,7 @@ int SafeLoad(lua_State* L) {
 // collector runs for the other scripts of the state.
 int SafeCollectGarbage(lua_State* L) {
   static const char* const kAllowed[] = {"collect", "count", "step", "isrunning", nullptr};
-  luaL_checkoption(L, 1, "collect", kAllowed);
+  ArgOption(L, 1, "collect", kAllowed);
   lua_pushvalue(L, lua_upvalueindex(1));  // the original collectgarbage
   lua_insert(L, 1);
   lua_call(L, lua_gettop(L) - 1, LUA_MULTRET);
@@ -111,7 +111,7 @@ void NewRestrictedTable(lua_State* L, const char* library, int fields) {
   lua_createtable(L, 0, fields);
   lua_createtable(L, 0, 1);
   lua_pushstring(L, library);
-  lua_pushcclosure(L, RefuseField, 1);
+  lua_pushcclosure(L, (Guarded<RefuseField, "">), 1);
   lua_setfield(L, -2, "__index");
   lua_setmetatable(L, -2);
 }
@@ -156,27 +156,27 @@ std::string CheckedPath(lua_State* L, const char* function, const std::string& t
 
 // io.open(path [, mode]): the original, on a checked path.
 int SafeOpen(lua_State* L) {
-  const std::string text = luaL_checkstring(L, 1);
-  const std::string mode = luaL_optstring(L, 2, "r");
+  const std::string text = ArgString(L, 1);
+  const std::string mode = lua_isnoneornil(L, 2) ? "r" : ArgString(L, 2);
   const bool write = mode != "r" && mode != "rb";
   const std::string path = CheckedPath(L, "io.open", text, write);
   lua_settop(L, 0);
   lua_pushvalue(L, lua_upvalueindex(1));
   lua_pushstring(L, path.c_str());
   lua_pushstring(L, mode.c_str());
-  lua_call(L, 2, LUA_MULTRET);
+  if (lua_pcall(L, 2, LUA_MULTRET, 0) != LUA_OK) throw LuaErrorOnStack{};
   return lua_gettop(L);
 }
 
 // io.lines(path, ...): reading only, never standard input.
 int SafeLines(lua_State* L) {
   if (lua_isnoneornil(L, 1)) Refuse(L, "io.lines() on standard input");
-  const std::string path = CheckedPath(L, "io.lines", luaL_checkstring(L, 1), false);
+  const std::string path = CheckedPath(L, "io.lines", ArgString(L, 1), false);
   lua_pushstring(L, path.c_str());
   lua_replace(L, 1);
   lua_pushvalue(L, lua_upvalueindex(1));
   lua_insert(L, 1);
-  lua_call(L, lua_gettop(L) - 1, LUA_MULTRET);
+  if (lua_pcall(L, lua_gettop(L) - 1, LUA_MULTRET, 0) != LUA_OK) throw LuaErrorOnStack{};
   return lua_gettop(L);
 }
 
@@ -188,7 +188,7 @@ const char kLoadingSentinel = 0;
 // folder, then its scripts/ folder, then the scripts/ folder beside it. Run
 // once per state in an environment of its own; its result is cached.
 int SafeRequire(lua_State* L) {
-  const std::string name = luaL_checkstring(L, 1);
+  const std::string name = ArgString(L, 1);
   lua_settop(L, 1);
   lua_rawgetp(L, LUA_REGISTRYINDEX, &kModulesKey);  // 2: the cache
   if (lua_isnil(L, 2)) {
@@ -226,7 +226,7 @@ int SafeRequire(lua_State* L) {
     std::string chunkname(1, '@');
     chunkname += candidate.lexically_normal().native();
     if (luaL_loadbufferx(L, text.data(), text.size(), chunkname.c_str(), "t") != LUA_OK)
-      lua_error(L);
+      throw LuaErrorOnStack{};
     // Its own environment: module globals do not leak into the scripts.
     lua_newtable(L);
     lua_createtable(L, 0, 1);
@@ -238,7 +238,8 @@ int SafeRequire(lua_State* L) {
     lua_setfield(L, 2, name.c_str());
     lua_pushvalue(L, 1);
     lua_pushstring(L, candidate.c_str());
-    lua_call(L, 2, 1);
+    // Protected: a module's error must not jump over this function's strings.
+    if (lua_pcall(L, 2, 1, 0) != LUA_OK) throw LuaErrorOnStack{};
     if (lua_isnil(L, -1)) {
       lua_pop(L, 1);
       lua_pushboolean(L, 1);
@@ -283,7 +284,7 @@ int SandboxGlobalIndex(lua_State* L) {
     NewRestrictedTable(L, key == "package" ? "package" : "debug", 0);
   } else if (key == "dofile" || key == "loadfile") {
     lua_pushvalue(L, 2);
-    lua_pushcclosure(L, RefuseFunction, 1);
+    lua_pushcclosure(L, (Guarded<RefuseFunction, "">), 1);
   } else {
     return 0;
   }
@@ -324,8 +325,8 @@ void OpenSafeLibraries(lua_State* L) {
     lua_pushnil(L);
     lua_setglobal(L, name);
   }
-  Wrap(L, "load", SafeLoad);
-  Wrap(L, "collectgarbage", SafeCollectGarbage);
+  Wrap(L, "load", Guarded<SafeLoad, "">);
+  Wrap(L, "collectgarbage", Guarded<SafeCollectGarbage, "collectgarbage">);
   // string.dump makes binary chunks, which nothing here can load. Strings'
   // methods ("abc"):upper() come from the new table too.
   Compact(L, LUA_STRLIBNAME, {"dump"});

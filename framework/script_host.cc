@@ -88,8 +88,9 @@ struct ScriptState {
 };
 
 // An error outside any protected call (out of memory while setting a state
-// up) would otherwise abort the process. With the C++ build of Lua, throwing
-// from the panic function is the documented way out.
+// up) would otherwise abort the process. Throwing from the panic function
+// unwinds through Lua's C frames (built with unwind tables on Debian); the
+// state is not used again.
 int ThrowOnPanic(lua_State* L) {
   const char* message = lua_tostring(L, -1);
   throw Error(std::string("Lua: ") + (message != nullptr ? message : "unprotected error"));
@@ -123,12 +124,14 @@ std::string HookWhere(lua_State* L, lua_Debug* ar) {
 
 // Count hook of non-threaded callbacks: the budget is used up.
 void BudgetHook(lua_State* L, lua_Debug* ar) {
-  const std::string message =
-      HookWhere(L, ar) + "the callback ran more than " +
-      std::to_string(Context(L).world->settings().instruction_budget) +
-      " Lua instructions without returning (an endless loop?); if the work is real, raise "
-      "simulation.instruction_budget";
-  lua_pushlstring(L, message.data(), message.size());
+  {  // the message is on the Lua stack, and destroyed, before the longjmp
+    const std::string message =
+        HookWhere(L, ar) + "the callback ran more than " +
+        std::to_string(Context(L).world->settings().instruction_budget) +
+        " Lua instructions without returning (an endless loop?); if the work is real, raise "
+        "simulation.instruction_budget";
+    lua_pushlstring(L, message.data(), message.size());
+  }
   lua_error(L);
 }
 
@@ -144,10 +147,12 @@ void SliceHook(lua_State* L, lua_Debug* ar) {
   const int64_t budget = c.world->settings().instruction_budget;
   const int count = lua_gethookcount(L);
   if (budget > 0 && ++c.slice_fires * count > budget) {
-    const std::string message = HookWhere(L, ar) + "the thread ran more than " +
-                                std::to_string(budget) +
-                                " Lua instructions inside a call that cannot yield";
-    lua_pushlstring(L, message.data(), message.size());
+    {
+      const std::string message = HookWhere(L, ar) + "the thread ran more than " +
+                                  std::to_string(budget) +
+                                  " Lua instructions inside a call that cannot yield";
+      lua_pushlstring(L, message.data(), message.size());
+    }
     lua_error(L);
   }
 }
@@ -559,7 +564,7 @@ int HandleChildScript(lua_State* L) {
     lua_pop(L, 1);
     if (Disable(state, script, c.name + ": " + error)) return 0;
     lua_pushlstring(L, error.data(), error.size());
-    lua_error(L);
+    throw LuaErrorOnStack{};  // raised by Guarded once `error` and `path` are gone
   }
   return lua_gettop(L) - 1;
 }
@@ -568,8 +573,8 @@ int HandleChildScript(lua_State* L) {
 // this step; it resumes in the next one.
 int SwitchThread(lua_State* L) {
   if (!lua_isyieldable(L))
-    RaiseError(L, "sim.step: only a threaded script (sysCall_thread) can yield");
-  return lua_yield(L, 0);
+    return luaL_error(L, "sim.step: only a threaded script (sysCall_thread) can yield");
+  return lua_yield(L, 0);  // not guarded: nothing here has a destructor
 }
 
 // sim.setThreadSwitchTiming(ms): the thread's time slice per step, after
@@ -577,7 +582,7 @@ int SwitchThread(lua_State* L) {
 // ms x 100,000 Lua instructions, not wall time.
 int SetThreadSwitchTiming(lua_State* L) {
   LuaContext& c = Context(L);
-  const double ms = luaL_checknumber(L, 1);
+  const double ms = ArgNumber(L, 1);
   if (!(ms > 0)) throw Error("the time slice must be a positive number of milliseconds");
   Script* script = static_cast<Script*>(c.host_script);
   if (script == nullptr) return 0;
@@ -610,7 +615,7 @@ void Dynamics(World* w) { w->HandleDynamics(); }
 // separate) are passed to every sysCall_sensing / sysCall_actuation called.
 int HandleChildScripts(lua_State* L) {
   static const char* const kPasses[] = {"sensing", "actuation", "all", nullptr};
-  const ScriptPass pass = static_cast<ScriptPass>(luaL_checkoption(L, 1, "all", kPasses));
+  const ScriptPass pass = static_cast<ScriptPass>(ArgOption(L, 1, "all", kPasses));
   LuaContext& c = Context(L);
   if (!c.is_main) throw Error("only the world's main script may run the phases");
   std::vector<ParamValue> args;

@@ -179,6 +179,7 @@ void World::EnsureRuntimes() {
     r.rng = Rng(settings_.seed, runtimes_.size());
     runtimes_.push_back(std::move(r));
   }
+  pending_.resize(runtimes_.size(), 0xff);  // new robots: look at everything once
   scene_runtime_.rng = Rng(settings_.seed, uint64_t{1} << 63);
 }
 
@@ -204,6 +205,7 @@ void World::Start() {
   started_ = true;
   try {
     scripts_->Start();
+    MarkAllPending();  // sysCall_init may have left anything anywhere
     FlushRobotBuffers();
   } catch (...) {
     failed_ = true;
@@ -308,6 +310,7 @@ void World::Control(ScriptPass pass) {
                               } catch (const std::exception& e) {
                                 runtimes_[r].error = e.what();
                               }
+                              pending_[r] |= PendingBits(runtimes_[r]);
                             }
                           });
   try {
@@ -318,6 +321,17 @@ void World::Control(ScriptPass pass) {
   FlushRobotBuffers();
   RunPhaseCallbacks(kSwarmsimAfterControl);
 }
+
+uint8_t World::PendingBits(const RobotRuntime& rt) {
+  uint8_t bits = 0;
+  if (!rt.log.empty() || !rt.metrics.empty() || !rt.error.empty()) bits |= kPendingOutput;
+  if (!rt.deferred.empty()) bits |= kPendingDeferred;
+  if (!rt.outbox.empty() || !rt.signal_writes.empty() || !rt.custom_data_writes.empty())
+    bits |= kPendingMessages;
+  return bits;
+}
+
+void World::MarkAllPending() { pending_.assign(runtimes_.size(), 0xff); }
 
 void World::FlushRobotBuffers() {
   // Logs and metrics in robot order, then the scene's; the lowest robot's
@@ -331,7 +345,11 @@ void World::FlushRobotBuffers() {
     if (!rt.error.empty() && first_error.empty()) first_error = rt.error;
     rt.error.clear();
   };
-  for (RobotRuntime& rt : runtimes_) flush(rt);
+  for (size_t r = 0; r < runtimes_.size(); ++r) {
+    if (!(pending_[r] & kPendingOutput)) continue;
+    flush(runtimes_[r]);
+    pending_[r] &= ~kPendingOutput;
+  }
   flush(scene_runtime_);
   if (!first_error.empty()) throw Error(first_error);
 }
@@ -339,9 +357,12 @@ void World::FlushRobotBuffers() {
 void World::Actuate() {
   // Writes to other robots' objects, in handle order (stable for equal handles).
   std::vector<DeferredWrite> writes;
-  for (RobotRuntime& rt : runtimes_) {
+  for (size_t r = 0; r < runtimes_.size(); ++r) {
+    if (!(pending_[r] & kPendingDeferred)) continue;
+    RobotRuntime& rt = runtimes_[r];
     writes.insert(writes.end(), rt.deferred.begin(), rt.deferred.end());
     rt.deferred.clear();
+    pending_[r] &= ~kPendingDeferred;
   }
   writes.insert(writes.end(), scene_runtime_.deferred.begin(), scene_runtime_.deferred.end());
   scene_runtime_.deferred.clear();
@@ -432,6 +453,7 @@ void World::Stop() {
   stopped_ = true;
   if (scripts_) {
     scripts_->Stop();
+    MarkAllPending();
     FlushRobotBuffers();  // cleanup's prints and errors
   }
 }

@@ -289,6 +289,16 @@ class World {
   std::unique_ptr<ProximityBackend> proximity_;
   std::unique_ptr<ScriptHost> scripts_;
   std::vector<RobotRuntime> runtimes_;
+  // Per robot, which of its RobotRuntime buffers may hold something (kPending*
+  // bits, world.cc): the serial passes between phases visit only those
+  // robots instead of touching 10,000 runtimes to find them empty.
+  std::vector<uint8_t> pending_;
+  static constexpr uint8_t kPendingOutput = 1;         // log, metrics, error
+  static constexpr uint8_t kPendingDeferred = 2;       // deferred writes
+  static constexpr uint8_t kPendingMessages = 4;       // outbox, signal and custom-data writes
+  static constexpr uint8_t kPendingInbox = 8;          // inbox (set by DeliverMessages)
+  static uint8_t PendingBits(const RobotRuntime& rt);  // what rt's buffers hold
+  void MarkAllPending();
   RobotRuntime scene_runtime_;
   std::vector<std::unique_ptr<Observer>> observers_;
   std::vector<std::pair<std::string, std::unique_ptr<CalculationModule>>> calculations_;

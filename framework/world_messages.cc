@@ -34,7 +34,15 @@ void World::DeliverMessages() {
     }
     rt.signal_writes.clear();
   };
-  for (RobotRuntime& rt : runtimes_) apply_signals(rt);
+  // Only robots whose scripts wrote something (pending_) are visited.
+  const int robot_count = static_cast<int>(runtimes_.size());
+  std::vector<int> writers;
+  for (int r = 0; r < robot_count; ++r)
+    if (pending_[r] & kPendingMessages) {
+      writers.push_back(r);
+      pending_[r] &= ~kPendingMessages;
+    }
+  for (int r : writers) apply_signals(runtimes_[r]);
   apply_signals(scene_runtime_);
   // Custom data written last step, robots in index order, then the scene's
   // scripts (the last write of a tag wins); objects removed since are skipped.
@@ -43,7 +51,7 @@ void World::DeliverMessages() {
       if (scene_.IsValid(w.object)) scene_.WriteCustomData(w.object, w.tag, std::move(w.data));
     rt.custom_data_writes.clear();
   };
-  for (RobotRuntime& rt : runtimes_) apply_custom_data(rt);
+  for (int r : writers) apply_custom_data(runtimes_[r]);
   apply_custom_data(scene_runtime_);
 
   // Gather in robot order, then the scene's; order by sender handle.
@@ -53,11 +61,14 @@ void World::DeliverMessages() {
     for (Message& m : rt.outbox) messages_.push_back(std::move(m));
     rt.outbox.clear();
   };
-  for (RobotRuntime& rt : runtimes_) gather(rt);
+  for (int r : writers) gather(runtimes_[r]);
   gather(scene_runtime_);
-  const int robot_count = static_cast<int>(runtimes_.size());
   if (messages_.empty()) {
-    for (RobotRuntime& rt : runtimes_) rt.inbox.clear();
+    for (int r = 0; r < robot_count; ++r)
+      if (pending_[r] & kPendingInbox) {
+        runtimes_[r].inbox.clear();
+        pending_[r] &= ~kPendingInbox;
+      }
     scene_runtime_.inbox.clear();
     return;
   }
@@ -110,6 +121,7 @@ void World::DeliverMessages() {
     for (int64_t r = begin; r < end; ++r) {
       std::vector<ReceivedMessage>& inbox = runtimes_[r].inbox;
       inbox.clear();
+      pending_[r] &= ~kPendingInbox;
       if (!instances[r].alive) continue;
       const Pose X_WR = scene_.world_pose(instances[r].root);
       const Pose X_RW = X_WR.Inverse();
@@ -143,6 +155,7 @@ void World::DeliverMessages() {
         std::sort(inbox.begin(), inbox.begin() + static_cast<ptrdiff_t>(sorted_end), by_message);
       std::inplace_merge(inbox.begin(), inbox.begin() + static_cast<ptrdiff_t>(sorted_end),
                          inbox.end(), by_message);
+      if (!inbox.empty()) pending_[r] |= kPendingInbox;
     }
   });
 

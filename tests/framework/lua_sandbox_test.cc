@@ -145,6 +145,30 @@ TEST_F(SandboxTest, RequireLoadsModulesFromTheWorldFoldersOncePerState) {
   EXPECT_CONTAINS(Run("require('leak')"), "module 'leak' not found");
 }
 
+// Lua errors are longjmps (the C build of Lua): errors raised by Lua code
+// that a sim/sandbox function calls, and errors of those functions caught by
+// pcall, keep their messages, and the script goes on (the sanitizer build
+// checks that nothing a C++ function held is leaked on the way).
+TEST_F(SandboxTest, ErrorsThroughCFunctionsKeepTheirMessagesAndCanBeCaught) {
+  EXPECT_CONTAINS(Run("print(setmetatable({}, {__tostring = function() error('no text') end}))"),
+                  "scripts/robot.lua:1: no text");
+  EXPECT_CONTAINS(Run("io.open('data.txt', 'rz')"), "invalid mode");
+  EXPECT_CONTAINS(Run("for l in io.lines('missing.txt') do end"), "missing.txt");
+  Write(root_ / "world" / "broken.lua", "local x = 1\nerror('module failed')\n");
+  EXPECT_CONTAINS(Run("require('broken')"), "broken.lua:2: module failed");
+  EXPECT_EQ(Run("for i = 1, 2000 do\n"
+                "  local ok, e = pcall(sim.getObject, './nope' .. i)\n"
+                "  assert(not ok and e:find('no object at path'), e)\n"
+                "  ok, e = pcall(require, 'nothere')\n"
+                "  assert(not ok and e:find('not found'), e)\n"
+                "  ok, e = pcall(sim.setSignal, 'x', {})\n"
+                "  assert(not ok and e:find('a signal is a number'), e)\n"
+                "end\n"
+                "print('still running')"),
+            "");
+  EXPECT_EQ(Log(), "[bot#0] still running\n");
+}
+
 TEST_F(SandboxTest, TrustScriptsGivesTheFullLibraries) {
   EXPECT_EQ(Run("assert(type(os.execute) == 'function' and type(io.popen) == 'function' and "
                 "type(debug.getinfo) == 'function' and type(package.loadlib) == 'function')",

@@ -243,7 +243,8 @@ TEST(ScriptHostTest, ErrorsInsideSimCallsCarryTheCallersLine) {
       {"sim.getParam('gain')", "sim.getParam: no parameter 'gain'"},
       {"sim.setJointTargetVelocity(sim.getObject('./leftMotor'), 0/0)",
        "sim.setJointTargetVelocity: the target is not a finite number"},
-      {"sim.getObjectPose('x')", "bad argument #1 to 'getObjectPose'"},
+      {"sim.getObjectPose('x')",
+       "sim.getObjectPose: bad argument #1 (number expected, got string)"},
   };
   for (const Case& c : cases) {
     ScriptWorld w;

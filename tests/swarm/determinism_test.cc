@@ -9,19 +9,22 @@
 namespace swarmsim {
 namespace {
 
-uint64_t RunDiffusion(int robots, int threads, uint64_t seed, int steps) {
+uint64_t RunWorld(const std::string& file, int robots, int threads, uint64_t seed, int steps) {
   ModuleRegistry registry;
   RegisterBuiltinModules(&registry);
   LoadOptions options;
   options.overrides = {{"robots", std::to_string(robots)}};
   options.seed = seed;
   options.threads = threads;
-  LoadedWorld loaded =
-      LoadWorld(std::string(SWARMSIM_SOURCE_DIR) + "/worlds/diffusion.yaml", options, registry);
+  LoadedWorld loaded = LoadWorld(std::string(SWARMSIM_SOURCE_DIR) + "/" + file, options, registry);
   loaded.world->set_log_sink([](std::string_view) {});
   loaded.world->Start();
   for (int i = 0; i < steps; ++i) loaded.world->Step();
   return loaded.world->StateHash();
+}
+
+uint64_t RunDiffusion(int robots, int threads, uint64_t seed, int steps) {
+  return RunWorld("worlds/diffusion.yaml", robots, threads, seed, steps);
 }
 
 TEST(DeterminismTest, DiffusionHashIsIndependentOfThreadCount) {
@@ -30,6 +33,20 @@ TEST(DeterminismTest, DiffusionHashIsIndependentOfThreadCount) {
   EXPECT_EQ(RunDiffusion(300, 4, 7, 300), one);
   // Another seed, another history.
   EXPECT_NE(RunDiffusion(300, 2, 8, 300), one);
+}
+
+// The benchmark's threaded controller (sysCall_thread, one sim.step() a
+// step) does what scripts/diffusion.lua does in sysCall_actuation: the same
+// history, at any thread count. The broadcasting one differs (messages are
+// part of the state), the same at 1 and 2 threads.
+TEST(DeterminismTest, ThreadedControllerMatchesTheNonThreadedOne) {
+  const uint64_t plain = RunWorld("bench/worlds/diffusion_nonthreaded.yaml", 200, 1, 3, 150);
+  EXPECT_EQ(plain, RunDiffusion(200, 1, 3, 150));
+  EXPECT_EQ(RunWorld("bench/worlds/diffusion_threaded.yaml", 200, 1, 3, 150), plain);
+  EXPECT_EQ(RunWorld("bench/worlds/diffusion_threaded.yaml", 200, 2, 3, 150), plain);
+  const uint64_t broadcast = RunWorld("bench/worlds/diffusion_broadcast.yaml", 200, 1, 3, 150);
+  EXPECT_NE(broadcast, plain);
+  EXPECT_EQ(RunWorld("bench/worlds/diffusion_broadcast.yaml", 200, 2, 3, 150), broadcast);
 }
 
 TEST(DeterminismTest, RobotsActuallyMoveSoTheHashMeansSomething) {
