@@ -61,7 +61,6 @@ ObjectId AddFootbot(Scene* scene, std::shared_ptr<const ScriptSource> script, do
     if (i < detections) {
       sensor.detected = true;
       sensor.distance = 0.05;
-      sensor.p_SD = {0, 0, 0.05};
     }
     scene->AddProximitySensor("prox", body,
                               {{0.085 * std::cos(angle), 0.085 * std::sin(angle), 0},

@@ -26,7 +26,7 @@ int ReadProximitySensor(lua_State* L) {
   }
   lua_pushinteger(L, 1);
   lua_pushnumber(L, sensor.distance);
-  const double p_SD[3] = {sensor.p_SD.x, sensor.p_SD.y, sensor.p_SD.z};
+  const double p_SD[3] = {0, 0, sensor.distance};  // sensor.p_SD()
   PushNumberArray(L, p_SD, 3);
   lua_pushinteger(L, sensor.detected_object.IsNull() ? -1 : sensor.detected_object.ToInteger());
   return 4;

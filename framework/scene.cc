@@ -527,7 +527,6 @@ void Scene::ScaleSubtree(ObjectId root, double s) {
         ProximitySensorData& p = proximity_sensors_[row_[slot]];
         p.range *= s;
         p.distance *= s;
-        p.p_SD = p.p_SD * s;
         break;
       }
       case ObjectType::kForceSensor: {

@@ -96,13 +96,15 @@ struct JointData {
 };
 
 // A ray proximity sensor looking along its +z axis (V-REP's convention).
+// 32 bytes: a robot's control step reads all of its sensors' rows.
 struct ProximitySensorData {
   double range = 0.1;  // m
   // Reading, written in the sense phase:
-  bool detected = false;
   double distance = 0;       // m, along the ray
-  Vec3 p_SD;                 // detected point in the sensor frame
   ObjectId detected_object;  // shape that was hit
+  bool detected = false;
+  // The detected point in the sensor frame: on the ray, the +z axis.
+  Vec3 p_SD() const { return {0, 0, distance}; }
 };
 
 // A script attached to an object. The source is shared by all copies.

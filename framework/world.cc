@@ -482,7 +482,7 @@ uint64_t World::StateHash() const {
     h.AddValue(scene_.proximity_sensor_owners()[r]);
     h.AddValue(p.detected);
     h.AddValue(p.distance);
-    h.AddValue(p.p_SD);
+    h.AddValue(p.p_SD());
     h.AddValue(p.detected_object);
   }
   for (size_t r = 0; r < scene_.force_sensors().size(); ++r) {

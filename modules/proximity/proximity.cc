@@ -85,15 +85,13 @@ void MakeRays(const Scene& scene, std::span<const SensorRef> sensors,
 void ReadNothing(ProximitySensorData* reading) {
   reading->detected = false;
   reading->distance = 0;
-  reading->p_SD = {0, 0, 0};
   reading->detected_object = ObjectId{};
 }
 
 // Zero if and only if the reading is ReadNothing's, bit for bit.
 uint64_t NothingBits(const ProximitySensorData& reading) {
   return uint64_t{reading.detected} | std::bit_cast<uint64_t>(reading.distance) |
-         std::bit_cast<uint64_t>(reading.p_SD.x) | std::bit_cast<uint64_t>(reading.p_SD.y) |
-         std::bit_cast<uint64_t>(reading.p_SD.z) | std::bit_cast<uint64_t>(reading.detected_object);
+         std::bit_cast<uint64_t>(reading.detected_object);
 }
 
 class OctreeGridProximity final : public ProximityBackend {
@@ -425,7 +423,6 @@ class OctreeGridProximity final : public ProximityBackend {
     ProximitySensorData& reading = scene->proximity_sensors()[ray.row];
     reading.detected = best <= ray.range;
     reading.distance = reading.detected ? best : 0;
-    reading.p_SD = {0, 0, reading.distance};
     reading.detected_object = reading.detected ? hit : ObjectId{};
   }
 

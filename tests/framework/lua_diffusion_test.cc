@@ -53,7 +53,6 @@ class DiffusionTest : public ::testing::Test {
     ProximitySensorData& p = world_->scene().mutable_proximity_sensor(prox_[sensor]);
     p.detected = true;
     p.distance = distance;
-    p.p_SD = {0, 0, distance};
   }
   // Wheel targets (rad/s) after one step.
   std::pair<double, double> Step() {

@@ -169,6 +169,18 @@ TEST_F(SandboxTest, ErrorsThroughCFunctionsKeepTheirMessagesAndCanBeCaught) {
   EXPECT_EQ(Log(), "[bot#0] still running\n");
 }
 
+// coroutine and utf8 are opened on first use (less memory per robot), in
+// every script of the state, like the other libraries.
+TEST_F(SandboxTest, CoroutineAndUtf8AreThereOnFirstUse) {
+  EXPECT_EQ(Run("local gen = coroutine.wrap(function() coroutine.yield(1) coroutine.yield(2) end)\n"
+                "assert(gen() == 1 and gen() == 2)\n"
+                "assert(utf8.char(72, 228) == 'H\\u{E4}' and utf8.len('H\\u{E4}') == 2)\n"
+                "assert(coroutine == _G.coroutine and type(coroutine.isyieldable) == 'function')\n"
+                "print(coroutine.running() ~= nil)"),
+            "");
+  EXPECT_EQ(Log(), "[bot#0] true\n");
+}
+
 TEST_F(SandboxTest, TrustScriptsGivesTheFullLibraries) {
   EXPECT_EQ(Run("assert(type(os.execute) == 'function' and type(io.popen) == 'function' and "
                 "type(debug.getinfo) == 'function' and type(package.loadlib) == 'function')",

@@ -462,7 +462,6 @@ TEST(ScriptHostTest, ReadProximitySensorReturnsTheReading) {
   ProximitySensorData& reading = w.scene().mutable_proximity_sensor(p0);
   reading.detected = true;
   reading.distance = 0.0625;
-  reading.p_SD = {0, 0, 0.0625};
   reading.detected_object = wall;
   w.world().Start();
   w.world().Step();  // the null proximity module leaves the readings alone

@@ -92,16 +92,16 @@ class ProximityTest : public ::testing::Test {
     const ProximitySensorData& r = Reading(sensor);
     EXPECT_TRUE(r.detected);
     EXPECT_NEAR(r.distance, distance, kTol);
-    EXPECT_NEAR(r.p_SD.x, 0, kTol);
-    EXPECT_NEAR(r.p_SD.y, 0, kTol);
-    EXPECT_NEAR(r.p_SD.z, distance, kTol);
+    EXPECT_NEAR(r.p_SD().x, 0, kTol);
+    EXPECT_NEAR(r.p_SD().y, 0, kTol);
+    EXPECT_NEAR(r.p_SD().z, distance, kTol);
     EXPECT_EQ(r.detected_object, object);
   }
   void ExpectNothing(ObjectId sensor) {
     const ProximitySensorData& r = Reading(sensor);
     EXPECT_FALSE(r.detected);
     EXPECT_EQ(r.distance, 0);
-    EXPECT_EQ(r.p_SD, Vec3{});
+    EXPECT_EQ(r.p_SD(), Vec3{});
     EXPECT_TRUE(r.detected_object.IsNull());
   }
 
@@ -431,9 +431,6 @@ TEST_F(ProximityTest, SwarmMatchesBruteForceAndConcurrentSensingMatchesSerial) {
 bool SameBits(const ProximitySensorData& a, const ProximitySensorData& b) {
   return a.detected == b.detected &&
          std::bit_cast<uint64_t>(a.distance) == std::bit_cast<uint64_t>(b.distance) &&
-         std::bit_cast<uint64_t>(a.p_SD.x) == std::bit_cast<uint64_t>(b.p_SD.x) &&
-         std::bit_cast<uint64_t>(a.p_SD.y) == std::bit_cast<uint64_t>(b.p_SD.y) &&
-         std::bit_cast<uint64_t>(a.p_SD.z) == std::bit_cast<uint64_t>(b.p_SD.z) &&
          a.detected_object == b.detected_object;
 }
 
@@ -453,7 +450,6 @@ struct TwinBackends {
     for (ProximitySensorData& r : scene.proximity_sensors()) {
       r.detected = true;
       r.distance = -7;
-      r.p_SD = {1, 2, 3};
       r.detected_object = ObjectId{12345, 6};
     }
     backend->Update(scene);
