@@ -72,8 +72,10 @@ void World::DeliverMessages() {
     scene_runtime_.inbox.clear();
     return;
   }
-  std::stable_sort(messages_.begin(), messages_.end(),
-                   [](const Message& a, const Message& b) { return a.sender < b.sender; });
+  // Gathered in robot order, which is usually sender-handle order already.
+  const auto by_sender = [](const Message& a, const Message& b) { return a.sender < b.sender; };
+  if (!std::is_sorted(messages_.begin(), messages_.end(), by_sender))
+    std::stable_sort(messages_.begin(), messages_.end(), by_sender);
 
   // Per message: the sender's position; global ones listed, local and
   // direct ones bucketed by receiving robot (bucket robot_count: the scene),
