@@ -22,7 +22,7 @@ namespace {
 // Robots per task in the parallel phases: big enough to amortise the task
 // overhead (a robot's sense + control is a few microseconds), small enough
 // to balance two to eight workers.
-constexpr int64_t kRobotGrain = 16;
+constexpr int64_t kRobotGrain = 8;
 
 class PhaseTimer {
  public:

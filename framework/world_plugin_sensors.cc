@@ -15,7 +15,7 @@ namespace swarmsim {
 static_assert(SWARMSIM_SENSOR_MAX_VALUES == 16, "World::PluginSensorState::values");
 
 namespace {
-constexpr int64_t kRobotGrain = 16;  // as the other per-robot phases
+constexpr int64_t kRobotGrain = 8;  // as the other per-robot phases
 }  // namespace
 
 void World::IndexPluginSensors() {
