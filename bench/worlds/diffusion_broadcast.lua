@@ -1,6 +1,6 @@
 -- Benchmark: scripts/diffusion.lua plus one range-limited broadcast per
 -- robot and step (0.5 m), and reading every message received. Compared
--- with bench/worlds/diffusion_nonthreaded.yaml: the difference is the cost
+-- with worlds/diffusion.yaml: the difference is the cost
 -- of messaging.
 --
 -- Attached to the foot-bot's body. Parameters (sim.getParam): wheel_speed

@@ -1,6 +1,6 @@
 -- Benchmark: scripts/diffusion.lua as a threaded script (sysCall_thread,
 -- one sim.step() per control step), doing exactly the same work per step.
--- Compared with bench/worlds/diffusion_nonthreaded.yaml.
+-- Compared with worlds/diffusion.yaml.
 --
 -- Attached to the foot-bot's body. Parameters (sim.getParam): wheel_speed
 -- (m/s), wheel_radius (m), go_straight_angle_deg, delta.

@@ -38,10 +38,23 @@ TEST(DeterminismTest, DiffusionHashIsIndependentOfThreadCount) {
 // The benchmark's threaded controller (sysCall_thread, one sim.step() a
 // step) does what scripts/diffusion.lua does in sysCall_actuation: the same
 // history, at any thread count. The broadcasting one differs (messages are
-// part of the state), the same at 1 and 2 threads.
+// part of the state), the same at 1 and 2 threads. Each bench world swaps
+// the foot-bot's script through its `controller` parameter.
 TEST(DeterminismTest, ThreadedControllerMatchesTheNonThreadedOne) {
-  const uint64_t plain = RunWorld("bench/worlds/diffusion_nonthreaded.yaml", 200, 1, 3, 150);
-  EXPECT_EQ(plain, RunDiffusion(200, 1, 3, 150));
+  for (const char* name : {"threaded", "broadcast"}) {
+    ModuleRegistry registry;
+    RegisterBuiltinModules(&registry);
+    LoadOptions options;
+    options.overrides = {{"robots", "3"}};
+    const std::string file = std::string("bench/worlds/diffusion_") + name;
+    LoadedWorld loaded =
+        LoadWorld(std::string(SWARMSIM_SOURCE_DIR) + "/" + file + ".yaml", options, registry);
+    const Scene& scene = loaded.world->scene();
+    const ScriptAttachment* script = scene.script(scene.instance(2).root);
+    ASSERT_NE(script, nullptr);
+    EXPECT_TRUE(script->source->path.ends_with(file + ".lua")) << script->source->path;
+  }
+  const uint64_t plain = RunDiffusion(200, 1, 3, 150);
   EXPECT_EQ(RunWorld("bench/worlds/diffusion_threaded.yaml", 200, 1, 3, 150), plain);
   EXPECT_EQ(RunWorld("bench/worlds/diffusion_threaded.yaml", 200, 2, 3, 150), plain);
   const uint64_t broadcast = RunWorld("bench/worlds/diffusion_broadcast.yaml", 200, 1, 3, 150);
