@@ -328,6 +328,11 @@ TEST(ScriptControlTest, MessageScopesReachExactlyTheirReceiversAtTheNextStep) {
       "[a] d\tb\t1.00 0.00", "[a] r\tc\t1.00 1.57", "[b] g\ta\t1.00 1.57", "[b] r\tc\t1.41 0.79",
       "[b] g\ta\t1.00 1.57", "[b] l\tb\t0.00 0.00", "[b] r\tc\t1.41 0.79", "[c] g\ta\t1.00 -1.57"};
   EXPECT_EQ(w.log, expected);
+  // Sent once, delivered once: the following steps, with no messages at all,
+  // deliver nothing (the inboxes of the last round are emptied).
+  w.log.clear();
+  w.Steps(2);
+  EXPECT_TRUE(w.log.empty()) << w.log.front();
 }
 
 TEST(ScriptControlTest, RangeMessagesHonourRangeAndLineOfSight) {
