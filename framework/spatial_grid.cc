@@ -136,33 +136,37 @@ void SpatialGrid::Build(std::span<const GridItem> items, double cell_size) {
   }
 }
 
+bool CellsReached(const Aabb2& box, double pad, double origin_x, double origin_y, double inv_cell,
+                  int cells_x, int cells_y, CellRange* out) {
+  if (cells_x <= 0 || cells_y <= 0) return false;
+  const double slack_x = 1e-12 * (std::abs(box.min_x) + std::abs(box.max_x) + std::abs(origin_x));
+  const double slack_y = 1e-12 * (std::abs(box.min_y) + std::abs(box.max_y) + std::abs(origin_y));
+  const double grow = pad * (1 + 1e-12) + 1e-300;
+  const double lo_x = std::floor((box.min_x - grow - slack_x - origin_x) * inv_cell);
+  const double hi_x = std::floor((box.max_x + grow + slack_x - origin_x) * inv_cell);
+  const double lo_y = std::floor((box.min_y - grow - slack_y - origin_y) * inv_cell);
+  const double hi_y = std::floor((box.max_y + grow + slack_y - origin_y) * inv_cell);
+  // (Negated comparisons so NaN boxes fall through to "nothing".)
+  if (!(lo_x <= hi_x && lo_y <= hi_y && hi_x >= 0 && hi_y >= 0 && lo_x < cells_x && lo_y < cells_y))
+    return false;
+  out->ix0 = static_cast<int>(std::max(lo_x, 0.0));
+  out->ix1 = static_cast<int>(std::min(hi_x, cells_x - 1.0));
+  out->iy0 = static_cast<int>(std::max(lo_y, 0.0));
+  out->iy1 = static_cast<int>(std::min(hi_y, cells_y - 1.0));
+  return true;
+}
+
 template <class Keep>
 void SpatialGrid::Collect(const Aabb2& box, Keep keep, std::vector<uint32_t>* out) const {
   out->clear();
-  if (cells_x_ > 0) {
-    // Grow the box by the largest radius (plus rounding slack) and clamp to the grid.
-    const double slack_x =
-        1e-12 * (std::abs(box.min_x) + std::abs(box.max_x) + std::abs(origin_x_));
-    const double slack_y =
-        1e-12 * (std::abs(box.min_y) + std::abs(box.max_y) + std::abs(origin_y_));
-    const double pad = max_radius_ * (1 + 1e-12) + 1e-300;
-    const double lo_x = std::floor((box.min_x - pad - slack_x - origin_x_) * inv_cell_size_);
-    const double hi_x = std::floor((box.max_x + pad + slack_x - origin_x_) * inv_cell_size_);
-    const double lo_y = std::floor((box.min_y - pad - slack_y - origin_y_) * inv_cell_size_);
-    const double hi_y = std::floor((box.max_y + pad + slack_y - origin_y_) * inv_cell_size_);
-    // (Negated comparisons so NaN boxes fall through to "nothing".)
-    if (lo_x <= hi_x && lo_y <= hi_y && hi_x >= 0 && hi_y >= 0 && lo_x < cells_x_ &&
-        lo_y < cells_y_) {
-      const int ix0 = static_cast<int>(std::max(lo_x, 0.0));
-      const int ix1 = static_cast<int>(std::min(hi_x, cells_x_ - 1.0));
-      const int iy0 = static_cast<int>(std::max(lo_y, 0.0));
-      const int iy1 = static_cast<int>(std::min(hi_y, cells_y_ - 1.0));
-      // Cells of a row are contiguous in cell_items_.
-      for (int iy = iy0; iy <= iy1; ++iy) {
-        const size_t row = static_cast<size_t>(iy) * cells_x_;
-        for (uint32_t e = cell_start_[row + ix0]; e < cell_start_[row + ix1 + 1]; ++e)
-          if (keep(cell_data_[e])) out->push_back(cell_items_[e]);
-      }
+  CellRange c;
+  if (CellsReached(box, max_radius_, origin_x_, origin_y_, inv_cell_size_, cells_x_, cells_y_,
+                   &c)) {
+    // Cells of a row are contiguous in cell_items_.
+    for (int iy = c.iy0; iy <= c.iy1; ++iy) {
+      const size_t row = static_cast<size_t>(iy) * cells_x_;
+      for (uint32_t e = cell_start_[row + c.ix0]; e < cell_start_[row + c.ix1 + 1]; ++e)
+        if (keep(cell_data_[e])) out->push_back(cell_items_[e]);
     }
   }
   for (uint32_t i : oversize_)

@@ -31,6 +31,16 @@ struct Aabb2 {  // 32 bytes
   double min_x = 0, min_y = 0, max_x = 0, max_y = 0;
 };
 
+// The cells of a uniform grid (cell (0, 0)'s lower-left corner at origin,
+// edge 1 / inv_cell, cells_x by cells_y) that `box` grown by `pad` can
+// reach, with slack for rounding: columns ix0..ix1, rows iy0..iy1.
+// false if none (also for a NaN box or an empty grid).
+struct CellRange {
+  int ix0 = 0, ix1 = -1, iy0 = 0, iy1 = -1;
+};
+bool CellsReached(const Aabb2& box, double pad, double origin_x, double origin_y, double inv_cell,
+                  int cells_x, int cells_y, CellRange* out);
+
 class SpatialGrid {
  public:
   static constexpr double kMaxCellsPerItem = 4;

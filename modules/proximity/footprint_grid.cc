@@ -136,29 +136,12 @@ void FootprintGrid::Build(std::span<const Aabb2> squares, std::span<const int32_
 
 template <class Visit>
 bool FootprintGrid::Scan(const Aabb2& box, Visit&& visit) const {
-  if (cells_x_ > 0) {
-    // The cells whose entries can meet the box: the box grown by the
-    // largest half edge, plus slack for rounding.
-    const double slack_x =
-        1e-12 * (std::abs(box.min_x) + std::abs(box.max_x) + std::abs(origin_x_));
-    const double slack_y =
-        1e-12 * (std::abs(box.min_y) + std::abs(box.max_y) + std::abs(origin_y_));
-    const double pad = max_half_ * (1 + 1e-12) + 1e-300;
-    const double lo_x = std::floor((box.min_x - pad - slack_x - origin_x_) * inv_cell_size_);
-    const double hi_x = std::floor((box.max_x + pad + slack_x - origin_x_) * inv_cell_size_);
-    const double lo_y = std::floor((box.min_y - pad - slack_y - origin_y_) * inv_cell_size_);
-    const double hi_y = std::floor((box.max_y + pad + slack_y - origin_y_) * inv_cell_size_);
-    if (lo_x <= hi_x && lo_y <= hi_y && hi_x >= 0 && hi_y >= 0 && lo_x < cells_x_ &&
-        lo_y < cells_y_) {
-      const int ix0 = static_cast<int>(std::max(lo_x, 0.0));
-      const int ix1 = static_cast<int>(std::min(hi_x, cells_x_ - 1.0));
-      const int iy0 = static_cast<int>(std::max(lo_y, 0.0));
-      const int iy1 = static_cast<int>(std::min(hi_y, cells_y_ - 1.0));
-      for (int iy = iy0; iy <= iy1; ++iy) {
-        const size_t row = size_t(iy) * size_t(cells_x_);
-        for (uint32_t e = cell_start_[row + ix0]; e < cell_start_[row + ix1 + 1]; ++e)
-          if (visit(cell_entries_[e])) return true;
-      }
+  CellRange c;
+  if (CellsReached(box, max_half_, origin_x_, origin_y_, inv_cell_size_, cells_x_, cells_y_, &c)) {
+    for (int iy = c.iy0; iy <= c.iy1; ++iy) {
+      const size_t row = size_t(iy) * size_t(cells_x_);
+      for (uint32_t e = cell_start_[row + c.ix0]; e < cell_start_[row + c.ix1 + 1]; ++e)
+        if (visit(cell_entries_[e])) return true;
     }
   }
   for (const Entry& entry : oversize_)
