@@ -63,6 +63,7 @@ int RecordMetric(lua_State* L) {
   size_t length = 0;
   const char* name = ArgString(L, 1, &length);
   const double value = ArgNumber(L, 2);
+  if (length == 0) throw Error("the metric name is empty");
   c.runtime->metrics.push_back(
       {c.world->step_count(), c.world->time(), c.instance, std::string(name, length), value});
   return 0;

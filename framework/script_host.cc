@@ -22,6 +22,7 @@
 
 #include <algorithm>
 #include <climits>
+#include <cstdlib>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -73,11 +74,26 @@ struct Script {  // 88 bytes
   ScriptMailbox mailbox;
 };
 
+// What a Lua state holds, against simulation.script_memory_limit. Past the
+// limit an allocation still succeeds (up to kMemorySlack more) but arms a
+// count hook on the state's threads; at the next instruction the hook
+// collects garbage and, if the state still holds too much, fails the
+// script with its file and line. Past limit + slack allocations fail (Lua
+// then collects and retries, and reports out of memory).
+struct LuaMemory {
+  size_t used = 0;   // bytes
+  size_t limit = 0;  // bytes; 0: no limit
+  bool armed = false;
+  bool refused = false;  // the last allocation was refused (limit + slack)
+};
+constexpr size_t kMemorySlack = size_t{16} << 20;
+
 // One lua_State and its scripts: a robot's, or the scene's.
 struct ScriptState {
   lua_State* L = nullptr;
   LuaContext context;
   std::vector<Script> scripts;  // hierarchy order
+  LuaMemory memory;
 
   ScriptState() = default;
   ScriptState(const ScriptState&) = delete;
@@ -97,8 +113,19 @@ int ThrowOnPanic(lua_State* L) {
 }
 
 // The text of the error value on top of the stack.
+std::string MemoryLimitText(const LuaMemory& memory) {
+  return "the scripts hold more than " + std::to_string(memory.limit >> 20) +
+         " MiB of Lua memory (simulation.script_memory_mb; raise it if the data is real)";
+}
 std::string ErrorText(lua_State* L, int status) {
-  if (status == LUA_ERRMEM) return "not enough memory";
+  if (status == LUA_ERRMEM) {
+    const auto* state = static_cast<const ScriptState*>(Context(L).host_state);
+    if (state != nullptr && state->memory.refused)
+      return "an allocation would take the scripts past " +
+             std::to_string(state->memory.limit >> 20) +
+             " MiB of Lua memory (simulation.script_memory_mb; raise it if the data is real)";
+    return "not enough memory";
+  }
   if (status != LUA_ERRRUN && status != LUA_ERRSYNTAX && status != LUA_ERRERR)
     return "internal error: a C++ exception crossed a Lua frame (please report this)";
   if (lua_type(L, -1) == LUA_TSTRING) return lua_tostring(L, -1);
@@ -163,6 +190,56 @@ void SetBudget(lua_State* L, const LuaContext& c) {
     lua_sethook(L, BudgetHook, LUA_MASKCOUNT, static_cast<int>(std::min<int64_t>(budget, INT_MAX)));
 }
 
+// Count hook armed when a state's memory passed the limit (LuaMemory).
+void MemoryHook(lua_State* L, lua_Debug* ar) {
+  auto* state = static_cast<ScriptState*>(Context(L).host_state);
+  lua_gc(L, LUA_GCCOLLECT);
+  if (state->memory.used > state->memory.limit) {
+    {  // the message is on the Lua stack, and destroyed, before the longjmp
+      const std::string message = HookWhere(L, ar) + MemoryLimitText(state->memory);
+      lua_pushlstring(L, message.data(), message.size());
+    }
+    lua_error(L);
+  }
+  // Garbage only: the threads get their usual hooks back.
+  state->memory.armed = false;
+  SetBudget(state->L, state->context);
+  for (const Script& script : state->scripts)
+    if (script.thread != nullptr)
+      lua_sethook(script.thread, SliceHook, LUA_MASKCOUNT, script.slice_instructions);
+}
+
+// lua_Alloc of every state: realloc/free, counting against the limit.
+void* LimitedAlloc(void* ud, void* ptr, size_t osize, size_t nsize) {
+  auto* state = static_cast<ScriptState*>(ud);
+  LuaMemory& m = state->memory;
+  const size_t old = ptr != nullptr ? osize : 0;
+  if (nsize == 0) {
+    std::free(ptr);
+    m.used -= old;
+    return nullptr;
+  }
+  if (m.limit > 0 && nsize > old) {
+    const size_t after = m.used + (nsize - old);
+    if (after > m.limit + kMemorySlack || after < m.used) {
+      m.refused = true;
+      return nullptr;
+    }
+    if (after > m.limit && !m.armed && state->L != nullptr) {
+      // lua_sethook may be called at any point (even from a signal handler).
+      m.armed = true;
+      lua_sethook(state->L, MemoryHook, LUA_MASKCOUNT, 1);
+      for (const Script& script : state->scripts)
+        if (script.thread != nullptr) lua_sethook(script.thread, MemoryHook, LUA_MASKCOUNT, 1);
+    }
+  }
+  void* p = std::realloc(ptr, nsize);
+  if (p == nullptr) return nullptr;
+  m.used = m.used - old + nsize;
+  m.refused = false;
+  return p;
+}
+
 void SetCurrent(ScriptState& state, Script& script) {
   state.context.script_object = script.object;
   state.context.script_env_ref = script.env_ref;
@@ -199,17 +276,31 @@ bool Disable(ScriptState& state, Script& script, const std::string& error) {
     return false;
   script.disabled = true;
   state.context.runtime->log.push_back("error, script disabled: " + error);
+  state.context.runtime->disabled.push_back(error);
   return true;
 }
 
 // sim.wait and sim.waitUntil, in Lua over sim.step (threaded scripts only).
-constexpr char kThreadHelpers[] = R"(local sim = ...
+constexpr char kThreadHelpers[] = R"(local sim, yieldable = ...
 local step, now = sim.step, sim.getSimulationTime
+local function threaded(name)  -- errors name the caller's line, not this chunk's
+  if not yieldable() then
+    error(name .. ': only a threaded script (sysCall_thread) can wait', 3)
+  end
+end
 function sim.wait(seconds)
+  threaded('sim.wait')
+  if type(seconds) ~= 'number' then
+    error('sim.wait: bad argument #1 (number expected, got ' .. type(seconds) .. ')', 2)
+  end
   local t_end = now() + seconds - 1e-9
   while now() < t_end do step() end
 end
 function sim.waitUntil(condition, timeout)
+  threaded('sim.waitUntil')
+  if type(condition) ~= 'function' then
+    error('sim.waitUntil: bad argument #1 (function expected, got ' .. type(condition) .. ')', 2)
+  end
   local t_end = timeout and now() + timeout - 1e-9
   while not condition() do
     if t_end and now() >= t_end then return false end
@@ -226,7 +317,11 @@ int SetUpState(lua_State* L) {
   if (luaL_loadbufferx(L, kThreadHelpers, sizeof kThreadHelpers - 1, "=sim", "t") != LUA_OK)
     lua_error(L);
   lua_getglobal(L, "sim");
-  lua_call(L, 1, 0);
+  lua_pushcfunction(L, [](lua_State* T) {
+    lua_pushboolean(T, lua_isyieldable(T));
+    return 1;
+  });
+  lua_call(L, 2, 0);
   // Lua's own math.random, reproducible per robot.
   lua_getglobal(L, LUA_MATHLIBNAME);
   lua_getfield(L, -1, "randomseed");
@@ -338,7 +433,9 @@ std::unique_ptr<ScriptState> NewState(World* world, int instance, RobotRuntime* 
   c.log_prefix = "[" + name + "] ";
   c.name = std::move(name);
   c.host_state = state.get();
-  lua_State* L = luaL_newstate();
+  state->memory.limit =
+      static_cast<size_t>(std::max<int64_t>(world->settings().script_memory_limit, 0));
+  lua_State* L = lua_newstate(LimitedAlloc, state.get());
   if (L == nullptr) throw Error(c.name + ": not enough memory for a Lua state");
   state->L = L;
   lua_atpanic(L, ThrowOnPanic);
@@ -490,8 +587,7 @@ void Cleanup(ScriptState* state) {
 
 size_t StateBytes(const ScriptState* state) {
   if (state == nullptr || state->L == nullptr) return 0;
-  return static_cast<size_t>(lua_gc(state->L, LUA_GCCOUNT)) * 1024 +
-         static_cast<size_t>(lua_gc(state->L, LUA_GCCOUNTB));
+  return state->memory.used;
 }
 
 // Slots of the objects outside any robot, hierarchy order (roots in slot

@@ -36,6 +36,9 @@ class PhaseTimer {
   std::chrono::steady_clock::time_point start_;
 };
 
+bool IsFinite(const Vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
 bool IsFinite(const Pose& X) {
   return std::isfinite(X.p.x) && std::isfinite(X.p.y) && std::isfinite(X.p.z) &&
          std::isfinite(X.q.w) && std::isfinite(X.q.x) && std::isfinite(X.q.y) &&
@@ -324,7 +327,8 @@ void World::Control(ScriptPass pass) {
 
 uint8_t World::PendingBits(const RobotRuntime& rt) {
   uint8_t bits = 0;
-  if (!rt.log.empty() || !rt.metrics.empty() || !rt.error.empty()) bits |= kPendingOutput;
+  if (!rt.log.empty() || !rt.metrics.empty() || !rt.error.empty() || !rt.disabled.empty())
+    bits |= kPendingOutput;
   if (!rt.deferred.empty()) bits |= kPendingDeferred;
   if (!rt.outbox.empty() || !rt.signal_writes.empty() || !rt.custom_data_writes.empty())
     bits |= kPendingMessages;
@@ -344,6 +348,8 @@ void World::FlushRobotBuffers() {
     rt.metrics.clear();
     if (!rt.error.empty() && first_error.empty()) first_error = rt.error;
     rt.error.clear();
+    for (std::string& why : rt.disabled) disabled_scripts_.push_back(std::move(why));
+    rt.disabled.clear();
   };
   for (size_t r = 0; r < runtimes_.size(); ++r) {
     if (!(pending_[r] & kPendingOutput)) continue;
@@ -431,16 +437,24 @@ void World::Physics() {
   }
   ++step_count_;
   time_ = static_cast<double>(step_count_) * settings_.time_step;
-  // NaNs out of physics are a user-visible error, not garbage in the outputs.
+  // NaNs and infinities out of physics are a user-visible error, not garbage
+  // in the outputs and the state hash: body poses and velocities, joints.
+  const auto non_finite = [&](uint32_t slot, const char* what) {
+    return Error("physics produced a non-finite " + std::string(what) + " for '" +
+                 scene_.PathOf(scene_.IdAt(slot)) + "' at step " + std::to_string(step_count_) +
+                 " (check masses, sizes and joint targets)");
+  };
   for (uint32_t row = 0; row < scene_.shapes().size(); ++row) {
     const uint32_t slot = scene_.shape_owners()[row];
     if (!scene_.shapes()[row].dynamic) continue;
-    const Pose& X = scene_.world_pose_at(slot);
-    if (!IsFinite(X))
-      throw Error("physics produced a non-finite pose for '" + scene_.PathOf(scene_.IdAt(slot)) +
-                  "' at step " + std::to_string(step_count_) +
-                  " (check masses, sizes and joint targets)");
+    if (!IsFinite(scene_.world_pose_at(slot))) throw non_finite(slot, "pose");
+    if (!IsFinite(scene_.linear_velocity_at(slot)) || !IsFinite(scene_.angular_velocity_at(slot)))
+      throw non_finite(slot, "velocity");
   }
+  const auto joints = scene_.joints();
+  for (uint32_t row = 0; row < joints.size(); ++row)
+    if (!std::isfinite(joints[row].position) || !std::isfinite(joints[row].velocity))
+      throw non_finite(scene_.joint_owners()[row], "joint position or velocity");
   RunPhaseCallbacks(kSwarmsimAfterPhysics);
 }
 

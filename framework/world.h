@@ -57,6 +57,9 @@ struct WorldSettings {
   // Lua instructions one non-threaded callback may run before it is stopped
   // with an error (0: no limit).
   int64_t instruction_budget = 100'000'000;
+  // Bytes of Lua memory one Lua state (a robot's scripts, the scene's, the
+  // main script) may hold before its script fails with an error (0: no limit).
+  int64_t script_memory_limit = int64_t{256} << 20;
   ScriptErrorPolicy on_script_error = ScriptErrorPolicy::kStop;
   // Sandbox (framework/lua_sandbox.cc): scripts may read files under
   // `directory` and write files under `output_directory` (the run's --out;
@@ -124,6 +127,7 @@ struct RobotRuntime {
   std::vector<MetricSample> metrics;    // samples recorded this step
   std::vector<DeferredWrite> deferred;  // writes to other robots' objects
   std::string error;                    // a script error in this phase
+  std::vector<std::string> disabled;    // scripts disabled this phase (disable_script), why
   std::vector<Message> outbox;          // messages sent this step
   std::vector<ReceivedMessage> inbox;   // messages delivered this step, sender-handle order
   // sim.setSignal/clearSignal writes (nullopt clears), applied at the next step.
@@ -208,6 +212,9 @@ class World {
   void WriteOutputs(const std::filesystem::path& dir) const;
   // Metric samples recorded since the last call, in (step, robot, order) order.
   std::vector<MetricSample> TakeMetrics();
+  // Scripts disabled under on_script_error: disable_script so far, each with
+  // its error (robot order within a step, then the scene's).
+  const std::vector<std::string>& disabled_scripts() const { return disabled_scripts_; }
   const PhaseTimes& phase_times() const { return phase_times_; }
 
   // --- For modules and the script host -----------------------------------------------
@@ -303,6 +310,7 @@ class World {
   std::vector<std::unique_ptr<Observer>> observers_;
   std::vector<std::pair<std::string, std::unique_ptr<CalculationModule>>> calculations_;
   std::vector<MetricSample> metrics_;
+  std::vector<std::string> disabled_scripts_;
   std::function<void(std::string_view)> log_sink_;
   PhaseTimes phase_times_{};
   std::vector<Message> messages_;

@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -15,12 +16,17 @@
 #include "modules/builtin.h"
 #include "modules/dynamics/box2d/box2d_backend.h"
 #include "modules/dynamics/ode/ode_backend.h"
+#include "swarm/loader_yaml.h"
 #include "swarm/runner.h"
 #include "swarm/world_loader.h"
 
 namespace swarmsim {
 
 namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char* kDefaultWorld = "worlds/diffusion.yaml";
 
 constexpr const char* kCsvHeader =
     "config,robots,threads,steps,wall_s,robot_ticks_per_s,us_sense,us_control,us_actuate,"
@@ -137,7 +143,55 @@ int RunBenchChild(const BenchOptions& options, const std::string& config, int ro
   return 0;
 }
 
-int RunBench(const BenchOptions& options, std::ostream& out, std::ostream& err) {
+std::string DefaultBenchWorld() {
+  // The source tree beside the program: build/swarmsim -> worlds/diffusion.yaml.
+  std::error_code ec;
+  const fs::path exe = fs::canonical("/proc/self/exe", ec);
+  if (!ec) {
+    const fs::path beside = exe.parent_path().parent_path() / kDefaultWorld;
+    if (fs::is_regular_file(beside, ec)) return loader::DisplayPath(beside);
+  }
+  // Else the current folder (a repository root).
+  if (fs::is_regular_file(kDefaultWorld, ec)) return kDefaultWorld;
+  return "";
+}
+
+std::string PrepareBench(BenchOptions* options) {
+  // The world: the one given, else the diffusion world found beside the program.
+  if (options->world.empty()) {
+    options->world = DefaultBenchWorld();
+    if (options->world.empty())
+      throw Error(std::string("bench: no --world given and the default world ") + kDefaultWorld +
+                  " was found neither beside the program nor in the current folder; pass "
+                  "--world FILE");
+  }
+  std::error_code ec;
+  if (!fs::is_regular_file(options->world, ec))
+    throw Error("bench: world file '" + options->world + "' not found");
+
+  // It must load with the robot count set through its `robots` parameter.
+  ModuleRegistry registry;
+  RegisterBuiltinModules(&registry);
+  LoadOptions load;
+  load.overrides = {{"robots", "1"}};
+  try {
+    const LoadedWorld loaded = LoadWorld(options->world, load, registry);
+    return loaded.world->settings().physics == "ode" ? "ode-only" : "box2d-only";
+  } catch (const Error&) {
+    // Tell a missing `robots` parameter from the file's own mistakes, which
+    // loading it as written reports (and throws).
+    const LoadedWorld as_written = LoadWorld(options->world, LoadOptions{}, registry);
+    if (!as_written.world->parameters().contains("robots"))
+      throw Error("bench: world '" + options->world +
+                  "' has no parameter 'robots'; bench sets the robot count through it "
+                  "(declare parameters: {robots: N} and use count: $robots in its models entry)");
+    throw;
+  }
+}
+
+int RunBench(BenchOptions options, std::ostream& out, std::ostream& err) {
+  // Everything that can be checked is, before the table's header.
+  const std::string bare = PrepareBench(&options);
   std::vector<BenchRow> rows;
   std::unique_ptr<std::ofstream> csv;
   if (options.csv) {
@@ -182,16 +236,7 @@ int RunBench(const BenchOptions& options, std::ostream& out, std::ostream& err) 
     return true;
   };
   bool ok = true;
-  // The bare-engine row matches the world's backend: ode-only for an ODE world.
-  std::string bare = "box2d-only";
-  {
-    ModuleRegistry registry;
-    RegisterBuiltinModules(&registry);
-    LoadOptions load;
-    load.overrides = {{"robots", "1"}};
-    if (LoadWorld(options.world, load, registry).world->settings().physics == "ode")
-      bare = "ode-only";
-  }
+  // The bare-engine row (`bare`) matches the world's backend: ode-only for an ODE world.
   for (int robots : options.robots) {
     for (int threads : options.threads) ok = measure("diffusion", robots, threads) && ok;
     ok = measure(bare, robots, 1) && ok;

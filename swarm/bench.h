@@ -10,7 +10,7 @@
 namespace swarmsim {
 
 struct BenchOptions {
-  std::string world = "worlds/diffusion.yaml";
+  std::string world;  // empty: worlds/diffusion.yaml (DefaultBenchWorld)
   std::vector<int> robots{100, 1000, 10000};
   std::vector<int> threads{1, 2};
   int64_t steps = 200;        // measured steps per configuration
@@ -32,10 +32,24 @@ struct BenchRow {
   double kb_per_robot = 0;
 };
 
+// The world `bench` measures without --world: worlds/diffusion.yaml of the
+// source tree the program was built in (build/swarmsim ->
+// ../worlds/diffusion.yaml), else of the current folder. Empty when neither
+// has it.
+std::string DefaultBenchWorld();
+
+// What `bench` checks before it prints anything: fills in the default world,
+// checks that the world loads and has the `robots` parameter the bench sets
+// the robot count through. Throws swarmsim::Error with a message a user can
+// act on. Returns the bare-engine row's configuration for the world's
+// backend: "box2d-only" or "ode-only".
+std::string PrepareBench(BenchOptions* options);
+
 // Runs every configuration, each in a fresh child process (clean peak memory,
 // no cache warmed by the previous one), prints the table to `out` and writes
-// the CSV. Returns the process exit code.
-int RunBench(const BenchOptions& options, std::ostream& out, std::ostream& err);
+// the CSV. Returns the process exit code; throws swarmsim::Error (before any
+// output) for a world PrepareBench rejects.
+int RunBench(BenchOptions options, std::ostream& out, std::ostream& err);
 
 // The child side: measures one configuration in this process and prints one
 // CSV row (no header) to `out`. `config` is "diffusion" or "box2d-only".

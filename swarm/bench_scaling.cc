@@ -47,6 +47,8 @@ int RunQuiet(const std::vector<std::string>& args) {
 }  // namespace
 
 int RunScalingBench(ScalingOptions o, std::ostream& out, std::ostream& err) {
+  // The world (default filled in, `robots` parameter) is checked before any output.
+  PrepareBench(&o.bench);
   const int cores = Cores();
   if (!o.threads_given) {
     o.bench.threads.clear();

@@ -3,8 +3,10 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <array>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <fstream>
 #include <iomanip>
@@ -28,8 +30,21 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// A CSV field (RFC 4180): quoted when it holds a comma, quote or line break.
+void WriteCsvField(std::ostream& os, std::string_view text) {
+  if (text.find_first_of(",\"\r\n") == std::string_view::npos) {
+    os << text;
+    return;
+  }
+  os << '"';
+  for (char ch : text) os << (ch == '"' ? "\"\"" : std::string_view(&ch, 1));
+  os << '"';
+}
+
 // Streams metric samples to metrics.csv in tidy (long) form, one row per
 // sample: step,time,robot,metric,value. `robot` is empty for swarm metrics.
+// Rows reach the file at least every second, so a run killed from outside
+// (a sweep's --timeout, the OOM killer) keeps all but the last second.
 class MetricsWriter {
  public:
   MetricsWriter(const std::filesystem::path& path, const World& world) : world_(world) {
@@ -37,19 +52,59 @@ class MetricsWriter {
     if (!file_) throw Error("cannot write '" + path.string() + "'");
     file_ << "step,time,robot,metric,value\n";
     file_ << std::setprecision(10);
+    file_.flush();
+    last_flush_ = Clock::now();
   }
   void Write(const std::vector<MetricSample>& samples) {
     for (const MetricSample& m : samples) {
       file_ << m.step << ',' << m.time << ',';
-      if (m.instance >= 0) file_ << world_.scene().instance(m.instance).name;
-      file_ << ',' << m.name << ',' << m.value << '\n';
+      if (m.instance >= 0) WriteCsvField(file_, world_.scene().instance(m.instance).name);
+      file_ << ',';
+      WriteCsvField(file_, m.name);
+      file_ << ',';
+      if (std::isnan(m.value))
+        file_ << "nan";  // not "-nan": one spelling for every reader
+      else
+        file_ << m.value;
+      file_ << '\n';
     }
+    if (!samples.empty() && Clock::now() - last_flush_ >= std::chrono::seconds(1)) Flush();
   }
-  void Flush() { file_.flush(); }
+  void Flush() {
+    file_.flush();
+    last_flush_ = Clock::now();
+  }
 
  private:
   const World& world_;
   std::ofstream file_;
+  Clock::time_point last_flush_;
+};
+
+// SIGINT, SIGTERM and SIGHUP end a run at the next step boundary, with its
+// outputs written; a second signal acts as usual (SA_RESETHAND).
+volatile std::sig_atomic_t g_stop_signal = 0;
+extern "C" void OnStopSignal(int sig) { g_stop_signal = sig; }
+
+class StopSignals {
+ public:
+  StopSignals() {
+    g_stop_signal = 0;
+    struct sigaction action {};
+    action.sa_handler = OnStopSignal;
+    action.sa_flags = SA_RESETHAND;
+    sigemptyset(&action.sa_mask);
+    for (size_t i = 0; i < kSignals.size(); ++i) sigaction(kSignals[i], &action, &saved_[i]);
+  }
+  ~StopSignals() {
+    for (size_t i = 0; i < kSignals.size(); ++i) sigaction(kSignals[i], &saved_[i], nullptr);
+  }
+  StopSignals(const StopSignals&) = delete;
+  StopSignals& operator=(const StopSignals&) = delete;
+
+ private:
+  static constexpr std::array<int, 3> kSignals = {SIGINT, SIGTERM, SIGHUP};
+  std::array<struct sigaction, 3> saved_{};
 };
 
 // A progress bar on a terminal; a plain line every 10% otherwise.
@@ -114,6 +169,7 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
   const auto start = Clock::now();
   const bool tty = isatty(STDERR_FILENO) && &progress_stream == &std::cerr;
   Progress progress(progress_stream, options.steps, !options.quiet, tty);
+  const StopSignals stop_signals;
   try {
     if (options.out_dir) {
       std::error_code ec;
@@ -126,6 +182,12 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
     world->Start();
     if (metrics) metrics->Write(world->TakeMetrics());
     for (int64_t i = 0; i < options.steps; ++i) {
+      if (const int sig = g_stop_signal; sig != 0) {
+        result.signal = sig;
+        throw Error(std::string("interrupted by SIG") + sigabbrev_np(sig) + " after " +
+                    std::to_string(result.steps) + " of " + std::to_string(options.steps) +
+                    " steps");
+      }
       world->Step();
       ++result.steps;
       if (metrics) metrics->Write(world->TakeMetrics());
@@ -182,6 +244,9 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
           << std::setw(10) << Fixed(1e3 * t, 1) << std::setw(10)
           << Fixed(robot_ticks > 0 ? 1e6 * t / robot_ticks : 0, 3) << "\n";
     }
+    if (const auto& disabled = world->disabled_scripts(); !disabled.empty())
+      out << "disabled scripts " << disabled.size()
+          << " (on_script_error: disable_script), first: " << disabled.front() << "\n";
   }
   if (options.print_hash) out << "state-hash: " << StateHasher::ToHex(result.state_hash) << "\n";
   out << std::flush;
@@ -191,7 +256,7 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
     j["swarmsim_version"] = Version();
     j["world"] = options.world_file;
     j["command"] = options.command_line;
-    j["status"] = result.ok ? "ok" : "error";
+    j["status"] = result.ok ? "ok" : result.signal != 0 ? "interrupted" : "error";
     if (!result.ok) j["error"] = result.error;
     j["seed"] = world->settings().seed;
     j["threads"] = world->threads();
@@ -207,6 +272,7 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
     j["peak_rss_mb"] = result.peak_rss_mb;
     j["lua_memory_kib"] = lua_kib;
     j["state_hash"] = StateHasher::ToHex(result.state_hash);
+    j["disabled_scripts"] = world->disabled_scripts();
     nlohmann::json phases;
     for (size_t p = 0; p < static_cast<size_t>(Phase::kCount); ++p)
       phases[ToString(static_cast<Phase>(p))] = world->phase_times()[p];

@@ -27,12 +27,15 @@ struct RunResult {
   double wall_seconds = 0;
   uint64_t state_hash = 0;
   double peak_rss_mb = 0;
+  int signal = 0;  // SIGINT/SIGTERM/SIGHUP that interrupted the run, else 0
 };
 
 // Steps `world` (starting it if needed), printing progress to `progress`
 // (a bar on a terminal, plain lines otherwise) and the summary to `out`.
 // Outputs are written as the run goes, so a failing run keeps everything up
-// to the failure; the summary records the error. Never throws for user errors.
+// to the failure; the summary records the error. SIGINT, SIGTERM and SIGHUP
+// during the run stop it at the next step boundary (status "interrupted",
+// outputs written, RunResult::signal set). Never throws for user errors.
 RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
                    std::ostream& progress);
 

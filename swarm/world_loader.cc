@@ -346,7 +346,8 @@ WorldSettings WorldLoader::ReadSimulation(const Fields& top, std::optional<int64
   if (sim.present()) {
     Fields f(*file_, sim, "'simulation'");
     f.Expect({"physics", "time_step", "physics_substeps", "seed", "duration", "steps", "gravity",
-              "octree_resolution", "main_script", "instruction_budget", "on_script_error"});
+              "octree_resolution", "main_script", "instruction_budget", "script_memory_mb",
+              "on_script_error"});
     if (f.Has("main_script")) {
       const Field main = f.Get("main_script");
       const std::string text = values.String(main);
@@ -355,6 +356,8 @@ WorldSettings WorldLoader::ReadSimulation(const Fields& top, std::optional<int64
     }
     if (f.Has("instruction_budget"))
       s.instruction_budget = values.Integer(f.Get("instruction_budget"), 0, int64_t{1} << 40);
+    if (f.Has("script_memory_mb"))
+      s.script_memory_limit = values.Integer(f.Get("script_memory_mb"), 0, int64_t{1} << 30) << 20;
     if (f.Has("on_script_error"))
       s.on_script_error =
           values.Choice(f.Get("on_script_error"), {"stop", "disable_script"}) == "stop"

@@ -192,6 +192,64 @@ TEST(ScriptControlTest, EndlessLoopBecomesAnErrorNamingRobotScriptAndLine) {
   EXPECT_CONTAINS(error, "[in sysCall_actuation of /bot#0/body]");
 }
 
+TEST(ScriptControlTest, WaitOutsideAThreadNamesTheCallersLine) {
+  ScriptWorld w;
+  w.AddRobot("bot#0", "function sysCall_actuation()\n  sim.wait(1)\nend\n");
+  EXPECT_CONTAINS(ErrorOf([&] { w.Steps(1); }),
+                  "bot#0: scripts/robot.lua:2: sim.wait: only a threaded script");
+}
+
+// --- Memory limit --------------------------------------------------------------------------
+
+TEST(ScriptControlTest, RunawayMemoryBecomesAnErrorNamingRobotScriptAndLine) {
+  WorldSettings settings;
+  settings.script_memory_limit = 4 << 20;
+  ScriptWorld w(1, settings);
+  w.AddRobot("bot#0",
+             "local t = {}\nfunction sysCall_actuation()\n  while true do\n"
+             "    t[#t + 1] = string.rep('x', 10000) .. #t\n  end\nend\n");
+  const std::string error = ErrorOf([&] { w.Steps(1); });
+  EXPECT_CONTAINS(error, "bot#0: scripts/robot.lua:4: the scripts hold more than 4 MiB");
+  EXPECT_CONTAINS(error, "simulation.script_memory_mb");
+  EXPECT_CONTAINS(error, "[in sysCall_actuation of /bot#0/body]");
+}
+
+TEST(ScriptControlTest, RunawayMemoryInAThreadIsCaughtToo) {
+  WorldSettings settings;
+  settings.script_memory_limit = 4 << 20;
+  ScriptWorld w(1, settings);
+  w.AddRobot("bot#0",
+             "function sysCall_thread()\n  local t = {}\n"
+             "  while true do t[#t + 1] = {1, 2, 3} end\nend\n");
+  const std::string error = ErrorOf([&] { w.Steps(2); });
+  EXPECT_CONTAINS(error, "bot#0: scripts/robot.lua:3: the scripts hold more than 4 MiB");
+  EXPECT_CONTAINS(error, "[in sysCall_thread of /bot#0/body]");
+}
+
+TEST(ScriptControlTest, OneAllocationPastTheLimitIsRefused) {
+  WorldSettings settings;
+  settings.script_memory_limit = 4 << 20;
+  ScriptWorld w(1, settings);
+  w.AddRobot("bot#0", "function sysCall_actuation() local s = string.rep('x', 1e8) end");
+  EXPECT_CONTAINS(ErrorOf([&] { w.Steps(1); }),
+                  "bot#0: an allocation would take the scripts past 4 MiB of Lua memory");
+}
+
+TEST(ScriptControlTest, GarbageAboveTheLimitIsCollectedNotAnError) {
+  WorldSettings settings;
+  settings.script_memory_limit = 2 << 20;
+  ScriptWorld w(1, settings);
+  // ~20 MB of short-lived strings a step, never more than ~100 KB alive.
+  w.AddRobot("bot#0", R"(
+    function sysCall_actuation()
+      for i = 1, 200 do local s = string.rep('y', 100000) .. i end
+      sim.recordMetric('done', 1)
+    end)");
+  w.Steps(5);
+  EXPECT_EQ(w.world().TakeMetrics().size(), 5u);
+  EXPECT_LT(w.world().script_memory_bytes(), size_t{2} << 20);
+}
+
 TEST(ScriptControlTest, StopPolicyEndsTheRunWithTheFaultyRobotNamed) {
   ScriptWorld w(2);
   for (int r = 0; r < 1000; ++r)

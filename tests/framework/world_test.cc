@@ -122,6 +122,29 @@ TEST(WorldTest, NonFinitePhysicsIsAnErrorNamingTheObject) {
   EXPECT_THROW(world.Step(), Error);  // no stepping on after a failure
 }
 
+TEST(WorldTest, JointRunningToInfinityIsAnErrorNamingTheJoint) {
+  const ModuleRegistry registry = MakeRegistry();
+  WorldSettings settings;
+  settings.physics = "null";
+  settings.time_step = 0.1;
+  World world(settings, registry);
+  JointData v;
+  v.mode = JointMode::kVelocity;
+  v.target_velocity = 1e308;  // finite, but its position overflows after ~18 steps
+  world.scene().AddJoint("wheel", {}, {}, v);
+  world.Start();
+  int steps = 0;
+  try {
+    for (; steps < 100; ++steps) world.Step();
+    FAIL() << "an infinite joint position was accepted";
+  } catch (const Error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("non-finite joint position"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("'/wheel'"), std::string::npos) << msg;
+  }
+  EXPECT_GT(steps, 10);
+}
+
 TEST(WorldTest, UnknownBackendAndBadSettingsAreErrors) {
   const ModuleRegistry registry = MakeRegistry();
   WorldSettings settings;

@@ -318,6 +318,25 @@ TEST(Box2dBackend, TractionIsLimitedByFriction) {
   EXPECT_NEAR(Position(duel, b.body).x, 0.25 + 0.085, 3e-3);
 }
 
+TEST(Box2dBackend, AbsurdWheelTargetsSaturateLikeLargeOnes) {
+  // The traction impulse is clipped to the friction limit; with a target of
+  // 1e200 m/s its square overflowed and the clip scaled it to zero: the
+  // robot stood still without a word. It must drive as with any target far
+  // above what the motor can reach.
+  auto run = [](double speed) {
+    Scene scene;
+    AddFloor(&scene);
+    Robot robot = AddRobot(&scene, "r", 0, 0, 0);
+    auto backend = Build(scene);
+    SetWheelSpeeds(&scene, robot, speed, speed);
+    Simulate(backend.get(), &scene, 1.0);
+    return Position(scene, robot.body).x;
+  };
+  const double large = run(1e3);
+  EXPECT_GT(large, 0.1);
+  EXPECT_EQ(run(1e200), large);
+}
+
 // Drives a robot at 0.1 m/s from (0.9 - offset, 0) with heading `yaw` into a
 // wall whose face is at x = 1 (yaw 0 faces the wall). Returns the final
 // position and the largest x seen.

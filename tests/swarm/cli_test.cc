@@ -19,15 +19,10 @@ namespace fs = std::filesystem;
 using Result = swarmsim::testing::CommandResult;
 using swarmsim::testing::RunProgram;
 
-std::string Data(const std::string& name) {
-  return std::string(SWARMSIM_SOURCE_DIR) + "/tests/data/cli/" + name;
-}
+std::string Data(const std::string& name) { return swarmsim::testing::CliData(name); }
 
 fs::path TempDir(const std::string& name) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("swarmsim_cli_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  return dir;
+  return swarmsim::testing::FreshTempDir("swarmsim_cli", name);
 }
 
 std::string HashOf(const std::string& output) {
@@ -51,8 +46,14 @@ TEST(CliTest, HelpVersionAndModules) {
 
 TEST(CliTest, UnknownFlagIsAClearErrorWithNonzeroExit) {
   Result r = RunProgram("run " + Data("ok.yaml") + " --stpes 10");
-  EXPECT_NE(r.exit_code, 0);
-  EXPECT_NE(r.output.find("--stpes"), std::string::npos) << r.output;
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("error: unknown option '--stpes' for 'run' (did you mean '--steps'?)"),
+            std::string::npos)
+      << r.output;
+  Result with_value = RunProgram("run " + Data("ok.yaml") + " --stpes=10");
+  EXPECT_NE(with_value.output.find("unknown option '--stpes' for 'run' (did you mean '--steps'?)"),
+            std::string::npos)
+      << with_value.output;
   Result bad_set = RunProgram("run " + Data("ok.yaml") + " --set robots");
   EXPECT_NE(bad_set.exit_code, 0);
   EXPECT_NE(bad_set.output.find("name=value"), std::string::npos) << bad_set.output;
@@ -68,6 +69,144 @@ TEST(CliTest, OutOfRangeNumbersAreClearErrors) {
   Result negative = RunProgram("run " + Data("ok.yaml") + " --steps -1");
   EXPECT_EQ(negative.exit_code, 2);
   EXPECT_NE(negative.output.find("must be >= 0"), std::string::npos) << negative.output;
+}
+
+TEST(CliTest, UnknownCommandSuggestsTheNearestAndListsThem) {
+  Result r = RunProgram("runn " + Data("ok.yaml"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("error: unknown command 'runn' (did you mean 'run'?)"), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("commands: run, bench, sweep"), std::string::npos) << r.output;
+}
+
+TEST(CliTest, WholeNumberOptionsSayWhatTheyExpect) {
+  Result r = RunProgram("run " + Data("ok.yaml") + " --steps 1e2");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("--steps: expected a whole number of steps, got '1e2'"),
+            std::string::npos)
+      << r.output;
+}
+
+TEST(CliTest, SeedOutsideZeroTo2To64Minus1IsRejected) {
+  for (const std::string seed : {"-1", "18446744073709551616", "1.5"}) {
+    Result r = RunProgram("run " + Data("ok.yaml") + " --steps 1 --quiet --seed " + seed);
+    EXPECT_EQ(r.exit_code, 2) << seed << ": " << r.output;
+    EXPECT_NE(r.output.find("--seed: expected a whole number from 0 to 18446744073709551615"),
+              std::string::npos)
+        << r.output;
+  }
+  Result largest =
+      RunProgram("run " + Data("ok.yaml") + " --steps 1 --quiet --seed 18446744073709551615");
+  EXPECT_EQ(largest.exit_code, 0) << largest.output;
+  // Decimal, as in the world file: 010 is ten, not octal eight.
+  const std::string run = "run " + Data("ok.yaml") + " --steps 3 --quiet --hash --seed ";
+  EXPECT_EQ(HashOf(RunProgram(run + "010").output), HashOf(RunProgram(run + "10").output));
+  EXPECT_NE(HashOf(RunProgram(run + "010").output), HashOf(RunProgram(run + "8").output));
+}
+
+TEST(CliTest, SetTakesOneNameEqualsValueEach) {
+  Result help = RunProgram("run --help");
+  EXPECT_NE(help.output.find("--set NAME=VALUE"), std::string::npos) << help.output;
+  EXPECT_EQ(help.output.find("--set TEXT"), std::string::npos) << help.output;
+  // Two values after one --set, with the world before them or after them.
+  for (const std::string& args :
+       {"run " + Data("ok.yaml") + " --steps 1 --set robots=2 bot.speed=0.1",
+        "run --steps 1 --set robots=2 bot.speed=0.1 " + Data("ok.yaml")}) {
+    Result r = RunProgram(args);
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(r.output.find("each --set takes one NAME=VALUE; repeat --set for more"),
+              std::string::npos)
+        << r.output;
+  }
+  Result repeated = RunProgram("run " + Data("ok.yaml") +
+                               " --steps 1 --quiet --set robots=2 --set bot.speed=0.1");
+  EXPECT_EQ(repeated.exit_code, 0) << repeated.output;
+}
+
+TEST(CliTest, EmptyOutIsRejected) {
+  Result r = RunProgram("run " + Data("ok.yaml") + " --steps 1 --quiet --out ''");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--out: expected a folder"), std::string::npos) << r.output;
+}
+
+TEST(CliTest, DurationIsWholeStepsAndNotLessThanOne) {
+  // ok.yaml steps 0.1 s.
+  Result short_run = RunProgram("run " + Data("ok.yaml") + " --duration 0.01");
+  EXPECT_EQ(short_run.exit_code, 2) << short_run.output;
+  EXPECT_NE(short_run.output.find("--duration 0.01 s is shorter than one time step (0.1 s)"),
+            std::string::npos)
+      << short_run.output;
+  // Not a multiple: the nearest whole number of steps, as --help says.
+  const fs::path out = TempDir("duration");
+  Result r =
+      RunProgram("run " + Data("ok.yaml") + " --duration 0.26 --quiet --out " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream summary_file(out / "summary.json");
+  ASSERT_TRUE(summary_file.good());
+  EXPECT_EQ(nlohmann::json::parse(summary_file)["steps"], 3);
+  EXPECT_NE(
+      RunProgram("run --help").output.find("rounded to the nearest whole number of time steps"),
+      std::string::npos);
+  fs::remove_all(out);
+}
+
+TEST(CliTest, BenchFindsItsWorldFromAnyFolder) {
+  // Without --world: worlds/diffusion.yaml beside the program, not in the current folder.
+  const fs::path elsewhere = TempDir("bench_elsewhere");
+  fs::create_directories(elsewhere);
+  Result r = swarmsim::testing::RunCommand("cd " + elsewhere.string() + " && " + SWARMSIM_BINARY +
+                                           " bench --robots 2 --threads 1 --steps 1");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("worlds/diffusion.yaml"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("box2d-only"), std::string::npos) << r.output;
+  fs::remove_all(elsewhere);
+}
+
+TEST(CliTest, BenchChecksItsWorldBeforeTheTable) {
+  Result missing = RunProgram("bench --world /nonexistent/world.yaml --robots 2 --steps 1");
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_NE(missing.output.find("world file '/nonexistent/world.yaml' not found"),
+            std::string::npos)
+      << missing.output;
+  EXPECT_EQ(missing.output.find("ticks/s"), std::string::npos) << missing.output;
+
+  // A world whose robot count is not the `robots` parameter.
+  const fs::path dir = TempDir("bench_no_robots");
+  fs::create_directories(dir);
+  const fs::path world = dir / "fixed_count.yaml";
+  std::ofstream(world) << "simulation: {physics: box2d, time_step: 0.1, physics_substeps: 5}\n"
+                       << "arena: {size: 3}\n"
+                       << "models:\n"
+                       << "  - model: " << Data("bot.yaml") << "\n"
+                       << "    count: 4\n"
+                       << "    distribute: {region: arena}\n";
+  for (const std::string mode : {"", " --scaling"}) {
+    Result r =
+        RunProgram("bench --world " + world.string() + " --robots 50 --threads 1 --steps 1" + mode);
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(r.output.find("has no parameter 'robots'; bench sets the robot count through it"),
+              std::string::npos)
+        << r.output;
+    EXPECT_NE(r.output.find("count: $robots"), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("robots=1"), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("ticks/s"), std::string::npos) << r.output;
+  }
+  fs::remove_all(dir);
+}
+
+TEST(CliTest, BenchThreadsAreCheckedLikeRun) {
+  const std::string expected = "--threads: expected a whole number from 1 to 1024, got '0'";
+  Result run = RunProgram("run " + Data("ok.yaml") + " --steps 1 --threads 0");
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.output.find(expected), std::string::npos) << run.output;
+  Result bench =
+      RunProgram("bench --world " + Data("ok.yaml") + " --robots 2 --steps 1 --threads 0");
+  EXPECT_EQ(bench.exit_code, 2) << bench.output;
+  EXPECT_NE(bench.output.find(expected), std::string::npos) << bench.output;
+  Result negative =
+      RunProgram("bench --world " + Data("ok.yaml") + " --robots 2 --steps 1 --threads 1,-1");
+  EXPECT_EQ(negative.exit_code, 2) << negative.output;
+  EXPECT_NE(negative.output.find("got '-1'"), std::string::npos) << negative.output;
 }
 
 TEST(CliTest, MissingWorldFileIsNamed) {

@@ -2,9 +2,11 @@
 #pragma once
 
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
 #include <cstdio>
+#include <filesystem>
 #include <string>
 
 namespace swarmsim::testing {
@@ -29,6 +31,20 @@ inline CommandResult RunCommand(const std::string& command) {
 // `build/swarmsim ARGS` (the binary this test tree was built with).
 inline CommandResult RunProgram(const std::string& args) {
   return RunCommand(std::string(SWARMSIM_BINARY) + " " + args);
+}
+
+// tests/data/cli/NAME in the source tree.
+inline std::string CliData(const std::string& name) {
+  return std::string(SWARMSIM_SOURCE_DIR) + "/tests/data/cli/" + name;
+}
+
+// An empty folder path under the temporary folder, unique to this process
+// (`prefix`_`name`_pid); whatever was there is removed.
+inline std::filesystem::path FreshTempDir(const std::string& prefix, const std::string& name) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                    (prefix + "_" + name + "_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  return dir;
 }
 
 }  // namespace swarmsim::testing

@@ -520,7 +520,9 @@ bool SolveWheelsPass(PlaneWheel* first, PlaneWheel* last, double dt, TractionSol
     const double limit = wheel->coulomb_rate * dt;
     const double norm2 = ax * ax + ay * ay;
     if (norm2 > limit * limit) {
-      const double k = limit / std::sqrt(norm2);
+      // hypot when the square overflowed (absurd targets, e.g. 1e200 rad/s):
+      // still saturate, rather than scale by limit / inf = 0 and stall.
+      const double k = limit / (std::isfinite(norm2) ? std::sqrt(norm2) : std::hypot(ax, ay));
       ax *= k;
       ay *= k;
     }

@@ -1,0 +1,149 @@
+// What `swarmsim run --out` leaves behind, also when a run is cut short:
+// metrics.csv as proper CSV, written as the run goes; summary.json with the
+// scripts that were disabled and the signal that stopped the run.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "tests/swarm/run_program.h"
+
+extern char** environ;
+
+namespace {
+
+namespace fs = std::filesystem;
+using swarmsim::testing::RunProgram;
+
+std::string Data(const std::string& name) { return swarmsim::testing::CliData(name); }
+
+fs::path TempDir(const std::string& name) {
+  return swarmsim::testing::FreshTempDir("swarmsim_outputs", name);
+}
+
+std::string ReadFile(const fs::path& path) {
+  std::ifstream f(path);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+std::vector<std::string> Lines(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+TEST(RunOutputsTest, MetricNamesAreCsvQuotedAndNanIsSpelledNan) {
+  const fs::path out = TempDir("csv");
+  const auto r =
+      RunProgram("run " + Data("outputs.yaml") + " --steps 2 --quiet --out " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::vector<std::string> lines = Lines(ReadFile(out / "metrics.csv"));
+  ASSERT_EQ(lines.size(), 1u + 2 * 3 * 2) << "header + 2 steps x 3 robots x 2 metrics";
+  EXPECT_EQ(lines[0], "step,time,robot,metric,value");
+  // Step 0 is the first control step (t = 0); robot outputs#0's two samples.
+  EXPECT_EQ(lines[1], "0,0,outputs#0,\"a,b\"\"c\",0");
+  EXPECT_EQ(lines[2], "0,0,outputs#0,undefined,nan");
+  fs::remove_all(out);
+}
+
+TEST(RunOutputsTest, DisabledScriptsAreReportedInTheSummary) {
+  const fs::path out = TempDir("disabled");
+  const auto r = RunProgram("run " + Data("outputs.yaml") + " --steps 6 --out " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("disabled scripts 1 (on_script_error: disable_script), first: "
+                          "outputs#1: "),
+            std::string::npos)
+      << r.output;
+  const auto summary = nlohmann::json::parse(ReadFile(out / "summary.json"));
+  EXPECT_EQ(summary["status"], "ok");
+  ASSERT_EQ(summary["disabled_scripts"].size(), 1u) << summary.dump(2);
+  const std::string why = summary["disabled_scripts"][0];
+  EXPECT_NE(why.find("outputs#1: "), std::string::npos) << why;
+  EXPECT_NE(why.find("outputs.lua:13: robot one gives up"), std::string::npos) << why;
+  fs::remove_all(out);
+}
+
+// A run stopped by SIGTERM (a sweep's timeout, a batch system, Ctrl-C's
+// SIGINT alike) ends at a step boundary with everything written, and exits
+// 128 + 15 as a shell expects.
+// Spawns `swarmsim ARGS...` without waiting; returns its pid.
+pid_t Spawn(std::vector<std::string> args) {
+  args.insert(args.begin(), SWARMSIM_BINARY);
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  if (posix_spawn(&pid, argv[0], nullptr, nullptr, argv.data(), environ) != 0) return -1;
+  return pid;
+}
+
+// Waits (for a condition, not a time) until metrics.csv holds rows beyond
+// its header; returns its size then (0 if it never did within two minutes).
+size_t WaitForRows(const fs::path& csv) {
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (std::chrono::steady_clock::now() < give_up) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    const std::string text = ReadFile(csv);
+    if (Lines(text).size() > 1) return text.size();
+  }
+  return 0;
+}
+
+// A slow run with sparse rows (one ~40-byte row a step, a step taking
+// milliseconds): rows must reach the file while it is far smaller than a
+// stream buffer, i.e. flushed by time, not when a buffer fills.
+TEST(RunOutputsTest, SparseMetricsReachTheFileWhileTheRunGoesOn) {
+  const fs::path out = TempDir("sparse");
+  const pid_t pid = Spawn({"run", Data("outputs.yaml"), "--set", "outputs.slow=1", "--steps",
+                           "1000000000", "--out", out.string(), "--quiet"});
+  ASSERT_GT(pid, 0);
+  const size_t size = WaitForRows(out / "metrics.csv");
+  kill(pid, SIGKILL);  // as a sweep's --timeout does: nothing gets written after this
+  waitpid(pid, nullptr, 0);
+  EXPECT_GT(size, 0u) << "no rows reached metrics.csv while the run went on";
+  EXPECT_LT(size, 4096u) << "rows arrived only when a buffer filled";
+  fs::remove_all(out);
+}
+
+TEST(RunOutputsTest, TerminatedRunKeepsItsOutputsAndSaysSo) {
+  const fs::path out = TempDir("sigterm");
+  const pid_t pid = Spawn(
+      {"run", Data("outputs.yaml"), "--steps", "1000000000", "--out", out.string(), "--quiet"});
+  ASSERT_GT(pid, 0);
+  EXPECT_GT(WaitForRows(out / "metrics.csv"), 0u) << "the run never got going";
+
+  ASSERT_EQ(kill(pid, SIGTERM), 0);
+  int status = 0;
+  ASSERT_EQ(waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status);
+  EXPECT_EQ(WEXITSTATUS(status), 128 + SIGTERM);
+
+  const auto summary = nlohmann::json::parse(ReadFile(out / "summary.json"));
+  EXPECT_EQ(summary["status"], "interrupted");
+  const std::string error = summary["error"];
+  EXPECT_EQ(error.rfind("interrupted by SIGTERM after ", 0), 0u) << error;
+  const int64_t steps = summary["steps"];
+  EXPECT_GT(steps, 0);
+  const std::string metrics = ReadFile(out / "metrics.csv");
+  ASSERT_FALSE(metrics.empty());
+  EXPECT_EQ(metrics.back(), '\n') << "the last row is complete";
+  // Every completed step's rows are there: robots 0 and 2 record 2 metrics
+  // a step throughout; robot 1 until its script is disabled at t = 0.3.
+  EXPECT_GE(Lines(metrics).size(), 1u + static_cast<size_t>(steps) * 4);
+  fs::remove_all(out);
+}
+
+}  // namespace
