@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstring>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "framework/error.h"
@@ -80,10 +81,57 @@ const ApiTables& Tables() {
   return tables;
 }
 
+// sim.wait and sim.waitUntil, in Lua over sim.step (threaded scripts only).
+// Loaded into a state when a script first looks either up: most robots never
+// do, and the chunk's functions and strings would cost each ~1.5 KB.
+constexpr char kThreadHelpers[] = R"(local sim, yieldable = ...
+local step, now = sim.step, sim.getSimulationTime
+local function threaded(name)  -- errors name the caller's line, not this chunk's
+  if not yieldable() then
+    error(name .. ': only a threaded script (sysCall_thread) can wait', 3)
+  end
+end
+function sim.wait(seconds)
+  threaded('sim.wait')
+  if type(seconds) ~= 'number' then
+    error('sim.wait: bad argument #1 (number expected, got ' .. type(seconds) .. ')', 2)
+  end
+  local t_end = now() + seconds - 1e-9
+  while now() < t_end do step() end
+end
+function sim.waitUntil(condition, timeout)
+  threaded('sim.waitUntil')
+  if type(condition) ~= 'function' then
+    error('sim.waitUntil: bad argument #1 (function expected, got ' .. type(condition) .. ')', 2)
+  end
+  local t_end = timeout and now() + timeout - 1e-9
+  while not condition() do
+    if t_end and now() >= t_end then return false end
+    step()
+  end
+  return true
+end
+)";
+
+int IsYieldable(lua_State* L) {
+  lua_pushboolean(L, lua_isyieldable(L));
+  return 1;
+}
+
 // __index of a robot's `sim` table: fetch the entry, keep it in the table.
 int LazySimIndex(lua_State* L) {
   if (lua_type(L, 2) != LUA_TSTRING) return 0;
   const std::string_view key = lua_tostring(L, 2);
+  if (key == "wait" || key == "waitUntil") {  // kThreadHelpers defines both
+    if (luaL_loadbufferx(L, kThreadHelpers, sizeof kThreadHelpers - 1, "=sim", "t") != LUA_OK)
+      lua_error(L);
+    lua_pushvalue(L, 1);
+    lua_pushcfunction(L, IsYieldable);
+    lua_call(L, 2, 0);
+    lua_pushvalue(L, 2);
+    lua_rawget(L, 1);
+    return 1;
+  }
   const std::vector<SimEntry>& entries = Tables().sim;
   auto it = std::lower_bound(entries.begin(), entries.end(), key,
                              [](const SimEntry& e, std::string_view k) { return e.name < k; });
@@ -196,6 +244,17 @@ void PushNumberArray(lua_State* L, const double* v, int n) {
   for (int i = 0; i < n; ++i) {
     lua_pushnumber(L, v[i]);
     lua_rawseti(L, -2, i + 1);
+  }
+}
+
+void PushParamValue(lua_State* L, const ParamValue& value) {
+  if (const double* d = std::get_if<double>(&value)) {
+    PushValueNumber(L, *d);
+  } else if (const bool* b = std::get_if<bool>(&value)) {
+    lua_pushboolean(L, *b);
+  } else {
+    const std::string& s = std::get<std::string>(value);
+    lua_pushlstring(L, s.data(), s.size());
   }
 }
 

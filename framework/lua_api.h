@@ -23,6 +23,7 @@
 #include <string_view>
 
 #include "framework/handle.h"
+#include "framework/parameters.h"
 #include "lua.hpp"
 
 namespace swarmsim {
@@ -56,7 +57,13 @@ struct LuaContext {
   bool is_main = false;         // the main script's state
   bool in_sensing = false;      // running a sysCall_sensing (sim.handleChildScript follows it)
   int64_t slice_fires = 0;      // time-slice hook calls since the thread was resumed
-  std::string pending_error;    // a World error raised through the main script, verbatim
+  lua_State* thread = nullptr;  // the script thread being resumed, else null
+  // The running callback (or thread resume) used up its instruction budget:
+  // every further instruction raises budget_error, and the host reports it.
+  bool budget_exhausted = false;
+  bool slice_yielded = false;  // the thread being resumed yielded from its time-slice hook
+  std::string budget_error;    // "file:line: the callback ran more than ..."
+  std::string pending_error;   // a World error raised through the main script, verbatim
 };
 
 inline LuaContext& Context(lua_State* L) {
@@ -120,6 +127,22 @@ ObjectId OptRelativeTo(lua_State* L, int arg);
 
 // Pushes a new array {v[0], ..., v[n-1]}.
 void PushNumberArray(lua_State* L, const double* v, int n);
+
+// Pushes a number a script gave as a value (a parameter, a signal, an
+// argument of sim.handleChildScripts), stored as a double: integral and
+// within +-2^53 (exact in a double) as a Lua integer, so 10 stays 10 and
+// '/st#' .. (i % n) reads '/st#3', not '/st#3.0'; otherwise as a float.
+inline void PushValueNumber(lua_State* L, double value) {
+  constexpr double kMaxExactInteger = 9007199254740992.0;  // 2^53
+  // NaN fails the range test; a cast back detects a fractional part.
+  if (value >= -kMaxExactInteger && value <= kMaxExactInteger &&
+      static_cast<double>(static_cast<lua_Integer>(value)) == value)
+    lua_pushinteger(L, static_cast<lua_Integer>(value));
+  else
+    lua_pushnumber(L, value);
+}
+// Pushes a parameter or signal value: number (PushValueNumber), boolean or string.
+void PushParamValue(lua_State* L, const ParamValue& value);
 
 // Each API area adds its functions to the `sim` table on top of the stack
 // (and, for base-library replacements such as print, to the globals).

@@ -9,8 +9,11 @@
 //                                        `range` m of the sender (optionally
 //                                        only those no static shape hides)
 //   sim.receiveMessage() -> data, sender, distance, bearing  (nil when done)
+// The world's main script has no object: its messages come from
+// sim.handle_world, without distance or bearing, and it cannot send by range.
 // Signals (scene-wide; a value set in step t is seen from step t+1; the last
-// writer in robot order wins): sim.setSignal, sim.getSignal, sim.clearSignal.
+// writer in robot order wins; integral numbers read back as integers):
+// sim.setSignal, sim.getSignal, sim.clearSignal.
 // Packing numbers into message strings: sim.packFloats / unpackFloats
 // (float32), packDoubles / unpackDoubles, packInt32s / unpackInt32s,
 // packTable / unpackTable (nested tables of numbers, strings, booleans).
@@ -69,6 +72,9 @@ int SendDirectMessage(lua_State* L) {
   return 0;
 }
 int SendRangeMessage(lua_State* L) {
+  if (Context(L).script_object.IsNull())
+    throw Error(
+        "the main script has no position: use sim.sendGlobalMessage or sim.sendDirectMessage");
   std::string data = CheckData(L, 1);
   const double range = ArgNumber(L, 2);
   if (!(range >= 0) || !std::isfinite(range))
@@ -91,7 +97,7 @@ int ReceiveMessage(lua_State* L) {
                                          : m.sender == c.script_object)
       continue;
     lua_pushlstring(L, m.data.data(), m.data.size());
-    lua_pushinteger(L, m.sender.ToInteger());
+    lua_pushinteger(L, m.sender.IsNull() ? kHandleWorld : m.sender.ToInteger());
     if (!r.has_geometry) return 2;
     lua_pushnumber(L, r.distance);
     lua_pushnumber(L, r.bearing);
@@ -135,13 +141,7 @@ int GetSignal(lua_State* L) {
     lua_pushnil(L);
     return 1;
   }
-  if (const double* d = std::get_if<double>(&it->second))
-    lua_pushnumber(L, *d);
-  else if (const bool* b = std::get_if<bool>(&it->second))
-    lua_pushboolean(L, *b);
-  else
-    lua_pushlstring(L, std::get<std::string>(it->second).data(),
-                    std::get<std::string>(it->second).size());
+  PushParamValue(L, it->second);  // integral numbers as Lua integers
   return 1;
 }
 

@@ -2,7 +2,6 @@
 // identity, and print.
 #include <string>
 #include <string_view>
-#include <variant>
 
 #include "framework/error.h"
 #include "framework/lua_api.h"
@@ -30,8 +29,9 @@ int Random(lua_State* L) {
   return 1;
 }
 
-// sim.getParam(name [, default]) -> number, boolean or string: the robot's
-// model parameter, else the world parameter, else the default.
+// sim.getParam(name [, default]) -> number (an integer if integral), boolean
+// or string: the robot's model parameter, else the world parameter, else the
+// default.
 int GetParam(lua_State* L) {
   const LuaContext& c = Context(L);
   size_t length = 0;
@@ -45,14 +45,7 @@ int GetParam(lua_State* L) {
     throw Error("no parameter '" + std::string(name, length) +
                 "': set it in the world's or the model's parameters, or give a default");
   }
-  if (const double* d = std::get_if<double>(value))
-    lua_pushnumber(L, *d);
-  else if (const bool* b = std::get_if<bool>(value))
-    lua_pushboolean(L, *b);
-  else {
-    const std::string& s = std::get<std::string>(*value);
-    lua_pushlstring(L, s.data(), s.size());
-  }
+  PushParamValue(L, *value);  // integral numbers as Lua integers
   return 1;
 }
 

@@ -10,8 +10,11 @@
 // Everything else (os.execute, io.popen, package.loadlib, debug, dofile,
 // loadfile, binary chunks) raises "file:line: os.execute is not allowed
 // ...". --trust-scripts (WorldSettings::trust_scripts) opens the full
-// standard libraries instead.
+// standard libraries instead, with the same folders: require searches the
+// world's folders before Lua's path, and relative paths in io.open/io.lines
+// start in the world's folder (reading) or the output folder (writing).
 #include <algorithm>
+#include <array>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -154,12 +157,35 @@ std::string CheckedPath(lua_State* L, const char* function, const std::string& t
   return path.string();
 }
 
-// io.open(path [, mode]): the original, on a checked path.
-int SafeOpen(lua_State* L) {
+// The file `text` names for a trusted script: like the sandbox, a relative
+// path starts in the world's folder (reading) or the output folder
+// (writing); an absolute one, or '..', goes anywhere.
+std::string TrustedPath(lua_State* L, const char* function, const std::string& text, bool write) {
+  if (text.empty() || fs::path(text).is_absolute()) return text;
+  const WorldSettings& settings = Context(L).world->settings();
+  const fs::path& root = write ? settings.output_directory : settings.directory;
+  if (root.empty()) {
+    if (write)
+      RaiseError(L, std::string(function) + ": cannot write '" + text +
+                        "': the run has no output folder (swarmsim run --out DIR)");
+    return text;
+  }
+  return (root / text).string();
+}
+
+// The path io.open / io.lines hand to Lua's: checked (sandbox) or resolved (trusted).
+template <bool kTrusted>
+std::string ScriptPath(lua_State* L, const char* function, const std::string& text, bool write) {
+  return kTrusted ? TrustedPath(L, function, text, write) : CheckedPath(L, function, text, write);
+}
+
+// io.open(path [, mode]): the original, on a checked (resolved) path.
+template <bool kTrusted>
+int OpenFile(lua_State* L) {
   const std::string text = ArgString(L, 1);
   const std::string mode = lua_isnoneornil(L, 2) ? "r" : ArgString(L, 2);
   const bool write = mode != "r" && mode != "rb";
-  const std::string path = CheckedPath(L, "io.open", text, write);
+  const std::string path = ScriptPath<kTrusted>(L, "io.open", text, write);
   lua_settop(L, 0);
   lua_pushvalue(L, lua_upvalueindex(1));
   lua_pushstring(L, path.c_str());
@@ -168,12 +194,16 @@ int SafeOpen(lua_State* L) {
   return lua_gettop(L);
 }
 
-// io.lines(path, ...): reading only, never standard input.
-int SafeLines(lua_State* L) {
-  if (lua_isnoneornil(L, 1)) Refuse(L, "io.lines() on standard input");
-  const std::string path = CheckedPath(L, "io.lines", ArgString(L, 1), false);
-  lua_pushstring(L, path.c_str());
-  lua_replace(L, 1);
+// io.lines(path, ...): reading only; standard input for trusted scripts only.
+template <bool kTrusted>
+int LinesOfFile(lua_State* L) {
+  if (!lua_isnoneornil(L, 1)) {
+    const std::string path = ScriptPath<kTrusted>(L, "io.lines", ArgString(L, 1), false);
+    lua_pushstring(L, path.c_str());
+    lua_replace(L, 1);
+  } else if (!kTrusted) {
+    Refuse(L, "io.lines() on standard input");
+  }
   lua_pushvalue(L, lua_upvalueindex(1));
   lua_insert(L, 1);
   if (lua_pcall(L, lua_gettop(L) - 1, LUA_MULTRET, 0) != LUA_OK) throw LuaErrorOnStack{};
@@ -183,6 +213,13 @@ int SafeLines(lua_State* L) {
 // Registry key of a state's table of required modules.
 const char kModulesKey = 0;
 const char kLoadingSentinel = 0;
+
+// The folders require searches, in order: the world's folder, its scripts/
+// folder, the scripts/ folder beside it.
+std::array<fs::path, 3> ModuleFolders(lua_State* L) {
+  const fs::path world = Canonical(fs::absolute(Context(L).world->settings().directory));
+  return {world, world / "scripts", world.parent_path() / "scripts"};
+}
 
 // require(name): a Lua module (name.lua, dots for folders) from the world's
 // folder, then its scripts/ folder, then the scripts/ folder beside it. Run
@@ -211,9 +248,8 @@ int SafeRequire(lua_State* L) {
   std::string relative = name;
   std::replace(relative.begin(), relative.end(), '.', '/');
   relative += ".lua";
-  const fs::path world = Canonical(fs::absolute(Context(L).world->settings().directory));
   std::string searched;
-  for (const fs::path& root : {world, world / "scripts", world.parent_path() / "scripts"}) {
+  for (const fs::path& root : ModuleFolders(L)) {
     const fs::path candidate = root / relative;
     searched += "\n\t" + candidate.string();
     std::error_code ec;
@@ -262,10 +298,10 @@ int SandboxGlobalIndex(lua_State* L) {
     luaL_requiref(L, LUA_IOLIBNAME, luaopen_io, 0);
     NewRestrictedTable(L, "io", 4);
     lua_getfield(L, -2, "open");
-    lua_pushcclosure(L, Guarded<SafeOpen, "io.open">, 1);
+    lua_pushcclosure(L, Guarded<OpenFile<false>, "io.open">, 1);
     lua_setfield(L, -2, "open");
     lua_getfield(L, -2, "lines");
-    lua_pushcclosure(L, Guarded<SafeLines, "io.lines">, 1);
+    lua_pushcclosure(L, Guarded<LinesOfFile<false>, "io.lines">, 1);
     lua_setfield(L, -2, "lines");
     for (const char* kept : {"type", "close"}) {
       lua_getfield(L, -2, kept);
@@ -297,11 +333,37 @@ int SandboxGlobalIndex(lua_State* L) {
   return 1;
 }
 
+// Trusted scripts: Lua's full libraries, but found where sandboxed scripts
+// find them: require searches the world's folders before Lua's path, and
+// io.open / io.lines take relative paths from the world's folder (reading)
+// or the output folder (writing).
+void OpenTrusted(lua_State* L) {
+  luaL_openlibs(L);
+  lua_getglobal(L, LUA_LOADLIBNAME);
+  std::string path;
+  for (const fs::path& root : ModuleFolders(L))
+    path += (root / (LUA_PATH_MARK ".lua")).string() + LUA_PATH_SEP;
+  lua_getfield(L, -1, "path");
+  if (const char* lua_path = lua_tostring(L, -1)) path += lua_path;
+  lua_pop(L, 1);
+  lua_pushlstring(L, path.data(), path.size());
+  lua_setfield(L, -2, "path");
+  lua_pop(L, 1);
+  lua_getglobal(L, LUA_IOLIBNAME);
+  lua_getfield(L, -1, "open");
+  lua_pushcclosure(L, Guarded<OpenFile<true>, "io.open">, 1);
+  lua_setfield(L, -2, "open");
+  lua_getfield(L, -1, "lines");
+  lua_pushcclosure(L, Guarded<LinesOfFile<true>, "io.lines">, 1);
+  lua_setfield(L, -2, "lines");
+  lua_pop(L, 1);
+}
+
 }  // namespace
 
 void OpenSandbox(lua_State* L) {
   if (Context(L).world != nullptr && Context(L).world->settings().trust_scripts) {
-    luaL_openlibs(L);
+    OpenTrusted(L);
     return;
   }
   OpenSafeLibraries(L);

@@ -16,8 +16,13 @@
 // time slice runs out: a count hook that yields, so the slice is a number of
 // Lua instructions (kInstructionsPerMs per millisecond of
 // sim.setThreadSwitchTiming) and results do not depend on machine speed.
+// Only the script's thread itself is yielded: a coroutine the script makes
+// inherits the hook but runs under the instruction budget instead.
 // Every non-threaded callback runs under an instruction budget (count hook
-// that raises an error).
+// that raises an error); explicit scripts run on their caller's. Once a
+// callback used up its budget every further instruction raises again, so
+// pcall cannot catch it, and the host reports the budget error whatever
+// error value the callback returns.
 #include "framework/script_host.h"
 
 #include <algorithm>
@@ -60,19 +65,21 @@ const char kEnvironmentMetatableKey = 0;
 struct Script {  // 88 bytes
   uint32_t slot = 0;
   ObjectId object;
-  const ScriptSource* source = nullptr;
   int env_ref = LUA_NOREF;  // environment table, in the registry
+  const ScriptSource* source = nullptr;
   int callbacks[kCallbackCount] = {LUA_NOREF, LUA_NOREF, LUA_NOREF,
                                    LUA_NOREF, LUA_NOREF, LUA_NOREF};
   bool initialized = false;        // sysCall_init returned: sysCall_cleanup is due
   bool explicit_handling = false;  // runs only through sim.handleChildScript
   bool disabled = false;           // failed under on_script_error: disable_script
   bool running = false;            // inside a call (no re-entry through handleChildScript)
+  bool slice_yielded = false;      // the thread's last yield was its time slice's (SliceHook)
   lua_State* thread = nullptr;     // sysCall_thread's coroutine, while it runs
   int thread_ref = LUA_NOREF;      // keeps `thread` alive, in the registry
   int slice_instructions = kDefaultSliceInstructions;
   ScriptMailbox mailbox;
 };
+static_assert(sizeof(Script) == 88);
 
 // What a Lua state holds, against simulation.script_memory_limit. Past the
 // limit an allocation still succeeds (up to kMemorySlack more) but arms a
@@ -149,45 +156,83 @@ std::string HookWhere(lua_State* L, lua_Debug* ar) {
   return std::string(ar->short_src) + ":" + std::to_string(ar->currentline) + ": ";
 }
 
-// Count hook of non-threaded callbacks: the budget is used up.
-void BudgetHook(lua_State* L, lua_Debug* ar) {
-  {  // the message is on the Lua stack, and destroyed, before the longjmp
-    const std::string message =
-        HookWhere(L, ar) + "the callback ran more than " +
-        std::to_string(Context(L).world->settings().instruction_budget) +
-        " Lua instructions without returning (an endless loop?); if the work is real, raise "
-        "simulation.instruction_budget";
-    lua_pushlstring(L, message.data(), message.size());
-  }
+// The lua_State the host called or resumed for the running callback: the
+// script's thread, or the state's main thread.
+lua_State* RootOf(const LuaContext& c) {
+  return c.thread != nullptr ? c.thread : static_cast<const ScriptState*>(c.host_state)->L;
+}
+
+// Count hook once the running callback has used up its budget: every further
+// instruction raises again, so pcall and xpcall cannot swallow the error.
+// It is raised as Lua's memory error (lua_error recognizes Lua's own "not
+// enough memory" string): an error raised from a hook would otherwise call
+// xpcall's message handler with hooks off, free to loop forever. The Lua
+// code sees "not enough memory"; the host reports budget_error.
+void ExhaustedHook(lua_State* L, lua_Debug*) {
+  lua_pushliteral(L, "not enough memory");
   lua_error(L);
 }
 
-// Count hook of threads: the time slice is used up; yield if Lua can.
-// Inside a call that cannot yield (a C function calling Lua, e.g. a
-// table.sort comparator), the instruction budget applies instead.
-void SliceHook(lua_State* L, lua_Debug* ar) {
-  if (lua_isyieldable(L)) {
-    lua_yield(L, 0);
-    return;
-  }
+// The running callback used up its budget: records `message` (the first
+// one), arms ExhaustedHook on L and on the callback's root state (so that
+// neither a new coroutine, which copies its creator's hook, nor the caller
+// gets a fresh count) and raises. Call() and ResumeThread() report
+// budget_error whatever error value reaches them.
+template <typename MakeMessage>
+void ExhaustBudget(lua_State* L, MakeMessage make_message) {
   LuaContext& c = Context(L);
-  const int64_t budget = c.world->settings().instruction_budget;
-  const int count = lua_gethookcount(L);
-  if (budget > 0 && ++c.slice_fires * count > budget) {
-    {
-      const std::string message = HookWhere(L, ar) + "the thread ran more than " +
-                                  std::to_string(budget) +
-                                  " Lua instructions inside a call that cannot yield";
-      lua_pushlstring(L, message.data(), message.size());
-    }
-    lua_error(L);
+  if (!c.budget_exhausted) {
+    c.budget_exhausted = true;
+    c.budget_error = make_message();  // a member: nothing is left to destroy at the longjmp
   }
+  lua_sethook(L, ExhaustedHook, LUA_MASKCOUNT, 1);
+  lua_sethook(RootOf(c), ExhaustedHook, LUA_MASKCOUNT, 1);
+  ExhaustedHook(L, nullptr);
+}
+
+// Count hook of non-threaded callbacks: the budget is used up.
+void BudgetHook(lua_State* L, lua_Debug* ar) {
+  ExhaustBudget(L, [&] {
+    return HookWhere(L, ar) + "the callback ran more than " +
+           std::to_string(Context(L).world->settings().instruction_budget) +
+           " Lua instructions without returning (an endless loop?); if the work is real, raise "
+           "simulation.instruction_budget";
+  });
 }
 
 void SetBudget(lua_State* L, const LuaContext& c) {
   const int64_t budget = c.world->settings().instruction_budget;
   if (budget > 0)
     lua_sethook(L, BudgetHook, LUA_MASKCOUNT, static_cast<int>(std::min<int64_t>(budget, INT_MAX)));
+}
+
+// Count hook of threads: the time slice is used up; yield if Lua can and L
+// is the script's thread itself. A coroutine of the script's own inherits
+// the hook (lua_newthread copies it) but is never yielded: that would hand
+// control back to its resumer, not to the simulation. There, and inside a
+// call that cannot yield (a C function calling Lua, e.g. a table.sort
+// comparator), the instruction budget applies instead.
+void SliceHook(lua_State* L, lua_Debug* ar) {
+  LuaContext& c = Context(L);
+  if (c.thread == nullptr) {
+    // A coroutine made by the thread, resumed from a non-threaded callback:
+    // that callback's budget regime applies from now on.
+    SetBudget(L, c);
+    return;
+  }
+  if (L == c.thread && lua_isyieldable(L)) {
+    c.slice_yielded = true;
+    lua_yield(L, 0);
+    return;
+  }
+  const int64_t budget = c.world->settings().instruction_budget;
+  const int count = lua_gethookcount(L);
+  if (budget > 0 && ++c.slice_fires * count > budget) {
+    ExhaustBudget(L, [&] {
+      return HookWhere(L, ar) + "the thread ran more than " + std::to_string(budget) +
+             " Lua instructions in a coroutine of its own or a call that cannot yield";
+    });
+  }
 }
 
 // Count hook armed when a state's memory passed the limit (LuaMemory).
@@ -201,12 +246,17 @@ void MemoryHook(lua_State* L, lua_Debug* ar) {
     }
     lua_error(L);
   }
-  // Garbage only: the threads get their usual hooks back.
+  // Garbage only: the threads get their usual hooks back (the exhausted
+  // budget's, if it ran out).
   state->memory.armed = false;
   SetBudget(state->L, state->context);
   for (const Script& script : state->scripts)
     if (script.thread != nullptr)
       lua_sethook(script.thread, SliceHook, LUA_MASKCOUNT, script.slice_instructions);
+  if (state->context.budget_exhausted) {
+    lua_sethook(L, ExhaustedHook, LUA_MASKCOUNT, 1);
+    lua_sethook(RootOf(state->context), ExhaustedHook, LUA_MASKCOUNT, 1);
+  }
 }
 
 // lua_Alloc of every state: realloc/free, counting against the limit.
@@ -249,9 +299,11 @@ void SetCurrent(ScriptState& state, Script& script) {
 
 // Calls the function below `nargs` arguments on the stack as `script`,
 // under the instruction budget. Throws swarmsim::Error naming the robot,
-// file:line, `what` and the object.
+// file:line, `what` and the object. Once the budget ran out, that is the
+// error reported, whatever error value the call returns.
 void Call(ScriptState& state, Script& script, int nargs, std::string_view what) {
   SetCurrent(state, script);
+  state.context.budget_exhausted = false;
   SetBudget(state.L, state.context);
   script.running = true;
   const int status = lua_pcall(state.L, nargs, 0, 0);
@@ -264,6 +316,8 @@ void Call(ScriptState& state, Script& script, int nargs, std::string_view what) 
       lua_settop(state.L, 0);
       throw Error(error);
     }
+    if (state.context.budget_exhausted)
+      ThrowScriptError(state, script.object, state.context.budget_error, what);
     ThrowScriptError(state, script.object, ErrorText(state.L, status), what);
   }
 }
@@ -280,48 +334,10 @@ bool Disable(ScriptState& state, Script& script, const std::string& error) {
   return true;
 }
 
-// sim.wait and sim.waitUntil, in Lua over sim.step (threaded scripts only).
-constexpr char kThreadHelpers[] = R"(local sim, yieldable = ...
-local step, now = sim.step, sim.getSimulationTime
-local function threaded(name)  -- errors name the caller's line, not this chunk's
-  if not yieldable() then
-    error(name .. ': only a threaded script (sysCall_thread) can wait', 3)
-  end
-end
-function sim.wait(seconds)
-  threaded('sim.wait')
-  if type(seconds) ~= 'number' then
-    error('sim.wait: bad argument #1 (number expected, got ' .. type(seconds) .. ')', 2)
-  end
-  local t_end = now() + seconds - 1e-9
-  while now() < t_end do step() end
-end
-function sim.waitUntil(condition, timeout)
-  threaded('sim.waitUntil')
-  if type(condition) ~= 'function' then
-    error('sim.waitUntil: bad argument #1 (function expected, got ' .. type(condition) .. ')', 2)
-  end
-  local t_end = timeout and now() + timeout - 1e-9
-  while not condition() do
-    if t_end and now() >= t_end then return false end
-    step()
-  end
-  return true
-end
-)";
-
 // Protected part of creating a state. Arguments: two integers seeding math.random.
 int SetUpState(lua_State* L) {
   OpenSandbox(L);
   RegisterAllApis(L);
-  if (luaL_loadbufferx(L, kThreadHelpers, sizeof kThreadHelpers - 1, "=sim", "t") != LUA_OK)
-    lua_error(L);
-  lua_getglobal(L, "sim");
-  lua_pushcfunction(L, [](lua_State* T) {
-    lua_pushboolean(T, lua_isyieldable(T));
-    return 1;
-  });
-  lua_call(L, 2, 0);
   // Lua's own math.random, reproducible per robot.
   lua_getglobal(L, LUA_MATHLIBNAME);
   lua_getfield(L, -1, "randomseed");
@@ -516,19 +532,35 @@ void Initialize(ScriptState* state) {
 // Resumes a script's thread until it yields, returns or fails.
 void ResumeThread(ScriptState* state, Script& script) {
   lua_State* co = script.thread;
+  LuaContext& c = state->context;
   SetCurrent(*state, script);
-  state->context.slice_fires = 0;
-  lua_sethook(co, SliceHook, LUA_MASKCOUNT, script.slice_instructions);
+  c.thread = co;
+  c.budget_exhausted = false;
+  c.slice_fires = 0;
+  c.slice_yielded = false;
+  // A fresh slice. After a yield from the hook, Lua itself left it so: it
+  // set the count to 1 and marked the interrupted instruction, which is
+  // executed again on resume; that execution resets the count to the slice
+  // and, seeing the mark, skips the hook. Resetting the count here would let
+  // the mark swallow the next firing instead: two slices in that step.
+  if (!script.slice_yielded || lua_gethook(co) != SliceHook ||
+      lua_gethookcount(co) != script.slice_instructions)
+    lua_sethook(co, SliceHook, LUA_MASKCOUNT, script.slice_instructions);
   int results = 0;
   script.running = true;
   const int status = lua_resume(co, state->L, 0, &results);
   script.running = false;
+  c.thread = nullptr;
+  script.slice_yielded = c.slice_yielded;
   if (status == LUA_YIELD) {
     lua_pop(co, results);
     return;
   }
   std::string error;
-  if (status != LUA_OK) error = ErrorText(co, status);
+  if (c.budget_exhausted)
+    error = c.budget_error;
+  else if (status != LUA_OK)
+    error = ErrorText(co, status);
   // Finished or failed: the coroutine is not resumed again.
   lua_settop(co, 0);
   luaL_unref(state->L, LUA_REGISTRYINDEX, script.thread_ref);
@@ -541,14 +573,7 @@ void ResumeThread(ScriptState* state, Script& script) {
 // to their ancestors); with the actuation callbacks, the threads.
 // `args` (from sim.handleChildScripts) are passed to each callback.
 void PushArgs(lua_State* L, const std::vector<ParamValue>& args) {
-  for (const ParamValue& v : args) {
-    if (const double* d = std::get_if<double>(&v))
-      lua_pushnumber(L, *d);
-    else if (const bool* b = std::get_if<bool>(&v))
-      lua_pushboolean(L, *b);
-    else
-      lua_pushstring(L, std::get<std::string>(v).c_str());
-  }
+  for (const ParamValue& v : args) PushParamValue(L, v);
 }
 
 void RunCallback(ScriptState* state, Callback callback, const std::vector<ParamValue>& args = {}) {
@@ -648,17 +673,35 @@ int HandleChildScript(lua_State* L) {
   const int nargs = lua_gettop(L) - 1;
   lua_rawgeti(L, LUA_REGISTRYINDEX, script.callbacks[callback]);
   lua_insert(L, 2);
+  // The script runs on its caller's count: the caller's budget, or its
+  // thread's slice (it cannot yield: the budget applies there). Re-arming a
+  // budget here would give a caller calling it in a loop endless instructions.
+  const lua_Hook hook = lua_gethook(L);
+  const int hook_count = lua_gethookcount(L);
   SetCurrent(state, script);
-  SetBudget(L, c);
   script.running = true;
   const int status = lua_pcall(L, nargs, LUA_MULTRET, 0);
   script.running = false;
   SetCurrent(state, *caller);
   if (status != LUA_OK) {
-    std::string error = ErrorText(L, status) + " (in " + kCallbackNames[callback] +
-                        " of the explicit script of " + path + ")";
+    std::string error = (c.budget_exhausted ? c.budget_error : ErrorText(L, status)) + " (in " +
+                        kCallbackNames[callback] + " of the explicit script of " + path + ")";
     lua_pop(L, 1);
-    if (Disable(state, script, c.name + ": " + error)) return 0;
+    if (Disable(state, script, c.name + ": " + error)) {
+      if (c.budget_exhausted) {
+        // The disabled script will not run again: its caller goes on, on a
+        // count of its own again.
+        c.budget_exhausted = false;
+        lua_sethook(L, hook, LUA_MASKCOUNT, hook_count);
+        if (lua_State* root = RootOf(c); root != L) {
+          if (c.thread != nullptr)
+            lua_sethook(root, SliceHook, LUA_MASKCOUNT, caller->slice_instructions);
+          else
+            SetBudget(root, c);
+        }
+      }
+      return 0;
+    }
     lua_pushlstring(L, error.data(), error.size());
     throw LuaErrorOnStack{};  // raised by Guarded once `error` and `path` are gone
   }
@@ -666,9 +709,14 @@ int HandleChildScript(lua_State* L) {
 }
 
 // sim.step() / sim.switchThread(): a threaded script gives up the rest of
-// this step; it resumes in the next one.
+// this step; it resumes in the next one. Only the script's thread itself yields: in a coroutine of
+// the script's own, lua_yield would return to that coroutine's resumer, not to the simulation.
 int SwitchThread(lua_State* L) {
-  if (!lua_isyieldable(L))
+  const lua_State* thread = Context(L).thread;
+  if (thread != nullptr && L != thread)
+    return luaL_error(
+        L, "sim.step: call it from sysCall_thread itself, not from a coroutine of your own");
+  if (thread == nullptr || !lua_isyieldable(L))
     return luaL_error(L, "sim.step: only a threaded script (sysCall_thread) can yield");
   return lua_yield(L, 0);  // not guarded: nothing here has a destructor
 }

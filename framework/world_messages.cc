@@ -6,7 +6,8 @@
 // serially), and the range messages whose circle covers it, found through a
 // spatial grid of the senders (radius = range). Cost: O(messages + receivers
 // in range). Every inbox ends in message order, i.e. sender-handle order,
-// whatever the thread count.
+// whatever the thread count. The world's main script sends with a null
+// sender (it has no object): first in that order, without distance or bearing.
 #include <algorithm>
 #include <cmath>
 
@@ -89,8 +90,15 @@ void World::DeliverMessages() {
   std::vector<GridItem> items;
   for (uint32_t m = 0; m < message_count; ++m) {
     const Message& msg = messages_[m];
-    if (!scene_.IsValid(msg.sender)) continue;  // removed meanwhile
-    message_origin_[m] = scene_.world_pose(msg.sender).p;
+    // The main script has no object: its messages have no origin. A sending
+    // object removed meanwhile drops its messages.
+    if (msg.sender.IsNull()) {
+      message_origin_[m] = {};
+    } else if (scene_.IsValid(msg.sender)) {
+      message_origin_[m] = scene_.world_pose(msg.sender).p;
+    } else {
+      continue;
+    }
     switch (msg.scope) {
       case MessageScope::kGlobal: global_messages_.push_back(m); break;
       case MessageScope::kLocal:
@@ -128,6 +136,10 @@ void World::DeliverMessages() {
       const Pose X_WR = scene_.world_pose(instances[r].root);
       const Pose X_RW = X_WR.Inverse();
       auto push = [&](uint32_t m) {
+        if (messages_[m].sender.IsNull()) {  // from the main script: no distance or bearing
+          inbox.push_back({m, 0, 0, false});
+          return;
+        }
         const Vec3 d = message_origin_[m] - X_WR.p;
         const Vec3 p_RS = X_RW * message_origin_[m];
         inbox.push_back({m, static_cast<float>(std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z)),

@@ -13,6 +13,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace swarmsim::loader {
@@ -66,6 +67,22 @@ struct Field {
   YAML::Node node;
   YAML::Mark mark;      // the value's position, or its key's when the value is empty
   YAML::Mark key_mark;  // the key's position (the list's for an element)
+
+  Field() = default;
+  Field(std::string name_, YAML::Node node_, YAML::Mark mark_, YAML::Mark key_mark_)
+      : name(std::move(name_)), node(std::move(node_)), mark(mark_), key_mark(key_mark_) {}
+  Field(const Field&) = default;
+  // yaml-cpp's Node::operator= writes the right side into the node the left
+  // side refers to, i.e. into the parsed document: `field = other` would edit
+  // a model file's tree that later copies are read from again. A Field
+  // assignment rebinds instead (Node::reset).
+  Field& operator=(const Field& other) {
+    name = other.name;
+    node.reset(other.node);
+    mark = other.mark;
+    key_mark = other.key_mark;
+    return *this;
+  }
   bool present() const { return node.IsDefined() && !node.IsNull(); }
 };
 

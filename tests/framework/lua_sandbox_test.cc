@@ -189,5 +189,47 @@ TEST_F(SandboxTest, TrustScriptsGivesTheFullLibraries) {
   EXPECT_CONTAINS(Run("assert(type(os.execute) == 'function')"), "os.execute is not allowed");
 }
 
+// --trust-scripts lifts the restrictions, not the folders: require searches
+// the world's folders first, relative reads start in the world's folder and
+// relative writes in --out; absolute paths and '..' go anywhere.
+TEST_F(SandboxTest, TrustedScriptsFindModulesAndFilesWhereSandboxedOnesDo) {
+  fs::create_directories(root_ / "scripts");
+  Write(root_ / "world" / "good.lua", "return {name = 'good'}\n");
+  Write(root_ / "world" / "scripts" / "sub.lua", "return {name = 'sub'}\n");
+  Write(root_ / "scripts" / "beside.lua", "return {name = 'beside'}\n");
+  const std::string secret = (root_ / "secret.txt").string();
+  EXPECT_EQ(Run("assert(require('good').name == 'good'); assert(require('sub').name == 'sub')\n"
+                "assert(require('beside').name == 'beside')",
+                true, /*trust=*/true),
+            "");
+  EXPECT_EQ(Run("local f = assert(io.open('data.txt')); assert(f:read('l') == 'hello'); f:close()\n"
+                "for l in io.lines('data.txt') do assert(l == 'hello') end",
+                true, /*trust=*/true),
+            "");
+  EXPECT_EQ(Run("local w = assert(io.open('trusted_copy.txt', 'w')); w:write('x=2'); w:close()",
+                true, /*trust=*/true),
+            "");
+  EXPECT_EQ(Run("assert(io.open('" + secret +
+                    "'):read('l') == 'secret')\n"
+                    "assert(io.open('../secret.txt'):read('l') == 'secret')\n"
+                    "assert(type(os.execute) == 'function' and type(io.popen) == 'function')",
+                true, /*trust=*/true),
+            "");
+  std::ifstream in(root_ / "out" / "trusted_copy.txt");
+  std::string text;
+  std::getline(in, text);
+  EXPECT_EQ(text, "x=2");
+  EXPECT_FALSE(fs::exists("trusted_copy.txt"));  // not in the current directory
+  fs::remove("trusted_copy.txt");
+  // Then Lua's own search path; a missing module names the world's folders too.
+  EXPECT_CONTAINS(Run("require('nothere')", true, /*trust=*/true),
+                  (root_ / "world" / "scripts" / "nothere.lua").string());
+  EXPECT_CONTAINS(Run("require('nothere')", true, /*trust=*/true), "no file '/usr/");
+  EXPECT_CONTAINS(Run("io.open('trusted_nowhere.txt', 'w')", /*with_out=*/false, /*trust=*/true),
+                  "the run has no output folder (swarmsim run --out DIR)");
+  EXPECT_FALSE(fs::exists("trusted_nowhere.txt"));
+  fs::remove("trusted_nowhere.txt");
+}
+
 }  // namespace
 }  // namespace swarmsim

@@ -179,6 +179,66 @@ TEST(ScriptControlTest, StepOutsideAThreadIsAnError) {
   EXPECT_CONTAINS(ErrorOf([&] { w.Steps(1); }), "only a threaded script");
 }
 
+TEST(ScriptControlTest, ThreadThatNeverYieldsGetsExactlyItsSliceEveryStep) {
+  ScriptWorld w;
+  w.AddRobot("bot#0", R"(
+    n = 0
+    function sysCall_thread()
+      sim.setThreadSwitchTiming(1)  -- 100,000 instructions: 25,000 turns of the loop
+      while true do n = n + 1 end
+    end
+    function sysCall_sensing() sim.recordMetric('n', n) end
+  )");
+  w.Steps(6);
+  const std::vector<MetricSample> metrics = w.world().TakeMetrics();
+  ASSERT_EQ(metrics.size(), 6u);
+  EXPECT_EQ(metrics[0].value, 0);
+  for (size_t step = 1; step < metrics.size(); ++step)
+    EXPECT_NEAR(metrics[step].value - metrics[step - 1].value, 25'000, 2) << "step " << step - 1;
+}
+
+TEST(ScriptControlTest, ACoroutineOfTheThreadRunsToItsEndAndReturnsItsValues) {
+  ScriptWorld w;
+  w.AddRobot("bot#0", R"(
+    function sysCall_thread()
+      local co = coroutine.create(function()
+        for i = 1, 1e6 do end  -- five time slices
+        return 'done'
+      end)
+      print(coroutine.resume(co))
+      print(coroutine.status(co))
+    end
+  )");
+  w.Steps(1);
+  EXPECT_EQ(w.log, (std::vector<std::string>{"[bot#0] true\tdone", "[bot#0] dead"}));
+}
+
+TEST(ScriptControlTest, EndlessCoroutineOfTheThreadBecomesABudgetError) {
+  WorldSettings settings;
+  settings.instruction_budget = 1'000'000;
+  ScriptWorld w(1, settings);
+  w.AddRobot("bot#0",
+             "function sysCall_thread()\n  local co = coroutine.wrap(function()\n"
+             "    while true do end\n  end)\n  while true do co() end\nend\n");
+  const std::string error = ErrorOf([&] { w.Steps(1); });
+  EXPECT_CONTAINS(error, "bot#0: scripts/robot.lua:3: ");
+  EXPECT_CONTAINS(error, "more than 1000000 Lua instructions");
+  EXPECT_CONTAINS(error, "[in sysCall_thread of /bot#0/body]");
+}
+
+TEST(ScriptControlTest, StepInsideACoroutineOfTheThreadIsAnError) {
+  ScriptWorld w;
+  w.AddRobot("bot#0",
+             "function sysCall_thread()\n  local co = coroutine.wrap(function()\n"
+             "    sim.step()\n  end)\n  co()\n  print('went on')\nend\n");
+  const std::string error = ErrorOf([&] { w.Steps(2); });
+  // coroutine.wrap prefixes the line of its caller.
+  EXPECT_CONTAINS(error,
+                  "scripts/robot.lua:3: sim.step: call it from sysCall_thread itself, "
+                  "not from a coroutine of your own [in sysCall_thread of /bot#0/body]");
+  EXPECT_TRUE(w.log.empty()) << w.log.front();
+}
+
 // --- Budget and error policy ---------------------------------------------------------------
 
 TEST(ScriptControlTest, EndlessLoopBecomesAnErrorNamingRobotScriptAndLine) {
@@ -190,6 +250,69 @@ TEST(ScriptControlTest, EndlessLoopBecomesAnErrorNamingRobotScriptAndLine) {
   EXPECT_CONTAINS(error, "bot#0: scripts/robot.lua:2: ");
   EXPECT_CONTAINS(error, "more than 1000000 Lua instructions");
   EXPECT_CONTAINS(error, "[in sysCall_actuation of /bot#0/body]");
+}
+
+TEST(ScriptControlTest, PcallCannotCatchTheBudgetError) {
+  auto error_of = [](const std::string& code) {
+    WorldSettings settings;
+    settings.instruction_budget = 100'000;
+    ScriptWorld w(1, settings);
+    w.AddRobot("bot#0", code);
+    const std::string error = ErrorOf([&] { w.Steps(2); });
+    EXPECT_TRUE(w.log.empty()) << w.log.front();
+    return error;
+  };
+  for (const std::string code : {
+           // In a loop: the callback would never return.
+           "function sysCall_actuation()\n  while true do\n"
+           "    pcall(function() while true do end end)\n  end\nend\n",
+           // Once: the run would go on as if nothing happened.
+           "function sysCall_actuation()\n  local ok = pcall(function()\n"
+           "    while true do end\n  end)\n  print('went on', ok)\nend\n",
+           // In a message handler that loops too.
+           "function sysCall_actuation()\n  while true do\n"
+           "    xpcall(function() while true do end end, function() while true do end end)\n"
+           "  end\nend\n",
+           // In a coroutine of the callback: each new one would get a fresh count.
+           "function sysCall_actuation()\n  while true do\n"
+           "    pcall(coroutine.wrap(function() while true do end end))\n  end\nend\n",
+       }) {
+    const std::string error = error_of(code);
+    EXPECT_CONTAINS(error, "bot#0: scripts/robot.lua:3: ");
+    EXPECT_CONTAINS(error, "more than 100000 Lua instructions");
+    EXPECT_CONTAINS(error, "[in sysCall_actuation of /bot#0/body]");
+  }
+}
+
+TEST(ScriptControlTest, ExplicitScriptsRunOnTheirCallersBudget) {
+  WorldSettings settings;
+  settings.instruction_budget = 100'000;
+  ScriptWorld w(1, settings);
+  const ObjectId body =
+      w.AddRobot("bot#0",
+                 "function sysCall_actuation()\n  local arm = sim.getObject('./arm')\n"
+                 "  while true do sim.handleChildScript(arm) end\nend\n");
+  const ObjectId arm = w.scene().AddDummy("arm", body, {});
+  w.scene().AttachScript(arm, Source("scripts/arm.lua", "function sysCall_actuation() end"),
+                         /*explicit_handling=*/true);
+  const std::string error = ErrorOf([&] { w.Steps(1); });
+  EXPECT_CONTAINS(error, "more than 100000 Lua instructions");
+  EXPECT_CONTAINS(error, "[in sysCall_actuation of /bot#0/body]");
+}
+
+TEST(ScriptControlTest, PcallCannotCatchTheBudgetErrorOfAThread) {
+  WorldSettings settings;
+  settings.instruction_budget = 1'000'000;
+  ScriptWorld w(1, settings);
+  // A comparator cannot yield: the budget applies there.
+  w.AddRobot("bot#0",
+             "function sysCall_thread()\n  while true do\n"
+             "    pcall(table.sort, {3, 2, 1}, function() while true do end end)\n"
+             "  end\nend\n");
+  const std::string error = ErrorOf([&] { w.Steps(3); });
+  EXPECT_CONTAINS(error, "bot#0: scripts/robot.lua:3: ");
+  EXPECT_CONTAINS(error, "more than 1000000 Lua instructions");
+  EXPECT_CONTAINS(error, "[in sysCall_thread of /bot#0/body]");
 }
 
 TEST(ScriptControlTest, WaitOutsideAThreadNamesTheCallersLine) {
@@ -458,8 +581,8 @@ TEST(ScriptControlTest, SignalsAreVisibleFromTheNextStepAndTheLastRobotWins) {
     )",
                r);
   w.Steps(3);
-  EXPECT_EQ(w.log, (std::vector<std::string>{"[bot#0] nil\tnil", "[bot#0] 39.0\ttrue",
-                                             "[bot#0] 39.0\tnil"}));
+  EXPECT_EQ(w.log,
+            (std::vector<std::string>{"[bot#0] nil\tnil", "[bot#0] 39\ttrue", "[bot#0] 39\tnil"}));
 }
 
 TEST(ScriptControlTest, PackAndUnpackRoundTrip) {

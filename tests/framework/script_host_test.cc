@@ -20,8 +20,8 @@ std::shared_ptr<const ScriptSource> Source(std::string path, std::string code) {
 // A world with null modules whose script output lands in `log`.
 class ScriptWorld {
  public:
-  explicit ScriptWorld(int threads = 1, uint64_t seed = 1) : registry_(testing::NullRegistry()) {
-    WorldSettings settings;
+  explicit ScriptWorld(int threads = 1, uint64_t seed = 1, WorldSettings settings = {})
+      : registry_(testing::NullRegistry()) {
     settings.physics = "null";
     settings.time_step = 0.1;
     settings.threads = threads;
@@ -551,7 +551,7 @@ TEST(ScriptHostTest, ParametersComeFromTheRobotThenTheWorldThenTheDefault) {
   w.world().SetInstanceParameters(1, own);
   w.world().Start();
   const std::vector<std::string> expected = {"[bot#0] 0.5\tworld\tfalse\t3\tnil",
-                                             "[bot#1] 2.0\tworld\ttrue\t3\tnil"};
+                                             "[bot#1] 2\tworld\ttrue\t3\tnil"};
   EXPECT_EQ(w.log, expected);
 }
 
@@ -575,6 +575,138 @@ TEST(ScriptHostTest, SameStateWhateverTheThreadCount) {
     return w.world().StateHash();
   };
   EXPECT_EQ(run(1), run(2));
+}
+
+// Integral numbers (parameters, signals, sim.handleChildScripts arguments)
+// reach scripts as Lua integers, so '/st#' .. (i % robots) reads '/st#3'.
+TEST(ScriptHostTest, IntegralParametersAndSignalsAreLuaIntegers) {
+  ScriptWorld w;
+  w.AddRobot("bot#0", R"(
+    function sysCall_init()
+      local robots = sim.getParam('robots')
+      print('/st#' .. (13 % robots), math.type(robots), math.type(sim.getParam('speed')),
+            math.type(sim.getParam('exact')), math.type(sim.getParam('inexact')),
+            math.type(sim.getParam('negative')), sim.getParam('negative'))
+    end
+    function sysCall_actuation()
+      if sim.getSimulationTime() == 0 then
+        sim.setSignal('count', 4.0)
+        sim.setSignal('half', 0.5)
+      else
+        print('/st#' .. sim.getSignal('count'), sim.getSignal('half'))
+      end
+    end
+  )");
+  w.world().parameters()["robots"] = 10.0;
+  w.world().parameters()["speed"] = 0.5;
+  w.world().parameters()["exact"] = 9007199254740992.0;     // 2^53
+  w.world().parameters()["inexact"] = 18014398509481984.0;  // 2^54: a float
+  w.world().parameters()["negative"] = -3.0;
+  w.world().Start();
+  w.world().Step();
+  w.world().Step();
+  const std::vector<std::string> expected = {
+      "[bot#0] /st#3\tinteger\tfloat\tinteger\tfloat\tinteger\t-3", "[bot#0] /st#4\t0.5"};
+  EXPECT_EQ(w.log, expected);
+}
+
+TEST(ScriptHostTest, HandleChildScriptsPassesIntegralArgumentsAsIntegers) {
+  WorldSettings settings;
+  settings.main_script = Source("main.lua", R"(
+    function sysCall_step()
+      sim.handleSensing()
+      sim.handleChildScripts('sensing', 3, 2.0, 2.5, 2^60)
+      sim.handleChildScripts('actuation')
+      sim.handleActuation()
+      sim.handleDynamics()
+    end
+  )");
+  ScriptWorld w(1, 1, settings);
+  w.AddRobot("bot#0", R"(
+    function sysCall_sensing(...)
+      local types = {}
+      for i = 1, select('#', ...) do types[i] = math.type((select(i, ...))) end
+      print('/st#' .. (...), table.concat(types, ' '))
+    end
+  )");
+  w.world().Start();
+  w.world().Step();
+  const std::vector<std::string> expected = {"[bot#0] /st#3\tinteger integer float float"};
+  EXPECT_EQ(w.log, expected);
+}
+
+// --- Messages from the main and scene scripts ----------------------------------------------
+
+// Prints each message received: data, sender name ('world' for the main
+// script) and distance (nil without a position).
+constexpr const char* kPrintMessages = R"(
+  function sysCall_actuation()
+    while true do
+      local data, sender, distance = sim.receiveMessage()
+      if not data then break end
+      print(data, sender == sim.handle_world and 'world' or sim.getObjectName(sender), distance)
+    end
+  end
+)";
+
+TEST(ScriptHostTest, MainAndSceneScriptMessagesAreDeliveredAtTheNextStep) {
+  for (int threads : {1, 2}) {
+    WorldSettings settings;
+    settings.main_script = Source("main.lua", R"(
+      function sysCall_step()
+        while true do
+          local data, sender = sim.receiveMessage()
+          if not data then break end
+          print('main got', data, sim.getObjectName(sender))
+        end
+        if sim.getSimulationTime() == 0 then
+          sim.sendGlobalMessage('from-main')
+          sim.sendDirectMessage(sim.getObject('/b/body'), 'main-to-b')
+        end
+        sim.handleSensing()
+        sim.handleChildScripts('actuation')
+        sim.handleChildScripts('sensing')
+        sim.handleActuation()
+        sim.handleDynamics()
+      end
+    )");
+    ScriptWorld w(threads, 1, settings);
+    w.AddRobot("a", kPrintMessages);
+    w.AddRobot("b", kPrintMessages);
+    const ObjectId floor = w.scene().AddDummy("floor", {}, {});
+    w.scene().AttachScript(floor, Source("scripts/floor.lua", std::string(kPrintMessages) + R"(
+      function sysCall_sensing()
+        if sim.getSimulationTime() == 0 then
+          sim.sendGlobalMessage('from-scene')
+          sim.sendDirectMessage(sim.getObject('/a/body'), 'scene-to-a')
+        end
+      end
+    )"));
+    w.world().Start();
+    w.world().Step();
+    EXPECT_TRUE(w.log.empty()) << w.log.front();
+    w.world().Step();
+    // Sender-handle order: the main script (sim.handle_world) first. The main
+    // script reads its inbox before running the phases, hence first in the log.
+    const std::vector<std::string> expected = {
+        "[main] main got\tfrom-scene\tfloor", "[a] from-main\tworld\tnil",
+        "[a] from-scene\tfloor\t0.0",         "[a] scene-to-a\tfloor\t0.0",
+        "[b] from-main\tworld\tnil",          "[b] main-to-b\tworld\tnil",
+        "[b] from-scene\tfloor\t1.0",         "[scene] from-main\tworld\tnil"};
+    EXPECT_EQ(w.log, expected) << threads << " threads";
+  }
+}
+
+TEST(ScriptHostTest, RangeMessageFromTheMainScriptIsAnError) {
+  WorldSettings settings;
+  settings.main_script =
+      Source("main.lua", "function sysCall_step()\n  sim.sendRangeMessage('x', 1)\nend");
+  ScriptWorld w(1, 1, settings);
+  w.AddRobot("a", kPrintMessages);
+  w.world().Start();
+  EXPECT_CONTAINS(ErrorOf([&] { w.world().Step(); }),
+                  "main.lua:2: sim.sendRangeMessage: the main script has no position: use "
+                  "sim.sendGlobalMessage or sim.sendDirectMessage");
 }
 
 TEST(ScriptHostTest, MemoryIsReportedAndReleasedAtStop) {

@@ -81,4 +81,25 @@ TEST(SandboxCliTest, OutFolderIsWritableAndTrustScriptsLiftsTheSandbox) {
   fs::remove_all(dir);
 }
 
+// What works sandboxed works trusted: modules from the world's folders,
+// relative reads from the world's folder and writes to --out.
+TEST(SandboxCliTest, TrustedScriptsUseTheWorldsFoldersLikeSandboxedOnes) {
+  const fs::path dir = MakeWorld(
+      "local v = require('good').scale * io.open('data.txt'):read('n'); "
+      "local f = assert(io.open('copy.txt', 'w')); f:write(v); f:close()");
+  std::ofstream(dir / "good.lua") << "return {scale = 3}\n";
+  for (const char* flags : {"", " --trust-scripts"}) {
+    fs::remove_all(dir / "out");
+    const Result r = RunProgram("run " + (dir / "world.yaml").string() +
+                                " --steps 1 --quiet --out " + (dir / "out").string() + flags);
+    EXPECT_EQ(r.exit_code, 0) << flags << "\n" << r.output;
+    std::ifstream copy(dir / "out" / "copy.txt");
+    std::string text;
+    std::getline(copy, text);
+    EXPECT_EQ(text, "126") << flags;
+  }
+  EXPECT_FALSE(fs::exists("copy.txt"));
+  fs::remove_all(dir);
+}
+
 }  // namespace

@@ -94,6 +94,37 @@ TEST_F(ControlLoaderTest, SimulationControlKeys) {
                   "nothere.lua");
 }
 
+TEST_F(ControlLoaderTest, EveryEntryOfAModelKeepsItsExplicitScripts) {
+  // Reading `script: {file:, explicit:}` once replaced that map by its file
+  // name in the parsed model (yaml-cpp's Node assignment writes through), so
+  // the second entry of the same model got a plain, self-running script.
+  Write("arm.yaml",
+        "model: arm\n"
+        "objects:\n"
+        "  {type: dummy, script: arm.lua,\n"
+        "   children: [{name: x, type: dummy, script: {file: x.lua, explicit: true}}]}\n");
+  Write("arm.lua",
+        "function sysCall_actuation()\n"
+        "  sim.recordMetric('doubled', sim.handleChildScript(sim.getObject('./x'), 21))\n"
+        "end\n");
+  Write("x.lua",
+        "function sysCall_actuation(a) sim.recordMetric('x_ran', a or -1) return 2 * a end\n");
+  LoadedWorld w = Load(
+      "simulation: {physics: kinematic}\n"
+      "models:\n"
+      "  - {model: arm.yaml, position: [0, 0]}\n"
+      "  - {model: arm.yaml, position: [1, 0]}\n"
+      "  - {model: arm.yaml, count: 2, distribute: {region: {min: [2, 2], max: [9, 9]}}}\n");
+  w.world->Step();
+  int doubled = 0, x_ran = 0;
+  for (const MetricSample& m : w.world->TakeMetrics()) {
+    if (m.name == "doubled") doubled += m.value == 42;
+    if (m.name == "x_ran") x_ran += m.value == 21;  // only when called, with its argument
+  }
+  EXPECT_EQ(doubled, 4);
+  EXPECT_EQ(x_ran, 4);
+}
+
 TEST_F(ControlLoaderTest, PerCopyParametersOverrideTheEntrysAndSetAppliesToAll) {
   LoadedWorld w = Load(kThree);
   const World& world = *w.world;
