@@ -116,6 +116,34 @@ void SetCounters(benchmark::State& state, double wall_s, double cpu_s, double ro
   state.counters["cpu_ns_per_robot_substep"] = cpu_s * per;
 }
 
+// Runs `work` once per benchmark iteration as manual time; returns the wall
+// and thread-CPU seconds spent in it.
+struct Spent {
+  double wall_s = 0, cpu_s = 0;
+};
+template <typename Work>
+Spent TimeIterations(benchmark::State& state, Work work) {
+  Spent spent;
+  const double cpu_start = ThreadCpuSeconds();
+  for (auto _ : state) {
+    const auto start = std::chrono::steady_clock::now();
+    work();
+    const double s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    state.SetIterationTime(s);
+    spent.wall_s += s;
+  }
+  spent.cpu_s = ThreadCpuSeconds() - cpu_start;
+  return spent;
+}
+
+// ns per robot-tick (one control step of `n` robots per iteration).
+void SetTickCounters(benchmark::State& state, const Spent& spent, int n) {
+  const double ticks = static_cast<double>(n) * static_cast<double>(state.iterations());
+  state.counters["ns_per_robot_tick"] = 1e9 * spent.wall_s / ticks;
+  state.counters["cpu_ns_per_robot_tick"] = 1e9 * spent.cpu_s / ticks;
+}
+
 // The backend: one Step of one substep, with the scene write-back.
 void BM_Box2dBackendSubstep(benchmark::State& state) {
   const int n = static_cast<int>(state.range(0));
@@ -123,17 +151,8 @@ void BM_Box2dBackendSubstep(benchmark::State& state) {
   auto backend = MakeBackend(WithScale(state.range(1)));
   backend->Build(*scene, {});
   for (int i = 0; i < 100; ++i) backend->Step(scene.get(), kDt, 1);  // settle
-  double wall_s = 0;
-  const double cpu_start = ThreadCpuSeconds();
-  for (auto _ : state) {
-    const auto start = std::chrono::steady_clock::now();
-    backend->Step(scene.get(), kDt, 1);
-    const double s =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    state.SetIterationTime(s);
-    wall_s += s;
-  }
-  SetCounters(state, wall_s, ThreadCpuSeconds() - cpu_start,
+  const Spent spent = TimeIterations(state, [&] { backend->Step(scene.get(), kDt, 1); });
+  SetCounters(state, spent.wall_s, spent.cpu_s,
               static_cast<double>(n) * static_cast<double>(state.iterations()));
 }
 
@@ -172,20 +191,11 @@ void BM_PhysicsPhase(benchmark::State& state) {
     backend->Step(scene.get(), kDt, kSubstepsPerTick);
     UpdatePoses(scene.get());
   }
-  double wall_s = 0;
-  const double cpu_start = ThreadCpuSeconds();
-  for (auto _ : state) {
-    const auto start = std::chrono::steady_clock::now();
+  const auto tick = [&] {
     backend->Step(scene.get(), kDt, kSubstepsPerTick);
     UpdatePoses(scene.get());
-    const double s =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    state.SetIterationTime(s);
-    wall_s += s;
-  }
-  const double ticks = static_cast<double>(n) * static_cast<double>(state.iterations());
-  state.counters["ns_per_robot_tick"] = 1e9 * wall_s / ticks;
-  state.counters["cpu_ns_per_robot_tick"] = 1e9 * (ThreadCpuSeconds() - cpu_start) / ticks;
+  };
+  SetTickCounters(state, TimeIterations(state, tick), n);
 }
 
 // The post-physics pose update alone (bodies flagged as simulated, as after
@@ -199,22 +209,13 @@ void BM_PoseUpdate(benchmark::State& state) {
   UpdatePoses(scene.get());
   std::vector<uint32_t> bodies;
   for (const ModelInstance& instance : scene->instances()) bodies.push_back(instance.root.index());
-  double wall_s = 0;
-  const double cpu_start = ThreadCpuSeconds();
-  for (auto _ : state) {
-    const auto start = std::chrono::steady_clock::now();
+  const auto tick = [&] {
     for (uint32_t slot : bodies)
       scene->SetSimulatedState(slot, scene->world_pose_at(slot), scene->linear_velocity_at(slot),
                                scene->angular_velocity_at(slot));
     UpdatePoses(scene.get());
-    const double s =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    state.SetIterationTime(s);
-    wall_s += s;
-  }
-  const double ticks = static_cast<double>(n) * static_cast<double>(state.iterations());
-  state.counters["ns_per_robot_tick"] = 1e9 * wall_s / ticks;
-  state.counters["cpu_ns_per_robot_tick"] = 1e9 * (ThreadCpuSeconds() - cpu_start) / ticks;
+  };
+  SetTickCounters(state, TimeIterations(state, tick), n);
 }
 
 double Min(const std::vector<double>& v) { return *std::min_element(v.begin(), v.end()); }

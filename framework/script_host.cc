@@ -88,9 +88,8 @@ static_assert(sizeof(Script) == 88);
 // script with its file and line. Past limit + slack allocations fail (Lua
 // then collects and retries, and reports out of memory).
 struct LuaMemory {
-  size_t used = 0;   // bytes
-  size_t limit = 0;  // bytes; 0: no limit
-  bool armed = false;
+  size_t used = 0;       // bytes
+  size_t limit = 0;      // bytes; 0: no limit
   bool refused = false;  // the last allocation was refused (limit + slack)
 };
 constexpr size_t kMemorySlack = size_t{16} << 20;
@@ -239,16 +238,12 @@ void SliceHook(lua_State* L, lua_Debug* ar) {
 void MemoryHook(lua_State* L, lua_Debug* ar) {
   auto* state = static_cast<ScriptState*>(Context(L).host_state);
   lua_gc(L, LUA_GCCOLLECT);
-  if (state->memory.used > state->memory.limit) {
-    {  // the message is on the Lua stack, and destroyed, before the longjmp
-      const std::string message = HookWhere(L, ar) + MemoryLimitText(state->memory);
-      lua_pushlstring(L, message.data(), message.size());
-    }
-    lua_error(L);
-  }
+  // Still too much: fails the callback as a spent budget does, so pcall and
+  // xpcall's handler cannot catch it and go on allocating.
+  if (state->memory.used > state->memory.limit)
+    ExhaustBudget(L, [&] { return HookWhere(L, ar) + MemoryLimitText(state->memory); });
   // Garbage only: the threads get their usual hooks back (the exhausted
   // budget's, if it ran out).
-  state->memory.armed = false;
   SetBudget(state->L, state->context);
   for (const Script& script : state->scripts)
     if (script.thread != nullptr)
@@ -275,12 +270,16 @@ void* LimitedAlloc(void* ud, void* ptr, size_t osize, size_t nsize) {
       m.refused = true;
       return nullptr;
     }
-    if (after > m.limit && !m.armed && state->L != nullptr) {
-      // lua_sethook may be called at any point (even from a signal handler).
-      m.armed = true;
-      lua_sethook(state->L, MemoryHook, LUA_MASKCOUNT, 1);
+    if (after > m.limit && state->L != nullptr) {
+      // Armed on every thread whose hook is another (a callback's budget hook
+      // set since would otherwise leave only the hard cap). lua_sethook may
+      // be called at any point (even from a signal handler).
+      const auto arm = [](lua_State* T) {
+        if (lua_gethook(T) != MemoryHook) lua_sethook(T, MemoryHook, LUA_MASKCOUNT, 1);
+      };
+      arm(state->L);
       for (const Script& script : state->scripts)
-        if (script.thread != nullptr) lua_sethook(script.thread, MemoryHook, LUA_MASKCOUNT, 1);
+        if (script.thread != nullptr) arm(script.thread);
     }
   }
   void* p = std::realloc(ptr, nsize);

@@ -337,6 +337,31 @@ TEST(ScriptControlTest, RunawayMemoryBecomesAnErrorNamingRobotScriptAndLine) {
   EXPECT_CONTAINS(error, "[in sysCall_actuation of /bot#0/body]");
 }
 
+TEST(ScriptControlTest, PcallCannotCatchTheMemoryLimit) {
+  WorldSettings settings;
+  settings.script_memory_limit = 4 << 20;
+  ScriptWorld w(1, settings);
+  // A pcall loop would retry for ever, an xpcall handler that loops would
+  // never return: the limit must end the callback either way.
+  w.AddRobot(
+      "bot#0",
+      "local t = {}\n"
+      "local function grow() while true do t[#t + 1] = string.rep('x', 10000) .. #t end end\n"
+      "function sysCall_actuation()\n"
+      "  while true do pcall(grow) end\n"
+      "end\n");
+  w.AddRobot(
+      "bot#1",
+      "local t = {}\n"
+      "local function grow() while true do t[#t + 1] = string.rep('x', 10000) .. #t end end\n"
+      "function sysCall_actuation()\n"
+      "  xpcall(grow, function() while true do end end)\n"
+      "end\n",
+      1);
+  const std::string error = ErrorOf([&] { w.Steps(1); });
+  EXPECT_CONTAINS(error, "bot#0: scripts/robot.lua:2: the scripts hold more than 4 MiB");
+}
+
 TEST(ScriptControlTest, RunawayMemoryInAThreadIsCaughtToo) {
   WorldSettings settings;
   settings.script_memory_limit = 4 << 20;
