@@ -398,6 +398,10 @@ WorldSettings WorldLoader::ReadSimulation(const Fields& top, std::optional<int64
       const double n = std::round(duration / s.time_step);
       if (n > static_cast<double>(int64_t{1} << 40))
         values.Fail(f.Get("duration"), "'duration' is too many steps of 'time_step'");
+      if (duration > 0 && n < 1)  // as --duration: not a silent run of 0 steps
+        values.Fail(f.Get("duration"), "'duration' " + loader::FormatNumber(duration) +
+                                           " s is shorter than one time step (" +
+                                           loader::FormatNumber(s.time_step) + " s)");
       *steps = static_cast<int64_t>(n);
     }
   }

@@ -92,6 +92,9 @@ TEST_F(ControlLoaderTest, SimulationControlKeys) {
                   "world.yaml:1:54:");
   EXPECT_CONTAINS(ErrorOf("simulation: {physics: kinematic, main_script: nothere.lua}\n"),
                   "nothere.lua");
+  // Shorter than one step: an error, not a silent run of 0 steps.
+  EXPECT_CONTAINS(ErrorOf("simulation: {physics: kinematic, time_step: 0.1, duration: 0.01}\n"),
+                  "world.yaml:1:60: 'duration' 0.01 s is shorter than one time step (0.1 s)");
 }
 
 TEST_F(ControlLoaderTest, EveryEntryOfAModelKeepsItsExplicitScripts) {
