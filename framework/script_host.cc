@@ -26,8 +26,10 @@
 #include "framework/script_host.h"
 
 #include <algorithm>
+#include <atomic>
 #include <climits>
 #include <cstdlib>
+#include <mutex>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -289,18 +291,71 @@ void* LimitedAlloc(void* ud, void* ptr, size_t osize, size_t nsize) {
   return p;
 }
 
+// --- Calls in progress (ScriptCallsInProgress) ------------------------------------------
+// Each thread that runs scripts keeps a record of the innermost call it is
+// in. The records are never freed (a thread may end; its record stays, idle),
+// so a watchdog can read them at any time.
+struct CallRecord {
+  std::atomic<const ScriptState*> state{nullptr};
+  std::atomic<const Script*> script{nullptr};
+  std::atomic<const char*> what{nullptr};
+};
+std::mutex g_call_records_mutex;
+std::vector<CallRecord*>& CallRecords() {
+  static auto* records = new std::vector<CallRecord*>;  // leaked on purpose, as the records
+  return *records;
+}
+CallRecord& ThisThreadsRecord() {
+  thread_local CallRecord* record = [] {
+    auto* r = new CallRecord;
+    const std::lock_guard lock(g_call_records_mutex);
+    CallRecords().push_back(r);
+    return r;
+  }();
+  return *record;
+}
+
+// Marks the calling thread as running `what` of a script of `state` for the
+// scope's duration (SetCurrent names the script); restores the outer call.
+class CallInProgress {
+ public:
+  CallInProgress(const ScriptState& state, const char* what)
+      : record_(ThisThreadsRecord()),
+        state_(record_.state.load(std::memory_order_relaxed)),
+        script_(record_.script.load(std::memory_order_relaxed)),
+        what_(record_.what.load(std::memory_order_relaxed)) {
+    record_.what.store(what, std::memory_order_relaxed);
+    record_.state.store(&state, std::memory_order_release);
+  }
+  ~CallInProgress() {
+    record_.state.store(state_, std::memory_order_relaxed);
+    record_.script.store(script_, std::memory_order_relaxed);
+    record_.what.store(what_, std::memory_order_relaxed);
+  }
+  CallInProgress(const CallInProgress&) = delete;
+  CallInProgress& operator=(const CallInProgress&) = delete;
+
+ private:
+  CallRecord& record_;
+  const ScriptState* state_;
+  const Script* script_;
+  const char* what_;
+};
+
 void SetCurrent(ScriptState& state, Script& script) {
   state.context.script_object = script.object;
   state.context.script_env_ref = script.env_ref;
   state.context.mailbox = &script.mailbox;
   state.context.host_script = &script;
+  ThisThreadsRecord().script.store(&script, std::memory_order_relaxed);
 }
 
 // Calls the function below `nargs` arguments on the stack as `script`,
 // under the instruction budget. Throws swarmsim::Error naming the robot,
 // file:line, `what` and the object. Once the budget ran out, that is the
 // error reported, whatever error value the call returns.
-void Call(ScriptState& state, Script& script, int nargs, std::string_view what) {
+void Call(ScriptState& state, Script& script, int nargs, const char* what) {
+  const CallInProgress in_progress(state, what);
   SetCurrent(state, script);
   state.context.budget_exhausted = false;
   SetBudget(state.L, state.context);
@@ -532,6 +587,7 @@ void Initialize(ScriptState* state) {
 void ResumeThread(ScriptState* state, Script& script) {
   lua_State* co = script.thread;
   LuaContext& c = state->context;
+  const CallInProgress in_progress(*state, kCallbackNames[kThread]);
   SetCurrent(*state, script);
   c.thread = co;
   c.budget_exhausted = false;
@@ -921,6 +977,25 @@ size_t ScriptHost::MemoryBytes() const {
   size_t total = StateBytes(impl_->scene.get()) + StateBytes(impl_->main.get());
   for (const auto& state : impl_->robots) total += StateBytes(state.get());
   return total;
+}
+
+std::vector<std::string> ScriptCallsInProgress() {
+  std::vector<std::string> out;
+  const std::lock_guard lock(g_call_records_mutex);
+  for (const CallRecord* record : CallRecords()) {
+    const ScriptState* state = record->state.load(std::memory_order_acquire);
+    if (state == nullptr) continue;
+    const Script* script = record->script.load(std::memory_order_relaxed);
+    const char* what = record->what.load(std::memory_order_relaxed);
+    std::string line = state->context.name;
+    if (script != nullptr && script->source != nullptr) line += ": " + script->source->path;
+    if (what != nullptr) line += std::string(", in ") + what;
+    const Scene& scene = *state->context.scene;
+    if (script != nullptr && scene.IsValid(script->object))
+      line += " of " + scene.PathOf(script->object);
+    out.push_back(std::move(line));
+  }
+  return out;
 }
 
 }  // namespace swarmsim

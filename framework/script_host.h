@@ -13,6 +13,7 @@
 
 #include <cstddef>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "framework/world.h"
@@ -61,5 +62,12 @@ class ScriptHost {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+// The script calls running right now on any thread, innermost first per
+// thread: "footbot#3: probe.lua, in sysCall_actuation of /footbot#3/body".
+// For a watchdog that finds a run stuck in one call (Lua's hooks cannot stop
+// a script inside one C function, such as a pattern match that backtracks
+// for hours); safe to call from any thread while scripts run.
+std::vector<std::string> ScriptCallsInProgress();
 
 }  // namespace swarmsim

@@ -60,6 +60,12 @@ struct WorldSettings {
   // Bytes of Lua memory one Lua state (a robot's scripts, the scene's, the
   // main script) may hold before its script fails with an error (0: no limit).
   int64_t script_memory_limit = int64_t{256} << 20;
+  // Wall-clock seconds one step (or the start or stop of the world) may take
+  // before the runner ends the run as stuck, naming the script calls in
+  // progress (0: no limit). A safety net for what the instruction budget
+  // cannot stop: a script inside one C function (e.g. a pattern match that
+  // backtracks). It does not change results: it only ends runs.
+  double step_timeout = 60;
   ScriptErrorPolicy on_script_error = ScriptErrorPolicy::kStop;
   // Sandbox (framework/lua_sandbox.cc): scripts may read files under
   // `directory` and write files under `output_directory` (the run's --out;

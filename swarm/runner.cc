@@ -4,17 +4,23 @@
 #include <unistd.h>
 
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
+#include <functional>
 #include <iomanip>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <thread>
 
 #include "framework/error.h"
+#include "framework/script_host.h"
 #include "framework/state_hash.h"
 #include "swarm/version.h"
 
@@ -107,6 +113,106 @@ class StopSignals {
   std::array<struct sigaction, 3> saved_{};
 };
 
+std::string Fixed(double v, int digits) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(digits) << v;
+  return s.str();
+}
+
+// Ends a run whose step does not finish. Lua's hooks stop runaway Lua code
+// (the instruction budget, the memory limit) but not a script stuck inside
+// one C function, and a stop signal is only looked at between steps. After
+// `timeout` seconds (0: never) without progress, or kSignalGrace after a
+// stop signal the step did not answer, `end_run(error, signal)` runs on the
+// watchdog's thread; it writes the outputs and exits the process, since the
+// stuck thread cannot be unwound. The run loop holds io_mutex() while it
+// writes outputs and reports progress; end_run runs holding it too, so the
+// two never write at once.
+class Watchdog {
+ public:
+  using EndRun = std::function<void(const std::string& error, int signal)>;
+  static constexpr double kSignalGrace = 3;  // s
+
+  Watchdog(double timeout, EndRun end_run)
+      : timeout_(timeout), end_run_(std::move(end_run)), thread_([this] { Watch(); }) {}
+  ~Watchdog() {
+    {
+      const std::lock_guard lock(wake_mutex_);
+      done_ = true;
+    }
+    wake_.notify_one();
+    thread_.join();
+  }
+  Watchdog(const Watchdog&) = delete;
+  Watchdog& operator=(const Watchdog&) = delete;
+
+  std::mutex& io_mutex() { return io_mutex_; }
+  // One more unit of progress (the start, a step, the stop); `what` names
+  // the next one for the message ("step 12").
+  void Progress(std::string what) {
+    const std::lock_guard lock(wake_mutex_);
+    ++progress_;
+    next_ = std::move(what);
+  }
+
+ private:
+  void Watch() {
+    using namespace std::chrono_literals;
+    uint64_t seen = ~uint64_t{0};
+    Clock::time_point since = Clock::now();
+    Clock::time_point signal_since{};
+    std::unique_lock lock(wake_mutex_);
+    while (!wake_.wait_for(lock, 100ms, [this] { return done_; })) {
+      const Clock::time_point now = Clock::now();
+      if (progress_ != seen) seen = progress_, since = now, signal_since = {};
+      const int sig = g_stop_signal;
+      if (sig != 0 && signal_since == Clock::time_point{}) signal_since = now;
+      const double stalled = std::chrono::duration<double>(now - since).count();
+      std::string error;
+      int end_signal = 0;
+      if (sig != 0 && now - signal_since >= std::chrono::duration<double>(kSignalGrace)) {
+        error = std::string("interrupted by SIG") + sigabbrev_np(sig) + " during " + next_ +
+                ", which did not finish within " + Fixed(kSignalGrace, 0) + " s of the signal";
+        end_signal = sig;
+      } else if (timeout_ > 0 && stalled >= timeout_) {
+        std::ostringstream limit;
+        limit << timeout_;
+        error = next_ + " did not finish within " + limit.str() + " s (simulation.step_timeout)";
+      } else {
+        continue;
+      }
+      const std::vector<std::string> calls = ScriptCallsInProgress();
+      if (calls.empty()) {
+        error += "; no script was running";
+      } else {
+        error += "; running: ";
+        for (size_t i = 0; i < calls.size(); ++i) error += (i ? "; " : "") + calls[i];
+        error +=
+            " (Lua cannot interrupt a script inside one C function, e.g. a pattern match that "
+            "backtracks over a long string)";
+      }
+      // Outputs are written under io_mutex; progress_ cannot move meanwhile
+      // (the loop reports progress only after writing them).
+      const uint64_t before = progress_;
+      lock.unlock();
+      const std::lock_guard io(io_mutex_);
+      lock.lock();
+      if (progress_ != before) continue;  // it moved on after all
+      end_run_(error, end_signal);
+    }
+  }
+
+  const double timeout_;
+  const EndRun end_run_;
+  std::mutex io_mutex_;
+  std::mutex wake_mutex_;
+  std::condition_variable wake_;
+  bool done_ = false;
+  uint64_t progress_ = 0;
+  std::string next_ = "the start of the world";
+  std::thread thread_;  // last: starts once the members above exist
+};
+
 // A progress bar on a terminal; a plain line every 10% otherwise.
 class Progress {
  public:
@@ -153,10 +259,52 @@ class Progress {
   int last_decile_ = -1;
 };
 
-std::string Fixed(double v, int digits) {
-  std::ostringstream s;
-  s << std::fixed << std::setprecision(digits) << v;
-  return s.str();
+// summary.json. `complete`: the world is between steps; else a step is
+// stuck (Watchdog) and what a running step may change is left out: the
+// state hash and the disabled scripts.
+bool WriteSummary(const World& world, const RunOptions& options, const RunResult& result,
+                  double lua_kib, bool complete) {
+  const int robots = world.robot_count();
+  const double sim_time = world.time();
+  const double robot_ticks = static_cast<double>(robots) * static_cast<double>(result.steps);
+  nlohmann::json j;
+  j["swarmsim_version"] = Version();
+  j["world"] = options.world_file;
+  j["command"] = options.command_line;
+  j["status"] = result.ok ? "ok" : result.signal != 0 ? "interrupted" : "error";
+  if (!result.ok) j["error"] = result.error;
+  j["seed"] = world.settings().seed;
+  j["threads"] = world.threads();
+  j["physics"] = world.settings().physics;
+  j["robots"] = robots;
+  j["steps"] = result.steps;
+  j["time_step"] = world.settings().time_step;
+  j["physics_substeps"] = world.settings().physics_substeps;
+  j["simulated_time"] = sim_time;
+  j["wall_time"] = result.wall_seconds;
+  j["real_time_factor"] = result.wall_seconds > 0 ? sim_time / result.wall_seconds : 0;
+  j["robot_ticks_per_s"] = result.wall_seconds > 0 ? robot_ticks / result.wall_seconds : 0;
+  j["peak_rss_mb"] = result.peak_rss_mb;
+  j["lua_memory_kib"] = lua_kib;
+  j["state_hash"] = complete ? nlohmann::json(StateHasher::ToHex(result.state_hash)) : nullptr;
+  if (complete) j["disabled_scripts"] = world.disabled_scripts();
+  nlohmann::json phases;
+  for (size_t p = 0; p < static_cast<size_t>(Phase::kCount); ++p)
+    phases[ToString(static_cast<Phase>(p))] = world.phase_times()[p];
+  j["phase_seconds"] = phases;
+  nlohmann::json params;
+  for (const auto& [name, value] : world.parameters()) {
+    if (const double* d = std::get_if<double>(&value))
+      params[name] = *d;
+    else if (const bool* b = std::get_if<bool>(&value))
+      params[name] = *b;
+    else
+      params[name] = std::get<std::string>(value);
+  }
+  j["parameters"] = params;
+  std::ofstream f(*options.out_dir / "summary.json");
+  f << j.dump(2) << "\n";
+  return static_cast<bool>(f);
 }
 
 }  // namespace
@@ -170,37 +318,75 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
   const bool tty = isatty(STDERR_FILENO) && &progress_stream == &std::cerr;
   Progress progress(progress_stream, options.steps, !options.quiet, tty);
   const StopSignals stop_signals;
-  try {
-    if (options.out_dir) {
-      std::error_code ec;
-      std::filesystem::create_directories(*options.out_dir, ec);
-      if (ec)
-        throw Error("cannot create output folder '" + options.out_dir->string() +
-                    "': " + ec.message());
-      metrics = std::make_unique<MetricsWriter>(*options.out_dir / "metrics.csv", *world);
-    }
-    world->Start();
-    if (metrics) metrics->Write(world->TakeMetrics());
-    for (int64_t i = 0; i < options.steps; ++i) {
-      if (const int sig = g_stop_signal; sig != 0) {
-        result.signal = sig;
-        throw Error(std::string("interrupted by SIG") + sigabbrev_np(sig) + " after " +
-                    std::to_string(result.steps) + " of " + std::to_string(options.steps) +
-                    " steps");
-      }
-      world->Step();
-      ++result.steps;
+  {
+    // A step that never finishes: write what a failed run writes and exit.
+    const auto end_stuck_run = [&](const std::string& error, int signal) {
+      RunResult stuck = result;
+      stuck.ok = false;
+      stuck.error = error;
+      stuck.signal = signal;
+      stuck.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+      stuck.peak_rss_mb = PeakRssMb();
+      if (metrics) metrics->Flush();
+      if (options.out_dir && std::filesystem::is_directory(*options.out_dir))
+        WriteSummary(*world, options, stuck, 0, /*complete=*/false);
+      progress.Finish();
+      std::fflush(stdout);
+      std::cerr << "error: " << error << "\n";
+      if (options.out_dir && std::filesystem::is_directory(*options.out_dir))
+        std::cerr << "outputs up to step " << stuck.steps << " are in " << options.out_dir->string()
+                  << "\n";
+      std::cerr.flush();
+      std::_Exit(signal != 0 ? 128 + signal : 1);  // 1: the run failed, as main's
+    };
+    Watchdog watchdog(world->settings().step_timeout, end_stuck_run);
+    // Outputs of the step just done, then the next unit of work for the
+    // watchdog's message; under its lock, so it never writes at the same time.
+    const auto done = [&](std::string next) {
+      const std::lock_guard lock(watchdog.io_mutex());
       if (metrics) metrics->Write(world->TakeMetrics());
-      progress.Update(result.steps, world->time());
+      watchdog.Progress(std::move(next));
+    };
+    const auto step_name = [&] {
+      return "step " + std::to_string(result.steps + 1) + " of " + std::to_string(options.steps);
+    };
+    try {
+      if (options.out_dir) {
+        std::error_code ec;
+        std::filesystem::create_directories(*options.out_dir, ec);
+        if (ec)
+          throw Error("cannot create output folder '" + options.out_dir->string() +
+                      "': " + ec.message());
+        const std::lock_guard lock(watchdog.io_mutex());
+        metrics = std::make_unique<MetricsWriter>(*options.out_dir / "metrics.csv", *world);
+      }
+      world->Start();
+      done(options.steps > 0 ? step_name() : "the stop of the world");
+      for (int64_t i = 0; i < options.steps; ++i) {
+        if (const int sig = g_stop_signal; sig != 0) {
+          result.signal = sig;
+          throw Error(std::string("interrupted by SIG") + sigabbrev_np(sig) + " after " +
+                      std::to_string(result.steps) + " of " + std::to_string(options.steps) +
+                      " steps");
+        }
+        world->Step();
+        {
+          const std::lock_guard lock(watchdog.io_mutex());
+          ++result.steps;
+        }
+        done(result.steps < options.steps ? step_name() : "the stop of the world");
+        progress.Update(result.steps, world->time());
+      }
+      lua_kib =
+          static_cast<double>(world->script_memory_bytes()) / 1024.0;  // before the states close
+      world->Stop();
+      done("writing the outputs");
+      result.ok = true;
+    } catch (const std::exception& e) {
+      const std::lock_guard lock(watchdog.io_mutex());
+      result.error = e.what();
+      if (metrics) metrics->Write(world->TakeMetrics());  // whatever was recorded before the error
     }
-    lua_kib =
-        static_cast<double>(world->script_memory_bytes()) / 1024.0;  // before the states close
-    world->Stop();
-    if (metrics) metrics->Write(world->TakeMetrics());
-    result.ok = true;
-  } catch (const std::exception& e) {
-    result.error = e.what();
-    if (metrics) metrics->Write(world->TakeMetrics());  // whatever was recorded before the error
   }
   progress.Finish();
   if (metrics) metrics->Flush();
@@ -251,49 +437,10 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
   if (options.print_hash) out << "state-hash: " << StateHasher::ToHex(result.state_hash) << "\n";
   out << std::flush;
 
-  if (options.out_dir) {
-    nlohmann::json j;
-    j["swarmsim_version"] = Version();
-    j["world"] = options.world_file;
-    j["command"] = options.command_line;
-    j["status"] = result.ok ? "ok" : result.signal != 0 ? "interrupted" : "error";
-    if (!result.ok) j["error"] = result.error;
-    j["seed"] = world->settings().seed;
-    j["threads"] = world->threads();
-    j["physics"] = world->settings().physics;
-    j["robots"] = robots;
-    j["steps"] = result.steps;
-    j["time_step"] = world->settings().time_step;
-    j["physics_substeps"] = world->settings().physics_substeps;
-    j["simulated_time"] = sim_time;
-    j["wall_time"] = result.wall_seconds;
-    j["real_time_factor"] = rtf;
-    j["robot_ticks_per_s"] = ticks_per_s;
-    j["peak_rss_mb"] = result.peak_rss_mb;
-    j["lua_memory_kib"] = lua_kib;
-    j["state_hash"] = StateHasher::ToHex(result.state_hash);
-    j["disabled_scripts"] = world->disabled_scripts();
-    nlohmann::json phases;
-    for (size_t p = 0; p < static_cast<size_t>(Phase::kCount); ++p)
-      phases[ToString(static_cast<Phase>(p))] = world->phase_times()[p];
-    j["phase_seconds"] = phases;
-    nlohmann::json params;
-    for (const auto& [name, value] : world->parameters()) {
-      if (const double* d = std::get_if<double>(&value))
-        params[name] = *d;
-      else if (const bool* b = std::get_if<bool>(&value))
-        params[name] = *b;
-      else
-        params[name] = std::get<std::string>(value);
-    }
-    j["parameters"] = params;
-    std::ofstream f(*options.out_dir / "summary.json");
-    f << j.dump(2) << "\n";
-    if (!f) {
-      if (result.ok) {
-        result.ok = false;
-        result.error = "cannot write '" + (*options.out_dir / "summary.json").string() + "'";
-      }
+  if (options.out_dir && !WriteSummary(*world, options, result, lua_kib, /*complete=*/true)) {
+    if (result.ok) {
+      result.ok = false;
+      result.error = "cannot write '" + (*options.out_dir / "summary.json").string() + "'";
     }
   }
   return result;

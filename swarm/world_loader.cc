@@ -126,6 +126,7 @@ class WorldLoader {
  private:
   void ReadParameters(const Fields& top);
   std::shared_ptr<const ModuleRegistry> LoadPlugins(const Fields& top);
+  bool IsTrustedPluginLocation(const fs::path& canonical) const;
   void ReadModelEntries(const Fields& top);
   void CheckOverrides();
   WorldSettings ReadSimulation(const Fields& top, std::optional<int64_t>* steps);
@@ -229,6 +230,21 @@ void WorldLoader::ReadParameters(const Fields& top) {
   }
 }
 
+// Whether `canonical` lies inside the world's folder or one of the program's
+// plugin folders (symbolic links resolved on both sides).
+bool WorldLoader::IsTrustedPluginLocation(const fs::path& canonical) const {
+  std::vector<fs::path> roots{path_.parent_path()};
+  roots.insert(roots.end(), options_.plugin_directories.begin(), options_.plugin_directories.end());
+  for (const fs::path& root : roots) {
+    std::error_code ec;
+    const fs::path dir = fs::weakly_canonical(root.empty() ? fs::path(".") : root, ec);
+    if (ec) continue;
+    const fs::path relative = canonical.lexically_relative(dir);
+    if (!relative.empty() && *relative.begin() != ".." && !relative.is_absolute()) return true;
+  }
+  return false;
+}
+
 // plugins: [name or path, ...]: a path (with '/' or ending in .so) is relative
 // to the world file; a bare name is NAME.so in the world's folder, then in
 // LoadOptions::plugin_directories. Null when the world names none.
@@ -259,6 +275,16 @@ std::shared_ptr<const ModuleRegistry> WorldLoader::LoadPlugins(const Fields& top
     // Loaded already (--plugin): its commands are there.
     const fs::path canonical = fs::weakly_canonical(*found, ec);
     if (registry->HasPlugin(ec ? found->string() : canonical.string())) continue;
+    // A plugin is native code: a world may load one from its own folder or
+    // the program's plugin folders; anything else takes --trust-scripts (or
+    // --plugin), as scripts need it to reach outside the world's folder.
+    if (!options_.trust_scripts && !IsTrustedPluginLocation(canonical))
+      values.Fail(element, "plugin '" + text + "' resolves to " + canonical.string() +
+                               ", outside the world's folder (" +
+                               path_.parent_path().lexically_normal().string() +
+                               ") and the program's plugin folders; a world may load native "
+                               "code only from there (load it with --plugin PATH, or pass "
+                               "--trust-scripts)");
     try {
       LoadPlugin(found->string(), registry.get());
     } catch (const Error& e) {
@@ -347,7 +373,7 @@ WorldSettings WorldLoader::ReadSimulation(const Fields& top, std::optional<int64
     Fields f(*file_, sim, "'simulation'");
     f.Expect({"physics", "time_step", "physics_substeps", "seed", "duration", "steps", "gravity",
               "octree_resolution", "main_script", "instruction_budget", "script_memory_mb",
-              "on_script_error"});
+              "step_timeout", "on_script_error"});
     if (f.Has("main_script")) {
       const Field main = f.Get("main_script");
       const std::string text = values.String(main);
@@ -358,6 +384,9 @@ WorldSettings WorldLoader::ReadSimulation(const Fields& top, std::optional<int64
       s.instruction_budget = values.Integer(f.Get("instruction_budget"), 0, int64_t{1} << 40);
     if (f.Has("script_memory_mb"))
       s.script_memory_limit = values.Integer(f.Get("script_memory_mb"), 0, int64_t{1} << 30) << 20;
+    if (f.Has("step_timeout"))
+      s.step_timeout =
+          values.Number(f.Get("step_timeout"), {"a non-negative number of seconds", 0, 1e9});
     if (f.Has("on_script_error"))
       s.on_script_error =
           values.Choice(f.Get("on_script_error"), {"stop", "disable_script"}) == "stop"

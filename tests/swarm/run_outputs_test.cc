@@ -118,6 +118,24 @@ TEST(RunOutputsTest, SparseMetricsReachTheFileWhileTheRunGoesOn) {
   fs::remove_all(out);
 }
 
+// Sends SIGTERM to run `pid`, checks it exits 128 + 15 with summary.json's
+// status 'interrupted', and returns the summary ({} if there is none).
+nlohmann::json TerminateAndReadSummary(pid_t pid, const fs::path& out) {
+  EXPECT_EQ(kill(pid, SIGTERM), 0);
+  int status = 0;
+  EXPECT_EQ(waitpid(pid, &status, 0), pid);
+  EXPECT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status);
+  EXPECT_EQ(WEXITSTATUS(status), 128 + SIGTERM);
+  const nlohmann::json summary =
+      nlohmann::json::parse(ReadFile(out / "summary.json"), nullptr, /*allow_exceptions=*/false);
+  if (!summary.is_object()) {
+    ADD_FAILURE() << "no summary.json";
+    return nlohmann::json::object();
+  }
+  EXPECT_EQ(summary.value("status", ""), "interrupted");
+  return summary;
+}
+
 TEST(RunOutputsTest, TerminatedRunKeepsItsOutputsAndSaysSo) {
   const fs::path out = TempDir("sigterm");
   const pid_t pid = Spawn(
@@ -125,15 +143,8 @@ TEST(RunOutputsTest, TerminatedRunKeepsItsOutputsAndSaysSo) {
   ASSERT_GT(pid, 0);
   EXPECT_GT(WaitForRows(out / "metrics.csv"), 0u) << "the run never got going";
 
-  ASSERT_EQ(kill(pid, SIGTERM), 0);
-  int status = 0;
-  ASSERT_EQ(waitpid(pid, &status, 0), pid);
-  ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status);
-  EXPECT_EQ(WEXITSTATUS(status), 128 + SIGTERM);
-
-  const auto summary = nlohmann::json::parse(ReadFile(out / "summary.json"));
-  EXPECT_EQ(summary["status"], "interrupted");
-  const std::string error = summary["error"];
+  const nlohmann::json summary = TerminateAndReadSummary(pid, out);
+  const std::string error = summary.value("error", "");
   EXPECT_EQ(error.rfind("interrupted by SIGTERM after ", 0), 0u) << error;
   const int64_t steps = summary["steps"];
   EXPECT_GT(steps, 0);
@@ -144,6 +155,75 @@ TEST(RunOutputsTest, TerminatedRunKeepsItsOutputsAndSaysSo) {
   // a step throughout; robot 1 until its script is disabled at t = 0.3.
   EXPECT_GE(Lines(metrics).size(), 1u + static_cast<size_t>(steps) * 4);
   fs::remove_all(out);
+}
+
+// A world whose one robot records its time every step and, from step 4 on,
+// gets stuck in one C call the instruction budget cannot stop (a pattern
+// match backtracking over 300,000 characters: hours). It writes 'stuck' to
+// the run's folder first.
+fs::path StuckWorld(const std::string& name, const std::string& step_timeout) {
+  const fs::path dir = TempDir(name);
+  fs::create_directories(dir);
+  std::ofstream(dir / "world.yaml") << "simulation: {physics: kinematic, time_step: 0.1, "
+                                       "step_timeout: "
+                                    << step_timeout
+                                    << "}\n"
+                                       "models:\n  - {model: probe.yaml, position: [0, 0]}\n";
+  std::ofstream(dir / "probe.yaml") << "model: probe\n"
+                                       "objects: {name: body, type: dummy, script: probe.lua}\n";
+  std::ofstream(dir / "probe.lua") << "function sysCall_actuation()\n"
+                                      "  sim.recordMetric('t', sim.getSimulationTime())\n"
+                                      "  if sim.getSimulationTime() > 0.25 then\n"
+                                      "    io.open('stuck', 'w'):close()\n"
+                                      "    return string.rep('a', 300000):find('.-.-b')\n"
+                                      "  end\n"
+                                      "end\n";
+  return dir;
+}
+
+// The watchdog: a step stuck past simulation.step_timeout ends the run with
+// the calls in progress named and the outputs written.
+TEST(RunOutputsTest, StuckStepEndsTheRunNamingTheScriptAndKeepsTheOutputs) {
+  const fs::path dir = StuckWorld("stuck", "1");
+  const auto r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 100 --out " +
+                            (dir / "out").string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("error: step 4 of 100 did not finish within 1 s "
+                          "(simulation.step_timeout); running: probe#0: "),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("probe.lua, in sysCall_actuation of /probe#0"), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("outputs up to step 3 are in"), std::string::npos) << r.output;
+  const auto summary = nlohmann::json::parse(ReadFile(dir / "out" / "summary.json"));
+  EXPECT_EQ(summary["status"], "error");
+  EXPECT_EQ(summary["steps"], 3);
+  EXPECT_NE(std::string(summary["error"]).find("did not finish"), std::string::npos);
+  EXPECT_TRUE(summary["state_hash"].is_null()) << "a stuck step's state is not a state";
+  const std::vector<std::string> rows = Lines(ReadFile(dir / "out" / "metrics.csv"));
+  ASSERT_EQ(rows.size(), 1u + 3) << "the header and steps 1-3";
+  EXPECT_EQ(rows[3], "2,0.2,probe#0,t,0.2");
+  fs::remove_all(dir);
+}
+
+// Without a timeout, a stop signal still ends a stuck step: a few seconds
+// after it, with status 'interrupted' and 128 + signal.
+TEST(RunOutputsTest, StopSignalEndsAStuckStep) {
+  const fs::path dir = StuckWorld("stuck_signal", "0");
+  const fs::path out = dir / "out";
+  const pid_t pid = Spawn(
+      {"run", (dir / "world.yaml").string(), "--steps", "100", "--out", out.string(), "--quiet"});
+  ASSERT_GT(pid, 0);
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (!fs::exists(out / "stuck") && std::chrono::steady_clock::now() < give_up)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  ASSERT_TRUE(fs::exists(out / "stuck"));
+  const std::string error = TerminateAndReadSummary(pid, out).value("error", "");
+  EXPECT_EQ(error.rfind("interrupted by SIGTERM during step 4 of 100, which did not finish", 0), 0u)
+      << error;
+  EXPECT_NE(error.find("probe#0: "), std::string::npos) << error;
+  EXPECT_EQ(Lines(ReadFile(out / "metrics.csv")).size(), 1u + 3);
+  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -102,4 +102,50 @@ TEST(SandboxCliTest, TrustedScriptsUseTheWorldsFoldersLikeSandboxedOnes) {
   fs::remove_all(dir);
 }
 
+// A plugin is native code: a world loads one from its own folder or the
+// program's plugins/ folder; one elsewhere (absolute, '../', or a symbolic
+// link out of the folder) takes --trust-scripts or --plugin.
+TEST(SandboxCliTest, WorldLoadsPluginsOnlyFromItsFolderOrTheProgramsUnlessTrusted) {
+  const fs::path built = fs::path(SWARMSIM_BINARY).parent_path() / "plugins" / "example_plugin.so";
+  ASSERT_TRUE(fs::exists(built));
+  const fs::path dir = MakeWorld("assert(sim.exampleSum(1, 2) == 3)");
+  const fs::path elsewhere = dir.string() + "_lib";
+  fs::remove_all(elsewhere);
+  fs::create_directories(elsewhere);
+  fs::copy_file(built, elsewhere / "example_plugin.so");
+  fs::create_directories(dir / "lib");
+  fs::copy_file(built, dir / "lib" / "mine.so");
+  fs::create_symlink(elsewhere / "example_plugin.so", dir / "link.so");
+  const auto world_with = [&](const std::string& plugin) {
+    std::ofstream(dir / "world.yaml") << "plugins: [" << plugin
+                                      << "]\nsimulation: {physics: kinematic, time_step: 0.1}\n"
+                                         "models:\n  - {model: probe.yaml, position: [0, 0]}\n";
+    return "run " + (dir / "world.yaml").string() + " --steps 1 --quiet";
+  };
+  for (const std::string& outside :
+       {(elsewhere / "example_plugin.so").string(),
+        "../" + elsewhere.filename().string() + "/example_plugin.so", std::string("link.so")}) {
+    Result r = RunProgram(world_with(outside));
+    EXPECT_EQ(r.exit_code, 2) << outside << "\n" << r.output;
+    EXPECT_NE(r.output.find("world.yaml:1:"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("outside the world's folder"), std::string::npos) << r.output;
+    r = RunProgram(world_with(outside) + " --trust-scripts");
+    EXPECT_EQ(r.exit_code, 0) << outside << "\n" << r.output;
+  }
+  // From the world's folder, and by name from the program's plugins/.
+  for (const std::string& inside : {std::string("lib/mine.so"), std::string("example_plugin")}) {
+    const Result r = RunProgram(world_with(inside));
+    EXPECT_EQ(r.exit_code, 0) << inside << "\n" << r.output;
+  }
+  // --plugin is the user's own choice, from anywhere.
+  std::ofstream(dir / "world.yaml") << "simulation: {physics: kinematic, time_step: 0.1}\n"
+                                       "models:\n  - {model: probe.yaml, position: [0, 0]}\n";
+  const Result r =
+      RunProgram("run " + (dir / "world.yaml").string() + " --steps 1 --quiet --plugin " +
+                 (elsewhere / "example_plugin.so").string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  fs::remove_all(dir);
+  fs::remove_all(elsewhere);
+}
+
 }  // namespace
