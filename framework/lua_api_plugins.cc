@@ -61,7 +61,8 @@ int CallPluginCommand(lua_State* L) {
   for (int i = 0; i < count; ++i) {
     const SwarmsimValue& r = results[i];
     switch (r.type) {
-      case kSwarmsimNumber: lua_pushnumber(L, r.number); break;
+      // Whole numbers as Lua integers (3, not 3.0), as getParam gives them.
+      case kSwarmsimNumber: PushValueNumber(L, r.number); break;
       case kSwarmsimString: lua_pushlstring(L, r.text != nullptr ? r.text : "", r.size); break;
       case kSwarmsimNumbers: PushNumberArray(L, r.numbers, static_cast<int>(r.size)); break;
       default: lua_pushnil(L); break;

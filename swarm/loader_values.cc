@@ -75,6 +75,26 @@ std::vector<std::string> Scope::Names() const {
   return out;
 }
 
+std::string Scope::NotYetDefined(std::string_view name) const {
+  constexpr std::string_view kRule = "a parameter can use only the parameters defined above it";
+  if (!reading) return "";
+  if (name == reading->current)
+    return "parameter '" + std::string(name) + "' cannot use itself (" + std::string(kRule) + ")";
+  const auto it = reading->later.find(name);
+  if (it == reading->later.end()) return "";
+  return "parameter '" + std::string(name) + "' is defined below this one (at " + it->second +
+         "); " + std::string(kRule);
+}
+
+std::string Scope::ListHint() const {
+  std::string params;
+  for (const std::string& n : Names()) params += (params.empty() ? "" : ", ") + n;
+  if (reading)
+    return params.empty() ? " (no parameters are defined above this one)"
+                          : " (parameters defined above this one: " + params + ")";
+  return params.empty() ? " (there are no parameters)" : " (parameters: " + params + ")";
+}
+
 // --- Expressions ------------------------------------------------------------------------
 
 struct Expressions::Impl {
@@ -119,21 +139,20 @@ struct Expressions::Impl {
         message = "unknown name";
       } else {
         const std::string key = lua_tostring(L, 2);
-        std::vector<std::string> names;
-        lua_pushnil(L);
-        while (lua_next(L, 1) != 0) {
-          if (lua_type(L, -2) == LUA_TSTRING) names.push_back(lua_tostring(L, -2));
-          lua_pop(L, 1);
-        }
-        std::string hint = Suggest(key, names);
-        if (!hint.starts_with(";")) {
+        const Scope& scope = *From(L)->scope;
+        message = scope.NotYetDefined(key);
+        if (message.empty()) {
+          std::vector<std::string> names;
+          lua_pushnil(L);
+          while (lua_next(L, 1) != 0) {
+            if (lua_type(L, -2) == LUA_TSTRING) names.push_back(lua_tostring(L, -2));
+            lua_pop(L, 1);
+          }
+          std::string hint = Suggest(key, names);
           // No near miss: list the parameters only (not all of math).
-          std::string params;
-          for (const std::string& n : From(L)->scope->Names())
-            params += (params.empty() ? "" : ", ") + n;
-          hint = params.empty() ? " (there are no parameters)" : " (parameters: " + params + ")";
+          if (!hint.starts_with(";")) hint = scope.ListHint();
+          message = "unknown name '" + key + "'" + hint;
         }
-        message = "unknown name '" + key + "'" + hint;
       }
       lua_pushstring(L, message.c_str());
     }
@@ -266,9 +285,11 @@ ParamValue ValueReader::Resolve(const Field& field) const {
   if (trimmed.starts_with("$")) {
     const std::string name(Trim(trimmed.substr(1)));
     if (const ParamValue* value = scope_.Find(name)) return *value;
+    if (std::string later = scope_.NotYetDefined(name); !later.empty())
+      Fail(field, "'" + field.name + "': " + later);
     const std::vector<std::string> names = scope_.Names();
     Fail(field, "unknown parameter '$" + name + "' in '" + field.name + "'" +
-                    (names.empty() ? " (there are no parameters)" : Suggest(name, names)));
+                    (names.empty() ? scope_.ListHint() : Suggest(name, names)));
   }
   if (trimmed.starts_with("=")) {
     const std::string expression(Trim(trimmed.substr(1)));

@@ -4,6 +4,8 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -16,14 +18,29 @@
 
 namespace swarmsim::loader {
 
+// While the world's parameters are read, in file order: the one being read
+// and those further down the file, which exist but cannot be used yet.
+struct ParametersBeingRead {
+  std::string_view current;
+  std::map<std::string, std::string, std::less<>> later;  // name -> "line 12"
+};
+
 // The names a value may refer to: a model's parameters (if any) shadow the
 // world's, as World::FindParameter does for scripts.
 struct Scope {
   const ParameterSet* world = nullptr;
   const ParameterSet* model = nullptr;
+  const ParametersBeingRead* reading = nullptr;  // only while reading them
 
   const ParamValue* Find(std::string_view name) const;
   std::vector<std::string> Names() const;
+  // Why `name` (not found) cannot be used when it is being read or below
+  // ("parameter 'b' is defined below this one (at line 12); ..."), else "".
+  std::string NotYetDefined(std::string_view name) const;
+  // The hint after "unknown ..." when there is no near miss: the parameters
+  // there are, or " (there are no parameters)"; while the world's
+  // parameters are read, the ones above.
+  std::string ListHint() const;
 };
 
 // A small sandboxed Lua state for "= expression" values. Its globals are the

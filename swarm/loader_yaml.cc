@@ -87,6 +87,20 @@ std::string ReadFileOrThrow(const fs::path& path, std::string_view kind, const s
   return buffer.str();
 }
 
+// Whether the indentation of line `line` (0-based) of `text` holds a tab,
+// which YAML forbids and yaml-cpp reports in its own terms.
+static bool TabInIndentation(std::string_view text, int line) {
+  size_t start = 0;
+  for (int i = 0; i < line; ++i) {
+    start = text.find('\n', start);
+    if (start == std::string_view::npos) return false;
+    ++start;
+  }
+  for (size_t i = start; i < text.size() && (text[i] == ' ' || text[i] == '\t'); ++i)
+    if (text[i] == '\t') return true;
+  return false;
+}
+
 YamlFile YamlFile::Load(const fs::path& path, std::string_view kind,
                         const std::string& referenced_by, const std::string& reference_text) {
   YamlFile file;
@@ -97,7 +111,9 @@ YamlFile YamlFile::Load(const fs::path& path, std::string_view kind,
     file.root_ = YAML::Load(text);
   } catch (const YAML::ParserException& e) {
     // Includes yaml-cpp's DeepRecursion (nesting beyond its depth guard).
-    file.Fail(e.mark, "YAML syntax error: " + e.msg);
+    const std::string hint =
+        TabInIndentation(text, e.mark.line) ? " (YAML does not allow tabs for indentation)" : "";
+    file.Fail(e.mark, "YAML syntax error: " + e.msg + hint);
   } catch (const YAML::Exception& e) {
     file.Fail(e.mark, std::string("cannot read YAML: ") + e.what());
   }

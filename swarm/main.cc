@@ -11,6 +11,7 @@
 #include <iostream>
 #include <limits>
 #include <span>
+#include <sstream>
 #include <string_view>
 
 #include "framework/error.h"
@@ -490,8 +491,19 @@ int Main(int argc, char** argv) {
   }
 
   // run
+  RunOptions options;
+  if (!out_dir.empty()) options.out_dir = out_dir;
+  options.world_file = world_file;
+  for (int i = 0; i < argc; ++i) options.command_line += (i ? " " : "") + std::string(argv[i]);
+  // A world that does not load (or does not fit the command line): with
+  // --out, summary.json says so too, for a batch system watching the folder.
+  const auto bad_input = [&](const std::string& message) {
+    std::cerr << "error: " << message << "\n";
+    if (options.out_dir && !WriteErrorSummary(options, message))
+      std::cerr << "error: cannot write '" << (*options.out_dir / "summary.json").string() << "'\n";
+    return kExitBadInput;
+  };
   LoadOptions load;
-  load.overrides = ParseSets(sets);
   load.seed = seed;
   load.threads = threads;
   if (!out_dir.empty()) load.output_directory = out_dir;
@@ -499,42 +511,38 @@ int Main(int argc, char** argv) {
   load.plugin_directories = PluginDirectories();
   LoadedWorld loaded;
   try {
+    load.overrides = ParseSets(sets);
     for (const std::string& plugin : plugins) LoadPlugin(plugin, &registry);
     loaded = LoadWorld(world_file, load, registry);
   } catch (const Error& e) {
-    std::cerr << "error: " << e.what() << "\n";
-    return kExitBadInput;
+    return bad_input(e.what());
   }
-  RunOptions options;
   if (steps >= 0) {
     options.steps = steps;
   } else if (duration >= 0) {
     // The nearest whole number of steps; a duration under one step would run none.
     const double time_step = loaded.world->settings().time_step;
     if (duration > 0 && duration < time_step) {
-      std::cerr << "error: --duration " << duration << " s is shorter than one time step ("
-                << time_step << " s)\n";
-      return kExitBadInput;
+      std::ostringstream message;
+      message << "--duration " << duration << " s is shorter than one time step (" << time_step
+              << " s)";
+      return bad_input(message.str());
     }
     const double step_count = std::round(duration / time_step);
     if (!(step_count <= 1e15)) {
-      std::cerr << "error: --duration " << duration << " s is " << step_count << " steps of "
-                << time_step << " s; at most 1e15 steps\n";
-      return kExitBadInput;
+      std::ostringstream message;
+      message << "--duration " << duration << " s is " << step_count << " steps of " << time_step
+              << " s; at most 1e15 steps";
+      return bad_input(message.str());
     }
     options.steps = static_cast<int64_t>(step_count);
   } else if (loaded.steps) {
     options.steps = *loaded.steps;
   } else {
-    std::cerr << "error: " << world_file
-              << " gives no run length; pass --steps N or --duration SECONDS\n";
-    return kExitBadInput;
+    return bad_input(world_file + " gives no run length; pass --steps N or --duration SECONDS");
   }
-  if (!out_dir.empty()) options.out_dir = out_dir;
   options.print_hash = hash;
   options.quiet = quiet;
-  options.world_file = world_file;
-  for (int i = 0; i < argc; ++i) options.command_line += (i ? " " : "") + std::string(argv[i]);
   const RunResult result = RunWorld(loaded.world.get(), options, std::cout, std::cerr);
   if (!result.ok) {
     std::cerr << "error: " << result.error << "\n";

@@ -309,6 +309,21 @@ bool WriteSummary(const World& world, const RunOptions& options, const RunResult
 
 }  // namespace
 
+bool WriteErrorSummary(const RunOptions& options, const std::string& error) {
+  if (!options.out_dir) return false;
+  std::error_code ec;
+  std::filesystem::create_directories(*options.out_dir, ec);
+  nlohmann::json j;
+  j["swarmsim_version"] = Version();
+  j["world"] = options.world_file;
+  j["command"] = options.command_line;
+  j["status"] = "error";
+  j["error"] = error;
+  std::ofstream f(*options.out_dir / "summary.json");
+  f << j.dump(2) << "\n";
+  return static_cast<bool>(f);
+}
+
 RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
                    std::ostream& progress_stream) {
   RunResult result;

@@ -39,6 +39,12 @@ struct RunResult {
 RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
                    std::ostream& progress);
 
+// summary.json for a run that never started (the world did not load, or the
+// command line and world do not agree): status "error", the message, world,
+// command and swarmsim_version. Creates `options.out_dir`; returns false
+// when the file cannot be written.
+bool WriteErrorSummary(const RunOptions& options, const std::string& error);
+
 // Peak resident set size of this process, in MiB.
 double PeakRssMb();
 

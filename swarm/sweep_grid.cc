@@ -1,5 +1,7 @@
 #include "swarm/sweep_grid.h"
 
+#include <cctype>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <set>
@@ -41,10 +43,17 @@ int64_t ToCount(const std::string& text, const std::string& context) {
   return static_cast<int64_t>(v);
 }
 
+// What a seed is, as `run --seed` takes it.
+constexpr char kSeedRange[] = "(a whole number from 0 to 18446744073709551615)";
+
+// One seed: decimal, 0..2^64-1.
 uint64_t ToSeed(const std::string& text, const std::string& context) {
-  if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos)
-    throw Error(context + ": '" + text + "' is not a seed (a whole number >= 0)");
-  return std::stoull(text);
+  uint64_t value = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (text.empty() || !std::isdigit(static_cast<unsigned char>(text[0])) || ec != std::errc() ||
+      end != text.data() + text.size())
+    throw Error(context + ": '" + text + "' is not a seed " + kSeedRange);
+  return value;
 }
 
 }  // namespace
@@ -96,19 +105,37 @@ ParamSpec ParseParamSpec(const std::string& name_equals_spec) {
 
 std::vector<uint64_t> ParseSeeds(const std::string& spec) {
   const std::string context = "--seeds " + spec;
+  if (spec.empty())
+    throw Error("--seeds: expected K (seeds 1..K), a range A-B or a list A,B,C, got ''");
   std::vector<uint64_t> seeds;
   if (spec.find(',') != std::string::npos) {
-    for (const std::string& s : Split(spec, ',')) seeds.push_back(ToSeed(s, context));
-  } else if (const size_t dash = spec.find('-'); dash != std::string::npos) {
-    const uint64_t a = ToSeed(spec.substr(0, dash), context);
-    const uint64_t b = ToSeed(spec.substr(dash + 1), context);
-    if (b < a) throw Error(context + ": a seed range A-B needs A <= B");
+    for (const std::string& s : Split(spec, ',')) {
+      if (s.empty()) throw Error(context + ": empty seed in the list");
+      seeds.push_back(ToSeed(s, context));
+    }
+  } else if (const size_t dash = spec.find('-'); dash != std::string::npos && dash > 0) {
+    // (A leading '-' is a negative seed, not a range.)
+    const std::string first = spec.substr(0, dash), last = spec.substr(dash + 1);
+    if (last.empty()) throw Error(context + ": a seed range A-B needs both A and B");
+    const uint64_t a = ToSeed(first, context);
+    const uint64_t b = ToSeed(last, context);
+    if (b < a)
+      throw Error(context + ": a seed range A-B needs A <= B (got " + first + " > " + last + ")");
     if (b - a >= 1000000) throw Error(context + ": more than a million seeds");
     for (uint64_t s = a; s <= b; ++s) seeds.push_back(s);
-  } else {
-    const uint64_t k = ToSeed(spec, context);
-    if (k == 0 || k > 1000000) throw Error(context + ": the number of seeds must be 1 to 10^6");
+  } else if (spec.find_first_not_of("0123456789") == std::string::npos) {
+    // A count K (out of range for any number of digits).
+    uint64_t k = 0;
+    const auto [end, ec] = std::from_chars(spec.data(), spec.data() + spec.size(), k);
+    if (ec != std::errc() || k == 0 || k > 1000000)
+      throw Error(context + ": the number of seeds K must be 1 to 10^6, got '" + spec +
+                  "' (a range A-B or a list A,B,C takes any seeds)");
     for (uint64_t s = 1; s <= k; ++s) seeds.push_back(s);
+  } else if (spec.front() == '-') {
+    throw Error(context + ": '" + spec + "' is not a seed " + kSeedRange);
+  } else {
+    throw Error(context + ": expected K (seeds 1..K), a range A-B or a list A,B,C, got '" + spec +
+                "'");
   }
   std::set<uint64_t> seen;
   for (uint64_t s : seeds)

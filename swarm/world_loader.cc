@@ -210,8 +210,14 @@ void WorldLoader::ReadParameters(const Fields& top) {
   const Field params = top.Get("parameters");
   if (!params.present()) return;
   Fields fields(*file_, params, "'parameters'");
-  // In file order: a parameter's expression may use the ones above it.
+  // In file order: a parameter's expression may use the ones above it; the
+  // ones below are named as such in messages.
+  loader::ParametersBeingRead reading;
+  for (const Field& p : fields.fields())
+    reading.later.emplace(p.name, "line " + std::to_string(p.key_mark.line + 1));
   for (const Field& p : fields.fields()) {
+    reading.current = p.name;
+    reading.later.erase(p.name);
     if (!loader::IsParameterName(p.name))
       file_->Fail(p.key_mark,
                   "parameter name '" + p.name +
@@ -219,7 +225,8 @@ void WorldLoader::ReadParameters(const Fields& top) {
     if (!p.node.IsScalar() || !p.present())
       file_->Fail(p.mark, "parameter '" + p.name + "' must be a number, true/false or text (got " +
                               loader::Describe(p.node) + ")");
-    ParamValue value = WorldValues().Resolve(p);
+    ParamValue value =
+        ValueReader(*file_, &expressions_, {&parameters_, nullptr, &reading}).Resolve(p);
     for (Override& o : overrides_) {
       if (!o.model.empty() || o.name != p.name) continue;
       value = CoerceOverride(o, value, file_->Where(p.mark));

@@ -56,9 +56,37 @@ end)"}));
   world.Start();
   const std::string error = ErrorOf([&] { world.Step(); });
   EXPECT_CONTAINS(error, "bot#0: robot.lua:5: sim.exampleSum: argument 1 must be a number");
-  const std::vector<std::string> expected = {"[bot#0] 10.0\t1.0\t2.0\t0.0",
-                                             "[bot#1] 10.0\t2.0\t2.0\t1.0"};
+  const std::vector<std::string> expected = {"[bot#0] 10\t1.0\t2.0\t0", "[bot#1] 10\t2.0\t2.0\t1"};
   EXPECT_EQ(log, expected);
+}
+
+// A world without physics of one robot, bot#0 (a dummy), running `code` as
+// robot.lua; its prints go to *log.
+std::unique_ptr<World> OneBotWorld(const ModuleRegistry& registry, const char* code,
+                                   std::vector<std::string>* log) {
+  WorldSettings settings;
+  settings.physics = "null";
+  auto world = std::make_unique<World>(settings, registry);
+  world->set_log_sink([log](std::string_view line) { log->emplace_back(line); });
+  const ObjectId root = world->scene().AddDummy("bot", {}, {});
+  world->scene().MakeModelInstance(root, "bot", "bot#0");
+  world->scene().AttachScript(
+      root, std::make_shared<const ScriptSource>(ScriptSource{"robot.lua", code}));
+  return world;
+}
+
+TEST(PluginTest, WholeNumberResultsArriveAsLuaIntegers) {
+  ModuleRegistry registry = testing::NullRegistry();
+  LoadPlugin(PluginPath("example_plugin.so"), &registry);
+  std::vector<std::string> log;
+  const auto world = OneBotWorld(registry, R"(
+function sysCall_init()
+  print(sim.exampleSum(1, 2), math.type(sim.exampleSum(1, 2)), sim.exampleSum(0.5, 1),
+        sim.exampleSum(-4), 'robot' .. sim.exampleSum(3.0))
+end)",
+                                 &log);
+  world->Start();
+  EXPECT_EQ(log, std::vector<std::string>{"[bot#0] 3\tinteger\t1.5\t-4\trobot3"});
 }
 
 TEST(PluginTest, LoadErrorsNameThePathAndTheProblem) {
@@ -77,31 +105,21 @@ TEST(PluginTest, PhaseCallbacksRunAtTheirPointsOfTheStep) {
   ModuleRegistry registry = testing::NullRegistry();
   LoadPlugin(PluginPath("example_plugin.so"), &registry);
   EXPECT_EQ(registry.phase_callbacks().size(), 5u);  // Steer + 4 counters
-  WorldSettings settings;
-  settings.physics = "null";
-  World world(settings, registry);
   std::vector<std::string> log;
-  world.set_log_sink([&](std::string_view line) { log.emplace_back(line); });
-  const ObjectId root = world.scene().AddDummy("bot", {}, {});
-  world.scene().MakeModelInstance(root, "bot", "bot#0");
-  world.scene().AttachScript(root,
-                             std::make_shared<const ScriptSource>(ScriptSource{"robot.lua", R"(
+  const auto world = OneBotWorld(registry, R"(
 function sysCall_actuation()
   print(table.concat(sim.examplePhaseCounts(), ' '))
-end)"}));
-  for (int i = 0; i < 3; ++i) world.Step();
+end)",
+                                 &log);
+  for (int i = 0; i < 3; ++i) world->Step();
   // In step k (from 0) the script runs after sense and before-control of
   // step k, after control and physics of steps 0..k-1.
   const std::vector<std::string> expected = {"[bot#0] 1.0 1.0 0.0 0.0", "[bot#0] 2.0 2.0 1.0 1.0",
                                              "[bot#0] 3.0 3.0 2.0 2.0"};
   EXPECT_EQ(log, expected);
   // A robot without motors cannot use robotMoveAndAvoidObstacles.
-  World other(settings, registry);
-  const ObjectId bot = other.scene().AddDummy("bot", {}, {});
-  other.scene().MakeModelInstance(bot, "bot", "bot#0");
-  other.scene().AttachScript(bot, std::make_shared<const ScriptSource>(ScriptSource{
-                                      "robot.lua", "sim.robotMoveAndAvoidObstacles(1)"}));
-  EXPECT_CONTAINS(ErrorOf([&] { other.Start(); }),
+  const auto other = OneBotWorld(registry, "sim.robotMoveAndAvoidObstacles(1)", &log);
+  EXPECT_CONTAINS(ErrorOf([&] { other->Start(); }),
                   "sim.robotMoveAndAvoidObstacles: the robot has no :/leftMotor and :/rightMotor");
 }
 

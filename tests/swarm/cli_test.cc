@@ -222,6 +222,39 @@ TEST(CliTest, TypoInWorldNamesLineAndSuggests) {
   EXPECT_NE(r.output.find("wall_thickness"), std::string::npos) << r.output;
 }
 
+TEST(CliTest, WorldThatDoesNotLoadWritesAnErrorSummaryWithOut) {
+  // The --out folder is created (nested) and summary.json says what went wrong.
+  const fs::path out = TempDir("load_error") / "run1";
+  const std::string command = std::string(SWARMSIM_BINARY) + " run " + Data("typo.yaml") +
+                              " --steps 1 --out " + out.string();
+  Result r = swarmsim::testing::RunCommand(command);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("error: "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("typo.yaml:4:3: unknown key 'wall_thicknes'"), std::string::npos)
+      << r.output;
+  std::ifstream summary_file(out / "summary.json");
+  ASSERT_TRUE(summary_file.good()) << "summary.json must be written when the world fails to load";
+  const auto summary = nlohmann::json::parse(summary_file);
+  EXPECT_EQ(summary["status"], "error");
+  const std::string error = summary["error"];
+  EXPECT_NE(error.find("typo.yaml:4:3: unknown key 'wall_thicknes'"), std::string::npos) << error;
+  EXPECT_NE(r.output.find("error: " + error), std::string::npos) << r.output;
+  EXPECT_EQ(summary["world"], Data("typo.yaml"));
+  EXPECT_EQ(summary["command"], command);
+  EXPECT_EQ("swarmsim " + summary["swarmsim_version"].get<std::string>() + "\n",
+            RunProgram("version").output);
+  EXPECT_FALSE(fs::exists(out / "metrics.csv"));
+  // A --duration the world cannot run is bad input too, and says so in the folder.
+  fs::remove_all(out);
+  r = RunProgram("run " + Data("ok.yaml") + " --duration 0.01 --out " + out.string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  std::ifstream duration_file(out / "summary.json");
+  ASSERT_TRUE(duration_file.good());
+  EXPECT_EQ(nlohmann::json::parse(duration_file)["error"],
+            "--duration 0.01 s is shorter than one time step (0.1 s)");
+  fs::remove_all(out.parent_path());
+}
+
 TEST(CliTest, RunWritesSummaryAndMetricsAndHashIsStable) {
   const fs::path out = TempDir("ok");
   Result r =

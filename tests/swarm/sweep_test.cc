@@ -221,6 +221,31 @@ TEST(SweepTest, SameSeedSameHashAsRunAndChangedWorldIsRefused) {
   fs::remove_all(dir);
 }
 
+TEST(SweepTest, MalformedSeedsAreClearErrorsNamingTheOptionAndTheValue) {
+  const fs::path dir = TempDir("seeds");
+  const fs::path db = dir / "r.db";
+  // --seeds SPEC -> what the message must say after "error: --seeds SPEC: ".
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"18446744073709551616",
+       "the number of seeds K must be 1 to 10^6, got '18446744073709551616'"},
+      {"1-18446744073709551616",
+       "'18446744073709551616' is not a seed (a whole number from 0 to 18446744073709551615)"},
+      {"5-3", "a seed range A-B needs A <= B (got 5 > 3)"},
+      {"1,,2", "empty seed in the list"},
+      {"-1", "'-1' is not a seed (a whole number from 0 to 18446744073709551615)"},
+      {"1.5", "expected K (seeds 1..K), a range A-B or a list A,B,C, got '1.5'"},
+  };
+  for (const auto& [spec, message] : cases) {
+    Result r = RunProgram("sweep " + kWorld + " --seeds " + spec + " --steps 1 --quiet --db " +
+                          db.string());
+    EXPECT_EQ(r.exit_code, 2) << spec << ": " << r.output;
+    EXPECT_NE(r.output.find("error: --seeds " + spec + ": " + message), std::string::npos)
+        << r.output;
+    EXPECT_FALSE(fs::exists(db)) << spec;
+  }
+  fs::remove_all(dir);
+}
+
 TEST(SweepTest, ReportTableCsvColumnsAndPlot) {
   const fs::path dir = TempDir("report");
   const fs::path db = dir / "r.db";

@@ -393,6 +393,28 @@ TEST_F(MalformedWorldTest, EachMistakeHasAClearMessage) {
   }
 }
 
+TEST_F(MalformedWorldTest, TabIndentationSaysYamlDoesNotAllowTabs) {
+  const std::string hint = "(YAML does not allow tabs for indentation)";
+  // A tab alone, a tab after spaces, a tab before a list entry.
+  for (const std::string& world :
+       {std::string("arena:\n\tsize: 2\n"), std::string("arena:\n  size: 2\n  \twall_height: 1\n"),
+        std::string("arena: {size: 2}\nmodels:\n\t- model: bot.yaml\n")}) {
+    const std::string message = LoadText(world);
+    EXPECT_NE(message.find("world.yaml:"), std::string::npos) << message;
+    EXPECT_NE(message.find("YAML syntax error: "), std::string::npos) << message;
+    EXPECT_NE(message.find(hint), std::string::npos) << message;
+  }
+  // In a model file too.
+  Write("bot.yaml", "model: bot\nobjects:\n  type: dummy\n\tname: x\n");
+  std::string message = LoadText(std::string("arena: {size: 2}\n") + kModels);
+  EXPECT_NE(message.find("bot.yaml:4:"), std::string::npos) << message;
+  EXPECT_NE(message.find(hint), std::string::npos) << message;
+  // Not for other syntax errors, nor for a tab that is not indentation.
+  message = LoadText("arena: {size: [1,\t2}\n");
+  EXPECT_NE(message.find("YAML syntax error"), std::string::npos) << message;
+  EXPECT_EQ(message.find(hint), std::string::npos) << message;
+}
+
 TEST_F(MalformedWorldTest, MissingWorldFileIsNamed) {
   const std::string message = ErrorOf([&] { Load(dir_ / "nothere.yaml"); });
   EXPECT_NE(message.find("nothere.yaml"), std::string::npos) << message;
@@ -562,6 +584,39 @@ TEST_F(MalformedWorldTest, ExpressionsSeeParametersAndMath) {
   LoadOptions options;
   options.overrides = {{"robots", "32"}};
   EXPECT_DOUBLE_EQ(std::get<double>(Load(file, options).world->parameters().at("side")), 11);
+}
+
+TEST_F(MalformedWorldTest, ParameterUsingOneBelowItSaysOnlyThoseAboveCanBeUsed) {
+  const std::string rule = "a parameter can use only the parameters defined above it";
+  // An expression and a $reference to a later parameter: named, with where it is.
+  std::string message = LoadText("parameters:\n  a: \"= b * 2\"\n  b: 3\n");
+  EXPECT_NE(message.find("world.yaml:2:6: in expression 'b * 2' for 'a': parameter 'b' is "
+                         "defined below this one (at line 3); " +
+                         rule),
+            std::string::npos)
+      << message;
+  EXPECT_EQ(message.find("there are no parameters"), std::string::npos) << message;
+  message = LoadText("parameters:\n  x: 1\n  a: $b\n  b: 3\n");
+  EXPECT_NE(message.find("world.yaml:3:6: 'a': parameter 'b' is defined below this one "
+                         "(at line 4); " +
+                         rule),
+            std::string::npos)
+      << message;
+  // An unknown name lists the parameters above; none above is not "none at all".
+  message = LoadText("parameters:\n  a: \"= zzz\"\n  b: 3\n");
+  EXPECT_NE(message.find("unknown name 'zzz' (no parameters are defined above this one)"),
+            std::string::npos)
+      << message;
+  message = LoadText("parameters:\n  x: 1\n  a: \"= zzz\"\n  b: 3\n");
+  EXPECT_NE(message.find("unknown name 'zzz' (parameters defined above this one: x)"),
+            std::string::npos)
+      << message;
+  message = LoadText("parameters:\n  a: \"= a + 1\"\n");
+  EXPECT_NE(message.find("parameter 'a' cannot use itself (" + rule + ")"), std::string::npos)
+      << message;
+  // Outside 'parameters' every parameter is visible, and the message says so.
+  message = LoadText("parameters:\n  x: 1\narena: {size: \"= zzz\"}\n");
+  EXPECT_NE(message.find("unknown name 'zzz' (parameters: x)"), std::string::npos) << message;
 }
 
 TEST_F(MalformedWorldTest, ModelValuesUseModelParametersAndScriptsAreShared) {
