@@ -188,8 +188,9 @@ class Watchdog {
         error += "; running: ";
         for (size_t i = 0; i < calls.size(); ++i) error += (i ? "; " : "") + calls[i];
         error +=
-            " (Lua cannot interrupt a script inside one C function, e.g. a pattern match that "
-            "backtracks over a long string)";
+            " (the instruction budget cannot stop a script inside one C function, such as a "
+            "pattern match that backtracks over a long string or a garbage collection of a "
+            "large heap)";
       }
       // Outputs are written under io_mutex; progress_ cannot move meanwhile
       // (the loop reports progress only after writing them).
@@ -400,6 +401,8 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
     } catch (const std::exception& e) {
       const std::lock_guard lock(watchdog.io_mutex());
       result.error = e.what();
+      // The states are still open after an error: what they held then.
+      lua_kib = static_cast<double>(world->script_memory_bytes()) / 1024.0;
       if (metrics) metrics->Write(world->TakeMetrics());  // whatever was recorded before the error
     }
   }

@@ -286,12 +286,13 @@ std::shared_ptr<const ModuleRegistry> WorldLoader::LoadPlugins(const Fields& top
     // the program's plugin folders; anything else takes --trust-scripts (or
     // --plugin), as scripts need it to reach outside the world's folder.
     if (!options_.trust_scripts && !IsTrustedPluginLocation(canonical))
-      values.Fail(element, "plugin '" + text + "' resolves to " + canonical.string() +
-                               ", outside the world's folder (" +
-                               path_.parent_path().lexically_normal().string() +
-                               ") and the program's plugin folders; a world may load native "
-                               "code only from there (load it with --plugin PATH, or pass "
-                               "--trust-scripts)");
+      values.Fail(element,
+                  "plugin '" + text + "' resolves to " + canonical.string() +
+                      ", outside the world's folder (" +
+                      fs::weakly_canonical(fs::absolute(path_).parent_path(), ec).string() +
+                      ") and the program's plugin folders; a world may load native "
+                      "code only from there (load it with --plugin PATH, or pass "
+                      "--trust-scripts)");
     try {
       LoadPlugin(found->string(), registry.get());
     } catch (const Error& e) {

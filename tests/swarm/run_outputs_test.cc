@@ -226,4 +226,25 @@ TEST(RunOutputsTest, StopSignalEndsAStuckStep) {
   fs::remove_all(dir);
 }
 
+// A run ended by a script error still reports the Lua memory its scripts held.
+TEST(RunOutputsTest, FailedRunReportsItsLuaMemory) {
+  const fs::path dir = TempDir("failed_memory");
+  fs::create_directories(dir);
+  std::ofstream(dir / "world.yaml") << "simulation: {physics: kinematic, time_step: 0.1}\n"
+                                       "models:\n  - {model: probe.yaml, position: [0, 0]}\n";
+  std::ofstream(dir / "probe.yaml") << "model: probe\n"
+                                       "objects: {name: body, type: dummy, script: probe.lua}\n";
+  std::ofstream(dir / "probe.lua") << "big = string.rep('x', 100000)\n"
+                                      "function sysCall_actuation()\n"
+                                      "  if sim.getSimulationTime() > 0.15 then error('boom') end\n"
+                                      "end\n";
+  const auto r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 5 --quiet --out " +
+                            (dir / "out").string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  const auto summary = nlohmann::json::parse(ReadFile(dir / "out" / "summary.json"));
+  EXPECT_EQ(summary["status"], "error");
+  EXPECT_GT(summary["lua_memory_kib"].get<double>(), 100) << "the 100 kB string at least";
+  fs::remove_all(dir);
+}
+
 }  // namespace
