@@ -91,11 +91,18 @@ local function threaded(name)  -- errors name the caller's line, not this chunk'
     error(name .. ': only a threaded script (sysCall_thread) can wait', 3)
   end
 end
+local function seconds_arg(name, arg, what, s)  -- a finite number >= 0 (not NaN)
+  if type(s) ~= 'number' then
+    error(name .. ': bad argument #' .. arg .. ' (number expected, got ' .. type(s) .. ')', 3)
+  end
+  if not (s >= 0 and s - s == 0) then
+    error(name .. ': ' .. what .. ' must be a finite number of seconds >= 0 (got ' ..
+          tostring(s) .. ')', 3)
+  end
+end
 function sim.wait(seconds)
   threaded('sim.wait')
-  if type(seconds) ~= 'number' then
-    error('sim.wait: bad argument #1 (number expected, got ' .. type(seconds) .. ')', 2)
-  end
+  seconds_arg('sim.wait', 1, 'the time', seconds)
   local t_end = now() + seconds - 1e-9
   while now() < t_end do step() end
 end
@@ -104,6 +111,7 @@ function sim.waitUntil(condition, timeout)
   if type(condition) ~= 'function' then
     error('sim.waitUntil: bad argument #1 (function expected, got ' .. type(condition) .. ')', 2)
   end
+  if timeout ~= nil then seconds_arg('sim.waitUntil', 2, 'the timeout', timeout) end
   local t_end = timeout and now() + timeout - 1e-9
   while not condition() do
     if t_end and now() >= t_end then return false end
@@ -186,6 +194,8 @@ int CallProtected(lua_State* L, lua_CFunction f, const char* name) noexcept {
   } catch (...) {
     format(name, "unknown C++ exception");
   }
+  // Room for the message whatever `f` left on the stack (it is discarded).
+  lua_settop(L, 0);
   luaL_where(L, 1);
   lua_pushstring(L, message);
   lua_concat(L, 2);

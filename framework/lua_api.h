@@ -52,12 +52,13 @@ struct LuaContext {
   ObjectId script_object;
   int script_env_ref = LUA_NOREF;  // its environment table, in the registry
   ScriptMailbox* mailbox = nullptr;
-  void* host_state = nullptr;   // the host's ScriptState (script_host.cc)
-  void* host_script = nullptr;  // the host's Script being run (script_host.cc)
-  bool is_main = false;         // the main script's state
-  bool in_sensing = false;      // running a sysCall_sensing (sim.handleChildScript follows it)
-  int64_t slice_fires = 0;      // time-slice hook calls since the thread was resumed
-  lua_State* thread = nullptr;  // the script thread being resumed, else null
+  void* host_state = nullptr;     // the host's ScriptState (script_host.cc)
+  void* host_script = nullptr;    // the host's Script being run (script_host.cc)
+  bool is_main = false;           // the main script's state
+  bool in_sensing = false;        // running a sysCall_sensing (sim.handleChildScript follows it)
+  bool dynamics_handled = false;  // the main script called sim.handleDynamics() this step
+  int64_t slice_fires = 0;        // time-slice hook calls since the thread was resumed
+  lua_State* thread = nullptr;    // the script thread being resumed, else null
   // The running callback (or thread resume) used up its instruction budget:
   // every further instruction raises budget_error, and the host reports it.
   bool budget_exhausted = false;

@@ -1,6 +1,8 @@
 // sim.* messages, signals and packing.
 //
-// Messages (delivered at the start of the next step, in sender-handle order):
+// Messages (delivered at the start of the next step, in sender-handle order;
+// at most 1 MiB each, and the messages one robot sends in one step hold at
+// most its Lua memory limit, simulation.script_memory_mb):
 //   sim.sendGlobalMessage(data)          every script of the world but the sender
 //   sim.sendLocalMessage(data)           the other scripts of the sender's model
 //   sim.sendDirectMessage(handle, data)  the script attached to object `handle`
@@ -16,11 +18,13 @@
 // sim.setSignal, sim.getSignal, sim.clearSignal.
 // Packing numbers into message strings: sim.packFloats / unpackFloats
 // (float32), packDoubles / unpackDoubles, packInt32s / unpackInt32s,
-// packTable / unpackTable (nested tables of numbers, strings, booleans).
+// packTable / unpackTable (nested tables of numbers, strings, booleans; at
+// most 32 levels of tables).
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <string>
+#include <string_view>
 
 #include "framework/error.h"
 #include "framework/lua_api.h"
@@ -31,28 +35,45 @@ namespace {
 
 constexpr size_t kMaxMessageBytes = 1 << 20;
 
-std::string CheckData(lua_State* L, int arg) {
+// The message argument, still owned by Lua (it stays on the stack).
+std::string_view CheckData(lua_State* L, int arg) {
   if (lua_type(L, arg) != LUA_TSTRING)
     throw Error(std::string("the message must be a string (got ") + luaL_typename(L, arg) +
                 "); pack numbers with sim.packFloats or tables with sim.packTable");
   size_t length = 0;
   const char* data = lua_tolstring(L, arg, &length);
   if (length > kMaxMessageBytes) throw Error("a message may hold at most 1 MiB");
-  return std::string(data, length);
+  return {data, length};
 }
 
-void Send(lua_State* L, MessageScope scope, std::string data, ObjectId target = {},
+// "256 MiB", or bytes for a limit that is not a whole number of MiB.
+std::string LimitText(uint64_t bytes) {
+  return bytes % (1 << 20) == 0 ? std::to_string(bytes >> 20) + " MiB"
+                                : std::to_string(bytes) + " bytes";
+}
+
+void Send(lua_State* L, MessageScope scope, std::string_view data, ObjectId target = {},
           double range = 0, bool line_of_sight = false) {
   LuaContext& c = Context(L);
+  // What one robot sends in one step is bounded like its Lua memory: the
+  // outboxes of a swarm could otherwise take all of the host's. A message
+  // counts its data and its outbox entry.
+  RobotRuntime& runtime = *c.runtime;
+  const uint64_t total = runtime.outbox_bytes + data.size() + sizeof(Message);
+  const int64_t limit = c.world->settings().script_memory_limit;  // 0: no limit
+  if (limit > 0 && total > static_cast<uint64_t>(limit))
+    throw Error("the messages sent this step would hold more than " +
+                LimitText(static_cast<uint64_t>(limit)) + " (simulation.script_memory_mb)");
+  runtime.outbox_bytes = total;
   Message m;
-  m.data = std::move(data);
+  m.data = data;
   m.sender = c.script_object;
   m.target = target;
   m.sender_instance = c.instance;
   m.range = range;
   m.scope = scope;
   m.line_of_sight = line_of_sight;
-  c.runtime->outbox.push_back(std::move(m));
+  runtime.outbox.push_back(std::move(m));
 }
 
 int SendGlobalMessage(lua_State* L) {
@@ -75,11 +96,11 @@ int SendRangeMessage(lua_State* L) {
   if (Context(L).script_object.IsNull())
     throw Error(
         "the main script has no position: use sim.sendGlobalMessage or sim.sendDirectMessage");
-  std::string data = CheckData(L, 1);
+  const std::string_view data = CheckData(L, 1);
   const double range = ArgNumber(L, 2);
   if (!(range >= 0) || !std::isfinite(range))
     throw Error("the range must be a non-negative number of metres");
-  Send(L, MessageScope::kRange, std::move(data), {}, range, lua_toboolean(L, 3) != 0);
+  Send(L, MessageScope::kRange, data, {}, range, lua_toboolean(L, 3) != 0);
   return 0;
 }
 
@@ -108,9 +129,16 @@ int ReceiveMessage(lua_State* L) {
 
 // --- Signals ---------------------------------------------------------------------------
 
+// A string argument with every byte (a NUL too).
+std::string ArgBytes(lua_State* L, int arg) {
+  size_t length = 0;
+  const char* text = ArgString(L, arg, &length);
+  return std::string(text, length);
+}
+
 int SetSignal(lua_State* L) {
   LuaContext& c = Context(L);
-  std::string name = ArgString(L, 1);
+  std::string name = ArgBytes(L, 1);
   switch (lua_type(L, 2)) {
     case LUA_TNUMBER:
       c.runtime->signal_writes.emplace_back(std::move(name), lua_tonumber(L, 2));
@@ -118,9 +146,7 @@ int SetSignal(lua_State* L) {
     case LUA_TBOOLEAN:
       c.runtime->signal_writes.emplace_back(std::move(name), lua_toboolean(L, 2) != 0);
       break;
-    case LUA_TSTRING:
-      c.runtime->signal_writes.emplace_back(std::move(name), std::string(lua_tostring(L, 2)));
-      break;
+    case LUA_TSTRING: c.runtime->signal_writes.emplace_back(std::move(name), ArgBytes(L, 2)); break;
     case LUA_TNIL: c.runtime->signal_writes.emplace_back(std::move(name), std::nullopt); break;
     default:
       throw Error(std::string("a signal is a number, boolean or string (got ") +
@@ -129,7 +155,7 @@ int SetSignal(lua_State* L) {
   return 0;
 }
 int ClearSignal(lua_State* L) {
-  Context(L).runtime->signal_writes.emplace_back(ArgString(L, 1), std::nullopt);
+  Context(L).runtime->signal_writes.emplace_back(ArgBytes(L, 1), std::nullopt);
   return 0;
 }
 int GetSignal(lua_State* L) {
@@ -196,7 +222,17 @@ int UnpackArray(lua_State* L) {
 
 // packTable format: a tag byte per value: 'n' double, 'i' int64, 's' u32
 // length + bytes, 'T'/'F' booleans, 't' u32 pair count + key/value pairs.
+// Tables nest at most kMaxTableDepth levels (the outer table is level 1),
+// which also stops a cycle. Each level holds a key and a value on the Lua
+// stack, beyond the LUA_MINSTACK slots a C function is given: every level
+// reserves its slots first.
 constexpr int kMaxTableDepth = 32;
+constexpr int kStackSlotsPerLevel = 3;  // key and value (packing); table, key and value (unpacking)
+
+void ReserveStack(lua_State* L) {
+  if (!lua_checkstack(L, kStackSlotsPerLevel))
+    throw Error("not enough memory for the Lua stack of a nested table");
+}
 
 void PackValue(lua_State* L, int index, int depth, std::string* out) {
   auto append = [out](const void* p, size_t n) { out->append(static_cast<const char*>(p), n); };
@@ -223,7 +259,10 @@ void PackValue(lua_State* L, int index, int depth, std::string* out) {
       break;
     }
     case LUA_TTABLE: {
-      if (depth >= kMaxTableDepth) throw Error("the table is nested too deeply (or has a cycle)");
+      if (depth >= kMaxTableDepth)
+        throw Error("the table is nested more than " + std::to_string(kMaxTableDepth) +
+                    " levels deep (or has a cycle)");
+      ReserveStack(L);
       index = lua_absindex(L, index);
       uint32_t count = 0;
       for (lua_pushnil(L); lua_next(L, index) != 0; lua_pop(L, 1)) ++count;
@@ -243,8 +282,14 @@ void PackValue(lua_State* L, int index, int depth, std::string* out) {
 
 int PackTable(lua_State* L) {
   ArgType(L, 1, LUA_TTABLE);
+  lua_settop(L, 1);
   std::string out;
-  PackValue(L, 1, 0, &out);
+  try {
+    PackValue(L, 1, 0, &out);
+  } catch (...) {
+    lua_settop(L, 1);  // the keys and values of the levels left, for the error message's room
+    throw;
+  }
   lua_pushlstring(L, out.data(), out.size());
   return 1;
 }
@@ -260,8 +305,6 @@ struct Reader {
 };
 
 void UnpackValue(lua_State* L, Reader* r, int depth) {
-  if (depth > kMaxTableDepth) throw Error("the packed table is nested too deeply");
-  if (!lua_checkstack(L, 4)) throw Error("the packed table is too deep for the Lua stack");
   char tag = 0;
   r->Read(&tag, 1);
   switch (tag) {
@@ -288,13 +331,19 @@ void UnpackValue(lua_State* L, Reader* r, int depth) {
       break;
     }
     case 't': {
+      if (depth >= kMaxTableDepth)
+        throw Error("the packed table is nested more than " + std::to_string(kMaxTableDepth) +
+                    " levels deep");
+      ReserveStack(L);
       uint32_t count = 0;
       r->Read(&count, sizeof count);
       lua_createtable(L, 0, 0);
       for (uint32_t i = 0; i < count; ++i) {
         UnpackValue(L, r, depth + 1);
         UnpackValue(L, r, depth + 1);
-        if (lua_isnil(L, -2)) throw Error("the string is not a packed table");
+        // Keys Lua refuses (lua_rawset would raise a Lua error here).
+        if (lua_isnil(L, -2) || (lua_type(L, -2) == LUA_TNUMBER && std::isnan(lua_tonumber(L, -2))))
+          throw Error("the string is not a packed table");
         lua_rawset(L, -3);
       }
       break;
@@ -306,8 +355,14 @@ void UnpackValue(lua_State* L, Reader* r, int depth) {
 int UnpackTable(lua_State* L) {
   size_t length = 0;
   const char* data = ArgString(L, 1, &length);
+  lua_settop(L, 1);
   Reader r{data, data + length};
-  UnpackValue(L, &r, 0);
+  try {
+    UnpackValue(L, &r, 0);
+  } catch (...) {
+    lua_settop(L, 1);  // the tables of the levels left, for the error message's room
+    throw;
+  }
   if (r.p != r.end || !lua_istable(L, -1)) throw Error("the string is not a packed table");
   return 1;
 }

@@ -58,6 +58,8 @@ int CallPluginCommand(lua_State* L) {
                                       sizeof error, command->user_data);
   if (count < 0 || count > kMaxResults)
     RaiseError(L, "sim." + command->name + ": " + (error[0] ? error : "the plugin command failed"));
+  if (!lua_checkstack(L, count))
+    RaiseError(L, "sim." + command->name + ": its results do not fit on Lua's stack");
   for (int i = 0; i < count; ++i) {
     const SwarmsimValue& r = results[i];
     switch (r.type) {

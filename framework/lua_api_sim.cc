@@ -85,7 +85,8 @@ int Print(lua_State* L) {
   const int n = lua_gettop(L);
   // Every argument to a string first: __tostring may raise a Lua error,
   // which must not jump over `line`.
-  if (!lua_checkstack(L, n)) throw Error("too many arguments");
+  // A string per argument, and a few slots for luaL_tolstring's own work.
+  if (!lua_checkstack(L, n + LUA_MINSTACK)) throw Error("too many arguments");
   for (int i = 1; i <= n; ++i) luaL_tolstring(L, i, nullptr);  // honours __tostring
   std::string line = c.log_prefix;
   for (int i = 1; i <= n; ++i) {

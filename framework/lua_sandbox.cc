@@ -8,11 +8,17 @@
 //            inside and beside it, cached per state (per robot);
 //   os       clock, time, date, difftime only.
 // Everything else (os.execute, io.popen, package.loadlib, debug, dofile,
-// loadfile, binary chunks) raises "file:line: os.execute is not allowed
-// ...". --trust-scripts (WorldSettings::trust_scripts) opens the full
-// standard libraries instead, with the same folders: require searches the
-// world's folders before Lua's path, and relative paths in io.open/io.lines
-// start in the world's folder (reading) or the output folder (writing).
+// loadfile, string.dump, binary chunks) raises "file:line: os.execute is not
+// allowed ...". Three more rules keep runs stoppable, reproducible and their
+// outputs intact: setmetatable refuses a metatable with __gc (Lua runs
+// finalizers with hooks off: nothing could stop one that loops);
+// math.randomseed needs a seed (without one it reads the clock); io.open
+// refuses to write the run's own outputs (metrics.csv, summary.json, ...) in
+// the output folder. --trust-scripts (WorldSettings::trust_scripts) opens
+// the full standard libraries instead, with the same folders: require
+// searches the world's folders before Lua's path, and relative paths in
+// io.open/io.lines start in the world's folder (reading) or the output
+// folder (writing).
 #include <algorithm>
 #include <array>
 #include <cstring>
@@ -20,8 +26,10 @@
 #include <fstream>
 #include <initializer_list>
 #include <sstream>
+#include <string>
 #include <string_view>
 
+#include "framework/error.h"
 #include "framework/lua_api.h"
 #include "framework/world.h"
 
@@ -47,6 +55,52 @@ int SafeLoad(lua_State* L) {
   lua_pushvalue(L, lua_upvalueindex(1));  // the original load
   lua_insert(L, 1);
   lua_call(L, 4, LUA_MULTRET);
+  return lua_gettop(L);
+}
+
+// setmetatable(t, mt): Lua's, but a metatable with a __gc field is refused.
+// A finalizer runs with hooks off, so neither the instruction budget nor the
+// memory limit could stop one that loops. Lua marks an object for
+// finalization only here (when its new metatable has __gc, looked up raw),
+// so a __gc added to the metatable afterwards is never run.
+int SafeSetMetatable(lua_State* L) {
+  ArgType(L, 1, LUA_TTABLE);
+  const int type = lua_type(L, 2);
+  if (type != LUA_TNIL && type != LUA_TTABLE)
+    throw Error(std::string("bad argument #2 (nil or table expected, got ") + luaL_typename(L, 2) +
+                ")");
+  lua_settop(L, 2);
+  if (type == LUA_TTABLE) {
+    lua_pushliteral(L, "__gc");
+    const bool finalizer = lua_rawget(L, 2) != LUA_TNIL;
+    lua_pop(L, 1);
+    if (finalizer)
+      RaiseError(L,
+                 "setmetatable: __gc finalizers are not allowed in a sandboxed script (Lua cannot "
+                 "stop one that loops); run with --trust-scripts to lift the sandbox");
+  }
+  if (luaL_getmetafield(L, 1, "__metatable") != LUA_TNIL)
+    throw Error("cannot change a protected metatable");
+  lua_setmetatable(L, 1);
+  return 1;
+}
+
+// math.randomseed(x [, y]): Lua's, but a seed is required; without one Lua
+// seeds from the clock and the address of a local, and runs stop being
+// reproducible.
+int SafeRandomSeed(lua_State* L) {
+  if (lua_type(L, 1) != LUA_TNUMBER)
+    RaiseError(L,
+               "math.randomseed needs a seed: without one it reads the clock and runs stop being "
+               "reproducible (math.random is already seeded per robot)");
+  // Lua's own checks, made here so that the call below cannot raise.
+  ArgInteger(L, 1);
+  const int arguments = lua_isnoneornil(L, 2) ? 1 : 2;
+  if (arguments == 2) ArgInteger(L, 2);
+  lua_settop(L, arguments);
+  lua_pushvalue(L, lua_upvalueindex(1));  // the original math.randomseed
+  lua_insert(L, 1);
+  lua_call(L, arguments, LUA_MULTRET);
   return lua_gettop(L);
 }
 
@@ -109,6 +163,14 @@ int RefuseField(lua_State* L) {
   Refuse(L, std::string(library) + "." + field);
 }
 
+// __index of the string table: string.dump, which makes binary chunks, is
+// refused by name; other missing fields are nil as usual ("s.x" reads them).
+int StringIndex(lua_State* L) {
+  if (lua_type(L, 2) == LUA_TSTRING && std::strcmp(lua_tostring(L, 2), "dump") == 0)
+    Refuse(L, "string.dump");
+  return 0;
+}
+
 // A table whose missing fields are refused; left on the stack.
 void NewRestrictedTable(lua_State* L, const char* library, int fields) {
   lua_createtable(L, 0, fields);
@@ -135,6 +197,20 @@ fs::path Canonical(const fs::path& path) {
   return ec ? path.lexically_normal() : out;
 }
 
+// The files a run writes into its output folder (swarm/runner.cc:
+// metrics.csv, summary.json; observers' WriteOutputs: paint.png), and
+// stderr.txt, where a sweep (swarm/sweep_worker.cc) keeps a run's errors.
+constexpr std::string_view kRunOutputs[] = {"metrics.csv", "summary.json", "paint.png",
+                                            "stderr.txt"};
+
+// Is `path` (canonical) one of the run's own outputs in `root` (canonical)?
+bool IsRunOutput(const fs::path& path, const fs::path& root) {
+  const fs::path folder = root.has_filename() ? root : root.parent_path();  // "out/": "out"
+  if (path.parent_path() != folder) return false;
+  const std::string name = path.filename().string();
+  return std::find(std::begin(kRunOutputs), std::end(kRunOutputs), name) != std::end(kRunOutputs);
+}
+
 // The file `text` names, checked against the sandbox: relative paths are
 // taken from the world's folder (reading) or the output folder (writing).
 std::string CheckedPath(lua_State* L, const char* function, const std::string& text, bool write) {
@@ -150,10 +226,15 @@ std::string CheckedPath(lua_State* L, const char* function, const std::string& t
   root = Canonical(fs::absolute(root));
   const fs::path path = fs::path(text).is_absolute() ? fs::path(text) : root / text;
   // Symlinks are resolved first: one inside the folder pointing out is refused.
-  if (!IsInside(Canonical(path), root))
+  const fs::path resolved = Canonical(path);
+  if (!IsInside(resolved, root))
     RaiseError(L, std::string(function) + ": '" + text + "' is outside the " +
                       (write ? "run's output folder" : "world's folder") + " (" + root.string() +
                       "); scripts are sandboxed (run with --trust-scripts to lift it)");
+  if (write && IsRunOutput(resolved, root))
+    RaiseError(L, std::string(function) + ": '" + resolved.filename().string() +
+                      "' is one of the run's own outputs in the output folder (" + root.string() +
+                      "); write to another name");
   return path.string();
 }
 
@@ -307,6 +388,12 @@ int SandboxGlobalIndex(lua_State* L) {
       lua_getfield(L, -2, kept);
       lua_setfield(L, -2, kept);
     }
+    // Files are finalized by their metatable's __gc: a script must not reach
+    // it (getmetatable(f).__gc = <a loop>) to replace it.
+    luaL_getmetatable(L, LUA_FILEHANDLE);
+    lua_pushliteral(L, "file");
+    lua_setfield(L, -2, "__metatable");
+    lua_pop(L, 1);
   } else if (key == "os") {
     luaL_requiref(L, LUA_OSLIBNAME, luaopen_os, 0);
     NewRestrictedTable(L, "os", 4);
@@ -394,18 +481,32 @@ void OpenSafeLibraries(lua_State* L) {
     lua_setglobal(L, name);
   }
   Wrap(L, "load", Guarded<SafeLoad, "">);
+  lua_pushcfunction(L, (Guarded<SafeSetMetatable, "setmetatable">));
+  lua_setglobal(L, "setmetatable");
   Wrap(L, "collectgarbage", Guarded<SafeCollectGarbage, "collectgarbage">);
-  // string.dump makes binary chunks, which nothing here can load. Strings'
-  // methods ("abc"):upper() come from the new table too.
+  // string.dump makes binary chunks, which nothing here can load: the
+  // table's __index refuses it by name (kept out of the table, 16 entries
+  // fit its 16 slots). Strings' methods ("abc"):upper() come from the new
+  // table too.
   Compact(L, LUA_STRLIBNAME, {"dump"});
+  lua_getglobal(L, LUA_STRLIBNAME);
+  lua_createtable(L, 0, 1);
+  lua_pushcfunction(L, (Guarded<StringIndex, "">));
+  lua_setfield(L, -2, "__index");
+  lua_setmetatable(L, -2);
   lua_pushliteral(L, "");
   lua_getmetatable(L, -1);
-  lua_getglobal(L, LUA_STRLIBNAME);
+  lua_pushvalue(L, -3);
   lua_setfield(L, -2, "__index");
-  lua_pop(L, 2);
+  lua_pop(L, 3);
   // Debian builds Lua with LUA_COMPAT_MATHLIB: functions 5.4 deprecated, and
   // 35 entries need a 64-slot table where 28 fit in 32 (~0.5 KB per robot).
   Compact(L, LUA_MATHLIBNAME, {"cosh", "sinh", "tanh", "pow", "frexp", "ldexp", "log10"});
+  lua_getglobal(L, LUA_MATHLIBNAME);
+  lua_getfield(L, -1, "randomseed");
+  lua_pushcclosure(L, (Guarded<SafeRandomSeed, "math.randomseed">), 1);
+  lua_setfield(L, -2, "randomseed");
+  lua_pop(L, 1);
 }
 
 }  // namespace swarmsim

@@ -12,10 +12,12 @@
 // siblings in scene order). An explicit script runs only when an ancestor's
 // script calls sim.handleChildScript(handle, ...). A script defining
 // sysCall_thread runs it as a coroutine, resumed once a step with the
-// actuation callbacks until it yields (sim.step/sim.switchThread) or its
-// time slice runs out: a count hook that yields, so the slice is a number of
-// Lua instructions (kInstructionsPerMs per millisecond of
-// sim.setThreadSwitchTiming) and results do not depend on machine speed.
+// actuation callbacks (with a main script calling sim.handleChildScripts
+// more than once a step, in the first pass that runs them) until it yields
+// (sim.step/sim.switchThread) or its time slice runs out: a count hook that
+// yields, so the slice is a number of Lua instructions (kInstructionsPerMs
+// per millisecond of sim.setThreadSwitchTiming, at most the instruction
+// budget) and results do not depend on machine speed.
 // Only the script's thread itself is yielded: a coroutine the script makes
 // inherits the hook but runs under the instruction budget instead.
 // Every non-threaded callback runs under an instruction budget (count hook
@@ -27,9 +29,13 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <climits>
+#include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <mutex>
+#include <span>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -39,6 +45,7 @@
 #include "framework/lua_api.h"
 #include "framework/scene.h"
 #include "framework/scheduler.h"
+#include "framework/suggest.h"
 #include "framework/world.h"
 
 namespace swarmsim {
@@ -49,12 +56,29 @@ constexpr const char* kCallbackNames[kCallbackCount] = {"sysCall_init",      "sy
                                                         "sysCall_actuation", "sysCall_cleanup",
                                                         "sysCall_thread",    "sysCall_step"};
 
+// The callbacks each kind of script gets called: child scripts (a robot's,
+// the scene's), explicit child scripts (through sim.handleChildScript) and
+// the world's main script.
+constexpr Callback kChildCallbacks[] = {kInit, kSensing, kActuation, kCleanup, kThread};
+constexpr Callback kExplicitCallbacks[] = {kInit, kSensing, kActuation, kCleanup};
+constexpr Callback kMainCallbacks[] = {kInit, kStep, kCleanup};
+
 // Lua instructions per millisecond of thread time slice: PUC Lua 5.4 runs
 // roughly 100 to 300 million simple VM instructions a second on a current
 // core, so 100,000 per ms errs on the short side. The default slice, 2 ms
 // (CoppeliaSim's), is 200,000 instructions.
 constexpr int64_t kInstructionsPerMs = 100'000;
 constexpr int kDefaultSliceInstructions = 200'000;
+constexpr double kMinSliceInstructions = 1000;
+
+// The time slice of a thread asking for `instructions`: at least 1,000, and
+// at most the world's instruction budget (when it has one), so that a
+// thread runs no more Lua in a step than a callback may.
+int SliceInstructions(double instructions, int64_t budget) {
+  double slice = std::clamp(instructions, kMinSliceInstructions, static_cast<double>(INT_MAX));
+  if (budget > 0) slice = std::min(slice, static_cast<double>(budget));
+  return static_cast<int>(slice);
+}
 
 // Robots started per task: starting one compiles its scripts and runs their
 // bodies and sysCall_init, a few tens of microseconds.
@@ -102,6 +126,12 @@ struct ScriptState {
   LuaContext context;
   std::vector<Script> scripts;  // hierarchy order
   LuaMemory memory;
+  // With a main script: the ScriptHost::Impl::main_steps of the step whose
+  // sim.handleChildScripts resumed the threads (once a step).
+  uint64_t threads_resumed_step = 0;
+  // Start only: sysCall_* names no one calls, {file + '\0' + name, warning
+  // line}, for ScriptHost::Start to log once per file.
+  std::vector<std::pair<std::string, std::string>> warnings;
 
   ScriptState() = default;
   ScriptState(const ScriptState&) = delete;
@@ -201,10 +231,15 @@ void BudgetHook(lua_State* L, lua_Debug* ar) {
   });
 }
 
+// A fresh budget for the next callback on L. Without a budget (0), a spent
+// one's ExhaustedHook (left by the memory limit) goes, or it would fail every
+// later callback of the state.
 void SetBudget(lua_State* L, const LuaContext& c) {
   const int64_t budget = c.world->settings().instruction_budget;
   if (budget > 0)
     lua_sethook(L, BudgetHook, LUA_MASKCOUNT, static_cast<int>(std::min<int64_t>(budget, INT_MAX)));
+  else if (lua_gethook(L) == ExhaustedHook)
+    lua_sethook(L, nullptr, 0, 0);
 }
 
 // Count hook of threads: the time slice is used up; yield if Lua can and L
@@ -452,7 +487,8 @@ std::string CompileFactory(lua_State* L, const ScriptSource& source) {
 }
 
 // A registry reference to the callback `name` the script defines (not one
-// inherited from the shared globals), or LUA_NOREF.
+// inherited from the shared globals), or LUA_NOREF. CheckSysCallNames has
+// made sure that the ones the script gets called are functions.
 int FindCallback(lua_State* L, const Script& script, const char* name) {
   lua_rawgeti(L, LUA_REGISTRYINDEX, script.env_ref);
   lua_pushstring(L, name);
@@ -460,6 +496,152 @@ int FindCallback(lua_State* L, const Script& script, const char* name) {
   const int ref = lua_isfunction(L, -1) ? luaL_ref(L, LUA_REGISTRYINDEX) : LUA_NOREF;
   lua_settop(L, 0);
   return ref;
+}
+
+// Throws "<file>: sysCall_init must be a function (got number)" (with the
+// robot and object) if the script's global `name` is neither nil nor a function.
+void CheckIsFunction(ScriptState& state, const Script& script, const char* name) {
+  lua_State* L = state.L;
+  lua_rawgeti(L, LUA_REGISTRYINDEX, script.env_ref);
+  lua_pushstring(L, name);
+  const int type = lua_rawget(L, -2);
+  lua_settop(L, 0);
+  if (type == LUA_TNIL || type == LUA_TFUNCTION) return;
+  ThrowScriptError(
+      state, script.object,
+      script.source->path + ": " + name + " must be a function (got " + lua_typename(L, type) + ")",
+      "loading the script");
+}
+
+// CoppeliaSim callbacks a ported script may define, which swarmsim never
+// calls, and what to do instead.
+struct PortedCallback {
+  const char* name;
+  const char* hint;
+};
+constexpr PortedCallback kCoppeliaSimCallbacks[] = {
+    {"sysCall_beforeSimulation", "put its code in sysCall_init"},
+    {"sysCall_afterSimulation", "put its code in sysCall_cleanup"},
+    {"sysCall_nonSimulation", "scripts run only while simulating"},
+    {"sysCall_beforeMainScript", "a world's own main script is simulation.main_script"},
+    {"sysCall_suspend", "a run is never paused"},
+    {"sysCall_suspended", "a run is never paused"},
+    {"sysCall_resume", "a run is never paused"},
+    {"sysCall_realTimeIdle", "a run is never paused"},
+    {"sysCall_beforeInstanceSwitch", "there is one scene"},
+    {"sysCall_afterInstanceSwitch", "there is one scene"},
+    {"sysCall_beforeSave", "scenes are never saved"},
+    {"sysCall_afterSave", "scenes are never saved"},
+    {"sysCall_afterLoad", "put its code in sysCall_init"},
+    {"sysCall_beforeCopy", "scripts are not told of copies"},
+    {"sysCall_afterCopy", "scripts are not told of copies"},
+    {"sysCall_afterCreate", "put its code in sysCall_init"},
+    {"sysCall_beforeDelete", "scripts are not told of deletions"},
+    {"sysCall_afterDelete", "scripts are not told of deletions"},
+    {"sysCall_dynCallback", "the physics engines call no scripts"},
+    {"sysCall_jointCallback",
+     "the physics engines call no scripts; drive joints with sim.setJointTargetVelocity/Position"},
+    {"sysCall_contactCallback", "the physics engines call no scripts"},
+    {"sysCall_vision", "there are no vision sensors"},
+    {"sysCall_trigger", "read proximity sensors with sim.readProximitySensor"},
+    {"sysCall_userConfig", "runs are headless"},
+    {"sysCall_selChange", "runs are headless"},
+    {"sysCall_msg", "read messages with sim.receiveMessage"},
+    {"sysCall_event", "runs are headless"},
+    {"sysCall_addOnScriptSuspend", "there are no add-ons"},
+    {"sysCall_addOnScriptResume", "there are no add-ons"},
+    {"sysCall_moduleEntry", "there are no add-ons"},
+};
+
+// Why swarmsim never calls the script's global `name` (a sysCall_* it does
+// not call for this kind of script), as the end of a warning.
+std::string UncalledHint(std::string_view name, std::span<const Callback> called, bool is_main,
+                         bool explicit_handling) {
+  for (const PortedCallback& ported : kCoppeliaSimCallbacks)
+    if (name == ported.name) return std::string("it is CoppeliaSim's; ") + ported.hint;
+  if (name == kCallbackNames[kStep])
+    return "only the world's main script, simulation.main_script, has a sysCall_step";
+  if (is_main && (name == kCallbackNames[kSensing] || name == kCallbackNames[kActuation] ||
+                  name == kCallbackNames[kThread]))
+    return "the main script runs sysCall_init, sysCall_step and sysCall_cleanup; it runs the "
+           "robots' callbacks with sim.handleChildScripts";
+  if (explicit_handling && name == kCallbackNames[kThread])
+    return "an explicit script runs only through sim.handleChildScript, which calls its "
+           "sysCall_sensing or sysCall_actuation";
+  std::vector<std::string> names;
+  for (Callback callback : called) names.emplace_back(kCallbackNames[callback]);
+  if (const std::string* nearest = NearestName(name, names))
+    return "did you mean " + *nearest + "?";
+  std::string list = "it calls ";
+  for (size_t i = 0; i < names.size(); ++i)
+    list += (i == 0 ? "" : i + 1 == names.size() ? " and " : ", ") + names[i];
+  return list;
+}
+
+// Once per script at load, after sysCall_init (which may define callbacks):
+// a callback the script gets called must be a function (else a script error
+// naming the file and the callback); any other global named sysCall_*
+// (case aside: a typo, a CoppeliaSim callback) gets a warning in
+// state.warnings, which ScriptHost::Start logs once per file. Warnings are
+// in name order: the table's order is not deterministic.
+void CheckSysCallNames(ScriptState& state, const Script& script) {
+  lua_State* L = state.L;
+  const bool is_main = state.context.is_main;
+  const std::span<const Callback> called = is_main ? std::span<const Callback>(kMainCallbacks)
+                                           : script.explicit_handling
+                                               ? std::span<const Callback>(kExplicitCallbacks)
+                                               : std::span<const Callback>(kChildCallbacks);
+  struct Uncalled {
+    std::string name;
+    int line = 0;  // where the script defines the function; 0: not a function of its own
+  };
+  std::vector<Uncalled> uncalled;
+  const std::string& path = script.source->path;
+  lua_rawgeti(L, LUA_REGISTRYINDEX, script.env_ref);
+  lua_pushnil(L);
+  while (lua_next(L, -2) != 0) {
+    size_t length = 0;
+    const char* key = lua_type(L, -2) == LUA_TSTRING ? lua_tolstring(L, -2, &length) : nullptr;
+    constexpr std::string_view kPrefix = "syscall_";
+    if (key == nullptr || length < kPrefix.size() ||
+        !std::equal(kPrefix.begin(), kPrefix.end(), key, [](char a, char b) {
+          return a == std::tolower(static_cast<unsigned char>(b));
+        })) {
+      lua_pop(L, 1);
+      continue;
+    }
+    const std::string_view name(key, length);
+    const bool is_called = std::any_of(called.begin(), called.end(), [&](Callback callback) {
+      return name == kCallbackNames[callback];
+    });
+    if (is_called) {
+      if (lua_type(L, -1) != LUA_TFUNCTION) {
+        const std::string message = path + ": " + std::string(name) + " must be a function (got " +
+                                    luaL_typename(L, -1) + ")";
+        ThrowScriptError(state, script.object, message, "loading the script");
+      }
+    } else {
+      Uncalled& u = uncalled.emplace_back(Uncalled{std::string(name)});
+      if (lua_isfunction(L, -1)) {
+        lua_Debug ar;
+        lua_pushvalue(L, -1);
+        lua_getinfo(L, ">S", &ar);  // pops the copy
+        if (ar.source[0] == '@' && path == ar.source + 1 && ar.linedefined > 0)
+          u.line = ar.linedefined;
+      }
+    }
+    lua_pop(L, 1);
+  }
+  lua_settop(L, 0);
+  std::sort(uncalled.begin(), uncalled.end(),
+            [](const Uncalled& a, const Uncalled& b) { return a.name < b.name; });
+  for (const Uncalled& u : uncalled) {
+    std::string line = "warning: " + path;
+    if (u.line > 0) line += ":" + std::to_string(u.line) + ":";
+    line += " defines " + u.name + ", which swarmsim never calls (" +
+            UncalledHint(u.name, called, is_main, script.explicit_handling) + ")";
+    state.warnings.emplace_back(path + '\0' + u.name, std::move(line));
+  }
 }
 
 bool Runs(const Scene& scene, const Script& script) {
@@ -546,24 +728,31 @@ void Initialize(ScriptState* state) {
     script.env_ref = luaL_ref(L, LUA_REGISTRYINDEX);
     lua_rawgeti(L, LUA_REGISTRYINDEX, it->second);
     lua_rawgeti(L, LUA_REGISTRYINDEX, script.env_ref);
-    Call(*state, script, 1, "the main chunk");
+    try {
+      Call(*state, script, 1, "the main chunk");
+    } catch (const Error& e) {
+      if (!Disable(*state, script, e.what())) throw;
+    }
   }
   // The bodies' code is not needed any more (the callbacks they defined
   // keep their own prototypes).
   for (const auto& factory : factories) luaL_unref(L, LUA_REGISTRYINDEX, factory.second);
   // sysCall_init, then the per-step callbacks (sysCall_init may define them).
   for (Script& script : state->scripts) {
-    if (const int init = FindCallback(L, script, kCallbackNames[kInit]); init != LUA_NOREF) {
-      lua_rawgeti(L, LUA_REGISTRYINDEX, init);
-      luaL_unref(L, LUA_REGISTRYINDEX, init);
-      try {
+    if (script.disabled) continue;  // its main chunk failed (disable_script)
+    try {
+      CheckIsFunction(*state, script, kCallbackNames[kInit]);
+      if (const int init = FindCallback(L, script, kCallbackNames[kInit]); init != LUA_NOREF) {
+        lua_rawgeti(L, LUA_REGISTRYINDEX, init);
+        luaL_unref(L, LUA_REGISTRYINDEX, init);
         Call(*state, script, 0, kCallbackNames[kInit]);
-      } catch (const Error& e) {
-        if (!Disable(*state, script, e.what())) throw;
-        continue;
       }
+      script.initialized = true;
+      CheckSysCallNames(*state, script);
+    } catch (const Error& e) {
+      if (!Disable(*state, script, e.what())) throw;
+      continue;
     }
-    script.initialized = true;
     for (int callback : {kSensing, kActuation, kCleanup, kThread, kStep})
       script.callbacks[callback] = FindCallback(L, script, kCallbackNames[callback]);
     // sysCall_thread becomes a coroutine, first resumed in the first step.
@@ -571,6 +760,9 @@ void Initialize(ScriptState* state) {
       script.thread = lua_newthread(L);
       script.thread_ref = luaL_ref(L, LUA_REGISTRYINDEX);
       lua_rawgeti(script.thread, LUA_REGISTRYINDEX, script.callbacks[kThread]);
+      // The default slice (or one sim.setThreadSwitchTiming set already), capped.
+      script.slice_instructions = SliceInstructions(
+          script.slice_instructions, state->context.world->settings().instruction_budget);
     }
   }
   // Generational collection keeps a robot's heap within ~20% of what it
@@ -624,25 +816,43 @@ void ResumeThread(ScriptState* state, Script& script) {
   if (!error.empty()) ThrowScriptError(*state, script.object, std::move(error), "sysCall_thread");
 }
 
-// One callback of every script in hierarchy order (explicit ones are left
-// to their ancestors); with the actuation callbacks, the threads.
-// `args` (from sim.handleChildScripts) are passed to each callback.
-void PushArgs(lua_State* L, const std::vector<ParamValue>& args) {
+// Pushes the callback `ref` of `script` and `args` (from
+// sim.handleChildScripts), growing the stack for them: Lua guarantees only
+// LUA_MINSTACK free slots, and writing past them corrupts the state.
+void PushCallback(ScriptState& state, const Script& script, int ref, Callback callback,
+                  const std::vector<ParamValue>& args) {
+  lua_State* L = state.L;
+  if (!args.empty() &&
+      (args.size() >= INT_MAX || !lua_checkstack(L, 1 + static_cast<int>(args.size()))))
+    ThrowScriptError(state, script.object,
+                     "sim.handleChildScripts: " + std::to_string(args.size()) +
+                         " arguments do not fit on Lua's stack",
+                     kCallbackNames[callback]);
+  lua_rawgeti(L, LUA_REGISTRYINDEX, ref);
   for (const ParamValue& v : args) PushParamValue(L, v);
 }
 
-void RunCallback(ScriptState* state, Callback callback, const std::vector<ParamValue>& args = {}) {
+// One callback of every script in hierarchy order (explicit ones are left
+// to their ancestors); with the actuation callbacks, the threads, unless
+// they already ran in step `step` (0: no main script, once a step anyway).
+// `args` (from sim.handleChildScripts) are passed to each callback.
+void RunCallback(ScriptState* state, Callback callback, const std::vector<ParamValue>& args = {},
+                 uint64_t step = 0) {
   const Scene& scene = *state->context.scene;
   state->context.in_sensing = callback == kSensing;
+  bool resume_threads = callback == kActuation;
+  if (resume_threads && step != 0) {
+    resume_threads = state->threads_resumed_step != step;
+    state->threads_resumed_step = step;
+  }
   for (Script& script : state->scripts) {
     if (script.explicit_handling || !Runs(scene, script)) continue;
     try {
       if (const int ref = script.callbacks[callback]; ref != LUA_NOREF) {
-        lua_rawgeti(state->L, LUA_REGISTRYINDEX, ref);
-        PushArgs(state->L, args);
+        PushCallback(*state, script, ref, callback, args);
         Call(*state, script, static_cast<int>(args.size()), kCallbackNames[callback]);
       }
-      if (callback == kActuation && script.thread != nullptr) ResumeThread(state, script);
+      if (resume_threads && script.thread != nullptr) ResumeThread(state, script);
     } catch (const Error& e) {
       if (!Disable(*state, script, e.what())) throw;
     }
@@ -650,7 +860,8 @@ void RunCallback(ScriptState* state, Callback callback, const std::vector<ParamV
 }
 
 // sysCall_cleanup of the scripts whose sysCall_init returned. Every script
-// gets its cleanup; the first error is thrown afterwards.
+// gets its cleanup; under disable_script a failing one is disabled (logged
+// and listed), else the first error is thrown afterwards.
 void Cleanup(ScriptState* state) {
   std::string first_error;
   for (Script& script : state->scripts) {
@@ -659,7 +870,7 @@ void Cleanup(ScriptState* state) {
     try {
       Call(*state, script, 0, kCallbackNames[kCleanup]);
     } catch (const Error& e) {
-      if (first_error.empty()) first_error = e.what();
+      if (!Disable(*state, script, e.what()) && first_error.empty()) first_error = e.what();
     }
   }
   if (!first_error.empty()) throw Error(first_error);
@@ -735,6 +946,8 @@ int HandleChildScript(lua_State* L) {
   const int hook_count = lua_gethookcount(L);
   SetCurrent(state, script);
   script.running = true;
+  // Lua makes room for all the results of a LUA_MULTRET call (and the
+  // arguments are the caller's, already on this stack): nothing to grow here.
   const int status = lua_pcall(L, nargs, LUA_MULTRET, 0);
   script.running = false;
   SetCurrent(state, *caller);
@@ -778,15 +991,21 @@ int SwitchThread(lua_State* L) {
 
 // sim.setThreadSwitchTiming(ms): the thread's time slice per step, after
 // which it is switched out automatically. Deterministic: measured as
-// ms x 100,000 Lua instructions, not wall time.
+// ms x 100,000 Lua instructions, not wall time; at least 1,000 and at most
+// simulation.instruction_budget (when it is not 0) instructions.
 int SetThreadSwitchTiming(lua_State* L) {
   LuaContext& c = Context(L);
   const double ms = ArgNumber(L, 1);
-  if (!(ms > 0)) throw Error("the time slice must be a positive number of milliseconds");
+  if (!std::isfinite(ms) || !(ms > 0)) {
+    char given[32];
+    std::snprintf(given, sizeof given, "%g", ms);
+    throw Error("the time slice must be a finite positive number of milliseconds (got " +
+                std::string(std::isnan(ms) ? "nan" : given) + ")");
+  }
   Script* script = static_cast<Script*>(c.host_script);
   if (script == nullptr) return 0;
-  script->slice_instructions = static_cast<int>(
-      std::clamp<double>(ms * kInstructionsPerMs, 1000, static_cast<double>(INT_MAX)));
+  script->slice_instructions =
+      SliceInstructions(ms * kInstructionsPerMs, c.world->settings().instruction_budget);
   if (script->thread == L) lua_sethook(L, SliceHook, LUA_MASKCOUNT, script->slice_instructions);
   return 0;
 }
@@ -807,6 +1026,17 @@ int MainHandler(lua_State* L) {
 void Sensing(World* w) { w->HandleSensing(); }
 void Actuation(World* w) { w->HandleActuation(); }
 void Dynamics(World* w) { w->HandleDynamics(); }
+
+// sim.handleDynamics(): once per step (ScriptHost::RunMainScript resets the
+// flag), checked here so that the error names the main script's line.
+int HandleDynamics(lua_State* L) {
+  LuaContext& c = Context(L);
+  if (c.is_main) {
+    if (c.dynamics_handled) throw Error("may run only once per step");
+    c.dynamics_handled = true;
+  }
+  return MainHandler<Dynamics>(L);
+}
 
 // sim.handleChildScripts([pass [, ...]]): the child scripts of every robot,
 // then the scene's. pass: 'sensing', 'actuation' (with the threads) or 'all'
@@ -852,7 +1082,7 @@ void RegisterControlApi(lua_State* L) {
       {"handleSensing", Guarded<MainHandler<Sensing>, "sim.handleSensing">},
       {"handleChildScripts", Guarded<HandleChildScripts, "sim.handleChildScripts">},
       {"handleActuation", Guarded<MainHandler<Actuation>, "sim.handleActuation">},
-      {"handleDynamics", Guarded<MainHandler<Dynamics>, "sim.handleDynamics">},
+      {"handleDynamics", Guarded<HandleDynamics, "sim.handleDynamics">},
       {nullptr, nullptr},
   };
   luaL_setfuncs(L, kFunctions, 0);
@@ -864,6 +1094,7 @@ struct ScriptHost::Impl {
   std::unique_ptr<ScriptState> scene;                // null: no scene scripts
   std::unique_ptr<ScriptState> main;                 // null: the default main script
   std::vector<ParamValue> child_args;                // of the running sim.handleChildScripts
+  uint64_t main_steps = 0;                           // sysCall_step calls of the main script
   bool started = false;
   bool stopped = false;
 };
@@ -910,6 +1141,21 @@ void ScriptHost::Start() {
                   "sim.handleSensing(), sim.handleChildScripts(), sim.handleActuation(), "
                   "sim.handleDynamics())");
   }
+  // sysCall_* names no one calls: one warning per script file and name, not
+  // per robot, in robot order, then the scene's, then the main script's.
+  std::vector<std::string> warned;
+  const auto log_warnings = [&](ScriptState* state) {
+    if (state == nullptr) return;
+    for (auto& [key, line] : state->warnings) {
+      if (std::find(warned.begin(), warned.end(), key) != warned.end()) continue;
+      warned.push_back(std::move(key));
+      world.Log(line);
+    }
+    std::vector<std::pair<std::string, std::string>>().swap(state->warnings);
+  };
+  for (const auto& state : h.robots) log_warnings(state.get());
+  log_warnings(h.scene.get());
+  log_warnings(h.main.get());
 }
 
 bool ScriptHost::has_main_script() const { return impl_->main != nullptr; }
@@ -918,6 +1164,8 @@ void ScriptHost::RunMainScript() {
   Impl& h = *impl_;
   if (h.stopped || !h.main) return;
   Script& script = h.main->scripts[0];
+  ++h.main_steps;
+  h.main->context.dynamics_handled = false;
   lua_rawgeti(h.main->L, LUA_REGISTRYINDEX, script.callbacks[kStep]);
   Call(*h.main, script, 0, kCallbackNames[kStep]);
 }
@@ -928,14 +1176,15 @@ void ScriptHost::RunInstance(int instance, ScriptPass pass) {
   ScriptState* state = h.robots[instance].get();
   if (state == nullptr) return;
   if (pass != ScriptPass::kActuation) RunCallback(state, kSensing, h.child_args);
-  if (pass != ScriptPass::kSensing) RunCallback(state, kActuation, h.child_args);
+  if (pass != ScriptPass::kSensing) RunCallback(state, kActuation, h.child_args, h.main_steps);
 }
 
 void ScriptHost::RunSceneScripts(ScriptPass pass) {
   Impl& h = *impl_;
   if (h.stopped || !h.scene) return;
   if (pass != ScriptPass::kActuation) RunCallback(h.scene.get(), kSensing, h.child_args);
-  if (pass != ScriptPass::kSensing) RunCallback(h.scene.get(), kActuation, h.child_args);
+  if (pass != ScriptPass::kSensing)
+    RunCallback(h.scene.get(), kActuation, h.child_args, h.main_steps);
 }
 
 void ScriptHost::SetChildScriptArguments(std::vector<ParamValue> args) {

@@ -31,14 +31,19 @@ class ScriptHost {
   // then every sysCall_init, each robot's scripts in hierarchy order; then
   // the scene's scripts likewise. Robots start in parallel (each touches
   // only its own state); their prints and errors come out in robot order.
-  // Throws swarmsim::Error on a script error (the lowest robot's).
+  // Throws swarmsim::Error on a script error (the lowest robot's), or under
+  // on_script_error: disable_script disables the failing script (an error
+  // in its main chunk or sysCall_init, a sysCall_* callback that is not a
+  // function). Logs one warning per script file and name for globals named
+  // sysCall_* that are never called (typos, CoppeliaSim-only callbacks).
   void Start();
   // Control phase of one robot: sysCall_sensing of each of its scripts in
   // hierarchy order, then sysCall_actuation likewise. Safe to call
   // concurrently for different robots. Throws swarmsim::Error naming the
   // robot, script file and line on a Lua error.
   // A pass runs only the sensing or the actuation callbacks (threads are
-  // resumed with the actuation callbacks). Explicit scripts are skipped.
+  // resumed with the actuation callbacks; with a main script, in the first
+  // such pass of a step only). Explicit scripts are skipped.
   void RunInstance(int instance, ScriptPass pass = ScriptPass::kAll);
   // Control phase of the scripts outside any model, on the calling thread.
   void RunSceneScripts(ScriptPass pass = ScriptPass::kAll);
@@ -51,7 +56,9 @@ class ScriptHost {
   // callbacks it runs (empty outside such a call).
   void SetChildScriptArguments(std::vector<ParamValue> args);
   // sysCall_cleanup of every script whose sysCall_init returned; closes the
-  // states. Throws the lowest robot's cleanup error. Safe to call twice.
+  // states. Throws the lowest robot's cleanup error (under disable_script, a
+  // failing cleanup is logged and listed as disabled instead). Safe to call
+  // twice.
   void Stop();
 
   // Bytes held by all Lua states, as Lua counts them (lua_gc LUA_GCCOUNT;

@@ -231,7 +231,8 @@ void World::Step() {
       dynamics_handled_ = false;
       scripts_->RunMainScript();
       if (!dynamics_handled_)
-        throw Error("the main script's sysCall_step must call sim.handleDynamics() once per step");
+        throw Error("main: " + settings_.main_script->path +
+                    ": sysCall_step must call sim.handleDynamics() once per step");
     } else {
       // 1. sense: sensors read the state left by the last physics step.
       {

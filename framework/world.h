@@ -136,6 +136,9 @@ struct RobotRuntime {
   std::vector<std::string> disabled;    // scripts disabled this phase (disable_script), why
   std::vector<Message> outbox;          // messages sent this step
   std::vector<ReceivedMessage> inbox;   // messages delivered this step, sender-handle order
+  // Bytes the outbox holds (data + sizeof(Message) each), against
+  // WorldSettings::script_memory_limit; reset when the outbox is gathered.
+  uint64_t outbox_bytes = 0;
   // sim.setSignal/clearSignal writes (nullopt clears), applied at the next step.
   std::vector<std::pair<std::string, std::optional<ParamValue>>> signal_writes;
   // sim.writeCustomDataBlock writes (object, tag, data; empty data removes),

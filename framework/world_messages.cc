@@ -61,6 +61,7 @@ void World::DeliverMessages() {
   auto gather = [&](RobotRuntime& rt) {
     for (Message& m : rt.outbox) messages_.push_back(std::move(m));
     rt.outbox.clear();
+    rt.outbox_bytes = 0;
   };
   for (int r : writers) gather(runtimes_[r]);
   gather(scene_runtime_);

@@ -16,15 +16,14 @@
 #include <utility>
 #include <vector>
 
+#include "framework/suggest.h"
+
 namespace swarmsim::loader {
 
-// Damerau-Levenshtein distance (optimal string alignment: insertions,
-// deletions, substitutions and swaps of adjacent characters cost 1).
-int EditDistance(std::string_view a, std::string_view b);
-
-// "; did you mean 'radius'?" for the nearest candidate if it is close enough,
-// else " (expected one of: a, b, c)", or "" when there are no candidates.
-std::string Suggest(std::string_view name, std::span<const std::string> candidates);
+// EditDistance and Suggest ("; did you mean 'radius'?"), shared with the
+// script host (framework/suggest.h).
+using swarmsim::EditDistance;
+using swarmsim::Suggest;
 
 // A path as the user would recognise it: relative to the current directory
 // when the file is below it, else as given, lexically normalised.

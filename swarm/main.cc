@@ -17,6 +17,7 @@
 #include "framework/error.h"
 #include "framework/plugin_loader.h"
 #include "framework/registry.h"
+#include "framework/suggest.h"
 #include "modules/builtin.h"
 #include "swarm/bench.h"
 #include "swarm/bench_scaling.h"
@@ -130,12 +131,10 @@ std::vector<std::pair<std::string, std::string>> ParseSets(const std::vector<std
 }
 
 // `name`'s nearest among `candidates` when it is close enough to be a typo
-// (the world loader's rule, loader::Suggest), else "".
+// (the world loader's rule, framework/suggest.h), else "".
 std::string Nearest(std::string_view name, std::span<const std::string> candidates) {
-  const std::string hint = loader::Suggest(name, candidates);
-  constexpr std::string_view kLead = "; did you mean '";
-  if (!hint.starts_with(kLead)) return "";
-  return hint.substr(kLead.size(), hint.size() - kLead.size() - 2);  // without the "'?"
+  const std::string* nearest = NearestName(name, candidates);
+  return nearest != nullptr ? *nearest : std::string();
 }
 
 std::string Join(const std::vector<std::string>& items) {

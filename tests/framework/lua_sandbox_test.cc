@@ -22,6 +22,8 @@ namespace fs = std::filesystem;
 
 #define EXPECT_CONTAINS(haystack, needle) \
   EXPECT_NE(std::string(haystack).find(needle), std::string::npos) << (haystack)
+#define ASSERT_CONTAINS(haystack, needle) \
+  ASSERT_NE(std::string(haystack).find(needle), std::string::npos) << (haystack)
 
 // A temporary world folder with world/, world/scripts/ and out/.
 class SandboxTest : public ::testing::Test {
@@ -85,6 +87,8 @@ TEST_F(SandboxTest, ForbiddenFunctionsAreRefusedWithScriptAndLine) {
       {"os.getenv('HOME')", "os.getenv is not allowed"},
       {"io.lines()", "io.lines() on standard input is not allowed"},
       {"load('\\27LuaT\\0')", "binary chunks are not allowed"},
+      {"string.dump(print)", "string.dump is not allowed"},
+      {"('x').dump(print)", "string.dump is not allowed"},
   };
   for (const auto& [call, message] : escapes) {
     const std::string error = Run("\nfunction sysCall_init()\n  " + call + "\nend\n");
@@ -92,8 +96,9 @@ TEST_F(SandboxTest, ForbiddenFunctionsAreRefusedWithScriptAndLine) {
     EXPECT_CONTAINS(error, "bot#0: scripts/robot.lua:3:");
     EXPECT_CONTAINS(error, "--trust-scripts");
   }
-  // string.dump is gone; harmless os functions stay.
-  EXPECT_EQ(Run("assert(string.dump == nil); assert(os.clock() >= 0)"), "");
+  // Harmless os functions stay; other missing string fields are nil as usual.
+  EXPECT_EQ(Run("assert(os.clock() >= 0); assert(string.nothere == nil and ('x').nothere == nil)"),
+            "");
 }
 
 TEST_F(SandboxTest, ReadsOnlyUnderTheWorldFolder) {
@@ -179,6 +184,54 @@ TEST_F(SandboxTest, CoroutineAndUtf8AreThereOnFirstUse) {
                 "print(coroutine.running() ~= nil)"),
             "");
   EXPECT_EQ(Log(), "[bot#0] true\n");
+}
+
+// Lua runs __gc finalizers with hooks off: one that loops would hang the
+// step for good. setmetatable refuses a metatable with __gc (Lua marks an
+// object for finalization only there, so adding __gc later does nothing).
+TEST_F(SandboxTest, GcFinalizersAreRefusedBecauseNothingCouldStopOne) {
+  ASSERT_CONTAINS(Run("\nsetmetatable({}, {__gc = function() end})"),
+                  "bot#0: scripts/robot.lua:2: setmetatable: __gc finalizers are not allowed in a "
+                  "sandboxed script (Lua cannot stop one that loops)");
+  EXPECT_CONTAINS(Run("setmetatable({}, {__gc = function() while true do end end})\n"
+                      "collectgarbage()"),
+                  "__gc finalizers are not allowed");
+  EXPECT_EQ(Run("local ok, e = pcall(setmetatable, {}, {__gc = false})\n"
+                "assert(not ok and e:find('__gc finalizers'), e)\n"
+                "local mt = {}\n"
+                "local t = setmetatable({}, mt)\n"
+                "mt.__gc = function() print('finalized') end\n"
+                "t = nil; collectgarbage(); collectgarbage()\n"
+                "-- Everything else setmetatable does is unchanged.\n"
+                "local c = setmetatable({}, {__index = {x = 1}, __metatable = 'locked'})\n"
+                "assert(c.x == 1 and getmetatable(c) == 'locked')\n"
+                "assert(not pcall(setmetatable, c, {}))\n"
+                "assert(getmetatable(setmetatable(setmetatable({}, {}), nil)) == nil)\n"
+                "assert(not pcall(setmetatable, 1, {}) and not pcall(setmetatable, {}, 1))\n"
+                "-- A file's metatable, whose __gc Lua runs, cannot be reached.\n"
+                "assert(type(getmetatable(io.open('data.txt'))) == 'string')"),
+            "");
+  EXPECT_EQ(Log(), "");
+  EXPECT_EQ(Run("local t = setmetatable({}, {__gc = function() print('finalized') end})\n"
+                "t = nil; collectgarbage()",
+                true, /*trust=*/true),
+            "");
+  EXPECT_EQ(Log(), "[bot#0] finalized\n");
+}
+
+// math.randomseed() without a seed reads the clock: runs would stop being
+// reproducible. With a seed it works as in Lua.
+TEST_F(SandboxTest, RandomSeedNeedsASeed) {
+  EXPECT_CONTAINS(Run("\nmath.randomseed()"),
+                  "bot#0: scripts/robot.lua:2: math.randomseed needs a seed: without one it "
+                  "reads the clock and runs stop being reproducible");
+  EXPECT_CONTAINS(Run("math.randomseed(nil)"), "math.randomseed needs a seed");
+  EXPECT_EQ(Run("math.randomseed(42); local a = math.random(1000000)\n"
+                "math.randomseed(42, 7); local b = math.random(1000000)\n"
+                "math.randomseed(42); assert(math.random(1000000) == a)\n"
+                "math.randomseed(42, 7); assert(math.random(1000000) == b)"),
+            "");
+  EXPECT_EQ(Run("math.randomseed()", true, /*trust=*/true), "");
 }
 
 TEST_F(SandboxTest, TrustScriptsGivesTheFullLibraries) {

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "framework/error.h"
@@ -626,6 +627,138 @@ TEST(ScriptControlTest, PackAndUnpackRoundTrip) {
   EXPECT_CONTAINS(w.log[1], "not a packed table");
 }
 
+// Nested tables take Lua stack space per level: packing one used to write
+// past the stack and corrupt the heap. Deep tables and cycles are Lua errors
+// naming sim.packTable, which pcall catches; 32 levels still pack.
+TEST(ScriptControlTest, PackTableOfDeepOrCyclicTablesIsACleanError) {
+  ScriptWorld w;
+  w.AddRobot("bot#0", R"(
+    local function chain(n)
+      local root = {}
+      local t = root
+      for i = 2, n do t.k = {i = i}; t = t.k end
+      return root
+    end
+    function sysCall_actuation()
+      local d = chain(21)
+      for i = 1, 50 do sim.sendGlobalMessage(sim.packTable(d)) end
+      for i = 1, 50 do
+        local ok, e = pcall(sim.packTable, chain(33 + i))
+        assert(not ok and e:find('nested more than 32 levels'), e)
+      end
+      local cycle = {}
+      cycle.self = {up = cycle}
+      local ok, e = pcall(sim.packTable, cycle)
+      print(ok, e)
+      local t = sim.unpackTable(sim.packTable(chain(32)))
+      local depth = 1
+      while t.k do t = t.k; depth = depth + 1 end
+      print(depth, t.i)
+      -- A table as a key takes its stack slots too.
+      local keyed = {}
+      local t = keyed
+      for i = 1, 31 do local k = {}; t[k] = true; t = k end
+      print(#sim.packTable(keyed) > 0, pcall(sim.packTable, {[chain(32)] = 1}))
+    end
+  )");
+  w.Steps(2);
+  ASSERT_EQ(w.log.size(), 6u);
+  EXPECT_CONTAINS(
+      w.log[0],
+      "[bot#0] false\tsim.packTable: the table is nested more than 32 levels deep (or has "
+      "a cycle)");
+  EXPECT_EQ(w.log[1], "[bot#0] 32\t32");
+  EXPECT_CONTAINS(
+      w.log[2], "[bot#0] true\tfalse\tsim.packTable: the table is nested more than 32 levels deep");
+}
+
+// A packed string nested deeper than packTable makes is refused, not unpacked.
+TEST(ScriptControlTest, UnpackTableRefusesStringsNestedTooDeeply) {
+  ScriptWorld w;
+  w.AddRobot("bot#0", R"(
+    local function nested(n)  -- n tables, each {[1] = <the next>}
+      local s = string.pack('<c1I4', 't', 0)
+      for i = 2, n do s = string.pack('<c1I4c1i8', 't', 1, 'i', 1) .. s end
+      return s
+    end
+    local t = sim.unpackTable(nested(32))
+    local depth = 1
+    while t[1] do t = t[1]; depth = depth + 1 end
+    print(depth, pcall(sim.unpackTable, nested(33)))
+    print(pcall(sim.unpackTable, nested(1000)))
+  )");
+  w.world().Start();
+  ASSERT_EQ(w.log.size(), 2u);
+  EXPECT_CONTAINS(w.log[0],
+                  "[bot#0] 32\tfalse\tsim.unpackTable: the packed table is nested more than 32 "
+                  "levels deep");
+  EXPECT_CONTAINS(w.log[1], "nested more than 32 levels deep");
+}
+
+TEST(ScriptControlTest, StringSignalsKeepEveryByte) {
+  ScriptWorld w;
+  w.AddRobot("bot#0", R"(
+    function sysCall_actuation()
+      local v = sim.getSignal('blob')
+      if v then print(#v, v == 'a\0b\0' .. sim.packInt32s({7})) end
+      sim.setSignal('blob', 'a\0b\0' .. sim.packInt32s({7}))
+    end
+  )");
+  w.Steps(2);
+  EXPECT_EQ(w.log, (std::vector<std::string>{"[bot#0] 8\ttrue"}));
+}
+
+// The messages one robot sends in one step may hold at most its Lua memory
+// limit (simulation.script_memory_mb): 20 robots sending 100 MiB each per
+// step used to exhaust the host's memory. The count starts again each step.
+TEST(ScriptControlTest, MessagesSentInOneStepAreBoundedByTheScriptMemoryLimit) {
+  WorldSettings settings;
+  settings.script_memory_limit = 4 << 20;
+  ScriptWorld w(1, settings);
+  w.AddRobot("bot#0", R"(
+    function sysCall_actuation()
+      local n = 0
+      while sim.receiveMessage() do n = n + 1 end
+      local m = string.rep('x', 1 << 20)
+      local sent, ok, e = 0, true, nil
+      while ok and sent < 10 do
+        ok, e = pcall(sim.sendRangeMessage, m, 5)
+        if ok then sent = sent + 1 end
+      end
+      print(n, sent, e)
+      ok, e = pcall(sim.sendGlobalMessage, m)  -- the same count for every scope
+      print(ok, e)
+    end
+  )");
+  w.AddRobot("bot#1", "", 1, 0);
+  const ObjectId listener = w.scene().FindObject("/bot#1/body");
+  w.scene().AttachScript(listener, Source("scripts/listener.lua", R"(
+    function sysCall_actuation()
+      local n = 0
+      while sim.receiveMessage() do n = n + 1 end
+      if n > 0 then print('received', n) end
+    end
+  )"));
+  w.Steps(2);
+  const std::string limit =
+      "the messages sent this step would hold more than 4 MiB (simulation.script_memory_mb)";
+  ASSERT_EQ(w.log.size(), 5u);
+  EXPECT_EQ(w.log[0], "[bot#0] 0\t3\tsim.sendRangeMessage: " + limit);
+  EXPECT_EQ(w.log[1], "[bot#0] false\tsim.sendGlobalMessage: " + limit);
+  EXPECT_EQ(w.log[2], "[bot#0] 0\t3\tsim.sendRangeMessage: " + limit);
+  EXPECT_EQ(w.log[4], "[bot#1] received\t3");
+  // 0: no limit.
+  settings.script_memory_limit = 0;
+  ScriptWorld u(1, settings);
+  u.AddRobot("bot#0", R"(
+    function sysCall_actuation()
+      local m = string.rep('x', 1 << 20)
+      for i = 1, 20 do sim.sendGlobalMessage(m) end
+    end
+  )");
+  EXPECT_EQ(ErrorOf([&] { u.Steps(2); }), "");
+}
+
 TEST(ScriptControlTest, CustomDataIsSeenNextStepAndCopiedWithTheModel) {
   ScriptWorld w(2);
   // Robot 0 writes a block on its own body and on robot 1's; robot 1 reads both.
@@ -674,6 +807,297 @@ TEST(ScriptControlTest, StateHashCoversWhatScriptsLeaveForTheNextStep) {
   EXPECT_NE(hash_after("sim.setSignal('s', 1)"), nothing);
   EXPECT_NE(hash_after("sim.sendGlobalMessage('hi')"), nothing);
   EXPECT_NE(hash_after("sim.writeCustomDataBlock(sim.getObject('.'), 't', 'x')"), nothing);
+}
+
+// --- Rough edges (QA) ----------------------------------------------------------------------
+
+// A main script passing `extra` (Lua expressions) to every child callback of a
+// pass, then stepping the rest of the phases.
+WorldSettings MainPassing(const std::string& pass, const std::string& extra) {
+  WorldSettings settings;
+  settings.main_script = Source("main.lua", R"(
+    function sysCall_step()
+      local t = {}
+      for i = 1, )" + extra + R"( do t[i] = i end
+      sim.handleSensing()
+      sim.handleChildScripts(')" + pass + R"(', table.unpack(t))
+      sim.handleActuation()
+      sim.handleDynamics()
+    end
+  )");
+  return settings;
+}
+
+TEST(ScriptControlTest, HandleChildScriptsPassesManyArgumentsToEveryRobot) {
+  // 45 arguments overflowed each robot's Lua stack (a segfault); 5,000 need it grown.
+  for (const std::string count : {"45", "5000"}) {
+    ScriptWorld w(2, MainPassing("actuation", count));
+    for (int r = 0; r < 2; ++r)
+      w.AddRobot("bot#" + std::to_string(r), R"(
+        function sysCall_actuation(...) print(select('#', ...), (select(select('#', ...), ...))) end
+        function sysCall_thread() while true do sim.step() end end
+      )",
+                 r);
+    w.AddRobot("bot#2", "", 2);
+    w.Steps(2);
+    const std::vector<std::string> expected = {
+        "[bot#0] " + count + "\t" + count, "[bot#1] " + count + "\t" + count,
+        "[bot#0] " + count + "\t" + count, "[bot#1] " + count + "\t" + count};
+    EXPECT_EQ(w.log, expected);
+  }
+}
+
+TEST(ScriptControlTest, HandleChildScriptPassesAndReturnsManyValues) {
+  ScriptWorld w;
+  const ObjectId body = w.AddRobot("bot#0", R"(
+    function sysCall_actuation()
+      local t = {}
+      for i = 1, 5000 do t[i] = i end
+      local arm = sim.getObject('./arm')
+      print(select('#', sim.handleChildScript(arm, table.unpack(t))))
+      print(select('#', sim.handleChildScript(arm)))
+    end
+  )");
+  const ObjectId arm = w.scene().AddDummy("arm", body, {});
+  w.scene().AttachScript(arm, Source("scripts/arm.lua", R"(
+    function sysCall_actuation(...)
+      if select('#', ...) > 0 then return ... end
+      local t = {}
+      for i = 1, 10000 do t[i] = i end
+      return table.unpack(t)
+    end
+  )"),
+                         /*explicit_handling=*/true);
+  w.Steps(1);
+  EXPECT_EQ(w.log, (std::vector<std::string>{"[bot#0] 5000", "[bot#0] 10000"}));
+}
+
+TEST(ScriptControlTest, ThreadSwitchTimingMustBeFiniteAndPositive) {
+  for (const std::string ms : {"1/0", "-1/0", "0/0", "-1", "0", "'x'"}) {
+    ScriptWorld w;
+    w.AddRobot("bot#0", "function sysCall_thread()\n  sim.setThreadSwitchTiming(" + ms +
+                            ")\n  while true do end\nend\n");
+    const std::string error = ErrorOf([&] { w.Steps(1); });
+    EXPECT_CONTAINS(error, "bot#0: scripts/robot.lua:2: sim.setThreadSwitchTiming: ") << ms;
+  }
+}
+
+TEST(ScriptControlTest, ThreadSliceIsCappedAtTheInstructionBudget) {
+  // 100,000 instructions are 25,000 turns of the loop.
+  auto turns_per_step = [](const std::string& timing, const std::string& init = "") {
+    WorldSettings settings;
+    settings.instruction_budget = 100'000;
+    ScriptWorld w(1, settings);
+    w.AddRobot("bot#0", R"(
+      n = 0
+      function sysCall_init() )" +
+                            init + R"( end
+      function sysCall_thread()
+        )" + timing + R"(
+        while true do n = n + 1 end
+      end
+      function sysCall_sensing() sim.recordMetric('n', n) end
+    )");
+    w.Steps(4);
+    const std::vector<MetricSample> metrics = w.world().TakeMetrics();
+    return metrics.back().value - metrics[metrics.size() - 2].value;
+  };
+  EXPECT_NEAR(turns_per_step("sim.setThreadSwitchTiming(10)"), 25'000, 2);  // 1,000,000 asked
+  EXPECT_NEAR(turns_per_step("sim.setThreadSwitchTiming(1e300)"), 25'000, 2);
+  EXPECT_NEAR(turns_per_step(""), 25'000, 2);  // the default, 200,000
+  EXPECT_NEAR(turns_per_step("sim.setThreadSwitchTiming(0.5)"), 12'500, 2);
+  EXPECT_NEAR(turns_per_step("", "sim.setThreadSwitchTiming(0.5)"), 12'500,
+              2);  // before the thread
+}
+
+TEST(ScriptControlTest, WaitAndWaitUntilRejectNaNInfiniteAndNegativeTimes) {
+  for (const std::string call :
+       {"sim.wait(0/0)", "sim.wait(1/0)", "sim.wait(-1)", "sim.waitUntil(f, 0/0)",
+        "sim.waitUntil(f, 1/0)", "sim.waitUntil(f, -0.5)", "sim.waitUntil(f, 'x')"}) {
+    ScriptWorld w;
+    w.AddRobot("bot#0", "local function f() return false end\nfunction sysCall_thread()\n  " +
+                            call + "\n  print('went on')\nend\n");
+    const std::string error = ErrorOf([&] { w.Steps(3); });
+    const std::string name = call.substr(0, call.find('('));
+    EXPECT_CONTAINS(error, "bot#0: scripts/robot.lua:3: " + name + ": ") << call;
+    EXPECT_TRUE(w.log.empty()) << call << ": " << w.log.front();
+  }
+  ScriptWorld w;  // zero and nil stay fine
+  w.AddRobot("bot#0", R"(
+    function sysCall_thread()
+      sim.wait(0)
+      print(sim.waitUntil(function() return true end, 0), sim.waitUntil(function() return true end))
+    end
+  )");
+  w.Steps(1);
+  EXPECT_EQ(w.log, (std::vector<std::string>{"[bot#0] true\ttrue"}));
+}
+
+TEST(ScriptControlTest, DisableScriptPolicyCoversCleanupErrors) {
+  WorldSettings settings;
+  settings.on_script_error = ScriptErrorPolicy::kDisableScript;
+  ScriptWorld w(2, settings);
+  for (int r = 0; r < 3; ++r)
+    w.AddRobot("bot#" + std::to_string(r),
+               r == 1 ? "function sysCall_cleanup()\n  error('bye')\nend"
+                      : "function sysCall_cleanup() print('cleanup') end",
+               r);
+  w.Steps(1);
+  EXPECT_EQ(ErrorOf([&] { w.world().Stop(); }), "");
+  ASSERT_EQ(w.log.size(), 3u);
+  EXPECT_EQ(w.log[0], "[bot#0] cleanup");
+  EXPECT_EQ(w.log[1],
+            "error, script disabled: bot#1: scripts/robot.lua:2: bye [in sysCall_cleanup of "
+            "/bot#1/body]");
+  EXPECT_EQ(w.log[2], "[bot#2] cleanup");
+  ASSERT_EQ(w.world().disabled_scripts().size(), 1u);
+  EXPECT_CONTAINS(w.world().disabled_scripts()[0], "bot#1: scripts/robot.lua:2: bye");
+}
+
+TEST(ScriptControlTest, DisableScriptPolicyWithoutABudgetLetsTheRobotsOtherScriptsGoOn) {
+  // With instruction_budget 0, the spent memory limit of one script failed
+  // every later script of its robot ("not enough memory").
+  WorldSettings settings;
+  settings.on_script_error = ScriptErrorPolicy::kDisableScript;
+  settings.instruction_budget = 0;
+  settings.script_memory_limit = 4 << 20;
+  ScriptWorld w(1, settings);
+  const ObjectId body = w.AddRobot("bot#0",
+                                   "function sysCall_actuation()\n  local t = {}\n"
+                                   "  while true do t[#t + 1] = string.rep('x', 10000) .. #t end\n"
+                                   "end\n");
+  const ObjectId arm = w.scene().AddDummy("arm", body, {});
+  w.scene().AttachScript(
+      arm, Source("scripts/arm.lua", "function sysCall_actuation() print('arm') end"));
+  w.Steps(3);
+  ASSERT_EQ(w.log.size(), 4u);
+  EXPECT_CONTAINS(w.log[0], "script disabled: bot#0: scripts/robot.lua:3: the scripts hold more");
+  EXPECT_EQ(w.log[1], "[bot#0] arm");
+  EXPECT_EQ(w.log[3], "[bot#0] arm");
+}
+
+TEST(ScriptControlTest, DisableScriptPolicyCoversMainChunkErrors) {
+  auto world_with_a_failing_body = [](ScriptErrorPolicy policy) {
+    WorldSettings settings;
+    settings.on_script_error = policy;
+    auto w = std::make_unique<ScriptWorld>(2, settings);
+    for (int r = 0; r < 3; ++r)
+      w->AddRobot("bot#" + std::to_string(r),
+                  std::string(r == 1 ? "local x = 1\nerror('boom')\n" : "") +
+                      "function sysCall_init() print('init') end\n"
+                      "function sysCall_actuation() sim.recordMetric('alive', 1) end\n"
+                      "function sysCall_cleanup() print('cleanup') end\n",
+                  r);
+    return w;
+  };
+  auto w = world_with_a_failing_body(ScriptErrorPolicy::kDisableScript);
+  w->Steps(2);
+  w->world().Stop();
+  const std::vector<std::string> expected = {
+      "[bot#0] init",
+      "error, script disabled: bot#1: scripts/robot.lua:2: boom [in the main chunk of "
+      "/bot#1/body]",
+      "[bot#2] init", "[bot#0] cleanup", "[bot#2] cleanup"};
+  EXPECT_EQ(w->log, expected);
+  EXPECT_EQ(w->world().TakeMetrics().size(), 4u);
+  ASSERT_EQ(w->world().disabled_scripts().size(), 1u);
+  EXPECT_CONTAINS(w->world().disabled_scripts()[0], "bot#1: scripts/robot.lua:2: boom");
+  // Under stop the run ends, as before.
+  auto v = world_with_a_failing_body(ScriptErrorPolicy::kStop);
+  EXPECT_CONTAINS(ErrorOf([&] { v->world().Start(); }),
+                  "bot#1: scripts/robot.lua:2: boom [in the main chunk of /bot#1/body]");
+}
+
+TEST(ScriptControlTest, CallbackThatIsNotAFunctionIsAnErrorAtLoad) {
+  const std::pair<std::string, std::string> cases[] = {
+      {"sysCall_actuation = 5", "sysCall_actuation must be a function (got number)"},
+      {"sysCall_init = 'x'", "sysCall_init must be a function (got string)"},
+      {"function sysCall_init() sysCall_sensing = {} end",
+       "sysCall_sensing must be a function (got table)"},
+      {"sysCall_thread = true", "sysCall_thread must be a function (got boolean)"},
+  };
+  for (const auto& [code, message] : cases) {
+    ScriptWorld w;
+    w.AddRobot("bot#0", code);
+    EXPECT_CONTAINS(ErrorOf([&] { w.world().Start(); }), "bot#0: scripts/robot.lua: " + message +
+                                                             " [in loading the script of "
+                                                             "/bot#0/body]");
+  }
+  // Under disable_script, that script is disabled like one whose sysCall_init fails.
+  WorldSettings settings;
+  settings.on_script_error = ScriptErrorPolicy::kDisableScript;
+  ScriptWorld w(1, settings);
+  w.AddRobot("bot#0", "sysCall_actuation = 5\nfunction sysCall_sensing() print('sensing') end");
+  w.Steps(1);
+  ASSERT_EQ(w.log.size(), 1u);
+  EXPECT_CONTAINS(w.log[0], "script disabled: bot#0: scripts/robot.lua: sysCall_actuation must");
+}
+
+TEST(ScriptControlTest, UnknownSysCallNamesAreWarnedOncePerScriptFile) {
+  ScriptWorld w(2);
+  for (int r = 0; r < 1000; ++r)
+    w.AddRobot("bot#" + std::to_string(r), R"(
+      function sysCall_actuate() end
+      function sysCall_beforeSimulation() end
+      function sysCall_step() end
+      sysCall_frobnicate = 3
+      function sysCall_actuation() end
+    )",
+               r);
+  w.world().Start();
+  w.Steps(1);
+  const std::vector<std::string> expected = {
+      "warning: scripts/robot.lua:2: defines sysCall_actuate, which swarmsim never calls (did you "
+      "mean sysCall_actuation?)",
+      "warning: scripts/robot.lua:3: defines sysCall_beforeSimulation, which swarmsim never calls "
+      "(it is CoppeliaSim's; put its code in sysCall_init)",
+      "warning: scripts/robot.lua defines sysCall_frobnicate, which swarmsim never calls "
+      "(it calls sysCall_init, sysCall_sensing, sysCall_actuation, sysCall_cleanup and "
+      "sysCall_thread)",
+      "warning: scripts/robot.lua:4: defines sysCall_step, which swarmsim never calls (only the "
+      "world's main script, simulation.main_script, has a sysCall_step)"};
+  EXPECT_EQ(w.log, expected);
+}
+
+TEST(ScriptControlTest, ThreadsResumeAtMostOncePerStep) {
+  for (const std::string passes : {"'actuation', 'actuation'", "'all', 'actuation'"}) {
+    WorldSettings settings;
+    settings.main_script = Source("main.lua", R"(
+      function sysCall_step()
+        sim.handleSensing()
+        for _, pass in ipairs({)" + passes + R"(}) do sim.handleChildScripts(pass) end
+        sim.handleActuation()
+        sim.handleDynamics()
+      end
+    )");
+    ScriptWorld w(1, settings);
+    w.AddRobot("bot#0", R"(
+      function sysCall_actuation() print('actuation', sim.getSimulationTime()) end
+      function sysCall_thread()
+        while true do print('thread', sim.getSimulationTime()) sim.step() end
+      end
+    )");
+    w.Steps(2);
+    const std::vector<std::string> expected = {"[bot#0] actuation\t0.0", "[bot#0] thread\t0.0",
+                                               "[bot#0] actuation\t0.0", "[bot#0] actuation\t0.1",
+                                               "[bot#0] thread\t0.1",    "[bot#0] actuation\t0.1"};
+    EXPECT_EQ(w.log, expected) << passes;
+  }
+}
+
+TEST(ScriptControlTest, MainScriptPhaseMistakesNameTheMainScript) {
+  WorldSettings twice;
+  twice.main_script = Source("main.lua",
+                             "function sysCall_step()\n  sim.handleDynamics()\n"
+                             "  sim.handleDynamics()\nend\n");
+  ScriptWorld w(1, twice);
+  EXPECT_CONTAINS(ErrorOf([&] { w.Steps(1); }),
+                  "main: main.lua:3: sim.handleDynamics: may run only once per step");
+  WorldSettings never;
+  never.main_script = Source("main.lua", "function sysCall_step() sim.handleSensing() end");
+  ScriptWorld v(1, never);
+  EXPECT_CONTAINS(ErrorOf([&] { v.Steps(1); }),
+                  "main: main.lua: sysCall_step must call sim.handleDynamics() once per step");
 }
 
 }  // namespace

@@ -81,6 +81,40 @@ TEST(SandboxCliTest, OutFolderIsWritableAndTrustScriptsLiftsTheSandbox) {
   fs::remove_all(dir);
 }
 
+// A script cannot clobber the files the run itself writes into --out: any
+// mode but plain reading is refused for them; other names, and the same
+// names in a subfolder, stay writable.
+TEST(SandboxCliTest, ScriptsCannotOverwriteTheRunsOwnOutputs) {
+  for (const std::string name : {"metrics.csv", "summary.json", "paint.png", "stderr.txt"}) {
+    for (const std::string mode : {"w", "a", "r+", "wb"}) {
+      const fs::path dir =
+          MakeWorld("local f = io.open('" + name + "', '" + mode + "'); f:write('clobbered')");
+      const Result r = RunProgram("run " + (dir / "world.yaml").string() +
+                                  " --steps 2 --quiet --out " + (dir / "out").string());
+      EXPECT_EQ(r.exit_code, 1) << name << " " << mode << "\n" << r.output;
+      EXPECT_NE(
+          r.output.find("probe.lua:2: io.open: '" + name + "' is one of the run's own outputs"),
+          std::string::npos)
+          << r.output;
+      std::ifstream summary(dir / "out" / "summary.json");
+      std::string text((std::istreambuf_iterator<char>(summary)), std::istreambuf_iterator<char>());
+      EXPECT_NE(text.find("\"status\""), std::string::npos) << name << " " << mode << ": " << text;
+      fs::remove_all(dir);
+    }
+  }
+  const fs::path dir = MakeWorld(
+      "assert(io.open('out.csv', 'w')):close()\n"
+      "  local ok, e = pcall(io.open, './metrics.csv', 'w'); assert(not ok and e:find('own'))\n"
+      "  assert(io.open('sub/metrics.csv', 'w')):close()");
+  fs::create_directories(dir / "out" / "sub");
+  const Result r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 2 --quiet --out " +
+                              (dir / "out").string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(fs::exists(dir / "out" / "sub" / "metrics.csv"));
+  EXPECT_TRUE(fs::exists(dir / "out" / "out.csv"));
+  fs::remove_all(dir);
+}
+
 // What works sandboxed works trusted: modules from the world's folders,
 // relative reads from the world's folder and writes to --out.
 TEST(SandboxCliTest, TrustedScriptsUseTheWorldsFoldersLikeSandboxedOnes) {

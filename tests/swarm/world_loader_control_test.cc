@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "framework/error.h"
@@ -17,6 +18,7 @@
 #include "framework/world.h"
 #include "swarm/world_loader.h"
 #include "tests/framework/fakes.h"
+#include "tests/swarm/run_program.h"
 
 namespace swarmsim {
 namespace {
@@ -185,6 +187,82 @@ TEST_F(ControlLoaderTest, DescribeListsModelsParametersAndScripts) {
   EXPECT_CONTAINS(out, "bot.lua");
   EXPECT_CONTAINS(out, "bot.speed = 0.25 m/s  (default 0.1, range [0, 0.5])  forward speed");
   EXPECT_CONTAINS(out, "copy 1 of this entry: label=special");
+}
+
+// --- Script errors and warnings, as the program reports them ---------------------------------
+
+// `swarmsim run` of world.yaml in the test folder.
+swarmsim::testing::CommandResult RunWorld(const fs::path& dir, const std::string& args) {
+  return swarmsim::testing::RunProgram("run " + (dir / "world.yaml").string() + " " + args);
+}
+
+const char kTwoBots[] =
+    "models:\n"
+    "  - model: bot.yaml\n"
+    "    count: 2\n"
+    "    distribute: {region: {min: [-5, -5], max: [5, 5]}}\n";
+
+TEST_F(ControlLoaderTest, ManyArgumentsToHandleChildScriptsDoNotCrashTheRun) {
+  Write("main.lua",
+        "function sysCall_step() local t={} for i=1,45 do t[i]=i end sim.handleSensing() "
+        "sim.handleChildScripts('actuation', table.unpack(t)) sim.handleActuation() "
+        "sim.handleDynamics() end\n");
+  Write("bot.lua", "function sysCall_actuation(...) print(select('#',...)) end\n");
+  Write("world.yaml",
+        std::string("simulation: {physics: kinematic, main_script: main.lua}\n") + kTwoBots);
+  const auto r = RunWorld(dir_, "--steps 2 --quiet");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_CONTAINS(r.output, "[bot#0] 45\n[bot#1] 45\n[bot#0] 45\n[bot#1] 45\n");
+}
+
+TEST_F(ControlLoaderTest, DisabledCleanupAndMainChunkErrorsEndTheRunOkAndAreListed) {
+  Write("bot.lua",
+        "if sim.getRobotIndex() == 1 then error('boom') end\n"
+        "function sysCall_cleanup()\n  error('bye')\nend\n");
+  Write("world.yaml",
+        std::string("simulation: {physics: kinematic, on_script_error: disable_script}\n") +
+            kTwoBots);
+  const fs::path out = dir_ / "out";
+  const auto r = RunWorld(dir_, "--steps 2 --out " + out.string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream summary_file(out / "summary.json");
+  ASSERT_TRUE(summary_file.good());
+  const auto summary = nlohmann::json::parse(summary_file);
+  EXPECT_EQ(summary["status"], "ok") << summary.dump();
+  ASSERT_EQ(summary["disabled_scripts"].size(), 2u) << summary.dump();
+  const std::string script = (dir_ / "bot.lua").string();
+  EXPECT_EQ(summary["disabled_scripts"][0],
+            "bot#1: " + script + ":1: boom [in the main chunk of /bot#1]");
+  EXPECT_EQ(summary["disabled_scripts"][1],
+            "bot#0: " + script + ":3: bye [in sysCall_cleanup of /bot#0]");
+  EXPECT_CONTAINS(r.output, "disabled scripts 2");
+  // Under stop, the cleanup error still ends the run.
+  Write("bot.lua", "function sysCall_cleanup()\n  error('bye')\nend\n");
+  Write("world.yaml", std::string("simulation: {physics: kinematic}\n") + kTwoBots);
+  const auto stopped = RunWorld(dir_, "--steps 1 --quiet");
+  EXPECT_EQ(stopped.exit_code, 1) << stopped.output;
+  EXPECT_CONTAINS(stopped.output,
+                  "error: bot#0: " + script + ":2: bye [in sysCall_cleanup of /bot#0]");
+}
+
+TEST_F(ControlLoaderTest, ACallbackTypoIsWarnedOnceForAThousandRobots) {
+  Write("bot.lua", "function sysCall_actuate() end\n");
+  Write("world.yaml",
+        "simulation: {physics: kinematic}\n"
+        "models:\n"
+        "  - model: bot.yaml\n"
+        "    count: 1000\n"
+        "    distribute: {region: {min: [-50, -50], max: [50, 50]}}\n");
+  const auto r = RunWorld(dir_, "--steps 1 --quiet");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  const std::string warning =
+      "warning: " + (dir_ / "bot.lua").string() +
+      ":1: defines sysCall_actuate, which swarmsim never calls (did you mean "
+      "sysCall_actuation?)\n";
+  const size_t first = r.output.find(warning);
+  EXPECT_NE(first, std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("sysCall_actuate,", first + warning.size()), std::string::npos)
+      << r.output;
 }
 
 }  // namespace
