@@ -88,11 +88,11 @@ struct Message {
   bool line_of_sight = false;  // kRange: only receivers the static environment does not hide
 };
 // One message in a robot's inbox.
-struct ReceivedMessage {      // 24 bytes
+struct ReceivedMessage {      // 32 bytes
   uint32_t message = 0;       // index into World::messages()
-  float distance = 0;         // m, from the receiver's model root to the sender
-  float bearing = 0;          // rad, of the sender in the receiver's root frame (0 = +x, CCW)
   bool has_geometry = false;  // false for scene receivers
+  double distance = 0;        // m, from the receiver's model root to the sender
+  double bearing = 0;         // rad, of the sender in the receiver's root frame (0 = +x, CCW)
 };
 
 // A value recorded by a script (sim.recordMetric) or by an observer.

@@ -138,13 +138,13 @@ void World::DeliverMessages() {
       const Pose X_RW = X_WR.Inverse();
       auto push = [&](uint32_t m) {
         if (messages_[m].sender.IsNull()) {  // from the main script: no distance or bearing
-          inbox.push_back({m, 0, 0, false});
+          inbox.push_back({m, false, 0, 0});
           return;
         }
         const Vec3 d = message_origin_[m] - X_WR.p;
         const Vec3 p_RS = X_RW * message_origin_[m];
-        inbox.push_back({m, static_cast<float>(std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z)),
-                         static_cast<float>(std::atan2(p_RS.y, p_RS.x)), true});
+        inbox.push_back(
+            {m, true, std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z), std::atan2(p_RS.y, p_RS.x)});
       };
       for (uint32_t m : global_messages_) push(m);
       for (uint32_t e = message_bucket_start_[r]; e < message_bucket_start_[r + 1]; ++e)
@@ -177,10 +177,10 @@ void World::DeliverMessages() {
   // The scene's scripts: global messages and those addressed to them.
   std::vector<ReceivedMessage>& scene_inbox = scene_runtime_.inbox;
   scene_inbox.clear();
-  for (uint32_t m : global_messages_) scene_inbox.push_back({m, 0, 0, false});
+  for (uint32_t m : global_messages_) scene_inbox.push_back({m, false, 0, 0});
   for (uint32_t e = message_bucket_start_[scene_bucket];
        e < message_bucket_start_[scene_bucket + 1]; ++e)
-    scene_inbox.push_back({message_bucket_[e], 0, 0, false});
+    scene_inbox.push_back({message_bucket_[e], false, 0, 0});
   std::sort(
       scene_inbox.begin(), scene_inbox.end(),
       [](const ReceivedMessage& a, const ReceivedMessage& b) { return a.message < b.message; });

@@ -566,6 +566,21 @@ TEST(ScriptControlTest, RangeMessagesHonourRangeAndLineOfSight) {
   EXPECT_EQ(w.log, expected);
 }
 
+// Distance and bearing arrive in full double precision: a receiver 1.9 m
+// along +y from the sender (both facing +x) gets exactly 1.9 and -pi/2.
+TEST(ScriptControlTest, RangeMessageDistanceAndBearingAreExact) {
+  ScriptWorld w;
+  w.AddRobot("s", "function sysCall_actuation() sim.sendRangeMessage('x', 2) end", 0, 0);
+  w.AddRobot("r", R"(
+    function sysCall_actuation()
+      local data, sender, distance, bearing = sim.receiveMessage()
+      if data then print(distance == 1.9, bearing == -math.pi / 2, distance) end
+    end)",
+             0, 1.9);
+  w.Steps(2);
+  EXPECT_EQ(w.log, std::vector<std::string>{"[r] true\ttrue\t1.9"});
+}
+
 TEST(ScriptControlTest, RangeMessagingIsTheSameAtAnyThreadCount) {
   auto run = [](int threads) {
     ScriptWorld w(threads);
