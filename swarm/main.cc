@@ -511,6 +511,7 @@ int Main(int argc, char** argv) {
   LoadedWorld loaded;
   try {
     load.overrides = ParseSets(sets);
+    options.overrides = load.overrides;
     for (const std::string& plugin : plugins) LoadPlugin(plugin, &registry);
     loaded = LoadWorld(world_file, load, registry);
   } catch (const Error& e) {

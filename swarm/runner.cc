@@ -133,8 +133,13 @@ class Watchdog {
   using EndRun = std::function<void(const std::string& error, int signal)>;
   static constexpr double kSignalGrace = 3;  // s
 
-  Watchdog(double timeout, EndRun end_run)
-      : timeout_(timeout), end_run_(std::move(end_run)), thread_([this] { Watch(); }) {}
+  // `instruction_budget`: the world's (simulation.instruction_budget), for
+  // the message: with none, an endless Lua loop is also stopped only here.
+  Watchdog(double timeout, int64_t instruction_budget, EndRun end_run)
+      : timeout_(timeout),
+        instruction_budget_(instruction_budget),
+        end_run_(std::move(end_run)),
+        thread_([this] { Watch(); }) {}
   ~Watchdog() {
     {
       const std::lock_guard lock(wake_mutex_);
@@ -187,10 +192,12 @@ class Watchdog {
       } else {
         error += "; running: ";
         for (size_t i = 0; i < calls.size(); ++i) error += (i ? "; " : "") + calls[i];
-        error +=
-            " (the instruction budget cannot stop a script inside one C function, such as a "
-            "pattern match that backtracks over a long string or a garbage collection of a "
-            "large heap)";
+        error += instruction_budget_ > 0
+                     ? " (the instruction budget cannot stop a script inside one C function, "
+                       "such as a pattern match that backtracks over a long string or a garbage "
+                       "collection of a large heap)"
+                     : " (simulation.instruction_budget is 0, no limit: an endless loop in a "
+                       "script runs until this timeout)";
       }
       // Outputs are written under io_mutex; progress_ cannot move meanwhile
       // (the loop reports progress only after writing them).
@@ -204,6 +211,7 @@ class Watchdog {
   }
 
   const double timeout_;
+  const int64_t instruction_budget_;
   const EndRun end_run_;
   std::mutex io_mutex_;
   std::mutex wake_mutex_;
@@ -260,6 +268,9 @@ class Progress {
   int last_decile_ = -1;
 };
 
+// A double that JSON should show as an integer: whole and exact (|v| <= 2^53).
+bool IsWholeNumber(double v) { return std::abs(v) <= 9007199254740992.0 && v == std::trunc(v); }
+
 // summary.json. `complete`: the world is between steps; else a step is
 // stuck (Watchdog) and what a running step may change is left out: the
 // state hash and the disabled scripts.
@@ -296,13 +307,17 @@ bool WriteSummary(const World& world, const RunOptions& options, const RunResult
   nlohmann::json params;
   for (const auto& [name, value] : world.parameters()) {
     if (const double* d = std::get_if<double>(&value))
-      params[name] = *d;
+      params[name] = IsWholeNumber(*d) ? nlohmann::json(static_cast<int64_t>(*d))
+                                       : nlohmann::json(*d);  // 50, not 50.0
     else if (const bool* b = std::get_if<bool>(&value))
       params[name] = *b;
     else
       params[name] = std::get<std::string>(value);
   }
   j["parameters"] = params;
+  nlohmann::json overrides = nlohmann::json::object();
+  for (const auto& [name, value] : options.overrides) overrides[name] = value;
+  j["overrides"] = overrides;
   std::ofstream f(*options.out_dir / "summary.json");
   f << j.dump(2) << "\n";
   return static_cast<bool>(f);
@@ -355,7 +370,8 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
       std::cerr.flush();
       std::_Exit(signal != 0 ? 128 + signal : 1);  // 1: the run failed, as main's
     };
-    Watchdog watchdog(world->settings().step_timeout, end_stuck_run);
+    Watchdog watchdog(world->settings().step_timeout, world->settings().instruction_budget,
+                      end_stuck_run);
     // Outputs of the step just done, then the next unit of work for the
     // watchdog's message; under its lock, so it never writes at the same time.
     const auto done = [&](std::string next) {

@@ -6,6 +6,8 @@
 #include <iosfwd>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "framework/world.h"
 
@@ -18,6 +20,9 @@ struct RunOptions {
   bool quiet = false;      // no progress, no summary table (errors still go to stderr)
   std::string world_file;  // for the summary
   std::string command_line;
+  // --set NAME=VALUE, in order, for the summary ("overrides"): world
+  // parameters are in "parameters" too, model parameters only here.
+  std::vector<std::pair<std::string, std::string>> overrides;
 };
 
 struct RunResult {

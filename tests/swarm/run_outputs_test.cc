@@ -247,4 +247,47 @@ TEST(RunOutputsTest, FailedRunReportsItsLuaMemory) {
   fs::remove_all(dir);
 }
 
+// With no instruction budget a plain endless loop is stopped by the watchdog
+// too, and the message says why nothing stopped it sooner.
+TEST(RunOutputsTest, StuckStepWithoutABudgetSaysTheBudgetIsOff) {
+  const fs::path dir = TempDir("no_budget");
+  fs::create_directories(dir);
+  std::ofstream(dir / "world.yaml") << "simulation: {physics: kinematic, time_step: 0.1, "
+                                       "instruction_budget: 0, step_timeout: 1}\n"
+                                       "models:\n  - {model: probe.yaml, position: [0, 0]}\n";
+  std::ofstream(dir / "probe.yaml") << "model: probe\n"
+                                       "objects: {name: body, type: dummy, script: probe.lua}\n";
+  std::ofstream(dir / "probe.lua") << "function sysCall_actuation() while true do end end\n";
+  const auto r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 5 --quiet");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("step 1 of 5 did not finish within 1 s"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("simulation.instruction_budget is 0, no limit"), std::string::npos)
+      << r.output;
+  fs::remove_all(dir);
+}
+
+// summary.json names every --set, model parameters included, and shows
+// whole-number parameters as integers.
+TEST(RunOutputsTest, SummaryListsTheOverridesAndWholeNumbersAsIntegers) {
+  const fs::path dir = TempDir("overrides");
+  fs::create_directories(dir);
+  std::ofstream(dir / "world.yaml") << "simulation: {physics: kinematic, time_step: 0.1}\n"
+                                       "parameters: {robots: 2, spacing: 0.5}\n"
+                                       "models:\n  - {model: probe.yaml, count: $robots, "
+                                       "distribute: {region: {min: [-5, -5], max: [5, 5]}}}\n";
+  std::ofstream(dir / "probe.yaml") << "model: probe\n"
+                                       "parameters: {speed: {default: 0.1}}\n"
+                                       "objects: {name: body, type: dummy}\n";
+  const auto r = RunProgram("run " + (dir / "world.yaml").string() +
+                            " --steps 1 --quiet --set robots=3 --set probe.speed=0.2 --out " +
+                            (dir / "out").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto summary = nlohmann::json::parse(ReadFile(dir / "out" / "summary.json"));
+  EXPECT_TRUE(summary["parameters"]["robots"].is_number_integer()) << summary.dump();
+  EXPECT_EQ(summary["parameters"]["robots"], 3);
+  EXPECT_EQ(summary["parameters"]["spacing"], 0.5);
+  EXPECT_EQ(summary["overrides"], nlohmann::json({{"robots", "3"}, {"probe.speed", "0.2"}}));
+  fs::remove_all(dir);
+}
+
 }  // namespace
