@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "framework/error.h"
+#include "framework/suggest.h"
 
 namespace swarmsim {
 
@@ -239,7 +240,16 @@ int ArgOption(lua_State* L, int arg, const char* def, const char* const options[
   const char* name = def != nullptr && lua_isnoneornil(L, arg) ? def : ArgString(L, arg);
   for (int i = 0; options[i] != nullptr; ++i)
     if (std::strcmp(options[i], name) == 0) return i;
-  throw Error("bad argument #" + std::to_string(arg) + " (invalid option '" + name + "')");
+  // The valid options, and the nearest one if `name` looks like a typo of it.
+  std::vector<std::string> valid;
+  for (int i = 0; options[i] != nullptr; ++i) valid.emplace_back(options[i]);
+  std::string expected;
+  for (size_t i = 0; i < valid.size(); ++i)
+    expected += (i == 0 ? "'" : i + 1 == valid.size() ? " or '" : ", '") + valid[i] + "'";
+  const std::string* nearest = NearestName(name, valid);
+  throw Error("bad argument #" + std::to_string(arg) + " (invalid option '" + name +
+              "'; expected " + expected +
+              (nearest != nullptr ? "; did you mean '" + *nearest + "'?" : std::string()) + ")");
 }
 
 ObjectId OptRelativeTo(lua_State* L, int arg) {

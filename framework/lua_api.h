@@ -116,7 +116,8 @@ lua_Number ArgNumber(lua_State* L, int arg);
 const char* ArgString(lua_State* L, int arg, size_t* length = nullptr);
 void ArgType(lua_State* L, int arg, int type);
 // The index of `arg` (a string) in the null-terminated `options`; `def` if
-// the argument is absent and def is not null.
+// the argument is absent and def is not null. Anything else is an error
+// listing the options (and the nearest, for a typo).
 int ArgOption(lua_State* L, int arg, const char* def, const char* const options[]);
 
 // An object handle argument (an integer, ObjectId::ToInteger()).

@@ -39,8 +39,11 @@ int GetObject(lua_State* L) {
     lua_pushinteger(L, -1);
     return 1;
   }
-  throw Error("no object at path '" + std::string(path, length) + "' (looked up from " +
-              c.scene->PathOf(c.script_object) + ")");
+  // Not found: what the path could have meant (the tree is walked again).
+  const std::string_view wanted(path, length);
+  throw Error("no object at path '" + std::string(wanted) + "' (looked up from " +
+              c.scene->PathOf(c.script_object) + ")" +
+              c.scene->ExplainMissingPath(wanted, c.script_object));
 }
 
 // Pose of the object at argument 1 in the frame of the object at argument 2

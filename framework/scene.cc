@@ -6,6 +6,7 @@
 
 #include "framework/error.h"
 #include "framework/state_hash.h"
+#include "framework/suggest.h"
 
 namespace swarmsim {
 
@@ -897,6 +898,71 @@ ObjectId Scene::FindObject(std::string_view path, ObjectId from) const {
     if (current < 0) return {};
   }
   return IdAt(static_cast<uint32_t>(current));
+}
+
+std::string Scene::ExplainMissingPath(std::string_view path, ObjectId from) const {
+  // The same walk as FindObject, stopping at the element that matches nothing.
+  const std::string_view full = path;
+  std::vector<uint32_t> candidates;
+  if (path.starts_with("./") || path.starts_with(":/")) {
+    if (!IsValid(from)) return "";
+    int32_t root = static_cast<int32_t>(from.index());
+    if (path[0] == ':')
+      for (int32_t a = root; a >= 0; a = parent_[a])
+        if (model_root_[a]) {
+          root = a;
+          break;
+        }
+    CollectSubtree(static_cast<uint32_t>(root), &candidates);
+    candidates.erase(candidates.begin());
+  } else if (path.starts_with("/")) {
+    for (uint32_t s = 0; s < generation_.size(); ++s)
+      if (alive_[s] && parent_[s] < 0) candidates.push_back(s);
+  } else {
+    return "";
+  }
+  const std::vector<PathElement> elements = SplitPath(path.substr(path[0] == '/' ? 1 : 2), full);
+  for (const PathElement& e : elements) {
+    int seen = 0;
+    int32_t current = -1;
+    for (uint32_t c : candidates) {
+      if (name_[c] != e.name) continue;
+      if (seen++ == std::max(e.index, 0)) {
+        current = static_cast<int32_t>(c);
+        break;
+      }
+    }
+    if (current >= 0) {
+      candidates.clear();
+      CollectSubtree(static_cast<uint32_t>(current), &candidates);
+      candidates.erase(candidates.begin());
+      continue;
+    }
+    // Too few objects of that name: say how many there are.
+    const std::string name(e.name);
+    if (seen > 0)
+      return "; there " +
+             std::string(seen == 1 ? "is 1 object" : "are " + std::to_string(seen) + " objects") +
+             " named '" + name + "' there: " + name + "[0]" +
+             (seen == 1 ? "" : ".." + name + "[" + std::to_string(seen - 1) + "]");
+    // A misspelt name: the path with the nearest name of the objects it could reach.
+    std::vector<std::string> names;
+    for (uint32_t c : candidates) names.push_back(name_[c]);
+    std::sort(names.begin(), names.end());
+    names.erase(std::unique(names.begin(), names.end()), names.end());
+    if (const std::string* nearest = NearestName(e.name, names)) {
+      const size_t at = static_cast<size_t>(e.name.data() - full.data());
+      return "; did you mean '" + std::string(full.substr(0, at)) + *nearest +
+             std::string(full.substr(at + e.name.size())) + "'?";
+    }
+    if (names.empty()) return "; there is no object there";
+    constexpr size_t kListed = 20;
+    std::string list;
+    for (size_t i = 0; i < names.size() && i < kListed; ++i) list += (i ? ", " : "") + names[i];
+    if (names.size() > kListed) list += ", ... (" + std::to_string(names.size()) + " names)";
+    return "; the names there: " + list;
+  }
+  return "";
 }
 
 }  // namespace swarmsim

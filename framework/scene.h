@@ -201,6 +201,12 @@ class Scene {
   // of `from`'s model root). "name[k]" picks the k-th (0-based) match of a
   // repeated name in hierarchy order. Returns null when nothing matches.
   ObjectId FindObject(std::string_view path, ObjectId from = {}) const;
+  // Why FindObject(path, from) found nothing, to end an error message: at
+  // the first element that matched nothing, "; did you mean '<path with the
+  // nearest name>'?", "; there are 3 objects named 'prox' there:
+  // prox[0]..prox[2]" or "; the names there: a, b"; "" if there is nothing
+  // to say. Walks the tree again: for error paths only.
+  std::string ExplainMissingPath(std::string_view path, ObjectId from = {}) const;
   // Slash-separated path from the root, e.g. "/footbot#3/leftMotor".
   std::string PathOf(ObjectId id) const;
 

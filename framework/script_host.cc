@@ -120,6 +120,14 @@ struct LuaMemory {
 };
 constexpr size_t kMemorySlack = size_t{16} << 20;
 
+// A global named sysCall_* that no one calls (a typo, a CoppeliaSim-only
+// callback), found at load.
+struct UncalledSysCall {
+  std::string file, name;
+  int line = 0;         // where the file defines the function; 0: not a function of its own
+  std::string warning;  // the line to log
+};
+
 // One lua_State and its scripts: a robot's, or the scene's.
 struct ScriptState {
   lua_State* L = nullptr;
@@ -129,9 +137,9 @@ struct ScriptState {
   // With a main script: the ScriptHost::Impl::main_steps of the step whose
   // sim.handleChildScripts resumed the threads (once a step).
   uint64_t threads_resumed_step = 0;
-  // Start only: sysCall_* names no one calls, {file + '\0' + name, warning
-  // line}, for ScriptHost::Start to log once per file.
-  std::vector<std::pair<std::string, std::string>> warnings;
+  // Start only: sysCall_* names no one calls, for ScriptHost::Start to log
+  // once per file and name.
+  std::vector<UncalledSysCall> warnings;
 
   ScriptState() = default;
   ScriptState(const ScriptState&) = delete;
@@ -583,7 +591,8 @@ std::string UncalledHint(std::string_view name, std::span<const Callback> called
 // naming the file and the callback); any other global named sysCall_*
 // (case aside: a typo, a CoppeliaSim callback) gets a warning in
 // state.warnings, which ScriptHost::Start logs once per file. Warnings are
-// in name order: the table's order is not deterministic.
+// in line order, then name order (the table's order is not deterministic);
+// names that are not functions of the file's own come last.
 void CheckSysCallNames(ScriptState& state, const Script& script) {
   lua_State* L = state.L;
   const bool is_main = state.context.is_main;
@@ -591,11 +600,7 @@ void CheckSysCallNames(ScriptState& state, const Script& script) {
                                            : script.explicit_handling
                                                ? std::span<const Callback>(kExplicitCallbacks)
                                                : std::span<const Callback>(kChildCallbacks);
-  struct Uncalled {
-    std::string name;
-    int line = 0;  // where the script defines the function; 0: not a function of its own
-  };
-  std::vector<Uncalled> uncalled;
+  std::vector<UncalledSysCall> uncalled;
   const std::string& path = script.source->path;
   lua_rawgeti(L, LUA_REGISTRYINDEX, script.env_ref);
   lua_pushnil(L);
@@ -621,7 +626,7 @@ void CheckSysCallNames(ScriptState& state, const Script& script) {
         ThrowScriptError(state, script.object, message, "loading the script");
       }
     } else {
-      Uncalled& u = uncalled.emplace_back(Uncalled{std::string(name)});
+      UncalledSysCall& u = uncalled.emplace_back(UncalledSysCall{path, std::string(name), 0, {}});
       if (lua_isfunction(L, -1)) {
         lua_Debug ar;
         lua_pushvalue(L, -1);
@@ -634,13 +639,17 @@ void CheckSysCallNames(ScriptState& state, const Script& script) {
   }
   lua_settop(L, 0);
   std::sort(uncalled.begin(), uncalled.end(),
-            [](const Uncalled& a, const Uncalled& b) { return a.name < b.name; });
-  for (const Uncalled& u : uncalled) {
-    std::string line = "warning: " + path;
-    if (u.line > 0) line += ":" + std::to_string(u.line) + ":";
-    line += " defines " + u.name + ", which swarmsim never calls (" +
-            UncalledHint(u.name, called, is_main, script.explicit_handling) + ")";
-    state.warnings.emplace_back(path + '\0' + u.name, std::move(line));
+            [](const UncalledSysCall& a, const UncalledSysCall& b) {
+              const int line_a = a.line > 0 ? a.line : INT_MAX;
+              const int line_b = b.line > 0 ? b.line : INT_MAX;
+              return line_a != line_b ? line_a < line_b : a.name < b.name;
+            });
+  for (UncalledSysCall& u : uncalled) {
+    u.warning = "warning: " + path;
+    if (u.line > 0) u.warning += ":" + std::to_string(u.line) + ":";
+    u.warning += " defines " + u.name + ", which swarmsim never calls (" +
+                 UncalledHint(u.name, called, is_main, script.explicit_handling) + ")";
+    state.warnings.push_back(std::move(u));
   }
 }
 
@@ -874,6 +883,26 @@ void Cleanup(ScriptState* state) {
     }
   }
   if (!first_error.empty()) throw Error(first_error);
+}
+
+// "; main.lua:3 defines sysCall_stpe: did you mean sysCall_step?" when the
+// main script defines a name near sysCall_step (not one of swarmsim's or
+// CoppeliaSim's own callbacks), else "".
+std::string MisspeltStepHint(const std::vector<UncalledSysCall>& uncalled) {
+  std::vector<std::string> names;
+  for (const UncalledSysCall& u : uncalled) {
+    const bool known =
+        std::any_of(std::begin(kCallbackNames), std::end(kCallbackNames),
+                    [&](const char* n) { return u.name == n; }) ||
+        std::any_of(std::begin(kCoppeliaSimCallbacks), std::end(kCoppeliaSimCallbacks),
+                    [&](const PortedCallback& p) { return u.name == p.name; });
+    names.push_back(known ? std::string() : u.name);  // "" is never near
+  }
+  const std::string* nearest = NearestName(kCallbackNames[kStep], names);
+  if (nearest == nullptr) return "";
+  const UncalledSysCall& u = uncalled[static_cast<size_t>(nearest - names.data())];
+  return "; " + u.file + (u.line > 0 ? ":" + std::to_string(u.line) : std::string()) + " defines " +
+         u.name + ": did you mean " + kCallbackNames[kStep] + "?";
 }
 
 size_t StateBytes(const ScriptState* state) {
@@ -1139,19 +1168,21 @@ void ScriptHost::Start() {
       throw Error("main: " + source->path +
                   ": the main script must define sysCall_step() (it runs one step: "
                   "sim.handleSensing(), sim.handleChildScripts(), sim.handleActuation(), "
-                  "sim.handleDynamics())");
+                  "sim.handleDynamics())" +
+                  MisspeltStepHint(h.main->warnings));
   }
   // sysCall_* names no one calls: one warning per script file and name, not
   // per robot, in robot order, then the scene's, then the main script's.
-  std::vector<std::string> warned;
+  std::vector<std::pair<std::string, std::string>> warned;  // file, name
   const auto log_warnings = [&](ScriptState* state) {
     if (state == nullptr) return;
-    for (auto& [key, line] : state->warnings) {
+    for (UncalledSysCall& u : state->warnings) {
+      std::pair<std::string, std::string> key(std::move(u.file), std::move(u.name));
       if (std::find(warned.begin(), warned.end(), key) != warned.end()) continue;
       warned.push_back(std::move(key));
-      world.Log(line);
+      world.Log(u.warning);
     }
-    std::vector<std::pair<std::string, std::string>>().swap(state->warnings);
+    std::vector<UncalledSysCall>().swap(state->warnings);
   };
   for (const auto& state : h.robots) log_warnings(state.get());
   log_warnings(h.scene.get());

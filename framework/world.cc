@@ -212,6 +212,7 @@ void World::Start() {
     FlushRobotBuffers();
   } catch (...) {
     failed_ = true;
+    FlushBuffersAfterError();  // the other robots' sysCall_init prints
     throw;
   }
 }
@@ -262,6 +263,7 @@ void World::Step() {
     }
   } catch (...) {
     failed_ = true;
+    if (scripts_->has_main_script()) FlushBuffersAfterError();  // the main script's prints
     throw;
   }
 }
@@ -359,6 +361,15 @@ void World::FlushRobotBuffers() {
   }
   flush(scene_runtime_);
   if (!first_error.empty()) throw Error(first_error);
+}
+
+void World::FlushBuffersAfterError() noexcept {
+  MarkAllPending();
+  try {
+    FlushRobotBuffers();
+  } catch (...) {
+    // A buffered error: the one in flight came first or from a lower robot.
+  }
 }
 
 void World::Actuate() {
@@ -467,7 +478,12 @@ void World::Stop() {
   if (stopped_ || !started_) return;
   stopped_ = true;
   if (scripts_) {
-    scripts_->Stop();
+    try {
+      scripts_->Stop();
+    } catch (...) {
+      FlushBuffersAfterError();  // every robot's cleanup prints, then the error
+      throw;
+    }
     MarkAllPending();
     FlushRobotBuffers();  // cleanup's prints and errors
   }

@@ -192,7 +192,9 @@ class World {
 
   // --- Lifecycle ------------------------------------------------------------------
   // Builds the dynamics and proximity modules from the placed scene and runs
-  // every script's sysCall_init. Throws swarmsim::Error on bad input.
+  // every script's sysCall_init. Throws swarmsim::Error on bad input. On a
+  // script error, Start, Step and Stop first pass what every robot printed
+  // to the log sink, in robot order.
   void Start();
   // One control step: sense, control, actuate, physics, record. Throws
   // swarmsim::Error on a script error or a non-finite physics state; the
@@ -272,6 +274,10 @@ class World {
   void EnsureRuntimes();
   void DeliverMessages();  // world_messages.cc
   void FlushRobotBuffers();
+  // After an error escaped the scripts: what every robot and the scene
+  // printed (and recorded) before it, in robot order. The error in flight is
+  // the one reported: the buffers' own are dropped. Not for the hot path.
+  void FlushBuffersAfterError() noexcept;
   // Plugin phase callbacks (SwarmsimPhase); nothing at all when none is registered.
   void RunPhaseCallbacks(int phase) {
     if (!phase_callbacks_[phase].empty()) CallPhaseCallbacks(phase);

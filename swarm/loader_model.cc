@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cmath>
 #include <limits>
+#include <map>
 
 #include "framework/error.h"
 #include "framework/registry.h"
@@ -49,6 +50,32 @@ std::vector<std::string> Concat(std::initializer_list<const std::vector<std::str
   return out;
 }
 
+// The keys an object of `type` (one of kObjectTypes) takes.
+const std::vector<std::string>& KeysOf(const std::string& type) {
+  static const std::map<std::string, std::vector<std::string>> keys = {
+      {"shape", Concat({&kCommonKeys, &ShapeKeys()})},
+      {"joint", Concat({&kCommonKeys, &kJointKeys})},
+      {"dummy", kCommonKeys},
+      {"proximity_sensor", Concat({&kCommonKeys, &kSensorKeys})},
+      {"proximity_ring", kRingKeys},
+      {"force_sensor", Concat({&kCommonKeys, &kForceSensorKeys})},
+      {"paint_nozzle", Concat({&kCommonKeys, &kPaintNozzleKeys})},
+      {"plugin_sensor", Concat({&kCommonKeys, &kPluginSensorKeys})}};
+  return keys.at(type);
+}
+
+// The keys of every object type, once each (for an object without a 'type').
+const std::vector<std::string>& AllObjectKeys() {
+  static const std::vector<std::string> all = [] {
+    std::vector<std::string> out;
+    for (const std::string& type : kObjectTypes)
+      for (const std::string& key : KeysOf(type))
+        if (std::find(out.begin(), out.end(), key) == out.end()) out.push_back(key);
+    return out;
+  }();
+  return all;
+}
+
 // Object names are path elements: no '/', no brackets.
 void CheckObjectName(const ValueReader& values, const Field& field, const std::string& name) {
   if (name.empty() || name.find_first_of("/[]") != std::string::npos ||
@@ -81,12 +108,16 @@ struct Builder {
     const std::string root_what = "the root object of model '" + model.name + "'";
     Fields fields(values.file(), field,
                   is_root ? root_what : "an object of model '" + model.name + "'");
+    // A misspelled 'type' or 'name' is an unknown key (with a suggestion),
+    // not a missing one: without them, check the keys first.
+    if (!fields.Has("type")) fields.Expect(AllObjectKeys());
     const Field type_field = fields.Require("type");
     const std::string type = values.Choice(type_field, kObjectTypes);
     // The root is named after each copy in the scene (footbot#0, ...); its
     // name here is optional and only labels it in messages.
     std::string name = model.name;
     if (!is_root || fields.Has("name")) {
+      if (!fields.Has("name")) fields.Expect(KeysOf(type));
       const Field name_field = fields.Require("name");
       name = values.String(name_field);
       CheckObjectName(values, name_field, name);
@@ -96,9 +127,10 @@ struct Builder {
                 : (type == "proximity_ring" ? "proximity ring '" : "object '") + name + "'";
     Fields named(values.file(), field, what);
 
+    if (type == "proximity_ring" && is_root)
+      values.Fail(type_field, "a proximity ring cannot be the root object of a model");
+    named.Expect(KeysOf(type));
     if (type == "proximity_ring") {
-      if (is_root) values.Fail(type_field, "a proximity ring cannot be the root object of a model");
-      named.Expect(kRingKeys);
       Ring(named, name, out);
       return;
     }
@@ -107,24 +139,19 @@ struct Builder {
     spec.name = name;
     spec.X_PO = ReadPose(values, named);
     if (type == "shape") {
-      named.Expect(Concat({&kCommonKeys, &ShapeKeys()}));
       spec.type = ObjectType::kShape;
       spec.shape = ReadShape(values, named, meshes);
     } else if (type == "joint") {
-      named.Expect(Concat({&kCommonKeys, &kJointKeys}));
       spec.type = ObjectType::kJoint;
       spec.joint = Joint(named);
     } else if (type == "proximity_sensor") {
-      named.Expect(Concat({&kCommonKeys, &kSensorKeys}));
       spec.type = ObjectType::kProximitySensor;
       if (named.Has("range"))
         spec.sensor.range = values.Number(named.Get("range"), kPositiveLength);
     } else if (type == "force_sensor") {
-      named.Expect(Concat({&kCommonKeys, &kForceSensorKeys}));
       spec.type = ObjectType::kForceSensor;
       spec.force_sensor = ForceSensor(named);
     } else if (type == "paint_nozzle") {
-      named.Expect(Concat({&kCommonKeys, &kPaintNozzleKeys}));
       spec.type = ObjectType::kPaintNozzle;
       if (named.Has("color"))
         spec.paint_nozzle.color = values.Vector3(named.Get("color"), kFraction);
@@ -132,11 +159,9 @@ struct Builder {
         spec.paint_nozzle.radius = values.Number(named.Get("radius"), kPositiveLength);
       if (named.Has("enabled")) spec.paint_nozzle.enabled = values.Bool(named.Get("enabled"));
     } else if (type == "plugin_sensor") {
-      named.Expect(Concat({&kCommonKeys, &kPluginSensorKeys}));
       spec.type = ObjectType::kDummy;
       spec.plugin_sensor = PluginSensor(named.Require("sensor"));
     } else {
-      named.Expect(kCommonKeys);
       spec.type = ObjectType::kDummy;
     }
     Count(field, 1);
@@ -416,22 +441,33 @@ ModelFile ReadModelFile(YamlFile file, const std::string& used_by) {
         Fields d(f, p, "parameter '" + p.name + "'");
         d.Expect({"default", "unit", "description", "range"});
         if (d.Has("range")) {
+          // [min, max]: two literal numbers, min <= max.
           const Field range = d.Get("range");
-          const ParamValue lo =
-              range.node.IsSequence() && range.node.size() == 2 && range.node[0].IsScalar()
-                  ? ParseScalar(range.node[0].Scalar(), false)
-                  : ParamValue(std::string());
-          const ParamValue hi =
-              range.node.IsSequence() && range.node.size() == 2 && range.node[1].IsScalar()
-                  ? ParseScalar(range.node[1].Scalar(), false)
-                  : ParamValue(std::string());
-          if (!std::holds_alternative<double>(lo) || !std::holds_alternative<double>(hi) ||
-              !(std::get<double>(lo) <= std::get<double>(hi)))
-            f.Fail(range.mark, "'range' must be [min, max], two numbers with min <= max (got " +
-                                   Describe(range.node) + ")");
+          if (!range.node.IsSequence() || range.node.size() != 2)
+            f.Fail(range.mark,
+                   "'range' must be [min, max], two numbers (got " +
+                       (range.node.IsSequence() ? "a list of " + std::to_string(range.node.size())
+                                                : Describe(range.node)) +
+                       ")");
+          double bounds[2];
+          for (size_t i = 0; i < 2; ++i) {
+            const YAML::Node bound = range.node[i];
+            const ParamValue value =
+                bound.IsScalar() ? ParseScalar(bound.Scalar(), false) : ParamValue(std::string());
+            if (!std::holds_alternative<double>(value))
+              f.Fail(bound.Mark().is_null() ? range.mark : bound.Mark(),
+                     "'range' must be [min, max], two numbers: its " +
+                         std::string(i == 0 ? "min" : "max") + " is not a number (got " +
+                         Describe(bound) + ")");
+            bounds[i] = std::get<double>(value);
+          }
+          if (!(bounds[0] <= bounds[1]))
+            f.Fail(range.mark, "'range' must be [min, max] with min <= max (got min " +
+                                   FormatNumber(bounds[0]) + " > max " + FormatNumber(bounds[1]) +
+                                   ")");
           decl.has_range = true;
-          decl.min = std::get<double>(lo);
-          decl.max = std::get<double>(hi);
+          decl.min = bounds[0];
+          decl.max = bounds[1];
         }
         decl.default_value = d.Require("default");
         decl.default_value.name = p.name;

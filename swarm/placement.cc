@@ -75,23 +75,34 @@ bool Placer::IsFree(double x, double y, double radius, double clearance) const {
 std::vector<Placement2> Placer::Distribute(const Region2& region, int64_t count, double radius,
                                            double clearance, uint64_t stream,
                                            std::optional<double> heading) {
+  return Distribute(
+      region, count, [radius](int64_t) { return radius; }, radius, clearance, stream, heading);
+}
+
+std::vector<Placement2> Placer::Distribute(const Region2& region, int64_t count,
+                                           const std::function<double(int64_t)>& radius_of,
+                                           double max_radius, double clearance, uint64_t stream,
+                                           std::optional<double> heading) {
   std::vector<Placement2> out;
   if (count <= 0) return out;
-  // The disc lies wholly inside the region: its centre in the shrunk rectangle.
-  const double lo_x = region.min_x + radius, hi_x = region.max_x - radius;
-  const double lo_y = region.min_y + radius, hi_y = region.max_y - radius;
+  // A disc lies wholly inside the region: its centre in the rectangle shrunk by its radius.
+  const double lo_x = region.min_x + max_radius, hi_x = region.max_x - max_radius;
+  const double lo_y = region.min_y + max_radius, hi_y = region.max_y - max_radius;
   if (!(lo_x <= hi_x) || !(lo_y <= hi_y)) return out;
   // A cell holds about one body; a query then looks at 3 x 3 cells.
-  max_body_radius_ = std::max(max_body_radius_, radius);
+  max_body_radius_ = std::max(max_body_radius_, max_radius);
   const double extent = std::max(hi_x - lo_x, hi_y - lo_y);
   const double cell = std::max({2 * max_body_radius_ + clearance, 1e-3, extent * 1e-9});
   if (cell != cell_size_) Rebuild(cell);
   out.reserve(static_cast<size_t>(count));
   Rng rng(seed_, kPlacementStream + stream);
   for (int64_t k = 0; k < count; ++k) {
+    const double radius = radius_of(k);
+    const double grow = max_radius - radius;  // a smaller disc may come closer to the edges
     bool placed = false;
     for (int attempt = 0; attempt < kMaxAttempts && !placed; ++attempt) {
-      const double x = rng.Uniform(lo_x, hi_x), y = rng.Uniform(lo_y, hi_y);
+      const double x = rng.Uniform(lo_x - grow, hi_x + grow);
+      const double y = rng.Uniform(lo_y - grow, hi_y + grow);
       if (!IsFree(x, y, radius, clearance)) continue;
       const double yaw = heading ? *heading : rng.Uniform(-M_PI, M_PI);
       out.push_back({x, y, yaw});

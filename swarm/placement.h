@@ -9,6 +9,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <unordered_map>
 #include <vector>
@@ -64,6 +65,13 @@ class Placer {
   // poses (the caller reports it). The placed discs are kept.
   std::vector<Placement2> Distribute(const Region2& region, int64_t count, double radius,
                                      double clearance, uint64_t stream,
+                                     std::optional<double> heading = std::nullopt);
+  // The same, with copy k's disc of radius `radius_of(k)` (at most
+  // `max_radius`): copies of one model whose own parameter values change
+  // their size. With every radius equal, the same poses as Distribute.
+  std::vector<Placement2> Distribute(const Region2& region, int64_t count,
+                                     const std::function<double(int64_t)>& radius_of,
+                                     double max_radius, double clearance, uint64_t stream,
                                      std::optional<double> heading = std::nullopt);
 
   // True if a disc at (x, y) of `radius` keeps `clearance` from every body

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "framework/error.h"
+#include "framework/suggest.h"
 #include "swarm/results_db.h"
 #include "swarm/stats.h"
 
@@ -43,6 +44,18 @@ bool IsNumber(const std::string& s) {
 bool ValueLess(const std::string& a, const std::string& b) {
   if (IsNumber(a) && IsNumber(b)) return std::stod(a) < std::stod(b);
   return a < b;
+}
+
+// For a name that is not among `valid`: " (<what>: a, b); did you mean
+// 'a'?" (when one is near), or " (<none>)" when there are none.
+std::string ValidNames(const std::string& name, const std::vector<std::string>& valid,
+                       const std::string& what, const std::string& none) {
+  if (valid.empty()) return " (" + none + ")";
+  std::string list;
+  for (const std::string& v : valid) list += (list.empty() ? "" : ", ") + v;
+  const std::string* nearest = NearestName(name, valid);
+  return " (" + what + ": " + list + ")" +
+         (nearest != nullptr ? "; did you mean '" + *nearest + "'?" : std::string());
 }
 
 std::string GnuplotQuote(const std::string& s) {
@@ -231,12 +244,15 @@ void WriteCsv(const ReportData& d, std::ostream& out) {
 int RunReport(const ReportOptions& o, std::ostream& out, std::ostream& err) {
   const ReportData d = LoadReport(o.db);
   for (const std::string* name : {&o.x, &o.by})
-    if (!name->empty() && !d.param_names.empty() &&
+    if (!name->empty() &&
         std::find(d.param_names.begin(), d.param_names.end(), *name) == d.param_names.end())
-      throw Error("'" + *name + "' is not a parameter of this sweep");
+      throw Error("'" + *name + "' is not a parameter of this sweep" +
+                  ValidNames(*name, d.param_names, "its parameters",
+                             "it has none: it was run without --param"));
   if (!o.y.empty() &&
       std::find(d.metric_names.begin(), d.metric_names.end(), o.y) == d.metric_names.end())
-    throw Error("no run recorded metric '" + o.y + "'");
+    throw Error("no run recorded metric '" + o.y + "'" +
+                ValidNames(o.y, d.metric_names, "the metrics recorded", "no run recorded any"));
   std::vector<std::string> metrics = o.y.empty() ? d.metric_names : std::vector{o.y};
 
   int64_t finished = 0, failed = 0;

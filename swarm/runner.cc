@@ -22,6 +22,7 @@
 #include "framework/error.h"
 #include "framework/script_host.h"
 #include "framework/state_hash.h"
+#include "swarm/stop_signals.h"
 #include "swarm/version.h"
 
 namespace swarmsim {
@@ -87,32 +88,6 @@ class MetricsWriter {
   Clock::time_point last_flush_;
 };
 
-// SIGINT, SIGTERM and SIGHUP end a run at the next step boundary, with its
-// outputs written; a second signal acts as usual (SA_RESETHAND).
-volatile std::sig_atomic_t g_stop_signal = 0;
-extern "C" void OnStopSignal(int sig) { g_stop_signal = sig; }
-
-class StopSignals {
- public:
-  StopSignals() {
-    g_stop_signal = 0;
-    struct sigaction action {};
-    action.sa_handler = OnStopSignal;
-    action.sa_flags = SA_RESETHAND;
-    sigemptyset(&action.sa_mask);
-    for (size_t i = 0; i < kSignals.size(); ++i) sigaction(kSignals[i], &action, &saved_[i]);
-  }
-  ~StopSignals() {
-    for (size_t i = 0; i < kSignals.size(); ++i) sigaction(kSignals[i], &saved_[i], nullptr);
-  }
-  StopSignals(const StopSignals&) = delete;
-  StopSignals& operator=(const StopSignals&) = delete;
-
- private:
-  static constexpr std::array<int, 3> kSignals = {SIGINT, SIGTERM, SIGHUP};
-  std::array<struct sigaction, 3> saved_{};
-};
-
 std::string Fixed(double v, int digits) {
   std::ostringstream s;
   s << std::fixed << std::setprecision(digits) << v;
@@ -170,7 +145,7 @@ class Watchdog {
     while (!wake_.wait_for(lock, 100ms, [this] { return done_; })) {
       const Clock::time_point now = Clock::now();
       if (progress_ != seen) seen = progress_, since = now, signal_since = {};
-      const int sig = g_stop_signal;
+      const int sig = StopSignals::Received();
       if (sig != 0 && signal_since == Clock::time_point{}) signal_since = now;
       const double stalled = std::chrono::duration<double>(now - since).count();
       std::string error;
@@ -348,6 +323,8 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
   const auto start = Clock::now();
   const bool tty = isatty(STDERR_FILENO) && &progress_stream == &std::cerr;
   Progress progress(progress_stream, options.steps, !options.quiet, tty);
+  // SIGINT, SIGTERM and SIGHUP end the run at the next step boundary, with
+  // its outputs written (or, for a stuck step, through the Watchdog).
   const StopSignals stop_signals;
   {
     // A step that never finishes: write what a failed run writes and exit.
@@ -395,7 +372,7 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
       world->Start();
       done(options.steps > 0 ? step_name() : "the stop of the world");
       for (int64_t i = 0; i < options.steps; ++i) {
-        if (const int sig = g_stop_signal; sig != 0) {
+        if (const int sig = StopSignals::Received(); sig != 0) {
           result.signal = sig;
           throw Error(std::string("interrupted by SIG") + sigabbrev_np(sig) + " after " +
                       std::to_string(result.steps) + " of " + std::to_string(options.steps) +

@@ -1,7 +1,11 @@
 #include "swarm/sweep.h"
 
+#include <signal.h>
 #include <unistd.h>
 
+#include <array>
+#include <csignal>
+#include <cstring>
 #include <deque>
 #include <fstream>
 #include <iostream>
@@ -12,6 +16,7 @@
 #include "framework/error.h"
 #include "framework/registry.h"
 #include "modules/builtin.h"
+#include "swarm/stop_signals.h"
 #include "swarm/sweep_mpi.h"
 #include "swarm/sweep_progress.h"
 #include "swarm/version.h"
@@ -97,6 +102,10 @@ int RunSweep(const SweepOptions& options, std::ostream& out, std::ostream& err) 
 
 int CoordinateSweep(const SweepOptions& o, RemoteWorkers* remote, std::ostream& out,
                     std::ostream& err) {
+  // SIGINT, SIGTERM and SIGHUP stop a sweep between runs: the runs in
+  // progress are killed and stay claimed (a resume runs them again), the
+  // finished ones are kept.
+  const StopSignals stop_signals;
   // The grid and the sweep's identity.
   std::vector<ParamSpec> params;
   for (const std::string& p : o.params) params.push_back(ParseParamSpec(p));
@@ -163,11 +172,23 @@ int CoordinateSweep(const SweepOptions& o, RemoteWorkers* remote, std::ostream& 
     return r;
   };
   auto running = [&] { return pool.active() + (remote ? remote->Running() : 0); };
+  int stop_signal = 0;
   auto done = [&](RunOutcome outcome) {
+    // After a stop signal, a run that did not finish (the signal reached it
+    // too) is no result: it stays claimed and runs again on resume.
+    if (!outcome.ok && (stop_signal != 0 || StopSignals::Received() != 0)) return;
     db.Complete(outcome);
     progress.RunEnded(outcome.id, outcome.ok, outcome.error, running());
   };
   while (!pending.empty() || pool.active() > 0 || (remote && remote->Busy())) {
+    if (stop_signal == 0 && StopSignals::Received() != 0) {
+      // Stop: no new runs (the other ranks are told so as they ask), the
+      // local runs in progress killed.
+      stop_signal = StopSignals::Received();
+      pending.clear();
+      pool.KillAll();
+      continue;
+    }
     while (pool.HasFreeSlot() && !pending.empty()) pool.Start(*next());
     if (remote) remote->Service(next, done);
     for (RunOutcome& outcome : pool.Poll(remote ? 0.002 : 0.5)) done(std::move(outcome));
@@ -176,7 +197,25 @@ int CoordinateSweep(const SweepOptions& o, RemoteWorkers* remote, std::ostream& 
   const RunCounts after = db.Counts();
   out << "sweep: " << after.ok << " ok, " << after.failed << " failed, "
       << after.pending + after.running << " not run, of " << after.total << " runs; results in "
-      << o.db << "\n";
+      << o.db << "\n"
+      << std::flush;
+  if (stop_signal != 0) {
+    err << "sweep: interrupted by SIG" << sigabbrev_np(stop_signal) << ": "
+        << after.ok + after.failed << " of " << after.total << " runs done (" << after.failed
+        << " failed)";
+    if (after.running > 0)
+      err << ", " << after.running << (after.running == 1 ? " run" : " runs")
+          << " in progress stopped (run again on resume)";
+    err << ". Run the same command to resume; finished runs are kept.\n" << std::flush;
+    return 128 + stop_signal;
+  }
+  if (after.failed > 0) {
+    err << "sweep: " << after.failed << (after.failed == 1 ? " run" : " runs")
+        << " failed or timed out (exit status 1): `swarmsim report " << o.db
+        << "` lists them; --retry-failed runs them again\n"
+        << std::flush;
+    return 1;
+  }
   return 0;
 }
 

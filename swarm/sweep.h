@@ -41,8 +41,10 @@ WorkerConfig MakeWorkerConfig(const SweepOptions& options);
 void ParseShard(const std::string& text, int* index, int* count);
 
 // Runs (or resumes) the sweep. Returns the exit code: 0 when every run of
-// this shard has finished (failed runs included: they are results),
-// 2 for bad input.
+// this shard has finished and the database holds no failed run, 1 when it
+// holds failed or timed-out runs (all the others were still run), 128 +
+// the signal when SIGINT, SIGTERM or SIGHUP stopped it (finished runs kept;
+// the same command resumes). Throws swarmsim::Error for bad input (exit 2).
 int RunSweep(const SweepOptions& options, std::ostream& out, std::ostream& err);
 
 // The content hash of a world file (hex), as stored in the sweep table.

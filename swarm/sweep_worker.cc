@@ -177,13 +177,20 @@ RunPool::RunPool(const WorkerConfig& config, int slots)
   }
 }
 
-RunPool::~RunPool() {
+int RunPool::KillAll() {
+  const int killed = active();
   for (const Active& a : active_) {
     kill(a.pid, SIGKILL);
     waitpid(a.pid, nullptr, 0);
     std::error_code ec;
     std::filesystem::remove_all(a.dir, ec);
   }
+  active_.clear();
+  return killed;
+}
+
+RunPool::~RunPool() {
+  KillAll();
   std::error_code ec;
   std::filesystem::remove(config_.scratch, ec);  // only if empty
   if (restore_mask_) {

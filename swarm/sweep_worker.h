@@ -49,6 +49,8 @@ class RunPool {
   void Start(const GridRun& run);
   // Waits up to `wait_s` seconds for runs to end; returns the ended ones.
   std::vector<RunOutcome> Poll(double wait_s);
+  // Kills the runs in progress (SIGKILL) and forgets them; returns how many.
+  int KillAll();
 
  private:
   using Clock = std::chrono::steady_clock;

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <optional>
+#include <tuple>
+#include <utility>
 
 #include "framework/error.h"
 #include "framework/plugin_loader.h"
@@ -31,6 +34,10 @@ constexpr double kDegToRad = M_PI / 180.0;
 
 const std::vector<std::string> kTopKeys = {"simulation", "parameters", "arena", "obstacles",
                                            "models",     "metrics",    "paint", "plugins"};
+
+const std::vector<std::string> kEntryKeys = {"model",      "count",       "distribute",
+                                             "position",   "heading_deg", "orientation_deg",
+                                             "parameters", "instances",   "scale"};
 
 // One --set, split into its target.
 struct Override {
@@ -88,8 +95,42 @@ struct EntryPlan {
   std::optional<double> heading;
   std::vector<Placement2> placements;
   std::vector<loader::IkGroupDef> ik_groups;
-  // instances: [{index, parameters}]: copies with their own values.
-  std::vector<std::pair<int64_t, std::shared_ptr<ParameterSet>>> instance_parameters;
+  // instances: [{index, parameters}]: copies with their own values, in file order.
+  struct OwnCopy {
+    int64_t index = 0;
+    Field field;  // the instances element, for messages
+    std::shared_ptr<ParameterSet> parameters;
+    // The copy's objects, resolved with its own values (a size, a range, a
+    // limit may use them); absent when its values equal the entry's, so it
+    // is duplicated from the entry's first copy like the others.
+    std::optional<ObjectSpec> spec;
+    loader::Footprint footprint;  // of the scaled copy (spec present)
+    std::vector<loader::IkGroupDef> ik_groups;
+  };
+  std::vector<OwnCopy> own_copies;
+  std::map<int64_t, size_t> own_copy_of;  // copy index -> own_copies position
+
+  // The copy's own values and objects, or null when it has none.
+  const OwnCopy* FindOwnCopy(int64_t k) const {
+    const auto it = own_copy_of.find(k);
+    return it == own_copy_of.end() ? nullptr : &own_copies[it->second];
+  }
+  // The objects copy k is built from, and its footprint.
+  const ObjectSpec& SpecOf(int64_t k) const {
+    const OwnCopy* own = FindOwnCopy(k);
+    return own && own->spec ? *own->spec : spec;
+  }
+  const loader::Footprint& FootprintOf(int64_t k) const {
+    const OwnCopy* own = FindOwnCopy(k);
+    return own && own->spec ? own->footprint : footprint;
+  }
+  // The largest footprint radius of the `count` copies.
+  double MaxFootprintRadius() const {
+    if (own_copies.empty()) return footprint.radius;
+    double r = 0;
+    for (int64_t k = 0; k < count; ++k) r = std::max(r, FootprintOf(k).radius);
+    return r;
+  }
 };
 
 // A value as a user writes it (0.2, not 0.20000000000000001).
@@ -104,9 +145,16 @@ std::string RangeError(const loader::ModelParameterDecl& decl, const std::string
   if (!decl.has_range) return "";
   const double* v = std::get_if<double>(&value);
   if (v != nullptr && *v >= decl.min && *v <= decl.max) return "";
-  return "parameter '" + decl.name + "' of model '" + model + "' must be within [" +
-         loader::FormatNumber(decl.min) + ", " + loader::FormatNumber(decl.max) + "]" +
-         (decl.unit.empty() ? "" : " " + decl.unit) + " (got " + ShowValue(value) + ")";
+  const std::string range = "[" + loader::FormatNumber(decl.min) + ", " +
+                            loader::FormatNumber(decl.max) + "]" +
+                            (decl.unit.empty() ? "" : " " + decl.unit);
+  const std::string what = "parameter '" + decl.name + "' of model '" + model + "'";
+  if (v == nullptr)  // a string or a boolean: the range makes it a number parameter
+    return what + " must be a number within " + range + " (got " +
+           (std::holds_alternative<std::string>(value) ? "\"" + ShowValue(value) + "\""
+                                                       : ShowValue(value)) +
+           ", which is not a number)";
+  return what + " must be within " + range + " (got " + ShowValue(value) + ")";
 }
 
 // The script files of a model's objects, in tree order, once each.
@@ -114,6 +162,22 @@ void CollectScripts(const ObjectSpec& spec, std::vector<std::string>* out) {
   if (spec.script && std::find(out->begin(), out->end(), spec.script->path) == out->end())
     out->push_back(spec.script->path);
   for (const ObjectSpec& child : spec.children) CollectScripts(child, out);
+}
+
+// Scaled mesh assets of one entry, by the asset they scale.
+using ScaledMeshes = std::map<const TriangleMesh*, std::shared_ptr<const TriangleMesh>>;
+
+// Points the mesh shapes of the copy at `id` (built from `spec`, then scaled)
+// at the assets an earlier copy of the entry was scaled to, so that copies
+// built from their own description share them as duplicates do.
+void ShareScaledMeshes(const ObjectSpec& spec, ObjectId id, Scene* scene, ScaledMeshes* scaled) {
+  if (spec.type == ObjectType::kShape && spec.shape.mesh) {
+    const auto [it, added] = scaled->emplace(spec.shape.mesh.get(), scene->shape(id).mesh);
+    if (!added) scene->mutable_shape(id).mesh = it->second;
+  }
+  const std::vector<ObjectId> children = scene->children(id);
+  for (size_t i = 0; i < spec.children.size() && i < children.size(); ++i)
+    ShareScaledMeshes(spec.children[i], children[i], scene, scaled);
 }
 
 class WorldLoader {
@@ -320,6 +384,8 @@ const ModelFile& WorldLoader::LoadModel(const Field& field, const std::string& t
 void WorldLoader::ReadModelEntries(const Fields& top) {
   for (const Field& element : loader::ListElements(*file_, top.Get("models"), "model entries")) {
     Fields entry(*file_, element, "a models entry");
+    // A misspelled 'model' is an unknown key (with a suggestion), not a missing one.
+    if (!entry.Has("model")) entry.Expect(kEntryKeys);
     const Field model = entry.Require("model");
     if (!model.node.IsScalar())
       file_->Fail(model.mark,
@@ -561,8 +627,7 @@ void WorldLoader::ResolveEntry(EntryPlan* entry) {
   const ModelFile& model = *entry->model;
   const ValueReader world_values = WorldValues();
   Fields f(*file_, entry->field, "the models entry for '" + model.name + "'");
-  f.Expect({"model", "count", "distribute", "position", "heading_deg", "orientation_deg",
-            "parameters", "instances", "scale"});
+  f.Expect(kEntryKeys);
 
   // Model parameters: declared defaults, then this entry's values, then --set.
   auto params = std::make_shared<ParameterSet>();
@@ -620,15 +685,15 @@ void WorldLoader::ResolveEntry(EntryPlan* entry) {
     Fields inst(*file_, element, "an instances entry");
     inst.Expect({"index", "parameters"});
     const int64_t index = world_values.Integer(inst.Require("index"), 0, kMaxCount - 1);
-    for (const auto& [other, set] : entry->instance_parameters)
-      if (other == index)
-        file_->Fail(inst.Get("index").mark,
-                    "copy " + std::to_string(index) + " is given twice in 'instances'");
+    if (entry->own_copy_of.contains(index))
+      file_->Fail(inst.Get("index").mark,
+                  "copy " + std::to_string(index) + " is given twice in 'instances'");
     auto own = std::make_shared<ParameterSet>(*params);
     apply(inst.Require("parameters"), own.get());
     for (Override& o : overrides_)
       if (o.model == model.name) (*own)[o.name] = (*params)[o.name];
-    entry->instance_parameters.emplace_back(index, std::move(own));
+    entry->own_copy_of.emplace(index, entry->own_copies.size());
+    entry->own_copies.push_back({index, element, std::move(own), std::nullopt, {}, {}});
   }
 
   // The model's objects, in a scope where its parameters shadow the world's.
@@ -643,6 +708,23 @@ void WorldLoader::ResolveEntry(EntryPlan* entry) {
     entry->footprint.bottom *= entry->scale;
   }
   entry->ik_groups = loader::ReadIkGroups(model, model_values);
+  // A copy with values of its own gets objects of its own: every value of
+  // the model that uses a parameter (a sensor's range, a size, a limit, a
+  // mass, an IK setting) takes the copy's value.
+  for (EntryPlan::OwnCopy& own : entry->own_copies) {
+    if (*own.parameters == *params) continue;  // nothing of its own: duplicated as the others
+    const ValueReader own_values(model.file, &expressions_, {&parameters_, own.parameters.get()});
+    try {
+      own.spec = loader::ResolveModel(model, own_values, &scripts_, &meshes_, world_registry_);
+      own.ik_groups = loader::ReadIkGroups(model, own_values);
+    } catch (const Error& e) {
+      throw Error(std::string(e.what()) + " (with the parameters of copy " +
+                  std::to_string(own.index) + " given at " + file_->Where(own.field.mark) + ")");
+    }
+    own.footprint = loader::ComputeFootprint(*own.spec);
+    own.footprint.radius *= entry->scale;
+    own.footprint.bottom *= entry->scale;
+  }
 
   // Placement: distributed copies or one placed copy.
   if (f.Has("distribute")) {
@@ -686,7 +768,7 @@ void WorldLoader::ResolveEntry(EntryPlan* entry) {
       entry->clearance = world_values.Number(d.Get("clearance"), loader::kNonNegativeLength);
     if (d.Has("heading_deg"))
       entry->heading = world_values.Number(d.Get("heading_deg"), loader::kAngleDeg) * kDegToRad;
-    const double r = entry->footprint.radius;
+    const double r = entry->MaxFootprintRadius();
     if (entry->count > 0 && (entry->region.max_x - entry->region.min_x < 2 * r ||
                              entry->region.max_y - entry->region.min_y < 2 * r))
       file_->Fail(entry->count_field.mark, "the region is too small for one " + model.name +
@@ -706,15 +788,14 @@ void WorldLoader::ResolveEntry(EntryPlan* entry) {
     entry->position_field = position;
     const std::vector<double> p = world_values.Numbers(position, 2, 3, loader::kCoordinate);
     entry->fixed_pose.q = loader::ReadOrientation(world_values, f);
-    entry->fixed_pose.p = {p[0], p[1], p.size() == 3 ? p[2] : -entry->footprint.bottom};
     entry->count = 1;
+    entry->fixed_pose.p = {p[0], p[1], p.size() == 3 ? p[2] : -entry->FootprintOf(0).bottom};
   }
-  for (const Field& element : loader::ListElements(*file_, f.Get("instances"), "instances")) {
-    const Field index = Fields(*file_, element, "an instances entry").Get("index");
-    if (world_values.Integer(index, 0, kMaxCount - 1) >= entry->count)
-      file_->Fail(index.mark, "'index' must be below the entry's count (" +
-                                  std::to_string(entry->count) + "): copies are numbered from 0");
-  }
+  for (const EntryPlan::OwnCopy& own : entry->own_copies)
+    if (own.index >= entry->count)
+      file_->Fail(Fields(*file_, own.field, "an instances entry").Get("index").mark,
+                  "'index' must be below the entry's count (" + std::to_string(entry->count) +
+                      "): copies are numbered from 0");
 }
 
 void WorldLoader::PlaceEntries() {
@@ -722,18 +803,26 @@ void WorldLoader::PlaceEntries() {
   for (EntryPlan& e : entries_) {
     if (e.distribute) continue;
     const Pose& X = e.fixed_pose;
-    if (!placer_->IsFree(X.p.x, X.p.y, e.footprint.radius, 0))
+    const double radius = e.FootprintOf(0).radius;
+    if (!placer_->IsFree(X.p.x, X.p.y, radius, 0))
       file_->Fail(e.position_field.mark,
                   "this " + e.model->name + " at [" + loader::FormatNumber(X.p.x) + ", " +
                       loader::FormatNumber(X.p.y) +
                       "] overlaps a wall, an obstacle or another placed copy");
-    placer_->AddBody(X.p.x, X.p.y, e.footprint.radius);
+    placer_->AddBody(X.p.x, X.p.y, radius);
   }
   uint64_t stream = 0;
   for (EntryPlan& e : entries_) {
     if (!e.distribute) continue;
-    e.placements = placer_->Distribute(e.region, e.count, e.footprint.radius, e.clearance, stream++,
-                                       e.heading);
+    if (e.own_copies.empty()) {
+      e.placements = placer_->Distribute(e.region, e.count, e.footprint.radius, e.clearance,
+                                         stream++, e.heading);
+    } else {
+      // Copies whose own values change their size have footprints of their own.
+      e.placements = placer_->Distribute(
+          e.region, e.count, [&e](int64_t k) { return e.FootprintOf(k).radius; },
+          e.MaxFootprintRadius(), e.clearance, stream++, e.heading);
+    }
     if (static_cast<int64_t>(e.placements.size()) < e.count)
       file_->Fail(e.count_field.mark,
                   "cannot place " + std::to_string(e.count) + " " + e.model->name + " copies in " +
@@ -750,40 +839,57 @@ void WorldLoader::BuildCopies(World* world) {
     if (!e.distribute) {
       poses.push_back(e.fixed_pose);
     } else {
-      for (const Placement2& p : e.placements)
-        poses.push_back({{p.x, p.y, -e.footprint.bottom}, Quat::FromYaw(p.yaw)});
+      for (size_t k = 0; k < e.placements.size(); ++k) {
+        const Placement2& p = e.placements[k];
+        poses.push_back(
+            {{p.x, p.y, -e.FootprintOf(static_cast<int64_t>(k)).bottom}, Quat::FromYaw(p.yaw)});
+      }
     }
     if (poses.empty()) continue;
-    // The first copy from the description, the others duplicated from it
-    // (rows copied, scripts shared); each copy is a robot named model#index.
-    const ObjectId first = loader::AddToScene(e.spec, {}, &scene);
-    // Scaled once, before duplication: copies share the scaled mesh assets.
-    // The model frame scales too (the root's offset in it).
-    Pose X_MR = e.spec.X_PO;
-    if (e.scale != 1) {
-      scene.ScaleSubtree(first, e.scale);
-      X_MR.p = X_MR.p * e.scale;
-    }
-    scene.ReserveForCopies(first, poses.size() - 1);
+    // Copies built from their own description: the entry's first copy, and
+    // each copy with values of its own. The others are duplicated from the
+    // entry's first copy (rows copied, scripts and mesh assets shared); each
+    // copy is a robot named model#index.
     const std::string& name = e.model->name;
+    size_t duplicates = poses.size();
+    for (const EntryPlan::OwnCopy& own : e.own_copies) duplicates -= own.spec.has_value();
+    ScaledMeshes scaled_meshes;
+    auto build = [&](const ObjectSpec& spec, const std::vector<loader::IkGroupDef>& ik_groups,
+                     std::optional<size_t> reserve) {
+      const ObjectId root = loader::AddToScene(spec, {}, &scene);
+      // Scaled once, before duplication: copies share the scaled mesh assets
+      // (copies with objects of their own too).
+      if (e.scale != 1) {
+        scene.ScaleSubtree(root, e.scale);
+        if (!e.own_copies.empty()) ShareScaledMeshes(spec, root, &scene, &scaled_meshes);
+      }
+      if (reserve) scene.ReserveForCopies(root, *reserve);
+      const int instance = scene.MakeModelInstance(
+          root, name, name + "#" + std::to_string(scene.instances().size()));
+      // IK groups of this copy; duplicates get theirs from the "ik" module.
+      loader::AddIkGroups(*e.model, ik_groups, spec, root, world);
+      return std::pair(root, instance);
+    };
+    ObjectId first;  // the entry's first copy built from its own description
     for (size_t k = 0; k < poses.size(); ++k) {
-      ObjectId root = first;
+      const EntryPlan::OwnCopy* own = e.FindOwnCopy(static_cast<int64_t>(k));
+      ObjectId root;
       int instance;
-      if (k == 0) {
-        instance = scene.MakeModelInstance(first, name,
-                                           name + "#" + std::to_string(scene.instances().size()));
-        // IK groups of the first copy; duplicates get theirs from the "ik" module.
-        loader::AddIkGroups(*e.model, e.ik_groups, e.spec, first, world);
+      if (own && own->spec) {
+        std::tie(root, instance) = build(*own->spec, own->ik_groups, std::nullopt);
+      } else if (first.IsNull()) {
+        std::tie(root, instance) = build(e.spec, e.ik_groups, duplicates - 1);
+        first = root;
       } else {
         root = scene.DuplicateSubtree(first, {});
         instance = scene.instance_of(root);
       }
       scene.set_name(root, scene.instance(instance).name);
+      // The root's pose in the model frame (scaled with the copy).
+      Pose X_MR = e.SpecOf(static_cast<int64_t>(k)).X_PO;
+      X_MR.p = X_MR.p * e.scale;
       scene.SetWorldPose(root, poses[k] * X_MR);
-      SharedParameters parameters = e.parameters;
-      for (const auto& [index, own] : e.instance_parameters)
-        if (index == static_cast<int64_t>(k)) parameters = own;
-      world->SetInstanceParameters(instance, parameters);
+      world->SetInstanceParameters(instance, own ? own->parameters : e.parameters);
     }
   }
 }
@@ -808,14 +914,16 @@ std::vector<ModelSummary> WorldLoader::Summarize() const {
             "[" + loader::FormatNumber(decl.min) + ", " + loader::FormatNumber(decl.max) + "]";
       m.parameters.push_back(std::move(p));
     }
-    for (const auto& [index, own] : e.instance_parameters) {
+    for (const EntryPlan::OwnCopy& own : e.own_copies) {
       std::string text;
-      for (const auto& [name, value] : *own)
+      for (const auto& [name, value] : *own.parameters)
         if (!(value == e.parameters->at(name)))
           text += (text.empty() ? "" : ", ") + name + "=" + ShowValue(value);
-      m.instances.emplace_back(index, text);
+      m.instances.emplace_back(own.index, text);
     }
     CollectScripts(e.spec, &m.scripts);
+    for (const EntryPlan::OwnCopy& own : e.own_copies)
+      if (own.spec) CollectScripts(*own.spec, &m.scripts);
     m.ik_groups = static_cast<int>(e.ik_groups.size());
     out.push_back(std::move(m));
   }

@@ -411,6 +411,73 @@ TEST(ScriptControlTest, StopPolicyEndsTheRunWithTheFaultyRobotNamed) {
                   "bot#617: scripts/robot.lua:1: boom [in sysCall_actuation of /bot#617/body]");
 }
 
+TEST(ScriptControlTest, StopPolicyCleanupErrorKeepsEveryRobotsCleanupPrintsInRobotOrder) {
+  for (int threads : {1, 2}) {
+    ScriptWorld w(threads);
+    for (int r = 0; r < 3; ++r)
+      w.AddRobot("bot#" + std::to_string(r), R"(
+        function sysCall_cleanup()
+          print('cleanup ran')
+          if sim.getRobotIndex() == 1 then error('boom') end
+        end
+      )",
+                 r);
+    w.Steps(1);
+    EXPECT_CONTAINS(ErrorOf([&] { w.world().Stop(); }),
+                    "bot#1: scripts/robot.lua:4: boom [in sysCall_cleanup of /bot#1/body]");
+    const std::vector<std::string> expected = {"[bot#0] cleanup ran", "[bot#1] cleanup ran",
+                                               "[bot#2] cleanup ran"};
+    EXPECT_EQ(w.log, expected) << threads << " threads";
+  }
+}
+
+TEST(ScriptControlTest, StopPolicyInitErrorKeepsEveryRobotsInitPrintsInRobotOrder) {
+  for (int threads : {1, 3}) {
+    ScriptWorld w(threads);
+    for (int r = 0; r < 10; ++r)
+      w.AddRobot("bot#" + std::to_string(r), R"(
+        function sysCall_init()
+          print('init')
+          if sim.getRobotIndex() == 5 then error('boom') end
+        end
+      )",
+                 r);
+    EXPECT_CONTAINS(ErrorOf([&] { w.world().Start(); }),
+                    "bot#5: scripts/robot.lua:4: boom [in sysCall_init of /bot#5/body]");
+    std::vector<std::string> expected;
+    for (int r = 0; r < 10; ++r) expected.push_back("[bot#" + std::to_string(r) + "] init");
+    EXPECT_EQ(w.log, expected) << threads << " threads";
+  }
+}
+
+TEST(ScriptControlTest, StopPolicyMainScriptErrorKeepsWhatItPrintedBefore) {
+  WorldSettings settings;
+  settings.main_script = Source("main.lua", R"(
+    function sysCall_init() print('main init') end
+    function sysCall_step()
+      print('main step')
+      error('boom')
+    end
+  )");
+  ScriptWorld w(1, settings);
+  w.AddRobot("bot#0", "function sysCall_init() print('init') end");
+  EXPECT_CONTAINS(ErrorOf([&] { w.Steps(1); }), "main: main.lua:5: boom [in sysCall_step");
+  const std::vector<std::string> expected = {"[bot#0] init", "[main] main init",
+                                             "[main] main step"};
+  EXPECT_EQ(w.log, expected);
+  // A main script that fails in sysCall_init keeps the robots' prints too.
+  WorldSettings failing_init;
+  failing_init.main_script = Source("main.lua", R"(
+    function sysCall_init() print('main init') error('bad init') end
+    function sysCall_step() end
+  )");
+  ScriptWorld v(1, failing_init);
+  v.AddRobot("bot#0", "function sysCall_init() print('init') end");
+  EXPECT_CONTAINS(ErrorOf([&] { v.world().Start(); }), "main.lua:2: bad init");
+  const std::vector<std::string> expected_init = {"[bot#0] init", "[main] main init"};
+  EXPECT_EQ(v.log, expected_init);
+}
+
 TEST(ScriptControlTest, DisableScriptPolicyLogsOnceAndTheSwarmGoesOn) {
   WorldSettings settings;
   settings.on_script_error = ScriptErrorPolicy::kDisableScript;
@@ -484,6 +551,35 @@ TEST(ScriptControlTest, HandleChildScriptsForwardsExtraArguments) {
   ScriptWorld v(1, bad);
   EXPECT_CONTAINS(ErrorOf([&] { v.Steps(1); }),
                   "main.lua:1: sim.handleChildScripts: argument 2 must be");
+}
+
+TEST(ScriptControlTest, HandleChildScriptsListsItsPassesAndSuggestsTheNearest) {
+  WorldSettings settings;
+  settings.main_script =
+      Source("main.lua", "function sysCall_step()\n  sim.handleChildScripts('actuate')\nend\n");
+  ScriptWorld w(1, settings);
+  EXPECT_CONTAINS(ErrorOf([&] { w.Steps(1); }),
+                  "main.lua:2: sim.handleChildScripts: bad argument #1 (invalid option "
+                  "'actuate'; expected 'sensing', 'actuation' or 'all'; did you mean "
+                  "'actuation'?)");
+  WorldSettings far;
+  far.main_script =
+      Source("main.lua", "function sysCall_step() sim.handleChildScripts('physics') end");
+  ScriptWorld v(1, far);
+  EXPECT_CONTAINS(ErrorOf([&] { v.Steps(1); }),
+                  "bad argument #1 (invalid option 'physics'; expected 'sensing', 'actuation' or "
+                  "'all')");
+}
+
+TEST(ScriptControlTest, MainScriptWithoutSysCallStepSuggestsAMisspeltOne) {
+  WorldSettings settings;
+  settings.main_script = Source("main.lua",
+                                "function sysCall_init() end\n"
+                                "function sysCall_stpe()\n  sim.handleDynamics()\nend\n");
+  ScriptWorld w(1, settings);
+  const std::string error = ErrorOf([&] { w.world().Start(); });
+  EXPECT_CONTAINS(error, "main: main.lua: the main script must define sysCall_step()");
+  EXPECT_CONTAINS(error, "main.lua:2 defines sysCall_stpe: did you mean sysCall_step?");
 }
 
 TEST(ScriptControlTest, MainScriptMustStepTheDynamicsAndChildrenCannotRunPhases) {
@@ -1066,12 +1162,28 @@ TEST(ScriptControlTest, UnknownSysCallNamesAreWarnedOncePerScriptFile) {
       "mean sysCall_actuation?)",
       "warning: scripts/robot.lua:3: defines sysCall_beforeSimulation, which swarmsim never calls "
       "(it is CoppeliaSim's; put its code in sysCall_init)",
+      "warning: scripts/robot.lua:4: defines sysCall_step, which swarmsim never calls (only the "
+      "world's main script, simulation.main_script, has a sysCall_step)",
       "warning: scripts/robot.lua defines sysCall_frobnicate, which swarmsim never calls "
       "(it calls sysCall_init, sysCall_sensing, sysCall_actuation, sysCall_cleanup and "
-      "sysCall_thread)",
-      "warning: scripts/robot.lua:4: defines sysCall_step, which swarmsim never calls (only the "
-      "world's main script, simulation.main_script, has a sysCall_step)"};
+      "sysCall_thread)"};
   EXPECT_EQ(w.log, expected);
+}
+
+TEST(ScriptControlTest, UnknownSysCallNamesOfOneFileAreWarnedInLineOrder) {
+  ScriptWorld w;
+  w.AddRobot("bot#0",
+             "function sysCall_beforeSimulation() end\n"
+             "function sysCall_Init() end\n"
+             "function sysCall_b() end function sysCall_a() end\n"
+             "sysCall_zzz = 1\n");
+  w.world().Start();
+  ASSERT_EQ(w.log.size(), 5u);
+  EXPECT_CONTAINS(w.log[0], "robot.lua:1: defines sysCall_beforeSimulation,");
+  EXPECT_CONTAINS(w.log[1], "robot.lua:2: defines sysCall_Init,");
+  EXPECT_CONTAINS(w.log[2], "robot.lua:3: defines sysCall_a,");  // same line: by name
+  EXPECT_CONTAINS(w.log[3], "robot.lua:3: defines sysCall_b,");
+  EXPECT_CONTAINS(w.log[4], "robot.lua defines sysCall_zzz,");  // no line: last
 }
 
 TEST(ScriptControlTest, ThreadsResumeAtMostOncePerStep) {

@@ -333,6 +333,31 @@ TEST(ScriptHostTest, RepeatedNamesAreIndexed) {
   EXPECT_EQ(w.log, expected);
 }
 
+TEST(ScriptHostTest, MissingObjectPathSuggestsTheNearestNameOrTheIndexRange) {
+  // path -> what the error must say, for a script on /bot#0/body (joints
+  // leftMotor and rightMotor, 12 sensors 'prox').
+  const std::pair<std::string, std::string> cases[] = {
+      {"./leftmotor",
+       "no object at path './leftmotor' (looked up from /bot#0/body); did you mean "
+       "'./leftMotor'?"},
+      {"./prox[12]",
+       "no object at path './prox[12]' (looked up from /bot#0/body); there are 12 objects named "
+       "'prox' there: prox[0]..prox[11]"},
+      {":/body/rigthMotor", "; did you mean ':/body/rightMotor'?"},
+      {"/bot#0/bdy/leftMotor", "; did you mean '/bot#0/body/leftMotor'?"},
+      {"./wheel",
+       "no object at path './wheel' (looked up from /bot#0/body); the names there: "
+       "leftMotor, prox, rightMotor"},
+  };
+  for (const auto& [path, message] : cases) {
+    ScriptWorld w;
+    const ObjectId body =
+        w.AddRobot("bot#0", "function sysCall_init() sim.getObject('" + path + "') end");
+    for (int i = 0; i < 12; ++i) w.scene().AddProximitySensor("prox", body, {}, {});
+    EXPECT_CONTAINS(ErrorOf([&] { w.world().Start(); }), message);
+  }
+}
+
 TEST(ScriptHostTest, PosesInWorldAndRelativeFrames) {
   ScriptWorld w;
   const ObjectId body = w.scene().AddDummy("base", {}, {{1, 2, 0}, Quat::FromYaw(M_PI / 2)});

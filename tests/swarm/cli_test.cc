@@ -310,4 +310,51 @@ TEST(CliTest, ScriptErrorNamesRobotFileAndLineAndKeepsOutputs) {
   fs::remove_all(out);
 }
 
+// A world of `count` dummy robots whose script is `code`, in a fresh folder.
+std::string DummyWorld(const fs::path& dir, int count, const std::string& code) {
+  fs::create_directories(dir);
+  std::ofstream(dir / "dummy.yaml") << "model: dummy\nobjects: {name: body, type: dummy, script: "
+                                       "c.lua}\n";
+  std::ofstream(dir / "c.lua") << code;
+  std::ofstream(dir / "w.yaml") << "simulation: {physics: kinematic, time_step: 0.1, seed: 1}\n"
+                                   "arena: {size: 3}\nmodels:\n  - model: dummy.yaml\n    count: "
+                                << count << "\n    distribute: {region: arena}\n";
+  return (dir / "w.yaml").string();
+}
+
+TEST(CliTest, ScriptErrorInOneRobotKeepsEveryRobotsPrintsInRobotOrder) {
+  const fs::path dir = TempDir("prints");
+  // A cleanup error in robot 1 of 3: every cleanup's line, in robot order, and the error.
+  std::string world = DummyWorld(dir / "cleanup", 3,
+                                 "function sysCall_cleanup() print('cleanup ran'); "
+                                 "if sim.getRobotIndex() == 1 then error('boom') end end\n");
+  Result r = RunProgram("run " + world + " --steps 1 --quiet");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  const size_t p0 = r.output.find("[dummy#0] cleanup ran"),
+               p1 = r.output.find("[dummy#1] cleanup ran"),
+               p2 = r.output.find("[dummy#2] cleanup ran");
+  ASSERT_NE(p0, std::string::npos) << r.output;
+  ASSERT_NE(p1, std::string::npos) << r.output;
+  ASSERT_NE(p2, std::string::npos) << r.output;
+  EXPECT_TRUE(p0 < p1 && p1 < p2) << r.output;
+  EXPECT_NE(r.output.find("c.lua:1: boom [in sysCall_cleanup of /dummy#1]"), std::string::npos)
+      << r.output;
+  // A sysCall_init error in robot 5 of 10: every robot's init line.
+  world = DummyWorld(dir / "init", 10,
+                     "function sysCall_init() print('init ran'); "
+                     "if sim.getRobotIndex() == 5 then error('boom') end end\n");
+  r = RunProgram("run " + world + " --steps 1 --threads 2 --quiet");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  size_t last = 0;
+  for (int i = 0; i < 10; ++i) {
+    const size_t at = r.output.find("[dummy#" + std::to_string(i) + "] init ran");
+    ASSERT_NE(at, std::string::npos) << i << ": " << r.output;
+    EXPECT_GE(at, last) << r.output;
+    last = at;
+  }
+  EXPECT_NE(r.output.find("c.lua:1: boom [in sysCall_init of /dummy#5]"), std::string::npos)
+      << r.output;
+  fs::remove_all(dir);
+}
+
 }  // namespace

@@ -73,8 +73,12 @@ TEST(SweepTest, FailedRunsAndTimeoutsAreRecordedAndTheSweepGoesOn) {
   // fail_at=0.2: a Lua error at t = 0.2 s; spin=1e9: far past the 1 s limit.
   Result r = RunProgram("sweep " + kWorld + " --param fail_at=-1,0.2 --param spin=0,1000000000 " +
                         "--seeds 2 --steps 10 --jobs 2 --timeout 1 --db " + db.string());
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_NE(r.output.find("failed"), std::string::npos) << r.output;
+  // Every run is attempted; failures make the exit status 1, after the summary.
+  ASSERT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("sweep: 2 ok, 6 failed, 0 not run, of 8 runs"), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("6 runs failed or timed out (exit status 1)"), std::string::npos)
+      << r.output;
   const auto runs = ReadRuns(db);
   ASSERT_EQ(runs.size(), 8u);
   int ok = 0, lua = 0, timeout = 0;
@@ -97,6 +101,88 @@ TEST(SweepTest, FailedRunsAndTimeoutsAreRecordedAndTheSweepGoesOn) {
                   "SELECT count(*) FROM final_metrics JOIN runs ON id = run "
                   "WHERE metric = 'x' AND status = 'ok'"),
             2);
+  // The same command on the finished sweep runs nothing and still says it failed.
+  r = RunProgram("sweep " + kWorld + " --param fail_at=-1,0.2 --param spin=0,1000000000 " +
+                 "--seeds 2 --steps 10 --jobs 2 --timeout 1 --quiet --db " + db.string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  fs::remove_all(dir);
+}
+
+// Starts `args` in a process group of its own with stdout and stderr to
+// `log`; returns its pid.
+pid_t StartInOwnGroup(const std::vector<std::string>& args, const fs::path& log) {
+  fflush(nullptr);
+  std::cout.flush();
+  const pid_t pid = fork();
+  if (pid == 0) {
+    setpgid(0, 0);
+    std::vector<char*> argv;
+    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    freopen(log.c_str(), "w", stdout);
+    dup2(fileno(stdout), STDERR_FILENO);
+    execv(argv[0], argv.data());
+    _exit(127);
+  }
+  setpgid(pid, pid);  // (either side may win the race)
+  return pid;
+}
+
+std::string ReadText(const fs::path& path) {
+  std::ifstream f(path);
+  std::ostringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+TEST(SweepTest, InterruptedBySignalSaysSoAndTheSameCommandResumes) {
+  const fs::path dir = TempDir("sigint");
+  const fs::path db = dir / "r.db";
+  // 30 runs of ~0.1 s each on 2 jobs.
+  const std::vector<std::string> args{
+      SWARMSIM_BINARY, "sweep", kWorld,    "--param", "robots=2,3,4", "--param", "spin=100000",
+      "--seeds",       "10",    "--steps", "20",      "--jobs",       "2",       "--db",
+      db.string()};
+  // Ctrl-C (SIGINT to the whole process group, runs included), then SIGTERM
+  // to the sweep alone.
+  const int64_t kTargets[] = {3, 10};
+  const int kSignals[] = {SIGINT, SIGTERM};
+  for (int round = 0; round < 2; ++round) {
+    const fs::path log = dir / ("log" + std::to_string(round));
+    const pid_t pid = StartInOwnGroup(args, log);
+    ASSERT_GT(pid, 0);
+    const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    while (std::chrono::steady_clock::now() < give_up) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      if (!fs::exists(db)) continue;
+      try {
+        if (Count(db, "SELECT count(*) FROM runs WHERE status = 'ok'") >= kTargets[round]) break;
+      } catch (const std::exception&) {  // schema not created yet
+      }
+    }
+    if (round == 0)
+      kill(-pid, SIGINT);
+    else
+      kill(pid, SIGTERM);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    const std::string output = ReadText(log);
+    ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status) << ":\n" << output;
+    EXPECT_EQ(WEXITSTATUS(status), 128 + kSignals[round]) << output;
+    const std::string name = round == 0 ? "SIGINT" : "SIGTERM";
+    EXPECT_NE(output.find("sweep: interrupted by " + name + ": "), std::string::npos) << output;
+    EXPECT_NE(output.find(" of 30 runs done (0 failed)"), std::string::npos) << output;
+    EXPECT_NE(output.find("Run the same command to resume"), std::string::npos) << output;
+    // The runs the signal cut short are not failures: they run again on resume.
+    EXPECT_EQ(Count(db, "SELECT count(*) FROM runs WHERE status = 'failed'"), 0) << output;
+    EXPECT_LT(Count(db, "SELECT count(*) FROM runs WHERE status = 'ok'"), 30)
+        << "the sweep ended before the signal; make it longer";
+  }
+  std::string cmd;
+  for (const std::string& a : args) cmd += a + " ";
+  Result r = RunCommand(cmd);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(Count(db, "SELECT count(*) FROM runs WHERE status = 'ok'"), 30);
   fs::remove_all(dir);
 }
 
@@ -251,7 +337,7 @@ TEST(SweepTest, ReportTableCsvColumnsAndPlot) {
   const fs::path db = dir / "r.db";
   Result r = RunProgram("sweep " + kWorld + " --param robots=2,4 --param fail_at=-1,0.3 " +
                         "--seeds 3 --steps 8 --quiet --db " + db.string());
-  ASSERT_EQ(r.exit_code, 0) << r.output;
+  ASSERT_EQ(r.exit_code, 1) << r.output;  // the fail_at=0.3 runs fail, as planned
   const fs::path csv = dir / "runs.csv", png = dir / "plot.png";
   r = RunProgram("report " + db.string() + " --x robots --by fail_at --y x --csv " + csv.string() +
                  (RunCommand("command -v gnuplot").exit_code == 0 ? " --plot " + png.string()
@@ -283,6 +369,38 @@ TEST(SweepTest, ReportTableCsvColumnsAndPlot) {
   }
   r = RunProgram("report " + db.string() + " --by nosuch");
   EXPECT_EQ(r.exit_code, 2) << r.output;
+  fs::remove_all(dir);
+}
+
+TEST(SweepTest, ReportListsTheValidNamesAndSuggestsTheNearest) {
+  const fs::path dir = TempDir("report_names");
+  const fs::path db = dir / "r.db";
+  Result r = RunProgram("sweep " + kWorld + " --param robots=2,3 --param fail_at=-1 " +
+                        "--steps 4 --quiet --db " + db.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = RunProgram("report " + db.string() + " --y mnnd");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("no run recorded metric 'mnnd' (the metrics recorded: "
+                          "mean_nearest_neighbor_distance, x)"),
+            std::string::npos)
+      << r.output;
+  r = RunProgram("report " + db.string() + " --y mean_nearest_neighbour_distance");
+  EXPECT_NE(r.output.find("no run recorded metric 'mean_nearest_neighbour_distance' (the metrics "
+                          "recorded: mean_nearest_neighbor_distance, x); did you mean "
+                          "'mean_nearest_neighbor_distance'?"),
+            std::string::npos)
+      << r.output;
+  r = RunProgram("report " + db.string() + " --x robts");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("'robts' is not a parameter of this sweep (its parameters: robots, "
+                          "fail_at); did you mean 'robots'?"),
+            std::string::npos)
+      << r.output;
+  r = RunProgram("report " + db.string() + " --by seed");
+  EXPECT_NE(r.output.find("'seed' is not a parameter of this sweep (its parameters: robots, "
+                          "fail_at)"),
+            std::string::npos)
+      << r.output;
   fs::remove_all(dir);
 }
 

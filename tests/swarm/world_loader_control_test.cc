@@ -14,8 +14,10 @@
 #include <string>
 
 #include "framework/error.h"
+#include "framework/ik_groups.h"
 #include "framework/registry.h"
 #include "framework/world.h"
+#include "modules/builtin.h"
 #include "swarm/world_loader.h"
 #include "tests/framework/fakes.h"
 #include "tests/swarm/run_program.h"
@@ -169,6 +171,188 @@ TEST_F(ControlLoaderTest, RangesAndInstanceMistakesNameFileLineAndColumn) {
   EXPECT_CONTAINS(ErrorOf(kThree), "bot.yaml:3:32: 'range' must be [min, max]");
 }
 
+// A model whose objects use its parameters everywhere a value can.
+const char kGear[] =
+    "model: gear\n"
+    "parameters:\n"
+    "  r: {default: 0.3, unit: m, range: [0.05, 2]}\n"
+    "  size: 0.1\n"
+    "  lim: 0.5\n"
+    "  mass: 1\n"
+    "  damping: 0.01\n"
+    "objects:\n"
+    "  type: shape\n"
+    "  shape: cylinder\n"
+    "  radius: $size\n"
+    "  height: \"= 2 * size\"\n"
+    "  dynamic: true\n"
+    "  mass: $mass\n"
+    "  script: bot.lua\n"
+    "  children:\n"
+    "    - {name: s, type: proximity_sensor, position: [$size, 0, 0], range: $r}\n"
+    "    - {name: ring, type: proximity_ring, count: 2, radius: $size, range: \"= r / 2\"}\n"
+    "    - name: j\n"
+    "      type: joint\n"
+    "      mode: position\n"
+    "      limits: [\"= -lim\", $lim]\n"
+    "      children: [{name: tip, type: dummy, position: [0.1, 0, 0]}]\n"
+    "    - {name: target, type: dummy, position: [0.05, 0.05, 0]}\n"
+    "ik_groups:\n"
+    "  - {name: reach, tips: [{tip: j/tip, target: target}], damping: $damping}\n";
+
+TEST_F(ControlLoaderTest, PerCopyValuesReachEveryObjectValueThatUsesThem) {
+  // instances: values changed what sim.getParam saw, but the objects were
+  // built once for the whole entry: copy 0's sensor kept the entry's range.
+  Write("gear.yaml", kGear);
+  Write("world.yaml",
+        "simulation: {physics: kinematic}\n"
+        "models:\n"
+        "  - model: gear.yaml\n"
+        "    count: 3\n"
+        "    distribute: {region: {min: [-5, -5], max: [5, 5]}, clearance: 0.1}\n"
+        "    parameters: {mass: 1.5}\n"
+        "    instances:\n"
+        "      - {index: 0, parameters: {r: 1.8, size: 0.4, lim: 1, mass: 2, damping: 0.2}}\n"
+        "      - {index: 2, parameters: {r: 0.3}}\n");  // the entry's values: shared
+  ModuleRegistry builtin;
+  RegisterBuiltinModules(&builtin);
+  const LoadedWorld w = LoadWorld(dir_ / "world.yaml", {}, builtin);
+  const Scene& scene = w.world->scene();
+  ASSERT_EQ(scene.instances().size(), 3u);
+  const auto* ik = dynamic_cast<const IkGroups*>(w.world->find_calculation(kIkModuleName));
+  ASSERT_NE(ik, nullptr);
+  struct Expected {
+    double r, size, lim, mass, damping;
+  };
+  const Expected expected[] = {
+      {1.8, 0.4, 1, 2, 0.2}, {0.3, 0.1, 0.5, 1.5, 0.01}, {0.3, 0.1, 0.5, 1.5, 0.01}};
+  for (int k = 0; k < 3; ++k) {
+    SCOPED_TRACE("copy " + std::to_string(k));
+    const Expected& e = expected[k];
+    const ObjectId root = scene.instance(k).root;
+    EXPECT_EQ(std::get<double>(*w.world->FindParameter(k, "r")), e.r);
+    EXPECT_EQ(scene.proximity_sensor(scene.FindObject("./s", root)).range, e.r);
+    EXPECT_EQ(scene.local_pose(scene.FindObject("./s", root)).p.x, e.size);
+    EXPECT_EQ(scene.proximity_sensor(scene.FindObject("./ring[1]", root)).range, e.r / 2);
+    EXPECT_EQ(scene.shape(root).size.x, e.size);
+    EXPECT_EQ(scene.shape(root).size.z, 2 * e.size);
+    EXPECT_EQ(scene.shape(root).mass, e.mass);
+    EXPECT_EQ(scene.joint(scene.FindObject("./j", root)).min_position, -e.lim);
+    EXPECT_EQ(scene.joint(scene.FindObject("./j", root)).max_position, e.lim);
+    EXPECT_EQ(ik->spec(ik->FindGroup("reach", k)).damping, e.damping);
+    // Each copy stands on the ground by its own height.
+    EXPECT_DOUBLE_EQ(scene.world_pose(root).p.z, e.size);
+  }
+  // Placement keeps the larger copy clear of the others by its own radius.
+  for (int k = 1; k < 3; ++k) {
+    const Vec3 d =
+        scene.world_pose(scene.instance(0).root).p - scene.world_pose(scene.instance(k).root).p;
+    EXPECT_GE(std::hypot(d.x, d.y), 0.4 + 0.1 + 0.1) << k;
+  }
+  // --set still sets every copy, and describe lists copy 0's values.
+  LoadOptions set;
+  set.overrides = {{"gear.r", "1.2"}};
+  const LoadedWorld s = LoadWorld(dir_ / "world.yaml", set, builtin);
+  for (int k = 0; k < 3; ++k) {
+    const ObjectId root = s.world->scene().instance(k).root;
+    EXPECT_EQ(s.world->scene().proximity_sensor(s.world->scene().FindObject("./s", root)).range,
+              1.2)
+        << k;
+  }
+  ASSERT_EQ(w.models[0].instances.size(), 2u);
+  EXPECT_EQ(w.models[0].instances[0].second, "damping=0.2, lim=1, mass=2, r=1.8, size=0.4");
+  EXPECT_EQ(w.models[0].instances[1].second, "");
+}
+
+TEST_F(ControlLoaderTest, ScaledCopiesWithTheirOwnValuesShareTheScaledMesh) {
+  Write("cube.obj",
+        "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n"
+        "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n");
+  Write("cube.yaml",
+        "model: cube\n"
+        "parameters: {m: 1}\n"
+        "objects: {type: shape, shape: mesh, file: cube.obj, dynamic: true, mass: $m}\n");
+  ModuleRegistry builtin;
+  RegisterBuiltinModules(&builtin);
+  Write("world.yaml",
+        "simulation: {physics: kinematic}\n"
+        "models:\n"
+        "  - {model: cube.yaml, count: 3, scale: 0.1, "
+        "distribute: {region: {min: [-5, -5], max: [5, 5]}},\n"
+        "     instances: [{index: 1, parameters: {m: 2}}]}\n");
+  const LoadedWorld w = LoadWorld(dir_ / "world.yaml", {}, builtin);
+  const Scene& scene = w.world->scene();
+  const ShapeData& own = scene.shape(scene.instance(1).root);
+  EXPECT_DOUBLE_EQ(own.mass, 2 * 0.001);  // its own mass, scaled by 0.1^3
+  EXPECT_DOUBLE_EQ(scene.shape(scene.instance(0).root).mass, 0.001);
+  for (int k : {0, 2}) EXPECT_EQ(scene.shape(scene.instance(k).root).mesh, own.mesh) << k;
+  EXPECT_DOUBLE_EQ(own.mesh->CenteredExtents().x, 0.2);
+}
+
+TEST_F(ControlLoaderTest, ACopysOwnValueThatBreaksAnObjectNamesTheCopy) {
+  Write("gear.yaml", kGear);
+  const std::string error = ErrorOf(
+      "simulation: {physics: kinematic}\n"
+      "models:\n"
+      "  - model: gear.yaml\n"
+      "    count: 2\n"
+      "    distribute: {region: {min: [-5, -5], max: [5, 5]}}\n"
+      "    instances: [{index: 1, parameters: {lim: -1}}]\n");
+  EXPECT_CONTAINS(error,
+                  "gear.yaml:22:15: 'limits' must be [min, max] with min <= max (with the "
+                  "parameters of copy 1 given at ");
+  EXPECT_CONTAINS(error, "world.yaml:6:17)");
+}
+
+TEST_F(ControlLoaderTest, AMisspelledRequiredKeyIsAnUnknownKeyWithASuggestion) {
+  // 'model', 'type' and 'name' were reported missing before the keys were checked.
+  EXPECT_CONTAINS(ErrorOf("models:\n  - modle: bot.yaml\n"),
+                  "world.yaml:2:5: unknown key 'modle' in a models entry; did you mean 'model'?");
+  EXPECT_CONTAINS(ErrorOf("models:\n  - {count: 1}\n"),
+                  "world.yaml:2:5: 'model' is required in a models entry");
+  const std::string world =
+      "simulation: {physics: kinematic}\n"
+      "models: [{model: bot.yaml, position: [0, 0]}]\n";
+  Write("bot.yaml",
+        "model: bot\n"
+        "objects: {name: body, type: dummy, children: [{name: arm, tpye: dummy}]}\n");
+  EXPECT_CONTAINS(ErrorOf(world),
+                  "bot.yaml:2:59: unknown key 'tpye' in an object of model 'bot'; did you mean "
+                  "'type'?");
+  Write("bot.yaml",
+        "model: bot\n"
+        "objects: {name: body, type: dummy, children: [{nmae: arm, type: dummy}]}\n");
+  EXPECT_CONTAINS(ErrorOf(world),
+                  "bot.yaml:2:48: unknown key 'nmae' in an object of model 'bot'; did you mean "
+                  "'name'?");
+  Write("bot.yaml",
+        "model: bot\n"
+        "objects: {name: body, type: dummy, children: [{position: [1, 0, 0], type: dummy}]}\n");
+  EXPECT_CONTAINS(ErrorOf(world), "bot.yaml:2:47: 'name' is required in an object of model 'bot'");
+}
+
+TEST_F(ControlLoaderTest, ARangeOrDefaultMistakeSaysWhatIsWrong) {
+  Write("bot.yaml",
+        "model: bot\nparameters:\n  speed: {default: 0.1, range: [0.3, 0]}\n"
+        "objects: {name: body, type: dummy}\n");
+  EXPECT_CONTAINS(
+      ErrorOf(kThree),
+      "bot.yaml:3:32: 'range' must be [min, max] with min <= max (got min 0.3 > max 0)");
+  Write("bot.yaml",
+        "model: bot\nparameters:\n  speed: {default: 0.1, range: [low, 1]}\n"
+        "objects: {name: body, type: dummy}\n");
+  EXPECT_CONTAINS(ErrorOf(kThree),
+                  "bot.yaml:3:33: 'range' must be [min, max], two numbers: its min is not a "
+                  "number (got \"low\")");
+  Write("bot.yaml",
+        "model: bot\nparameters:\n  speed: {default: fast, unit: m/s, range: [0, 1]}\n"
+        "objects: {name: body, type: dummy}\n");
+  EXPECT_CONTAINS(ErrorOf("simulation: {physics: kinematic}\n"
+                          "models: [{model: bot.yaml, position: [0, 0]}]\n"),
+                  "bot.yaml:3:20: the default of parameter 'speed' of model 'bot' must be a "
+                  "number within [0, 1] m/s (got \"fast\", which is not a number)");
+}
+
 TEST_F(ControlLoaderTest, DescribeListsModelsParametersAndScripts) {
   Write("world.yaml", kThree);
   const std::string cmd = std::string(SWARMSIM_BINARY) + " describe " +
@@ -263,6 +447,30 @@ TEST_F(ControlLoaderTest, ACallbackTypoIsWarnedOnceForAThousandRobots) {
   EXPECT_NE(first, std::string::npos) << r.output;
   EXPECT_EQ(r.output.find("sysCall_actuate,", first + warning.size()), std::string::npos)
       << r.output;
+}
+
+TEST_F(ControlLoaderTest, ACopysOwnSensorRangeIsWhatItsSensorReads) {
+  // Two robots 1 m apart, facing each other's side; copy 0's own range
+  // (1.8 m) reaches the other, the entry's default (0.3 m) does not.
+  Write("m.yaml",
+        "model: p\n"
+        "parameters: {r: {default: 0.3, unit: m, range: [0.05, 2]}}\n"
+        "objects: {type: shape, shape: cylinder, radius: 0.05, height: 0.1, script: p.lua,\n"
+        "  children: [{name: s, type: proximity_sensor, position: [0.05,0,0], "
+        "orientation_deg: [0,90,0], range: $r}]}\n");
+  Write("p.lua",
+        "function sysCall_sensing() local d, x = sim.readProximitySensor(sim.getObject('./s')) "
+        "print(sim.getParam('r'), d, x ~= nil) end\n");
+  Write("world.yaml",
+        "simulation: {physics: kinematic, steps: 1}\n"
+        "models:\n"
+        "  - {model: m.yaml, count: 2, distribute: {region: {min: [-0.06,-1], max: [0.06,1]}, "
+        "heading_deg: 90, clearance: 0.5},\n"
+        "     instances: [{index: 0, parameters: {r: 1.8}}]}\n");
+  const auto r = RunWorld(dir_, "--quiet");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_CONTAINS(r.output, "[p#0] 1.8\t1\ttrue\n");
+  EXPECT_CONTAINS(r.output, "[p#1] 0.3\t0\tfalse\n");
 }
 
 }  // namespace
