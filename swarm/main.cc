@@ -244,7 +244,9 @@ void PrintDescription(const LoadedWorld& w, std::ostream& out) {
   }
   for (const ModelSummary& m : w.models) {
     out << "\nmodel " << m.name << " (" << m.file << "): " << m.count
-        << (m.count == 1 ? " copy" : " copies") << "\n";
+        << (m.count == 1 ? " copy" : " copies");
+    if (m.scale != 1) out << ", scale " << m.scale;
+    out << "\n";
     for (const std::string& script : m.scripts) out << "  script: " << script << "\n";
     if (m.ik_groups > 0) out << "  module: ik (" << m.ik_groups << " IK groups)\n";
     if (m.parameters.empty()) out << "  parameters: none\n";

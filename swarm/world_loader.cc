@@ -157,11 +157,21 @@ std::string RangeError(const loader::ModelParameterDecl& decl, const std::string
   return what + " must be within " + range + " (got " + ShowValue(value) + ")";
 }
 
-// The script files of a model's objects, in tree order, once each.
-void CollectScripts(const ObjectSpec& spec, std::vector<std::string>* out) {
-  if (spec.script && std::find(out->begin(), out->end(), spec.script->path) == out->end())
-    out->push_back(spec.script->path);
-  for (const ObjectSpec& child : spec.children) CollectScripts(child, out);
+// The script files of a model's objects, in tree order, each with the
+// objects it is attached to, as paths from the model root (':' the root
+// itself, ':/a/b' below it) marked "(explicit)" where it runs only through
+// sim.handleChildScript: {file, "on :/leg0, :/leg1 (explicit)"}.
+void CollectScripts(const ObjectSpec& spec, const std::string& path,
+                    std::vector<std::pair<std::string, std::string>>* out) {
+  if (spec.script) {
+    auto it = std::find_if(out->begin(), out->end(),
+                           [&](const auto& s) { return s.first == spec.script->path; });
+    if (it == out->end()) it = out->insert(out->end(), {spec.script->path, "on"});
+    it->second +=
+        (it->second == "on" ? " " : ", ") + path + (spec.script_explicit ? " (explicit)" : "");
+  }
+  for (const ObjectSpec& child : spec.children)
+    CollectScripts(child, (path == ":" ? ":/" : path + "/") + child.name, out);
 }
 
 // Scaled mesh assets of one entry, by the asset they scale.
@@ -921,9 +931,19 @@ std::vector<ModelSummary> WorldLoader::Summarize() const {
           text += (text.empty() ? "" : ", ") + name + "=" + ShowValue(value);
       m.instances.emplace_back(own.index, text);
     }
-    CollectScripts(e.spec, &m.scripts);
-    for (const EntryPlan::OwnCopy& own : e.own_copies)
-      if (own.spec) CollectScripts(*own.spec, &m.scripts);
+    std::vector<std::pair<std::string, std::string>> scripts;
+    CollectScripts(e.spec, ":", &scripts);
+    for (const EntryPlan::OwnCopy& own : e.own_copies)  // a copy's own values may name others
+      if (own.spec) {
+        std::vector<std::pair<std::string, std::string>> own_scripts;
+        CollectScripts(*own.spec, ":", &own_scripts);
+        for (auto& script : own_scripts)
+          if (std::none_of(scripts.begin(), scripts.end(),
+                           [&](const auto& s) { return s.first == script.first; }))
+            scripts.push_back(std::move(script));
+      }
+    for (const auto& [file, where] : scripts) m.scripts.push_back(file + " " + where);
+    m.scale = e.scale;
     m.ik_groups = static_cast<int>(e.ik_groups.size());
     out.push_back(std::move(m));
   }

@@ -50,7 +50,10 @@ struct ModelSummary {
   int64_t count = 0;
   std::vector<ParameterSummary> parameters;                // values of every copy (after --set)
   std::vector<std::pair<int64_t, std::string>> instances;  // copy index -> "name=value, ..."
-  std::vector<std::string> scripts;                        // script files, tree order
+  // Script files in tree order, each with the objects it is on, as paths
+  // from the model root: "bot.lua on :, :/arm (explicit)".
+  std::vector<std::string> scripts;
+  double scale = 1;  // `scale:` of the entry
   int ik_groups = 0;
 };
 

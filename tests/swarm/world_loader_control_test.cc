@@ -373,6 +373,29 @@ TEST_F(ControlLoaderTest, DescribeListsModelsParametersAndScripts) {
   EXPECT_CONTAINS(out, "copy 1 of this entry: label=special");
 }
 
+// describe shows an entry's scale and, per script file, the objects it is on
+// (paths from the model root) and which of them are explicit.
+TEST_F(ControlLoaderTest, DescribeShowsScaleAndWhereEachScriptIsAttached) {
+  Write("arm.yaml",
+        "model: arm\n"
+        "objects:\n"
+        "  type: dummy\n"
+        "  script: base.lua\n"
+        "  children:\n"
+        "    - {name: a, type: dummy, script: {file: link.lua, explicit: true},\n"
+        "       children: [{name: b, type: dummy, script: link.lua}]}\n");
+  Write("base.lua", "");
+  Write("link.lua", "");
+  Write("world.yaml",
+        "models:\n  - {model: arm.yaml, count: 2, scale: 1.5, "
+        "distribute: {region: {min: [-5, -5], max: [5, 5]}}}\n");
+  const auto r = swarmsim::testing::RunProgram("describe " + (dir_ / "world.yaml").string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_CONTAINS(r.output, "arm.yaml): 2 copies, scale 1.5\n");
+  EXPECT_CONTAINS(r.output, "/base.lua on :\n");
+  EXPECT_CONTAINS(r.output, "/link.lua on :/a (explicit), :/a/b\n");
+}
+
 // --- Script errors and warnings, as the program reports them ---------------------------------
 
 // `swarmsim run` of world.yaml in the test folder.
