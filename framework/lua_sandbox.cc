@@ -335,7 +335,11 @@ int SafeRequire(lua_State* L) {
     searched += "\n\t" + candidate.string();
     std::error_code ec;
     if (!fs::is_regular_file(candidate, ec)) continue;
-    if (!IsInside(Canonical(candidate), Canonical(root))) continue;  // a symlink leading out
+    if (!IsInside(Canonical(candidate), Canonical(root))) {  // a symlink leading out
+      searched += " (a symbolic link to " + Canonical(candidate).string() +
+                  ", outside the folder: refused)";
+      continue;
+    }
     std::ifstream in(candidate, std::ios::binary);
     std::stringstream code;
     code << in.rdbuf();

@@ -148,6 +148,9 @@ TEST_F(SandboxTest, RequireLoadsModulesFromTheWorldFoldersOncePerState) {
   EXPECT_CONTAINS(Run("require('bad')"), "bad.lua:1: os.execute is not allowed");
   fs::create_symlink(root_ / "secret.txt", root_ / "world" / "leak.lua");
   EXPECT_CONTAINS(Run("require('leak')"), "module 'leak' not found");
+  EXPECT_CONTAINS(Run("require('leak')"), "leak.lua (a symbolic link to " +
+                                              fs::weakly_canonical(root_ / "secret.txt").string() +
+                                              ", outside the folder: refused)");
 }
 
 // Lua errors are longjmps (the C build of Lua): errors raised by Lua code
