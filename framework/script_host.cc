@@ -405,14 +405,16 @@ void Call(ScriptState& state, Script& script, int nargs, const char* what) {
   script.running = true;
   const int status = lua_pcall(state.L, nargs, 0, 0);
   script.running = false;
+  if (!state.context.pending_error.empty()) {
+    // A World error passed up through the main script: report it as is,
+    // also when the script caught it (pcall(sim.handleDynamics)): the world
+    // is broken and must not go on.
+    std::string error;
+    error.swap(state.context.pending_error);
+    lua_settop(state.L, 0);
+    throw Error(error);
+  }
   if (status != LUA_OK) {
-    if (!state.context.pending_error.empty()) {
-      // A World error passed up through the main script: report it as is.
-      std::string error;
-      error.swap(state.context.pending_error);
-      lua_settop(state.L, 0);
-      throw Error(error);
-    }
     if (state.context.budget_exhausted)
       ThrowScriptError(state, script.object, state.context.budget_error, what);
     ThrowScriptError(state, script.object, ErrorText(state.L, status), what);
@@ -1044,6 +1046,8 @@ template <void (*F)(World*)>
 int MainHandler(lua_State* L) {
   LuaContext& c = Context(L);
   if (!c.is_main) throw Error("only the world's main script may run the phases");
+  // After a World error (caught by the script) no phase runs again.
+  if (!c.pending_error.empty()) RaiseError(L, "stopped by an error");
   try {
     F(c.world);
   } catch (const std::exception& e) {
@@ -1089,6 +1093,7 @@ int HandleChildScripts(lua_State* L) {
                     luaL_typename(L, i));
     }
   }
+  if (!c.pending_error.empty()) RaiseError(L, "stopped by an error");
   c.world->scripts()->SetChildScriptArguments(std::move(args));
   try {
     c.world->HandleChildScripts(pass);

@@ -592,6 +592,24 @@ TEST(ScriptControlTest, MainScriptMustStepTheDynamicsAndChildrenCannotRunPhases)
   EXPECT_CONTAINS(ErrorOf([&] { v.Steps(1); }), "only the world's main script");
 }
 
+// A main script that catches a handler's error (pcall) does not keep a
+// broken world going: no phase runs after it, and the step fails with it.
+TEST(ScriptControlTest, MainScriptCannotSwallowAPhaseError) {
+  WorldSettings settings;
+  settings.main_script = Source("main.lua",
+                                "function sysCall_step()\n"
+                                "  print(pcall(sim.handleChildScripts))\n"
+                                "  print(pcall(sim.handleDynamics))\n"
+                                "end\n");
+  ScriptWorld w(1, settings);
+  w.AddRobot("bot#0", "function sysCall_actuation() error('boom') end");
+  EXPECT_CONTAINS(ErrorOf([&] { w.Steps(1); }), "bot#0: scripts/robot.lua:1: boom");
+  ASSERT_EQ(w.log.size(), 2u);
+  EXPECT_CONTAINS(w.log[1], "[main] false\t");
+  EXPECT_CONTAINS(w.log[1], "stopped by an error");
+  EXPECT_EQ(w.world().step_count(), 0);
+}
+
 // --- Messages ------------------------------------------------------------------------------
 
 // A robot that sends what `send` says in step 0 and prints everything it receives.
