@@ -99,6 +99,13 @@ TriangleMesh::TriangleMesh(std::string name, std::vector<Vec3> vertices,
     if (tri.v[0] >= n || tri.v[1] >= n || tri.v[2] >= n)
       throw Error("mesh '" + name_ + "' has a triangle with a vertex index out of range");
     if (tri.v[0] == tri.v[1] || tri.v[1] == tri.v[2] || tri.v[0] == tri.v[2]) continue;
+    // Degenerate by position too (repeated or collinear corners, as STL files
+    // write them): no area to collide with, and ODE's mesh collider crashes
+    // on them. Relative to the edges, so tiny meshes keep their triangles.
+    const Vec3 e1 = vertices_[tri.v[1]] - vertices_[tri.v[0]];
+    const Vec3 e2 = vertices_[tri.v[2]] - vertices_[tri.v[0]];
+    const double scale = e1.SquaredNorm() + e2.SquaredNorm();
+    if (!(e1.Cross(e2).SquaredNorm() > 1e-24 * scale * scale)) continue;
     triangles_.push_back(tri);
   }
   if (triangles_.empty()) throw Error("mesh '" + name_ + "' has no triangles");

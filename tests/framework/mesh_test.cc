@@ -111,5 +111,27 @@ TEST(TriangleMesh, RefusesEmptyOrBrokenInput) {
   EXPECT_THROW(TriangleMesh("m", {{0, 0, 0}, {1, 0, 0}}, {{{0, 1, 1}}}), Error);
 }
 
+// Triangles without area (repeated or collinear corners, as an STL file can
+// write them: each facet has its own vertices) are dropped; ODE's mesh
+// collider crashed on one. A tiny but real triangle stays.
+TEST(TriangleMesh, DropsTrianglesWithoutArea) {
+  const TriangleMesh m("m",
+                       {{0, 0, 0},
+                        {0.1, 0, 0},
+                        {0, 0.1, 0},
+                        {1, 1, 1},
+                        {1, 1, 1},
+                        {1, 1, 1},
+                        {0, 0, 0},
+                        {1, 0, 0},
+                        {2, 0, 0},
+                        {5, 5, 5},
+                        {5 + 1e-6, 5, 5},
+                        {5, 5 + 1e-6, 5}},
+                       {{{0, 1, 2}}, {{3, 4, 5}}, {{6, 7, 8}}, {{9, 10, 11}}});
+  EXPECT_EQ(m.triangles().size(), 2u);
+  EXPECT_THROW(TriangleMesh("m", {{1, 1, 1}, {1, 1, 1}, {1, 1, 1}}, {{{0, 1, 2}}}), Error);
+}
+
 }  // namespace
 }  // namespace swarmsim

@@ -147,5 +147,29 @@ TEST_F(LoaderMeshTest, ObjFilesLoadToo) {
   EXPECT_FALSE(s.mesh->closed());
 }
 
+// Two one-triangle meshes (as left by an STL whose other facet has no area)
+// colliding under ODE: its mesh collider dereferenced null on them.
+TEST_F(LoaderMeshTest, OneTriangleMeshesCollideUnderOde) {
+  Write("tri.stl",
+        "solid m\n"
+        "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 0.1 0 0\nvertex 0 0.1 0\n"
+        "endloop\nendfacet\n"
+        "facet normal 0 0 1\nouter loop\nvertex 1 1 1\nvertex 1 1 1\nvertex 1 1 1\n"
+        "endloop\nendfacet\n"
+        "endsolid m\n");
+  const fs::path world =
+      Write("tri_world.yaml",
+            "simulation: {physics: ode, steps: 3}\n"
+            "obstacles:\n"
+            "  - {shape: mesh, file: tri.stl, position: [0, 0, 0.05]}\n"
+            "  - {shape: mesh, file: tri.stl, dynamic: true, mass: 1, position: [1, 1, 0.5]}\n");
+  ModuleRegistry registry;
+  RegisterBuiltinModules(&registry);
+  LoadedWorld w = LoadWorld(world, {}, registry);
+  ASSERT_EQ(w.world->scene().shapes().size(), 2u);
+  for (int i = 0; i < 3; ++i) w.world->Step();
+  EXPECT_EQ(w.world->step_count(), 3);
+}
+
 }  // namespace
 }  // namespace swarmsim

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <mutex>
+#include <span>
 #include <string>
 
 #include "framework/error.h"
@@ -148,6 +149,7 @@ void OdeWorld::Clear() {
   if (threading_) dThreadingFreeImplementation(threading_);
   for (auto& [mesh, data] : meshes_) dGeomTriMeshDataDestroy(data);  // after their geoms
   meshes_.clear();
+  single_triangle_meshes_.clear();  // after the data that points at them
   contacts_ = nullptr;
   space_ = nullptr;
   world_ = nullptr;
@@ -174,9 +176,18 @@ dTriMeshDataID OdeWorld::MeshData(const std::shared_ptr<const TriangleMesh>& mes
     if (known == mesh) return data;
   // Few distinct meshes per world: a linear search is fine.
   dTriMeshDataID data = dGeomTriMeshDataCreate();
+  std::span<const MeshTriangle> triangles = mesh->triangles();
+  if (triangles.size() == 1) {
+    // OPCODE's tree-against-tree collider dereferences null on a tree of one
+    // leaf: give a one-triangle mesh its back face too (ODE keeps the
+    // pointer, so the buffer lives as long as the data).
+    const MeshTriangle& t = triangles[0];
+    single_triangle_meshes_.push_back({t, MeshTriangle{{t.v[0], t.v[2], t.v[1]}}});
+    triangles = single_triangle_meshes_.back();
+  }
   dGeomTriMeshDataBuildDouble(data, mesh->vertices().data(), sizeof(Vec3),
-                              static_cast<int>(mesh->vertices().size()), mesh->triangles().data(),
-                              static_cast<int>(3 * mesh->triangles().size()), sizeof(MeshTriangle));
+                              static_cast<int>(mesh->vertices().size()), triangles.data(),
+                              static_cast<int>(3 * triangles.size()), sizeof(MeshTriangle));
   meshes_.emplace_back(mesh, data);
   return data;
 }

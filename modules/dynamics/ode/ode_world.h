@@ -115,6 +115,8 @@ class OdeWorld {
   std::vector<dContact> contact_buffer_;
   // Mesh assets in use and their trimesh data (ODE reads the asset's arrays in place).
   std::vector<std::pair<std::shared_ptr<const TriangleMesh>, dTriMeshDataID>> meshes_;
+  // Index buffers of one-triangle meshes, doubled (MeshData); ODE points at them.
+  std::vector<std::vector<MeshTriangle>> single_triangle_meshes_;
   // Joint commands, read once per control step (rows of joints_).
   std::vector<JointData> commands_;
   double step_dt_ = 0;  // substep length, for the servo
