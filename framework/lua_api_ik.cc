@@ -6,6 +6,7 @@
 //   sim.getIkGroupStatus(h) -> status of the group's last solve
 // Groups are solved automatically each step in the actuate phase unless
 // declared `automatic: false`; a robot's scripts handle only its own groups.
+#include <climits>
 #include <string>
 
 #include "framework/error.h"
@@ -24,7 +25,7 @@ IkGroups* Module(const LuaContext& c, bool required) {
 
 int CheckGroup(lua_State* L, const LuaContext& c, IkGroups* module) {
   const lua_Integer h = ArgInteger(L, 1);
-  if (!module->IsLive(static_cast<int>(h)))
+  if (h < 0 || h > INT_MAX || !module->IsLive(static_cast<int>(h)))  // (g + 2^32 is not g)
     throw Error("no IK group with handle " + std::to_string(h) +
                 " (it was removed with its model, or never existed)");
   if (c.instance >= 0 && module->instance_of(static_cast<int>(h)) != c.instance)

@@ -3,6 +3,7 @@
 // Poses are read from the scene as it was at the start of the control
 // phase (nothing moves objects during it), so any robot may read any object.
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "framework/error.h"
@@ -136,6 +137,18 @@ int SetObjectPoseOrPosition(lua_State* L, bool position_only) {
     const Quat q = Quat{v[6], v[3], v[4], v[5]}.Normalized();
     X_WO = X_WR * Pose{{v[0], v[1], v[2]}, q};
   }
+  // The physics engines work in single precision (Box2D) or abort on huge
+  // coordinates (ODE): keep to the extent a world file may use.
+  constexpr double kMaxCoordinate = 1e6;  // m, as the loader's
+  if (!(std::abs(X_WO.p.x) <= kMaxCoordinate && std::abs(X_WO.p.y) <= kMaxCoordinate &&
+        std::abs(X_WO.p.z) <= kMaxCoordinate)) {
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  "the position (%g, %g, %g) is beyond +-1e6 m, the largest coordinate a world "
+                  "may use",
+                  X_WO.p.x, X_WO.p.y, X_WO.p.z);
+    throw Error(text);
+  }
   DeferredWrite w{id, DeferredWrite::Kind::kObjectPose, 0};
   w.pose = X_WO;
   c.runtime->deferred.push_back(w);
@@ -162,8 +175,8 @@ int SetObjectSizeFactor(lua_State* L) {
   const ObjectId id = CheckObject(L, 1);
   c.scene->SlotOf(id);
   const double f = ArgNumber(L, 2);
-  if (!std::isfinite(f) || !(f > 0) || f > 1e3)
-    throw Error("the size factor must be a finite number above 0 and at most 1000");
+  if (!(f >= 1e-3 && f <= 1e3))  // (NaN fails too)
+    throw Error("the size factor must be a number from 0.001 to 1000");
   if (c.instance >= 0 && c.scene->instance_of(id) != c.instance)
     throw Error("object '" + c.scene->PathOf(id) +
                 "' belongs to another robot or the scene; a robot's scripts can rescale only "

@@ -712,7 +712,7 @@ void WorldLoader::ResolveEntry(EntryPlan* entry) {
   entry->footprint = loader::ComputeFootprint(entry->spec);
   if (f.Has("scale")) {
     // Every length of the model scales, so its footprint does too.
-    static constexpr loader::NumberRule kScale{"a positive number", 0, 1e3, true};
+    static constexpr loader::NumberRule kScale{"a number from 0.001 to 1000", 1e-3, 1e3};
     entry->scale = world_values.Number(f.Get("scale"), kScale);
     entry->footprint.radius *= entry->scale;
     entry->footprint.bottom *= entry->scale;

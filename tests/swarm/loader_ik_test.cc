@@ -114,6 +114,19 @@ TEST_F(LoaderIkTest, ScriptsHandleTheirOwnGroupExplicitly) {
   EXPECT_EQ(log_, "[arm#0] 0\t1\t1\n");
 }
 
+// A handle is not taken modulo 2^32: g + 2^32 is no group.
+TEST_F(LoaderIkTest, HandlesBeyondTheIntRangeAreNoGroup) {
+  LoadedWorld loaded =
+      Load("  - {name: reach, tips: [{tip: j1/j2/tip, target: target}], automatic: false}\n",
+           "function sysCall_actuation()\n"
+           "  print(pcall(sim.handleIkGroup, sim.getIkGroup('reach') + (1 << 32)))\n"
+           "end\n",
+           1);
+  loaded.world->Step();
+  EXPECT_NE(log_.find("[arm#0] false\t"), std::string::npos) << log_;
+  EXPECT_NE(log_.find("no IK group with handle 42949672"), std::string::npos) << log_;
+}
+
 TEST_F(LoaderIkTest, MistakesNameTheLineAndTheNearestName) {
   const std::string bad_path =
       ErrorOf("  - {name: reach, tips: [{tip: j1/j2/tpi, target: target}]}\n");

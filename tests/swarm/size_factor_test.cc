@@ -196,6 +196,33 @@ TEST_F(SizeFactorTest, RobotsCannotRescaleOtherRobots) {
   }
 }
 
+// What a script may ask of the engines: size factors from 0.001 to 1000
+// and positions within +-1e6 m (beyond, ODE aborted and Box2D asserted).
+TEST_F(SizeFactorTest, ScriptsCannotRescaleOrMoveBeyondWhatTheEnginesHandle) {
+  Write("mover.yaml",
+        "model: mover\n"
+        "objects: {name: body, type: shape, shape: cylinder, radius: 0.1, height: 0.1, "
+        "dynamic: true, mass: 1, script: mover.lua}\n");
+  for (const char* call : {"sim.setObjectSizeFactor(sim.getObject('.'), 1e-300)",
+                           "sim.setObjectSizeFactor(sim.getObject('.'), 0/0)",
+                           "sim.setObjectPosition(sim.getObject('.'), {1e9, 0, 0.1})",
+                           "sim.setObjectPose(sim.getObject('.'), {0, 0, -3e38, 0, 0, 0, 1})"}) {
+    Write("mover.lua", std::string("function sysCall_actuation()\n  ") + call + "\nend\n");
+    LoadedWorld loaded = Load(
+        "simulation: {physics: ode}\n"
+        "models:\n  - {model: mover.yaml, position: [0, 0]}\n");
+    try {
+      loaded.world->Step();
+      ADD_FAILURE() << "expected an error for " << call;
+    } catch (const Error& e) {
+      EXPECT_CONTAINS(e.what(), "mover.lua:2:");
+      EXPECT_TRUE(std::string(e.what()).find("from 0.001 to 1000") != std::string::npos ||
+                  std::string(e.what()).find("beyond +-1e6 m") != std::string::npos)
+          << e.what();
+    }
+  }
+}
+
 TEST_F(SizeFactorTest, ScaledWorldHashIsIndependentOfThreadCount) {
   const std::string world =
       "simulation: {physics: box2d, time_step: 0.1, physics_substeps: 10, seed: 3}\n"
