@@ -142,10 +142,18 @@ void Compact(lua_State* L, const char* name, std::initializer_list<const char*> 
   lua_settop(L, old - 1);
 }
 
+// Replaces the global `name` with `wrapper`, which gets the original as its
+// upvalue 1; WrapField does the same for field `name` of the table at `table`.
 void Wrap(lua_State* L, const char* name, lua_CFunction wrapper) {
   lua_getglobal(L, name);
   lua_pushcclosure(L, wrapper, 1);
   lua_setglobal(L, name);
+}
+void WrapField(lua_State* L, int table, const char* name, lua_CFunction wrapper) {
+  table = lua_absindex(L, table);
+  lua_getfield(L, table, name);
+  lua_pushcclosure(L, wrapper, 1);
+  lua_setfield(L, table, name);
 }
 
 namespace fs = std::filesystem;
@@ -382,16 +390,12 @@ int SandboxGlobalIndex(lua_State* L) {
   if (key == "io") {
     luaL_requiref(L, LUA_IOLIBNAME, luaopen_io, 0);
     NewRestrictedTable(L, "io", 4);
-    lua_getfield(L, -2, "open");
-    lua_pushcclosure(L, Guarded<OpenFile<false>, "io.open">, 1);
-    lua_setfield(L, -2, "open");
-    lua_getfield(L, -2, "lines");
-    lua_pushcclosure(L, Guarded<LinesOfFile<false>, "io.lines">, 1);
-    lua_setfield(L, -2, "lines");
-    for (const char* kept : {"type", "close"}) {
+    for (const char* kept : {"open", "lines", "type", "close"}) {
       lua_getfield(L, -2, kept);
       lua_setfield(L, -2, kept);
     }
+    WrapField(L, -1, "open", Guarded<OpenFile<false>, "io.open">);
+    WrapField(L, -1, "lines", Guarded<LinesOfFile<false>, "io.lines">);
     // Files are finalized by their metatable's __gc: a script must not reach
     // it (getmetatable(f).__gc = <a loop>) to replace it.
     luaL_getmetatable(L, LUA_FILEHANDLE);
@@ -441,12 +445,8 @@ void OpenTrusted(lua_State* L) {
   lua_setfield(L, -2, "path");
   lua_pop(L, 1);
   lua_getglobal(L, LUA_IOLIBNAME);
-  lua_getfield(L, -1, "open");
-  lua_pushcclosure(L, Guarded<OpenFile<true>, "io.open">, 1);
-  lua_setfield(L, -2, "open");
-  lua_getfield(L, -1, "lines");
-  lua_pushcclosure(L, Guarded<LinesOfFile<true>, "io.lines">, 1);
-  lua_setfield(L, -2, "lines");
+  WrapField(L, -1, "open", Guarded<OpenFile<true>, "io.open">);
+  WrapField(L, -1, "lines", Guarded<LinesOfFile<true>, "io.lines">);
   lua_pop(L, 1);
 }
 
@@ -507,9 +507,7 @@ void OpenSafeLibraries(lua_State* L) {
   // 35 entries need a 64-slot table where 28 fit in 32 (~0.5 KB per robot).
   Compact(L, LUA_MATHLIBNAME, {"cosh", "sinh", "tanh", "pow", "frexp", "ldexp", "log10"});
   lua_getglobal(L, LUA_MATHLIBNAME);
-  lua_getfield(L, -1, "randomseed");
-  lua_pushcclosure(L, (Guarded<SafeRandomSeed, "math.randomseed">), 1);
-  lua_setfield(L, -2, "randomseed");
+  WrapField(L, -1, "randomseed", Guarded<SafeRandomSeed, "math.randomseed">);
   lua_pop(L, 1);
 }
 

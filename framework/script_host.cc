@@ -159,17 +159,20 @@ int ThrowOnPanic(lua_State* L) {
 }
 
 // The text of the error value on top of the stack.
-std::string MemoryLimitText(const LuaMemory& memory) {
-  return "the scripts hold more than " + std::to_string(memory.limit >> 20) +
+// "4 MiB of Lua memory (simulation.script_memory_mb; ...)", the end of both
+// memory-limit messages.
+std::string MemoryLimitTail(const LuaMemory& memory) {
+  return std::to_string(memory.limit >> 20) +
          " MiB of Lua memory (simulation.script_memory_mb; raise it if the data is real)";
+}
+std::string MemoryLimitText(const LuaMemory& memory) {
+  return "the scripts hold more than " + MemoryLimitTail(memory);
 }
 std::string ErrorText(lua_State* L, int status) {
   if (status == LUA_ERRMEM) {
     const auto* state = static_cast<const ScriptState*>(Context(L).host_state);
     if (state != nullptr && state->memory.refused)
-      return "an allocation would take the scripts past " +
-             std::to_string(state->memory.limit >> 20) +
-             " MiB of Lua memory (simulation.script_memory_mb; raise it if the data is real)";
+      return "an allocation would take the scripts past " + MemoryLimitTail(state->memory);
     return "not enough memory";
   }
   if (status != LUA_ERRRUN && status != LUA_ERRSYNTAX && status != LUA_ERRERR)
