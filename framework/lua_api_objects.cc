@@ -137,9 +137,7 @@ int SetObjectPoseOrPosition(lua_State* L, bool position_only) {
     const Quat q = Quat{v[6], v[3], v[4], v[5]}.Normalized();
     X_WO = X_WR * Pose{{v[0], v[1], v[2]}, q};
   }
-  // The physics engines work in single precision (Box2D) or abort on huge
-  // coordinates (ODE): keep to the extent a world file may use.
-  constexpr double kMaxCoordinate = 1e6;  // m, as the loader's
+  // Within what a world file may use (the engines cannot take much more).
   if (!(std::abs(X_WO.p.x) <= kMaxCoordinate && std::abs(X_WO.p.y) <= kMaxCoordinate &&
         std::abs(X_WO.p.z) <= kMaxCoordinate)) {
     char text[160];

@@ -12,6 +12,11 @@
 
 namespace swarmsim {
 
+// Largest length or coordinate a world may use, m (world files, scripts'
+// moves): keeps geometry and grids far from overflow, and within what the
+// physics engines handle (Box2D works in float; ODE aborts on huge AABBs).
+inline constexpr double kMaxCoordinate = 1e6;
+
 struct Vec3 {  // 24 bytes
   double x = 0, y = 0, z = 0;
 

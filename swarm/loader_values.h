@@ -70,9 +70,8 @@ struct NumberRule {
   double max;
   bool min_exclusive = false;
 };
-// Largest length or coordinate accepted, m: keeps geometry (and placement
-// grids) far from overflow.
-inline constexpr double kMaxLength = 1e6;
+// Largest length or coordinate accepted, m (framework/math.h).
+inline constexpr double kMaxLength = kMaxCoordinate;
 inline constexpr NumberRule kAnyNumber{"a number", -1e300, 1e300};
 inline constexpr NumberRule kCoordinate{"a number of metres", -kMaxLength, kMaxLength};
 inline constexpr NumberRule kPositiveLength{"a positive number", 0, kMaxLength, true};
