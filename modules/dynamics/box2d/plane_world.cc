@@ -115,22 +115,19 @@ void SetSkinnedBox(double hx, double hy, const b2Vec2& center, double angle, b2P
   out->SetAsBox(static_cast<float>(hx), static_cast<float>(hy), center, static_cast<float>(angle));
 }
 
-// A mesh in the plane: the convex hull of its vertices projected by X (mesh
-// frame -> plane frame, metres), in Box2D units, as convex polygons of at
-// most b2_maxPolygonVertices (a fan cut of the hull: exact, not simplified).
-// No skin correction: the collision surface is the hull grown by
-// b2_polygonRadius. False when the hull has no area.
-bool MeshPolygons(const TriangleMesh& mesh, const Pose& X, double L,
-                  std::vector<b2PolygonShape>* out) {
-  struct P {
-    double x, y;
-  };
-  std::vector<P> points;
-  points.reserve(mesh.vertices().size());
-  for (const Vec3& v : mesh.vertices()) {
-    const Vec3 p = X * v;
-    points.push_back({p.x * L, p.y * L});
-  }
+// A point in the plane, Box2D units.
+struct PlanePoint {
+  double x, y;
+};
+
+// The convex hull of `points` as convex polygons of at most
+// b2_maxPolygonVertices (a fan cut of the hull: exact, not simplified), with
+// the vertices Box2D would weld dropped first, so that b2PolygonShape::Set
+// never sees a collapsed hull (it asserts). No skin correction: the
+// collision surface is the hull grown by b2_polygonRadius. False when the
+// hull has no area.
+bool HullPolygons(std::vector<PlanePoint> points, std::vector<b2PolygonShape>* out) {
+  using P = PlanePoint;
   std::sort(points.begin(), points.end(),
             [](const P& a, const P& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
   // Andrew's monotone chain, counter-clockwise, collinear points dropped.
@@ -171,6 +168,19 @@ bool MeshPolygons(const TriangleMesh& mesh, const Pose& X, double L,
     out->back().Set(piece, count);
   }
   return true;
+}
+
+// A mesh in the plane: the hull of its vertices projected by X (mesh frame
+// -> plane frame, metres), L units per metre (HullPolygons).
+bool MeshPolygons(const TriangleMesh& mesh, const Pose& X, double L,
+                  std::vector<b2PolygonShape>* out) {
+  std::vector<PlanePoint> points;
+  points.reserve(mesh.vertices().size());
+  for (const Vec3& v : mesh.vertices()) {
+    const Vec3 p = X * v;
+    points.push_back({p.x * L, p.y * L});
+  }
+  return HullPolygons(std::move(points), out);
 }
 
 std::string PathAt(const Scene& scene, uint32_t slot) { return scene.PathOf(scene.IdAt(slot)); }
@@ -338,14 +348,17 @@ void PlaneWorld::Build(const Scene& scene) {
         shape->kind == ShapeKind::kSphere ||
         ((shape->kind == ShapeKind::kCylinder || shape->kind == ShapeKind::kCapsule) &&
          IsUpright(X_WS));
-    if (shape->kind == ShapeKind::kMesh) {
-      // The hull of the vertices projected to the plane, in pieces.
-      std::vector<b2PolygonShape> pieces;
-      if (!shape->mesh || !MeshPolygons(*shape->mesh, X_WS, L, &pieces)) continue;
+    // A mesh, or a tilted box or lying cylinder: the hull of the points
+    // projected to the plane, in pieces (none: no area seen from above).
+    std::vector<b2PolygonShape> pieces;
+    const auto add_pieces = [&] {
       for (const b2PolygonShape& piece : pieces) {
         fixture.shape = &piece;
         ground_->CreateFixture(&fixture);
       }
+    };
+    if (shape->kind == ShapeKind::kMesh) {
+      if (shape->mesh && MeshPolygons(*shape->mesh, X_WS, L, &pieces)) add_pieces();
       continue;
     }
     if (round) {
@@ -362,21 +375,17 @@ void PlaneWorld::Build(const Scene& scene) {
       if (IsUpright(X_WS)) {
         SetSkinnedBox(0.5 * size.x * L, 0.5 * size.y * L, center, X_WS.q.Yaw(), &polygon);
       } else {
-        // Tilted: the convex hull of the eight projected corners (no skin
-        // correction). Skip a footprint with no area (a vertical sheet seen edge on).
-        const Vec3 ax = X_WS.q.Rotate({1, 0, 0}), ay = X_WS.q.Rotate({0, 1, 0}),
-                   az = X_WS.q.Rotate({0, 0, 1});
-        const double area = size.y * size.z * std::abs(ax.z) + size.x * size.z * std::abs(ay.z) +
-                            size.x * size.y * std::abs(az.z);
-        if (area * L * L < 4 * b2_linearSlop * b2_linearSlop) continue;
-        b2Vec2 corners[8];
+        // Tilted: the hull of the eight projected corners (a vertical sheet
+        // seen edge on has none and is skipped).
+        std::vector<PlanePoint> corners;
         for (int i = 0; i < 8; ++i) {
           const Vec3 p_SC{(i & 1 ? 0.5 : -0.5) * size.x, (i & 2 ? 0.5 : -0.5) * size.y,
                           (i & 4 ? 0.5 : -0.5) * size.z};
           const Vec3 p_WC = X_WS * p_SC;
-          corners[i].Set(static_cast<float>(p_WC.x * L), static_cast<float>(p_WC.y * L));
+          corners.push_back({p_WC.x * L, p_WC.y * L});
         }
-        polygon.Set(corners, 8);
+        if (HullPolygons(std::move(corners), &pieces)) add_pieces();
+        continue;
       }
       fixture.shape = &polygon;
     }
