@@ -23,6 +23,7 @@ extern char** environ;
 namespace {
 
 namespace fs = std::filesystem;
+using swarmsim::testing::ProbeWorld;
 using swarmsim::testing::RunProgram;
 
 std::string Data(const std::string& name) { return swarmsim::testing::CliData(name); }
@@ -162,23 +163,14 @@ TEST(RunOutputsTest, TerminatedRunKeepsItsOutputsAndSaysSo) {
 // match backtracking over 300,000 characters: hours). It writes 'stuck' to
 // the run's folder first.
 fs::path StuckWorld(const std::string& name, const std::string& step_timeout) {
-  const fs::path dir = TempDir(name);
-  fs::create_directories(dir);
-  std::ofstream(dir / "world.yaml") << "simulation: {physics: kinematic, time_step: 0.1, "
-                                       "step_timeout: "
-                                    << step_timeout
-                                    << "}\n"
-                                       "models:\n  - {model: probe.yaml, position: [0, 0]}\n";
-  std::ofstream(dir / "probe.yaml") << "model: probe\n"
-                                       "objects: {name: body, type: dummy, script: probe.lua}\n";
-  std::ofstream(dir / "probe.lua") << "function sysCall_actuation()\n"
-                                      "  sim.recordMetric('t', sim.getSimulationTime())\n"
-                                      "  if sim.getSimulationTime() > 0.25 then\n"
-                                      "    io.open('stuck', 'w'):close()\n"
-                                      "    return string.rep('a', 300000):find('.-.-b')\n"
-                                      "  end\n"
-                                      "end\n";
-  return dir;
+  return ProbeWorld("swarmsim_outputs", name, "step_timeout: " + step_timeout,
+                    "function sysCall_actuation()\n"
+                    "  sim.recordMetric('t', sim.getSimulationTime())\n"
+                    "  if sim.getSimulationTime() > 0.25 then\n"
+                    "    io.open('stuck', 'w'):close()\n"
+                    "    return string.rep('a', 300000):find('.-.-b')\n"
+                    "  end\n"
+                    "end\n");
 }
 
 // The watchdog: a step stuck past simulation.step_timeout ends the run with
@@ -228,16 +220,11 @@ TEST(RunOutputsTest, StopSignalEndsAStuckStep) {
 
 // A run ended by a script error still reports the Lua memory its scripts held.
 TEST(RunOutputsTest, FailedRunReportsItsLuaMemory) {
-  const fs::path dir = TempDir("failed_memory");
-  fs::create_directories(dir);
-  std::ofstream(dir / "world.yaml") << "simulation: {physics: kinematic, time_step: 0.1}\n"
-                                       "models:\n  - {model: probe.yaml, position: [0, 0]}\n";
-  std::ofstream(dir / "probe.yaml") << "model: probe\n"
-                                       "objects: {name: body, type: dummy, script: probe.lua}\n";
-  std::ofstream(dir / "probe.lua") << "big = string.rep('x', 100000)\n"
-                                      "function sysCall_actuation()\n"
-                                      "  if sim.getSimulationTime() > 0.15 then error('boom') end\n"
-                                      "end\n";
+  const fs::path dir = ProbeWorld("swarmsim_outputs", "failed_memory", "",
+                                  "big = string.rep('x', 100000)\n"
+                                  "function sysCall_actuation()\n"
+                                  "  if sim.getSimulationTime() > 0.15 then error('boom') end\n"
+                                  "end\n");
   const auto r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 5 --quiet --out " +
                             (dir / "out").string());
   EXPECT_EQ(r.exit_code, 1) << r.output;
@@ -250,14 +237,9 @@ TEST(RunOutputsTest, FailedRunReportsItsLuaMemory) {
 // With no instruction budget a plain endless loop is stopped by the watchdog
 // too, and the message says why nothing stopped it sooner.
 TEST(RunOutputsTest, StuckStepWithoutABudgetSaysTheBudgetIsOff) {
-  const fs::path dir = TempDir("no_budget");
-  fs::create_directories(dir);
-  std::ofstream(dir / "world.yaml") << "simulation: {physics: kinematic, time_step: 0.1, "
-                                       "instruction_budget: 0, step_timeout: 1}\n"
-                                       "models:\n  - {model: probe.yaml, position: [0, 0]}\n";
-  std::ofstream(dir / "probe.yaml") << "model: probe\n"
-                                       "objects: {name: body, type: dummy, script: probe.lua}\n";
-  std::ofstream(dir / "probe.lua") << "function sysCall_actuation() while true do end end\n";
+  const fs::path dir =
+      ProbeWorld("swarmsim_outputs", "no_budget", "instruction_budget: 0, step_timeout: 1",
+                 "function sysCall_actuation() while true do end end\n");
   const auto r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 5 --quiet");
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_NE(r.output.find("step 1 of 5 did not finish within 1 s"), std::string::npos) << r.output;

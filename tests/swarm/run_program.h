@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 namespace swarmsim::testing {
@@ -44,6 +45,22 @@ inline std::filesystem::path FreshTempDir(const std::string& prefix, const std::
   const std::filesystem::path dir = std::filesystem::temp_directory_path() /
                                     (prefix + "_" + name + "_" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);
+  return dir;
+}
+
+// A world folder (FreshTempDir(prefix, name)) of one robot, probe#0 (a dummy
+// at the origin), running `code` as probe.lua; `settings` go into the
+// world's simulation map after the kinematic physics and 0.1 s time step.
+inline std::filesystem::path ProbeWorld(const std::string& prefix, const std::string& name,
+                                        const std::string& settings, const std::string& code) {
+  const std::filesystem::path dir = FreshTempDir(prefix, name);
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "world.yaml") << "simulation: {physics: kinematic, time_step: 0.1"
+                                    << (settings.empty() ? "" : ", " + settings)
+                                    << "}\nmodels:\n  - {model: probe.yaml, position: [0, 0]}\n";
+  std::ofstream(dir / "probe.yaml") << "model: probe\n"
+                                       "objects: {name: body, type: dummy, script: probe.lua}\n";
+  std::ofstream(dir / "probe.lua") << code;
   return dir;
 }
 

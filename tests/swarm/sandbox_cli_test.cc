@@ -23,15 +23,8 @@ using swarmsim::testing::RunProgram;
 
 // A world folder whose one robot runs `code` in sysCall_init (line 2).
 fs::path MakeWorld(const std::string& code) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("swarmsim_sandbox_cli_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  std::ofstream(dir / "world.yaml") << "simulation: {physics: kinematic, time_step: 0.1}\n"
-                                       "models:\n  - {model: probe.yaml, position: [0, 0]}\n";
-  std::ofstream(dir / "probe.yaml") << "model: probe\n"
-                                       "objects: {name: body, type: dummy, script: probe.lua}\n";
-  std::ofstream(dir / "probe.lua") << "function sysCall_init()\n  " << code << "\nend\n";
+  const fs::path dir = swarmsim::testing::ProbeWorld(
+      "swarmsim_sandbox_cli", "probe", "", "function sysCall_init()\n  " + code + "\nend\n");
   std::ofstream(dir / "data.txt") << "42\n";
   return dir;
 }
