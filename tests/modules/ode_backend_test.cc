@@ -8,6 +8,7 @@
 #include <memory>
 #include <string>
 
+#include "framework/error.h"
 #include "framework/registry.h"
 #include "framework/scene.h"
 #include "framework/world.h"
@@ -65,6 +66,23 @@ TEST(OdeBackend, RegistersAsOdeAndKinematic) {
   RegisterBuiltinModules(&registry);
   EXPECT_TRUE(registry.HasDynamics("ode"));
   EXPECT_TRUE(registry.HasDynamics("kinematic"));
+}
+
+// An internal assertion of ODE (here: a body moved to 1e9 m, past what its
+// collision space hashes) ends the step with an error instead of aborting
+// the process.
+TEST(OdeBackend, InternalAssertionIsAnErrorNotAnAbort) {
+  Fixture f;
+  const ObjectId ball = f.scene().AddShape("ball", {}, {{0, 0, 1}, {}}, Sphere(0.1, true));
+  f.scene().AddShape("floor", {}, {{0, 0, -0.5}, {}}, Box({4, 4, 1}, false));
+  f.world->Step();
+  f.scene().SetWorldPose(ball, {{1e9, 0, 1}, {}});
+  try {
+    f.world->Step();
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("ode: internal error"), std::string::npos) << e.what();
+  }
 }
 
 TEST(OdeBackend, DroppedSphereLandsAtFreeFallTime) {

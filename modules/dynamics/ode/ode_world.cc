@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdarg>
 #include <cstdint>
+#include <cstdio>
 #include <mutex>
 #include <span>
 #include <string>
@@ -20,9 +22,25 @@ constexpr double kBounceVelocity = 0.1;
 // Position servo: motor velocity = kServoGain * error / dt (clamped).
 constexpr double kServoGain = 0.5;
 
+// ODE's error and debug handlers: ODE calls them on an internal assertion
+// (huge or degenerate geometry) and aborts the process if they return. Ours
+// throws instead, so the run ends with an error and its outputs written;
+// the unwinding leaves that ODE world unusable, and the World stops after
+// any physics error anyway.
+[[noreturn]] void ThrowOdeError(int number, const char* message, va_list arguments) {
+  char text[512];
+  std::vsnprintf(text, sizeof text, message, arguments);
+  throw Error("ode: internal error " + std::to_string(number) + ": " + text +
+              " (the physics cannot go on; an object moved or grew to extreme values?)");
+}
+
 void InitOdeOnce() {
   static std::once_flag once;
-  std::call_once(once, [] { dInitODE2(0); });
+  std::call_once(once, [] {
+    dInitODE2(0);
+    dSetErrorHandler(ThrowOdeError);
+    dSetDebugHandler(ThrowOdeError);
+  });
 }
 
 std::string PathAt(const Scene& scene, uint32_t slot) { return scene.PathOf(scene.IdAt(slot)); }
@@ -140,6 +158,16 @@ OdeWorld::OdeWorld(const Options& options, const DynamicsSettings& settings)
 OdeWorld::~OdeWorld() { Clear(); }
 
 void OdeWorld::Clear() {
+  if (broken_) {
+    // Unwound out of an ODE call: its space may still be locked and its
+    // destructors would assert again. The process ends with the run; leak.
+    contacts_ = nullptr;
+    space_ = nullptr;
+    world_ = nullptr;
+    threading_ = nullptr;
+    meshes_.clear();  // (their trimesh data leaks with the geoms)
+    broken_ = false;
+  }
   if (contacts_) dJointGroupDestroy(contacts_);
   if (space_) dSpaceDestroy(space_);  // destroys its geoms
   if (world_) {
@@ -452,6 +480,15 @@ void OdeWorld::TrackJointPositions() {
 }
 
 void OdeWorld::Substep(double dt, double fraction) {
+  try {
+    StepOnce(dt, fraction);
+  } catch (...) {
+    broken_ = true;  // ODE was left mid-call (ThrowOdeError): Clear leaks it
+    throw;
+  }
+}
+
+void OdeWorld::StepOnce(double dt, double fraction) {
   step_dt_ = dt;
   for (KinematicBody& k : kinematic_) {
     SetBodyPose(k.body, Interpolate(k.X_WB_from, k.X_WB_to, fraction));

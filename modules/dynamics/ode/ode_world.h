@@ -88,6 +88,7 @@ class OdeWorld {
 
  private:
   void Clear();
+  void StepOnce(double dt, double fraction);  // Substep's work
   // Fixed joints with feedback for the scene's force sensors (ode_force_sensors.cc).
   void BuildForceSensors(const Scene& scene, const std::vector<dBodyID>& body_of);
   // Samples each sensor's joint feedback and breaks links over their threshold.
@@ -119,7 +120,8 @@ class OdeWorld {
   std::vector<std::vector<MeshTriangle>> single_triangle_meshes_;
   // Joint commands, read once per control step (rows of joints_).
   std::vector<JointData> commands_;
-  double step_dt_ = 0;  // substep length, for the servo
+  double step_dt_ = 0;   // substep length, for the servo
+  bool broken_ = false;  // an ODE call was unwound by an error (Substep)
 };
 
 }  // namespace swarmsim::ode
