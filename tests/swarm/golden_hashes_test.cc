@@ -1,0 +1,78 @@
+// Results do not move by accident: every example world's state hash after a
+// fixed number of steps, for two seeds and 1 and 2 threads, equals the one
+// checked in (tests/data/golden_hashes.tsv). A change that means to move
+// results rewrites the table with tools/golden_hashes.sh and says why in its
+// commit.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "tests/swarm/run_program.h"
+
+namespace swarmsim {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::RunProgram;
+
+struct GoldenRow {
+  std::string world;
+  std::string seed, steps, threads, hash;
+};
+
+std::vector<GoldenRow> ReadTable() {
+  std::ifstream in(std::string(SWARMSIM_SOURCE_DIR) + "/tests/data/golden_hashes.tsv");
+  std::vector<GoldenRow> rows;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream fields(line);
+    GoldenRow row;
+    std::getline(fields, row.world, '\t');
+    std::getline(fields, row.seed, '\t');
+    std::getline(fields, row.steps, '\t');
+    std::getline(fields, row.threads, '\t');
+    std::getline(fields, row.hash, '\t');
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+TEST(GoldenHashesTest, EveryExampleWorldHasItsCheckedInHash) {
+  const std::vector<GoldenRow> rows = ReadTable();
+  ASSERT_GE(rows.size(), 40u) << "tests/data/golden_hashes.tsv is missing or short";
+  for (const GoldenRow& row : rows) {
+    const auto r = RunProgram("run " + std::string(SWARMSIM_SOURCE_DIR) + "/" + row.world +
+                              " --seed " + row.seed + " --steps " + row.steps + " --threads " +
+                              row.threads + " --hash --quiet");
+    const std::string expected = "state-hash: " + row.hash;
+    EXPECT_NE(r.output.find(expected), std::string::npos)
+        << row.world << " --seed " << row.seed << " --steps " << row.steps << " --threads "
+        << row.threads << ": the state hash moved (expected " << row.hash << ", got\n"
+        << r.output
+        << ").\nIf the change of results is intended, run tools/golden_hashes.sh and say why in "
+           "the commit.";
+  }
+}
+
+// A new example world cannot skip the table.
+TEST(GoldenHashesTest, TheTableCoversEveryExampleWorld) {
+  std::set<std::string> listed;
+  for (const GoldenRow& row : ReadTable()) listed.insert(row.world);
+  for (const char* folder : {"worlds", "bench/worlds"}) {
+    for (const auto& entry : fs::directory_iterator(fs::path(SWARMSIM_SOURCE_DIR) / folder)) {
+      if (entry.path().extension() != ".yaml") continue;
+      const std::string world = std::string(folder) + "/" + entry.path().filename().string();
+      EXPECT_TRUE(listed.contains(world))
+          << world << " has no row in tests/data/golden_hashes.tsv: run tools/golden_hashes.sh";
+    }
+  }
+}
+
+}  // namespace
+}  // namespace swarmsim

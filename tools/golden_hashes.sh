@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Writes tests/data/golden_hashes.tsv: the state hash of every example world
+# (worlds/*.yaml, bench/worlds/*.yaml) after a fixed number of steps, for two
+# seeds and 1 and 2 threads, as `swarmsim run WORLD --hash` prints it.
+# tests/swarm/golden_hashes_test.cc fails when any of them drifts.
+#
+# Run it only when a change of results is intended, and say why in the
+# commit:   tools/golden_hashes.sh [BUILD_DIR]      (default: build)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+program="${1:-build}/swarmsim"
+[ -x "$program" ] || { echo "golden_hashes: no program at $program (build first)" >&2; exit 2; }
+steps=200
+table=tests/data/golden_hashes.tsv
+tmp=$(mktemp)
+trap 'rm -f "$tmp"' EXIT
+printf '# world\tseed\tsteps\tthreads\tstate_hash   (written by tools/golden_hashes.sh)\n' >"$tmp"
+for world in worlds/*.yaml bench/worlds/*.yaml; do
+  for seed in 1 7; do
+    for threads in 1 2; do
+      line=$("$program" run "$world" --seed "$seed" --steps "$steps" --threads "$threads" \
+               --hash --quiet 2>&1 | grep '^state-hash: ') ||
+        { echo "golden_hashes: $world --seed $seed failed" >&2; exit 1; }
+      printf '%s\t%s\t%s\t%s\t%s\n' "$world" "$seed" "$steps" "$threads" "${line#state-hash: }" >>"$tmp"
+    done
+  done
+done
+mv "$tmp" "$table"
+trap - EXIT
+echo "wrote $table ($(grep -vc '^#' "$table") rows)"
