@@ -84,9 +84,9 @@ std::vector<IkGroupDef> ReadIkGroups(const ModelFile& model, const ValueReader& 
     if (f.Has("weights")) {
       Fields w(model.file, f.Get("weights"), "the weights of IK group '" + s.name + "'");
       for (const Field& joint : w.fields()) {
-        Field path = joint;
-        path.node = YAML::Node(joint.name);
-        path.mark = joint.key_mark;
+        // A new Field for the key: assigning to a copy's node would write
+        // the path over the weight in the parsed file (loader_yaml.h).
+        const Field path(joint.name, YAML::Node(joint.name), joint.key_mark, joint.key_mark);
         def.weights.emplace_back(path, values.Number(joint, kNonNegative));
       }
     }

@@ -127,6 +127,33 @@ TEST_F(LoaderIkTest, HandlesBeyondTheIntRangeAreNoGroup) {
   EXPECT_NE(log_.find("no IK group with handle 42949672"), std::string::npos) << log_;
 }
 
+// The README's `weights: {path: w}`, in flow and block form: weight 0
+// freezes j1, so only j2 moves; with no weights both do.
+TEST_F(LoaderIkTest, WeightsFromTheModelFileChangeTheSolution) {
+  const auto joints_after_a_step = [&](const std::string& weights) {
+    LoadedWorld loaded = Load(
+        "  - name: reach\n"
+        "    tips: [{tip: j1/j2/tip, target: target, constraints: [x, y]}]\n"
+        "    iterations: 20\n" +
+            weights,
+        "", 1);
+    loaded.world->Step();
+    const Scene& scene = loaded.world->scene();
+    const ObjectId root = scene.instance(0).root;
+    return std::pair(scene.joint(scene.FindObject("./j1", root)).position,
+                     scene.joint(scene.FindObject("./j1/j2", root)).position);
+  };
+  const auto [free1, free2] = joints_after_a_step("");
+  EXPECT_NE(free1, 0.0);
+  for (const std::string weights :
+       {"    weights: {j1: 0, j1/j2: 1}\n", "    weights:\n      j1: 0\n      j1/j2: 0.5\n"}) {
+    const auto [frozen1, moved2] = joints_after_a_step(weights);
+    EXPECT_EQ(frozen1, 0.0) << weights;
+    EXPECT_NE(moved2, 0.3) << weights;  // its initial position
+    EXPECT_NE(moved2, free2) << weights;
+  }
+}
+
 TEST_F(LoaderIkTest, MistakesNameTheLineAndTheNearestName) {
   const std::string bad_path =
       ErrorOf("  - {name: reach, tips: [{tip: j1/j2/tpi, target: target}]}\n");
