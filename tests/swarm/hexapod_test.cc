@@ -11,6 +11,7 @@
 #include "framework/world.h"
 #include "modules/builtin.h"
 #include "swarm/world_loader.h"
+#include "tests/swarm/run_program.h"
 
 namespace swarmsim {
 namespace {
@@ -69,6 +70,26 @@ TEST(HexapodTest, StateHashIsEqualAtOneAndTwoThreads) {
     hash[threads - 1] = loaded.world->StateHash();
   }
   EXPECT_EQ(hash[0], hash[1]);
+}
+
+}  // namespace
+}  // namespace swarmsim
+
+namespace swarmsim {
+namespace {
+
+// The README's scaling command: the paint layer's resolution follows the
+// arena (1 cm up to 40 m, then at most 4000 x 4000 pixels), so 10,000
+// hexapods load instead of asking for a 10,200 x 10,200 image.
+TEST(HexapodTest, TenThousandCopiesLoadWithAPaintLayerThatFits) {
+  const auto r = testing::RunProgram("describe " + std::string(SWARMSIM_SOURCE_DIR) +
+                                     "/worlds/hexapod.yaml --set robots=10000");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("paint_resolution = 0.0255\n"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("10000 copies"), std::string::npos) << r.output;
+  // One hexapod keeps its 1 cm.
+  LoadedWorld one = Load("hexapod.yaml", 1);
+  EXPECT_EQ(std::get<double>(one.world->parameters().at("paint_resolution")), 0.01);
 }
 
 }  // namespace

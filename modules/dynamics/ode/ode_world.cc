@@ -234,7 +234,15 @@ void OdeWorld::Build(const Scene& scene) {
   dWorldSetQuickStepNumIterations(world_, std::max(1, options_.iterations));
   dWorldSetContactSurfaceLayer(world_, 1e-4);
   dWorldSetContactMaxCorrectingVel(world_, 10);
-  space_ = dHashSpaceCreate(nullptr);
+  // ODE's hash space keeps an n x n bit table of the pairs it tested (n
+  // geoms): 12 MB cleared every substep at 10,000 geoms, and past ~46,000
+  // its int index overflows (an internal assertion). Large scenes use sweep
+  // and prune instead. The choice depends on the scene alone, never on the
+  // thread count; below the limit results are those of the hash space.
+  constexpr size_t kHashSpaceMaxGeoms = 8192;
+  space_ = scene.shapes().size() <= kHashSpaceMaxGeoms
+               ? dHashSpaceCreate(nullptr)
+               : dSweepAndPruneSpaceCreate(nullptr, dSAP_AXES_XYZ);
   contacts_ = dJointGroupCreate(0);
   if (options_.ground_plane) {
     AddGeom(dCreatePlane(space_, 0, 0, 1, 0), -1, options_.ground_friction, 0);
