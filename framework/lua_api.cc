@@ -173,6 +173,7 @@ int LazySimIndex(lua_State* L) {
 }  // namespace
 
 void RaiseError(lua_State*, const std::string& message) { throw LuaError(message); }
+void RaiseRefusal(lua_State*, const std::string& message) { throw LuaRefusal(message); }
 
 int CallProtected(lua_State* L, lua_CFunction f, const char* name) noexcept {
   // The message is built in a plain buffer: nothing with a destructor may be
@@ -184,11 +185,13 @@ int CallProtected(lua_State* L, lua_CFunction f, const char* name) noexcept {
     else
       std::snprintf(message, sizeof message, "%s", what);
   };
+  bool refused = false;
   try {
     return f(L);
   } catch (const LuaErrorOnStack&) {
     return -1;
   } catch (const LuaError& e) {
+    refused = dynamic_cast<const LuaRefusal*>(&e) != nullptr;
     format("", e.what());
   } catch (const std::exception& e) {
     format(name, e.what());
@@ -197,10 +200,16 @@ int CallProtected(lua_State* L, lua_CFunction f, const char* name) noexcept {
   }
   // Room for the message whatever `f` left on the stack (it is discarded).
   lua_settop(L, 0);
-  luaL_where(L, 1);
+  // Where the script called from: a refusal ends the callback, so it names
+  // the nearest Lua line even when a C function (pcall) made the call.
+  int level = 1;
+  lua_Debug ar;
+  if (refused)
+    while (lua_getstack(L, level, &ar) && lua_getinfo(L, "l", &ar) && ar.currentline <= 0) ++level;
+  luaL_where(L, level);
   lua_pushstring(L, message);
   lua_concat(L, 2);
-  return -1;
+  return refused ? kRefused : -1;
 }
 
 namespace {

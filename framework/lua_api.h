@@ -83,12 +83,29 @@ struct LuaError : std::runtime_error {
 // the stack (from a lua_pcall of user code): raised as it is.
 struct LuaErrorOnStack {};
 
+// Thrown by guarded functions for what the sandbox refuses: like LuaError,
+// but it ends the running callback (FailCallback), so pcall cannot turn a
+// refusal into a silently missing file or command.
+struct LuaRefusal : LuaError {
+  using LuaError::LuaError;
+};
+
 // Throws LuaError(message); only inside a guarded function.
 [[noreturn]] void RaiseError(lua_State* L, const std::string& message);
+// Throws LuaRefusal(message); only inside a guarded function.
+[[noreturn]] void RaiseRefusal(lua_State* L, const std::string& message);
+
+// Ends the running callback with the error message on top of L's stack, the
+// way a spent instruction budget does: every further instruction raises
+// again, so pcall and xpcall cannot swallow it, and the host reports the
+// message (script_host.cc).
+[[noreturn]] void FailCallback(lua_State* L);
 
 // Runs `f`; if it throws, leaves the error value on the stack and returns -1
 // (a std::exception becomes "file:line: name: what", with no prefix for an
-// empty name or a LuaError). Out of line: the C++ handlers live in one place.
+// empty name or a LuaError), or kRefused for a LuaRefusal. Out of line: the
+// C++ handlers live in one place.
+constexpr int kRefused = -2;
 int CallProtected(lua_State* L, lua_CFunction f, const char* name) noexcept;
 
 // A function name as a template argument: Guarded<F, "sim.getObject">.
@@ -105,6 +122,7 @@ struct FunctionName {
 template <lua_CFunction F, FunctionName kName>
 int Guarded(lua_State* L) {
   const int results = CallProtected(L, F, kName.text);
+  if (results == kRefused) FailCallback(L);
   return results >= 0 ? results : lua_error(L);
 }
 

@@ -95,7 +95,7 @@ int Print(lua_State* L) {
     if (i > 1) line += '\t';
     line.append(text, length);
   }
-  c.runtime->log.push_back(std::move(line));
+  c.runtime->log.Add(std::move(line));
   return 0;
 }
 

@@ -29,6 +29,7 @@
 #include <string>
 #include <string_view>
 
+#include "framework/display_path.h"
 #include "framework/error.h"
 #include "framework/lua_api.h"
 #include "framework/world.h"
@@ -42,9 +43,9 @@ namespace {
 int SafeLoad(lua_State* L) {
   const int n = lua_gettop(L);
   if (lua_type(L, 1) == LUA_TSTRING && lua_tostring(L, 1)[0] == LUA_SIGNATURE[0])
-    RaiseError(L,
-               "load: binary chunks are not allowed in a sandboxed script (run with "
-               "--trust-scripts to lift the sandbox)");
+    RaiseRefusal(L,
+                 "load: binary chunks are not allowed in a sandboxed script (run with "
+                 "--trust-scripts to lift the sandbox)");
   lua_settop(L, 4);
   lua_pushliteral(L, "t");
   lua_replace(L, 3);
@@ -75,9 +76,10 @@ int SafeSetMetatable(lua_State* L) {
     const bool finalizer = lua_rawget(L, 2) != LUA_TNIL;
     lua_pop(L, 1);
     if (finalizer)
-      RaiseError(L,
-                 "setmetatable: __gc finalizers are not allowed in a sandboxed script (Lua cannot "
-                 "stop one that loops); run with --trust-scripts to lift the sandbox");
+      RaiseRefusal(
+          L,
+          "setmetatable: __gc finalizers are not allowed in a sandboxed script (Lua cannot "
+          "stop one that loops); run with --trust-scripts to lift the sandbox");
   }
   if (luaL_getmetafield(L, 1, "__metatable") != LUA_TNIL)
     throw Error("cannot change a protected metatable");
@@ -90,9 +92,9 @@ int SafeSetMetatable(lua_State* L) {
 // reproducible.
 int SafeRandomSeed(lua_State* L) {
   if (lua_type(L, 1) != LUA_TNUMBER)
-    RaiseError(L,
-               "math.randomseed needs a seed: without one it reads the clock and runs stop being "
-               "reproducible (math.random is already seeded per robot)");
+    RaiseRefusal(L,
+                 "math.randomseed needs a seed: without one it reads the clock and runs stop being "
+                 "reproducible (math.random is already seeded per robot)");
   // Lua's own checks, made here so that the call below cannot raise.
   ArgInteger(L, 1);
   const int arguments = lua_isnoneornil(L, 2) ? 1 : 2;
@@ -159,9 +161,9 @@ void WrapField(lua_State* L, int table, const char* name, lua_CFunction wrapper)
 namespace fs = std::filesystem;
 
 [[noreturn]] void Refuse(lua_State* L, const std::string& what) {
-  RaiseError(L, what +
-                    " is not allowed in a sandboxed script (run with --trust-scripts to lift "
-                    "the sandbox)");
+  RaiseRefusal(L, what +
+                      " is not allowed in a sandboxed script (run with --trust-scripts to lift "
+                      "the sandbox)");
 }
 
 // __index of a restricted library table: a missing field is refused by name.
@@ -225,8 +227,8 @@ std::string CheckedPath(lua_State* L, const char* function, const std::string& t
   const WorldSettings& settings = Context(L).world->settings();
   for (const fs::path& part : fs::path(text))
     if (part == "..")
-      RaiseError(L, std::string(function) + ": '..' is not allowed in a path ('" + text +
-                        "'); scripts are sandboxed (run with --trust-scripts to lift it)");
+      RaiseRefusal(L, std::string(function) + ": '..' is not allowed in a path ('" + text +
+                          "'); scripts are sandboxed (run with --trust-scripts to lift it)");
   fs::path root = write ? settings.output_directory : settings.directory;
   if (root.empty())
     RaiseError(L, std::string(function) + ": cannot write '" + text +
@@ -236,13 +238,13 @@ std::string CheckedPath(lua_State* L, const char* function, const std::string& t
   // Symlinks are resolved first: one inside the folder pointing out is refused.
   const fs::path resolved = Canonical(path);
   if (!IsInside(resolved, root))
-    RaiseError(L, std::string(function) + ": '" + text + "' is outside the " +
-                      (write ? "run's output folder" : "world's folder") + " (" + root.string() +
-                      "); scripts are sandboxed (run with --trust-scripts to lift it)");
+    RaiseRefusal(L, std::string(function) + ": '" + text + "' is outside the " +
+                        (write ? "run's output folder" : "world's folder") + " (" + root.string() +
+                        "); scripts are sandboxed (run with --trust-scripts to lift it)");
   if (write && IsRunOutput(resolved, root))
-    RaiseError(L, std::string(function) + ": '" + resolved.filename().string() +
-                      "' is one of the run's own outputs in the output folder (" + root.string() +
-                      "); write to another name");
+    RaiseRefusal(L, std::string(function) + ": '" + resolved.filename().string() +
+                        "' is one of the run's own outputs in the output folder (" + root.string() +
+                        "); write to another name");
   return path.string();
 }
 
@@ -352,8 +354,8 @@ int SafeRequire(lua_State* L) {
     std::stringstream code;
     code << in.rdbuf();
     const std::string text = code.str();
-    std::string chunkname(1, '@');
-    chunkname += candidate.lexically_normal().native();
+    // Named in messages as the scripts are: relative to the current folder.
+    const std::string chunkname = "@" + DisplayPath(candidate);
     if (luaL_loadbufferx(L, text.data(), text.size(), chunkname.c_str(), "t") != LUA_OK)
       throw LuaErrorOnStack{};
     // Its own environment: module globals do not leak into the scripts.

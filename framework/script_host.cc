@@ -112,11 +112,14 @@ static_assert(sizeof(Script) == 88);
 // count hook on the state's threads; at the next instruction the hook
 // collects garbage and, if the state still holds too much, fails the
 // script with its file and line. Past limit + slack allocations fail (Lua
-// then collects and retries, and reports out of memory).
+// then collects and retries, and reports out of memory) and arm the same
+// hook, which then fails the callback: a pcall loop around a huge
+// allocation would otherwise go on (each refusal costs a full collection).
 struct LuaMemory {
-  size_t used = 0;       // bytes
-  size_t limit = 0;      // bytes; 0: no limit
-  bool refused = false;  // the last allocation was refused (limit + slack)
+  size_t used = 0;           // bytes
+  size_t limit = 0;          // bytes; 0: no limit
+  bool refused = false;      // the last allocation was refused (limit + slack)
+  size_t refused_bytes = 0;  // the size of a refused allocation MemoryHook has not reported, or 0
 };
 constexpr size_t kMemorySlack = size_t{16} << 20;
 
@@ -164,6 +167,17 @@ int ThrowOnPanic(lua_State* L) {
 std::string MemoryLimitTail(const LuaMemory& memory) {
   return std::to_string(memory.limit >> 20) +
          " MiB of Lua memory (simulation.script_memory_mb; raise it if the data is real)";
+}
+// "1.0 GiB", "300 MiB", "12 KiB": a refused allocation's size.
+std::string FormatBytes(size_t bytes) {
+  char text[32];
+  if (bytes >= (size_t{1} << 30))
+    std::snprintf(text, sizeof text, "%.1f GiB", static_cast<double>(bytes) / (1 << 30));
+  else if (bytes >= (size_t{1} << 20))
+    std::snprintf(text, sizeof text, "%zu MiB", bytes >> 20);
+  else
+    std::snprintf(text, sizeof text, "%zu KiB", (bytes + 1023) >> 10);
+  return text;
 }
 std::string MemoryLimitText(const LuaMemory& memory) {
   return "the scripts hold more than " + MemoryLimitTail(memory);
@@ -232,6 +246,18 @@ void ExhaustBudget(lua_State* L, MakeMessage make_message) {
   ExhaustedHook(L, nullptr);
 }
 
+}  // namespace
+
+void FailCallback(lua_State* L) {
+  ExhaustBudget(L, [&] {
+    size_t length = 0;
+    const char* message = lua_tolstring(L, -1, &length);
+    return message != nullptr ? std::string(message, length) : std::string("refused");
+  });
+}
+
+namespace {
+
 // Count hook of non-threaded callbacks: the budget is used up.
 void BudgetHook(lua_State* L, lua_Debug* ar) {
   ExhaustBudget(L, [&] {
@@ -285,6 +311,12 @@ void SliceHook(lua_State* L, lua_Debug* ar) {
 // Count hook armed when a state's memory passed the limit (LuaMemory).
 void MemoryHook(lua_State* L, lua_Debug* ar) {
   auto* state = static_cast<ScriptState*>(Context(L).host_state);
+  if (const size_t refused = std::exchange(state->memory.refused_bytes, 0); refused > 0) {
+    ExhaustBudget(L, [&] {
+      return HookWhere(L, ar) + "an allocation of " + FormatBytes(refused) +
+             " would take the scripts past " + MemoryLimitTail(state->memory);
+    });
+  }
   lua_gc(L, LUA_GCCOLLECT);
   // Still too much: fails the callback as a spent budget does, so pcall and
   // xpcall's handler cannot catch it and go on allocating.
@@ -314,11 +346,12 @@ void* LimitedAlloc(void* ud, void* ptr, size_t osize, size_t nsize) {
   }
   if (m.limit > 0 && nsize > old) {
     const size_t after = m.used + (nsize - old);
-    if (after > m.limit + kMemorySlack || after < m.used) {
+    const bool refuse = after > m.limit + kMemorySlack || after < m.used;
+    if (refuse) {
       m.refused = true;
-      return nullptr;
+      m.refused_bytes = nsize - old;
     }
-    if (after > m.limit && state->L != nullptr) {
+    if ((after > m.limit || refuse) && state->L != nullptr) {
       // Armed on every thread whose hook is another (a callback's budget hook
       // set since would otherwise leave only the hard cap). lua_sethook may
       // be called at any point (even from a signal handler).
@@ -329,6 +362,7 @@ void* LimitedAlloc(void* ud, void* ptr, size_t osize, size_t nsize) {
       for (const Script& script : state->scripts)
         if (script.thread != nullptr) arm(script.thread);
     }
+    if (refuse) return nullptr;
   }
   void* p = std::realloc(ptr, nsize);
   if (p == nullptr) return nullptr;
@@ -404,6 +438,7 @@ void Call(ScriptState& state, Script& script, int nargs, const char* what) {
   const CallInProgress in_progress(state, what);
   SetCurrent(state, script);
   state.context.budget_exhausted = false;
+  state.memory.refused_bytes = 0;  // reported with the callback that made it
   SetBudget(state.L, state.context);
   script.running = true;
   const int status = lua_pcall(state.L, nargs, 0, 0);
@@ -431,7 +466,7 @@ bool Disable(ScriptState& state, Script& script, const std::string& error) {
       state.context.is_main)
     return false;
   script.disabled = true;
-  state.context.runtime->log.push_back("error, script disabled: " + error);
+  state.context.runtime->log.Add("error, script disabled: " + error);
   state.context.runtime->disabled.push_back(error);
   return true;
 }
@@ -797,6 +832,7 @@ void ResumeThread(ScriptState* state, Script& script) {
   SetCurrent(*state, script);
   c.thread = co;
   c.budget_exhausted = false;
+  state->memory.refused_bytes = 0;  // reported with the callback that made it
   c.slice_fires = 0;
   c.slice_yielded = false;
   // A fresh slice. After a yield from the hook, Lua itself left it so: it

@@ -1,6 +1,7 @@
 #include "framework/world.h"
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -14,6 +15,7 @@
 #include "framework/scheduler.h"
 #include "framework/script_host.h"
 #include "framework/state_hash.h"
+#include "framework/utf8.h"
 
 namespace swarmsim {
 
@@ -59,6 +61,15 @@ const char* ToString(Phase phase) {
   return "?";
 }
 
+std::string ShowParamValue(const ParamValue& value) {
+  if (const double* d = std::get_if<double>(&value)) {
+    char buf[32];
+    const auto result = std::to_chars(buf, buf + sizeof buf, *d);
+    return std::string(buf, result.ptr);
+  }
+  return ParamToString(value);
+}
+
 std::string ParamToString(const ParamValue& value) {
   if (const double* d = std::get_if<double>(&value)) {
     char buf[32];
@@ -74,6 +85,9 @@ World::World(const WorldSettings& settings, const ModuleRegistry& registry)
       registry_(registry),
       scheduler_(std::make_unique<TaskScheduler>(settings.threads)),
       log_sink_([](std::string_view line) {
+        // A script may print any bytes; the console gets UTF-8.
+        const std::string valid = IsValidUtf8(line) ? std::string() : ValidUtf8(line);
+        if (!valid.empty()) line = valid;
         std::fwrite(line.data(), 1, line.size(), stdout);
         std::fputc('\n', stdout);
       }) {
@@ -135,6 +149,11 @@ int World::threads() const { return scheduler_->threads(); }
 
 void World::Log(std::string_view line) const { log_sink_(line); }
 
+void World::FlushPrintsOfStuckStep() {
+  for (RobotRuntime& rt : runtimes_) rt.log.Drain(log_sink_);
+  scene_runtime_.log.Drain(log_sink_);
+}
+
 void World::AddObserver(std::unique_ptr<Observer> observer) {
   observers_.push_back(std::move(observer));
 }
@@ -146,6 +165,11 @@ void World::WriteOutputs(const std::filesystem::path& dir) const {
 std::vector<MetricSample> World::TakeMetrics() {
   std::vector<MetricSample> out;
   out.swap(metrics_);
+  // In step order, whatever order the scripts and observers recorded in
+  // (already sorted in the usual case: then no sort).
+  const auto by_step = [](const MetricSample& a, const MetricSample& b) { return a.step < b.step; };
+  if (!std::is_sorted(out.begin(), out.end(), by_step))
+    std::stable_sort(out.begin(), out.end(), by_step);
   return out;
 }
 
@@ -256,6 +280,9 @@ void World::Step() {
         Physics();
       }
     }
+    // What a main script printed and recorded after its last pass belongs
+    // to this step's outputs, not the next one's.
+    if (scripts_->has_main_script()) FlushSceneBuffers();
     // 5. record: observers append to their streams.
     {
       PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kRecord)]);
@@ -289,8 +316,7 @@ void World::HandleSensing() {
 void World::HandleChildScripts(ScriptPass pass) {
   PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kControl)]);
   // What the main script printed so far comes first.
-  for (const std::string& line : scene_runtime_.log) log_sink_(line);
-  scene_runtime_.log.clear();
+  scene_runtime_.log.Drain(log_sink_);
   Control(pass);
 }
 void World::HandleActuation() {
@@ -324,6 +350,9 @@ void World::Control(ScriptPass pass) {
   } catch (const std::exception& e) {
     scene_runtime_.error = e.what();
   }
+  // Signals written in this pass: the robots see them from the next step
+  // (they have run), a main script as soon as sim.handleChildScripts returns.
+  ApplySignalWrites();
   FlushRobotBuffers();
   RunPhaseCallbacks(kSwarmsimAfterControl);
 }
@@ -345,8 +374,7 @@ void World::FlushRobotBuffers() {
   // error wins, so the report does not depend on the thread count.
   std::string first_error;
   auto flush = [&](RobotRuntime& rt) {
-    for (const std::string& line : rt.log) log_sink_(line);
-    rt.log.clear();
+    rt.log.Drain(log_sink_);
     for (MetricSample& m : rt.metrics) metrics_.push_back(std::move(m));
     rt.metrics.clear();
     if (!rt.error.empty() && first_error.empty()) first_error = rt.error;
@@ -361,6 +389,12 @@ void World::FlushRobotBuffers() {
   }
   flush(scene_runtime_);
   if (!first_error.empty()) throw Error(first_error);
+}
+
+void World::FlushSceneBuffers() {
+  scene_runtime_.log.Drain(log_sink_);
+  for (MetricSample& m : scene_runtime_.metrics) metrics_.push_back(std::move(m));
+  scene_runtime_.metrics.clear();
 }
 
 void World::FlushBuffersAfterError() noexcept {

@@ -9,6 +9,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <span>
 #include <string>
@@ -126,10 +127,45 @@ struct DeferredWrite {
 
 // Per-robot runtime state. Only the worker running that robot touches it
 // during a phase; the world merges the buffers after the phase, in robot order.
+// Lines a robot's scripts printed during the phase, in order. Its robot's
+// worker appends and the main thread drains it after the phase; the run's
+// watchdog may drain it from its own thread when a step never ends, so that
+// what was printed before is not lost. Hence the lock (never contended
+// outside that case).
+class LogBuffer {
+ public:
+  LogBuffer() = default;
+  LogBuffer(LogBuffer&& other) noexcept : lines_(std::move(other.lines_)) {}
+  LogBuffer& operator=(LogBuffer&& other) noexcept {
+    const std::lock_guard lock(mutex_);
+    lines_ = std::move(other.lines_);
+    return *this;
+  }
+  void Add(std::string line) {
+    const std::lock_guard lock(mutex_);
+    lines_.push_back(std::move(line));
+  }
+  bool empty() const {
+    const std::lock_guard lock(mutex_);
+    return lines_.empty();
+  }
+  // Hands every line to sink(std::string_view) in order and empties the buffer.
+  template <typename Sink>
+  void Drain(const Sink& sink) {
+    const std::lock_guard lock(mutex_);
+    for (const std::string& line : lines_) sink(line);
+    lines_.clear();
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::vector<std::string> lines_;
+};
+
 struct RobotRuntime {
   Rng rng;
   SharedParameters parameters;          // the instance's model parameters
-  std::vector<std::string> log;         // lines printed during the phase
+  LogBuffer log;                        // lines printed during the phase
   std::vector<MetricSample> metrics;    // samples recorded this step
   std::vector<DeferredWrite> deferred;  // writes to other robots' objects
   std::string error;                    // a script error in this phase
@@ -217,6 +253,10 @@ class World {
   // Script `print` lines are passed here, prefixed by the robot instance
   // name, in robot order after each phase. Default: standard output.
   void set_log_sink(std::function<void(std::string_view)> sink) { log_sink_ = std::move(sink); }
+  // For a step that never ends (the runner's watchdog thread): hands what
+  // the scripts printed in it so far to the log sink, robots in index order,
+  // then the scene's scripts.
+  void FlushPrintsOfStuckStep();
   void Log(std::string_view line) const;
   void AddObserver(std::unique_ptr<Observer> observer);
   // Every observer's WriteOutputs(dir), in the order they were added.
@@ -262,7 +302,8 @@ class World {
   const std::vector<Message>& messages() const { return messages_; }
   // Bumped each time the inboxes are refilled.
   uint64_t message_round() const { return message_round_; }
-  // Signal values as of the start of this step.
+  // Signal values: the scripts' writes are applied when a control pass ends
+  // (robots in index order, then the scene's scripts; the last write wins).
   const std::map<std::string, ParamValue, std::less<>>& signals() const { return signals_; }
 
  private:
@@ -272,8 +313,11 @@ class World {
   void Physics();
   void Record();
   void EnsureRuntimes();
-  void DeliverMessages();  // world_messages.cc
+  void DeliverMessages();    // world_messages.cc
+  void ApplySignalWrites();  // world_messages.cc
   void FlushRobotBuffers();
+  // The scene's scripts' prints and metrics (a main script's, after its step).
+  void FlushSceneBuffers();
   // After an error escaped the scripts: what every robot and the scene
   // printed (and recorded) before it, in robot order. The error in flight is
   // the one reported: the buffers' own are dropped. Not for the hot path.

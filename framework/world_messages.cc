@@ -23,8 +23,9 @@ constexpr int64_t kReceiverGrain = 64;
 
 }  // namespace
 
-void World::DeliverMessages() {
-  // Signals: writes in robot order, then the scene's; the last write wins.
+void World::ApplySignalWrites() {
+  // Writes in robot order, then the scene's; the last write wins. Only
+  // robots whose scripts wrote something (pending_) are visited.
   auto apply_signals = [&](RobotRuntime& rt) {
     for (auto& [name, value] : rt.signal_writes) {
       if (value) {
@@ -35,6 +36,15 @@ void World::DeliverMessages() {
     }
     rt.signal_writes.clear();
   };
+  for (size_t r = 0; r < runtimes_.size(); ++r)
+    if (pending_[r] & kPendingMessages) apply_signals(runtimes_[r]);
+  apply_signals(scene_runtime_);
+}
+
+void World::DeliverMessages() {
+  // Signals the scene's scripts wrote since the last control pass (a main
+  // script after sim.handleChildScripts).
+  ApplySignalWrites();
   // Only robots whose scripts wrote something (pending_) are visited.
   const int robot_count = static_cast<int>(runtimes_.size());
   std::vector<int> writers;
@@ -43,8 +53,6 @@ void World::DeliverMessages() {
       writers.push_back(r);
       pending_[r] &= ~kPendingMessages;
     }
-  for (int r : writers) apply_signals(runtimes_[r]);
-  apply_signals(scene_runtime_);
   // Custom data written last step, robots in index order, then the scene's
   // scripts (the last write of a tag wins); objects removed since are skipped.
   auto apply_custom_data = [&](RobotRuntime& rt) {

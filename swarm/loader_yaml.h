@@ -16,6 +16,7 @@
 #include <utility>
 #include <vector>
 
+#include "framework/display_path.h"
 #include "framework/suggest.h"
 
 namespace swarmsim::loader {
@@ -25,9 +26,8 @@ namespace swarmsim::loader {
 using swarmsim::EditDistance;
 using swarmsim::Suggest;
 
-// A path as the user would recognise it: relative to the current directory
-// when the file is below it, else as given, lexically normalised.
-std::string DisplayPath(const std::filesystem::path& path);
+// A path as the user would recognise it (framework/display_path.h).
+using swarmsim::DisplayPath;
 
 // A YAML file being read: its name for messages and its parsed root.
 class YamlFile {

@@ -18,6 +18,7 @@
 #include "framework/plugin_loader.h"
 #include "framework/registry.h"
 #include "framework/suggest.h"
+#include "framework/utf8.h"
 #include "modules/builtin.h"
 #include "swarm/bench.h"
 #include "swarm/bench_scaling.h"
@@ -240,7 +241,7 @@ void PrintDescription(const LoadedWorld& w, std::ostream& out) {
   if (!w.world->parameters().empty()) {
     out << "world parameters:\n";
     for (const auto& [name, value] : w.world->parameters())
-      out << "  " << name << " = " << ParamToString(value) << "\n";
+      out << "  " << name << " = " << ShowParamValue(value) << "\n";
   }
   for (const ModelSummary& m : w.models) {
     out << "\nmodel " << m.name << " (" << m.file << "): " << m.count
@@ -452,7 +453,7 @@ int Main(int argc, char** argv) {
       const LoadedWorld w = LoadWorld(describe_world, describe_load, registry);
       PrintDescription(w, std::cout);
     } catch (const Error& e) {
-      std::cerr << "error: " << e.what() << "\n";
+      std::cerr << "error: " << swarmsim::ValidUtf8(e.what()) << "\n";
       return kExitBadInput;
     }
     return 0;
@@ -499,7 +500,7 @@ int Main(int argc, char** argv) {
   // A world that does not load (or does not fit the command line): with
   // --out, summary.json says so too, for a batch system watching the folder.
   const auto bad_input = [&](const std::string& message) {
-    std::cerr << "error: " << message << "\n";
+    std::cerr << "error: " << swarmsim::ValidUtf8(message) << "\n";
     if (options.out_dir && !WriteErrorSummary(options, message))
       std::cerr << "error: cannot write '" << (*options.out_dir / "summary.json").string() << "'\n";
     return kExitBadInput;
@@ -547,7 +548,7 @@ int Main(int argc, char** argv) {
   options.quiet = quiet;
   const RunResult result = RunWorld(loaded.world.get(), options, std::cout, std::cerr);
   if (!result.ok) {
-    std::cerr << "error: " << result.error << "\n";
+    std::cerr << "error: " << swarmsim::ValidUtf8(result.error) << "\n";
     if (options.out_dir && std::filesystem::is_directory(*options.out_dir))
       std::cerr << "outputs up to step " << result.steps << " are in " << options.out_dir->string()
                 << "\n";
@@ -564,10 +565,10 @@ int main(int argc, char** argv) {
   try {
     return swarmsim::Main(argc, argv);
   } catch (const swarmsim::Error& e) {
-    std::cerr << "error: " << e.what() << "\n";
+    std::cerr << "error: " << swarmsim::ValidUtf8(e.what()) << "\n";
     return 2;
   } catch (const std::exception& e) {
-    std::cerr << "error: " << e.what() << "\n";
+    std::cerr << "error: " << swarmsim::ValidUtf8(e.what()) << "\n";
     return 1;
   }
 }

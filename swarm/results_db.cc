@@ -70,7 +70,7 @@ void ResultsDb::CreateSweep(const SweepRecord& sweep, const std::vector<GridRun>
     nlohmann::json params = nlohmann::json::object();
     for (const auto& [name, value] : run.params) params[name] = value;
     r.Bind(1, run.id).Bind(2, run.point).Bind(3, static_cast<int64_t>(run.seed));
-    r.Bind(4, params.dump()).Run();
+    r.Bind(4, params.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace)).Run();
     for (const auto& [name, value] : run.params)
       p.Bind(1, run.id).Bind(2, name).Bind(3, value).Run();
   }

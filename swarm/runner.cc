@@ -22,6 +22,7 @@
 #include "framework/error.h"
 #include "framework/script_host.h"
 #include "framework/state_hash.h"
+#include "framework/utf8.h"
 #include "swarm/stop_signals.h"
 #include "swarm/version.h"
 
@@ -37,8 +38,10 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// A CSV field (RFC 4180): quoted when it holds a comma, quote or line break.
+// A CSV field (RFC 4180): quoted when it holds a comma, quote or line break;
+// invalid UTF-8 replaced (ValidUtf8).
 void WriteCsvField(std::ostream& os, std::string_view text) {
+  if (!IsValidUtf8(text)) return WriteCsvField(os, ValidUtf8(text));
   if (text.find_first_of(",\"\r\n") == std::string_view::npos) {
     os << text;
     return;
@@ -243,6 +246,13 @@ class Progress {
   int last_decile_ = -1;
 };
 
+// "box2d, 10 substeps"; "kinematic" (no physics engine steps: no substeps).
+std::string PhysicsLine(const WorldSettings& settings) {
+  if (settings.physics == "kinematic" || settings.physics == "null") return settings.physics;
+  return settings.physics + ", " + std::to_string(settings.physics_substeps) +
+         (settings.physics_substeps == 1 ? " physics substep" : " physics substeps");
+}
+
 // A double that JSON should show as an integer: whole and exact (|v| <= 2^53).
 bool IsWholeNumber(double v) { return std::abs(v) <= 9007199254740992.0 && v == std::trunc(v); }
 
@@ -294,7 +304,8 @@ bool WriteSummary(const World& world, const RunOptions& options, const RunResult
   for (const auto& [name, value] : options.overrides) overrides[name] = value;
   j["overrides"] = overrides;
   std::ofstream f(*options.out_dir / "summary.json");
-  f << j.dump(2) << "\n";
+  // Invalid UTF-8 (from a world file, a script, a --set) is replaced, not fatal.
+  f << j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
   return static_cast<bool>(f);
 }
 
@@ -311,7 +322,8 @@ bool WriteErrorSummary(const RunOptions& options, const std::string& error) {
   j["status"] = "error";
   j["error"] = error;
   std::ofstream f(*options.out_dir / "summary.json");
-  f << j.dump(2) << "\n";
+  // Invalid UTF-8 (from a world file, a script, a --set) is replaced, not fatal.
+  f << j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
   return static_cast<bool>(f);
 }
 
@@ -339,8 +351,9 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
       if (options.out_dir && std::filesystem::is_directory(*options.out_dir))
         WriteSummary(*world, options, stuck, 0, /*complete=*/false);
       progress.Finish();
+      world->FlushPrintsOfStuckStep();  // what the scripts printed before they got stuck
       std::fflush(stdout);
-      std::cerr << "error: " << error << "\n";
+      std::cerr << "error: " << ValidUtf8(error) << "\n";
       if (options.out_dir && std::filesystem::is_directory(*options.out_dir))
         std::cerr << "outputs up to step " << stuck.steps << " are in " << options.out_dir->string()
                   << "\n";
@@ -425,7 +438,7 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
   if (!options.quiet) {
     out << "robots          " << robots << "\n"
         << "steps           " << result.steps << " (time step " << world->settings().time_step
-        << " s, " << world->settings().physics_substeps << " physics substeps)\n"
+        << " s, " << PhysicsLine(world->settings()) << ")\n"
         << "simulated time  " << Fixed(sim_time, 2) << " s\n"
         << "wall time       " << Fixed(result.wall_seconds, 3) << " s on " << world->threads()
         << (world->threads() == 1 ? " thread\n" : " threads\n") << "real-time factor "

@@ -3,12 +3,44 @@
 #include <sqlite3.h>
 
 #include "framework/error.h"
+#include "framework/utf8.h"
 
 namespace swarmsim {
 
+namespace {
+
+// A file: URI for `path` (RFC 3986: '%', '?' and '#' escaped).
+std::string FileUri(const std::filesystem::path& path) {
+  std::string uri = "file:";
+  for (const char c : std::filesystem::absolute(path).string()) {
+    if (c == '%' || c == '?' || c == '#') {
+      static constexpr char kHex[] = "0123456789ABCDEF";
+      uri += '%';
+      uri += kHex[static_cast<unsigned char>(c) >> 4];
+      uri += kHex[static_cast<unsigned char>(c) & 15];
+    } else {
+      uri += c;
+    }
+  }
+  return uri;
+}
+
+}  // namespace
+
 SqliteDb::SqliteDb(const std::filesystem::path& path, bool read_only) : path_(path) {
-  const int flags = read_only ? SQLITE_OPEN_READONLY : (SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE);
-  if (sqlite3_open_v2(path.c_str(), &db_, flags, nullptr) != SQLITE_OK) {
+  int flags = read_only ? SQLITE_OPEN_READONLY : (SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE);
+  std::string name = path.string();
+  // A reader of a WAL database makes its -wal and -shm files and, being
+  // read-only, cannot remove them again: `report` left two empty files
+  // beside a finished sweep's database. With no writer (neither file there)
+  // the database is read as immutable, which makes none.
+  std::error_code ec;
+  if (read_only && !std::filesystem::exists(name + "-wal", ec) &&
+      !std::filesystem::exists(name + "-shm", ec)) {
+    name = FileUri(path) + "?immutable=1";
+    flags |= SQLITE_OPEN_URI;
+  }
+  if (sqlite3_open_v2(name.c_str(), &db_, flags, nullptr) != SQLITE_OK) {
     const std::string message = db_ ? sqlite3_errmsg(db_) : "out of memory";
     sqlite3_close(db_);
     db_ = nullptr;
@@ -54,7 +86,9 @@ SqliteStatement& SqliteStatement::Bind(int index, double value) {
   if (sqlite3_bind_double(stmt_, index, value) != SQLITE_OK) db_->Fail("bind");
   return *this;
 }
-SqliteStatement& SqliteStatement::Bind(int index, const std::string& value) {
+SqliteStatement& SqliteStatement::Bind(int index, const std::string& raw) {
+  // TEXT is UTF-8 to every reader (Python's sqlite3 fails on anything else).
+  const std::string value = ValidUtf8(raw);
   if (sqlite3_bind_text(stmt_, index, value.data(), static_cast<int>(value.size()),
                         SQLITE_TRANSIENT) != SQLITE_OK)
     db_->Fail("bind");

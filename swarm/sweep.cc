@@ -92,7 +92,7 @@ std::string SweepSpace(const std::vector<ParamSpec>& params, const std::vector<u
   j["seeds"] = seeds;
   j["steps"] = steps ? nlohmann::json(*steps) : nlohmann::json(nullptr);
   j["duration"] = duration ? nlohmann::json(*duration) : nlohmann::json(nullptr);
-  return j.dump();
+  return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 int RunSweep(const SweepOptions& options, std::ostream& out, std::ostream& err) {
@@ -144,7 +144,7 @@ int CoordinateSweep(const SweepOptions& o, RemoteWorkers* remote, std::ostream& 
   // This shard's pending runs.
   std::deque<GridRun> pending;
   for (GridRun& r : db.PendingRuns())
-    if (r.id % o.shard_count == o.shard_index) pending.push_back(std::move(r));
+    if ((r.id - 1) % o.shard_count == o.shard_index) pending.push_back(std::move(r));
   const RunCounts before = db.Counts();
   const int64_t shard_total =
       o.shard_count == 1 ? before.total

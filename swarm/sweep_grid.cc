@@ -163,7 +163,7 @@ std::vector<GridRun> ExpandGrid(const std::vector<ParamSpec>& params,
     }
     for (uint64_t seed : seeds) {
       GridRun r;
-      r.id = static_cast<int64_t>(runs.size());
+      r.id = static_cast<int64_t>(runs.size()) + 1;  // runs are numbered from 1, as SQLite's rows
       r.point = point;
       r.seed = seed;
       r.params = values;

@@ -25,7 +25,7 @@ ParamSpec ParseParamSpec(const std::string& name_equals_spec);
 // `--seeds K` (seeds 1..K), `A-B` (A..B inclusive) or a list `3,7,11`.
 std::vector<uint64_t> ParseSeeds(const std::string& spec);
 
-// One run of the grid. Runs are numbered point-major: id = point * seeds + s.
+// One run of the grid. Runs are numbered from 1, point-major: id = point * seeds + s + 1.
 struct GridRun {
   int64_t id = 0;
   int64_t point = 0;  // index of the parameter combination

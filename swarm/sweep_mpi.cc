@@ -101,7 +101,7 @@ class MpiWorkers : public RemoteWorkers {
         Send(
             nlohmann::json{
                 {"id", run->id}, {"point", run->point}, {"seed", run->seed}, {"params", params}}
-                .dump(),
+                .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace),
             from, kTagRun);
         holding_[static_cast<size_t>(from)] = true;
         ++running_;
@@ -139,7 +139,7 @@ int WorkerLoop(const SweepOptions& o) {
     pool.Start(run);
     std::vector<RunOutcome> ended;
     while (ended.empty()) ended = pool.Poll(1.0);
-    result = ToJson(ended.front()).dump();
+    result = ToJson(ended.front()).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
   }
   return 0;
 }

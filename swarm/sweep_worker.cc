@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "framework/error.h"
+#include "framework/utf8.h"
 
 namespace swarmsim {
 namespace {
@@ -155,6 +156,7 @@ RunOutcome CollectRun(int64_t id, const std::filesystem::path& out_dir, int wait
   } else {
     o.ok = true;
   }
+  o.error = ValidUtf8(o.error);  // stderr's tail may hold any bytes
   return o;
 }
 

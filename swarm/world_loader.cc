@@ -133,28 +133,23 @@ struct EntryPlan {
   }
 };
 
-// A value as a user writes it (0.2, not 0.20000000000000001).
-std::string ShowValue(const ParamValue& value) {
-  if (const double* d = std::get_if<double>(&value)) return loader::FormatNumber(*d);
-  return ParamToString(value);
-}
-
 // A parameter value outside its declared range: the message, or "".
 std::string RangeError(const loader::ModelParameterDecl& decl, const std::string& model,
                        const ParamValue& value) {
   if (!decl.has_range) return "";
   const double* v = std::get_if<double>(&value);
   if (v != nullptr && *v >= decl.min && *v <= decl.max) return "";
+  // A unit is shown unless it is the dimensionless "1" ("within [0, 1] 1" reads as a typo).
   const std::string range = "[" + loader::FormatNumber(decl.min) + ", " +
                             loader::FormatNumber(decl.max) + "]" +
-                            (decl.unit.empty() ? "" : " " + decl.unit);
+                            (decl.unit.empty() || decl.unit == "1" ? "" : " " + decl.unit);
   const std::string what = "parameter '" + decl.name + "' of model '" + model + "'";
   if (v == nullptr)  // a string or a boolean: the range makes it a number parameter
     return what + " must be a number within " + range + " (got " +
-           (std::holds_alternative<std::string>(value) ? "\"" + ShowValue(value) + "\""
-                                                       : ShowValue(value)) +
+           (std::holds_alternative<std::string>(value) ? "\"" + ShowParamValue(value) + "\""
+                                                       : ShowParamValue(value)) +
            ", which is not a number)";
-  return what + " must be within " + range + " (got " + ShowValue(value) + ")";
+  return what + " must be within " + range + " (got " + ShowParamValue(value) + ")";
 }
 
 // The script files of a model's objects, in tree order, each with the
@@ -915,8 +910,8 @@ std::vector<ModelSummary> WorldLoader::Summarize() const {
     for (const auto& decl : e.model->parameters) {
       ParameterSummary p;
       p.name = decl.name;
-      p.value = ShowValue(e.parameters->at(decl.name));
-      p.default_value = ShowValue(defaults.Resolve(decl.default_value));
+      p.value = ShowParamValue(e.parameters->at(decl.name));
+      p.default_value = ShowParamValue(defaults.Resolve(decl.default_value));
       p.unit = decl.unit;
       p.description = decl.description;
       if (decl.has_range)
@@ -928,7 +923,7 @@ std::vector<ModelSummary> WorldLoader::Summarize() const {
       std::string text;
       for (const auto& [name, value] : *own.parameters)
         if (!(value == e.parameters->at(name)))
-          text += (text.empty() ? "" : ", ") + name + "=" + ShowValue(value);
+          text += (text.empty() ? "" : ", ") + name + "=" + ShowParamValue(value);
       m.instances.emplace_back(own.index, text);
     }
     std::vector<std::pair<std::string, std::string>> scripts;

@@ -384,6 +384,47 @@ TEST(ScriptControlTest, OneAllocationPastTheLimitIsRefused) {
                   "bot#0: an allocation would take the scripts past 4 MiB of Lua memory");
 }
 
+// Under disable_script, a refused allocation disables its script only: the
+// robot's next script is not failed by the refusal already reported (with no
+// instruction budget, nothing else replaces the hook the refusal armed).
+TEST(ScriptControlTest, ARefusedAllocationDoesNotFailTheNextScript) {
+  WorldSettings settings;
+  settings.script_memory_limit = 4 << 20;
+  settings.instruction_budget = 0;
+  settings.on_script_error = ScriptErrorPolicy::kDisableScript;
+  ScriptWorld w(1, settings);
+  const ObjectId body =
+      w.AddRobot("bot#0", "function sysCall_actuation() local s = string.rep('x', 1e8) end");
+  w.scene().AttachScript(
+      w.scene().AddDummy("eye", body, {}),
+      Source("scripts/eye.lua", "function sysCall_actuation() sim.recordMetric('alive', 1) end"));
+  w.Steps(3);
+  ASSERT_EQ(w.world().disabled_scripts().size(), 1u);
+  EXPECT_CONTAINS(w.world().disabled_scripts()[0], "of /bot#0/body]");
+  EXPECT_EQ(w.world().TakeMetrics().size(), 3u);
+}
+
+// Each refused allocation costs Lua a full collection and a retry; a pcall
+// loop around one would go on until the step timeout. The first refusal
+// fails the callback instead, with the line, and pcall cannot catch it.
+TEST(ScriptControlTest, APcallLoopAroundARefusedAllocationEndsAtOnce) {
+  WorldSettings settings;
+  settings.script_memory_limit = 4 << 20;
+  settings.instruction_budget = 1000000;  // without the rule: a budget error instead
+  ScriptWorld w(1, settings);
+  w.AddRobot("bot#0",
+             "function sysCall_actuation()\n"
+             "  local n = 0\n"
+             "  while true do pcall(string.rep, 'x', 1e9); n = n + 1 end\n"
+             "end\n");
+  const std::string error = ErrorOf([&] { w.Steps(1); });
+  EXPECT_CONTAINS(error,
+                  "bot#0: scripts/robot.lua:3: an allocation of 953 MiB would take the "
+                  "scripts past 4 MiB of Lua memory");
+  EXPECT_CONTAINS(error, "[in sysCall_actuation of /bot#0/body]");
+  // The next step's callbacks are not failed by the refusal that was reported.
+}
+
 TEST(ScriptControlTest, GarbageAboveTheLimitIsCollectedNotAnError) {
   WorldSettings settings;
   settings.script_memory_limit = 2 << 20;
@@ -520,6 +561,52 @@ TEST(ScriptControlTest, WorldMainScriptRunsThePhases) {
                                              "[bot#0] actuation", "[bot#0] sensing"};
   EXPECT_EQ(w.log, expected);
   EXPECT_DOUBLE_EQ(w.world().time(), 0.2);
+}
+
+// A swarm metric: the step count after physics, recorded every step.
+class StepObserver : public Observer {
+ public:
+  void Record(const World& world, std::vector<MetricSample>* out) override {
+    out->push_back({world.step_count(), world.time(), -1, "observer", 0});
+  }
+};
+
+// A main script's rows: the step the world has reached where they are
+// recorded, the robots' signals of the same step (not the step before), and
+// metrics.csv's order: the step never goes back.
+TEST(ScriptControlTest, MainScriptMetricsDescribeTheirStepAndComeInStepOrder) {
+  WorldSettings settings;
+  settings.main_script = Source("main.lua", R"(
+    function sysCall_step()
+      sim.handleSensing()
+      sim.handleChildScripts()
+      sim.recordMetric('pre', sim.getSignal('robot_step'))
+      sim.handleActuation()
+      sim.handleDynamics()
+      sim.recordMetric('post', sim.getSignal('robot_step'))
+    end
+  )");
+  ScriptWorld w(2, settings);
+  w.AddRobot("bot#0", R"(
+    local n = 0
+    function sysCall_actuation()
+      sim.recordMetric('robot', n)
+      sim.setSignal('robot_step', n)
+      n = n + 1
+    end
+  )");
+  w.world().AddObserver(std::make_unique<StepObserver>());
+  std::vector<std::string> rows;
+  for (int i = 0; i < 3; ++i) {
+    w.Steps(1);
+    for (const MetricSample& m : w.world().TakeMetrics())
+      rows.push_back(std::to_string(m.step) + " " + m.name + " " + std::to_string(int(m.value)));
+  }
+  const std::vector<std::string> expected = {
+      "0 robot 0", "0 pre 0", "1 post 0", "1 observer 0",  // step 0
+      "1 robot 1", "1 pre 1", "2 post 1", "2 observer 0",  // step 1
+      "2 robot 2", "2 pre 2", "3 post 2", "3 observer 0"};
+  EXPECT_EQ(rows, expected);
 }
 
 TEST(ScriptControlTest, HandleChildScriptsForwardsExtraArguments) {

@@ -168,6 +168,7 @@ fs::path StuckWorld(const std::string& name, const std::string& step_timeout) {
                     "  sim.recordMetric('t', sim.getSimulationTime())\n"
                     "  if sim.getSimulationTime() > 0.25 then\n"
                     "    io.open('stuck', 'w'):close()\n"
+                    "    print('about to get stuck')\n"
                     "    return string.rep('a', 300000):find('.-.-b')\n"
                     "  end\n"
                     "end\n");
@@ -187,6 +188,10 @@ TEST(RunOutputsTest, StuckStepEndsTheRunNamingTheScriptAndKeepsTheOutputs) {
   EXPECT_NE(r.output.find("probe.lua, in sysCall_actuation of /probe#0"), std::string::npos)
       << r.output;
   EXPECT_NE(r.output.find("outputs up to step 3 are in"), std::string::npos) << r.output;
+  // What the script printed in the stuck step comes before the error.
+  const size_t printed = r.output.find("[probe#0] about to get stuck\n");
+  EXPECT_NE(printed, std::string::npos) << r.output;
+  EXPECT_LT(printed, r.output.find("error: step 4")) << r.output;
   const auto summary = nlohmann::json::parse(ReadFile(dir / "out" / "summary.json"));
   EXPECT_EQ(summary["status"], "error");
   EXPECT_EQ(summary["steps"], 3);

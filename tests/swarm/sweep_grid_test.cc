@@ -57,7 +57,7 @@ TEST(SweepGridTest, CartesianProductTimesSeedsLastParameterFastest) {
   const std::vector<GridRun> runs = ExpandGrid(params, {7, 9});
   ASSERT_EQ(runs.size(), 2u * 3u * 2u);
   for (size_t i = 0; i < runs.size(); ++i) {
-    EXPECT_EQ(runs[i].id, static_cast<int64_t>(i));
+    EXPECT_EQ(runs[i].id, static_cast<int64_t>(i) + 1);  // as `report` and the database show them
     EXPECT_EQ(runs[i].point, static_cast<int64_t>(i / 2));
     EXPECT_EQ(runs[i].seed, i % 2 == 0 ? 7u : 9u);
   }

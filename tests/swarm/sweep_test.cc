@@ -343,6 +343,9 @@ TEST(SweepTest, ReportTableCsvColumnsAndPlot) {
                  (RunCommand("command -v gnuplot").exit_code == 0 ? " --plot " + png.string()
                                                                   : std::string()));
   ASSERT_EQ(r.exit_code, 0) << r.output;
+  // Reading leaves nothing beside the database (no empty -wal/-shm files).
+  EXPECT_FALSE(fs::exists(db.string() + "-wal"));
+  EXPECT_FALSE(fs::exists(db.string() + "-shm"));
   EXPECT_NE(r.output.find("12 of 12 runs finished, 6 failed"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("ci95_low"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("planned failure"), std::string::npos) << r.output;
@@ -355,6 +358,8 @@ TEST(SweepTest, ReportTableCsvColumnsAndPlot) {
   int rows = 0, failed = 0;
   while (std::getline(f, line)) {
     ++rows;
+    // Runs are numbered from 1, in the CSV as in the database.
+    EXPECT_EQ(line.substr(0, line.find(',')), std::to_string(rows)) << line;
     failed += line.find(",failed,") != std::string::npos;
   }
   EXPECT_EQ(rows, 12);
