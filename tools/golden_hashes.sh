@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Writes tests/data/golden_hashes.tsv: the state hash of every example world
-# (worlds/*.yaml, bench/worlds/*.yaml) after a fixed number of steps, for two
+# (worlds/*.yaml, bench/worlds/*.yaml) and of the coverage worlds
+# (tests/data/worlds/golden_*.yaml: every object type, copied and scaled) after a fixed number of steps, for two
 # seeds and 1 and 2 threads, as `swarmsim run WORLD --hash` prints it.
 # tests/swarm/golden_hashes_test.cc fails when any of them drifts.
 #
@@ -15,7 +16,7 @@ table=tests/data/golden_hashes.tsv
 tmp=$(mktemp)
 trap 'rm -f "$tmp"' EXIT
 printf '# world\tseed\tsteps\tthreads\tstate_hash   (written by tools/golden_hashes.sh)\n' >"$tmp"
-for world in worlds/*.yaml bench/worlds/*.yaml; do
+for world in worlds/*.yaml bench/worlds/*.yaml tests/data/worlds/golden_*.yaml; do
   for seed in 1 7; do
     for threads in 1 2; do
       line=$("$program" run "$world" --seed "$seed" --steps "$steps" --threads "$threads" \
