@@ -355,7 +355,8 @@ int SafeRequire(lua_State* L) {
     code << in.rdbuf();
     const std::string text = code.str();
     // Named in messages as the scripts are: relative to the current folder.
-    const std::string chunkname = "@" + DisplayPath(candidate);
+    std::string chunkname = DisplayPath(candidate);
+    chunkname.insert(chunkname.begin(), '@');
     if (luaL_loadbufferx(L, text.data(), text.size(), chunkname.c_str(), "t") != LUA_OK)
       throw LuaErrorOnStack{};
     // Its own environment: module globals do not leak into the scripts.

@@ -5,21 +5,16 @@
 #include <unordered_map>
 
 #include "framework/error.h"
+#include "framework/object_type.h"
 #include "framework/state_hash.h"
 #include "framework/suggest.h"
 
 namespace swarmsim {
 
 const char* ToString(ObjectType type) {
-  switch (type) {
-    case ObjectType::kDummy: return "dummy";
-    case ObjectType::kShape: return "shape";
-    case ObjectType::kJoint: return "joint";
-    case ObjectType::kProximitySensor: return "proximity_sensor";
-    case ObjectType::kForceSensor: return "force_sensor";
-    case ObjectType::kPaintNozzle: return "paint_nozzle";
-  }
-  return "?";
+  const auto core = CoreObjectTypes();
+  const size_t t = static_cast<size_t>(type);
+  return t < core.size() ? core[t]->name : "registered type";
 }
 
 const char* ToString(ShapeKind kind) {
@@ -75,8 +70,38 @@ Pose JointData::Motion() const {
   return {};
 }
 
-Scene::Scene() = default;
+Scene::Scene() {
+  for (const ObjectTypeDescriptor* type : CoreObjectTypes()) RegisterType(*type);
+}
 Scene::~Scene() = default;
+
+// --- Object types ----------------------------------------------------------------
+
+ObjectType Scene::RegisterType(const ObjectTypeDescriptor& type) {
+  ObjectType existing;
+  if (FindType(type.name, &existing))
+    throw Error("object type '" + std::string(type.name) + "' is registered twice");
+  if (types_.size() >= static_cast<size_t>(kMaxObjectTypes))
+    throw Error("cannot register object type '" + std::string(type.name) + "': at most " +
+                std::to_string(kMaxObjectTypes) + " object types");
+  types_.push_back(&type);
+  tables_.push_back(type.make_rows != nullptr ? type.make_rows() : nullptr);
+  return static_cast<ObjectType>(types_.size() - 1);
+}
+
+bool Scene::FindType(std::string_view name, ObjectType* type) const {
+  for (size_t t = 0; t < types_.size(); ++t) {
+    if (name != types_[t]->name) continue;
+    *type = static_cast<ObjectType>(t);
+    return true;
+  }
+  return false;
+}
+
+const char* Scene::type_name(ObjectType type) const {
+  const size_t t = static_cast<size_t>(type);
+  return t < types_.size() ? types_[t]->name : "?";
+}
 
 // --- Slots ----------------------------------------------------------------------
 
@@ -138,33 +163,10 @@ uint32_t Scene::AllocateSlot(std::string name, ObjectId parent, const Pose& X_PO
   return slot;
 }
 
-template <typename T>
-static void SwapRemoveRow(std::vector<T>* table, std::vector<uint32_t>* owners, uint32_t row,
-                          std::vector<uint32_t>* row_of_slot) {
-  const uint32_t last = static_cast<uint32_t>(table->size() - 1);
-  if (row != last) {
-    (*table)[row] = std::move((*table)[last]);
-    (*owners)[row] = (*owners)[last];
-    (*row_of_slot)[(*owners)[row]] = row;
-  }
-  table->pop_back();
-  owners->pop_back();
-}
-
 void Scene::FreeSlot(uint32_t slot) {
-  switch (type_[slot]) {
-    case ObjectType::kShape: SwapRemoveRow(&shapes_, &shape_owner_, row_[slot], &row_); break;
-    case ObjectType::kJoint: SwapRemoveRow(&joints_, &joint_owner_, row_[slot], &row_); break;
-    case ObjectType::kProximitySensor:
-      SwapRemoveRow(&proximity_sensors_, &proximity_sensor_owner_, row_[slot], &row_);
-      break;
-    case ObjectType::kForceSensor:
-      SwapRemoveRow(&force_sensors_, &force_sensor_owner_, row_[slot], &row_);
-      break;
-    case ObjectType::kPaintNozzle:
-      SwapRemoveRow(&paint_nozzles_, &paint_nozzle_owner_, row_[slot], &row_);
-      break;
-    case ObjectType::kDummy: break;
+  if (RowTable* table = tables_[static_cast<size_t>(type_[slot])].get()) {
+    const uint32_t moved = table->SwapRemove(row_[slot]);
+    if (moved != RowTable::kNoOwner) row_[moved] = row_[slot];
   }
   if (script_[slot] >= 0) scripts_[script_[slot]] = {};
   // Unlink any dummy linked to this one.
@@ -179,54 +181,43 @@ void Scene::FreeSlot(uint32_t slot) {
   --object_count_;
 }
 
-ObjectId Scene::AddDummy(std::string name, ObjectId parent, const Pose& X_PO) {
-  const uint32_t slot = AllocateSlot(std::move(name), parent, X_PO, ObjectType::kDummy);
+ObjectId Scene::AddObject(ObjectType type, std::string name, ObjectId parent, const Pose& X_PO,
+                          const void* row) {
+  SWARMSIM_CHECK(static_cast<size_t>(type) < types_.size(), "unregistered object type");
+  const uint32_t slot = AllocateSlot(std::move(name), parent, X_PO, type);
+  if (RowTable* table = tables_[static_cast<size_t>(type)].get())
+    row_[slot] = table->Append(row, slot);
   return IdAt(slot);
 }
 
+ObjectId Scene::AddDummy(std::string name, ObjectId parent, const Pose& X_PO) {
+  return AddObject(ObjectType::kDummy, std::move(name), parent, X_PO, nullptr);
+}
 ObjectId Scene::AddShape(std::string name, ObjectId parent, const Pose& X_PO,
                          const ShapeData& shape) {
-  const uint32_t slot = AllocateSlot(std::move(name), parent, X_PO, ObjectType::kShape);
-  row_[slot] = static_cast<uint32_t>(shapes_.size());
-  shapes_.push_back(shape);
-  shape_owner_.push_back(slot);
-  return IdAt(slot);
+  return AddObject(ObjectType::kShape, std::move(name), parent, X_PO, &shape);
 }
-
 ObjectId Scene::AddJoint(std::string name, ObjectId parent, const Pose& X_PO,
                          const JointData& joint) {
-  const uint32_t slot = AllocateSlot(std::move(name), parent, X_PO, ObjectType::kJoint);
-  row_[slot] = static_cast<uint32_t>(joints_.size());
-  joints_.push_back(joint);
-  joint_owner_.push_back(slot);
-  return IdAt(slot);
+  return AddObject(ObjectType::kJoint, std::move(name), parent, X_PO, &joint);
 }
-
 ObjectId Scene::AddProximitySensor(std::string name, ObjectId parent, const Pose& X_PO,
                                    const ProximitySensorData& sensor) {
-  const uint32_t slot = AllocateSlot(std::move(name), parent, X_PO, ObjectType::kProximitySensor);
-  row_[slot] = static_cast<uint32_t>(proximity_sensors_.size());
-  proximity_sensors_.push_back(sensor);
-  proximity_sensor_owner_.push_back(slot);
-  return IdAt(slot);
+  return AddObject(ObjectType::kProximitySensor, std::move(name), parent, X_PO, &sensor);
 }
-
 ObjectId Scene::AddForceSensor(std::string name, ObjectId parent, const Pose& X_PO,
                                const ForceSensorData& sensor) {
-  const uint32_t slot = AllocateSlot(std::move(name), parent, X_PO, ObjectType::kForceSensor);
-  row_[slot] = static_cast<uint32_t>(force_sensors_.size());
-  force_sensors_.push_back(sensor);
-  force_sensor_owner_.push_back(slot);
-  return IdAt(slot);
+  return AddObject(ObjectType::kForceSensor, std::move(name), parent, X_PO, &sensor);
 }
-
 ObjectId Scene::AddPaintNozzle(std::string name, ObjectId parent, const Pose& X_PO,
                                const PaintNozzleData& nozzle) {
-  const uint32_t slot = AllocateSlot(std::move(name), parent, X_PO, ObjectType::kPaintNozzle);
-  row_[slot] = static_cast<uint32_t>(paint_nozzles_.size());
-  paint_nozzles_.push_back(nozzle);
-  paint_nozzle_owner_.push_back(slot);
-  return IdAt(slot);
+  return AddObject(ObjectType::kPaintNozzle, std::move(name), parent, X_PO, &nozzle);
+}
+
+void* Scene::row_data(ObjectId id) {
+  const uint32_t slot = SlotOf(id);
+  RowTable* table = tables_[static_cast<size_t>(type_[slot])].get();
+  return table != nullptr ? table->At(row_[slot]) : nullptr;
 }
 
 // --- Tree links -------------------------------------------------------------------
@@ -348,42 +339,11 @@ uint32_t Scene::CopyObject(uint32_t src, int32_t new_parent) {
   // Copy the name and pose first: AllocateSlot may grow (and move) the arrays.
   std::string name = name_[src];
   const Pose X_PO = X_PO_[src];
-  ObjectId copy;
-  switch (type_[src]) {
-    case ObjectType::kDummy: copy = AddDummy(std::move(name), parent, X_PO); break;
-    case ObjectType::kShape: {
-      const ShapeData data = shapes_[row_[src]];
-      copy = AddShape(std::move(name), parent, X_PO, data);
-      break;
-    }
-    case ObjectType::kJoint: {
-      const JointData data = joints_[row_[src]];
-      copy = AddJoint(std::move(name), parent, X_PO, data);
-      break;
-    }
-    case ObjectType::kProximitySensor: {
-      const ProximitySensorData data = proximity_sensors_[row_[src]];
-      copy = AddProximitySensor(std::move(name), parent, X_PO, data);
-      break;
-    }
-    case ObjectType::kForceSensor: {
-      // The copy starts from the settings, unbroken and with no reading.
-      const ForceSensorData& src_data = force_sensors_[row_[src]];
-      ForceSensorData data;
-      data.filter_samples = src_data.filter_samples;
-      data.force_threshold = src_data.force_threshold;
-      data.torque_threshold = src_data.torque_threshold;
-      data.break_after = src_data.break_after;
-      copy = AddForceSensor(std::move(name), parent, X_PO, data);
-      break;
-    }
-    case ObjectType::kPaintNozzle: {
-      const PaintNozzleData data = paint_nozzles_[row_[src]];
-      copy = AddPaintNozzle(std::move(name), parent, X_PO, data);
-      break;
-    }
-  }
-  const uint32_t slot = copy.index();
+  // The copy's row from the source's, through the type's copy rule.
+  const ObjectType type = type_[src];
+  const uint32_t slot = AllocateSlot(std::move(name), parent, X_PO, type);
+  if (RowTable* table = tables_[static_cast<size_t>(type)].get())
+    row_[slot] = table->AppendCopy(row_[src], slot, types_[static_cast<size_t>(type)]->copy_row);
   v_WO_[slot] = v_WO_[src];
   w_WO_[slot] = w_WO_[src];
   model_root_[slot] = model_root_[src];
@@ -401,11 +361,10 @@ uint32_t Scene::CopyObject(uint32_t src, int32_t new_parent) {
 void Scene::ReserveForCopies(ObjectId root, size_t copies) {
   std::vector<uint32_t> sub;
   CollectSubtree(SlotOf(root), &sub);
-  size_t shapes = 0, joints = 0, sensors = 0, scripts = 0;
+  std::vector<size_t> rows_of_type(types_.size(), 0);
+  size_t scripts = 0;
   for (uint32_t s : sub) {
-    shapes += type_[s] == ObjectType::kShape;
-    joints += type_[s] == ObjectType::kJoint;
-    sensors += type_[s] == ObjectType::kProximitySensor;
+    ++rows_of_type[static_cast<size_t>(type_[s])];
     scripts += script_[s] >= 0;
   }
   const size_t slots = generation_.size() + sub.size() * copies;
@@ -421,12 +380,10 @@ void Scene::ReserveForCopies(ObjectId root, size_t copies) {
   row_.reserve(slots);
   generation_.reserve(slots);
   name_.reserve(slots);
-  shapes_.reserve(shapes_.size() + shapes * copies);
-  shape_owner_.reserve(shapes_.capacity());
-  joints_.reserve(joints_.size() + joints * copies);
-  joint_owner_.reserve(joints_.capacity());
-  proximity_sensors_.reserve(proximity_sensors_.size() + sensors * copies);
-  proximity_sensor_owner_.reserve(proximity_sensors_.capacity());
+  // Every type's table, whatever the type.
+  for (size_t t = 0; t < types_.size(); ++t)
+    if (tables_[t] && rows_of_type[t] > 0)
+      tables_[t]->Reserve(tables_[t]->size() + rows_of_type[t] * copies);
   scripts_.reserve(scripts_.size() + scripts * copies);
   instances_.reserve(instances_.size() + copies);
 }
@@ -480,64 +437,15 @@ void Scene::ScaleSubtree(ObjectId root, double s) {
     throw Error("cannot scale '" + name_[root_slot] + "' by " + std::to_string(s) +
                 ": the factor must be a finite number above 0");
   if (s == 1) return;
-  const double s3 = s * s * s, s4 = s3 * s;
   std::vector<uint32_t> sub;
   CollectSubtree(root_slot, &sub);
-  // Scaled mesh assets, one per original within this call.
-  std::unordered_map<const TriangleMesh*, std::shared_ptr<const TriangleMesh>> scaled_meshes;
+  ScaleContext context;  // scaled assets (meshes), one per original within this call
   for (uint32_t slot : sub) {
     size_factor_[slot] *= s;
     if (slot != root_slot) X_PO_[slot].p = X_PO_[slot].p * s;
-    switch (type_[slot]) {
-      case ObjectType::kDummy: break;
-      case ObjectType::kShape: {
-        ShapeData& shape = shapes_[row_[slot]];
-        shape.size = shape.size * s;
-        shape.mass *= s3;
-        if (shape.mesh) {
-          auto& scaled = scaled_meshes[shape.mesh.get()];
-          if (!scaled) {
-            std::vector<Vec3> vertices(shape.mesh->vertices().begin(),
-                                       shape.mesh->vertices().end());
-            for (Vec3& v : vertices) v = v * s;
-            std::vector<MeshTriangle> triangles(shape.mesh->triangles().begin(),
-                                                shape.mesh->triangles().end());
-            scaled = std::make_shared<const TriangleMesh>(shape.mesh->name(), std::move(vertices),
-                                                          std::move(triangles));
-          }
-          shape.mesh = scaled;
-          shape.size = scaled->CenteredExtents();
-        }
-        break;
-      }
-      case ObjectType::kJoint: {
-        JointData& j = joints_[row_[slot]];
-        if (j.type == JointType::kPrismatic) {  // lengths x s, forces (N) x s^3
-          for (double* v : {&j.position, &j.velocity, &j.target_velocity, &j.target_position,
-                            &j.max_velocity, &j.min_position, &j.max_position})
-            *v *= s;
-          j.max_force *= s3;
-          j.target_force *= s3;
-        } else {  // angles unchanged, torques (N m) x s^4
-          j.max_force *= s4;
-          j.target_force *= s4;
-        }
-        break;
-      }
-      case ObjectType::kProximitySensor: {
-        ProximitySensorData& p = proximity_sensors_[row_[slot]];
-        p.range *= s;
-        p.distance *= s;
-        break;
-      }
-      case ObjectType::kForceSensor: {
-        ForceSensorData& f = force_sensors_[row_[slot]];
-        f.force_threshold *= s3;
-        f.torque_threshold *= s4;
-        break;
-      }
-      case ObjectType::kPaintNozzle: paint_nozzles_[row_[slot]].radius *= s; break;
-    }
+    const size_t type = static_cast<size_t>(type_[slot]);
+    if (types_[type]->scale_row != nullptr)
+      types_[type]->scale_row(tables_[type]->At(row_[slot]), s, &context);
   }
   RefreshSubtree(root_slot);
   ++structure_version_;
@@ -546,7 +454,7 @@ void Scene::ScaleSubtree(ObjectId root, double s) {
 // --- Poses ---------------------------------------------------------------------------
 
 Pose Scene::ChildFrameAt(uint32_t slot) const {
-  if (type_[slot] == ObjectType::kJoint) return X_WO_[slot] * joints_[row_[slot]].Motion();
+  if (type_[slot] == ObjectType::kJoint) return X_WO_[slot] * joints()[row_[slot]].Motion();
   return X_WO_[slot];
 }
 
@@ -602,7 +510,7 @@ void Scene::UpdatePoses(std::span<const uint32_t> slots) {
   const int32_t* const parent = parent_.data();
   const ObjectType* const type = type_.data();
   const uint32_t* const row = row_.data();
-  const JointData* const joints = joints_.data();
+  const JointData* const joint_rows = joints().data();
   uint8_t* const simulated = simulated_.data();
   Pose* const X_PO = X_PO_.data();
   Pose* const X_WO = X_WO_.data();
@@ -616,7 +524,7 @@ void Scene::UpdatePoses(std::span<const uint32_t> slots) {
   for (const uint32_t s : slots) {
     const int32_t p = parent[s];
     if (p >= 0 && p != frame_slot) {
-      X_WF = type[p] == ObjectType::kJoint ? X_WO[p] * joints[row[p]].Motion() : X_WO[p];
+      X_WF = type[p] == ObjectType::kJoint ? X_WO[p] * joint_rows[row[p]].Motion() : X_WO[p];
       frame_slot = p;
     }
     if (simulated[s]) {
@@ -649,19 +557,19 @@ void Scene::UpdateWorldPoses(int instance) {
 
 static void ExpectType(const Scene& scene, uint32_t slot, ObjectType want) {
   if (scene.type_at(slot) != want)
-    throw Error("object '" + scene.name_at(slot) + "' is a " + ToString(scene.type_at(slot)) +
-                ", not a " + ToString(want));
+    throw Error("object '" + scene.name_at(slot) + "' is a " +
+                scene.type_name(scene.type_at(slot)) + ", not a " + scene.type_name(want));
 }
 
 const ShapeData& Scene::shape(ObjectId id) const {
   const uint32_t s = SlotOf(id, "shape");
   ExpectType(*this, s, ObjectType::kShape);
-  return shapes_[row_[s]];
+  return shapes()[row_[s]];
 }
 ShapeData& Scene::mutable_shape(ObjectId id) {
   const uint32_t s = SlotOf(id, "shape");
   ExpectType(*this, s, ObjectType::kShape);
-  return shapes_[row_[s]];
+  return shapes()[row_[s]];
 }
 void Scene::SetShapeDynamic(ObjectId id, bool dynamic) {
   ShapeData& shape = mutable_shape(id);
@@ -672,42 +580,42 @@ void Scene::SetShapeDynamic(ObjectId id, bool dynamic) {
 const JointData& Scene::joint(ObjectId id) const {
   const uint32_t s = SlotOf(id, "joint");
   ExpectType(*this, s, ObjectType::kJoint);
-  return joints_[row_[s]];
+  return joints()[row_[s]];
 }
 JointData& Scene::mutable_joint(ObjectId id) {
   const uint32_t s = SlotOf(id, "joint");
   ExpectType(*this, s, ObjectType::kJoint);
-  return joints_[row_[s]];
+  return joints()[row_[s]];
 }
 const ProximitySensorData& Scene::proximity_sensor(ObjectId id) const {
   const uint32_t s = SlotOf(id, "proximity sensor");
   ExpectType(*this, s, ObjectType::kProximitySensor);
-  return proximity_sensors_[row_[s]];
+  return proximity_sensors()[row_[s]];
 }
 const ForceSensorData& Scene::force_sensor(ObjectId id) const {
   const uint32_t s = SlotOf(id, "force sensor");
   ExpectType(*this, s, ObjectType::kForceSensor);
-  return force_sensors_[row_[s]];
+  return force_sensors()[row_[s]];
 }
 ForceSensorData& Scene::mutable_force_sensor(ObjectId id) {
   const uint32_t s = SlotOf(id, "force sensor");
   ExpectType(*this, s, ObjectType::kForceSensor);
-  return force_sensors_[row_[s]];
+  return force_sensors()[row_[s]];
 }
 const PaintNozzleData& Scene::paint_nozzle(ObjectId id) const {
   const uint32_t s = SlotOf(id, "paint nozzle");
   ExpectType(*this, s, ObjectType::kPaintNozzle);
-  return paint_nozzles_[row_[s]];
+  return Table<PaintNozzleData>(ObjectType::kPaintNozzle).rows[row_[s]];
 }
 PaintNozzleData& Scene::mutable_paint_nozzle(ObjectId id) {
   const uint32_t s = SlotOf(id, "paint nozzle");
   ExpectType(*this, s, ObjectType::kPaintNozzle);
-  return paint_nozzles_[row_[s]];
+  return Table<PaintNozzleData>(ObjectType::kPaintNozzle).rows[row_[s]];
 }
 ProximitySensorData& Scene::mutable_proximity_sensor(ObjectId id) {
   const uint32_t s = SlotOf(id, "proximity sensor");
   ExpectType(*this, s, ObjectType::kProximitySensor);
-  return proximity_sensors_[row_[s]];
+  return proximity_sensors()[row_[s]];
 }
 
 void Scene::LinkDummies(ObjectId a, ObjectId b) {

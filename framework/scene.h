@@ -2,9 +2,12 @@
 //
 // Objects are referred to by ObjectId {index1, generation}. Per-object hot
 // data (poses, velocities, parent links) lives in dense arrays indexed by slot;
-// type-specific data lives in one dense table per type (shapes, joints,
-// proximity sensors), each row pointing back at its object. Names, scripts and
-// model bookkeeping are cold arrays.
+// type-specific data lives in one dense table per object type, each row
+// pointing back at its object. What a type's rows are and how they are
+// copied, scaled and hashed is its descriptor's (framework/object_type.h):
+// Scene holds a table per registered type and calls those hooks; it has no
+// code of its own per type. Names, scripts and model bookkeeping are cold
+// arrays.
 //
 // A model is a subtree whose root is marked as a model. Each top-level model
 // copy is a *model instance* (a robot): the unit of parallelism and of random
@@ -23,20 +26,16 @@
 #include "framework/handle.h"
 #include "framework/math.h"
 #include "framework/mesh.h"
+#include "framework/object_rows.h"
 #include "framework/paint_nozzle.h"
 
 namespace swarmsim {
 
 class StateHasher;
+struct ObjectTypeDescriptor;
 
-enum class ObjectType : uint8_t {
-  kDummy,
-  kShape,
-  kJoint,
-  kProximitySensor,
-  kForceSensor,
-  kPaintNozzle
-};
+// The name of a built-in type ("proximity_sensor"); Scene::type_name names
+// registered ones too.
 const char* ToString(ObjectType type);
 
 enum class ShapeKind : uint8_t { kBox, kCylinder, kSphere, kCapsule, kMesh };
@@ -150,8 +149,30 @@ class Scene {
   Scene(const Scene&) = delete;
   Scene& operator=(const Scene&) = delete;
 
+  // --- Object types ---------------------------------------------------------------
+  // The built-in types are there from the start; a registered type (a
+  // module's or a plugin's) gets the next ObjectType value. Throws
+  // swarmsim::Error for a name already taken. The descriptor must outlive
+  // the scene.
+  ObjectType RegisterType(const ObjectTypeDescriptor& type);
+  const ObjectTypeDescriptor& type_descriptor(ObjectType type) const {
+    return *types_[static_cast<size_t>(type)];
+  }
+  // Every type, in ObjectType order.
+  std::span<const ObjectTypeDescriptor* const> types() const { return types_; }
+  // The type named `name`; false if there is none.
+  bool FindType(std::string_view name, ObjectType* type) const;
+  const char* type_name(ObjectType type) const;
+  // The rows of a type (null for a type without rows, such as dummy).
+  RowTable* rows(ObjectType type) { return tables_[static_cast<size_t>(type)].get(); }
+  const RowTable* rows(ObjectType type) const { return tables_[static_cast<size_t>(type)].get(); }
+
   // --- Creation and deletion --------------------------------------------------
-  // `parent` may be null (a root). X_PO is the pose of the new object in its parent.
+  // `parent` may be null (a root). X_PO is the pose of the new object in its
+  // parent. `row` points at a row of the type's row type to copy, or is null
+  // for the type's default row.
+  ObjectId AddObject(ObjectType type, std::string name, ObjectId parent, const Pose& X_PO,
+                     const void* row);
   ObjectId AddDummy(std::string name, ObjectId parent, const Pose& X_PO);
   ObjectId AddShape(std::string name, ObjectId parent, const Pose& X_PO, const ShapeData& shape);
   ObjectId AddJoint(std::string name, ObjectId parent, const Pose& X_PO, const JointData& joint);
@@ -255,27 +276,42 @@ class Scene {
   JointData& mutable_joint(ObjectId id);
   const ProximitySensorData& proximity_sensor(ObjectId id) const;
   ProximitySensorData& mutable_proximity_sensor(ObjectId id);
-  // Dense typed tables. Row r belongs to the object at slot *_owner()[r].
-  std::span<ShapeData> shapes() { return shapes_; }
-  std::span<const ShapeData> shapes() const { return shapes_; }
-  std::span<const uint32_t> shape_owners() const { return shape_owner_; }
-  std::span<JointData> joints() { return joints_; }
-  std::span<const JointData> joints() const { return joints_; }
-  std::span<const uint32_t> joint_owners() const { return joint_owner_; }
-  std::span<ProximitySensorData> proximity_sensors() { return proximity_sensors_; }
-  std::span<const ProximitySensorData> proximity_sensors() const { return proximity_sensors_; }
-  std::span<const uint32_t> proximity_sensor_owners() const { return proximity_sensor_owner_; }
+  // Dense typed tables of the built-in types. Row r belongs to the object at
+  // slot *_owners()[r].
+  std::span<ShapeData> shapes() { return Table<ShapeData>(ObjectType::kShape).rows; }
+  std::span<const ShapeData> shapes() const { return Table<ShapeData>(ObjectType::kShape).rows; }
+  std::span<const uint32_t> shape_owners() const { return Owners(ObjectType::kShape); }
+  std::span<JointData> joints() { return Table<JointData>(ObjectType::kJoint).rows; }
+  std::span<const JointData> joints() const { return Table<JointData>(ObjectType::kJoint).rows; }
+  std::span<const uint32_t> joint_owners() const { return Owners(ObjectType::kJoint); }
+  std::span<ProximitySensorData> proximity_sensors() {
+    return Table<ProximitySensorData>(ObjectType::kProximitySensor).rows;
+  }
+  std::span<const ProximitySensorData> proximity_sensors() const {
+    return Table<ProximitySensorData>(ObjectType::kProximitySensor).rows;
+  }
+  std::span<const uint32_t> proximity_sensor_owners() const {
+    return Owners(ObjectType::kProximitySensor);
+  }
   const ForceSensorData& force_sensor(ObjectId id) const;
   ForceSensorData& mutable_force_sensor(ObjectId id);
-  std::span<ForceSensorData> force_sensors() { return force_sensors_; }
-  std::span<const ForceSensorData> force_sensors() const { return force_sensors_; }
-  std::span<const uint32_t> force_sensor_owners() const { return force_sensor_owner_; }
+  std::span<ForceSensorData> force_sensors() {
+    return Table<ForceSensorData>(ObjectType::kForceSensor).rows;
+  }
+  std::span<const ForceSensorData> force_sensors() const {
+    return Table<ForceSensorData>(ObjectType::kForceSensor).rows;
+  }
+  std::span<const uint32_t> force_sensor_owners() const { return Owners(ObjectType::kForceSensor); }
   const PaintNozzleData& paint_nozzle(ObjectId id) const;
   PaintNozzleData& mutable_paint_nozzle(ObjectId id);
-  std::span<const PaintNozzleData> paint_nozzles() const { return paint_nozzles_; }
-  std::span<const uint32_t> paint_nozzle_owners() const { return paint_nozzle_owner_; }
-  // Row of the object's typed data (shape, joint or sensor table), by slot.
+  std::span<const PaintNozzleData> paint_nozzles() const {
+    return Table<PaintNozzleData>(ObjectType::kPaintNozzle).rows;
+  }
+  std::span<const uint32_t> paint_nozzle_owners() const { return Owners(ObjectType::kPaintNozzle); }
+  // Row of the object's typed data in its type's table, by slot.
   uint32_t row_at(uint32_t slot) const { return row_[slot]; }
+  // The object's row (of its type's row type), or null for a type without rows.
+  void* row_data(ObjectId id);
 
   // Dummy links (V-REP's dummy-dummy link, used by IK tip/target pairs).
   void LinkDummies(ObjectId a, ObjectId b);
@@ -337,6 +373,18 @@ class Scene {
   void RebuildInstanceObjects(int instance);
   void CollectSubtree(uint32_t slot, std::vector<uint32_t>* out) const;
   uint32_t CopyObject(uint32_t src, int32_t new_parent);
+  // A built-in type's table (the descriptor made Rows<Row> for it).
+  template <typename Row>
+  Rows<Row>& Table(ObjectType type) {
+    return static_cast<Rows<Row>&>(*tables_[static_cast<size_t>(type)]);
+  }
+  template <typename Row>
+  const Rows<Row>& Table(ObjectType type) const {
+    return static_cast<const Rows<Row>&>(*tables_[static_cast<size_t>(type)]);
+  }
+  std::span<const uint32_t> Owners(ObjectType type) const {
+    return tables_[static_cast<size_t>(type)]->owners;
+  }
 
   // Per slot, hot.
   std::vector<Pose> X_PO_;       // pose in parent (slots)
@@ -362,17 +410,10 @@ class Scene {
   std::vector<uint32_t> free_slots_;
   size_t object_count_ = 0;
 
-  // Typed tables.
-  std::vector<ShapeData> shapes_;
-  std::vector<uint32_t> shape_owner_;
-  std::vector<JointData> joints_;
-  std::vector<uint32_t> joint_owner_;
-  std::vector<ProximitySensorData> proximity_sensors_;
-  std::vector<uint32_t> proximity_sensor_owner_;
-  std::vector<ForceSensorData> force_sensors_;
-  std::vector<uint32_t> force_sensor_owner_;
-  std::vector<PaintNozzleData> paint_nozzles_;
-  std::vector<uint32_t> paint_nozzle_owner_;
+  // Object types and their row tables, by ObjectType value (a table is null
+  // for a type without rows).
+  std::vector<const ObjectTypeDescriptor*> types_;
+  std::vector<std::unique_ptr<RowTable>> tables_;
 
   std::vector<ScriptAttachment> scripts_;
   std::vector<ModelInstance> instances_;

@@ -254,6 +254,7 @@ void FailCallback(lua_State* L) {
     const char* message = lua_tolstring(L, -1, &length);
     return message != nullptr ? std::string(message, length) : std::string("refused");
   });
+  __builtin_unreachable();  // ExhaustBudget raises the Lua error (a longjmp)
 }
 
 namespace {

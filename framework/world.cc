@@ -9,6 +9,7 @@
 #include "framework/calculation_module.h"
 #include "framework/dynamics_backend.h"
 #include "framework/error.h"
+#include "framework/object_type.h"
 #include "framework/plugin_world_api.h"
 #include "framework/proximity_backend.h"
 #include "framework/registry.h"
@@ -534,30 +535,10 @@ uint64_t World::StateHash() const {
     h.AddValue(scene_.linear_velocity_at(s));
     h.AddValue(scene_.angular_velocity_at(s));
   }
-  for (size_t r = 0; r < scene_.joints().size(); ++r) {
-    const JointData& j = scene_.joints()[r];
-    h.AddValue(scene_.joint_owners()[r]);
-    h.AddValue(j.position);
-    h.AddValue(j.velocity);
-    h.AddValue(j.target_velocity);
-    h.AddValue(j.target_position);
-  }
-  for (size_t r = 0; r < scene_.proximity_sensors().size(); ++r) {
-    const ProximitySensorData& p = scene_.proximity_sensors()[r];
-    h.AddValue(scene_.proximity_sensor_owners()[r]);
-    h.AddValue(p.detected);
-    h.AddValue(p.distance);
-    h.AddValue(p.p_SD());
-    h.AddValue(p.detected_object);
-  }
-  for (size_t r = 0; r < scene_.force_sensors().size(); ++r) {
-    const ForceSensorData& f = scene_.force_sensors()[r];
-    h.AddValue(scene_.force_sensor_owners()[r]);
-    h.AddValue(f.broken);
-    h.AddValue(f.violations);
-    h.AddValue(f.force);
-    h.AddValue(f.torque);
-  }
+  // Each type's changing state, types in ObjectType order (object_type.h).
+  for (size_t t = 0; t < scene_.types().size(); ++t)
+    if (const auto hash_rows = scene_.types()[t]->hash_rows)
+      hash_rows(scene_, static_cast<ObjectType>(t), &h);
   for (const RobotRuntime& rt : runtimes_) h.Add(rt.rng.state(), 4 * sizeof(uint64_t));
   h.Add(scene_runtime_.rng.state(), 4 * sizeof(uint64_t));
   // What scripts left for the next step: signals, messages not yet delivered,

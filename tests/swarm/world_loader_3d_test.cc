@@ -141,11 +141,14 @@ TEST_F(WorldLoader3dTest, KinematicAndBox2dWorldsAcceptTheSameModel) {
     EXPECT_EQ(scene.world_pose(base).p.x, p_base.x) << physics;
     EXPECT_EQ(scene.world_pose(base).p.y, p_base.y) << physics;
     for (const char* path : {"/arm#0/shoulder", "/arm#0/shoulder/link",
-                             "/arm#0/shoulder/link/wrist", "/arm#0/shoulder/link/weld"})
-      for (double v : PoseValues(scene.world_pose(scene.FindObject(path))))
+                             "/arm#0/shoulder/link/wrist", "/arm#0/shoulder/link/weld"}) {
+      for (double v : PoseValues(scene.world_pose(scene.FindObject(path)))) {
         EXPECT_TRUE(std::isfinite(v)) << physics << " " << path;
-    if (std::string(physics) == "kinematic")
+      }
+    }
+    if (std::string(physics) == "kinematic") {
       EXPECT_EQ(scene.joint(scene.FindObject("/arm#0/shoulder")).position, 0.0);
+    }
   }
 }
 

@@ -1,0 +1,118 @@
+// Object-type descriptors: everything the simulator knows about one kind of
+// scene object, in one table entry (ARGoS's registered entities; MuJoCo's
+// plugin declarations). Scene, the world-file loader, the state hash and the
+// Lua host go through these entries; no code outside them switches over
+// object types.
+//
+// The built-in types are declared in framework/types/ (one file each) and
+// listed in framework/types/core_types.cc; a module or plugin adds its own
+// with ModuleRegistry::RegisterObjectType, and every World's Scene gets it.
+// Adding a type: its file (rows, hooks, keys), one registration line, tests,
+// and its section in worlds/README.md (tests/swarm/world_keys_doc_test.cc
+// checks that every key is documented).
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "framework/math.h"
+#include "framework/number_rule.h"
+#include "framework/object_rows.h"
+
+struct lua_State;
+
+namespace swarmsim {
+
+class ModuleRegistry;
+class Scene;
+class StateHasher;
+class TriangleMesh;
+
+// What a type's `read` hook sees of one object entry in a model file: the
+// loader's reader behind an interface (no YAML types here). Keys are the
+// type's own; `required` ones are an error when absent. Every error names
+// file:line:column.
+class ObjectReader {
+ public:
+  virtual ~ObjectReader() = default;
+  virtual bool Has(std::string_view key) const = 0;
+  virtual double Number(std::string_view key, const NumberRule& rule,
+                        bool required = false) const = 0;
+  virtual int64_t Integer(std::string_view key, int64_t min, int64_t max) const = 0;
+  virtual bool Bool(std::string_view key) const = 0;
+  virtual std::string String(std::string_view key, bool required = false) const = 0;
+  // One of `choices`, with a suggestion for a near miss.
+  virtual std::string Choice(std::string_view key, const std::vector<std::string>& choices,
+                             bool required = false) const = 0;
+  virtual std::vector<double> Numbers(std::string_view key, size_t min_count, size_t max_count,
+                                      const NumberRule& rule) const = 0;
+  virtual Vec3 Vector3(std::string_view key, const NumberRule& rule,
+                       bool required = false) const = 0;
+  // An error at the key's value, or at the key itself.
+  [[noreturn]] virtual void Fail(std::string_view key, const std::string& message) const = 0;
+  [[noreturn]] virtual void FailAtKey(std::string_view key, const std::string& message) const = 0;
+  // The triangle mesh file the string at `key` names (relative to the model
+  // file), read once per world and scale.
+  virtual std::shared_ptr<const TriangleMesh> Mesh(std::string_view key,
+                                                   const Vec3& scale) const = 0;
+  // The world's registry (plugin sensor types), or null.
+  virtual const ModuleRegistry* registry() const = 0;
+};
+
+// One world-file key of a type: its name, its default as the docs show it,
+// and one line of documentation (worlds/README.md lists the same keys).
+struct ObjectKey {
+  const char* name;
+  const char* default_text;
+  const char* doc;
+};
+
+// State a ScaleSubtree call shares between the rows it scales: one scaled
+// copy of each shared asset (a mesh) per call, so copies keep sharing.
+struct ScaleContext {
+  std::map<const void*, std::shared_ptr<const void>> assets;
+};
+
+// A Lua function of a type's API area (sim.readProximitySensor, ...).
+struct LuaFunction {
+  const char* name;
+  int (*function)(lua_State*);
+};
+
+struct ObjectTypeDescriptor {
+  const char* name;         // "proximity_sensor": world files, messages, `swarmsim modules`
+  const char* description;  // one line
+  // --- Rows ---------------------------------------------------------------------
+  // A new, empty table of the type's rows; null for a type without rows (dummy).
+  std::unique_ptr<RowTable> (*make_rows)() = nullptr;
+  // Copy-paste of an object: the copy's row from the source's. Null: the
+  // whole row (a force sensor copies its settings only and starts unbroken).
+  void (*copy_row)(const void* source, void* row) = nullptr;
+  // Size factor s (V-REP's): lengths x s, masses and forces x s^3, torques
+  // x s^4. Null: nothing of the row scales.
+  void (*scale_row)(void* row, double s, ScaleContext* context) = nullptr;
+  // --- State hash -------------------------------------------------------------------
+  // Adds the rows' changing state (and each row's owner slot), in row order.
+  // Null: the type adds nothing besides its objects' poses.
+  void (*hash_rows)(const Scene& scene, ObjectType type, StateHasher* hasher) = nullptr;
+  // --- World files ----------------------------------------------------------------
+  // The keys an object of the type takes besides name, type, pose, script
+  // and children, in the order messages list them.
+  std::span<const ObjectKey> keys = {};
+  // Fills `row` (a default row) from the object's entry.
+  void (*read)(const ObjectReader& reader, void* row) = nullptr;
+  // --- Scripts -----------------------------------------------------------------------
+  // The type's sim.* functions (its Lua API area).
+  std::span<const LuaFunction> lua_api = {};
+};
+
+// The built-in types, in the order world files, messages and the state hash
+// list them (framework/types/core_types.cc).
+std::span<const ObjectTypeDescriptor* const> CoreObjectTypes();
+
+}  // namespace swarmsim

@@ -1,0 +1,16 @@
+// The built-in object types' descriptors (one file each in this folder),
+// for core_types.cc's list.
+#pragma once
+
+#include "framework/object_type.h"
+
+namespace swarmsim {
+
+extern const ObjectTypeDescriptor kDummyType;
+extern const ObjectTypeDescriptor kShapeType;
+extern const ObjectTypeDescriptor kJointType;
+extern const ObjectTypeDescriptor kProximitySensorType;
+extern const ObjectTypeDescriptor kForceSensorType;
+extern const ObjectTypeDescriptor kPaintNozzleType;
+
+}  // namespace swarmsim

@@ -1,0 +1,72 @@
+// force_sensor: V-REP's force sensor, a rigid link between its parent shape
+// and the first dynamic shape below it that measures the force and torque it
+// transmits and breaks when they stay above a threshold (force_sensor.h).
+#include "framework/force_sensor.h"
+#include "framework/object_type.h"
+#include "framework/scene.h"
+#include "framework/state_hash.h"
+#include "framework/types/core_types.h"
+
+namespace swarmsim {
+namespace {
+
+constexpr ObjectKey kKeys[] = {
+    {"filter_samples", "1",
+     "readings are the mean of the last N samples (one per control step), 1..1000"},
+    {"force_threshold", "none", "N, a step whose (filtered) |F| exceeds it is a violation"},
+    {"torque_threshold", "none", "N m, likewise for |T|"},
+    {"break_after", "1", "consecutive violating steps that break the link, 1..1000000"},
+};
+
+std::unique_ptr<RowTable> MakeRows() { return std::make_unique<Rows<ForceSensorData>>(); }
+
+// A copy starts from the settings, unbroken and with no reading.
+void Copy(const void* source, void* row) {
+  const ForceSensorData& from = *static_cast<const ForceSensorData*>(source);
+  ForceSensorData& to = *static_cast<ForceSensorData*>(row);
+  to.filter_samples = from.filter_samples;
+  to.force_threshold = from.force_threshold;
+  to.torque_threshold = from.torque_threshold;
+  to.break_after = from.break_after;
+}
+
+void Scale(void* row, double s, ScaleContext*) {
+  ForceSensorData& f = *static_cast<ForceSensorData*>(row);
+  f.force_threshold *= s * s * s;
+  f.torque_threshold *= s * s * s * s;
+}
+
+void Hash(const Scene& scene, ObjectType, StateHasher* h) {
+  for (size_t r = 0; r < scene.force_sensors().size(); ++r) {
+    const ForceSensorData& f = scene.force_sensors()[r];
+    h->AddValue(scene.force_sensor_owners()[r]);
+    h->AddValue(f.broken);
+    h->AddValue(f.violations);
+    h->AddValue(f.force);
+    h->AddValue(f.torque);
+  }
+}
+
+void Read(const ObjectReader& r, void* row) {
+  ForceSensorData& s = *static_cast<ForceSensorData*>(row);
+  if (r.Has("filter_samples"))
+    s.filter_samples = static_cast<int>(r.Integer("filter_samples", 1, 1000));
+  if (r.Has("force_threshold")) s.force_threshold = r.Number("force_threshold", kPositive);
+  if (r.Has("torque_threshold")) s.torque_threshold = r.Number("torque_threshold", kPositive);
+  if (r.Has("break_after")) s.break_after = static_cast<int>(r.Integer("break_after", 1, 1000000));
+}
+
+}  // namespace
+
+constinit const ObjectTypeDescriptor kForceSensorType{
+    .name = "force_sensor",
+    .description = "a breakable rigid link that measures the force and torque it transmits",
+    .make_rows = MakeRows,
+    .copy_row = Copy,
+    .scale_row = Scale,
+    .hash_rows = Hash,
+    .keys = kKeys,
+    .read = Read,
+};
+
+}  // namespace swarmsim

@@ -1,0 +1,38 @@
+// paint_nozzle: marks the floor paint layer under it each step while enabled
+// (modules/paint).
+#include "framework/object_type.h"
+#include "framework/paint_nozzle.h"
+#include "framework/types/core_types.h"
+
+namespace swarmsim {
+namespace {
+
+constexpr ObjectKey kKeys[] = {
+    {"color", "[0.1, 0.1, 0.8]", "RGB, each 0..1"},
+    {"radius", "0.02", "m, of the painted disc"},
+    {"enabled", "true", "paints from the first step"},
+};
+
+std::unique_ptr<RowTable> MakeRows() { return std::make_unique<Rows<PaintNozzleData>>(); }
+
+void Scale(void* row, double s, ScaleContext*) { static_cast<PaintNozzleData*>(row)->radius *= s; }
+
+void Read(const ObjectReader& r, void* row) {
+  PaintNozzleData& n = *static_cast<PaintNozzleData*>(row);
+  if (r.Has("color")) n.color = r.Vector3("color", kFraction);
+  if (r.Has("radius")) n.radius = r.Number("radius", kPositiveLength);
+  if (r.Has("enabled")) n.enabled = r.Bool("enabled");
+}
+
+}  // namespace
+
+constinit const ObjectTypeDescriptor kPaintNozzleType{
+    .name = "paint_nozzle",
+    .description = "marks the floor paint layer under it while enabled",
+    .make_rows = MakeRows,
+    .scale_row = Scale,
+    .keys = kKeys,
+    .read = Read,
+};
+
+}  // namespace swarmsim
