@@ -5,6 +5,7 @@
 #include "framework/calculation_module.h"
 #include "framework/dynamics_backend.h"
 #include "framework/error.h"
+#include "framework/object_type.h"
 #include "framework/proximity_backend.h"
 
 namespace swarmsim {
@@ -63,6 +64,19 @@ void ModuleRegistry::RegisterPluginSensor(ModuleInfo info, PluginSensorType type
   info.kind = "sensor";
   modules_.push_back(std::move(info));
   plugin_sensors_.push_back(std::move(type));
+}
+
+void ModuleRegistry::RegisterObjectType(std::shared_ptr<const ObjectTypeDescriptor> type) {
+  if (!type || type->name == nullptr || *type->name == '\0')
+    throw Error("an object type needs a name");
+  const std::string name = type->name;
+  for (const ObjectTypeDescriptor* t : CoreObjectTypes())
+    if (name == t->name) throw Error("object type '" + name + "' is a built-in type");
+  for (const ObjectTypeDescriptor* t : object_types_)
+    if (name == t->name) throw Error("object type '" + name + "' is registered twice");
+  modules_.push_back({"object type", name, "", type->description ? type->description : ""});
+  object_types_.push_back(type.get());
+  owned_object_types_.push_back(std::move(type));
 }
 
 const PluginSensorType* ModuleRegistry::FindPluginSensor(std::string_view name) const {

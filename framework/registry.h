@@ -7,6 +7,7 @@
 
 #include <functional>
 #include <memory>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -18,6 +19,7 @@ namespace swarmsim {
 class CalculationModule;
 class DynamicsBackend;
 class ProximityBackend;
+struct ObjectTypeDescriptor;
 
 // A script command registered by a plugin (framework/plugin_api.h): sim.<name>.
 struct ScriptCommand {
@@ -76,6 +78,12 @@ class ModuleRegistry {
   // Null if no sensor type has that name.
   const PluginSensorType* FindPluginSensor(std::string_view name) const;
   const std::vector<PluginSensorType>& plugin_sensors() const { return plugin_sensors_; }
+  // Object types of modules and plugins (framework/object_type.h): kind
+  // "object type". Every World's Scene registers them after the built-in
+  // types, in this order. Throws swarmsim::Error if the name is taken
+  // (built-in names included).
+  void RegisterObjectType(std::shared_ptr<const ObjectTypeDescriptor> type);
+  std::span<const ObjectTypeDescriptor* const> object_types() const { return object_types_; }
   // Plugins loaded into this registry, by canonical path (LoadPlugin records them).
   void AddPluginPath(std::string path) { plugin_paths_.push_back(std::move(path)); }
   bool HasPlugin(std::string_view path) const;
@@ -99,6 +107,8 @@ class ModuleRegistry {
   std::vector<PhaseCallback> phase_callbacks_;
   std::vector<PluginSensorType> plugin_sensors_;
   std::vector<std::string> plugin_paths_;
+  std::vector<std::shared_ptr<const ObjectTypeDescriptor>> owned_object_types_;
+  std::vector<const ObjectTypeDescriptor*> object_types_;
 };
 
 }  // namespace swarmsim

@@ -100,6 +100,8 @@ World::World(const WorldSettings& settings, const ModuleRegistry& registry)
   for (const PhaseCallback& callback : registry_.phase_callbacks())
     phase_callbacks_.at(callback.phase).push_back(&callback);
   has_plugin_sensor_types_ = !registry_.plugin_sensors().empty();
+  // Object types of modules and plugins, after the built-in ones.
+  for (const ObjectTypeDescriptor* type : registry_.object_types()) scene_.RegisterType(*type);
 }
 
 World::World(const WorldSettings& settings, std::shared_ptr<const ModuleRegistry> registry)

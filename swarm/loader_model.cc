@@ -7,7 +7,9 @@
 #include <map>
 
 #include "framework/error.h"
+#include "framework/object_type.h"
 #include "framework/registry.h"
+#include "swarm/loader_object_reader.h"
 
 namespace swarmsim::loader {
 
@@ -22,58 +24,67 @@ constexpr int64_t kMaxRingCount = 1024;
 
 constexpr double kDegToRad = M_PI / 180.0;
 
-const std::vector<std::string> kObjectTypes = {
-    "shape",          "joint",        "dummy",        "proximity_sensor",
-    "proximity_ring", "force_sensor", "paint_nozzle", "plugin_sensor"};
 const std::vector<std::string> kCommonKeys = {
     "name", "type", "position", "orientation_deg", "heading_deg", "children", "script"};
-const std::vector<std::string> kJointKeys = {"joint",
-                                             "mode",
-                                             "max_force",
-                                             "max_velocity",
-                                             "target_velocity",
-                                             "target_position",
-                                             "initial_position",
-                                             "target_force",
-                                             "limits"};
-const std::vector<std::string> kSensorKeys = {"range"};
-const std::vector<std::string> kForceSensorKeys = {"filter_samples", "force_threshold",
-                                                   "torque_threshold", "break_after"};
-const std::vector<std::string> kPaintNozzleKeys = {"color", "radius", "enabled"};
-const std::vector<std::string> kPluginSensorKeys = {"sensor"};
+// Two loader-only types: a ring of proximity sensors, and a plugin sensor (a
+// dummy tagged with the sensor type a plugin registers).
 const std::vector<std::string> kRingKeys = {"name",   "type",  "count",          "radius",
                                             "height", "range", "start_angle_deg"};
+const std::vector<std::string> kPluginSensorKeys = {"sensor"};
 
-std::vector<std::string> Concat(std::initializer_list<const std::vector<std::string>*> lists) {
-  std::vector<std::string> out;
-  for (const auto* l : lists) out.insert(out.end(), l->begin(), l->end());
-  return out;
-}
+// The object types a model may use: every type of the scene (the built-in
+// ones, then the registry's, in ObjectType order; object_type.h), with
+// proximity_ring after proximity_sensor and plugin_sensor last.
+struct TypeList {
+  std::vector<const ObjectTypeDescriptor*> types;  // by ObjectType value
+  std::vector<std::string> names;                  // as world files write them
 
-// The keys an object of `type` (one of kObjectTypes) takes.
-const std::vector<std::string>& KeysOf(const std::string& type) {
-  static const std::map<std::string, std::vector<std::string>> keys = {
-      {"shape", Concat({&kCommonKeys, &ShapeKeys()})},
-      {"joint", Concat({&kCommonKeys, &kJointKeys})},
-      {"dummy", kCommonKeys},
-      {"proximity_sensor", Concat({&kCommonKeys, &kSensorKeys})},
-      {"proximity_ring", kRingKeys},
-      {"force_sensor", Concat({&kCommonKeys, &kForceSensorKeys})},
-      {"paint_nozzle", Concat({&kCommonKeys, &kPaintNozzleKeys})},
-      {"plugin_sensor", Concat({&kCommonKeys, &kPluginSensorKeys})}};
-  return keys.at(type);
-}
+  explicit TypeList(const ModuleRegistry* registry) {
+    const auto core = CoreObjectTypes();
+    types.assign(core.begin(), core.end());
+    if (registry != nullptr)
+      types.insert(types.end(), registry->object_types().begin(), registry->object_types().end());
+    for (const ObjectTypeDescriptor* t : types) {
+      names.push_back(t->name);
+      if (names.back() == "proximity_sensor") names.push_back("proximity_ring");
+    }
+    names.push_back("plugin_sensor");
+  }
+  // The type named `name` (one of `names` but the two loader-only ones).
+  ObjectType Find(const std::string& name) const {
+    for (size_t t = 0; t < types.size(); ++t)
+      if (name == types[t]->name) return static_cast<ObjectType>(t);
+    return ObjectType::kDummy;
+  }
+  // The keys an object of the type named `name` takes.
+  std::vector<std::string> KeysOf(const std::string& name) const {
+    if (name == "proximity_ring") return kRingKeys;
+    std::vector<std::string> keys = kCommonKeys;
+    if (name == "plugin_sensor") {
+      keys.insert(keys.end(), kPluginSensorKeys.begin(), kPluginSensorKeys.end());
+    } else {
+      for (const ObjectKey& key : types[static_cast<size_t>(Find(name))]->keys)
+        keys.push_back(key.name);
+    }
+    return keys;
+  }
+  // The keys of every type, once each (for an object without a 'type').
+  std::vector<std::string> AllKeys() const {
+    std::vector<std::string> all;
+    for (const std::string& name : names)
+      for (const std::string& key : KeysOf(name))
+        if (std::find(all.begin(), all.end(), key) == all.end()) all.push_back(key);
+    return all;
+  }
+};
 
-// The keys of every object type, once each (for an object without a 'type').
-const std::vector<std::string>& AllObjectKeys() {
-  static const std::vector<std::string> all = [] {
-    std::vector<std::string> out;
-    for (const std::string& type : kObjectTypes)
-      for (const std::string& key : KeysOf(type))
-        if (std::find(out.begin(), out.end(), key) == out.end()) out.push_back(key);
-    return out;
-  }();
-  return all;
+// A new row of `type`'s default values, in a table of its own (null for a
+// type without rows).
+std::shared_ptr<RowTable> NewRow(const ObjectTypeDescriptor& type) {
+  if (type.make_rows == nullptr) return nullptr;
+  std::shared_ptr<RowTable> row = type.make_rows();
+  row->Append(nullptr, 0);
+  return row;
 }
 
 // Object names are path elements: no '/', no brackets.
@@ -92,6 +103,7 @@ struct Builder {
   int objects = 0;
   MeshCache* meshes = nullptr;
   const ModuleRegistry* registry = nullptr;
+  TypeList types{registry};
 
   void Count(const Field& field, int n) {
     objects += n;
@@ -110,14 +122,14 @@ struct Builder {
                   is_root ? root_what : "an object of model '" + model.name + "'");
     // A misspelled 'type' or 'name' is an unknown key (with a suggestion),
     // not a missing one: without them, check the keys first.
-    if (!fields.Has("type")) fields.Expect(AllObjectKeys());
+    if (!fields.Has("type")) fields.Expect(types.AllKeys());
     const Field type_field = fields.Require("type");
-    const std::string type = values.Choice(type_field, kObjectTypes);
+    const std::string type = values.Choice(type_field, types.names);
     // The root is named after each copy in the scene (footbot#0, ...); its
     // name here is optional and only labels it in messages.
     std::string name = model.name;
     if (!is_root || fields.Has("name")) {
-      if (!fields.Has("name")) fields.Expect(KeysOf(type));
+      if (!fields.Has("name")) fields.Expect(types.KeysOf(type));
       const Field name_field = fields.Require("name");
       name = values.String(name_field);
       CheckObjectName(values, name_field, name);
@@ -129,7 +141,7 @@ struct Builder {
 
     if (type == "proximity_ring" && is_root)
       values.Fail(type_field, "a proximity ring cannot be the root object of a model");
-    named.Expect(KeysOf(type));
+    named.Expect(types.KeysOf(type));
     if (type == "proximity_ring") {
       Ring(named, name, out);
       return;
@@ -138,31 +150,16 @@ struct Builder {
     ObjectSpec spec;
     spec.name = name;
     spec.X_PO = ReadPose(values, named);
-    if (type == "shape") {
-      spec.type = ObjectType::kShape;
-      spec.shape = ReadShape(values, named, meshes);
-    } else if (type == "joint") {
-      spec.type = ObjectType::kJoint;
-      spec.joint = Joint(named);
-    } else if (type == "proximity_sensor") {
-      spec.type = ObjectType::kProximitySensor;
-      if (named.Has("range"))
-        spec.sensor.range = values.Number(named.Get("range"), kPositiveLength);
-    } else if (type == "force_sensor") {
-      spec.type = ObjectType::kForceSensor;
-      spec.force_sensor = ForceSensor(named);
-    } else if (type == "paint_nozzle") {
-      spec.type = ObjectType::kPaintNozzle;
-      if (named.Has("color"))
-        spec.paint_nozzle.color = values.Vector3(named.Get("color"), kFraction);
-      if (named.Has("radius"))
-        spec.paint_nozzle.radius = values.Number(named.Get("radius"), kPositiveLength);
-      if (named.Has("enabled")) spec.paint_nozzle.enabled = values.Bool(named.Get("enabled"));
-    } else if (type == "plugin_sensor") {
+    if (type == "plugin_sensor") {
       spec.type = ObjectType::kDummy;
       spec.plugin_sensor = PluginSensor(named.Require("sensor"));
     } else {
-      spec.type = ObjectType::kDummy;
+      // The type's own reader fills its row (framework/types/, object_type.h).
+      spec.type = types.Find(type);
+      const ObjectTypeDescriptor& descriptor = *types.types[static_cast<size_t>(spec.type)];
+      spec.row = NewRow(descriptor);
+      if (descriptor.read != nullptr)
+        descriptor.read(FieldsObjectReader(values, named, meshes, registry), spec.row->At(0));
     }
     Count(field, 1);
     if (named.Has("script")) {
@@ -201,57 +198,6 @@ struct Builder {
                            Suggest(name, known));
   }
 
-  ForceSensorData ForceSensor(const Fields& f) {
-    ForceSensorData s;
-    if (f.Has("filter_samples"))
-      s.filter_samples = static_cast<int>(values.Integer(f.Get("filter_samples"), 1, 1000));
-    if (f.Has("force_threshold"))
-      s.force_threshold = values.Number(f.Get("force_threshold"), kPositive);
-    if (f.Has("torque_threshold"))
-      s.torque_threshold = values.Number(f.Get("torque_threshold"), kPositive);
-    if (f.Has("break_after"))
-      s.break_after = static_cast<int>(values.Integer(f.Get("break_after"), 1, 1000000));
-    return s;
-  }
-
-  JointData Joint(const Fields& f) {
-    JointData j;
-    if (f.Has("joint")) {
-      const std::string type =
-          values.Choice(f.Get("joint"), {"revolute", "prismatic", "spherical", "fixed"});
-      j.type = type == "revolute"    ? JointType::kRevolute
-               : type == "prismatic" ? JointType::kPrismatic
-               : type == "spherical" ? JointType::kSpherical
-                                     : JointType::kFixed;
-    }
-    if (f.Has("mode")) {
-      const std::string mode =
-          values.Choice(f.Get("mode"), {"passive", "velocity", "position", "force"});
-      j.mode = mode == "passive"    ? JointMode::kPassive
-               : mode == "velocity" ? JointMode::kVelocity
-               : mode == "position" ? JointMode::kPosition
-                                    : JointMode::kForce;
-    }
-    if (f.Has("target_force")) j.target_force = values.Number(f.Get("target_force"), kAnyNumber);
-    if (f.Has("limits")) {
-      // [min, max] in rad or m, like initial_position.
-      const Field limits = f.Get("limits");
-      const std::vector<double> v = values.Numbers(limits, 2, 2, kAnyNumber);
-      if (!(v[0] <= v[1])) values.Fail(limits, "'limits' must be [min, max] with min <= max");
-      j.min_position = v[0];
-      j.max_position = v[1];
-    }
-    if (f.Has("max_force")) j.max_force = values.Number(f.Get("max_force"), kPositive);
-    if (f.Has("max_velocity")) j.max_velocity = values.Number(f.Get("max_velocity"), kPositive);
-    if (f.Has("target_velocity"))
-      j.target_velocity = values.Number(f.Get("target_velocity"), kAnyNumber);
-    if (f.Has("target_position"))
-      j.target_position = values.Number(f.Get("target_position"), kAnyNumber);
-    if (f.Has("initial_position"))
-      j.position = values.Number(f.Get("initial_position"), kAnyNumber);
-    return j;
-  }
-
   // `count` proximity sensors named `name` in a ring around the parent's z
   // axis: sensor i at angle start + 2 pi i / count counter-clockwise from the
   // parent's +x, its z axis (the ray) pointing radially outwards.
@@ -259,8 +205,11 @@ struct Builder {
     const int64_t count = values.Integer(f.Require("count"), 1, kMaxRingCount);
     const double radius = values.Number(f.Require("radius"), kNonNegativeLength);
     const double height = f.Has("height") ? values.Number(f.Get("height"), kCoordinate) : 0.0;
-    ProximitySensorData sensor;
-    if (f.Has("range")) sensor.range = values.Number(f.Get("range"), kPositiveLength);
+    // Each sensor of the ring reads the ring's range like a proximity_sensor.
+    const ObjectTypeDescriptor& sensor_type =
+        *types.types[static_cast<size_t>(ObjectType::kProximitySensor)];
+    const std::shared_ptr<RowTable> sensor = NewRow(sensor_type);
+    sensor_type.read(FieldsObjectReader(values, f, meshes, registry), sensor->At(0));
     const double start = f.Has("start_angle_deg")
                              ? values.Number(f.Get("start_angle_deg"), kAngleDeg) * kDegToRad
                              : 0;
@@ -272,7 +221,7 @@ struct Builder {
       ObjectSpec spec;
       spec.name = name;
       spec.type = ObjectType::kProximitySensor;
-      spec.sensor = sensor;
+      spec.row = sensor;  // shared: specs are not changed after they are read
       spec.X_PO = {{radius * std::cos(theta), radius * std::sin(theta), height},
                    Quat::FromYaw(theta) * z_to_x};
       out->push_back(std::move(spec));
@@ -300,9 +249,12 @@ std::shared_ptr<const ScriptSource> ScriptCache::Get(const fs::path& path, const
 // --- Shapes and poses ----------------------------------------------------------------
 
 const std::vector<std::string>& ShapeKeys() {
-  static const std::vector<std::string> keys = {"shape",   "size", "radius",   "height",
-                                                "dynamic", "mass", "friction", "restitution",
-                                                "color",   "file", "scale"};
+  static const std::vector<std::string> keys = [] {
+    std::vector<std::string> out;
+    for (const ObjectKey& key : CoreObjectTypes()[static_cast<size_t>(ObjectType::kShape)]->keys)
+      out.push_back(key.name);
+    return out;
+  }();
   return keys;
 }
 
@@ -312,59 +264,10 @@ const std::vector<std::string>& PoseKeys() {
 }
 
 ShapeData ReadShape(const ValueReader& values, const Fields& f, MeshCache* meshes) {
-  ShapeData s;
-  const std::string kind =
-      values.Choice(f.Require("shape"), {"box", "cylinder", "sphere", "capsule", "mesh"});
-  // Each kind takes its own size keys; a key of another kind is a mistake.
-  auto forbid = [&](const char* key, const char* hint) {
-    if (f.Has(key))
-      values.file().Fail(f.Get(key).key_mark, "'" + std::string(key) + "' does not apply to a " +
-                                                  kind + " (" + hint + ")");
-  };
-  if (kind != "mesh") {
-    forbid("file", "only a mesh takes 'file: part.stl'");
-    forbid("scale", "only a mesh takes 'scale: [sx, sy, sz]'");
-  }
-  if (kind == "mesh") {
-    s.kind = ShapeKind::kMesh;
-    for (const char* key : {"size", "radius", "height"})
-      forbid(key, "a mesh takes 'file: part.stl|part.obj' and optionally 'scale: [sx, sy, sz]'");
-    const Field file = f.Require("file");
-    const std::string text = values.String(file);
-    if (text.empty()) values.Fail(file, "'file' must be a mesh file name (.stl or .obj)");
-    const Vec3 scale = f.Has("scale") ? values.Vector3(f.Get("scale"), kPositive) : Vec3{1, 1, 1};
-    MeshCache local;
-    if (!meshes) meshes = &local;
-    s.mesh = meshes->Get(values.file().path().parent_path() / text, scale,
-                         values.file().Where(file.mark), text);
-    s.size = s.mesh->CenteredExtents();
-  } else if (kind == "box") {
-    s.kind = ShapeKind::kBox;
-    forbid("radius", "a box takes 'size: [x, y, z]'");
-    forbid("height", "a box takes 'size: [x, y, z]'");
-    s.size = values.Vector3(f.Require("size"), kPositiveLength);
-  } else if (kind == "cylinder" || kind == "capsule") {
-    s.kind = kind == "cylinder" ? ShapeKind::kCylinder : ShapeKind::kCapsule;
-    forbid("size", kind == "cylinder" ? "a cylinder takes 'radius' and 'height'"
-                                      : "a capsule takes 'radius' and 'height' (caps included)");
-    s.size = {values.Number(f.Require("radius"), kPositiveLength), 0,
-              values.Number(f.Require("height"), kPositiveLength)};
-    if (kind == "capsule" && s.size.z < 2 * s.size.x)
-      values.Fail(f.Get("height"),
-                  "a capsule's height includes its caps: it must be at least "
-                  "twice its radius");
-  } else {
-    s.kind = ShapeKind::kSphere;
-    forbid("size", "a sphere takes 'radius'");
-    forbid("height", "a sphere takes 'radius'");
-    s.size = {values.Number(f.Require("radius"), kPositiveLength), 0, 0};
-  }
-  if (f.Has("dynamic")) s.dynamic = values.Bool(f.Get("dynamic"));
-  if (f.Has("mass")) s.mass = values.Number(f.Get("mass"), kPositive);
-  if (f.Has("friction")) s.friction = values.Number(f.Get("friction"), kNonNegative);
-  if (f.Has("restitution")) s.restitution = values.Number(f.Get("restitution"), kFraction);
-  if (f.Has("color")) s.color = values.Vector3(f.Get("color"), kFraction);
-  return s;
+  ShapeData shape;
+  CoreObjectTypes()[static_cast<size_t>(ObjectType::kShape)]->read(
+      FieldsObjectReader(values, f, meshes, nullptr), &shape);
+  return shape;
 }
 
 Pose ReadPose(const ValueReader& values, const Fields& f) {
@@ -512,21 +415,8 @@ ObjectSpec ResolveModel(const ModelFile& model, const ValueReader& values, Scrip
 // --- Scene ----------------------------------------------------------------------------
 
 ObjectId AddToScene(const ObjectSpec& spec, ObjectId parent, Scene* scene) {
-  ObjectId id;
-  switch (spec.type) {
-    case ObjectType::kShape: id = scene->AddShape(spec.name, parent, spec.X_PO, spec.shape); break;
-    case ObjectType::kJoint: id = scene->AddJoint(spec.name, parent, spec.X_PO, spec.joint); break;
-    case ObjectType::kProximitySensor:
-      id = scene->AddProximitySensor(spec.name, parent, spec.X_PO, spec.sensor);
-      break;
-    case ObjectType::kForceSensor:
-      id = scene->AddForceSensor(spec.name, parent, spec.X_PO, spec.force_sensor);
-      break;
-    case ObjectType::kPaintNozzle:
-      id = scene->AddPaintNozzle(spec.name, parent, spec.X_PO, spec.paint_nozzle);
-      break;
-    case ObjectType::kDummy: id = scene->AddDummy(spec.name, parent, spec.X_PO); break;
-  }
+  const ObjectId id = scene->AddObject(spec.type, spec.name, parent, spec.X_PO,
+                                       spec.row ? spec.row->At(0) : nullptr);
   if (!spec.plugin_sensor.empty()) scene->WriteCustomData(id, kPluginSensorTag, spec.plugin_sensor);
   if (spec.script) scene->AttachScript(id, spec.script, spec.script_explicit);
   for (const ObjectSpec& child : spec.children) AddToScene(child, id, scene);
@@ -537,8 +427,8 @@ namespace {
 
 void Accumulate(const ObjectSpec& spec, const Pose& X_RP, Footprint* fp, bool* any) {
   const Pose X_RO = X_RP * spec.X_PO;
-  if (spec.type == ObjectType::kShape) {
-    const ShapeData& s = spec.shape;
+  if (const ShapeData* shape = spec.As<ShapeData>(ObjectType::kShape)) {
+    const ShapeData& s = *shape;
     Vec3 half;  // half extents in the shape's frame
     switch (s.kind) {
       case ShapeKind::kBox: half = s.size * 0.5; break;
@@ -581,7 +471,8 @@ void Accumulate(const ObjectSpec& spec, const Pose& X_RP, Footprint* fp, bool* a
       fp->bottom = std::min(fp->bottom, bottom);
     }
   }
-  const Pose X_RC = spec.type == ObjectType::kJoint ? X_RO * spec.joint.Motion() : X_RO;
+  const JointData* joint = spec.As<JointData>(ObjectType::kJoint);
+  const Pose X_RC = joint != nullptr ? X_RO * joint->Motion() : X_RO;
   for (const ObjectSpec& child : spec.children) Accumulate(child, X_RC, fp, any);
 }
 

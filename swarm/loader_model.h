@@ -26,12 +26,16 @@ struct ObjectSpec {
   std::string name;
   ObjectType type = ObjectType::kDummy;
   Pose X_PO;  // pose in the parent
-  ShapeData shape;
-  JointData joint;
-  ProximitySensorData sensor;
-  ForceSensorData force_sensor;
-  PaintNozzleData paint_nozzle;
+  // The object's row (of its type's row type, object_type.h) in a table of
+  // its own; null for a type without rows.
+  std::shared_ptr<RowTable> row;
   std::string plugin_sensor;  // type: plugin_sensor: the sensor type (a kDummy tagged with it)
+  // The row as `Row` if the object is of `type`, else null (the placement
+  // footprint reads shapes and joints).
+  template <typename Row>
+  const Row* As(ObjectType want) const {
+    return type == want && row ? static_cast<const Row*>(row->At(0)) : nullptr;
+  }
   std::shared_ptr<const ScriptSource> script;
   bool script_explicit = false;  // script: {file: ..., explicit: true}
   std::vector<ObjectSpec> children;
@@ -84,8 +88,9 @@ bool IsParameterName(std::string_view name);
 ObjectSpec ResolveModel(const ModelFile& model, const ValueReader& values, ScriptCache* scripts,
                         MeshCache* meshes = nullptr, const ModuleRegistry* registry = nullptr);
 
-// Shape keys and object poses, shared with the world's obstacles. A mesh's
-// file is relative to the file being read; `meshes` null: no sharing.
+// Shape keys and object poses, shared with the world's obstacles (the shape
+// type's own reader, framework/types/shape_type.cc). A mesh's file is
+// relative to the file being read; `meshes` null: no sharing.
 ShapeData ReadShape(const ValueReader& values, const Fields& fields, MeshCache* meshes = nullptr);
 Pose ReadPose(const ValueReader& values, const Fields& fields);
 // orientation_deg: [roll, pitch, yaw] or heading_deg (identity if neither).

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "framework/math.h"
+#include "framework/number_rule.h"
 #include "framework/parameters.h"
 #include "swarm/loader_yaml.h"
 
@@ -63,23 +64,8 @@ class Expressions {
   std::unique_ptr<Impl> impl_;
 };
 
-// Bounds for a number read from a file.
-struct NumberRule {
-  const char* text;  // what is expected, for messages: "a positive number"
-  double min;
-  double max;
-  bool min_exclusive = false;
-};
-// Largest length or coordinate accepted, m (framework/math.h).
-inline constexpr double kMaxLength = kMaxCoordinate;
-inline constexpr NumberRule kAnyNumber{"a number", -1e300, 1e300};
-inline constexpr NumberRule kCoordinate{"a number of metres", -kMaxLength, kMaxLength};
-inline constexpr NumberRule kPositiveLength{"a positive number", 0, kMaxLength, true};
-inline constexpr NumberRule kNonNegativeLength{"a non-negative number", 0, kMaxLength};
-inline constexpr NumberRule kPositive{"a positive number", 0, 1e300, true};
-inline constexpr NumberRule kNonNegative{"a non-negative number", 0, 1e300};
-inline constexpr NumberRule kFraction{"a number from 0 to 1", 0, 1};
-inline constexpr NumberRule kAngleDeg{"an angle in degrees", -1e6, 1e6};
+// NumberRule and the usual rules (kPositiveLength, ...): framework/number_rule.h.
+using swarmsim::NumberRule;
 
 // Reads typed values from fields of one file, in one scope.
 class ValueReader {

@@ -176,8 +176,9 @@ using ScaledMeshes = std::map<const TriangleMesh*, std::shared_ptr<const Triangl
 // at the assets an earlier copy of the entry was scaled to, so that copies
 // built from their own description share them as duplicates do.
 void ShareScaledMeshes(const ObjectSpec& spec, ObjectId id, Scene* scene, ScaledMeshes* scaled) {
-  if (spec.type == ObjectType::kShape && spec.shape.mesh) {
-    const auto [it, added] = scaled->emplace(spec.shape.mesh.get(), scene->shape(id).mesh);
+  const ShapeData* shape = spec.As<ShapeData>(ObjectType::kShape);
+  if (shape != nullptr && shape->mesh) {
+    const auto [it, added] = scaled->emplace(shape->mesh.get(), scene->shape(id).mesh);
     if (!added) scene->mutable_shape(id).mesh = it->second;
   }
   const std::vector<ObjectId> children = scene->children(id);
@@ -496,7 +497,7 @@ WorldSettings WorldLoader::ReadSimulation(const Fields& top, std::optional<int64
     if (f.Has("gravity"))
       s.gravity = values.Number(f.Get("gravity"), {"a non-negative number (m/s^2)", 0, 1e4});
     if (f.Has("octree_resolution"))
-      s.octree_resolution = values.Number(f.Get("octree_resolution"), loader::kPositiveLength);
+      s.octree_resolution = values.Number(f.Get("octree_resolution"), kPositiveLength);
     if (f.Has("duration") && f.Has("steps"))
       values.Fail(f.Get("steps"), "give either 'duration' (seconds) or 'steps', not both");
     if (f.Has("steps")) *steps = values.Integer(f.Get("steps"), 0, int64_t{1} << 40);
@@ -573,17 +574,15 @@ void WorldLoader::BuildArena(const Fields& top, World* world) {
   const Field size = f.Require("size");
   double w, h;
   if (size.node.IsSequence()) {
-    const std::vector<double> v = values.Numbers(size, 2, 2, loader::kPositiveLength);
+    const std::vector<double> v = values.Numbers(size, 2, 2, kPositiveLength);
     w = v[0], h = v[1];
   } else {
-    w = h =
-        values.Number(size, {"a positive number or [width, depth]", 0, loader::kMaxLength, true});
+    w = h = values.Number(size, {"a positive number or [width, depth]", 0, kMaxLength, true});
   }
-  const double t = f.Has("wall_thickness")
-                       ? values.Number(f.Get("wall_thickness"), loader::kPositiveLength)
-                       : 0.1;
+  const double t =
+      f.Has("wall_thickness") ? values.Number(f.Get("wall_thickness"), kPositiveLength) : 0.1;
   const double height =
-      f.Has("wall_height") ? values.Number(f.Get("wall_height"), loader::kPositiveLength) : 0.2;
+      f.Has("wall_height") ? values.Number(f.Get("wall_height"), kPositiveLength) : 0.2;
   arena_ = Region2{-w / 2, -h / 2, w / 2, h / 2};
   // Four static walls around the inner area; the north and south ones span the corners.
   struct Wall {
@@ -707,7 +706,7 @@ void WorldLoader::ResolveEntry(EntryPlan* entry) {
   entry->footprint = loader::ComputeFootprint(entry->spec);
   if (f.Has("scale")) {
     // Every length of the model scales, so its footprint does too.
-    static constexpr loader::NumberRule kScale{"a number from 0.001 to 1000", 1e-3, 1e3};
+    static constexpr NumberRule kScale{"a number from 0.001 to 1000", 1e-3, 1e3};
     entry->scale = world_values.Number(f.Get("scale"), kScale);
     entry->footprint.radius *= entry->scale;
     entry->footprint.bottom *= entry->scale;
@@ -755,10 +754,8 @@ void WorldLoader::ResolveEntry(EntryPlan* entry) {
     } else if (region.node.IsMap()) {
       Fields r(*file_, region, "'region'");
       r.Expect({"min", "max"});
-      const std::vector<double> lo =
-          world_values.Numbers(r.Require("min"), 2, 2, loader::kCoordinate);
-      const std::vector<double> hi =
-          world_values.Numbers(r.Require("max"), 2, 2, loader::kCoordinate);
+      const std::vector<double> lo = world_values.Numbers(r.Require("min"), 2, 2, kCoordinate);
+      const std::vector<double> hi = world_values.Numbers(r.Require("max"), 2, 2, kCoordinate);
       if (!(lo[0] < hi[0] && lo[1] < hi[1]))
         file_->Fail(r.Get("max").mark, "'region' needs max greater than min in x and in y");
       entry->region = {lo[0], lo[1], hi[0], hi[1]};
@@ -770,9 +767,9 @@ void WorldLoader::ResolveEntry(EntryPlan* entry) {
                                    loader::Describe(region.node) + ")");
     }
     if (d.Has("clearance"))
-      entry->clearance = world_values.Number(d.Get("clearance"), loader::kNonNegativeLength);
+      entry->clearance = world_values.Number(d.Get("clearance"), kNonNegativeLength);
     if (d.Has("heading_deg"))
-      entry->heading = world_values.Number(d.Get("heading_deg"), loader::kAngleDeg) * kDegToRad;
+      entry->heading = world_values.Number(d.Get("heading_deg"), kAngleDeg) * kDegToRad;
     const double r = entry->MaxFootprintRadius();
     if (entry->count > 0 && (entry->region.max_x - entry->region.min_x < 2 * r ||
                              entry->region.max_y - entry->region.min_y < 2 * r))
@@ -791,7 +788,7 @@ void WorldLoader::ResolveEntry(EntryPlan* entry) {
     }
     const Field position = f.Get("position");
     entry->position_field = position;
-    const std::vector<double> p = world_values.Numbers(position, 2, 3, loader::kCoordinate);
+    const std::vector<double> p = world_values.Numbers(position, 2, 3, kCoordinate);
     entry->fixed_pose.q = loader::ReadOrientation(world_values, f);
     entry->count = 1;
     entry->fixed_pose.p = {p[0], p[1], p.size() == 3 ? p[2] : -entry->FootprintOf(0).bottom};
