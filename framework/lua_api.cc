@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "framework/error.h"
+#include "framework/object_type.h"
 #include "framework/suggest.h"
 
 namespace swarmsim {
@@ -289,24 +290,25 @@ void PushParamValue(lua_State* L, const ParamValue& value) {
 
 namespace {
 void RegisterAreas(lua_State* L) {
-  // One API area per file; a new area adds one line here.
+  // One API area per file; a new area adds one line here (an object type's
+  // area is named by its descriptor instead).
   static constexpr void (*kAreas[])(lua_State*) = {
-      RegisterSimApi,          // lua_api_sim.cc: time, parameters, random, metrics, print
-      RegisterObjectsApi,      // lua_api_objects.cc: lookup, names, tree, poses
-      RegisterJointsApi,       // lua_api_joints.cc: joint targets and states
-      RegisterSensorsApi,      // lua_api_sensors.cc: proximity sensors
-      RegisterMessagesApi,     // lua_api_messages.cc: messages, signals, packing
-      RegisterControlApi,      // script_host.cc: child scripts, threads, main-script handlers
-      RegisterDynamicsApi,     // lua_api_dynamics.cc: dynamic/kinematic switch, joint forces
-      RegisterIkApi,           // lua_api_ik.cc: IK groups
-      RegisterForceSensorApi,  // lua_api_force.cc: force sensors
-      RegisterPaintApi,        // lua_api_paint.cc: paint nozzles
-      RegisterCustomDataApi,   // lua_api_custom_data.cc: custom data blocks
-      RegisterPluginApi,       // lua_api_plugins.cc: plugin sensors
+      RegisterSimApi,         // lua_api_sim.cc: time, parameters, random, metrics, print
+      RegisterObjectsApi,     // lua_api_objects.cc: lookup, names, tree, poses
+      RegisterMessagesApi,    // lua_api_messages.cc: messages, signals, packing
+      RegisterControlApi,     // script_host.cc: child scripts, threads, main-script handlers
+      RegisterDynamicsApi,    // lua_api_dynamics.cc: dynamic/kinematic switch, joint forces
+      RegisterIkApi,          // lua_api_ik.cc: IK groups
+      RegisterCustomDataApi,  // lua_api_custom_data.cc: custom data blocks
+      RegisterPluginApi,      // lua_api_plugins.cc: plugin sensors
   };
   lua_pushinteger(L, kHandleWorld);
   lua_setfield(L, -2, "handle_world");
   for (auto area : kAreas) area(L);
+  // Each object type's own area (joints, proximity, force sensors, paint
+  // nozzles: framework/types/, object_type.h).
+  for (const ObjectTypeDescriptor* type : CoreObjectTypes())
+    if (type->register_lua != nullptr) type->register_lua(L);
 }
 }  // namespace
 

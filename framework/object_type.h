@@ -78,12 +78,6 @@ struct ScaleContext {
   std::map<const void*, std::shared_ptr<const void>> assets;
 };
 
-// A Lua function of a type's API area (sim.readProximitySensor, ...).
-struct LuaFunction {
-  const char* name;
-  int (*function)(lua_State*);
-};
-
 struct ObjectTypeDescriptor {
   const char* name;         // "proximity_sensor": world files, messages, `swarmsim modules`
   const char* description;  // one line
@@ -107,8 +101,9 @@ struct ObjectTypeDescriptor {
   // Fills `row` (a default row) from the object's entry.
   void (*read)(const ObjectReader& reader, void* row) = nullptr;
   // --- Scripts -----------------------------------------------------------------------
-  // The type's sim.* functions (its Lua API area).
-  std::span<const LuaFunction> lua_api = {};
+  // The type's Lua API area: adds its sim.* functions to the table on top of
+  // L's stack (framework/lua_api.h; sim.readProximitySensor, ...). Null: none.
+  void (*register_lua)(lua_State* L) = nullptr;
 };
 
 // The built-in types, in the order world files, messages and the state hash

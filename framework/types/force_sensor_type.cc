@@ -8,6 +8,10 @@
 #include "framework/types/core_types.h"
 
 namespace swarmsim {
+
+// Its Lua API area (framework/lua_api_*.cc).
+void RegisterForceSensorApi(lua_State* L);
+
 namespace {
 
 constexpr ObjectKey kKeys[] = {
@@ -67,6 +71,7 @@ constinit const ObjectTypeDescriptor kForceSensorType{
     .hash_rows = Hash,
     .keys = kKeys,
     .read = Read,
+    .register_lua = RegisterForceSensorApi,
 };
 
 }  // namespace swarmsim

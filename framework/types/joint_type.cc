@@ -7,6 +7,10 @@
 #include "framework/types/core_types.h"
 
 namespace swarmsim {
+
+// Its Lua API area (framework/lua_api_*.cc).
+void RegisterJointsApi(lua_State* L);
+
 namespace {
 
 constexpr ObjectKey kKeys[] = {
@@ -92,6 +96,7 @@ constinit const ObjectTypeDescriptor kJointType{
     .hash_rows = Hash,
     .keys = kKeys,
     .read = Read,
+    .register_lua = RegisterJointsApi,
 };
 
 }  // namespace swarmsim

@@ -5,6 +5,10 @@
 #include "framework/types/core_types.h"
 
 namespace swarmsim {
+
+// Its Lua API area (framework/lua_api_*.cc).
+void RegisterPaintApi(lua_State* L);
+
 namespace {
 
 constexpr ObjectKey kKeys[] = {
@@ -33,6 +37,7 @@ constinit const ObjectTypeDescriptor kPaintNozzleType{
     .scale_row = Scale,
     .keys = kKeys,
     .read = Read,
+    .register_lua = RegisterPaintApi,
 };
 
 }  // namespace swarmsim

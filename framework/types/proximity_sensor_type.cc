@@ -6,6 +6,10 @@
 #include "framework/types/core_types.h"
 
 namespace swarmsim {
+
+// Its Lua API area (framework/lua_api_*.cc).
+void RegisterSensorsApi(lua_State* L);
+
 namespace {
 
 constexpr ObjectKey kKeys[] = {
@@ -46,6 +50,7 @@ constinit const ObjectTypeDescriptor kProximitySensorType{
     .hash_rows = Hash,
     .keys = kKeys,
     .read = Read,
+    .register_lua = RegisterSensorsApi,
 };
 
 }  // namespace swarmsim
