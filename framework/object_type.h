@@ -81,15 +81,19 @@ struct ScaleContext {
 struct ObjectTypeDescriptor {
   const char* name;         // "proximity_sensor": world files, messages, `swarmsim modules`
   const char* description;  // one line
+  // What a type's hooks may need of their own (a plugin type's keys); the
+  // hooks get their descriptor.
+  const void* context = nullptr;
   // --- Rows ---------------------------------------------------------------------
   // A new, empty table of the type's rows; null for a type without rows (dummy).
-  std::unique_ptr<RowTable> (*make_rows)() = nullptr;
+  std::unique_ptr<RowTable> (*make_rows)(const ObjectTypeDescriptor& type) = nullptr;
   // Copy-paste of an object: the copy's row from the source's. Null: the
   // whole row (a force sensor copies its settings only and starts unbroken).
   void (*copy_row)(const void* source, void* row) = nullptr;
   // Size factor s (V-REP's): lengths x s, masses and forces x s^3, torques
   // x s^4. Null: nothing of the row scales.
-  void (*scale_row)(void* row, double s, ScaleContext* context) = nullptr;
+  void (*scale_row)(const ObjectTypeDescriptor& type, void* row, double s,
+                    ScaleContext* context) = nullptr;
   // --- State hash -------------------------------------------------------------------
   // Adds the rows' changing state (and each row's owner slot), in row order.
   // Null: the type adds nothing besides its objects' poses.
@@ -99,7 +103,7 @@ struct ObjectTypeDescriptor {
   // and children, in the order messages list them.
   std::span<const ObjectKey> keys = {};
   // Fills `row` (a default row) from the object's entry.
-  void (*read)(const ObjectReader& reader, void* row) = nullptr;
+  void (*read)(const ObjectTypeDescriptor& type, const ObjectReader& reader, void* row) = nullptr;
   // --- Scripts -----------------------------------------------------------------------
   // The type's Lua API area: adds its sim.* functions to the table on top of
   // L's stack (framework/lua_api.h; sim.readProximitySensor, ...). Null: none.

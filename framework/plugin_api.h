@@ -9,7 +9,8 @@
 // and registers script commands through the registrar: a command `name`
 // is called from Lua as sim.name(...); and per-phase callbacks, which the
 // world runs at fixed points of each step (SwarmsimPhase); and sensor types
-// (ABI 3), read by scripts with sim.readPluginSensor. Arguments and results are numbers,
+// (ABI 3), read by scripts with sim.readPluginSensor; and object types (ABI
+// 4) that model files place like built-in ones. Arguments and results are numbers,
 // strings and number arrays (SwarmsimValue); no Lua type crosses this
 // interface. Everything here is plain C, so a plugin built with another
 // compiler works as long as the ABI version matches; the version changes
@@ -20,7 +21,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#define SWARMSIM_PLUGIN_ABI_VERSION 3
+#define SWARMSIM_PLUGIN_ABI_VERSION 4
 
 #ifdef __cplusplus
 extern "C" {
@@ -67,6 +68,23 @@ typedef struct SwarmsimWorldApi {
   // Step count and number of robots (robot indices are 0..count-1).
   int64_t (*step_count)(void* world);
   int (*robot_count)(void* world);
+  // --- ABI 4 ---
+  // The values of an object of a plugin's object type (its keys, in the
+  // order the type declared them) into out[0..max); returns how many it has,
+  // or -1 if `object` is not of a plugin's type (or is stale).
+  int (*object_values)(void* world, int64_t object, double* out, int max);
+  // The objects of the type `type` (a plugin's or a built-in one, e.g.
+  // "beacon", "proximity_sensor"), in handle order, into out[0..max);
+  // returns how many there are (possibly more than max), or -1 for an
+  // unknown type.
+  int (*objects_of_type)(void* world, const char* type, int64_t* out, int max);
+  // The robot (model instance) `object` belongs to; -1 for an object
+  // outside every robot or a stale handle.
+  int (*robot_of)(void* world, int64_t object);
+  // A row of metrics.csv for this step: robot -1 for a swarm-level value.
+  // From record-phase callbacks only (kSwarmsimRecord); returns 0, or -1
+  // elsewhere or for a bad robot or name.
+  int (*record_metric)(void* world, int robot, const char* name, double value);
 } SwarmsimWorldApi;
 
 // Who is calling: the robot and the script's object.
@@ -94,7 +112,8 @@ enum SwarmsimPhase {
   kSwarmsimBeforeControl = 1,  // before the child scripts run
   kSwarmsimAfterControl = 2,   // after them, before deferred writes and joint motion
   kSwarmsimAfterPhysics = 3,   // after the dynamics step (poses are current)
-  kSwarmsimPhaseCount = 4
+  kSwarmsimRecord = 4,         // ABI 4: the record phase, after the swarm metrics
+  kSwarmsimPhaseCount = 5
 };
 
 // A phase callback. Whole-world callbacks run once per phase on the calling
@@ -120,6 +139,18 @@ typedef int (*SwarmsimSensorFunction)(const SwarmsimCallContext* context, int64_
                                       double* values, int max_values, char* error,
                                       size_t error_size, void* user_data);
 
+// One world-file key of a plugin's object type (ABI 4): a number, with its
+// default and accepted range. Under a size factor s (a model's `scale:`,
+// sim.setObjectSizeFactor) the value becomes value * s^length_power: 1 for
+// a length, 3 for a mass or force, 0 for what does not scale.
+typedef struct SwarmsimObjectKey {
+  const char* name;
+  double default_value;
+  double min, max;
+  int length_power;
+  const char* doc;  // one line: unit and meaning
+} SwarmsimObjectKey;
+
 typedef struct SwarmsimRegistrar {
   void* impl;
   // Registers sim.<name>; returns 0, or -1 if the name is taken or invalid.
@@ -138,6 +169,15 @@ typedef struct SwarmsimRegistrar {
   // or -1 for a missing name or function.
   int (*add_sensor_type)(void* impl, const char* name, const char* description,
                          SwarmsimSensorFunction sense, void* user_data);
+  // --- ABI 4 ---
+  // Registers the object type `name`: model files place its objects as
+  // {type: NAME, name: ..., KEY: value, ...}, copied, scaled and removed
+  // with their model like built-in objects; scripts and callbacks read an
+  // object's values through the world API's object_values (a plugin command
+  // such as sim.readBeacon(h)). Returns 0, or -1 for a missing or taken
+  // name, a key without a name, or a default outside its range.
+  int (*add_object_type)(void* impl, const char* name, const char* description,
+                         const SwarmsimObjectKey* keys, int key_count);
 } SwarmsimRegistrar;
 
 // The two entry points a plugin exports.

@@ -5,7 +5,9 @@
 #include <filesystem>
 
 #include "framework/error.h"
+#include "framework/object_type.h"
 #include "framework/plugin_api.h"
+#include "framework/plugin_object_type.h"
 #include "framework/registry.h"
 
 namespace swarmsim {
@@ -17,6 +19,7 @@ struct Registration {
   std::vector<ScriptCommand> commands;
   std::vector<PhaseCallback> callbacks;
   std::vector<PluginSensorType> sensors;
+  std::vector<std::shared_ptr<const ObjectTypeDescriptor>> object_types;
   std::string error;
 };
 
@@ -26,6 +29,7 @@ const char* PhaseName(int phase) {
     case kSwarmsimBeforeControl: return "before_control";
     case kSwarmsimAfterControl: return "after_control";
     case kSwarmsimAfterPhysics: return "after_physics";
+    case kSwarmsimRecord: return "record";
   }
   return "?";
 }
@@ -63,6 +67,24 @@ int AddSensorType(void* impl, const char* name, const char* description,
   return 0;
 }
 
+int AddObjectType(void* impl, const char* name, const char* description,
+                  const SwarmsimObjectKey* keys, int key_count) {
+  auto* r = static_cast<Registration*>(impl);
+  if (name == nullptr || name[0] == 0 || key_count < 0 || (key_count > 0 && keys == nullptr)) {
+    r->error = "add_object_type needs a name and its keys";
+    return -1;
+  }
+  try {
+    r->object_types.push_back(
+        MakePluginObjectType(name, description != nullptr ? description : "",
+                             std::vector<SwarmsimObjectKey>(keys, keys + key_count)));
+  } catch (const Error& e) {
+    r->error = e.what();
+    return -1;
+  }
+  return 0;
+}
+
 void SetInfo(void* impl, const char* name, const char* version, const char* description) {
   auto* r = static_cast<Registration*>(impl);
   if (name != nullptr) r->info.name = name;
@@ -95,7 +117,8 @@ void LoadPlugin(const std::string& path, ModuleRegistry* registry) {
   Registration r;
   r.info.name.assign(path);
   r.info.version.assign("unversioned");
-  const SwarmsimRegistrar registrar{&r, AddCommand, SetInfo, AddPhaseCallback, AddSensorType};
+  const SwarmsimRegistrar registrar{
+      &r, AddCommand, SetInfo, AddPhaseCallback, AddSensorType, AddObjectType};
   if (do_register(&registrar) != 0 || !r.error.empty()) {
     std::string message = "plugin '" + path + "' failed to register";
     if (!r.error.empty()) message.append(": ").append(r.error);
@@ -125,6 +148,13 @@ void LoadPlugin(const std::string& path, ModuleRegistry* registry) {
     info.description = sensor.description;
     try {
       registry->RegisterPluginSensor(info, std::move(sensor));
+    } catch (const Error& e) {
+      throw Error("plugin '" + path + "': " + e.what());
+    }
+  }
+  for (std::shared_ptr<const ObjectTypeDescriptor>& type : r.object_types) {
+    try {
+      registry->RegisterObjectType(std::move(type));
     } catch (const Error& e) {
       throw Error("plugin '" + path + "': " + e.what());
     }

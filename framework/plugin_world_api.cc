@@ -2,6 +2,7 @@
 
 #include <variant>
 
+#include "framework/plugin_object_type.h"
 #include "framework/world.h"
 
 namespace swarmsim {
@@ -73,9 +74,42 @@ int SetJointTargetVelocity(void* world, int robot, int64_t joint, double velocit
 int64_t StepCount(void* world) { return W(world).step_count(); }
 int RobotCount(void* world) { return W(world).robot_count(); }
 
+int ObjectValues(void* world, int64_t object, double* out, int max) {
+  const std::vector<double>* values =
+      PluginObjectValues(W(world).scene(), ObjectId::FromInteger(object));
+  if (values == nullptr) return -1;
+  for (size_t k = 0; k < values->size() && static_cast<int>(k) < max; ++k) out[k] = (*values)[k];
+  return static_cast<int>(values->size());
+}
+
+int ObjectsOfType(void* world, const char* type, int64_t* out, int max) {
+  const Scene& scene = W(world).scene();
+  ObjectType t;
+  if (type == nullptr || !scene.FindType(type, &t)) return -1;
+  int count = 0;
+  for (uint32_t slot = 0; slot < scene.slot_count(); ++slot) {
+    if (!scene.alive_at(slot) || scene.type_at(slot) != t) continue;
+    if (count < max) out[count] = scene.IdAt(slot).ToInteger();
+    ++count;
+  }
+  return count;
+}
+
+int RobotOf(void* world, int64_t object) {
+  const Scene& scene = W(world).scene();
+  const ObjectId id = ObjectId::FromInteger(object);
+  return scene.IsValid(id) ? scene.instance_of(id) : -1;
+}
+
+int RecordMetric(void* world, int robot, const char* name, double value) {
+  return W(world).RecordPluginMetric(robot, name != nullptr ? name : "", value) ? 0 : -1;
+}
+
 constexpr SwarmsimWorldApi kWorldApi = {
-    WorldTime,           ObjectPosition,         NumberParameter, FindObject, RobotRoot,
-    ReadProximitySensor, SetJointTargetVelocity, StepCount,       RobotCount};
+    WorldTime,   ObjectPosition,      NumberParameter,        FindObject,
+    RobotRoot,   ReadProximitySensor, SetJointTargetVelocity, StepCount,
+    RobotCount,  ObjectValues,        ObjectsOfType,          RobotOf,
+    RecordMetric};
 
 }  // namespace
 

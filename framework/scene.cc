@@ -85,7 +85,7 @@ ObjectType Scene::RegisterType(const ObjectTypeDescriptor& type) {
     throw Error("cannot register object type '" + std::string(type.name) + "': at most " +
                 std::to_string(kMaxObjectTypes) + " object types");
   types_.push_back(&type);
-  tables_.push_back(type.make_rows != nullptr ? type.make_rows() : nullptr);
+  tables_.push_back(type.make_rows != nullptr ? type.make_rows(type) : nullptr);
   return static_cast<ObjectType>(types_.size() - 1);
 }
 
@@ -445,7 +445,7 @@ void Scene::ScaleSubtree(ObjectId root, double s) {
     if (slot != root_slot) X_PO_[slot].p = X_PO_[slot].p * s;
     const size_t type = static_cast<size_t>(type_[slot]);
     if (types_[type]->scale_row != nullptr)
-      types_[type]->scale_row(tables_[type]->At(row_[slot]), s, &context);
+      types_[type]->scale_row(*types_[type], tables_[type]->At(row_[slot]), s, &context);
   }
   RefreshSubtree(root_slot);
   ++structure_version_;

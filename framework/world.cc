@@ -509,6 +509,30 @@ void World::Physics() {
 
 void World::Record() {
   for (auto& observer : observers_) observer->Record(*this, &metrics_);
+  if (phase_callbacks_[kSwarmsimRecord].empty()) return;
+  // Plugins' record-phase callbacks, then their rows in robot order (the
+  // swarm-level ones first), whatever the thread count.
+  recording_ = true;
+  try {
+    RunPhaseCallbacks(kSwarmsimRecord);
+  } catch (...) {
+    recording_ = false;
+    plugin_metrics_.clear();
+    throw;
+  }
+  recording_ = false;
+  std::stable_sort(
+      plugin_metrics_.begin(), plugin_metrics_.end(),
+      [](const MetricSample& a, const MetricSample& b) { return a.instance < b.instance; });
+  for (MetricSample& m : plugin_metrics_) metrics_.push_back(std::move(m));
+  plugin_metrics_.clear();
+}
+
+bool World::RecordPluginMetric(int robot, std::string_view name, double value) {
+  if (!recording_ || name.empty() || robot < -1 || robot >= robot_count()) return false;
+  const std::lock_guard lock(plugin_metrics_mutex_);
+  plugin_metrics_.push_back({step_count_, time_, robot, std::string(name), value});
+  return true;
 }
 
 void World::Stop() {

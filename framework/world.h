@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "framework/parameters.h"
+#include "framework/plugin_api.h"
 #include "framework/random.h"
 #include "framework/scene.h"
 #include "framework/spatial_grid.h"
@@ -253,6 +254,11 @@ class World {
   // Script `print` lines are passed here, prefixed by the robot instance
   // name, in robot order after each phase. Default: standard output.
   void set_log_sink(std::function<void(std::string_view)> sink) { log_sink_ = std::move(sink); }
+  // For the plugins' world API (record_metric): a metrics row of this step
+  // for `robot` (-1: swarm-level), from the record phase's plugin callbacks
+  // only (any thread). False outside that phase, for a bad robot or an
+  // empty name.
+  bool RecordPluginMetric(int robot, std::string_view name, double value);
   // For a step that never ends (the runner's watchdog thread): hands what
   // the scripts printed in it so far to the log sink, robots in index order,
   // then the scene's scripts.
@@ -342,7 +348,12 @@ class World {
   WorldSettings settings_;
   const ModuleRegistry& registry_;
   std::shared_ptr<const ModuleRegistry> owned_registry_;  // null unless given by shared_ptr
-  std::array<std::vector<const PhaseCallback*>, 4> phase_callbacks_;  // by SwarmsimPhase
+  std::array<std::vector<const PhaseCallback*>, kSwarmsimPhaseCount>
+      phase_callbacks_;  // by SwarmsimPhase
+  // Rows plugins record in the record phase (RecordPluginMetric).
+  bool recording_ = false;
+  std::mutex plugin_metrics_mutex_;
+  std::vector<MetricSample> plugin_metrics_;
   bool has_plugin_sensor_types_ = false;
   std::vector<PluginSensorState> plugin_sensors_;  // robot by robot, then the scene's
   std::vector<uint32_t> plugin_sensor_start_;      // robots + 2: robot r's are [r], [r + 1)

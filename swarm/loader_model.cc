@@ -82,7 +82,7 @@ struct TypeList {
 // type without rows).
 std::shared_ptr<RowTable> NewRow(const ObjectTypeDescriptor& type) {
   if (type.make_rows == nullptr) return nullptr;
-  std::shared_ptr<RowTable> row = type.make_rows();
+  std::shared_ptr<RowTable> row = type.make_rows(type);
   row->Append(nullptr, 0);
   return row;
 }
@@ -159,7 +159,8 @@ struct Builder {
       const ObjectTypeDescriptor& descriptor = *types.types[static_cast<size_t>(spec.type)];
       spec.row = NewRow(descriptor);
       if (descriptor.read != nullptr)
-        descriptor.read(FieldsObjectReader(values, named, meshes, registry), spec.row->At(0));
+        descriptor.read(descriptor, FieldsObjectReader(values, named, meshes, registry),
+                        spec.row->At(0));
     }
     Count(field, 1);
     if (named.Has("script")) {
@@ -209,7 +210,7 @@ struct Builder {
     const ObjectTypeDescriptor& sensor_type =
         *types.types[static_cast<size_t>(ObjectType::kProximitySensor)];
     const std::shared_ptr<RowTable> sensor = NewRow(sensor_type);
-    sensor_type.read(FieldsObjectReader(values, f, meshes, registry), sensor->At(0));
+    sensor_type.read(sensor_type, FieldsObjectReader(values, f, meshes, registry), sensor->At(0));
     const double start = f.Has("start_angle_deg")
                              ? values.Number(f.Get("start_angle_deg"), kAngleDeg) * kDegToRad
                              : 0;
@@ -265,8 +266,8 @@ const std::vector<std::string>& PoseKeys() {
 
 ShapeData ReadShape(const ValueReader& values, const Fields& f, MeshCache* meshes) {
   ShapeData shape;
-  CoreObjectTypes()[static_cast<size_t>(ObjectType::kShape)]->read(
-      FieldsObjectReader(values, f, meshes, nullptr), &shape);
+  const ObjectTypeDescriptor& type = *CoreObjectTypes()[static_cast<size_t>(ObjectType::kShape)];
+  type.read(type, FieldsObjectReader(values, f, meshes, nullptr), &shape);
   return shape;
 }
 

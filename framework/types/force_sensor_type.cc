@@ -22,7 +22,9 @@ constexpr ObjectKey kKeys[] = {
     {"break_after", "1", "consecutive violating steps that break the link, 1..1000000"},
 };
 
-std::unique_ptr<RowTable> MakeRows() { return std::make_unique<Rows<ForceSensorData>>(); }
+std::unique_ptr<RowTable> MakeRows(const ObjectTypeDescriptor&) {
+  return std::make_unique<Rows<ForceSensorData>>();
+}
 
 // A copy starts from the settings, unbroken and with no reading.
 void Copy(const void* source, void* row) {
@@ -34,7 +36,7 @@ void Copy(const void* source, void* row) {
   to.break_after = from.break_after;
 }
 
-void Scale(void* row, double s, ScaleContext*) {
+void Scale(const ObjectTypeDescriptor&, void* row, double s, ScaleContext*) {
   ForceSensorData& f = *static_cast<ForceSensorData*>(row);
   f.force_threshold *= s * s * s;
   f.torque_threshold *= s * s * s * s;
@@ -51,7 +53,7 @@ void Hash(const Scene& scene, ObjectType, StateHasher* h) {
   }
 }
 
-void Read(const ObjectReader& r, void* row) {
+void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
   ForceSensorData& s = *static_cast<ForceSensorData*>(row);
   if (r.Has("filter_samples"))
     s.filter_samples = static_cast<int>(r.Integer("filter_samples", 1, 1000));

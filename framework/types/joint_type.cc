@@ -25,11 +25,13 @@ constexpr ObjectKey kKeys[] = {
     {"limits", "none", "[min, max], rad or m: ODE stops, and IK keeps solutions inside"},
 };
 
-std::unique_ptr<RowTable> MakeRows() { return std::make_unique<Rows<JointData>>(); }
+std::unique_ptr<RowTable> MakeRows(const ObjectTypeDescriptor&) {
+  return std::make_unique<Rows<JointData>>();
+}
 
 // Prismatic: lengths x s, forces (N) x s^3; revolute and others: angles
 // unchanged, torques (N m) x s^4.
-void Scale(void* row, double s, ScaleContext*) {
+void Scale(const ObjectTypeDescriptor&, void* row, double s, ScaleContext*) {
   JointData& j = *static_cast<JointData*>(row);
   const double s3 = s * s * s, s4 = s3 * s;
   if (j.type == JointType::kPrismatic) {
@@ -55,7 +57,7 @@ void Hash(const Scene& scene, ObjectType, StateHasher* h) {
   }
 }
 
-void Read(const ObjectReader& r, void* row) {
+void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
   JointData& j = *static_cast<JointData*>(row);
   if (r.Has("joint")) {
     const std::string type = r.Choice("joint", {"revolute", "prismatic", "spherical", "fixed"});

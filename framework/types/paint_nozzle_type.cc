@@ -17,11 +17,15 @@ constexpr ObjectKey kKeys[] = {
     {"enabled", "true", "paints from the first step"},
 };
 
-std::unique_ptr<RowTable> MakeRows() { return std::make_unique<Rows<PaintNozzleData>>(); }
+std::unique_ptr<RowTable> MakeRows(const ObjectTypeDescriptor&) {
+  return std::make_unique<Rows<PaintNozzleData>>();
+}
 
-void Scale(void* row, double s, ScaleContext*) { static_cast<PaintNozzleData*>(row)->radius *= s; }
+void Scale(const ObjectTypeDescriptor&, void* row, double s, ScaleContext*) {
+  static_cast<PaintNozzleData*>(row)->radius *= s;
+}
 
-void Read(const ObjectReader& r, void* row) {
+void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
   PaintNozzleData& n = *static_cast<PaintNozzleData*>(row);
   if (r.Has("color")) n.color = r.Vector3("color", kFraction);
   if (r.Has("radius")) n.radius = r.Number("radius", kPositiveLength);

@@ -16,9 +16,11 @@ constexpr ObjectKey kKeys[] = {
     {"range", "0.1", "m, > 0"},
 };
 
-std::unique_ptr<RowTable> MakeRows() { return std::make_unique<Rows<ProximitySensorData>>(); }
+std::unique_ptr<RowTable> MakeRows(const ObjectTypeDescriptor&) {
+  return std::make_unique<Rows<ProximitySensorData>>();
+}
 
-void Scale(void* row, double s, ScaleContext*) {
+void Scale(const ObjectTypeDescriptor&, void* row, double s, ScaleContext*) {
   ProximitySensorData& p = *static_cast<ProximitySensorData*>(row);
   p.range *= s;
   p.distance *= s;
@@ -35,7 +37,7 @@ void Hash(const Scene& scene, ObjectType, StateHasher* h) {
   }
 }
 
-void Read(const ObjectReader& r, void* row) {
+void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
   if (r.Has("range"))
     static_cast<ProximitySensorData*>(row)->range = r.Number("range", kPositiveLength);
 }

@@ -26,11 +26,13 @@ constexpr ObjectKey kKeys[] = {
      "[sx, sy, sz], positive factors applied to the file's coordinates"},
 };
 
-std::unique_ptr<RowTable> MakeRows() { return std::make_unique<Rows<ShapeData>>(); }
+std::unique_ptr<RowTable> MakeRows(const ObjectTypeDescriptor&) {
+  return std::make_unique<Rows<ShapeData>>();
+}
 
 // Sizes x s, mass x s^3; a mesh gets a scaled copy of its asset, one per
 // asset per call (context), so copies duplicated afterwards share it.
-void Scale(void* row, double s, ScaleContext* context) {
+void Scale(const ObjectTypeDescriptor&, void* row, double s, ScaleContext* context) {
   ShapeData& shape = *static_cast<ShapeData*>(row);
   shape.size = shape.size * s;
   shape.mass *= s * s * s;
@@ -49,7 +51,7 @@ void Scale(void* row, double s, ScaleContext* context) {
 }
 
 // Each kind takes its own size keys; a key of another kind is a mistake.
-void Read(const ObjectReader& r, void* row) {
+void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
   ShapeData& s = *static_cast<ShapeData*>(row);
   const std::string kind =
       r.Choice("shape", {"box", "cylinder", "sphere", "capsule", "mesh"}, /*required=*/true);

@@ -94,7 +94,9 @@ TEST(PluginTest, LoadErrorsNameThePathAndTheProblem) {
   EXPECT_CONTAINS(ErrorOf([&] { LoadPlugin("/nonexistent/p.so", &registry); }),
                   "cannot load plugin '/nonexistent/p.so': ");
   EXPECT_CONTAINS(ErrorOf([&] { LoadPlugin(PluginPath("wrong_abi_plugin.so"), &registry); }),
-                  "was built for plugin ABI version 4, this swarmsim has version 3");
+                  "was built for plugin ABI version 5, this swarmsim has version 4");
+  EXPECT_CONTAINS(ErrorOf([&] { LoadPlugin(PluginPath("old_abi_plugin.so"), &registry); }),
+                  "was built for plugin ABI version 3, this swarmsim has version 4; rebuild it");
   EXPECT_CONTAINS(ErrorOf([&] { LoadPlugin("libm.so.6", &registry); }), "cannot load plugin");
   LoadPlugin(PluginPath("example_plugin.so"), &registry);
   EXPECT_CONTAINS(ErrorOf([&] { LoadPlugin(PluginPath("example_plugin.so"), &registry); }),
@@ -104,7 +106,7 @@ TEST(PluginTest, LoadErrorsNameThePathAndTheProblem) {
 TEST(PluginTest, PhaseCallbacksRunAtTheirPointsOfTheStep) {
   ModuleRegistry registry = testing::NullRegistry();
   LoadPlugin(PluginPath("example_plugin.so"), &registry);
-  EXPECT_EQ(registry.phase_callbacks().size(), 5u);  // Steer + 4 counters
+  EXPECT_EQ(registry.phase_callbacks().size(), 7u);  // Steer + 5 counters + beacon coverage
   std::vector<std::string> log;
   const auto world = OneBotWorld(registry, R"(
 function sysCall_actuation()
@@ -113,9 +115,9 @@ end)",
                                  &log);
   for (int i = 0; i < 3; ++i) world->Step();
   // In step k (from 0) the script runs after sense and before-control of
-  // step k, after control and physics of steps 0..k-1.
-  const std::vector<std::string> expected = {"[bot#0] 1.0 1.0 0.0 0.0", "[bot#0] 2.0 2.0 1.0 1.0",
-                                             "[bot#0] 3.0 3.0 2.0 2.0"};
+  // step k, after control, physics and record of steps 0..k-1.
+  const std::vector<std::string> expected = {
+      "[bot#0] 1.0 1.0 0.0 0.0 0.0", "[bot#0] 2.0 2.0 1.0 1.0 1.0", "[bot#0] 3.0 3.0 2.0 2.0 2.0"};
   EXPECT_EQ(log, expected);
   // A robot without motors cannot use robotMoveAndAvoidObstacles.
   const auto other = OneBotWorld(registry, "sim.robotMoveAndAvoidObstacles(1)", &log);

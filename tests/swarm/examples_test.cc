@@ -200,6 +200,79 @@ TEST(ExamplesTest, PluginLightSensorReadsTheLightThroughTheProgram) {
   std::filesystem::remove_all(out);
 }
 
+// worlds/beacons.yaml: the example plugin's own object type (beacon, with
+// world-file keys, copied and scaled with its model, read from Lua with the
+// plugin's sim.readBeacon) and its record-phase module (near_beacon_fraction
+// in metrics.csv every step), through the program.
+TEST(ExamplesTest, BeaconsWorldUsesThePluginsObjectTypeAndRecordModule) {
+  const std::string world = std::string(SWARMSIM_SOURCE_DIR) + "/worlds/beacons.yaml";
+  const std::filesystem::path out =
+      std::filesystem::temp_directory_path() / ("swarmsim_beacons_" + std::to_string(getpid()));
+  std::string hash;
+  for (int threads : {1, 2}) {
+    const auto [status, text] =
+        swarmsim::testing::RunProgram("run " + world + " --steps 60 --quiet --hash --threads " +
+                                      std::to_string(threads) + " --out " + out.string());
+    ASSERT_EQ(status, 0) << text;
+    // The model's `reach` parameter reaches the beacon's key; copy 0 has its own.
+    EXPECT_NE(text.find("[beacon_post#0] beacon radius 1.20 m, strength 2"), std::string::npos)
+        << text;
+    EXPECT_NE(text.find("[beacon_post#3] beacon radius 0.80 m, strength 2"), std::string::npos)
+        << text;
+    const std::string line = text.substr(text.find("state-hash: "));
+    if (hash.empty()) hash = line;
+    EXPECT_EQ(line, hash) << threads << " threads";
+  }
+  std::ifstream csv(out / "metrics.csv");
+  std::vector<double> fractions;
+  for (std::string row; std::getline(csv, row);)
+    if (row.find(",,near_beacon_fraction,") != std::string::npos)
+      fractions.push_back(std::stod(row.substr(row.rfind(',') + 1)));
+  ASSERT_EQ(fractions.size(), 60u);  // one swarm-level row per step
+  for (double f : fractions) {
+    EXPECT_GE(f, 0.0);
+    EXPECT_LE(f, 1.0);
+  }
+  EXPECT_GT(*std::max_element(fractions.begin(), fractions.end()), 0.0);
+  std::filesystem::remove_all(out);
+}
+
+// A plugin's object type in a model of one's own: its keys are checked like
+// built-in ones (unknown key with a suggestion, range), and `scale:`
+// multiplies a key declared as a length.
+TEST(ExamplesTest, APluginObjectTypeIsReadCheckedAndScaledLikeABuiltInOne) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                    ("swarmsim_beacon_model_" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  const auto run = [&](const std::string& beacon_keys) {
+    std::ofstream(dir / "post.yaml") << "model: post\n"
+                                        "objects:\n"
+                                        "  type: dummy\n"
+                                        "  children:\n"
+                                        "    - {name: b, type: beacon, script: post.lua, "
+                                     << beacon_keys << "}\n";
+    std::ofstream(dir / "post.lua")
+        << "function sysCall_init() print(sim.readBeacon(sim.getObject('.'))[1]) end\n";
+    std::ofstream(dir / "world.yaml") << "plugins: [example_plugin]\n"
+                                         "simulation: {physics: kinematic, time_step: 0.1}\n"
+                                         "models: [{model: post.yaml, position: [0, 0], "
+                                         "scale: 2}]\n";
+    return swarmsim::testing::RunProgram("run " + (dir / "world.yaml").string() +
+                                         " --steps 1 --quiet");
+  };
+  auto r = run("radius: 0.5");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("[post#0] 1.0\n"), std::string::npos) << r.output;  // 0.5 x 2
+  r = run("radus: 0.5");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("post.yaml:5:"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("did you mean 'radius'"), std::string::npos) << r.output;
+  r = run("radius: -1");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("a number from 0 to 1000"), std::string::npos) << r.output;
+  std::filesystem::remove_all(dir);
+}
+
 TEST(ExamplesTest, UnknownPluginSensorTypeIsALoadErrorWithASuggestion) {
   const std::filesystem::path dir = std::filesystem::temp_directory_path() /
                                     ("swarmsim_plugin_sensor_" + std::to_string(getpid()));

@@ -13,10 +13,15 @@
 //       named prox (ring, prox[0] ahead), as worlds/models/footbot.yaml.
 //   sim.robotIsMoving() -> 1 while the command above runs, else nil
 //   sim.examplePhaseCounts() -> {after_sense, before_control, after_control,
-//       after_physics}: how often each phase callback has run in this world
+//       after_physics, record}: how often each phase callback has run in this world
 // Phase callbacks: a per-robot after_control callback steers every robot
 // that runs robotMoveAndAvoidObstacles (robots in parallel); whole-world
 // callbacks count the phases.
+// Object type `beacon` (ABI 4; {type: beacon, radius: 1, strength: 2} in a
+// model): sim.readBeacon(h) -> {radius, strength}; the radius scales with the
+// model. Record-phase module `beacon_coverage`: records
+// near_beacon_fraction, the fraction of robots carrying no beacon whose root
+// lies within the radius of some beacon (in the plane), every step.
 // Sensor type `light` ({type: plugin_sensor, sensor: light} in a model):
 // reading {intensity, distance}, distance (m) from the sensor to the light
 // at the parameters (light_x, light_y, light_z) (default 0, 0, 1), and
@@ -226,13 +231,75 @@ int SenseLight(const SwarmsimCallContext* c, int64_t sensor, double* values, int
   return 2;
 }
 
+// --- Beacons ----------------------------------------------------------------------------
+
+const SwarmsimObjectKey kBeaconKeys[] = {
+    {"radius", 0.5, 0, 1000, 1, "m, how far the beacon reaches (scales with the model)"},
+    {"strength", 1, 0, 1e6, 0, "its signal strength"},
+};
+
+int ReadBeacon(const SwarmsimCallContext* c, const SwarmsimValue* args, int n,
+               SwarmsimValue* results, int, char* error, size_t error_size, void*) {
+  thread_local double values[2];
+  if (n < 1 || args[0].type != kSwarmsimNumber ||
+      c->api->object_values(c->world, static_cast<int64_t>(args[0].number), values, 2) != 2) {
+    std::snprintf(error, error_size, "argument 1 must be the handle of a beacon");
+    return -1;
+  }
+  results[0] = {kSwarmsimNumbers, 0, nullptr, values, 2};
+  return 1;
+}
+
+int BeaconCoverage(const SwarmsimCallContext* c, char* error, size_t error_size, void*) {
+  const SwarmsimWorldApi& api = *c->api;
+  struct Beacon {
+    double x, y, radius;
+    int robot;
+  };
+  thread_local std::vector<int64_t> handles;
+  thread_local std::vector<Beacon> beacons;
+  const int count = api.objects_of_type(c->world, "beacon", nullptr, 0);
+  if (count < 0) {
+    std::snprintf(error, error_size, "no beacon object type");
+    return -1;
+  }
+  handles.resize(static_cast<size_t>(count));
+  api.objects_of_type(c->world, "beacon", handles.data(), count);
+  beacons.clear();
+  std::vector<char> carries(static_cast<size_t>(api.robot_count(c->world)), 0);
+  for (int64_t h : handles) {
+    double p[3], v[2];
+    if (!api.object_position(c->world, h, p) || api.object_values(c->world, h, v, 2) != 2) continue;
+    const int robot = api.robot_of(c->world, h);
+    if (robot >= 0 && robot < static_cast<int>(carries.size())) carries[robot] = 1;
+    beacons.push_back({p[0], p[1], v[0], robot});
+  }
+  int robots = 0, near = 0;
+  for (int r = 0; r < static_cast<int>(carries.size()); ++r) {
+    double p[3];
+    const int64_t root = api.robot_root(c->world, r);
+    if (carries[r] || root == 0 || !api.object_position(c->world, root, p)) continue;
+    ++robots;
+    for (const Beacon& b : beacons) {
+      if (std::hypot(p[0] - b.x, p[1] - b.y) <= b.radius) {
+        ++near;
+        break;
+      }
+    }
+  }
+  api.record_metric(c->world, -1, "near_beacon_fraction",
+                    robots > 0 ? static_cast<double>(near) / robots : 0);
+  return 0;
+}
+
 }  // namespace
 
 extern "C" int swarmsim_plugin_abi_version(void) { return SWARMSIM_PLUGIN_ABI_VERSION; }
 
 extern "C" int swarmsim_plugin_register(const SwarmsimRegistrar* r) {
-  r->set_info(r->impl, "example", "3.0",
-              "example plugin: exampleSum, exampleWhereAmI, robotMoveAndAvoidObstacles, light");
+  r->set_info(r->impl, "example", "4.0",
+              "example plugin: exampleSum, exampleWhereAmI, robotMoveAndAvoidObstacles, light, "
+              "beacon");
   struct Command {
     const char* name;
     const char* description;
@@ -244,6 +311,7 @@ extern "C" int swarmsim_plugin_register(const SwarmsimRegistrar* r) {
       {"robotMoveAndAvoidObstacles", "drive for a duration, avoiding obstacles", MoveAndAvoid},
       {"robotIsMoving", "true while robotMoveAndAvoidObstacles runs", IsMoving},
       {"examplePhaseCounts", "how often each phase callback ran", PhaseCounts},
+      {"readBeacon", "{radius, strength} of a beacon object", ReadBeacon},
   };
   for (const Command& c : commands)
     if (r->add_command(r->impl, c.name, c.description, c.function, nullptr) != 0) return -1;
@@ -255,5 +323,9 @@ extern "C" int swarmsim_plugin_register(const SwarmsimRegistrar* r) {
   if (r->add_sensor_type(r->impl, "light", "{intensity, distance} from the light_x/y/z parameters",
                          SenseLight, nullptr) != 0)
     return -1;
+  if (r->add_object_type(r->impl, "beacon", "a marker robots are near or not (radius, strength)",
+                         kBeaconKeys, 2) != 0)
+    return -1;
+  if (r->add_phase_callback(r->impl, kSwarmsimRecord, 0, BeaconCoverage, nullptr) != 0) return -1;
   return 0;
 }
