@@ -11,14 +11,14 @@
 #include <iostream>
 #include <sstream>
 
+#include "framework/display_path.h"
 #include "framework/error.h"
 #include "framework/registry.h"
 #include "modules/builtin.h"
 #include "modules/dynamics/box2d/box2d_backend.h"
 #include "modules/dynamics/ode/ode_backend.h"
-#include "swarm/loader_yaml.h"
+#include "swarm/loader/world_loader.h"
 #include "swarm/runner.h"
-#include "swarm/world_loader.h"
 
 namespace swarmsim {
 
@@ -149,7 +149,7 @@ std::string DefaultBenchWorld() {
   const fs::path exe = fs::canonical("/proc/self/exe", ec);
   if (!ec) {
     const fs::path beside = exe.parent_path().parent_path() / kDefaultWorld;
-    if (fs::is_regular_file(beside, ec)) return loader::DisplayPath(beside);
+    if (fs::is_regular_file(beside, ec)) return DisplayPath(beside);
   }
   // Else the current folder (a repository root).
   if (fs::is_regular_file(kDefaultWorld, ec)) return kDefaultWorld;

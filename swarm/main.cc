@@ -22,13 +22,12 @@
 #include "modules/builtin.h"
 #include "swarm/bench.h"
 #include "swarm/bench_scaling.h"
-#include "swarm/loader_yaml.h"
+#include "swarm/loader/world_loader.h"
 #include "swarm/report.h"
 #include "swarm/results_merge.h"
 #include "swarm/runner.h"
 #include "swarm/sweep.h"
 #include "swarm/version.h"
-#include "swarm/world_loader.h"
 
 namespace swarmsim {
 namespace {

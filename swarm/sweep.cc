@@ -16,11 +16,11 @@
 #include "framework/error.h"
 #include "framework/registry.h"
 #include "modules/builtin.h"
+#include "swarm/loader/world_loader.h"
 #include "swarm/stop_signals.h"
 #include "swarm/sweep_mpi.h"
 #include "swarm/sweep_progress.h"
 #include "swarm/version.h"
-#include "swarm/world_loader.h"
 
 namespace swarmsim {
 namespace {

@@ -1,5 +1,5 @@
 // Mesh files (shape: mesh, file: part.stl|part.obj): read with assimp, welded
-// into a framework TriangleMesh (plain arrays; assimp stays in loader_mesh.cc),
+// into a framework TriangleMesh (plain arrays; assimp stays in mesh.cc),
 // once per file and scale per world, and shared by every shape and copy.
 #pragma once
 

@@ -2,8 +2,8 @@
 // messages (file:line:column, 1-based), key checking with "did you mean"
 // suggestions, and file reading that names who referenced a missing file.
 //
-// yaml-cpp types stay in the loader's files (swarm/loader_*.h are internal
-// to swarm/; the public API is world_loader.h).
+// yaml-cpp types stay in the loader's files (swarm/loader/*.h are internal
+// to the loader; the public API is world_loader.h).
 #pragma once
 
 #include <yaml-cpp/yaml.h>

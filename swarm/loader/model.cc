@@ -1,4 +1,4 @@
-#include "swarm/loader_model.h"
+#include "swarm/loader/model.h"
 
 #include <algorithm>
 #include <cctype>

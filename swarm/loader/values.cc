@@ -1,4 +1,4 @@
-#include "swarm/loader_values.h"
+#include "swarm/loader/values.h"
 
 #include <lauxlib.h>
 #include <lua.h>

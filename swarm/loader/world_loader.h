@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "framework/world.h"
-#include "swarm/metrics.h"
+#include "swarm/loader/metrics.h"
 
 namespace swarmsim {
 

@@ -1,6 +1,6 @@
 // Distributing copies: no overlaps, inside the region, clear of walls and
 // obstacles, varied headings, deterministic, and a clear error when full.
-#include "swarm/placement.h"
+#include "swarm/loader/placement.h"
 
 #include <gtest/gtest.h>
 
@@ -10,7 +10,7 @@
 
 #include "framework/error.h"
 #include "framework/registry.h"
-#include "swarm/world_loader.h"
+#include "swarm/loader/world_loader.h"
 #include "tests/framework/fakes.h"
 
 namespace swarmsim {

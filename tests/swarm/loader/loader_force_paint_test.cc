@@ -11,7 +11,7 @@
 #include "framework/registry.h"
 #include "framework/world.h"
 #include "modules/builtin.h"
-#include "swarm/world_loader.h"
+#include "swarm/loader/world_loader.h"
 
 namespace swarmsim {
 namespace {

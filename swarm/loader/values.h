@@ -14,7 +14,7 @@
 
 #include "framework/math.h"
 #include "framework/parameters.h"
-#include "swarm/loader_yaml.h"
+#include "swarm/loader/yaml.h"
 
 namespace swarmsim::loader {
 

@@ -1,4 +1,4 @@
-#include "swarm/loader_ik.h"
+#include "swarm/loader/ik.h"
 
 #include <set>
 
@@ -85,7 +85,7 @@ std::vector<IkGroupDef> ReadIkGroups(const ModelFile& model, const ValueReader& 
       Fields w(model.file, f.Get("weights"), "the weights of IK group '" + s.name + "'");
       for (const Field& joint : w.fields()) {
         // A new Field for the key: assigning to a copy's node would write
-        // the path over the weight in the parsed file (loader_yaml.h).
+        // the path over the weight in the parsed file (yaml.h).
         const Field path(joint.name, YAML::Node(joint.name), joint.key_mark, joint.key_mark);
         def.weights.emplace_back(path, values.Number(joint, kNonNegative));
       }

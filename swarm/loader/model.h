@@ -11,9 +11,9 @@
 #include <vector>
 
 #include "framework/scene.h"
-#include "swarm/loader_mesh.h"
-#include "swarm/loader_values.h"
-#include "swarm/loader_yaml.h"
+#include "swarm/loader/mesh.h"
+#include "swarm/loader/values.h"
+#include "swarm/loader/yaml.h"
 
 namespace swarmsim {
 class ModuleRegistry;
@@ -66,7 +66,7 @@ struct ModelFile {
   std::string name;  // "footbot"
   std::vector<ModelParameterDecl> parameters;
   Field root;       // the root object
-  Field ik_groups;  // IK groups (swarm/loader_ik.h), not present if none
+  Field ik_groups;  // IK groups (swarm/loader/ik.h), not present if none
 };
 
 // `used_by` (file:line:column of the reference) is named when the file is

@@ -1,4 +1,4 @@
-#include "swarm/loader_yaml.h"
+#include "swarm/loader/yaml.h"
 
 #include <algorithm>
 #include <cerrno>

@@ -1,6 +1,6 @@
 // Loading worlds and models as a user writes them: what ends up in the
 // scene, how overrides and seeds act, and what each mistake says.
-#include "swarm/world_loader.h"
+#include "swarm/loader/world_loader.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>

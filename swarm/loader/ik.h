@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "framework/ik_groups.h"
-#include "swarm/loader_model.h"
-#include "swarm/loader_values.h"
+#include "swarm/loader/model.h"
+#include "swarm/loader/values.h"
 
 namespace swarmsim {
 class World;

@@ -4,9 +4,9 @@
 
 #include <optional>
 
-#include "swarm/loader_values.h"
-#include "swarm/loader_yaml.h"
-#include "swarm/placement.h"
+#include "swarm/loader/placement.h"
+#include "swarm/loader/values.h"
+#include "swarm/loader/yaml.h"
 
 namespace swarmsim {
 class World;

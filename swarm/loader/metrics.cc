@@ -1,4 +1,4 @@
-#include "swarm/metrics.h"
+#include "swarm/loader/metrics.h"
 
 #include <cmath>
 #include <limits>

@@ -1,4 +1,4 @@
-#include "swarm/loader_paint.h"
+#include "swarm/loader/paint.h"
 
 #include <memory>
 

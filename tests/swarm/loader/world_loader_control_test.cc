@@ -18,7 +18,7 @@
 #include "framework/registry.h"
 #include "framework/world.h"
 #include "modules/builtin.h"
-#include "swarm/world_loader.h"
+#include "swarm/loader/world_loader.h"
 #include "tests/framework/fakes.h"
 #include "tests/swarm/run_program.h"
 

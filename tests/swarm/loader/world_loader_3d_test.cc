@@ -13,7 +13,7 @@
 #include "framework/registry.h"
 #include "framework/world.h"
 #include "modules/builtin.h"
-#include "swarm/world_loader.h"
+#include "swarm/loader/world_loader.h"
 
 namespace swarmsim {
 namespace {
@@ -144,8 +144,9 @@ TEST_F(WorldLoader3dTest, KinematicAndBox2dWorldsAcceptTheSameModel) {
                              "/arm#0/shoulder/link/wrist", "/arm#0/shoulder/link/weld"})
       for (double v : PoseValues(scene.world_pose(scene.FindObject(path))))
         EXPECT_TRUE(std::isfinite(v)) << physics << " " << path;
-    if (std::string(physics) == "kinematic")
+    if (std::string(physics) == "kinematic") {
       EXPECT_EQ(scene.joint(scene.FindObject("/arm#0/shoulder")).position, 0.0);
+    }
   }
 }
 

@@ -1,4 +1,4 @@
-#include "swarm/loader_mesh.h"
+#include "swarm/loader/mesh.h"
 
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -8,7 +8,7 @@
 #include <cctype>
 
 #include "framework/error.h"
-#include "swarm/loader_yaml.h"
+#include "swarm/loader/yaml.h"
 
 namespace swarmsim::loader {
 

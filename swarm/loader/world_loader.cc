@@ -1,4 +1,4 @@
-#include "swarm/world_loader.h"
+#include "swarm/loader/world_loader.h"
 
 #include <algorithm>
 #include <cmath>
@@ -10,12 +10,12 @@
 #include "framework/error.h"
 #include "framework/plugin_loader.h"
 #include "framework/registry.h"
-#include "swarm/loader_ik.h"
-#include "swarm/loader_model.h"
-#include "swarm/loader_paint.h"
-#include "swarm/loader_values.h"
-#include "swarm/loader_yaml.h"
-#include "swarm/placement.h"
+#include "swarm/loader/ik.h"
+#include "swarm/loader/model.h"
+#include "swarm/loader/paint.h"
+#include "swarm/loader/placement.h"
+#include "swarm/loader/values.h"
+#include "swarm/loader/yaml.h"
 
 namespace swarmsim {
 

@@ -1,4 +1,4 @@
-#include "swarm/placement.h"
+#include "swarm/loader/placement.h"
 
 #include <algorithm>
 #include <cmath>
