@@ -2,7 +2,7 @@
 # Writes tests/data/golden_hashes.tsv: the state hash of every example world
 # (worlds/*.yaml, bench/worlds/*.yaml) after a fixed number of steps, for two
 # seeds and 1 and 2 threads, as `swarmsim run WORLD --hash` prints it.
-# tests/swarm/golden_hashes_test.cc fails when any of them drifts.
+# tests/swarm/run/golden_hashes_test.cc fails when any of them drifts.
 #
 # Run it only when a change of results is intended, and say why in the
 # commit:   tools/golden_hashes.sh [BUILD_DIR]      (default: build)

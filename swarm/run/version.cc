@@ -1,4 +1,4 @@
-#include "swarm/version.h"
+#include "swarm/run/version.h"
 
 namespace swarmsim {
 const char* Version() { return SWARMSIM_VERSION; }

@@ -1,4 +1,4 @@
-#include "swarm/stats.h"
+#include "swarm/sweep/stats.h"
 
 #include <cmath>
 #include <iterator>

@@ -1,4 +1,4 @@
-#include "swarm/sweep.h"
+#include "swarm/sweep/coordinator.h"
 
 #include <signal.h>
 #include <unistd.h>
@@ -17,10 +17,9 @@
 #include "framework/registry.h"
 #include "modules/builtin.h"
 #include "swarm/loader/world_loader.h"
-#include "swarm/stop_signals.h"
-#include "swarm/sweep_mpi.h"
-#include "swarm/sweep_progress.h"
-#include "swarm/version.h"
+#include "swarm/run/stop_signals.h"
+#include "swarm/run/version.h"
+#include "swarm/sweep/progress.h"
 
 namespace swarmsim {
 namespace {
@@ -54,21 +53,6 @@ WorkerConfig MakeWorkerConfig(const SweepOptions& o) {
   return c;
 }
 
-void ParseShard(const std::string& text, int* index, int* count) {
-  const size_t slash = text.find('/');
-  try {
-    if (slash == std::string::npos) throw std::invalid_argument("");
-    size_t a = 0, b = 0;
-    *index = std::stoi(text.substr(0, slash), &a);
-    *count = std::stoi(text.substr(slash + 1), &b);
-    if (a != slash || b != text.size() - slash - 1) throw std::invalid_argument("");
-  } catch (const std::exception&) {
-    throw Error("--shard expects i/n (e.g. 0/10 for the first of 10 shards), got '" + text + "'");
-  }
-  if (*count < 1 || *index < 0 || *index >= *count)
-    throw Error("--shard " + text + ": need 0 <= i < n");
-}
-
 std::string WorldFileHash(const std::string& path) {
   std::ifstream f(path, std::ios::binary);
   if (!f) throw Error("cannot read world file '" + path + "'");
@@ -93,11 +77,6 @@ std::string SweepSpace(const std::vector<ParamSpec>& params, const std::vector<u
   j["steps"] = steps ? nlohmann::json(*steps) : nlohmann::json(nullptr);
   j["duration"] = duration ? nlohmann::json(*duration) : nlohmann::json(nullptr);
   return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
-}
-
-int RunSweep(const SweepOptions& options, std::ostream& out, std::ostream& err) {
-  if (options.mpi) return RunSweepMpi(options, out, err);
-  return CoordinateSweep(options, nullptr, out, err);
 }
 
 int CoordinateSweep(const SweepOptions& o, RemoteWorkers* remote, std::ostream& out,

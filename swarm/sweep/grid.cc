@@ -1,4 +1,4 @@
-#include "swarm/sweep_grid.h"
+#include "swarm/sweep/grid.h"
 
 #include <cctype>
 #include <charconv>

@@ -1,4 +1,4 @@
-#include "swarm/sweep_progress.h"
+#include "swarm/sweep/progress.h"
 
 #include <iomanip>
 #include <ostream>

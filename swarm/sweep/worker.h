@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "swarm/results_db.h"
-#include "swarm/sweep_grid.h"
+#include "swarm/sweep/grid.h"
+#include "swarm/sweep/results_db.h"
 
 namespace swarmsim {
 

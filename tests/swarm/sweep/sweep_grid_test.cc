@@ -1,14 +1,13 @@
 // Sweep grids (parameter specs, seeds, cartesian product) and the report's
 // statistics (Student t, mean, sd, 95% CI) against known values.
-#include "swarm/sweep_grid.h"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <set>
 
 #include "framework/error.h"
-#include "swarm/stats.h"
+#include "swarm/sweep/grid.h"
+#include "swarm/sweep/stats.h"
 
 namespace swarmsim {
 namespace {

@@ -23,8 +23,8 @@
 #include <string>
 #include <vector>
 
-#include "swarm/sqlite_db.h"
-#include "swarm/sweep_grid.h"
+#include "swarm/sweep/grid.h"
+#include "swarm/sweep/sqlite_db.h"
 
 namespace swarmsim {
 

@@ -1,4 +1,4 @@
-#include "swarm/results_db.h"
+#include "swarm/sweep/results_db.h"
 
 #include <ctime>
 #include <nlohmann/json.hpp>

@@ -20,14 +20,14 @@
 #include "framework/suggest.h"
 #include "framework/utf8.h"
 #include "modules/builtin.h"
-#include "swarm/bench.h"
-#include "swarm/bench_scaling.h"
+#include "swarm/bench/bench.h"
+#include "swarm/bench/scaling.h"
 #include "swarm/loader/world_loader.h"
-#include "swarm/report.h"
-#include "swarm/results_merge.h"
-#include "swarm/runner.h"
-#include "swarm/sweep.h"
-#include "swarm/version.h"
+#include "swarm/run/runner.h"
+#include "swarm/run/version.h"
+#include "swarm/sweep/report.h"
+#include "swarm/sweep/results_merge.h"
+#include "swarm/sweep/sweep.h"
 
 namespace swarmsim {
 namespace {

@@ -1,4 +1,4 @@
-#include "swarm/stop_signals.h"
+#include "swarm/run/stop_signals.h"
 
 namespace swarmsim {
 namespace {

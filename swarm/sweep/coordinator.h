@@ -1,5 +1,6 @@
-// `swarmsim sweep`: a world over a grid of parameters x seeds, one worker
-// process per run, results in a SQLite database, resumable after a kill.
+// The coordinator of a sweep, shared by local and MPI sweeps: it owns the
+// results database, hands this shard's pending runs to worker processes (and,
+// under MPI, to the other ranks) and records what they return.
 #pragma once
 
 #include <cstdint>
@@ -9,9 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "swarm/results_db.h"
-#include "swarm/sweep_grid.h"
-#include "swarm/sweep_worker.h"
+#include "swarm/sweep/grid.h"
+#include "swarm/sweep/worker.h"
 
 namespace swarmsim {
 
@@ -36,16 +36,6 @@ struct SweepOptions {
 
 // How the worker processes of a sweep run (shared by local and MPI sweeps).
 WorkerConfig MakeWorkerConfig(const SweepOptions& options);
-
-// Parses "i/n" (0 <= i < n). Throws swarmsim::Error.
-void ParseShard(const std::string& text, int* index, int* count);
-
-// Runs (or resumes) the sweep. Returns the exit code: 0 when every run of
-// this shard has finished and the database holds no failed run, 1 when it
-// holds failed or timed-out runs (all the others were still run), 128 +
-// the signal when SIGINT, SIGTERM or SIGHUP stopped it (finished runs kept;
-// the same command resumes). Throws swarmsim::Error for bad input (exit 2).
-int RunSweep(const SweepOptions& options, std::ostream& out, std::ostream& err);
 
 // The content hash of a world file (hex), as stored in the sweep table.
 std::string WorldFileHash(const std::string& path);

@@ -1,11 +1,11 @@
-#include "swarm/sweep_mpi.h"
+#include "swarm/sweep/mpi.h"
 
 #include <unistd.h>
 
 #include <ostream>
 
 #include "framework/error.h"
-#include "swarm/sweep.h"
+#include "swarm/sweep/coordinator.h"
 
 #ifdef SWARMSIM_HAVE_MPI
 #include <mpi.h>

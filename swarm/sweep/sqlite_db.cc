@@ -1,4 +1,4 @@
-#include "swarm/sqlite_db.h"
+#include "swarm/sweep/sqlite_db.h"
 
 #include <sqlite3.h>
 

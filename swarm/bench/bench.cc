@@ -1,4 +1,4 @@
-#include "swarm/bench.h"
+#include "swarm/bench/bench.h"
 
 #include <sys/wait.h>
 #include <unistd.h>
@@ -18,7 +18,7 @@
 #include "modules/dynamics/box2d/box2d_backend.h"
 #include "modules/dynamics/ode/ode_backend.h"
 #include "swarm/loader/world_loader.h"
-#include "swarm/runner.h"
+#include "swarm/run/runner.h"
 
 namespace swarmsim {
 

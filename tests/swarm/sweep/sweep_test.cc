@@ -18,7 +18,7 @@
 #include <string>
 #include <thread>
 
-#include "swarm/sqlite_db.h"
+#include "swarm/sweep/sqlite_db.h"
 #include "tests/swarm/run_program.h"
 
 namespace swarmsim {

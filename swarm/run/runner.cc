@@ -1,4 +1,4 @@
-#include "swarm/runner.h"
+#include "swarm/run/runner.h"
 
 #include <sys/resource.h>
 #include <unistd.h>
@@ -23,8 +23,8 @@
 #include "framework/script_host.h"
 #include "framework/state_hash.h"
 #include "framework/utf8.h"
-#include "swarm/stop_signals.h"
-#include "swarm/version.h"
+#include "swarm/run/stop_signals.h"
+#include "swarm/run/version.h"
 
 namespace swarmsim {
 

@@ -1,4 +1,4 @@
-#include "swarm/sweep_worker.h"
+#include "swarm/sweep/worker.h"
 
 #include <fcntl.h>
 #include <signal.h>

@@ -1,10 +1,10 @@
-#include "swarm/results_merge.h"
+#include "swarm/sweep/results_merge.h"
 
 #include <filesystem>
 #include <ostream>
 
 #include "framework/error.h"
-#include "swarm/results_db.h"
+#include "swarm/sweep/results_db.h"
 
 namespace swarmsim {
 

@@ -11,7 +11,7 @@
 #include <string>
 
 #include "framework/utf8.h"
-#include "swarm/sqlite_db.h"
+#include "swarm/sweep/sqlite_db.h"
 #include "tests/swarm/run_program.h"
 
 namespace swarmsim {

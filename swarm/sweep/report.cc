@@ -1,4 +1,4 @@
-#include "swarm/report.h"
+#include "swarm/sweep/report.h"
 
 #include <sys/wait.h>
 
@@ -14,8 +14,8 @@
 
 #include "framework/error.h"
 #include "framework/suggest.h"
-#include "swarm/results_db.h"
-#include "swarm/stats.h"
+#include "swarm/sweep/results_db.h"
+#include "swarm/sweep/stats.h"
 
 namespace swarmsim {
 namespace {

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "swarm/bench.h"
+#include "swarm/bench/bench.h"
 
 namespace swarmsim {
 

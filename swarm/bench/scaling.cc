@@ -1,4 +1,4 @@
-#include "swarm/bench_scaling.h"
+#include "swarm/bench/scaling.h"
 
 #include <sys/wait.h>
 #include <unistd.h>
