@@ -309,6 +309,128 @@ bool WriteSummary(const World& world, const RunOptions& options, const RunResult
   return static_cast<bool>(f);
 }
 
+// What a run has produced so far, shared by its step loop, the watchdog's
+// end of a stuck run and the outputs written after the loop.
+struct RunRecord {
+  RunResult result;
+  std::unique_ptr<MetricsWriter> metrics;  // metrics.csv, with an output folder
+  double lua_kib = 0;                      // the scripts' memory when they stopped
+};
+
+// Starts `world` and steps it options.steps times under a Watchdog, writing
+// metrics as it goes. A failure ends up in record->result (ok false, error);
+// a step that never finishes ends the process (the Watchdog's end_run).
+void StepWatched(World* world, const RunOptions& options, Clock::time_point start,
+                 Progress* progress_bar, RunRecord* record) {
+  RunResult& result = record->result;
+  std::unique_ptr<MetricsWriter>& metrics = record->metrics;
+  double& lua_kib = record->lua_kib;
+  Progress& progress = *progress_bar;
+  // A step that never finishes: write what a failed run writes and exit.
+  const auto end_stuck_run = [&](const std::string& error, int signal) {
+    RunResult stuck = result;
+    stuck.ok = false;
+    stuck.error = error;
+    stuck.signal = signal;
+    stuck.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    stuck.peak_rss_mb = PeakRssMb();
+    if (metrics) metrics->Flush();
+    if (options.out_dir && std::filesystem::is_directory(*options.out_dir))
+      WriteSummary(*world, options, stuck, 0, /*complete=*/false);
+    progress.Finish();
+    world->FlushPrintsOfStuckStep();  // what the scripts printed before they got stuck
+    std::fflush(stdout);
+    std::cerr << "error: " << ValidUtf8(error) << "\n";
+    if (options.out_dir && std::filesystem::is_directory(*options.out_dir))
+      std::cerr << "outputs up to step " << stuck.steps << " are in " << options.out_dir->string()
+                << "\n";
+    std::cerr.flush();
+    std::_Exit(signal != 0 ? 128 + signal : 1);  // 1: the run failed, as main's
+  };
+  Watchdog watchdog(world->settings().step_timeout, world->settings().instruction_budget,
+                    end_stuck_run);
+  // Outputs of the step just done, then the next unit of work for the
+  // watchdog's message; under its lock, so it never writes at the same time.
+  const auto done = [&](std::string next) {
+    const std::lock_guard lock(watchdog.io_mutex());
+    if (metrics) metrics->Write(world->TakeMetrics());
+    watchdog.Progress(std::move(next));
+  };
+  const auto step_name = [&] {
+    return "step " + std::to_string(result.steps + 1) + " of " + std::to_string(options.steps);
+  };
+  try {
+    if (options.out_dir) {
+      std::error_code ec;
+      std::filesystem::create_directories(*options.out_dir, ec);
+      if (ec)
+        throw Error("cannot create output folder '" + options.out_dir->string() +
+                    "': " + ec.message());
+      const std::lock_guard lock(watchdog.io_mutex());
+      metrics = std::make_unique<MetricsWriter>(*options.out_dir / "metrics.csv", *world);
+    }
+    world->Start();
+    done(options.steps > 0 ? step_name() : "the stop of the world");
+    for (int64_t i = 0; i < options.steps; ++i) {
+      if (const int sig = StopSignals::Received(); sig != 0) {
+        result.signal = sig;
+        throw Error(std::string("interrupted by SIG") + sigabbrev_np(sig) + " after " +
+                    std::to_string(result.steps) + " of " + std::to_string(options.steps) +
+                    " steps");
+      }
+      world->Step();
+      {
+        const std::lock_guard lock(watchdog.io_mutex());
+        ++result.steps;
+      }
+      done(result.steps < options.steps ? step_name() : "the stop of the world");
+      progress.Update(result.steps, world->time());
+    }
+    lua_kib =
+        static_cast<double>(world->script_memory_bytes()) / 1024.0;  // before the states close
+    world->Stop();
+    done("writing the outputs");
+    result.ok = true;
+  } catch (const std::exception& e) {
+    const std::lock_guard lock(watchdog.io_mutex());
+    result.error = e.what();
+    // The states are still open after an error: what they held then.
+    lua_kib = static_cast<double>(world->script_memory_bytes()) / 1024.0;
+    if (metrics) metrics->Write(world->TakeMetrics());  // whatever was recorded before the error
+  }
+}
+
+// The summary table a run prints unless --quiet.
+void PrintSummaryTable(const World& world, const RunResult& result, double lua_kib,
+                       std::ostream& out) {
+  const int robots = world.robot_count();
+  const double sim_time = world.time();
+  const double robot_ticks = static_cast<double>(robots) * static_cast<double>(result.steps);
+  const double rtf = result.wall_seconds > 0 ? sim_time / result.wall_seconds : 0;
+  const double ticks_per_s = result.wall_seconds > 0 ? robot_ticks / result.wall_seconds : 0;
+  out << "robots          " << robots << "\n"
+      << "steps           " << result.steps << " (time step " << world.settings().time_step
+      << " s, " << PhysicsLine(world.settings()) << ")\n"
+      << "simulated time  " << Fixed(sim_time, 2) << " s\n"
+      << "wall time       " << Fixed(result.wall_seconds, 3) << " s on " << world.threads()
+      << (world.threads() == 1 ? " thread\n" : " threads\n") << "real-time factor " << Fixed(rtf, 1)
+      << "x\n"
+      << "robot-ticks/s   " << Fixed(ticks_per_s, 0) << "\n"
+      << "peak memory     " << Fixed(result.peak_rss_mb, 1) << " MiB ("
+      << Fixed(robots > 0 ? result.peak_rss_mb * 1024 / robots : 0, 1)
+      << " KiB per robot, of which Lua " << Fixed(robots > 0 ? lua_kib / robots : 0, 1) << ")\n"
+      << "time per phase  (ms total, us per robot-tick)\n";
+  for (size_t p = 0; p < static_cast<size_t>(Phase::kCount); ++p) {
+    const double t = world.phase_times()[p];
+    out << "  " << std::left << std::setw(9) << ToString(static_cast<Phase>(p)) << std::right
+        << std::setw(10) << Fixed(1e3 * t, 1) << std::setw(10)
+        << Fixed(robot_ticks > 0 ? 1e6 * t / robot_ticks : 0, 3) << "\n";
+  }
+  if (const auto& disabled = world.disabled_scripts(); !disabled.empty())
+    out << "disabled scripts " << disabled.size()
+        << " (on_script_error: disable_script), first: " << disabled.front() << "\n";
+}
+
 }  // namespace
 
 bool WriteErrorSummary(const RunOptions& options, const std::string& error) {
@@ -329,91 +451,18 @@ bool WriteErrorSummary(const RunOptions& options, const std::string& error) {
 
 RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
                    std::ostream& progress_stream) {
-  RunResult result;
-  std::unique_ptr<MetricsWriter> metrics;
-  double lua_kib = 0;
+  RunRecord record;
+  RunResult& result = record.result;
   const auto start = Clock::now();
   const bool tty = isatty(STDERR_FILENO) && &progress_stream == &std::cerr;
   Progress progress(progress_stream, options.steps, !options.quiet, tty);
   // SIGINT, SIGTERM and SIGHUP end the run at the next step boundary, with
   // its outputs written (or, for a stuck step, through the Watchdog).
   const StopSignals stop_signals;
-  {
-    // A step that never finishes: write what a failed run writes and exit.
-    const auto end_stuck_run = [&](const std::string& error, int signal) {
-      RunResult stuck = result;
-      stuck.ok = false;
-      stuck.error = error;
-      stuck.signal = signal;
-      stuck.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
-      stuck.peak_rss_mb = PeakRssMb();
-      if (metrics) metrics->Flush();
-      if (options.out_dir && std::filesystem::is_directory(*options.out_dir))
-        WriteSummary(*world, options, stuck, 0, /*complete=*/false);
-      progress.Finish();
-      world->FlushPrintsOfStuckStep();  // what the scripts printed before they got stuck
-      std::fflush(stdout);
-      std::cerr << "error: " << ValidUtf8(error) << "\n";
-      if (options.out_dir && std::filesystem::is_directory(*options.out_dir))
-        std::cerr << "outputs up to step " << stuck.steps << " are in " << options.out_dir->string()
-                  << "\n";
-      std::cerr.flush();
-      std::_Exit(signal != 0 ? 128 + signal : 1);  // 1: the run failed, as main's
-    };
-    Watchdog watchdog(world->settings().step_timeout, world->settings().instruction_budget,
-                      end_stuck_run);
-    // Outputs of the step just done, then the next unit of work for the
-    // watchdog's message; under its lock, so it never writes at the same time.
-    const auto done = [&](std::string next) {
-      const std::lock_guard lock(watchdog.io_mutex());
-      if (metrics) metrics->Write(world->TakeMetrics());
-      watchdog.Progress(std::move(next));
-    };
-    const auto step_name = [&] {
-      return "step " + std::to_string(result.steps + 1) + " of " + std::to_string(options.steps);
-    };
-    try {
-      if (options.out_dir) {
-        std::error_code ec;
-        std::filesystem::create_directories(*options.out_dir, ec);
-        if (ec)
-          throw Error("cannot create output folder '" + options.out_dir->string() +
-                      "': " + ec.message());
-        const std::lock_guard lock(watchdog.io_mutex());
-        metrics = std::make_unique<MetricsWriter>(*options.out_dir / "metrics.csv", *world);
-      }
-      world->Start();
-      done(options.steps > 0 ? step_name() : "the stop of the world");
-      for (int64_t i = 0; i < options.steps; ++i) {
-        if (const int sig = StopSignals::Received(); sig != 0) {
-          result.signal = sig;
-          throw Error(std::string("interrupted by SIG") + sigabbrev_np(sig) + " after " +
-                      std::to_string(result.steps) + " of " + std::to_string(options.steps) +
-                      " steps");
-        }
-        world->Step();
-        {
-          const std::lock_guard lock(watchdog.io_mutex());
-          ++result.steps;
-        }
-        done(result.steps < options.steps ? step_name() : "the stop of the world");
-        progress.Update(result.steps, world->time());
-      }
-      lua_kib =
-          static_cast<double>(world->script_memory_bytes()) / 1024.0;  // before the states close
-      world->Stop();
-      done("writing the outputs");
-      result.ok = true;
-    } catch (const std::exception& e) {
-      const std::lock_guard lock(watchdog.io_mutex());
-      result.error = e.what();
-      // The states are still open after an error: what they held then.
-      lua_kib = static_cast<double>(world->script_memory_bytes()) / 1024.0;
-      if (metrics) metrics->Write(world->TakeMetrics());  // whatever was recorded before the error
-    }
-  }
+  // The steps, watched for one that never finishes.
+  StepWatched(world, options, start, &progress, &record);
   progress.Finish();
-  if (metrics) metrics->Flush();
+  if (record.metrics) record.metrics->Flush();
   // Observers' files (paint.png), also after an error: the outputs so far.
   if (options.out_dir && world->started()) {
     try {
@@ -430,38 +479,12 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
   result.peak_rss_mb = PeakRssMb();
 
   // The summary.
-  const int robots = world->robot_count();
-  const double sim_time = world->time();
-  const double robot_ticks = static_cast<double>(robots) * static_cast<double>(result.steps);
-  const double rtf = result.wall_seconds > 0 ? sim_time / result.wall_seconds : 0;
-  const double ticks_per_s = result.wall_seconds > 0 ? robot_ticks / result.wall_seconds : 0;
-  if (!options.quiet) {
-    out << "robots          " << robots << "\n"
-        << "steps           " << result.steps << " (time step " << world->settings().time_step
-        << " s, " << PhysicsLine(world->settings()) << ")\n"
-        << "simulated time  " << Fixed(sim_time, 2) << " s\n"
-        << "wall time       " << Fixed(result.wall_seconds, 3) << " s on " << world->threads()
-        << (world->threads() == 1 ? " thread\n" : " threads\n") << "real-time factor "
-        << Fixed(rtf, 1) << "x\n"
-        << "robot-ticks/s   " << Fixed(ticks_per_s, 0) << "\n"
-        << "peak memory     " << Fixed(result.peak_rss_mb, 1) << " MiB ("
-        << Fixed(robots > 0 ? result.peak_rss_mb * 1024 / robots : 0, 1)
-        << " KiB per robot, of which Lua " << Fixed(robots > 0 ? lua_kib / robots : 0, 1) << ")\n"
-        << "time per phase  (ms total, us per robot-tick)\n";
-    for (size_t p = 0; p < static_cast<size_t>(Phase::kCount); ++p) {
-      const double t = world->phase_times()[p];
-      out << "  " << std::left << std::setw(9) << ToString(static_cast<Phase>(p)) << std::right
-          << std::setw(10) << Fixed(1e3 * t, 1) << std::setw(10)
-          << Fixed(robot_ticks > 0 ? 1e6 * t / robot_ticks : 0, 3) << "\n";
-    }
-    if (const auto& disabled = world->disabled_scripts(); !disabled.empty())
-      out << "disabled scripts " << disabled.size()
-          << " (on_script_error: disable_script), first: " << disabled.front() << "\n";
-  }
+  if (!options.quiet) PrintSummaryTable(*world, result, record.lua_kib, out);
   if (options.print_hash) out << "state-hash: " << StateHasher::ToHex(result.state_hash) << "\n";
   out << std::flush;
 
-  if (options.out_dir && !WriteSummary(*world, options, result, lua_kib, /*complete=*/true)) {
+  if (options.out_dir &&
+      !WriteSummary(*world, options, result, record.lua_kib, /*complete=*/true)) {
     if (result.ok) {
       result.ok = false;
       result.error = "cannot write '" + (*options.out_dir / "summary.json").string() + "'";
