@@ -207,9 +207,9 @@ fs::path Canonical(const fs::path& path) {
   return ec ? path.lexically_normal() : out;
 }
 
-// The files a run writes into its output folder (swarm/runner.cc:
+// The files a run writes into its output folder (swarm/run/runner.cc:
 // metrics.csv, summary.json; observers' WriteOutputs: paint.png), and
-// stderr.txt, where a sweep (swarm/sweep_worker.cc) keeps a run's errors.
+// stderr.txt, where a sweep (swarm/sweep/worker.cc) keeps a run's errors.
 constexpr std::string_view kRunOutputs[] = {"metrics.csv", "summary.json", "paint.png",
                                             "stderr.txt"};
 

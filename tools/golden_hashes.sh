@@ -3,7 +3,7 @@
 # (worlds/*.yaml, bench/worlds/*.yaml) and of the coverage worlds
 # (tests/data/worlds/golden_*.yaml: every object type, copied and scaled) after a fixed number of steps, for two
 # seeds and 1 and 2 threads, as `swarmsim run WORLD --hash` prints it.
-# tests/swarm/golden_hashes_test.cc fails when any of them drifts.
+# tests/swarm/run/golden_hashes_test.cc fails when any of them drifts.
 #
 # Run it only when a change of results is intended, and say why in the
 # commit:   tools/golden_hashes.sh [BUILD_DIR]      (default: build)

@@ -1,0 +1,248 @@
+#include "swarm/bench/bench.h"
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+#include "framework/display_path.h"
+#include "framework/error.h"
+#include "framework/registry.h"
+#include "modules/builtin.h"
+#include "modules/dynamics/box2d/box2d_backend.h"
+#include "modules/dynamics/ode/ode_backend.h"
+#include "swarm/loader/world_loader.h"
+#include "swarm/run/runner.h"
+
+namespace swarmsim {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char* kDefaultWorld = "worlds/diffusion.yaml";
+
+constexpr const char* kCsvHeader =
+    "config,robots,threads,steps,wall_s,robot_ticks_per_s,us_sense,us_control,us_actuate,"
+    "us_physics,us_record,peak_rss_mb,kb_per_robot";
+
+std::string ToCsv(const BenchRow& r) {
+  std::ostringstream s;
+  s << std::setprecision(8) << r.config << ',' << r.robots << ',' << r.threads << ',' << r.steps
+    << ',' << r.wall_s << ',' << r.robot_ticks_per_s;
+  for (double us : r.us_per_tick) s << ',' << us;
+  s << ',' << r.peak_rss_mb << ',' << r.kb_per_robot;
+  return s.str();
+}
+
+bool FromCsv(const std::string& line, BenchRow* r) {
+  std::istringstream s(line);
+  std::string field;
+  std::vector<std::string> f;
+  while (std::getline(s, field, ',')) f.push_back(field);
+  if (f.size() != 13) return false;
+  try {
+    r->config = f[0];
+    r->robots = std::stoi(f[1]);
+    r->threads = std::stoi(f[2]);
+    r->steps = std::stoll(f[3]);
+    r->wall_s = std::stod(f[4]);
+    r->robot_ticks_per_s = std::stod(f[5]);
+    for (int i = 0; i < 5; ++i) r->us_per_tick[i] = std::stod(f[6 + i]);
+    r->peak_rss_mb = std::stod(f[11]);
+    r->kb_per_robot = std::stod(f[12]);
+  } catch (const std::exception&) {
+    return false;
+  }
+  return true;
+}
+
+// Runs `argv` and returns its standard output; the child's stderr passes through.
+bool RunChild(const std::vector<std::string>& args, std::string* output, int* status) {
+  int fds[2];
+  if (pipe(fds) != 0) return false;
+  const pid_t pid = fork();
+  if (pid < 0) return false;
+  if (pid == 0) {
+    dup2(fds[1], STDOUT_FILENO);
+    close(fds[0]);
+    close(fds[1]);
+    std::vector<char*> argv;
+    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    execv(argv[0], argv.data());
+    _exit(127);
+  }
+  close(fds[1]);
+  char buf[4096];
+  ssize_t n;
+  while ((n = read(fds[0], buf, sizeof buf)) > 0) output->append(buf, static_cast<size_t>(n));
+  close(fds[0]);
+  waitpid(pid, status, 0);
+  return true;
+}
+
+}  // namespace
+
+int RunBenchChild(const BenchOptions& options, const std::string& config, int robots, int threads,
+                  std::ostream& out) {
+  if (config != "diffusion" && config != "box2d-only" && config != "ode-only")
+    throw Error("unknown bench configuration '" + config + "'");
+  ModuleRegistry registry;
+  RegisterBuiltinModules(&registry);
+  LoadOptions load;
+  load.overrides = {{"robots", std::to_string(robots)}};
+  load.seed = 1;
+  load.threads = threads;
+  LoadedWorld loaded = LoadWorld(options.world, load, registry);
+  World& world = *loaded.world;
+  world.set_log_sink([](std::string_view) {});
+  world.Start();
+  // Warm-up through the full pipeline: scripts set the wheel commands.
+  for (int64_t i = 0; i < options.warmup_steps; ++i) world.Step();
+
+  BenchRow row;
+  row.config = config;
+  row.robots = world.robot_count();
+  row.threads = config == "box2d-only" || config == "ode-only" ? 1 : world.threads();
+  row.steps = options.steps;
+  const double ticks = static_cast<double>(row.robots) * static_cast<double>(options.steps);
+  if (config == "diffusion") {
+    const PhaseTimes before = world.phase_times();
+    const auto start = std::chrono::steady_clock::now();
+    for (int64_t i = 0; i < options.steps; ++i) world.Step();
+    row.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    for (int p = 0; p < 5; ++p)
+      row.us_per_tick[p] = 1e6 * (world.phase_times()[p] - before[p]) / ticks;
+  } else if (config == "ode-only") {
+    // The same bodies and joint commands through ODE alone (collision + solver).
+    const WorldSettings& s = world.settings();
+    DynamicsSettings dynamics;
+    dynamics.gravity = s.gravity;
+    row.wall_s =
+        ode::TimeBareLoop(world.scene(), s.time_step / s.physics_substeps, s.physics_substeps,
+                          static_cast<int>(options.steps), {}, dynamics);
+    row.us_per_tick[static_cast<int>(Phase::kPhysics)] = 1e6 * row.wall_s / ticks;
+  } else {
+    // The same bodies and wheel commands through Box2D alone.
+    const WorldSettings& s = world.settings();
+    row.wall_s = box2d::TimeBareLoop(world.scene(), s.time_step / s.physics_substeps,
+                                     s.physics_substeps, options.steps);
+    row.us_per_tick[static_cast<int>(Phase::kPhysics)] = 1e6 * row.wall_s / ticks;
+  }
+  row.robot_ticks_per_s = row.wall_s > 0 ? ticks / row.wall_s : 0;
+  row.peak_rss_mb = PeakRssMb();
+  row.kb_per_robot = row.robots > 0 ? row.peak_rss_mb * 1024.0 / row.robots : 0;
+  out << ToCsv(row) << "\n";
+  return 0;
+}
+
+std::string DefaultBenchWorld() {
+  // The source tree beside the program: build/swarmsim -> worlds/diffusion.yaml.
+  std::error_code ec;
+  const fs::path exe = fs::canonical("/proc/self/exe", ec);
+  if (!ec) {
+    const fs::path beside = exe.parent_path().parent_path() / kDefaultWorld;
+    if (fs::is_regular_file(beside, ec)) return DisplayPath(beside);
+  }
+  // Else the current folder (a repository root).
+  if (fs::is_regular_file(kDefaultWorld, ec)) return kDefaultWorld;
+  return "";
+}
+
+std::string PrepareBench(BenchOptions* options) {
+  // The world: the one given, else the diffusion world found beside the program.
+  if (options->world.empty()) {
+    options->world = DefaultBenchWorld();
+    if (options->world.empty())
+      throw Error(std::string("bench: no --world given and the default world ") + kDefaultWorld +
+                  " was found neither beside the program nor in the current folder; pass "
+                  "--world FILE");
+  }
+  std::error_code ec;
+  if (!fs::is_regular_file(options->world, ec))
+    throw Error("bench: world file '" + options->world + "' not found");
+
+  // It must load with the robot count set through its `robots` parameter.
+  ModuleRegistry registry;
+  RegisterBuiltinModules(&registry);
+  LoadOptions load;
+  load.overrides = {{"robots", "1"}};
+  try {
+    const LoadedWorld loaded = LoadWorld(options->world, load, registry);
+    return loaded.world->settings().physics == "ode" ? "ode-only" : "box2d-only";
+  } catch (const Error&) {
+    // Tell a missing `robots` parameter from the file's own mistakes, which
+    // loading it as written reports (and throws).
+    const LoadedWorld as_written = LoadWorld(options->world, LoadOptions{}, registry);
+    if (!as_written.world->parameters().contains("robots"))
+      throw Error("bench: world '" + options->world +
+                  "' has no parameter 'robots'; bench sets the robot count through it "
+                  "(declare parameters: {robots: N} and use count: $robots in its models entry)");
+    throw;
+  }
+}
+
+int RunBench(BenchOptions options, std::ostream& out, std::ostream& err) {
+  // Everything that can be checked is, before the table's header.
+  const std::string bare = PrepareBench(&options);
+  std::vector<BenchRow> rows;
+  std::unique_ptr<std::ofstream> csv;
+  if (options.csv) {
+    csv = std::make_unique<std::ofstream>(*options.csv);
+    if (!*csv) throw Error("cannot write '" + *options.csv + "'");
+    *csv << kCsvHeader << "\n" << std::flush;
+  }
+  out << "world " << options.world << ", " << options.steps << " measured steps after "
+      << options.warmup_steps << " warm-up steps; one process per row\n\n";
+  out << std::left << std::setw(12) << "config" << std::right << std::setw(8) << "robots"
+      << std::setw(8) << "threads" << std::setw(14) << "ticks/s" << std::setw(9) << "sense"
+      << std::setw(9) << "control" << std::setw(9) << "actuate" << std::setw(9) << "physics"
+      << std::setw(9) << "record" << std::setw(10) << "peak MiB" << std::setw(9) << "KB/robot"
+      << "\n"
+      << std::string(12 + 8 + 8 + 14 + 9 * 5 + 10 + 9, '-') << "\n"
+      << std::flush;
+  auto measure = [&](const std::string& config, int robots, int threads) {
+    std::vector<std::string> args{options.self_exe,  "bench",
+                                  "--child",         config,
+                                  "--child-robots",  std::to_string(robots),
+                                  "--child-threads", std::to_string(threads),
+                                  "--steps",         std::to_string(options.steps),
+                                  "--world",         options.world};
+    std::string output;
+    int status = 0;
+    BenchRow row;
+    if (!RunChild(args, &output, &status) || !WIFEXITED(status) || WEXITSTATUS(status) != 0 ||
+        !FromCsv(output.substr(0, output.find('\n')), &row)) {
+      err << "bench: " << config << " with " << robots << " robots on " << threads
+          << " threads failed\n";
+      return false;
+    }
+    out << std::left << std::setw(12) << row.config << std::right << std::setw(8) << row.robots
+        << std::setw(8) << row.threads << std::setw(14) << std::fixed << std::setprecision(0)
+        << row.robot_ticks_per_s << std::setprecision(3);
+    for (double us : row.us_per_tick) out << std::setw(9) << us;
+    out << std::setw(10) << std::setprecision(1) << row.peak_rss_mb << std::setw(9)
+        << row.kb_per_robot << "\n"
+        << std::defaultfloat << std::flush;
+    if (csv) *csv << ToCsv(row) << "\n" << std::flush;
+    rows.push_back(row);
+    return true;
+  };
+  bool ok = true;
+  // The bare-engine row (`bare`) matches the world's backend: ode-only for an ODE world.
+  for (int robots : options.robots) {
+    for (int threads : options.threads) ok = measure("diffusion", robots, threads) && ok;
+    ok = measure(bare, robots, 1) && ok;
+  }
+  out << "\nphase columns: microseconds per robot-tick (a tick = one robot for one control step)\n";
+  return ok ? 0 : 1;
+}
+
+}  // namespace swarmsim

@@ -1,0 +1,27 @@
+// `swarmsim bench --scaling`: robot-ticks/s over robot counts x threads
+// (1 .. cores) and sweep throughput (runs per minute at --jobs 1 .. cores);
+// a table, a CSV and a PNG plot of speed-up with the ideal line.
+#pragma once
+
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+#include "swarm/bench/bench.h"
+
+namespace swarmsim {
+
+struct ScalingOptions {
+  BenchOptions bench;          // world, robots, threads, steps; csv unused
+  bool threads_given = false;  // else threads 1 .. cores
+  std::vector<int> jobs;       // empty: 1 .. cores
+  int sweep_runs = 16;         // runs per sweep measurement
+  int sweep_robots = 100;
+  int sweep_steps = 200;
+  std::string csv = "scaling.csv";
+  std::string plot = "scaling.png";
+};
+
+int RunScalingBench(ScalingOptions options, std::ostream& out, std::ostream& err);
+
+}  // namespace swarmsim

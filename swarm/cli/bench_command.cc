@@ -1,0 +1,62 @@
+// swarmsim bench: robot-ticks/s over robots x threads, one child process per
+// configuration (bench --child is that child); --scaling adds the sweep jobs.
+#include <CLI/CLI.hpp>
+#include <iostream>
+
+#include "swarm/bench/bench.h"
+#include "swarm/bench/scaling.h"
+#include "swarm/cli/commands.h"
+#include "swarm/cli/options.h"
+
+namespace swarmsim::cli {
+
+CLI::App* AddBenchCommand(CLI::App* app, BenchArgs* args) {
+  CLI::App* bench = app->add_subcommand("bench", "Measure robot-ticks/s over robots x threads");
+  BenchOptions& options = args->options;
+  bench->add_option("--robots", options.robots, "Robot counts, e.g. 100,1000,10000")
+      ->delimiter(',')
+      ->transform(WholeNumberCheck(1, kIntMax, "robots"));
+  bench->add_option("--threads", options.threads, "Thread counts, e.g. 1,2")
+      ->delimiter(',')
+      ->transform(ThreadCountCheck());
+  bench->add_option("--steps", options.steps, "Measured steps per configuration")
+      ->transform(WholeNumberCheck(1, kInt64Max, "steps"));
+  bench->add_option("--csv", options.csv, "Write one CSV row per measurement")
+      ->check(NonEmpty("a file"));
+  bench
+      ->add_option("--world", options.world,
+                   "World to measure (default: worlds/diffusion.yaml beside the program)")
+      ->check(NonEmpty("a world file"));
+  bench->add_option("--child", args->child_config)->group("");  // internal: one config
+  bench->add_option("--child-robots", args->child_robots)->group("");
+  bench->add_option("--child-threads", args->child_threads)->group("");
+  ScalingOptions& scaling = args->scaling_options;  // bench --scaling (issue 5)
+  bench->add_flag("--scaling", args->scaling,
+                  "Speed-up over threads 1..cores and sweep --jobs 1..cores; CSV + PNG");
+  bench->add_option("--jobs", scaling.jobs, "With --scaling: sweep jobs, e.g. 1,2")
+      ->delimiter(',')
+      ->transform(WholeNumberCheck(1, kIntMax, "jobs"));
+  bench->add_option("--sweep-runs", scaling.sweep_runs, "With --scaling: runs per sweep")
+      ->transform(WholeNumberCheck(1, kIntMax, "runs"));
+  bench->add_option("--plot", scaling.plot, "With --scaling: the PNG plot")
+      ->capture_default_str()
+      ->check(NonEmpty("a file"));
+  return bench;
+}
+
+int BenchCommand(BenchArgs args, const CLI::App& command) {
+  args.options.self_exe = "/proc/self/exe";
+  if (args.scaling) {
+    ScalingOptions& scaling = args.scaling_options;
+    scaling.bench = args.options;
+    scaling.threads_given = command.count("--threads") > 0;
+    if (args.options.csv) scaling.csv = *args.options.csv;
+    return RunScalingBench(scaling, std::cout, std::cerr);
+  }
+  if (!args.child_config.empty())
+    return RunBenchChild(args.options, args.child_config, args.child_robots, args.child_threads,
+                         std::cout);
+  return RunBench(args.options, std::cout, std::cerr);
+}
+
+}  // namespace swarmsim::cli

@@ -1,0 +1,96 @@
+// The commands of the `swarmsim` program. Each has what its command line
+// gives it (the *Args), an Add*Command that declares its options on the
+// program's CLI::App, and one function that does it and returns the exit
+// code. main.cc adds them in the order `swarmsim --help` lists them and
+// calls the one that was given.
+#pragma once
+
+#include <cstdint>
+#include <iosfwd>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "swarm/bench/scaling.h"
+#include "swarm/sweep/report.h"
+#include "swarm/sweep/sweep.h"
+
+namespace CLI {
+class App;
+}  // namespace CLI
+
+namespace swarmsim {
+class ModuleRegistry;
+}  // namespace swarmsim
+
+namespace swarmsim::cli {
+
+// swarmsim run WORLD (run_command.cc)
+struct RunArgs {
+  std::string world_file;
+  int64_t steps = -1;    // -1: not given
+  double duration = -1;  // s; -1: not given
+  int threads = 0;       // 0: all cores
+  std::optional<uint64_t> seed;
+  std::vector<std::string> sets;  // NAME=VALUE
+  std::string out_dir;
+  bool hash = false, quiet = false;
+  bool trust_scripts = false;
+  std::vector<std::string> plugins;
+};
+CLI::App* AddRunCommand(CLI::App* app, RunArgs* args);
+// Loads the world (the plugins first into `registry`) and runs it.
+int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegistry* registry);
+
+// swarmsim bench (bench_command.cc)
+struct BenchArgs {
+  BenchOptions options;
+  std::string child_config;  // internal: measure one configuration in this process
+  int child_robots = 0, child_threads = 1;
+  bool scaling = false;  // --scaling
+  ScalingOptions scaling_options;
+};
+CLI::App* AddBenchCommand(CLI::App* app, BenchArgs* args);
+// `command`: what AddBenchCommand returned (was --threads given?).
+int BenchCommand(BenchArgs args, const CLI::App& command);
+
+// swarmsim sweep WORLD, report DB, merge OUT IN... (sweep_commands.cc)
+struct SweepArgs {
+  SweepOptions options;
+  std::string shard;     // i/n
+  int64_t steps = -1;    // -1: not given
+  double duration = -1;  // s; -1: not given
+};
+CLI::App* AddSweepCommand(CLI::App* app, SweepArgs* args);
+int SweepCommand(SweepArgs args, const std::string& command_line);
+
+struct ReportArgs {
+  ReportOptions options;
+  std::string csv, plot;  // empty: not given
+};
+CLI::App* AddReportCommand(CLI::App* app, ReportArgs* args);
+int ReportCommand(ReportArgs args);
+
+struct MergeArgs {
+  std::string out;
+  std::vector<std::string> inputs;
+  bool allow_changed_world = false;
+};
+CLI::App* AddMergeCommand(CLI::App* app, MergeArgs* args);
+int MergeCommand(const MergeArgs& args);
+
+// swarmsim modules, version (info_commands.cc)
+CLI::App* AddModulesCommand(CLI::App* app);
+int ModulesCommand(const ModuleRegistry& registry);
+CLI::App* AddVersionCommand(CLI::App* app);
+int VersionCommand();
+
+// swarmsim describe WORLD (describe_command.cc)
+struct DescribeArgs {
+  std::string world;
+  std::vector<std::string> sets;  // NAME=VALUE
+};
+CLI::App* AddDescribeCommand(CLI::App* app, DescribeArgs* args);
+int DescribeCommand(const DescribeArgs& args, const ModuleRegistry& registry);
+
+}  // namespace swarmsim::cli

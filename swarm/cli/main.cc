@@ -1,0 +1,89 @@
+// The swarmsim command-line program: declares the commands (commands.h),
+// parses the command line and calls the command that was given.
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "framework/error.h"
+#include "framework/registry.h"
+#include "framework/utf8.h"
+#include "modules/builtin.h"
+#include "swarm/cli/commands.h"
+#include "swarm/cli/options.h"
+#include "swarm/cli/parse_error.h"
+#include "swarm/run/version.h"
+
+namespace swarmsim::cli {
+namespace {
+
+int Main(int argc, char** argv) {
+  CLI::App app{"swarmsim " + std::string(Version()) +
+               ": a headless, swarm-scale robot simulator.\n"
+               "Lua-controlled robot models, copied by the thousand, stepped in parallel."};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", Version());
+
+  // The commands, in the order --help lists them.
+  RunArgs run_args;
+  AddRunCommand(&app, &run_args);
+  BenchArgs bench_args;
+  const CLI::App* bench = AddBenchCommand(&app, &bench_args);
+  SweepArgs sweep_args;
+  const CLI::App* sweep = AddSweepCommand(&app, &sweep_args);
+  ReportArgs report_args;
+  const CLI::App* report = AddReportCommand(&app, &report_args);
+  MergeArgs merge_args;
+  const CLI::App* merge = AddMergeCommand(&app, &merge_args);
+  const CLI::App* modules = AddModulesCommand(&app);
+  DescribeArgs describe_args;
+  const CLI::App* describe = AddDescribeCommand(&app, &describe_args);
+  const CLI::App* version = AddVersionCommand(&app);
+
+  const std::vector<std::string> args(argv + std::min(argc, 1), argv + argc);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::cerr << ParseErrorMessage(app, args, e);
+    return kExitBadInput;
+  }
+  // `run --set a=1 b=2` parses (b=2 as the world) but is the same mistake.
+  if (const std::string message = SecondValueOfRepeatable(args); !message.empty()) {
+    std::cerr << message;
+    return kExitBadInput;
+  }
+
+  ModuleRegistry registry;
+  RegisterBuiltinModules(&registry);
+
+  if (*version) return VersionCommand();
+  if (*describe) return DescribeCommand(describe_args, registry);
+  if (*modules) return ModulesCommand(registry);
+  if (*sweep) return SweepCommand(sweep_args, CommandLine(argc, argv));
+  if (*report) return ReportCommand(report_args);
+  if (*merge) return MergeCommand(merge_args);
+  if (*bench) return BenchCommand(bench_args, *bench);
+  return RunCommand(run_args, CommandLine(argc, argv), &registry);
+}
+
+}  // namespace
+}  // namespace swarmsim::cli
+
+int main(int argc, char** argv) {
+  try {
+    return swarmsim::cli::Main(argc, argv);
+  } catch (const swarmsim::Error& e) {
+    std::cerr << "error: " << swarmsim::ValidUtf8(e.what()) << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << swarmsim::ValidUtf8(e.what()) << "\n";
+    return 1;
+  }
+}

@@ -1,0 +1,22 @@
+// What CLI11 rejects, said in this program's words: the nearest known option
+// or command for a typo, and the repeat-the-option hint for `--set a=1 b=2`.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+#include <vector>
+
+namespace swarmsim::cli {
+
+// `--set a=1 b=2`: each --set (sweep --param) takes one value, so b=2 was left
+// over or taken for the world file. Returns the message, or "" when `args`
+// (argv without the program) have no such value; an existing file is a world.
+std::string SecondValueOfRepeatable(const std::vector<std::string>& args);
+
+// What CLI11 rejected, in this program's words: an unknown option or command
+// with the nearest known one, a second value after --set, else CLI11's own
+// message. `args` is argv without the program.
+std::string ParseErrorMessage(CLI::App& app, const std::vector<std::string>& args,
+                              const CLI::ParseError& error);
+
+}  // namespace swarmsim::cli

@@ -1,0 +1,42 @@
+// Mesh files (shape: mesh, file: part.stl|part.obj): read with assimp, welded
+// into a framework TriangleMesh (plain arrays; assimp stays in mesh.cc),
+// once per file and scale per world, and shared by every shape and copy.
+#pragma once
+
+#include <array>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "framework/math.h"
+#include "framework/mesh.h"
+
+namespace swarmsim::loader {
+
+class MeshCache {
+ public:
+  // The mesh in `path` (STL, ASCII or binary, or OBJ), each vertex scaled by
+  // `scale` (positive). Throws swarmsim::Error "<where>: mesh file 'text' ..."
+  // for a missing, unreadable, unsupported or empty file.
+  std::shared_ptr<const TriangleMesh> Get(const std::filesystem::path& path, const Vec3& scale,
+                                          const std::string& where, const std::string& text);
+  // Files read so far (each once, whatever the scales).
+  size_t files_read() const { return files_.size(); }
+
+  // A file's triangles, vertices at equal positions merged, unscaled.
+  struct Welded {
+    std::vector<Vec3> vertices;
+    std::vector<MeshTriangle> triangles;
+  };
+
+ private:
+  std::map<std::filesystem::path, std::shared_ptr<const Welded>> files_;
+  std::map<std::pair<std::filesystem::path, std::array<double, 3>>,
+           std::shared_ptr<const TriangleMesh>>
+      meshes_;
+};
+
+}  // namespace swarmsim::loader

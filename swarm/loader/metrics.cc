@@ -1,0 +1,105 @@
+#include "swarm/loader/metrics.h"
+
+#include <cmath>
+#include <limits>
+#include <unordered_set>
+
+#include "framework/error.h"
+#include "framework/spatial_grid.h"
+
+namespace swarmsim {
+
+namespace {
+
+// Positions of the live robots' roots, in robot order.
+void RobotPositions(const World& world, std::vector<GridItem>* out) {
+  out->clear();
+  const Scene& scene = world.scene();
+  for (const ModelInstance& inst : scene.instances()) {
+    if (!inst.alive) continue;
+    const Vec3& p = scene.world_pose(inst.root).p;
+    out->push_back({p.x, p.y, 0, static_cast<uint32_t>(out->size())});
+  }
+}
+
+// Mean over robots of the distance to the nearest other robot (centre to
+// centre, in the plane), m. Grid queries keep it O(N) at constant density.
+class MeanNearestNeighborDistance : public Observer {
+ public:
+  explicit MeanNearestNeighborDistance(int every) : every_(every) {}
+  void Record(const World& world, std::vector<MetricSample>* out) override {
+    if (world.step_count() % every_ != 0) return;
+    RobotPositions(world, &items_);
+    if (items_.size() < 2) return;
+    grid_.Build(items_);
+    double sum = 0;
+    std::vector<uint32_t> hits;
+    for (uint32_t i = 0; i < items_.size(); ++i) {
+      double best = std::numeric_limits<double>::infinity();
+      for (double r = std::max(grid_.cell_size(), 1e-3); !std::isfinite(best); r *= 2) {
+        grid_.QueryCircle(items_[i].x, items_[i].y, r, &hits);
+        for (uint32_t j : hits) {
+          if (j == i) continue;
+          const double d = std::hypot(items_[j].x - items_[i].x, items_[j].y - items_[i].y);
+          if (d <= r) best = std::min(best, d);  // only trust neighbours inside the searched disc
+        }
+      }
+      sum += best;
+    }
+    out->push_back({world.step_count(), world.time(), -1, "mean_nearest_neighbor_distance",
+                    sum / static_cast<double>(items_.size())});
+  }
+
+ private:
+  int every_;
+  std::vector<GridItem> items_;
+  SpatialGrid grid_;
+};
+
+// Area visited by at least one robot since the start, m^2, on a grid of
+// 0.25 m cells (about a foot-bot's diameter).
+class CoveredArea : public Observer {
+ public:
+  explicit CoveredArea(int every) : every_(every) {}
+  void Record(const World& world, std::vector<MetricSample>* out) override {
+    const Scene& scene = world.scene();
+    for (const ModelInstance& inst : scene.instances()) {
+      if (!inst.alive) continue;
+      const Vec3& p = scene.world_pose(inst.root).p;
+      const auto cx = static_cast<int64_t>(std::floor(p.x / kCell));
+      const auto cy = static_cast<int64_t>(std::floor(p.y / kCell));
+      visited_.insert((static_cast<uint64_t>(cx) << 32) ^ static_cast<uint32_t>(cy));
+    }
+    if (world.step_count() % every_ != 0) return;
+    out->push_back({world.step_count(), world.time(), -1, "covered_area",
+                    static_cast<double>(visited_.size()) * kCell * kCell});
+  }
+
+ private:
+  static constexpr double kCell = 0.25;
+  int every_;
+  std::unordered_set<uint64_t> visited_;
+};
+
+}  // namespace
+
+std::vector<std::pair<std::string, std::string>> KnownSwarmMetrics() {
+  return {
+      {"mean_nearest_neighbor_distance",
+       "mean distance from each robot to its nearest neighbour (m)"},
+      {"covered_area", "area visited by at least one robot since the start (m^2, 0.25 m cells)"},
+  };
+}
+
+std::unique_ptr<Observer> MakeSwarmMetric(const SwarmMetricSpec& spec) {
+  if (spec.every_steps < 1) throw Error("metric '" + spec.name + "': 'every' must be >= 1");
+  if (spec.name == "mean_nearest_neighbor_distance")
+    return std::make_unique<MeanNearestNeighborDistance>(spec.every_steps);
+  if (spec.name == "covered_area") return std::make_unique<CoveredArea>(spec.every_steps);
+  std::string known;
+  for (const auto& [name, description] : KnownSwarmMetrics())
+    known += (known.empty() ? "" : ", ") + name;
+  throw Error("unknown metric '" + spec.name + "' (known: " + known + ")");
+}
+
+}  // namespace swarmsim

@@ -1,0 +1,62 @@
+// The loader's side of framework/object_type.h's ObjectReader: an object
+// type's `read` hook reads its keys from one model-file entry through the
+// loader's ValueReader (parameters, expressions, file:line:column messages).
+#pragma once
+
+#include "framework/object_type.h"
+#include "swarm/loader/mesh.h"
+#include "swarm/loader/values.h"
+#include "swarm/loader/yaml.h"
+
+namespace swarmsim::loader {
+
+class FieldsObjectReader final : public ObjectReader {
+ public:
+  // `meshes` may be null (a cache of this reader's own); `registry` too.
+  FieldsObjectReader(const ValueReader& values, const Fields& fields, MeshCache* meshes,
+                     const ModuleRegistry* registry)
+      : values_(values), fields_(fields), meshes_(meshes), registry_(registry) {}
+
+  bool Has(std::string_view key) const override { return fields_.Has(key); }
+  double Number(std::string_view key, const NumberRule& rule, bool required) const override {
+    return values_.Number(Get(key, required), rule);
+  }
+  int64_t Integer(std::string_view key, int64_t min, int64_t max) const override {
+    return values_.Integer(fields_.Get(key), min, max);
+  }
+  bool Bool(std::string_view key) const override { return values_.Bool(fields_.Get(key)); }
+  std::string String(std::string_view key, bool required) const override {
+    return values_.String(Get(key, required));
+  }
+  std::string Choice(std::string_view key, const std::vector<std::string>& choices,
+                     bool required) const override {
+    return values_.Choice(Get(key, required), choices);
+  }
+  std::vector<double> Numbers(std::string_view key, size_t min_count, size_t max_count,
+                              const NumberRule& rule) const override {
+    return values_.Numbers(fields_.Get(key), min_count, max_count, rule);
+  }
+  Vec3 Vector3(std::string_view key, const NumberRule& rule, bool required) const override {
+    return values_.Vector3(Get(key, required), rule);
+  }
+  [[noreturn]] void Fail(std::string_view key, const std::string& message) const override {
+    values_.Fail(fields_.Get(key), message);
+  }
+  [[noreturn]] void FailAtKey(std::string_view key, const std::string& message) const override {
+    values_.file().Fail(fields_.Get(key).key_mark, message);
+  }
+  std::shared_ptr<const TriangleMesh> Mesh(std::string_view key, const Vec3& scale) const override;
+  const ModuleRegistry* registry() const override { return registry_; }
+
+ private:
+  Field Get(std::string_view key, bool required) const {
+    return required ? fields_.Require(key) : fields_.Get(key);
+  }
+
+  const ValueReader& values_;
+  const Fields& fields_;
+  MeshCache* meshes_;
+  const ModuleRegistry* registry_;
+};
+
+}  // namespace swarmsim::loader

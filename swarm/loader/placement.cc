@@ -1,0 +1,117 @@
+#include "swarm/loader/placement.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace swarmsim {
+
+double Obstacle2::Distance(double px, double py) const {
+  const double dx = px - x, dy = py - y;
+  if (kind == Kind::kCircle) return std::hypot(dx, dy) - radius;
+  // Into the box's frame, then the distance to an axis-aligned rectangle.
+  const double c = std::cos(yaw), s = std::sin(yaw);
+  const double lx = c * dx + s * dy, ly = -s * dx + c * dy;
+  const double qx = std::abs(lx) - half_x, qy = std::abs(ly) - half_y;
+  const double outside = std::hypot(std::max(qx, 0.0), std::max(qy, 0.0));
+  const double inside = std::min(std::max(qx, qy), 0.0);
+  return outside + inside;
+}
+
+double Obstacle2::BoundingRadius() const {
+  return kind == Kind::kCircle ? radius : std::hypot(half_x, half_y);
+}
+
+Placer::CellKey Placer::CellOf(double x, double y) const {
+  return {static_cast<int64_t>(std::floor(x / cell_size_)),
+          static_cast<int64_t>(std::floor(y / cell_size_))};
+}
+
+void Placer::Insert(uint32_t body) {
+  const Body& b = bodies_[body];
+  cells_[CellOf(b.x, b.y)].push_back(body);
+}
+
+void Placer::Rebuild(double cell_size) {
+  cell_size_ = cell_size;
+  cells_.clear();
+  for (uint32_t i = 0; i < bodies_.size(); ++i) Insert(i);
+}
+
+void Placer::AddBody(double x, double y, double radius) {
+  bodies_.push_back({x, y, radius});
+  max_body_radius_ = std::max(max_body_radius_, radius);
+  if (cell_size_ > 0) Insert(static_cast<uint32_t>(bodies_.size() - 1));
+}
+
+bool Placer::IsFree(double x, double y, double radius, double clearance) const {
+  // Obstacles: few, checked one by one behind a bounding-circle test.
+  const double keep = radius + clearance;
+  for (const Obstacle2& o : obstacles_) {
+    if (std::hypot(x - o.x, y - o.y) - o.BoundingRadius() >= keep) continue;
+    if (o.Distance(x, y) < keep) return false;
+  }
+  auto clear_of = [&](const Body& b) {
+    const double dx = x - b.x, dy = y - b.y, min = radius + b.radius + clearance;
+    return dx * dx + dy * dy >= min * min;
+  };
+  if (cell_size_ <= 0) {
+    for (const Body& b : bodies_)
+      if (!clear_of(b)) return false;
+    return true;
+  }
+  // Bodies: the cells within reach of any body that could touch this disc.
+  const double reach = radius + max_body_radius_ + clearance;
+  const CellKey lo = CellOf(x - reach, y - reach), hi = CellOf(x + reach, y + reach);
+  for (int64_t cx = lo.x; cx <= hi.x; ++cx)
+    for (int64_t cy = lo.y; cy <= hi.y; ++cy) {
+      auto it = cells_.find({cx, cy});
+      if (it == cells_.end()) continue;
+      for (uint32_t i : it->second)
+        if (!clear_of(bodies_[i])) return false;
+    }
+  return true;
+}
+
+std::vector<Placement2> Placer::Distribute(const Region2& region, int64_t count, double radius,
+                                           double clearance, uint64_t stream,
+                                           std::optional<double> heading) {
+  return Distribute(
+      region, count, [radius](int64_t) { return radius; }, radius, clearance, stream, heading);
+}
+
+std::vector<Placement2> Placer::Distribute(const Region2& region, int64_t count,
+                                           const std::function<double(int64_t)>& radius_of,
+                                           double max_radius, double clearance, uint64_t stream,
+                                           std::optional<double> heading) {
+  std::vector<Placement2> out;
+  if (count <= 0) return out;
+  // A disc lies wholly inside the region: its centre in the rectangle shrunk by its radius.
+  const double lo_x = region.min_x + max_radius, hi_x = region.max_x - max_radius;
+  const double lo_y = region.min_y + max_radius, hi_y = region.max_y - max_radius;
+  if (!(lo_x <= hi_x) || !(lo_y <= hi_y)) return out;
+  // A cell holds about one body; a query then looks at 3 x 3 cells.
+  max_body_radius_ = std::max(max_body_radius_, max_radius);
+  const double extent = std::max(hi_x - lo_x, hi_y - lo_y);
+  const double cell = std::max({2 * max_body_radius_ + clearance, 1e-3, extent * 1e-9});
+  if (cell != cell_size_) Rebuild(cell);
+  out.reserve(static_cast<size_t>(count));
+  Rng rng(seed_, kPlacementStream + stream);
+  for (int64_t k = 0; k < count; ++k) {
+    const double radius = radius_of(k);
+    const double grow = max_radius - radius;  // a smaller disc may come closer to the edges
+    bool placed = false;
+    for (int attempt = 0; attempt < kMaxAttempts && !placed; ++attempt) {
+      const double x = rng.Uniform(lo_x - grow, hi_x + grow);
+      const double y = rng.Uniform(lo_y - grow, hi_y + grow);
+      if (!IsFree(x, y, radius, clearance)) continue;
+      const double yaw = heading ? *heading : rng.Uniform(-M_PI, M_PI);
+      out.push_back({x, y, yaw});
+      AddBody(x, y, radius);
+      placed = true;
+    }
+    if (!placed) break;
+  }
+  return out;
+}
+
+}  // namespace swarmsim

@@ -1,0 +1,80 @@
+// Loading a world file (worlds/*.yaml) and the model files it names into a
+// placed, not yet started World. The format is described, key by key, in
+// worlds/README.md.
+//
+// Every mistake in a file throws swarmsim::Error with "file:line:column:
+// message" (1-based) saying what was expected; unknown keys and names come
+// with the nearest known one ("did you mean 'radius'?").
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "framework/world.h"
+#include "swarm/loader/metrics.h"
+
+namespace swarmsim {
+
+class ModuleRegistry;
+
+struct LoadOptions {
+  // --set name=value, applied in order. `name` is a world parameter, or
+  // `model.parameter` for a model parameter of every copy of that model.
+  // The value is read as a YAML scalar (number, true/false, else text) and
+  // must have the type of the parameter's value in the file.
+  std::vector<std::pair<std::string, std::string>> overrides;
+  std::optional<uint64_t> seed;  // --seed: replaces simulation.seed
+  int threads = 0;               // --threads: <= 0 all cores
+  // The run's output folder (--out), where sandboxed scripts may write;
+  // --trust-scripts lifts the sandbox (WorldSettings).
+  std::filesystem::path output_directory;
+  bool trust_scripts = false;
+  // Folders searched for a plugin the world names without a path
+  // (`plugins: [example_plugin]` -> example_plugin.so); the program passes
+  // the `plugins/` folder beside its executable.
+  std::vector<std::filesystem::path> plugin_directories;
+};
+
+// What `swarmsim describe` lists about one `models:` entry.
+struct ParameterSummary {
+  std::string name, value, default_value, unit, range, description;  // range: "[a, b]" or ""
+};
+struct ModelSummary {
+  std::string name;  // "footbot"
+  std::string file;  // the model file, as the world names it
+  int64_t count = 0;
+  std::vector<ParameterSummary> parameters;                // values of every copy (after --set)
+  std::vector<std::pair<int64_t, std::string>> instances;  // copy index -> "name=value, ..."
+  // Script files in tree order, each with the objects it is on, as paths
+  // from the model root: "bot.lua on :, :/arm (explicit)".
+  std::vector<std::string> scripts;
+  double scale = 1;  // `scale:` of the entry
+  int ik_groups = 0;
+};
+
+struct LoadedWorld {
+  std::unique_ptr<World> world;  // placed, not started
+  std::filesystem::path file;    // the world file, as given
+  // The world's default run length: simulation.steps, or
+  // round(simulation.duration / simulation.time_step). Empty if it gives neither.
+  std::optional<int64_t> steps;
+  // The swarm metrics the world asked for (already added to the world as observers).
+  std::vector<SwarmMetricSpec> metrics;
+  // The models entries, for `swarmsim describe`.
+  std::vector<ModelSummary> models;
+};
+
+// Reads `file`, resolves parameters (after `options.overrides`), builds the
+// arena, obstacles and model copies, and adds the metrics. A world naming
+// `plugins` gets a registry of its own (a copy of `registry` plus the
+// plugins), which the World keeps alive. Throws
+// swarmsim::Error on any mistake in the files or the options.
+LoadedWorld LoadWorld(const std::filesystem::path& file, const LoadOptions& options,
+                      const ModuleRegistry& registry);
+
+}  // namespace swarmsim

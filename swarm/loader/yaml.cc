@@ -1,0 +1,173 @@
+#include "swarm/loader/yaml.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include "framework/error.h"
+
+namespace swarmsim::loader {
+
+namespace fs = std::filesystem;
+
+std::string ReadFileOrThrow(const fs::path& path, std::string_view kind, const std::string& where,
+                            const std::string& text) {
+  const std::string prefix = where.empty() ? "" : where + ": ";
+  const std::string looked =
+      DisplayPath(path) != text ? " (looked for " + DisplayPath(path) + ")" : "";
+  std::error_code ec;
+  if (!fs::exists(path, ec))
+    throw Error(prefix + std::string(kind) + " '" + text + "' not found" + looked);
+  if (fs::is_directory(path, ec))
+    throw Error(prefix + std::string(kind) + " '" + text + "' is a directory, not a file" + looked);
+  // Not a device or a pipe (which could be read forever), and of a sane size.
+  if (!fs::is_regular_file(path, ec))
+    throw Error(prefix + std::string(kind) + " '" + text + "' is not a regular file" + looked);
+  constexpr uintmax_t kMaxBytes = 64 << 20;
+  if (const uintmax_t size = fs::file_size(path, ec); !ec && size > kMaxBytes)
+    throw Error(prefix + std::string(kind) + " '" + text + "' is too large (" +
+                std::to_string(size >> 20) + " MiB; the limit is 64 MiB)" + looked);
+  std::ifstream in(path, std::ios::binary);
+  if (!in)
+    throw Error(prefix + "cannot read " + std::string(kind) + " '" + text + "'" + looked + ": " +
+                std::strerror(errno));
+  std::ostringstream buffer;
+  buffer << in.rdbuf();
+  if (in.bad())
+    throw Error(prefix + "cannot read " + std::string(kind) + " '" + text + "'" + looked);
+  return buffer.str();
+}
+
+// Whether the indentation of line `line` (0-based) of `text` holds a tab,
+// which YAML forbids and yaml-cpp reports in its own terms.
+static bool TabInIndentation(std::string_view text, int line) {
+  size_t start = 0;
+  for (int i = 0; i < line; ++i) {
+    start = text.find('\n', start);
+    if (start == std::string_view::npos) return false;
+    ++start;
+  }
+  for (size_t i = start; i < text.size() && (text[i] == ' ' || text[i] == '\t'); ++i)
+    if (text[i] == '\t') return true;
+  return false;
+}
+
+YamlFile YamlFile::Load(const fs::path& path, std::string_view kind,
+                        const std::string& referenced_by, const std::string& reference_text) {
+  YamlFile file;
+  file.path_ = path;
+  file.name_ = DisplayPath(path);
+  const std::string text = ReadFileOrThrow(path, kind, referenced_by, reference_text);
+  try {
+    file.root_ = YAML::Load(text);
+  } catch (const YAML::ParserException& e) {
+    // Includes yaml-cpp's DeepRecursion (nesting beyond its depth guard).
+    const std::string hint =
+        TabInIndentation(text, e.mark.line) ? " (YAML does not allow tabs for indentation)" : "";
+    file.Fail(e.mark, "YAML syntax error: " + e.msg + hint);
+  } catch (const YAML::Exception& e) {
+    file.Fail(e.mark, std::string("cannot read YAML: ") + e.what());
+  }
+  return file;
+}
+
+std::string YamlFile::Where(const YAML::Mark& mark) const {
+  if (mark.is_null() || mark.line < 0 || mark.column < 0) return name_;
+  return name_ + ":" + std::to_string(mark.line + 1) + ":" + std::to_string(mark.column + 1);
+}
+
+void YamlFile::Fail(const YAML::Mark& mark, const std::string& message) const {
+  throw Error(Where(mark) + ": " + message);
+}
+
+std::string Describe(const YAML::Node& node) {
+  if (!node.IsDefined() || node.IsNull()) return "nothing";
+  if (node.IsSequence()) return "a list";
+  if (node.IsMap()) return "a mapping";
+  std::string text = node.Scalar();
+  if (text.size() > 40) text = text.substr(0, 37) + "...";
+  // Keep the message one printable line.
+  for (char& c : text)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  return "\"" + text + "\"";
+}
+
+static YAML::Mark MarkOf(const YAML::Node& value, const YAML::Mark& fallback) {
+  if (!value.IsDefined() || value.IsNull()) return fallback;
+  const YAML::Mark m = value.Mark();
+  return m.is_null() ? fallback : m;
+}
+
+Fields::Fields(const YamlFile& file, const Field& mapping, std::string what)
+    : file_(file), what_(std::move(what)), mark_(mapping.mark) {
+  if (!mapping.node.IsMap())
+    file.Fail(mapping.mark,
+              what_ + " must be a mapping of keys to values (got " + Describe(mapping.node) + ")");
+  for (const auto& kv : mapping.node) {
+    const YAML::Mark key_mark = kv.first.Mark();
+    if (!kv.first.IsScalar() || kv.first.Scalar().empty())
+      file.Fail(MarkOf(kv.first, mark_),
+                "keys in " + what_ + " must be plain names (got " + Describe(kv.first) + ")");
+    const std::string key = kv.first.Scalar();
+    for (const Field& f : fields_)
+      if (f.name == key)
+        file.Fail(key_mark, "duplicate key '" + key + "' in " + what_ + " (first given at " +
+                                file.Where(f.key_mark) + ")");
+    fields_.push_back({key, kv.second, MarkOf(kv.second, key_mark), key_mark});
+  }
+}
+
+void Fields::Expect(std::span<const std::string> known) const {
+  for (const Field& f : fields_) {
+    if (std::find(known.begin(), known.end(), f.name) != known.end()) continue;
+    file_.Fail(f.key_mark, "unknown key '" + f.name + "' in " + what_ + Suggest(f.name, known));
+  }
+}
+
+void Fields::Expect(std::initializer_list<std::string_view> known) const {
+  std::vector<std::string> names(known.begin(), known.end());
+  Expect(std::span<const std::string>(names));
+}
+
+bool Fields::Has(std::string_view key) const {
+  for (const Field& f : fields_)
+    if (f.name == key) return true;
+  return false;
+}
+
+Field Fields::Get(std::string_view key) const {
+  for (const Field& f : fields_)
+    if (f.name == key) return f;
+  return {std::string(key), YAML::Node(), mark_, mark_};
+}
+
+Field Fields::Require(std::string_view key) const {
+  Field f = Get(key);
+  if (!f.present()) file_.Fail(f.mark, "'" + std::string(key) + "' is required in " + what_);
+  return f;
+}
+
+std::vector<std::string> Fields::keys() const {
+  std::vector<std::string> out;
+  for (const Field& f : fields_) out.push_back(f.name);
+  return out;
+}
+
+std::vector<Field> ListElements(const YamlFile& file, const Field& list, std::string_view what) {
+  std::vector<Field> out;
+  if (!list.present()) return out;
+  if (!list.node.IsSequence())
+    file.Fail(list.mark, "'" + list.name + "' must be a list of " + std::string(what) + " (got " +
+                             Describe(list.node) + ")");
+  size_t i = 0;
+  for (const YAML::Node& element : list.node) {
+    out.push_back({list.name + "[" + std::to_string(i) + "]", element, MarkOf(element, list.mark),
+                   MarkOf(element, list.mark)});
+    ++i;
+  }
+  return out;
+}
+
+}  // namespace swarmsim::loader

@@ -1,0 +1,496 @@
+#include "swarm/run/runner.h"
+
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <functional>
+#include <iomanip>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <thread>
+
+#include "framework/error.h"
+#include "framework/script_host.h"
+#include "framework/state_hash.h"
+#include "framework/utf8.h"
+#include "swarm/run/stop_signals.h"
+#include "swarm/run/version.h"
+
+namespace swarmsim {
+
+double PeakRssMb() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// A CSV field (RFC 4180): quoted when it holds a comma, quote or line break;
+// invalid UTF-8 replaced (ValidUtf8).
+void WriteCsvField(std::ostream& os, std::string_view text) {
+  if (!IsValidUtf8(text)) return WriteCsvField(os, ValidUtf8(text));
+  if (text.find_first_of(",\"\r\n") == std::string_view::npos) {
+    os << text;
+    return;
+  }
+  os << '"';
+  for (char ch : text) os << (ch == '"' ? "\"\"" : std::string_view(&ch, 1));
+  os << '"';
+}
+
+// Streams metric samples to metrics.csv in tidy (long) form, one row per
+// sample: step,time,robot,metric,value. `robot` is empty for swarm metrics.
+// Rows reach the file at least every second, so a run killed from outside
+// (a sweep's --timeout, the OOM killer) keeps all but the last second.
+class MetricsWriter {
+ public:
+  MetricsWriter(const std::filesystem::path& path, const World& world) : world_(world) {
+    file_.open(path);
+    if (!file_) throw Error("cannot write '" + path.string() + "'");
+    file_ << "step,time,robot,metric,value\n";
+    file_ << std::setprecision(10);
+    file_.flush();
+    last_flush_ = Clock::now();
+  }
+  void Write(const std::vector<MetricSample>& samples) {
+    for (const MetricSample& m : samples) {
+      file_ << m.step << ',' << m.time << ',';
+      if (m.instance >= 0) WriteCsvField(file_, world_.scene().instance(m.instance).name);
+      file_ << ',';
+      WriteCsvField(file_, m.name);
+      file_ << ',';
+      if (std::isnan(m.value))
+        file_ << "nan";  // not "-nan": one spelling for every reader
+      else
+        file_ << m.value;
+      file_ << '\n';
+    }
+    if (!samples.empty() && Clock::now() - last_flush_ >= std::chrono::seconds(1)) Flush();
+  }
+  void Flush() {
+    file_.flush();
+    last_flush_ = Clock::now();
+  }
+
+ private:
+  const World& world_;
+  std::ofstream file_;
+  Clock::time_point last_flush_;
+};
+
+std::string Fixed(double v, int digits) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(digits) << v;
+  return s.str();
+}
+
+// Ends a run whose step does not finish. Lua's hooks stop runaway Lua code
+// (the instruction budget, the memory limit) but not a script stuck inside
+// one C function, and a stop signal is only looked at between steps. After
+// `timeout` seconds (0: never) without progress, or kSignalGrace after a
+// stop signal the step did not answer, `end_run(error, signal)` runs on the
+// watchdog's thread; it writes the outputs and exits the process, since the
+// stuck thread cannot be unwound. The run loop holds io_mutex() while it
+// writes outputs and reports progress; end_run runs holding it too, so the
+// two never write at once.
+class Watchdog {
+ public:
+  using EndRun = std::function<void(const std::string& error, int signal)>;
+  static constexpr double kSignalGrace = 3;  // s
+
+  // `instruction_budget`: the world's (simulation.instruction_budget), for
+  // the message: with none, an endless Lua loop is also stopped only here.
+  Watchdog(double timeout, int64_t instruction_budget, EndRun end_run)
+      : timeout_(timeout),
+        instruction_budget_(instruction_budget),
+        end_run_(std::move(end_run)),
+        thread_([this] { Watch(); }) {}
+  ~Watchdog() {
+    {
+      const std::lock_guard lock(wake_mutex_);
+      done_ = true;
+    }
+    wake_.notify_one();
+    thread_.join();
+  }
+  Watchdog(const Watchdog&) = delete;
+  Watchdog& operator=(const Watchdog&) = delete;
+
+  std::mutex& io_mutex() { return io_mutex_; }
+  // One more unit of progress (the start, a step, the stop); `what` names
+  // the next one for the message ("step 12").
+  void Progress(std::string what) {
+    const std::lock_guard lock(wake_mutex_);
+    ++progress_;
+    next_ = std::move(what);
+  }
+
+ private:
+  void Watch() {
+    using namespace std::chrono_literals;
+    uint64_t seen = ~uint64_t{0};
+    Clock::time_point since = Clock::now();
+    Clock::time_point signal_since{};
+    std::unique_lock lock(wake_mutex_);
+    while (!wake_.wait_for(lock, 100ms, [this] { return done_; })) {
+      const Clock::time_point now = Clock::now();
+      if (progress_ != seen) seen = progress_, since = now, signal_since = {};
+      const int sig = StopSignals::Received();
+      if (sig != 0 && signal_since == Clock::time_point{}) signal_since = now;
+      const double stalled = std::chrono::duration<double>(now - since).count();
+      std::string error;
+      int end_signal = 0;
+      if (sig != 0 && now - signal_since >= std::chrono::duration<double>(kSignalGrace)) {
+        error = std::string("interrupted by SIG") + sigabbrev_np(sig) + " during " + next_ +
+                ", which did not finish within " + Fixed(kSignalGrace, 0) + " s of the signal";
+        end_signal = sig;
+      } else if (timeout_ > 0 && stalled >= timeout_) {
+        std::ostringstream limit;
+        limit << timeout_;
+        error = next_ + " did not finish within " + limit.str() + " s (simulation.step_timeout)";
+      } else {
+        continue;
+      }
+      const std::vector<std::string> calls = ScriptCallsInProgress();
+      if (calls.empty()) {
+        error += "; no script was running";
+      } else {
+        error += "; running: ";
+        for (size_t i = 0; i < calls.size(); ++i) error += (i ? "; " : "") + calls[i];
+        error += instruction_budget_ > 0
+                     ? " (the instruction budget cannot stop a script inside one C function, "
+                       "such as a pattern match that backtracks over a long string or a garbage "
+                       "collection of a large heap)"
+                     : " (simulation.instruction_budget is 0, no limit: an endless loop in a "
+                       "script runs until this timeout)";
+      }
+      // Outputs are written under io_mutex; progress_ cannot move meanwhile
+      // (the loop reports progress only after writing them).
+      const uint64_t before = progress_;
+      lock.unlock();
+      const std::lock_guard io(io_mutex_);
+      lock.lock();
+      if (progress_ != before) continue;  // it moved on after all
+      end_run_(error, end_signal);
+    }
+  }
+
+  const double timeout_;
+  const int64_t instruction_budget_;
+  const EndRun end_run_;
+  std::mutex io_mutex_;
+  std::mutex wake_mutex_;
+  std::condition_variable wake_;
+  bool done_ = false;
+  uint64_t progress_ = 0;
+  std::string next_ = "the start of the world";
+  std::thread thread_;  // last: starts once the members above exist
+};
+
+// A progress bar on a terminal; a plain line every 10% otherwise.
+class Progress {
+ public:
+  Progress(std::ostream& os, int64_t total, bool enabled, bool tty)
+      : os_(os), total_(total), enabled_(enabled), tty_(tty), start_(Clock::now()) {}
+
+  void Update(int64_t done, double sim_time) {
+    if (!enabled_ || total_ <= 0) return;
+    const auto now = Clock::now();
+    const int decile = static_cast<int>(10 * done / total_);
+    if (tty_) {
+      if (done != total_ && now - last_ < std::chrono::milliseconds(100)) return;
+    } else if (decile == last_decile_) {
+      return;
+    }
+    last_ = now;
+    last_decile_ = decile;
+    const double wall = std::chrono::duration<double>(now - start_).count();
+    const double frac = static_cast<double>(done) / static_cast<double>(total_);
+    const double eta = done > 0 ? wall * (1 - frac) / frac : 0;
+    std::ostringstream line;
+    line << std::fixed << std::setprecision(1);
+    if (tty_) {
+      constexpr int kWidth = 30;
+      const int filled = static_cast<int>(frac * kWidth);
+      line << "\r[" << std::string(filled, '#') << std::string(kWidth - filled, ' ') << "] ";
+    }
+    line << std::setw(3) << static_cast<int>(100 * frac) << "%  step " << done << "/" << total_
+         << "  sim " << sim_time << " s  " << (wall > 0 ? sim_time / wall : 0) << "x real time"
+         << "  ETA " << eta << " s";
+    os_ << line.str() << (tty_ ? "" : "\n") << std::flush;
+  }
+  void Finish() {
+    if (enabled_ && tty_) os_ << "\n" << std::flush;
+  }
+
+ private:
+  std::ostream& os_;
+  int64_t total_;
+  bool enabled_;
+  bool tty_;
+  Clock::time_point start_;
+  Clock::time_point last_{};
+  int last_decile_ = -1;
+};
+
+// "box2d, 10 substeps"; "kinematic" (no physics engine steps: no substeps).
+std::string PhysicsLine(const WorldSettings& settings) {
+  if (settings.physics == "kinematic" || settings.physics == "null") return settings.physics;
+  return settings.physics + ", " + std::to_string(settings.physics_substeps) +
+         (settings.physics_substeps == 1 ? " physics substep" : " physics substeps");
+}
+
+// A double that JSON should show as an integer: whole and exact (|v| <= 2^53).
+bool IsWholeNumber(double v) { return std::abs(v) <= 9007199254740992.0 && v == std::trunc(v); }
+
+// summary.json. `complete`: the world is between steps; else a step is
+// stuck (Watchdog) and what a running step may change is left out: the
+// state hash and the disabled scripts.
+bool WriteSummary(const World& world, const RunOptions& options, const RunResult& result,
+                  double lua_kib, bool complete) {
+  const int robots = world.robot_count();
+  const double sim_time = world.time();
+  const double robot_ticks = static_cast<double>(robots) * static_cast<double>(result.steps);
+  nlohmann::json j;
+  j["swarmsim_version"] = Version();
+  j["world"] = options.world_file;
+  j["command"] = options.command_line;
+  j["status"] = result.ok ? "ok" : result.signal != 0 ? "interrupted" : "error";
+  if (!result.ok) j["error"] = result.error;
+  j["seed"] = world.settings().seed;
+  j["threads"] = world.threads();
+  j["physics"] = world.settings().physics;
+  j["robots"] = robots;
+  j["steps"] = result.steps;
+  j["time_step"] = world.settings().time_step;
+  j["physics_substeps"] = world.settings().physics_substeps;
+  j["simulated_time"] = sim_time;
+  j["wall_time"] = result.wall_seconds;
+  j["real_time_factor"] = result.wall_seconds > 0 ? sim_time / result.wall_seconds : 0;
+  j["robot_ticks_per_s"] = result.wall_seconds > 0 ? robot_ticks / result.wall_seconds : 0;
+  j["peak_rss_mb"] = result.peak_rss_mb;
+  j["lua_memory_kib"] = lua_kib;
+  j["state_hash"] = complete ? nlohmann::json(StateHasher::ToHex(result.state_hash)) : nullptr;
+  if (complete) j["disabled_scripts"] = world.disabled_scripts();
+  nlohmann::json phases;
+  for (size_t p = 0; p < static_cast<size_t>(Phase::kCount); ++p)
+    phases[ToString(static_cast<Phase>(p))] = world.phase_times()[p];
+  j["phase_seconds"] = phases;
+  nlohmann::json params;
+  for (const auto& [name, value] : world.parameters()) {
+    if (const double* d = std::get_if<double>(&value))
+      params[name] = IsWholeNumber(*d) ? nlohmann::json(static_cast<int64_t>(*d))
+                                       : nlohmann::json(*d);  // 50, not 50.0
+    else if (const bool* b = std::get_if<bool>(&value))
+      params[name] = *b;
+    else
+      params[name] = std::get<std::string>(value);
+  }
+  j["parameters"] = params;
+  nlohmann::json overrides = nlohmann::json::object();
+  for (const auto& [name, value] : options.overrides) overrides[name] = value;
+  j["overrides"] = overrides;
+  std::ofstream f(*options.out_dir / "summary.json");
+  // Invalid UTF-8 (from a world file, a script, a --set) is replaced, not fatal.
+  f << j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
+  return static_cast<bool>(f);
+}
+
+// What a run has produced so far, shared by its step loop, the watchdog's
+// end of a stuck run and the outputs written after the loop.
+struct RunRecord {
+  RunResult result;
+  std::unique_ptr<MetricsWriter> metrics;  // metrics.csv, with an output folder
+  double lua_kib = 0;                      // the scripts' memory when they stopped
+};
+
+// Starts `world` and steps it options.steps times under a Watchdog, writing
+// metrics as it goes. A failure ends up in record->result (ok false, error);
+// a step that never finishes ends the process (the Watchdog's end_run).
+void StepWatched(World* world, const RunOptions& options, Clock::time_point start,
+                 Progress* progress_bar, RunRecord* record) {
+  RunResult& result = record->result;
+  std::unique_ptr<MetricsWriter>& metrics = record->metrics;
+  double& lua_kib = record->lua_kib;
+  Progress& progress = *progress_bar;
+  // A step that never finishes: write what a failed run writes and exit.
+  const auto end_stuck_run = [&](const std::string& error, int signal) {
+    RunResult stuck = result;
+    stuck.ok = false;
+    stuck.error = error;
+    stuck.signal = signal;
+    stuck.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    stuck.peak_rss_mb = PeakRssMb();
+    if (metrics) metrics->Flush();
+    if (options.out_dir && std::filesystem::is_directory(*options.out_dir))
+      WriteSummary(*world, options, stuck, 0, /*complete=*/false);
+    progress.Finish();
+    world->FlushPrintsOfStuckStep();  // what the scripts printed before they got stuck
+    std::fflush(stdout);
+    std::cerr << "error: " << ValidUtf8(error) << "\n";
+    if (options.out_dir && std::filesystem::is_directory(*options.out_dir))
+      std::cerr << "outputs up to step " << stuck.steps << " are in " << options.out_dir->string()
+                << "\n";
+    std::cerr.flush();
+    std::_Exit(signal != 0 ? 128 + signal : 1);  // 1: the run failed, as main's
+  };
+  Watchdog watchdog(world->settings().step_timeout, world->settings().instruction_budget,
+                    end_stuck_run);
+  // Outputs of the step just done, then the next unit of work for the
+  // watchdog's message; under its lock, so it never writes at the same time.
+  const auto done = [&](std::string next) {
+    const std::lock_guard lock(watchdog.io_mutex());
+    if (metrics) metrics->Write(world->TakeMetrics());
+    watchdog.Progress(std::move(next));
+  };
+  const auto step_name = [&] {
+    return "step " + std::to_string(result.steps + 1) + " of " + std::to_string(options.steps);
+  };
+  try {
+    if (options.out_dir) {
+      std::error_code ec;
+      std::filesystem::create_directories(*options.out_dir, ec);
+      if (ec)
+        throw Error("cannot create output folder '" + options.out_dir->string() +
+                    "': " + ec.message());
+      const std::lock_guard lock(watchdog.io_mutex());
+      metrics = std::make_unique<MetricsWriter>(*options.out_dir / "metrics.csv", *world);
+    }
+    world->Start();
+    done(options.steps > 0 ? step_name() : "the stop of the world");
+    for (int64_t i = 0; i < options.steps; ++i) {
+      if (const int sig = StopSignals::Received(); sig != 0) {
+        result.signal = sig;
+        throw Error(std::string("interrupted by SIG") + sigabbrev_np(sig) + " after " +
+                    std::to_string(result.steps) + " of " + std::to_string(options.steps) +
+                    " steps");
+      }
+      world->Step();
+      {
+        const std::lock_guard lock(watchdog.io_mutex());
+        ++result.steps;
+      }
+      done(result.steps < options.steps ? step_name() : "the stop of the world");
+      progress.Update(result.steps, world->time());
+    }
+    lua_kib =
+        static_cast<double>(world->script_memory_bytes()) / 1024.0;  // before the states close
+    world->Stop();
+    done("writing the outputs");
+    result.ok = true;
+  } catch (const std::exception& e) {
+    const std::lock_guard lock(watchdog.io_mutex());
+    result.error = e.what();
+    // The states are still open after an error: what they held then.
+    lua_kib = static_cast<double>(world->script_memory_bytes()) / 1024.0;
+    if (metrics) metrics->Write(world->TakeMetrics());  // whatever was recorded before the error
+  }
+}
+
+// The summary table a run prints unless --quiet.
+void PrintSummaryTable(const World& world, const RunResult& result, double lua_kib,
+                       std::ostream& out) {
+  const int robots = world.robot_count();
+  const double sim_time = world.time();
+  const double robot_ticks = static_cast<double>(robots) * static_cast<double>(result.steps);
+  const double rtf = result.wall_seconds > 0 ? sim_time / result.wall_seconds : 0;
+  const double ticks_per_s = result.wall_seconds > 0 ? robot_ticks / result.wall_seconds : 0;
+  out << "robots          " << robots << "\n"
+      << "steps           " << result.steps << " (time step " << world.settings().time_step
+      << " s, " << PhysicsLine(world.settings()) << ")\n"
+      << "simulated time  " << Fixed(sim_time, 2) << " s\n"
+      << "wall time       " << Fixed(result.wall_seconds, 3) << " s on " << world.threads()
+      << (world.threads() == 1 ? " thread\n" : " threads\n") << "real-time factor " << Fixed(rtf, 1)
+      << "x\n"
+      << "robot-ticks/s   " << Fixed(ticks_per_s, 0) << "\n"
+      << "peak memory     " << Fixed(result.peak_rss_mb, 1) << " MiB ("
+      << Fixed(robots > 0 ? result.peak_rss_mb * 1024 / robots : 0, 1)
+      << " KiB per robot, of which Lua " << Fixed(robots > 0 ? lua_kib / robots : 0, 1) << ")\n"
+      << "time per phase  (ms total, us per robot-tick)\n";
+  for (size_t p = 0; p < static_cast<size_t>(Phase::kCount); ++p) {
+    const double t = world.phase_times()[p];
+    out << "  " << std::left << std::setw(9) << ToString(static_cast<Phase>(p)) << std::right
+        << std::setw(10) << Fixed(1e3 * t, 1) << std::setw(10)
+        << Fixed(robot_ticks > 0 ? 1e6 * t / robot_ticks : 0, 3) << "\n";
+  }
+  if (const auto& disabled = world.disabled_scripts(); !disabled.empty())
+    out << "disabled scripts " << disabled.size()
+        << " (on_script_error: disable_script), first: " << disabled.front() << "\n";
+}
+
+}  // namespace
+
+bool WriteErrorSummary(const RunOptions& options, const std::string& error) {
+  if (!options.out_dir) return false;
+  std::error_code ec;
+  std::filesystem::create_directories(*options.out_dir, ec);
+  nlohmann::json j;
+  j["swarmsim_version"] = Version();
+  j["world"] = options.world_file;
+  j["command"] = options.command_line;
+  j["status"] = "error";
+  j["error"] = error;
+  std::ofstream f(*options.out_dir / "summary.json");
+  // Invalid UTF-8 (from a world file, a script, a --set) is replaced, not fatal.
+  f << j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
+  return static_cast<bool>(f);
+}
+
+RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
+                   std::ostream& progress_stream) {
+  RunRecord record;
+  RunResult& result = record.result;
+  const auto start = Clock::now();
+  const bool tty = isatty(STDERR_FILENO) && &progress_stream == &std::cerr;
+  Progress progress(progress_stream, options.steps, !options.quiet, tty);
+  // SIGINT, SIGTERM and SIGHUP end the run at the next step boundary, with
+  // its outputs written (or, for a stuck step, through the Watchdog).
+  const StopSignals stop_signals;
+  // The steps, watched for one that never finishes.
+  StepWatched(world, options, start, &progress, &record);
+  progress.Finish();
+  if (record.metrics) record.metrics->Flush();
+  // Observers' files (paint.png), also after an error: the outputs so far.
+  if (options.out_dir && world->started()) {
+    try {
+      world->WriteOutputs(*options.out_dir);
+    } catch (const std::exception& e) {
+      if (result.ok) {
+        result.ok = false;
+        result.error = e.what();
+      }
+    }
+  }
+  result.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  result.state_hash = world->StateHash();
+  result.peak_rss_mb = PeakRssMb();
+
+  // The summary.
+  if (!options.quiet) PrintSummaryTable(*world, result, record.lua_kib, out);
+  if (options.print_hash) out << "state-hash: " << StateHasher::ToHex(result.state_hash) << "\n";
+  out << std::flush;
+
+  if (options.out_dir &&
+      !WriteSummary(*world, options, result, record.lua_kib, /*complete=*/true)) {
+    if (result.ok) {
+      result.ok = false;
+      result.error = "cannot write '" + (*options.out_dir / "summary.json").string() + "'";
+    }
+  }
+  return result;
+}
+
+}  // namespace swarmsim

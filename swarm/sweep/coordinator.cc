@@ -1,0 +1,201 @@
+#include "swarm/sweep/coordinator.h"
+
+#include <signal.h>
+#include <unistd.h>
+
+#include <array>
+#include <csignal>
+#include <cstring>
+#include <deque>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <thread>
+
+#include "framework/error.h"
+#include "framework/registry.h"
+#include "modules/builtin.h"
+#include "swarm/loader/world_loader.h"
+#include "swarm/run/stop_signals.h"
+#include "swarm/run/version.h"
+#include "swarm/sweep/progress.h"
+
+namespace swarmsim {
+namespace {
+
+// Loads the world once with the first run's parameters, so that a misspelt
+// --param or a bad value is one clear error instead of every run failing.
+void CheckWorld(const SweepOptions& o, const GridRun& first) {
+  ModuleRegistry registry;
+  RegisterBuiltinModules(&registry);
+  LoadOptions load;
+  load.overrides = first.params;
+  load.seed = first.seed;
+  load.threads = 1;
+  LoadedWorld loaded = LoadWorld(o.world, load, registry);
+  if (!o.steps && !o.duration && !loaded.steps)
+    throw Error(o.world + " gives no run length; pass --steps N or --duration SECONDS");
+}
+
+}  // namespace
+
+WorkerConfig MakeWorkerConfig(const SweepOptions& o) {
+  WorkerConfig c;
+  c.self_exe = o.self_exe;
+  c.world = o.world;
+  c.steps = o.steps;
+  c.duration = o.duration;
+  c.threads_per_run = o.threads_per_run;
+  c.timeout_s = o.timeout_s;
+  c.scratch =
+      std::filesystem::temp_directory_path() / ("swarmsim-sweep-" + std::to_string(getpid()));
+  return c;
+}
+
+std::string WorldFileHash(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) throw Error("cannot read world file '" + path + "'");
+  std::ostringstream s;
+  s << f.rdbuf();
+  // FNV-1a, 64 bits: a change detector, not a security hash.
+  uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : s.str()) h = (h ^ c) * 1099511628211ull;
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
+std::string SweepSpace(const std::vector<ParamSpec>& params, const std::vector<uint64_t>& seeds,
+                       const std::optional<int64_t>& steps, const std::optional<double>& duration) {
+  nlohmann::json j;
+  j["params"] = nlohmann::json::array();
+  for (const ParamSpec& p : params)
+    j["params"].push_back(
+        {{"name", p.name}, {"spec", p.spec}, {"kind", p.kind}, {"values", p.values}});
+  j["seeds"] = seeds;
+  j["steps"] = steps ? nlohmann::json(*steps) : nlohmann::json(nullptr);
+  j["duration"] = duration ? nlohmann::json(*duration) : nlohmann::json(nullptr);
+  return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+int CoordinateSweep(const SweepOptions& o, RemoteWorkers* remote, std::ostream& out,
+                    std::ostream& err) {
+  // SIGINT, SIGTERM and SIGHUP stop a sweep between runs: the runs in
+  // progress are killed and stay claimed (a resume runs them again), the
+  // finished ones are kept.
+  const StopSignals stop_signals;
+  // The grid and the sweep's identity.
+  std::vector<ParamSpec> params;
+  for (const std::string& p : o.params) params.push_back(ParseParamSpec(p));
+  const std::vector<uint64_t> seeds = ParseSeeds(o.seeds);
+  const std::vector<GridRun> grid = ExpandGrid(params, seeds);
+  const std::string world_hash = WorldFileHash(o.world);
+  const std::string space = SweepSpace(params, seeds, o.steps, o.duration);
+  if (o.db.empty()) throw Error("sweep needs --db FILE for the results");
+
+  // A new sweep: check the world and parameters before creating the database.
+  if (!std::filesystem::exists(o.db)) CheckWorld(o, grid.front());
+  ResultsDb db(o.db);
+  if (std::optional<SweepRecord> existing = db.ReadSweep()) {
+    if (existing->space_json != space)
+      throw Error("'" + o.db + "' holds another sweep (different parameters, seeds or run " +
+                  "length); resume it with the same command or use another --db");
+    if (existing->world_hash != world_hash) {
+      if (!o.allow_changed_world)
+        throw Error("world file '" + o.world + "' has changed since this sweep began (" +
+                    existing->started_at + "); its runs would mix two worlds. Pass " +
+                    "--allow-changed-world to continue anyway, or use another --db");
+      err << "warning: world file changed since the sweep began; continuing as asked\n";
+      db.SetWorldHash(world_hash);
+    }
+    if (const int64_t n = db.ResetInterrupted(); n > 0)
+      err << "resuming: " << n << " run" << (n == 1 ? " was" : "s were")
+          << " in progress when the sweep stopped; running again\n";
+  } else {
+    SweepRecord record{o.world, world_hash, space, UtcNow(), Version(), o.command_line};
+    db.CreateSweep(record, grid);
+  }
+  if (o.retry_failed) {
+    if (const int64_t n = db.ResetFailed(); n > 0) err << "retrying " << n << " failed runs\n";
+  }
+
+  // This shard's pending runs.
+  std::deque<GridRun> pending;
+  for (GridRun& r : db.PendingRuns())
+    if ((r.id - 1) % o.shard_count == o.shard_index) pending.push_back(std::move(r));
+  const RunCounts before = db.Counts();
+  const int64_t shard_total =
+      o.shard_count == 1 ? before.total
+                         : (before.total - o.shard_index + o.shard_count - 1) / o.shard_count;
+  const int64_t already = shard_total - static_cast<int64_t>(pending.size());
+  const int jobs =
+      o.jobs > 0 ? o.jobs : (remote ? 1 : std::max(1u, std::thread::hardware_concurrency()));
+  if (!o.quiet)
+    err << "sweep: " << before.total << " runs (" << grid.size() / seeds.size() << " points x "
+        << seeds.size() << " seeds)"
+        << (o.shard_count > 1
+                ? ", shard " + std::to_string(o.shard_index) + "/" + std::to_string(o.shard_count)
+                : std::string())
+        << ", " << already << " already finished, " << pending.size() << " to run on " << jobs
+        << (jobs == 1 ? " job" : " jobs") << (remote ? " here plus the other ranks" : "") << "\n";
+
+  SweepProgress progress(err, shard_total, already, isatty(STDERR_FILENO) != 0, !o.quiet);
+  RunPool pool(MakeWorkerConfig(o), jobs);
+  const std::string me = WorkerName();
+  auto next = [&]() -> std::optional<GridRun> {
+    if (pending.empty()) return std::nullopt;
+    GridRun r = std::move(pending.front());
+    pending.pop_front();
+    db.Claim(r.id, me);
+    return r;
+  };
+  auto running = [&] { return pool.active() + (remote ? remote->Running() : 0); };
+  int stop_signal = 0;
+  auto done = [&](RunOutcome outcome) {
+    // After a stop signal, a run that did not finish (the signal reached it
+    // too) is no result: it stays claimed and runs again on resume.
+    if (!outcome.ok && (stop_signal != 0 || StopSignals::Received() != 0)) return;
+    db.Complete(outcome);
+    progress.RunEnded(outcome.id, outcome.ok, outcome.error, running());
+  };
+  while (!pending.empty() || pool.active() > 0 || (remote && remote->Busy())) {
+    if (stop_signal == 0 && StopSignals::Received() != 0) {
+      // Stop: no new runs (the other ranks are told so as they ask), the
+      // local runs in progress killed.
+      stop_signal = StopSignals::Received();
+      pending.clear();
+      pool.KillAll();
+      continue;
+    }
+    while (pool.HasFreeSlot() && !pending.empty()) pool.Start(*next());
+    if (remote) remote->Service(next, done);
+    for (RunOutcome& outcome : pool.Poll(remote ? 0.002 : 0.5)) done(std::move(outcome));
+  }
+  progress.Finish();
+  const RunCounts after = db.Counts();
+  out << "sweep: " << after.ok << " ok, " << after.failed << " failed, "
+      << after.pending + after.running << " not run, of " << after.total << " runs; results in "
+      << o.db << "\n"
+      << std::flush;
+  if (stop_signal != 0) {
+    err << "sweep: interrupted by SIG" << sigabbrev_np(stop_signal) << ": "
+        << after.ok + after.failed << " of " << after.total << " runs done (" << after.failed
+        << " failed)";
+    if (after.running > 0)
+      err << ", " << after.running << (after.running == 1 ? " run" : " runs")
+          << " in progress stopped (run again on resume)";
+    err << ". Run the same command to resume; finished runs are kept.\n" << std::flush;
+    return 128 + stop_signal;
+  }
+  if (after.failed > 0) {
+    err << "sweep: " << after.failed << (after.failed == 1 ? " run" : " runs")
+        << " failed or timed out (exit status 1): `swarmsim report " << o.db
+        << "` lists them; --retry-failed runs them again\n"
+        << std::flush;
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace swarmsim

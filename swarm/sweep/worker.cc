@@ -1,0 +1,293 @@
+#include "swarm/sweep/worker.h"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "framework/error.h"
+#include "framework/utf8.h"
+
+namespace swarmsim {
+namespace {
+
+static_assert(sizeof(sigset_t) <= 128, "RunPool::old_mask_ too small");
+
+std::string ReadFile(const std::filesystem::path& path) {
+  std::ifstream f(path);
+  std::ostringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+// The last non-empty lines of a child's stderr, for a failure message.
+std::string Tail(const std::string& text, int lines) {
+  std::vector<std::string> all;
+  std::istringstream s(text);
+  std::string line;
+  while (std::getline(s, line))
+    if (!line.empty()) all.push_back(line);
+  std::string out;
+  for (size_t i = all.size() > static_cast<size_t>(lines) ? all.size() - lines : 0; i < all.size();
+       ++i)
+    out += (out.empty() ? "" : " | ") + all[i];
+  return out;
+}
+
+// metrics.csv (step,time,robot,metric,value) -> series and final values.
+// Swarm metrics (robot empty) are kept as they are; a per-robot metric
+// becomes its mean over the robots that recorded it in that step.
+void ReadMetrics(const std::filesystem::path& path, RunOutcome* out) {
+  std::ifstream f(path);
+  std::string line;
+  if (!std::getline(f, line)) return;  // header
+  struct Key {
+    std::string metric;
+    int64_t step;
+    bool operator<(const Key& o) const {
+      return metric != o.metric ? metric < o.metric : step < o.step;
+    }
+  };
+  struct Acc {
+    double time = 0, sum = 0;
+    int64_t n = 0;
+  };
+  std::map<Key, Acc> acc;
+  while (std::getline(f, line)) {
+    // step,time,robot,metric,value: robot names hold no commas but split from both ends anyway.
+    const size_t c1 = line.find(','), c2 = line.find(',', c1 + 1);
+    const size_t c4 = line.rfind(','), c3 = line.rfind(',', c4 - 1);
+    if (c1 == std::string::npos || c2 == std::string::npos || c3 == std::string::npos || c3 < c2 ||
+        c4 == c3)
+      continue;
+    try {
+      Acc& a = acc[Key{line.substr(c3 + 1, c4 - c3 - 1), std::stoll(line.substr(0, c1))}];
+      a.time = std::stod(line.substr(c1 + 1, c2 - c1 - 1));
+      a.sum += std::stod(line.substr(c4 + 1));
+      ++a.n;
+    } catch (const std::exception&) {
+      continue;  // nan/inf values or a torn last line
+    }
+  }
+  for (const auto& [key, a] : acc) {
+    const double value = a.sum / static_cast<double>(a.n);
+    out->series.push_back({key.metric, key.step, a.time, value});
+    out->final_metrics[key.metric] = value;  // steps ascend within a metric: the last wins
+  }
+}
+
+}  // namespace
+
+std::string WorkerName() {
+  char host[256] = {0};
+  gethostname(host, sizeof host - 1);
+  return std::string(host) + ":" + std::to_string(getpid());
+}
+
+std::vector<std::string> RunArguments(const WorkerConfig& config, const GridRun& run,
+                                      const std::filesystem::path& out_dir) {
+  std::vector<std::string> args{"run", config.world, "--seed", std::to_string(run.seed)};
+  for (const auto& [name, value] : run.params) {
+    args.push_back("--set");
+    args.push_back(name + "=" + value);
+  }
+  if (config.steps) {
+    args.push_back("--steps");
+    args.push_back(std::to_string(*config.steps));
+  } else if (config.duration) {
+    args.push_back("--duration");
+    args.push_back(FormatNumber(*config.duration));
+  }
+  args.push_back("--threads");
+  args.push_back(std::to_string(config.threads_per_run));
+  args.push_back("--quiet");
+  args.push_back("--out");
+  args.push_back(out_dir.string());
+  return args;
+}
+
+RunOutcome CollectRun(int64_t id, const std::filesystem::path& out_dir, int wait_status,
+                      bool timed_out, double timeout_s) {
+  RunOutcome o;
+  o.id = id;
+  const std::string err = Tail(ReadFile(out_dir / "stderr.txt"), 3);
+  nlohmann::json summary;
+  bool have_summary = false;
+  try {
+    std::ifstream f(out_dir / "summary.json");
+    if (f) {
+      summary = nlohmann::json::parse(f);
+      have_summary = true;
+    }
+  } catch (const std::exception&) {
+  }
+  if (have_summary) {
+    o.steps = summary.value("steps", int64_t{0});
+    o.robots = summary.value("robots", int64_t{0});
+    o.state_hash = summary.value("state_hash", std::string());
+  }
+  ReadMetrics(out_dir / "metrics.csv", &o);
+  if (timed_out) {
+    o.error = "timed out after " + FormatNumber(timeout_s) + " s (--timeout)";
+    o.state_hash.clear();
+  } else if (WIFSIGNALED(wait_status)) {
+    const int sig = WTERMSIG(wait_status);
+    o.error = "crashed: killed by signal " + std::to_string(sig) + " (" + strsignal(sig) + ")";
+    if (!err.empty()) o.error += ": " + err;
+  } else if (!WIFEXITED(wait_status) || WEXITSTATUS(wait_status) != 0) {
+    if (have_summary && summary.contains("error"))
+      o.error = summary["error"].get<std::string>();
+    else if (!err.empty())
+      o.error = err;
+    else
+      o.error = "exit status " + std::to_string(WEXITSTATUS(wait_status));
+    if (WIFEXITED(wait_status) && WEXITSTATUS(wait_status) == 127 && err.empty())
+      o.error = "cannot start the worker program";
+  } else if (!have_summary || summary.value("status", std::string()) != "ok") {
+    o.error = "the run wrote no valid summary.json";
+  } else {
+    o.ok = true;
+  }
+  o.error = ValidUtf8(o.error);  // stderr's tail may hold any bytes
+  return o;
+}
+
+RunPool::RunPool(const WorkerConfig& config, int slots)
+    : config_(config), slots_(std::max(1, slots)), worker_name_(WorkerName()) {
+  sigset_t block;
+  sigemptyset(&block);
+  sigaddset(&block, SIGCHLD);
+  restore_mask_ = pthread_sigmask(SIG_BLOCK, &block, reinterpret_cast<sigset_t*>(old_mask_)) == 0;
+  std::filesystem::create_directories(config_.scratch);
+  // Scratch folders of sweeps that were killed (their process is gone).
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(config_.scratch.parent_path(), ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind("swarmsim-sweep-", 0) != 0) continue;
+    const std::string pid = name.substr(15);
+    if (pid.empty() || pid.find_first_not_of("0123456789") != std::string::npos) continue;
+    if (kill(static_cast<pid_t>(std::stol(pid)), 0) == -1 && errno == ESRCH)
+      std::filesystem::remove_all(entry.path(), ec);
+  }
+}
+
+int RunPool::KillAll() {
+  const int killed = active();
+  for (const Active& a : active_) {
+    kill(a.pid, SIGKILL);
+    waitpid(a.pid, nullptr, 0);
+    std::error_code ec;
+    std::filesystem::remove_all(a.dir, ec);
+  }
+  active_.clear();
+  return killed;
+}
+
+RunPool::~RunPool() {
+  KillAll();
+  std::error_code ec;
+  std::filesystem::remove(config_.scratch, ec);  // only if empty
+  if (restore_mask_) {
+    // Drain a SIGCHLD left pending so it does not reach the old mask's handler later.
+    sigset_t chld;
+    sigemptyset(&chld);
+    sigaddset(&chld, SIGCHLD);
+    timespec zero{0, 0};
+    while (sigtimedwait(&chld, nullptr, &zero) > 0) {
+    }
+    pthread_sigmask(SIG_SETMASK, reinterpret_cast<sigset_t*>(old_mask_), nullptr);
+  }
+}
+
+void RunPool::Start(const GridRun& run) {
+  const std::filesystem::path dir = config_.scratch / ("run-" + std::to_string(run.id));
+  std::error_code ec;
+  std::filesystem::remove_all(dir, ec);
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw Error("cannot create '" + dir.string() + "': " + ec.message());
+  std::vector<std::string> args = RunArguments(config_, run, dir);
+  args.insert(args.begin(), config_.self_exe);
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  const std::string err_path = (dir / "stderr.txt").string();
+  const pid_t parent = getpid();
+  const pid_t pid = fork();
+  if (pid < 0) throw Error(std::string("cannot start a worker process: ") + strerror(errno));
+  if (pid == 0) {
+    // The child: die with the sweep, no inherited signal mask, quiet stdout.
+    prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (getppid() != parent) _exit(126);
+    sigset_t none;
+    sigemptyset(&none);
+    sigprocmask(SIG_SETMASK, &none, nullptr);
+    const int null_fd = open("/dev/null", O_RDWR);
+    const int err_fd = open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (null_fd >= 0) {
+      dup2(null_fd, STDIN_FILENO);
+      dup2(null_fd, STDOUT_FILENO);
+    }
+    if (err_fd >= 0) dup2(err_fd, STDERR_FILENO);
+    execv(argv[0], argv.data());
+    _exit(127);
+  }
+  active_.push_back({run.id, pid, dir, Clock::now()});
+}
+
+std::vector<RunOutcome> RunPool::Poll(double wait_s) {
+  std::vector<RunOutcome> done;
+  if (active_.empty()) return done;
+  // Wait for SIGCHLD, but not past the earliest time limit.
+  auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                     std::chrono::duration<double>(std::max(0.0, wait_s)));
+  if (config_.timeout_s > 0)
+    for (const Active& a : active_)
+      deadline =
+          std::min(deadline, a.start + std::chrono::duration_cast<Clock::duration>(
+                                           std::chrono::duration<double>(config_.timeout_s)));
+  const double wait = std::chrono::duration<double>(deadline - Clock::now()).count();
+  if (wait > 0) {
+    sigset_t chld;
+    sigemptyset(&chld);
+    sigaddset(&chld, SIGCHLD);
+    timespec ts;
+    ts.tv_sec = static_cast<time_t>(wait);
+    ts.tv_nsec = static_cast<long>((wait - static_cast<double>(ts.tv_sec)) * 1e9);
+    sigtimedwait(&chld, nullptr, &ts);
+  }
+  const auto now = Clock::now();
+  for (size_t i = 0; i < active_.size();) {
+    Active& a = active_[i];
+    int status = 0;
+    bool timed_out = false;
+    pid_t r = waitpid(a.pid, &status, WNOHANG);
+    if (r == 0 && config_.timeout_s > 0 &&
+        std::chrono::duration<double>(now - a.start).count() >= config_.timeout_s) {
+      kill(a.pid, SIGKILL);
+      r = waitpid(a.pid, &status, 0);
+      timed_out = true;
+    }
+    if (r == 0) {
+      ++i;
+      continue;
+    }
+    RunOutcome o = CollectRun(a.id, a.dir, status, timed_out, config_.timeout_s);
+    o.wall_s = std::chrono::duration<double>(Clock::now() - a.start).count();
+    o.worker = worker_name_;
+    done.push_back(std::move(o));
+    std::error_code ec;
+    std::filesystem::remove_all(a.dir, ec);
+    active_.erase(active_.begin() + static_cast<std::ptrdiff_t>(i));
+  }
+  return done;
+}
+
+}  // namespace swarmsim

@@ -1,5 +1,0 @@
-#include "swarm/version.h"
-
-namespace swarmsim {
-const char* Version() { return SWARMSIM_VERSION; }
-}  // namespace swarmsim

@@ -1,0 +1,300 @@
+// The example worlds of issue 3: each runs, does what its README line says,
+// and gives the same state hash at 1, 2 and 4 threads.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "framework/registry.h"
+#include "framework/world.h"
+#include "modules/builtin.h"
+#include "swarm/loader/world_loader.h"
+#include "tests/swarm/run_program.h"
+
+namespace swarmsim {
+namespace {
+
+struct WorldRun {
+  uint64_t hash = 0;
+  std::vector<MetricSample> metrics;
+};
+
+WorldRun RunWorld(const std::string& name, int threads, int steps,
+                  std::vector<std::pair<std::string, std::string>> overrides = {}) {
+  ModuleRegistry registry;
+  RegisterBuiltinModules(&registry);
+  LoadOptions options;
+  options.threads = threads;
+  options.overrides = std::move(overrides);
+  LoadedWorld loaded =
+      LoadWorld(std::string(SWARMSIM_SOURCE_DIR) + "/worlds/" + name, options, registry);
+  loaded.world->set_log_sink([](std::string_view) {});
+  loaded.world->Start();
+  WorldRun run;
+  for (int i = 0; i < steps; ++i) loaded.world->Step();
+  run.hash = loaded.world->StateHash();
+  run.metrics = loaded.world->TakeMetrics();
+  return run;
+}
+
+// The claim of worlds/fireflies.yaml and the README: phase_spread ~0.9 at
+// step 0 (random phases), below 0.05 within 10 s, then all robots flash in
+// the same step (0).
+TEST(ExamplesTest, FirefliesSynchroniseAndAreIndependentOfThreadCount) {
+  const WorldRun one = RunWorld("fireflies.yaml", 1, 300);  // 15 s
+  ASSERT_EQ(one.metrics.size(), 31u) << "steps 0, 10, ..., 300";
+  for (size_t i = 0; i < one.metrics.size(); ++i) {
+    EXPECT_EQ(one.metrics[i].name, "phase_spread");
+    EXPECT_EQ(one.metrics[i].step, static_cast<int64_t>(10 * i));
+    EXPECT_EQ(one.metrics[i].instance, -1);
+  }
+  EXPECT_GT(one.metrics.front().value, 0.75);  // 200 random phases: ~0.9
+  for (const MetricSample& m : one.metrics) {
+    if (m.step >= 200) {
+      EXPECT_LT(m.value, 0.05) << "step " << m.step;
+    }
+  }
+  EXPECT_LT(std::abs(one.metrics.back().value), 1e-9) << "all flash in the same step";
+  for (int threads : {2, 4}) {
+    const WorldRun other = RunWorld("fireflies.yaml", threads, 300);
+    EXPECT_EQ(other.hash, one.hash) << threads << " threads";
+    ASSERT_EQ(other.metrics.size(), one.metrics.size());
+    for (size_t i = 0; i < one.metrics.size(); ++i)
+      EXPECT_EQ(other.metrics[i].value, one.metrics[i].value) << i;
+  }
+}
+
+// Values of one metric, in recorded order.
+std::vector<double> Values(const std::vector<MetricSample>& metrics, const std::string& name,
+                           int instance = -1) {
+  std::vector<double> out;
+  for (const MetricSample& m : metrics)
+    if (m.name == name && m.instance == instance) out.push_back(m.value);
+  return out;
+}
+
+TEST(ExamplesTest, FlockingAlignsHeadingsAndIsIndependentOfThreadCount) {
+  const WorldRun one = RunWorld("flocking.yaml", 1, 300);
+  const std::vector<double> alignment = Values(one.metrics, "alignment");
+  const std::vector<double> cohesion = Values(one.metrics, "cohesion");
+  // Step 0, then every 10 steps (the main script's samples of the last step
+  // are collected with the next step's).
+  ASSERT_GE(alignment.size(), 30u);
+  ASSERT_EQ(cohesion.size(), alignment.size());
+  // Random headings at the start; one direction after 30 s, still together.
+  EXPECT_LT(alignment.front(), 0.6);
+  EXPECT_GT(alignment.back(), 0.95);
+  EXPECT_LT(cohesion.back(), 1.5 * cohesion.front());
+  for (int threads : {2, 4}) {
+    const WorldRun other = RunWorld("flocking.yaml", threads, 300);
+    EXPECT_EQ(other.hash, one.hash) << threads << " threads";
+    EXPECT_EQ(Values(other.metrics, "alignment"), alignment) << threads << " threads";
+  }
+}
+
+TEST(ExamplesTest, ThreadedArmsCycleWithWaitsAndAreIndependentOfThreadCount) {
+  const WorldRun one = RunWorld("threaded_arms.yaml", 1, 600);
+  // A cycle takes 2 x 0.8 s (finger) + 2 x 0.5 s (holds) + 2 x pi/2 s
+  // (shoulder) = 5.74 s plus step rounding, after a 0..1 s start delay:
+  // every arm finishes 4 or 5 cycles in 30 s, numbered 1, 2, ...
+  for (int arm = 0; arm < 16; ++arm) {
+    const std::vector<double> cycles = Values(one.metrics, "cycles", arm);
+    ASSERT_GE(cycles.size(), 4u) << "arm " << arm;
+    ASSERT_LE(cycles.size(), 5u) << "arm " << arm;
+    for (size_t i = 0; i < cycles.size(); ++i) EXPECT_EQ(cycles[i], i + 1.0);
+  }
+  for (const MetricSample& m : one.metrics) {
+    if (m.value == 1) {
+      EXPECT_GE(m.time, 5.74) << m.instance;
+    }
+  }
+  for (int threads : {2, 4}) {
+    const WorldRun other = RunWorld("threaded_arms.yaml", threads, 600);
+    EXPECT_EQ(other.hash, one.hash) << threads << " threads";
+    ASSERT_EQ(other.metrics.size(), one.metrics.size());
+    for (size_t i = 0; i < one.metrics.size(); ++i)
+      EXPECT_EQ(other.metrics[i].step, one.metrics[i].step) << i;
+  }
+}
+
+TEST(ExamplesTest, PluginDemoRunsThroughTheProgramWithTheWorldsPlugin) {
+  // plugins: [example_plugin] is found in plugins/ beside the program.
+  const std::string world = std::string(SWARMSIM_SOURCE_DIR) + "/worlds/plugin_demo.yaml";
+  const std::filesystem::path out =
+      std::filesystem::temp_directory_path() / ("swarmsim_plugin_demo_" + std::to_string(getpid()));
+  std::string hash;
+  for (int threads : {1, 2, 4}) {
+    const auto [status, text] =
+        swarmsim::testing::RunProgram("run " + world + " --quiet --hash --threads " +
+                                      std::to_string(threads) + " --out " + out.string());
+    ASSERT_EQ(status, 0) << text;
+    const std::string line = text.substr(text.find("state-hash: "));
+    if (hash.empty()) hash = line;
+    EXPECT_EQ(line, hash) << threads << " threads";
+  }
+  // Each robot drove 5 legs of 5 s at 0.05 m/s, turning away from walls,
+  // the pillar and each other: after the last leg it is away from its start.
+  std::ifstream csv(out / "metrics.csv");
+  std::map<std::string, double> last;
+  std::string row;
+  while (std::getline(csv, row)) {
+    std::vector<std::string> cells;
+    std::stringstream ss(row);
+    for (std::string cell; std::getline(ss, cell, ',');) cells.push_back(cell);
+    if (cells.size() == 5 && cells[3] == "distance") last[cells[2]] = std::stod(cells[4]);
+  }
+  EXPECT_EQ(last.size(), 20u);
+  int away = 0;
+  for (const auto& [robot, distance] : last) away += distance > 0.1;
+  EXPECT_GE(away, 15);
+  std::filesystem::remove_all(out);
+}
+
+TEST(ExamplesTest, PluginLightSensorReadsTheLightThroughTheProgram) {
+  // The example plugin's `light` sensor type: four per puck, sensed robots in
+  // parallel; the scripts check every reading against their own calculation.
+  const std::string world = std::string(SWARMSIM_SOURCE_DIR) + "/worlds/plugin_light.yaml";
+  const std::filesystem::path out = std::filesystem::temp_directory_path() /
+                                    ("swarmsim_plugin_light_" + std::to_string(getpid()));
+  std::string hash;
+  for (int threads : {1, 2}) {
+    const auto [status, text] =
+        swarmsim::testing::RunProgram("run " + world + " --quiet --hash --threads " +
+                                      std::to_string(threads) + " --out " + out.string());
+    ASSERT_EQ(status, 0) << text;
+    const std::string line = text.substr(text.find("state-hash: "));
+    if (hash.empty()) hash = line;
+    EXPECT_EQ(line, hash) << threads << " threads";
+  }
+  std::ifstream csv(out / "metrics.csv");
+  std::map<std::string, std::vector<double>> intensity;
+  int unsensed = 0, checked = 0;
+  std::string row;
+  while (std::getline(csv, row)) {
+    std::vector<std::string> cells;
+    std::stringstream ss(row);
+    for (std::string cell; std::getline(ss, cell, ',');) cells.push_back(cell);
+    if (cells.size() != 5) continue;
+    if (cells[3] == "unsensed") unsensed += std::stod(cells[4]) == 1;
+    if (cells[3] == "reading_error") {
+      EXPECT_LE(std::stod(cells[4]), 1e-12) << row;
+      ++checked;
+    }
+    if (cells[3] == "intensity") intensity[cells[2]].push_back(std::stod(cells[4]));
+  }
+  EXPECT_EQ(unsensed, 20);       // nil before the first sense phase
+  EXPECT_EQ(checked, 20 * 100);  // every robot, every step
+  ASSERT_EQ(intensity.size(), 20u);
+  int brighter = 0;
+  for (const auto& [robot, values] : intensity) brighter += values.back() > values.front();
+  EXPECT_GE(brighter, 18);  // they climbed toward the light
+  std::filesystem::remove_all(out);
+}
+
+// worlds/beacons.yaml: the example plugin's own object type (beacon, with
+// world-file keys, copied and scaled with its model, read from Lua with the
+// plugin's sim.readBeacon) and its record-phase module (near_beacon_fraction
+// in metrics.csv every step), through the program.
+TEST(ExamplesTest, BeaconsWorldUsesThePluginsObjectTypeAndRecordModule) {
+  const std::string world = std::string(SWARMSIM_SOURCE_DIR) + "/worlds/beacons.yaml";
+  const std::filesystem::path out =
+      std::filesystem::temp_directory_path() / ("swarmsim_beacons_" + std::to_string(getpid()));
+  std::string hash;
+  for (int threads : {1, 2}) {
+    const auto [status, text] =
+        swarmsim::testing::RunProgram("run " + world + " --steps 60 --quiet --hash --threads " +
+                                      std::to_string(threads) + " --out " + out.string());
+    ASSERT_EQ(status, 0) << text;
+    // The model's `reach` parameter reaches the beacon's key; copy 0 has its own.
+    EXPECT_NE(text.find("[beacon_post#0] beacon radius 1.20 m, strength 2"), std::string::npos)
+        << text;
+    EXPECT_NE(text.find("[beacon_post#3] beacon radius 0.80 m, strength 2"), std::string::npos)
+        << text;
+    const std::string line = text.substr(text.find("state-hash: "));
+    if (hash.empty()) hash = line;
+    EXPECT_EQ(line, hash) << threads << " threads";
+  }
+  std::ifstream csv(out / "metrics.csv");
+  std::vector<double> fractions;
+  for (std::string row; std::getline(csv, row);)
+    if (row.find(",,near_beacon_fraction,") != std::string::npos)
+      fractions.push_back(std::stod(row.substr(row.rfind(',') + 1)));
+  ASSERT_EQ(fractions.size(), 60u);  // one swarm-level row per step
+  for (double f : fractions) {
+    EXPECT_GE(f, 0.0);
+    EXPECT_LE(f, 1.0);
+  }
+  EXPECT_GT(*std::max_element(fractions.begin(), fractions.end()), 0.0);
+  std::filesystem::remove_all(out);
+}
+
+// A plugin's object type in a model of one's own: its keys are checked like
+// built-in ones (unknown key with a suggestion, range), and `scale:`
+// multiplies a key declared as a length.
+TEST(ExamplesTest, APluginObjectTypeIsReadCheckedAndScaledLikeABuiltInOne) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                    ("swarmsim_beacon_model_" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  const auto run = [&](const std::string& beacon_keys) {
+    std::ofstream(dir / "post.yaml") << "model: post\n"
+                                        "objects:\n"
+                                        "  type: dummy\n"
+                                        "  children:\n"
+                                        "    - {name: b, type: beacon, script: post.lua, "
+                                     << beacon_keys << "}\n";
+    std::ofstream(dir / "post.lua")
+        << "function sysCall_init() print(sim.readBeacon(sim.getObject('.'))[1]) end\n";
+    std::ofstream(dir / "world.yaml") << "plugins: [example_plugin]\n"
+                                         "simulation: {physics: kinematic, time_step: 0.1}\n"
+                                         "models: [{model: post.yaml, position: [0, 0], "
+                                         "scale: 2}]\n";
+    return swarmsim::testing::RunProgram("run " + (dir / "world.yaml").string() +
+                                         " --steps 1 --quiet");
+  };
+  auto r = run("radius: 0.5");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("[post#0] 1.0\n"), std::string::npos) << r.output;  // 0.5 x 2
+  r = run("radus: 0.5");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("post.yaml:5:"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("did you mean 'radius'"), std::string::npos) << r.output;
+  r = run("radius: -1");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("a number from 0 to 1000"), std::string::npos) << r.output;
+  std::filesystem::remove_all(dir);
+}
+
+TEST(ExamplesTest, UnknownPluginSensorTypeIsALoadErrorWithASuggestion) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                    ("swarmsim_plugin_sensor_" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "bot.yaml") << "model: bot\n"
+                                     "objects:\n"
+                                     "  type: dummy\n"
+                                     "  children:\n"
+                                     "    - {name: eye, type: plugin_sensor, sensor: lihgt}\n";
+  std::ofstream(dir / "world.yaml") << "plugins: [example_plugin]\n"
+                                       "models:\n"
+                                       "  - {model: bot.yaml, count: 1, position: [0, 0, 0]}\n";
+  const auto [status, text] =
+      swarmsim::testing::RunProgram("run " + (dir / "world.yaml").string() + " --steps 1");
+  EXPECT_NE(status, 0);
+  EXPECT_NE(text.find("bot.yaml:5:"), std::string::npos) << text;
+  EXPECT_NE(text.find("unknown plugin sensor type 'lihgt' (registered: light); did you mean "
+                      "'light'?"),
+            std::string::npos)
+      << text;
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace swarmsim
