@@ -1,4 +1,4 @@
-// Internal to the Lua host: included only by script_host.cc and lua_*.cc.
+// Internal to the Lua host: included only by script_*.cc and lua_*.cc.
 //
 // The per-state context every sim.* function reads, helpers shared by the
 // API areas, and the list of API areas. The rest of swarmsim never sees a
@@ -28,6 +28,7 @@
 
 namespace swarmsim {
 
+class PhaseHandlers;
 class Scene;
 class World;
 struct RobotRuntime;
@@ -43,6 +44,7 @@ struct ScriptMailbox {
 // the script fields before each callback.
 struct LuaContext {
   World* world = nullptr;
+  PhaseHandlers* phases = nullptr;  // the world's, which sim.handleSensing(), ... run
   Scene* scene = nullptr;
   RobotRuntime* runtime = nullptr;  // the robot's, or the world's scene runtime
   int instance = -1;                // robot index; -1 for the scene state

@@ -137,10 +137,13 @@ struct ScriptState {
   LuaContext context;
   std::vector<Script> scripts;  // hierarchy order
   LuaMemory memory;
-  // With a main script: the ScriptHost::Impl::main_steps of the step whose
+  // With a main script: the LuaScriptHost::main_steps_ of the step whose
   // sim.handleChildScripts resumed the threads (once a step).
   uint64_t threads_resumed_step = 0;
-  // Start only: sysCall_* names no one calls, for ScriptHost::Start to log
+  // The main script's state only: the host's arguments for the child
+  // callbacks, which sim.handleChildScripts(pass, ...) sets for its call.
+  std::vector<ParamValue>* child_args = nullptr;
+  // Start only: sysCall_* names no one calls, for LuaScriptHost::Start to log
   // once per file and name.
   std::vector<UncalledSysCall> warnings;
 
@@ -254,6 +257,9 @@ void FailCallback(lua_State* L) {
     const char* message = lua_tolstring(L, -1, &length);
     return message != nullptr ? std::string(message, length) : std::string("refused");
   });
+  // ExhaustBudget raises (lua_error does not return, though Lua does not
+  // declare it so).
+  __builtin_unreachable();
 }
 
 namespace {
@@ -630,7 +636,7 @@ std::string UncalledHint(std::string_view name, std::span<const Callback> called
 // a callback the script gets called must be a function (else a script error
 // naming the file and the callback); any other global named sysCall_*
 // (case aside: a typo, a CoppeliaSim callback) gets a warning in
-// state.warnings, which ScriptHost::Start logs once per file. Warnings are
+// state.warnings, which LuaScriptHost::Start logs once per file. Warnings are
 // in line order, then name order (the table's order is not deterministic);
 // names that are not functions of the file's own come last.
 void CheckSysCallNames(ScriptState& state, const Script& script) {
@@ -728,6 +734,7 @@ std::unique_ptr<ScriptState> NewState(World* world, int instance, RobotRuntime* 
   if (state->scripts.empty()) return nullptr;
   LuaContext& c = state->context;
   c.world = world;
+  c.phases = world;
   c.scene = &scene;
   c.runtime = runtime;
   c.instance = instance;
@@ -1081,25 +1088,25 @@ int SetThreadSwitchTiming(lua_State* L) {
 }
 
 // The main script's handlers: the phases of a step, robots in parallel.
-template <void (*F)(World*)>
+template <void (*F)(PhaseHandlers*)>
 int MainHandler(lua_State* L) {
   LuaContext& c = Context(L);
   if (!c.is_main) throw Error("only the world's main script may run the phases");
   // After a World error (caught by the script) no phase runs again.
   if (!c.pending_error.empty()) RaiseError(L, "stopped by an error");
   try {
-    F(c.world);
+    F(c.phases);
   } catch (const std::exception& e) {
     c.pending_error = e.what();
   }
   if (!c.pending_error.empty()) RaiseError(L, "stopped by an error");
   return 0;
 }
-void Sensing(World* w) { w->HandleSensing(); }
-void Actuation(World* w) { w->HandleActuation(); }
-void Dynamics(World* w) { w->HandleDynamics(); }
+void Sensing(PhaseHandlers* p) { p->HandleSensing(); }
+void Actuation(PhaseHandlers* p) { p->HandleActuation(); }
+void Dynamics(PhaseHandlers* p) { p->HandleDynamics(); }
 
-// sim.handleDynamics(): once per step (ScriptHost::RunMainScript resets the
+// sim.handleDynamics(): once per step (LuaScriptHost::RunMainScript resets the
 // flag), checked here so that the error names the main script's line.
 int HandleDynamics(lua_State* L) {
   LuaContext& c = Context(L);
@@ -1133,13 +1140,14 @@ int HandleChildScripts(lua_State* L) {
     }
   }
   if (!c.pending_error.empty()) RaiseError(L, "stopped by an error");
-  c.world->scripts()->SetChildScriptArguments(std::move(args));
+  std::vector<ParamValue>& child_args = *static_cast<ScriptState*>(c.host_state)->child_args;
+  child_args = std::move(args);
   try {
-    c.world->HandleChildScripts(pass);
+    c.phases->HandleChildScripts(pass);
   } catch (const std::exception& e) {
     c.pending_error = e.what();
   }
-  c.world->scripts()->SetChildScriptArguments({});
+  child_args = {};
   if (!c.pending_error.empty()) RaiseError(L, "stopped by an error");
   return 0;
 }
@@ -1161,39 +1169,50 @@ void RegisterControlApi(lua_State* L) {
   luaL_setfuncs(L, kFunctions, 0);
 }
 
-struct ScriptHost::Impl {
-  World* world;
-  std::vector<std::unique_ptr<ScriptState>> robots;  // by instance; null: no scripts
-  std::unique_ptr<ScriptState> scene;                // null: no scene scripts
-  std::unique_ptr<ScriptState> main;                 // null: the default main script
-  std::vector<ParamValue> child_args;                // of the running sim.handleChildScripts
-  uint64_t main_steps = 0;                           // sysCall_step calls of the main script
-  bool started = false;
-  bool stopped = false;
+namespace {
+
+// World's ScriptHost (phase_handlers.h).
+class LuaScriptHost final : public ScriptHost {
+ public:
+  explicit LuaScriptHost(World* world) : world_(world) {}
+
+  void Start() override;
+  void RunInstance(int instance, ScriptPass pass) override;
+  void RunSceneScripts(ScriptPass pass) override;
+  bool has_main_script() const override { return main_ != nullptr; }
+  void RunMainScript() override;
+  void Stop() override;
+  size_t MemoryBytes() const override;
+
+ private:
+  World* world_;
+  std::vector<std::unique_ptr<ScriptState>> robots_;  // by instance; null: no scripts
+  std::unique_ptr<ScriptState> scene_;                // null: no scene scripts
+  std::unique_ptr<ScriptState> main_;                 // null: the default main script
+  std::vector<ParamValue> child_args_;                // of the running sim.handleChildScripts
+  uint64_t main_steps_ = 0;                           // sysCall_step calls of the main script
+  bool started_ = false;
+  bool stopped_ = false;
 };
 
-ScriptHost::ScriptHost(World* world) : impl_(std::make_unique<Impl>()) { impl_->world = world; }
-ScriptHost::~ScriptHost() = default;
-
-void ScriptHost::Start() {
-  Impl& h = *impl_;
-  if (h.started) return;
-  h.started = true;
-  World& world = *h.world;
+void LuaScriptHost::Start() {
+  if (started_) return;
+  started_ = true;
+  World& world = *world_;
   const Scene& scene = world.scene();
   // Robots in parallel: each touches only its own state and runtime. The
   // lowest robot's error is reported, whatever the thread count.
   const int robot_count = world.robot_count();
-  h.robots.resize(robot_count);
+  robots_.resize(robot_count);
   std::vector<std::string> errors(robot_count);
   world.scheduler().ParallelFor(0, robot_count, kStartGrain, [&](int64_t begin, int64_t end) {
     for (int64_t r = begin; r < end; ++r) {
       const ModelInstance& instance = scene.instance(static_cast<int>(r));
       if (!instance.alive) continue;
       try {
-        h.robots[r] = NewState(&world, static_cast<int>(r), &world.runtime(static_cast<int>(r)),
-                               instance.name, instance.objects);
-        if (h.robots[r]) Initialize(h.robots[r].get());
+        robots_[r] = NewState(&world, static_cast<int>(r), &world.runtime(static_cast<int>(r)),
+                              instance.name, instance.objects);
+        if (robots_[r]) Initialize(robots_[r].get());
       } catch (const std::exception& e) {
         errors[r] = e.what();
       }
@@ -1202,18 +1221,19 @@ void ScriptHost::Start() {
   for (const std::string& error : errors)
     if (!error.empty()) throw Error(error);
   // Then the scene's scripts, on this thread.
-  h.scene = NewState(&world, -1, &world.scene_runtime(), "scene", SceneObjectSlots(scene));
-  if (h.scene) Initialize(h.scene.get());
+  scene_ = NewState(&world, -1, &world.scene_runtime(), "scene", SceneObjectSlots(scene));
+  if (scene_) Initialize(scene_.get());
   // Last, the world's own main script, in a state of its own.
   if (const auto& source = world.settings().main_script) {
-    h.main = NewState(&world, -1, &world.scene_runtime(), "main", {}, source.get());
-    Initialize(h.main.get());
-    if (h.main->scripts[0].callbacks[kStep] == LUA_NOREF)
+    main_ = NewState(&world, -1, &world.scene_runtime(), "main", {}, source.get());
+    main_->child_args = &child_args_;
+    Initialize(main_.get());
+    if (main_->scripts[0].callbacks[kStep] == LUA_NOREF)
       throw Error("main: " + source->path +
                   ": the main script must define sysCall_step() (it runs one step: "
                   "sim.handleSensing(), sim.handleChildScripts(), sim.handleActuation(), "
                   "sim.handleDynamics())" +
-                  MisspeltStepHint(h.main->warnings));
+                  MisspeltStepHint(main_->warnings));
   }
   // sysCall_* names no one calls: one warning per script file and name, not
   // per robot, in robot order, then the scene's, then the main script's.
@@ -1228,63 +1248,52 @@ void ScriptHost::Start() {
     }
     std::vector<UncalledSysCall>().swap(state->warnings);
   };
-  for (const auto& state : h.robots) log_warnings(state.get());
-  log_warnings(h.scene.get());
-  log_warnings(h.main.get());
+  for (const auto& state : robots_) log_warnings(state.get());
+  log_warnings(scene_.get());
+  log_warnings(main_.get());
 }
 
-bool ScriptHost::has_main_script() const { return impl_->main != nullptr; }
-
-void ScriptHost::RunMainScript() {
-  Impl& h = *impl_;
-  if (h.stopped || !h.main) return;
-  Script& script = h.main->scripts[0];
-  ++h.main_steps;
-  h.main->context.dynamics_handled = false;
-  lua_rawgeti(h.main->L, LUA_REGISTRYINDEX, script.callbacks[kStep]);
-  Call(*h.main, script, 0, kCallbackNames[kStep]);
+void LuaScriptHost::RunMainScript() {
+  if (stopped_ || !main_) return;
+  Script& script = main_->scripts[0];
+  ++main_steps_;
+  main_->context.dynamics_handled = false;
+  lua_rawgeti(main_->L, LUA_REGISTRYINDEX, script.callbacks[kStep]);
+  Call(*main_, script, 0, kCallbackNames[kStep]);
 }
 
-void ScriptHost::RunInstance(int instance, ScriptPass pass) {
-  Impl& h = *impl_;
-  if (h.stopped || instance < 0 || instance >= static_cast<int>(h.robots.size())) return;
-  ScriptState* state = h.robots[instance].get();
+void LuaScriptHost::RunInstance(int instance, ScriptPass pass) {
+  if (stopped_ || instance < 0 || instance >= static_cast<int>(robots_.size())) return;
+  ScriptState* state = robots_[instance].get();
   if (state == nullptr) return;
-  if (pass != ScriptPass::kActuation) RunCallback(state, kSensing, h.child_args);
-  if (pass != ScriptPass::kSensing) RunCallback(state, kActuation, h.child_args, h.main_steps);
+  if (pass != ScriptPass::kActuation) RunCallback(state, kSensing, child_args_);
+  if (pass != ScriptPass::kSensing) RunCallback(state, kActuation, child_args_, main_steps_);
 }
 
-void ScriptHost::RunSceneScripts(ScriptPass pass) {
-  Impl& h = *impl_;
-  if (h.stopped || !h.scene) return;
-  if (pass != ScriptPass::kActuation) RunCallback(h.scene.get(), kSensing, h.child_args);
-  if (pass != ScriptPass::kSensing)
-    RunCallback(h.scene.get(), kActuation, h.child_args, h.main_steps);
+void LuaScriptHost::RunSceneScripts(ScriptPass pass) {
+  if (stopped_ || !scene_) return;
+  if (pass != ScriptPass::kActuation) RunCallback(scene_.get(), kSensing, child_args_);
+  if (pass != ScriptPass::kSensing) RunCallback(scene_.get(), kActuation, child_args_, main_steps_);
 }
 
-void ScriptHost::SetChildScriptArguments(std::vector<ParamValue> args) {
-  impl_->child_args = std::move(args);
-}
-
-void ScriptHost::Stop() {
-  Impl& h = *impl_;
-  if (!h.started || h.stopped) return;
-  h.stopped = true;
+void LuaScriptHost::Stop() {
+  if (!started_ || stopped_) return;
+  stopped_ = true;
   // Robots in index order of their errors, then the scene; every state closes.
-  const int robot_count = static_cast<int>(h.robots.size());
+  const int robot_count = static_cast<int>(robots_.size());
   std::vector<std::string> errors(robot_count + 1);
-  h.world->scheduler().ParallelFor(0, robot_count, kStartGrain, [&](int64_t begin, int64_t end) {
+  world_->scheduler().ParallelFor(0, robot_count, kStartGrain, [&](int64_t begin, int64_t end) {
     for (int64_t r = begin; r < end; ++r) {
-      if (!h.robots[r]) continue;
+      if (!robots_[r]) continue;
       try {
-        Cleanup(h.robots[r].get());
+        Cleanup(robots_[r].get());
       } catch (const std::exception& e) {
         errors[r] = e.what();
       }
-      h.robots[r].reset();
+      robots_[r].reset();
     }
   });
-  for (std::unique_ptr<ScriptState>* state : {&h.scene, &h.main}) {
+  for (std::unique_ptr<ScriptState>* state : {&scene_, &main_}) {
     if (!*state) continue;
     try {
       Cleanup(state->get());
@@ -1297,10 +1306,16 @@ void ScriptHost::Stop() {
     if (!error.empty()) throw Error(error);
 }
 
-size_t ScriptHost::MemoryBytes() const {
-  size_t total = StateBytes(impl_->scene.get()) + StateBytes(impl_->main.get());
-  for (const auto& state : impl_->robots) total += StateBytes(state.get());
+size_t LuaScriptHost::MemoryBytes() const {
+  size_t total = StateBytes(scene_.get()) + StateBytes(main_.get());
+  for (const auto& state : robots_) total += StateBytes(state.get());
   return total;
+}
+
+}  // namespace
+
+std::unique_ptr<ScriptHost> MakeScriptHost(World* world) {
+  return std::make_unique<LuaScriptHost>(world);
 }
 
 std::vector<std::string> ScriptCallsInProgress() {

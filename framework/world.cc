@@ -9,11 +9,9 @@
 #include "framework/calculation_module.h"
 #include "framework/dynamics_backend.h"
 #include "framework/error.h"
-#include "framework/plugin_world_api.h"
 #include "framework/proximity_backend.h"
 #include "framework/registry.h"
 #include "framework/scheduler.h"
-#include "framework/script_host.h"
 #include "framework/state_hash.h"
 #include "framework/utf8.h"
 
@@ -104,36 +102,6 @@ World::World(const WorldSettings& settings, const ModuleRegistry& registry)
 World::World(const WorldSettings& settings, std::shared_ptr<const ModuleRegistry> registry)
     : World(settings, *registry) {
   owned_registry_ = std::move(registry);
-}
-
-void World::CallPhaseCallbacks(int phase) {
-  // Whole-world callbacks on this thread, per-robot ones fanned out over the
-  // robots; the lowest robot's error wins, whatever the thread count.
-  auto call = [&](const PhaseCallback& callback, int robot, std::string* error) {
-    const SwarmsimCallContext context{robot, 0, this, PluginWorldApi()};
-    char message[512] = {0};
-    if (callback.function(&context, message, sizeof message, callback.user_data) != 0)
-      *error = callback.name + (robot >= 0 ? " (robot " + scene_.instance(robot).name + ")" : "") +
-               ": " + (message[0] ? message : "the plugin callback failed");
-  };
-  for (const PhaseCallback* callback : phase_callbacks_[phase]) {
-    std::string error;
-    if (!callback->per_robot) {
-      call(*callback, -1, &error);
-    } else {
-      const auto& instances = scene_.instances();
-      std::vector<std::string> errors(instances.size());
-      scheduler_->ParallelFor(0, static_cast<int64_t>(instances.size()), kRobotGrain,
-                              [&](int64_t begin, int64_t end) {
-                                for (int64_t r = begin; r < end; ++r)
-                                  if (instances[r].alive)
-                                    call(*callback, static_cast<int>(r), &errors[r]);
-                              });
-      for (std::string& e : errors)
-        if (!e.empty() && error.empty()) error = std::move(e);
-    }
-    if (!error.empty()) throw Error(error);
-  }
 }
 
 World::~World() {
@@ -228,7 +196,7 @@ void World::Start() {
   ProximitySettings proximity_settings;
   proximity_settings.octree_resolution = settings_.octree_resolution;
   proximity_->Build(scene_, proximity_settings);
-  scripts_ = std::make_unique<ScriptHost>(this);
+  scripts_ = MakeScriptHost(this);
   started_ = true;
   try {
     scripts_->Start();

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "framework/parameters.h"
+#include "framework/phase_handlers.h"
 #include "framework/random.h"
 #include "framework/scene.h"
 #include "framework/spatial_grid.h"
@@ -29,7 +30,6 @@ class ModuleRegistry;
 struct PhaseCallback;
 struct PluginSensorType;
 class ProximityBackend;
-class ScriptHost;
 class TaskScheduler;
 class World;
 
@@ -38,9 +38,6 @@ enum class ScriptErrorPolicy : uint8_t {
   kStop,           // end the run with the error (nonzero exit, outputs so far kept)
   kDisableScript,  // log the error once, disable that script instance, go on
 };
-
-// Which child-script callbacks a pass of the control phase runs.
-enum class ScriptPass : uint8_t { kSensing, kActuation, kAll };
 
 struct WorldSettings {
   std::string file;                 // world file, for messages ("" for worlds built in code)
@@ -203,7 +200,7 @@ enum class Phase { kSense, kControl, kActuate, kPhysics, kRecord, kCount };
 const char* ToString(Phase phase);
 using PhaseTimes = std::array<double, static_cast<size_t>(Phase::kCount)>;
 
-class World {
+class World : public PhaseHandlers {
  public:
   World(const WorldSettings& settings, const ModuleRegistry& registry);
   // Same, keeping `registry` alive as long as the world (a world file's
@@ -284,13 +281,13 @@ class World {
   CalculationModule* find_calculation(const std::string& name) const;
   size_t script_memory_bytes() const;
 
-  // --- Main-script handlers ---------------------------------------------------------
+  // --- Main-script handlers (PhaseHandlers) ---------------------------------------------
   // The phases of the default step, for a world's own main script
   // (sim.handleSensing(), ...). Robots fan out in parallel inside each.
-  void HandleSensing();
-  void HandleChildScripts(ScriptPass pass);
-  void HandleActuation();
-  void HandleDynamics();
+  void HandleSensing() override;
+  void HandleChildScripts(ScriptPass pass) override;
+  void HandleActuation() override;
+  void HandleDynamics() override;
 
   // --- Plugin sensors (framework/plugin_api.h) -------------------------------------------
   // The last reading of plugin sensor `id` into *values: false before its
