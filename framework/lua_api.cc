@@ -296,7 +296,7 @@ void RegisterAreas(lua_State* L) {
       RegisterJointsApi,       // lua_api_joints.cc: joint targets and states
       RegisterSensorsApi,      // lua_api_sensors.cc: proximity sensors
       RegisterMessagesApi,     // lua_api_messages.cc: messages, signals, packing
-      RegisterControlApi,      // script_host.cc: child scripts, threads, main-script handlers
+      RegisterControlApi,      // lua_api_control.cc: child scripts, threads, main-script handlers
       RegisterDynamicsApi,     // lua_api_dynamics.cc: dynamic/kinematic switch, joint forces
       RegisterIkApi,           // lua_api_ik.cc: IK groups
       RegisterForceSensorApi,  // lua_api_force.cc: force sensors
