@@ -31,11 +31,12 @@ namespace swarmsim {
 class PhaseHandlers;
 class Scene;
 class World;
+struct RobotMail;
 struct RobotRuntime;
 
 // A script's read position in its robot's inbox (sim.receiveMessage).
 struct ScriptMailbox {
-  uint64_t round = 0;  // World::message_round() the position refers to
+  uint64_t round = 0;  // Messaging::round() the position refers to
   uint32_t next = 0;   // next inbox entry to look at
 };
 
@@ -47,6 +48,7 @@ struct LuaContext {
   PhaseHandlers* phases = nullptr;  // the world's, which sim.handleSensing(), ... run
   Scene* scene = nullptr;
   RobotRuntime* runtime = nullptr;  // the robot's, or the world's scene runtime
+  RobotMail* mail = nullptr;        // the robot's, or the scene's (Messaging)
   int instance = -1;                // robot index; -1 for the scene state
   std::string name;                 // "footbot#12", or "scene"
   std::string log_prefix;           // "[footbot#12] ", or "[scene] "

@@ -221,6 +221,8 @@ std::unique_ptr<ScriptState> NewState(World* world, int instance, RobotRuntime* 
   c.phases = world;
   c.scene = &scene;
   c.runtime = runtime;
+  c.mail =
+      instance >= 0 ? &world->messaging().robot_mail(instance) : &world->messaging().scene_mail();
   c.instance = instance;
   c.log_prefix = "[" + name + "] ";
   c.name = std::move(name);
