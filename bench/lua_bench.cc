@@ -94,7 +94,7 @@ void RunControl(benchmark::State& state, Bench* b) {
   ScriptHost& host = *b->world->scripts();
   RobotRuntime& runtime = b->world->runtime(0);
   for (auto _ : state) {
-    host.RunInstance(0);
+    host.RunInstance(0, ScriptPass::kAll);
     runtime.deferred.clear();
   }
   state.SetItemsProcessed(state.iterations());
@@ -135,7 +135,7 @@ void BM_ControlSweep(benchmark::State& state) {
   ScriptHost& host = *b.world->scripts();
   int r = 0;
   for (auto _ : state) {
-    host.RunInstance(r);
+    host.RunInstance(r, ScriptPass::kAll);
     r = r + 1 == robots ? 0 : r + 1;
   }
   state.SetItemsProcessed(state.iterations());

@@ -296,7 +296,7 @@ void RegisterAreas(lua_State* L) {
       RegisterSimApi,         // lua_api_sim.cc: time, parameters, random, metrics, print
       RegisterObjectsApi,     // lua_api_objects.cc: lookup, names, tree, poses
       RegisterMessagesApi,    // lua_api_messages.cc: messages, signals, packing
-      RegisterControlApi,     // script_host.cc: child scripts, threads, main-script handlers
+      RegisterControlApi,     // lua_api_control.cc: child scripts, threads, main-script handlers
       RegisterDynamicsApi,    // lua_api_dynamics.cc: dynamic/kinematic switch, joint forces
       RegisterIkApi,          // lua_api_ik.cc: IK groups
       RegisterCustomDataApi,  // lua_api_custom_data.cc: custom data blocks

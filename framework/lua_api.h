@@ -1,4 +1,4 @@
-// Internal to the Lua host: included only by script_host.cc and lua_*.cc.
+// Internal to the Lua host: included only by script_*.cc and lua_*.cc.
 //
 // The per-state context every sim.* function reads, helpers shared by the
 // API areas, and the list of API areas. The rest of swarmsim never sees a
@@ -28,13 +28,15 @@
 
 namespace swarmsim {
 
+class PhaseHandlers;
 class Scene;
 class World;
+struct RobotMail;
 struct RobotRuntime;
 
 // A script's read position in its robot's inbox (sim.receiveMessage).
 struct ScriptMailbox {
-  uint64_t round = 0;  // World::message_round() the position refers to
+  uint64_t round = 0;  // Messaging::round() the position refers to
   uint32_t next = 0;   // next inbox entry to look at
 };
 
@@ -43,8 +45,10 @@ struct ScriptMailbox {
 // the script fields before each callback.
 struct LuaContext {
   World* world = nullptr;
+  PhaseHandlers* phases = nullptr;  // the world's, which sim.handleSensing(), ... run
   Scene* scene = nullptr;
   RobotRuntime* runtime = nullptr;  // the robot's, or the world's scene runtime
+  RobotMail* mail = nullptr;        // the robot's, or the scene's (Messaging)
   int instance = -1;                // robot index; -1 for the scene state
   std::string name;                 // "footbot#12", or "scene"
   std::string log_prefix;           // "[footbot#12] ", or "[scene] "

@@ -10,8 +10,8 @@
 // count; writes to one block in one step: the highest robot index wins, then
 // scene scripts.
 #include "framework/lua_api.h"
+#include "framework/messaging.h"
 #include "framework/scene.h"
-#include "framework/world.h"
 
 namespace swarmsim {
 namespace {
@@ -23,7 +23,7 @@ int WriteCustomDataBlock(lua_State* L) {
   std::string tag = ArgString(L, 2);
   size_t size = 0;
   const char* data = lua_isnoneornil(L, 3) ? "" : ArgString(L, 3, &size);
-  c.runtime->custom_data_writes.push_back({id, std::move(tag), std::string(data, size)});
+  c.mail->custom_data_writes.push_back({id, std::move(tag), std::string(data, size)});
   return 0;
 }
 

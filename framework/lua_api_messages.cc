@@ -28,6 +28,7 @@
 
 #include "framework/error.h"
 #include "framework/lua_api.h"
+#include "framework/messaging.h"
 #include "framework/world.h"
 
 namespace swarmsim {
@@ -58,13 +59,13 @@ void Send(lua_State* L, MessageScope scope, std::string_view data, ObjectId targ
   // What one robot sends in one step is bounded like its Lua memory: the
   // outboxes of a swarm could otherwise take all of the host's. A message
   // counts its data and its outbox entry.
-  RobotRuntime& runtime = *c.runtime;
-  const uint64_t total = runtime.outbox_bytes + data.size() + sizeof(Message);
+  RobotMail& mail = *c.mail;
+  const uint64_t total = mail.outbox_bytes + data.size() + sizeof(Message);
   const int64_t limit = c.world->settings().script_memory_limit;  // 0: no limit
   if (limit > 0 && total > static_cast<uint64_t>(limit))
     throw Error("the messages sent this step would hold more than " +
                 LimitText(static_cast<uint64_t>(limit)) + " (simulation.script_memory_mb)");
-  runtime.outbox_bytes = total;
+  mail.outbox_bytes = total;
   Message m;
   m.data = data;
   m.sender = c.script_object;
@@ -73,7 +74,7 @@ void Send(lua_State* L, MessageScope scope, std::string_view data, ObjectId targ
   m.range = range;
   m.scope = scope;
   m.line_of_sight = line_of_sight;
-  runtime.outbox.push_back(std::move(m));
+  mail.outbox.push_back(std::move(m));
 }
 
 int SendGlobalMessage(lua_State* L) {
@@ -108,9 +109,10 @@ int ReceiveMessage(lua_State* L) {
   LuaContext& c = Context(L);
   if (c.mailbox == nullptr) return 0;
   ScriptMailbox& mailbox = *c.mailbox;
-  if (mailbox.round != c.world->message_round()) mailbox = {c.world->message_round(), 0};
-  const std::vector<ReceivedMessage>& inbox = c.runtime->inbox;
-  const std::vector<Message>& messages = c.world->messages();
+  const Messaging& messaging = c.world->messaging();
+  if (mailbox.round != messaging.round()) mailbox = {messaging.round(), 0};
+  const std::vector<ReceivedMessage>& inbox = c.mail->inbox;
+  const std::vector<Message>& messages = messaging.messages();
   while (mailbox.next < inbox.size()) {
     const ReceivedMessage& r = inbox[mailbox.next++];
     const Message& m = messages[r.message];
@@ -141,13 +143,13 @@ int SetSignal(lua_State* L) {
   std::string name = ArgBytes(L, 1);
   switch (lua_type(L, 2)) {
     case LUA_TNUMBER:
-      c.runtime->signal_writes.emplace_back(std::move(name), lua_tonumber(L, 2));
+      c.mail->signal_writes.emplace_back(std::move(name), lua_tonumber(L, 2));
       break;
     case LUA_TBOOLEAN:
-      c.runtime->signal_writes.emplace_back(std::move(name), lua_toboolean(L, 2) != 0);
+      c.mail->signal_writes.emplace_back(std::move(name), lua_toboolean(L, 2) != 0);
       break;
-    case LUA_TSTRING: c.runtime->signal_writes.emplace_back(std::move(name), ArgBytes(L, 2)); break;
-    case LUA_TNIL: c.runtime->signal_writes.emplace_back(std::move(name), std::nullopt); break;
+    case LUA_TSTRING: c.mail->signal_writes.emplace_back(std::move(name), ArgBytes(L, 2)); break;
+    case LUA_TNIL: c.mail->signal_writes.emplace_back(std::move(name), std::nullopt); break;
     default:
       throw Error(std::string("a signal is a number, boolean or string (got ") +
                   luaL_typename(L, 2) + ")");
@@ -155,13 +157,13 @@ int SetSignal(lua_State* L) {
   return 0;
 }
 int ClearSignal(lua_State* L) {
-  Context(L).runtime->signal_writes.emplace_back(ArgBytes(L, 1), std::nullopt);
+  Context(L).mail->signal_writes.emplace_back(ArgBytes(L, 1), std::nullopt);
   return 0;
 }
 int GetSignal(lua_State* L) {
   size_t length = 0;
   const char* name = ArgString(L, 1, &length);
-  const auto& signals = Context(L).world->signals();
+  const auto& signals = Context(L).world->messaging().signals();
   auto it = signals.find(std::string_view(name, length));
   if (it == signals.end()) {
     lua_pushnil(L);

@@ -10,11 +10,9 @@
 #include "framework/dynamics_backend.h"
 #include "framework/error.h"
 #include "framework/object_type.h"
-#include "framework/plugin_world_api.h"
 #include "framework/proximity_backend.h"
 #include "framework/registry.h"
 #include "framework/scheduler.h"
-#include "framework/script_host.h"
 #include "framework/state_hash.h"
 #include "framework/utf8.h"
 
@@ -109,36 +107,6 @@ World::World(const WorldSettings& settings, std::shared_ptr<const ModuleRegistry
   owned_registry_ = std::move(registry);
 }
 
-void World::CallPhaseCallbacks(int phase) {
-  // Whole-world callbacks on this thread, per-robot ones fanned out over the
-  // robots; the lowest robot's error wins, whatever the thread count.
-  auto call = [&](const PhaseCallback& callback, int robot, std::string* error) {
-    const SwarmsimCallContext context{robot, 0, this, PluginWorldApi()};
-    char message[512] = {0};
-    if (callback.function(&context, message, sizeof message, callback.user_data) != 0)
-      *error = callback.name + (robot >= 0 ? " (robot " + scene_.instance(robot).name + ")" : "") +
-               ": " + (message[0] ? message : "the plugin callback failed");
-  };
-  for (const PhaseCallback* callback : phase_callbacks_[phase]) {
-    std::string error;
-    if (!callback->per_robot) {
-      call(*callback, -1, &error);
-    } else {
-      const auto& instances = scene_.instances();
-      std::vector<std::string> errors(instances.size());
-      scheduler_->ParallelFor(0, static_cast<int64_t>(instances.size()), kRobotGrain,
-                              [&](int64_t begin, int64_t end) {
-                                for (int64_t r = begin; r < end; ++r)
-                                  if (instances[r].alive)
-                                    call(*callback, static_cast<int>(r), &errors[r]);
-                              });
-      for (std::string& e : errors)
-        if (!e.empty() && error.empty()) error = std::move(e);
-    }
-    if (!error.empty()) throw Error(error);
-  }
-}
-
 World::~World() {
   try {
     Stop();
@@ -210,6 +178,7 @@ void World::EnsureRuntimes() {
     runtimes_.push_back(std::move(r));
   }
   pending_.resize(runtimes_.size(), 0xff);  // new robots: look at everything once
+  messaging_.Resize(static_cast<int>(runtimes_.size()));
   scene_runtime_.rng = Rng(settings_.seed, uint64_t{1} << 63);
 }
 
@@ -231,7 +200,7 @@ void World::Start() {
   ProximitySettings proximity_settings;
   proximity_settings.octree_resolution = settings_.octree_resolution;
   proximity_->Build(scene_, proximity_settings);
-  scripts_ = std::make_unique<ScriptHost>(this);
+  scripts_ = MakeScriptHost(this);
   started_ = true;
   try {
     scripts_->Start();
@@ -252,7 +221,7 @@ void World::Step() {
     // 0. messages and signals sent in the last step become visible.
     {
       PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kControl)]);
-      DeliverMessages();
+      messaging_.Deliver(&scene_, proximity_.get(), *scheduler_);
     }
     if (scripts_->has_main_script()) {
       // 1-4. the world's own main script runs the phases (sim.handleSensing(), ...).
@@ -346,6 +315,7 @@ void World::Control(ScriptPass pass) {
                                 runtimes_[r].error = e.what();
                               }
                               pending_[r] |= PendingBits(runtimes_[r]);
+                              messaging_.NoteWrites(static_cast<int>(r));
                             }
                           });
   try {
@@ -355,7 +325,7 @@ void World::Control(ScriptPass pass) {
   }
   // Signals written in this pass: the robots see them from the next step
   // (they have run), a main script as soon as sim.handleChildScripts returns.
-  ApplySignalWrites();
+  messaging_.ApplySignalWrites();
   FlushRobotBuffers();
   RunPhaseCallbacks(kSwarmsimAfterControl);
 }
@@ -365,12 +335,13 @@ uint8_t World::PendingBits(const RobotRuntime& rt) {
   if (!rt.log.empty() || !rt.metrics.empty() || !rt.error.empty() || !rt.disabled.empty())
     bits |= kPendingOutput;
   if (!rt.deferred.empty()) bits |= kPendingDeferred;
-  if (!rt.outbox.empty() || !rt.signal_writes.empty() || !rt.custom_data_writes.empty())
-    bits |= kPendingMessages;
   return bits;
 }
 
-void World::MarkAllPending() { pending_.assign(runtimes_.size(), 0xff); }
+void World::MarkAllPending() {
+  pending_.assign(runtimes_.size(), 0xff);
+  messaging_.MarkAllPending();
+}
 
 void World::FlushRobotBuffers() {
   // Logs and metrics in robot order, then the scene's; the lowest robot's
@@ -567,36 +538,9 @@ uint64_t World::StateHash() const {
       hash_rows(scene_, static_cast<ObjectType>(t), &h);
   for (const RobotRuntime& rt : runtimes_) h.Add(rt.rng.state(), 4 * sizeof(uint64_t));
   h.Add(scene_runtime_.rng.state(), 4 * sizeof(uint64_t));
-  // What scripts left for the next step: signals, messages not yet delivered,
-  // custom data blocks.
-  auto add_text = [&h](const std::string& text) {
-    h.AddValue(text.size());
-    h.Add(text.data(), text.size());
-  };
-  for (const auto& [name, value] : signals_) {
-    add_text(name);
-    add_text(ParamToString(value));
-  }
-  auto add_pending = [&](const RobotRuntime& rt) {
-    for (const Message& m : rt.outbox) {
-      add_text(m.data);
-      h.AddValue(m.sender);
-      h.AddValue(m.target);
-      h.AddValue(m.range);
-      h.AddValue(m.scope);
-    }
-    for (const auto& [name, value] : rt.signal_writes) {
-      add_text(name);
-      add_text(value ? ParamToString(*value) : std::string("<cleared>"));
-    }
-    for (const RobotRuntime::CustomDataWrite& w : rt.custom_data_writes) {
-      h.AddValue(w.object);
-      add_text(w.tag);
-      add_text(w.data);
-    }
-  };
-  for (const RobotRuntime& rt : runtimes_) add_pending(rt);
-  add_pending(scene_runtime_);
+  // What scripts left for the next step: signals and mail not yet delivered
+  // (Messaging), custom data blocks.
+  messaging_.HashState(&h);
   for (uint32_t s = 0; s < scene_.slot_count(); ++s)
     if (scene_.alive_at(s)) scene_.HashCustomData(s, &h);
   if (dynamics_) dynamics_->HashState(&h);

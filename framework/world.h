@@ -7,20 +7,19 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
-#include <map>
 #include <memory>
 #include <mutex>
-#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "framework/messaging.h"
 #include "framework/parameters.h"
+#include "framework/phase_handlers.h"
 #include "framework/plugin_api.h"
 #include "framework/random.h"
 #include "framework/scene.h"
-#include "framework/spatial_grid.h"
 
 namespace swarmsim {
 
@@ -30,7 +29,6 @@ class ModuleRegistry;
 struct PhaseCallback;
 struct PluginSensorType;
 class ProximityBackend;
-class ScriptHost;
 class TaskScheduler;
 class World;
 
@@ -39,9 +37,6 @@ enum class ScriptErrorPolicy : uint8_t {
   kStop,           // end the run with the error (nonzero exit, outputs so far kept)
   kDisableScript,  // log the error once, disable that script instance, go on
 };
-
-// Which child-script callbacks a pass of the control phase runs.
-enum class ScriptPass : uint8_t { kSensing, kActuation, kAll };
 
 struct WorldSettings {
   std::string file;                 // world file, for messages ("" for worlds built in code)
@@ -75,26 +70,6 @@ struct WorldSettings {
   // full standard libraries instead.
   std::filesystem::path output_directory;
   bool trust_scripts = false;
-};
-
-// A message sent by a script (sim.send*Message), delivered at the start of
-// the next step in sender-handle order.
-enum class MessageScope : uint8_t { kGlobal, kLocal, kDirect, kRange };
-struct Message {
-  std::string data;
-  ObjectId sender;           // object carrying the sending script
-  ObjectId target;           // kDirect: object carrying the receiving script
-  int sender_instance = -1;  // robot of the sender, -1 for the scene
-  double range = 0;          // m, kRange
-  MessageScope scope = MessageScope::kGlobal;
-  bool line_of_sight = false;  // kRange: only receivers the static environment does not hide
-};
-// One message in a robot's inbox.
-struct ReceivedMessage {      // 32 bytes
-  uint32_t message = 0;       // index into World::messages()
-  bool has_geometry = false;  // false for scene receivers
-  double distance = 0;        // m, from the receiver's model root to the sender
-  double bearing = 0;         // rad, of the sender in the receiver's root frame (0 = +x, CCW)
 };
 
 // A value recorded by a script (sim.recordMetric) or by an observer.
@@ -171,21 +146,7 @@ struct RobotRuntime {
   std::vector<DeferredWrite> deferred;  // writes to other robots' objects
   std::string error;                    // a script error in this phase
   std::vector<std::string> disabled;    // scripts disabled this phase (disable_script), why
-  std::vector<Message> outbox;          // messages sent this step
-  std::vector<ReceivedMessage> inbox;   // messages delivered this step, sender-handle order
-  // Bytes the outbox holds (data + sizeof(Message) each), against
-  // WorldSettings::script_memory_limit; reset when the outbox is gathered.
-  uint64_t outbox_bytes = 0;
-  // sim.setSignal/clearSignal writes (nullopt clears), applied at the next step.
-  std::vector<std::pair<std::string, std::optional<ParamValue>>> signal_writes;
-  // sim.writeCustomDataBlock writes (object, tag, data; empty data removes),
-  // applied at the next step like signals.
-  struct CustomDataWrite {
-    ObjectId object;
-    std::string tag;
-    std::string data;
-  };
-  std::vector<CustomDataWrite> custom_data_writes;
+  // Its messages, signal and custom-data writes: Messaging::robot_mail.
 };
 
 // A calculation object that observes the world in the record phase
@@ -204,7 +165,7 @@ enum class Phase { kSense, kControl, kActuate, kPhysics, kRecord, kCount };
 const char* ToString(Phase phase);
 using PhaseTimes = std::array<double, static_cast<size_t>(Phase::kCount)>;
 
-class World {
+class World : public PhaseHandlers {
  public:
   World(const WorldSettings& settings, const ModuleRegistry& registry);
   // Same, keeping `registry` alive as long as the world (a world file's
@@ -290,13 +251,13 @@ class World {
   CalculationModule* find_calculation(const std::string& name) const;
   size_t script_memory_bytes() const;
 
-  // --- Main-script handlers ---------------------------------------------------------
+  // --- Main-script handlers (PhaseHandlers) ---------------------------------------------
   // The phases of the default step, for a world's own main script
   // (sim.handleSensing(), ...). Robots fan out in parallel inside each.
-  void HandleSensing();
-  void HandleChildScripts(ScriptPass pass);
-  void HandleActuation();
-  void HandleDynamics();
+  void HandleSensing() override;
+  void HandleChildScripts(ScriptPass pass) override;
+  void HandleActuation() override;
+  void HandleDynamics() override;
 
   // --- Plugin sensors (framework/plugin_api.h) -------------------------------------------
   // The last reading of plugin sensor `id` into *values: false before its
@@ -304,13 +265,10 @@ class World {
   bool PluginSensorReading(ObjectId id, std::span<const double>* values) const;
 
   // --- Messages and signals ------------------------------------------------------------
-  // Messages delivered this step (RobotRuntime::inbox indexes into it).
-  const std::vector<Message>& messages() const { return messages_; }
-  // Bumped each time the inboxes are refilled.
-  uint64_t message_round() const { return message_round_; }
-  // Signal values: the scripts' writes are applied when a control pass ends
-  // (robots in index order, then the scene's scripts; the last write wins).
-  const std::map<std::string, ParamValue, std::less<>>& signals() const { return signals_; }
+  // Delivered at the start of each step; signal writes applied when a
+  // control pass ends.
+  Messaging& messaging() { return messaging_; }
+  const Messaging& messaging() const { return messaging_; }
 
  private:
   void Sense();
@@ -319,8 +277,6 @@ class World {
   void Physics();
   void Record();
   void EnsureRuntimes();
-  void DeliverMessages();    // world_messages.cc
-  void ApplySignalWrites();  // world_messages.cc
   void FlushRobotBuffers();
   // The scene's scripts' prints and metrics (a main script's, after its step).
   void FlushSceneBuffers();
@@ -370,10 +326,9 @@ class World {
   // bits, world.cc): the serial passes between phases visit only those
   // robots instead of touching 10,000 runtimes to find them empty.
   std::vector<uint8_t> pending_;
+  // (Messaging keeps its own for the robots' mail.)
   static constexpr uint8_t kPendingOutput = 1;         // log, metrics, error
   static constexpr uint8_t kPendingDeferred = 2;       // deferred writes
-  static constexpr uint8_t kPendingMessages = 4;       // outbox, signal and custom-data writes
-  static constexpr uint8_t kPendingInbox = 8;          // inbox (set by DeliverMessages)
   static uint8_t PendingBits(const RobotRuntime& rt);  // what rt's buffers hold
   void MarkAllPending();
   RobotRuntime scene_runtime_;
@@ -383,15 +338,8 @@ class World {
   std::vector<std::string> disabled_scripts_;
   std::function<void(std::string_view)> log_sink_;
   PhaseTimes phase_times_{};
-  std::vector<Message> messages_;
-  uint64_t message_round_ = 0;
-  std::map<std::string, ParamValue, std::less<>> signals_;
-  SpatialGrid message_grid_;                    // range messages, rebuilt each step
-  std::vector<uint32_t> message_bucket_start_;  // local/direct messages per robot (robots + 2)
-  std::vector<uint32_t> message_bucket_;        // message indices, grouped by receiving robot
-  std::vector<uint32_t> global_messages_;       // indices of global messages
-  std::vector<Vec3> message_origin_;            // sender position per message (messages)
-  bool dynamics_handled_ = false;               // sim.handleDynamics() ran this step
+  Messaging messaging_;
+  bool dynamics_handled_ = false;  // sim.handleDynamics() ran this step
   int64_t step_count_ = 0;
   double time_ = 0;
   bool started_ = false;

@@ -1,0 +1,187 @@
+// The Lua host's count hooks: the instruction budget of callbacks, the time
+// slice of threads, and the memory limit of states (script_hooks.h).
+#include "framework/script_hooks.h"
+
+#include <algorithm>
+#include <climits>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <utility>
+
+#include "framework/script_state.h"
+#include "framework/world.h"
+
+namespace swarmsim {
+namespace lua_host {
+namespace {
+
+// "1.0 GiB", "300 MiB", "12 KiB": a refused allocation's size.
+std::string FormatBytes(size_t bytes) {
+  char text[32];
+  if (bytes >= (size_t{1} << 30))
+    std::snprintf(text, sizeof text, "%.1f GiB", static_cast<double>(bytes) / (1 << 30));
+  else if (bytes >= (size_t{1} << 20))
+    std::snprintf(text, sizeof text, "%zu MiB", bytes >> 20);
+  else
+    std::snprintf(text, sizeof text, "%zu KiB", (bytes + 1023) >> 10);
+  return text;
+}
+std::string MemoryLimitText(const LuaMemory& memory) {
+  return "the scripts hold more than " + MemoryLimitTail(memory);
+}
+
+// "file:line: " of the Lua function a hook interrupted, or "".
+std::string HookWhere(lua_State* L, lua_Debug* ar) {
+  if (lua_getinfo(L, "Sl", ar) == 0 || ar->currentline <= 0) return "";
+  return std::string(ar->short_src) + ":" + std::to_string(ar->currentline) + ": ";
+}
+
+// Count hook once the running callback has used up its budget: every further
+// instruction raises again, so pcall and xpcall cannot swallow the error.
+// It is raised as Lua's memory error (lua_error recognizes Lua's own "not
+// enough memory" string): an error raised from a hook would otherwise call
+// xpcall's message handler with hooks off, free to loop forever. The Lua
+// code sees "not enough memory"; the host reports budget_error.
+void ExhaustedHook(lua_State* L, lua_Debug*) {
+  lua_pushliteral(L, "not enough memory");
+  lua_error(L);
+}
+
+// The running callback used up its budget: records `message` (the first
+// one), arms ExhaustedHook on L and on the callback's root state (so that
+// neither a new coroutine, which copies its creator's hook, nor the caller
+// gets a fresh count) and raises. Call() and ResumeThread() report
+// budget_error whatever error value reaches them.
+template <typename MakeMessage>
+void ExhaustBudget(lua_State* L, MakeMessage make_message) {
+  LuaContext& c = Context(L);
+  if (!c.budget_exhausted) {
+    c.budget_exhausted = true;
+    c.budget_error = make_message();  // a member: nothing is left to destroy at the longjmp
+  }
+  lua_sethook(L, ExhaustedHook, LUA_MASKCOUNT, 1);
+  lua_sethook(RootOf(c), ExhaustedHook, LUA_MASKCOUNT, 1);
+  ExhaustedHook(L, nullptr);
+}
+
+// Count hook of non-threaded callbacks: the budget is used up.
+void BudgetHook(lua_State* L, lua_Debug* ar) {
+  ExhaustBudget(L, [&] {
+    return HookWhere(L, ar) + "the callback ran more than " +
+           std::to_string(Context(L).world->settings().instruction_budget) +
+           " Lua instructions without returning (an endless loop?); if the work is real, raise "
+           "simulation.instruction_budget";
+  });
+}
+
+// Count hook armed when a state's memory passed the limit (LuaMemory).
+void MemoryHook(lua_State* L, lua_Debug* ar) {
+  auto* state = static_cast<ScriptState*>(Context(L).host_state);
+  if (const size_t refused = std::exchange(state->memory.refused_bytes, 0); refused > 0) {
+    ExhaustBudget(L, [&] {
+      return HookWhere(L, ar) + "an allocation of " + FormatBytes(refused) +
+             " would take the scripts past " + MemoryLimitTail(state->memory);
+    });
+  }
+  lua_gc(L, LUA_GCCOLLECT);
+  // Still too much: fails the callback as a spent budget does, so pcall and
+  // xpcall's handler cannot catch it and go on allocating.
+  if (state->memory.used > state->memory.limit)
+    ExhaustBudget(L, [&] { return HookWhere(L, ar) + MemoryLimitText(state->memory); });
+  // Garbage only: the threads get their usual hooks back (the exhausted
+  // budget's, if it ran out).
+  SetBudget(state->L, state->context);
+  for (const Script& script : state->scripts)
+    if (script.thread != nullptr)
+      lua_sethook(script.thread, SliceHook, LUA_MASKCOUNT, script.slice_instructions);
+  if (state->context.budget_exhausted) {
+    lua_sethook(L, ExhaustedHook, LUA_MASKCOUNT, 1);
+    lua_sethook(RootOf(state->context), ExhaustedHook, LUA_MASKCOUNT, 1);
+  }
+}
+
+}  // namespace
+
+void SetBudget(lua_State* L, const LuaContext& c) {
+  const int64_t budget = c.world->settings().instruction_budget;
+  if (budget > 0)
+    lua_sethook(L, BudgetHook, LUA_MASKCOUNT, static_cast<int>(std::min<int64_t>(budget, INT_MAX)));
+  else if (lua_gethook(L) == ExhaustedHook)
+    lua_sethook(L, nullptr, 0, 0);
+}
+
+void SliceHook(lua_State* L, lua_Debug* ar) {
+  LuaContext& c = Context(L);
+  if (c.thread == nullptr) {
+    // A coroutine made by the thread, resumed from a non-threaded callback:
+    // that callback's budget regime applies from now on.
+    SetBudget(L, c);
+    return;
+  }
+  if (L == c.thread && lua_isyieldable(L)) {
+    c.slice_yielded = true;
+    lua_yield(L, 0);
+    return;
+  }
+  const int64_t budget = c.world->settings().instruction_budget;
+  const int count = lua_gethookcount(L);
+  if (budget > 0 && ++c.slice_fires * count > budget) {
+    ExhaustBudget(L, [&] {
+      return HookWhere(L, ar) + "the thread ran more than " + std::to_string(budget) +
+             " Lua instructions in a coroutine of its own or a call that cannot yield";
+    });
+  }
+}
+
+void* LimitedAlloc(void* ud, void* ptr, size_t osize, size_t nsize) {
+  auto* state = static_cast<ScriptState*>(ud);
+  LuaMemory& m = state->memory;
+  const size_t old = ptr != nullptr ? osize : 0;
+  if (nsize == 0) {
+    std::free(ptr);
+    m.used -= old;
+    return nullptr;
+  }
+  if (m.limit > 0 && nsize > old) {
+    const size_t after = m.used + (nsize - old);
+    const bool refuse = after > m.limit + kMemorySlack || after < m.used;
+    if (refuse) {
+      m.refused = true;
+      m.refused_bytes = nsize - old;
+    }
+    if ((after > m.limit || refuse) && state->L != nullptr) {
+      // Armed on every thread whose hook is another (a callback's budget hook
+      // set since would otherwise leave only the hard cap). lua_sethook may
+      // be called at any point (even from a signal handler).
+      const auto arm = [](lua_State* T) {
+        if (lua_gethook(T) != MemoryHook) lua_sethook(T, MemoryHook, LUA_MASKCOUNT, 1);
+      };
+      arm(state->L);
+      for (const Script& script : state->scripts)
+        if (script.thread != nullptr) arm(script.thread);
+    }
+    if (refuse) return nullptr;
+  }
+  void* p = std::realloc(ptr, nsize);
+  if (p == nullptr) return nullptr;
+  m.used = m.used - old + nsize;
+  m.refused = false;
+  return p;
+}
+
+}  // namespace lua_host
+
+void FailCallback(lua_State* L) {
+  lua_host::ExhaustBudget(L, [&] {
+    size_t length = 0;
+    const char* message = lua_tolstring(L, -1, &length);
+    return message != nullptr ? std::string(message, length) : std::string("refused");
+  });
+  // ExhaustBudget raises (lua_error does not return, though Lua does not
+  // declare it so).
+  __builtin_unreachable();
+}
+
+}  // namespace swarmsim

@@ -1,0 +1,146 @@
+// Internal to the Lua host (script_*.cc, lua_api_control.cc): one Lua state
+// of the host and its scripts, and the errors that name them.
+//
+// The host's internals live in namespace lua_host rather than in an
+// anonymous namespace per file, since several files share them; the
+// namespace keeps generic names (Script, Call, Runs) from meeting another
+// file's.
+#pragma once
+
+#include <algorithm>
+#include <climits>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "framework/handle.h"
+#include "framework/lua_api.h"
+#include "framework/parameters.h"
+#include "framework/scene.h"
+
+namespace swarmsim::lua_host {
+
+enum Callback : int { kInit, kSensing, kActuation, kCleanup, kThread, kStep, kCallbackCount };
+inline constexpr const char* kCallbackNames[kCallbackCount] = {
+    "sysCall_init",    "sysCall_sensing", "sysCall_actuation",
+    "sysCall_cleanup", "sysCall_thread",  "sysCall_step"};
+
+// Lua instructions per millisecond of thread time slice: PUC Lua 5.4 runs
+// roughly 100 to 300 million simple VM instructions a second on a current
+// core, so 100,000 per ms errs on the short side. The default slice, 2 ms
+// (CoppeliaSim's), is 200,000 instructions.
+inline constexpr int64_t kInstructionsPerMs = 100'000;
+inline constexpr int kDefaultSliceInstructions = 200'000;
+inline constexpr double kMinSliceInstructions = 1000;
+
+// The time slice of a thread asking for `instructions`: at least 1,000, and
+// at most the world's instruction budget (when it has one), so that a
+// thread runs no more Lua in a step than a callback may.
+inline int SliceInstructions(double instructions, int64_t budget) {
+  double slice = std::clamp(instructions, kMinSliceInstructions, static_cast<double>(INT_MAX));
+  if (budget > 0) slice = std::min(slice, static_cast<double>(budget));
+  return static_cast<int>(slice);
+}
+
+// A script attached to one object (or the main script: no object).
+struct Script {  // 88 bytes
+  uint32_t slot = 0;
+  ObjectId object;
+  int env_ref = LUA_NOREF;  // environment table, in the registry
+  const ScriptSource* source = nullptr;
+  int callbacks[kCallbackCount] = {LUA_NOREF, LUA_NOREF, LUA_NOREF,
+                                   LUA_NOREF, LUA_NOREF, LUA_NOREF};
+  bool initialized = false;        // sysCall_init returned: sysCall_cleanup is due
+  bool explicit_handling = false;  // runs only through sim.handleChildScript
+  bool disabled = false;           // failed under on_script_error: disable_script
+  bool running = false;            // inside a call (no re-entry through handleChildScript)
+  bool slice_yielded = false;      // the thread's last yield was its time slice's (SliceHook)
+  lua_State* thread = nullptr;     // sysCall_thread's coroutine, while it runs
+  int thread_ref = LUA_NOREF;      // keeps `thread` alive, in the registry
+  int slice_instructions = kDefaultSliceInstructions;
+  ScriptMailbox mailbox;
+};
+static_assert(sizeof(Script) == 88);
+
+// What a Lua state holds, against simulation.script_memory_limit. Past the
+// limit an allocation still succeeds (up to kMemorySlack more) but arms a
+// count hook on the state's threads; at the next instruction the hook
+// collects garbage and, if the state still holds too much, fails the
+// script with its file and line. Past limit + slack allocations fail (Lua
+// then collects and retries, and reports out of memory) and arm the same
+// hook, which then fails the callback: a pcall loop around a huge
+// allocation would otherwise go on (each refusal costs a full collection).
+// The hooks and the allocator are in script_hooks.cc.
+struct LuaMemory {
+  size_t used = 0;           // bytes
+  size_t limit = 0;          // bytes; 0: no limit
+  bool refused = false;      // the last allocation was refused (limit + slack)
+  size_t refused_bytes = 0;  // the size of a refused allocation MemoryHook has not reported, or 0
+};
+inline constexpr size_t kMemorySlack = size_t{16} << 20;
+
+// A global named sysCall_* that no one calls (a typo, a CoppeliaSim-only
+// callback), found at load (script_hints.cc).
+struct UncalledSysCall {
+  std::string file, name;
+  int line = 0;         // where the file defines the function; 0: not a function of its own
+  std::string warning;  // the line to log
+};
+
+// One lua_State and its scripts: a robot's, or the scene's.
+struct ScriptState {
+  lua_State* L = nullptr;
+  LuaContext context;
+  std::vector<Script> scripts;  // hierarchy order
+  LuaMemory memory;
+  // With a main script: the LuaScriptHost::main_steps_ of the step whose
+  // sim.handleChildScripts resumed the threads (once a step).
+  uint64_t threads_resumed_step = 0;
+  // The main script's state only: the host's arguments for the child
+  // callbacks, which sim.handleChildScripts(pass, ...) sets for its call.
+  std::vector<ParamValue>* child_args = nullptr;
+  // Start only: sysCall_* names no one calls, for LuaScriptHost::Start to log
+  // once per file and name.
+  std::vector<UncalledSysCall> warnings;
+
+  ScriptState() = default;
+  ScriptState(const ScriptState&) = delete;
+  ScriptState& operator=(const ScriptState&) = delete;
+  ~ScriptState() {
+    if (L != nullptr) lua_close(L);
+  }
+};
+
+// The lua_State the host called or resumed for the running callback: the
+// script's thread, or the state's main thread.
+inline lua_State* RootOf(const LuaContext& c) {
+  return c.thread != nullptr ? c.thread : static_cast<const ScriptState*>(c.host_state)->L;
+}
+
+// Does `script` run (not disabled, its object alive and its script enabled)?
+inline bool Runs(const Scene& scene, const Script& script) {
+  if (script.disabled) return false;
+  if (script.slot == UINT32_MAX) return true;  // the main script
+  if (!scene.IsValid(script.object)) return false;
+  const ScriptAttachment* attachment = scene.script_at(script.slot);
+  return attachment != nullptr && attachment->enabled;
+}
+
+// "4 MiB of Lua memory (simulation.script_memory_mb; ...)", the end of both
+// memory-limit messages.
+std::string MemoryLimitTail(const LuaMemory& memory);
+
+// The text of the error value on top of the stack.
+std::string ErrorText(lua_State* L, int status);
+
+// Throws "footbot#12: <message> [in <what> of /footbot#12/body]".
+[[noreturn]] void ThrowScriptError(const ScriptState& state, ObjectId object, std::string message,
+                                   std::string_view what);
+
+// Under on_script_error: disable_script, disables `script` and logs `error`
+// once; returns false (the caller rethrows) under stop, and for the main script.
+bool Disable(ScriptState& state, Script& script, const std::string& error);
+
+}  // namespace swarmsim::lua_host
