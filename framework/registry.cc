@@ -2,30 +2,55 @@
 
 #include <cctype>
 
-#include "framework/calculation_module.h"
 #include "framework/dynamics_backend.h"
 #include "framework/error.h"
 #include "framework/object_type.h"
 #include "framework/proximity_backend.h"
+#include "framework/proximity_module.h"
 
 namespace swarmsim {
 
-void ModuleRegistry::RegisterDynamics(ModuleInfo info, DynamicsFactory factory) {
+void ModuleRegistry::RegisterDynamics(ModuleInfo info, DynamicsFactory factory,
+                                      BareLoop bare_loop) {
   info.kind = "dynamics";
-  dynamics_.emplace_back(info.name, std::move(factory));
+  dynamics_.push_back({info.name, std::move(factory), std::move(bare_loop)});
   modules_.push_back(std::move(info));
+}
+
+void ModuleRegistry::RegisterModule(ModuleDescriptor module) {
+  if (module.info.name.empty() || !module.make)
+    throw Error("a module needs a name and a way to make it");
+  if (FindModule(module.info.name) != nullptr)
+    throw Error("module '" + module.info.name + "' is registered twice");
+  modules_.push_back(module.info);
+  module_descriptors_.push_back(std::make_shared<const ModuleDescriptor>(std::move(module)));
+}
+
+const ModuleDescriptor* ModuleRegistry::FindModule(std::string_view name) const {
+  for (const auto& m : module_descriptors_)
+    if (m->info.name == name) return m.get();
+  return nullptr;
+}
+
+std::vector<const ModuleDescriptor*> ModuleRegistry::ModulesOfKind(std::string_view kind) const {
+  std::vector<const ModuleDescriptor*> out;
+  for (const auto& m : module_descriptors_)
+    if (m->info.kind == kind) out.push_back(m.get());
+  return out;
 }
 
 void ModuleRegistry::RegisterProximity(ModuleInfo info, ProximityFactory factory) {
   info.kind = "proximity";
-  proximity_.emplace_back(info.name, std::move(factory));
-  modules_.push_back(std::move(info));
+  RegisterModule({std::move(info), PhaseBit(ModulePhase::kSense), 100, /*every_world=*/true,
+                  [factory = std::move(factory)](World*, const void*) {
+                    return MakeProximityModule(factory());
+                  }});
 }
 
 void ModuleRegistry::RegisterCalculation(ModuleInfo info, CalculationFactory factory) {
   info.kind = "calculation";
-  calculation_.emplace_back(info.name, std::move(factory));
-  modules_.push_back(std::move(info));
+  RegisterModule({std::move(info), PhaseBit(ModulePhase::kActuate), 100, /*every_world=*/false,
+                  [factory = std::move(factory)](World*, const void*) { return factory(); }});
 }
 
 void ModuleRegistry::RegisterScriptCommand(ModuleInfo info, ScriptCommand command) {
@@ -91,40 +116,30 @@ bool ModuleRegistry::HasPlugin(std::string_view path) const {
   return false;
 }
 
-template <typename Factories>
-static std::string Known(const Factories& factories) {
-  std::string out;
-  for (const auto& [name, f] : factories) out += (out.empty() ? "" : ", ") + name;
-  return out.empty() ? "(none)" : out;
-}
-
 std::unique_ptr<DynamicsBackend> ModuleRegistry::MakeDynamics(const std::string& name) const {
-  for (const auto& [n, f] : dynamics_)
-    if (n == name) return f();
-  throw Error("unknown physics backend '" + name + "' (available: " + Known(dynamics_) + ")");
+  for (const Dynamics& d : dynamics_)
+    if (d.name == name) return d.factory();
+  std::string known;
+  for (const Dynamics& d : dynamics_) known += (known.empty() ? "" : ", ") + d.name;
+  throw Error("unknown physics backend '" + name +
+              "' (available: " + (known.empty() ? "(none)" : known) + ")");
 }
 
-std::unique_ptr<ProximityBackend> ModuleRegistry::MakeProximity(const std::string& name) const {
-  for (const auto& [n, f] : proximity_)
-    if (n == name) return f();
-  throw Error("unknown proximity module '" + name + "' (available: " + Known(proximity_) + ")");
-}
-
-std::unique_ptr<CalculationModule> ModuleRegistry::MakeCalculation(const std::string& name) const {
-  for (const auto& [n, f] : calculation_)
-    if (n == name) return f();
-  throw Error("unknown calculation module '" + name + "' (available: " + Known(calculation_) + ")");
+const ModuleRegistry::BareLoop* ModuleRegistry::FindBareLoop(const std::string& physics) const {
+  for (const Dynamics& d : dynamics_)
+    if (d.name == physics && d.bare_loop) return &d.bare_loop;
+  return nullptr;
 }
 
 bool ModuleRegistry::HasDynamics(const std::string& name) const {
-  for (const auto& [n, f] : dynamics_)
-    if (n == name) return true;
+  for (const Dynamics& d : dynamics_)
+    if (d.name == name) return true;
   return false;
 }
 
 std::vector<std::string> ModuleRegistry::DynamicsNames() const {
   std::vector<std::string> out;
-  for (const auto& [n, f] : dynamics_) out.push_back(n);
+  for (const Dynamics& d : dynamics_) out.push_back(d.name);
   return out;
 }
 

@@ -12,13 +12,14 @@
 #include <string_view>
 #include <vector>
 
+#include "framework/module.h"
 #include "framework/plugin_api.h"
 
 namespace swarmsim {
 
-class CalculationModule;
 class DynamicsBackend;
 class ProximityBackend;
+class Scene;
 struct ObjectTypeDescriptor;
 
 // A script command registered by a plugin (framework/plugin_api.h): sim.<name>.
@@ -48,22 +49,33 @@ struct PluginSensorType {
 };
 inline constexpr const char* kPluginSensorTag = "swarmsim.plugin_sensor";
 
-struct ModuleInfo {
-  std::string kind;  // "dynamics", "proximity", ...
-  std::string name;  // e.g. "box2d"
-  std::string version;
-  std::string description;  // one line
-};
-
 class ModuleRegistry {
  public:
   using DynamicsFactory = std::function<std::unique_ptr<DynamicsBackend>()>;
   using ProximityFactory = std::function<std::unique_ptr<ProximityBackend>()>;
-  using CalculationFactory = std::function<std::unique_ptr<CalculationModule>()>;
+  using CalculationFactory = std::function<std::unique_ptr<Module>()>;
+  // The engine alone stepping a world's bodies `steps` times (swarmsim
+  // bench's "<physics>-only" row): wall seconds.
+  using BareLoop = std::function<double(const Scene& scene, double time_step, int substeps,
+                                        int steps, double gravity)>;
 
-  void RegisterDynamics(ModuleInfo info, DynamicsFactory factory);
+  // Dynamics backends: kind "dynamics", chosen by a world's `physics:`.
+  void RegisterDynamics(ModuleInfo info, DynamicsFactory factory, BareLoop bare_loop = {});
+  // Modules (framework/module.h): every other kind. Throws swarmsim::Error
+  // if the name is taken or the descriptor has no `make`.
+  void RegisterModule(ModuleDescriptor module);
+  // Null if no module has that name.
+  const ModuleDescriptor* FindModule(std::string_view name) const;
+  // Every module of `kind`, in registration order.
+  std::vector<const ModuleDescriptor*> ModulesOfKind(std::string_view kind) const;
+  const std::vector<std::shared_ptr<const ModuleDescriptor>>& module_descriptors() const {
+    return module_descriptors_;
+  }
+  // The proximity backend as a module made for every world (kind
+  // "proximity", sense phase, order 100; World::proximity()).
   void RegisterProximity(ModuleInfo info, ProximityFactory factory);
-  // Calculation modules (IK groups, ...): kind "calculation".
+  // A calculation module (IK groups, ...): kind "calculation", actuate
+  // phase, order 100, made on request (World::module).
   void RegisterCalculation(ModuleInfo info, CalculationFactory factory);
   // Script commands (plugins): kind "command". Throws swarmsim::Error if the
   // name is not a Lua identifier or is already a command.
@@ -90,8 +102,8 @@ class ModuleRegistry {
 
   // Throw swarmsim::Error listing what is available when `name` is unknown.
   std::unique_ptr<DynamicsBackend> MakeDynamics(const std::string& name) const;
-  std::unique_ptr<ProximityBackend> MakeProximity(const std::string& name) const;
-  std::unique_ptr<CalculationModule> MakeCalculation(const std::string& name) const;
+  // Null if the dynamics backend has no bare loop.
+  const BareLoop* FindBareLoop(const std::string& physics) const;
   bool HasDynamics(const std::string& name) const;
   std::vector<std::string> DynamicsNames() const;
 
@@ -99,9 +111,14 @@ class ModuleRegistry {
 
  private:
   std::vector<ModuleInfo> modules_;
-  std::vector<std::pair<std::string, DynamicsFactory>> dynamics_;
-  std::vector<std::pair<std::string, ProximityFactory>> proximity_;
-  std::vector<std::pair<std::string, CalculationFactory>> calculation_;
+  struct Dynamics {
+    std::string name;
+    DynamicsFactory factory;
+    BareLoop bare_loop;
+  };
+  std::vector<Dynamics> dynamics_;
+  // Shared: a world's copy of the registry (plus its plugins) keeps them.
+  std::vector<std::shared_ptr<const ModuleDescriptor>> module_descriptors_;
   std::vector<std::shared_ptr<const ScriptCommand>>
       commands_;  // stable addresses (Lua keeps pointers)
   std::vector<PhaseCallback> phase_callbacks_;

@@ -14,16 +14,12 @@
 #include "framework/registry.h"
 #include "framework/scheduler.h"
 #include "framework/state_hash.h"
+#include "framework/suggest.h"
 #include "framework/utf8.h"
 
 namespace swarmsim {
 
 namespace {
-
-// Robots per task in the parallel phases: big enough to amortise the task
-// overhead (a robot's sense + control is a few microseconds), small enough
-// to balance two to eight workers.
-constexpr int64_t kRobotGrain = 8;
 
 class PhaseTimer {
  public:
@@ -125,12 +121,79 @@ void World::FlushPrintsOfStuckStep() {
   scene_runtime_.log.Drain(log_sink_);
 }
 
+Module* World::InstallModule(std::string name, int order, uint32_t phases,
+                             std::unique_ptr<Module> instance) {
+  Module* module = instance.get();
+  modules_.push_back({std::move(name), order, phases, std::move(instance)});
+  scene_.AddListener(module);
+  // Each phase's list in (order, creation) order.
+  for (size_t p = 0; p < modules_by_phase_.size(); ++p) {
+    if (!(phases & PhaseBit(static_cast<ModulePhase>(p)))) continue;
+    std::vector<Module*>& list = modules_by_phase_[p];
+    auto at = list.end();
+    while (at != list.begin()) {
+      const Module* before = *(at - 1);
+      const auto entry = std::find_if(modules_.begin(), modules_.end(), [&](const ModuleEntry& e) {
+        return e.instance.get() == before;
+      });
+      if (entry->order <= order) break;
+      --at;
+    }
+    list.insert(at, module);
+  }
+  if (started_) module->Start(this);
+  return module;
+}
+
+Module* World::module(std::string_view name) {
+  if (Module* existing = find_module(name)) return existing;
+  return AddModule(name, nullptr);
+}
+
+std::vector<std::string> World::module_names() const {
+  std::vector<std::string> names;
+  for (const ModuleEntry& e : modules_) names.push_back(e.name);
+  if (!started_)
+    for (const auto& descriptor : registry_.module_descriptors())
+      if (descriptor->every_world) names.push_back(descriptor->info.name);
+  return names;
+}
+
+Module* World::find_module(std::string_view name) const {
+  for (const ModuleEntry& e : modules_)
+    if (e.name == name) return e.instance.get();
+  return nullptr;
+}
+
+Module* World::AddModule(std::string_view name, const void* config) {
+  const ModuleDescriptor* descriptor = registry_.FindModule(name);
+  if (descriptor == nullptr) {
+    std::vector<std::string> known;
+    for (const auto& d : registry_.module_descriptors()) known.push_back(d->info.name);
+    throw Error("unknown module '" + std::string(name) + "'" + Suggest(name, known));
+  }
+  return InstallModule(descriptor->info.name, descriptor->order, descriptor->phases,
+                       descriptor->make(this, config));
+}
+
 void World::AddObserver(std::unique_ptr<Observer> observer) {
-  observers_.push_back(std::move(observer));
+  InstallModule("observer", 1000, PhaseBit(ModulePhase::kRecord), std::move(observer));
+}
+
+void World::RunModules(ModulePhase phase) {
+  for (Module* module : modules_by_phase_[static_cast<size_t>(phase)]) {
+    switch (phase) {
+      case ModulePhase::kSense: module->Sense(this); break;
+      case ModulePhase::kActuate: module->Actuate(this); break;
+      case ModulePhase::kAfterPhysics: module->AfterPhysics(this); break;
+      case ModulePhase::kRecord: module->Record(*this, &metrics_); break;
+      case ModulePhase::kCount: break;
+    }
+  }
 }
 
 void World::WriteOutputs(const std::filesystem::path& dir) const {
-  for (const auto& observer : observers_) observer->WriteOutputs(dir);
+  for (const ModuleEntry& e : modules_) e.instance->WriteOutputs(dir);
 }
 
 std::vector<MetricSample> World::TakeMetrics() {
@@ -142,19 +205,6 @@ std::vector<MetricSample> World::TakeMetrics() {
   if (!std::is_sorted(out.begin(), out.end(), by_step))
     std::stable_sort(out.begin(), out.end(), by_step);
   return out;
-}
-
-CalculationModule* World::calculation(const std::string& name) {
-  if (CalculationModule* existing = find_calculation(name)) return existing;
-  calculations_.emplace_back(name, registry_.MakeCalculation(name));
-  scene_.AddListener(calculations_.back().second.get());
-  return calculations_.back().second.get();
-}
-
-CalculationModule* World::find_calculation(const std::string& name) const {
-  for (const auto& [n, module] : calculations_)
-    if (n == name) return module.get();
-  return nullptr;
 }
 
 size_t World::script_memory_bytes() const { return scripts_ ? scripts_->MemoryBytes() : 0; }
@@ -196,10 +246,13 @@ void World::Start() {
   dynamics_settings.gravity = settings_.gravity;
   dynamics_->Build(scene_, dynamics_settings);
   dynamics_->MarkSimulatedJoints(&scene_);
-  proximity_ = registry_.MakeProximity("proximity");
-  ProximitySettings proximity_settings;
-  proximity_settings.octree_resolution = settings_.octree_resolution;
-  proximity_->Build(scene_, proximity_settings);
+  // The modules every world has (proximity), in registration order; then
+  // every module starts, in creation order.
+  for (const auto& descriptor : registry_.module_descriptors())
+    if (descriptor->every_world && find_module(descriptor->info.name) == nullptr)
+      InstallModule(descriptor->info.name, descriptor->order, descriptor->phases,
+                    descriptor->make(this, nullptr));
+  for (const ModuleEntry& e : modules_) e.instance->Start(this);
   scripts_ = MakeScriptHost(this);
   started_ = true;
   try {
@@ -221,7 +274,7 @@ void World::Step() {
     // 0. messages and signals sent in the last step become visible.
     {
       PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kControl)]);
-      messaging_.Deliver(&scene_, proximity_.get(), *scheduler_);
+      messaging_.Deliver(&scene_, proximity_, *scheduler_);
     }
     if (scripts_->has_main_script()) {
       // 1-4. the world's own main script runs the phases (sim.handleSensing(), ...).
@@ -268,15 +321,7 @@ void World::Step() {
 }
 
 void World::Sense() {
-  proximity_->Update(scene_);
-  const auto& instances = scene_.instances();
-  scheduler_->ParallelFor(0, static_cast<int64_t>(instances.size()), kRobotGrain,
-                          [&](int64_t begin, int64_t end) {
-                            for (int64_t r = begin; r < end; ++r)
-                              if (instances[r].alive)
-                                proximity_->SenseInstance(&scene_, static_cast<int>(r));
-                          });
-  proximity_->SenseSceneSensors(&scene_);
+  RunModules(ModulePhase::kSense);  // proximity, ...
   if (has_plugin_sensor_types_) SensePluginSensors();
   RunPhaseCallbacks(kSwarmsimAfterSense);
 }
@@ -416,7 +461,7 @@ void World::Actuate() {
       j.target_position = w.value;
   }
   // Calculation objects (IK groups, ...) set joint positions and targets.
-  for (auto& [name, module] : calculations_) module->Actuate(this);
+  RunModules(ModulePhase::kActuate);
   // Joints move kinematically toward their targets over the control step:
   // velocity mode at the target velocity, position mode at up to max_velocity.
   const double dt = settings_.time_step;
@@ -475,11 +520,12 @@ void World::Physics() {
   for (uint32_t row = 0; row < joints.size(); ++row)
     if (!std::isfinite(joints[row].position) || !std::isfinite(joints[row].velocity))
       throw non_finite(scene_.joint_owners()[row], "joint position or velocity");
+  RunModules(ModulePhase::kAfterPhysics);
   RunPhaseCallbacks(kSwarmsimAfterPhysics);
 }
 
 void World::Record() {
-  for (auto& observer : observers_) observer->Record(*this, &metrics_);
+  RunModules(ModulePhase::kRecord);  // swarm metrics, paint, ...
   if (phase_callbacks_[kSwarmsimRecord].empty()) return;
   // Plugins' record-phase callbacks, then their rows in robot order (the
   // swarm-level ones first), whatever the thread count.
@@ -544,7 +590,7 @@ uint64_t World::StateHash() const {
   for (uint32_t s = 0; s < scene_.slot_count(); ++s)
     if (scene_.alive_at(s)) scene_.HashCustomData(s, &h);
   if (dynamics_) dynamics_->HashState(&h);
-  for (const auto& [name, module] : calculations_) module->HashState(&h);
+  for (const ModuleEntry& e : modules_) e.instance->HashState(&h);
   return h.Digest();
 }
 

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "framework/messaging.h"
+#include "framework/module.h"
 #include "framework/parameters.h"
 #include "framework/phase_handlers.h"
 #include "framework/plugin_api.h"
@@ -23,7 +24,7 @@
 
 namespace swarmsim {
 
-class CalculationModule;
+using CalculationModule = Module;  // framework/calculation_module.h
 class DynamicsBackend;
 class ModuleRegistry;
 struct PhaseCallback;
@@ -149,16 +150,14 @@ struct RobotRuntime {
   // Its messages, signal and custom-data writes: Messaging::robot_mail.
 };
 
-// A calculation object that observes the world in the record phase
-// (minimum distance, swarm metrics, graphs).
-class Observer {
- public:
-  virtual ~Observer() = default;
-  virtual void Record(const World& world, std::vector<MetricSample>* out) = 0;
-  // Writes the observer's files (e.g. paint.png) into the run's output folder
-  // at the end of a run. Throws swarmsim::Error if it cannot.
-  virtual void WriteOutputs(const std::filesystem::path& /*dir*/) const {}
-};
+// A module that observes the world in the record phase (swarm metrics,
+// the paint layer; framework/module.h).
+using Observer = Module;
+
+// Robots per task in the parallel phases (and module hooks that fan out over
+// robots): big enough to amortise the task overhead (a robot's sense +
+// control is a few microseconds), small enough to balance two to eight workers.
+inline constexpr int64_t kRobotGrain = 8;
 
 // Wall-clock seconds spent in each phase, summed over the run.
 enum class Phase { kSense, kControl, kActuate, kPhysics, kRecord, kCount };
@@ -225,8 +224,25 @@ class World : public PhaseHandlers {
   // then the scene's scripts.
   void FlushPrintsOfStuckStep();
   void Log(std::string_view line) const;
+  // --- Modules (framework/module.h) --------------------------------------------------
+  // The world's instance of the module registered as `name`, made on first
+  // use (with no configuration) and run from then on. Call before the model
+  // copies it serves are duplicated, so it follows them. Throws
+  // swarmsim::Error for an unknown name.
+  Module* module(std::string_view name);
+  // Null if the world has no instance of it.
+  Module* find_module(std::string_view name) const;
+  // Adds an instance of the module registered as `name`, made with `config`
+  // (what its descriptor's `make` expects: a `paint:` section's settings, a
+  // metric's `every`); a module may have several. Returns it.
+  Module* AddModule(std::string_view name, const void* config);
+  // The names of the world's modules, in creation order, then those every
+  // world gets when it starts (proximity) if it has not started.
+  std::vector<std::string> module_names() const;
+  // Adds a record-phase module made by the caller, not registered (tests,
+  // embedders), after the registered ones.
   void AddObserver(std::unique_ptr<Observer> observer);
-  // Every observer's WriteOutputs(dir), in the order they were added.
+  // Every module's WriteOutputs(dir), in creation order.
   void WriteOutputs(const std::filesystem::path& dir) const;
   // Metric samples recorded since the last call, in (step, robot, order) order.
   std::vector<MetricSample> TakeMetrics();
@@ -241,14 +257,13 @@ class World : public PhaseHandlers {
   TaskScheduler& scheduler() { return *scheduler_; }
   const ModuleRegistry& registry() const { return registry_; }
   DynamicsBackend* dynamics() { return dynamics_.get(); }
-  ProximityBackend* proximity() { return proximity_.get(); }
+  // The proximity module's backend (line-of-sight messages); null before Start.
+  ProximityBackend* proximity() { return proximity_; }
+  void set_proximity(ProximityBackend* proximity) { proximity_ = proximity; }
   ScriptHost* scripts() { return scripts_.get(); }
-  // The calculation module registered as `name` (e.g. "ik"), created on
-  // first use and run in each actuate phase from then on. Call before the
-  // model copies it serves are duplicated, so it follows them.
-  CalculationModule* calculation(const std::string& name);
-  // Null if not created.
-  CalculationModule* find_calculation(const std::string& name) const;
+  // module(name) / find_module(name), by their old names.
+  CalculationModule* calculation(const std::string& name) { return module(name); }
+  CalculationModule* find_calculation(const std::string& name) const { return find_module(name); }
   size_t script_memory_bytes() const;
 
   // --- Main-script handlers (PhaseHandlers) ---------------------------------------------
@@ -276,6 +291,7 @@ class World : public PhaseHandlers {
   void Actuate();
   void Physics();
   void Record();
+  void RunModules(ModulePhase phase);
   void EnsureRuntimes();
   void FlushRobotBuffers();
   // The scene's scripts' prints and metrics (a main script's, after its step).
@@ -319,7 +335,7 @@ class World : public PhaseHandlers {
   ParameterSet parameters_;
   std::unique_ptr<TaskScheduler> scheduler_;
   std::unique_ptr<DynamicsBackend> dynamics_;
-  std::unique_ptr<ProximityBackend> proximity_;
+  ProximityBackend* proximity_ = nullptr;  // owned by its module
   std::unique_ptr<ScriptHost> scripts_;
   std::vector<RobotRuntime> runtimes_;
   // Per robot, which of its RobotRuntime buffers may hold something (kPending*
@@ -332,8 +348,17 @@ class World : public PhaseHandlers {
   static uint8_t PendingBits(const RobotRuntime& rt);  // what rt's buffers hold
   void MarkAllPending();
   RobotRuntime scene_runtime_;
-  std::vector<std::unique_ptr<Observer>> observers_;
-  std::vector<std::pair<std::string, std::unique_ptr<CalculationModule>>> calculations_;
+  // The world's modules in creation order, and by phase in run order.
+  struct ModuleEntry {
+    std::string name;
+    int order = 0;
+    uint32_t phases = 0;
+    std::unique_ptr<Module> instance;
+  };
+  std::vector<ModuleEntry> modules_;
+  std::array<std::vector<Module*>, static_cast<size_t>(ModulePhase::kCount)> modules_by_phase_;
+  Module* InstallModule(std::string name, int order, uint32_t phases,
+                        std::unique_ptr<Module> instance);
   std::vector<MetricSample> metrics_;
   std::vector<std::string> disabled_scripts_;
   std::function<void(std::string_view)> log_sink_;

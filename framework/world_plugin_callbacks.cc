@@ -13,9 +13,7 @@
 #include "framework/world.h"
 
 namespace swarmsim {
-namespace {
-constexpr int64_t kRobotGrain = 8;  // as the other per-robot phases
-}  // namespace
+namespace {}  // namespace
 
 void World::CallPhaseCallbacks(int phase) {
   // Whole-world callbacks on this thread, per-robot ones fanned out over the

@@ -14,9 +14,7 @@ namespace swarmsim {
 
 static_assert(SWARMSIM_SENSOR_MAX_VALUES == 16, "World::PluginSensorState::values");
 
-namespace {
-constexpr int64_t kRobotGrain = 8;  // as the other per-robot phases
-}  // namespace
+namespace {}  // namespace
 
 void World::IndexPluginSensors() {
   std::vector<std::pair<int, uint32_t>> found;  // (robot or -1, slot)

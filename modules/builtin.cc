@@ -1,21 +1,42 @@
 #include "modules/builtin.h"
 
+#include "framework/dynamics_backend.h"
 #include "framework/registry.h"
 #include "modules/dynamics/box2d/box2d_backend.h"
 #include "modules/dynamics/kinematic/kinematic_backend.h"
 #include "modules/dynamics/ode/ode_backend.h"
 #include "modules/kinematics/ik_groups.h"
+#include "modules/metrics/swarm_metrics.h"
+#include "modules/paint/paint_layer.h"
 #include "modules/proximity/proximity.h"
 
 namespace swarmsim {
 
+namespace {
+
+// The engine alone, for `swarmsim bench`'s "<physics>-only" row.
+template <auto kTimeBareLoop>
+double BareLoop(const Scene& scene, double dt, int substeps, int steps, double gravity) {
+  DynamicsSettings settings;
+  settings.gravity = gravity;
+  return kTimeBareLoop(scene, dt, substeps, steps, {}, settings);
+}
+
+}  // namespace
+
+// One line per module.
 void RegisterBuiltinModules(ModuleRegistry* registry) {
-  registry->RegisterDynamics(box2d::ModuleInfo(), [] { return box2d::MakeBackend(); });
-  registry->RegisterDynamics(ode::ModuleInfo(), [] { return ode::MakeBackend(); });
+  registry->RegisterDynamics(
+      box2d::ModuleInfo(), [] { return box2d::MakeBackend(); }, BareLoop<box2d::TimeBareLoop>);
+  registry->RegisterDynamics(
+      ode::ModuleInfo(), [] { return ode::MakeBackend(); }, BareLoop<ode::TimeBareLoop>);
   registry->RegisterDynamics(kinematic::ModuleInfo(), [] { return kinematic::MakeBackend(); });
   registry->RegisterProximity(proximity::ModuleInfo(), [] { return proximity::MakeBackend(); });
   registry->RegisterCalculation(kinematics::IkModuleInfo(),
                                 [] { return kinematics::MakeIkGroups(); });
+  registry->RegisterModule(paint::PaintModule());
+  for (ModuleDescriptor& metric : metrics::SwarmMetricModules())
+    registry->RegisterModule(std::move(metric));
 }
 
 }  // namespace swarmsim

@@ -133,4 +133,16 @@ void PaintLayer::WriteOutputs(const std::filesystem::path& dir) const {
   WritePng(dir / "paint.png", width_, height_, rgb_);
 }
 
+ModuleDescriptor PaintModule() {
+  return {{"record", "paint", "1.0",
+           "the floor paint layer paint nozzles mark (paint.png), world file key paint:"},
+          PhaseBit(ModulePhase::kRecord),
+          200,
+          /*every_world=*/false,
+          [](World* world, const void* config) -> std::unique_ptr<Module> {
+            if (config == nullptr) throw Error("the paint module needs its settings (paint:)");
+            return std::make_unique<PaintLayer>(world, *static_cast<const PaintSettings*>(config));
+          }};
+}
+
 }  // namespace swarmsim::paint

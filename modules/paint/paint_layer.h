@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "framework/math.h"
+#include "framework/module.h"
 #include "framework/world.h"
 
 namespace swarmsim::paint {
@@ -28,6 +29,10 @@ struct PaintSettings {
   double max_x = 1, max_y = 1;
   Vec3 background{1, 1, 1};  // RGB in [0, 1], unpainted floor
 };
+
+// The paint layer as a module: "paint", record phase, order 200 (after the
+// swarm metrics); World::AddModule("paint", &settings) makes one.
+ModuleDescriptor PaintModule();
 
 class PaintLayer final : public Observer {
  public:

@@ -15,8 +15,6 @@
 #include "framework/error.h"
 #include "framework/registry.h"
 #include "modules/builtin.h"
-#include "modules/dynamics/box2d/box2d_backend.h"
-#include "modules/dynamics/ode/ode_backend.h"
 #include "swarm/loader/world_loader.h"
 #include "swarm/run/runner.h"
 
@@ -92,10 +90,14 @@ bool RunChild(const std::vector<std::string>& args, std::string* output, int* st
 
 int RunBenchChild(const BenchOptions& options, const std::string& config, int robots, int threads,
                   std::ostream& out) {
-  if (config != "diffusion" && config != "box2d-only" && config != "ode-only")
-    throw Error("unknown bench configuration '" + config + "'");
   ModuleRegistry registry;
   RegisterBuiltinModules(&registry);
+  // "diffusion" (the whole world), or "<physics>-only": the world's
+  // dynamics backend alone, through the bare loop it registered.
+  const bool bare = config.ends_with("-only");
+  const std::string physics = bare ? config.substr(0, config.size() - 5) : std::string();
+  if (config != "diffusion" && (!bare || registry.FindBareLoop(physics) == nullptr))
+    throw Error("unknown bench configuration '" + config + "'");
   LoadOptions load;
   load.overrides = {{"robots", std::to_string(robots)}};
   load.seed = 1;
@@ -110,7 +112,7 @@ int RunBenchChild(const BenchOptions& options, const std::string& config, int ro
   BenchRow row;
   row.config = config;
   row.robots = world.robot_count();
-  row.threads = config == "box2d-only" || config == "ode-only" ? 1 : world.threads();
+  row.threads = bare ? 1 : world.threads();
   row.steps = options.steps;
   const double ticks = static_cast<double>(row.robots) * static_cast<double>(options.steps);
   if (config == "diffusion") {
@@ -120,20 +122,12 @@ int RunBenchChild(const BenchOptions& options, const std::string& config, int ro
     row.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     for (int p = 0; p < 5; ++p)
       row.us_per_tick[p] = 1e6 * (world.phase_times()[p] - before[p]) / ticks;
-  } else if (config == "ode-only") {
-    // The same bodies and joint commands through ODE alone (collision + solver).
-    const WorldSettings& s = world.settings();
-    DynamicsSettings dynamics;
-    dynamics.gravity = s.gravity;
-    row.wall_s =
-        ode::TimeBareLoop(world.scene(), s.time_step / s.physics_substeps, s.physics_substeps,
-                          static_cast<int>(options.steps), {}, dynamics);
-    row.us_per_tick[static_cast<int>(Phase::kPhysics)] = 1e6 * row.wall_s / ticks;
   } else {
-    // The same bodies and wheel commands through Box2D alone.
+    // The same bodies and wheel or joint commands through the engine alone.
     const WorldSettings& s = world.settings();
-    row.wall_s = box2d::TimeBareLoop(world.scene(), s.time_step / s.physics_substeps,
-                                     s.physics_substeps, options.steps);
+    row.wall_s = (*registry.FindBareLoop(physics))(world.scene(), s.time_step / s.physics_substeps,
+                                                   s.physics_substeps,
+                                                   static_cast<int>(options.steps), s.gravity);
     row.us_per_tick[static_cast<int>(Phase::kPhysics)] = 1e6 * row.wall_s / ticks;
   }
   row.robot_ticks_per_s = row.wall_s > 0 ? ticks / row.wall_s : 0;
@@ -176,7 +170,10 @@ std::string PrepareBench(BenchOptions* options) {
   load.overrides = {{"robots", "1"}};
   try {
     const LoadedWorld loaded = LoadWorld(options->world, load, registry);
-    return loaded.world->settings().physics == "ode" ? "ode-only" : "box2d-only";
+    // The bare-engine row of the world's backend, if it registered a bare
+    // loop (kinematic has none: its row is the box2d one, as before).
+    const std::string& physics = loaded.world->settings().physics;
+    return registry.FindBareLoop(physics) != nullptr ? physics + "-only" : "box2d-only";
   } catch (const Error&) {
     // Tell a missing `robots` parameter from the file's own mistakes, which
     // loading it as written reports (and throws).

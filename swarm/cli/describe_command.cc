@@ -20,6 +20,10 @@ void PrintDescription(const LoadedWorld& w, std::ostream& out) {
   out << "world: " << s.file << "\n"
       << "physics: " << s.physics << ", time step " << s.time_step << " s, seed " << s.seed << "\n"
       << "main script: " << (s.main_script ? s.main_script->path : "(default step)") << "\n";
+  // The world's modules (framework/module.h), in the order they run within a phase.
+  out << "modules:";
+  for (const std::string& name : w.world->module_names()) out << " " << name;
+  out << "\n";
   if (!w.world->parameters().empty()) {
     out << "world parameters:\n";
     for (const auto& [name, value] : w.world->parameters())

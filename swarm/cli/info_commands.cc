@@ -2,6 +2,7 @@
 #include <CLI/CLI.hpp>
 #include <iostream>
 
+#include "framework/object_type.h"
 #include "framework/registry.h"
 #include "swarm/cli/commands.h"
 #include "swarm/run/version.h"
@@ -13,6 +14,10 @@ CLI::App* AddModulesCommand(CLI::App* app) {
 }
 
 int ModulesCommand(const ModuleRegistry& registry) {
+  // The built-in object types (framework/types/), then every registered
+  // module (object types of modules and plugins among them).
+  for (const ObjectTypeDescriptor* type : CoreObjectTypes())
+    std::cout << "object type\t" << type->name << "\tbuilt-in\t" << type->description << "\n";
   for (const ModuleInfo& m : registry.modules())
     std::cout << m.kind << "\t" << m.name << "\t" << m.version << "\t" << m.description << "\n";
   return 0;

@@ -52,7 +52,7 @@ void AddPaintLayer(const YamlFile& file, const Field& top_field, const Field& pa
     settings.max_y = arena->max_y;
   }
   try {
-    world->AddObserver(std::make_unique<paint::PaintLayer>(world, settings));
+    world->AddModule("paint", &settings);  // modules/paint
   } catch (const Error& e) {
     file.Fail(paint.present() ? paint.mark : top_field.mark, e.what());
   }

@@ -947,8 +947,9 @@ std::vector<ModelSummary> WorldLoader::Summarize() const {
 std::vector<SwarmMetricSpec> WorldLoader::ReadMetrics(const Fields& top, World* world) {
   std::vector<SwarmMetricSpec> out;
   const ValueReader values = WorldValues();
-  std::vector<std::string> known;
-  for (const auto& [name, description] : KnownSwarmMetrics()) known.push_back(name);
+  std::vector<std::string> known;  // the registered metric modules
+  for (const ModuleDescriptor* metric : world->registry().ModulesOfKind("metric"))
+    known.push_back(metric->info.name);
   for (const Field& element : loader::ListElements(*file_, top.Get("metrics"), "metrics")) {
     SwarmMetricSpec spec;
     Field name_field = element;
@@ -965,7 +966,7 @@ std::vector<SwarmMetricSpec> WorldLoader::ReadMetrics(const Fields& top, World* 
       file_->Fail(name_field.mark,
                   "unknown metric '" + spec.name + "'" + loader::Suggest(spec.name, known));
     try {
-      world->AddObserver(MakeSwarmMetric(spec));
+      world->AddModule(spec.name, &spec.every_steps);
     } catch (const Error& e) {
       file_->Fail(name_field.mark, e.what());
     }

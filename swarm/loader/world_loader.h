@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "framework/world.h"
-#include "swarm/loader/metrics.h"
+#include "modules/metrics/swarm_metrics.h"
 
 namespace swarmsim {
 

@@ -17,6 +17,7 @@
 #include "framework/random.h"
 #include "framework/registry.h"
 #include "framework/world.h"
+#include "modules/metrics/swarm_metrics.h"
 #include "tests/framework/fakes.h"
 
 namespace swarmsim {
@@ -34,6 +35,7 @@ ModuleRegistry TestRegistry() {
                        [] { return std::make_unique<testing::NullDynamics>(); });
   r.RegisterProximity({"", "proximity", "1", "test double"},
                       [] { return std::make_unique<testing::NullProximity>(); });
+  for (ModuleDescriptor& metric : metrics::SwarmMetricModules()) r.RegisterModule(metric);
   return r;
 }
 

@@ -1,4 +1,4 @@
-#include "swarm/loader/metrics.h"
+#include "modules/metrics/swarm_metrics.h"
 
 #include <cmath>
 #include <limits>
@@ -6,6 +6,7 @@
 
 #include "framework/error.h"
 #include "framework/spatial_grid.h"
+#include "framework/world.h"
 
 namespace swarmsim {
 
@@ -83,23 +84,33 @@ class CoveredArea : public Observer {
 
 }  // namespace
 
-std::vector<std::pair<std::string, std::string>> KnownSwarmMetrics() {
+namespace metrics {
+
+std::vector<ModuleDescriptor> SwarmMetricModules() {
+  const auto every = [](const void* config) {
+    const int n = config != nullptr ? *static_cast<const int*>(config) : 1;
+    if (n < 1) throw Error("a metric's 'every' must be >= 1");
+    return n;
+  };
   return {
-      {"mean_nearest_neighbor_distance",
-       "mean distance from each robot to its nearest neighbour (m)"},
-      {"covered_area", "area visited by at least one robot since the start (m^2, 0.25 m cells)"},
+      {{"metric", "mean_nearest_neighbor_distance", "1.0",
+        "mean distance from each robot to its nearest neighbour (m)"},
+       PhaseBit(ModulePhase::kRecord),
+       100,
+       false,
+       [every](World*, const void* config) -> std::unique_ptr<Module> {
+         return std::make_unique<MeanNearestNeighborDistance>(every(config));
+       }},
+      {{"metric", "covered_area", "1.0",
+        "area visited by at least one robot since the start (m^2, 0.25 m cells)"},
+       PhaseBit(ModulePhase::kRecord),
+       100,
+       false,
+       [every](World*, const void* config) -> std::unique_ptr<Module> {
+         return std::make_unique<CoveredArea>(every(config));
+       }},
   };
 }
 
-std::unique_ptr<Observer> MakeSwarmMetric(const SwarmMetricSpec& spec) {
-  if (spec.every_steps < 1) throw Error("metric '" + spec.name + "': 'every' must be >= 1");
-  if (spec.name == "mean_nearest_neighbor_distance")
-    return std::make_unique<MeanNearestNeighborDistance>(spec.every_steps);
-  if (spec.name == "covered_area") return std::make_unique<CoveredArea>(spec.every_steps);
-  std::string known;
-  for (const auto& [name, description] : KnownSwarmMetrics())
-    known += (known.empty() ? "" : ", ") + name;
-  throw Error("unknown metric '" + spec.name + "' (known: " + known + ")");
-}
-
+}  // namespace metrics
 }  // namespace swarmsim

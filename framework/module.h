@@ -1,0 +1,87 @@
+// The module contract: what a calculation module declares and what World
+// runs (ARGoS's registered engines and sensors; MuJoCo's engine plugins).
+//
+// A module registers once, by name, in the ModuleRegistry with a
+// ModuleDescriptor: its `swarmsim modules` line (kind, name, version, one
+// line), the phases it hooks and its order within them, and how one world's
+// instance is made. World makes the every-world modules when it starts, the
+// others when something asks for them (World::module: the loader for a
+// model's IK groups, a world file's `paint:` or `metrics:`), and runs every
+// instance's hooks phase by phase:
+//
+//   sense        after the scene's state is final, before the scripts
+//                (proximity 100; then plugin sensors, after_sense callbacks)
+//   actuate      after deferred writes, before joints move (IK groups 100)
+//   after_physics after the dynamics step (then after_physics callbacks)
+//   record       after the step (swarm metrics 100, paint 200, then
+//                record-phase plugin callbacks)
+//
+// Within a phase, lower `order` first, then creation order: never the
+// thread count. A module's state that changes the future goes into the
+// state hash (HashState), modules in creation order after the dynamics.
+// A module follows the objects it refers to through copies and removals
+// (SceneListener; paper §2.3).
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "framework/scene.h"
+
+namespace swarmsim {
+
+class StateHasher;
+class World;
+struct MetricSample;
+
+enum class ModulePhase : uint8_t { kSense, kActuate, kAfterPhysics, kRecord, kCount };
+constexpr uint32_t PhaseBit(ModulePhase phase) { return 1u << static_cast<unsigned>(phase); }
+
+// One world's instance of a module. Hooks it does not declare are not called.
+class Module : public SceneListener {
+ public:
+  ~Module() override = default;
+  // The world has started: the scene is placed and the dynamics built, the
+  // scripts' sysCall_init has not run yet.
+  virtual void Start(World* /*world*/) {}
+  // Robots may be handled concurrently through world->scheduler(); results
+  // must not depend on the thread count.
+  virtual void Sense(World* /*world*/) {}
+  virtual void Actuate(World* /*world*/) {}
+  virtual void AfterPhysics(World* /*world*/) {}
+  // Appends this step's rows of metrics.csv.
+  virtual void Record(const World& /*world*/, std::vector<MetricSample>* /*out*/) {}
+  // Writes the module's files (paint.png) into the run's output folder at
+  // the end of a run. Throws swarmsim::Error if it cannot.
+  virtual void WriteOutputs(const std::filesystem::path& /*dir*/) const {}
+  // Folds state that is not in the scene and changes the future into the hash.
+  virtual void HashState(StateHasher* /*hasher*/) const {}
+  void OnSubtreeDuplicated(const Scene&, std::span<const uint32_t>,
+                           std::span<const uint32_t>) override {}
+  void OnSubtreeRemoved(const Scene&, std::span<const uint32_t>) override {}
+};
+
+struct ModuleInfo {
+  std::string kind;  // "dynamics", "proximity", "calculation", "metric", ...
+  std::string name;  // e.g. "box2d"
+  std::string version;
+  std::string description;  // one line
+};
+
+struct ModuleDescriptor {
+  ModuleInfo info;
+  uint32_t phases = 0;       // PhaseBit(...) | ...
+  int order = 0;             // within each phase, lower first
+  bool every_world = false;  // made by World::Start for every world; else on request
+  // One world's instance. `config` is what the requester passes
+  // (World::AddModule: a `paint:` section's settings, a metric's `every`),
+  // or null (World::module).
+  std::function<std::unique_ptr<Module>(World* world, const void* config)> make;
+};
+
+}  // namespace swarmsim

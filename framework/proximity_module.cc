@@ -1,0 +1,46 @@
+#include "framework/proximity_module.h"
+
+#include "framework/proximity_backend.h"
+#include "framework/scheduler.h"
+#include "framework/world.h"
+
+namespace swarmsim {
+namespace {
+
+class ProximityModule final : public Module {
+ public:
+  explicit ProximityModule(std::unique_ptr<ProximityBackend> backend)
+      : backend_(std::move(backend)) {}
+
+  void Start(World* world) override {
+    ProximitySettings settings;
+    settings.octree_resolution = world->settings().octree_resolution;
+    backend_->Build(world->scene(), settings);
+    world->set_proximity(backend_.get());
+  }
+
+  // Every robot's sensors, robots in parallel, then the scene's own sensors.
+  void Sense(World* world) override {
+    Scene& scene = world->scene();
+    backend_->Update(scene);
+    const auto& instances = scene.instances();
+    world->scheduler().ParallelFor(0, static_cast<int64_t>(instances.size()), kRobotGrain,
+                                   [&](int64_t begin, int64_t end) {
+                                     for (int64_t r = begin; r < end; ++r)
+                                       if (instances[r].alive)
+                                         backend_->SenseInstance(&scene, static_cast<int>(r));
+                                   });
+    backend_->SenseSceneSensors(&scene);
+  }
+
+ private:
+  std::unique_ptr<ProximityBackend> backend_;
+};
+
+}  // namespace
+
+std::unique_ptr<Module> MakeProximityModule(std::unique_ptr<ProximityBackend> backend) {
+  return std::make_unique<ProximityModule>(std::move(backend));
+}
+
+}  // namespace swarmsim
