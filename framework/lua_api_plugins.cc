@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "framework/lua_api.h"
+#include "framework/plugin_sensors.h"
 #include "framework/plugin_world_api.h"
 #include "framework/registry.h"
 #include "framework/world.h"
@@ -80,7 +81,7 @@ int ReadPluginSensor(lua_State* L) {
   const LuaContext& c = Context(L);
   if (c.world == nullptr) RaiseError(L, "sim.readPluginSensor: no world");
   std::span<const double> values;
-  if (!c.world->PluginSensorReading(CheckObject(L, 1), &values)) {
+  if (!PluginSensorReading(*c.world, CheckObject(L, 1), &values)) {
     lua_pushnil(L);
     return 1;
   }

@@ -178,6 +178,11 @@ typedef struct SwarmsimRegistrar {
   // name, a key without a name, or a default outside its range.
   int (*add_object_type)(void* impl, const char* name, const char* description,
                          const SwarmsimObjectKey* keys, int key_count);
+  // Like add_sensor_type, with readings of up to `max_values` numbers (any
+  // size: a scan, an image) instead of SWARMSIM_SENSOR_MAX_VALUES; the sense
+  // function gets max_values. Returns -1 for max_values < 1.
+  int (*add_sensor_type_of_size)(void* impl, const char* name, const char* description,
+                                 int max_values, SwarmsimSensorFunction sense, void* user_data);
 } SwarmsimRegistrar;
 
 // The two entry points a plugin exports.

@@ -56,15 +56,21 @@ int AddCommand(void* impl, const char* name, const char* description, SwarmsimCo
   return 0;
 }
 
-int AddSensorType(void* impl, const char* name, const char* description,
-                  SwarmsimSensorFunction sense, void* user_data) {
+int AddSensorTypeOfSize(void* impl, const char* name, const char* description, int max_values,
+                        SwarmsimSensorFunction sense, void* user_data) {
   auto* r = static_cast<Registration*>(impl);
-  if (name == nullptr || name[0] == 0 || sense == nullptr) {
-    r->error = "add_sensor_type needs a name and a function";
+  if (name == nullptr || name[0] == 0 || sense == nullptr || max_values < 1) {
+    r->error = "add_sensor_type needs a name, a function and a reading of at least one number";
     return -1;
   }
-  r->sensors.push_back({name, description != nullptr ? description : "", sense, user_data});
+  r->sensors.push_back(
+      {name, description != nullptr ? description : "", sense, user_data, max_values});
   return 0;
+}
+
+int AddSensorType(void* impl, const char* name, const char* description,
+                  SwarmsimSensorFunction sense, void* user_data) {
+  return AddSensorTypeOfSize(impl, name, description, SWARMSIM_SENSOR_MAX_VALUES, sense, user_data);
 }
 
 int AddObjectType(void* impl, const char* name, const char* description,
@@ -118,7 +124,7 @@ void LoadPlugin(const std::string& path, ModuleRegistry* registry) {
   r.info.name.assign(path);
   r.info.version.assign("unversioned");
   const SwarmsimRegistrar registrar{
-      &r, AddCommand, SetInfo, AddPhaseCallback, AddSensorType, AddObjectType};
+      &r, AddCommand, SetInfo, AddPhaseCallback, AddSensorType, AddObjectType, AddSensorTypeOfSize};
   if (do_register(&registrar) != 0 || !r.error.empty()) {
     std::string message = "plugin '" + path + "' failed to register";
     if (!r.error.empty()) message.append(": ").append(r.error);

@@ -5,6 +5,7 @@
 #include "framework/dynamics_backend.h"
 #include "framework/error.h"
 #include "framework/object_type.h"
+#include "framework/plugin_sensors.h"
 #include "framework/proximity_backend.h"
 #include "framework/proximity_module.h"
 
@@ -86,9 +87,12 @@ void ModuleRegistry::RegisterPluginSensor(ModuleInfo info, PluginSensorType type
     throw Error("a plugin sensor type needs a name and a sense function");
   if (FindPluginSensor(type.name) != nullptr)
     throw Error("plugin sensor type '" + type.name + "' is registered twice");
+  if (type.max_values < 1) throw Error("plugin sensor type '" + type.name + "' holds no values");
   info.kind = "sensor";
   modules_.push_back(std::move(info));
   plugin_sensors_.push_back(std::move(type));
+  // The module that senses every type's objects, with the first type.
+  if (FindModule("plugin_sensors") == nullptr) RegisterModule(PluginSensorsModule());
 }
 
 void ModuleRegistry::RegisterObjectType(std::shared_ptr<const ObjectTypeDescriptor> type) {

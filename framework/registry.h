@@ -46,6 +46,7 @@ struct PluginSensorType {
   std::string description;
   SwarmsimSensorFunction function = nullptr;
   void* user_data = nullptr;
+  int max_values = SWARMSIM_SENSOR_MAX_VALUES;  // numbers one reading holds at most
 };
 inline constexpr const char* kPluginSensorTag = "swarmsim.plugin_sensor";
 

@@ -93,7 +93,6 @@ World::World(const WorldSettings& settings, const ModuleRegistry& registry)
   if (!registry_.HasDynamics(settings_.physics)) registry_.MakeDynamics(settings_.physics);
   for (const PhaseCallback& callback : registry_.phase_callbacks())
     phase_callbacks_.at(callback.phase).push_back(&callback);
-  has_plugin_sensor_types_ = !registry_.plugin_sensors().empty();
   // Object types of modules and plugins, after the built-in ones.
   for (const ObjectTypeDescriptor* type : registry_.object_types()) scene_.RegisterType(*type);
 }
@@ -321,8 +320,7 @@ void World::Step() {
 }
 
 void World::Sense() {
-  RunModules(ModulePhase::kSense);  // proximity, ...
-  if (has_plugin_sensor_types_) SensePluginSensors();
+  RunModules(ModulePhase::kSense);  // proximity, plugin sensors, ...
   RunPhaseCallbacks(kSwarmsimAfterSense);
 }
 

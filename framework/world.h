@@ -277,7 +277,6 @@ class World : public PhaseHandlers {
   // --- Plugin sensors (framework/plugin_api.h) -------------------------------------------
   // The last reading of plugin sensor `id` into *values: false before its
   // first sense. Throws swarmsim::Error if `id` is not a plugin sensor.
-  bool PluginSensorReading(ObjectId id, std::span<const double>* values) const;
 
   // --- Messages and signals ------------------------------------------------------------
   // Delivered at the start of each step; signal writes applied when a
@@ -305,18 +304,6 @@ class World : public PhaseHandlers {
     if (!phase_callbacks_[phase].empty()) CallPhaseCallbacks(phase);
   }
   void CallPhaseCallbacks(int phase);
-  // Plugin sensors: sensed in the sense phase when the registry has sensor
-  // types (world_plugin_sensors.cc); the table is rebuilt when the scene's
-  // structure changes.
-  struct PluginSensorState {
-    ObjectId id;
-    const PluginSensorType* type = nullptr;
-    int count = -1;                   // values in the last reading; -1 before the first
-    std::array<double, 16> values{};  // SWARMSIM_SENSOR_MAX_VALUES
-  };
-  void SensePluginSensors();
-  void IndexPluginSensors();
-
   WorldSettings settings_;
   const ModuleRegistry& registry_;
   std::shared_ptr<const ModuleRegistry> owned_registry_;  // null unless given by shared_ptr
@@ -326,11 +313,6 @@ class World : public PhaseHandlers {
   bool recording_ = false;
   std::mutex plugin_metrics_mutex_;
   std::vector<MetricSample> plugin_metrics_;
-  bool has_plugin_sensor_types_ = false;
-  std::vector<PluginSensorState> plugin_sensors_;  // robot by robot, then the scene's
-  std::vector<uint32_t> plugin_sensor_start_;      // robots + 2: robot r's are [r], [r + 1)
-  std::vector<int32_t> plugin_sensor_of_slot_;     // index into plugin_sensors_ or -1 (slots)
-  uint64_t plugin_sensor_version_ = UINT64_MAX;    // scene structure they were indexed at
   Scene scene_;
   ParameterSet parameters_;
   std::unique_ptr<TaskScheduler> scheduler_;

@@ -22,6 +22,8 @@
 // model. Record-phase module `beacon_coverage`: records
 // near_beacon_fraction, the fraction of robots carrying no beacon whose root
 // lies within the radius of some beacon (in the plane), every step.
+// Sensor type `spectrum` (ABI 4, a reading of 256 numbers): the light's
+// intensity in 256 bands, band k of 256 getting intensity * (k + 1) / 256.
 // Sensor type `light` ({type: plugin_sensor, sensor: light} in a model):
 // reading {intensity, distance}, distance (m) from the sensor to the light
 // at the parameters (light_x, light_y, light_z) (default 0, 0, 1), and
@@ -231,6 +233,14 @@ int SenseLight(const SwarmsimCallContext* c, int64_t sensor, double* values, int
   return 2;
 }
 
+int SenseSpectrum(const SwarmsimCallContext* c, int64_t sensor, double* values, int max_values,
+                  char* error, size_t error_size, void* user_data) {
+  double light[2];
+  if (SenseLight(c, sensor, light, 2, error, error_size, user_data) < 0) return -1;
+  for (int k = 0; k < max_values; ++k) values[k] = light[0] * (k + 1) / max_values;
+  return max_values;
+}
+
 // --- Beacons ----------------------------------------------------------------------------
 
 const SwarmsimObjectKey kBeaconKeys[] = {
@@ -322,6 +332,9 @@ extern "C" int swarmsim_plugin_register(const SwarmsimRegistrar* r) {
       return -1;
   if (r->add_sensor_type(r->impl, "light", "{intensity, distance} from the light_x/y/z parameters",
                          SenseLight, nullptr) != 0)
+    return -1;
+  if (r->add_sensor_type_of_size(r->impl, "spectrum", "the light's intensity in 256 bands", 256,
+                                 SenseSpectrum, nullptr) != 0)
     return -1;
   if (r->add_object_type(r->impl, "beacon", "a marker robots are near or not (radius, strength)",
                          kBeaconKeys, 2) != 0)

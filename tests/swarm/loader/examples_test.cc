@@ -273,6 +273,33 @@ TEST(ExamplesTest, APluginObjectTypeIsReadCheckedAndScaledLikeABuiltInOne) {
   std::filesystem::remove_all(dir);
 }
 
+// A plugin sensor reading of any size (ABI 4): the example's `spectrum`
+// sensor fills 256 numbers a step, read whole with sim.readPluginSensor.
+TEST(ExamplesTest, APluginSensorReadingHasTheSizeItsTypeDeclares) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("swarmsim_spectrum_" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "bot.yaml") << "model: bot\n"
+                                     "objects:\n"
+                                     "  type: dummy\n"
+                                     "  children:\n"
+                                     "    - {name: eye, type: plugin_sensor, sensor: spectrum, "
+                                     "script: eye.lua}\n";
+  std::ofstream(dir / "eye.lua") << "function sysCall_actuation()\n"
+                                    "  local s = sim.readPluginSensor(sim.getObject('.'))\n"
+                                    "  if s then print(#s, s[256] > s[1] and s[1] > 0) end\n"
+                                    "end\n";
+  std::ofstream(dir / "world.yaml") << "plugins: [example_plugin]\n"
+                                       "simulation: {physics: kinematic, time_step: 0.1}\n"
+                                       "models:\n"
+                                       "  - {model: bot.yaml, position: [1, 0, 0]}\n";
+  const auto [status, text] =
+      swarmsim::testing::RunProgram("run " + (dir / "world.yaml").string() + " --steps 2 --quiet");
+  EXPECT_EQ(status, 0) << text;
+  EXPECT_NE(text.find("[bot#0] 256\ttrue"), std::string::npos) << text;
+  std::filesystem::remove_all(dir);
+}
+
 TEST(ExamplesTest, UnknownPluginSensorTypeIsALoadErrorWithASuggestion) {
   const std::filesystem::path dir = std::filesystem::temp_directory_path() /
                                     ("swarmsim_plugin_sensor_" + std::to_string(getpid()));
@@ -289,9 +316,10 @@ TEST(ExamplesTest, UnknownPluginSensorTypeIsALoadErrorWithASuggestion) {
       swarmsim::testing::RunProgram("run " + (dir / "world.yaml").string() + " --steps 1");
   EXPECT_NE(status, 0);
   EXPECT_NE(text.find("bot.yaml:5:"), std::string::npos) << text;
-  EXPECT_NE(text.find("unknown plugin sensor type 'lihgt' (registered: light); did you mean "
-                      "'light'?"),
-            std::string::npos)
+  EXPECT_NE(
+      text.find("unknown plugin sensor type 'lihgt' (registered: light, spectrum); did you mean "
+                "'light'?"),
+      std::string::npos)
       << text;
   std::filesystem::remove_all(dir);
 }
