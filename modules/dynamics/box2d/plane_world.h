@@ -15,7 +15,7 @@
 
 #include "framework/dynamics_backend.h"
 #include "framework/math.h"
-#include "modules/dynamics/box2d/box2d_backend.h"
+#include "modules/dynamics/box2d/box2d_options.h"
 
 namespace swarmsim {
 class Scene;

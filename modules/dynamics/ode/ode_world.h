@@ -11,7 +11,7 @@
 #include "framework/dynamics_backend.h"
 #include "framework/math.h"
 #include "framework/scene.h"
-#include "modules/dynamics/ode/ode_backend.h"
+#include "modules/dynamics/ode/ode_options.h"
 
 namespace swarmsim {
 class Scene;
