@@ -20,6 +20,8 @@
 namespace swarmsim {
 class Scene;
 class StateHasher;
+struct JointData;
+struct ShapeData;
 }  // namespace swarmsim
 
 namespace swarmsim::box2d {
@@ -81,6 +83,11 @@ struct TractionSolve {      // 64 bytes
   double vx = 0, vy = 0, w = 0;  // velocity, body plane frame, Box2D units
 };
 
+// Height range [lo, hi] of shapes, m.
+struct HeightRange {
+  double lo, hi;
+};
+
 class PlaneWorld {
  public:
   PlaneWorld(const Options& options, const DynamicsSettings& settings);
@@ -108,6 +115,24 @@ class PlaneWorld {
   int wheel_count() const { return static_cast<int>(wheels_.size()); }
 
  private:
+  // Build's phases, in order. 0: a fresh b2World and its ground body.
+  void Reset();
+  // 1. A body per dynamic shape, in slot order; fills body_of (slots) and
+  // returns the dynamic shapes' height range.
+  HeightRange BuildBodies(const Scene& scene, std::vector<int32_t>* body_of);
+  void AddBody(const Scene& scene, uint32_t slot, const ShapeData& shape, const Pose& X_WS);
+  // 2. Ground fixtures for the non-dynamic shapes that are no part of a body
+  // and reach into the dynamic range.
+  void BuildObstacles(const Scene& scene, const std::vector<int32_t>& body_of,
+                      const HeightRange& dynamic_range);
+  void AddObstacle(const ShapeData& shape, const Pose& X_WS);
+  // 3. Wheels, grouped by body, each with its share of the body's weight.
+  void BuildWheels(const Scene& scene, const std::vector<int32_t>& body_of);
+  void AddWheel(const Scene& scene, uint32_t joint_slot, const JointData& joint,
+                uint32_t body_index, const ShapeData& wheel_shape);
+  // 4. A ground friction joint for every body without wheels.
+  void BuildGroundFriction(const Scene& scene);
+
   // Traction impulses for every awake wheeled body, in blocks of
   // kTractionBlock bodies (the second form does one block).
   void ApplyTraction(double dt);
