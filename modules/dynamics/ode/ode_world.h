@@ -88,6 +88,17 @@ class OdeWorld {
 
  private:
   void Clear();
+  // Build's phases, in order. 0: a fresh world, space, contact group and
+  // ground plane (the space's kind depends on the scene's size).
+  void CreateWorld(const Scene& scene);
+  // 1. A body and geom per dynamic shape, in slot order; fills body_of (slots).
+  void BuildBodies(const Scene& scene, std::vector<dBodyID>* body_of);
+  // 2. A geom per other shape: a part of a body, a kinematic body (added to
+  // body_of) or a static geom.
+  void BuildNonDynamicShapes(const Scene& scene, std::vector<dBodyID>* body_of);
+  // 3. An ODE joint per joint with a dynamic child body, in slot order.
+  void BuildJoints(const Scene& scene, const std::vector<dBodyID>& body_of);
+  void AddJoint(const Scene& scene, uint32_t slot, dBodyID child, dBodyID parent);
   void StepOnce(double dt, double fraction);  // Substep's work
   // Fixed joints with feedback for the scene's force sensors (ode_force_sensors.cc).
   void BuildForceSensors(const Scene& scene, const std::vector<dBodyID>& body_of);
