@@ -52,7 +52,7 @@ PlaneWorld::PlaneWorld(const Options& options, const DynamicsSettings& settings)
 
 PlaneWorld::~PlaneWorld() = default;
 
-void PlaneWorld::SyncTeleports(const Scene& scene) {
+void PlaneWorld::SyncFromScene(const Scene& scene, double /*duration*/) {
   const double L = scale_;
   for (size_t b = 0; b < bodies_.size(); ++b) {
     PlaneBodyPose& pose = body_poses_[b];
@@ -71,7 +71,7 @@ void PlaneWorld::SyncTeleports(const Scene& scene) {
   }
 }
 
-void PlaneWorld::ReadWheelCommands(const Scene& scene) {
+void PlaneWorld::ReadCommands(const Scene& scene) {
   for (uint32_t b : wheeled_) bodies_[b].commanded = false;
   for (PlaneWheel& wheel : wheels_) {
     const JointData& joint = scene.joints()[scene.row_at(wheel.joint_slot)];
@@ -231,7 +231,7 @@ void PlaneWorld::ApplyTraction(std::span<const uint32_t> wheeled, double dt) {
   }
 }
 
-void PlaneWorld::Substep(double dt) {
+void PlaneWorld::Substep(double dt, double /*fraction*/) {
   last_dt_ = dt;
   ApplyTraction(dt);
   world_->Step(static_cast<float>(dt), options_.velocity_iterations, options_.position_iterations);

@@ -11,6 +11,7 @@
 #include <limits>
 #include <memory>
 #include <span>
+#include <string_view>
 #include <vector>
 
 #include "framework/dynamics_backend.h"
@@ -90,6 +91,11 @@ struct HeightRange {
 
 class PlaneWorld {
  public:
+  // For EngineBackend (engine_backend.h), which runs the step below.
+  using Options = box2d::Options;
+  static constexpr std::string_view kName = "box2d";
+  static constexpr bool kIdleWithoutSubsteps = false;
+
   PlaneWorld(const Options& options, const DynamicsSettings& settings);
   ~PlaneWorld();
   PlaneWorld(const PlaneWorld&) = delete;
@@ -98,14 +104,17 @@ class PlaneWorld {
   // Builds bodies, ground fixtures, wheels and ground friction from the scene
   // (discarding any previous world). Body velocities come from the scene.
   void Build(const Scene& scene);
+  // No joint is simulated: wheels drive by traction and World::Actuate
+  // advances their positions.
+  void MarkJoints(Scene* /*scene*/) const {}
   // Moves bodies whose scene pose differs from the last one written (set from
   // outside since the last step).
-  void SyncTeleports(const Scene& scene);
+  void SyncFromScene(const Scene& scene, double /*duration*/);
   // Reads each wheel's target velocity from its joint.
-  void ReadWheelCommands(const Scene& scene);
+  void ReadCommands(const Scene& scene);
   // One Box2D step of dt seconds: traction impulses, b2World::Step, then the
   // contact-made velocity change of each wheeled body.
-  void Substep(double dt);
+  void Substep(double dt, double /*fraction*/);
   // Writes body poses and velocities. Wheel joint positions are not written:
   // World::Actuate already advances every velocity-mode joint kinematically.
   void WriteBack(Scene* scene);

@@ -464,7 +464,7 @@ void OdeWorld::SyncFromScene(const Scene& scene, double duration) {
   }
 }
 
-void OdeWorld::ReadJointCommands(const Scene& scene) {
+void OdeWorld::ReadCommands(const Scene& scene) {
   for (size_t k = 0; k < joints_.size(); ++k) commands_[k] = scene.joints()[joints_[k].row];
 }
 

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <string_view>
 #include <vector>
 
 #include "framework/dynamics_backend.h"
@@ -67,6 +68,12 @@ struct GeomInfo {    // 24 bytes
 
 class OdeWorld {
  public:
+  // For EngineBackend (engine_backend.h), which runs the step below.
+  using Options = ode::Options;
+  static constexpr std::string_view kName = "ode";
+  // SyncFromScene divides by the step's duration: no substeps, no step.
+  static constexpr bool kIdleWithoutSubsteps = true;
+
   OdeWorld(const Options& options, const DynamicsSettings& settings);
   ~OdeWorld();
   OdeWorld(const OdeWorld&) = delete;
@@ -77,10 +84,11 @@ class OdeWorld {
   // Moves bodies teleported by scripts and reads the kinematic bodies' new
   // poses (to be reached over `duration` seconds).
   void SyncFromScene(const Scene& scene, double duration);
-  // Sets motors from the joint commands (targets, forces).
-  void ReadJointCommands(const Scene& scene);
-  // One ODE step of `dt`; `fraction` (0..1] is how far through the control
-  // step its end is (kinematic bodies are placed accordingly).
+  // Reads the joint commands (targets, forces) that set the motors.
+  void ReadCommands(const Scene& scene);
+  // One ODE step of `dt`; `fraction` in [0, 1] is how far through the control
+  // step it starts (kinematic bodies are placed there and move at their
+  // step's velocity).
   void Substep(double dt, double fraction);
   void WriteBack(Scene* scene);
   void Hash(StateHasher* hasher) const;
