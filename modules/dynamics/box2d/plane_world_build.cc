@@ -16,10 +16,13 @@
 #include "framework/error.h"
 #include "framework/scene.h"
 #include "modules/dynamics/box2d/plane_world.h"
+#include "modules/dynamics/scene_walk.h"
 
 namespace swarmsim::box2d {
 
 namespace {
+
+using dynamics::ShapeAt;
 
 // A wheel axis counts as horizontal when its vertical component is below this
 // (about 0.06 degrees of tilt).
@@ -183,19 +186,6 @@ void ThrowIfNotFinite(const Scene& scene, uint32_t slot, const Pose& X) {
       throw Error("box2d: shape '" + PathAt(scene, slot) + "' has a non-finite pose");
 }
 
-// The shape at a slot, or null if the slot holds no live shape.
-const ShapeData* ShapeAt(const Scene& scene, uint32_t slot) {
-  if (!scene.alive_at(slot) || scene.type_at(slot) != ObjectType::kShape) return nullptr;
-  return &scene.shapes()[scene.row_at(slot)];
-}
-
-// Nearest dynamic ancestor of a slot (its body index in `body_of`), or -1.
-int32_t DynamicAncestor(const Scene& scene, const std::vector<int32_t>& body_of, uint32_t slot) {
-  for (int32_t p = scene.parent_at(slot); p >= 0; p = scene.parent_at(static_cast<uint32_t>(p)))
-    if (body_of[p] >= 0) return body_of[p];
-  return -1;
-}
-
 // A wheel joint's wheel: its first non-dynamic round child, or null.
 const ShapeData* WheelShapeOf(const Scene& scene, uint32_t joint_slot) {
   for (ObjectId child : scene.children(scene.IdAt(joint_slot))) {
@@ -334,7 +324,8 @@ void PlaneWorld::BuildObstacles(const Scene& scene, const std::vector<int32_t>& 
                                 const HeightRange& dynamic_range) {
   for (uint32_t s = 0; s < scene.slot_count(); ++s) {
     const ShapeData* shape = ShapeAt(scene, s);
-    if (!shape || shape->dynamic || DynamicAncestor(scene, body_of, s) >= 0) continue;
+    if (!shape || shape->dynamic || dynamics::NearestBodyAbove(scene, body_of, s, -1) >= 0)
+      continue;
     const Pose& X_WS = scene.world_pose_at(s);
     ThrowIfNotFinite(scene, s, X_WS);
     const HeightRange range = CalcHeightRange(*shape, X_WS);
@@ -406,7 +397,7 @@ void PlaneWorld::BuildWheels(const Scene& scene, const std::vector<int32_t>& bod
     if (!scene.alive_at(s) || scene.type_at(s) != ObjectType::kJoint) continue;
     const JointData& joint = scene.joints()[scene.row_at(s)];
     if (joint.type != JointType::kRevolute || joint.mode != JointMode::kVelocity) continue;
-    const int32_t b = DynamicAncestor(scene, body_of, s);
+    const int32_t b = dynamics::NearestBodyAbove(scene, body_of, s, -1);
     if (b < 0) continue;
     const ShapeData* wheel_shape = WheelShapeOf(scene, s);
     if (!wheel_shape) continue;

@@ -12,10 +12,13 @@
 #include "framework/error.h"
 #include "framework/scene.h"
 #include "framework/state_hash.h"
+#include "modules/dynamics/scene_walk.h"
 
 namespace swarmsim::ode {
 
 namespace {
+
+using dynamics::ShapeAt;
 
 // Restitution applies above this approach speed, m/s (as in the Box2D backend).
 constexpr double kBounceVelocity = 0.1;
@@ -143,12 +146,6 @@ Pose Interpolate(const Pose& a, const Pose& b, double f) {
   return {a.p + (b.p - a.p) * f, q.Normalized()};
 }
 
-// The shape at a slot, or null if the slot holds no live shape.
-const ShapeData* ShapeAt(const Scene& scene, uint32_t slot) {
-  if (!scene.alive_at(slot) || scene.type_at(slot) != ObjectType::kShape) return nullptr;
-  return &scene.shapes()[scene.row_at(slot)];
-}
-
 // What carries a non-dynamic shape: the body of its nearest dynamic ancestor
 // when no joint or force sensor lies between them (the shape is a part of
 // it), else none; and whether a joint or force sensor lies above it on the
@@ -170,32 +167,6 @@ Carrier CarrierOf(const Scene& scene, const std::vector<dBodyID>& body_of, uint3
     }
   }
   return carrier;
-}
-
-// The first dynamic shape below a slot in depth-first order, not across a
-// joint or force sensor: its slot, or -1.
-int32_t FirstDynamicShapeBelow(const Scene& scene, uint32_t slot) {
-  std::vector<uint32_t> stack;
-  for (ObjectId c : scene.children(scene.IdAt(slot))) stack.push_back(c.index());
-  std::reverse(stack.begin(), stack.end());
-  while (!stack.empty()) {
-    const uint32_t c = stack.back();
-    stack.pop_back();
-    if (scene.type_at(c) == ObjectType::kJoint || scene.type_at(c) == ObjectType::kForceSensor)
-      continue;
-    const ShapeData* shape = ShapeAt(scene, c);
-    if (shape && shape->dynamic) return static_cast<int32_t>(c);
-    std::vector<ObjectId> grand = scene.children(scene.IdAt(c));
-    for (auto it = grand.rbegin(); it != grand.rend(); ++it) stack.push_back(it->index());
-  }
-  return -1;
-}
-
-// The nearest body (dynamic or kinematic) above a slot, or null (the world).
-dBodyID NearestBodyAbove(const Scene& scene, const std::vector<dBodyID>& body_of, uint32_t slot) {
-  for (int32_t p = scene.parent_at(slot); p >= 0; p = scene.parent_at(static_cast<uint32_t>(p)))
-    if (body_of[p]) return body_of[p];
-  return nullptr;
 }
 
 }  // namespace
@@ -379,10 +350,11 @@ void OdeWorld::BuildJoints(const Scene& scene, const std::vector<dBodyID>& body_
   for (uint32_t s = 0; s < scene.slot_count(); ++s) {
     if (!scene.alive_at(s) || scene.type_at(s) != ObjectType::kJoint) continue;
     // Child: the first dynamic shape below, not across another joint.
-    const int32_t child_slot = FirstDynamicShapeBelow(scene, s);
+    const int32_t child_slot = dynamics::FirstDynamicShapeBelow(scene, s);
     if (child_slot < 0) continue;  // stays kinematic
     // Parent: the nearest body above (dynamic or kinematic), else the world.
-    AddJoint(scene, s, body_of[child_slot], NearestBodyAbove(scene, body_of, s));
+    AddJoint(scene, s, body_of[child_slot],
+             dynamics::NearestBodyAbove<dBodyID>(scene, body_of, s, nullptr));
   }
 }
 
