@@ -89,22 +89,13 @@
 
 #include "framework/dynamics_backend.h"
 #include "framework/registry.h"
+#include "modules/dynamics/box2d/box2d_options.h"
 
 namespace swarmsim {
 class Scene;
 }
 
 namespace swarmsim::box2d {
-
-// Box2D units per metre; see "Length scale" above.
-inline constexpr double kDefaultLengthScale = 10.0;
-
-struct Options {
-  double length_scale = kDefaultLengthScale;  // Box2D units per metre
-  int velocity_iterations = 8;                // Box2D's contact solver
-  int position_iterations = 3;
-  int traction_iterations = 4;  // Gauss-Seidel passes over a body's wheels
-};
 
 swarmsim::ModuleInfo ModuleInfo();
 std::unique_ptr<DynamicsBackend> MakeBackend();

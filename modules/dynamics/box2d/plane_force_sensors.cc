@@ -2,48 +2,25 @@
 // reaction force and torque (in-plane force, torque about z).
 #include <box2d/b2_weld_joint.h>
 
-#include <algorithm>
 #include <vector>
 
 #include "framework/force_sensor.h"
 #include "framework/scene.h"
 #include "modules/dynamics/box2d/plane_world.h"
+#include "modules/dynamics/scene_walk.h"
 
 namespace swarmsim::box2d {
 
 void PlaneWorld::BuildForceSensors(const Scene& scene, const std::vector<int32_t>& body_of) {
   const auto owners = scene.force_sensor_owners();
-  std::vector<uint32_t> rows(owners.size());
-  for (uint32_t r = 0; r < rows.size(); ++r) rows[r] = r;
-  std::sort(rows.begin(), rows.end(),
-            [&](uint32_t a, uint32_t b) { return owners[a] < owners[b]; });
-  for (uint32_t row : rows) {
+  for (uint32_t row : dynamics::ForceSensorRowsInSlotOrder(scene)) {
     const uint32_t s = owners[row];
     if (scene.force_sensors()[row].broken) continue;
-    // Child: the first dynamic shape below, not across a joint or another sensor.
-    int32_t child = -1;
-    std::vector<uint32_t> stack;
-    std::vector<ObjectId> kids = scene.children(scene.IdAt(s));
-    for (auto it = kids.rbegin(); it != kids.rend(); ++it) stack.push_back(it->index());
-    while (!stack.empty() && child < 0) {
-      const uint32_t c = stack.back();
-      stack.pop_back();
-      const ObjectType type = scene.type_at(c);
-      if (type == ObjectType::kJoint || type == ObjectType::kForceSensor) continue;
-      if (body_of[c] >= 0) {
-        child = body_of[c];
-        break;
-      }
-      std::vector<ObjectId> grand = scene.children(scene.IdAt(c));
-      for (auto it = grand.rbegin(); it != grand.rend(); ++it) stack.push_back(it->index());
-    }
-    if (child < 0) continue;
-    b2Body* parent = ground_;
-    for (int32_t p = scene.parent_at(s); p >= 0; p = scene.parent_at(static_cast<uint32_t>(p)))
-      if (body_of[p] >= 0) {
-        parent = bodies_[body_of[p]].body;
-        break;
-      }
+    const int32_t child_slot = dynamics::FirstDynamicShapeBelow(scene, s);
+    if (child_slot < 0) continue;  // nothing dynamic to hold: no reading
+    const int32_t child = body_of[child_slot];
+    const int32_t above = dynamics::NearestBodyAbove(scene, body_of, s, -1);
+    b2Body* parent = above >= 0 ? bodies_[above].body : ground_;
     const Vec3& p_WS = scene.world_pose_at(s).p;
     b2WeldJointDef def;
     def.Initialize(

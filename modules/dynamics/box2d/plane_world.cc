@@ -1,11 +1,10 @@
+// PlaneWorld: stepping (traction, Box2D), write-back and hashing. Build is in
+// plane_world_build.cc, force sensors in plane_force_sensors.cc.
 #include "modules/dynamics/box2d/plane_world.h"
 
 #include <box2d/b2_body.h>
-#include <box2d/b2_circle_shape.h>
 #include <box2d/b2_contact.h>
-#include <box2d/b2_fixture.h>
-#include <box2d/b2_friction_joint.h>
-#include <box2d/b2_polygon_shape.h>
+#include <box2d/b2_joint.h>
 
 #include <algorithm>
 #include <bit>
@@ -23,180 +22,15 @@ namespace swarmsim::box2d {
 
 namespace {
 
-// A wheel axis counts as horizontal when its vertical component is below this
-// (about 0.06 degrees of tilt).
-constexpr double kHorizontalTolerance = 1e-3;
-// A shape whose z axis is this close to vertical is "upright".
-constexpr double kUprightTolerance = 1e-6;
-// Static shapes must reach this far into the dynamic shapes' height range to
-// be obstacles (a floor whose top touches the robots' bottom is not one), m.
-constexpr double kHeightOverlap = 1e-3;
-// Restitution applies above this approach speed, m/s (Box2D's default is
-// 1 unit/s, i.e. 0.1 m/s at the default scale; keep that whatever the scale).
-constexpr double kRestitutionThreshold = 0.1;
 // Traction passes stop when no wheel's impulse changes by more than this
 // fraction of its Coulomb limit.
 constexpr double kConverged = 1e-6;
-
-// Height range [lo, hi] of a shape at pose X_WS, m.
-struct HeightRange {
-  double lo, hi;
-};
-HeightRange CalcHeightRange(const ShapeData& shape, const Pose& X_WS) {
-  const double z = X_WS.p.z;
-  if (shape.kind == ShapeKind::kMesh && shape.mesh) {  // exact over the vertices
-    HeightRange range{std::numeric_limits<double>::infinity(),
-                      -std::numeric_limits<double>::infinity()};
-    for (const Vec3& v : shape.mesh->vertices()) {
-      const double vz = (X_WS * v).z;
-      range = {std::min(range.lo, vz), std::max(range.hi, vz)};
-    }
-    return range;
-  }
-  if (shape.kind == ShapeKind::kSphere) return {z - shape.size.x, z + shape.size.x};
-  // Half extents along the shape's axes; the vertical extent is the sum of
-  // their projections on world z.
-  const Vec3 half = shape.kind == ShapeKind::kBox
-                        ? shape.size * 0.5
-                        : Vec3{shape.size.x, shape.size.x, shape.size.z * 0.5};
-  const Vec3 ax = X_WS.q.Rotate({1, 0, 0}), ay = X_WS.q.Rotate({0, 1, 0}),
-             az = X_WS.q.Rotate({0, 0, 1});
-  double h;
-  if (shape.kind == ShapeKind::kBox) {
-    h = half.x * std::abs(ax.z) + half.y * std::abs(ay.z) + half.z * std::abs(az.z);
-  } else {  // cylinder: the axis part plus the disc's radius across
-    h = half.z * std::abs(az.z) + shape.size.x * std::sqrt(std::max(0.0, 1 - az.z * az.z));
-  }
-  return {z - h, z + h};
-}
-
-bool IsUpright(const Pose& X_WS) {
-  return std::abs(X_WS.q.Rotate({0, 0, 1}).z) > 1 - kUprightTolerance;
-}
-
-// Area-preserving footprint radius of a shape, m.
-double FootprintRadius(const ShapeData& shape) {
-  if (shape.kind == ShapeKind::kBox) return std::sqrt(shape.size.x * shape.size.y / M_PI);
-  if (shape.kind == ShapeKind::kMesh && shape.mesh) {  // of its bounding box
-    const Vec3 e = shape.mesh->hi() - shape.mesh->lo();
-    return std::sqrt(e.x * e.y / M_PI);
-  }
-  return shape.size.x;
-}
-
-// Moment of inertia about the vertical axis through the centre, kg m^2.
-double CalcInertia(const ShapeData& shape) {
-  const double m = shape.mass;
-  switch (shape.kind) {
-    case ShapeKind::kBox:
-      return m * (shape.size.x * shape.size.x + shape.size.y * shape.size.y) / 12;
-    case ShapeKind::kCylinder:
-    case ShapeKind::kCapsule:
-      return 0.5 * m * shape.size.x * shape.size.x;  // capsule: as its cylinder
-    case ShapeKind::kSphere: return 0.4 * m * shape.size.x * shape.size.x;
-    case ShapeKind::kMesh: {  // its bounding box's, about the shape's origin
-      const Vec3 lo = shape.mesh ? shape.mesh->lo() : shape.size * -0.5;
-      const Vec3 hi = shape.mesh ? shape.mesh->hi() : shape.size * 0.5;
-      const Vec3 e = hi - lo, c = (lo + hi) * 0.5;
-      return m * (e.x * e.x + e.y * e.y) / 12 + m * (c.x * c.x + c.y * c.y);
-    }
-  }
-  return 0;
-}
-
-// A rectangle of half extents (hx, hy) units, shrunk by the polygon skin so
-// that the collision surface is the real face (when the box is big enough).
-void SetSkinnedBox(double hx, double hy, const b2Vec2& center, double angle, b2PolygonShape* out) {
-  const double r = b2_polygonRadius;
-  if (hx > 2 * r && hy > 2 * r) {
-    hx -= r;
-    hy -= r;
-  }
-  out->SetAsBox(static_cast<float>(hx), static_cast<float>(hy), center, static_cast<float>(angle));
-}
-
-// A point in the plane, Box2D units.
-struct PlanePoint {
-  double x, y;
-};
-
-// The convex hull of `points` as convex polygons of at most
-// b2_maxPolygonVertices (a fan cut of the hull: exact, not simplified), with
-// the vertices Box2D would weld dropped first, so that b2PolygonShape::Set
-// never sees a collapsed hull (it asserts). No skin correction: the
-// collision surface is the hull grown by b2_polygonRadius. False when the
-// hull has no area.
-bool HullPolygons(std::vector<PlanePoint> points, std::vector<b2PolygonShape>* out) {
-  using P = PlanePoint;
-  std::sort(points.begin(), points.end(),
-            [](const P& a, const P& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
-  // Andrew's monotone chain, counter-clockwise, collinear points dropped.
-  auto cross = [](const P& o, const P& a, const P& b) {
-    return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
-  };
-  std::vector<P> hull(2 * points.size() + 1);
-  size_t k = 0;
-  for (size_t i = 0; i < points.size(); ++i) {
-    while (k >= 2 && cross(hull[k - 2], hull[k - 1], points[i]) <= 0) --k;
-    hull[k++] = points[i];
-  }
-  for (size_t i = points.size() - 1, lower = k + 1; i-- > 0;) {
-    while (k >= lower && cross(hull[k - 2], hull[k - 1], points[i]) <= 0) --k;
-    hull[k++] = points[i];
-  }
-  hull.resize(k > 0 ? k - 1 : 0);
-  // Drop vertices Box2D would weld (closer than a linear slop).
-  const double weld = b2_linearSlop;
-  std::vector<b2Vec2> kept;
-  for (const P& p : hull) {
-    if (!kept.empty() && std::hypot(p.x - kept.back().x, p.y - kept.back().y) < weld) continue;
-    kept.emplace_back(static_cast<float>(p.x), static_cast<float>(p.y));
-  }
-  while (kept.size() > 1 && b2Distance(kept.front(), kept.back()) < weld) kept.pop_back();
-  if (kept.size() < 3) return false;
-  double area = 0;
-  for (size_t i = 0; i < kept.size(); ++i) area += b2Cross(kept[i], kept[(i + 1) % kept.size()]);
-  if (area * 0.5 < 4 * b2_linearSlop * b2_linearSlop) return false;
-  // Fan pieces: vertex 0 with up to 7 consecutive others.
-  const size_t n = kept.size();
-  for (size_t j = 1; j + 1 < n; j += b2_maxPolygonVertices - 2) {
-    b2Vec2 piece[b2_maxPolygonVertices];
-    int count = 0;
-    piece[count++] = kept[0];
-    for (size_t i = j; i < n && count < b2_maxPolygonVertices; ++i) piece[count++] = kept[i];
-    out->emplace_back();
-    out->back().Set(piece, count);
-  }
-  return true;
-}
-
-// A mesh in the plane: the hull of its vertices projected by X (mesh frame
-// -> plane frame, metres), L units per metre (HullPolygons).
-bool MeshPolygons(const TriangleMesh& mesh, const Pose& X, double L,
-                  std::vector<b2PolygonShape>* out) {
-  std::vector<PlanePoint> points;
-  points.reserve(mesh.vertices().size());
-  for (const Vec3& v : mesh.vertices()) {
-    const Vec3 p = X * v;
-    points.push_back({p.x * L, p.y * L});
-  }
-  return HullPolygons(std::move(points), out);
-}
-
-std::string PathAt(const Scene& scene, uint32_t slot) { return scene.PathOf(scene.IdAt(slot)); }
 
 // True when `q` is (s, c) bit for bit (so +0 and -0 differ: atan2 tells them
 // apart) and not NaN (the "not known" mark).
 bool SameRotation(const b2Rot& q, float s, float c) {
   return q.s == s && q.c == c && std::bit_cast<uint32_t>(q.s) == std::bit_cast<uint32_t>(s) &&
          std::bit_cast<uint32_t>(q.c) == std::bit_cast<uint32_t>(c);
-}
-
-void ThrowIfNotFinite(const Scene& scene, uint32_t slot, const Pose& X) {
-  const double values[] = {X.p.x, X.p.y, X.p.z, X.q.w, X.q.x, X.q.y, X.q.z};
-  for (double v : values)
-    if (!std::isfinite(v))
-      throw Error("box2d: shape '" + PathAt(scene, slot) + "' has a non-finite pose");
 }
 
 }  // namespace
@@ -218,263 +52,7 @@ PlaneWorld::PlaneWorld(const Options& options, const DynamicsSettings& settings)
 
 PlaneWorld::~PlaneWorld() = default;
 
-void PlaneWorld::Build(const Scene& scene) {
-  world_ = std::make_unique<b2World>(b2Vec2(0, 0));  // top-down: no gravity in the plane
-  bodies_.clear();
-  body_poses_.clear();
-  wheeled_.clear();
-  wheels_.clear();
-  force_sensors_.clear();
-  const double L = scale_;
-  const double g = settings_.gravity;
-
-  b2BodyDef ground_def;
-  ground_ = world_->CreateBody(&ground_def);
-
-  const uint32_t slots = scene.slot_count();
-  auto shape_at = [&](uint32_t s) -> const ShapeData* {
-    if (!scene.alive_at(s) || scene.type_at(s) != ObjectType::kShape) return nullptr;
-    return &scene.shapes()[scene.row_at(s)];
-  };
-
-  // 1. A body per dynamic shape, in slot order.
-  std::vector<int32_t> body_of(slots, -1);  // body index of a dynamic shape (slots)
-  double dynamic_lo = std::numeric_limits<double>::infinity();
-  double dynamic_hi = -dynamic_lo;
-  for (uint32_t s = 0; s < slots; ++s) {
-    const ShapeData* shape = shape_at(s);
-    if (!shape || !shape->dynamic) continue;
-    const Pose& X_WS = scene.world_pose_at(s);
-    ThrowIfNotFinite(scene, s, X_WS);
-    const bool box = shape->kind == ShapeKind::kBox;
-    if (!(shape->mass > 0) || !(shape->size.x > 0) || (box && !(shape->size.y > 0)) ||
-        !std::isfinite(shape->mass))
-      throw Error("box2d: dynamic shape '" + PathAt(scene, s) +
-                  "' needs a positive mass and size (mass " + std::to_string(shape->mass) +
-                  " kg, size x " + std::to_string(shape->size.x) + " m)");
-    const HeightRange range = CalcHeightRange(*shape, X_WS);
-    dynamic_lo = std::min(dynamic_lo, range.lo);
-    dynamic_hi = std::max(dynamic_hi, range.hi);
-
-    const double yaw = X_WS.q.Yaw();
-    b2BodyDef def;
-    def.type = b2_dynamicBody;
-    def.position.Set(static_cast<float>(X_WS.p.x * L), static_cast<float>(X_WS.p.y * L));
-    def.angle = static_cast<float>(yaw);
-    const Vec3& v_WS = scene.linear_velocity_at(s);
-    def.linearVelocity.Set(static_cast<float>(v_WS.x * L), static_cast<float>(v_WS.y * L));
-    def.angularVelocity = static_cast<float>(scene.angular_velocity_at(s).z);
-    b2Body* body = world_->CreateBody(&def);
-
-    // The fixture's density gives the body the shape's mass (Box2D ignores
-    // the polygon skin in its mass); the inertia is then set to the real
-    // shape's below.
-    b2FixtureDef fixture;
-    fixture.friction = static_cast<float>(shape->friction);
-    fixture.restitution = static_cast<float>(shape->restitution);
-    fixture.restitutionThreshold = static_cast<float>(kRestitutionThreshold * L);
-    b2CircleShape circle;
-    b2PolygonShape polygon;
-    std::vector<b2PolygonShape> pieces;  // a mesh's hull
-    if (shape->kind == ShapeKind::kMesh) {
-      // In the body's plane frame: the shape's tilt applied, its yaw not.
-      const Pose X_PS{{}, (Quat::FromYaw(-yaw) * X_WS.q).Normalized()};
-      if (!shape->mesh || !MeshPolygons(*shape->mesh, X_PS, L, &pieces))
-        throw Error("box2d: dynamic mesh '" + PathAt(scene, s) +
-                    "' has no area seen from above (its hull in the plane is degenerate)");
-      fixture.density = 1;  // the mass is set below
-      for (size_t i = 0; i + 1 < pieces.size(); ++i) {
-        fixture.shape = &pieces[i];
-        body->CreateFixture(&fixture);
-      }
-      fixture.shape = &pieces.back();
-    } else if (box) {
-      SetSkinnedBox(0.5 * shape->size.x * L, 0.5 * shape->size.y * L, b2Vec2(0, 0), 0, &polygon);
-      b2MassData unit;
-      polygon.ComputeMass(&unit, 1.0f);
-      fixture.shape = &polygon;
-      fixture.density = static_cast<float>(shape->mass / unit.mass);
-    } else {
-      circle.m_radius = static_cast<float>(shape->size.x * L);
-      fixture.shape = &circle;
-      fixture.density =
-          static_cast<float>(shape->mass / (M_PI * circle.m_radius * circle.m_radius));
-    }
-    body->CreateFixture(&fixture);
-    b2MassData mass;
-    mass.mass = static_cast<float>(shape->mass);
-    mass.center.SetZero();
-    mass.I = static_cast<float>(CalcInertia(*shape) * L * L);
-    body->SetMassData(&mass);
-
-    body_of[s] = static_cast<int32_t>(bodies_.size());
-    PlaneBody plane_body;
-    plane_body.body = body;
-    plane_body.slot = s;
-    plane_body.inverse_mass = body->GetMass() > 0 ? 1.0 / body->GetMass() : 0.0;
-    plane_body.inverse_inertia = body->GetInertia() > 0 ? 1.0 / body->GetInertia() : 0.0;
-    bodies_.push_back(plane_body);
-    PlaneBodyPose pose;
-    pose.z = X_WS.p.z;
-    pose.q_tilt = (Quat::FromYaw(-yaw) * X_WS.q).Normalized();
-    pose.X_WB_last = X_WS;
-    body_poses_.push_back(pose);
-  }
-  // Nearest dynamic ancestor of a slot (its body), or -1.
-  auto dynamic_ancestor = [&](uint32_t s) -> int32_t {
-    for (int32_t p = scene.parent_at(s); p >= 0; p = scene.parent_at(static_cast<uint32_t>(p)))
-      if (body_of[p] >= 0) return body_of[p];
-    return -1;
-  };
-
-  // 2. Obstacles: non-dynamic shapes that are not parts of a body, projected
-  // to the plane, as fixtures of the ground body.
-  for (uint32_t s = 0; s < slots && !bodies_.empty(); ++s) {
-    const ShapeData* shape = shape_at(s);
-    if (!shape || shape->dynamic || dynamic_ancestor(s) >= 0) continue;
-    const Pose& X_WS = scene.world_pose_at(s);
-    ThrowIfNotFinite(scene, s, X_WS);
-    const HeightRange range = CalcHeightRange(*shape, X_WS);
-    if (range.hi <= dynamic_lo + kHeightOverlap || range.lo >= dynamic_hi - kHeightOverlap)
-      continue;
-    b2FixtureDef fixture;
-    fixture.friction = static_cast<float>(shape->friction);
-    fixture.restitution = static_cast<float>(shape->restitution);
-    fixture.restitutionThreshold = static_cast<float>(kRestitutionThreshold * L);
-    const b2Vec2 center(static_cast<float>(X_WS.p.x * L), static_cast<float>(X_WS.p.y * L));
-    b2CircleShape circle;
-    b2PolygonShape polygon;
-    const bool round =
-        shape->kind == ShapeKind::kSphere ||
-        ((shape->kind == ShapeKind::kCylinder || shape->kind == ShapeKind::kCapsule) &&
-         IsUpright(X_WS));
-    // A mesh, or a tilted box or lying cylinder: the hull of the points
-    // projected to the plane, in pieces (none: no area seen from above).
-    std::vector<b2PolygonShape> pieces;
-    const auto add_pieces = [&] {
-      for (const b2PolygonShape& piece : pieces) {
-        fixture.shape = &piece;
-        ground_->CreateFixture(&fixture);
-      }
-    };
-    if (shape->kind == ShapeKind::kMesh) {
-      if (shape->mesh && MeshPolygons(*shape->mesh, X_WS, L, &pieces)) add_pieces();
-      continue;
-    }
-    if (round) {
-      if (!(shape->size.x > 0)) continue;
-      circle.m_p = center;
-      circle.m_radius = static_cast<float>(shape->size.x * L);
-      fixture.shape = &circle;
-    } else {
-      // Box extents; a lying cylinder is taken as its bounding box.
-      const Vec3 size = shape->kind == ShapeKind::kBox
-                            ? shape->size
-                            : Vec3{2 * shape->size.x, 2 * shape->size.x, shape->size.z};
-      if (!(size.x > 0 && size.y > 0 && size.z >= 0)) continue;
-      if (IsUpright(X_WS)) {
-        SetSkinnedBox(0.5 * size.x * L, 0.5 * size.y * L, center, X_WS.q.Yaw(), &polygon);
-      } else {
-        // Tilted: the hull of the eight projected corners (a vertical sheet
-        // seen edge on has none and is skipped).
-        std::vector<PlanePoint> corners;
-        for (int i = 0; i < 8; ++i) {
-          const Vec3 p_SC{(i & 1 ? 0.5 : -0.5) * size.x, (i & 2 ? 0.5 : -0.5) * size.y,
-                          (i & 4 ? 0.5 : -0.5) * size.z};
-          const Vec3 p_WC = X_WS * p_SC;
-          corners.push_back({p_WC.x * L, p_WC.y * L});
-        }
-        if (HullPolygons(std::move(corners), &pieces)) add_pieces();
-        continue;
-      }
-      fixture.shape = &polygon;
-    }
-    ground_->CreateFixture(&fixture);
-  }
-
-  // 3. Wheels: velocity-mode revolute joints under a body, with a horizontal
-  // axis and a round child, in slot order, then grouped by body.
-  for (uint32_t s = 0; s < slots; ++s) {
-    if (!scene.alive_at(s) || scene.type_at(s) != ObjectType::kJoint) continue;
-    const JointData& joint = scene.joints()[scene.row_at(s)];
-    if (joint.type != JointType::kRevolute || joint.mode != JointMode::kVelocity) continue;
-    const int32_t b = dynamic_ancestor(s);
-    if (b < 0) continue;
-    // The first non-dynamic round child is the wheel.
-    const ShapeData* wheel_shape = nullptr;
-    for (ObjectId child : scene.children(scene.IdAt(s))) {
-      const ShapeData* shape = shape_at(child.index());
-      if (shape && !shape->dynamic && shape->kind != ShapeKind::kBox &&
-          shape->kind != ShapeKind::kMesh && shape->size.x > 0) {
-        wheel_shape = shape;
-        break;
-      }
-    }
-    if (!wheel_shape) continue;
-    const double radius = wheel_shape->size.x;
-    // Joint position and axis in the body's plane frame (yaw only).
-    const PlaneBody& body = bodies_[b];
-    const Pose& X_WB = scene.world_pose_at(body.slot);
-    const Pose& X_WJ = scene.world_pose_at(s);
-    const Quat q_PW = Quat::FromYaw(-X_WB.q.Yaw());
-    const Vec3 p_BJ = q_PW.Rotate(X_WJ.p - X_WB.p);
-    const Vec3 axis = q_PW.Rotate(X_WJ.q.Rotate({0, 0, 1}));
-    if (std::abs(axis.z) > kHorizontalTolerance) continue;
-    const Vec3 forward = axis.Cross({0, 0, 1}).Normalized();  // (a_y, -a_x, 0)
-    PlaneWheel wheel;
-    wheel.body = static_cast<uint32_t>(b);
-    wheel.joint_slot = s;
-    wheel.p_x = p_BJ.x * L;
-    wheel.p_y = p_BJ.y * L;
-    wheel.f_x = forward.x;
-    wheel.f_y = forward.y;
-    wheel.radius_m = radius;
-    wheel.coulomb_rate = wheel_shape->friction;  // times m g / n below
-    wheel.motor_rate = std::max(0.0, joint.max_force) / radius * L;
-    // Inverse effective mass at the contact point: K = [m^-1 + I^-1 py^2, -I^-1 px py;
-    // -I^-1 px py, m^-1 + I^-1 px^2], inverted.
-    const double im = body.inverse_mass, ii = body.inverse_inertia;
-    const double k11 = im + ii * wheel.p_y * wheel.p_y, k22 = im + ii * wheel.p_x * wheel.p_x;
-    const double k12 = -ii * wheel.p_x * wheel.p_y;
-    const double det = k11 * k22 - k12 * k12;
-    wheel.k_xx = k22 / det;
-    wheel.k_xy = -k12 / det;
-    wheel.k_yy = k11 / det;
-    wheels_.push_back(wheel);
-  }
-  std::stable_sort(wheels_.begin(), wheels_.end(),
-                   [](const PlaneWheel& a, const PlaneWheel& b) { return a.body < b.body; });
-  for (uint32_t w = 0; w < wheels_.size(); ++w) {
-    PlaneBody& body = bodies_[wheels_[w].body];
-    if (body.wheel_count == 0) body.first_wheel = w;
-    ++body.wheel_count;
-  }
-  for (uint32_t b = 0; b < bodies_.size(); ++b) {
-    PlaneBody& body = bodies_[b];
-    const ShapeData& shape = scene.shapes()[scene.row_at(body.slot)];
-    if (body.wheel_count > 0) {
-      // Each wheel carries an equal share of the weight.
-      wheeled_.push_back(b);
-      const double load = shape.mass * g / body.wheel_count;
-      for (uint32_t w = body.first_wheel; w < body.first_wheel + body.wheel_count; ++w)
-        wheels_[w].coulomb_rate *= load * L;
-      continue;
-    }
-    // 4. No wheels: Coulomb friction with the ground (a disc of uniform
-    // pressure resists turning with 2/3 mu m g r).
-    b2FrictionJointDef def;
-    def.Initialize(ground_, body.body, body.body->GetWorldCenter());
-    def.collideConnected = true;  // the obstacles are ground fixtures: still walls to it
-    const double force = shape.friction * shape.mass * g;
-    def.maxForce = static_cast<float>(force * L);
-    def.maxTorque = static_cast<float>(2.0 / 3.0 * force * FootprintRadius(shape) * L * L);
-    world_->CreateJoint(&def);
-  }
-  // 5. Force sensors.
-  if (!scene.force_sensors().empty()) BuildForceSensors(scene, body_of);
-}
-
-void PlaneWorld::SyncTeleports(const Scene& scene) {
+void PlaneWorld::SyncFromScene(const Scene& scene, double /*duration*/) {
   const double L = scale_;
   for (size_t b = 0; b < bodies_.size(); ++b) {
     PlaneBodyPose& pose = body_poses_[b];
@@ -493,7 +71,7 @@ void PlaneWorld::SyncTeleports(const Scene& scene) {
   }
 }
 
-void PlaneWorld::ReadWheelCommands(const Scene& scene) {
+void PlaneWorld::ReadCommands(const Scene& scene) {
   for (uint32_t b : wheeled_) bodies_[b].commanded = false;
   for (PlaneWheel& wheel : wheels_) {
     const JointData& joint = scene.joints()[scene.row_at(wheel.joint_slot)];
@@ -653,7 +231,7 @@ void PlaneWorld::ApplyTraction(std::span<const uint32_t> wheeled, double dt) {
   }
 }
 
-void PlaneWorld::Substep(double dt) {
+void PlaneWorld::Substep(double dt, double /*fraction*/) {
   last_dt_ = dt;
   ApplyTraction(dt);
   world_->Step(static_cast<float>(dt), options_.velocity_iterations, options_.position_iterations);

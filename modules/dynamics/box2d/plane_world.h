@@ -11,15 +11,18 @@
 #include <limits>
 #include <memory>
 #include <span>
+#include <string_view>
 #include <vector>
 
 #include "framework/dynamics_backend.h"
 #include "framework/math.h"
-#include "modules/dynamics/box2d/box2d_backend.h"
+#include "modules/dynamics/box2d/box2d_options.h"
 
 namespace swarmsim {
 class Scene;
 class StateHasher;
+struct JointData;
+struct ShapeData;
 }  // namespace swarmsim
 
 namespace swarmsim::box2d {
@@ -81,8 +84,18 @@ struct TractionSolve {      // 64 bytes
   double vx = 0, vy = 0, w = 0;  // velocity, body plane frame, Box2D units
 };
 
+// Height range [lo, hi] of shapes, m.
+struct HeightRange {
+  double lo, hi;
+};
+
 class PlaneWorld {
  public:
+  // For EngineBackend (engine_backend.h), which runs the step below.
+  using Options = box2d::Options;
+  static constexpr std::string_view kName = "box2d";
+  static constexpr bool kIdleWithoutSubsteps = false;
+
   PlaneWorld(const Options& options, const DynamicsSettings& settings);
   ~PlaneWorld();
   PlaneWorld(const PlaneWorld&) = delete;
@@ -91,14 +104,17 @@ class PlaneWorld {
   // Builds bodies, ground fixtures, wheels and ground friction from the scene
   // (discarding any previous world). Body velocities come from the scene.
   void Build(const Scene& scene);
+  // No joint is simulated: wheels drive by traction and World::Actuate
+  // advances their positions.
+  void MarkJoints(Scene* /*scene*/) const {}
   // Moves bodies whose scene pose differs from the last one written (set from
   // outside since the last step).
-  void SyncTeleports(const Scene& scene);
+  void SyncFromScene(const Scene& scene, double /*duration*/);
   // Reads each wheel's target velocity from its joint.
-  void ReadWheelCommands(const Scene& scene);
+  void ReadCommands(const Scene& scene);
   // One Box2D step of dt seconds: traction impulses, b2World::Step, then the
   // contact-made velocity change of each wheeled body.
-  void Substep(double dt);
+  void Substep(double dt, double /*fraction*/);
   // Writes body poses and velocities. Wheel joint positions are not written:
   // World::Actuate already advances every velocity-mode joint kinematically.
   void WriteBack(Scene* scene);
@@ -108,6 +124,24 @@ class PlaneWorld {
   int wheel_count() const { return static_cast<int>(wheels_.size()); }
 
  private:
+  // Build's phases, in order. 0: a fresh b2World and its ground body.
+  void Reset();
+  // 1. A body per dynamic shape, in slot order; fills body_of (slots) and
+  // returns the dynamic shapes' height range.
+  HeightRange BuildBodies(const Scene& scene, std::vector<int32_t>* body_of);
+  void AddBody(const Scene& scene, uint32_t slot, const ShapeData& shape, const Pose& X_WS);
+  // 2. Ground fixtures for the non-dynamic shapes that are no part of a body
+  // and reach into the dynamic range.
+  void BuildObstacles(const Scene& scene, const std::vector<int32_t>& body_of,
+                      const HeightRange& dynamic_range);
+  void AddObstacle(const ShapeData& shape, const Pose& X_WS);
+  // 3. Wheels, grouped by body, each with its share of the body's weight.
+  void BuildWheels(const Scene& scene, const std::vector<int32_t>& body_of);
+  void AddWheel(const Scene& scene, uint32_t joint_slot, const JointData& joint,
+                uint32_t body_index, const ShapeData& wheel_shape);
+  // 4. A ground friction joint for every body without wheels.
+  void BuildGroundFriction(const Scene& scene);
+
   // Traction impulses for every awake wheeled body, in blocks of
   // kTractionBlock bodies (the second form does one block).
   void ApplyTraction(double dt);

@@ -56,27 +56,17 @@
 // about that origin (ode_world.cc, CalcMass).
 #pragma once
 
-#include <cstdint>
 #include <memory>
 
 #include "framework/dynamics_backend.h"
 #include "framework/registry.h"
+#include "modules/dynamics/ode/ode_options.h"
 
 namespace swarmsim {
 class Scene;
 }
 
 namespace swarmsim::ode {
-
-struct Options {
-  int iterations = 40;         // quickstep iterations; 0: dWorldStep (exact, slower)
-  int max_contacts = 4;        // contact points per geom pair
-  bool ground_plane = true;    // a static plane at z = 0
-  double ground_friction = 1;  // Coulomb coefficient of the ground plane
-  double erp = 0.2;            // ODE's error reduction parameter
-  double cfm = 1e-6;           // ODE's constraint force mixing
-  uint32_t seed = 1;           // ODE's global random generator, at Build
-};
 
 swarmsim::ModuleInfo ModuleInfo();
 std::unique_ptr<DynamicsBackend> MakeBackend();

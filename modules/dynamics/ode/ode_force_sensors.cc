@@ -1,10 +1,10 @@
 // Force sensors in ODE: a fixed joint with dJointSetFeedback per sensor.
-#include <algorithm>
 #include <vector>
 
 #include "framework/force_sensor.h"
 #include "framework/scene.h"
 #include "modules/dynamics/ode/ode_world.h"
+#include "modules/dynamics/scene_walk.h"
 
 namespace swarmsim::ode {
 
@@ -20,38 +20,13 @@ Pose BodyPoseOf(dBodyID body) {
 
 void OdeWorld::BuildForceSensors(const Scene& scene, const std::vector<dBodyID>& body_of) {
   const auto owners = scene.force_sensor_owners();
-  // Slot order, like the joints, so the ODE joint list is the same every build.
-  std::vector<uint32_t> rows(owners.size());
-  for (uint32_t r = 0; r < rows.size(); ++r) rows[r] = r;
-  std::sort(rows.begin(), rows.end(),
-            [&](uint32_t a, uint32_t b) { return owners[a] < owners[b]; });
-  for (uint32_t row : rows) {
+  for (uint32_t row : dynamics::ForceSensorRowsInSlotOrder(scene)) {
     const uint32_t s = owners[row];
     if (scene.force_sensors()[row].broken) continue;
-    // Child: the first dynamic shape below, not across a joint or another sensor.
-    dBodyID child = nullptr;
-    std::vector<uint32_t> stack;
-    std::vector<ObjectId> kids = scene.children(scene.IdAt(s));
-    for (auto it = kids.rbegin(); it != kids.rend(); ++it) stack.push_back(it->index());
-    while (!stack.empty() && !child) {
-      const uint32_t c = stack.back();
-      stack.pop_back();
-      const ObjectType type = scene.type_at(c);
-      if (type == ObjectType::kJoint || type == ObjectType::kForceSensor) continue;
-      if (type == ObjectType::kShape && scene.shapes()[scene.row_at(c)].dynamic) {
-        child = body_of[c];
-        break;
-      }
-      std::vector<ObjectId> grand = scene.children(scene.IdAt(c));
-      for (auto it = grand.rbegin(); it != grand.rend(); ++it) stack.push_back(it->index());
-    }
-    if (!child) continue;  // nothing dynamic to hold: no reading
-    dBodyID parent = nullptr;
-    for (int32_t p = scene.parent_at(s); p >= 0; p = scene.parent_at(static_cast<uint32_t>(p)))
-      if (body_of[p]) {
-        parent = body_of[p];
-        break;
-      }
+    const int32_t child_slot = dynamics::FirstDynamicShapeBelow(scene, s);
+    if (child_slot < 0) continue;  // nothing dynamic to hold: no reading
+    const dBodyID child = body_of[child_slot];
+    const dBodyID parent = dynamics::NearestBodyAbove<dBodyID>(scene, body_of, s, nullptr);
     SimForceSensor f{};
     f.row = row;
     f.child_body = child;

@@ -12,10 +12,13 @@
 #include "framework/error.h"
 #include "framework/scene.h"
 #include "framework/state_hash.h"
+#include "modules/dynamics/scene_walk.h"
 
 namespace swarmsim::ode {
 
 namespace {
+
+using dynamics::ShapeAt;
 
 // Restitution applies above this approach speed, m/s (as in the Box2D backend).
 constexpr double kBounceVelocity = 0.1;
@@ -143,6 +146,29 @@ Pose Interpolate(const Pose& a, const Pose& b, double f) {
   return {a.p + (b.p - a.p) * f, q.Normalized()};
 }
 
+// What carries a non-dynamic shape: the body of its nearest dynamic ancestor
+// when no joint or force sensor lies between them (the shape is a part of
+// it), else none; and whether a joint or force sensor lies above it on the
+// way to that ancestor (or to the root).
+struct Carrier {
+  dBodyID body = nullptr;
+  bool below_joint = false;
+};
+Carrier CarrierOf(const Scene& scene, const std::vector<dBodyID>& body_of, uint32_t slot) {
+  Carrier carrier;
+  for (int32_t p = scene.parent_at(slot); p >= 0; p = scene.parent_at(static_cast<uint32_t>(p))) {
+    const uint32_t ps = static_cast<uint32_t>(p);
+    if (scene.type_at(ps) == ObjectType::kJoint || scene.type_at(ps) == ObjectType::kForceSensor)
+      carrier.below_joint = true;
+    const ShapeData* ancestor = ShapeAt(scene, ps);
+    if (ancestor && ancestor->dynamic) {
+      if (!carrier.below_joint) carrier.body = body_of[ps];
+      break;
+    }
+  }
+  return carrier;
+}
+
 }  // namespace
 
 OdeWorld::OdeWorld(const Options& options, const DynamicsSettings& settings)
@@ -221,6 +247,21 @@ dTriMeshDataID OdeWorld::MeshData(const std::shared_ptr<const TriangleMesh>& mes
 }
 
 void OdeWorld::Build(const Scene& scene) {
+  // 0. A fresh ODE world, collision space and contact group (and the ground plane).
+  CreateWorld(scene);
+  // 1. A body per dynamic shape, in slot order.
+  std::vector<dBodyID> body_of(scene.slot_count(), nullptr);  // dynamic or kinematic body (slots)
+  BuildBodies(scene, &body_of);
+  // 2. Non-dynamic shapes: parts of a body, kinematic bodies or static geoms.
+  BuildNonDynamicShapes(scene, &body_of);
+  // 3. Joints with a dynamic child body, in slot order.
+  BuildJoints(scene, body_of);
+  // 4. Force sensors.
+  if (!scene.force_sensors().empty()) BuildForceSensors(scene, body_of);
+  commands_.assign(joints_.size(), JointData{});
+}
+
+void OdeWorld::CreateWorld(const Scene& scene) {
   Clear();
   dAllocateODEDataForThread(dAllocateMaskAll);
   dRandSetSeed(options_.seed);
@@ -247,17 +288,11 @@ void OdeWorld::Build(const Scene& scene) {
   if (options_.ground_plane) {
     AddGeom(dCreatePlane(space_, 0, 0, 1, 0), -1, options_.ground_friction, 0);
   }
+}
 
-  const uint32_t slots = scene.slot_count();
-  auto shape_at = [&](uint32_t s) -> const ShapeData* {
-    if (!scene.alive_at(s) || scene.type_at(s) != ObjectType::kShape) return nullptr;
-    return &scene.shapes()[scene.row_at(s)];
-  };
-
-  // 1. A body per dynamic shape, in slot order.
-  std::vector<dBodyID> body_of(slots, nullptr);  // dynamic or kinematic body (slots)
-  for (uint32_t s = 0; s < slots; ++s) {
-    const ShapeData* shape = shape_at(s);
+void OdeWorld::BuildBodies(const Scene& scene, std::vector<dBodyID>* body_of) {
+  for (uint32_t s = 0; s < scene.slot_count(); ++s) {
+    const ShapeData* shape = ShapeAt(scene, s);
     if (!shape || !shape->dynamic) continue;
     const Pose& X_WS = scene.world_pose_at(s);
     if (!IsFinite(X_WS)) throw Error("ode: shape '" + PathAt(scene, s) + "' has a non-finite pose");
@@ -276,42 +311,32 @@ void OdeWorld::Build(const Scene& scene) {
     dBodySetMass(body, &mass);
     dGeomSetBody(geom, body);
     AddGeom(geom, scene.instance_of_at(s), shape->friction, shape->restitution);
-    body_of[s] = body;
+    (*body_of)[s] = body;
     bodies_.push_back({body, s, X_WS});
   }
+}
 
-  // 2. Non-dynamic shapes: parts of a body, kinematic bodies or static geoms.
-  for (uint32_t s = 0; s < slots; ++s) {
-    const ShapeData* shape = shape_at(s);
+void OdeWorld::BuildNonDynamicShapes(const Scene& scene, std::vector<dBodyID>* body_of) {
+  for (uint32_t s = 0; s < scene.slot_count(); ++s) {
+    const ShapeData* shape = ShapeAt(scene, s);
     if (!shape || shape->dynamic) continue;
     const Pose& X_WS = scene.world_pose_at(s);
     if (!IsFinite(X_WS)) throw Error("ode: shape '" + PathAt(scene, s) + "' has a non-finite pose");
-    dBodyID carrier = nullptr;
-    bool below_joint = false;
-    for (int32_t p = scene.parent_at(s); p >= 0; p = scene.parent_at(static_cast<uint32_t>(p))) {
-      const uint32_t ps = static_cast<uint32_t>(p);
-      if (scene.type_at(ps) == ObjectType::kJoint || scene.type_at(ps) == ObjectType::kForceSensor)
-        below_joint = true;
-      const ShapeData* ancestor = shape_at(ps);
-      if (ancestor && ancestor->dynamic) {
-        if (!below_joint) carrier = body_of[ps];
-        break;
-      }
-    }
+    const Carrier carrier = CarrierOf(scene, *body_of, s);
     dGeomID geom = MakeGeom(space_, *shape, MeshData(shape->mesh));
     if (!geom) continue;  // a zero-size decoration: nothing to collide with
     AddGeom(geom, scene.instance_of_at(s), shape->friction, shape->restitution);
-    if (carrier) {
-      dGeomSetBody(geom, carrier);
+    if (carrier.body) {
+      dGeomSetBody(geom, carrier.body);
       dGeomSetOffsetWorldPosition(geom, X_WS.p.x, X_WS.p.y, X_WS.p.z);
       const dQuaternion q = {X_WS.q.w, X_WS.q.x, X_WS.q.y, X_WS.q.z};
       dGeomSetOffsetWorldQuaternion(geom, q);
-    } else if (below_joint || scene.instance_of_at(s) >= 0) {
+    } else if (carrier.below_joint || scene.instance_of_at(s) >= 0) {
       dBodyID body = dBodyCreate(world_);
       dBodySetKinematic(body);
       SetBodyPose(body, X_WS);
       dGeomSetBody(geom, body);
-      body_of[s] = body;
+      (*body_of)[s] = body;
       kinematic_.push_back({body, s, X_WS, X_WS, {}, {}});
     } else {
       dGeomSetPosition(geom, X_WS.p.x, X_WS.p.y, X_WS.p.z);
@@ -319,89 +344,69 @@ void OdeWorld::Build(const Scene& scene) {
       dGeomSetQuaternion(geom, q);
     }
   }
+}
 
-  // 3. Joints with a dynamic child body, in slot order.
-  for (uint32_t s = 0; s < slots; ++s) {
+void OdeWorld::BuildJoints(const Scene& scene, const std::vector<dBodyID>& body_of) {
+  for (uint32_t s = 0; s < scene.slot_count(); ++s) {
     if (!scene.alive_at(s) || scene.type_at(s) != ObjectType::kJoint) continue;
-    const uint32_t row = scene.row_at(s);
-    const JointData& data = scene.joints()[row];
     // Child: the first dynamic shape below, not across another joint.
-    dBodyID child = nullptr;
-    std::vector<uint32_t> stack;
-    for (ObjectId c : scene.children(scene.IdAt(s))) stack.push_back(c.index());
-    std::reverse(stack.begin(), stack.end());
-    while (!stack.empty() && !child) {
-      const uint32_t c = stack.back();
-      stack.pop_back();
-      if (scene.type_at(c) == ObjectType::kJoint || scene.type_at(c) == ObjectType::kForceSensor)
-        continue;
-      const ShapeData* shape = shape_at(c);
-      if (shape && shape->dynamic) {
-        child = body_of[c];
-        break;
-      }
-      std::vector<ObjectId> grand = scene.children(scene.IdAt(c));
-      for (auto it = grand.rbegin(); it != grand.rend(); ++it) stack.push_back(it->index());
-    }
-    if (!child) continue;  // stays kinematic
+    const int32_t child_slot = dynamics::FirstDynamicShapeBelow(scene, s);
+    if (child_slot < 0) continue;  // stays kinematic
     // Parent: the nearest body above (dynamic or kinematic), else the world.
-    dBodyID parent = nullptr;
-    for (int32_t p = scene.parent_at(s); p >= 0; p = scene.parent_at(static_cast<uint32_t>(p))) {
-      if (body_of[p]) {
-        parent = body_of[p];
-        break;
-      }
-    }
-    const Pose& X_WJ = scene.world_pose_at(s);
-    const Vec3 axis = X_WJ.q.Rotate({0, 0, 1});
-    SimJoint j{};
-    j.slot = s;
-    j.row = row;
-    j.offset = data.position;
-    j.position = data.position;
-    j.parent_body = parent;
-    j.child_body = child;
-    j.X_AJ = parent ? BodyPose(parent).Inverse() * X_WJ : X_WJ;
-    j.q_JB0 = X_WJ.q.Conjugate() * BodyPose(child).q;
-    j.ball0 = data.ball;
-    switch (data.type) {
-      case JointType::kRevolute:
-        j.joint = dJointCreateHinge(world_, nullptr);
-        dJointAttach(j.joint, child, parent);
-        dJointSetHingeAnchor(j.joint, X_WJ.p.x, X_WJ.p.y, X_WJ.p.z);
-        dJointSetHingeAxis(j.joint, axis.x, axis.y, axis.z);
-        // ODE's stops live in (-pi, pi] around the Build position.
-        if (data.min_position - j.offset >= -M_PI && data.max_position - j.offset <= M_PI) {
-          dJointSetHingeParam(j.joint, dParamLoStop, data.min_position - j.offset);
-          dJointSetHingeParam(j.joint, dParamHiStop, data.max_position - j.offset);
-        }
-        j.last_angle = dJointGetHingeAngle(j.joint);
-        break;
-      case JointType::kPrismatic:
-        j.joint = dJointCreateSlider(world_, nullptr);
-        dJointAttach(j.joint, child, parent);
-        dJointSetSliderAxis(j.joint, axis.x, axis.y, axis.z);
-        if (std::isfinite(data.min_position))
-          dJointSetSliderParam(j.joint, dParamLoStop, data.min_position - j.offset);
-        if (std::isfinite(data.max_position))
-          dJointSetSliderParam(j.joint, dParamHiStop, data.max_position - j.offset);
-        break;
-      case JointType::kSpherical:
-        j.joint = dJointCreateBall(world_, nullptr);
-        dJointAttach(j.joint, child, parent);
-        dJointSetBallAnchor(j.joint, X_WJ.p.x, X_WJ.p.y, X_WJ.p.z);
-        break;
-      case JointType::kFixed:
-        j.joint = dJointCreateFixed(world_, nullptr);
-        dJointAttach(j.joint, child, parent);
-        dJointSetFixed(j.joint);
-        break;
-    }
-    joints_.push_back(j);
+    AddJoint(scene, s, body_of[child_slot],
+             dynamics::NearestBodyAbove<dBodyID>(scene, body_of, s, nullptr));
   }
-  // 4. Force sensors.
-  if (!scene.force_sensors().empty()) BuildForceSensors(scene, body_of);
-  commands_.assign(joints_.size(), JointData{});
+}
+
+void OdeWorld::AddJoint(const Scene& scene, uint32_t slot, dBodyID child, dBodyID parent) {
+  const uint32_t row = scene.row_at(slot);
+  const JointData& data = scene.joints()[row];
+  const Pose& X_WJ = scene.world_pose_at(slot);
+  const Vec3 axis = X_WJ.q.Rotate({0, 0, 1});
+  SimJoint j{};
+  j.slot = slot;
+  j.row = row;
+  j.offset = data.position;
+  j.position = data.position;
+  j.parent_body = parent;
+  j.child_body = child;
+  j.X_AJ = parent ? BodyPose(parent).Inverse() * X_WJ : X_WJ;
+  j.q_JB0 = X_WJ.q.Conjugate() * BodyPose(child).q;
+  j.ball0 = data.ball;
+  switch (data.type) {
+    case JointType::kRevolute:
+      j.joint = dJointCreateHinge(world_, nullptr);
+      dJointAttach(j.joint, child, parent);
+      dJointSetHingeAnchor(j.joint, X_WJ.p.x, X_WJ.p.y, X_WJ.p.z);
+      dJointSetHingeAxis(j.joint, axis.x, axis.y, axis.z);
+      // ODE's stops live in (-pi, pi] around the Build position.
+      if (data.min_position - j.offset >= -M_PI && data.max_position - j.offset <= M_PI) {
+        dJointSetHingeParam(j.joint, dParamLoStop, data.min_position - j.offset);
+        dJointSetHingeParam(j.joint, dParamHiStop, data.max_position - j.offset);
+      }
+      j.last_angle = dJointGetHingeAngle(j.joint);
+      break;
+    case JointType::kPrismatic:
+      j.joint = dJointCreateSlider(world_, nullptr);
+      dJointAttach(j.joint, child, parent);
+      dJointSetSliderAxis(j.joint, axis.x, axis.y, axis.z);
+      if (std::isfinite(data.min_position))
+        dJointSetSliderParam(j.joint, dParamLoStop, data.min_position - j.offset);
+      if (std::isfinite(data.max_position))
+        dJointSetSliderParam(j.joint, dParamHiStop, data.max_position - j.offset);
+      break;
+    case JointType::kSpherical:
+      j.joint = dJointCreateBall(world_, nullptr);
+      dJointAttach(j.joint, child, parent);
+      dJointSetBallAnchor(j.joint, X_WJ.p.x, X_WJ.p.y, X_WJ.p.z);
+      break;
+    case JointType::kFixed:
+      j.joint = dJointCreateFixed(world_, nullptr);
+      dJointAttach(j.joint, child, parent);
+      dJointSetFixed(j.joint);
+      break;
+  }
+  joints_.push_back(j);
 }
 
 void OdeWorld::MarkJoints(Scene* scene) const {
@@ -431,7 +436,7 @@ void OdeWorld::SyncFromScene(const Scene& scene, double duration) {
   }
 }
 
-void OdeWorld::ReadJointCommands(const Scene& scene) {
+void OdeWorld::ReadCommands(const Scene& scene) {
   for (size_t k = 0; k < joints_.size(); ++k) commands_[k] = scene.joints()[joints_[k].row];
 }
 

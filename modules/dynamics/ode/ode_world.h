@@ -6,12 +6,13 @@
 
 #include <cstdint>
 #include <memory>
+#include <string_view>
 #include <vector>
 
 #include "framework/dynamics_backend.h"
 #include "framework/math.h"
 #include "framework/scene.h"
-#include "modules/dynamics/ode/ode_backend.h"
+#include "modules/dynamics/ode/ode_options.h"
 
 namespace swarmsim {
 class Scene;
@@ -67,6 +68,12 @@ struct GeomInfo {    // 24 bytes
 
 class OdeWorld {
  public:
+  // For EngineBackend (engine_backend.h), which runs the step below.
+  using Options = ode::Options;
+  static constexpr std::string_view kName = "ode";
+  // SyncFromScene divides by the step's duration: no substeps, no step.
+  static constexpr bool kIdleWithoutSubsteps = true;
+
   OdeWorld(const Options& options, const DynamicsSettings& settings);
   ~OdeWorld();
   OdeWorld(const OdeWorld&) = delete;
@@ -77,10 +84,11 @@ class OdeWorld {
   // Moves bodies teleported by scripts and reads the kinematic bodies' new
   // poses (to be reached over `duration` seconds).
   void SyncFromScene(const Scene& scene, double duration);
-  // Sets motors from the joint commands (targets, forces).
-  void ReadJointCommands(const Scene& scene);
-  // One ODE step of `dt`; `fraction` (0..1] is how far through the control
-  // step its end is (kinematic bodies are placed accordingly).
+  // Reads the joint commands (targets, forces) that set the motors.
+  void ReadCommands(const Scene& scene);
+  // One ODE step of `dt`; `fraction` in [0, 1] is how far through the control
+  // step it starts (kinematic bodies are placed there and move at their
+  // step's velocity).
   void Substep(double dt, double fraction);
   void WriteBack(Scene* scene);
   void Hash(StateHasher* hasher) const;
@@ -88,6 +96,17 @@ class OdeWorld {
 
  private:
   void Clear();
+  // Build's phases, in order. 0: a fresh world, space, contact group and
+  // ground plane (the space's kind depends on the scene's size).
+  void CreateWorld(const Scene& scene);
+  // 1. A body and geom per dynamic shape, in slot order; fills body_of (slots).
+  void BuildBodies(const Scene& scene, std::vector<dBodyID>* body_of);
+  // 2. A geom per other shape: a part of a body, a kinematic body (added to
+  // body_of) or a static geom.
+  void BuildNonDynamicShapes(const Scene& scene, std::vector<dBodyID>* body_of);
+  // 3. An ODE joint per joint with a dynamic child body, in slot order.
+  void BuildJoints(const Scene& scene, const std::vector<dBodyID>& body_of);
+  void AddJoint(const Scene& scene, uint32_t slot, dBodyID child, dBodyID parent);
   void StepOnce(double dt, double fraction);  // Substep's work
   // Fixed joints with feedback for the scene's force sensors (ode_force_sensors.cc).
   void BuildForceSensors(const Scene& scene, const std::vector<dBodyID>& body_of);
