@@ -1,0 +1,172 @@
+// Internal to the world loader (swarm/loader), not for use outside it: the
+// WorldLoader class behind LoadWorld and the types it works with. Its members
+// are defined by topic: world_loader.cc (the world file's parameters, plugins,
+// simulation, arena, obstacles and metrics) and world_entries.cc (the
+// `models:` entries: their parameters, objects and placement, and the copies
+// built from them).
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "swarm/loader/ik.h"
+#include "swarm/loader/mesh.h"
+#include "swarm/loader/model.h"
+#include "swarm/loader/placement.h"
+#include "swarm/loader/values.h"
+#include "swarm/loader/world_loader.h"
+#include "swarm/loader/yaml.h"
+
+namespace swarmsim::loader {
+
+inline constexpr int64_t kMaxCount = 1000000;  // copies per models entry
+
+inline const std::vector<std::string> kEntryKeys = {"model",      "count",       "distribute",
+                                                    "position",   "heading_deg", "orientation_deg",
+                                                    "parameters", "instances",   "scale"};
+
+// One --set, split into its target.
+struct Override {
+  std::string text;   // "name=value", for messages
+  std::string model;  // "" for a world parameter
+  std::string name;
+  std::string value;
+  bool used = false;
+};
+
+// A --set value with the type of the parameter it replaces: a string
+// parameter takes the text as is; a number or boolean must read as one.
+ParamValue CoerceOverride(const Override& o, const ParamValue& declared,
+                          const std::string& declared_where);
+
+// How one `models:` entry places its copies.
+struct EntryPlan {
+  Field field;
+  const ModelFile* model = nullptr;
+  std::shared_ptr<ParameterSet> parameters;
+  ObjectSpec spec;
+  loader::Footprint footprint;  // of the scaled model
+  double scale = 1;             // size factor of every copy (`scale:`)
+  // Either one copy at a fixed pose, or `count` distributed copies.
+  bool distribute = false;
+  Pose fixed_pose;
+  Field position_field;
+  Field count_field;
+  int64_t count = 1;
+  Region2 region;
+  std::string region_text;  // "the arena", "the region [..] - [..]"
+  double clearance = 0;
+  std::optional<double> heading;
+  std::vector<Placement2> placements;
+  std::vector<loader::IkGroupDef> ik_groups;
+  // instances: [{index, parameters}]: copies with their own values, in file order.
+  struct OwnCopy {
+    int64_t index = 0;
+    Field field;  // the instances element, for messages
+    std::shared_ptr<ParameterSet> parameters;
+    // The copy's objects, resolved with its own values (a size, a range, a
+    // limit may use them); absent when its values equal the entry's, so it
+    // is duplicated from the entry's first copy like the others.
+    std::optional<ObjectSpec> spec;
+    loader::Footprint footprint;  // of the scaled copy (spec present)
+    std::vector<loader::IkGroupDef> ik_groups;
+  };
+  std::vector<OwnCopy> own_copies;
+  std::map<int64_t, size_t> own_copy_of;  // copy index -> own_copies position
+
+  // The copy's own values and objects, or null when it has none.
+  const OwnCopy* FindOwnCopy(int64_t k) const {
+    const auto it = own_copy_of.find(k);
+    return it == own_copy_of.end() ? nullptr : &own_copies[it->second];
+  }
+  // The objects copy k is built from, and its footprint.
+  const ObjectSpec& SpecOf(int64_t k) const {
+    const OwnCopy* own = FindOwnCopy(k);
+    return own && own->spec ? *own->spec : spec;
+  }
+  const loader::Footprint& FootprintOf(int64_t k) const {
+    const OwnCopy* own = FindOwnCopy(k);
+    return own && own->spec ? own->footprint : footprint;
+  }
+  // The largest footprint radius of the `count` copies.
+  double MaxFootprintRadius() const {
+    if (own_copies.empty()) return footprint.radius;
+    double r = 0;
+    for (int64_t k = 0; k < count; ++k) r = std::max(r, FootprintOf(k).radius);
+    return r;
+  }
+};
+
+class WorldLoader {
+ public:
+  WorldLoader(const std::filesystem::path& file, const LoadOptions& options,
+              const ModuleRegistry& registry)
+      : path_(file), options_(options), registry_(registry) {}
+
+  LoadedWorld Load();
+
+ private:
+  // A model's declared parameters, for the messages about values given for them.
+  struct DeclaredParameters {
+    std::map<std::string, std::string> where;  // name -> where its default is given
+    std::vector<std::string> names;            // in declaration order
+  };
+
+  // The world file (world_loader.cc).
+  void ReadParameters(const Fields& top);
+  std::shared_ptr<const ModuleRegistry> LoadPlugins(const Fields& top);
+  bool IsTrustedPluginLocation(const std::filesystem::path& canonical) const;
+  void ReadModelEntries(const Fields& top);
+  void CheckOverrides();
+  WorldSettings ReadSimulation(const Fields& top, std::optional<int64_t>* steps);
+  void BuildArena(const Fields& top, World* world);
+  void BuildObstacles(const Fields& top, World* world);
+  void AddObstacleFootprint(const ShapeData& shape, const Pose& X_WO);
+  std::vector<SwarmMetricSpec> ReadMetrics(const Fields& top, World* world);
+
+  // The models entries (world_entries.cc), in the order Load runs them.
+  void ResolveEntry(EntryPlan* entry);
+  void ResolveEntryParameters(const Fields& f, const ValueReader& world_values,
+                              DeclaredParameters* declared, EntryPlan* entry);
+  void ApplyParameterValues(const ModelFile& model, const Field& field,
+                            const ValueReader& world_values, DeclaredParameters* declared,
+                            ParameterSet* set);
+  void ReadOwnCopies(const Fields& f, const ValueReader& world_values, DeclaredParameters* declared,
+                     EntryPlan* entry);
+  void ResolveObjects(const Fields& f, const ValueReader& world_values, EntryPlan* entry);
+  void ResolvePlacement(const Fields& f, const ValueReader& world_values, EntryPlan* entry);
+  void ReadDistribution(const Fields& f, const ValueReader& world_values, EntryPlan* entry);
+  void ReadSinglePosition(const Fields& f, const ValueReader& world_values, EntryPlan* entry);
+  void PlaceEntries();
+  void BuildCopies(World* world);
+  std::vector<ModelSummary> Summarize() const;
+
+  const ModelFile& LoadModel(const Field& field, const std::string& text);
+  ValueReader WorldValues() const {
+    return ValueReader(*file_, &expressions_, {&parameters_, nullptr});
+  }
+
+  std::filesystem::path path_;
+  const LoadOptions& options_;
+  const ModuleRegistry& registry_;
+  const ModuleRegistry* world_registry_ = nullptr;  // registry_ plus the world's plugins
+  std::unique_ptr<YamlFile> file_;
+  mutable Expressions expressions_;
+  ScriptCache scripts_;
+  MeshCache meshes_;  // each mesh file read once per world
+  std::vector<Override> overrides_;
+  ParameterSet parameters_;
+  std::map<std::string, Field> parameter_fields_;  // where each world parameter is set
+  std::map<std::filesystem::path, std::unique_ptr<ModelFile>> models_;
+  std::vector<EntryPlan> entries_;
+  std::optional<Region2> arena_;
+  std::unique_ptr<Placer> placer_;
+};
+
+}  // namespace swarmsim::loader
