@@ -1,0 +1,131 @@
+// Scene: copy-paste of subtrees (with their rows through each type's
+// copy rule, scripts, model marks and dummy links) and the size factor
+// (each type's scale rule). scene.cc has the rest of the scene.
+#include <unordered_map>
+
+#include "framework/error.h"
+#include "framework/object_type.h"
+#include "framework/scene.h"
+
+namespace swarmsim {
+
+// --- Duplication ----------------------------------------------------------------------
+
+uint32_t Scene::CopyObject(uint32_t src, int32_t new_parent) {
+  const ObjectId parent = new_parent >= 0 ? IdAt(static_cast<uint32_t>(new_parent)) : ObjectId{};
+  // Copy the name and pose first: AllocateSlot may grow (and move) the arrays.
+  std::string name = name_[src];
+  const Pose X_PO = X_PO_[src];
+  // The copy's row from the source's, through the type's copy rule.
+  const ObjectType type = type_[src];
+  const uint32_t slot = AllocateSlot(std::move(name), parent, X_PO, type);
+  if (RowTable* table = tables_[static_cast<size_t>(type)].get())
+    row_[slot] = table->AppendCopy(row_[src], slot, types_[static_cast<size_t>(type)]->copy_row);
+  v_WO_[slot] = v_WO_[src];
+  w_WO_[slot] = w_WO_[src];
+  model_root_[slot] = model_root_[src];
+  size_factor_[slot] = size_factor_[src];
+  if (custom_data_[src])
+    custom_data_[slot] = std::make_unique<std::map<std::string, std::string>>(*custom_data_[src]);
+  if (script_[src] >= 0 && scripts_[script_[src]].source) {
+    const ScriptAttachment attachment = scripts_[script_[src]];
+    script_[slot] = static_cast<int32_t>(scripts_.size());
+    scripts_.push_back(attachment);
+  }
+  return slot;
+}
+
+void Scene::ReserveForCopies(ObjectId root, size_t copies) {
+  std::vector<uint32_t> sub;
+  CollectSubtree(SlotOf(root), &sub);
+  std::vector<size_t> rows_of_type(types_.size(), 0);
+  size_t scripts = 0;
+  for (uint32_t s : sub) {
+    ++rows_of_type[static_cast<size_t>(type_[s])];
+    scripts += script_[s] >= 0;
+  }
+  const size_t slots = generation_.size() + sub.size() * copies;
+  for (auto* v : {&X_PO_, &X_WO_}) v->reserve(slots);
+  for (auto* v : {&v_WO_, &w_WO_}) v->reserve(slots);
+  for (auto* v : {&parent_, &first_child_, &last_child_, &next_sibling_, &prev_sibling_, &instance_,
+                  &script_, &linked_dummy_})
+    v->reserve(slots);
+  size_factor_.reserve(slots);
+  for (auto* v : {&simulated_, &alive_, &model_root_}) v->reserve(slots);
+  custom_data_.reserve(slots);
+  type_.reserve(slots);
+  row_.reserve(slots);
+  generation_.reserve(slots);
+  name_.reserve(slots);
+  // Every type's table, whatever the type.
+  for (size_t t = 0; t < types_.size(); ++t)
+    if (tables_[t] && rows_of_type[t] > 0)
+      tables_[t]->Reserve(tables_[t]->size() + rows_of_type[t] * copies);
+  scripts_.reserve(scripts_.size() + scripts * copies);
+  instances_.reserve(instances_.size() + copies);
+}
+
+ObjectId Scene::DuplicateSubtree(ObjectId root, ObjectId new_parent) {
+  const uint32_t root_slot = SlotOf(root);
+  int32_t parent_slot = -1;
+  if (!new_parent.IsNull()) parent_slot = static_cast<int32_t>(SlotOf(new_parent, "parent object"));
+  std::vector<uint32_t> sources;
+  CollectSubtree(root_slot, &sources);
+  // Pre-order guarantees a parent is copied before its children.
+  std::unordered_map<uint32_t, uint32_t> copy_of;
+  copy_of.reserve(sources.size());
+  for (uint32_t src : sources) {
+    const int32_t p =
+        src == root_slot ? parent_slot : static_cast<int32_t>(copy_of.at(parent_[src]));
+    copy_of[src] = CopyObject(src, p);
+  }
+  // Remap internal references: a link inside the subtree points at the copy;
+  // a link to an object outside stays as it was.
+  for (uint32_t src : sources) {
+    const int32_t link = linked_dummy_[src];
+    if (link < 0) continue;
+    auto it = copy_of.find(static_cast<uint32_t>(link));
+    linked_dummy_[copy_of[src]] = it != copy_of.end() ? static_cast<int32_t>(it->second) : link;
+  }
+  const uint32_t copy_root = copy_of.at(root_slot);
+  RefreshSubtree(copy_root);
+  // A copy of a whole robot is a new robot.
+  const int src_instance = instance_[root_slot];
+  if (model_root_[root_slot] && src_instance >= 0 && instances_[src_instance].root == root &&
+      instance_[copy_root] < 0) {
+    const std::string model_name = instances_[src_instance].model_name;
+    MakeModelInstance(IdAt(copy_root), model_name,
+                      model_name + "#" + std::to_string(instances_.size()));
+  }
+  if (!listeners_.empty()) {
+    std::vector<uint32_t> copies;
+    copies.reserve(sources.size());
+    for (uint32_t src : sources) copies.push_back(copy_of.at(src));
+    for (SceneListener* l : listeners_) l->OnSubtreeDuplicated(*this, sources, copies);
+  }
+  return IdAt(copy_root);
+}
+
+// --- Size factor ---------------------------------------------------------------------
+
+void Scene::ScaleSubtree(ObjectId root, double s) {
+  const uint32_t root_slot = SlotOf(root);
+  if (!std::isfinite(s) || !(s > 0))
+    throw Error("cannot scale '" + name_[root_slot] + "' by " + std::to_string(s) +
+                ": the factor must be a finite number above 0");
+  if (s == 1) return;
+  std::vector<uint32_t> sub;
+  CollectSubtree(root_slot, &sub);
+  ScaleContext context;  // scaled assets (meshes), one per original within this call
+  for (uint32_t slot : sub) {
+    size_factor_[slot] *= s;
+    if (slot != root_slot) X_PO_[slot].p = X_PO_[slot].p * s;
+    const size_t type = static_cast<size_t>(type_[slot]);
+    if (types_[type]->scale_row != nullptr)
+      types_[type]->scale_row(*types_[type], tables_[type]->At(row_[slot]), s, &context);
+  }
+  RefreshSubtree(root_slot);
+  ++structure_version_;
+}
+
+}  // namespace swarmsim
