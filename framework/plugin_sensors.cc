@@ -140,4 +140,18 @@ bool PluginSensorReading(const World& world, ObjectId id, std::span<const double
   return module != nullptr && module->Reading(scene, id, values);
 }
 
+// Defined beside the module it registers (registry.cc does not depend on it).
+void ModuleRegistry::RegisterPluginSensor(ModuleInfo info, PluginSensorType type) {
+  if (type.name.empty() || type.function == nullptr)
+    throw Error("a plugin sensor type needs a name and a sense function");
+  if (FindPluginSensor(type.name) != nullptr)
+    throw Error("plugin sensor type '" + type.name + "' is registered twice");
+  if (type.max_values < 1) throw Error("plugin sensor type '" + type.name + "' holds no values");
+  info.kind = "sensor";
+  modules_.push_back(std::move(info));
+  plugin_sensors_.push_back(std::move(type));
+  // The module that senses every type's objects, with the first type.
+  if (FindModule("plugin_sensors") == nullptr) RegisterModule(PluginSensorsModule());
+}
+
 }  // namespace swarmsim

@@ -1,6 +1,7 @@
 #include "framework/proximity_module.h"
 
 #include "framework/proximity_backend.h"
+#include "framework/registry.h"
 #include "framework/scheduler.h"
 #include "framework/world.h"
 
@@ -41,6 +42,15 @@ class ProximityModule final : public Module {
 
 std::unique_ptr<Module> MakeProximityModule(std::unique_ptr<ProximityBackend> backend) {
   return std::make_unique<ProximityModule>(std::move(backend));
+}
+
+// Defined beside the adapter it registers (registry.cc does not depend on it).
+void ModuleRegistry::RegisterProximity(ModuleInfo info, ProximityFactory factory) {
+  info.kind = "proximity";
+  RegisterModule({std::move(info), PhaseBit(ModulePhase::kSense), 100, /*every_world=*/true,
+                  [factory = std::move(factory)](World*, const void*) {
+                    return MakeProximityModule(factory());
+                  }});
 }
 
 }  // namespace swarmsim

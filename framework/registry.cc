@@ -5,9 +5,7 @@
 #include "framework/dynamics_backend.h"
 #include "framework/error.h"
 #include "framework/object_type.h"
-#include "framework/plugin_sensors.h"
 #include "framework/proximity_backend.h"
-#include "framework/proximity_module.h"
 
 namespace swarmsim {
 
@@ -38,14 +36,6 @@ std::vector<const ModuleDescriptor*> ModuleRegistry::ModulesOfKind(std::string_v
   for (const auto& m : module_descriptors_)
     if (m->info.kind == kind) out.push_back(m.get());
   return out;
-}
-
-void ModuleRegistry::RegisterProximity(ModuleInfo info, ProximityFactory factory) {
-  info.kind = "proximity";
-  RegisterModule({std::move(info), PhaseBit(ModulePhase::kSense), 100, /*every_world=*/true,
-                  [factory = std::move(factory)](World*, const void*) {
-                    return MakeProximityModule(factory());
-                  }});
 }
 
 void ModuleRegistry::RegisterCalculation(ModuleInfo info, CalculationFactory factory) {
@@ -80,19 +70,6 @@ void ModuleRegistry::RegisterPhaseCallback(ModuleInfo info, PhaseCallback callba
   info.kind = "callback";
   modules_.push_back(std::move(info));
   phase_callbacks_.push_back(std::move(callback));
-}
-
-void ModuleRegistry::RegisterPluginSensor(ModuleInfo info, PluginSensorType type) {
-  if (type.name.empty() || type.function == nullptr)
-    throw Error("a plugin sensor type needs a name and a sense function");
-  if (FindPluginSensor(type.name) != nullptr)
-    throw Error("plugin sensor type '" + type.name + "' is registered twice");
-  if (type.max_values < 1) throw Error("plugin sensor type '" + type.name + "' holds no values");
-  info.kind = "sensor";
-  modules_.push_back(std::move(info));
-  plugin_sensors_.push_back(std::move(type));
-  // The module that senses every type's objects, with the first type.
-  if (FindModule("plugin_sensors") == nullptr) RegisterModule(PluginSensorsModule());
 }
 
 void ModuleRegistry::RegisterObjectType(std::shared_ptr<const ObjectTypeDescriptor> type) {
