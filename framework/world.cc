@@ -229,7 +229,8 @@ void World::EnsureRuntimes() {
   }
   pending_.resize(runtimes_.size(), 0xff);  // new robots: look at everything once
   messaging_.Resize(static_cast<int>(runtimes_.size()));
-  scene_runtime_.rng = Rng(settings_.seed, uint64_t{1} << 63);
+  // (Before Start only: robots copied later must not restart the scene's stream.)
+  if (!started_) scene_runtime_.rng = Rng(settings_.seed, uint64_t{1} << 63);
 }
 
 void World::SetInstanceParameters(int instance, SharedParameters parameters) {
