@@ -301,6 +301,7 @@ void RegisterAreas(lua_State* L) {
       RegisterIkApi,          // lua_api_ik.cc: IK groups
       RegisterCustomDataApi,  // lua_api_custom_data.cc: custom data blocks
       RegisterPluginApi,      // lua_api_plugins.cc: plugin sensors
+      RegisterModelsApi,      // lua_api_models.cc: copying and removing robots at run time
   };
   lua_pushinteger(L, kHandleWorld);
   lua_setfield(L, -2, "handle_world");

@@ -182,6 +182,7 @@ void RegisterForceSensorApi(lua_State* L);
 void RegisterPaintApi(lua_State* L);
 void RegisterCustomDataApi(lua_State* L);
 void RegisterPluginApi(lua_State* L);
+void RegisterModelsApi(lua_State* L);
 
 // Pushes the plugin command `name` (registered in the world's
 // ModuleRegistry) as a function and returns true; false if there is none.

@@ -32,6 +32,11 @@ void Messaging::Resize(int robot_count) {
   pending_.resize(robot_count, 0xff);  // new robots: look at everything once
 }
 
+void Messaging::ClearRobot(int robot) {
+  robots_.at(robot) = RobotMail();
+  pending_[robot] = 0;
+}
+
 void Messaging::MarkAllPending() { pending_.assign(robots_.size(), 0xff); }
 
 void Messaging::ApplySignalWrites() {

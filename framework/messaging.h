@@ -78,6 +78,8 @@ class Messaging {
   // Mail for robots 0 .. robot_count - 1 (robots are only added).
   void Resize(int robot_count);
   RobotMail& robot_mail(int robot) { return robots_[robot]; }
+  // A removed robot: its inbox, unsent messages and writes are dropped.
+  void ClearRobot(int robot);
   RobotMail& scene_mail() { return scene_; }
 
   // Call after robot `robot`'s scripts ran, on its worker: the serial passes

@@ -55,6 +55,16 @@ class ScriptHost {
   // resumed with the actuation callbacks; with a main script, in the first
   // such pass of a step only). Explicit scripts are skipped.
   virtual void RunInstance(int instance, ScriptPass pass) = 0;
+  // Robots made after Start (copies, World::ApplyModelEdits), indices
+  // `first` .. robot_count - 1: like Start for them (their states, their
+  // scripts' bodies and sysCall_init, in parallel; the lowest robot's error
+  // is thrown). The world has grown its runtimes and mail for them (which
+  // may have moved the others': the host points its states at them again).
+  virtual void StartInstances(int first) = 0;
+  // A robot about to be removed: sysCall_cleanup of its scripts (as Stop
+  // does), then its state closes. On the calling thread, between phases, so
+  // no script of it is running. Throws its cleanup error.
+  virtual void StopInstance(int instance) = 0;
   // Control phase of the scripts outside any model, on the calling thread.
   virtual void RunSceneScripts(ScriptPass pass) = 0;
   // The world's own main script (WorldSettings::main_script), if any: its

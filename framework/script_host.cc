@@ -450,6 +450,8 @@ class LuaScriptHost final : public ScriptHost {
   explicit LuaScriptHost(World* world) : world_(world) {}
 
   void Start() override;
+  void StartInstances(int first) override;
+  void StopInstance(int instance) override;
   void RunInstance(int instance, ScriptPass pass) override;
   void RunSceneScripts(ScriptPass pass) override;
   bool has_main_script() const override { return main_ != nullptr; }
@@ -458,6 +460,10 @@ class LuaScriptHost final : public ScriptHost {
   size_t MemoryBytes() const override;
 
  private:
+  // States for robots `first` .. robot_count - 1, their scripts initialized,
+  // in parallel; throws the lowest robot's error.
+  void StartRobots(int first);
+
   World* world_;
   std::vector<std::unique_ptr<ScriptState>> robots_;  // by instance; null: no scripts
   std::unique_ptr<ScriptState> scene_;                // null: no scene scripts
@@ -473,26 +479,7 @@ void LuaScriptHost::Start() {
   started_ = true;
   World& world = *world_;
   const Scene& scene = world.scene();
-  // Robots in parallel: each touches only its own state and runtime. The
-  // lowest robot's error is reported, whatever the thread count.
-  const int robot_count = world.robot_count();
-  robots_.resize(robot_count);
-  std::vector<std::string> errors(robot_count);
-  world.scheduler().ParallelFor(0, robot_count, kStartGrain, [&](int64_t begin, int64_t end) {
-    for (int64_t r = begin; r < end; ++r) {
-      const ModelInstance& instance = scene.instance(static_cast<int>(r));
-      if (!instance.alive) continue;
-      try {
-        robots_[r] = NewState(&world, static_cast<int>(r), &world.runtime(static_cast<int>(r)),
-                              instance.name, instance.objects);
-        if (robots_[r]) Initialize(robots_[r].get());
-      } catch (const std::exception& e) {
-        errors[r] = e.what();
-      }
-    }
-  });
-  for (const std::string& error : errors)
-    if (!error.empty()) throw Error(error);
+  StartRobots(0);
   // Then the scene's scripts, on this thread.
   scene_ = NewState(&world, -1, &world.scene_runtime(), "scene", SceneObjectSlots(scene));
   if (scene_) Initialize(scene_.get());
@@ -524,6 +511,52 @@ void LuaScriptHost::Start() {
   for (const auto& state : robots_) log_warnings(state.get());
   log_warnings(scene_.get());
   log_warnings(main_.get());
+}
+
+void LuaScriptHost::StartRobots(int first) {
+  World& world = *world_;
+  const Scene& scene = world.scene();
+  // Robots in parallel: each touches only its own state and runtime. The
+  // lowest robot's error is reported, whatever the thread count.
+  const int robot_count = world.robot_count();
+  robots_.resize(robot_count);
+  std::vector<std::string> errors(robot_count);
+  world.scheduler().ParallelFor(first, robot_count, kStartGrain, [&](int64_t begin, int64_t end) {
+    for (int64_t r = begin; r < end; ++r) {
+      const ModelInstance& instance = scene.instance(static_cast<int>(r));
+      if (!instance.alive) continue;
+      try {
+        robots_[r] = NewState(&world, static_cast<int>(r), &world.runtime(static_cast<int>(r)),
+                              instance.name, instance.objects);
+        if (robots_[r]) Initialize(robots_[r].get());
+      } catch (const std::exception& e) {
+        errors[r] = e.what();
+      }
+    }
+  });
+  for (const std::string& error : errors)
+    if (!error.empty()) throw Error(error);
+}
+
+void LuaScriptHost::StartInstances(int first) {
+  if (!started_ || stopped_) return;
+  // The world's runtimes and mail may have moved as they grew.
+  for (size_t r = 0; r < robots_.size(); ++r) {
+    if (!robots_[r]) continue;
+    robots_[r]->context.runtime = &world_->runtime(static_cast<int>(r));
+    robots_[r]->context.mail = &world_->messaging().robot_mail(static_cast<int>(r));
+  }
+  StartRobots(first);
+  // Copies load the scripts of robots that were loaded at Start: their
+  // warnings were logged then.
+  for (size_t r = static_cast<size_t>(first); r < robots_.size(); ++r)
+    if (robots_[r]) std::vector<UncalledSysCall>().swap(robots_[r]->warnings);
+}
+
+void LuaScriptHost::StopInstance(int instance) {
+  if (!started_ || stopped_ || instance < 0 || instance >= static_cast<int>(robots_.size())) return;
+  std::unique_ptr<ScriptState> state = std::move(robots_[instance]);
+  if (state) Cleanup(state.get());  // the state closes as `state` goes, error or not
 }
 
 void LuaScriptHost::RunMainScript() {

@@ -228,7 +228,8 @@ void World::EnsureRuntimes() {
   }
   pending_.resize(runtimes_.size(), 0xff);  // new robots: look at everything once
   messaging_.Resize(static_cast<int>(runtimes_.size()));
-  scene_runtime_.rng = Rng(settings_.seed, uint64_t{1} << 63);
+  // (Before Start only: robots copied later must not restart the scene's stream.)
+  if (!started_) scene_runtime_.rng = Rng(settings_.seed, uint64_t{1} << 63);
 }
 
 void World::SetInstanceParameters(int instance, SharedParameters parameters) {
@@ -279,6 +280,8 @@ void World::Step() {
       // 1-4. the world's own main script runs the phases (sim.handleSensing(), ...).
       dynamics_handled_ = false;
       scripts_->RunMainScript();
+      // Copies and removals it queued after its last sim.handleActuation().
+      ApplyModelEdits();
       if (!dynamics_handled_)
         throw Error("main: " + settings_.main_script->path +
                     ": sysCall_step must call sim.handleDynamics() once per step");
@@ -378,6 +381,7 @@ uint8_t World::PendingBits(const RobotRuntime& rt) {
   if (!rt.log.empty() || !rt.metrics.empty() || !rt.error.empty() || !rt.disabled.empty())
     bits |= kPendingOutput;
   if (!rt.deferred.empty()) bits |= kPendingDeferred;
+  if (!rt.model_edits.empty()) bits |= kPendingModelEdits;
   return bits;
 }
 
@@ -424,6 +428,8 @@ void World::FlushBuffersAfterError() noexcept {
 }
 
 void World::Actuate() {
+  // Robots copied and removed by the scripts (world_model_edits.cc).
+  ApplyModelEdits();
   // Writes to other robots' objects, in handle order (stable for equal handles).
   std::vector<DeferredWrite> writes;
   for (size_t r = 0; r < runtimes_.size(); ++r) {
@@ -580,7 +586,9 @@ uint64_t World::StateHash() const {
   for (size_t t = 0; t < scene_.types().size(); ++t)
     if (const auto hash_rows = scene_.types()[t]->hash_rows)
       hash_rows(scene_, static_cast<ObjectType>(t), &h);
-  for (const RobotRuntime& rt : runtimes_) h.Add(rt.rng.state(), 4 * sizeof(uint64_t));
+  // Robots removed at run time are not hashed.
+  for (size_t r = 0; r < runtimes_.size(); ++r)
+    if (scene_.instances()[r].alive) h.Add(runtimes_[r].rng.state(), 4 * sizeof(uint64_t));
   h.Add(scene_runtime_.rng.state(), 4 * sizeof(uint64_t));
   // What scripts left for the next step: signals and mail not yet delivered
   // (Messaging), custom data blocks.

@@ -139,12 +139,28 @@ class LogBuffer {
   std::vector<std::string> lines_;
 };
 
+// A copy or removal of a robot asked for by a script (sim.copyModel,
+// sim.removeModel, lua_api_models.cc), applied by the World between the
+// control and actuate phases (World::ApplyModelEdits, world_model_edits.cc).
+struct ModelEdit {
+  enum class Kind : uint8_t { kCopy, kRemove };
+  Kind kind = Kind::kCopy;
+  ObjectId root;          // the robot's model root (validated when queued)
+  bool has_pose = false;  // kCopy: place the copy at (x, y, yaw), else at the source's pose
+  double x = 0, y = 0;    // m, world frame
+  double yaw = 0;         // rad
+};
+// Copies and removals one script state may queue between two applications
+// (one step): a clear error past it, so a runaway loop cannot exhaust memory.
+inline constexpr size_t kMaxModelEditsPerStep = 1000;
+
 struct RobotRuntime {
   Rng rng;
   SharedParameters parameters;          // the instance's model parameters
   LogBuffer log;                        // lines printed during the phase
   std::vector<MetricSample> metrics;    // samples recorded this step
   std::vector<DeferredWrite> deferred;  // writes to other robots' objects
+  std::vector<ModelEdit> model_edits;   // copies and removals of robots, call order
   std::string error;                    // a script error in this phase
   std::vector<std::string> disabled;    // scripts disabled this phase (disable_script), why
   // Its messages, signal and custom-data writes: Messaging::robot_mail.
@@ -203,7 +219,11 @@ class World : public PhaseHandlers {
 
   int64_t step_count() const { return step_count_; }
   double time() const { return time_; }
+  // Robot indices in use: every model instance ever made, removed ones
+  // included (indices are never reused; ModelInstance::alive tells).
   int robot_count() const;
+  // Robots not removed.
+  int live_robot_count() const;
   int threads() const;
 
   // Hash of every object's pose and velocity, joint states, sensor
@@ -292,6 +312,13 @@ class World : public PhaseHandlers {
   void Record();
   void RunModules(ModulePhase phase);
   void EnsureRuntimes();
+  // Copies and removals the scripts queued (RobotRuntime::model_edits),
+  // robots in index order then the scene's, call order within each: every
+  // copy first (new robots, their sysCall_init), then every removal (its
+  // sysCall_cleanup, then its objects). world_model_edits.cc.
+  void ApplyModelEdits();
+  ObjectId CopyRobot(const ModelEdit& edit);
+  void RemoveRobot(ObjectId root);
   void FlushRobotBuffers();
   // The scene's scripts' prints and metrics (a main script's, after its step).
   void FlushSceneBuffers();
@@ -327,6 +354,7 @@ class World : public PhaseHandlers {
   // (Messaging keeps its own for the robots' mail.)
   static constexpr uint8_t kPendingOutput = 1;         // log, metrics, error
   static constexpr uint8_t kPendingDeferred = 2;       // deferred writes
+  static constexpr uint8_t kPendingModelEdits = 4;     // copies and removals of robots
   static uint8_t PendingBits(const RobotRuntime& rt);  // what rt's buffers hold
   void MarkAllPending();
   RobotRuntime scene_runtime_;

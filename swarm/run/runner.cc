@@ -261,7 +261,7 @@ bool IsWholeNumber(double v) { return std::abs(v) <= 9007199254740992.0 && v == 
 // state hash and the disabled scripts.
 bool WriteSummary(const World& world, const RunOptions& options, const RunResult& result,
                   double lua_kib, bool complete) {
-  const int robots = world.robot_count();
+  const int robots = world.live_robot_count();  // removed robots are not counted
   const double sim_time = world.time();
   const double robot_ticks = static_cast<double>(robots) * static_cast<double>(result.steps);
   nlohmann::json j;
@@ -403,7 +403,7 @@ void StepWatched(World* world, const RunOptions& options, Clock::time_point star
 // The summary table a run prints unless --quiet.
 void PrintSummaryTable(const World& world, const RunResult& result, double lua_kib,
                        std::ostream& out) {
-  const int robots = world.robot_count();
+  const int robots = world.live_robot_count();  // removed robots are not counted
   const double sim_time = world.time();
   const double robot_ticks = static_cast<double>(robots) * static_cast<double>(result.steps);
   const double rtf = result.wall_seconds > 0 ? sim_time / result.wall_seconds : 0;

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 #include <string>
 
 #include "framework/registry.h"
@@ -106,6 +107,40 @@ TEST(IkGroupsTest, DuplicatedModelsGroupSolvesForTheCopyAndIsRemovedWithIt) {
   EXPECT_EQ(ik->live_group_count(), 1);
   EXPECT_FALSE(ik->IsLive(copy_group));
   scene.SetLocalPose(arm.target, {{0.1, 0.7, 0}, {}});
+  world->Step();
+  EXPECT_LT(Distance(scene, arm.tip, arm.target), 1e-5);
+}
+
+// Copies and removals by scripts at run time (sim.copyModel,
+// sim.removeModel): the IK group follows through the same SceneListener.
+TEST(IkGroupsTest, RobotsCopiedAndRemovedByScriptsTakeTheirGroupsAlong) {
+  auto world = MakeWorld(1);
+  Scene& scene = world->scene();
+  const Arm arm = AddArm(&scene, {});
+  IkGroups* ik = Ik(world.get());
+  ik->AddGroup(scene, ArmGroup(arm));
+  scene.AttachScript(arm.root, std::make_shared<const ScriptSource>(ScriptSource{"arm.lua", R"(
+    local step = 0
+    function sysCall_actuation()
+      step = step + 1
+      if sim.getRobotIndex() ~= 0 then return end
+      if step == 1 then sim.copyModel(sim.getObject(':'), {3, 0, 1}) end
+      if step == 3 then sim.removeModel(sim.getObject('/arm#1')) end
+    end
+  )"}));
+  world->Step();
+  ASSERT_EQ(world->robot_count(), 2);
+  ASSERT_EQ(ik->live_group_count(), 2);
+  const ObjectId copy = scene.instance(1).root;
+  const int copy_group = ik->FindGroup("reach", 1);
+  ASSERT_NE(copy_group, 0);
+  EXPECT_EQ(ik->spec(copy_group).tips[0].tip, scene.FindObject("./tip", copy));
+  world->Step();
+  EXPECT_LT(Distance(scene, scene.FindObject("./tip", copy), scene.FindObject("./target", copy)),
+            1e-5);
+  world->Step();  // the removal
+  EXPECT_EQ(ik->live_group_count(), 1);
+  EXPECT_FALSE(ik->IsLive(copy_group));
   world->Step();
   EXPECT_LT(Distance(scene, arm.tip, arm.target), 1e-5);
 }

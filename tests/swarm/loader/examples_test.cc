@@ -82,6 +82,33 @@ std::vector<double> Values(const std::vector<MetricSample>& metrics, const std::
   return out;
 }
 
+// The claim of worlds/respawn.yaml: robots fail (remove themselves) and the
+// main script copies live ones, so the population stays at `robots`; the
+// same at 1 and 2 threads; the program writes the metrics.
+TEST(ExamplesTest, RespawnKeepsThePopulationWithCopiesAndIsIndependentOfThreadCount) {
+  const std::vector<std::pair<std::string, std::string>> set = {{"failure_rate", "0.05"}};
+  const WorldRun one = RunWorld("respawn.yaml", 1, 200, set);
+  const std::vector<double> alive = Values(one.metrics, "robots_alive");
+  const std::vector<double> failed = Values(one.metrics, "robots_failed");
+  const std::vector<double> spawned = Values(one.metrics, "robots_spawned");
+  ASSERT_EQ(alive.size(), 20u);
+  for (double a : alive) EXPECT_EQ(a, 100);
+  EXPECT_GT(failed.back(), 20);  // ~100 x 0.05/s x 20 s = 100
+  EXPECT_EQ(spawned.back(), failed.back());
+  const WorldRun two = RunWorld("respawn.yaml", 2, 200, set);
+  EXPECT_EQ(two.hash, one.hash);
+  const std::filesystem::path out =
+      std::filesystem::temp_directory_path() / ("swarmsim_respawn_" + std::to_string(getpid()));
+  const auto r = swarmsim::testing::RunProgram("run " + std::string(SWARMSIM_SOURCE_DIR) +
+                                               "/worlds/respawn.yaml --steps 50 --quiet --out " +
+                                               out.string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  std::stringstream csv;
+  csv << std::ifstream(out / "metrics.csv").rdbuf();
+  EXPECT_NE(csv.str().find("50,5,,robots_alive,100\n"), std::string::npos) << csv.str();
+  std::filesystem::remove_all(out);
+}
+
 TEST(ExamplesTest, FlockingAlignsHeadingsAndIsIndependentOfThreadCount) {
   const WorldRun one = RunWorld("flocking.yaml", 1, 300);
   const std::vector<double> alignment = Values(one.metrics, "alignment");
