@@ -56,8 +56,8 @@ struct LuaContext {
   ObjectId script_object;
   int script_env_ref = LUA_NOREF;  // its environment table, in the registry
   ScriptMailbox* mailbox = nullptr;
-  void* host_state = nullptr;     // the host's ScriptState (script_host.cc)
-  void* host_script = nullptr;    // the host's Script being run (script_host.cc)
+  void* host_state = nullptr;     // the host's ScriptState (script_state.h)
+  void* host_script = nullptr;    // the host's Script being run (script_state.h)
   bool is_main = false;           // the main script's state
   bool in_sensing = false;        // running a sysCall_sensing (sim.handleChildScript follows it)
   bool dynamics_handled = false;  // the main script called sim.handleDynamics() this step
@@ -102,7 +102,7 @@ struct LuaRefusal : LuaError {
 // Ends the running callback with the error message on top of L's stack, the
 // way a spent instruction budget does: every further instruction raises
 // again, so pcall and xpcall cannot swallow it, and the host reports the
-// message (script_host.cc).
+// message (script_hooks.cc).
 [[noreturn]] void FailCallback(lua_State* L);
 
 // Runs `f`; if it throws, leaves the error value on the stack and returns -1
