@@ -78,6 +78,10 @@ void ModuleRegistry::RegisterObjectType(std::shared_ptr<const ObjectTypeDescript
   const std::string name = type->name;
   for (const ObjectTypeDescriptor* t : CoreObjectTypes())
     if (name == t->name) throw Error("object type '" + name + "' is a built-in type");
+  // The loader's own types: a registered one of the same name would never be
+  // reached (model files would build the loader's instead).
+  if (name == "proximity_ring" || name == "plugin_sensor")
+    throw Error("object type '" + name + "' is a world-file type of the loader's");
   for (const ObjectTypeDescriptor* t : object_types_)
     if (name == t->name) throw Error("object type '" + name + "' is registered twice");
   modules_.push_back({"object type", name, "", type->description ? type->description : ""});

@@ -8,7 +8,9 @@
 #include <sstream>
 #include <string>
 
+#include "framework/error.h"
 #include "framework/object_type.h"
+#include "framework/registry.h"
 #include "framework/scene.h"
 
 namespace swarmsim {
@@ -59,6 +61,24 @@ TEST(ObjectTypesTest, WorldsReadmeDocumentsEveryKeyOfEveryType) {
       EXPECT_NE(key.default_text, nullptr);
     }
   }
+}
+
+// A module's or plugin's type cannot take a name that is already a type:
+// the model files would silently build the other one.
+TEST(ObjectTypesTest, ARegisteredTypeCannotShadowABuiltInOrLoaderType) {
+  ModuleRegistry registry;
+  const auto type = [](const char* name) {
+    auto d = std::make_shared<ObjectTypeDescriptor>();
+    d->name = name;
+    d->description = "test";
+    return std::shared_ptr<const ObjectTypeDescriptor>(d);
+  };
+  for (const char* taken : {"shape", "proximity_ring", "plugin_sensor"})
+    EXPECT_THROW(registry.RegisterObjectType(type(taken)), Error) << taken;
+  registry.RegisterObjectType(type("beacon"));
+  EXPECT_THROW(registry.RegisterObjectType(type("beacon")), Error);
+  ASSERT_EQ(registry.object_types().size(), 1u);
+  EXPECT_STREQ(registry.object_types()[0]->name, "beacon");
 }
 
 // Copying, scaling and removing go through each type's hooks: a copied
