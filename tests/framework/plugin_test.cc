@@ -11,27 +11,17 @@
 #include "framework/error.h"
 #include "framework/plugin_loader.h"
 #include "framework/world.h"
+#include "tests/framework/error_of.h"
 #include "tests/framework/fakes.h"
 
 namespace swarmsim {
 namespace {
 
-#define EXPECT_CONTAINS(haystack, needle) \
-  EXPECT_NE(std::string(haystack).find(needle), std::string::npos) << (haystack)
-
 std::string PluginPath(const std::string& name) {
   return (std::filesystem::path(SWARMSIM_BINARY).parent_path() / "plugins" / name).string();
 }
 
-template <typename F>
-std::string ErrorOf(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "NO ERROR";
-}
+using testing::ErrorOf;
 
 TEST(PluginTest, CommandsAreCalledFromLuaWithNumbersArraysAndContext) {
   ModuleRegistry registry = testing::NullRegistry();

@@ -11,6 +11,7 @@
 
 #include "framework/error.h"
 #include "framework/world.h"
+#include "tests/framework/error_of.h"
 #include "tests/framework/fakes.h"
 
 namespace swarmsim {
@@ -56,18 +57,7 @@ class ScriptWorld {
   std::unique_ptr<World> world_;
 };
 
-template <typename F>
-std::string ErrorOf(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
-
-#define EXPECT_CONTAINS(haystack, needle) \
-  EXPECT_NE(std::string(haystack).find(needle), std::string::npos) << (haystack)
+using testing::ErrorOf;
 
 // --- Child scripts ------------------------------------------------------------------------
 

@@ -8,6 +8,7 @@
 
 #include "framework/error.h"
 #include "framework/world.h"
+#include "tests/framework/error_of.h"
 #include "tests/framework/fakes.h"
 
 namespace swarmsim {
@@ -56,19 +57,7 @@ class ScriptWorld {
   double next_x_ = 0;
 };
 
-// The message of the swarmsim::Error thrown by `f`, or "" if none.
-template <typename F>
-std::string ErrorOf(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
-
-#define EXPECT_CONTAINS(haystack, needle) \
-  EXPECT_NE(std::string(haystack).find(needle), std::string::npos) << (haystack)
+using testing::ErrorOf;
 
 // --- Callbacks ------------------------------------------------------------------------
 

@@ -9,6 +9,7 @@
 
 #include "framework/error.h"
 #include "framework/world.h"
+#include "tests/framework/error_of.h"
 #include "tests/framework/fakes.h"
 
 namespace swarmsim {
@@ -54,18 +55,7 @@ class ModelWorld {
   double next_x_ = 0;
 };
 
-template <typename F>
-std::string ErrorOf(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
-
-#define EXPECT_CONTAINS(haystack, needle) \
-  EXPECT_NE(std::string(haystack).find(needle), std::string::npos) << (haystack)
+using testing::ErrorOf;
 
 // Robot 0 copies itself once, at step 0, to (2, 1) heading 0.5 rad.
 const char kCopyOnce[] = R"(
