@@ -62,7 +62,12 @@ struct LuaContext {
   bool in_sensing = false;        // running a sysCall_sensing (sim.handleChildScript follows it)
   bool dynamics_handled = false;  // the main script called sim.handleDynamics() this step
   int64_t slice_fires = 0;        // time-slice hook calls since the thread was resumed
-  lua_State* thread = nullptr;    // the script thread being resumed, else null
+  // The instruction budget of a callback (simulation.instruction_budget; 0:
+  // none), and how its error names what ran and the setting that raises it.
+  int64_t instruction_budget = 0;
+  const char* budget_subject = "the callback";
+  const char* budget_setting = "simulation.instruction_budget";  // "": no setting to name
+  lua_State* thread = nullptr;  // the script thread being resumed, else null
   // The running callback (or thread resume) used up its instruction budget:
   // every further instruction raises budget_error, and the host reports it.
   bool budget_exhausted = false;

@@ -144,8 +144,7 @@ int SetThreadSwitchTiming(lua_State* L) {
   }
   Script* script = static_cast<Script*>(c.host_script);
   if (script == nullptr) return 0;
-  script->slice_instructions =
-      SliceInstructions(ms * kInstructionsPerMs, c.world->settings().instruction_budget);
+  script->slice_instructions = SliceInstructions(ms * kInstructionsPerMs, c.instruction_budget);
   if (script->thread == L) lua_sethook(L, SliceHook, LUA_MASKCOUNT, script->slice_instructions);
   return 0;
 }

@@ -11,7 +11,6 @@
 #include <utility>
 
 #include "framework/script_state.h"
-#include "framework/world.h"
 
 namespace swarmsim {
 namespace lua_host {
@@ -29,7 +28,8 @@ std::string FormatBytes(size_t bytes) {
   return text;
 }
 std::string MemoryLimitText(const LuaMemory& memory) {
-  return "the scripts hold more than " + MemoryLimitTail(memory);
+  return std::string(memory.holder) + (memory.plural ? " hold" : " holds") + " more than " +
+         MemoryLimitTail(memory);
 }
 
 // "file:line: " of the Lua function a hook interrupted, or "".
@@ -69,10 +69,13 @@ void ExhaustBudget(lua_State* L, MakeMessage make_message) {
 // Count hook of non-threaded callbacks: the budget is used up.
 void BudgetHook(lua_State* L, lua_Debug* ar) {
   ExhaustBudget(L, [&] {
-    return HookWhere(L, ar) + "the callback ran more than " +
-           std::to_string(Context(L).world->settings().instruction_budget) +
-           " Lua instructions without returning (an endless loop?); if the work is real, raise "
-           "simulation.instruction_budget";
+    const LuaContext& c = Context(L);
+    std::string message = HookWhere(L, ar) + c.budget_subject + " ran more than " +
+                          std::to_string(c.instruction_budget) +
+                          " Lua instructions without returning (an endless loop?)";
+    if (*c.budget_setting != '\0')
+      message += std::string("; if the work is real, raise ") + c.budget_setting;
+    return message;
   });
 }
 
@@ -81,8 +84,8 @@ void MemoryHook(lua_State* L, lua_Debug* ar) {
   auto* state = static_cast<ScriptState*>(Context(L).host_state);
   if (const size_t refused = std::exchange(state->memory.refused_bytes, 0); refused > 0) {
     ExhaustBudget(L, [&] {
-      return HookWhere(L, ar) + "an allocation of " + FormatBytes(refused) +
-             " would take the scripts past " + MemoryLimitTail(state->memory);
+      return HookWhere(L, ar) + "an allocation of " + FormatBytes(refused) + " would take " +
+             state->memory.holder + " past " + MemoryLimitTail(state->memory);
     });
   }
   lua_gc(L, LUA_GCCOLLECT);
@@ -105,7 +108,7 @@ void MemoryHook(lua_State* L, lua_Debug* ar) {
 }  // namespace
 
 void SetBudget(lua_State* L, const LuaContext& c) {
-  const int64_t budget = c.world->settings().instruction_budget;
+  const int64_t budget = c.instruction_budget;
   if (budget > 0)
     lua_sethook(L, BudgetHook, LUA_MASKCOUNT, static_cast<int>(std::min<int64_t>(budget, INT_MAX)));
   else if (lua_gethook(L) == ExhaustedHook)
@@ -125,7 +128,7 @@ void SliceHook(lua_State* L, lua_Debug* ar) {
     lua_yield(L, 0);
     return;
   }
-  const int64_t budget = c.world->settings().instruction_budget;
+  const int64_t budget = c.instruction_budget;
   const int count = lua_gethookcount(L);
   if (budget > 0 && ++c.slice_fires * count > budget) {
     ExhaustBudget(L, [&] {

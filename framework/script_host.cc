@@ -227,6 +227,7 @@ std::unique_ptr<ScriptState> NewState(World* world, int instance, RobotRuntime* 
   c.log_prefix = "[" + name + "] ";
   c.name = std::move(name);
   c.host_state = state.get();
+  c.instruction_budget = world->settings().instruction_budget;
   state->memory.limit =
       static_cast<size_t>(std::max<int64_t>(world->settings().script_memory_limit, 0));
   lua_State* L = lua_newstate(LimitedAlloc, state.get());
@@ -303,8 +304,8 @@ void Initialize(ScriptState* state) {
       script.thread_ref = luaL_ref(L, LUA_REGISTRYINDEX);
       lua_rawgeti(script.thread, LUA_REGISTRYINDEX, script.callbacks[kThread]);
       // The default slice (or one sim.setThreadSwitchTiming set already), capped.
-      script.slice_instructions = SliceInstructions(
-          script.slice_instructions, state->context.world->settings().instruction_budget);
+      script.slice_instructions =
+          SliceInstructions(script.slice_instructions, state->context.instruction_budget);
     }
   }
   // Generational collection keeps a robot's heap within ~20% of what it

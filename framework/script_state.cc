@@ -13,15 +13,15 @@
 namespace swarmsim::lua_host {
 
 std::string MemoryLimitTail(const LuaMemory& memory) {
-  return std::to_string(memory.limit >> 20) +
-         " MiB of Lua memory (simulation.script_memory_mb; raise it if the data is real)";
+  return std::to_string(memory.limit >> 20) + " MiB of Lua memory (" + memory.setting + ")";
 }
 
 std::string ErrorText(lua_State* L, int status) {
   if (status == LUA_ERRMEM) {
     const auto* state = static_cast<const ScriptState*>(Context(L).host_state);
     if (state != nullptr && state->memory.refused)
-      return "an allocation would take the scripts past " + MemoryLimitTail(state->memory);
+      return std::string("an allocation would take ") + state->memory.holder + " past " +
+             MemoryLimitTail(state->memory);
     return "not enough memory";
   }
   if (status != LUA_ERRRUN && status != LUA_ERRSYNTAX && status != LUA_ERRERR)

@@ -78,6 +78,10 @@ struct LuaMemory {
   size_t limit = 0;          // bytes; 0: no limit
   bool refused = false;      // the last allocation was refused (limit + slack)
   size_t refused_bytes = 0;  // the size of a refused allocation MemoryHook has not reported, or 0
+  // How the errors name what holds the memory and the limit's setting.
+  const char* holder = "the scripts";
+  bool plural = true;  // "the scripts hold", "the expression holds"
+  const char* setting = "simulation.script_memory_mb; raise it if the data is real";
 };
 inline constexpr size_t kMemorySlack = size_t{16} << 20;
 

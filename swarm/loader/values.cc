@@ -7,9 +7,9 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
-#include <cstdlib>
 
 #include "framework/error.h"
+#include "framework/lua_evaluator.h"
 
 namespace swarmsim::loader {
 
@@ -98,36 +98,15 @@ std::string Scope::ListHint() const {
 // --- Expressions ------------------------------------------------------------------------
 
 struct Expressions::Impl {
-  static constexpr size_t kMemoryLimit = 64 << 20;  // bytes
-  static constexpr int kHookInterval = 10000;       // instructions
-  static constexpr int kMaxHooks = 100;             // 1e6 instructions per expression
+  static constexpr size_t kMemoryLimit = 64 << 20;        // bytes
+  static constexpr int64_t kInstructionBudget = 1000000;  // per expression
 
-  lua_State* L = nullptr;
-  size_t memory = 0;
-  int hooks = 0;
+  LimitedLua lua{"the expression", kMemoryLimit, kInstructionBudget};
   int math_ref = LUA_NOREF;
   const Scope* scope = nullptr;  // during Evaluate
 
-  static void* Allocate(void* ud, void* ptr, size_t old_size, size_t new_size) {
-    Impl* self = static_cast<Impl*>(ud);
-    const size_t old_bytes = ptr ? old_size : 0;
-    if (new_size == 0) {
-      std::free(ptr);
-      self->memory -= old_bytes;
-      return nullptr;
-    }
-    if (new_size > old_bytes && self->memory - old_bytes + new_size > kMemoryLimit) return nullptr;
-    void* out = std::realloc(ptr, new_size);
-    if (out) self->memory = self->memory - old_bytes + new_size;
-    return out;
-  }
-
-  static Impl* From(lua_State* L) { return *static_cast<Impl**>(lua_getextraspace(L)); }
-
-  static void Hook(lua_State* L, lua_Debug*) {
-    if (++From(L)->hooks > kMaxHooks)
-      luaL_error(L, "the expression ran too long (more than %d instructions)",
-                 kHookInterval * kMaxHooks);
+  static Impl* From(lua_State* L) {
+    return static_cast<Impl*>(lua_touserdata(L, lua_upvalueindex(1)));
   }
 
   // __index of the expression's globals: a name that is neither a parameter
@@ -160,6 +139,7 @@ struct Expressions::Impl {
   }
 
   void PushValue(const ParamValue& value) {
+    lua_State* L = lua.L();
     if (const double* d = std::get_if<double>(&value))
       lua_pushnumber(L, *d);
     else if (const bool* b = std::get_if<bool>(&value))
@@ -170,10 +150,7 @@ struct Expressions::Impl {
 };
 
 Expressions::Expressions() : impl_(std::make_unique<Impl>()) {
-  lua_State* L = lua_newstate(&Impl::Allocate, impl_.get());
-  if (!L) throw Error("cannot create the Lua state for expressions (out of memory)");
-  impl_->L = L;
-  *static_cast<Impl**>(lua_getextraspace(L)) = impl_.get();
+  lua_State* L = impl_->lua.L();
   // The math library without its random generator (seeded from the clock).
   luaL_requiref(L, "math", luaopen_math, 0);
   lua_pushnil(L);
@@ -184,15 +161,12 @@ Expressions::Expressions() : impl_(std::make_unique<Impl>()) {
   lua_settop(L, 0);
 }
 
-Expressions::~Expressions() {
-  if (impl_->L) lua_close(impl_->L);
-}
+Expressions::~Expressions() = default;
 
 ParamValue Expressions::Evaluate(std::string_view expression, const Scope& scope) {
-  lua_State* L = impl_->L;
+  lua_State* L = impl_->lua.L();
   lua_settop(L, 0);
   impl_->scope = &scope;
-  impl_->hooks = 0;
   const std::string code = "return " + std::string(expression);
   // Text only: a binary chunk could crash the VM.
   if (luaL_loadbufferx(L, code.data(), code.size(), "=expression", "t") != LUA_OK) {
@@ -221,19 +195,14 @@ ParamValue Expressions::Evaluate(std::string_view expression, const Scope& scope
       lua_setfield(L, -2, name.c_str());
     }
   lua_newtable(L);
-  lua_pushcfunction(L, &Impl::UnknownName);
+  lua_pushlightuserdata(L, impl_.get());
+  lua_pushcclosure(L, &Impl::UnknownName, 1);
   lua_setfield(L, -2, "__index");
   lua_setmetatable(L, -2);
   lua_setupvalue(L, -2, 1);  // _ENV of the chunk
-  lua_sethook(L, &Impl::Hook, LUA_MASKCOUNT, Impl::kHookInterval);
-  const int status = lua_pcall(L, 0, 1, 0);
-  lua_sethook(L, nullptr, 0, 0);
   ParamValue result;
   std::string error;
-  if (status != LUA_OK) {
-    error = status == LUA_ERRMEM             ? "the expression used too much memory"
-            : lua_type(L, -1) == LUA_TSTRING ? lua_tostring(L, -1)
-                                             : "error";
+  if (!impl_->lua.Call(0, 1, &error)) {
     error = StripChunkPosition(error);
   } else {
     switch (lua_type(L, -1)) {

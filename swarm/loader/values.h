@@ -47,7 +47,9 @@ struct Scope {
 // A small sandboxed Lua state for "= expression" values. Its globals are the
 // scope's parameters and the math library (sqrt, floor, pi, ...; not random,
 // which would break determinism). No other library: no I/O, no os, no load.
-// An instruction budget and a memory cap turn runaway expressions into errors.
+// It is a LimitedLua (framework/lua_evaluator.h): the script host's
+// allocator and instruction-budget hook turn a runaway expression (over a
+// million instructions or 64 MiB) into an error.
 class Expressions {
  public:
   Expressions();

@@ -316,7 +316,11 @@ TEST_F(MalformedWorldTest, EachMistakeHasAClearMessage) {
        {"world.yaml:1:15:", "in expression '2 +'"}},
       {"runaway expression",
        "arena: {size: '= (function() while true do end end)()'}\n",
-       {"world.yaml:1:15:", "ran too long"}},
+       {"world.yaml:1:15:", "the expression ran more than 1000000 Lua instructions"}},
+      {"expression holding too much memory",
+       "arena: {size: '= (function() local s = \"x\" for i = 1, 40 do s = s .. s end "
+       "return #s end)()'}\n",
+       {"world.yaml:1:15:", "the expression", "past 64 MiB of Lua memory"}},
       {"no libraries in expressions",
        "arena: {size: '= os.exit(1)'}\n",
        {"world.yaml:1:15:", "unknown name 'os'"}},
