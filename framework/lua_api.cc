@@ -10,7 +10,9 @@
 
 #include "framework/error.h"
 #include "framework/object_type.h"
+#include "framework/registry.h"
 #include "framework/suggest.h"
+#include "framework/world.h"
 
 namespace swarmsim {
 
@@ -128,6 +130,26 @@ int IsYieldable(lua_State* L) {
   return 1;
 }
 
+// Pushes the function `key` of the Lua area of an object type the world's
+// registry holds (a module's type, object_type.h), if one has it.
+bool PushRegisteredTypeFunction(lua_State* L, std::string_view key) {
+  const LuaContext& c = Context(L);
+  if (c.world == nullptr) return false;
+  for (const ObjectTypeDescriptor* type : c.world->registry().object_types()) {
+    if (type->register_lua == nullptr) continue;
+    lua_newtable(L);
+    type->register_lua(L);
+    lua_pushlstring(L, key.data(), key.size());
+    lua_rawget(L, -2);
+    if (!lua_isnil(L, -1)) {
+      lua_remove(L, -2);
+      return true;
+    }
+    lua_pop(L, 2);
+  }
+  return false;
+}
+
 // __index of a robot's `sim` table: fetch the entry, keep it in the table.
 int LazySimIndex(lua_State* L) {
   if (lua_type(L, 2) != LUA_TSTRING) return 0;
@@ -146,8 +168,9 @@ int LazySimIndex(lua_State* L) {
   auto it = std::lower_bound(entries.begin(), entries.end(), key,
                              [](const SimEntry& e, std::string_view k) { return e.name < k; });
   if (it == entries.end() || it->name != key) {
-    // A plugin's command (lua_api_plugins.cc), kept like the others.
-    if (!PushPluginCommand(L, key)) return 0;
+    // A registered object type's function, or a plugin's command
+    // (lua_api_plugins.cc), kept like the others.
+    if (!PushRegisteredTypeFunction(L, key) && !PushPluginCommand(L, key)) return 0;
     lua_pushvalue(L, 2);
     lua_pushvalue(L, -2);
     lua_rawset(L, 1);
@@ -300,14 +323,15 @@ void RegisterAreas(lua_State* L) {
       RegisterDynamicsApi,    // lua_api_dynamics.cc: dynamic/kinematic switch, joint forces
       RegisterIkApi,          // lua_api_ik.cc: IK groups
       RegisterCustomDataApi,  // lua_api_custom_data.cc: custom data blocks
-      RegisterPluginApi,      // lua_api_plugins.cc: plugin sensors
       RegisterModelsApi,      // lua_api_models.cc: copying and removing robots at run time
   };
   lua_pushinteger(L, kHandleWorld);
   lua_setfield(L, -2, "handle_world");
   for (auto area : kAreas) area(L);
-  // Each object type's own area (joints, proximity, force sensors, paint
-  // nozzles: framework/types/, object_type.h).
+  // Each built-in object type's own area (joints, proximity, force sensors,
+  // paint nozzles, plugin sensors: framework/types/, object_type.h); the
+  // types of a world's registry add theirs on first use
+  // (PushRegisteredTypeFunction).
   for (const ObjectTypeDescriptor* type : CoreObjectTypes())
     if (type->register_lua != nullptr) type->register_lua(L);
 }

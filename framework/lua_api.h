@@ -186,7 +186,7 @@ void RegisterIkApi(lua_State* L);
 void RegisterForceSensorApi(lua_State* L);
 void RegisterPaintApi(lua_State* L);
 void RegisterCustomDataApi(lua_State* L);
-void RegisterPluginApi(lua_State* L);
+void RegisterPluginSensorApi(lua_State* L);
 void RegisterModelsApi(lua_State* L);
 
 // Pushes the plugin command `name` (registered in the world's

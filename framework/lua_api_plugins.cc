@@ -1,6 +1,7 @@
 // Plugin script commands (framework/plugin_api.h) as sim.* functions: the
 // arguments and results cross as SwarmsimValue, never as Lua values; and
-// sim.readPluginSensor for the plugin sensor types.
+// sim.readPluginSensor, the Lua area of the plugin_sensor type
+// (framework/types/plugin_sensor_type.cc).
 #include <string>
 #include <vector>
 
@@ -91,7 +92,7 @@ int ReadPluginSensor(lua_State* L) {
 
 }  // namespace
 
-void RegisterPluginApi(lua_State* L) {
+void RegisterPluginSensorApi(lua_State* L) {
   static constexpr luaL_Reg kFunctions[] = {
       {"readPluginSensor", Guarded<ReadPluginSensor, "sim.readPluginSensor">},
       {nullptr, nullptr},

@@ -13,16 +13,17 @@
 namespace swarmsim {
 
 // The built-in object types; types registered by modules and plugins
-// (Scene::RegisterType) take the values after kPaintNozzle.
+// (Scene::RegisterType) take the values after kPluginSensor.
 enum class ObjectType : uint8_t {
   kDummy,
   kShape,
   kJoint,
   kProximitySensor,
   kForceSensor,
-  kPaintNozzle
+  kPaintNozzle,
+  kPluginSensor
 };
-inline constexpr int kBuiltinObjectTypes = 6;
+inline constexpr int kBuiltinObjectTypes = 7;
 inline constexpr int kMaxObjectTypes = 64;
 
 // One type's rows, whatever their C++ type.

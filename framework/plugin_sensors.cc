@@ -39,8 +39,7 @@ void PluginSensors::Index(const World& world) {
   const Scene& scene = world.scene();
   std::vector<std::pair<int, uint32_t>> found;  // (robot or -1, slot)
   for (uint32_t slot = 0; slot < scene.slot_count(); ++slot) {
-    if (!scene.alive_at(slot) || scene.type_at(slot) != ObjectType::kDummy) continue;
-    if (scene.ReadCustomData(scene.IdAt(slot), kPluginSensorTag) == nullptr) continue;
+    if (!scene.alive_at(slot) || scene.type_at(slot) != ObjectType::kPluginSensor) continue;
     found.emplace_back(scene.instance_of_at(slot), slot);
   }
   // Robots in order, the scene's objects (-1) last.
@@ -52,9 +51,11 @@ void PluginSensors::Index(const World& world) {
   start_.assign(robots + 2, 0);
   sensor_of_slot_.assign(scene.slot_count(), -1);
   size_t size = 0;
+  const RowTable& rows = *scene.rows(ObjectType::kPluginSensor);
   for (const auto& [robot, slot] : found) {
     const ObjectId id = scene.IdAt(slot);
-    const std::string& name = *scene.ReadCustomData(id, kPluginSensorTag);
+    const std::string& name =
+        static_cast<const Rows<PluginSensorRow>&>(rows).rows[scene.row_at(slot)].sensor;
     Sensor sensor;
     sensor.id = id;
     sensor.type = world.registry().FindPluginSensor(name);
@@ -133,8 +134,7 @@ ModuleDescriptor PluginSensorsModule() {
 bool PluginSensorReading(const World& world, ObjectId id, std::span<const double>* values) {
   const Scene& scene = world.scene();
   const uint32_t slot = scene.SlotOf(id, "plugin sensor");
-  if (scene.type_at(slot) != ObjectType::kDummy ||
-      scene.ReadCustomData(id, kPluginSensorTag) == nullptr)
+  if (scene.type_at(slot) != ObjectType::kPluginSensor)
     throw Error("object " + scene.PathOf(id) + " is not a plugin sensor");
   const auto* module = dynamic_cast<const PluginSensors*>(world.find_module("plugin_sensors"));
   return module != nullptr && module->Reading(scene, id, values);

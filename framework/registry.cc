@@ -78,9 +78,9 @@ void ModuleRegistry::RegisterObjectType(std::shared_ptr<const ObjectTypeDescript
   const std::string name = type->name;
   for (const ObjectTypeDescriptor* t : CoreObjectTypes())
     if (name == t->name) throw Error("object type '" + name + "' is a built-in type");
-  // The loader's own types: a registered one of the same name would never be
-  // reached (model files would build the loader's instead).
-  if (name == "proximity_ring" || name == "plugin_sensor")
+  // The loader's own shorthand: a registered type of the same name would
+  // never be reached (model files would build a ring of sensors instead).
+  if (name == "proximity_ring")
     throw Error("object type '" + name + "' is a world-file type of the loader's");
   for (const ObjectTypeDescriptor* t : object_types_)
     if (name == t->name) throw Error("object type '" + name + "' is registered twice");

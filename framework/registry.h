@@ -40,7 +40,7 @@ struct PhaseCallback {
 };
 
 // A sensor type registered by a plugin (framework/plugin_api.h). Its objects
-// are dummies whose custom data kPluginSensorTag holds the type's name.
+// are of type plugin_sensor (framework/types/plugin_sensor_type.cc).
 struct PluginSensorType {
   std::string name;  // as models write it: {type: plugin_sensor, sensor: NAME}
   std::string description;
@@ -48,7 +48,6 @@ struct PluginSensorType {
   void* user_data = nullptr;
   int max_values = SWARMSIM_SENSOR_MAX_VALUES;  // numbers one reading holds at most
 };
-inline constexpr const char* kPluginSensorTag = "swarmsim.plugin_sensor";
 
 class ModuleRegistry {
  public:

@@ -12,5 +12,6 @@ extern const ObjectTypeDescriptor kJointType;
 extern const ObjectTypeDescriptor kProximitySensorType;
 extern const ObjectTypeDescriptor kForceSensorType;
 extern const ObjectTypeDescriptor kPaintNozzleType;
+extern const ObjectTypeDescriptor kPluginSensorType;
 
 }  // namespace swarmsim

@@ -30,11 +30,11 @@ const std::vector<std::string> kCommonKeys = {
 // dummy tagged with the sensor type a plugin registers).
 const std::vector<std::string> kRingKeys = {"name",   "type",  "count",          "radius",
                                             "height", "range", "start_angle_deg"};
-const std::vector<std::string> kPluginSensorKeys = {"sensor"};
 
 // The object types a model may use: every type of the scene (the built-in
 // ones, then the registry's, in ObjectType order; object_type.h), with
-// proximity_ring after proximity_sensor and plugin_sensor last.
+// proximity_ring (the loader's shorthand for a ring of sensors) after
+// proximity_sensor.
 struct TypeList {
   std::vector<const ObjectTypeDescriptor*> types;  // by ObjectType value
   std::vector<std::string> names;                  // as world files write them
@@ -48,9 +48,8 @@ struct TypeList {
       names.push_back(t->name);
       if (names.back() == "proximity_sensor") names.push_back("proximity_ring");
     }
-    names.push_back("plugin_sensor");
   }
-  // The type named `name` (one of `names` but the two loader-only ones).
+  // The type named `name` (one of `names` but proximity_ring).
   ObjectType Find(const std::string& name) const {
     for (size_t t = 0; t < types.size(); ++t)
       if (name == types[t]->name) return static_cast<ObjectType>(t);
@@ -60,12 +59,8 @@ struct TypeList {
   std::vector<std::string> KeysOf(const std::string& name) const {
     if (name == "proximity_ring") return kRingKeys;
     std::vector<std::string> keys = kCommonKeys;
-    if (name == "plugin_sensor") {
-      keys.insert(keys.end(), kPluginSensorKeys.begin(), kPluginSensorKeys.end());
-    } else {
-      for (const ObjectKey& key : types[static_cast<size_t>(Find(name))]->keys)
-        keys.push_back(key.name);
-    }
+    for (const ObjectKey& key : types[static_cast<size_t>(Find(name))]->keys)
+      keys.push_back(key.name);
     return keys;
   }
   // The keys of every type, once each (for an object without a 'type').
@@ -150,18 +145,13 @@ struct Builder {
     ObjectSpec spec;
     spec.name = name;
     spec.X_PO = ReadPose(values, named);
-    if (type == "plugin_sensor") {
-      spec.type = ObjectType::kDummy;
-      spec.plugin_sensor = PluginSensor(named.Require("sensor"));
-    } else {
-      // The type's own reader fills its row (framework/types/, object_type.h).
-      spec.type = types.Find(type);
-      const ObjectTypeDescriptor& descriptor = *types.types[static_cast<size_t>(spec.type)];
-      spec.row = NewRow(descriptor);
-      if (descriptor.read != nullptr)
-        descriptor.read(descriptor, FieldsObjectReader(values, named, meshes, registry),
-                        spec.row->At(0));
-    }
+    // The type's own reader fills its row (framework/types/, object_type.h).
+    spec.type = types.Find(type);
+    const ObjectTypeDescriptor& descriptor = *types.types[static_cast<size_t>(spec.type)];
+    spec.row = NewRow(descriptor);
+    if (descriptor.read != nullptr)
+      descriptor.read(descriptor, FieldsObjectReader(values, named, meshes, registry),
+                      spec.row->At(0));
     Count(field, 1);
     if (named.Has("script")) {
       // script: file.lua, or script: {file: file.lua, explicit: true}.
@@ -180,23 +170,6 @@ struct Builder {
     for (const Field& child : ListElements(values.file(), named.Get("children"), "objects"))
       Object(child, depth + 1, false, &spec.children);
     out->push_back(std::move(spec));
-  }
-
-  // sensor: NAME of a sensor type a loaded plugin registers.
-  std::string PluginSensor(const Field& field) {
-    const std::string name = values.String(field);
-    std::vector<std::string> known;
-    if (registry != nullptr) {
-      if (registry->FindPluginSensor(name) != nullptr) return name;
-      for (const PluginSensorType& t : registry->plugin_sensors()) known.push_back(t.name);
-    }
-    if (known.empty())
-      values.Fail(field, "unknown plugin sensor type '" + name +
-                             "': no loaded plugin registers sensor types (plugins: [...])");
-    std::string list;
-    for (const std::string& k : known) list += (list.empty() ? "" : ", ") + k;
-    values.Fail(field, "unknown plugin sensor type '" + name + "' (registered: " + list + ")" +
-                           Suggest(name, known));
   }
 
   // `count` proximity sensors named `name` in a ring around the parent's z
@@ -418,7 +391,6 @@ ObjectSpec ResolveModel(const ModelFile& model, const ValueReader& values, Scrip
 ObjectId AddToScene(const ObjectSpec& spec, ObjectId parent, Scene* scene) {
   const ObjectId id = scene->AddObject(spec.type, spec.name, parent, spec.X_PO,
                                        spec.row ? spec.row->At(0) : nullptr);
-  if (!spec.plugin_sensor.empty()) scene->WriteCustomData(id, kPluginSensorTag, spec.plugin_sensor);
   if (spec.script) scene->AttachScript(id, spec.script, spec.script_explicit);
   for (const ObjectSpec& child : spec.children) AddToScene(child, id, scene);
   return id;

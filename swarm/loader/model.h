@@ -29,7 +29,6 @@ struct ObjectSpec {
   // The object's row (of its type's row type, object_type.h) in a table of
   // its own; null for a type without rows.
   std::shared_ptr<RowTable> row;
-  std::string plugin_sensor;  // type: plugin_sensor: the sensor type (a kDummy tagged with it)
   // The row as `Row` if the object is of `type`, else null (the placement
   // footprint reads shapes and joints).
   template <typename Row>
