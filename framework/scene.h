@@ -22,6 +22,7 @@
 #include <string_view>
 #include <vector>
 
+#include "framework/environment.h"
 #include "framework/force_sensor.h"
 #include "framework/handle.h"
 #include "framework/math.h"
@@ -361,6 +362,12 @@ class Scene {
   // Monotonic counter bumped on every structural change (add, remove, reparent).
   uint64_t structure_version() const { return structure_version_; }
 
+  // --- Environment map ----------------------------------------------------------
+  // The static environment a world loads from a map file (environment.h),
+  // or null. Set before the world starts; the modules read it at Build().
+  const EnvironmentMap* environment() const { return environment_.get(); }
+  void set_environment(std::shared_ptr<const EnvironmentMap> map) { environment_ = std::move(map); }
+
  private:
   uint32_t AllocateSlot(std::string name, ObjectId parent, const Pose& X_PO, ObjectType type);
   void FreeSlot(uint32_t slot);
@@ -414,6 +421,7 @@ class Scene {
   // for a type without rows).
   std::vector<const ObjectTypeDescriptor*> types_;
   std::vector<std::unique_ptr<RowTable>> tables_;
+  std::shared_ptr<const EnvironmentMap> environment_;
 
   std::vector<ScriptAttachment> scripts_;
   std::vector<ModelInstance> instances_;

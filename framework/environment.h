@@ -1,0 +1,30 @@
+// The static environment loaded from a map (`environment: {octomap:
+// file.bt}` in a world file): the map's occupied space as axis-aligned boxes
+// in the world frame. Proximity, collision, minimum distance, line of sight
+// and physics read it from the Scene; the files are read by
+// modules/environment (no OctoMap types here). Mills cut it (voxels go).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "framework/math.h"
+
+namespace swarmsim {
+
+struct EnvironmentBox {
+  Vec3 lo, hi;  // m, world frame; lo < hi on every axis
+};
+
+struct EnvironmentMap {
+  std::string source;     // the file as the world names it, for messages
+  double resolution = 0;  // m, the map's voxel size
+  // The occupied leaves of the map, each a cube of resolution x 2^k
+  // (a pruned octree merges eight full children), in the map's own order
+  // (deterministic: depth-first from the root).
+  std::vector<EnvironmentBox> boxes;
+  Vec3 lo, hi;  // bounds of `boxes` (both zero when there are none)
+};
+
+}  // namespace swarmsim
