@@ -223,6 +223,8 @@ class Scene {
   // of `from`'s model root). "name[k]" picks the k-th (0-based) match of a
   // repeated name in hierarchy order. Returns null when nothing matches.
   ObjectId FindObject(std::string_view path, ObjectId from = {}) const;
+  // Appends the slots of `slot`'s subtree (itself first), hierarchy order.
+  void CollectSubtree(uint32_t slot, std::vector<uint32_t>* out) const;
   // Why FindObject(path, from) found nothing, to end an error message: at
   // the first element that matched nothing, "; did you mean '<path with the
   // nearest name>'?", "; there are 3 objects named 'prox' there:
@@ -378,7 +380,6 @@ class Scene {
   void UpdatePoses(std::span<const uint32_t> slots);
   void RebuildOrder() const;
   void RebuildInstanceObjects(int instance);
-  void CollectSubtree(uint32_t slot, std::vector<uint32_t>* out) const;
   uint32_t CopyObject(uint32_t src, int32_t new_parent);
   // A built-in type's table (the descriptor made Rows<Row> for it).
   template <typename Row>
