@@ -45,6 +45,7 @@ uint32_t SlotOf(const Object* o) {
 double PairDistance(const Object* a, const Object* b, Vec3* pa, Vec3* pb) {
   fcl::DistanceRequestd request(true);
   request.gjk_solver_type = fcl::GST_INDEP;
+  request.distance_tolerance = 1e-9;
   fcl::DistanceResultd result;
   fcl::distance(a, b, request, result);
   if (result.min_distance > 0) {
