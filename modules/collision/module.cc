@@ -3,8 +3,8 @@
 #include <algorithm>
 
 #include "framework/error.h"
-#include "framework/scheduler.h"
 #include "framework/scene.h"
+#include "framework/scheduler.h"
 #include "framework/world.h"
 #include "modules/collision/rows.h"
 
