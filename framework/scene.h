@@ -95,16 +95,37 @@ struct JointData {
   Pose Motion() const;  // transform produced by `position` about/along z
 };
 
-// A ray proximity sensor looking along its +z axis (V-REP's convention).
-// 32 bytes: a robot's control step reads all of its sensors' rows.
+// The detection volume of a proximity sensor (modules/proximity/volume.h):
+// a ray along +z (V-REP's convention), random rays in a cone about +z, or a
+// solid volume (cone, pyramid, cylinder about +z; disc: a sector in the xy
+// plane about +x).
+enum class ProximityVolume : uint8_t { kRay, kRandomizedRay, kCone, kPyramid, kCylinder, kDisc };
+const char* ToString(ProximityVolume volume);
+
+// A proximity sensor. The first 32 bytes are what a ray sensor reads and
+// writes every step; the volume settings and the point and normal follow.
 struct ProximitySensorData {
-  double range = 0.1;  // m
+  double range = 0.1;  // m: nothing farther than this is detected
   // Reading, written in the sense phase:
-  double distance = 0;       // m, along the ray
+  double distance = 0;       // m, from the sensor's origin to the detected point
   ObjectId detected_object;  // shape that was hit
   bool detected = false;
-  // The detected point in the sensor frame: on the ray, the +z axis.
-  Vec3 p_SD() const { return {0, 0, distance}; }
+  // Volume settings (constant):
+  ProximityVolume volume = ProximityVolume::kRay;
+  bool detect_front = true;             // meshes: faces seen from outside (counter-clockwise)
+  bool detect_back = true;              // meshes: faces seen from inside
+  uint16_t ray_count = 16;              // randomized_ray
+  double angle = 0.5235987755982988;    // rad: cone, randomized_ray half-angle; disc half sector
+  double angle_y = 0.5235987755982988;  // rad: pyramid half-angle about y (angle: about x)
+  double radius = 0.05;                 // m: cylinder
+  double thickness = 0.01;              // m: disc, along z
+  double blind_zone = 0;                // m: the volume starts at this distance along its axis
+  double max_detection_angle = 3.141592653589793;  // rad: reflectance cut-off (pi: none)
+  // Volume readings: the detected point and the outward surface normal
+  // there, in the sensor frame (rays: the point is on +z, see p_SD()).
+  Vec3 point, normal;
+  // The detected point in the sensor frame: for a ray, on its +z axis.
+  Vec3 p_SD() const { return volume == ProximityVolume::kRay ? Vec3{0, 0, distance} : point; }
 };
 
 // A script attached to an object. The source is shared by all copies.
