@@ -183,6 +183,105 @@ bool ProjectOriginOntoIntersection(const ConvexSet* sets, int count, double scal
   return true;
 }
 
+// Is p within `tolerance` of every set?
+bool InAll(const ConvexSet* sets, int count, const Vec3& p, double tolerance) {
+  for (int i = 0; i < count; ++i)
+    if ((Project(sets[i], p) - p).SquaredNorm() > tolerance * tolerance) return false;
+  return true;
+}
+
+// min |x| over S ∩ {n . x <= c} (n unit) when S's nearest point violates the
+// half-space: x = P_S(-lambda n) at the root lambda > 0 of n . x(lambda) = c
+// (the Lagrange dual of the one constraint; n . x(lambda) is nonincreasing),
+// by Illinois regula falsi to 1e-13 of `scale`. False: S misses it.
+bool NearestInHalfSpace(const ConvexSet& shape, const Vec3& n, double c, double scale, Vec3* x) {
+  auto h = [&](double lambda, Vec3* y) {
+    *y = Project(shape, n * -lambda);
+    return n.Dot(*y) - c;
+  };
+  Vec3 y;
+  double lo = 0, h_lo = h(0, &y);
+  if (h_lo <= 0) return *x = y, true;
+  double hi = scale, h_hi = h(hi, &y);
+  for (int k = 0; h_hi > 0; ++k) {
+    if (k == 60) return false;  // S lies beyond the plane
+    lo = hi, h_lo = h_hi;
+    hi *= 4;
+    h_hi = h(hi, &y);
+  }
+  *x = y;  // feasible
+  int side = 0;
+  for (int i = 0; i < 200 && hi - lo > 1e-13 * scale; ++i) {
+    double m = hi - h_hi * (hi - lo) / (h_hi - h_lo);
+    if (!(m > lo && m < hi)) m = 0.5 * (lo + hi);
+    const double hm = h(m, &y);
+    if (hm > 0) {
+      lo = m, h_lo = hm;
+      if (side == 1) h_hi *= 0.5;
+      side = 1;
+    } else {
+      *x = y;
+      if (hm == 0) break;
+      hi = m, h_hi = hm;
+      if (side == -1) h_lo *= 0.5;
+      side = -1;
+    }
+  }
+  return true;
+}
+
+// min |x| over S ∩ (a cone or cylinder piece) through its supporting
+// half-spaces: at the answer's azimuth phi, the half-space tangent there
+// gives the same answer, so iterate phi <- azimuth of that half-space's
+// answer. *found: an answer in every set of the volume.
+bool NearestThroughTangents(const ConvexSet* sets, int count, const ConvexSet& piece,
+                            const Vec3& start, double scale, Vec3* x, bool* found) {
+  double phi = std::atan2(start.y, start.x);
+  for (int k = 0; k < 40; ++k) {
+    const double cp = std::cos(phi), sp = std::sin(phi);
+    const bool cone = piece.kind == SetKind::kCone;
+    const Vec3 n = cone ? Vec3{piece.cos_a * cp, piece.cos_a * sp, -piece.sin_a} : Vec3{cp, sp, 0};
+    if (!NearestInHalfSpace(sets[0], n, cone ? 0 : piece.c, scale, x)) return false;
+    if (InAll(sets + 1, count - 1, *x, 1e-9 * scale)) return *found = true;
+    const double next = std::atan2(x->y, x->x);
+    if (std::abs(std::remainder(next - phi, 2 * M_PI)) < 1e-14) break;
+    phi = next;
+  }
+  return true;
+}
+
+// min |x| over sets[0] (the shape) ∩ sets[1..count) (the volume), when the
+// shape's own nearest point `start` is outside the volume. First the
+// relaxations to one piece of the volume (exact, a few dozen projections):
+// an answer of one that lies in the whole volume is the answer. Else
+// Dykstra. False: they do not meet.
+bool NearestInIntersection(const ConvexSet* sets, int count, const Vec3& start, double scale,
+                           Vec3* x) {
+  for (int i = 1; i < count; ++i) {
+    const ConvexSet& piece = sets[i];
+    if ((Project(piece, start) - start).SquaredNorm() == 0) continue;  // not what cuts it
+    bool found = false;
+    switch (piece.kind) {
+      case SetKind::kHalfSpace:
+        if (!NearestInHalfSpace(sets[0], piece.n, piece.c, scale, x)) return false;
+        found = InAll(sets + 1, count - 1, *x, 1e-9 * scale);
+        break;
+      case SetKind::kSlabZ:
+        if (!NearestInHalfSpace(sets[0], {0, 0, start.z > 0 ? 1.0 : -1.0}, piece.c, scale, x))
+          return false;
+        found = InAll(sets + 1, count - 1, *x, 1e-9 * scale);
+        break;
+      case SetKind::kCone:
+      case SetKind::kInfiniteCylinder:
+        if (!NearestThroughTangents(sets, count, piece, start, scale, x, &found)) return false;
+        break;
+      default: break;
+    }
+    if (found) return true;
+  }
+  return ProjectOriginOntoIntersection(sets, count, scale, x);
+}
+
 // Outward normal of a primitive (own frame) at its surface point nearest p.
 Vec3 PrimitiveNormal(const PlacedShape& shape, const Vec3& p) {
   const Vec3& h = shape.half_size;
@@ -278,7 +377,7 @@ bool NearestOnMesh(const Volume& v, const ConvexSet* volume_sets, int count,
       sets[0] = {};
       sets[0].kind = SetKind::kTriangle;
       sets[0].a = a, sets[0].b = b, sets[0].d = c;
-      if (!ProjectOriginOntoIntersection(sets, count + 1, scale, &p)) return;
+      if (!NearestInIntersection(sets, count + 1, p, scale, &p)) return;
       d = p.Norm();
       if (d >= best || d > v.range) return;
     }
@@ -362,7 +461,7 @@ bool NearestInVolume(const Volume& v, const PlacedShape& shape, const Pose& X_SW
   double d = p.Norm();
   if (d >= best || d > v.range) return false;
   if (!InVolume(v, p, 1e-9 * scale)) {
-    if (!ProjectOriginOntoIntersection(sets, count + 1, scale, &p)) return false;
+    if (!NearestInIntersection(sets, count + 1, p, scale, &p)) return false;
     d = p.Norm();
     if (d >= best || d > v.range) return false;
   }
