@@ -1,9 +1,11 @@
 // The proximity backend: ray sensors against the static environment (an
 // OctoMap octree built once, see static_index.h) and against robots and
-// dynamic shapes (a grid of their footprints rebuilt every step).
+// dynamic shapes (a grid of their footprints rebuilt every step); volume
+// and randomized-ray sensors (volume.h) one by one against the shapes whose
+// bounds meet their volume's box (SenseVolume, at the end).
 //
 // Detection rules:
-// - A sensor is a ray from its origin along its +z axis, of length `range`.
+// - A ray sensor is a ray from its origin along its +z axis, of length `range`.
 // - The nearest exact hit wins; on an exact tie the static environment wins,
 //   then the lower shape row (deterministic).
 // - A ray that starts inside or on a shape hits it at distance 0.
@@ -604,8 +606,9 @@ class OctreeGridProximity final : public ProximityBackend {
 
 swarmsim::ModuleInfo ModuleInfo() {
   return {"proximity", "proximity", "1.0.0",
-          "ray proximity sensors: exact distances to boxes, cylinders, spheres and triangle "
-          "meshes; static environment in an OctoMap octree, robots through a spatial grid"};
+          "proximity sensors (rays, randomized rays, cone, pyramid, cylinder and disc volumes): "
+          "exact distances to boxes, cylinders, spheres, capsules and triangle meshes; static "
+          "environment in an OctoMap octree, robots through a spatial grid"};
 }
 
 std::unique_ptr<ProximityBackend> MakeBackend(const BackendOptions& options) {

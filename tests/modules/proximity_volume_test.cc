@@ -3,8 +3,11 @@
 // checked against hand-computed cases.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
+#include <random>
+#include <string>
 #include <vector>
 
 #include "framework/mesh.h"
@@ -267,6 +270,80 @@ TEST_F(VolumeTest, CylinderAndDisc) {
   EXPECT_TRUE(Sense(s).detected);
   scene_->proximity_sensors()[0].angle = 50 * kDeg;
   EXPECT_FALSE(Sense(s).detected);
+}
+
+// Random boxes, spheres, cylinders and capsules against each volume (with a blind zone): the
+// reading is a point of the box inside the volume, and no point of a dense sample of the shape
+// inside the volume is nearer (a shape the sample finds inside is found).
+TEST(VolumePropertyTest, ReadingIsInsideAndNoSampledPointIsNearer) {
+  std::mt19937_64 random(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  int detected = 0;
+  for (ProximityVolume kind : {ProximityVolume::kCone, ProximityVolume::kPyramid,
+                               ProximityVolume::kCylinder, ProximityVolume::kDisc}) {
+    for (int trial = 0; trial < 40; ++trial) {
+      SCOPED_TRACE(std::string(ToString(kind)) + " trial " + std::to_string(trial));
+      ProximitySensorData sensor;
+      sensor.volume = kind;
+      sensor.range = 3;
+      sensor.angle = (20 + 10 * u(random)) * kDeg;
+      sensor.angle_y = (15 + 5 * u(random)) * kDeg;
+      sensor.radius = 0.2;
+      sensor.thickness = 0.1;
+      sensor.blind_zone = 0.2;
+      const Volume volume = MakeVolume(sensor);
+      // A shape around 1 m ahead along the volume's axis, off it by up to 0.5 m.
+      const Vec3 half{0.1 + 0.1 * std::abs(u(random)), 0.1 + 0.1 * std::abs(u(random)),
+                      0.1 + 0.1 * std::abs(u(random))};
+      Vec3 centre{0.5 * u(random), 0.5 * u(random), 1 + 0.3 * u(random)};
+      if (kind == ProximityVolume::kDisc) centre = {centre.z, centre.x, 0.1 * u(random)};
+      const Pose X_WB{centre, Quat::FromRollPitchYaw(u(random), u(random), u(random))};
+      // Box, sphere, cylinder or capsule in turn, and whether a point (shape
+      // frame) is in it.
+      ShapeData data = Box(2 * half.x, 2 * half.y, 2 * half.z);
+      const double r = half.x;
+      if (trial % 4 == 1) data = Sphere(r);
+      if (trial % 4 >= 2) {
+        data.kind = trial % 4 == 2 ? ShapeKind::kCylinder : ShapeKind::kCapsule;
+        data.size = {r, 0, 2 * (half.z + r)};
+      }
+      const Vec3 bound = data.kind == ShapeKind::kBox      ? half
+                         : data.kind == ShapeKind::kSphere ? Vec3{r, r, r}
+                                                           : Vec3{r, r, half.z + r};
+      auto inside = [&](const Vec3& p, double tol) {
+        switch (data.kind) {
+          case ShapeKind::kSphere: return p.Norm() <= r + tol;
+          case ShapeKind::kCylinder:
+            return std::hypot(p.x, p.y) <= r + tol && std::abs(p.z) <= bound.z + tol;
+          case ShapeKind::kCapsule:
+            return (p - Vec3{0, 0, std::clamp(p.z, -half.z, half.z)}).Norm() <= r + tol;
+          default:
+            return std::abs(p.x) <= half.x + tol && std::abs(p.y) <= half.y + tol &&
+                   std::abs(p.z) <= half.z + tol;
+        }
+      };
+      const PlacedShape shape = PlaceShape(data, X_WB, ObjectId{}, -1);
+      VolumeHit hit;
+      const bool found = NearestInVolume(volume, shape, Pose{}, INFINITY, &hit);
+      double sampled = INFINITY;
+      std::uniform_real_distribution<double> unit(-1, 1);
+      for (int k = 0; k < 20000; ++k) {
+        const Vec3 p_B{bound.x * unit(random), bound.y * unit(random), bound.z * unit(random)};
+        const Vec3 p = X_WB * p_B;
+        if (inside(p_B, 0) && InVolume(volume, p, 0)) sampled = std::min(sampled, p.Norm());
+      }
+      if (!found) {
+        EXPECT_EQ(sampled, INFINITY);
+        continue;
+      }
+      ++detected;
+      EXPECT_TRUE(InVolume(volume, hit.point, 1e-8));
+      EXPECT_TRUE(inside(X_WB.Inverse() * hit.point, 1e-8));
+      EXPECT_NEAR(hit.distance, hit.point.Norm(), 1e-12);
+      EXPECT_LE(hit.distance, sampled + 1e-9);
+    }
+  }
+  EXPECT_GT(detected, 80);  // most trials see the shape
 }
 
 TEST(RandomRaysTest, DirectionsStayInTheConeAndDependOnTheStream) {
