@@ -22,18 +22,31 @@
 //    sphere, cylinder, capsule segment, triangle: Ericson 5.1.5) lies in the
 //    volume: that is the answer. Its distance is also a lower bound that
 //    skips shapes (and triangles) no nearer than the best found.
-// 2. Otherwise Dykstra's alternating projections onto the shape and each of
+// 2. Otherwise one piece of the volume cuts the shape (usually). For each
+//    piece the nearest point violates, solve the relaxation "shape ∩ that
+//    piece" exactly: for a half-space n.x <= c (a pyramid's or disc's side,
+//    the blind plane, a disc's face) the answer is P_shape(-lambda n) at the
+//    root lambda of n.x(lambda) = c (the Lagrange dual of the one
+//    constraint; monotone, solved by Illinois regula falsi to 1e-13 of the
+//    scene's scale, a few dozen projections); for a cone's or cylinder's
+//    side, through its tangent half-space at the answer's azimuth, found by
+//    iterating azimuth <- azimuth of the half-space's answer. A relaxation's
+//    answer that lies in the whole volume is the answer (it is the minimum
+//    over a superset). A relaxation with no point means no detection.
+// 3. Else (two pieces active: a pyramid's edge, a cone's rim at the blind
+//    plane) Dykstra's alternating projections onto the shape and each of
 //    the volume's pieces (a second-order cone, half-spaces, an infinite
 //    cylinder, a slab; each projection exact and closed-form) converge to
 //    the projection of the origin onto the intersection. Iterations stop
-//    when a sweep moves the point by less than 1e-12 of the scene's scale
+//    when no projection or increment moves by 1e-12 of the scene's scale
 //    (or after 20,000 sweeps); the point is accepted if it lies within 1e-9
-//    (relative) of every set. Measured against the closed forms in
-//    tests/modules/proximity_volume_test.cc: within 1e-9 m at 1 m scale.
-//    Cost: Dykstra converges linearly, slowly where the sets meet at a
-//    shallow angle: a box cut by a cone's side takes ~1,000 sweeps (tens of
-//    microseconds), against ~100 ns for step 1. A shape whose bounding
-//    sphere misses a piece of the volume is skipped before either.
+//    (relative) of every set.
+// Precision: within 1e-9 m at 1 m scale against the closed forms in
+// tests/modules/proximity_volume_test.cc. Cost (bench/proximity_volume_bench,
+// 2-core VM): a ray reading 0.37 us, a cone over four primitives 0.73 us
+// when step 1 answers, 1.0 us when a side cuts the box (step 2); step 3
+// takes ~1,000 sweeps (tens of microseconds). A shape whose bounding sphere
+// misses a piece of the volume is skipped before any of this.
 //
 // The normal is the shape's outward normal at its surface point nearest the
 // detected point (for a point inside a shape cut by the volume: the nearest

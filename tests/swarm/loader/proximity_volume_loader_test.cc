@@ -162,6 +162,14 @@ TEST_F(ProximityVolumeLoaderTest, RandomizedRaysHashTheSameOnAnyThreadCount) {
              "  - {model: bot.yaml, position: [0.2, -1], heading_deg: 10}\n"
              "  - {model: bot.yaml, position: [-1, 0], heading_deg: 5}");
   LoadedWorld loaded = Load();
+  // Every copy has the model's sensor settings.
+  const Scene& scene = loaded.world->scene();
+  ASSERT_EQ(scene.proximity_sensors().size(), 6u);
+  for (const ProximitySensorData& s : scene.proximity_sensors()) {
+    EXPECT_EQ(s.volume, ProximityVolume::kRandomizedRay);
+    EXPECT_EQ(s.ray_count, 8);
+    EXPECT_NEAR(s.angle, 40 * kDeg, 1e-15);
+  }
   std::vector<std::string> log;
   loaded.world->set_log_sink([&](std::string_view line) { log.emplace_back(line); });
   loaded.world->Start();
