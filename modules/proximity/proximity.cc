@@ -482,8 +482,10 @@ class OctreeGridProximity final : public ProximityBackend {
       return !detectable_ || detectable_(sensor, shape);
     };
     if (!static_.empty() && AnyOccupied(lo, hi)) {
+      thread_local std::vector<uint32_t> near;
+      static_.ShapesInBox(lo, hi, &near);
       const auto shapes = static_.shapes();
-      for (size_t s = 0; s < shapes.size(); ++s)
+      for (uint32_t s : near)
         if (meets(static_lo_[s], static_hi_[s]) && detectable(shapes[s].id)) visit(shapes[s]);
     }
     thread_local std::vector<uint32_t> candidates;

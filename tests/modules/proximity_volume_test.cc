@@ -272,6 +272,55 @@ TEST_F(VolumeTest, CylinderAndDisc) {
   EXPECT_FALSE(Sense(s).detected);
 }
 
+// Many static shapes, sensors of each volume at random poses: the backend's
+// broad phase (the octree's buckets, the volume's box) finds the same
+// nearest shape as testing every shape.
+TEST_F(VolumeTest, BroadPhaseMissesNothing) {
+  std::mt19937_64 random(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<ObjectId> shapes;
+  for (int i = 0; i < 300; ++i) {
+    const Pose X_WS{{2 * u(random), 2 * u(random), 0.5 * u(random)},
+                    Quat::FromRollPitchYaw(u(random), u(random), u(random))};
+    shapes.push_back(AddShape(
+        i % 2 ? Sphere(0.03 + 0.02 * u(random)) : Box(0.1 + 0.05 * u(random), 0.05, 0.08), X_WS));
+  }
+  const ProximityVolume kinds[] = {ProximityVolume::kCone, ProximityVolume::kPyramid,
+                                   ProximityVolume::kCylinder, ProximityVolume::kDisc};
+  std::vector<ObjectId> sensors;
+  for (int i = 0; i < 40; ++i) {
+    ProximitySensorData s = Sensor(kinds[i % 4], 1.5);
+    s.angle = 25 * kDeg;
+    s.angle_y = 15 * kDeg;
+    s.radius = 0.15;
+    s.thickness = 0.2;
+    sensors.push_back(
+        AddSensor(s, {{2 * u(random), 2 * u(random), 0.5 * u(random)},
+                      Quat::FromRollPitchYaw(3 * u(random), 3 * u(random), 3 * u(random))}));
+  }
+  Sense(sensors[0]);
+  int detected = 0;
+  for (const ObjectId sensor : sensors) {
+    const ProximitySensorData& r = scene_->proximity_sensor(sensor);
+    const Volume volume = MakeVolume(r);
+    const Pose X_SW = scene_->world_pose(sensor).Inverse();
+    VolumeHit best{INFINITY, {}, {}};
+    ObjectId nearest;
+    for (const ObjectId shape : shapes) {
+      const PlacedShape placed =
+          PlaceShape(scene_->shape(shape), scene_->world_pose(shape), shape, -1);
+      VolumeHit h;
+      if (NearestInVolume(volume, placed, X_SW, best.distance, &h)) best = h, nearest = shape;
+    }
+    ASSERT_EQ(r.detected, best.distance <= r.range);
+    if (!r.detected) continue;
+    ++detected;
+    EXPECT_EQ(r.distance, best.distance);
+    EXPECT_EQ(r.detected_object, nearest);
+  }
+  EXPECT_GT(detected, 10);
+}
+
 // Random boxes, spheres, cylinders and capsules against each volume (with a blind zone): the
 // reading is a point of the box inside the volume, and no point of a dense sample of the shape
 // inside the volume is nearer (a shape the sample finds inside is found).
