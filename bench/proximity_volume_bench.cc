@@ -42,7 +42,7 @@ std::unique_ptr<OneSensor> Make(ProximityVolume volume, double angle_deg, double
   ProximitySensorData sensor;
   sensor.volume = volume;
   sensor.range = 3;
-  sensor.angle = sensor.angle_y = angle_deg * M_PI / 180;
+  sensor.more->angle = sensor.more->angle_y = angle_deg * M_PI / 180;
   s->scene.AddProximitySensor("s", {}, {}, sensor);
   s->scene.AddShape("box", {}, {{box_x, 0, 1}, {}}, Shape(ShapeKind::kBox, {0.2, 0.2, 0.2}));
   s->scene.AddShape("sphere", {}, {{0.3, 0.3, 1.5}, {}}, Shape(ShapeKind::kSphere, {0.1, 0, 0}));

@@ -102,30 +102,58 @@ struct JointData {
 enum class ProximityVolume : uint8_t { kRay, kRandomizedRay, kCone, kPyramid, kCylinder, kDisc };
 const char* ToString(ProximityVolume volume);
 
-// A proximity sensor. The first 32 bytes are what a ray sensor reads and
-// writes every step; the volume settings and the point and normal follow.
-struct ProximitySensorData {
-  double range = 0.1;  // m: nothing farther than this is detected
-  // Reading, written in the sense phase:
-  double distance = 0;       // m, from the sensor's origin to the detected point
-  ObjectId detected_object;  // shape that was hit
-  bool detected = false;
-  // Volume settings (constant):
-  ProximityVolume volume = ProximityVolume::kRay;
-  bool detect_front = true;             // meshes: faces seen from outside (counter-clockwise)
-  bool detect_back = true;              // meshes: faces seen from inside
-  uint16_t ray_count = 16;              // randomized_ray
+// A copyable owning pointer: copying it copies the pointee (never null but
+// when moved from).
+template <class T>
+class ClonePtr {
+ public:
+  ClonePtr() : p_(std::make_unique<T>()) {}
+  ClonePtr(const ClonePtr& o) : p_(std::make_unique<T>(*o.p_)) {}
+  ClonePtr(ClonePtr&&) noexcept = default;
+  ClonePtr& operator=(const ClonePtr& o) {
+    if (this != &o) p_ = std::make_unique<T>(*o.p_);
+    return *this;
+  }
+  ClonePtr& operator=(ClonePtr&&) noexcept = default;
+  T* operator->() { return p_.get(); }
+  const T* operator->() const { return p_.get(); }
+  T& operator*() { return *p_; }
+  const T& operator*() const { return *p_; }
+
+ private:
+  std::unique_ptr<T> p_;
+};
+
+// A proximity sensor's volume settings (constant) and the point and normal
+// of its reading: apart from the row, which a ray sensor reads and writes
+// every step, so that a swarm's rows stay small (40 bytes).
+struct ProximityVolumeData {
   double angle = 0.5235987755982988;    // rad: cone, randomized_ray half-angle; disc half sector
   double angle_y = 0.5235987755982988;  // rad: pyramid half-angle about y (angle: about x)
   double radius = 0.05;                 // m: cylinder
   double thickness = 0.01;              // m: disc, along z
   double blind_zone = 0;                // m: the volume starts at this distance along its axis
   double max_detection_angle = 3.141592653589793;  // rad: reflectance cut-off (pi: none)
-  // Volume readings: the detected point and the outward surface normal
-  // there, in the sensor frame (rays: the point is on +z, see p_SD()).
+  uint16_t ray_count = 16;                         // randomized_ray
+  bool detect_front = true;  // meshes: faces seen from outside (counter-clockwise)
+  bool detect_back = true;   // meshes: faces seen from inside
+  // The reading's detected point (volumes; a ray's is on +z, see p_SD())
+  // and the outward surface normal there, in the sensor frame.
   Vec3 point, normal;
+};
+
+// A proximity sensor. 40 bytes: a robot's control step reads all of its
+// sensors' rows.
+struct ProximitySensorData {
+  double range = 0.1;  // m: nothing farther than this is detected
+  // Reading, written in the sense phase:
+  double distance = 0;       // m, from the sensor's origin to the detected point
+  ObjectId detected_object;  // shape that was hit
+  bool detected = false;
+  ProximityVolume volume = ProximityVolume::kRay;  // constant
+  ClonePtr<ProximityVolumeData> more;              // settings, point and normal
   // The detected point in the sensor frame: for a ray, on its +z axis.
-  Vec3 p_SD() const { return volume == ProximityVolume::kRay ? Vec3{0, 0, distance} : point; }
+  Vec3 p_SD() const { return volume == ProximityVolume::kRay ? Vec3{0, 0, distance} : more->point; }
 };
 
 // A script attached to an object. The source is shared by all copies.

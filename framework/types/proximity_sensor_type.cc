@@ -57,10 +57,10 @@ void Scale(const ObjectTypeDescriptor&, void* row, double s, ScaleContext*) {
   ProximitySensorData& p = *static_cast<ProximitySensorData*>(row);
   p.range *= s;
   p.distance *= s;
-  p.radius *= s;
-  p.thickness *= s;
-  p.blind_zone *= s;
-  p.point = p.point * s;
+  p.more->radius *= s;
+  p.more->thickness *= s;
+  p.more->blind_zone *= s;
+  p.more->point = p.more->point * s;
 }
 
 // Ray sensors add what they always added (the golden hashes stay); volume
@@ -73,7 +73,7 @@ void Hash(const Scene& scene, ObjectType, StateHasher* h) {
     h->AddValue(p.distance);
     h->AddValue(p.p_SD());
     h->AddValue(p.detected_object);
-    if (p.volume != ProximityVolume::kRay) h->AddValue(p.normal);
+    if (p.volume != ProximityVolume::kRay) h->AddValue(p.more->normal);
   }
 }
 
@@ -115,29 +115,29 @@ void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
   };
   if (applies("angle_deg", v == V::kCone || v == V::kRandomizedRay || v == V::kDisc,
               "cone, randomized_ray and disc"))
-    p.angle = v == V::kRandomizedRay ? ReadAngle(r, "angle_deg", 90, false, 0, false)
-                                     : ReadAngle(r, "angle_deg", 90, v == V::kDisc);
+    p.more->angle = v == V::kRandomizedRay ? ReadAngle(r, "angle_deg", 90, false, 0, false)
+                                           : ReadAngle(r, "angle_deg", 90, v == V::kDisc);
   if (applies("angle_x_deg", v == V::kPyramid, "pyramid"))
-    p.angle = ReadAngle(r, "angle_x_deg", 90, false);
+    p.more->angle = ReadAngle(r, "angle_x_deg", 90, false);
   if (applies("angle_y_deg", v == V::kPyramid, "pyramid"))
-    p.angle_y = ReadAngle(r, "angle_y_deg", 90, false);
+    p.more->angle_y = ReadAngle(r, "angle_y_deg", 90, false);
   if (applies("cylinder_radius", v == V::kCylinder, "cylinder"))
-    p.radius = r.Number("cylinder_radius", kPositiveLength);
+    p.more->radius = r.Number("cylinder_radius", kPositiveLength);
   if (applies("thickness", v == V::kDisc, "disc"))
-    p.thickness = r.Number("thickness", kPositiveLength);
+    p.more->thickness = r.Number("thickness", kPositiveLength);
   if (applies("ray_count", v == V::kRandomizedRay, "randomized_ray"))
-    p.ray_count = static_cast<uint16_t>(r.Integer("ray_count", 1, 1024));
+    p.more->ray_count = static_cast<uint16_t>(r.Integer("ray_count", 1, 1024));
   if (applies("blind_zone", solid, "cone, pyramid, cylinder and disc")) {
-    p.blind_zone = r.Number("blind_zone", kNonNegativeLength);
-    if (!(p.blind_zone < p.range)) r.Fail("blind_zone", "must be less than the range");
+    p.more->blind_zone = r.Number("blind_zone", kNonNegativeLength);
+    if (!(p.more->blind_zone < p.range)) r.Fail("blind_zone", "must be less than the range");
   }
   if (r.Has("max_detection_angle_deg"))
-    p.max_detection_angle = ReadAngle(r, "max_detection_angle_deg", 180, true);
+    p.more->max_detection_angle = ReadAngle(r, "max_detection_angle_deg", 180, true);
   if (applies("detect_front", solid, "cone, pyramid, cylinder and disc"))
-    p.detect_front = r.Bool("detect_front");
+    p.more->detect_front = r.Bool("detect_front");
   if (applies("detect_back", solid, "cone, pyramid, cylinder and disc"))
-    p.detect_back = r.Bool("detect_back");
-  if (!p.detect_front && !p.detect_back)
+    p.more->detect_back = r.Bool("detect_back");
+  if (!p.more->detect_front && !p.more->detect_back)
     r.FailAtKey(r.Has("detect_back") ? "detect_back" : "detect_front",
                 "detect_front and detect_back are both false: the sensor would detect nothing");
 }

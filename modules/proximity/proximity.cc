@@ -457,9 +457,9 @@ class OctreeGridProximity final : public ProximityBackend {
     if (reading.detected) {
       const Quat q_SW =
           scene->world_pose_at(scene->proximity_sensor_owners()[ray.row]).q.Conjugate();
-      reading.normal = q_SW.Rotate(SurfaceNormal(*hit_shape, ray.p_W + ray.d_W * best));
-      if (reading.max_detection_angle < kPi && best > 0 &&
-          -reading.normal.z < std::cos(reading.max_detection_angle))
+      reading.more->normal = q_SW.Rotate(SurfaceNormal(*hit_shape, ray.p_W + ray.d_W * best));
+      if (reading.more->max_detection_angle < kPi && best > 0 &&
+          -reading.more->normal.z < std::cos(reading.more->max_detection_angle))
         reading.detected = false;
     }
     reading.distance = reading.detected ? best : 0;
@@ -540,8 +540,8 @@ class OctreeGridProximity final : public ProximityBackend {
     reading.detected = best.distance <= reading.range;
     reading.distance = reading.detected ? best.distance : 0;
     reading.detected_object = reading.detected ? hit : ObjectId{};
-    reading.point = reading.detected ? best.point : Vec3{};
-    reading.normal = reading.detected ? best.normal : Vec3{};
+    reading.more->point = reading.detected ? best.point : Vec3{};
+    reading.more->normal = reading.detected ? best.normal : Vec3{};
   }
 
   // `ray_count` rays in the cone, from the stream of (seed, sensor slot,
@@ -552,14 +552,15 @@ class OctreeGridProximity final : public ProximityBackend {
                        const Scene* scene) const {
     thread_local std::vector<Vec3> directions;
     thread_local std::vector<const PlacedShape*> shapes;
-    directions.resize(reading.ray_count);
+    directions.resize(reading.more->ray_count);
     const uint64_t stream = (uint64_t{sensor.slot} << 40) ^ step_;
-    RandomRayDirections(seed_, stream, reading.angle, reading.ray_count, directions.data());
+    RandomRayDirections(seed_, stream, reading.more->angle, reading.more->ray_count,
+                        directions.data());
     shapes.clear();
     VisitShapesNear(scene->IdAt(sensor.slot), lo, hi, instance, skip,
                     [&](const PlacedShape& shape) { shapes.push_back(&shape); });
     const double cos_cut =
-        reading.max_detection_angle < kPi ? std::cos(reading.max_detection_angle) : -2;
+        reading.more->max_detection_angle < kPi ? std::cos(reading.more->max_detection_angle) : -2;
     for (const Vec3& d_S : directions) {
       const Vec3 d_W = X_WS.q.Rotate(d_S);
       double nearest = std::min(best->distance, reading.range);

@@ -396,15 +396,15 @@ Volume MakeVolume(const ProximitySensorData& s) {
   Volume v;
   v.kind = s.volume;
   v.range = s.range;
-  v.cos_angle = std::cos(s.angle), v.sin_angle = std::sin(s.angle);
-  v.cos_x = std::cos(s.angle), v.sin_x = std::sin(s.angle);
-  v.cos_y = std::cos(s.angle_y), v.sin_y = std::sin(s.angle_y);
-  v.radius = s.radius;
-  v.half_thickness = 0.5 * s.thickness;
-  v.blind_zone = s.blind_zone;
+  v.cos_angle = std::cos(s.more->angle), v.sin_angle = std::sin(s.more->angle);
+  v.cos_x = std::cos(s.more->angle), v.sin_x = std::sin(s.more->angle);
+  v.cos_y = std::cos(s.more->angle_y), v.sin_y = std::sin(s.more->angle_y);
+  v.radius = s.more->radius;
+  v.half_thickness = 0.5 * s.more->thickness;
+  v.blind_zone = s.more->blind_zone;
   v.cos_max_detection_angle =
-      s.max_detection_angle >= 3.141592653589793 ? -1 : std::cos(s.max_detection_angle);
-  v.detect_front = s.detect_front, v.detect_back = s.detect_back;
+      s.more->max_detection_angle >= 3.141592653589793 ? -1 : std::cos(s.more->max_detection_angle);
+  v.detect_front = s.more->detect_front, v.detect_back = s.more->detect_back;
   return v;
 }
 

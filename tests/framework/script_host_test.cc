@@ -475,7 +475,7 @@ TEST(ScriptHostTest, ReadProximitySensorReturnsTheReading) {
   reading.detected = true;
   reading.distance = 0.0625;
   reading.detected_object = wall;
-  reading.normal = {0, 0, -1};
+  reading.more->normal = {0, 0, -1};
   w.world().Start();
   w.world().Step();  // the null proximity module leaves the readings alone
   // CoppeliaSim's order: result, distance, point, object, normal.

@@ -121,9 +121,9 @@ TEST_F(ProximityVolumeLoaderTest, ScaleScalesLengthsNotAngles) {
       scene.proximity_sensor(scene.FindObject("./s", scene.instance(0).root));
   EXPECT_EQ(s.volume, ProximityVolume::kCylinder);
   EXPECT_DOUBLE_EQ(s.range, 1.0);
-  EXPECT_DOUBLE_EQ(s.radius, 0.04);
-  EXPECT_DOUBLE_EQ(s.blind_zone, 0.2);
-  EXPECT_NEAR(s.max_detection_angle, 60 * kDeg, 1e-15);
+  EXPECT_DOUBLE_EQ(s.more->radius, 0.04);
+  EXPECT_DOUBLE_EQ(s.more->blind_zone, 0.2);
+  EXPECT_NEAR(s.more->max_detection_angle, 60 * kDeg, 1e-15);
 }
 
 // The wall's face is 1 m ahead (x = 1); a cone of 30 deg sees it at 1 m on
@@ -167,8 +167,8 @@ TEST_F(ProximityVolumeLoaderTest, RandomizedRaysHashTheSameOnAnyThreadCount) {
   ASSERT_EQ(scene.proximity_sensors().size(), 6u);
   for (const ProximitySensorData& s : scene.proximity_sensors()) {
     EXPECT_EQ(s.volume, ProximityVolume::kRandomizedRay);
-    EXPECT_EQ(s.ray_count, 8);
-    EXPECT_NEAR(s.angle, 40 * kDeg, 1e-15);
+    EXPECT_EQ(s.more->ray_count, 8);
+    EXPECT_NEAR(s.more->angle, 40 * kDeg, 1e-15);
   }
   std::vector<std::string> log;
   loaded.world->set_log_sink([&](std::string_view line) { log.emplace_back(line); });
