@@ -8,6 +8,7 @@
 //   BM_ConeCut     a 9 deg cone that cuts the box (its nearest point is
 //                  outside): Dykstra's projections for the box
 //   BM_PyramidCut  the same with a 9 deg pyramid
+//   BM_PyramidEdge a 9 deg pyramid whose edge cuts the box (two sides active)
 //
 // Time is per reading (SenseSceneSensors with one sensor). The target:
 // a cone reading at most 3x a ray's.
@@ -37,14 +38,15 @@ struct OneSensor {
 
 // A sensor at the origin looking along +z and four primitives ahead of it;
 // `box_x` moves the box off the axis.
-std::unique_ptr<OneSensor> Make(ProximityVolume volume, double angle_deg, double box_x) {
+std::unique_ptr<OneSensor> Make(ProximityVolume volume, double angle_deg, double box_x,
+                                double box_y = 0) {
   auto s = std::make_unique<OneSensor>();
   ProximitySensorData sensor;
   sensor.volume = volume;
   sensor.range = 3;
   sensor.more->angle = sensor.more->angle_y = angle_deg * M_PI / 180;
   s->scene.AddProximitySensor("s", {}, {}, sensor);
-  s->scene.AddShape("box", {}, {{box_x, 0, 1}, {}}, Shape(ShapeKind::kBox, {0.2, 0.2, 0.2}));
+  s->scene.AddShape("box", {}, {{box_x, box_y, 1}, {}}, Shape(ShapeKind::kBox, {0.2, 0.2, 0.2}));
   s->scene.AddShape("sphere", {}, {{0.3, 0.3, 1.5}, {}}, Shape(ShapeKind::kSphere, {0.1, 0, 0}));
   s->scene.AddShape("cylinder", {}, {{-0.3, 0.2, 1.6}, {}},
                     Shape(ShapeKind::kCylinder, {0.1, 0, 0.3}));
@@ -89,6 +91,12 @@ void BM_PyramidCut(benchmark::State& state) {
   Run(state, s.get());
 }
 BENCHMARK(BM_PyramidCut);
+
+void BM_PyramidEdge(benchmark::State& state) {
+  auto s = Make(ProximityVolume::kPyramid, 9, 0.25, 0.25);
+  Run(state, s.get());
+}
+BENCHMARK(BM_PyramidEdge);
 
 }  // namespace
 }  // namespace swarmsim

@@ -190,21 +190,17 @@ bool InAll(const ConvexSet* sets, int count, const Vec3& p, double tolerance) {
   return true;
 }
 
-// min |x| over S ∩ {n . x <= c} (n unit) when S's nearest point violates the
-// half-space: x = P_S(-lambda n) at the root lambda > 0 of n . x(lambda) = c
-// (the Lagrange dual of the one constraint; n . x(lambda) is nonincreasing),
-// by Illinois regula falsi to 1e-13 of `scale`. False: S misses it.
-bool NearestInHalfSpace(const ConvexSet& shape, const Vec3& n, double c, double scale, Vec3* x) {
-  auto h = [&](double lambda, Vec3* y) {
-    *y = Project(shape, n * -lambda);
-    return n.Dot(*y) - c;
-  };
+// The root lambda >= 0 of a nonincreasing h (h(lambda, &y) also gives the
+// point y(lambda)) by Illinois regula falsi, to 1e-13 of `scale`: *x = y
+// there, on the feasible side (h <= 0). False: h stays > 0 (no root).
+template <class H>
+bool DualRoot(H&& h, double scale, Vec3* x) {
   Vec3 y;
   double lo = 0, h_lo = h(0, &y);
   if (h_lo <= 0) return *x = y, true;
   double hi = scale, h_hi = h(hi, &y);
   for (int k = 0; h_hi > 0; ++k) {
-    if (k == 60) return false;  // S lies beyond the plane
+    if (k == 60) return false;
     lo = hi, h_lo = h_hi;
     hi *= 4;
     h_hi = h(hi, &y);
@@ -230,6 +226,33 @@ bool NearestInHalfSpace(const ConvexSet& shape, const Vec3& n, double c, double 
   return true;
 }
 
+// The point of S ∩ {n . x <= c} (n unit) nearest q: x = P_S(q - lambda n)
+// at the root of n . x(lambda) = c (the Lagrange dual of the one
+// constraint; n . x(lambda) is nonincreasing). False: S misses it.
+bool NearestInHalfSpace(const ConvexSet& shape, const Vec3& q, const Vec3& n, double c,
+                        double scale, Vec3* x) {
+  return DualRoot(
+      [&](double lambda, Vec3* y) {
+        *y = Project(shape, q - n * lambda);
+        return n.Dot(*y) - c;
+      },
+      scale, x);
+}
+
+// min |x| over S ∩ H1 ∩ H2: the root lambda2 of n2 . x(lambda2) = c2,
+// x(lambda2) the point of S ∩ H1 nearest -lambda2 n2 (nonincreasing: the
+// derivative of a concave dual). False: they do not meet.
+bool NearestInTwoHalfSpaces(const ConvexSet& shape, const Vec3& n1, double c1, const Vec3& n2,
+                            double c2, double scale, Vec3* x) {
+  if (!NearestInHalfSpace(shape, {}, n1, c1, scale, x)) return false;
+  return DualRoot(
+      [&](double lambda, Vec3* y) {
+        NearestInHalfSpace(shape, n2 * -lambda, n1, c1, scale, y);
+        return n2.Dot(*y) - c2;
+      },
+      scale, x);
+}
+
 // min |x| over S ∩ (a cone or cylinder piece) through its supporting
 // half-spaces: at the answer's azimuth phi, the half-space tangent there
 // gives the same answer, so iterate phi <- azimuth of that half-space's
@@ -241,7 +264,7 @@ bool NearestThroughTangents(const ConvexSet* sets, int count, const ConvexSet& p
     const double cp = std::cos(phi), sp = std::sin(phi);
     const bool cone = piece.kind == SetKind::kCone;
     const Vec3 n = cone ? Vec3{piece.cos_a * cp, piece.cos_a * sp, -piece.sin_a} : Vec3{cp, sp, 0};
-    if (!NearestInHalfSpace(sets[0], n, cone ? 0 : piece.c, scale, x)) return false;
+    if (!NearestInHalfSpace(sets[0], {}, n, cone ? 0 : piece.c, scale, x)) return false;
     if (InAll(sets + 1, count - 1, *x, 1e-9 * scale)) return *found = true;
     const double next = std::atan2(x->y, x->x);
     if (std::abs(std::remainder(next - phi, 2 * M_PI)) < 1e-14) break;
@@ -252,24 +275,31 @@ bool NearestThroughTangents(const ConvexSet* sets, int count, const ConvexSet& p
 
 // min |x| over sets[0] (the shape) ∩ sets[1..count) (the volume), when the
 // shape's own nearest point `start` is outside the volume. First the
-// relaxations to one piece of the volume (exact, a few dozen projections):
-// an answer of one that lies in the whole volume is the answer. Else
-// Dykstra. False: they do not meet.
+// relaxations to one piece of the volume (exact, a few dozen projections),
+// then to two half-spaces where one's answer violates the other (a
+// pyramid's edge): an answer that lies in the whole volume is the answer.
+// Else Dykstra. False: they do not meet.
 bool NearestInIntersection(const ConvexSet* sets, int count, const Vec3& start, double scale,
                            Vec3* x) {
+  const double tolerance = 1e-9 * scale;
+  // The half-spaces (a slab: its face on start's side), their answers.
+  Vec3 normals[8], answers[8];
+  double offsets[8];
+  int planes = 0;
   for (int i = 1; i < count; ++i) {
     const ConvexSet& piece = sets[i];
     if ((Project(piece, start) - start).SquaredNorm() == 0) continue;  // not what cuts it
     bool found = false;
     switch (piece.kind) {
       case SetKind::kHalfSpace:
-        if (!NearestInHalfSpace(sets[0], piece.n, piece.c, scale, x)) return false;
-        found = InAll(sets + 1, count - 1, *x, 1e-9 * scale);
-        break;
       case SetKind::kSlabZ:
-        if (!NearestInHalfSpace(sets[0], {0, 0, start.z > 0 ? 1.0 : -1.0}, piece.c, scale, x))
+        normals[planes] =
+            piece.kind == SetKind::kHalfSpace ? piece.n : Vec3{0, 0, start.z > 0 ? 1.0 : -1.0};
+        offsets[planes] = piece.c;
+        if (!NearestInHalfSpace(sets[0], {}, normals[planes], offsets[planes], scale, x))
           return false;
-        found = InAll(sets + 1, count - 1, *x, 1e-9 * scale);
+        found = InAll(sets + 1, count - 1, *x, tolerance);
+        answers[planes++] = *x;
         break;
       case SetKind::kCone:
       case SetKind::kInfiniteCylinder:
@@ -279,6 +309,14 @@ bool NearestInIntersection(const ConvexSet* sets, int count, const Vec3& start, 
     }
     if (found) return true;
   }
+  for (int a = 0; a < planes; ++a)
+    for (int b = 0; b < planes; ++b) {
+      if (a == b || normals[b].Dot(answers[a]) - offsets[b] <= tolerance) continue;
+      if (!NearestInTwoHalfSpaces(sets[0], normals[a], offsets[a], normals[b], offsets[b], scale,
+                                  x))
+        return false;
+      if (InAll(sets + 1, count - 1, *x, tolerance)) return true;
+    }
   return ProjectOriginOntoIntersection(sets, count, scale, x);
 }
 

@@ -145,6 +145,25 @@ TEST_F(VolumeTest, SphereAtThePyramidsEdgeReadsTheNearestPointOfItsInsidePart) {
   EXPECT_FALSE(Sense(sensor).detected);
 }
 
+// A sphere beyond both sides of a pyramid near its edge x = y = z tan 20:
+// by symmetry the nearest inside point is on the edge, where the edge's
+// ray e enters the sphere: t = e.c - sqrt((e.c)^2 - |c|^2 + r^2).
+TEST_F(VolumeTest, SphereAcrossThePyramidsEdgeReadsOnTheEdge) {
+  ProximitySensorData pyramid = Sensor(ProximityVolume::kPyramid, 2);
+  pyramid.more->angle = pyramid.more->angle_y = 20 * kDeg;
+  const ObjectId sensor = AddSensor(pyramid);
+  const double t22 = std::tan(22 * kDeg), t20 = std::tan(20 * kDeg);
+  const Vec3 c = Vec3{t22, t22, 1}.Normalized();
+  AddShape(Sphere(0.1), {c, {}});
+  const ProximitySensorData& r = Sense(sensor);
+  ASSERT_TRUE(r.detected);
+  const Vec3 e = Vec3{t20, t20, 1}.Normalized();
+  const double ec = e.Dot(c);
+  const double want = ec - std::sqrt(ec * ec - c.SquaredNorm() + 0.01);
+  EXPECT_NEAR(r.distance, want, kTol);
+  ExpectPoint(r.p_SD(), e * want);
+}
+
 // A cube mesh turned so that a corner points at the sensor: the reading is
 // the corner, at 1 - h sqrt 3. Without front faces the sensor sees only the
 // back faces, whose nearest points (the far side, behind the corner's
