@@ -69,6 +69,7 @@ class VolumeTest : public ::testing::Test {
   const ProximitySensorData& Sense(ObjectId sensor) {
     scene_->UpdateWorldPoses();
     backend_ = MakeBackend();
+    backend_->SetDetectableFilter(filter_);
     backend_->Build(*scene_, ProximitySettings{});
     backend_->Update(*scene_);
     backend_->SenseSceneSensors(scene_.get());
@@ -87,6 +88,7 @@ class VolumeTest : public ::testing::Test {
 
   std::unique_ptr<Scene> scene_ = std::make_unique<Scene>();
   std::unique_ptr<ProximityBackend> backend_;
+  DetectableFilter filter_;
 };
 
 // A wall (a big thin box) whose near face is the plane n . p = 0.5, n at 45
@@ -143,6 +145,19 @@ TEST_F(VolumeTest, SphereAtThePyramidsEdgeReadsTheNearestPointOfItsInsidePart) {
   // Wholly outside a 10 deg pyramid: nothing.
   scene_->proximity_sensors()[0].more->angle = 10 * kDeg;
   EXPECT_FALSE(Sense(sensor).detected);
+}
+
+// The detectable-set hook (collections): a filtered-out shape is looked
+// through, to the next one.
+TEST_F(VolumeTest, DetectableFilterHidesShapes) {
+  ProximitySensorData cone = Sensor(ProximityVolume::kCone, 2);
+  const ObjectId sensor = AddSensor(cone);
+  const ObjectId near = AddShape(Sphere(0.1), {{0, 0, 0.5}, {}});
+  const ObjectId far = AddShape(Sphere(0.1), {{0, 0, 1}, {}});
+  EXPECT_EQ(Sense(sensor).detected_object, near);
+  filter_ = [&](ObjectId s, ObjectId shape) { return s == sensor && shape != near; };
+  EXPECT_EQ(Sense(sensor).detected_object, far);
+  EXPECT_NEAR(Sense(sensor).distance, 0.9, kTol);
 }
 
 // A sphere beyond both sides of a pyramid near its edge x = y = z tan 20:
