@@ -1,5 +1,10 @@
 #include "framework/proximity_module.h"
 
+#include <algorithm>
+#include <memory>
+#include <vector>
+
+#include "framework/collections.h"
 #include "framework/proximity_backend.h"
 #include "framework/registry.h"
 #include "framework/scheduler.h"
@@ -19,11 +24,13 @@ class ProximityModule final : public Module {
     settings.seed = world->settings().seed;
     backend_->Build(world->scene(), settings);
     world->set_proximity(backend_.get());
+    RefreshDetectable(world->scene());
   }
 
   // Every robot's sensors, robots in parallel, then the scene's own sensors.
   void Sense(World* world) override {
     Scene& scene = world->scene();
+    if (detectable_version_ != scene.structure_version()) RefreshDetectable(scene);
     backend_->SetStep(static_cast<uint64_t>(world->step_count()));
     backend_->Update(scene);
     const auto& instances = scene.instances();
@@ -37,7 +44,44 @@ class ProximityModule final : public Module {
   }
 
  private:
+  // The sensors with a `detectable:` set: per sensor slot, the shapes it may
+  // detect (ascending slots), resolved once per scene structure, before the
+  // parallel sensing reads them through the backend's filter.
+  void RefreshDetectable(const Scene& scene) {
+    detectable_version_ = scene.structure_version();
+    struct Sets {
+      std::vector<char> used;                 // by sensor slot
+      std::vector<std::vector<uint32_t>> of;  // by sensor slot: detectable shapes, ascending
+    };
+    auto sets = std::make_shared<Sets>();
+    const auto sensors = scene.proximity_sensors();
+    const auto owners = scene.proximity_sensor_owners();
+    for (size_t r = 0; r < sensors.size(); ++r) {
+      if (sensors[r].more->detectable.empty()) continue;
+      sets->used.resize(scene.slot_count(), 0);
+      sets->of.resize(scene.slot_count());
+      const ObjectId sensor = scene.IdAt(owners[r]);
+      sets->of[owners[r]] =
+          EntitySlots(scene, sensors[r].more->detectable, sensor,
+                      "proximity sensor " + scene.PathOf(sensor) + " ('detectable')");
+      sets->used[owners[r]] = 1;
+    }
+    if (sets->used.empty()) {
+      if (filtering_) backend_->SetDetectableFilter({});
+      filtering_ = false;
+      return;
+    }
+    filtering_ = true;
+    backend_->SetDetectableFilter([sets](ObjectId sensor, ObjectId shape) {
+      const uint32_t s = sensor.index();
+      if (s >= sets->used.size() || !sets->used[s]) return true;
+      return std::binary_search(sets->of[s].begin(), sets->of[s].end(), shape.index());
+    });
+  }
+
   std::unique_ptr<ProximityBackend> backend_;
+  uint64_t detectable_version_ = UINT64_MAX;
+  bool filtering_ = false;
 };
 
 }  // namespace

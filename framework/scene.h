@@ -137,6 +137,9 @@ struct ProximityVolumeData {
   uint16_t ray_count = 16;                         // randomized_ray
   bool detect_front = true;  // meshes: faces seen from outside (counter-clockwise)
   bool detect_back = true;   // meshes: faces seen from inside
+  // What the sensor detects: a collection's or object subtree's path
+  // (framework/collections.h), resolved from the sensor; empty: everything.
+  std::string detectable;
   // The reading's detected point (volumes; a ray's is on +z, see p_SD())
   // and the outward surface normal there, in the sensor frame.
   Vec3 point, normal;

@@ -45,6 +45,9 @@ constexpr ObjectKey kKeys[] = {
      "detected (0 < angle <= 180; 180: no cut-off)"},
     {"detect_front", "true", "volumes: mesh faces seen from outside are detected"},
     {"detect_back", "true", "volumes: mesh faces seen from inside are detected"},
+    {"detectable", "everything",
+     "volumes and randomized_ray: only the shapes of this collection or object subtree (a path, "
+     "':/parts' or '/walls')"},
 };
 
 constexpr double kDeg = 3.141592653589793 / 180;
@@ -137,6 +140,14 @@ void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
     p.more->detect_front = r.Bool("detect_front");
   if (applies("detect_back", solid, "cone, pyramid, cylinder and disc"))
     p.more->detect_back = r.Bool("detect_back");
+  if (applies("detectable", v != V::kRay, "volume and randomized_ray")) {
+    p.more->detectable = r.String("detectable");
+    const std::string& path = p.more->detectable;
+    if (path.empty() || (path[0] != '/' && path[0] != ':' && path[0] != '.'))
+      r.Fail("detectable", "'" + path +
+                               "' is not an object path: start with '/' (absolute), ':' (this "
+                               "model) or './' (below the sensor)");
+  }
   if (!p.more->detect_front && !p.more->detect_back)
     r.FailAtKey(r.Has("detect_back") ? "detect_back" : "detect_front",
                 "detect_front and detect_back are both false: the sensor would detect nothing");

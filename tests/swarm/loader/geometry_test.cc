@@ -215,3 +215,52 @@ TEST(GeometryTest, BadEntitiesAreErrorsNamingWhere) {
 
 }  // namespace
 }  // namespace swarmsim
+
+namespace swarmsim {
+namespace {
+
+// A cone sensor's `detectable:` set: only the far box, though the near one
+// is in the cone.
+TEST(GeometryTest, AConeSensorDetectsOnlyItsDetectableSet) {
+  const auto run = [](const std::string& detectable) {
+    return RunWorld(
+        "detectable" + std::to_string(detectable.size()),
+        "simulation: {physics: kinematic, time_step: 0.1}\n"
+        "obstacles:\n"
+        "  - {name: near, shape: box, size: [0.2, 0.2, 0.2], position: [1, 0, 0.1]}\n"
+        "  - {name: far, shape: box, size: [0.2, 0.2, 0.2], position: [2, 0.2, 0.1]}\n"
+        "models:\n  - {model: probe.yaml, position: [0, 0, 0.1]}\n",
+        {{"probe.yaml",
+          "model: probe\nobjects:\n  name: body\n  type: dummy\n  children:\n"
+          "    - {name: eye, type: proximity_sensor, volume: cone, angle_deg: 45, range: 5,\n"
+          "       orientation_deg: [0, 90, 0], script: eye.lua" +
+              detectable + "}\n"},
+         {"eye.lua",
+          "function sysCall_actuation()\n"
+          "  local r, d, p, h = sim.readProximitySensor(sim.getObject('.'))\n"
+          "  print('seen', r, string.format('%.6f', d), sim.getObjectName(h))\n"
+          "end\n"}});
+  };
+  const WorldRun all = run("");
+  ASSERT_EQ(all.exit_code, 0) << all.output;
+  EXPECT_NE(all.output.find("seen\t1\t0.900000\tnear"), std::string::npos) << all.output;
+  const WorldRun far = run(", detectable: /far");
+  ASSERT_EQ(far.exit_code, 0) << far.output;
+  // The far box's nearest face point to the sensor: (1.9, 0.1, 0).
+  EXPECT_NE(far.output.find("seen\t1\t" + std::string("1.902630") + "\tfar"), std::string::npos)
+      << far.output;
+  const WorldRun ray = RunWorld("detectable_ray",
+                                "simulation: {physics: kinematic, time_step: 0.1}\n"
+                                "models:\n  - {model: probe.yaml}\n",
+                                {{"probe.yaml",
+                                  "model: probe\nobjects:\n  name: body\n  type: dummy\n"
+                                  "  children:\n    - {name: eye, type: proximity_sensor, "
+                                  "detectable: /far}\n"}});
+  EXPECT_NE(ray.exit_code, 0);
+  EXPECT_NE(ray.output.find("'detectable' applies to volume and randomized_ray sensors only"),
+            std::string::npos)
+      << ray.output;
+}
+
+}  // namespace
+}  // namespace swarmsim
