@@ -206,6 +206,7 @@ std::shared_ptr<const EnvironmentMap> MapCutter::Finish(const EnvironmentMap& ma
                   std::max(next->hi.z, box.hi.z)};
     }
   }
+  held_ = next;
   return next;
 }
 

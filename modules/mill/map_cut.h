@@ -76,6 +76,9 @@ class MapCutter {
 
  private:
   MapIndex index_;
+  // The last map Finish made, kept alive so that no later map can take its
+  // address while index_ may follow it (the index compares pointers).
+  std::shared_ptr<const EnvironmentMap> held_;
   std::map<uint32_t, std::vector<EnvironmentBox>> replaced_;  // box -> what is left of it
   std::vector<uint32_t> hits_;
 };

@@ -73,6 +73,7 @@ void MillModule::EnsureBlocks(Scene* scene) {
   blocks_.resize(std::max<size_t>(blocks_.size(), scene->slot_count()));
   centres_.resize(cuttables.size());
   radii_.resize(cuttables.size());
+  items_.resize(cuttables.size());
   for (uint32_t r = 0; r < cuttables.size(); ++r) {
     const uint32_t slot = cuttables.owners[r];
     const CuttableRow& c = cuttables.rows[r];
@@ -88,7 +89,9 @@ void MillModule::EnsureBlocks(Scene* scene) {
     }
     centres_[r] = scene->world_pose_at(slot).p;
     radii_[r] = c.size.Norm() / 2;
+    items_[r] = {centres_[r].x, centres_[r].y, radii_[r], r};
   }
+  grid_.Build(items_);
 }
 
 // The voxels (still there) of every cuttable near the mill whose centres
@@ -105,38 +108,44 @@ void MillModule::Find(const Scene& scene, uint32_t mill_row) {
   Bounds(m.volume, &lo_M, &hi_M);
   const Vec3 centre_W = X_WM * ((lo_M + hi_M) * 0.5);
   const double radius = (hi_M - lo_M).Norm() / 2;
-  for (uint32_t c = 0; c < cuttables.size(); ++c) {
-    if ((centre_W - centres_[c]).Norm() > radius + radii_[c]) continue;
-    const CuttableRow& cut = cuttables.rows[c];
-    const Block& block = *blocks_[cuttables.owners[c]];
+  // Cuttables in ascending row order (the grid's), spheres meeting the volume's.
+  grid_.ForEachInCircle(centre_W.x, centre_W.y, radius, [&](uint32_t c, const GridItem&) {
+    if ((centre_W - centres_[c]).Norm() > radius + radii_[c]) return;
     const Pose X_CM = scene.world_pose_at(cuttables.owners[c]).Inverse() * X_WM;
-    const Pose X_MC = X_CM.Inverse();
-    // The volume's bounds in the block's frame, then the voxels there.
-    Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
-    for (int k = 0; k < 8; ++k) {
-      const Vec3 p =
-          X_CM * Vec3{k & 1 ? hi_M.x : lo_M.x, k & 2 ? hi_M.y : lo_M.y, k & 4 ? hi_M.z : lo_M.z};
-      lo = Min(lo, p);
-      hi = Max(hi, p);
-    }
-    const Vec3 edge = cut.voxel_size();
-    const Vec3 start = cut.size * -0.5;
-    int64_t x0, x1, y0, y1, z0, z1;
-    VoxelRange(start.x, edge.x, cut.nx, lo.x, hi.x, &x0, &x1);
-    VoxelRange(start.y, edge.y, cut.ny, lo.y, hi.y, &y0, &y1);
-    VoxelRange(start.z, edge.z, cut.nz, lo.z, hi.z, &z0, &z1);
     Found f{c, {}};
-    for (int64_t z = z0; z <= z1; ++z)
-      for (int64_t y = y0; y <= y1; ++y)
-        for (int64_t x = x0; x <= x1; ++x) {
-          const uint32_t i = static_cast<uint32_t>((z * cut.ny + y) * cut.nx + x);
-          if (!block.Has(i)) continue;
-          const Vec3 p_C{start.x + (x + 0.5) * edge.x, start.y + (y + 0.5) * edge.y,
-                         start.z + (z + 0.5) * edge.z};
-          if (Contains(m.volume, X_MC * p_C)) f.voxels.push_back(i);
-        }
+    FindIn(cuttables.rows[c], *blocks_[cuttables.owners[c]], m.volume, X_CM, &f.voxels);
     if (!f.voxels.empty()) found.push_back(std::move(f));
+  });
+}
+
+void MillModule::FindIn(const CuttableRow& cut, const Block& block, const Volume& volume,
+                        const Pose& X_CM, std::vector<uint32_t>* voxels) {
+  // The volume's bounds in the block's frame, then the voxels there.
+  Vec3 lo_M, hi_M;
+  Bounds(volume, &lo_M, &hi_M);
+  Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
+  for (int k = 0; k < 8; ++k) {
+    const Vec3 p =
+        X_CM * Vec3{k & 1 ? hi_M.x : lo_M.x, k & 2 ? hi_M.y : lo_M.y, k & 4 ? hi_M.z : lo_M.z};
+    lo = Min(lo, p);
+    hi = Max(hi, p);
   }
+  const Pose X_MC = X_CM.Inverse();
+  const Vec3 edge = cut.voxel_size();
+  const Vec3 start = cut.size * -0.5;
+  int64_t x0, x1, y0, y1, z0, z1;
+  VoxelRange(start.x, edge.x, cut.nx, lo.x, hi.x, &x0, &x1);
+  VoxelRange(start.y, edge.y, cut.ny, lo.y, hi.y, &y0, &y1);
+  VoxelRange(start.z, edge.z, cut.nz, lo.z, hi.z, &z0, &z1);
+  for (int64_t z = z0; z <= z1; ++z)
+    for (int64_t y = y0; y <= y1; ++y)
+      for (int64_t x = x0; x <= x1; ++x) {
+        const uint32_t i = static_cast<uint32_t>((z * cut.ny + y) * cut.nx + x);
+        if (!block.Has(i)) continue;
+        const Vec3 p_C{start.x + (x + 0.5) * edge.x, start.y + (y + 0.5) * edge.y,
+                       start.z + (z + 0.5) * edge.z};
+        if (Contains(volume, X_MC * p_C)) voxels->push_back(i);
+      }
 }
 
 // The mill's finds, minus what earlier mills took this step.

@@ -23,7 +23,9 @@
 #include <vector>
 
 #include "framework/module.h"
+#include "framework/spatial_grid.h"
 #include "modules/mill/map_cut.h"
+#include "modules/mill/rows.h"
 
 namespace swarmsim::mill {
 
@@ -63,6 +65,9 @@ class MillModule final : public Module {
   void Refresh(Scene* scene);
   void EnsureBlocks(Scene* scene);
   void Find(const Scene& scene, uint32_t mill_row);
+  // One cuttable's voxels inside a mill's volume (Find's inner loop).
+  static void FindIn(const CuttableRow& cut, const Block& block, const Volume& volume,
+                     const Pose& X_CM, std::vector<uint32_t>* voxels);
   void Apply(Scene* scene, uint32_t mill_row);
   void CutMap(Scene* scene);
 
@@ -76,6 +81,8 @@ class MillModule final : public Module {
   std::vector<std::vector<Found>> found_;       // by mill row, this step
   std::vector<Vec3> centres_;                   // cuttables' centres, world (cuttable rows)
   std::vector<double> radii_;                   // and bounding radii
+  std::vector<GridItem> items_;                 // (cuttable rows)
+  SpatialGrid grid_;                            // the cuttables' spheres in the plane
   MapCutter map_cutter_;
   int64_t map_removed_voxels_ = 0;
 };
