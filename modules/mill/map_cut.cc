@@ -84,10 +84,9 @@ int64_t CutPart(const CutContext& c, const Vec3& lo, const Vec3& hi, const int64
 
 }  // namespace
 
-size_t MapIndex::CellHash::operator()(const Cell& c) const {
-  return static_cast<size_t>(
-      Mix(static_cast<uint64_t>(c.x) ^
-          Mix(static_cast<uint64_t>(c.y) ^ Mix(static_cast<uint64_t>(c.z)))));
+uint64_t MapIndex::Bucket(int64_t x, int64_t y, int64_t z) {
+  return Mix(static_cast<uint64_t>(x) ^
+             Mix(static_cast<uint64_t>(y) ^ Mix(static_cast<uint64_t>(z))));
 }
 
 void MapIndex::Build(const EnvironmentMap& map) {
@@ -96,6 +95,7 @@ void MapIndex::Build(const EnvironmentMap& map) {
   size_ = map.boxes.size();
   levels_.clear();
   const double resolution = map.resolution > 0 ? map.resolution : 1;
+  // The levels, and each box's.
   std::map<int, size_t> level_of;  // k -> levels_ index
   for (uint32_t b = 0; b < map.boxes.size(); ++b) {
     const EnvironmentBox& box = map.boxes[b];
@@ -109,10 +109,27 @@ void MapIndex::Build(const EnvironmentMap& map) {
     Level& level = levels_[it->second];
     level.max_edge = std::max(level.max_edge, edge);
     level.boxes.push_back(b);
-    level
-        .cells[{CellOf(box.lo.x, level.cell), CellOf(box.lo.y, level.cell),
-                CellOf(box.lo.z, level.cell)}]
-        .push_back(b);
+  }
+  // Each level's buckets: count, prefix sums, fill (boxes stay ascending).
+  std::vector<uint64_t> bucket_of;
+  for (Level& level : levels_) {
+    uint64_t buckets = 1;
+    while (buckets < level.boxes.size()) buckets <<= 1;
+    level.mask = buckets - 1;
+    level.start.assign(buckets + 1, 0);
+    bucket_of.resize(level.boxes.size());
+    for (size_t i = 0; i < level.boxes.size(); ++i) {
+      const EnvironmentBox& box = map.boxes[level.boxes[i]];
+      bucket_of[i] = Bucket(CellOf(box.lo.x, level.cell), CellOf(box.lo.y, level.cell),
+                            CellOf(box.lo.z, level.cell)) &
+                     level.mask;
+      ++level.start[bucket_of[i] + 1];
+    }
+    for (uint64_t b = 0; b < buckets; ++b) level.start[b + 1] += level.start[b];
+    level.entries.resize(level.boxes.size());
+    std::vector<uint32_t> next(level.start.begin(), level.start.end() - 1);
+    for (size_t i = 0; i < level.boxes.size(); ++i)
+      level.entries[next[bucket_of[i]]++] = level.boxes[i];
   }
 }
 
@@ -136,11 +153,15 @@ void MapIndex::Query(const Vec3& lo, const Vec3& hi, std::vector<uint32_t>* out)
     }
     for (int64_t z = z0; z <= z1; ++z)
       for (int64_t y = y0; y <= y1; ++y)
-        for (int64_t x = x0; x <= x1; ++x)
-          if (auto it = level.cells.find({x, y, z}); it != level.cells.end())
-            for (uint32_t b : it->second) keep(b);
+        for (int64_t x = x0; x <= x1; ++x) {
+          const uint64_t bucket = Bucket(x, y, z) & level.mask;
+          for (uint32_t i = level.start[bucket]; i < level.start[bucket + 1]; ++i)
+            keep(level.entries[i]);
+        }
   }
+  // Two cells may share a bucket: a box may have been kept twice.
   std::sort(out->begin(), out->end());
+  out->erase(std::unique(out->begin(), out->end()), out->end());
 }
 
 int64_t CutBox(const EnvironmentBox& box, double resolution, const Volume& volume, const Pose& X_MW,

@@ -17,7 +17,6 @@
 #include <cstdint>
 #include <map>
 #include <memory>
-#include <unordered_map>
 #include <vector>
 
 #include "framework/environment.h"
@@ -28,7 +27,9 @@ namespace swarmsim::mill {
 
 // Which of a map's boxes overlap a query box: the boxes grouped by size
 // (level k: edge ~ resolution x 2^k), each level a hash grid of cells of
-// that edge keyed by the cell holding the box's low corner.
+// that edge, keyed by the cell holding the box's low corner, stored flat
+// (buckets of a counting sort, no allocation per cell): building it for a
+// new map is two passes over the boxes.
 class MapIndex {
  public:
   void Build(const EnvironmentMap& map);
@@ -40,19 +41,15 @@ class MapIndex {
   void Query(const Vec3& lo, const Vec3& hi, std::vector<uint32_t>* out) const;
 
  private:
-  struct Cell {
-    int64_t x, y, z;
-    bool operator==(const Cell&) const = default;
-  };
-  struct CellHash {
-    size_t operator()(const Cell& c) const;
-  };
   struct Level {
-    double cell = 0;      // m, the grid's cell edge
-    double max_edge = 0;  // m, the largest box edge in the level
-    std::unordered_map<Cell, std::vector<uint32_t>, CellHash> cells;
+    double cell = 0;              // m, the grid's cell edge
+    double max_edge = 0;          // m, the largest box edge in the level
+    uint64_t mask = 0;            // buckets - 1 (a power of two)
     std::vector<uint32_t> boxes;  // every box of the level, ascending
+    std::vector<uint32_t> start;  // bucket b's boxes: entries[start[b] .. start[b + 1])
+    std::vector<uint32_t> entries;
   };
+  static uint64_t Bucket(int64_t x, int64_t y, int64_t z);
   const EnvironmentMap* map_ = nullptr;
   const EnvironmentBox* data_ = nullptr;
   size_t size_ = 0;
