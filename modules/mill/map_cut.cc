@@ -14,8 +14,10 @@ bool Overlap(const Vec3& a_lo, const Vec3& a_hi, const Vec3& b_lo, const Vec3& b
          a_lo.z <= b_hi.z && b_lo.z <= a_hi.z;
 }
 
+// (Clamped before the cast: a far or NaN coordinate is no undefined behaviour.)
 int64_t CellOf(double coordinate, double cell) {
-  return static_cast<int64_t>(std::floor(coordinate / cell));
+  const double c = std::floor(coordinate / cell);
+  return c >= -4e18 ? static_cast<int64_t>(std::min(c, 4e18)) : int64_t{-4'000'000'000'000'000'000};
 }
 
 // What CutBox's recursion shares.
@@ -168,9 +170,14 @@ int64_t CutBox(const EnvironmentBox& box, double resolution, const Volume& volum
                std::vector<EnvironmentBox>* out) {
   CutContext c{resolution, volume, X_MW, {}, {}, out};
   Bounds(volume, &c.bounds_lo, &c.bounds_hi);
-  const int64_t n[3] = {std::max<int64_t>(1, std::llround((box.hi.x - box.lo.x) / resolution)),
-                        std::max<int64_t>(1, std::llround((box.hi.y - box.lo.y) / resolution)),
-                        std::max<int64_t>(1, std::llround((box.hi.z - box.lo.z) / resolution))};
+  // Voxels per axis; past 2^20 a side (10 km at 0.01 m: no octree has them)
+  // the voxels grow instead, so counts stay within 64 bits.
+  const auto voxels = [&](double side) {
+    const double n = std::round(side / resolution);
+    return n >= 1 ? static_cast<int64_t>(std::min(n, 1048576.0)) : int64_t{1};
+  };
+  const int64_t n[3] = {voxels(box.hi.x - box.lo.x), voxels(box.hi.y - box.lo.y),
+                        voxels(box.hi.z - box.lo.z)};
   return CutPart(c, box.lo, box.hi, n);
 }
 

@@ -28,12 +28,19 @@ Vec3 Max(const Vec3& a, const Vec3& b) {
 }
 
 // Voxel indices [first, last] along an axis of n voxels of `edge` starting
-// at `start` whose centres lie in [lo, hi]; first > last when none.
+// at `start` whose centres lie in [lo, hi]; first > last when none (also
+// for NaN bounds: nothing is cast before it is clamped).
 void VoxelRange(double start, double edge, uint32_t n, double lo, double hi, int64_t* first,
                 int64_t* last) {
-  *first = std::max<int64_t>(0, static_cast<int64_t>(std::ceil((lo - start) / edge - 0.5)));
-  *last = std::min<int64_t>(int64_t{n} - 1,
-                            static_cast<int64_t>(std::floor((hi - start) / edge - 0.5)));
+  const double f = std::ceil((lo - start) / edge - 0.5);
+  const double l = std::floor((hi - start) / edge - 0.5);
+  if (!(f <= l) || !(l >= 0) || !(f < n)) {
+    *first = 1;
+    *last = 0;
+    return;
+  }
+  *first = static_cast<int64_t>(std::max(f, 0.0));
+  *last = static_cast<int64_t>(std::min(l, static_cast<double>(n) - 1));
 }
 
 }  // namespace

@@ -258,6 +258,22 @@ TEST_F(MillTest, ScriptsSwitchTheirOwnMills) {
   }
 }
 
+// sim.readMill on what is not a mill is an error naming the object.
+TEST_F(MillTest, ReadingWhatIsNotAMillIsAnError) {
+  Write("probe.yaml", "model: probe\nobjects: {type: dummy, script: probe.lua}\n");
+  Write("probe.lua", "function sysCall_init() sim.readMill(sim.getObject('/block')) end\n");
+  try {
+    Load(
+        "simulation: {physics: kinematic}\n"
+        "objects: [{name: block, type: cuttable}]\n"
+        "models: [{model: probe.yaml, position: [0, 0, 1]}]\n")
+        .world->Start();
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_CONTAINS(e.what(), "sim.readMill: object /block is not a mill");
+  }
+}
+
 // The example world: the blocks' voxels drop, every mill takes some, the
 // mills' volumes add up to the block's loss, and the hash is the same at
 // 1, 2 and 4 threads.
