@@ -8,6 +8,7 @@
 #include "modules/dynamics/ode/ode_backend.h"
 #include "modules/kinematics/ik_groups.h"
 #include "modules/metrics/swarm_metrics.h"
+#include "modules/mill/mill.h"
 #include "modules/paint/paint_layer.h"
 #include "modules/proximity/proximity.h"
 
@@ -39,6 +40,7 @@ void RegisterBuiltinModules(ModuleRegistry* registry) {
   for (ModuleDescriptor& metric : metrics::SwarmMetricModules())
     registry->RegisterModule(std::move(metric));
   collision::Register(registry);
+  mill::Register(registry);
 }
 
 }  // namespace swarmsim
