@@ -420,7 +420,13 @@ class Scene {
   // The static environment a world loads from a map file (environment.h),
   // or null. Set before the world starts; the modules read it at Build().
   const EnvironmentMap* environment() const { return environment_.get(); }
-  void set_environment(std::shared_ptr<const EnvironmentMap> map) { environment_ = std::move(map); }
+  void set_environment(std::shared_ptr<const EnvironmentMap> map) {
+    environment_ = std::move(map);
+    ++environment_version_;
+  }
+  // Counts set_environment calls: a module that indexed the map compares
+  // this, not the pointer (a new map may reuse a freed one's address).
+  uint64_t environment_version() const { return environment_version_; }
 
  private:
   uint32_t AllocateSlot(std::string name, ObjectId parent, const Pose& X_PO, ObjectType type);
@@ -475,6 +481,7 @@ class Scene {
   std::vector<const ObjectTypeDescriptor*> types_;
   std::vector<std::unique_ptr<RowTable>> tables_;
   std::shared_ptr<const EnvironmentMap> environment_;
+  uint64_t environment_version_ = 0;
 
   std::vector<ScriptAttachment> scripts_;
   std::vector<ModelInstance> instances_;

@@ -213,6 +213,7 @@ bool TreeCollide(Object* o1, Object* o2, void* data) {
 struct Geometry::Impl {
   uint64_t version = UINT64_MAX;
   const EnvironmentMap* map = nullptr;
+  uint64_t map_version = UINT64_MAX;             // Scene::environment_version of `map`
   std::vector<std::unique_ptr<Object>> objects;  // by slot; null: not a shape
   std::vector<uint32_t> moving;                  // slots of shapes that may move
   std::vector<uint32_t> fixed;                   // slots of static shapes (ascending)
@@ -307,9 +308,10 @@ struct Geometry::Impl {
     std::sort(moving.begin(), moving.end());
     // The environment tree only when its contents changed (the map's boxes
     // are many; robots come and go without touching it).
-    if (fixed_now != fixed || map != scene.environment() || version == UINT64_MAX) {
+    if (fixed_now != fixed || map_version != scene.environment_version() || version == UINT64_MAX) {
       fixed = std::move(fixed_now);
       map = scene.environment();
+      map_version = scene.environment_version();
       map_boxes.clear();
       map_prisms.clear();
       if (map != nullptr) {
@@ -346,7 +348,7 @@ size_t Geometry::object_count() const {
 
 void Geometry::Refresh(const Scene& scene) {
   Impl& m = *impl_;
-  if (m.version != scene.structure_version() || m.map != scene.environment()) {
+  if (m.version != scene.structure_version() || m.map_version != scene.environment_version()) {
     m.Rebuild(scene);
     return;
   }
