@@ -17,7 +17,8 @@ class ProximityBackend {
   virtual ~ProximityBackend() = default;
 
   // Indexes the static environment (shapes that belong to no robot and are
-  // not dynamic). Called once at start.
+  // not dynamic, and the Scene's environment map, whose boxes a reading
+  // reports as a null object). Called once at start.
   virtual void Build(const Scene& scene, const ProximitySettings& settings) = 0;
   // Rebuilds per-step acceleration structures (the spatial grid of robots)
   // from the current poses. Called once per step before Sense().
