@@ -12,6 +12,7 @@
 #include "framework/error.h"
 #include "framework/scene.h"
 #include "framework/state_hash.h"
+#include "modules/dynamics/environment_obstacles.h"
 #include "modules/dynamics/scene_walk.h"
 
 namespace swarmsim::ode {
@@ -247,13 +248,24 @@ dTriMeshDataID OdeWorld::MeshData(const std::shared_ptr<const TriangleMesh>& mes
 }
 
 void OdeWorld::Build(const Scene& scene) {
+  // The environment map's voxels the dynamic shapes can meet, merged into boxes.
+  const std::vector<EnvironmentBox> map_boxes =
+      dynamics::EnvironmentObstacles(scene, dynamics::DynamicHeightRange(scene), false);
   // 0. A fresh ODE world, collision space and contact group (and the ground plane).
-  CreateWorld(scene);
+  CreateWorld(scene, map_boxes.size());
   // 1. A body per dynamic shape, in slot order.
   std::vector<dBodyID> body_of(scene.slot_count(), nullptr);  // dynamic or kinematic body (slots)
   BuildBodies(scene, &body_of);
-  // 2. Non-dynamic shapes: parts of a body, kinematic bodies or static geoms.
+  // 2. Non-dynamic shapes: parts of a body, kinematic bodies or static geoms;
+  // then the map's boxes, static geoms of the default material.
   BuildNonDynamicShapes(scene, &body_of);
+  const ShapeData material;
+  for (const EnvironmentBox& box : map_boxes) {
+    const Vec3 size = box.hi - box.lo, centre = (box.lo + box.hi) * 0.5;
+    dGeomID geom = dCreateBox(space_, size.x, size.y, size.z);
+    dGeomSetPosition(geom, centre.x, centre.y, centre.z);
+    AddGeom(geom, -1, material.friction, material.restitution);
+  }
   // 3. Joints with a dynamic child body, in slot order.
   BuildJoints(scene, body_of);
   // 4. Force sensors.
@@ -261,7 +273,7 @@ void OdeWorld::Build(const Scene& scene) {
   commands_.assign(joints_.size(), JointData{});
 }
 
-void OdeWorld::CreateWorld(const Scene& scene) {
+void OdeWorld::CreateWorld(const Scene& scene, size_t map_boxes) {
   Clear();
   dAllocateODEDataForThread(dAllocateMaskAll);
   dRandSetSeed(options_.seed);
@@ -281,7 +293,7 @@ void OdeWorld::CreateWorld(const Scene& scene) {
   // and prune instead. The choice depends on the scene alone, never on the
   // thread count; below the limit results are those of the hash space.
   constexpr size_t kHashSpaceMaxGeoms = 8192;
-  space_ = scene.shapes().size() <= kHashSpaceMaxGeoms
+  space_ = scene.shapes().size() + map_boxes <= kHashSpaceMaxGeoms
                ? dHashSpaceCreate(nullptr)
                : dSweepAndPruneSpaceCreate(nullptr, dSAP_AXES_XYZ);
   contacts_ = dJointGroupCreate(0);
