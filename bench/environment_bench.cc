@@ -5,6 +5,8 @@
 //   BM_ReadOctomap     the file into an EnvironmentMap (checks + library + boxes)
 //   BM_IndexMap/res    the proximity module's Build with the map alone, at
 //                      octree resolution res mm (80: the map's own)
+//   BM_IndexMapAsShapes/res  the same voxels as static box shapes (the
+//                      generic shape path), for comparison
 //   BM_MergeBand2D/3D  the voxels at foot-bot height (0.001..0.145 m) merged
 //                      into rectangles (Box2D) / boxes (ODE); counters give
 //                      the counts
@@ -69,6 +71,29 @@ void BM_IndexMap(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_IndexMap)->Arg(80)->Arg(50)->Unit(benchmark::kMillisecond);
+
+// For comparison: the same voxels as 143,729 static box shapes of a scene,
+// through the generic shape path (each shape's voxels tested one by one,
+// grown by a margin): what the map would cost without its own path.
+void BM_IndexMapAsShapes(benchmark::State& state) {
+  if (Map() == nullptr) return state.SkipWithError("geb079.bt not found (SWARMSIM_MAPS_DIR)");
+  Scene scene;
+  ShapeData box;
+  box.kind = ShapeKind::kBox;
+  for (const EnvironmentBox& b : Map()->boxes) {
+    box.size = b.hi - b.lo;
+    scene.AddShape("voxel", {}, {(b.lo + b.hi) * 0.5, {}}, box);
+  }
+  scene.UpdateWorldPoses();
+  ProximitySettings settings;
+  settings.octree_resolution = static_cast<double>(state.range(0)) / 1000;
+  for (auto _ : state) {
+    auto backend = proximity::MakeBackend();
+    backend->Build(scene, settings);
+    benchmark::DoNotOptimize(backend.get());
+  }
+}
+BENCHMARK(BM_IndexMapAsShapes)->Arg(80)->Arg(50)->Unit(benchmark::kMillisecond);
 
 void BM_MergeBand(benchmark::State& state, bool planar) {
   if (Map() == nullptr) return state.SkipWithError("geb079.bt not found (SWARMSIM_MAPS_DIR)");
