@@ -12,6 +12,7 @@
 #include <span>
 #include <sstream>
 #include <streambuf>
+#include <string_view>
 
 #include "framework/error.h"
 #include "modules/environment/octomap_format.h"
@@ -131,6 +132,40 @@ void CheckOptions(const OctomapOptions& o, const std::string& name) {
   if (!(o.max_memory_mb > 0)) Fail(name, "max_memory_mb must be positive");
 }
 
+// The checked body read by the library into a tree, and its occupied
+// leaves collected into `map`.
+void ReadBoxes(const std::string& name, const OctomapHeader& header, std::string_view body,
+               const OctomapOptions& options, EnvironmentMap* map, OctomapReport* report) {
+  try {
+    // The header was parsed as the library's readers (readBinary,
+    // AbstractOcTree::read) parse it; their body readers read the body.
+    // (The header readers print to stderr on every file: not called.)
+    MemoryBuffer buffer(body.data(), body.size());
+    std::istream stream(&buffer);
+    auto tree = std::make_unique<octomap::OcTree>(header.resolution);
+    if (header.size > 0) {
+      if (header.format == OctomapFormat::kBinary)
+        tree->readBinaryData(stream);
+      else
+        tree->readData(stream);
+    }
+    if (!stream) Fail(name, "the OctoMap library could not read it");
+    if (tree->size() != header.size)
+      Fail(name, "the OctoMap library read " + std::to_string(tree->size()) +
+                     " nodes, the header says " + std::to_string(header.size));
+    tree->setOccupancyThres(options.occupancy_threshold);
+    // A tree whose root has no children is empty (the library would call the
+    // whole root cube occupied).
+    const octomap::OcTreeNode* root = tree->getRoot();
+    if (root != nullptr && tree->nodeHasChildren(root)) {
+      const int origin[3] = {0, 0, 0};
+      BoxCollector(*tree, options, map, report).Collect(root, origin, kTreeSize);
+    }
+  } catch (const std::bad_alloc&) {
+    Fail(name, "out of memory reading it");
+  }
+}
+
 }  // namespace
 
 EnvironmentMap ReadOctomap(const fs::path& file, const std::string& name,
@@ -208,39 +243,13 @@ EnvironmentMap ReadOctomap(const fs::path& file, const std::string& name,
   EnvironmentMap map;
   map.source = name;
   map.resolution = header.resolution;
-  try {
-    // The header was parsed above as the library's readers (readBinary,
-    // AbstractOcTree::read) parse it; their body readers read the body.
-    // (The header readers print to stderr on every file: not called.)
-    MemoryBuffer buffer(bytes.data() + header.body_offset, counts.bytes);
-    std::istream stream(&buffer);
-    auto tree = std::make_unique<octomap::OcTree>(header.resolution);
-    if (header.size > 0) {
-      if (binary)
-        tree->readBinaryData(stream);
-      else
-        tree->readData(stream);
-    }
-    if (!stream) Fail(name, "the OctoMap library could not read it");
-    if (tree->size() != header.size)
-      Fail(name, "the OctoMap library read " + std::to_string(tree->size()) +
-                     " nodes, the header says " + std::to_string(header.size));
-    tree->setOccupancyThres(options.occupancy_threshold);
-    // A .bt whose root has no children is empty (the library would call the
-    // whole root cube occupied).
-    const octomap::OcTreeNode* root = tree->getRoot();
-    if (root != nullptr && tree->nodeHasChildren(root)) {
-      const int origin[3] = {0, 0, 0};
-      BoxCollector(*tree, options, &map, &report).Collect(root, origin, kTreeSize);
-    }
-  } catch (const std::bad_alloc&) {
-    Fail(name, "out of memory reading it");
-  }
+  ReadBoxes(name, header, {bytes.data() + header.body_offset, counts.bytes}, options, &map,
+            &report);
 
   // Bounds, and what may surprise.
   report.kept_boxes = map.boxes.size();
   if (!map.boxes.empty()) {
-    map.lo = map.hi = map.boxes.front().lo;
+    map.lo = map.boxes.front().lo;
     map.hi = map.boxes.front().hi;
     for (const EnvironmentBox& b : map.boxes) {
       map.lo = {std::min(map.lo.x, b.lo.x), std::min(map.lo.y, b.lo.y), std::min(map.lo.z, b.lo.z)};

@@ -253,7 +253,7 @@ void StaticIndex::Build(const Scene& scene, double resolution) {
         }
   }
   // The environment map's voxels: boxes of no object, after the shapes.
-  if (const EnvironmentMap* map = scene.environment(); map != nullptr && !map->boxes.empty())
+  if (const EnvironmentMap* map = scene.environment())
     AddEnvironment(*map, resolution, tree_.get(), &shapes_, &touches, occupied_keys_.lo,
                    occupied_keys_.hi);
   tree_->updateInnerOccupancy();
