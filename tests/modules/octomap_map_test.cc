@@ -200,6 +200,16 @@ TEST_F(OctomapFileTest, ATruncatedBodyIsAnErrorAtEveryLength) {
   }
 }
 
+TEST_F(OctomapFileTest, ATruncatedOtIsAnErrorAtEveryLength) {
+  const std::string whole = OneVoxelFull(2.0f);
+  const size_t header = whole.find("data\n") + 5;
+  for (size_t cut = header; cut < whole.size(); ++cut) {
+    const std::string error =
+        ErrorOf([&] { ReadOctomap(Write("t.ot", whole.substr(0, cut)), "t.ot", {}); });
+    EXPECT_CONTAINS(error, "octomap t.ot: truncated") << cut;
+  }
+}
+
 TEST_F(OctomapFileTest, ATruncatedCopyOfTheSharedMapIsAnError) {
   SWARMSIM_NEED_SHARED_MAP(path, "geb079.bt");
   const std::string whole = ReadAll(path);
