@@ -21,6 +21,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "framework/handle.h"
 #include "framework/parameters.h"
@@ -205,5 +206,12 @@ void OpenSandbox(lua_State* L);
 
 // Constant shared with scripts.
 constexpr lua_Integer kHandleWorld = -1;
+// A script's own collections (lua_api_collections.cc): kScriptCollectionBase
+// for its robot's first, then one lower each.
+constexpr lua_Integer kScriptCollectionBase = -1000;
+// The slots of the collection or object at argument `arg`: a script's
+// collection or a collection object stands for its objects, any other object
+// for itself and everything below it. Ascending. Throws for a bad handle.
+std::vector<uint32_t> CollectionArgSlots(lua_State* L, int arg);
 
 }  // namespace swarmsim

@@ -10,8 +10,9 @@ namespace {
 
 // sim.readProximitySensor(h) -> 0 when nothing is detected; else
 // 1, distance (m), {x, y, z} (detected point in the sensor frame), handle of
-// the detected object. The no-detection path allocates nothing: a robot
-// calls this for each of its sensors every step.
+// the detected object, {nx, ny, nz} (the surface normal there, sensor
+// frame): CoppeliaSim's order. The no-detection path allocates nothing: a
+// robot calls this for each of its sensors every step.
 int ReadProximitySensor(lua_State* L) {
   const Scene& scene = *Context(L).scene;
   const ObjectId id = CheckObject(L, 1);
@@ -26,10 +27,13 @@ int ReadProximitySensor(lua_State* L) {
   }
   lua_pushinteger(L, 1);
   lua_pushnumber(L, sensor.distance);
-  const double p_SD[3] = {0, 0, sensor.distance};  // sensor.p_SD()
+  const Vec3 p = sensor.p_SD();
+  const double p_SD[3] = {p.x, p.y, p.z};
   PushNumberArray(L, p_SD, 3);
   lua_pushinteger(L, sensor.detected_object.IsNull() ? -1 : sensor.detected_object.ToInteger());
-  return 4;
+  const double n_S[3] = {sensor.more->normal.x, sensor.more->normal.y, sensor.more->normal.z};
+  PushNumberArray(L, n_S, 3);
+  return 5;
 }
 
 }  // namespace

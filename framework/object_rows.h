@@ -13,7 +13,7 @@
 namespace swarmsim {
 
 // The built-in object types; types registered by modules and plugins
-// (Scene::RegisterType) take the values after kPluginSensor.
+// (Scene::RegisterType) take the values after kCollection.
 enum class ObjectType : uint8_t {
   kDummy,
   kShape,
@@ -21,9 +21,10 @@ enum class ObjectType : uint8_t {
   kProximitySensor,
   kForceSensor,
   kPaintNozzle,
-  kPluginSensor
+  kPluginSensor,
+  kCollection
 };
-inline constexpr int kBuiltinObjectTypes = 7;
+inline constexpr int kBuiltinObjectTypes = 8;
 inline constexpr int kMaxObjectTypes = 64;
 
 // One type's rows, whatever their C++ type.

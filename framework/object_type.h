@@ -53,6 +53,9 @@ class ObjectReader {
                                       const NumberRule& rule) const = 0;
   virtual Vec3 Vector3(std::string_view key, const NumberRule& rule,
                        bool required = false) const = 0;
+  // A list of strings ([a, b] or a single string); `max_count` at most.
+  virtual std::vector<std::string> Strings(std::string_view key, size_t max_count,
+                                           bool required = false) const = 0;
   // An error at the key's value, or at the key itself.
   [[noreturn]] virtual void Fail(std::string_view key, const std::string& message) const = 0;
   [[noreturn]] virtual void FailAtKey(std::string_view key, const std::string& message) const = 0;

@@ -2,6 +2,10 @@
 // environment and against other robots.
 #pragma once
 
+#include <cstdint>
+#include <functional>
+
+#include "framework/handle.h"
 #include "framework/math.h"
 
 namespace swarmsim {
@@ -10,7 +14,15 @@ class Scene;
 
 struct ProximitySettings {
   double octree_resolution = 0.05;  // m, voxel size of the static environment's octree
+  uint64_t seed = 1;                // the world's seed: randomized-ray sensors draw from it
 };
+
+// May the sensor `sensor` detect the shape `shape`? The hook for per-sensor
+// detectable sets (collections): unset, every sensor detects every shape
+// (but its own robot's). Called concurrently from the sense phase; applied
+// to volume and randomized-ray sensors. `shape` is null for a voxel of the
+// Scene's environment map.
+using DetectableFilter = std::function<bool(ObjectId sensor, ObjectId shape)>;
 
 class ProximityBackend {
  public:
@@ -29,6 +41,10 @@ class ProximityBackend {
   virtual void SenseInstance(Scene* scene, int instance) const = 0;
   // Fills the readings of sensors that belong to no robot.
   virtual void SenseSceneSensors(Scene* scene) const = 0;
+  // The step about to be sensed (randomized rays are keyed by it).
+  virtual void SetStep(uint64_t step) { (void)step; }
+  // Sets (or, empty, clears) the detectable-set filter.
+  virtual void SetDetectableFilter(DetectableFilter filter) { (void)filter; }
   // Does a static shape cross the segment a-b (world frame, m)? Used for
   // line-of-sight messages. Thread-safe. Default: nothing blocks.
   virtual bool SegmentBlocked(const Vec3& a_W, const Vec3& b_W) const {

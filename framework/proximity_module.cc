@@ -16,6 +16,7 @@ class ProximityModule final : public Module {
   void Start(World* world) override {
     ProximitySettings settings;
     settings.octree_resolution = world->settings().octree_resolution;
+    settings.seed = world->settings().seed;
     backend_->Build(world->scene(), settings);
     world->set_proximity(backend_.get());
   }
@@ -23,6 +24,7 @@ class ProximityModule final : public Module {
   // Every robot's sensors, robots in parallel, then the scene's own sensors.
   void Sense(World* world) override {
     Scene& scene = world->scene();
+    backend_->SetStep(static_cast<uint64_t>(world->step_count()));
     backend_->Update(scene);
     const auto& instances = scene.instances();
     world->scheduler().ParallelFor(0, static_cast<int64_t>(instances.size()), kRobotGrain,

@@ -95,16 +95,65 @@ struct JointData {
   Pose Motion() const;  // transform produced by `position` about/along z
 };
 
-// A ray proximity sensor looking along its +z axis (V-REP's convention).
-// 32 bytes: a robot's control step reads all of its sensors' rows.
+// The detection volume of a proximity sensor (modules/proximity/volume.h):
+// a ray along +z (V-REP's convention), random rays in a cone about +z, or a
+// solid volume (cone, pyramid, cylinder about +z; disc: a sector in the xy
+// plane about +x).
+enum class ProximityVolume : uint8_t { kRay, kRandomizedRay, kCone, kPyramid, kCylinder, kDisc };
+const char* ToString(ProximityVolume volume);
+
+// A copyable owning pointer: copying it copies the pointee (never null but
+// when moved from).
+template <class T>
+class ClonePtr {
+ public:
+  ClonePtr() : p_(std::make_unique<T>()) {}
+  ClonePtr(const ClonePtr& o) : p_(std::make_unique<T>(*o.p_)) {}
+  ClonePtr(ClonePtr&&) noexcept = default;
+  ClonePtr& operator=(const ClonePtr& o) {
+    if (this != &o) p_ = std::make_unique<T>(*o.p_);
+    return *this;
+  }
+  ClonePtr& operator=(ClonePtr&&) noexcept = default;
+  T* operator->() { return p_.get(); }
+  const T* operator->() const { return p_.get(); }
+  T& operator*() { return *p_; }
+  const T& operator*() const { return *p_; }
+
+ private:
+  std::unique_ptr<T> p_;
+};
+
+// A proximity sensor's volume settings (constant) and the point and normal
+// of its reading: apart from the row, which a ray sensor reads and writes
+// every step, so that a swarm's rows stay small (40 bytes).
+struct ProximityVolumeData {
+  double angle = 0.5235987755982988;    // rad: cone, randomized_ray half-angle; disc half sector
+  double angle_y = 0.5235987755982988;  // rad: pyramid half-angle about y (angle: about x)
+  double radius = 0.05;                 // m: cylinder
+  double thickness = 0.01;              // m: disc, along z
+  double blind_zone = 0;                // m: the volume starts at this distance along its axis
+  double max_detection_angle = 3.141592653589793;  // rad: reflectance cut-off (pi: none)
+  uint16_t ray_count = 16;                         // randomized_ray
+  bool detect_front = true;  // meshes: faces seen from outside (counter-clockwise)
+  bool detect_back = true;   // meshes: faces seen from inside
+  // The reading's detected point (volumes; a ray's is on +z, see p_SD())
+  // and the outward surface normal there, in the sensor frame.
+  Vec3 point, normal;
+};
+
+// A proximity sensor. 40 bytes: a robot's control step reads all of its
+// sensors' rows.
 struct ProximitySensorData {
-  double range = 0.1;  // m
+  double range = 0.1;  // m: nothing farther than this is detected
   // Reading, written in the sense phase:
-  double distance = 0;       // m, along the ray
+  double distance = 0;       // m, from the sensor's origin to the detected point
   ObjectId detected_object;  // shape that was hit
   bool detected = false;
-  // The detected point in the sensor frame: on the ray, the +z axis.
-  Vec3 p_SD() const { return {0, 0, distance}; }
+  ProximityVolume volume = ProximityVolume::kRay;  // constant
+  ClonePtr<ProximityVolumeData> more;              // settings, point and normal
+  // The detected point in the sensor frame: for a ray, on its +z axis.
+  Vec3 p_SD() const { return volume == ProximityVolume::kRay ? Vec3{0, 0, distance} : more->point; }
 };
 
 // A script attached to an object. The source is shared by all copies.
@@ -223,6 +272,8 @@ class Scene {
   // of `from`'s model root). "name[k]" picks the k-th (0-based) match of a
   // repeated name in hierarchy order. Returns null when nothing matches.
   ObjectId FindObject(std::string_view path, ObjectId from = {}) const;
+  // Appends the slots of `slot`'s subtree (itself first), hierarchy order.
+  void CollectSubtree(uint32_t slot, std::vector<uint32_t>* out) const;
   // Why FindObject(path, from) found nothing, to end an error message: at
   // the first element that matched nothing, "; did you mean '<path with the
   // nearest name>'?", "; there are 3 objects named 'prox' there:
@@ -378,7 +429,6 @@ class Scene {
   void UpdatePoses(std::span<const uint32_t> slots);
   void RebuildOrder() const;
   void RebuildInstanceObjects(int instance);
-  void CollectSubtree(uint32_t slot, std::vector<uint32_t>* out) const;
   uint32_t CopyObject(uint32_t src, int32_t new_parent);
   // A built-in type's table (the descriptor made Rows<Row> for it).
   template <typename Row>

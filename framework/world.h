@@ -14,6 +14,7 @@
 #include <string_view>
 #include <vector>
 
+#include "framework/collections.h"
 #include "framework/messaging.h"
 #include "framework/module.h"
 #include "framework/parameters.h"
@@ -156,13 +157,14 @@ inline constexpr size_t kMaxModelEditsPerStep = 1000;
 
 struct RobotRuntime {
   Rng rng;
-  SharedParameters parameters;          // the instance's model parameters
-  LogBuffer log;                        // lines printed during the phase
-  std::vector<MetricSample> metrics;    // samples recorded this step
-  std::vector<DeferredWrite> deferred;  // writes to other robots' objects
-  std::vector<ModelEdit> model_edits;   // copies and removals of robots, call order
-  std::string error;                    // a script error in this phase
-  std::vector<std::string> disabled;    // scripts disabled this phase (disable_script), why
+  SharedParameters parameters;             // the instance's model parameters
+  LogBuffer log;                           // lines printed during the phase
+  std::vector<MetricSample> metrics;       // samples recorded this step
+  std::vector<DeferredWrite> deferred;     // writes to other robots' objects
+  std::vector<ModelEdit> model_edits;      // copies and removals of robots, call order
+  std::string error;                       // a script error in this phase
+  std::vector<std::string> disabled;       // scripts disabled this phase (disable_script), why
+  std::vector<CollectionRow> collections;  // the scripts' own (sim.createCollection)
   // Its messages, signal and custom-data writes: Messaging::robot_mail.
 };
 

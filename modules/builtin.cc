@@ -2,6 +2,7 @@
 
 #include "framework/dynamics_backend.h"
 #include "framework/registry.h"
+#include "modules/collision/collision.h"
 #include "modules/dynamics/box2d/box2d_backend.h"
 #include "modules/dynamics/kinematic/kinematic_backend.h"
 #include "modules/dynamics/ode/ode_backend.h"
@@ -37,6 +38,7 @@ void RegisterBuiltinModules(ModuleRegistry* registry) {
   registry->RegisterModule(paint::PaintModule());
   for (ModuleDescriptor& metric : metrics::SwarmMetricModules())
     registry->RegisterModule(std::move(metric));
+  collision::Register(registry);
 }
 
 }  // namespace swarmsim

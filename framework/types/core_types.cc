@@ -10,7 +10,7 @@ namespace swarmsim {
 std::span<const ObjectTypeDescriptor* const> CoreObjectTypes() {
   static constexpr const ObjectTypeDescriptor* kTypes[] = {
       &kDummyType,       &kShapeType,       &kJointType,        &kProximitySensorType,
-      &kForceSensorType, &kPaintNozzleType, &kPluginSensorType,
+      &kForceSensorType, &kPaintNozzleType, &kPluginSensorType, &kCollectionType,
   };
   static_assert(std::size(kTypes) == kBuiltinObjectTypes);
   return kTypes;

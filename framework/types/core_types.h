@@ -13,5 +13,6 @@ extern const ObjectTypeDescriptor kProximitySensorType;
 extern const ObjectTypeDescriptor kForceSensorType;
 extern const ObjectTypeDescriptor kPaintNozzleType;
 extern const ObjectTypeDescriptor kPluginSensorType;
+extern const ObjectTypeDescriptor kCollectionType;
 
 }  // namespace swarmsim

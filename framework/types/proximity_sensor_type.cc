@@ -1,5 +1,11 @@
-// proximity_sensor: a ray along the sensor's +z axis that reports the
+// proximity_sensor: a ray along the sensor's +z axis, random rays in a cone,
+// or a detection volume (cone, pyramid, cylinder, disc) that reports the
 // nearest shape within its range (modules/proximity senses it).
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
 #include "framework/object_type.h"
 #include "framework/scene.h"
 #include "framework/state_hash.h"
@@ -10,11 +16,38 @@ namespace swarmsim {
 // Its Lua API area (framework/lua_api_*.cc).
 void RegisterSensorsApi(lua_State* L);
 
+const char* ToString(ProximityVolume volume) {
+  switch (volume) {
+    case ProximityVolume::kRay: return "ray";
+    case ProximityVolume::kRandomizedRay: return "randomized_ray";
+    case ProximityVolume::kCone: return "cone";
+    case ProximityVolume::kPyramid: return "pyramid";
+    case ProximityVolume::kCylinder: return "cylinder";
+    case ProximityVolume::kDisc: return "disc";
+  }
+  return "?";
+}
+
 namespace {
 
 constexpr ObjectKey kKeys[] = {
-    {"range", "0.1", "m, > 0"},
+    {"range", "0.1", "m, > 0: nothing farther from the sensor's origin is detected"},
+    {"volume", "ray", "ray, randomized_ray, cone, pyramid, cylinder or disc"},
+    {"angle_deg", "30", "half-angle: cone and randomized_ray (< 90), disc's half sector (<= 90)"},
+    {"angle_x_deg", "30", "pyramid: half-angle in the sensor's xz plane (< 90)"},
+    {"angle_y_deg", "30", "pyramid: half-angle in the sensor's yz plane (< 90)"},
+    {"cylinder_radius", "0.05", "m, > 0: the cylinder volume's radius"},
+    {"thickness", "0.01", "m, > 0: disc, along the sensor's z"},
+    {"ray_count", "16", "randomized_ray: rays per step, 1..1024"},
+    {"blind_zone", "0", "m, >= 0, < range: volumes start this far along their axis"},
+    {"max_detection_angle_deg", "180",
+     "a point whose normal is more than this from the direction back to the sensor is not "
+     "detected (0 < angle <= 180; 180: no cut-off)"},
+    {"detect_front", "true", "volumes: mesh faces seen from outside are detected"},
+    {"detect_back", "true", "volumes: mesh faces seen from inside are detected"},
 };
+
+constexpr double kDeg = 3.141592653589793 / 180;
 
 std::unique_ptr<RowTable> MakeRows(const ObjectTypeDescriptor&) {
   return std::make_unique<Rows<ProximitySensorData>>();
@@ -24,8 +57,14 @@ void Scale(const ObjectTypeDescriptor&, void* row, double s, ScaleContext*) {
   ProximitySensorData& p = *static_cast<ProximitySensorData*>(row);
   p.range *= s;
   p.distance *= s;
+  p.more->radius *= s;
+  p.more->thickness *= s;
+  p.more->blind_zone *= s;
+  p.more->point = p.more->point * s;
 }
 
+// Ray sensors add what they always added (the golden hashes stay); volume
+// sensors add their normal too.
 void Hash(const Scene& scene, ObjectType, StateHasher* h) {
   for (size_t r = 0; r < scene.proximity_sensors().size(); ++r) {
     const ProximitySensorData& p = scene.proximity_sensors()[r];
@@ -34,19 +73,82 @@ void Hash(const Scene& scene, ObjectType, StateHasher* h) {
     h->AddValue(p.distance);
     h->AddValue(p.p_SD());
     h->AddValue(p.detected_object);
+    if (p.volume != ProximityVolume::kRay) h->AddValue(p.more->normal);
   }
 }
 
+// An angle in degrees, 0 < a < 90 (or <= `max_deg` if `max_inclusive`), in rad.
+double ReadAngle(const ObjectReader& r, const char* key, double max_deg, bool max_inclusive,
+                 double min_deg = 0, bool min_exclusive = true) {
+  static constexpr NumberRule kAnyAngle{"an angle in degrees", -1e300, 1e300};
+  const double a = r.Number(key, kAnyAngle);
+  const bool low_ok = min_exclusive ? a > min_deg : a >= min_deg;
+  const bool high_ok = max_inclusive ? a <= max_deg : a < max_deg;
+  if (!(low_ok && high_ok)) {
+    char message[160];
+    std::snprintf(message, sizeof message, "must be an angle %s %g and %s %g degrees",
+                  min_exclusive ? "above" : "from", min_deg, max_inclusive ? "up to" : "below",
+                  max_deg);
+    r.Fail(key, message);
+  }
+  return a * kDeg;
+}
+
 void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
-  if (r.Has("range"))
-    static_cast<ProximitySensorData*>(row)->range = r.Number("range", kPositiveLength);
+  ProximitySensorData& p = *static_cast<ProximitySensorData*>(row);
+  if (r.Has("range")) p.range = r.Number("range", kPositiveLength);
+  static const std::vector<std::string> kVolumes = {"ray",     "randomized_ray", "cone",
+                                                    "pyramid", "cylinder",       "disc"};
+  if (r.Has("volume")) {
+    const std::string v = r.Choice("volume", kVolumes);
+    for (size_t i = 0; i < kVolumes.size(); ++i)
+      if (v == kVolumes[i]) p.volume = static_cast<ProximityVolume>(i);
+  }
+  using V = ProximityVolume;
+  const V v = p.volume;
+  const bool solid = v == V::kCone || v == V::kPyramid || v == V::kCylinder || v == V::kDisc;
+  // Each key applies to some volumes: elsewhere it is an error.
+  auto applies = [&](const char* key, bool ok, const char* where) {
+    if (!r.Has(key)) return false;
+    if (!ok) r.FailAtKey(key, std::string("'") + key + "' applies to " + where + " sensors only");
+    return true;
+  };
+  if (applies("angle_deg", v == V::kCone || v == V::kRandomizedRay || v == V::kDisc,
+              "cone, randomized_ray and disc"))
+    p.more->angle = v == V::kRandomizedRay ? ReadAngle(r, "angle_deg", 90, false, 0, false)
+                                           : ReadAngle(r, "angle_deg", 90, v == V::kDisc);
+  if (applies("angle_x_deg", v == V::kPyramid, "pyramid"))
+    p.more->angle = ReadAngle(r, "angle_x_deg", 90, false);
+  if (applies("angle_y_deg", v == V::kPyramid, "pyramid"))
+    p.more->angle_y = ReadAngle(r, "angle_y_deg", 90, false);
+  if (applies("cylinder_radius", v == V::kCylinder, "cylinder"))
+    p.more->radius = r.Number("cylinder_radius", kPositiveLength);
+  if (applies("thickness", v == V::kDisc, "disc"))
+    p.more->thickness = r.Number("thickness", kPositiveLength);
+  if (applies("ray_count", v == V::kRandomizedRay, "randomized_ray"))
+    p.more->ray_count = static_cast<uint16_t>(r.Integer("ray_count", 1, 1024));
+  if (applies("blind_zone", solid, "cone, pyramid, cylinder and disc")) {
+    p.more->blind_zone = r.Number("blind_zone", kNonNegativeLength);
+    if (!(p.more->blind_zone < p.range)) r.Fail("blind_zone", "must be less than the range");
+  }
+  if (r.Has("max_detection_angle_deg"))
+    p.more->max_detection_angle = ReadAngle(r, "max_detection_angle_deg", 180, true);
+  if (applies("detect_front", solid, "cone, pyramid, cylinder and disc"))
+    p.more->detect_front = r.Bool("detect_front");
+  if (applies("detect_back", solid, "cone, pyramid, cylinder and disc"))
+    p.more->detect_back = r.Bool("detect_back");
+  if (!p.more->detect_front && !p.more->detect_back)
+    r.FailAtKey(r.Has("detect_back") ? "detect_back" : "detect_front",
+                "detect_front and detect_back are both false: the sensor would detect nothing");
 }
 
 }  // namespace
 
 constinit const ObjectTypeDescriptor kProximitySensorType{
     .name = "proximity_sensor",
-    .description = "a ray sensor along its +z axis: the nearest shape within its range",
+    .description =
+        "a ray along its +z axis, random rays in a cone, or a detection volume (cone, pyramid, "
+        "cylinder, disc): the nearest shape within its range",
     .make_rows = MakeRows,
     .scale_row = Scale,
     .hash_rows = Hash,

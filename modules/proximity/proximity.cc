@@ -1,9 +1,11 @@
 // The proximity backend: ray sensors against the static environment (an
 // OctoMap octree built once, see static_index.h) and against robots and
-// dynamic shapes (a grid of their footprints rebuilt every step).
+// dynamic shapes (a grid of their footprints rebuilt every step); volume
+// and randomized-ray sensors (volume.h) one by one against the shapes whose
+// bounds meet their volume's box (SenseVolume, at the end).
 //
 // Detection rules:
-// - A sensor is a ray from its origin along its +z axis, of length `range`.
+// - A ray sensor is a ray from its origin along its +z axis, of length `range`.
 // - The nearest exact hit wins; on an exact tie the static environment wins,
 //   then the lower shape row (deterministic).
 // - A ray that starts inside or on a shape hits it at distance 0.
@@ -41,6 +43,7 @@
 #include "modules/proximity/footprint_grid.h"
 #include "modules/proximity/ray_cast.h"
 #include "modules/proximity/static_index.h"
+#include "modules/proximity/volume.h"
 
 namespace swarmsim::proximity {
 namespace {
@@ -100,6 +103,15 @@ class OctreeGridProximity final : public ProximityBackend {
 
   void Build(const Scene& scene, const ProximitySettings& settings) override {
     static_.Build(scene, settings.octree_resolution);
+    seed_ = settings.seed;
+    static_lo_.clear();
+    static_hi_.clear();
+    for (const PlacedShape& shape : static_.shapes()) {
+      Vec3 lo, hi;
+      WorldBounds(shape, &lo, &hi);
+      static_lo_.push_back(lo);
+      static_hi_.push_back(hi);
+    }
     Update(scene);
   }
 
@@ -145,21 +157,28 @@ class OctreeGridProximity final : public ProximityBackend {
     if (!SensorListsCurrent(scene)) ListSensors(scene);
   }
 
+  void SetStep(uint64_t step) override { step_ = step; }
+  void SetDetectableFilter(DetectableFilter filter) override { detectable_ = std::move(filter); }
+
   void SenseInstance(Scene* scene, int instance) const override {
     if (SensorListsCurrent(*scene)) {
       const size_t i = static_cast<size_t>(instance);
       SenseBatch({instance_sensors_.data() + instance_sensor_start_[i],
                   instance_sensors_.data() + instance_sensor_start_[i + 1]},
                  instance, {}, scene);
+      for (uint32_t k = instance_volume_start_[i]; k < instance_volume_start_[i + 1]; ++k)
+        SenseVolume(instance_volumes_[k], instance, {}, scene);
       return;
     }
     // The scene changed since Update(): find the sensors the slow way.
-    thread_local std::vector<SensorRef> sensors;
+    thread_local std::vector<SensorRef> sensors, volumes;
     sensors.clear();
+    volumes.clear();
     for (uint32_t slot : scene->instance(instance).objects)
       if (scene->type_at(slot) == ObjectType::kProximitySensor)
-        sensors.push_back({slot, scene->row_at(slot)});
+        (IsRay(*scene, slot) ? sensors : volumes).push_back({slot, scene->row_at(slot)});
     SenseBatch(sensors, instance, {}, scene);
+    for (const SensorRef& sensor : volumes) SenseVolume(sensor, instance, {}, scene);
   }
 
   bool SegmentBlocked(const Vec3& a_W, const Vec3& b_W) const override {
@@ -191,16 +210,26 @@ class OctreeGridProximity final : public ProximityBackend {
            listed_instances_ == scene.instances().size();
   }
 
-  // Lists each robot's sensors (hierarchy order) and the sensors of no robot.
+  // A ray sensor (the batched fast path), or a volume or randomized rays?
+  static bool IsRay(const Scene& scene, uint32_t slot) {
+    return scene.proximity_sensors()[scene.row_at(slot)].volume == ProximityVolume::kRay;
+  }
+
+  // Lists each robot's sensors (hierarchy order; rays apart from volumes)
+  // and the sensors of no robot.
   void ListSensors(const Scene& scene) {
     const auto& instances = scene.instances();
     instance_sensor_start_.assign(1, 0);
     instance_sensors_.clear();
+    instance_volume_start_.assign(1, 0);
+    instance_volumes_.clear();
     for (const ModelInstance& instance : instances) {
       for (uint32_t slot : instance.objects)
         if (scene.type_at(slot) == ObjectType::kProximitySensor)
-          instance_sensors_.push_back({slot, scene.row_at(slot)});
+          (IsRay(scene, slot) ? instance_sensors_ : instance_volumes_)
+              .push_back({slot, scene.row_at(slot)});
       instance_sensor_start_.push_back(static_cast<uint32_t>(instance_sensors_.size()));
+      instance_volume_start_.push_back(static_cast<uint32_t>(instance_volumes_.size()));
     }
     scene_sensors_.clear();
     const auto owners = scene.proximity_sensor_owners();
@@ -217,7 +246,8 @@ class OctreeGridProximity final : public ProximityBackend {
     mounts.clear();
     for (int32_t a = scene->parent_at(sensor.slot); a >= 0; a = scene->parent_at(a))
       if (scene->type_at(a) == ObjectType::kShape) mounts.push_back(scene->IdAt(a));
-    SenseBatch({&sensor, 1}, -1, mounts, scene);
+    if (IsRay(*scene, sensor.slot)) return SenseBatch({&sensor, 1}, -1, mounts, scene);
+    SenseVolume(sensor, -1, mounts, scene);
   }
 
   // Reads the sensors of one robot (`instance`, or -1 for a scene sensor):
@@ -406,28 +436,157 @@ class OctreeGridProximity final : public ProximityBackend {
                 std::span<const ObjectId> skip, Scene* scene) const {
     double best = std::numeric_limits<double>::infinity();
     ObjectId hit;
+    const PlacedShape* hit_shape = nullptr;
     if (ray.range >= 0) {
       double t;
       uint32_t s;
       if (near_static && static_.CastRay(ray.p_W, ray.d_W, ray.range, skip, &t, &s))
-        best = t, hit = static_.shapes()[s].id;
+        best = t, hit = static_.shapes()[s].id, hit_shape = &static_.shapes()[s];
       const Vec3 end = ray.p_W + ray.d_W * ray.range;
       const Aabb2 box{std::min(ray.p_W.x, end.x), std::min(ray.p_W.y, end.y),
                       std::max(ray.p_W.x, end.x), std::max(ray.p_W.y, end.y)};
       for (uint32_t c : candidates) {
         if (!SpatialGrid::CircleIntersectsAabb(footprints_[c], box)) continue;
         if (RayCast(moving_[c], ray.p_W, ray.d_W, ray.range, &t) && t < best)
-          best = t, hit = moving_[c].id;
+          best = t, hit = moving_[c].id, hit_shape = &moving_[c];
       }
     }
     ProximitySensorData& reading = scene->proximity_sensors()[ray.row];
     reading.detected = best <= ray.range;
+    // The surface normal at the hit, in the sensor frame, and the cut-off.
+    if (reading.detected) {
+      const Quat q_SW =
+          scene->world_pose_at(scene->proximity_sensor_owners()[ray.row]).q.Conjugate();
+      reading.more->normal = q_SW.Rotate(SurfaceNormal(*hit_shape, ray.p_W + ray.d_W * best));
+      if (reading.more->max_detection_angle < kPi && best > 0 &&
+          -reading.more->normal.z < std::cos(reading.more->max_detection_angle))
+        reading.detected = false;
+    }
     reading.distance = reading.detected ? best : 0;
     reading.detected_object = reading.detected ? hit : ObjectId{};
   }
 
+  // --- Volume sensors (volume.h) and randomized rays -------------------------
+
+  // Calls visit(shape) for every shape (static first, then other robots' and
+  // dynamic shapes in row order) whose world bounds meet [lo, hi] and that
+  // the sensor may detect.
+  template <class Visit>
+  void VisitShapesNear(ObjectId sensor, const Vec3& lo, const Vec3& hi, int instance,
+                       std::span<const ObjectId> skip, Visit&& visit) const {
+    auto meets = [&](const Vec3& a, const Vec3& b) {
+      return a.x <= hi.x && b.x >= lo.x && a.y <= hi.y && b.y >= lo.y && a.z <= hi.z && b.z >= lo.z;
+    };
+    auto detectable = [&](ObjectId shape) {
+      if (std::find(skip.begin(), skip.end(), shape) != skip.end()) return false;
+      return !detectable_ || detectable_(sensor, shape);
+    };
+    if (!static_.empty() && AnyOccupied(lo, hi)) {
+      thread_local std::vector<uint32_t> near;
+      static_.ShapesInBox(lo, hi, &near);
+      const auto shapes = static_.shapes();
+      for (uint32_t s : near)
+        if (meets(static_lo_[s], static_hi_[s]) && detectable(shapes[s].id)) visit(shapes[s]);
+    }
+    thread_local std::vector<uint32_t> candidates;
+    candidates.clear();
+    Candidates({lo.x, lo.y, hi.x, hi.y}, instance, skip, &candidates);
+    for (uint32_t c : candidates) {
+      Vec3 a, b;
+      WorldBounds(moving_[c], &a, &b);
+      if (meets(a, b) && detectable(moving_[c].id)) visit(moving_[c]);
+    }
+  }
+
+  // World box of a sensor-frame box (its 8 corners through X_WS), grown by a margin.
+  static void WorldBox(const Pose& X_WS, const Vec3& lo_S, const Vec3& hi_S, Vec3* lo, Vec3* hi) {
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    *lo = {kInf, kInf, kInf};
+    *hi = {-kInf, -kInf, -kInf};
+    for (int i = 0; i < 8; ++i) {
+      const Vec3 p =
+          X_WS * Vec3{i & 1 ? hi_S.x : lo_S.x, i & 2 ? hi_S.y : lo_S.y, i & 4 ? hi_S.z : lo_S.z};
+      *lo = {std::min(lo->x, p.x), std::min(lo->y, p.y), std::min(lo->z, p.z)};
+      *hi = {std::max(hi->x, p.x), std::max(hi->y, p.y), std::max(hi->z, p.z)};
+    }
+    const double m = kReachMargin * (1 + (hi_S - lo_S).Norm() + X_WS.p.Norm());
+    *lo = *lo - Vec3{m, m, m};
+    *hi = *hi + Vec3{m, m, m};
+  }
+
+  // Reads a volume or randomized-ray sensor: the nearest point of the
+  // detectable shapes' parts inside its volume.
+  void SenseVolume(const SensorRef& sensor, int instance, std::span<const ObjectId> skip,
+                   Scene* scene) const {
+    ProximitySensorData& reading = scene->proximity_sensors()[sensor.row];
+    const Pose& X_WS = scene->world_pose_at(sensor.slot);
+    const ObjectId sensor_id = scene->IdAt(sensor.slot);
+    const Volume volume = MakeVolume(reading);
+    Vec3 lo_S, hi_S, lo, hi;
+    VolumeBounds(volume, &lo_S, &hi_S);
+    WorldBox(X_WS, lo_S, hi_S, &lo, &hi);
+    VolumeHit best{std::numeric_limits<double>::infinity(), {}, {}};
+    ObjectId hit;
+    const bool usable = std::isfinite(X_WS.p.x + X_WS.p.y + X_WS.p.z + reading.range);
+    if (usable && volume.kind == ProximityVolume::kRandomizedRay) {
+      SenseRandomRays(reading, sensor, X_WS, lo, hi, instance, skip, &best, &hit, scene);
+    } else if (usable) {
+      const Pose X_SW = X_WS.Inverse();
+      VisitShapesNear(sensor_id, lo, hi, instance, skip, [&](const PlacedShape& shape) {
+        VolumeHit h;
+        if (NearestInVolume(volume, shape, X_SW, best.distance, &h)) best = h, hit = shape.id;
+      });
+    }
+    reading.detected = best.distance <= reading.range;
+    reading.distance = reading.detected ? best.distance : 0;
+    reading.detected_object = reading.detected ? hit : ObjectId{};
+    reading.more->point = reading.detected ? best.point : Vec3{};
+    reading.more->normal = reading.detected ? best.normal : Vec3{};
+  }
+
+  // `ray_count` rays in the cone, from the stream of (seed, sensor slot,
+  // step): the same rays whatever thread reads the sensor.
+  void SenseRandomRays(const ProximitySensorData& reading, const SensorRef& sensor,
+                       const Pose& X_WS, const Vec3& lo, const Vec3& hi, int instance,
+                       std::span<const ObjectId> skip, VolumeHit* best, ObjectId* hit,
+                       const Scene* scene) const {
+    thread_local std::vector<Vec3> directions;
+    thread_local std::vector<const PlacedShape*> shapes;
+    directions.resize(reading.more->ray_count);
+    const uint64_t stream = (uint64_t{sensor.slot} << 40) ^ step_;
+    RandomRayDirections(seed_, stream, reading.more->angle, reading.more->ray_count,
+                        directions.data());
+    shapes.clear();
+    VisitShapesNear(scene->IdAt(sensor.slot), lo, hi, instance, skip,
+                    [&](const PlacedShape& shape) { shapes.push_back(&shape); });
+    const double cos_cut =
+        reading.more->max_detection_angle < kPi ? std::cos(reading.more->max_detection_angle) : -2;
+    for (const Vec3& d_S : directions) {
+      const Vec3 d_W = X_WS.q.Rotate(d_S);
+      double nearest = std::min(best->distance, reading.range);
+      const PlacedShape* nearest_shape = nullptr;
+      for (const PlacedShape* shape : shapes) {
+        double t;
+        if (RayCast(*shape, X_WS.p, d_W, nearest, &t) && (t < nearest || !nearest_shape))
+          nearest = t, nearest_shape = shape;
+      }
+      if (!nearest_shape || nearest >= best->distance) continue;
+      const Vec3 normal =
+          X_WS.q.Conjugate().Rotate(SurfaceNormal(*nearest_shape, X_WS.p + d_W * nearest));
+      if (nearest > 0 && -normal.Dot(d_S) < cos_cut) continue;
+      *best = {nearest, d_S * nearest, normal};
+      *hit = nearest_shape->id;
+    }
+  }
+
+  static constexpr double kPi = 3.141592653589793;
+
   BackendOptions options_;
   StaticIndex static_;
+  std::vector<Vec3> static_lo_, static_hi_;  // world bounds of static_.shapes() (static shapes)
+  uint64_t seed_ = 1;                        // the world's seed
+  uint64_t step_ = 0;                        // the step being sensed
+  DetectableFilter detectable_;              // unset: every shape is detectable
   std::vector<PlacedShape> moving_;   // robot and dynamic shapes, by shape row order (moving)
   std::vector<GridItem> footprints_;  // their footprints, item i: moving_[i] (moving)
   std::vector<Aabb2> squares_;        // bounding squares, grown (moving)
@@ -438,7 +597,9 @@ class OctreeGridProximity final : public ProximityBackend {
   SpatialGrid grid_;                            // casting every ray
   // The sensors by owner, as of ListSensors() (see SensorListsCurrent).
   std::vector<uint32_t> instance_sensor_start_;  // first of each instance's sensors (instances + 1)
-  std::vector<SensorRef> instance_sensors_;      // robot sensors, grouped by instance
+  std::vector<SensorRef> instance_sensors_;      // robot ray sensors, grouped by instance
+  std::vector<uint32_t> instance_volume_start_;  // the same for volume sensors (instances + 1)
+  std::vector<SensorRef> instance_volumes_;      // robot volume sensors, grouped by instance
   std::vector<SensorRef> scene_sensors_;         // sensors of no robot, by row
   uint64_t listed_version_ = ~uint64_t{0};
   size_t listed_instances_ = 0;
@@ -448,8 +609,9 @@ class OctreeGridProximity final : public ProximityBackend {
 
 swarmsim::ModuleInfo ModuleInfo() {
   return {"proximity", "proximity", "1.0.0",
-          "ray proximity sensors: exact distances to boxes, cylinders, spheres and triangle "
-          "meshes; static environment in an OctoMap octree, robots through a spatial grid"};
+          "proximity sensors (rays, randomized rays, cone, pyramid, cylinder and disc volumes): "
+          "exact distances to boxes, cylinders, spheres, capsules and triangle meshes; static "
+          "environment in an OctoMap octree, robots through a spatial grid"};
 }
 
 std::unique_ptr<ProximityBackend> MakeBackend(const BackendOptions& options) {

@@ -537,4 +537,39 @@ bool StaticIndex::CastRay(const Vec3& p_W, const Vec3& d_W, double max_t,
   return true;
 }
 
+void StaticIndex::ShapesInBox(const Vec3& lo, const Vec3& hi, std::vector<uint32_t>* out) const {
+  out->clear();
+  if (shapes_.empty()) return;
+  // The box's keys within the occupied ones (a non-finite box: every key).
+  int k0[3], k1[3];
+  for (int i = 0; i < 3; ++i) {
+    const double a = Axis(lo, i), b = Axis(hi, i);
+    k0[i] = std::isnan(a) ? occupied_keys_.lo[i] : std::max(ClampedKey(a), occupied_keys_.lo[i]);
+    k1[i] = std::isnan(b) ? occupied_keys_.hi[i] : std::min(ClampedKey(b), occupied_keys_.hi[i]);
+    if (k0[i] > k1[i]) return;
+  }
+  double buckets = 1;
+  for (int i = 0; i < 3; ++i) buckets *= (k1[i] >> kBucketShift) - (k0[i] >> kBucketShift) + 1;
+  // More buckets than shapes: scan the shapes' bounds instead.
+  if (buckets > static_cast<double>(std::min(buckets_.size(), shapes_.size()))) {
+    for (uint32_t s = 0; s < shapes_.size(); ++s) {
+      Vec3 a, b;
+      WorldBounds(shapes_[s], &a, &b);
+      if (a.x <= hi.x && b.x >= lo.x && a.y <= hi.y && b.y >= lo.y && a.z <= hi.z && b.z >= lo.z)
+        out->push_back(s);
+    }
+    return;
+  }
+  for (int bx = k0[0] >> kBucketShift; bx <= k1[0] >> kBucketShift; ++bx)
+    for (int by = k0[1] >> kBucketShift; by <= k1[1] >> kBucketShift; ++by)
+      for (int bz = k0[2] >> kBucketShift; bz <= k1[2] >> kBucketShift; ++bz) {
+        const auto it = buckets_.find(PackBucket(bx, by, bz));
+        if (it == buckets_.end()) continue;
+        for (uint32_t e = it->second.first; e < it->second.second; ++e)
+          out->push_back(bucket_shapes_[e]);
+      }
+  std::sort(out->begin(), out->end());
+  out->erase(std::unique(out->begin(), out->end()), out->end());
+}
+
 }  // namespace swarmsim::proximity

@@ -69,6 +69,11 @@ class StaticIndex {
     return coarse_shift_[0] == 0 && coarse_shift_[1] == 0 && coarse_shift_[2] == 0;
   }
 
+  // The static shapes that may meet the world box [lo, hi] (a superset:
+  // those of the octree buckets it reaches), as indices into shapes(),
+  // ascending (*out cleared first). For volume sensors.
+  void ShapesInBox(const Vec3& lo, const Vec3& hi, std::vector<uint32_t>* out) const;
+
   // Nearest exact hit of the ray (p_W, unit d_W, length max_t) on a static
   // shape not listed in `skip`. Sets *t and *shape (index into shapes()).
   bool CastRay(const Vec3& p_W, const Vec3& d_W, double max_t, std::span<const ObjectId> skip,

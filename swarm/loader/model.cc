@@ -386,6 +386,17 @@ ObjectSpec ResolveModel(const ModelFile& model, const ValueReader& values, Scrip
   return std::move(out.front());
 }
 
+std::vector<ObjectSpec> ReadSceneObjects(const YamlFile& file, const Field& list,
+                                         const ValueReader& values, ScriptCache* scripts,
+                                         MeshCache* meshes, const ModuleRegistry* registry) {
+  ModelFile scene_model{file, "the world", {}, list, {}};
+  Builder builder{scene_model, values, scripts, 0, meshes, registry};
+  std::vector<ObjectSpec> out;
+  for (const Field& element : ListElements(file, list, "objects"))
+    builder.Object(element, 1, false, &out);
+  return out;
+}
+
 // --- Scene ----------------------------------------------------------------------------
 
 ObjectId AddToScene(const ObjectSpec& spec, ObjectId parent, Scene* scene) {

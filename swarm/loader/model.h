@@ -76,6 +76,12 @@ struct ModelFile {
 // not a model at all.
 ModelFile ReadModelFile(YamlFile file, const std::string& used_by);
 
+// The world file's `objects:`: objects of the scene that belong to no model
+// (collections, distance objects, markers), each an entry as in a model file.
+std::vector<ObjectSpec> ReadSceneObjects(const YamlFile& file, const Field& list,
+                                         const ValueReader& values, ScriptCache* scripts,
+                                         MeshCache* meshes, const ModuleRegistry* registry);
+
 // Valid parameter name: a Lua identifier that is not a keyword.
 bool IsParameterName(std::string_view name);
 

@@ -14,4 +14,21 @@ std::shared_ptr<const TriangleMesh> FieldsObjectReader::Mesh(std::string_view ke
                      values_.file().Where(file.mark), text);
 }
 
+std::vector<std::string> FieldsObjectReader::Strings(std::string_view key, size_t max_count,
+                                                     bool required) const {
+  const Field field = Get(key, required);
+  std::vector<std::string> out;
+  if (!field.present()) return out;
+  if (field.node.IsScalar()) {
+    out.push_back(values_.String(field));
+    return out;
+  }
+  const std::vector<Field> elements = ListElements(values_.file(), field, "names");
+  if (elements.size() > max_count)
+    values_.Fail(field, "'" + field.name + "' takes at most " + std::to_string(max_count) +
+                            " names (got " + std::to_string(elements.size()) + ")");
+  for (const Field& element : elements) out.push_back(values_.String(element));
+  return out;
+}
+
 }  // namespace swarmsim::loader

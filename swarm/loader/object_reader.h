@@ -39,6 +39,8 @@ class FieldsObjectReader final : public ObjectReader {
   Vec3 Vector3(std::string_view key, const NumberRule& rule, bool required) const override {
     return values_.Vector3(Get(key, required), rule);
   }
+  std::vector<std::string> Strings(std::string_view key, size_t max_count,
+                                   bool required) const override;
   [[noreturn]] void Fail(std::string_view key, const std::string& message) const override {
     values_.Fail(fields_.Get(key), message);
   }

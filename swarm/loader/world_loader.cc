@@ -17,9 +17,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const std::vector<std::string> kTopKeys = {"simulation", "parameters",  "arena",
-                                           "obstacles",  "environment", "models",
-                                           "metrics",    "paint",       "plugins"};
+const std::vector<std::string> kTopKeys = {"simulation",  "parameters", "arena",   "obstacles",
+                                           "environment", "models",     "objects", "metrics",
+                                           "paint",       "plugins"};
 
 std::vector<Override> SplitOverrides(const LoadOptions& options) {
   std::vector<Override> out;
@@ -92,6 +92,11 @@ LoadedWorld WorldLoader::Load() {
   KeepPlacementClearOfTheMap();
   PlaceEntries();
   BuildCopies(world);
+  // The scene's own objects (collections, distance objects, ...), after the
+  // robots: they may name them.
+  for (const loader::ObjectSpec& spec : loader::ReadSceneObjects(
+           f, top.Get("objects"), WorldValues(), &scripts_, &meshes_, world_registry_))
+    loader::AddToScene(spec, {}, &world->scene());
   out.metrics = ReadMetrics(top, world);
   out.models = Summarize();
   loader::AddPaintLayer(f, root, top.Get("paint"), WorldValues(), arena_, world);

@@ -458,9 +458,10 @@ TEST(ScriptHostTest, ReadProximitySensorReturnsTheReading) {
       for i = 0, 1 do
         local h = sim.getObject('./prox[' .. i .. ']')
         print(select('#', sim.readProximitySensor(h)))
-        local detected, distance, point, object = sim.readProximitySensor(h)
+        local detected, distance, point, object, normal = sim.readProximitySensor(h)
         if detected == 1 then
-          print(detected, distance, point[1], point[2], point[3], sim.getObjectName(object))
+          print(detected, distance, point[1], point[2], point[3], sim.getObjectName(object),
+                normal[1], normal[2], normal[3])
         else
           print(detected)
         end
@@ -474,10 +475,13 @@ TEST(ScriptHostTest, ReadProximitySensorReturnsTheReading) {
   reading.detected = true;
   reading.distance = 0.0625;
   reading.detected_object = wall;
+  reading.more->normal = {0, 0, -1};
   w.world().Start();
   w.world().Step();  // the null proximity module leaves the readings alone
+  // CoppeliaSim's order: result, distance, point, object, normal.
   const std::vector<std::string> expected = {
-      "[bot#0] 4", "[bot#0] 1\t0.0625\t0.0\t0.0\t0.0625\twall", "[bot#0] 1", "[bot#0] 0"};
+      "[bot#0] 5", "[bot#0] 1\t0.0625\t0.0\t0.0\t0.0625\twall\t0.0\t0.0\t-1.0", "[bot#0] 1",
+      "[bot#0] 0"};
   EXPECT_EQ(w.log, expected);
 }
 
