@@ -92,6 +92,25 @@ TEST_F(EnvironmentProximityTest, TheSharedMapAnswersTheReferenceRayCasts) {
   }
 }
 
+// A detection volume (a cone) sees the map's voxels too, as a null object.
+TEST_F(EnvironmentProximityTest, AConeSeesTheSharedMap) {
+  SWARMSIM_NEED_SHARED_MAP(path, "geb079.bt");
+  scene_.set_environment(
+      std::make_shared<const EnvironmentMap>(environment::ReadOctomap(path, "geb079.bt", {})));
+  ProximitySensorData cone;
+  cone.volume = ProximityVolume::kCone;
+  cone.range = 5;
+  cone.more->angle = 10 * M_PI / 180;
+  const ObjectId sensor =
+      scene_.AddProximitySensor("cone", {}, {{0.001, 0.001, 1}, LookAlong({0, 1, 0})}, cone);
+  Start(0.08);
+  const ProximitySensorData& r = Reading(sensor);
+  EXPECT_TRUE(r.detected);
+  EXPECT_GT(r.distance, 0.5);
+  EXPECT_LE(r.distance, 3.44 - 0.001 + kTol);  // no farther than the wall on its axis
+  EXPECT_TRUE(r.detected_object.IsNull());
+}
+
 TEST_F(EnvironmentProximityTest, LineOfSightIsBlockedByTheSharedMapsWalls) {
   SWARMSIM_NEED_SHARED_MAP(path, "geb079.bt");
   scene_.set_environment(
