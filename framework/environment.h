@@ -21,7 +21,8 @@ struct EnvironmentMap {
   std::string source;     // the file as the world names it, for messages
   double resolution = 0;  // m, the map's voxel size
   // The occupied leaves of the map, each a cube of resolution x 2^k
-  // (a pruned octree merges eight full children), in the map's own order
+  // (a pruned octree merges eight full children; a z range may cut one to
+  // fewer voxel layers), on the map's voxel grid, in the map's own order
   // (deterministic: depth-first from the root).
   std::vector<EnvironmentBox> boxes;
   Vec3 lo, hi;  // bounds of `boxes` (both zero when there are none)

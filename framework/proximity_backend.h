@@ -20,7 +20,8 @@ struct ProximitySettings {
 // May the sensor `sensor` detect the shape `shape`? The hook for per-sensor
 // detectable sets (collections): unset, every sensor detects every shape
 // (but its own robot's). Called concurrently from the sense phase; applied
-// to volume and randomized-ray sensors.
+// to volume and randomized-ray sensors. `shape` is null for a voxel of the
+// Scene's environment map.
 using DetectableFilter = std::function<bool(ObjectId sensor, ObjectId shape)>;
 
 class ProximityBackend {
@@ -28,7 +29,8 @@ class ProximityBackend {
   virtual ~ProximityBackend() = default;
 
   // Indexes the static environment (shapes that belong to no robot and are
-  // not dynamic). Called once at start.
+  // not dynamic, and the Scene's environment map, whose boxes a reading
+  // reports as a null object). Called once at start.
   virtual void Build(const Scene& scene, const ProximitySettings& settings) = 0;
   // Rebuilds per-step acceleration structures (the spatial grid of robots)
   // from the current poses. Called once per step before Sense().

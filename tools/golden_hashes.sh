@@ -16,7 +16,21 @@ table=tests/data/golden_hashes.tsv
 tmp=$(mktemp)
 trap 'rm -f "$tmp"' EXIT
 printf '# world\tseed\tsteps\tthreads\tstate_hash   (written by tools/golden_hashes.sh)\n' >"$tmp"
+# A world reading a map beside the repository (../../shared/maps/, not in it)
+# that is not there keeps its rows of the old table.
+missing_map() {
+  local map
+  for map in $(grep -o '\.\./\.\./shared/maps/[A-Za-z0-9_.-]*' "$1"); do
+    [ -e "$(dirname "$1")/$map" ] || { echo "$map"; return 0; }
+  done
+  return 1
+}
 for world in worlds/*.yaml bench/worlds/*.yaml tests/data/worlds/golden_*.yaml; do
+  if map=$(missing_map "$world"); then
+    echo "golden_hashes: $world: $map is not here; its rows are kept" >&2
+    grep -P "^\Q$world\E\t" "$table" >>"$tmp" || true
+    continue
+  fi
   for seed in 1 7; do
     for threads in 1 2; do
       line=$("$program" run "$world" --seed "$seed" --steps "$steps" --threads "$threads" \

@@ -41,6 +41,106 @@ bool ClipSlab(double o, double d, double lo, double hi, double* t_lo, double* t_
   return *t_lo <= *t_hi;
 }
 
+// Makes `node` and everything below it occupied: a childless node becomes
+// an occupied leaf; below one with children, the missing children are
+// added as occupied leaves (prune() merges them).
+void FillOccupied(octomap::OcTree* tree, octomap::OcTreeNode* node, float occupied,
+                  int64_t* nodes) {
+  if (!tree->nodeHasChildren(node)) {
+    node->setLogOdds(occupied);
+    return;
+  }
+  for (unsigned int c = 0; c < 8; ++c) {
+    if (tree->nodeChildExists(node, c)) {
+      FillOccupied(tree, tree->getNodeChild(node, c), occupied, nodes);
+    } else {
+      ++*nodes;
+      tree->createNodeChild(node, c)->setLogOdds(occupied);
+    }
+  }
+}
+
+// Marks the voxels of the key box [lo, hi] (inclusive) occupied below
+// `node` (key cube `origin`, edge `size`) as whole cubes: a cube inside the
+// box becomes one occupied leaf (what prune() would make of its voxels).
+// Every childless node here is an occupied leaf (voxels and cubes are
+// only ever added occupied), so one found on the way already covers its
+// part; `fresh`: the node was just created (childless, not yet a leaf).
+// Counts created nodes in *nodes.
+void InsertKeyBox(octomap::OcTree* tree, octomap::OcTreeNode* node, const int origin[3], int size,
+                  const int lo[3], const int hi[3], float occupied, bool fresh, int64_t* nodes) {
+  bool inside = true;
+  for (int i = 0; i < 3; ++i)
+    inside = inside && origin[i] >= lo[i] && origin[i] + size - 1 <= hi[i];
+  if (inside) return FillOccupied(tree, node, occupied, nodes);
+  if (!fresh && !tree->nodeHasChildren(node)) return;  // inside an occupied leaf
+  const int half = size / 2;
+  for (unsigned int c = 0; c < 8; ++c) {
+    const int child[3] = {origin[0] + ((c & 1) ? half : 0), origin[1] + ((c & 2) ? half : 0),
+                          origin[2] + ((c & 4) ? half : 0)};
+    bool overlaps = true;
+    for (int i = 0; i < 3; ++i)
+      overlaps = overlaps && child[i] <= hi[i] && child[i] + half - 1 >= lo[i];
+    if (!overlaps) continue;
+    const bool exists = tree->nodeChildExists(node, c);
+    if (!exists) ++*nodes;
+    InsertKeyBox(tree, exists ? tree->getNodeChild(node, c) : tree->createNodeChild(node, c), child,
+                 half, lo, hi, occupied, !exists, nodes);
+  }
+}
+
+// The environment map's boxes (framework/environment.h) as static boxes of
+// no object (null id, instance -1), appended to `shapes`; the voxels their
+// interiors meet marked in `tree` a box at a time (InsertKeyBox: no
+// per-voxel overlap tests; a box on the octree's grid is one node), and the
+// buckets they touch added to `touches`. Grows the key bounds.
+void AddEnvironment(const EnvironmentMap& map, double resolution, octomap::OcTree* tree,
+                    std::vector<PlacedShape>* shapes,
+                    std::vector<std::pair<uint64_t, uint32_t>>* touches, int key_lo[3],
+                    int key_hi[3]) {
+  const float occupied = tree->getClampingThresMaxLog();
+  const double inv_resolution = 1 / resolution;
+  const double shrink = resolution * 1e-6;  // a box's faces do not mark the voxels beyond
+  constexpr int64_t kMaxNodes = 20000000;   // about 1.6 GB of octree
+  int64_t nodes = 0;
+  for (const EnvironmentBox& box : map.boxes) {
+    int lo[3], hi[3];
+    for (int i = 0; i < 3; ++i) {
+      const double a = std::floor((Axis(box.lo, i) + shrink) * inv_resolution) + kKeyOffset;
+      const double b = std::floor((Axis(box.hi, i) - shrink) * inv_resolution) + kKeyOffset;
+      if (!(a >= 0 && b <= kMaxKey)) {
+        std::ostringstream m;
+        m << "proximity: the environment map " << map.source
+          << " reaches outside the octree's reach (|x|, |y|, |z| < " << kKeyOffset * resolution
+          << " m at octree_resolution " << resolution << " m); move it or use a coarser resolution";
+        throw Error(m.str());
+      }
+      lo[i] = static_cast<int>(a), hi[i] = std::max(static_cast<int>(b), lo[i]);
+      key_lo[i] = std::min(key_lo[i], lo[i]);
+      key_hi[i] = std::max(key_hi[i], hi[i]);
+    }
+    if (tree->getRoot() == nullptr)  // the library makes the root (and a path to a voxel)
+      tree->setNodeValue(octomap::OcTreeKey(lo[0], lo[1], lo[2]), occupied, /*lazy_eval=*/true);
+    const int origin[3] = {0, 0, 0};
+    InsertKeyBox(tree, tree->getRoot(), origin, kTreeSize, lo, hi, occupied, false, &nodes);
+    if (nodes > kMaxNodes) {
+      std::ostringstream m;
+      m << "proximity: the environment map " << map.source << " needs more than " << kMaxNodes
+        << " octree nodes at octree_resolution " << resolution
+        << " m; use a coarser resolution (the map's own is " << map.resolution << " m)";
+      throw Error(m.str());
+    }
+    const uint32_t s = static_cast<uint32_t>(shapes->size());
+    ShapeData shape;
+    shape.kind = ShapeKind::kBox;
+    shape.size = box.hi - box.lo;
+    shapes->push_back(PlaceShape(shape, Pose{(box.lo + box.hi) * 0.5, {}}, ObjectId{}, -1));
+    for (int bx = lo[0] >> kBucketShift; bx <= hi[0] >> kBucketShift; ++bx)
+      for (int by = lo[1] >> kBucketShift; by <= hi[1] >> kBucketShift; ++by)
+        for (int bz = lo[2] >> kBucketShift; bz <= hi[2] >> kBucketShift; ++bz)
+          touches->emplace_back(PackBucket(bx, by, bz), s);
+  }
+}
 }  // namespace
 
 StaticIndex::StaticIndex() = default;
@@ -152,6 +252,10 @@ void StaticIndex::Build(const Scene& scene, double resolution) {
           if (touched) touches.emplace_back(PackBucket(bx, by, bz), s);
         }
   }
+  // The environment map's voxels: boxes of no object, after the shapes.
+  if (const EnvironmentMap* map = scene.environment())
+    AddEnvironment(*map, resolution, tree_.get(), &shapes_, &touches, occupied_keys_.lo,
+                   occupied_keys_.hi);
   tree_->updateInnerOccupancy();
   tree_->prune();
 

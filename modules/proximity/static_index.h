@@ -1,6 +1,7 @@
 // The static environment of the proximity module: the shapes that belong to
-// no robot and are not dynamic, frozen at Build() time, indexed in an
-// OctoMap octree.
+// no robot and are not dynamic, and the voxels of the scene's environment
+// map (framework/environment.h, as boxes of no object), frozen at Build()
+// time, indexed in an OctoMap octree.
 //
 // Every voxel a shape may overlap (conservatively) is marked occupied. Shape
 // lists are kept per *bucket* of 4x4x4 voxels (a map from the bucket's key to

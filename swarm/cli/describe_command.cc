@@ -24,6 +24,11 @@ void PrintDescription(const LoadedWorld& w, std::ostream& out) {
   out << "modules:";
   for (const std::string& name : w.world->module_names()) out << " " << name;
   out << "\n";
+  if (const EnvironmentMap* map = w.world->scene().environment())
+    out << "environment: " << map->source << ", " << map->boxes.size() << " occupied voxels of "
+        << map->resolution << " m, from (" << map->lo.x << ", " << map->lo.y << ", " << map->lo.z
+        << ") to (" << map->hi.x << ", " << map->hi.y << ", " << map->hi.z << ") m\n";
+  for (const std::string& warning : w.warnings) out << "warning: " << warning << "\n";
   if (!w.world->parameters().empty()) {
     out << "world parameters:\n";
     for (const auto& [name, value] : w.world->parameters())

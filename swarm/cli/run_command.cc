@@ -107,6 +107,8 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
   } catch (const Error& e) {
     return bad_input(e.what());
   }
+  for (const std::string& warning : loaded.warnings)
+    std::cerr << "warning: " << swarmsim::ValidUtf8(warning) << "\n";
   std::string length_error;
   const std::optional<int64_t> steps = RunLength(args, loaded, &length_error);
   if (!steps) return bad_input(length_error);

@@ -436,23 +436,27 @@ void Accumulate(const ObjectSpec& spec, const Pose& X_RP, Footprint* fp, bool* a
     } else {
       radius = std::hypot(std::abs(X_RO.p.x) + e.x, std::abs(X_RO.p.y) + e.y);
     }
-    double bottom = X_RO.p.z - e.z;
+    double bottom = X_RO.p.z - e.z, top = X_RO.p.z + e.z;
     if (s.kind == ShapeKind::kMesh && s.mesh) {  // exact over its vertices
       radius = 0;
       bottom = std::numeric_limits<double>::infinity();
+      top = -bottom;
       for (const Vec3& v : s.mesh->vertices()) {
         const Vec3 p = X_RO * v;
         radius = std::max(radius, std::hypot(p.x, p.y));
         bottom = std::min(bottom, p.z);
+        top = std::max(top, p.z);
       }
     }
     if (!*any) {
       fp->radius = radius;
       fp->bottom = bottom;
+      fp->top = top;
       *any = true;
     } else {
       fp->radius = std::max(fp->radius, radius);
       fp->bottom = std::min(fp->bottom, bottom);
+      fp->top = std::max(fp->top, top);
     }
   }
   const JointData* joint = spec.As<JointData>(ObjectType::kJoint);

@@ -115,6 +115,8 @@ ObjectId AddToScene(const ObjectSpec& spec, ObjectId parent, Scene* scene);
 struct Footprint {
   double radius = 0;
   double bottom = 0;
+  double top =
+      0;  // the highest z of any shape (placement keeps copies clear of map voxels below it)
 };
 Footprint ComputeFootprint(const ObjectSpec& root);
 

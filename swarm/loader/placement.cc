@@ -43,9 +43,31 @@ void Placer::AddBody(double x, double y, double radius) {
   if (cell_size_ > 0) Insert(static_cast<uint32_t>(bodies_.size() - 1));
 }
 
+bool Placer::NearMapCell(double x, double y, double keep) const {
+  const double c = map_.cell;
+  const auto first = [&](double v, double origin, int n) {
+    return static_cast<int>(std::clamp(std::floor((v - origin) / c), -1.0, double(n)));
+  };
+  const int i0 = std::max(first(x - keep, map_.x0, map_.nx), 0);
+  const int i1 = std::min(first(x + keep, map_.x0, map_.nx), map_.nx - 1);
+  const int j0 = std::max(first(y - keep, map_.y0, map_.ny), 0);
+  const int j1 = std::min(first(y + keep, map_.y0, map_.ny), map_.ny - 1);
+  for (int j = j0; j <= j1; ++j)
+    for (int i = i0; i <= i1; ++i) {
+      if (!map_.at(i, j)) continue;
+      // Distance from (x, y) to the cell's square.
+      const double lo_x = map_.x0 + i * c, lo_y = map_.y0 + j * c;
+      const double dx = std::max({lo_x - x, 0.0, x - (lo_x + c)});
+      const double dy = std::max({lo_y - y, 0.0, y - (lo_y + c)});
+      if (dx * dx + dy * dy < keep * keep) return true;
+    }
+  return false;
+}
+
 bool Placer::IsFree(double x, double y, double radius, double clearance) const {
   // Obstacles: few, checked one by one behind a bounding-circle test.
   const double keep = radius + clearance;
+  if (!map_.empty() && NearMapCell(x, y, keep)) return false;
   for (const Obstacle2& o : obstacles_) {
     if (std::hypot(x - o.x, y - o.y) - o.BoundingRadius() >= keep) continue;
     if (o.Distance(x, y) < keep) return false;

@@ -12,9 +12,11 @@
 #include <functional>
 #include <optional>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "framework/random.h"
+#include "modules/environment/voxel_merge.h"
 
 namespace swarmsim {
 
@@ -54,6 +56,10 @@ class Placer {
   explicit Placer(uint64_t seed) : seed_(seed) {}
 
   void AddObstacle(const Obstacle2& obstacle) { obstacles_.push_back(obstacle); }
+  // The environment map's occupied cells in the plane (a grid of squares,
+  // environment::ProjectBand): copies keep `clearance` from each like from
+  // an obstacle.
+  void SetMapCells(environment::PlaneGrid cells) { map_ = std::move(cells); }
   // A copy placed by other means (a fixed position): later copies keep clear of it.
   void AddBody(double x, double y, double radius);
 
@@ -96,12 +102,15 @@ class Placer {
   };
 
   CellKey CellOf(double x, double y) const;
+  // Does a map cell come closer than `keep` to (x, y)?
+  bool NearMapCell(double x, double y, double keep) const;
   void Insert(uint32_t body);
   void Rebuild(double cell_size);
 
   uint64_t seed_;
   std::vector<Body> bodies_;
   std::vector<Obstacle2> obstacles_;
+  environment::PlaneGrid map_;  // map cells (empty: none)
   double max_body_radius_ = 0;
   // Bodies by cell: the cell edge is at least the largest body diameter, so
   // a query looks at a small block of cells.

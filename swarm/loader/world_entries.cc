@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "framework/error.h"
+#include "modules/environment/voxel_merge.h"
 #include "swarm/loader/world_loader_impl.h"
 
 namespace swarmsim::loader {
@@ -179,6 +180,7 @@ void WorldLoader::ResolveObjects(const Fields& f, const ValueReader& world_value
     entry->scale = world_values.Number(f.Get("scale"), kScale);
     entry->footprint.radius *= entry->scale;
     entry->footprint.bottom *= entry->scale;
+    entry->footprint.top *= entry->scale;
   }
   entry->ik_groups = loader::ReadIkGroups(model, model_values);
   // A copy with values of its own gets objects of its own: every value of
@@ -197,6 +199,7 @@ void WorldLoader::ResolveObjects(const Fields& f, const ValueReader& world_value
     own.footprint = loader::ComputeFootprint(*own.spec);
     own.footprint.radius *= entry->scale;
     own.footprint.bottom *= entry->scale;
+    own.footprint.top *= entry->scale;
   }
 }
 
@@ -287,6 +290,26 @@ void WorldLoader::ReadSinglePosition(const Fields& f, const ValueReader& world_v
 
 // --- Placing and building the copies ------------------------------------------------------
 
+// The environment map's voxels that a copy standing on the ground would
+// meet (those reaching into the band from the ground to the tallest copy's
+// top, less 1 mm at either end: a floor whose top is at z = 0 is not one),
+// projected to the plane: placement keeps copies clear of them.
+void WorldLoader::KeepPlacementClearOfTheMap() {
+  if (!environment_ || entries_.empty()) return;
+  double height = 0;
+  for (const EntryPlan& e : entries_) {
+    height = std::max(height, e.footprint.top - e.footprint.bottom);
+    for (const EntryPlan::OwnCopy& own : e.own_copies)
+      if (own.spec) height = std::max(height, own.footprint.top - own.footprint.bottom);
+  }
+  constexpr double kOverlap = 1e-3;  // m, as the physics backends' rule
+  try {
+    placer_->SetMapCells(environment::ProjectBand(*environment_, kOverlap, height - kOverlap));
+  } catch (const Error& e) {
+    file_->Fail(environment_field_.mark, e.what());
+  }
+}
+
 void WorldLoader::PlaceEntries() {
   // Fixed copies first, so distributed ones keep clear of them wherever they are listed.
   for (EntryPlan& e : entries_) {
@@ -297,7 +320,7 @@ void WorldLoader::PlaceEntries() {
       file_->Fail(e.position_field.mark,
                   "this " + e.model->name + " at [" + loader::FormatNumber(X.p.x) + ", " +
                       loader::FormatNumber(X.p.y) +
-                      "] overlaps a wall, an obstacle or another placed copy");
+                      "] overlaps a wall, an obstacle, the map or another placed copy");
     placer_->AddBody(X.p.x, X.p.y, radius);
   }
   uint64_t stream = 0;

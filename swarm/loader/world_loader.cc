@@ -7,6 +7,7 @@
 #include "framework/error.h"
 #include "framework/plugin_loader.h"
 #include "framework/registry.h"
+#include "swarm/loader/environment.h"
 #include "swarm/loader/paint.h"
 #include "swarm/loader/world_loader_impl.h"
 
@@ -16,9 +17,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const std::vector<std::string> kTopKeys = {"simulation", "parameters", "arena",
-                                           "obstacles",  "models",     "objects",
-                                           "metrics",    "paint",      "plugins"};
+const std::vector<std::string> kTopKeys = {"simulation",  "parameters", "arena",   "obstacles",
+                                           "environment", "models",     "objects", "metrics",
+                                           "paint",       "plugins"};
 
 std::vector<Override> SplitOverrides(const LoadOptions& options) {
   std::vector<Override> out;
@@ -83,7 +84,12 @@ LoadedWorld WorldLoader::Load() {
   placer_ = std::make_unique<Placer>(settings.seed);
   BuildArena(top, world);
   BuildObstacles(top, world);
+  environment_field_ = top.Get("environment");
+  environment_ = loader::ReadEnvironment(f, environment_field_, WorldValues(), path_.parent_path(),
+                                         &out.warnings);
+  if (environment_) world->scene().set_environment(environment_);
   for (EntryPlan& entry : entries_) ResolveEntry(&entry);
+  KeepPlacementClearOfTheMap();
   PlaceEntries();
   BuildCopies(world);
   // The scene's own objects (collections, distance objects, ...), after the

@@ -67,6 +67,9 @@ struct LoadedWorld {
   std::vector<SwarmMetricSpec> metrics;
   // The models entries, for `swarmsim describe`.
   std::vector<ModelSummary> models;
+  // What may surprise without being an error ("file:line:col: ..."), for the
+  // program to print: e.g. an environment map without occupied voxels.
+  std::vector<std::string> warnings;
 };
 
 // Reads `file`, resolves parameters (after `options.overrides`), builds the

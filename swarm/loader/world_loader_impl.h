@@ -143,6 +143,7 @@ class WorldLoader {
   void ResolvePlacement(const Fields& f, const ValueReader& world_values, EntryPlan* entry);
   void ReadDistribution(const Fields& f, const ValueReader& world_values, EntryPlan* entry);
   void ReadSinglePosition(const Fields& f, const ValueReader& world_values, EntryPlan* entry);
+  void KeepPlacementClearOfTheMap();
   void PlaceEntries();
   void BuildCopies(World* world);
   std::vector<ModelSummary> Summarize() const;
@@ -166,6 +167,8 @@ class WorldLoader {
   std::map<std::filesystem::path, std::unique_ptr<ModelFile>> models_;
   std::vector<EntryPlan> entries_;
   std::optional<Region2> arena_;
+  Field environment_field_;                            // `environment:` (absent: none)
+  std::shared_ptr<const EnvironmentMap> environment_;  // the map it names, or null
   std::unique_ptr<Placer> placer_;
 };
 

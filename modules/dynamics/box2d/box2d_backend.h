@@ -13,6 +13,10 @@
 //     (so a floor slab under the robots is not an obstacle). Static fixtures
 //     are taken at Build time; moving a static shape afterwards does not move
 //     its fixture.
+//   - The scene's environment map (framework/environment.h): its voxels that
+//     reach into the same height range, projected to the plane and merged
+//     into rectangles (environment_obstacles.h), are fixtures of the ground
+//     body too (default material: friction 0.7, no restitution).
 //   - A *wheel* is a revolute joint in velocity mode whose nearest dynamic
 //     ancestor is a body, whose z axis (the rotation axis) is horizontal in
 //     that body's plane frame, and that has a non-dynamic cylinder or sphere

@@ -17,6 +17,7 @@
 #include "framework/dynamics_backend.h"
 #include "framework/math.h"
 #include "modules/dynamics/box2d/box2d_options.h"
+#include "modules/dynamics/height_range.h"
 
 namespace swarmsim {
 class Scene;
@@ -84,10 +85,7 @@ struct TractionSolve {      // 64 bytes
   double vx = 0, vy = 0, w = 0;  // velocity, body plane frame, Box2D units
 };
 
-// Height range [lo, hi] of shapes, m.
-struct HeightRange {
-  double lo, hi;
-};
+using dynamics::HeightRange;  // height range [lo, hi] of shapes, m
 
 class PlaneWorld {
  public:
@@ -131,7 +129,8 @@ class PlaneWorld {
   HeightRange BuildBodies(const Scene& scene, std::vector<int32_t>* body_of);
   void AddBody(const Scene& scene, uint32_t slot, const ShapeData& shape, const Pose& X_WS);
   // 2. Ground fixtures for the non-dynamic shapes that are no part of a body
-  // and reach into the dynamic range.
+  // and reach into the dynamic range, and for the environment map's voxels
+  // that do.
   void BuildObstacles(const Scene& scene, const std::vector<int32_t>& body_of,
                       const HeightRange& dynamic_range);
   void AddObstacle(const ShapeData& shape, const Pose& X_WS);

@@ -16,12 +16,15 @@
 #include "framework/error.h"
 #include "framework/scene.h"
 #include "modules/dynamics/box2d/plane_world.h"
+#include "modules/dynamics/environment_obstacles.h"
 #include "modules/dynamics/scene_walk.h"
 
 namespace swarmsim::box2d {
 
 namespace {
 
+using dynamics::CalcHeightRange;
+using dynamics::kHeightOverlap;
 using dynamics::ShapeAt;
 
 // A wheel axis counts as horizontal when its vertical component is below this
@@ -29,41 +32,9 @@ using dynamics::ShapeAt;
 constexpr double kHorizontalTolerance = 1e-3;
 // A shape whose z axis is this close to vertical is "upright".
 constexpr double kUprightTolerance = 1e-6;
-// Static shapes must reach this far into the dynamic shapes' height range to
-// be obstacles (a floor whose top touches the robots' bottom is not one), m.
-constexpr double kHeightOverlap = 1e-3;
 // Restitution applies above this approach speed, m/s (Box2D's default is
 // 1 unit/s, i.e. 0.1 m/s at the default scale; keep that whatever the scale).
 constexpr double kRestitutionThreshold = 0.1;
-// Height range [lo, hi] of a shape at pose X_WS, m.
-HeightRange CalcHeightRange(const ShapeData& shape, const Pose& X_WS) {
-  const double z = X_WS.p.z;
-  if (shape.kind == ShapeKind::kMesh && shape.mesh) {  // exact over the vertices
-    HeightRange range{std::numeric_limits<double>::infinity(),
-                      -std::numeric_limits<double>::infinity()};
-    for (const Vec3& v : shape.mesh->vertices()) {
-      const double vz = (X_WS * v).z;
-      range = {std::min(range.lo, vz), std::max(range.hi, vz)};
-    }
-    return range;
-  }
-  if (shape.kind == ShapeKind::kSphere) return {z - shape.size.x, z + shape.size.x};
-  // Half extents along the shape's axes; the vertical extent is the sum of
-  // their projections on world z.
-  const Vec3 half = shape.kind == ShapeKind::kBox
-                        ? shape.size * 0.5
-                        : Vec3{shape.size.x, shape.size.x, shape.size.z * 0.5};
-  const Vec3 ax = X_WS.q.Rotate({1, 0, 0}), ay = X_WS.q.Rotate({0, 1, 0}),
-             az = X_WS.q.Rotate({0, 0, 1});
-  double h;
-  if (shape.kind == ShapeKind::kBox) {
-    h = half.x * std::abs(ax.z) + half.y * std::abs(ay.z) + half.z * std::abs(az.z);
-  } else {  // cylinder: the axis part plus the disc's radius across
-    h = half.z * std::abs(az.z) + shape.size.x * std::sqrt(std::max(0.0, 1 - az.z * az.z));
-  }
-  return {z - h, z + h};
-}
-
 bool IsUpright(const Pose& X_WS) {
   return std::abs(X_WS.q.Rotate({0, 0, 1}).z) > 1 - kUprightTolerance;
 }
@@ -333,6 +304,14 @@ void PlaneWorld::BuildObstacles(const Scene& scene, const std::vector<int32_t>& 
         range.lo >= dynamic_range.hi - kHeightOverlap)
       continue;
     AddObstacle(*shape, X_WS);
+  }
+  // The environment map's voxels in that range, projected and merged into
+  // rectangles (fixtures of the ground body like the shapes above).
+  ShapeData voxels;  // the default material
+  for (const EnvironmentBox& box : dynamics::EnvironmentObstacles(scene, dynamic_range, true)) {
+    voxels.kind = ShapeKind::kBox;
+    voxels.size = box.hi - box.lo;
+    AddObstacle(voxels, {(box.lo + box.hi) * 0.5, {}});
   }
 }
 

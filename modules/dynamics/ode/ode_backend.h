@@ -16,6 +16,11 @@
 //   - Other non-dynamic shapes (walls, tables, floor slabs outside models) are
 //     static geoms, placed at Build time.
 //   - With Options::ground_plane, the plane z = 0 is a static geom.
+//   - The scene's environment map (framework/environment.h): its voxels that
+//     reach more than 1 mm into the height range of the dynamic shapes at
+//     Build (a floor under the robots and a ceiling above them do not),
+//     merged into boxes (environment_obstacles.h), are static box geoms
+//     (friction 0.7, no restitution).
 //   - A joint J whose subtree holds a dynamic shape B, reached without
 //     crossing another joint, is an ODE joint between B and J's nearest
 //     dynamic (or kinematic) ancestor body A, or the static world if there is

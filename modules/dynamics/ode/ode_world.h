@@ -97,8 +97,9 @@ class OdeWorld {
  private:
   void Clear();
   // Build's phases, in order. 0: a fresh world, space, contact group and
-  // ground plane (the space's kind depends on the scene's size).
-  void CreateWorld(const Scene& scene);
+  // ground plane (the space's kind depends on the scene's size and on
+  // whether the environment map adds boxes).
+  void CreateWorld(const Scene& scene, size_t map_boxes);
   // 1. A body and geom per dynamic shape, in slot order; fills body_of (slots).
   void BuildBodies(const Scene& scene, std::vector<dBodyID>* body_of);
   // 2. A geom per other shape: a part of a body, a kinematic body (added to

@@ -1,0 +1,28 @@
+// The world file's `environment:` key (worlds/README.md): the static
+// environment of a map file (an OctoMap .bt or .ot, read by
+// modules/environment) for proximity sensors, line of sight, physics and
+// placement.
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "framework/environment.h"
+#include "swarm/loader/values.h"
+#include "swarm/loader/yaml.h"
+
+namespace swarmsim::loader {
+
+// Reads the map `environment` names (a path relative to `world_folder`).
+// Null when the world gives no `environment`. Errors name the key's
+// file:line:column and the map's own problem; what may surprise without
+// being wrong (a map without occupied voxels) goes to `warnings`.
+std::shared_ptr<const EnvironmentMap> ReadEnvironment(const YamlFile& file,
+                                                      const Field& environment,
+                                                      const ValueReader& values,
+                                                      const std::filesystem::path& world_folder,
+                                                      std::vector<std::string>* warnings);
+
+}  // namespace swarmsim::loader
