@@ -18,8 +18,8 @@ ObjectId Resolve(const Scene& scene, const CollectionItem& item, ObjectId from,
   }
   const ObjectId id = scene.FindObject(item.path, from);
   if (id.IsNull())
-    throw Error(std::string(what) + ": item '" + item.path + "' matches no object" +
-                scene.ExplainMissingPath(item.path, from));
+    throw Error((item.where.empty() ? "" : item.where + ": ") + std::string(what) + ": item '" +
+                item.path + "' matches no object" + scene.ExplainMissingPath(item.path, from));
   return id;
 }
 

@@ -33,14 +33,19 @@ enum class CollectionItemKind : uint8_t { kObject, kTree, kAll };
 struct CollectionItem {
   CollectionItemKind kind = CollectionItemKind::kTree;
   bool exclude = false;
-  std::string path;  // resolved from the collection object; empty: `id`
-  ObjectId id;       // an item a script added by handle
+  std::string path;   // resolved from the collection object; empty: `id`
+  ObjectId id;        // an item a script added by handle
+  std::string where;  // "file:line:column" of a path from a file, for errors
 };
 
 // The row of an object of type collection.
 struct CollectionRow {
   std::vector<CollectionItem> items;
 };
+
+// Paths in a collection, an entity list or a sensor's `detectable` are
+// checked once the world is built (ObjectTypeDescriptor::check): a path
+// that matches nothing is an error at its file:line:column.
 
 // The slots of the objects `items` name, resolved from `from`, ascending.
 // Throws swarmsim::Error naming `what` and the item when a path matches

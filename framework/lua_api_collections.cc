@@ -57,10 +57,14 @@ int CreateCollection(lua_State* L) {
 int AddItemToCollection(lua_State* L) {
   const lua_Integer handle = ArgInteger(L, 1);
   const Scene& scene = *Context(L).scene;
-  if (handle > 0 && scene.IsValid(ObjectId::FromInteger(handle)))
-    throw Error("collection " + scene.PathOf(ObjectId::FromInteger(handle)) +
+  if (handle > 0 && scene.IsValid(ObjectId::FromInteger(handle))) {
+    const ObjectId id = ObjectId::FromInteger(handle);
+    if (scene.type(id) != ObjectType::kCollection)
+      throw Error(scene.PathOf(id) + " is not a collection (sim.createCollection makes one)");
+    throw Error("collection " + scene.PathOf(id) +
                 " comes from a model or world file and cannot change; make one with "
                 "sim.createCollection");
+  }
   CollectionRow& collection = ScriptCollection(L, handle);
   const lua_Integer what = ArgInteger(L, 2);
   CollectionItem item;

@@ -20,6 +20,7 @@
 #include <string_view>
 #include <vector>
 
+#include "framework/handle.h"
 #include "framework/math.h"
 #include "framework/number_rule.h"
 #include "framework/object_rows.h"
@@ -56,6 +57,9 @@ class ObjectReader {
   // A list of strings ([a, b] or a single string); `max_count` at most.
   virtual std::vector<std::string> Strings(std::string_view key, size_t max_count,
                                            bool required = false) const = 0;
+  // "file:line:column" of the key's value, for errors found after loading
+  // (a path that matches no object: ObjectTypeDescriptor::check).
+  virtual std::string Where(std::string_view key) const = 0;
   // An error at the key's value, or at the key itself.
   [[noreturn]] virtual void Fail(std::string_view key, const std::string& message) const = 0;
   [[noreturn]] virtual void FailAtKey(std::string_view key, const std::string& message) const = 0;
@@ -107,6 +111,10 @@ struct ObjectTypeDescriptor {
   std::span<const ObjectKey> keys = {};
   // Fills `row` (a default row) from the object's entry.
   void (*read)(const ObjectTypeDescriptor& type, const ObjectReader& reader, void* row) = nullptr;
+  // Once the whole world is built: throws swarmsim::Error (naming the file,
+  // line and column the row kept) when the row names what the scene lacks,
+  // such as a path that matches no object. Null: nothing to check.
+  void (*check)(const Scene& scene, ObjectId id, const void* row) = nullptr;
   // --- Scripts -----------------------------------------------------------------------
   // The type's Lua API area: adds its sim.* functions to the table on top of
   // L's stack (framework/lua_api.h; sim.readProximitySensor, ...). Null: none.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "framework/collections.h"
@@ -13,16 +14,22 @@
 namespace swarmsim {
 namespace {
 
+// "file:line:col: proximity sensor /bot#0/eye ('detectable')".
+std::string DetectableWhat(const Scene& scene, ObjectId sensor, const std::string& where) {
+  return (where.empty() ? "" : where + ": ") + "proximity sensor " + scene.PathOf(sensor) +
+         " ('detectable')";
+}
+
 class ProximityModule final : public Module {
  public:
   explicit ProximityModule(std::unique_ptr<ProximityBackend> backend)
       : backend_(std::move(backend)) {}
 
   void Start(World* world) override {
-    ProximitySettings settings;
-    settings.octree_resolution = world->settings().octree_resolution;
-    settings.seed = world->settings().seed;
-    backend_->Build(world->scene(), settings);
+    settings_.octree_resolution = world->settings().octree_resolution;
+    settings_.seed = world->settings().seed;
+    backend_->Build(world->scene(), settings_);
+    environment_version_ = world->scene().environment_version();
     world->set_proximity(backend_.get());
     RefreshDetectable(world->scene());
   }
@@ -30,6 +37,11 @@ class ProximityModule final : public Module {
   // Every robot's sensors, robots in parallel, then the scene's own sensors.
   void Sense(World* world) override {
     Scene& scene = world->scene();
+    // A mill cut the map (Scene::set_environment): the static index again.
+    if (environment_version_ != scene.environment_version()) {
+      backend_->Build(scene, settings_);
+      environment_version_ = scene.environment_version();
+    }
     if (detectable_version_ != scene.structure_version()) RefreshDetectable(scene);
     backend_->SetStep(static_cast<uint64_t>(world->step_count()));
     backend_->Update(scene);
@@ -63,7 +75,7 @@ class ProximityModule final : public Module {
       const ObjectId sensor = scene.IdAt(owners[r]);
       sets->of[owners[r]] =
           EntitySlots(scene, sensors[r].more->detectable, sensor,
-                      "proximity sensor " + scene.PathOf(sensor) + " ('detectable')");
+                      DetectableWhat(scene, sensor, sensors[r].more->detectable_where));
       sets->used[owners[r]] = 1;
     }
     if (sets->used.empty()) {
@@ -80,6 +92,8 @@ class ProximityModule final : public Module {
   }
 
   std::unique_ptr<ProximityBackend> backend_;
+  ProximitySettings settings_;
+  uint64_t environment_version_ = 0;  // of the map the static index holds
   uint64_t detectable_version_ = UINT64_MAX;
   bool filtering_ = false;
 };

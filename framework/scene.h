@@ -140,6 +140,7 @@ struct ProximityVolumeData {
   // What the sensor detects: a collection's or object subtree's path
   // (framework/collections.h), resolved from the sensor; empty: everything.
   std::string detectable;
+  std::string detectable_where;  // "file:line:column" of `detectable`, for errors
   // The reading's detected point (volumes; a ray's is on +z, see p_SD())
   // and the outward surface normal there, in the sensor frame.
   Vec3 point, normal;

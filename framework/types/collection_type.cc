@@ -31,7 +31,7 @@ std::unique_ptr<RowTable> MakeRows(const ObjectTypeDescriptor&) {
 
 void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
   std::vector<CollectionItem>& items = static_cast<CollectionRow*>(row)->items;
-  if (r.Has("all") && r.Bool("all")) items.push_back({CollectionItemKind::kAll, false, "", {}});
+  if (r.Has("all") && r.Bool("all")) items.push_back({CollectionItemKind::kAll, false, "", {}, ""});
   const auto add = [&](const char* key, CollectionItemKind kind, bool exclude) {
     if (!r.Has(key)) return;
     for (std::string& path : r.Strings(key, kMaxItems)) {
@@ -39,7 +39,7 @@ void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
         r.Fail(key, "'" + path +
                         "' is not an object path: start with '/' (absolute), ':' (this model) "
                         "or './' (below the collection)");
-      items.push_back({kind, exclude, std::move(path), {}});
+      items.push_back({kind, exclude, std::move(path), {}, r.Where(key)});
     }
   };
   add("trees", CollectionItemKind::kTree, false);
@@ -50,6 +50,9 @@ void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
     r.FailAtKey("name", "a collection needs at least one of 'all', 'trees' or 'objects'");
 }
 
+// Every item's path matches an object.
+void Check(const Scene& scene, ObjectId id, const void*) { CollectionSlots(scene, id); }
+
 }  // namespace
 
 const ObjectTypeDescriptor kCollectionType{
@@ -58,6 +61,7 @@ const ObjectTypeDescriptor kCollectionType{
     .make_rows = MakeRows,
     .keys = kKeys,
     .read = Read,
+    .check = Check,
     .register_lua = RegisterCollectionsApi,
 };
 

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "framework/collections.h"
 #include "framework/object_type.h"
 #include "framework/scene.h"
 #include "framework/state_hash.h"
@@ -88,13 +89,22 @@ double ReadAngle(const ObjectReader& r, const char* key, double max_deg, bool ma
   const bool low_ok = min_exclusive ? a > min_deg : a >= min_deg;
   const bool high_ok = max_inclusive ? a <= max_deg : a < max_deg;
   if (!(low_ok && high_ok)) {
-    char message[160];
-    std::snprintf(message, sizeof message, "must be an angle %s %g and %s %g degrees",
-                  min_exclusive ? "above" : "from", min_deg, max_inclusive ? "up to" : "below",
-                  max_deg);
+    char message[200];
+    std::snprintf(message, sizeof message, "'%s' must be an angle %s %g and %s %g degrees (got %g)",
+                  key, min_exclusive ? "above" : "from", min_deg, max_inclusive ? "up to" : "below",
+                  max_deg, a);
     r.Fail(key, message);
   }
   return a * kDeg;
+}
+
+// The detectable set's path matches objects.
+void Check(const Scene& scene, ObjectId id, const void* row) {
+  const ProximityVolumeData& v = *static_cast<const ProximitySensorData*>(row)->more;
+  if (v.detectable.empty()) return;
+  EntitySlots(scene, v.detectable, id,
+              (v.detectable_where.empty() ? "" : v.detectable_where + ": ") + "proximity sensor " +
+                  scene.PathOf(id) + " ('detectable')");
 }
 
 void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
@@ -132,7 +142,10 @@ void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
     p.more->ray_count = static_cast<uint16_t>(r.Integer("ray_count", 1, 1024));
   if (applies("blind_zone", solid, "cone, pyramid, cylinder and disc")) {
     p.more->blind_zone = r.Number("blind_zone", kNonNegativeLength);
-    if (!(p.more->blind_zone < p.range)) r.Fail("blind_zone", "must be less than the range");
+    if (!(p.more->blind_zone < p.range))
+      r.Fail("blind_zone", "'blind_zone' (" + std::to_string(p.more->blind_zone) +
+                               " m) must be less than the range (" + std::to_string(p.range) +
+                               " m)");
   }
   if (r.Has("max_detection_angle_deg"))
     p.more->max_detection_angle = ReadAngle(r, "max_detection_angle_deg", 180, true);
@@ -142,6 +155,7 @@ void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
     p.more->detect_back = r.Bool("detect_back");
   if (applies("detectable", v != V::kRay, "volume and randomized_ray")) {
     p.more->detectable = r.String("detectable");
+    p.more->detectable_where = r.Where("detectable");
     const std::string& path = p.more->detectable;
     if (path.empty() || (path[0] != '/' && path[0] != ':' && path[0] != '.'))
       r.Fail("detectable", "'" + path +
@@ -165,6 +179,7 @@ constinit const ObjectTypeDescriptor kProximitySensorType{
     .hash_rows = Hash,
     .keys = kKeys,
     .read = Read,
+    .check = Check,
     .register_lua = RegisterSensorsApi,
 };
 

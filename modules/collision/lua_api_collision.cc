@@ -1,8 +1,8 @@
 // sim.* collision and distance (the Lua area of the distance type):
-//   sim.checkCollision(a, b) -> colliding, {h1, h2}
+//   sim.checkCollision(a, b) -> 1 or 0, {h1, h2} (CoppeliaSim's)
 //   sim.checkDistance(a, b [, threshold]) -> result (0/1), {x1, y1, z1, x2, y2, z2, d}, {h1, h2}
 //   sim.readDistance(h) -> d or nil, {x1, y1, z1, x2, y2, z2}, {h1, h2}
-//   sim.readCollision(h) -> colliding, {h1, h2}, contacts {{x, y, z}, ...}
+//   sim.readCollision(h) -> 1 or 0, {h1, h2}, contacts {{x, y, z}, ...}
 // `a` is an object (with everything below it), a collection object or a
 // script's collection; `b` the same, 'environment' or 'everything_else'.
 // Checks run on the poses of the step's start, robots in parallel.
@@ -49,6 +49,8 @@ Sides ReadSides(lua_State* L, const Geometry& geometry) {
     s.b = geometry.ShapesOf(scene, CollectionArgSlots(L, 2));
   }
   s.target.slots = s.b;
+  if (s.target.kind == EntitySpec::kPath && s.a == s.b && !s.a.empty())
+    throw Error("the two entities are the same objects: nothing to measure between them");
   return s;
 }
 
@@ -74,7 +76,7 @@ int CheckCollision(lua_State* L) {
   const Geometry& geometry = module.Fresh(*Context(L).world);
   const Sides s = ReadSides(L, geometry);
   const CollisionAnswer c = geometry.Collide(s.a, s.target, 0);
-  lua_pushboolean(L, c.colliding);
+  lua_pushinteger(L, c.colliding ? 1 : 0);
   PushHandlePair(L, *Context(L).scene, c.s1, c.s2);
   return 2;
 }
@@ -122,7 +124,7 @@ int ReadDistance(lua_State* L) {
 
 int ReadCollision(lua_State* L) {
   const CollisionRow& c = RowOf<CollisionRow>(L, "collision");
-  lua_pushboolean(L, c.colliding);
+  lua_pushinteger(L, c.colliding ? 1 : 0);
   PushHandlePair(L, c.o1, c.o2);
   lua_createtable(L, static_cast<int>(c.contact_points.size()), 0);
   for (size_t i = 0; i < c.contact_points.size(); ++i) {

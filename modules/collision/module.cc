@@ -59,7 +59,10 @@ void CollisionModule::Resolve(const Scene& scene) {
   const auto add = [&](const char* type_name, bool distance, const std::string* entities,
                        uint32_t row, uint32_t owner) {
     const ObjectId from = scene.IdAt(owner);
-    const std::string what = std::string(type_name) + " object " + scene.PathOf(from);
+    const std::string& where = distance ? TableOf<DistanceRow>(&s, "distance")->rows[row].where
+                                        : TableOf<CollisionRow>(&s, "collision")->rows[row].where;
+    const std::string what = (where.empty() ? "" : where + ": ") + std::string(type_name) +
+                             " object " + scene.PathOf(from);
     Job job;
     job.distance = distance;
     job.row = row;

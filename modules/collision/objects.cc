@@ -34,7 +34,8 @@ constexpr ObjectKey kCollisionKeys[] = {
     {"record", "true", "write the colliding flag (and contact count) to metrics.csv"},
 };
 
-void ReadBetween(const ObjectReader& r, std::string* entities) {
+void ReadBetween(const ObjectReader& r, std::string* entities, std::string* where) {
+  *where = r.Where("between");
   const std::vector<std::string> between = r.Strings("between", 2, /*required=*/true);
   if (between.size() != 2)
     r.Fail("between",
@@ -55,14 +56,14 @@ void ReadBetween(const ObjectReader& r, std::string* entities) {
 
 void ReadDistance(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
   DistanceRow& d = *static_cast<DistanceRow*>(row);
-  ReadBetween(r, d.entity);
+  ReadBetween(r, d.entity, &d.where);
   if (r.Has("threshold")) d.threshold = r.Number("threshold", kPositiveLength);
   if (r.Has("record")) d.record = r.Bool("record");
 }
 
 void ReadCollision(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
   CollisionRow& c = *static_cast<CollisionRow*>(row);
-  ReadBetween(r, c.entity);
+  ReadBetween(r, c.entity, &c.where);
   if (r.Has("contacts")) c.contacts = static_cast<int>(r.Integer("contacts", 0, 64));
   if (r.Has("record")) c.record = r.Bool("record");
 }
@@ -73,6 +74,7 @@ void CopyDistance(const void* source, void* row) {
   DistanceRow& to = *static_cast<DistanceRow*>(row);
   to.entity[0] = from.entity[0];
   to.entity[1] = from.entity[1];
+  to.where = from.where;
   to.threshold = from.threshold;
   to.record = from.record;
 }
@@ -82,6 +84,7 @@ void CopyCollision(const void* source, void* row) {
   CollisionRow& to = *static_cast<CollisionRow*>(row);
   to.entity[0] = from.entity[0];
   to.entity[1] = from.entity[1];
+  to.where = from.where;
   to.contacts = from.contacts;
   to.record = from.record;
 }
@@ -116,6 +119,31 @@ void HashCollision(const Scene& scene, ObjectType type, StateHasher* h) {
   }
 }
 
+// Both entities name objects, and not the same ones.
+void CheckBetween(const Scene& scene, ObjectId id, const std::string* entities,
+                  const std::string& where, const char* type) {
+  const std::string what =
+      (where.empty() ? "" : where + ": ") + type + " object " + scene.PathOf(id);
+  std::vector<uint32_t> slots[2];
+  for (int i = 0; i < 2; ++i) {
+    const EntitySpec e = ParseEntity(entities[i]);
+    if (e.kind == EntitySpec::kPath) slots[i] = EntitySlots(scene, e.path, id, what);
+  }
+  if (ParseEntity(entities[1]).kind == EntitySpec::kPath && slots[0] == slots[1])
+    throw Error(what + ": '" + entities[0] + "' and '" + entities[1] +
+                "' are the same objects: nothing to measure between them");
+}
+
+void CheckDistance(const Scene& scene, ObjectId id, const void* row) {
+  const DistanceRow& d = *static_cast<const DistanceRow*>(row);
+  CheckBetween(scene, id, d.entity, d.where, "distance");
+}
+
+void CheckCollision(const Scene& scene, ObjectId id, const void* row) {
+  const CollisionRow& c = *static_cast<const CollisionRow*>(row);
+  CheckBetween(scene, id, c.entity, c.where, "collision");
+}
+
 std::shared_ptr<const ObjectTypeDescriptor> DistanceType() {
   auto t = std::make_shared<ObjectTypeDescriptor>();
   t->name = "distance";
@@ -128,6 +156,7 @@ std::shared_ptr<const ObjectTypeDescriptor> DistanceType() {
   t->hash_rows = HashDistance;
   t->keys = kDistanceKeys;
   t->read = ReadDistance;
+  t->check = CheckDistance;
   t->register_lua = RegisterCollisionApi;
   return t;
 }
@@ -143,6 +172,7 @@ std::shared_ptr<const ObjectTypeDescriptor> CollisionType() {
   t->hash_rows = HashCollision;
   t->keys = kCollisionKeys;
   t->read = ReadCollision;
+  t->check = CheckCollision;
   return t;
 }
 

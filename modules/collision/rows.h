@@ -17,6 +17,7 @@ namespace swarmsim::collision {
 struct DistanceRow {
   // Settings.
   std::string entity[2];        // as the file gives them (`between`)
+  std::string where;            // "file:line:column" of `between`, for errors
   double threshold = INFINITY;  // m: nothing farther is measured
   bool record = true;           // into metrics.csv
   // The reading, after each step.
@@ -30,6 +31,7 @@ struct DistanceRow {
 
 struct CollisionRow {
   std::string entity[2];
+  std::string where;
   int contacts = 0;  // contact points kept (the collision contour), 0..64
   bool record = true;
   bool colliding = false;

@@ -321,22 +321,38 @@ bool NearestInIntersection(const ConvexSet* sets, int count, const Vec3& start, 
 }
 
 // Outward normal of a primitive (own frame) at its surface point nearest p.
-Vec3 PrimitiveNormal(const PlacedShape& shape, const Vec3& p) {
+// On an edge or a corner, of the faces that meet there, the one facing
+// `toward` most (the direction back to the sensor; zero: the first).
+Vec3 PrimitiveNormal(const PlacedShape& shape, const Vec3& p, const Vec3& toward = {}) {
   const Vec3& h = shape.half_size;
+  const double tolerance = 1e-9 * std::max({h.x, h.y, h.z, 1e-300});
   switch (shape.kind) {
     case ShapeKind::kBox:
     case ShapeKind::kMesh: {
-      // The face with the least slack (outside: the most excess).
-      const double sx = h.x - std::abs(p.x), sy = h.y - std::abs(p.y), sz = h.z - std::abs(p.z);
-      if (sx <= sy && sx <= sz) return {std::copysign(1.0, p.x), 0, 0};
-      if (sy <= sz) return {0, std::copysign(1.0, p.y), 0};
-      return {0, 0, std::copysign(1.0, p.z)};
+      // The faces with the least slack (outside: the most excess).
+      const double slack[3] = {h.x - std::abs(p.x), h.y - std::abs(p.y), h.z - std::abs(p.z)};
+      const Vec3 faces[3] = {{std::copysign(1.0, p.x), 0, 0},
+                             {0, std::copysign(1.0, p.y), 0},
+                             {0, 0, std::copysign(1.0, p.z)}};
+      const double least = std::min({slack[0], slack[1], slack[2]});
+      int best = -1;
+      for (int i = 0; i < 3; ++i)
+        if (slack[i] <= least + tolerance &&
+            (best < 0 || faces[i].Dot(toward) > faces[best].Dot(toward)))
+          best = i;
+      return faces[best];
     }
     case ShapeKind::kSphere: return p.SquaredNorm() > 0 ? p.Normalized() : Vec3{0, 0, 1};
     case ShapeKind::kCylinder: {
       const double r = std::sqrt(p.x * p.x + p.y * p.y);
-      if (h.x - r < h.z - std::abs(p.z) && r > 0) return {p.x / r, p.y / r, 0};
-      return {0, 0, std::copysign(1.0, p.z)};
+      const double side_slack = h.x - r, cap_slack = h.z - std::abs(p.z);
+      const Vec3 cap{0, 0, std::copysign(1.0, p.z)};
+      if (r > 0 && std::abs(side_slack - cap_slack) <= tolerance) {  // on the rim
+        const Vec3 side{p.x / r, p.y / r, 0};
+        return side.Dot(toward) > cap.Dot(toward) ? side : cap;
+      }
+      if (side_slack < cap_slack && r > 0) return {p.x / r, p.y / r, 0};
+      return cap;
     }
     case ShapeKind::kCapsule: {
       const Vec3 v = p - Vec3{0, 0, std::clamp(p.z, -(h.z - h.x), h.z - h.x)};
@@ -503,7 +519,8 @@ bool NearestInVolume(const Volume& v, const PlacedShape& shape, const Pose& X_SW
     d = p.Norm();
     if (d >= best || d > v.range) return false;
   }
-  const Vec3 normal = X_SSh.q.Rotate(PrimitiveNormal(shape, sets[0].X_ShS * p));
+  const Vec3 normal =
+      X_SSh.q.Rotate(PrimitiveNormal(shape, sets[0].X_ShS * p, sets[0].X_ShS.q.Rotate(Vec3{} - p)));
   if (!PassesCutOff(v, p, normal)) return false;
   *hit = {d, p, normal};
   return true;

@@ -41,6 +41,9 @@ class FieldsObjectReader final : public ObjectReader {
   }
   std::vector<std::string> Strings(std::string_view key, size_t max_count,
                                    bool required) const override;
+  std::string Where(std::string_view key) const override {
+    return values_.file().Where(fields_.Get(key).mark);
+  }
   [[noreturn]] void Fail(std::string_view key, const std::string& message) const override {
     values_.Fail(fields_.Get(key), message);
   }

@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "framework/error.h"
+#include "framework/object_type.h"
 #include "framework/plugin_loader.h"
 #include "framework/registry.h"
 #include "swarm/loader/environment.h"
@@ -34,6 +35,21 @@ std::vector<Override> SplitOverrides(const LoadOptions& options) {
     out.push_back(std::move(o));
   }
   return out;
+}
+
+// Once every object is there: the paths objects name (collections, distance
+// and collision objects, sensors' detectable sets) through each type's check,
+// so that a misspelled path is a load error at its file:line:col.
+void CheckObjects(Scene& scene) {
+  for (uint32_t slot = 0; slot < scene.slot_count(); ++slot) {
+    if (!scene.alive_at(slot)) continue;
+    const ObjectType type = scene.type_at(slot);
+    const ObjectTypeDescriptor& descriptor = scene.type_descriptor(type);
+    if (descriptor.check == nullptr) continue;
+    RowTable* rows = scene.rows(type);
+    descriptor.check(scene, scene.IdAt(slot),
+                     rows != nullptr ? rows->At(scene.row_at(slot)) : nullptr);
+  }
 }
 
 }  // namespace
@@ -97,6 +113,7 @@ LoadedWorld WorldLoader::Load() {
   for (const loader::ObjectSpec& spec : loader::ReadSceneObjects(
            f, top.Get("objects"), WorldValues(), &scripts_, &meshes_, world_registry_))
     loader::AddToScene(spec, {}, &world->scene());
+  CheckObjects(world->scene());
   out.metrics = ReadMetrics(top, world);
   out.models = Summarize();
   loader::AddPaintLayer(f, root, top.Get("paint"), WorldValues(), arena_, world);

@@ -180,7 +180,7 @@ TEST(GeometryTest, ScriptCollectionsAndChecks) {
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_NE(run.output.find("[bot#0] n\t3"), std::string::npos) << run.output;
   // The mast sinks 5 cm into the body; the wall is 2.8 m away.
-  EXPECT_NE(run.output.find("[bot#0] hit\ttrue\tfalse"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("[bot#0] hit\t1\t0"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("cannot change; make one with sim.createCollection"), std::string::npos)
       << run.output;
 }
@@ -194,7 +194,7 @@ TEST(GeometryTest, BadEntitiesAreErrorsNamingWhere) {
                                   "  - {name: a, type: shape, shape: box, size: [1, 1, 1]}\n"
                                   "  - " +
                                       object + "\n");
-    EXPECT_NE(run.exit_code, 0) << name;
+    EXPECT_EQ(run.exit_code, 2) << name;
     EXPECT_NE(run.output.find(expected), std::string::npos) << name << ": " << run.output;
   };
   fails("one", "{name: d, type: distance, between: [/a]}",
@@ -203,14 +203,20 @@ TEST(GeometryTest, BadEntitiesAreErrorsNamingWhere) {
         "the first entity must be an object or a collection");
   fails("not_path", "{name: d, type: distance, between: [/a, wall]}",
         "'wall' is neither an object path");
+  // Paths are checked once the world is built: at their file:line:col, exit 2.
   fails("missing", "{name: d, type: distance, between: [/a, /b]}",
-        "distance object /d: '/b' matches no object");
+        "world.yaml:4:40: distance object /d: '/b' matches no object");
+  fails("same", "{name: d, type: distance, between: [/a, /a]}",
+        "world.yaml:4:40: distance object /d: '/a' and '/a' are the same objects");
   fails("threshold", "{name: d, type: distance, between: [/a, environment], threshold: -1}",
         "positive number");
   fails("collection",
         "{name: c, type: collection, trees: [/nope]}\n"
         "  - {name: d, type: distance, between: [/a, /c]}",
-        "item '/nope' matches no object");
+        "world.yaml:4:40: collection /c: item '/nope' matches no object");
+  // Even when nothing uses the collection.
+  fails("unused_collection", "{name: c, type: collection, objects: [/a, /missing]}",
+        "world.yaml:4:42: collection /c: item '/missing' matches no object");
 }
 
 }  // namespace
@@ -260,6 +266,36 @@ TEST(GeometryTest, AConeSensorDetectsOnlyItsDetectableSet) {
   EXPECT_NE(ray.output.find("'detectable' applies to volume and randomized_ray sensors only"),
             std::string::npos)
       << ray.output;
+}
+
+}  // namespace
+}  // namespace swarmsim
+
+namespace swarmsim {
+namespace {
+
+// A box's nearest point on its bottom edge: the bottom face (facing the
+// sensor, 14 degrees off) is the normal there, so a 45-degree reflectance
+// cut-off keeps the detection.
+TEST(GeometryTest, TheCutOffTakesTheFaceOfAnEdgeThatFacesTheSensor) {
+  const WorldRun run = RunWorld(
+      "cutoff_edge",
+      "simulation: {physics: kinematic, time_step: 0.1}\n"
+      "obstacles:\n"
+      "  - {name: box, shape: box, size: [0.2, 0.2, 0.2], position: [0.2, 0, 0.5]}\n"
+      "models:\n  - {model: probe.yaml, position: [0, 0, 0]}\n",
+      {{"probe.yaml",
+        "model: probe\nobjects:\n  name: body\n  type: dummy\n  children:\n"
+        "    - {name: eye, type: proximity_sensor, volume: cone, angle_deg: 30, range: 1,\n"
+        "       max_detection_angle_deg: 45, script: eye.lua}\n"},
+       {"eye.lua",
+        "function sysCall_actuation()\n"
+        "  local r, d, p, h, n = sim.readProximitySensor(sim.getObject('.'))\n"
+        "  print('seen', r, string.format('%.5f %g %g %g', d or -1, n and n[1] or 9,\n"
+        "        n and n[2] or 9, n and n[3] or 9))\n"
+        "end\n"}});
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("seen\t1\t0.41231 0 0 -1"), std::string::npos) << run.output;
 }
 
 }  // namespace
