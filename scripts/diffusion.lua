@@ -2,7 +2,9 @@
 -- and turn away from whatever the 24 proximity sensors see.
 --
 -- Attached to the foot-bot's body. Parameters (sim.getParam): wheel_speed
--- (m/s), wheel_radius (m), go_straight_angle_deg, delta.
+-- (m/s), wheel_radius (m), go_straight_angle_deg, delta; slow_distance (m,
+-- default 0: off): half speed while the look-ahead sensor ./front sees
+-- something that close (worlds/models/clearbot.yaml's cone).
 
 local RANGE = 0.1  -- m, the proximity sensors' range
 
@@ -12,6 +14,7 @@ local cos_a, sin_a = {}, {}  -- direction of each sensor, counter-clockwise from
 local wheel_speed        -- rad/s
 local straight_angle     -- rad
 local delta
+local front, slow_distance  -- the look-ahead sensor, if slow_distance > 0
 
 function sysCall_init()
   wheel_speed = sim.getParam('wheel_speed', 0.05) / sim.getParam('wheel_radius', 0.029)
@@ -19,6 +22,8 @@ function sysCall_init()
   delta = sim.getParam('delta', 0.1)
   left_motor = sim.getObject('./leftMotor')
   right_motor = sim.getObject('./rightMotor')
+  slow_distance = sim.getParam('slow_distance', 0)
+  if slow_distance > 0 then front = sim.getObject('./front') end
   for i = 0, 23 do
     sensors[i + 1] = sim.getObject('./prox[' .. i .. ']')
     cos_a[i + 1], sin_a[i + 1] = math.cos(2 * math.pi * i / 24), math.sin(2 * math.pi * i / 24)
@@ -43,6 +48,10 @@ function sysCall_actuation()
     left, right = wheel_speed, 0            -- obstacle on the left: turn right
   else
     left, right = 0, wheel_speed            -- obstacle on the right: turn left
+  end
+  if front then
+    local seen, ahead = sim.readProximitySensor(front)
+    if seen == 1 and ahead < slow_distance then left, right = left / 2, right / 2 end
   end
   sim.setJointTargetVelocity(left_motor, left)
   sim.setJointTargetVelocity(right_motor, right)
