@@ -62,8 +62,8 @@ bool RayTriangle(const Vec3& o, const Vec3& d, const Vec3& a, const Vec3& b, con
   return true;
 }
 
-// Closest point of triangle (a, b, c) to p (Ericson, Real-Time Collision
-// Detection, 5.1.5).
+}  // namespace
+
 Vec3 ClosestOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
   const Vec3 ab = b - a, ac = c - a, ap = p - a;
   const double d1 = ab.Dot(ap), d2 = ac.Dot(ap);
@@ -84,8 +84,6 @@ Vec3 ClosestOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& 
   const double denom = 1 / (va + vb + vc);
   return a + ab * (vb * denom) + ac * (vc * denom);
 }
-
-}  // namespace
 
 TriangleMesh::TriangleMesh(std::string name, std::vector<Vec3> vertices,
                            std::vector<MeshTriangle> triangles)

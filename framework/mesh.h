@@ -36,6 +36,10 @@ struct MeshBvhNode {  // 56 bytes
   uint32_t count;
 };
 
+// Closest point of triangle (a, b, c) to p (Ericson, Real-Time Collision
+// Detection, 5.1.5).
+Vec3 ClosestOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
+
 class TriangleMesh {
  public:
   // Builds the asset and its BVH. Throws swarmsim::Error (naming `name`) for

@@ -54,28 +54,6 @@ Vec3 ProjectPrimitive(const PlacedShape& shape, const Vec3& p) {
   return p;
 }
 
-// Closest point of triangle abc to p (Ericson, Real-Time Collision Detection, 5.1.5).
-Vec3 ProjectTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
-  const Vec3 ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = ab.Dot(ap), d2 = ac.Dot(ap);
-  if (d1 <= 0 && d2 <= 0) return a;
-  const Vec3 bp = p - b;
-  const double d3 = ab.Dot(bp), d4 = ac.Dot(bp);
-  if (d3 >= 0 && d4 <= d3) return b;
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + ab * (d1 / (d1 - d3));
-  const Vec3 cp = p - c;
-  const double d5 = ab.Dot(cp), d6 = ac.Dot(cp);
-  if (d6 >= 0 && d5 <= d6) return c;
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + ac * (d2 / (d2 - d6));
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
-    return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
-  const double denom = 1 / (va + vb + vc);
-  return a + ab * (vb * denom) + ac * (vc * denom);
-}
-
 Vec3 Project(const ConvexSet& set, const Vec3& p) {
   switch (set.kind) {
     case SetKind::kHalfSpace: {
@@ -101,7 +79,7 @@ Vec3 Project(const ConvexSet& set, const Vec3& p) {
     }
     case SetKind::kSlabZ: return {p.x, p.y, std::clamp(p.z, -set.c, set.c)};
     case SetKind::kShape: return set.X_SSh * ProjectPrimitive(*set.shape, set.X_ShS * p);
-    case SetKind::kTriangle: return ProjectTriangle(p, set.a, set.b, set.d);
+    case SetKind::kTriangle: return ClosestOnTriangle(p, set.a, set.b, set.d);
   }
   return p;
 }
@@ -424,7 +402,7 @@ bool NearestOnMesh(const Volume& v, const ConvexSet* volume_sets, int count,
     // Front: the sensor is on the triangle's outer side.
     const bool front = normal.Dot(a) < 0;
     if (front ? !v.detect_front : !v.detect_back) return;
-    Vec3 p = ProjectTriangle({}, a, b, c);
+    Vec3 p = ClosestOnTriangle({}, a, b, c);
     double d = p.Norm();
     if (d >= best || d > v.range) return;  // no nearer point on it
     if (!InVolume(v, p, tolerance)) {
@@ -536,7 +514,7 @@ Vec3 SurfaceNormal(const PlacedShape& shape, const Vec3& p_W) {
   Vec3 normal{0, 0, 1};
   VisitTrianglesNear(*shape.mesh, p, &best, [&](const MeshTriangle& t) {
     const Vec3 &a = vertices[t.v[0]], &b = vertices[t.v[1]], &c = vertices[t.v[2]];
-    const double d = (ProjectTriangle(p, a, b, c) - p).SquaredNorm();
+    const double d = (ClosestOnTriangle(p, a, b, c) - p).SquaredNorm();
     const Vec3 cross = (b - a).Cross(c - a);
     if (d < best && cross.SquaredNorm() > 0) best = d, normal = cross.Normalized();
   });
