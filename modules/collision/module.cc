@@ -113,16 +113,18 @@ void CollisionModule::Run(Scene* scene, const Job& job) {
 
 void CollisionModule::Compute(World* world) {
   Scene& scene = world->scene();
+  bool refreshed = false;
   if (jobs_version_ != scene.structure_version()) {
     any_jobs_ = HasObjects(&scene);
     if (any_jobs_) {
-      Refresh(*world);
+      Refresh(*world);  // ShapesOf reads the geometry's shapes
       Resolve(scene);
+      refreshed = true;
     }
     jobs_version_ = scene.structure_version();
   }
   if (!any_jobs_) return;
-  Refresh(*world);
+  if (!refreshed) Refresh(*world);
   const int64_t robots = static_cast<int64_t>(jobs_.size()) - 1;
   world->scheduler().ParallelFor(0, robots, kRobotGrain, [&](int64_t begin, int64_t end) {
     for (int64_t r = begin; r < end; ++r)

@@ -8,7 +8,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
+#include <vector>
 
 namespace swarmsim::testing {
 
@@ -62,6 +64,34 @@ inline std::filesystem::path ProbeWorld(const std::string& prefix, const std::st
                                        "objects: {name: body, type: dummy, script: probe.lua}\n";
   std::ofstream(dir / "probe.lua") << code;
   return dir;
+}
+
+// The rows of a run's metrics.csv (step,time,robot,metric,value); robot is
+// empty for the scene's metrics.
+struct MetricRow {
+  long step = 0;
+  std::string robot, metric;
+  double value = 0;
+};
+inline std::vector<MetricRow> ReadMetricsCsv(const std::filesystem::path& file) {
+  std::vector<MetricRow> rows;
+  std::ifstream csv(file);
+  std::string line;
+  std::getline(csv, line);  // header
+  while (std::getline(csv, line)) {
+    std::stringstream s(line);
+    std::string step, time, value;
+    MetricRow row;
+    std::getline(s, step, ',');
+    std::getline(s, time, ',');
+    std::getline(s, row.robot, ',');
+    std::getline(s, row.metric, ',');
+    std::getline(s, value, ',');
+    row.step = std::stol(step);
+    row.value = std::stod(value);
+    rows.push_back(std::move(row));
+  }
+  return rows;
 }
 
 }  // namespace swarmsim::testing

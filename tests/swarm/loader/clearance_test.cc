@@ -7,9 +7,7 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <map>
-#include <sstream>
 #include <string>
 
 #include "tests/swarm/run_program.h"
@@ -41,20 +39,9 @@ TEST(ClearanceWorldTest, RecordedClosestPointsLieOnTheObstaclesAndOnTheRobots) {
       testing::RunProgram("run " + std::string(SWARMSIM_SOURCE_DIR) +
                           "/worlds/clearance.yaml --steps 30 --quiet --out " + out.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  std::ifstream csv(out / "metrics.csv");
-  std::string line;
-  std::getline(csv, line);
   std::map<std::string, std::map<std::string, double>> last;  // robot -> metric -> value
-  while (std::getline(csv, line)) {
-    std::stringstream s(line);
-    std::string step, time, robot, metric, value;
-    std::getline(s, step, ',');
-    std::getline(s, time, ',');
-    std::getline(s, robot, ',');
-    std::getline(s, metric, ',');
-    std::getline(s, value, ',');
-    if (step == "30") last[robot][metric] = std::stod(value);
-  }
+  for (const testing::MetricRow& row : testing::ReadMetricsCsv(out / "metrics.csv"))
+    if (row.step == 30) last[row.robot][row.metric] = row.value;
   int robots = 0;
   for (const auto& [robot, m] : last) {
     if (robot.empty()) continue;

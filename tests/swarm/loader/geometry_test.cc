@@ -7,7 +7,6 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <sstream>
 #include <string>
 
 #include "tests/swarm/run_program.h"
@@ -40,19 +39,8 @@ WorldRun RunWorld(const std::string& name, const std::string& world,
                  " --quiet --out " + (dir / "out").string() + " " + extra);
   run.exit_code = r.exit_code;
   run.output = r.output;
-  std::ifstream csv(dir / "out" / "metrics.csv");
-  std::string line;
-  std::getline(csv, line);  // header
-  while (std::getline(csv, line)) {
-    std::stringstream s(line);
-    std::string step, time, robot, metric, value;
-    std::getline(s, step, ',');
-    std::getline(s, time, ',');
-    std::getline(s, robot, ',');
-    std::getline(s, metric, ',');
-    std::getline(s, value, ',');
-    run.last[robot + ":" + metric] = std::stod(value);
-  }
+  for (const testing::MetricRow& row : testing::ReadMetricsCsv(dir / "out" / "metrics.csv"))
+    run.last[row.robot + ":" + row.metric] = row.value;
   fs::remove_all(dir);
   return run;
 }

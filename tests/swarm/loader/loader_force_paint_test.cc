@@ -12,27 +12,15 @@
 #include "framework/world.h"
 #include "modules/builtin.h"
 #include "swarm/loader/world_loader.h"
+#include "tests/swarm/loader/world_dir_test.h"
 
 namespace swarmsim {
 namespace {
 
 namespace fs = std::filesystem;
 
-class LoaderForcePaintTest : public ::testing::Test {
+class LoaderForcePaintTest : public testing::WorldDirTest {
  protected:
-  void SetUp() override {
-    RegisterBuiltinModules(&registry_);
-    dir_ = fs::temp_directory_path() /
-           ("swarmsim_forcepaint_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  fs::path Write(const std::string& name, const std::string& text) {
-    std::ofstream(dir_ / name, std::ios::binary) << text;
-    return dir_ / name;
-  }
   LoadedWorld Load(const std::string& sensor_keys, const std::string& extra_world = "") {
     Write("hook.lua",
           "function sysCall_sensing()\n"
@@ -63,8 +51,6 @@ class LoaderForcePaintTest : public ::testing::Test {
                   extra_world + "models: [{model: hanger.yaml, position: [0, 0, 2]}]\n");
     return LoadWorld(world, {}, registry_);
   }
-  ModuleRegistry registry_;
-  fs::path dir_;
 };
 
 TEST_F(LoaderForcePaintTest, ForceSensorKeysAndScriptReading) {

@@ -19,6 +19,7 @@
 #include "modules/builtin.h"
 #include "modules/mill/rows.h"
 #include "swarm/loader/world_loader.h"
+#include "tests/swarm/loader/world_dir_test.h"
 
 namespace swarmsim {
 namespace {
@@ -29,21 +30,8 @@ using mill::MillRow;
 
 constexpr double kPi = 3.141592653589793;
 
-class MillTest : public ::testing::Test {
+class MillTest : public testing::WorldDirTest {
  protected:
-  void SetUp() override {
-    RegisterBuiltinModules(&registry_);
-    dir_ = fs::temp_directory_path() /
-           ("swarmsim_mill_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  fs::path Write(const std::string& name, const std::string& text) {
-    std::ofstream(dir_ / name, std::ios::binary) << text;
-    return dir_ / name;
-  }
   LoadedWorld Load(const std::string& world_text, int threads = 1) {
     LoadOptions options;
     options.threads = threads;
@@ -69,8 +57,6 @@ class MillTest : public ::testing::Test {
     EXPECT_FALSE(id.IsNull()) << path;
     return *static_cast<Row*>(scene.row_data(id));
   }
-  ModuleRegistry registry_;
-  fs::path dir_;
 };
 
 #define EXPECT_CONTAINS(text, part) \

@@ -14,28 +14,15 @@
 #include "framework/world.h"
 #include "modules/builtin.h"
 #include "swarm/loader/world_loader.h"
+#include "tests/swarm/loader/world_dir_test.h"
 
 namespace swarmsim {
 namespace {
 
 namespace fs = std::filesystem;
 
-class WorldLoader3dTest : public ::testing::Test {
+class WorldLoader3dTest : public testing::WorldDirTest {
  protected:
-  void SetUp() override {
-    RegisterBuiltinModules(&registry_);
-    dir_ = fs::temp_directory_path() /
-           ("swarmsim_loader3d_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  fs::path Write(const std::string& name, const std::string& text) {
-    std::ofstream(dir_ / name, std::ios::binary) << text;
-    return dir_ / name;
-  }
   // Loads world.yaml placing one copy of arm.yaml (with `model` as its text).
   LoadedWorld LoadArm(const std::string& model, const std::string& physics = "ode") {
     Write("arm.yaml", model);
@@ -82,9 +69,6 @@ class WorldLoader3dTest : public ::testing::Test {
       "          children:\n"
       "            - {name: wrist, type: joint, joint: spherical, position: [0, 0, 0.15]}\n"
       "            - {name: weld, type: joint, joint: fixed, position: [0, 0, -0.15]}\n";
-
-  ModuleRegistry registry_;
-  fs::path dir_;
 };
 
 TEST_F(WorldLoader3dTest, ReadsCapsulesJointTypesForceModeAndLimits) {
