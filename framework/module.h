@@ -39,6 +39,14 @@ class StateHasher;
 class World;
 struct MetricSample;
 
+// A file a module wrote into the run's output folder, for summary.json's
+// "outputs" list.
+struct OutputFile {
+  std::string kind;         // "graph", "snapshot", "video", "image", ...
+  std::string path;         // relative to the output folder
+  std::string description;  // one line (a graph's name, a camera's)
+};
+
 enum class ModulePhase : uint8_t { kSense, kActuate, kAfterPhysics, kRecord, kCount };
 constexpr uint32_t PhaseBit(ModulePhase phase) { return 1u << static_cast<unsigned>(phase); }
 
@@ -59,6 +67,8 @@ class Module : public SceneListener {
   // Writes the module's files (paint.png) into the run's output folder at
   // the end of a run. Throws swarmsim::Error if it cannot.
   virtual void WriteOutputs(const std::filesystem::path& /*dir*/) const {}
+  // The files WriteOutputs (or the run so far) wrote, for summary.json.
+  virtual void ListOutputs(std::vector<OutputFile>* /*out*/) const {}
   // Folds state that is not in the scene and changes the future into the hash.
   virtual void HashState(StateHasher* /*hasher*/) const {}
   void OnSubtreeDuplicated(const Scene&, std::span<const uint32_t>,

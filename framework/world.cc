@@ -195,6 +195,12 @@ void World::WriteOutputs(const std::filesystem::path& dir) const {
   for (const ModuleEntry& e : modules_) e.instance->WriteOutputs(dir);
 }
 
+std::vector<OutputFile> World::ListOutputs() const {
+  std::vector<OutputFile> files;
+  for (const ModuleEntry& e : modules_) e.instance->ListOutputs(&files);
+  return files;
+}
+
 std::vector<MetricSample> World::TakeMetrics() {
   std::vector<MetricSample> out;
   out.swap(metrics_);

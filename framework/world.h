@@ -266,6 +266,8 @@ class World : public PhaseHandlers {
   void AddObserver(std::unique_ptr<Observer> observer);
   // Every module's WriteOutputs(dir), in creation order.
   void WriteOutputs(const std::filesystem::path& dir) const;
+  // Every module's ListOutputs, in creation order.
+  std::vector<OutputFile> ListOutputs() const;
   // Metric samples recorded since the last call, in (step, robot, order) order.
   std::vector<MetricSample> TakeMetrics();
   // Scripts disabled under on_script_error: disable_script so far, each with

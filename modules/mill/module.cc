@@ -232,6 +232,13 @@ void MillModule::Record(const World& world, std::vector<MetricSample>* out) {
   }
 }
 
+void MillModule::ListOutputs(std::vector<OutputFile>* out) const {
+  if (!have_types_) return;
+  const Scene& scene = world_->scene();
+  if (scene.rows(mill_type_)->size() == 0 && scene.rows(cuttable_type_)->size() == 0) return;
+  out->push_back({"table", "mill.csv", "volume each mill removed and each cuttable has left"});
+}
+
 void MillModule::WriteOutputs(const std::filesystem::path& dir) const {
   if (!have_types_) return;
   const Scene& scene = world_->scene();

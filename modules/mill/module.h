@@ -42,6 +42,7 @@ class MillModule final : public Module {
   void Record(const World& world, std::vector<MetricSample>* out) override;
   // mill.csv: every mill's removed volume and every cuttable's voxels left.
   void WriteOutputs(const std::filesystem::path& dir) const override;
+  void ListOutputs(std::vector<OutputFile>* out) const override;
   // The voxels cut out of the map so far (the cuttables' are in their rows).
   void HashState(StateHasher* hasher) const override;
   void OnSubtreeRemoved(const Scene& scene, std::span<const uint32_t> slots) override;

@@ -133,6 +133,10 @@ void PaintLayer::WriteOutputs(const std::filesystem::path& dir) const {
   WritePng(dir / "paint.png", width_, height_, rgb_);
 }
 
+void PaintLayer::ListOutputs(std::vector<OutputFile>* out) const {
+  out->push_back({"image", "paint.png", "the floor paint layer"});
+}
+
 ModuleDescriptor PaintModule() {
   return {{"record", "paint", "1.0",
            "the floor paint layer paint nozzles mark (paint.png), world file key paint:"},

@@ -43,6 +43,7 @@ class PaintLayer final : public Observer {
   void Record(const World& world, std::vector<MetricSample>* out) override;
   // Writes paint.png into `dir`.
   void WriteOutputs(const std::filesystem::path& dir) const override;
+  void ListOutputs(std::vector<OutputFile>* out) const override;
 
   int width() const { return width_; }
   int height() const { return height_; }

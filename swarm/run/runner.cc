@@ -303,6 +303,13 @@ bool WriteSummary(const World& world, const RunOptions& options, const RunResult
   nlohmann::json overrides = nlohmann::json::object();
   for (const auto& [name, value] : options.overrides) overrides[name] = value;
   j["overrides"] = overrides;
+  // The modules' files (graphs, snapshots, video), once the run has started.
+  nlohmann::json outputs = nlohmann::json::array();
+  if (world.started())
+    for (const OutputFile& file : world.ListOutputs())
+      outputs.push_back(
+          {{"kind", file.kind}, {"path", file.path}, {"description", file.description}});
+  j["outputs"] = outputs;
   std::ofstream f(*options.out_dir / "summary.json");
   // Invalid UTF-8 (from a world file, a script, a --set) is replaced, not fatal.
   f << j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
