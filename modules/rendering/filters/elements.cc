@@ -117,9 +117,10 @@ class ColorThreshold final : public VisionFilterElement {
     run->next.Reset(in.width, in.height, kMask);
     const uint8_t* c = in.pixels.data();
     uint8_t* m = run->next.pixels.data();
+    const int lo0 = lo_[0], lo1 = lo_[1], lo2 = lo_[2], hi0 = hi_[0], hi1 = hi_[1], hi2 = hi_[2];
     for (size_t i = 0, n = in.count(); i < n; ++i, c += 3) {
-      const bool in_range = c[0] >= lo_[0] && c[0] <= hi_[0] && c[1] >= lo_[1] && c[1] <= hi_[1] &&
-                            c[2] >= lo_[2] && c[2] <= hi_[2];
+      const bool in_range =
+          c[0] >= lo0 && c[0] <= hi0 && c[1] >= lo1 && c[1] <= hi1 && c[2] >= lo2 && c[2] <= hi2;
       m[i] = in_range ? 255 : 0;
     }
     run->Swap();
@@ -137,29 +138,37 @@ class HsvThreshold final : public VisionFilterElement {
                const std::vector<double>& value)
       : hue_lo_(static_cast<float>(hue[0])),
         hue_hi_(static_cast<float>(hue[1])),
-        saturation_lo_(static_cast<float>(saturation[0])),
-        saturation_hi_(static_cast<float>(saturation[1])),
+        saturation_lo_(static_cast<int>(std::ceil(saturation[0] * kOne - 1e-9))),
+        saturation_hi_(static_cast<int>(std::floor(saturation[1] * kOne + 1e-9))),
         value_lo_(static_cast<int>(std::ceil(255 * value[0] - 1e-9))),
         value_hi_(static_cast<int>(std::floor(255 * value[1] + 1e-9))) {}
 
-  // Value first (the maximum channel), then saturation without a division,
-  // then the hue (degrees, 0 for grey) only for what is left.
+  // Value (the largest channel) and saturation ((max - min) / max, compared
+  // without a division, to 1/65536) in integers and without branches; the
+  // hue (degrees, 0 for grey) only for the pixels they keep.
   void Apply(FilterRun* run) const override {
     const WorkImage& in = run->work;
     run->next.Reset(in.width, in.height, kMask);
     const uint8_t* c = in.pixels.data();
     uint8_t* m = run->next.pixels.data();
-    const bool wraps = hue_lo_ > hue_hi_;
+    // Locals, not members: the stores into the mask would make the
+    // compiler reload members every pixel.
+    const float hue_lo = hue_lo_, hue_hi = hue_hi_;
+    const int saturation_lo = saturation_lo_, saturation_hi = saturation_hi_;
+    const int value_lo = value_lo_, value_hi = value_hi_;
+    const bool wraps = hue_lo > hue_hi;
     for (size_t i = 0, n = in.count(); i < n; ++i, c += 3) {
       const int r = c[0], g = c[1], b = c[2];
       const int max = std::max(r, std::max(g, b)), min = std::min(r, std::min(g, b));
-      m[i] = 0;
-      if (max < value_lo_ || max > value_hi_) continue;
       const int delta = max - min;
-      const float fdelta = static_cast<float>(delta), fmax = static_cast<float>(max);
-      if (fdelta < saturation_lo_ * fmax || fdelta > saturation_hi_ * fmax) continue;
+      const bool kept = (max >= value_lo) & (max <= value_hi) &
+                        (delta * kOne >= saturation_lo * max) &
+                        (delta * kOne <= saturation_hi * max);
+      m[i] = 0;
+      if (!kept) continue;
       float h = 0;
       if (delta > 0) {
+        const float fdelta = static_cast<float>(delta);
         if (max == r) {
           h = 60.0f * static_cast<float>(g - b) / fdelta;
           if (h < 0) h += 360.0f;
@@ -169,14 +178,16 @@ class HsvThreshold final : public VisionFilterElement {
           h = 240.0f + 60.0f * static_cast<float>(r - g) / fdelta;
         }
       }
-      const bool hue_ok = wraps ? (h >= hue_lo_ || h <= hue_hi_) : (h >= hue_lo_ && h <= hue_hi_);
+      const bool hue_ok = wraps ? (h >= hue_lo || h <= hue_hi) : (h >= hue_lo && h <= hue_hi);
       if (hue_ok) m[i] = 255;
     }
     run->Swap();
   }
 
  private:
-  float hue_lo_, hue_hi_, saturation_lo_, saturation_hi_;
+  static constexpr int kOne = 1 << 16;  // saturation 1
+  float hue_lo_, hue_hi_;
+  int saturation_lo_, saturation_hi_;
   int value_lo_, value_hi_;
 };
 
