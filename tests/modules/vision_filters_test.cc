@@ -418,8 +418,10 @@ TEST(VisionFiltersTest, ExamplePluginsElementsRunInAChain) {
   } catch (const Error& e) {
     EXPECT_CONTAINS(e.what(), "filters[0].gain: must be a number from 0 to 16");
   }
-  // Not without the plugin.
+  // Not without the plugin; a registry without elements has the built-in ones.
   EXPECT_CONTAINS(ChainError({{"invert", {}}}), "unknown 'invert'");
+  const ModuleRegistry empty;
+  EXPECT_EQ(Chain({{"grayscale", {}}}, &empty).size(), 1u);
 }
 
 TEST(VisionFiltersTest, OneChainRunsOnManyThreadsWithTheSameResults) {

@@ -269,6 +269,11 @@ FilterOutput FilterChain::Run(const Image& image, const CameraModel& camera) con
 }
 
 void FilterChain::Run(const Image& image, const CameraModel& camera, FilterOutput* out) const {
+  SWARMSIM_CHECK(image.width >= 0 && image.height >= 0 &&
+                     image.rgb.size() ==
+                         static_cast<size_t>(image.width) * static_cast<size_t>(image.height) * 3,
+                 "a filter chain's image has " + std::to_string(image.rgb.size()) + " bytes for " +
+                     std::to_string(image.width) + "x" + std::to_string(image.height) + " pixels");
   out->packets.resize(1);
   Statistics(image, camera, &out->packets[0]);
   out->blobs.clear();
@@ -279,15 +284,16 @@ void FilterChain::Run(const Image& image, const CameraModel& camera, FilterOutpu
   run.camera = &camera;
   run.out = out;
   run.work.Reset(image.width, image.height, kSwarmsimColourImage);
-  std::memcpy(run.work.pixels.data(), image.rgb.data(),
-              std::min(run.work.pixels.size(), image.rgb.size()));
+  std::memcpy(run.work.pixels.data(), image.rgb.data(), image.rgb.size());
   for (const auto& element : data_->elements) element->Apply(&run);
   ToRgb(run.work, camera, &out->image);
 }
 
 FilterChain ParseFilterChain(const ObjectReader& reader, std::string_view key,
                              const ModuleRegistry* registry) {
-  const ModuleRegistry& elements = registry != nullptr ? *registry : BuiltinRegistry();
+  // A registry without elements (a test's, a tool's) gets the built-in ones.
+  const ModuleRegistry& elements =
+      registry != nullptr && !registry->vision_filters().empty() ? *registry : BuiltinRegistry();
   std::vector<std::string> names, all_keys = {"type"};
   for (const auto& d : elements.vision_filters()) {
     names.push_back(d->name);

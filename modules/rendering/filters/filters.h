@@ -70,7 +70,8 @@ class FilterChain {
  public:
   FilterChain();
   // Runs the chain on `image` (its depth, if any, for the depth elements and
-  // statistics). Throws swarmsim::Error if a plugin's element fails.
+  // statistics; a depth of another size counts as none). Throws
+  // swarmsim::Error if a plugin's element fails.
   FilterOutput Run(const Image& image, const CameraModel& camera) const;
   // The same into *out, reusing its buffers (a sensor's reading).
   void Run(const Image& image, const CameraModel& camera, FilterOutput* out) const;
@@ -85,8 +86,8 @@ class FilterChain {
 };
 
 // The chain the list at `key` of a model entry describes (none: an empty
-// chain). Elements are looked up in `registry` (null: the built-in ones
-// only). Throws swarmsim::Error at the item's file:line:column for an
+// chain). Elements are looked up in `registry` (null, or one without
+// elements: the built-in ones). Throws swarmsim::Error at the item's file:line:column for an
 // unknown element (with a suggestion), a key it does not take, a bad value,
 // or kinds that do not fit.
 FilterChain ParseFilterChain(const ObjectReader& reader, std::string_view key,
