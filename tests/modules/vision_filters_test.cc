@@ -296,6 +296,12 @@ TEST(VisionFiltersTest, PointCloudOfAFlatDepthImageLiesOnItsPlane) {
   ASSERT_EQ(out.packets.size(), 2u);
   EXPECT_EQ(out.packets[1][0], 32 * 23);
   EXPECT_EQ(out.packets[1][3], 2);
+  // A blob's bearing from its centroid: the same rays.
+  const Vec3 p = ImageToSensor(camera, 32, 24, 0.5, 0.5, 2);
+  EXPECT_DOUBLE_EQ(p.x, out.points[0].x);
+  EXPECT_DOUBLE_EQ(p.y, out.points[0].y);
+  const Vec3 edge = ImageToSensor(camera, 32, 24, 32, 12, 1);  // right edge, middle row
+  EXPECT_NEAR(std::atan2(edge.x, edge.z), -30 * kDeg, 1e-12);
   // Orthographic: pixel pitch ortho_size / larger side whatever the depth.
   camera.perspective = false;
   camera.ortho_size = 3.2;

@@ -44,10 +44,11 @@ struct Moments {
 
 }  // namespace
 
-void DetectBlobs(const FilterRun& run, int min_pixels, int max_blobs, FilterOutput* out) {
-  const WorkImage& mask = run.work;
+void DetectBlobs(FilterRun* run, int min_pixels, int max_blobs) {
+  FilterOutput* out = run->out;
+  const WorkImage& mask = run->work;
   const int width = mask.width, height = mask.height;
-  const Image& source = *run.source;
+  const Image& source = *run->source;
   const bool same_size = source.width == width && source.height == height;
   // Runs, row by row, joined to the runs of the row above that touch them
   // (diagonals included).
@@ -160,7 +161,7 @@ void DetectBlobs(const FilterRun& run, int min_pixels, int max_blobs, FilterOutp
   }
   // The packet: count, values per blob, then per blob CoppeliaSim's six
   // (relative size, orientation, x, y, width, height) and colour and pixels.
-  std::vector<double>& packet = out->packets.emplace_back();
+  std::vector<double>& packet = run->NewPacket();
   constexpr int kValuesPerBlob = 10;
   packet.reserve(2 + kValuesPerBlob * out->blobs.size());
   packet.push_back(static_cast<double>(out->blobs.size()));

@@ -3,6 +3,8 @@
 // element interface the registry's descriptors make (framework/vision_filter.h).
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -43,8 +45,36 @@ struct FilterRun {
   FilterOutput* out = nullptr;
   WorkImage work;
   WorkImage next;
+  size_t packets = 1;  // packets of `out` written so far (1: the statistics)
 
   void Swap() { std::swap(work, next); }
+  // The next packet of `out`, empty (its buffer reused from the last run).
+  std::vector<double>& NewPacket() {
+    if (packets == out->packets.size()) out->packets.emplace_back();
+    std::vector<double>& packet = out->packets[packets++];
+    packet.clear();
+    return packet;
+  }
+};
+
+// From image positions to the sensor's frame (CoppeliaSim's): z along the
+// view axis, y up in the image, x = y cross z, to the image's left.
+struct Projection {
+  double half_width, half_height;
+  double pitch;  // m per pixel at depth 1 (perspective) or at any depth (orthographic)
+  bool perspective;
+
+  Projection(const CameraModel& camera, int width, int height)
+      : half_width(width / 2.0), half_height(height / 2.0), perspective(camera.perspective) {
+    const double larger = std::max(width, height);
+    pitch = perspective ? 2 * std::tan(camera.fov / 2) / larger : camera.ortho_size / larger;
+  }
+  // The point at `depth` (m along the view axis) seen at (x, y), pixels
+  // from the top-left corner (a pixel's centre at + 0.5).
+  Vec3 Point(double x, double y, double depth) const {
+    const double scale = perspective ? pitch * depth : pitch;
+    return {-(x - half_width) * scale, (half_height - y) * scale, depth};
+  }
 };
 
 // Intensity of an RGB pixel, 0..255 (CoppeliaSim's: the mean of the channels).
@@ -54,7 +84,7 @@ inline uint8_t Intensity(const uint8_t* rgb) {
 
 // Blob detection on the mask `work` (blobs.cc): fills out->blobs and appends
 // its packet.
-void DetectBlobs(const FilterRun& run, int min_pixels, int max_blobs, FilterOutput* out);
+void DetectBlobs(FilterRun* run, int min_pixels, int max_blobs);
 
 }  // namespace filters
 

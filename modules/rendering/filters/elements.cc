@@ -238,9 +238,7 @@ class Edges final : public VisionFilterElement {
 class Blobs final : public VisionFilterElement {
  public:
   Blobs(int min_pixels, int max_blobs) : min_pixels_(min_pixels), max_blobs_(max_blobs) {}
-  void Apply(FilterRun* run) const override {
-    DetectBlobs(*run, min_pixels_, max_blobs_, run->out);
-  }
+  void Apply(FilterRun* run) const override { DetectBlobs(run, min_pixels_, max_blobs_); }
 
  private:
   int min_pixels_, max_blobs_;
@@ -293,36 +291,29 @@ class DepthThreshold final : public VisionFilterElement {
 
 // --- point_cloud ----------------------------------------------------------------------
 
-// Pixel (i, j) at depth d, in the sensor's frame: z along the view axis, y
-// up in the image, x = y cross z (to the image's left), as CoppeliaSim's
-// vision sensors. Pixels at the far plane (nothing seen) give no point.
+// A point per pixel at depth d, in the sensor's frame (Projection).
+// Pixels at the far plane (nothing seen) give no point.
 class PointCloud final : public VisionFilterElement {
  public:
   explicit PointCloud(int stride) : stride_(stride) {}
   void Apply(FilterRun* run) const override {
     const WorkImage& in = run->work;
-    const CameraModel& camera = *run->camera;
-    const double half_w = in.width / 2.0, half_h = in.height / 2.0;
-    const double larger = std::max(in.width, in.height);
-    // Metres per pixel at depth 1 (perspective) or at any depth (orthographic).
-    const double pitch =
-        camera.perspective ? 2 * std::tan(camera.fov / 2) / larger : camera.ortho_size / larger;
-    const float far = static_cast<float>(camera.far * (1 - 1e-6));
+    const Projection projection(*run->camera, in.width, in.height);
+    const float far = static_cast<float>(run->camera->far * (1 - 1e-6));
     std::vector<Vec3>& points = run->out->points;
     points.clear();
     for (int y = 0; y < in.height; y += stride_) {
       for (int x = 0; x < in.width; x += stride_) {
         const double d = in.depth[static_cast<size_t>(y) * in.width + x];
         if (!(d > 0) || d >= far) continue;
-        const double scale = camera.perspective ? pitch * d : pitch;
-        const double right = (x + 0.5 - half_w) * scale, up = (half_h - (y + 0.5)) * scale;
-        points.push_back({-right, up, d});
+        points.push_back(projection.Point(x + 0.5, y + 0.5, d));
       }
     }
-    std::vector<double>& packet = run->out->packets.emplace_back();
-    packet.reserve(1 + 3 * points.size());
-    packet.push_back(static_cast<double>(points.size()));
-    for (const Vec3& p : points) packet.insert(packet.end(), {p.x, p.y, p.z});
+    std::vector<double>& packet = run->NewPacket();
+    packet.resize(1 + 3 * points.size());
+    packet[0] = static_cast<double>(points.size());
+    double* v = packet.data() + 1;
+    for (const Vec3& p : points) v[0] = p.x, v[1] = p.y, v[2] = p.z, v += 3;
     if (!points.empty()) run->out->triggered = true;
   }
 

@@ -78,7 +78,7 @@ class PluginElement final : public VisionFilterElement {
     }
     std::vector<double>* packet = nullptr;
     if (d.plugin_max_values > 0) {
-      packet = &run->out->packets.emplace_back();
+      packet = &run->NewPacket();
       packet->resize(static_cast<size_t>(d.plugin_max_values));
     }
     char error[256] = "";
@@ -274,7 +274,7 @@ void FilterChain::Run(const Image& image, const CameraModel& camera, FilterOutpu
                          static_cast<size_t>(image.width) * static_cast<size_t>(image.height) * 3,
                  "a filter chain's image has " + std::to_string(image.rgb.size()) + " bytes for " +
                      std::to_string(image.width) + "x" + std::to_string(image.height) + " pixels");
-  out->packets.resize(1);
+  if (out->packets.empty()) out->packets.emplace_back();
   Statistics(image, camera, &out->packets[0]);
   out->blobs.clear();
   out->points.clear();
@@ -286,7 +286,13 @@ void FilterChain::Run(const Image& image, const CameraModel& camera, FilterOutpu
   run.work.Reset(image.width, image.height, kSwarmsimColourImage);
   std::memcpy(run.work.pixels.data(), image.rgb.data(), image.rgb.size());
   for (const auto& element : data_->elements) element->Apply(&run);
+  out->packets.resize(run.packets);
   ToRgb(run.work, camera, &out->image);
+}
+
+Vec3 ImageToSensor(const CameraModel& camera, int width, int height, double x, double y,
+                   double depth) {
+  return Projection(camera, width, height).Point(x, y, depth);
 }
 
 FilterChain ParseFilterChain(const ObjectReader& reader, std::string_view key,

@@ -93,6 +93,14 @@ class FilterChain {
 FilterChain ParseFilterChain(const ObjectReader& reader, std::string_view key,
                              const ModuleRegistry* registry);
 
+// The point at `depth` (m along the view axis) that a camera of `width` x
+// `height` pixels sees at image position (x, y) (pixels from the top-left
+// corner, y down; a blob's centroid), in the sensor's frame as point_cloud
+// gives it: z along the view axis, y up in the image, x to the image's left.
+// A blob's bearing: atan2(p.x, p.z) of the point at depth 1.
+Vec3 ImageToSensor(const CameraModel& camera, int width, int height, double x, double y,
+                   double depth);
+
 // Registers the built-in elements (modules/builtin.cc).
 void Register(ModuleRegistry* registry);
 
