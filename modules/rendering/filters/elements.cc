@@ -134,18 +134,30 @@ class ColorThreshold final : public VisionFilterElement {
 
 class HsvThreshold final : public VisionFilterElement {
  public:
+  // Per largest channel (the value, 0..255): the range of max - min a kept
+  // pixel may have, which folds the value range and the saturation range
+  // ((max - min) / max, exact to 1/65536) into one table.
   HsvThreshold(const std::vector<double>& hue, const std::vector<double>& saturation,
                const std::vector<double>& value)
-      : hue_lo_(static_cast<float>(hue[0])),
-        hue_hi_(static_cast<float>(hue[1])),
-        saturation_lo_(static_cast<int>(std::ceil(saturation[0] * kOne - 1e-9))),
-        saturation_hi_(static_cast<int>(std::floor(saturation[1] * kOne + 1e-9))),
-        value_lo_(static_cast<int>(std::ceil(255 * value[0] - 1e-9))),
-        value_hi_(static_cast<int>(std::floor(255 * value[1] + 1e-9))) {}
+      : hue_lo_(static_cast<float>(hue[0])), hue_hi_(static_cast<float>(hue[1])) {
+    constexpr int64_t kOne = 1 << 16;  // saturation 1
+    const int64_t saturation_lo = static_cast<int64_t>(std::ceil(saturation[0] * kOne - 1e-9));
+    const int64_t saturation_hi = static_cast<int64_t>(std::floor(saturation[1] * kOne + 1e-9));
+    const int value_lo = static_cast<int>(std::ceil(255 * value[0] - 1e-9));
+    const int value_hi = static_cast<int>(std::floor(255 * value[1] + 1e-9));
+    for (int max = 0; max < 256; ++max) {
+      Range& range = delta_[max];
+      range = {1, 0};  // empty
+      if (max < value_lo || max > value_hi) continue;
+      for (int delta = 0; delta <= max; ++delta) {
+        if (delta * kOne < saturation_lo * max || delta * kOne > saturation_hi * max) continue;
+        if (range.lo > range.hi) range.lo = static_cast<int16_t>(delta);
+        range.hi = static_cast<int16_t>(delta);
+      }
+    }
+  }
 
-  // Value (the largest channel) and saturation ((max - min) / max, compared
-  // without a division, to 1/65536) in integers and without branches; the
-  // hue (degrees, 0 for grey) only for the pixels they keep.
+  // The table first; the hue (degrees, 0 for grey) only for what it keeps.
   void Apply(FilterRun* run) const override {
     const WorkImage& in = run->work;
     run->next.Reset(in.width, in.height, kMask);
@@ -154,18 +166,15 @@ class HsvThreshold final : public VisionFilterElement {
     // Locals, not members: the stores into the mask would make the
     // compiler reload members every pixel.
     const float hue_lo = hue_lo_, hue_hi = hue_hi_;
-    const int saturation_lo = saturation_lo_, saturation_hi = saturation_hi_;
-    const int value_lo = value_lo_, value_hi = value_hi_;
     const bool wraps = hue_lo > hue_hi;
+    const Range* table = delta_;
     for (size_t i = 0, n = in.count(); i < n; ++i, c += 3) {
       const int r = c[0], g = c[1], b = c[2];
       const int max = std::max(r, std::max(g, b)), min = std::min(r, std::min(g, b));
       const int delta = max - min;
-      const bool kept = (max >= value_lo) & (max <= value_hi) &
-                        (delta * kOne >= saturation_lo * max) &
-                        (delta * kOne <= saturation_hi * max);
+      const Range range = table[max];
       m[i] = 0;
-      if (!kept) continue;
+      if (delta < range.lo || delta > range.hi) continue;
       float h = 0;
       if (delta > 0) {
         const float fdelta = static_cast<float>(delta);
@@ -185,10 +194,11 @@ class HsvThreshold final : public VisionFilterElement {
   }
 
  private:
-  static constexpr int kOne = 1 << 16;  // saturation 1
+  struct Range {
+    int16_t lo, hi;  // max - min kept, inclusive (lo > hi: none)
+  };
   float hue_lo_, hue_hi_;
-  int saturation_lo_, saturation_hi_;
-  int value_lo_, value_hi_;
+  Range delta_[256];  // by the largest channel (1 KiB, shared by the chain's copies)
 };
 
 // --- edges ----------------------------------------------------------------------------

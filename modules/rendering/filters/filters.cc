@@ -85,6 +85,7 @@ class PluginElement final : public VisionFilterElement {
     const int n =
         d.plugin_function(&input, &output, parameters_.data(), packet ? packet->data() : nullptr,
                           d.plugin_max_values, error, sizeof error, d.plugin_user_data);
+    error[sizeof error - 1] = '\0';
     if (n < 0) throw Error("vision filter '" + d.name + "': " + (error[0] ? error : "failed"));
     if (packet) packet->resize(static_cast<size_t>(std::min(n, d.plugin_max_values)));
     if (kind != kSwarmsimValues) run->Swap();
