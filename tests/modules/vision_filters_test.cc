@@ -321,6 +321,15 @@ TEST(VisionFiltersTest, DepthThresholdMasksTheNearPixels) {
   ASSERT_EQ(out.blobs.size(), 1u);
   EXPECT_EQ(out.blobs[0].pixels, 2);
   EXPECT_EQ(out.blobs[0].min_x, 1);
+  // Resized depth is the mean of each cell: 0.75 and 2.25, only the first kept.
+  const FilterOutput half = Chain({{"depth", {}},
+                                   {"resize", {{"width", {2}}, {"height", {1}}}},
+                                   {"depth_threshold", {{"range", {0.7, 0.8}}}},
+                                   {"blobs", {}}})
+                                .Run(image, {});
+  ASSERT_EQ(half.blobs.size(), 1u);
+  EXPECT_EQ(half.blobs[0].min_x, 0);
+  EXPECT_EQ(half.blobs[0].max_x, 0);
 }
 
 TEST(VisionFiltersTest, StatisticsPacketIsMinMaxMeanOfIntensityChannelsAndDepth) {
@@ -350,6 +359,10 @@ TEST(VisionFiltersTest, StatisticsPacketIsMinMaxMeanOfIntensityChannelsAndDepth)
                                         0.3,
                                         0.25};  // mean
   for (size_t i = 0; i < 15; ++i) EXPECT_NEAR(p[i], expected[i], 1e-12) << i;
+  // An empty image: zeros, no element runs.
+  const FilterOutput empty =
+      Chain({{"resize", {{"width", {4}}, {"height", {4}}}}}).Run(Image{}, camera);
+  EXPECT_EQ(empty.packets, std::vector<std::vector<double>>{std::vector<double>(15, 0.0)});
 }
 
 TEST(VisionFiltersTest, KindsThatDoNotFitAreErrorsNamingBothElements) {

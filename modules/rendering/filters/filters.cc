@@ -286,7 +286,9 @@ void FilterChain::Run(const Image& image, const CameraModel& camera, FilterOutpu
   run.out = out;
   run.work.Reset(image.width, image.height, kSwarmsimColourImage);
   std::memcpy(run.work.pixels.data(), image.rgb.data(), image.rgb.size());
-  for (const auto& element : data_->elements) element->Apply(&run);
+  // An empty image has nothing to filter (a sensor refuses resolution 0).
+  if (image.width > 0 && image.height > 0)
+    for (const auto& element : data_->elements) element->Apply(&run);
   out->packets.resize(run.packets);
   ToRgb(run.work, camera, &out->image);
 }
