@@ -115,6 +115,7 @@ TEST(VisionFiltersTest, BlobsOfTwoDiscsHaveTheirSizeCentroidBoxAndColour) {
   // Packets: the statistics, then blobs: count, 10 values per blob.
   ASSERT_EQ(out.packets.size(), 2u);
   EXPECT_EQ(out.packets[0].size(), 15u);
+  EXPECT_EQ(out.packets[0][4], 1);  // no depth image: depth at the far plane
   const std::vector<double>& p = out.packets[1];
   ASSERT_EQ(p.size(), 2u + 2 * 10);
   EXPECT_EQ(p[0], 2);
@@ -284,32 +285,32 @@ TEST(VisionFiltersTest, PointCloudOfAFlatDepthImageLiesOnItsPlane) {
   const FilterChain chain = Chain({{"depth", {}}, {"point_cloud", {}}});
   EXPECT_TRUE(chain.needs_depth());
   const FilterOutput out = chain.Run(image, camera);
-  ASSERT_EQ(out.points.size(), 32u * 23u);            // not the far row
-  const double pitch = 2 * std::tan(30 * kDeg) / 32;  // m per pixel at 1 m, larger side
-  for (const Vec3& p : out.points) EXPECT_DOUBLE_EQ(p.z, 2);
-  // First point: the top-left pixel, to the left (+x) and up (+y).
-  EXPECT_NEAR(out.points[0].x, 15.5 * pitch * 2, 1e-12);
-  EXPECT_NEAR(out.points[0].y, 11.5 * pitch * 2, 1e-12);
+  ASSERT_EQ(out.points.size(), 32u * 23u);                    // not the far row
+  const double pitch = 2 * std::tan(30 * kDeg) / 32;          // m per pixel at 1 m (horizontal fov)
+  for (const Vec3& p : out.points) EXPECT_DOUBLE_EQ(p.x, 2);  // x: the view axis
+  // First point: the top-left pixel, to the left (+y) and up (+z).
+  EXPECT_NEAR(out.points[0].y, 15.5 * pitch * 2, 1e-12);
+  EXPECT_NEAR(out.points[0].z, 11.5 * pitch * 2, 1e-12);
   // The image's edges at 2 m span the view angle.
-  EXPECT_NEAR(out.points[31].x - out.points[0].x, -31 * pitch * 2, 1e-12);
+  EXPECT_NEAR(out.points[31].y - out.points[0].y, -31 * pitch * 2, 1e-12);
   EXPECT_TRUE(out.triggered);
   ASSERT_EQ(out.packets.size(), 2u);
   EXPECT_EQ(out.packets[1][0], 32 * 23);
-  EXPECT_EQ(out.packets[1][3], 2);
+  EXPECT_EQ(out.packets[1][1], 2);
   // A blob's bearing from its centroid: the same rays.
   const Vec3 p = ImageToSensor(camera, 32, 24, 0.5, 0.5, 2);
-  EXPECT_DOUBLE_EQ(p.x, out.points[0].x);
   EXPECT_DOUBLE_EQ(p.y, out.points[0].y);
+  EXPECT_DOUBLE_EQ(p.z, out.points[0].z);
   const Vec3 edge = ImageToSensor(camera, 32, 24, 32, 12, 1);  // right edge, middle row
-  EXPECT_NEAR(std::atan2(edge.x, edge.z), -30 * kDeg, 1e-12);
-  // Orthographic: pixel pitch ortho_size / larger side whatever the depth.
+  EXPECT_NEAR(std::atan2(edge.y, edge.x), -30 * kDeg, 1e-12);
+  // Orthographic: pixel pitch ortho_width / width whatever the depth.
   camera.perspective = false;
-  camera.ortho_size = 3.2;
+  camera.ortho_width = 3.2;
   const FilterOutput ortho =
       Chain({{"depth", {}}, {"point_cloud", {{"stride", {2}}}}}).Run(image, camera);
   ASSERT_EQ(ortho.points.size(), 16u * 12u);
-  EXPECT_NEAR(ortho.points[0].x, 15.5 * 0.1, 1e-12);
-  EXPECT_NEAR(ortho.points[1].x, 13.5 * 0.1, 1e-12);
+  EXPECT_NEAR(ortho.points[0].y, 15.5 * 0.1, 1e-12);
+  EXPECT_NEAR(ortho.points[1].y, 13.5 * 0.1, 1e-12);
 }
 
 TEST(VisionFiltersTest, DepthThresholdMasksTheNearPixels) {

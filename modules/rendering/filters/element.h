@@ -57,8 +57,10 @@ struct FilterRun {
   }
 };
 
-// From image positions to the sensor's frame (CoppeliaSim's): z along the
-// view axis, y up in the image, x = y cross z, to the image's left.
+// From image positions to the sensor's frame (the renderer's,
+// modules/rendering/render.h): x along the view axis, y to the image's
+// left, z up in the image. Pixels are square; the view angle or
+// orthographic width spans the image horizontally.
 struct Projection {
   double half_width, half_height;
   double pitch;  // m per pixel at depth 1 (perspective) or at any depth (orthographic)
@@ -66,14 +68,13 @@ struct Projection {
 
   Projection(const CameraModel& camera, int width, int height)
       : half_width(width / 2.0), half_height(height / 2.0), perspective(camera.perspective) {
-    const double larger = std::max(width, height);
-    pitch = perspective ? 2 * std::tan(camera.fov / 2) / larger : camera.ortho_size / larger;
+    pitch = (perspective ? 2 * std::tan(camera.fov / 2) : camera.ortho_width) / width;
   }
   // The point at `depth` (m along the view axis) seen at (x, y), pixels
   // from the top-left corner (a pixel's centre at + 0.5).
   Vec3 Point(double x, double y, double depth) const {
     const double scale = perspective ? pitch * depth : pitch;
-    return {-(x - half_width) * scale, (half_height - y) * scale, depth};
+    return {depth, -(x - half_width) * scale, (half_height - y) * scale};
   }
 };
 

@@ -112,8 +112,8 @@ std::shared_ptr<const VisionFilterElement> MakePluginElement(
 // --- Running --------------------------------------------------------------------------
 
 // Packet 1 (CoppeliaSim's): min, max and mean of intensity, red, green,
-// blue and depth (0..1; depth from the near plane to the far one, 0 without
-// a depth image), in that order.
+// blue and depth (0..1; depth from the near plane to the far one, 1 without
+// a depth image: nothing seen), in that order.
 void Statistics(const Image& image, const CameraModel& camera, std::vector<double>* packet) {
   const size_t n = static_cast<size_t>(image.width) * static_cast<size_t>(image.height);
   const uint8_t* rgb = image.rgb.data();
@@ -166,7 +166,8 @@ void Statistics(const Image& image, const CameraModel& camera, std::vector<doubl
   }
   min[0] = *std::min_element(i_lo, i_lo + 4);
   max[0] = *std::max_element(i_hi, i_hi + 4);
-  double depth_min = 0, depth_max = 0, depth_mean = 0;
+  const double no_depth = n > 0 ? 1.0 : 0.0;
+  double depth_min = no_depth, depth_max = no_depth, depth_mean = no_depth;
   if (n > 0 && image.depth.size() == n) {
     // Loops the compiler vectorises. Depths are >= 0, so their bit patterns
     // order as the numbers do: an integer min and max.
