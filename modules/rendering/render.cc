@@ -46,6 +46,10 @@ struct Gl {
 const Gl& Library() {
   static const Gl gl = [] {
     Gl g;
+    // llvmpipe rasterises in the calling thread: images are small and drawn
+    // many at a time, one per worker thread (its own rasteriser threads
+    // would fight the scheduler's for the cores). A user's setting wins.
+    setenv("LP_NUM_THREADS", "0", /*overwrite=*/0);
     const char* name = std::getenv("SWARMSIM_OSMESA_LIBRARY");  // tests name a missing one
     const std::string file = name != nullptr && *name != '\0' ? name : "libOSMesa.so.8";
     void* lib = dlopen(file.c_str(), RTLD_NOW | RTLD_LOCAL);

@@ -1,8 +1,11 @@
 // Vision sensors, cameras and lights (modules/rendering) as a user writes
 // them: a world file, a step, and what the sensor saw.
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 
+#include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <string>
 
@@ -145,6 +148,114 @@ TEST_F(RenderingTest, BadSettingsNameTheirPlaceInTheFile) {
   EXPECT_NE(ErrorOf(base + "near: 2, far: 1}\n").find("'far'"), std::string::npos);
   EXPECT_NE(ErrorOf(base + "detectable: /nowhere}\n").find("world.yaml:3:"), std::string::npos);
   EXPECT_NE(ErrorOf(base + "projection: fisheye}\n").find("perspective"), std::string::npos);
+}
+
+// A robot's script switches its light and recolours its shape; the sensor
+// sees it from the next sense phase on, and its image reaches the script.
+constexpr char kLampModel[] = R"(model: lamp
+objects:
+  name: base
+  type: dummy
+  script: lamp.lua
+  children:
+    - {name: cube, type: shape, shape: box, size: [0.5, 0.5, 0.5], position: [2, 0, 0.25],
+       color: [0.9, 0.1, 0.1]}
+    - {name: sun, type: light, kind: directional, orientation_deg: [0, 90, 0], color: [1, 1, 1]}
+    - {name: lamp, type: light, kind: point, position: [1, 0, 0.25], color: [1, 1, 1]}
+    - {name: eye, type: vision_sensor, position: [0, 0, 0.25], resolution: [32, 24], floor: false}
+)";
+
+constexpr char kLampScript[] = R"(
+function sysCall_init()
+  eye = sim.getObject(':/eye')
+  local img, res = sim.getVisionSensorImg(eye)
+  assert(#img == res[1] * res[2] * 3 and res[1] == 32 and res[2] == 24)
+  local depth = sim.getVisionSensorDepth(eye)
+  assert(#depth == 32 * 24)
+  local result, packet = sim.readVisionSensor(eye)
+  assert(result == 0 and #packet == 15)
+end
+function sysCall_actuation()
+  local step = math.floor(sim.getSimulationTime() / sim.getTimeStep() + 0.5)
+  if step == 0 then
+    sim.setLightOn(sim.getObject(':/sun'), false)
+    sim.setLightOn(sim.getObject(':/lamp'), false)
+  elseif step == 1 then
+    sim.setLightOn(sim.getObject(':/lamp'), true)
+    sim.setLightColor(sim.getObject(':/lamp'), {0, 0, 1})
+    sim.setShapeColor(sim.getObject(':/cube'), {1, 1, 1})
+  end
+  local img = sim.getVisionSensorImg(eye)
+  local i = (12 * 32 + 16) * 3
+  sim.recordMetric('centre_red', img:byte(i + 1))
+end
+)";
+
+TEST_F(RenderingTest, ScriptsSwitchLightsAndRecolourShapesAndTheSensorSeesIt) {
+  Write("lamp.yaml", kLampModel);
+  Write("lamp.lua", kLampScript);
+  LoadedWorld w = Load(
+      "simulation: {physics: kinematic, time_step: 0.1}\n"
+      "models: [{model: lamp.yaml, position: [0, 0, 0]}]\n");
+  w.world->Start();
+  const auto centre = [&] {
+    const uint8_t* p = Sensor(*w.world, "/lamp#0/eye").image.Pixel(16, 12);
+    return std::array<int, 3>{p[0], p[1], p[2]};
+  };
+  const std::array<int, 3> lit = centre();
+  EXPECT_GT(lit[0], 100);
+  EXPECT_LT(lit[2], 60);
+  w.world->Step();  // the first step's scripts switch both lights off
+  w.world->Step();  // ... which the next step's sense phase sees
+  const std::array<int, 3> dark = centre();
+  EXPECT_LT(dark[0], lit[0] / 2) << "only the ambient light is left";
+  w.world->Step();  // the lamp is on again, blue, and the cube white
+  const std::array<int, 3> blue = centre();
+  EXPECT_GT(blue[2], blue[0] + 60) << "a white cube under a blue lamp";
+}
+
+TEST_F(RenderingTest, ARobotMayNotRecolourAnotherRobotsShapes) {
+  Write("bot.yaml",
+        "model: bot\nobjects:\n  name: body\n  type: shape\n  shape: box\n  size: [0.1, 0.1, "
+        "0.1]\n  script: bot.lua\n");
+  Write("bot.lua",
+        "function sysCall_actuation()\n"
+        "  if sim.getRobotIndex() == 0 then sim.setShapeColor(sim.getObject('/bot#1'), {0, 1, 0}) "
+        "end\nend\n");
+  LoadedWorld w = Load(
+      "simulation: {physics: kinematic}\n"
+      "models: [{model: bot.yaml, position: [0, 0, 0.05]}, {model: bot.yaml, position: [1, 0, "
+      "0.05]}]\n");
+  w.world->Start();
+  try {
+    w.world->Step();
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("only its own robot's shapes"), std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("bot.lua:2"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(RenderingTest, AMissingOsMesaIsAClearErrorOnlyWhenSomethingRenders) {
+  // (a child process: the library is chosen once per process)
+  const std::string program = SWARMSIM_BINARY;
+  Write("world.yaml", kRedCube);
+  const std::string command = "SWARMSIM_OSMESA_LIBRARY=/nonexistent/libOSMesa.so " + program +
+                              " run " + (dir_ / "world.yaml").string() + " --steps 2 --quiet 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string output;
+  char buffer[512];
+  while (fgets(buffer, sizeof buffer, pipe) != nullptr) output += buffer;
+  const int status = pclose(pipe);
+  EXPECT_NE(WEXITSTATUS(status), 0);
+  EXPECT_NE(output.find("libosmesa6"), std::string::npos) << output;
+  // A world that renders nothing runs without it.
+  Write("plain.yaml", "simulation: {physics: kinematic}\nobjects: [{name: a, type: dummy}]\n");
+  const std::string plain = "SWARMSIM_OSMESA_LIBRARY=/nonexistent/libOSMesa.so " + program +
+                            " run " + (dir_ / "plain.yaml").string() + " --steps 2 --quiet";
+  EXPECT_EQ(std::system(plain.c_str()), 0);
 }
 
 }  // namespace
