@@ -1,5 +1,6 @@
 #include "modules/rendering/module.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "framework/collections.h"
@@ -15,6 +16,11 @@ namespace swarmsim::rendering {
 namespace {
 
 constexpr int kSensorSegments = 16;  // sides of cylinders, slices of spheres
+
+// Level of detail: sides of a cylinder for an image `width` pixels wide (a
+// 64-pixel image gets octagons; nobody sees the difference, and it is half
+// the triangles of 16).
+int SegmentsFor(int width) { return std::clamp(width / 8, 8, 24); }
 
 Rows<VisionSensorRow>* Sensors(Scene* scene) {
   ObjectType type;
@@ -77,7 +83,24 @@ void RenderingModule::RenderDue(World* world, bool all) {
     }
     version_ = scene.structure_version();
   }
-  BuildDrawList(*world, kSensorSegments, &list_);
+  // Each list the due sensors need, built once (then pointed at: the vector
+  // no longer grows).
+  std::vector<int> segments_of(due.size());
+  std::vector<int> built;
+  for (size_t i = 0; i < due.size(); ++i) {
+    const int segments = SegmentsFor(sensors->rows[due[i]].lens.width);
+    segments_of[i] = segments;
+    if (std::find(built.begin(), built.end(), segments) != built.end()) continue;
+    built.push_back(segments);
+    auto it = std::find_if(lists_.begin(), lists_.end(),
+                           [&](const auto& entry) { return entry.first == segments; });
+    if (it == lists_.end()) it = lists_.insert(lists_.end(), {segments, DrawList{}});
+    BuildDrawList(*world, segments, &it->second);
+  }
+  std::vector<const DrawList*> list_of(due.size());
+  for (size_t i = 0; i < due.size(); ++i)
+    for (const auto& [segments, list] : lists_)
+      if (segments == segments_of[i]) list_of[i] = &list;
   world->scheduler().ParallelFor(
       0, static_cast<int64_t>(due.size()), 1, [&](int64_t begin, int64_t end) {
         for (int64_t i = begin; i < end; ++i) {
@@ -87,7 +110,7 @@ void RenderingModule::RenderDue(World* world, bool all) {
           options.visible = visible_[r].empty() ? nullptr : &visible_[r];
           options.floor = s.floor;
           options.background = s.background;
-          Draw(list_, ViewOf(scene, sensors->owners[r], s.lens, s.depth), options, &s.image);
+          Draw(*list_of[i], ViewOf(scene, sensors->owners[r], s.lens, s.depth), options, &s.image);
           s.rendered_step = step;
         }
       });

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "framework/module.h"
@@ -22,7 +23,8 @@ class RenderingModule final : public Module {
  private:
   void RenderDue(World* world, bool all);
 
-  DrawList list_;
+  // One draw list per level of detail the due sensors need, built once a step.
+  std::vector<std::pair<int, DrawList>> lists_;
   uint64_t version_ = UINT64_MAX;              // the scene structure the masks are for
   std::vector<std::vector<uint8_t>> visible_;  // per sensor row: slots it sees (empty: all)
 };
