@@ -173,6 +173,48 @@ int GetShapeColor(lua_State* L) {
   return 1;
 }
 
+// CoppeliaSim's object parameters of vision sensors (and cameras):
+// sim.getObjectFloatParam(h, sim.visionfloatparam_near_clipping | _far_clipping
+// | _perspective_angle (rad, horizontal) | _ortho_size (m, the width)),
+// sim.getObjectInt32Param(h, sim.visionintparam_resolution_x | _y).
+constexpr int kNearClipping = 1000, kFarClipping = 1001, kResolutionX = 1002, kResolutionY = 1003,
+              kPerspectiveAngle = 1004, kOrthoSize = 1005;
+
+const Lens& LensOf(lua_State* L) {
+  Scene& scene = *Context(L).scene;
+  const ObjectId id = CheckObject(L, 1);
+  const uint32_t slot = scene.SlotOf(id);
+  ObjectType type;
+  if (scene.FindType("vision_sensor", &type) && scene.type_at(slot) == type)
+    return static_cast<Rows<VisionSensorRow>*>(scene.rows(type))->rows[scene.row_at(slot)].lens;
+  if (scene.FindType("camera", &type) && scene.type_at(slot) == type)
+    return static_cast<Rows<CameraRow>*>(scene.rows(type))->rows[scene.row_at(slot)].lens;
+  throw Error("'" + scene.PathOf(id) + "' is a " + scene.type_name(scene.type_at(slot)) +
+              ": swarmsim has object parameters of vision sensors and cameras only");
+}
+
+int GetObjectFloatParam(lua_State* L) {
+  const Lens& lens = LensOf(L);
+  switch (ArgInteger(L, 2)) {
+    case kNearClipping: lua_pushnumber(L, lens.near); break;
+    case kFarClipping: lua_pushnumber(L, lens.far); break;
+    case kPerspectiveAngle: lua_pushnumber(L, lens.fov); break;
+    case kOrthoSize: lua_pushnumber(L, lens.ortho_width); break;
+    default: throw Error("unknown float parameter " + std::to_string(ArgInteger(L, 2)));
+  }
+  return 1;
+}
+
+int GetObjectInt32Param(lua_State* L) {
+  const Lens& lens = LensOf(L);
+  switch (ArgInteger(L, 2)) {
+    case kResolutionX: lua_pushinteger(L, lens.width); break;
+    case kResolutionY: lua_pushinteger(L, lens.height); break;
+    default: throw Error("unknown integer parameter " + std::to_string(ArgInteger(L, 2)));
+  }
+  return 1;
+}
+
 LightRow& LightOf(lua_State* L) { return RowOf<LightRow>(L, 1, "light", "a light"); }
 
 int SetLightOn(lua_State* L) {
@@ -208,9 +250,23 @@ void RegisterRenderingApi(lua_State* L) {
       {"setLightOn", Guarded<SetLightOn, "sim.setLightOn">},
       {"getLightOn", Guarded<GetLightOn, "sim.getLightOn">},
       {"setLightColor", Guarded<SetLightColor, "sim.setLightColor">},
+      {"getObjectFloatParam", Guarded<GetObjectFloatParam, "sim.getObjectFloatParam">},
+      {"getObjectInt32Param", Guarded<GetObjectInt32Param, "sim.getObjectInt32Param">},
       {nullptr, nullptr},
   };
   luaL_setfuncs(L, kFunctions, 0);
+  const std::pair<const char*, int> constants[] = {
+      {"visionfloatparam_near_clipping", kNearClipping},
+      {"visionfloatparam_far_clipping", kFarClipping},
+      {"visionintparam_resolution_x", kResolutionX},
+      {"visionintparam_resolution_y", kResolutionY},
+      {"visionfloatparam_perspective_angle", kPerspectiveAngle},
+      {"visionfloatparam_ortho_size", kOrthoSize},
+  };
+  for (const auto& [name, value] : constants) {
+    lua_pushinteger(L, value);
+    lua_setfield(L, -2, name);
+  }
 }
 
 }  // namespace swarmsim::rendering
