@@ -15,9 +15,11 @@ namespace swarmsim::rendering {
 
 namespace {
 
-// A primitive in its own frame: triangles (3 vertices each) with normals.
+// A primitive in its own frame: triangles (3 vertices each) with normals,
+// and a colour per vertex for meshes with materials.
 struct Primitive {
   std::vector<Vec3> p, n;
+  std::vector<Vec3> c;  // per vertex, or empty: the shape's colour
 };
 
 void AddTriangle(Primitive* m, const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& na,
@@ -121,10 +123,13 @@ Primitive Capsule(int segments, double r, double h) {
 Primitive MeshPrimitive(const TriangleMesh& mesh) {
   Primitive m;
   const auto v = mesh.vertices();
-  for (const MeshTriangle& t : mesh.triangles()) {
+  const auto colors = mesh.colors();
+  for (size_t i = 0; i < mesh.triangles().size(); ++i) {
+    const MeshTriangle& t = mesh.triangles()[i];
     const Vec3 &a = v[t.v[0]], &b = v[t.v[1]], &c = v[t.v[2]];
     const Vec3 n = (b - a).Cross(c - a).Normalized();
     AddTriangle(&m, a, b, c, n, n, n);
+    if (!colors.empty()) m.c.insert(m.c.end(), {colors[i], colors[i], colors[i]});
   }
   return m;
 }
@@ -143,7 +148,7 @@ uint8_t Byte(double c) { return static_cast<uint8_t>(std::lround(std::clamp(c, 0
 
 // Appends `prim` scaled by `scale` and placed at X_WS.
 void Append(DrawList* list, uint32_t slot, const Primitive& prim, const Vec3& scale,
-            const Pose& X_WS, const Vec3& color, bool emissive) {
+            const Pose& X_WS, const Vec3& color, bool emissive, bool own_colors = false) {
   DrawItem item{};
   item.slot = slot;
   item.first = static_cast<uint32_t>(list->xyz.size() / 3);
@@ -159,7 +164,12 @@ void Append(DrawList* list, uint32_t slot, const Primitive& prim, const Vec3& sc
                      {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)});
     list->normal.insert(list->normal.end(), {static_cast<float>(n.x), static_cast<float>(n.y),
                                              static_cast<float>(n.z)});
-    list->rgb.insert(list->rgb.end(), rgb, rgb + 3);
+    if (own_colors) {
+      const Vec3& c = prim.c[i];
+      list->rgb.insert(list->rgb.end(), {Byte(c.x), Byte(c.y), Byte(c.z)});
+    } else {
+      list->rgb.insert(list->rgb.end(), rgb, rgb + 3);
+    }
     lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
     hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
   }
@@ -216,7 +226,10 @@ void BuildDrawList(const World& world, int segments, DrawList* list) {
                s.color, false);
         break;
       case ShapeKind::kMesh:
-        if (s.mesh) Append(list, slot, MeshFor(s.mesh.get()), {1, 1, 1}, X, s.color, false);
+        if (s.mesh) {
+          const Primitive& mesh = MeshFor(s.mesh.get());
+          Append(list, slot, mesh, {1, 1, 1}, X, s.color, false, s.mesh_colors && !mesh.c.empty());
+        }
         break;
     }
   }

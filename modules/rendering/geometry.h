@@ -53,8 +53,8 @@ struct DrawList {
   std::vector<LightSource> lights;  // on, in scene order (at most 8 are used)
   bool scene_has_lights = false;    // light objects exist (on or off)
   FloorLayer floor;
-  int64_t step = -1;  // the world's step when built (the paint layer's version)
-  Vec3 lo, hi;        // bounds of the shapes and the environment (zero when none)
+  int64_t step = -1;        // the world's step when built (the paint layer's version)
+  Vec3 lo, hi;              // bounds of the shapes and the environment (zero when none)
   bool has_bounds = false;  // lo, hi hold something
 };
 

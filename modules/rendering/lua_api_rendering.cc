@@ -157,7 +157,9 @@ int SetShapeColor(lua_State* L) {
   CheckOwn(L, id, "shapes");
   // (h, {r, g, b}) or CoppeliaSim's (h, colorName, colorComponent, {r, g, b}).
   const int arg = lua_istable(L, 2) ? 2 : 4;
-  scene.mutable_shape(id).color = ArgColor(L, arg);
+  ShapeData& shape = scene.mutable_shape(id);
+  shape.color = ArgColor(L, arg);
+  shape.mesh_colors = false;  // a mesh's materials give way
   return 0;
 }
 

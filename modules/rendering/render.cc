@@ -24,16 +24,17 @@ namespace {
 
 // The GL and OSMesa entry points we use, from the library opened at run time.
 struct Gl {
-#define SWARMSIM_GL_FUNCTIONS(X)                                                                   \
-  X(glViewport)                                                                                    \
-  X(glClearColor)                                                                                  \
-  X(glClear) X(glMatrixMode) X(glLoadIdentity) X(glLoadMatrixd) X(glEnable) X(glDisable)           \
-      X(glLightfv) X(glLightf) X(glLightModelfv) X(glLightModeli) X(glColorMaterial)               \
-          X(glEnableClientState) X(glDisableClientState) X(glVertexPointer) X(glNormalPointer)     \
-              X(glColorPointer) X(glTexCoordPointer) X(glDrawArrays) X(glFinish) X(glReadPixels)   \
-                  X(glPixelStorei) X(glGenTextures) X(glBindTexture) X(glTexImage2D)               \
-                      X(glTexParameteri) X(glShadeModel) X(glDepthFunc) X(glColor3f) X(glNormal3f) \
-                          X(glTexEnvi) X(glDepthMask) X(glGetError)
+  // clang-format off
+#define SWARMSIM_GL_FUNCTIONS(X) \
+  X(glViewport) X(glClearColor) X(glClear) X(glMatrixMode) X(glLoadIdentity) \
+  X(glLoadMatrixd) X(glEnable) X(glDisable) X(glLightfv) X(glLightf) \
+  X(glLightModelfv) X(glLightModeli) X(glColorMaterial) X(glEnableClientState) \
+  X(glDisableClientState) X(glVertexPointer) X(glNormalPointer) X(glColorPointer) \
+  X(glTexCoordPointer) X(glDrawArrays) X(glFinish) X(glReadPixels) \
+  X(glPixelStorei) X(glGenTextures) X(glBindTexture) X(glTexImage2D) \
+  X(glTexParameteri) X(glShadeModel) X(glDepthFunc) X(glColor3f) X(glNormal3f) \
+  X(glTexEnvi) X(glDepthMask) X(glGetError)
+  // clang-format on
 #define SWARMSIM_DECLARE(name) decltype(&::name) name = nullptr;
   SWARMSIM_GL_FUNCTIONS(SWARMSIM_DECLARE)
 #undef SWARMSIM_DECLARE

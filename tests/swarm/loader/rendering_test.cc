@@ -258,5 +258,37 @@ TEST_F(RenderingTest, AMissingOsMesaIsAClearErrorOnlyWhenSomethingRenders) {
   EXPECT_EQ(std::system(plain.c_str()), 0);
 }
 
+// A mesh is drawn in its OBJ file's material colours (mtllib beside it),
+// unless the world gives it a colour.
+TEST_F(RenderingTest, AMeshIsDrawnInItsMaterialsColoursUnlessGivenOne) {
+  Write("panel.obj",
+        "mtllib panel.mtl\n"
+        "v 0 -0.5 -0.25\nv 0 0 -0.25\nv 0 0 0.25\nv 0 -0.5 0.25\nv 0 0.5 -0.25\nv 0 0.5 0.25\n"
+        "usemtl red\nf 1 2 3\nf 1 3 4\nusemtl green\nf 2 5 6\nf 2 6 3\n");
+  Write("panel.mtl", "newmtl red\nKd 0.9 0.1 0.1\nnewmtl green\nKd 0.1 0.9 0.1\n");
+  const std::string world =
+      "simulation: {physics: kinematic}\n"
+      "objects:\n"
+      "  - {name: panel, type: shape, shape: mesh, file: panel.obj, position: [2, 0, 0.25]COLOR}\n"
+      "  - {name: eye, type: vision_sensor, position: [0, 0, 0.25], resolution: [64, 48]}\n";
+  std::string plain = world;
+  plain.replace(plain.find("COLOR"), 5, "");
+  LoadedWorld w = Load(plain);
+  w.world->Start();
+  const Image& image = Sensor(*w.world, "/eye").image;
+  Keep(image, "mesh_materials");
+  // The sensor's left (+y) sees the green half, its right (-y) the red one.
+  const uint8_t* left = image.Pixel(26, 24);
+  const uint8_t* right = image.Pixel(38, 24);
+  EXPECT_GT(left[1], left[0] + 60) << "green";
+  EXPECT_GT(right[0], right[1] + 60) << "red";
+  std::string blue = world;
+  blue.replace(blue.find("COLOR"), 5, ", color: [0.1, 0.1, 0.9]");
+  LoadedWorld b = Load(blue);
+  b.world->Start();
+  EXPECT_GT(Sensor(*b.world, "/eye").image.Pixel(26, 24)[2], 120) << "the world's colour wins";
+  EXPECT_GT(Sensor(*b.world, "/eye").image.Pixel(38, 24)[2], 120);
+}
+
 }  // namespace
 }  // namespace swarmsim
