@@ -6,6 +6,7 @@
 #include "modules/dynamics/box2d/box2d_backend.h"
 #include "modules/dynamics/kinematic/kinematic_backend.h"
 #include "modules/dynamics/ode/ode_backend.h"
+#include "modules/graphs/graphs.h"
 #include "modules/kinematics/ik_groups.h"
 #include "modules/metrics/swarm_metrics.h"
 #include "modules/mill/mill.h"
@@ -41,6 +42,7 @@ void RegisterBuiltinModules(ModuleRegistry* registry) {
     registry->RegisterModule(std::move(metric));
   collision::Register(registry);
   mill::Register(registry);
+  graphs::Register(registry);
 }
 
 }  // namespace swarmsim
