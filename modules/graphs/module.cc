@@ -143,7 +143,14 @@ void GraphModule::Refresh(Scene* scene) {
       if (spec.kind == StreamKind::kScript) continue;
       std::string problem;
       const ObjectId target = ResolveStream(*scene, id, spec, &problem);
-      if (!target.IsNull()) s.sources[i] = target.index();
+      if (target.IsNull()) continue;
+      s.sources[i] = target.index();
+      // A joint's unit, now that its type is known.
+      if (spec.kind == StreamKind::kJoint || spec.kind == StreamKind::kJointVelocity) {
+        const bool linear = scene->joint(target).type == JointType::kPrismatic;
+        s.settings.streams[i].unit =
+            spec.kind == StreamKind::kJoint ? (linear ? "m" : "rad") : (linear ? "m/s" : "rad/s");
+      }
     }
     const int instance = scene->instance_of_at(slot);
     by_robot_[instance >= 0 ? instance : by_robot_.size() - 1].push_back(

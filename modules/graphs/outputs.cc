@@ -80,7 +80,7 @@ std::string AxisRange(double lo, double hi, double margin) {
 }
 
 std::string Label(const StreamSpec& s) {
-  const std::string unit = UnitOf(s);
+  const std::string& unit = s.unit;
   return unit.empty() ? s.name : s.name + " (" + unit + ")";
 }
 
@@ -98,33 +98,46 @@ void PlotCommands(const Series& s, const fs::path& csv, const fs::path& png, std
   const size_t n = g.streams.size();
   double lo[4], hi[4];
   if (g.kind == GraphKind::kTime) {
+    // The streams with data; two units get an axis each (y and y2).
     std::vector<size_t> plotted;
-    double ylo = INFINITY, yhi = -INFINITY;
+    std::vector<std::string> units;
+    double ylo[2] = {INFINITY, INFINITY}, yhi[2] = {-INFINITY, -INFINITY};
     for (size_t i = 0; i < n; ++i) {
       double a, b;
       if (!RangeOf(s, i + 1, &a, &b)) continue;
       plotted.push_back(i);
-      ylo = std::min(ylo, a);
-      yhi = std::max(yhi, b);
+      if (std::find(units.begin(), units.end(), g.streams[i].unit) == units.end())
+        units.push_back(g.streams[i].unit);
     }
     if (plotted.empty() || !RangeOf(s, 0, &lo[0], &hi[0])) return no_data();
-    std::string unit = UnitOf(g.streams[plotted[0]]);
-    for (size_t i : plotted)
-      if (UnitOf(g.streams[i]) != unit) unit.clear();
-    gp << "set xlabel 'time (s)'\nset ylabel " << GnuplotQuote(unit) << "\nset xrange "
-       << AxisRange(lo[0], hi[0], 0) << "\nset yrange " << AxisRange(ylo, yhi, 0.05)
-       << "\nset key outside right top\nplot ";
+    const bool two_axes = units.size() == 2;
+    const auto axis = [&](size_t i) { return two_axes && g.streams[i].unit == units[1] ? 1 : 0; };
+    for (size_t i : plotted) {
+      double a, b;
+      RangeOf(s, i + 1, &a, &b);
+      ylo[axis(i)] = std::min(ylo[axis(i)], a);
+      yhi[axis(i)] = std::max(yhi[axis(i)], b);
+    }
+    gp << "set xlabel 'time (s)'\nset ylabel " << GnuplotQuote(units.size() == 1 ? units[0] : "")
+       << "\nset xrange " << AxisRange(lo[0], hi[0], 0) << "\nset yrange "
+       << AxisRange(ylo[0], yhi[0], 0.05) << "\n";
+    if (two_axes)
+      gp << "set ylabel " << GnuplotQuote(units[0]) << "\nset y2label " << GnuplotQuote(units[1])
+         << "\nset y2range " << AxisRange(ylo[1], yhi[1], 0.05)
+         << "\nset ytics nomirror\nset y2tics\n";
+    gp << "set key outside right top\nplot ";
     for (size_t k = 0; k < plotted.size(); ++k)
       gp << (k ? ", \\\n     " : "") << data << " using 1:" << plotted[k] + 2
-         << " with lines lw 1.5 title " << GnuplotQuote(g.streams[plotted[k]].name);
+         << (axis(plotted[k]) ? " axes x1y2" : "") << " with lines lw 1.5 title "
+         << GnuplotQuote(g.streams[plotted[k]].name +
+                         (two_axes ? " (" + g.streams[plotted[k]].unit + ")" : ""));
     gp << "\nunset output\n";
     return;
   }
   for (size_t c = 1; c <= n; ++c)
     if (!RangeOf(s, c, &lo[c], &hi[c])) return no_data();
-  const bool same_units = std::all_of(g.streams.begin(), g.streams.end(), [&](const auto& x) {
-    return std::string(UnitOf(x)) == UnitOf(g.streams[0]);
-  });
+  const bool same_units = std::all_of(g.streams.begin(), g.streams.end(),
+                                      [&](const auto& x) { return x.unit == g.streams[0].unit; });
   const char* axes[3] = {"x", "y", "z"};
   for (size_t c = 1; c <= n; ++c)
     gp << "set " << axes[c - 1] << "label " << GnuplotQuote(Label(g.streams[c - 1]))
@@ -132,13 +145,16 @@ void PlotCommands(const Series& s, const fs::path& csv, const fs::path& png, std
        << AxisRange(lo[c], hi[c], 0.05) << "\n";
   gp << "set key top right\n";
   if (g.kind == GraphKind::kXy) {
-    if (same_units) gp << "set size ratio -1\n";
+    // Equal scales for a path in the plane, unless that squeezes it flat.
+    const double ratio = (hi[2] - lo[2]) / (hi[1] - lo[1]);
+    if (same_units && ratio > 1.0 / 3 && ratio < 3) gp << "set size ratio -1\n";
     gp << "plot " << data << " using 2:3 with lines lw 1.5 notitle, \\\n     " << data
        << " every ::0::0 using 2:3 with points pt 7 ps 1.5 title 'start'\nunset output\n";
   } else {
     if (same_units) gp << "set view equal xy\n";
-    gp << "set ticslevel 0\nset border 4095\nsplot " << data << " using 2:3:4 with lines lw 1.5 notitle, \\\n     "
-       << data << " every ::0::0 using 2:3:4 with points pt 7 ps 1.5 title 'start'\n"
+    gp << "set ticslevel 0\nset border 4095\nsplot " << data
+       << " using 2:3:4 with lines lw 1.5 notitle, \\\n     " << data
+       << " every ::0::0 using 2:3:4 with points pt 7 ps 1.5 title 'start'\n"
        << "unset output\n";
   }
 }

@@ -33,6 +33,7 @@ struct StreamSpec {
   StreamKind kind = StreamKind::kPosition;
   Component component = Component::kNone;
   std::string path;  // the object, resolved from the graph (empty for kScript)
+  std::string unit;  // for axis labels: "m", "rad", "rad or m" (a joint's until resolved)
 };
 
 enum class GraphKind : uint8_t { kTime, kXy, kXyz };
@@ -56,8 +57,5 @@ struct GraphRow {
 // appends its streams (a vector without a component gives three). Throws
 // swarmsim::Error with a message about `text` (the caller adds where).
 void ParseStream(std::string_view text, std::vector<StreamSpec>* out);
-
-// The units of a stream, for axis labels: "m", "rad", "" (a script's).
-const char* UnitOf(const StreamSpec& stream);
 
 }  // namespace swarmsim::graphs

@@ -72,12 +72,6 @@ std::string Quoted(std::string_view text) {
 
 }  // namespace
 
-const char* UnitOf(const StreamSpec& stream) {
-  for (const KindInfo& k : kKinds)
-    if (k.kind == stream.kind) return k.unit;
-  return "";
-}
-
 void ParseStream(std::string_view text, std::vector<StreamSpec>* out) {
   std::vector<std::string> words = Words(text);
   const std::string what = "stream " + Quoted(text);
@@ -114,7 +108,7 @@ void ParseStream(std::string_view text, std::vector<StreamSpec>* out) {
                   "'speed = script'");
     if (words.size() == 2) name = words[1];
     if (name.empty()) throw Error(what + ": a script stream needs a name" + usage);
-    out->push_back({name, StreamKind::kScript, Component::kNone, ""});
+    out->push_back({name, StreamKind::kScript, Component::kNone, "", ""});
     return;
   }
 
@@ -130,7 +124,8 @@ void ParseStream(std::string_view text, std::vector<StreamSpec>* out) {
     if (words.size() == 3)
       throw Error(what + ": " + Quoted(kind->name) + " is one number and takes no component " +
                   Quoted(words[2]) + usage);
-    out->push_back({name.empty() ? default_name : name, kind->kind, Component::kNone, path});
+    out->push_back(
+        {name.empty() ? default_name : name, kind->kind, Component::kNone, path, kind->unit});
     return;
   }
   const std::span<const ComponentInfo> components =
@@ -138,8 +133,8 @@ void ParseStream(std::string_view text, std::vector<StreamSpec>* out) {
   if (words.size() == 3) {
     for (const ComponentInfo& c : components)
       if (words[2] == c.name) {
-        out->push_back(
-            {name.empty() ? default_name + " " + c.name : name, kind->kind, c.component, path});
+        out->push_back({name.empty() ? default_name + " " + c.name : name, kind->kind, c.component,
+                        path, kind->unit});
         return;
       }
     std::string list;
@@ -152,7 +147,7 @@ void ParseStream(std::string_view text, std::vector<StreamSpec>* out) {
   for (size_t i = 0; i < 3; ++i)
     out->push_back(
         {name.empty() ? default_name + " " + components[i].name : name + "." + components[i].name,
-         kind->kind, components[i].component, path});
+         kind->kind, components[i].component, path, kind->unit});
 }
 
 }  // namespace swarmsim::graphs
