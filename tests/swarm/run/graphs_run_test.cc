@@ -326,3 +326,75 @@ TEST(GraphsRunTest, SettingANonScriptStreamIsAScriptError) {
 }
 
 }  // namespace
+
+namespace {
+
+// The example worlds' graphs show what the worlds do.
+TEST(GraphsExamplesTest, ArmGraphsShowTheBoxCarriedAndDropped) {
+  const fs::path out = FreshTempDir("swarmsim_graphs", "arm");
+  const auto r = RunProgram("run " + std::string(SWARMSIM_SOURCE_DIR) +
+                            "/worlds/arm_pick_and_place.yaml --quiet --out " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  // The box is lifted while the task says it is carried, and lands on the
+  // table (its top at 0.4 m) after the release.
+  const Csv box = ReadCsv(out / "graphs/box_height.csv");
+  const Csv task = ReadCsv(out / "graphs/ur5#0/task.csv");
+  ASSERT_EQ(box.rows.size(), 501u);
+  ASSERT_EQ(task.rows.size(), box.rows.size());
+  double highest = 0, carried_time = 0;
+  for (size_t i = 0; i < box.rows.size(); ++i) {
+    highest = std::max(highest, box.rows[i][1]);
+    if (task.rows[i][2] == 1) carried_time += 0.02;
+  }
+  EXPECT_GT(highest, 0.425 + 0.1);
+  EXPECT_NEAR(box.rows.back()[1], 0.425, 0.005);
+  EXPECT_NEAR(carried_time, 4, 0.1);  // grasp at 3 s, release at 7 s
+  EXPECT_EQ(task.rows.back()[1], 7);  // past the last of 6 segments
+  EXPECT_EQ(ReadCsv(out / "graphs/ur5#0/joints.csv").header.size(), 7u);
+  EXPECT_EQ(ReadCsv(out / "graphs/ur5#0/tip_path.csv").header,
+            (std::vector<std::string>{"time", "tip.x", "tip.y", "tip.z"}));
+  for (const char* png : {"box_height.png", "ur5#0/task.png", "ur5#0/tip_path.png"})
+    EXPECT_TRUE(IsPng(out / "graphs" / png)) << png;
+}
+
+TEST(GraphsExamplesTest, HexapodGraphsShowItStandingAndWalking) {
+  const fs::path out = FreshTempDir("swarmsim_graphs", "hexapod");
+  const auto r = RunProgram("run " + std::string(SWARMSIM_SOURCE_DIR) +
+                            "/worlds/hexapod.yaml --steps 500 --quiet --out " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const Csv body = ReadCsv(out / "graphs/body.csv");
+  ASSERT_EQ(body.header, (std::vector<std::string>{"time", "height", "clearance"}));
+  ASSERT_EQ(body.rows.size(), 501u);
+  for (const auto& row : body.rows) EXPECT_GT(row[1], 0.03);  // standing all along
+  // The track goes along +x; the knee swings through its gait.
+  const Csv track = ReadCsv(out / "graphs/track.csv");
+  EXPECT_GT(track.rows.back()[1] - track.rows.front()[1], 0.2);
+  const Csv leg = ReadCsv(out / "graphs/leg0.csv");
+  double knee_lo = 10, knee_hi = -10;
+  for (const auto& row : leg.rows)
+    knee_lo = std::min(knee_lo, row[3]), knee_hi = std::max(knee_hi, row[3]);
+  EXPECT_GT(knee_hi - knee_lo, 0.3);
+}
+
+TEST(GraphsExamplesTest, ThreadedArmsHaveOneGraphPerCopyEqualAtOneAndTwoThreads) {
+  const fs::path out = FreshTempDir("swarmsim_graphs", "arms");
+  for (int t = 1; t <= 2; ++t) {
+    const auto r = RunProgram("run " + std::string(SWARMSIM_SOURCE_DIR) +
+                              "/worlds/threaded_arms.yaml --steps 200 --quiet --threads " +
+                              std::to_string(t) + " --out " + (out / std::to_string(t)).string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+  }
+  for (int k = 0; k < 16; ++k) {
+    const std::string file = "graphs/gripper_arm#" + std::to_string(k) + "/joints.csv";
+    const std::string one = ReadFile(out / "1" / file);
+    ASSERT_FALSE(one.empty()) << file;
+    EXPECT_EQ(one, ReadFile(out / "2" / file)) << file;
+  }
+  // The shoulder swings to 90 degrees and back.
+  double widest = 0;
+  for (const auto& row : ReadCsv(out / "1/graphs/gripper_arm#0/joints.csv").rows)
+    widest = std::max(widest, row[1]);
+  EXPECT_NEAR(widest, M_PI / 2, 0.01);
+}
+
+}  // namespace
