@@ -13,6 +13,7 @@
 #include <iostream>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "framework/error.h"
@@ -159,9 +160,12 @@ void PlotCommands(const Series& s, const fs::path& csv, const fs::path& png, std
   }
 }
 
-// Runs `gnuplot script` with its messages into `log`. Returns "" on
-// success, else why not.
-std::string RunGnuplot(const fs::path& script, const fs::path& log) {
+// "gnuplot not found" in the words the user needs.
+constexpr const char* kNoGnuplot = "gnuplot not found; install gnuplot-nox (tools/setup.sh)";
+
+// Starts `gnuplot script` with its messages into `log`. Returns "" and sets
+// *pid, or says why it could not.
+std::string StartGnuplot(const fs::path& script, const fs::path& log, pid_t* pid) {
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
@@ -170,16 +174,19 @@ std::string RunGnuplot(const fs::path& script, const fs::path& log) {
   std::string script_arg = script.string();
   char gnuplot[] = "gnuplot";
   char* argv[] = {gnuplot, script_arg.data(), nullptr};
-  pid_t pid = 0;
-  const int error = posix_spawnp(&pid, "gnuplot", &actions, nullptr, argv, environ);
+  const int error = posix_spawnp(pid, "gnuplot", &actions, nullptr, argv, environ);
   posix_spawn_file_actions_destroy(&actions);
-  if (error == ENOENT) return "gnuplot not found; install gnuplot-nox (tools/setup.sh)";
+  if (error == ENOENT) return kNoGnuplot;
   if (error != 0) return std::string("cannot run gnuplot: ") + std::strerror(error);
+  return "";
+}
+
+// Waits for a gnuplot StartGnuplot started: "" if it succeeded, else why not.
+std::string FinishGnuplot(pid_t pid, const fs::path& log) {
   int status = 0;
   while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
   }
-  if (WIFEXITED(status) && WEXITSTATUS(status) == 127)
-    return "gnuplot not found; install gnuplot-nox (tools/setup.sh)";
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 127) return kNoGnuplot;
   if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return "";
   // Its first lines say what went wrong.
   std::ifstream in(log);
@@ -201,9 +208,13 @@ void GraphModule::WriteOutputs(const fs::path& dir) const {
   std::error_code ec;
   fs::create_directories(folder, ec);
   if (ec) throw Error("cannot create '" + folder.string() + "': " + ec.message());
-  // The CSV files, and the plots of the first kMaxPngs graphs that want one.
-  std::ostringstream script;
-  script << "set terminal pngcairo size 900,600 noenhanced font 'sans,10'\n";
+  // The CSV files, and the plots of the first kMaxPngs graphs that want one:
+  // a gnuplot per core (at most 4), 25 plots each at least.
+  const size_t processes = std::clamp<size_t>(
+      std::min<size_t>(std::thread::hardware_concurrency(), (series_.size() + 24) / 25), 1, 4);
+  std::vector<std::ostringstream> scripts(processes);
+  for (std::ostringstream& script : scripts)
+    script << "set terminal pngcairo size 900,600 noenhanced font 'sans,10'\n";
   std::vector<size_t> plotted;
   int over_cap = 0;
   std::vector<std::string> descriptions(series_.size());
@@ -239,7 +250,9 @@ void GraphModule::WriteOutputs(const fs::path& dir) const {
       ++over_cap;
       continue;
     }
-    PlotCommands(s, csv, folder / (s.file + ".png"), script);
+    const fs::path png = folder / (s.file + ".png");
+    fs::remove(png, ec);  // a PNG of an earlier run in the same folder is not this one's
+    PlotCommands(s, csv, png, scripts[plotted.size() % processes]);
     plotted.push_back(k);
   }
   if (over_cap > 0)
@@ -247,16 +260,30 @@ void GraphModule::WriteOutputs(const fs::path& dir) const {
               << over_cap << " more have their CSV file alone (png: false on a model's graph "
               << "avoids this note)\n";
   if (plotted.empty()) return;
-  // One gnuplot process draws them all.
-  const fs::path gp = folder / ".plot.gp", log = folder / ".gnuplot.log";
-  {
+  // The gnuplot processes draw them, concurrently.
+  std::vector<fs::path> files;  // scripts and logs, removed afterwards
+  std::vector<pid_t> pids;
+  std::string failure;
+  for (size_t p = 0; p < processes && p < plotted.size() && failure.empty(); ++p) {
+    const fs::path gp = folder / (".plot" + std::to_string(p) + ".gp");
+    const fs::path log = folder / (".plot" + std::to_string(p) + ".log");
+    files.push_back(gp);
+    files.push_back(log);
     std::ofstream f(gp);
-    f << script.str();
-    if (!f.flush()) throw Error("cannot write '" + gp.string() + "'");
+    f << scripts[p].str();
+    if (!f.flush()) {
+      failure = "cannot write '" + gp.string() + "'";
+      break;
+    }
+    pid_t pid = 0;
+    failure = StartGnuplot(gp, log, &pid);
+    if (failure.empty()) pids.push_back(pid);
   }
-  const std::string failure = RunGnuplot(gp, log);
-  fs::remove(gp, ec);
-  fs::remove(log, ec);
+  for (size_t p = 0; p < pids.size(); ++p) {
+    const std::string why = FinishGnuplot(pids[p], files[2 * p + 1]);
+    if (failure.empty()) failure = why;
+  }
+  for (const fs::path& file : files) fs::remove(file, ec);
   int missing = 0;
   for (size_t k : plotted) {
     const Series& s = *series_[k];
