@@ -41,6 +41,7 @@ TEST(GraphsTest, WorldsReadmeDocumentsEveryKey) {
     EXPECT_NE(text.find(std::string("| `") + kind + "`"), std::string::npos) << kind;
   EXPECT_NE(text.find("sim.setGraphStreamValue(h, name, value)"), std::string::npos);
   EXPECT_NE(text.find("sim.addGraphStream(h, name)"), std::string::npos);
+  EXPECT_NE(text.find("sim.getGraphStreamValues(h, stream [, count])"), std::string::npos);
   // Every world gets the module (it samples after the others in the record phase).
   const ModuleDescriptor* module = registry.FindModule("graphs");
   ASSERT_NE(module, nullptr);

@@ -183,11 +183,18 @@ TEST(GraphsRunTest, ScriptStreamsDistancesAndCopiesAtRunTime) {
       "    local step = math.floor(t * 10 + 0.5)\n"
       "    if step == 5 then sim.copyModel(self) end\n"
       "    if step == 10 then sim.removeModel(sim.getObject('/bot#2')) end\n"
+      "    if step == 10 then\n"
+      "      local t, v = sim.getGraphStreamValues(g, 'twice', 3)\n"
+      "      print(string.format('read %d %.1f %.1f', #t, t[1], v[3]))\n"
+      "    end\n"
       "  end\n"
       "end\n");
   const auto r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 20 --quiet --out " +
                             (dir / "out").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
+  // sim.getGraphStreamValues at step 10 read the last 3 samples (the
+  // steps ending at 0.8, 0.9 and 1.0 s; 'twice' was 2 t at their sensing).
+  EXPECT_NE(r.output.find("[bot#0] read 3 0.8 1.8"), std::string::npos) << r.output;
   // A value set in a step is the sample of that step; unset: nan.
   const Csv g0 = ReadCsv(dir / "out/graphs/bot#0/g.csv");
   ASSERT_EQ(g0.rows.size(), 21u);
