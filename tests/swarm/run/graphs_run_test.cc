@@ -18,6 +18,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using swarmsim::testing::FreshTempDir;
+using swarmsim::testing::ReadFile;
 using swarmsim::testing::RunProgram;
 
 struct Csv {
@@ -45,13 +46,6 @@ Csv ReadCsv(const fs::path& file) {
     csv.rows.push_back(row);
   }
   return csv;
-}
-
-std::string ReadFile(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
 }
 
 std::string HashOf(const std::string& output) {
