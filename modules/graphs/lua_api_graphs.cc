@@ -76,6 +76,7 @@ int SetGraphStreamValue(lua_State* L) {
   if (c.instance >= 0 && c.scene->instance_of(id) != c.instance)
     throw Error("a robot's script may set only its own graphs' streams ('" + c.scene->PathOf(id) +
                 "' belongs to another robot or to the scene)");
+  if (g.script_values.size() != g.streams.size()) g.script_values.assign(g.streams.size(), NAN);
   g.script_values[i] = value;
   return 0;
 }

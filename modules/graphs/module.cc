@@ -162,6 +162,8 @@ void GraphModule::Sample(Scene* scene, Series* series, double time) {
   Series& s = *series;
   auto& rows = static_cast<Rows<GraphRow>&>(*scene->rows(type_));
   GraphRow& row = rows.rows[s.row];
+  if (row.script_values.size() != s.settings.streams.size())  // a row not read from a file
+    row.script_values.assign(s.settings.streams.size(), NAN);
   const size_t width = s.width();
   const size_t capacity = static_cast<size_t>(s.settings.buffer);
   double* out = nullptr;
