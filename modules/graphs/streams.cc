@@ -23,11 +23,11 @@ struct KindInfo {
 };
 
 constexpr KindInfo kKinds[] = {
-    {"position", StreamKind::kPosition, true, false, "m", "position ./body x"},
-    {"orientation", StreamKind::kOrientation, true, true, "rad", "orientation ./body yaw"},
-    {"velocity", StreamKind::kVelocity, true, false, "m/s", "velocity ./body x"},
+    {"position", StreamKind::kPosition, true, false, "m", "position :/body x"},
+    {"orientation", StreamKind::kOrientation, true, true, "rad", "orientation :/body yaw"},
+    {"velocity", StreamKind::kVelocity, true, false, "m/s", "velocity :/body x"},
     {"angular_velocity", StreamKind::kAngularVelocity, true, false, "rad/s",
-     "angular_velocity ./body z"},
+     "angular_velocity :/body z"},
     {"joint", StreamKind::kJoint, false, false, "rad or m", "joint :/hip"},
     {"joint_velocity", StreamKind::kJointVelocity, false, false, "rad/s or m/s",
      "joint_velocity :/hip"},
@@ -73,19 +73,21 @@ std::string Quoted(std::string_view text) {
 }  // namespace
 
 void ParseStream(std::string_view text, std::vector<StreamSpec>* out) {
-  std::vector<std::string> words = Words(text);
   const std::string what = "stream " + Quoted(text);
-  // An explicit name: "height = position :/body z".
+  // An explicit name: "height = position :/body z" (one word before '=').
   std::string name;
-  if (words.size() >= 2 && words[1] == "=") {
-    name = words[0];
-    words.erase(words.begin(), words.begin() + 2);
-  } else if (!words.empty() && words[0].size() > 1 && words[0].back() == '=') {
-    name = words[0].substr(0, words[0].size() - 1);  // "height= position ..."
-    words.erase(words.begin());
+  std::string_view rest = text;
+  if (const size_t eq = text.find('='); eq != std::string_view::npos) {
+    const std::vector<std::string> before = Words(text.substr(0, eq));
+    rest = text.substr(eq + 1);
+    if (before.size() != 1 || rest.find('=') != std::string_view::npos)
+      throw Error(what +
+                  ": a stream's name is one word before one '=' (\"hip_yaw = joint :/hip\")");
+    name = before[0];
   }
-  if (name.find_first_of(",\"=") != std::string::npos)
-    throw Error(what + ": a stream name may not hold ',', '\"' or '='");
+  if (name.find_first_of(",\"") != std::string::npos)
+    throw Error(what + ": a stream's name may not hold ',' or '\"'");
+  std::vector<std::string> words = Words(rest);
   if (words.empty())
     throw Error(what + ": expected '[NAME =] KIND [PATH] [COMPONENT]', such as " +
                 Quoted(kKinds[0].example) + " or 'speed = script'");
@@ -95,9 +97,13 @@ void ParseStream(std::string_view text, std::vector<StreamSpec>* out) {
   if (kind == nullptr) {
     std::vector<std::string> names;
     for (const KindInfo& k : kKinds) names.emplace_back(k.name);
-    throw Error(what + ": unknown stream kind " + Quoted(words[0]) + Suggest(words[0], names) +
-                " (kinds: position, orientation, velocity, angular_velocity, joint, "
-                "joint_velocity, proximity, force, torque, distance, script)");
+    std::string hint = Suggest(words[0], names);
+    if (hint.find("did you mean") != std::string::npos) {
+      hint += " (kinds: ";
+      for (size_t i = 0; i < names.size(); ++i) hint += (i ? ", " : "") + names[i];
+      hint += ")";
+    }
+    throw Error(what + ": unknown stream kind " + Quoted(words[0]) + hint);
   }
   const std::string usage = " (for example " + Quoted(kind->example) + ")";
 
