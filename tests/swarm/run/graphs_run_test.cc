@@ -216,6 +216,38 @@ TEST(GraphsRunTest, ScriptStreamsDistancesAndCopiesAtRunTime) {
     EXPECT_NEAR(gap.rows[i - 1][1] - gap.rows[i][1], 0.02, 1e-6) << i;
 }
 
+// A proximity stream holds the sensor's reading of the step (what the
+// script read in its sensing), nan when nothing is in range (the copies
+// face random headings: some rays meet the wall, some do not).
+TEST(GraphsRunTest, ProximityStreamHoldsTheSensorsReading) {
+  const fs::path dir = BotWorld(
+      "proximity",
+      "    - {name: front, type: proximity_sensor, range: 20, orientation_deg: [0, 90, 0]}\n"
+      "    - {name: g, type: graph, streams: [\"proximity :/front\"]}\n",
+      "obstacles:\n"
+      "  - {name: wall, shape: box, size: [0.1, 20, 1], position: [10, 0, 0.5]}\n",
+      "function sysCall_sensing()\n"
+      "  local r, d = sim.readProximitySensor(sim.getObject('./front'))\n"
+      "  sim.recordMetric('front', r == 1 and d or -1)\n"
+      "end\n");
+  const auto r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 10 --quiet --out " +
+                            (dir / "out").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  int compared = 0;
+  for (const auto& m : swarmsim::testing::ReadMetricsCsv(dir / "out/metrics.csv")) {
+    if (m.metric != "front") continue;
+    const Csv g = ReadCsv(dir / "out/graphs" / m.robot / "g.csv");
+    ASSERT_EQ(g.rows.size(), 11u);
+    const double sampled = g.rows.at(m.step + 1)[1];
+    if (m.value < 0)
+      EXPECT_TRUE(std::isnan(sampled)) << m.robot << " step " << m.step;
+    else
+      EXPECT_NEAR(m.value, sampled, 1e-8) << m.robot << " step " << m.step;  // 10 digits
+    ++compared;
+  }
+  EXPECT_EQ(compared, 30);
+}
+
 TEST(GraphsRunTest, SameFilesAndHashAtOneAndTwoThreads) {
   const fs::path dir = BotWorld(
       "threads",
