@@ -248,6 +248,35 @@ TEST(GraphsRunTest, ProximityStreamHoldsTheSensorsReading) {
   EXPECT_EQ(compared, 30);
 }
 
+// A force stream holds the force sensor's reading: a 2 kg load hanging
+// from it pulls with its weight; a velocity stream the falling-free load's.
+TEST(GraphsRunTest, ForceStreamHoldsTheLoadsWeight) {
+  const fs::path dir = FreshTempDir("swarmsim_graphs", "force");
+  fs::create_directories(dir);
+  std::ofstream(dir / "hanger.yaml")
+      << "model: hanger\n"
+         "objects:\n"
+         "  {type: shape, shape: box, size: [0.2, 0.2, 0.05], children: [\n"
+         "    {name: hook, type: force_sensor, position: [0, 0, -0.05], children: [\n"
+         "      {name: load, type: shape, shape: sphere, radius: 0.05, dynamic: true, mass: 2,\n"
+         "       position: [0, 0, -0.25]}]},\n"
+         "    {name: g, type: graph, streams: [\"f = force :/hook\", \"speed = velocity :/load "
+         "norm\"]}]}\n";
+  std::ofstream(dir / "world.yaml")
+      << "simulation: {physics: ode, time_step: 0.01, physics_substeps: 2}\n"
+         "models: [{model: hanger.yaml, position: [0, 0, 2]}]\n";
+  const auto r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 50 --quiet --out " +
+                            (dir / "out").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const Csv g = ReadCsv(dir / "out/graphs/hanger#0/g.csv");
+  ASSERT_EQ(g.header, (std::vector<std::string>{"time", "f.x", "f.y", "f.z", "speed"}));
+  ASSERT_EQ(g.rows.size(), 51u);
+  EXPECT_TRUE(std::isnan(g.rows[0][3]));  // no reading before the first physics step
+  const std::vector<double>& last = g.rows.back();
+  EXPECT_NEAR(std::hypot(last[1], last[2], last[3]), 2 * 9.81, 0.2);
+  EXPECT_NEAR(last[4], 0, 1e-3);  // held still
+}
+
 TEST(GraphsRunTest, SameFilesAndHashAtOneAndTwoThreads) {
   const fs::path dir = BotWorld(
       "threads",
