@@ -6,6 +6,7 @@
 #include "modules/dynamics/box2d/box2d_backend.h"
 #include "modules/dynamics/kinematic/kinematic_backend.h"
 #include "modules/dynamics/ode/ode_backend.h"
+#include "modules/graphs/graphs.h"
 #include "modules/kinematics/ik_groups.h"
 #include "modules/metrics/swarm_metrics.h"
 #include "modules/mill/mill.h"
@@ -43,6 +44,7 @@ void RegisterBuiltinModules(ModuleRegistry* registry) {
   collision::Register(registry);
   mill::Register(registry);
   rendering::RegisterObjects(registry);
+  graphs::Register(registry);
 }
 
 }  // namespace swarmsim
