@@ -6,12 +6,14 @@
 #include "modules/dynamics/box2d/box2d_backend.h"
 #include "modules/dynamics/kinematic/kinematic_backend.h"
 #include "modules/dynamics/ode/ode_backend.h"
+#include "modules/graphs/graphs.h"
 #include "modules/kinematics/ik_groups.h"
 #include "modules/metrics/swarm_metrics.h"
 #include "modules/mill/mill.h"
 #include "modules/paint/paint_layer.h"
 #include "modules/proximity/proximity.h"
 #include "modules/rendering/filters/filters.h"
+#include "modules/rendering/objects.h"
 
 namespace swarmsim {
 
@@ -42,6 +44,8 @@ void RegisterBuiltinModules(ModuleRegistry* registry) {
     registry->RegisterModule(std::move(metric));
   collision::Register(registry);
   mill::Register(registry);
+  rendering::RegisterObjects(registry);
+  graphs::Register(registry);
   filters::Register(registry);
 }
 

@@ -4,7 +4,7 @@
 -- is switched to dynamic when released, so it falls onto the table.
 -- Waypoints are in the arm base's frame; the tool keeps its start orientation.
 
-local base, target, tip, box
+local base, target, tip, box, task
 local start            -- tool position at start
 local orientation      -- tool orientation (quaternion x, y, z, w) kept throughout
 local grasp_offset     -- box position in the tool frame while carried
@@ -23,6 +23,7 @@ function sysCall_init()
   target = sim.getObject('./target')
   tip = sim.getObject('./tip')
   box = sim.getObject('/box')     -- a scene object of the world file
+  task = sim.getObject('./task')  -- the model's graph of the task state
   local pose = sim.getObjectPose(tip, base)
   start = {pose[1], pose[2], pose[3]}
   orientation = {pose[4], pose[5], pose[6], pose[7]}
@@ -78,4 +79,6 @@ function sysCall_actuation()
     -- Carried: the box follows the tool (kinematically), orientation unchanged.
     sim.setObjectPosition(box, grasp_offset, tip)
   end
+  sim.setGraphStreamValue(task, 'segment', math.min(segment, #segments + 1))
+  sim.setGraphStreamValue(task, 'carried', grasp_offset and 1 or 0)
 end

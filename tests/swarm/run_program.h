@@ -36,6 +36,14 @@ inline CommandResult RunProgram(const std::string& args) {
   return RunCommand(std::string(SWARMSIM_BINARY) + " " + args);
 }
 
+// A file's bytes ("" if it cannot be read).
+inline std::string ReadFile(const std::filesystem::path& path) {
+  std::ifstream f(path, std::ios::binary);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
 // tests/data/cli/NAME in the source tree.
 inline std::string CliData(const std::string& name) {
   return std::string(SWARMSIM_SOURCE_DIR) + "/tests/data/cli/" + name;

@@ -45,13 +45,14 @@ TEST(CliTest, HelpVersionAndModules) {
   // Every object type and every registered module has its line: kind, name,
   // version, one line of description.
   for (const char* line : {"object type\tforce_sensor\tbuilt-in\t", "calculation\tik\t",
-                           "record\tpaint\t", "metric\tcovered_area\t"})
+                           "record\tpaint\t", "record\tgraphs\t", "metric\tcovered_area\t"})
     EXPECT_NE(modules.output.find(line), std::string::npos) << line << "\n" << modules.output;
   // describe names the modules a world gets: every world's, then its own.
   Result describe =
       RunProgram("describe " + std::string(SWARMSIM_SOURCE_DIR) + "/worlds/hexapod.yaml");
   EXPECT_EQ(describe.exit_code, 0) << describe.output;
-  EXPECT_NE(describe.output.find("modules: ik paint proximity collision mill\n"), std::string::npos)
+  EXPECT_NE(describe.output.find("modules: ik paint proximity collision mill rendering graphs\n"),
+            std::string::npos)
       << describe.output;
 }
 

@@ -24,19 +24,13 @@ namespace {
 
 namespace fs = std::filesystem;
 using swarmsim::testing::ProbeWorld;
+using swarmsim::testing::ReadFile;
 using swarmsim::testing::RunProgram;
 
 std::string Data(const std::string& name) { return swarmsim::testing::CliData(name); }
 
 fs::path TempDir(const std::string& name) {
   return swarmsim::testing::FreshTempDir("swarmsim_outputs", name);
-}
-
-std::string ReadFile(const fs::path& path) {
-  std::ifstream f(path);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
 }
 
 std::vector<std::string> Lines(const std::string& text) {

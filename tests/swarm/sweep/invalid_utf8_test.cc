@@ -20,16 +20,10 @@ namespace {
 namespace fs = std::filesystem;
 using testing::FreshTempDir;
 using testing::ProbeWorld;
+using testing::ReadFile;
 using testing::RunProgram;
 
 constexpr const char* kReplacement = "\xEF\xBF\xBD";  // U+FFFD
-
-std::string ReadFile(const fs::path& path) {
-  std::ifstream f(path, std::ios::binary);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
 
 // summary.json parsed; fails the test if it does not parse.
 nlohmann::json Summary(const fs::path& out) {
