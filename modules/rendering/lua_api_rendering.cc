@@ -4,8 +4,9 @@
 //   sim.getVisionSensorDepth(h) -> {d, ...} (m along the view axis; far where
 //     nothing), {width, height}
 //   sim.getVisionSensorRes(h) -> {width, height}
-//   sim.readVisionSensor(h) -> result, packet1 (CoppeliaSim's 15 values: min,
-//     max and average of intensity, red, green, blue and depth), ...
+//   sim.readVisionSensor(h) -> result, packet1 (CoppeliaSim's 15 values: the
+//     min of intensity, red, green, blue and depth, then their max, then
+//     their mean), then one packet per filter element that outputs values
 //   sim.setShapeColor(h, {r, g, b}) (or CoppeliaSim's (h, nil, 0, {r, g, b})),
 //   sim.getShapeColor(h) -> {r, g, b}
 //   sim.setLightOn(h, on), sim.getLightOn(h), sim.setLightColor(h, {r, g, b})
@@ -16,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "framework/error.h"
 #include "framework/lua_api.h"
@@ -105,47 +107,28 @@ int GetVisionSensorRes(lua_State* L) {
   return 1;
 }
 
-// CoppeliaSim's first packet: min, max, average of intensity, red, green,
-// blue, depth (0..1 as CoppeliaSim; depth normalised to near..far).
-void PushPacket1(lua_State* L, const VisionSensorRow& s) {
-  const Image& image = s.image;
-  double lo[5], hi[5], sum[5];
-  std::fill(lo, lo + 5, INFINITY);
-  std::fill(hi, hi + 5, -INFINITY);
-  std::fill(sum, sum + 5, 0.0);
-  const size_t n = static_cast<size_t>(image.width) * static_cast<size_t>(image.height);
-  for (size_t i = 0; i < n; ++i) {
-    const double r = image.rgb[3 * i] / 255.0, g = image.rgb[3 * i + 1] / 255.0,
-                 b = image.rgb[3 * i + 2] / 255.0;
-    const double d =
-        image.depth.empty() ? 1.0 : (image.depth[i] - s.lens.near) / (s.lens.far - s.lens.near);
-    const double v[5] = {(r + g + b) / 3, r, g, b, d};
-    for (int k = 0; k < 5; ++k) {
-      lo[k] = std::min(lo[k], v[k]);
-      hi[k] = std::max(hi[k], v[k]);
-      sum[k] += v[k];
-    }
-  }
-  lua_createtable(L, 15, 0);
-  int index = 1;
-  for (int k = 0; k < 5; ++k) {
-    const double values[3] = {lo[k], hi[k], n > 0 ? sum[k] / static_cast<double>(n) : 0};
-    for (double v : values) {
-      lua_pushnumber(L, n > 0 ? v : 0);
-      lua_rawseti(L, -2, index++);
-    }
-  }
-}
-
+// result (-1 before the first image; with a filter chain 1 when it
+// triggered, else 0), then CoppeliaSim's first packet (min of intensity,
+// red, green, blue and depth, then their max, then their mean; 0..1, depth
+// from near to far) and the packet of each chain element that outputs values.
 int ReadVisionSensor(lua_State* L) {
   const VisionSensorRow& s = SensorOf(L);
   if (s.rendered_step < 0) {
     lua_pushinteger(L, -1);
     return 1;
   }
-  lua_pushinteger(L, 0);
-  PushPacket1(L, s);
-  return 2;
+  if (s.filters.empty()) {
+    lua_pushinteger(L, 0);
+    const std::vector<double> packet = filters::ImageStatistics(s.image, CameraModelOf(s.lens));
+    PushNumberArray(L, packet.data(), static_cast<int>(packet.size()));
+    return 2;
+  }
+  const std::vector<std::vector<double>>& packets = s.reading.packets;
+  luaL_checkstack(L, static_cast<int>(packets.size()) + 1, "sim.readVisionSensor");
+  lua_pushinteger(L, s.reading.triggered ? 1 : 0);
+  for (const std::vector<double>& packet : packets)
+    PushNumberArray(L, packet.data(), static_cast<int>(packet.size()));
+  return 1 + static_cast<int>(packets.size());
 }
 
 int SetShapeColor(lua_State* L) {

@@ -45,6 +45,8 @@ constexpr ObjectKey kVisionSensorKeys[] = {
      "only the shapes (and LEDs) of this collection or object subtree are seen (a path)"},
     {"background", "[0, 0, 0]", "RGB, each 0..1: where nothing is seen"},
     {"floor", "true", "the floor (and the paint layer on it) is seen"},
+    {"filters", "none",
+     "a filter chain run on each image: a list of elements (see vision sensor filters)"},
 };
 
 constexpr ObjectKey kLightKeys[] = {
@@ -101,6 +103,12 @@ void ReadVisionSensor(const ObjectTypeDescriptor&, const ObjectReader& r, void* 
   }
   if (r.Has("background")) v.background = r.Vector3("background", kFraction);
   if (r.Has("floor")) v.floor = r.Bool("floor");
+  v.filters = filters::ParseFilterChain(r, "filters", r.registry());
+  if (v.filters.needs_depth()) {
+    if (r.Has("depth") && !v.depth)
+      r.Fail("depth", "the filter chain reads the depth image ('depth'): remove 'depth: false'");
+    v.depth = true;
+  }
 }
 
 void ReadLight(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
@@ -142,6 +150,7 @@ void CopyVisionSensor(const void* source, void* row) {
   to.where = from.where;
   to.background = from.background;
   to.floor = from.floor;
+  to.filters = from.filters;
 }
 
 void CheckVisionSensor(const Scene& scene, ObjectId id, const void* row) {

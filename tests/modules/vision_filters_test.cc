@@ -183,6 +183,7 @@ TEST(VisionFiltersTest, HsvThresholdPicksThePixelsInItsRanges) {
       {{255, 0, 40}, false, true},      // hue ~351
       {{255, 60, 0}, false, true},      // hue ~14
       {{128, 128, 128}, false, false},  // grey
+      {{0, 0, 0}, false, false},        // black: saturation 0, not 1
   };
   const int n = static_cast<int>(std::size(cases));
   Image image;

@@ -294,6 +294,12 @@ void FilterChain::Run(const Image& image, const CameraModel& camera, FilterOutpu
   ToRgb(run.work, camera, &out->image);
 }
 
+std::vector<double> ImageStatistics(const Image& image, const CameraModel& camera) {
+  std::vector<double> packet;
+  Statistics(image, camera, &packet);
+  return packet;
+}
+
 Vec3 ImageToSensor(const CameraModel& camera, int width, int height, double x, double y,
                    double depth) {
   return Projection(camera, width, height).Point(x, y, depth);

@@ -102,6 +102,10 @@ FilterChain ParseFilterChain(const ObjectReader& reader, std::string_view key,
 Vec3 ImageToSensor(const CameraModel& camera, int width, int height, double x, double y,
                    double depth);
 
+// Packet 1 alone (what Run puts first): CoppeliaSim's 15 statistics of
+// `image`, for a sensor without a chain.
+std::vector<double> ImageStatistics(const Image& image, const CameraModel& camera);
+
 // Registers the built-in elements (modules/builtin.cc).
 void Register(ModuleRegistry* registry);
 
