@@ -117,18 +117,16 @@ int ReadVisionSensor(lua_State* L) {
     lua_pushinteger(L, -1);
     return 1;
   }
-  if (s.filters.empty()) {
-    lua_pushinteger(L, 0);
-    const std::vector<double> packet = filters::ImageStatistics(s.image, CameraModelOf(s.lens));
-    PushNumberArray(L, packet.data(), static_cast<int>(packet.size()));
-    return 2;
-  }
+  // Packet 1 from the image (the chain leaves it to the reader), then the chain's.
   const std::vector<std::vector<double>>& packets = s.reading.packets;
-  luaL_checkstack(L, static_cast<int>(packets.size()) + 1, "sim.readVisionSensor");
-  lua_pushinteger(L, s.reading.triggered ? 1 : 0);
-  for (const std::vector<double>& packet : packets)
-    PushNumberArray(L, packet.data(), static_cast<int>(packet.size()));
-  return 1 + static_cast<int>(packets.size());
+  const size_t count = s.filters.empty() ? 1 : packets.size();
+  luaL_checkstack(L, static_cast<int>(count) + 1, "sim.readVisionSensor");
+  lua_pushinteger(L, !s.filters.empty() && s.reading.triggered ? 1 : 0);
+  const std::vector<double> packet1 = filters::ImageStatistics(s.image, CameraModelOf(s.lens));
+  PushNumberArray(L, packet1.data(), static_cast<int>(packet1.size()));
+  for (size_t k = 1; k < count; ++k)
+    PushNumberArray(L, packets[k].data(), static_cast<int>(packets[k].size()));
+  return 1 + static_cast<int>(count);
 }
 
 int SetShapeColor(lua_State* L) {

@@ -111,7 +111,9 @@ void RenderingModule::RenderDue(World* world, bool all) {
           options.floor = s.floor;
           options.background = s.background;
           Draw(*list_of[i], ViewOf(scene, sensors->owners[r], s.lens, s.depth), options, &s.image);
-          if (!s.filters.empty()) s.filters.Run(s.image, CameraModelOf(s.lens), &s.reading);
+          // Packet 1 is computed when a script reads it.
+          if (!s.filters.empty())
+            s.filters.Run(s.image, CameraModelOf(s.lens), &s.reading, /*statistics=*/false);
           s.rendered_step = step;
         }
       });

@@ -361,6 +361,12 @@ TEST(VisionFiltersTest, StatisticsPacketIsMinMaxMeanOfIntensityChannelsAndDepth)
                                         0.3,
                                         0.25};  // mean
   for (size_t i = 0; i < 15; ++i) EXPECT_NEAR(p[i], expected[i], 1e-12) << i;
+  // Left to the reader: the same numbers from ImageStatistics.
+  FilterOutput later;
+  Chain({{"grayscale", {}}}).Run(image, camera, &later, /*statistics=*/false);
+  ASSERT_EQ(later.packets.size(), 1u);
+  EXPECT_TRUE(later.packets[0].empty());
+  EXPECT_EQ(ImageStatistics(image, camera), p);
   // An empty image: zeros, no element runs.
   const FilterOutput empty =
       Chain({{"resize", {{"width", {4}}, {"height", {4}}}}}).Run(Image{}, camera);

@@ -270,14 +270,19 @@ FilterOutput FilterChain::Run(const Image& image, const CameraModel& camera) con
   return out;
 }
 
-void FilterChain::Run(const Image& image, const CameraModel& camera, FilterOutput* out) const {
+void FilterChain::Run(const Image& image, const CameraModel& camera, FilterOutput* out,
+                      bool statistics) const {
   SWARMSIM_CHECK(image.width >= 0 && image.height >= 0 &&
                      image.rgb.size() ==
                          static_cast<size_t>(image.width) * static_cast<size_t>(image.height) * 3,
                  "a filter chain's image has " + std::to_string(image.rgb.size()) + " bytes for " +
                      std::to_string(image.width) + "x" + std::to_string(image.height) + " pixels");
   if (out->packets.empty()) out->packets.emplace_back();
-  Statistics(image, camera, &out->packets[0]);
+  if (statistics) {
+    Statistics(image, camera, &out->packets[0]);
+  } else {
+    out->packets[0].clear();
+  }
   out->blobs.clear();
   out->points.clear();
   out->triggered = false;
