@@ -69,6 +69,16 @@ class ObjectReader {
                                                    const Vec3& scale) const = 0;
   // The world's registry (plugin sensor types), or null.
   virtual const ModuleRegistry* registry() const = 0;
+  // A list of maps (`filters: [{type: grayscale}, {type: blobs, min_pixels: 4}]`):
+  // a reader for each map, in order, whose messages name the item
+  // ("filters[1] of object 'cam'") and its own file:line:column; none when
+  // the key is absent. An element that is not a map is an error. The
+  // readers live no longer than this one (use them inside `read`).
+  virtual std::vector<std::unique_ptr<ObjectReader>> Items(std::string_view key) const = 0;
+  // An error at the first key of this entry that is not among `known`, with
+  // the nearest known one ("did you mean 'min_pixels'?"). The loader checks
+  // an object's own keys before `read`; an item's are the reader's to check.
+  virtual void Expect(std::span<const std::string> known) const = 0;
 };
 
 // One world-file key of a type: its name, its default as the docs show it,

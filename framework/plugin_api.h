@@ -10,18 +10,19 @@
 // is called from Lua as sim.name(...); and per-phase callbacks, which the
 // world runs at fixed points of each step (SwarmsimPhase); and sensor types
 // (ABI 3), read by scripts with sim.readPluginSensor; and object types (ABI
-// 4) that model files place like built-in ones. Arguments and results are numbers,
-// strings and number arrays (SwarmsimValue); no Lua type crosses this
-// interface. Everything here is plain C, so a plugin built with another
-// compiler works as long as the ABI version matches; the version changes
-// whenever a struct below does.
+// 4) that model files place like built-in ones; and vision-sensor filter
+// elements (ABI 5) that a sensor's `filters:` list names. Arguments and
+// results are numbers, strings and number arrays (SwarmsimValue); no Lua
+// type crosses this interface. Everything here is plain C, so a plugin
+// built with another compiler works as long as the ABI version matches; the
+// version changes whenever a struct below does.
 #ifndef SWARMSIM_PLUGIN_API_H_
 #define SWARMSIM_PLUGIN_API_H_
 
 #include <stddef.h>
 #include <stdint.h>
 
-#define SWARMSIM_PLUGIN_ABI_VERSION 4
+#define SWARMSIM_PLUGIN_ABI_VERSION 5
 
 #ifdef __cplusplus
 extern "C" {
@@ -151,6 +152,36 @@ typedef struct SwarmsimObjectKey {
   const char* doc;  // one line: unit and meaning
 } SwarmsimObjectKey;
 
+// What a vision-sensor filter element takes and gives (ABI 5): bits, so an
+// element may take several kinds.
+enum SwarmsimImageKind {
+  kSwarmsimColourImage = 1,  // RGB, 3 bytes a pixel
+  kSwarmsimGreyImage = 2,    // 1 byte a pixel
+  kSwarmsimMask = 4,         // 1 byte a pixel, 0 or 255
+  kSwarmsimDepthImage = 8,   // 1 float a pixel, metres along the view axis
+  kSwarmsimValues = 16       // numbers only: the image goes no further
+};
+
+// A work image passed to a filter element (ABI 5); rows top to bottom.
+typedef struct SwarmsimImage {
+  int width, height;  // pixels
+  int kind;           // one SwarmsimImageKind
+  uint8_t* pixels;    // colour, grey or mask; else null
+  float* depth;       // depth image; else null
+} SwarmsimImage;
+
+// A plugin's filter element (ABI 5). Reads `input` and writes `output`, an
+// image of the same size whose buffer swarmsim allocated for the element's
+// output kind (both null when it gives values: the chain then goes on with
+// `input` as kind values). `parameters` are the element's key values in the
+// order it declared them. It may write up to max_values numbers (its
+// packet, as sim.readVisionSensor returns it) and returns how many, or -1
+// after writing a message into `error`: the run stops with it. Sensors of
+// different robots run concurrently: keep it thread-safe.
+typedef int (*SwarmsimFilterFunction)(const SwarmsimImage* input, SwarmsimImage* output,
+                                      const double* parameters, double* values, int max_values,
+                                      char* error, size_t error_size, void* user_data);
+
 typedef struct SwarmsimRegistrar {
   void* impl;
   // Registers sim.<name>; returns 0, or -1 if the name is taken or invalid.
@@ -183,6 +214,17 @@ typedef struct SwarmsimRegistrar {
   // function gets max_values. Returns -1 for max_values < 1.
   int (*add_sensor_type_of_size)(void* impl, const char* name, const char* description,
                                  int max_values, SwarmsimSensorFunction sense, void* user_data);
+  // --- ABI 5 ---
+  // Registers the vision-sensor filter element `name`: a sensor's model
+  // entry lists it as {type: NAME, KEY: value, ...}. It takes the kinds
+  // `input_kinds` (SwarmsimImageKind bits) and gives `output_kind` (one
+  // kind; 0: the kind it was given); its keys are numbers (length_power is
+  // ignored: images do not scale). max_values: the numbers its packet holds
+  // at most (0: it outputs none). Returns 0, or -1 for a missing or taken
+  // name, no function, no input kind, or a bad key.
+  int (*add_vision_filter)(void* impl, const char* name, const char* description, int input_kinds,
+                           int output_kind, const SwarmsimObjectKey* keys, int key_count,
+                           int max_values, SwarmsimFilterFunction filter, void* user_data);
 } SwarmsimRegistrar;
 
 // The two entry points a plugin exports.

@@ -2,6 +2,7 @@
 
 #include <dlfcn.h>
 
+#include <cstdio>
 #include <filesystem>
 
 #include "framework/error.h"
@@ -9,6 +10,7 @@
 #include "framework/plugin_api.h"
 #include "framework/plugin_object_type.h"
 #include "framework/registry.h"
+#include "framework/vision_filter.h"
 
 namespace swarmsim {
 namespace {
@@ -20,6 +22,7 @@ struct Registration {
   std::vector<PhaseCallback> callbacks;
   std::vector<PluginSensorType> sensors;
   std::vector<std::shared_ptr<const ObjectTypeDescriptor>> object_types;
+  std::vector<std::shared_ptr<const VisionFilterDescriptor>> vision_filters;
   std::string error;
 };
 
@@ -91,6 +94,46 @@ int AddObjectType(void* impl, const char* name, const char* description,
   return 0;
 }
 
+int AddVisionFilter(void* impl, const char* name, const char* description, int input_kinds,
+                    int output_kind, const SwarmsimObjectKey* keys, int key_count, int max_values,
+                    SwarmsimFilterFunction filter, void* user_data) {
+  auto* r = static_cast<Registration*>(impl);
+  constexpr int kAllKinds = kSwarmsimColourImage | kSwarmsimGreyImage | kSwarmsimMask |
+                            kSwarmsimDepthImage | kSwarmsimValues;
+  const bool one_kind = output_kind == 0 || (output_kind & (output_kind - 1)) == 0;
+  if (name == nullptr || name[0] == 0 || filter == nullptr || (input_kinds & kAllKinds) == 0 ||
+      (input_kinds & ~kAllKinds) != 0 || (output_kind & ~kAllKinds) != 0 || !one_kind ||
+      key_count < 0 || (key_count > 0 && keys == nullptr) || max_values < 0) {
+    r->error =
+        "add_vision_filter needs a name, a function, input kinds and at most one output kind "
+        "(SwarmsimImageKind)";
+    return -1;
+  }
+  auto d = std::make_shared<VisionFilterDescriptor>();
+  d->name = name;
+  d->description = description != nullptr ? description : "";
+  d->input = static_cast<uint32_t>(input_kinds);
+  d->output = static_cast<uint32_t>(output_kind);
+  for (int k = 0; k < key_count; ++k) {
+    const SwarmsimObjectKey& key = keys[k];
+    if (key.name == nullptr || key.name[0] == 0 || key.name == std::string("type") ||
+        !(key.min <= key.default_value && key.default_value <= key.max)) {
+      r->error = "vision filter '" + d->name +
+                 "': a key needs a name other than 'type' and a default within its range";
+      return -1;
+    }
+    char default_text[32];
+    std::snprintf(default_text, sizeof default_text, "%g", key.default_value);
+    d->keys.push_back({key.name, default_text, key.doc != nullptr ? key.doc : "", key.default_value,
+                       key.min, key.max});
+  }
+  d->plugin_function = filter;
+  d->plugin_user_data = user_data;
+  d->plugin_max_values = max_values;
+  r->vision_filters.push_back(std::move(d));
+  return 0;
+}
+
 void SetInfo(void* impl, const char* name, const char* version, const char* description) {
   auto* r = static_cast<Registration*>(impl);
   if (name != nullptr) r->info.name = name;
@@ -123,8 +166,14 @@ void LoadPlugin(const std::string& path, ModuleRegistry* registry) {
   Registration r;
   r.info.name.assign(path);
   r.info.version.assign("unversioned");
-  const SwarmsimRegistrar registrar{
-      &r, AddCommand, SetInfo, AddPhaseCallback, AddSensorType, AddObjectType, AddSensorTypeOfSize};
+  const SwarmsimRegistrar registrar{&r,
+                                    AddCommand,
+                                    SetInfo,
+                                    AddPhaseCallback,
+                                    AddSensorType,
+                                    AddObjectType,
+                                    AddSensorTypeOfSize,
+                                    AddVisionFilter};
   if (do_register(&registrar) != 0 || !r.error.empty()) {
     std::string message = "plugin '" + path + "' failed to register";
     if (!r.error.empty()) message.append(": ").append(r.error);
@@ -161,6 +210,15 @@ void LoadPlugin(const std::string& path, ModuleRegistry* registry) {
   for (std::shared_ptr<const ObjectTypeDescriptor>& type : r.object_types) {
     try {
       registry->RegisterObjectType(std::move(type));
+    } catch (const Error& e) {
+      throw Error("plugin '" + path + "': " + e.what());
+    }
+  }
+  for (std::shared_ptr<const VisionFilterDescriptor>& filter : r.vision_filters) {
+    auto named = std::make_shared<VisionFilterDescriptor>(*filter);
+    named->version = r.info.version;
+    try {
+      registry->RegisterVisionFilter(std::move(named));
     } catch (const Error& e) {
       throw Error("plugin '" + path + "': " + e.what());
     }

@@ -6,6 +6,7 @@
 #include "framework/error.h"
 #include "framework/object_type.h"
 #include "framework/proximity_backend.h"
+#include "framework/vision_filter.h"
 
 namespace swarmsim {
 
@@ -87,6 +88,22 @@ void ModuleRegistry::RegisterObjectType(std::shared_ptr<const ObjectTypeDescript
   modules_.push_back({"object type", name, "", type->description ? type->description : ""});
   object_types_.push_back(type.get());
   owned_object_types_.push_back(std::move(type));
+}
+
+void ModuleRegistry::RegisterVisionFilter(std::shared_ptr<const VisionFilterDescriptor> filter) {
+  if (!filter || filter->name.empty()) throw Error("a vision filter element needs a name");
+  if (!filter->make && filter->plugin_function == nullptr)
+    throw Error("vision filter element '" + filter->name + "' has no way to make it");
+  if (FindVisionFilter(filter->name) != nullptr)
+    throw Error("vision filter element '" + filter->name + "' is registered twice");
+  modules_.push_back({"vision filter", filter->name, filter->version, filter->description});
+  vision_filters_.push_back(std::move(filter));
+}
+
+const VisionFilterDescriptor* ModuleRegistry::FindVisionFilter(std::string_view name) const {
+  for (const auto& f : vision_filters_)
+    if (f->name == name) return f.get();
+  return nullptr;
 }
 
 const PluginSensorType* ModuleRegistry::FindPluginSensor(std::string_view name) const {

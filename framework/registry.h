@@ -21,6 +21,7 @@ class DynamicsBackend;
 class ProximityBackend;
 class Scene;
 struct ObjectTypeDescriptor;
+struct VisionFilterDescriptor;
 
 // A script command registered by a plugin (framework/plugin_api.h): sim.<name>.
 struct ScriptCommand {
@@ -96,6 +97,16 @@ class ModuleRegistry {
   // (built-in names included).
   void RegisterObjectType(std::shared_ptr<const ObjectTypeDescriptor> type);
   std::span<const ObjectTypeDescriptor* const> object_types() const { return object_types_; }
+  // Vision-sensor filter elements (framework/vision_filter.h): kind "vision
+  // filter". The built-in ones (modules/rendering/filters) and plugins'
+  // (add_vision_filter) alike. Throws swarmsim::Error if the name is taken
+  // or the descriptor has neither `make` nor a plugin function.
+  void RegisterVisionFilter(std::shared_ptr<const VisionFilterDescriptor> filter);
+  // Null if no element has that name.
+  const VisionFilterDescriptor* FindVisionFilter(std::string_view name) const;
+  const std::vector<std::shared_ptr<const VisionFilterDescriptor>>& vision_filters() const {
+    return vision_filters_;
+  }
   // Plugins loaded into this registry, by canonical path (LoadPlugin records them).
   void AddPluginPath(std::string path) { plugin_paths_.push_back(std::move(path)); }
   bool HasPlugin(std::string_view path) const;
@@ -126,6 +137,7 @@ class ModuleRegistry {
   std::vector<std::string> plugin_paths_;
   std::vector<std::shared_ptr<const ObjectTypeDescriptor>> owned_object_types_;
   std::vector<const ObjectTypeDescriptor*> object_types_;
+  std::vector<std::shared_ptr<const VisionFilterDescriptor>> vision_filters_;
 };
 
 }  // namespace swarmsim

@@ -1,11 +1,14 @@
 // sim.* vision sensors, shape colours and lights (the Lua area of the
 // vision_sensor and light types):
-//   sim.getVisionSensorImg(h) -> bytes (RGB, rows top to bottom), {width, height}
+//   sim.getVisionSensorImg(h [, 1]) -> bytes (RGB, rows top to bottom: the
+//     filter chain's image, or with 1 the camera's), {width, height}
 //   sim.getVisionSensorDepth(h) -> {d, ...} (m along the view axis; far where
 //     nothing), {width, height}
 //   sim.getVisionSensorRes(h) -> {width, height}
-//   sim.readVisionSensor(h) -> result, packet1 (CoppeliaSim's 15 values: min,
-//     max and average of intensity, red, green, blue and depth), ...
+//   sim.readVisionSensor(h) -> result, packet1 (CoppeliaSim's 15 values:
+//     minima, maxima and means of intensity, red, green, blue and depth),
+//     then a packet per filter element that gives values
+//   sim.getVisionSensorBlobs(h) -> {{pixels, color, x, y, u, v, box, orientation}, ...}
 //   sim.setShapeColor(h, {r, g, b}) (or CoppeliaSim's (h, nil, 0, {r, g, b})),
 //   sim.getShapeColor(h) -> {r, g, b}
 //   sim.setLightOn(h, on), sim.getLightOn(h), sim.setLightColor(h, {r, g, b})
@@ -65,24 +68,29 @@ Vec3 ArgColor(lua_State* L, int arg) {
   return {rgb[0], rgb[1], rgb[2]};
 }
 
-void PushResolution(lua_State* L, const Lens& lens) {
+void PushResolution(lua_State* L, int width, int height) {
   lua_createtable(L, 2, 0);
-  lua_pushinteger(L, lens.width);
+  lua_pushinteger(L, width);
   lua_rawseti(L, -2, 1);
-  lua_pushinteger(L, lens.height);
+  lua_pushinteger(L, height);
   lua_rawseti(L, -2, 2);
 }
+
+void PushResolution(lua_State* L, const Lens& lens) { PushResolution(L, lens.width, lens.height); }
 
 const Image& ImageOf(const VisionSensorRow& s) {
   if (s.rendered_step < 0) throw Error("the vision sensor has not rendered an image yet");
   return s.image;
 }
 
+// The filtered image when the sensor has a chain (CoppeliaSim's), else the
+// camera's; sim.getVisionSensorImg(h, 1): always the camera's.
 int GetVisionSensorImg(lua_State* L) {
   const VisionSensorRow& s = SensorOf(L);
-  const Image& image = ImageOf(s);
+  const bool raw = !lua_isnoneornil(L, 2) && ArgInteger(L, 2) == 1;
+  const Image& image = raw || s.filters.empty() ? ImageOf(s) : (ImageOf(s), s.output.image);
   lua_pushlstring(L, reinterpret_cast<const char*>(image.rgb.data()), image.rgb.size());
-  PushResolution(L, s.lens);
+  PushResolution(L, image.width, image.height);
   return 2;
 }
 
@@ -105,47 +113,60 @@ int GetVisionSensorRes(lua_State* L) {
   return 1;
 }
 
-// CoppeliaSim's first packet: min, max, average of intensity, red, green,
-// blue, depth (0..1 as CoppeliaSim; depth normalised to near..far).
-void PushPacket1(lua_State* L, const VisionSensorRow& s) {
-  const Image& image = s.image;
-  double lo[5], hi[5], sum[5];
-  std::fill(lo, lo + 5, INFINITY);
-  std::fill(hi, hi + 5, -INFINITY);
-  std::fill(sum, sum + 5, 0.0);
-  const size_t n = static_cast<size_t>(image.width) * static_cast<size_t>(image.height);
-  for (size_t i = 0; i < n; ++i) {
-    const double r = image.rgb[3 * i] / 255.0, g = image.rgb[3 * i + 1] / 255.0,
-                 b = image.rgb[3 * i + 2] / 255.0;
-    const double d =
-        image.depth.empty() ? 1.0 : (image.depth[i] - s.lens.near) / (s.lens.far - s.lens.near);
-    const double v[5] = {(r + g + b) / 3, r, g, b, d};
-    for (int k = 0; k < 5; ++k) {
-      lo[k] = std::min(lo[k], v[k]);
-      hi[k] = std::max(hi[k], v[k]);
-      sum[k] += v[k];
-    }
-  }
-  lua_createtable(L, 15, 0);
-  int index = 1;
-  for (int k = 0; k < 5; ++k) {
-    const double values[3] = {lo[k], hi[k], n > 0 ? sum[k] / static_cast<double>(n) : 0};
-    for (double v : values) {
-      lua_pushnumber(L, n > 0 ? v : 0);
-      lua_rawseti(L, -2, index++);
-    }
-  }
+// The chain's output: the sensor's own when its chain has elements, else
+// an empty chain run now (packet 1 only, on the caller's copy).
+const filters::FilterOutput& OutputOf(const VisionSensorRow& s, filters::FilterOutput* scratch) {
+  if (!s.filters.empty()) return s.output;
+  s.filters.Run(s.image, CameraModelOf(s.lens), scratch);
+  return *scratch;
 }
 
+// result (1: the chain triggered: a blob, a point; else 0; -1 before the
+// first image), then the packets: packet 1 (CoppeliaSim's 15 statistics),
+// then one per element that gives values.
 int ReadVisionSensor(lua_State* L) {
   const VisionSensorRow& s = SensorOf(L);
   if (s.rendered_step < 0) {
     lua_pushinteger(L, -1);
     return 1;
   }
-  lua_pushinteger(L, 0);
-  PushPacket1(L, s);
-  return 2;
+  filters::FilterOutput scratch;
+  const filters::FilterOutput& out = OutputOf(s, &scratch);
+  lua_pushinteger(L, out.triggered ? 1 : 0);
+  luaL_checkstack(L, static_cast<int>(out.packets.size()) + 2, "too many packets");
+  for (const std::vector<double>& packet : out.packets)
+    PushNumberArray(L, packet.data(), static_cast<int>(packet.size()));
+  return 1 + static_cast<int>(out.packets.size());
+}
+
+// The last blobs element's blobs, largest first: {pixels, color = {r, g, b},
+// x, y (centroid, pixels from the top-left corner), u, v (0..1 from the
+// bottom-left, CoppeliaSim's), box = {min_x, min_y, max_x, max_y},
+// orientation (rad)}.
+int GetVisionSensorBlobs(lua_State* L) {
+  const VisionSensorRow& s = SensorOf(L);
+  lua_createtable(L, static_cast<int>(s.output.blobs.size()), 0);
+  if (s.rendered_step < 0 || s.filters.empty()) return 1;
+  int index = 1;
+  for (const filters::Blob& b : s.output.blobs) {
+    lua_createtable(L, 0, 8);
+    lua_pushinteger(L, b.pixels);
+    lua_setfield(L, -2, "pixels");
+    PushNumberArray(L, b.colour.data(), 3);
+    lua_setfield(L, -2, "color");
+    const std::pair<const char*, double> numbers[] = {
+        {"x", b.x}, {"y", b.y}, {"u", b.u}, {"v", b.v}, {"orientation", b.orientation}};
+    for (const auto& [name, value] : numbers) {
+      lua_pushnumber(L, value);
+      lua_setfield(L, -2, name);
+    }
+    const double box[4] = {static_cast<double>(b.min_x), static_cast<double>(b.min_y),
+                           static_cast<double>(b.max_x), static_cast<double>(b.max_y)};
+    PushNumberArray(L, box, 4);
+    lua_setfield(L, -2, "box");
+    lua_rawseti(L, -2, index++);
+  }
+  return 1;
 }
 
 int SetShapeColor(lua_State* L) {
@@ -247,6 +268,7 @@ void RegisterRenderingApi(lua_State* L) {
       {"getVisionSensorDepth", Guarded<GetVisionSensorDepth, "sim.getVisionSensorDepth">},
       {"getVisionSensorRes", Guarded<GetVisionSensorRes, "sim.getVisionSensorRes">},
       {"readVisionSensor", Guarded<ReadVisionSensor, "sim.readVisionSensor">},
+      {"getVisionSensorBlobs", Guarded<GetVisionSensorBlobs, "sim.getVisionSensorBlobs">},
       {"setShapeColor", Guarded<SetShapeColor, "sim.setShapeColor">},
       {"getShapeColor", Guarded<GetShapeColor, "sim.getShapeColor">},
       {"setLightOn", Guarded<SetLightOn, "sim.setLightOn">},

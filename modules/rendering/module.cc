@@ -111,6 +111,7 @@ void RenderingModule::RenderDue(World* world, bool all) {
           options.floor = s.floor;
           options.background = s.background;
           Draw(*list_of[i], ViewOf(scene, sensors->owners[r], s.lens, s.depth), options, &s.image);
+          if (!s.filters.empty()) s.filters.Run(s.image, CameraModelOf(s.lens), &s.output);
           s.rendered_step = step;
         }
       });

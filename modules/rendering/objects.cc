@@ -45,6 +45,8 @@ constexpr ObjectKey kVisionSensorKeys[] = {
      "only the shapes (and LEDs) of this collection or object subtree are seen (a path)"},
     {"background", "[0, 0, 0]", "RGB, each 0..1: where nothing is seen"},
     {"floor", "true", "the floor (and the paint layer on it) is seen"},
+    {"filters", "none",
+     "a filter chain run on each image: a list of elements (see vision sensor filters)"},
 };
 
 constexpr ObjectKey kLightKeys[] = {
@@ -101,6 +103,10 @@ void ReadVisionSensor(const ObjectTypeDescriptor&, const ObjectReader& r, void* 
   }
   if (r.Has("background")) v.background = r.Vector3("background", kFraction);
   if (r.Has("floor")) v.floor = r.Bool("floor");
+  if (r.Has("filters")) {
+    v.filters = filters::ParseFilterChain(r, "filters", r.registry());
+    if (v.filters.needs_depth()) v.depth = true;
+  }
 }
 
 void ReadLight(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
@@ -142,6 +148,7 @@ void CopyVisionSensor(const void* source, void* row) {
   to.where = from.where;
   to.background = from.background;
   to.floor = from.floor;
+  to.filters = from.filters;
 }
 
 void CheckVisionSensor(const Scene& scene, ObjectId id, const void* row) {
@@ -213,6 +220,18 @@ std::shared_ptr<const ObjectTypeDescriptor> LightType() {
 }
 
 }  // namespace
+
+filters::CameraModel CameraModelOf(const Lens& lens) {
+  filters::CameraModel camera;
+  camera.perspective = !lens.orthographic;
+  // The chain measures angles and sizes along the image's larger side.
+  const double ratio = static_cast<double>(lens.height) / lens.width;
+  camera.fov = lens.width >= lens.height ? lens.fov : 2 * std::atan(std::tan(lens.fov / 2) * ratio);
+  camera.ortho_size = lens.width >= lens.height ? lens.ortho_width : lens.ortho_width * ratio;
+  camera.near = lens.near;
+  camera.far = lens.far;
+  return camera;
+}
 
 void CollectLights(const Scene& scene, std::vector<LightSource>* lights, bool* any) {
   lights->clear();

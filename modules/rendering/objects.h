@@ -10,6 +10,7 @@
 
 #include "framework/image.h"
 #include "framework/math.h"
+#include "modules/rendering/filters/filters.h"
 #include "modules/rendering/geometry.h"
 
 namespace swarmsim {
@@ -44,9 +45,11 @@ struct VisionSensorRow {
   std::string where;               // "file:line:column" of `detectable`
   Vec3 background{0.0, 0.0, 0.0};  // RGB where nothing is seen
   bool floor = true;               // the floor (and its paint) is seen
+  filters::FilterChain filters;    // run on each image (shared by copies)
   // The reading, updated when the sensor renders.
   Image image;
-  int64_t rendered_step = -1;  // the step it last rendered (-1: never)
+  filters::FilterOutput output;  // the chain's, when it has elements
+  int64_t rendered_step = -1;    // the step it last rendered (-1: never)
 };
 
 struct LightRow {
@@ -57,6 +60,9 @@ struct LightRow {
   double exponent = 2;                 // spot fall-off
   double range = 0;                    // m, point and spot: half intensity here (0: no fall-off)
 };
+
+// What a filter chain needs to know of a sensor's lens.
+filters::CameraModel CameraModelOf(const Lens& lens);
 
 // Registers the types and the module.
 void RegisterObjects(ModuleRegistry* registry);

@@ -31,4 +31,15 @@ std::vector<std::string> FieldsObjectReader::Strings(std::string_view key, size_
   return out;
 }
 
+std::vector<std::unique_ptr<ObjectReader>> FieldsObjectReader::Items(std::string_view key) const {
+  std::vector<std::unique_ptr<ObjectReader>> out;
+  for (const Field& item : ListElements(values_.file(), fields_.Get(key), "maps")) {
+    auto fields =
+        std::make_unique<Fields>(values_.file(), item, item.name + " of " + fields_.what());
+    out.push_back(std::unique_ptr<ObjectReader>(
+        new FieldsObjectReader(values_, std::move(fields), meshes_, registry_)));
+  }
+  return out;
+}
+
 }  // namespace swarmsim::loader

@@ -52,8 +52,19 @@ class FieldsObjectReader final : public ObjectReader {
   }
   std::shared_ptr<const TriangleMesh> Mesh(std::string_view key, const Vec3& scale) const override;
   const ModuleRegistry* registry() const override { return registry_; }
+  std::vector<std::unique_ptr<ObjectReader>> Items(std::string_view key) const override;
+  void Expect(std::span<const std::string> known) const override { fields_.Expect(known); }
 
  private:
+  // An item's reader owns its map's fields.
+  FieldsObjectReader(const ValueReader& values, std::unique_ptr<Fields> fields, MeshCache* meshes,
+                     const ModuleRegistry* registry)
+      : values_(values),
+        fields_(*fields),
+        meshes_(meshes),
+        registry_(registry),
+        owned_fields_(std::move(fields)) {}
+
   Field Get(std::string_view key, bool required) const {
     return required ? fields_.Require(key) : fields_.Get(key);
   }
@@ -62,6 +73,7 @@ class FieldsObjectReader final : public ObjectReader {
   const Fields& fields_;
   MeshCache* meshes_;
   const ModuleRegistry* registry_;
+  std::unique_ptr<Fields> owned_fields_;
 };
 
 }  // namespace swarmsim::loader

@@ -28,6 +28,11 @@
 // reading {intensity, distance}, distance (m) from the sensor to the light
 // at the parameters (light_x, light_y, light_z) (default 0, 0, 1), and
 // intensity = light_power / (1 + distance^2) (light_power default 1).
+// Vision filter elements (ABI 5), for a sensor's `filters:` list:
+// `invert` (a colour or grey image or a mask -> the same, each byte 255 - v)
+// and `brightness` ({type: brightness, gain: 1.5, offset: 0.1}: a colour or
+// grey image -> the same, v' = clamp(gain v + 255 offset); its packet is the
+// mean of the result, 0..1).
 #include <atomic>
 #include <cmath>
 #include <cstdio>
@@ -302,14 +307,50 @@ int BeaconCoverage(const SwarmsimCallContext* c, char* error, size_t error_size,
   return 0;
 }
 
+// --- Vision filters ----------------------------------------------------------------------
+
+size_t Bytes(const SwarmsimImage* image) {
+  return static_cast<size_t>(image->width) * static_cast<size_t>(image->height) *
+         (image->kind == kSwarmsimColourImage ? 3 : 1);
+}
+
+int Invert(const SwarmsimImage* in, SwarmsimImage* out, const double*, double*, int, char*, size_t,
+           void*) {
+  for (size_t i = 0, n = Bytes(in); i < n; ++i) out->pixels[i] = 255 - in->pixels[i];
+  return 0;
+}
+
+const SwarmsimObjectKey kBrightnessKeys[] = {
+    {"gain", 1, 0, 16, 0, "factor on each channel"},
+    {"offset", 0, -1, 1, 0, "added to each channel after the gain, -1..1 (1 = 255)"},
+};
+
+int Brightness(const SwarmsimImage* in, SwarmsimImage* out, const double* parameters,
+               double* values, int max_values, char* error, size_t error_size, void*) {
+  if (max_values < 1) {
+    std::snprintf(error, error_size, "no room for the mean");
+    return -1;
+  }
+  const double gain = parameters[0], offset = 255 * parameters[1];
+  double sum = 0;
+  const size_t n = Bytes(in);
+  for (size_t i = 0; i < n; ++i) {
+    const double v = std::fmin(255, std::fmax(0, gain * in->pixels[i] + offset));
+    out->pixels[i] = static_cast<uint8_t>(v + 0.5);
+    sum += out->pixels[i];
+  }
+  values[0] = n > 0 ? sum / (255.0 * static_cast<double>(n)) : 0;
+  return 1;
+}
+
 }  // namespace
 
 extern "C" int swarmsim_plugin_abi_version(void) { return SWARMSIM_PLUGIN_ABI_VERSION; }
 
 extern "C" int swarmsim_plugin_register(const SwarmsimRegistrar* r) {
-  r->set_info(r->impl, "example", "4.0",
+  r->set_info(r->impl, "example", "5.0",
               "example plugin: exampleSum, exampleWhereAmI, robotMoveAndAvoidObstacles, light, "
-              "beacon");
+              "beacon, invert, brightness");
   struct Command {
     const char* name;
     const char* description;
@@ -340,5 +381,12 @@ extern "C" int swarmsim_plugin_register(const SwarmsimRegistrar* r) {
                          kBeaconKeys, 2) != 0)
     return -1;
   if (r->add_phase_callback(r->impl, kSwarmsimRecord, 0, BeaconCoverage, nullptr) != 0) return -1;
+  const int images = kSwarmsimColourImage | kSwarmsimGreyImage;
+  if (r->add_vision_filter(r->impl, "invert", "each byte 255 - v", images | kSwarmsimMask, 0,
+                           nullptr, 0, 0, Invert, nullptr) != 0)
+    return -1;
+  if (r->add_vision_filter(r->impl, "brightness", "gain and offset on each channel", images, 0,
+                           kBrightnessKeys, 2, 1, Brightness, nullptr) != 0)
+    return -1;
   return 0;
 }
