@@ -1,0 +1,190 @@
+// Blob cameras: which lit LEDs each camera sees.
+//
+// Each sense phase:
+// 1. the lit LEDs (on and not black) go into a 2D grid over their (x, y);
+// 2. if any camera tests occlusion, the shapes that move (robots' shapes,
+//    dynamic shapes) are placed and go into a second grid, their (x, y)
+//    bounds as circles; the static shapes and the environment map are the
+//    proximity backend's (frozen when the world starts, as for proximity
+//    sensors);
+// 3. every camera, in parallel (each writes only its own row): the LEDs of
+//    the grid cells within its range, minus its own robot's, those within
+//    range in 3D and inside its field of view; each tested for occlusion
+//    by a segment from the camera's origin to the LED's centre: the moving
+//    shapes near the camera (a z-range and 2D distance test, then the
+//    exact ray test of modules/proximity/ray_cast.h), then the static ones.
+//    The shapes of the camera's robot and of the LED's robot never hide it
+//    (ARGoS's rule: a robot's LEDs are seen through its own body); for a
+//    camera or LED of no robot, the moving shapes it hangs from.
+// A camera's blobs are sorted by bearing, distance, then handle: the
+// reading does not depend on the grid, the thread count or row order.
+#include "modules/blobs/module.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "framework/proximity_backend.h"
+#include "framework/scene.h"
+#include "framework/scheduler.h"
+#include "framework/world.h"
+#include "modules/blobs/blob_camera.h"
+#include "modules/blobs/leds.h"
+
+namespace swarmsim::blobs {
+
+namespace {
+
+constexpr double kTwoPi = 6.283185307179586;
+constexpr double kPi = 3.141592653589793;
+// The occlusion segment stops this short of the LED (m), so that the shape
+// an LED sits on the surface of does not hide it.
+constexpr double kEndMargin = 1e-6;
+// Cameras per task: a camera costs about a microsecond.
+constexpr int64_t kCameraGrain = 16;
+
+// Is `ancestor` above `slot` in the tree?
+bool IsAncestor(const Scene& scene, uint32_t ancestor, uint32_t slot) {
+  for (int32_t s = scene.parent_at(slot); s >= 0; s = scene.parent_at(static_cast<uint32_t>(s)))
+    if (static_cast<uint32_t>(s) == ancestor) return true;
+  return false;
+}
+
+bool BlobBefore(const Blob& a, const Blob& b) {
+  if (a.bearing != b.bearing) return a.bearing < b.bearing;
+  if (a.distance != b.distance) return a.distance < b.distance;
+  return a.led < b.led;
+}
+
+}  // namespace
+
+void BlobCameraModule::IndexLeds(const Scene& scene, ObjectType led_type) {
+  leds_.clear();
+  led_items_.clear();
+  const auto& rows = static_cast<const Rows<LedRow>&>(*scene.rows(led_type));
+  for (size_t r = 0; r < rows.size(); ++r) {
+    const LedRow& led = rows.rows[r];
+    if (!led.lit()) continue;
+    const uint32_t slot = rows.owners[r];
+    const Vec3& p = scene.world_pose_at(slot).p;
+    led_items_.push_back({p.x, p.y, 0, static_cast<uint32_t>(leds_.size())});
+    leds_.push_back({p, led.color, scene.IdAt(slot), scene.instance_of_at(slot), slot});
+  }
+  if (!leds_.empty()) led_grid_.Build(led_items_);
+}
+
+void BlobCameraModule::IndexOccluders(const Scene& scene) {
+  occluders_.clear();
+  occluder_items_.clear();
+  const auto shapes = scene.shapes();
+  const auto owners = scene.shape_owners();
+  for (size_t r = 0; r < shapes.size(); ++r) {
+    const uint32_t slot = owners[r];
+    const int instance = scene.instance_of_at(slot);
+    if (instance < 0 && !shapes[r].dynamic) continue;  // static: the proximity backend's
+    const Occluder o{
+        proximity::PlaceShape(shapes[r], scene.world_pose_at(slot), scene.IdAt(slot), instance), 0,
+        0, slot};
+    Vec3 lo, hi;
+    proximity::WorldBounds(o.shape, &lo, &hi);
+    // Grown a little: the exact test decides, this one only must not miss.
+    const double margin = 1e-9 * (1 + std::abs(lo.x) + std::abs(lo.y) + std::abs(hi.x) +
+                                  std::abs(hi.y) + std::abs(lo.z) + std::abs(hi.z));
+    occluder_items_.push_back({0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y),
+                               0.5 * std::hypot(hi.x - lo.x, hi.y - lo.y) + margin,
+                               static_cast<uint32_t>(occluders_.size())});
+    occluders_.push_back(o);
+    occluders_.back().z_lo = lo.z - margin;
+    occluders_.back().z_hi = hi.z + margin;
+  }
+  occluder_grid_.Build(occluder_items_);
+}
+
+bool BlobCameraModule::Hidden(const Scene& scene, const Vec3& p_W, int instance, uint32_t slot,
+                              const LitLed& led, double distance,
+                              const std::vector<uint32_t>& occluders) const {
+  const double length = distance - kEndMargin;
+  if (!(length > 0)) return false;
+  const Vec3 d_W = (led.p_W - p_W) / distance;
+  const Vec3 end = p_W + d_W * length;
+  const double z_lo = std::min(p_W.z, end.z), z_hi = std::max(p_W.z, end.z);
+  const double vx = end.x - p_W.x, vy = end.y - p_W.y, vv = vx * vx + vy * vy;
+  for (uint32_t j : occluders) {
+    const Occluder& o = occluders_[j];
+    const int owner = o.shape.instance;
+    if (owner >= 0 ? owner == instance || owner == led.instance
+                   : IsAncestor(scene, o.slot, slot) || IsAncestor(scene, o.slot, led.slot))
+      continue;
+    if (o.z_hi < z_lo || o.z_lo > z_hi) continue;
+    // The segment's nearest point to the footprint's centre, in the plane.
+    const GridItem& c = occluder_items_[j];
+    const double ux = c.x - p_W.x, uy = c.y - p_W.y;
+    const double t = vv > 0 ? std::clamp((ux * vx + uy * vy) / vv, 0.0, 1.0) : 0.0;
+    const double ex = ux - t * vx, ey = uy - t * vy;
+    if (ex * ex + ey * ey > c.radius * c.radius) continue;
+    double hit = 0;
+    if (proximity::RayCast(o.shape, p_W, d_W, length, &hit)) return true;
+  }
+  return proximity_ != nullptr && proximity_->SegmentBlocked(p_W, end);
+}
+
+void BlobCameraModule::See(const Scene& scene, uint32_t slot, BlobCameraRow* camera) const {
+  BlobCameraRow& c = *camera;
+  c.blobs.clear();
+  if (!c.enabled || leds_.empty()) return;
+  const Pose& X_WC = scene.world_pose_at(slot);
+  const Vec3& p_W = X_WC.p;
+  const Quat q_CW = X_WC.q.Conjugate();
+  const int instance = scene.instance_of_at(slot);
+  const bool all_around = c.fov >= kTwoPi, all_up_down = c.vertical_fov >= kPi;
+  const double half_fov = 0.5 * c.fov, half_vertical = 0.5 * c.vertical_fov;
+  const double range2 = c.range * c.range;
+  thread_local std::vector<uint32_t> near, occluders;
+  led_grid_.QueryCircle(p_W.x, p_W.y, c.range, &near);
+  bool occluders_listed = false;
+  for (uint32_t i : near) {
+    const LitLed& led = leds_[i];
+    if (instance >= 0 && led.instance == instance) continue;  // its own robot's
+    const Vec3 d_W = led.p_W - p_W;
+    const double d2 = d_W.SquaredNorm();
+    if (!(d2 <= range2) || d2 == 0) continue;
+    const Vec3 d_C = q_CW.Rotate(d_W);
+    const double bearing = std::atan2(d_C.y, d_C.x);
+    if (!all_around && std::abs(bearing) > half_fov) continue;
+    const double elevation = std::atan2(d_C.z, std::hypot(d_C.x, d_C.y));
+    if (!all_up_down && std::abs(elevation) > half_vertical) continue;
+    const double distance = std::sqrt(d2);
+    if (c.occlusion) {
+      if (!occluders_listed) {
+        occluder_grid_.QueryCircle(p_W.x, p_W.y, c.range, &occluders);
+        occluders_listed = true;
+      }
+      if (Hidden(scene, p_W, instance, slot, led, distance, occluders)) continue;
+    }
+    c.blobs.push_back({led.color, distance, bearing, elevation, led.id});
+  }
+  std::sort(c.blobs.begin(), c.blobs.end(), BlobBefore);
+}
+
+void BlobCameraModule::Sense(World* world) {
+  Scene& scene = world->scene();
+  if (!types_found_) {
+    have_types_ = scene.FindType(kLedTypeName, &led_type_) &&
+                  scene.FindType(kBlobCameraTypeName, &camera_type_);
+    types_found_ = true;
+  }
+  if (!have_types_) return;
+  auto& cameras = static_cast<Rows<BlobCameraRow>&>(*scene.rows(camera_type_));
+  if (cameras.size() == 0) return;
+  proximity_ = world->proximity();
+  IndexLeds(scene, led_type_);
+  bool occlusion = false;
+  for (const BlobCameraRow& c : cameras.rows) occlusion |= c.enabled && c.occlusion;
+  if (occlusion && !leds_.empty()) IndexOccluders(scene);
+  world->scheduler().ParallelFor(0, static_cast<int64_t>(cameras.size()), kCameraGrain,
+                                 [&](int64_t begin, int64_t end) {
+                                   for (int64_t r = begin; r < end; ++r)
+                                     See(scene, cameras.owners[r], &cameras.rows[r]);
+                                 });
+}
+
+}  // namespace swarmsim::blobs

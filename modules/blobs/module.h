@@ -1,0 +1,69 @@
+// The blob cameras' module (internal to modules/blobs): in the sense phase
+// it indexes the lit LEDs and the shapes that may hide them, then fills
+// every blob camera's reading, cameras in parallel.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "framework/module.h"
+#include "framework/object_rows.h"
+#include "framework/spatial_grid.h"
+#include "modules/proximity/ray_cast.h"
+
+namespace swarmsim {
+class ModuleRegistry;
+class ProximityBackend;
+struct BlobCameraRow;
+}  // namespace swarmsim
+
+namespace swarmsim::blobs {
+
+inline constexpr const char* kModuleName = "blobs";
+
+// The metrics of colour clustering (metrics.cc).
+void RegisterColorMetrics(ModuleRegistry* registry);
+
+class BlobCameraModule final : public Module {
+ public:
+  void Sense(World* world) override;
+
+ private:
+  struct LitLed {  // 64 bytes
+    Vec3 p_W;      // its centre
+    Vec3 color;
+    ObjectId id;
+    int32_t instance;  // its robot, or -1
+    uint32_t slot;
+  };
+  // A shape that may hide an LED: robots' shapes and dynamic ones (the
+  // static ones are the proximity backend's, SegmentBlocked).
+  struct Occluder {
+    proximity::PlacedShape shape;
+    double z_lo, z_hi;  // its world bounds along z
+    uint32_t slot;
+  };
+
+  void IndexLeds(const Scene& scene, ObjectType led_type);
+  void IndexOccluders(const Scene& scene);
+  // Fills one camera's reading. Thread-safe across cameras.
+  void See(const Scene& scene, uint32_t slot, BlobCameraRow* camera) const;
+  // Does a shape (other than the camera's and the LED's own) cross the
+  // segment from the camera at p_W to `led`? `occluders`: the candidates
+  // near the camera.
+  bool Hidden(const Scene& scene, const Vec3& p_W, int instance, uint32_t slot, const LitLed& led,
+              double distance, const std::vector<uint32_t>& occluders) const;
+
+  bool types_found_ = false;
+  bool have_types_ = false;
+  ObjectType led_type_{}, camera_type_{};
+  const ProximityBackend* proximity_ = nullptr;
+  std::vector<LitLed> leds_;         // lit LEDs (LED rows order)
+  std::vector<GridItem> led_items_;  // their xy (leds_)
+  SpatialGrid led_grid_;
+  std::vector<Occluder> occluders_;       // (occluders)
+  std::vector<GridItem> occluder_items_;  // their xy footprint circles (occluders)
+  SpatialGrid occluder_grid_;
+};
+
+}  // namespace swarmsim::blobs
