@@ -2,20 +2,20 @@
 //
 // Each sense phase:
 // 1. the lit LEDs (on and not black) go into a 2D grid over their (x, y);
-// 2. if any camera tests occlusion, the shapes that move (robots' shapes,
-//    dynamic shapes) are placed and go into a second grid, their (x, y)
-//    bounds as circles; the static shapes and the environment map are the
-//    proximity backend's (frozen when the world starts, as for proximity
-//    sensors);
+// 2. if any camera tests occlusion, every shape is placed at its pose and
+//    goes into a second grid, its (x, y) bounds as a circle (walls, larger
+//    than a cell, go to the grid's short list every query scans); the
+//    environment map's voxels are the proximity backend's, frozen when the
+//    world starts (SegmentBlocked);
 // 3. every camera, in parallel (each writes only its own row): the LEDs of
 //    the grid cells within its range, minus its own robot's, those within
 //    range in 3D and inside its field of view; each tested for occlusion
-//    by a segment from the camera's origin to the LED's centre: the moving
-//    shapes near the camera (a z-range and 2D distance test, then the
-//    exact ray test of modules/proximity/ray_cast.h), then the static ones.
+//    by a segment from the camera's origin to the LED's centre: the shapes
+//    near the camera (a test against their bounding box, then the exact
+//    ray test of modules/proximity/ray_cast.h), then the map's voxels.
 //    The shapes of the camera's robot and of the LED's robot never hide it
 //    (ARGoS's rule: a robot's LEDs are seen through its own body); for a
-//    camera or LED of no robot, the moving shapes it hangs from.
+//    camera or LED of no robot, the shapes it hangs from.
 // A camera's blobs are sorted by bearing, distance, then handle: the
 // reading does not depend on the grid, the thread count or row order.
 #include "modules/blobs/module.h"
@@ -49,6 +49,26 @@ bool IsAncestor(const Scene& scene, uint32_t ancestor, uint32_t slot) {
   return false;
 }
 
+// Does the segment p + t v, t in [0, 1], meet the box [lo, hi]?
+bool SegmentMeetsBox(const Vec3& p, const Vec3& v, const Vec3& lo, const Vec3& hi) {
+  double t0 = 0, t1 = 1;
+  const double ps[3] = {p.x, p.y, p.z}, vs[3] = {v.x, v.y, v.z};
+  const double los[3] = {lo.x, lo.y, lo.z}, his[3] = {hi.x, hi.y, hi.z};
+  for (int i = 0; i < 3; ++i) {
+    if (vs[i] == 0) {
+      if (ps[i] < los[i] || ps[i] > his[i]) return false;
+      continue;
+    }
+    const double inv = 1 / vs[i];
+    double a = (los[i] - ps[i]) * inv, b = (his[i] - ps[i]) * inv;
+    if (a > b) std::swap(a, b);
+    t0 = std::max(t0, a);
+    t1 = std::min(t1, b);
+    if (t0 > t1) return false;
+  }
+  return true;
+}
+
 bool BlobBefore(const Blob& a, const Blob& b) {
   if (a.bearing != b.bearing) return a.bearing < b.bearing;
   if (a.distance != b.distance) return a.distance < b.distance;
@@ -79,22 +99,19 @@ void BlobCameraModule::IndexOccluders(const Scene& scene) {
   const auto owners = scene.shape_owners();
   for (size_t r = 0; r < shapes.size(); ++r) {
     const uint32_t slot = owners[r];
-    const int instance = scene.instance_of_at(slot);
-    if (instance < 0 && !shapes[r].dynamic) continue;  // static: the proximity backend's
-    const Occluder o{
-        proximity::PlaceShape(shapes[r], scene.world_pose_at(slot), scene.IdAt(slot), instance), 0,
-        0, slot};
-    Vec3 lo, hi;
-    proximity::WorldBounds(o.shape, &lo, &hi);
-    // Grown a little: the exact test decides, this one only must not miss.
-    const double margin = 1e-9 * (1 + std::abs(lo.x) + std::abs(lo.y) + std::abs(hi.x) +
-                                  std::abs(hi.y) + std::abs(lo.z) + std::abs(hi.z));
-    occluder_items_.push_back({0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y),
-                               0.5 * std::hypot(hi.x - lo.x, hi.y - lo.y) + margin,
-                               static_cast<uint32_t>(occluders_.size())});
-    occluders_.push_back(o);
-    occluders_.back().z_lo = lo.z - margin;
-    occluders_.back().z_hi = hi.z + margin;
+    Occluder& o = occluders_.emplace_back();
+    o.shape = proximity::PlaceShape(shapes[r], scene.world_pose_at(slot), scene.IdAt(slot),
+                                    scene.instance_of_at(slot));
+    o.slot = slot;
+    proximity::WorldBounds(o.shape, &o.lo, &o.hi);
+    // Grown a little: the exact test decides, these only must not miss.
+    const double margin = 1e-9 * (1 + std::abs(o.lo.x) + std::abs(o.lo.y) + std::abs(o.lo.z) +
+                                  std::abs(o.hi.x) + std::abs(o.hi.y) + std::abs(o.hi.z));
+    o.lo = o.lo - Vec3{margin, margin, margin};
+    o.hi = o.hi + Vec3{margin, margin, margin};
+    occluder_items_.push_back({0.5 * (o.lo.x + o.hi.x), 0.5 * (o.lo.y + o.hi.y),
+                               0.5 * std::hypot(o.hi.x - o.lo.x, o.hi.y - o.lo.y),
+                               static_cast<uint32_t>(r)});
   }
   occluder_grid_.Build(occluder_items_);
 }
@@ -106,25 +123,18 @@ bool BlobCameraModule::Hidden(const Scene& scene, const Vec3& p_W, int instance,
   if (!(length > 0)) return false;
   const Vec3 d_W = (led.p_W - p_W) / distance;
   const Vec3 end = p_W + d_W * length;
-  const double z_lo = std::min(p_W.z, end.z), z_hi = std::max(p_W.z, end.z);
-  const double vx = end.x - p_W.x, vy = end.y - p_W.y, vv = vx * vx + vy * vy;
+  const Vec3 v_W = end - p_W;
   for (uint32_t j : occluders) {
     const Occluder& o = occluders_[j];
     const int owner = o.shape.instance;
     if (owner >= 0 ? owner == instance || owner == led.instance
                    : IsAncestor(scene, o.slot, slot) || IsAncestor(scene, o.slot, led.slot))
       continue;
-    if (o.z_hi < z_lo || o.z_lo > z_hi) continue;
-    // The segment's nearest point to the footprint's centre, in the plane.
-    const GridItem& c = occluder_items_[j];
-    const double ux = c.x - p_W.x, uy = c.y - p_W.y;
-    const double t = vv > 0 ? std::clamp((ux * vx + uy * vy) / vv, 0.0, 1.0) : 0.0;
-    const double ex = ux - t * vx, ey = uy - t * vy;
-    if (ex * ex + ey * ey > c.radius * c.radius) continue;
+    if (!SegmentMeetsBox(p_W, v_W, o.lo, o.hi)) continue;
     double hit = 0;
     if (proximity::RayCast(o.shape, p_W, d_W, length, &hit)) return true;
   }
-  return proximity_ != nullptr && proximity_->SegmentBlocked(p_W, end);
+  return map_ != nullptr && map_->SegmentBlocked(p_W, end);
 }
 
 void BlobCameraModule::See(const Scene& scene, uint32_t slot, BlobCameraRow* camera) const {
@@ -175,7 +185,8 @@ void BlobCameraModule::Sense(World* world) {
   if (!have_types_) return;
   auto& cameras = static_cast<Rows<BlobCameraRow>&>(*scene.rows(camera_type_));
   if (cameras.size() == 0) return;
-  proximity_ = world->proximity();
+  const EnvironmentMap* map = scene.environment();
+  map_ = map != nullptr && !map->boxes.empty() ? world->proximity() : nullptr;
   IndexLeds(scene, led_type_);
   bool occlusion = false;
   for (const BlobCameraRow& c : cameras.rows) occlusion |= c.enabled && c.occlusion;

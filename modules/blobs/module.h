@@ -36,11 +36,10 @@ class BlobCameraModule final : public Module {
     int32_t instance;  // its robot, or -1
     uint32_t slot;
   };
-  // A shape that may hide an LED: robots' shapes and dynamic ones (the
-  // static ones are the proximity backend's, SegmentBlocked).
+  // A shape that may hide an LED.
   struct Occluder {
     proximity::PlacedShape shape;
-    double z_lo, z_hi;  // its world bounds along z
+    Vec3 lo, hi;  // its world bounds, grown for rounding
     uint32_t slot;
   };
 
@@ -57,7 +56,9 @@ class BlobCameraModule final : public Module {
   bool types_found_ = false;
   bool have_types_ = false;
   ObjectType led_type_{}, camera_type_{};
-  const ProximityBackend* proximity_ = nullptr;
+  // The environment map's voxels are the proximity backend's
+  // (SegmentBlocked); null when the scene has no map.
+  const ProximityBackend* map_ = nullptr;
   std::vector<LitLed> leds_;         // lit LEDs (LED rows order)
   std::vector<GridItem> led_items_;  // their xy (leds_)
   SpatialGrid led_grid_;
