@@ -12,6 +12,7 @@
 #include <memory>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "framework/error.h"
@@ -237,6 +238,48 @@ TEST(BlobCameraTest, AnotherRobotsBodyHidesAnLedButTheLedsOwnBodyDoesNot) {
   EXPECT_EQ(blobs[1].led, beside);
 }
 
+TEST(BlobCameraTest, TheMapsVoxelsHideLedsToo) {
+  BlobWorld w;
+  const ObjectId camera = w.CameraRobot(0, 0, 0);
+  w.LedRobot(0.8, 0, kRed);
+  w.LedRobot(0, 0.8, kGreen);
+  // A map block across +x between the camera and the red LED.
+  auto map = std::make_shared<EnvironmentMap>();
+  map->source = "test";
+  map->resolution = 0.05;
+  map->boxes.push_back({{0.4, -0.2, 0}, {0.45, 0.2, 0.4}});
+  map->lo = map->boxes[0].lo;
+  map->hi = map->boxes[0].hi;
+  w.scene().set_environment(map);
+  const std::vector<Blob> blobs = w.See(camera);
+  ASSERT_EQ(blobs.size(), 1u);
+  EXPECT_EQ(blobs[0].color, kGreen);
+}
+
+// Cameras and LEDs of no robot: a scene LED inside the static post it hangs
+// from is seen, one inside another static box is not; a scene camera sees
+// every robot's LED.
+TEST(BlobCameraTest, TheShapesASceneLedHangsFromDoNotHideIt) {
+  BlobWorld w;
+  const ObjectId camera = w.CameraRobot(0, 0, 0);
+  const ObjectId post = w.scene().AddShape("post", {}, {{0.6, 0, 0.25}, {}}, Cylinder(0.05, 0.5));
+  const ObjectId mounted = w.Led(post, {0, 0, -0.05}, kRed);  // 0.2 m up, inside the post
+  const ObjectId crate = w.scene().AddShape("crate", {}, {{0, 0.6, 0.1}, {}}, Box({0.2, 0.2, 0.2}));
+  w.Led({}, {0, 0.6, 0.15}, kGreen);  // inside the crate, which it does not hang from
+  (void)crate;
+  BlobCameraRow wide;
+  wide.range = 1.5;
+  const ObjectId scene_camera = w.Camera({}, {{-0.5, 0, 0.3}, {}}, wide);
+  const ObjectId robot_led = w.Led(w.scene().parent(camera), {0, 0, 0.083}, kBlue);
+  std::vector<Blob> blobs = w.See(camera);
+  ASSERT_EQ(blobs.size(), 1u);
+  EXPECT_EQ(blobs[0].led, mounted);
+  blobs = w.Blobs(scene_camera);
+  ASSERT_EQ(blobs.size(), 2u);  // the robot's LED and the post's; the crate's is hidden
+  EXPECT_EQ(blobs[0].led, robot_led);
+  EXPECT_EQ(blobs[1].led, mounted);
+}
+
 TEST(BlobCameraTest, CopiesOfAModelWithAnLedAndACameraSeeEachOther) {
   BlobWorld w;
   const ObjectId first = w.Robot(0, 0);
@@ -304,6 +347,46 @@ TEST(BlobCameraTest, ReadingsAreTheSameAtOneAndTwoThreads) {
     seen += one[c].size();
   }
   EXPECT_GT(seen, 1000u);  // about 8 LEDs within 1.5 m of each camera
+}
+
+// --- Metrics -----------------------------------------------------------------------------
+
+// The two colour metrics of robots with LEDs at (x, 0), colours[i].
+std::pair<double, double> ColorMetrics(const std::vector<double>& xs,
+                                       const std::vector<Vec3>& colors) {
+  BlobWorld w;
+  for (size_t i = 0; i < xs.size(); ++i) w.LedRobot(xs[i], 0, colors[i]);
+  w.Robot(0.05, 0.05);  // no LED: does not count
+  const int every = 1;
+  w.world().AddModule("same_color_neighbor_fraction", &every);
+  w.world().AddModule("color_dispersion", &every);
+  w.world().Step();
+  std::pair<double, double> out{-1, -1};
+  for (const MetricSample& m : w.world().TakeMetrics()) {
+    if (m.name == "same_color_neighbor_fraction") out.first = m.value;
+    if (m.name == "color_dispersion") out.second = m.value;
+  }
+  return out;
+}
+
+TEST(BlobCameraTest, ColourMetricsTellSegregatedFromMixed) {
+  // Two far groups of four, one colour each: every neighbour is one's own
+  // colour; each robot is 0.15 or 0.05 m from its group's centre.
+  const auto [together, spread] =
+      ColorMetrics({0, 0.1, 0.2, 0.3, 10, 10.1, 10.2, 10.3},
+                   {kRed, kRed, kRed, kRed, kBlue, kBlue, kBlue, kBlue});
+  EXPECT_DOUBLE_EQ(together, 1.0);
+  EXPECT_NEAR(spread, 0.1, 1e-12);
+  // Alternating on a line 1 m apart: of the 3 nearest, one shares the colour.
+  std::vector<double> xs;
+  std::vector<Vec3> colors;
+  for (int i = 0; i < 8; ++i) {
+    xs.push_back(i);
+    colors.push_back(i % 2 == 0 ? kRed : kBlue);
+  }
+  const auto [mixed, mixed_spread] = ColorMetrics(xs, colors);
+  EXPECT_NEAR(mixed, 1.0 / 3, 1e-12);
+  EXPECT_NEAR(mixed_spread, 2.0, 1e-12);  // |i - 3| or |i - 4| over each colour: 3, 1, 1, 3
 }
 
 // --- Scripts -----------------------------------------------------------------------------
