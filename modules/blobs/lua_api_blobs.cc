@@ -48,17 +48,7 @@ LedRow& OwnLed(lua_State* L, const char* verb) {
 
 int SetLedColor(lua_State* L) {
   LedRow& led = OwnLed(L, "set");
-  ArgType(L, 2, LUA_TTABLE);
-  double rgb[3];
-  for (int i = 0; i < 3; ++i) {
-    lua_rawgeti(L, 2, i + 1);
-    int ok = 0;
-    rgb[i] = lua_tonumberx(L, -1, &ok);
-    lua_pop(L, 1);
-    if (!ok || !(rgb[i] >= 0 && rgb[i] <= 1))
-      throw Error("the colour must be {r, g, b}, each a number from 0 to 1");
-  }
-  led.color = {rgb[0], rgb[1], rgb[2]};
+  led.color = ArgColor(L, 2);
   return 0;
 }
 

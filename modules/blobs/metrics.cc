@@ -127,33 +127,30 @@ class ColorDispersion : public Observer {
   std::vector<ColoredRobot> robots_;
 };
 
-int Every(const void* config) {
-  const int n = config != nullptr ? *static_cast<const int*>(config) : 1;
-  if (n < 1) throw Error("a metric's 'every' must be >= 1");
-  return n;
+// The descriptor of a metric `M`, made with its `every` (a const int*;
+// null: every step).
+template <class M>
+ModuleDescriptor MetricModule(const char* name, const char* description) {
+  return {{"metric", name, "1.0", description},
+          PhaseBit(ModulePhase::kRecord),
+          100,
+          false,
+          [](World*, const void* config) -> std::unique_ptr<Module> {
+            const int every = config != nullptr ? *static_cast<const int*>(config) : 1;
+            if (every < 1) throw Error("a metric's 'every' must be >= 1");
+            return std::make_unique<M>(every);
+          }};
 }
 
 }  // namespace
 
 void RegisterColorMetrics(ModuleRegistry* registry) {
-  registry->RegisterModule(
-      {{"metric", "same_color_neighbor_fraction", "1.0",
-        "mean share of each robot's 3 nearest LED-carrying robots that have its LED colour"},
-       PhaseBit(ModulePhase::kRecord),
-       100,
-       false,
-       [](World*, const void* config) -> std::unique_ptr<Module> {
-         return std::make_unique<SameColorNeighborFraction>(Every(config));
-       }});
-  registry->RegisterModule(
-      {{"metric", "color_dispersion", "1.0",
-        "mean distance from each robot to the centroid of the robots of its LED colour (m)"},
-       PhaseBit(ModulePhase::kRecord),
-       100,
-       false,
-       [](World*, const void* config) -> std::unique_ptr<Module> {
-         return std::make_unique<ColorDispersion>(Every(config));
-       }});
+  registry->RegisterModule(MetricModule<SameColorNeighborFraction>(
+      "same_color_neighbor_fraction",
+      "mean share of each robot's 3 nearest LED-carrying robots that have its LED colour"));
+  registry->RegisterModule(MetricModule<ColorDispersion>(
+      "color_dispersion",
+      "mean distance from each robot to the centroid of the robots of its LED colour (m)"));
 }
 
 }  // namespace swarmsim::blobs

@@ -456,7 +456,7 @@ TEST(BlobCameraTest, ScriptErrorsNameWhatIsWrong) {
   EXPECT_NE(error_of("sim.getLedColor(sim.getObject('/bot#1/led'))").find("read only its own LEDs"),
             std::string::npos);
   EXPECT_NE(error_of("sim.setLedColor(sim.getObject('./led'), {1, 2, 0})")
-                .find("the colour must be {r, g, b}, each a number from 0 to 1"),
+                .find("the colour must be {r, g, b} with each component between 0 and 1"),
             std::string::npos);
   EXPECT_NE(error_of("sim.setLedOn(sim.getObject('./led'), 1)").find("bad argument #2"),
             std::string::npos);

@@ -5,13 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include "framework/error.h"
-#include "framework/object_type.h"
 #include "framework/registry.h"
 #include "framework/world.h"
 #include "modules/blobs/blob_camera.h"
@@ -155,26 +152,7 @@ models:
 }
 
 TEST_F(BlobsLoaderTest, WorldsReadmeDocumentsEveryKeyOfLedAndBlobCamera) {
-  std::ifstream in(std::string(SWARMSIM_SOURCE_DIR) + "/worlds/README.md");
-  std::stringstream s;
-  s << in.rdbuf();
-  const std::string readme = s.str();
-  const size_t type_row = readme.find("| `type` | required |");
-  ASSERT_NE(type_row, std::string::npos);
-  const std::string row = readme.substr(type_row, readme.find('\n', type_row) - type_row);
-  int found = 0;
-  for (const ObjectTypeDescriptor* type : registry_.object_types()) {
-    const std::string name = type->name;
-    if (name != kLedTypeName && name != kBlobCameraTypeName) continue;
-    ++found;
-    EXPECT_CONTAINS(row, "`" + name + "`");
-    const size_t section = readme.find("\n#### " + name + "\n");
-    ASSERT_NE(section, std::string::npos) << "no '#### " << name << "' in worlds/README.md";
-    const std::string text = readme.substr(section, readme.find("\n#### ", section + 1) - section);
-    for (const ObjectKey& key : type->keys)
-      EXPECT_CONTAINS(text, std::string("| `") + key.name + "` | `" + key.default_text + "` |");
-  }
-  EXPECT_EQ(found, 2);
+  ExpectDocumented({kLedTypeName, kBlobCameraTypeName});
 }
 
 }  // namespace

@@ -339,28 +339,7 @@ TEST_F(MillTest, MillsCutTheEnvironmentMap) {
 
 // worlds/README.md documents every key of both types, one table row each,
 // and lists them in the `type` row.
-TEST_F(MillTest, WorldsReadmeDocumentsEveryKey) {
-  std::ifstream in(std::string(SWARMSIM_SOURCE_DIR) + "/worlds/README.md");
-  std::stringstream s;
-  s << in.rdbuf();
-  const std::string readme = s.str();
-  const size_t type_row = readme.find("| `type` | required |");
-  ASSERT_NE(type_row, std::string::npos);
-  const std::string row = readme.substr(type_row, readme.find('\n', type_row) - type_row);
-  int found = 0;
-  for (const ObjectTypeDescriptor* type : registry_.object_types()) {
-    const std::string name = type->name;
-    if (name != "mill" && name != "cuttable") continue;
-    ++found;
-    EXPECT_CONTAINS(row, "`" + name + "`");
-    const size_t section = readme.find("\n#### " + name + "\n");
-    ASSERT_NE(section, std::string::npos) << "no '#### " << name << "' in worlds/README.md";
-    const std::string text = readme.substr(section, readme.find("\n#### ", section + 1) - section);
-    for (const ObjectKey& key : type->keys)
-      EXPECT_CONTAINS(text, std::string("| `") + key.name + "` | `" + key.default_text + "` |");
-  }
-  EXPECT_EQ(found, 2);
-}
+TEST_F(MillTest, WorldsReadmeDocumentsEveryKey) { ExpectDocumented({"mill", "cuttable"}); }
 
 }  // namespace
 }  // namespace swarmsim
