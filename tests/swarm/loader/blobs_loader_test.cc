@@ -23,31 +23,7 @@ namespace {
 #define EXPECT_CONTAINS(text, part) \
   EXPECT_NE(std::string(text).find(part), std::string::npos) << (text)
 
-class BlobsLoaderTest : public testing::WorldDirTest {
- protected:
-  LoadedWorld Load(const std::string& world_text, int threads = 1) {
-    LoadOptions options;
-    options.threads = threads;
-    LoadedWorld w = LoadWorld(Write("world.yaml", world_text), options, registry_);
-    return w;
-  }
-  // The loader's message for a model whose root is of `type` with `keys`.
-  std::string ErrorOf(const std::string& type, const std::string& keys) {
-    Write("thing.yaml", "model: thing\nobjects:\n  type: " + type + "\n" + keys);
-    try {
-      Load("simulation: {physics: kinematic}\nmodels: [{model: thing.yaml, position: [0, 0]}]\n");
-    } catch (const Error& e) {
-      return e.what();
-    }
-    return "(no error)";
-  }
-  template <typename Row>
-  const Row& RowOf(World& world, const std::string& path) {
-    const ObjectId id = world.scene().FindObject(path);
-    EXPECT_FALSE(id.IsNull()) << path;
-    return *static_cast<const Row*>(world.scene().row_data(id));
-  }
-};
+using BlobsLoaderTest = testing::WorldDirTest;
 
 TEST_F(BlobsLoaderTest, BadKeysAreFileLineColumnErrors) {
   EXPECT_CONTAINS(ErrorOf("led", "  color: [1, 2, 0]\n"),

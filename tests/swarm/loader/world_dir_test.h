@@ -13,9 +13,12 @@
 #include <string>
 #include <vector>
 
+#include "framework/error.h"
 #include "framework/object_type.h"
 #include "framework/registry.h"
+#include "framework/world.h"
 #include "modules/builtin.h"
+#include "swarm/loader/world_loader.h"
 
 namespace swarmsim::testing {
 
@@ -36,6 +39,35 @@ class WorldDirTest : public ::testing::Test {
   std::filesystem::path Write(const std::string& name, const std::string& text) {
     std::ofstream(dir_ / name, std::ios::binary) << text;
     return dir_ / name;
+  }
+
+  // Loads `world_text` as dir_/world.yaml; the scripts' prints are dropped.
+  LoadedWorld Load(const std::string& world_text, int threads = 1) {
+    LoadOptions options;
+    options.threads = threads;
+    LoadedWorld w = LoadWorld(Write("world.yaml", world_text), options, registry_);
+    w.world->set_log_sink([](std::string_view) {});
+    return w;
+  }
+  // The loader's message for a model (thing.yaml) whose root is of `type`
+  // and carries `keys` (indented lines), or "(no error)".
+  std::string ErrorOf(const std::string& type, const std::string& keys) {
+    Write("thing.yaml", "model: thing\nobjects:\n  type: " + type + "\n" + keys);
+    try {
+      Load(
+          "simulation: {physics: kinematic}\nmodels: [{model: thing.yaml, position: [0, 0, 1]}]\n");
+    } catch (const Error& e) {
+      return e.what();
+    }
+    return "(no error)";
+  }
+  // The row of the object at `path` (of the type's row type `Row`).
+  template <typename Row>
+  Row& RowOf(World& world, const std::string& path) {
+    Scene& scene = world.scene();
+    const ObjectId id = scene.FindObject(path);
+    EXPECT_FALSE(id.IsNull()) << path;
+    return *static_cast<Row*>(scene.row_data(id));
   }
 
   // worlds/README.md documents each of the registry's object types named
