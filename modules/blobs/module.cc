@@ -11,8 +11,9 @@
 //    the grid cells within its range, minus its own robot's, those within
 //    range in 3D and inside its field of view; each tested for occlusion
 //    by a segment from the camera's origin to the LED's centre: the shapes
-//    near the camera (a test against their bounding box, then the exact
-//    ray test of modules/proximity/ray_cast.h), then the map's voxels.
+//    near the camera that reach the heights of those segments (listed once
+//    per camera), each against its bounding box, then the exact ray test
+//    of modules/proximity/ray_cast.h; then the map's voxels.
 //    The shapes of the camera's robot and of the LED's robot never hide it
 //    (ARGoS's rule: a robot's LEDs are seen through its own body); for a
 //    camera or LED of no robot, the shapes it hangs from.
@@ -116,9 +117,23 @@ void BlobCameraModule::IndexOccluders(const Scene& scene) {
   occluder_grid_.Build(occluder_items_);
 }
 
-bool BlobCameraModule::Hidden(const Scene& scene, const Vec3& p_W, int instance, uint32_t slot,
-                              const LitLed& led, double distance,
-                              const std::vector<uint32_t>& occluders) const {
+void BlobCameraModule::ListOccluders(const Scene& scene, const Vec3& p_W, double range,
+                                     int instance, uint32_t slot, double z_lo, double z_hi,
+                                     std::vector<uint32_t>* out) const {
+  occluder_grid_.QueryCircle(p_W.x, p_W.y, range, out);
+  size_t kept = 0;
+  for (uint32_t j : *out) {
+    const Occluder& o = occluders_[j];
+    const int owner = o.shape.instance;
+    if (owner >= 0 ? owner == instance : IsAncestor(scene, o.slot, slot)) continue;
+    if (o.hi.z < z_lo || o.lo.z > z_hi) continue;
+    (*out)[kept++] = j;
+  }
+  out->resize(kept);
+}
+
+bool BlobCameraModule::Hidden(const Scene& scene, const Vec3& p_W, const LitLed& led,
+                              double distance, const std::vector<uint32_t>& occluders) const {
   const double length = distance - kEndMargin;
   if (!(length > 0)) return false;
   const Vec3 d_W = (led.p_W - p_W) / distance;
@@ -127,9 +142,7 @@ bool BlobCameraModule::Hidden(const Scene& scene, const Vec3& p_W, int instance,
   for (uint32_t j : occluders) {
     const Occluder& o = occluders_[j];
     const int owner = o.shape.instance;
-    if (owner >= 0 ? owner == instance || owner == led.instance
-                   : IsAncestor(scene, o.slot, slot) || IsAncestor(scene, o.slot, led.slot))
-      continue;
+    if (owner >= 0 ? owner == led.instance : IsAncestor(scene, o.slot, led.slot)) continue;
     if (!SegmentMeetsBox(p_W, v_W, o.lo, o.hi)) continue;
     double hit = 0;
     if (proximity::RayCast(o.shape, p_W, d_W, length, &hit)) return true;
@@ -148,9 +161,12 @@ void BlobCameraModule::See(const Scene& scene, uint32_t slot, BlobCameraRow* cam
   const bool all_around = c.fov >= kTwoPi, all_up_down = c.vertical_fov >= kPi;
   const double half_fov = 0.5 * c.fov, half_vertical = 0.5 * c.vertical_fov;
   const double range2 = c.range * c.range;
-  thread_local std::vector<uint32_t> near, occluders;
+  // The LEDs in range and view (seen[k]: the LED of blobs[k]), and the
+  // heights their segments from the camera span.
+  thread_local std::vector<uint32_t> near, seen, occluders;
   led_grid_.QueryCircle(p_W.x, p_W.y, c.range, &near);
-  bool occluders_listed = false;
+  seen.clear();
+  double z_lo = p_W.z, z_hi = p_W.z;
   for (uint32_t i : near) {
     const LitLed& led = leds_[i];
     if (instance >= 0 && led.instance == instance) continue;  // its own robot's
@@ -162,15 +178,20 @@ void BlobCameraModule::See(const Scene& scene, uint32_t slot, BlobCameraRow* cam
     if (!all_around && std::abs(bearing) > half_fov) continue;
     const double elevation = std::atan2(d_C.z, std::hypot(d_C.x, d_C.y));
     if (!all_up_down && std::abs(elevation) > half_vertical) continue;
-    const double distance = std::sqrt(d2);
-    if (c.occlusion) {
-      if (!occluders_listed) {
-        occluder_grid_.QueryCircle(p_W.x, p_W.y, c.range, &occluders);
-        occluders_listed = true;
-      }
-      if (Hidden(scene, p_W, instance, slot, led, distance, occluders)) continue;
-    }
-    c.blobs.push_back({led.color, distance, bearing, elevation, led.id});
+    c.blobs.push_back({led.color, std::sqrt(d2), bearing, elevation, led.id});
+    seen.push_back(i);
+    z_lo = std::min(z_lo, led.p_W.z);
+    z_hi = std::max(z_hi, led.p_W.z);
+  }
+  // Occlusion: the shapes near the camera at those heights, but its own,
+  // tested for each LED.
+  if (c.occlusion && !seen.empty()) {
+    ListOccluders(scene, p_W, c.range, instance, slot, z_lo, z_hi, &occluders);
+    size_t kept = 0;
+    for (size_t k = 0; k < seen.size(); ++k)
+      if (!Hidden(scene, p_W, leds_[seen[k]], c.blobs[k].distance, occluders))
+        c.blobs[kept++] = c.blobs[k];
+    c.blobs.resize(kept);
   }
   std::sort(c.blobs.begin(), c.blobs.end(), BlobBefore);
 }

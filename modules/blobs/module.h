@@ -47,11 +47,15 @@ class BlobCameraModule final : public Module {
   void IndexOccluders(const Scene& scene);
   // Fills one camera's reading. Thread-safe across cameras.
   void See(const Scene& scene, uint32_t slot, BlobCameraRow* camera) const;
-  // Does a shape (other than the camera's and the LED's own) cross the
-  // segment from the camera at p_W to `led`? `occluders`: the candidates
-  // near the camera.
-  bool Hidden(const Scene& scene, const Vec3& p_W, int instance, uint32_t slot, const LitLed& led,
-              double distance, const std::vector<uint32_t>& occluders) const;
+  // The occluders whose (x, y) bounds meet the camera's range disc and
+  // whose heights meet [z_lo, z_hi], but those of the camera's robot (or,
+  // for a camera of no robot, those it hangs from).
+  void ListOccluders(const Scene& scene, const Vec3& p_W, double range, int instance, uint32_t slot,
+                     double z_lo, double z_hi, std::vector<uint32_t>* out) const;
+  // Does one of `occluders` (but the LED's robot's, or the shapes it hangs
+  // from) or the map cross the segment from the camera at p_W to `led`?
+  bool Hidden(const Scene& scene, const Vec3& p_W, const LitLed& led, double distance,
+              const std::vector<uint32_t>& occluders) const;
 
   bool types_found_ = false;
   bool have_types_ = false;
