@@ -33,6 +33,8 @@ struct BlobCameraRow {
                                             // around)
   double vertical_fov = 3.141592653589793;  // rad: |elevation| <= vertical_fov / 2 (pi: all)
   bool occlusion = true;                    // shapes hide LEDs
+  double angle_noise = 0;                   // rad: std dev of the noise on bearing and elevation
+  double distance_noise = 0;                // std dev of the noise on distance, x distance
   bool enabled = true;                      // off: sees nothing
   // The reading, written in the sense phase: sorted by bearing, then
   // distance, then the LED's handle.

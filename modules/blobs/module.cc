@@ -17,7 +17,9 @@
 //    The shapes of the camera's robot and of the LED's robot never hide it
 //    (ARGoS's rule: a robot's LEDs are seen through its own body); for a
 //    camera or LED of no robot, the shapes it hangs from.
-// A camera's blobs are sorted by bearing, distance, then handle: the
+// Noise, if the camera has any, is drawn per camera and step from a stream
+// keyed by (seed, camera slot, step), blob by blob in LED row order. A
+// camera's blobs are then sorted by bearing, distance, then handle: the
 // reading does not depend on the grid, the thread count or row order.
 #include "modules/blobs/module.h"
 
@@ -25,6 +27,7 @@
 #include <cmath>
 
 #include "framework/proximity_backend.h"
+#include "framework/random.h"
 #include "framework/scene.h"
 #include "framework/scheduler.h"
 #include "framework/world.h"
@@ -193,7 +196,22 @@ void BlobCameraModule::See(const Scene& scene, uint32_t slot, BlobCameraRow* cam
         c.blobs[kept++] = c.blobs[k];
     c.blobs.resize(kept);
   }
+  if (c.angle_noise > 0 || c.distance_noise > 0) AddNoise(slot, &c);
   std::sort(c.blobs.begin(), c.blobs.end(), BlobBefore);
+}
+
+void BlobCameraModule::AddNoise(uint32_t slot, BlobCameraRow* camera) const {
+  Rng rng(seed_, (uint64_t{slot} << 40) ^ step_);
+  for (Blob& b : camera->blobs) {
+    if (camera->angle_noise > 0) {
+      b.bearing = std::remainder(b.bearing + rng.Normal(0, camera->angle_noise), kTwoPi);
+      if (b.bearing == -kPi) b.bearing = kPi;  // (-pi, pi]
+      b.elevation =
+          std::clamp(b.elevation + rng.Normal(0, camera->angle_noise), -0.5 * kPi, 0.5 * kPi);
+    }
+    if (camera->distance_noise > 0)
+      b.distance = std::max(0.0, b.distance * (1 + rng.Normal(0, camera->distance_noise)));
+  }
 }
 
 void BlobCameraModule::Sense(World* world) {
@@ -204,6 +222,8 @@ void BlobCameraModule::Sense(World* world) {
     types_found_ = true;
   }
   if (!have_types_) return;
+  seed_ = world->settings().seed;
+  step_ = static_cast<uint64_t>(world->step_count());
   auto& cameras = static_cast<Rows<BlobCameraRow>&>(*scene.rows(camera_type_));
   if (cameras.size() == 0) return;
   const EnvironmentMap* map = scene.environment();

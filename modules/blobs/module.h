@@ -47,6 +47,9 @@ class BlobCameraModule final : public Module {
   void IndexOccluders(const Scene& scene);
   // Fills one camera's reading. Thread-safe across cameras.
   void See(const Scene& scene, uint32_t slot, BlobCameraRow* camera) const;
+  // Adds the camera's noise to its blobs, from a stream keyed by (the
+  // world's seed, the camera's slot, the step).
+  void AddNoise(uint32_t slot, BlobCameraRow* camera) const;
   // The occluders whose (x, y) bounds meet the camera's range disc and
   // whose heights meet [z_lo, z_hi], but those of the camera's robot (or,
   // for a camera of no robot, those it hangs from).
@@ -57,6 +60,8 @@ class BlobCameraModule final : public Module {
   bool Hidden(const Scene& scene, const Vec3& p_W, const LitLed& led, double distance,
               const std::vector<uint32_t>& occluders) const;
 
+  uint64_t seed_ = 0;  // the world's
+  uint64_t step_ = 0;  // the step being sensed
   bool types_found_ = false;
   bool have_types_ = false;
   ObjectType led_type_{}, camera_type_{};

@@ -36,6 +36,8 @@ constexpr ObjectKey kCameraKeys[] = {
      "LEDs within half of it above or below the camera's xy plane "
      "are seen; above 0 and up to 180 (180: all)"},
     {"occlusion", "true", "shapes between the camera and an LED hide it"},
+    {"angle_noise_deg", "0", "std dev of Gaussian noise added to bearing and elevation, 0..90"},
+    {"distance_noise", "0", "std dev of Gaussian noise on distance, as a fraction of it, 0..1"},
     {"enabled", "true", "off: the camera sees nothing"},
 };
 
@@ -64,6 +66,9 @@ void ReadCamera(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
   if (r.Has("fov_deg")) c.fov = ReadAperture(r, "fov_deg", 360);
   if (r.Has("vertical_fov_deg")) c.vertical_fov = ReadAperture(r, "vertical_fov_deg", 180);
   if (r.Has("occlusion")) c.occlusion = r.Bool("occlusion");
+  static constexpr NumberRule kNoiseDeg{"an angle from 0 to 90 degrees", 0, 90};
+  if (r.Has("angle_noise_deg")) c.angle_noise = r.Number("angle_noise_deg", kNoiseDeg) * kDeg;
+  if (r.Has("distance_noise")) c.distance_noise = r.Number("distance_noise", kFraction);
   if (r.Has("enabled")) c.enabled = r.Bool("enabled");
 }
 
@@ -85,6 +90,8 @@ void CopyCamera(const void* source, void* row) {
   to.fov = from.fov;
   to.vertical_fov = from.vertical_fov;
   to.occlusion = from.occlusion;
+  to.angle_noise = from.angle_noise;
+  to.distance_noise = from.distance_noise;
   to.enabled = from.enabled;
 }
 

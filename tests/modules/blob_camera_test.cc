@@ -280,6 +280,46 @@ TEST(BlobCameraTest, TheShapesASceneLedHangsFromDoNotHideIt) {
   EXPECT_EQ(blobs[1].led, mounted);
 }
 
+// Noise: over many steps the bearings and distances of an LED spread
+// about the true ones by the settings' standard deviations; the readings
+// are the same in a second world (the stream is keyed by seed, camera and
+// step, not by anything that runs).
+std::vector<Blob> NoisyReadings(int steps) {
+  BlobWorld w;
+  BlobCameraRow row;
+  row.angle_noise = 0.05;
+  row.distance_noise = 0.1;
+  const ObjectId camera = w.CameraRobot(0, 0, 0, row);
+  w.Led(w.Robot(0.5, 0, 0, false), {0, 0, 0.127}, kRed);  // bearing 0, elevation 0, 0.5 m
+  std::vector<Blob> out;
+  for (int i = 0; i < steps; ++i) {
+    const std::vector<Blob> blobs = w.See(camera);
+    EXPECT_EQ(blobs.size(), 1u);
+    if (!blobs.empty()) out.push_back(blobs[0]);
+  }
+  return out;
+}
+
+TEST(BlobCameraTest, NoiseSpreadsReadingsByTheGivenDeviationsTheSameEveryRun) {
+  const std::vector<Blob> a = NoisyReadings(400), b = NoisyReadings(400);
+  ASSERT_EQ(a.size(), 400u);
+  double bearing2 = 0, elevation2 = 0, distance_mean = 0, distance2 = 0;
+  for (size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].bearing, b[i].bearing);
+    EXPECT_EQ(a[i].distance, b[i].distance);
+    bearing2 += a[i].bearing * a[i].bearing;
+    elevation2 += a[i].elevation * a[i].elevation;
+    distance_mean += a[i].distance / a.size();
+    distance2 += (a[i].distance - 0.5) * (a[i].distance - 0.5);
+  }
+  const double n = static_cast<double>(a.size());
+  EXPECT_NEAR(std::sqrt(bearing2 / n), 0.05, 0.01);
+  EXPECT_NEAR(std::sqrt(elevation2 / n), 0.05, 0.01);
+  EXPECT_NEAR(std::sqrt(distance2 / n), 0.05, 0.01);  // 10% of 0.5 m
+  EXPECT_NEAR(distance_mean, 0.5, 0.01);
+  EXPECT_NE(a[0].bearing, a[1].bearing);  // a new draw each step
+}
+
 TEST(BlobCameraTest, CopiesOfAModelWithAnLedAndACameraSeeEachOther) {
   BlobWorld w;
   const ObjectId first = w.Robot(0, 0);

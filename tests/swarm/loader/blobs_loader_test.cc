@@ -42,6 +42,8 @@ TEST_F(BlobsLoaderTest, BadKeysAreFileLineColumnErrors) {
   EXPECT_CONTAINS(ErrorOf("blob_camera", "  vertical_fov_deg: 181\n"),
                   "thing.yaml:4:21: 'vertical_fov_deg' must be an angle above 0 and up to 180");
   EXPECT_CONTAINS(ErrorOf("blob_camera", "  occlusion: 3\n"), "thing.yaml:4:14:");
+  EXPECT_CONTAINS(ErrorOf("blob_camera", "  angle_noise_deg: -1\n"), "thing.yaml:4:20:");
+  EXPECT_CONTAINS(ErrorOf("blob_camera", "  distance_noise: 2\n"), "thing.yaml:4:19:");
   EXPECT_EQ(ErrorOf("blob_camera", "  fov_deg: 360\n  vertical_fov_deg: 180\n"), "(no error)");
   EXPECT_EQ(ErrorOf("led", "  color: [0, 0, 0]\n  on: false\n"), "(no error)");
 }
@@ -62,7 +64,7 @@ objects:
   children:
     - {name: led, type: led, color: [0, 0.5, 1], on: false, radius: 0.02}
     - {name: cam, type: blob_camera, range: 1.5, fov_deg: 90, vertical_fov_deg: 60,
-       occlusion: false, enabled: false}
+       occlusion: false, enabled: false, angle_noise_deg: 2, distance_noise: 0.05}
 )");
   LoadedWorld w = Load(R"(simulation: {physics: kinematic}
 models:
@@ -79,6 +81,8 @@ models:
   EXPECT_NEAR(cam.vertical_fov, M_PI / 3, 1e-15);
   EXPECT_FALSE(cam.occlusion);
   EXPECT_FALSE(cam.enabled);
+  EXPECT_NEAR(cam.angle_noise, 2 * M_PI / 180, 1e-15);
+  EXPECT_EQ(cam.distance_noise, 0.05);
   EXPECT_EQ(RowOf<LedRow>(*w.world, "/bot#1/led").radius, 0.04);
   EXPECT_EQ(RowOf<BlobCameraRow>(*w.world, "/bot#1/cam").range, 3.0);
   EXPECT_NEAR(RowOf<BlobCameraRow>(*w.world, "/bot#1/cam").fov, M_PI / 2, 1e-15);

@@ -1,4 +1,4 @@
--- Turns the mount, recolours and switches the LEDs, rescales every other
+-- Turns the mount (the narrow camera is noisy), recolours and switches the LEDs, rescales every other
 -- robot at run time, and records what the cameras see, so that the blob
 -- module's run-time paths reach the state hash.
 local base, mount, inner, tip, omni, narrow
@@ -25,5 +25,6 @@ function sysCall_actuation()
   local sum = 0
   for _, b in ipairs(sim.readBlobCamera(omni)) do sum = sum + b.bearing + b.distance end
   sim.recordMetric('omni', sum)
-  sim.recordMetric('narrow', #sim.readBlobCamera(narrow))
+  local seen = sim.readBlobCamera(narrow)
+  sim.recordMetric('narrow', #seen > 0 and seen[1].bearing + seen[1].distance or 0)
 end
