@@ -82,17 +82,11 @@ void ScaleCamera(const ObjectTypeDescriptor&, void* row, double s, ScaleContext*
   for (Blob& blob : c.blobs) blob.distance *= s;
 }
 
-// A copy sees afresh.
+// A copy sees afresh: the settings, no blobs.
 void CopyCamera(const void* source, void* row) {
-  const BlobCameraRow& from = *static_cast<const BlobCameraRow*>(source);
   BlobCameraRow& to = *static_cast<BlobCameraRow*>(row);
-  to.range = from.range;
-  to.fov = from.fov;
-  to.vertical_fov = from.vertical_fov;
-  to.occlusion = from.occlusion;
-  to.angle_noise = from.angle_noise;
-  to.distance_noise = from.distance_noise;
-  to.enabled = from.enabled;
+  to = *static_cast<const BlobCameraRow*>(source);
+  to.blobs.clear();
 }
 
 // An LED's colour and switch change what other robots see.
