@@ -177,7 +177,8 @@ void BlobCameraModule::See(const Scene& scene, uint32_t slot, BlobCameraRow* cam
     const double d2 = d_W.SquaredNorm();
     if (!(d2 <= range2) || d2 == 0) continue;
     const Vec3 d_C = q_CW.Rotate(d_W);
-    const double bearing = std::atan2(d_C.y, d_C.x);
+    double bearing = std::atan2(d_C.y, d_C.x);
+    if (bearing == -kPi) bearing = kPi;  // (-pi, pi]: straight behind is +pi
     if (!all_around && std::abs(bearing) > half_fov) continue;
     const double elevation = std::atan2(d_C.z, std::hypot(d_C.x, d_C.y));
     if (!all_up_down && std::abs(elevation) > half_vertical) continue;

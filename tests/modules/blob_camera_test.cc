@@ -153,7 +153,7 @@ TEST(BlobCameraTest, ReadsInBearingOrderWithEachLedsColour) {
   w.LedRobot(0, -0.5, kBlue);
   w.LedRobot(0.5, 0, kRed);
   w.LedRobot(0, 0.5, kGreen);
-  w.LedRobot(-0.7, 0, kBlue);
+  w.LedRobot(-0.7, -0.0, kBlue);  // straight behind, from below: still +pi
   const std::vector<Blob> blobs = w.See(camera);
   ASSERT_EQ(blobs.size(), 4u);
   const Vec3 colors[4] = {kBlue, kRed, kGreen, kBlue};
