@@ -96,7 +96,7 @@ void BlobCameraModule::IndexLeds(const Scene& scene, ObjectType led_type) {
   if (!leds_.empty()) led_grid_.Build(led_items_);
 }
 
-void BlobCameraModule::IndexOccluders(const Scene& scene) {
+void BlobCameraModule::IndexOccluders(const Scene& scene, double z_lo, double z_hi) {
   occluders_.clear();
   occluder_items_.clear();
   const auto shapes = scene.shapes();
@@ -113,9 +113,13 @@ void BlobCameraModule::IndexOccluders(const Scene& scene) {
                                   std::abs(o.hi.x) + std::abs(o.hi.y) + std::abs(o.hi.z));
     o.lo = o.lo - Vec3{margin, margin, margin};
     o.hi = o.hi + Vec3{margin, margin, margin};
+    if (o.hi.z < z_lo || o.lo.z > z_hi) {
+      occluders_.pop_back();
+      continue;
+    }
     occluder_items_.push_back({0.5 * (o.lo.x + o.hi.x), 0.5 * (o.lo.y + o.hi.y),
                                0.5 * std::hypot(o.hi.x - o.lo.x, o.hi.y - o.lo.y),
-                               static_cast<uint32_t>(r)});
+                               static_cast<uint32_t>(occluder_items_.size())});
   }
   occluder_grid_.Build(occluder_items_);
 }
@@ -230,9 +234,19 @@ void BlobCameraModule::Sense(World* world) {
   const EnvironmentMap* map = scene.environment();
   map_ = map != nullptr && !map->boxes.empty() ? world->proximity() : nullptr;
   IndexLeds(scene, led_type_);
+  // The heights every occlusion segment stays within: those of the lit
+  // LEDs and of the cameras that test occlusion.
   bool occlusion = false;
-  for (const BlobCameraRow& c : cameras.rows) occlusion |= c.enabled && c.occlusion;
-  if (occlusion && !leds_.empty()) IndexOccluders(scene);
+  double z_lo = INFINITY, z_hi = -INFINITY;
+  for (size_t r = 0; r < cameras.size(); ++r) {
+    if (!cameras.rows[r].enabled || !cameras.rows[r].occlusion) continue;
+    occlusion = true;
+    const double z = scene.world_pose_at(cameras.owners[r]).p.z;
+    z_lo = std::min(z_lo, z), z_hi = std::max(z_hi, z);
+  }
+  for (const LitLed& led : leds_)
+    z_lo = std::min(z_lo, led.p_W.z), z_hi = std::max(z_hi, led.p_W.z);
+  if (occlusion && !leds_.empty()) IndexOccluders(scene, z_lo, z_hi);
   world->scheduler().ParallelFor(0, static_cast<int64_t>(cameras.size()), kCameraGrain,
                                  [&](int64_t begin, int64_t end) {
                                    for (int64_t r = begin; r < end; ++r)

@@ -44,7 +44,9 @@ class BlobCameraModule final : public Module {
   };
 
   void IndexLeds(const Scene& scene, ObjectType led_type);
-  void IndexOccluders(const Scene& scene);
+  // The shapes whose heights meet [z_lo, z_hi] (no segment from a camera
+  // to an LED leaves that band).
+  void IndexOccluders(const Scene& scene, double z_lo, double z_hi);
   // Fills one camera's reading. Thread-safe across cameras.
   void See(const Scene& scene, uint32_t slot, BlobCameraRow* camera) const;
   // Adds the camera's noise to its blobs, from a stream keyed by (the
