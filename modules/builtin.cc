@@ -2,6 +2,7 @@
 
 #include "framework/dynamics_backend.h"
 #include "framework/registry.h"
+#include "modules/blobs/blobs.h"
 #include "modules/collision/collision.h"
 #include "modules/dynamics/box2d/box2d_backend.h"
 #include "modules/dynamics/kinematic/kinematic_backend.h"
@@ -47,6 +48,7 @@ void RegisterBuiltinModules(ModuleRegistry* registry) {
   filters::Register(registry);
   rendering::RegisterObjects(registry);
   graphs::Register(registry);
+  blobs::Register(registry);
 }
 
 }  // namespace swarmsim

@@ -130,7 +130,9 @@ ModuleDescriptor RenderingModuleDescriptor() {
 
 void Render(const World& world, const View& view, Image* image) {
   DrawList list;
-  BuildDrawList(world, kSensorSegments, &list);
+  // A view from above keeps LEDs at least 3 pixels across.
+  const double pixel = view.orthographic ? view.ortho_width / std::max(1, view.width) : 0;
+  BuildDrawList(world, kSensorSegments, &list, 1.5 * pixel);
   Draw(list, view, DrawOptions{}, image);
 }
 
