@@ -3,6 +3,7 @@
 // third-party types (modules/rendering draws into it with OSMesa).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 

@@ -86,8 +86,12 @@ Vec3 ClosestOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& 
 }
 
 TriangleMesh::TriangleMesh(std::string name, std::vector<Vec3> vertices,
-                           std::vector<MeshTriangle> triangles)
+                           std::vector<MeshTriangle> triangles, std::vector<Vec3> colors)
     : name_(std::move(name)), vertices_(std::move(vertices)) {
+  if (!colors.empty() && colors.size() != triangles.size())
+    throw Error("mesh '" + name_ + "' has " + std::to_string(colors.size()) + " colours for " +
+                std::to_string(triangles.size()) + " triangles");
+  std::vector<uint32_t> origin;  // input index of each kept triangle
   const uint32_t n = static_cast<uint32_t>(vertices_.size());
   for (const Vec3& v : vertices_)
     if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
@@ -104,6 +108,7 @@ TriangleMesh::TriangleMesh(std::string name, std::vector<Vec3> vertices,
     const Vec3 e2 = vertices_[tri.v[2]] - vertices_[tri.v[0]];
     const double scale = e1.SquaredNorm() + e2.SquaredNorm();
     if (!(e1.Cross(e2).SquaredNorm() > 1e-24 * scale * scale)) continue;
+    origin.push_back(static_cast<uint32_t>(&tri - triangles.data()));
     triangles_.push_back(tri);
   }
   if (triangles_.empty()) throw Error("mesh '" + name_ + "' has no triangles");
@@ -139,11 +144,15 @@ TriangleMesh::TriangleMesh(std::string name, std::vector<Vec3> vertices,
     centroids.push_back((vertices_[tri.v[0]] + vertices_[tri.v[1]] + vertices_[tri.v[2]]) / 3.0);
   nodes_.reserve(2 * triangles_.size() / kLeafTriangles + 1);
   nodes_.emplace_back();
-  Build(0, 0, static_cast<uint32_t>(triangles_.size()), &centroids);
+  Build(0, 0, static_cast<uint32_t>(triangles_.size()), &centroids, &origin);
+  if (!colors.empty()) {
+    colors_.reserve(triangles_.size());
+    for (uint32_t i : origin) colors_.push_back(colors[i]);
+  }
 }
 
 void TriangleMesh::Build(uint32_t index, uint32_t first, uint32_t count,
-                         std::vector<Vec3>* centroids) {
+                         std::vector<Vec3>* centroids, std::vector<uint32_t>* origin) {
   // nodes_ may grow below: always address the node by index.
   Vec3 lo{kInf, kInf, kInf}, hi = -lo, clo = lo, chi = hi;
   for (uint32_t i = first; i < first + count; ++i) {
@@ -170,12 +179,15 @@ void TriangleMesh::Build(uint32_t index, uint32_t first, uint32_t count,
   });
   std::vector<MeshTriangle> tris(count);
   std::vector<Vec3> cents(count);
+  std::vector<uint32_t> origins(count);
   for (uint32_t i = 0; i < count; ++i) {
     tris[i] = triangles_[order[i]];
     cents[i] = (*centroids)[order[i]];
+    origins[i] = (*origin)[order[i]];
   }
   std::copy(tris.begin(), tris.end(), triangles_.begin() + first);
   std::copy(cents.begin(), cents.end(), centroids->begin() + first);
+  std::copy(origins.begin(), origins.end(), origin->begin() + first);
   // Children are adjacent: left at `left`, right at `left + 1`.
   const uint32_t left = static_cast<uint32_t>(nodes_.size());
   nodes_[index].first = left;
@@ -183,8 +195,8 @@ void TriangleMesh::Build(uint32_t index, uint32_t first, uint32_t count,
   nodes_.emplace_back();
   nodes_.emplace_back();
   const uint32_t half = count / 2;
-  Build(left, first, half, centroids);
-  Build(left + 1, first + half, count - half, centroids);
+  Build(left, first, half, centroids, origin);
+  Build(left + 1, first + half, count - half, centroids, origin);
 }
 
 bool TriangleMesh::NearestHit(const Vec3& o, const Vec3& d, double max_t, double* t,

@@ -45,12 +45,17 @@ class TriangleMesh {
   // Builds the asset and its BVH. Throws swarmsim::Error (naming `name`) for
   // no triangles, an index out of range or a non-finite vertex. Triangles
   // whose corners coincide are dropped; the others are reordered by the BVH.
-  TriangleMesh(std::string name, std::vector<Vec3> vertices, std::vector<MeshTriangle> triangles);
+  // `colors`: none, or one RGB (0..1) per triangle, the file's materials
+  // (they follow their triangles).
+  TriangleMesh(std::string name, std::vector<Vec3> vertices, std::vector<MeshTriangle> triangles,
+               std::vector<Vec3> colors = {});
 
   const std::string& name() const { return name_; }  // the file, for messages
   std::span<const Vec3> vertices() const { return vertices_; }
   std::span<const MeshTriangle> triangles() const { return triangles_; }
   std::span<const MeshBvhNode> bvh() const { return nodes_; }
+  // One RGB per triangle (triangles' order), or empty: the file had no materials.
+  std::span<const Vec3> colors() const { return colors_; }
   const Vec3& lo() const { return lo_; }  // bounds of the vertices
   const Vec3& hi() const { return hi_; }
   bool closed() const { return closed_; }
@@ -70,13 +75,16 @@ class TriangleMesh {
 
  private:
   // Fills node `index` with triangles [first, first + count) and its subtree.
-  void Build(uint32_t index, uint32_t first, uint32_t count, std::vector<Vec3>* centroids);
+  // `origin`: each triangle's index in the constructor's list, reordered alike.
+  void Build(uint32_t index, uint32_t first, uint32_t count, std::vector<Vec3>* centroids,
+             std::vector<uint32_t>* origin);
   // Nearest triangle hit in (0 <= t <= max_t); *entering: the ray enters there.
   bool NearestHit(const Vec3& o, const Vec3& d, double max_t, double* t, bool* entering) const;
 
   std::string name_;
   std::vector<Vec3> vertices_;           // (vertices)
   std::vector<MeshTriangle> triangles_;  // (triangles), BVH order
+  std::vector<Vec3> colors_;             // (triangles) or empty
   std::vector<MeshBvhNode> nodes_;       // (nodes), root first
   Vec3 lo_, hi_;
   bool closed_ = false;

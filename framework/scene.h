@@ -58,7 +58,10 @@ struct ShapeData {
   double mass = 1.0;         // kg, dynamic shapes only
   double friction = 0.7;     // Coulomb coefficient
   double restitution = 0.0;
-  Vec3 color{0.7, 0.7, 0.7};                 // RGB in [0, 1]
+  Vec3 color{0.7, 0.7, 0.7};  // RGB in [0, 1]
+  // kMesh: drawn in the mesh file's material colours, if it has any, until
+  // a colour is given (the `color` key, sim.setShapeColor).
+  bool mesh_colors = true;
   std::shared_ptr<const TriangleMesh> mesh;  // kMesh: the asset (shared by copies), else null
 
   // Radius of the shape's footprint circle in its xy plane (for broad phases).

@@ -12,6 +12,7 @@
 #include "modules/mill/mill.h"
 #include "modules/paint/paint_layer.h"
 #include "modules/proximity/proximity.h"
+#include "modules/rendering/objects.h"
 
 namespace swarmsim {
 
@@ -42,6 +43,7 @@ void RegisterBuiltinModules(ModuleRegistry* registry) {
     registry->RegisterModule(std::move(metric));
   collision::Register(registry);
   mill::Register(registry);
+  rendering::RegisterObjects(registry);
   graphs::Register(registry);
 }
 

@@ -43,8 +43,9 @@ void Scale(const ObjectTypeDescriptor&, void* row, double s, ScaleContext* conte
     for (Vec3& v : vertices) v = v * s;
     std::vector<MeshTriangle> triangles(shape.mesh->triangles().begin(),
                                         shape.mesh->triangles().end());
-    scaled = std::make_shared<const TriangleMesh>(shape.mesh->name(), std::move(vertices),
-                                                  std::move(triangles));
+    scaled = std::make_shared<const TriangleMesh>(
+        shape.mesh->name(), std::move(vertices), std::move(triangles),
+        std::vector<Vec3>(shape.mesh->colors().begin(), shape.mesh->colors().end()));
   }
   shape.mesh = std::static_pointer_cast<const TriangleMesh>(scaled);
   shape.size = shape.mesh->CenteredExtents();
@@ -97,7 +98,10 @@ void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
   if (r.Has("mass")) s.mass = r.Number("mass", kPositive);
   if (r.Has("friction")) s.friction = r.Number("friction", kNonNegative);
   if (r.Has("restitution")) s.restitution = r.Number("restitution", kFraction);
-  if (r.Has("color")) s.color = r.Vector3("color", kFraction);
+  if (r.Has("color")) {
+    s.color = r.Vector3("color", kFraction);
+    s.mesh_colors = false;
+  }
 }
 
 }  // namespace

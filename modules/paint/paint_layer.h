@@ -45,6 +45,7 @@ class PaintLayer final : public Observer {
   void WriteOutputs(const std::filesystem::path& dir) const override;
   void ListOutputs(std::vector<OutputFile>* out) const override;
 
+  const PaintSettings& settings() const { return settings_; }
   int width() const { return width_; }
   int height() const { return height_; }
   const std::vector<uint8_t>& rgb() const { return rgb_; }  // (height x width x 3)

@@ -1,5 +1,6 @@
 #include "swarm/loader/mesh.h"
 
+#include <assimp/material.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
@@ -39,7 +40,7 @@ std::shared_ptr<const TriangleMesh> MeshCache::Get(const fs::path& path, const V
   std::shared_ptr<const TriangleMesh> mesh;
   try {
     mesh = std::make_shared<const TriangleMesh>(DisplayPath(path), std::move(vertices),
-                                                file->second->triangles);
+                                                file->second->triangles, file->second->colors);
   } catch (const Error& e) {
     throw Error((where.empty() ? "" : where + ": ") + e.what());
   }
@@ -62,15 +63,36 @@ std::shared_ptr<const MeshCache::Welded> ReadMeshFile(const fs::path& path,
   if (bytes.empty()) throw Error(prefix + "mesh file '" + text + "' is empty");
 
   Assimp::Importer importer;
-  const aiScene* scene = importer.ReadFileFromMemory(
-      bytes.data(), bytes.size(),
-      aiProcess_Triangulate | aiProcess_PreTransformVertices | aiProcess_SortByPType,
-      ext.c_str() + 1);
+  const unsigned flags =
+      aiProcess_Triangulate | aiProcess_PreTransformVertices | aiProcess_SortByPType;
+  // An OBJ file is read from its folder, so that its material library
+  // (mtllib x.mtl beside it) gives the colours; an STL file has none.
+  const aiScene* scene = ext == ".obj" ? importer.ReadFile(path.string(), flags)
+                                       : importer.ReadFileFromMemory(bytes.data(), bytes.size(),
+                                                                     flags, ext.c_str() + 1);
   if (!scene)
     throw Error(prefix + "cannot read mesh file '" + text + "': " + importer.GetErrorString());
 
   auto out = std::make_shared<MeshCache::Welded>();
   std::map<std::array<double, 3>, uint32_t> index_of;
+  // The diffuse colour of each part's material; assimp's stand-in material
+  // for a file without any has none.
+  bool any_color = false;
+  std::vector<Vec3> part_color(scene->mNumMeshes, Vec3{0.7, 0.7, 0.7});
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+    const unsigned index = scene->mMeshes[m]->mMaterialIndex;
+    if (index >= scene->mNumMaterials) continue;
+    const aiMaterial* material = scene->mMaterials[index];
+    aiString name;
+    aiColor4D diffuse;
+    if (material->Get(AI_MATKEY_NAME, name) == AI_SUCCESS &&
+        std::string(name.C_Str()) == AI_DEFAULT_MATERIAL_NAME)
+      continue;
+    if (aiGetMaterialColor(material, AI_MATKEY_COLOR_DIFFUSE, &diffuse) != AI_SUCCESS) continue;
+    part_color[m] = {std::clamp<double>(diffuse.r, 0, 1), std::clamp<double>(diffuse.g, 0, 1),
+                     std::clamp<double>(diffuse.b, 0, 1)};
+    any_color = true;
+  }
   for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
     const aiMesh* mesh = scene->mMeshes[m];
     for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
@@ -86,6 +108,7 @@ std::shared_ptr<const MeshCache::Welded> ReadMeshFile(const fs::path& path,
       }
       if (tri.v[0] == tri.v[1] || tri.v[1] == tri.v[2] || tri.v[0] == tri.v[2]) continue;
       out->triangles.push_back(tri);
+      if (any_color) out->colors.push_back(part_color[m]);
     }
   }
   if (out->triangles.empty()) throw Error(prefix + "mesh file '" + text + "' has no triangles");

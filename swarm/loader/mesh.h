@@ -30,6 +30,7 @@ class MeshCache {
   struct Welded {
     std::vector<Vec3> vertices;
     std::vector<MeshTriangle> triangles;
+    std::vector<Vec3> colors;  // per triangle, the materials' diffuse colours; or empty
   };
 
  private:

@@ -1,0 +1,256 @@
+#include "modules/rendering/geometry.h"
+
+#include <algorithm>
+#include <cmath>
+#include <mutex>
+
+#include "framework/environment.h"
+#include "framework/mesh.h"
+#include "framework/scene.h"
+#include "framework/world.h"
+#include "modules/paint/paint_layer.h"
+#include "modules/rendering/objects.h"
+
+namespace swarmsim::rendering {
+
+namespace {
+
+// A primitive in its own frame: triangles (3 vertices each) with normals,
+// and a colour per vertex for meshes with materials.
+struct Primitive {
+  std::vector<Vec3> p, n;
+  std::vector<Vec3> c;  // per vertex, or empty: the shape's colour
+};
+
+void AddTriangle(Primitive* m, const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& na,
+                 const Vec3& nb, const Vec3& nc) {
+  m->p.insert(m->p.end(), {a, b, c});
+  m->n.insert(m->n.end(), {na, nb, nc});
+}
+
+void AddQuad(Primitive* m, const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d,
+             const Vec3& n) {
+  AddTriangle(m, a, b, c, n, n, n);
+  AddTriangle(m, a, c, d, n, n, n);
+}
+
+// The unit box [-0.5, 0.5]^3, counter-clockwise seen from outside.
+Primitive UnitBox() {
+  Primitive m;
+  for (int axis = 0; axis < 3; ++axis) {
+    for (int sign = -1; sign <= 1; sign += 2) {
+      Vec3 n{};
+      (&n.x)[axis] = sign;
+      const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+      Vec3 c[4];
+      const double us[4] = {-0.5, 0.5, 0.5, -0.5}, vs[4] = {-0.5, -0.5, 0.5, 0.5};
+      for (int k = 0; k < 4; ++k) {
+        (&c[k].x)[axis] = 0.5 * sign;
+        (&c[k].x)[u] = us[k];
+        (&c[k].x)[v] = vs[k] * sign;
+      }
+      AddQuad(&m, c[0], c[1], c[2], c[3], n);
+    }
+  }
+  return m;
+}
+
+// Radius 1 about z, z from z0 to z1; caps when asked.
+void AddTube(Primitive* m, int segments, double z0, double z1, bool caps) {
+  for (int i = 0; i < segments; ++i) {
+    const double a0 = 2 * M_PI * i / segments, a1 = 2 * M_PI * (i + 1) / segments;
+    const Vec3 r0{std::cos(a0), std::sin(a0), 0}, r1{std::cos(a1), std::sin(a1), 0};
+    AddTriangle(m, r0 + Vec3{0, 0, z0}, r1 + Vec3{0, 0, z0}, r1 + Vec3{0, 0, z1}, r0, r1, r1);
+    AddTriangle(m, r0 + Vec3{0, 0, z0}, r1 + Vec3{0, 0, z1}, r0 + Vec3{0, 0, z1}, r0, r1, r0);
+    if (caps) {
+      const Vec3 up{0, 0, 1}, down{0, 0, -1};
+      AddTriangle(m, Vec3{0, 0, z1}, r0 + Vec3{0, 0, z1}, r1 + Vec3{0, 0, z1}, up, up, up);
+      AddTriangle(m, Vec3{0, 0, z0}, r1 + Vec3{0, 0, z0}, r0 + Vec3{0, 0, z0}, down, down, down);
+    }
+  }
+}
+
+// The unit sphere's band of polar angles [t0, t1] (0: +z), moved by dz.
+void AddSphereBand(Primitive* m, int segments, int stacks, double t0, double t1, double dz) {
+  for (int j = 0; j < stacks; ++j) {
+    const double a = t0 + (t1 - t0) * j / stacks, b = t0 + (t1 - t0) * (j + 1) / stacks;
+    for (int i = 0; i < segments; ++i) {
+      const double p0 = 2 * M_PI * i / segments, p1 = 2 * M_PI * (i + 1) / segments;
+      const auto at = [](double t, double p) {
+        return Vec3{std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t)};
+      };
+      const Vec3 v00 = at(a, p0), v01 = at(a, p1), v10 = at(b, p0), v11 = at(b, p1);
+      const Vec3 d{0, 0, dz};
+      if (j > 0 || t0 > 0) AddTriangle(m, v00 + d, v10 + d, v01 + d, v00, v10, v01);
+      if (j < stacks - 1 || t1 < M_PI) AddTriangle(m, v01 + d, v10 + d, v11 + d, v01, v10, v11);
+      if (j == 0 && t0 == 0) AddTriangle(m, v00 + d, v10 + d, v11 + d, v00, v10, v11);
+      if (j == stacks - 1 && t1 >= M_PI) AddTriangle(m, v00 + d, v10 + d, v11 + d, v00, v10, v11);
+    }
+  }
+}
+
+struct Primitives {
+  Primitive box, cylinder, sphere;
+  explicit Primitives(int segments) {
+    box = UnitBox();
+    AddTube(&cylinder, segments, -0.5, 0.5, true);
+    AddSphereBand(&sphere, segments, std::max(2, segments / 2), 0, M_PI, 0);
+  }
+};
+
+const Primitives& PrimitivesFor(int segments) {
+  static std::mutex mutex;
+  static std::vector<std::pair<int, std::unique_ptr<Primitives>>> cache;
+  const std::lock_guard lock(mutex);
+  for (const auto& [n, p] : cache)
+    if (n == segments) return *p;
+  cache.emplace_back(segments, std::make_unique<Primitives>(segments));
+  return *cache.back().second;
+}
+
+// A capsule of radius r and total height h about z (h >= 2r): built per
+// shape (its caps do not scale with the height).
+Primitive Capsule(int segments, double r, double h) {
+  Primitive m;
+  const double half = std::max(0.0, h / 2 - r) / r;  // in radii
+  AddTube(&m, segments, -half, half, false);
+  AddSphereBand(&m, segments, std::max(1, segments / 4), 0, M_PI / 2, half);
+  AddSphereBand(&m, segments, std::max(1, segments / 4), M_PI / 2, M_PI, -half);
+  return m;
+}
+
+// Flat-shaded triangles of a mesh, in its frame.
+Primitive MeshPrimitive(const TriangleMesh& mesh) {
+  Primitive m;
+  const auto v = mesh.vertices();
+  const auto colors = mesh.colors();
+  for (size_t i = 0; i < mesh.triangles().size(); ++i) {
+    const MeshTriangle& t = mesh.triangles()[i];
+    const Vec3 &a = v[t.v[0]], &b = v[t.v[1]], &c = v[t.v[2]];
+    const Vec3 n = (b - a).Cross(c - a).Normalized();
+    AddTriangle(&m, a, b, c, n, n, n);
+    if (!colors.empty()) m.c.insert(m.c.end(), {colors[i], colors[i], colors[i]});
+  }
+  return m;
+}
+
+const Primitive& MeshFor(const TriangleMesh* mesh) {
+  static std::mutex mutex;
+  static std::vector<std::pair<const TriangleMesh*, std::unique_ptr<Primitive>>> cache;
+  const std::lock_guard lock(mutex);
+  for (const auto& [m, p] : cache)
+    if (m == mesh) return *p;
+  cache.emplace_back(mesh, std::make_unique<Primitive>(MeshPrimitive(*mesh)));
+  return *cache.back().second;
+}
+
+uint8_t Byte(double c) { return static_cast<uint8_t>(std::lround(std::clamp(c, 0.0, 1.0) * 255)); }
+
+// Appends `prim` scaled by `scale` and placed at X_WS.
+void Append(DrawList* list, uint32_t slot, const Primitive& prim, const Vec3& scale,
+            const Pose& X_WS, const Vec3& color, bool emissive, bool own_colors = false) {
+  DrawItem item{};
+  item.slot = slot;
+  item.first = static_cast<uint32_t>(list->xyz.size() / 3);
+  item.count = static_cast<uint32_t>(prim.p.size());
+  item.emissive = emissive;
+  const uint8_t rgb[3] = {Byte(color.x), Byte(color.y), Byte(color.z)};
+  Vec3 lo{INFINITY, INFINITY, INFINITY}, hi = -lo;
+  for (size_t i = 0; i < prim.p.size(); ++i) {
+    const Vec3& p0 = prim.p[i];
+    const Vec3 p = X_WS * Vec3{p0.x * scale.x, p0.y * scale.y, p0.z * scale.z};
+    const Vec3 n = X_WS.q.Rotate(prim.n[i]);
+    list->xyz.insert(list->xyz.end(),
+                     {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)});
+    list->normal.insert(list->normal.end(), {static_cast<float>(n.x), static_cast<float>(n.y),
+                                             static_cast<float>(n.z)});
+    if (own_colors) {
+      const Vec3& c = prim.c[i];
+      list->rgb.insert(list->rgb.end(), {Byte(c.x), Byte(c.y), Byte(c.z)});
+    } else {
+      list->rgb.insert(list->rgb.end(), rgb, rgb + 3);
+    }
+    lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+    hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+  }
+  const Vec3 c = (lo + hi) * 0.5;
+  item.center[0] = static_cast<float>(c.x);
+  item.center[1] = static_cast<float>(c.y);
+  item.center[2] = static_cast<float>(c.z);
+  item.radius = static_cast<float>((hi - lo).Norm() * 0.5) + 1e-4f;
+  if (item.count > 0) list->items.push_back(item);
+  if (item.count > 0 && !emissive) {
+    if (!list->has_bounds) {
+      list->has_bounds = true;
+      list->lo = lo;
+      list->hi = hi;
+    } else {
+      list->lo = {std::min(list->lo.x, lo.x), std::min(list->lo.y, lo.y),
+                  std::min(list->lo.z, lo.z)};
+      list->hi = {std::max(list->hi.x, hi.x), std::max(list->hi.y, hi.y),
+                  std::max(list->hi.z, hi.z)};
+    }
+  }
+}
+
+}  // namespace
+
+void BuildDrawList(const World& world, int segments, DrawList* list) {
+  const Scene& scene = world.scene();
+  list->xyz.clear();
+  list->normal.clear();
+  list->rgb.clear();
+  list->items.clear();
+  list->lights.clear();
+  list->lo = list->hi = Vec3{};
+  list->has_bounds = false;
+  const Primitives& prims = PrimitivesFor(segments);
+  // Shapes, in row order.
+  const auto shapes = scene.shapes();
+  const auto owners = scene.shape_owners();
+  for (size_t r = 0; r < shapes.size(); ++r) {
+    const ShapeData& s = shapes[r];
+    const uint32_t slot = owners[r];
+    if (!scene.alive_at(slot)) continue;
+    const Pose& X = scene.world_pose_at(slot);
+    switch (s.kind) {
+      case ShapeKind::kBox: Append(list, slot, prims.box, s.size, X, s.color, false); break;
+      case ShapeKind::kCylinder:
+        Append(list, slot, prims.cylinder, {s.size.x, s.size.x, s.size.z}, X, s.color, false);
+        break;
+      case ShapeKind::kSphere:
+        Append(list, slot, prims.sphere, {s.size.x, s.size.x, s.size.x}, X, s.color, false);
+        break;
+      case ShapeKind::kCapsule:
+        Append(list, slot, Capsule(segments, s.size.x, s.size.z), {s.size.x, s.size.x, s.size.x}, X,
+               s.color, false);
+        break;
+      case ShapeKind::kMesh:
+        if (s.mesh) {
+          const Primitive& mesh = MeshFor(s.mesh.get());
+          Append(list, slot, mesh, {1, 1, 1}, X, s.color, false, s.mesh_colors && !mesh.c.empty());
+        }
+        break;
+    }
+  }
+  // The environment map's boxes.
+  if (const EnvironmentMap* env = scene.environment()) {
+    const Vec3 color{0.55, 0.5, 0.45};
+    for (const EnvironmentBox& b : env->boxes)
+      Append(list, kNoSlot, prims.box, b.hi - b.lo, Pose{(b.lo + b.hi) * 0.5, Quat{}}, color,
+             false);
+  }
+  // The module's own objects: LEDs (emissive spheres) and lights.
+  CollectLights(scene, &list->lights, &list->scene_has_lights);
+  list->step = world.step_count();
+  // The paint layer, laid on the floor.
+  list->floor = {};
+  if (const Module* m = world.find_module("paint"))
+    if (const auto* paint = dynamic_cast<const paint::PaintLayer*>(m)) {
+      const paint::PaintSettings& ps = paint->settings();
+      list->floor = {true,     ps.min_x,       ps.min_y,        ps.max_x,
+                     ps.max_y, paint->width(), paint->height(), paint->rgb().data()};
+    }
+}
+
+}  // namespace swarmsim::rendering
