@@ -321,6 +321,29 @@ TEST(GraphsRunTest, CsvIsWrittenWithoutGnuplot) {
   EXPECT_EQ(csvs, 3);
 }
 
+// A graph with nothing to draw (a script stream no script sets) still gets
+// its CSV (nan) and a PNG saying so; the other graphs are drawn too (one
+// gnuplot script holds them all: an empty plot must not stop it).
+TEST(GraphsRunTest, GraphsWithoutDataGetAnEmptyPlotAndTheOthersTheirs) {
+  const fs::path dir =
+      BotWorld("nodata",
+               "    - {name: a, type: graph, streams: [\"script never\"]}\n"
+               "    - {name: b, type: graph, kind: xyz, streams: [\"x = script\", \"y = script\", "
+               "\"z = script\"]}\n"
+               "    - {name: c, type: graph, streams: [\"position : x\"]}\n");
+  const auto r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 3 --quiet --out " +
+                            (dir / "out").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.output.find("warning"), std::string::npos) << r.output;
+  for (int k = 0; k < 3; ++k)
+    for (const char* name : {"a", "b", "c"})
+      EXPECT_TRUE(
+          IsPng(dir / "out/graphs" / ("bot#" + std::to_string(k)) / (name + std::string(".png"))))
+          << k << name;
+  for (const auto& row : ReadCsv(dir / "out/graphs/bot#0/a.csv").rows)
+    EXPECT_TRUE(std::isnan(row[1]));
+}
+
 TEST(GraphsRunTest, CyclicBufferKeepsTheLastSamples) {
   const fs::path dir = BotWorld("cyclic",
                                 "    - {name: last, type: graph, streams: [\"joint :/wheel\"], "
