@@ -344,6 +344,39 @@ TEST(GraphsRunTest, GraphsWithoutDataGetAnEmptyPlotAndTheOthersTheirs) {
     EXPECT_TRUE(std::isnan(row[1]));
 }
 
+// 201 copies with a graph each: every CSV, the first 200 PNGs, a warning
+// and a note in summary.json for the rest.
+TEST(GraphsRunTest, PngsPastTheCapAreLeftOutWithANote) {
+  const fs::path dir = FreshTempDir("swarmsim_graphs", "cap");
+  fs::create_directories(dir);
+  std::ofstream(dir / "world.yaml")
+      << "simulation: {physics: kinematic, time_step: 0.1}\n"
+         "models:\n"
+         "  - {model: dot.yaml, count: 201, distribute: {region: {min: [-20, -20], max: [20, "
+         "20]}}}\n";
+  std::ofstream(dir / "dot.yaml") << "model: dot\nobjects: {name: body, type: dummy, children: [\n"
+                                     "  {name: g, type: graph, streams: [\"position : x\"]}]}\n";
+  const auto r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 2 --quiet --out " +
+                            (dir / "out").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("PNGs drawn for the first 200 graphs only; 1 more"), std::string::npos)
+      << r.output;
+  EXPECT_TRUE(IsPng(dir / "out/graphs/dot#199/g.png"));
+  EXPECT_FALSE(fs::exists(dir / "out/graphs/dot#200/g.png"));
+  EXPECT_TRUE(fs::exists(dir / "out/graphs/dot#200/g.csv"));
+  const nlohmann::json summary = nlohmann::json::parse(ReadFile(dir / "out/summary.json"));
+  int csv = 0, png = 0, notes = 0;
+  for (const auto& o : summary.at("outputs")) {
+    const std::string path = o.at("path");
+    csv += path.ends_with(".csv");
+    png += path.ends_with(".png");
+    notes += o.at("kind") == "note";
+  }
+  EXPECT_EQ(csv, 201);
+  EXPECT_EQ(png, 200);
+  EXPECT_EQ(notes, 1);
+}
+
 TEST(GraphsRunTest, CyclicBufferKeepsTheLastSamples) {
   const fs::path dir = BotWorld("cyclic",
                                 "    - {name: last, type: graph, streams: [\"joint :/wheel\"], "
