@@ -53,6 +53,12 @@ std::string HashOf(const std::string& output) {
   return at == std::string::npos ? "" : output.substr(at + 12, 16);
 }
 
+// `swarmsim run DIR/world.yaml --steps STEPS --quiet --out DIR/out`.
+swarmsim::testing::CommandResult RunWorld(const fs::path& dir, int steps) {
+  return RunProgram("run " + (dir / "world.yaml").string() + " --steps " + std::to_string(steps) +
+                    " --quiet --out " + (dir / "out").string());
+}
+
 // A PNG file: its signature and a nonzero size.
 bool IsPng(const fs::path& file) {
   const std::string bytes = ReadFile(file);
@@ -99,8 +105,7 @@ fs::path BotWorld(const std::string& name, const std::string& graphs,
 TEST(GraphsRunTest, TimeGraphHoldsTheValuesTheObjectsHad) {
   const fs::path dir = BotWorld(
       "time", "    - {name: trace, type: graph, streams: [\"position : x\", \"joint :/wheel\"]}\n");
-  const auto r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 20 --quiet --out " +
-                            (dir / "out").string());
+  const auto r = RunWorld(dir, 20);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   // One file per copy, named after the graph's path.
   for (int k = 0; k < 3; ++k) {
@@ -134,8 +139,7 @@ TEST(GraphsRunTest, CurvesHaveTheirColumnsAndPngsAndSummaryListsThem) {
                "y\"]}\n"
                "    - {name: tip, type: graph, kind: xyz, streams: [\"p = position :\"]}\n"
                "    - {name: flat, type: graph, streams: [\"position : z\"], png: false}\n");
-  const auto r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 10 --quiet --out " +
-                            (dir / "out").string());
+  const auto r = RunWorld(dir, 10);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const fs::path g = dir / "out/graphs/bot#2";
   EXPECT_EQ(ReadCsv(g / "xy.csv").header,
@@ -183,8 +187,7 @@ TEST(GraphsRunTest, ScriptStreamsDistancesAndCopiesAtRunTime) {
       "    end\n"
       "  end\n"
       "end\n");
-  const auto r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 20 --quiet --out " +
-                            (dir / "out").string());
+  const auto r = RunWorld(dir, 20);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   // sim.getGraphStreamValues at step 10 read the last 3 samples (the
   // steps ending at 0.8, 0.9 and 1.0 s; 'twice' was 2 t at their sensing).
@@ -230,8 +233,7 @@ TEST(GraphsRunTest, ProximityStreamHoldsTheSensorsReading) {
       "  local r, d = sim.readProximitySensor(sim.getObject('./front'))\n"
       "  sim.recordMetric('front', r == 1 and d or -1)\n"
       "end\n");
-  const auto r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 10 --quiet --out " +
-                            (dir / "out").string());
+  const auto r = RunWorld(dir, 10);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   int compared = 0;
   for (const auto& m : swarmsim::testing::ReadMetricsCsv(dir / "out/metrics.csv")) {
@@ -265,8 +267,7 @@ TEST(GraphsRunTest, ForceStreamHoldsTheLoadsWeight) {
   std::ofstream(dir / "world.yaml")
       << "simulation: {physics: ode, time_step: 0.01, physics_substeps: 2}\n"
          "models: [{model: hanger.yaml, position: [0, 0, 2]}]\n";
-  const auto r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 50 --quiet --out " +
-                            (dir / "out").string());
+  const auto r = RunWorld(dir, 50);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const Csv g = ReadCsv(dir / "out/graphs/hanger#0/g.csv");
   ASSERT_EQ(g.header, (std::vector<std::string>{"time", "f.x", "f.y", "f.z", "speed"}));
@@ -331,8 +332,7 @@ TEST(GraphsRunTest, GraphsWithoutDataGetAnEmptyPlotAndTheOthersTheirs) {
                "    - {name: b, type: graph, kind: xyz, streams: [\"x = script\", \"y = script\", "
                "\"z = script\"]}\n"
                "    - {name: c, type: graph, streams: [\"position : x\"]}\n");
-  const auto r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 3 --quiet --out " +
-                            (dir / "out").string());
+  const auto r = RunWorld(dir, 3);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_EQ(r.output.find("warning"), std::string::npos) << r.output;
   for (int k = 0; k < 3; ++k)
@@ -356,8 +356,7 @@ TEST(GraphsRunTest, PngsPastTheCapAreLeftOutWithANote) {
          "20]}}}\n";
   std::ofstream(dir / "dot.yaml") << "model: dot\nobjects: {name: body, type: dummy, children: [\n"
                                      "  {name: g, type: graph, streams: [\"position : x\"]}]}\n";
-  const auto r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 2 --quiet --out " +
-                            (dir / "out").string());
+  const auto r = RunWorld(dir, 2);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("PNGs drawn for the first 200 graphs only; 1 more"), std::string::npos)
       << r.output;
@@ -383,8 +382,7 @@ TEST(GraphsRunTest, CyclicBufferKeepsTheLastSamples) {
                                 "buffer: 5, cyclic: true, every: 2}\n"
                                 "    - {name: first, type: graph, streams: [\"joint :/wheel\"], "
                                 "buffer: 5}\n");
-  const auto r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 20 --quiet --out " +
-                            (dir / "out").string());
+  const auto r = RunWorld(dir, 20);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const Csv last = ReadCsv(dir / "out/graphs/bot#0/last.csv");
   ASSERT_EQ(last.rows.size(), 5u);
