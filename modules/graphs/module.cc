@@ -67,6 +67,13 @@ ObjectId ResolveStream(const Scene& scene, ObjectId graph, const StreamSpec& str
   if (id.IsNull()) {
     *problem =
         "'" + stream.path + "' matches no object" + scene.ExplainMissingPath(stream.path, graph);
+    // './' looks below the graph; the graph's siblings are ':/' away.
+    if (stream.path.starts_with("./")) {
+      const std::string in_model = ":/" + stream.path.substr(2);
+      if (!scene.FindObject(in_model, graph).IsNull())
+        *problem +=
+            " ('./' looks below the graph: did you mean '" + in_model + "', in the graph's model?)";
+    }
     return {};
   }
   const ObjectType type = scene.type(id);

@@ -414,6 +414,8 @@ TEST(GraphsRunTest, BadStreamsAreLoadErrorsAtTheirLine) {
                   "bot.yaml:11:", "unknown stream kind 'positon'; did you mean 'position'?");
   ExpectLoadError("path", "    - {name: g, type: graph, streams: [\"joint :/wheal\"]}\n",
                   "bot.yaml:11:", "':/wheal' matches no object; did you mean ':/wheel'?");
+  ExpectLoadError("below", "    - {name: g, type: graph, streams: [\"joint ./wheel\"]}\n",
+                  "bot.yaml:11:", "did you mean ':/wheel', in the graph's model?");
   ExpectLoadError("type", "    - {name: g, type: graph, streams: [\"joint :\"]}\n",
                   "bot.yaml:11:", "':' is a shape, not a joint");
   ExpectLoadError("component", "    - {name: g, type: graph, streams: [\"position : w\"]}\n",
