@@ -73,6 +73,9 @@ ObjectId ResolveStream(const Scene& scene, ObjectId graph, const StreamSpec& str
       if (!scene.FindObject(in_model, graph).IsNull())
         *problem +=
             " ('./' looks below the graph: did you mean '" + in_model + "', in the graph's model?)";
+    } else if (stream.path.starts_with(":/") && stream.path.find('/', 2) == std::string::npos &&
+               scene.instance_of(graph) >= 0) {
+      *problem += " (the model's root is ':' itself, named after the copy)";
     }
     return {};
   }

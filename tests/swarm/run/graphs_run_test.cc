@@ -416,6 +416,8 @@ TEST(GraphsRunTest, BadStreamsAreLoadErrorsAtTheirLine) {
                   "bot.yaml:11:", "':/wheal' matches no object; did you mean ':/wheel'?");
   ExpectLoadError("below", "    - {name: g, type: graph, streams: [\"joint ./wheel\"]}\n",
                   "bot.yaml:11:", "did you mean ':/wheel', in the graph's model?");
+  ExpectLoadError("root", "    - {name: g, type: graph, streams: [\"position :/body z\"]}\n",
+                  "bot.yaml:11:", "the model's root is ':' itself, named after the copy");
   ExpectLoadError("type", "    - {name: g, type: graph, streams: [\"joint :\"]}\n",
                   "bot.yaml:11:", "':' is a shape, not a joint");
   ExpectLoadError("component", "    - {name: g, type: graph, streams: [\"position : w\"]}\n",
