@@ -292,6 +292,20 @@ ObjectId OptRelativeTo(lua_State* L, int arg) {
   return ObjectId::FromInteger(h);
 }
 
+Vec3 ArgColor(lua_State* L, int arg) {
+  ArgType(L, arg, LUA_TTABLE);
+  double rgb[3];
+  for (int i = 0; i < 3; ++i) {
+    lua_rawgeti(L, arg, i + 1);
+    int ok = 0;
+    rgb[i] = lua_tonumberx(L, -1, &ok);
+    lua_pop(L, 1);
+    if (!ok || !(rgb[i] >= 0 && rgb[i] <= 1))
+      throw Error("the colour must be {r, g, b} with each component between 0 and 1");
+  }
+  return {rgb[0], rgb[1], rgb[2]};
+}
+
 void PushNumberArray(lua_State* L, const double* v, int n) {
   lua_createtable(L, n, 0);
   for (int i = 0; i < n; ++i) {

@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "framework/handle.h"
+#include "framework/math.h"
 #include "framework/parameters.h"
 #include "lua.hpp"
 
@@ -154,6 +155,10 @@ inline ObjectId CheckObject(lua_State* L, int arg) {
 }
 // The optional "relative to" argument: nil or sim.handle_world give null.
 ObjectId OptRelativeTo(lua_State* L, int arg);
+
+// A colour argument {r, g, b}, each a number from 0 to 1 (paint nozzles,
+// LEDs); anything else throws, naming what is expected.
+Vec3 ArgColor(lua_State* L, int arg);
 
 // Pushes a new array {v[0], ..., v[n-1]}.
 void PushNumberArray(lua_State* L, const double* v, int n);

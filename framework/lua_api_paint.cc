@@ -25,20 +25,7 @@ int SetPaintNozzle(lua_State* L) {
                 "' belongs to another robot or to the scene)");
   ArgType(L, 2, LUA_TBOOLEAN);
   const bool enabled = lua_toboolean(L, 2) != 0;
-  Vec3 color = nozzle.color;
-  if (!lua_isnoneornil(L, 3)) {
-    ArgType(L, 3, LUA_TTABLE);
-    double rgb[3];
-    for (int i = 0; i < 3; ++i) {
-      lua_rawgeti(L, 3, i + 1);
-      int ok = 0;
-      rgb[i] = lua_tonumberx(L, -1, &ok);
-      lua_pop(L, 1);
-      if (!ok || !(rgb[i] >= 0 && rgb[i] <= 1))
-        throw Error("the colour must be {r, g, b} with each component between 0 and 1");
-    }
-    color = {rgb[0], rgb[1], rgb[2]};
-  }
+  const Vec3 color = lua_isnoneornil(L, 3) ? nozzle.color : ArgColor(L, 3);
   nozzle.enabled = enabled;
   nozzle.color = color;
   return 0;

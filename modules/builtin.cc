@@ -2,6 +2,7 @@
 
 #include "framework/dynamics_backend.h"
 #include "framework/registry.h"
+#include "modules/blobs/blobs.h"
 #include "modules/collision/collision.h"
 #include "modules/dynamics/box2d/box2d_backend.h"
 #include "modules/dynamics/kinematic/kinematic_backend.h"
@@ -44,9 +45,10 @@ void RegisterBuiltinModules(ModuleRegistry* registry) {
     registry->RegisterModule(std::move(metric));
   collision::Register(registry);
   mill::Register(registry);
+  filters::Register(registry);
   rendering::RegisterObjects(registry);
   graphs::Register(registry);
-  filters::Register(registry);
+  blobs::Register(registry);
 }
 
 }  // namespace swarmsim

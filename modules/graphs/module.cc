@@ -67,6 +67,16 @@ ObjectId ResolveStream(const Scene& scene, ObjectId graph, const StreamSpec& str
   if (id.IsNull()) {
     *problem =
         "'" + stream.path + "' matches no object" + scene.ExplainMissingPath(stream.path, graph);
+    // './' looks below the graph; the graph's siblings are ':/' away.
+    if (stream.path.starts_with("./")) {
+      const std::string in_model = ":/" + stream.path.substr(2);
+      if (!scene.FindObject(in_model, graph).IsNull())
+        *problem +=
+            " ('./' looks below the graph: did you mean '" + in_model + "', in the graph's model?)";
+    } else if (stream.path.starts_with(":/") && stream.path.find('/', 2) == std::string::npos &&
+               scene.instance_of(graph) >= 0) {
+      *problem += " (the model's root is ':' itself, named after the copy)";
+    }
     return {};
   }
   const ObjectType type = scene.type(id);

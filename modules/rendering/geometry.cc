@@ -8,6 +8,7 @@
 #include "framework/mesh.h"
 #include "framework/scene.h"
 #include "framework/world.h"
+#include "modules/blobs/leds.h"
 #include "modules/paint/paint_layer.h"
 #include "modules/rendering/objects.h"
 
@@ -195,7 +196,7 @@ void Append(DrawList* list, uint32_t slot, const Primitive& prim, const Vec3& sc
 
 }  // namespace
 
-void BuildDrawList(const World& world, int segments, DrawList* list) {
+void BuildDrawList(const World& world, int segments, DrawList* list, double min_led_radius) {
   const Scene& scene = world.scene();
   list->xyz.clear();
   list->normal.clear();
@@ -240,7 +241,20 @@ void BuildDrawList(const World& world, int segments, DrawList* list) {
       Append(list, kNoSlot, prims.box, b.hi - b.lo, Pose{(b.lo + b.hi) * 0.5, Quat{}}, color,
              false);
   }
-  // The module's own objects: LEDs (emissive spheres) and lights.
+  // LEDs: spheres in their colour, unlit (emissive) while on, dark when off.
+  ObjectType led;
+  if (scene.FindType(kLedTypeName, &led)) {
+    const auto& leds = static_cast<const Rows<LedRow>&>(*scene.rows(led));
+    for (size_t r = 0; r < leds.size(); ++r) {
+      const uint32_t slot = leds.owners[r];
+      if (!scene.alive_at(slot)) continue;
+      const LedRow& l = leds.rows[r];
+      const double radius = std::max(l.radius, min_led_radius);
+      Append(list, slot, prims.sphere, {radius, radius, radius}, scene.world_pose_at(slot),
+             l.lit() ? l.color : Vec3{0.15, 0.15, 0.15}, /*emissive=*/l.lit());
+    }
+  }
+  // Lights.
   CollectLights(scene, &list->lights, &list->scene_has_lights);
   list->step = world.step_count();
   // The paint layer, laid on the floor.

@@ -59,8 +59,9 @@ struct DrawList {
 };
 
 // Fills *list from `world`'s scene. `segments`: sides of a cylinder and
-// slices of a sphere.
-void BuildDrawList(const World& world, int segments, DrawList* list);
+// slices of a sphere; LEDs are drawn at least `min_led_radius` m big (an
+// overview keeps them visible).
+void BuildDrawList(const World& world, int segments, DrawList* list, double min_led_radius = 0);
 
 struct DrawOptions {
   const std::vector<uint8_t>* visible = nullptr;  // by slot: 1 drawn (null: every slot)

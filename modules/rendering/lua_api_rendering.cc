@@ -1,12 +1,14 @@
 // sim.* vision sensors, shape colours and lights (the Lua area of the
 // vision_sensor and light types):
-//   sim.getVisionSensorImg(h) -> bytes (RGB, rows top to bottom), {width, height}
+//   sim.getVisionSensorImg(h [, 1]) -> bytes (RGB, rows top to bottom: the
+//     filter chain's image, or with 1 the camera's), {width, height}
 //   sim.getVisionSensorDepth(h) -> {d, ...} (m along the view axis; far where
 //     nothing), {width, height}
 //   sim.getVisionSensorRes(h) -> {width, height}
-//   sim.readVisionSensor(h) -> result, packet1 (CoppeliaSim's 15 values: the
-//     min of intensity, red, green, blue and depth, then their max, then
-//     their mean), then one packet per filter element that outputs values
+//   sim.readVisionSensor(h) -> result, packet1 (CoppeliaSim's 15 values:
+//     minima, maxima and means of intensity, red, green, blue and depth),
+//     then a packet per filter element that gives values
+//   sim.getVisionSensorBlobs(h) -> {{pixels, color, x, y, u, v, box, orientation}, ...}
 //   sim.setShapeColor(h, {r, g, b}) (or CoppeliaSim's (h, nil, 0, {r, g, b})),
 //   sim.getShapeColor(h) -> {r, g, b}
 //   sim.setLightOn(h, on), sim.getLightOn(h), sim.setLightColor(h, {r, g, b})
@@ -17,7 +19,6 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
-#include <vector>
 
 #include "framework/error.h"
 #include "framework/lua_api.h"
@@ -53,38 +54,29 @@ void CheckOwn(lua_State* L, ObjectId id, const char* what) {
                 c.scene->PathOf(id) + "' belongs to another robot or to the scene)");
 }
 
-Vec3 ArgColor(lua_State* L, int arg) {
-  ArgType(L, arg, LUA_TTABLE);
-  double rgb[3];
-  for (int i = 0; i < 3; ++i) {
-    lua_rawgeti(L, arg, i + 1);
-    int ok = 0;
-    rgb[i] = lua_tonumberx(L, -1, &ok);
-    lua_pop(L, 1);
-    if (!ok || !(rgb[i] >= 0 && rgb[i] <= 1))
-      throw Error("the colour must be {r, g, b} with each component between 0 and 1");
-  }
-  return {rgb[0], rgb[1], rgb[2]};
-}
-
-void PushResolution(lua_State* L, const Lens& lens) {
+void PushResolution(lua_State* L, int width, int height) {
   lua_createtable(L, 2, 0);
-  lua_pushinteger(L, lens.width);
+  lua_pushinteger(L, width);
   lua_rawseti(L, -2, 1);
-  lua_pushinteger(L, lens.height);
+  lua_pushinteger(L, height);
   lua_rawseti(L, -2, 2);
 }
+
+void PushResolution(lua_State* L, const Lens& lens) { PushResolution(L, lens.width, lens.height); }
 
 const Image& ImageOf(const VisionSensorRow& s) {
   if (s.rendered_step < 0) throw Error("the vision sensor has not rendered an image yet");
   return s.image;
 }
 
+// The filtered image when the sensor has a chain (CoppeliaSim's), else the
+// camera's; sim.getVisionSensorImg(h, 1): always the camera's.
 int GetVisionSensorImg(lua_State* L) {
   const VisionSensorRow& s = SensorOf(L);
-  const Image& image = ImageOf(s);
+  const bool raw = !lua_isnoneornil(L, 2) && ArgInteger(L, 2) == 1;
+  const Image& image = raw || s.filters.empty() ? ImageOf(s) : (ImageOf(s), s.output.image);
   lua_pushlstring(L, reinterpret_cast<const char*>(image.rgb.data()), image.rgb.size());
-  PushResolution(L, s.lens);
+  PushResolution(L, image.width, image.height);
   return 2;
 }
 
@@ -107,26 +99,65 @@ int GetVisionSensorRes(lua_State* L) {
   return 1;
 }
 
-// result (-1 before the first image; with a filter chain 1 when it
-// triggered, else 0), then CoppeliaSim's first packet (min of intensity,
-// red, green, blue and depth, then their max, then their mean; 0..1, depth
-// from near to far) and the packet of each chain element that outputs values.
+// The chain's output: the sensor's own when its chain has elements, else
+// an empty chain run now (packet 1 only, on the caller's copy).
+const filters::FilterOutput& OutputOf(const VisionSensorRow& s, filters::FilterOutput* scratch) {
+  if (!s.filters.empty()) return s.output;
+  s.filters.Run(s.image, CameraModelOf(s.lens), scratch);
+  return *scratch;
+}
+
+// result (1: the chain triggered: a blob, a point; else 0; -1 before the
+// first image), then the packets: packet 1 (CoppeliaSim's 15 statistics),
+// then one per element that gives values.
 int ReadVisionSensor(lua_State* L) {
   const VisionSensorRow& s = SensorOf(L);
   if (s.rendered_step < 0) {
     lua_pushinteger(L, -1);
     return 1;
   }
-  // Packet 1 from the image (the chain leaves it to the reader), then the chain's.
-  const std::vector<std::vector<double>>& packets = s.reading.packets;
-  const size_t count = s.filters.empty() ? 1 : packets.size();
-  luaL_checkstack(L, static_cast<int>(count) + 1, "sim.readVisionSensor");
-  lua_pushinteger(L, !s.filters.empty() && s.reading.triggered ? 1 : 0);
-  const std::vector<double> packet1 = filters::ImageStatistics(s.image, CameraModelOf(s.lens));
+  filters::FilterOutput scratch;
+  const filters::FilterOutput& out = OutputOf(s, &scratch);
+  lua_pushinteger(L, out.triggered ? 1 : 0);
+  luaL_checkstack(L, static_cast<int>(out.packets.size()) + 2, "too many packets");
+  // Packet 1 from the image now when the sense phase left it (module.cc).
+  const std::vector<double> packet1 = out.packets[0].empty()
+                                          ? filters::ImageStatistics(s.image, CameraModelOf(s.lens))
+                                          : out.packets[0];
   PushNumberArray(L, packet1.data(), static_cast<int>(packet1.size()));
-  for (size_t k = 1; k < count; ++k)
-    PushNumberArray(L, packets[k].data(), static_cast<int>(packets[k].size()));
-  return 1 + static_cast<int>(count);
+  for (size_t k = 1; k < out.packets.size(); ++k)
+    PushNumberArray(L, out.packets[k].data(), static_cast<int>(out.packets[k].size()));
+  return 1 + static_cast<int>(out.packets.size());
+}
+
+// The last blobs element's blobs, largest first: {pixels, color = {r, g, b},
+// x, y (centroid, pixels from the top-left corner), u, v (0..1 from the
+// bottom-left, CoppeliaSim's), box = {min_x, min_y, max_x, max_y},
+// orientation (rad)}.
+int GetVisionSensorBlobs(lua_State* L) {
+  const VisionSensorRow& s = SensorOf(L);
+  lua_createtable(L, static_cast<int>(s.output.blobs.size()), 0);
+  if (s.rendered_step < 0 || s.filters.empty()) return 1;
+  int index = 1;
+  for (const filters::Blob& b : s.output.blobs) {
+    lua_createtable(L, 0, 8);
+    lua_pushinteger(L, b.pixels);
+    lua_setfield(L, -2, "pixels");
+    PushNumberArray(L, b.colour.data(), 3);
+    lua_setfield(L, -2, "color");
+    const std::pair<const char*, double> numbers[] = {
+        {"x", b.x}, {"y", b.y}, {"u", b.u}, {"v", b.v}, {"orientation", b.orientation}};
+    for (const auto& [name, value] : numbers) {
+      lua_pushnumber(L, value);
+      lua_setfield(L, -2, name);
+    }
+    const double box[4] = {static_cast<double>(b.min_x), static_cast<double>(b.min_y),
+                           static_cast<double>(b.max_x), static_cast<double>(b.max_y)};
+    PushNumberArray(L, box, 4);
+    lua_setfield(L, -2, "box");
+    lua_rawseti(L, -2, index++);
+  }
+  return 1;
 }
 
 int SetShapeColor(lua_State* L) {
@@ -228,6 +259,7 @@ void RegisterRenderingApi(lua_State* L) {
       {"getVisionSensorDepth", Guarded<GetVisionSensorDepth, "sim.getVisionSensorDepth">},
       {"getVisionSensorRes", Guarded<GetVisionSensorRes, "sim.getVisionSensorRes">},
       {"readVisionSensor", Guarded<ReadVisionSensor, "sim.readVisionSensor">},
+      {"getVisionSensorBlobs", Guarded<GetVisionSensorBlobs, "sim.getVisionSensorBlobs">},
       {"setShapeColor", Guarded<SetShapeColor, "sim.setShapeColor">},
       {"getShapeColor", Guarded<GetShapeColor, "sim.getShapeColor">},
       {"setLightOn", Guarded<SetLightOn, "sim.setLightOn">},

@@ -111,9 +111,9 @@ void RenderingModule::RenderDue(World* world, bool all) {
           options.floor = s.floor;
           options.background = s.background;
           Draw(*list_of[i], ViewOf(scene, sensors->owners[r], s.lens, s.depth), options, &s.image);
-          // Packet 1 is computed when a script reads it.
+          // Packet 1 is left to sim.readVisionSensor (most runs never read it).
           if (!s.filters.empty())
-            s.filters.Run(s.image, CameraModelOf(s.lens), &s.reading, /*statistics=*/false);
+            s.filters.Run(s.image, CameraModelOf(s.lens), &s.output, /*statistics=*/false);
           s.rendered_step = step;
         }
       });
@@ -132,7 +132,9 @@ ModuleDescriptor RenderingModuleDescriptor() {
 
 void Render(const World& world, const View& view, Image* image) {
   DrawList list;
-  BuildDrawList(world, kSensorSegments, &list);
+  // A view from above keeps LEDs at least 3 pixels across.
+  const double pixel = view.orthographic ? view.ortho_width / std::max(1, view.width) : 0;
+  BuildDrawList(world, kSensorSegments, &list, 1.5 * pixel);
   Draw(list, view, DrawOptions{}, image);
 }
 

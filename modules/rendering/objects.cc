@@ -103,11 +103,9 @@ void ReadVisionSensor(const ObjectTypeDescriptor&, const ObjectReader& r, void* 
   }
   if (r.Has("background")) v.background = r.Vector3("background", kFraction);
   if (r.Has("floor")) v.floor = r.Bool("floor");
-  v.filters = filters::ParseFilterChain(r, "filters", r.registry());
-  if (v.filters.needs_depth()) {
-    if (r.Has("depth") && !v.depth)
-      r.Fail("depth", "the filter chain reads the depth image ('depth'): remove 'depth: false'");
-    v.depth = true;
+  if (r.Has("filters")) {
+    v.filters = filters::ParseFilterChain(r, "filters", r.registry());
+    if (v.filters.needs_depth()) v.depth = true;
   }
 }
 
@@ -222,6 +220,18 @@ std::shared_ptr<const ObjectTypeDescriptor> LightType() {
 }
 
 }  // namespace
+
+filters::CameraModel CameraModelOf(const Lens& lens) {
+  filters::CameraModel camera;
+  camera.perspective = !lens.orthographic;
+  // The chain measures angles and sizes along the image's larger side.
+  const double ratio = static_cast<double>(lens.height) / lens.width;
+  camera.fov = lens.width >= lens.height ? lens.fov : 2 * std::atan(std::tan(lens.fov / 2) * ratio);
+  camera.ortho_size = lens.width >= lens.height ? lens.ortho_width : lens.ortho_width * ratio;
+  camera.near = lens.near;
+  camera.far = lens.far;
+  return camera;
+}
 
 void CollectLights(const Scene& scene, std::vector<LightSource>* lights, bool* any) {
   lights->clear();

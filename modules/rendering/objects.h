@@ -45,11 +45,11 @@ struct VisionSensorRow {
   std::string where;               // "file:line:column" of `detectable`
   Vec3 background{0.0, 0.0, 0.0};  // RGB where nothing is seen
   bool floor = true;               // the floor (and its paint) is seen
-  filters::FilterChain filters;    // run on each image (elements shared by copies)
+  filters::FilterChain filters;    // run on each image (shared by copies)
   // The reading, updated when the sensor renders.
   Image image;
-  int64_t rendered_step = -1;     // the step it last rendered (-1: never)
-  filters::FilterOutput reading;  // the chain's output for `image` (a chain's only)
+  filters::FilterOutput output;  // the chain's, when it has elements
+  int64_t rendered_step = -1;    // the step it last rendered (-1: never)
 };
 
 struct LightRow {
@@ -61,10 +61,8 @@ struct LightRow {
   double range = 0;                    // m, point and spot: half intensity here (0: no fall-off)
 };
 
-// What the filter chain needs of a lens.
-inline filters::CameraModel CameraModelOf(const Lens& lens) {
-  return {!lens.orthographic, lens.fov, lens.ortho_width, lens.near, lens.far};
-}
+// What a filter chain needs to know of a sensor's lens.
+filters::CameraModel CameraModelOf(const Lens& lens);
 
 // Registers the types and the module.
 void RegisterObjects(ModuleRegistry* registry);

@@ -33,7 +33,8 @@ struct View {
 };
 
 // Draws `world`'s scene as `view` sees it into *image: shapes in their
-// colours, LEDs, lights (a headlight when the scene has none on), the floor
+// colours, LEDs (at least 3 pixels wide in an orthographic view), lights (a
+// sun and a headlight when the scene has no light objects), the floor
 // with the paint layer. Thread-safe (one GL context per calling thread);
 // the same scene and view give the same bytes whatever the thread.
 // Throws swarmsim::Error when OSMesa cannot make a context.

@@ -287,8 +287,8 @@ TEST(VisionFiltersTest, PointCloudOfAFlatDepthImageLiesOnItsPlane) {
   EXPECT_TRUE(chain.needs_depth());
   const FilterOutput out = chain.Run(image, camera);
   ASSERT_EQ(out.points.size(), 32u * 23u);                    // not the far row
-  const double pitch = 2 * std::tan(30 * kDeg) / 32;          // m per pixel at 1 m (horizontal fov)
-  for (const Vec3& p : out.points) EXPECT_DOUBLE_EQ(p.x, 2);  // x: the view axis
+  const double pitch = 2 * std::tan(30 * kDeg) / 32;          // m per pixel at 1 m, larger side
+  for (const Vec3& p : out.points) EXPECT_DOUBLE_EQ(p.x, 2);  // along the view axis
   // First point: the top-left pixel, to the left (+y) and up (+z).
   EXPECT_NEAR(out.points[0].y, 15.5 * pitch * 2, 1e-12);
   EXPECT_NEAR(out.points[0].z, 11.5 * pitch * 2, 1e-12);
@@ -297,16 +297,16 @@ TEST(VisionFiltersTest, PointCloudOfAFlatDepthImageLiesOnItsPlane) {
   EXPECT_TRUE(out.triggered);
   ASSERT_EQ(out.packets.size(), 2u);
   EXPECT_EQ(out.packets[1][0], 32 * 23);
-  EXPECT_EQ(out.packets[1][1], 2);
+  EXPECT_EQ(out.packets[1][1], 2);  // the first point's x: its depth
   // A blob's bearing from its centroid: the same rays.
   const Vec3 p = ImageToSensor(camera, 32, 24, 0.5, 0.5, 2);
   EXPECT_DOUBLE_EQ(p.y, out.points[0].y);
   EXPECT_DOUBLE_EQ(p.z, out.points[0].z);
   const Vec3 edge = ImageToSensor(camera, 32, 24, 32, 12, 1);  // right edge, middle row
   EXPECT_NEAR(std::atan2(edge.y, edge.x), -30 * kDeg, 1e-12);
-  // Orthographic: pixel pitch ortho_width / width whatever the depth.
+  // Orthographic: pixel pitch ortho_size / larger side whatever the depth.
   camera.perspective = false;
-  camera.ortho_width = 3.2;
+  camera.ortho_size = 3.2;
   const FilterOutput ortho =
       Chain({{"depth", {}}, {"point_cloud", {{"stride", {2}}}}}).Run(image, camera);
   ASSERT_EQ(ortho.points.size(), 16u * 12u);

@@ -57,10 +57,8 @@ struct FilterRun {
   }
 };
 
-// From image positions to the sensor's frame (the renderer's,
-// modules/rendering/render.h): x along the view axis, y to the image's
-// left, z up in the image. Pixels are square; the view angle or
-// orthographic width spans the image horizontally.
+// From image positions to the sensor's frame (swarmsim's, modules/rendering/
+// render.h): x along the view axis, z up in the image, y to the image's left.
 struct Projection {
   double half_width, half_height;
   double pitch;  // m per pixel at depth 1 (perspective) or at any depth (orthographic)
@@ -68,7 +66,8 @@ struct Projection {
 
   Projection(const CameraModel& camera, int width, int height)
       : half_width(width / 2.0), half_height(height / 2.0), perspective(camera.perspective) {
-    pitch = (perspective ? 2 * std::tan(camera.fov / 2) : camera.ortho_width) / width;
+    const double larger = std::max(width, height);
+    pitch = perspective ? 2 * std::tan(camera.fov / 2) / larger : camera.ortho_size / larger;
   }
   // The point at `depth` (m along the view axis) seen at (x, y), pixels
   // from the top-left corner (a pixel's centre at + 0.5).

@@ -36,10 +36,10 @@ namespace filters {
 // depth statistics). The resolution is the image's own.
 struct CameraModel {
   bool perspective = true;
-  double fov = M_PI / 3;     // rad, perspective: horizontal view angle
-  double ortho_width = 1.0;  // m, orthographic: what the image spans horizontally
-  double near = 0.01;        // m, clipping planes: depth is measured along the view axis
-  double far = 10.0;         // m
+  double fov = M_PI / 3;    // rad, perspective: view angle of the image's larger side
+  double ortho_size = 1.0;  // m, orthographic: extent of the image's larger side
+  double near = 0.01;       // m, clipping planes: depth is measured along the view axis
+  double far = 10.0;        // m
 };
 
 // One blob (a connected part of a mask, 8-connected).
@@ -99,14 +99,13 @@ FilterChain ParseFilterChain(const ObjectReader& reader, std::string_view key,
 // The point at `depth` (m along the view axis) that a camera of `width` x
 // `height` pixels sees at image position (x, y) (pixels from the top-left
 // corner, y down; a blob's centroid), in the sensor's frame as point_cloud
-// gives it: x along the view axis, y to the image's left, z up (the frame a
-// vision sensor looks along, modules/rendering/render.h). A blob's bearing:
-// atan2(p.y, p.x) of the point at depth 1.
+// gives it: x along the view axis, z up in the image, y to the image's left.
+// A blob's bearing: atan2(p.y, p.x) of the point at depth 1.
 Vec3 ImageToSensor(const CameraModel& camera, int width, int height, double x, double y,
                    double depth);
 
 // Packet 1 alone (what Run puts first): CoppeliaSim's 15 statistics of
-// `image`, for a sensor without a chain.
+// `image`.
 std::vector<double> ImageStatistics(const Image& image, const CameraModel& camera);
 
 // Registers the built-in elements (modules/builtin.cc).

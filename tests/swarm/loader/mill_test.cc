@@ -30,34 +30,7 @@ using mill::MillRow;
 
 constexpr double kPi = 3.141592653589793;
 
-class MillTest : public testing::WorldDirTest {
- protected:
-  LoadedWorld Load(const std::string& world_text, int threads = 1) {
-    LoadOptions options;
-    options.threads = threads;
-    LoadedWorld w = LoadWorld(Write("world.yaml", world_text), options, registry_);
-    w.world->set_log_sink([](std::string_view) {});
-    return w;
-  }
-  // The loader's message for a model whose root carries `keys`.
-  std::string ErrorOf(const std::string& type, const std::string& keys) {
-    Write("thing.yaml", "model: thing\nobjects:\n  type: " + type + "\n" + keys);
-    try {
-      Load(
-          "simulation: {physics: kinematic}\nmodels: [{model: thing.yaml, position: [0, 0, 1]}]\n");
-    } catch (const Error& e) {
-      return e.what();
-    }
-    return "(no error)";
-  }
-  template <typename Row>
-  Row& RowOf(World& world, const std::string& path) {
-    Scene& scene = world.scene();
-    const ObjectId id = scene.FindObject(path);
-    EXPECT_FALSE(id.IsNull()) << path;
-    return *static_cast<Row*>(scene.row_data(id));
-  }
-};
+using MillTest = testing::WorldDirTest;
 
 #define EXPECT_CONTAINS(text, part) \
   EXPECT_NE(std::string(text).find(part), std::string::npos) << (text)

@@ -24,13 +24,6 @@ using rendering::VisionSensorRow;
 
 class RenderingTest : public testing::WorldDirTest {
  protected:
-  LoadedWorld Load(const std::string& world_text, int threads = 1) {
-    LoadOptions options;
-    options.threads = threads;
-    LoadedWorld w = LoadWorld(Write("world.yaml", world_text), options, registry_);
-    w.world->set_log_sink([](std::string_view) {});
-    return w;
-  }
   std::string ErrorOf(const std::string& world_text) {
     try {
       Load(world_text);

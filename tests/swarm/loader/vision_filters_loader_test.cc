@@ -87,7 +87,7 @@ TEST_F(VisionFiltersLoaderTest, ARenderedBoxIsABlobWhereTheBoxIs) {
   LoadedWorld w = Load(WorldText(kRedBlobs));
   w.world->Start();
   const rendering::VisionSensorRow& eye = Eye(*w.world);
-  const filters::FilterOutput& out = eye.reading;
+  const filters::FilterOutput& out = eye.output;
   ASSERT_EQ(out.blobs.size(), 1u);
   EXPECT_TRUE(out.triggered);
   // Straight ahead: centred horizontally; its face (0.5 m at 1.75 m) about
@@ -100,10 +100,10 @@ TEST_F(VisionFiltersLoaderTest, ARenderedBoxIsABlobWhereTheBoxIs) {
   // To the left: its bearing from the centroid's ray.
   LoadedWorld left = Load(WorldText(kRedBlobs, 0.5));
   left.world->Start();
-  const filters::FilterOutput& seen = Eye(*left.world).reading;
+  const filters::FilterOutput& seen = Eye(*left.world).output;
   ASSERT_EQ(seen.blobs.size(), 1u);
-  const Vec3 ray =
-      filters::ImageToSensor(filters::CameraModel{}, 64, 48, seen.blobs[0].x, seen.blobs[0].y, 1);
+  const Vec3 ray = filters::ImageToSensor(rendering::CameraModelOf(Eye(*left.world).lens), 64, 48,
+                                          seen.blobs[0].x, seen.blobs[0].y, 1);
   EXPECT_NEAR(std::atan2(ray.y, ray.x), std::atan2(0.5, 2.0), 3 * kDeg);
 }
 
@@ -119,7 +119,7 @@ end
     LoadedWorld w = Load(WorldText(kRedBlobs, 0.3) + "    script: eye.lua\n", threads);
     w.world->Start();
     for (int i = 0; i < 3; ++i) w.world->Step();
-    packets[threads - 1] = Eye(*w.world).reading.packets;
+    packets[threads - 1] = Eye(*w.world).output.packets;
   }
   ASSERT_EQ(packets[0].size(), 2u);
   EXPECT_EQ(packets[0], packets[1]);
@@ -129,9 +129,9 @@ TEST_F(VisionFiltersLoaderTest, APluginsElementIsFoundThroughTheWorldsPlugins) {
   LoadedWorld w = Load(WorldText("        - {type: invert}\n", 0, "plugins: [example_plugin]\n"));
   w.world->Start();
   const rendering::VisionSensorRow& eye = Eye(*w.world);
-  ASSERT_EQ(eye.reading.image.rgb.size(), eye.image.rgb.size());
+  ASSERT_EQ(eye.output.image.rgb.size(), eye.image.rgb.size());
   for (size_t i = 0; i < eye.image.rgb.size(); ++i)
-    ASSERT_EQ(eye.reading.image.rgb[i], 255 - eye.image.rgb[i]) << i;
+    ASSERT_EQ(eye.output.image.rgb[i], 255 - eye.image.rgb[i]) << i;
   // Without the plugin: unknown.
   EXPECT_CONTAINS(LoadError(WorldText("        - {type: invert}\n")), "'type' must be one of");
 }
@@ -171,11 +171,6 @@ TEST_F(VisionFiltersLoaderTest, MistakesAreErrorsAtTheirFileLineAndColumn) {
   EXPECT_CONTAINS(LoadError(world), "world.yaml:" + PositionOf(world, "blobs") +
                                         ": filters[0] of object 'eye' must be a mapping");
   EXPECT_CONTAINS(LoadError(WorldText("          blobs\n")), "'filters' must be a list of maps");
-  // A chain that reads depth on a sensor told to keep none.
-  world =
-      WorldText("        - {type: depth}\n        - {type: point_cloud}\n") + "    depth: false\n";
-  EXPECT_CONTAINS(LoadError(world), "world.yaml:" + PositionOf(world, "false") +
-                                        ": the filter chain reads the depth image");
 }
 
 }  // namespace

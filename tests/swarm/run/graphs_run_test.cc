@@ -53,6 +53,12 @@ std::string HashOf(const std::string& output) {
   return at == std::string::npos ? "" : output.substr(at + 12, 16);
 }
 
+// `swarmsim run DIR/world.yaml --steps STEPS --quiet --out DIR/out`.
+swarmsim::testing::CommandResult RunWorld(const fs::path& dir, int steps) {
+  return RunProgram("run " + (dir / "world.yaml").string() + " --steps " + std::to_string(steps) +
+                    " --quiet --out " + (dir / "out").string());
+}
+
 // A PNG file: its signature and a nonzero size.
 bool IsPng(const fs::path& file) {
   const std::string bytes = ReadFile(file);
@@ -99,8 +105,7 @@ fs::path BotWorld(const std::string& name, const std::string& graphs,
 TEST(GraphsRunTest, TimeGraphHoldsTheValuesTheObjectsHad) {
   const fs::path dir = BotWorld(
       "time", "    - {name: trace, type: graph, streams: [\"position : x\", \"joint :/wheel\"]}\n");
-  const auto r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 20 --quiet --out " +
-                            (dir / "out").string());
+  const auto r = RunWorld(dir, 20);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   // One file per copy, named after the graph's path.
   for (int k = 0; k < 3; ++k) {
@@ -134,8 +139,7 @@ TEST(GraphsRunTest, CurvesHaveTheirColumnsAndPngsAndSummaryListsThem) {
                "y\"]}\n"
                "    - {name: tip, type: graph, kind: xyz, streams: [\"p = position :\"]}\n"
                "    - {name: flat, type: graph, streams: [\"position : z\"], png: false}\n");
-  const auto r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 10 --quiet --out " +
-                            (dir / "out").string());
+  const auto r = RunWorld(dir, 10);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const fs::path g = dir / "out/graphs/bot#2";
   EXPECT_EQ(ReadCsv(g / "xy.csv").header,
@@ -183,8 +187,7 @@ TEST(GraphsRunTest, ScriptStreamsDistancesAndCopiesAtRunTime) {
       "    end\n"
       "  end\n"
       "end\n");
-  const auto r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 20 --quiet --out " +
-                            (dir / "out").string());
+  const auto r = RunWorld(dir, 20);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   // sim.getGraphStreamValues at step 10 read the last 3 samples (the
   // steps ending at 0.8, 0.9 and 1.0 s; 'twice' was 2 t at their sensing).
@@ -230,8 +233,7 @@ TEST(GraphsRunTest, ProximityStreamHoldsTheSensorsReading) {
       "  local r, d = sim.readProximitySensor(sim.getObject('./front'))\n"
       "  sim.recordMetric('front', r == 1 and d or -1)\n"
       "end\n");
-  const auto r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 10 --quiet --out " +
-                            (dir / "out").string());
+  const auto r = RunWorld(dir, 10);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   int compared = 0;
   for (const auto& m : swarmsim::testing::ReadMetricsCsv(dir / "out/metrics.csv")) {
@@ -265,8 +267,7 @@ TEST(GraphsRunTest, ForceStreamHoldsTheLoadsWeight) {
   std::ofstream(dir / "world.yaml")
       << "simulation: {physics: ode, time_step: 0.01, physics_substeps: 2}\n"
          "models: [{model: hanger.yaml, position: [0, 0, 2]}]\n";
-  const auto r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 50 --quiet --out " +
-                            (dir / "out").string());
+  const auto r = RunWorld(dir, 50);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const Csv g = ReadCsv(dir / "out/graphs/hanger#0/g.csv");
   ASSERT_EQ(g.header, (std::vector<std::string>{"time", "f.x", "f.y", "f.z", "speed"}));
@@ -321,14 +322,67 @@ TEST(GraphsRunTest, CsvIsWrittenWithoutGnuplot) {
   EXPECT_EQ(csvs, 3);
 }
 
+// A graph with nothing to draw (a script stream no script sets) still gets
+// its CSV (nan) and a PNG saying so; the other graphs are drawn too (one
+// gnuplot script holds them all: an empty plot must not stop it).
+TEST(GraphsRunTest, GraphsWithoutDataGetAnEmptyPlotAndTheOthersTheirs) {
+  const fs::path dir =
+      BotWorld("nodata",
+               "    - {name: a, type: graph, streams: [\"script never\"]}\n"
+               "    - {name: b, type: graph, kind: xyz, streams: [\"x = script\", \"y = script\", "
+               "\"z = script\"]}\n"
+               "    - {name: c, type: graph, streams: [\"position : x\"]}\n");
+  const auto r = RunWorld(dir, 3);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.output.find("warning"), std::string::npos) << r.output;
+  for (int k = 0; k < 3; ++k)
+    for (const char* name : {"a", "b", "c"})
+      EXPECT_TRUE(
+          IsPng(dir / "out/graphs" / ("bot#" + std::to_string(k)) / (name + std::string(".png"))))
+          << k << name;
+  for (const auto& row : ReadCsv(dir / "out/graphs/bot#0/a.csv").rows)
+    EXPECT_TRUE(std::isnan(row[1]));
+}
+
+// 201 copies with a graph each: every CSV, the first 200 PNGs, a warning
+// and a note in summary.json for the rest.
+TEST(GraphsRunTest, PngsPastTheCapAreLeftOutWithANote) {
+  const fs::path dir = FreshTempDir("swarmsim_graphs", "cap");
+  fs::create_directories(dir);
+  std::ofstream(dir / "world.yaml")
+      << "simulation: {physics: kinematic, time_step: 0.1}\n"
+         "models:\n"
+         "  - {model: dot.yaml, count: 201, distribute: {region: {min: [-20, -20], max: [20, "
+         "20]}}}\n";
+  std::ofstream(dir / "dot.yaml") << "model: dot\nobjects: {name: body, type: dummy, children: [\n"
+                                     "  {name: g, type: graph, streams: [\"position : x\"]}]}\n";
+  const auto r = RunWorld(dir, 2);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("PNGs drawn for the first 200 graphs only; 1 more"), std::string::npos)
+      << r.output;
+  EXPECT_TRUE(IsPng(dir / "out/graphs/dot#199/g.png"));
+  EXPECT_FALSE(fs::exists(dir / "out/graphs/dot#200/g.png"));
+  EXPECT_TRUE(fs::exists(dir / "out/graphs/dot#200/g.csv"));
+  const nlohmann::json summary = nlohmann::json::parse(ReadFile(dir / "out/summary.json"));
+  int csv = 0, png = 0, notes = 0;
+  for (const auto& o : summary.at("outputs")) {
+    const std::string path = o.at("path");
+    csv += path.ends_with(".csv");
+    png += path.ends_with(".png");
+    notes += o.at("kind") == "note";
+  }
+  EXPECT_EQ(csv, 201);
+  EXPECT_EQ(png, 200);
+  EXPECT_EQ(notes, 1);
+}
+
 TEST(GraphsRunTest, CyclicBufferKeepsTheLastSamples) {
   const fs::path dir = BotWorld("cyclic",
                                 "    - {name: last, type: graph, streams: [\"joint :/wheel\"], "
                                 "buffer: 5, cyclic: true, every: 2}\n"
                                 "    - {name: first, type: graph, streams: [\"joint :/wheel\"], "
                                 "buffer: 5}\n");
-  const auto r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 20 --quiet --out " +
-                            (dir / "out").string());
+  const auto r = RunWorld(dir, 20);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const Csv last = ReadCsv(dir / "out/graphs/bot#0/last.csv");
   ASSERT_EQ(last.rows.size(), 5u);
@@ -360,6 +414,10 @@ TEST(GraphsRunTest, BadStreamsAreLoadErrorsAtTheirLine) {
                   "bot.yaml:11:", "unknown stream kind 'positon'; did you mean 'position'?");
   ExpectLoadError("path", "    - {name: g, type: graph, streams: [\"joint :/wheal\"]}\n",
                   "bot.yaml:11:", "':/wheal' matches no object; did you mean ':/wheel'?");
+  ExpectLoadError("below", "    - {name: g, type: graph, streams: [\"joint ./wheel\"]}\n",
+                  "bot.yaml:11:", "did you mean ':/wheel', in the graph's model?");
+  ExpectLoadError("root", "    - {name: g, type: graph, streams: [\"position :/body z\"]}\n",
+                  "bot.yaml:11:", "the model's root is ':' itself, named after the copy");
   ExpectLoadError("type", "    - {name: g, type: graph, streams: [\"joint :\"]}\n",
                   "bot.yaml:11:", "':' is a shape, not a joint");
   ExpectLoadError("component", "    - {name: g, type: graph, streams: [\"position : w\"]}\n",
