@@ -120,8 +120,13 @@ int ReadVisionSensor(lua_State* L) {
   const filters::FilterOutput& out = OutputOf(s, &scratch);
   lua_pushinteger(L, out.triggered ? 1 : 0);
   luaL_checkstack(L, static_cast<int>(out.packets.size()) + 2, "too many packets");
-  for (const std::vector<double>& packet : out.packets)
-    PushNumberArray(L, packet.data(), static_cast<int>(packet.size()));
+  // Packet 1 from the image now when the sense phase left it (module.cc).
+  const std::vector<double> packet1 = out.packets[0].empty()
+                                          ? filters::ImageStatistics(s.image, CameraModelOf(s.lens))
+                                          : out.packets[0];
+  PushNumberArray(L, packet1.data(), static_cast<int>(packet1.size()));
+  for (size_t k = 1; k < out.packets.size(); ++k)
+    PushNumberArray(L, out.packets[k].data(), static_cast<int>(out.packets[k].size()));
   return 1 + static_cast<int>(out.packets.size());
 }
 

@@ -111,7 +111,9 @@ void RenderingModule::RenderDue(World* world, bool all) {
           options.floor = s.floor;
           options.background = s.background;
           Draw(*list_of[i], ViewOf(scene, sensors->owners[r], s.lens, s.depth), options, &s.image);
-          if (!s.filters.empty()) s.filters.Run(s.image, CameraModelOf(s.lens), &s.output);
+          // Packet 1 is left to sim.readVisionSensor (most runs never read it).
+          if (!s.filters.empty())
+            s.filters.Run(s.image, CameraModelOf(s.lens), &s.output, /*statistics=*/false);
           s.rendered_step = step;
         }
       });

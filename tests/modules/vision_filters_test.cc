@@ -115,6 +115,7 @@ TEST(VisionFiltersTest, BlobsOfTwoDiscsHaveTheirSizeCentroidBoxAndColour) {
   // Packets: the statistics, then blobs: count, 10 values per blob.
   ASSERT_EQ(out.packets.size(), 2u);
   EXPECT_EQ(out.packets[0].size(), 15u);
+  EXPECT_EQ(out.packets[0][4], 1);  // no depth image: depth at the far plane
   const std::vector<double>& p = out.packets[1];
   ASSERT_EQ(p.size(), 2u + 2 * 10);
   EXPECT_EQ(p[0], 2);
@@ -182,6 +183,7 @@ TEST(VisionFiltersTest, HsvThresholdPicksThePixelsInItsRanges) {
       {{255, 0, 40}, false, true},      // hue ~351
       {{255, 60, 0}, false, true},      // hue ~14
       {{128, 128, 128}, false, false},  // grey
+      {{0, 0, 0}, false, false},        // black: saturation 0, not 1
   };
   const int n = static_cast<int>(std::size(cases));
   Image image;
@@ -359,6 +361,12 @@ TEST(VisionFiltersTest, StatisticsPacketIsMinMaxMeanOfIntensityChannelsAndDepth)
                                         0.3,
                                         0.25};  // mean
   for (size_t i = 0; i < 15; ++i) EXPECT_NEAR(p[i], expected[i], 1e-12) << i;
+  // Left to the reader: the same numbers from ImageStatistics.
+  FilterOutput later;
+  Chain({{"grayscale", {}}}).Run(image, camera, &later, /*statistics=*/false);
+  ASSERT_EQ(later.packets.size(), 1u);
+  EXPECT_TRUE(later.packets[0].empty());
+  EXPECT_EQ(ImageStatistics(image, camera), p);
   // An empty image: zeros, no element runs.
   const FilterOutput empty =
       Chain({{"resize", {{"width", {4}}, {"height", {4}}}}}).Run(Image{}, camera);

@@ -150,7 +150,10 @@ class HsvThreshold final : public VisionFilterElement {
       range = {1, 0};  // empty
       if (max < value_lo || max > value_hi) continue;
       for (int delta = 0; delta <= max; ++delta) {
-        if (delta * kOne < saturation_lo * max || delta * kOne > saturation_hi * max) continue;
+        // delta / max against the range, without a division; black (max 0)
+        // has saturation 0.
+        const int64_t scaled = max > 0 ? delta * kOne : 0, bound = max > 0 ? max : 1;
+        if (scaled < saturation_lo * bound || scaled > saturation_hi * bound) continue;
         if (range.lo > range.hi) range.lo = static_cast<int16_t>(delta);
         range.hi = static_cast<int16_t>(delta);
       }

@@ -112,8 +112,8 @@ std::shared_ptr<const VisionFilterElement> MakePluginElement(
 // --- Running --------------------------------------------------------------------------
 
 // Packet 1 (CoppeliaSim's): min, max and mean of intensity, red, green,
-// blue and depth (0..1; depth from the near plane to the far one, 0 without
-// a depth image), in that order.
+// blue and depth (0..1; depth from the near plane to the far one, 1 without
+// a depth image: nothing seen), in that order.
 void Statistics(const Image& image, const CameraModel& camera, std::vector<double>* packet) {
   const size_t n = static_cast<size_t>(image.width) * static_cast<size_t>(image.height);
   const uint8_t* rgb = image.rgb.data();
@@ -166,7 +166,8 @@ void Statistics(const Image& image, const CameraModel& camera, std::vector<doubl
   }
   min[0] = *std::min_element(i_lo, i_lo + 4);
   max[0] = *std::max_element(i_hi, i_hi + 4);
-  double depth_min = 0, depth_max = 0, depth_mean = 0;
+  const double no_depth = n > 0 ? 1.0 : 0.0;
+  double depth_min = no_depth, depth_max = no_depth, depth_mean = no_depth;
   if (n > 0 && image.depth.size() == n) {
     // Loops the compiler vectorises. Depths are >= 0, so their bit patterns
     // order as the numbers do: an integer min and max.
@@ -269,14 +270,19 @@ FilterOutput FilterChain::Run(const Image& image, const CameraModel& camera) con
   return out;
 }
 
-void FilterChain::Run(const Image& image, const CameraModel& camera, FilterOutput* out) const {
+void FilterChain::Run(const Image& image, const CameraModel& camera, FilterOutput* out,
+                      bool statistics) const {
   SWARMSIM_CHECK(image.width >= 0 && image.height >= 0 &&
                      image.rgb.size() ==
                          static_cast<size_t>(image.width) * static_cast<size_t>(image.height) * 3,
                  "a filter chain's image has " + std::to_string(image.rgb.size()) + " bytes for " +
                      std::to_string(image.width) + "x" + std::to_string(image.height) + " pixels");
   if (out->packets.empty()) out->packets.emplace_back();
-  Statistics(image, camera, &out->packets[0]);
+  if (statistics) {
+    Statistics(image, camera, &out->packets[0]);
+  } else {
+    out->packets[0].clear();
+  }
   out->blobs.clear();
   out->points.clear();
   out->triggered = false;
@@ -291,6 +297,12 @@ void FilterChain::Run(const Image& image, const CameraModel& camera, FilterOutpu
     for (const auto& element : data_->elements) element->Apply(&run);
   out->packets.resize(run.packets);
   ToRgb(run.work, camera, &out->image);
+}
+
+std::vector<double> ImageStatistics(const Image& image, const CameraModel& camera) {
+  std::vector<double> packet;
+  Statistics(image, camera, &packet);
+  return packet;
 }
 
 Vec3 ImageToSensor(const CameraModel& camera, int width, int height, double x, double y,

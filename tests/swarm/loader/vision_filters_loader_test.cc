@@ -1,19 +1,19 @@
-// Filter chains read from a model file (ObjectReader::Items through the
-// loader): a valid chain runs, a plugin's element is found through the
-// world's `plugins:`, and mistakes are errors at their file:line:column.
-// Until a built-in type holds a chain, a test type (`filter_probe`, key
-// `filters`) reads one the way the vision sensor will.
+// Vision sensors' filter chains as a user writes them (a `filters:` list in
+// a world or model file, read through ObjectReader::Items): a rendered box
+// found as a blob where it is, what scripts read, a plugin's element found
+// through the world's `plugins:`, and mistakes as errors at their
+// file:line:column.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <string>
 
 #include "framework/error.h"
-#include "framework/object_type.h"
-#include "framework/registry.h"
 #include "framework/world.h"
 #include "modules/rendering/filters/filters.h"
+#include "modules/rendering/objects.h"
 #include "swarm/loader/world_loader.h"
 #include "tests/swarm/loader/world_dir_test.h"
 
@@ -23,26 +23,7 @@ namespace {
 #define EXPECT_CONTAINS(haystack, needle) \
   EXPECT_NE(std::string(haystack).find(needle), std::string::npos) << (haystack)
 
-struct ProbeRow {
-  filters::FilterChain chain;
-};
-
-constexpr ObjectKey kProbeKeys[] = {{"filters", "[]", "a filter chain (test)"}};
-
-std::shared_ptr<const ObjectTypeDescriptor> ProbeType() {
-  auto type = std::make_shared<ObjectTypeDescriptor>();
-  type->name = "filter_probe";
-  type->description = "holds a filter chain (test)";
-  type->make_rows = [](const ObjectTypeDescriptor&) -> std::unique_ptr<RowTable> {
-    return std::make_unique<Rows<ProbeRow>>();
-  };
-  type->keys = kProbeKeys;
-  type->read = [](const ObjectTypeDescriptor&, const ObjectReader& reader, void* row) {
-    static_cast<ProbeRow*>(row)->chain =
-        filters::ParseFilterChain(reader, "filters", reader.registry());
-  };
-  return type;
-}
+constexpr double kDeg = M_PI / 180;
 
 // "line:column" (1-based) of the first `needle` in `text`.
 std::string PositionOf(const std::string& text, const std::string& needle) {
@@ -54,122 +35,142 @@ std::string PositionOf(const std::string& text, const std::string& needle) {
   return std::to_string(line) + ":" + std::to_string(column);
 }
 
+// A red box (0.5 m) 2 m ahead and `y` m to the left of a 64x48 sensor
+// 0.25 m above the floor, whose filters are `filters` (YAML lines, indented
+// by 8).
+std::string WorldText(const std::string& filters, double y = 0, const std::string& more = "") {
+  return "simulation: {physics: kinematic, time_step: 0.1}\n" + more +
+         "objects:\n"
+         "  - {name: box, type: shape, shape: box, size: [0.5, 0.5, 0.5], position: [2, " +
+         std::to_string(y) +
+         ", 0.25],\n"
+         "     color: [0.9, 0.1, 0.1]}\n"
+         "  - name: eye\n"
+         "    type: vision_sensor\n"
+         "    position: [0, 0, 0.25]\n"
+         "    resolution: [64, 48]\n"
+         "    filters:\n" +
+         filters;
+}
+
+constexpr char kRedBlobs[] =
+    "        - {type: hsv_threshold, hue: [340, 20], saturation: [0.5, 1]}\n"
+    "        - {type: blobs, min_pixels: 4}\n";
+
 class VisionFiltersLoaderTest : public testing::WorldDirTest {
  protected:
-  void SetUp() override {
-    WorldDirTest::SetUp();
-    registry_.RegisterObjectType(ProbeType());
-  }
-  // A robot whose `cam` holds `filters` (YAML lines, indented by 8).
-  std::string WriteModel(const std::string& filters, const std::string& plugins = "") {
-    const std::string model =
-        "model: bot\n"
-        "objects:\n"
-        "  name: body\n"
-        "  type: dummy\n"
-        "  children:\n"
-        "    - name: cam\n"
-        "      type: filter_probe\n"
-        "      filters:\n" +
-        filters;
-    Write("bot.yaml", model);
-    Write("world.yaml", "simulation: {physics: kinematic, time_step: 0.1}\n" + plugins +
-                            "models:\n  - {model: bot.yaml, position: [0, 0]}\n");
-    return model;
-  }
-  // The program's plugin folder is where a world finds `plugins: [example_plugin]`.
-  LoadedWorld Load() {
+  LoadedWorld Load(const std::string& world_text, int threads = 1) {
     LoadOptions options;
+    options.threads = threads;
+    // The program's plugin folder is where a world finds `plugins: [example_plugin]`.
     options.plugin_directories = {std::filesystem::path(SWARMSIM_BINARY).parent_path() / "plugins"};
-    return LoadWorld(dir_ / "world.yaml", options, registry_);
+    LoadedWorld w = LoadWorld(Write("world.yaml", world_text), options, registry_);
+    w.world->set_log_sink([](std::string_view) {});
+    return w;
   }
-  std::string LoadError() {
+  std::string LoadError(const std::string& world_text) {
     try {
-      Load();
+      Load(world_text);
     } catch (const Error& e) {
       return e.what();
     }
     return "NO ERROR";
   }
-  // The chain the loaded world's probe holds.
-  static filters::FilterChain ChainOf(const LoadedWorld& loaded) {
-    const Scene& scene = loaded.world->scene();
-    ObjectType type;
-    EXPECT_TRUE(scene.FindType("filter_probe", &type));
-    const auto& rows = static_cast<const Rows<ProbeRow>&>(*scene.rows(type));
-    EXPECT_EQ(rows.size(), 1u);
-    return rows.rows.at(0).chain;
+  static const rendering::VisionSensorRow& Eye(World& world) {
+    const ObjectId id = world.scene().FindObject("/eye");
+    EXPECT_FALSE(id.IsNull());
+    return *static_cast<const rendering::VisionSensorRow*>(world.scene().row_data(id));
   }
 };
 
-TEST_F(VisionFiltersLoaderTest, AChainFromAModelFileRuns) {
-  WriteModel(
-      "        - {type: hsv_threshold, hue: [100, 140], saturation: [0.5, 1], value: [0.3, 1]}\n"
-      "        - type: blobs\n"
-      "          min_pixels: 2\n");
-  const LoadedWorld loaded = Load();
-  const filters::FilterChain chain = ChainOf(loaded);
-  ASSERT_EQ(chain.size(), 2u);
-  Image image;
-  image.Resize(8, 8);
-  for (int x = 2; x < 5; ++x) image.Pixel(x, 3)[1] = 200;  // a green bar
-  image.Pixel(7, 7)[1] = 200;                              // too small
-  const filters::FilterOutput out = chain.Run(image, {});
+TEST_F(VisionFiltersLoaderTest, ARenderedBoxIsABlobWhereTheBoxIs) {
+  LoadedWorld w = Load(WorldText(kRedBlobs));
+  w.world->Start();
+  const rendering::VisionSensorRow& eye = Eye(*w.world);
+  const filters::FilterOutput& out = eye.output;
   ASSERT_EQ(out.blobs.size(), 1u);
-  EXPECT_EQ(out.blobs[0].pixels, 3);
-  EXPECT_DOUBLE_EQ(out.blobs[0].x, 3.5);
+  EXPECT_TRUE(out.triggered);
+  // Straight ahead: centred horizontally; its face (0.5 m at 1.75 m) about
+  // 64 (0.25 / 1.75) / tan(30 deg) pixels wide.
+  const filters::Blob& blob = out.blobs[0];
+  EXPECT_NEAR(blob.u, 0.5, 0.5 / 64);
+  EXPECT_NEAR(blob.max_x - blob.min_x + 1, 64 * (0.25 / 1.75) / std::tan(30 * kDeg), 1.5);
+  EXPECT_GT(blob.colour[0], 0.4);
+  EXPECT_LT(blob.colour[1], 0.2);
+  // To the left: its bearing from the centroid's ray.
+  LoadedWorld left = Load(WorldText(kRedBlobs, 0.5));
+  left.world->Start();
+  const filters::FilterOutput& seen = Eye(*left.world).output;
+  ASSERT_EQ(seen.blobs.size(), 1u);
+  const Vec3 ray = filters::ImageToSensor(rendering::CameraModelOf(Eye(*left.world).lens), 64, 48,
+                                          seen.blobs[0].x, seen.blobs[0].y, 1);
+  EXPECT_NEAR(std::atan2(ray.y, ray.x), std::atan2(0.5, 2.0), 3 * kDeg);
+}
+
+TEST_F(VisionFiltersLoaderTest, ScriptsReadTheChainsPacketsTheSameAtAnyThreadCount) {
+  Write("eye.lua", R"(
+function sysCall_sensing()
+  local result, packet1, blobs = sim.readVisionSensor(sim.getObject('/eye'))
+  assert(result == 1 and #packet1 == 15 and blobs[1] == 1 and blobs[2] == 10)
+end
+)");
+  std::vector<std::vector<double>> packets[2];
+  for (int threads : {1, 2}) {
+    LoadedWorld w = Load(WorldText(kRedBlobs, 0.3) + "    script: eye.lua\n", threads);
+    w.world->Start();
+    for (int i = 0; i < 3; ++i) w.world->Step();
+    packets[threads - 1] = Eye(*w.world).output.packets;
+  }
+  ASSERT_EQ(packets[0].size(), 2u);
+  EXPECT_EQ(packets[0], packets[1]);
 }
 
 TEST_F(VisionFiltersLoaderTest, APluginsElementIsFoundThroughTheWorldsPlugins) {
-  WriteModel("        - {type: invert}\n", "plugins: [example_plugin]\n");
-  const LoadedWorld loaded = Load();
-  Image image;
-  image.Resize(2, 1);
-  image.Pixel(0, 0)[0] = 10;
-  const filters::FilterOutput out = ChainOf(loaded).Run(image, {});
-  EXPECT_EQ(out.image.Pixel(0, 0)[0], 245);
-  EXPECT_EQ(out.image.Pixel(1, 0)[2], 255);
+  LoadedWorld w = Load(WorldText("        - {type: invert}\n", 0, "plugins: [example_plugin]\n"));
+  w.world->Start();
+  const rendering::VisionSensorRow& eye = Eye(*w.world);
+  ASSERT_EQ(eye.output.image.rgb.size(), eye.image.rgb.size());
+  for (size_t i = 0; i < eye.image.rgb.size(); ++i)
+    ASSERT_EQ(eye.output.image.rgb[i], 255 - eye.image.rgb[i]) << i;
   // Without the plugin: unknown.
-  WriteModel("        - {type: invert}\n");
-  EXPECT_CONTAINS(LoadError(), "'type' must be one of");
+  EXPECT_CONTAINS(LoadError(WorldText("        - {type: invert}\n")), "'type' must be one of");
 }
 
 TEST_F(VisionFiltersLoaderTest, MistakesAreErrorsAtTheirFileLineAndColumn) {
   // An unknown element, with a suggestion.
-  std::string model = WriteModel("        - {type: blob}\n");
-  EXPECT_CONTAINS(LoadError(),
-                  "bot.yaml:" + PositionOf(model, "blob}") + ": 'type' must be one of");
-  EXPECT_CONTAINS(LoadError(), R"((got "blob"); did you mean 'blobs'?)");
+  std::string world = WorldText("        - {type: blob}\n");
+  EXPECT_CONTAINS(LoadError(world), "world.yaml:" + PositionOf(world, "blob}") +
+                                        ": 'type' must be one of grayscale, resize");
+  EXPECT_CONTAINS(LoadError(world), R"((got "blob"); did you mean 'blobs'?)");
   // Kinds that do not fit, at the element that needs another.
-  model = WriteModel(
+  world = WorldText(
       "        - {type: grayscale}\n"
       "        - {type: blobs, min_pixels: 4}\n");
-  EXPECT_CONTAINS(LoadError(), "bot.yaml:" + PositionOf(model, "blobs,") +
-                                   ": 'blobs' needs a mask; 'grayscale' gives a grey image: put a "
-                                   "threshold before it");
-  // A bad value.
-  model = WriteModel("        - {type: color_threshold, color: [1, 0, 2]}\n");
-  EXPECT_CONTAINS(LoadError(), "bot.yaml:" + PositionOf(model, "2]"));
-  model = WriteModel("        - {type: resize, width: 0, height: 4}\n");
-  EXPECT_CONTAINS(LoadError(), "bot.yaml:" + PositionOf(model, "0,"));
+  EXPECT_CONTAINS(LoadError(world), "world.yaml:" + PositionOf(world, "blobs,") +
+                                        ": 'blobs' needs a mask; 'grayscale' gives a grey image: "
+                                        "put a threshold before it");
+  // Bad values.
+  world = WorldText("        - {type: color_threshold, color: [1, 0, 2]}\n");
+  EXPECT_CONTAINS(LoadError(world), "world.yaml:" + PositionOf(world, "2]}"));
+  world = WorldText("        - {type: resize, width: 0, height: 4}\n");
+  EXPECT_CONTAINS(LoadError(world), "world.yaml:" + PositionOf(world, "0, h"));
   // A key the element does not take, with a suggestion and the item named.
-  model = WriteModel(
+  world = WorldText(
       "        - {type: color_threshold, color: [1, 0, 0]}\n"
       "        - {type: blobs, min_pixel: 4}\n");
-  EXPECT_CONTAINS(LoadError(), "bot.yaml:" + PositionOf(model, "min_pixel") +
-                                   ": unknown key 'min_pixel' in filters[1] of object 'cam'; did "
-                                   "you mean 'min_pixels'?");
+  EXPECT_CONTAINS(LoadError(world), "world.yaml:" + PositionOf(world, "min_pixel") +
+                                        ": unknown key 'min_pixel' in filters[1] of object 'eye'; "
+                                        "did you mean 'min_pixels'?");
   // A misspelt 'type'.
-  model = WriteModel("        - {tpye: blobs}\n");
-  EXPECT_CONTAINS(LoadError(), "bot.yaml:" + PositionOf(model, "tpye") +
-                                   ": unknown key 'tpye' in filters[0] of object 'cam'; did you "
-                                   "mean 'type'?");
+  world = WorldText("        - {tpye: blobs}\n");
+  EXPECT_CONTAINS(LoadError(world), "world.yaml:" + PositionOf(world, "tpye") +
+                                        ": unknown key 'tpye' in filters[0] of object 'eye'; did "
+                                        "you mean 'type'?");
   // An item that is not a map; a list that is not a list.
-  model = WriteModel("        - blobs\n");
-  EXPECT_CONTAINS(LoadError(), "bot.yaml:" + PositionOf(model, "blobs") +
-                                   ": filters[0] of object 'cam' must be a mapping");
-  model = WriteModel("          blobs\n");
-  EXPECT_CONTAINS(LoadError(), "'filters' must be a list of maps");
+  world = WorldText("        - blobs\n");
+  EXPECT_CONTAINS(LoadError(world), "world.yaml:" + PositionOf(world, "blobs") +
+                                        ": filters[0] of object 'eye' must be a mapping");
+  EXPECT_CONTAINS(LoadError(WorldText("          blobs\n")), "'filters' must be a list of maps");
 }
 
 }  // namespace
