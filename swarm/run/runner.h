@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <iosfwd>
 #include <optional>
 #include <string>
@@ -23,6 +24,9 @@ struct RunOptions {
   // --set NAME=VALUE, in order, for the summary ("overrides"): world
   // parameters are in "parameters" too, model parameters only here.
   std::vector<std::pair<std::string, std::string>> overrides;
+  // What else the run produces, appended to the progress line ("video 120
+  // frames"); null: nothing.
+  std::function<std::string()> progress_note;
 };
 
 struct RunResult {
