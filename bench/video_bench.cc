@@ -20,6 +20,7 @@
 #include "modules/paint/png_io.h"
 #include "modules/rendering/geometry.h"
 #include "modules/rendering/render.h"
+#include "modules/rendering/video/frame_geometry.h"
 #include "modules/rendering/video/video_writer.h"
 #include "swarm/loader/world_loader.h"
 
@@ -84,6 +85,26 @@ BENCHMARK(BM_Draw)
     ->Args({1000, 6})
     ->Args({1000, 4})
     ->Unit(benchmark::kMillisecond);
+
+// What the recorder does per frame of the arena view: the draw list (the
+// simulation's thread), faces turned away dropped, drawing (its own thread).
+void BM_Frame(benchmark::State& state) {
+  Diffusion& d = World(static_cast<int>(state.range(0)));
+  rendering::DrawList list;
+  std::vector<uint8_t> closed;
+  Image image;
+  const int segments = video::SegmentsFor(d.view);
+  for (auto _ : state) {
+    rendering::BuildDrawList(*d.loaded.world, segments, &list);
+    video::MarkClosed(d.loaded.world->scene(), list, &closed);
+    video::DropHiddenFaces(d.view, closed, &list);
+    rendering::Draw(list, d.view, rendering::DrawOptions{}, &image);
+  }
+  state.counters["segments"] = segments;
+  state.counters["triangles"] = static_cast<double>(list.xyz.size() / 9);
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_Frame)->Arg(100)->Arg(1000)->Unit(benchmark::kMillisecond);
 
 void BM_Encode(benchmark::State& state) {
   Diffusion& d = World(1000);

@@ -14,13 +14,13 @@
 #include "modules/paint/png_io.h"
 #include "modules/rendering/geometry.h"
 #include "modules/rendering/render.h"
+#include "modules/rendering/video/frame_geometry.h"
 #include "modules/rendering/video/video_writer.h"
 
 namespace swarmsim::video {
 
 namespace {
 
-constexpr int kSegments = 8;    // sides of cylinders: a robot is a few pixels across
 constexpr int kMaxSide = 8192;  // pixels, the renderer's limit
 constexpr int kMaxVideoSide = 4096;
 constexpr size_t kMaxQueued = 4;  // frames waiting for the recorder's thread
@@ -53,75 +53,6 @@ struct Job {
   bool snapshot = false;
   bool video = false;
 };
-
-// Per item of `list`: 1 when it is a closed primitive (a shape other than
-// a mesh, an environment box), whose faces turned away from the eye are
-// hidden behind its others.
-void MarkClosed(const Scene& scene, const rendering::DrawList& list, std::vector<uint8_t>* closed) {
-  const auto shapes = scene.shapes();
-  closed->resize(list.items.size());
-  for (size_t i = 0; i < list.items.size(); ++i) {
-    const uint32_t slot = list.items[i].slot;
-    (*closed)[i] =
-        slot == rendering::kNoSlot || (scene.type_at(slot) == ObjectType::kShape &&
-                                       shapes[scene.row_at(slot)].kind != ShapeKind::kMesh);
-  }
-}
-
-// Drops the triangles of closed items that face away from the eye of
-// `view` (or are edge-on): what OpenGL's back-face culling would drop, but
-// before Mesa's vertex stage, which is where a frame of a thousand robots
-// spends its time. Seen from above, an upright cylinder keeps its top cap.
-void DropHiddenFaces(const rendering::View& view, const std::vector<uint8_t>& closed,
-                     rendering::DrawList* list) {
-  const Vec3 axis = view.pose.q.Rotate({1, 0, 0});  // where the view looks
-  const float ax = static_cast<float>(axis.x), ay = static_cast<float>(axis.y),
-              az = static_cast<float>(axis.z);
-  const float ex = static_cast<float>(view.pose.p.x), ey = static_cast<float>(view.pose.p.y),
-              ez = static_cast<float>(view.pose.p.z);
-  std::vector<float>& xyz = list->xyz;
-  std::vector<float>& normal = list->normal;
-  std::vector<uint8_t>& rgb = list->rgb;
-  uint32_t out = 0;  // vertices kept so far
-  size_t kept_items = 0;
-  for (size_t i = 0; i < list->items.size(); ++i) {
-    rendering::DrawItem item = list->items[i];
-    const uint32_t first = out;
-    for (uint32_t v = item.first; v + 3 <= item.first + item.count; v += 3) {
-      const float* a = &xyz[3 * v];
-      bool keep = closed[i] == 0;
-      if (!keep) {
-        const float* b = a + 3;
-        const float* c = a + 6;
-        const float ux = b[0] - a[0], uy = b[1] - a[1], uz = b[2] - a[2];
-        const float vx = c[0] - a[0], vy = c[1] - a[1], vz = c[2] - a[2];
-        const float nx = uy * vz - uz * vy, ny = uz * vx - ux * vz, nz = ux * vy - uy * vx;
-        // From the eye to the triangle: the view's axis (orthographic), or the ray to it.
-        const float dx = view.orthographic ? ax : a[0] - ex;
-        const float dy = view.orthographic ? ay : a[1] - ey;
-        const float dz = view.orthographic ? az : a[2] - ez;
-        const float facing = nx * dx + ny * dy + nz * dz;  // < 0: toward the eye
-        const float scale =
-            std::sqrt((nx * nx + ny * ny + nz * nz) * (dx * dx + dy * dy + dz * dz));
-        keep = facing < -1e-4f * scale;
-      }
-      if (!keep) continue;
-      if (out != v) {
-        std::copy_n(&xyz[3 * v], 9, &xyz[3 * out]);
-        std::copy_n(&normal[3 * v], 9, &normal[3 * out]);
-        std::copy_n(&rgb[3 * v], 9, &rgb[3 * out]);
-      }
-      out += 3;
-    }
-    item.first = first;
-    item.count = out - first;
-    if (item.count > 0) list->items[kept_items++] = item;
-  }
-  list->items.resize(kept_items);
-  xyz.resize(3 * static_cast<size_t>(out));
-  normal.resize(3 * static_cast<size_t>(out));
-  rgb.resize(3 * static_cast<size_t>(out));
-}
 
 }  // namespace
 
@@ -244,7 +175,7 @@ struct Recorder::Impl {
       job.view.height = height;
       job.view.depth = false;
     }
-    rendering::BuildDrawList(world, kSegments, &job.list);
+    rendering::BuildDrawList(world, SegmentsFor(job.view), &job.list);
     MarkClosed(world.scene(), job.list, &job.closed);
     // The paint layer changes in the next steps: the frame gets a copy.
     rendering::FloorLayer& floor = job.list.floor;

@@ -131,6 +131,8 @@ VideoWriter::VideoWriter(const std::filesystem::path& path, const VideoSettings&
   av_dict_free(&options);
   if (rc < 0) v.Fail("cannot write the MP4 header", rc);
   avio_flush(v.format->pb);
+  if (v.format->pb->error < 0)
+    throw Error("cannot write '" + v.name + "': " + AvError(v.format->pb->error));
 
   v.frame->format = AV_PIX_FMT_YUV420P;
   v.frame->width = settings.width;
@@ -173,9 +175,10 @@ void VideoWriter::Finish() {
   if (v.finished) return;
   v.finished = true;
   v.Encode(nullptr);
-  const int rc = av_write_trailer(v.format);
+  int rc = av_write_trailer(v.format);
   if (rc < 0) v.Fail("cannot complete the file", rc);
-  avio_closep(&v.format->pb);
+  rc = avio_closep(&v.format->pb);
+  if (rc < 0) v.Fail("cannot complete the file", rc);
 }
 
 int64_t VideoWriter::frames() const { return impl_->frames; }

@@ -277,6 +277,25 @@ TEST(VideoCli, ARunKilledOutrightKeepsTheVideoUpToItsLastWholeSecond) {
   EXPECT_LE(frames, 46u);
 }
 
+TEST(VideoCli, AVideoThatCannotBeWrittenMidRunFailsTheRunWithTheOutputsSoFar) {
+  // A file size limit (and SIGXFSZ ignored: writes fail with EFBIG) stops
+  // the video a few seconds in.
+  const auto dir = MarkerWorld("full", -1.5, 0.01);
+  const auto out = dir / "out";
+  const auto r = testing::RunCommand(
+      "ulimit -f 24; trap '' XFSZ; exec " + std::string(SWARMSIM_BINARY) + " run " +
+      (dir / "world.yaml").string() + " --steps 100000 --video --quiet --out " + out.string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("error: --video: video '"), std::string::npos) << r.output;
+  const nlohmann::json summary = Summary(out);
+  EXPECT_EQ(summary["status"], "error");
+  EXPECT_NE(summary["error"].get<std::string>().find("--video"), std::string::npos);
+  EXPECT_LT(summary["steps"].get<int64_t>(), 100000);
+  EXPECT_TRUE(std::filesystem::exists(out / "metrics.csv"));
+  video::VideoReader reader(out / "video.mp4");  // what reached the disk still plays
+  EXPECT_GE(DecodeAll(&reader).size(), 10u);
+}
+
 TEST(VideoCli, BadVideoOptionsAreNamedAndStopTheRunBeforeItStarts) {
   const auto dir = MarkerWorld("bad", 1.0, 0, "  - {name: overhead, type: camera}\n");
   const std::string world = (dir / "world.yaml").string();
@@ -300,6 +319,9 @@ TEST(VideoCli, BadVideoOptionsAreNamedAndStopTheRunBeforeItStarts) {
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("--video: cannot write"), std::string::npos) << r.output;
   EXPECT_EQ(Summary(out)["status"], "error");
+  r = RunProgram("run " + world + " --steps 2 --video /dev/full");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--video: video '/dev/full'"), std::string::npos) << r.output;
   // --video with no file and no folder.
   r = RunProgram("run " + world + " --steps 2 --video");
   EXPECT_EQ(r.exit_code, 2) << r.output;
