@@ -127,7 +127,16 @@ CLI::App* AddRunCommand(CLI::App* app, RunArgs* args) {
                                 "Record an H.264 video of the view (default DIR/video.mp4 with "
                                 "--out; a FILE is relative to the current folder)")
                     ->expected(0, 1)
-                    ->option_text("[FILE.mp4]");
+                    ->option_text("[FILE.mp4]")
+                    ->check(CLI::Validator(
+                        [](std::string& text) -> std::string {
+                          const std::string_view t(text);
+                          if (!t.ends_with(".yaml") && !t.ends_with(".yml")) return "";
+                          return "'" + text +
+                                 "' looks like a world file: put the world before --video, or "
+                                 "name a FILE.mp4";
+                        },
+                        ""));
   run->add_option(
          "--camera", args->camera,
          "View of the snapshots and video: a camera or vision sensor (/cam, footbot#3/eye) "

@@ -322,6 +322,10 @@ TEST(VideoCli, BadVideoOptionsAreNamedAndStopTheRunBeforeItStarts) {
   r = RunProgram("run " + world + " --steps 2 --video /dev/full");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("--video: video '/dev/full'"), std::string::npos) << r.output;
+  // --video's FILE is optional: a world file after it is not taken for one.
+  r = RunProgram("run --steps 2 --video " + world + " --out " + out.string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("put the world before --video"), std::string::npos) << r.output;
   // --video with no file and no folder.
   r = RunProgram("run " + world + " --steps 2 --video");
   EXPECT_EQ(r.exit_code, 2) << r.output;
