@@ -210,13 +210,7 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
   video::Recorder* recorder = nullptr;
   if (recording) {
     try {
-      if (options.out_dir) {
-        std::error_code ec;
-        std::filesystem::create_directories(*options.out_dir, ec);
-        if (ec)
-          throw Error("cannot create output folder '" + options.out_dir->string() +
-                      "': " + ec.message());
-      }
+      if (options.out_dir) CreateOutputFolder(*options.out_dir);  // for DIR/video.mp4
       recorder = static_cast<video::Recorder*>(loaded.world->AddModule("recorder", &*recording));
     } catch (const Error& e) {
       return bad_input(e.what());

@@ -378,11 +378,7 @@ void StepWatched(World* world, const RunOptions& options, Clock::time_point star
   };
   try {
     if (options.out_dir) {
-      std::error_code ec;
-      std::filesystem::create_directories(*options.out_dir, ec);
-      if (ec)
-        throw Error("cannot create output folder '" + options.out_dir->string() +
-                    "': " + ec.message());
+      CreateOutputFolder(*options.out_dir);
       const std::lock_guard lock(watchdog.io_mutex());
       metrics = std::make_unique<MetricsWriter>(*options.out_dir / "metrics.csv", *world);
     }
@@ -449,6 +445,12 @@ void PrintSummaryTable(const World& world, const RunResult& result, double lua_k
 }
 
 }  // namespace
+
+void CreateOutputFolder(const std::filesystem::path& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw Error("cannot create output folder '" + dir.string() + "': " + ec.message());
+}
 
 bool WriteErrorSummary(const RunOptions& options, const std::string& error) {
   if (!options.out_dir) return false;

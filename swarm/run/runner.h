@@ -54,6 +54,10 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
 // when the file cannot be written.
 bool WriteErrorSummary(const RunOptions& options, const std::string& error);
 
+// Creates the run's output folder (and its parents). Throws swarmsim::Error
+// naming it when it cannot.
+void CreateOutputFolder(const std::filesystem::path& dir);
+
 // Peak resident set size of this process, in MiB.
 double PeakRssMb();
 

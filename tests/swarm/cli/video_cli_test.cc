@@ -227,10 +227,13 @@ TEST(VideoCli, ResultsAreTheSameWithAndWithoutVideo) {
   EXPECT_NE(hash(plain.output), "(none)");
 }
 
-// A dummy whose script (signal.lua, WriteSignalScript) signals its own
-// process at step `at` (--trust-scripts: os.execute).
-constexpr char kSignaller[] = "  - {name: clock, type: dummy, script: signal.lua}\n";
-void WriteSignalScript(const std::filesystem::path& dir, int at, const std::string& signal) {
+// Runs a MarkerWorld whose extra dummy signals its own process with
+// `signal` at step `at` (its script: os.execute, so --trust-scripts), with
+// a 160x120 video into `*out`.
+testing::CommandResult RunUntilSignalled(const std::string& name, int at, const std::string& signal,
+                                         std::filesystem::path* out) {
+  const auto dir =
+      MarkerWorld(name, -1.5, 0.01, "  - {name: clock, type: dummy, script: signal.lua}\n");
   std::ofstream(dir / "signal.lua") << "local steps = 0\n"
                                        "function sysCall_actuation()\n"
                                        "  steps = steps + 1\n"
@@ -240,16 +243,15 @@ void WriteSignalScript(const std::filesystem::path& dir, int at, const std::stri
                                        "    local pid = io.open('/proc/self/stat'):read('n')\n"
                                        "    os.execute('kill -"
                                     << signal << " ' .. pid)\n  end\nend\n";
+  *out = dir / "out";
+  return RunProgram("run " + (dir / "world.yaml").string() +
+                    " --steps 100000 --trust-scripts --video --video-size 160x120 --quiet --out " +
+                    out->string());
 }
 
 TEST(VideoCli, ARunStoppedBySigtermLeavesAPlayableVideoUpToItsLastStep) {
-  const auto dir = MarkerWorld("sigterm", -1.5, 0.01, kSignaller);
-  WriteSignalScript(dir, 30, "TERM");
-  const auto out = dir / "out";
-  const auto r = RunProgram("run " + (dir / "world.yaml").string() +
-                            " --steps 100000 --trust-scripts --video --video-size 160x120 "
-                            "--quiet --out " +
-                            out.string());
+  std::filesystem::path out;
+  const auto r = RunUntilSignalled("sigterm", 30, "TERM", &out);
   EXPECT_EQ(r.exit_code, 128 + 15) << r.output;
   const nlohmann::json summary = Summary(out);
   EXPECT_EQ(summary["status"], "interrupted");
@@ -261,13 +263,8 @@ TEST(VideoCli, ARunStoppedBySigtermLeavesAPlayableVideoUpToItsLastStep) {
 }
 
 TEST(VideoCli, ARunKilledOutrightKeepsTheVideoUpToItsLastWholeSecond) {
-  const auto dir = MarkerWorld("sigkill", -1.5, 0.01, kSignaller);
-  WriteSignalScript(dir, 45, "KILL");
-  const auto out = dir / "out";
-  const auto r = RunProgram("run " + (dir / "world.yaml").string() +
-                            " --steps 100000 --trust-scripts --video --video-size 160x120 "
-                            "--quiet --out " +
-                            out.string());
+  std::filesystem::path out;
+  const auto r = RunUntilSignalled("sigkill", 45, "KILL", &out);
   EXPECT_EQ(r.exit_code, 128 + 9) << r.output;
   // A keyframe, and so a fragment on disk, every 10 frames (1 s of video);
   // x264 holds a few frames back.
