@@ -10,6 +10,7 @@
 #include <benchmark/benchmark.h>
 #include <unistd.h>
 
+#include <bit>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -62,6 +63,11 @@ void BM_BuildDrawList(benchmark::State& state) {
   for (auto _ : state)
     rendering::BuildDrawList(*d.loaded.world, static_cast<int>(state.range(1)), &list);
   state.counters["triangles"] = static_cast<double>(list.xyz.size() / 9);
+  uint64_t sum = 0;
+  for (float f : list.xyz) sum = sum * 31 + std::bit_cast<uint32_t>(f);
+  for (float f : list.normal) sum = sum * 31 + std::bit_cast<uint32_t>(f);
+  for (uint8_t c : list.rgb) sum = sum * 31 + c;
+  state.SetLabel("checksum " + std::to_string(sum));
   state.SetItemsProcessed(state.iterations());
 }
 BENCHMARK(BM_BuildDrawList)

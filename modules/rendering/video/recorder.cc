@@ -1,5 +1,7 @@
 #include "modules/rendering/video/recorder.h"
 
+#include <pthread.h>
+
 #include <algorithm>
 #include <cmath>
 #include <condition_variable>
@@ -302,6 +304,7 @@ Recorder::Recorder(World* world, const RecorderSettings& settings)
     rendering::Draw(rendering::DrawList{}, probe, rendering::DrawOptions{}, &image);
   }
   r.thread = std::thread([&r] { r.Work(); });
+  pthread_setname_np(r.thread.native_handle(), "recorder");  // in top and perf
 }
 
 Recorder::~Recorder() {
