@@ -15,6 +15,7 @@
 #include "framework/world.h"
 #include "modules/paint/png_io.h"
 #include "modules/rendering/geometry.h"
+#include "modules/rendering/objects.h"
 #include "modules/rendering/render.h"
 #include "modules/rendering/video/frame_geometry.h"
 #include "modules/rendering/video/video_writer.h"
@@ -51,10 +52,28 @@ struct Job {
   std::vector<uint8_t> closed;  // per item of `list`: 1 for a closed primitive (box, cylinder, ...)
   std::vector<uint8_t> paint;   // the paint layer's pixels then (list.floor points here)
   rendering::View view;
+  rendering::DrawOptions options;
   int64_t step = 0;
   bool snapshot = false;
   bool video = false;
 };
+
+// How a camera object draws: a vision sensor with its own floor and
+// background (not its detectable set: the recorder shows everything);
+// a camera, the defaults.
+rendering::DrawOptions OptionsOf(const Scene& scene, std::string_view path) {
+  rendering::DrawOptions options;
+  const ObjectId id = scene.FindObject(path);
+  ObjectType sensor{};
+  if (id.IsNull() || !scene.FindType("vision_sensor", &sensor)) return options;
+  const uint32_t slot = scene.SlotOf(id);
+  if (scene.type_at(slot) != sensor) return options;
+  const auto& rows = static_cast<const Rows<rendering::VisionSensorRow>&>(*scene.rows(sensor));
+  const rendering::VisionSensorRow& row = rows.rows[scene.row_at(slot)];
+  options.floor = row.floor;
+  options.background = row.background;
+  return options;
+}
 
 }  // namespace
 
@@ -116,7 +135,7 @@ struct Recorder::Impl {
       if (!failed) {
         try {
           DropHiddenFaces(job.view, job.closed, &job.list);
-          rendering::Draw(job.list, job.view, rendering::DrawOptions{}, &image);
+          rendering::Draw(job.list, job.view, job.options, &image);
           if (job.snapshot) {
             char name[64];
             std::snprintf(name, sizeof name, "snapshots/step_%06lld.png",
@@ -176,6 +195,7 @@ struct Recorder::Impl {
       job.view.width = width;
       job.view.height = height;
       job.view.depth = false;
+      job.options = OptionsOf(world.scene(), settings.camera);
     }
     rendering::BuildDrawList(world, SegmentsFor(job.view), &job.list);
     MarkClosed(world.scene(), job.list, &job.closed);

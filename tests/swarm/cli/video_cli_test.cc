@@ -210,6 +210,25 @@ TEST(VideoCli, ACameraGivesTheViewAtItsResolutionRoundedToEvenForVideo) {
   EXPECT_EQ(DecodeAll(&reader).size(), 5u);
 }
 
+TEST(VideoCli, AVisionSensorsSnapshotsDrawItsFloorAndBackgroundAsItSees) {
+  // A sensor that sees no floor, on a black background, looking at the red box.
+  const auto dir = MarkerWorld("sensor", 1.0, 0,
+                               "  - {name: eye, type: vision_sensor, position: [-2, 0.75, 0.1], "
+                               "resolution: [64, 48], fov_deg: 40, floor: false}\n");
+  const auto out = dir / "out";
+  const auto r =
+      RunProgram("run " + (dir / "world.yaml").string() +
+                 " --steps 1 --snapshot-every 1 --camera /eye --quiet --out " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const paint::RgbImage png = paint::ReadPng(out / "snapshots" / "step_000001.png");
+  ASSERT_EQ(png.width, 64);
+  ASSERT_EQ(png.height, 48);
+  EXPECT_GT(Find(png.width, png.height, png.rgb, Red).pixels, 10);
+  const auto black = [](int r, int g, int b) { return r + g + b == 0; };
+  EXPECT_GT(Find(png.width, png.height, png.rgb, black).pixels, 64 * 48 / 2)
+      << "the background where the floor would be";
+}
+
 TEST(VideoCli, ResultsAreTheSameWithAndWithoutVideo) {
   const std::string world = std::string(SWARMSIM_SOURCE_DIR) + "/worlds/diffusion.yaml";
   const auto out = FreshTempDir("video_cli", "hash");
