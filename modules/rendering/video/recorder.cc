@@ -197,7 +197,10 @@ struct Recorder::Impl {
       job.view.depth = false;
       job.options = OptionsOf(world.scene(), settings.camera);
     }
-    rendering::BuildDrawList(world, SegmentsFor(job.view), &job.list);
+    // A view from above keeps LEDs at least 3 pixels across, as Render does.
+    const double pixel =
+        job.view.orthographic ? job.view.ortho_width / std::max(1, job.view.width) : 0;
+    rendering::BuildDrawList(world, SegmentsFor(job.view), &job.list, 1.5 * pixel);
     MarkClosed(world.scene(), job.list, &job.closed);
     // The paint layer changes in the next steps: the frame gets a copy.
     rendering::FloorLayer& floor = job.list.floor;
