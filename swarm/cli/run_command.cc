@@ -139,7 +139,7 @@ CLI::App* AddRunCommand(CLI::App* app, RunArgs* args) {
                         ""));
   run->add_option(
          "--camera", args->camera,
-         "View of the snapshots and video: a camera or vision sensor (/cam, footbot#3/eye) "
+         "View of the snapshots and video: a camera or vision sensor (/cam, /footbot#3/eye) "
          "instead of the arena seen from above")
       ->check(NonEmpty("a camera's path"));
   run->add_option_function<std::string>(

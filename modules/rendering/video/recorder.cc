@@ -75,6 +75,23 @@ rendering::DrawOptions OptionsOf(const Scene& scene, std::string_view path) {
   return options;
 }
 
+// The view of the camera or vision sensor at `path`; nullopt and *why
+// (what is wrong with the name, without the scene's list of names) when
+// there is none.
+std::optional<rendering::View> FindCamera(const World& world, const std::string& path,
+                                          std::string* why) {
+  try {
+    if (world.scene().FindObject(path).IsNull()) {
+      *why = "no object has that path";
+      return std::nullopt;
+    }
+    return rendering::CameraView(world, path, why);
+  } catch (const Error& e) {  // a malformed path
+    *why = e.what();
+    return std::nullopt;
+  }
+}
+
 }  // namespace
 
 int64_t FramePeriod(double fps, double time_step) {
@@ -188,8 +205,7 @@ struct Recorder::Impl {
     job.view = arena;
     if (!settings.camera.empty()) {
       std::string why;
-      const std::optional<rendering::View> camera =
-          rendering::CameraView(world, settings.camera, &why);
+      const std::optional<rendering::View> camera = FindCamera(world, settings.camera, &why);
       if (!camera) throw Error("--camera '" + settings.camera + "': " + why);
       job.view = *camera;
       job.view.width = width;
@@ -254,8 +270,7 @@ Recorder::Recorder(World* world, const RecorderSettings& settings)
   r.view_name = "the arena seen from above";
   if (!settings.camera.empty()) {
     std::string why;
-    const std::optional<rendering::View> camera =
-        rendering::CameraView(*world, settings.camera, &why);
+    const std::optional<rendering::View> camera = FindCamera(*world, settings.camera, &why);
     if (!camera) {
       const std::vector<std::string> cameras = CameraPaths(world->scene());
       std::string message = "--camera '" + settings.camera + "': " + why + "; ";

@@ -328,6 +328,15 @@ TEST(VideoCli, BadVideoOptionsAreNamedAndStopTheRunBeforeItStarts) {
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("--camera '/nosuch'"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("/overhead"), std::string::npos) << "lists the cameras: " << r.output;
+  // A name that is no path, and an object that is no camera.
+  r = RunProgram("run " + world + " --steps 2 --snapshot-every 1 --camera overhead --out " +
+                 out.string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--camera 'overhead': malformed"), std::string::npos) << r.output;
+  r = RunProgram("run " + world + " --steps 2 --snapshot-every 1 --camera /mover --out " +
+                 out.string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("not a camera or vision sensor"), std::string::npos) << r.output;
   // A video where no file can be made: named, and summary.json says so.
   std::filesystem::remove_all(out);
   r = RunProgram("run " + world + " --steps 2 --video " + (dir / "world.yaml/x.mp4").string() +
