@@ -246,6 +246,23 @@ TEST(VideoCli, ResultsAreTheSameWithAndWithoutVideo) {
   EXPECT_NE(hash(plain.output), "(none)");
 }
 
+TEST(VideoCli, TheVideoIsTheSameFileAtOneAndTwoThreads) {
+  const std::string world = std::string(SWARMSIM_SOURCE_DIR) + "/worlds/diffusion.yaml";
+  const auto dir = FreshTempDir("video_cli", "threads");
+  std::filesystem::create_directories(dir);
+  std::string bytes[2];
+  for (int threads : {1, 2}) {
+    const auto file = dir / ("t" + std::to_string(threads) + ".mp4");
+    const auto r = RunProgram("run " + world + " --set robots=30 --steps 20 --quiet --threads " +
+                              std::to_string(threads) + " --video " + file.string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    std::ifstream f(file, std::ios::binary);
+    bytes[threads - 1].assign(std::istreambuf_iterator<char>(f), {});
+  }
+  EXPECT_GT(bytes[0].size(), 1000u);
+  EXPECT_TRUE(bytes[0] == bytes[1]) << "byte for byte";
+}
+
 // Runs a MarkerWorld whose extra dummy signals its own process with
 // `signal` at step `at` (its script: os.execute, so --trust-scripts), with
 // a 160x120 video into `*out`.
