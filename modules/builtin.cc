@@ -15,6 +15,7 @@
 #include "modules/proximity/proximity.h"
 #include "modules/rendering/filters/filters.h"
 #include "modules/rendering/objects.h"
+#include "modules/rendering/video/recorder.h"
 
 namespace swarmsim {
 
@@ -49,6 +50,7 @@ void RegisterBuiltinModules(ModuleRegistry* registry) {
   rendering::RegisterObjects(registry);
   graphs::Register(registry);
   blobs::Register(registry);
+  registry->RegisterModule(video::RecorderModule());
 }
 
 }  // namespace swarmsim

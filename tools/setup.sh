@@ -10,6 +10,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   gnuplot-nox libopenmpi-dev openmpi-bin
   libpng-dev libassimp-dev
+  libavcodec-dev libavformat-dev libavutil-dev libswscale-dev
 )
 
 missing=()

@@ -227,7 +227,8 @@ void SetLights(const Gl& gl, const DrawList& list) {
 // The floor: a square under the eye reaching the far plane, then the paint
 // layer's texture over its area, just above.
 void DrawFloor(const Gl& gl, Context* c, const DrawList& list, const View& view) {
-  const double s = view.far + std::abs(view.pose.p.z);
+  // (An orthographic view sees as far sideways as its width, whatever its far plane.)
+  const double s = view.far + std::abs(view.pose.p.z) + (view.orthographic ? view.ortho_width : 0);
   const float x0 = static_cast<float>(view.pose.p.x - s),
               x1 = static_cast<float>(view.pose.p.x + s);
   const float y0 = static_cast<float>(view.pose.p.y - s),

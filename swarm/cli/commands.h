@@ -37,6 +37,13 @@ struct RunArgs {
   bool hash = false, quiet = false;
   bool trust_scripts = false;
   std::vector<std::string> plugins;
+  // Snapshots and video (modules/rendering/video/recorder.h).
+  int64_t snapshot_every = 0;             // 0: none
+  std::string camera;                     // empty: the arena seen from above
+  bool video = false;                     // --video given
+  std::string video_file;                 // its FILE; empty: DIR/video.mp4
+  int video_width = 0, video_height = 0;  // --video-size; 0: the view's default
+  double video_fps = 30;
 };
 CLI::App* AddRunCommand(CLI::App* app, RunArgs* args);
 // Loads the world (the plugins first into `registry`) and runs it.

@@ -1,5 +1,6 @@
 // swarmsim run WORLD: load the world, decide the run length, run it.
 #include <CLI/CLI.hpp>
+#include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -9,6 +10,7 @@
 #include "framework/plugin_loader.h"
 #include "framework/registry.h"
 #include "framework/utf8.h"
+#include "modules/rendering/video/recorder.h"
 #include "swarm/cli/commands.h"
 #include "swarm/cli/options.h"
 #include "swarm/loader/world_loader.h"
@@ -47,6 +49,47 @@ std::optional<int64_t> RunLength(const RunArgs& args, const LoadedWorld& loaded,
   return std::nullopt;
 }
 
+// --video-size WIDTHxHEIGHT, each side 1..4096 pixels.
+bool ParseVideoSize(const std::string& text, int* width, int* height) {
+  const size_t x = text.find_first_of("xX");
+  if (x == std::string::npos) return false;
+  const auto side = [](std::string_view digits, int* out) {
+    const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), *out);
+    return !digits.empty() && ec == std::errc() && end == digits.data() + digits.size() &&
+           *out >= 1 && *out <= 4096;
+  };
+  const std::string_view all(text);
+  return side(all.substr(0, x), width) && side(all.substr(x + 1), height);
+}
+
+// The recorder's settings from the command line; nullopt when none is asked for.
+std::optional<video::RecorderSettings> RecorderSettingsOf(const RunArgs& args, std::string* error) {
+  const bool recording = args.snapshot_every > 0 || args.video;
+  if (!recording) {
+    if (!args.camera.empty()) *error = "--camera names the view of --snapshot-every or --video";
+    if (args.video_width > 0) *error = "--video-size is the size of --snapshot-every or --video";
+    return std::nullopt;
+  }
+  video::RecorderSettings settings;
+  if (!args.out_dir.empty()) settings.out_dir = args.out_dir;
+  settings.snapshot_every = args.snapshot_every;
+  settings.camera = args.camera;
+  settings.width = args.video_width;
+  settings.height = args.video_height;
+  settings.video_fps = args.video_fps;
+  if (args.video) {
+    if (!args.video_file.empty()) {
+      settings.video = args.video_file;  // relative to the current folder, as typed
+    } else if (!args.out_dir.empty()) {
+      settings.video = std::filesystem::path(args.out_dir) / "video.mp4";
+    } else {
+      *error = "--video without a FILE writes DIR/video.mp4: pass --out DIR or --video FILE.mp4";
+      return std::nullopt;
+    }
+  }
+  return settings;
+}
+
 }  // namespace
 
 CLI::App* AddRunCommand(CLI::App* app, RunArgs* args) {
@@ -76,6 +119,50 @@ CLI::App* AddRunCommand(CLI::App* app, RunArgs* args) {
       ->allow_extra_args(false);
   run->add_flag("--trust-scripts", args->trust_scripts,
                 "Lift the script sandbox: full Lua libraries (os, io, debug, package)");
+  run->add_option("--snapshot-every", args->snapshot_every,
+                  "Write a PNG of the view at step 0 and every N steps to "
+                  "DIR/snapshots/step_NNNNNN.png (needs --out)")
+      ->transform(WholeNumberCheck(1, kInt64Max, "steps"));
+  auto* video = run->add_option("--video", args->video_file,
+                                "Record an H.264 video of the view (default DIR/video.mp4 with "
+                                "--out; a FILE is relative to the current folder)")
+                    ->expected(0, 1)
+                    ->option_text("[FILE.mp4]")
+                    ->check(CLI::Validator(
+                        [](std::string& text) -> std::string {
+                          const std::string_view t(text);
+                          if (!t.ends_with(".yaml") && !t.ends_with(".yml")) return "";
+                          return "'" + text +
+                                 "' looks like a world file: put the world before --video, or "
+                                 "name a FILE.mp4";
+                        },
+                        ""));
+  run->add_option(
+         "--camera", args->camera,
+         "View of the snapshots and video: a camera or vision sensor (/cam, /footbot#3/eye) "
+         "instead of the arena seen from above")
+      ->check(NonEmpty("a camera's path"));
+  run->add_option_function<std::string>(
+         "--video-size",
+         [args](const std::string& text) {
+           ParseVideoSize(text, &args->video_width, &args->video_height);
+         },
+         "Pixels of the snapshots and video frames (default 640x480 for the arena, a camera's own "
+         "resolution)")
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {
+            int w = 0, h = 0;
+            return ParseVideoSize(text, &w, &h)
+                       ? ""
+                       : "expected WIDTHxHEIGHT with each side 1..4096 pixels, got '" + text + "'";
+          },
+          "WxH"));
+  run->add_option("--video-fps", args->video_fps,
+                  "Video frames per simulated second (default 30): a frame every round(1 / (FPS "
+                  "time_step)) steps, at least 1")
+      ->check(NumberCheck(false))
+      ->needs(video);
+  run->callback([args, video] { args->video = video->count() > 0; });
   return run;
 }
 
@@ -115,7 +202,36 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
   options.steps = *steps;
   options.print_hash = args.hash;
   options.quiet = args.quiet;
+  // Snapshots and video: the recorder module, checked before the run starts.
+  std::string recorder_error;
+  const std::optional<video::RecorderSettings> recording =
+      RecorderSettingsOf(args, &recorder_error);
+  if (!recorder_error.empty()) return bad_input(recorder_error);
+  video::Recorder* recorder = nullptr;
+  if (recording) {
+    try {
+      if (options.out_dir) CreateOutputFolder(*options.out_dir);  // for DIR/video.mp4
+      recorder = static_cast<video::Recorder*>(loaded.world->AddModule("recorder", &*recording));
+    } catch (const Error& e) {
+      return bad_input(e.what());
+    }
+    for (const std::string& note : recorder->notes())
+      std::cerr << "note: " << swarmsim::ValidUtf8(note) << "\n";
+    options.progress_note = [recorder] { return recorder->ProgressNote(); };
+  }
   const RunResult result = RunWorld(loaded.world.get(), options, std::cout, std::cerr);
+  if (recorder != nullptr) {
+    // The video's end, also without --out (with it, the run's outputs did it).
+    try {
+      recorder->Finish();
+    } catch (const Error& e) {
+      if (result.ok) {
+        std::cerr << "error: " << swarmsim::ValidUtf8(e.what()) << "\n";
+        return kExitRunError;
+      }
+    }
+    if (!args.quiet && args.video) std::cout << "video           " << recorder->VideoLine() << "\n";
+  }
   if (!result.ok) {
     std::cerr << "error: " << swarmsim::ValidUtf8(result.error) << "\n";
     if (options.out_dir && std::filesystem::is_directory(*options.out_dir))

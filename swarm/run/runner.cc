@@ -203,8 +203,14 @@ class Watchdog {
 // A progress bar on a terminal; a plain line every 10% otherwise.
 class Progress {
  public:
-  Progress(std::ostream& os, int64_t total, bool enabled, bool tty)
-      : os_(os), total_(total), enabled_(enabled), tty_(tty), start_(Clock::now()) {}
+  Progress(std::ostream& os, int64_t total, bool enabled, bool tty,
+           std::function<std::string()> note)
+      : os_(os),
+        total_(total),
+        enabled_(enabled),
+        tty_(tty),
+        note_(std::move(note)),
+        start_(Clock::now()) {}
 
   void Update(int64_t done, double sim_time) {
     if (!enabled_ || total_ <= 0) return;
@@ -230,6 +236,9 @@ class Progress {
     line << std::setw(3) << static_cast<int>(100 * frac) << "%  step " << done << "/" << total_
          << "  sim " << sim_time << " s  " << (wall > 0 ? sim_time / wall : 0) << "x real time"
          << "  ETA " << eta << " s";
+    if (note_)
+      if (const std::string note = note_(); !note.empty()) line << "  " << note;
+    if (tty_) line << "\x1b[K";  // the rest of a longer line before
     os_ << line.str() << (tty_ ? "" : "\n") << std::flush;
   }
   void Finish() {
@@ -241,6 +250,7 @@ class Progress {
   int64_t total_;
   bool enabled_;
   bool tty_;
+  std::function<std::string()> note_;
   Clock::time_point start_;
   Clock::time_point last_{};
   int last_decile_ = -1;
@@ -368,11 +378,7 @@ void StepWatched(World* world, const RunOptions& options, Clock::time_point star
   };
   try {
     if (options.out_dir) {
-      std::error_code ec;
-      std::filesystem::create_directories(*options.out_dir, ec);
-      if (ec)
-        throw Error("cannot create output folder '" + options.out_dir->string() +
-                    "': " + ec.message());
+      CreateOutputFolder(*options.out_dir);
       const std::lock_guard lock(watchdog.io_mutex());
       metrics = std::make_unique<MetricsWriter>(*options.out_dir / "metrics.csv", *world);
     }
@@ -440,6 +446,12 @@ void PrintSummaryTable(const World& world, const RunResult& result, double lua_k
 
 }  // namespace
 
+void CreateOutputFolder(const std::filesystem::path& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw Error("cannot create output folder '" + dir.string() + "': " + ec.message());
+}
+
 bool WriteErrorSummary(const RunOptions& options, const std::string& error) {
   if (!options.out_dir) return false;
   std::error_code ec;
@@ -462,7 +474,7 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
   RunResult& result = record.result;
   const auto start = Clock::now();
   const bool tty = isatty(STDERR_FILENO) && &progress_stream == &std::cerr;
-  Progress progress(progress_stream, options.steps, !options.quiet, tty);
+  Progress progress(progress_stream, options.steps, !options.quiet, tty, options.progress_note);
   // SIGINT, SIGTERM and SIGHUP end the run at the next step boundary, with
   // its outputs written (or, for a stuck step, through the Watchdog).
   const StopSignals stop_signals;

@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <iosfwd>
 #include <optional>
 #include <string>
@@ -23,6 +24,9 @@ struct RunOptions {
   // --set NAME=VALUE, in order, for the summary ("overrides"): world
   // parameters are in "parameters" too, model parameters only here.
   std::vector<std::pair<std::string, std::string>> overrides;
+  // What else the run produces, appended to the progress line ("video 120
+  // frames"); null: nothing.
+  std::function<std::string()> progress_note;
 };
 
 struct RunResult {
@@ -49,6 +53,10 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
 // command and swarmsim_version. Creates `options.out_dir`; returns false
 // when the file cannot be written.
 bool WriteErrorSummary(const RunOptions& options, const std::string& error);
+
+// Creates the run's output folder (and its parents). Throws swarmsim::Error
+// naming it when it cannot.
+void CreateOutputFolder(const std::filesystem::path& dir);
 
 // Peak resident set size of this process, in MiB.
 double PeakRssMb();
