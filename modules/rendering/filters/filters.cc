@@ -224,7 +224,7 @@ void ToRgb(const WorkImage& work, const CameraModel& camera, Image* out) {
   out->rgb.resize(n * 3);
   uint8_t* o = out->rgb.data();
   if (work.kind == kSwarmsimColourImage) {
-    std::memcpy(o, work.pixels.data(), n * 3);
+    if (n > 0) std::memcpy(o, work.pixels.data(), n * 3);
   } else if (work.kind == kSwarmsimDepthImage) {
     const double range = camera.far > camera.near ? camera.far - camera.near : 1;
     for (size_t i = 0; i < n; ++i, o += 3) {
@@ -291,7 +291,8 @@ void FilterChain::Run(const Image& image, const CameraModel& camera, FilterOutpu
   run.camera = &camera;
   run.out = out;
   run.work.Reset(image.width, image.height, kSwarmsimColourImage);
-  std::memcpy(run.work.pixels.data(), image.rgb.data(), image.rgb.size());
+  if (!image.rgb.empty())  // (an empty image's data() may be null)
+    std::memcpy(run.work.pixels.data(), image.rgb.data(), image.rgb.size());
   // An empty image has nothing to filter (a sensor refuses resolution 0).
   if (image.width > 0 && image.height > 0)
     for (const auto& element : data_->elements) element->Apply(&run);
