@@ -20,7 +20,7 @@ uint32_t JointMasterSlot(const Scene& scene, uint32_t slot) {
   const JointDependency& d = *DependencyAt(scene, slot);
   const ObjectId self = scene.IdAt(slot);
   const ObjectId master = scene.FindObject(d.master, self);
-  if (!master)
+  if (master.IsNull())
     throw Error(d.where + ": joint '" + scene.PathOf(self) + "': master '" + d.master +
                 "' matches no object" + scene.ExplainMissingPath(d.master, self));
   if (scene.type(master) != ObjectType::kJoint)
@@ -76,7 +76,7 @@ void DependentJoints::Refresh(const Scene& scene) {
   for (const Entry& e : entries) links_.push_back({e.row, e.master_row});
 }
 
-void DependentJoints::Apply(Scene* scene, bool targets) {
+bool DependentJoints::Apply(Scene* scene, bool targets) {
   if (version_ != scene->structure_version()) Refresh(*scene);
   auto joints = scene->joints();
   for (const Link& l : links_) {
@@ -90,6 +90,7 @@ void DependentJoints::Apply(Scene* scene, bool targets) {
     j.position = q;
     j.velocity = j.depends->factor * m.velocity;
   }
+  return !links_.empty();
 }
 
 }  // namespace swarmsim

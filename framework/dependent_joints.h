@@ -27,8 +27,8 @@ class DependentJoints {
   // Non-simulated dependent joints take the formula as position and
   // factor * the master's velocity as velocity; simulated ones (a dynamics
   // backend moves them) take it as their target position when
-  // `targets` is true.
-  void Apply(Scene* scene, bool targets);
+  // `targets` is true. Returns whether there are any.
+  bool Apply(Scene* scene, bool targets);
 
  private:
   struct Link {

@@ -252,6 +252,8 @@ void World::Start() {
   dynamics_settings.gravity = settings_.gravity;
   dynamics_->Build(scene_, dynamics_settings);
   dynamics_->MarkSimulatedJoints(&scene_);
+  // Dependent joints start where their masters put them.
+  if (dependent_joints_.Apply(&scene_, true)) scene_.UpdateWorldPoses();
   // The modules every world has (proximity), in registration order; then
   // every module starts, in creation order.
   for (const auto& descriptor : registry_.module_descriptors())
