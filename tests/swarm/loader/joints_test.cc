@@ -70,6 +70,30 @@ class JointsTest : public testing::WorldDirTest {
     const Scene& scene = world.scene();
     return scene.joint(scene.FindObject(path)).position;
   }
+  // The error of w's next step, or "(no error)".
+  static std::string StepError(LoadedWorld& w) {
+    try {
+      w.world->Step();
+    } catch (const Error& e) {
+      return e.what();
+    }
+    return "(no error)";
+  }
+  // A model of one joint under a dummy (its keys `joint_keys`, indented as
+  // a list item's) carrying a dynamic box, with `script`, under ODE.
+  LoadedWorld LoadOdeArm(const std::string& joint_keys, const std::string& script) {
+    Write("arm.yaml",
+          "model: arm\nobjects:\n  name: base\n  type: dummy\n  script: arm.lua\n"
+          "  children:\n    - name: m\n      type: joint\n      target_velocity: 0.5\n"
+          "    - name: hinge\n      type: joint\n" +
+              joint_keys +
+              "      children:\n        - {name: link, type: shape, shape: box, size: [0.1, "
+              "0.1, 0.1], dynamic: true, mass: 1}\n");
+    Write("arm.lua", script);
+    return Load(
+        "simulation: {physics: ode, time_step: 0.02}\nmodels: [{model: arm.yaml, position: [0, 0, "
+        "1]}]\n");
+  }
   std::string LoadError(const std::string& rig) {
     Write("rig.yaml", rig);
     Write("rig.lua", "");
@@ -139,39 +163,27 @@ end
 TEST_F(JointsTest, SetJointPositionOnADependentJointIsAnErrorNamingTheMaster) {
   LoadedWorld w =
       LoadRig("function sysCall_actuation() sim.setJointPosition(sim.getObject(':/b'), 1) end\n");
-  try {
-    w.world->Step();
-    FAIL() << "no error";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("follows its master ':/c'"), std::string::npos)
-        << e.what();
-  }
+  const std::string e = StepError(w);
+  EXPECT_NE(e.find("follows its master ':/c'"), std::string::npos) << e;
 }
 
 TEST_F(JointsTest, SetJointPositionOnAnOdeSimulatedJointSaysToUseTheTarget) {
-  Write("arm.yaml", R"(model: arm
-objects:
-  name: base
-  type: dummy
-  script: arm.lua
-  children:
-    - name: hinge
-      type: joint
-      mode: position
-      children:
-        - {name: link, type: shape, shape: box, size: [0.1, 0.1, 0.1], dynamic: true, mass: 1}
-)");
-  Write("arm.lua",
-        "function sysCall_actuation() sim.setJointPosition(sim.getObject(':/hinge'), 1) end\n");
-  LoadedWorld w =
-      Load("simulation: {physics: ode}\nmodels: [{model: arm.yaml, position: [0, 0, 1]}]\n");
-  try {
-    w.world->Step();
-    FAIL() << "no error";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("use sim.setJointTargetPosition"), std::string::npos)
-        << e.what();
-  }
+  LoadedWorld w = LoadOdeArm(
+      "      mode: position\n",
+      "function sysCall_actuation() sim.setJointPosition(sim.getObject(':/hinge'), 1) end\n");
+  const std::string e = StepError(w);
+  EXPECT_NE(e.find("use sim.setJointTargetPosition"), std::string::npos) << e;
+}
+
+// Under ODE a dependent joint moving a dynamic body is servoed to the formula.
+TEST_F(JointsTest, OdeDependentJointTracksItsFormulaAsAPositionTarget) {
+  LoadedWorld w = LoadOdeArm(
+      "      mode: position\n      max_force: 100\n      master: ':/m'\n      factor: -2\n", "");
+  for (int i = 0; i < 100; ++i) w.world->Step();
+  const double m = Q(*w.world, "/arm#0/m"), q = Q(*w.world, "/arm#0/hinge");
+  EXPECT_NEAR(m, 0.5 * 0.02 * 100, 1e-9);
+  EXPECT_LT(q, -1.5);            // it moved, the master's way times -2
+  EXPECT_NEAR(q, -2 * m, 0.05);  // within a step's travel of the formula
 }
 
 TEST_F(JointsTest, HashIsEqualAtOneAndTwoThreads) {
@@ -238,20 +250,10 @@ TEST_F(JointsTest, BadPitchIsAnErrorAtItsLine) {
 }
 
 TEST_F(JointsTest, OdeRefusesAScrewJointMovingADynamicBody) {
-  Write("arm.yaml", R"(model: arm
-objects:
-  name: screw
-  type: joint
-  joint: screw
-  pitch: 0.01
-  children:
-    - {name: link, type: shape, shape: box, size: [0.1, 0.1, 0.1], dynamic: true, mass: 1}
-)");
   std::string e = "(no error)";
   try {
-    LoadedWorld w =
-        Load("simulation: {physics: ode}\nmodels: [{model: arm.yaml, position: [0, 0, 1]}]\n");
-    w.world->Step();
+    LoadedWorld w = LoadOdeArm("      joint: screw\n      pitch: 0.01\n", "");
+    e = StepError(w);
   } catch (const Error& err) {
     e = err.what();
   }
