@@ -16,6 +16,9 @@ namespace {
 constexpr double kDt = 0.05;
 constexpr double kPitch = 0.02;
 
+// A model's root dummy; its children follow (line 6 on).
+constexpr const char* kBase = "model: rig\nobjects:\n  name: base\n  type: dummy\n  children:\n";
+
 // A screw turning at 0.5 rad/s with a nut 0.1 m off its axis; a chain of
 // dependent joints listed before their masters: a (prismatic) follows b,
 // b follows c (velocity 0.3 rad/s) with a negative factor.
@@ -208,12 +211,8 @@ end
 }
 
 TEST_F(JointsTest, ACycleOfDependentJointsIsALoadErrorNamingThem) {
-  const std::string e = LoadError(R"(model: rig
-objects:
-  name: base
-  type: dummy
-  children:
-    - {name: a, type: joint, master: ":/b"}
+  const std::string e =
+      LoadError(std::string(kBase) + R"(    - {name: a, type: joint, master: ":/b"}
     - {name: b, type: joint, master: ":/c"}
     - {name: c, type: joint, master: ":/a"}
 )");
@@ -223,12 +222,8 @@ objects:
 }
 
 TEST_F(JointsTest, AMasterThatIsNoJointIsALoadError) {
-  const std::string e = LoadError(R"(model: rig
-objects:
-  name: base
-  type: dummy
-  children:
-    - {name: a, type: joint, master: ":/d"}
+  const std::string e =
+      LoadError(std::string(kBase) + R"(    - {name: a, type: joint, master: ":/d"}
     - {name: d, type: dummy}
 )");
   EXPECT_NE(e.find("rig.yaml:6:"), std::string::npos) << e;
