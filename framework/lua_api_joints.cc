@@ -58,6 +58,34 @@ int SetJointTargetPosition(lua_State* L) {
   return 0;
 }
 
+// sim.setJointPosition(h, q): rad or m, joints no dynamics backend simulates
+// (kinematic physics, or children that are not dynamic). Other robots read
+// positions during the control phase, so a robot's write is applied after
+// it (a scene script's at once): getJointPosition shows it next step.
+int SetJointPosition(lua_State* L) {
+  const LuaContext& c = Context(L);
+  uint32_t slot = 0;
+  JointData& joint = CheckJoint(L, &slot);
+  const double value = ArgNumber(L, 2);
+  const std::string path = c.scene->PathOf(c.scene->IdAt(slot));
+  if (!std::isfinite(value)) throw Error("the position is not a finite number");
+  if (joint.simulated)
+    throw Error("joint '" + path +
+                "' is simulated by the dynamics: use sim.setJointTargetPosition (position "
+                "mode) or sim.setJointTargetVelocity");
+  if (joint.depends)
+    throw Error("joint '" + path + "' follows its master '" + joint.depends->master +
+                "': set the master's position");
+  if (joint.type == JointType::kSpherical || joint.type == JointType::kFixed)
+    throw Error("joint '" + path + "' is " + ToString(joint.type) + ": it has no position");
+  if (c.instance < 0)
+    joint.JumpTo(value);
+  else
+    c.runtime->deferred.push_back(
+        {c.scene->IdAt(slot), DeferredWrite::Kind::kJointPosition, value});
+  return 0;
+}
+
 // sim.getJointPosition(h) -> rad or m, as of the start of the phase.
 int GetJointPosition(lua_State* L) {
   uint32_t slot = 0;
@@ -104,6 +132,7 @@ void RegisterJointsApi(lua_State* L) {
   static constexpr luaL_Reg kFunctions[] = {
       {"setJointTargetVelocity", Guarded<SetJointTargetVelocity, "sim.setJointTargetVelocity">},
       {"setJointTargetPosition", Guarded<SetJointTargetPosition, "sim.setJointTargetPosition">},
+      {"setJointPosition", Guarded<SetJointPosition, "sim.setJointPosition">},
       {"getJointPosition", Guarded<GetJointPosition, "sim.getJointPosition">},
       {"getJointVelocity", Guarded<GetJointVelocity, "sim.getJointVelocity">},
       {"getJointTargetVelocity", Guarded<GetJointTargetVelocity, "sim.getJointTargetVelocity">},

@@ -34,6 +34,7 @@ const char* ToString(JointType type) {
     case JointType::kPrismatic: return "prismatic";
     case JointType::kSpherical: return "spherical";
     case JointType::kFixed: return "fixed";
+    case JointType::kScrew: return "screw";
   }
   return "?";
 }
@@ -65,9 +66,17 @@ Pose JointData::Motion() const {
     case JointType::kRevolute: return {{}, Quat::FromAxisAngle({0, 0, 1}, position)};
     case JointType::kPrismatic: return {{0, 0, position}, {}};
     case JointType::kSpherical: return {{}, ball};
+    case JointType::kScrew:
+      return {{0, 0, pitch * position}, Quat::FromAxisAngle({0, 0, 1}, position)};
     case JointType::kFixed: break;
   }
   return {};
+}
+
+void JointData::JumpTo(double q) {
+  position = q;
+  velocity = 0;
+  if (mode == JointMode::kPosition) target_position = q;
 }
 
 Scene::Scene() {

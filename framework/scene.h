@@ -68,16 +68,30 @@ struct ShapeData {
   double BoundingRadius() const;
 };
 
-enum class JointType : uint8_t { kRevolute, kPrismatic, kSpherical, kFixed };
+enum class JointType : uint8_t { kRevolute, kPrismatic, kSpherical, kFixed, kScrew };
 // kForce: the joint applies target_force (N or N m) and moves only if a
 // dynamics backend simulates it.
 enum class JointMode : uint8_t { kPassive, kVelocity, kPosition, kForce };
 const char* ToString(JointType type);
 const char* ToString(JointMode mode);
 
+// A dependent joint (V-REP's dependent mode, URDF's mimic): its position is
+// offset + factor * (the master's position), set every step after the
+// master moved (framework/dependent_joints.h). `master` is a path as world
+// files write it ("/robot/j", ":/j", "./j"), resolved from the joint; shared
+// by copies, so a model copy's joint follows its own copy's master.
+struct JointDependency {
+  std::string master;
+  double factor = 1;
+  double offset = 0;
+  std::string where;  // file:line:column of `master`, for errors
+};
+
 // A joint moves its children along/about its own z axis (V-REP's convention):
 // X_W(child) = X_WJ * Motion(position) * X_J(child). A spherical joint turns
 // them by `ball` (position and velocity unused); a fixed joint does not move.
+// A screw joint turns them by `position` (rad) about z and moves them
+// pitch * position (m) along z.
 struct JointData {
   JointType type = JointType::kRevolute;
   JointMode mode = JointMode::kVelocity;
@@ -90,12 +104,17 @@ struct JointData {
   double target_force = 0;          // N or N m, force mode
   double min_position = -INFINITY;  // limits, rad or m (infinite: unlimited)
   double max_position = INFINITY;
-  Quat ball;  // spherical joints: rotation of the children
+  Quat ball;                                       // spherical joints: rotation of the children
+  double pitch = 0;                                // screw joints: m per rad, finite and nonzero
+  std::shared_ptr<const JointDependency> depends;  // null: an independent joint
   // Set by a dynamics backend that integrates this joint's position and
   // velocity itself; World::Actuate then leaves them alone.
   bool simulated = false;
 
   Pose Motion() const;  // transform produced by `position` about/along z
+  // sim.setJointPosition on a joint nothing simulates: it jumps to q and
+  // stays (a position-mode joint's target becomes q, its velocity 0).
+  void JumpTo(double q);
 };
 
 // The detection volume of a proximity sensor (modules/proximity/volume.h):

@@ -252,6 +252,8 @@ void World::Start() {
   dynamics_settings.gravity = settings_.gravity;
   dynamics_->Build(scene_, dynamics_settings);
   dynamics_->MarkSimulatedJoints(&scene_);
+  // Dependent joints start where their masters put them.
+  if (dependent_joints_.Apply(&scene_, true)) scene_.UpdateWorldPoses();
   // The modules every world has (proximity), in registration order; then
   // every module starts, in creation order.
   for (const auto& descriptor : registry_.module_descriptors())
@@ -465,6 +467,10 @@ void World::Actuate() {
       continue;
     }
     JointData& j = scene_.mutable_joint(w.object);
+    if (w.kind == DeferredWrite::Kind::kJointPosition) {
+      if (!j.simulated && !j.depends) j.JumpTo(w.value);  // checked when the script called
+      continue;
+    }
     if (w.kind == DeferredWrite::Kind::kJointTargetVelocity)
       j.target_velocity = w.value;
     else
@@ -476,7 +482,7 @@ void World::Actuate() {
   // velocity mode at the target velocity, position mode at up to max_velocity.
   const double dt = settings_.time_step;
   for (JointData& j : scene_.joints()) {
-    if (j.simulated) continue;  // the dynamics backend integrates it
+    if (j.simulated || j.depends) continue;  // the dynamics backend, or its master, moves it
     switch (j.mode) {
       case JointMode::kVelocity:
         j.velocity = j.target_velocity;
@@ -493,11 +499,15 @@ void World::Actuate() {
       case JointMode::kForce: break;
     }
   }
+  // Dependent joints follow their masters (simulated ones: as position targets).
+  dependent_joints_.Apply(&scene_, true);
 }
 
 void World::Physics() {
   dynamics_->Step(&scene_, settings_.time_step / settings_.physics_substeps,
                   settings_.physics_substeps);
+  // Joints that follow a master the dynamics moved, before their children's poses.
+  dependent_joints_.Apply(&scene_, false);
   // Objects carried by the simulated bodies follow them: each robot's
   // subtree on its own worker, then the scene's objects.
   if (scene_.InstancesAreIndependent()) {

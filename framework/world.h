@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "framework/collections.h"
+#include "framework/dependent_joints.h"
 #include "framework/messaging.h"
 #include "framework/module.h"
 #include "framework/parameters.h"
@@ -90,9 +91,11 @@ struct DeferredWrite {
   // kObjectPose: the object moves to world pose `pose` (sim.setObjectPose/Position).
   // kSizeFactor: the object's subtree is rescaled so that its size factor
   // becomes `value` (sim.setObjectSizeFactor, Scene::ScaleSubtree).
+  // kJointPosition: a non-simulated joint jumps to `value` (sim.setJointPosition).
   enum class Kind : uint8_t {
     kJointTargetVelocity,
     kJointTargetPosition,
+    kJointPosition,
     kShapeDynamic,
     kObjectPose,
     kSizeFactor
@@ -345,6 +348,7 @@ class World : public PhaseHandlers {
   std::mutex plugin_metrics_mutex_;
   std::vector<MetricSample> plugin_metrics_;
   Scene scene_;
+  DependentJoints dependent_joints_;  // joints following a master, in order
   ParameterSet parameters_;
   std::unique_ptr<TaskScheduler> scheduler_;
   std::unique_ptr<DynamicsBackend> dynamics_;

@@ -1,6 +1,12 @@
 // joint: a kinematic pair that moves its children about (revolute) or along
-// (prismatic) its own z axis, or turns them freely (spherical), or holds
-// them (fixed); passive, velocity-, position- or force-driven.
+// (prismatic) its own z axis, or both coupled (screw), or turns them freely
+// (spherical), or holds them (fixed); passive, velocity-, position- or
+// force-driven, or dependent on another joint (master, factor, offset).
+#include <cmath>
+#include <memory>
+#include <string>
+
+#include "framework/dependent_joints.h"
 #include "framework/object_type.h"
 #include "framework/scene.h"
 #include "framework/state_hash.h"
@@ -14,7 +20,9 @@ void RegisterJointsApi(lua_State* L);
 namespace {
 
 constexpr ObjectKey kKeys[] = {
-    {"joint", "revolute", "revolute, prismatic, spherical (ball; ode only simulates it) or fixed"},
+    {"joint", "revolute",
+     "revolute, prismatic, screw (kinematic), spherical (ball; ode only simulates it) or fixed"},
+    {"pitch", "none", "screw joints (required): m of travel along z per rad, finite, nonzero"},
     {"mode", "velocity", "passive, velocity, position or force (applies target_force; ode only)"},
     {"max_force", "10", "N or N m, > 0"},
     {"max_velocity", "10", "rad/s or m/s, > 0 (position mode)"},
@@ -23,6 +31,9 @@ constexpr ObjectKey kKeys[] = {
     {"initial_position", "0", "rad or m, the joint's position at the start"},
     {"target_force", "0", "N or N m, force mode"},
     {"limits", "none", "[min, max], rad or m: ODE stops, and IK keeps solutions inside"},
+    {"master", "none", "path of the joint this one follows: q = offset + factor * q_master"},
+    {"factor", "1", "dependent joints: factor of the master's position"},
+    {"offset", "0", "dependent joints: rad or m added"},
 };
 
 std::unique_ptr<RowTable> MakeRows(const ObjectTypeDescriptor&) {
@@ -41,8 +52,16 @@ void Scale(const ObjectTypeDescriptor&, void* row, double s, ScaleContext*) {
     j.max_force *= s3;
     j.target_force *= s3;
   } else {
+    if (j.type == JointType::kScrew) j.pitch *= s;  // m per rad
     j.max_force *= s4;
     j.target_force *= s4;
+  }
+  // A prismatic joint's offset is a length (the factor's units depend on
+  // the master's kind and stay as they are).
+  if (j.depends && j.type == JointType::kPrismatic) {
+    auto d = std::make_shared<JointDependency>(*j.depends);
+    d->offset *= s;
+    j.depends = std::move(d);
   }
 }
 
@@ -60,11 +79,38 @@ void Hash(const Scene& scene, ObjectType, StateHasher* h) {
 void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
   JointData& j = *static_cast<JointData*>(row);
   if (r.Has("joint")) {
-    const std::string type = r.Choice("joint", {"revolute", "prismatic", "spherical", "fixed"});
+    const std::string type =
+        r.Choice("joint", {"revolute", "prismatic", "screw", "spherical", "fixed"});
     j.type = type == "revolute"    ? JointType::kRevolute
              : type == "prismatic" ? JointType::kPrismatic
+             : type == "screw"     ? JointType::kScrew
              : type == "spherical" ? JointType::kSpherical
                                    : JointType::kFixed;
+  }
+  if (j.type == JointType::kScrew) {
+    if (!r.Has("pitch"))
+      r.FailAtKey("joint", "a screw joint needs 'pitch' (m of travel per rad, nonzero)");
+    j.pitch = r.Number("pitch", kAnyNumber);
+    if (!std::isfinite(j.pitch) || j.pitch == 0)
+      r.Fail("pitch", "'pitch' must be a finite, nonzero number of m per rad");
+  } else if (r.Has("pitch")) {
+    r.FailAtKey("pitch", "'pitch' is for screw joints (joint: screw)");
+  }
+  if (r.Has("master")) {
+    auto d = std::make_shared<JointDependency>();
+    d->master = r.String("master", true);
+    if (d->master.empty() || (d->master[0] != '/' && d->master[0] != ':' && d->master[0] != '.'))
+      r.Fail("master", "'" + d->master +
+                           "' is not a joint path: start with '/' (absolute), ':' (this model) "
+                           "or './' (below this joint)");
+    if (r.Has("factor")) d->factor = r.Number("factor", kAnyNumber);
+    if (r.Has("offset")) d->offset = r.Number("offset", kAnyNumber);
+    d->where = r.Where("master");
+    j.depends = std::move(d);
+  } else {
+    for (const char* key : {"factor", "offset"})
+      if (r.Has(key))
+        r.FailAtKey(key, std::string("'") + key + "' is for dependent joints: add 'master'");
   }
   if (r.Has("mode")) {
     const std::string mode = r.Choice("mode", {"passive", "velocity", "position", "force"});
@@ -88,16 +134,21 @@ void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
   if (r.Has("initial_position")) j.position = r.Number("initial_position", kAnyNumber);
 }
 
+// A dependent joint's master is a joint, and masters never lead back to it.
+void Check(const Scene& scene, ObjectId id, const void*) { CheckJointDependency(scene, id); }
+
 }  // namespace
 
 constinit const ObjectTypeDescriptor kJointType{
     .name = "joint",
-    .description = "a revolute, prismatic, spherical or fixed joint; passive or driven",
+    .description =
+        "a revolute, prismatic, screw, spherical or fixed joint; passive, driven or dependent",
     .make_rows = MakeRows,
     .scale_row = Scale,
     .hash_rows = Hash,
     .keys = kKeys,
     .read = Read,
+    .check = Check,
     .register_lua = RegisterJointsApi,
 };
 

@@ -421,6 +421,12 @@ void OdeWorld::AddJoint(const Scene& scene, uint32_t slot, dBodyID child, dBodyI
       dJointAttach(j.joint, child, parent);
       dJointSetBallAnchor(j.joint, X_WJ.p.x, X_WJ.p.y, X_WJ.p.z);
       break;
+    case JointType::kScrew:
+      // ODE has no screw joint: one between bodies it simulates is refused
+      // (a screw joint whose children are not dynamic moves kinematically).
+      throw Error("ode: screw joint '" + PathAt(scene, slot) +
+                  "' moves a dynamic body: screw joints need kinematic physics "
+                  "(physics: kinematic), or children that are not dynamic");
     case JointType::kFixed:
       j.joint = dJointCreateFixed(world_, nullptr);
       dJointAttach(j.joint, child, parent);
@@ -508,6 +514,7 @@ void OdeWorld::TrackJointPositions() {
       }
       case JointType::kPrismatic: j.position = j.offset + dJointGetSliderPosition(j.joint); break;
       case JointType::kSpherical:
+      case JointType::kScrew:
       case JointType::kFixed: break;
     }
   }
@@ -594,6 +601,7 @@ void OdeWorld::WriteBack(Scene* scene) {
         data.ball = (q_JB * j.q_JB0.Conjugate() * j.ball0).Normalized();
         break;
       }
+      case JointType::kScrew:
       case JointType::kFixed: break;
     }
   }
