@@ -45,8 +45,14 @@ void CheckJointDependency(const Scene& scene, ObjectId id) {
     }
     if (seen != chain.begin()) return;  // a cycle further on: its own joints report it
     std::string names;
-    for (uint32_t c : chain) names += "'" + scene.PathOf(scene.IdAt(c)) + "' -> ";
-    names += "'" + scene.PathOf(id) + "'";
+    for (uint32_t c : chain) {
+      names += '\'';
+      names += scene.PathOf(scene.IdAt(c));
+      names += "' -> ";
+    }
+    names += '\'';
+    names += scene.PathOf(id);
+    names += '\'';
     throw Error(DependencyAt(scene, start)->where + ": dependent joints form a cycle: " + names +
                 " (a joint cannot follow itself through its masters)");
   }
