@@ -1,8 +1,10 @@
 // sim.* paths (the Lua area of the path type), CoppeliaSim's names:
 //   sim.getPathLength(h) -> m
 //   sim.getPathPose(h, s) -> {x, y, z, qx, qy, qz, qw}, world frame, at arc length s
-//   sim.getPathPosition(h) -> m, where the path's followers are
-//   sim.setPathPosition(h, s), sim.setPathVelocity(h, v) (m/s)
+//   sim.getPathPosition(h) -> m, where the path's followers are (as of the
+//     step's start: it changes in the actuate phase only)
+//   sim.setPathPosition(h, s) (applied in the actuate phase, before this
+//     step's motion), sim.setPathVelocity(h, v) (m/s)
 // `h` is a path, or one of its children (a follower). A script sets only its
 // own robot's paths (a scene script any), so the result never depends on
 // which robot ran first; the followers move in the actuate phase.
@@ -74,7 +76,7 @@ int GetPathPosition(lua_State* L) {
 
 int SetPathPosition(lua_State* L) {
   PathRow& p = OwnPathArg(L);
-  p.position = p.curve->Normalize(FiniteArg(L, 2, "the position"));
+  p.requested_position = p.curve->Normalize(FiniteArg(L, 2, "the position"));
   return 0;
 }
 

@@ -1,5 +1,7 @@
 #include "modules/paths/module.h"
 
+#include <cmath>
+
 #include "framework/world.h"
 #include "modules/paths/rows.h"
 
@@ -28,6 +30,10 @@ void PathsModule::Move(Scene* scene, double dt) {
   }
   for (size_t r = 0; r < rows->size(); ++r) {
     PathRow& p = rows->rows[r];
+    if (!std::isnan(p.requested_position)) {
+      p.position = p.requested_position;
+      p.requested_position = NAN;
+    }
     if (p.followers.empty() && p.velocity == 0) continue;
     const std::vector<uint32_t>& slots = followers_[r];
     // A follower's file pose is its offset in the moving frame.

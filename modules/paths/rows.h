@@ -2,6 +2,7 @@
 // area find it. Internal to modules/paths.
 #pragma once
 
+#include <cmath>
 #include <memory>
 #include <string>
 #include <vector>
@@ -23,6 +24,9 @@ struct PathRow {
   // State: where the followers are along the curve and how fast they move.
   double position = 0;  // m, arc length
   double velocity = 0;  // m/s
+  // sim.setPathPosition's request, applied in the actuate phase (NaN: none),
+  // so `position` changes only there and any robot may read it.
+  double requested_position = NAN;
   // The followers' poses in the frame moving along the curve (their file
   // poses, kept when first moved; one per follower).
   std::vector<Pose> offsets;
