@@ -54,6 +54,13 @@ class ObjectReader {
                                       const NumberRule& rule) const = 0;
   virtual Vec3 Vector3(std::string_view key, const NumberRule& rule,
                        bool required = false) const = 0;
+  // A list of at least `min_count` [x, y, z] lists (`points: [[0, 0, 0],
+  // [1, 0, 0]]`); an element's error names its own file:line:column.
+  virtual std::vector<Vec3> Vector3List(std::string_view key, size_t min_count,
+                                        const NumberRule& rule, bool required = false) const = 0;
+  // An error at element `index` of the list at `key`.
+  [[noreturn]] virtual void FailAtElement(std::string_view key, size_t index,
+                                          const std::string& message) const = 0;
   // A list of strings ([a, b] or a single string); `max_count` at most.
   virtual std::vector<std::string> Strings(std::string_view key, size_t max_count,
                                            bool required = false) const = 0;

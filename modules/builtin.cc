@@ -12,6 +12,7 @@
 #include "modules/metrics/swarm_metrics.h"
 #include "modules/mill/mill.h"
 #include "modules/paint/paint_layer.h"
+#include "modules/paths/paths.h"
 #include "modules/proximity/proximity.h"
 #include "modules/rendering/filters/filters.h"
 #include "modules/rendering/objects.h"
@@ -46,6 +47,7 @@ void RegisterBuiltinModules(ModuleRegistry* registry) {
     registry->RegisterModule(std::move(metric));
   collision::Register(registry);
   mill::Register(registry);
+  paths::Register(registry);
   filters::Register(registry);
   rendering::RegisterObjects(registry);
   graphs::Register(registry);

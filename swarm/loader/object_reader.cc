@@ -14,6 +14,27 @@ std::shared_ptr<const TriangleMesh> FieldsObjectReader::Mesh(std::string_view ke
                      values_.file().Where(file.mark), text);
 }
 
+std::vector<Vec3> FieldsObjectReader::Vector3List(std::string_view key, size_t min_count,
+                                                  const NumberRule& rule, bool required) const {
+  const Field field = Get(key, required);
+  std::vector<Vec3> out;
+  if (!field.present()) return out;
+  const std::vector<Field> elements = ListElements(values_.file(), field, "[x, y, z] lists");
+  if (elements.size() < min_count)
+    values_.Fail(field, "'" + field.name + "' needs at least " + std::to_string(min_count) +
+                            " [x, y, z] lists, e.g. [[0, 0, 0], [1, 0, 0]] (got " +
+                            std::to_string(elements.size()) + ")");
+  for (const Field& element : elements) out.push_back(values_.Vector3(element, rule));
+  return out;
+}
+
+void FieldsObjectReader::FailAtElement(std::string_view key, size_t index,
+                                       const std::string& message) const {
+  const Field field = fields_.Get(key);
+  const std::vector<Field> elements = ListElements(values_.file(), field, "elements");
+  values_.Fail(index < elements.size() ? elements[index] : field, message);
+}
+
 std::vector<std::string> FieldsObjectReader::Strings(std::string_view key, size_t max_count,
                                                      bool required) const {
   const Field field = Get(key, required);

@@ -39,6 +39,10 @@ class FieldsObjectReader final : public ObjectReader {
   Vec3 Vector3(std::string_view key, const NumberRule& rule, bool required) const override {
     return values_.Vector3(Get(key, required), rule);
   }
+  std::vector<Vec3> Vector3List(std::string_view key, size_t min_count, const NumberRule& rule,
+                                bool required) const override;
+  [[noreturn]] void FailAtElement(std::string_view key, size_t index,
+                                  const std::string& message) const override;
   std::vector<std::string> Strings(std::string_view key, size_t max_count,
                                    bool required) const override;
   std::string Where(std::string_view key) const override {

@@ -86,6 +86,14 @@ class FilterListReader final : public ObjectReader {
   [[noreturn]] void FailAtKey(std::string_view key, const std::string& message) const override {
     Fail(key, message);
   }
+  std::vector<Vec3> Vector3List(std::string_view key, size_t, const NumberRule&,
+                                bool) const override {
+    Fail(key, "takes no list of [x, y, z] here");
+  }
+  [[noreturn]] void FailAtElement(std::string_view key, size_t,
+                                  const std::string& message) const override {
+    Fail(key, message);
+  }
   std::shared_ptr<const TriangleMesh> Mesh(std::string_view, const Vec3&) const override {
     return nullptr;
   }
