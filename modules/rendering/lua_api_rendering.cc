@@ -74,7 +74,8 @@ const Image& ImageOf(const VisionSensorRow& s) {
 int GetVisionSensorImg(lua_State* L) {
   const VisionSensorRow& s = SensorOf(L);
   const bool raw = !lua_isnoneornil(L, 2) && ArgInteger(L, 2) == 1;
-  const Image& image = raw || s.filters.empty() ? ImageOf(s) : (ImageOf(s), s.output.image);
+  const Image& camera = ImageOf(s);  // (throws before the first image)
+  const Image& image = raw || s.filters.empty() ? camera : s.output.image;
   lua_pushlstring(L, reinterpret_cast<const char*>(image.rgb.data()), image.rgb.size());
   PushResolution(L, image.width, image.height);
   return 2;

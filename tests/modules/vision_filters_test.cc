@@ -19,6 +19,7 @@
 #include "framework/vision_filter.h"
 #include "modules/builtin.h"
 #include "modules/rendering/filters/filters.h"
+#include "tests/framework/error_of.h"
 #include "tests/modules/filter_list_reader.h"
 
 namespace swarmsim::filters {
@@ -26,9 +27,6 @@ namespace {
 
 using testing::FilterItem;
 using testing::FilterListReader;
-
-#define EXPECT_CONTAINS(haystack, needle) \
-  EXPECT_NE(std::string(haystack).find(needle), std::string::npos) << (haystack)
 
 constexpr double kDeg = M_PI / 180;
 

@@ -14,14 +14,12 @@
 #include "modules/blobs/blob_camera.h"
 #include "modules/blobs/leds.h"
 #include "swarm/loader/world_loader.h"
+#include "tests/framework/error_of.h"
 #include "tests/swarm/loader/world_dir_test.h"
 #include "tests/swarm/run_program.h"
 
 namespace swarmsim {
 namespace {
-
-#define EXPECT_CONTAINS(text, part) \
-  EXPECT_NE(std::string(text).find(part), std::string::npos) << (text)
 
 using BlobsLoaderTest = testing::WorldDirTest;
 

@@ -14,6 +14,7 @@
 #include "framework/world.h"
 #include "modules/paths/rows.h"
 #include "swarm/loader/world_loader.h"
+#include "tests/framework/error_of.h"
 #include "tests/swarm/loader/world_dir_test.h"
 
 namespace swarmsim {
@@ -21,9 +22,6 @@ namespace {
 
 using paths::PathRow;
 using PathsTest = testing::WorldDirTest;
-
-#define EXPECT_CONTAINS(text, part) \
-  EXPECT_NE(std::string(text).find(part), std::string::npos) << (text)
 
 constexpr double kPi = 3.141592653589793;
 

@@ -15,13 +15,11 @@
 #include "modules/rendering/filters/filters.h"
 #include "modules/rendering/objects.h"
 #include "swarm/loader/world_loader.h"
+#include "tests/framework/error_of.h"
 #include "tests/swarm/loader/world_dir_test.h"
 
 namespace swarmsim {
 namespace {
-
-#define EXPECT_CONTAINS(haystack, needle) \
-  EXPECT_NE(std::string(haystack).find(needle), std::string::npos) << (haystack)
 
 constexpr double kDeg = M_PI / 180;
 
