@@ -84,8 +84,11 @@ TEST_F(RenderingTest, ObjectsOutsideTheDetectableSetAreNotSeen) {
   world += "  - {name: nothing, type: dummy}\n";
   LoadedWorld w = Load(world);
   w.world->Start();
-  const uint8_t* centre = Sensor(*w.world, "/eye").image.Pixel(32, 24);
+  const Image& image = Sensor(*w.world, "/eye").image;
+  const uint8_t* centre = image.Pixel(32, 24);
   EXPECT_FALSE(centre[0] > 120 && centre[1] < 60) << "the cube is not detectable";
+  EXPECT_GT(image.Pixel(2, 45)[0], 100) << "the sensor rendered: it sees the floor";
+  EXPECT_NEAR(image.depth[24 * 64 + 32], 10.0, 1e-3) << "nothing at the cube's place: far";
 }
 
 TEST_F(RenderingTest, AnOrthographicSensorLookingDownSeesTheCubeFromAbove) {
@@ -130,6 +133,12 @@ TEST_F(RenderingTest, ImagesAreTheSameWhateverTheThreadCount) {
     EXPECT_EQ(Sensor(*one.world, path).image.rgb, Sensor(*two.world, path).image.rgb) << path;
     EXPECT_EQ(Sensor(*one.world, path).image.depth, Sensor(*two.world, path).image.depth) << path;
   }
+  // They rendered something (floor, cylinders): not every pixel at the far plane.
+  int near_pixels = 0;
+  for (int i = 0; i < 8; ++i)
+    for (float d : Sensor(*one.world, "/s" + std::to_string(i)).image.depth)
+      near_pixels += d < 2.0f;
+  EXPECT_GT(near_pixels, 0);
 }
 
 TEST_F(RenderingTest, BadSettingsNameTheirPlaceInTheFile) {
