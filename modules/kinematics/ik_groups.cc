@@ -300,6 +300,11 @@ class IkGroupsImpl final : public IkGroups {
       auto it = std::find(slots.begin(), slots.end(), slot);
       return it == slots.end() ? -1 : static_cast<int>(it - slots.begin());
     };
+    for (const auto& [joint, weight] : g->spec.weights) {
+      const uint32_t slot = scene.SlotOf(joint, "IK weight joint");
+      for (int c = 0; c < problem.dof(); ++c)
+        if (slots[c] == slot) problem.set_weight(c, weight);
+    }
     for (int c = 0; c < problem.dof(); ++c) {
       const JointData& j = scene.joints()[scene.row_at(slots[c])];
       // No dynamics backend drives a spherical joint to a target.
@@ -308,7 +313,7 @@ class IkGroupsImpl final : public IkGroups {
                     "' can only be solved in direct mode (mode: targets sets target "
                     "positions, and a spherical joint has none)");
       // Dependent joints follow their master's column, or keep their value
-      // if it is not an unknown of the group.
+      // if it is not an unknown of the group (whatever their weight).
       if (j.depends == nullptr || problem.is_ball_part(c)) continue;
       double factor, offset;
       const int master = column_of(RootMaster(scene, slots[c], &factor, &offset));
@@ -316,11 +321,6 @@ class IkGroupsImpl final : public IkGroups {
         problem.SetDependent(c, master, factor, offset);
       else
         problem.set_weight(c, 0);
-    }
-    for (const auto& [joint, weight] : g->spec.weights) {
-      const uint32_t slot = scene.SlotOf(joint, "IK weight joint");
-      for (int c = 0; c < problem.dof(); ++c)
-        if (slots[c] == slot) problem.set_weight(c, weight);
     }
     if (obstacles) ResolveObstacles(g, scene);
     g->problem = std::move(problem);

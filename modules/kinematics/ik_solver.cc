@@ -272,7 +272,7 @@ IkResult IkProblem::Solve(const IkSettings& settings, std::vector<double>* q_io,
     for (int c = 0; c < n; ++c) {
       if (weights(c) == 0 && kind_[c] == kOne) continue;  // keeps its value (and limits)
       if (kind_[c] == kBallX) {
-        if (frozen_[c]) continue;
+        if (weights(c) == 0) continue;  // frozen
         const Vec3 step{std::clamp(dq(c), -settings.max_step, settings.max_step),
                         std::clamp(dq(c + 1), -settings.max_step, settings.max_step),
                         std::clamp(dq(c + 2), -settings.max_step, settings.max_step)};
