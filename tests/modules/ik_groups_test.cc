@@ -67,6 +67,17 @@ IkGroupSpec ArmGroup(const Arm& a) {
   return spec;
 }
 
+// A group "reach" of one tip solved to `tolerance` (m and rad) in up to 100 iterations.
+IkGroupSpec ReachGroup(ObjectId tip, ObjectId target, uint8_t constraints, double tolerance) {
+  IkGroupSpec spec;
+  spec.name = "reach";
+  spec.tips.push_back({tip, target, {}, constraints});
+  spec.max_iterations = 100;
+  spec.position_tolerance = tolerance;
+  spec.orientation_tolerance = tolerance;
+  return spec;
+}
+
 double Distance(const Scene& scene, ObjectId a, ObjectId b) {
   return (scene.world_pose(a).p - scene.world_pose(b).p).Norm();
 }
@@ -247,11 +258,7 @@ TEST(IkGroupsTest, FrozenJointKeepsItsValueWhileTheOthersReach) {
     second.position = 0.3;
     second.ik_frozen = frozen;
     const Arm3 arm = AddArm3(&scene, second);
-    IkGroupSpec spec;
-    spec.name = "reach";
-    spec.tips.push_back({arm.tip, arm.target, {}, kIkX | kIkY});
-    spec.max_iterations = 100;
-    spec.position_tolerance = 1e-6;
+    const IkGroupSpec spec = ReachGroup(arm.tip, arm.target, kIkX | kIkY, 1e-6);
     IkGroups* ik = Ik(world.get());
     const int h = ik->AddGroup(scene, spec);
     world->Start();
@@ -286,11 +293,7 @@ TEST(IkGroupsTest, DependentJointMovesWithItsMasterDuringTheSolve) {
   const Vec3 target{0.5 * std::cos(q1) + 0.4 * std::cos(0.1) + 0.3 * std::cos(0.1 + q3),
                     0.5 * std::sin(q1) + 0.4 * std::sin(0.1) + 0.3 * std::sin(0.1 + q3), 0};
   scene.SetLocalPose(arm.target, {target, {}});
-  IkGroupSpec spec;
-  spec.name = "reach";
-  spec.tips.push_back({arm.tip, arm.target, {}, kIkX | kIkY});
-  spec.max_iterations = 100;
-  spec.position_tolerance = 1e-7;
+  const IkGroupSpec spec = ReachGroup(arm.tip, arm.target, kIkX | kIkY, 1e-7);
   IkGroups* ik = Ik(world.get());
   const int h = ik->AddGroup(scene, spec);
   world->Start();
@@ -315,11 +318,7 @@ TEST(IkGroupsTest, ScrewJointTurnsAndTravelsToTheTarget) {
   const ObjectId target =
       scene.AddDummy("target", root, {{0.2 * std::cos(1.0), 0.2 * std::sin(1.0), 0.1}, {}});
   scene.MakeModelInstance(root, "screw", "screw#0");
-  IkGroupSpec spec;
-  spec.name = "reach";
-  spec.tips.push_back({tip, target, {}, kIkPosition});
-  spec.max_iterations = 100;
-  spec.position_tolerance = 1e-7;
+  const IkGroupSpec spec = ReachGroup(tip, target, kIkPosition, 1e-7);
   IkGroups* ik = Ik(world.get());
   EXPECT_EQ(ik->Handle(ik->AddGroup(scene, spec), &scene), IkStatus::kSolved);
   EXPECT_NEAR(scene.joint(joint).position, 1.0, 1e-6);
@@ -345,12 +344,7 @@ TEST(IkGroupsTest, SphericalJointOrientsWhereARevoluteChainCannot) {
     const ObjectId tip = scene.AddDummy("tip", j2, {{0.3, 0, 0}, {}});
     const ObjectId target = scene.AddDummy("target", root, X_WTarget);
     scene.MakeModelInstance(root, "arm", "arm#0");
-    IkGroupSpec spec;
-    spec.name = "reach";
-    spec.tips.push_back({tip, target, {}, kIkPose});
-    spec.max_iterations = 100;
-    spec.position_tolerance = 1e-6;
-    spec.orientation_tolerance = 1e-6;
+    const IkGroupSpec spec = ReachGroup(tip, target, kIkPose, 1e-6);
     IkGroups* ik = Ik(world.get());
     const IkStatus status = ik->Handle(ik->AddGroup(scene, spec), &scene);
     const Quat q_error = scene.world_pose(tip).q.Conjugate() * X_WTarget.q;
