@@ -146,10 +146,16 @@ int SetJointIkMode(lua_State* L) {
   return 0;
 }
 
-// sim.getJointIkMode(h) -> sim.jointikmode_active or sim.jointikmode_frozen.
+// sim.getJointIkMode(h) -> sim.jointikmode_active or sim.jointikmode_frozen
+// (own robot only: its scripts may change it during the phase).
 int GetJointIkMode(lua_State* L) {
+  const LuaContext& c = Context(L);
   uint32_t slot = 0;
-  lua_pushinteger(L, CheckJoint(L, &slot).ik_frozen ? kJointIkFrozen : kJointIkActive);
+  const JointData& joint = CheckJoint(L, &slot);
+  if (!OwnsJoint(c, slot))
+    throw Error("joint '" + c.scene->PathOf(c.scene->IdAt(slot)) +
+                "' belongs to another robot; only its own scripts can read its IK mode");
+  lua_pushinteger(L, joint.ik_frozen ? kJointIkFrozen : kJointIkActive);
   return 1;
 }
 

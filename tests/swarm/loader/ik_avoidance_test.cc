@@ -199,6 +199,8 @@ TEST_F(IkAvoidanceErrorTest, ScriptsFreezeAndReleaseAJointForIk) {
         "function sysCall_init()\n"
         "  j1 = sim.getObject(':/j1')\n"
         "  sim.setJointIkMode(j1, sim.jointikmode_frozen)\n"
+        "  assert(sim.getJointIkMode(j1) == sim.jointikmode_frozen)\n"
+        "  assert(not pcall(sim.setJointIkMode, j1, 7))\n"
         "end\n"
         "function sysCall_actuation()\n"
         "  steps = steps + 1\n"
