@@ -63,6 +63,14 @@ class WorldTest(unittest.TestCase):
         self.assertEqual(p.shape[1], 7)
         np.testing.assert_allclose(np.linalg.norm(p[:, 3:], axis=1), 1, atol=1e-9)
         self.assertTrue(np.all(p[:, 2] > -0.5), "robots fell through the floor")
+        # The planar form's heading is the quaternion's yaw.
+        flat = w.poses(columns=3)
+        np.testing.assert_array_equal(flat[:, :2], p[:, :2])
+        qw, qx, qy, qz = p[:, 3], p[:, 4], p[:, 5], p[:, 6]
+        yaw = np.arctan2(2 * (qw * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz))
+        np.testing.assert_allclose(flat[:, 2], yaw, rtol=1e-15, atol=1e-15)
+        with self.assertRaises(ValueError):
+            w.poses(columns=4)
 
     def test_sensor_and_joint_arrays(self):
         w = swarmsim.World(world("diffusion.yaml"), seed=3, set={"robots": 200, "density": 4.0})
