@@ -38,6 +38,19 @@ struct LoadOptions {
   // (`plugins: [example_plugin]` -> example_plugin.so); the program passes
   // the `plugins/` folder beside its executable.
   std::vector<std::filesystem::path> plugin_directories;
+  // Whether the caller runs `python_controller:` entries (swarm/python does;
+  // the program does not, and a world naming one is an error there).
+  bool python_controllers = false;
+};
+
+// A models entry's `python_controller:` (swarm/python runs it; the program
+// cannot): a function called once per step with the arrays of all the
+// entry's robots.
+struct PythonController {
+  std::filesystem::path file;  // absolute; empty: the entry has none
+  std::string function = "control";
+  bool keep_scripts = false;  // false: the model's Lua scripts are dropped
+  std::string where;          // "file:line:column" of the key, for messages
 };
 
 // What `swarmsim describe` lists about one `models:` entry.
@@ -55,6 +68,7 @@ struct ModelSummary {
   std::vector<std::string> scripts;
   double scale = 1;  // `scale:` of the entry
   int ik_groups = 0;
+  PythonController python;  // python_controller:, if any
 };
 
 struct LoadedWorld {

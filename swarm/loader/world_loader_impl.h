@@ -27,9 +27,9 @@ namespace swarmsim::loader {
 
 inline constexpr int64_t kMaxCount = 1000000;  // copies per models entry
 
-inline const std::vector<std::string> kEntryKeys = {"model",      "count",       "distribute",
-                                                    "position",   "heading_deg", "orientation_deg",
-                                                    "parameters", "instances",   "scale"};
+inline const std::vector<std::string> kEntryKeys = {
+    "model",           "count",      "distribute", "position", "heading_deg",
+    "orientation_deg", "parameters", "instances",  "scale",    "python_controller"};
 
 // One --set, split into its target.
 struct Override {
@@ -65,6 +65,7 @@ struct EntryPlan {
   std::optional<double> heading;
   std::vector<Placement2> placements;
   std::vector<loader::IkGroupDef> ik_groups;
+  PythonController python;  // python_controller: (file empty: none)
   // instances: [{index, parameters}]: copies with their own values, in file order.
   struct OwnCopy {
     int64_t index = 0;
@@ -141,6 +142,7 @@ class WorldLoader {
                      EntryPlan* entry);
   void ResolveObjects(const Fields& f, const ValueReader& world_values, EntryPlan* entry);
   void ResolvePlacement(const Fields& f, const ValueReader& world_values, EntryPlan* entry);
+  void ResolvePythonController(const Fields& f, const ValueReader& world_values, EntryPlan* entry);
   void ReadDistribution(const Fields& f, const ValueReader& world_values, EntryPlan* entry);
   void ReadSinglePosition(const Fields& f, const ValueReader& world_values, EntryPlan* entry);
   void KeepPlacementClearOfTheMap();
