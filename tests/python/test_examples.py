@@ -32,9 +32,13 @@ class DiffusionEnvTest(unittest.TestCase):
         # Straight at 0.05 m/s for 0.1 s: about 5 mm a step where nothing is close.
         self.assertAlmostEqual(float(np.median(rewards)), 0.005, delta=0.001)
         env.reset(seed=3)
-        for expected in trace:
+        for step, expected in enumerate(trace):
             again, _, _ = env.step(actions)
-            np.testing.assert_array_equal(again, expected)
+            where = np.argwhere(again != expected)
+            self.assertEqual(len(where), 0,
+                             f"step {step + 1}: observations differ at (robot, column) "
+                             f"{where[:5].tolist()}: {again[tuple(where[0])]!r} against "
+                             f"{expected[tuple(where[0])]!r}" if len(where) else "")
         with self.assertRaises(ValueError):
             env.step(np.zeros((3, 2)))
         env.close()
