@@ -38,6 +38,9 @@ struct LoadOptions {
   // (`plugins: [example_plugin]` -> example_plugin.so); the program passes
   // the `plugins/` folder beside its executable.
   std::vector<std::filesystem::path> plugin_directories;
+  // --package-path: folders searched for the ROS packages a URDF model's
+  // package:// URIs name, after the world's own `package_path`.
+  std::vector<std::filesystem::path> package_path;
 };
 
 // What `swarmsim describe` lists about one `models:` entry.
@@ -55,6 +58,7 @@ struct ModelSummary {
   std::vector<std::string> scripts;
   double scale = 1;  // `scale:` of the entry
   int ik_groups = 0;
+  std::vector<std::string> imported;  // a URDF model: what was imported (links, joints, meshes)
 };
 
 struct LoadedWorld {
