@@ -26,7 +26,7 @@ constexpr ObjectKey kKeys[] = {
     {"friction", "0.7", "Coulomb coefficient, >= 0"},
     {"restitution", "0", "0..1"},
     {"color", "[0.7, 0.7, 0.7]", "RGB, each 0..1"},
-    {"file", "mesh: required", "STL or OBJ file, relative to the file naming it; metres"},
+    {"file", "mesh: required", "STL, OBJ or COLLADA file, relative to the file naming it; metres"},
     {"scale", "mesh: [1, 1, 1]",
      "[sx, sy, sz], positive factors applied to the file's coordinates"},
 };
