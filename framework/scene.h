@@ -113,6 +113,7 @@ struct JointData {
   double max_force = 10;            // N or N m
   double max_velocity = 10;         // rad/s or m/s, position mode
   double target_force = 0;          // N or N m, force mode
+  double damping = 0;               // N m s/rad or N s/m: viscous -damping * velocity (ode)
   double min_position = -INFINITY;  // limits, rad or m (infinite: unlimited)
   double max_position = INFINITY;
   Quat ball;                                       // spherical joints: rotation of the children

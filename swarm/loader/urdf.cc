@@ -188,8 +188,10 @@ void Importer::ReadXml(const std::string& bytes) {
           double damping = 0, friction = 0;
           k->QueryDoubleAttribute("damping", &damping);
           k->QueryDoubleAttribute("friction", &friction);
-          if (damping != 0 || friction != 0)
-            Ignore("joint <dynamics> damping and friction (not simulated)", k->GetLineNum());
+          if (!(damping >= 0) || !std::isfinite(damping))
+            Fail(k->GetLineNum(), "joint '" + std::string(name) + "': <dynamics damping=\"" +
+                                      Num(damping) + "\"> must be a non-negative number");
+          if (friction != 0) Ignore("joint <dynamics> friction (not simulated)", k->GetLineNum());
         }
       }
     } else if (kind != "material") {
@@ -565,6 +567,7 @@ ObjectSpec Importer::LinkObject(const urdf::Link& link, bool top, bool is_root, 
       d.max_force = kUrdfDefaultEffort;
       d.max_velocity = kUrdfDefaultVelocity;
     }
+    if (joint->dynamics) d.damping = joint->dynamics->damping;
     if (joint->mimic) {
       auto dep = std::make_shared<JointDependency>();
       dep->master = ":/" + ObjectName(joint->mimic->joint_name);

@@ -501,6 +501,13 @@ void OdeWorld::ApplyMotors(double dt) {
         break;
       case JointMode::kPassive: break;
     }
+    // Viscous damping (a URDF joint's <dynamics damping>), in every mode.
+    if (c.damping > 0) {
+      if (hinge)
+        dJointAddHingeTorque(j.joint, -c.damping * dJointGetHingeAngleRate(j.joint));
+      else
+        dJointAddSliderForce(j.joint, -c.damping * dJointGetSliderPositionRate(j.joint));
+    }
     if (hinge) {
       dJointSetHingeParam(j.joint, dParamVel, velocity);
       dJointSetHingeParam(j.joint, dParamFMax, max_force);

@@ -393,6 +393,42 @@ TEST_F(UrdfTest, TheExampleArmsFollowTheirTargets) {
   }
 }
 
+TEST_F(UrdfTest, JointDampingSlowsAPendulumUnderOde) {
+  // A 1 kg box on a passive hinge about y, released horizontal: without
+  // damping it swings on; with 2 N m s/rad it settles hanging.
+  auto swing = [&](double damping) {
+    Write(
+        "pendulum.yaml",
+        "model: pendulum\nobjects:\n  name: base\n  type: dummy\n  children:\n"
+        "    - name: hinge\n      type: joint\n      mode: passive\n      damping: " +
+            std::to_string(damping) +
+            "\n      orientation_deg: [-90, 0, 0]\n      children:\n"
+            "        - {name: bob, type: shape, shape: box, size: [0.1, 0.1, 0.1], dynamic: true, "
+            "mass: 1, position: [0.3, 0, 0]}\n");
+    LoadedWorld w = Load(
+        "simulation: {physics: ode, time_step: 0.01}\nmodels: [{model: pendulum.yaml, position: "
+        "[0, 0, 1]}]\n");
+    World& world = *w.world;
+    world.Start();
+    double fastest = 0;  // rad/s, over the last second of 4
+    for (int k = 0; k < 400; ++k) {
+      world.Step();
+      if (k >= 300)
+        fastest = std::max(fastest, std::abs(world.scene().joint(Find(world, "hinge")).velocity));
+    }
+    return fastest;
+  };
+  const double free = swing(0), damped = swing(2);
+  EXPECT_GT(free, 3.0);
+  EXPECT_LT(damped, 0.1 * free);
+}
+
+TEST_F(UrdfTest, UrdfJointDampingIsImported) {
+  NEED_SHARED_URDF(dir);
+  LoadedWorld w = LoadRobot(dir, kPanda, "kinematic");
+  EXPECT_EQ(w.world->scene().joint(Find(*w.world, "panda_joint1")).damping, 0.003);
+}
+
 // --- Bad input -----------------------------------------------------------------------
 
 class UrdfErrorTest : public testing::WorldDirTest {
