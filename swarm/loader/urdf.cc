@@ -86,6 +86,7 @@ class Importer {
   XmlFacts xml_;
   std::map<std::string, std::optional<fs::path>> packages_;
   std::set<std::string> default_mass_links_;
+  std::vector<std::string> isotropic_links_;  // bodies whose inertia was made isotropic
   int frames_ = 0, bodies_ = 0, meshes_count_ = 0, visuals_ = 0, collisions_ = 0;
   std::map<std::string, int> mesh_formats_;
   std::map<std::string, int> joint_kinds_;
@@ -481,7 +482,15 @@ ObjectSpec Importer::LinkObject(const urdf::Link& link, bool top, bool is_root, 
     s.collidable = false;
     s.mass = mass;  // 0: a frame, never simulated
     s.dynamic = mass > 0 && !is_root;
-    if (mass > 0 && InertiaIsValid(inertia)) s.inertia = inertia;
+    if (mass > 0 && !InertiaIsValid(inertia)) {
+      // Each link's tensor is positive definite (checked), but CAD exports
+      // break the triangle inequality ODE needs: keep the mean moment.
+      const double mean = (inertia[0] + inertia[1] + inertia[2]) / 3;
+      inertia = {mean > 0 ? mean : mass * kUrdfDefaultInertia, 0, 0, 0, 0, 0};
+      inertia[1] = inertia[2] = inertia[0];
+      isotropic_links_.push_back(link.name);
+    }
+    if (mass > 0) s.inertia = inertia;
     if (mass > 0) {
       ++bodies_;
       total_mass_ += mass;
@@ -637,6 +646,14 @@ UrdfImport Importer::Run(const std::string& where, const std::string& text) {
     out.warnings.push_back(name_ + ":" + std::to_string(count_line.second) + ": ignored " +
                            std::to_string(count_line.first) + " " + kind +
                            (count_line.first == 1 ? "" : " (first here)"));
+  if (!isotropic_links_.empty()) {
+    std::string names;
+    for (const std::string& n : isotropic_links_) names += (names.empty() ? "" : ", ") + n;
+    out.warnings.push_back(name_ + ": the inertia of " + std::to_string(isotropic_links_.size()) +
+                           " bod" + (isotropic_links_.size() == 1 ? "y" : "ies") + " (" + names +
+                           ") breaks the triangle inequality of principal moments: replaced by "
+                           "its mean moment about each axis");
+  }
   if (!default_mass_links_.empty()) {
     std::string names;
     for (const std::string& n : default_mass_links_) names += (names.empty() ? "" : ", ") + n;

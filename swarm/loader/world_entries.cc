@@ -247,7 +247,8 @@ void WorldLoader::ExtendObjects(const Fields& f, const ValueReader& world_values
         for (auto it = at->children.rbegin(); it != at->children.rend(); ++it)
           stack.push_back(&*it);
       }
-      if (s.name == ":" || s.name == ".") target = spec;
+      if (s.name == ":" || s.name == "." || (target == nullptr && s.name == spec->name))
+        target = spec;
       if (target == nullptr)
         file_->Fail(s.key_mark, "no object '" + s.name + "' in model '" + model.name +
                                     "' to attach a script to (':' is the root)" +

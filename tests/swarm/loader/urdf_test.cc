@@ -429,6 +429,41 @@ TEST_F(UrdfTest, UrdfJointDampingIsImported) {
   EXPECT_EQ(w.world->scene().joint(Find(*w.world, "panda_joint1")).damping, 0.003);
 }
 
+TEST_F(UrdfTest, AnIkGroupFromTheEntryDrivesTheImportedFanucUnderOde) {
+  NEED_SHARED_URDF(dir);
+  LoadedWorld w = Load("simulation: {physics: ode, time_step: 0.01}\nmodels:\n  - model: " + dir +
+                       "/" + kFanuc +
+                       "\n    position: [0, 0, 0]\n"
+                       "    objects: [{name: goal, type: dummy, position: [0.75, 0.25, 1.0]}]\n"
+                       "    ik_groups:\n"
+                       "      - {name: reach, mode: targets, tips: [{tip: tool0, target: goal, "
+                       "base: base_link}]}\n");
+  World& world = *w.world;
+  world.Start();
+  for (int k = 0; k < 500; ++k) world.Step();
+  const Vec3 tip = world.scene().world_pose(Find(world, "tool0")).p;
+  EXPECT_LT((tip - Vec3{0.75, 0.25, 1.0}).Norm(), 0.01);
+}
+
+TEST_F(UrdfTest, ACadInertiaBreakingTheTriangleInequalityIsMadeIsotropicWithAWarning) {
+  Write("cad.urdf",
+        "<robot name=\"cad\">\n  <link name=\"base\"/>\n  <link name=\"bar\">\n"
+        "    <inertial><mass value=\"1\"/><inertia ixx=\"1\" iyy=\"0.1\" izz=\"0.1\" ixy=\"0\" "
+        "ixz=\"0\" iyz=\"0\"/></inertial>\n"
+        "    <collision><geometry><box size=\"0.4 0.1 0.1\"/></geometry></collision>\n  </link>\n"
+        "  <joint name=\"j\" type=\"continuous\"><parent link=\"base\"/><child link=\"bar\"/>"
+        "<origin xyz=\"0 0 0.5\"/><axis xyz=\"0 0 1\"/></joint>\n</robot>\n");
+  LoadedWorld w =
+      Load("simulation: {physics: ode}\nmodels: [{model: cad.urdf, position: [0, 0, 0]}]\n");
+  ASSERT_EQ(w.warnings.size(), 1u);
+  EXPECT_CONTAINS(w.warnings[0], "triangle inequality");
+  const ShapeData& bar = w.world->scene().shape(Find(*w.world, "bar"));
+  EXPECT_NEAR(bar.inertia[0], 0.4, 1e-12);
+  EXPECT_NEAR(bar.inertia[2], 0.4, 1e-12);
+  w.world->Start();
+  for (int k = 0; k < 100; ++k) w.world->Step();
+}
+
 // --- Bad input -----------------------------------------------------------------------
 
 class UrdfErrorTest : public testing::WorldDirTest {
