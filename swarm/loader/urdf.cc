@@ -11,6 +11,7 @@
 #include <cmath>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <set>
 
 #include "framework/display_path.h"
@@ -121,6 +122,17 @@ void Importer::ReadXml(const std::string& bytes) {
         if (part == "visual" || part == "collision") {
           auto& lines = part == "visual" ? xml_.visual_lines[name] : xml_.collision_lines[name];
           const tinyxml2::XMLElement* g = c->FirstChildElement("geometry");
+          const tinyxml2::XMLElement* shape = g ? g->FirstChildElement() : nullptr;
+          const std::string what = "link '" + std::string(name) + "' <" + part + ">";
+          if (!shape)
+            Fail(c->GetLineNum(),
+                 what + " needs <geometry> holding a box, cylinder, sphere or mesh");
+          const std::string kind = shape->Name();
+          if (kind != "box" && kind != "cylinder" && kind != "sphere" && kind != "mesh")
+            Fail(shape->GetLineNum(),
+                 what + ": unknown geometry <" + kind + "> (box, cylinder, sphere or mesh)");
+          if (kind == "mesh" && !shape->Attribute("filename"))
+            Fail(shape->GetLineNum(), what + ": <mesh> needs a 'filename'");
           lines.push_back(g && g->FirstChildElement() ? g->FirstChildElement()->GetLineNum()
                                                       : c->GetLineNum());
           if (const tinyxml2::XMLElement* m = c->FirstChildElement("material"))
@@ -160,6 +172,14 @@ void Importer::ReadXml(const std::string& bytes) {
         Fail(line, "joint '" + std::string(name) + "' is defined twice (first at line " +
                        std::to_string(xml_.joint_line[name]) + ")");
       xml_.joint_order[name] = order++;
+      const std::string type = e->Attribute("type") ? e->Attribute("type") : "";
+      if (type != "revolute" && type != "continuous" && type != "prismatic" && type != "fixed" &&
+          type != "floating" && type != "planar")
+        Fail(line, "joint '" + std::string(name) + "': unknown type '" + type +
+                       "' (revolute, continuous, prismatic, fixed, floating or planar)");
+      if ((type == "revolute" || type == "prismatic") && !e->FirstChildElement("limit"))
+        Fail(line, "joint '" + std::string(name) + "' is " + type +
+                       " and needs <limit lower upper effort velocity>");
       const tinyxml2::XMLElement* p = e->FirstChildElement("parent");
       const tinyxml2::XMLElement* c = e->FirstChildElement("child");
       const char* parent = p ? p->Attribute("link") : nullptr;
@@ -327,6 +347,13 @@ Quat ZTo(const Vec3& a) {
   return Quat::FromAxisAngle(z.Cross(a), std::acos(std::clamp(c, -1.0, 1.0)));
 }
 
+// The link `joint` (one of link's child joints) leads to.
+urdf::LinkConstSharedPtr ChildLink(const urdf::Link& link, const urdf::Joint& joint) {
+  for (const auto& c : link.child_links)
+    if (c->name == joint.child_link_name) return c;
+  return nullptr;
+}
+
 ObjectSpec NewObject(ObjectType type, std::string name, const Pose& X_PO) {
   ObjectSpec spec;
   spec.type = type;
@@ -450,11 +477,7 @@ void Importer::GroupMass(const urdf::Link& link, const Pose& X_TL, double* mass,
   }
   for (const urdf::JointSharedPtr& joint : ChildJoints(link))
     if (joint->type == urdf::Joint::FIXED || joint->type == urdf::Joint::PLANAR)
-      if (const urdf::LinkConstSharedPtr child = [&] {
-            for (const auto& c : link.child_links)
-              if (c->name == joint->child_link_name) return urdf::LinkConstSharedPtr(c);
-            return urdf::LinkConstSharedPtr();
-          }())
+      if (const urdf::LinkConstSharedPtr child = ChildLink(link, *joint))
         GroupMass(*child, X_TL * ToPose(joint->parent_to_joint_origin_transform), mass, inertia);
 }
 
@@ -526,9 +549,7 @@ ObjectSpec Importer::LinkObject(const urdf::Link& link, bool top, bool is_root, 
       spec.children.push_back(std::move(*shape));
   }
   for (const urdf::JointSharedPtr& joint : ChildJoints(link)) {
-    urdf::LinkConstSharedPtr child;
-    for (const auto& c : link.child_links)
-      if (c->name == joint->child_link_name) child = c;
+    const urdf::LinkConstSharedPtr child = ChildLink(link, *joint);
     if (!child) continue;
     const int line = xml_.joint_line[joint->name];
     const Pose X_LJ = ToPose(joint->parent_to_joint_origin_transform);

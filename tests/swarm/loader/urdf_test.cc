@@ -524,8 +524,20 @@ TEST_F(UrdfErrorTest, MalformedFilesNameTheFileTheElementAndTheLine) {
   e = ErrorOfUrdf(std::string(kHead) +
                   "  <link name=\"a\"/>\n  <link name=\"b\"/>\n"
                   "  <joint name=\"j\" type=\"revolute\"><parent link=\"a\"/><child link=\"b\"/>"
-                  "<mimic joint=\"nobody\"/></joint>\n</robot>\n");
+                  "<mimic joint=\"nobody\"/><limit lower=\"-1\" upper=\"1\" effort=\"1\" "
+                  "velocity=\"1\"/></joint>\n</robot>\n");
   EXPECT_CONTAINS(e, "bad.urdf:5: joint 'j': <mimic joint=\"nobody\">");
+
+  e = ErrorOfUrdf(std::string(kHead) +
+                  "  <link name=\"a\"/>\n  <link name=\"b\"/>\n"
+                  "  <joint name=\"j\" type=\"revolutee\"><parent link=\"a\"/><child "
+                  "link=\"b\"/></joint>\n</robot>\n");
+  EXPECT_CONTAINS(e, "bad.urdf:5: joint 'j': unknown type 'revolutee'");
+
+  e = ErrorOfUrdf(std::string(kHead) +
+                  "  <link name=\"a\">\n    <collision><geometry><cone/></geometry></collision>\n"
+                  "  </link>\n</robot>\n");
+  EXPECT_CONTAINS(e, "bad.urdf:4: link 'a' <collision>: unknown geometry <cone>");
 }
 
 TEST_F(UrdfErrorTest, TheProgramExitsWithTwoAndTheMessage) {
