@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "framework/error.h"
+#include "framework/mesh.h"
 #include "framework/world.h"
 #include "swarm/loader/world_loader.h"
 #include "tests/framework/error_of.h"
@@ -316,6 +317,20 @@ TEST_F(UrdfTest, TurtlebotColladaMeshesKeepTheUrdfFrame) {
   const Vec3 c = camera.mesh->hi() - camera.mesh->lo();
   EXPECT_LT(std::max({c.x, c.y, c.z}), 0.2);
   EXPECT_GT(std::max({c.x, c.y, c.z}), 0.1);
+}
+
+TEST_F(UrdfTest, PandaColladaVisualsLieOnTheirStlCollisions) {
+  NEED_SHARED_URDF(dir);
+  LoadedWorld w = LoadRobot(dir, kPanda, "kinematic");
+  const Scene& scene = w.world->scene();
+  const ObjectId root = scene.instances()[0].root;
+  // link2.dae (Z_UP) and link2.stl: 0.110 x 0.249 x 0.184 m both, not y and z swapped.
+  const TriangleMesh& visual = *scene.shape(scene.FindObject("./panda_link2/visual", root)).mesh;
+  const TriangleMesh& collision =
+      *scene.shape(scene.FindObject("./panda_link2/collision", root)).mesh;
+  EXPECT_NEAR((visual.lo() - collision.lo()).Norm(), 0, 0.01);
+  EXPECT_NEAR((visual.hi() - collision.hi()).Norm(), 0, 0.01);
+  EXPECT_NEAR(visual.hi().y - visual.lo().y, 0.249, 0.005);
 }
 
 TEST_F(UrdfTest, TheDefaultInertiaWarningComesOnce) {
