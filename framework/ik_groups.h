@@ -5,9 +5,13 @@
 //
 // A group has one or more tip/target pairs, each solved for a constraint
 // subset (x, y, z; alpha, beta, gamma about the target's axes). The joints
-// are the revolute and prismatic joints between each tip and its base (by
-// default the tip's model root). A target that hangs below the base through
-// joints makes a closed chain: those joints are unknowns too.
+// are the revolute, prismatic, screw and spherical joints between each tip
+// and its base (by default the tip's model root), but those in IK mode
+// `frozen` (JointData::ik_frozen) keep their values, and dependent joints
+// follow their masters. A target that hangs below the base through joints
+// makes a closed chain: those joints are unknowns too. A group may keep
+// chosen links at least a distance from an obstacle (IkAvoidSpec; the
+// collision module measures it).
 #pragma once
 
 #include <cstdint>
@@ -46,6 +50,19 @@ struct IkTipSpec {
   uint8_t constraints = kIkPosition;
 };
 
+// Obstacle avoidance: each link (a rigid body: the object and what hangs
+// below it without crossing a joint) stays at least `distance` from
+// `obstacle`.
+struct IkAvoidSpec {
+  std::vector<ObjectId> links;
+  // A path resolved from the group's model root as distance objects
+  // resolve theirs (a collection, or an object and its subtree), or
+  // "environment".
+  std::string obstacle;
+  double distance = 0.05;  // m, > 0
+  std::string where;       // "file:line:column" of `obstacle`, for errors
+};
+
 struct IkGroupSpec {
   std::string name;
   std::vector<IkTipSpec> tips;
@@ -58,6 +75,7 @@ struct IkGroupSpec {
   bool conditional = false;  // apply only when solved, else leave the joints as they were
   bool automatic = true;  // solved each step in the actuate phase (else only by sim.handleIkGroup)
   std::vector<std::pair<ObjectId, double>> weights;  // per joint, default 1
+  std::vector<IkAvoidSpec> avoid;
 };
 
 // V-REP's sim.ikresult_* values.
@@ -67,7 +85,12 @@ class IkGroups : public CalculationModule {
  public:
   // Adds a group; returns its handle (> 0, never reused). Throws
   // swarmsim::Error if an object is invalid or a tip has no joints.
+  // Obstacles are resolved by CheckReferences (once the world's objects
+  // exist) or at the first solve.
   virtual int AddGroup(const Scene& scene, IkGroupSpec spec) = 0;
+  // Resolves every group's obstacles; throws swarmsim::Error naming the
+  // entry's file:line:column when a path matches nothing.
+  virtual void CheckReferences(const Scene& scene) = 0;
   // Handle of the live group named `name` of robot `instance` (-1: scene
   // groups), or 0.
   virtual int FindGroup(std::string_view name, int instance) const = 0;

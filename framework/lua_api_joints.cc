@@ -16,6 +16,8 @@
 namespace swarmsim {
 namespace {
 
+constexpr lua_Integer kJointIkActive = 0, kJointIkFrozen = 1;
+
 bool OwnsJoint(const LuaContext& c, uint32_t slot) {
   return c.instance < 0 || c.scene->instance_of_at(slot) == c.instance;
 }
@@ -126,6 +128,37 @@ int GetJointTargetPosition(lua_State* L) {
   return 1;
 }
 
+// sim.setJointIkMode(h, mode): sim.jointikmode_active (IK groups move the
+// joint) or sim.jointikmode_frozen (they keep its value). The robot's own
+// joints (or any from a scene script); IK reads it in the actuate phase.
+int SetJointIkMode(lua_State* L) {
+  const LuaContext& c = Context(L);
+  uint32_t slot = 0;
+  JointData& joint = CheckJoint(L, &slot);
+  const lua_Integer mode = ArgInteger(L, 2);
+  if (mode != kJointIkActive && mode != kJointIkFrozen)
+    throw Error("bad argument #2 (sim.jointikmode_active or sim.jointikmode_frozen expected, got " +
+                std::to_string(mode) + ")");
+  if (!OwnsJoint(c, slot))
+    throw Error("joint '" + c.scene->PathOf(c.scene->IdAt(slot)) +
+                "' belongs to another robot; only its own scripts can set its IK mode");
+  joint.ik_frozen = mode == kJointIkFrozen;
+  return 0;
+}
+
+// sim.getJointIkMode(h) -> sim.jointikmode_active or sim.jointikmode_frozen
+// (own robot only: its scripts may change it during the phase).
+int GetJointIkMode(lua_State* L) {
+  const LuaContext& c = Context(L);
+  uint32_t slot = 0;
+  const JointData& joint = CheckJoint(L, &slot);
+  if (!OwnsJoint(c, slot))
+    throw Error("joint '" + c.scene->PathOf(c.scene->IdAt(slot)) +
+                "' belongs to another robot; only its own scripts can read its IK mode");
+  lua_pushinteger(L, joint.ik_frozen ? kJointIkFrozen : kJointIkActive);
+  return 1;
+}
+
 }  // namespace
 
 void RegisterJointsApi(lua_State* L) {
@@ -137,9 +170,15 @@ void RegisterJointsApi(lua_State* L) {
       {"getJointVelocity", Guarded<GetJointVelocity, "sim.getJointVelocity">},
       {"getJointTargetVelocity", Guarded<GetJointTargetVelocity, "sim.getJointTargetVelocity">},
       {"getJointTargetPosition", Guarded<GetJointTargetPosition, "sim.getJointTargetPosition">},
+      {"setJointIkMode", Guarded<SetJointIkMode, "sim.setJointIkMode">},
+      {"getJointIkMode", Guarded<GetJointIkMode, "sim.getJointIkMode">},
       {nullptr, nullptr},
   };
   luaL_setfuncs(L, kFunctions, 0);
+  lua_pushinteger(L, kJointIkActive);
+  lua_setfield(L, -2, "jointikmode_active");
+  lua_pushinteger(L, kJointIkFrozen);
+  lua_setfield(L, -2, "jointikmode_frozen");
 }
 
 }  // namespace swarmsim

@@ -122,6 +122,9 @@ struct JointData {
   // Set by a dynamics backend that integrates this joint's position and
   // velocity itself; World::Actuate then leaves them alone.
   bool simulated = false;
+  // IK mode (V-REP's joint IK mode): a frozen joint keeps its value while
+  // IK groups solve (the `ik` key, sim.setJointIkMode).
+  bool ik_frozen = false;
 
   Pose Motion() const;  // transform produced by `position` about/along z
   // sim.setJointPosition on a joint nothing simulates: it jumps to q and

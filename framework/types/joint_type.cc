@@ -36,6 +36,7 @@ constexpr ObjectKey kKeys[] = {
     {"master", "none", "path of the joint this one follows: q = offset + factor * q_master"},
     {"factor", "1", "dependent joints: factor of the master's position"},
     {"offset", "0", "dependent joints: rad or m added"},
+    {"ik", "active", "active (IK groups move it) or frozen (IK keeps its value)"},
 };
 
 std::unique_ptr<RowTable> MakeRows(const ObjectTypeDescriptor&) {
@@ -77,6 +78,7 @@ void Hash(const Scene& scene, ObjectType, StateHasher* h) {
     h->AddValue(j.velocity);
     h->AddValue(j.target_velocity);
     h->AddValue(j.target_position);
+    if (j.ik_frozen) h->AddValue(j.ik_frozen);  // (only when set: older hashes stay)
   }
 }
 
@@ -123,6 +125,7 @@ void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
              : mode == "position" ? JointMode::kPosition
                                   : JointMode::kForce;
   }
+  if (r.Has("ik")) j.ik_frozen = r.Choice("ik", {"active", "frozen"}) == "frozen";
   if (r.Has("target_force")) j.target_force = r.Number("target_force", kAnyNumber);
   if (r.Has("damping")) j.damping = r.Number("damping", kNonNegative);
   if (r.Has("limits")) {

@@ -7,6 +7,17 @@
 
 namespace swarmsim::kinematics {
 
+Pose ChainJoint::Motion(double q, const Quat& rotation) const {
+  switch (kind) {
+    case ChainJointKind::kRevolute: return {{}, {std::cos(q / 2), 0, 0, std::sin(q / 2)}};
+    case ChainJointKind::kPrismatic: return {{0, 0, q}, {}};
+    case ChainJointKind::kScrew:
+      return {{0, 0, pitch * q}, {std::cos(q / 2), 0, 0, std::sin(q / 2)}};
+    case ChainJointKind::kSpherical: return {{}, rotation};
+  }
+  return {};
+}
+
 Chain Chain::FromScene(const Scene& scene, ObjectId base, ObjectId tip) {
   const uint32_t tip_slot = scene.SlotOf(tip, "IK tip");
   const int32_t base_slot =
@@ -30,13 +41,19 @@ Chain Chain::FromScene(const Scene& scene, ObjectId base, ObjectId tip) {
     X_acc = X_acc * scene.local_pose_at(slot);
     if (scene.type_at(slot) != ObjectType::kJoint) continue;
     const JointData& j = scene.joints()[scene.row_at(slot)];
-    if (j.type == JointType::kRevolute || j.type == JointType::kPrismatic) {
-      chain.joints_.push_back(
-          {X_acc, j.type == JointType::kPrismatic, j.min_position, j.max_position, slot});
-      X_acc = Pose{};
-    } else {
-      X_acc = X_acc * j.Motion();  // fixed, or spherical frozen at its rotation
+    ChainJoint c{X_acc, ChainJointKind::kRevolute, 0, j.min_position, j.max_position, j.ball, slot};
+    switch (j.type) {
+      case JointType::kRevolute: break;
+      case JointType::kPrismatic: c.kind = ChainJointKind::kPrismatic; break;
+      case JointType::kScrew:
+        c.kind = ChainJointKind::kScrew;
+        c.pitch = j.pitch;
+        break;
+      case JointType::kSpherical: c.kind = ChainJointKind::kSpherical; break;
+      case JointType::kFixed: X_acc = X_acc * j.Motion(); continue;
     }
+    chain.joints_.push_back(c);
+    X_acc = Pose{};
   }
   chain.X_after_ = X_acc;
   return chain;
@@ -54,17 +71,10 @@ void Chain::WritePositions(std::span<const double> q, Scene* scene) const {
     scene->joints()[scene->row_at(joints_[i].slot)].position = q[i];
 }
 
-namespace {
-Pose Motion(bool prismatic, double q) {
-  if (prismatic) return {{0, 0, q}, {}};
-  return {{}, {std::cos(q / 2), 0, 0, std::sin(q / 2)}};
-}
-}  // namespace
-
 Pose Chain::CalcTipPose(std::span<const double> q) const {
   Pose X = X_WBase_;
   for (size_t i = 0; i < joints_.size(); ++i)
-    X = X * joints_[i].X_before * Motion(joints_[i].prismatic, q[i]);
+    X = X * joints_[i].X_before * joints_[i].Motion(q[i], joints_[i].ball);
   return X * X_after_;
 }
 
@@ -73,7 +83,17 @@ Pose Chain::CalcTipPose(std::span<const double> q, Pose* X_WJ) const {
   for (size_t i = 0; i < joints_.size(); ++i) {
     X = X * joints_[i].X_before;
     X_WJ[i] = X;  // the axis frame (motion about/along its z)
-    X = X * Motion(joints_[i].prismatic, q[i]);
+    X = X * joints_[i].Motion(q[i], joints_[i].ball);
+  }
+  return X * X_after_;
+}
+
+Pose Chain::CalcTipPose(std::span<const double> q, std::span<const Quat> ball, Pose* X_WJ) const {
+  Pose X = X_WBase_;
+  for (size_t i = 0; i < joints_.size(); ++i) {
+    X = X * joints_[i].X_before;
+    X_WJ[i] = X;
+    X = X * joints_[i].Motion(q[i], ball[i]);
   }
   return X * X_after_;
 }

@@ -3,15 +3,16 @@
 // prefix), fast enough to run inside an IK loop (no scene writes).
 //
 // A chain runs from a base object (or the world) down to a tip object. Its
-// joints are the revolute and prismatic joints on the path, in order from
-// the base; every other object on the path (dummies, shapes, fixed joints,
-// spherical joints at their current rotation) folds into the constant
-// transform between two joints.
+// joints are the revolute, prismatic, screw and spherical joints on the
+// path, in order from the base; every other object on the path (dummies,
+// shapes, fixed joints) folds into the constant transform between two
+// joints.
 //
-//   X_W(tip) = X_W(base) * X_0 * M(q_1) * X_1 * M(q_2) * ... * M(q_n) * X_n
+//   X_W(tip) = X_W(base) * X_0 * M_1 * X_1 * M_2 * ... * M_n * X_n
 //
-// M(q) is JointData::Motion(): rotation about, or translation along, the
-// joint's own z axis.
+// M_i is the joint's motion (JointData::Motion()): a rotation about, or a
+// translation along, its own z axis by q; both for a screw joint (pitch * q
+// along z); a free rotation (`ball`) for a spherical joint.
 #pragma once
 
 #include <cstdint>
@@ -24,11 +25,19 @@
 
 namespace swarmsim::kinematics {
 
-struct ChainJoint {  // 88 bytes
+enum class ChainJointKind : uint8_t { kRevolute, kPrismatic, kScrew, kSpherical };
+
+struct ChainJoint {  // 128 bytes
   Pose X_before;     // constant transform from the previous joint's moved frame (or the base)
-  bool prismatic;    // else revolute
-  double min_position, max_position;  // limits, rad or m
+  ChainJointKind kind = ChainJointKind::kRevolute;
+  double pitch = 0;                   // screw: m along z per rad
+  double min_position, max_position;  // limits, rad or m (spherical: none)
+  Quat ball;                          // spherical: its rotation at extraction
   uint32_t slot;                      // the joint's scene slot
+
+  bool prismatic() const { return kind == ChainJointKind::kPrismatic; }
+  // The motion for position q (rotation `ball` for a spherical joint).
+  Pose Motion(double q, const Quat& ball) const;
 };
 
 class Chain {
@@ -37,6 +46,7 @@ class Chain {
   // swarmsim::Error if `base` is not an ancestor of `tip`.
   static Chain FromScene(const Scene& scene, ObjectId base, ObjectId tip);
 
+  // The joints on the path (a spherical joint counts once).
   int dof() const { return static_cast<int>(joints_.size()); }
   std::span<const ChainJoint> joints() const { return joints_; }
   // Current joint positions in the scene (chain order).
@@ -49,11 +59,14 @@ class Chain {
   const Pose& X_WBase() const { return X_WBase_; }
   void set_X_WBase(const Pose& X) { X_WBase_ = X; }
 
-  // World pose of the tip for positions q (size dof()).
+  // World pose of the tip for positions q (size dof(); spherical joints at
+  // their rotation of extraction).
   Pose CalcTipPose(std::span<const double> q) const;
-  // Same, and the world frame of each joint after its motion (size dof()),
+  // Same, and the world frame of each joint before its motion (size dof()),
   // whose z axis and origin give the Jacobian columns.
   Pose CalcTipPose(std::span<const double> q, Pose* X_WJ) const;
+  // Same with each spherical joint's rotation from `ball` (size dof()).
+  Pose CalcTipPose(std::span<const double> q, std::span<const Quat> ball, Pose* X_WJ) const;
 
  private:
   Pose X_WBase_;

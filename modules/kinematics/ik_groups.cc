@@ -5,10 +5,13 @@
 #include <string>
 #include <unordered_map>
 
+#include "framework/collections.h"
+#include "framework/dependent_joints.h"
 #include "framework/error.h"
 #include "framework/scheduler.h"
 #include "framework/state_hash.h"
 #include "framework/world.h"
+#include "modules/collision/module.h"
 #include "modules/kinematics/ik_solver.h"
 
 namespace swarmsim::kinematics {
@@ -27,7 +30,48 @@ struct Group {
   std::optional<IkProblem> problem;
   std::vector<int32_t> base_slot;     // per tip, -1: the world
   std::vector<int32_t> fixed_target;  // per tip: target slot read each solve, -1: closed chain
+  // Obstacle avoidance: per avoidance link of the problem, and per `avoid` entry.
+  struct AvoidLink {
+    uint32_t slot;                // the link object
+    std::vector<uint32_t> parts;  // its rigid body's shapes (ascending)
+    int entry;                    // in spec.avoid
+  };
+  std::vector<AvoidLink> avoid_links;
+  std::vector<collision::Target> obstacles;
+  std::vector<std::vector<uint32_t>> obstacle_slots;
+  bool obstacles_resolved = false;
 };
+
+// The shapes of the rigid body of `link`: it and what hangs below it without
+// crossing a joint, ascending.
+std::vector<uint32_t> RigidBodyShapes(const Scene& scene, uint32_t link) {
+  std::vector<uint32_t> subtree, out;
+  scene.CollectSubtree(link, &subtree);
+  for (uint32_t s : subtree) {
+    bool rigid = true;
+    for (uint32_t a = s; a != link && rigid; a = static_cast<uint32_t>(scene.parent_at(a)))
+      rigid = scene.type_at(a) != ObjectType::kJoint;
+    if (rigid && scene.type_at(s) == ObjectType::kShape) out.push_back(s);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// q_joint = offset + factor * q_root through a dependent joint's masters;
+// returns the root (a joint that depends on none).
+uint32_t RootMaster(const Scene& scene, uint32_t slot, double* factor, double* offset) {
+  *factor = 1;
+  *offset = 0;
+  for (size_t hops = 0; hops <= scene.joints().size(); ++hops) {
+    const JointData& j = scene.joints()[scene.row_at(slot)];
+    if (j.depends == nullptr) return slot;
+    *offset += *factor * j.depends->offset;
+    *factor *= j.depends->factor;
+    slot = JointMasterSlot(scene, slot);
+  }
+  CheckJointDependency(scene, scene.IdAt(slot));  // a cycle: throws
+  return slot;
+}
 
 bool IsAncestor(const Scene& scene, int32_t ancestor, uint32_t slot) {
   if (ancestor < 0) return true;
@@ -56,10 +100,17 @@ class IkGroupsImpl final : public IkGroups {
     Group g;
     g.instance = scene.instance_of(spec.tips.front().tip);
     g.spec = std::move(spec);
-    Build(&g, scene);  // reports a bad chain now, not at the first step
+    Build(&g, scene, false);  // reports a bad chain now, not at the first step
     groups_.push_back(std::move(g));
     by_instance_dirty_ = true;
     return static_cast<int>(groups_.size());
+  }
+
+  void Start(World* world) override { world_ = world; }
+
+  void CheckReferences(const Scene& scene) override {
+    for (Group& g : groups_)
+      if (g.alive) Build(&g, scene, true);
   }
 
   int FindGroup(std::string_view name, int instance) const override {
@@ -82,21 +133,23 @@ class IkGroupsImpl final : public IkGroups {
 
   IkStatus Handle(int handle, Scene* scene) override {
     Group& g = At(handle);
-    const IkStatus status = Solve(&g, scene);
+    const IkStatus status = Solve(&g, scene, g.spec.avoid.empty() ? nullptr : Geometry(world_));
     if (g.spec.mode == IkMode::kDirect) RefreshPoses(g.instance, scene);
     return status;
   }
 
   void Actuate(World* world) override {
     if (groups_.empty()) return;
+    world_ = world;
     Scene& scene = world->scene();
     RebuildByInstance(scene);
+    const collision::Geometry* geometry = any_avoid_ ? Geometry(world) : nullptr;
     // Robots concurrently (each writes only its own joints), then the scene's groups.
     const bool independent = scene.InstancesAreIndependent();
     auto solve_robot = [&](int r) {
       for (int h : by_instance_[r]) {
         Group& g = groups_[h - 1];
-        Solve(&g, &scene);
+        Solve(&g, &scene, geometry);
         // Direct mode: later groups of the robot see the new poses.
         if (g.spec.mode != IkMode::kDirect) continue;
         if (independent)
@@ -115,7 +168,7 @@ class IkGroupsImpl final : public IkGroups {
     }
     for (int h : scene_groups_) {
       Group& g = groups_[h - 1];
-      Solve(&g, &scene);
+      Solve(&g, &scene, geometry);
       if (g.spec.mode == IkMode::kDirect) scene.UpdateWorldPoses();
     }
   }
@@ -153,6 +206,8 @@ class IkGroupsImpl final : public IkGroups {
         t.base = remap(t.base);
       }
       for (auto& [joint, weight] : g.spec.weights) joint = remap(joint);
+      for (IkAvoidSpec& a : g.spec.avoid)
+        for (ObjectId& link : a.links) link = remap(link);
       g.instance = scene.instance_of(g.spec.tips.front().tip);
       groups_.push_back(std::move(g));
     }
@@ -170,6 +225,8 @@ class IkGroupsImpl final : public IkGroups {
       for (const IkTipSpec& t : g.spec.tips)
         remove |= gone(t.tip) || gone(t.target) || gone(t.base);
       for (const auto& [joint, weight] : g.spec.weights) remove |= gone(joint);
+      for (const IkAvoidSpec& a : g.spec.avoid)
+        for (ObjectId link : a.links) remove |= gone(link);
       if (remove) {
         g.alive = false;
         g.problem.reset();
@@ -187,7 +244,19 @@ class IkGroupsImpl final : public IkGroups {
   }
   const Group& At(int handle) const { return const_cast<IkGroupsImpl*>(this)->At(handle); }
 
-  static void Build(Group* g, const Scene& scene) {
+  // The collision module's geometry as of this step (built every world).
+  static const collision::Geometry* Geometry(World* world) {
+    auto* module =
+        world != nullptr
+            ? dynamic_cast<collision::CollisionModule*>(world->find_module(collision::kModuleName))
+            : nullptr;
+    return module != nullptr ? &module->Fresh(*world) : nullptr;
+  }
+
+  // The problem from the scene; `obstacles`: resolve the avoid entries'
+  // obstacle paths too (the world's objects exist).
+  static void Build(Group* g, const Scene& scene, bool obstacles) {
+    const std::string group = "IK group '" + g->spec.name + "'";
     IkProblem problem;
     g->base_slot.clear();
     g->fixed_target.clear();
@@ -196,8 +265,8 @@ class IkGroupsImpl final : public IkGroups {
       const ObjectId base_id = base >= 0 ? scene.IdAt(static_cast<uint32_t>(base)) : ObjectId{};
       Chain tip_chain = Chain::FromScene(scene, base_id, t.tip);
       if (tip_chain.dof() == 0)
-        throw Error("IK group '" + g->spec.name + "': no joint between '" + scene.PathOf(base_id) +
-                    "' and the tip '" + scene.PathOf(t.tip) + "'");
+        throw Error(group + ": no joint between '" + scene.PathOf(base_id) + "' and the tip '" +
+                    scene.PathOf(t.tip) + "'");
       const uint32_t target_slot = scene.SlotOf(t.target, "IK target");
       Chain target_chain;
       const bool below_base = base >= 0 && IsAncestor(scene, base, target_slot);
@@ -211,18 +280,103 @@ class IkGroupsImpl final : public IkGroups {
       }
       g->base_slot.push_back(base);
     }
+    // Avoidance links: chains from the first tip's base.
+    g->avoid_links.clear();
+    const int32_t base = g->base_slot.front();
+    const ObjectId base_id = base >= 0 ? scene.IdAt(static_cast<uint32_t>(base)) : ObjectId{};
+    for (size_t e = 0; e < g->spec.avoid.size(); ++e) {
+      const IkAvoidSpec& a = g->spec.avoid[e];
+      for (ObjectId link : a.links) {
+        const uint32_t slot = scene.SlotOf(link, "IK avoid link");
+        if (!IsAncestor(scene, base, slot))
+          throw Error(a.where + ": " + group + ": the link '" + scene.PathOf(link) +
+                      "' is not below the group's base '" + scene.PathOf(base_id) + "'");
+        problem.AddAvoidLink(Chain::FromScene(scene, base_id, link), a.distance);
+        g->avoid_links.push_back({slot, RigidBodyShapes(scene, slot), static_cast<int>(e)});
+      }
+    }
+    const auto slots = problem.joint_slots();
+    const auto column_of = [&](uint32_t slot) {
+      auto it = std::find(slots.begin(), slots.end(), slot);
+      return it == slots.end() ? -1 : static_cast<int>(it - slots.begin());
+    };
     for (const auto& [joint, weight] : g->spec.weights) {
       const uint32_t slot = scene.SlotOf(joint, "IK weight joint");
-      const auto slots = problem.joint_slots();
-      auto it = std::find(slots.begin(), slots.end(), slot);
-      if (it != slots.end()) problem.set_weight(static_cast<int>(it - slots.begin()), weight);
+      for (int c = 0; c < problem.dof(); ++c)
+        if (slots[c] == slot) problem.set_weight(c, weight);
     }
+    for (int c = 0; c < problem.dof(); ++c) {
+      const JointData& j = scene.joints()[scene.row_at(slots[c])];
+      // No dynamics backend drives a spherical joint to a target.
+      if (problem.is_ball(c) && g->spec.mode == IkMode::kJointTargets)
+        throw Error(group + ": the spherical joint '" + scene.PathOf(scene.IdAt(slots[c])) +
+                    "' can only be solved in direct mode (mode: targets sets target "
+                    "positions, and a spherical joint has none)");
+      // Dependent joints follow their master's column, or keep their value
+      // if it is not an unknown of the group (whatever their weight).
+      if (j.depends == nullptr || problem.is_ball_part(c)) continue;
+      double factor, offset;
+      const int master = column_of(RootMaster(scene, slots[c], &factor, &offset));
+      if (master >= 0 && !problem.is_ball_part(master))
+        problem.SetDependent(c, master, factor, offset);
+      else
+        problem.set_weight(c, 0);
+    }
+    if (obstacles) ResolveObstacles(g, scene);
     g->problem = std::move(problem);
     g->built_version = scene.structure_version();
   }
 
-  static IkStatus Solve(Group* g, Scene* scene) {
-    if (!g->problem || g->built_version != scene->structure_version()) Build(g, *scene);
+  static void ResolveObstacles(Group* g, const Scene& scene) {
+    g->obstacles.assign(g->spec.avoid.size(), {});
+    g->obstacle_slots.assign(g->spec.avoid.size(), {});
+    const ObjectId root = g->instance >= 0 ? scene.instance(g->instance).root : ObjectId{};
+    for (size_t e = 0; e < g->spec.avoid.size(); ++e) {
+      const IkAvoidSpec& a = g->spec.avoid[e];
+      const std::string what = a.where + ": IK group '" + g->spec.name + "', avoid";
+      const EntitySpec entity = ParseEntity(a.obstacle);
+      if (entity.kind == EntitySpec::kEverythingElse)
+        throw Error(what +
+                    ": 'everything_else' would include the arm itself: name a "
+                    "collection, an object or 'environment'");
+      if (entity.kind == EntitySpec::kPath)
+        g->obstacle_slots[e] = EntitySlots(scene, entity.path, root, what);
+      g->obstacles[e].kind = entity.kind;
+    }
+    g->obstacles_resolved = true;
+  }
+
+  // Each avoidance link's distance to its obstacle now (within 3 clearances).
+  static void MeasureClearances(Group* g, const Scene& scene, const collision::Geometry& geometry) {
+    IkProblem& problem = *g->problem;
+    for (size_t i = 0; i < g->avoid_links.size(); ++i) {
+      const Group::AvoidLink& link = g->avoid_links[i];
+      const IkAvoidSpec& a = g->spec.avoid[link.entry];
+      const std::vector<uint32_t> parts = geometry.ShapesOf(scene, link.parts);
+      const std::vector<uint32_t> obstacle =
+          geometry.ShapesOf(scene, g->obstacle_slots[link.entry]);
+      collision::Target target = g->obstacles[link.entry];
+      target.slots = obstacle;
+      IkClearance reading;
+      reading.X_WLink = scene.world_pose_at(link.slot);
+      if (!parts.empty() && (target.kind != EntitySpec::kPath || !obstacle.empty())) {
+        const collision::DistanceAnswer d = geometry.Distance(
+            parts, target, 3 * a.distance, collision::kNoSlot, collision::kNoSlot);
+        reading.near = d.found;
+        reading.distance = d.distance;
+        reading.p_WL = d.p1;
+        // Away from the obstacle; touching: from its point to the link's frame.
+        Vec3 n = d.p1 - d.p2;
+        if (!(d.distance > 1e-9) || n.Norm() < 1e-12) n = reading.X_WLink.p - d.p2;
+        reading.n_W = n.Norm() > 1e-12 ? n * (1 / n.Norm()) : Vec3{0, 0, 1};
+      }
+      problem.set_clearance(static_cast<int>(i), reading);
+    }
+  }
+
+  static IkStatus Solve(Group* g, Scene* scene, const collision::Geometry* geometry) {
+    if (!g->problem || g->built_version != scene->structure_version()) Build(g, *scene, true);
+    if (!g->obstacles_resolved) ResolveObstacles(g, *scene);
     IkProblem& problem = *g->problem;
     // Moving bases and targets as they are now.
     for (size_t e = 0; e < g->base_slot.size(); ++e) {
@@ -233,14 +387,24 @@ class IkGroupsImpl final : public IkGroups {
         problem.set_target(static_cast<int>(e),
                            scene->world_pose_at(static_cast<uint32_t>(g->fixed_target[e])));
     }
+    const int32_t b = g->base_slot.front();
+    for (int i = 0; i < problem.avoid_link_count(); ++i)
+      problem.set_avoid_base_pose(i,
+                                  b >= 0 ? scene->ChildFrameAt(static_cast<uint32_t>(b)) : Pose{});
+    if (geometry != nullptr) MeasureClearances(g, *scene, *geometry);
     // Joint-target mode solves from the last targets (the kinematic model the
-    // dynamics tracks), direct mode from the positions.
+    // dynamics tracks), direct mode from the positions; frozen joints keep theirs.
     const bool targets = g->spec.mode == IkMode::kJointTargets;
-    std::vector<double> q;
-    q.reserve(problem.dof());
-    for (uint32_t s : problem.joint_slots()) {
-      const JointData& j = scene->joints()[scene->row_at(s)];
-      q.push_back(targets ? j.target_position : j.position);
+    const auto slots = problem.joint_slots();
+    std::vector<double> q(slots.size(), 0.0);
+    std::vector<Quat> ball(slots.size());
+    for (size_t c = 0; c < slots.size(); ++c) {
+      const JointData& j = scene->joints()[scene->row_at(slots[c])];
+      problem.set_frozen(static_cast<int>(c), j.ik_frozen);
+      if (problem.is_ball_part(static_cast<int>(c)))
+        ball[c] = j.ball;
+      else
+        q[c] = targets ? j.target_position : j.position;
     }
     IkSettings settings;
     settings.damping = g->spec.damping;
@@ -249,13 +413,14 @@ class IkGroupsImpl final : public IkGroups {
     settings.orientation_tolerance = g->spec.orientation_tolerance;
     settings.max_step = g->spec.max_step;
     settings.apply_only_when_solved = g->spec.conditional;
-    const IkResult result = problem.Solve(settings, &q);
+    const IkResult result = problem.Solve(settings, &q, &ball);
     if (result.solved || !g->spec.conditional) {
-      const auto slots = problem.joint_slots();
-      for (size_t i = 0; i < slots.size(); ++i) {
-        JointData& j = scene->joints()[scene->row_at(slots[i])];
-        j.target_position = q[i];
-        if (!targets) j.position = q[i];
+      for (size_t c = 0; c < slots.size(); ++c) {
+        JointData& j = scene->joints()[scene->row_at(slots[c])];
+        if (problem.is_ball(static_cast<int>(c))) j.ball = ball[c];
+        if (problem.is_ball_part(static_cast<int>(c))) continue;
+        j.target_position = q[c];
+        if (!targets) j.position = q[c];
       }
     }
     g->last = result.solved ? IkStatus::kSolved : IkStatus::kFailed;
@@ -282,12 +447,16 @@ class IkGroupsImpl final : public IkGroups {
         scene_groups_.push_back(static_cast<int>(i) + 1);
     }
     by_instance_dirty_ = false;
+    any_avoid_ = std::any_of(groups_.begin(), groups_.end(),
+                             [](const Group& g) { return g.alive && !g.spec.avoid.empty(); });
   }
 
   std::vector<Group> groups_;
   std::vector<std::vector<int>> by_instance_;  // automatic group handles per robot
   std::vector<int> scene_groups_;
   bool by_instance_dirty_ = true;
+  bool any_avoid_ = false;  // a live group avoids obstacles
+  World* world_ = nullptr;  // since the first actuate phase (sim.handleIkGroup's geometry)
 };
 
 }  // namespace

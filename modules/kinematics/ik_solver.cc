@@ -11,7 +11,7 @@ namespace swarmsim::kinematics {
 
 namespace {
 
-constexpr int kMaxRows = 6 * kMaxIkElements;
+constexpr int kMaxRows = 6 * kMaxIkElements + kMaxIkAvoidLinks;
 using Jacobian = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxRows, kMaxIkDof>;
 using Square = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxRows, kMaxRows>;
 using RowVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxRows, 1>;
@@ -26,19 +26,36 @@ Vec3 RotationVector(Quat q) {
   return v * (2 * std::atan2(s, q.w) / s);
 }
 
+// The rotation of rotation vector v.
+Quat FromRotationVector(const Vec3& v) {
+  const double angle = v.Norm();
+  if (angle < 1e-300) return {};
+  return Quat::FromAxisAngle(v, angle);
+}
+
 }  // namespace
 
 int IkProblem::AddColumn(const ChainJoint& j) {
   auto it = std::find(slots_.begin(), slots_.end(), j.slot);
   if (it != slots_.end()) return static_cast<int>(it - slots_.begin());
-  if (slots_.size() >= kMaxIkDof)
-    throw Error("an IK group has at most " + std::to_string(kMaxIkDof) + " joints");
-  slots_.push_back(j.slot);
-  weights_.push_back(1.0);
-  min_.push_back(j.min_position);
-  max_.push_back(j.max_position);
-  prismatic_.push_back(j.prismatic);
-  return static_cast<int>(slots_.size()) - 1;
+  const bool ball = j.kind == ChainJointKind::kSpherical;
+  if (slots_.size() + (ball ? 3 : 1) > kMaxIkDof)
+    throw Error("an IK group has at most " + std::to_string(kMaxIkDof) +
+                " unknowns (a spherical joint counts 3)");
+  const int first = static_cast<int>(slots_.size());
+  for (int k = 0; k < (ball ? 3 : 1); ++k) {
+    slots_.push_back(j.slot);
+    weights_.push_back(1.0);
+    min_.push_back(ball ? -INFINITY : j.min_position);
+    max_.push_back(ball ? INFINITY : j.max_position);
+    kind_.push_back(static_cast<uint8_t>(ball ? kBallX + k : kOne));
+    frozen_.push_back(0);
+    master_.push_back(-1);
+    factor_.push_back(1);
+    offset_.push_back(0);
+    ball0_.push_back(j.ball);
+  }
+  return first;
 }
 
 int IkProblem::AddElement(Chain chain, const Pose& X_WTarget, uint8_t constraints) {
@@ -62,6 +79,26 @@ int IkProblem::AddClosedElement(Chain tip_chain, Chain target_chain, uint8_t con
   return index;
 }
 
+int IkProblem::AddAvoidLink(Chain link_chain, double clearance) {
+  if (avoid_.size() >= kMaxIkAvoidLinks)
+    throw Error("an IK group avoids obstacles with at most " + std::to_string(kMaxIkAvoidLinks) +
+                " links");
+  AvoidLink a;
+  a.chain = std::move(link_chain);
+  a.clearance = clearance;
+  for (const ChainJoint& j : a.chain.joints()) a.columns.push_back(AddColumn(j));
+  avoid_.push_back(std::move(a));
+  return static_cast<int>(avoid_.size()) - 1;
+}
+
+void IkProblem::SetDependent(int column, int master, double factor, double offset) {
+  SWARMSIM_CHECK(kind_.at(column) == kOne && kind_.at(master) == kOne && master_[master] < 0,
+                 "IK: a dependent column follows a one-column independent master");
+  master_[column] = master;
+  factor_[column] = factor;
+  offset_[column] = offset;
+}
+
 void IkProblem::set_base_pose(int element, const Pose& X_WBase) {
   Element& e = elements_.at(element);
   e.chain.set_X_WBase(X_WBase);
@@ -70,44 +107,103 @@ void IkProblem::set_base_pose(int element, const Pose& X_WBase) {
 
 std::vector<double> IkProblem::ReadPositions(const Scene& scene) const {
   std::vector<double> q;
-  for (uint32_t s : slots_) q.push_back(scene.joints()[scene.row_at(s)].position);
+  for (size_t c = 0; c < slots_.size(); ++c)
+    q.push_back(kind_[c] == kOne ? scene.joints()[scene.row_at(slots_[c])].position : 0.0);
   return q;
 }
 
 void IkProblem::WritePositions(std::span<const double> q, Scene* scene) const {
-  for (size_t i = 0; i < slots_.size(); ++i)
-    scene->joints()[scene->row_at(slots_[i])].position = q[i];
+  for (size_t c = 0; c < slots_.size(); ++c)
+    if (kind_[c] == kOne) scene->joints()[scene->row_at(slots_[c])].position = q[c];
 }
 
-IkResult IkProblem::Solve(const IkSettings& settings, std::vector<double>* q_io) const {
+IkResult IkProblem::Solve(const IkSettings& settings, std::vector<double>* q_io,
+                          std::vector<Quat>* ball_io) const {
   const int n = dof();
   SWARMSIM_CHECK(static_cast<int>(q_io->size()) == n, "IK: q has the wrong size");
-  int rows = 0;
+  SWARMSIM_CHECK(ball_io == nullptr || static_cast<int>(ball_io->size()) == n,
+                 "IK: ball has the wrong size");
+  int target_rows = 0;
   for (const Element& e : elements_)
-    rows += std::popcount(static_cast<unsigned>(e.constraints & kPose));
+    target_rows += std::popcount(static_cast<unsigned>(e.constraints & kPose));
   std::vector<double> q = *q_io;
+  std::vector<Quat> ball = ball_io != nullptr ? *ball_io : ball0_;
+  // Dependent columns start on their formula.
+  for (int c = 0; c < n; ++c)
+    if (master_[c] >= 0) q[c] = offset_[c] + factor_[c] * q[master_[c]];
   std::vector<double> q_chain;
+  std::vector<Quat> ball_chain;
   Pose X_WJ[kMaxIkDof], X_WJt[kMaxIkDof];
-  Jacobian J(rows, n);
-  RowVector err(rows);
+  // Each avoidance link's witness point in the link frame.
+  Vec3 p_L[kMaxIkAvoidLinks];
+  for (size_t a = 0; a < avoid_.size(); ++a)
+    p_L[a] = avoid_[a].reading.X_WLink.Inverse() * avoid_[a].reading.p_WL;
+  Jacobian J(target_rows + static_cast<int>(avoid_.size()), n);
+  RowVector err(target_rows + static_cast<int>(avoid_.size()));
   IkResult result;
   const double lambda2 = settings.damping * settings.damping;
+
+  // The chain's joint values (q per joint, balls) from the columns.
+  const auto chain_values = [&](const Chain& chain, const std::vector<int>& columns) {
+    const int m = chain.dof();
+    q_chain.resize(m);
+    ball_chain.resize(m);
+    for (int i = 0; i < m; ++i) {
+      q_chain[i] = q[columns[i]];
+      ball_chain[i] = ball[columns[i]];
+    }
+  };
+  // Adds sign * d(point, rotation)/dq of the chain's joints to out's rows
+  // from `row` (the constraint subset `bits`); a dependent joint's column
+  // folds into its master's.
+  const auto add_columns = [&](const Chain& chain, const std::vector<int>& columns,
+                               const Pose* X_WJs, const Vec3& p_W, const Quat& q_TW, uint8_t bits,
+                               int row, double sign, Jacobian* out) {
+    for (int i = 0; i < chain.dof(); ++i) {
+      const ChainJoint& joint = chain.joints()[i];
+      const Vec3 r = p_W - X_WJs[i].p;
+      int column = columns[i];
+      double scale = sign;
+      if (master_[column] >= 0) {
+        scale *= factor_[column];
+        column = master_[column];
+      }
+      const bool ball = joint.kind == ChainJointKind::kSpherical;
+      for (int k = ball ? 0 : 2; k < 3; ++k) {
+        // Revolute, prismatic, screw: about/along z; spherical: x, y and z.
+        const Vec3 a =
+            X_WJs[i].q.Rotate({k == 0 ? 1.0 : 0.0, k == 1 ? 1.0 : 0.0, k == 2 ? 1.0 : 0.0});
+        Vec3 v = a.Cross(r), w = q_TW.Rotate(a);
+        if (joint.kind == ChainJointKind::kPrismatic) {
+          v = a;
+          w = {};
+        } else if (joint.kind == ChainJointKind::kScrew) {
+          v = v + a * joint.pitch;
+        }
+        const double vv[3] = {v.x, v.y, v.z}, ww[3] = {w.x, w.y, w.z};
+        const int c = column + (ball ? k : 0);
+        int rr = row;
+        for (int d = 0; d < 3; ++d)
+          if (bits & (kX << d)) (*out)(rr++, c) += scale * vv[d];
+        for (int d = 0; d < 3; ++d)
+          if (bits & (kAlpha << d)) (*out)(rr++, c) += scale * ww[d];
+      }
+    }
+  };
+  Jacobian J_point(3, n);
+
   for (int iteration = 0;; ++iteration) {
     // Errors and Jacobian rows, element by element.
     J.setZero();
     int r = 0;
     double worst_p = 0, worst_o = 0;
     for (const Element& e : elements_) {
-      const int m = e.chain.dof();
-      q_chain.resize(m);
-      for (int i = 0; i < m; ++i) q_chain[i] = q[e.columns[i]];
-      const Pose X_WTip = e.chain.CalcTipPose(q_chain, X_WJ);
+      chain_values(e.chain, e.columns);
+      const Pose X_WTip = e.chain.CalcTipPose(q_chain, ball_chain, X_WJ);
       Pose X_WTarget = e.X_WTarget;
       if (e.closed) {
-        const int mt = e.target_chain.dof();
-        q_chain.resize(mt);
-        for (int i = 0; i < mt; ++i) q_chain[i] = q[e.target_columns[i]];
-        X_WTarget = e.target_chain.CalcTipPose(q_chain, X_WJt);
+        chain_values(e.target_chain, e.target_columns);
+        X_WTarget = e.target_chain.CalcTipPose(q_chain, ball_chain, X_WJt);
       }
       const Vec3 e_p = X_WTarget.p - X_WTip.p;
       const Quat q_TW = X_WTarget.q.Conjugate();
@@ -121,60 +217,79 @@ IkResult IkProblem::Solve(const IkSettings& settings, std::vector<double>* q_io)
       }
       worst_p = std::max(worst_p, std::sqrt(norm_p));
       worst_o = std::max(worst_o, std::sqrt(norm_o));
-      // Columns: revolute a x (p_tip - p_joint) and a; prismatic a and 0.
-      for (int i = 0; i < m; ++i) {
-        const Vec3 a = X_WJ[i].q.Rotate({0, 0, 1});
-        const bool prismatic = prismatic_[e.columns[i]] != 0;
-        const Vec3 v = prismatic ? a : a.Cross(X_WTip.p - X_WJ[i].p);
-        const Vec3 w = prismatic ? Vec3{} : q_TW.Rotate(a);
-        const double vv[3] = {v.x, v.y, v.z}, ww[3] = {w.x, w.y, w.z};
-        int row = r;
-        for (int k = 0; k < 3; ++k)
-          if (e.constraints & (kX << k)) J(row++, e.columns[i]) += vv[k];
-        for (int k = 0; k < 3; ++k)
-          if (e.constraints & (kAlpha << k)) J(row++, e.columns[i]) += ww[k];
-      }
+      // Columns: revolute a x (p_tip - p_joint) and a; prismatic a and 0;
+      // screw a x (p_tip - p_joint) + pitch a and a; spherical: the same
+      // as revolute about each axis of its frame.
+      add_columns(e.chain, e.columns, X_WJ, X_WTip.p, q_TW, e.constraints, r, 1.0, &J);
       // Closed chain: the target's joints move the target, so they enter
       // with the opposite sign (the error is target - tip).
-      for (int i = 0; e.closed && i < e.target_chain.dof(); ++i) {
-        const Vec3 a = X_WJt[i].q.Rotate({0, 0, 1});
-        const bool prismatic = prismatic_[e.target_columns[i]] != 0;
-        const Vec3 v = prismatic ? a : a.Cross(X_WTarget.p - X_WJt[i].p);
-        const Vec3 w = prismatic ? Vec3{} : q_TW.Rotate(a);
-        const double vv[3] = {v.x, v.y, v.z}, ww[3] = {w.x, w.y, w.z};
-        int row = r;
-        for (int k = 0; k < 3; ++k)
-          if (e.constraints & (kX << k)) J(row++, e.target_columns[i]) -= vv[k];
-        for (int k = 0; k < 3; ++k)
-          if (e.constraints & (kAlpha << k)) J(row++, e.target_columns[i]) -= ww[k];
-      }
+      if (e.closed)
+        add_columns(e.target_chain, e.target_columns, X_WJt, X_WTarget.p, q_TW, e.constraints, r,
+                    -1.0, &J);
       for (int k = 0; k < 3; ++k)
         if (e.constraints & (kX << k)) err(r++) = ep[k];
       for (int k = 0; k < 3; ++k)
         if (e.constraints & (kAlpha << k)) err(r++) = eo[k];
     }
+    // Avoidance rows, while a link's estimated distance is below its clearance.
+    bool clear = true;
+    for (size_t a = 0; a < avoid_.size(); ++a) {
+      const AvoidLink& link = avoid_[a];
+      if (!link.reading.near) continue;
+      chain_values(link.chain, link.columns);
+      const Pose X_WLink = link.chain.CalcTipPose(q_chain, ball_chain, X_WJ);
+      const Vec3 p = X_WLink * p_L[a];
+      const Vec3& nrm = link.reading.n_W;
+      const double estimate = link.reading.distance + nrm.Dot(p - link.reading.p_WL);
+      if (estimate >= link.clearance) continue;
+      clear &= estimate >= link.clearance - settings.position_tolerance;
+      // n^T dp/dq: the x, y, z rows of the point, projected on n.
+      J_point.setZero();
+      add_columns(link.chain, link.columns, X_WJ, p, Quat{}, kPosition, 0, 1.0, &J_point);
+      J.row(r) = nrm.x * J_point.row(0) + nrm.y * J_point.row(1) + nrm.z * J_point.row(2);
+      err(r++) = link.clearance - estimate;
+    }
     result.iterations = iteration;
     result.position_error = worst_p;
     result.orientation_error = worst_o;
-    if (worst_p <= settings.position_tolerance && worst_o <= settings.orientation_tolerance) {
+    if (worst_p <= settings.position_tolerance && worst_o <= settings.orientation_tolerance &&
+        clear) {
       result.solved = true;
       break;
     }
     if (iteration >= settings.max_iterations) break;
-    // Damped least squares step, weighted, clamped.
+    // Damped least squares step, weighted (frozen and dependent columns:
+    // 0), clamped.
     ColVector weights(n);
-    for (int i = 0; i < n; ++i) weights(i) = weights_[i];
-    const Jacobian JW = J * weights.asDiagonal();
-    Square A = JW * J.transpose();
+    for (int c = 0; c < n; ++c) weights(c) = frozen_[c] || master_[c] >= 0 ? 0.0 : weights_[c];
+    const Jacobian Jr = J.topRows(r);  // the target rows and the active avoidance rows
+    const RowVector er = err.head(r);
+    const Jacobian JW = Jr * weights.asDiagonal();
+    Square A = JW * Jr.transpose();
     A.diagonal().array() += lambda2;
-    const RowVector y = A.ldlt().solve(err);
+    const RowVector y = A.ldlt().solve(er);
     const ColVector dq = JW.transpose() * y;
-    for (int i = 0; i < n; ++i) {
-      const double step = std::clamp(dq(i), -settings.max_step, settings.max_step);
-      q[i] = std::clamp(q[i] + step, min_[i], max_[i]);
+    for (int c = 0; c < n; ++c) {
+      if (weights(c) == 0 && kind_[c] == kOne) continue;  // keeps its value (and limits)
+      if (kind_[c] == kBallX) {
+        if (weights(c) == 0) continue;  // frozen
+        const Vec3 step{std::clamp(dq(c), -settings.max_step, settings.max_step),
+                        std::clamp(dq(c + 1), -settings.max_step, settings.max_step),
+                        std::clamp(dq(c + 2), -settings.max_step, settings.max_step)};
+        ball[c] = (FromRotationVector(step) * ball[c]).Normalized();
+        continue;
+      }
+      if (kind_[c] != kOne) continue;
+      const double step = std::clamp(dq(c), -settings.max_step, settings.max_step);
+      q[c] = std::clamp(q[c] + step, min_[c], max_[c]);
     }
+    for (int c = 0; c < n; ++c)
+      if (master_[c] >= 0) q[c] = offset_[c] + factor_[c] * q[master_[c]];
   }
-  if (result.solved || !settings.apply_only_when_solved) *q_io = q;
+  if (result.solved || !settings.apply_only_when_solved) {
+    *q_io = q;
+    if (ball_io != nullptr) *ball_io = ball;
+  }
   return result;
 }
 

@@ -47,7 +47,7 @@ std::vector<IkGroupDef> ReadIkGroups(const ModelFile& model, const ValueReader& 
   for (const Field& element : ListElements(model.file, model.ik_groups, "IK groups")) {
     Fields f(model.file, element, "an IK group of model '" + model.name + "'");
     f.Expect({"name", "tips", "mode", "damping", "iterations", "tolerance", "orientation_tolerance",
-              "max_step", "conditional", "automatic", "weights"});
+              "max_step", "conditional", "automatic", "weights", "avoid"});
     IkGroupDef def;
     def.field = element;
     IkGroupSpec& s = def.spec;
@@ -88,6 +88,22 @@ std::vector<IkGroupDef> ReadIkGroups(const ModelFile& model, const ValueReader& 
         // the path over the weight in the parsed file (yaml.h).
         const Field path(joint.name, YAML::Node(joint.name), joint.key_mark, joint.key_mark);
         def.weights.emplace_back(path, values.Number(joint, kNonNegative));
+      }
+    }
+    if (f.Has("avoid")) {
+      // avoid: [{links: [paths], collection: PATH | environment, distance: m}]
+      for (const Field& e : ListElements(model.file, f.Get("avoid"), "avoid")) {
+        Fields af(model.file, e, "an avoid entry of IK group '" + s.name + "'");
+        af.Expect({"links", "collection", "distance"});
+        IkAvoidDef avoid;
+        const Field links = af.Require("links");
+        avoid.links = ListElements(model.file, links, "links");
+        if (avoid.links.empty()) values.Fail(links, "'links' needs at least one link path");
+        const Field obstacle = af.Require("collection");
+        avoid.spec.obstacle = values.String(obstacle);
+        avoid.spec.where = model.file.Where(obstacle.mark);
+        if (af.Has("distance")) avoid.spec.distance = values.Number(af.Get("distance"), kPositive);
+        def.avoid.push_back(std::move(avoid));
       }
     }
     out.push_back(std::move(def));
@@ -139,6 +155,11 @@ void AddIkGroups(const ModelFile& model, const std::vector<IkGroupDef>& groups,
       if (scene.type(joint) != ObjectType::kJoint)
         model.file.Fail(field.mark, "'" + field.node.Scalar() + "' is not a joint");
       s.weights.emplace_back(joint, weight);
+    }
+    for (const IkAvoidDef& avoid : def.avoid) {
+      IkAvoidSpec a = avoid.spec;
+      for (const Field& link : avoid.links) a.links.push_back(resolve(link, "links"));
+      s.avoid.push_back(std::move(a));
     }
     try {
       module->AddGroup(scene, std::move(s));

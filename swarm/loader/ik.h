@@ -21,11 +21,17 @@ struct IkTipDef {
   uint8_t constraints = kIkPosition;
 };
 
+struct IkAvoidDef {
+  std::vector<Field> links;  // object paths in the model
+  IkAvoidSpec spec;          // obstacle, distance, where
+};
+
 struct IkGroupDef {
   Field field;       // the group's mapping, for messages
   IkGroupSpec spec;  // settings; objects filled in by AddIkGroups
   std::vector<IkTipDef> tips;
   std::vector<std::pair<Field, double>> weights;  // joint path, weight
+  std::vector<IkAvoidDef> avoid;
 };
 
 std::vector<IkGroupDef> ReadIkGroups(const ModelFile& model, const ValueReader& values);

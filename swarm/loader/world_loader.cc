@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "framework/error.h"
+#include "framework/ik_groups.h"
 #include "framework/object_type.h"
 #include "framework/plugin_loader.h"
 #include "framework/registry.h"
@@ -117,6 +118,9 @@ LoadedWorld WorldLoader::Load() {
            f, top.Get("objects"), WorldValues(), &scripts_, &meshes_, world_registry_))
     loader::AddToScene(spec, {}, &world->scene());
   CheckObjects(world->scene());
+  // IK groups' obstacles (avoid entries) may name those objects too.
+  if (auto* ik = dynamic_cast<IkGroups*>(world->find_calculation(kIkModuleName)))
+    ik->CheckReferences(world->scene());
   out.metrics = ReadMetrics(top, world);
   out.models = Summarize();
   loader::AddPaintLayer(f, root, top.Get("paint"), WorldValues(), arena_, world);
