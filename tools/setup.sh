@@ -11,6 +11,7 @@ packages=(
   gnuplot-nox libopenmpi-dev openmpi-bin
   libpng-dev libassimp-dev liburdfdom-dev libtinyxml2-dev
   libavcodec-dev libavformat-dev libavutil-dev libswscale-dev
+  pybind11-dev python3-dev python3-numpy
 )
 
 missing=()

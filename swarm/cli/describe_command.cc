@@ -41,6 +41,10 @@ void PrintDescription(const LoadedWorld& w, std::ostream& out) {
     out << "\n";
     for (const std::string& line : m.imported) out << "  " << line << "\n";
     for (const std::string& script : m.scripts) out << "  script: " << script << "\n";
+    if (!m.python.file.empty())
+      out << "  python controller: " << m.python.file.string() << ":" << m.python.function
+          << (m.python.keep_scripts ? " (beside the Lua scripts)" : " (instead of the Lua scripts)")
+          << "\n";
     if (m.ik_groups > 0) out << "  module: ik (" << m.ik_groups << " IK groups)\n";
     if (m.parameters.empty()) out << "  parameters: none\n";
     for (const ParameterSummary& p : m.parameters) {

@@ -2,6 +2,7 @@
 // (its model's parameters, its copies' own values, its objects, its
 // placement), then the entries are placed together and their copies built.
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <map>
 #include <optional>
@@ -85,6 +86,68 @@ void WorldLoader::ResolveEntry(EntryPlan* entry) {
   ReadOwnCopies(f, world_values, &declared, entry);
   ResolveObjects(f, world_values, entry);
   ResolvePlacement(f, world_values, entry);
+  ResolvePythonController(f, world_values, entry);
+}
+
+namespace {
+void DropScripts(ObjectSpec* spec) {
+  spec->script = nullptr;
+  spec->script_explicit = false;
+  for (ObjectSpec& child : spec->children) DropScripts(&child);
+}
+}  // namespace
+
+// python_controller: FILE.py, FILE.py:function, or {file, function, keep_scripts}.
+void WorldLoader::ResolvePythonController(const Fields& f, const ValueReader& world_values,
+                                          EntryPlan* entry) {
+  if (!f.Has("python_controller")) return;
+  Field file_field = f.Get("python_controller");
+  PythonController& python = entry->python;
+  python.where = file_->Where(file_field.key_mark);
+  if (file_field.node.IsMap()) {
+    Fields p(*file_, file_field, "'python_controller'");
+    p.Expect({"file", "function", "keep_scripts"});
+    if (p.Has("function")) python.function = world_values.String(p.Get("function"));
+    if (p.Has("keep_scripts")) python.keep_scripts = world_values.Bool(p.Get("keep_scripts"));
+    file_field = p.Require("file");
+  }
+  std::string text = world_values.String(file_field);
+  if (!file_field.node.IsMap()) {
+    const size_t colon = text.rfind(':');
+    if (colon != std::string::npos && colon > 0) {
+      python.function = text.substr(colon + 1);
+      text.resize(colon);
+    }
+  }
+  const auto identifier = [](const std::string& name) {
+    if (name.empty() || std::isdigit(static_cast<unsigned char>(name[0]))) return false;
+    return std::all_of(name.begin(), name.end(), [](char c) {
+      return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
+    });
+  };
+  if (!identifier(python.function))
+    file_->Fail(file_field.mark, "'python_controller' names a Python function: '" +
+                                     python.function + "' is not an identifier");
+  if (text.size() < 4 || text.substr(text.size() - 3) != ".py")
+    file_->Fail(
+        file_field.mark,
+        "'python_controller' is a Python file (FILE.py or FILE.py:function), got '" + text + "'");
+  const std::filesystem::path path = file_->path().parent_path() / text;
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec))
+    file_->Fail(file_field.mark, "'python_controller': no file " + path.string());
+  python.file = std::filesystem::absolute(path, ec).lexically_normal();
+  if (!options_.python_controllers)
+    file_->Fail(f.Get("python_controller").key_mark,
+                "model '" + entry->model->name +
+                    "' has a Python controller: run this world from Python "
+                    "(PYTHONPATH=build/python /usr/bin/python3 -m swarmsim run " +
+                    path_.string() + ", README.md 'Python')");
+  if (!python.keep_scripts) {
+    DropScripts(&entry->spec);
+    for (EntryPlan::OwnCopy& own : entry->own_copies)
+      if (own.spec) DropScripts(&*own.spec);
+  }
 }
 
 // Model parameters: declared defaults, then this entry's values, then --set.
@@ -509,6 +572,7 @@ std::vector<ModelSummary> WorldLoader::Summarize() const {
       m.file = e.model->imported_file;
       m.imported = e.model->import_summary;
     }
+    m.python = e.python;
     out.push_back(std::move(m));
   }
   return out;

@@ -41,6 +41,19 @@ struct LoadOptions {
   // --package-path: folders searched for the ROS packages a URDF model's
   // package:// URIs name, after the world's own `package_path`.
   std::vector<std::filesystem::path> package_path;
+  // Whether the caller runs `python_controller:` entries (swarm/python does;
+  // the program does not, and a world naming one is an error there).
+  bool python_controllers = false;
+};
+
+// A models entry's `python_controller:` (swarm/python runs it; the program
+// cannot): a function called once per step with the arrays of all the
+// entry's robots.
+struct PythonController {
+  std::filesystem::path file;  // absolute; empty: the entry has none
+  std::string function = "control";
+  bool keep_scripts = false;  // false: the model's Lua scripts are dropped
+  std::string where;          // "file:line:column" of the key, for messages
 };
 
 // What `swarmsim describe` lists about one `models:` entry.
@@ -59,6 +72,7 @@ struct ModelSummary {
   double scale = 1;  // `scale:` of the entry
   int ik_groups = 0;
   std::vector<std::string> imported;  // a URDF model: what was imported (links, joints, meshes)
+  PythonController python;            // python_controller:, if any
 };
 
 struct LoadedWorld {

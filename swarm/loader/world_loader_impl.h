@@ -27,9 +27,13 @@ namespace swarmsim::loader {
 
 inline constexpr int64_t kMaxCount = 1000000;  // copies per models entry
 
-inline const std::vector<std::string> kEntryKeys = {
-    "model",     "count", "distribute", "position", "heading_deg", "orientation_deg", "parameters",
-    "instances", "scale", "base",       "objects",  "scripts",     "ik_groups"};
+inline const std::vector<std::string> kEntryKeys = {"model",       "count",
+                                                    "distribute",  "position",
+                                                    "heading_deg", "orientation_deg",
+                                                    "parameters",  "instances",
+                                                    "scale",       "base",
+                                                    "objects",     "scripts",
+                                                    "ik_groups",   "python_controller"};
 
 // One --set, split into its target.
 struct Override {
@@ -68,6 +72,7 @@ struct EntryPlan {
   // The entry's own `ik_groups` (read in the world file, through `entry_model`).
   std::shared_ptr<ModelFile> entry_model;
   std::vector<loader::IkGroupDef> entry_ik_groups;
+  PythonController python;  // python_controller: (file empty: none)
   // instances: [{index, parameters}]: copies with their own values, in file order.
   struct OwnCopy {
     int64_t index = 0;
@@ -147,6 +152,7 @@ class WorldLoader {
                      ObjectSpec* spec);
   void ReadPackagePath(const Fields& top);
   void ResolvePlacement(const Fields& f, const ValueReader& world_values, EntryPlan* entry);
+  void ResolvePythonController(const Fields& f, const ValueReader& world_values, EntryPlan* entry);
   void ReadDistribution(const Fields& f, const ValueReader& world_values, EntryPlan* entry);
   void ReadSinglePosition(const Fields& f, const ValueReader& world_values, EntryPlan* entry);
   void KeepPlacementClearOfTheMap();

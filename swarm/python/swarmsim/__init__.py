@@ -1,0 +1,22 @@
+"""swarmsim from Python: load a world file, step it, read and drive the swarm with numpy.
+
+    import swarmsim
+    w = swarmsim.World("worlds/diffusion.yaml", seed=7, set={"robots": 200}, threads=2)
+    w.step(100)
+    xy_yaw = w.poses()          # (N, 3) for planar worlds, (N, 7) x y z qw qx qy qz in 3D
+    print(w.time, w.state_hash(), w.metrics)
+
+A models entry may name a Python controller (``python_controller: FILE.py:function``)
+or one may be given here (``World(..., controllers={"footbot": fn})``): it is called
+once per step with a :class:`Robots` holding the arrays of all the model's robots and
+returns ``{joint name: array of one target per robot}``. See README.md, "Python".
+
+Errors: a world that does not load raises ValueError with the message the command
+line prints (file:line:column); a script or controller error while stepping raises
+RuntimeError (with the controller's traceback) and the world cannot be stepped again.
+Every array is a copy (pass ``out=`` to reuse one).
+"""
+
+from ._swarmsim import Robots, World
+
+__all__ = ["World", "Robots"]
