@@ -14,6 +14,7 @@
 // streams. DuplicateSubtree copies rows, not assets (script sources are shared).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -56,7 +57,13 @@ struct ShapeData {
                              // height); sphere: (radius, -, -)
   bool dynamic = false;      // simulated by the dynamics backend, else static or kinematic
   double mass = 1.0;         // kg, dynamic shapes only
-  double friction = 0.7;     // Coulomb coefficient
+  // Inertia about the shape's origin in its frame, kg m^2: (ixx, iyy, izz,
+  // ixy, ixz, iyz); all zero: the dynamics backend derives it from the geometry.
+  std::array<double, 6> inertia{};
+  // false: no contacts in the dynamics backends (a URDF visual, a body's
+  // mass carrier); sensors still see it.
+  bool collidable = true;
+  double friction = 0.7;  // Coulomb coefficient
   double restitution = 0.0;
   Vec3 color{0.7, 0.7, 0.7};  // RGB in [0, 1]
   // kMesh: drawn in the mesh file's material colours, if it has any, until
@@ -67,6 +74,10 @@ struct ShapeData {
   // Radius of the shape's footprint circle in its xy plane (for broad phases).
   double BoundingRadius() const;
 };
+
+// Whether (ixx, iyy, izz, ixy, ixz, iyz) is a rigid body's inertia: finite,
+// positive definite, each principal moment at most the sum of the others.
+bool InertiaIsValid(const std::array<double, 6>& inertia);
 
 enum class JointType : uint8_t { kRevolute, kPrismatic, kSpherical, kFixed, kScrew };
 // kForce: the joint applies target_force (N or N m) and moves only if a
@@ -102,6 +113,7 @@ struct JointData {
   double max_force = 10;            // N or N m
   double max_velocity = 10;         // rad/s or m/s, position mode
   double target_force = 0;          // N or N m, force mode
+  double damping = 0;               // N m s/rad or N s/m: viscous -damping * velocity (ode)
   double min_position = -INFINITY;  // limits, rad or m (infinite: unlimited)
   double max_position = INFINITY;
   Quat ball;                                       // spherical joints: rotation of the children

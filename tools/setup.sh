@@ -9,7 +9,7 @@ packages=(
   libosmesa6-dev libyaml-cpp-dev libeigen3-dev libsqlite3-dev libxxhash-dev nlohmann-json3-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   gnuplot-nox libopenmpi-dev openmpi-bin
-  libpng-dev libassimp-dev
+  libpng-dev libassimp-dev liburdfdom-dev libtinyxml2-dev
   libavcodec-dev libavformat-dev libavutil-dev libswscale-dev
   pybind11-dev python3-dev python3-numpy
 )

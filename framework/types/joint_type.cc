@@ -30,6 +30,8 @@ constexpr ObjectKey kKeys[] = {
     {"target_position", "0", "rad or m, initial target"},
     {"initial_position", "0", "rad or m, the joint's position at the start"},
     {"target_force", "0", "N or N m, force mode"},
+    {"damping", "0",
+     "N m s/rad or N s/m, >= 0: a viscous torque or force -damping * velocity (ode)"},
     {"limits", "none", "[min, max], rad or m: ODE stops, and IK keeps solutions inside"},
     {"master", "none", "path of the joint this one follows: q = offset + factor * q_master"},
     {"factor", "1", "dependent joints: factor of the master's position"},
@@ -52,10 +54,12 @@ void Scale(const ObjectTypeDescriptor&, void* row, double s, ScaleContext*) {
       *v *= s;
     j.max_force *= s3;
     j.target_force *= s3;
+    j.damping *= s * s;  // N s/m
   } else {
     if (j.type == JointType::kScrew) j.pitch *= s;  // m per rad
     j.max_force *= s4;
     j.target_force *= s4;
+    j.damping *= s4;  // N m s/rad
   }
   // A prismatic joint's offset is a length (the factor's units depend on
   // the master's kind and stay as they are).
@@ -123,6 +127,7 @@ void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
   }
   if (r.Has("ik")) j.ik_frozen = r.Choice("ik", {"active", "frozen"}) == "frozen";
   if (r.Has("target_force")) j.target_force = r.Number("target_force", kAnyNumber);
+  if (r.Has("damping")) j.damping = r.Number("damping", kNonNegative);
   if (r.Has("limits")) {
     // [min, max] in rad or m, like initial_position.
     const std::vector<double> v = r.Numbers("limits", 2, 2, kAnyNumber);

@@ -1,5 +1,7 @@
 // shape: a rigid body's geometry (box, cylinder, sphere, capsule, triangle
 // mesh), static, moved with its parent, or simulated by the dynamics backend.
+#include <cmath>
+
 #include "framework/mesh.h"
 #include "framework/object_type.h"
 #include "framework/scene.h"
@@ -18,10 +20,13 @@ constexpr ObjectKey kKeys[] = {
     {"dynamic", "false",
      "simulated by the physics backend; otherwise static or moved with its parent"},
     {"mass", "1", "kg (dynamic shapes)"},
+    {"inertia", "from the geometry",
+     "[ixx, iyy, izz, ixy, ixz, iyz] kg m^2 about the shape's origin (dynamic shapes, ode)"},
+    {"collidable", "true", "false: no contacts in the physics backends (sensors still see it)"},
     {"friction", "0.7", "Coulomb coefficient, >= 0"},
     {"restitution", "0", "0..1"},
     {"color", "[0.7, 0.7, 0.7]", "RGB, each 0..1"},
-    {"file", "mesh: required", "STL or OBJ file, relative to the file naming it; metres"},
+    {"file", "mesh: required", "STL, OBJ or COLLADA file, relative to the file naming it; metres"},
     {"scale", "mesh: [1, 1, 1]",
      "[sx, sy, sz], positive factors applied to the file's coordinates"},
 };
@@ -36,6 +41,7 @@ void Scale(const ObjectTypeDescriptor&, void* row, double s, ScaleContext* conte
   ShapeData& shape = *static_cast<ShapeData*>(row);
   shape.size = shape.size * s;
   shape.mass *= s * s * s;
+  for (double& i : shape.inertia) i *= s * s * s * s * s;
   if (!shape.mesh) return;
   std::shared_ptr<const void>& scaled = context->assets[shape.mesh.get()];
   if (!scaled) {
@@ -96,6 +102,15 @@ void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
   }
   if (r.Has("dynamic")) s.dynamic = r.Bool("dynamic");
   if (r.Has("mass")) s.mass = r.Number("mass", kPositive);
+  if (r.Has("inertia")) {
+    const std::vector<double> i = r.Numbers("inertia", 6, 6, kAnyNumber);
+    if (!InertiaIsValid({i[0], i[1], i[2], i[3], i[4], i[5]}))
+      r.Fail("inertia",
+             "'inertia' [ixx, iyy, izz, ixy, ixz, iyz] must be positive definite, each principal "
+             "moment at most the sum of the other two");
+    std::copy(i.begin(), i.end(), s.inertia.begin());
+  }
+  if (r.Has("collidable")) s.collidable = r.Bool("collidable");
   if (r.Has("friction")) s.friction = r.Number("friction", kNonNegative);
   if (r.Has("restitution")) s.restitution = r.Number("restitution", kFraction);
   if (r.Has("color")) {
@@ -105,6 +120,19 @@ void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
 }
 
 }  // namespace
+
+bool InertiaIsValid(const std::array<double, 6>& i) {
+  const double xx = i[0], yy = i[1], zz = i[2], xy = i[3], xz = i[4], yz = i[5];
+  for (double v : i)
+    if (!std::isfinite(v)) return false;
+  // Positive definite (Sylvester's criterion) and the triangle inequality
+  // of the principal moments, which ODE checks too (a little slack).
+  const double m2 = xx * yy - xy * xy;
+  const double m3 = xx * (yy * zz - yz * yz) - xy * (xy * zz - yz * xz) + xz * (xy * yz - yy * xz);
+  if (!(xx > 0 && m2 > 0 && m3 > 0)) return false;
+  const double slack = 1e-9 * (xx + yy + zz);
+  return xx <= yy + zz + slack && yy <= xx + zz + slack && zz <= xx + yy + slack;
+}
 
 constinit const ObjectTypeDescriptor kShapeType{
     .name = "shape",

@@ -37,6 +37,7 @@ struct RunArgs {
   bool hash = false, quiet = false;
   bool trust_scripts = false;
   std::vector<std::string> plugins;
+  std::vector<std::string> package_path;  // --package-path: URDF packages' folders
   // Snapshots and video (modules/rendering/video/recorder.h).
   int64_t snapshot_every = 0;             // 0: none
   std::string camera;                     // empty: the arena seen from above
@@ -95,7 +96,8 @@ int VersionCommand();
 // swarmsim describe WORLD (describe_command.cc)
 struct DescribeArgs {
   std::string world;
-  std::vector<std::string> sets;  // NAME=VALUE
+  std::vector<std::string> sets;          // NAME=VALUE
+  std::vector<std::string> package_path;  // --package-path
 };
 CLI::App* AddDescribeCommand(CLI::App* app, DescribeArgs* args);
 int DescribeCommand(const DescribeArgs& args, const ModuleRegistry& registry);

@@ -39,6 +39,7 @@ void PrintDescription(const LoadedWorld& w, std::ostream& out) {
         << (m.count == 1 ? " copy" : " copies");
     if (m.scale != 1) out << ", scale " << m.scale;
     out << "\n";
+    for (const std::string& line : m.imported) out << "  " << line << "\n";
     for (const std::string& script : m.scripts) out << "  script: " << script << "\n";
     if (!m.python.file.empty())
       out << "  python controller: " << m.python.file.string() << ":" << m.python.function
@@ -73,6 +74,11 @@ CLI::App* AddDescribeCommand(CLI::App* app, DescribeArgs* args) {
                    "--set a=1 --set b=2")
       ->option_text("NAME=VALUE")
       ->allow_extra_args(false);
+  describe
+      ->add_option("--package-path", args->package_path,
+                   "A folder holding the ROS packages of URDF models' package:// URIs; repeat "
+                   "for more")
+      ->allow_extra_args(false);
   return describe;
 }
 
@@ -80,6 +86,7 @@ int DescribeCommand(const DescribeArgs& args, const ModuleRegistry& registry) {
   LoadOptions load;
   load.overrides = ParseSets(args.sets);
   load.plugin_directories = PluginDirectories();
+  load.package_path.assign(args.package_path.begin(), args.package_path.end());
   try {
     const LoadedWorld w = LoadWorld(args.world, load, registry);
     PrintDescription(w, std::cout);

@@ -117,6 +117,10 @@ CLI::App* AddRunCommand(CLI::App* app, RunArgs* args) {
   run->add_flag("--quiet", args->quiet, "No progress bar and no summary table");
   run->add_option("--plugin", args->plugins, "Load a plugin (shared library) before the world")
       ->allow_extra_args(false);
+  run->add_option("--package-path", args->package_path,
+                  "A folder holding the ROS packages of URDF models' package:// URIs (after the "
+                  "world's package_path); repeat for more")
+      ->allow_extra_args(false);
   run->add_flag("--trust-scripts", args->trust_scripts,
                 "Lift the script sandbox: full Lua libraries (os, io, debug, package)");
   run->add_option("--snapshot-every", args->snapshot_every,
@@ -185,6 +189,7 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
   if (!args.out_dir.empty()) load.output_directory = args.out_dir;
   load.trust_scripts = args.trust_scripts;
   load.plugin_directories = PluginDirectories();
+  load.package_path.assign(args.package_path.begin(), args.package_path.end());
   LoadedWorld loaded;
   try {
     load.overrides = ParseSets(args.sets);

@@ -131,6 +131,8 @@ void AddIkGroups(const ModelFile& model, const std::vector<IkGroupDef>& groups,
     } catch (const Error& e) {
       model.file.Fail(field.mark, e.what());
     }
+    // The root is named after the copy; its name in the file (a URDF's root link) names it too.
+    if (id.IsNull() && path == spec.name) id = root;
     if (id.IsNull())
       model.file.Fail(field.mark, "no object '" + path + "' in model '" + model.name + "'" +
                                       Suggest(path, known));

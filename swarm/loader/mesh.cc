@@ -1,5 +1,6 @@
 #include "swarm/loader/mesh.h"
 
+#include <assimp/config.h>
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -57,17 +58,23 @@ std::shared_ptr<const MeshCache::Welded> ReadMeshFile(const fs::path& path,
   std::string ext = path.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  if (ext != ".stl" && ext != ".obj")
-    throw Error(prefix + "mesh file '" + text + "' must be STL or OBJ (a .stl or .obj name)");
+  if (ext != ".stl" && ext != ".obj" && ext != ".dae")
+    throw Error(prefix + "mesh file '" + text +
+                "' must be STL, OBJ or COLLADA (a .stl, .obj or .dae name)");
   const std::string bytes = ReadFileOrThrow(path, "mesh file", where, text);
   if (bytes.empty()) throw Error(prefix + "mesh file '" + text + "' is empty");
 
   Assimp::Importer importer;
+  // COLLADA: the file's <unit> applies, its up axis does not (assimp would
+  // turn a Z_UP file to Y-up): coordinates stay in the file's own frame,
+  // which is what URDF and the world files mean. Node transforms are baked
+  // into the vertices (aiProcess_PreTransformVertices).
+  importer.SetPropertyBool(AI_CONFIG_IMPORT_COLLADA_IGNORE_UP_DIRECTION, true);
   const unsigned flags =
       aiProcess_Triangulate | aiProcess_PreTransformVertices | aiProcess_SortByPType;
-  // An OBJ file is read from its folder, so that its material library
+  // An OBJ or DAE file is read from its folder, so that its material library
   // (mtllib x.mtl beside it) gives the colours; an STL file has none.
-  const aiScene* scene = ext == ".obj" ? importer.ReadFile(path.string(), flags)
+  const aiScene* scene = ext != ".stl" ? importer.ReadFile(path.string(), flags)
                                        : importer.ReadFileFromMemory(bytes.data(), bytes.size(),
                                                                      flags, ext.c_str() + 1);
   if (!scene)

@@ -1,4 +1,4 @@
-// Mesh files (shape: mesh, file: part.stl|part.obj): read with assimp, welded
+// Mesh files (shape: mesh, file: part.stl|.obj|.dae): read with assimp, welded
 // into a framework TriangleMesh (plain arrays; assimp stays in mesh.cc),
 // once per file and scale per world, and shared by every shape and copy.
 #pragma once
@@ -18,7 +18,8 @@ namespace swarmsim::loader {
 
 class MeshCache {
  public:
-  // The mesh in `path` (STL, ASCII or binary, or OBJ), each vertex scaled by
+  // The mesh in `path` (STL, ASCII or binary, OBJ or COLLADA: its unit
+  // applies, its up axis does not), each vertex scaled by
   // `scale` (positive). Throws swarmsim::Error "<where>: mesh file 'text' ..."
   // for a missing, unreadable, unsupported or empty file.
   std::shared_ptr<const TriangleMesh> Get(const std::filesystem::path& path, const Vec3& scale,

@@ -70,6 +70,12 @@ struct ModelFile {
   std::vector<ModelParameterDecl> parameters;
   Field root;       // the root object
   Field ik_groups;  // IK groups (swarm/loader/ik.h), not present if none
+  // A model imported from another format (a URDF file, swarm/loader/urdf.h):
+  // its objects, built once; `file` is then the world file naming it (the
+  // entry's keys are read there) and `root` is not present.
+  std::shared_ptr<const ObjectSpec> imported;
+  std::string imported_file;                // the imported file, as the world names it
+  std::vector<std::string> import_summary;  // `swarmsim describe` lines
 };
 
 // `used_by` (file:line:column of the reference) is named when the file is

@@ -11,6 +11,7 @@
 
 #include "framework/error.h"
 #include "modules/environment/voxel_merge.h"
+#include "swarm/loader/urdf.h"
 #include "swarm/loader/world_loader_impl.h"
 
 namespace swarmsim::loader {
@@ -236,6 +237,7 @@ void WorldLoader::ResolveObjects(const Fields& f, const ValueReader& world_value
   const std::shared_ptr<ParameterSet>& params = entry->parameters;
   const ValueReader model_values(model.file, &expressions_, {&parameters_, params.get()});
   entry->spec = loader::ResolveModel(model, model_values, &scripts_, &meshes_, world_registry_);
+  ExtendObjects(f, world_values, *entry, &entry->spec);
   entry->footprint = loader::ComputeFootprint(entry->spec);
   if (f.Has("scale")) {
     // Every length of the model scales, so its footprint does too.
@@ -246,6 +248,12 @@ void WorldLoader::ResolveObjects(const Fields& f, const ValueReader& world_value
     entry->footprint.top *= entry->scale;
   }
   entry->ik_groups = loader::ReadIkGroups(model, model_values);
+  if (f.Has("ik_groups")) {
+    // The entry's own groups (an imported robot's): paths and messages in the world file.
+    entry->entry_model = std::make_shared<ModelFile>(
+        ModelFile{*file_, model.name, {}, {}, f.Get("ik_groups"), nullptr, {}, {}});
+    entry->entry_ik_groups = loader::ReadIkGroups(*entry->entry_model, world_values);
+  }
   // A copy with values of its own gets objects of its own: every value of
   // the model that uses a parameter (a sensor's range, a size, a limit, a
   // mass, an IK setting) takes the copy's value.
@@ -254,6 +262,7 @@ void WorldLoader::ResolveObjects(const Fields& f, const ValueReader& world_value
     const ValueReader own_values(model.file, &expressions_, {&parameters_, own.parameters.get()});
     try {
       own.spec = loader::ResolveModel(model, own_values, &scripts_, &meshes_, world_registry_);
+      ExtendObjects(f, world_values, *entry, &*own.spec);
       own.ik_groups = loader::ReadIkGroups(model, own_values);
     } catch (const Error& e) {
       throw Error(std::string(e.what()) + " (with the parameters of copy " +
@@ -263,6 +272,54 @@ void WorldLoader::ResolveObjects(const Fields& f, const ValueReader& world_value
     own.footprint.radius *= entry->scale;
     own.footprint.bottom *= entry->scale;
     own.footprint.top *= entry->scale;
+  }
+}
+
+// What the entry adds to its model's objects: `base: floating` (URDF), the
+// `objects` under the root (IK targets, sensors) and `scripts` attached to
+// the root or to a named object (an imported robot's link).
+void WorldLoader::ExtendObjects(const Fields& f, const ValueReader& world_values,
+                                const EntryPlan& entry, ObjectSpec* spec) {
+  const ModelFile& model = *entry.model;
+  if (f.Has("base")) {
+    const Field base = f.Get("base");
+    const std::string kind = world_values.Choice(base, {"fixed", "floating"});
+    if (!model.imported)
+      world_values.Fail(base,
+                        "'base' applies to URDF models (a model file says which shapes "
+                        "are dynamic itself)");
+    if (kind == "floating") *spec = loader::WithFloatingBase(*spec, file_->Where(base.mark));
+  }
+  if (f.Has("objects")) {
+    std::vector<ObjectSpec> extra = loader::ReadSceneObjects(*file_, f.Get("objects"), world_values,
+                                                             &scripts_, &meshes_, world_registry_);
+    for (ObjectSpec& o : extra) spec->children.push_back(std::move(o));
+  }
+  if (f.Has("scripts")) {
+    Fields scripts(*file_, f.Get("scripts"), "'scripts'");
+    for (const Field& s : scripts.fields()) {
+      // ':' (or '.') the root; else the first object of that name, in hierarchy order.
+      ObjectSpec* target = nullptr;
+      std::vector<std::string> names;
+      std::vector<ObjectSpec*> stack{spec};
+      while (!stack.empty() && target == nullptr) {
+        ObjectSpec* at = stack.back();
+        stack.pop_back();
+        names.push_back(at->name);
+        if (at != spec && at->name == s.name) target = at;
+        for (auto it = at->children.rbegin(); it != at->children.rend(); ++it)
+          stack.push_back(&*it);
+      }
+      if (s.name == ":" || s.name == "." || (target == nullptr && s.name == spec->name))
+        target = spec;
+      if (target == nullptr)
+        file_->Fail(s.key_mark, "no object '" + s.name + "' in model '" + model.name +
+                                    "' to attach a script to (':' is the root)" +
+                                    loader::Suggest(s.name, names));
+      const std::string text = world_values.String(s);
+      if (text.empty()) world_values.Fail(s, "a script must be a file name");
+      target->script = scripts_.Get(path_.parent_path() / text, file_->Where(s.mark), text);
+    }
   }
 }
 
@@ -443,6 +500,7 @@ void WorldLoader::BuildCopies(World* world) {
           root, name, name + "#" + std::to_string(scene.instances().size()));
       // IK groups of this copy; duplicates get theirs from the "ik" module.
       loader::AddIkGroups(*e.model, ik_groups, spec, root, world);
+      if (e.entry_model) loader::AddIkGroups(*e.entry_model, e.entry_ik_groups, spec, root, world);
       return std::pair(root, instance);
     };
     ObjectId first;  // the entry's first copy built from its own description
@@ -509,7 +567,11 @@ std::vector<ModelSummary> WorldLoader::Summarize() const {
       }
     for (const auto& [file, where] : scripts) m.scripts.push_back(file + " " + where);
     m.scale = e.scale;
-    m.ik_groups = static_cast<int>(e.ik_groups.size());
+    m.ik_groups = static_cast<int>(e.ik_groups.size() + e.entry_ik_groups.size());
+    if (e.model->imported) {
+      m.file = e.model->imported_file;
+      m.imported = e.model->import_summary;
+    }
     m.python = e.python;
     out.push_back(std::move(m));
   }

@@ -11,6 +11,7 @@
 #include "framework/registry.h"
 #include "swarm/loader/environment.h"
 #include "swarm/loader/paint.h"
+#include "swarm/loader/urdf.h"
 #include "swarm/loader/world_loader_impl.h"
 
 namespace swarmsim::loader {
@@ -19,9 +20,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const std::vector<std::string> kTopKeys = {"simulation",  "parameters", "arena",   "obstacles",
-                                           "environment", "models",     "objects", "metrics",
-                                           "paint",       "plugins"};
+const std::vector<std::string> kTopKeys = {"simulation",  "parameters", "arena",       "obstacles",
+                                           "environment", "models",     "objects",     "metrics",
+                                           "paint",       "plugins",    "package_path"};
 
 std::vector<Override> SplitOverrides(const LoadOptions& options) {
   std::vector<Override> out;
@@ -84,11 +85,13 @@ LoadedWorld WorldLoader::Load() {
 
   // Parameters first: every other value may use them.
   ReadParameters(top);
+  ReadPackagePath(top);
   ReadModelEntries(top);
   CheckOverrides();
 
   LoadedWorld out;
   out.file = path_;
+  out.warnings = warnings_;
   WorldSettings settings = ReadSimulation(top, &out.steps);
   if (std::shared_ptr<const ModuleRegistry> own = LoadPlugins(top))
     out.world = std::make_unique<World>(settings, std::move(own));
@@ -222,12 +225,45 @@ std::shared_ptr<const ModuleRegistry> WorldLoader::LoadPlugins(const Fields& top
   return registry;
 }
 
+// package_path: [folder, ...], relative to the world file: where the ROS
+// packages of URDF models' package:// URIs are looked for (before --package-path).
+void WorldLoader::ReadPackagePath(const Fields& top) {
+  const ValueReader values = WorldValues();
+  for (const Field& element :
+       loader::ListElements(*file_, top.Get("package_path"), "package_path folders")) {
+    const std::string text = values.String(element);
+    if (text.empty()) values.Fail(element, "a 'package_path' folder must be a non-empty path");
+    const fs::path dir = path_.parent_path() / text;
+    std::error_code ec;
+    if (!fs::is_directory(dir, ec))
+      values.Fail(element, "package_path folder '" + text + "' is not a folder (looked for " +
+                               loader::DisplayPath(dir) + ")");
+    package_path_.push_back(dir);
+  }
+  for (const fs::path& dir : options_.package_path) {
+    std::error_code ec;
+    if (!fs::is_directory(dir, ec))
+      throw Error("--package-path " + dir.string() + ": not a folder");
+    package_path_.push_back(dir);
+  }
+}
+
 const ModelFile& WorldLoader::LoadModel(const Field& field, const std::string& text) {
   const fs::path path = path_.parent_path() / text;
   std::error_code ec;
   fs::path key = fs::weakly_canonical(path, ec);
   if (ec) key = path.lexically_normal();
   auto it = models_.find(key);
+  if (it == models_.end() && loader::IsUrdfFile(text)) {
+    // A URDF robot: imported once; the entry's keys are read in the world file.
+    const std::string where = file_->Where(field.mark);
+    loader::UrdfImport urdf = loader::ImportUrdf(path, where, text, package_path_, &meshes_);
+    auto model = std::make_unique<ModelFile>(
+        ModelFile{*file_, urdf.name, {}, {}, {}, nullptr, text, std::move(urdf.summary)});
+    model->imported = std::make_shared<const ObjectSpec>(std::move(urdf.root));
+    warnings_.insert(warnings_.end(), urdf.warnings.begin(), urdf.warnings.end());
+    it = models_.emplace(key, std::move(model)).first;
+  }
   if (it == models_.end()) {
     const std::string where = file_->Where(field.mark);
     auto model = std::make_unique<ModelFile>(

@@ -38,6 +38,9 @@ struct LoadOptions {
   // (`plugins: [example_plugin]` -> example_plugin.so); the program passes
   // the `plugins/` folder beside its executable.
   std::vector<std::filesystem::path> plugin_directories;
+  // --package-path: folders searched for the ROS packages a URDF model's
+  // package:// URIs name, after the world's own `package_path`.
+  std::vector<std::filesystem::path> package_path;
   // Whether the caller runs `python_controller:` entries (swarm/python does;
   // the program does not, and a world naming one is an error there).
   bool python_controllers = false;
@@ -68,7 +71,8 @@ struct ModelSummary {
   std::vector<std::string> scripts;
   double scale = 1;  // `scale:` of the entry
   int ik_groups = 0;
-  PythonController python;  // python_controller:, if any
+  std::vector<std::string> imported;  // a URDF model: what was imported (links, joints, meshes)
+  PythonController python;            // python_controller:, if any
 };
 
 struct LoadedWorld {

@@ -27,9 +27,13 @@ namespace swarmsim::loader {
 
 inline constexpr int64_t kMaxCount = 1000000;  // copies per models entry
 
-inline const std::vector<std::string> kEntryKeys = {
-    "model",           "count",      "distribute", "position", "heading_deg",
-    "orientation_deg", "parameters", "instances",  "scale",    "python_controller"};
+inline const std::vector<std::string> kEntryKeys = {"model",       "count",
+                                                    "distribute",  "position",
+                                                    "heading_deg", "orientation_deg",
+                                                    "parameters",  "instances",
+                                                    "scale",       "base",
+                                                    "objects",     "scripts",
+                                                    "ik_groups",   "python_controller"};
 
 // One --set, split into its target.
 struct Override {
@@ -65,6 +69,9 @@ struct EntryPlan {
   std::optional<double> heading;
   std::vector<Placement2> placements;
   std::vector<loader::IkGroupDef> ik_groups;
+  // The entry's own `ik_groups` (read in the world file, through `entry_model`).
+  std::shared_ptr<ModelFile> entry_model;
+  std::vector<loader::IkGroupDef> entry_ik_groups;
   PythonController python;  // python_controller: (file empty: none)
   // instances: [{index, parameters}]: copies with their own values, in file order.
   struct OwnCopy {
@@ -141,6 +148,9 @@ class WorldLoader {
   void ReadOwnCopies(const Fields& f, const ValueReader& world_values, DeclaredParameters* declared,
                      EntryPlan* entry);
   void ResolveObjects(const Fields& f, const ValueReader& world_values, EntryPlan* entry);
+  void ExtendObjects(const Fields& f, const ValueReader& world_values, const EntryPlan& entry,
+                     ObjectSpec* spec);
+  void ReadPackagePath(const Fields& top);
   void ResolvePlacement(const Fields& f, const ValueReader& world_values, EntryPlan* entry);
   void ResolvePythonController(const Fields& f, const ValueReader& world_values, EntryPlan* entry);
   void ReadDistribution(const Fields& f, const ValueReader& world_values, EntryPlan* entry);
@@ -172,6 +182,8 @@ class WorldLoader {
   Field environment_field_;                            // `environment:` (absent: none)
   std::shared_ptr<const EnvironmentMap> environment_;  // the map it names, or null
   std::unique_ptr<Placer> placer_;
+  std::vector<std::filesystem::path> package_path_;  // the world's, then --package-path
+  std::vector<std::string> warnings_;                // found before the World exists
 };
 
 }  // namespace swarmsim::loader

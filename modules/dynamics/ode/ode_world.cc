@@ -97,6 +97,11 @@ dGeomID MakeGeom(dSpaceID space, const ShapeData& shape, dTriMeshDataID mesh_dat
 dMass CalcMass(const ShapeData& shape) {
   dMass m;
   const Vec3& s = shape.size;
+  if (shape.inertia[0] > 0) {  // given (a URDF <inertial>): about the origin, in the shape's frame
+    const auto& i = shape.inertia;
+    dMassSetParameters(&m, shape.mass, 0, 0, 0, i[0], i[1], i[2], i[3], i[4], i[5]);
+    return m;
+  }
   switch (shape.kind) {
     case ShapeKind::kBox: dMassSetBoxTotal(&m, shape.mass, s.x, s.y, s.z); break;
     case ShapeKind::kSphere: dMassSetSphereTotal(&m, shape.mass, s.x); break;
@@ -320,8 +325,10 @@ void OdeWorld::BuildBodies(const Scene& scene, std::vector<dBodyID>* body_of) {
     if (!(shape->mass > 0) || !std::isfinite(shape->mass))
       throw Error("ode: dynamic shape '" + PathAt(scene, s) + "' needs a positive mass (got " +
                   std::to_string(shape->mass) + " kg)");
-    dGeomID geom = MakeGeom(space_, *shape, MeshData(shape->mesh));
-    if (!geom) throw Error("ode: dynamic shape '" + PathAt(scene, s) + "' needs a positive size");
+    // A shape that is not collidable carries its mass without a geom.
+    dGeomID geom = shape->collidable ? MakeGeom(space_, *shape, MeshData(shape->mesh)) : nullptr;
+    if (!geom && shape->collidable)
+      throw Error("ode: dynamic shape '" + PathAt(scene, s) + "' needs a positive size");
     dBodyID body = dBodyCreate(world_);
     SetBodyPose(body, X_WS);
     const Vec3& v = scene.linear_velocity_at(s);
@@ -330,8 +337,10 @@ void OdeWorld::BuildBodies(const Scene& scene, std::vector<dBodyID>* body_of) {
     dBodySetAngularVel(body, w.x, w.y, w.z);
     const dMass mass = CalcMass(*shape);
     dBodySetMass(body, &mass);
-    dGeomSetBody(geom, body);
-    AddGeom(geom, scene.instance_of_at(s), shape->friction, shape->restitution);
+    if (geom) {
+      dGeomSetBody(geom, body);
+      AddGeom(geom, scene.instance_of_at(s), shape->friction, shape->restitution);
+    }
     (*body_of)[s] = body;
     bodies_.push_back({body, s, X_WS});
   }
@@ -340,7 +349,7 @@ void OdeWorld::BuildBodies(const Scene& scene, std::vector<dBodyID>* body_of) {
 void OdeWorld::BuildNonDynamicShapes(const Scene& scene, std::vector<dBodyID>* body_of) {
   for (uint32_t s = 0; s < scene.slot_count(); ++s) {
     const ShapeData* shape = ShapeAt(scene, s);
-    if (!shape || shape->dynamic) continue;
+    if (!shape || shape->dynamic || !shape->collidable) continue;
     const Pose& X_WS = scene.world_pose_at(s);
     if (!IsFinite(X_WS)) throw Error("ode: shape '" + PathAt(scene, s) + "' has a non-finite pose");
     const Carrier carrier = CarrierOf(scene, *body_of, s);
@@ -491,6 +500,13 @@ void OdeWorld::ApplyMotors(double dt) {
           dJointAddSliderForce(j.joint, c.target_force);
         break;
       case JointMode::kPassive: break;
+    }
+    // Viscous damping (a URDF joint's <dynamics damping>), in every mode.
+    if (c.damping > 0) {
+      if (hinge)
+        dJointAddHingeTorque(j.joint, -c.damping * dJointGetHingeAngleRate(j.joint));
+      else
+        dJointAddSliderForce(j.joint, -c.damping * dJointGetSliderPositionRate(j.joint));
     }
     if (hinge) {
       dJointSetHingeParam(j.joint, dParamVel, velocity);

@@ -115,7 +115,7 @@ TEST_F(LoaderMeshTest, MistakesNameTheFileAndThePlace) {
   EXPECT_NE(e.find("'file'"), std::string::npos) << e;
   Write("models/part.ply", "ply\n");
   e = ErrorOf("  shape: mesh\n  file: part.ply\n");
-  EXPECT_NE(e.find("mesh file 'part.ply' must be STL or OBJ"), std::string::npos) << e;
+  EXPECT_NE(e.find("mesh file 'part.ply' must be STL, OBJ or COLLADA"), std::string::npos) << e;
   Write("models/empty.stl", "");
   e = ErrorOf("  shape: mesh\n  file: empty.stl\n");
   EXPECT_NE(e.find("bot.yaml:6:9: mesh file 'empty.stl' is empty"), std::string::npos) << e;

@@ -1,0 +1,720 @@
+#include "swarm/loader/urdf.h"
+
+#include <console_bridge/console.h>
+#include <tinyxml2.h>
+#include <urdf_model/model.h>
+#include <urdf_parser/urdf_parser.h>
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cmath>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <set>
+
+#include "framework/display_path.h"
+#include "framework/error.h"
+#include "framework/object_type.h"
+#include "swarm/loader/yaml.h"
+
+namespace swarmsim::loader {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using Inertia = std::array<double, 6>;  // ixx, iyy, izz, ixy, ixz, iyz
+
+std::string Num(double v) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%g", v);
+  return buffer;
+}
+
+// --- The XML pass: lines, checks urdfdom does not make, ignored elements ----------
+
+struct XmlFacts {
+  std::map<std::string, int> link_line, joint_line, mimic_line;
+  std::map<std::string, std::vector<int>> visual_lines, collision_lines;  // per link, in order
+  std::map<std::string, int> joint_order;  // document order of each joint
+  // Ignored elements, by kind: count and first line.
+  std::map<std::string, std::pair<int, int>> ignored;
+  int damped_joints = 0, first_damped_line = 0;
+};
+
+// urdfdom's messages go here instead of the console, for the error text.
+class Capture : public console_bridge::OutputHandler {
+ public:
+  void log(const std::string& text, console_bridge::LogLevel level, const char*, int) override {
+    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR && first_error.empty())
+      first_error = text;
+  }
+  std::string first_error;
+};
+
+class Importer {
+ public:
+  Importer(const fs::path& path, const std::vector<fs::path>& package_path, MeshCache* meshes)
+      : path_(path), name_(DisplayPath(path)), package_path_(package_path), meshes_(meshes) {}
+
+  UrdfImport Run(const std::string& where, const std::string& text);
+
+ private:
+  [[noreturn]] void Fail(int line, const std::string& message) const {
+    throw Error(name_ + (line > 0 ? ":" + std::to_string(line) : "") + ": " + message);
+  }
+  void ReadXml(const std::string& bytes);
+  void Ignore(const std::string& kind, int line) {
+    auto [it, added] = xml_.ignored.emplace(kind, std::make_pair(0, line));
+    ++it->second.first;
+  }
+  fs::path ResolveUri(const std::string& uri, int line, const std::string& what);
+  std::optional<fs::path> FindPackage(const std::string& package);
+  std::optional<ObjectSpec> Geometry(const urdf::Link& link, const urdf::Geometry* geometry,
+                                     const urdf::Pose& origin, bool visual, int line,
+                                     const Vec3* color);
+  void GroupMass(const urdf::Link& link, const Pose& X_TL, double* mass, Inertia* inertia);
+  ObjectSpec LinkObject(const urdf::Link& link, bool top, bool is_root, const Pose& X_PO,
+                        const Pose& X_TL);
+  std::vector<urdf::JointSharedPtr> ChildJoints(const urdf::Link& link) const;
+
+  fs::path path_;
+  std::string name_;
+  const std::vector<fs::path>& package_path_;
+  MeshCache* meshes_;
+  XmlFacts xml_;
+  std::map<std::string, std::optional<fs::path>> packages_;
+  std::set<std::string> default_mass_links_;
+  std::vector<std::string> isotropic_links_;  // bodies whose inertia was made isotropic
+  int frames_ = 0, bodies_ = 0, meshes_count_ = 0, visuals_ = 0, collisions_ = 0;
+  std::map<std::string, int> mesh_formats_;
+  std::map<std::string, int> joint_kinds_;
+  int mimics_ = 0;
+  double total_mass_ = 0;
+};
+
+void Importer::ReadXml(const std::string& bytes) {
+  tinyxml2::XMLDocument doc;
+  if (doc.Parse(bytes.data(), bytes.size()) != tinyxml2::XML_SUCCESS)
+    Fail(doc.ErrorLineNum(), std::string("malformed XML: ") + doc.ErrorName() +
+                                 (doc.ErrorStr() ? std::string(" (") + doc.ErrorStr() + ")" : ""));
+  const tinyxml2::XMLElement* robot = doc.RootElement();
+  if (!robot || std::string(robot->Name()) != "robot")
+    Fail(robot ? robot->GetLineNum() : 1, "a URDF file's root element must be <robot>");
+  if (!robot->Attribute("name")) Fail(robot->GetLineNum(), "<robot> needs a 'name' attribute");
+  std::map<std::string, std::string> parent_joint;                // child link -> joint
+  std::map<std::string, std::string> parent_link;                 // child link -> parent link
+  std::vector<std::tuple<std::string, std::string, int>> mimics;  // joint, master, line
+  int order = 0;
+  for (const tinyxml2::XMLElement* e = robot->FirstChildElement(); e; e = e->NextSiblingElement()) {
+    const std::string kind = e->Name();
+    const int line = e->GetLineNum();
+    if (kind == "link") {
+      const char* name = e->Attribute("name");
+      if (!name || !*name) Fail(line, "<link> needs a 'name' attribute");
+      if (!xml_.link_line.emplace(name, line).second)
+        Fail(line, "link '" + std::string(name) + "' is defined twice (first at line " +
+                       std::to_string(xml_.link_line[name]) + ")");
+      for (const tinyxml2::XMLElement* c = e->FirstChildElement(); c; c = c->NextSiblingElement()) {
+        const std::string part = c->Name();
+        if (part == "visual" || part == "collision") {
+          auto& lines = part == "visual" ? xml_.visual_lines[name] : xml_.collision_lines[name];
+          const tinyxml2::XMLElement* g = c->FirstChildElement("geometry");
+          const tinyxml2::XMLElement* shape = g ? g->FirstChildElement() : nullptr;
+          const std::string what = "link '" + std::string(name) + "' <" + part + ">";
+          if (!shape)
+            Fail(c->GetLineNum(),
+                 what + " needs <geometry> holding a box, cylinder, sphere or mesh");
+          const std::string kind = shape->Name();
+          if (kind != "box" && kind != "cylinder" && kind != "sphere" && kind != "mesh")
+            Fail(shape->GetLineNum(),
+                 what + ": unknown geometry <" + kind + "> (box, cylinder, sphere or mesh)");
+          if (kind == "mesh" && !shape->Attribute("filename"))
+            Fail(shape->GetLineNum(), what + ": <mesh> needs a 'filename'");
+          lines.push_back(g && g->FirstChildElement() ? g->FirstChildElement()->GetLineNum()
+                                                      : c->GetLineNum());
+          if (const tinyxml2::XMLElement* m = c->FirstChildElement("material"))
+            if (m->FirstChildElement("texture")) Ignore("<texture> (materials' textures)", line);
+        } else if (part == "inertial") {
+          double mass = 0;
+          const tinyxml2::XMLElement* m = c->FirstChildElement("mass");
+          if (m && m->QueryDoubleAttribute("value", &mass) == tinyxml2::XML_SUCCESS &&
+              !(mass >= 0 && std::isfinite(mass)))
+            Fail(m->GetLineNum(), "link '" + std::string(name) + "': <mass value=\"" + Num(mass) +
+                                      "\"> must be a non-negative number of kg");
+          const tinyxml2::XMLElement* in = c->FirstChildElement("inertia");
+          if (in) {
+            Inertia i{};
+            const char* keys[6] = {"ixx", "iyy", "izz", "ixy", "ixz", "iyz"};
+            for (int k = 0; k < 6; ++k) in->QueryDoubleAttribute(keys[k], &i[k]);
+            const bool zero = std::all_of(i.begin(), i.end(), [](double v) { return v == 0; });
+            const double m2 = i[0] * i[1] - i[3] * i[3];
+            const double m3 = i[0] * (i[1] * i[2] - i[5] * i[5]) -
+                              i[3] * (i[3] * i[2] - i[5] * i[4]) +
+                              i[4] * (i[3] * i[5] - i[1] * i[4]);
+            const bool definite = i[0] > 0 && m2 > 0 && m3 > 0;
+            if (!definite && !(zero && mass == 0))
+              Fail(in->GetLineNum(),
+                   "link '" + std::string(name) + "': <inertia> is not positive definite (ixx " +
+                       Num(i[0]) + ", iyy " + Num(i[1]) + ", izz " + Num(i[2]) + ", ixy " +
+                       Num(i[3]) + ", ixz " + Num(i[4]) + ", iyz " + Num(i[5]) + ")");
+          }
+        } else {
+          Ignore("<" + part + "> in a link", c->GetLineNum());
+        }
+      }
+    } else if (kind == "joint") {
+      const char* name = e->Attribute("name");
+      if (!name || !*name) Fail(line, "<joint> needs a 'name' attribute");
+      if (!xml_.joint_line.emplace(name, line).second)
+        Fail(line, "joint '" + std::string(name) + "' is defined twice (first at line " +
+                       std::to_string(xml_.joint_line[name]) + ")");
+      xml_.joint_order[name] = order++;
+      const std::string type = e->Attribute("type") ? e->Attribute("type") : "";
+      if (type != "revolute" && type != "continuous" && type != "prismatic" && type != "fixed" &&
+          type != "floating" && type != "planar")
+        Fail(line, "joint '" + std::string(name) + "': unknown type '" + type +
+                       "' (revolute, continuous, prismatic, fixed, floating or planar)");
+      if ((type == "revolute" || type == "prismatic") && !e->FirstChildElement("limit"))
+        Fail(line, "joint '" + std::string(name) + "' is " + type +
+                       " and needs <limit lower upper effort velocity>");
+      const tinyxml2::XMLElement* p = e->FirstChildElement("parent");
+      const tinyxml2::XMLElement* c = e->FirstChildElement("child");
+      const char* parent = p ? p->Attribute("link") : nullptr;
+      const char* child = c ? c->Attribute("link") : nullptr;
+      if (!parent)
+        Fail(p ? p->GetLineNum() : line,
+             "joint '" + std::string(name) + "' needs <parent link=\"...\"/>");
+      if (!child)
+        Fail(c ? c->GetLineNum() : line,
+             "joint '" + std::string(name) + "' needs <child link=\"...\"/>");
+      if (auto [it, added] = parent_joint.emplace(child, name); !added)
+        Fail(c->GetLineNum(), "link '" + std::string(child) + "' is the child of two joints, '" +
+                                  it->second + "' (line " +
+                                  std::to_string(xml_.joint_line[it->second]) + ") and '" + name +
+                                  "': the kinematic tree has a loop");
+      parent_link[child] = parent;
+      if (const tinyxml2::XMLElement* m = e->FirstChildElement("mimic")) {
+        xml_.mimic_line[name] = m->GetLineNum();
+        mimics.emplace_back(name, m->Attribute("joint") ? m->Attribute("joint") : "",
+                            m->GetLineNum());
+      }
+      for (const tinyxml2::XMLElement* k = e->FirstChildElement(); k; k = k->NextSiblingElement()) {
+        const std::string part = k->Name();
+        if (part == "safety_controller" || part == "calibration")
+          Ignore("<" + part + "> in a joint", k->GetLineNum());
+        if (part == "dynamics") {
+          double damping = 0, friction = 0;
+          k->QueryDoubleAttribute("damping", &damping);
+          k->QueryDoubleAttribute("friction", &friction);
+          if (!(damping >= 0) || !std::isfinite(damping))
+            Fail(k->GetLineNum(), "joint '" + std::string(name) + "': <dynamics damping=\"" +
+                                      Num(damping) + "\"> must be a non-negative number");
+          if (friction != 0) Ignore("joint <dynamics> friction (not simulated)", k->GetLineNum());
+        }
+      }
+    } else if (kind != "material") {
+      Ignore("<" + kind + ">", line);
+    }
+  }
+  // Every joint names links the file defines; one root; no loops.
+  for (const auto& [child, joint] : parent_joint) {
+    const int line = xml_.joint_line[joint];
+    if (!xml_.link_line.contains(child))
+      Fail(line, "joint '" + joint + "' names child link '" + child +
+                     "', which the file does not define");
+    const std::string& parent = parent_link[child];
+    if (!xml_.link_line.contains(parent))
+      Fail(line, "joint '" + joint + "' names parent link '" + parent +
+                     "', which the file does not define");
+    if (parent == child) Fail(line, "joint '" + joint + "' joins link '" + child + "' to itself");
+  }
+  if (xml_.link_line.empty()) Fail(robot->GetLineNum(), "the robot has no <link>");
+  std::vector<std::string> roots;
+  for (const auto& [link, line] : xml_.link_line)
+    if (!parent_joint.contains(link)) roots.push_back(link);
+  // Links that do not reach a root through their parents are on a loop.
+  for (const auto& [link, line] : xml_.link_line) {
+    std::string at = link;
+    for (size_t steps = 0; parent_link.contains(at); ++steps) {
+      at = parent_link[at];
+      if (steps > xml_.link_line.size()) {
+        const std::string& joint = parent_joint[link];
+        Fail(xml_.joint_line[joint],
+             "the kinematic tree has a loop through link '" + link + "' (joint '" + joint + "')");
+      }
+    }
+  }
+  if (roots.size() > 1)
+    Fail(xml_.link_line[roots[1]], "the robot has several root links ('" + roots[0] + "', '" +
+                                       roots[1] + "'): every link but one must be a joint's child");
+  for (const auto& [joint, master, line] : mimics)
+    if (!xml_.joint_line.contains(master))
+      Fail(line, "joint '" + joint + "': <mimic joint=\"" + master +
+                     "\"> names a joint the file does not define");
+}
+
+// --- package:// ---------------------------------------------------------------------
+
+std::string PackageName(const fs::path& package_xml) {
+  tinyxml2::XMLDocument doc;
+  if (doc.LoadFile(package_xml.string().c_str()) != tinyxml2::XML_SUCCESS) return "";
+  const tinyxml2::XMLElement* root = doc.RootElement();
+  const tinyxml2::XMLElement* name = root ? root->FirstChildElement("name") : nullptr;
+  if (!name || !name->GetText()) return "";
+  std::string text = name->GetText();
+  text.erase(0, text.find_first_not_of(" \t\r\n"));
+  text.erase(text.find_last_not_of(" \t\r\n") + 1);
+  return text;
+}
+
+std::optional<fs::path> Importer::FindPackage(const std::string& package) {
+  if (auto it = packages_.find(package); it != packages_.end()) return it->second;
+  std::optional<fs::path> found;
+  std::error_code ec;
+  auto holds = [&](const fs::path& dir) {
+    return fs::is_regular_file(dir / "package.xml", ec) &&
+           PackageName(dir / "package.xml") == package;
+  };
+  for (const fs::path& dir : package_path_) {
+    if (found) break;
+    if (fs::is_directory(dir / package, ec)) {
+      found = dir / package;
+      break;
+    }
+    if (holds(dir)) {
+      found = dir;
+      break;
+    }
+    // package.xml files one or two levels down (a workspace's src/ folder).
+    for (auto it = fs::recursive_directory_iterator(dir, ec);
+         !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
+      if (it.depth() >= 2) it.disable_recursion_pending();
+      if (it->is_directory(ec) && holds(it->path())) {
+        found = it->path();
+        break;
+      }
+    }
+  }
+  // The package holding the URDF file itself (ROS's rule for its own files).
+  for (fs::path dir = fs::absolute(path_, ec).parent_path(); !found && !dir.empty();
+       dir = dir.parent_path()) {
+    if (holds(dir)) found = dir;
+    if (dir == dir.parent_path()) break;
+  }
+  packages_[package] = found;
+  return found;
+}
+
+fs::path Importer::ResolveUri(const std::string& uri, int line, const std::string& what) {
+  if (uri.starts_with("package://")) {
+    const std::string rest = uri.substr(10);
+    const size_t slash = rest.find('/');
+    const std::string package = rest.substr(0, slash);
+    if (package.empty() || slash == std::string::npos)
+      Fail(line, what + ": '" + uri + "' must be package://PACKAGE/PATH");
+    const std::optional<fs::path> dir = FindPackage(package);
+    if (!dir) {
+      std::string searched;
+      for (const fs::path& p : package_path_)
+        searched += (searched.empty() ? "" : ", ") + DisplayPath(p);
+      Fail(line, what + ": cannot resolve package '" + package + "' of '" + uri + "' (searched " +
+                     (searched.empty() ? "no package path" : searched) +
+                     ", and the folders holding the URDF; give the folder holding the package "
+                     "with the world's 'package_path' or --package-path)");
+    }
+    return *dir / rest.substr(slash + 1);
+  }
+  if (uri.starts_with("file://")) return uri.substr(7);
+  return path_.parent_path() / uri;
+}
+
+// --- Objects ------------------------------------------------------------------------
+
+Pose ToPose(const urdf::Pose& p) {
+  return {{p.position.x, p.position.y, p.position.z},
+          Quat{p.rotation.w, p.rotation.x, p.rotation.y, p.rotation.z}.Normalized()};
+}
+
+// Rotation taking z onto the unit vector `a`.
+Quat ZTo(const Vec3& a) {
+  const Vec3 z{0, 0, 1};
+  const double c = z.Dot(a);
+  if (c > 1 - 1e-12) return {};
+  if (c < -1 + 1e-12) return Quat::FromAxisAngle({1, 0, 0}, M_PI);
+  return Quat::FromAxisAngle(z.Cross(a), std::acos(std::clamp(c, -1.0, 1.0)));
+}
+
+// The link `joint` (one of link's child joints) leads to.
+urdf::LinkConstSharedPtr ChildLink(const urdf::Link& link, const urdf::Joint& joint) {
+  for (const auto& c : link.child_links)
+    if (c->name == joint.child_link_name) return c;
+  return nullptr;
+}
+
+ObjectSpec NewObject(ObjectType type, std::string name, const Pose& X_PO) {
+  ObjectSpec spec;
+  spec.type = type;
+  spec.name = std::move(name);
+  spec.X_PO = X_PO;
+  const ObjectTypeDescriptor& descriptor = *CoreObjectTypes()[static_cast<size_t>(type)];
+  if (descriptor.make_rows != nullptr) {
+    spec.row = descriptor.make_rows(descriptor);
+    spec.row->Append(nullptr, 0);
+  }
+  return spec;
+}
+
+template <typename Row>
+Row& RowOf(ObjectSpec& spec) {
+  return *static_cast<Row*>(spec.row->At(0));
+}
+
+// Object names are path elements: no spaces, '/', '[' or ']'.
+std::string ObjectName(std::string name) {
+  for (char& c : name)
+    if (c == '/' || c == '[' || c == ']' || std::isspace(static_cast<unsigned char>(c))) c = '_';
+  return name.empty() ? "_" : name;
+}
+
+std::optional<ObjectSpec> Importer::Geometry(const urdf::Link& link, const urdf::Geometry* g,
+                                             const urdf::Pose& origin, bool visual, int line,
+                                             const Vec3* color) {
+  const std::string what =
+      "link '" + link.name + "' " + (visual ? "<visual>" : "<collision>") + " geometry";
+  if (g == nullptr) return std::nullopt;
+  ObjectSpec spec = NewObject(ObjectType::kShape, visual ? "visual" : "collision", ToPose(origin));
+  ShapeData& s = RowOf<ShapeData>(spec);
+  s.collidable = !visual;
+  auto positive = [&](double v, const char* key) {
+    if (!(v > 0) || !std::isfinite(v))
+      Fail(line, what + ": " + key + " must be a positive number (got " + Num(v) + ")");
+    return v;
+  };
+  switch (g->type) {
+    case urdf::Geometry::BOX: {
+      const auto& d = static_cast<const urdf::Box*>(g)->dim;
+      s.kind = ShapeKind::kBox;
+      s.size = {positive(d.x, "box size x"), positive(d.y, "box size y"),
+                positive(d.z, "box size z")};
+      break;
+    }
+    case urdf::Geometry::CYLINDER: {
+      const auto* c = static_cast<const urdf::Cylinder*>(g);
+      s.kind = ShapeKind::kCylinder;
+      s.size = {positive(c->radius, "cylinder radius"), 0, positive(c->length, "cylinder length")};
+      break;
+    }
+    case urdf::Geometry::SPHERE:
+      s.kind = ShapeKind::kSphere;
+      s.size = {positive(static_cast<const urdf::Sphere*>(g)->radius, "sphere radius"), 0, 0};
+      break;
+    case urdf::Geometry::MESH: {
+      const auto* m = static_cast<const urdf::Mesh*>(g);
+      const fs::path file = ResolveUri(m->filename, line, what);
+      const Vec3 scale{positive(m->scale.x, "mesh scale x"), positive(m->scale.y, "mesh scale y"),
+                       positive(m->scale.z, "mesh scale z")};
+      s.kind = ShapeKind::kMesh;
+      s.mesh =
+          meshes_->Get(file, scale, name_ + ":" + std::to_string(line) + ": " + what, m->filename);
+      s.size = s.mesh->CenteredExtents();
+      std::string ext = file.extension().string();
+      for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+      ++mesh_formats_[ext.empty() ? "?" : ext.substr(1)];
+      ++meshes_count_;
+      break;
+    }
+    default: Fail(line, what + ": unknown geometry");
+  }
+  if (color != nullptr) {
+    s.color = *color;
+    s.mesh_colors = false;
+  }
+  (visual ? visuals_ : collisions_)++;
+  return spec;
+}
+
+// The mass of `link` and the links fixed to it, and their inertia about the
+// group's top frame T (X_TL: the link in T).
+void Importer::GroupMass(const urdf::Link& link, const Pose& X_TL, double* mass, Inertia* inertia) {
+  double m = 0;
+  Pose X_LC;      // the centre of mass in the link
+  Inertia I_C{};  // about the centre of mass, its frame
+  if (link.inertial) {
+    m = link.inertial->mass;
+    X_LC = ToPose(link.inertial->origin);
+    const auto& in = *link.inertial;
+    I_C = {in.ixx, in.iyy, in.izz, in.ixy, in.ixz, in.iyz};
+  } else if (!link.collision_array.empty() || !link.visual_array.empty()) {
+    m = kUrdfDefaultMass;
+    I_C = {kUrdfDefaultInertia, kUrdfDefaultInertia, kUrdfDefaultInertia, 0, 0, 0};
+    default_mass_links_.insert(link.name);
+  }
+  if (m > 0) {
+    const Pose X_TC = X_TL * X_LC;
+    // R I R^T, then the parallel-axis term m (|p|^2 E - p p^T).
+    const double I[3][3] = {
+        {I_C[0], I_C[3], I_C[4]}, {I_C[3], I_C[1], I_C[5]}, {I_C[4], I_C[5], I_C[2]}};
+    double R[3][3];
+    for (int c = 0; c < 3; ++c) {
+      const Vec3 col = X_TC.q.Rotate({c == 0 ? 1.0 : 0.0, c == 1 ? 1.0 : 0.0, c == 2 ? 1.0 : 0.0});
+      R[0][c] = col.x, R[1][c] = col.y, R[2][c] = col.z;
+    }
+    double J[3][3] = {};
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b)
+        for (int k = 0; k < 3; ++k)
+          for (int l = 0; l < 3; ++l) J[a][b] += R[a][k] * I[k][l] * R[b][l];
+    const double p[3] = {X_TC.p.x, X_TC.p.y, X_TC.p.z};
+    const double p2 = p[0] * p[0] + p[1] * p[1] + p[2] * p[2];
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) J[a][b] += m * ((a == b ? p2 : 0) - p[a] * p[b]);
+    const Inertia add{J[0][0], J[1][1], J[2][2], J[0][1], J[0][2], J[1][2]};
+    *mass += m;
+    for (int k = 0; k < 6; ++k) (*inertia)[k] += add[k];
+  }
+  for (const urdf::JointSharedPtr& joint : ChildJoints(link))
+    if (joint->type == urdf::Joint::FIXED || joint->type == urdf::Joint::PLANAR)
+      if (const urdf::LinkConstSharedPtr child = ChildLink(link, *joint))
+        GroupMass(*child, X_TL * ToPose(joint->parent_to_joint_origin_transform), mass, inertia);
+}
+
+std::vector<urdf::JointSharedPtr> Importer::ChildJoints(const urdf::Link& link) const {
+  std::vector<urdf::JointSharedPtr> joints = link.child_joints;
+  std::sort(joints.begin(), joints.end(), [&](const auto& a, const auto& b) {
+    return xml_.joint_order.at(a->name) < xml_.joint_order.at(b->name);
+  });
+  return joints;
+}
+
+// The object of `link` at X_PO in its parent: the group's body carrier
+// (`top`) or a frame (a dummy), with its geometry and what hangs from it.
+ObjectSpec Importer::LinkObject(const urdf::Link& link, bool top, bool is_root, const Pose& X_PO,
+                                const Pose& X_TL) {
+  ObjectSpec spec;
+  if (top) {
+    double mass = 0;
+    Inertia inertia{};
+    GroupMass(link, Pose{}, &mass, &inertia);
+    spec = NewObject(ObjectType::kShape, ObjectName(link.name), X_PO);
+    ShapeData& s = RowOf<ShapeData>(spec);
+    s.kind = ShapeKind::kSphere;
+    s.size = {kUrdfCarrierRadius, 0, 0};
+    s.collidable = false;
+    s.mass = mass;  // 0: a frame, never simulated
+    s.dynamic = mass > 0 && !is_root;
+    if (mass > 0 && !InertiaIsValid(inertia)) {
+      // Each link's tensor is positive definite (checked), but CAD exports
+      // break the triangle inequality ODE needs: keep the mean moment.
+      const double mean = (inertia[0] + inertia[1] + inertia[2]) / 3;
+      inertia = {mean > 0 ? mean : mass * kUrdfDefaultInertia, 0, 0, 0, 0, 0};
+      inertia[1] = inertia[2] = inertia[0];
+      isotropic_links_.push_back(link.name);
+    }
+    if (mass > 0) s.inertia = inertia;
+    if (mass > 0) {
+      ++bodies_;
+      total_mass_ += mass;
+    } else {
+      ++frames_;
+    }
+  } else {
+    spec = NewObject(ObjectType::kDummy, ObjectName(link.name), X_PO);
+  }
+  // The link's colour: its first visual's material.
+  std::optional<Vec3> color;
+  for (const auto& v : link.visual_array)
+    if (v->material && v->material->color.a > 0) {
+      color = Vec3{v->material->color.r, v->material->color.g, v->material->color.b};
+      break;
+    }
+  const std::vector<int>& collision_lines = xml_.collision_lines[link.name];
+  const std::vector<int>& visual_lines = xml_.visual_lines[link.name];
+  for (size_t k = 0; k < link.collision_array.size(); ++k) {
+    const auto& c = *link.collision_array[k];
+    const int line = k < collision_lines.size() ? collision_lines[k] : xml_.link_line[link.name];
+    if (auto shape =
+            Geometry(link, c.geometry.get(), c.origin, false, line, color ? &*color : nullptr))
+      spec.children.push_back(std::move(*shape));
+  }
+  for (size_t k = 0; k < link.visual_array.size(); ++k) {
+    const auto& v = *link.visual_array[k];
+    const int line = k < visual_lines.size() ? visual_lines[k] : xml_.link_line[link.name];
+    std::optional<Vec3> own;
+    if (v.material && v.material->color.a > 0)
+      own = Vec3{v.material->color.r, v.material->color.g, v.material->color.b};
+    if (auto shape = Geometry(link, v.geometry.get(), v.origin, true, line, own ? &*own : nullptr))
+      spec.children.push_back(std::move(*shape));
+  }
+  for (const urdf::JointSharedPtr& joint : ChildJoints(link)) {
+    const urdf::LinkConstSharedPtr child = ChildLink(link, *joint);
+    if (!child) continue;
+    const int line = xml_.joint_line[joint->name];
+    const Pose X_LJ = ToPose(joint->parent_to_joint_origin_transform);
+    switch (joint->type) {
+      case urdf::Joint::FIXED:
+      case urdf::Joint::PLANAR:
+        ++joint_kinds_[joint->type == urdf::Joint::FIXED ? "fixed" : "planar (as fixed)"];
+        spec.children.push_back(LinkObject(*child, false, false, X_LJ, X_TL * X_LJ));
+        continue;
+      case urdf::Joint::FLOATING:
+        // A free body: no joint between it and its parent.
+        ++joint_kinds_["floating"];
+        spec.children.push_back(LinkObject(*child, true, false, X_LJ, Pose{}));
+        continue;
+      default: break;
+    }
+    Vec3 axis{joint->axis.x, joint->axis.y, joint->axis.z};
+    if (!(axis.Norm() > 1e-9) || !std::isfinite(axis.Norm()))
+      Fail(line, "joint '" + joint->name + "': <axis xyz> must be a nonzero vector");
+    axis = axis.Normalized();
+    const Quat z_to_axis = ZTo(axis);
+    ObjectSpec j =
+        NewObject(ObjectType::kJoint, ObjectName(joint->name), X_LJ * Pose{{}, z_to_axis});
+    JointData& d = RowOf<JointData>(j);
+    d.type = joint->type == urdf::Joint::PRISMATIC ? JointType::kPrismatic : JointType::kRevolute;
+    d.mode = joint->type == urdf::Joint::CONTINUOUS ? JointMode::kVelocity : JointMode::kPosition;
+    ++joint_kinds_[joint->type == urdf::Joint::CONTINUOUS  ? "continuous"
+                   : joint->type == urdf::Joint::PRISMATIC ? "prismatic"
+                                                           : "revolute"];
+    if (joint->limits) {
+      if (joint->type != urdf::Joint::CONTINUOUS) {
+        if (!(joint->limits->lower <= joint->limits->upper))
+          Fail(line, "joint '" + joint->name + "': <limit lower> is above upper");
+        d.min_position = joint->limits->lower;
+        d.max_position = joint->limits->upper;
+        // Start inside the limits.
+        d.position = d.target_position = std::clamp(0.0, d.min_position, d.max_position);
+      }
+      if (joint->limits->effort > 0)
+        d.max_force = joint->limits->effort;
+      else
+        d.max_force = kUrdfDefaultEffort;
+      d.max_velocity = joint->limits->velocity > 0 ? joint->limits->velocity : kUrdfDefaultVelocity;
+    } else {
+      d.max_force = kUrdfDefaultEffort;
+      d.max_velocity = kUrdfDefaultVelocity;
+    }
+    if (joint->dynamics) d.damping = joint->dynamics->damping;
+    if (joint->mimic) {
+      auto dep = std::make_shared<JointDependency>();
+      dep->master = ":/" + ObjectName(joint->mimic->joint_name);
+      dep->factor = joint->mimic->multiplier;
+      dep->offset = joint->mimic->offset;
+      dep->where = name_ + ":" + std::to_string(xml_.mimic_line[joint->name]);
+      d.depends = std::move(dep);
+      d.mode = JointMode::kPosition;
+      ++mimics_;
+    }
+    j.children.push_back(LinkObject(*child, true, false, Pose{{}, z_to_axis.Conjugate()}, Pose{}));
+    spec.children.push_back(std::move(j));
+  }
+  return spec;
+}
+
+UrdfImport Importer::Run(const std::string& where, const std::string& text) {
+  const std::string bytes = ReadFileOrThrow(path_, "URDF file", where, text);
+  ReadXml(bytes);
+  urdf::ModelInterfaceSharedPtr model;
+  {
+    // urdfdom reports through console_bridge's process-wide handler.
+    static std::mutex mutex;
+    std::lock_guard lock(mutex);
+    Capture capture;
+    console_bridge::useOutputHandler(&capture);
+    try {
+      model = urdf::parseURDF(bytes);
+    } catch (const std::exception& e) {
+      capture.first_error = e.what();
+    }
+    console_bridge::restorePreviousOutputHandler();
+    if (!model)
+      Fail(0,
+           "urdfdom cannot read it: " +
+               (capture.first_error.empty() ? std::string("(no message)") : capture.first_error));
+  }
+  if (!model->getRoot()) Fail(0, "the robot has no root link");
+  UrdfImport out;
+  out.name = ObjectName(model->getName());
+  for (char& c : out.name)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-') c = '_';
+  out.root = LinkObject(*model->getRoot(), true, true, Pose{}, Pose{});
+
+  std::string joints;
+  for (const auto& [kind, n] : joint_kinds_)
+    joints += (joints.empty() ? "" : ", ") + std::to_string(n) + " " + kind;
+  std::string formats;
+  for (const auto& [ext, n] : mesh_formats_)
+    formats += (formats.empty() ? "" : ", ") + std::to_string(n) + " " + ext;
+  int joint_count = 0;
+  for (const auto& [kind, n] : joint_kinds_) joint_count += n;
+  out.summary.push_back("urdf: robot '" + model->getName() + "', root link '" +
+                        model->getRoot()->name + "'");
+  out.summary.push_back("  links: " + std::to_string(xml_.link_line.size()) + " (" +
+                        std::to_string(bodies_) + " bodies with mass, " + Num(total_mass_) +
+                        " kg in all; " + std::to_string(default_mass_links_.size()) +
+                        " with the default mass)");
+  out.summary.push_back("  joints: " + std::to_string(joint_count) +
+                        (joints.empty() ? "" : " (" + joints + ")") +
+                        (mimics_ ? ", " + std::to_string(mimics_) + " mimic (dependent)" : ""));
+  out.summary.push_back("  shapes: " + std::to_string(collisions_) + " collision, " +
+                        std::to_string(visuals_) +
+                        " visual; meshes: " + std::to_string(meshes_count_) +
+                        (formats.empty() ? "" : " (" + formats + ")"));
+  for (const auto& [kind, count_line] : xml_.ignored)
+    out.warnings.push_back(name_ + ":" + std::to_string(count_line.second) + ": ignored " +
+                           std::to_string(count_line.first) + " " + kind +
+                           (count_line.first == 1 ? "" : " (first here)"));
+  if (!isotropic_links_.empty()) {
+    std::string names;
+    for (const std::string& n : isotropic_links_) names += (names.empty() ? "" : ", ") + n;
+    out.warnings.push_back(name_ + ": the inertia of " + std::to_string(isotropic_links_.size()) +
+                           " bod" + (isotropic_links_.size() == 1 ? "y" : "ies") + " (" + names +
+                           ") breaks the triangle inequality of principal moments: replaced by "
+                           "its mean moment about each axis");
+  }
+  if (!default_mass_links_.empty()) {
+    std::string names;
+    for (const std::string& n : default_mass_links_) names += (names.empty() ? "" : ", ") + n;
+    out.warnings.push_back(
+        name_ + ": " + std::to_string(default_mass_links_.size()) + " link" +
+        (default_mass_links_.size() == 1 ? " has" : "s have") + " geometry but no <inertial> (" +
+        names + "): each gets the default mass " + Num(kUrdfDefaultMass) + " kg and inertia " +
+        Num(kUrdfDefaultInertia) + " kg m^2 about each axis at the link origin");
+  }
+  return out;
+}
+
+}  // namespace
+
+bool IsUrdfFile(const std::string& text) {
+  if (text.size() < 5) return false;
+  std::string ext = text.substr(text.size() - 5);
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".urdf";
+}
+
+UrdfImport ImportUrdf(const fs::path& path, const std::string& where, const std::string& text,
+                      const std::vector<fs::path>& package_path, MeshCache* meshes) {
+  MeshCache own;
+  return Importer(path, package_path, meshes ? meshes : &own).Run(where, text);
+}
+
+ObjectSpec WithFloatingBase(const ObjectSpec& root, const std::string& where) {
+  ObjectSpec out = root;
+  const ShapeData* shape = root.As<ShapeData>(ObjectType::kShape);
+  if (shape == nullptr || shape->dynamic) return out;
+  if (!(shape->mass > 0))
+    throw Error(where +
+                ": 'base: floating' needs a root link with mass (the root link and the "
+                "links fixed to it have no <inertial> nor geometry)");
+  const ObjectTypeDescriptor& type = *CoreObjectTypes()[static_cast<size_t>(ObjectType::kShape)];
+  out.row = type.make_rows(type);
+  out.row->Append(shape, 0);
+  static_cast<ShapeData*>(out.row->At(0))->dynamic = true;
+  return out;
+}
+
+}  // namespace swarmsim::loader

@@ -1,0 +1,54 @@
+// URDF import (`model: robot.urdf` in a world's models entry): a URDF file
+// read with urdfdom (and tinyxml2 for the line of each element) into the
+// objects of a model, once per world; the urdf:: types stay in urdf.cc.
+//
+// Links become shapes: each rigid group of links (joined by fixed joints)
+// is one body, a non-collidable carrier shape at the group's top link frame
+// holding the group's mass and inertia (about that origin); each link's
+// <collision> and <visual> geometry are shapes below it (visuals do not
+// collide). Moving joints become joints whose z axis is the URDF axis;
+// mimic joints become dependent joints. worlds/README.md ("URDF models")
+// documents the mapping.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "swarm/loader/mesh.h"
+#include "swarm/loader/model.h"
+
+namespace swarmsim::loader {
+
+// The mass and inertia of a link without <inertial> that has geometry.
+inline constexpr double kUrdfDefaultMass = 0.1;      // kg
+inline constexpr double kUrdfDefaultInertia = 1e-4;  // kg m^2, about each axis
+inline constexpr double kUrdfDefaultEffort = 100;    // N or N m, a <limit effort="0">
+inline constexpr double kUrdfDefaultVelocity = 10;   // rad/s or m/s, no <limit velocity>
+inline constexpr double kUrdfCarrierRadius = 0.001;  // m, the body carrier's sphere
+
+struct UrdfImport {
+  ObjectSpec root;                    // the root link's object, base fixed (not dynamic)
+  std::string name;                   // the robot's name, usable as a model name
+  std::vector<std::string> summary;   // what was imported, for `swarmsim describe`
+  std::vector<std::string> warnings;  // one per kind of thing ignored or defaulted
+};
+
+// Reads the URDF at `path` (`text` as the world names it, `where` the
+// file:line:column naming it). package://PKG/REST URIs resolve through
+// `package_path` (each folder: PKG below it, a package.xml naming PKG in it
+// or in a subfolder up to two levels down), then the folders holding the
+// URDF (a package.xml naming PKG). Throws swarmsim::Error naming the file,
+// the element and its line for malformed input.
+UrdfImport ImportUrdf(const std::filesystem::path& path, const std::string& where,
+                      const std::string& text,
+                      const std::vector<std::filesystem::path>& package_path, MeshCache* meshes);
+
+// Whether `text` names a URDF file (.urdf, any case).
+bool IsUrdfFile(const std::string& text);
+
+// `root` with a floating base: its root body simulated (dynamic) when it has
+// a mass. Throws (naming `where`) when the root group has none.
+ObjectSpec WithFloatingBase(const ObjectSpec& root, const std::string& where);
+
+}  // namespace swarmsim::loader

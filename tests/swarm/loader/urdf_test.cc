@@ -1,0 +1,572 @@
+// URDF models (model: robot.urdf): the three real robots of ../shared/urdf
+// load, stand or drive under ODE with their links attached, match the
+// URDF's own joint frames (composed here from the XML, independently of
+// the importer), follow their mimic joints; malformed files are errors
+// naming the file, the element and its line.
+#include <gtest/gtest.h>
+#include <tinyxml2.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "framework/error.h"
+#include "framework/mesh.h"
+#include "framework/world.h"
+#include "swarm/loader/world_loader.h"
+#include "tests/framework/error_of.h"
+#include "tests/swarm/loader/world_dir_test.h"
+
+namespace swarmsim {
+namespace {
+
+namespace fs = std::filesystem;
+
+// ../shared/urdf beside the source tree, or $SWARMSIM_URDF_DIR; "" if absent.
+std::string SharedUrdf() {
+  std::vector<fs::path> folders;
+  if (const char* dir = std::getenv("SWARMSIM_URDF_DIR")) folders.emplace_back(dir);
+  folders.push_back(fs::path(SWARMSIM_SOURCE_DIR) / ".." / "shared" / "urdf");
+  folders.emplace_back("/work/shared/urdf");
+  for (const fs::path& f : folders) {
+    std::error_code ec;
+    const fs::path p = fs::weakly_canonical(f, ec);
+    if (!ec && fs::is_regular_file(p / "README.md", ec)) return p.string();
+  }
+  return "";
+}
+
+#define NEED_SHARED_URDF(dir)                                                  \
+  const std::string dir = SharedUrdf();                                        \
+  if (dir.empty())                                                             \
+  GTEST_SKIP() << "the shared URDF robots (../shared/urdf) are not here; set " \
+                  "SWARMSIM_URDF_DIR to the folder holding fanuc_m10ia, panda, turtlebot3_waffle"
+
+const char* kFanuc = "fanuc_m10ia/moveit_resources_fanuc_description/urdf/fanuc.urdf";
+const char* kPanda = "panda/example-robot-data/robots/panda_description/urdf/panda.urdf";
+const char* kTurtlebot = "turtlebot3_waffle/nav2_minimal_tb3_sim/urdf/turtlebot3_waffle.urdf";
+
+// --- The URDF's kinematics, read from the XML here ------------------------------------
+
+struct XmlJoint {
+  std::string name, type, parent, child;
+  Pose origin;
+  Vec3 axis{1, 0, 0};
+};
+
+Vec3 ParseVec(const char* text, Vec3 fallback) {
+  if (!text) return fallback;
+  std::istringstream in(text);
+  Vec3 v;
+  in >> v.x >> v.y >> v.z;
+  return v;
+}
+
+std::vector<XmlJoint> ReadJoints(const std::string& path) {
+  tinyxml2::XMLDocument doc;
+  EXPECT_EQ(doc.LoadFile(path.c_str()), tinyxml2::XML_SUCCESS);
+  std::vector<XmlJoint> out;
+  for (auto* e = doc.RootElement()->FirstChildElement("joint"); e;
+       e = e->NextSiblingElement("joint")) {
+    XmlJoint j;
+    j.name = e->Attribute("name");
+    j.type = e->Attribute("type");
+    j.parent = e->FirstChildElement("parent")->Attribute("link");
+    j.child = e->FirstChildElement("child")->Attribute("link");
+    if (auto* o = e->FirstChildElement("origin")) {
+      const Vec3 rpy = ParseVec(o->Attribute("rpy"), {});
+      j.origin = {ParseVec(o->Attribute("xyz"), {}), Quat::FromRollPitchYaw(rpy.x, rpy.y, rpy.z)};
+    }
+    if (auto* a = e->FirstChildElement("axis")) j.axis = ParseVec(a->Attribute("xyz"), {1, 0, 0});
+    out.push_back(j);
+  }
+  return out;
+}
+
+// Pose of every link in the robot's root frame for joint values `q`.
+std::map<std::string, Pose> ForwardKinematics(const std::vector<XmlJoint>& joints,
+                                              const std::map<std::string, double>& q) {
+  std::map<std::string, Pose> X;
+  for (const XmlJoint& j : joints) X.emplace(j.parent, Pose{});  // roots stay at identity
+  for (const XmlJoint& j : joints) X.erase(j.child);
+  for (size_t pass = 0; pass < joints.size(); ++pass)
+    for (const XmlJoint& j : joints) {
+      if (!X.contains(j.parent) || X.contains(j.child)) continue;
+      const double v = q.contains(j.name) ? q.at(j.name) : 0.0;
+      Pose motion;
+      if (j.type == "revolute" || j.type == "continuous") motion.q = Quat::FromAxisAngle(j.axis, v);
+      if (j.type == "prismatic") motion.p = j.axis.Normalized() * v;
+      X[j.child] = X[j.parent] * j.origin * motion;
+    }
+  return X;
+}
+
+class UrdfTest : public testing::WorldDirTest {
+ protected:
+  LoadedWorld LoadRobot(const std::string& dir, const char* urdf, const std::string& physics,
+                        const std::string& extra = "") {
+    return Load("simulation: {physics: " + physics + ", time_step: 0.01}\nmodels:\n  - model: " +
+                dir + "/" + urdf + "\n    position: [0, 0, 0]\n" + extra);
+  }
+  // An object of the (first) robot by name; the root link is the robot's root
+  // (named after the copy, fanuc#0).
+  static ObjectId Find(const World& w, const std::string& name) {
+    const Scene& scene = w.scene();
+    const ObjectId root = scene.instances()[0].root;
+    if (name == root_link_) return root;
+    const ObjectId id = scene.FindObject("./" + name, root);
+    EXPECT_FALSE(id.IsNull()) << name;
+    return id;
+  }
+  // Sets every moving joint to its value in `q` (0 if absent; the importer
+  // starts a joint whose limits exclude 0 at the nearer limit) and
+  // recomputes the poses.
+  static void SetJoints(World& w, const std::vector<XmlJoint>& joints,
+                        const std::map<std::string, double>& q) {
+    for (const XmlJoint& j : joints) {
+      if (j.type == "fixed") continue;
+      w.scene().mutable_joint(Find(w, j.name)).position = q.contains(j.name) ? q.at(j.name) : 0;
+    }
+    w.scene().UpdateWorldPoses();
+  }
+  static inline std::string root_link_;
+  // Largest distance between an imported link's pose and the URDF's, for `q`.
+  void ExpectFkMatches(const std::string& dir, const char* urdf,
+                       const std::vector<std::map<std::string, double>>& configurations) {
+    LoadedWorld w = LoadRobot(dir, urdf, "kinematic");
+    const std::vector<XmlJoint> joints = ReadJoints(dir + "/" + urdf);
+    root_link_ = joints.front().parent;
+    for (const auto& q : configurations) {
+      SetJoints(*w.world, joints, q);
+      const std::map<std::string, Pose> expected = ForwardKinematics(joints, q);
+      ASSERT_GE(expected.size(), 9u);
+      for (const auto& [link, X] : expected) {
+        const Pose got = w.world->scene().world_pose(Find(*w.world, link));
+        EXPECT_NEAR((got.p - X.p).Norm(), 0, 1e-9) << link;
+        // Same rotation: q and -q alike.
+        const double dot = got.q.w * X.q.w + got.q.x * X.q.x + got.q.y * X.q.y + got.q.z * X.q.z;
+        EXPECT_NEAR(std::abs(dot), 1, 1e-9) << link;
+      }
+    }
+  }
+  // Runs `seconds` under ODE, checking every 0.1 s that each moving
+  // joint's child link stays at the joint's anchor (revolute: the origin
+  // on the axis; prismatic: on the axis line).
+  static double MaxDetachment(World& world, double seconds) {
+    Scene& scene = world.scene();
+    std::vector<std::pair<ObjectId, ObjectId>> pairs;  // joint, child link
+    for (uint32_t s = 0; s < scene.slot_count(); ++s)
+      if (scene.alive_at(s) && scene.type_at(s) == ObjectType::kJoint) {
+        const ObjectId j = scene.IdAt(s);
+        for (ObjectId c : scene.children(j)) pairs.emplace_back(j, c);
+      }
+    EXPECT_FALSE(pairs.empty());
+    double worst = 0;
+    world.Start();
+    const int steps = static_cast<int>(std::lround(seconds / 0.01));
+    for (int k = 0; k < steps; ++k) {
+      world.Step();
+      if (k % 10 != 9) continue;
+      for (const auto& [j, c] : pairs) {
+        const Pose X_WJ = scene.world_pose(j), X_WC = scene.world_pose(c);
+        const Vec3 d = X_WJ.q.Conjugate().Rotate(X_WC.p - X_WJ.p);  // in the joint frame
+        const double off_axis =
+            scene.joint(j).type == JointType::kPrismatic ? std::hypot(d.x, d.y) : d.Norm();
+        worst = std::max(worst, off_axis);
+      }
+    }
+    return worst;
+  }
+};
+
+TEST_F(UrdfTest, EachSharedRobotLoadsWithWhatItHolds) {
+  NEED_SHARED_URDF(dir);
+  struct Case {
+    const char* urdf;
+    int joints, meshes;
+  };
+  for (const Case& c : {Case{kFanuc, 6, 14}, Case{kPanda, 9, 20}, Case{kTurtlebot, 2, 5}}) {
+    LoadedWorld w = LoadRobot(dir, c.urdf, "ode",
+                              std::string(c.urdf) == kTurtlebot ? "    base: floating\n" : "");
+    const Scene& scene = w.world->scene();
+    int joints = 0, meshes = 0;
+    for (uint32_t s = 0; s < scene.slot_count(); ++s) {
+      if (!scene.alive_at(s)) continue;
+      joints += scene.type_at(s) == ObjectType::kJoint;
+      if (scene.type_at(s) == ObjectType::kShape &&
+          scene.shape(scene.IdAt(s)).kind == ShapeKind::kMesh)
+        ++meshes;
+    }
+    EXPECT_EQ(joints, c.joints) << c.urdf;
+    EXPECT_EQ(meshes, c.meshes) << c.urdf;
+    ASSERT_EQ(w.models.size(), 1u);
+    EXPECT_FALSE(w.models[0].imported.empty());
+  }
+}
+
+TEST_F(UrdfTest, ReferencePosesOfTheReadmeHold) {
+  NEED_SHARED_URDF(dir);
+  LoadedWorld fanuc = LoadRobot(dir, kFanuc, "kinematic");
+  const Vec3 tool0 = fanuc.world->scene().world_pose(Find(*fanuc.world, "tool0")).p;
+  EXPECT_NEAR((tool0 - Vec3{0.89, 0, 1.25}).Norm(), 0, 1e-6);
+  LoadedWorld panda = LoadRobot(dir, kPanda, "kinematic");
+  // At the zero configuration (panda_joint4's limits exclude 0: it starts at -0.0698).
+  SetJoints(*panda.world, ReadJoints(dir + "/" + kPanda), {});
+  EXPECT_NEAR(
+      (panda.world->scene().world_pose(Find(*panda.world, "panda_link8")).p - Vec3{0.088, 0, 0.926})
+          .Norm(),
+      0, 1e-6);
+  EXPECT_NEAR((panda.world->scene().world_pose(Find(*panda.world, "panda_hand_tcp")).p -
+               Vec3{0.088, 0, 0.8226})
+                  .Norm(),
+              0, 1e-6);
+  LoadedWorld tb = LoadRobot(dir, kTurtlebot, "kinematic");
+  EXPECT_NEAR(
+      (tb.world->scene().world_pose(Find(*tb.world, "base_scan")).p - Vec3{-0.064, 0, 0.132})
+          .Norm(),
+      0, 1e-6);
+}
+
+TEST_F(UrdfTest, ForwardKinematicsMatchesTheUrdfFrames) {
+  NEED_SHARED_URDF(dir);
+  ExpectFkMatches(dir, kFanuc,
+                  {{},
+                   {{"joint_1", 0.5},
+                    {"joint_2", -0.4},
+                    {"joint_3", 0.3},
+                    {"joint_4", 1.1},
+                    {"joint_5", -0.7},
+                    {"joint_6", 2.0}},
+                   {{"joint_1", -1.2}, {"joint_2", 0.8}, {"joint_5", 1.5}}});
+  ExpectFkMatches(dir, kPanda,
+                  {{},
+                   {{"panda_joint1", 0.3},
+                    {"panda_joint2", -0.5},
+                    {"panda_joint3", 0.7},
+                    {"panda_joint4", -2.0},
+                    {"panda_joint5", 0.4},
+                    {"panda_joint6", 1.9},
+                    {"panda_joint7", -0.6},
+                    {"panda_finger_joint1", 0.03},
+                    {"panda_finger_joint2", 0.03}}});
+}
+
+TEST_F(UrdfTest, MimicFingerFollowsItsMaster) {
+  NEED_SHARED_URDF(dir);
+  LoadedWorld w = LoadRobot(dir, kPanda, "kinematic");
+  World& world = *w.world;
+  world.scene().mutable_joint(Find(world, "panda_finger_joint1")).target_position = 0.03;
+  world.Start();
+  for (int k = 0; k < 100; ++k) world.Step();
+  const double q1 = world.scene().joint(Find(world, "panda_finger_joint1")).position;
+  const double q2 = world.scene().joint(Find(world, "panda_finger_joint2")).position;
+  EXPECT_NEAR(q1, 0.03, 1e-9);
+  EXPECT_NEAR(q2, 1.0 * q1 + 0.0, 1e-12);
+  // The fingers open symmetrically: 2 x 0.03 m apart, about the hand's axis.
+  const Vec3 left = world.scene().world_pose(Find(world, "panda_leftfinger")).p;
+  const Vec3 right = world.scene().world_pose(Find(world, "panda_rightfinger")).p;
+  EXPECT_NEAR((left - right).Norm(), 0.06, 1e-9);
+}
+
+TEST_F(UrdfTest, FixedBaseArmsStandWithLinksAttachedForTenSeconds) {
+  NEED_SHARED_URDF(dir);
+  for (const char* urdf : {kFanuc, kPanda}) {
+    LoadedWorld w = LoadRobot(dir, urdf, "ode");
+    const std::string tip = std::string(urdf) == kFanuc ? "tool0" : "panda_link8";
+    const Vec3 before = w.world->scene().world_pose(Find(*w.world, tip)).p;
+    EXPECT_LT(MaxDetachment(*w.world, 10), 0.01) << urdf;
+    const Vec3 after = w.world->scene().world_pose(Find(*w.world, tip)).p;
+    EXPECT_LT((after - before).Norm(), 0.05) << urdf << ": the arm sagged";
+  }
+}
+
+TEST_F(UrdfTest, TurtlebotDrivesForwardOnItsWheels) {
+  NEED_SHARED_URDF(dir);
+  LoadedWorld w = LoadRobot(dir, kTurtlebot, "ode", "    base: floating\n");
+  World& world = *w.world;
+  for (const char* wheel : {"wheel_left_joint", "wheel_right_joint"})
+    world.scene().mutable_joint(Find(world, wheel)).target_velocity = 5;  // rad/s
+  EXPECT_LT(MaxDetachment(world, 10), 0.01);
+  const Pose X = world.scene().world_pose(world.scene().instances()[0].root);
+  // 5 rad/s x 0.033 m = 0.165 m/s: about 1.6 m in 10 s, straight ahead (+x).
+  EXPECT_GT(X.p.x, 1.0);
+  EXPECT_LT(std::abs(X.p.y), 0.1);
+  EXPECT_LT(std::abs(X.p.z), 0.02);
+}
+
+TEST_F(UrdfTest, TurtlebotColladaMeshesKeepTheUrdfFrame) {
+  NEED_SHARED_URDF(dir);
+  LoadedWorld w = LoadRobot(dir, kTurtlebot, "kinematic");
+  const Scene& scene = w.world->scene();
+  // waffle_base.dae: node transforms and scale 0.001 give 0.265 x 0.265 x 0.093 m
+  // (z up: its 0.093 m is the height, as the collision box's 0.094).
+  const ShapeData& base =
+      scene.shape(scene.FindObject("./base_link/visual", scene.instances()[0].root));
+  ASSERT_EQ(base.kind, ShapeKind::kMesh);
+  const Vec3 size = base.mesh->hi() - base.mesh->lo();
+  EXPECT_NEAR(size.x, 0.265, 0.005);
+  EXPECT_NEAR(size.y, 0.265, 0.005);
+  EXPECT_NEAR(size.z, 0.093, 0.005);
+  // r200.dae declares inches: 0.13 x 0.02 x 0.008 m, not 51 units wide.
+  const ShapeData& camera =
+      scene.shape(scene.FindObject("./camera_link/visual", scene.instances()[0].root));
+  const Vec3 c = camera.mesh->hi() - camera.mesh->lo();
+  EXPECT_LT(std::max({c.x, c.y, c.z}), 0.2);
+  EXPECT_GT(std::max({c.x, c.y, c.z}), 0.1);
+}
+
+TEST_F(UrdfTest, PandaColladaVisualsLieOnTheirStlCollisions) {
+  NEED_SHARED_URDF(dir);
+  LoadedWorld w = LoadRobot(dir, kPanda, "kinematic");
+  const Scene& scene = w.world->scene();
+  const ObjectId root = scene.instances()[0].root;
+  // link2.dae (Z_UP) and link2.stl: 0.110 x 0.249 x 0.184 m both, not y and z swapped.
+  const TriangleMesh& visual = *scene.shape(scene.FindObject("./panda_link2/visual", root)).mesh;
+  const TriangleMesh& collision =
+      *scene.shape(scene.FindObject("./panda_link2/collision", root)).mesh;
+  EXPECT_NEAR((visual.lo() - collision.lo()).Norm(), 0, 0.01);
+  EXPECT_NEAR((visual.hi() - collision.hi()).Norm(), 0, 0.01);
+  EXPECT_NEAR(visual.hi().y - visual.lo().y, 0.249, 0.005);
+}
+
+TEST_F(UrdfTest, TheDefaultInertiaWarningComesOnce) {
+  NEED_SHARED_URDF(dir);
+  LoadedWorld w = Load("simulation: {physics: ode}\nmodels:\n  - {model: " + dir + "/" + kFanuc +
+                       ", count: 3, distribute: {region: {min: [-5, -5], max: [5, 5]}}}\n"
+                       "  - {model: " +
+                       dir + "/" + kFanuc + ", position: [8, 8]}\n");
+  int count = 0;
+  for (const std::string& warning : w.warnings)
+    if (warning.find("no <inertial>") != std::string::npos) {
+      ++count;
+      EXPECT_CONTAINS(warning, "7 links");
+    }
+  EXPECT_EQ(count, 1);
+}
+
+TEST_F(UrdfTest, PackagesResolveThroughThePackagePath) {
+  NEED_SHARED_URDF(dir);
+  // A copy of the FANUC URDF outside its package: only the package path finds the meshes.
+  fs::copy_file(dir + "/" + kFanuc, dir_ / "fanuc.urdf");
+  EXPECT_CONTAINS(
+      testing::ErrorOf([&] { Load("models: [{model: fanuc.urdf, position: [0, 0]}]\n"); }),
+      "cannot resolve package 'moveit_resources_fanuc_description'");
+  EXPECT_NO_THROW(Load("package_path: [" + dir +
+                       "/fanuc_m10ia]\nmodels: [{model: fanuc.urdf, position: [0, 0]}]\n"));
+  LoadOptions options;
+  options.package_path = {dir + "/fanuc_m10ia"};
+  Write("w.yaml", "models: [{model: fanuc.urdf, position: [0, 0]}]\n");
+  EXPECT_NO_THROW(LoadWorld(dir_ / "w.yaml", options, registry_));
+}
+
+TEST_F(UrdfTest, CopiesScaleAndScriptsOnLinksWorkAsForAnyModel) {
+  NEED_SHARED_URDF(dir);
+  Write(
+      "link.lua",
+      "function sysCall_init() sim.setJointTargetPosition(sim.getObject(':/joint_1'), 0.5) end\n");
+  LoadedWorld w =
+      Load("simulation: {physics: kinematic, time_step: 0.05}\nmodels:\n  - model: " + dir + "/" +
+           kFanuc +
+           "\n    position: [0, 0, 0]\n    scale: 2\n    scripts: {link_3: link.lua}\n"
+           "  - model: " +
+           dir + "/" + kFanuc +
+           "\n    count: 2\n    distribute: {region: {min: [4, 4], max: [9, 9]}}\n");
+  World& world = *w.world;
+  const Scene& scene = world.scene();
+  ASSERT_EQ(scene.instances().size(), 3u);
+  // Scaled twice: tool0 at twice the README's (0.89, 0, 1.25) m.
+  const ObjectId root0 = scene.instances()[0].root;
+  EXPECT_NEAR((scene.world_pose(scene.FindObject("./tool0", root0)).p - Vec3{1.78, 0, 2.5}).Norm(),
+              0, 1e-6);
+  world.Start();
+  for (int k = 0; k < 40; ++k) world.Step();
+  // The script on link_3 of the first copy turned that copy's joint_1 only.
+  EXPECT_NEAR(scene.joint(scene.FindObject("./joint_1", root0)).position, 0.5, 1e-9);
+  for (int i = 1; i < 3; ++i)
+    EXPECT_EQ(scene.joint(scene.FindObject("./joint_1", scene.instances()[i].root)).position, 0);
+}
+
+TEST_F(UrdfTest, TheExampleArmsFollowTheirTargets) {
+  LoadOptions options;
+  LoadedWorld w =
+      LoadWorld(fs::path(SWARMSIM_SOURCE_DIR) / "worlds" / "urdf_arms.yaml", options, registry_);
+  w.world->set_log_sink([](std::string_view) {});
+  World& world = *w.world;
+  const Scene& scene = world.scene();
+  ASSERT_EQ(scene.instances().size(), 20u);
+  world.Start();
+  for (int k = 0; k < 150; ++k) world.Step();  // 3 s
+  for (const ModelInstance& robot : scene.instances()) {
+    const Vec3 tip = scene.world_pose(scene.FindObject("./tool0", robot.root)).p;
+    const Vec3 goal = scene.world_pose(scene.FindObject("./goal", robot.root)).p;
+    // The goal moved away from the tool at the start (0.5 m); the arm caught it.
+    EXPECT_LT((tip - goal).Norm(), 1e-3) << robot.name;
+  }
+}
+
+TEST_F(UrdfTest, JointDampingSlowsAPendulumUnderOde) {
+  // A 1 kg box on a passive hinge about y, released horizontal: without
+  // damping it swings on; with 2 N m s/rad it settles hanging.
+  auto swing = [&](double damping) {
+    Write(
+        "pendulum.yaml",
+        "model: pendulum\nobjects:\n  name: base\n  type: dummy\n  children:\n"
+        "    - name: hinge\n      type: joint\n      mode: passive\n      damping: " +
+            std::to_string(damping) +
+            "\n      orientation_deg: [-90, 0, 0]\n      children:\n"
+            "        - {name: bob, type: shape, shape: box, size: [0.1, 0.1, 0.1], dynamic: true, "
+            "mass: 1, position: [0.3, 0, 0]}\n");
+    LoadedWorld w = Load(
+        "simulation: {physics: ode, time_step: 0.01}\nmodels: [{model: pendulum.yaml, position: "
+        "[0, 0, 1]}]\n");
+    World& world = *w.world;
+    world.Start();
+    double fastest = 0;  // rad/s, over the last second of 4
+    for (int k = 0; k < 400; ++k) {
+      world.Step();
+      if (k >= 300)
+        fastest = std::max(fastest, std::abs(world.scene().joint(Find(world, "hinge")).velocity));
+    }
+    return fastest;
+  };
+  const double free = swing(0), damped = swing(2);
+  EXPECT_GT(free, 3.0);
+  EXPECT_LT(damped, 0.1 * free);
+}
+
+TEST_F(UrdfTest, UrdfJointDampingIsImported) {
+  NEED_SHARED_URDF(dir);
+  LoadedWorld w = LoadRobot(dir, kPanda, "kinematic");
+  EXPECT_EQ(w.world->scene().joint(Find(*w.world, "panda_joint1")).damping, 0.003);
+}
+
+TEST_F(UrdfTest, AnIkGroupFromTheEntryDrivesTheImportedFanucUnderOde) {
+  NEED_SHARED_URDF(dir);
+  LoadedWorld w = Load("simulation: {physics: ode, time_step: 0.01}\nmodels:\n  - model: " + dir +
+                       "/" + kFanuc +
+                       "\n    position: [0, 0, 0]\n"
+                       "    objects: [{name: goal, type: dummy, position: [0.75, 0.25, 1.0]}]\n"
+                       "    ik_groups:\n"
+                       "      - {name: reach, mode: targets, tips: [{tip: tool0, target: goal, "
+                       "base: base_link}]}\n");
+  World& world = *w.world;
+  world.Start();
+  for (int k = 0; k < 500; ++k) world.Step();
+  const Vec3 tip = world.scene().world_pose(Find(world, "tool0")).p;
+  EXPECT_LT((tip - Vec3{0.75, 0.25, 1.0}).Norm(), 0.01);
+}
+
+TEST_F(UrdfTest, ACadInertiaBreakingTheTriangleInequalityIsMadeIsotropicWithAWarning) {
+  Write("cad.urdf",
+        "<robot name=\"cad\">\n  <link name=\"base\"/>\n  <link name=\"bar\">\n"
+        "    <inertial><mass value=\"1\"/><inertia ixx=\"1\" iyy=\"0.1\" izz=\"0.1\" ixy=\"0\" "
+        "ixz=\"0\" iyz=\"0\"/></inertial>\n"
+        "    <collision><geometry><box size=\"0.4 0.1 0.1\"/></geometry></collision>\n  </link>\n"
+        "  <joint name=\"j\" type=\"continuous\"><parent link=\"base\"/><child link=\"bar\"/>"
+        "<origin xyz=\"0 0 0.5\"/><axis xyz=\"0 0 1\"/></joint>\n</robot>\n");
+  LoadedWorld w =
+      Load("simulation: {physics: ode}\nmodels: [{model: cad.urdf, position: [0, 0, 0]}]\n");
+  ASSERT_EQ(w.warnings.size(), 1u);
+  EXPECT_CONTAINS(w.warnings[0], "triangle inequality");
+  const ShapeData& bar = w.world->scene().shape(Find(*w.world, "bar"));
+  EXPECT_NEAR(bar.inertia[0], 0.4, 1e-12);
+  EXPECT_NEAR(bar.inertia[2], 0.4, 1e-12);
+  w.world->Start();
+  for (int k = 0; k < 100; ++k) w.world->Step();
+}
+
+// --- Bad input -----------------------------------------------------------------------
+
+class UrdfErrorTest : public testing::WorldDirTest {
+ protected:
+  std::string ErrorOfUrdf(const std::string& urdf) {
+    Write("bad.urdf", urdf);
+    return testing::ErrorOf([&] { Load("models: [{model: bad.urdf, position: [0, 0]}]\n"); });
+  }
+};
+
+constexpr const char* kHead = "<?xml version=\"1.0\"?>\n<robot name=\"bad\">\n";
+
+TEST_F(UrdfErrorTest, MalformedFilesNameTheFileTheElementAndTheLine) {
+  std::string e =
+      ErrorOfUrdf(std::string(kHead) + "  <link name=\"a\">\n  <link name=\"b\"/>\n</robot>\n");
+  EXPECT_CONTAINS(e, "bad.urdf:");
+  EXPECT_CONTAINS(e, "malformed XML");
+
+  e = ErrorOfUrdf(std::string(kHead) +
+                  "  <link name=\"a\"/>\n  <joint name=\"j\" type=\"fixed\">\n"
+                  "    <parent link=\"a\"/><child link=\"ghost\"/>\n  </joint>\n</robot>\n");
+  EXPECT_CONTAINS(e, "bad.urdf:4: joint 'j' names child link 'ghost'");
+
+  e = ErrorOfUrdf(
+      std::string(kHead) +
+      "  <link name=\"a\"/>\n  <link name=\"b\"/>\n"
+      "  <joint name=\"j1\" type=\"fixed\"><parent link=\"a\"/><child link=\"b\"/></joint>\n"
+      "  <joint name=\"j2\" type=\"fixed\"><parent link=\"b\"/><child link=\"a\"/></joint>\n"
+      "</robot>\n");
+  EXPECT_CONTAINS(e, "bad.urdf:");
+  EXPECT_CONTAINS(e, "loop");
+
+  e = ErrorOfUrdf(std::string(kHead) +
+                  "  <link name=\"a\">\n    <visual><geometry><mesh filename=\"missing.stl\"/>"
+                  "</geometry></visual>\n  </link>\n</robot>\n");
+  EXPECT_CONTAINS(e, "bad.urdf:4: link 'a' <visual> geometry");
+  EXPECT_CONTAINS(e, "missing.stl");
+
+  e = ErrorOfUrdf(std::string(kHead) +
+                  "  <link name=\"a\">\n    <collision><geometry><mesh "
+                  "filename=\"package://nowhere_pkg/m.stl\"/></geometry></collision>\n  </link>\n"
+                  "</robot>\n");
+  EXPECT_CONTAINS(
+      e, "bad.urdf:4: link 'a' <collision> geometry: cannot resolve package 'nowhere_pkg'");
+
+  e = ErrorOfUrdf(std::string(kHead) +
+                  "  <link name=\"a\">\n    <inertial>\n      <mass value=\"-2\"/>\n"
+                  "      <inertia ixx=\"1\" iyy=\"1\" izz=\"1\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/>\n"
+                  "    </inertial>\n  </link>\n</robot>\n");
+  EXPECT_CONTAINS(e, "bad.urdf:5: link 'a': <mass value=\"-2\">");
+
+  e = ErrorOfUrdf(std::string(kHead) +
+                  "  <link name=\"a\">\n    <inertial>\n      <mass value=\"2\"/>\n"
+                  "      <inertia ixx=\"1\" iyy=\"1\" izz=\"-1\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/>\n"
+                  "    </inertial>\n  </link>\n</robot>\n");
+  EXPECT_CONTAINS(e, "bad.urdf:6: link 'a': <inertia> is not positive definite");
+
+  e = ErrorOfUrdf(std::string(kHead) +
+                  "  <link name=\"a\"/>\n  <link name=\"b\"/>\n"
+                  "  <joint name=\"j\" type=\"revolute\"><parent link=\"a\"/><child link=\"b\"/>"
+                  "<mimic joint=\"nobody\"/><limit lower=\"-1\" upper=\"1\" effort=\"1\" "
+                  "velocity=\"1\"/></joint>\n</robot>\n");
+  EXPECT_CONTAINS(e, "bad.urdf:5: joint 'j': <mimic joint=\"nobody\">");
+
+  e = ErrorOfUrdf(std::string(kHead) +
+                  "  <link name=\"a\"/>\n  <link name=\"b\"/>\n"
+                  "  <joint name=\"j\" type=\"revolutee\"><parent link=\"a\"/><child "
+                  "link=\"b\"/></joint>\n</robot>\n");
+  EXPECT_CONTAINS(e, "bad.urdf:5: joint 'j': unknown type 'revolutee'");
+
+  e = ErrorOfUrdf(std::string(kHead) +
+                  "  <link name=\"a\">\n    <collision><geometry><cone/></geometry></collision>\n"
+                  "  </link>\n</robot>\n");
+  EXPECT_CONTAINS(e, "bad.urdf:4: link 'a' <collision>: unknown geometry <cone>");
+}
+
+TEST_F(UrdfErrorTest, TheProgramExitsWithTwoAndTheMessage) {
+  Write("bad.urdf", std::string(kHead) + "  <link name=\"a\">\n</robot>\n");
+  Write("w.yaml", "models: [{model: bad.urdf, position: [0, 0]}]\n");
+  const std::string command = std::string(SWARMSIM_BINARY) + " run " + (dir_ / "w.yaml").string() +
+                              " --steps 1 --quiet 2>" + (dir_ / "err.txt").string();
+  const int status = std::system(command.c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 2);
+  std::ifstream in(dir_ / "err.txt");
+  const std::string err((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_CONTAINS(err, "bad.urdf:");
+}
+
+}  // namespace
+}  // namespace swarmsim
