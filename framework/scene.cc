@@ -467,6 +467,11 @@ void Scene::SetShapeDynamic(ObjectId id, bool dynamic) {
   shape.dynamic = dynamic;
   ++structure_version_;
 }
+void Scene::SetSurfaceVelocity(ObjectId id, const Vec3& v_S) {
+  ShapeData& shape = mutable_shape(id);
+  if (shape.surface_velocity == Vec3{} && !(v_S == Vec3{})) ++structure_version_;
+  shape.surface_velocity = v_S;
+}
 const JointData& Scene::joint(ObjectId id) const {
   const uint32_t s = SlotOf(id, "joint");
   ExpectType(*this, s, ObjectType::kJoint);

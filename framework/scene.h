@@ -63,6 +63,11 @@ struct ShapeData {
   // a colour is given (the `color` key, sim.setShapeColor).
   bool mesh_colors = true;
   std::shared_ptr<const TriangleMesh> mesh;  // kMesh: the asset (shared by copies), else null
+  // A moving surface (a conveyor belt's, modules/paths): the velocity its
+  // surface slides at relative to the shape, m/s in the shape's frame. The
+  // dynamics backends make contacts carry what touches it along. Set it
+  // through Scene::SetSurfaceVelocity.
+  Vec3 surface_velocity;
 
   // Radius of the shape's footprint circle in its xy plane (for broad phases).
   double BoundingRadius() const;
@@ -350,6 +355,10 @@ class Scene {
   // simulation). Counts as a structural change, so dynamics backends rebuild
   // (taking velocities from the scene). Not thread-safe: call between phases.
   void SetShapeDynamic(ObjectId id, bool dynamic);
+  // Sets ShapeData::surface_velocity. From zero to nonzero it is a
+  // structural change (the backends list a world's moving surfaces when
+  // they build); other changes are read every step. Not thread-safe.
+  void SetSurfaceVelocity(ObjectId id, const Vec3& v_S);
   const JointData& joint(ObjectId id) const;
   JointData& mutable_joint(ObjectId id);
   const ProximitySensorData& proximity_sensor(ObjectId id) const;

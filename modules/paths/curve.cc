@@ -18,7 +18,8 @@ constexpr double kGaussX[5] = {-0.9061798459386640, -0.5384693101056831, 0.0, 0.
 constexpr double kGaussW[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889,
                                0.4786286704993665, 0.2369268850561891};
 
-// The rotation whose columns are the orthonormal axes x, y, z.
+}  // namespace
+
 Quat FromAxes(const Vec3& x, const Vec3& y, const Vec3& z) {
   const double trace = x.x + y.y + z.z;
   Quat q;
@@ -37,8 +38,6 @@ Quat FromAxes(const Vec3& x, const Vec3& y, const Vec3& z) {
   }
   return q.Normalized();
 }
-
-}  // namespace
 
 PathCurve::PathCurve(std::vector<Vec3> points, Interpolation interpolation, bool closed)
     : points_(std::move(points)), interpolation_(interpolation), closed_(closed) {

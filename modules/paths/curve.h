@@ -11,6 +11,9 @@
 
 namespace swarmsim::paths {
 
+// The rotation whose columns are the orthonormal axes x, y, z.
+Quat FromAxes(const Vec3& x, const Vec3& y, const Vec3& z);
+
 enum class Interpolation { kLinear, kSmooth };
 
 class PathCurve {

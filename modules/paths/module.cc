@@ -4,6 +4,7 @@
 
 #include "framework/world.h"
 #include "modules/paths/rows.h"
+#include "modules/paths/types.h"
 
 namespace swarmsim::paths {
 
@@ -13,9 +14,51 @@ uint32_t FindFollower(const Scene& scene, uint32_t path_slot, const std::string&
   return kNoSlot;
 }
 
-void PathsModule::Start(World* world) { Move(&world->scene(), 0.0); }
+void PathsModule::Start(World* world) {
+  Scene* scene = &world->scene();
+  if (Rows<ConveyorRow>* conveyors = ConveyorRows(scene)) {
+    // Belts of conveyors loaded from files (a copy made later has its own).
+    for (size_t r = 0; r < conveyors->size(); ++r)
+      if (conveyors->rows[r].segments == 0)
+        BuildBelt(scene, conveyors->owners[r], &conveyors->rows[r]);
+    if (conveyors->size() > 0) scene->UpdateWorldPoses();
+  }
+  DriveConveyors(scene);
+  Move(scene, 0.0);
+}
 
-void PathsModule::Actuate(World* world) { Move(&world->scene(), world->settings().time_step); }
+void PathsModule::Actuate(World* world) {
+  DriveConveyors(&world->scene());
+  Move(&world->scene(), world->settings().time_step);
+}
+
+void PathsModule::DriveConveyors(Scene* scene) {
+  Rows<ConveyorRow>* rows = ConveyorRows(scene);
+  if (rows == nullptr || rows->size() == 0) return;
+  // The belts' segments by name, again when objects were added, copied or removed.
+  if (belts_version_ != scene->structure_version()) {
+    belts_.assign(rows->size(), {});
+    for (size_t r = 0; r < rows->size(); ++r)
+      for (uint32_t k = 0; k < rows->rows[r].segments; ++k) {
+        const uint32_t slot = FindFollower(*scene, rows->owners[r], BeltSegmentName(k));
+        if (slot != kNoSlot && scene->type_at(slot) == ObjectType::kShape)
+          belts_[r].push_back(slot);
+      }
+    belts_version_ = scene->structure_version();
+  }
+  for (size_t r = 0; r < rows->size(); ++r) {
+    ConveyorRow& c = rows->rows[r];
+    if (!std::isnan(c.requested_speed)) {
+      c.speed = c.requested_speed;
+      c.requested_speed = NAN;
+    }
+    if (c.applied_speed == c.speed) continue;
+    c.applied_speed = c.speed;
+    // Each segment's x axis runs along the belt.
+    for (const uint32_t slot : belts_[r])
+      scene->SetSurfaceVelocity(scene->IdAt(slot), {c.speed, 0, 0});
+  }
+}
 
 void PathsModule::Move(Scene* scene, double dt) {
   Rows<PathRow>* rows = PathRows(scene);

@@ -12,11 +12,40 @@
 #include "modules/paths/module.h"
 #include "modules/paths/paths.h"
 #include "modules/paths/rows.h"
+#include "modules/paths/types.h"
 
 namespace swarmsim::paths {
 
-// The Lua area of the type (lua_api_paths.cc).
-void RegisterPathApi(lua_State* L);
+std::shared_ptr<const PathCurve> ReadCurve(const ObjectReader& r) {
+  std::vector<Vec3> points = r.Vector3List("points", 2, kCoordinate, /*required=*/true);
+  const bool closed = r.Has("closed") && r.Bool("closed");
+  for (size_t i = 1; i < points.size(); ++i)
+    if (points[i] == points[i - 1])
+      r.FailAtElement("points", i,
+                      "points[" + std::to_string(i) + "] repeats points[" + std::to_string(i - 1) +
+                          "]: a path segment must have a length");
+  if (closed && points.back() == points.front())
+    r.FailAtElement("points", points.size() - 1,
+                    "the last point repeats the first: a closed path already joins them (drop "
+                    "the last point)");
+  Interpolation interpolation = Interpolation::kLinear;
+  if (r.Has("interpolation") &&
+      r.Choice("interpolation", {"linear", "smooth"}) == std::string("smooth"))
+    interpolation = Interpolation::kSmooth;
+  return std::make_shared<const PathCurve>(std::move(points), interpolation, closed);
+}
+
+std::shared_ptr<const PathCurve> ScaledCurve(const std::shared_ptr<const PathCurve>& curve,
+                                             double s, ScaleContext* context) {
+  std::shared_ptr<const void>& scaled = context->assets[curve.get()];
+  if (scaled == nullptr) {
+    std::vector<Vec3> points = curve->points();
+    for (Vec3& point : points) point = point * s;
+    scaled = std::make_shared<const PathCurve>(std::move(points), curve->interpolation(),
+                                               curve->closed());
+  }
+  return std::static_pointer_cast<const PathCurve>(scaled);
+}
 
 namespace {
 
@@ -36,22 +65,7 @@ constexpr ObjectKey kPathKeys[] = {
 
 void ReadPath(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
   PathRow& p = *static_cast<PathRow*>(row);
-  std::vector<Vec3> points = r.Vector3List("points", 2, kCoordinate, /*required=*/true);
-  const bool closed = r.Has("closed") && r.Bool("closed");
-  for (size_t i = 1; i < points.size(); ++i)
-    if (points[i] == points[i - 1])
-      r.FailAtElement("points", i,
-                      "points[" + std::to_string(i) + "] repeats points[" + std::to_string(i - 1) +
-                          "]: a path segment must have a length");
-  if (closed && points.back() == points.front())
-    r.FailAtElement("points", points.size() - 1,
-                    "the last point repeats the first: a closed path already joins them (drop "
-                    "the last point)");
-  Interpolation interpolation = Interpolation::kLinear;
-  if (r.Has("interpolation") &&
-      r.Choice("interpolation", {"linear", "smooth"}) == std::string("smooth"))
-    interpolation = Interpolation::kSmooth;
-  p.curve = std::make_shared<const PathCurve>(std::move(points), interpolation, closed);
+  p.curve = ReadCurve(r);
   if (r.Has("velocity")) p.velocity = r.Number("velocity", kCoordinate);
   if (r.Has("start")) p.position = p.curve->Normalize(r.Number("start", kCoordinate));
   if (r.Has("followers")) {
@@ -64,14 +78,7 @@ void ReadPath(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
 // it scales), the position and speed along it, the followers' offsets.
 void ScalePath(const ObjectTypeDescriptor&, void* row, double s, ScaleContext* context) {
   PathRow& p = *static_cast<PathRow*>(row);
-  std::shared_ptr<const void>& scaled = context->assets[p.curve.get()];
-  if (scaled == nullptr) {
-    std::vector<Vec3> points = p.curve->points();
-    for (Vec3& point : points) point = point * s;
-    scaled = std::make_shared<const PathCurve>(std::move(points), p.curve->interpolation(),
-                                               p.curve->closed());
-  }
-  p.curve = std::static_pointer_cast<const PathCurve>(scaled);
+  p.curve = ScaledCurve(p.curve, s, context);
   p.position *= s;
   p.velocity *= s;
   for (Pose& offset : p.offsets) offset.p = offset.p * s;
@@ -123,6 +130,7 @@ void Register(ModuleRegistry* registry) {
        /*every_world=*/true,
        [](World*, const void*) { return std::make_unique<PathsModule>(); }});
   registry->RegisterObjectType(PathType());
+  registry->RegisterObjectType(ConveyorType());
 }
 
 }  // namespace swarmsim::paths
