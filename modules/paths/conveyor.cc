@@ -62,6 +62,15 @@ void ScaleConveyor(const ObjectTypeDescriptor&, void* row, double s, ScaleContex
   c.speed *= s;
   if (!std::isnan(c.requested_speed)) c.requested_speed *= s;
   if (!std::isnan(c.applied_speed)) c.applied_speed *= s;  // the segments' shapes scale too
+  if (c.curvature) {
+    std::shared_ptr<const void>& scaled = context->assets[c.curvature.get()];
+    if (scaled == nullptr) {
+      auto curvature = std::make_shared<std::vector<double>>(*c.curvature);
+      for (double& k : *curvature) k /= s;
+      scaled = std::move(curvature);
+    }
+    c.curvature = std::static_pointer_cast<const std::vector<double>>(scaled);
+  }
 }
 
 void HashConveyors(const Scene& scene, ObjectType type, StateHasher* h) {
@@ -115,6 +124,11 @@ void BuildBelt(Scene* scene, uint32_t slot, ConveyorRow* row) {
   belt.color = row->color;
   belt.mesh_colors = false;
   const ObjectId conveyor = scene->IdAt(slot);
+  // Each segment's curvature on a smooth curve: the (signed) turns at its
+  // ends, half each, over its length, so that a bend's segments (short
+  // against its radius) turn what they carry about the bend's centre. A
+  // linear belt's corners are sharp: its straight segments do not turn.
+  auto curvature = std::make_shared<std::vector<double>>(n, 0.0);
   for (size_t k = 0; k < n; ++k) {
     // x along the chord, z as near the curve's up as x allows.
     const Vec3 x = d[k];
@@ -129,7 +143,18 @@ void BuildBelt(Scene* scene, uint32_t slot, ConveyorRow* row) {
                         z * (row->thickness / 2);
     scene->AddShape(BeltSegmentName(static_cast<uint32_t>(k)), conveyor,
                     {centre, FromAxes(x, y, z)}, belt);
+    // Signed about z: the turn from the segment before to this one, and
+    // from this one to the next.
+    auto signed_turn = [&](const Vec3& from, const Vec3& to) {
+      return std::atan2(from.Cross(to).Dot(z), from.Dot(to));
+    };
+    double total = 0;
+    if (k > 0 || curve.closed()) total += signed_turn(d[k > 0 ? k - 1 : n - 1], x) / 2;
+    if (k + 1 < n || curve.closed()) total += signed_turn(x, d[k + 1 < n ? k + 1 : 0]) / 2;
+    if (curve.interpolation() == Interpolation::kSmooth && chord > 0)
+      (*curvature)[k] = total / chord;
   }
+  row->curvature = std::move(curvature);
   row->segments = static_cast<uint32_t>(n);
 }
 

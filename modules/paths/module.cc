@@ -55,8 +55,11 @@ void PathsModule::DriveConveyors(Scene* scene) {
     if (c.applied_speed == c.speed) continue;
     c.applied_speed = c.speed;
     // Each segment's x axis runs along the belt.
-    for (const uint32_t slot : belts_[r])
-      scene->SetSurfaceVelocity(scene->IdAt(slot), {c.speed, 0, 0});
+    for (size_t k = 0; k < belts_[r].size(); ++k) {
+      const double curvature = c.curvature && k < c.curvature->size() ? (*c.curvature)[k] : 0.0;
+      scene->SetSurfaceVelocity(scene->IdAt(belts_[r][k]), {c.speed, 0, 0},
+                                {0, 0, c.speed * curvature});
+    }
   }
 }
 

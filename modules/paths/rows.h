@@ -49,6 +49,9 @@ struct ConveyorRow {
   double requested_speed = NAN;  // sim.setConveyorSpeed's, applied in the actuate phase
   double applied_speed = NAN;    // what the segments' surfaces carry (NaN: not yet)
   uint32_t segments = 0;         // belt segments made (0: not yet; copies keep theirs)
+  // Per segment: its turn per metre about its z axis (rad/m, positive to
+  // the left), so a segment on a bend turns what it carries with the bend.
+  std::shared_ptr<const std::vector<double>> curvature;
 };
 
 // The scene's path rows, or null if the type is not registered.

@@ -91,14 +91,15 @@ struct TractionSolve {      // 64 bytes
 // segment) that is no part of a body: its footprint in the plane and its
 // top, taken at Build (like static obstacles); its surface velocity read
 // every step. Box2D units but `top`.
-struct PlaneBelt {  // 80 bytes
+struct PlaneBelt {  // 88 bytes
   uint32_t slot = 0;
   double c_x = 0, c_y = 0;        // footprint centre
   double cos = 1, sin = 0;        // footprint rotation (the shape's yaw)
   double half_x = 0, half_y = 0;  // footprint half extents
   double top = 0;                 // m, height of its top face
   double friction = 0;            // the belt's Coulomb coefficient
-  double v_x = 0, v_y = 0;        // surface velocity in the plane, world frame
+  double v_x = 0, v_y = 0;        // surface velocity at the centre, world frame
+  double w = 0;                   // rad/s: the surface's turn about the vertical
 };
 
 // A body without wheels that may lie on a belt (only built when there are
@@ -109,8 +110,8 @@ struct PlaneRider {                     // 48 bytes
   double bottom = 0;                    // m, height of its lowest point (z stays put in the plane)
   b2FrictionJoint* friction = nullptr;  // its ground friction, off while on a belt
   double max_force = 0;                 // the joint's own force limit, Box2D units
+  double max_torque = 0;                // and torque limit
   double body_friction = 0;             // its shape's Coulomb coefficient
-  double weight = 0;                    // m g, Box2D units
 };
 
 using dynamics::HeightRange;  // height range [lo, hi] of shapes, m
@@ -171,7 +172,8 @@ class PlaneWorld {
   // 2b. The belts, and (after 4.) the bodies that may ride them
   // (plane_belts.cc).
   void BuildBelts(const Scene& scene, const std::vector<int32_t>& body_of);
-  void AddRider(const Scene& scene, uint32_t body, b2FrictionJoint* friction, double max_force);
+  void AddRider(const Scene& scene, uint32_t body, b2FrictionJoint* friction, double max_force,
+                double max_torque);
   // Each belt's surface velocity, once per step.
   void ReadBelts(const Scene& scene);
   // Friction towards its belt's surface velocity for each body lying on a

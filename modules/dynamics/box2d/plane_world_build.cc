@@ -302,7 +302,7 @@ void PlaneWorld::BuildObstacles(const Scene& scene, const std::vector<int32_t>& 
     if (!shape || shape->dynamic || dynamics::NearestBodyAbove(scene, body_of, s, -1) >= 0)
       continue;
     // A moving surface (a belt) carries bodies: no obstacle (BuildBelts).
-    if (!(shape->surface_velocity == Vec3{})) continue;
+    if (shape->HasMovingSurface()) continue;
     const Pose& X_WS = scene.world_pose_at(s);
     ThrowIfNotFinite(scene, s, X_WS);
     const HeightRange range = CalcHeightRange(*shape, X_WS);
@@ -456,7 +456,8 @@ void PlaneWorld::BuildGroundFriction(const Scene& scene) {
     def.maxForce = static_cast<float>(force * L);
     def.maxTorque = static_cast<float>(2.0 / 3.0 * force * FootprintRadius(shape) * L * L);
     b2Joint* joint = world_->CreateJoint(&def);
-    if (!belts_.empty()) AddRider(scene, b, static_cast<b2FrictionJoint*>(joint), def.maxForce);
+    if (!belts_.empty())
+      AddRider(scene, b, static_cast<b2FrictionJoint*>(joint), def.maxForce, def.maxTorque);
   }
 }
 

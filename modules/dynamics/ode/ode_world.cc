@@ -225,16 +225,19 @@ void OdeWorld::AddGeom(dGeomID geom, int32_t instance, double friction, double r
 }
 
 void OdeWorld::AddSurface(const ShapeData& shape, uint32_t slot) {
-  if (shape.surface_velocity == Vec3{}) return;
+  if (!shape.HasMovingSurface()) return;
   geom_info_.back().surface = static_cast<int32_t>(surfaces_.size());
-  surfaces_.push_back({slot, shape.surface_velocity});
+  surfaces_.push_back({slot, shape.surface_velocity, shape.surface_angular_velocity});
 }
 
-Vec3 OdeWorld::SurfaceVelocity(dGeomID geom, const GeomInfo& info) const {
+Vec3 OdeWorld::SurfaceVelocity(dGeomID geom, const GeomInfo& info, const Vec3& p_W) const {
   if (info.surface < 0) return {};
+  const MovingSurface& surface = surfaces_[info.surface];
   dQuaternion q;
   dGeomGetQuaternion(geom, q);
-  return Quat{q[0], q[1], q[2], q[3]}.Rotate(surfaces_[info.surface].v_S);
+  const Quat q_WS{q[0], q[1], q[2], q[3]};
+  const Vec3 p_S = q_WS.Conjugate().Rotate(p_W - ToVec3(dGeomGetPosition(geom)));
+  return q_WS.Rotate(surface.v_S + surface.w_S.Cross(p_S));
 }
 
 dTriMeshDataID OdeWorld::MeshData(const std::shared_ptr<const TriangleMesh>& mesh) {
@@ -481,8 +484,11 @@ void OdeWorld::SyncFromScene(const Scene& scene, double duration) {
 
 void OdeWorld::ReadCommands(const Scene& scene) {
   for (size_t k = 0; k < joints_.size(); ++k) commands_[k] = scene.joints()[joints_[k].row];
-  for (MovingSurface& surface : surfaces_)
-    surface.v_S = scene.shapes()[scene.row_at(surface.slot)].surface_velocity;
+  for (MovingSurface& surface : surfaces_) {
+    const ShapeData& shape = scene.shapes()[scene.row_at(surface.slot)];
+    surface.v_S = shape.surface_velocity;
+    surface.w_S = shape.surface_angular_velocity;
+  }
 }
 
 void OdeWorld::ApplyMotors(double dt) {
@@ -582,19 +588,21 @@ void OdeWorld::Collide(dGeomID a, dGeomID b) {
   const double mu = std::sqrt(ia.friction * ib.friction);
   const double bounce = std::max(ia.restitution, ib.restitution);
   // Moving surfaces (conveyor belts): friction drives the contact towards
-  // a's surface point moving as b's, v_a + u_a = v_b + u_b, so the bodies'
-  // relative velocity v_a - v_b is u = u_b - u_a in the contact plane. ODE
+  // a's surface point moving as b's, v_a + u_a = v_b + u_b (u: each
+  // surface's velocity at the contact point), so the bodies' relative
+  // velocity v_a - v_b is u = u_b - u_a in the contact plane. ODE
   // constrains (v_1 - v_2) . fdir1 = motion1 where body 1 is a's body, or
   // b's when a has none (a static belt: ODE then swaps the two).
-  const Vec3 u =
-      ia.surface >= 0 || ib.surface >= 0 ? SurfaceVelocity(b, ib) - SurfaceVelocity(a, ia) : Vec3{};
+  const bool moving = ia.surface >= 0 || ib.surface >= 0;
   for (int i = 0; i < n; ++i) {
     dContact& c = contact_buffer_[i];
     c.surface.mode = dContactApprox1 | (bounce > 0 ? dContactBounce : 0);
     c.surface.mu = mu;
     c.surface.bounce = bounce;
     c.surface.bounce_vel = kBounceVelocity;
-    if (!(u == Vec3{})) {
+    if (moving) {
+      const Vec3 p_W = ToVec3(c.geom.pos);
+      const Vec3 u = SurfaceVelocity(b, ib, p_W) - SurfaceVelocity(a, ia, p_W);
       const Vec3 normal = ToVec3(c.geom.normal);
       const Vec3 t = u - normal * normal.Dot(u);
       const double speed = t.Norm();

@@ -69,9 +69,9 @@ struct GeomInfo {        // 24 bytes
 
 // A shape whose surface moves (ShapeData::surface_velocity: a conveyor
 // belt's segment), read from the scene every step.
-struct MovingSurface {  // 32 bytes
+struct MovingSurface {  // 56 bytes
   uint32_t slot;
-  Vec3 v_S;  // m/s in the shape's frame
+  Vec3 v_S, w_S;  // m/s, rad/s in the shape's frame (ShapeData::surface_*)
 };
 
 class OdeWorld {
@@ -125,8 +125,8 @@ class OdeWorld {
   // The geom last added is the shape at `slot`: listed as a moving surface
   // if the shape has a surface velocity.
   void AddSurface(const ShapeData& shape, uint32_t slot);
-  // The world velocity of a moving surface geom's surface.
-  Vec3 SurfaceVelocity(dGeomID geom, const GeomInfo& info) const;
+  // The world velocity of a geom's surface at p_W (zero if it does not move).
+  Vec3 SurfaceVelocity(dGeomID geom, const GeomInfo& info, const Vec3& p_W) const;
   // ODE's trimesh data for a mesh asset, made once per world (ode_world.cc).
   dTriMeshDataID MeshData(const std::shared_ptr<const TriangleMesh>& mesh);
   void ApplyMotors(double dt);
