@@ -1,5 +1,6 @@
 #include "modules/paths/module.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "framework/world.h"
@@ -7,6 +8,45 @@
 #include "modules/paths/types.h"
 
 namespace swarmsim::paths {
+
+namespace {
+
+// Moves a path's position by velocity x dt, stopping at the first point
+// with a pause on the way (then waiting there, whole steps, before going on).
+void Advance(PathRow* p, double dt) {
+  if (p->pause_left > 0) {
+    p->pause_left -= dt;
+    if (p->pause_left < 1e-9) p->pause_left = 0;  // (0.5 s is five steps of 0.1 s)
+    return;
+  }
+  const double from = p->position, to = from + p->velocity * dt;
+  const PathCurve& curve = *p->curve;
+  if (!p->pauses.empty() && dt > 0 && p->velocity != 0) {
+    // The nearest paused point in (from, to] (or [to, from) backwards),
+    // counting a closed path's points once more a lap ahead and behind.
+    const double length = curve.length();
+    double best = NAN;
+    for (size_t i = 0; i < p->pauses.size(); ++i) {
+      if (!(p->pauses[i] > 0)) continue;
+      for (const double lap : {-1.0, 0.0, 1.0}) {
+        if (lap != 0 && !curve.closed()) continue;
+        const double s = curve.LengthAtPoint(i) + lap * length;
+        const bool ahead = p->velocity > 0 ? s > from && s <= to : s < from && s >= to;
+        if (ahead && (std::isnan(best) || std::abs(s - from) < std::abs(best - from))) {
+          best = s;
+          p->pause_left = p->pauses[i];
+        }
+      }
+    }
+    if (!std::isnan(best)) {
+      p->position = curve.Normalize(best);
+      return;
+    }
+  }
+  p->position = curve.Normalize(to);
+}
+
+}  // namespace
 
 uint32_t FindFollower(const Scene& scene, uint32_t path_slot, const std::string& name) {
   for (const ObjectId child : scene.children(scene.IdAt(path_slot)))
@@ -88,7 +128,7 @@ void PathsModule::Move(Scene* scene, double dt) {
       for (const uint32_t slot : slots)
         p.offsets.push_back(slot != kNoSlot ? scene->local_pose_at(slot) : Pose{});
     }
-    p.position = p.curve->Normalize(p.position + p.velocity * dt);
+    Advance(&p, dt);
     if (slots.empty()) continue;
     const Pose X_PC = p.curve->PoseAt(p.position);
     for (size_t k = 0; k < slots.size(); ++k)

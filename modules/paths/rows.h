@@ -22,12 +22,14 @@ struct PathRow {
   std::shared_ptr<const PathCurve> curve;  // shared by copies (scaled: one copy per scale)
   std::vector<std::string> followers;      // names of the path's children that ride it
   std::string where;                       // "file:line:column" of `followers`, for errors
+  std::vector<double> pauses;              // s, per point (or empty): followers stop there
   // State: where the followers are along the curve and how fast they move.
   double position = 0;  // m, arc length
   double velocity = 0;  // m/s
   // sim.setPathPosition's request, applied in the actuate phase (NaN: none),
   // so `position` changes only there and any robot may read it.
   double requested_position = NAN;
+  double pause_left = 0;  // s: the followers wait at a point this much longer
   // The followers' poses in the frame moving along the curve (their file
   // poses, kept when first moved; one per follower).
   std::vector<Pose> offsets;

@@ -103,8 +103,8 @@ TEST_F(ConveyorsTest, ACurvedBeltCarriesACrateRoundTheBend) {
 // A script stops its belt (speed 0) and reverses it; the crate stops and
 // comes back. The belt is in a model: a kinematic body in ODE.
 TEST_F(ConveyorsTest, ScriptsStopAndReverseTheirBelt) {
-  Write("line.yaml", LineModel("      points: [[-1, 0, 0], [3, 0, 0]]\n      speed: 0.2\n",
-                               "line.lua"));
+  Write("line.yaml",
+        LineModel("      points: [[-1, 0, 0], [3, 0, 0]]\n      speed: 0.2\n", "line.lua"));
   Write("line.lua",
         "local n = 0\n"
         "function sysCall_actuation()\n"
@@ -210,8 +210,8 @@ TEST_F(ConveyorsTest, TheExampleWorldDeliversItsCrates) {
   for (const int threads : {1, 2}) {
     LoadOptions options;
     options.threads = threads;
-    LoadedWorld w = LoadWorld(std::string(SWARMSIM_SOURCE_DIR) + "/worlds/conveyor.yaml", options,
-                              registry_);
+    LoadedWorld w =
+        LoadWorld(std::string(SWARMSIM_SOURCE_DIR) + "/worlds/conveyor.yaml", options, registry_);
     w.world->set_log_sink([](std::string_view) {});
     for (int i = 0; i < 2500; ++i) w.world->Step();
     hashes[threads - 1] = w.world->StateHash();
