@@ -1,7 +1,8 @@
 // Paths' per-point orientations and pauses (modules/paths): followers turn
 // from one point's orientation to the next (slerp) instead of following the
 // tangent, and stop at a point for its pause, going either way; mistakes
-// are file:line:col errors.
+// are file:line:col errors. Paths made by scripts (sim.createPath) exist
+// from the next step, the same for any thread count.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -119,6 +120,70 @@ TEST_F(PathPausesTest, BadOrientationsAndPausesAreFileLineColumnErrors) {
                     "  points: [[0, 0, 0], [1, 0, 0]]\n  yaw_deg: [0, 1]\n"
                     "  pauses: [1, 0]\n"),
             "(no error)");
+}
+
+// Each robot makes a path under itself in its first step; from the next
+// one, sim.getObject finds it, its length and poses are the points', and
+// the hash is the same at 1 and 2 threads.
+TEST_F(PathPausesTest, ScriptsCreatePathsDeterministically) {
+  Write("bot.yaml", "model: bot\nobjects: {type: dummy, script: bot.lua}\n");
+  Write("bot.lua",
+        "local n = 0\n"
+        "function sysCall_actuation()\n"
+        "  n = n + 1\n"
+        "  if n == 1 then\n"
+        "    sim.createPath({{0, 0, 0}, {1, 0, 0}, {1, 2, 0}}, {name = 'made', velocity = 0.5})\n"
+        "  else\n"
+        "    local h = sim.getObject('./made')\n"
+        "    sim.recordMetric('length', sim.getPathLength(h))\n"
+        "    sim.recordMetric('y', sim.getPathPose(h, 2)[2])\n"
+        "  end\n"
+        "end\n");
+  uint64_t hashes[2] = {};
+  for (const int threads : {1, 2}) {
+    LoadedWorld w = Load(
+        "simulation: {physics: kinematic, time_step: 0.1}\n"
+        "models: [{model: bot.yaml, count: 6, distribute: {region: {min: [-3, -3], max: [3, "
+        "3]}}}]\n",
+        threads);
+    for (int i = 0; i < 5; ++i) w.world->Step();
+    hashes[threads - 1] = w.world->StateHash();
+    int lengths = 0;
+    for (const MetricSample& m : w.world->TakeMetrics()) {
+      if (m.name == "length") {
+        EXPECT_EQ(m.value, 3.0);
+        ++lengths;
+      }
+    }
+    EXPECT_EQ(lengths, 6 * 4);
+    const Scene& scene = w.world->scene();
+    const ObjectId made = scene.FindObject("/bot#3/made");
+    ASSERT_FALSE(made.IsNull());
+    // Made after step 1's control phase, it moves from that step's actuate
+    // phase on: 5 steps at 0.5 m/s.
+    EXPECT_NEAR(RowOf<PathRow>(*w.world, "/bot#3/made").position, 0.25, 1e-12);
+  }
+  EXPECT_EQ(hashes[0], hashes[1]);
+}
+
+TEST_F(PathPausesTest, BadCreatePathCallsNameTheScriptLine) {
+  Write("bot.yaml", "model: bot\nobjects: {type: dummy, script: bot.lua}\n");
+  for (const std::string call :
+       {"sim.createPath({{0, 0, 0}})", "sim.createPath({{0, 0, 0}, {0/0, 0, 0}})",
+        "sim.createPath({{0, 0, 0}, {0, 0, 0}})",
+        "sim.createPath({{0, 0, 0}, {1, 0, 0}}, {interpolation = 'smoth'})",
+        "sim.createPath({{0, 0, 0}, {1, 0, 0}}, {parent = sim.getObject('/bot#1')})"}) {
+    Write("bot.lua", "function sysCall_actuation()\n  " + call + "\nend\n");
+    LoadedWorld w = Load(
+        "simulation: {physics: kinematic}\n"
+        "models: [{model: bot.yaml, position: [0, 0]}, {model: bot.yaml, position: [2, 0]}]\n");
+    try {
+      w.world->Step();
+      ADD_FAILURE() << "no error: " << call;
+    } catch (const Error& e) {
+      EXPECT_CONTAINS(e.what(), "bot.lua:2");
+    }
+  }
 }
 
 }  // namespace
