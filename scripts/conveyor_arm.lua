@@ -24,16 +24,6 @@ local function lerp(a, b, s)
   return {a[1] + (b[1] - a[1]) * s, a[2] + (b[2] - a[2]) * s, a[3] + (b[3] - a[3]) * s}
 end
 
--- v rotated by the conjugate of the quaternion q = {x, y, z, w}.
-local function rotate_inverse(q, v)
-  local x, y, z, w = -q[1], -q[2], -q[3], q[4]
-  local tx = 2 * (y * v[3] - z * v[2])
-  local ty = 2 * (z * v[1] - x * v[3])
-  local tz = 2 * (x * v[2] - y * v[1])
-  return {v[1] + w * tx + (y * tz - z * ty), v[2] + w * ty + (z * tx - x * tz),
-          v[3] + w * tz + (x * ty - y * tx)}
-end
-
 local function set_target(p)
   sim.setObjectPose(target, {p[1], p[2], p[3], orientation[1], orientation[2], orientation[3],
                              orientation[4]}, base)
@@ -90,10 +80,7 @@ function sysCall_actuation()
     if s >= 1 then
       if move[4] == 'grasp' then
         -- The crate's position in the tool frame, kept while carried.
-        local tool = sim.getObjectPose(tip)
-        local b = sim.getObjectPosition(carried)
-        grasp_offset = rotate_inverse({tool[4], tool[5], tool[6], tool[7]},
-                                      {b[1] - tool[1], b[2] - tool[2], b[3] - tool[3]})
+        grasp_offset = sim.getObjectPosition(carried, tip)
         sim.setObjectDynamic(carried, false)
         picked = picked + 1
       elseif move[4] == 'release' then

@@ -30,8 +30,8 @@ std::unique_ptr<RowTable> MakeRows(const ObjectTypeDescriptor&) {
   return std::make_unique<Rows<ShapeData>>();
 }
 
-// Sizes and surface velocity x s (not its angular velocity), mass x s^3; a mesh gets a scaled copy of its asset, one per
-// asset per call (context), so copies duplicated afterwards share it.
+// Sizes and surface velocity x s (not its angular velocity), mass x s^3; a mesh gets a scaled copy
+// of its asset, one per asset per call (context), so copies duplicated afterwards share it.
 void Scale(const ObjectTypeDescriptor&, void* row, double s, ScaleContext* context) {
   ShapeData& shape = *static_cast<ShapeData*>(row);
   shape.size = shape.size * s;
