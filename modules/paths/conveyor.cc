@@ -22,6 +22,8 @@ namespace swarmsim::paths {
 
 namespace {
 
+constexpr NumberRule kSpeed{"a finite number of m/s", -kMaxLength, kMaxLength};
+
 constexpr ObjectKey kConveyorKeys[] = {
     {"points", "required",
      "[[x, y, z], ...]: the belt's top centre line, m in the conveyor's frame; at least 2, no two "
@@ -47,7 +49,7 @@ void ReadConveyor(const ObjectTypeDescriptor&, const ObjectReader& r, void* row)
   if (r.Has("width")) c.width = r.Number("width", kPositiveLength);
   if (r.Has("thickness")) c.thickness = r.Number("thickness", kPositiveLength);
   if (r.Has("segment_length")) c.segment_length = r.Number("segment_length", kPositiveLength);
-  if (r.Has("speed")) c.speed = r.Number("speed", kCoordinate);
+  if (r.Has("speed")) c.speed = r.Number("speed", kSpeed);
   if (r.Has("friction")) c.friction = r.Number("friction", kNonNegative);
   if (r.Has("color")) c.color = r.Vector3("color", kFraction);
 }
