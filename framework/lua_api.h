@@ -18,6 +18,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <exception>
+#include <functional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -148,6 +149,12 @@ void ArgType(lua_State* L, int arg, int type);
 // the argument is absent and def is not null. Anything else is an error
 // listing the options (and the nearest, for a typo).
 int ArgOption(lua_State* L, int arg, const char* def, const char* const options[]);
+
+// Queues `add` to run on the scene when the caller's copies and removals
+// of robots are applied (after the control phase, robots in index order):
+// how a module's Lua area makes objects (sim.createPath) the same way for
+// any thread count (lua_api_models.cc).
+void QueueSceneAddition(lua_State* L, std::function<void(Scene*)> add);
 
 // An object handle argument (an integer, ObjectId::ToInteger()).
 inline ObjectId CheckObject(lua_State* L, int arg) {

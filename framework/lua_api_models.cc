@@ -44,6 +44,17 @@ void Queue(lua_State* L, const ModelEdit& edit) {
   queued.push_back(edit);
 }
 
+}  // namespace
+
+void QueueSceneAddition(lua_State* L, std::function<void(Scene*)> add) {
+  ModelEdit edit;
+  edit.kind = ModelEdit::Kind::kAdd;
+  edit.add = std::move(add);
+  Queue(L, edit);
+}
+
+namespace {
+
 // The optional pose argument {x, y, yaw} (m, m, rad) of sim.copyModel.
 void ReadPose(lua_State* L, int arg, ModelEdit* edit) {
   if (lua_isnoneornil(L, arg)) return;

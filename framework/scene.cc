@@ -467,6 +467,13 @@ void Scene::SetShapeDynamic(ObjectId id, bool dynamic) {
   shape.dynamic = dynamic;
   ++structure_version_;
 }
+void Scene::SetSurfaceVelocity(ObjectId id, const Vec3& v_S, const Vec3& w_S) {
+  ShapeData& shape = mutable_shape(id);
+  const bool was_moving = shape.HasMovingSurface();
+  shape.surface_velocity = v_S;
+  shape.surface_angular_velocity = w_S;
+  if (!was_moving && shape.HasMovingSurface()) ++structure_version_;
+}
 const JointData& Scene::joint(ObjectId id) const {
   const uint32_t s = SlotOf(id, "joint");
   ExpectType(*this, s, ObjectType::kJoint);

@@ -70,6 +70,17 @@ struct ShapeData {
   // a colour is given (the `color` key, sim.setShapeColor).
   bool mesh_colors = true;
   std::shared_ptr<const TriangleMesh> mesh;  // kMesh: the asset (shared by copies), else null
+  // A moving surface (a conveyor belt's, modules/paths): its surface slides
+  // relative to the shape, a point p of it (in the shape's frame) at
+  // surface_velocity + surface_angular_velocity x p (m/s, rad/s, in the
+  // shape's frame: a belt's segment on a bend turns about the bend's
+  // centre). The dynamics backends make contacts carry what touches it
+  // along. Set them through Scene::SetSurfaceVelocity.
+  Vec3 surface_velocity;
+  Vec3 surface_angular_velocity;
+  bool HasMovingSurface() const {
+    return !(surface_velocity == Vec3{}) || !(surface_angular_velocity == Vec3{});
+  }
 
   // Radius of the shape's footprint circle in its xy plane (for broad phases).
   double BoundingRadius() const;
@@ -365,6 +376,11 @@ class Scene {
   // simulation). Counts as a structural change, so dynamics backends rebuild
   // (taking velocities from the scene). Not thread-safe: call between phases.
   void SetShapeDynamic(ObjectId id, bool dynamic);
+  // Sets ShapeData::surface_velocity and surface_angular_velocity. From
+  // still to moving it is a structural change (the backends list a world's
+  // moving surfaces when they build); other changes are read every step.
+  // Not thread-safe.
+  void SetSurfaceVelocity(ObjectId id, const Vec3& v_S, const Vec3& w_S);
   const JointData& joint(ObjectId id) const;
   JointData& mutable_joint(ObjectId id);
   const ProximitySensorData& proximity_sensor(ObjectId id) const;

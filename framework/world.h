@@ -147,9 +147,12 @@ class LogBuffer {
 // sim.removeModel, lua_api_models.cc), applied by the World between the
 // control and actuate phases (World::ApplyModelEdits, world_model_edits.cc).
 struct ModelEdit {
-  enum class Kind : uint8_t { kCopy, kRemove };
+  // kAdd: objects a module's Lua call makes (sim.createPath), `add` run on
+  // the scene after the copies and removals, in the same order.
+  enum class Kind : uint8_t { kCopy, kRemove, kAdd };
   Kind kind = Kind::kCopy;
-  ObjectId root;          // the robot's model root (validated when queued)
+  std::function<void(Scene*)> add;  // kAdd
+  ObjectId root;                    // the robot's model root (validated when queued)
   bool has_pose = false;  // kCopy: place the copy at (x, y, yaw), else at the source's pose
   double x = 0, y = 0;    // m, world frame
   double yaw = 0;         // rad

@@ -60,6 +60,14 @@ void World::ApplyModelEdits() {
   // Then removals (a robot removed twice goes once).
   for (const ModelEdit& edit : edits)
     if (edit.kind == ModelEdit::Kind::kRemove && scene_.IsValid(edit.root)) RemoveRobot(edit.root);
+  // Then the objects scripts made (sim.createPath), robots in index order.
+  bool added = false;
+  for (const ModelEdit& edit : edits)
+    if (edit.kind == ModelEdit::Kind::kAdd && edit.add) {
+      edit.add(&scene_);
+      added = true;
+    }
+  if (added) scene_.UpdateWorldPoses();
   // What the new robots' sysCall_init and the removed ones' sysCall_cleanup
   // printed, recorded or failed with, in robot order.
   for (const auto& [robot, source] : copies) pending_[robot] |= kPendingOutput;

@@ -35,13 +35,14 @@ std::unique_ptr<RowTable> MakeRows(const ObjectTypeDescriptor&) {
   return std::make_unique<Rows<ShapeData>>();
 }
 
-// Sizes x s, mass x s^3; a mesh gets a scaled copy of its asset, one per
-// asset per call (context), so copies duplicated afterwards share it.
+// Sizes and surface velocity x s (not its angular velocity), mass x s^3; a mesh gets a scaled copy
+// of its asset, one per asset per call (context), so copies duplicated afterwards share it.
 void Scale(const ObjectTypeDescriptor&, void* row, double s, ScaleContext* context) {
   ShapeData& shape = *static_cast<ShapeData*>(row);
   shape.size = shape.size * s;
   shape.mass *= s * s * s;
   for (double& i : shape.inertia) i *= s * s * s * s * s;
+  shape.surface_velocity = shape.surface_velocity * s;
   if (!shape.mesh) return;
   std::shared_ptr<const void>& scaled = context->assets[shape.mesh.get()];
   if (!scaled) {

@@ -18,7 +18,8 @@ constexpr double kGaussX[5] = {-0.9061798459386640, -0.5384693101056831, 0.0, 0.
 constexpr double kGaussW[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889,
                                0.4786286704993665, 0.2369268850561891};
 
-// The rotation whose columns are the orthonormal axes x, y, z.
+}  // namespace
+
 Quat FromAxes(const Vec3& x, const Vec3& y, const Vec3& z) {
   const double trace = x.x + y.y + z.z;
   Quat q;
@@ -38,7 +39,29 @@ Quat FromAxes(const Vec3& x, const Vec3& y, const Vec3& z) {
   return q.Normalized();
 }
 
-}  // namespace
+Quat Slerp(const Quat& a, const Quat& b_in, double f) {
+  Quat b = b_in;
+  double cosine = a.w * b.w + a.x * b.x + a.y * b.y + a.z * b.z;
+  if (cosine < 0) {
+    b = {-b.w, -b.x, -b.y, -b.z};
+    cosine = -cosine;
+  }
+  double ka = 1 - f, kb = f;
+  if (cosine < 0.9999) {  // else nearly equal: linear, normalized below
+    const double angle = std::acos(std::min(cosine, 1.0));
+    const double s = std::sin(angle);
+    ka = std::sin((1 - f) * angle) / s;
+    kb = std::sin(f * angle) / s;
+  }
+  return Quat{ka * a.w + kb * b.w, ka * a.x + kb * b.x, ka * a.y + kb * b.y, ka * a.z + kb * b.z}
+      .Normalized();
+}
+
+PathCurve::PathCurve(std::vector<Vec3> points, Interpolation interpolation, bool closed,
+                     std::vector<Quat> orientations)
+    : PathCurve(std::move(points), interpolation, closed) {
+  if (orientations.size() == points_.size()) orientations_ = std::move(orientations);
+}
 
 PathCurve::PathCurve(std::vector<Vec3> points, Interpolation interpolation, bool closed)
     : points_(std::move(points)), interpolation_(interpolation), closed_(closed) {
@@ -149,6 +172,10 @@ Pose PathCurve::PoseAt(double s) const {
       if (!(next > lo && next < hi)) next = (lo + hi) / 2;
       t = next;
     }
+  }
+  if (!orientations_.empty()) {
+    const double f = seg_len > 0 ? std::clamp(local / seg_len, 0.0, 1.0) : 0.0;
+    return {Position(i, t), Slerp(orientations_[i], orientations_[(i + 1) % points_.size()], f)};
   }
   Vec3 x = Derivative(i, t).Normalized();
   if (x.SquaredNorm() == 0) x = (points_[(i + 1) % points_.size()] - points_[i]).Normalized();

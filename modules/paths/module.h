@@ -17,18 +17,23 @@ uint32_t FindFollower(const Scene& scene, uint32_t path_slot, const std::string&
 
 class PathsModule final : public Module {
  public:
-  // Places the followers at their paths' starting positions.
+  // Places the followers at their paths' starting positions; makes the
+  // conveyors' belts and sets their surfaces moving.
   void Start(World* world) override;
   // Advances each path's position by velocity x dt (clamped at the ends of
-  // an open path, wrapped on a closed one) and moves its followers there.
-  // Paths in row order, serially: cheap, and the same for any thread count.
+  // an open path, wrapped on a closed one) and moves its followers there;
+  // applies the conveyors' new speeds to their belts' surfaces. Rows in
+  // order, serially: cheap, and the same for any thread count.
   void Actuate(World* world) override;
 
  private:
   void Move(Scene* scene, double dt);
+  void DriveConveyors(Scene* scene);
 
   uint64_t version_ = UINT64_MAX;                 // the scene structure followers_ follows
   std::vector<std::vector<uint32_t>> followers_;  // by path row: the followers' slots
+  uint64_t belts_version_ = UINT64_MAX;           // the scene structure belts_ follows
+  std::vector<std::vector<uint32_t>> belts_;      // by conveyor row: the segments' slots
 };
 
 }  // namespace swarmsim::paths

@@ -24,6 +24,12 @@
 //     friction instead (a b2FrictionJoint to the ground with max force
 //     mu m g and max torque 2/3 mu m g r, r the footprint radius).
 //
+//   - Moving surfaces (ShapeData::surface_velocity: conveyor belts) that are
+//     no part of a body are belts, not obstacles: a body without wheels lying
+//     on one (centre over its footprint, bottom at its top) has its ground
+//     friction pull it towards the belt's surface velocity and turn instead
+//     (plane_belts.cc).
+//
 // Wheel sign convention. A revolute joint turns its children by +theta about
 // its own z axis `a` (right-hand rule). The contact point sits at -R below
 // the wheel centre, so rolling without slip needs

@@ -79,6 +79,7 @@ void PlaneWorld::ReadCommands(const Scene& scene) {
     wheel.surface_speed = target * wheel.radius_m * scale_;
     if (target != 0) bodies_[wheel.body].commanded = true;
   }
+  if (!belts_.empty()) ReadBelts(scene);
 }
 
 namespace {
@@ -234,6 +235,7 @@ void PlaneWorld::ApplyTraction(std::span<const uint32_t> wheeled, double dt) {
 void PlaneWorld::Substep(double dt, double /*fraction*/) {
   last_dt_ = dt;
   ApplyTraction(dt);
+  if (!riders_.empty()) ApplyBelts(dt);
   world_->Step(static_cast<float>(dt), options_.velocity_iterations, options_.position_iterations);
   // What the step (contacts) did to each wheeled body's velocity.
   for (uint32_t b : wheeled_) {

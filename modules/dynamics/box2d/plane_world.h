@@ -26,6 +26,8 @@ struct JointData;
 struct ShapeData;
 }  // namespace swarmsim
 
+class b2FrictionJoint;
+
 namespace swarmsim::box2d {
 
 // One simulated body: a dynamic shape.
@@ -85,6 +87,33 @@ struct TractionSolve {      // 64 bytes
   double vx = 0, vy = 0, w = 0;  // velocity, body plane frame, Box2D units
 };
 
+// A moving surface (ShapeData::surface_velocity: a conveyor belt's
+// segment) that is no part of a body: its footprint in the plane and its
+// top, taken at Build (like static obstacles); its surface velocity read
+// every step. Box2D units but `top`.
+struct PlaneBelt {  // 88 bytes
+  uint32_t slot = 0;
+  double c_x = 0, c_y = 0;        // footprint centre
+  double cos = 1, sin = 0;        // footprint rotation (the shape's yaw)
+  double half_x = 0, half_y = 0;  // footprint half extents
+  double top = 0;                 // m, height of its top face
+  double friction = 0;            // the belt's Coulomb coefficient
+  double v_x = 0, v_y = 0;        // surface velocity at the centre, world frame
+  double w = 0;                   // rad/s: the surface's turn about the vertical
+};
+
+// A body without wheels that may lie on a belt (only built when there are
+// belts): what its ground friction is while it does.
+struct PlaneRider {                     // 48 bytes
+  uint32_t body = 0;                    // index into bodies_
+  int32_t belt = -1;                    // the belt it lies on in this substep, or -1
+  double bottom = 0;                    // m, height of its lowest point (z stays put in the plane)
+  b2FrictionJoint* friction = nullptr;  // its ground friction, off while on a belt
+  double max_force = 0;                 // the joint's own force limit, Box2D units
+  double max_torque = 0;                // and torque limit
+  double body_friction = 0;             // its shape's Coulomb coefficient
+};
+
 using dynamics::HeightRange;  // height range [lo, hi] of shapes, m
 
 class PlaneWorld {
@@ -140,6 +169,17 @@ class PlaneWorld {
                 uint32_t body_index, const ShapeData& wheel_shape);
   // 4. A ground friction joint for every body without wheels.
   void BuildGroundFriction(const Scene& scene);
+  // 2b. The belts, and (after 4.) the bodies that may ride them
+  // (plane_belts.cc).
+  void BuildBelts(const Scene& scene, const std::vector<int32_t>& body_of);
+  void AddRider(const Scene& scene, uint32_t body, b2FrictionJoint* friction, double max_force,
+                double max_torque);
+  // Each belt's surface velocity, once per step.
+  void ReadBelts(const Scene& scene);
+  // Friction towards its belt's surface velocity for each body lying on a
+  // belt (Coulomb-limited impulses before the Box2D step), in place of its
+  // ground friction.
+  void ApplyBelts(double dt);
 
   // Traction impulses for every awake wheeled body, in blocks of
   // kTractionBlock bodies (the second form does one block).
@@ -159,6 +199,8 @@ class PlaneWorld {
   std::vector<PlaneBodyPose> body_poses_;  // (bodies)
   std::vector<uint32_t> wheeled_;          // bodies with wheels, ascending
   std::vector<PlaneWheel> wheels_;         // (wheels), grouped by body
+  std::vector<PlaneBelt> belts_;           // slot order
+  std::vector<PlaneRider> riders_;         // bodies without wheels, when there are belts
   static constexpr size_t kTractionBlock = 64;
   std::array<TractionSolve, kTractionBlock> traction_;  // ApplyTraction scratch, one block
   // Force sensors: weld joint (null once broken), scene row, sensor slot.

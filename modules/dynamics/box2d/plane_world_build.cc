@@ -217,6 +217,8 @@ void PlaneWorld::Build(const Scene& scene) {
   // 2. Obstacles: non-dynamic shapes that are not parts of a body, projected
   // to the plane, as fixtures of the ground body.
   if (!bodies_.empty()) BuildObstacles(scene, body_of, dynamic_range);
+  // 2b. Belts: moving surfaces that are no part of a body (plane_belts.cc).
+  if (!bodies_.empty()) BuildBelts(scene, body_of);
   // 3. Wheels: velocity-mode revolute joints under a body, with a horizontal
   // axis and a round child, in slot order, then grouped by body.
   BuildWheels(scene, body_of);
@@ -232,6 +234,8 @@ void PlaneWorld::Reset() {
   body_poses_.clear();
   wheeled_.clear();
   wheels_.clear();
+  belts_.clear();
+  riders_.clear();
   force_sensors_.clear();
   b2BodyDef ground_def;
   ground_ = world_->CreateBody(&ground_def);
@@ -297,6 +301,8 @@ void PlaneWorld::BuildObstacles(const Scene& scene, const std::vector<int32_t>& 
     const ShapeData* shape = ShapeAt(scene, s);
     if (!shape || shape->dynamic || dynamics::NearestBodyAbove(scene, body_of, s, -1) >= 0)
       continue;
+    // A moving surface (a belt) carries bodies: no obstacle (BuildBelts).
+    if (shape->HasMovingSurface()) continue;
     const Pose& X_WS = scene.world_pose_at(s);
     ThrowIfNotFinite(scene, s, X_WS);
     const HeightRange range = CalcHeightRange(*shape, X_WS);
@@ -438,7 +444,8 @@ void PlaneWorld::AddWheel(const Scene& scene, uint32_t joint_slot, const JointDa
 
 void PlaneWorld::BuildGroundFriction(const Scene& scene) {
   const double L = scale_;
-  for (const PlaneBody& body : bodies_) {
+  for (uint32_t b = 0; b < bodies_.size(); ++b) {
+    const PlaneBody& body = bodies_[b];
     if (body.wheel_count > 0) continue;
     // A disc of uniform pressure resists turning with 2/3 mu m g r.
     const ShapeData& shape = scene.shapes()[scene.row_at(body.slot)];
@@ -448,7 +455,9 @@ void PlaneWorld::BuildGroundFriction(const Scene& scene) {
     const double force = shape.friction * shape.mass * settings_.gravity;
     def.maxForce = static_cast<float>(force * L);
     def.maxTorque = static_cast<float>(2.0 / 3.0 * force * FootprintRadius(shape) * L * L);
-    world_->CreateJoint(&def);
+    b2Joint* joint = world_->CreateJoint(&def);
+    if (!belts_.empty())
+      AddRider(scene, b, static_cast<b2FrictionJoint*>(joint), def.maxForce, def.maxTorque);
   }
 }
 

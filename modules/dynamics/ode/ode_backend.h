@@ -41,6 +41,13 @@
 // (no self-collision), between geoms of one body, between bodies joined by a
 // joint, or between two non-dynamic geoms.
 //
+// Moving surfaces (ShapeData::surface_velocity and surface_angular_velocity:
+// conveyor belts, modules/paths): a contact with such a geom gets a first
+// friction direction along the surfaces' relative velocity at the contact
+// point, projected into the contact plane, and that speed as its contact
+// motion (dContactMotion1), so friction carries the other body along. The
+// geoms are listed at Build; their velocities are read every step.
+//
 // Hybrid simulation: Scene::SetShapeDynamic (sim.setObjectDynamic) is a
 // structural change; the backend then rebuilds from the scene, velocities
 // included. A script that sets a dynamic body's pose teleports it.

@@ -220,12 +220,29 @@ void OdeWorld::Clear() {
   force_sensors_.clear();
   feedback_.clear();
   geom_info_.clear();
+  surfaces_.clear();
   commands_.clear();
 }
 
 void OdeWorld::AddGeom(dGeomID geom, int32_t instance, double friction, double restitution) {
-  geom_info_.push_back({instance, friction, restitution});
+  geom_info_.push_back({instance, -1, friction, restitution});
   dGeomSetData(geom, reinterpret_cast<void*>(static_cast<uintptr_t>(geom_info_.size())));
+}
+
+void OdeWorld::AddSurface(const ShapeData& shape, uint32_t slot) {
+  if (!shape.HasMovingSurface()) return;
+  geom_info_.back().surface = static_cast<int32_t>(surfaces_.size());
+  surfaces_.push_back({slot, shape.surface_velocity, shape.surface_angular_velocity});
+}
+
+Vec3 OdeWorld::SurfaceVelocity(dGeomID geom, const GeomInfo& info, const Vec3& p_W) const {
+  if (info.surface < 0) return {};
+  const MovingSurface& surface = surfaces_[info.surface];
+  dQuaternion q;
+  dGeomGetQuaternion(geom, q);
+  const Quat q_WS{q[0], q[1], q[2], q[3]};
+  const Vec3 p_S = q_WS.Conjugate().Rotate(p_W - ToVec3(dGeomGetPosition(geom)));
+  return q_WS.Rotate(surface.v_S + surface.w_S.Cross(p_S));
 }
 
 dTriMeshDataID OdeWorld::MeshData(const std::shared_ptr<const TriangleMesh>& mesh) {
@@ -340,6 +357,7 @@ void OdeWorld::BuildBodies(const Scene& scene, std::vector<dBodyID>* body_of) {
     if (geom) {
       dGeomSetBody(geom, body);
       AddGeom(geom, scene.instance_of_at(s), shape->friction, shape->restitution);
+      AddSurface(*shape, s);
     }
     (*body_of)[s] = body;
     bodies_.push_back({body, s, X_WS});
@@ -356,6 +374,7 @@ void OdeWorld::BuildNonDynamicShapes(const Scene& scene, std::vector<dBodyID>* b
     dGeomID geom = MakeGeom(space_, *shape, MeshData(shape->mesh));
     if (!geom) continue;  // a zero-size decoration: nothing to collide with
     AddGeom(geom, scene.instance_of_at(s), shape->friction, shape->restitution);
+    AddSurface(*shape, s);
     if (carrier.body) {
       dGeomSetBody(geom, carrier.body);
       dGeomSetOffsetWorldPosition(geom, X_WS.p.x, X_WS.p.y, X_WS.p.z);
@@ -474,6 +493,11 @@ void OdeWorld::SyncFromScene(const Scene& scene, double duration) {
 
 void OdeWorld::ReadCommands(const Scene& scene) {
   for (size_t k = 0; k < joints_.size(); ++k) commands_[k] = scene.joints()[joints_[k].row];
+  for (MovingSurface& surface : surfaces_) {
+    const ShapeData& shape = scene.shapes()[scene.row_at(surface.slot)];
+    surface.v_S = shape.surface_velocity;
+    surface.w_S = shape.surface_angular_velocity;
+  }
 }
 
 void OdeWorld::ApplyMotors(double dt) {
@@ -579,12 +603,34 @@ void OdeWorld::Collide(dGeomID a, dGeomID b) {
   const int n = dCollide(a, b, options_.max_contacts, &contact_buffer_[0].geom, sizeof(dContact));
   const double mu = std::sqrt(ia.friction * ib.friction);
   const double bounce = std::max(ia.restitution, ib.restitution);
+  // Moving surfaces (conveyor belts): friction drives the contact towards
+  // a's surface point moving as b's, v_a + u_a = v_b + u_b (u: each
+  // surface's velocity at the contact point), so the bodies' relative
+  // velocity v_a - v_b is u = u_b - u_a in the contact plane. ODE
+  // constrains (v_1 - v_2) . fdir1 = motion1 where body 1 is a's body, or
+  // b's when a has none (a static belt: ODE then swaps the two).
+  const bool moving = ia.surface >= 0 || ib.surface >= 0;
   for (int i = 0; i < n; ++i) {
     dContact& c = contact_buffer_[i];
     c.surface.mode = dContactApprox1 | (bounce > 0 ? dContactBounce : 0);
     c.surface.mu = mu;
     c.surface.bounce = bounce;
     c.surface.bounce_vel = kBounceVelocity;
+    if (moving) {
+      const Vec3 p_W = ToVec3(c.geom.pos);
+      const Vec3 u = SurfaceVelocity(b, ib, p_W) - SurfaceVelocity(a, ia, p_W);
+      const Vec3 normal = ToVec3(c.geom.normal);
+      const Vec3 t = u - normal * normal.Dot(u);
+      const double speed = t.Norm();
+      if (speed > 1e-9) {
+        const Vec3 direction = t / speed;
+        c.fdir1[0] = direction.x;
+        c.fdir1[1] = direction.y;
+        c.fdir1[2] = direction.z;
+        c.surface.mode |= dContactFDir1 | dContactMotion1;
+        c.surface.motion1 = ba ? speed : -speed;
+      }
+    }
     dJointID joint = dJointCreateContact(world_, contacts_, &c);
     dJointAttach(joint, ba, bb);
   }

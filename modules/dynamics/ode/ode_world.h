@@ -60,10 +60,18 @@ struct SimForceSensor {
 };
 
 // Per geom: owner info for the contact filter and materials.
-struct GeomInfo {    // 24 bytes
-  int32_t instance;  // model instance or -1
+struct GeomInfo {        // 24 bytes
+  int32_t instance;      // model instance or -1
+  int32_t surface = -1;  // index into OdeWorld::surfaces_, or -1: not a moving surface
   double friction;
   double restitution;
+};
+
+// A shape whose surface moves (ShapeData::surface_velocity: a conveyor
+// belt's segment), read from the scene every step.
+struct MovingSurface {  // 56 bytes
+  uint32_t slot;
+  Vec3 v_S, w_S;  // m/s, rad/s in the shape's frame (ShapeData::surface_*)
 };
 
 class OdeWorld {
@@ -114,6 +122,11 @@ class OdeWorld {
   // Samples each sensor's joint feedback and breaks links over their threshold.
   void ReadForceSensors(Scene* scene);
   void AddGeom(dGeomID geom, int32_t instance, double friction, double restitution);
+  // The geom last added is the shape at `slot`: listed as a moving surface
+  // if the shape has a surface velocity.
+  void AddSurface(const ShapeData& shape, uint32_t slot);
+  // The world velocity of a geom's surface at p_W (zero if it does not move).
+  Vec3 SurfaceVelocity(dGeomID geom, const GeomInfo& info, const Vec3& p_W) const;
   // ODE's trimesh data for a mesh asset, made once per world (ode_world.cc).
   dTriMeshDataID MeshData(const std::shared_ptr<const TriangleMesh>& mesh);
   void ApplyMotors(double dt);
@@ -133,6 +146,7 @@ class OdeWorld {
   std::vector<SimForceSensor> force_sensors_;
   std::vector<std::unique_ptr<dJointFeedback>> feedback_;  // (force_sensors_), stable addresses
   std::vector<GeomInfo> geom_info_;                        // indexed by the geom's data (index + 1)
+  std::vector<MovingSurface> surfaces_;                    // slot order
   std::vector<dContact> contact_buffer_;
   // Mesh assets in use and their trimesh data (ODE reads the asset's arrays in place).
   std::vector<std::pair<std::shared_ptr<const TriangleMesh>, dTriMeshDataID>> meshes_;
