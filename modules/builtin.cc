@@ -13,6 +13,7 @@
 #include "modules/mill/mill.h"
 #include "modules/paint/paint_layer.h"
 #include "modules/paths/paths.h"
+#include "modules/planning/planning.h"
 #include "modules/proximity/proximity.h"
 #include "modules/rendering/filters/filters.h"
 #include "modules/rendering/objects.h"
@@ -48,6 +49,7 @@ void RegisterBuiltinModules(ModuleRegistry* registry) {
   collision::Register(registry);
   mill::Register(registry);
   paths::Register(registry);
+  planning::Register(registry);
   filters::Register(registry);
   rendering::RegisterObjects(registry);
   graphs::Register(registry);

@@ -8,6 +8,7 @@ packages=(
   libbox2d-dev libode-dev libfcl-dev liboctomap-dev liblua5.4-dev libtbb-dev
   libosmesa6-dev libyaml-cpp-dev libeigen3-dev libsqlite3-dev libxxhash-dev nlohmann-json3-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  libompl-dev
   gnuplot-nox libopenmpi-dev openmpi-bin
   libpng-dev libassimp-dev liburdfdom-dev libtinyxml2-dev
   libavcodec-dev libavformat-dev libavutil-dev libswscale-dev

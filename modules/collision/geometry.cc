@@ -446,6 +446,51 @@ DistanceAnswer Geometry::Distance(std::span<const uint32_t> a, const Target& b, 
   return best;
 }
 
+namespace {
+
+// The shape `oa` (slot `sa`, one of `a`) against `b`; true when the query
+// is settled (a collision found and enough contacts).
+template <typename Impl>
+bool CollideOne(const Impl& m, const Object* oa, uint32_t sa, std::span<const uint32_t> a,
+                const Target& b, CollideQuery* q) {
+  const auto done = [&] {
+    return q->answer->colliding &&
+           q->answer->contacts.size() >= static_cast<size_t>(q->max_contacts);
+  };
+  q->query = oa;
+  q->query_slot = sa;
+  switch (b.kind) {
+    case EntitySpec::kPath:
+      for (uint32_t sb : b.slots) {
+        if (sb == sa || Contains(a, sb)) continue;
+        const Object* ob = m.objects[sb].get();
+        if (!oa->getAABB().overlap(ob->getAABB())) continue;
+        PairCollide(q, ob, sb);
+        if (done()) break;
+      }
+      break;
+    case EntitySpec::kEverythingElse: {
+      thread_local std::vector<const Object*> near;
+      near.clear();
+      m.GatherMoving(oa->getAABB(), &near);
+      for (const Object* ob : near) {
+        const uint32_t sb = SlotOf(ob);
+        if (Contains(a, sb) || !oa->getAABB().overlap(ob->getAABB())) continue;
+        PairCollide(q, ob, sb);
+        if (done()) break;
+      }
+      if (done()) break;
+      [[fallthrough]];
+    }
+    case EntitySpec::kEnvironment:
+      m.fixed_tree.collide(const_cast<Object*>(oa), q, TreeCollide);
+      break;
+  }
+  return done();
+}
+
+}  // namespace
+
 CollisionAnswer Geometry::Collide(std::span<const uint32_t> a, const Target& b,
                                   int max_contacts) const {
   const Impl& m = *impl_;
@@ -454,43 +499,50 @@ CollisionAnswer Geometry::Collide(std::span<const uint32_t> a, const Target& b,
   q.answer = &answer;
   q.exclude = a;
   q.max_contacts = max_contacts;
-  const auto done = [&] {
-    return answer.colliding && answer.contacts.size() >= static_cast<size_t>(max_contacts);
-  };
-  for (uint32_t sa : a) {
-    const Object* oa = m.objects[sa].get();
-    q.query = oa;
-    q.query_slot = sa;
-    switch (b.kind) {
-      case EntitySpec::kPath:
-        for (uint32_t sb : b.slots) {
-          if (sb == sa || Contains(a, sb)) continue;
-          const Object* ob = m.objects[sb].get();
-          if (!oa->getAABB().overlap(ob->getAABB())) continue;
-          PairCollide(&q, ob, sb);
-          if (done()) break;
-        }
-        break;
-      case EntitySpec::kEverythingElse: {
-        thread_local std::vector<const Object*> near;
-        near.clear();
-        m.GatherMoving(oa->getAABB(), &near);
-        for (const Object* ob : near) {
-          const uint32_t sb = SlotOf(ob);
-          if (Contains(a, sb) || !oa->getAABB().overlap(ob->getAABB())) continue;
-          PairCollide(&q, ob, sb);
-          if (done()) break;
-        }
-        if (done()) break;
-        [[fallthrough]];
-      }
-      case EntitySpec::kEnvironment:
-        m.fixed_tree.collide(const_cast<Object*>(oa), &q, TreeCollide);
-        break;
-    }
-    if (done()) break;
-  }
+  for (uint32_t sa : a)
+    if (CollideOne(m, m.objects[sa].get(), sa, a, b, &q)) break;
   return answer;
+}
+
+struct Probe::Impl {
+  const Geometry::Impl* geometry = nullptr;
+  std::vector<uint32_t> slots;  // ascending
+  std::vector<Pose> X_FS;       // each shape's pose in the frame
+  std::vector<std::unique_ptr<Object>> objects;
+};
+
+Probe::Probe(const Geometry& geometry, const Scene& scene, std::span<const uint32_t> shapes,
+             const Pose& X_WF)
+    : impl_(std::make_unique<Impl>()) {
+  Impl& p = *impl_;
+  p.geometry = geometry.impl_.get();
+  const Pose X_FW = X_WF.Inverse();
+  for (uint32_t slot : shapes) {
+    if (slot >= p.geometry->objects.size() || !p.geometry->objects[slot]) continue;
+    p.slots.push_back(slot);
+    p.X_FS.push_back(X_FW * scene.world_pose_at(slot));
+    auto o = std::make_unique<Object>(std::const_pointer_cast<fcl::CollisionGeometryd>(
+        p.geometry->objects[slot]->collisionGeometry()));
+    o->setUserData(reinterpret_cast<void*>(static_cast<uintptr_t>(slot)));
+    p.objects.push_back(std::move(o));
+  }
+}
+
+Probe::~Probe() = default;
+
+bool Probe::Collides(const Pose& X_WF, const Target& b) {
+  Impl& p = *impl_;
+  CollisionAnswer answer;
+  CollideQuery q;
+  q.answer = &answer;
+  q.exclude = p.slots;
+  for (size_t i = 0; i < p.objects.size(); ++i) {
+    Object& o = *p.objects[i];
+    o.setTransform(ToFcl(X_WF * p.X_FS[i]));
+    o.computeAABB();
+    if (CollideOne(*p.geometry, &o, p.slots[i], p.slots, b, &q)) return true;
+  }
+  return false;
 }
 
 }  // namespace swarmsim::collision

@@ -72,6 +72,31 @@ class Geometry {
   size_t object_count() const;
 
  private:
+  friend class Probe;
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Shapes moved together as one rigid body to poses other than the scene's,
+// checked against the rest (path planning, modules/planning): a frame F
+// carries them, each keeping its pose in F as the scene has it now. Reads
+// the geometry only (refresh it first, and not while probing), so probes
+// of different robots run in parallel; one probe is for one thread.
+class Probe {
+ public:
+  // `shapes`: ascending slots of shapes of `geometry`; X_WF: the frame's
+  // pose now.
+  Probe(const Geometry& geometry, const Scene& scene, std::span<const uint32_t> shapes,
+        const Pose& X_WF);
+  ~Probe();
+  Probe(const Probe&) = delete;
+  Probe& operator=(const Probe&) = delete;
+
+  // Do the shapes, with their frame at X_WF, collide with `b`? The shapes
+  // themselves are never part of `b`.
+  bool Collides(const Pose& X_WF, const Target& b);
+
+ private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
