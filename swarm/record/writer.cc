@@ -1,10 +1,5 @@
 #include "swarm/record/writer.h"
 
-#include <fcntl.h>
-#include <unistd.h>
-#include <xxhash.h>
-#include <zstd.h>
-
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -19,6 +14,7 @@
 #include "framework/world.h"
 #include "modules/blobs/leds.h"
 #include "modules/paint/paint_layer.h"
+#include "swarm/record/chunk_writer.h"
 #include "swarm/record/format.h"
 #include "swarm/run/version.h"
 
@@ -35,13 +31,6 @@ struct Tracked {  // 16 bytes
   int32_t root;  // slot of its robot's root (its pose is X_RO), -1: X_WO (roots, scene objects)
   uint32_t row;  // in its type's table
   Kind kind;
-};
-
-// A pose in the file's integers: position in kPositionUnit, quaternion in 1/32767.
-struct QuantizedPose {  // 20 bytes
-  int32_t x, y, z;
-  int16_t qw, qx, qy, qz;
-  bool operator==(const QuantizedPose&) const = default;
 };
 
 int32_t QuantizePosition(double metres) {
@@ -76,38 +65,6 @@ uint8_t Channel(double v) {
 uint32_t PackColor(const Vec3& c, bool on) {
   return Channel(c.x) | (uint32_t{Channel(c.y)} << 8) | (uint32_t{Channel(c.z)} << 16) |
          (uint32_t{on ? 1u : 0u} << 24);
-}
-
-// A little-endian byte buffer with alignment padding.
-class Bytes {
- public:
-  template <typename T>
-  void Put(T value) {
-    const size_t at = data_.size();
-    data_.resize(at + sizeof(T));
-    std::memcpy(data_.data() + at, &value, sizeof(T));
-  }
-  void PutBytes(const void* p, size_t n) {
-    const auto* b = static_cast<const uint8_t*>(p);
-    data_.insert(data_.end(), b, b + n);
-  }
-  void Pad(size_t alignment) {
-    while (data_.size() % alignment != 0) data_.push_back(0);
-  }
-  void clear() { data_.clear(); }
-  const std::vector<uint8_t>& data() const { return data_; }
-
- private:
-  std::vector<uint8_t> data_;
-};
-
-// Ids ascending, as differences (FORMAT.md).
-void PutIds(const std::vector<uint32_t>& ids, Bytes* out) {
-  uint32_t last = 0;
-  for (const uint32_t id : ids) {
-    out->Put<uint32_t>(id - last);
-    last = id;
-  }
 }
 
 json ColorJson(const Vec3& c) { return json::array({c.x, c.y, c.z}); }
@@ -145,11 +102,7 @@ json ParamsJson(const ParameterSet& parameters) {
 
 struct RunRecorder::Impl {
   RecordSettings settings;
-  std::filesystem::path path;
-  int fd = -1;
-  ZSTD_CCtx* cctx = nullptr;
-  std::vector<uint8_t> chunk;  // header + compressed payload
-  uint64_t bytes = 0;
+  std::unique_ptr<ChunkWriter> file;
   bool finished = false;
 
   World* world = nullptr;
@@ -163,38 +116,28 @@ struct RunRecorder::Impl {
   std::vector<Tracked> tracked;                          // (ids)
   std::vector<std::pair<uint32_t, uint32_t>> robot_ids;  // first, count (live robots)
   std::vector<int> robot_index;                          // robot of each range
-  std::vector<uint32_t> color_ids, proximity_ids;        // ids of shapes and LEDs, of sensors
-  std::vector<Pose> relative;                            // scratch: X_RO by slot (slots)
+  // X_RO of every robot object, and the local pose it was made from (slots);
+  // whether it changed at this capture (slots).
+  std::vector<Pose> relative, relative_from;
+  std::vector<uint8_t> moved;
+  bool capture_all = true;  // after a new scene: every pose afresh
 
-  // State at this step and at the last step record, by id.
-  std::vector<QuantizedPose> pose, pose_previous;
-  std::vector<uint32_t> color, color_previous;
-  std::vector<uint16_t> reading, reading_previous;
+  // The state at this step, by id.
+  std::vector<QuantizedPose> pose;
+  std::vector<uint32_t> color;
+  std::vector<uint16_t> reading;
 
   // Metrics: names by id, samples since the last step record.
   std::map<std::string, uint32_t, std::less<>> metric_ids;
   std::vector<std::string> metric_names;
   size_t names_written = 0;
-  struct Sample {
-    uint32_t name;
-    int32_t robot;
-    uint32_t step;
-    double value;
-  };
-  std::vector<Sample> samples;
+  std::vector<SampleRow> samples;
 
   int64_t records = 0;
-  Bytes payload;
 
-  void WriteChunk(ChunkKind kind, int64_t step, const std::vector<uint8_t>& raw);
-  void WriteJson(ChunkKind kind, int64_t step, const json& j) {
-    const std::string text = j.dump();
-    WriteChunk(kind, step, std::vector<uint8_t>(text.begin(), text.end()));
-  }
   json Header() const;
   void BuildScene();
   void Capture();
-  void EncodeStep(bool keyframe);
   void WriteStep(const World& world);
   uint32_t MetricId(std::string_view name) {
     if (const auto it = metric_ids.find(name); it != metric_ids.end()) return it->second;
@@ -204,45 +147,6 @@ struct RunRecorder::Impl {
     return id;
   }
 };
-
-namespace {
-// Fills in a chunk's header before its stored payload (FORMAT.md "Chunks").
-void FillChunkHeader(uint8_t kind, uint32_t step, size_t stored, size_t raw, uint8_t* h) {
-  std::memcpy(h, kMagic, 4);
-  h[4] = kind;
-  h[5] = 0;
-  h[6] = h[7] = 0;
-  const auto put32 = [](uint8_t* at, uint32_t v) {
-    for (int i = 0; i < 4; ++i) at[i] = static_cast<uint8_t>(v >> (8 * i));
-  };
-  put32(h + 8, step);
-  put32(h + 12, static_cast<uint32_t>(stored));
-  put32(h + 16, static_cast<uint32_t>(raw));
-  put32(h + 20, XXH32(h + kChunkHeaderSize, stored, 0));
-}
-}  // namespace
-
-void RunRecorder::Impl::WriteChunk(ChunkKind kind, int64_t step, const std::vector<uint8_t>& raw) {
-  const size_t bound = ZSTD_compressBound(raw.size());
-  chunk.resize(kChunkHeaderSize + bound);
-  const size_t stored = ZSTD_compressCCtx(cctx, chunk.data() + kChunkHeaderSize, bound, raw.data(),
-                                          raw.size(), settings.zstd_level);
-  if (ZSTD_isError(stored))
-    throw Error("cannot compress a chunk of " + path.string() + ": " + ZSTD_getErrorName(stored));
-  chunk.resize(kChunkHeaderSize + stored);
-  FillChunkHeader(static_cast<uint8_t>(kind), static_cast<uint32_t>(step), stored, raw.size(),
-                  chunk.data());
-  // One write per chunk, so a reader (or a kill) never sees half of one but at the end.
-  size_t done = 0;
-  while (done < chunk.size()) {
-    const ssize_t n = ::write(fd, chunk.data() + done, chunk.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0)
-      throw Error("cannot write " + path.string() + ": " + std::strerror(n < 0 ? errno : ENOSPC));
-    done += static_cast<size_t>(n);
-  }
-  bytes += chunk.size();
-}
 
 json RunRecorder::Impl::Header() const {
   const WorldSettings& ws = world->settings();
@@ -325,8 +229,6 @@ void RunRecorder::Impl::BuildScene() {
   tracked.clear();
   robot_ids.clear();
   robot_index.clear();
-  color_ids.clear();
-  proximity_ids.clear();
   const ObjectType shape_type = ObjectType::kShape, sensor_type = ObjectType::kProximitySensor;
   const auto kind_of = [&](uint32_t slot, Kind* kind) {
     const ObjectType t = scene.type_at(slot);
@@ -441,36 +343,50 @@ void RunRecorder::Impl::BuildScene() {
     id_of_slot[slot] = static_cast<uint32_t>(tracked.size());
     tracked.push_back(t);
   }
+  SceneLists lists;
   for (uint32_t id = 0; id < tracked.size(); ++id) {
-    if (tracked[id].kind == Kind::kShape || tracked[id].kind == Kind::kLed) color_ids.push_back(id);
-    if (tracked[id].kind == Kind::kProximity) proximity_ids.push_back(id);
+    if (tracked[id].kind == Kind::kShape || tracked[id].kind == Kind::kLed)
+      lists.color_ids.push_back(id);
+    if (tracked[id].kind == Kind::kProximity) lists.proximity_ids.push_back(id);
   }
   const size_t n = tracked.size();
+  lists.object_count = n;
   pose.assign(n, {});
-  pose_previous.assign(n, {});
   color.assign(n, 0);
-  color_previous.assign(n, 0);
   reading.assign(n, 0);
-  reading_previous.assign(n, 0);
-  WriteJson(ChunkKind::kScene, world->step_count(),
-            {{"object_count", n},
-             {"templates", std::move(templates)},
-             {"robots", std::move(robots)},
-             {"objects", std::move(objects)}});
+  capture_all = true;
+  const json j = {{"object_count", n},
+                  {"templates", std::move(templates)},
+                  {"robots", std::move(robots)},
+                  {"objects", std::move(objects)},
+                  {"meshes", std::move(meshes)}};
+  file->AddScene(static_cast<uint32_t>(world->step_count()), j.dump(), std::move(lists));
 }
 
-// This step's poses, colours and readings, robots in parallel.
+// This step's poses, colours and readings, robots in parallel. A robot
+// object's X_RO is made from the local poses down its branch, and only
+// where something on the branch moved (a joint, a local pose that changed):
+// the 24 sensors of a ring are not quantised again every step.
 void RunRecorder::Impl::Capture() {
   const Scene& scene = world->scene();
-  relative.resize(scene.slot_count());
+  if (relative.size() != scene.slot_count()) {
+    relative.resize(scene.slot_count());
+    relative_from.resize(scene.slot_count());
+    moved.resize(scene.slot_count());
+    capture_all = true;
+  }
   const auto joints = scene.joints();
   const auto shapes = scene.shapes();
   const auto sensors = scene.proximity_sensors();
   const Rows<LedRow>* leds =
       has_leds ? &static_cast<const Rows<LedRow>&>(*scene.rows(led_type)) : nullptr;
+  const bool all = capture_all;
   const auto capture = [&](uint32_t id) {
     const Tracked& t = tracked[id];
-    pose[id] = Quantize(t.root < 0 ? scene.world_pose_at(t.slot) : relative[t.slot]);
+    if (t.root < 0)
+      pose[id] = Quantize(scene.world_pose_at(t.slot));
+    else if (moved[t.slot])
+      pose[id] = Quantize(relative[t.slot]);
     switch (t.kind) {
       case Kind::kFrame: break;
       case Kind::kShape: color[id] = PackColor(shapes[t.row].color, true); break;
@@ -493,18 +409,22 @@ void RunRecorder::Impl::Capture() {
   world->scheduler().ParallelFor(
       0, static_cast<int64_t>(robot_ids.size()), kRobotGrain, [&](int64_t begin, int64_t end) {
         for (int64_t r = begin; r < end; ++r) {
-          // X_RO of every object of the robot from the local poses, parents first:
-          // a rigid part's stays exactly the same from step to step.
           const ModelInstance& robot = scene.instance(robot_index[r]);
           const uint32_t root = scene.SlotOf(robot.root);
           relative[root] = Pose{};
+          moved[root] = 0;  // the root's own frame never moves in itself
           for (const uint32_t slot : robot.objects) {
             if (slot == root) continue;
             const uint32_t p = static_cast<uint32_t>(scene.parent_at(slot));
-            const Pose frame = scene.type_at(p) == ObjectType::kJoint
-                                   ? relative[p] * joints[scene.row_at(p)].Motion()
-                                   : relative[p];
-            relative[slot] = frame * scene.local_pose_at(slot);
+            const bool joint = scene.type_at(p) == ObjectType::kJoint;
+            const Pose& X_PO = scene.local_pose_at(slot);
+            const bool changed = all || joint || moved[p] ||
+                                 std::memcmp(&X_PO, &relative_from[slot], sizeof(Pose)) != 0;
+            moved[slot] = changed;
+            if (!changed) continue;
+            relative_from[slot] = X_PO;
+            relative[slot] =
+                (joint ? relative[p] * joints[scene.row_at(p)].Motion() : relative[p]) * X_PO;
           }
           const auto [first, count] = robot_ids[r];
           for (uint32_t id = first; id < first + count; ++id) capture(id);
@@ -513,97 +433,7 @@ void RunRecorder::Impl::Capture() {
   const uint32_t scene_first =
       robot_ids.empty() ? 0 : robot_ids.back().first + robot_ids.back().second;
   for (uint32_t id = scene_first; id < tracked.size(); ++id) capture(id);
-}
-
-void RunRecorder::Impl::EncodeStep(bool keyframe) {
-  Bytes& out = payload;
-  out.clear();
-  out.Put<double>(world->time());
-  out.Put<uint32_t>(static_cast<uint32_t>(records));
-  out.Put<uint32_t>(0);
-  std::vector<uint32_t> ids;
-  // Poses.
-  for (uint32_t id = 0; id < tracked.size(); ++id)
-    if (keyframe || !(pose[id] == pose_previous[id])) ids.push_back(id);
-  out.Put<uint32_t>(static_cast<uint32_t>(ids.size()));
-  PutIds(ids, &out);
-  const auto put_ints = [&](auto field) {
-    for (const uint32_t id : ids) {
-      using T = std::remove_reference_t<decltype(pose[id].*field)>;
-      const T now = pose[id].*field;
-      if (keyframe) {
-        out.Put<T>(now);
-      } else {
-        // Wrapping difference, as unsigned.
-        using U = std::make_unsigned_t<T>;
-        out.Put<U>(static_cast<U>(static_cast<U>(now) - static_cast<U>(pose_previous[id].*field)));
-      }
-    }
-  };
-  put_ints(&QuantizedPose::x);
-  put_ints(&QuantizedPose::y);
-  put_ints(&QuantizedPose::z);
-  put_ints(&QuantizedPose::qw);
-  put_ints(&QuantizedPose::qx);
-  put_ints(&QuantizedPose::qy);
-  put_ints(&QuantizedPose::qz);
-  out.Pad(4);
-  // Colours.
-  ids.clear();
-  for (const uint32_t id : color_ids)
-    if (keyframe || color[id] != color_previous[id]) ids.push_back(id);
-  out.Put<uint32_t>(static_cast<uint32_t>(ids.size()));
-  PutIds(ids, &out);
-  for (const uint32_t id : ids) out.Put<uint32_t>(color[id]);
-  // Proximity readings.
-  ids.clear();
-  for (const uint32_t id : proximity_ids)
-    if (keyframe || reading[id] != reading_previous[id]) ids.push_back(id);
-  out.Put<uint32_t>(static_cast<uint32_t>(ids.size()));
-  PutIds(ids, &out);
-  for (const uint32_t id : ids) out.Put<uint16_t>(reading[id]);
-  out.Pad(4);
-  // Paint cells.
-  ids.clear();
-  if (paint != nullptr) {
-    const std::vector<uint8_t>& rgb = paint->rgb();
-    const int width = paint->width();
-    if (paint_previous.size() != rgb.size()) paint_previous.assign(rgb.size(), 0);
-    const uint32_t cells = static_cast<uint32_t>(rgb.size() / 3);
-    for (uint32_t c = 0; c < cells; ++c) {
-      const bool changed = std::memcmp(&rgb[3 * c], &paint_previous[3 * c], 3) != 0;
-      if (keyframe ? paint->painted(static_cast<int>(c % width), static_cast<int>(c / width))
-                   : changed)
-        ids.push_back(c);
-    }
-    out.Put<uint32_t>(static_cast<uint32_t>(ids.size()));
-    PutIds(ids, &out);
-    for (const uint32_t c : ids) {
-      out.PutBytes(&rgb[3 * c], 3);
-      out.Put<uint8_t>(255);
-    }
-    paint_previous = rgb;
-  } else {
-    out.Put<uint32_t>(0);
-  }
-  // Metrics.
-  const size_t first_name = keyframe ? 0 : names_written;
-  out.Put<uint32_t>(static_cast<uint32_t>(first_name));
-  out.Put<uint32_t>(static_cast<uint32_t>(metric_names.size() - first_name));
-  for (size_t i = first_name; i < metric_names.size(); ++i) {
-    const std::string& name = metric_names[i];
-    out.Put<uint16_t>(static_cast<uint16_t>(std::min<size_t>(name.size(), 65535)));
-    out.PutBytes(name.data(), std::min<size_t>(name.size(), 65535));
-  }
-  names_written = metric_names.size();
-  out.Pad(4);
-  out.Put<uint32_t>(static_cast<uint32_t>(samples.size()));
-  for (const Sample& s : samples) out.Put<uint32_t>(s.name);
-  for (const Sample& s : samples) out.Put<int32_t>(s.robot);
-  for (const Sample& s : samples) out.Put<uint32_t>(s.step);
-  out.Pad(8);
-  for (const Sample& s : samples) out.Put<double>(s.value);
-  samples.clear();
+  capture_all = false;
 }
 
 void RunRecorder::Impl::WriteStep(const World& w) {
@@ -613,12 +443,38 @@ void RunRecorder::Impl::WriteStep(const World& w) {
     keyframe = true;
   }
   Capture();
-  EncodeStep(keyframe);
-  WriteChunk(keyframe ? ChunkKind::kKeyframe : ChunkKind::kDelta, w.step_count(), payload.data());
+  auto snap = std::make_unique<StepSnapshot>();
+  snap->step = static_cast<uint32_t>(w.step_count());
+  snap->time = w.time();
+  snap->record = static_cast<uint32_t>(records);
+  snap->keyframe = keyframe;
+  snap->pose = pose;
+  snap->color = color;
+  snap->reading = reading;
+  // Paint: every painted cell in a keyframe, else the cells that changed.
+  if (paint != nullptr) {
+    const std::vector<uint8_t>& rgb = paint->rgb();
+    const uint32_t width = static_cast<uint32_t>(paint->width());
+    if (paint_previous.size() != rgb.size()) paint_previous.assign(rgb.size(), 0);
+    const uint32_t cells = static_cast<uint32_t>(rgb.size() / 3);
+    for (uint32_t c = 0; c < cells; ++c) {
+      const bool take =
+          keyframe ? paint->painted(static_cast<int>(c % width), static_cast<int>(c / width))
+                   : std::memcmp(&rgb[3 * c], &paint_previous[3 * c], 3) != 0;
+      if (!take) continue;
+      snap->paint_cells.push_back(c);
+      snap->paint_rgba.push_back(rgb[3 * c] | (uint32_t{rgb[3 * c + 1]} << 8) |
+                                 (uint32_t{rgb[3 * c + 2]} << 16) | (uint32_t{255} << 24));
+    }
+    paint_previous = rgb;
+  }
+  // Metric names (all of them in a keyframe) and the samples since the last record.
+  snap->first_name = static_cast<uint32_t>(keyframe ? 0 : names_written);
+  snap->names.assign(metric_names.begin() + snap->first_name, metric_names.end());
+  names_written = metric_names.size();
+  snap->samples.swap(samples);
+  file->AddStep(std::move(snap));
   ++records;
-  pose_previous.swap(pose);
-  color_previous.swap(color);
-  reading_previous.swap(reading);
 }
 
 RunRecorder::RunRecorder(const RecordSettings& settings) : impl_(std::make_unique<Impl>()) {
@@ -626,16 +482,11 @@ RunRecorder::RunRecorder(const RecordSettings& settings) : impl_(std::make_uniqu
   r.settings = settings;
   r.settings.every = std::max<int64_t>(1, settings.every);
   r.settings.keyframe_every = std::max<int64_t>(1, settings.keyframe_every);
-  r.path = settings.out_dir / kRecordingFileName;
-  r.fd = ::open(r.path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (r.fd < 0) throw Error("cannot create " + r.path.string() + ": " + std::strerror(errno));
-  r.cctx = ZSTD_createCCtx();
+  r.file =
+      std::make_unique<ChunkWriter>(settings.out_dir / kRecordingFileName, settings.zstd_level);
 }
 
-RunRecorder::~RunRecorder() {
-  if (impl_->cctx != nullptr) ZSTD_freeCCtx(impl_->cctx);
-  if (impl_->fd >= 0) ::close(impl_->fd);
-}
+RunRecorder::~RunRecorder() = default;
 
 void RunRecorder::Start(World* world) {
   Impl& r = *impl_;
@@ -644,8 +495,7 @@ void RunRecorder::Start(World* world) {
   if (const Module* m = world->find_module("paint"); m != nullptr)
     r.paint = dynamic_cast<const paint::PaintLayer*>(m);
   for (const std::string& name : r.settings.metric_names) r.MetricId(name);
-  r.WriteJson(ChunkKind::kHeader, 0, r.Header());
-  r.names_written = 0;
+  r.file->AddJson(static_cast<uint8_t>(ChunkKind::kHeader), 0, r.Header().dump());
   r.WriteStep(*world);
 }
 
@@ -660,6 +510,8 @@ void RunRecorder::Record(const World& world, std::vector<MetricSample>* out) {
   r.WriteStep(world);
 }
 
+void RunRecorder::WriteOutputs(const std::filesystem::path& /*dir*/) const { impl_->file->Flush(); }
+
 void RunRecorder::ListOutputs(std::vector<OutputFile>* out) const {
   out->push_back({"recording", kRecordingFileName,
                   std::to_string(impl_->records) + " step records (swarmsim view)"});
@@ -667,29 +519,23 @@ void RunRecorder::ListOutputs(std::vector<OutputFile>* out) const {
 
 void RunRecorder::Finish(int64_t steps, const std::string& status, const std::string& error) {
   Impl& r = *impl_;
-  if (r.finished || r.fd < 0) return;
+  if (r.finished) return;
   r.finished = true;
   json j = {{"steps", steps}, {"status", status}};
   if (!error.empty()) j["error"] = error;
   try {
-    r.WriteJson(ChunkKind::kEnd, steps, j);
+    r.file->AddJson(static_cast<uint8_t>(ChunkKind::kEnd), static_cast<uint32_t>(steps), j.dump());
+    r.file->Flush();
   } catch (const Error&) {
-    // The steps are all there; a viewer just does not learn that the run ended.
+    // The steps before are all there; a viewer just does not learn that the run ended.
   }
 }
 
 int64_t RunRecorder::step_records() const { return impl_->records; }
-uint64_t RunRecorder::bytes_written() const { return impl_->bytes; }
+uint64_t RunRecorder::bytes_written() const { return impl_->file->bytes_written(); }
 
 std::string EncodeChunk(uint8_t kind, uint32_t step, const std::string& payload) {
-  std::string out(kChunkHeaderSize + ZSTD_compressBound(payload.size()), '\0');
-  auto* h = reinterpret_cast<uint8_t*>(out.data());
-  const size_t stored = ZSTD_compress(h + kChunkHeaderSize, out.size() - kChunkHeaderSize,
-                                      payload.data(), payload.size(), 3);
-  if (ZSTD_isError(stored)) throw Error(std::string("zstd: ") + ZSTD_getErrorName(stored));
-  out.resize(kChunkHeaderSize + stored);
-  FillChunkHeader(kind, step, stored, payload.size(), reinterpret_cast<uint8_t*>(out.data()));
-  return out;
+  return EncodeChunkBytes(kind, step, payload);
 }
 
 RunRecorder* AddRecorder(World* world, const RecordSettings& settings) {

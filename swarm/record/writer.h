@@ -37,10 +37,15 @@ class RunRecorder final : public Module {
   // The header, the scene and the keyframe of step 0.
   void Start(World* world) override;
   void Record(const World& world, std::vector<MetricSample>* out) override;
+  // Waits until every step record so far is in the file (the records are
+  // compressed and written on a thread of the recorder's own). Throws
+  // swarmsim::Error if one could not be written.
+  void WriteOutputs(const std::filesystem::path& dir) const override;
   void ListOutputs(std::vector<OutputFile>* out) const override;
 
   // The end chunk: the run's last step and how it ended ("ok", "error",
-  // "interrupted"); later calls do nothing. Never throws.
+  // "interrupted"), then waits until the file is complete; later calls do
+  // nothing. Never throws.
   void Finish(int64_t steps, const std::string& status, const std::string& error);
   int64_t step_records() const;
   uint64_t bytes_written() const;
