@@ -27,7 +27,8 @@ uint32_t Get32(const uint8_t* p) {
 
 std::string Megabytes(uint64_t bytes) {
   std::ostringstream out;
-  out.precision(bytes < 10'000'000 ? 2 : 3);
+  out.setf(std::ios::fixed);
+  out.precision(2);
   out << static_cast<double>(bytes) / 1e6 << " MB";
   return out.str();
 }
