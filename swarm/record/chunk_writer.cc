@@ -131,6 +131,18 @@ void ChunkWriter::AddStep(std::unique_ptr<StepSnapshot> step) {
   Push(std::move(job));
 }
 
+std::unique_ptr<StepSnapshot> ChunkWriter::TakeSnapshot() {
+  {
+    const std::lock_guard lock(mutex_);
+    if (!spare_.empty()) {
+      std::unique_ptr<StepSnapshot> s = std::move(spare_.back());
+      spare_.pop_back();
+      return s;
+    }
+  }
+  return std::make_unique<StepSnapshot>();
+}
+
 void ChunkWriter::Flush() {
   std::unique_lock lock(mutex_);
   changed_.wait(lock, [&] { return (queue_.empty() && !busy_) || !error_.empty(); });
@@ -158,7 +170,7 @@ void ChunkWriter::Run() {
     changed_.notify_all();
     std::string error;
     try {
-      if (!failed) Write(*job);  // after a failure, nothing more
+      if (!failed) Write(job.get());  // after a failure, nothing more
     } catch (const std::exception& e) {
       error = e.what();
     }
@@ -166,27 +178,31 @@ void ChunkWriter::Run() {
       const std::lock_guard lock(mutex_);
       busy_ = false;
       if (!error.empty() && error_.empty()) error_ = error;
+      if (job->snap && spare_.size() < kMaxQueued) spare_.push_back(std::move(job->snap));
     }
     changed_.notify_all();
   }
 }
 
-void ChunkWriter::Write(const Job& job) {
-  if (job.lists) {
-    lists_ = *job.lists;
+void ChunkWriter::Write(Job* job) {
+  if (job->lists) {
+    lists_ = *job->lists;
     pose_.assign(lists_.object_count, {});
     color_.assign(lists_.object_count, 0);
     reading_.assign(lists_.object_count, 0);
   }
-  if (job.snap) {
-    Encode(*job.snap, &payload_);
-    WriteChunk(job.kind, job.step, payload_.data(), payload_.size());
+  if (job->snap) {
+    Encode(job->snap.get(), &payload_);
+    WriteChunk(job->kind, job->step, payload_.data(), payload_.size());
   } else {
-    WriteChunk(job.kind, job.step, job.text.data(), job.text.size());
+    WriteChunk(job->kind, job->step, job->text.data(), job->text.size());
   }
 }
 
-void ChunkWriter::Encode(const StepSnapshot& s, std::vector<uint8_t>* payload) {
+// Keeps the snapshot's state as the previous one (swapped: the snapshot goes
+// back to the spares with the old arrays, overwritten when it is next filled).
+void ChunkWriter::Encode(StepSnapshot* snap, std::vector<uint8_t>* payload) {
+  const StepSnapshot& s = *snap;
   Out out(payload);
   const bool key = s.keyframe;
   out.Put<double>(s.time);
@@ -245,9 +261,13 @@ void ChunkWriter::Encode(const StepSnapshot& s, std::vector<uint8_t>* payload) {
   for (const SampleRow& r : s.samples) out.Put<uint32_t>(r.step);
   out.Pad(8);
   for (const SampleRow& r : s.samples) out.Put<double>(r.value);
-  pose_ = s.pose;
-  color_ = s.color;
-  reading_ = s.reading;
+  pose_.swap(snap->pose);
+  color_.swap(snap->color);
+  reading_.swap(snap->reading);
+  snap->paint_cells.clear();
+  snap->paint_rgba.clear();
+  snap->names.clear();
+  snap->samples.clear();
 }
 
 void ChunkWriter::WriteChunk(uint8_t kind, uint32_t step, const void* raw, size_t size) {

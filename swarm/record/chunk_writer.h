@@ -65,6 +65,9 @@ class ChunkWriter {
   // A scene chunk; the step records after it are encoded against `lists`.
   void AddScene(uint32_t step, std::string text, SceneLists lists);
   void AddStep(std::unique_ptr<StepSnapshot> step);
+  // A snapshot to fill: one the writer is done with (its arrays keep their
+  // room: no allocation per step), or a new one.
+  std::unique_ptr<StepSnapshot> TakeSnapshot();
   // Waits until everything queued is written. Throws swarmsim::Error if a
   // chunk could not be written (also from the Add calls, after a failure).
   void Flush();
@@ -74,8 +77,8 @@ class ChunkWriter {
   struct Job;
   void Push(std::unique_ptr<Job> job);
   void Run();
-  void Write(const Job& job);
-  void Encode(const StepSnapshot& s, std::vector<uint8_t>* out);
+  void Write(Job* job);
+  void Encode(StepSnapshot* s, std::vector<uint8_t>* out);
   void WriteChunk(uint8_t kind, uint32_t step, const void* raw, size_t size);
 
   std::filesystem::path path_;
@@ -92,6 +95,7 @@ class ChunkWriter {
   mutable std::mutex mutex_;
   std::condition_variable changed_;
   std::deque<std::unique_ptr<Job>> queue_;  // at most kMaxQueued
+  std::vector<std::unique_ptr<StepSnapshot>> spare_;
   bool busy_ = false, stopping_ = false;
   std::string error_;
   uint64_t bytes_ = 0;

@@ -116,11 +116,22 @@ struct RunRecorder::Impl {
   std::vector<Tracked> tracked;                          // (ids)
   std::vector<std::pair<uint32_t, uint32_t>> robot_ids;  // first, count (live robots)
   std::vector<int> robot_index;                          // robot of each range
-  // X_RO of every robot object, and the local pose it was made from (slots);
-  // whether it changed at this capture (slots).
-  std::vector<Pose> relative, relative_from;
-  std::vector<uint8_t> moved;
-  bool capture_all = true;  // after a new scene: every pose afresh
+  // Every object of every robot (joints too: their motion moves what hangs
+  // below), robots in id order, each in hierarchy order, root first; per
+  // robot its range. By plan entry: X_RO, the local pose it was made from,
+  // and whether it changed at this capture.
+  struct PlanEntry {  // 16 bytes
+    uint32_t slot;
+    int32_t parent;      // entry of the parent, -1: the root
+    uint32_t id;         // recorded id, kNotRecorded
+    uint32_t joint_row;  // the parent's row in the joint table, kNotRecorded: not a joint
+  };
+  static constexpr uint32_t kNotRecorded = ~uint32_t{0};
+  std::vector<PlanEntry> plan;
+  std::vector<std::pair<uint32_t, uint32_t>> robot_plan;  // begin, end (robot ranges)
+  std::vector<Pose> relative, relative_from;              // (plan)
+  std::vector<uint8_t> moved;                             // (plan)
+  bool capture_all = true;                                // after a new scene: every pose afresh
 
   // The state at this step, by id.
   std::vector<QuantizedPose> pose;
@@ -229,6 +240,8 @@ void RunRecorder::Impl::BuildScene() {
   tracked.clear();
   robot_ids.clear();
   robot_index.clear();
+  plan.clear();
+  robot_plan.clear();
   const ObjectType shape_type = ObjectType::kShape, sensor_type = ObjectType::kProximitySensor;
   const auto kind_of = [&](uint32_t slot, Kind* kind) {
     const ObjectType t = scene.type_at(slot);
@@ -307,9 +320,22 @@ void RunRecorder::Impl::BuildScene() {
     const uint32_t first = static_cast<uint32_t>(tracked.size());
     const uint32_t root = scene.SlotOf(robot.root);
     json list = json::array();
+    const uint32_t plan_begin = static_cast<uint32_t>(plan.size());
+    std::unordered_map<uint32_t, int32_t> entry_of_slot;
     for (const uint32_t slot : robot.objects) {
+      PlanEntry e{slot, -1, kNotRecorded, kNotRecorded};
+      if (slot != root) {
+        const uint32_t parent = static_cast<uint32_t>(scene.parent_at(slot));
+        e.parent = entry_of_slot.at(parent);
+        if (scene.type_at(parent) == ObjectType::kJoint) e.joint_row = scene.row_at(parent);
+      }
+      entry_of_slot[slot] = static_cast<int32_t>(plan.size());
       Kind kind = Kind::kFrame;
-      if (!kind_of(slot, &kind) && slot != root) continue;
+      const bool drawn = kind_of(slot, &kind);
+      const bool recorded = drawn || slot == root;
+      if (recorded) e.id = static_cast<uint32_t>(tracked.size());
+      plan.push_back(e);
+      if (!recorded) continue;
       const Tracked t{slot, slot == root ? -1 : static_cast<int32_t>(root), scene.row_at(slot),
                       kind};
       const int64_t parent = slot == root ? -1 : parent_id(slot) - first;
@@ -332,6 +358,7 @@ void RunRecorder::Impl::BuildScene() {
     robots.push_back(std::move(entry));
     robot_ids.emplace_back(first, count);
     robot_index.push_back(static_cast<int>(i));
+    robot_plan.emplace_back(plan_begin, static_cast<uint32_t>(plan.size()));
   }
   for (uint32_t slot = 0; slot < scene.slot_count(); ++slot) {
     Kind kind = Kind::kFrame;
@@ -354,6 +381,9 @@ void RunRecorder::Impl::BuildScene() {
   pose.assign(n, {});
   color.assign(n, 0);
   reading.assign(n, 0);
+  relative.assign(plan.size(), Pose{});
+  relative_from.assign(plan.size(), Pose{});
+  moved.assign(plan.size(), 1);
   capture_all = true;
   const json j = {{"object_count", n},
                   {"templates", std::move(templates)},
@@ -369,24 +399,19 @@ void RunRecorder::Impl::BuildScene() {
 // the 24 sensors of a ring are not quantised again every step.
 void RunRecorder::Impl::Capture() {
   const Scene& scene = world->scene();
-  if (relative.size() != scene.slot_count()) {
-    relative.resize(scene.slot_count());
-    relative_from.resize(scene.slot_count());
-    moved.resize(scene.slot_count());
-    capture_all = true;
-  }
   const auto joints = scene.joints();
   const auto shapes = scene.shapes();
   const auto sensors = scene.proximity_sensors();
   const Rows<LedRow>* leds =
       has_leds ? &static_cast<const Rows<LedRow>&>(*scene.rows(led_type)) : nullptr;
   const bool all = capture_all;
-  const auto capture = [&](uint32_t id) {
+  // `entry`: its plan entry (robots' objects), or -1 (scene objects).
+  const auto capture = [&](uint32_t id, int64_t entry) {
     const Tracked& t = tracked[id];
     if (t.root < 0)
       pose[id] = Quantize(scene.world_pose_at(t.slot));
-    else if (moved[t.slot])
-      pose[id] = Quantize(relative[t.slot]);
+    else if (moved[entry])
+      pose[id] = Quantize(relative[entry]);
     switch (t.kind) {
       case Kind::kFrame: break;
       case Kind::kShape: color[id] = PackColor(shapes[t.row].color, true); break;
@@ -409,30 +434,30 @@ void RunRecorder::Impl::Capture() {
   world->scheduler().ParallelFor(
       0, static_cast<int64_t>(robot_ids.size()), kRobotGrain, [&](int64_t begin, int64_t end) {
         for (int64_t r = begin; r < end; ++r) {
-          const ModelInstance& robot = scene.instance(robot_index[r]);
-          const uint32_t root = scene.SlotOf(robot.root);
-          relative[root] = Pose{};
-          moved[root] = 0;  // the root's own frame never moves in itself
-          for (const uint32_t slot : robot.objects) {
-            if (slot == root) continue;
-            const uint32_t p = static_cast<uint32_t>(scene.parent_at(slot));
-            const bool joint = scene.type_at(p) == ObjectType::kJoint;
-            const Pose& X_PO = scene.local_pose_at(slot);
-            const bool changed = all || joint || moved[p] ||
-                                 std::memcmp(&X_PO, &relative_from[slot], sizeof(Pose)) != 0;
-            moved[slot] = changed;
-            if (!changed) continue;
-            relative_from[slot] = X_PO;
-            relative[slot] =
-                (joint ? relative[p] * joints[scene.row_at(p)].Motion() : relative[p]) * X_PO;
+          const auto [plan_begin, plan_end] = robot_plan[r];
+          for (uint32_t k = plan_begin; k < plan_end; ++k) {
+            const PlanEntry& e = plan[k];
+            if (e.parent < 0) {
+              moved[k] = 0;  // the root's frame, in itself: identity
+            } else {
+              const Pose& X_PO = scene.local_pose_at(e.slot);
+              const bool joint = e.joint_row != kNotRecorded;
+              const bool changed = all || joint || moved[e.parent] ||
+                                   std::memcmp(&X_PO, &relative_from[k], sizeof(Pose)) != 0;
+              moved[k] = changed;
+              if (changed) {
+                relative_from[k] = X_PO;
+                const Pose& X_RP = relative[e.parent];
+                relative[k] = (joint ? X_RP * joints[e.joint_row].Motion() : X_RP) * X_PO;
+              }
+            }
+            if (e.id != kNotRecorded) capture(e.id, k);
           }
-          const auto [first, count] = robot_ids[r];
-          for (uint32_t id = first; id < first + count; ++id) capture(id);
         }
       });
   const uint32_t scene_first =
       robot_ids.empty() ? 0 : robot_ids.back().first + robot_ids.back().second;
-  for (uint32_t id = scene_first; id < tracked.size(); ++id) capture(id);
+  for (uint32_t id = scene_first; id < tracked.size(); ++id) capture(id, -1);
   capture_all = false;
 }
 
@@ -443,7 +468,7 @@ void RunRecorder::Impl::WriteStep(const World& w) {
     keyframe = true;
   }
   Capture();
-  auto snap = std::make_unique<StepSnapshot>();
+  std::unique_ptr<StepSnapshot> snap = file->TakeSnapshot();
   snap->step = static_cast<uint32_t>(w.step_count());
   snap->time = w.time();
   snap->record = static_cast<uint32_t>(records);
@@ -473,6 +498,7 @@ void RunRecorder::Impl::WriteStep(const World& w) {
   snap->names.assign(metric_names.begin() + snap->first_name, metric_names.end());
   names_written = metric_names.size();
   snap->samples.swap(samples);
+  samples.clear();
   file->AddStep(std::move(snap));
   ++records;
 }

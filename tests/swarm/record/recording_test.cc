@@ -146,6 +146,17 @@ TEST(RecordingTest, PosesAndMetricsReadBackAsTheRunHadThem) {
   EXPECT_EQ(scene["robots"][3]["name"], "footbot#3");
   EXPECT_EQ(scene["robots"][3]["model"], "footbot");
   EXPECT_EQ(scene["templates"].size(), 1u);  // 30 copies described once
+  // The root first: the body cylinder, with its colour; then the wheels and the 24 sensors.
+  const nlohmann::json& objects = scene["templates"][0]["objects"];
+  ASSERT_EQ(objects.size(), 27u);
+  EXPECT_EQ(objects[0]["type"], "shape");
+  EXPECT_EQ(objects[0]["shape"], "cylinder");
+  EXPECT_EQ(objects[0]["size"][0], 0.085);
+  EXPECT_EQ(objects[0]["color"], nlohmann::json::parse("[0.2, 0.6, 0.2]"));
+  EXPECT_EQ(objects[1]["name"], "leftWheel");
+  EXPECT_EQ(objects[26]["type"], "proximity_sensor");
+  EXPECT_EQ(objects[26]["range"], 0.1);
+  EXPECT_EQ(objects[26]["parent"], 0);
   EXPECT_EQ(scene["robots"][3]["parameters"]["wheel_speed"], 0.05);
   fs::remove_all(out);
 }
