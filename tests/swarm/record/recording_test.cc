@@ -80,6 +80,15 @@ std::unique_ptr<Loaded> LoadRecorded(
   return l;
 }
 
+// Starts the world, runs `steps` steps and completes the recording.
+World& RunRecorded(Loaded* l, int steps) {
+  World& world = *l->loaded.world;
+  world.Start();
+  for (int i = 0; i < steps; ++i) world.Step();
+  l->recorder->Finish(steps, "ok", "");
+  return world;
+}
+
 // The world poses the run had, by recorded id, after each step (0: the start).
 using PoseTable = std::vector<std::vector<Pose>>;
 
@@ -165,11 +174,7 @@ TEST(RecordingTest, SeekingFromAKeyframeGivesTheStateOfPlayingThrough) {
   const fs::path out = TempDir("seek");
   RecordSettings settings;
   settings.keyframe_every = 7;
-  auto l = LoadRecorded("worlds/diffusion.yaml", 12, out, settings);
-  World& world = *l->loaded.world;
-  world.Start();
-  for (int i = 0; i < 30; ++i) world.Step();
-  l->recorder->Finish(30, "ok", "");
+  RunRecorded(LoadRecorded("worlds/diffusion.yaml", 12, out, settings).get(), 30);
   RecordingPlayer through(out), seek(out);
   int keyframes = 0;
   for (const ChunkInfo& c : through.info().chunks)
@@ -220,10 +225,7 @@ TEST(RecordingTest, LedColoursAndThePaintLayerReadBack) {
   {
     const fs::path out = TempDir("leds");
     auto l = LoadRecorded("worlds/led_aggregation.yaml", 9, out);
-    World& world = *l->loaded.world;
-    world.Start();
-    for (int i = 0; i < 5; ++i) world.Step();
-    l->recorder->Finish(5, "ok", "");
+    const World& world = RunRecorded(l.get(), 5);
     RecordingPlayer player(out);
     while (player.Next()) {
     }
@@ -252,10 +254,7 @@ TEST(RecordingTest, LedColoursAndThePaintLayerReadBack) {
   {
     const fs::path out = TempDir("paint");
     auto l = LoadRecorded("worlds/trails.yaml", 6, out);
-    World& world = *l->loaded.world;
-    world.Start();
-    for (int i = 0; i < 30; ++i) world.Step();
-    l->recorder->Finish(30, "ok", "");
+    const World& world = RunRecorded(l.get(), 30);
     RecordingPlayer player(out);
     while (player.Next()) {
     }
