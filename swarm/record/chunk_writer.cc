@@ -1,6 +1,7 @@
 #include "swarm/record/chunk_writer.h"
 
 #include <fcntl.h>
+#include <sys/resource.h>
 #include <unistd.h>
 #include <xxhash.h>
 #include <zstd.h>
@@ -155,6 +156,9 @@ uint64_t ChunkWriter::bytes_written() const {
 }
 
 void ChunkWriter::Run() {
+  // Below the simulation's threads: on few cores, compressing waits for
+  // their idle moments rather than taking a core from a parallel phase.
+  setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), 10);
   for (;;) {
     std::unique_ptr<Job> job;
     bool failed = false;
