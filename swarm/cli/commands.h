@@ -22,6 +22,9 @@ class App;
 namespace swarmsim {
 class ModuleRegistry;
 }  // namespace swarmsim
+namespace swarmsim::viewer {
+class Server;
+}  // namespace swarmsim::viewer
 
 namespace swarmsim::cli {
 
@@ -99,5 +102,20 @@ struct DescribeArgs {
 };
 CLI::App* AddDescribeCommand(CLI::App* app, DescribeArgs* args);
 int DescribeCommand(const DescribeArgs& args, const ModuleRegistry& registry);
+
+// swarmsim view DIR (view_command.cc)
+struct ViewArgs {
+  std::string folder;
+  std::string host = "127.0.0.1";
+  int port = 8600;          // 0: a free port
+  std::string export_file;  // --export FILE.html; empty: serve
+};
+CLI::App* AddViewCommand(CLI::App* app, ViewArgs* args);
+int ViewCommand(const ViewArgs& args);
+// What is wrong with `folder` as a recorded run's output folder ("": nothing).
+std::string CheckRecordingFolder(const std::string& folder);
+// Binds `server` and prints its address ("swarmsim view: http://...");
+// prints why not and returns kExitRunError when it cannot.
+int BindViewServer(const std::string& host, int port, viewer::Server* server);
 
 }  // namespace swarmsim::cli
