@@ -6,7 +6,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config ccache clang-format git
   libbox2d-dev libode-dev libfcl-dev liboctomap-dev liblua5.4-dev libtbb-dev
-  libosmesa6-dev libyaml-cpp-dev libeigen3-dev libsqlite3-dev libxxhash-dev nlohmann-json3-dev libcli11-dev
+  libosmesa6-dev libyaml-cpp-dev libeigen3-dev libsqlite3-dev libxxhash-dev libzstd-dev nlohmann-json3-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   gnuplot-nox libopenmpi-dev openmpi-bin
   libpng-dev libassimp-dev

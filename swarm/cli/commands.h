@@ -47,10 +47,15 @@ struct RunArgs {
   std::string video_file;                 // its FILE; empty: DIR/video.mp4
   int video_width = 0, video_height = 0;  // --video-size; 0: the view's default
   double video_fps = 30;
+  bool record = false;  // --record: DIR/recording.swrec (swarm/record/writer.h)
 };
 CLI::App* AddRunCommand(CLI::App* app, RunArgs* args);
 // Loads the world (the plugins first into `registry`) and runs it.
 int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegistry* registry);
+
+// swarmsim record-info DIR (record_info_command.cc)
+CLI::App* AddRecordInfoCommand(CLI::App* app, std::string* path);
+int RecordInfoCommand(const std::string& path);
 
 // swarmsim bench (bench_command.cc)
 struct BenchArgs {

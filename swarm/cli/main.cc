@@ -42,6 +42,8 @@ int Main(int argc, char** argv) {
   DescribeArgs describe_args;
   const CLI::App* describe = AddDescribeCommand(&app, &describe_args);
   const CLI::App* version = AddVersionCommand(&app);
+  std::string record_info_path;
+  const CLI::App* record_info = AddRecordInfoCommand(&app, &record_info_path);
 
   const std::vector<std::string> args(argv + std::min(argc, 1), argv + argc);
   try {
@@ -66,6 +68,7 @@ int Main(int argc, char** argv) {
   RegisterBuiltinModules(&registry);
 
   if (*version) return VersionCommand();
+  if (*record_info) return RecordInfoCommand(record_info_path);
   if (*describe) return DescribeCommand(describe_args, registry);
   if (*modules) return ModulesCommand(registry);
   if (*view) return ViewCommand(view_args);

@@ -14,6 +14,7 @@
 #include "swarm/cli/commands.h"
 #include "swarm/cli/options.h"
 #include "swarm/loader/world_loader.h"
+#include "swarm/record/writer.h"
 #include "swarm/run/runner.h"
 
 namespace swarmsim::cli {
@@ -162,6 +163,9 @@ CLI::App* AddRunCommand(CLI::App* app, RunArgs* args) {
                   "time_step)) steps, at least 1")
       ->check(NumberCheck(false))
       ->needs(video);
+  run->add_flag("--record", args->record,
+                "Record the run for swarmsim view: DIR/recording.swrec (needs --out; a world's "
+                "record: setting does the same)");
   run->callback([args, video] { args->video = video->count() > 0; });
   return run;
 }
@@ -219,7 +223,35 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
       std::cerr << "note: " << swarmsim::ValidUtf8(note) << "\n";
     options.progress_note = [recorder] { return recorder->ProgressNote(); };
   }
+  // The recording (swarm/record): --record or the world's record: setting.
+  record::RunRecorder* run_recorder = nullptr;
+  if (args.record || loaded.record_every > 0) {
+    if (!options.out_dir) {
+      if (args.record)
+        return bad_input("--record writes DIR/recording.swrec: pass --out DIR as well");
+      std::cerr << "note: the world's record: setting writes DIR/recording.swrec: pass --out DIR "
+                   "to record this run\n";
+    } else {
+      record::RecordSettings settings;
+      settings.out_dir = *options.out_dir;
+      settings.every = std::max<int64_t>(1, loaded.record_every);
+      settings.world_file = args.world_file;
+      settings.steps_planned = options.steps;
+      for (const SwarmMetricSpec& metric : loaded.metrics)
+        settings.metric_names.push_back(metric.name);
+      try {
+        CreateOutputFolder(*options.out_dir);
+        run_recorder = record::AddRecorder(loaded.world.get(), settings);
+      } catch (const Error& e) {
+        return bad_input(e.what());
+      }
+    }
+  }
   const RunResult result = RunWorld(loaded.world.get(), options, std::cout, std::cerr);
+  if (run_recorder != nullptr)
+    run_recorder->Finish(result.steps,
+                         result.ok ? "ok" : (result.signal != 0 ? "interrupted" : "error"),
+                         result.ok ? "" : result.error);
   if (recorder != nullptr) {
     // The video's end, also without --out (with it, the run's outputs did it).
     try {

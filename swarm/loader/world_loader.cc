@@ -20,7 +20,7 @@ namespace {
 
 const std::vector<std::string> kTopKeys = {"simulation",  "parameters", "arena",   "obstacles",
                                            "environment", "models",     "objects", "metrics",
-                                           "paint",       "plugins"};
+                                           "paint",       "plugins",    "record"};
 
 std::vector<Override> SplitOverrides(const LoadOptions& options) {
   std::vector<Override> out;
@@ -117,7 +117,19 @@ LoadedWorld WorldLoader::Load() {
   out.metrics = ReadMetrics(top, world);
   out.models = Summarize();
   loader::AddPaintLayer(f, root, top.Get("paint"), WorldValues(), arena_, world);
+  out.record_every = ReadRecord(top);
   return out;
+}
+
+// `record: true` or `record: {every: N}`: a recording every N steps (swarm/record).
+int64_t WorldLoader::ReadRecord(const Fields& top) const {
+  const Field record = top.Get("record");
+  if (!record.present()) return 0;
+  const ValueReader values = WorldValues();
+  if (!record.node.IsMap()) return values.Bool(record) ? 1 : 0;
+  Fields f(*file_, record, "'record'");
+  f.Expect({"every"});
+  return f.Has("every") ? values.Integer(f.Get("every"), 1, int64_t{1} << 40) : 1;
 }
 
 // --- Parameters ----------------------------------------------------------------------

@@ -70,6 +70,8 @@ struct LoadedWorld {
   // What may surprise without being an error ("file:line:col: ..."), for the
   // program to print: e.g. an environment map without occupied voxels.
   std::vector<std::string> warnings;
+  // The world's `record:` setting: a step record every N steps; 0: not asked for.
+  int64_t record_every = 0;
 };
 
 // Reads `file`, resolves parameters (after `options.overrides`), builds the

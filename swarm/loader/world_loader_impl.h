@@ -129,6 +129,7 @@ class WorldLoader {
   void BuildObstacles(const Fields& top, World* world);
   void AddObstacleFootprint(const ShapeData& shape, const Pose& X_WO);
   std::vector<SwarmMetricSpec> ReadMetrics(const Fields& top, World* world);
+  int64_t ReadRecord(const Fields& top) const;
 
   // The models entries (world_entries.cc), in the order Load runs them.
   void ResolveEntry(EntryPlan* entry);
