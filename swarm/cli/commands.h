@@ -48,6 +48,10 @@ struct RunArgs {
   int video_width = 0, video_height = 0;  // --video-size; 0: the view's default
   double video_fps = 30;
   bool record = false;  // --record: DIR/recording.swrec (swarm/record/writer.h)
+  // --view: record, and serve DIR to the viewer page while the run goes.
+  bool view = false;
+  int view_port = 8600;  // 0: a free port
+  std::string view_host = "127.0.0.1";
 };
 CLI::App* AddRunCommand(CLI::App* app, RunArgs* args);
 // Loads the world (the plugins first into `registry`) and runs it.
@@ -117,8 +121,6 @@ struct ViewArgs {
 };
 CLI::App* AddViewCommand(CLI::App* app, ViewArgs* args);
 int ViewCommand(const ViewArgs& args);
-// What is wrong with `folder` as a recorded run's output folder ("": nothing).
-std::string CheckRecordingFolder(const std::string& folder);
 // Binds `server` and prints its address ("swarmsim view: http://...");
 // prints why not and returns kExitRunError when it cannot.
 int BindViewServer(const std::string& host, int port, viewer::Server* server);

@@ -8,6 +8,7 @@
 #include "framework/utf8.h"
 #include "swarm/cli/commands.h"
 #include "swarm/cli/options.h"
+#include "swarm/record/reader.h"
 #include "swarm/viewer/page.h"
 #include "swarm/viewer/server.h"
 
@@ -19,29 +20,17 @@ CLI::App* AddViewCommand(CLI::App* app, ViewArgs* args) {
   view->add_option("folder", args->folder, "The run's output folder (holds recording.swrec)")
       ->required()
       ->check(NonEmpty("a folder"));
-  view->add_option("--port", args->port, "Port to listen on (0: a free one)")
+  view->add_option("--port", args->port, "Port to listen on (default 8600; 0: a free one)")
       ->transform(WholeNumberCheck(0, 65535, ""));
   view->add_option("--host", args->host,
                    "Address to listen on (default 127.0.0.1: this machine only)")
       ->check(NonEmpty("an address"));
   view->add_option("--export", args->export_file,
                    "Write one self-contained HTML file (page, three.js, recording) that plays "
-                   "offline, instead of serving")
+                   "offline from disk, instead of serving")
       ->option_text("FILE.html")
       ->check(NonEmpty("a file"));
   return view;
-}
-
-std::string CheckRecordingFolder(const std::string& folder) {
-  namespace fs = std::filesystem;
-  std::error_code error;
-  if (!fs::is_directory(folder, error))
-    return "'" + folder + "' is not a folder: give the output folder of a run (swarmsim run " +
-           "WORLD --out DIR --record)";
-  if (!fs::is_regular_file(fs::path(folder) / viewer::kRecordingFile, error))
-    return folder +
-           " has no recording.swrec: record a run with swarmsim run WORLD --out DIR --record";
-  return "";
 }
 
 int BindViewServer(const std::string& host, int port, viewer::Server* server) {
@@ -56,19 +45,34 @@ int BindViewServer(const std::string& host, int port, viewer::Server* server) {
 }
 
 int ViewCommand(const ViewArgs& args) {
-  if (const std::string problem = CheckRecordingFolder(args.folder); !problem.empty()) {
-    std::cerr << "error: " << ValidUtf8(problem) << "\n";
+  // The folder and its recording: missing, corrupt or of a newer format are
+  // the user's to fix; a truncated one (a run in progress, or killed) is
+  // shown up to its last whole step.
+  namespace fs = std::filesystem;
+  std::error_code error;
+  if (!fs::is_directory(args.folder, error)) {
+    std::cerr << "error: '" << ValidUtf8(args.folder)
+              << "' is not a folder: give the output folder of a run (swarmsim run WORLD --out "
+                 "DIR --record)\n";
     return kExitBadInput;
   }
+  record::RecordingInfo info;
+  try {
+    info = record::ScanRecording(args.folder);
+  } catch (const Error& e) {
+    std::cerr << "error: " << ValidUtf8(e.what()) << "\n";
+    return kExitBadInput;
+  }
+  std::cerr << ValidUtf8(info.Describe()) << "\n";
   if (!args.export_file.empty()) {
     try {
-      viewer::ExportFolder(args.folder, args.export_file);
+      viewer::ExportFolder(args.folder, info.valid_size, args.export_file);
     } catch (const Error& e) {
       std::cerr << "error: " << ValidUtf8(e.what()) << "\n";
       return kExitRunError;
     }
     std::cout << "swarmsim view: wrote " << args.export_file << " ("
-              << std::filesystem::file_size(args.export_file) << " bytes)\n";
+              << fs::file_size(args.export_file, error) << " bytes)\n";
     return 0;
   }
   viewer::Server server(args.folder);

@@ -3,7 +3,6 @@
 
 #include <cctype>
 #include <fstream>
-#include <sstream>
 
 #include "framework/error.h"
 #include "swarm/viewer/assets.h"
@@ -70,13 +69,15 @@ std::string ExportedPage(std::string_view recording) {
                      "</script>");
 }
 
-void ExportFolder(const std::filesystem::path& folder, const std::filesystem::path& html_file) {
+void ExportFolder(const std::filesystem::path& folder, uint64_t size,
+                  const std::filesystem::path& html_file) {
   const std::filesystem::path recording_file = folder / kRecordingFile;
   std::ifstream in(recording_file, std::ios::binary);
-  std::stringstream bytes;
-  if (!(in && bytes << in.rdbuf())) throw Error("cannot read '" + recording_file.string() + "'");
+  std::string bytes(size, '\0');
+  if (!in.read(bytes.data(), static_cast<std::streamsize>(size)))
+    throw Error("cannot read '" + recording_file.string() + "'");
   std::ofstream out(html_file, std::ios::binary);
-  out << ExportedPage(bytes.str());
+  out << ExportedPage(bytes);
   out.close();
   if (!out) throw Error("cannot write '" + html_file.string() + "'");
 }

@@ -1,6 +1,7 @@
 // The page as the server sends it and as --export writes it.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <string_view>
@@ -16,8 +17,10 @@ std::string ServedPage();
 // bytes) base64-encoded inside, playable from disk (file://).
 std::string ExportedPage(std::string_view recording);
 
-// Writes ExportedPage of `folder`'s recording to `html_file`; throws Error
-// when the recording cannot be read or the file written.
-void ExportFolder(const std::filesystem::path& folder, const std::filesystem::path& html_file);
+// Writes ExportedPage of the first `size` bytes of `folder`'s recording (its
+// whole chunks) to `html_file`; throws Error when the recording cannot be
+// read or the file written.
+void ExportFolder(const std::filesystem::path& folder, uint64_t size,
+                  const std::filesystem::path& html_file);
 
 }  // namespace swarmsim::viewer

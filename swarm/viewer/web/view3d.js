@@ -21,7 +21,7 @@ function geometryOf(o) {
 export class View3D {
   constructor(container) {
     this.container = container;
-    this.renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+    this.renderer = new THREE.WebGLRenderer({ antialias: true });
     this.renderer.setPixelRatio(window.devicePixelRatio || 1);
     container.prepend(this.renderer.domElement);
     this.scene = new THREE.Scene();

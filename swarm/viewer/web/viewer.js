@@ -207,23 +207,40 @@ async function fetchMore() {
 
 async function poll() {
   try {
-    const before = viewer.recording.records.length;
-    await fetchMore();
     const r = viewer.recording;
-    if (r.records.length > before) {
-      const wasAtEnd = viewer.record >= before - 1;
+    const before = r.records.length;
+    await fetchMore();
+    if (!viewer.started) {
+      if (r.records.length) start();
+      else $('status').textContent = 'waiting for the run to record its first step...';
+    } else if (r.records.length > before) {
       // Following: stay on the newest step unless the user went back.
+      const wasAtEnd = viewer.record >= before - 1;
       if (wasAtEnd && !viewer.playing) show(r.records.length - 1);
       else show(viewer.record);
       fillMetrics();
       if (viewer.metricsRead) { viewer.metricsRead = false; readMetricsSlowly(); }
     }
-    setStatus();
+    if (viewer.started) setStatus();
     if (!r.ended) setTimeout(poll, POLL_MS);
     else viewer.live = false;
   } catch (e) {
-    showError(e.message);
+    showError(`swarmsim view: ${e.message}`);
   }
+}
+
+// The first whole step is here: draw it and start the clock.
+function start() {
+  const r = viewer.recording;
+  viewer.started = true;
+  show(viewer.live ? r.records.length - 1 : 0);
+  viewer.view.frame(false);
+  fillMetrics();
+  setStatus();
+  requestAnimationFrame(frame);
+  viewer.loadMs = performance.now();
+  viewer.ready = true;
+  readMetricsSlowly();
 }
 
 async function main() {
@@ -233,22 +250,10 @@ async function main() {
   if (embedded) viewer.recording.append(base64Bytes(embedded.textContent));
   else await fetchMore();
   const r = viewer.recording;
-  if (!r.header || !r.records.length)
-    throw new Error(r.header ? 'the recording has no whole step yet: reload when the run has written one'
-      : 'the recording is empty');
   viewer.live = !embedded && !r.ended;
-  show(0);
-  viewer.view.frame(false);
-  fillMetrics();
-  setStatus();
-  requestAnimationFrame(frame);
-  viewer.loadMs = performance.now();
-  viewer.ready = true;
-  readMetricsSlowly();
-  if (viewer.live) {
-    show(r.records.length - 1);
-    setTimeout(poll, POLL_MS);
-  }
+  if (r.records.length) start();
+  else if (!viewer.live) throw new Error('the recording has no whole step');
+  if (viewer.live) setTimeout(poll, viewer.started ? POLL_MS : 200);
 }
 
 // The test hook: read state, set the time, project world points to pixels.
