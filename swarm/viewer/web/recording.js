@@ -139,27 +139,36 @@ export class State {
   apply(u8, keyframe) {
     const s = sections(u8);
     const dv = s.dv;
+    // Typed views (the sections are aligned for them; `decode` gives a
+    // buffer of its own).
+    const buffer = u8.buffer, base = u8.byteOffset, n = s.poseN;
+    const ids = new Uint32Array(buffer, base + s.poseIds, n);
+    const xyz = new Int32Array(buffer, base + s.poseXyz, 3 * n);
+    const q = new Int16Array(buffer, base + s.poseQ, 4 * n);
+    const X = this.xyz, Q = this.q;
     let id = 0;
-    for (let i = 0; i < s.poseN; ++i) {
-      id += dv.getUint32(s.poseIds + 4 * i, true);
-      for (let c = 0; c < 3; ++c) {
-        const v = dv.getInt32(s.poseXyz + 4 * (c * s.poseN + i), true);
-        this.xyz[3 * id + c] = keyframe ? v : (this.xyz[3 * id + c] + v) | 0;
-      }
-      for (let c = 0; c < 4; ++c) {
-        const v = dv.getInt16(s.poseQ + 2 * (c * s.poseN + i), true);
-        this.q[4 * id + c] = keyframe ? v : ((this.q[4 * id + c] + v) << 16) >> 16;
+    for (let i = 0; i < n; ++i) {
+      id += ids[i];
+      if (keyframe) {
+        X[3 * id] = xyz[i]; X[3 * id + 1] = xyz[n + i]; X[3 * id + 2] = xyz[2 * n + i];
+        Q[4 * id] = q[i]; Q[4 * id + 1] = q[n + i]; Q[4 * id + 2] = q[2 * n + i]; Q[4 * id + 3] = q[3 * n + i];
+      } else {
+        X[3 * id] += xyz[i]; X[3 * id + 1] += xyz[n + i]; X[3 * id + 2] += xyz[2 * n + i];
+        Q[4 * id] += q[i]; Q[4 * id + 1] += q[n + i]; Q[4 * id + 2] += q[2 * n + i]; Q[4 * id + 3] += q[3 * n + i];
       }
     }
+    const colorIds = new Uint32Array(buffer, base + s.colorIds, s.colorN);
     id = 0;
     for (let i = 0; i < s.colorN; ++i) {
-      id += dv.getUint32(s.colorIds + 4 * i, true);
+      id += colorIds[i];
       for (let c = 0; c < 4; ++c) this.rgba[4 * id + c] = u8[s.colorRgba + 4 * i + c];
     }
+    const proxIds = new Uint32Array(buffer, base + s.proxIds, s.proxN);
+    const proxValues = new Uint16Array(buffer, base + s.proxValues, s.proxN);
     id = 0;
     for (let i = 0; i < s.proxN; ++i) {
-      id += dv.getUint32(s.proxIds + 4 * i, true);
-      this.prox[id] = dv.getUint16(s.proxValues + 2 * i, true);
+      id += proxIds[i];
+      this.prox[id] = proxValues[i];
     }
     if (this.paint) {
       if (keyframe) this.clearPaint();

@@ -7,22 +7,30 @@ import { NO_DETECTION } from './recording.js';
 
 const TRAIL_LENGTH = 40;
 
-function geometryOf(o) {
+// Fewer triangles per round shape when there are many of them (a software
+// renderer draws 10,000 robots at 30 frames/s only so).
+function geometryOf(o, many) {
   const [a, b, c] = o.size || [0.05, 0.05, 0.05];
+  const round = many ? 8 : 24;
   switch (o.shape) {
     case 'box': case 'mesh': return new THREE.BoxGeometry(Math.max(a, 1e-4), Math.max(b, 1e-4), Math.max(c, 1e-4));
-    case 'sphere': return new THREE.SphereGeometry(Math.max(a, 1e-4), 16, 12);
-    case 'capsule': return new THREE.CapsuleGeometry(Math.max(a, 1e-4), Math.max(c - 2 * a, 0), 6, 16).rotateX(Math.PI / 2);
+    case 'sphere': return new THREE.SphereGeometry(Math.max(a, 1e-4), round, round * 3 / 4);
+    case 'capsule': return new THREE.CapsuleGeometry(Math.max(a, 1e-4), Math.max(c - 2 * a, 0), 4, round).rotateX(Math.PI / 2);
     case 'cylinder': default:
-      return new THREE.CylinderGeometry(Math.max(a, 1e-4), Math.max(a, 1e-4), Math.max(c, 1e-4), 24).rotateX(Math.PI / 2);
+      return new THREE.CylinderGeometry(Math.max(a, 1e-4), Math.max(a, 1e-4), Math.max(c, 1e-4), round).rotateX(Math.PI / 2);
   }
 }
 
+// Above this many instances of a kind, the cheaper geometry.
+const MANY = 1000;
+
 export class View3D {
-  constructor(container) {
+  // `large`: a scene of thousands of robots (no antialiasing, 1 pixel per CSS pixel).
+  constructor(container, large) {
     this.container = container;
-    this.renderer = new THREE.WebGLRenderer({ antialias: true });
-    this.renderer.setPixelRatio(window.devicePixelRatio || 1);
+    this.renderer = new THREE.WebGLRenderer({ antialias: !large, powerPreference: 'high-performance' });
+    this.renderer.setPixelRatio(large ? 1 : window.devicePixelRatio || 1);
+    this.large = large;
     container.prepend(this.renderer.domElement);
     this.scene = new THREE.Scene();
     this.scene.background = new THREE.Color(0x1d2127);
@@ -101,12 +109,15 @@ export class View3D {
       this.world.add(m);
     }
 
-    // Shapes and LEDs, instanced by kind and size.
+    // Shapes and LEDs, instanced by kind and size. A swarm of thousands is
+    // drawn as its robots' bodies (root shapes) and LEDs only.
     const groups = new Map();
     const sensors = [];
+    this.bodiesOnly = this.large;
     for (const o of scene.objects) {
       if (o.type === 'proximity_sensor') { sensors.push(o.id); continue; }
       let key;
+      if (o.type === 'shape' && this.bodiesOnly && o.robot >= 0 && o.templateObject !== 0) continue;
       if (o.type === 'shape') key = `s|${o.shape}|${(o.size || []).join(',')}`;
       else if (o.type === 'led') key = `l|${o.radius}`;
       else continue;
@@ -114,14 +125,17 @@ export class View3D {
       if (!g) groups.set(key, g = { key, led: o.type === 'led', sample: o, ids: [] });
       g.ids.push(o.id);
     }
+    // The objects whose world pose is needed: drawn ones and robot roots
+    // (sensors too while rays are shown), in id order (roots first).
+    const drawn = new Uint8Array(scene.count);
+    for (const g of groups.values()) for (const id of g.ids) drawn[id] = 1;
+    for (const r of scene.robots) drawn[r.first] = 1;
+    for (let id = 0; id < scene.count; ++id) if (scene.rootOf[id] < 0) drawn[id] = 1;
+    this.drawnIds = Uint32Array.from(drawn.reduce((list, on, id) => (on && list.push(id), list), []));
+    this.drawnAndSensorIds = Uint32Array.from([...this.drawnIds, ...sensors].sort((a, b) => a - b));
     this.groups = [];
     for (const g of groups.values()) {
-      const geometry = g.led ? new THREE.SphereGeometry(Math.max(g.sample.radius || 0.01, 1e-4), 10, 8) : geometryOf(g.sample);
-      const material = g.led ? new THREE.MeshBasicMaterial({ color: 0xffffff })
-        : new THREE.MeshLambertMaterial({ color: 0xffffff });
-      const mesh = new THREE.InstancedMesh(geometry, material, g.ids.length);
-      mesh.instanceMatrix.setUsage(THREE.DynamicDrawUsage);
-      mesh.setColorAt(0, new THREE.Color(1, 1, 1));
+      const mesh = this.large ? this.pointsOf(g) : this.instancesOf(g);
       mesh.frustumCulled = false;
       mesh.userData.ids = Int32Array.from(g.ids);
       mesh.userData.led = g.led;
@@ -153,6 +167,45 @@ export class View3D {
     this.update();
   }
 
+  // One InstancedMesh for the objects of group `g` (same kind and size).
+  instancesOf(g) {
+    const many = g.ids.length > MANY;
+    const geometry = g.led ? new THREE.SphereGeometry(Math.max(g.sample.radius || 0.01, 1e-4), many ? 6 : 10, many ? 4 : 8)
+      : geometryOf(g.sample, many);
+    const material = g.led ? new THREE.MeshBasicMaterial({ color: 0xffffff })
+      : new THREE.MeshLambertMaterial({ color: 0xffffff });
+    const mesh = new THREE.InstancedMesh(geometry, material, g.ids.length);
+    mesh.instanceMatrix.setUsage(THREE.DynamicDrawUsage);
+    mesh.setColorAt(0, new THREE.Color(1, 1, 1));
+    return mesh;
+  }
+
+  // A swarm of thousands: each object a disc of its size seen from any side
+  // (one point each; software renderers draw 10,000 instanced meshes slowly).
+  pointsOf(g) {
+    const o = g.sample, n = g.ids.length;
+    const [a, b] = o.size || [0.05, 0.05];
+    const diameter = g.led ? 2 * (o.radius || 0.01) : o.shape === 'box' || o.shape === 'mesh' ? Math.hypot(a, b) : 2 * a;
+    if (!View3D.disc) {
+      const canvas = document.createElement('canvas');
+      canvas.width = canvas.height = 64;
+      const c = canvas.getContext('2d');
+      c.fillStyle = '#fff';
+      c.beginPath();
+      c.arc(32, 32, 30, 0, 2 * Math.PI);
+      c.fill();
+      View3D.disc = new THREE.CanvasTexture(canvas);
+    }
+    const geometry = new THREE.BufferGeometry();
+    geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(3 * n), 3).setUsage(THREE.DynamicDrawUsage));
+    geometry.setAttribute('color', new THREE.BufferAttribute(new Float32Array(3 * n), 3).setUsage(THREE.DynamicDrawUsage));
+    const points = new THREE.Points(geometry, new THREE.PointsMaterial({
+      size: Math.max(diameter, 1e-3), sizeAttenuation: true, vertexColors: true, map: View3D.disc, alphaTest: 0.5 }));
+    points.userData.points = true;
+    points.userData.radius = diameter / 2;
+    return points;
+  }
+
   // The camera looking at the whole floor from above (`topDown`) or slanted.
   frame(topDown) {
     const floor = this.header.floor || { min: [-5, -5], max: [5, 5] };
@@ -173,8 +226,9 @@ export class View3D {
   computeWorldPoses() {
     const { xyz, q } = this.state, unit = this.unit, qs = 1 / 32767;
     const P = this.worldPos, Q = this.worldQuat, roots = this.sceneInfo.rootOf;
-    const n = this.sceneInfo.count;
-    for (let i = 0; i < n; ++i) {
+    const ids = this.show.rays ? this.drawnAndSensorIds : this.drawnIds;
+    for (let k = 0; k < ids.length; ++k) {
+      const i = ids[k];
       let px = xyz[3 * i] * unit, py = xyz[3 * i + 1] * unit, pz = xyz[3 * i + 2] * unit;
       let qw = q[4 * i] * qs, qx = q[4 * i + 1] * qs, qy = q[4 * i + 2] * qs, qz = q[4 * i + 3] * qs;
       const norm = Math.hypot(qw, qx, qy, qz) || 1;
@@ -204,6 +258,7 @@ export class View3D {
     this.computeWorldPoses();
     const P = this.worldPos, Q = this.worldQuat, rgba = this.state.rgba;
     for (const mesh of this.groups) {
+      if (mesh.userData.points) { this.updatePoints(mesh); continue; }
       const ids = mesh.userData.ids, m = mesh.instanceMatrix.array, c = mesh.instanceColor.array;
       const led = mesh.userData.led, showLeds = this.show.leds;
       for (let j = 0; j < ids.length; ++j) {
@@ -233,6 +288,24 @@ export class View3D {
     this.updateTrails();
     if (this.followRobot >= 0) this.follow();
     this.dirty = true;
+  }
+
+  updatePoints(points) {
+    const ids = points.userData.ids, led = points.userData.led, P = this.worldPos, rgba = this.state.rgba;
+    const pos = points.geometry.attributes.position.array, c = points.geometry.attributes.color.array;
+    points.visible = !led || this.show.leds;
+    for (let j = 0; j < ids.length; ++j) {
+      const id = ids[j];
+      // LEDs a little above the bodies, so they show from above.
+      pos[3 * j] = P[3 * id]; pos[3 * j + 1] = P[3 * id + 1]; pos[3 * j + 2] = P[3 * id + 2] + (led ? 0.05 : 0);
+      const dim = led && rgba[4 * id + 3] === 0 ? 0.12 : 1;
+      for (let k = 0; k < 3; ++k) {
+        const v = rgba[4 * id + k] / 255;
+        c[3 * j + k] = dim * (v <= 0.04045 ? v / 12.92 : Math.pow((v + 0.055) / 1.055, 2.4));
+      }
+    }
+    points.geometry.attributes.position.needsUpdate = true;
+    points.geometry.attributes.color.needsUpdate = true;
   }
 
   updateRays() {
@@ -307,10 +380,15 @@ export class View3D {
     const raycaster = new THREE.Raycaster();
     raycaster.setFromCamera(ndc, this.camera);
     const pickable = this.groups.filter((g) => !g.userData.led);
-    for (const mesh of pickable) mesh.computeBoundingSphere();
+    for (const mesh of pickable) {
+      if (mesh.userData.points) {
+        mesh.geometry.computeBoundingSphere();
+        raycaster.params.Points.threshold = mesh.userData.radius;
+      } else mesh.computeBoundingSphere();
+    }
     const hits = raycaster.intersectObjects(pickable, false);
     for (const hit of hits) {
-      const id = hit.object.userData.ids[hit.instanceId];
+      const id = hit.object.userData.ids[hit.object.userData.points ? hit.index : hit.instanceId];
       const robot = this.sceneInfo.robotOf[id];
       if (robot >= 0) return robot;
     }

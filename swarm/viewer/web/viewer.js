@@ -32,6 +32,7 @@ function setStatus() {
   const r = viewer.recording;
   const parts = [`${r.header.world}`, `${viewer.state ? viewer.sceneInfo.robots.length : 0} robots`,
     `${r.records.length} steps recorded`];
+  if (viewer.view?.bodiesOnly) parts.push('large swarm: bodies and LEDs only');
   if (r.ended) parts.push(r.ended.status === 'ok' ? 'run complete' : `run ${r.ended.status}`);
   else if (viewer.live) parts.push('live: following the run');
   else parts.push('recording ends early (truncated)');
@@ -233,6 +234,9 @@ async function poll() {
 function start() {
   const r = viewer.recording;
   viewer.started = true;
+  const robots = r.scenes[r.scenes.length - 1].scene.robots.length;
+  viewer.view = new View3D($('view'), robots > 2000);
+  wireControls();
   show(viewer.live ? r.records.length - 1 : 0);
   viewer.view.frame(false);
   fillMetrics();
@@ -244,8 +248,6 @@ function start() {
 }
 
 async function main() {
-  viewer.view = new View3D($('view'));
-  wireControls();
   const embedded = document.getElementById('swarmsim-recording');
   if (embedded) viewer.recording.append(base64Bytes(embedded.textContent));
   else await fetchMore();
@@ -267,6 +269,7 @@ window.swarmsimViewer = {
   get live() { return viewer.live; },
   get ended() { return !!viewer.recording.ended; },
   get robotCount() { return viewer.sceneInfo?.robots.length || 0; },
+  get view() { return viewer.view; },  // for measurements
   setRecord(i) { setPlaying(false); show(i); viewer.view.render(); return viewer.record; },
   // World position [x, y, z] of robot `index` at the record shown.
   robotPosition(index) {
