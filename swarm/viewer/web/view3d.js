@@ -5,7 +5,7 @@ import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import { NO_DETECTION } from './recording.js';
 
-const TRAIL_LENGTH = 40;
+
 
 // Fewer triangles per round shape when there are many of them (a software
 // renderer draws 10,000 robots at 30 frames/s only so).
@@ -153,13 +153,15 @@ export class View3D {
     this.world.add(this.rays);
     // Trails of the robots' roots.
     this.robotRoots = Int32Array.from(scene.robots.map((r) => r.first));
-    this.trailPoints = new Float32Array(3 * TRAIL_LENGTH * this.robotRoots.length);
+    // The last 200 positions of each robot (40 in a swarm of thousands).
+    this.trailLength = this.large ? 40 : 200;
+    this.trailPoints = new Float32Array(3 * this.trailLength * this.robotRoots.length);
     this.trailCount = 0;
     this.trailHead = 0;
     this.trailRecord = -1;
     const trailGeometry = new THREE.BufferGeometry();
     trailGeometry.setAttribute('position', new THREE.BufferAttribute(
-      new Float32Array(6 * (TRAIL_LENGTH - 1) * this.robotRoots.length), 3));
+      new Float32Array(6 * (this.trailLength - 1) * this.robotRoots.length), 3));
     this.trails = new THREE.LineSegments(trailGeometry, new THREE.LineBasicMaterial({ color: 0xffd34d }));
     this.trails.frustumCulled = false;
     this.trails.visible = this.show.trails;
@@ -327,12 +329,12 @@ export class View3D {
     this.rays.geometry.attributes.color.needsUpdate = true;
   }
 
-  // Trails: the last TRAIL_LENGTH positions of every robot, reset on a jump.
+  // Trails: the last trailLength positions of every robot, reset on a jump.
   updateTrails() {
     const record = this.state.record, roots = this.robotRoots, P = this.worldPos;
     if (record !== this.trailRecord + 1) { this.trailCount = 0; this.trailHead = 0; }
     this.trailRecord = record;
-    const t = this.trailPoints, L = TRAIL_LENGTH;
+    const t = this.trailPoints, L = this.trailLength;
     for (let r = 0; r < roots.length; ++r) {
       const o = 3 * (r * L + this.trailHead);
       t[o] = P[3 * roots[r]]; t[o + 1] = P[3 * roots[r] + 1]; t[o + 2] = P[3 * roots[r] + 2] + 0.002;

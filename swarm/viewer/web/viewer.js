@@ -269,7 +269,8 @@ window.swarmsimViewer = {
   get live() { return viewer.live; },
   get ended() { return !!viewer.recording.ended; },
   get robotCount() { return viewer.sceneInfo?.robots.length || 0; },
-  get view() { return viewer.view; },  // for measurements
+  get view() { return viewer.view; },
+  get metricsRead() { return !!viewer.metricsRead; },  // for measurements
   setRecord(i) { setPlaying(false); show(i); viewer.view.render(); return viewer.record; },
   // World position [x, y, z] of robot `index` at the record shown.
   robotPosition(index) {
