@@ -22,6 +22,9 @@ class App;
 namespace swarmsim {
 class ModuleRegistry;
 }  // namespace swarmsim
+namespace swarmsim::viewer {
+class Server;
+}  // namespace swarmsim::viewer
 
 namespace swarmsim::cli {
 
@@ -46,6 +49,10 @@ struct RunArgs {
   int video_width = 0, video_height = 0;  // --video-size; 0: the view's default
   double video_fps = 30;
   bool record = false;  // --record: DIR/recording.swrec (swarm/record/writer.h)
+  // --view: record, and serve DIR to the viewer page while the run goes.
+  bool view = false;
+  int view_port = 8600;  // 0: a free port
+  std::string view_host = "127.0.0.1";
 };
 CLI::App* AddRunCommand(CLI::App* app, RunArgs* args);
 // Loads the world (the plugins first into `registry`) and runs it.
@@ -106,5 +113,18 @@ struct DescribeArgs {
 };
 CLI::App* AddDescribeCommand(CLI::App* app, DescribeArgs* args);
 int DescribeCommand(const DescribeArgs& args, const ModuleRegistry& registry);
+
+// swarmsim view DIR (view_command.cc)
+struct ViewArgs {
+  std::string folder;
+  std::string host = "127.0.0.1";
+  int port = 8600;          // 0: a free port
+  std::string export_file;  // --export FILE.html; empty: serve
+};
+CLI::App* AddViewCommand(CLI::App* app, ViewArgs* args);
+int ViewCommand(const ViewArgs& args);
+// Binds `server` and prints its address ("swarmsim view: http://...");
+// prints why not and returns kExitRunError when it cannot.
+int BindViewServer(const std::string& host, int port, viewer::Server* server);
 
 }  // namespace swarmsim::cli

@@ -36,6 +36,8 @@ int Main(int argc, char** argv) {
   const CLI::App* report = AddReportCommand(&app, &report_args);
   MergeArgs merge_args;
   const CLI::App* merge = AddMergeCommand(&app, &merge_args);
+  ViewArgs view_args;
+  const CLI::App* view = AddViewCommand(&app, &view_args);
   const CLI::App* modules = AddModulesCommand(&app);
   DescribeArgs describe_args;
   const CLI::App* describe = AddDescribeCommand(&app, &describe_args);
@@ -69,6 +71,7 @@ int Main(int argc, char** argv) {
   if (*record_info) return RecordInfoCommand(record_info_path);
   if (*describe) return DescribeCommand(describe_args, registry);
   if (*modules) return ModulesCommand(registry);
+  if (*view) return ViewCommand(view_args);
   if (*sweep) return SweepCommand(sweep_args, CommandLine(argc, argv));
   if (*report) return ReportCommand(report_args);
   if (*merge) return MergeCommand(merge_args);

@@ -1,9 +1,12 @@
 // swarmsim run WORLD: load the world, decide the run length, run it.
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
 #include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
+#include <memory>
 #include <sstream>
 
 #include "framework/error.h"
@@ -16,6 +19,7 @@
 #include "swarm/loader/world_loader.h"
 #include "swarm/record/writer.h"
 #include "swarm/run/runner.h"
+#include "swarm/viewer/server.h"
 
 namespace swarmsim::cli {
 namespace {
@@ -170,6 +174,16 @@ CLI::App* AddRunCommand(CLI::App* app, RunArgs* args) {
   run->add_flag("--record", args->record,
                 "Record the run for swarmsim view: DIR/recording.swrec (needs --out; a world's "
                 "record: setting does the same)");
+  auto* view = run->add_flag("--view", args->view,
+                             "Record the run and watch it live: serves DIR to the viewer page "
+                             "(swarmsim view) while the run goes, and after it until Ctrl-C");
+  run->add_option("--view-port", args->view_port, "Port of --view (default 8600; 0: a free one)")
+      ->transform(WholeNumberCheck(0, 65535, ""))
+      ->needs(view);
+  run->add_option("--view-host", args->view_host,
+                  "Address --view listens on (default 127.0.0.1: this machine only)")
+      ->check(NonEmpty("an address"))
+      ->needs(view);
   run->callback([args, video] { args->video = video->count() > 0; });
   return run;
 }
@@ -230,10 +244,11 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
   }
   // The recording (swarm/record): --record or the world's record: setting.
   record::RunRecorder* run_recorder = nullptr;
-  if (args.record || loaded.record_every > 0) {
+  if (args.record || args.view || loaded.record_every > 0) {
     if (!options.out_dir) {
-      if (args.record)
-        return bad_input("--record writes DIR/recording.swrec: pass --out DIR as well");
+      if (args.record || args.view)
+        return bad_input(std::string(args.view ? "--view" : "--record") +
+                         " writes DIR/recording.swrec: pass --out DIR as well");
       std::cerr << "note: the world's record: setting writes DIR/recording.swrec: pass --out DIR "
                    "to record this run\n";
     } else {
@@ -252,11 +267,25 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
       }
     }
   }
+  // --view: the page follows the recording while the run writes it.
+  std::unique_ptr<viewer::Server> view_server;
+  if (args.view && run_recorder != nullptr) {
+    view_server = std::make_unique<viewer::Server>(*options.out_dir);
+    if (const int code = BindViewServer(args.view_host, args.view_port, view_server.get()))
+      return code;
+    view_server->Start();
+  }
   const RunResult result = RunWorld(loaded.world.get(), options, std::cout, std::cerr);
   if (run_recorder != nullptr)
     run_recorder->Finish(result.steps,
                          result.ok ? "ok" : (result.signal != 0 ? "interrupted" : "error"),
                          result.ok ? "" : result.error);
+  if (view_server && result.signal == 0) {
+    // The run is over, the page stays: serve until Ctrl-C (its default action).
+    std::cout << "swarmsim run: the run ended; still serving " << view_server->Address()
+              << " (Ctrl-C to stop)" << std::endl;
+    for (;;) ::pause();
+  }
   if (recorder != nullptr) {
     // The video's end, also without --out (with it, the run's outputs did it).
     try {

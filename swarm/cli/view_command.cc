@@ -1,0 +1,84 @@
+// swarmsim view DIR: serve the viewer page for a run's recording, or write
+// it as one self-contained HTML file (--export).
+#include <CLI/CLI.hpp>
+#include <filesystem>
+#include <iostream>
+
+#include "framework/error.h"
+#include "framework/utf8.h"
+#include "swarm/cli/commands.h"
+#include "swarm/cli/options.h"
+#include "swarm/record/reader.h"
+#include "swarm/viewer/page.h"
+#include "swarm/viewer/server.h"
+
+namespace swarmsim::cli {
+
+CLI::App* AddViewCommand(CLI::App* app, ViewArgs* args) {
+  CLI::App* view = app->add_subcommand(
+      "view", "Watch a recorded run (swarmsim run WORLD --out DIR --record) in the browser");
+  view->add_option("folder", args->folder, "The run's output folder (holds recording.swrec)")
+      ->required()
+      ->check(NonEmpty("a folder"));
+  view->add_option("--port", args->port, "Port to listen on (default 8600; 0: a free one)")
+      ->transform(WholeNumberCheck(0, 65535, ""));
+  view->add_option("--host", args->host,
+                   "Address to listen on (default 127.0.0.1: this machine only)")
+      ->check(NonEmpty("an address"));
+  view->add_option("--export", args->export_file,
+                   "Write one self-contained HTML file (page, three.js, recording) that plays "
+                   "offline from disk, instead of serving")
+      ->option_text("FILE.html")
+      ->check(NonEmpty("a file"));
+  return view;
+}
+
+int BindViewServer(const std::string& host, int port, viewer::Server* server) {
+  try {
+    server->Bind(host, port);
+  } catch (const Error& e) {
+    std::cerr << "error: " << ValidUtf8(e.what()) << "\n";
+    return kExitRunError;
+  }
+  std::cout << "swarmsim view: " << server->Address() << " (Ctrl-C to stop)" << std::endl;
+  return 0;
+}
+
+int ViewCommand(const ViewArgs& args) {
+  // The folder and its recording: missing, corrupt or of a newer format are
+  // the user's to fix; a truncated one (a run in progress, or killed) is
+  // shown up to its last whole step.
+  namespace fs = std::filesystem;
+  std::error_code error;
+  if (!fs::is_directory(args.folder, error)) {
+    std::cerr << "error: '" << ValidUtf8(args.folder)
+              << "' is not a folder: give the output folder of a run (swarmsim run WORLD --out "
+                 "DIR --record)\n";
+    return kExitBadInput;
+  }
+  record::RecordingInfo info;
+  try {
+    info = record::ScanRecording(args.folder);
+  } catch (const Error& e) {
+    std::cerr << "error: " << ValidUtf8(e.what()) << "\n";
+    return kExitBadInput;
+  }
+  std::cerr << ValidUtf8(info.Describe()) << "\n";
+  if (!args.export_file.empty()) {
+    try {
+      viewer::ExportFolder(args.folder, info.valid_size, args.export_file);
+    } catch (const Error& e) {
+      std::cerr << "error: " << ValidUtf8(e.what()) << "\n";
+      return kExitRunError;
+    }
+    std::cout << "swarmsim view: wrote " << args.export_file << " ("
+              << fs::file_size(args.export_file, error) << " bytes)\n";
+    return 0;
+  }
+  viewer::Server server(args.folder);
+  if (const int code = BindViewServer(args.host, args.port, &server)) return code;
+  server.Run();
+  return 0;
+}
+
+}  // namespace swarmsim::cli

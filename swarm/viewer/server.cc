@@ -1,0 +1,192 @@
+// The HTTP server of `swarmsim view` (cpp-httplib): the page, its script,
+// the recording from a byte offset, and other files of the output folder.
+#include "swarm/viewer/server.h"
+
+#include <httplib.h>
+#include <sys/socket.h>
+
+#include <algorithm>
+#include <charconv>
+#include <chrono>
+#include <fstream>
+#include <system_error>
+
+#include "framework/error.h"
+#include "swarm/viewer/assets.h"
+#include "swarm/viewer/page.h"
+
+namespace swarmsim::viewer {
+namespace fs = std::filesystem;
+
+namespace {
+
+// At most this many bytes in one answer for the recording: a page reading a
+// larger file asks again from where the answer ended.
+constexpr uint64_t kMaxRecordingAnswer = 64ull << 20;
+
+// `file`'s bytes from `from` on, at most `max_bytes`; false when unreadable.
+bool ReadFrom(const fs::path& file, uint64_t from, uint64_t max_bytes, std::string* bytes,
+              uint64_t* size) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) return false;
+  in.seekg(0, std::ios::end);
+  *size = static_cast<uint64_t>(in.tellg());
+  bytes->clear();
+  if (from >= *size) return true;
+  bytes->resize(std::min(*size - from, max_bytes));
+  in.seekg(static_cast<std::streamoff>(from));
+  in.read(bytes->data(), static_cast<std::streamsize>(bytes->size()));
+  bytes->resize(static_cast<size_t>(in.gcount()));
+  return true;
+}
+
+std::string ContentType(const fs::path& file) {
+  const std::string ext = file.extension().string();
+  if (ext == ".json") return "application/json";
+  if (ext == ".csv" || ext == ".txt" || ext == ".yaml") return "text/plain; charset=utf-8";
+  if (ext == ".png") return "image/png";
+  if (ext == ".stl" || ext == ".obj") return "model/" + ext.substr(1);
+  return "application/octet-stream";
+}
+
+}  // namespace
+
+std::optional<fs::path> FileInside(const fs::path& folder, std::string_view request_path) {
+  // A relative path of plain names: no `..`, `.`, empty part, NUL or leading '/'.
+  if (request_path.empty() || request_path.front() == '/') return std::nullopt;
+  if (request_path.find('\0') != std::string_view::npos) return std::nullopt;
+  const fs::path relative(request_path);
+  if (relative.is_absolute() || relative.has_root_name()) return std::nullopt;
+  for (const fs::path& part : relative)
+    if (part.empty() || part == ".." || part == ".") return std::nullopt;
+  // Resolved through every symbolic link, it must still be inside the folder.
+  std::error_code error;
+  const fs::path root = fs::canonical(folder, error);
+  if (error) return std::nullopt;
+  const fs::path file = fs::canonical(root / relative, error);
+  if (error) return std::nullopt;
+  const auto [root_end, file_it] =
+      std::mismatch(root.begin(), root.end(), file.begin(), file.end());
+  if (root_end != root.end() || file_it == file.end()) return std::nullopt;
+  if (!fs::is_regular_file(file, error)) return std::nullopt;
+  return file;
+}
+
+struct Server::Impl {
+  fs::path folder;
+  httplib::Server http;
+  std::string host;
+  int port = 0;
+};
+
+Server::Server(fs::path folder) : impl_(std::make_unique<Impl>()) {
+  impl_->folder = std::move(folder);
+  httplib::Server& http = impl_->http;
+  // SO_REUSEADDR only: httplib's default SO_REUSEPORT would let a second
+  // server share a port in use instead of saying so.
+  http.set_socket_options([](int sock) {
+    int yes = 1;
+    setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof(yes));
+  });
+  // Hostile or stuck clients: small bodies, short timeouts.
+  http.set_payload_max_length(1 << 16);
+  http.set_read_timeout(5, 0);
+  http.set_write_timeout(30, 0);
+  http.set_keep_alive_timeout(5);
+  http.set_exception_handler(
+      [](const httplib::Request&, httplib::Response& res, std::exception_ptr) {
+        res.status = 500;
+        res.set_content("internal error\n", "text/plain");
+      });
+  http.set_error_handler([](const httplib::Request&, httplib::Response& res) {
+    if (res.body.empty()) res.set_content(std::to_string(res.status) + "\n", "text/plain");
+  });
+
+  // The page and its script.
+  const auto page = [](const httplib::Request&, httplib::Response& res) {
+    res.set_header("Cache-Control", "no-store");
+    res.set_content(ServedPage(), "text/html; charset=utf-8");
+  };
+  http.Get("/", page);
+  http.Get("/index.html", page);
+  http.Get("/viewer.js", [](const httplib::Request&, httplib::Response& res) {
+    const std::string_view script = PageScript();
+    res.set_content(script.data(), script.size(), "text/javascript; charset=utf-8");
+  });
+  http.Get("/favicon.ico",
+           [](const httplib::Request&, httplib::Response& res) { res.status = 204; });
+
+  // The recording from byte `from` on (a page following a run asks again
+  // from where it is); X-Swarmsim-Size: the file's size now.
+  Impl* impl = impl_.get();
+  http.Get("/recording.swrec", [impl](const httplib::Request& req, httplib::Response& res) {
+    uint64_t from = 0;
+    if (req.has_param("from")) {
+      const std::string text = req.get_param_value("from");
+      const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), from);
+      if (ec != std::errc() || end != text.data() + text.size()) {
+        res.status = 400;
+        res.set_content("from: expected a byte offset\n", "text/plain");
+        return;
+      }
+    }
+    const std::optional<fs::path> file = FileInside(impl->folder, kRecordingFile);
+    std::string bytes;
+    uint64_t size = 0;
+    if (!file || !ReadFrom(*file, from, kMaxRecordingAnswer, &bytes, &size)) {
+      res.status = 404;
+      return;
+    }
+    res.set_header("Cache-Control", "no-store");
+    res.set_header("X-Swarmsim-Size", std::to_string(size));
+    res.set_content(std::move(bytes), "application/octet-stream");
+  });
+
+  // Other files of the folder the page may need (summary.json, meshes).
+  http.Get("/files/(.+)", [impl](const httplib::Request& req, httplib::Response& res) {
+    const std::optional<fs::path> file = FileInside(impl->folder, req.matches[1].str());
+    std::string bytes;
+    uint64_t size = 0;
+    if (!file || !ReadFrom(*file, 0, kMaxRecordingAnswer, &bytes, &size)) {
+      res.status = 404;
+      return;
+    }
+    res.set_content(std::move(bytes), ContentType(*file).c_str());
+  });
+}
+
+Server::~Server() { Stop(); }
+
+int Server::Bind(const std::string& host, int port) {
+  const bool bound = port == 0 ? (port = impl_->http.bind_to_any_port(host)) > 0
+                               : impl_->http.bind_to_port(host, port);
+  if (!bound)
+    throw Error("cannot listen on " + host + ":" + (port > 0 ? std::to_string(port) : "0") +
+                ": the port is in use or the address is not this machine's (--port 0 picks a "
+                "free port)");
+  impl_->host = host;
+  impl_->port = port;
+  return port;
+}
+
+std::string Server::Address() const {
+  const bool ipv6 = impl_->host.find(':') != std::string::npos;
+  return "http://" + (ipv6 ? "[" + impl_->host + "]" : impl_->host) + ":" +
+         std::to_string(impl_->port) + "/";
+}
+
+void Server::Run() { impl_->http.listen_after_bind(); }
+
+void Server::Start() {
+  thread_ = std::thread([this] { Run(); });
+}
+
+void Server::Stop() {
+  // A server started on another thread may not be listening yet.
+  for (int i = 0; thread_.joinable() && !impl_->http.is_running() && i < 2000; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  impl_->http.stop();
+  if (thread_.joinable()) thread_.join();
+}
+
+}  // namespace swarmsim::viewer

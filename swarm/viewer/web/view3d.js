@@ -1,0 +1,412 @@
+// The 3D view (three.js): the floor, the paint layer, every recorded shape
+// and LED as instances (one InstancedMesh per kind and size), proximity
+// rays, trails; camera with orbit/pan; picking robots.
+import * as THREE from 'three';
+import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
+import { NO_DETECTION } from './recording.js';
+
+
+
+// Fewer triangles per round shape when there are many of them (a software
+// renderer draws 10,000 robots at 30 frames/s only so).
+function geometryOf(o, many) {
+  const [a, b, c] = o.size || [0.05, 0.05, 0.05];
+  const round = many ? 8 : 24;
+  switch (o.shape) {
+    case 'box': case 'mesh': return new THREE.BoxGeometry(Math.max(a, 1e-4), Math.max(b, 1e-4), Math.max(c, 1e-4));
+    case 'sphere': return new THREE.SphereGeometry(Math.max(a, 1e-4), round, round * 3 / 4);
+    case 'capsule': return new THREE.CapsuleGeometry(Math.max(a, 1e-4), Math.max(c - 2 * a, 0), 4, round).rotateX(Math.PI / 2);
+    case 'cylinder': default:
+      return new THREE.CylinderGeometry(Math.max(a, 1e-4), Math.max(a, 1e-4), Math.max(c, 1e-4), round).rotateX(Math.PI / 2);
+  }
+}
+
+// Above this many instances of a kind, the cheaper geometry.
+const MANY = 1000;
+
+export class View3D {
+  // `large`: a scene of thousands of robots (no antialiasing, 1 pixel per CSS pixel).
+  constructor(container, large) {
+    this.container = container;
+    this.renderer = new THREE.WebGLRenderer({ antialias: !large, powerPreference: 'high-performance' });
+    this.renderer.setPixelRatio(large ? 1 : window.devicePixelRatio || 1);
+    this.large = large;
+    container.prepend(this.renderer.domElement);
+    this.scene = new THREE.Scene();
+    this.scene.background = new THREE.Color(0x1d2127);
+    this.camera = new THREE.PerspectiveCamera(45, 1, 0.01, 1000);
+    this.camera.up.set(0, 0, 1);
+    this.controls = new OrbitControls(this.camera, this.renderer.domElement);
+    this.controls.enableDamping = false;
+    this.scene.add(new THREE.HemisphereLight(0xffffff, 0x445566, 1.6));
+    const sun = new THREE.DirectionalLight(0xffffff, 1.4);
+    sun.position.set(3, -4, 10);
+    this.scene.add(sun);
+    this.world = new THREE.Group();
+    this.scene.add(this.world);
+    this.show = { rays: false, leds: true, trails: false, paint: true };
+    this.followRobot = -1;
+    this.dirty = true;
+    new ResizeObserver(() => this.resize()).observe(container);
+    this.resize();
+    this.controls.addEventListener('change', () => { this.dirty = true; });
+  }
+
+  resize() {
+    const w = Math.max(1, this.container.clientWidth), h = Math.max(1, this.container.clientHeight);
+    this.renderer.setSize(w, h, true);
+    this.camera.aspect = w / h;
+    this.camera.updateProjectionMatrix();
+    this.dirty = true;
+  }
+
+  // Builds the drawables of a scene (again when the scene changes).
+  build(header, scene, state) {
+    for (const child of [...this.world.children]) {
+      this.world.remove(child);
+      child.traverse((c) => { c.geometry?.dispose(); c.material?.map?.dispose(); c.material?.dispose(); });
+    }
+    this.header = header;
+    this.sceneInfo = scene;
+    this.state = state;
+    const unit = header.position_unit;
+    // World poses of every object: position (3 n) and quaternion x, y, z, w (4 n).
+    this.worldPos = new Float64Array(3 * scene.count);
+    this.worldQuat = new Float64Array(4 * scene.count);
+    this.unit = unit;
+
+    // The floor and the paint layer.
+    const floor = header.floor || { min: [-5, -5], max: [5, 5] };
+    const fw = floor.max[0] - floor.min[0], fh = floor.max[1] - floor.min[1];
+    const floorMesh = new THREE.Mesh(new THREE.PlaneGeometry(fw, fh),
+      new THREE.MeshLambertMaterial({ color: 0xb9bdc4 }));
+    floorMesh.position.set((floor.min[0] + floor.max[0]) / 2, (floor.min[1] + floor.max[1]) / 2, -0.001);
+    this.world.add(floorMesh);
+    const grid = new THREE.GridHelper(Math.max(fw, fh), Math.round(Math.max(fw, fh)), 0x8a8f99, 0x9ea3ab);
+    grid.rotateX(Math.PI / 2);
+    grid.position.copy(floorMesh.position).setZ(0);
+    this.world.add(grid);
+    this.paintMesh = null;
+    if (header.paint && state.paint) {
+      const p = header.paint;
+      this.paintTexture = new THREE.DataTexture(state.paint, p.width, p.height, THREE.RGBAFormat);
+      this.paintTexture.magFilter = THREE.NearestFilter;
+      this.paintTexture.colorSpace = THREE.SRGBColorSpace;
+      this.paintTexture.needsUpdate = true;
+      const pw = p.max[0] - p.min[0], ph = p.max[1] - p.min[1];
+      this.paintMesh = new THREE.Mesh(new THREE.PlaneGeometry(pw, ph),
+        new THREE.MeshBasicMaterial({ map: this.paintTexture, side: THREE.DoubleSide, transparent: true, opacity: 0.85 }));
+      // Row 0 is the +y edge: mirror v.
+      this.paintMesh.scale.y = -1;
+      this.paintMesh.position.set((p.min[0] + p.max[0]) / 2, (p.min[1] + p.max[1]) / 2, 0.0005);
+      this.world.add(this.paintMesh);
+    }
+    // The map's boxes.
+    for (const b of header.environment?.boxes || []) {
+      const m = new THREE.Mesh(new THREE.BoxGeometry(b[3] - b[0], b[4] - b[1], b[5] - b[2]),
+        new THREE.MeshLambertMaterial({ color: 0x8d8d8d }));
+      m.position.set((b[0] + b[3]) / 2, (b[1] + b[4]) / 2, (b[2] + b[5]) / 2);
+      this.world.add(m);
+    }
+
+    // Shapes and LEDs, instanced by kind and size. A swarm of thousands is
+    // drawn as its robots' bodies (root shapes) and LEDs only.
+    const groups = new Map();
+    const sensors = [];
+    this.bodiesOnly = this.large;
+    for (const o of scene.objects) {
+      if (o.type === 'proximity_sensor') { sensors.push(o.id); continue; }
+      let key;
+      if (o.type === 'shape' && this.bodiesOnly && o.robot >= 0 && o.templateObject !== 0) continue;
+      if (o.type === 'shape') key = `s|${o.shape}|${(o.size || []).join(',')}`;
+      else if (o.type === 'led') key = `l|${o.radius}`;
+      else continue;
+      let g = groups.get(key);
+      if (!g) groups.set(key, g = { key, led: o.type === 'led', sample: o, ids: [] });
+      g.ids.push(o.id);
+    }
+    // The objects whose world pose is needed: drawn ones and robot roots
+    // (sensors too while rays are shown), in id order (roots first).
+    const drawn = new Uint8Array(scene.count);
+    for (const g of groups.values()) for (const id of g.ids) drawn[id] = 1;
+    for (const r of scene.robots) drawn[r.first] = 1;
+    for (let id = 0; id < scene.count; ++id) if (scene.rootOf[id] < 0) drawn[id] = 1;
+    this.drawnIds = Uint32Array.from(drawn.reduce((list, on, id) => (on && list.push(id), list), []));
+    this.drawnAndSensorIds = Uint32Array.from([...this.drawnIds, ...sensors].sort((a, b) => a - b));
+    this.groups = [];
+    for (const g of groups.values()) {
+      const mesh = this.large ? this.pointsOf(g) : this.instancesOf(g);
+      mesh.frustumCulled = false;
+      mesh.userData.ids = Int32Array.from(g.ids);
+      mesh.userData.led = g.led;
+      this.world.add(mesh);
+      this.groups.push(mesh);
+    }
+    // Proximity rays: one segment per sensor.
+    this.sensorIds = Int32Array.from(sensors);
+    const rayGeometry = new THREE.BufferGeometry();
+    rayGeometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(6 * sensors.length), 3));
+    rayGeometry.setAttribute('color', new THREE.BufferAttribute(new Float32Array(6 * sensors.length), 3));
+    this.rays = new THREE.LineSegments(rayGeometry, new THREE.LineBasicMaterial({ vertexColors: true }));
+    this.rays.frustumCulled = false;
+    this.rays.visible = this.show.rays;
+    this.world.add(this.rays);
+    // Trails of the robots' roots.
+    this.robotRoots = Int32Array.from(scene.robots.map((r) => r.first));
+    // The last 200 positions of each robot (40 in a swarm of thousands).
+    this.trailLength = this.large ? 40 : 200;
+    this.trailPoints = new Float32Array(3 * this.trailLength * this.robotRoots.length);
+    this.trailCount = 0;
+    this.trailHead = 0;
+    this.trailRecord = -1;
+    const trailGeometry = new THREE.BufferGeometry();
+    trailGeometry.setAttribute('position', new THREE.BufferAttribute(
+      new Float32Array(6 * (this.trailLength - 1) * this.robotRoots.length), 3));
+    this.trails = new THREE.LineSegments(trailGeometry, new THREE.LineBasicMaterial({ color: 0xffd34d }));
+    this.trails.frustumCulled = false;
+    this.trails.visible = this.show.trails;
+    this.world.add(this.trails);
+    this.update();
+  }
+
+  // One InstancedMesh for the objects of group `g` (same kind and size).
+  instancesOf(g) {
+    const many = g.ids.length > MANY;
+    const geometry = g.led ? new THREE.SphereGeometry(Math.max(g.sample.radius || 0.01, 1e-4), many ? 6 : 10, many ? 4 : 8)
+      : geometryOf(g.sample, many);
+    const material = g.led ? new THREE.MeshBasicMaterial({ color: 0xffffff })
+      : new THREE.MeshLambertMaterial({ color: 0xffffff });
+    const mesh = new THREE.InstancedMesh(geometry, material, g.ids.length);
+    mesh.instanceMatrix.setUsage(THREE.DynamicDrawUsage);
+    mesh.setColorAt(0, new THREE.Color(1, 1, 1));
+    return mesh;
+  }
+
+  // A swarm of thousands: each object a disc of its size seen from any side
+  // (one point each; software renderers draw 10,000 instanced meshes slowly).
+  pointsOf(g) {
+    const o = g.sample, n = g.ids.length;
+    const [a, b] = o.size || [0.05, 0.05];
+    const diameter = g.led ? 2 * (o.radius || 0.01) : o.shape === 'box' || o.shape === 'mesh' ? Math.hypot(a, b) : 2 * a;
+    if (!View3D.disc) {
+      const canvas = document.createElement('canvas');
+      canvas.width = canvas.height = 64;
+      const c = canvas.getContext('2d');
+      c.fillStyle = '#fff';
+      c.beginPath();
+      c.arc(32, 32, 30, 0, 2 * Math.PI);
+      c.fill();
+      View3D.disc = new THREE.CanvasTexture(canvas);
+    }
+    const geometry = new THREE.BufferGeometry();
+    geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(3 * n), 3).setUsage(THREE.DynamicDrawUsage));
+    geometry.setAttribute('color', new THREE.BufferAttribute(new Float32Array(3 * n), 3).setUsage(THREE.DynamicDrawUsage));
+    const points = new THREE.Points(geometry, new THREE.PointsMaterial({
+      size: Math.max(diameter, 1e-3), sizeAttenuation: true, vertexColors: true, map: View3D.disc, alphaTest: 0.5 }));
+    points.userData.points = true;
+    points.userData.radius = diameter / 2;
+    return points;
+  }
+
+  // The camera looking at the whole floor from above (`topDown`) or slanted.
+  frame(topDown) {
+    const floor = this.header.floor || { min: [-5, -5], max: [5, 5] };
+    const cx = (floor.min[0] + floor.max[0]) / 2, cy = (floor.min[1] + floor.max[1]) / 2;
+    const size = Math.max(floor.max[0] - floor.min[0], floor.max[1] - floor.min[1]);
+    const distance = size / 2 / Math.tan(THREE.MathUtils.degToRad(this.camera.fov / 2)) * 1.1;
+    this.controls.target.set(cx, cy, 0);
+    if (topDown) this.camera.position.set(cx, cy - distance * 1e-4, distance);
+    else this.camera.position.set(cx, cy - distance * 0.75, distance * 0.75);
+    this.camera.near = distance / 1000;
+    this.camera.far = distance * 10;
+    this.camera.updateProjectionMatrix();
+    this.controls.update();
+    this.dirty = true;
+  }
+
+  // World poses from the state's integers: X_WO = X_WR X_RO for robots' parts.
+  computeWorldPoses() {
+    const { xyz, q } = this.state, unit = this.unit, qs = 1 / 32767;
+    const P = this.worldPos, Q = this.worldQuat, roots = this.sceneInfo.rootOf;
+    const ids = this.show.rays ? this.drawnAndSensorIds : this.drawnIds;
+    for (let k = 0; k < ids.length; ++k) {
+      const i = ids[k];
+      let px = xyz[3 * i] * unit, py = xyz[3 * i + 1] * unit, pz = xyz[3 * i + 2] * unit;
+      let qw = q[4 * i] * qs, qx = q[4 * i + 1] * qs, qy = q[4 * i + 2] * qs, qz = q[4 * i + 3] * qs;
+      const norm = Math.hypot(qw, qx, qy, qz) || 1;
+      qw /= norm; qx /= norm; qy /= norm; qz /= norm;
+      const r = roots[i];
+      if (r >= 0) {
+        // Rotate p by the root's quaternion, add its position; compose rotations.
+        const rx = Q[4 * r], ry = Q[4 * r + 1], rz = Q[4 * r + 2], rw = Q[4 * r + 3];
+        const tx = 2 * (ry * pz - rz * py), ty = 2 * (rz * px - rx * pz), tz = 2 * (rx * py - ry * px);
+        const wx = px + rw * tx + (ry * tz - rz * ty);
+        const wy = py + rw * ty + (rz * tx - rx * tz);
+        const wz = pz + rw * tz + (rx * ty - ry * tx);
+        px = P[3 * r] + wx; py = P[3 * r + 1] + wy; pz = P[3 * r + 2] + wz;
+        const nw = rw * qw - rx * qx - ry * qy - rz * qz;
+        const nx = rw * qx + rx * qw + ry * qz - rz * qy;
+        const ny = rw * qy - rx * qz + ry * qw + rz * qx;
+        const nz = rw * qz + rx * qy - ry * qx + rz * qw;
+        qw = nw; qx = nx; qy = ny; qz = nz;
+      }
+      P[3 * i] = px; P[3 * i + 1] = py; P[3 * i + 2] = pz;
+      Q[4 * i] = qx; Q[4 * i + 1] = qy; Q[4 * i + 2] = qz; Q[4 * i + 3] = qw;
+    }
+  }
+
+  // Pushes the state into the instances, rays, paint and trails.
+  update() {
+    this.computeWorldPoses();
+    const P = this.worldPos, Q = this.worldQuat, rgba = this.state.rgba;
+    for (const mesh of this.groups) {
+      if (mesh.userData.points) { this.updatePoints(mesh); continue; }
+      const ids = mesh.userData.ids, m = mesh.instanceMatrix.array, c = mesh.instanceColor.array;
+      const led = mesh.userData.led, showLeds = this.show.leds;
+      for (let j = 0; j < ids.length; ++j) {
+        const id = ids[j];
+        const x = Q[4 * id], y = Q[4 * id + 1], z = Q[4 * id + 2], w = Q[4 * id + 3];
+        const s = led && (!showLeds) ? 0 : 1;
+        const o = 16 * j;
+        m[o] = (1 - 2 * (y * y + z * z)) * s; m[o + 1] = 2 * (x * y + z * w) * s; m[o + 2] = 2 * (x * z - y * w) * s; m[o + 3] = 0;
+        m[o + 4] = 2 * (x * y - z * w) * s; m[o + 5] = (1 - 2 * (x * x + z * z)) * s; m[o + 6] = 2 * (y * z + x * w) * s; m[o + 7] = 0;
+        m[o + 8] = 2 * (x * z + y * w) * s; m[o + 9] = 2 * (y * z - x * w) * s; m[o + 10] = (1 - 2 * (x * x + y * y)) * s; m[o + 11] = 0;
+        m[o + 12] = P[3 * id]; m[o + 13] = P[3 * id + 1]; m[o + 14] = P[3 * id + 2]; m[o + 15] = 1;
+        // sRGB bytes to the linear colours three works in; an LED that is off is dim.
+        const dim = led && rgba[4 * id + 3] === 0 ? 0.12 : 1;
+        for (let k = 0; k < 3; ++k) {
+          const v = rgba[4 * id + k] / 255;
+          c[3 * j + k] = dim * (v <= 0.04045 ? v / 12.92 : Math.pow((v + 0.055) / 1.055, 2.4));
+        }
+      }
+      mesh.instanceMatrix.needsUpdate = true;
+      mesh.instanceColor.needsUpdate = true;
+    }
+    if (this.show.rays) this.updateRays();
+    if (this.paintMesh) {
+      this.paintMesh.visible = this.show.paint;
+      if (this.state.changedPaint) { this.paintTexture.needsUpdate = true; this.state.changedPaint = false; }
+    }
+    this.updateTrails();
+    if (this.followRobot >= 0) this.follow();
+    this.dirty = true;
+  }
+
+  updatePoints(points) {
+    const ids = points.userData.ids, led = points.userData.led, P = this.worldPos, rgba = this.state.rgba;
+    const pos = points.geometry.attributes.position.array, c = points.geometry.attributes.color.array;
+    points.visible = !led || this.show.leds;
+    for (let j = 0; j < ids.length; ++j) {
+      const id = ids[j];
+      // LEDs a little above the bodies, so they show from above.
+      pos[3 * j] = P[3 * id]; pos[3 * j + 1] = P[3 * id + 1]; pos[3 * j + 2] = P[3 * id + 2] + (led ? 0.05 : 0);
+      const dim = led && rgba[4 * id + 3] === 0 ? 0.12 : 1;
+      for (let k = 0; k < 3; ++k) {
+        const v = rgba[4 * id + k] / 255;
+        c[3 * j + k] = dim * (v <= 0.04045 ? v / 12.92 : Math.pow((v + 0.055) / 1.055, 2.4));
+      }
+    }
+    points.geometry.attributes.position.needsUpdate = true;
+    points.geometry.attributes.color.needsUpdate = true;
+  }
+
+  updateRays() {
+    const objects = this.sceneInfo.objects, P = this.worldPos, Q = this.worldQuat, prox = this.state.prox;
+    const pos = this.rays.geometry.attributes.position.array, col = this.rays.geometry.attributes.color.array;
+    for (let j = 0; j < this.sensorIds.length; ++j) {
+      const id = this.sensorIds[j], range = objects[id].range || 0;
+      const reading = prox[id];
+      const length = reading === NO_DETECTION ? range : reading / 65534 * range;
+      // The sensor's +z axis in the world.
+      const x = Q[4 * id], y = Q[4 * id + 1], z = Q[4 * id + 2], w = Q[4 * id + 3];
+      const dx = 2 * (x * z + y * w), dy = 2 * (y * z - x * w), dz = 1 - 2 * (x * x + y * y);
+      pos.set([P[3 * id], P[3 * id + 1], P[3 * id + 2],
+        P[3 * id] + dx * length, P[3 * id + 1] + dy * length, P[3 * id + 2] + dz * length], 6 * j);
+      const hit = reading !== NO_DETECTION;
+      col.set(hit ? [1, 0.2, 0.2, 1, 0.2, 0.2] : [0.3, 0.8, 1, 0.3, 0.8, 1], 6 * j);
+    }
+    this.rays.geometry.attributes.position.needsUpdate = true;
+    this.rays.geometry.attributes.color.needsUpdate = true;
+  }
+
+  // Trails: the last trailLength positions of every robot, reset on a jump.
+  updateTrails() {
+    const record = this.state.record, roots = this.robotRoots, P = this.worldPos;
+    if (record !== this.trailRecord + 1) { this.trailCount = 0; this.trailHead = 0; }
+    this.trailRecord = record;
+    const t = this.trailPoints, L = this.trailLength;
+    for (let r = 0; r < roots.length; ++r) {
+      const o = 3 * (r * L + this.trailHead);
+      t[o] = P[3 * roots[r]]; t[o + 1] = P[3 * roots[r] + 1]; t[o + 2] = P[3 * roots[r] + 2] + 0.002;
+    }
+    this.trailHead = (this.trailHead + 1) % L;
+    this.trailCount = Math.min(this.trailCount + 1, L);
+    if (!this.show.trails) return;
+    const out = this.trails.geometry.attributes.position.array;
+    let k = 0;
+    for (let r = 0; r < roots.length; ++r) {
+      for (let i = 0; i + 1 < this.trailCount; ++i) {
+        const a = (this.trailHead - this.trailCount + i + 2 * L) % L, b = (a + 1) % L;
+        const oa = 3 * (r * L + a), ob = 3 * (r * L + b);
+        out[k++] = t[oa]; out[k++] = t[oa + 1]; out[k++] = t[oa + 2];
+        out[k++] = t[ob]; out[k++] = t[ob + 1]; out[k++] = t[ob + 2];
+      }
+    }
+    this.trails.geometry.setDrawRange(0, k / 3);
+    this.trails.geometry.attributes.position.needsUpdate = true;
+  }
+
+  setShow(what, on) {
+    this.show[what] = on;
+    if (what === 'rays') this.rays.visible = on;
+    if (what === 'trails') this.trails.visible = on;
+    if (this.state) this.update();
+  }
+
+  // Keeps the camera's target on robot `index`, the view's offset unchanged.
+  follow() {
+    const robot = this.sceneInfo.robotByIndex.get(this.followRobot);
+    if (!robot) return;
+    const id = robot.first, P = this.worldPos;
+    const target = new THREE.Vector3(P[3 * id], P[3 * id + 1], P[3 * id + 2]);
+    const offset = this.camera.position.clone().sub(this.controls.target);
+    this.controls.target.copy(target);
+    this.camera.position.copy(target).add(offset);
+    this.controls.update();
+  }
+
+  // The robot index under the canvas pixel (x, y), or -1.
+  pick(x, y) {
+    const rect = this.renderer.domElement.getBoundingClientRect();
+    const ndc = new THREE.Vector2((x - rect.left) / rect.width * 2 - 1, -((y - rect.top) / rect.height) * 2 + 1);
+    const raycaster = new THREE.Raycaster();
+    raycaster.setFromCamera(ndc, this.camera);
+    const pickable = this.groups.filter((g) => !g.userData.led);
+    for (const mesh of pickable) {
+      if (mesh.userData.points) {
+        mesh.geometry.computeBoundingSphere();
+        raycaster.params.Points.threshold = mesh.userData.radius;
+      } else mesh.computeBoundingSphere();
+    }
+    const hits = raycaster.intersectObjects(pickable, false);
+    for (const hit of hits) {
+      const id = hit.object.userData.ids[hit.object.userData.points ? hit.index : hit.instanceId];
+      const robot = this.sceneInfo.robotOf[id];
+      if (robot >= 0) return robot;
+    }
+    return -1;
+  }
+
+  // Page pixel of world point (x, y, z).
+  project(x, y, z) {
+    const v = new THREE.Vector3(x, y, z).project(this.camera);
+    const rect = this.renderer.domElement.getBoundingClientRect();
+    return { x: rect.left + (v.x + 1) / 2 * rect.width, y: rect.top + (1 - v.y) / 2 * rect.height };
+  }
+
+  render() {
+    this.controls.update();
+    this.renderer.render(this.scene, this.camera);
+    this.dirty = false;
+  }
+}
