@@ -41,8 +41,15 @@ class DiffusionEnv:
     def _observe(self):
         d = self.world.proximity("footbot")
         seen = np.where(np.isfinite(d), 1 - d / RANGE, 0.0)
-        yaw = self.world.poses("footbot")[:, 2]
-        return np.hstack([seen, np.cos(yaw)[:, None], np.sin(yaw)[:, None]])
+        # The heading's cosine and sine straight from the quaternion (the body's x axis
+        # in the plane), not np.cos/np.sin of the yaw: numpy's SIMD sin/cos may round a
+        # value differently depending on where the array lies in memory, which would
+        # make equal runs give observations an ulp apart.
+        q = self.world.poses("footbot", columns=7)
+        w, x, y, z = q[:, 3], q[:, 4], q[:, 5], q[:, 6]
+        cos_yaw = 1 - 2 * (y * y + z * z)
+        sin_yaw = 2 * (x * y + w * z)
+        return np.hstack([seen, cos_yaw[:, None], sin_yaw[:, None]])
 
     def reset(self, seed):
         if self.world is not None:

@@ -479,8 +479,10 @@ class PyWorld {
  public:
   PyWorld(const std::string& path, std::optional<uint64_t> seed,
           const std::map<std::string, py::object>& set, int threads,
-          const std::map<std::string, py::object>& controllers) {
+          const std::map<std::string, py::object>& controllers,
+          const std::vector<std::string>& package_path) {
     LoadOptions options;
+    for (const std::string& dir : package_path) options.package_path.emplace_back(dir);
     options.seed = seed;
     options.threads = threads;
     options.python_controllers = true;
@@ -753,10 +755,11 @@ PYBIND11_MODULE(_swarmsim, m) {
   py::class_<PyWorld>(m, "World")
       .def(py::init<const std::string&, std::optional<uint64_t>,
                     const std::map<std::string, py::object>&, int,
-                    const std::map<std::string, py::object>&>(),
+                    const std::map<std::string, py::object>&, const std::vector<std::string>&>(),
            py::arg("path"), py::arg("seed") = py::none(),
            py::arg("set") = std::map<std::string, py::object>{}, py::arg("threads") = 0,
-           py::arg("controllers") = std::map<std::string, py::object>{})
+           py::arg("controllers") = std::map<std::string, py::object>{},
+           py::arg("package_path") = std::vector<std::string>{})
       .def("step", &PyWorld::Step, py::arg("n") = 1)
       .def("close", &PyWorld::Close)
       .def_property_readonly("time", &PyWorld::time)

@@ -22,18 +22,20 @@ class DiffusionEnvTest(unittest.TestCase):
         obs = env.reset(seed=3)
         self.assertEqual(obs.shape, (20, 26))
         actions = np.tile([0.05, 0.05], (20, 1))
-        trace = []
+        trace, hashes = [], []
         for _ in range(5):
             obs, rewards, dones = env.step(actions)
             self.assertEqual(rewards.shape, (20,))
             self.assertEqual(dones.dtype, bool)
             trace.append(obs.copy())
+            hashes.append(env.world.state_hash())
         self.assertTrue(dones.all(), "the episode ends after episode_steps")
         # Straight at 0.05 m/s for 0.1 s: about 5 mm a step where nothing is close.
         self.assertAlmostEqual(float(np.median(rewards)), 0.005, delta=0.001)
         env.reset(seed=3)
         for step, expected in enumerate(trace):
             again, _, _ = env.step(actions)
+            self.assertEqual(env.world.state_hash(), hashes[step], f"step {step + 1}")
             where = np.argwhere(again != expected)
             self.assertEqual(len(where), 0,
                              f"step {step + 1}: observations differ at (robot, column) "

@@ -105,6 +105,27 @@ class WorldTest(unittest.TestCase):
         self.assertIn("diffusion.lua", text)
 
 
+class UrdfTest(unittest.TestCase):
+    def test_package_path_resolves_a_urdfs_package_uris(self):
+        # The example arm's URDF alone in a folder: its package:// mesh is found only
+        # through package_path (the folder holding simple_arm_description).
+        with tempfile.TemporaryDirectory() as d:
+            urdf = ROOT / "worlds" / "models" / "simple_arm_description" / "urdf" / "simple_arm.urdf"
+            with open(os.path.join(d, "arm.urdf"), "w") as f:
+                f.write(urdf.read_text())
+            path = os.path.join(d, "w.yaml")
+            with open(path, "w") as f:
+                f.write("simulation: {physics: ode, time_step: 0.05, seed: 1, steps: 10}\n"
+                        "models:\n  - model: arm.urdf\n    position: [0, 0]\n")
+            with self.assertRaises(ValueError) as e:
+                swarmsim.World(path)
+            self.assertIn("simple_arm_description", str(e.exception))
+            w = swarmsim.World(path, package_path=[world("models")])
+            self.assertFalse(w.planar)
+            w.step(10)
+            self.assertEqual(w.joint_positions().shape[0], 1)
+
+
 class ErrorTest(unittest.TestCase):
     def test_a_world_that_does_not_load_raises_with_the_programs_message(self):
         with tempfile.TemporaryDirectory() as d:
