@@ -17,6 +17,14 @@ RuntimeError (with the controller's traceback) and the world cannot be stepped a
 Every array is a copy (pass ``out=`` to reuse one).
 """
 
-from ._swarmsim import Robots, World
+import sys
+
+try:
+    import numpy  # noqa: F401  (the arrays' type; Debian's python3-numpy)
+    from ._swarmsim import Robots, World
+except ImportError as e:
+    raise ImportError(
+        f"swarmsim is built for Debian's Python, /usr/bin/python3 (with python3-numpy); "
+        f"this is {sys.executable}: run your script with /usr/bin/python3 ({e})") from e
 
 __all__ = ["World", "Robots"]
