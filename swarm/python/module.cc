@@ -504,8 +504,20 @@ class PyWorld {
     planar_ = world.settings().physics == "box2d";
     // Controllers: the world file's, then the constructor's (replacing them).
     std::map<std::string, ControllerConfig> configs;
+    // A controller drives every robot of its model, so all the entries of
+    // one model must name the same one (or none at all).
+    for (const ModelSummary& m : loaded_.models)
+      for (const ModelSummary& other : loaded_.models)
+        if (&other != &m && other.name == m.name && !m.python.file.empty() &&
+            (other.python.file != m.python.file || other.python.function != m.python.function))
+          throw py::value_error(
+              m.python.where + ": model '" + m.name + "' has another models entry with " +
+              (other.python.file.empty() ? std::string("no python_controller")
+                                         : "python_controller at " + other.python.where) +
+              ": a Python controller drives every robot of its model, so "
+              "give every entry of the model the same one");
     for (const ModelSummary& m : loaded_.models) {
-      if (m.python.file.empty()) continue;
+      if (m.python.file.empty() || configs.contains(m.name)) continue;
       configs[m.name] = {m.name, m.python.where, LoadFunction(m.python), planar_};
     }
     for (const auto& [model, function] : controllers) {

@@ -163,6 +163,15 @@ class ControllerTest(unittest.TestCase):
                 swarmsim.World(path)
             self.assertIn("is a Python file", str(e.exception))
 
+    def test_two_entries_of_one_model_with_different_controllers_are_an_error(self):
+        with tempfile.TemporaryDirectory() as d:
+            path = write_world(d, "def control(robots):\n    return {}\n",
+                               "    python_controller: ctl.py\n"
+                               f"  - model: {FOOTBOT}\n    count: 2\n    distribute: {{region: arena}}\n")
+            with self.assertRaises(ValueError) as e:
+                swarmsim.World(path)
+            self.assertIn("has another models entry with no python_controller", str(e.exception))
+
     def test_keep_scripts_runs_lua_beside_python(self):
         with tempfile.TemporaryDirectory() as d:
             code = "def control(robots):\n    return {}\n"

@@ -87,6 +87,8 @@ class WorldTest(unittest.TestCase):
         self.assertEqual(q.shape, (200, 2))
         # The Lua controller drives each wheel at 0 or wheel_speed / radius.
         self.assertTrue(np.all(np.isclose(q, 0, atol=0.05) | np.isclose(q, 0.05 / 0.029, atol=0.05)))
+        self.assertTrue(np.any(np.isclose(q, 0.05 / 0.029, atol=0.05)), "the wheels turn")
+        self.assertTrue(np.any(np.isclose(q, 0, atol=0.05)), "robots near others turn on one wheel")
 
     def test_metrics(self):
         w = swarmsim.World(world("diffusion.yaml"), seed=1, set={"robots": 20})
@@ -102,7 +104,7 @@ class WorldTest(unittest.TestCase):
         text = w.describe()
         self.assertIn("model footbot", text)
         self.assertIn("12 copies", text)
-        self.assertIn("diffusion.lua", text)
+        self.assertRegex(text, r"\n  script: \S*scripts/diffusion.lua on :")
 
 
 class UrdfTest(unittest.TestCase):
