@@ -13,9 +13,18 @@ namespace swarmsim {
 
 class Scene;
 class StateHasher;
+class TaskScheduler;
 
 struct DynamicsSettings {
   double gravity = 9.81;  // m/s^2, magnitude; 2D backends use it for ground friction
+  // Regions of the arena stepped independently (simulation.physics_partitions):
+  // 0 = auto (the backend chooses from the scene, never from the thread
+  // count), 1 = one engine world. Part of the model: it changes results.
+  int partitions = 1;
+  // Workers for independent parts of the step (regions, islands). Never
+  // changes results: the same world gives the same state for any thread
+  // count. Null: everything on the caller's thread.
+  TaskScheduler* scheduler = nullptr;
 };
 
 class DynamicsBackend {

@@ -250,6 +250,8 @@ void World::Start() {
   dynamics_ = registry_.MakeDynamics(settings_.physics);
   DynamicsSettings dynamics_settings;
   dynamics_settings.gravity = settings_.gravity;
+  dynamics_settings.partitions = settings_.physics_partitions;
+  dynamics_settings.scheduler = scheduler_.get();
   dynamics_->Build(scene_, dynamics_settings);
   dynamics_->MarkSimulatedJoints(&scene_);
   // Dependent joints start where their masters put them.

@@ -47,6 +47,9 @@ struct WorldSettings {
   std::string physics = "box2d";    // dynamics backend, by registered name
   double time_step = 0.1;           // s, one control step
   int physics_substeps = 10;        // physics steps per control step
+  // Arena regions the dynamics steps concurrently: 0 = auto (chosen from the
+  // scene, never from the thread count), N = that many; 1 = one engine world.
+  int physics_partitions = 1;
   uint64_t seed = 1;
   int threads = 0;                  // <= 0: all cores
   double gravity = 9.81;            // m/s^2

@@ -1,6 +1,7 @@
 #include "swarm/loader/world_loader.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <utility>
 
@@ -349,9 +350,9 @@ WorldSettings WorldLoader::ReadSimulation(const Fields& top, std::optional<int64
   const Field sim = top.Get("simulation");
   if (sim.present()) {
     Fields f(*file_, sim, "'simulation'");
-    f.Expect({"physics", "time_step", "physics_substeps", "seed", "duration", "steps", "gravity",
-              "octree_resolution", "main_script", "instruction_budget", "script_memory_mb",
-              "step_timeout", "on_script_error"});
+    f.Expect({"physics", "time_step", "physics_substeps", "physics_partitions", "seed", "duration",
+              "steps", "gravity", "octree_resolution", "main_script", "instruction_budget",
+              "script_memory_mb", "step_timeout", "on_script_error"});
     if (f.Has("main_script")) {
       const Field main = f.Get("main_script");
       const std::string text = values.String(main);
@@ -391,6 +392,22 @@ WorldSettings WorldLoader::ReadSimulation(const Fields& top, std::optional<int64
           values.Number(f.Get("time_step"), {"a positive number of seconds", 0, 3600, true});
     if (f.Has("physics_substeps"))
       s.physics_substeps = static_cast<int>(values.Integer(f.Get("physics_substeps"), 1, 1000));
+    if (f.Has("physics_partitions")) {
+      // auto: the backend chooses from the scene (never from the thread count).
+      const Field partitions = f.Get("physics_partitions");
+      const std::string text =
+          partitions.node.IsScalar() ? std::string(partitions.node.Scalar()) : std::string();
+      if (text == "auto")
+        s.physics_partitions = 0;
+      else if (!text.empty() && std::isalpha(static_cast<unsigned char>(text[0]))) {
+        std::string message =
+            "'physics_partitions' must be auto or a whole number from 1 to 1024 (got '";
+        message += text;
+        message += "')";
+        values.Fail(partitions, message);
+      } else
+        s.physics_partitions = static_cast<int>(values.Integer(partitions, 1, 1024));
+    }
     if (f.Has("seed")) s.seed = values.Seed(f.Get("seed"));
     if (f.Has("gravity"))
       s.gravity = values.Number(f.Get("gravity"), {"a non-negative number (m/s^2)", 0, 1e4});

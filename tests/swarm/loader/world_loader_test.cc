@@ -279,6 +279,25 @@ TEST_F(MalformedWorldTest, ValidBaseLoads) {
   EXPECT_FALSE(loaded.steps.has_value());
 }
 
+TEST_F(MalformedWorldTest, PhysicsPartitionsIsAutoOrACount) {
+  EXPECT_EQ(Load(Write("world.yaml", std::string("arena: {size: 2}\n") + kModels))
+                .world->settings()
+                .physics_partitions,
+            1);
+  EXPECT_EQ(Load(Write("world.yaml", std::string("arena: {size: 2}\nsimulation: "
+                                                 "{physics_partitions: auto}\n") +
+                                         kModels))
+                .world->settings()
+                .physics_partitions,
+            0);
+  EXPECT_EQ(Load(Write("world.yaml", std::string("arena: {size: 2}\nparameters: {p: 3}\n"
+                                                 "simulation: {physics_partitions: $p}\n") +
+                                         kModels))
+                .world->settings()
+                .physics_partitions,
+            3);
+}
+
 struct BadCase {
   const char* label;
   std::string world;                   // world.yaml
@@ -300,6 +319,13 @@ TEST_F(MalformedWorldTest, EachMistakeHasAClearMessage) {
        {"world.yaml:1:15:", "'size'", "positive number", "(got \"abc\")"}},
       {"negative size", "arena: {size: -3}\n", {"world.yaml:1:15:", "positive number", "-3"}},
       {"nan size", "arena: {size: .nan}\n", {"world.yaml:1:15:", "positive number"}},
+      {"partitions not auto or a number",
+       "arena: {size: 2}\nsimulation: {physics_partitions: automatic}\n",
+       {"world.yaml:2:34:", "'physics_partitions' must be auto or a whole number from 1 to 1024",
+        "(got 'automatic')"}},
+      {"zero partitions",
+       "arena: {size: 2}\nsimulation: {physics_partitions: 0}\n",
+       {"world.yaml:2:34:", "'physics_partitions' must be a whole number from 1 to 1024"}},
       {"inf size", "arena: {size: inf}\n", {"positive number"}},
       {"huge size",
        "arena: {size: 1e300}\n",
