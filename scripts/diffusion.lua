@@ -10,6 +10,7 @@ local RANGE = 0.1  -- m, the proximity sensors' range
 
 local left_motor, right_motor
 local sensors = {}       -- handles, ./prox[0] .. ./prox[23]
+local distances = {}     -- their readings (m, -1: nothing), refilled every step
 local cos_a, sin_a = {}, {}  -- direction of each sensor, counter-clockwise from the front
 local wheel_speed        -- rad/s
 local straight_angle     -- rad
@@ -32,12 +33,15 @@ end
 
 function sysCall_actuation()
   -- Sum of the readings as vectors pointing at what each sensor sees.
+  -- One call reads all 24 (sim.readProximitySensor(h) reads one).
   local x, y = 0, 0
-  for i = 1, #sensors do
-    local detected, distance = sim.readProximitySensor(sensors[i])
-    if detected == 1 then
-      local value = 1 - distance / RANGE
-      x, y = x + value * cos_a[i], y + value * sin_a[i]
+  if sim.readProximitySensors(sensors, distances) > 0 then
+    for i = 1, #sensors do
+      local distance = distances[i]
+      if distance >= 0 then
+        local value = 1 - distance / RANGE
+        x, y = x + value * cos_a[i], y + value * sin_a[i]
+      end
     end
   end
   local angle = math.atan(y, x)
