@@ -2,6 +2,9 @@
 //
 // Readings are written in the sense phase and only read during the control
 // phase, so any robot may read any sensor.
+#include <string>
+
+#include "framework/error.h"
 #include "framework/lua_api.h"
 #include "framework/scene.h"
 
@@ -13,14 +16,18 @@ namespace {
 // the detected object, {nx, ny, nz} (the surface normal there, sensor
 // frame): CoppeliaSim's order. The no-detection path allocates nothing: a
 // robot calls this for each of its sensors every step.
+//
+// The sensor `id`; the fast check first, the Scene's accessor producing the
+// message on a bad handle.
+const ProximitySensorData& SensorOf(const Scene& scene, ObjectId id) {
+  return scene.IsValid(id) && scene.type_at(id.index()) == ObjectType::kProximitySensor
+             ? scene.proximity_sensors()[scene.row_at(id.index())]
+             : scene.proximity_sensor(id);
+}
+
 int ReadProximitySensor(lua_State* L) {
   const Scene& scene = *Context(L).scene;
-  const ObjectId id = CheckObject(L, 1);
-  // Fast check; the Scene's accessor produces the message on a bad handle.
-  const ProximitySensorData& sensor =
-      scene.IsValid(id) && scene.type_at(id.index()) == ObjectType::kProximitySensor
-          ? scene.proximity_sensors()[scene.row_at(id.index())]
-          : scene.proximity_sensor(id);
+  const ProximitySensorData& sensor = SensorOf(scene, CheckObject(L, 1));
   if (!sensor.detected) {
     lua_pushinteger(L, 0);
     return 1;
@@ -36,11 +43,59 @@ int ReadProximitySensor(lua_State* L) {
   return 5;
 }
 
+// sim.readProximitySensors(handles [, distances]) -> count, distances: the
+// distance (m) each sensor of the array `handles` reads, as the second
+// result of sim.readProximitySensor(handles[i]), or -1 when it detects
+// nothing; `count`: how many detect something. The distances go into
+// `distances` (entries 1 .. #handles overwritten, the rest left alone),
+// reused in place from step to step so that the call allocates nothing, or
+// into a new table when it is absent or nil.
+int ReadProximitySensors(lua_State* L) {
+  const Scene& scene = *Context(L).scene;
+  ArgType(L, 1, LUA_TTABLE);
+  if (lua_isnoneornil(L, 2)) {
+    lua_settop(L, 1);
+    lua_createtable(L, static_cast<int>(lua_rawlen(L, 1)), 0);
+  } else {
+    ArgType(L, 2, LUA_TTABLE);
+    lua_settop(L, 2);
+  }
+  const lua_Integer n = static_cast<lua_Integer>(lua_rawlen(L, 1));
+  lua_Integer count = 0;
+  for (lua_Integer i = 1; i <= n; ++i) {
+    lua_rawgeti(L, 1, i);
+    int ok = 0;
+    const lua_Integer handle = lua_tointegerx(L, -1, &ok);
+    if (!ok)
+      throw Error("handles[" + std::to_string(i) + "] is not an object handle (got " +
+                  luaL_typename(L, -1) + ")");
+    lua_pop(L, 1);
+    const ObjectId id = ObjectId::FromInteger(handle);
+    const ProximitySensorData* sensor = nullptr;
+    try {
+      sensor = &SensorOf(scene, id);
+    } catch (const std::exception& e) {
+      throw Error("handles[" + std::to_string(i) + "]: " + e.what());
+    }
+    if (sensor->detected) {
+      ++count;
+      lua_pushnumber(L, sensor->distance);
+    } else {
+      lua_pushinteger(L, -1);
+    }
+    lua_rawseti(L, 2, i);
+  }
+  lua_pushinteger(L, count);
+  lua_insert(L, 2);
+  return 2;
+}
+
 }  // namespace
 
 void RegisterSensorsApi(lua_State* L) {
   static constexpr luaL_Reg kFunctions[] = {
       {"readProximitySensor", Guarded<ReadProximitySensor, "sim.readProximitySensor">},
+      {"readProximitySensors", Guarded<ReadProximitySensors, "sim.readProximitySensors">},
       {nullptr, nullptr},
   };
   luaL_setfuncs(L, kFunctions, 0);
