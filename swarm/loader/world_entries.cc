@@ -88,8 +88,8 @@ void WorldLoader::ResolveEntry(EntryPlan* entry) {
   ReadOwnCopies(f, world_values, &declared, entry);
   ResolveObjects(f, world_values, entry);
   ResolvePlacement(f, world_values, entry);
-  ResolvePythonController(f, world_values, entry);
   ResolveNativeController(f, world_values, entry);
+  ResolvePythonController(f, world_values, entry);
 }
 
 namespace {
