@@ -1,6 +1,8 @@
 #include "framework/plugin_controllers.h"
 
+#include <cstdio>
 #include <cstring>
+#include <exception>
 
 #include "framework/error.h"
 #include "framework/messaging.h"
@@ -64,8 +66,15 @@ void PluginControllers::Init(int first) {
       if (robot.type->init == nullptr) continue;
       const SwarmsimCallContext context = Context(static_cast<int>(r));
       char error[kErrorSize] = "";
-      if (robot.type->init(&context, &robot.state, error, sizeof error, robot.type->user_data) != 0)
-        Fail(static_cast<int>(r), "init", error);
+      int status;
+      try {  // a plugin breaking the rule (no exception leaves it) still gets a message
+        status =
+            robot.type->init(&context, &robot.state, error, sizeof error, robot.type->user_data);
+      } catch (const std::exception& e) {
+        std::snprintf(error, sizeof error, "a C++ exception left the plugin: %s", e.what());
+        status = -1;
+      }
+      if (status != 0) Fail(static_cast<int>(r), "init", error);
     }
   });
 }
@@ -75,8 +84,14 @@ void PluginControllers::CallStep(int r) {
   const SwarmsimCallContext context = Context(r);
   char error[kErrorSize];
   error[0] = 0;
-  if (robot.type->step(&context, robot.state, error, sizeof error, robot.type->user_data) != 0)
-    Fail(r, "step", error);
+  int status;
+  try {
+    status = robot.type->step(&context, robot.state, error, sizeof error, robot.type->user_data);
+  } catch (const std::exception& e) {
+    std::snprintf(error, sizeof error, "a C++ exception left the plugin: %s", e.what());
+    status = -1;
+  }
+  if (status != 0) Fail(r, "step", error);
 }
 
 void PluginControllers::Fail(int r, const char* what, const char* message) {
