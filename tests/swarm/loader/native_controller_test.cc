@@ -165,6 +165,25 @@ TEST_F(NativeControllerTest, KeptScriptsRunFirstAndTheControllerAfterThem) {
   EXPECT_EQ(WheelTarget(*w.world, "bot#0"), 1);  // the controller's write is the last
 }
 
+TEST_F(NativeControllerTest, WithAMainScriptControllersRunInTheActuationPassOnly) {
+  Write("main.lua", R"(
+function sysCall_step()
+  sim.handleSensing()
+  sim.handleChildScripts('sensing')
+  sim.handleChildScripts('actuation')
+  sim.handleActuation()
+  sim.handleDynamics()
+end
+)");
+  LoadedWorld w =
+      LoadNative(WorldText("    native_controller: relay\n", 4, 0, ", main_script: main.lua"));
+  w.world->Start();
+  w.world->Step();
+  w.world->Step();
+  // Once a step: 3 greetings (twice would send 6, and the second pass would find none).
+  for (int r = 0; r < 4; ++r) EXPECT_EQ(WheelTarget(*w.world, "bot#" + std::to_string(r)), 3);
+}
+
 TEST_F(NativeControllerTest, ParametersReachTheController) {
   // Greetings of another text than the receivers' are not counted.
   LoadedWorld w =
