@@ -11,7 +11,9 @@
 // world runs at fixed points of each step (SwarmsimPhase); and sensor types
 // (ABI 3), read by scripts with sim.readPluginSensor; and object types (ABI
 // 4) that model files place like built-in ones; and vision-sensor filter
-// elements (ABI 5) that a sensor's `filters:` list names. Arguments and
+// elements (ABI 5) that a sensor's `filters:` list names; and native
+// controllers (ABI 6) that a models entry attaches with `native_controller:`,
+// called once per robot per step in the control phase. Arguments and
 // results are numbers, strings and number arrays (SwarmsimValue); no Lua
 // type crosses this interface. Everything here is plain C, so a plugin
 // built with another compiler works as long as the ABI version matches; the
@@ -22,7 +24,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#define SWARMSIM_PLUGIN_ABI_VERSION 5
+#define SWARMSIM_PLUGIN_ABI_VERSION 6
 
 #ifdef __cplusplus
 extern "C" {
@@ -45,6 +47,25 @@ typedef struct SwarmsimValue {
   const double* numbers;  // kSwarmsimNumbers
   size_t size;            // bytes of text, or count of numbers
 } SwarmsimValue;
+
+// Scopes of a message (ABI 6), as sim.sendGlobalMessage, sendLocalMessage,
+// sendDirectMessage and sendRangeMessage.
+enum SwarmsimMessageScope {
+  kSwarmsimMessageGlobal = 0,  // every script and controller of the world but the sender
+  kSwarmsimMessageLocal = 1,   // the others of the sender's model
+  kSwarmsimMessageDirect = 2,  // the script or controller on object `target`
+  kSwarmsimMessageRange = 3    // robots whose model root is within `range` m of the sender
+};
+
+// A message delivered to a native controller (ABI 6).
+typedef struct SwarmsimMessage {
+  const char* data;  // bytes, valid until the controller's step returns
+  size_t size;
+  int64_t sender;    // the sending script's object (a controller's: its root; -1: the main script)
+  int has_geometry;  // 0 for a message from the main script: no distance or bearing
+  double distance;   // m, from the receiver's model root to the sender
+  double bearing;    // rad, of the sender in the receiver's root frame (0 = +x, CCW)
+} SwarmsimMessage;
 
 // A narrow, read-mostly view of the world the command runs in.
 typedef struct SwarmsimWorldApi {
@@ -86,6 +107,43 @@ typedef struct SwarmsimWorldApi {
   // From record-phase callbacks only (kSwarmsimRecord); returns 0, or -1
   // elsewhere or for a bad robot or name.
   int (*record_metric)(void* world, int robot, const char* name, double value);
+  // --- ABI 6 ---
+  // The last readings of `count` proximity sensors in one call:
+  // distances[i] is the distance (m) to what sensors[i] detects, or -1 when
+  // it detects nothing (or is not a proximity sensor). Returns how many
+  // detect something, or -1 if some handle is not a live proximity sensor.
+  int (*read_proximity_sensors)(void* world, const int64_t* sensors, int count, double* distances);
+  // The last reading of a plugin sensor (ABI 3) into out[0..max); returns how
+  // many numbers it holds (possibly more than max), 0 before its first sense,
+  // -1 if `sensor` is not a plugin sensor.
+  int (*read_plugin_sensor)(void* world, int64_t sensor, double* out, int max);
+  // Sets a position-mode joint's target position (rad or m), with the rules
+  // of set_joint_target_velocity; returns 0 otherwise.
+  int (*set_joint_target_position)(void* world, int robot, int64_t joint, double position);
+  // A joint's position (rad or m) and velocity; returns 0 if `joint` is not a live joint.
+  int (*joint_state)(void* world, int64_t joint, double* position, double* velocity);
+  // A parameter as sim.getParam sees it for `robot` (its model's, else the
+  // world's): a number (a boolean as 1 or 0) or a string (text valid while
+  // the world lives); returns 0 if there is none.
+  int (*parameter)(void* world, int robot, const char* name, SwarmsimValue* out);
+  // Sends a message from `robot` (its model root is the sender, as a script
+  // on the root), delivered at the start of the next step as the sim.send*
+  // functions' (scope: SwarmsimMessageScope; target: the receiving object of
+  // a direct message; range: m, of a range message, line_of_sight: 1 for
+  // receivers no static shape hides). Only from that robot's own controller
+  // (or per-robot callback). Returns 0, or -1 for a bad scope, target or
+  // range, a message over 1 MiB, or the robot's messages of this step over
+  // its memory limit (simulation.script_memory_mb).
+  int (*send_message)(void* world, int robot, int scope, const char* data, size_t size,
+                      int64_t target, double range, int line_of_sight);
+  // The next message delivered this step to `robot`'s native controller
+  // (sender-handle order, the robot's own skipped; sim.receiveMessage's
+  // rules) into *out: returns 1, or 0 when there are no more. Only from that
+  // robot's controller.
+  int (*receive_message)(void* world, int robot, SwarmsimMessage* out);
+  // A uniform number in [0, 1) from `robot`'s own random stream (keyed by
+  // seed and robot index, sim.random's). Only from that robot's controller.
+  double (*random_uniform)(void* world, int robot);
 } SwarmsimWorldApi;
 
 // Who is calling: the robot and the script's object.
@@ -182,6 +240,28 @@ typedef int (*SwarmsimFilterFunction)(const SwarmsimImage* input, SwarmsimImage*
                                       const double* parameters, double* values, int max_values,
                                       char* error, size_t error_size, void* user_data);
 
+// A native controller (ABI 6): a models entry's `native_controller: NAME`
+// attaches it to each of the entry's robots (their Lua scripts are dropped
+// unless `keep_scripts: true`). For each robot, `init` runs when the world
+// starts (or the robot is copied at run time), `step` once per step in the
+// control phase (after the robot's scripts, if kept; with a main script, on
+// each sim.handleChildScripts pass but the sensing one), `cleanup` when the
+// world stops or the robot is removed. context->robot is the robot,
+// context->script_object its model root (find_object paths such as
+// "./leftMotor" are relative to it). Robots run concurrently: touch only
+// the robot's own objects and state. init stores the robot's state in
+// *state (null is fine); step and cleanup get it back. init and step
+// return 0, or -1 after writing a message into `error`: the run stops with
+// it, naming the robot and the plugin (or, under on_script_error:
+// disable_script, that robot's controller is disabled). No C++ exception
+// may leave these functions.
+typedef int (*SwarmsimControllerInit)(const SwarmsimCallContext* context, void** state, char* error,
+                                      size_t error_size, void* user_data);
+typedef int (*SwarmsimControllerStep)(const SwarmsimCallContext* context, void* state, char* error,
+                                      size_t error_size, void* user_data);
+typedef void (*SwarmsimControllerCleanup)(const SwarmsimCallContext* context, void* state,
+                                          void* user_data);
+
 typedef struct SwarmsimRegistrar {
   void* impl;
   // Registers sim.<name>; returns 0, or -1 if the name is taken or invalid.
@@ -225,6 +305,13 @@ typedef struct SwarmsimRegistrar {
   int (*add_vision_filter)(void* impl, const char* name, const char* description, int input_kinds,
                            int output_kind, const SwarmsimObjectKey* keys, int key_count,
                            int max_values, SwarmsimFilterFunction filter, void* user_data);
+  // --- ABI 6 ---
+  // Registers the native controller `name` (see SwarmsimControllerInit);
+  // init and cleanup may be null. Returns 0, or -1 for a missing or taken
+  // name or no step function.
+  int (*add_controller)(void* impl, const char* name, const char* description,
+                        SwarmsimControllerInit init, SwarmsimControllerStep step,
+                        SwarmsimControllerCleanup cleanup, void* user_data);
 } SwarmsimRegistrar;
 
 // The two entry points a plugin exports.

@@ -8,6 +8,7 @@
 #include "framework/error.h"
 #include "framework/object_type.h"
 #include "framework/plugin_api.h"
+#include "framework/plugin_controllers.h"
 #include "framework/plugin_object_type.h"
 #include "framework/registry.h"
 #include "framework/vision_filter.h"
@@ -23,6 +24,7 @@ struct Registration {
   std::vector<PluginSensorType> sensors;
   std::vector<std::shared_ptr<const ObjectTypeDescriptor>> object_types;
   std::vector<std::shared_ptr<const VisionFilterDescriptor>> vision_filters;
+  std::vector<PluginControllerType> controllers;
   std::string error;
 };
 
@@ -134,6 +136,24 @@ int AddVisionFilter(void* impl, const char* name, const char* description, int i
   return 0;
 }
 
+int AddController(void* impl, const char* name, const char* description,
+                  SwarmsimControllerInit init, SwarmsimControllerStep step,
+                  SwarmsimControllerCleanup cleanup, void* user_data) {
+  auto* r = static_cast<Registration*>(impl);
+  if (name == nullptr || name[0] == 0 || step == nullptr) {
+    r->error = "add_controller needs a name and a step function";
+    return -1;
+  }
+  for (const PluginControllerType& c : r->controllers)
+    if (c.name == name) {
+      r->error = "add_controller: the controller '" + c.name + "' is registered twice";
+      return -1;
+    }
+  r->controllers.push_back(
+      {name, description != nullptr ? description : "", "", init, step, cleanup, user_data});
+  return 0;
+}
+
 void SetInfo(void* impl, const char* name, const char* version, const char* description) {
   auto* r = static_cast<Registration*>(impl);
   if (name != nullptr) r->info.name = name;
@@ -173,7 +193,8 @@ void LoadPlugin(const std::string& path, ModuleRegistry* registry) {
                                     AddSensorType,
                                     AddObjectType,
                                     AddSensorTypeOfSize,
-                                    AddVisionFilter};
+                                    AddVisionFilter,
+                                    AddController};
   if (do_register(&registrar) != 0 || !r.error.empty()) {
     std::string message = "plugin '" + path + "' failed to register";
     if (!r.error.empty()) message.append(": ").append(r.error);
@@ -219,6 +240,17 @@ void LoadPlugin(const std::string& path, ModuleRegistry* registry) {
     named->version = r.info.version;
     try {
       registry->RegisterVisionFilter(std::move(named));
+    } catch (const Error& e) {
+      throw Error("plugin '" + path + "': " + e.what());
+    }
+  }
+  for (PluginControllerType& controller : r.controllers) {
+    ModuleInfo info = r.info;
+    info.name = r.info.name + ":" + controller.name;
+    info.description = controller.description;
+    controller.plugin = path;
+    try {
+      registry->RegisterController(info, std::move(controller));
     } catch (const Error& e) {
       throw Error("plugin '" + path + "': " + e.what());
     }

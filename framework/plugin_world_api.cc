@@ -1,8 +1,12 @@
 #include "framework/plugin_world_api.h"
 
+#include <cmath>
+#include <span>
 #include <variant>
 
+#include "framework/plugin_controllers.h"
 #include "framework/plugin_object_type.h"
+#include "framework/plugin_sensors.h"
 #include "framework/world.h"
 
 namespace swarmsim {
@@ -105,11 +109,149 @@ int RecordMetric(void* world, int robot, const char* name, double value) {
   return W(world).RecordPluginMetric(robot, name != nullptr ? name : "", value) ? 0 : -1;
 }
 
-constexpr SwarmsimWorldApi kWorldApi = {
-    WorldTime,   ObjectPosition,      NumberParameter,        FindObject,
-    RobotRoot,   ReadProximitySensor, SetJointTargetVelocity, StepCount,
-    RobotCount,  ObjectValues,        ObjectsOfType,          RobotOf,
-    RecordMetric};
+// --- ABI 6 ---------------------------------------------------------------------------
+// None of these may throw: they are called from C.
+
+int ReadProximitySensors(void* world, const int64_t* sensors, int count, double* distances) {
+  const Scene& scene = W(world).scene();
+  int detected = 0;
+  bool all_sensors = true;
+  for (int i = 0; i < count; ++i) {
+    const ObjectId id = ObjectId::FromInteger(sensors[i]);
+    distances[i] = -1;
+    if (!scene.IsValid(id) || scene.type_at(id.index()) != ObjectType::kProximitySensor) {
+      all_sensors = false;
+      continue;
+    }
+    const ProximitySensorData& p = scene.proximity_sensors()[scene.row_at(id.index())];
+    if (!p.detected) continue;
+    distances[i] = p.distance;
+    ++detected;
+  }
+  return all_sensors ? detected : -1;
+}
+
+int ReadPluginSensor(void* world, int64_t sensor, double* out, int max) {
+  try {
+    std::span<const double> values;
+    if (!PluginSensorReading(W(world), ObjectId::FromInteger(sensor), &values)) return 0;
+    for (size_t k = 0; k < values.size() && static_cast<int>(k) < max; ++k) out[k] = values[k];
+    return static_cast<int>(values.size());
+  } catch (const std::exception&) {
+    return -1;  // not a plugin sensor
+  }
+}
+
+// The joint `joint` of robot `robot`, or null.
+JointData* OwnJoint(void* world, int robot, int64_t joint) {
+  Scene& scene = W(world).scene();
+  const ObjectId id = ObjectId::FromInteger(joint);
+  if (!scene.IsValid(id) || scene.type(id) != ObjectType::kJoint) return nullptr;
+  if (scene.instance_of(id) != robot) return nullptr;
+  return &scene.mutable_joint(id);
+}
+
+int SetJointTargetPosition(void* world, int robot, int64_t joint, double position) {
+  JointData* j = OwnJoint(world, robot, joint);
+  if (j == nullptr || !std::isfinite(position)) return 0;
+  j->target_position = position;
+  return 1;
+}
+
+int JointState(void* world, int64_t joint, double* position, double* velocity) {
+  const Scene& scene = W(world).scene();
+  const ObjectId id = ObjectId::FromInteger(joint);
+  if (!scene.IsValid(id) || scene.type(id) != ObjectType::kJoint) return 0;
+  const JointData& j = scene.joint(id);
+  if (position != nullptr) *position = j.position;
+  if (velocity != nullptr) *velocity = j.velocity;
+  return 1;
+}
+
+int Parameter(void* world, int robot, const char* name, SwarmsimValue* out) {
+  if (name == nullptr || out == nullptr) return 0;
+  const ParamValue* v = W(world).FindParameter(robot, name);
+  if (v == nullptr) return 0;
+  *out = {};
+  if (const double* d = std::get_if<double>(v)) {
+    out->type = kSwarmsimNumber, out->number = *d;
+  } else if (const bool* b = std::get_if<bool>(v)) {
+    out->type = kSwarmsimNumber, out->number = *b ? 1 : 0;
+  } else {
+    const std::string& text = std::get<std::string>(*v);
+    out->type = kSwarmsimString, out->text = text.data(), out->size = text.size();
+  }
+  return 1;
+}
+
+int SendMessage(void* world, int robot, int scope, const char* data, size_t size, int64_t target,
+                double range, int line_of_sight) {
+  World& w = W(world);
+  const Scene& scene = w.scene();
+  constexpr size_t kMaxMessageBytes = 1 << 20;  // as sim.send*Message
+  if (robot < 0 || robot >= w.robot_count() || !scene.instance(robot).alive ||
+      (data == nullptr && size > 0) || size > kMaxMessageBytes || scope < kSwarmsimMessageGlobal ||
+      scope > kSwarmsimMessageRange)
+    return -1;
+  Message m;
+  m.scope = static_cast<MessageScope>(scope);  // same order as SwarmsimMessageScope
+  if (m.scope == MessageScope::kDirect) {
+    m.target = ObjectId::FromInteger(target);
+    if (!scene.IsValid(m.target)) return -1;
+  }
+  if (m.scope == MessageScope::kRange) {
+    if (!(range >= 0) || !std::isfinite(range)) return -1;
+    m.range = range;
+    m.line_of_sight = line_of_sight != 0;
+  }
+  RobotMail& mail = w.messaging().robot_mail(robot);
+  const uint64_t total = mail.outbox_bytes + size + sizeof(Message);
+  const int64_t limit = w.settings().script_memory_limit;  // 0: no limit
+  if (limit > 0 && total > static_cast<uint64_t>(limit)) return -1;
+  try {
+    m.data.assign(data != nullptr ? data : "", size);
+    m.sender = scene.instance(robot).root;
+    m.sender_instance = robot;
+    mail.outbox.push_back(std::move(m));
+  } catch (const std::exception&) {
+    return -1;  // out of memory
+  }
+  mail.outbox_bytes = total;
+  return 0;
+}
+
+int ReceiveMessage(void* world, int robot, SwarmsimMessage* out) {
+  PluginControllers* controllers = W(world).plugin_controllers();
+  return controllers != nullptr ? controllers->Receive(robot, out) : 0;
+}
+
+double RandomUniform(void* world, int robot) {
+  World& w = W(world);
+  if (robot < 0 || robot >= w.robot_count()) return 0;
+  return w.runtime(robot).rng.Uniform();
+}
+
+constexpr SwarmsimWorldApi kWorldApi = {WorldTime,
+                                        ObjectPosition,
+                                        NumberParameter,
+                                        FindObject,
+                                        RobotRoot,
+                                        ReadProximitySensor,
+                                        SetJointTargetVelocity,
+                                        StepCount,
+                                        RobotCount,
+                                        ObjectValues,
+                                        ObjectsOfType,
+                                        RobotOf,
+                                        RecordMetric,
+                                        ReadProximitySensors,
+                                        ReadPluginSensor,
+                                        SetJointTargetPosition,
+                                        JointState,
+                                        Parameter,
+                                        SendMessage,
+                                        ReceiveMessage,
+                                        RandomUniform};
 
 }  // namespace
 

@@ -21,6 +21,7 @@ class DynamicsBackend;
 class ProximityBackend;
 class Scene;
 struct ObjectTypeDescriptor;
+struct PluginControllerType;
 struct VisionFilterDescriptor;
 
 // A script command registered by a plugin (framework/plugin_api.h): sim.<name>.
@@ -107,6 +108,12 @@ class ModuleRegistry {
   const std::vector<std::shared_ptr<const VisionFilterDescriptor>>& vision_filters() const {
     return vision_filters_;
   }
+  // Native controllers (plugins, framework/plugin_controllers.h): kind
+  // "controller". Throws swarmsim::Error if the name is taken.
+  void RegisterController(ModuleInfo info, PluginControllerType controller);
+  // Null if no controller has that name.
+  const PluginControllerType* FindController(std::string_view name) const;
+  std::vector<std::string> ControllerNames() const;
   // Plugins loaded into this registry, by canonical path (LoadPlugin records them).
   void AddPluginPath(std::string path) { plugin_paths_.push_back(std::move(path)); }
   bool HasPlugin(std::string_view path) const;
@@ -138,6 +145,8 @@ class ModuleRegistry {
   std::vector<std::shared_ptr<const ObjectTypeDescriptor>> owned_object_types_;
   std::vector<const ObjectTypeDescriptor*> object_types_;
   std::vector<std::shared_ptr<const VisionFilterDescriptor>> vision_filters_;
+  // Shared, stable addresses: a world's robots point at them.
+  std::vector<std::shared_ptr<const PluginControllerType>> controllers_;
 };
 
 }  // namespace swarmsim

@@ -10,6 +10,7 @@
 #include "framework/dynamics_backend.h"
 #include "framework/error.h"
 #include "framework/object_type.h"
+#include "framework/plugin_controllers.h"
 #include "framework/proximity_backend.h"
 #include "framework/registry.h"
 #include "framework/scheduler.h"
@@ -267,6 +268,8 @@ void World::Start() {
   started_ = true;
   try {
     scripts_->Start();
+    // Native controllers' init, after the scripts' sysCall_init.
+    if (controllers_) controllers_->Init(0);
     MarkAllPending();  // sysCall_init may have left anything anywhere
     FlushRobotBuffers();
   } catch (...) {
@@ -367,6 +370,9 @@ void World::Control(ScriptPass pass) {
                               if (!instances[r].alive) continue;
                               try {
                                 scripts_->RunInstance(static_cast<int>(r), pass);
+                                // A native controller, after the robot's scripts.
+                                if (controllers_ && pass != ScriptPass::kSensing)
+                                  controllers_->Step(static_cast<int>(r));
                               } catch (const std::exception& e) {
                                 runtimes_[r].error = e.what();
                               }
@@ -574,9 +580,18 @@ bool World::RecordPluginMetric(int robot, std::string_view name, double value) {
   return true;
 }
 
+void World::SetNativeController(int robot, const PluginControllerType* type,
+                                bool in_place_of_scripts) {
+  if (started_) throw Error("native controllers are attached before the world starts");
+  if (!controllers_) controllers_ = std::make_unique<PluginControllers>(this);
+  controllers_->Assign(robot, type, in_place_of_scripts);
+}
+
 void World::Stop() {
   if (stopped_ || !started_) return;
   stopped_ = true;
+  // Native controllers' cleanup (it cannot fail), before the scripts'.
+  if (controllers_) controllers_->CleanupAll();
   if (scripts_) {
     try {
       scripts_->Stop();

@@ -30,6 +30,8 @@ using CalculationModule = Module;  // framework/calculation_module.h
 class DynamicsBackend;
 class ModuleRegistry;
 struct PhaseCallback;
+class PluginControllers;
+struct PluginControllerType;
 struct PluginSensorType;
 class ProximityBackend;
 class TaskScheduler;
@@ -311,6 +313,15 @@ class World : public PhaseHandlers {
   // The last reading of plugin sensor `id` into *values: false before its
   // first sense. Throws swarmsim::Error if `id` is not a plugin sensor.
 
+  // --- Native controllers (framework/plugin_controllers.h) -------------------------------
+  // Robot `robot` runs the plugin controller `type` (a models entry's
+  // native_controller:) from Start on; copies made at run time inherit it.
+  // in_place_of_scripts: its model's Lua scripts were dropped for it
+  // (PluginControllers::Assign).
+  void SetNativeController(int robot, const PluginControllerType* type, bool in_place_of_scripts);
+  // Null when no robot has one.
+  PluginControllers* plugin_controllers() { return controllers_.get(); }
+
   // --- Messages and signals ------------------------------------------------------------
   // Delivered at the start of each step; signal writes applied when a
   // control pass ends.
@@ -360,6 +371,7 @@ class World : public PhaseHandlers {
   std::unique_ptr<DynamicsBackend> dynamics_;
   ProximityBackend* proximity_ = nullptr;  // owned by its module
   std::unique_ptr<ScriptHost> scripts_;
+  std::unique_ptr<PluginControllers> controllers_;  // null: no robot has a native controller
   std::vector<RobotRuntime> runtimes_;
   // Per robot, which of its RobotRuntime buffers may hold something (kPending*
   // bits, world.cc): the serial passes between phases visit only those

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "framework/error.h"
+#include "framework/plugin_controllers.h"
 #include "framework/world.h"
 
 namespace swarmsim {
@@ -56,6 +57,13 @@ void World::ApplyModelEdits() {
     for (const auto& [robot, source] : copies)
       runtimes_[robot].parameters = runtimes_[source].parameters;
     scripts_->StartInstances(first_new);
+    // A copy runs its source's native controller, from a fresh init.
+    if (controllers_) {
+      for (const auto& [robot, source] : copies)
+        if (const PluginControllerType* type = controllers_->type_of(source))
+          controllers_->Assign(robot, type, controllers_->in_place_of_scripts(source));
+      controllers_->Init(first_new);
+    }
   }
   // Then removals (a robot removed twice goes once).
   for (const ModelEdit& edit : edits)
@@ -96,6 +104,7 @@ void World::RemoveRobot(ObjectId root) {
   // Its scripts' sysCall_cleanup, while its objects still exist; a cleanup
   // error (under on_script_error: stop) ends the run after the robot is gone.
   std::string cleanup_error;
+  if (controllers_) controllers_->Cleanup(robot);
   try {
     scripts_->StopInstance(robot);
   } catch (const std::exception& e) {

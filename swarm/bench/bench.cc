@@ -26,6 +26,15 @@ namespace fs = std::filesystem;
 
 constexpr const char* kDefaultWorld = "worlds/diffusion.yaml";
 
+// Where a world's `plugins: [NAME]` are looked for, as `swarmsim run` does:
+// plugins/ beside this program.
+std::vector<fs::path> BenchPluginDirectories() {
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (ec) return {};
+  return {exe.parent_path() / "plugins", exe.parent_path().parent_path() / "lib/swarmsim/plugins"};
+}
+
 constexpr const char* kCsvHeader =
     "config,robots,threads,steps,wall_s,robot_ticks_per_s,us_sense,us_control,us_actuate,"
     "us_physics,us_record,peak_rss_mb,kb_per_robot";
@@ -102,6 +111,7 @@ int RunBenchChild(const BenchOptions& options, const std::string& config, int ro
   load.overrides = {{"robots", std::to_string(robots)}};
   load.seed = 1;
   load.threads = threads;
+  load.plugin_directories = BenchPluginDirectories();
   LoadedWorld loaded = LoadWorld(options.world, load, registry);
   World& world = *loaded.world;
   world.set_log_sink([](std::string_view) {});
@@ -168,6 +178,7 @@ std::string PrepareBench(BenchOptions* options) {
   RegisterBuiltinModules(&registry);
   LoadOptions load;
   load.overrides = {{"robots", "1"}};
+  load.plugin_directories = BenchPluginDirectories();
   try {
     const LoadedWorld loaded = LoadWorld(options->world, load, registry);
     // The bare-engine row of the world's backend, if it registered a bare
@@ -177,7 +188,9 @@ std::string PrepareBench(BenchOptions* options) {
   } catch (const Error&) {
     // Tell a missing `robots` parameter from the file's own mistakes, which
     // loading it as written reports (and throws).
-    const LoadedWorld as_written = LoadWorld(options->world, LoadOptions{}, registry);
+    LoadOptions as_is;
+    as_is.plugin_directories = load.plugin_directories;
+    const LoadedWorld as_written = LoadWorld(options->world, as_is, registry);
     if (!as_written.world->parameters().contains("robots"))
       throw Error("bench: world '" + options->world +
                   "' has no parameter 'robots'; bench sets the robot count through it "

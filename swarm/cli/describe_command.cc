@@ -45,6 +45,7 @@ void PrintDescription(const LoadedWorld& w, std::ostream& out) {
       out << "  python controller: " << m.python.file.string() << ":" << m.python.function
           << (m.python.keep_scripts ? " (beside the Lua scripts)" : " (instead of the Lua scripts)")
           << "\n";
+    if (!m.native_controller.empty()) out << "  native controller: " << m.native_controller << "\n";
     if (m.ik_groups > 0) out << "  module: ik (" << m.ik_groups << " IK groups)\n";
     if (m.parameters.empty()) out << "  parameters: none\n";
     for (const ParameterSummary& p : m.parameters) {

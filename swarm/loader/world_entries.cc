@@ -10,6 +10,8 @@
 #include <utility>
 
 #include "framework/error.h"
+#include "framework/plugin_controllers.h"
+#include "framework/registry.h"
 #include "modules/environment/voxel_merge.h"
 #include "swarm/loader/urdf.h"
 #include "swarm/loader/world_loader_impl.h"
@@ -86,10 +88,18 @@ void WorldLoader::ResolveEntry(EntryPlan* entry) {
   ReadOwnCopies(f, world_values, &declared, entry);
   ResolveObjects(f, world_values, entry);
   ResolvePlacement(f, world_values, entry);
+  ResolveNativeController(f, world_values, entry);
   ResolvePythonController(f, world_values, entry);
 }
 
 namespace {
+bool HasScripts(const ObjectSpec& spec) {
+  if (spec.script) return true;
+  for (const ObjectSpec& child : spec.children)
+    if (HasScripts(child)) return true;
+  return false;
+}
+
 void DropScripts(ObjectSpec* spec) {
   spec->script = nullptr;
   spec->script_explicit = false;
@@ -144,6 +154,44 @@ void WorldLoader::ResolvePythonController(const Fields& f, const ValueReader& wo
                     "(PYTHONPATH=build/python /usr/bin/python3 -m swarmsim run " +
                     path_.string() + ", README.md 'Python')");
   if (!python.keep_scripts) {
+    DropScripts(&entry->spec);
+    for (EntryPlan::OwnCopy& own : entry->own_copies)
+      if (own.spec) DropScripts(&*own.spec);
+  }
+}
+
+// native_controller: NAME, or {name: NAME, keep_scripts: true}: a controller
+// a plugin of the world's `plugins:` registered (add_controller).
+void WorldLoader::ResolveNativeController(const Fields& f, const ValueReader& world_values,
+                                          EntryPlan* entry) {
+  if (!f.Has("native_controller")) return;
+  Field name_field = f.Get("native_controller");
+  bool keep_scripts = false;
+  if (name_field.node.IsMap()) {
+    Fields n(*file_, name_field, "'native_controller'");
+    n.Expect({"name", "keep_scripts"});
+    if (n.Has("keep_scripts")) keep_scripts = world_values.Bool(n.Get("keep_scripts"));
+    name_field = n.Require("name");
+  }
+  if (f.Has("python_controller"))
+    file_->Fail(f.Get("native_controller").key_mark,
+                "a models entry has either a 'python_controller' or a 'native_controller', "
+                "not both");
+  const std::string name = world_values.String(name_field);
+  entry->native = world_registry_->FindController(name);
+  if (entry->native == nullptr) {
+    const std::vector<std::string> known = world_registry_->ControllerNames();
+    std::string list;
+    for (const std::string& k : known) list += (list.empty() ? "" : ", ") + k;
+    file_->Fail(name_field.mark,
+                "'native_controller': no controller '" + name + "' (" +
+                    (known.empty() ? std::string("no plugin of the world's 'plugins:' registers "
+                                                 "one")
+                                   : "registered: " + list) +
+                    ")" + loader::Suggest(name, known));
+  }
+  if (!keep_scripts) {
+    entry->native_replaces_scripts = HasScripts(entry->spec);
     DropScripts(&entry->spec);
     for (EntryPlan::OwnCopy& own : entry->own_copies)
       if (own.spec) DropScripts(&*own.spec);
@@ -523,6 +571,8 @@ void WorldLoader::BuildCopies(World* world) {
       X_MR.p = X_MR.p * e.scale;
       scene.SetWorldPose(root, poses[k] * X_MR);
       world->SetInstanceParameters(instance, own ? own->parameters : e.parameters);
+      if (e.native != nullptr)
+        world->SetNativeController(instance, e.native, e.native_replaces_scripts);
     }
   }
 }
@@ -573,6 +623,7 @@ std::vector<ModelSummary> WorldLoader::Summarize() const {
       m.imported = e.model->import_summary;
     }
     m.python = e.python;
+    if (e.native != nullptr) m.native_controller = e.native->name;
     out.push_back(std::move(m));
   }
   return out;

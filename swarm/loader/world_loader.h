@@ -73,6 +73,7 @@ struct ModelSummary {
   int ik_groups = 0;
   std::vector<std::string> imported;  // a URDF model: what was imported (links, joints, meshes)
   PythonController python;            // python_controller:, if any
+  std::string native_controller;      // native_controller:, if any
 };
 
 struct LoadedWorld {

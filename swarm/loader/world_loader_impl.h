@@ -27,13 +27,21 @@ namespace swarmsim::loader {
 
 inline constexpr int64_t kMaxCount = 1000000;  // copies per models entry
 
-inline const std::vector<std::string> kEntryKeys = {"model",       "count",
-                                                    "distribute",  "position",
-                                                    "heading_deg", "orientation_deg",
-                                                    "parameters",  "instances",
-                                                    "scale",       "base",
-                                                    "objects",     "scripts",
-                                                    "ik_groups",   "python_controller"};
+inline const std::vector<std::string> kEntryKeys = {"model",
+                                                    "count",
+                                                    "distribute",
+                                                    "position",
+                                                    "heading_deg",
+                                                    "orientation_deg",
+                                                    "parameters",
+                                                    "instances",
+                                                    "scale",
+                                                    "base",
+                                                    "objects",
+                                                    "scripts",
+                                                    "ik_groups",
+                                                    "python_controller",
+                                                    "native_controller"};
 
 // One --set, split into its target.
 struct Override {
@@ -73,6 +81,9 @@ struct EntryPlan {
   std::shared_ptr<ModelFile> entry_model;
   std::vector<loader::IkGroupDef> entry_ik_groups;
   PythonController python;  // python_controller: (file empty: none)
+  // native_controller: (null: none); the plugin's controller every copy runs.
+  const PluginControllerType* native = nullptr;
+  bool native_replaces_scripts = false;  // the model's Lua scripts were dropped for it
   // instances: [{index, parameters}]: copies with their own values, in file order.
   struct OwnCopy {
     int64_t index = 0;
@@ -154,6 +165,7 @@ class WorldLoader {
   void ReadPackagePath(const Fields& top);
   void ResolvePlacement(const Fields& f, const ValueReader& world_values, EntryPlan* entry);
   void ResolvePythonController(const Fields& f, const ValueReader& world_values, EntryPlan* entry);
+  void ResolveNativeController(const Fields& f, const ValueReader& world_values, EntryPlan* entry);
   void ReadDistribution(const Fields& f, const ValueReader& world_values, EntryPlan* entry);
   void ReadSinglePosition(const Fields& f, const ValueReader& world_values, EntryPlan* entry);
   void KeepPlacementClearOfTheMap();

@@ -33,11 +33,23 @@
 // and `brightness` ({type: brightness, gain: 1.5, offset: 0.1}: a colour or
 // grey image -> the same, v' = clamp(gain v + 255 offset); its packet is the
 // mean of the result, 0..1).
+// Native controllers (ABI 6; `native_controller: NAME` on a models entry):
+// `relay`: each step the robot sends its `greeting` parameter (a string,
+// default "hi") to every other robot (a global message), counts the
+// messages it received with that text, and sets its ./wheel joint's target
+// velocity to that count plus a draw of its random stream times
+// `noise` (default 0). `faulty`: fails in its step when the step count
+// reaches the `fail_step` parameter (default 2) on the robots whose index is
+// at least `fail_robot` (default 0), and in init if `fail_init` is 1.
+// sim.exampleLiveControllers() -> how many controller states are alive
+// (init made, cleanup not yet freed).
 #include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <map>
 #include <mutex>
+#include <new>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -343,14 +355,98 @@ int Brightness(const SwarmsimImage* in, SwarmsimImage* out, const double* parame
   return 1;
 }
 
+// --- Native controllers ---------------------------------------------------------------
+
+std::atomic<int> g_live_controllers{0};
+
+struct RelayState {
+  int64_t wheel = 0;
+  std::string greeting;
+  double noise = 0;
+};
+
+int RelayInit(const SwarmsimCallContext* c, void** state, char* error, size_t error_size, void*) {
+  RelayState* s = new (std::nothrow) RelayState;
+  if (s == nullptr) return -1;
+  *state = s;
+  ++g_live_controllers;
+  const SwarmsimWorldApi& api = *c->api;
+  if (!api.find_object(c->world, c->script_object, "./wheel", &s->wheel)) {
+    std::snprintf(error, error_size, "no ./wheel joint");
+    return -1;
+  }
+  SwarmsimValue greeting;
+  s->greeting = "hi";
+  if (api.parameter(c->world, c->robot, "greeting", &greeting) && greeting.type == kSwarmsimString)
+    s->greeting.assign(greeting.text, greeting.size);
+  api.number_parameter(c->world, c->robot, "noise", &s->noise);
+  return 0;
+}
+
+int RelayStep(const SwarmsimCallContext* c, void* state, char*, size_t, void*) {
+  const RelayState& s = *static_cast<const RelayState*>(state);
+  const SwarmsimWorldApi& api = *c->api;
+  int count = 0;
+  SwarmsimMessage m;
+  while (api.receive_message(c->world, c->robot, &m) == 1)
+    if (std::string(m.data, m.size) == s.greeting) ++count;
+  api.send_message(c->world, c->robot, kSwarmsimMessageGlobal, s.greeting.data(), s.greeting.size(),
+                   0, 0, 0);
+  const double noise = s.noise != 0 ? s.noise * api.random_uniform(c->world, c->robot) : 0;
+  api.set_joint_target_velocity(c->world, c->robot, s.wheel, count + noise);
+  return 0;
+}
+
+void FreeState(const SwarmsimCallContext*, void* state, void*) {
+  if (state == nullptr) return;
+  --g_live_controllers;
+  ::operator delete(state);  // FaultyInit's byte
+}
+
+void RelayCleanup(const SwarmsimCallContext*, void* state, void*) {
+  if (state == nullptr) return;
+  --g_live_controllers;
+  delete static_cast<RelayState*>(state);
+}
+
+int FaultyInit(const SwarmsimCallContext* c, void** state, char* error, size_t error_size, void*) {
+  *state = ::operator new(1, std::nothrow);
+  if (*state != nullptr) ++g_live_controllers;
+  double fail_init = 0;
+  c->api->number_parameter(c->world, c->robot, "fail_init", &fail_init);
+  if (fail_init == 1) {
+    std::snprintf(error, error_size, "cannot start robot %d", c->robot);
+    return -1;
+  }
+  return 0;
+}
+
+int FaultyStep(const SwarmsimCallContext* c, void*, char* error, size_t error_size, void*) {
+  double fail_step = 2, fail_robot = 0;
+  c->api->number_parameter(c->world, c->robot, "fail_step", &fail_step);
+  c->api->number_parameter(c->world, c->robot, "fail_robot", &fail_robot);
+  const int64_t step = c->api->step_count(c->world);
+  if (static_cast<double>(step) >= fail_step && c->robot >= fail_robot) {
+    std::snprintf(error, error_size, "broke at step %lld", static_cast<long long>(step));
+    return -1;
+  }
+  return 0;
+}
+
+int LiveControllers(const SwarmsimCallContext*, const SwarmsimValue*, int, SwarmsimValue* results,
+                    int, char*, size_t, void*) {
+  results[0] = Number(g_live_controllers.load());
+  return 1;
+}
+
 }  // namespace
 
 extern "C" int swarmsim_plugin_abi_version(void) { return SWARMSIM_PLUGIN_ABI_VERSION; }
 
 extern "C" int swarmsim_plugin_register(const SwarmsimRegistrar* r) {
-  r->set_info(r->impl, "example", "5.0",
+  r->set_info(r->impl, "example", "6.0",
               "example plugin: exampleSum, exampleWhereAmI, robotMoveAndAvoidObstacles, light, "
-              "beacon, invert, brightness");
+              "beacon, invert, brightness, relay, faulty");
   struct Command {
     const char* name;
     const char* description;
@@ -363,6 +459,7 @@ extern "C" int swarmsim_plugin_register(const SwarmsimRegistrar* r) {
       {"robotIsMoving", "true while robotMoveAndAvoidObstacles runs", IsMoving},
       {"examplePhaseCounts", "how often each phase callback ran", PhaseCounts},
       {"readBeacon", "{radius, strength} of a beacon object", ReadBeacon},
+      {"exampleLiveControllers", "controller states alive", LiveControllers},
   };
   for (const Command& c : commands)
     if (r->add_command(r->impl, c.name, c.description, c.function, nullptr) != 0) return -1;
@@ -387,6 +484,11 @@ extern "C" int swarmsim_plugin_register(const SwarmsimRegistrar* r) {
     return -1;
   if (r->add_vision_filter(r->impl, "brightness", "gain and offset on each channel", images, 0,
                            kBrightnessKeys, 2, 1, Brightness, nullptr) != 0)
+    return -1;
+  if (r->add_controller(r->impl, "relay", "greets the other robots, counts their greetings",
+                        RelayInit, RelayStep, RelayCleanup, nullptr) != 0 ||
+      r->add_controller(r->impl, "faulty", "fails at a given step (tests)", FaultyInit, FaultyStep,
+                        FreeState, nullptr) != 0)
     return -1;
   return 0;
 }
