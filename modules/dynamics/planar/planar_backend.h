@@ -48,7 +48,7 @@
 //   fast robots; at most Options::max_internal_steps).
 //
 // Broad phase: Verlet lists. Each body keeps the bodies and obstacles within
-// its bounding radius + a skin (half the mean bounding radius) of it,
+// its bounding radius + a skin (the mean bounding radius) of it,
 // queried from framework/spatial_grid.h; the lists are rebuilt when some body
 // has moved more than half the skin since. Contacts are computed exactly from
 // the lists, in ascending index, so results do not depend on when they were

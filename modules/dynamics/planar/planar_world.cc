@@ -244,10 +244,10 @@ void PlanarWorld::Build(const Scene& scene) {
     wheeled_.push_back(body);
     k = end;
   }
-  // 4. Verlet skin: half the mean bounding radius; the obstacles' grid.
+  // 4. Verlet skin: the mean bounding radius; the obstacles' grid.
   double sum = 0;
   for (double b : bound_) sum += b;
-  skin_ = n > 0 ? 0.5 * sum / static_cast<double>(n) : 0;
+  skin_ = n > 0 ? sum / static_cast<double>(n) : 0;
   items_.clear();
   for (uint32_t k = 0; k < obstacles_.size(); ++k)
     items_.push_back({obstacles_[k].x, obstacles_[k].y, BoundOf(obstacles_[k]) + 0.5 * skin_, k});
