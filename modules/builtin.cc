@@ -7,6 +7,7 @@
 #include "modules/dynamics/box2d/box2d_backend.h"
 #include "modules/dynamics/kinematic/kinematic_backend.h"
 #include "modules/dynamics/ode/ode_backend.h"
+#include "modules/dynamics/planar/planar_backend.h"
 #include "modules/graphs/graphs.h"
 #include "modules/kinematics/ik_groups.h"
 #include "modules/metrics/swarm_metrics.h"
@@ -40,6 +41,8 @@ void RegisterBuiltinModules(ModuleRegistry* registry) {
   registry->RegisterDynamics(
       ode::ModuleInfo(), [] { return ode::MakeBackend(); }, BareLoop<ode::TimeBareLoop>);
   registry->RegisterDynamics(kinematic::ModuleInfo(), [] { return kinematic::MakeBackend(); });
+  registry->RegisterDynamics(
+      planar::ModuleInfo(), [] { return planar::MakeBackend(); }, BareLoop<planar::TimeBareLoop>);
   registry->RegisterProximity(proximity::ModuleInfo(), [] { return proximity::MakeBackend(); });
   registry->RegisterCalculation(kinematics::IkModuleInfo(),
                                 [] { return kinematics::MakeIkGroups(); });

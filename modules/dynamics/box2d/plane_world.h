@@ -28,6 +28,10 @@ struct ShapeData;
 
 class b2FrictionJoint;
 
+namespace swarmsim::dynamics {
+struct PlaneWheelGeometry;
+}
+
 namespace swarmsim::box2d {
 
 // One simulated body: a dynamic shape.
@@ -165,8 +169,8 @@ class PlaneWorld {
   void AddObstacle(const ShapeData& shape, const Pose& X_WS);
   // 3. Wheels, grouped by body, each with its share of the body's weight.
   void BuildWheels(const Scene& scene, const std::vector<int32_t>& body_of);
-  void AddWheel(const Scene& scene, uint32_t joint_slot, const JointData& joint,
-                uint32_t body_index, const ShapeData& wheel_shape);
+  void AddWheel(uint32_t joint_slot, const JointData& joint, uint32_t body_index,
+                const dynamics::PlaneWheelGeometry& geometry);
   // 4. A ground friction joint for every body without wheels.
   void BuildGroundFriction(const Scene& scene);
   // 2b. The belts, and (after 4.) the bodies that may ride them

@@ -17,6 +17,7 @@
 #include "framework/scene.h"
 #include "modules/dynamics/box2d/plane_world.h"
 #include "modules/dynamics/environment_obstacles.h"
+#include "modules/dynamics/plane_wheels.h"
 #include "modules/dynamics/scene_walk.h"
 
 namespace swarmsim::box2d {
@@ -27,9 +28,6 @@ using dynamics::CalcHeightRange;
 using dynamics::kHeightOverlap;
 using dynamics::ShapeAt;
 
-// A wheel axis counts as horizontal when its vertical component is below this
-// (about 0.06 degrees of tilt).
-constexpr double kHorizontalTolerance = 1e-3;
 // A shape whose z axis is this close to vertical is "upright".
 constexpr double kUprightTolerance = 1e-6;
 // Restitution applies above this approach speed, m/s (Box2D's default is
@@ -155,17 +153,6 @@ void ThrowIfNotFinite(const Scene& scene, uint32_t slot, const Pose& X) {
   for (double v : values)
     if (!std::isfinite(v))
       throw Error("box2d: shape '" + PathAt(scene, slot) + "' has a non-finite pose");
-}
-
-// A wheel joint's wheel: its first non-dynamic round child, or null.
-const ShapeData* WheelShapeOf(const Scene& scene, uint32_t joint_slot) {
-  for (ObjectId child : scene.children(scene.IdAt(joint_slot))) {
-    const ShapeData* shape = ShapeAt(scene, child.index());
-    if (shape && !shape->dynamic && shape->kind != ShapeKind::kBox &&
-        shape->kind != ShapeKind::kMesh && shape->size.x > 0)
-      return shape;
-  }
-  return nullptr;
 }
 
 // The fixtures of a dynamic shape's body, in its plane frame, L units per
@@ -378,16 +365,12 @@ void PlaneWorld::AddObstacle(const ShapeData& shape, const Pose& X_WS) {
 }
 
 void PlaneWorld::BuildWheels(const Scene& scene, const std::vector<int32_t>& body_of) {
-  for (uint32_t s = 0; s < scene.slot_count(); ++s) {
-    if (!scene.alive_at(s) || scene.type_at(s) != ObjectType::kJoint) continue;
-    const JointData& joint = scene.joints()[scene.row_at(s)];
-    if (joint.type != JointType::kRevolute || joint.mode != JointMode::kVelocity) continue;
-    const int32_t b = dynamics::NearestBodyAbove(scene, body_of, s, -1);
-    if (b < 0) continue;
-    const ShapeData* wheel_shape = WheelShapeOf(scene, s);
-    if (!wheel_shape) continue;
-    AddWheel(scene, s, joint, static_cast<uint32_t>(b), *wheel_shape);
-  }
+  dynamics::ForEachPlaneWheel(
+      scene, body_of, [&](uint32_t b) { return bodies_[b].slot; },
+      [&](uint32_t joint_slot, const JointData& joint, uint32_t body,
+          const dynamics::PlaneWheelGeometry& geometry) {
+        AddWheel(joint_slot, joint, body, geometry);
+      });
   std::stable_sort(wheels_.begin(), wheels_.end(),
                    [](const PlaneWheel& a, const PlaneWheel& b) { return a.body < b.body; });
   for (uint32_t w = 0; w < wheels_.size(); ++w) {
@@ -407,28 +390,20 @@ void PlaneWorld::BuildWheels(const Scene& scene, const std::vector<int32_t>& bod
   }
 }
 
-void PlaneWorld::AddWheel(const Scene& scene, uint32_t joint_slot, const JointData& joint,
-                          uint32_t body_index, const ShapeData& wheel_shape) {
+void PlaneWorld::AddWheel(uint32_t joint_slot, const JointData& joint, uint32_t body_index,
+                          const dynamics::PlaneWheelGeometry& geometry) {
   const double L = scale_;
-  const double radius = wheel_shape.size.x;
-  // Joint position and axis in the body's plane frame (yaw only).
+  const double radius = geometry.radius;
   const PlaneBody& body = bodies_[body_index];
-  const Pose& X_WB = scene.world_pose_at(body.slot);
-  const Pose& X_WJ = scene.world_pose_at(joint_slot);
-  const Quat q_PW = Quat::FromYaw(-X_WB.q.Yaw());
-  const Vec3 p_BJ = q_PW.Rotate(X_WJ.p - X_WB.p);
-  const Vec3 axis = q_PW.Rotate(X_WJ.q.Rotate({0, 0, 1}));
-  if (std::abs(axis.z) > kHorizontalTolerance) return;
-  const Vec3 forward = axis.Cross({0, 0, 1}).Normalized();  // (a_y, -a_x, 0)
   PlaneWheel wheel;
   wheel.body = body_index;
   wheel.joint_slot = joint_slot;
-  wheel.p_x = p_BJ.x * L;
-  wheel.p_y = p_BJ.y * L;
-  wheel.f_x = forward.x;
-  wheel.f_y = forward.y;
+  wheel.p_x = geometry.p_x * L;
+  wheel.p_y = geometry.p_y * L;
+  wheel.f_x = geometry.f_x;
+  wheel.f_y = geometry.f_y;
   wheel.radius_m = radius;
-  wheel.coulomb_rate = wheel_shape.friction;  // times m g / n (BuildWheels)
+  wheel.coulomb_rate = geometry.shape->friction;  // times m g / n (BuildWheels)
   wheel.motor_rate = std::max(0.0, joint.max_force) / radius * L;
   // Inverse effective mass at the contact point: K = [m^-1 + I^-1 py^2, -I^-1 px py;
   // -I^-1 px py, m^-1 + I^-1 px^2], inverted.

@@ -1,0 +1,100 @@
+// The planar backend's world (see planar_backend.h for the model): bodies in
+// dense arrays, wheels as precomputed columns of the rolling solve, static
+// obstacles in a fixed grid, candidate pairs in Verlet lists. Internal to
+// this folder.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "framework/dynamics_backend.h"
+#include "framework/math.h"
+#include "framework/spatial_grid.h"
+#include "modules/dynamics/planar/planar_contact.h"
+#include "modules/dynamics/planar/planar_options.h"
+
+namespace swarmsim {
+class Scene;
+class StateHasher;
+struct ShapeData;
+}  // namespace swarmsim
+
+namespace swarmsim::planar {
+
+// A wheel: how its surface speed moves its body (a column of the body's
+// least-squares rolling solve, body plane frame).
+struct PlanarWheel {  // 40 bytes
+  uint32_t joint_slot = 0;
+  double radius = 0;          // m
+  double g_vx = 0, g_vy = 0;  // body velocity per unit surface speed
+  double g_w = 0;             // rad per m of surface travel
+};
+
+// What the scene does not hold about a body.
+struct PlanarBodyCold {  // 144 bytes
+  uint32_t slot = 0;
+  uint32_t first_wheel = 0, wheel_count = 0;
+  double yaw = 0;       // rad, unwrapped
+  double z = 0;         // m, kept
+  Quat q_tilt;          // roll and pitch, kept
+  Pose X_WB_last;       // pose last written to (or read from) the scene
+  double yaw_last = 0;  // yaw of X_WB_last
+};
+
+class PlanarWorld {
+ public:
+  PlanarWorld(const Options& options, const DynamicsSettings& settings);
+
+  // Bodies, obstacles and wheels from the scene (discarding any previous).
+  void Build(const Scene& scene);
+  // Moves bodies whose scene pose was set from outside since the last write.
+  void SyncFromScene(const Scene& scene);
+  // Each body's velocity from its wheels' commands.
+  void ReadCommands(const Scene& scene);
+  // Moves every body by its wheels for `duration` seconds and resolves the
+  // overlaps, in internal steps small enough that nothing tunnels.
+  void Advance(double duration);
+  // Poses and velocities (what moved / duration).
+  void WriteBack(Scene* scene, double duration);
+  void Hash(StateHasher* hasher) const;
+
+  int body_count() const { return static_cast<int>(shapes_.size()); }
+  // Internal steps the last Advance took.
+  int last_internal_steps() const { return last_internal_steps_; }
+
+ private:
+  void AddObstacle(const ShapeData& shape, const Pose& X_WS);
+  void RebuildPairs();
+  // Parallel over bodies (inline without a scheduler).
+  template <class F>
+  void ForBodies(F&& body);
+
+  Options options_;
+  DynamicsSettings settings_;
+  // Bodies, slot order.
+  std::vector<PlaneShape> shapes_;                     // current iterate (bodies)
+  std::vector<PlaneShape> next_;                       // Jacobi scratch (bodies)
+  std::vector<double> bound_;                          // bounding radius, m (bodies)
+  std::vector<double> inner_;                          // inner radius, m (bodies)
+  std::vector<double> inverse_mass_;                   // 1/kg (bodies)
+  std::vector<double> v_x_, v_y_, w_;                  // commanded velocity, body frame (bodies)
+  std::vector<double> start_x_, start_y_, start_yaw_;  // at the start of Advance (bodies)
+  std::vector<PlanarBodyCold> cold_;                   // (bodies)
+  std::vector<PlanarWheel> wheels_;                    // grouped by body
+  std::vector<uint32_t> wheeled_;                      // bodies with wheels, ascending
+  // Static obstacles and their grid (built once).
+  std::vector<PlaneShape> obstacles_;
+  SpatialGrid obstacle_grid_;
+  // Verlet lists: candidates within bound + skin at the last rebuild.
+  double skin_ = 0;                                    // m
+  std::vector<double> ref_x_, ref_y_;                  // positions at the last rebuild (bodies)
+  std::vector<std::vector<uint32_t>> near_;            // bodies (bodies)
+  std::vector<std::vector<uint32_t>> near_obstacles_;  // obstacles (bodies)
+  bool pairs_valid_ = false;
+  SpatialGrid body_grid_;
+  std::vector<GridItem> items_;  // scratch
+  double max_speed_ratio_ = 0;   // max over bodies of speed / (fraction * inner radius), 1/s
+  int last_internal_steps_ = 0;
+};
+
+}  // namespace swarmsim::planar
