@@ -14,104 +14,18 @@
 #include "framework/dynamics_backend.h"
 #include "framework/scene.h"
 #include "framework/state_hash.h"
+#include "tests/modules/box2d_scene.h"
 
 namespace swarmsim::box2d {
 namespace {
 
-constexpr double kDt = 0.01;   // s, one physics substep
-constexpr int kSubsteps = 10;  // substeps per control step (0.1 s)
-
-// A differential-drive robot, e-puck/footbot-like: a cylinder body standing
-// on the floor, two wheels mirror-mounted (left axis +y, right axis -y).
-struct RobotSpec {
-  double radius = 0.085;        // m
-  double height = 0.1;          // m
-  double mass = 1.6;            // kg
-  double half_axle = 0.07;      // m, wheel offset from the centre line
-  double wheel_radius = 0.029;  // m
-};
-
-struct Robot {
-  ObjectId body, left, right;
-  RobotSpec spec;
-};
-
-Robot AddRobot(Scene* scene, const std::string& name, double x, double y, double yaw,
-               const RobotSpec& spec = {}) {
-  Robot robot;
-  robot.spec = spec;
-  ShapeData body;
-  body.kind = ShapeKind::kCylinder;
-  body.size = {spec.radius, 0, spec.height};
-  body.dynamic = true;
-  body.mass = spec.mass;
-  robot.body = scene->AddShape(name, {}, {{x, y, spec.height / 2}, Quat::FromYaw(yaw)}, body);
-  scene->MakeModelInstance(robot.body, "robot", name);
-  // Joint z axis along the body's +y (left) or -y (right).
-  const double wheel_z = spec.wheel_radius - spec.height / 2;
-  JointData motor;
-  motor.type = JointType::kRevolute;
-  motor.mode = JointMode::kVelocity;
-  robot.left = scene->AddJoint(
-      "leftMotor", robot.body,
-      {{0, spec.half_axle, wheel_z}, Quat::FromAxisAngle({1, 0, 0}, -M_PI / 2)}, motor);
-  robot.right = scene->AddJoint(
-      "rightMotor", robot.body,
-      {{0, -spec.half_axle, wheel_z}, Quat::FromAxisAngle({1, 0, 0}, M_PI / 2)}, motor);
-  ShapeData wheel;
-  wheel.kind = ShapeKind::kCylinder;
-  wheel.size = {spec.wheel_radius, 0, 0.01};
-  wheel.friction = 0.7;
-  scene->AddShape("leftWheel", robot.left, {}, wheel);
-  scene->AddShape("rightWheel", robot.right, {}, wheel);
-  return robot;
-}
-
-// Wheel surface speeds in m/s, positive forward. The right wheel's axis is
-// -y, so it turns backwards (negative joint velocity) to drive forward.
-void SetWheelSpeeds(Scene* scene, const Robot& robot, double v_left, double v_right) {
-  scene->mutable_joint(robot.left).target_velocity = v_left / robot.spec.wheel_radius;
-  scene->mutable_joint(robot.right).target_velocity = -v_right / robot.spec.wheel_radius;
-}
-
-// A static box standing on the floor, height 0.2 m.
-ObjectId AddWall(Scene* scene, double x, double y, double size_x, double size_y, double yaw = 0) {
-  ShapeData wall;
-  wall.kind = ShapeKind::kBox;
-  wall.size = {size_x, size_y, 0.2};
-  return scene->AddShape("wall", {}, {{x, y, 0.1}, Quat::FromYaw(yaw)}, wall);
-}
-
-// A floor slab under everything: must not be an obstacle.
-void AddFloor(Scene* scene) {
-  ShapeData floor;
-  floor.kind = ShapeKind::kBox;
-  floor.size = {20, 20, 0.1};
-  scene->AddShape("floor", {}, {{0, 0, -0.05}, {}}, floor);
-}
-
-// Runs `seconds` of simulated time in control steps as the world would.
-void Simulate(DynamicsBackend* backend, Scene* scene, double seconds,
-              const std::function<void()>& after_step = {}) {
-  const int steps = static_cast<int>(std::lround(seconds / (kDt * kSubsteps)));
-  for (int i = 0; i < steps; ++i) {
-    backend->Step(scene, kDt, kSubsteps);
-    scene->UpdateWorldPoses();
-    if (after_step) after_step();
-  }
-}
+using namespace box2d::scene_kit;  // NOLINT: the scene helpers
 
 std::unique_ptr<DynamicsBackend> Build(const Scene& scene, const Options& options = {}) {
   auto backend = MakeBackend(options);
   backend->Build(scene, {});
   return backend;
 }
-
-double Yaw(const Scene& scene, ObjectId id) { return scene.world_pose(id).q.Yaw(); }
-Vec3 Position(const Scene& scene, ObjectId id) { return scene.world_pose(id).p; }
-
-// Wraps an angle difference into (-pi, pi].
-double AngleDiff(double a, double b) { return std::remainder(a - b, 2 * M_PI); }
 
 TEST(Box2dBackend, RegistersAsBox2d) {
   EXPECT_EQ(ModuleInfo().name, "box2d");
