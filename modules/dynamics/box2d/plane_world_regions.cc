@@ -17,6 +17,19 @@ namespace swarmsim::box2d {
 
 namespace {
 
+// What makes another fixture like `f` (sharing its shape).
+b2FixtureDef DefinitionOf(const b2Fixture* f) {
+  b2FixtureDef def;
+  def.shape = f->GetShape();
+  def.friction = f->GetFriction();
+  def.restitution = f->GetRestitution();
+  def.restitutionThreshold = f->GetRestitutionThreshold();
+  def.density = f->GetDensity();
+  def.isSensor = f->IsSensor();
+  def.filter = f->GetFilterData();
+  return def;
+}
+
 // The fixtures of `from` added to `to`, in their creation order (Box2D keeps
 // them newest first).
 void CloneFixtures(const b2Body* from, b2Body* to) {
@@ -24,14 +37,7 @@ void CloneFixtures(const b2Body* from, b2Body* to) {
   for (const b2Fixture* f = from->GetFixtureList(); f; f = f->GetNext()) fixtures.push_back(f);
   for (auto it = fixtures.rbegin(); it != fixtures.rend(); ++it) {
     const b2Fixture* f = *it;
-    b2FixtureDef def;
-    def.shape = f->GetShape();
-    def.friction = f->GetFriction();
-    def.restitution = f->GetRestitution();
-    def.restitutionThreshold = f->GetRestitutionThreshold();
-    def.density = f->GetDensity();
-    def.isSensor = f->IsSensor();
-    def.filter = f->GetFilterData();
+    const b2FixtureDef def = DefinitionOf(f);
     to->CreateFixture(&def);
   }
 }
@@ -54,14 +60,7 @@ void PlaneWorld::CopyGround(const PlaneWorld& from, int axis, double lo, double 
       reaches = a_hi >= lo && a_lo <= hi;
     }
     if (!reaches) continue;
-    b2FixtureDef def;
-    def.shape = f->GetShape();
-    def.friction = f->GetFriction();
-    def.restitution = f->GetRestitution();
-    def.restitutionThreshold = f->GetRestitutionThreshold();
-    def.density = f->GetDensity();
-    def.isSensor = f->IsSensor();
-    def.filter = f->GetFilterData();
+    const b2FixtureDef def = DefinitionOf(f);
     ground_->CreateFixture(&def);
   }
 }
