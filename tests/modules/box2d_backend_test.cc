@@ -14,43 +14,18 @@
 #include "framework/dynamics_backend.h"
 #include "framework/scene.h"
 #include "framework/state_hash.h"
-#include "tests/modules/plane_robot.h"
+#include "tests/modules/box2d_scene.h"
 
 namespace swarmsim::box2d {
 namespace {
 
-constexpr double kDt = 0.01;   // s, one physics substep
-constexpr int kSubsteps = 10;  // substeps per control step (0.1 s)
-
-using plane_test::AddFloor;
-using plane_test::AddRobot;
-using plane_test::AddWall;
-using plane_test::Robot;
-using plane_test::RobotSpec;
-using plane_test::SetWheelSpeeds;
-
-// Runs `seconds` of simulated time in control steps as the world would.
-void Simulate(DynamicsBackend* backend, Scene* scene, double seconds,
-              const std::function<void()>& after_step = {}) {
-  const int steps = static_cast<int>(std::lround(seconds / (kDt * kSubsteps)));
-  for (int i = 0; i < steps; ++i) {
-    backend->Step(scene, kDt, kSubsteps);
-    scene->UpdateWorldPoses();
-    if (after_step) after_step();
-  }
-}
+using namespace box2d::scene_kit;  // NOLINT: the scene helpers
 
 std::unique_ptr<DynamicsBackend> Build(const Scene& scene, const Options& options = {}) {
   auto backend = MakeBackend(options);
   backend->Build(scene, {});
   return backend;
 }
-
-double Yaw(const Scene& scene, ObjectId id) { return scene.world_pose(id).q.Yaw(); }
-Vec3 Position(const Scene& scene, ObjectId id) { return scene.world_pose(id).p; }
-
-// Wraps an angle difference into (-pi, pi].
-double AngleDiff(double a, double b) { return std::remainder(a - b, 2 * M_PI); }
 
 TEST(Box2dBackend, RegistersAsBox2d) {
   EXPECT_EQ(ModuleInfo().name, "box2d");

@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "modules/dynamics/box2d/plane_world.h"
+#include "modules/dynamics/box2d/plane_partition.h"
 #include "modules/dynamics/engine_backend.h"
 
 namespace swarmsim::box2d {
@@ -20,12 +20,13 @@ swarmsim::ModuleInfo ModuleInfo() {
 std::unique_ptr<DynamicsBackend> MakeBackend() { return MakeBackend(Options{}); }
 
 std::unique_ptr<DynamicsBackend> MakeBackend(const Options& options) {
-  return std::make_unique<dynamics::EngineBackend<PlaneWorld>>(options);
+  return std::make_unique<dynamics::EngineBackend<PartitionedPlaneWorld>>(options);
 }
 
 double TimeBareLoop(const Scene& scene, double dt, int substeps, int steps, const Options& options,
                     const DynamicsSettings& settings) {
-  return dynamics::TimeBareLoop<PlaneWorld>(scene, dt, substeps, steps, options, settings);
+  return dynamics::TimeBareLoop<PartitionedPlaneWorld>(scene, dt, substeps, steps, options,
+                                                       settings);
 }
 
 }  // namespace swarmsim::box2d

@@ -82,8 +82,52 @@
 // applies above 0.1 m/s whatever the scale. Scaling does not change float
 // precision in metres: 100 m from the origin a position resolves ~8 um.
 //
-// Determinism. Box2D runs on one thread in a fixed order; the world is built
-// in slot order, so the same scene and steps give bit-identical results.
+// Partitions (simulation.physics_partitions, DynamicsSettings::partitions;
+// plane_partition.h). With N > 1 the plane is cut into N strips across the
+// longer side of the bodies' bounding box at Build, borders placed so that
+// each strip holds the same number of body centres then (fixed until the
+// next rebuild; from the scene only, never from the thread count). Each strip
+// is its own Box2D world with the traction model above, owning the bodies
+// whose centre lies in it. `auto` (0): one strip per 500 bodies, at most 16
+// (under 1,000 bodies: one world). A world with belts or force sensors stays
+// one world (riders and welds are not split).
+//   - Static geometry (walls, obstacles, map voxels) is copied into every
+//     strip it reaches, widened by 1 m plus four of the largest body's radius:
+//     a wall across all strips is solid in each.
+//   - Ghosts: once per control step, after migration, each body within reach
+//     of another strip (its bounding radius + the largest body's + 1.5 x its
+//     speed bound x the step's duration + Box2D's AABB margin; the speed bound
+//     is its speed or its wheels' commanded surface speed, whichever is
+//     larger) gets a ghost there: a kinematic body with its fixtures. Before
+//     every substep each ghost takes its owner's pose and velocity as
+//     published after the previous substep (double-buffered by slot), and
+//     moves with that velocity during the substep. A ghost has infinite mass:
+//     two robots meeting on a border each see the other as a wall moving at
+//     its own velocity (they stop each other as in one world; momentum across
+//     a border is not exchanged exactly), and a robot pushing a crate across
+//     a border drives it through its ghost.
+//   - Migration: before each step's substeps (after scripts may have moved
+//     bodies), a body whose centre left its strip is moved to the strip
+//     holding it: re-created with the same fixtures, mass, pose (unwrapped
+//     angle), velocity, awake flag, wheels and ground friction, appended to
+//     that strip's bodies; in strip order then body order. Its contact warm
+//     starts and sleep timer start afresh.
+//   - Substeps: strips step concurrently (DynamicsSettings::scheduler,
+//     ParallelFor over strips); each reads only the published states and
+//     writes only its own bodies and its own slots of the next states, so
+//     which worker steps which strip never changes a bit. Everything between
+//     substeps (migration, ghost sets, write-back) runs on the caller in a
+//     fixed order.
+//   - HashState folds the strip count and, per strip in order, its body count
+//     and its state as below (contacts with ghosts included). One partition is
+//     exactly one world: the same hashes as before partitions existed.
+//   - Cost: bodies near borders are simulated twice (once as a ghost), and
+//     there is a barrier per substep. Measured on diffusion in worlds/README.md
+//     ("Physics partitions").
+//
+// Determinism. Box2D runs on one thread in a fixed order per world; the world
+// is built in slot order, so the same scene and steps give bit-identical
+// results.
 // Engine state that the scene does not mirror (float positions and unwrapped
 // angles, velocities, awake flags, contact warm-start impulses, friction
 // joint impulses) is folded by HashState.

@@ -120,6 +120,20 @@ struct PlaneRider {                     // 48 bytes
 
 using dynamics::HeightRange;  // height range [lo, hi] of shapes, m
 
+// A body's Box2D state as a region publishes it for the ghosts of it in
+// other regions (plane_partition.h). Box2D units; indexed by scene slot.
+struct PlaneBodyState {  // 28 bytes
+  float x = 0, y = 0, angle = 0;
+  float vx = 0, vy = 0, w = 0;
+  bool awake = false;
+};
+
+// A body of another region mirrored here (a kinematic body following it).
+struct PlaneGhost {
+  uint32_t slot = 0;  // the owner's scene slot
+  b2Body* body = nullptr;
+};
+
 class PlaneWorld {
  public:
   // For EngineBackend (engine_backend.h), which runs the step below.
@@ -153,6 +167,36 @@ class PlaneWorld {
 
   int body_count() const { return static_cast<int>(bodies_.size()); }
   int wheel_count() const { return static_cast<int>(wheels_.size()); }
+
+  // Regions (plane_partition.h drives them; plane_world_regions.cc).
+  // A world with only its ground body (no scene).
+  void BuildEmpty() { Reset(); }
+  // False when the world has what a region cannot split: belts (riders'
+  // friction is per belt) or force sensors (welds between bodies).
+  bool CanPartition() const { return belts_.empty() && force_sensors_.empty(); }
+  const std::vector<PlaneBody>& bodies() const { return bodies_; }
+  // Adds to this world's ground the ground fixtures of `from` whose AABB
+  // reaches into [lo, hi] along `axis` (0: x, 1: y), Box2D units.
+  void CopyGround(const PlaneWorld& from, int axis, double lo, double hi);
+  // Moves body `b` with its wheels, ground friction, pose record, velocity
+  // and awake state to the end of `to`'s bodies, leaving a hole here that
+  // Compact() closes. Contact warm starts of the body are lost.
+  void MoveBody(uint32_t b, PlaneWorld* to);
+  // Drops moved bodies, keeping the others in order.
+  void Compact();
+  // The largest speed the body may reach in this step, Box2D units/s: its
+  // speed or its wheels' commanded surface speed.
+  double SpeedBound(uint32_t b) const;
+  // Bounding radius of a body's fixtures about its origin, Box2D units.
+  static double BoundingRadius(const b2Body* body);
+  // Makes the ghosts exactly `wanted` (slot, owner body), sorted by slot:
+  // keeps those already there, destroys the others, creates the new ones.
+  void SetGhosts(const std::vector<std::pair<uint32_t, const b2Body*>>& wanted);
+  // Moves every ghost to its owner's published state (slot-indexed).
+  void RefreshGhosts(const PlaneBodyState* states);
+  // Publishes every body's state at states[slot].
+  void PublishStates(PlaneBodyState* states) const;
+  int ghost_count() const { return static_cast<int>(ghosts_.size()); }
 
  private:
   // Build's phases, in order. 0: a fresh b2World and its ground body.
@@ -214,7 +258,8 @@ class PlaneWorld {
     uint32_t slot;
   };
   std::vector<PlaneForceSensor> force_sensors_;
-  double last_dt_ = 0;  // s, of the last substep (for reaction forces)
+  double last_dt_ = 0;              // s, of the last substep (for reaction forces)
+  std::vector<PlaneGhost> ghosts_;  // sorted by slot
 };
 
 }  // namespace swarmsim::box2d

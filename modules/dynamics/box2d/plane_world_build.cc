@@ -224,6 +224,7 @@ void PlaneWorld::Reset() {
   belts_.clear();
   riders_.clear();
   force_sensors_.clear();
+  ghosts_.clear();
   b2BodyDef ground_def;
   ground_ = world_->CreateBody(&ground_def);
 }

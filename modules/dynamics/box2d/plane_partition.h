@@ -1,0 +1,66 @@
+// The box2d backend's world: the plane cut into regions (strips), each its own
+// PlaneWorld, stepped concurrently (see "Partitions" in box2d_backend.h for
+// the model). With one region it is exactly one PlaneWorld. Internal.
+#pragma once
+
+#include <array>
+#include <memory>
+#include <string_view>
+#include <vector>
+
+#include "framework/dynamics_backend.h"
+#include "modules/dynamics/box2d/plane_world.h"
+
+namespace swarmsim::box2d {
+
+class PartitionedPlaneWorld {
+ public:
+  // For EngineBackend (engine_backend.h).
+  using Options = box2d::Options;
+  static constexpr std::string_view kName = "box2d";
+  static constexpr bool kIdleWithoutSubsteps = false;
+
+  // `auto` (settings.partitions 0): one region per this many bodies...
+  static constexpr int kAutoBodiesPerRegion = 500;
+  // ...and at most this many regions.
+  static constexpr int kAutoMaxRegions = 16;
+
+  PartitionedPlaneWorld(const Options& options, const DynamicsSettings& settings);
+  ~PartitionedPlaneWorld();
+
+  void Build(const Scene& scene);
+  void MarkJoints(Scene* /*scene*/) const {}
+  void SyncFromScene(const Scene& scene, double duration);
+  // Commands, then (with regions) migration and the ghost sets for the step.
+  void ReadCommands(const Scene& scene);
+  void Substep(double dt, double fraction);
+  void WriteBack(Scene* scene);
+  void Hash(StateHasher* hasher) const;
+  int body_count() const;
+
+  // Regions in use (1 when the world could not be split), and ghosts now.
+  int region_count() const { return static_cast<int>(regions_.size()); }
+  int ghost_count() const;
+
+ private:
+  // The region holding a position along the axis, Box2D units.
+  int RegionOf(double position) const;
+  // Bodies whose centre left their region move to the one holding it, in
+  // region and body order.
+  void Migrate();
+  // Each body within reach of another region gets a ghost there.
+  void UpdateGhosts();
+
+  Options options_;
+  DynamicsSettings settings_;
+  std::vector<std::unique_ptr<PlaneWorld>> regions_;
+  int axis_ = 0;                 // 0: strips across x, 1: across y
+  std::vector<double> borders_;  // (regions - 1), ascending, Box2D units
+  double max_radius_ = 0;        // largest body's bounding radius, Box2D units
+  double duration_ = 0;          // s, of the current step
+  // Published body states by slot: substeps read one, write the other.
+  std::array<std::vector<PlaneBodyState>, 2> states_;
+  int current_ = 0;
+};
+
+}  // namespace swarmsim::box2d
