@@ -52,15 +52,33 @@
 // structural change; the backend then rebuilds from the scene, velocities
 // included. A script that sets a dynamic body's pose teleports it.
 //
-// Threads and determinism. Each backend owns its ODE world, collision space
-// (a hash space, deterministic for a given insertion order) and its own
-// self-threaded step implementation (worlds sharing ODE's default one crash
-// when stepped from two threads). ODE's random generator (used by the
-// quickstep solver) is process-global: Build seeds it with Options::seed, so
-// a run is repeatable, but two ODE worlds stepped concurrently in one process
-// are not (sweeps use processes). The scene's thread count does not matter:
-// the physics phase runs on one thread. That matters for meshes too: Debian's
-// ODE trimesh collision (OPCODE) is not thread-safe.
+// Spaces. Each robot (model instance) has its own dSimpleSpace holding all
+// its geoms; a sweep-and-prune space holds these sub-spaces and every geom
+// outside a robot (statics, loose dynamic objects, the environment map's
+// boxes, the ground plane). A robot's geoms are never paired with each other
+// (no self-collision), so its sub-space is only tested against others:
+// broadphase cost and memory grow with the robot count (ODE's hash space,
+// used before, keeps an n x n bit table of tested pairs: 10,000 hexapods
+// ended in an ODE assertion after 8.6 GB).
+//
+// Threads and determinism. A substep finds the candidate geom pairs on the
+// calling thread (the spaces' order is deterministic for a given insertion
+// order), computes every pair's contact points concurrently on the world's
+// workers (DynamicsSettings::scheduler; each pair writes only its own
+// slots), then creates the contact joints in pair order and runs the solver
+// on the calling thread: the same joints in the same order for any thread
+// count. The solver stays on one thread: ODE's quickstep reorders its rows
+// with dRandInt, one process-global, unsynchronized seed, and ODE's own
+// multi-threaded island stepping (tried: dThreadingAllocateThreadPool with
+// dWorldSetStepIslandsProcessingMaxThreadCount) gave different states at 3
+// and 4 threads, and between two runs at 4 threads, even with dRandInt made
+// a pure function. Each backend owns its ODE world and its own self-threaded
+// step implementation (worlds sharing ODE's default one crash when stepped
+// from two threads). Build seeds ODE's random generator with Options::seed,
+// so a run is repeatable, but two ODE worlds stepped concurrently in one
+// process are not (sweeps use processes). Meshes: Debian's ODE trimesh
+// collision (OPCODE) is not thread-safe, so a world with a mesh finds its
+// contact points on the calling thread too.
 //
 // Meshes. A mesh shape is a dTriMesh geom; its trimesh data is made once per
 // asset per world and reads the shared asset's arrays in place. A dynamic

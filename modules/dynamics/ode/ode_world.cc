@@ -11,6 +11,7 @@
 
 #include "framework/error.h"
 #include "framework/scene.h"
+#include "framework/scheduler.h"
 #include "framework/state_hash.h"
 #include "modules/dynamics/environment_obstacles.h"
 #include "modules/dynamics/scene_walk.h"
@@ -181,10 +182,10 @@ OdeWorld::OdeWorld(const Options& options, const DynamicsSettings& settings)
     : options_(options), settings_(settings) {
   if (!std::isfinite(settings_.gravity))
     throw Error("ode: gravity must be a finite number, got " + std::to_string(settings_.gravity));
-  if (options_.max_contacts < 1 || options_.iterations < 0)
-    throw Error("ode: max_contacts must be >= 1 and iterations >= 0");
+  // dCollide takes the contact count in the low 16 bits of its flags.
+  if (options_.max_contacts < 1 || options_.max_contacts > 0xffff || options_.iterations < 0)
+    throw Error("ode: max_contacts must be in 1..65535 and iterations >= 0");
   InitOdeOnce();
-  contact_buffer_.resize(static_cast<size_t>(options_.max_contacts));
 }
 
 OdeWorld::~OdeWorld() { Clear(); }
@@ -221,6 +222,9 @@ void OdeWorld::Clear() {
   feedback_.clear();
   geom_info_.clear();
   surfaces_.clear();
+  instance_spaces_.clear();  // destroyed with space_
+  pairs_.clear();
+  has_meshes_ = false;
   commands_.clear();
 }
 
@@ -252,6 +256,7 @@ dTriMeshDataID OdeWorld::MeshData(const std::shared_ptr<const TriangleMesh>& mes
   for (const auto& [known, data] : meshes_)
     if (known == mesh) return data;
   // Few distinct meshes per world: a linear search is fine.
+  has_meshes_ = true;
   dTriMeshDataID data = dGeomTriMeshDataCreate();
   std::span<const MeshTriangle> triangles = mesh->triangles();
   if (triangles.size() == 1) {
@@ -274,7 +279,7 @@ void OdeWorld::Build(const Scene& scene) {
   const std::vector<EnvironmentBox> map_boxes =
       dynamics::EnvironmentObstacles(scene, dynamics::DynamicHeightRange(scene), false);
   // 0. A fresh ODE world, collision space and contact group (and the ground plane).
-  CreateWorld(scene, map_boxes.size());
+  CreateWorld();
   // 1. A body per dynamic shape, in slot order.
   std::vector<dBodyID> body_of(scene.slot_count(), nullptr);  // dynamic or kinematic body (slots)
   BuildBodies(scene, &body_of);
@@ -300,7 +305,15 @@ void OdeWorld::Build(const Scene& scene) {
   commands_.assign(joints_.size(), JointData{});
 }
 
-void OdeWorld::CreateWorld(const Scene& scene, size_t map_boxes) {
+dSpaceID OdeWorld::SpaceOf(int32_t instance) {
+  if (instance < 0) return space_;
+  const size_t i = static_cast<size_t>(instance);
+  if (i >= instance_spaces_.size()) instance_spaces_.resize(i + 1, nullptr);
+  if (!instance_spaces_[i]) instance_spaces_[i] = dSimpleSpaceCreate(space_);
+  return instance_spaces_[i];
+}
+
+void OdeWorld::CreateWorld() {
   Clear();
   dAllocateODEDataForThread(dAllocateMaskAll);
   dRandSetSeed(options_.seed);
@@ -314,19 +327,14 @@ void OdeWorld::CreateWorld(const Scene& scene, size_t map_boxes) {
   dWorldSetQuickStepNumIterations(world_, std::max(1, options_.iterations));
   dWorldSetContactSurfaceLayer(world_, 1e-4);
   dWorldSetContactMaxCorrectingVel(world_, 10);
-  // ODE's hash space keeps an n x n bit table of the pairs it tested (n
-  // geoms): 12 MB cleared every substep at 10,000 geoms, and past ~46,000
-  // its int index overflows (an internal assertion). Large scenes use sweep
-  // and prune instead, and so do scenes with an environment map: its merged
-  // boxes (walls tens of metres long) sit in the hash space's top levels and
-  // are tested against every geom (100 foot-bots in geb079.bt: 173 us per
-  // robot and step in the hash space, 80 in sweep and prune, as without the
-  // map). The choice depends on the scene alone, never on the thread count;
-  // below the limit and without a map, results are those of the hash space.
-  constexpr size_t kHashSpaceMaxGeoms = 8192;
-  space_ = map_boxes == 0 && scene.shapes().size() <= kHashSpaceMaxGeoms
-               ? dHashSpaceCreate(nullptr)
-               : dSweepAndPruneSpaceCreate(nullptr, dSAP_AXES_XYZ);
+  // Spaces (see ode_world.h): a sweep-and-prune space over the robots'
+  // sub-spaces (one dSimpleSpace per model instance, created on its first
+  // geom) and the geoms outside any robot (statics, loose dynamic objects,
+  // the ground plane). A robot's geoms are never paired with each other (no
+  // self-collision), so its sub-space only ever meets other geoms. Memory
+  // and broadphase cost grow with the robot count, not its square (ODE's
+  // hash space keeps an n x n bit table of tested pairs).
+  space_ = dSweepAndPruneSpaceCreate(nullptr, dSAP_AXES_XYZ);
   contacts_ = dJointGroupCreate(0);
   if (options_.ground_plane) {
     AddGeom(dCreatePlane(space_, 0, 0, 1, 0), -1, options_.ground_friction, 0);
@@ -343,7 +351,9 @@ void OdeWorld::BuildBodies(const Scene& scene, std::vector<dBodyID>* body_of) {
       throw Error("ode: dynamic shape '" + PathAt(scene, s) + "' needs a positive mass (got " +
                   std::to_string(shape->mass) + " kg)");
     // A shape that is not collidable carries its mass without a geom.
-    dGeomID geom = shape->collidable ? MakeGeom(space_, *shape, MeshData(shape->mesh)) : nullptr;
+    dGeomID geom = shape->collidable
+                       ? MakeGeom(SpaceOf(scene.instance_of_at(s)), *shape, MeshData(shape->mesh))
+                       : nullptr;
     if (!geom && shape->collidable)
       throw Error("ode: dynamic shape '" + PathAt(scene, s) + "' needs a positive size");
     dBodyID body = dBodyCreate(world_);
@@ -371,7 +381,7 @@ void OdeWorld::BuildNonDynamicShapes(const Scene& scene, std::vector<dBodyID>* b
     const Pose& X_WS = scene.world_pose_at(s);
     if (!IsFinite(X_WS)) throw Error("ode: shape '" + PathAt(scene, s) + "' has a non-finite pose");
     const Carrier carrier = CarrierOf(scene, *body_of, s);
-    dGeomID geom = MakeGeom(space_, *shape, MeshData(shape->mesh));
+    dGeomID geom = MakeGeom(SpaceOf(scene.instance_of_at(s)), *shape, MeshData(shape->mesh));
     if (!geom) continue;  // a zero-size decoration: nothing to collide with
     AddGeom(geom, scene.instance_of_at(s), shape->friction, shape->restitution);
     AddSurface(*shape, s);
@@ -577,7 +587,14 @@ void OdeWorld::StepOnce(double dt, double fraction) {
     dBodySetAngularVel(k.body, k.w_WB.x, k.w_WB.y, k.w_WB.z);
   }
   ApplyMotors(dt);
+  // Broadphase on this thread: the candidate geom pairs, in the space's
+  // (deterministic) order. Then each pair's contact points, concurrently
+  // (each pair writes only its own slots), and the contact joints in pair
+  // order: the same joints in the same order for any thread count.
+  pairs_.clear();
   dSpaceCollide(space_, this, &OdeWorld::NearCallback);
+  FindContacts();
+  for (size_t k = 0; k < pairs_.size(); ++k) AddContacts(k);
   if (options_.iterations > 0)
     dWorldQuickStep(world_, dt);
   else
@@ -587,7 +604,14 @@ void OdeWorld::StepOnce(double dt, double fraction) {
 }
 
 void OdeWorld::NearCallback(void* data, dGeomID a, dGeomID b) {
-  static_cast<OdeWorld*>(data)->Collide(a, b);
+  OdeWorld* self = static_cast<OdeWorld*>(data);
+  // A robot's sub-space against a geom or another robot's: their geoms
+  // pairwise (never a robot's geoms with each other).
+  if (dGeomIsSpace(a) || dGeomIsSpace(b)) {
+    dSpaceCollide2(a, b, data, &OdeWorld::NearCallback);
+    return;
+  }
+  self->Collide(a, b);
 }
 
 void OdeWorld::Collide(dGeomID a, dGeomID b) {
@@ -600,7 +624,36 @@ void OdeWorld::Collide(dGeomID a, dGeomID b) {
   const GeomInfo& ib = geom_info_[reinterpret_cast<uintptr_t>(dGeomGetData(b)) - 1];
   if (ia.instance >= 0 && ia.instance == ib.instance) return;
   if (ba && bb && dAreConnectedExcluding(ba, bb, dJointTypeContact)) return;
-  const int n = dCollide(a, b, options_.max_contacts, &contact_buffer_[0].geom, sizeof(dContact));
+  pairs_.push_back({a, b, 0});
+}
+
+void OdeWorld::FindContacts() {
+  const size_t m = static_cast<size_t>(options_.max_contacts);
+  if (pair_contacts_.size() < pairs_.size() * m) pair_contacts_.resize(pairs_.size() * m);
+  auto narrow = [this, m](int64_t begin, int64_t end) {
+    dAllocateODEDataForThread(dAllocateMaskAll);
+    for (int64_t k = begin; k < end; ++k) {
+      CandidatePair& pair = pairs_[static_cast<size_t>(k)];
+      pair.count = dCollide(pair.a, pair.b, options_.max_contacts,
+                            &pair_contacts_[static_cast<size_t>(k) * m], sizeof(dContactGeom));
+    }
+  };
+  // Debian's trimesh collider (OPCODE) is not thread-safe: worlds with
+  // meshes find their contacts on this thread.
+  constexpr int64_t kGrain = 256;
+  const int64_t n = static_cast<int64_t>(pairs_.size());
+  if (settings_.scheduler && !has_meshes_)
+    settings_.scheduler->ParallelFor(0, n, kGrain, narrow);
+  else
+    narrow(0, n);
+}
+
+void OdeWorld::AddContacts(size_t k) {
+  const CandidatePair& pair = pairs_[k];
+  const dGeomID a = pair.a, b = pair.b;
+  dBodyID ba = dGeomGetBody(a), bb = dGeomGetBody(b);
+  const GeomInfo& ia = geom_info_[reinterpret_cast<uintptr_t>(dGeomGetData(a)) - 1];
+  const GeomInfo& ib = geom_info_[reinterpret_cast<uintptr_t>(dGeomGetData(b)) - 1];
   const double mu = std::sqrt(ia.friction * ib.friction);
   const double bounce = std::max(ia.restitution, ib.restitution);
   // Moving surfaces (conveyor belts): friction drives the contact towards
@@ -610,8 +663,10 @@ void OdeWorld::Collide(dGeomID a, dGeomID b) {
   // constrains (v_1 - v_2) . fdir1 = motion1 where body 1 is a's body, or
   // b's when a has none (a static belt: ODE then swaps the two).
   const bool moving = ia.surface >= 0 || ib.surface >= 0;
-  for (int i = 0; i < n; ++i) {
-    dContact& c = contact_buffer_[i];
+  const size_t first = k * static_cast<size_t>(options_.max_contacts);
+  for (int i = 0; i < pair.count; ++i) {
+    dContact c{};
+    c.geom = pair_contacts_[first + static_cast<size_t>(i)];
     c.surface.mode = dContactApprox1 | (bounce > 0 ? dContactBounce : 0);
     c.surface.mu = mu;
     c.surface.bounce = bounce;

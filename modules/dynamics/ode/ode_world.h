@@ -104,10 +104,10 @@ class OdeWorld {
 
  private:
   void Clear();
-  // Build's phases, in order. 0: a fresh world, space, contact group and
-  // ground plane (the space's kind depends on the scene's size and on
-  // whether the environment map adds boxes).
-  void CreateWorld(const Scene& scene, size_t map_boxes);
+  // Build's phases, in order. 0: a fresh world, its spaces (sweep and prune
+  // over the robots' sub-spaces and the other geoms), contact group and
+  // ground plane.
+  void CreateWorld();
   // 1. A body and geom per dynamic shape, in slot order; fills body_of (slots).
   void BuildBodies(const Scene& scene, std::vector<dBodyID>* body_of);
   // 2. A geom per other shape: a part of a body, a kinematic body (added to
@@ -131,8 +131,12 @@ class OdeWorld {
   dTriMeshDataID MeshData(const std::shared_ptr<const TriangleMesh>& mesh);
   void ApplyMotors(double dt);
   void TrackJointPositions();
+  // The space holding the geoms of `instance` (the top-level space for -1).
+  dSpaceID SpaceOf(int32_t instance);
   static void NearCallback(void* data, dGeomID a, dGeomID b);
-  void Collide(dGeomID a, dGeomID b);
+  void Collide(dGeomID a, dGeomID b);  // records a candidate pair
+  void FindContacts();                 // dCollide per pair, concurrently
+  void AddContacts(size_t pair);       // its contact joints
 
   Options options_;
   DynamicsSettings settings_;
@@ -147,7 +151,17 @@ class OdeWorld {
   std::vector<std::unique_ptr<dJointFeedback>> feedback_;  // (force_sensors_), stable addresses
   std::vector<GeomInfo> geom_info_;                        // indexed by the geom's data (index + 1)
   std::vector<MovingSurface> surfaces_;                    // slot order
-  std::vector<dContact> contact_buffer_;
+  // Each model instance's dSimpleSpace inside space_ (SpaceOf), or null.
+  std::vector<dSpaceID> instance_spaces_;
+  // A substep's candidate geom pairs (broadphase order) and their contact
+  // points: pair k's in [k * max_contacts, + count).
+  struct CandidatePair {
+    dGeomID a, b;
+    int count;
+  };
+  std::vector<CandidatePair> pairs_;
+  std::vector<dContactGeom> pair_contacts_;
+  bool has_meshes_ = false;  // a trimesh geom: contacts on one thread (OPCODE)
   // Mesh assets in use and their trimesh data (ODE reads the asset's arrays in place).
   std::vector<std::pair<std::shared_ptr<const TriangleMesh>, dTriMeshDataID>> meshes_;
   // Index buffers of one-triangle meshes, doubled (MeshData); ODE points at them.
