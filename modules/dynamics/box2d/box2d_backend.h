@@ -88,8 +88,8 @@
 // each strip holds the same number of body centres then (fixed until the
 // next rebuild; from the scene only, never from the thread count). Each strip
 // is its own Box2D world with the traction model above, owning the bodies
-// whose centre lies in it. `auto` (0): one strip per 500 bodies, at most 16
-// (under 1,000 bodies: one world). A world with belts or force sensors stays
+// whose centre lies in it. `auto` (0): one strip per 250 bodies, at most 16
+// (under 500 bodies: one world). A world with belts or force sensors stays
 // one world (riders and welds are not split).
 //   - Static geometry (walls, obstacles, map voxels) is copied into every
 //     strip it reaches, widened by 1 m plus four of the largest body's radius:

@@ -21,7 +21,7 @@ class PartitionedPlaneWorld {
   static constexpr bool kIdleWithoutSubsteps = false;
 
   // `auto` (settings.partitions 0): one region per this many bodies...
-  static constexpr int kAutoBodiesPerRegion = 500;
+  static constexpr int kAutoBodiesPerRegion = 250;
   // ...and at most this many regions.
   static constexpr int kAutoMaxRegions = 16;
 
