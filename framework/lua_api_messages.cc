@@ -29,6 +29,7 @@
 #include "framework/error.h"
 #include "framework/lua_api.h"
 #include "framework/messaging.h"
+#include "framework/plugin_controllers.h"
 #include "framework/world.h"
 
 namespace swarmsim {
@@ -88,8 +89,16 @@ int SendLocalMessage(lua_State* L) {
 int SendDirectMessage(lua_State* L) {
   const ObjectId target = CheckObject(L, 1);
   const Scene& scene = *Context(L).scene;
-  if (!scene.IsValid(target) || scene.script(target) == nullptr)
-    throw Error("object " + std::to_string(target.ToInteger()) + " carries no script");
+  // A script reads it, or the native controller of the robot it is the root of.
+  const auto native_root = [&] {
+    PluginControllers* controllers = Context(L).world->plugin_controllers();
+    const int robot = scene.instance_of(target);
+    return controllers != nullptr && robot >= 0 && scene.instance(robot).root == target &&
+           controllers->type_of(robot) != nullptr;
+  };
+  if (!scene.IsValid(target) || (scene.script(target) == nullptr && !native_root()))
+    throw Error("object " + std::to_string(target.ToInteger()) +
+                " carries no script (nor is it the root of a robot with a native controller)");
   Send(L, MessageScope::kDirect, CheckData(L, 2), target);
   return 0;
 }

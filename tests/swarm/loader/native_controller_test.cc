@@ -65,6 +65,7 @@ function sysCall_actuation()
   end
   print('got ' .. count)
   sim.sendGlobalMessage('hi')
+  if DIRECT then sim.sendDirectMessage(sim.getObject('/bot#0'), 'hi') end
   if step == 1 and COPY then
     sim.copyModel(sim.getObject('/bot#0'))
     sim.removeModel(sim.getObject('/bot#1'))
@@ -152,6 +153,18 @@ TEST_F(NativeControllerTest, NativeAndLuaRobotsExchangeMessagesTheStepAfter) {
   for (int r = 0; r < 4; ++r) EXPECT_EQ(WheelTarget(world, "bot#" + std::to_string(r)), 4);
   const std::vector<std::string> expected = {"[luabot#4] got 0", "[luabot#4] got 4"};
   EXPECT_EQ(log, expected);
+}
+
+TEST_F(NativeControllerTest, ALuaScriptSendsADirectMessageToANativeRobot) {
+  Write("luabot.lua", std::string("DIRECT = true\n") + kLuaBotLua);
+  LoadedWorld w = LoadNative(WorldText("    native_controller: relay\n", 4, 1), 1, nullptr);
+  World& world = *w.world;
+  world.Start();
+  world.Step();
+  world.Step();
+  // bot#0 got the Lua robot's direct greeting on top of the 4 global ones.
+  EXPECT_EQ(WheelTarget(world, "bot#0"), 5);
+  for (int r = 1; r < 4; ++r) EXPECT_EQ(WheelTarget(world, "bot#" + std::to_string(r)), 4);
 }
 
 TEST_F(NativeControllerTest, KeptScriptsRunFirstAndTheControllerAfterThem) {
