@@ -5,9 +5,13 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
+#include <string>
+#include <string_view>
 #include <vector>
 
+#include "framework/error.h"
 #include "framework/scene.h"
 
 namespace swarmsim::dynamics {
@@ -58,6 +62,25 @@ inline std::vector<uint32_t> ForceSensorRowsInSlotOrder(const Scene& scene) {
   std::sort(rows.begin(), rows.end(),
             [&](uint32_t a, uint32_t b) { return owners[a] < owners[b]; });
   return rows;
+}
+
+// The scene path of the object in `slot`, for messages.
+inline std::string PathAt(const Scene& scene, uint32_t slot) {
+  return scene.PathOf(scene.IdAt(slot));
+}
+
+// Refuses a body whose pose is not finite: "<engine>: shape '/a/b' has a
+// non-finite pose".
+inline void ThrowIfNotFinite(std::string_view engine, const Scene& scene, uint32_t slot,
+                             const Pose& X) {
+  for (double v : {X.p.x, X.p.y, X.p.z, X.q.w, X.q.x, X.q.y, X.q.z})
+    if (!std::isfinite(v)) {
+      std::string message(engine);
+      message += ": shape '";
+      message += PathAt(scene, slot);
+      message += "' has a non-finite pose";
+      throw Error(message);
+    }
 }
 
 }  // namespace swarmsim::dynamics

@@ -26,7 +26,9 @@ namespace {
 
 using dynamics::CalcHeightRange;
 using dynamics::kHeightOverlap;
+using dynamics::PathAt;
 using dynamics::ShapeAt;
+using dynamics::ThrowIfNotFinite;
 
 // A shape whose z axis is this close to vertical is "upright".
 constexpr double kUprightTolerance = 1e-6;
@@ -146,15 +148,6 @@ bool MeshPolygons(const TriangleMesh& mesh, const Pose& X, double L,
   return HullPolygons(std::move(points), out);
 }
 
-std::string PathAt(const Scene& scene, uint32_t slot) { return scene.PathOf(scene.IdAt(slot)); }
-
-void ThrowIfNotFinite(const Scene& scene, uint32_t slot, const Pose& X) {
-  const double values[] = {X.p.x, X.p.y, X.p.z, X.q.w, X.q.x, X.q.y, X.q.z};
-  for (double v : values)
-    if (!std::isfinite(v))
-      throw Error("box2d: shape '" + PathAt(scene, slot) + "' has a non-finite pose");
-}
-
 // The fixtures of a dynamic shape's body, in its plane frame, L units per
 // metre. The fixture's density gives the body the shape's mass (Box2D
 // ignores the polygon skin in its mass); the caller then sets the inertia to
@@ -236,7 +229,7 @@ HeightRange PlaneWorld::BuildBodies(const Scene& scene, std::vector<int32_t>* bo
     const ShapeData* shape = ShapeAt(scene, s);
     if (!shape || !shape->dynamic) continue;
     const Pose& X_WS = scene.world_pose_at(s);
-    ThrowIfNotFinite(scene, s, X_WS);
+    ThrowIfNotFinite("box2d", scene, s, X_WS);
     const bool box = shape->kind == ShapeKind::kBox;
     if (!(shape->mass > 0) || !(shape->size.x > 0) || (box && !(shape->size.y > 0)) ||
         !std::isfinite(shape->mass))
@@ -292,7 +285,7 @@ void PlaneWorld::BuildObstacles(const Scene& scene, const std::vector<int32_t>& 
     // A moving surface (a belt) carries bodies: no obstacle (BuildBelts).
     if (shape->HasMovingSurface()) continue;
     const Pose& X_WS = scene.world_pose_at(s);
-    ThrowIfNotFinite(scene, s, X_WS);
+    ThrowIfNotFinite("box2d", scene, s, X_WS);
     const HeightRange range = CalcHeightRange(*shape, X_WS);
     if (range.hi <= dynamic_range.lo + kHeightOverlap ||
         range.lo >= dynamic_range.hi - kHeightOverlap)

@@ -48,13 +48,8 @@ void InitOdeOnce() {
   });
 }
 
-std::string PathAt(const Scene& scene, uint32_t slot) { return scene.PathOf(scene.IdAt(slot)); }
-
-bool IsFinite(const Pose& X) {
-  return std::isfinite(X.p.x) && std::isfinite(X.p.y) && std::isfinite(X.p.z) &&
-         std::isfinite(X.q.w) && std::isfinite(X.q.x) && std::isfinite(X.q.y) &&
-         std::isfinite(X.q.z);
-}
+using dynamics::PathAt;
+using dynamics::ThrowIfNotFinite;
 
 void SetBodyPose(dBodyID body, const Pose& X) {
   dBodySetPosition(body, X.p.x, X.p.y, X.p.z);
@@ -346,7 +341,7 @@ void OdeWorld::BuildBodies(const Scene& scene, std::vector<dBodyID>* body_of) {
     const ShapeData* shape = ShapeAt(scene, s);
     if (!shape || !shape->dynamic) continue;
     const Pose& X_WS = scene.world_pose_at(s);
-    if (!IsFinite(X_WS)) throw Error("ode: shape '" + PathAt(scene, s) + "' has a non-finite pose");
+    ThrowIfNotFinite("ode", scene, s, X_WS);
     if (!(shape->mass > 0) || !std::isfinite(shape->mass))
       throw Error("ode: dynamic shape '" + PathAt(scene, s) + "' needs a positive mass (got " +
                   std::to_string(shape->mass) + " kg)");
@@ -379,7 +374,7 @@ void OdeWorld::BuildNonDynamicShapes(const Scene& scene, std::vector<dBodyID>* b
     const ShapeData* shape = ShapeAt(scene, s);
     if (!shape || shape->dynamic || !shape->collidable) continue;
     const Pose& X_WS = scene.world_pose_at(s);
-    if (!IsFinite(X_WS)) throw Error("ode: shape '" + PathAt(scene, s) + "' has a non-finite pose");
+    ThrowIfNotFinite("ode", scene, s, X_WS);
     const Carrier carrier = CarrierOf(scene, *body_of, s);
     dGeomID geom = MakeGeom(SpaceOf(scene.instance_of_at(s)), *shape, MeshData(shape->mesh));
     if (!geom) continue;  // a zero-size decoration: nothing to collide with

@@ -25,7 +25,9 @@ namespace {
 using dynamics::CalcHeightRange;
 using dynamics::HeightRange;
 using dynamics::kHeightOverlap;
+using dynamics::PathAt;
 using dynamics::ShapeAt;
+using dynamics::ThrowIfNotFinite;
 
 // Bodies per task of a parallel pass.
 constexpr int64_t kGrain = 128;
@@ -35,8 +37,6 @@ constexpr double kUprightTolerance = 1e-6;
 bool IsUpright(const Pose& X_WS) {
   return std::abs(X_WS.q.Rotate({0, 0, 1}).z) > 1 - kUprightTolerance;
 }
-
-std::string PathAt(const Scene& scene, uint32_t slot) { return scene.PathOf(scene.IdAt(slot)); }
 
 // A largest value over threads, independent of their order (non-negative
 // doubles compare like their bit patterns).
@@ -115,9 +115,7 @@ void PlanarWorld::Build(const Scene& scene) {
     const ShapeData* shape = ShapeAt(scene, s);
     if (!shape || !shape->dynamic) continue;
     const Pose& X_WS = scene.world_pose_at(s);
-    for (double v : {X_WS.p.x, X_WS.p.y, X_WS.p.z, X_WS.q.w, X_WS.q.x, X_WS.q.y, X_WS.q.z})
-      if (!std::isfinite(v))
-        throw Error("planar: shape '" + PathAt(scene, s) + "' has a non-finite pose");
+    ThrowIfNotFinite("planar", scene, s, X_WS);
     PlaneShape body;
     if (shape->kind == ShapeKind::kBox) {
       body.box = true;
