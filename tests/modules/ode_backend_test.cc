@@ -7,6 +7,7 @@
 #include <cmath>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "framework/error.h"
 #include "framework/registry.h"
@@ -314,6 +315,48 @@ TEST(OdeBackend, StateHashIsEqualAtOneAndTwoThreads) {
   const uint64_t one = RunWheeledSwarm(1);
   EXPECT_EQ(RunWheeledSwarm(1), one);
   EXPECT_EQ(RunWheeledSwarm(2), one);
+}
+
+// Four towers of eight boxes with spheres dropped on them: each tower is one
+// island of eight bodies and a few dozen contacts, solved by the threaded
+// solver's multi-threaded path; loose spheres are islands of their own.
+struct Towers {
+  std::vector<Pose> poses;  // every box and sphere, after the run
+  uint64_t hash = 0;
+};
+Towers RunTowers(int threads) {
+  Fixture f(0.01, 2, 9.81, "ode", threads);
+  std::vector<ObjectId> bodies;
+  for (int t = 0; t < 4; ++t)
+    for (int level = 0; level < 8; ++level)
+      bodies.push_back(f.scene().AddShape("box", {}, {{1.0 * t, 0, 0.05 + 0.1 * level}, {}},
+                                          Box({0.1, 0.1, 0.1}, true, 0.5)));
+  for (int s = 0; s < 12; ++s)
+    bodies.push_back(f.scene().AddShape(
+        "ball", {}, {{0.02 + 0.25 * s, 0.03 * (s % 3), 1.2 + 0.05 * s}, {}}, Sphere(0.04, true)));
+  for (int i = 0; i < 300; ++i) f.world->Step();  // 3 s: the spheres land and the towers settle
+  Towers out;
+  for (ObjectId id : bodies) out.poses.push_back(f.scene().world_pose(id));
+  out.hash = f.world->StateHash();
+  return out;
+}
+
+TEST(OdeBackend, TowersOfBoxesStandAndAreBitIdenticalAtOneToFourThreads) {
+  const Towers one = RunTowers(1);
+  for (int t = 0; t < 4; ++t) {  // each tower still stands, its top box where it began
+    const Pose& top = one.poses[static_cast<size_t>(t * 8 + 7)];
+    EXPECT_NEAR(top.p.x, 1.0 * t, 0.02) << "tower " << t;
+    EXPECT_NEAR(top.p.z, 0.75, 0.01) << "tower " << t;
+  }
+  for (int threads : {2, 3, 4}) {
+    const Towers other = RunTowers(threads);
+    EXPECT_EQ(other.hash, one.hash) << threads << " threads";
+    for (size_t i = 0; i < one.poses.size(); ++i) {
+      ASSERT_EQ(other.poses[i].p.x, one.poses[i].p.x) << "body " << i << ", " << threads;
+      ASSERT_EQ(other.poses[i].p.z, one.poses[i].p.z) << "body " << i << ", " << threads;
+      ASSERT_EQ(other.poses[i].q.w, one.poses[i].q.w) << "body " << i << ", " << threads;
+    }
+  }
 }
 
 TEST(OdeBackend, KinematicPlatformLiftsADynamicBall) {

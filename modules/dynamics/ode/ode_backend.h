@@ -62,23 +62,24 @@
 // ended in an ODE assertion after 8.6 GB).
 //
 // Threads and determinism. A substep finds the candidate geom pairs on the
-// calling thread (the spaces' order is deterministic for a given insertion
-// order), computes every pair's contact points concurrently on the world's
-// workers (DynamicsSettings::scheduler; each pair writes only its own
-// slots), then creates the contact joints in pair order and runs the solver
-// on the calling thread: the same joints in the same order for any thread
-// count. The solver stays on one thread: ODE's quickstep reorders its rows
-// with dRandInt, one process-global, unsynchronized seed, and ODE's own
-// multi-threaded island stepping (tried: dThreadingAllocateThreadPool with
-// dWorldSetStepIslandsProcessingMaxThreadCount) gave different states at 3
-// and 4 threads, and between two runs at 4 threads, even with dRandInt made
-// a pure function. Each backend owns its ODE world and its own self-threaded
-// step implementation (worlds sharing ODE's default one crash when stepped
-// from two threads). Build seeds ODE's random generator with Options::seed,
-// so a run is repeatable, but two ODE worlds stepped concurrently in one
-// process are not (sweeps use processes). Meshes: Debian's ODE trimesh
-// collision (OPCODE) is not thread-safe, so a world with a mesh finds its
-// contact points on the calling thread too.
+// calling thread, puts them in the geoms' build order (the spaces' own order
+// depends on the order the solver last moved the geoms), computes every
+// pair's contact points concurrently on the world's workers
+// (DynamicsSettings::scheduler; each pair writes only its own slots), then
+// creates the contact joints in pair order. The solver then steps ODE's
+// islands (bodies linked by joints and contacts: a robot, or robots touching)
+// concurrently on the run's threads through our own ODE threading
+// implementation (ode_threading.h), which keeps each island's work on one
+// thread: ODE's own pool splits an island's constraint rows over threads in
+// an order that depends on timing. ODE's quickstep shuffles an island's rows
+// with dRandInt, ODE's process-global random generator; the program defines
+// its own dRandInt (ode_world.cc), a fixed function, so the shuffles do not
+// depend on the order the islands are stepped in, and checks at start-up that
+// ODE calls it (if not, the solver runs on one thread). The state is
+// bit-identical for any thread count, 1 included. Each backend owns its ODE
+// world and its solver threads. Meshes: Debian's ODE trimesh collision
+// (OPCODE) is not thread-safe, so a world with a mesh finds its contact
+// points on the calling thread.
 //
 // Meshes. A mesh shape is a dTriMesh geom; its trimesh data is made once per
 // asset per world and reads the shared asset's arrays in place. A dynamic

@@ -1,6 +1,7 @@
 #include "modules/dynamics/ode/ode_world.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdarg>
 #include <cstdint>
@@ -14,7 +15,40 @@
 #include "framework/scheduler.h"
 #include "framework/state_hash.h"
 #include "modules/dynamics/environment_obstacles.h"
+#include "modules/dynamics/ode/ode_threading.h"
 #include "modules/dynamics/scene_walk.h"
+
+namespace swarmsim::ode {
+namespace {
+uint64_t Mix64(uint64_t z) {  // splitmix64's finalizer
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+// Set when ODE calls the dRandInt below (ProbeSolverShuffle).
+std::atomic<bool> g_shuffle_called{false};
+}  // namespace
+}  // namespace swarmsim::ode
+
+// ODE's quickstep shuffles its constraint rows (every 8th iteration, per
+// island) with `swap(order[i], order[dRandInt(i + 1)])`, and dRandInt is
+// ODE's only use of its random generator: one process-global seed. Stepped
+// islands on several threads, the draws interleave in whatever order the
+// threads run, so the state would depend on the thread count and timing.
+// This definition takes the place of ODE's (the program's own definition of
+// an exported function comes first when libode's call is bound, the usual
+// ELF rule): the draw is a fixed function of n, so each shuffle is the same
+// permutation of its rows whichever thread makes it, when, and in which
+// island. The rows are still mixed (what the shuffle is for); they are mixed
+// the same way every step. InitOdeOnce checks that ODE calls this one
+// (ProbeSolverShuffle); if not, the solver stays on one thread.
+extern "C" __attribute__((visibility("default"))) int dRandInt(int n) {
+  std::atomic<bool>& called = swarmsim::ode::g_shuffle_called;
+  if (!called.load(std::memory_order_relaxed)) called.store(true, std::memory_order_relaxed);
+  if (n <= 1) return 0;
+  const uint64_t z = swarmsim::ode::Mix64(static_cast<uint64_t>(n) * 0x9e3779b97f4a7c15ULL);
+  return static_cast<int>(((z >> 32) * static_cast<uint64_t>(n)) >> 32);
+}
 
 namespace swarmsim::ode {
 
@@ -39,12 +73,43 @@ constexpr double kServoGain = 0.5;
               " (the physics cannot go on; an object moved or grew to extreme values?)");
 }
 
+// Whether ODE's quickstep draws its constraint shuffles from the dRandInt
+// defined below. Steps a small world once (a chain of three bodies, nine
+// iterations, so that the rows are shuffled) and looks.
+bool ProbeSolverShuffle() {
+  dWorldID world = dWorldCreate();
+  dThreadingImplementationID threading = dThreadingAllocateSelfThreadedImplementation();
+  dWorldSetStepThreadingImplementation(world, dThreadingImplementationGetFunctions(threading),
+                                       threading);
+  dWorldSetQuickStepNumIterations(world, 9);
+  dBodyID previous = nullptr;
+  for (int i = 0; i < 3; ++i) {
+    dBodyID body = dBodyCreate(world);
+    dBodySetPosition(body, i, 0, 0);
+    dJointID joint = dJointCreateBall(world, nullptr);
+    dJointAttach(joint, body, previous);
+    dJointSetBallAnchor(joint, i - 0.5, 0, 0);
+    previous = body;
+  }
+  g_shuffle_called = false;
+  dWorldQuickStep(world, 0.01);
+  const bool ours = g_shuffle_called;
+  dWorldSetStepThreadingImplementation(world, nullptr, nullptr);
+  dWorldDestroy(world);
+  dThreadingFreeImplementation(threading);
+  return ours;
+}
+
+bool g_solver_shuffle_is_ours = false;
+
 void InitOdeOnce() {
   static std::once_flag once;
   std::call_once(once, [] {
     dInitODE2(0);
     dSetErrorHandler(ThrowOdeError);
     dSetDebugHandler(ThrowOdeError);
+    dAllocateODEDataForThread(dAllocateMaskAll);
+    g_solver_shuffle_is_ours = ProbeSolverShuffle();
   });
 }
 
@@ -183,7 +248,10 @@ OdeWorld::OdeWorld(const Options& options, const DynamicsSettings& settings)
   InitOdeOnce();
 }
 
-OdeWorld::~OdeWorld() { Clear(); }
+OdeWorld::~OdeWorld() {
+  Clear();
+  if (threading_) dThreadingFreeImplementation(threading_);
+}
 
 void OdeWorld::Clear() {
   if (broken_) {
@@ -192,8 +260,9 @@ void OdeWorld::Clear() {
     contacts_ = nullptr;
     space_ = nullptr;
     world_ = nullptr;
-    threading_ = nullptr;
-    meshes_.clear();  // (their trimesh data leaks with the geoms)
+    threading_ = nullptr;             // (in use by the unwound step: leaked)
+    (void)solver_threads_.release();  // likewise (its threads stay asleep)
+    meshes_.clear();                  // (their trimesh data leaks with the geoms)
     broken_ = false;
   }
   if (contacts_) dJointGroupDestroy(contacts_);
@@ -202,14 +271,12 @@ void OdeWorld::Clear() {
     dWorldSetStepThreadingImplementation(world_, nullptr, nullptr);
     dWorldDestroy(world_);  // destroys bodies and joints
   }
-  if (threading_) dThreadingFreeImplementation(threading_);
   for (auto& [mesh, data] : meshes_) dGeomTriMeshDataDestroy(data);  // after their geoms
   meshes_.clear();
   single_triangle_meshes_.clear();  // after the data that points at them
   contacts_ = nullptr;
   space_ = nullptr;
   world_ = nullptr;
-  threading_ = nullptr;
   bodies_.clear();
   kinematic_.clear();
   joints_.clear();
@@ -313,9 +380,25 @@ void OdeWorld::CreateWorld() {
   dAllocateODEDataForThread(dAllocateMaskAll);
   dRandSetSeed(options_.seed);
   world_ = dWorldCreate();
-  threading_ = dThreadingAllocateSelfThreadedImplementation();
-  dWorldSetStepThreadingImplementation(world_, dThreadingImplementationGetFunctions(threading_),
-                                       threading_);
+  // The solver's threads (ode_threading.h), made once per OdeWorld (a
+  // rebuild keeps them): islands stepped concurrently, each on one thread,
+  // the same state for any thread count, 1 included. ODE's own
+  // single-threaded implementation only when the shuffle is not ours.
+  if (!solver_threads_ && !threading_) {
+    if (g_solver_shuffle_is_ours) {
+      solver_threads_ =
+          std::make_unique<SolverThreads>(settings_.scheduler ? settings_.scheduler->threads() : 1);
+    } else {
+      threading_ = dThreadingAllocateSelfThreadedImplementation();
+    }
+  }
+  if (solver_threads_) {
+    dWorldSetStepThreadingImplementation(world_, solver_threads_->functions(),
+                                         solver_threads_->id());
+  } else {
+    dWorldSetStepThreadingImplementation(world_, dThreadingImplementationGetFunctions(threading_),
+                                         threading_);
+  }
   dWorldSetGravity(world_, 0, 0, -settings_.gravity);
   dWorldSetERP(world_, options_.erp);
   dWorldSetCFM(world_, options_.cfm);
@@ -588,12 +671,24 @@ void OdeWorld::StepOnce(double dt, double fraction) {
   // order: the same joints in the same order for any thread count.
   pairs_.clear();
   dSpaceCollide(space_, this, &OdeWorld::NearCallback);
+  // The spaces list their geoms in the order the solver last moved them,
+  // which depends on the order its threads finished the islands: the pairs
+  // go in the geoms' build order, each with its first-built geom first.
+  auto order = [](dGeomID g) { return reinterpret_cast<uintptr_t>(dGeomGetData(g)); };
+  for (CandidatePair& pair : pairs_)
+    if (order(pair.a) > order(pair.b)) std::swap(pair.a, pair.b);
+  std::sort(pairs_.begin(), pairs_.end(), [&](const CandidatePair& x, const CandidatePair& y) {
+    return order(x.a) != order(y.a) ? order(x.a) < order(y.a) : order(x.b) < order(y.b);
+  });
   FindContacts();
   for (size_t k = 0; k < pairs_.size(); ++k) AddContacts(k);
-  if (options_.iterations > 0)
-    dWorldQuickStep(world_, dt);
-  else
-    dWorldStep(world_, dt);
+  const int stepped =
+      options_.iterations > 0 ? dWorldQuickStep(world_, dt) : dWorldStep(world_, dt);
+  if (solver_threads_) {
+    if (std::exception_ptr failure = solver_threads_->TakeFailure())
+      std::rethrow_exception(failure);
+  }
+  if (!stepped) throw Error("ode: the solver could not step (out of memory?)");
   dJointGroupEmpty(contacts_);
   TrackJointPositions();
 }

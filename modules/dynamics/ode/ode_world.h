@@ -21,6 +21,8 @@ class StateHasher;
 
 namespace swarmsim::ode {
 
+class SolverThreads;  // ode_threading.h
+
 // A dynamic body: one per dynamic shape.
 struct DynamicBody {  // 72 bytes
   dBodyID body;
@@ -144,6 +146,7 @@ class OdeWorld {
   dSpaceID space_ = nullptr;
   dJointGroupID contacts_ = nullptr;
   dThreadingImplementationID threading_ = nullptr;
+  std::unique_ptr<SolverThreads> solver_threads_;  // the solver's threads (CreateWorld), or null
   std::vector<DynamicBody> bodies_;
   std::vector<KinematicBody> kinematic_;
   std::vector<SimJoint> joints_;

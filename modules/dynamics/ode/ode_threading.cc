@@ -1,0 +1,265 @@
+#include "modules/dynamics/ode/ode_threading.h"
+
+#include <algorithm>
+#include <memory>
+
+namespace swarmsim::ode {
+
+struct SolverThreads::Job {
+  ddependencycount_t dependencies = 0;  // calls (and its own run) still to finish
+  Job* dependent = nullptr;             // released when this one completes
+  Wait* wait = nullptr;
+  int* fault_out = nullptr;
+  dThreadedCallFunction* fn = nullptr;
+  void* context = nullptr;
+  dcallindex_t index = 0;
+  int home = kShared;    // the queue it runs from
+  bool started = false;  // taken from its queue (ODE's "dequeued")
+  bool fault = false;    // it or a call it waited for failed
+};
+
+struct SolverThreads::Wait {
+  bool done = false;
+};
+
+namespace {
+
+struct MutexGroup {
+  std::unique_ptr<std::mutex[]> mutexes;
+};
+
+// The thread's place in a pool: which pool, its queue, and whether it is
+// running one of the pool's calls (posts from a call stay on the thread).
+thread_local SolverThreads* t_pool = nullptr;
+thread_local int t_self = -1;
+thread_local int t_in_call = 0;
+
+SolverThreads* Self(dThreadingImplementationID impl) {
+  return reinterpret_cast<SolverThreads*>(impl);
+}
+
+}  // namespace
+
+SolverThreads::SolverThreads(int threads) : threads_(std::max(1, threads)) {
+  local_.resize(static_cast<size_t>(threads_));
+  functions_.struct_size = sizeof(functions_);
+  functions_.alloc_mutex_group = [](dThreadingImplementationID, dmutexindex_t count,
+                                    const char* const*) -> dMutexGroupID {
+    auto* group = new MutexGroup{std::make_unique<std::mutex[]>(count)};
+    return reinterpret_cast<dMutexGroupID>(group);
+  };
+  functions_.free_mutex_group = [](dThreadingImplementationID, dMutexGroupID group) {
+    delete reinterpret_cast<MutexGroup*>(group);
+  };
+  functions_.lock_group_mutex = [](dThreadingImplementationID, dMutexGroupID group,
+                                   dmutexindex_t i) {
+    reinterpret_cast<MutexGroup*>(group)->mutexes[i].lock();
+  };
+  functions_.unlock_group_mutex = [](dThreadingImplementationID, dMutexGroupID group,
+                                     dmutexindex_t i) {
+    reinterpret_cast<MutexGroup*>(group)->mutexes[i].unlock();
+  };
+  functions_.alloc_call_wait = [](dThreadingImplementationID) -> dCallWaitID {
+    return reinterpret_cast<dCallWaitID>(new Wait);
+  };
+  functions_.reset_call_wait = [](dThreadingImplementationID impl, dCallWaitID wait) {
+    std::lock_guard<std::mutex> lock(Self(impl)->mutex_);
+    reinterpret_cast<Wait*>(wait)->done = false;
+  };
+  functions_.free_call_wait = [](dThreadingImplementationID, dCallWaitID wait) {
+    delete reinterpret_cast<Wait*>(wait);
+  };
+  functions_.post_call = [](dThreadingImplementationID impl, int* out_fault,
+                            dCallReleaseeID* out_releasee, ddependencycount_t dependencies,
+                            dCallReleaseeID dependent, dCallWaitID wait, dThreadedCallFunction* fn,
+                            void* context, dcallindex_t index, const char*) {
+    Self(impl)->Post(out_fault, out_releasee, dependencies, dependent, wait, fn, context, index);
+  };
+  functions_.alter_call_dependencies_count =
+      [](dThreadingImplementationID impl, dCallReleaseeID releasee, ddependencychange_t change) {
+        Self(impl)->Alter(releasee, change);
+      };
+  functions_.wait_call = [](dThreadingImplementationID impl, int* out_status, dCallWaitID wait,
+                            const dThreadedWaitTime* timeout,
+                            const char*) { Self(impl)->WaitCall(out_status, wait, timeout); };
+  // At least 2: ODE then always takes its multi-threaded path (see the header).
+  functions_.retrieve_thread_count = [](dThreadingImplementationID impl) -> unsigned {
+    return static_cast<unsigned>(std::max(2, Self(impl)->threads_));
+  };
+  functions_.preallocate_resources_for_calls = [](dThreadingImplementationID,
+                                                  ddependencycount_t) -> int { return 1; };
+  for (int i = 1; i < threads_; ++i) workers_.emplace_back([this, i] { WorkerLoop(i); });
+}
+
+SolverThreads::~SolverThreads() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    shutdown_ = true;
+  }
+  work_.notify_all();
+  for (std::thread& worker : workers_) worker.join();
+  for (Job* job : free_jobs_) delete job;
+  // Jobs still queued or waiting (a step unwound by an error) are leaked
+  // with the ODE world that posted them.
+}
+
+std::exception_ptr SolverThreads::TakeFailure() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::exception_ptr failure = failure_;
+  failure_ = nullptr;
+  failed_ = false;
+  return failure;
+}
+
+SolverThreads::Job* SolverThreads::NewJob() {
+  if (free_jobs_.empty()) return new Job;
+  Job* job = free_jobs_.back();
+  free_jobs_.pop_back();
+  *job = Job{};
+  return job;
+}
+
+void SolverThreads::Post(int* out_fault, dCallReleaseeID* out_releasee,
+                         ddependencycount_t dependencies, dCallReleaseeID dependent,
+                         dCallWaitID wait, dThreadedCallFunction* fn, void* context,
+                         dcallindex_t index) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  Job* job = NewJob();
+  job->dependencies = dependencies;
+  job->dependent = reinterpret_cast<Job*>(dependent);
+  job->wait = reinterpret_cast<Wait*>(wait);
+  job->fault_out = out_fault;
+  job->fn = fn;
+  job->context = context;
+  job->index = index;
+  job->home = t_pool == this && t_in_call > 0 ? t_self : kShared;
+  if (out_releasee) *out_releasee = reinterpret_cast<dCallReleaseeID>(job);
+  if (dependencies == 0) MakeReady(job);
+}
+
+void SolverThreads::MakeReady(Job* job) {
+  if (job->home == kShared) {
+    shared_.push_back(job);
+  } else {
+    local_[static_cast<size_t>(job->home)].push_back(job);
+  }
+  // The thread itself will find it; any other may be asleep.
+  if (!(t_pool == this && job->home == t_self)) work_.notify_all();
+}
+
+void SolverThreads::Alter(dCallReleaseeID releasee, ddependencychange_t change) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  Job* job = reinterpret_cast<Job*>(releasee);
+  job->dependencies =
+      static_cast<ddependencycount_t>(static_cast<ddependencychange_t>(job->dependencies) + change);
+  if (job->dependencies != 0) return;
+  if (!job->started) {
+    MakeReady(job);
+    return;
+  }
+  // A call that ran and then waited for calls it added: they are all done.
+  job->dependencies = 1;
+  Release(job, false);
+}
+
+void SolverThreads::Release(Job* job, bool failed) {
+  if (failed) job->fault = true;
+  while (job) {
+    if (--job->dependencies != 0) return;
+    if (!job->started) {
+      MakeReady(job);
+      return;
+    }
+    if (job->wait) Signal(job->wait);
+    if (job->fault_out) *job->fault_out = job->fault ? 1 : 0;
+    Job* dependent = job->dependent;
+    if (dependent && job->fault) dependent->fault = true;
+    free_jobs_.push_back(job);
+    job = dependent;
+  }
+}
+
+void SolverThreads::Signal(Wait* wait) {
+  wait->done = true;
+  work_.notify_all();
+}
+
+SolverThreads::Job* SolverThreads::PopFor(int self) {
+  std::deque<Job*>* queue = &local_[static_cast<size_t>(self)];
+  if (queue->empty()) queue = &shared_;
+  if (queue->empty()) return nullptr;
+  Job* job = queue->front();
+  queue->pop_front();
+  job->started = true;
+  job->dependencies = 1;  // its own run
+  return job;
+}
+
+void SolverThreads::Run(Job* job, int self) {
+  (void)self;
+  bool ok = false;
+  bool skip;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    skip = failed_;
+  }
+  if (!skip) {
+    ++t_in_call;
+    try {
+      ok = job->fn(job->context, job->index, reinterpret_cast<dCallReleaseeID>(job)) != 0;
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (!failure_) failure_ = std::current_exception();
+      failed_ = true;
+    }
+    --t_in_call;
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  Release(job, !ok);
+}
+
+void SolverThreads::WorkerLoop(int index) {
+  t_pool = this;
+  t_self = index;
+  dAllocateODEDataForThread(dAllocateMaskAll);
+  std::unique_lock<std::mutex> lock(mutex_);
+  while (true) {
+    if (Job* job = PopFor(index)) {
+      lock.unlock();
+      Run(job, index);
+      lock.lock();
+      continue;
+    }
+    if (shutdown_) break;
+    work_.wait(lock);
+  }
+  lock.unlock();
+  dCleanupODEAllDataForThread();
+}
+
+void SolverThreads::WaitCall(int* out_status, dCallWaitID wait_id,
+                             const dThreadedWaitTime* timeout) {
+  Wait* wait = reinterpret_cast<Wait*>(wait_id);
+  SolverThreads* const saved_pool = t_pool;
+  const int saved_self = t_self;
+  t_pool = this;
+  t_self = 0;  // the stepping thread works from queue 0
+  const bool poll = timeout && timeout->wait_sec == 0 && timeout->wait_nsec == 0;
+  std::unique_lock<std::mutex> lock(mutex_);
+  while (!wait->done && !poll) {
+    if (Job* job = PopFor(0)) {
+      lock.unlock();
+      Run(job, 0);
+      lock.lock();
+      continue;
+    }
+    work_.wait(lock);
+  }
+  const bool done = wait->done;
+  lock.unlock();
+  t_pool = saved_pool;
+  t_self = saved_self;
+  if (out_status) *out_status = done ? 1 : 0;
+}
+
+}  // namespace swarmsim::ode
