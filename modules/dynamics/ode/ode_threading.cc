@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <memory>
 
+#include "framework/scheduler.h"
+
 namespace swarmsim::ode {
 
 struct SolverThreads::Job {
@@ -40,7 +42,8 @@ SolverThreads* Self(dThreadingImplementationID impl) {
 
 }  // namespace
 
-SolverThreads::SolverThreads(int threads) : threads_(std::max(1, threads)) {
+SolverThreads::SolverThreads(TaskScheduler* scheduler)
+    : scheduler_(scheduler), threads_(scheduler ? std::max(1, scheduler->threads()) : 1) {
   local_.resize(static_cast<size_t>(threads_));
   functions_.struct_size = sizeof(functions_);
   functions_.alloc_mutex_group = [](dThreadingImplementationID, dmutexindex_t count,
@@ -88,16 +91,9 @@ SolverThreads::SolverThreads(int threads) : threads_(std::max(1, threads)) {
   };
   functions_.preallocate_resources_for_calls = [](dThreadingImplementationID,
                                                   ddependencycount_t) -> int { return 1; };
-  for (int i = 1; i < threads_; ++i) workers_.emplace_back([this, i] { WorkerLoop(i); });
 }
 
 SolverThreads::~SolverThreads() {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    shutdown_ = true;
-  }
-  work_.notify_all();
-  for (std::thread& worker : workers_) worker.join();
   for (Job* job : free_jobs_) delete job;
   // Jobs still queued or waiting (a step unwound by an error) are leaked
   // with the ODE world that posted them.
@@ -195,8 +191,7 @@ SolverThreads::Job* SolverThreads::PopFor(int self) {
   return job;
 }
 
-void SolverThreads::Run(Job* job, int self) {
-  (void)self;
+void SolverThreads::Run(Job* job) {
   bool ok = false;
   bool skip;
   {
@@ -218,48 +213,45 @@ void SolverThreads::Run(Job* job, int self) {
   Release(job, !ok);
 }
 
-void SolverThreads::WorkerLoop(int index) {
+void SolverThreads::Lane(int lane, Wait* wait) {
+  SolverThreads* const saved_pool = t_pool;
+  const int saved_self = t_self;
   t_pool = this;
-  t_self = index;
+  t_self = lane;
   dAllocateODEDataForThread(dAllocateMaskAll);
   std::unique_lock<std::mutex> lock(mutex_);
-  while (true) {
-    if (Job* job = PopFor(index)) {
+  while (!wait->done) {
+    if (Job* job = PopFor(lane)) {
       lock.unlock();
-      Run(job, index);
+      Run(job);
       lock.lock();
       continue;
     }
-    if (shutdown_) break;
     work_.wait(lock);
   }
   lock.unlock();
-  dCleanupODEAllDataForThread();
+  t_pool = saved_pool;
+  t_self = saved_self;
 }
 
 void SolverThreads::WaitCall(int* out_status, dCallWaitID wait_id,
                              const dThreadedWaitTime* timeout) {
   Wait* wait = reinterpret_cast<Wait*>(wait_id);
-  SolverThreads* const saved_pool = t_pool;
-  const int saved_self = t_self;
-  t_pool = this;
-  t_self = 0;  // the stepping thread works from queue 0
   const bool poll = timeout && timeout->wait_sec == 0 && timeout->wait_nsec == 0;
-  std::unique_lock<std::mutex> lock(mutex_);
-  while (!wait->done && !poll) {
-    if (Job* job = PopFor(0)) {
-      lock.unlock();
-      Run(job, 0);
-      lock.lock();
-      continue;
+  if (!poll) {
+    if (threads_ > 1) {
+      // One lane per thread; a lane that starts late finds the step done.
+      scheduler_->ParallelFor(0, threads_, 1, [this, wait](int64_t begin, int64_t end) {
+        for (int64_t lane = begin; lane < end; ++lane) Lane(static_cast<int>(lane), wait);
+      });
+    } else {
+      Lane(0, wait);
     }
-    work_.wait(lock);
   }
-  const bool done = wait->done;
-  lock.unlock();
-  t_pool = saved_pool;
-  t_self = saved_self;
-  if (out_status) *out_status = done ? 1 : 0;
+  if (out_status) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    *out_status = wait->done ? 1 : 0;
+  }
 }
 
 }  // namespace swarmsim::ode

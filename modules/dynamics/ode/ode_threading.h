@@ -18,8 +18,10 @@
 //     after another on one thread, in an order fixed by the island alone;
 //   - only calls posted from outside a call (ODE's top-level "stepping start"
 //     calls, one per chain) go to a queue that every thread takes from.
-// The threads are `threads - 1` workers plus the thread that steps the world,
-// which works while it waits for the step (WaitCall).
+// The threads are the run's (TaskScheduler): while the stepping thread waits
+// for a step (WaitCall), it and the scheduler's workers each work from one
+// queue ("lane") until the step is done. No threads of its own: on a 2-core
+// machine a third thread would compete with the scheduler's.
 //
 // A call that throws (ODE's error handler throws: ode_world.cc) is caught on
 // its thread; the calls after it are skipped and the step is reported failed,
@@ -32,15 +34,18 @@
 #include <deque>
 #include <exception>
 #include <mutex>
-#include <thread>
 #include <vector>
+
+namespace swarmsim {
+class TaskScheduler;
+}
 
 namespace swarmsim::ode {
 
 class SolverThreads {
  public:
-  // threads >= 1: that many threads in all (the stepping thread included).
-  explicit SolverThreads(int threads);
+  // The scheduler's threads (null: the stepping thread alone).
+  explicit SolverThreads(TaskScheduler* scheduler);
   ~SolverThreads();
   SolverThreads(const SolverThreads&) = delete;
   SolverThreads& operator=(const SolverThreads&) = delete;
@@ -63,9 +68,10 @@ class SolverThreads {
             dcallindex_t index);
   void Alter(dCallReleaseeID releasee, ddependencychange_t change);
   void WaitCall(int* out_status, dCallWaitID wait, const dThreadedWaitTime* timeout);
-  void WorkerLoop(int index);
-  // Runs `job` on this thread (index `self`) and releases it.
-  void Run(Job* job, int self);
+  // Works from queue `lane` (and the shared one) until `wait` is done.
+  void Lane(int lane, Wait* wait);
+  // Runs `job` on this thread and releases it.
+  void Run(Job* job);
   // One dependency of `job` done (its own run, or a call it waits for): a
   // job with none left either starts (queued) or, if it ran, completes and
   // releases the job depending on it.
@@ -75,6 +81,7 @@ class SolverThreads {
   Job* PopFor(int self);     // lock held
   void Signal(Wait* wait);
 
+  TaskScheduler* scheduler_;
   int threads_;
   dThreadingFunctionsInfo functions_{};
   std::mutex mutex_;
@@ -82,10 +89,8 @@ class SolverThreads {
   std::vector<std::deque<Job*>> local_;  // per thread: calls posted from its calls
   std::deque<Job*> shared_;
   std::vector<Job*> free_jobs_;
-  std::vector<std::thread> workers_;
   std::exception_ptr failure_;
   bool failed_ = false;  // a call threw this step: skip the rest
-  bool shutdown_ = false;
 };
 
 }  // namespace swarmsim::ode

@@ -386,8 +386,7 @@ void OdeWorld::CreateWorld() {
   // single-threaded implementation only when the shuffle is not ours.
   if (!solver_threads_ && !threading_) {
     if (g_solver_shuffle_is_ours) {
-      solver_threads_ =
-          std::make_unique<SolverThreads>(settings_.scheduler ? settings_.scheduler->threads() : 1);
+      solver_threads_ = std::make_unique<SolverThreads>(settings_.scheduler);
     } else {
       threading_ = dThreadingAllocateSelfThreadedImplementation();
     }
