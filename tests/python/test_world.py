@@ -32,6 +32,15 @@ class WorldTest(unittest.TestCase):
                                                       ["robots=30"]))
         w.close()
 
+    def test_an_ode_world_steps_as_in_the_program(self):
+        # ODE's solver threads and its constraint shuffle (the program's own
+        # dRandInt) work the same inside the Python module as in the program.
+        w = swarmsim.World(world("hexapod.yaml"), seed=3, set={"robots": 12}, threads=2)
+        w.step(30)
+        self.assertEqual(w.state_hash(), program_hash(world("hexapod.yaml"), 3, 30, 1,
+                                                      ["robots=12"]))
+        w.close()
+
     def test_poses_of_a_planar_world_move_as_the_robots_drive(self):
         w = swarmsim.World(world("diffusion.yaml"), seed=1, set={"robots": 40})
         self.assertTrue(w.planar)
