@@ -1,13 +1,16 @@
 #include "modules/dynamics/ode/ode_threading.h"
 
 #include <algorithm>
+#include <cstring>
 #include <memory>
 
+#include "framework/error.h"
 #include "framework/scheduler.h"
 
 namespace swarmsim::ode {
 
 struct SolverThreads::Job {
+  const char* name = nullptr;           // ODE's name for the call
   ddependencycount_t dependencies = 0;  // calls (and its own run) still to finish
   Job* dependent = nullptr;             // released when this one completes
   Wait* wait = nullptr;
@@ -40,10 +43,34 @@ SolverThreads* Self(dThreadingImplementationID impl) {
   return reinterpret_cast<SolverThreads*>(impl);
 }
 
+// The first members of ODE 0.16's dxIslandsProcessingCallContext (ode/src/util.cpp).
+struct IslandsContextHead {
+  dxWorld* world;
+  const void* islands_info;  // a reference
+  dReal step_size;
+  void* stepper;
+  dCallReleaseeID group_releasee;
+  size_t island_to_process;
+  unsigned stepper_allowed_threads;
+};
+
+constexpr char kIslandsStart[] = "World Islands Stepping Start";
+// The call that steps one island: all of it, when islands have one thread.
+constexpr char kIslandStepper[] = "Island Stepping Job Start";
+
+// The shuffle stream of the island being solved on this thread.
+thread_local bool t_shuffling = false;
+thread_local uint64_t t_shuffle_state = 0;
+
+// Set once per process (ProbeSingleThreadedIslands): islands get one thread each.
+bool g_single_threaded_islands = false;
+
 }  // namespace
 
-SolverThreads::SolverThreads(TaskScheduler* scheduler)
-    : scheduler_(scheduler), threads_(scheduler ? std::max(1, scheduler->threads()) : 1) {
+SolverThreads::SolverThreads(TaskScheduler* scheduler, dWorldID world)
+    : scheduler_(scheduler),
+      world_(world),
+      threads_(scheduler ? std::max(1, scheduler->threads()) : 1) {
   local_.resize(static_cast<size_t>(threads_));
   functions_.struct_size = sizeof(functions_);
   functions_.alloc_mutex_group = [](dThreadingImplementationID, dmutexindex_t count,
@@ -75,8 +102,9 @@ SolverThreads::SolverThreads(TaskScheduler* scheduler)
   functions_.post_call = [](dThreadingImplementationID impl, int* out_fault,
                             dCallReleaseeID* out_releasee, ddependencycount_t dependencies,
                             dCallReleaseeID dependent, dCallWaitID wait, dThreadedCallFunction* fn,
-                            void* context, dcallindex_t index, const char*) {
-    Self(impl)->Post(out_fault, out_releasee, dependencies, dependent, wait, fn, context, index);
+                            void* context, dcallindex_t index, const char* name) {
+    Self(impl)->Post(out_fault, out_releasee, dependencies, dependent, wait, fn, context, index,
+                     name);
   };
   functions_.alter_call_dependencies_count =
       [](dThreadingImplementationID impl, dCallReleaseeID releasee, ddependencychange_t change) {
@@ -85,9 +113,8 @@ SolverThreads::SolverThreads(TaskScheduler* scheduler)
   functions_.wait_call = [](dThreadingImplementationID impl, int* out_status, dCallWaitID wait,
                             const dThreadedWaitTime* timeout,
                             const char*) { Self(impl)->WaitCall(out_status, wait, timeout); };
-  // At least 2: ODE then always takes its multi-threaded path (see the header).
   functions_.retrieve_thread_count = [](dThreadingImplementationID impl) -> unsigned {
-    return static_cast<unsigned>(std::max(2, Self(impl)->threads_));
+    return Self(impl)->Reported();
   };
   functions_.preallocate_resources_for_calls = [](dThreadingImplementationID,
                                                   ddependencycount_t) -> int { return 1; };
@@ -115,11 +142,73 @@ SolverThreads::Job* SolverThreads::NewJob() {
   return job;
 }
 
+bool SolverThreads::DrawShuffle(int n, int* out) {
+  if (!t_shuffling) return false;
+  // splitmix64
+  uint64_t z = (t_shuffle_state += 0x9e3779b97f4a7c15ULL);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  z ^= z >> 31;
+  *out = n > 1 ? static_cast<int>(((z >> 32) * static_cast<uint64_t>(n)) >> 32) : 0;
+  return true;
+}
+
+unsigned SolverThreads::Reported() const {
+  // Without one thread per island: at least 2, so that ODE always takes its
+  // multi-threaded path (see the header).
+  return static_cast<unsigned>(g_single_threaded_islands ? threads_ : std::max(2, threads_));
+}
+
+bool SolverThreads::SingleThreadedIslands(void* context) {
+  auto* head = static_cast<IslandsContextHead*>(context);
+  // One such call per chain of islands, all with this context: the first
+  // finds ODE's count, the others the 1 it was given.
+  if (head->world != reinterpret_cast<dxWorld*>(world_) ||
+      (head->stepper_allowed_threads != Reported() && head->stepper_allowed_threads != 1))
+    return false;
+  head->stepper_allowed_threads = 1;
+  return true;
+}
+
+bool SolverThreads::ProbeSingleThreadedIslands() {
+  // Two separate bodies (two islands) hanging from the world by a ball joint
+  // each, stepped once with 2 threads reported and the layout checked.
+  dWorldID world = dWorldCreate();
+  dWorldSetQuickStepNumIterations(world, 4);
+  for (int i = 0; i < 2; ++i) {
+    dBodyID body = dBodyCreate(world);
+    dBodySetPosition(body, 2.0 * i, 0, 0);
+    dJointID joint = dJointCreateBall(world, nullptr);
+    dJointAttach(joint, body, nullptr);
+    dJointSetBallAnchor(joint, 2.0 * i, 0, 1);
+  }
+  g_single_threaded_islands = true;
+  bool ok = true;
+  {
+    SolverThreads probe(nullptr, world);
+    probe.threads_ = 2;  // reported; the stepping thread does the work
+    dWorldSetStepThreadingImplementation(world, probe.functions(), probe.id());
+    ok = dWorldQuickStep(world, 0.01) != 0 && !probe.TakeFailure();
+    dWorldSetStepThreadingImplementation(world, nullptr, nullptr);
+  }
+  dWorldDestroy(world);
+  g_single_threaded_islands = ok;
+  return ok;
+}
+
 void SolverThreads::Post(int* out_fault, dCallReleaseeID* out_releasee,
                          ddependencycount_t dependencies, dCallReleaseeID dependent,
                          dCallWaitID wait, dThreadedCallFunction* fn, void* context,
-                         dcallindex_t index) {
+                         dcallindex_t index, const char* name) {
   std::lock_guard<std::mutex> lock(mutex_);
+  if (g_single_threaded_islands && name && std::strcmp(name, kIslandsStart) == 0 &&
+      !SingleThreadedIslands(context) && !failed_) {
+    // ODE went on with its multi-threaded islands: a result the other thread
+    // counts would not give. The step is reported failed (TakeFailure).
+    failure_ = std::make_exception_ptr(
+        Error("ode: the solver's island threads are not where ODE 0.16 keeps them"));
+    failed_ = true;
+  }
   Job* job = NewJob();
   job->dependencies = dependencies;
   job->dependent = reinterpret_cast<Job*>(dependent);
@@ -128,6 +217,7 @@ void SolverThreads::Post(int* out_fault, dCallReleaseeID* out_releasee,
   job->fn = fn;
   job->context = context;
   job->index = index;
+  job->name = name;
   job->home = t_pool == this && t_in_call > 0 ? t_self : kShared;
   if (out_releasee) *out_releasee = reinterpret_cast<dCallReleaseeID>(job);
   if (dependencies == 0) MakeReady(job);
@@ -200,6 +290,12 @@ void SolverThreads::Run(Job* job) {
   }
   if (!skip) {
     ++t_in_call;
+    const bool island =
+        g_single_threaded_islands && job->name && std::strcmp(job->name, kIslandStepper) == 0;
+    if (island) {
+      t_shuffling = true;
+      t_shuffle_state = shuffle_seed_;
+    }
     try {
       ok = job->fn(job->context, job->index, reinterpret_cast<dCallReleaseeID>(job)) != 0;
     } catch (...) {
@@ -207,6 +303,7 @@ void SolverThreads::Run(Job* job) {
       if (!failure_) failure_ = std::current_exception();
       failed_ = true;
     }
+    t_shuffling = false;
     --t_in_call;
   }
   std::lock_guard<std::mutex> lock(mutex_);
@@ -239,7 +336,7 @@ void SolverThreads::WaitCall(int* out_status, dCallWaitID wait_id,
   Wait* wait = reinterpret_cast<Wait*>(wait_id);
   const bool poll = timeout && timeout->wait_sec == 0 && timeout->wait_nsec == 0;
   if (!poll) {
-    if (threads_ > 1) {
+    if (scheduler_ && threads_ > 1) {
       // One lane per thread; a lane that starts late finds the step done.
       scheduler_->ParallelFor(0, threads_, 1, [this, wait](int64_t begin, int64_t end) {
         for (int64_t lane = begin; lane < end; ++lane) Lane(static_cast<int>(lane), wait);

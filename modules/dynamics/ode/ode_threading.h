@@ -5,19 +5,29 @@
 // thread count. Internal to the ODE module (ode_world.cc).
 //
 // Why not ODE's own thread pool: ODE 0.16 gives every island as many threads
-// as it steps islands in parallel, and its multi-threaded quickstep then
-// solves an island's constraint rows concurrently, each row waiting only for
-// the last earlier row on one of its two bodies: the order of the updates to
-// the other body depends on timing (different states at 3 and 4 threads, and
-// between two runs at 4, measured). Here:
-//   - thread_count() is what ODE is told, at least 2, so that ODE always takes
-//     its multi-threaded code path (whose result differs from its
-//     single-threaded one), whatever the real number of threads;
+// as it steps islands in parallel (util.cpp: "for now, set stepper allowed
+// threads equal to island stepping threads"), and its multi-threaded
+// quickstep then solves an island's constraint rows concurrently, each row
+// waiting only for the last earlier row on one of its two bodies: the order
+// of the updates to the other body depends on timing (different states at 3
+// and 4 threads, and between two runs at 4, measured). That path also posts a
+// few calls per solver iteration: for small islands (a 3-body wheeled robot)
+// it cost more than the island's whole single-threaded solve. Here:
+//   - each island is solved by ODE's single-threaded quickstep: before ODE
+//     runs its "World Islands Stepping Start" calls, the threads it allows
+//     one island's stepper (the last of the first members of ODE 0.16's
+//     dxIslandsProcessingCallContext, which those calls carry: the world, the
+//     islands, the step size, the stepper, the group releasee, the island
+//     counter, then that count) are set to 1. The layout is checked (the
+//     world and the count must be where they belong) and probed once per
+//     process (ProbeSingleThreadedIslands); where it does not hold, ODE is
+//     told of at least 2 threads at any thread count, so that it always takes
+//     its multi-threaded path and results still do not depend on the count;
 //   - a call posted from inside a call runs on the thread that posted it, so
-//     an island's calls (each island is stepped by one chain of calls) run one
-//     after another on one thread, in an order fixed by the island alone;
+//     an island's calls run one after another on one thread, in an order
+//     fixed by the island alone;
 //   - only calls posted from outside a call (ODE's top-level "stepping start"
-//     calls, one per chain) go to a queue that every thread takes from.
+//     calls, one per chain of islands) go to a queue every thread takes from.
 // The threads are the run's (TaskScheduler): while the stepping thread waits
 // for a step (WaitCall), it and the scheduler's workers each work from one
 // queue ("lane") until the step is done. No threads of its own: on a 2-core
@@ -31,6 +41,7 @@
 #include <ode/ode.h>
 
 #include <condition_variable>
+#include <cstdint>
 #include <deque>
 #include <exception>
 #include <mutex>
@@ -44,8 +55,9 @@ namespace swarmsim::ode {
 
 class SolverThreads {
  public:
-  // The scheduler's threads (null: the stepping thread alone).
-  explicit SolverThreads(TaskScheduler* scheduler);
+  // The scheduler's threads (null: the stepping thread alone), stepping
+  // `world`'s islands (set_world when it is rebuilt).
+  SolverThreads(TaskScheduler* scheduler, dWorldID world);
   ~SolverThreads();
   SolverThreads(const SolverThreads&) = delete;
   SolverThreads& operator=(const SolverThreads&) = delete;
@@ -54,8 +66,24 @@ class SolverThreads {
   const dThreadingFunctionsInfo* functions() const { return &functions_; }
   dThreadingImplementationID id() { return reinterpret_cast<dThreadingImplementationID>(this); }
 
+  void set_world(dWorldID world) { world_ = world; }
+  // Seeds the constraint shuffles of the next step (DrawShuffle).
+  void set_shuffle_seed(uint64_t seed) { shuffle_seed_ = seed; }
+
+  // ODE's quickstep shuffles an island's constraint rows now and then with
+  // dRandInt (ode_world.cc). While an island is solved on this thread (one
+  // island per thread at a time, see above), its draws come from a stream
+  // that starts at the step's seed for every island: the same draws whatever
+  // thread solves it and whenever. Sets *out to a draw in [0, n) and returns
+  // true, or returns false outside an island's solve.
+  static bool DrawShuffle(int n, int* out);
+
   // The first exception a call threw during the last step, cleared (null if none).
   std::exception_ptr TakeFailure();
+
+  // Whether ODE's islands can be given one thread each (see above): steps a
+  // small world once and looks. Call once per process, before any other use.
+  static bool ProbeSingleThreadedIslands();
 
   struct Job;
   struct Wait;
@@ -65,7 +93,12 @@ class SolverThreads {
 
   void Post(int* out_fault, dCallReleaseeID* out_releasee, ddependencycount_t dependencies,
             dCallReleaseeID dependent, dCallWaitID wait, dThreadedCallFunction* fn, void* context,
-            dcallindex_t index);
+            dcallindex_t index, const char* name);
+  // The thread count ODE is told.
+  unsigned Reported() const;
+  // Gives the islands of the step ODE starts with `context` one thread each
+  // (see above); false if ODE's layout is not the probed one.
+  bool SingleThreadedIslands(void* context);
   void Alter(dCallReleaseeID releasee, ddependencychange_t change);
   void WaitCall(int* out_status, dCallWaitID wait, const dThreadedWaitTime* timeout);
   // Works from queue `lane` (and the shared one) until `wait` is done.
@@ -82,6 +115,8 @@ class SolverThreads {
   void Signal(Wait* wait);
 
   TaskScheduler* scheduler_;
+  dWorldID world_;
+  uint64_t shuffle_seed_ = 0;
   int threads_;
   dThreadingFunctionsInfo functions_{};
   std::mutex mutex_;

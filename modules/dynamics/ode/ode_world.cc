@@ -37,14 +37,17 @@ std::atomic<bool> g_shuffle_called{false};
 // threads run, so the state would depend on the thread count and timing.
 // This definition takes the place of ODE's (the program's own definition of
 // an exported function comes first when libode's call is bound, the usual
-// ELF rule): the draw is a fixed function of n, so each shuffle is the same
-// permutation of its rows whichever thread makes it, when, and in which
-// island. The rows are still mixed (what the shuffle is for); they are mixed
-// the same way every step. InitOdeOnce checks that ODE calls this one
-// (ProbeSolverShuffle); if not, the solver stays on one thread.
+// ELF rule). While an island is solved, the draws come from that island's
+// stream (SolverThreads::DrawShuffle: seeded by the step, the same whichever
+// thread solves the island); elsewhere (ODE's multi-threaded path, where an
+// island's solve is split into calls) the draw is a fixed function of n.
+// InitOdeOnce checks that ODE calls this one (ProbeSolverShuffle); if not,
+// the solver stays on one thread.
 extern "C" __attribute__((visibility("default"))) int dRandInt(int n) {
   std::atomic<bool>& called = swarmsim::ode::g_shuffle_called;
   if (!called.load(std::memory_order_relaxed)) called.store(true, std::memory_order_relaxed);
+  int draw;
+  if (swarmsim::ode::SolverThreads::DrawShuffle(n, &draw)) return draw;
   if (n <= 1) return 0;
   const uint64_t z = swarmsim::ode::Mix64(static_cast<uint64_t>(n) * 0x9e3779b97f4a7c15ULL);
   return static_cast<int>(((z >> 32) * static_cast<uint64_t>(n)) >> 32);
@@ -110,6 +113,7 @@ void InitOdeOnce() {
     dSetDebugHandler(ThrowOdeError);
     dAllocateODEDataForThread(dAllocateMaskAll);
     g_solver_shuffle_is_ours = ProbeSolverShuffle();
+    if (g_solver_shuffle_is_ours) SolverThreads::ProbeSingleThreadedIslands();
   });
 }
 
@@ -386,12 +390,13 @@ void OdeWorld::CreateWorld() {
   // single-threaded implementation only when the shuffle is not ours.
   if (!solver_threads_ && !threading_) {
     if (g_solver_shuffle_is_ours) {
-      solver_threads_ = std::make_unique<SolverThreads>(settings_.scheduler);
+      solver_threads_ = std::make_unique<SolverThreads>(settings_.scheduler, world_);
     } else {
       threading_ = dThreadingAllocateSelfThreadedImplementation();
     }
   }
   if (solver_threads_) {
+    solver_threads_->set_world(world_);
     dWorldSetStepThreadingImplementation(world_, solver_threads_->functions(),
                                          solver_threads_->id());
   } else {
@@ -681,6 +686,10 @@ void OdeWorld::StepOnce(double dt, double fraction) {
   });
   FindContacts();
   for (size_t k = 0; k < pairs_.size(); ++k) AddContacts(k);
+  // Each substep's constraint shuffles start from their own seed (DrawShuffle).
+  ++substeps_done_;
+  if (solver_threads_)
+    solver_threads_->set_shuffle_seed(Mix64(Mix64(options_.seed) ^ substeps_done_));
   const int stepped =
       options_.iterations > 0 ? dWorldQuickStep(world_, dt) : dWorldStep(world_, dt);
   if (solver_threads_) {
@@ -826,6 +835,7 @@ void OdeWorld::Hash(StateHasher* hasher) const {
   }
   const uint64_t seed = dRandGetSeed();
   hasher->AddValue(seed);
+  hasher->AddValue(substeps_done_);
 }
 
 }  // namespace swarmsim::ode

@@ -171,8 +171,9 @@ class OdeWorld {
   std::vector<std::vector<MeshTriangle>> single_triangle_meshes_;
   // Joint commands, read once per control step (rows of joints_).
   std::vector<JointData> commands_;
-  double step_dt_ = 0;   // substep length, for the servo
-  bool broken_ = false;  // an ODE call was unwound by an error (Substep)
+  double step_dt_ = 0;          // substep length, for the servo
+  uint64_t substeps_done_ = 0;  // seeds each substep's constraint shuffles
+  bool broken_ = false;         // an ODE call was unwound by an error (Substep)
 };
 
 }  // namespace swarmsim::ode
