@@ -8,7 +8,8 @@ namespace swarmsim::ode {
 swarmsim::ModuleInfo ModuleInfo() {
   return {"dynamics", "ode", "1.0 (ODE 0.16, double precision)",
           "3D rigid bodies: boxes, spheres, cylinders, capsules; hinge, slider, ball and fixed "
-          "joints with motors and servos; kinematic bodies for hybrid simulation"};
+          "joints with motors and servos; kinematic bodies for hybrid simulation; " +
+              SolverThreading()};
 }
 
 std::unique_ptr<DynamicsBackend> MakeBackend() { return MakeBackend(Options{}); }

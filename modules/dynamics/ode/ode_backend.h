@@ -68,18 +68,18 @@
 // (DynamicsSettings::scheduler; each pair writes only its own slots), then
 // creates the contact joints in pair order. The solver then steps ODE's
 // islands (bodies linked by joints and contacts: a robot, or robots touching)
-// concurrently on the run's threads through our own ODE threading
-// implementation (ode_threading.h), which keeps each island's work on one
-// thread: ODE's own pool splits an island's constraint rows over threads in
-// an order that depends on timing. ODE's quickstep shuffles an island's rows
-// with dRandInt, ODE's process-global random generator; the program defines
-// its own dRandInt (ode_world.cc), a fixed function, so the shuffles do not
-// depend on the order the islands are stepped in, and checks at start-up that
-// ODE calls it (if not, the solver runs on one thread). The state is
-// bit-identical for any thread count, 1 included. Each backend owns its ODE
-// world and its solver threads. Meshes: Debian's ODE trimesh collision
-// (OPCODE) is not thread-safe, so a world with a mesh finds its contact
-// points on the calling thread.
+// concurrently on the run's threads, each island by ODE's single-threaded
+// quickstep on one thread, through our own ODE threading implementation
+// (ode_threading.h: why not ODE's pool, and how an island gets one thread).
+// Quickstep shuffles an island's rows with dRandInt, ODE's process-global
+// random generator; the program defines its own dRandInt (ode_world.cc),
+// whose draws come from a stream that starts at the substep's seed for every
+// island, so they do not depend on which thread solves which island when.
+// Both are checked once per process, and `swarmsim modules` says how the
+// solver runs. The state is bit-identical for any thread count, 1 included.
+// Each backend owns its ODE world and its solver threads. Meshes: Debian's
+// ODE trimesh collision (OPCODE) is not thread-safe, so a world with a mesh
+// finds its contact points on the calling thread.
 //
 // Meshes. A mesh shape is a dTriMesh geom; its trimesh data is made once per
 // asset per world and reads the shared asset's arrays in place. A dynamic

@@ -104,6 +104,7 @@ bool ProbeSolverShuffle() {
 }
 
 bool g_solver_shuffle_is_ours = false;
+bool g_single_threaded_islands = false;  // SolverThreads' probe
 
 void InitOdeOnce() {
   static std::once_flag once;
@@ -113,9 +114,23 @@ void InitOdeOnce() {
     dSetDebugHandler(ThrowOdeError);
     dAllocateODEDataForThread(dAllocateMaskAll);
     g_solver_shuffle_is_ours = ProbeSolverShuffle();
-    if (g_solver_shuffle_is_ours) SolverThreads::ProbeSingleThreadedIslands();
+    if (g_solver_shuffle_is_ours)
+      g_single_threaded_islands = SolverThreads::ProbeSingleThreadedIslands();
   });
 }
+
+}  // namespace
+
+std::string SolverThreading() {
+  InitOdeOnce();
+  if (!g_solver_shuffle_is_ours)
+    return "the solver runs on one thread (ODE's dRandInt is not the program's)";
+  if (!g_single_threaded_islands)
+    return "islands solved concurrently on the run's threads (ODE's multi-threaded island path)";
+  return "islands solved concurrently on the run's threads";
+}
+
+namespace {
 
 using dynamics::PathAt;
 using dynamics::ThrowIfNotFinite;

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -22,6 +23,10 @@ class StateHasher;
 namespace swarmsim::ode {
 
 class SolverThreads;  // ode_threading.h
+
+// How the solver uses threads in this process (ODE initialised and probed
+// once), for the module's description.
+std::string SolverThreading();
 
 // A dynamic body: one per dynamic shape.
 struct DynamicBody {  // 72 bytes

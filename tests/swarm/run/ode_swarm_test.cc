@@ -33,6 +33,20 @@ void ExpectSameHashAtOneTwoAndFourThreads(const std::string& args) {
   EXPECT_EQ(HashOf(args + "4"), one);
 }
 
+// The solver steps islands on every thread on this platform: ODE calls the
+// program's dRandInt and its island contexts have the layout the solver
+// threads adjust (modules/dynamics/ode/ode_threading.h). Either failing would
+// silently put the solver back on one thread (or on ODE's costlier
+// multi-threaded island path); `swarmsim modules` says which.
+TEST(OdeSwarmTest, ModulesSaysTheSolverStepsIslandsOnEveryThread) {
+  const auto r = RunProgram("modules");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const size_t ode = r.output.find("dynamics\tode\t");
+  ASSERT_NE(ode, std::string::npos) << r.output;
+  const std::string line = r.output.substr(ode, r.output.find('\n', ode) - ode);
+  EXPECT_TRUE(line.ends_with("; islands solved concurrently on the run's threads")) << line;
+}
+
 // 150 hexapods packed at 0.6 m^2 each: hundreds of foot-floor pairs and
 // hexapods bumping into each other, enough pairs to be split over workers.
 TEST(OdeSwarmTest, HexapodHashIsTheSameAtOneTwoAndFourThreads) {
