@@ -202,6 +202,28 @@ TEST(OdeBackend, ForceModeGivesTheExpectedAngularAcceleration) {
   EXPECT_NEAR(f.scene().joint(arm.joint).position, 0.5 * 0.1 / inertia * t * t, 0.01);
 }
 
+// Absurd torques blow eight arms (eight islands, solved on both threads) up:
+// whatever ODE does with the infinities, on whichever thread, the step ends
+// with an error naming physics or ODE, never an abort.
+TEST(OdeBackend, ExplodingIslandsOnSolverThreadsAreAnErrorNotAnAbort) {
+  Fixture f(0.01, 2, 9.81, "ode", 2);
+  JointData j = Joint(JointType::kRevolute, JointMode::kForce);
+  j.target_force = 1e300;  // N m
+  for (int i = 0; i < 8; ++i) AddArm(&f.scene(), j, {{2.0 * i, 0, 1}, {}});
+  std::string message;
+  for (int i = 0; i < 100 && message.empty(); ++i) {
+    try {
+      f.world->Step();
+    } catch (const Error& e) {
+      message = e.what();
+    }
+  }
+  ASSERT_FALSE(message.empty()) << "the arms never broke the physics";
+  EXPECT_TRUE(message.find("non-finite") != std::string::npos ||
+              message.find("ode:") != std::string::npos)
+      << message;
+}
+
 TEST(OdeBackend, PassiveJointStopsAtItsLimits) {
   Fixture f(0.01, 5);
   JointData j = Joint(JointType::kRevolute, JointMode::kPassive);
