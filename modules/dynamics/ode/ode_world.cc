@@ -650,21 +650,30 @@ void OdeWorld::ApplyMotors(double dt) {
 }
 
 void OdeWorld::TrackJointPositions() {
-  for (size_t k = 0; k < joints_.size(); ++k) {
-    SimJoint& j = joints_[k];
-    switch (commands_[k].type) {
-      case JointType::kRevolute: {
-        const double a = dJointGetHingeAngle(j.joint);
-        j.position += WrapAngle(a - j.last_angle);
-        j.last_angle = a;
-        break;
+  // Each joint reads its bodies and writes only its own row: on every thread.
+  auto track = [this](int64_t begin, int64_t end) {
+    for (int64_t k = begin; k < end; ++k) {
+      SimJoint& j = joints_[static_cast<size_t>(k)];
+      switch (commands_[static_cast<size_t>(k)].type) {
+        case JointType::kRevolute: {
+          const double a = dJointGetHingeAngle(j.joint);
+          j.position += WrapAngle(a - j.last_angle);
+          j.last_angle = a;
+          break;
+        }
+        case JointType::kPrismatic: j.position = j.offset + dJointGetSliderPosition(j.joint); break;
+        case JointType::kSpherical:
+        case JointType::kScrew:
+        case JointType::kFixed: break;
       }
-      case JointType::kPrismatic: j.position = j.offset + dJointGetSliderPosition(j.joint); break;
-      case JointType::kSpherical:
-      case JointType::kScrew:
-      case JointType::kFixed: break;
     }
-  }
+  };
+  constexpr int64_t kGrain = 1024;
+  const int64_t n = static_cast<int64_t>(joints_.size());
+  if (settings_.scheduler)
+    settings_.scheduler->ParallelFor(0, n, kGrain, track);
+  else
+    track(0, n);
 }
 
 void OdeWorld::Substep(double dt, double fraction) {
@@ -692,13 +701,10 @@ void OdeWorld::StepOnce(double dt, double fraction) {
   dSpaceCollide(space_, this, &OdeWorld::NearCallback);
   // The spaces list their geoms in the order the solver last moved them,
   // which depends on the order its threads finished the islands: the pairs
-  // go in the geoms' build order, each with its first-built geom first.
-  auto order = [](dGeomID g) { return reinterpret_cast<uintptr_t>(dGeomGetData(g)); };
-  for (CandidatePair& pair : pairs_)
-    if (order(pair.a) > order(pair.b)) std::swap(pair.a, pair.b);
-  std::sort(pairs_.begin(), pairs_.end(), [&](const CandidatePair& x, const CandidatePair& y) {
-    return order(x.a) != order(y.a) ? order(x.a) < order(y.a) : order(x.b) < order(y.b);
-  });
+  // go in the geoms' build order (Collide: each with its first-built geom
+  // first).
+  std::sort(pairs_.begin(), pairs_.end(),
+            [](const CandidatePair& x, const CandidatePair& y) { return x.order < y.order; });
   FindContacts();
   for (size_t k = 0; k < pairs_.size(); ++k) AddContacts(k);
   // Each substep's constraint shuffles start from their own seed (DrawShuffle).
@@ -737,7 +743,14 @@ void OdeWorld::Collide(dGeomID a, dGeomID b) {
   const GeomInfo& ib = geom_info_[reinterpret_cast<uintptr_t>(dGeomGetData(b)) - 1];
   if (ia.instance >= 0 && ia.instance == ib.instance) return;
   if (ba && bb && dAreConnectedExcluding(ba, bb, dJointTypeContact)) return;
-  pairs_.push_back({a, b, 0});
+  // Geom data: build index + 1.
+  uint64_t first = reinterpret_cast<uintptr_t>(dGeomGetData(a));
+  uint64_t second = reinterpret_cast<uintptr_t>(dGeomGetData(b));
+  if (first > second) {
+    std::swap(a, b);
+    std::swap(first, second);
+  }
+  pairs_.push_back({a, b, 0, first << 32 | second});
 }
 
 void OdeWorld::FindContacts() {

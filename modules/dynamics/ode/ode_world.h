@@ -164,8 +164,9 @@ class OdeWorld {
   // A substep's candidate geom pairs (broadphase order) and their contact
   // points: pair k's in [k * max_contacts, + count).
   struct CandidatePair {
-    dGeomID a, b;
-    int count;
+    dGeomID a, b;    // a built before b
+    int count;       // contact points (FindContacts)
+    uint64_t order;  // a's build index, then b's: the pairs' order
   };
   std::vector<CandidatePair> pairs_;
   std::vector<dContactGeom> pair_contacts_;
