@@ -14,7 +14,7 @@ struct Options {
   double ground_friction = 1;  // Coulomb coefficient of the ground plane
   double erp = 0.2;            // ODE's error reduction parameter
   double cfm = 1e-6;           // ODE's constraint force mixing
-  uint32_t seed = 1;           // ODE's global random generator, at Build (if dRandInt is not ours)
+  uint32_t seed = 1;           // seeds the solver's constraint shuffles (ode_world.cc, dRandInt)
 };
 
 }  // namespace swarmsim::ode
