@@ -3,20 +3,11 @@
 
 #include "framework/force_sensor.h"
 #include "framework/scene.h"
+#include "modules/dynamics/ode/ode_internal.h"
 #include "modules/dynamics/ode/ode_world.h"
 #include "modules/dynamics/scene_walk.h"
 
 namespace swarmsim::ode {
-
-namespace {
-
-Pose BodyPoseOf(dBodyID body) {
-  const dReal* p = dBodyGetPosition(body);
-  const dReal* q = dBodyGetQuaternion(body);
-  return {{p[0], p[1], p[2]}, {q[0], q[1], q[2], q[3]}};
-}
-
-}  // namespace
 
 void OdeWorld::BuildForceSensors(const Scene& scene, const std::vector<dBodyID>& body_of) {
   const auto owners = scene.force_sensor_owners();
@@ -30,7 +21,7 @@ void OdeWorld::BuildForceSensors(const Scene& scene, const std::vector<dBodyID>&
     SimForceSensor f{};
     f.row = row;
     f.child_body = child;
-    f.X_BS = BodyPoseOf(child).Inverse() * scene.world_pose_at(s);
+    f.X_BS = BodyPose(child).Inverse() * scene.world_pose_at(s);
     feedback_.push_back(std::make_unique<dJointFeedback>());
     f.feedback = feedback_.back().get();
     f.joint = dJointCreateFixed(world_, nullptr);
@@ -48,7 +39,7 @@ void OdeWorld::ReadForceSensors(Scene* scene) {
     // centre of mass) that the joint applies to the child, world frame.
     const Vec3 f_W{f.feedback->f1[0], f.feedback->f1[1], f.feedback->f1[2]};
     const Vec3 t_com_W{f.feedback->t1[0], f.feedback->t1[1], f.feedback->t1[2]};
-    const Pose X_WB = BodyPoseOf(f.child_body);
+    const Pose X_WB = BodyPose(f.child_body);
     const Pose X_WS = X_WB * f.X_BS;
     // About the sensor origin: t_S = t_com + (p_com - p_S) x f.
     const Vec3 t_W = t_com_W + (X_WB.p - X_WS.p).Cross(f_W);

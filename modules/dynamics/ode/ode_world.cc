@@ -1,12 +1,8 @@
 #include "modules/dynamics/ode/ode_world.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
-#include <cstdarg>
 #include <cstdint>
-#include <cstdio>
-#include <mutex>
 #include <span>
 #include <string>
 
@@ -15,139 +11,20 @@
 #include "framework/scheduler.h"
 #include "framework/state_hash.h"
 #include "modules/dynamics/environment_obstacles.h"
+#include "modules/dynamics/ode/ode_internal.h"
 #include "modules/dynamics/ode/ode_threading.h"
 #include "modules/dynamics/scene_walk.h"
 
 namespace swarmsim::ode {
-namespace {
-uint64_t Mix64(uint64_t z) {  // splitmix64's finalizer
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  return z ^ (z >> 31);
-}
-// Set when ODE calls the dRandInt below (ProbeSolverShuffle).
-std::atomic<bool> g_shuffle_called{false};
-}  // namespace
-}  // namespace swarmsim::ode
-
-// ODE's quickstep shuffles its constraint rows (every 8th iteration, per
-// island) with `swap(order[i], order[dRandInt(i + 1)])`, and dRandInt is
-// ODE's only use of its random generator: one process-global seed. Stepped
-// islands on several threads, the draws interleave in whatever order the
-// threads run, so the state would depend on the thread count and timing.
-// This definition takes the place of ODE's (the program's own definition of
-// an exported function comes first when libode's call is bound, the usual
-// ELF rule). While an island is solved, the draws come from that island's
-// stream (SolverThreads::DrawShuffle: seeded by the step, the same whichever
-// thread solves the island); elsewhere (ODE's multi-threaded path, where an
-// island's solve is split into calls) the draw is a fixed function of n.
-// InitOdeOnce checks that ODE calls this one (ProbeSolverShuffle); if not,
-// the solver stays on one thread.
-extern "C" __attribute__((visibility("default"))) int dRandInt(int n) {
-  std::atomic<bool>& called = swarmsim::ode::g_shuffle_called;
-  if (!called.load(std::memory_order_relaxed)) called.store(true, std::memory_order_relaxed);
-  int draw;
-  if (swarmsim::ode::SolverThreads::DrawShuffle(n, &draw)) return draw;
-  if (n <= 1) return 0;
-  const uint64_t z = swarmsim::ode::Mix64(static_cast<uint64_t>(n) * 0x9e3779b97f4a7c15ULL);
-  return static_cast<int>(((z >> 32) * static_cast<uint64_t>(n)) >> 32);
-}
-
-namespace swarmsim::ode {
-
-namespace {
-
-using dynamics::ShapeAt;
-
-// Restitution applies above this approach speed, m/s (as in the Box2D backend).
-constexpr double kBounceVelocity = 0.1;
-// Position servo: motor velocity = kServoGain * error / dt (clamped).
-constexpr double kServoGain = 0.5;
-
-// ODE's error and debug handlers: ODE calls them on an internal assertion
-// (huge or degenerate geometry) and aborts the process if they return. Ours
-// throws instead, so the run ends with an error and its outputs written;
-// the unwinding leaves that ODE world unusable, and the World stops after
-// any physics error anyway.
-[[noreturn]] void ThrowOdeError(int number, const char* message, va_list arguments) {
-  char text[512];
-  std::vsnprintf(text, sizeof text, message, arguments);
-  throw Error("ode: internal error " + std::to_string(number) + ": " + text +
-              " (the physics cannot go on; an object moved or grew to extreme values?)");
-}
-
-// Whether ODE's quickstep draws its constraint shuffles from the dRandInt
-// defined below. Steps a small world once (a chain of three bodies, nine
-// iterations, so that the rows are shuffled) and looks.
-bool ProbeSolverShuffle() {
-  dWorldID world = dWorldCreate();
-  dThreadingImplementationID threading = dThreadingAllocateSelfThreadedImplementation();
-  dWorldSetStepThreadingImplementation(world, dThreadingImplementationGetFunctions(threading),
-                                       threading);
-  dWorldSetQuickStepNumIterations(world, 9);
-  dBodyID previous = nullptr;
-  for (int i = 0; i < 3; ++i) {
-    dBodyID body = dBodyCreate(world);
-    dBodySetPosition(body, i, 0, 0);
-    dJointID joint = dJointCreateBall(world, nullptr);
-    dJointAttach(joint, body, previous);
-    dJointSetBallAnchor(joint, i - 0.5, 0, 0);
-    previous = body;
-  }
-  g_shuffle_called = false;
-  dWorldQuickStep(world, 0.01);
-  const bool ours = g_shuffle_called;
-  dWorldSetStepThreadingImplementation(world, nullptr, nullptr);
-  dWorldDestroy(world);
-  dThreadingFreeImplementation(threading);
-  return ours;
-}
-
-bool g_solver_shuffle_is_ours = false;
-bool g_single_threaded_islands = false;  // SolverThreads' probe
-
-void InitOdeOnce() {
-  static std::once_flag once;
-  std::call_once(once, [] {
-    dInitODE2(0);
-    dSetErrorHandler(ThrowOdeError);
-    dSetDebugHandler(ThrowOdeError);
-    dAllocateODEDataForThread(dAllocateMaskAll);
-    g_solver_shuffle_is_ours = ProbeSolverShuffle();
-    if (g_solver_shuffle_is_ours)
-      g_single_threaded_islands = SolverThreads::ProbeSingleThreadedIslands();
-  });
-}
-
-}  // namespace
-
-std::string SolverThreading() {
-  InitOdeOnce();
-  if (!g_solver_shuffle_is_ours)
-    return "the solver runs on one thread (ODE's dRandInt is not the program's)";
-  if (!g_single_threaded_islands)
-    return "islands solved concurrently on the run's threads (ODE's multi-threaded island path)";
-  return "islands solved concurrently on the run's threads";
-}
 
 namespace {
 
 using dynamics::PathAt;
+using dynamics::ShapeAt;
 using dynamics::ThrowIfNotFinite;
 
-void SetBodyPose(dBodyID body, const Pose& X) {
-  dBodySetPosition(body, X.p.x, X.p.y, X.p.z);
-  const dQuaternion q = {X.q.w, X.q.x, X.q.y, X.q.z};
-  dBodySetQuaternion(body, q);
-}
-
-Pose BodyPose(dBodyID body) {
-  const dReal* p = dBodyGetPosition(body);
-  const dReal* q = dBodyGetQuaternion(body);
-  return {{p[0], p[1], p[2]}, {q[0], q[1], q[2], q[3]}};
-}
-
-Vec3 ToVec3(const dReal* v) { return {v[0], v[1], v[2]}; }
+// Position servo: motor velocity = kServoGain * error / dt (clamped).
+constexpr double kServoGain = 0.5;
 
 // A geom for the shape, or null if its size cannot make one. `mesh_data`:
 // the trimesh data of a mesh shape.
@@ -320,16 +197,6 @@ void OdeWorld::AddSurface(const ShapeData& shape, uint32_t slot) {
   surfaces_.push_back({slot, shape.surface_velocity, shape.surface_angular_velocity});
 }
 
-Vec3 OdeWorld::SurfaceVelocity(dGeomID geom, const GeomInfo& info, const Vec3& p_W) const {
-  if (info.surface < 0) return {};
-  const MovingSurface& surface = surfaces_[info.surface];
-  dQuaternion q;
-  dGeomGetQuaternion(geom, q);
-  const Quat q_WS{q[0], q[1], q[2], q[3]};
-  const Vec3 p_S = q_WS.Conjugate().Rotate(p_W - ToVec3(dGeomGetPosition(geom)));
-  return q_WS.Rotate(surface.v_S + surface.w_S.Cross(p_S));
-}
-
 dTriMeshDataID OdeWorld::MeshData(const std::shared_ptr<const TriangleMesh>& mesh) {
   static_assert(sizeof(dTriIndex) == sizeof(uint32_t) && sizeof(MeshTriangle) == 12 &&
                 sizeof(Vec3) == 3 * sizeof(double));
@@ -404,7 +271,7 @@ void OdeWorld::CreateWorld() {
   // the same state for any thread count, 1 included. ODE's own
   // single-threaded implementation only when the shuffle is not ours.
   if (!solver_threads_ && !threading_) {
-    if (g_solver_shuffle_is_ours) {
+    if (SolverShuffleIsOurs()) {
       solver_threads_ = std::make_unique<SolverThreads>(settings_.scheduler, world_);
     } else {
       threading_ = dThreadingAllocateSelfThreadedImplementation();
@@ -693,18 +560,9 @@ void OdeWorld::StepOnce(double dt, double fraction) {
     dBodySetAngularVel(k.body, k.w_WB.x, k.w_WB.y, k.w_WB.z);
   }
   ApplyMotors(dt);
-  // Broadphase on this thread: the candidate geom pairs, in the space's
-  // (deterministic) order. Then each pair's contact points, concurrently
-  // (each pair writes only its own slots), and the contact joints in pair
-  // order: the same joints in the same order for any thread count.
-  pairs_.clear();
-  dSpaceCollide(space_, this, &OdeWorld::NearCallback);
-  // The spaces list their geoms in the order the solver last moved them,
-  // which depends on the order its threads finished the islands: the pairs
-  // go in the geoms' build order (Collide: each with its first-built geom
-  // first).
-  std::sort(pairs_.begin(), pairs_.end(),
-            [](const CandidatePair& x, const CandidatePair& y) { return x.order < y.order; });
+  // The contact joints (ode_contacts.cc): the same joints in the same order
+  // for any thread count.
+  FindCandidatePairs();
   FindContacts();
   for (size_t k = 0; k < pairs_.size(); ++k) AddContacts(k);
   // Each substep's constraint shuffles start from their own seed (DrawShuffle).
@@ -720,101 +578,6 @@ void OdeWorld::StepOnce(double dt, double fraction) {
   if (!stepped) throw Error("ode: the solver could not step (out of memory?)");
   dJointGroupEmpty(contacts_);
   TrackJointPositions();
-}
-
-void OdeWorld::NearCallback(void* data, dGeomID a, dGeomID b) {
-  OdeWorld* self = static_cast<OdeWorld*>(data);
-  // A robot's sub-space against a geom or another robot's: their geoms
-  // pairwise (never a robot's geoms with each other).
-  if (dGeomIsSpace(a) || dGeomIsSpace(b)) {
-    dSpaceCollide2(a, b, data, &OdeWorld::NearCallback);
-    return;
-  }
-  self->Collide(a, b);
-}
-
-void OdeWorld::Collide(dGeomID a, dGeomID b) {
-  dBodyID ba = dGeomGetBody(a), bb = dGeomGetBody(b);
-  const bool dynamic_a = ba && !dBodyIsKinematic(ba);
-  const bool dynamic_b = bb && !dBodyIsKinematic(bb);
-  if (!dynamic_a && !dynamic_b) return;
-  if (ba == bb) return;
-  const GeomInfo& ia = geom_info_[reinterpret_cast<uintptr_t>(dGeomGetData(a)) - 1];
-  const GeomInfo& ib = geom_info_[reinterpret_cast<uintptr_t>(dGeomGetData(b)) - 1];
-  if (ia.instance >= 0 && ia.instance == ib.instance) return;
-  if (ba && bb && dAreConnectedExcluding(ba, bb, dJointTypeContact)) return;
-  // Geom data: build index + 1.
-  uint64_t first = reinterpret_cast<uintptr_t>(dGeomGetData(a));
-  uint64_t second = reinterpret_cast<uintptr_t>(dGeomGetData(b));
-  if (first > second) {
-    std::swap(a, b);
-    std::swap(first, second);
-  }
-  pairs_.push_back({a, b, 0, first << 32 | second});
-}
-
-void OdeWorld::FindContacts() {
-  const size_t m = static_cast<size_t>(options_.max_contacts);
-  if (pair_contacts_.size() < pairs_.size() * m) pair_contacts_.resize(pairs_.size() * m);
-  auto narrow = [this, m](int64_t begin, int64_t end) {
-    dAllocateODEDataForThread(dAllocateMaskAll);
-    for (int64_t k = begin; k < end; ++k) {
-      CandidatePair& pair = pairs_[static_cast<size_t>(k)];
-      pair.count = dCollide(pair.a, pair.b, options_.max_contacts,
-                            &pair_contacts_[static_cast<size_t>(k) * m], sizeof(dContactGeom));
-    }
-  };
-  // Debian's trimesh collider (OPCODE) is not thread-safe: worlds with
-  // meshes find their contacts on this thread.
-  constexpr int64_t kGrain = 256;
-  const int64_t n = static_cast<int64_t>(pairs_.size());
-  if (settings_.scheduler && !has_meshes_)
-    settings_.scheduler->ParallelFor(0, n, kGrain, narrow);
-  else
-    narrow(0, n);
-}
-
-void OdeWorld::AddContacts(size_t k) {
-  const CandidatePair& pair = pairs_[k];
-  const dGeomID a = pair.a, b = pair.b;
-  dBodyID ba = dGeomGetBody(a), bb = dGeomGetBody(b);
-  const GeomInfo& ia = geom_info_[reinterpret_cast<uintptr_t>(dGeomGetData(a)) - 1];
-  const GeomInfo& ib = geom_info_[reinterpret_cast<uintptr_t>(dGeomGetData(b)) - 1];
-  const double mu = std::sqrt(ia.friction * ib.friction);
-  const double bounce = std::max(ia.restitution, ib.restitution);
-  // Moving surfaces (conveyor belts): friction drives the contact towards
-  // a's surface point moving as b's, v_a + u_a = v_b + u_b (u: each
-  // surface's velocity at the contact point), so the bodies' relative
-  // velocity v_a - v_b is u = u_b - u_a in the contact plane. ODE
-  // constrains (v_1 - v_2) . fdir1 = motion1 where body 1 is a's body, or
-  // b's when a has none (a static belt: ODE then swaps the two).
-  const bool moving = ia.surface >= 0 || ib.surface >= 0;
-  const size_t first = k * static_cast<size_t>(options_.max_contacts);
-  for (int i = 0; i < pair.count; ++i) {
-    dContact c{};
-    c.geom = pair_contacts_[first + static_cast<size_t>(i)];
-    c.surface.mode = dContactApprox1 | (bounce > 0 ? dContactBounce : 0);
-    c.surface.mu = mu;
-    c.surface.bounce = bounce;
-    c.surface.bounce_vel = kBounceVelocity;
-    if (moving) {
-      const Vec3 p_W = ToVec3(c.geom.pos);
-      const Vec3 u = SurfaceVelocity(b, ib, p_W) - SurfaceVelocity(a, ia, p_W);
-      const Vec3 normal = ToVec3(c.geom.normal);
-      const Vec3 t = u - normal * normal.Dot(u);
-      const double speed = t.Norm();
-      if (speed > 1e-9) {
-        const Vec3 direction = t / speed;
-        c.fdir1[0] = direction.x;
-        c.fdir1[1] = direction.y;
-        c.fdir1[2] = direction.z;
-        c.surface.mode |= dContactFDir1 | dContactMotion1;
-        c.surface.motion1 = ba ? speed : -speed;
-      }
-    }
-    dJointID joint = dJointCreateContact(world_, contacts_, &c);
-    dJointAttach(joint, ba, bb);
-  }
 }
 
 void OdeWorld::WriteBack(Scene* scene) {

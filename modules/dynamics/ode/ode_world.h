@@ -140,6 +140,9 @@ class OdeWorld {
   void TrackJointPositions();
   // The space holding the geoms of `instance` (the top-level space for -1).
   dSpaceID SpaceOf(int32_t instance);
+  // ode_contacts.cc: the broadphase's candidate pairs (pairs_), in geom
+  // build order.
+  void FindCandidatePairs();
   static void NearCallback(void* data, dGeomID a, dGeomID b);
   void Collide(dGeomID a, dGeomID b);  // records a candidate pair
   void FindContacts();                 // dCollide per pair, concurrently
