@@ -10,7 +10,7 @@
 namespace swarmsim::ode {
 
 struct SolverThreads::Job {
-  const char* name = nullptr;           // ODE's name for the call
+  bool island = false;                  // the call that steps one whole island
   ddependencycount_t dependencies = 0;  // calls (and its own run) still to finish
   Job* dependent = nullptr;             // released when this one completes
   Wait* wait = nullptr;
@@ -217,7 +217,7 @@ void SolverThreads::Post(int* out_fault, dCallReleaseeID* out_releasee,
   job->fn = fn;
   job->context = context;
   job->index = index;
-  job->name = name;
+  job->island = g_single_threaded_islands && name && std::strcmp(name, kIslandStepper) == 0;
   job->home = t_pool == this && t_in_call > 0 ? t_self : kShared;
   if (out_releasee) *out_releasee = reinterpret_cast<dCallReleaseeID>(job);
   if (dependencies == 0) MakeReady(job);
@@ -281,32 +281,29 @@ SolverThreads::Job* SolverThreads::PopFor(int self) {
   return job;
 }
 
-void SolverThreads::Run(Job* job) {
+void SolverThreads::Run(std::unique_lock<std::mutex>& lock, Job* job) {
   bool ok = false;
-  bool skip;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    skip = failed_;
-  }
-  if (!skip) {
+  if (!failed_) {
+    lock.unlock();
     ++t_in_call;
-    const bool island =
-        g_single_threaded_islands && job->name && std::strcmp(job->name, kIslandStepper) == 0;
-    if (island) {
+    if (job->island) {
       t_shuffling = true;
       t_shuffle_state = shuffle_seed_;
     }
+    std::exception_ptr thrown;
     try {
       ok = job->fn(job->context, job->index, reinterpret_cast<dCallReleaseeID>(job)) != 0;
     } catch (...) {
-      std::lock_guard<std::mutex> lock(mutex_);
-      if (!failure_) failure_ = std::current_exception();
-      failed_ = true;
+      thrown = std::current_exception();
     }
     t_shuffling = false;
     --t_in_call;
+    lock.lock();
+    if (thrown) {
+      if (!failure_) failure_ = thrown;
+      failed_ = true;
+    }
   }
-  std::lock_guard<std::mutex> lock(mutex_);
   Release(job, !ok);
 }
 
@@ -319,9 +316,7 @@ void SolverThreads::Lane(int lane, Wait* wait) {
   std::unique_lock<std::mutex> lock(mutex_);
   while (!wait->done) {
     if (Job* job = PopFor(lane)) {
-      lock.unlock();
-      Run(job);
-      lock.lock();
+      Run(lock, job);
       continue;
     }
     work_.wait(lock);

@@ -103,8 +103,10 @@ class SolverThreads {
   void WaitCall(int* out_status, dCallWaitID wait, const dThreadedWaitTime* timeout);
   // Works from queue `lane` (and the shared one) until `wait` is done.
   void Lane(int lane, Wait* wait);
-  // Runs `job` on this thread and releases it.
-  void Run(Job* job);
+  // Runs `job` on this thread (unless a call failed this step) and releases
+  // it; `lock` (on mutex_) is held on entry and on return, not while the
+  // call runs.
+  void Run(std::unique_lock<std::mutex>& lock, Job* job);
   // One dependency of `job` done (its own run, or a call it waits for): a
   // job with none left either starts (queued) or, if it ran, completes and
   // releases the job depending on it.
