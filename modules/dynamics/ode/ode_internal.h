@@ -31,6 +31,11 @@ inline uint64_t Mix64(uint64_t z) {
   return z ^ (z >> 31);
 }
 
+// A draw in [0, n) from the high bits of `z` (0 when n <= 1).
+inline int Below(uint64_t z, int n) {
+  return n > 1 ? static_cast<int>(((z >> 32) * static_cast<uint64_t>(n)) >> 32) : 0;
+}
+
 // ODE initialised for the process (once; ode_process.cc), and whether ODE's
 // quickstep calls the program's dRandInt (else the solver stays on one thread).
 void InitOdeOnce();

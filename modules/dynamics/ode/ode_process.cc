@@ -40,9 +40,8 @@ extern "C" __attribute__((visibility("default"))) int dRandInt(int n) {
   if (!called.load(std::memory_order_relaxed)) called.store(true, std::memory_order_relaxed);
   int draw;
   if (swarmsim::ode::SolverThreads::DrawShuffle(n, &draw)) return draw;
-  if (n <= 1) return 0;
-  const uint64_t z = swarmsim::ode::Mix64(static_cast<uint64_t>(n) * 0x9e3779b97f4a7c15ULL);
-  return static_cast<int>(((z >> 32) * static_cast<uint64_t>(n)) >> 32);
+  return swarmsim::ode::Below(
+      swarmsim::ode::Mix64(static_cast<uint64_t>(n) * 0x9e3779b97f4a7c15ULL), n);
 }
 
 namespace swarmsim::ode {

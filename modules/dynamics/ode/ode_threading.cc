@@ -6,6 +6,7 @@
 
 #include "framework/error.h"
 #include "framework/scheduler.h"
+#include "modules/dynamics/ode/ode_internal.h"
 
 namespace swarmsim::ode {
 
@@ -145,11 +146,7 @@ SolverThreads::Job* SolverThreads::NewJob() {
 bool SolverThreads::DrawShuffle(int n, int* out) {
   if (!t_shuffling) return false;
   // splitmix64
-  uint64_t z = (t_shuffle_state += 0x9e3779b97f4a7c15ULL);
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  z ^= z >> 31;
-  *out = n > 1 ? static_cast<int>(((z >> 32) * static_cast<uint64_t>(n)) >> 32) : 0;
+  *out = Below(Mix64(t_shuffle_state += 0x9e3779b97f4a7c15ULL), n);
   return true;
 }
 
