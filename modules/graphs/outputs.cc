@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "framework/error.h"
+#include "framework/output_file.h"
 #include "framework/scheduler.h"
 #include "framework/world.h"
 #include "modules/graphs/module.h"
@@ -243,20 +244,19 @@ void GraphModule::WriteOutputs(const fs::path& dir) const {
   // The CSV files, robots' graphs in parallel (folders first, serially).
   for (const auto& series : series_)
     fs::create_directories((folder / series->file).parent_path(), ec);
-  std::vector<char> csv_ok(series_.size(), 0);
+  // Each written whole (WriteFileAtomically); "" or why not.
+  std::vector<std::string> csv_failure(series_.size());
   world_->scheduler().ParallelFor(
       0, static_cast<int64_t>(series_.size()), 4, [&](int64_t begin, int64_t end) {
-        for (int64_t k = begin; k < end; ++k) {
-          const std::string text = CsvText(*series_[k]);
-          std::ofstream f(folder / (series_[k]->file + ".csv"), std::ios::binary);
-          f.write(text.data(), static_cast<std::streamsize>(text.size()));
-          csv_ok[k] = f.flush() ? 1 : 0;
-        }
+        for (int64_t k = begin; k < end; ++k)
+          csv_failure[k] =
+              TryWriteFileAtomically(folder / (series_[k]->file + ".csv"), CsvText(*series_[k]));
       });
   for (size_t k = 0; k < series_.size(); ++k) {
     const Series& s = *series_[k];
     const fs::path csv = folder / (s.file + ".csv");
-    if (!csv_ok[k]) throw Error("cannot write '" + csv.string() + "'");
+    if (!csv_failure[k].empty())
+      throw Error("cannot write '" + csv.string() + "': " + csv_failure[k]);
     std::string& d = descriptions[k];
     d = "graph " + s.path + ": " + KindName(s.settings.kind) + ", " +
         std::to_string(s.settings.streams.size()) + " stream" +

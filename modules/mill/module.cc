@@ -4,9 +4,11 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <sstream>
 #include <string>
 
 #include "framework/error.h"
+#include "framework/output_file.h"
 #include "framework/scene.h"
 #include "framework/scheduler.h"
 #include "framework/state_hash.h"
@@ -246,7 +248,7 @@ void MillModule::WriteOutputs(const std::filesystem::path& dir) const {
   const auto& cuttables = static_cast<const Rows<CuttableRow>&>(*scene.rows(cuttable_type_));
   if (mills.size() == 0 && cuttables.size() == 0) return;
   const std::filesystem::path path = dir / "mill.csv";
-  std::ofstream f(path);
+  std::ostringstream f;  // written whole at the end (WriteFileAtomically)
   f << "object,type,removed_m3,voxels,voxels_left,volume_left_m3\n";
   char line[160];
   for (uint32_t r = 0; r < mills.size(); ++r) {
@@ -268,7 +270,7 @@ void MillModule::WriteOutputs(const std::filesystem::path& dir) const {
                   static_cast<double>(map_removed_voxels_) * v);
     f << line;
   }
-  if (!f) throw Error("cannot write " + path.string());
+  WriteFileAtomically(path, f.str());
 }
 
 void MillModule::HashState(StateHasher* hasher) const {

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "framework/error.h"
+#include "framework/output_file.h"
 
 namespace swarmsim::paint {
 
@@ -18,11 +19,21 @@ void WritePng(const std::filesystem::path& path, int width, int height,
   image.width = static_cast<png_uint_32>(width);
   image.height = static_cast<png_uint_32>(height);
   image.format = PNG_FORMAT_RGB;
-  if (!png_image_write_to_file(&image, path.c_str(), 0, rgb.data(), 0, nullptr)) {
+  // Encoded in memory, then written whole (WriteFileAtomically): a snapshot
+  // cut by a full disk never stays behind as a broken PNG.
+  png_alloc_size_t size = 0;
+  std::vector<uint8_t> bytes;
+  bool encoded = png_image_write_get_memory_size(image, size, 0, rgb.data(), 0, nullptr);
+  if (encoded) {
+    bytes.resize(size);
+    encoded = png_image_write_to_memory(&image, bytes.data(), &size, 0, rgb.data(), 0, nullptr);
+  }
+  if (!encoded) {
     const std::string why = image.message;
     png_image_free(&image);
     throw Error("cannot write '" + path.string() + "': " + why);
   }
+  WriteFileAtomically(path, std::string_view(reinterpret_cast<const char*>(bytes.data()), size));
 }
 
 RgbImage ReadPng(const std::filesystem::path& path) {

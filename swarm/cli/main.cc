@@ -2,6 +2,7 @@
 // parses the command line and calls the command that was given.
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <csignal>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -63,6 +64,10 @@ int Main(int argc, char** argv) {
     std::cerr << message;
     return kExitBadInput;
   }
+
+  // A file-size limit (ulimit -f) makes a write fail with EFBIG, reported
+  // like a full disk, instead of killing the program mid-write.
+  std::signal(SIGXFSZ, SIG_IGN);
 
   ModuleRegistry registry;
   RegisterBuiltinModules(&registry);

@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 #include <charconv>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -19,6 +20,7 @@
 #include "swarm/loader/world_loader.h"
 #include "swarm/record/writer.h"
 #include "swarm/run/runner.h"
+#include "swarm/run/stop_signals.h"
 #include "swarm/viewer/server.h"
 
 namespace swarmsim::cli {
@@ -197,10 +199,20 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
   // --out, summary.json says so too, for a batch system watching the folder.
   const auto bad_input = [&](const std::string& message) {
     std::cerr << "error: " << swarmsim::ValidUtf8(message) << "\n";
-    if (options.out_dir && !WriteErrorSummary(options, message))
-      std::cerr << "error: cannot write '" << (*options.out_dir / "summary.json").string() << "'\n";
-    return kExitBadInput;
+    // A stop signal while the world loaded: "interrupted", the shell's 128 + N.
+    const int sig = StopSignals::Received();
+    if (options.out_dir) {
+      const std::string reason =
+          WriteErrorSummary(options, message, sig != 0 ? "interrupted" : "error");
+      if (!reason.empty())
+        std::cerr << "error: cannot write '" << (*options.out_dir / "summary.json").string()
+                  << "': " << reason << "\n";
+    }
+    return sig != 0 ? 128 + sig : kExitBadInput;
   };
+  // SIGINT, SIGTERM, SIGHUP while a large world loads: the load stops between
+  // model copies and the run ends as interrupted, with its summary.json.
+  const StopSignals stop_signals;
   LoadOptions load;
   load.seed = args.seed;
   load.threads = args.threads;
@@ -208,12 +220,22 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
   load.trust_scripts = args.trust_scripts;
   load.plugin_directories = PluginDirectories();
   load.package_path.assign(args.package_path.begin(), args.package_path.end());
+  load.check_stop = [] {
+    if (const int sig = StopSignals::Received(); sig != 0)
+      throw Error(std::string("interrupted by SIG") + sigabbrev_np(sig) +
+                  " while the world was loading");
+  };
   LoadedWorld loaded;
   try {
     load.overrides = ParseSets(args.sets);
     options.overrides = load.overrides;
     for (const std::string& plugin : args.plugins) LoadPlugin(plugin, registry);
     loaded = LoadWorld(args.world_file, load, *registry);
+  } catch (const Error& e) {
+    return bad_input(e.what());
+  }
+  try {
+    load.check_stop();  // a signal at the end of the load
   } catch (const Error& e) {
     return bad_input(e.what());
   }

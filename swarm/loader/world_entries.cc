@@ -553,6 +553,7 @@ void WorldLoader::BuildCopies(World* world) {
     };
     ObjectId first;  // the entry's first copy built from its own description
     for (size_t k = 0; k < poses.size(); ++k) {
+      if (options_.check_stop && k % 256 == 0) options_.check_stop();
       const EntryPlan::OwnCopy* own = e.FindOwnCopy(static_cast<int64_t>(k));
       ObjectId root;
       int instance;

@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -44,6 +45,10 @@ struct LoadOptions {
   // Whether the caller runs `python_controller:` entries (swarm/python does;
   // the program does not, and a world naming one is an error there).
   bool python_controllers = false;
+  // Called now and then while the world loads (between model copies); may
+  // throw swarmsim::Error to abandon the load (the program's stop signals).
+  // Empty: never.
+  std::function<void()> check_stop;
 };
 
 // A models entry's `python_controller:` (swarm/python runs it; the program

@@ -11,6 +11,7 @@
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <functional>
 #include <iomanip>
@@ -20,6 +21,7 @@
 #include <thread>
 
 #include "framework/error.h"
+#include "framework/output_file.h"
 #include "framework/script_host.h"
 #include "framework/state_hash.h"
 #include "framework/utf8.h"
@@ -37,6 +39,10 @@ double PeakRssMb() {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+// Disk space kept aside for the final summary.json (a summary of a run with
+// thousands of snapshots lists each one: ~100 bytes each).
+constexpr size_t kSummaryRoom = size_t{1} << 20;
 
 // A CSV field (RFC 4180): quoted when it holds a comma, quote or line break;
 // invalid UTF-8 replaced (ValidUtf8).
@@ -57,13 +63,14 @@ void WriteCsvField(std::ostream& os, std::string_view text) {
 // (a sweep's --timeout, the OOM killer) keeps all but the last second.
 class MetricsWriter {
  public:
-  MetricsWriter(const std::filesystem::path& path, const World& world) : world_(world) {
+  MetricsWriter(const std::filesystem::path& path, const World& world)
+      : world_(world), path_(path) {
+    errno = 0;
     file_.open(path);
-    if (!file_) throw Error("cannot write '" + path.string() + "'");
+    if (!file_) Fail();
     file_ << "step,time,robot,metric,value\n";
     file_ << std::setprecision(10);
-    file_.flush();
-    last_flush_ = Clock::now();
+    Flush();
   }
   void Write(const std::vector<MetricSample>& samples) {
     for (const MetricSample& m : samples) {
@@ -80,13 +87,24 @@ class MetricsWriter {
     }
     if (!samples.empty() && Clock::now() - last_flush_ >= std::chrono::seconds(1)) Flush();
   }
+  // Throws Error naming the file when the rows could not be written (a full
+  // disk): a run must not go on as if its metrics were kept.
   void Flush() {
+    errno = 0;
     file_.flush();
+    if (!file_) Fail();
     last_flush_ = Clock::now();
   }
 
  private:
+  [[noreturn]] void Fail() {
+    const int error = errno;
+    throw Error("cannot write '" + path_.string() + "'" +
+                (error != 0 ? std::string(": ") + std::strerror(error) : std::string()));
+  }
+
   const World& world_;
+  std::filesystem::path path_;
   std::ofstream file_;
   Clock::time_point last_flush_;
 };
@@ -266,11 +284,13 @@ std::string PhysicsLine(const WorldSettings& settings) {
 // A double that JSON should show as an integer: whole and exact (|v| <= 2^53).
 bool IsWholeNumber(double v) { return std::abs(v) <= 9007199254740992.0 && v == std::trunc(v); }
 
-// summary.json. `complete`: the world is between steps; else a step is
-// stuck (Watchdog) and what a running step may change is left out: the
-// state hash and the disabled scripts.
-bool WriteSummary(const World& world, const RunOptions& options, const RunResult& result,
-                  double lua_kib, bool complete) {
+// summary.json, written whole or not at all (WriteFileAtomically); returns
+// "" or why it could not be written. `complete`: the world is between steps;
+// else a step is stuck (Watchdog) and what a running step may change is
+// left out: the state hash and the disabled scripts. `status` replaces the
+// result's own ("running" while the run goes).
+std::string WriteSummary(const World& world, const RunOptions& options, const RunResult& result,
+                         double lua_kib, bool complete, const char* status = nullptr) {
   const int robots = world.live_robot_count();  // removed robots are not counted
   const double sim_time = world.time();
   const double robot_ticks = static_cast<double>(robots) * static_cast<double>(result.steps);
@@ -278,8 +298,11 @@ bool WriteSummary(const World& world, const RunOptions& options, const RunResult
   j["swarmsim_version"] = Version();
   j["world"] = options.world_file;
   j["command"] = options.command_line;
-  j["status"] = result.ok ? "ok" : result.signal != 0 ? "interrupted" : "error";
-  if (!result.ok) j["error"] = result.error;
+  j["status"] = status != nullptr    ? status
+                : result.ok          ? "ok"
+                : result.signal != 0 ? "interrupted"
+                                     : "error";
+  if (!result.ok && status == nullptr) j["error"] = result.error;
   j["seed"] = world.settings().seed;
   j["threads"] = world.threads();
   j["physics"] = world.settings().physics;
@@ -320,10 +343,10 @@ bool WriteSummary(const World& world, const RunOptions& options, const RunResult
       outputs.push_back(
           {{"kind", file.kind}, {"path", file.path}, {"description", file.description}});
   j["outputs"] = outputs;
-  std::ofstream f(*options.out_dir / "summary.json");
   // Invalid UTF-8 (from a world file, a script, a --set) is replaced, not fatal.
-  f << j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
-  return static_cast<bool>(f);
+  return TryWriteFileAtomically(
+      *options.out_dir / "summary.json",
+      j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
 }
 
 // What a run has produced so far, shared by its step loop, the watchdog's
@@ -331,7 +354,9 @@ bool WriteSummary(const World& world, const RunOptions& options, const RunResult
 struct RunRecord {
   RunResult result;
   std::unique_ptr<MetricsWriter> metrics;  // metrics.csv, with an output folder
-  double lua_kib = 0;                      // the scripts' memory when they stopped
+  // Room for the last summary.json when the disk fills during the run.
+  OutputReserve summary_room;
+  double lua_kib = 0;  // the scripts' memory when they stopped
 };
 
 // Starts `world` and steps it options.steps times under a Watchdog, writing
@@ -351,7 +376,11 @@ void StepWatched(World* world, const RunOptions& options, Clock::time_point star
     stuck.signal = signal;
     stuck.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
     stuck.peak_rss_mb = PeakRssMb();
-    if (metrics) metrics->Flush();
+    try {
+      if (metrics) metrics->Flush();
+    } catch (const Error&) {  // the summary says what stopped the run
+    }
+    record->summary_room.Release();
     if (options.out_dir && std::filesystem::is_directory(*options.out_dir))
       WriteSummary(*world, options, stuck, 0, /*complete=*/false);
     progress.Finish();
@@ -380,6 +409,14 @@ void StepWatched(World* world, const RunOptions& options, Clock::time_point star
     if (options.out_dir) {
       CreateOutputFolder(*options.out_dir);
       const std::lock_guard lock(watchdog.io_mutex());
+      // summary.json first (status "running"), so that the folder says what
+      // it is from the start and a full disk stops the run before step 1.
+      if (const std::string reason =
+              WriteSummary(*world, options, result, 0, /*complete=*/false, "running");
+          !reason.empty())
+        throw Error("cannot write '" + (*options.out_dir / "summary.json").string() +
+                    "': " + reason);
+      record->summary_room.Reserve(*options.out_dir, kSummaryRoom);
       metrics = std::make_unique<MetricsWriter>(*options.out_dir / "metrics.csv", *world);
     }
     world->Start();
@@ -452,20 +489,22 @@ void CreateOutputFolder(const std::filesystem::path& dir) {
   if (ec) throw Error("cannot create output folder '" + dir.string() + "': " + ec.message());
 }
 
-bool WriteErrorSummary(const RunOptions& options, const std::string& error) {
-  if (!options.out_dir) return false;
+std::string WriteErrorSummary(const RunOptions& options, const std::string& error,
+                              const std::string& status) {
+  if (!options.out_dir) return "no output folder";
   std::error_code ec;
   std::filesystem::create_directories(*options.out_dir, ec);
+  if (ec) return ec.message();
   nlohmann::json j;
   j["swarmsim_version"] = Version();
   j["world"] = options.world_file;
   j["command"] = options.command_line;
-  j["status"] = "error";
+  j["status"] = status;
   j["error"] = error;
-  std::ofstream f(*options.out_dir / "summary.json");
   // Invalid UTF-8 (from a world file, a script, a --set) is replaced, not fatal.
-  f << j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
-  return static_cast<bool>(f);
+  return TryWriteFileAtomically(
+      *options.out_dir / "summary.json",
+      j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
 }
 
 RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
@@ -481,7 +520,16 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
   // The steps, watched for one that never finishes.
   StepWatched(world, options, start, &progress, &record);
   progress.Finish();
-  if (record.metrics) record.metrics->Flush();
+  if (record.metrics) {
+    try {
+      record.metrics->Flush();
+    } catch (const Error& e) {
+      if (result.ok) {
+        result.ok = false;
+        result.error = e.what();
+      }
+    }
+  }
   // Observers' files (paint.png), also after an error: the outputs so far.
   if (options.out_dir && world->started()) {
     try {
@@ -502,11 +550,20 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
   if (options.print_hash) out << "state-hash: " << StateHasher::ToHex(result.state_hash) << "\n";
   out << std::flush;
 
-  if (options.out_dir &&
-      !WriteSummary(*world, options, result, record.lua_kib, /*complete=*/true)) {
-    if (result.ok) {
-      result.ok = false;
-      result.error = "cannot write '" + (*options.out_dir / "summary.json").string() + "'";
+  // The last file: the room kept for it is given back first (a full disk).
+  record.summary_room.Release();
+  if (options.out_dir && std::filesystem::is_directory(*options.out_dir)) {
+    if (const std::string reason =
+            WriteSummary(*world, options, result, record.lua_kib, /*complete=*/true);
+        !reason.empty()) {
+      const std::string message =
+          "cannot write '" + (*options.out_dir / "summary.json").string() + "': " + reason;
+      if (result.ok) {
+        result.ok = false;
+        result.error = message;
+      } else {
+        result.error += "; " + message;
+      }
     }
   }
   return result;

@@ -49,10 +49,12 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
                    std::ostream& progress);
 
 // summary.json for a run that never started (the world did not load, or the
-// command line and world do not agree): status "error", the message, world,
-// command and swarmsim_version. Creates `options.out_dir`; returns false
-// when the file cannot be written.
-bool WriteErrorSummary(const RunOptions& options, const std::string& error);
+// command line and world do not agree, or a signal came while it loaded):
+// `status` ("error" or "interrupted"), the message, world, command and
+// swarmsim_version. Creates `options.out_dir`; returns "" or why the file
+// could not be written.
+std::string WriteErrorSummary(const RunOptions& options, const std::string& error,
+                              const std::string& status = "error");
 
 // Creates the run's output folder (and its parents). Throws swarmsim::Error
 // naming it when it cannot.

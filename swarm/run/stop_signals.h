@@ -12,7 +12,7 @@ namespace swarmsim {
 
 class StopSignals {
  public:
-  StopSignals();   // clears a signal noted earlier
+  StopSignals();   // clears a signal noted earlier, unless another StopSignals lives
   ~StopSignals();  // restores the previous handlers
   StopSignals(const StopSignals&) = delete;
   StopSignals& operator=(const StopSignals&) = delete;
