@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include "framework/error.h"
@@ -212,7 +213,11 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
   };
   // SIGINT, SIGTERM, SIGHUP while a large world loads: the load stops between
   // model copies and the run ends as interrupted, with its summary.json.
-  const StopSignals stop_signals;
+  // Held until the run is over (the run's own nest inside and keep a signal
+  // noted in between); after it, the signals act as usual again (--view's
+  // serving ends with Ctrl-C).
+  std::optional<StopSignals> stop_signals;
+  stop_signals.emplace();
   LoadOptions load;
   load.seed = args.seed;
   load.threads = args.threads;
@@ -298,6 +303,7 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
     view_server->Start();
   }
   const RunResult result = RunWorld(loaded.world.get(), options, std::cout, std::cerr);
+  stop_signals.reset();
   if (run_recorder != nullptr)
     run_recorder->Finish(result.steps,
                          result.ok ? "ok" : (result.signal != 0 ? "interrupted" : "error"),

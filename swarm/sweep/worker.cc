@@ -129,11 +129,21 @@ RunOutcome CollectRun(int64_t id, const std::filesystem::path& out_dir, int wait
     }
   } catch (const std::exception&) {
   }
-  if (have_summary) {
-    o.steps = summary.value("steps", int64_t{0});
-    o.robots = summary.value("robots", int64_t{0});
-    o.state_hash = summary.value("state_hash", std::string());
-  }
+  // A run killed mid-way leaves its first summary ("running", no hash yet):
+  // each field read only when it has the type it should.
+  const auto field = [&](const char* key) -> const nlohmann::json* {
+    if (!have_summary || !summary.is_object()) return nullptr;
+    const auto it = summary.find(key);
+    return it == summary.end() ? nullptr : &*it;
+  };
+  if (const nlohmann::json* steps = field("steps"); steps && steps->is_number_integer())
+    o.steps = steps->get<int64_t>();
+  if (const nlohmann::json* robots = field("robots"); robots && robots->is_number_integer())
+    o.robots = robots->get<int64_t>();
+  if (const nlohmann::json* hash = field("state_hash"); hash && hash->is_string())
+    o.state_hash = hash->get<std::string>();
+  const nlohmann::json* status = field("status");
+  const nlohmann::json* error = field("error");
   ReadMetrics(out_dir / "metrics.csv", &o);
   if (timed_out) {
     o.error = "timed out after " + FormatNumber(timeout_s) + " s (--timeout)";
@@ -143,15 +153,15 @@ RunOutcome CollectRun(int64_t id, const std::filesystem::path& out_dir, int wait
     o.error = "crashed: killed by signal " + std::to_string(sig) + " (" + strsignal(sig) + ")";
     if (!err.empty()) o.error += ": " + err;
   } else if (!WIFEXITED(wait_status) || WEXITSTATUS(wait_status) != 0) {
-    if (have_summary && summary.contains("error"))
-      o.error = summary["error"].get<std::string>();
+    if (error && error->is_string())
+      o.error = error->get<std::string>();
     else if (!err.empty())
       o.error = err;
     else
       o.error = "exit status " + std::to_string(WEXITSTATUS(wait_status));
     if (WIFEXITED(wait_status) && WEXITSTATUS(wait_status) == 127 && err.empty())
       o.error = "cannot start the worker program";
-  } else if (!have_summary || summary.value("status", std::string()) != "ok") {
+  } else if (!status || !status->is_string() || status->get<std::string>() != "ok") {
     o.error = "the run wrote no valid summary.json";
   } else {
     o.ok = true;
