@@ -200,14 +200,23 @@ void RaiseError(lua_State*, const std::string& message) { throw LuaError(message
 void RaiseRefusal(lua_State*, const std::string& message) { throw LuaRefusal(message); }
 
 int CallProtected(lua_State* L, lua_CFunction f, const char* name) noexcept {
+  // After the running callback failed, every sim.* and sandbox function
+  // fails again: a C function called without a Lua instruction between
+  // (a __close handler run while the error unwinds) gets no count hook.
+  if (Context(L).budget_exhausted) return kRefused;
   // The message is built in a plain buffer: nothing with a destructor may be
   // alive when the caller raises the Lua error.
-  char message[4096];
+  char message[kMaxErrorTextBytes];
   const auto format = [&](const char* prefix, const char* what) {
-    if (prefix[0] != '\0')
-      std::snprintf(message, sizeof message, "%s: %s", prefix, what);
-    else
-      std::snprintf(message, sizeof message, "%s", what);
+    const int length = prefix[0] != '\0'
+                           ? std::snprintf(message, sizeof message, "%s: %s", prefix, what)
+                           : std::snprintf(message, sizeof message, "%s", what);
+    if (length < static_cast<int>(sizeof message)) return;
+    // Cut between UTF-8 characters, and said so (the note takes < 40 bytes).
+    size_t end = sizeof message - 40;
+    while (end > 0 && (static_cast<unsigned char>(message[end]) & 0xC0) == 0x80) --end;
+    std::snprintf(message + end, sizeof message - end, " ... (%d bytes cut)",
+                  length - static_cast<int>(end));
   };
   bool refused = false;
   try {
@@ -283,6 +292,11 @@ int ArgOption(lua_State* L, int arg, const char* def, const char* const options[
   throw Error("bad argument #" + std::to_string(arg) + " (invalid option '" + name +
               "'; expected " + expected +
               (nearest != nullptr ? "; did you mean '" + *nearest + "'?" : std::string()) + ")");
+}
+
+void PushDeferredWrite(lua_State* L, const DeferredWrite& write) {
+  ChargeScriptData(L, sizeof(DeferredWrite), "the write to another robot's object");
+  Context(L).runtime->deferred.push_back(write);  // released by World::Actuate
 }
 
 ObjectId OptRelativeTo(lua_State* L, int arg) {

@@ -33,7 +33,9 @@ namespace swarmsim {
 
 class PhaseHandlers;
 class Scene;
+class ScriptMemory;
 class World;
+struct DeferredWrite;
 struct RobotMail;
 struct RobotRuntime;
 
@@ -52,6 +54,7 @@ struct LuaContext {
   Scene* scene = nullptr;
   RobotRuntime* runtime = nullptr;  // the robot's, or the world's scene runtime
   RobotMail* mail = nullptr;        // the robot's, or the scene's (Messaging)
+  ScriptMemory* memory = nullptr;   // the robot's account, or the scene's (script_memory.h)
   int instance = -1;                // robot index; -1 for the scene state
   std::string name;                 // "footbot#12", or "scene"
   std::string log_prefix;           // "[footbot#12] ", or "[scene] "
@@ -74,9 +77,10 @@ struct LuaContext {
   // The running callback (or thread resume) used up its instruction budget:
   // every further instruction raises budget_error, and the host reports it.
   bool budget_exhausted = false;
-  bool slice_yielded = false;  // the thread being resumed yielded from its time-slice hook
-  std::string budget_error;    // "file:line: the callback ran more than ..."
-  std::string pending_error;   // a World error raised through the main script, verbatim
+  bool slice_yielded = false;   // the thread being resumed yielded from its time-slice hook
+  bool data_collected = false;  // ChargeScriptData collected garbage in this callback
+  std::string budget_error;     // "file:line: the callback ran more than ..."
+  std::string pending_error;    // a World error raised through the main script, verbatim
 };
 
 inline LuaContext& Context(lua_State* L) {
@@ -149,6 +153,17 @@ void ArgType(lua_State* L, int arg, int type);
 // the argument is absent and def is not null. Anything else is an error
 // listing the options (and the nearest, for a typo).
 int ArgOption(lua_State* L, int arg, const char* def, const char* const options[]);
+
+// Charges `bytes` of the calling script's data that C++ keeps for it to its
+// robot's account (ScriptMemory: lines printed, metrics, messages, signals,
+// custom data, deferred writes). When they do not fit, collects the state's
+// garbage and tries again; then throws an Error naming `what` and the
+// limit ("the signal would take the scripts past 256 MiB ...").
+void ChargeScriptData(lua_State* L, uint64_t bytes, const char* what);
+
+// Queues a write to an object another robot (or the scene) owns, applied
+// after the control phase (RobotRuntime::deferred), charged to the robot.
+void PushDeferredWrite(lua_State* L, const DeferredWrite& write);
 
 // Queues `add` to run on the scene when the caller's copies and removals
 // of robots are applied (after the control phase, robots in index order):

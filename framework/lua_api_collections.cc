@@ -45,6 +45,7 @@ int CreateCollection(lua_State* L) {
   if (all.size() >= kMaxScriptCollections)
     throw Error("a robot may make at most " + std::to_string(kMaxScriptCollections) +
                 " collections");
+  ChargeScriptData(L, sizeof(CollectionRow), "the collection");  // for the robot's lifetime
   all.emplace_back();
   lua_pushinteger(L, kScriptCollectionBase - static_cast<lua_Integer>(all.size() - 1));
   return 1;
@@ -78,6 +79,7 @@ int AddItemToCollection(lua_State* L) {
     throw Error("bad argument #2 (sim.handle_single, sim.handle_tree or sim.handle_all expected)");
   }
   item.exclude = !lua_isnoneornil(L, 4) && (ArgInteger(L, 4) & 1) != 0;
+  ChargeScriptData(L, sizeof(CollectionItem), "the collection item");
   collection.items.push_back(item);
   return 0;
 }

@@ -77,7 +77,10 @@ int HandleChildScript(lua_State* L) {
   if (script.callbacks[callback] == LUA_NOREF) return 0;
   // Call it with the arguments after the handle; return all it returns.
   const int nargs = lua_gettop(L) - 1;
+  if (!lua_checkstack(L, 2)) throw Error("not enough memory for the call");
   lua_rawgeti(L, LUA_REGISTRYINDEX, script.callbacks[callback]);
+  lua_insert(L, 2);
+  lua_pushcfunction(L, lua_host::LocateError);  // errors name the child's line
   lua_insert(L, 2);
   // The script runs on its caller's count: the caller's budget, or its
   // thread's slice (it cannot yield: the budget applies there). Re-arming a
@@ -88,12 +91,14 @@ int HandleChildScript(lua_State* L) {
   script.running = true;
   // Lua makes room for all the results of a LUA_MULTRET call (and the
   // arguments are the caller's, already on this stack): nothing to grow here.
-  const int status = lua_pcall(L, nargs, LUA_MULTRET, 0);
+  const int status = lua_pcall(L, nargs, LUA_MULTRET, 2);
   script.running = false;
   SetCurrent(state, *caller);
+  lua_remove(L, 2);  // the message handler
   if (status != LUA_OK) {
-    std::string error = (c.budget_exhausted ? c.budget_error : ErrorText(L, status)) + " (in " +
-                        kCallbackNames[callback] + " of the explicit script of " + path + ")";
+    std::string error = CutErrorText(c.budget_exhausted ? c.budget_error : ErrorText(L, status)) +
+                        " (in " + kCallbackNames[callback] + " of the explicit script of " + path +
+                        ")";
     lua_pop(L, 1);
     if (Disable(state, script, c.name + ": " + error)) {
       if (c.budget_exhausted) {
@@ -120,6 +125,7 @@ int HandleChildScript(lua_State* L) {
 // this step; it resumes in the next one. Only the script's thread itself yields: in a coroutine of
 // the script's own, lua_yield would return to that coroutine's resumer, not to the simulation.
 int SwitchThread(lua_State* L) {
+  if (Context(L).budget_exhausted) FailCallback(L);  // the thread failed: no yield
   const lua_State* thread = Context(L).thread;
   if (thread != nullptr && L != thread)
     return luaL_error(

@@ -9,9 +9,13 @@
 // reads the blocks as they were when the step began, whatever the thread
 // count; writes to one block in one step: the highest robot index wins, then
 // scene scripts.
+#include <cstring>
+#include <string>
+
 #include "framework/lua_api.h"
 #include "framework/messaging.h"
 #include "framework/scene.h"
+#include "framework/script_memory.h"
 
 namespace swarmsim {
 namespace {
@@ -20,10 +24,13 @@ int WriteCustomDataBlock(lua_State* L) {
   const LuaContext& c = Context(L);
   const ObjectId id = CheckObject(L, 1);
   c.scene->SlotOf(id);  // a bad handle is an error now, not a silent no-op later
-  std::string tag = ArgString(L, 2);
+  const char* tag = ArgString(L, 2);
+  const size_t tag_size = std::strlen(tag);  // up to a NUL, as readCustomDataBlock reads it
   size_t size = 0;
   const char* data = lua_isnoneornil(L, 3) ? "" : ArgString(L, 3, &size);
-  c.mail->custom_data_writes.push_back({id, std::move(tag), std::string(data, size)});
+  // Charged until the block is overwritten or removed (Scene::WriteCustomData).
+  ChargeScriptData(L, CustomDataBytes(tag_size, size), "the custom data block");
+  c.mail->custom_data_writes.push_back({id, std::string(tag, tag_size), std::string(data, size)});
   return 0;
 }
 

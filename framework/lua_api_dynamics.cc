@@ -24,8 +24,7 @@ int SetObjectDynamic(lua_State* L) {
   const ObjectId id = CheckObject(L, 1);
   ArgType(L, 2, LUA_TBOOLEAN);
   c.scene->shape(id);  // validates: a shape, not stale
-  c.runtime->deferred.push_back(
-      {id, DeferredWrite::Kind::kShapeDynamic, lua_toboolean(L, 2) ? 1.0 : 0.0});
+  PushDeferredWrite(L, {id, DeferredWrite::Kind::kShapeDynamic, lua_toboolean(L, 2) ? 1.0 : 0.0});
   return 0;
 }
 

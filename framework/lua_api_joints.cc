@@ -44,7 +44,7 @@ void SetJointTarget(lua_State* L, DeferredWrite::Kind kind) {
     else
       joint.target_position = value;
   } else {
-    c.runtime->deferred.push_back({c.scene->IdAt(slot), kind, value});
+    PushDeferredWrite(L, {c.scene->IdAt(slot), kind, value});
   }
 }
 
@@ -83,8 +83,7 @@ int SetJointPosition(lua_State* L) {
   if (c.instance < 0)
     joint.JumpTo(value);
   else
-    c.runtime->deferred.push_back(
-        {c.scene->IdAt(slot), DeferredWrite::Kind::kJointPosition, value});
+    PushDeferredWrite(L, {c.scene->IdAt(slot), DeferredWrite::Kind::kJointPosition, value});
   return 0;
 }
 

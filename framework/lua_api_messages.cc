@@ -1,8 +1,8 @@
 // sim.* messages, signals and packing.
 //
 // Messages (delivered at the start of the next step, in sender-handle order;
-// at most 1 MiB each, and the messages one robot sends in one step hold at
-// most its Lua memory limit, simulation.script_memory_mb):
+// at most 1 MiB each; until then each is charged to its sender's memory
+// account, against simulation.script_memory_mb with its Lua memory):
 //   sim.sendGlobalMessage(data)          every script of the world but the sender
 //   sim.sendLocalMessage(data)           the other scripts of the sender's model
 //   sim.sendDirectMessage(handle, data)  the script attached to object `handle`
@@ -30,6 +30,7 @@
 #include "framework/lua_api.h"
 #include "framework/messaging.h"
 #include "framework/plugin_controllers.h"
+#include "framework/script_memory.h"
 #include "framework/world.h"
 
 namespace swarmsim {
@@ -48,25 +49,14 @@ std::string_view CheckData(lua_State* L, int arg) {
   return {data, length};
 }
 
-// "256 MiB", or bytes for a limit that is not a whole number of MiB.
-std::string LimitText(uint64_t bytes) {
-  return bytes % (1 << 20) == 0 ? std::to_string(bytes >> 20) + " MiB"
-                                : std::to_string(bytes) + " bytes";
-}
-
 void Send(lua_State* L, MessageScope scope, std::string_view data, ObjectId target = {},
           double range = 0, bool line_of_sight = false) {
   LuaContext& c = Context(L);
-  // What one robot sends in one step is bounded like its Lua memory: the
-  // outboxes of a swarm could otherwise take all of the host's. A message
-  // counts its data and its outbox entry.
+  // Charged to the robot's account until the next step's messages are
+  // delivered (Messaging::GatherMessages): the outboxes of a swarm could
+  // otherwise take all of the host's memory.
   RobotMail& mail = *c.mail;
-  const uint64_t total = mail.outbox_bytes + data.size() + sizeof(Message);
-  const int64_t limit = c.world->settings().script_memory_limit;  // 0: no limit
-  if (limit > 0 && total > static_cast<uint64_t>(limit))
-    throw Error("the messages sent this step would hold more than " +
-                LimitText(static_cast<uint64_t>(limit)) + " (simulation.script_memory_mb)");
-  mail.outbox_bytes = total;
+  ChargeScriptData(L, data.size() + sizeof(Message), "the message");
   Message m;
   m.data = data;
   m.sender = c.script_object;
@@ -149,8 +139,17 @@ std::string ArgBytes(lua_State* L, int arg) {
 
 int SetSignal(lua_State* L) {
   LuaContext& c = Context(L);
+  const int type = lua_type(L, 2);
+  if (type != LUA_TNUMBER && type != LUA_TBOOLEAN && type != LUA_TSTRING && type != LUA_TNIL)
+    throw Error(std::string("a signal is a number, boolean or string (got ") + luaL_typename(L, 2) +
+                ")");
+  // Charged until the signal is overwritten or cleared (Messaging).
+  size_t name_size = 0, text_size = 0;
+  ArgString(L, 1, &name_size);
+  if (type == LUA_TSTRING) lua_tolstring(L, 2, &text_size);
+  ChargeScriptData(L, SignalBytes(name_size, text_size), "the signal");
   std::string name = ArgBytes(L, 1);
-  switch (lua_type(L, 2)) {
+  switch (type) {
     case LUA_TNUMBER:
       c.mail->signal_writes.emplace_back(std::move(name), lua_tonumber(L, 2));
       break;
@@ -158,14 +157,14 @@ int SetSignal(lua_State* L) {
       c.mail->signal_writes.emplace_back(std::move(name), lua_toboolean(L, 2) != 0);
       break;
     case LUA_TSTRING: c.mail->signal_writes.emplace_back(std::move(name), ArgBytes(L, 2)); break;
-    case LUA_TNIL: c.mail->signal_writes.emplace_back(std::move(name), std::nullopt); break;
-    default:
-      throw Error(std::string("a signal is a number, boolean or string (got ") +
-                  luaL_typename(L, 2) + ")");
+    default: c.mail->signal_writes.emplace_back(std::move(name), std::nullopt); break;
   }
   return 0;
 }
 int ClearSignal(lua_State* L) {
+  size_t name_size = 0;
+  ArgString(L, 1, &name_size);
+  ChargeScriptData(L, SignalBytes(name_size, 0), "the signal");
   Context(L).mail->signal_writes.emplace_back(ArgBytes(L, 1), std::nullopt);
   return 0;
 }
@@ -178,7 +177,7 @@ int GetSignal(lua_State* L) {
     lua_pushnil(L);
     return 1;
   }
-  PushParamValue(L, it->second);  // integral numbers as Lua integers
+  PushParamValue(L, it->second.value);  // integral numbers as Lua integers
   return 1;
 }
 

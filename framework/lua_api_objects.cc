@@ -149,7 +149,7 @@ int SetObjectPoseOrPosition(lua_State* L, bool position_only) {
   }
   DeferredWrite w{id, DeferredWrite::Kind::kObjectPose, 0};
   w.pose = X_WO;
-  c.runtime->deferred.push_back(w);
+  PushDeferredWrite(L, w);
   return 0;
 }
 int SetObjectPose(lua_State* L) { return SetObjectPoseOrPosition(L, false); }
@@ -179,7 +179,7 @@ int SetObjectSizeFactor(lua_State* L) {
     throw Error("object '" + c.scene->PathOf(id) +
                 "' belongs to another robot or the scene; a robot's scripts can rescale only "
                 "their own robot");
-  c.runtime->deferred.push_back({id, DeferredWrite::Kind::kSizeFactor, f});
+  PushDeferredWrite(L, {id, DeferredWrite::Kind::kSizeFactor, f});
   return 0;
 }
 

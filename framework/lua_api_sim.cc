@@ -10,6 +10,12 @@
 namespace swarmsim {
 namespace {
 
+// A metric's name: a column of metrics.csv, a label in summary.json.
+constexpr size_t kMaxMetricNameBytes = 256;
+// What one robot's scripts (or the scene's and the main script) may print
+// in one step: a runaway print loop must not fill the disk or the memory.
+constexpr size_t kMaxPrintBytesPerStep = size_t{1} << 20;
+
 // sim.getSimulationTime() -> s, at the start of the current step.
 int GetSimulationTime(lua_State* L) {
   lua_pushnumber(L, Context(L).world->time());
@@ -52,13 +58,19 @@ int GetParam(lua_State* L) {
 // sim.recordMetric(name, value): a sample of this step for this robot; the
 // World collects them in robot order (World::TakeMetrics, metrics.csv).
 int RecordMetric(lua_State* L) {
-  const LuaContext& c = Context(L);
+  LuaContext& c = Context(L);
   size_t length = 0;
   const char* name = ArgString(L, 1, &length);
   const double value = ArgNumber(L, 2);
   if (length == 0) throw Error("the metric name is empty");
+  if (length > kMaxMetricNameBytes)
+    throw Error("the metric name is " + std::to_string(length) + " bytes long; at most " +
+                std::to_string(kMaxMetricNameBytes));
+  const uint64_t bytes = length + sizeof(MetricSample);
+  ChargeScriptData(L, bytes, "the metric sample");
   c.runtime->metrics.push_back(
       {c.world->step_count(), c.world->time(), c.instance, std::string(name, length), value});
+  c.runtime->metric_bytes += bytes;
   return 0;
 }
 
@@ -81,13 +93,29 @@ int GetRobotName(lua_State* L) {
 // print(...): one line in the run's log, "[footbot#12] a\tb" (scene scripts:
 // "[scene] "), written out after the phase in robot order.
 int Print(lua_State* L) {
-  const LuaContext& c = Context(L);
+  LuaContext& c = Context(L);
   const int n = lua_gettop(L);
   // Every argument to a string first: __tostring may raise a Lua error,
   // which must not jump over `line`.
   // A string per argument, and a few slots for luaL_tolstring's own work.
   if (!lua_checkstack(L, n + LUA_MINSTACK)) throw Error("too many arguments");
   for (int i = 1; i <= n; ++i) luaL_tolstring(L, i, nullptr);  // honours __tostring
+  // At most kMaxPrintBytesPerStep a step, checked before anything is copied.
+  RobotRuntime& rt = *c.runtime;
+  if (rt.print_step != c.world->step_count()) {
+    rt.print_step = c.world->step_count();
+    rt.printed_bytes = 0;
+  }
+  size_t printed = static_cast<size_t>(n);  // the tabs and the newline
+  for (int i = 1; i <= n; ++i) printed += lua_rawlen(L, n + i);
+  if (rt.printed_bytes + printed > kMaxPrintBytesPerStep)
+    throw Error("the scripts of " + c.name + " printed more than " +
+                std::to_string(kMaxPrintBytesPerStep >> 20) +
+                " MiB in this step (the most a robot may print in one step); a print in a loop?");
+  const uint64_t bytes = c.log_prefix.size() + printed + kHeldEntryBytes;
+  ChargeScriptData(L, bytes, "the printed line");
+  rt.printed_bytes += printed;
+  rt.log_bytes += bytes;
   std::string line = c.log_prefix;
   for (int i = 1; i <= n; ++i) {
     size_t length = 0;
@@ -95,7 +123,7 @@ int Print(lua_State* L) {
     if (i > 1) line += '\t';
     line.append(text, length);
   }
-  c.runtime->log.Add(std::move(line));
+  rt.log.Add(std::move(line));
   return 0;
 }
 

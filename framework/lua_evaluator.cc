@@ -26,7 +26,8 @@ LimitedLua::LimitedLua(const char* subject, size_t memory_limit, int64_t instruc
   c.instruction_budget = instruction_budget;
   c.budget_subject = subject;
   c.budget_setting = "";
-  state.memory.limit = memory_limit;
+  state.memory.own.Attach(nullptr, memory_limit);
+  c.memory = &state.memory.own;
   state.memory.holder = subject;
   state.memory.plural = false;
   state.memory.setting = "the limit of one evaluation";

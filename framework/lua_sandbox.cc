@@ -9,12 +9,14 @@
 //   os       clock, time, date, difftime only.
 // Everything else (os.execute, io.popen, package.loadlib, debug, dofile,
 // loadfile, string.dump, binary chunks) raises "file:line: os.execute is not
-// allowed ...". Three more rules keep runs stoppable, reproducible and their
-// outputs intact: setmetatable refuses a metatable with __gc (Lua runs
-// finalizers with hooks off: nothing could stop one that loops);
-// math.randomseed needs a seed (without one it reads the clock); io.open
-// refuses to write the run's own outputs (metrics.csv, summary.json, ...) in
-// the output folder. --trust-scripts (WorldSettings::trust_scripts) opens
+// allowed ...". A refusal ends the running callback whatever catches it
+// (pcall, xpcall, coroutines nested in coroutines: CheckedCall). Three more
+// rules keep runs stoppable, reproducible and their outputs intact:
+// setmetatable refuses a metatable with __gc (Lua runs finalizers with hooks
+// off: nothing could stop one that loops); math.randomseed needs a seed
+// (without one it reads the clock); io.open refuses to write the run's own
+// outputs (kRunOutputs and what the modules list) in the output folder.
+// --trust-scripts (WorldSettings::trust_scripts) opens
 // the full standard libraries instead, with the same folders: require
 // searches the world's folders before Lua's path, and relative paths in
 // io.open/io.lines start in the world's folder (reading) or the output
@@ -25,6 +27,7 @@
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
+#include <iterator>
 #include <sstream>
 #include <string>
 #include <string_view>
@@ -207,18 +210,47 @@ fs::path Canonical(const fs::path& path) {
   return ec ? path.lexically_normal() : out;
 }
 
-// The files a run writes into its output folder (swarm/run/runner.cc:
-// metrics.csv, summary.json; observers' WriteOutputs: paint.png), and
-// stderr.txt, where a sweep (swarm/sweep/worker.cc) keeps a run's errors.
-constexpr std::string_view kRunOutputs[] = {"metrics.csv", "summary.json", "paint.png",
-                                            "stderr.txt"};
+// What a run writes into its output folder, which scripts may not write:
+// the runner's files (swarm/run: summary.json, metrics.csv; swarm/record:
+// recording.swrec; --video without a FILE: video.mp4), a sweep's stderr.txt
+// (swarm/sweep/worker.cc), the modules' (paint.png, mill.csv) and the
+// folders they fill (graphs/, snapshots/). Beyond this list, every file the
+// world's modules list as theirs (World::ListOutputs: a --video FILE inside
+// the folder, the snapshots so far) is protected too.
+constexpr std::string_view kRunOutputs[] = {"summary.json", "metrics.csv", "recording.swrec",
+                                            "video.mp4",    "stderr.txt",  "paint.png",
+                                            "mill.csv",     "graphs",      "snapshots"};
 
-// Is `path` (canonical) one of the run's own outputs in `root` (canonical)?
-bool IsRunOutput(const fs::path& path, const fs::path& root) {
-  const fs::path folder = root.has_filename() ? root : root.parent_path();  // "out/": "out"
-  if (path.parent_path() != folder) return false;
-  const std::string name = path.filename().string();
-  return std::find(std::begin(kRunOutputs), std::end(kRunOutputs), name) != std::end(kRunOutputs);
+// Is `name` the output `output`, or a name a writer may give it while it
+// writes it aside (summary.json.tmp, .summary.json.1234)? A folder's name
+// stands for everything in it.
+bool IsOutputName(std::string_view name, std::string_view output) {
+  if (name.size() < output.size()) return false;
+  if (name == output) return true;
+  if (name.substr(0, output.size()) == output && name[output.size()] == '.') return true;
+  return name[0] == '.' && name.substr(1, output.size()) == output;
+}
+
+// Is `path` (canonical) one of the run's own outputs in `root` (canonical),
+// or inside one, or a folder holding one?
+bool IsRunOutput(const World& world, const fs::path& path, const fs::path& root) {
+  const fs::path relative = path.lexically_relative(root);
+  if (relative.empty() || *relative.begin() == "..") return false;
+  const std::string first = relative.begin()->string();
+  for (std::string_view output : kRunOutputs)
+    if (IsOutputName(first, output)) return true;
+  for (const OutputFile& file : world.ListOutputs()) {
+    // Component by component: the listed file's last one by IsOutputName.
+    const fs::path listed = fs::path(file.path).lexically_normal();
+    auto l = listed.begin(), r = relative.begin();
+    bool same = true;
+    for (; same && l != listed.end() && !l->empty() && r != relative.end(); ++l, ++r) {
+      const bool last = std::next(l) == listed.end() || std::next(l)->empty();
+      same = last ? IsOutputName(r->string(), l->string()) : *l == *r;
+    }
+    if (same && l != listed.begin()) return true;
+  }
+  return false;
 }
 
 // The file `text` names, checked against the sandbox: relative paths are
@@ -241,8 +273,8 @@ std::string CheckedPath(lua_State* L, const char* function, const std::string& t
     RaiseRefusal(L, std::string(function) + ": '" + text + "' is outside the " +
                         (write ? "run's output folder" : "world's folder") + " (" + root.string() +
                         "); scripts are sandboxed (run with --trust-scripts to lift it)");
-  if (write && IsRunOutput(resolved, root))
-    RaiseRefusal(L, std::string(function) + ": '" + resolved.filename().string() +
+  if (write && IsRunOutput(*Context(L).world, resolved, root))
+    RaiseRefusal(L, std::string(function) + ": '" + resolved.lexically_relative(root).string() +
                         "' is one of the run's own outputs in the output folder (" + root.string() +
                         "); write to another name");
   return path.string();
@@ -385,6 +417,41 @@ int SafeRequire(lua_State* L) {
 
 int RefuseFunction(lua_State* L) { Refuse(L, lua_tostring(L, lua_upvalueindex(1))); }
 
+// coroutine.resume, coroutine.close and the functions coroutine.wrap makes:
+// Lua's (upvalue 1), called protected. Once the running callback has failed
+// (a refusal, a spent instruction budget, the memory limit: LuaContext::
+// budget_exhausted) the resumer fails too. Count hooks are per Lua thread:
+// the failure arms one on the failing thread and on the callback's root,
+// but a coroutine between them (root -> co1 -> co2 -> refusal, each resume
+// under pcall) would get control back unhooked and go on; here it fails
+// instead, so no thread of the state runs Lua code again in that callback
+// (a suspended coroutine can only run through these functions).
+int CheckedCall(lua_State* L) {
+  if (Context(L).budget_exhausted) FailCallback(L);
+  lua_pushvalue(L, lua_upvalueindex(1));
+  lua_insert(L, 1);
+  const int status = lua_pcall(L, lua_gettop(L) - 1, LUA_MULTRET, 0);
+  if (Context(L).budget_exhausted) FailCallback(L);
+  if (status != LUA_OK) return lua_error(L);  // the error as Lua raised it
+  return lua_gettop(L);
+}
+
+// coroutine.wrap(f): Lua's generator, itself wrapped as CheckedCall.
+int CheckedWrap(lua_State* L) {
+  lua_pushvalue(L, lua_upvalueindex(1));  // Lua's coroutine.wrap
+  lua_insert(L, 1);
+  lua_call(L, lua_gettop(L) - 1, 1);
+  lua_pushcclosure(L, CheckedCall, 1);
+  return 1;
+}
+
+// The coroutine library at `table` with resume, wrap and close checked.
+void CheckCoroutines(lua_State* L, int table) {
+  WrapField(L, table, "resume", CheckedCall);
+  WrapField(L, table, "close", CheckedCall);
+  WrapField(L, table, "wrap", CheckedWrap);
+}
+
 // __index of the globals: builds the restricted libraries on first use and
 // refuses the forbidden ones. Other names are nil as usual.
 int SandboxGlobalIndex(lua_State* L) {
@@ -412,9 +479,11 @@ int SandboxGlobalIndex(lua_State* L) {
       lua_getfield(L, -2, kept);
       lua_setfield(L, -2, kept);
     }
-  } else if (key == LUA_COLIBNAME || key == LUA_UTF8LIBNAME) {
-    luaL_requiref(L, key == LUA_COLIBNAME ? LUA_COLIBNAME : LUA_UTF8LIBNAME,
-                  key == LUA_COLIBNAME ? luaopen_coroutine : luaopen_utf8, 0);
+  } else if (key == LUA_COLIBNAME) {
+    luaL_requiref(L, LUA_COLIBNAME, luaopen_coroutine, 0);
+    CheckCoroutines(L, -1);
+  } else if (key == LUA_UTF8LIBNAME) {
+    luaL_requiref(L, LUA_UTF8LIBNAME, luaopen_utf8, 0);
   } else if (key == "require") {
     lua_pushcfunction(L, (Guarded<SafeRequire, "require">));
   } else if (key == "package" || key == "debug") {
@@ -450,6 +519,9 @@ void OpenTrusted(lua_State* L) {
   lua_getglobal(L, LUA_IOLIBNAME);
   WrapField(L, -1, "open", Guarded<OpenFile<true>, "io.open">);
   WrapField(L, -1, "lines", Guarded<LinesOfFile<true>, "io.lines">);
+  lua_pop(L, 1);
+  lua_getglobal(L, LUA_COLIBNAME);
+  CheckCoroutines(L, -1);
   lua_pop(L, 1);
 }
 

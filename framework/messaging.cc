@@ -13,10 +13,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
+#include <string>
+#include <variant>
 
 #include "framework/proximity_backend.h"
 #include "framework/scene.h"
 #include "framework/scheduler.h"
+#include "framework/script_memory.h"
 #include "framework/state_hash.h"
 
 namespace swarmsim {
@@ -24,6 +28,19 @@ namespace {
 
 // Robots per task when filling inboxes: a few grid queries each.
 constexpr int64_t kReceiverGrain = 64;
+
+void Release(ScriptMemory* memory, uint64_t bytes) {
+  if (memory != nullptr) memory->Release(bytes);
+}
+
+// A signal's charge (value null: a clear).
+uint64_t SignalValueBytes(const std::string& name, const ParamValue* value) {
+  const std::string* text = value != nullptr ? std::get_if<std::string>(value) : nullptr;
+  return SignalBytes(name.size(), text != nullptr ? text->size() : 0);
+}
+uint64_t SignalWriteBytes(const std::string& name, const std::optional<ParamValue>& value) {
+  return SignalValueBytes(name, value ? &*value : nullptr);
+}
 
 }  // namespace
 
@@ -33,7 +50,16 @@ void Messaging::Resize(int robot_count) {
 }
 
 void Messaging::ClearRobot(int robot) {
-  robots_.at(robot) = RobotMail();
+  RobotMail& mail = robots_.at(robot);
+  // What it held goes, and so does its charge.
+  for (const Message& m : mail.outbox) Release(mail.memory, MessageBytes(m.data));
+  for (const auto& [name, value] : mail.signal_writes)
+    Release(mail.memory, SignalWriteBytes(name, value));
+  for (const RobotMail::CustomDataWrite& w : mail.custom_data_writes)
+    Release(mail.memory, CustomDataBytes(w.tag.size(), w.data.size()));
+  ScriptMemory* memory = mail.memory;
+  mail = RobotMail();
+  mail.memory = memory;
   pending_[robot] = 0;
 }
 
@@ -42,12 +68,21 @@ void Messaging::MarkAllPending() { pending_.assign(robots_.size(), 0xff); }
 void Messaging::ApplySignalWrites() {
   // Writes in robot order, then the scene's; the last write wins. Only
   // robots whose scripts wrote something (pending_) are visited.
+  // A write's charge becomes its signal's; the value it replaces, or a
+  // clear, releases the old charge.
   auto apply_signals = [&](RobotMail& mail) {
     for (auto& [name, value] : mail.signal_writes) {
-      if (value) {
-        signals_.insert_or_assign(std::move(name), std::move(*value));
-      } else if (auto it = signals_.find(name); it != signals_.end()) {
-        signals_.erase(it);
+      auto it = signals_.find(name);
+      if (it != signals_.end()) {
+        Release(it->second.owner, SignalValueBytes(it->first, &it->second.value));
+        if (!value) signals_.erase(it);
+      }
+      if (!value) {
+        Release(mail.memory, SignalWriteBytes(name, value));
+      } else if (it != signals_.end()) {
+        it->second = {std::move(*value), mail.memory};
+      } else {
+        signals_.emplace(std::move(name), Signal{std::move(*value), mail.memory});
       }
     }
     mail.signal_writes.clear();
@@ -89,8 +124,12 @@ void Messaging::ApplyCustomDataWrites(const std::vector<int>& writers, Scene* sc
   // Custom data written last step, robots in index order, then the scene's
   // scripts (the last write of a tag wins); objects removed since are skipped.
   auto apply_custom_data = [&](RobotMail& mail) {
-    for (RobotMail::CustomDataWrite& w : mail.custom_data_writes)
-      if (scene->IsValid(w.object)) scene->WriteCustomData(w.object, w.tag, std::move(w.data));
+    for (RobotMail::CustomDataWrite& w : mail.custom_data_writes) {
+      if (scene->IsValid(w.object))
+        scene->WriteCustomData(w.object, w.tag, std::move(w.data), mail.memory);
+      else
+        Release(mail.memory, CustomDataBytes(w.tag.size(), w.data.size()));
+    }
     mail.custom_data_writes.clear();
   };
   for (int r : writers) apply_custom_data(robots_[r]);
@@ -100,11 +139,14 @@ void Messaging::ApplyCustomDataWrites(const std::vector<int>& writers, Scene* sc
 void Messaging::GatherMessages(const std::vector<int>& writers) {
   // Gather in robot order, then the scene's; order by sender handle.
   ++round_;
+  // The last step's messages go: their senders' charges with them.
+  for (const Message& m : messages_)
+    Release(m.sender_instance >= 0 ? robots_[m.sender_instance].memory : scene_.memory,
+            MessageBytes(m.data));
   messages_.clear();
   auto gather = [&](RobotMail& mail) {
     for (Message& m : mail.outbox) messages_.push_back(std::move(m));
     mail.outbox.clear();
-    mail.outbox_bytes = 0;
   };
   for (int r : writers) gather(robots_[r]);
   gather(scene_);
@@ -240,9 +282,9 @@ void Messaging::HashState(StateHasher* h) const {
     h->AddValue(text.size());
     h->Add(text.data(), text.size());
   };
-  for (const auto& [name, value] : signals_) {
+  for (const auto& [name, signal] : signals_) {
     add_text(name);
-    add_text(ParamToString(value));
+    add_text(ParamToString(signal.value));
   }
   auto add_pending = [&](const RobotMail& mail) {
     for (const Message& m : mail.outbox) {

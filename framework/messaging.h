@@ -25,6 +25,7 @@ namespace swarmsim {
 
 class ProximityBackend;
 class Scene;
+class ScriptMemory;
 class StateHasher;
 class TaskScheduler;
 
@@ -48,14 +49,20 @@ struct ReceivedMessage {      // 32 bytes
   double bearing = 0;         // rad, of the sender in the receiver's root frame (0 = +x, CCW)
 };
 
+// What one message is charged to its sender's ScriptMemory, from the time
+// it is sent until the next step's messages are delivered.
+inline uint64_t MessageBytes(const std::string& data) { return data.size() + sizeof(Message); }
+
 // The mail of one robot's scripts, or of the scene's (and the main
 // script's). Only the worker running that robot touches it during a phase.
+// What it holds is charged to `memory` (the writer's): messages by
+// MessageBytes, signal writes by SignalBytes, custom-data writes by
+// CustomDataBytes (framework/script_memory.h); Messaging passes the charge
+// on to the signal or block written, or releases it.
 struct RobotMail {
+  ScriptMemory* memory = nullptr;      // the robot's (the World's), or null: nothing charged
   std::vector<Message> outbox;         // messages sent this step
   std::vector<ReceivedMessage> inbox;  // messages delivered this step, sender-handle order
-  // Bytes the outbox holds (data + sizeof(Message) each), against
-  // WorldSettings::script_memory_limit; reset when the outbox is gathered.
-  uint64_t outbox_bytes = 0;
   // sim.setSignal/clearSignal writes (nullopt clears), applied at the next step.
   std::vector<std::pair<std::string, std::optional<ParamValue>>> signal_writes;
   // sim.writeCustomDataBlock writes (object, tag, data; empty data removes),
@@ -71,6 +78,13 @@ struct RobotMail {
   bool has_writes() const {
     return !outbox.empty() || !signal_writes.empty() || !custom_data_writes.empty();
   }
+};
+
+// A signal's value, and the account of the script that wrote it (null:
+// set from C++, not charged).
+struct Signal {
+  ParamValue value;
+  ScriptMemory* owner = nullptr;
 };
 
 class Messaging {
@@ -110,7 +124,7 @@ class Messaging {
   uint64_t round() const { return round_; }
   // Signal values: the scripts' writes are applied when a control pass ends
   // (robots in index order, then the scene's scripts; the last write wins).
-  const std::map<std::string, ParamValue, std::less<>>& signals() const { return signals_; }
+  const std::map<std::string, Signal, std::less<>>& signals() const { return signals_; }
 
  private:
   // Robots whose scripts wrote mail since the last Deliver, in index order;
@@ -138,7 +152,7 @@ class Messaging {
   RobotMail scene_;                // the scene's scripts and the main script
   std::vector<Message> messages_;
   uint64_t round_ = 0;
-  std::map<std::string, ParamValue, std::less<>> signals_;
+  std::map<std::string, Signal, std::less<>> signals_;
   SpatialGrid grid_;                    // range messages, rebuilt each step
   std::vector<uint32_t> bucket_start_;  // local/direct messages per robot (robots + 2)
   std::vector<uint32_t> bucket_;        // message indices, grouped by receiving robot

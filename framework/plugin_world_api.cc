@@ -204,19 +204,19 @@ int SendMessage(void* world, int robot, int scope, const char* data, size_t size
     m.range = range;
     m.line_of_sight = line_of_sight != 0;
   }
+  // Charged to the robot's memory account, as a script's message is.
   RobotMail& mail = w.messaging().robot_mail(robot);
-  const uint64_t total = mail.outbox_bytes + size + sizeof(Message);
-  const int64_t limit = w.settings().script_memory_limit;  // 0: no limit
-  if (limit > 0 && total > static_cast<uint64_t>(limit)) return -1;
+  const uint64_t bytes = size + sizeof(Message);
+  if (mail.memory != nullptr && mail.memory->Charge(bytes) != ScriptMemory::kOk) return -1;
   try {
     m.data.assign(data != nullptr ? data : "", size);
     m.sender = scene.instance(robot).root;
     m.sender_instance = robot;
     mail.outbox.push_back(std::move(m));
   } catch (const std::exception&) {
+    if (mail.memory != nullptr) mail.memory->Release(bytes);
     return -1;  // out of memory
   }
-  mail.outbox_bytes = total;
   return 0;
 }
 

@@ -6,6 +6,7 @@
 
 #include "framework/error.h"
 #include "framework/object_type.h"
+#include "framework/script_memory.h"
 #include "framework/state_hash.h"
 #include "framework/suggest.h"
 
@@ -158,7 +159,7 @@ uint32_t Scene::AllocateSlot(std::string name, ObjectId parent, const Pose& X_PO
   name_[slot] = std::move(name);
   script_[slot] = -1;
   linked_dummy_[slot] = -1;
-  custom_data_[slot].reset();
+  DropCustomData(slot);
   size_factor_[slot] = 1;
   parent_[slot] = -1;
   first_child_[slot] = last_child_[slot] = next_sibling_[slot] = prev_sibling_[slot] = -1;
@@ -182,7 +183,7 @@ void Scene::FreeSlot(uint32_t slot) {
   if (linked_dummy_[slot] >= 0 && linked_dummy_[linked_dummy_[slot]] == static_cast<int32_t>(slot))
     linked_dummy_[linked_dummy_[slot]] = -1;
   alive_[slot] = 0;
-  custom_data_[slot].reset();
+  DropCustomData(slot);
   ++generation_[slot];
   name_[slot].clear();
   name_[slot].shrink_to_fit();
@@ -523,32 +524,48 @@ void Scene::LinkDummies(ObjectId a, ObjectId b) {
   linked_dummy_[sb] = static_cast<int32_t>(sa);
 }
 
-void Scene::WriteCustomData(ObjectId id, const std::string& tag, std::string data) {
+void Scene::WriteCustomData(ObjectId id, const std::string& tag, std::string data,
+                            ScriptMemory* writer) {
   auto& blocks = custom_data_[SlotOf(id)];
+  if (blocks) {
+    if (auto it = blocks->find(tag); it != blocks->end()) {
+      if (it->second.writer != nullptr)
+        it->second.writer->Release(CustomDataBytes(tag.size(), it->second.data.size()));
+      if (data.empty()) blocks->erase(it);
+    }
+  }
   if (data.empty()) {
-    if (blocks) blocks->erase(tag);
+    if (writer != nullptr) writer->Release(CustomDataBytes(tag.size(), 0));
     return;
   }
-  if (!blocks) blocks = std::make_unique<std::map<std::string, std::string>>();
-  (*blocks)[tag] = std::move(data);
+  if (!blocks) blocks = std::make_unique<CustomData>();
+  (*blocks)[tag] = {std::move(data), writer};
+}
+
+void Scene::DropCustomData(uint32_t slot) {
+  std::unique_ptr<CustomData> blocks = std::move(custom_data_[slot]);
+  if (!blocks) return;
+  for (const auto& [tag, block] : *blocks)
+    if (block.writer != nullptr)
+      block.writer->Release(CustomDataBytes(tag.size(), block.data.size()));
 }
 
 const std::string* Scene::ReadCustomData(ObjectId id, const std::string& tag) const {
   const auto& blocks = custom_data_[SlotOf(id)];
   if (!blocks) return nullptr;
   auto it = blocks->find(tag);
-  return it == blocks->end() ? nullptr : &it->second;
+  return it == blocks->end() ? nullptr : &it->second.data;
 }
 
 void Scene::HashCustomData(uint32_t slot, StateHasher* hasher) const {
   const auto& blocks = custom_data_[slot];
   if (!blocks) return;
   hasher->AddValue(slot);
-  for (const auto& [tag, data] : *blocks) {
+  for (const auto& [tag, block] : *blocks) {
     hasher->AddValue(tag.size());
     hasher->Add(tag.data(), tag.size());
-    hasher->AddValue(data.size());
-    hasher->Add(data.data(), data.size());
+    hasher->AddValue(block.data.size());
+    hasher->Add(block.data.data(), block.data.size());
   }
 }
 

@@ -33,6 +33,7 @@
 
 namespace swarmsim {
 
+class ScriptMemory;
 class StateHasher;
 struct ObjectTypeDescriptor;
 
@@ -429,7 +430,14 @@ class Scene {
   // Custom data: named byte strings attached to an object (CoppeliaSim's
   // custom data blocks), copied with the object when its model is duplicated.
   // Empty `data` removes the entry. Returns null when there is none.
-  void WriteCustomData(ObjectId id, const std::string& tag, std::string data);
+  // `writer` (a script's account, or null) has been charged
+  // CustomDataBytes(tag, data) for the write (framework/script_memory.h):
+  // the block keeps that charge until it is overwritten, removed or its
+  // object goes; a removal releases it at once. A copy of the object
+  // charges each writer again, whatever its limit (DuplicateSubtree throws
+  // first if the run's would be passed).
+  void WriteCustomData(ObjectId id, const std::string& tag, std::string data,
+                       ScriptMemory* writer = nullptr);
   const std::string* ReadCustomData(ObjectId id, const std::string& tag) const;
   // Folds the slot's custom data blocks (if any) into a state hash.
   void HashCustomData(uint32_t slot, StateHasher* hasher) const;
@@ -525,7 +533,14 @@ class Scene {
   std::vector<int32_t> script_;        // index into scripts_ or -1
   std::vector<int32_t> linked_dummy_;  // slot or -1
   // Custom data per slot, allocated only for objects that have some.
-  std::vector<std::unique_ptr<std::map<std::string, std::string>>> custom_data_;
+  struct CustomDataBlock {
+    std::string data;
+    ScriptMemory* writer = nullptr;  // charged for it (WriteCustomData)
+  };
+  using CustomData = std::map<std::string, CustomDataBlock>;
+  std::vector<std::unique_ptr<CustomData>> custom_data_;
+  // Releases the writers' charges for the slot's blocks and drops them.
+  void DropCustomData(uint32_t slot);
   std::vector<double> size_factor_;  // accumulated scale, 1 by default
   std::vector<uint32_t> free_slots_;
   size_t object_count_ = 0;

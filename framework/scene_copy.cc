@@ -6,6 +6,7 @@
 #include "framework/error.h"
 #include "framework/object_type.h"
 #include "framework/scene.h"
+#include "framework/script_memory.h"
 
 namespace swarmsim {
 
@@ -25,8 +26,14 @@ uint32_t Scene::CopyObject(uint32_t src, int32_t new_parent) {
   w_WO_[slot] = w_WO_[src];
   model_root_[slot] = model_root_[src];
   size_factor_[slot] = size_factor_[src];
-  if (custom_data_[src])
-    custom_data_[slot] = std::make_unique<std::map<std::string, std::string>>(*custom_data_[src]);
+  if (custom_data_[src]) {
+    // Each block a script wrote is charged again to its writer (the run's
+    // limit was checked by DuplicateSubtree).
+    custom_data_[slot] = std::make_unique<CustomData>(*custom_data_[src]);
+    for (const auto& [tag, block] : *custom_data_[slot])
+      if (block.writer != nullptr)
+        block.writer->Force(CustomDataBytes(tag.size(), block.data.size()));
+  }
   if (script_[src] >= 0 && scripts_[script_[src]].source) {
     const ScriptAttachment attachment = scripts_[script_[src]];
     script_[slot] = static_cast<int32_t>(scripts_.size());
@@ -71,6 +78,22 @@ ObjectId Scene::DuplicateSubtree(ObjectId root, ObjectId new_parent) {
   if (!new_parent.IsNull()) parent_slot = static_cast<int32_t>(SlotOf(new_parent, "parent object"));
   std::vector<uint32_t> sources;
   CollectSubtree(root_slot, &sources);
+  // The custom data blocks scripts wrote are charged again for the copy:
+  // refused before anything is copied if the run cannot hold them.
+  uint64_t charged = 0;
+  const RunScriptMemory* run = nullptr;
+  for (uint32_t src : sources) {
+    if (!custom_data_[src]) continue;
+    for (const auto& [tag, block] : *custom_data_[src]) {
+      if (block.writer == nullptr) continue;
+      charged += CustomDataBytes(tag.size(), block.data.size());
+      run = block.writer->run();
+    }
+  }
+  if (run != nullptr && run->limit() > 0 && run->taken() + charged > run->limit())
+    throw Error("copying '" + name_[root_slot] + "': its custom data blocks (" +
+                std::to_string(charged >> 20) + " MiB) would take the run's scripts past " +
+                std::to_string(run->limit() >> 20) + " MiB (simulation.run_script_memory_mb)");
   // Pre-order guarantees a parent is copied before its children.
   std::unordered_map<uint32_t, uint32_t> copy_of;
   copy_of.reserve(sources.size());

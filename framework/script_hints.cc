@@ -120,7 +120,7 @@ void CheckSysCallNames(ScriptState& state, const Script& script) {
       if (lua_type(L, -1) != LUA_TFUNCTION) {
         const std::string message = path + ": " + std::string(name) + " must be a function (got " +
                                     luaL_typename(L, -1) + ")";
-        ThrowScriptError(state, script.object, message, "loading the script");
+        ThrowScriptError(state, script, message, "loading the script");
       }
     } else {
       UncalledSysCall& u = uncalled.emplace_back(UncalledSysCall{path, std::string(name), 0, {}});

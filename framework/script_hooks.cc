@@ -16,17 +16,6 @@ namespace swarmsim {
 namespace lua_host {
 namespace {
 
-// "1.0 GiB", "300 MiB", "12 KiB": a refused allocation's size.
-std::string FormatBytes(size_t bytes) {
-  char text[32];
-  if (bytes >= (size_t{1} << 30))
-    std::snprintf(text, sizeof text, "%.1f GiB", static_cast<double>(bytes) / (1 << 30));
-  else if (bytes >= (size_t{1} << 20))
-    std::snprintf(text, sizeof text, "%zu MiB", bytes >> 20);
-  else
-    std::snprintf(text, sizeof text, "%zu KiB", (bytes + 1023) >> 10);
-  return text;
-}
 std::string MemoryLimitText(const LuaMemory& memory) {
   return std::string(memory.holder) + (memory.plural ? " hold" : " holds") + " more than " +
          MemoryLimitTail(memory);
@@ -82,17 +71,20 @@ void BudgetHook(lua_State* L, lua_Debug* ar) {
 // Count hook armed when a state's memory passed the limit (LuaMemory).
 void MemoryHook(lua_State* L, lua_Debug* ar) {
   auto* state = static_cast<ScriptState*>(Context(L).host_state);
-  if (const size_t refused = std::exchange(state->memory.refused_bytes, 0); refused > 0) {
+  LuaMemory& m = state->memory;
+  if (const size_t refused = std::exchange(m.refused_bytes, 0); refused > 0) {
     ExhaustBudget(L, [&] {
       return HookWhere(L, ar) + "an allocation of " + FormatBytes(refused) + " would take " +
-             state->memory.holder + " past " + MemoryLimitTail(state->memory);
+             (m.refused_by_run ? RunLimitTail(*m.account)
+                               : m.holder + std::string(" past ") + MemoryLimitTail(m));
     });
   }
   lua_gc(L, LUA_GCCOLLECT);
   // Still too much: fails the callback as a spent budget does, so pcall and
   // xpcall's handler cannot catch it and go on allocating.
-  if (state->memory.used > state->memory.limit)
-    ExhaustBudget(L, [&] { return HookWhere(L, ar) + MemoryLimitText(state->memory); });
+  const ScriptMemory& account = *m.account;
+  if (account.limit() > 0 && account.used() > account.limit())
+    ExhaustBudget(L, [&] { return HookWhere(L, ar) + MemoryLimitText(m); });
   // Garbage only: the threads get their usual hooks back (the exhausted
   // budget's, if it ran out).
   SetBudget(state->L, state->context);
@@ -141,20 +133,34 @@ void SliceHook(lua_State* L, lua_Debug* ar) {
 void* LimitedAlloc(void* ud, void* ptr, size_t osize, size_t nsize) {
   auto* state = static_cast<ScriptState*>(ud);
   LuaMemory& m = state->memory;
+  ScriptMemory& account = *m.account;
   const size_t old = ptr != nullptr ? osize : 0;
   if (nsize == 0) {
     std::free(ptr);
     m.used -= old;
+    account.ShrinkHeap(old);
     return nullptr;
   }
-  if (m.limit > 0 && nsize > old) {
-    const size_t after = m.used + (nsize - old);
-    const bool refuse = after > m.limit + kMemorySlack || after < m.used;
+  if (nsize <= old) {  // Lua assumes that shrinking never fails
+    void* p = std::realloc(ptr, nsize);
+    if (p == nullptr) return nullptr;
+    m.used -= old - nsize;
+    account.ShrinkHeap(old - nsize);
+    return p;
+  }
+  const size_t grow = nsize - old;
+  const uint64_t limit = account.limit();
+  const uint64_t after = account.used() + grow;
+  bool refuse = limit > 0 && (after > limit + kMemorySlack || after < account.used());
+  bool by_run = false;
+  if (!refuse && !account.GrowHeap(grow)) refuse = by_run = true;
+  if (refuse || (limit > 0 && after > limit)) {
     if (refuse) {
       m.refused = true;
-      m.refused_bytes = nsize - old;
+      m.refused_by_run = by_run;
+      m.refused_bytes = grow;
     }
-    if ((after > m.limit || refuse) && state->L != nullptr) {
+    if (state->L != nullptr) {
       // Armed on every thread whose hook is another (a callback's budget hook
       // set since would otherwise leave only the hard cap). lua_sethook may
       // be called at any point (even from a signal handler).
@@ -168,8 +174,11 @@ void* LimitedAlloc(void* ud, void* ptr, size_t osize, size_t nsize) {
     if (refuse) return nullptr;
   }
   void* p = std::realloc(ptr, nsize);
-  if (p == nullptr) return nullptr;
-  m.used = m.used - old + nsize;
+  if (p == nullptr) {
+    account.ShrinkHeap(grow);
+    return nullptr;
+  }
+  m.used += grow;
   m.refused = false;
   return p;
 }

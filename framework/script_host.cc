@@ -80,10 +80,16 @@ void Call(ScriptState& state, Script& script, int nargs, const char* what) {
   const CallInProgress in_progress(state, what);
   SetCurrent(state, script);
   state.context.budget_exhausted = false;
+  state.context.data_collected = false;
   state.memory.refused_bytes = 0;  // reported with the callback that made it
   SetBudget(state.L, state.context);
   script.running = true;
-  const int status = lua_pcall(state.L, nargs, 0, 0);
+  // LocateError below the function: errors name a line where Lua has one.
+  lua_State* L = state.L;
+  const int handler = lua_gettop(L) - nargs;
+  lua_pushcfunction(L, LocateError);
+  lua_insert(L, handler);
+  const int status = lua_pcall(L, nargs, 0, handler);
   script.running = false;
   if (!state.context.pending_error.empty()) {
     // A World error passed up through the main script: report it as is,
@@ -96,9 +102,10 @@ void Call(ScriptState& state, Script& script, int nargs, const char* what) {
   }
   if (status != LUA_OK) {
     if (state.context.budget_exhausted)
-      ThrowScriptError(state, script.object, state.context.budget_error, what);
-    ThrowScriptError(state, script.object, ErrorText(state.L, status), what);
+      ThrowScriptError(state, script, state.context.budget_error, what);
+    ThrowScriptError(state, script, ErrorText(L, status), what);
   }
+  lua_settop(L, handler - 1);
 }
 
 // Protected part of creating a state. Arguments: two integers seeding math.random.
@@ -186,7 +193,7 @@ void CheckIsFunction(ScriptState& state, const Script& script, const char* name)
   lua_settop(L, 0);
   if (type == LUA_TNIL || type == LUA_TFUNCTION) return;
   ThrowScriptError(
-      state, script.object,
+      state, script,
       script.source->path + ": " + name + " must be a function (got " + lua_typename(L, type) + ")",
       "loading the script");
 }
@@ -228,8 +235,10 @@ std::unique_ptr<ScriptState> NewState(World* world, int instance, RobotRuntime* 
   c.name = std::move(name);
   c.host_state = state.get();
   c.instruction_budget = world->settings().instruction_budget;
-  state->memory.limit =
-      static_cast<size_t>(std::max<int64_t>(world->settings().script_memory_limit, 0));
+  // The robot's account (the scene's for the scene's scripts and the main
+  // script), which the data its sim.* calls keep charges too.
+  state->memory.account = &world->script_memory(instance);
+  c.memory = state->memory.account;
   lua_State* L = lua_newstate(LimitedAlloc, state.get());
   if (L == nullptr) throw Error(c.name + ": not enough memory for a Lua state");
   state->L = L;
@@ -255,7 +264,7 @@ void Initialize(ScriptState* state) {
     if (it == factories.end()) {
       std::string message = CompileFactory(L, source);
       if (!message.empty())
-        ThrowScriptError(*state, script.object, std::move(message), "loading the script");
+        ThrowScriptError(*state, script, std::move(message), "loading the script");
       factories.emplace_back(&source, luaL_ref(L, LUA_REGISTRYINDEX));
       it = factories.end() - 1;
     }
@@ -326,6 +335,7 @@ void ResumeThread(ScriptState* state, Script& script) {
   SetCurrent(*state, script);
   c.thread = co;
   c.budget_exhausted = false;
+  c.data_collected = false;
   state->memory.refused_bytes = 0;  // reported with the callback that made it
   c.slice_fires = 0;
   c.slice_yielded = false;
@@ -343,7 +353,7 @@ void ResumeThread(ScriptState* state, Script& script) {
   script.running = false;
   c.thread = nullptr;
   script.slice_yielded = c.slice_yielded;
-  if (status == LUA_YIELD) {
+  if (status == LUA_YIELD && !c.budget_exhausted) {
     lua_pop(co, results);
     return;
   }
@@ -351,24 +361,25 @@ void ResumeThread(ScriptState* state, Script& script) {
   if (c.budget_exhausted)
     error = c.budget_error;
   else if (status != LUA_OK)
-    error = ErrorText(co, status);
+    error = LocatedErrorText(co, status, script);
   // Finished or failed: the coroutine is not resumed again.
   lua_settop(co, 0);
   luaL_unref(state->L, LUA_REGISTRYINDEX, script.thread_ref);
   script.thread = nullptr;
   script.thread_ref = LUA_NOREF;
-  if (!error.empty()) ThrowScriptError(*state, script.object, std::move(error), "sysCall_thread");
+  if (!error.empty()) ThrowScriptError(*state, script, std::move(error), "sysCall_thread");
 }
 
 // Pushes the callback `ref` of `script` and `args` (from
 // sim.handleChildScripts), growing the stack for them: Lua guarantees only
-// LUA_MINSTACK free slots, and writing past them corrupts the state.
+// LUA_MINSTACK free slots, and writing past them corrupts the state (and
+// Call adds its message handler).
 void PushCallback(ScriptState& state, const Script& script, int ref, Callback callback,
                   const std::vector<ParamValue>& args) {
   lua_State* L = state.L;
   if (!args.empty() &&
-      (args.size() >= INT_MAX || !lua_checkstack(L, 1 + static_cast<int>(args.size()))))
-    ThrowScriptError(state, script.object,
+      (args.size() >= INT_MAX - 2 || !lua_checkstack(L, 2 + static_cast<int>(args.size()))))
+    ThrowScriptError(state, script,
                      "sim.handleChildScripts: " + std::to_string(args.size()) +
                          " arguments do not fit on Lua's stack",
                      kCallbackNames[callback]);

@@ -2,6 +2,9 @@
 // under on_script_error.
 #include "framework/script_state.h"
 
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -11,17 +14,100 @@
 #include "framework/world.h"
 
 namespace swarmsim::lua_host {
+namespace {
+
+// Stack levels looked at for an error's place: it is raised near the top,
+// and lua_getstack walks from there (a deep recursion must not cost more).
+constexpr int kLevelsSearched = 100;
+
+// Does `text` start with a position, "name:line:" as luaL_where makes it
+// (a chunk name "[string \"...\"]" may hold colons of its own)?
+bool HasPosition(const char* text, size_t length) {
+  const size_t end = std::min<size_t>(length, 1024);
+  size_t i = 0;
+  if (end > 0 && text[0] == '[')
+    while (i < end && text[i] != ']') ++i;
+  while (i < end && text[i] != ':' && text[i] != '\n') ++i;
+  if (i == 0 || i >= end || text[i] != ':') return false;
+  size_t j = i + 1;
+  while (j < end && text[j] >= '0' && text[j] <= '9') ++j;
+  return j > i + 1 && j < end && text[j] == ':';
+}
+
+// Does `text` start with "<file>:"?
+bool StartsWithFile(const char* text, size_t length, const std::string& file) {
+  return !file.empty() && length > file.size() && text[file.size()] == ':' &&
+         std::memcmp(text, file.data(), file.size()) == 0;
+}
+
+// Where an error was raised: the innermost Lua function with a line, and
+// the innermost line of the running script's own file, from stack level
+// `level` of L outwards. Plain data: the message handler builds no C++
+// object (a Lua error may jump out of it).
+struct ErrorPlace {
+  char where[LUA_IDSIZE + 32] = "";  // "file:line: ", or ""
+  int script_line = 0;               // 0: no function of the script's file
+};
+ErrorPlace FindErrorPlace(lua_State* L, int level, const std::string* file) {
+  ErrorPlace place;
+  lua_Debug ar;
+  for (int n = 0; n < kLevelsSearched && lua_getstack(L, level, &ar) != 0; ++n, ++level) {
+    if (lua_getinfo(L, "Sl", &ar) == 0 || ar.currentline <= 0) continue;
+    if (place.where[0] == '\0')
+      std::snprintf(place.where, sizeof place.where, "%s:%d: ", ar.short_src, ar.currentline);
+    if (file != nullptr && ar.source[0] == '@' && *file == ar.source + 1) {
+      place.script_line = ar.currentline;
+      break;
+    }
+  }
+  return place;
+}
+
+const std::string* ScriptFile(const Script* script) {
+  return script != nullptr && script->source != nullptr && !script->source->path.empty()
+             ? &script->source->path
+             : nullptr;
+}
+
+}  // namespace
+
+std::string FormatBytes(uint64_t bytes) {
+  char text[32];
+  if (bytes >= (uint64_t{1} << 30))
+    std::snprintf(text, sizeof text, "%.1f GiB", static_cast<double>(bytes) / (1 << 30));
+  else if (bytes >= (uint64_t{1} << 20))
+    std::snprintf(text, sizeof text, "%llu MiB", static_cast<unsigned long long>(bytes >> 20));
+  else
+    std::snprintf(text, sizeof text, "%llu KiB",
+                  static_cast<unsigned long long>((bytes + 1023) >> 10));
+  return text;
+}
 
 std::string MemoryLimitTail(const LuaMemory& memory) {
-  return std::to_string(memory.limit >> 20) + " MiB of Lua memory (" + memory.setting + ")";
+  const ScriptMemory& account = *memory.account;
+  const std::string limit = std::to_string(account.limit() >> 20) + " MiB";
+  if (account.data() == 0) return limit + " of Lua memory (" + memory.setting + ")";
+  return limit + " (" + FormatBytes(account.used() - account.data()) + " of Lua memory and " +
+         FormatBytes(account.data()) +
+         " of data the sim.* calls keep for them: signals, custom data, messages, prints, "
+         "metrics; " +
+         memory.setting + ")";
+}
+
+std::string RunLimitTail(const ScriptMemory& account) {
+  const RunScriptMemory* run = account.run();
+  return "the run's scripts past " + std::to_string(run != nullptr ? run->limit() >> 20 : 0) +
+         " MiB (simulation.run_script_memory_mb: every robot's Lua memory and data together)";
 }
 
 std::string ErrorText(lua_State* L, int status) {
   if (status == LUA_ERRMEM) {
     const auto* state = static_cast<const ScriptState*>(Context(L).host_state);
     if (state != nullptr && state->memory.refused)
-      return std::string("an allocation would take ") + state->memory.holder + " past " +
-             MemoryLimitTail(state->memory);
+      return std::string("an allocation would take ") +
+             (state->memory.refused_by_run
+                  ? RunLimitTail(*state->memory.account)
+                  : state->memory.holder + std::string(" past ") + MemoryLimitTail(state->memory));
     return "not enough memory";
   }
   if (status != LUA_ERRRUN && status != LUA_ERRSYNTAX && status != LUA_ERRERR)
@@ -30,15 +116,63 @@ std::string ErrorText(lua_State* L, int status) {
   return std::string("(error object is a ") + luaL_typename(L, -1) + " value)";
 }
 
-void ThrowScriptError(const ScriptState& state, ObjectId object, std::string message,
+int LocateError(lua_State* L) {
+  const std::string* file = ScriptFile(static_cast<const Script*>(Context(L).host_script));
+  const int value = lua_gettop(L);
+  if (lua_type(L, value) != LUA_TSTRING) {
+    lua_pushfstring(L, "(error object is a %s value)", luaL_typename(L, value));
+    lua_replace(L, value);
+  }
+  size_t length = 0;
+  const char* text = lua_tolstring(L, value, &length);
+  const ErrorPlace place = FindErrorPlace(L, 1, file);
+  // The message as it starts once located.
+  const bool add_where = !HasPosition(text, length) && place.where[0] != '\0';
+  const char* start = add_where ? place.where : text;
+  int pieces = 1;
+  if (file != nullptr && place.script_line > 0 &&
+      !StartsWithFile(start, std::strlen(start), *file)) {
+    lua_pushfstring(L, "%s:%d: ", file->c_str(), place.script_line);
+    ++pieces;
+  }
+  if (add_where) {
+    lua_pushstring(L, place.where);
+    ++pieces;
+  }
+  lua_pushvalue(L, value);
+  lua_concat(L, pieces);
+  return 1;
+}
+
+std::string LocatedErrorText(lua_State* co, int status, const Script& script) {
+  std::string text = ErrorText(co, status);
+  if (status != LUA_ERRRUN && status != LUA_ERRERR) return text;
+  const std::string* file = ScriptFile(&script);
+  const ErrorPlace place = FindErrorPlace(co, 0, file);
+  if (!HasPosition(text.data(), text.size())) text.insert(0, place.where);
+  if (file != nullptr && place.script_line > 0 && !StartsWithFile(text.data(), text.size(), *file))
+    text.insert(0, *file + ":" + std::to_string(place.script_line) + ": ");
+  return text;
+}
+
+void ThrowScriptError(const ScriptState& state, const Script& script, std::string message,
                       std::string_view what) {
   lua_settop(state.L, 0);
   const Scene& scene = *state.context.scene;
-  const std::string path = scene.IsValid(object)   ? scene.PathOf(object)
-                           : state.context.is_main ? std::string("the main script")
-                                                   : std::string("?");
-  throw Error(state.context.name + ": " + message + " [in " + std::string(what) + " of " + path +
-              "]");
+  const std::string path = scene.IsValid(script.object) ? scene.PathOf(script.object)
+                           : state.context.is_main      ? std::string("the main script")
+                                                        : std::string("?");
+  // The script is named whatever the message says (a module's line, none).
+  if (const std::string* file = ScriptFile(&script);
+      file != nullptr && !StartsWithFile(message.data(), message.size(), *file))
+    message.insert(0, *file + ": ");
+  const std::string head = state.context.name + ": ";
+  const std::string tail = " [in " + std::string(what) + " of " + path + "]";
+  // Cut so that the whole text fits: the tail names where it happened.
+  const size_t room = kMaxErrorTextBytes > head.size() + tail.size() + 256
+                          ? kMaxErrorTextBytes - head.size() - tail.size()
+                          : 256;
+  throw Error(head + CutErrorText(message, room) + tail);
 }
 
 bool Disable(ScriptState& state, Script& script, const std::string& error) {
@@ -46,9 +180,34 @@ bool Disable(ScriptState& state, Script& script, const std::string& error) {
       state.context.is_main)
     return false;
   script.disabled = true;
-  state.context.runtime->log.Add("error, script disabled: " + error);
-  state.context.runtime->disabled.push_back(error);
+  std::string text = CutErrorText(error);
+  state.context.runtime->log.Add("error, script disabled: " + text);
+  state.context.runtime->disabled.push_back(std::move(text));
   return true;
 }
 
 }  // namespace swarmsim::lua_host
+
+namespace swarmsim {
+
+void ChargeScriptData(lua_State* L, uint64_t bytes, const char* what) {
+  LuaContext& c = Context(L);
+  ScriptMemory* account = c.memory;
+  if (account == nullptr) return;
+  ScriptMemory::Result result = account->Charge(bytes);
+  if (result != ScriptMemory::kOk && !c.data_collected) {
+    // Garbage first, as for the Lua heap; once per callback (a pcall loop
+    // around a refused call must not cost a full collection each time).
+    c.data_collected = true;
+    lua_gc(L, LUA_GCCOLLECT);
+    result = account->Charge(bytes);
+  }
+  if (result == ScriptMemory::kOk) return;
+  const auto* state = static_cast<const lua_host::ScriptState*>(c.host_state);
+  if (result == ScriptMemory::kPastRunLimit || state == nullptr)
+    throw Error(std::string(what) + " would take " + lua_host::RunLimitTail(*account));
+  throw Error(std::string(what) + " would take " + state->memory.holder + " past " +
+              lua_host::MemoryLimitTail(state->memory));
+}
+
+}  // namespace swarmsim

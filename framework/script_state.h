@@ -19,6 +19,7 @@
 #include "framework/lua_api.h"
 #include "framework/parameters.h"
 #include "framework/scene.h"
+#include "framework/script_memory.h"
 
 namespace swarmsim::lua_host {
 
@@ -64,19 +65,24 @@ struct Script {  // 88 bytes
 };
 static_assert(sizeof(Script) == 88);
 
-// What a Lua state holds, against simulation.script_memory_limit. Past the
-// limit an allocation still succeeds (up to kMemorySlack more) but arms a
-// count hook on the state's threads; at the next instruction the hook
-// collects garbage and, if the state still holds too much, fails the
-// script with its file and line. Past limit + slack allocations fail (Lua
-// then collects and retries, and reports out of memory) and arm the same
-// hook, which then fails the callback: a pcall loop around a huge
-// allocation would otherwise go on (each refusal costs a full collection).
-// The hooks and the allocator are in script_hooks.cc.
+// What a Lua state holds, counted in its robot's account (`account`, with
+// the data the sim.* calls keep for the robot's scripts: script_memory.h)
+// against simulation.script_memory_mb. Past the limit an allocation still
+// succeeds (up to kMemorySlack more) but arms a count hook on the state's
+// threads; at the next instruction the hook collects garbage and, if the
+// account still holds too much, fails the script with its file and line.
+// Past limit + slack, or past what the run may still give
+// (simulation.run_script_memory_mb), allocations fail (Lua then collects
+// and retries, and reports out of memory) and arm the same hook, which then
+// fails the callback: a pcall loop around a huge allocation would otherwise
+// go on (each refusal costs a full collection). The hooks and the
+// allocator are in script_hooks.cc.
 struct LuaMemory {
-  size_t used = 0;           // bytes
-  size_t limit = 0;          // bytes; 0: no limit
-  bool refused = false;      // the last allocation was refused (limit + slack)
+  size_t used = 0;               // bytes of this state's Lua heap
+  ScriptMemory own;              // the account of a state that has no robot's (LimitedLua)
+  ScriptMemory* account = &own;  // the robot's (World::script_memory)
+  bool refused = false;          // the last allocation was refused (limit + slack, or the run's)
+  bool refused_by_run = false;   // ... by the run's limit
   size_t refused_bytes = 0;  // the size of a refused allocation MemoryHook has not reported, or 0
   // How the errors name what holds the memory and the limit's setting.
   const char* holder = "the scripts";
@@ -132,16 +138,34 @@ inline bool Runs(const Scene& scene, const Script& script) {
   return attachment != nullptr && attachment->enabled;
 }
 
-// "4 MiB of Lua memory (simulation.script_memory_mb; ...)", the end of both
-// memory-limit messages.
+// "1.0 GiB", "300 MiB", "12 KiB".
+std::string FormatBytes(uint64_t bytes);
+
+// "4 MiB of Lua memory (simulation.script_memory_mb; ...)", the end of the
+// memory-limit messages (with the data the sim.* calls keep, when there is some).
 std::string MemoryLimitTail(const LuaMemory& memory);
+// "the run's scripts past 4096 MiB (simulation.run_script_memory_mb)".
+std::string RunLimitTail(const ScriptMemory& account);
 
 // The text of the error value on top of the stack.
 std::string ErrorText(lua_State* L, int status);
 
-// Throws "footbot#12: <message> [in <what> of /footbot#12/body]".
-[[noreturn]] void ThrowScriptError(const ScriptState& state, ObjectId object, std::string message,
-                                   std::string_view what);
+// Message handler of the host's protected calls of script code (lua_pcall's
+// msgh): the error's text (a value that is not a string named by its type),
+// with the file:line of the innermost Lua function that has one when the
+// text has no position (error(), error({}), math.max(nil, 1), a yield
+// outside a thread), and the running script's own file:line in front when
+// the position is another file's (a module it required).
+int LocateError(lua_State* L);
+// The same text for a coroutine that died of an error (its stack is not
+// unwound): a sysCall_thread.
+std::string LocatedErrorText(lua_State* co, int status, const Script& script);
+
+// Throws "footbot#12: <message> [in <what> of /footbot#12/body]", the
+// script's file in front of a message that does not start with it, the
+// message cut to kMaxErrorTextBytes (framework/error.h).
+[[noreturn]] void ThrowScriptError(const ScriptState& state, const Script& script,
+                                   std::string message, std::string_view what);
 
 // Under on_script_error: disable_script, disables `script` and logs `error`
 // once; returns false (the caller rethrows) under stop, and for the main script.

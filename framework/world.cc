@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <utility>
 
 #include "framework/calculation_module.h"
 #include "framework/dynamics_backend.h"
@@ -90,6 +91,11 @@ World::World(const WorldSettings& settings, const ModuleRegistry& registry)
   if (!(settings_.time_step > 0) || !std::isfinite(settings_.time_step))
     throw Error("time step must be a positive number of seconds");
   if (settings_.physics_substeps < 1) throw Error("physics substeps must be at least 1");
+  run_script_memory_.set_limit(
+      static_cast<uint64_t>(std::max<int64_t>(settings_.run_script_memory_limit, 0)));
+  scene_script_memory_.Attach(&run_script_memory_, static_cast<uint64_t>(std::max<int64_t>(
+                                                       settings_.script_memory_limit, 0)));
+  messaging_.scene_mail().memory = &scene_script_memory_;
   // Validate the backend name now, so a typo fails before any work is done.
   if (!registry_.HasDynamics(settings_.physics)) registry_.MakeDynamics(settings_.physics);
   for (const PhaseCallback& callback : registry_.phase_callbacks())
@@ -235,6 +241,14 @@ void World::EnsureRuntimes() {
   }
   pending_.resize(runtimes_.size(), 0xff);  // new robots: look at everything once
   messaging_.Resize(static_cast<int>(runtimes_.size()));
+  // Each robot's memory account, which its mail charges too.
+  while (robot_script_memory_.size() < runtimes_.size()) {
+    robot_script_memory_.emplace_back().Attach(
+        &run_script_memory_,
+        static_cast<uint64_t>(std::max<int64_t>(settings_.script_memory_limit, 0)));
+    const int robot = static_cast<int>(robot_script_memory_.size()) - 1;
+    messaging_.robot_mail(robot).memory = &robot_script_memory_.back();
+  }
   // (Before Start only: robots copied later must not restart the scene's stream.)
   if (!started_) scene_runtime_.rng = Rng(settings_.seed, uint64_t{1} << 63);
 }
@@ -347,7 +361,7 @@ void World::HandleSensing() {
 void World::HandleChildScripts(ScriptPass pass) {
   PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kControl)]);
   // What the main script printed so far comes first.
-  scene_runtime_.log.Drain(log_sink_);
+  DrainLog(scene_runtime_, scene_script_memory_);
   Control(pass);
 }
 void World::HandleActuation() {
@@ -410,10 +424,11 @@ void World::FlushRobotBuffers() {
   // Logs and metrics in robot order, then the scene's; the lowest robot's
   // error wins, so the report does not depend on the thread count.
   std::string first_error;
-  auto flush = [&](RobotRuntime& rt) {
-    rt.log.Drain(log_sink_);
+  auto flush = [&](RobotRuntime& rt, ScriptMemory& memory) {
+    DrainLog(rt, memory);
     for (MetricSample& m : rt.metrics) metrics_.push_back(std::move(m));
     rt.metrics.clear();
+    memory.Release(std::exchange(rt.metric_bytes, 0));
     if (!rt.error.empty() && first_error.empty()) first_error = rt.error;
     rt.error.clear();
     for (std::string& why : rt.disabled) disabled_scripts_.push_back(std::move(why));
@@ -421,17 +436,23 @@ void World::FlushRobotBuffers() {
   };
   for (size_t r = 0; r < runtimes_.size(); ++r) {
     if (!(pending_[r] & kPendingOutput)) continue;
-    flush(runtimes_[r]);
+    flush(runtimes_[r], robot_script_memory_[r]);
     pending_[r] &= ~kPendingOutput;
   }
-  flush(scene_runtime_);
+  flush(scene_runtime_, scene_script_memory_);
   if (!first_error.empty()) throw Error(first_error);
 }
 
 void World::FlushSceneBuffers() {
-  scene_runtime_.log.Drain(log_sink_);
+  DrainLog(scene_runtime_, scene_script_memory_);
   for (MetricSample& m : scene_runtime_.metrics) metrics_.push_back(std::move(m));
   scene_runtime_.metrics.clear();
+  scene_script_memory_.Release(std::exchange(scene_runtime_.metric_bytes, 0));
+}
+
+void World::DrainLog(RobotRuntime& rt, ScriptMemory& memory) {
+  rt.log.Drain(log_sink_);
+  memory.Release(std::exchange(rt.log_bytes, 0));
 }
 
 void World::FlushBuffersAfterError() noexcept {
@@ -452,10 +473,12 @@ void World::Actuate() {
     if (!(pending_[r] & kPendingDeferred)) continue;
     RobotRuntime& rt = runtimes_[r];
     writes.insert(writes.end(), rt.deferred.begin(), rt.deferred.end());
+    robot_script_memory_[r].Release(rt.deferred.size() * sizeof(DeferredWrite));
     rt.deferred.clear();
     pending_[r] &= ~kPendingDeferred;
   }
   writes.insert(writes.end(), scene_runtime_.deferred.begin(), scene_runtime_.deferred.end());
+  scene_script_memory_.Release(scene_runtime_.deferred.size() * sizeof(DeferredWrite));
   scene_runtime_.deferred.clear();
   std::stable_sort(
       writes.begin(), writes.end(),

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <deque>
 #include <filesystem>
 #include <functional>
 #include <memory>
@@ -23,6 +24,7 @@
 #include "framework/plugin_api.h"
 #include "framework/random.h"
 #include "framework/scene.h"
+#include "framework/script_memory.h"
 
 namespace swarmsim {
 
@@ -62,9 +64,14 @@ struct WorldSettings {
   // Lua instructions one non-threaded callback may run before it is stopped
   // with an error (0: no limit).
   int64_t instruction_budget = 100'000'000;
-  // Bytes of Lua memory one Lua state (a robot's scripts, the scene's, the
-  // main script) may hold before its script fails with an error (0: no limit).
+  // Bytes one robot's scripts (or the scene's scripts and the main script)
+  // may hold, their Lua memory and the data sim.* calls keep for them
+  // (framework/script_memory.h), before a script fails with an error (0: no
+  // limit).
   int64_t script_memory_limit = int64_t{256} << 20;
+  // Bytes every script of the run may hold together (0: no limit): 20
+  // robots x 256 MiB would otherwise be 5 GiB.
+  int64_t run_script_memory_limit = int64_t{4} << 30;
   // Wall-clock seconds one step (or the start or stop of the world) may take
   // before the runner ends the run as stuck, naming the script calls in
   // progress (0: no limit). A safety net for what the instruction budget
@@ -168,12 +175,17 @@ inline constexpr size_t kMaxModelEditsPerStep = 1000;
 
 struct RobotRuntime {
   Rng rng;
-  SharedParameters parameters;             // the instance's model parameters
-  LogBuffer log;                           // lines printed during the phase
-  std::vector<MetricSample> metrics;       // samples recorded this step
-  std::vector<DeferredWrite> deferred;     // writes to other robots' objects
-  std::vector<ModelEdit> model_edits;      // copies and removals of robots, call order
-  std::string error;                       // a script error in this phase
+  SharedParameters parameters;          // the instance's model parameters
+  LogBuffer log;                        // lines printed during the phase
+  std::vector<MetricSample> metrics;    // samples recorded this step
+  std::vector<DeferredWrite> deferred;  // writes to other robots' objects
+  std::vector<ModelEdit> model_edits;   // copies and removals of robots, call order
+  std::string error;                    // a script error in this phase
+  // Bytes of `log` and `metrics` charged to the robot's ScriptMemory,
+  // released when the world takes them; bytes printed in step print_step.
+  uint64_t log_bytes = 0, metric_bytes = 0;
+  uint64_t printed_bytes = 0;
+  int64_t print_step = -1;
   std::vector<std::string> disabled;       // scripts disabled this phase (disable_script), why
   std::vector<CollectionRow> collections;  // the scripts' own (sim.createCollection)
   // Its messages, signal and custom-data writes: Messaging::robot_mail.
@@ -296,6 +308,12 @@ class World : public PhaseHandlers {
   ProximityBackend* proximity() { return proximity_; }
   void set_proximity(ProximityBackend* proximity) { proximity_ = proximity; }
   ScriptHost* scripts() { return scripts_.get(); }
+  // What robot `instance`'s scripts hold (-1: the scene's scripts and the
+  // main script), and the run's whole (framework/script_memory.h).
+  ScriptMemory& script_memory(int instance) {
+    return instance < 0 ? scene_script_memory_ : robot_script_memory_.at(instance);
+  }
+  const RunScriptMemory& run_script_memory() const { return run_script_memory_; }
   // module(name) / find_module(name), by their old names.
   CalculationModule* calculation(const std::string& name) { return module(name); }
   CalculationModule* find_calculation(const std::string& name) const { return find_module(name); }
@@ -344,6 +362,8 @@ class World : public PhaseHandlers {
   ObjectId CopyRobot(const ModelEdit& edit);
   void RemoveRobot(ObjectId root);
   void FlushRobotBuffers();
+  // Hands rt's printed lines to the log sink and releases their bytes.
+  void DrainLog(RobotRuntime& rt, ScriptMemory& memory);
   // The scene's scripts' prints and metrics (a main script's, after its step).
   void FlushSceneBuffers();
   // After an error escaped the scripts: what every robot and the scene
@@ -358,6 +378,11 @@ class World : public PhaseHandlers {
   WorldSettings settings_;
   const ModuleRegistry& registry_;
   std::shared_ptr<const ModuleRegistry> owned_registry_;  // null unless given by shared_ptr
+  // What the scripts hold: first, so that they outlive the scene (custom
+  // data blocks), the messages and the script states that charge them.
+  RunScriptMemory run_script_memory_;
+  std::deque<ScriptMemory> robot_script_memory_;  // by robot (stable addresses)
+  ScriptMemory scene_script_memory_;
   std::array<std::vector<const PhaseCallback*>, kSwarmsimPhaseCount>
       phase_callbacks_;  // by SwarmsimPhase
   // Rows plugins record in the record phase (RecordPluginMetric).

@@ -352,7 +352,7 @@ WorldSettings WorldLoader::ReadSimulation(const Fields& top, std::optional<int64
     Fields f(*file_, sim, "'simulation'");
     f.Expect({"physics", "time_step", "physics_substeps", "physics_partitions", "seed", "duration",
               "steps", "gravity", "octree_resolution", "main_script", "instruction_budget",
-              "script_memory_mb", "step_timeout", "on_script_error"});
+              "script_memory_mb", "run_script_memory_mb", "step_timeout", "on_script_error"});
     if (f.Has("main_script")) {
       const Field main = f.Get("main_script");
       const std::string text = values.String(main);
@@ -363,6 +363,9 @@ WorldSettings WorldLoader::ReadSimulation(const Fields& top, std::optional<int64
       s.instruction_budget = values.Integer(f.Get("instruction_budget"), 0, int64_t{1} << 40);
     if (f.Has("script_memory_mb"))
       s.script_memory_limit = values.Integer(f.Get("script_memory_mb"), 0, int64_t{1} << 30) << 20;
+    if (f.Has("run_script_memory_mb"))
+      s.run_script_memory_limit = values.Integer(f.Get("run_script_memory_mb"), 0, int64_t{1} << 30)
+                                  << 20;
     if (f.Has("step_timeout"))
       s.step_timeout =
           values.Number(f.Get("step_timeout"), {"a non-negative number of seconds", 0, 1e9});

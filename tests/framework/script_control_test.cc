@@ -370,8 +370,10 @@ TEST(ScriptControlTest, OneAllocationPastTheLimitIsRefused) {
   settings.script_memory_limit = 4 << 20;
   ScriptWorld w(1, settings);
   w.AddRobot("bot#0", "function sysCall_actuation() local s = string.rep('x', 1e8) end");
-  EXPECT_CONTAINS(ErrorOf([&] { w.Steps(1); }),
-                  "bot#0: an allocation would take the scripts past 4 MiB of Lua memory");
+  EXPECT_CONTAINS(
+      ErrorOf([&] { w.Steps(1); }),
+      "bot#0: scripts/robot.lua: an allocation would take the scripts past 4 MiB of Lua "
+      "memory");
 }
 
 // Under disable_script, a refused allocation disables its script only: the
@@ -914,10 +916,13 @@ TEST(ScriptControlTest, StringSignalsKeepEveryByte) {
   EXPECT_EQ(w.log, (std::vector<std::string>{"[bot#0] 8\ttrue"}));
 }
 
-// The messages one robot sends in one step may hold at most its Lua memory
-// limit (simulation.script_memory_mb): 20 robots sending 100 MiB each per
-// step used to exhaust the host's memory. The count starts again each step.
-TEST(ScriptControlTest, MessagesSentInOneStepAreBoundedByTheScriptMemoryLimit) {
+// A message is charged to its sender's memory account, with its Lua memory
+// (simulation.script_memory_mb), from the step it is sent until the next
+// step's messages are delivered: 20 robots sending 100 MiB each per step
+// used to exhaust the host's memory. Here the robot holds ~1 MiB of Lua
+// memory: two 1 MiB messages fit its 4 MiB in a step; the next step, while
+// they are delivered, none does; the step after, two again.
+TEST(ScriptControlTest, MessagesAreChargedToTheSendersMemoryUntilDelivered) {
   WorldSettings settings;
   settings.script_memory_limit = 4 << 20;
   ScriptWorld w(1, settings);
@@ -945,14 +950,17 @@ TEST(ScriptControlTest, MessagesSentInOneStepAreBoundedByTheScriptMemoryLimit) {
       if n > 0 then print('received', n) end
     end
   )"));
-  w.Steps(2);
+  w.Steps(3);
   const std::string limit =
-      "the messages sent this step would hold more than 4 MiB (simulation.script_memory_mb)";
-  ASSERT_EQ(w.log.size(), 5u);
-  EXPECT_EQ(w.log[0], "[bot#0] 0\t3\tsim.sendRangeMessage: " + limit);
+      "the message would take the scripts past 4 MiB (1 MiB of Lua memory and 2 MiB of data the "
+      "sim.* calls keep for them: signals, custom data, messages, prints, metrics; "
+      "simulation.script_memory_mb; raise it if the data is real)";
+  ASSERT_EQ(w.log.size(), 7u);
+  EXPECT_EQ(w.log[0], "[bot#0] 0\t2\tsim.sendRangeMessage: " + limit);
   EXPECT_EQ(w.log[1], "[bot#0] false\tsim.sendGlobalMessage: " + limit);
-  EXPECT_EQ(w.log[2], "[bot#0] 0\t3\tsim.sendRangeMessage: " + limit);
-  EXPECT_EQ(w.log[4], "[bot#1] received\t3");
+  EXPECT_EQ(w.log[2], "[bot#0] 0\t0\tsim.sendRangeMessage: " + limit);
+  EXPECT_EQ(w.log[4], "[bot#1] received\t2");
+  EXPECT_EQ(w.log[5], "[bot#0] 0\t2\tsim.sendRangeMessage: " + limit);
   // 0: no limit.
   settings.script_memory_limit = 0;
   ScriptWorld u(1, settings);

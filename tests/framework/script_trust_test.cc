@@ -1,0 +1,434 @@
+// What a script cannot do whatever it tries (issue 26, "Trust"): go on after
+// a refusal however deeply it is caught, overwrite its run's outputs, hold
+// more than its memory limit (or the run's) through sim.* calls, or raise
+// an error that fills the disk or names no line.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "framework/error.h"
+#include "framework/module.h"
+#include "framework/utf8.h"
+#include "framework/world.h"
+#include "tests/framework/error_of.h"
+#include "tests/framework/fakes.h"
+
+namespace swarmsim {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::ErrorOf;
+
+std::shared_ptr<const ScriptSource> Source(std::string path, std::string code) {
+  return std::make_shared<const ScriptSource>(ScriptSource{std::move(path), std::move(code)});
+}
+
+// A world folder (world/) and an output folder (out/), robots with null
+// modules, script output in `log`.
+class TrustTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    root_ = fs::temp_directory_path() /
+            ("swarmsim_trust_" + std::to_string(::getpid()) + "_" +
+             ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(root_);
+    fs::create_directories(root_ / "world");
+    fs::create_directories(root_ / "out");
+    settings_.physics = "null";
+    settings_.directory = root_ / "world";
+    settings_.output_directory = root_ / "out";
+    settings_.threads = 1;
+  }
+  void TearDown() override {
+    world_.reset();
+    fs::remove_all(root_);
+  }
+
+  World& MakeWorld() {
+    registry_ = testing::NullRegistry();
+    world_ = std::make_unique<World>(settings_, registry_);
+    world_->set_log_sink([this](std::string_view line) { log_.emplace_back(line); });
+    return *world_;
+  }
+  // Robot `name` (a root dummy and a `body` dummy carrying `code` as
+  // scripts/robot.lua). Returns the body.
+  ObjectId AddRobot(const std::string& name, const std::string& code) {
+    Scene& scene = world_->scene();
+    const ObjectId root = scene.AddDummy(name, {}, {});
+    const ObjectId body = scene.AddDummy("body", root, {});
+    scene.MakeModelInstance(root, "bot", name);
+    if (!code.empty()) scene.AttachScript(body, Source("scripts/robot.lua", code));
+    return body;
+  }
+  // One robot running `code` for `steps` steps; the error, or "".
+  std::string Run(const std::string& code, int steps = 1) {
+    MakeWorld();
+    AddRobot("bot#0", code);
+    return ErrorOf([&] {
+      for (int i = 0; i < steps; ++i) world_->Step();
+      world_->Stop();
+    });
+  }
+  // The files a script wrote into out/.
+  std::vector<std::string> OutFiles() const {
+    std::vector<std::string> names;
+    for (const auto& entry : fs::recursive_directory_iterator(root_ / "out"))
+      names.push_back(entry.path().lexically_relative(root_ / "out").string());
+    return names;
+  }
+
+  fs::path root_;
+  WorldSettings settings_;
+  ModuleRegistry registry_;
+  std::unique_ptr<World> world_;
+  std::vector<std::string> log_;
+};
+
+// --- Refusals end the callback ----------------------------------------------------------
+
+// The innermost function is refused, wrapped `depth` times in a coroutine
+// caught by `catcher`; every level tries to go on after its call (a
+// metric, a file, a line printed), as does the callback.
+std::string NestedRefusal(const std::string& callback, const std::string& catcher, int depth,
+                          const std::string& refused = "os.execute('true')") {
+  return "local function after(tag)\n"
+         "  sim.recordMetric('after_' .. tag, 1)\n"
+         "  local f = io.open('after_' .. tag .. '.txt', 'w')\n"
+         "  if f then f:write('x') f:close() end\n"
+         "  print('went on', tag)\n"
+         "end\n"
+         "local catchers = {\n"
+         "  pcall = function(f) pcall(coroutine.resume, coroutine.create(f)) end,\n"
+         "  resume = function(f) coroutine.resume(coroutine.create(f)) end,\n"
+         "  xpcall = function(f)\n"
+         "    xpcall(function() assert(coroutine.resume(coroutine.create(f))) end,\n"
+         "           function(e) return e end)\n"
+         "  end,\n"
+         "  wrap = function(f) pcall(coroutine.wrap(f)) end,\n"
+         "}\n"
+         "function " +
+         callback +
+         "()\n"
+         "  local f = function() pcall(function() " +
+         refused +
+         " end) after('0') end\n"
+         "  for level = 1, " +
+         std::to_string(depth) +
+         " do\n"
+         "    local inner = f\n"
+         "    f = function() catchers['" +
+         catcher +
+         "'](inner) after(tostring(level)) end\n"
+         "  end\n"
+         "  f()\n"
+         "  after('top')\n"
+         "  if sim.step then while true do sim.step() after('next') end end\n"
+         "end\n";
+}
+
+TEST_F(TrustTest, ARefusalInNestedCoroutinesEndsTheCallbackWhateverCatchesIt) {
+  for (const std::string callback : {"sysCall_init", "sysCall_actuation", "sysCall_thread"}) {
+    for (const std::string catcher : {"pcall", "resume", "xpcall", "wrap"}) {
+      for (int depth = 1; depth <= 3; ++depth) {
+        SCOPED_TRACE(callback + ", " + catcher + ", depth " + std::to_string(depth));
+        log_.clear();
+        fs::remove_all(root_ / "out");
+        fs::create_directories(root_ / "out");
+        const std::string error = Run(NestedRefusal(callback, catcher, depth), 3);
+        EXPECT_CONTAINS(error, "os.execute is not allowed");
+        EXPECT_CONTAINS(error, "bot#0: scripts/robot.lua:");
+        EXPECT_CONTAINS(error, "[in " + callback + " of /bot#0/body]");
+        EXPECT_EQ(log_, std::vector<std::string>{});
+        EXPECT_EQ(world_->TakeMetrics().size(), 0u);
+        EXPECT_EQ(OutFiles(), std::vector<std::string>{});
+      }
+    }
+  }
+}
+
+TEST_F(TrustTest, AnyRefusalIsCaughtTheSameWay) {
+  for (const std::string refused :
+       {"io.open('/etc/passwd')", "io.open('summary.json', 'w')", "debug.getinfo(1)",
+        "math.randomseed()", "load(string.char(27) .. 'Lua')"}) {
+    SCOPED_TRACE(refused);
+    log_.clear();
+    const std::string error = Run(NestedRefusal("sysCall_actuation", "pcall", 2, refused));
+    EXPECT_NE(error, "");
+    EXPECT_EQ(log_, std::vector<std::string>{});
+    EXPECT_EQ(OutFiles(), std::vector<std::string>{});
+  }
+}
+
+// A spent instruction budget ends the callback the same way: the coroutine
+// that resumed the looping one does not go on.
+TEST_F(TrustTest, ASpentBudgetInANestedCoroutineEndsTheCallbackToo) {
+  settings_.instruction_budget = 1000000;
+  const std::string error =
+      Run(NestedRefusal("sysCall_actuation", "pcall", 2, "while true do end"));
+  EXPECT_CONTAINS(error, "more than 1000000 Lua instructions");
+  EXPECT_EQ(log_, std::vector<std::string>{});
+  EXPECT_EQ(OutFiles(), std::vector<std::string>{});
+}
+
+// Under disable_script the refusing script is disabled and listed, and
+// does nothing more; the robot's other scripts go on.
+TEST_F(TrustTest, UnderDisableScriptARefusalDisablesTheScript) {
+  settings_.on_script_error = ScriptErrorPolicy::kDisableScript;
+  for (const std::string callback : {"sysCall_actuation", "sysCall_thread"}) {
+    SCOPED_TRACE(callback);
+    log_.clear();
+    MakeWorld();
+    const ObjectId body = AddRobot("bot#0", NestedRefusal(callback, "pcall", 3));
+    world_->scene().AttachScript(
+        world_->scene().AddDummy("eye", body, {}),
+        Source("scripts/eye.lua", "function sysCall_actuation() sim.recordMetric('alive', 1) end"));
+    for (int i = 0; i < 3; ++i) world_->Step();
+    ASSERT_EQ(world_->disabled_scripts().size(), 1u);
+    EXPECT_CONTAINS(world_->disabled_scripts()[0], "os.execute is not allowed");
+    const std::vector<MetricSample> metrics = world_->TakeMetrics();
+    ASSERT_EQ(metrics.size(), 3u);
+    for (const MetricSample& m : metrics) EXPECT_EQ(m.name, "alive");
+    EXPECT_EQ(OutFiles(), std::vector<std::string>{});
+    ASSERT_EQ(log_.size(), 1u);
+    EXPECT_CONTAINS(log_[0], "error, script disabled: bot#0: scripts/robot.lua:");
+  }
+}
+
+// --- The run's outputs ----------------------------------------------------------------------
+
+// A module that lists a file of its own in the output folder, as the video
+// recorder lists a --video FILE there.
+class ListsAFile : public Module {
+ public:
+  void ListOutputs(std::vector<OutputFile>* out) const override {
+    out->push_back({"video", "clips/film.mp4", "a film"});
+  }
+};
+
+TEST_F(TrustTest, ScriptsCannotWriteAnyOfTheRunsOwnOutputs) {
+  for (const std::string name :
+       {"summary.json", "metrics.csv", "recording.swrec", "video.mp4", "stderr.txt", "paint.png",
+        "mill.csv", "graphs", "graphs/speed.csv", "snapshots/step_000010.png", "summary.json.tmp",
+        ".metrics.csv.1234", "clips/film.mp4", "clips"}) {
+    SCOPED_TRACE(name);
+    MakeWorld();
+    world_->AddObserver(std::make_unique<ListsAFile>());
+    fs::create_directories(root_ / "out" / "graphs");
+    fs::create_directories(root_ / "out" / "snapshots");
+    fs::create_directories(root_ / "out" / "clips");
+    AddRobot("bot#0", "\nio.open('" + name + "', 'w')");
+    const std::string error = ErrorOf([&] { world_->Step(); });
+    EXPECT_CONTAINS(error, "bot#0: scripts/robot.lua:2: io.open: '" + name +
+                               "' is one of the run's own outputs in the output folder");
+  }
+  // Other names are the scripts' to use.
+  for (const std::string name : {"notes.txt", "graphs_notes.txt", "clips/other.mp4", "my.csv"}) {
+    SCOPED_TRACE(name);
+    MakeWorld();
+    world_->AddObserver(std::make_unique<ListsAFile>());
+    AddRobot("bot#0", "assert(io.open('" + name + "', 'w')):close()");
+    EXPECT_EQ(ErrorOf([&] { world_->Step(); }), "");
+  }
+}
+
+// --- Memory ----------------------------------------------------------------------------------
+
+// Data the sim.* calls keep for a robot counts against its script_memory_mb
+// with its Lua heap: signals, custom data blocks, messages, printed lines,
+// metrics. Each is refused past the limit, with the setting named.
+TEST_F(TrustTest, DataTheSimCallsKeepCountsAgainstTheRobotsMemoryLimit) {
+  settings_.script_memory_limit = 4 << 20;
+  const std::vector<std::pair<std::string, std::string>> calls = {
+      {"sim.setSignal('s' .. i, block)",
+       "sim.setSignal: the signal would take the scripts past 4 MiB"},
+      {"sim.writeCustomDataBlock(sim.getObject('.'), 't' .. i, block)",
+       "sim.writeCustomDataBlock: the custom data block would take the scripts past 4 MiB"},
+      {"sim.sendGlobalMessage(block)",
+       "sim.sendGlobalMessage: the message would take the scripts "
+       "past 4 MiB"},
+      {"sim.recordMetric(('m'):rep(200), i)",
+       "sim.recordMetric: the metric sample would take the scripts past 4 MiB"},
+  };
+  for (const auto& [call, message] : calls) {
+    SCOPED_TRACE(call);
+    const std::string error =
+        Run("local block = ('x'):rep(100000)\n"
+            "function sysCall_actuation()\n"
+            "  for i = 1, 200000 do " +
+            call +
+            " end\n"
+            "end\n");
+    EXPECT_CONTAINS(error, "bot#0: scripts/robot.lua:3: " + message);
+    EXPECT_CONTAINS(error, "of data the sim.* calls keep for them");
+    EXPECT_CONTAINS(error, "simulation.script_memory_mb");
+    EXPECT_LE(world_->script_memory(0).used(), uint64_t{4} << 20);
+  }
+}
+
+// What is overwritten, cleared or delivered is released: a robot may set a
+// 1 MiB signal and block and send a 1 MiB message every step for good.
+TEST_F(TrustTest, DataIsReleasedWhenOverwrittenClearedOrDelivered) {
+  settings_.script_memory_limit = 16 << 20;
+  EXPECT_EQ(
+      Run("local block = ('x'):rep(1 << 20)\n"
+          "function sysCall_actuation()\n"
+          "  sim.setSignal('s', block .. sim.getSimulationTime())\n"
+          "  sim.writeCustomDataBlock(sim.getObject('.'), 't', block .. sim.getSimulationTime())\n"
+          "  sim.sendGlobalMessage(block)\n"
+          "  sim.setSignal('gone', block) sim.clearSignal('gone')\n"
+          "  sim.writeCustomDataBlock(sim.getObject('.'), 'gone', block)\n"
+          "  sim.writeCustomDataBlock(sim.getObject('.'), 'gone', nil)\n"
+          "  print(('p'):rep(100000))\n"
+          "  sim.recordMetric('m', 1)\n"
+          "end\n",
+          30),
+      "");
+  // The robot holds the signal, the block, the message being delivered and
+  // the writes waiting for the next step, not 30 of each.
+  EXPECT_LT(world_->script_memory(0).data(), uint64_t{8} << 20);
+}
+
+// A data block kept from an earlier step leaves the Lua heap that much less.
+TEST_F(TrustTest, HeldDataLeavesTheLuaHeapLessRoom) {
+  settings_.script_memory_limit = 8 << 20;
+  const std::string error =
+      Run("local n = 0\n"
+          "function sysCall_actuation()\n"
+          "  n = n + 1\n"
+          "  if n == 1 then sim.setSignal('big', ('x'):rep(3 << 20)) return end\n"
+          "  local t = {} for i = 1, 4e5 do t[i] = i end\n"
+          "end\n",
+          3);
+  EXPECT_CONTAINS(error, "bot#0: scripts/robot.lua:5: ");
+  EXPECT_CONTAINS(error, "8 MiB (");
+  EXPECT_CONTAINS(error, "of Lua memory and 3 MiB of data the sim.* calls keep for them");
+}
+
+// The run's limit holds whatever each robot's allows: 20 robots under a
+// limit each would otherwise hold 20 times it.
+TEST_F(TrustTest, TheRunsScriptsTogetherHoldAtMostTheRunsLimit) {
+  settings_.script_memory_limit = 8 << 20;
+  settings_.run_script_memory_limit = 40 << 20;
+  settings_.threads = 2;
+  for (const std::string grow : {"local t = {} for i = 1, 3000 do t[i] = ('x'):rep(1000) .. i end "
+                                 "keep = t",
+                                 "sim.setSignal('s' .. sim.getRobotIndex(), ('x'):rep(3e6))"}) {
+    SCOPED_TRACE(grow);
+    MakeWorld();
+    for (int r = 0; r < 20; ++r)
+      AddRobot("bot#" + std::to_string(r), "function sysCall_actuation()\n  " + grow + "\nend\n");
+    const std::string error = ErrorOf([&] {
+      for (int i = 0; i < 2; ++i) world_->Step();
+    });
+    EXPECT_CONTAINS(error,
+                    "would take the run's scripts past 40 MiB "
+                    "(simulation.run_script_memory_mb");
+    EXPECT_LE(world_->run_script_memory().taken(), uint64_t{40} << 20);
+  }
+}
+
+TEST_F(TrustTest, MetricNamesAndPrintsAreCapped) {
+  EXPECT_CONTAINS(Run("sim.recordMetric(('m'):rep(1 << 20), 1)"),
+                  "sim.recordMetric: the metric name is 1048576 bytes long; at most 256");
+  EXPECT_EQ(Run("sim.recordMetric(('m'):rep(256), 1)"), "");
+  EXPECT_CONTAINS(Run("function sysCall_actuation()\n"
+                      "  for i = 1, 100 do print(('p'):rep(20000)) end\n"
+                      "end\n"),
+                  "bot#0: scripts/robot.lua:2: print: the scripts of bot#0 printed more than 1 "
+                  "MiB in this step");
+  // The count starts again each step.
+  EXPECT_EQ(Run("function sysCall_actuation()\n"
+                "  for i = 1, 40 do print(('p'):rep(20000)) end\n"
+                "end\n",
+                5),
+            "");
+}
+
+// --- Error texts ------------------------------------------------------------------------------
+
+TEST(CutErrorTextTest, CutsTheMiddleBetweenCharacters) {
+  EXPECT_EQ(CutErrorText("short"), "short");
+  const std::string long_text = "file.lua:3: " + std::string(10000, 'e') + " [in x]";
+  const std::string cut = CutErrorText(long_text);
+  EXPECT_LE(cut.size(), kMaxErrorTextBytes);
+  EXPECT_EQ(cut.rfind("file.lua:3: eee", 0), 0u);
+  EXPECT_CONTAINS(cut, " bytes cut) ... ");
+  EXPECT_EQ(cut.substr(cut.size() - 8), "e [in x]");
+  // Two-, three- and four-byte characters are never split.
+  for (const std::string character : {"\xC3\xA9", "\xE2\x82\xAC", "\xF0\x9F\x98\x80"}) {
+    for (size_t shift = 0; shift < 4; ++shift) {
+      std::string text(shift, 'a');
+      for (int i = 0; i < 5000; ++i) text += character;
+      const std::string c = CutErrorText(text);
+      EXPECT_LE(c.size(), kMaxErrorTextBytes);
+      EXPECT_TRUE(IsValidUtf8(c)) << shift;
+    }
+  }
+  // Every swarmsim::Error is cut so.
+  EXPECT_LE(std::string(Error(std::string(1 << 20, 'x')).what()).size(), kMaxErrorTextBytes);
+}
+
+TEST_F(TrustTest, AHugeScriptErrorIsCutAndStillNamesWhereItHappened) {
+  const std::string error = Run("function sysCall_actuation()\n  error(('e'):rep(1e7))\nend\n");
+  EXPECT_LE(error.size(), kMaxErrorTextBytes);
+  EXPECT_EQ(error.rfind("bot#0: scripts/robot.lua:2: eeee", 0), 0u) << error.substr(0, 100);
+  EXPECT_CONTAINS(error, " bytes cut) ... ");
+  EXPECT_CONTAINS(error, "eee [in sysCall_actuation of /bot#0/body]");
+  // Multi-byte text stays valid UTF-8; the disabled-script list is cut too.
+  settings_.on_script_error = ScriptErrorPolicy::kDisableScript;
+  EXPECT_EQ(Run("function sysCall_actuation()\n  error(('\\u{E9}'):rep(1e6))\nend\n"), "");
+  ASSERT_EQ(world_->disabled_scripts().size(), 1u);
+  EXPECT_LE(world_->disabled_scripts()[0].size(), kMaxErrorTextBytes);
+  EXPECT_TRUE(IsValidUtf8(world_->disabled_scripts()[0]));
+  ASSERT_EQ(log_.size(), 1u);
+  EXPECT_LE(log_[0].size(), kMaxErrorTextBytes + 64);
+}
+
+// Errors Lua gives no position name the line of the script all the same,
+// with the robot and the callback.
+TEST_F(TrustTest, EveryScriptErrorNamesRobotScriptLineAndCallback) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"error()", "scripts/robot.lua:3: (error object is a nil value)"},
+      {"error({})", "scripts/robot.lua:3: (error object is a table value)"},
+      {"error('plain', 0)", "scripts/robot.lua:3: plain"},
+      {"coroutine.yield()", "scripts/robot.lua:3: attempt to yield from outside a coroutine"},
+      {"math.max(nil, 1)", "scripts/robot.lua:3: "},
+      {"print(setmetatable({}, {__tostring = function(s) return tostring(s) end}))",
+       "scripts/robot.lua:3: "},
+  };
+  for (const auto& [call, message] : cases) {
+    SCOPED_TRACE(call);
+    for (const std::string callback : {"sysCall_actuation", "sysCall_thread"}) {
+      if (callback == "sysCall_thread" && call == "coroutine.yield()") continue;  // it yields
+      const std::string error =
+          Run("local x = 1\nfunction " + callback + "()\n  " + call + "\nend\n");
+      EXPECT_EQ(error.rfind("bot#0: " + message, 0), 0u) << error;
+      EXPECT_CONTAINS(error, "[in " + callback + " of /bot#0/body]");
+    }
+  }
+  // A recursive __tostring through print.
+  const std::string error =
+      Run("local t = setmetatable({}, {__tostring = function(s) print(s) return 'x' end})\n"
+          "function sysCall_actuation()\n  print(t)\nend\n");
+  EXPECT_EQ(error.rfind("bot#0: scripts/robot.lua:", 0), 0u) << error;
+  EXPECT_CONTAINS(error, "[in sysCall_actuation of /bot#0/body]");
+}
+
+// An error raised in a module the script required names the module's line
+// and the script's.
+TEST_F(TrustTest, AnErrorInARequiredModuleNamesTheScriptsLineToo) {
+  std::ofstream(root_ / "world" / "helper.lua") << "return function()\n  error()\nend\n";
+  const std::string error =
+      Run("local helper = require('helper')\nfunction sysCall_actuation()\n  helper()\nend\n");
+  EXPECT_EQ(error.rfind("bot#0: scripts/robot.lua:3: ", 0), 0u) << error;
+  EXPECT_CONTAINS(error, "helper.lua:2: (error object is a nil value)");
+}
+
+}  // namespace
+}  // namespace swarmsim
