@@ -56,9 +56,20 @@ int ViewCommand(const ViewArgs& args) {
                  "DIR --record)\n";
     return kExitBadInput;
   }
+  // Serving scans the chunks (and the JSON of header, scene and end chunks):
+  // the page decodes the step records as it plays, following a run in
+  // progress. An export is checked as record-info checks, every step record
+  // decoded, so a file that plays nowhere is not passed on.
   record::RecordingInfo info;
   try {
-    info = record::ScanRecording(args.folder);
+    if (args.export_file.empty()) {
+      info = record::ScanRecording(args.folder);
+    } else {
+      record::RecordingPlayer player(args.folder);
+      while (player.Next()) {
+      }
+      info = player.info();
+    }
   } catch (const Error& e) {
     std::cerr << "error: " << ValidUtf8(e.what()) << "\n";
     return kExitBadInput;

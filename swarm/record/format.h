@@ -22,4 +22,14 @@ inline constexpr double kQuaternionScale = 32767;  // integer per quaternion uni
 // A proximity reading: 65535 nothing detected, else distance / range * 65534.
 inline constexpr uint16_t kNoDetection = 65535;
 
+// What a reader accepts (FORMAT.md "Limits"): beyond these a file is refused
+// as corrupt instead of allocated.
+inline constexpr uint32_t kMaxChunkRawBytes = uint32_t{256} << 20;  // a payload, decompressed
+inline constexpr uint64_t kMaxPaintCells = uint64_t{1} << 26;       // paint width x height
+inline constexpr int kMaxJsonDepth = 64;                            // nesting in a JSON chunk
+// Bytes of one object's pose in a step record (u32 id, 3 x i32, 4 x i16): a
+// keyframe lists every object of its scene, so it holds at least this times
+// the scene's object count.
+inline constexpr uint32_t kPoseBytes = 24;
+
 }  // namespace swarmsim::record

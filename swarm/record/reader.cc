@@ -1,29 +1,23 @@
 #include "swarm/record/reader.h"
 
-#include <xxhash.h>
 #include <zstd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <fstream>
-#include <nlohmann/json.hpp>
+#include <limits>
+#include <new>
 #include <sstream>
 
 #include "framework/error.h"
+#include "swarm/record/chunk_json.h"
+#include "swarm/record/chunk_reader.h"
 #include "swarm/record/format.h"
 
 namespace swarmsim::record {
 namespace {
 
-using nlohmann::json;
 namespace fs = std::filesystem;
-
-// Chunks bigger than this are taken for a corrupt header, not a long payload.
-constexpr uint32_t kMaxChunkBytes = uint32_t{1} << 30;
-
-uint32_t Get32(const uint8_t* p) {
-  return p[0] | (uint32_t{p[1]} << 8) | (uint32_t{p[2]} << 16) | (uint32_t{p[3]} << 24);
-}
 
 std::string Megabytes(uint64_t bytes) {
   std::ostringstream out;
@@ -33,42 +27,144 @@ std::string Megabytes(uint64_t bytes) {
   return out.str();
 }
 
-std::string Decompress(const std::string& stored, uint32_t raw_size, const std::string& where) {
-  std::string raw(raw_size, '\0');
-  const size_t n = ZSTD_decompress(raw.data(), raw.size(), stored.data(), stored.size());
-  if (ZSTD_isError(n))
-    throw Error(where + ": the payload does not decompress (" + ZSTD_getErrorName(n) + ")");
-  if (n != raw_size)
-    throw Error(where + ": the payload decompresses to " + std::to_string(n) + " bytes, not " +
-                std::to_string(raw_size));
-  return raw;
-}
-
-std::string ChunkWhere(const RecordingInfo& info, size_t index, uint64_t offset) {
-  return info.file.string() + " is corrupt: chunk " + std::to_string(index + 1) + " at byte " +
-         std::to_string(offset);
-}
-
-// The header chunk's JSON: format name and version.
-void CheckHeader(RecordingInfo* info, const std::string& text) {
-  json j;
-  try {
-    j = json::parse(text);
-  } catch (const json::exception&) {
-    throw Error(info->file.string() + " is corrupt: its header is not JSON");
-  }
-  if (!j.is_object() || j.value("format", "") != kFormatName || !j.contains("version") ||
-      !j["version"].is_array() || j["version"].size() < 2 || !j["version"][0].is_number_integer())
+// The header chunk's JSON: format name and version first (a newer major
+// version may differ in everything else), then its other fields.
+void CheckHeader(RecordingInfo* info, std::string text, const std::string& where) {
+  const HeaderFields header = ParseHeaderJson(text, where);
+  if (!header.is_object || header.format != kFormatName || !header.has_version)
     throw Error(info->file.string() + " is not a swarmsim recording (its header names no " +
                 kFormatName + " version)");
-  info->version_major = j["version"][0].get<int>();
-  info->version_minor = j["version"][1].is_number_integer() ? j["version"][1].get<int>() : 0;
+  info->version_major = header.version_major;
+  info->version_minor = header.version_minor;
   if (info->version_major > kVersionMajor)
     throw Error(info->file.string() + " is a recording of format version " +
                 std::to_string(info->version_major) + "." + std::to_string(info->version_minor) +
                 ", newer than this swarmsim reads (" + std::to_string(kVersionMajor) + "." +
                 std::to_string(kVersionMinor) + "): use a newer swarmsim");
-  info->header_json = text;
+  if (!header.problem.empty()) throw Error(where + ": " + header.problem);
+  info->header_json = std::move(text);
+}
+
+// What one whole chunk says, checked (ContinueScan): its payload's frame,
+// and the JSON of header, scene and end chunks.
+void CheckChunk(RecordingInfo* info, size_t index, const ChunkInfo& c, const std::string& stored,
+                const std::string& where) {
+  CheckFrame(stored, c.raw_size, where);
+  switch (static_cast<ChunkKind>(c.kind)) {
+    case ChunkKind::kHeader:
+      if (index != 0) throw Error(where + ": a second header chunk");
+      CheckHeader(info, Decompress(stored, c.raw_size, where), where);
+      break;
+    case ChunkKind::kScene:
+      info->scene_objects = static_cast<int64_t>(
+          ParseSceneJson(Decompress(stored, c.raw_size, where), where).object_count);
+      info->keyframe_due = true;
+      break;
+    case ChunkKind::kKeyframe:
+    case ChunkKind::kDelta:
+      if (info->scene_objects < 0) throw Error(where + ": a step record before any scene chunk");
+      if (info->keyframe_due) {
+        // The keyframe after a scene lists every object's pose.
+        if (c.kind != static_cast<uint8_t>(ChunkKind::kKeyframe))
+          throw Error(where + ": the step record after a scene chunk must be a keyframe");
+        const uint64_t least = uint64_t{kPoseBytes} * static_cast<uint64_t>(info->scene_objects);
+        if (c.raw_size < least)
+          throw Error(where + ": its scene has " + std::to_string(info->scene_objects) +
+                      " objects, whose poses take at least " + std::to_string(least) +
+                      " bytes, but it holds " + std::to_string(c.raw_size));
+        info->keyframe_due = false;
+      }
+      if (info->step_records == 0) info->first_step = c.step;
+      info->last_step = c.step;
+      ++info->step_records;
+      break;
+    case ChunkKind::kEnd: {
+      const EndFields end = ParseEndJson(Decompress(stored, c.raw_size, where), where);
+      info->ended = true;
+      info->end_status = end.status;
+      info->end_error = end.error;
+      break;
+    }
+  }
+}
+
+// Reads the chunks of `file` after info->valid_size (ContinueScan).
+void ScanChunks(const RecordingFile& file, RecordingInfo* info) {
+  info->file_size = file.CurrentSize();
+  uint64_t offset = info->valid_size;
+  info->truncated = false;
+  std::string head, stored;
+  while (offset < info->file_size) {
+    const size_t index = info->chunks.size();
+    // A chunk the file ends inside: a run in progress, or killed.
+    if (!file.ReadAt(offset, kChunkHeaderSize, &head)) {
+      info->truncated = true;
+      break;
+    }
+    const auto* h = reinterpret_cast<const uint8_t*>(head.data());
+    const ChunkInfo c = ParseChunkHeader(h, offset);
+    const std::string where = ChunkPlace(info->file, static_cast<int64_t>(index), c);
+    if (std::memcmp(h, kMagic, 4) != 0) {
+      if (offset == 0)
+        throw Error(info->file.string() +
+                    " is not a swarmsim recording (it does not start with SWRC)");
+      throw Error(info->file.string() + " is corrupt: chunk " + std::to_string(index + 1) +
+                  " at byte " + std::to_string(offset) + ": no chunk starts there (bad magic)");
+    }
+    if (index == 0 && c.kind != static_cast<uint8_t>(ChunkKind::kHeader))
+      throw Error(info->file.string() +
+                  " is not a swarmsim recording (its first chunk is no header)");
+    // Sizes no writer makes: refused before anything is read for them.
+    if (c.kind == 0) throw Error(where + ": its header is damaged (kind 0)");
+    if (c.raw_size > kMaxChunkRawBytes || c.stored_size > ZSTD_compressBound(c.raw_size))
+      throw Error(where + ": its header is damaged (" + std::to_string(c.stored_size) +
+                  " bytes stored for " + std::to_string(c.raw_size) +
+                  " decompressed; a chunk holds at most " +
+                  std::to_string(kMaxChunkRawBytes >> 20) + " MiB decompressed)");
+    if (!file.ReadAt(offset + kChunkHeaderSize, c.stored_size, &stored)) {
+      info->truncated = true;
+      break;
+    }
+    CheckChecksum(stored, c, where);
+    // Unknown kinds (above 5) are skipped, as FORMAT.md says.
+    if (c.kind <= static_cast<uint8_t>(ChunkKind::kEnd)) {
+      try {
+        CheckChunk(info, index, c, stored, where);
+      } catch (const std::bad_alloc&) {
+        throw Error(where + ": not enough memory to check it");
+      }
+    }
+    info->chunks.push_back(c);
+    offset += kChunkHeaderSize + c.stored_size;
+    info->valid_size = offset;
+  }
+}
+
+// The file `path` names: a run's folder's recording, or the file itself.
+fs::path RecordingPath(const fs::path& path) {
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) {
+    const fs::path file = path / kRecordingFileName;
+    if (!fs::exists(fs::symlink_status(file, ec)))
+      throw Error(path.string() + " has no " + kRecordingFileName +
+                  ": record a run with swarmsim run WORLD --out " + path.string() + " --record");
+    return file;
+  }
+  if (!fs::exists(fs::symlink_status(path, ec)))
+    throw Error(path.string() +
+                " does not exist: record a run with swarmsim run WORLD --out DIR "
+                "--record");
+  return path;
+}
+
+RecordingInfo Scan(const RecordingFile& file) {
+  RecordingInfo info;
+  info.file = file.path();
+  ScanChunks(file, &info);
+  if (info.chunks.empty())
+    throw Error(info.file.string() +
+                " holds no whole chunk yet (a run that just started, or not a recording)");
+  return info;
 }
 
 }  // namespace
@@ -93,175 +189,92 @@ std::string RecordingInfo::Describe() const {
   return out.str();
 }
 
-void ContinueScan(RecordingInfo* info) {
-  std::ifstream in(info->file, std::ios::binary);
-  if (!in) throw Error("cannot read " + info->file.string());
-  in.seekg(0, std::ios::end);
-  info->file_size = static_cast<uint64_t>(in.tellg());
-  uint64_t offset = info->valid_size;
-  info->truncated = false;
-  std::string stored;
-  while (offset < info->file_size) {
-    const size_t index = info->chunks.size();
-    if (info->file_size - offset < kChunkHeaderSize) {
-      info->truncated = true;
-      break;
-    }
-    uint8_t h[kChunkHeaderSize];
-    in.seekg(static_cast<std::streamoff>(offset));
-    in.read(reinterpret_cast<char*>(h), kChunkHeaderSize);
-    if (!in) throw Error("cannot read " + info->file.string());
-    if (std::memcmp(h, kMagic, 4) != 0) {
-      if (offset == 0)
-        throw Error(info->file.string() +
-                    " is not a swarmsim recording (it does not start with SWRC)");
-      throw Error(ChunkWhere(*info, index, offset) + ": no chunk starts there (bad magic)");
-    }
-    ChunkInfo c;
-    c.offset = offset;
-    c.kind = h[4];
-    c.step = Get32(h + 8);
-    c.stored_size = Get32(h + 12);
-    c.raw_size = Get32(h + 16);
-    if (c.kind == 0 || c.stored_size > kMaxChunkBytes || c.raw_size > kMaxChunkBytes)
-      throw Error(ChunkWhere(*info, index, offset) + ": its header is damaged");
-    if (index == 0 && c.kind != static_cast<uint8_t>(ChunkKind::kHeader))
-      throw Error(info->file.string() +
-                  " is not a swarmsim recording (its first chunk is no header)");
-    if (info->file_size - offset - kChunkHeaderSize < c.stored_size) {
-      info->truncated = true;
-      break;
-    }
-    stored.resize(c.stored_size);
-    in.read(stored.data(), c.stored_size);
-    if (!in) throw Error("cannot read " + info->file.string());
-    const uint32_t sum = XXH32(stored.data(), stored.size(), 0);
-    if (sum != Get32(h + 20)) {
-      std::ostringstream message;
-      message << ChunkWhere(*info, index, offset) << ": checksum mismatch (stored 0x" << std::hex
-              << Get32(h + 20) << ", computed 0x" << sum << ")";
-      throw Error(message.str());
-    }
-    const auto kind = static_cast<ChunkKind>(c.kind);
-    if (kind == ChunkKind::kHeader) {
-      if (index != 0) throw Error(ChunkWhere(*info, index, offset) + ": a second header chunk");
-      CheckHeader(info, Decompress(stored, c.raw_size, ChunkWhere(*info, index, offset)));
-    } else if (kind == ChunkKind::kKeyframe || kind == ChunkKind::kDelta) {
-      if (info->step_records == 0) info->first_step = c.step;
-      info->last_step = c.step;
-      ++info->step_records;
-    } else if (kind == ChunkKind::kEnd) {
-      const std::string text = Decompress(stored, c.raw_size, ChunkWhere(*info, index, offset));
-      const json j = json::parse(text, nullptr, false);
-      info->ended = true;
-      if (j.is_object()) {
-        info->end_status = j.value("status", "");
-        info->end_error = j.value("error", "");
-      }
-    }
-    info->chunks.push_back(c);
-    offset += kChunkHeaderSize + c.stored_size;
-    info->valid_size = offset;
-  }
-}
+void ContinueScan(RecordingInfo* info) { ScanChunks(RecordingFile(info->file), info); }
 
 RecordingInfo ScanRecording(const fs::path& path) {
-  RecordingInfo info;
-  std::error_code ec;
-  if (fs::is_directory(path, ec)) {
-    info.file = path / kRecordingFileName;
-    if (!fs::exists(info.file, ec))
-      throw Error(path.string() + " has no " + kRecordingFileName +
-                  ": record a run with swarmsim run WORLD --out " + path.string() + " --record");
-  } else {
-    info.file = path;
-    if (!fs::exists(path, ec))
-      throw Error(path.string() +
-                  " does not exist: record a run with swarmsim run WORLD --out DIR "
-                  "--record");
-  }
-  ContinueScan(&info);
-  if (info.chunks.empty())
-    throw Error(info.file.string() +
-                " holds no whole chunk yet (a run that just started, or not a recording)");
-  return info;
+  return Scan(RecordingFile(RecordingPath(path)));
 }
 
 std::string ReadChunk(const fs::path& file, const ChunkInfo& chunk) {
-  std::ifstream in(file, std::ios::binary);
-  std::string stored(chunk.stored_size, '\0');
-  in.seekg(static_cast<std::streamoff>(chunk.offset + kChunkHeaderSize));
-  in.read(stored.data(), chunk.stored_size);
-  const std::string where = file.string() + ": chunk at byte " + std::to_string(chunk.offset);
-  if (!in) throw Error(where + ": cannot read it");
-  return Decompress(stored, chunk.raw_size, where);
+  return ReadPayload(RecordingFile(file), chunk, ChunkPlace(file, -1, chunk));
 }
 
 // --- RecordingPlayer ---------------------------------------------------------------
 
-RecordingPlayer::RecordingPlayer(const fs::path& path) : info_(ScanRecording(path)) {
-  const json header = json::parse(info_.header_json);
-  if (const json& paint = header["paint"]; paint.is_object()) {
-    const int w = paint["width"].get<int>(), h = paint["height"].get<int>();
-    paint_.resize(static_cast<size_t>(w) * h * 3);
+RecordingPlayer::RecordingPlayer(const fs::path& path)
+    : file_(std::make_unique<RecordingFile>(RecordingPath(path))), info_(Scan(*file_)) {
+  // The scan checked the header; its paint layer and metric names.
+  const std::string where = ChunkPlace(info_.file, 0, info_.chunks[0]);
+  HeaderFields header = ParseHeaderJson(info_.header_json, where);
+  if (header.has_paint) {
+    const size_t cells = size_t{header.paint_width} * header.paint_height;  // <= kMaxPaintCells
+    try {
+      paint_.resize(3 * cells);
+    } catch (const std::bad_alloc&) {
+      throw Error(where + ": not enough memory for its paint layer of " + std::to_string(cells) +
+                  " cells");
+    }
     for (int c = 0; c < 3; ++c)
-      paint_background_[c] =
-          static_cast<uint8_t>(std::lround(paint["background"][c].get<double>() * 255));
+      paint_background_[c] = static_cast<uint8_t>(std::lround(header.paint_background[c] * 255));
     for (size_t i = 0; i < paint_.size(); ++i) paint_[i] = paint_background_[i % 3];
   }
-  for (const json& name : header["metrics"]) metric_names_.push_back(name.get<std::string>());
+  metric_names_ = std::move(header.metrics);
 }
 
 RecordingPlayer::~RecordingPlayer() = default;
 
-void RecordingPlayer::LoadScene(const std::string& text) {
-  scene_json_ = text;
-  const json scene = json::parse(text);
-  const size_t n = scene["object_count"].get<size_t>();
-  root_.assign(n, -1);
+void RecordingPlayer::Refresh() { ScanChunks(*file_, &info_); }
+
+// The scene's robots and count; the arrays by id wait for its keyframe.
+void RecordingPlayer::LoadScene(std::string text, const std::string& where) {
+  const SceneFields scene = ParseSceneJson(text, where);
+  scene_json_ = std::move(text);
+  scene_objects_ = scene.object_count;
+  scene_ranges_.clear();
   robot_roots_.clear();
-  for (const json& robot : scene["robots"]) {
-    const int64_t first = robot["first"].get<int64_t>(), count = robot["count"].get<int64_t>();
-    for (int64_t id = first + 1; id < first + count; ++id) root_[id] = first;
-    const size_t index = robot["index"].get<size_t>();
-    if (robot_roots_.size() <= index) robot_roots_.resize(index + 1, -1);
-    robot_roots_[index] = first;
+  for (const SceneRobot& robot : scene.robots) {
+    scene_ranges_.emplace_back(robot.first, robot.count);
+    robot_roots_.emplace_back(robot.index, static_cast<int64_t>(robot.first));
   }
-  pose_.assign(n, {});
-  color_.assign(n, 0);
-  reading_.assign(n, 0);
+  std::sort(robot_roots_.begin(), robot_roots_.end());
+  keyframe_due_ = true;
 }
 
 int64_t RecordingPlayer::robot_root(int robot_index) const {
-  return robot_index >= 0 && static_cast<size_t>(robot_index) < robot_roots_.size()
-             ? robot_roots_[robot_index]
-             : -1;
+  const std::pair<int64_t, int64_t> key{robot_index, std::numeric_limits<int64_t>::min()};
+  const auto it = std::lower_bound(robot_roots_.begin(), robot_roots_.end(), key);
+  return it != robot_roots_.end() && it->first == robot_index ? it->second : -1;
 }
 
 bool RecordingPlayer::Next() {
   while (next_chunk_ < info_.chunks.size()) {
-    const ChunkInfo& c = info_.chunks[next_chunk_++];
+    const size_t index = next_chunk_++;
+    const ChunkInfo& c = info_.chunks[index];
     const auto kind = static_cast<ChunkKind>(c.kind);
-    if (kind == ChunkKind::kScene) {
-      LoadScene(ReadChunk(info_.file, c));
-    } else if (kind == ChunkKind::kKeyframe || kind == ChunkKind::kDelta) {
-      if (scene_json_.empty())
-        throw Error(info_.file.string() + ": a step record at byte " + std::to_string(c.offset) +
-                    " comes before any scene chunk");
-      Decode(ReadChunk(info_.file, c), kind == ChunkKind::kKeyframe);
-      step_ = c.step;
-      return true;
+    if (kind != ChunkKind::kScene && kind != ChunkKind::kKeyframe && kind != ChunkKind::kDelta)
+      continue;
+    const std::string where = ChunkPlace(info_.file, static_cast<int64_t>(index), c);
+    try {
+      if (kind == ChunkKind::kScene) {
+        LoadScene(ReadPayload(*file_, c, where), where);
+        continue;
+      }
+      if (scene_json_.empty()) throw Error(where + ": a step record before any scene chunk");
+      Decode(ReadPayload(*file_, c, where), kind == ChunkKind::kKeyframe, where);
+    } catch (const std::bad_alloc&) {
+      throw Error(where + ": not enough memory to read it");
     }
+    step_ = c.step;
+    return true;
   }
   return false;
 }
 
 bool RecordingPlayer::SeekTo(int64_t step) {
-  // The last keyframe at or before `step`, and the scene chunk before it.
-  size_t keyframe = info_.chunks.size(), scene = info_.chunks.size();
+  // The last keyframe at or before `step`.
+  size_t keyframe = info_.chunks.size();
   for (size_t i = 0; i < info_.chunks.size(); ++i) {
     const ChunkInfo& c = info_.chunks[i];
-    if (c.kind == static_cast<uint8_t>(ChunkKind::kScene)) scene = i;
     if (c.kind == static_cast<uint8_t>(ChunkKind::kKeyframe) && c.step <= step) keyframe = i;
     if ((c.kind == static_cast<uint8_t>(ChunkKind::kKeyframe) ||
          c.kind == static_cast<uint8_t>(ChunkKind::kDelta)) &&
@@ -269,13 +282,23 @@ bool RecordingPlayer::SeekTo(int64_t step) {
       break;
   }
   if (keyframe == info_.chunks.size()) return false;
-  // The scene in force at the keyframe: the last scene chunk before it.
+  // The scene in force at the keyframe (the last scene chunk before it),
+  // then the keyframe and the deltas after it.
+  size_t scene = info_.chunks.size();
   for (size_t i = keyframe; i-- > 0;)
     if (info_.chunks[i].kind == static_cast<uint8_t>(ChunkKind::kScene)) {
       scene = i;
       break;
     }
-  next_chunk_ = scene;
+  if (scene == info_.chunks.size()) return false;  // the scan refuses such files
+  const std::string where =
+      ChunkPlace(info_.file, static_cast<int64_t>(scene), info_.chunks[scene]);
+  try {
+    LoadScene(ReadPayload(*file_, info_.chunks[scene], where), where);
+  } catch (const std::bad_alloc&) {
+    throw Error(where + ": not enough memory to read it");
+  }
+  next_chunk_ = keyframe;
   while (Next())
     if (step_ >= step) return step_ == step;
   return false;
@@ -297,31 +320,46 @@ Pose RecordingPlayer::world_pose(uint32_t id) const {
   return root < 0 ? frame_pose(id) : frame_pose(static_cast<uint32_t>(root)) * frame_pose(id);
 }
 
-// A step record (FORMAT.md "Step records").
-void RecordingPlayer::Decode(const std::string& payload, bool keyframe) {
+// A step record (FORMAT.md "Step records"). Every count is checked against
+// the bytes left before anything is allocated for it, every id against the
+// scene.
+void RecordingPlayer::Decode(const std::string& payload, bool keyframe, const std::string& where) {
   const auto* data = reinterpret_cast<const uint8_t*>(payload.data());
-  size_t at = 0;
+  size_t at = 0;     // <= payload.size()
+  samples_.clear();  // their names view metric_names_, which changes below
   const auto fail = [&](const std::string& what) {
-    throw Error(info_.file.string() + ": a step record does not decode (" + what + ")");
+    throw Error(where + ": its step record does not decode at byte " + std::to_string(at) + " of " +
+                std::to_string(payload.size()) + ": " + what);
   };
-  const auto need = [&](size_t bytes) {
-    if (payload.size() - at < bytes || at > payload.size()) fail("it ends early");
+  const auto need = [&](uint64_t bytes) {
+    if (bytes > payload.size() - at) fail("it ends early");
   };
   const auto get = [&]<typename T>(T* out) {
     need(sizeof(T));
     std::memcpy(out, data + at, sizeof(T));
     at += sizeof(T);
   };
-  const auto pad = [&](size_t alignment) { at = (at + alignment - 1) / alignment * alignment; };
-  const auto ids = [&](uint32_t n, uint32_t limit) {
+  const auto pad = [&](size_t alignment) {
+    const size_t to = (at + alignment - 1) / alignment * alignment;
+    need(to - at);
+    at = to;
+  };
+  // `n` ascending ids below `limit` (of `unit`s), as differences;
+  // `bytes_each`: what the section holds per id, all of which must be there.
+  const auto ids = [&](uint32_t n, uint64_t limit, size_t bytes_each, const std::string& what,
+                       const char* unit) {
+    need(uint64_t{n} * bytes_each);
     std::vector<uint32_t> out(n);
-    uint32_t last = 0;
-    for (uint32_t& id : out) {
+    uint64_t id = 0;
+    for (uint32_t i = 0; i < n; ++i) {
       uint32_t d = 0;
       get(&d);
-      id = last + d;
-      last = id;
-      if (id >= limit) fail("an id out of range");
+      if (i > 0 && d == 0) fail(what + " ids are not ascending");
+      id = (i == 0 ? 0 : id) + d;
+      if (id >= limit)
+        fail(what + " id " + std::to_string(id) + " is outside the " + std::to_string(limit) + " " +
+             unit + " of the scene in force");
+      out[i] = static_cast<uint32_t>(id);
     }
     return out;
   };
@@ -329,9 +367,25 @@ void RecordingPlayer::Decode(const std::string& payload, bool keyframe) {
   get(&time_);
   get(&record);
   get(&pad32);
-  // Poses.
+  // Poses. The keyframe after a scene chunk lists every object: the arrays
+  // by id are made for it only once its bytes are known to be there.
   get(&n);
-  const std::vector<uint32_t> pose_ids = ids(n, static_cast<uint32_t>(pose_.size()));
+  if (keyframe_due_ && !keyframe) fail("a delta right after a scene chunk (a keyframe must come)");
+  if (keyframe && n != scene_objects_)
+    fail("a keyframe lists " + std::to_string(n) + " poses, but its scene has " +
+         std::to_string(scene_objects_) + " objects");
+  need(uint64_t{n} * kPoseBytes);
+  if (keyframe_due_) {
+    root_.assign(scene_objects_, -1);
+    for (const auto& [first, count] : scene_ranges_)
+      for (uint64_t id = first + 1; id < first + count; ++id)
+        root_[id] = static_cast<int64_t>(first);
+    pose_.assign(scene_objects_, {});
+    color_.assign(scene_objects_, 0);
+    reading_.assign(scene_objects_, 0);
+    keyframe_due_ = false;
+  }
+  const std::vector<uint32_t> pose_ids = ids(n, pose_.size(), kPoseBytes, "pose", "objects");
   const auto apply = [&]<typename T>(T Quantized::*field) {
     for (const uint32_t id : pose_ids) {
       T v{};
@@ -352,29 +406,33 @@ void RecordingPlayer::Decode(const std::string& payload, bool keyframe) {
   pad(4);
   // Colours.
   get(&n);
-  for (const uint32_t id : ids(n, static_cast<uint32_t>(color_.size()))) get(&color_[id]);
+  for (const uint32_t id : ids(n, color_.size(), 8, "colour", "objects")) get(&color_[id]);
   // Proximity readings.
   get(&n);
-  for (const uint32_t id : ids(n, static_cast<uint32_t>(reading_.size()))) get(&reading_[id]);
+  for (const uint32_t id : ids(n, reading_.size(), 6, "proximity reading", "objects"))
+    get(&reading_[id]);
   pad(4);
   // Paint cells.
   get(&n);
-  if (keyframe && n > 0 && paint_.empty()) fail("paint cells without a paint layer");
+  if (n > 0 && paint_.empty()) fail("paint cells, but the header has no paint layer");
   if (keyframe)
     for (size_t i = 0; i < paint_.size(); ++i) paint_[i] = paint_background_[i % 3];
-  for (const uint32_t cell : ids(n, static_cast<uint32_t>(paint_.size() / 3))) {
+  for (const uint32_t cell : ids(n, paint_.size() / 3, 8, "paint cell", "cells")) {
     uint32_t rgba = 0;
     get(&rgba);
-    paint_[3 * cell] = rgba & 0xff;
-    paint_[3 * cell + 1] = (rgba >> 8) & 0xff;
-    paint_[3 * cell + 2] = (rgba >> 16) & 0xff;
+    paint_[3 * size_t{cell}] = rgba & 0xff;
+    paint_[3 * size_t{cell} + 1] = (rgba >> 8) & 0xff;
+    paint_[3 * size_t{cell} + 2] = (rgba >> 16) & 0xff;
   }
   // Metrics.
   uint32_t first_name = 0, name_count = 0;
   get(&first_name);
   get(&name_count);
-  if (first_name > metric_names_.size()) fail("a metric name id out of order");
+  if (first_name > metric_names_.size())
+    fail("metric names from id " + std::to_string(first_name) + ", but " +
+         std::to_string(metric_names_.size()) + " are known");
   metric_names_.resize(first_name);
+  need(uint64_t{name_count} * 2);
   for (uint32_t i = 0; i < name_count; ++i) {
     uint16_t length = 0;
     get(&length);
@@ -384,11 +442,14 @@ void RecordingPlayer::Decode(const std::string& payload, bool keyframe) {
   }
   pad(4);
   get(&n);
+  need(uint64_t{n} * 20);  // name id, robot, step, value
   samples_.assign(n, {});
   for (RecordedSample& s : samples_) {
     uint32_t name = 0;
     get(&name);
-    if (name >= metric_names_.size()) fail("an unknown metric name id");
+    if (name >= metric_names_.size())
+      fail("metric name id " + std::to_string(name) + ", but " +
+           std::to_string(metric_names_.size()) + " are known");
     s.name = metric_names_[name];
   }
   for (RecordedSample& s : samples_) {
@@ -403,7 +464,7 @@ void RecordingPlayer::Decode(const std::string& payload, bool keyframe) {
   }
   pad(8);
   for (RecordedSample& s : samples_) get(&s.value);
-  if (at != payload.size()) fail("bytes left over");
+  if (at != payload.size()) fail(std::to_string(payload.size() - at) + " bytes left over");
 }
 
 }  // namespace swarmsim::record

@@ -8,24 +8,34 @@
 //   RecordingPlayer player(dir);
 //   while (player.Next()) ... player.world_pose(id) ...
 //
-// No third-party types here (zstd, xxHash and JSON stay in reader.cc).
+// Every read is bounded by what the file holds (chunk_reader.h): only a
+// regular file is read, nothing is allocated beyond the bytes left in it
+// (or kMaxChunkRawBytes for a payload, checked against its zstd frame), and
+// every index and count in a chunk is checked before it is used. Errors are
+// swarmsim::Error naming the file, the chunk and its byte offset.
+//
+// No third-party types here (zstd, xxHash and JSON stay in the .cc files).
 #pragma once
 
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 #include "framework/math.h"
 
 namespace swarmsim::record {
 
-struct ChunkInfo {      // 24 bytes
+struct ChunkInfo {      // 32 bytes
   uint64_t offset = 0;  // of its header, from the start of the file
   uint32_t step = 0;
   uint32_t stored_size = 0;  // compressed payload bytes after the header
   uint32_t raw_size = 0;
-  uint8_t kind = 0;  // ChunkKind (format.h)
+  uint32_t checksum = 0;  // XXH32 of the stored payload
+  uint8_t kind = 0;       // ChunkKind (format.h)
 };
 
 struct RecordingInfo {
@@ -43,6 +53,10 @@ struct RecordingInfo {
   std::vector<ChunkInfo> chunks;
   int64_t step_records = 0;                 // keyframes and deltas
   int64_t first_step = -1, last_step = -1;  // of the step records (-1: none)
+  // Where the scan is, for ContinueScan: the objects of the scene in force
+  // (-1: no scene yet), and whether its keyframe is still to come.
+  int64_t scene_objects = -1;
+  bool keyframe_due = false;
 
   // One paragraph for a user: steps, size, whether the run ended or the
   // file was cut short ("... the file ends inside a chunk at byte 123456
@@ -51,11 +65,15 @@ struct RecordingInfo {
 };
 
 // The recording in `path`: a run's output folder (DIR/recording.swrec) or
-// the file itself. Checks every chunk's header and checksum and the
-// header's format and version. Throws swarmsim::Error with a message for a
-// user: no recording in the folder, not a recording, a corrupt chunk
-// (naming its number and byte offset), a newer major format version
-// (naming both). A truncated file is not an error (info.truncated).
+// the file itself. Checks every chunk's header, checksum and zstd frame
+// header, the header's format and version, and every header, scene and end
+// chunk's JSON (every index and count in a scene against the scene itself,
+// and its object count against the keyframe after it). Step records are
+// decoded by RecordingPlayer. Throws swarmsim::Error with a message for a
+// user: no recording in the folder, not a regular file, not a recording, a
+// corrupt chunk (naming its number, byte offset and kind, and the field), a
+// newer major format version (naming both). A truncated file is not an
+// error (info.truncated).
 RecordingInfo ScanRecording(const std::filesystem::path& path);
 // Reads the chunks appended since `info` was scanned (a run in progress).
 // Same errors.
@@ -67,11 +85,13 @@ std::string ReadChunk(const std::filesystem::path& file, const ChunkInfo& chunk)
 
 // One metric sample of a step record.
 struct RecordedSample {
-  std::string name;
-  int robot = -1;  // -1: swarm-level
+  std::string_view name;  // valid until the next Next() or SeekTo()
+  int robot = -1;         // -1: swarm-level
   int64_t step = 0;
   double value = 0;
 };
+
+class RecordingFile;  // chunk_reader.h
 
 // Replays a recording's step records in order (or from a keyframe).
 class RecordingPlayer {
@@ -84,10 +104,11 @@ class RecordingPlayer {
 
   const RecordingInfo& info() const { return info_; }
   // Rescans for chunks a run appended since (ContinueScan).
-  void Refresh() { ContinueScan(&info_); }
+  void Refresh();
 
   // Decodes the next step record; false when there is none. Throws
-  // swarmsim::Error for a chunk that does not decode.
+  // swarmsim::Error for a chunk that does not decode, naming it, its byte
+  // offset and the byte of its payload.
   bool Next();
   // Decodes the step record of `step` (from the keyframe at or before it);
   // false if no step record has that step.
@@ -119,16 +140,23 @@ class RecordingPlayer {
     int32_t x = 0, y = 0, z = 0;
     int16_t qw = 0, qx = 0, qy = 0, qz = 0;
   };
-  void LoadScene(const std::string& json);
-  void Decode(const std::string& payload, bool keyframe);
+  void LoadScene(std::string text, const std::string& where);
+  void Decode(const std::string& payload, bool keyframe, const std::string& where);
 
+  std::unique_ptr<RecordingFile> file_;
   RecordingInfo info_;
   size_t next_chunk_ = 0;
   int64_t step_ = -1;
   double time_ = 0;
   std::string scene_json_;
-  std::vector<int64_t> root_;         // (ids)
-  std::vector<int64_t> robot_roots_;  // by robot index (-1: none)
+  // The scene in force: its object count and robots' ranges; the arrays by
+  // id below are sized to it by the keyframe after it (which lists every
+  // object, so no scene claims more than its keyframe holds).
+  uint64_t scene_objects_ = 0;
+  std::vector<std::pair<uint64_t, uint64_t>> scene_ranges_;  // first, count
+  bool keyframe_due_ = false;
+  std::vector<int64_t> root_;                             // (ids)
+  std::vector<std::pair<int64_t, int64_t>> robot_roots_;  // (robot index, root id), by index
   std::vector<Quantized> pose_;
   std::vector<uint32_t> color_;
   std::vector<uint16_t> reading_;

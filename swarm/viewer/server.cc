@@ -8,8 +8,13 @@
 #include <algorithm>
 #include <charconv>
 #include <chrono>
+#include <condition_variable>
 #include <fstream>
+#include <functional>
+#include <memory>
+#include <mutex>
 #include <system_error>
+#include <thread>
 
 #include "framework/error.h"
 #include "swarm/viewer/assets.h"
@@ -39,6 +44,62 @@ bool ReadFrom(const fs::path& file, uint64_t from, uint64_t max_bytes, std::stri
   bytes->resize(static_cast<size_t>(in.gcount()));
   return true;
 }
+
+// Connections served at once. A browser keeps a few idle sockets open per
+// tab; a flood beyond this waits in the kernel's listen queue.
+constexpr size_t kMaxConnections = 256;
+
+// httplib's task queue: a thread of its own for each connection, up to
+// kMaxConnections. (httplib's default, a pool of max(8, cores - 1)
+// threads, let 8 idle connections -- two browser tabs' spare sockets --
+// hold every thread for the keep-alive timeout while the next request
+// waited.) At the cap, the listening thread waits for a connection to end
+// before it accepts another: memory stays bounded, the flood queues in the
+// kernel.
+class ThreadPerConnection : public httplib::TaskQueue {
+ public:
+  ~ThreadPerConnection() override { shutdown(); }
+
+  void enqueue(std::function<void()> task) override {
+    std::unique_lock<std::mutex> lock(state_->mutex);
+    state_->changed.wait(lock, [&] { return state_->running < kMaxConnections; });
+    ++state_->running;
+    lock.unlock();
+    auto shared = std::make_shared<std::function<void()>>(std::move(task));
+    try {
+      // The thread holds the state, which outlives this queue until the last
+      // connection's thread is done with it.
+      std::thread([state = state_, shared] {
+        (*shared)();
+        std::lock_guard<std::mutex> done(state->mutex);
+        --state->running;
+        state->changed.notify_all();
+      }).detach();
+    } catch (const std::system_error&) {
+      // No thread to be had (a process or memory limit): serve the
+      // connection here, delaying the next accept, rather than drop it.
+      (*shared)();
+      std::lock_guard<std::mutex> done(state_->mutex);
+      --state_->running;
+      state_->changed.notify_all();
+    }
+  }
+
+  // Waits until every connection's thread has answered and closed it
+  // (within the read and keep-alive timeouts: the server socket is closed).
+  void shutdown() override {
+    std::unique_lock<std::mutex> lock(state_->mutex);
+    state_->changed.wait(lock, [&] { return state_->running == 0; });
+  }
+
+ private:
+  struct State {
+    std::mutex mutex;
+    std::condition_variable changed;
+    size_t running = 0;
+  };
+  std::shared_ptr<State> state_ = std::make_shared<State>();
+};
 
 std::string ContentType(const fs::path& file) {
   const std::string ext = file.extension().string();
@@ -88,11 +149,18 @@ Server::Server(fs::path folder) : impl_(std::make_unique<Impl>()) {
     int yes = 1;
     setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof(yes));
   });
-  // Hostile or stuck clients: small bodies, short timeouts.
+  // Hostile or stuck clients: small bodies, short timeouts. A request
+  // arrives in one piece from a browser: one that stops halfway (or a
+  // malformed one waiting for its end) is answered 400 after 1 s. An idle
+  // connection, new or between requests, is closed after 1 s (browsers open
+  // another), so it holds its thread no longer; a busy one is served up to
+  // 100 requests.
+  http.new_task_queue = [] { return new ThreadPerConnection; };
   http.set_payload_max_length(1 << 16);
-  http.set_read_timeout(5, 0);
+  http.set_read_timeout(1, 0);
   http.set_write_timeout(30, 0);
-  http.set_keep_alive_timeout(5);
+  http.set_keep_alive_timeout(1);
+  http.set_keep_alive_max_count(100);
   http.set_exception_handler(
       [](const httplib::Request&, httplib::Response& res, std::exception_ptr) {
         res.status = 500;
