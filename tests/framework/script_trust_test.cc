@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <memory>
 #include <string>
 #include <utility>
@@ -75,6 +76,12 @@ class TrustTest : public ::testing::Test {
       world_->Stop();
     });
   }
+  // What the script wrote into out/pre.txt (NestedRefusal).
+  std::string PreText() {
+    world_.reset();  // closes the file
+    std::ifstream in(root_ / "out" / "pre.txt");
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  }
   // The files a script wrote into out/.
   std::vector<std::string> OutFiles() const {
     std::vector<std::string> names;
@@ -97,7 +104,9 @@ class TrustTest : public ::testing::Test {
 // metric, a file, a line printed), as does the callback.
 std::string NestedRefusal(const std::string& callback, const std::string& catcher, int depth,
                           const std::string& refused = "os.execute('true')") {
-  return "local function after(tag)\n"
+  return "local pre\n"
+         "local function after(tag)\n"
+         "  pre:write('went on ', tag, '\\n') pre:flush()\n"
          "  sim.recordMetric('after_' .. tag, 1)\n"
          "  local f = io.open('after_' .. tag .. '.txt', 'w')\n"
          "  if f then f:write('x') f:close() end\n"
@@ -115,6 +124,7 @@ std::string NestedRefusal(const std::string& callback, const std::string& catche
          "function " +
          callback +
          "()\n"
+         "  pre = io.open('pre.txt', 'w')\n"
          "  local f = function() pcall(function() " +
          refused +
          " end) after('0') end\n"
@@ -146,7 +156,8 @@ TEST_F(TrustTest, ARefusalInNestedCoroutinesEndsTheCallbackWhateverCatchesIt) {
         EXPECT_CONTAINS(error, "[in " + callback + " of /bot#0/body]");
         EXPECT_EQ(log_, std::vector<std::string>{});
         EXPECT_EQ(world_->TakeMetrics().size(), 0u);
-        EXPECT_EQ(OutFiles(), std::vector<std::string>{});
+        EXPECT_EQ(OutFiles(), std::vector<std::string>{"pre.txt"});
+        EXPECT_EQ(PreText(), "");
       }
     }
   }
@@ -161,7 +172,27 @@ TEST_F(TrustTest, AnyRefusalIsCaughtTheSameWay) {
     const std::string error = Run(NestedRefusal("sysCall_actuation", "pcall", 2, refused));
     EXPECT_NE(error, "");
     EXPECT_EQ(log_, std::vector<std::string>{});
-    EXPECT_EQ(OutFiles(), std::vector<std::string>{});
+    EXPECT_EQ(OutFiles(), std::vector<std::string>{"pre.txt"});
+    EXPECT_EQ(PreText(), "");
+  }
+}
+
+// A to-be-closed variable's handler runs while the refusal unwinds the
+// callback: a Lua handler is stopped at its first instruction, and a
+// sim.* or sandbox function used as one is refused (it gets no count hook).
+TEST_F(TrustTest, AClosingHandlerCannotActAfterARefusal) {
+  for (const std::string handler : {"print", "function(t, e) print('closing', e) end"}) {
+    SCOPED_TRACE(handler);
+    log_.clear();
+    const std::string error =
+        Run("function sysCall_actuation()\n"
+            "  local guard <close> = setmetatable({}, {__close = " +
+            handler +
+            "})\n"
+            "  pcall(os.execute, 'true')\n"
+            "end\n");
+    EXPECT_CONTAINS(error, "bot#0: scripts/robot.lua:3: os.execute is not allowed");
+    EXPECT_EQ(log_, std::vector<std::string>{});
   }
 }
 
@@ -173,7 +204,8 @@ TEST_F(TrustTest, ASpentBudgetInANestedCoroutineEndsTheCallbackToo) {
       Run(NestedRefusal("sysCall_actuation", "pcall", 2, "while true do end"));
   EXPECT_CONTAINS(error, "more than 1000000 Lua instructions");
   EXPECT_EQ(log_, std::vector<std::string>{});
-  EXPECT_EQ(OutFiles(), std::vector<std::string>{});
+  EXPECT_EQ(OutFiles(), std::vector<std::string>{"pre.txt"});
+  EXPECT_EQ(PreText(), "");
 }
 
 // Under disable_script the refusing script is disabled and listed, and
@@ -194,7 +226,8 @@ TEST_F(TrustTest, UnderDisableScriptARefusalDisablesTheScript) {
     const std::vector<MetricSample> metrics = world_->TakeMetrics();
     ASSERT_EQ(metrics.size(), 3u);
     for (const MetricSample& m : metrics) EXPECT_EQ(m.name, "alive");
-    EXPECT_EQ(OutFiles(), std::vector<std::string>{});
+    EXPECT_EQ(OutFiles(), std::vector<std::string>{"pre.txt"});
+    EXPECT_EQ(PreText(), "");
     ASSERT_EQ(log_.size(), 1u);
     EXPECT_CONTAINS(log_[0], "error, script disabled: bot#0: scripts/robot.lua:");
   }
@@ -244,15 +277,15 @@ TEST_F(TrustTest, ScriptsCannotWriteAnyOfTheRunsOwnOutputs) {
 // metrics. Each is refused past the limit, with the setting named.
 TEST_F(TrustTest, DataTheSimCallsKeepCountsAgainstTheRobotsMemoryLimit) {
   settings_.script_memory_limit = 4 << 20;
+  // Each loop would hold ~20 MiB.
   const std::vector<std::pair<std::string, std::string>> calls = {
-      {"sim.setSignal('s' .. i, block)",
+      {"for i = 1, 200 do sim.setSignal('s' .. i, block) end",
        "sim.setSignal: the signal would take the scripts past 4 MiB"},
-      {"sim.writeCustomDataBlock(sim.getObject('.'), 't' .. i, block)",
+      {"for i = 1, 200 do sim.writeCustomDataBlock(sim.getObject('.'), 't' .. i, block) end",
        "sim.writeCustomDataBlock: the custom data block would take the scripts past 4 MiB"},
-      {"sim.sendGlobalMessage(block)",
-       "sim.sendGlobalMessage: the message would take the scripts "
-       "past 4 MiB"},
-      {"sim.recordMetric(('m'):rep(200), i)",
+      {"for i = 1, 200 do sim.sendGlobalMessage(block) end",
+       "sim.sendGlobalMessage: the message would take the scripts past 4 MiB"},
+      {"for i = 1, 80000 do sim.recordMetric(('m'):rep(200), i) end",
        "sim.recordMetric: the metric sample would take the scripts past 4 MiB"},
   };
   for (const auto& [call, message] : calls) {
@@ -260,9 +293,9 @@ TEST_F(TrustTest, DataTheSimCallsKeepCountsAgainstTheRobotsMemoryLimit) {
     const std::string error =
         Run("local block = ('x'):rep(100000)\n"
             "function sysCall_actuation()\n"
-            "  for i = 1, 200000 do " +
+            "  " +
             call +
-            " end\n"
+            "\n"
             "end\n");
     EXPECT_CONTAINS(error, "bot#0: scripts/robot.lua:3: " + message);
     EXPECT_CONTAINS(error, "of data the sim.* calls keep for them");
