@@ -36,7 +36,8 @@ if [ -z "$line" ]; then
   echo "tools/fuzz.sh: no target '$target' (targets: $(targets | tr '\n' ' '))" >&2
   exit 2
 fi
-read -r _ max_len timeout rss seeds <<<"$line"
+read -r _ max_len timeout rss flags seeds <<<"$line"
+[ "$flags" = - ] && flags="" || flags="${flags//,/ }"
 
 # clang and libFuzzer's runtime (Debian: clang, libclang-rt-14-dev).
 if ! command -v clang++ >/dev/null 2>&1; then
@@ -92,17 +93,19 @@ log="$build/artifacts/$target/last-run.log"
 status=0
 # One core (no -jobs/-workers); -fork=0. -max_total_time also bounds a
 # stuck run: libFuzzer's own -timeout reports an input slower than TIMEOUT s.
+# Third-party leaks we cannot fix (tools/fuzz/lsan.supp says which).
+export LSAN_OPTIONS="suppressions=$root/tools/fuzz/lsan.supp${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
 keep_going=()
 if [ -n "${FUZZ_KEEP_GOING:-}" ]; then
   keep_going=(-fork=1 -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1)
 fi
 "$program" "$build/corpus/$target" "$seed_dir" ${keep_going[@]+"${keep_going[@]}"} \
   -max_total_time="$seconds" -timeout="$timeout" -rss_limit_mb="$rss" -max_len="$max_len" \
-  -artifact_prefix="$build/artifacts/$target/" -print_final_stats=1 ${FUZZ_ARGS:-} \
+  -artifact_prefix="$build/artifacts/$target/" -print_final_stats=1 $flags ${FUZZ_ARGS:-} \
   >"$log" 2>&1 || status=$?
 
 # The figures.
-last="$(grep -E '^#[0-9]+:? ' "$log" | tail -n 1 || true)"
+last="$(grep -E '^#[0-9]+:?[[:space:]]' "$log" | tail -n 1 || true)"
 echo "$last"
 execs="$(grep -E '^stat::number_of_executed_units' "$log" | awk '{print $2}' | tail -n 1)"
 [ -n "$execs" ] || execs="$(echo "$last" | sed -nE 's/^#([0-9]+).*/\1/p')"

@@ -24,7 +24,8 @@ simulation:
   steps: 3
   instruction_budget: 200000
   script_memory_mb: 32
-arena: {size: 2}
+  octree_resolution: 0.25
+arena: {size: 1.2}
 obstacles:
   - {shape: box, size: [0.1, 0.1, 0.1], position: [0.3, 0, 0.05]}
 models:
