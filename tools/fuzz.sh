@@ -107,7 +107,7 @@ fi
 # The figures.
 last="$(grep -E '^#[0-9]+:?[[:space:]]' "$log" | tail -n 1 || true)"
 echo "$last"
-execs="$(grep -E '^stat::number_of_executed_units' "$log" | awk '{print $2}' | tail -n 1)"
+execs="$(grep -E '^stat::number_of_executed_units' "$log" | awk '{print $2}' | tail -n 1 || true)"
 [ -n "$execs" ] || execs="$(echo "$last" | sed -nE 's/^#([0-9]+).*/\1/p')"
 cov="$(echo "$last" | sed -nE 's/.*cov: ([0-9]+).*ft: ([0-9]+).*/\1 edges, \2 features/p')"
 if [ -n "${FUZZ_KEEP_GOING:-}" ]; then

@@ -11,6 +11,13 @@
 // always run. A crash, an abort or an exception other than swarmsim::Error
 // ends the program as it would end libFuzzer's; a harness that finishes
 // every input exits 0 and prints how many it ran and the slowest.
+//
+// Memory is capped (kMaxMemoryBytes of address space, except under ASan,
+// which reserves terabytes): an input that makes the code allocate without
+// bound ends in std::bad_alloc, a failed test, instead of taking the
+// machine's memory.
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -28,6 +35,20 @@ namespace {
 
 namespace fs = std::filesystem;
 
+constexpr rlim_t kMaxMemoryBytes = rlim_t{4} << 30;
+
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kAddressSanitizer = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+constexpr bool kAddressSanitizer = true;
+#else
+constexpr bool kAddressSanitizer = false;
+#endif
+#else
+constexpr bool kAddressSanitizer = false;
+#endif
+
 std::set<std::string> SplitExtensions(const std::string& list) {
   std::set<std::string> out;
   std::stringstream in(list);
@@ -39,6 +60,10 @@ std::set<std::string> SplitExtensions(const std::string& list) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (!kAddressSanitizer) {
+    const rlimit limit{kMaxMemoryBytes, kMaxMemoryBytes};
+    setrlimit(RLIMIT_AS, &limit);
+  }
   std::vector<fs::path> inputs;
   std::set<std::string> extensions;  // empty: every file
   for (int i = 1; i < argc; ++i) {
