@@ -1,0 +1,6 @@
+-- Seed: a call the sandbox refuses, inside a coroutine under pcall.
+function sysCall_init()
+  local co = coroutine.wrap(function() print(pcall(function() return io.open('/etc/passwd') end)) end)
+  print(pcall(co))
+  sim.recordMetric('after', 1)
+end

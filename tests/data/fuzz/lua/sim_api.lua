@@ -1,0 +1,32 @@
+-- Seed: the sim.* calls on this robot's objects, with odd arguments too.
+function sysCall_init()
+  body = sim.getObject('.')
+  left = sim.getObject('./leftMotor')
+  right = sim.getObject(':/rightMotor')
+  prox = sim.getObject('./prox[0]')
+  led = sim.getObject('./led')
+  print(sim.getObjectName(body), sim.getRobotName(), sim.getRobotIndex())
+  print(pcall(sim.getObject, '/nothing'), pcall(sim.getObject, './prox[99]'))
+  print(pcall(sim.getObject, 42), pcall(sim.getObjectPose, -1))
+  sim.setJointTargetVelocity(left, 1)
+  print(pcall(sim.setJointTargetVelocity, right, 0 / 0))
+  print(sim.getObjectPose(body), sim.getObjectPosition(left, body))
+  print(sim.getParam('wheel_speed'), sim.getParam('missing', 3))
+  sim.setSignal('s', 'v')
+  sim.writeCustomDataBlock(body, 'k', 'data')
+  print(sim.readCustomDataBlock(body, 'k'))
+end
+function sysCall_sensing()
+  print(sim.readProximitySensor(prox))
+  local count, distances = sim.readProximitySensors({prox, prox})
+  print(count, distances and #distances)
+end
+function sysCall_actuation()
+  sim.setJointTargetVelocity(right, sim.random() * 2)
+  sim.recordMetric('x', sim.getObjectPosition(body)[1])
+  sim.recordMetric('robot-' .. sim.getRobotIndex(), sim.getJointVelocity(left))
+  print(sim.getSimulationTime(), sim.getTimeStep())
+end
+function sysCall_cleanup()
+  print('bye', sim.getSignal and sim.getSignal('s'))
+end
