@@ -2,14 +2,17 @@
 // the recording from a byte offset, and other files of the output folder.
 #include "swarm/viewer/server.h"
 
+#include <fcntl.h>
 #include <httplib.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <charconv>
 #include <chrono>
 #include <condition_variable>
-#include <fstream>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -28,20 +31,69 @@ namespace {
 // At most this many bytes in one answer for the recording: a page reading a
 // larger file asks again from where the answer ended.
 constexpr uint64_t kMaxRecordingAnswer = 64ull << 20;
+// An answer's bytes are read from the file in pieces of this size as they
+// are sent, so a connection holds no more of them (kMaxConnections at once).
+constexpr size_t kAnswerPiece = 64 << 10;
 
-// `file`'s bytes from `from` on, at most `max_bytes`; false when unreadable.
-bool ReadFrom(const fs::path& file, uint64_t from, uint64_t max_bytes, std::string* bytes,
-              uint64_t* size) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) return false;
-  in.seekg(0, std::ios::end);
-  *size = static_cast<uint64_t>(in.tellg());
-  bytes->clear();
-  if (from >= *size) return true;
-  bytes->resize(std::min(*size - from, max_bytes));
-  in.seekg(static_cast<std::streamoff>(from));
-  in.read(bytes->data(), static_cast<std::streamsize>(bytes->size()));
-  bytes->resize(static_cast<size_t>(in.gcount()));
+// A file of the folder opened for one answer. Only a regular file is
+// opened: a FIFO put in place after FileInside's check is refused, never
+// waited on.
+class OpenFile {
+ public:
+  // nullptr when `file` cannot be read or is not a regular file.
+  static std::shared_ptr<OpenFile> Open(const fs::path& file) {
+    const int fd = ::open(file.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+    if (fd < 0) return nullptr;
+    struct stat status {};
+    if (::fstat(fd, &status) != 0 || !S_ISREG(status.st_mode)) {
+      ::close(fd);
+      return nullptr;
+    }
+    return std::shared_ptr<OpenFile>(new OpenFile(fd, static_cast<uint64_t>(status.st_size)));
+  }
+  ~OpenFile() { ::close(fd_); }
+  OpenFile(const OpenFile&) = delete;
+  OpenFile& operator=(const OpenFile&) = delete;
+
+  uint64_t size() const { return size_; }  // when opened
+  // The `n` bytes at `offset`; false when they cannot all be read.
+  bool ReadAt(uint64_t offset, char* out, size_t n) const {
+    while (n > 0) {
+      const ssize_t got = ::pread(fd_, out, n, static_cast<off_t>(offset));
+      if (got < 0 && errno == EINTR) continue;
+      if (got <= 0) return false;
+      out += got;
+      offset += static_cast<uint64_t>(got);
+      n -= static_cast<size_t>(got);
+    }
+    return true;
+  }
+
+ private:
+  OpenFile(int fd, uint64_t size) : fd_(fd), size_(size) {}
+  int fd_;
+  uint64_t size_;
+};
+
+// Answers `file`'s bytes from `from` on, at most kMaxRecordingAnswer of
+// them, read piece by piece as they are sent; `*size`: the file's size.
+// False when the file cannot be read.
+bool AnswerFile(const fs::path& file, uint64_t from, const std::string& content_type,
+                httplib::Response* res, uint64_t* size) {
+  const std::shared_ptr<OpenFile> open = OpenFile::Open(file);
+  if (!open) return false;
+  *size = open->size();
+  const uint64_t length = from >= *size ? 0 : std::min(*size - from, kMaxRecordingAnswer);
+  if (length == 0) {
+    res->set_content("", content_type);
+    return true;
+  }
+  res->set_content_provider(length, content_type,
+                            [open, from](size_t offset, size_t left, httplib::DataSink& sink) {
+                              std::string piece(std::min(left, kAnswerPiece), '\0');
+                              return open->ReadAt(from + offset, piece.data(), piece.size()) &&
+                                     sink.write(piece.data(), piece.size());
+                            });
   return true;
 }
 
@@ -199,27 +251,20 @@ Server::Server(fs::path folder) : impl_(std::make_unique<Impl>()) {
       }
     }
     const std::optional<fs::path> file = FileInside(impl->folder, kRecordingFile);
-    std::string bytes;
     uint64_t size = 0;
-    if (!file || !ReadFrom(*file, from, kMaxRecordingAnswer, &bytes, &size)) {
+    if (!file || !AnswerFile(*file, from, "application/octet-stream", &res, &size)) {
       res.status = 404;
       return;
     }
     res.set_header("Cache-Control", "no-store");
     res.set_header("X-Swarmsim-Size", std::to_string(size));
-    res.set_content(std::move(bytes), "application/octet-stream");
   });
 
   // Other files of the folder the page may need (summary.json, meshes).
   http.Get("/files/(.+)", [impl](const httplib::Request& req, httplib::Response& res) {
     const std::optional<fs::path> file = FileInside(impl->folder, req.matches[1].str());
-    std::string bytes;
     uint64_t size = 0;
-    if (!file || !ReadFrom(*file, 0, kMaxRecordingAnswer, &bytes, &size)) {
-      res.status = 404;
-      return;
-    }
-    res.set_content(std::move(bytes), ContentType(*file).c_str());
+    if (!file || !AnswerFile(*file, 0, ContentType(*file), &res, &size)) res.status = 404;
   });
 }
 

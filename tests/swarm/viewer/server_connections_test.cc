@@ -136,5 +136,26 @@ TEST_F(ServerConnectionsTest, ABrokenRequestIsAnsweredAndClosedPromptly) {
       std::string::npos);
 }
 
+TEST_F(ServerConnectionsTest, ALargeRecordingIsServedWholeFromAnyOffset) {
+  // Larger than the pieces an answer is read in, of bytes that differ.
+  std::string bytes(300000, '\0');
+  for (size_t i = 0; i < bytes.size(); ++i) bytes[i] = static_cast<char>((i * 7919) % 251);
+  std::ofstream(run_ / "recording.swrec", std::ios::binary) << bytes;
+  Server server(run_);
+  const int port = server.Bind("127.0.0.1", 0);
+  server.Start();
+  for (const size_t from : {size_t{0}, size_t{1}, size_t{65536}, size_t{299999}, size_t{300000}}) {
+    const Answer answer = Exchange(port,
+                                   "GET /recording.swrec?from=" + std::to_string(from) +
+                                       " HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n",
+                                   5);
+    const size_t body = answer.bytes.find("\r\n\r\n");
+    ASSERT_NE(body, std::string::npos) << from;
+    EXPECT_NE(answer.bytes.find("X-Swarmsim-Size: 300000\r\n"), std::string::npos) << from;
+    EXPECT_TRUE(answer.bytes.substr(body + 4) == bytes.substr(from))
+        << "from " << from << ": " << answer.bytes.size() - body - 4 << " bytes";
+  }
+}
+
 }  // namespace
 }  // namespace swarmsim::viewer
