@@ -5,6 +5,7 @@
 #include <fstream>
 
 #include "framework/error.h"
+#include "framework/output_file.h"
 #include "swarm/viewer/assets.h"
 
 namespace swarmsim::viewer {
@@ -76,10 +77,7 @@ void ExportFolder(const std::filesystem::path& folder, uint64_t size,
   std::string bytes(size, '\0');
   if (!in.read(bytes.data(), static_cast<std::streamsize>(size)))
     throw Error("cannot read '" + recording_file.string() + "'");
-  std::ofstream out(html_file, std::ios::binary);
-  out << ExportedPage(bytes);
-  out.close();
-  if (!out) throw Error("cannot write '" + html_file.string() + "'");
+  WriteFileAtomically(html_file, ExportedPage(bytes));  // whole or not at all
 }
 
 }  // namespace swarmsim::viewer
