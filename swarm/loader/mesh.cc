@@ -1,5 +1,7 @@
 #include "swarm/loader/mesh.h"
 
+#include <assimp/DefaultIOSystem.h>
+#include <assimp/MemoryIOWrapper.h>
 #include <assimp/config.h>
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
@@ -8,15 +10,65 @@
 #include <algorithm>
 #include <assimp/Importer.hpp>
 #include <cctype>
+#include <cmath>
+#include <stdexcept>
 
+#include "framework/display_path.h"
 #include "framework/error.h"
+#include "swarm/loader/mesh_check.h"
 #include "swarm/loader/yaml.h"
+
+// assimp's assertions: Debian's assimp 5.2 is built with them on, and a
+// failed one calls std::abort() (exit 134, no message of ours, no outputs).
+// 5.2 has no setAiAssertHandler (5.3 does), but every assertion calls this
+// function through the library's PLT, so the program's own definition
+// replaces the library's: it throws, and assimp's importer catches the
+// exception (BaseImporter::ReadFile) and returns no scene with its text,
+// which ReadMeshFile reports. mesh_check.h refuses the inputs known to
+// fail one first, with the file and line; this is the backstop for the
+// rest. (Default visibility: a Python module built with hidden symbols
+// still replaces it.)
+namespace Assimp {
+__attribute__((visibility("default"))) void aiAssertViolation(const char* expression,
+                                                              const char* file, int line) {
+  throw std::runtime_error(std::string("assimp's check '") + expression + "' failed (" + file +
+                           ":" + std::to_string(line) + ")");
+}
+}  // namespace Assimp
 
 namespace swarmsim::loader {
 
 namespace fs = std::filesystem;
 
 namespace {
+
+// The files assimp opens: the mesh file itself from the bytes already read
+// and checked (never read twice), others (an OBJ's material library) only
+// if they are regular files of a sane size (not a FIFO, which would block,
+// nor a device).
+class CheckedFiles : public Assimp::DefaultIOSystem {
+ public:
+  CheckedFiles(std::string path, const std::string* bytes)
+      : path_(std::move(path)), bytes_(bytes) {}
+  bool Exists(const char* file) const override { return file == path_ || Readable(file); }
+  Assimp::IOStream* Open(const char* file, const char* mode = "rb") override {
+    if (file == path_)
+      return new Assimp::MemoryIOStream(reinterpret_cast<const uint8_t*>(bytes_->data()),
+                                        bytes_->size());
+    if (!Readable(file) || std::string_view(mode).find_first_of("wa+") != std::string_view::npos)
+      return nullptr;
+    return DefaultIOSystem::Open(file, mode);
+  }
+
+ private:
+  static bool Readable(const char* file) {
+    constexpr uintmax_t kMaxBytes = 64 << 20;  // as ReadFileOrThrow
+    std::error_code ec;
+    return fs::is_regular_file(file, ec) && fs::file_size(file, ec) <= kMaxBytes && !ec;
+  }
+  std::string path_;
+  const std::string* bytes_;
+};
 
 // Reads the file's triangles (assimp), merging vertices at equal positions
 // (STL repeats each corner per facet) so that closed meshes are seen closed.
@@ -37,7 +89,17 @@ std::shared_ptr<const TriangleMesh> MeshCache::Get(const fs::path& path, const V
   auto file = files_.find(key);
   if (file == files_.end()) file = files_.emplace(key, ReadMeshFile(path, where, text)).first;
   std::vector<Vec3> vertices = file->second->vertices;
-  for (Vec3& v : vertices) v = {v.x * scale.x, v.y * scale.y, v.z * scale.z};
+  for (Vec3& v : vertices) {
+    v = {v.x * scale.x, v.y * scale.y, v.z * scale.z};
+    if (!(std::abs(v.x) <= kMaxCoordinate && std::abs(v.y) <= kMaxCoordinate &&
+          std::abs(v.z) <= kMaxCoordinate)) {
+      char text_v[128];
+      std::snprintf(text_v, sizeof text_v, "(%g, %g, %g) m; coordinates are at most %g m", v.x, v.y,
+                    v.z, kMaxCoordinate);
+      throw Error((where.empty() ? "" : where + ": ") + "mesh file '" + text + "' has a vertex " +
+                  (scale.x == 1 && scale.y == 1 && scale.z == 1 ? "" : "scaled ") + "at " + text_v);
+    }
+  }
   std::shared_ptr<const TriangleMesh> mesh;
   try {
     mesh = std::make_shared<const TriangleMesh>(DisplayPath(path), std::move(vertices),
@@ -63,8 +125,21 @@ std::shared_ptr<const MeshCache::Welded> ReadMeshFile(const fs::path& path,
                 "' must be STL, OBJ or COLLADA (a .stl, .obj or .dae name)");
   const std::string bytes = ReadFileOrThrow(path, "mesh file", where, text);
   if (bytes.empty()) throw Error(prefix + "mesh file '" + text + "' is empty");
+  // What assimp reads: the bytes, checked (mesh_check.h); of a COLLADA
+  // file, the parts the loader uses.
+  std::string checked;
+  try {
+    const std::string name = DisplayPath(path);
+    if (ext == ".stl") CheckStlBytes(bytes, name);
+    if (ext == ".obj") CheckObjBytes(bytes, name);
+    if (ext == ".dae") checked = CheckColladaBytes(bytes, name);
+  } catch (const Error& e) {
+    throw Error(prefix + e.what());
+  }
+  const std::string& read = ext == ".dae" ? checked : bytes;
 
   Assimp::Importer importer;
+  importer.SetIOHandler(new CheckedFiles(path.string(), &read));  // the importer owns it
   // COLLADA: the file's <unit> applies, its up axis does not (assimp would
   // turn a Z_UP file to Y-up): coordinates stay in the file's own frame,
   // which is what URDF and the world files mean. Node transforms are baked
@@ -72,13 +147,22 @@ std::shared_ptr<const MeshCache::Welded> ReadMeshFile(const fs::path& path,
   importer.SetPropertyBool(AI_CONFIG_IMPORT_COLLADA_IGNORE_UP_DIRECTION, true);
   const unsigned flags =
       aiProcess_Triangulate | aiProcess_PreTransformVertices | aiProcess_SortByPType;
-  // An OBJ or DAE file is read from its folder, so that its material library
-  // (mtllib x.mtl beside it) gives the colours; an STL file has none.
-  const aiScene* scene = ext != ".stl" ? importer.ReadFile(path.string(), flags)
-                                       : importer.ReadFileFromMemory(bytes.data(), bytes.size(),
-                                                                     flags, ext.c_str() + 1);
+  // Read by its path, so that an OBJ file's material library (mtllib x.mtl
+  // beside it) gives the colours.
+  const aiScene* scene = nullptr;
+  try {
+    scene = importer.ReadFile(path.string(), flags);
+  } catch (const std::exception& e) {  // one of assimp's checks failed outside its importer
+    throw Error(prefix + "cannot read mesh file '" + text + "': " + e.what());
+  }
   if (!scene)
     throw Error(prefix + "cannot read mesh file '" + text + "': " + importer.GetErrorString());
+  size_t faces = 0;
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) faces += scene->mMeshes[m]->mNumFaces;
+  if (faces > static_cast<size_t>(kMaxMeshTriangles))
+    throw Error(prefix + "mesh file '" + text + "' has " + std::to_string(faces) +
+                " faces; the limit for a mesh file is " + std::to_string(kMaxMeshTriangles) +
+                " triangles");
 
   auto out = std::make_shared<MeshCache::Welded>();
   std::map<std::array<double, 3>, uint32_t> index_of;
@@ -109,6 +193,9 @@ std::shared_ptr<const MeshCache::Welded> ReadMeshFile(const fs::path& path,
       for (int k = 0; k < 3; ++k) {
         const aiVector3D& v = mesh->mVertices[face.mIndices[k]];
         const std::array<double, 3> p{v.x, v.y, v.z};
+        if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
+          throw Error(prefix + "mesh file '" + text +
+                      "' has a vertex that is not finite (after its unit and node transforms)");
         auto [it, added] = index_of.emplace(p, static_cast<uint32_t>(out->vertices.size()));
         if (added) out->vertices.push_back({p[0], p[1], p[2]});
         tri.v[k] = it->second;

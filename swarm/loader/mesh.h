@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -16,12 +17,22 @@
 
 namespace swarmsim::loader {
 
+// Limits on a mesh file, checked before assimp reads it (mesh_check.h). The
+// file itself is at most 64 MiB, as every file a world reads.
+inline constexpr int64_t kMaxMeshTriangles = 2000000;    // polygons split, each instance counted
+inline constexpr int64_t kMaxColladaElements = 1000000;  // XML elements of a COLLADA file
+inline constexpr int kMaxColladaNodeDepth = 256;     // nested nodes, instance_node hops included
+inline constexpr int64_t kMaxColladaNodes = 100000;  // scene nodes, each instance counted
+
 class MeshCache {
  public:
   // The mesh in `path` (STL, ASCII or binary, OBJ or COLLADA: its unit
   // applies, its up axis does not), each vertex scaled by
   // `scale` (positive). Throws swarmsim::Error "<where>: mesh file 'text' ..."
-  // for a missing, unreadable, unsupported or empty file.
+  // for a missing, unreadable, unsupported or empty file, and
+  // "<where>: <file>:<line>: ..." for one that breaks a limit above or that
+  // assimp would not survive (mesh_check.h); a vertex, once scaled, is
+  // finite and within kMaxCoordinate of the file's origin.
   std::shared_ptr<const TriangleMesh> Get(const std::filesystem::path& path, const Vec3& scale,
                                           const std::string& where, const std::string& text);
   // Files read so far (each once, whatever the scales).
