@@ -1,0 +1,132 @@
+// Numbers in a URDF file (issue 26): every attribute urdfdom reads a number
+// from holds finite numbers, else the import fails naming the file, the line
+// and the attribute; urdfdom's own message named no line, and an unreadable
+// <mass value> made a massless link.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "framework/error.h"
+#include "swarm/loader/urdf.h"
+
+namespace swarmsim::loader {
+namespace {
+
+namespace fs = std::filesystem;
+
+class UrdfNumbersTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("swarmsim_urdf_numbers_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  // A two-link robot; `link` and `joint` are inserted into the base link
+  // and the joint (line 3 holds the base link, line 4 the inserted part of
+  // it; line 7 the joint, line 8 its inserted part).
+  std::string Robot(const std::string& link, const std::string& joint,
+                    const std::string& top = "") {
+    return "<?xml version=\"1.0\"?>\n"
+           "<robot name=\"r\">\n"
+           "  <link name=\"base\">\n" +
+           link +
+           "\n"
+           "  </link>\n"
+           "  <link name=\"arm\"/>\n"
+           "  <joint name=\"j\" type=\"revolute\">\n" +
+           joint +
+           "\n"
+           "    <parent link=\"base\"/><child link=\"arm\"/>\n"
+           "    <limit lower=\"-1\" upper=\"1\" effort=\"1\" velocity=\"1\"/>\n"
+           "  </joint>\n" +
+           top + "</robot>\n";
+  }
+  std::string ErrorOf(const std::string& text) {
+    std::ofstream(dir_ / "r.urdf") << text;
+    try {
+      ImportUrdf(dir_ / "r.urdf", "", "r.urdf", {}, nullptr);
+    } catch (const Error& e) {
+      return e.what();
+    }
+    return "no error";
+  }
+  // The error of `text`, from "r.urdf:" on.
+  std::string Message(const std::string& text) {
+    const std::string e = ErrorOf(text);
+    const size_t at = e.find("r.urdf:");
+    return at == std::string::npos ? e : e.substr(at);
+  }
+
+  fs::path dir_;
+};
+
+const std::string kInertial =
+    "    <inertial><mass value=\"1\"/>"
+    "<inertia ixx=\"1\" iyy=\"1\" izz=\"1\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial>";
+
+TEST_F(UrdfNumbersTest, ReadableNumbersLoad) {
+  EXPECT_EQ(ErrorOf(Robot("    <inertial><origin xyz=\" +1 .5 2e-3 \" rpy=\"0 0 -1.5707963\"/>"
+                          "<mass value=\"1.\"/><inertia ixx=\"1e-3\" iyy=\"1E-3\" izz=\"0.001\" "
+                          "ixy=\"0\" ixz=\"-0\" iyz=\"0\"/></inertial>\n"
+                          "    <visual><geometry><box size=\"0.1 0.2 0.3\"/></geometry>"
+                          "<material name=\"m\"><color rgba=\"1 0 0 1\"/></material></visual>",
+                          "    <axis xyz=\"0 0 1\"/><dynamics damping=\"0.1\" friction=\"0\"/>")),
+            "no error");
+}
+
+TEST_F(UrdfNumbersTest, UnreadableMassIsAnErrorNotAMasslessLink) {
+  EXPECT_EQ(Message(Robot("    <inertial><mass value=\"abc\"/>"
+                          "<inertia ixx=\"1\" iyy=\"1\" izz=\"1\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/>"
+                          "</inertial>",
+                          "")),
+            "r.urdf:4: link 'base' <inertial>: <mass value=\"abc\">: 'abc' is not a finite number");
+  EXPECT_EQ(Message(Robot("    <inertial><mass value=\"\"/>"
+                          "<inertia ixx=\"1\" iyy=\"1\" izz=\"1\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/>"
+                          "</inertial>",
+                          "")),
+            "r.urdf:4: link 'base' <inertial>: <mass value=\"\"> needs a number");
+  EXPECT_EQ(
+      Message(Robot("    <inertial><mass value=\"1\"/>"
+                    "<inertia ixx=\"inf\" iyy=\"1\" izz=\"1\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/>"
+                    "</inertial>",
+                    "")),
+      "r.urdf:4: link 'base' <inertial>: <inertia ixx=\"inf\">: 'inf' is not a finite number");
+}
+
+TEST_F(UrdfNumbersTest, VectorsHoldTheirCountOfFiniteNumbers) {
+  EXPECT_EQ(Message(Robot(kInertial + "\n    <visual><origin xyz=\"0 nan 0\"/>"
+                                      "<geometry><sphere radius=\"1\"/></geometry></visual>",
+                          "")),
+            "r.urdf:5: link 'base' <visual>: <origin xyz=\"0 nan 0\">: 'nan' is not a finite "
+            "number");
+  EXPECT_EQ(Message(Robot("", "    <origin xyz=\"0 0 0\" rpy=\"0 0\"/>")),
+            "r.urdf:8: joint 'j': <origin rpy=\"0 0\"> needs 3 numbers (it has 2)");
+  EXPECT_EQ(Message(Robot("", "    <axis xyz=\"0 0 1 0\"/>")),
+            "r.urdf:8: joint 'j': <axis xyz=\"0 0 1 0\"> needs 3 numbers (it has 4)");
+  EXPECT_EQ(Message(Robot("    <collision><geometry><box size=\"1 1 1e400\"/></geometry>"
+                          "</collision>",
+                          "")),
+            "r.urdf:4: link 'base' <collision>: <box size=\"1 1 1e400\">: '1e400' is not a finite "
+            "number");
+  EXPECT_EQ(Message(Robot("", "", "  <material name=\"red\"><color rgba=\"1 0 0\"/></material>\n")),
+            "r.urdf:12: material 'red': <color rgba=\"1 0 0\"> needs 4 numbers (it has 3)");
+}
+
+TEST_F(UrdfNumbersTest, JointNumbersNameTheJoint) {
+  EXPECT_EQ(Message(Robot("", "    <dynamics damping=\"1,5\"/>")),
+            "r.urdf:8: joint 'j': <dynamics damping=\"1,5\">: '1,5' is not a finite number");
+  EXPECT_EQ(Message(Robot("", "    <mimic joint=\"j\" multiplier=\"0x2\"/>")),
+            "r.urdf:8: joint 'j': <mimic multiplier=\"0x2\">: '0x2' is not a finite number");
+  EXPECT_EQ(Message(Robot("", "    <safety_controller k_velocity=\"fast\"/>")),
+            "r.urdf:8: joint 'j': <safety_controller k_velocity=\"fast\">: 'fast' is not a finite "
+            "number");
+}
+
+}  // namespace
+}  // namespace swarmsim::loader
