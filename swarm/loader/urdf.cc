@@ -747,21 +747,41 @@ UrdfImport Importer::Run(const std::string& where, const std::string& text) {
   ReadXml(bytes);
   urdf::ModelInterfaceSharedPtr model;
   {
-    // urdfdom reports through console_bridge's process-wide handler.
+    // urdfdom reports through console_bridge's process-wide handler, and
+    // passes some of its messages, the file's text inside, as printf
+    // formats: a '%' in the file would be read as a conversion (a crash).
+    // So a file holding '%' is parsed with no handler (console_bridge then
+    // formats nothing), and on failure its message comes from a copy with
+    // '?' for each '%'.
     static std::mutex mutex;
     std::lock_guard lock(mutex);
-    Capture capture;
-    console_bridge::useOutputHandler(&capture);
-    try {
-      model = urdf::parseURDF(bytes);
-    } catch (const std::exception& e) {
-      capture.first_error = e.what();
+    const auto parse = [](const std::string& xml, std::string* message) {
+      Capture capture;
+      if (message != nullptr)
+        console_bridge::useOutputHandler(&capture);
+      else
+        console_bridge::noOutputHandler();
+      urdf::ModelInterfaceSharedPtr parsed;
+      try {
+        parsed = urdf::parseURDF(xml);
+      } catch (const std::exception& e) {
+        capture.first_error = e.what();
+      }
+      console_bridge::restorePreviousOutputHandler();
+      if (message != nullptr) *message = capture.first_error;
+      return parsed;
+    };
+    std::string message;
+    if (bytes.find('%') == std::string::npos) {
+      model = parse(bytes, &message);
+    } else if (!(model = parse(bytes, nullptr))) {
+      std::string quiet = bytes;
+      std::replace(quiet.begin(), quiet.end(), '%', '?');
+      parse(quiet, &message);
     }
-    console_bridge::restorePreviousOutputHandler();
     if (!model)
       Fail(0,
-           "urdfdom cannot read it: " +
-               (capture.first_error.empty() ? std::string("(no message)") : capture.first_error));
+           "urdfdom cannot read it: " + (message.empty() ? std::string("(no message)") : message));
   }
   if (!model->getRoot()) Fail(0, "the robot has no root link");
   UrdfImport out;

@@ -555,6 +555,25 @@ TEST_F(UrdfErrorTest, MalformedFilesNameTheFileTheElementAndTheLine) {
   EXPECT_CONTAINS(e, "bad.urdf:4: link 'a' <collision>: unknown geometry <cone>");
 }
 
+// urdfdom hands some messages, the file's text inside, to printf as the
+// format: a '%' in a value was a conversion reading stray memory (found by
+// tools/fuzz; tests/data/fuzz/urdf/crashes/format-string-in-a-color.urdf).
+TEST_F(UrdfErrorTest, APercentInTheFileIsTextNotAFormat) {
+  const std::string e = ErrorOfUrdf(
+      std::string(kHead) +
+      "  <link name=\"a\"/>\n  <link name=\"b\"/>\n"
+      "  <joint name=\"j\" type=\"revolute\"><parent link=\"a\"/><child link=\"b\"/>"
+      "<limit lower=\"0\" upper=\"1%s%s%n\" effort=\"1\" velocity=\"1\"/></joint>\n</robot>\n");
+  EXPECT_CONTAINS(e,
+                  "bad.urdf: urdfdom cannot read it: upper value (1?s?s?n) is not a valid float");
+  // What urdfdom only logs (a colour it cannot read), and a '%' in a name, load.
+  Write("ok.urdf", std::string(kHead) +
+                       "  <link name=\"100%s\"><visual><geometry><box size=\"1 1 1\"/></geometry>"
+                       "<material name=\"m\"><color rgba=\"0.5 %s%n 0.6 1\"/></material></visual>"
+                       "</link>\n</robot>\n");
+  EXPECT_NO_THROW(Load("models: [{model: ok.urdf, position: [0, 0]}]\n"));
+}
+
 TEST_F(UrdfErrorTest, TheProgramExitsWithTwoAndTheMessage) {
   Write("bad.urdf", std::string(kHead) + "  <link name=\"a\">\n</robot>\n");
   Write("w.yaml", "models: [{model: bad.urdf, position: [0, 0]}]\n");
