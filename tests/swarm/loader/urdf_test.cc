@@ -565,11 +565,20 @@ TEST_F(UrdfErrorTest, APercentInTheFileIsTextNotAFormat) {
       "  <joint name=\"j\" type=\"revolute\"><parent link=\"a\"/><child link=\"b\"/>"
       "<limit lower=\"0\" upper=\"1%s%s%n\" effort=\"1\" velocity=\"1\"/></joint>\n</robot>\n");
   EXPECT_CONTAINS(e,
-                  "bad.urdf: urdfdom cannot read it: upper value (1?s?s?n) is not a valid float");
-  // What urdfdom only logs (a colour it cannot read), and a '%' in a name, load.
+                  "bad.urdf:5: joint 'j': <limit upper=\"1%s%s%n\">: '1%s%s%n' is not a finite "
+                  "number");
+  // A colour that is no number is an error with its line too (urdfdom only
+  // logged it, with the file's text as printf's format).
+  const std::string colour = ErrorOfUrdf(
+      std::string(kHead) +
+      "  <link name=\"a\"><visual><geometry><box size=\"1 1 1\"/></geometry>"
+      "<material name=\"m\"><color rgba=\"0.5 %s%n 0.6 1\"/></material></visual></link>\n"
+      "</robot>\n");
+  EXPECT_CONTAINS(colour, "'%s%n' is not a finite number");
+  // A '%' in a name loads.
   Write("ok.urdf", std::string(kHead) +
                        "  <link name=\"100%s\"><visual><geometry><box size=\"1 1 1\"/></geometry>"
-                       "<material name=\"m\"><color rgba=\"0.5 %s%n 0.6 1\"/></material></visual>"
+                       "<material name=\"m\"><color rgba=\"0.5 0.5 0.6 1\"/></material></visual>"
                        "</link>\n</robot>\n");
   EXPECT_NO_THROW(Load("models: [{model: ok.urdf, position: [0, 0]}]\n"));
 }
