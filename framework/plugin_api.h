@@ -132,8 +132,8 @@ typedef struct SwarmsimWorldApi {
   // a direct message; range: m, of a range message, line_of_sight: 1 for
   // receivers no static shape hides). Only from that robot's own controller
   // (or per-robot callback). Returns 0, or -1 for a bad scope, target or
-  // range, a message over 1 MiB, or the robot's messages of this step over
-  // its memory limit (simulation.script_memory_mb).
+  // range, a message over 1 MiB, or a message that does not fit the robot's
+  // memory account (simulation.script_memory_mb, run_script_memory_mb).
   int (*send_message)(void* world, int robot, int scope, const char* data, size_t size,
                       int64_t target, double range, int line_of_sight);
   // The next message delivered this step to `robot`'s native controller

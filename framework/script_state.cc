@@ -129,9 +129,9 @@ int LocateError(lua_State* L) {
   // The message as it starts once located.
   const bool add_where = !HasPosition(text, length) && place.where[0] != '\0';
   const char* start = add_where ? place.where : text;
+  const size_t start_length = add_where ? std::strlen(place.where) : length;
   int pieces = 1;
-  if (file != nullptr && place.script_line > 0 &&
-      !StartsWithFile(start, std::strlen(start), *file)) {
+  if (file != nullptr && place.script_line > 0 && !StartsWithFile(start, start_length, *file)) {
     lua_pushfstring(L, "%s:%d: ", file->c_str(), place.script_line);
     ++pieces;
   }
