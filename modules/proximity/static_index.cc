@@ -7,14 +7,17 @@
 #include <limits>
 #include <sstream>
 
+#include "framework/environment.h"
 #include "framework/error.h"
 #include "framework/scene.h"
 
 namespace swarmsim::proximity {
 namespace {
 
-constexpr int kKeyOffset = 32768;  // octomap's tree_max_val for a depth-16 tree
+constexpr int kKeyOffset = 32768;  // the key of coordinate 0 unless the octree is moved
 constexpr int kMaxKey = 65535;
+constexpr double kMaxShift =
+    1e8;                          // |key offset| at most: ClampedKey's +-1e9 stays beyond every key
 constexpr int kBucketShift = 2;   // a bucket is 4x4x4 voxels
 constexpr int kTreeSize = 65536;  // keys per axis
 constexpr int kTreeDepth = 16;
@@ -94,28 +97,35 @@ void InsertKeyBox(octomap::OcTree* tree, octomap::OcTreeNode* node, const int or
 // interiors meet marked in `tree` a box at a time (InsertKeyBox: no
 // per-voxel overlap tests; a box on the octree's grid is one node), and the
 // buckets they touch added to `touches`. Grows the key bounds.
-void AddEnvironment(const EnvironmentMap& map, double resolution, octomap::OcTree* tree,
-                    std::vector<PlacedShape>* shapes,
-                    std::vector<std::pair<uint64_t, uint32_t>>* touches, int key_lo[3],
-                    int key_hi[3]) {
+void AddEnvironment(const EnvironmentMap& map, double resolution, const int key_offset[3],
+                    octomap::OcTree* tree, std::vector<PlacedShape>* shapes,
+                    std::vector<uint32_t>* far, std::vector<std::pair<uint64_t, uint32_t>>* touches,
+                    int key_lo[3], int key_hi[3]) {
   const float occupied = tree->getClampingThresMaxLog();
   const double inv_resolution = 1 / resolution;
   const double shrink = resolution * 1e-6;  // a box's faces do not mark the voxels beyond
   constexpr int64_t kMaxNodes = 20000000;   // about 1.6 GB of octree
   int64_t nodes = 0;
   for (const EnvironmentBox& box : map.boxes) {
+    const uint32_t s = static_cast<uint32_t>(shapes->size());
+    ShapeData shape;
+    shape.kind = ShapeKind::kBox;
+    shape.size = box.hi - box.lo;
+    shapes->push_back(PlaceShape(shape, Pose{(box.lo + box.hi) * 0.5, {}}, ObjectId{}, -1));
+    double a[3], b[3];
+    bool inside = true;
+    for (int i = 0; i < 3; ++i) {
+      a[i] = std::floor((Axis(box.lo, i) + shrink) * inv_resolution) + key_offset[i];
+      b[i] = std::floor((Axis(box.hi, i) - shrink) * inv_resolution) + key_offset[i];
+      inside = inside && a[i] >= 0 && b[i] <= kMaxKey;
+    }
+    if (!inside) {  // beyond the octree: tested one by one
+      far->push_back(s);
+      continue;
+    }
     int lo[3], hi[3];
     for (int i = 0; i < 3; ++i) {
-      const double a = std::floor((Axis(box.lo, i) + shrink) * inv_resolution) + kKeyOffset;
-      const double b = std::floor((Axis(box.hi, i) - shrink) * inv_resolution) + kKeyOffset;
-      if (!(a >= 0 && b <= kMaxKey)) {
-        std::ostringstream m;
-        m << "proximity: the environment map " << map.source
-          << " reaches outside the octree's reach (|x|, |y|, |z| < " << kKeyOffset * resolution
-          << " m at octree_resolution " << resolution << " m); move it or use a coarser resolution";
-        throw Error(m.str());
-      }
-      lo[i] = static_cast<int>(a), hi[i] = std::max(static_cast<int>(b), lo[i]);
+      lo[i] = static_cast<int>(a[i]), hi[i] = std::max(static_cast<int>(b[i]), lo[i]);
       key_lo[i] = std::min(key_lo[i], lo[i]);
       key_hi[i] = std::max(key_hi[i], hi[i]);
     }
@@ -130,11 +140,6 @@ void AddEnvironment(const EnvironmentMap& map, double resolution, octomap::OcTre
         << " m; use a coarser resolution (the map's own is " << map.resolution << " m)";
       throw Error(m.str());
     }
-    const uint32_t s = static_cast<uint32_t>(shapes->size());
-    ShapeData shape;
-    shape.kind = ShapeKind::kBox;
-    shape.size = box.hi - box.lo;
-    shapes->push_back(PlaceShape(shape, Pose{(box.lo + box.hi) * 0.5, {}}, ObjectId{}, -1));
     for (int bx = lo[0] >> kBucketShift; bx <= hi[0] >> kBucketShift; ++bx)
       for (int by = lo[1] >> kBucketShift; by <= hi[1] >> kBucketShift; ++by)
         for (int bz = lo[2] >> kBucketShift; bz <= hi[2] >> kBucketShift; ++bz)
@@ -146,16 +151,47 @@ void AddEnvironment(const EnvironmentMap& map, double resolution, octomap::OcTre
 StaticIndex::StaticIndex() = default;
 StaticIndex::~StaticIndex() = default;
 
-double StaticIndex::RawKey(double coordinate) const {
-  return std::floor(coordinate * inv_resolution_) + kKeyOffset;
+// Keys are offsets in voxels from key_offset_ (the key of coordinate 0): at
+// kKeyOffset, as octomap places a depth-16 tree's, when the static
+// environment lies within 32,768 voxels of the origin, which gives the
+// same voxels as ever; else, along each axis where it spans at most 65,536
+// voxels, the octree is moved by a whole number of voxels to centre it
+// (the voxels' faces stay where they were). Where it spans more, the
+// shapes beyond the octree are tested one by one (far_).
+void StaticIndex::ChooseKeyOffsets(const EnvironmentMap* map, const std::vector<Vec3>& lo,
+                                   const std::vector<Vec3>& hi, double margin) {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  double key_lo[3] = {kInf, kInf, kInf}, key_hi[3] = {-kInf, -kInf, -kInf};
+  const auto grow = [&](const Vec3& a, const Vec3& b) {
+    for (int i = 0; i < 3; ++i) {
+      key_lo[i] = std::min(key_lo[i], std::floor((Axis(a, i) - margin) * inv_resolution_));
+      key_hi[i] = std::max(key_hi[i], std::floor((Axis(b, i) + margin) * inv_resolution_));
+    }
+  };
+  for (size_t s = 0; s < lo.size(); ++s) grow(lo[s], hi[s]);
+  if (map != nullptr)
+    for (const EnvironmentBox& box : map->boxes) grow(box.lo, box.hi);
+  for (int i = 0; i < 3; ++i) {
+    key_offset_[i] = kKeyOffset;
+    if (!(key_lo[i] <= key_hi[i])) continue;  // nothing static
+    if (key_lo[i] + kKeyOffset >= 0 && key_hi[i] + kKeyOffset <= kMaxKey) continue;
+    const double span = key_hi[i] - key_lo[i];
+    if (span > kMaxKey) continue;  // too wide for any placement: far_ takes the rest
+    const double offset = std::floor((kMaxKey - span) / 2) - key_lo[i];
+    if (std::abs(offset) <= kMaxShift) key_offset_[i] = static_cast<int>(offset);
+  }
 }
 
-int StaticIndex::ClampedKey(double coordinate) const {
+double StaticIndex::RawKey(double coordinate, int axis) const {
+  return std::floor(coordinate * inv_resolution_) + key_offset_[axis];
+}
+
+int StaticIndex::ClampedKey(double coordinate, int axis) const {
   // floor() by truncation, in a range where int holds it exactly; values
   // beyond clamp to keys beyond every voxel, as RawKey's would be.
   const double scaled = std::clamp(coordinate * inv_resolution_, -1e9, 1e9);
   const int truncated = static_cast<int>(scaled);
-  return truncated - (scaled < truncated ? 1 : 0) + kKeyOffset;
+  return truncated - (scaled < truncated ? 1 : 0) + key_offset_[axis];
 }
 
 size_t StaticIndex::octree_node_count() const { return tree_ ? tree_->size() : 0; }
@@ -175,6 +211,9 @@ void StaticIndex::Build(const Scene& scene, double resolution) {
   bucket_shapes_.clear();
   coarse_.clear();
   blocks_.clear();
+  far_.clear();
+  far_lo_.clear();
+  far_hi_.clear();
 
   // The static shapes, in slot order (independent of table history).
   const auto shape_rows = scene.shapes();
@@ -188,32 +227,42 @@ void StaticIndex::Build(const Scene& scene, double resolution) {
   std::sort(shapes_.begin(), shapes_.end(),
             [](const PlacedShape& a, const PlacedShape& b) { return a.id.index1 < b.id.index1; });
 
-  // Mark the voxels each shape may overlap; remember the buckets it touches.
-  const float occupied = tree_->getClampingThresMaxLog();
+  // Every shape's bounds are finite (a world file's always are; a script's
+  // pose may not be).
   const double margin = resolution * 1e-6;  // grows shapes a hair: robust on voxel faces
+  std::vector<Vec3> shape_lo(shapes_.size()), shape_hi(shapes_.size());
+  for (uint32_t s = 0; s < shapes_.size(); ++s) {
+    WorldBounds(shapes_[s], &shape_lo[s], &shape_hi[s]);
+    for (int i = 0; i < 3; ++i)
+      if (!std::isfinite(Axis(shape_lo[s], i)) || !std::isfinite(Axis(shape_hi[s], i))) {
+        std::ostringstream m;
+        m << "proximity: static shape '" << scene.PathOf(shapes_[s].id)
+          << "' has a non-finite pose or size";
+        throw Error(m.str());
+      }
+  }
+  ChooseKeyOffsets(scene.environment(), shape_lo, shape_hi, margin);
+
+  // Mark the voxels each shape may overlap; remember the buckets it touches.
+  // A shape beyond the octree's keys is tested one by one instead (far_).
+  const float occupied = tree_->getClampingThresMaxLog();
   const double half = resolution / 2;
   std::vector<std::pair<uint64_t, uint32_t>> touches;  // (bucket, shape)
   for (int i = 0; i < 3; ++i) occupied_keys_.lo[i] = kMaxKey, occupied_keys_.hi[i] = 0;
   double voxel_tests = 0;
   for (uint32_t s = 0; s < shapes_.size(); ++s) {
     const PlacedShape& shape = shapes_[s];
-    Vec3 lo, hi;
-    WorldBounds(shape, &lo, &hi);
     double klo[3], khi[3];
+    bool inside = true;
     for (int i = 0; i < 3; ++i) {
-      klo[i] = RawKey(Axis(lo, i) - margin);
-      khi[i] = RawKey(Axis(hi, i) + margin);
+      klo[i] = RawKey(Axis(shape_lo[s], i) - margin, i);
+      khi[i] = RawKey(Axis(shape_hi[s], i) + margin, i);
+      inside = inside && klo[i] >= 0 && khi[i] <= kMaxKey;
     }
-    const double reach = kKeyOffset * resolution;
-    for (int i = 0; i < 3; ++i)
-      if (!(klo[i] >= 0 && khi[i] <= kMaxKey)) {
-        std::ostringstream m;
-        m << "proximity: static shape '" << scene.PathOf(shape.id)
-          << "' lies outside the octree's reach (|x|, |y|, |z| < " << reach
-          << " m at octree_resolution " << resolution
-          << " m), or has a non-finite pose or size; move it or use a coarser resolution";
-        throw Error(m.str());
-      }
+    if (!inside) {
+      far_.push_back(s);
+      continue;
+    }
     voxel_tests += (khi[0] - klo[0] + 1) * (khi[1] - klo[1] + 1) * (khi[2] - klo[2] + 1);
     if (voxel_tests > kMaxVoxelTests) {
       std::ostringstream m;
@@ -237,9 +286,9 @@ void StaticIndex::Build(const Scene& scene, double resolution) {
           for (int x = v0[0]; x <= v1[0]; ++x)
             for (int y = v0[1]; y <= v1[1]; ++y)
               for (int z = v0[2]; z <= v1[2]; ++z) {
-                const Vec3 centre{(x - kKeyOffset + 0.5) * resolution,
-                                  (y - kKeyOffset + 0.5) * resolution,
-                                  (z - kKeyOffset + 0.5) * resolution};
+                const Vec3 centre{(x - key_offset_[0] + 0.5) * resolution,
+                                  (y - key_offset_[1] + 0.5) * resolution,
+                                  (z - key_offset_[2] + 0.5) * resolution};
                 if (!MayOverlapCube(shape, centre, half, margin)) continue;
                 tree_->setNodeValue(octomap::OcTreeKey(x, y, z), occupied, /*lazy_eval=*/true);
                 touched = true;
@@ -254,8 +303,14 @@ void StaticIndex::Build(const Scene& scene, double resolution) {
   }
   // The environment map's voxels: boxes of no object, after the shapes.
   if (const EnvironmentMap* map = scene.environment())
-    AddEnvironment(*map, resolution, tree_.get(), &shapes_, &touches, occupied_keys_.lo,
-                   occupied_keys_.hi);
+    AddEnvironment(*map, resolution, key_offset_, tree_.get(), &shapes_, &far_, &touches,
+                   occupied_keys_.lo, occupied_keys_.hi);
+  for (const uint32_t s : far_) {
+    Vec3 lo, hi;
+    WorldBounds(shapes_[s], &lo, &hi);
+    far_lo_.push_back(lo);
+    far_hi_.push_back(hi);
+  }
   tree_->updateInnerOccupancy();
   tree_->prune();
 
@@ -272,12 +327,12 @@ void StaticIndex::Build(const Scene& scene, double resolution) {
     buckets_.emplace(bucket, std::make_pair(begin, static_cast<uint32_t>(bucket_shapes_.size())));
   }
 
-  occupied_lo_ = {(occupied_keys_.lo[0] - kKeyOffset) * resolution,
-                  (occupied_keys_.lo[1] - kKeyOffset) * resolution,
-                  (occupied_keys_.lo[2] - kKeyOffset) * resolution};
-  occupied_hi_ = {(occupied_keys_.hi[0] + 1 - kKeyOffset) * resolution,
-                  (occupied_keys_.hi[1] + 1 - kKeyOffset) * resolution,
-                  (occupied_keys_.hi[2] + 1 - kKeyOffset) * resolution};
+  occupied_lo_ = {(occupied_keys_.lo[0] - key_offset_[0]) * resolution,
+                  (occupied_keys_.lo[1] - key_offset_[1]) * resolution,
+                  (occupied_keys_.lo[2] - key_offset_[2]) * resolution};
+  occupied_hi_ = {(occupied_keys_.hi[0] + 1 - key_offset_[0]) * resolution,
+                  (occupied_keys_.hi[1] + 1 - key_offset_[1]) * resolution,
+                  (occupied_keys_.hi[2] + 1 - key_offset_[2]) * resolution};
   BuildCoarseMap();
 }
 
@@ -347,6 +402,7 @@ void StaticIndex::MarkCoarse(const octomap::OcTreeNode* node, const int origin[3
 }
 
 bool StaticIndex::MayBeOccupied(const Vec3& lo, const Vec3& hi) const {
+  if (!far_.empty() && FarOverlaps(lo, hi)) return true;
   if (coarse_.empty()) return false;  // no occupied voxel
   const double box_lo[3] = {lo.x, lo.y, lo.z}, box_hi[3] = {hi.x, hi.y, hi.z};
   const double occupied_lo[3] = {occupied_lo_.x, occupied_lo_.y, occupied_lo_.z};
@@ -358,8 +414,8 @@ bool StaticIndex::MayBeOccupied(const Vec3& lo, const Vec3& hi) const {
     // occupied voxel: every one lies within occupied_keys_.
     if (!(box_lo[i] <= occupied_hi[i] && box_hi[i] >= occupied_lo[i])) return false;
     const int key_lo = occupied_keys_.lo[i], key_hi = occupied_keys_.hi[i];
-    const int a = std::max(ClampedKey(box_lo[i]), key_lo);
-    const int b = std::min(ClampedKey(box_hi[i]), key_hi);
+    const int a = std::max(ClampedKey(box_lo[i], i), key_lo);
+    const int b = std::min(ClampedKey(box_hi[i], i), key_hi);
     if (a > b) return false;
     cell_lo[i] = (a - key_lo) >> coarse_shift_[i];
     cell_hi[i] = (b - key_lo) >> coarse_shift_[i];
@@ -405,15 +461,24 @@ bool StaticIndex::AnyOccupiedIn(const octomap::OcTreeNode* node, const int origi
   return false;
 }
 
+bool StaticIndex::FarOverlaps(const Vec3& lo, const Vec3& hi) const {
+  for (size_t f = 0; f < far_.size(); ++f)
+    if (far_lo_[f].x <= hi.x && far_hi_[f].x >= lo.x && far_lo_[f].y <= hi.y &&
+        far_hi_[f].y >= lo.y && far_lo_[f].z <= hi.z && far_hi_[f].z >= lo.z)
+      return true;
+  return false;
+}
+
 bool StaticIndex::AnyOccupied(const Vec3& lo, const Vec3& hi) const {
+  if (!far_.empty() && FarOverlaps(lo, hi)) return true;
   if (shapes_.empty() || tree_->getRoot() == nullptr) return false;
   KeyBox box;
   for (int i = 0; i < 3; ++i) {
     // (Written so that NaN bounds answer "no".)
     if (!(Axis(lo, i) <= Axis(occupied_hi_, i) && Axis(hi, i) >= Axis(occupied_lo_, i)))
       return false;
-    box.lo[i] = static_cast<int>(std::max(RawKey(Axis(lo, i)), double(occupied_keys_.lo[i])));
-    box.hi[i] = static_cast<int>(std::min(RawKey(Axis(hi, i)), double(occupied_keys_.hi[i])));
+    box.lo[i] = static_cast<int>(std::max(RawKey(Axis(lo, i), i), double(occupied_keys_.lo[i])));
+    box.hi[i] = static_cast<int>(std::min(RawKey(Axis(hi, i), i), double(occupied_keys_.hi[i])));
   }
   const int origin[3] = {0, 0, 0};
   return AnyOccupiedIn(tree_->getRoot(), origin, kTreeSize, box);
@@ -450,6 +515,30 @@ const octomap::OcTreeNode* StaticIndex::CommonAncestor(const int lo[3], const in
 bool StaticIndex::CastRay(const Vec3& p_W, const Vec3& d_W, double max_t,
                           std::span<const ObjectId> skip, double* t, uint32_t* shape) const {
   if (shapes_.empty()) return false;
+  double best = std::numeric_limits<double>::infinity();
+  uint32_t best_shape = 0;
+  if (CastRayInOctree(p_W, d_W, max_t, skip, &best, &best_shape) && far_.empty()) {
+    *t = best;
+    *shape = best_shape;
+    return true;
+  }
+  // The shapes beyond the octree, one by one (the lower shape wins a tie).
+  for (const uint32_t s : far_) {
+    if (std::find(skip.begin(), skip.end(), shapes_[s].id) != skip.end()) continue;
+    double hit;
+    if (RayCast(shapes_[s], p_W, d_W, max_t, &hit) &&
+        (hit < best || (hit == best && s < best_shape)))
+      best = hit, best_shape = s;
+  }
+  if (!(best <= max_t)) return false;
+  *t = best;
+  *shape = best_shape;
+  return true;
+}
+
+bool StaticIndex::CastRayInOctree(const Vec3& p_W, const Vec3& d_W, double max_t,
+                                  std::span<const ObjectId> skip, double* t,
+                                  uint32_t* shape) const {
   // Clip the ray to the box of occupied voxels.
   double t0 = 0, t1 = max_t;
   for (int i = 0; i < 3; ++i)
@@ -463,8 +552,8 @@ bool StaticIndex::CastRay(const Vec3& p_W, const Vec3& d_W, double max_t,
   int box_lo[3], box_hi[3];
   for (int i = 0; i < 3; ++i) {
     const double lo = double(occupied_keys_.lo[i]), hi = double(occupied_keys_.hi[i]);
-    const double a = std::clamp(RawKey(p[i] + d[i] * t0), lo, hi);
-    const double b = std::clamp(RawKey(p[i] + d[i] * t1), lo, hi);
+    const double a = std::clamp(RawKey(p[i] + d[i] * t0, i), lo, hi);
+    const double b = std::clamp(RawKey(p[i] + d[i] * t1, i), lo, hi);
     box_lo[i] = std::max(static_cast<int>(std::min(a, b)) - 1, 0);
     box_hi[i] = std::min(static_cast<int>(std::max(a, b)) + 1, kMaxKey);
   }
@@ -478,7 +567,7 @@ bool StaticIndex::CastRay(const Vec3& p_W, const Vec3& d_W, double max_t,
   int key[3], step[3];
   double t_max[3], t_delta[3];
   for (int i = 0; i < 3; ++i) {
-    const double entry = RawKey(p[i] + d[i] * t0);
+    const double entry = RawKey(p[i] + d[i] * t0, i);
     key[i] = static_cast<int>(
         std::clamp(entry, double(occupied_keys_.lo[i]), double(occupied_keys_.hi[i])));
     step[i] = d[i] > 0 ? 1 : d[i] < 0 ? -1 : 0;
@@ -486,7 +575,7 @@ bool StaticIndex::CastRay(const Vec3& p_W, const Vec3& d_W, double max_t,
       t_max[i] = t_delta[i] = std::numeric_limits<double>::infinity();
       continue;
     }
-    const double face = (key[i] + (step[i] > 0 ? 1 : 0) - kKeyOffset) * resolution_;
+    const double face = (key[i] + (step[i] > 0 ? 1 : 0) - key_offset_[i]) * resolution_;
     t_max[i] = (face - p[i]) / d[i];
     t_delta[i] = resolution_ / std::abs(d[i]);
   }
@@ -540,12 +629,28 @@ bool StaticIndex::CastRay(const Vec3& p_W, const Vec3& d_W, double max_t,
 void StaticIndex::ShapesInBox(const Vec3& lo, const Vec3& hi, std::vector<uint32_t>* out) const {
   out->clear();
   if (shapes_.empty()) return;
+  ShapesInBoxInOctree(lo, hi, out);
+  if (far_.empty()) return;
+  // The shapes beyond the octree whose bounds meet the box (a non-finite
+  // box: every one).
+  const bool any = std::isnan(lo.x) || std::isnan(lo.y) || std::isnan(lo.z) || std::isnan(hi.x) ||
+                   std::isnan(hi.y) || std::isnan(hi.z);
+  for (size_t f = 0; f < far_.size(); ++f)
+    if (any || (far_lo_[f].x <= hi.x && far_hi_[f].x >= lo.x && far_lo_[f].y <= hi.y &&
+                far_hi_[f].y >= lo.y && far_lo_[f].z <= hi.z && far_hi_[f].z >= lo.z))
+      out->push_back(far_[f]);
+  std::sort(out->begin(), out->end());
+  out->erase(std::unique(out->begin(), out->end()), out->end());
+}
+
+void StaticIndex::ShapesInBoxInOctree(const Vec3& lo, const Vec3& hi,
+                                      std::vector<uint32_t>* out) const {
   // The box's keys within the occupied ones (a non-finite box: every key).
   int k0[3], k1[3];
   for (int i = 0; i < 3; ++i) {
     const double a = Axis(lo, i), b = Axis(hi, i);
-    k0[i] = std::isnan(a) ? occupied_keys_.lo[i] : std::max(ClampedKey(a), occupied_keys_.lo[i]);
-    k1[i] = std::isnan(b) ? occupied_keys_.hi[i] : std::min(ClampedKey(b), occupied_keys_.hi[i]);
+    k0[i] = std::isnan(a) ? occupied_keys_.lo[i] : std::max(ClampedKey(a, i), occupied_keys_.lo[i]);
+    k1[i] = std::isnan(b) ? occupied_keys_.hi[i] : std::min(ClampedKey(b, i), occupied_keys_.hi[i]);
     if (k0[i] > k1[i]) return;
   }
   double buckets = 1;

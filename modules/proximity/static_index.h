@@ -12,6 +12,12 @@
 // occupied voxel tests the bucket's shapes exactly; the nearest exact hit
 // wins, so distances are exact to the geometry, not to the voxel size.
 //
+// The octree's keys (16 bits per axis) span 65,536 voxels: it is centred
+// on the origin, or moved to hold the static environment where that lies
+// elsewhere; shapes beyond its keys (a static environment wider than
+// 65,536 voxels: 3,276.8 m at the default 0.05 m) are kept apart and
+// tested one by one, so any finite coordinate works, only slower.
+//
 // A coarse occupancy map, built once from the octree's occupied leaves,
 // answers "may anything static be in this box?" with a few bit tests: it
 // lets a robot far from every wall skip its rays without an octree descent,
@@ -36,7 +42,8 @@ class OcTreeNode;
 
 namespace swarmsim {
 class Scene;
-}
+struct EnvironmentMap;
+}  // namespace swarmsim
 
 namespace swarmsim::proximity {
 
@@ -48,8 +55,8 @@ class StaticIndex {
   StaticIndex& operator=(const StaticIndex&) = delete;
 
   // Indexes the static shapes of `scene` at `resolution` (m). Throws
-  // swarmsim::Error for a bad resolution or a shape outside the octree's
-  // reach (+-32768 voxels around the origin).
+  // swarmsim::Error for a bad resolution, a static shape whose pose or size
+  // is not finite, or an environment too large for the octree at it.
   void Build(const Scene& scene, double resolution);
 
   bool empty() const { return shapes_.empty(); }
@@ -92,10 +99,19 @@ class StaticIndex {
   // The deepest node holding the key box [lo, hi] (or a pruned block around
   // it); *bit is the key bit its children split on. Null: the box is empty.
   const octomap::OcTreeNode* CommonAncestor(const int lo[3], const int hi[3], int* bit) const;
-  // Voxel key of a coordinate, unclamped (may fall outside 0..65535).
-  double RawKey(double coordinate) const;
+  // key_offset_ for the static shapes (bounds lo, hi) and the map.
+  void ChooseKeyOffsets(const EnvironmentMap* map, const std::vector<Vec3>& lo,
+                        const std::vector<Vec3>& hi, double margin);
+  // Voxel key of a coordinate along `axis`, unclamped (may fall outside 0..65535).
+  double RawKey(double coordinate, int axis) const;
   // The same, clamped to +-1e9 (cheaper; equal to RawKey between). Not NaN.
-  int ClampedKey(double coordinate) const;
+  int ClampedKey(double coordinate, int axis) const;
+  // Does the box [lo, hi] meet the bounds of a shape beyond the octree?
+  bool FarOverlaps(const Vec3& lo, const Vec3& hi) const;
+  // CastRay and ShapesInBox over the octree's shapes only.
+  bool CastRayInOctree(const Vec3& p_W, const Vec3& d_W, double max_t,
+                       std::span<const ObjectId> skip, double* t, uint32_t* shape) const;
+  void ShapesInBoxInOctree(const Vec3& lo, const Vec3& hi, std::vector<uint32_t>* out) const;
   // Builds coarse_ from the octree (end of Build).
   void BuildCoarseMap();
   // Index of coarse column (x, y) in coarse_: the 64 columns of a block are
@@ -111,6 +127,11 @@ class StaticIndex {
   std::unique_ptr<octomap::OcTree> tree_;
   double resolution_ = 0.05;
   double inv_resolution_ = 20;
+  int key_offset_[3] = {32768, 32768, 32768};  // the key of coordinate 0 per axis
+  // Shapes beyond the octree's keys (indices into shapes_, ascending) and
+  // their world bounds (far shapes).
+  std::vector<uint32_t> far_;
+  std::vector<Vec3> far_lo_, far_hi_;
   std::vector<PlacedShape> shapes_;  // the static shapes (static shapes)
   // Meshes of the static shapes, kept alive while shapes_ points at them (static meshes).
   std::vector<std::shared_ptr<const TriangleMesh>> meshes_;
