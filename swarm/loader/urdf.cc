@@ -8,7 +8,6 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
-#include <charconv>
 #include <cmath>
 #include <cstdlib>
 #include <map>
@@ -19,6 +18,7 @@
 #include "framework/display_path.h"
 #include "framework/error.h"
 #include "framework/object_type.h"
+#include "swarm/loader/urdf_numbers.h"
 #include "swarm/loader/yaml.h"
 
 namespace swarmsim::loader {
@@ -68,8 +68,6 @@ class Importer {
     throw Error(name_ + (line > 0 ? ":" + std::to_string(line) : "") + ": " + message);
   }
   void ReadXml(const std::string& bytes);
-  void CheckNumbers(const tinyxml2::XMLElement* e, const std::string& owner) const;
-  void CheckNumbersOf(const tinyxml2::XMLElement* top) const;
   void Ignore(const std::string& kind, int line) {
     auto [it, added] = xml_.ignored.emplace(kind, std::make_pair(0, line));
     ++it->second.first;
@@ -99,129 +97,6 @@ class Importer {
   double total_mass_ = 0;
 };
 
-// --- Numbers: every attribute urdfdom reads a number from --------------------------
-
-// A finite decimal number, as urdfdom reads one ("1", "-0.5", "2e-3").
-bool ParseUrdfNumber(std::string_view t, double* value) {
-  if (!t.empty() && t[0] == '+') t.remove_prefix(1);
-  if (t.empty() || !(std::isdigit(static_cast<unsigned char>(t.back())) || t.back() == '.'))
-    return false;  // "", "inf", "nan", "1e"
-  const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), *value);
-  if (end != t.data() + t.size()) return false;
-  if (ec == std::errc::result_out_of_range)
-    *value = std::strtod(std::string(t).c_str(), nullptr);
-  else if (ec != std::errc())
-    return false;
-  return std::isfinite(*value);
-}
-
-// The numeric attributes of the elements urdfdom reads, and how many
-// numbers each holds.
-struct NumericAttribute {
-  const char* element;
-  const char* attribute;
-  int count;
-};
-constexpr NumericAttribute kNumericAttributes[] = {
-    {"origin", "xyz", 3},
-    {"origin", "rpy", 3},
-    {"mass", "value", 1},
-    {"inertia", "ixx", 1},
-    {"inertia", "ixy", 1},
-    {"inertia", "ixz", 1},
-    {"inertia", "iyy", 1},
-    {"inertia", "iyz", 1},
-    {"inertia", "izz", 1},
-    {"box", "size", 3},
-    {"cylinder", "radius", 1},
-    {"cylinder", "length", 1},
-    {"sphere", "radius", 1},
-    {"mesh", "scale", 3},
-    {"color", "rgba", 4},
-    {"axis", "xyz", 3},
-    {"limit", "lower", 1},
-    {"limit", "upper", 1},
-    {"limit", "effort", 1},
-    {"limit", "velocity", 1},
-    {"dynamics", "damping", 1},
-    {"dynamics", "friction", 1},
-    {"mimic", "multiplier", 1},
-    {"mimic", "offset", 1},
-    {"safety_controller", "soft_lower_limit", 1},
-    {"safety_controller", "soft_upper_limit", 1},
-    {"safety_controller", "k_position", 1},
-    {"safety_controller", "k_velocity", 1},
-    {"calibration", "rising", 1},
-    {"calibration", "falling", 1},
-    {"calibration", "reference_position", 1},
-};
-
-// Each numeric attribute of `e` holds its count of finite numbers, so that
-// a number urdfdom cannot read (or reads as NaN, or silently skips) is an
-// error naming the file, the line and the attribute. `owner`: "link 'x'".
-void Importer::CheckNumbers(const tinyxml2::XMLElement* e, const std::string& owner) const {
-  if (e == nullptr) return;
-  const std::string_view element = e->Name();
-  for (const NumericAttribute& a : kNumericAttributes) {
-    if (element != a.element) continue;
-    const char* value = e->Attribute(a.attribute);
-    if (value == nullptr) continue;
-    std::string shown(value);
-    if (shown.size() > 60) shown = shown.substr(0, 60) + "...";
-    for (char& c : shown)
-      if (static_cast<unsigned char>(c) < 0x20) c = ' ';
-    const std::string what =
-        owner + ": <" + std::string(element) + " " + a.attribute + "=\"" + shown + "\">";
-    int found = 0;
-    std::string_view rest(value);
-    while (true) {
-      const size_t begin = rest.find_first_not_of(" \t\r\n");
-      if (begin == std::string_view::npos) break;
-      rest.remove_prefix(begin);
-      const size_t end = std::min(rest.find_first_of(" \t\r\n"), rest.size());
-      const std::string_view token = rest.substr(0, end);
-      rest.remove_prefix(end);
-      double number;
-      if (!ParseUrdfNumber(token, &number))
-        Fail(e->GetLineNum(),
-             what + ": '" + std::string(token.substr(0, 40)) + "' is not a finite number");
-      ++found;
-    }
-    if (found != a.count)
-      Fail(e->GetLineNum(), what + " needs " +
-                                (a.count == 1 ? "a number" : std::to_string(a.count) + " numbers") +
-                                (found == 0 ? "" : " (it has " + std::to_string(found) + ")"));
-  }
-}
-
-// The elements of a <link>, <joint> or top-level <material> that urdfdom
-// reads numbers from (the first of a kind where urdfdom reads the first).
-void Importer::CheckNumbersOf(const tinyxml2::XMLElement* top) const {
-  const std::string kind = top->Name();
-  const std::string owner =
-      kind + " '" + (top->Attribute("name") ? top->Attribute("name") : "") + "'";
-  if (kind == "material") return CheckNumbers(top->FirstChildElement("color"), owner);
-  if (kind == "joint") {
-    for (const char* part :
-         {"origin", "axis", "limit", "dynamics", "mimic", "safety_controller", "calibration"})
-      CheckNumbers(top->FirstChildElement(part), owner);
-    return;
-  }
-  if (const tinyxml2::XMLElement* inertial = top->FirstChildElement("inertial"))
-    for (const char* part : {"origin", "mass", "inertia"})
-      CheckNumbers(inertial->FirstChildElement(part), owner + " <inertial>");
-  for (const char* part : {"visual", "collision"})
-    for (const tinyxml2::XMLElement* v = top->FirstChildElement(part); v;
-         v = v->NextSiblingElement(part)) {
-      const std::string where = owner + " <" + part + ">";
-      CheckNumbers(v->FirstChildElement("origin"), where);
-      if (const tinyxml2::XMLElement* g = v->FirstChildElement("geometry"))
-        CheckNumbers(g->FirstChildElement(), where);
-      if (const tinyxml2::XMLElement* m = v->FirstChildElement("material"))
-        CheckNumbers(m->FirstChildElement("color"), where);
-    }
-}
-
 void Importer::ReadXml(const std::string& bytes) {
   tinyxml2::XMLDocument doc;
   if (doc.Parse(bytes.data(), bytes.size()) != tinyxml2::XML_SUCCESS)
@@ -238,7 +113,8 @@ void Importer::ReadXml(const std::string& bytes) {
   for (const tinyxml2::XMLElement* e = robot->FirstChildElement(); e; e = e->NextSiblingElement()) {
     const std::string kind = e->Name();
     const int line = e->GetLineNum();
-    if (kind == "link" || kind == "joint" || kind == "material") CheckNumbersOf(e);
+    if (kind == "link" || kind == "joint" || kind == "material")
+      if (const std::optional<BadNumber> bad = FindBadNumber(e)) Fail(bad->line, bad->message);
     if (kind == "link") {
       const char* name = e->Attribute("name");
       if (!name || !*name) Fail(line, "<link> needs a 'name' attribute");

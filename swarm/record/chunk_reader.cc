@@ -1,8 +1,5 @@
 #include "swarm/record/chunk_reader.h"
 
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
 #include <xxhash.h>
 #include <zstd.h>
 
@@ -26,42 +23,24 @@ uint32_t Get32(const uint8_t* p) {
   return p[0] | (uint32_t{p[1]} << 8) | (uint32_t{p[2]} << 16) | (uint32_t{p[3]} << 24);
 }
 
-// What a non-regular file is, for the message refusing it.
-std::string FileTypeName(mode_t mode) {
-  if (S_ISDIR(mode)) return "a folder";
-  if (S_ISFIFO(mode)) return "a FIFO (named pipe)";
-  if (S_ISSOCK(mode)) return "a socket";
-  if (S_ISCHR(mode)) return "a character device";
-  if (S_ISBLK(mode)) return "a block device";
-  return "not a regular file";
-}
-
 }  // namespace
 
 RecordingFile::RecordingFile(fs::path path) : path_(std::move(path)) {
-  // O_NONBLOCK: opening a FIFO for reading returns at once instead of
-  // waiting for a writer; it is refused below. Regular files ignore it.
-  fd_ = ::open(path_.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
-  if (fd_ < 0) throw Error("cannot read " + path_.string() + ": " + std::strerror(errno));
-  struct stat status {};
-  if (::fstat(fd_, &status) != 0 || !S_ISREG(status.st_mode)) {
-    const std::string type = FileTypeName(status.st_mode);
-    ::close(fd_);
-    fd_ = -1;
-    throw Error(path_.string() + " is " + type +
+  std::string why;
+  file_ = RegularFile::Open(path_, &why);
+  if (file_) return;
+  if (std::filesystem::exists(path_) && !std::filesystem::is_regular_file(path_))
+    throw Error(path_.string() + " is " + why +
                 ", not a recording file: swarmsim reads recordings from regular files only");
-  }
+  throw Error("cannot read " + path_.string() + ": " + why);
 }
 
-RecordingFile::~RecordingFile() {
-  if (fd_ >= 0) ::close(fd_);
-}
+RecordingFile::~RecordingFile() = default;
 
 uint64_t RecordingFile::CurrentSize() const {
-  struct stat status {};
-  if (::fstat(fd_, &status) != 0)
-    throw Error("cannot read " + path_.string() + ": " + std::strerror(errno));
-  return static_cast<uint64_t>(status.st_size);
+  const int64_t size = file_->CurrentSize();
+  if (size < 0) throw Error("cannot read " + path_.string() + ": " + std::strerror(errno));
+  return static_cast<uint64_t>(size);
 }
 
 bool RecordingFile::ReadAt(uint64_t offset, uint64_t size, std::string* bytes) const {
@@ -74,18 +53,12 @@ bool RecordingFile::ReadAt(uint64_t offset, uint64_t size, std::string* bytes) c
     throw Error("cannot read " + path_.string() + ": not enough memory for the " +
                 std::to_string(size) + " bytes at byte " + std::to_string(offset));
   }
-  uint64_t done = 0;
-  while (done < size) {
-    const ssize_t n =
-        ::pread(fd_, bytes->data() + done, size - done, static_cast<off_t>(offset + done));
-    if (n < 0 && errno == EINTR) continue;
-    if (n < 0)
-      throw Error("cannot read " + path_.string() + " at byte " + std::to_string(offset + done) +
-                  ": " + std::strerror(errno));
-    if (n == 0) return false;  // cut shorter since fstat
-    done += static_cast<uint64_t>(n);
-  }
-  return true;
+  std::string why;
+  if (file_->ReadAt(offset, bytes->data(), size, &why)) return true;
+  if (!why.empty())
+    throw Error("cannot read " + path_.string() + " at byte " + std::to_string(offset) + ": " +
+                why);
+  return false;  // cut shorter since its size was read
 }
 
 ChunkInfo ParseChunkHeader(const uint8_t* h, uint64_t offset) {

@@ -10,9 +10,11 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <string_view>
 
+#include "framework/regular_file.h"
 #include "swarm/record/reader.h"
 
 namespace swarmsim::record {
@@ -35,7 +37,7 @@ class RecordingFile {
 
  private:
   std::filesystem::path path_;
-  int fd_ = -1;
+  std::unique_ptr<RegularFile> file_;
 };
 
 // The 24-byte chunk header at `bytes` (FORMAT.md "Chunks"), magic unchecked.

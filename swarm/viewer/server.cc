@@ -2,10 +2,8 @@
 // the recording from a byte offset, and other files of the output folder.
 #include "swarm/viewer/server.h"
 
-#include <fcntl.h>
 #include <httplib.h>
 #include <sys/socket.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -20,6 +18,7 @@
 #include <thread>
 
 #include "framework/error.h"
+#include "framework/regular_file.h"
 #include "swarm/viewer/assets.h"
 #include "swarm/viewer/page.h"
 
@@ -35,54 +34,17 @@ constexpr uint64_t kMaxRecordingAnswer = 64ull << 20;
 // are sent, so a connection holds no more of them (kMaxConnections at once).
 constexpr size_t kAnswerPiece = 64 << 10;
 
-// A file of the folder opened for one answer. Only a regular file is
-// opened: a FIFO put in place after FileInside's check is refused, never
-// waited on.
-class OpenFile {
- public:
-  // nullptr when `file` cannot be read or is not a regular file.
-  static std::shared_ptr<OpenFile> Open(const fs::path& file) {
-    const int fd = ::open(file.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
-    if (fd < 0) return nullptr;
-    struct stat status {};
-    if (::fstat(fd, &status) != 0 || !S_ISREG(status.st_mode)) {
-      ::close(fd);
-      return nullptr;
-    }
-    return std::shared_ptr<OpenFile>(new OpenFile(fd, static_cast<uint64_t>(status.st_size)));
-  }
-  ~OpenFile() { ::close(fd_); }
-  OpenFile(const OpenFile&) = delete;
-  OpenFile& operator=(const OpenFile&) = delete;
-
-  uint64_t size() const { return size_; }  // when opened
-  // The `n` bytes at `offset`; false when they cannot all be read.
-  bool ReadAt(uint64_t offset, char* out, size_t n) const {
-    while (n > 0) {
-      const ssize_t got = ::pread(fd_, out, n, static_cast<off_t>(offset));
-      if (got < 0 && errno == EINTR) continue;
-      if (got <= 0) return false;
-      out += got;
-      offset += static_cast<uint64_t>(got);
-      n -= static_cast<size_t>(got);
-    }
-    return true;
-  }
-
- private:
-  OpenFile(int fd, uint64_t size) : fd_(fd), size_(size) {}
-  int fd_;
-  uint64_t size_;
-};
-
 // Answers `file`'s bytes from `from` on, at most kMaxRecordingAnswer of
 // them, read piece by piece as they are sent; `*size`: the file's size.
 // False when the file cannot be read.
 bool AnswerFile(const fs::path& file, uint64_t from, const std::string& content_type,
                 httplib::Response* res, uint64_t* size) {
-  const std::shared_ptr<OpenFile> open = OpenFile::Open(file);
-  if (!open) return false;
-  *size = open->size();
+  // Only a regular file: a FIFO put in place after FileInside's check is
+  // refused, never waited on.
+  std::string why;
+  const std::shared_ptr<const RegularFile> open = RegularFile::Open(file, &why);
+  if (!open || open->CurrentSize() < 0) return false;
+  *size = static_cast<uint64_t>(open->CurrentSize());
   const uint64_t length = from >= *size ? 0 : std::min(*size - from, kMaxRecordingAnswer);
   if (length == 0) {
     res->set_content("", content_type);

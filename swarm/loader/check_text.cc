@@ -1,0 +1,83 @@
+#include "swarm/loader/check_text.h"
+
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <cstdlib>
+
+#include "framework/error.h"
+#include "swarm/loader/mesh.h"
+
+namespace swarmsim::loader {
+
+// A non-negative decimal integer of at most `max` (digits only, as an index
+// or a count is written).
+bool ParseUnsigned(std::string_view t, uint64_t max, uint64_t* value) {
+  if (t.empty() || t.size() > 19) return false;
+  uint64_t v = 0;
+  for (char c : t) {
+    if (c < '0' || c > '9') return false;
+    v = v * 10 + static_cast<uint64_t>(c - '0');
+  }
+  if (v > max) return false;
+  *value = v;
+  return true;
+}
+
+// A finite decimal number ("1", "-0.5", "+2.5e-3", ".5").
+bool ParseFinite(std::string_view t, double* value) {
+  if (!t.empty() && t[0] == '+') t.remove_prefix(1);
+  if (t.empty() || !(std::isdigit(static_cast<unsigned char>(t.back())) || t.back() == '.'))
+    return false;  // no "inf", "nan", "1e"
+  double v = 0;
+  const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+  if (end != t.data() + t.size()) return false;
+  if (ec == std::errc::result_out_of_range) {
+    // Too large, or too small: strtod tells (a tiny value reads as about 0).
+    const std::string copy(t);
+    v = std::strtod(copy.c_str(), nullptr);
+  } else if (ec != std::errc()) {
+    return false;
+  }
+  if (!std::isfinite(v)) return false;
+  *value = v;
+  return true;
+}
+
+// A token for a message: at most 40 characters, printable.
+std::string Shown(std::string_view t) {
+  constexpr size_t kShown = 40;
+  std::string out(t.substr(0, kShown));
+  for (char& c : out)
+    if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) c = '?';
+  return t.size() > kShown ? out + "..." : out;
+}
+
+std::string Quoted(std::string_view t) {
+  std::string out(1, '\'');  // (appended: GCC 12 warns, wrongly, on "'" + std::string)
+  out += Shown(t);
+  out += '\'';
+  return out;
+}
+
+std::string Count(int64_t n) {
+  std::string digits = std::to_string(n < 0 ? -n : n), out;
+  for (size_t i = 0; i < digits.size(); ++i) {
+    if (i > 0 && (digits.size() - i) % 3 == 0) out += ',';
+    out += digits[i];
+  }
+  return (n < 0 ? "-" : "") + out;
+}
+
+[[noreturn]] void Fail(const std::string& name, int line, const std::string& message) {
+  throw Error(name + (line > 0 ? ":" + std::to_string(line) : "") + ": " + message);
+}
+
+void CheckTriangleCount(const std::string& name, int line, int64_t triangles, const char* what) {
+  if (triangles > kMaxMeshTriangles)
+    Fail(name, line,
+         std::string(what) + " more than " + Count(kMaxMeshTriangles) +
+             " triangles, the limit for a mesh file (simplify it, or split it into parts)");
+}
+
+}  // namespace swarmsim::loader
