@@ -1,12 +1,10 @@
 #include "swarm/loader/yaml.h"
 
 #include <algorithm>
-#include <cerrno>
-#include <cstring>
-#include <fstream>
-#include <sstream>
+#include <memory>
 
 #include "framework/error.h"
+#include "framework/regular_file.h"
 
 namespace swarmsim::loader {
 
@@ -29,15 +27,17 @@ std::string ReadFileOrThrow(const fs::path& path, std::string_view kind, const s
   if (const uintmax_t size = fs::file_size(path, ec); !ec && size > kMaxBytes)
     throw Error(prefix + std::string(kind) + " '" + text + "' is too large (" +
                 std::to_string(size >> 20) + " MiB; the limit is 64 MiB)" + looked);
-  std::ifstream in(path, std::ios::binary);
-  if (!in)
-    throw Error(prefix + "cannot read " + std::string(kind) + " '" + text + "'" + looked + ": " +
-                std::strerror(errno));
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  if (in.bad())
-    throw Error(prefix + "cannot read " + std::string(kind) + " '" + text + "'" + looked);
-  return buffer.str();
+  // Opened as a regular file only (RegularFile): a FIFO put in its place
+  // after the checks above is refused, not waited on.
+  std::string why;
+  const std::unique_ptr<RegularFile> file = RegularFile::Open(path, &why);
+  const int64_t size = file ? file->CurrentSize() : -1;
+  std::string bytes(size > 0 && static_cast<uintmax_t>(size) <= kMaxBytes ? size : 0, '\0');
+  if (!file || size < 0 || static_cast<uintmax_t>(size) > kMaxBytes ||
+      !file->ReadAt(0, bytes.data(), bytes.size(), &why))
+    throw Error(prefix + "cannot read " + std::string(kind) + " '" + text + "'" + looked +
+                (why.empty() ? "" : ": " + why));
+  return bytes;
 }
 
 // Whether the indentation of line `line` (0-based) of `text` holds a tab,
