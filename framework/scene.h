@@ -269,6 +269,17 @@ class Scene {
   // The rows of a type (null for a type without rows, such as dummy).
   RowTable* rows(ObjectType type) { return tables_[static_cast<size_t>(type)].get(); }
   const RowTable* rows(ObjectType type) const { return tables_[static_cast<size_t>(type)].get(); }
+  // The rows of a type as their C++ type: how a module reads its own
+  // types' rows (`scene.rows<LedRow>(led_type)`, the type from FindType or
+  // RegisterType). `Row` must be the type's row type.
+  template <typename Row>
+  Rows<Row>& rows(ObjectType type) {
+    return Table<Row>(type);
+  }
+  template <typename Row>
+  const Rows<Row>& rows(ObjectType type) const {
+    return Table<Row>(type);
+  }
 
   // --- Creation and deletion --------------------------------------------------
   // `parent` may be null (a root). X_PO is the pose of the new object in its
