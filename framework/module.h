@@ -9,12 +9,15 @@
 // model's IK groups, a world file's `paint:` or `metrics:`), and runs every
 // instance's hooks phase by phase:
 //
-//   sense        after the scene's state is final, before the scripts
-//                (proximity 100; then plugin sensors, after_sense callbacks)
-//   actuate      after deferred writes, before joints move (IK groups 100)
-//   after_physics after the dynamics step (then after_physics callbacks)
-//   record       after the step (swarm metrics 100, paint 200, then
-//                record-phase plugin callbacks)
+//   Phase::kSense    after the scene's state is final, before the scripts
+//                    (proximity 100; then plugin sensors, after_sense callbacks)
+//   Phase::kActuate  after deferred writes, before joints move (IK groups 100)
+//   Phase::kPhysics  after the dynamics step (AfterPhysics; then after_physics
+//                    callbacks)
+//   Phase::kRecord   after the step (swarm metrics 100, paint 200, then
+//                    record-phase plugin callbacks)
+//
+// (Phase::kControl is the scripts' own: no module hooks it.)
 //
 // Within a phase, lower `order` first, then creation order: never the
 // thread count. A module's state that changes the future goes into the
@@ -31,6 +34,7 @@
 #include <string>
 #include <vector>
 
+#include "framework/phase.h"
 #include "framework/scene.h"
 
 namespace swarmsim {
@@ -46,9 +50,6 @@ struct OutputFile {
   std::string path;         // relative to the output folder
   std::string description;  // one line (a graph's name, a camera's)
 };
-
-enum class ModulePhase : uint8_t { kSense, kActuate, kAfterPhysics, kRecord, kCount };
-constexpr uint32_t PhaseBit(ModulePhase phase) { return 1u << static_cast<unsigned>(phase); }
 
 // One world's instance of a module. Hooks it does not declare are not called.
 class Module : public SceneListener {
@@ -85,7 +86,7 @@ struct ModuleInfo {
 
 struct ModuleDescriptor {
   ModuleInfo info;
-  uint32_t phases = 0;       // PhaseBit(...) | ...
+  uint32_t phases = 0;       // PhaseBit(Phase::kSense) | ... (not kControl)
   int order = 0;             // within each phase, lower first
   bool every_world = false;  // made by World::Start for every world; else on request
   // One world's instance. `config` is what the requester passes

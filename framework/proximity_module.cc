@@ -107,7 +107,7 @@ std::unique_ptr<Module> MakeProximityModule(std::unique_ptr<ProximityBackend> ba
 // Defined beside the adapter it registers (registry.cc does not depend on it).
 void ModuleRegistry::RegisterProximity(ModuleInfo info, ProximityFactory factory) {
   info.kind = "proximity";
-  RegisterModule({std::move(info), PhaseBit(ModulePhase::kSense), 100, /*every_world=*/true,
+  RegisterModule({std::move(info), PhaseBit(Phase::kSense), 100, /*every_world=*/true,
                   [factory = std::move(factory)](World*, const void*) {
                     return MakeProximityModule(factory());
                   }});

@@ -10,10 +10,10 @@
 
 namespace swarmsim {
 
-void ModuleRegistry::RegisterDynamics(ModuleInfo info, DynamicsFactory factory,
-                                      BareLoop bare_loop) {
+void ModuleRegistry::RegisterDynamics(ModuleInfo info, DynamicsCapabilities capabilities,
+                                      DynamicsFactory factory, BareLoop bare_loop) {
   info.kind = "dynamics";
-  dynamics_.push_back({info.name, std::move(factory), std::move(bare_loop)});
+  dynamics_.push_back({info.name, capabilities, std::move(factory), std::move(bare_loop)});
   modules_.push_back(std::move(info));
 }
 
@@ -41,7 +41,7 @@ std::vector<const ModuleDescriptor*> ModuleRegistry::ModulesOfKind(std::string_v
 
 void ModuleRegistry::RegisterCalculation(ModuleInfo info, CalculationFactory factory) {
   info.kind = "calculation";
-  RegisterModule({std::move(info), PhaseBit(ModulePhase::kActuate), 100, /*every_world=*/false,
+  RegisterModule({std::move(info), PhaseBit(Phase::kActuate), 100, /*every_world=*/false,
                   [factory = std::move(factory)](World*, const void*) { return factory(); }});
 }
 
@@ -66,7 +66,7 @@ const ScriptCommand* ModuleRegistry::FindScriptCommand(std::string_view name) co
 }
 
 void ModuleRegistry::RegisterPhaseCallback(ModuleInfo info, PhaseCallback callback) {
-  if (callback.phase < 0 || callback.phase >= kSwarmsimPhaseCount || callback.function == nullptr)
+  if (callback.phase >= Phase::kCount || callback.function == nullptr)
     throw Error("phase callback '" + callback.name + "' has an unknown phase or no function");
   info.kind = "callback";
   modules_.push_back(std::move(info));
@@ -137,6 +137,13 @@ bool ModuleRegistry::HasDynamics(const std::string& name) const {
   for (const Dynamics& d : dynamics_)
     if (d.name == name) return true;
   return false;
+}
+
+const DynamicsCapabilities& ModuleRegistry::dynamics_capabilities(const std::string& name) const {
+  for (const Dynamics& d : dynamics_)
+    if (d.name == name) return d.capabilities;
+  MakeDynamics(name);  // throws: unknown, with the names there are
+  throw Error("no dynamics backend '" + name + "'");
 }
 
 std::vector<std::string> ModuleRegistry::DynamicsNames() const {

@@ -12,6 +12,7 @@
 #include <string_view>
 #include <vector>
 
+#include "framework/dynamics_backend.h"
 #include "framework/module.h"
 #include "framework/plugin_api.h"
 
@@ -35,7 +36,10 @@ struct ScriptCommand {
 // A per-phase callback registered by a plugin (framework/plugin_api.h).
 struct PhaseCallback {
   std::string name;  // "plugin:phase", for messages
-  int phase = 0;     // SwarmsimPhase
+  // The plugin's SwarmsimPhase as a point of the step: after_sense is
+  // (kSense, kEnd), before_control (kControl, kStart), ...
+  Phase phase = Phase::kSense;
+  PhaseEdge edge = PhaseEdge::kEnd;
   bool per_robot = false;
   SwarmsimPhaseCallback function = nullptr;
   void* user_data = nullptr;
@@ -62,7 +66,8 @@ class ModuleRegistry {
                                         int steps, double gravity)>;
 
   // Dynamics backends: kind "dynamics", chosen by a world's `physics:`.
-  void RegisterDynamics(ModuleInfo info, DynamicsFactory factory, BareLoop bare_loop = {});
+  void RegisterDynamics(ModuleInfo info, DynamicsCapabilities capabilities, DynamicsFactory factory,
+                        BareLoop bare_loop = {});
   // Modules (framework/module.h): every other kind. Throws swarmsim::Error
   // if the name is taken or the descriptor has no `make`.
   void RegisterModule(ModuleDescriptor module);
@@ -123,6 +128,9 @@ class ModuleRegistry {
   // Null if the dynamics backend has no bare loop.
   const BareLoop* FindBareLoop(const std::string& physics) const;
   bool HasDynamics(const std::string& name) const;
+  // What the backend named `name` declared. Throws swarmsim::Error listing
+  // the backends when there is none of that name.
+  const DynamicsCapabilities& dynamics_capabilities(const std::string& name) const;
   std::vector<std::string> DynamicsNames() const;
 
   const std::vector<ModuleInfo>& modules() const { return modules_; }
@@ -131,6 +139,7 @@ class ModuleRegistry {
   std::vector<ModuleInfo> modules_;
   struct Dynamics {
     std::string name;
+    DynamicsCapabilities capabilities;
     DynamicsFactory factory;
     BareLoop bare_loop;
   };

@@ -200,10 +200,8 @@ using Observer = Module;
 // control is a few microseconds), small enough to balance two to eight workers.
 inline constexpr int64_t kRobotGrain = 8;
 
-// Wall-clock seconds spent in each phase, summed over the run.
-enum class Phase { kSense, kControl, kActuate, kPhysics, kRecord, kCount };
-const char* ToString(Phase phase);
-using PhaseTimes = std::array<double, static_cast<size_t>(Phase::kCount)>;
+// Wall-clock seconds spent in each phase (framework/phase.h), summed over the run.
+using PhaseTimes = std::array<double, kPhaseCount>;
 
 class World : public PhaseHandlers {
  public:
@@ -352,7 +350,7 @@ class World : public PhaseHandlers {
   void Actuate();
   void Physics();
   void Record();
-  void RunModules(ModulePhase phase);
+  void RunModules(Phase phase);
   void EnsureRuntimes();
   // Copies and removals the scripts queued (RobotRuntime::model_edits),
   // robots in index order then the scene's, call order within each: every
@@ -370,11 +368,15 @@ class World : public PhaseHandlers {
   // printed (and recorded) before it, in robot order. The error in flight is
   // the one reported: the buffers' own are dropped. Not for the hot path.
   void FlushBuffersAfterError() noexcept;
-  // Plugin phase callbacks (SwarmsimPhase); nothing at all when none is registered.
-  void RunPhaseCallbacks(int phase) {
-    if (!phase_callbacks_[phase].empty()) CallPhaseCallbacks(phase);
+  // Plugin phase callbacks at that edge of the phase; nothing at all when none
+  // is registered.
+  void RunPhaseCallbacks(Phase phase, PhaseEdge edge) {
+    if (!CallbacksAt(phase, edge).empty()) CallPhaseCallbacks(CallbacksAt(phase, edge));
   }
-  void CallPhaseCallbacks(int phase);
+  std::vector<const PhaseCallback*>& CallbacksAt(Phase phase, PhaseEdge edge) {
+    return phase_callbacks_[static_cast<size_t>(phase) * 2 + static_cast<size_t>(edge)];
+  }
+  void CallPhaseCallbacks(const std::vector<const PhaseCallback*>& callbacks);
   WorldSettings settings_;
   const ModuleRegistry& registry_;
   std::shared_ptr<const ModuleRegistry> owned_registry_;  // null unless given by shared_ptr
@@ -383,8 +385,8 @@ class World : public PhaseHandlers {
   RunScriptMemory run_script_memory_;
   std::deque<ScriptMemory> robot_script_memory_;  // by robot (stable addresses)
   ScriptMemory scene_script_memory_;
-  std::array<std::vector<const PhaseCallback*>, kSwarmsimPhaseCount>
-      phase_callbacks_;  // by SwarmsimPhase
+  std::array<std::vector<const PhaseCallback*>, kPhaseCount * 2>
+      phase_callbacks_;  // by (phase, edge): CallbacksAt
   // Rows plugins record in the record phase (RecordPluginMetric).
   bool recording_ = false;
   std::mutex plugin_metrics_mutex_;
@@ -417,7 +419,7 @@ class World : public PhaseHandlers {
     std::unique_ptr<Module> instance;
   };
   std::vector<ModuleEntry> modules_;
-  std::array<std::vector<Module*>, static_cast<size_t>(ModulePhase::kCount)> modules_by_phase_;
+  std::array<std::vector<Module*>, kPhaseCount> modules_by_phase_;
   Module* InstallModule(std::string name, int order, uint32_t phases,
                         std::unique_ptr<Module> instance);
   std::vector<MetricSample> metrics_;

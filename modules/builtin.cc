@@ -37,12 +37,16 @@ double BareLoop(const Scene& scene, double dt, int substeps, int steps, double g
 // One line per module.
 void RegisterBuiltinModules(ModuleRegistry* registry) {
   registry->RegisterDynamics(
-      box2d::ModuleInfo(), [] { return box2d::MakeBackend(); }, BareLoop<box2d::TimeBareLoop>);
+      box2d::ModuleInfo(), {.planar = true}, [] { return box2d::MakeBackend(); },
+      BareLoop<box2d::TimeBareLoop>);
   registry->RegisterDynamics(
-      ode::ModuleInfo(), [] { return ode::MakeBackend(); }, BareLoop<ode::TimeBareLoop>);
-  registry->RegisterDynamics(kinematic::ModuleInfo(), [] { return kinematic::MakeBackend(); });
+      ode::ModuleInfo(), {.planar = false}, [] { return ode::MakeBackend(); },
+      BareLoop<ode::TimeBareLoop>);
+  registry->RegisterDynamics(kinematic::ModuleInfo(), {.planar = false, .substeps = false},
+                             [] { return kinematic::MakeBackend(); });
   registry->RegisterDynamics(
-      planar::ModuleInfo(), [] { return planar::MakeBackend(); }, BareLoop<planar::TimeBareLoop>);
+      planar::ModuleInfo(), {.planar = true}, [] { return planar::MakeBackend(); },
+      BareLoop<planar::TimeBareLoop>);
   registry->RegisterProximity(proximity::ModuleInfo(), [] { return proximity::MakeBackend(); });
   registry->RegisterCalculation(kinematics::IkModuleInfo(),
                                 [] { return kinematics::MakeIkGroups(); });

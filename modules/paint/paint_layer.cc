@@ -140,7 +140,7 @@ void PaintLayer::ListOutputs(std::vector<OutputFile>* out) const {
 ModuleDescriptor PaintModule() {
   return {{"record", "paint", "1.0",
            "the floor paint layer paint nozzles mark (paint.png), world file key paint:"},
-          PhaseBit(ModulePhase::kRecord),
+          PhaseBit(Phase::kRecord),
           200,
           /*every_world=*/false,
           [](World* world, const void* config) -> std::unique_ptr<Module> {

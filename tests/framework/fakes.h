@@ -30,7 +30,7 @@ class NullProximity : public ProximityBackend {
 // A registry with "null" dynamics and "proximity" (null) modules.
 inline ModuleRegistry NullRegistry() {
   ModuleRegistry r;
-  r.RegisterDynamics({"", "null", "1", "moves nothing"},
+  r.RegisterDynamics({"", "null", "1", "moves nothing"}, {.substeps = false},
                      [] { return std::make_unique<NullDynamics>(); });
   r.RegisterProximity({"", "proximity", "1", "detects nothing"},
                       [] { return std::make_unique<NullProximity>(); });

@@ -744,7 +744,7 @@ TEST(ScriptControlTest, RangeMessagesHonourRangeAndLineOfSight) {
     }
   };
   ModuleRegistry walled;
-  walled.RegisterDynamics({"", "null", "1", ""},
+  walled.RegisterDynamics({"", "null", "1", ""}, {.substeps = false},
                           [] { return std::make_unique<testing::NullDynamics>(); });
   walled.RegisterProximity({"", "proximity", "1", ""}, [] { return std::make_unique<Wall>(); });
   ScriptWorld w(1, {}, std::move(walled));

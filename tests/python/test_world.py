@@ -64,6 +64,17 @@ class WorldTest(unittest.TestCase):
         self.assertEqual(len(names), 40)
         self.assertEqual(names[0], "footbot#0")
 
+    def test_the_planar_backend_gives_planar_poses_too(self):
+        # Decided by what the backend declares (planar), not by its name:
+        # the planar contact backend was taken for 3D when only box2d was.
+        w = swarmsim.World(world("diffusion_planar.yaml"), seed=1, set={"robots": 20})
+        self.assertTrue(w.planar)
+        w.step(10)
+        p = w.poses()
+        self.assertEqual(p.shape, (20, 3))
+        self.assertTrue(np.all(np.abs(p[:, 2]) <= math.pi))
+        w.close()
+
     def test_3d_poses_are_positions_and_unit_quaternions(self):
         w = swarmsim.World(world("wheeled3d.yaml"), seed=1)
         w.step(5)

@@ -44,7 +44,7 @@ class ControlLoaderTest : public ::testing::Test {
           "objects: {name: body, type: dummy, script: bot.lua}\n");
     Write("bot.lua", "function sysCall_init() end\n");
     Write("main.lua", "function sysCall_step() sim.handleDynamics() end\n");
-    registry_.RegisterDynamics({"", "kinematic", "1", "test"},
+    registry_.RegisterDynamics({"", "kinematic", "1", "test"}, {},
                                [] { return std::make_unique<testing::NullDynamics>(); });
     registry_.RegisterProximity({"", "proximity", "1", "test"},
                                 [] { return std::make_unique<testing::NullProximity>(); });

@@ -31,7 +31,7 @@ const std::string kDiffusion = std::string(SWARMSIM_SOURCE_DIR) + "/worlds/diffu
 ModuleRegistry TestRegistry() {
   ModuleRegistry r;
   for (const char* name : {"box2d", "null"})
-    r.RegisterDynamics({"", name, "1", "test double"},
+    r.RegisterDynamics({"", name, "1", "test double"}, {},
                        [] { return std::make_unique<testing::NullDynamics>(); });
   r.RegisterProximity({"", "proximity", "1", "test double"},
                       [] { return std::make_unique<testing::NullProximity>(); });
@@ -456,7 +456,7 @@ TEST_F(MalformedWorldTest, MissingWorldFileIsNamed) {
 TEST_F(MalformedWorldTest, DefaultBackendMustExist) {
   // A registry without "box2d": a world that names no backend says so.
   ModuleRegistry registry;
-  registry.RegisterDynamics({"", "ode", "1", "test double"},
+  registry.RegisterDynamics({"", "ode", "1", "test double"}, {},
                             [] { return std::make_unique<testing::NullDynamics>(); });
   const fs::path file = Write("world.yaml", "arena: {size: 2}\n");
   const std::string message = ErrorOf([&] { LoadWorld(file, {}, registry); });
