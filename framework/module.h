@@ -4,9 +4,10 @@
 // A module registers once, by name, in the ModuleRegistry with a
 // ModuleDescriptor: its `swarmsim modules` line (kind, name, version, one
 // line), the phases it hooks and its order within them, and how one world's
-// instance is made. World makes the every-world modules when it starts, the
-// others when something asks for them (World::module: the loader for a
-// model's IK groups, a world file's `paint:` or `metrics:`), and runs every
+// instance is made, and its Lua area. World makes the every-world modules
+// when it starts, the others when something asks for them (World::module:
+// the loader for a model's IK groups; a module's world-file section,
+// framework/world_section.h, for `paint:` or `metrics:`), and runs every
 // instance's hooks phase by phase:
 //
 //   Phase::kSense    after the scene's state is final, before the scripts
@@ -36,6 +37,8 @@
 
 #include "framework/phase.h"
 #include "framework/scene.h"
+
+struct lua_State;
 
 namespace swarmsim {
 
@@ -72,6 +75,10 @@ class Module : public SceneListener {
   virtual void ListOutputs(std::vector<OutputFile>* /*out*/) const {}
   // Folds state that is not in the scene and changes the future into the hash.
   virtual void HashState(StateHasher* /*hasher*/) const {}
+  // Once the loader has built every object: throws swarmsim::Error (naming
+  // the file:line:column the module kept) for a reference that matches
+  // nothing, such as an IK group's obstacle path (World::CheckModuleReferences).
+  virtual void CheckReferences(const Scene& /*scene*/) {}
   void OnSubtreeDuplicated(const Scene&, std::span<const uint32_t>,
                            std::span<const uint32_t>) override {}
   void OnSubtreeRemoved(const Scene&, std::span<const uint32_t>) override {}
@@ -93,6 +100,10 @@ struct ModuleDescriptor {
   // (World::AddModule: a `paint:` section's settings, a metric's `every`),
   // or null (World::module).
   std::function<std::unique_ptr<Module>(World* world, const void* config)> make;
+  // The module's Lua API area (framework/lua_api.h): adds its sim.*
+  // functions and constants to the table on top of L's stack, as an object
+  // type's register_lua does (sim.getIkGroup, ...). Null: none.
+  void (*register_lua)(lua_State* L) = nullptr;
 };
 
 }  // namespace swarmsim

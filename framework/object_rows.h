@@ -19,12 +19,10 @@ enum class ObjectType : uint8_t {
   kShape,
   kJoint,
   kProximitySensor,
-  kForceSensor,
-  kPaintNozzle,
   kPluginSensor,
   kCollection
 };
-inline constexpr int kBuiltinObjectTypes = 8;
+inline constexpr int kBuiltinObjectTypes = 6;
 inline constexpr int kMaxObjectTypes = 64;
 
 // One type's rows, whatever their C++ type.

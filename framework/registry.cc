@@ -7,6 +7,7 @@
 #include "framework/object_type.h"
 #include "framework/proximity_backend.h"
 #include "framework/vision_filter.h"
+#include "framework/world_section.h"
 
 namespace swarmsim {
 
@@ -98,6 +99,15 @@ void ModuleRegistry::RegisterVisionFilter(std::shared_ptr<const VisionFilterDesc
     throw Error("vision filter element '" + filter->name + "' is registered twice");
   modules_.push_back({"vision filter", filter->name, filter->version, filter->description});
   vision_filters_.push_back(std::move(filter));
+}
+
+void ModuleRegistry::RegisterWorldSection(std::shared_ptr<const WorldSectionDescriptor> section) {
+  if (!section || section->key.empty() || !section->read)
+    throw Error("a world-file section needs a key and a reader");
+  for (const auto& s : world_sections_)
+    if (s->key == section->key)
+      throw Error("world-file section '" + section->key + "' is registered twice");
+  world_sections_.push_back(std::move(section));
 }
 
 const VisionFilterDescriptor* ModuleRegistry::FindVisionFilter(std::string_view name) const {

@@ -24,6 +24,7 @@ class Scene;
 struct ObjectTypeDescriptor;
 struct PluginControllerType;
 struct VisionFilterDescriptor;
+struct WorldSectionDescriptor;
 
 // A script command registered by a plugin (framework/plugin_api.h): sim.<name>.
 struct ScriptCommand {
@@ -113,6 +114,14 @@ class ModuleRegistry {
   const std::vector<std::shared_ptr<const VisionFilterDescriptor>>& vision_filters() const {
     return vision_filters_;
   }
+  // World-file sections (framework/world_section.h): a top-level key a
+  // module reads itself. Not listed by `swarmsim modules` (its module is).
+  // Throws swarmsim::Error if the key is taken.
+  void RegisterWorldSection(std::shared_ptr<const WorldSectionDescriptor> section);
+  // In registration order, the order the loader reads them in.
+  const std::vector<std::shared_ptr<const WorldSectionDescriptor>>& world_sections() const {
+    return world_sections_;
+  }
   // Native controllers (plugins, framework/plugin_controllers.h): kind
   // "controller". Throws swarmsim::Error if the name is taken.
   void RegisterController(ModuleInfo info, PluginControllerType controller);
@@ -154,6 +163,7 @@ class ModuleRegistry {
   std::vector<std::shared_ptr<const ObjectTypeDescriptor>> owned_object_types_;
   std::vector<const ObjectTypeDescriptor*> object_types_;
   std::vector<std::shared_ptr<const VisionFilterDescriptor>> vision_filters_;
+  std::vector<std::shared_ptr<const WorldSectionDescriptor>> world_sections_;
   // Shared, stable addresses: a world's robots point at them.
   std::vector<std::shared_ptr<const PluginControllerType>> controllers_;
 };

@@ -167,6 +167,10 @@ std::vector<std::string> World::module_names() const {
   return names;
 }
 
+void World::CheckModuleReferences() {
+  for (ModuleEntry& e : modules_) e.instance->CheckReferences(scene_);
+}
+
 Module* World::find_module(std::string_view name) const {
   for (const ModuleEntry& e : modules_)
     if (e.name == name) return e.instance.get();

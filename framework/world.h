@@ -30,6 +30,7 @@ namespace swarmsim {
 
 using CalculationModule = Module;  // framework/calculation_module.h
 class DynamicsBackend;
+class FloorLayer;
 class ModuleRegistry;
 struct PhaseCallback;
 class PluginControllers;
@@ -282,6 +283,9 @@ class World : public PhaseHandlers {
   // The names of the world's modules, in creation order, then those every
   // world gets when it starts (proximity) if it has not started.
   std::vector<std::string> module_names() const;
+  // Every module's CheckReferences (the loader, once the world's objects
+  // exist), in creation order.
+  void CheckModuleReferences();
   // Adds a record-phase module made by the caller, not registered (tests,
   // embedders), after the registered ones.
   void AddObserver(std::unique_ptr<Observer> observer);
@@ -306,6 +310,10 @@ class World : public PhaseHandlers {
   ProximityBackend* proximity() { return proximity_; }
   void set_proximity(ProximityBackend* proximity) { proximity_ = proximity; }
   ScriptHost* scripts() { return scripts_.get(); }
+  // The floor image a module keeps (framework/floor_layer.h: the paint
+  // layer), or null; its provider sets it and outlives the world's use of it.
+  const FloorLayer* floor_layer() const { return floor_layer_; }
+  void set_floor_layer(const FloorLayer* layer) { floor_layer_ = layer; }
   // What robot `instance`'s scripts hold (-1: the scene's scripts and the
   // main script), and the run's whole (framework/script_memory.h).
   ScriptMemory& script_memory(int instance) {
@@ -398,6 +406,7 @@ class World : public PhaseHandlers {
   std::unique_ptr<DynamicsBackend> dynamics_;
   ProximityBackend* proximity_ = nullptr;  // owned by its module
   std::unique_ptr<ScriptHost> scripts_;
+  const FloorLayer* floor_layer_ = nullptr;         // owned by its module
   std::unique_ptr<PluginControllers> controllers_;  // null: no robot has a native controller
   std::vector<RobotRuntime> runtimes_;
   // Per robot, which of its RobotRuntime buffers may hold something (kPending*

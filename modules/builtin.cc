@@ -2,17 +2,19 @@
 
 #include "framework/dynamics_backend.h"
 #include "framework/registry.h"
+#include "framework/world_section.h"
 #include "modules/blobs/blobs.h"
 #include "modules/collision/collision.h"
 #include "modules/dynamics/box2d/box2d_backend.h"
 #include "modules/dynamics/kinematic/kinematic_backend.h"
 #include "modules/dynamics/ode/ode_backend.h"
 #include "modules/dynamics/planar/planar_backend.h"
+#include "modules/force_sensor/force_sensor.h"
 #include "modules/graphs/graphs.h"
 #include "modules/kinematics/ik_groups.h"
 #include "modules/metrics/swarm_metrics.h"
 #include "modules/mill/mill.h"
-#include "modules/paint/paint_layer.h"
+#include "modules/paint/paint_nozzle.h"
 #include "modules/paths/paths.h"
 #include "modules/planning/planning.h"
 #include "modules/proximity/proximity.h"
@@ -48,9 +50,11 @@ void RegisterBuiltinModules(ModuleRegistry* registry) {
       planar::ModuleInfo(), {.planar = true}, [] { return planar::MakeBackend(); },
       BareLoop<planar::TimeBareLoop>);
   registry->RegisterProximity(proximity::ModuleInfo(), [] { return proximity::MakeBackend(); });
-  registry->RegisterCalculation(kinematics::IkModuleInfo(),
-                                [] { return kinematics::MakeIkGroups(); });
-  registry->RegisterModule(paint::PaintModule());
+  // The first types after the built-in ones: the state hash adds each type's
+  // rows in registration order, and force sensors' came before the others'.
+  force_sensor::Register(registry);
+  kinematics::Register(registry);
+  paint::Register(registry);
   for (ModuleDescriptor& metric : metrics::SwarmMetricModules())
     registry->RegisterModule(std::move(metric));
   collision::Register(registry);
@@ -62,6 +66,9 @@ void RegisterBuiltinModules(ModuleRegistry* registry) {
   graphs::Register(registry);
   blobs::Register(registry);
   registry->RegisterModule(video::RecorderModule());
+  // World-file sections, in the order the loader reads them.
+  registry->RegisterWorldSection(metrics::MetricsSection());
+  registry->RegisterWorldSection(paint::PaintSection());
 }
 
 }  // namespace swarmsim

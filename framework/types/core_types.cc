@@ -9,8 +9,8 @@ namespace swarmsim {
 
 std::span<const ObjectTypeDescriptor* const> CoreObjectTypes() {
   static constexpr const ObjectTypeDescriptor* kTypes[] = {
-      &kDummyType,       &kShapeType,       &kJointType,        &kProximitySensorType,
-      &kForceSensorType, &kPaintNozzleType, &kPluginSensorType, &kCollectionType,
+      &kDummyType,           &kShapeType,        &kJointType,
+      &kProximitySensorType, &kPluginSensorType, &kCollectionType,
   };
   static_assert(std::size(kTypes) == kBuiltinObjectTypes);
   return kTypes;

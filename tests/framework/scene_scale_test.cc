@@ -44,13 +44,6 @@ TEST(SceneScaleTest, ScalesGeometryJointsSensorsAndMasses) {
   ProximitySensorData sensor;
   sensor.range = 0.1;
   const ObjectId eye = scene.AddProximitySensor("eye", root, {{0, 0.05, 0}, {}}, sensor);
-  ForceSensorData force;
-  force.force_threshold = 10;
-  force.torque_threshold = 1;
-  const ObjectId link = scene.AddForceSensor("link", root, {}, force);
-  PaintNozzleData nozzle;
-  nozzle.radius = 0.02;
-  const ObjectId pen = scene.AddPaintNozzle("pen", root, {}, nozzle);
   const uint64_t version = scene.structure_version();
 
   scene.ScaleSubtree(root, 2);
@@ -68,16 +61,13 @@ TEST(SceneScaleTest, ScalesGeometryJointsSensorsAndMasses) {
   EXPECT_DOUBLE_EQ(scene.joint(revolute).max_force, 48);      // N m: x s^4
   EXPECT_DOUBLE_EQ(scene.world_pose(m1).p.z, 1 + 0.2 + 0.2);  // offset + slider
   EXPECT_DOUBLE_EQ(scene.proximity_sensor(eye).range, 0.2);
-  EXPECT_DOUBLE_EQ(scene.force_sensor(link).force_threshold, 80);
-  EXPECT_DOUBLE_EQ(scene.force_sensor(link).torque_threshold, 16);
-  EXPECT_DOUBLE_EQ(scene.paint_nozzle(pen).radius, 0.04);
   // One scaled asset for both shapes that shared the original.
   EXPECT_EQ(scene.shape(m1).mesh, scene.shape(m2).mesh);
   EXPECT_NE(scene.shape(m1).mesh, mesh.mesh);
   EXPECT_DOUBLE_EQ(scene.shape(m1).mesh->hi().x, 2);
   EXPECT_DOUBLE_EQ(mesh.mesh->hi().x, 1);  // the original is untouched
   EXPECT_DOUBLE_EQ(scene.shape(m1).size.x, 4);
-  for (ObjectId id : {root, prismatic, m1, eye, pen}) EXPECT_DOUBLE_EQ(scene.size_factor(id), 2);
+  for (ObjectId id : {root, prismatic, m1, eye}) EXPECT_DOUBLE_EQ(scene.size_factor(id), 2);
 
   // Factors accumulate; a part can be scaled on its own.
   scene.ScaleSubtree(prismatic, 0.5);

@@ -44,8 +44,9 @@ TEST(CliTest, HelpVersionAndModules) {
   EXPECT_NE(modules.output.find("proximity"), std::string::npos) << modules.output;
   // Every object type and every registered module has its line: kind, name,
   // version, one line of description.
-  for (const char* line : {"object type\tforce_sensor\tbuilt-in\t", "calculation\tik\t",
-                           "record\tpaint\t", "record\tgraphs\t", "metric\tcovered_area\t"})
+  for (const char* line :
+       {"object type\tjoint\tbuilt-in\t", "object type\tforce_sensor\t", "calculation\tik\t",
+        "record\tpaint\t", "record\tgraphs\t", "metric\tcovered_area\t"})
     EXPECT_NE(modules.output.find(line), std::string::npos) << line << "\n" << modules.output;
   // describe names the modules a world gets: every world's, then its own.
   Result describe =

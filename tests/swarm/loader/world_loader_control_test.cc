@@ -14,10 +14,10 @@
 #include <string>
 
 #include "framework/error.h"
-#include "framework/ik_groups.h"
 #include "framework/registry.h"
 #include "framework/world.h"
 #include "modules/builtin.h"
+#include "modules/kinematics/ik_groups.h"
 #include "swarm/loader/world_loader.h"
 #include "tests/framework/fakes.h"
 #include "tests/swarm/run_program.h"
@@ -219,7 +219,7 @@ TEST_F(ControlLoaderTest, PerCopyValuesReachEveryObjectValueThatUsesThem) {
   const LoadedWorld w = LoadWorld(dir_ / "world.yaml", {}, builtin);
   const Scene& scene = w.world->scene();
   ASSERT_EQ(scene.instances().size(), 3u);
-  const auto* ik = dynamic_cast<const IkGroups*>(w.world->find_calculation(kIkModuleName));
+  const auto* ik = kinematics::FindIkGroups(*w.world);
   ASSERT_NE(ik, nullptr);
   struct Expected {
     double r, size, lim, mass, damping;

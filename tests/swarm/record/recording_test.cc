@@ -10,11 +10,11 @@
 #include <set>
 
 #include "framework/error.h"
+#include "framework/floor_layer.h"
 #include "framework/registry.h"
 #include "framework/world.h"
 #include "modules/blobs/leds.h"
 #include "modules/builtin.h"
-#include "modules/paint/paint_layer.h"
 #include "swarm/loader/world_loader.h"
 #include "swarm/record/format.h"
 #include "swarm/record/reader.h"
@@ -258,14 +258,20 @@ TEST(RecordingTest, LedColoursAndThePaintLayerReadBack) {
     RecordingPlayer player(out);
     while (player.Next()) {
     }
-    const auto* paint = dynamic_cast<const paint::PaintLayer*>(world.find_module("paint"));
+    const FloorLayer* paint = world.floor_layer();  // the paint layer
     ASSERT_NE(paint, nullptr);
-    EXPECT_GT(paint->painted_count(), 100);
-    EXPECT_EQ(player.paint_rgb(), paint->rgb());
+    const FloorArea area = paint->floor_area();
+    int64_t painted = 0;
+    for (int row = 0; row < area.height; ++row)
+      for (int column = 0; column < area.width; ++column)
+        painted += paint->floor_marked(column, row);
+    EXPECT_GT(painted, 100);
+    const std::vector<uint8_t> rgb(paint->floor_rgb().begin(), paint->floor_rgb().end());
+    EXPECT_EQ(player.paint_rgb(), rgb);
     // From the keyframe alone too (every painted cell is in it).
     RecordingPlayer seek(out);
     ASSERT_TRUE(seek.SeekTo(0));
-    EXPECT_EQ(seek.paint_rgb().size(), paint->rgb().size());
+    EXPECT_EQ(seek.paint_rgb().size(), rgb.size());
     fs::remove_all(out);
   }
 }

@@ -1,20 +1,24 @@
 // The floor paint layer: a nozzle moved along a known path paints exactly
 // the pixels within its radius of the path's points; the PNG decodes with
-// the layer's size and pixels; the image is the same at 1 and 2 threads.
+// the layer's size and pixels; the image is the same at 1 and 2 threads;
+// others see it as the world's floor layer.
 #include "modules/paint/paint_layer.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "framework/floor_layer.h"
 #include "framework/registry.h"
 #include "framework/scene.h"
 #include "framework/world.h"
 #include "modules/builtin.h"
+#include "modules/paint/paint_nozzle.h"
 #include "modules/paint/png_io.h"
 
 namespace swarmsim::paint {
@@ -40,7 +44,9 @@ struct Fixture {
   // A robot: a dummy root with a nozzle 0.05 m above the floor.
   ObjectId AddRobot(int index, const PaintNozzleData& nozzle) {
     const ObjectId root = scene().AddDummy("bot", {}, {{0, 0, 0.1}, {}});
-    scene().AddPaintNozzle("nozzle", root, {{0, 0, -0.05}, {}}, nozzle);
+    ObjectType nozzle_type;
+    EXPECT_TRUE(scene().FindType(kPaintNozzleTypeName, &nozzle_type));
+    scene().AddObject(nozzle_type, "nozzle", root, {{0, 0, -0.05}, {}}, &nozzle);
     scene().MakeModelInstance(root, "bot", "bot#" + std::to_string(index));
     return root;
   }
@@ -150,6 +156,39 @@ std::vector<uint8_t> PaintCircles(int threads) {
 }
 
 TEST(PaintLayerTest, SameImageAtOneAndTwoThreads) { EXPECT_EQ(PaintCircles(1), PaintCircles(2)); }
+
+}  // namespace
+}  // namespace swarmsim::paint
+
+namespace swarmsim::paint {
+namespace {
+
+// The recorder and the renderer read the layer as the world's floor layer
+// (framework/floor_layer.h): its area, size and the pixels painted.
+TEST(PaintLayerTest, IsTheWorldsFloorLayer) {
+  Fixture f(1, Area());
+  const FloorLayer* floor = f.world->floor_layer();
+  ASSERT_EQ(floor, static_cast<const FloorLayer*>(f.layer));
+  PaintNozzleData nozzle;
+  nozzle.radius = 0.05;
+  nozzle.color = {1, 0, 0};
+  f.AddRobot(0, nozzle);
+  f.world->Start();
+  f.world->Step();
+  const FloorArea area = floor->floor_area();
+  EXPECT_EQ(area.width, 100);
+  EXPECT_EQ(area.height, 50);
+  EXPECT_DOUBLE_EQ(area.min_x, -0.5);
+  EXPECT_DOUBLE_EQ(area.max_y, 0.25);
+  EXPECT_DOUBLE_EQ(area.resolution, 0.01);
+  ASSERT_EQ(floor->floor_rgb().size(), f.layer->rgb().size());
+  EXPECT_TRUE(
+      std::equal(floor->floor_rgb().begin(), floor->floor_rgb().end(), f.layer->rgb().begin()));
+  // The pixel under the nozzle (x = y = 0: column 50, row 25) is marked and red.
+  EXPECT_TRUE(floor->floor_marked(50, 25));
+  EXPECT_EQ(floor->floor_rgb()[3 * (25 * 100 + 50)], 255);
+  EXPECT_FALSE(floor->floor_marked(0, 0));
+}
 
 }  // namespace
 }  // namespace swarmsim::paint

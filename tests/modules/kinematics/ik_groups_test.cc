@@ -2,7 +2,7 @@
 // removed with their model, the same whatever the thread count; several
 // tips and closed chains; frozen joints, spherical, screw and dependent
 // joints as unknowns.
-#include "framework/ik_groups.h"
+#include "modules/kinematics/ik_groups.h"
 
 #include <gtest/gtest.h>
 
@@ -56,7 +56,7 @@ Arm AddArm(Scene* scene, const Pose& X_WRoot) {
   return a;
 }
 
-IkGroups* Ik(World* world) { return dynamic_cast<IkGroups*>(world->calculation(kIkModuleName)); }
+IkGroups* Ik(World* world) { return &kinematics::IkGroupsOf(world); }
 
 IkGroupSpec ArmGroup(const Arm& a) {
   IkGroupSpec spec;

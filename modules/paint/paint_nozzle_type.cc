@@ -1,12 +1,12 @@
 // paint_nozzle: marks the floor paint layer under it each step while enabled
 // (modules/paint).
 #include "framework/object_type.h"
-#include "framework/paint_nozzle.h"
-#include "framework/types/core_types.h"
+#include "modules/paint/paint_nozzle.h"
+#include "modules/paint/paint_type.h"
 
-namespace swarmsim {
+namespace swarmsim::paint {
 
-// Its Lua API area (framework/lua_api_*.cc).
+// Its Lua API area (lua_api_paint.cc).
 void RegisterPaintApi(lua_State* L);
 
 namespace {
@@ -44,4 +44,4 @@ constinit const ObjectTypeDescriptor kPaintNozzleType{
     .register_lua = RegisterPaintApi,
 };
 
-}  // namespace swarmsim
+}  // namespace swarmsim::paint

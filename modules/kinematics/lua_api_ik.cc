@@ -1,4 +1,4 @@
-// sim.* IK groups (framework/ik_groups.h):
+// sim.* IK groups, the "ik" module's Lua area (ik_groups.h):
 //   sim.getIkGroup(name [, {noError = true}]) -> handle (-1 with noError)
 //       a group of the calling script's robot (scene scripts: scene groups)
 //   sim.handleIkGroup(h) -> status   solves now and applies the result;
@@ -10,15 +10,15 @@
 #include <string>
 
 #include "framework/error.h"
-#include "framework/ik_groups.h"
 #include "framework/lua_api.h"
 #include "framework/world.h"
+#include "modules/kinematics/ik_groups.h"
 
-namespace swarmsim {
+namespace swarmsim::kinematics {
 namespace {
 
 IkGroups* Module(const LuaContext& c, bool required) {
-  auto* module = dynamic_cast<IkGroups*>(c.world->find_calculation(kIkModuleName));
+  IkGroups* module = FindIkGroups(*c.world);
   if (!module && required) throw Error("the world has no IK groups");
   return module;
 }
@@ -85,4 +85,4 @@ void RegisterIkApi(lua_State* L) {
   lua_setfield(L, -2, "ikresult_fail");
 }
 
-}  // namespace swarmsim
+}  // namespace swarmsim::kinematics

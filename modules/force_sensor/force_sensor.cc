@@ -1,4 +1,4 @@
-#include "framework/force_sensor.h"
+#include "modules/force_sensor/force_sensor.h"
 
 #include <algorithm>
 

@@ -1,4 +1,4 @@
-// sim.* paint nozzles (framework/paint_nozzle.h; the layer is modules/paint).
+// sim.* paint nozzles, the paint_nozzle type's Lua area (paint_nozzle.h).
 //
 // The paint layer reads nozzles in the record phase, after every script has
 // run, so a robot's writes to its own nozzles are race-free. Writing another
@@ -9,8 +9,9 @@
 #include "framework/error.h"
 #include "framework/lua_api.h"
 #include "framework/scene.h"
+#include "modules/paint/paint_nozzle.h"
 
-namespace swarmsim {
+namespace swarmsim::paint {
 namespace {
 
 // sim.setPaintNozzle(h, enabled [, {r, g, b}]): switches a paint nozzle on or
@@ -19,7 +20,10 @@ int SetPaintNozzle(lua_State* L) {
   const LuaContext& c = Context(L);
   Scene& scene = *c.scene;
   const ObjectId id = CheckObject(L, 1);
-  PaintNozzleData& nozzle = scene.mutable_paint_nozzle(id);
+  ObjectType type;
+  if (!scene.FindType(kPaintNozzleTypeName, &type))
+    throw Error("the scene has no paint nozzle type (modules/paint is not registered)");
+  PaintNozzleData& nozzle = scene.row<PaintNozzleData>(type, id, "paint nozzle");
   if (c.instance >= 0 && scene.instance_of(id) != c.instance)
     throw Error("a robot's script may set only its own paint nozzles ('" + scene.PathOf(id) +
                 "' belongs to another robot or to the scene)");
@@ -41,4 +45,4 @@ void RegisterPaintApi(lua_State* L) {
   luaL_setfuncs(L, kFunctions, 0);
 }
 
-}  // namespace swarmsim
+}  // namespace swarmsim::paint

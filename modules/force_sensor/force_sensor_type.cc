@@ -1,15 +1,18 @@
 // force_sensor: V-REP's force sensor, a rigid link between its parent shape
 // and the first dynamic shape below it that measures the force and torque it
 // transmits and breaks when they stay above a threshold (force_sensor.h).
-#include "framework/force_sensor.h"
+#include <memory>
+
+#include "framework/error.h"
 #include "framework/object_type.h"
+#include "framework/registry.h"
 #include "framework/scene.h"
 #include "framework/state_hash.h"
-#include "framework/types/core_types.h"
+#include "modules/force_sensor/force_sensor.h"
 
-namespace swarmsim {
+namespace swarmsim::force_sensor {
 
-// Its Lua API area (framework/lua_api_*.cc).
+// Its Lua API area (lua_api_force.cc).
 void RegisterForceSensorApi(lua_State* L);
 
 namespace {
@@ -42,10 +45,11 @@ void Scale(const ObjectTypeDescriptor&, void* row, double s, ScaleContext*) {
   f.torque_threshold *= s * s * s * s;
 }
 
-void Hash(const Scene& scene, ObjectType, StateHasher* h) {
-  for (size_t r = 0; r < scene.force_sensors().size(); ++r) {
-    const ForceSensorData& f = scene.force_sensors()[r];
-    h->AddValue(scene.force_sensor_owners()[r]);
+void Hash(const Scene& scene, ObjectType type, StateHasher* h) {
+  const Rows<ForceSensorData>& sensors = scene.rows<ForceSensorData>(type);
+  for (size_t r = 0; r < sensors.size(); ++r) {
+    const ForceSensorData& f = sensors.rows[r];
+    h->AddValue(sensors.owners[r]);
     h->AddValue(f.broken);
     h->AddValue(f.violations);
     h->AddValue(f.force);
@@ -62,8 +66,6 @@ void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
   if (r.Has("break_after")) s.break_after = static_cast<int>(r.Integer("break_after", 1, 1000000));
 }
 
-}  // namespace
-
 constinit const ObjectTypeDescriptor kForceSensorType{
     .name = "force_sensor",
     .description = "a breakable rigid link that measures the force and torque it transmits",
@@ -76,4 +78,19 @@ constinit const ObjectTypeDescriptor kForceSensorType{
     .register_lua = RegisterForceSensorApi,
 };
 
-}  // namespace swarmsim
+}  // namespace
+
+const ForceSensorData& Row(const Scene& scene, ObjectId id) {
+  ObjectType type;
+  if (!scene.FindType(kForceSensorTypeName, &type))
+    throw Error("the scene has no force sensor type (modules/force_sensor is not registered)");
+  return scene.row<ForceSensorData>(type, id, "force sensor");
+}
+
+const ObjectTypeDescriptor& Descriptor() { return kForceSensorType; }
+
+void Register(ModuleRegistry* registry) {
+  registry->RegisterObjectType(std::make_shared<const ObjectTypeDescriptor>(kForceSensorType));
+}
+
+}  // namespace swarmsim::force_sensor

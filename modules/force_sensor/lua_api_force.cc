@@ -1,11 +1,12 @@
-// sim.* force sensors (framework/force_sensor.h).
+// sim.* force sensors, the force_sensor type's Lua area (force_sensor.h).
 //
 // Readings are written in the physics phase and only read during the
 // control phase, so any robot may read any sensor.
 #include "framework/lua_api.h"
 #include "framework/scene.h"
+#include "modules/force_sensor/force_sensor.h"
 
-namespace swarmsim {
+namespace swarmsim::force_sensor {
 namespace {
 
 // sim.readForceSensor(h) -> state, {fx, fy, fz}, {tx, ty, tz}, as in
@@ -16,7 +17,7 @@ namespace {
 // reading or once broken.
 int ReadForceSensor(lua_State* L) {
   const Scene& scene = *Context(L).scene;
-  const ForceSensorData& sensor = scene.force_sensor(CheckObject(L, 1));
+  const ForceSensorData& sensor = Row(scene, CheckObject(L, 1));
   const int state = (sensor.has_reading && !sensor.broken ? 1 : 0) | (sensor.broken ? 2 : 0);
   lua_pushinteger(L, state);
   const bool live = sensor.has_reading && !sensor.broken;
@@ -39,4 +40,4 @@ void RegisterForceSensorApi(lua_State* L) {
   luaL_setfuncs(L, kFunctions, 0);
 }
 
-}  // namespace swarmsim
+}  // namespace swarmsim::force_sensor
