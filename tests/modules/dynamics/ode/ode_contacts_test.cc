@@ -54,6 +54,14 @@ ShapeData Box(const Vec3& size, bool dynamic, double mass = 1) {
   return s;
 }
 
+JointData Joint(JointType type, JointMode mode) {
+  JointData j;
+  j.type = type;
+  j.mode = mode;
+  j.max_force = 100;
+  return j;
+}
+
 TEST(OdeBackend, DroppedSphereLandsAtFreeFallTime) {
   const double h = 1.0, r = 0.1, g = 9.81, dt = 0.005;
   Fixture f(dt, 1, g);

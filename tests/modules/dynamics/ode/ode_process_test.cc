@@ -45,6 +45,15 @@ ShapeData Sphere(double r, bool dynamic, double mass = 1) {
   return s;
 }
 
+ShapeData Box(const Vec3& size, bool dynamic, double mass = 1) {
+  ShapeData s;
+  s.kind = ShapeKind::kBox;
+  s.size = size;
+  s.dynamic = dynamic;
+  s.mass = mass;
+  return s;
+}
+
 // An internal assertion of ODE (here: a body teleported to a zero
 // quaternion, which ODE cannot normalize) ends the step with an error
 // instead of aborting the process.
