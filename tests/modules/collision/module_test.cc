@@ -18,11 +18,13 @@ namespace {
 
 using testing::ModuleWorld;
 
-// Two unit cubes, /a at the origin and /b at x = 3 (facing faces 2 m apart).
+// Two unit cubes, /a at the origin and /b at x = 3 (facing faces 2 m apart);
+// b is a robot, so that it may move (static scene shapes are fixed).
 struct TwoCubes {
   ModuleWorld w;
   ObjectId a = w.Box("a", {}, {}, {1, 1, 1});
   ObjectId b = w.Box("b", {}, {{3, 0, 0}, {}}, {1, 1, 1});
+  TwoCubes() { w.scene().MakeModelInstance(b, "cube", "b"); }
 
   ObjectId Distance(const std::string& name, double threshold = INFINITY, bool record = true) {
     DistanceRow row;

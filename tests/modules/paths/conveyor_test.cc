@@ -64,23 +64,31 @@ TEST(ConveyorTest, AStraightBeltIsOneSegmentWithItsTopOnTheLine) {
   ExpectNear(belt.surface_angular_velocity, {0, 0, 0}, 1e-12);
 }
 
-// An L: two segments, each reaching past the corner by width/2 x tan(45
-// deg), so that the outside of the corner has no gap; straight segments
-// do not turn what they carry.
-TEST(ConveyorTest, ASharpCornerIsClosedOnTheOutside) {
+// A 45-degree corner: two segments, each reaching past the corner by
+// width/2 x tan(22.5 deg), so that their outer edges meet; straight
+// segments do not turn what they carry.
+TEST(ConveyorTest, ACornerIsClosedOnTheOutside) {
   ModuleWorld w;
-  ConveyorRow row = Belt({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}}, Interpolation::kLinear, false, 1);
+  const Vec3 d{std::sqrt(0.5), std::sqrt(0.5), 0};  // the second leg's direction
+  ConveyorRow row =
+      Belt({{0, 0, 0}, {1, 0, 0}, Vec3{1, 0, 0} + d}, Interpolation::kLinear, false, 1);
   row.width = 0.2;
   const ObjectId conveyor = w.Add(kConveyorTypeName, "conveyor", {}, {}, &row);
   ASSERT_EQ(w.Run(0), "");
   const std::vector<ObjectId> segments = Segments(w.scene(), conveyor);
   ASSERT_EQ(segments.size(), 2u);
-  const double reach = 0.1 * std::tan(M_PI / 4);
+  const double reach = 0.1 * std::tan(M_PI / 8);
   EXPECT_NEAR(w.scene().shape(segments[0]).size.x, 1 + reach, 1e-12);
   EXPECT_NEAR(w.scene().shape(segments[1]).size.x, 1 + reach, 1e-12);
   ExpectNear(w.scene().local_pose(segments[0]).p, {(1 + reach) / 2, 0, -0.025}, 1e-12);
-  EXPECT_NEAR(w.scene().local_pose(segments[1]).q.Yaw(), M_PI / 2, 1e-12);
-  ExpectNear(w.scene().local_pose(segments[1]).p, {1, 1 - (1 + reach) / 2, -0.025}, 1e-12);
+  EXPECT_NEAR(w.scene().local_pose(segments[1]).q.Yaw(), M_PI / 4, 1e-12);
+  ExpectNear(w.scene().local_pose(segments[1]).p, Vec3{1, 0, -0.025} + d * (1 - (1 + reach) / 2),
+             1e-12);
+  // The outer (right-hand) edges meet: the first's far corner is the
+  // second's near one.
+  const Vec3 right0 = w.scene().local_pose(segments[0]) * Vec3{(1 + reach) / 2, -0.1, 0};
+  const Vec3 right1 = w.scene().local_pose(segments[1]) * Vec3{-(1 + reach) / 2, -0.1, 0};
+  ExpectNear(right0, right1, 1e-12);
   for (const ObjectId s : segments)
     ExpectNear(w.scene().shape(s).surface_angular_velocity, {0, 0, 0}, 1e-12);
 }
