@@ -1,15 +1,18 @@
 // modules/environment/voxel_merge: the band's grids, their cell size and
-// what they may cost.
+// what they may cost; the shared real map's band merged into few boxes.
 #include "modules/environment/voxel_merge.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <string>
 #include <vector>
 
 #include "framework/error.h"
 #include "modules/environment/octomap_map.h"
+#include "tests/shared_maps.h"
 
 namespace swarmsim {
 namespace {
@@ -96,6 +99,33 @@ TEST(VoxelMergeTest, AGridLargerThanMaxMemoryIsRefusedWithTheKeyToRaise) {
   EXPECT_EQ(g.nx, 3000);
   EXPECT_TRUE(g.at(2999, 2999));
   EXPECT_FALSE(g.at(1, 1));
+}
+
+// The shared map at foot-bot height: a few hundred merged boxes that cover
+// exactly the band's voxels.
+TEST(EnvironmentPhysicsTest, TheSharedMapsBandMergesIntoFewBoxesCoveringItsVoxels) {
+  SWARMSIM_NEED_SHARED_MAP(path, "geb079.bt");
+  const EnvironmentMap map = environment::ReadOctomap(path, "geb079.bt", {});
+  const double lo = 0.001, hi = 0.145;  // a foot-bot's height range, 1 mm in
+  int64_t voxels = 0;
+  for (const EnvironmentBox& b : map.boxes) {
+    const int64_t side = std::lround((b.hi.x - b.lo.x) / 0.08);
+    for (int64_t k = 0; k < side; ++k) {
+      const double bottom = b.lo.z + k * 0.08;
+      if (bottom + 0.08 > lo && bottom < hi) voxels += side * side;
+    }
+  }
+  const auto boxes = environment::MergeBand3D(map, lo, hi);
+  int64_t covered = 0;
+  for (const EnvironmentBox& b : boxes)
+    covered += std::lround((b.hi.x - b.lo.x) / 0.08) * std::lround((b.hi.y - b.lo.y) / 0.08) *
+               std::lround((b.hi.z - b.lo.z) / 0.08);
+  EXPECT_EQ(covered, voxels);
+  EXPECT_LT(boxes.size() * 4, static_cast<size_t>(voxels));
+  const auto rects = environment::MergeBand2D(map, lo, hi);
+  EXPECT_LT(rects.size(), boxes.size());
+  std::printf("geb079.bt, band z %.3f..%.3f m: %lld voxels, %zu boxes (3D), %zu rectangles (2D)\n",
+              lo, hi, static_cast<long long>(voxels), boxes.size(), rects.size());
 }
 
 }  // namespace

@@ -1,7 +1,11 @@
-// The environment map (framework/environment.h) in the physics backends:
-// its voxels at the robots' height are walls (Box2D: projected to the plane;
-// ODE: boxes), while the floor under them and an overhang above them are
-// not. Driven through a World, as a run would.
+// The environment map's voxels as obstacles of the physics backends
+// (modules/dynamics/environment_obstacles.h): its voxels at the robots'
+// height are walls (Box2D: projected to the plane; ODE: boxes), while the
+// floor under them and an overhang above them are not. Driven through a
+// World, as a run would.
+
+#include "modules/dynamics/environment_obstacles.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -12,7 +16,6 @@
 #include "framework/scene.h"
 #include "framework/world.h"
 #include "modules/builtin.h"
-#include "modules/dynamics/environment_obstacles.h"
 #include "modules/environment/octomap_map.h"
 #include "tests/shared_maps.h"
 
@@ -153,33 +156,6 @@ TEST(EnvironmentPhysicsTest, OdeRobotStopsAtAMapWallAndPassesUnderTheOverhang) {
   EXPECT_GT(f.scene().world_pose(bot).p.z, 0.04);  // on the floor, not sunk or lifted
   EXPECT_LT(f.scene().world_pose(bot).p.z, 0.06);
   EXPECT_GT(f.scene().world_pose(beside).p.x, 1.5);
-}
-
-// The shared map at foot-bot height: a few hundred merged boxes that cover
-// exactly the band's voxels.
-TEST(EnvironmentPhysicsTest, TheSharedMapsBandMergesIntoFewBoxesCoveringItsVoxels) {
-  SWARMSIM_NEED_SHARED_MAP(path, "geb079.bt");
-  const EnvironmentMap map = environment::ReadOctomap(path, "geb079.bt", {});
-  const double lo = 0.001, hi = 0.145;  // a foot-bot's height range, 1 mm in
-  int64_t voxels = 0;
-  for (const EnvironmentBox& b : map.boxes) {
-    const int64_t side = std::lround((b.hi.x - b.lo.x) / 0.08);
-    for (int64_t k = 0; k < side; ++k) {
-      const double bottom = b.lo.z + k * 0.08;
-      if (bottom + 0.08 > lo && bottom < hi) voxels += side * side;
-    }
-  }
-  const auto boxes = environment::MergeBand3D(map, lo, hi);
-  int64_t covered = 0;
-  for (const EnvironmentBox& b : boxes)
-    covered += std::lround((b.hi.x - b.lo.x) / 0.08) * std::lround((b.hi.y - b.lo.y) / 0.08) *
-               std::lround((b.hi.z - b.lo.z) / 0.08);
-  EXPECT_EQ(covered, voxels);
-  EXPECT_LT(boxes.size() * 4, static_cast<size_t>(voxels));
-  const auto rects = environment::MergeBand2D(map, lo, hi);
-  EXPECT_LT(rects.size(), boxes.size());
-  std::printf("geb079.bt, band z %.3f..%.3f m: %lld voxels, %zu boxes (3D), %zu rectangles (2D)\n",
-              lo, hi, static_cast<long long>(voxels), boxes.size(), rects.size());
 }
 
 }  // namespace

@@ -4,6 +4,8 @@
 // (as the descriptor gives it, in backticks or not), so the docs cannot
 // drift from the loader. (tests/framework/object_types_test.cc: the
 // built-in types.)
+#include "modules/builtin.h"
+
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -12,7 +14,6 @@
 
 #include "framework/object_type.h"
 #include "framework/registry.h"
-#include "modules/builtin.h"
 
 namespace swarmsim {
 namespace {

@@ -1,11 +1,11 @@
 // The mills' cutting volumes (modules/mill/volume.h): the exact
 // point-in-volume test on points a user can check by hand, its volume
 // against the closed forms, and the bounds.
+#include "modules/mill/volume.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
-
-#include "modules/mill/volume.h"
 
 namespace swarmsim::mill {
 namespace {

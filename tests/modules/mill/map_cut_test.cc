@@ -2,12 +2,12 @@
 // whose centres are inside a volume go, exactly (checked voxel by voxel
 // against the volume), what is left covers the rest exactly once, and a
 // box nothing was cut from stays whole.
+#include "modules/mill/map_cut.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <vector>
-
-#include "modules/mill/map_cut.h"
 
 namespace swarmsim::mill {
 namespace {

@@ -1,6 +1,5 @@
-// The ODE backend through a World: free fall, bounces, joint modes and
-// limits, a wheeled robot, kinematic bodies, the hybrid switch, repeatability.
-#include "modules/dynamics/ode/ode_backend.h"
+// The ODE world (ode_world.cc) through a World: joint modes and limits, a
+// wheeled robot, the hybrid switch, scripts, teleports and bad shapes.
 
 #include <gtest/gtest.h>
 
@@ -14,6 +13,7 @@
 #include "framework/scene.h"
 #include "framework/world.h"
 #include "modules/builtin.h"
+#include "modules/dynamics/ode/ode_backend.h"
 
 namespace swarmsim::ode {
 namespace {
@@ -60,64 +60,6 @@ JointData Joint(JointType type, JointMode mode) {
   j.mode = mode;
   j.max_force = 100;
   return j;
-}
-
-TEST(OdeBackend, RegistersAsOdeAndKinematic) {
-  ModuleRegistry registry;
-  RegisterBuiltinModules(&registry);
-  EXPECT_TRUE(registry.HasDynamics("ode"));
-  EXPECT_TRUE(registry.HasDynamics("kinematic"));
-}
-
-// An internal assertion of ODE (here: a body teleported to a zero
-// quaternion, which ODE cannot normalize) ends the step with an error
-// instead of aborting the process.
-TEST(OdeBackend, InternalAssertionIsAnErrorNotAnAbort) {
-  Fixture f;
-  const ObjectId ball = f.scene().AddShape("ball", {}, {{0, 0, 1}, {}}, Sphere(0.1, true));
-  f.scene().AddShape("floor", {}, {{0, 0, -0.5}, {}}, Box({4, 4, 1}, false));
-  f.world->Step();
-  f.scene().SetWorldPose(ball, {{0, 0, 1}, {0, 0, 0, 0}});
-  try {
-    f.world->Step();
-    FAIL() << "expected an error";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("ode: internal error"), std::string::npos) << e.what();
-  }
-}
-
-TEST(OdeBackend, DroppedSphereLandsAtFreeFallTime) {
-  const double h = 1.0, r = 0.1, g = 9.81, dt = 0.005;
-  Fixture f(dt, 1, g);
-  const ObjectId ball = f.scene().AddShape("ball", {}, {{0, 0, r + h}, {}}, Sphere(r, true));
-  f.world->Start();
-  EXPECT_EQ(f.world->dynamics()->body_count(), 1);
-  double landed = -1;
-  for (int i = 0; i < 400 && landed < 0; ++i) {
-    f.world->Step();
-    if (f.scene().world_pose(ball).p.z <= r + 1e-9) landed = f.world->time();
-  }
-  EXPECT_NEAR(landed, std::sqrt(2 * h / g), dt);
-  // And it rests on the ground instead of falling through.
-  for (int i = 0; i < 200; ++i) f.world->Step();
-  EXPECT_NEAR(f.scene().world_pose(ball).p.z, r, 2e-3);
-}
-
-TEST(OdeBackend, RestitutionBouncesToTheExpectedHeight) {
-  const double h = 1.0, r = 0.05;
-  Fixture f(0.002, 1);
-  ShapeData shape = Sphere(r, true);
-  shape.restitution = 0.8;
-  const ObjectId ball = f.scene().AddShape("ball", {}, {{0, 0, r + h}, {}}, shape);
-  double peak = 0;
-  bool bounced = false;
-  for (int i = 0; i < 1000; ++i) {
-    f.world->Step();
-    const double z = f.scene().world_pose(ball).p.z - r;
-    if (!bounced && f.scene().linear_velocity_at(ball.index()).z > 0) bounced = true;
-    if (bounced) peak = std::max(peak, z);
-  }
-  EXPECT_NEAR(peak, 0.64 * h, 0.06);  // e^2 h
 }
 
 // A bar hanging from a scene-level joint (attached to the static world).
@@ -200,28 +142,6 @@ TEST(OdeBackend, ForceModeGivesTheExpectedAngularAcceleration) {
   const double inertia = (0.25 + 0.0016) / 12 + 0.0625;
   const double t = 0.5;
   EXPECT_NEAR(f.scene().joint(arm.joint).position, 0.5 * 0.1 / inertia * t * t, 0.01);
-}
-
-// Absurd torques blow eight arms (eight islands, solved on both threads) up:
-// whatever ODE does with the infinities, on whichever thread, the step ends
-// with an error naming physics or ODE, never an abort.
-TEST(OdeBackend, ExplodingIslandsOnSolverThreadsAreAnErrorNotAnAbort) {
-  Fixture f(0.01, 2, 9.81, "ode", 2);
-  JointData j = Joint(JointType::kRevolute, JointMode::kForce);
-  j.target_force = 1e300;  // N m
-  for (int i = 0; i < 8; ++i) AddArm(&f.scene(), j, {{2.0 * i, 0, 1}, {}});
-  std::string message;
-  for (int i = 0; i < 100 && message.empty(); ++i) {
-    try {
-      f.world->Step();
-    } catch (const Error& e) {
-      message = e.what();
-    }
-  }
-  ASSERT_FALSE(message.empty()) << "the arms never broke the physics";
-  EXPECT_TRUE(message.find("non-finite") != std::string::npos ||
-              message.find("ode:") != std::string::npos)
-      << message;
 }
 
 TEST(OdeBackend, PassiveJointStopsAtItsLimits) {
@@ -322,79 +242,6 @@ TEST(OdeBackend, WheeledRobotDrivesStraightAtOmegaTimesRadius) {
   EXPECT_NEAR(f.scene().joint(r.left).velocity, omega, 0.05);
 }
 
-uint64_t RunWheeledSwarm(int threads) {
-  Fixture f(0.01, 4, 9.81, "ode", threads);
-  for (int i = 0; i < 8; ++i) {
-    const Wheeled r = AddWheeledRobot(&f.scene(), {0.0, 0.5 * i, 0}, 2.0 + 0.5 * i);
-    f.scene().MakeModelInstance(r.chassis, "wheeled", "wheeled#" + std::to_string(i));
-    f.scene().AddShape("ball", {}, {{0.4, 0.5 * i, 0.3}, {}}, Sphere(0.05, true, 0.3));
-  }
-  for (int i = 0; i < 100; ++i) f.world->Step();
-  return f.world->StateHash();
-}
-
-TEST(OdeBackend, StateHashIsEqualAtOneAndTwoThreads) {
-  const uint64_t one = RunWheeledSwarm(1);
-  EXPECT_EQ(RunWheeledSwarm(1), one);
-  EXPECT_EQ(RunWheeledSwarm(2), one);
-}
-
-// Four towers of eight boxes with spheres dropped on them: each tower is one
-// island of eight bodies and a few dozen contacts, solved by the threaded
-// solver's multi-threaded path; loose spheres are islands of their own.
-struct Towers {
-  std::vector<Pose> poses;  // every box and sphere, after the run
-  uint64_t hash = 0;
-};
-Towers RunTowers(int threads) {
-  Fixture f(0.01, 2, 9.81, "ode", threads);
-  std::vector<ObjectId> bodies;
-  for (int t = 0; t < 4; ++t)
-    for (int level = 0; level < 8; ++level)
-      bodies.push_back(f.scene().AddShape("box", {}, {{1.0 * t, 0, 0.05 + 0.1 * level}, {}},
-                                          Box({0.1, 0.1, 0.1}, true, 0.5)));
-  for (int s = 0; s < 12; ++s)
-    bodies.push_back(f.scene().AddShape(
-        "ball", {}, {{0.02 + 0.25 * s, 0.03 * (s % 3), 1.2 + 0.05 * s}, {}}, Sphere(0.04, true)));
-  for (int i = 0; i < 300; ++i) f.world->Step();  // 3 s: the spheres land and the towers settle
-  Towers out;
-  for (ObjectId id : bodies) out.poses.push_back(f.scene().world_pose(id));
-  out.hash = f.world->StateHash();
-  return out;
-}
-
-TEST(OdeBackend, TowersOfBoxesStandAndAreBitIdenticalAtOneToFourThreads) {
-  const Towers one = RunTowers(1);
-  for (int t = 0; t < 4; ++t) {  // each tower still stands, its top box where it began
-    const Pose& top = one.poses[static_cast<size_t>(t * 8 + 7)];
-    EXPECT_NEAR(top.p.x, 1.0 * t, 0.02) << "tower " << t;
-    EXPECT_NEAR(top.p.z, 0.75, 0.01) << "tower " << t;
-  }
-  for (int threads : {2, 3, 4}) {
-    const Towers other = RunTowers(threads);
-    EXPECT_EQ(other.hash, one.hash) << threads << " threads";
-    for (size_t i = 0; i < one.poses.size(); ++i) {
-      ASSERT_EQ(other.poses[i].p.x, one.poses[i].p.x) << "body " << i << ", " << threads;
-      ASSERT_EQ(other.poses[i].p.z, one.poses[i].p.z) << "body " << i << ", " << threads;
-      ASSERT_EQ(other.poses[i].q.w, one.poses[i].q.w) << "body " << i << ", " << threads;
-    }
-  }
-}
-
-TEST(OdeBackend, KinematicPlatformLiftsADynamicBall) {
-  Fixture f(0.01, 2);
-  JointData lift = Joint(JointType::kPrismatic, JointMode::kVelocity);
-  lift.target_velocity = 0.2;
-  const ObjectId j = f.scene().AddJoint("lift", {}, {{0, 0, 0.1}, {}}, lift);
-  f.scene().AddShape("platform", j, {}, Box({1, 1, 0.05}, false));
-  const ObjectId ball = f.scene().AddShape("ball", {}, {{0, 0, 0.2}, {}}, Sphere(0.075, true));
-  f.world->Start();
-  EXPECT_FALSE(f.scene().joint(j).simulated);     // no dynamic child: kinematic
-  for (int i = 0; i < 100; ++i) f.world->Step();  // platform top rises 0.2 m to 0.325
-  EXPECT_NEAR(f.scene().joint(j).position, 0.2, 1e-9);
-  EXPECT_NEAR(f.scene().world_pose(ball).p.z, 0.325 + 0.2 + 0.075 - 0.2, 0.01);
-}
-
 TEST(OdeBackend, HybridSwitchMakesAKinematicBoxFallAndStopsItAgain) {
   Fixture f(0.01, 2);
   const ObjectId crate =
@@ -457,24 +304,6 @@ TEST(OdeBackend, BadDynamicShapeIsAClearError) {
     EXPECT_NE(std::string(e.what()).find("/ghost"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("mass"), std::string::npos) << e.what();
   }
-}
-
-TEST(KinematicBackend, MovesJointsButNothingFalls) {
-  Fixture f(0.1, 1, 9.81, "kinematic");
-  JointData j = Joint(JointType::kRevolute, JointMode::kVelocity);
-  j.target_velocity = 1;
-  const Arm arm = AddArm(&f.scene(), j, {{0, 0, 1}, {}});
-  for (int i = 0; i < 10; ++i) f.world->Step();
-  EXPECT_NEAR(f.scene().joint(arm.joint).position, 1.0, 1e-12);
-  EXPECT_NEAR(f.scene().world_pose(arm.bar).p.z, 1.0, 1e-12);
-  EXPECT_NEAR(f.scene().world_pose(arm.bar).q.Yaw(), 1.0, 1e-12);
-}
-
-TEST(OdeBackend, BareLoopTimesStepping) {
-  Scene scene;
-  AddWheeledRobot(&scene, {}, 2);
-  scene.UpdateWorldPoses();
-  EXPECT_GT(TimeBareLoop(scene, 0.01, 2, 10), 0.0);
 }
 
 }  // namespace

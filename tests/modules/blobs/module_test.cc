@@ -1,10 +1,8 @@
-// Blob cameras (modules/blobs): which LEDs a camera sees — range, field of
-// view, occlusion by static shapes and other robots, its own robot's LEDs
-// and switched-off LEDs left out — with the colour, distance, bearing and
-// elevation of each, in bearing order; copies of a model; the same readings
-// at 1 and 2 threads; and the scripts' side (sim.setLedColor,
-// sim.readBlobCamera and their errors).
-#include "modules/blobs/blob_camera.h"
+// The blob cameras' module (modules/blobs/module.cc): which LEDs a camera
+// sees — range, field of view, occlusion by static shapes, other robots and
+// the map, its own robot's LEDs and switched-off LEDs left out — with the
+// colour, distance, bearing and elevation of each, in bearing order; noise;
+// copies of a model; the same readings at 1 and 2 threads.
 
 #include <gtest/gtest.h>
 
@@ -19,6 +17,7 @@
 #include "framework/registry.h"
 #include "framework/scene.h"
 #include "framework/world.h"
+#include "modules/blobs/blob_camera.h"
 #include "modules/blobs/leds.h"
 #include "modules/builtin.h"
 
@@ -387,119 +386,6 @@ TEST(BlobCameraTest, ReadingsAreTheSameAtOneAndTwoThreads) {
     seen += one[c].size();
   }
   EXPECT_GT(seen, 1000u);  // about 8 LEDs within 1.5 m of each camera
-}
-
-// --- Metrics -----------------------------------------------------------------------------
-
-// The two colour metrics of robots with LEDs at (x, 0), colours[i].
-std::pair<double, double> ColorMetrics(const std::vector<double>& xs,
-                                       const std::vector<Vec3>& colors) {
-  BlobWorld w;
-  for (size_t i = 0; i < xs.size(); ++i) w.LedRobot(xs[i], 0, colors[i]);
-  w.Robot(0.05, 0.05);  // no LED: does not count
-  const int every = 1;
-  w.world().AddModule("same_color_neighbor_fraction", &every);
-  w.world().AddModule("color_dispersion", &every);
-  w.world().Step();
-  std::pair<double, double> out{-1, -1};
-  for (const MetricSample& m : w.world().TakeMetrics()) {
-    if (m.name == "same_color_neighbor_fraction") out.first = m.value;
-    if (m.name == "color_dispersion") out.second = m.value;
-  }
-  return out;
-}
-
-TEST(BlobCameraTest, ColourMetricsTellSegregatedFromMixed) {
-  // Two far groups of four, one colour each: every neighbour is one's own
-  // colour; each robot is 0.15 or 0.05 m from its group's centre.
-  const auto [together, spread] =
-      ColorMetrics({0, 0.1, 0.2, 0.3, 10, 10.1, 10.2, 10.3},
-                   {kRed, kRed, kRed, kRed, kBlue, kBlue, kBlue, kBlue});
-  EXPECT_DOUBLE_EQ(together, 1.0);
-  EXPECT_NEAR(spread, 0.1, 1e-12);
-  // Alternating on a line 1 m apart: of the 3 nearest, one shares the colour.
-  std::vector<double> xs;
-  std::vector<Vec3> colors;
-  for (int i = 0; i < 8; ++i) {
-    xs.push_back(i);
-    colors.push_back(i % 2 == 0 ? kRed : kBlue);
-  }
-  const auto [mixed, mixed_spread] = ColorMetrics(xs, colors);
-  EXPECT_NEAR(mixed, 1.0 / 3, 1e-12);
-  EXPECT_NEAR(mixed_spread, 2.0, 1e-12);  // |i - 3| or |i - 4| over each colour: 3, 1, 1, 3
-}
-
-// --- Scripts -----------------------------------------------------------------------------
-
-// Two robots 0.5 m apart on x, each with an LED and a camera; `code` runs on
-// robot 0's root. Returns what the scripts printed.
-std::vector<std::string> RunScript(const std::string& code, std::string* error) {
-  BlobWorld w;
-  std::vector<std::string> log;
-  w.world().set_log_sink([&](std::string_view line) { log.emplace_back(line); });
-  for (int i = 0; i < 2; ++i) {
-    const ObjectId root = w.Robot(0.5 * i, 0);
-    w.Led(root, {0, 0, 0.083}, kRed);
-    w.Camera(root, {{0, 0, 0.127}, {}});
-  }
-  w.scene().AddShape("wall", {}, {{0, 1, 0.1}, {}}, Box({1, 0.1, 0.2}));
-  w.scene().AttachScript(w.scene().instance(0).root,
-                         std::make_shared<const ScriptSource>(ScriptSource{"bot.lua", code}));
-  try {
-    w.world().Start();
-    for (int i = 0; i < 3; ++i) w.world().Step();
-  } catch (const Error& e) {
-    *error = e.what();
-  }
-  return log;
-}
-
-TEST(BlobCameraTest, ScriptsSetTheirLedAndReadTheirCamera) {
-  std::string error;
-  const auto log = RunScript(R"(
-    function sysCall_init()
-      led, camera = sim.getObject('./led'), sim.getObject('./camera')
-      sim.setLedColor(led, {0, 0.5, 1})
-      sim.setLedOn(led, false)
-      local c, on = sim.getLedColor(led)
-      print(string.format('led %g %g %g %s', c[1], c[2], c[3], tostring(on)))
-      sim.setLedOn(led, true)
-    end
-    function sysCall_sensing()
-      local blobs = sim.readBlobCamera(camera)
-      local b = blobs[1]
-      print(string.format('%d blob: %g %g %g d=%.3f b=%.3f e=%.3f other=%s', #blobs,
-        b.color[1], b.color[2], b.color[3], b.distance, b.bearing, b.elevation,
-        tostring(b.handle == sim.getObject('/bot#1/led'))))
-    end
-  )",
-                             &error);
-  EXPECT_EQ(error, "");
-  ASSERT_GE(log.size(), 2u);
-  EXPECT_NE(log[0].find("led 0 0.5 1 false"), std::string::npos) << log[0];
-  EXPECT_NE(log[1].find("1 blob: 1 0 0 d=0.502 b=0.000 e=-0.088 other=true"), std::string::npos)
-      << log[1];
-}
-
-TEST(BlobCameraTest, ScriptErrorsNameWhatIsWrong) {
-  const auto error_of = [](const std::string& code) {
-    std::string error;
-    RunScript("function sysCall_init()\n" + code + "\nend\n", &error);
-    return error;
-  };
-  EXPECT_NE(error_of("sim.readBlobCamera(sim.getObject('./led'))")
-                .find("sim.readBlobCamera: object /bot#0/led is a led, not a blob_camera"),
-            std::string::npos);
-  EXPECT_NE(error_of("sim.setLedColor(sim.getObject('/bot#1/led'), {1, 0, 0})")
-                .find("may set only its own LEDs ('/bot#1/led' belongs to another robot"),
-            std::string::npos);
-  EXPECT_NE(error_of("sim.getLedColor(sim.getObject('/bot#1/led'))").find("read only its own LEDs"),
-            std::string::npos);
-  EXPECT_NE(error_of("sim.setLedColor(sim.getObject('./led'), {1, 2, 0})")
-                .find("the colour must be {r, g, b} with each component between 0 and 1"),
-            std::string::npos);
-  EXPECT_NE(error_of("sim.setLedOn(sim.getObject('./led'), 1)").find("bad argument #2"),
-            std::string::npos);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
-// The Box2D backend, driven directly (no World): what a user of a wheeled
-// swarm would notice — distances, turn rates, walls, pushing, determinism.
-#include "modules/dynamics/box2d/box2d_backend.h"
+// The Box2D plane world's step (plane_world.cc), driven directly (no World):
+// what a user of a wheeled swarm would notice — distances, turn rates,
+// pushing, traction limits, sliding, write-back of carried objects and
+// teleports.
 
 #include <gtest/gtest.h>
 
@@ -14,7 +15,8 @@
 #include "framework/dynamics_backend.h"
 #include "framework/scene.h"
 #include "framework/state_hash.h"
-#include "tests/modules/box2d_scene.h"
+#include "modules/dynamics/box2d/box2d_backend.h"
+#include "tests/modules/dynamics/box2d/box2d_scene.h"
 
 namespace swarmsim::box2d {
 namespace {
@@ -25,21 +27,6 @@ std::unique_ptr<DynamicsBackend> Build(const Scene& scene, const Options& option
   auto backend = MakeBackend(options);
   backend->Build(scene, {});
   return backend;
-}
-
-TEST(Box2dBackend, RegistersAsBox2d) {
-  EXPECT_EQ(ModuleInfo().name, "box2d");
-  EXPECT_EQ(ModuleInfo().kind, "dynamics");
-}
-
-TEST(Box2dBackend, MakesOneBodyPerDynamicShape) {
-  Scene scene;
-  AddFloor(&scene);
-  AddRobot(&scene, "a", 0, 0, 0);
-  AddRobot(&scene, "b", 1, 0, 0);
-  AddWall(&scene, 3, 0, 0.1, 2);
-  auto backend = Build(scene);
-  EXPECT_EQ(backend->body_count(), 2);  // not the wheels, the wall or the floor
 }
 
 TEST(Box2dBackend, DrivesStraightAtCommandedSpeed) {
@@ -118,91 +105,6 @@ TEST(Box2dBackend, SpinsInPlaceAtTwoVOverSeparation) {
   const Vec3 p = Position(scene, robot.body);
   EXPECT_NEAR(p.x, 0.5, 1e-3);
   EXPECT_NEAR(p.y, 0.5, 1e-3);
-}
-
-// Drives a robot at +x into a wall whose face is at x = 1; returns the
-// largest centre x seen and leaves the robot at rest against it.
-struct WallRun {
-  double max_x = -1e9;
-  double final_x = 0;
-  double final_vx = 0;
-};
-WallRun DriveIntoWall(double v, double seconds, const RobotSpec& spec = {},
-                      const Options& options = {}) {
-  Scene scene;
-  AddFloor(&scene);
-  AddWall(&scene, 1.05, 0, 0.1, 2);  // face at x = 1.0
-  Robot robot = AddRobot(&scene, "r", 0, 0, 0, spec);
-  auto backend = Build(scene, options);
-  SetWheelSpeeds(&scene, robot, v, v);
-  WallRun out;
-  Simulate(backend.get(), &scene, seconds,
-           [&] { out.max_x = std::max(out.max_x, Position(scene, robot.body).x); });
-  out.final_x = Position(scene, robot.body).x;
-  out.final_vx = scene.linear_velocity_at(scene.SlotOf(robot.body)).x;
-  return out;
-}
-
-TEST(Box2dBackend, StopsAtWall) {
-  const double contact = 1.0 - 0.085;
-  const WallRun run = DriveIntoWall(0.05, 30.0);  // reaches the wall after ~18 s
-  EXPECT_NEAR(run.final_x, contact, 3e-3);
-  EXPECT_LT(run.max_x, contact + 3e-3);
-  EXPECT_NEAR(run.final_vx, 0, 1e-3);  // pushing, but not gaining energy
-}
-
-// Tilted obstacles become the hull of their projected corners. One nearly
-// edge-on (a 10 m x 0.2 m x 0.1 mm sheet at 89.99 degrees) projects to a
-// strip thinner than Box2D's weld distance: it is skipped, where Box2D's
-// polygon code used to assert (abort); a tilted box with a real footprint
-// still stops a robot.
-TEST(Box2dBackend, TiltedObstaclesUseTheirProjectedHull) {
-  Scene scene;
-  const Robot robot = AddRobot(&scene, "r", 0, 0, 0);
-  ShapeData sheet;
-  sheet.kind = ShapeKind::kBox;
-  sheet.size = {10, 0.2, 0.0001};
-  scene.AddShape("sheet", {}, {{0, 2, 0.07}, Quat::FromAxisAngle({1, 0, 0}, 89.99 * M_PI / 180)},
-                 sheet);
-  ShapeData block;
-  block.kind = ShapeKind::kBox;
-  block.size = {0.2, 2, 0.2};
-  scene.AddShape("block", {}, {{1, 0, 0.1}, Quat::FromAxisAngle({0, 1, 0}, 0.3)}, block);
-  auto backend = Build(scene);
-  SetWheelSpeeds(&scene, robot, 0.1, 0.1);
-  Simulate(backend.get(), &scene, 15);
-  // The block's hull reaches x = 1 - (0.1 cos 0.3 + 0.1 sin 0.3) ~ 0.875 m.
-  EXPECT_LT(Position(scene, robot.body).x, 0.9 - 0.085);
-  EXPECT_GT(Position(scene, robot.body).x, 0.7);
-}
-
-TEST(Box2dBackend, StopsAtWallWithoutTunnellingWhenFast) {
-  const double contact = 1.0 - 0.085;
-  const WallRun run = DriveIntoWall(0.5, 5.0);
-  EXPECT_NEAR(run.final_x, contact, 3e-3);
-  EXPECT_LT(run.max_x, contact + 3e-3);
-  EXPECT_NEAR(run.final_vx, 0, 1e-3);
-}
-
-TEST(Box2dBackend, SmallRobotRestsAgainstWallAndDrivesTrue) {
-  RobotSpec small;
-  small.radius = 0.03;
-  small.height = 0.04;
-  small.mass = 0.1;
-  small.half_axle = 0.025;
-  small.wheel_radius = 0.01;
-  const WallRun run = DriveIntoWall(0.05, 25.0, small);
-  EXPECT_NEAR(run.final_x, 1.0 - small.radius, 2e-3);
-  EXPECT_LT(run.max_x, 1.0 - small.radius + 2e-3);
-
-  Scene scene;
-  Robot robot = AddRobot(&scene, "r", 0, 0, 0, small);
-  auto backend = Build(scene);
-  SetWheelSpeeds(&scene, robot, 0.05, 0.05);
-  Simulate(backend.get(), &scene, 10.0);
-  EXPECT_NEAR(Position(scene, robot.body).x, 0.5, 0.01);
-  EXPECT_NEAR(Position(scene, robot.body).y, 0, 1e-3);
-  EXPECT_NEAR(Yaw(scene, robot.body), 0, 1e-3);
 }
 
 ObjectId AddPassiveCylinder(Scene* scene, double x, double y, double mass, double friction) {
@@ -312,43 +214,6 @@ TEST(Box2dBackend, SlidesAlongWallWhenDrivenDiagonally) {
   EXPECT_LT(run.max_x, 1.0 - 0.085 + 3e-3);
   EXPECT_NEAR(run.p.x, 1.0 - 0.085, 3e-3);
   EXPECT_GT(run.p.y, 0.6);  // free driving: 0.71; sticking: ~0.12
-}
-
-struct RunResult {
-  std::vector<Pose> poses;
-  uint64_t hash = 0;
-};
-
-RunResult RunBusyScene() {
-  Scene scene;
-  AddFloor(&scene);
-  AddWall(&scene, 1.05, 0, 0.1, 4);
-  AddWall(&scene, -1.05, 0, 0.1, 4);
-  std::vector<Robot> robots;
-  for (int i = 0; i < 6; ++i) {
-    std::string name = "r";  // (not "r" + ...: GCC 12 -Wrestrict false positive)
-    name += std::to_string(i);
-    robots.push_back(AddRobot(&scene, name, -0.6 + 0.25 * i, 0.1 * (i % 2), 0.7 * i));
-  }
-  AddPassiveCylinder(&scene, 0, 0.5, 0.5, 0.5);
-  auto backend = Build(scene);
-  for (size_t i = 0; i < robots.size(); ++i)
-    SetWheelSpeeds(&scene, robots[i], 0.1 + 0.02 * i, 0.15 - 0.01 * i);
-  Simulate(backend.get(), &scene, 10.0);
-  RunResult out;
-  for (uint32_t s = 0; s < scene.slot_count(); ++s) out.poses.push_back(scene.world_pose_at(s));
-  StateHasher hasher;
-  backend->HashState(&hasher);
-  out.hash = hasher.Digest();
-  return out;
-}
-
-TEST(Box2dBackend, IdenticalRunsAreBitIdentical) {
-  const RunResult a = RunBusyScene();
-  const RunResult b = RunBusyScene();
-  ASSERT_EQ(a.poses.size(), b.poses.size());
-  EXPECT_EQ(std::memcmp(a.poses.data(), b.poses.data(), a.poses.size() * sizeof(Pose)), 0);
-  EXPECT_EQ(a.hash, b.hash);
 }
 
 // Robots far apart never touch, so each must move exactly as it would alone:
@@ -483,29 +348,6 @@ TEST(Box2dBackend, TeleportedBodyIsWrittenAsIfBuiltThere) {
     const Pose a = moved.world_pose(robot.body), b = fresh.world_pose(same.body);
     EXPECT_EQ(std::memcmp(&a, &b, sizeof(Pose)), 0) << "yaw " << yaw;
   }
-}
-
-TEST(Box2dBackend, RebuildsWhenRobotsAreAdded) {
-  Scene scene;
-  Robot a = AddRobot(&scene, "a", 0, 0, 0);
-  auto backend = Build(scene);
-  SetWheelSpeeds(&scene, a, 0.05, 0.05);
-  Simulate(backend.get(), &scene, 1.0);
-  Robot b = AddRobot(&scene, "b", 0, 1, 0);
-  SetWheelSpeeds(&scene, b, 0.05, 0.05);
-  Simulate(backend.get(), &scene, 1.0);
-  EXPECT_EQ(backend->body_count(), 2);
-  EXPECT_NEAR(Position(scene, a.body).x, 0.1, 2e-3);
-  EXPECT_NEAR(Position(scene, b.body).x, 0.05, 2e-3);
-}
-
-TEST(Box2dBackend, BareLoopTimesStepping) {
-  Scene scene;
-  Robot robot = AddRobot(&scene, "r", 0, 0, 0);
-  SetWheelSpeeds(&scene, robot, 0.05, 0.05);
-  const Pose before = scene.world_pose(robot.body);
-  EXPECT_GE(TimeBareLoop(scene, kDt, kSubsteps, 5), 0.0);
-  EXPECT_EQ(scene.world_pose(robot.body), before);  // no write-back
 }
 
 }  // namespace

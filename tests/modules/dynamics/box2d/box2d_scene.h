@@ -8,7 +8,7 @@
 
 #include "framework/dynamics_backend.h"
 #include "framework/scene.h"
-#include "tests/modules/plane_robot.h"
+#include "tests/modules/dynamics/plane_robot.h"
 
 namespace swarmsim::box2d::scene_kit {
 
