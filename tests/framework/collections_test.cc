@@ -110,8 +110,7 @@ TEST(CollectionsTest, EntitiesAreKeywordsOrPaths) {
 TEST(CollectionsTest, AnEntityPathIsACollectionsObjectsOrAnObjectsTree) {
   Arena a({Item(CollectionItemKind::kObject, "/walls/north"),
            Item(CollectionItemKind::kObject, ":/body")});
-  EXPECT_EQ(EntitySlots(a.scene, "/bot#0/group", {}, "collision 'c'"),
-            a.Slots({a.north, a.body}));
+  EXPECT_EQ(EntitySlots(a.scene, "/bot#0/group", {}, "collision 'c'"), a.Slots({a.north, a.body}));
   EXPECT_EQ(EntitySlots(a.scene, "/bot#0/arm", {}, "collision 'c'"), a.Slots({a.arm, a.tip}));
   EXPECT_EQ(EntitySlots(a.scene, ":/arm", a.body, "collision 'c'"), a.Slots({a.arm, a.tip}));
   EXPECT_CONTAINS(ErrorOf([&] { EntitySlots(a.scene, "/bot#0/leg", {}, "collision 'c'"); }),

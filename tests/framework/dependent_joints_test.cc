@@ -75,7 +75,7 @@ TEST(DependentJointsTest, JointsAddedLaterAreFollowedToo) {
   const ObjectId m = scene.AddJoint("m", {}, {}, master);
   scene.MakeModelInstance(m, "arm", "arm#0");
   DependentJoints dependents;
-  EXPECT_FALSE(dependents.Apply(&scene, false));  // none yet
+  EXPECT_FALSE(dependents.Apply(&scene, false));                         // none yet
   const ObjectId f = scene.AddJoint("f", m, {}, Follower(":", 0.5, 0));  // its model's root
   EXPECT_TRUE(dependents.Apply(&scene, false));
   EXPECT_DOUBLE_EQ(scene.joint(f).position, 1);

@@ -38,8 +38,8 @@ class ScriptWorld {
     const ObjectId arm = scene().AddDummy("arm", root, {});
     scene().AddDummy("tip", arm, {});
     scene().MakeModelInstance(root, "bot", name);
-    scene().AttachScript(body, std::make_shared<const ScriptSource>(
-                                   ScriptSource{"scripts/robot.lua", code}));
+    scene().AttachScript(
+        body, std::make_shared<const ScriptSource>(ScriptSource{"scripts/robot.lua", code}));
     return root;
   }
   std::string Step() {
@@ -81,9 +81,9 @@ TEST(LuaApiCollectionsTest, AScriptBuildsACollectionItemByItem) {
   )");
   w.scene().AddDummy("post", {}, {});
   EXPECT_EQ(w.Step(), "");
-  const std::vector<std::string> expected = {
-      "[bot#0] -1000\t0", "[bot#0] bot#0 body arm tip", "[bot#0] bot#0 body tip",
-      "[bot#0] -1001\tpost", "[bot#0] arm tip"};
+  const std::vector<std::string> expected = {"[bot#0] -1000\t0", "[bot#0] bot#0 body arm tip",
+                                             "[bot#0] bot#0 body tip", "[bot#0] -1001\tpost",
+                                             "[bot#0] arm tip"};
   EXPECT_EQ(w.log, expected);
 }
 

@@ -54,8 +54,7 @@ TEST(LimitedLuaTest, PcallCannotCatchTheSpentBudget) {
   luaL_requiref(lua.L(), "_G", luaopen_base, 1);
   lua_pop(lua.L(), 1);
   std::string error;
-  EXPECT_FALSE(
-      Run(&lua, "pcall(function() while true do end end)\nreturn 'went on'", &error));
+  EXPECT_FALSE(Run(&lua, "pcall(function() while true do end end)\nreturn 'went on'", &error));
   EXPECT_CONTAINS(error, "the expression ran more than 100000 Lua instructions");
 }
 

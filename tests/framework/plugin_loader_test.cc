@@ -1,6 +1,8 @@
 // Loading plugins (framework/plugin_loader.cc): what a plugin registers
 // reaches the registry; clear errors for a missing file, a library that is
 // not a plugin, an ABI mismatch and a name registered twice.
+#include "framework/plugin_loader.h"
+
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -9,7 +11,6 @@
 #include <vector>
 
 #include "framework/error.h"
-#include "framework/plugin_loader.h"
 #include "framework/world.h"
 #include "tests/framework/error_of.h"
 #include "tests/framework/fakes.h"

@@ -1,6 +1,8 @@
 // The state hash (framework/state_hash.cc, World::StateHash): what `--hash`
 // prints and tests/data/golden_hashes.tsv compares, so a run can be checked
 // against another bit for bit.
+#include "framework/state_hash.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -12,7 +14,6 @@
 #include <vector>
 
 #include "framework/error.h"
-#include "framework/state_hash.h"
 #include "framework/world.h"
 #include "tests/framework/error_of.h"
 #include "tests/framework/fakes.h"

@@ -84,17 +84,23 @@ TEST(JointTypeTest, AScrewJointNeedsAFiniteNonzeroPitchAndOnlyItHasOne) {
   const JointData screw = Read(FakeReader{{"joint", std::string("screw")}, {"pitch", 0.01}});
   EXPECT_EQ(screw.type, JointType::kScrew);
   EXPECT_EQ(screw.pitch, 0.01);
-  EXPECT_EQ(ErrorOf([] { Read(FakeReader{{"joint", std::string("screw")}}); }),
+  EXPECT_EQ(ErrorOf([] {
+              Read(FakeReader{{"joint", std::string("screw")}});
+            }),
             "model.yaml:2:1: a screw joint needs 'pitch' (m of travel per rad, nonzero)");
-  EXPECT_EQ(ErrorOf([] { Read(FakeReader{{"joint", std::string("screw")}, {"pitch", 0.0}}); }),
+  EXPECT_EQ(ErrorOf([] {
+              Read(FakeReader{{"joint", std::string("screw")}, {"pitch", 0.0}});
+            }),
             "model.yaml:3:3: 'pitch' must be a finite, nonzero number of m per rad");
-  EXPECT_EQ(ErrorOf([] { Read(FakeReader{{"pitch", 0.01}}); }),
+  EXPECT_EQ(ErrorOf([] {
+              Read(FakeReader{{"pitch", 0.01}});
+            }),
             "model.yaml:2:1: 'pitch' is for screw joints (joint: screw)");
 }
 
 TEST(JointTypeTest, ADependentJointNamesItsMasterByPath) {
-  const JointData j = Read(FakeReader{
-      {"master", std::string(":/leftWheel")}, {"factor", -1.0}, {"offset", 0.25}});
+  const JointData j =
+      Read(FakeReader{{"master", std::string(":/leftWheel")}, {"factor", -1.0}, {"offset", 0.25}});
   ASSERT_NE(j.depends, nullptr);
   EXPECT_EQ(j.depends->master, ":/leftWheel");
   EXPECT_EQ(j.depends->factor, -1);
@@ -103,23 +109,31 @@ TEST(JointTypeTest, ADependentJointNamesItsMasterByPath) {
   const JointData plain = Read(FakeReader{{"master", std::string("/base/j")}});
   EXPECT_EQ(plain.depends->factor, 1);
   EXPECT_EQ(plain.depends->offset, 0);
-  EXPECT_EQ(ErrorOf([] { Read(FakeReader{{"master", std::string("leftWheel")}}); }),
+  EXPECT_EQ(ErrorOf([] {
+              Read(FakeReader{{"master", std::string("leftWheel")}});
+            }),
             "model.yaml:2:3: 'leftWheel' is not a joint path: start with '/' (absolute), ':' "
             "(this model) or './' (below this joint)");
   for (const char* key : {"factor", "offset"})
-    EXPECT_EQ(ErrorOf([&] { Read(FakeReader{{key, 2.0}}); }),
+    EXPECT_EQ(ErrorOf([&] {
+                Read(FakeReader{{key, 2.0}});
+              }),
               std::string("model.yaml:2:1: '") + key + "' is for dependent joints: add 'master'");
 }
 
 TEST(JointTypeTest, LimitsMustBeOrderedAndForcesPositive) {
-  EXPECT_EQ(ErrorOf([] { Read(FakeReader{{"limits", std::vector<double>{1, -1}}}); }),
+  EXPECT_EQ(ErrorOf([] {
+              Read(FakeReader{{"limits", std::vector<double>{1, -1}}});
+            }),
             "model.yaml:2:3: 'limits' must be [min, max] with min <= max");
   const JointData pinned = Read(FakeReader{{"limits", std::vector<double>{0.5, 0.5}}});
   EXPECT_EQ(pinned.min_position, 0.5);
   EXPECT_EQ(pinned.max_position, 0.5);
   EXPECT_CONTAINS(ErrorOf([] { Read(FakeReader{{"max_force", 0.0}}); }), "a positive number");
   EXPECT_CONTAINS(ErrorOf([] { Read(FakeReader{{"damping", -1.0}}); }), "a non-negative number");
-  EXPECT_CONTAINS(ErrorOf([] { Read(FakeReader{{"joint", std::string("hinge")}}); }),
+  EXPECT_CONTAINS(ErrorOf([] {
+                    Read(FakeReader{{"joint", std::string("hinge")}});
+                  }),
                   "not 'hinge'");
 }
 

@@ -82,13 +82,13 @@ TEST(ShapeTypeTest, AKeyOfAnotherKindIsRefusedAtThatKey) {
                               {"radius", 0.1}});
             }),
             "model.yaml:4:1: 'radius' does not apply to a box (a box takes 'size: [x, y, z]')");
-  EXPECT_EQ(ErrorOf([] {
-              Read(FakeReader{{"shape", std::string("sphere")},
-                              {"radius", 0.1},
-                              {"file", std::string("part.stl")}});
-            }),
-            "model.yaml:4:1: 'file' does not apply to a sphere (only a mesh takes 'file: "
-            "part.stl')");
+  EXPECT_EQ(
+      ErrorOf([] {
+        Read(FakeReader{
+            {"shape", std::string("sphere")}, {"radius", 0.1}, {"file", std::string("part.stl")}});
+      }),
+      "model.yaml:4:1: 'file' does not apply to a sphere (only a mesh takes 'file: "
+      "part.stl')");
   EXPECT_EQ(ErrorOf([] {
               Read(FakeReader{{"shape", std::string("cylinder")},
                               {"size", std::vector<double>{1, 1, 1}}});
@@ -101,18 +101,20 @@ TEST(ShapeTypeTest, AKeyOfAnotherKindIsRefusedAtThatKey) {
             "model.yaml:3:1: 'radius' does not apply to a mesh (a mesh takes 'file: "
             "part.stl|part.obj' and optionally 'scale: [sx, sy, sz]')");
   // A required size key missing, and no shape at all.
-  EXPECT_CONTAINS(ErrorOf([] { Read(FakeReader{{"shape", std::string("box")}}); }),
+  EXPECT_CONTAINS(ErrorOf([] {
+                    Read(FakeReader{{"shape", std::string("box")}});
+                  }),
                   "missing 'size'");
   EXPECT_CONTAINS(ErrorOf([] { Read(FakeReader{}); }), "missing 'shape'");
 }
 
 TEST(ShapeTypeTest, ACapsuleIsAtLeastTwoRadiiHigh) {
-  EXPECT_EQ(ErrorOf([] {
-              Read(FakeReader{
-                  {"shape", std::string("capsule")}, {"radius", 0.1}, {"height", 0.19}});
-            }),
-            "model.yaml:4:3: a capsule's height includes its caps: it must be at least twice "
-            "its radius");
+  EXPECT_EQ(
+      ErrorOf([] {
+        Read(FakeReader{{"shape", std::string("capsule")}, {"radius", 0.1}, {"height", 0.19}});
+      }),
+      "model.yaml:4:3: a capsule's height includes its caps: it must be at least twice "
+      "its radius");
 }
 
 TEST(ShapeTypeTest, InertiaMustBePositiveDefiniteAndObeyTheTriangleInequality) {
