@@ -40,25 +40,25 @@ class FakeReader : public ObjectReader {
   double Number(std::string_view key, const NumberRule& rule, bool required) const override {
     if (!Present(key, required)) return 0;
     const double* v = std::get_if<double>(&At(key));
-    if (v == nullptr) Fail(key, "'" + std::string(key) + "' must be " + rule.text);
+    if (v == nullptr) Raise(key, Must(key, rule.text), 3);
     CheckNumber(key, *v, rule);
     return *v;
   }
   int64_t Integer(std::string_view key, int64_t min, int64_t max) const override {
     const double v = Number(key, kAnyNumber, true);
     if (v != std::floor(v) || v < static_cast<double>(min) || v > static_cast<double>(max))
-      Fail(key, "'" + std::string(key) + "' must be a whole number in range");
+      Raise(key, Must(key, "a whole number in range"), 3);
     return static_cast<int64_t>(v);
   }
   bool Bool(std::string_view key) const override {
     const bool* v = std::get_if<bool>(&At(key));
-    if (v == nullptr) Fail(key, "'" + std::string(key) + "' must be true or false");
+    if (v == nullptr) Raise(key, Must(key, "true or false"), 3);
     return *v;
   }
   std::string String(std::string_view key, bool required) const override {
     if (!Present(key, required)) return "";
     const std::string* v = std::get_if<std::string>(&At(key));
-    if (v == nullptr) Fail(key, "'" + std::string(key) + "' must be a string");
+    if (v == nullptr) Raise(key, Must(key, "a string"), 3);
     return *v;
   }
   std::string Choice(std::string_view key, const std::vector<std::string>& choices,
@@ -66,13 +66,15 @@ class FakeReader : public ObjectReader {
     const std::string v = String(key, required);
     for (const std::string& c : choices)
       if (c == v) return v;
-    Fail(key, "'" + std::string(key) + "' must be one of the choices, not '" + v + "'");
+    std::string message = Must(key, "one of the choices, not '");
+    message.append(v).append("'");
+    Raise(key, message, 3);
   }
   std::vector<double> Numbers(std::string_view key, size_t min_count, size_t max_count,
                               const NumberRule& rule) const override {
     const auto* v = std::get_if<std::vector<double>>(&At(key));
     if (v == nullptr || v->size() < min_count || v->size() > max_count)
-      Fail(key, "'" + std::string(key) + "' must be a list of numbers of the right length");
+      Raise(key, Must(key, "a list of numbers of the right length"), 3);
     for (double x : *v) CheckNumber(key, x, rule);
     return *v;
   }
@@ -83,35 +85,31 @@ class FakeReader : public ObjectReader {
   }
   std::vector<Vec3> Vector3List(std::string_view key, size_t, const NumberRule&,
                                 bool) const override {
-    Fail(key, "FakeReader: no lists of vectors");
+    Raise(key, "FakeReader: no lists of vectors", 3);
   }
   [[noreturn]] void FailAtElement(std::string_view key, size_t index,
                                   const std::string& message) const override {
-    Fail(key, "[" + std::to_string(index) + "] " + message);
+    std::string text = "[";
+    text.append(std::to_string(index)).append("] ").append(message);
+    Raise(key, text, 3);
   }
   std::vector<std::string> Strings(std::string_view key, size_t max_count,
                                    bool required) const override {
     if (!Present(key, required)) return {};
     if (const auto* one = std::get_if<std::string>(&At(key))) return {*one};
     const auto* v = std::get_if<std::vector<std::string>>(&At(key));
-    if (v == nullptr || v->size() > max_count)
-      Fail(key, "'" + std::string(key) + "' must be a list of strings");
+    if (v == nullptr || v->size() > max_count) Raise(key, Must(key, "a list of strings"), 3);
     return *v;
   }
-  std::string Where(std::string_view key) const override {
-    const auto it = lines_.find(std::string(key));
-    return "model.yaml:" + std::to_string(it == lines_.end() ? 1 : it->second) + ":3";
-  }
+  std::string Where(std::string_view key) const override { return Position(key, 3); }
   [[noreturn]] void Fail(std::string_view key, const std::string& message) const override {
-    throw Error(Where(key) + ": " + message);
+    Raise(key, message, 3);
   }
   [[noreturn]] void FailAtKey(std::string_view key, const std::string& message) const override {
-    const auto it = lines_.find(std::string(key));
-    throw Error("model.yaml:" + std::to_string(it == lines_.end() ? 1 : it->second) +
-                ":1: " + message);
+    Raise(key, message, 1);
   }
   std::shared_ptr<const TriangleMesh> Mesh(std::string_view key, const Vec3&) const override {
-    Fail(key, "FakeReader: no meshes");
+    Raise(key, "FakeReader: no meshes", 3);
   }
   const ModuleRegistry* registry() const override { return registry_; }
   std::vector<std::unique_ptr<ObjectReader>> Items(std::string_view) const override { return {}; }
@@ -120,20 +118,39 @@ class FakeReader : public ObjectReader {
   void set_registry(const ModuleRegistry* registry) { registry_ = registry; }
 
  private:
+  // "model.yaml:<line>:<column>" of `key` (line 1 for an absent key).
+  std::string Position(std::string_view key, int column) const {
+    const auto it = lines_.find(std::string(key));
+    std::string where = "model.yaml:";
+    where.append(std::to_string(it == lines_.end() ? 1 : it->second)).append(":");
+    return where.append(std::to_string(column));
+  }
+  [[noreturn]] void Raise(std::string_view key, const std::string& message, int column) const {
+    throw Error(Position(key, column).append(": ").append(message));
+  }
+  // "'key' must be <what>".
+  static std::string Must(std::string_view key, const char* what) {
+    std::string message = "'";
+    message.append(key).append("' must be ").append(what);
+    return message;
+  }
   bool Present(std::string_view key, bool required) const {
     if (Has(key)) return true;
-    if (required) FailAtKey("", "missing '" + std::string(key) + "'");
+    if (required) Raise("", Missing(key), 1);
     return false;
   }
   const Value& At(std::string_view key) const {
     const auto it = values_.find(std::string(key));
-    if (it == values_.end()) FailAtKey("", "missing '" + std::string(key) + "'");
+    if (it == values_.end()) Raise("", Missing(key), 1);
     return it->second;
+  }
+  static std::string Missing(std::string_view key) {
+    std::string message = "missing '";
+    return message.append(key).append("'");
   }
   void CheckNumber(std::string_view key, double v, const NumberRule& rule) const {
     const bool low = rule.min_exclusive ? !(v > rule.min) : !(v >= rule.min);
-    if (!std::isfinite(v) || low || !(v <= rule.max))
-      Fail(key, "'" + std::string(key) + "' must be " + rule.text);
+    if (!std::isfinite(v) || low || !(v <= rule.max)) Raise(key, Must(key, rule.text), 3);
   }
 
   std::map<std::string, Value> values_;

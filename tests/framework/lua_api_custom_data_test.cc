@@ -90,5 +90,52 @@ TEST(ScriptControlTest, CustomDataIsSeenNextStepAndCopiedWithTheModel) {
   EXPECT_EQ(*w.scene().ReadCustomData(body0, "serial"), "A-17");
 }
 
+// Writes to one block in one step: the highest robot index wins, then the
+// scene's scripts, whatever the thread count.
+TEST(LuaApiCustomDataTest, OneBlockWrittenByManyInOneStepHasOneWinner) {
+  for (int threads : {1, 4}) {
+    for (bool with_scene : {false, true}) {
+      ScriptWorld w(threads);
+      const ObjectId board = w.scene().AddDummy("board", {}, {});
+      for (int r = 0; r < 6; ++r)
+        w.AddRobot("bot#" + std::to_string(r), R"(
+          function sysCall_actuation()
+            sim.writeCustomDataBlock(sim.getObject('/board'), 'owner', sim.getRobotName())
+          end
+        )");
+      if (with_scene)
+        w.scene().AttachScript(board, Source("scripts/board.lua", R"(
+          function sysCall_actuation() sim.writeCustomDataBlock(sim.getObject('.'), 'owner', 'scene') end
+        )"));
+      w.Steps(2);  // step 0's writes are applied when step 1 begins
+      const std::string* owner = w.scene().ReadCustomData(board, "owner");
+      ASSERT_NE(owner, nullptr);
+      EXPECT_EQ(*owner, with_scene ? "scene" : "bot#5") << threads << " threads";
+    }
+  }
+}
+
+TEST(LuaApiCustomDataTest, BlocksKeepEveryByteAndBadHandlesAreErrorsAtTheCall) {
+  ScriptWorld w;
+  w.AddRobot("bot#0", R"(
+    function sysCall_actuation()
+      if sim.getSimulationTime() == 0 then
+        sim.writeCustomDataBlock(sim.getObject('.'), 'raw', 'a\0b\255')
+      else
+        local data = sim.readCustomDataBlock(sim.getObject('.'), 'raw')
+        print(#data, data:byte(2), data:byte(4))
+        print(sim.readCustomDataBlock(sim.getObject('.'), 'other'))
+      end
+    end
+  )");
+  w.Steps(2);
+  EXPECT_EQ(w.log, (std::vector<std::string>{"[bot#0] 4\t0\t255", "[bot#0] nil"}));
+  ScriptWorld v;
+  v.AddRobot("bot#0",
+             "function sysCall_actuation()\n  sim.writeCustomDataBlock(987654, 't', 'x')\nend");
+  EXPECT_CONTAINS(ErrorOf([&] { v.Steps(1); }),
+                  "bot#0: scripts/robot.lua:2: sim.writeCustomDataBlock: object handle 987654");
+}
+
 }  // namespace
 }  // namespace swarmsim

@@ -18,7 +18,7 @@ constexpr int64_t kBudget = 100000;
 
 // Loads `code` as chunk "expr" and calls it for one result: true, or false
 // with the error in *error.
-bool Run(LimitedLua* lua, const std::string& code, std::string* error) {
+bool Evaluate(LimitedLua* lua, const std::string& code, std::string* error) {
   lua_State* L = lua->L();
   if (luaL_loadbuffer(L, code.data(), code.size(), "=expr") != LUA_OK) {
     *error = lua_tostring(L, -1);
@@ -31,18 +31,18 @@ bool Run(LimitedLua* lua, const std::string& code, std::string* error) {
 TEST(LimitedLuaTest, EvaluatesAnExpression) {
   LimitedLua lua("the expression", kMemoryLimit, kBudget);
   std::string error;
-  ASSERT_TRUE(Run(&lua, "return 2 * 21 + 0.5", &error)) << error;
+  ASSERT_TRUE(Evaluate(&lua, "return 2 * 21 + 0.5", &error)) << error;
   EXPECT_EQ(lua_tonumber(lua.L(), -1), 42.5);
   lua_pop(lua.L(), 1);
   // No library is open: the expression sees nothing it was not given.
-  ASSERT_TRUE(Run(&lua, "return os == nil and io == nil and print == nil", &error)) << error;
+  ASSERT_TRUE(Evaluate(&lua, "return os == nil and io == nil and print == nil", &error)) << error;
   EXPECT_TRUE(lua_toboolean(lua.L(), -1));
 }
 
 TEST(LimitedLuaTest, AnEndlessLoopIsAnErrorNamingTheSubjectAndTheLine) {
   LimitedLua lua("the expression", kMemoryLimit, kBudget);
   std::string error;
-  EXPECT_FALSE(Run(&lua, "local x = 1\nwhile true do x = x + 1 end", &error));
+  EXPECT_FALSE(Evaluate(&lua, "local x = 1\nwhile true do x = x + 1 end", &error));
   EXPECT_EQ(error,
             "expr:2: the expression ran more than 100000 Lua instructions without returning "
             "(an endless loop?)");
@@ -54,7 +54,7 @@ TEST(LimitedLuaTest, PcallCannotCatchTheSpentBudget) {
   luaL_requiref(lua.L(), "_G", luaopen_base, 1);
   lua_pop(lua.L(), 1);
   std::string error;
-  EXPECT_FALSE(Run(&lua, "pcall(function() while true do end end)\nreturn 'went on'", &error));
+  EXPECT_FALSE(Evaluate(&lua, "pcall(function() while true do end end)\nreturn 'went on'", &error));
   EXPECT_CONTAINS(error, "the expression ran more than 100000 Lua instructions");
 }
 
@@ -64,22 +64,22 @@ TEST(LimitedLuaTest, EachCallHasAFreshBudget) {
   std::string error;
   const std::string loop = "local n = 0\nfor i = 1, 30000 do n = n + i end\nreturn n";
   for (int call = 0; call < 5; ++call) {  // 5 x 30,000 turns: more than one budget in all
-    ASSERT_TRUE(Run(&lua, loop, &error)) << "call " << call << ": " << error;
+    ASSERT_TRUE(Evaluate(&lua, loop, &error)) << "call " << call << ": " << error;
     EXPECT_EQ(lua_tointeger(lua.L(), -1), 30000LL * 30001 / 2);
     lua_pop(lua.L(), 1);
   }
-  EXPECT_FALSE(Run(&lua, "while true do end", &error));
-  ASSERT_TRUE(Run(&lua, loop, &error)) << error;
+  EXPECT_FALSE(Evaluate(&lua, "while true do end", &error));
+  ASSERT_TRUE(Evaluate(&lua, loop, &error)) << error;
 }
 
 TEST(LimitedLuaTest, TooMuchMemoryIsAnErrorNamingTheLimit) {
   LimitedLua lua("the expression", kMemoryLimit, int64_t{1} << 40);
   std::string error;
-  EXPECT_FALSE(Run(&lua, "local t = {}\nfor i = 1, 1e8 do t[i] = i end\nreturn #t", &error));
+  EXPECT_FALSE(Evaluate(&lua, "local t = {}\nfor i = 1, 1e8 do t[i] = i end\nreturn #t", &error));
   EXPECT_CONTAINS(error, "the expression");
   EXPECT_CONTAINS(error, "4 MiB of Lua memory (the limit of one evaluation)");
   // The memory is given back: the next evaluation runs.
-  ASSERT_TRUE(Run(&lua, "local t = {}\nfor i = 1, 1000 do t[i] = i end\nreturn #t", &error))
+  ASSERT_TRUE(Evaluate(&lua, "local t = {}\nfor i = 1, 1000 do t[i] = i end\nreturn #t", &error))
       << error;
   EXPECT_EQ(lua_tointeger(lua.L(), -1), 1000);
 }
@@ -87,7 +87,7 @@ TEST(LimitedLuaTest, TooMuchMemoryIsAnErrorNamingTheLimit) {
 TEST(LimitedLuaTest, ARuntimeErrorKeepsLuasMessage) {
   LimitedLua lua("the expression", kMemoryLimit, kBudget);
   std::string error;
-  EXPECT_FALSE(Run(&lua, "local a\nreturn a + 1", &error));
+  EXPECT_FALSE(Evaluate(&lua, "local a\nreturn a + 1", &error));
   EXPECT_CONTAINS(error, "expr:2: attempt to perform arithmetic on a nil value");
 }
 

@@ -151,7 +151,7 @@ TEST(PluginControllersTest, DisableScriptStopsOnlyTheFailingController) {
   EXPECT_EQ(script.calls, expected);
   ASSERT_EQ(w.log.size(), 1u);
   EXPECT_EQ(w.log[0],
-            "[bot#0] error, native controller disabled: bot#0: native controller 'counter' "
+            "error, native controller disabled: bot#0: native controller 'counter' "
             "(plugins/test.so), in step: lost at step 0");
 }
 

@@ -65,9 +65,11 @@ TEST(PluginObjectTypeTest, ValuesAreReadCheckedScaledCopiedAndHashed) {
   const std::vector<double>* values = PluginObjectValues(scene, b);
   ASSERT_NE(values, nullptr);
   EXPECT_EQ(*values, (std::vector<double>{0.5, 2.5}));
-  // A value outside the range names it.
+  // A value outside the range names it (a failed read fails the whole load:
+  // the row it was reading is not used).
+  const ObjectId rejected = scene.AddObject(type, "rejected", {}, {}, nullptr);
   EXPECT_EQ(ErrorOf([&] {
-              beacon->read(*beacon, FakeReader{{"radius", 200.0}}, scene.row_data(b));
+              beacon->read(*beacon, FakeReader{{"radius", 200.0}}, scene.row_data(rejected));
             }),
             "model.yaml:2:3: 'radius' must be a number from 0.01 to 100");
   // Scaling: the radius is a length (power 1), the strength is not.

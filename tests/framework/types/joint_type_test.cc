@@ -38,9 +38,13 @@ TEST(JointTypeTest, WithoutKeysAJointIsAVelocityDrivenRevoluteJoint) {
   // The documented defaults are those values.
   for (const ObjectKey& key : kJointType.keys) {
     const std::string name = key.name;
-    if (name == "joint") EXPECT_STREQ(key.default_text, "revolute");
-    if (name == "mode") EXPECT_STREQ(key.default_text, "velocity");
-    if (name == "max_force" || name == "max_velocity") EXPECT_STREQ(key.default_text, "10");
+    if (name == "joint") {
+      EXPECT_STREQ(key.default_text, "revolute");
+    } else if (name == "mode") {
+      EXPECT_STREQ(key.default_text, "velocity");
+    } else if (name == "max_force" || name == "max_velocity") {
+      EXPECT_STREQ(key.default_text, "10");
+    }
   }
 }
 

@@ -43,7 +43,8 @@ TEST(PluginSensorTypeTest, TheSensorKeyNamesARegisteredType) {
 
 TEST(PluginSensorTypeTest, WithoutAPluginsSensorTypesTheMessageSaysSo) {
   ModuleRegistry empty;
-  for (const ModuleRegistry* registry : {&empty, static_cast<const ModuleRegistry*>(nullptr)})
+  for (const ModuleRegistry* registry :
+       std::initializer_list<const ModuleRegistry*>{&empty, nullptr})
     EXPECT_EQ(ErrorOf([&] { ReadSensor(registry, "light"); }),
               "model.yaml:2:3: unknown plugin sensor type 'light': no loaded plugin registers "
               "sensor types (plugins: [...])");
