@@ -63,24 +63,6 @@ TEST(ObjectTypesTest, WorldsReadmeDocumentsEveryKeyOfEveryType) {
   }
 }
 
-// A module's or plugin's type cannot take a name that is already a type:
-// the model files would silently build the other one.
-TEST(ObjectTypesTest, ARegisteredTypeCannotShadowABuiltInOrLoaderType) {
-  ModuleRegistry registry;
-  const auto type = [](const char* name) {
-    auto d = std::make_shared<ObjectTypeDescriptor>();
-    d->name = name;
-    d->description = "test";
-    return std::shared_ptr<const ObjectTypeDescriptor>(d);
-  };
-  for (const char* taken : {"shape", "proximity_ring", "plugin_sensor"})
-    EXPECT_THROW(registry.RegisterObjectType(type(taken)), Error) << taken;
-  registry.RegisterObjectType(type("beacon"));
-  EXPECT_THROW(registry.RegisterObjectType(type("beacon")), Error);
-  ASSERT_EQ(registry.object_types().size(), 1u);
-  EXPECT_STREQ(registry.object_types()[0]->name, "beacon");
-}
-
 // Copying, scaling and removing go through each type's hooks: a scaled
 // joint's limits scale with it, and removing swaps the last row into the
 // hole (a force sensor's copy: tests/modules/force_sensor/force_sensor_type_test.cc).

@@ -1,6 +1,6 @@
-// Plugins: the example plugin's commands called from Lua through the
-// registry; clear errors for a missing file, a library that is not a
-// plugin, and an ABI mismatch.
+// Plugin script commands as sim.* functions (framework/lua_api_plugins.cc):
+// the example plugin's commands called from Lua with numbers, arrays and
+// the calling robot's context; whole numbers come back as Lua integers.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -77,42 +77,6 @@ end)",
                                  &log);
   world->Start();
   EXPECT_EQ(log, std::vector<std::string>{"[bot#0] 3\tinteger\t1.5\t-4\trobot3"});
-}
-
-TEST(PluginTest, LoadErrorsNameThePathAndTheProblem) {
-  ModuleRegistry registry;
-  EXPECT_CONTAINS(ErrorOf([&] { LoadPlugin("/nonexistent/p.so", &registry); }),
-                  "cannot load plugin '/nonexistent/p.so': ");
-  EXPECT_CONTAINS(ErrorOf([&] { LoadPlugin(PluginPath("wrong_abi_plugin.so"), &registry); }),
-                  "was built for plugin ABI version 7, this swarmsim has version 6");
-  EXPECT_CONTAINS(ErrorOf([&] { LoadPlugin(PluginPath("old_abi_plugin.so"), &registry); }),
-                  "was built for plugin ABI version 3, this swarmsim has version 6; rebuild it");
-  EXPECT_CONTAINS(ErrorOf([&] { LoadPlugin("libm.so.6", &registry); }), "cannot load plugin");
-  LoadPlugin(PluginPath("example_plugin.so"), &registry);
-  EXPECT_CONTAINS(ErrorOf([&] { LoadPlugin(PluginPath("example_plugin.so"), &registry); }),
-                  "script command 'exampleSum' is registered twice");
-}
-
-TEST(PluginTest, PhaseCallbacksRunAtTheirPointsOfTheStep) {
-  ModuleRegistry registry = testing::NullRegistry();
-  LoadPlugin(PluginPath("example_plugin.so"), &registry);
-  EXPECT_EQ(registry.phase_callbacks().size(), 7u);  // Steer + 5 counters + beacon coverage
-  std::vector<std::string> log;
-  const auto world = OneBotWorld(registry, R"(
-function sysCall_actuation()
-  print(table.concat(sim.examplePhaseCounts(), ' '))
-end)",
-                                 &log);
-  for (int i = 0; i < 3; ++i) world->Step();
-  // In step k (from 0) the script runs after sense and before-control of
-  // step k, after control, physics and record of steps 0..k-1.
-  const std::vector<std::string> expected = {
-      "[bot#0] 1.0 1.0 0.0 0.0 0.0", "[bot#0] 2.0 2.0 1.0 1.0 1.0", "[bot#0] 3.0 3.0 2.0 2.0 2.0"};
-  EXPECT_EQ(log, expected);
-  // A robot without motors cannot use robotMoveAndAvoidObstacles.
-  const auto other = OneBotWorld(registry, "sim.robotMoveAndAvoidObstacles(1)", &log);
-  EXPECT_CONTAINS(ErrorOf([&] { other->Start(); }),
-                  "sim.robotMoveAndAvoidObstacles: the robot has no :/leftMotor and :/rightMotor");
 }
 
 }  // namespace

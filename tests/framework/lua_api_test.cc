@@ -1,6 +1,8 @@
 // A module's own object type brings its Lua API area with it: a world whose
 // registry holds the type has its sim.* functions, one without does not
 // (lua_api.cc, PushRegisteredTypeFunction).
+#include "framework/lua_api.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -8,7 +10,6 @@
 #include <string>
 #include <vector>
 
-#include "framework/lua_api.h"
 #include "framework/object_type.h"
 #include "framework/registry.h"
 #include "framework/world.h"
