@@ -94,10 +94,11 @@ TEST(EnvironmentWorldTest, EnvironmentValuesSayWhatTheyExpectAtTheirKey) {
   };
   EXPECT_CONTAINS(error("maps/x.bt"),
                   "world.yaml:1:14: 'environment' must be a mapping such as "
-                  "{octomap: maps/building.bt} (got 'maps/x.bt')");
+                  "{octomap: maps/building.bt} (got \"maps/x.bt\")");
   EXPECT_CONTAINS(error("{octomap: ''}"), "'octomap' must be the path of a .bt or .ot file");
-  EXPECT_CONTAINS(error("{octomap: x.bt, occupancy_threshold: 1}"),
-                  "a probability between 0 and 1 (exclusive)");
+  EXPECT_CONTAINS(error("{octomap: x.bt, occupancy_threshold: 0}"),
+                  "world.yaml:1:51: 'occupancy_threshold' must be a probability between 0 and 1 "
+                  "(exclusive) (got \"0\")");
   EXPECT_CONTAINS(error("{octomap: x.bt, max_memory_mb: 0}"), "a positive number of MiB");
   EXPECT_CONTAINS(error("{octomap: x.bt, offset: [0, 0]}"), "offset");
   // Every value is checked before the map is read: a missing map comes last.

@@ -127,7 +127,7 @@ TEST(ValuesTest, ParametersBeingReadCanUseOnlyThoseAboveThem) {
   EXPECT_EQ((Scope{&none, nullptr, &reading}).ListHint(),
             " (no parameters are defined above this one)");
   EXPECT_EQ((Scope{&above, nullptr, nullptr}).NotYetDefined("c"), "") << "not while reading";
-  const Read r("b: = c * 2\n");
+  Read r("b: = c * 2\n");
   const ValueReader values(r.file, &r.expressions, scope);
   EXPECT_EQ(ErrorOf([&] { values.Resolve(r["b"]); }),
             r.Where("b") +

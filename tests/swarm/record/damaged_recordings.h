@@ -3,6 +3,8 @@
 // changed and put together again, and what reading them says.
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include <cstring>
 #include <filesystem>
 #include <fstream>

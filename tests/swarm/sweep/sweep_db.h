@@ -15,6 +15,10 @@ namespace swarmsim::sweep_testing {
 
 namespace fs = std::filesystem;
 
+// A few bots, a Lua error or busy work on request (its parameters fail_at, spin).
+inline const std::string kWorld = std::string(SWARMSIM_SOURCE_DIR) + "/tests/data/sweep/sweep.yaml";
+
+// An empty folder of this process's own, `name` in its name.
 inline fs::path TempDir(const std::string& name) {
   const fs::path dir =
       fs::temp_directory_path() / ("swarmsim_sweep_" + name + "_" + std::to_string(getpid()));

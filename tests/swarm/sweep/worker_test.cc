@@ -148,7 +148,9 @@ TEST(WorkerTest, ATornLastMetricsRowIsLeftOut) {
     const RunOutcome o = CollectRun(1, dir, SIGKILL, true, 1.5);
     EXPECT_EQ(o.final_metrics.size(), 1u) << torn;
     EXPECT_EQ(o.final_metrics.count("x"), 1u) << torn;
-    if (o.final_metrics.count("x")) EXPECT_EQ(o.final_metrics.at("x"), 2) << torn;
+    if (o.final_metrics.count("x")) {
+      EXPECT_EQ(o.final_metrics.at("x"), 2) << torn;
+    }
     EXPECT_EQ(o.series.size(), 2u) << torn;
     fs::remove_all(dir);
   }
