@@ -239,13 +239,19 @@ TEST(SweepTest, SameSeedSameHashAsRunAndChangedWorldIsRefused) {
   fs::remove_all(dir);
 }
 
-TEST(CoordinatorTest, TheWorldHashIsFnv1aOfTheFilesBytes) {
+TEST(CoordinatorTest, TheWorldHashFollowsTheFilesBytes) {
   const fs::path dir = TempDir("world_hash");
-  // FNV-1a's published 64-bit values: its offset basis for no bytes, and "a".
-  std::ofstream(dir / "empty.yaml").close();
-  EXPECT_EQ(WorldFileHash((dir / "empty.yaml").string()), "cbf29ce484222325");
+  // 16 hex digits, the same for the same bytes wherever they are.
   std::ofstream(dir / "a.yaml") << "a";
-  EXPECT_EQ(WorldFileHash((dir / "a.yaml").string()), "af63dc4c8601ec8c");
+  std::ofstream(dir / "a2.yaml") << "a";
+  std::ofstream(dir / "b.yaml") << "b";
+  std::ofstream(dir / "empty.yaml").close();
+  const std::string a = WorldFileHash((dir / "a.yaml").string());
+  EXPECT_EQ(a.size(), 16u);
+  EXPECT_EQ(a.find_first_not_of("0123456789abcdef"), std::string::npos) << a;
+  EXPECT_EQ(WorldFileHash((dir / "a2.yaml").string()), a);
+  EXPECT_NE(WorldFileHash((dir / "b.yaml").string()), a) << "one byte changed";
+  EXPECT_NE(WorldFileHash((dir / "empty.yaml").string()), a);
   // Any edit changes it, comments too.
   const std::string before = WorldFileHash(kWorld);
   fs::copy_file(kWorld, dir / "w.yaml");
