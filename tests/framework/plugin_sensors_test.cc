@@ -173,7 +173,7 @@ TEST(PluginSensorsTest, TypesNeedANameAFunctionAndRoomAndComeOnce) {
   ASSERT_EQ(registry.module_descriptors().size(), 1u);
   const ModuleDescriptor* module = registry.FindModule("plugin_sensors");
   ASSERT_NE(module, nullptr);
-  EXPECT_EQ(module->phases, PhaseBit(ModulePhase::kSense));
+  EXPECT_EQ(module->phases, PhaseBit(Phase::kSense));
   EXPECT_EQ(module->order, 200);
   EXPECT_TRUE(module->every_world);
 }

@@ -80,7 +80,7 @@ TEST(RegistryTest, ScriptCommandNamesAreLuaIdentifiersRegisteredOnce) {
 // the registry gives it whatever the caller wrote.
 TEST(RegistryTest, ModulesAreListedInRegistrationOrderWithTheirKind) {
   ModuleRegistry registry;
-  registry.RegisterDynamics({"ignored", "null", "1", "moves nothing"},
+  registry.RegisterDynamics({"ignored", "null", "1", "moves nothing"}, {.substeps = false},
                             [] { return std::make_unique<testing::NullDynamics>(); });
   registry.RegisterCalculation({"ignored", "solver", "2.1", "solves"}, [] { return nullptr; });
   registry.RegisterModule(Descriptor("metrics", "metric"));
@@ -93,7 +93,7 @@ TEST(RegistryTest, ModulesAreListedInRegistrationOrderWithTheirKind) {
   // A calculation module runs in the actuate phase at order 100.
   const ModuleDescriptor* solver = registry.FindModule("solver");
   ASSERT_NE(solver, nullptr);
-  EXPECT_EQ(solver->phases, PhaseBit(ModulePhase::kActuate));
+  EXPECT_EQ(solver->phases, PhaseBit(Phase::kActuate));
   EXPECT_EQ(solver->order, 100);
   EXPECT_FALSE(solver->every_world);
   ASSERT_EQ(registry.ModulesOfKind("metric").size(), 1u);
@@ -120,7 +120,7 @@ TEST(RegistryTest, AModuleNeedsANameAndAFactoryAndComesOnce) {
 // A world's `physics:` names a backend: a wrong one lists those there are.
 TEST(RegistryTest, UnknownPhysicsNamesTheAvailableBackends) {
   ModuleRegistry registry = testing::NullRegistry();
-  registry.RegisterDynamics({"", "other", "1", ""},
+  registry.RegisterDynamics({"", "other", "1", ""}, {},
                             [] { return std::make_unique<testing::NullDynamics>(); });
   EXPECT_NE(registry.MakeDynamics("other"), nullptr);
   EXPECT_TRUE(registry.HasDynamics("null"));
@@ -133,10 +133,26 @@ TEST(RegistryTest, UnknownPhysicsNamesTheAvailableBackends) {
   // A backend registered without a bare loop has no "<physics>-only" row.
   EXPECT_EQ(registry.FindBareLoop("null"), nullptr);
   registry.RegisterDynamics(
-      {"", "timed", "1", ""}, [] { return std::make_unique<testing::NullDynamics>(); },
+      {"", "timed", "1", ""}, {}, [] { return std::make_unique<testing::NullDynamics>(); },
       [](const Scene&, double, int, int steps, double) { return 0.5 * steps; });
   ASSERT_NE(registry.FindBareLoop("timed"), nullptr);
   EXPECT_EQ((*registry.FindBareLoop("timed"))(Scene(), 0.01, 1, 4, -9.81), 2.0);
+}
+
+// What a backend declares is what callers get (Python's World.planar, the
+// summary's physics line), never a guess from its name.
+TEST(RegistryTest, DynamicsCapabilitiesAreWhatTheBackendDeclared) {
+  ModuleRegistry registry;
+  registry.RegisterDynamics({"", "flat", "1", ""}, {.planar = true},
+                            [] { return std::make_unique<testing::NullDynamics>(); });
+  registry.RegisterDynamics({"", "box2d", "1", ""}, {.planar = false, .substeps = false},
+                            [] { return std::make_unique<testing::NullDynamics>(); });
+  EXPECT_TRUE(registry.dynamics_capabilities("flat").planar);
+  EXPECT_TRUE(registry.dynamics_capabilities("flat").substeps);
+  EXPECT_FALSE(registry.dynamics_capabilities("box2d").planar);  // the name says nothing
+  EXPECT_FALSE(registry.dynamics_capabilities("box2d").substeps);
+  EXPECT_EQ(ErrorOf([&] { registry.dynamics_capabilities("ode"); }),
+            "unknown physics backend 'ode' (available: flat, box2d)");
 }
 
 TEST(RegistryTest, PhaseCallbacksNeedAKnownPhaseAndAFunction) {

@@ -1,4 +1,5 @@
-"""swarmsim's Python binding: loading, stepping, arrays, errors (README.md, "Python")."""
+"""swarmsim's Python binding (swarm/python/module.cc): loading, stepping, arrays, errors
+(README.md, "Python")."""
 
 import math
 import os

@@ -1,6 +1,9 @@
-// A recorded run reads back as the run was: every recorded object's pose,
-// LED colours, the paint layer and the metric samples, step by step, also
-// through robots copied and removed at run time and from a keyframe.
+// Recording a run (swarm/record/writer.cc): a recorded run reads back as the
+// run was: every recorded object's pose, LED colours, the paint layer and the
+// metric samples, step by step, also through robots copied and removed at run
+// time and from a keyframe.
+#include "swarm/record/writer.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -18,7 +21,6 @@
 #include "swarm/loader/world_loader.h"
 #include "swarm/record/format.h"
 #include "swarm/record/reader.h"
-#include "swarm/record/writer.h"
 
 namespace swarmsim::record {
 namespace {
@@ -306,93 +308,6 @@ TEST(RecordingTest, RobotsCopiedAndRemovedAtRunTimeGetANewScene) {
   }
   EXPECT_EQ(player.step(), 30);
   fs::remove_all(out);
-}
-
-// --- Bad files ----------------------------------------------------------------------
-
-std::string Data(const std::string& name) {
-  return std::string(SWARMSIM_SOURCE_DIR) + "/tests/data/recordings/" + name;
-}
-
-std::string ErrorOf(const fs::path& path) {
-  try {
-    ScanRecording(path);
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
-
-TEST(RecordingReaderTest, AFolderWithoutARecordingSaysHowToMakeOne) {
-  const fs::path dir = TempDir("empty");
-  EXPECT_EQ(ErrorOf(dir), dir.string() +
-                              " has no recording.swrec: record a run with swarmsim run WORLD "
-                              "--out " +
-                              dir.string() + " --record");
-  fs::remove_all(dir);
-}
-
-TEST(RecordingReaderTest, ATruncatedFileReadsItsWholeStepsAndSaysSo) {
-  const RecordingInfo info = ScanRecording(Data("truncated"));
-  EXPECT_TRUE(info.truncated);
-  EXPECT_FALSE(info.ended);
-  EXPECT_EQ(info.step_records, 30);
-  EXPECT_NE(info.Describe().find("ends inside a chunk at byte " + std::to_string(info.valid_size)),
-            std::string::npos)
-      << info.Describe();
-  RecordingPlayer player(Data("truncated"));
-  int n = 0;
-  while (player.Next()) ++n;
-  EXPECT_EQ(n, 30);
-  EXPECT_EQ(player.step(), 29);
-  // Cut anywhere: never an error, always the whole records before the cut.
-  const std::string bytes = [] {
-    std::ifstream in(Data("diffusion") + "/recording.swrec", std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(in), {});
-  }();
-  const fs::path dir = TempDir("cut");
-  int64_t last = -1;
-  // Inside the header chunk: not yet a recording (a run that just started).
-  const size_t header_end = ScanRecording(Data("diffusion")).chunks[1].offset;
-  std::ofstream(dir / "recording.swrec", std::ios::binary) << bytes.substr(0, header_end - 1);
-  EXPECT_NE(ErrorOf(dir).find("holds no whole chunk yet"), std::string::npos) << ErrorOf(dir);
-  for (size_t size = header_end; size < bytes.size(); size += 97) {
-    std::ofstream(dir / "recording.swrec", std::ios::binary) << bytes.substr(0, size);
-    const RecordingInfo cut = ScanRecording(dir);
-    EXPECT_GE(cut.step_records, last);
-    last = cut.step_records;
-    EXPECT_LE(cut.valid_size, size);
-  }
-  EXPECT_GE(last, 30);
-  std::ofstream(dir / "recording.swrec", std::ios::binary) << bytes;
-  EXPECT_EQ(ScanRecording(dir).step_records, 31);
-  fs::remove_all(dir);
-}
-
-TEST(RecordingReaderTest, ACorruptChunkIsNamedWithItsOffset) {
-  const std::string error = ErrorOf(Data("corrupt"));
-  EXPECT_NE(error.find("is corrupt: chunk 11 at byte "), std::string::npos) << error;
-  EXPECT_NE(error.find("checksum mismatch"), std::string::npos) << error;
-  // Not a recording at all.
-  const fs::path dir = TempDir("notone");
-  std::ofstream(dir / "recording.swrec") << "hello, this is text and no recording at all\n";
-  EXPECT_NE(ErrorOf(dir).find("is not a swarmsim recording"), std::string::npos) << ErrorOf(dir);
-  fs::remove_all(dir);
-}
-
-TEST(RecordingReaderTest, ANewerMajorVersionIsRefusedNamingBoth) {
-  EXPECT_NE(ErrorOf(Data("newer_version"))
-                .find("is a recording of format version 2.0, newer than this swarmsim reads (1.0)"),
-            std::string::npos)
-      << ErrorOf(Data("newer_version"));
-  // A newer minor version reads.
-  const fs::path dir = TempDir("minor");
-  std::ofstream(dir / "recording.swrec", std::ios::binary)
-      << EncodeChunk(1, 0, R"({"format": "swarmsim-recording", "version": [1, 7], "metrics": []})");
-  const RecordingInfo info = ScanRecording(dir);
-  EXPECT_EQ(info.version_minor, 7);
-  EXPECT_EQ(info.step_records, 0);
-  fs::remove_all(dir);
 }
 
 }  // namespace

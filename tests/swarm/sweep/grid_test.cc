@@ -1,16 +1,29 @@
-// Sweep grids (parameter specs, seeds, cartesian product) and the report's
-// statistics (Student t, mean, sd, 95% CI) against known values.
+// Sweep grids (swarm/sweep/grid.cc): parameter specs, seeds and their
+// cartesian product, and malformed seeds named by the program.
+#include "swarm/sweep/grid.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <set>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "framework/error.h"
-#include "swarm/sweep/grid.h"
-#include "swarm/sweep/stats.h"
+#include "tests/swarm/run_program.h"
+#include "tests/swarm/sweep/sweep_db.h"
 
 namespace swarmsim {
 namespace {
+
+namespace fs = std::filesystem;
+
+using Result = swarmsim::testing::CommandResult;
+using swarmsim::testing::RunProgram;
+using sweep_testing::kWorld;
+using sweep_testing::TempDir;
 
 using Values = std::vector<std::string>;
 
@@ -74,37 +87,29 @@ TEST(SweepGridTest, CartesianProductTimesSeedsLastParameterFastest) {
   EXPECT_THROW(ExpandGrid({ParseParamSpec("a=1"), ParseParamSpec("a=2")}, {1}), Error);
 }
 
-TEST(StatsTest, StudentTAgainstKnownValues) {
-  // Tabulated and interpolated entries against t(0.975, df) from mpmath.
-  EXPECT_NEAR(StudentT975(1), 12.7062047, 1e-6);
-  EXPECT_NEAR(StudentT975(2), 4.3026527, 1e-6);
-  EXPECT_NEAR(StudentT975(4), 2.7764451, 1e-6);
-  EXPECT_NEAR(StudentT975(10), 2.2281389, 1e-6);
-  EXPECT_NEAR(StudentT975(19), 2.0930241, 1e-6);
-  EXPECT_NEAR(StudentT975(30), 2.0422725, 1e-6);
-  EXPECT_NEAR(StudentT975(33), 2.0345153, 2e-4);  // interpolated
-  EXPECT_NEAR(StudentT975(75), 1.9921022, 2e-4);
-  EXPECT_NEAR(StudentT975(250), 1.9694984, 2e-4);
-  EXPECT_NEAR(StudentT975(2000), 1.9611508, 2e-4);
-  EXPECT_NEAR(StudentT975(100000), 1.9599877, 2e-4);
-  for (int64_t df = 1; df < 3000; ++df) EXPECT_GT(StudentT975(df), StudentT975(df + 1)) << df;
-}
-
-TEST(StatsTest, MeanSdAndConfidenceInterval) {
-  const Summary s = Summarize({1, 2, 3, 4, 5});
-  EXPECT_EQ(s.n, 5);
-  EXPECT_DOUBLE_EQ(s.mean, 3.0);
-  EXPECT_NEAR(s.sd, 1.5811388301, 1e-9);  // sample sd, n - 1
-  // 3 -/+ t(0.975, 4) * sd / sqrt(5) = 3 -/+ 1.9632432
-  EXPECT_NEAR(s.ci_low, 1.0367568, 1e-6);
-  EXPECT_NEAR(s.ci_high, 4.9632432, 1e-6);
-  const Summary two = Summarize({10, 12});
-  EXPECT_NEAR(two.ci_high - two.mean, 12.7062047 * std::sqrt(2.0) / std::sqrt(2.0), 1e-6);
-  const Summary one = Summarize({4});
-  EXPECT_EQ(one.mean, 4);
-  EXPECT_TRUE(std::isnan(one.sd));
-  EXPECT_TRUE(std::isnan(one.ci_low));
-  EXPECT_TRUE(std::isnan(Summarize({}).mean));
+TEST(SweepTest, MalformedSeedsAreClearErrorsNamingTheOptionAndTheValue) {
+  const fs::path dir = TempDir("seeds");
+  const fs::path db = dir / "r.db";
+  // --seeds SPEC -> what the message must say after "error: --seeds SPEC: ".
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"18446744073709551616",
+       "the number of seeds K must be 1 to 10^6, got '18446744073709551616'"},
+      {"1-18446744073709551616",
+       "'18446744073709551616' is not a seed (a whole number from 0 to 18446744073709551615)"},
+      {"5-3", "a seed range A-B needs A <= B (got 5 > 3)"},
+      {"1,,2", "empty seed in the list"},
+      {"-1", "'-1' is not a seed (a whole number from 0 to 18446744073709551615)"},
+      {"1.5", "expected K (seeds 1..K), a range A-B or a list A,B,C, got '1.5'"},
+  };
+  for (const auto& [spec, message] : cases) {
+    Result r = RunProgram("sweep " + kWorld + " --seeds " + spec + " --steps 1 --quiet --db " +
+                          db.string());
+    EXPECT_EQ(r.exit_code, 2) << spec << ": " << r.output;
+    EXPECT_NE(r.output.find("error: --seeds " + spec + ": " + message), std::string::npos)
+        << r.output;
+    EXPECT_FALSE(fs::exists(db)) << spec;
+  }
+  fs::remove_all(dir);
 }
 
 }  // namespace
