@@ -158,15 +158,17 @@ TEST(RegistryTest, DynamicsCapabilitiesAreWhatTheBackendDeclared) {
 TEST(RegistryTest, PhaseCallbacksNeedAKnownPhaseAndAFunction) {
   ModuleRegistry registry;
   const SwarmsimPhaseCallback fn = NoCallback;
-  for (int phase : {-1, static_cast<int>(kSwarmsimPhaseCount)})
+  for (Phase phase : {Phase::kCount, static_cast<Phase>(200)})
     EXPECT_EQ(ErrorOf([&] {
-                registry.RegisterPhaseCallback({"", "p", "1", ""}, {"p:bad", phase, false, fn});
+                registry.RegisterPhaseCallback({"", "p", "1", ""},
+                                               {"p:bad", phase, PhaseEdge::kEnd, false, fn});
               }),
               "phase callback 'p:bad' has an unknown phase or no function");
-  EXPECT_THROW(registry.RegisterPhaseCallback({"", "p", "1", ""},
-                                              {"p:none", kSwarmsimRecord, false, nullptr}),
+  EXPECT_THROW(registry.RegisterPhaseCallback(
+                   {"", "p", "1", ""}, {"p:none", Phase::kRecord, PhaseEdge::kEnd, false, nullptr}),
                Error);
-  registry.RegisterPhaseCallback({"", "p", "1", ""}, {"p:record", kSwarmsimRecord, true, fn});
+  registry.RegisterPhaseCallback({"", "p", "1", ""},
+                                 {"p:record", Phase::kRecord, PhaseEdge::kEnd, true, fn});
   ASSERT_EQ(registry.phase_callbacks().size(), 1u);
   EXPECT_TRUE(registry.phase_callbacks()[0].per_robot);
   EXPECT_EQ(registry.modules().at(0).kind, "callback");

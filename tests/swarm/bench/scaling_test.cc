@@ -51,7 +51,9 @@ TEST(ScalingTest, SpeedUpsAreOverTheFirstThreadAndTheFirstJob) {
   const int code = RunScalingBench(o, out, err);
   const bool gnuplot = testing::RunCommand("command -v gnuplot").exit_code == 0;
   EXPECT_EQ(code, gnuplot ? 0 : 1) << err.str();
-  if (!gnuplot) EXPECT_NE(err.str().find("bench: gnuplot failed or is missing"), std::string::npos);
+  if (!gnuplot) {
+    EXPECT_NE(err.str().find("bench: gnuplot failed or is missing"), std::string::npos);
+  }
   EXPECT_EQ(fs::exists(o.plot), gnuplot);
   std::ifstream csv(o.csv);
   std::vector<std::vector<std::string>> rows;
