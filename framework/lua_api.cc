@@ -356,8 +356,8 @@ void RegisterAreas(lua_State* L) {
   lua_pushinteger(L, kHandleWorld);
   lua_setfield(L, -2, "handle_world");
   for (auto area : kAreas) area(L);
-  // Each built-in object type's own area (joints, proximity, force sensors,
-  // paint nozzles, plugin sensors: framework/types/, object_type.h); the
+  // Each built-in object type's own area (joints, force sensors, paint
+  // nozzles, plugin sensors: framework/types/, object_type.h); the
   // types of a world's registry add theirs on first use
   // (PushRegisteredTypeFunction).
   for (const ObjectTypeDescriptor* type : CoreObjectTypes())

@@ -13,18 +13,18 @@
 namespace swarmsim {
 
 // The built-in object types; types registered by modules and plugins
-// (Scene::RegisterType) take the values after kCollection.
+// (Scene::RegisterType) take the values after kCollection (a module finds
+// its own by name: Scene::FindType).
 enum class ObjectType : uint8_t {
   kDummy,
   kShape,
   kJoint,
-  kProximitySensor,
   kForceSensor,
   kPaintNozzle,
   kPluginSensor,
   kCollection
 };
-inline constexpr int kBuiltinObjectTypes = 8;
+inline constexpr int kBuiltinObjectTypes = 7;
 inline constexpr int kMaxObjectTypes = 64;
 
 // One type's rows, whatever their C++ type.

@@ -43,7 +43,7 @@ void RegisterBuiltinModules(ModuleRegistry* registry) {
   registry->RegisterDynamics(kinematic::ModuleInfo(), [] { return kinematic::MakeBackend(); });
   registry->RegisterDynamics(
       planar::ModuleInfo(), [] { return planar::MakeBackend(); }, BareLoop<planar::TimeBareLoop>);
-  registry->RegisterProximity(proximity::ModuleInfo(), [] { return proximity::MakeBackend(); });
+  proximity::Register(registry);
   registry->RegisterCalculation(kinematics::IkModuleInfo(),
                                 [] { return kinematics::MakeIkGroups(); });
   registry->RegisterModule(paint::PaintModule());

@@ -6,6 +6,7 @@
 
 #include "framework/error.h"
 #include "framework/scene.h"
+#include "modules/proximity/proximity_sensor.h"
 
 namespace swarmsim {
 namespace {
@@ -43,7 +44,7 @@ TEST(SceneScaleTest, ScalesGeometryJointsSensorsAndMasses) {
   const ObjectId m2 = scene.AddShape("m2", revolute, {}, mesh);
   ProximitySensorData sensor;
   sensor.range = 0.1;
-  const ObjectId eye = scene.AddProximitySensor("eye", root, {{0, 0.05, 0}, {}}, sensor);
+  const ObjectId eye = proximity::AddSensor(&scene, "eye", root, {{0, 0.05, 0}, {}}, sensor);
   ForceSensorData force;
   force.force_threshold = 10;
   force.torque_threshold = 1;
@@ -67,7 +68,7 @@ TEST(SceneScaleTest, ScalesGeometryJointsSensorsAndMasses) {
   EXPECT_DOUBLE_EQ(scene.joint(revolute).position, 0.5);      // angles unchanged
   EXPECT_DOUBLE_EQ(scene.joint(revolute).max_force, 48);      // N m: x s^4
   EXPECT_DOUBLE_EQ(scene.world_pose(m1).p.z, 1 + 0.2 + 0.2);  // offset + slider
-  EXPECT_DOUBLE_EQ(scene.proximity_sensor(eye).range, 0.2);
+  EXPECT_DOUBLE_EQ(proximity::Sensor(scene, eye).range, 0.2);
   EXPECT_DOUBLE_EQ(scene.force_sensor(link).force_threshold, 80);
   EXPECT_DOUBLE_EQ(scene.force_sensor(link).torque_threshold, 16);
   EXPECT_DOUBLE_EQ(scene.paint_nozzle(pen).radius, 0.04);
