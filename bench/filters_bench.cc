@@ -21,7 +21,7 @@
 #include <vector>
 
 #include "modules/rendering/filters/filters.h"
-#include "tests/modules/filter_list_reader.h"
+#include "tests/modules/rendering/filters/filter_list_reader.h"
 
 namespace swarmsim::filters {
 namespace {

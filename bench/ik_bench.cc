@@ -7,7 +7,7 @@
 
 #include "modules/kinematics/chain.h"
 #include "modules/kinematics/ik_solver.h"
-#include "tests/modules/kinematics_test.h"
+#include "tests/modules/kinematics/kinematics_test.h"
 
 namespace swarmsim::kinematics {
 namespace {

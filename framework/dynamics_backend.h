@@ -27,6 +27,19 @@ struct DynamicsSettings {
   TaskScheduler* scheduler = nullptr;
 };
 
+// What a backend simulates, declared when it registers
+// (ModuleRegistry::RegisterDynamics): callers (summaries, the Python
+// module, benchmarks) ask this instead of testing the backend's name.
+struct DynamicsCapabilities {
+  // Bodies move in the ground plane only: pose (x, y, yaw), no gravity
+  // along z (box2d, planar). Python's World.planar; poses as (x, y, yaw).
+  bool planar = false;
+  // An engine integrates bodies in substeps (simulation.physics_substeps);
+  // false for a backend that only moves what scripts and joints move
+  // (kinematic).
+  bool substeps = true;
+};
+
 class DynamicsBackend {
  public:
   virtual ~DynamicsBackend() = default;

@@ -26,6 +26,10 @@ struct EnvironmentMap {
   // (deterministic: depth-first from the root).
   std::vector<EnvironmentBox> boxes;
   Vec3 lo, hi;  // bounds of `boxes` (both zero when there are none)
+  // What the grids made from the map (modules/environment/voxel_merge.h:
+  // physics' boxes, placement) may take, bytes: the world file's
+  // `max_memory_mb`, which also bounds the map itself.
+  double max_grid_bytes = 2048.0 * (1 << 20);
 };
 
 }  // namespace swarmsim

@@ -130,23 +130,30 @@ int IsYieldable(lua_State* L) {
   return 1;
 }
 
-// Pushes the function `key` of the Lua area of an object type the world's
-// registry holds (a module's type, object_type.h), if one has it.
+// Pushes the entry `key` of one Lua area (an object type's or a module's
+// register_lua), if the area has it.
+bool PushAreaEntry(lua_State* L, void (*register_lua)(lua_State*), std::string_view key) {
+  lua_newtable(L);
+  register_lua(L);
+  lua_pushlstring(L, key.data(), key.size());
+  lua_rawget(L, -2);
+  if (!lua_isnil(L, -1)) {
+    lua_remove(L, -2);
+    return true;
+  }
+  lua_pop(L, 2);
+  return false;
+}
+
+// Pushes the entry `key` of the Lua area of an object type or a module the
+// world's registry holds (object_type.h, module.h), if one has it.
 bool PushRegisteredTypeFunction(lua_State* L, std::string_view key) {
   const LuaContext& c = Context(L);
   if (c.world == nullptr) return false;
-  for (const ObjectTypeDescriptor* type : c.world->registry().object_types()) {
-    if (type->register_lua == nullptr) continue;
-    lua_newtable(L);
-    type->register_lua(L);
-    lua_pushlstring(L, key.data(), key.size());
-    lua_rawget(L, -2);
-    if (!lua_isnil(L, -1)) {
-      lua_remove(L, -2);
-      return true;
-    }
-    lua_pop(L, 2);
-  }
+  for (const ObjectTypeDescriptor* type : c.world->registry().object_types())
+    if (type->register_lua != nullptr && PushAreaEntry(L, type->register_lua, key)) return true;
+  for (const auto& module : c.world->registry().module_descriptors())
+    if (module->register_lua != nullptr && PushAreaEntry(L, module->register_lua, key)) return true;
   return false;
 }
 
@@ -349,17 +356,15 @@ void RegisterAreas(lua_State* L) {
       RegisterMessagesApi,    // lua_api_messages.cc: messages, signals, packing
       RegisterControlApi,     // lua_api_control.cc: child scripts, threads, main-script handlers
       RegisterDynamicsApi,    // lua_api_dynamics.cc: dynamic/kinematic switch, joint forces
-      RegisterIkApi,          // lua_api_ik.cc: IK groups
       RegisterCustomDataApi,  // lua_api_custom_data.cc: custom data blocks
       RegisterModelsApi,      // lua_api_models.cc: copying and removing robots at run time
   };
   lua_pushinteger(L, kHandleWorld);
   lua_setfield(L, -2, "handle_world");
   for (auto area : kAreas) area(L);
-  // Each built-in object type's own area (joints, force sensors, paint
-  // nozzles, plugin sensors: framework/types/, object_type.h); the
-  // types of a world's registry add theirs on first use
-  // (PushRegisteredTypeFunction).
+  // Each built-in object type's own area (joints, plugin sensors:
+  // framework/types/, object_type.h); the types and modules of a world's
+  // registry add theirs on first use (PushRegisteredTypeFunction).
   for (const ObjectTypeDescriptor* type : CoreObjectTypes())
     if (type->register_lua != nullptr) type->register_lua(L);
 }

@@ -4,17 +4,21 @@
 // A module registers once, by name, in the ModuleRegistry with a
 // ModuleDescriptor: its `swarmsim modules` line (kind, name, version, one
 // line), the phases it hooks and its order within them, and how one world's
-// instance is made. World makes the every-world modules when it starts, the
-// others when something asks for them (World::module: the loader for a
-// model's IK groups, a world file's `paint:` or `metrics:`), and runs every
+// instance is made, and its Lua area. World makes the every-world modules
+// when it starts, the others when something asks for them (World::module:
+// the loader for a model's IK groups; a module's world-file section,
+// framework/world_section.h, for `paint:` or `metrics:`), and runs every
 // instance's hooks phase by phase:
 //
-//   sense        after the scene's state is final, before the scripts
-//                (proximity 100; then plugin sensors, after_sense callbacks)
-//   actuate      after deferred writes, before joints move (IK groups 100)
-//   after_physics after the dynamics step (then after_physics callbacks)
-//   record       after the step (swarm metrics 100, paint 200, then
-//                record-phase plugin callbacks)
+//   Phase::kSense    after the scene's state is final, before the scripts
+//                    (proximity 100; then plugin sensors, after_sense callbacks)
+//   Phase::kActuate  after deferred writes, before joints move (IK groups 100)
+//   Phase::kPhysics  after the dynamics step (AfterPhysics; then after_physics
+//                    callbacks)
+//   Phase::kRecord   after the step (swarm metrics 100, paint 200, then
+//                    record-phase plugin callbacks)
+//
+// (Phase::kControl is the scripts' own: no module hooks it.)
 //
 // Within a phase, lower `order` first, then creation order: never the
 // thread count. A module's state that changes the future goes into the
@@ -31,7 +35,10 @@
 #include <string>
 #include <vector>
 
+#include "framework/phase.h"
 #include "framework/scene.h"
+
+struct lua_State;
 
 namespace swarmsim {
 
@@ -46,9 +53,6 @@ struct OutputFile {
   std::string path;         // relative to the output folder
   std::string description;  // one line (a graph's name, a camera's)
 };
-
-enum class ModulePhase : uint8_t { kSense, kActuate, kAfterPhysics, kRecord, kCount };
-constexpr uint32_t PhaseBit(ModulePhase phase) { return 1u << static_cast<unsigned>(phase); }
 
 // One world's instance of a module. Hooks it does not declare are not called.
 class Module : public SceneListener {
@@ -71,6 +75,10 @@ class Module : public SceneListener {
   virtual void ListOutputs(std::vector<OutputFile>* /*out*/) const {}
   // Folds state that is not in the scene and changes the future into the hash.
   virtual void HashState(StateHasher* /*hasher*/) const {}
+  // Once the loader has built every object: throws swarmsim::Error (naming
+  // the file:line:column the module kept) for a reference that matches
+  // nothing, such as an IK group's obstacle path (World::CheckModuleReferences).
+  virtual void CheckReferences(const Scene& /*scene*/) {}
   void OnSubtreeDuplicated(const Scene&, std::span<const uint32_t>,
                            std::span<const uint32_t>) override {}
   void OnSubtreeRemoved(const Scene&, std::span<const uint32_t>) override {}
@@ -85,13 +93,17 @@ struct ModuleInfo {
 
 struct ModuleDescriptor {
   ModuleInfo info;
-  uint32_t phases = 0;       // PhaseBit(...) | ...
+  uint32_t phases = 0;       // PhaseBit(Phase::kSense) | ... (not kControl)
   int order = 0;             // within each phase, lower first
   bool every_world = false;  // made by World::Start for every world; else on request
   // One world's instance. `config` is what the requester passes
   // (World::AddModule: a `paint:` section's settings, a metric's `every`),
   // or null (World::module).
   std::function<std::unique_ptr<Module>(World* world, const void* config)> make;
+  // The module's Lua API area (framework/lua_api.h): adds its sim.*
+  // functions and constants to the table on top of L's stack, as an object
+  // type's register_lua does (sim.getIkGroup, ...). Null: none.
+  void (*register_lua)(lua_State* L) = nullptr;
 };
 
 }  // namespace swarmsim

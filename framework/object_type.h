@@ -86,6 +86,27 @@ class ObjectReader {
   // the nearest known one ("did you mean 'min_pixels'?"). The loader checks
   // an object's own keys before `read`; an item's are the reader's to check.
   virtual void Expect(std::span<const std::string> known) const = 0;
+
+  // --- Nested values (world-file sections, framework/world_section.h) -------------
+  // Readers without them (a test's fake) throw swarmsim::Error.
+  // "'key' is required in <what>" when the key is absent or empty.
+  virtual void Require(std::string_view key) const;
+  // A reader for the mapping at `key`, whose messages name it `what`
+  // ("'area'"); null when the key is absent or empty. A value that is not a
+  // mapping is an error "'key' must be <expected> (got ...)".
+  virtual std::unique_ptr<ObjectReader> Map(std::string_view key, const std::string& what,
+                                            std::string_view expected) const;
+  // The elements of the list at `key` (`metrics: [a, {name: b, every: 10}]`),
+  // a reader each: a map reads as itself (messages name it `what`), any
+  // other value as a map holding it under `scalar_key` (a bare name). None
+  // when the key is absent; a value that is not a list is an error "'key'
+  // must be a list of <list_what> (got ...)".
+  virtual std::vector<std::unique_ptr<ObjectReader>> Elements(std::string_view key,
+                                                              std::string_view list_what,
+                                                              const std::string& what,
+                                                              std::string_view scalar_key) const;
+  // An error at this entry itself (where its mapping starts).
+  [[noreturn]] virtual void FailHere(const std::string& message) const;
 };
 
 // One world-file key of a type: its name, its default as the docs show it,

@@ -39,6 +39,20 @@ const char* PhaseName(int phase) {
   return "?";
 }
 
+// The plugin ABI's points of a step as (phase, edge) of the step's phases.
+Phase PhaseOf(int phase) {
+  switch (phase) {
+    case kSwarmsimAfterSense: return Phase::kSense;
+    case kSwarmsimBeforeControl:
+    case kSwarmsimAfterControl: return Phase::kControl;
+    case kSwarmsimAfterPhysics: return Phase::kPhysics;
+    default: return Phase::kRecord;
+  }
+}
+PhaseEdge EdgeOf(int phase) {
+  return phase == kSwarmsimBeforeControl ? PhaseEdge::kStart : PhaseEdge::kEnd;
+}
+
 int AddPhaseCallback(void* impl, int phase, int per_robot, SwarmsimPhaseCallback callback,
                      void* user_data) {
   auto* r = static_cast<Registration*>(impl);
@@ -46,7 +60,8 @@ int AddPhaseCallback(void* impl, int phase, int per_robot, SwarmsimPhaseCallback
     r->error = "add_phase_callback needs a phase (SwarmsimPhase) and a function";
     return -1;
   }
-  r->callbacks.push_back({PhaseName(phase), phase, per_robot != 0, callback, user_data});
+  r->callbacks.push_back(
+      {PhaseName(phase), PhaseOf(phase), EdgeOf(phase), per_robot != 0, callback, user_data});
   return 0;
 }
 

@@ -125,7 +125,7 @@ bool PluginSensors::Reading(const Scene& scene, ObjectId id,
 ModuleDescriptor PluginSensorsModule() {
   return {{"sensor", "plugin_sensors", "1.0",
            "the plugin sensor types' objects, sensed after the proximity sensors"},
-          PhaseBit(ModulePhase::kSense),
+          PhaseBit(Phase::kSense),
           200,
           /*every_world=*/true,
           [](World*, const void*) { return std::make_unique<PluginSensors>(); }};

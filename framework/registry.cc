@@ -6,13 +6,14 @@
 #include "framework/error.h"
 #include "framework/object_type.h"
 #include "framework/vision_filter.h"
+#include "framework/world_section.h"
 
 namespace swarmsim {
 
-void ModuleRegistry::RegisterDynamics(ModuleInfo info, DynamicsFactory factory,
-                                      BareLoop bare_loop) {
+void ModuleRegistry::RegisterDynamics(ModuleInfo info, DynamicsCapabilities capabilities,
+                                      DynamicsFactory factory, BareLoop bare_loop) {
   info.kind = "dynamics";
-  dynamics_.push_back({info.name, std::move(factory), std::move(bare_loop)});
+  dynamics_.push_back({info.name, capabilities, std::move(factory), std::move(bare_loop)});
   modules_.push_back(std::move(info));
 }
 
@@ -40,7 +41,7 @@ std::vector<const ModuleDescriptor*> ModuleRegistry::ModulesOfKind(std::string_v
 
 void ModuleRegistry::RegisterCalculation(ModuleInfo info, CalculationFactory factory) {
   info.kind = "calculation";
-  RegisterModule({std::move(info), PhaseBit(ModulePhase::kActuate), 100, /*every_world=*/false,
+  RegisterModule({std::move(info), PhaseBit(Phase::kActuate), 100, /*every_world=*/false,
                   [factory = std::move(factory)](World*, const void*) { return factory(); }});
 }
 
@@ -65,7 +66,7 @@ const ScriptCommand* ModuleRegistry::FindScriptCommand(std::string_view name) co
 }
 
 void ModuleRegistry::RegisterPhaseCallback(ModuleInfo info, PhaseCallback callback) {
-  if (callback.phase < 0 || callback.phase >= kSwarmsimPhaseCount || callback.function == nullptr)
+  if (callback.phase >= Phase::kCount || callback.function == nullptr)
     throw Error("phase callback '" + callback.name + "' has an unknown phase or no function");
   info.kind = "callback";
   modules_.push_back(std::move(info));
@@ -97,6 +98,15 @@ void ModuleRegistry::RegisterVisionFilter(std::shared_ptr<const VisionFilterDesc
     throw Error("vision filter element '" + filter->name + "' is registered twice");
   modules_.push_back({"vision filter", filter->name, filter->version, filter->description});
   vision_filters_.push_back(std::move(filter));
+}
+
+void ModuleRegistry::RegisterWorldSection(std::shared_ptr<const WorldSectionDescriptor> section) {
+  if (!section || section->key.empty() || !section->read)
+    throw Error("a world-file section needs a key and a reader");
+  for (const auto& s : world_sections_)
+    if (s->key == section->key)
+      throw Error("world-file section '" + section->key + "' is registered twice");
+  world_sections_.push_back(std::move(section));
 }
 
 const VisionFilterDescriptor* ModuleRegistry::FindVisionFilter(std::string_view name) const {
@@ -136,6 +146,13 @@ bool ModuleRegistry::HasDynamics(const std::string& name) const {
   for (const Dynamics& d : dynamics_)
     if (d.name == name) return true;
   return false;
+}
+
+const DynamicsCapabilities& ModuleRegistry::dynamics_capabilities(const std::string& name) const {
+  for (const Dynamics& d : dynamics_)
+    if (d.name == name) return d.capabilities;
+  MakeDynamics(name);  // throws: unknown, with the names there are
+  throw Error("no dynamics backend '" + name + "'");
 }
 
 std::vector<std::string> ModuleRegistry::DynamicsNames() const {

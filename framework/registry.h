@@ -12,6 +12,7 @@
 #include <string_view>
 #include <vector>
 
+#include "framework/dynamics_backend.h"
 #include "framework/module.h"
 #include "framework/plugin_api.h"
 
@@ -22,6 +23,7 @@ class Scene;
 struct ObjectTypeDescriptor;
 struct PluginControllerType;
 struct VisionFilterDescriptor;
+struct WorldSectionDescriptor;
 
 // A script command registered by a plugin (framework/plugin_api.h): sim.<name>.
 struct ScriptCommand {
@@ -34,7 +36,10 @@ struct ScriptCommand {
 // A per-phase callback registered by a plugin (framework/plugin_api.h).
 struct PhaseCallback {
   std::string name;  // "plugin:phase", for messages
-  int phase = 0;     // SwarmsimPhase
+  // The plugin's SwarmsimPhase as a point of the step: after_sense is
+  // (kSense, kEnd), before_control (kControl, kStart), ...
+  Phase phase = Phase::kSense;
+  PhaseEdge edge = PhaseEdge::kEnd;
   bool per_robot = false;
   SwarmsimPhaseCallback function = nullptr;
   void* user_data = nullptr;
@@ -60,7 +65,8 @@ class ModuleRegistry {
                                         int steps, double gravity)>;
 
   // Dynamics backends: kind "dynamics", chosen by a world's `physics:`.
-  void RegisterDynamics(ModuleInfo info, DynamicsFactory factory, BareLoop bare_loop = {});
+  void RegisterDynamics(ModuleInfo info, DynamicsCapabilities capabilities, DynamicsFactory factory,
+                        BareLoop bare_loop = {});
   // Modules (framework/module.h): every other kind. Throws swarmsim::Error
   // if the name is taken or the descriptor has no `make`.
   void RegisterModule(ModuleDescriptor module);
@@ -103,6 +109,14 @@ class ModuleRegistry {
   const std::vector<std::shared_ptr<const VisionFilterDescriptor>>& vision_filters() const {
     return vision_filters_;
   }
+  // World-file sections (framework/world_section.h): a top-level key a
+  // module reads itself. Not listed by `swarmsim modules` (its module is).
+  // Throws swarmsim::Error if the key is taken.
+  void RegisterWorldSection(std::shared_ptr<const WorldSectionDescriptor> section);
+  // In registration order, the order the loader reads them in.
+  const std::vector<std::shared_ptr<const WorldSectionDescriptor>>& world_sections() const {
+    return world_sections_;
+  }
   // Native controllers (plugins, framework/plugin_controllers.h): kind
   // "controller". Throws swarmsim::Error if the name is taken.
   void RegisterController(ModuleInfo info, PluginControllerType controller);
@@ -118,6 +132,9 @@ class ModuleRegistry {
   // Null if the dynamics backend has no bare loop.
   const BareLoop* FindBareLoop(const std::string& physics) const;
   bool HasDynamics(const std::string& name) const;
+  // What the backend named `name` declared. Throws swarmsim::Error listing
+  // the backends when there is none of that name.
+  const DynamicsCapabilities& dynamics_capabilities(const std::string& name) const;
   std::vector<std::string> DynamicsNames() const;
 
   const std::vector<ModuleInfo>& modules() const { return modules_; }
@@ -126,6 +143,7 @@ class ModuleRegistry {
   std::vector<ModuleInfo> modules_;
   struct Dynamics {
     std::string name;
+    DynamicsCapabilities capabilities;
     DynamicsFactory factory;
     BareLoop bare_loop;
   };
@@ -140,6 +158,7 @@ class ModuleRegistry {
   std::vector<std::shared_ptr<const ObjectTypeDescriptor>> owned_object_types_;
   std::vector<const ObjectTypeDescriptor*> object_types_;
   std::vector<std::shared_ptr<const VisionFilterDescriptor>> vision_filters_;
+  std::vector<std::shared_ptr<const WorldSectionDescriptor>> world_sections_;
   // Shared, stable addresses: a world's robots point at them.
   std::vector<std::shared_ptr<const PluginControllerType>> controllers_;
 };

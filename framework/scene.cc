@@ -213,14 +213,6 @@ ObjectId Scene::AddJoint(std::string name, ObjectId parent, const Pose& X_PO,
                          const JointData& joint) {
   return AddObject(ObjectType::kJoint, std::move(name), parent, X_PO, &joint);
 }
-ObjectId Scene::AddForceSensor(std::string name, ObjectId parent, const Pose& X_PO,
-                               const ForceSensorData& sensor) {
-  return AddObject(ObjectType::kForceSensor, std::move(name), parent, X_PO, &sensor);
-}
-ObjectId Scene::AddPaintNozzle(std::string name, ObjectId parent, const Pose& X_PO,
-                               const PaintNozzleData& nozzle) {
-  return AddObject(ObjectType::kPaintNozzle, std::move(name), parent, X_PO, &nozzle);
-}
 
 void* Scene::row_data(ObjectId id) {
   const uint32_t slot = SlotOf(id);
@@ -483,25 +475,10 @@ JointData& Scene::mutable_joint(ObjectId id) {
   ExpectType(*this, s, ObjectType::kJoint);
   return joints()[row_[s]];
 }
-const ForceSensorData& Scene::force_sensor(ObjectId id) const {
-  const uint32_t s = SlotOf(id, "force sensor");
-  ExpectType(*this, s, ObjectType::kForceSensor);
-  return force_sensors()[row_[s]];
-}
-ForceSensorData& Scene::mutable_force_sensor(ObjectId id) {
-  const uint32_t s = SlotOf(id, "force sensor");
-  ExpectType(*this, s, ObjectType::kForceSensor);
-  return force_sensors()[row_[s]];
-}
-const PaintNozzleData& Scene::paint_nozzle(ObjectId id) const {
-  const uint32_t s = SlotOf(id, "paint nozzle");
-  ExpectType(*this, s, ObjectType::kPaintNozzle);
-  return Table<PaintNozzleData>(ObjectType::kPaintNozzle).rows[row_[s]];
-}
-PaintNozzleData& Scene::mutable_paint_nozzle(ObjectId id) {
-  const uint32_t s = SlotOf(id, "paint nozzle");
-  ExpectType(*this, s, ObjectType::kPaintNozzle);
-  return Table<PaintNozzleData>(ObjectType::kPaintNozzle).rows[row_[s]];
+uint32_t Scene::SlotOfType(ObjectId id, ObjectType type, std::string_view what) const {
+  const uint32_t s = SlotOf(id, what);
+  ExpectType(*this, s, type);
+  return s;
 }
 
 void Scene::LinkDummies(ObjectId a, ObjectId b) {

@@ -24,12 +24,10 @@
 #include <vector>
 
 #include "framework/environment.h"
-#include "framework/force_sensor.h"
 #include "framework/handle.h"
 #include "framework/math.h"
 #include "framework/mesh.h"
 #include "framework/object_rows.h"
-#include "framework/paint_nozzle.h"
 
 namespace swarmsim {
 
@@ -218,6 +216,19 @@ class Scene {
   const Rows<Row>& rows(ObjectType type) const {
     return Table<Row>(type);
   }
+  // The row of object `id`, which must be of `type` (`Row` its row type):
+  // how a module's Lua area reads one object's row. Throws swarmsim::Error
+  // for a stale handle ("no <what> ...") or an object of another type.
+  template <typename Row>
+  Row& row(ObjectType type, ObjectId id, std::string_view what) {
+    return Table<Row>(type).rows[row_[SlotOfType(id, type, what)]];
+  }
+  template <typename Row>
+  const Row& row(ObjectType type, ObjectId id, std::string_view what) const {
+    return Table<Row>(type).rows[row_[SlotOfType(id, type, what)]];
+  }
+  // The slot of `id`, checked as row() checks it.
+  uint32_t SlotOfType(ObjectId id, ObjectType type, std::string_view what) const;
 
   // --- Creation and deletion --------------------------------------------------
   // `parent` may be null (a root). X_PO is the pose of the new object in its
@@ -228,12 +239,6 @@ class Scene {
   ObjectId AddDummy(std::string name, ObjectId parent, const Pose& X_PO);
   ObjectId AddShape(std::string name, ObjectId parent, const Pose& X_PO, const ShapeData& shape);
   ObjectId AddJoint(std::string name, ObjectId parent, const Pose& X_PO, const JointData& joint);
-  // A force sensor links its parent shape to the first dynamic shape below it
-  // (framework/force_sensor.h); a paint nozzle marks the floor (paint_nozzle.h).
-  ObjectId AddForceSensor(std::string name, ObjectId parent, const Pose& X_PO,
-                          const ForceSensorData& sensor);
-  ObjectId AddPaintNozzle(std::string name, ObjectId parent, const Pose& X_PO,
-                          const PaintNozzleData& nozzle);
   // Removes an object and all its descendants (their handles become stale).
   void RemoveSubtree(ObjectId root);
   // Copies a subtree under `new_parent` (null: a new root), with its scripts,
@@ -339,21 +344,6 @@ class Scene {
   std::span<JointData> joints() { return Table<JointData>(ObjectType::kJoint).rows; }
   std::span<const JointData> joints() const { return Table<JointData>(ObjectType::kJoint).rows; }
   std::span<const uint32_t> joint_owners() const { return Owners(ObjectType::kJoint); }
-  const ForceSensorData& force_sensor(ObjectId id) const;
-  ForceSensorData& mutable_force_sensor(ObjectId id);
-  std::span<ForceSensorData> force_sensors() {
-    return Table<ForceSensorData>(ObjectType::kForceSensor).rows;
-  }
-  std::span<const ForceSensorData> force_sensors() const {
-    return Table<ForceSensorData>(ObjectType::kForceSensor).rows;
-  }
-  std::span<const uint32_t> force_sensor_owners() const { return Owners(ObjectType::kForceSensor); }
-  const PaintNozzleData& paint_nozzle(ObjectId id) const;
-  PaintNozzleData& mutable_paint_nozzle(ObjectId id);
-  std::span<const PaintNozzleData> paint_nozzles() const {
-    return Table<PaintNozzleData>(ObjectType::kPaintNozzle).rows;
-  }
-  std::span<const uint32_t> paint_nozzle_owners() const { return Owners(ObjectType::kPaintNozzle); }
   // Row of the object's typed data in its type's table, by slot.
   uint32_t row_at(uint32_t slot) const { return row_[slot]; }
   // The object's row (of its type's row type), or null for a type without rows.

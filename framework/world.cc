@@ -99,7 +99,7 @@ World::World(const WorldSettings& settings, const ModuleRegistry& registry)
   // Validate the backend name now, so a typo fails before any work is done.
   if (!registry_.HasDynamics(settings_.physics)) registry_.MakeDynamics(settings_.physics);
   for (const PhaseCallback& callback : registry_.phase_callbacks())
-    phase_callbacks_.at(callback.phase).push_back(&callback);
+    CallbacksAt(callback.phase, callback.edge).push_back(&callback);
   // Object types of modules and plugins, after the built-in ones.
   for (const ObjectTypeDescriptor* type : registry_.object_types()) scene_.RegisterType(*type);
 }
@@ -129,12 +129,14 @@ void World::FlushPrintsOfStuckStep() {
 
 Module* World::InstallModule(std::string name, int order, uint32_t phases,
                              std::unique_ptr<Module> instance) {
+  if (phases & PhaseBit(Phase::kControl))
+    throw Error("module '" + name + "' hooks the control phase, which is the scripts' own");
   Module* module = instance.get();
   modules_.push_back({std::move(name), order, phases, std::move(instance)});
   scene_.AddListener(module);
   // Each phase's list in (order, creation) order.
   for (size_t p = 0; p < modules_by_phase_.size(); ++p) {
-    if (!(phases & PhaseBit(static_cast<ModulePhase>(p)))) continue;
+    if (!(phases & PhaseBit(static_cast<Phase>(p)))) continue;
     std::vector<Module*>& list = modules_by_phase_[p];
     auto at = list.end();
     while (at != list.begin()) {
@@ -165,6 +167,10 @@ std::vector<std::string> World::module_names() const {
   return names;
 }
 
+void World::CheckModuleReferences() {
+  for (ModuleEntry& e : modules_) e.instance->CheckReferences(scene_);
+}
+
 Module* World::find_module(std::string_view name) const {
   for (const ModuleEntry& e : modules_)
     if (e.name == name) return e.instance.get();
@@ -183,17 +189,18 @@ Module* World::AddModule(std::string_view name, const void* config) {
 }
 
 void World::AddObserver(std::unique_ptr<Observer> observer) {
-  InstallModule("observer", 1000, PhaseBit(ModulePhase::kRecord), std::move(observer));
+  InstallModule("observer", 1000, PhaseBit(Phase::kRecord), std::move(observer));
 }
 
-void World::RunModules(ModulePhase phase) {
+void World::RunModules(Phase phase) {
   for (Module* module : modules_by_phase_[static_cast<size_t>(phase)]) {
     switch (phase) {
-      case ModulePhase::kSense: module->Sense(this); break;
-      case ModulePhase::kActuate: module->Actuate(this); break;
-      case ModulePhase::kAfterPhysics: module->AfterPhysics(this); break;
-      case ModulePhase::kRecord: module->Record(*this, &metrics_); break;
-      case ModulePhase::kCount: break;
+      case Phase::kSense: module->Sense(this); break;
+      case Phase::kActuate: module->Actuate(this); break;
+      case Phase::kPhysics: module->AfterPhysics(this); break;
+      case Phase::kRecord: module->Record(*this, &metrics_); break;
+      case Phase::kControl:  // refused by InstallModule
+      case Phase::kCount: break;
     }
   }
 }
@@ -350,8 +357,8 @@ void World::Step() {
 }
 
 void World::Sense() {
-  RunModules(ModulePhase::kSense);  // proximity, plugin sensors, ...
-  RunPhaseCallbacks(kSwarmsimAfterSense);
+  RunModules(Phase::kSense);  // proximity, plugin sensors, ...
+  RunPhaseCallbacks(Phase::kSense, PhaseEdge::kEnd);
 }
 
 void World::HandleSensing() {
@@ -376,7 +383,7 @@ void World::HandleDynamics() {
 }
 
 void World::Control(ScriptPass pass) {
-  RunPhaseCallbacks(kSwarmsimBeforeControl);
+  RunPhaseCallbacks(Phase::kControl, PhaseEdge::kStart);
   const auto& instances = scene_.instances();
   scheduler_->ParallelFor(0, static_cast<int64_t>(instances.size()), kRobotGrain,
                           [&](int64_t begin, int64_t end) {
@@ -403,7 +410,7 @@ void World::Control(ScriptPass pass) {
   // (they have run), a main script as soon as sim.handleChildScripts returns.
   messaging_.ApplySignalWrites();
   FlushRobotBuffers();
-  RunPhaseCallbacks(kSwarmsimAfterControl);
+  RunPhaseCallbacks(Phase::kControl, PhaseEdge::kEnd);
 }
 
 uint8_t World::PendingBits(const RobotRuntime& rt) {
@@ -508,7 +515,7 @@ void World::Actuate() {
       j.target_position = w.value;
   }
   // Calculation objects (IK groups, ...) set joint positions and targets.
-  RunModules(ModulePhase::kActuate);
+  RunModules(Phase::kActuate);
   // Joints move kinematically toward their targets over the control step:
   // velocity mode at the target velocity, position mode at up to max_velocity.
   const double dt = settings_.time_step;
@@ -571,18 +578,18 @@ void World::Physics() {
   for (uint32_t row = 0; row < joints.size(); ++row)
     if (!std::isfinite(joints[row].position) || !std::isfinite(joints[row].velocity))
       throw non_finite(scene_.joint_owners()[row], "joint position or velocity");
-  RunModules(ModulePhase::kAfterPhysics);
-  RunPhaseCallbacks(kSwarmsimAfterPhysics);
+  RunModules(Phase::kPhysics);  // after the engine: mills, collision, ...
+  RunPhaseCallbacks(Phase::kPhysics, PhaseEdge::kEnd);
 }
 
 void World::Record() {
-  RunModules(ModulePhase::kRecord);  // swarm metrics, paint, ...
-  if (phase_callbacks_[kSwarmsimRecord].empty()) return;
+  RunModules(Phase::kRecord);  // swarm metrics, paint, ...
+  if (CallbacksAt(Phase::kRecord, PhaseEdge::kEnd).empty()) return;
   // Plugins' record-phase callbacks, then their rows in robot order (the
   // swarm-level ones first), whatever the thread count.
   recording_ = true;
   try {
-    RunPhaseCallbacks(kSwarmsimRecord);
+    RunPhaseCallbacks(Phase::kRecord, PhaseEdge::kEnd);
   } catch (...) {
     recording_ = false;
     plugin_metrics_.clear();

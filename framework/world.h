@@ -30,6 +30,7 @@ namespace swarmsim {
 
 using CalculationModule = Module;  // framework/calculation_module.h
 class DynamicsBackend;
+class FloorLayer;
 class ModuleRegistry;
 struct PhaseCallback;
 class PluginControllers;
@@ -200,10 +201,8 @@ using Observer = Module;
 // control is a few microseconds), small enough to balance two to eight workers.
 inline constexpr int64_t kRobotGrain = 8;
 
-// Wall-clock seconds spent in each phase, summed over the run.
-enum class Phase { kSense, kControl, kActuate, kPhysics, kRecord, kCount };
-const char* ToString(Phase phase);
-using PhaseTimes = std::array<double, static_cast<size_t>(Phase::kCount)>;
+// Wall-clock seconds spent in each phase (framework/phase.h), summed over the run.
+using PhaseTimes = std::array<double, kPhaseCount>;
 
 class World : public PhaseHandlers {
  public:
@@ -284,6 +283,9 @@ class World : public PhaseHandlers {
   // The names of the world's modules, in creation order, then those every
   // world gets when it starts (proximity) if it has not started.
   std::vector<std::string> module_names() const;
+  // Every module's CheckReferences (the loader, once the world's objects
+  // exist), in creation order.
+  void CheckModuleReferences();
   // Adds a record-phase module made by the caller, not registered (tests,
   // embedders), after the registered ones.
   void AddObserver(std::unique_ptr<Observer> observer);
@@ -310,6 +312,10 @@ class World : public PhaseHandlers {
   const LineOfSight* line_of_sight() const { return line_of_sight_; }
   void set_line_of_sight(const LineOfSight* service) { line_of_sight_ = service; }
   ScriptHost* scripts() { return scripts_.get(); }
+  // The floor image a module keeps (framework/floor_layer.h: the paint
+  // layer), or null; its provider sets it and outlives the world's use of it.
+  const FloorLayer* floor_layer() const { return floor_layer_; }
+  void set_floor_layer(const FloorLayer* layer) { floor_layer_ = layer; }
   // What robot `instance`'s scripts hold (-1: the scene's scripts and the
   // main script), and the run's whole (framework/script_memory.h).
   ScriptMemory& script_memory(int instance) {
@@ -354,7 +360,7 @@ class World : public PhaseHandlers {
   void Actuate();
   void Physics();
   void Record();
-  void RunModules(ModulePhase phase);
+  void RunModules(Phase phase);
   void EnsureRuntimes();
   // Copies and removals the scripts queued (RobotRuntime::model_edits),
   // robots in index order then the scene's, call order within each: every
@@ -372,11 +378,15 @@ class World : public PhaseHandlers {
   // printed (and recorded) before it, in robot order. The error in flight is
   // the one reported: the buffers' own are dropped. Not for the hot path.
   void FlushBuffersAfterError() noexcept;
-  // Plugin phase callbacks (SwarmsimPhase); nothing at all when none is registered.
-  void RunPhaseCallbacks(int phase) {
-    if (!phase_callbacks_[phase].empty()) CallPhaseCallbacks(phase);
+  // Plugin phase callbacks at that edge of the phase; nothing at all when none
+  // is registered.
+  void RunPhaseCallbacks(Phase phase, PhaseEdge edge) {
+    if (!CallbacksAt(phase, edge).empty()) CallPhaseCallbacks(CallbacksAt(phase, edge));
   }
-  void CallPhaseCallbacks(int phase);
+  std::vector<const PhaseCallback*>& CallbacksAt(Phase phase, PhaseEdge edge) {
+    return phase_callbacks_[static_cast<size_t>(phase) * 2 + static_cast<size_t>(edge)];
+  }
+  void CallPhaseCallbacks(const std::vector<const PhaseCallback*>& callbacks);
   WorldSettings settings_;
   const ModuleRegistry& registry_;
   std::shared_ptr<const ModuleRegistry> owned_registry_;  // null unless given by shared_ptr
@@ -385,8 +395,8 @@ class World : public PhaseHandlers {
   RunScriptMemory run_script_memory_;
   std::deque<ScriptMemory> robot_script_memory_;  // by robot (stable addresses)
   ScriptMemory scene_script_memory_;
-  std::array<std::vector<const PhaseCallback*>, kSwarmsimPhaseCount>
-      phase_callbacks_;  // by SwarmsimPhase
+  std::array<std::vector<const PhaseCallback*>, kPhaseCount * 2>
+      phase_callbacks_;  // by (phase, edge): CallbacksAt
   // Rows plugins record in the record phase (RecordPluginMetric).
   bool recording_ = false;
   std::mutex plugin_metrics_mutex_;
@@ -398,6 +408,7 @@ class World : public PhaseHandlers {
   std::unique_ptr<DynamicsBackend> dynamics_;
   const LineOfSight* line_of_sight_ = nullptr;  // owned by the module that provides it
   std::unique_ptr<ScriptHost> scripts_;
+  const FloorLayer* floor_layer_ = nullptr;         // owned by its module
   std::unique_ptr<PluginControllers> controllers_;  // null: no robot has a native controller
   std::vector<RobotRuntime> runtimes_;
   // Per robot, which of its RobotRuntime buffers may hold something (kPending*
@@ -419,7 +430,7 @@ class World : public PhaseHandlers {
     std::unique_ptr<Module> instance;
   };
   std::vector<ModuleEntry> modules_;
-  std::array<std::vector<Module*>, static_cast<size_t>(ModulePhase::kCount)> modules_by_phase_;
+  std::array<std::vector<Module*>, kPhaseCount> modules_by_phase_;
   Module* InstallModule(std::string name, int order, uint32_t phases,
                         std::unique_ptr<Module> instance);
   std::vector<MetricSample> metrics_;

@@ -15,7 +15,7 @@
 namespace swarmsim {
 namespace {}  // namespace
 
-void World::CallPhaseCallbacks(int phase) {
+void World::CallPhaseCallbacks(const std::vector<const PhaseCallback*>& callbacks) {
   // Whole-world callbacks on this thread, per-robot ones fanned out over the
   // robots; the lowest robot's error wins, whatever the thread count.
   auto call = [&](const PhaseCallback& callback, int robot, std::string* error) {
@@ -25,7 +25,7 @@ void World::CallPhaseCallbacks(int phase) {
       *error = callback.name + (robot >= 0 ? " (robot " + scene_.instance(robot).name + ")" : "") +
                ": " + (message[0] ? message : "the plugin callback failed");
   };
-  for (const PhaseCallback* callback : phase_callbacks_[phase]) {
+  for (const PhaseCallback* callback : callbacks) {
     std::string error;
     if (!callback->per_robot) {
       call(*callback, -1, &error);

@@ -2,17 +2,19 @@
 
 #include "framework/dynamics_backend.h"
 #include "framework/registry.h"
+#include "framework/world_section.h"
 #include "modules/blobs/blobs.h"
 #include "modules/collision/collision.h"
 #include "modules/dynamics/box2d/box2d_backend.h"
 #include "modules/dynamics/kinematic/kinematic_backend.h"
 #include "modules/dynamics/ode/ode_backend.h"
 #include "modules/dynamics/planar/planar_backend.h"
+#include "modules/force_sensor/force_sensor.h"
 #include "modules/graphs/graphs.h"
 #include "modules/kinematics/ik_groups.h"
 #include "modules/metrics/swarm_metrics.h"
 #include "modules/mill/mill.h"
-#include "modules/paint/paint_layer.h"
+#include "modules/paint/paint_nozzle.h"
 #include "modules/paths/paths.h"
 #include "modules/planning/planning.h"
 #include "modules/proximity/proximity.h"
@@ -37,16 +39,24 @@ double BareLoop(const Scene& scene, double dt, int substeps, int steps, double g
 // One line per module.
 void RegisterBuiltinModules(ModuleRegistry* registry) {
   registry->RegisterDynamics(
-      box2d::ModuleInfo(), [] { return box2d::MakeBackend(); }, BareLoop<box2d::TimeBareLoop>);
+      box2d::ModuleInfo(), {.planar = true}, [] { return box2d::MakeBackend(); },
+      BareLoop<box2d::TimeBareLoop>);
   registry->RegisterDynamics(
-      ode::ModuleInfo(), [] { return ode::MakeBackend(); }, BareLoop<ode::TimeBareLoop>);
-  registry->RegisterDynamics(kinematic::ModuleInfo(), [] { return kinematic::MakeBackend(); });
+      ode::ModuleInfo(), {.planar = false}, [] { return ode::MakeBackend(); },
+      BareLoop<ode::TimeBareLoop>);
+  registry->RegisterDynamics(kinematic::ModuleInfo(), {.planar = false, .substeps = false},
+                             [] { return kinematic::MakeBackend(); });
   registry->RegisterDynamics(
-      planar::ModuleInfo(), [] { return planar::MakeBackend(); }, BareLoop<planar::TimeBareLoop>);
+      planar::ModuleInfo(), {.planar = true}, [] { return planar::MakeBackend(); },
+      BareLoop<planar::TimeBareLoop>);
+  // The first module types, registered right after the built-in ones so the
+  // state hash adds types' rows in the order it did when they were built in:
+  // proximity_sensor is listed right after joint (its listed_after), then
+  // the built-in plugin_sensor and collection, then force_sensor.
   proximity::Register(registry);
-  registry->RegisterCalculation(kinematics::IkModuleInfo(),
-                                [] { return kinematics::MakeIkGroups(); });
-  registry->RegisterModule(paint::PaintModule());
+  force_sensor::Register(registry);
+  kinematics::Register(registry);
+  paint::Register(registry);
   for (ModuleDescriptor& metric : metrics::SwarmMetricModules())
     registry->RegisterModule(std::move(metric));
   collision::Register(registry);
@@ -58,6 +68,9 @@ void RegisterBuiltinModules(ModuleRegistry* registry) {
   graphs::Register(registry);
   blobs::Register(registry);
   registry->RegisterModule(video::RecorderModule());
+  // World-file sections, in the order the loader reads them.
+  registry->RegisterWorldSection(metrics::MetricsSection());
+  registry->RegisterWorldSection(paint::PaintSection());
 }
 
 }  // namespace swarmsim

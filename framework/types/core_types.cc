@@ -10,8 +10,7 @@ namespace swarmsim {
 
 std::span<const ObjectTypeDescriptor* const> CoreObjectTypes() {
   static constexpr const ObjectTypeDescriptor* kTypes[] = {
-      &kDummyType,       &kShapeType,        &kJointType,      &kForceSensorType,
-      &kPaintNozzleType, &kPluginSensorType, &kCollectionType,
+      &kDummyType, &kShapeType, &kJointType, &kPluginSensorType, &kCollectionType,
   };
   static_assert(std::size(kTypes) == kBuiltinObjectTypes);
   return kTypes;

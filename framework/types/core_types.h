@@ -9,8 +9,6 @@ namespace swarmsim {
 extern const ObjectTypeDescriptor kDummyType;
 extern const ObjectTypeDescriptor kShapeType;
 extern const ObjectTypeDescriptor kJointType;
-extern const ObjectTypeDescriptor kForceSensorType;
-extern const ObjectTypeDescriptor kPaintNozzleType;
 extern const ObjectTypeDescriptor kPluginSensorType;
 extern const ObjectTypeDescriptor kCollectionType;
 

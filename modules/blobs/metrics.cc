@@ -132,7 +132,7 @@ class ColorDispersion : public Observer {
 template <class M>
 ModuleDescriptor MetricModule(const char* name, const char* description) {
   return {{"metric", name, "1.0", description},
-          PhaseBit(ModulePhase::kRecord),
+          PhaseBit(Phase::kRecord),
           100,
           false,
           [](World*, const void* config) -> std::unique_ptr<Module> {

@@ -155,7 +155,7 @@ void Register(ModuleRegistry* registry) {
       {{"sensor", kModuleName, "1.0",
         "LEDs and blob cameras: LEDs in range and view, occlusion by ray tests (led, blob_camera "
         "types)"},
-       PhaseBit(ModulePhase::kSense),
+       PhaseBit(Phase::kSense),
        150,
        /*every_world=*/true,
        [](World*, const void*) { return std::make_unique<BlobCameraModule>(); }});

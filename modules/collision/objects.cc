@@ -182,7 +182,7 @@ void Register(ModuleRegistry* registry) {
   registry->RegisterModule(
       {{"calculation", kModuleName, "1.0",
         "collision and minimum-distance objects on FCL 0.7 (distance, collision types)"},
-       PhaseBit(ModulePhase::kAfterPhysics) | PhaseBit(ModulePhase::kRecord),
+       PhaseBit(Phase::kPhysics) | PhaseBit(Phase::kRecord),
        50,
        /*every_world=*/true,
        [](World*, const void*) { return std::make_unique<CollisionModule>(); }});

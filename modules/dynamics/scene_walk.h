@@ -13,6 +13,7 @@
 
 #include "framework/error.h"
 #include "framework/scene.h"
+#include "modules/force_sensor/force_sensor.h"
 
 namespace swarmsim::dynamics {
 
@@ -26,14 +27,15 @@ inline const ShapeData* ShapeAt(const Scene& scene, uint32_t slot) {
 // not across a joint or force sensor (what a joint or sensor holds): its
 // slot, or -1.
 inline int32_t FirstDynamicShapeBelow(const Scene& scene, uint32_t slot) {
+  ObjectType sensor_type = ObjectType::kJoint;  // stays kJoint when there is no such type
+  force_sensor::FindType(scene, &sensor_type);
   std::vector<uint32_t> stack;
   const std::vector<ObjectId> children = scene.children(scene.IdAt(slot));
   for (auto it = children.rbegin(); it != children.rend(); ++it) stack.push_back(it->index());
   while (!stack.empty()) {
     const uint32_t c = stack.back();
     stack.pop_back();
-    if (scene.type_at(c) == ObjectType::kJoint || scene.type_at(c) == ObjectType::kForceSensor)
-      continue;
+    if (scene.type_at(c) == ObjectType::kJoint || scene.type_at(c) == sensor_type) continue;
     const ShapeData* shape = ShapeAt(scene, c);
     if (shape && shape->dynamic) return static_cast<int32_t>(c);
     const std::vector<ObjectId> grand = scene.children(scene.IdAt(c));
@@ -53,10 +55,13 @@ Body NearestBodyAbove(const Scene& scene, const std::vector<Body>& body_of, uint
   return none;
 }
 
-// The rows of Scene::force_sensors() in their owners' slot order, like the
-// joints, so that an engine's joint list is the same every build.
+// The force sensors' rows (modules/force_sensor) in their owners' slot
+// order, like the joints, so that an engine's joint list is the same every
+// build.
 inline std::vector<uint32_t> ForceSensorRowsInSlotOrder(const Scene& scene) {
-  const auto owners = scene.force_sensor_owners();
+  const Rows<ForceSensorData>* sensors = force_sensor::RowsOf(scene);
+  if (sensors == nullptr) return {};
+  const std::vector<uint32_t>& owners = sensors->owners;
   std::vector<uint32_t> rows(owners.size());
   for (uint32_t r = 0; r < rows.size(); ++r) rows[r] = r;
   std::sort(rows.begin(), rows.end(),

@@ -243,6 +243,7 @@ EnvironmentMap ReadOctomap(const fs::path& file, const std::string& name,
   EnvironmentMap map;
   map.source = name;
   map.resolution = header.resolution;
+  map.max_grid_bytes = options.max_memory_mb * (1 << 20);
   ReadBoxes(name, header, {bytes.data() + header.body_offset, counts.bytes}, options, &map,
             &report);
 

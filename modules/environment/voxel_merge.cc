@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <sstream>
 #include <string>
 #include <tuple>
 
@@ -14,7 +15,9 @@ namespace {
 // The band's voxels on the map's grid: layer k (0 = the band's lowest)
 // spans [z0 + k res, z0 + (k + 1) res].
 struct BandGrid {
-  double x0 = 0, y0 = 0, z0 = 0, res = 0;
+  double x0 = 0, y0 = 0, z0 = 0;
+  double res = 0;   // m, one layer (the map's voxel)
+  double cell = 0;  // m, a cell's side in x and y (a power-of-two number of voxels)
   int nx = 0, ny = 0, nz = 0;
   std::vector<uint8_t> cells;  // (nz x ny x nx)
 };
@@ -28,12 +31,34 @@ int GridIndex(const EnvironmentMap& map, double value, double origin) {
   return static_cast<int>(r);
 }
 
+// The largest power of two (at most 2^20) that divides every box's x and y
+// cell indices and the map's extent: the cell of the band's grid, in voxels.
+// A pruned leaf is a cube of 2^k voxels on its own grid, so a map made of a
+// few big leaves gets a few big cells instead of millions of small ones; the
+// boxes merged from either grid are the same.
+int CoarseFactor(const EnvironmentMap& map) {
+  constexpr int kMax = 1 << 20;
+  int bits = kMax;  // every index's bits: the lowest set one is the factor
+  auto take = [&](double value, double origin) { bits |= GridIndex(map, value, origin); };
+  take(map.hi.x, map.lo.x);
+  take(map.hi.y, map.lo.y);
+  for (const EnvironmentBox& b : map.boxes) {
+    if (bits & 1) break;
+    take(b.lo.x, map.lo.x), take(b.hi.x, map.lo.x);
+    take(b.lo.y, map.lo.y), take(b.hi.y, map.lo.y);
+  }
+  return bits & -bits;
+}
+
 // The grid of the voxels in the band (z_lo, z_hi); `project`: one layer,
-// the columns' union.
+// the columns' union. Its cells are CoarseFactor voxels wide in x and y,
+// one voxel high.
 BandGrid MakeGrid(const EnvironmentMap& map, double z_lo, double z_hi, bool project) {
   BandGrid g;
   if (map.boxes.empty() || !(map.resolution > 0) || !(z_lo < z_hi)) return g;
+  const int f = CoarseFactor(map);
   g.res = map.resolution;
+  g.cell = map.resolution * f;
   const int layers = GridIndex(map, map.hi.z, map.lo.z);
   auto bottom = [&](int k) { return map.lo.z + k * g.res; };
   // Layers [k_lo, k_hi): top > z_lo and bottom < z_hi.
@@ -42,22 +67,30 @@ BandGrid MakeGrid(const EnvironmentMap& map, double z_lo, double z_hi, bool proj
   while (k_hi > k_lo && !(bottom(k_hi - 1) < z_hi)) --k_hi;
   if (k_lo >= k_hi) return g;
   g.x0 = map.lo.x, g.y0 = map.lo.y, g.z0 = bottom(k_lo);
-  g.nx = GridIndex(map, map.hi.x, map.lo.x);
-  g.ny = GridIndex(map, map.hi.y, map.lo.y);
+  g.nx = GridIndex(map, map.hi.x, map.lo.x) / f;
+  g.ny = GridIndex(map, map.hi.y, map.lo.y) / f;
   g.nz = project ? 1 : k_hi - k_lo;
-  const int64_t cells = int64_t{g.nx} * g.ny * (k_hi - k_lo);
-  if (cells > kMaxGridCells)
-    throw Error("environment " + map.source + ": the map's band from z " + std::to_string(z_lo) +
-                " to " + std::to_string(z_hi) + " m is " + std::to_string(cells) +
-                " voxels, more than " + std::to_string(kMaxGridCells) +
-                " (crop the map with z_range, or a coarser map)");
+  // One byte a cell, at most kMaxGridCells and at most the map's max_memory_mb.
+  const int64_t cells = int64_t{g.nx} * g.ny * g.nz;
+  const double limit = std::min(static_cast<double>(kMaxGridCells), map.max_grid_bytes);
+  if (static_cast<double>(cells) > limit) {
+    std::ostringstream m;
+    m << "environment " << map.source << ": the map's band from z " << z_lo << " to " << z_hi
+      << " m needs a grid of " << cells << " cells (" << g.nx << " x " << g.ny << " x " << g.nz
+      << ", " << g.cell << " m), one byte each, more than "
+      << (map.max_grid_bytes < kMaxGridCells ? "its max_memory_mb allows"
+                                             : "the limit of " + std::to_string(kMaxGridCells))
+      << " (crop the map with z_range or a bounding box, use a coarser map, or raise "
+         "max_memory_mb)";
+    throw Error(m.str());
+  }
   g.cells.assign(size_t(g.nx) * size_t(g.ny) * size_t(g.nz), 0);
   for (const EnvironmentBox& b : map.boxes) {
     const int k0 = std::max(GridIndex(map, b.lo.z, map.lo.z), k_lo);
     const int k1 = std::min(GridIndex(map, b.hi.z, map.lo.z), k_hi);
     if (k0 >= k1) continue;
-    const int i0 = GridIndex(map, b.lo.x, map.lo.x), i1 = GridIndex(map, b.hi.x, map.lo.x);
-    const int j0 = GridIndex(map, b.lo.y, map.lo.y), j1 = GridIndex(map, b.hi.y, map.lo.y);
+    const int i0 = GridIndex(map, b.lo.x, map.lo.x) / f, i1 = GridIndex(map, b.hi.x, map.lo.x) / f;
+    const int j0 = GridIndex(map, b.lo.y, map.lo.y) / f, j1 = GridIndex(map, b.hi.y, map.lo.y) / f;
     for (int k = project ? 0 : k0 - k_lo; k < (project ? 1 : k1 - k_lo); ++k)
       for (int j = j0; j < j1; ++j)
         std::fill_n(&g.cells[(size_t(k) * g.ny + j) * g.nx + i0], i1 - i0, uint8_t{1});
@@ -127,8 +160,8 @@ std::vector<EnvironmentBox> ToBoxes(std::vector<CellBox> boxes, const BandGrid& 
   std::vector<EnvironmentBox> out;
   out.reserve(boxes.size());
   for (const CellBox& c : boxes)
-    out.push_back({{g.x0 + c.r.x0 * g.res, g.y0 + c.r.y0 * g.res, g.z0 + c.z0 * g.res},
-                   {g.x0 + c.r.x1 * g.res, g.y0 + c.r.y1 * g.res, g.z0 + c.z1 * g.res}});
+    out.push_back({{g.x0 + c.r.x0 * g.cell, g.y0 + c.r.y0 * g.cell, g.z0 + c.z0 * g.res},
+                   {g.x0 + c.r.x1 * g.cell, g.y0 + c.r.y1 * g.cell, g.z0 + c.z1 * g.res}});
   return out;
 }
 
@@ -173,7 +206,7 @@ PlaneGrid ProjectBand(const EnvironmentMap& map, double z_lo, double z_hi) {
   BandGrid g = MakeGrid(map, z_lo, z_hi, /*project=*/true);
   PlaneGrid out;
   if (g.cells.empty()) return out;
-  out.x0 = g.x0, out.y0 = g.y0, out.cell = g.res;
+  out.x0 = g.x0, out.y0 = g.y0, out.cell = g.cell;
   out.nx = g.nx, out.ny = g.ny;
   out.occupied = std::move(g.cells);
   return out;

@@ -6,7 +6,8 @@
 #include "framework/scene.h"
 #include "framework/scheduler.h"
 #include "framework/world.h"
-#include "modules/collision/rows.h"              // DistanceRow: a plain struct, no FCL
+#include "modules/collision/rows.h"  // DistanceRow: a plain struct, no FCL
+#include "modules/force_sensor/force_sensor.h"
 #include "modules/proximity/proximity_sensor.h"  // readings: inline lookups, nothing linked
 
 namespace swarmsim::graphs {
@@ -45,7 +46,7 @@ double Read(const Scene& scene, const StreamSpec& s, uint32_t slot) {
     }
     case StreamKind::kForce:
     case StreamKind::kTorque: {
-      const ForceSensorData& f = scene.force_sensors()[scene.row_at(slot)];
+      const ForceSensorData& f = force_sensor::RowsOf(scene)->rows[scene.row_at(slot)];
       if (!f.has_reading) return NAN;
       return ComponentOf(s.kind == StreamKind::kForce ? f.force : f.torque, s.component);
     }
@@ -91,9 +92,11 @@ ObjectId ResolveStream(const Scene& scene, ObjectId graph, const StreamSpec& str
       if (!proximity::IsSensorAt(scene, scene.SlotOf(id))) want = proximity::kSensorTypeName;
       break;
     case StreamKind::kForce:
-    case StreamKind::kTorque:
-      if (type != ObjectType::kForceSensor) want = "force_sensor";
+    case StreamKind::kTorque: {
+      ObjectType force;
+      if (!force_sensor::FindType(scene, &force) || type != force) want = kForceSensorTypeName;
       break;
+    }
     case StreamKind::kDistance: {
       ObjectType distance;
       if (!scene.FindType("distance", &distance) || type != distance) want = "distance";

@@ -113,7 +113,7 @@ void Register(ModuleRegistry* registry) {
       {{"record", kModuleName, "1.0",
         "graph objects: data streams sampled after each step, written as CSV and PNG "
         "(gnuplot) into <out>/graphs/"},
-       PhaseBit(ModulePhase::kRecord),
+       PhaseBit(Phase::kRecord),
        300,
        /*every_world=*/true,
        [](World* world, const void*) { return std::make_unique<GraphModule>(world); }});

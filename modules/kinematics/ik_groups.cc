@@ -15,6 +15,10 @@
 #include "modules/kinematics/ik_solver.h"
 
 namespace swarmsim::kinematics {
+
+// Its Lua area (lua_api_ik.cc).
+void RegisterIkApi(lua_State* L);
+
 namespace {
 
 // Robots per task: a leg's solve is a few microseconds.
@@ -461,11 +465,27 @@ class IkGroupsImpl final : public IkGroups {
 
 }  // namespace
 
-ModuleInfo IkModuleInfo() {
-  return {"calculation", kIkModuleName, "1.0",
-          "IK groups: damped least squares, several tips, closed chains, per robot in parallel"};
+IkGroups& IkGroupsOf(World* world) {
+  auto* groups = dynamic_cast<IkGroups*>(world->module(kIkModuleName));
+  if (groups == nullptr) throw Error("the 'ik' calculation module is not an IK module");
+  return *groups;
 }
 
-std::unique_ptr<IkGroups> MakeIkGroups() { return std::make_unique<IkGroupsImpl>(); }
+IkGroups* FindIkGroups(const World& world) {
+  return dynamic_cast<IkGroups*>(world.find_module(kIkModuleName));
+}
+
+void Register(ModuleRegistry* registry) {
+  registry->RegisterModule(
+      {{"calculation", kIkModuleName, "1.0",
+        "IK groups: damped least squares, several tips, closed chains, per robot in parallel"},
+       PhaseBit(Phase::kActuate),
+       100,
+       /*every_world=*/false,
+       [](World*, const void*) -> std::unique_ptr<Module> {
+         return std::make_unique<IkGroupsImpl>();
+       },
+       RegisterIkApi});
+}
 
 }  // namespace swarmsim::kinematics

@@ -95,7 +95,7 @@ std::vector<ModuleDescriptor> SwarmMetricModules() {
   return {
       {{"metric", "mean_nearest_neighbor_distance", "1.0",
         "mean distance from each robot to its nearest neighbour (m)"},
-       PhaseBit(ModulePhase::kRecord),
+       PhaseBit(Phase::kRecord),
        100,
        false,
        [every](World*, const void* config) -> std::unique_ptr<Module> {
@@ -103,7 +103,7 @@ std::vector<ModuleDescriptor> SwarmMetricModules() {
        }},
       {{"metric", "covered_area", "1.0",
         "area visited by at least one robot since the start (m^2, 0.25 m cells)"},
-       PhaseBit(ModulePhase::kRecord),
+       PhaseBit(Phase::kRecord),
        100,
        false,
        [every](World*, const void* config) -> std::unique_ptr<Module> {

@@ -204,7 +204,7 @@ void Register(ModuleRegistry* registry) {
   registry->RegisterModule(
       {{"calculation", kModuleName, "1.0",
         "mills cutting voxel blocks and the environment map (mill, cuttable types)"},
-       PhaseBit(ModulePhase::kAfterPhysics) | PhaseBit(ModulePhase::kRecord),
+       PhaseBit(Phase::kPhysics) | PhaseBit(Phase::kRecord),
        40,
        /*every_world=*/true,
        [](World* world, const void*) { return std::make_unique<MillModule>(world); }});

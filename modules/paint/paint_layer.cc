@@ -44,6 +44,23 @@ PaintLayer::PaintLayer(World* world, const PaintSettings& settings)
                          ToByte(settings_.background.z)};
   for (size_t p = 0; p < n; ++p)
     std::copy(bg, bg + 3, rgb_.begin() + static_cast<ptrdiff_t>(3 * p));
+  world_->set_floor_layer(this);
+}
+
+PaintLayer::~PaintLayer() {
+  if (world_->floor_layer() == this) world_->set_floor_layer(nullptr);
+}
+
+FloorArea PaintLayer::floor_area() const {
+  return {settings_.min_x,      settings_.min_y, settings_.max_x, settings_.max_y,
+          settings_.resolution, width_,          height_,         settings_.background};
+}
+
+const Rows<PaintNozzleData>& PaintLayer::Nozzles(const Scene& scene) const {
+  ObjectType type;
+  if (!scene.FindType(kPaintNozzleTypeName, &type))
+    throw Error("paint: the scene has no paint nozzle type (modules/paint is not registered)");
+  return scene.rows<PaintNozzleData>(type);
 }
 
 Vec3 PaintLayer::PixelCentre(int column, int row) const {
@@ -56,14 +73,15 @@ int64_t PaintLayer::painted_count() const {
 }
 
 void PaintLayer::RefreshNozzles(const Scene& scene) {
+  nozzles_ = &Nozzles(scene);  // one look-up a step, not one a nozzle
   // Rebuilt only when objects were added or removed (slot order: deterministic).
   if (nozzles_version_ == scene.structure_version()) return;
   nozzles_version_ = scene.structure_version();
   robot_nozzles_.assign(scene.instances().size(), {});
   strokes_.resize(scene.instances().size());
   scene_nozzles_.clear();
-  std::vector<uint32_t> slots(scene.paint_nozzle_owners().begin(),
-                              scene.paint_nozzle_owners().end());
+  const std::vector<uint32_t>& owners = nozzles_->owners;
+  std::vector<uint32_t> slots(owners.begin(), owners.end());
   std::sort(slots.begin(), slots.end());
   for (uint32_t slot : slots) {
     const int instance = scene.instance_of_at(slot);
@@ -75,7 +93,7 @@ void PaintLayer::RefreshNozzles(const Scene& scene) {
 }
 
 void PaintLayer::Stamp(const Scene& scene, uint32_t slot, std::vector<Stroke>* out) const {
-  const PaintNozzleData& nozzle = scene.paint_nozzles()[scene.row_at(slot)];
+  const PaintNozzleData& nozzle = nozzles_->rows[scene.row_at(slot)];
   if (!nozzle.enabled) return;
   const Vec3& p = scene.world_pose_at(slot).p;
   if (!(p.z >= 0)) return;  // below the floor (or not finite)
@@ -140,7 +158,7 @@ void PaintLayer::ListOutputs(std::vector<OutputFile>* out) const {
 ModuleDescriptor PaintModule() {
   return {{"record", "paint", "1.0",
            "the floor paint layer paint nozzles mark (paint.png), world file key paint:"},
-          PhaseBit(ModulePhase::kRecord),
+          PhaseBit(Phase::kRecord),
           200,
           /*every_world=*/false,
           [](World* world, const void* config) -> std::unique_ptr<Module> {

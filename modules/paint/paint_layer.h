@@ -15,11 +15,14 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <span>
 #include <vector>
 
+#include "framework/floor_layer.h"
 #include "framework/math.h"
 #include "framework/module.h"
 #include "framework/world.h"
+#include "modules/paint/paint_nozzle.h"
 
 namespace swarmsim::paint {
 
@@ -34,11 +37,18 @@ struct PaintSettings {
 // swarm metrics); World::AddModule("paint", &settings) makes one.
 ModuleDescriptor PaintModule();
 
-class PaintLayer final : public Observer {
+// It is the world's floor layer (World::floor_layer): the recorder and the
+// renderer read its image through that interface.
+class PaintLayer final : public Observer, public FloorLayer {
  public:
   // Throws swarmsim::Error for a bad resolution or area, or an image over
-  // 100 megapixels.
+  // 100 megapixels. Becomes `world`'s floor layer.
   PaintLayer(World* world, const PaintSettings& settings);
+  ~PaintLayer() override;
+
+  FloorArea floor_area() const override;
+  std::span<const uint8_t> floor_rgb() const override { return rgb_; }
+  bool floor_marked(int column, int row) const override { return painted(column, row); }
 
   void Record(const World& world, std::vector<MetricSample>* out) override;
   // Writes paint.png into `dir`.
@@ -60,14 +70,16 @@ class PaintLayer final : public Observer {
     uint8_t r, g, b;
   };
   void RefreshNozzles(const Scene& scene);
+  const Rows<PaintNozzleData>& Nozzles(const Scene& scene) const;
   void Stamp(const Scene& scene, uint32_t slot, std::vector<Stroke>* out) const;
   void Apply(std::vector<Stroke>* strokes);
 
   World* world_;
   PaintSettings settings_;
   int width_ = 0, height_ = 0;
-  std::vector<uint8_t> rgb_;      // (height x width x 3)
-  std::vector<uint8_t> painted_;  // (height x width)
+  std::vector<uint8_t> rgb_;                        // (height x width x 3)
+  std::vector<uint8_t> painted_;                    // (height x width)
+  const Rows<PaintNozzleData>* nozzles_ = nullptr;  // the scene's, since the last Record
   uint64_t nozzles_version_ = ~uint64_t{0};
   std::vector<std::vector<uint32_t>> robot_nozzles_;  // nozzle slots per robot (robots)
   std::vector<uint32_t> scene_nozzles_;               // slots of nozzles outside robots

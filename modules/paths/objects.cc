@@ -157,7 +157,7 @@ void Register(ModuleRegistry* registry) {
   registry->RegisterModule(
       {{"calculation", kModuleName, "1.0",
         "path objects and their followers, moved along them in the actuate phase (path type)"},
-       PhaseBit(ModulePhase::kActuate),
+       PhaseBit(Phase::kActuate),
        50,
        /*every_world=*/true,
        [](World*, const void*) { return std::make_unique<PathsModule>(); }});

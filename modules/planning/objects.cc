@@ -158,7 +158,7 @@ void Register(ModuleRegistry* registry) {
       {{"calculation", kModuleName, "1.0",
         "path planning on OMPL 1.5 (planning_task type): RRT-Connect (se2, se3), RRT (dubins, "
         "reeds_shepp), robots in parallel, deterministic"},
-       PhaseBit(ModulePhase::kActuate),
+       PhaseBit(Phase::kActuate),
        60,
        /*every_world=*/true,
        [](World*, const void*) { return std::make_unique<PlanningModule>(); }});

@@ -116,7 +116,7 @@ void Register(ModuleRegistry* registry, swarmsim::ModuleInfo info, BackendFactor
   if (!factory) factory = [] { return MakeBackend(); };
   info.kind = "proximity";
   registry->RegisterModule(
-      {std::move(info), PhaseBit(ModulePhase::kSense), 100,
+      {std::move(info), PhaseBit(Phase::kSense), 100,
        /*every_world=*/true,
        [factory = std::move(factory)](World*, const void*) { return MakeModule(factory()); }});
   // The descriptor is a constant of this module: shared without an owner.

@@ -5,11 +5,11 @@
 #include <mutex>
 
 #include "framework/environment.h"
+#include "framework/floor_layer.h"
 #include "framework/mesh.h"
 #include "framework/scene.h"
 #include "framework/world.h"
 #include "modules/blobs/leds.h"
-#include "modules/paint/paint_layer.h"
 #include "modules/rendering/objects.h"
 
 namespace swarmsim::rendering {
@@ -259,12 +259,11 @@ void BuildDrawList(const World& world, int segments, DrawList* list, double min_
   list->step = world.step_count();
   // The paint layer, laid on the floor.
   list->floor = {};
-  if (const Module* m = world.find_module("paint"))
-    if (const auto* paint = dynamic_cast<const paint::PaintLayer*>(m)) {
-      const paint::PaintSettings& ps = paint->settings();
-      list->floor = {true,     ps.min_x,       ps.min_y,        ps.max_x,
-                     ps.max_y, paint->width(), paint->height(), paint->rgb().data()};
-    }
+  if (const ::swarmsim::FloorLayer* layer = world.floor_layer()) {
+    const FloorArea area = layer->floor_area();
+    list->floor = {true,       area.min_x, area.min_y,  area.max_x,
+                   area.max_y, area.width, area.height, layer->floor_rgb().data()};
+  }
 }
 
 }  // namespace swarmsim::rendering

@@ -122,7 +122,7 @@ void RenderingModule::RenderDue(World* world, bool all) {
 ModuleDescriptor RenderingModuleDescriptor() {
   return {{"sensing", kModuleName, "1.0",
            "cameras, lights and vision sensors drawn with Mesa's off-screen OpenGL (OSMesa)"},
-          PhaseBit(ModulePhase::kSense),
+          PhaseBit(Phase::kSense),
           150,
           /*every_world=*/true,
           [](World*, const void*) { return std::make_unique<RenderingModule>(); }};

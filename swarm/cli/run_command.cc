@@ -284,8 +284,7 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
       settings.every = std::max<int64_t>(1, loaded.record_every);
       settings.world_file = args.world_file;
       settings.steps_planned = options.steps;
-      for (const SwarmMetricSpec& metric : loaded.metrics)
-        settings.metric_names.push_back(metric.name);
+      settings.metric_names = loaded.metric_names;
       try {
         CreateOutputFolder(*options.out_dir);
         run_recorder = record::AddRecorder(loaded.world.get(), settings);

@@ -115,8 +115,7 @@ void AddIkGroups(const ModelFile& model, const std::vector<IkGroupDef>& groups,
                  const ObjectSpec& spec, ObjectId root, World* world) {
   if (groups.empty()) return;
   Scene& scene = world->scene();
-  auto* module = dynamic_cast<IkGroups*>(world->calculation(kIkModuleName));
-  if (!module) throw Error("the 'ik' calculation module is not an IK module");
+  IkGroups* module = &kinematics::IkGroupsOf(world);
   std::vector<std::string> known;
   CollectPaths(spec, "", &known);
   // A path in the model, from its root: "leg1/footTip" (or "." for the root).

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "framework/ik_groups.h"
+#include "modules/kinematics/ik_groups.h"
 #include "swarm/loader/model.h"
 #include "swarm/loader/values.h"
 

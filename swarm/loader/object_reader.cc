@@ -64,3 +64,38 @@ std::vector<std::unique_ptr<ObjectReader>> FieldsObjectReader::Items(std::string
 }
 
 }  // namespace swarmsim::loader
+
+namespace swarmsim::loader {
+
+std::unique_ptr<ObjectReader> FieldsObjectReader::Map(std::string_view key, const std::string& what,
+                                                      std::string_view expected) const {
+  const Field field = fields_.Get(key);
+  if (!field.present()) return nullptr;
+  if (!field.node.IsMap())
+    values_.file().Fail(field.mark, "'" + std::string(key) + "' must be " + std::string(expected) +
+                                        " (got " + Describe(field.node) + ")");
+  auto fields = std::make_unique<Fields>(values_.file(), field, what);
+  return std::unique_ptr<ObjectReader>(
+      new FieldsObjectReader(values_, std::move(fields), meshes_, registry_));
+}
+
+std::vector<std::unique_ptr<ObjectReader>> FieldsObjectReader::Elements(
+    std::string_view key, std::string_view list_what, const std::string& what,
+    std::string_view scalar_key) const {
+  std::vector<std::unique_ptr<ObjectReader>> out;
+  for (Field& element : ListElements(values_.file(), fields_.Get(key), list_what)) {
+    const bool is_map = element.node.IsMap();
+    std::unique_ptr<Fields> fields;
+    if (is_map) {
+      fields = std::make_unique<Fields>(values_.file(), element, what);
+    } else {
+      element.name = std::string(scalar_key);
+      fields = std::make_unique<Fields>(Fields::Single(values_.file(), element, what));
+    }
+    out.push_back(std::unique_ptr<ObjectReader>(
+        new FieldsObjectReader(values_, std::move(fields), meshes_, registry_, !is_map)));
+  }
+  return out;
+}
+
+}  // namespace swarmsim::loader

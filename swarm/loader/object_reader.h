@@ -58,19 +58,35 @@ class FieldsObjectReader final : public ObjectReader {
   const ModuleRegistry* registry() const override { return registry_; }
   std::vector<std::unique_ptr<ObjectReader>> Items(std::string_view key) const override;
   void Expect(std::span<const std::string> known) const override { fields_.Expect(known); }
+  void Require(std::string_view key) const override {
+    if (!single_value_) fields_.Require(key);
+  }
+  std::unique_ptr<ObjectReader> Map(std::string_view key, const std::string& what,
+                                    std::string_view expected) const override;
+  std::vector<std::unique_ptr<ObjectReader>> Elements(std::string_view key,
+                                                      std::string_view list_what,
+                                                      const std::string& what,
+                                                      std::string_view scalar_key) const override;
+  [[noreturn]] void FailHere(const std::string& message) const override {
+    values_.file().Fail(fields_.mark(), message);
+  }
 
  private:
-  // An item's reader owns its map's fields.
+  // An item's reader owns its map's fields; `single_value`: a bare value
+  // read as a map of one key (Elements), whose value is there as it is.
   FieldsObjectReader(const ValueReader& values, std::unique_ptr<Fields> fields, MeshCache* meshes,
-                     const ModuleRegistry* registry)
+                     const ModuleRegistry* registry, bool single_value = false)
       : values_(values),
         fields_(*fields),
         meshes_(meshes),
         registry_(registry),
-        owned_fields_(std::move(fields)) {}
+        owned_fields_(std::move(fields)),
+        single_value_(single_value) {}
 
+  // A single value's one key is never "required": an empty value is read
+  // (and refused) as a value.
   Field Get(std::string_view key, bool required) const {
-    return required ? fields_.Require(key) : fields_.Get(key);
+    return required && !single_value_ ? fields_.Require(key) : fields_.Get(key);
   }
 
   const ValueReader& values_;
@@ -78,6 +94,7 @@ class FieldsObjectReader final : public ObjectReader {
   MeshCache* meshes_;
   const ModuleRegistry* registry_;
   std::unique_ptr<Fields> owned_fields_;
+  bool single_value_ = false;
 };
 
 }  // namespace swarmsim::loader

@@ -6,12 +6,12 @@
 #include <utility>
 
 #include "framework/error.h"
-#include "framework/ik_groups.h"
 #include "framework/object_type.h"
 #include "framework/plugin_loader.h"
 #include "framework/registry.h"
+#include "framework/world_section.h"
 #include "swarm/loader/environment.h"
-#include "swarm/loader/paint.h"
+#include "swarm/loader/object_reader.h"
 #include "swarm/loader/urdf.h"
 #include "swarm/loader/world_loader_impl.h"
 
@@ -21,9 +21,18 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const std::vector<std::string> kTopKeys = {"simulation",  "parameters", "arena",        "obstacles",
-                                           "environment", "models",     "objects",      "metrics",
-                                           "paint",       "plugins",    "package_path", "record"};
+// The loader's own top-level keys; the others are the registered modules'
+// world-file sections (framework/world_section.h: metrics, paint, ...).
+const std::vector<std::string> kTopKeys = {"simulation",   "parameters", "arena",   "obstacles",
+                                           "environment",  "models",     "objects", "plugins",
+                                           "package_path", "record"};
+
+// Every top-level key a world file may give: the loader's, then the sections'.
+std::vector<std::string> TopKeys(const ModuleRegistry& registry) {
+  std::vector<std::string> keys = kTopKeys;
+  for (const auto& section : registry.world_sections()) keys.push_back(section->key);
+  return keys;
+}
 
 std::vector<Override> SplitOverrides(const LoadOptions& options) {
   std::vector<Override> out;
@@ -81,7 +90,7 @@ LoadedWorld WorldLoader::Load() {
            "'models' (got " +
                loader::Describe(f.root()) + ")");
   Fields top(f, root, "the world file");
-  top.Expect(kTopKeys);
+  top.Expect(TopKeys(registry_));
   overrides_ = SplitOverrides(options_);
 
   // Parameters first: every other value may use them.
@@ -119,12 +128,11 @@ LoadedWorld WorldLoader::Load() {
            f, top.Get("objects"), WorldValues(), &scripts_, &meshes_, world_registry_))
     loader::AddToScene(spec, {}, &world->scene());
   CheckObjects(world->scene());
-  // IK groups' obstacles (avoid entries) may name those objects too.
-  if (auto* ik = dynamic_cast<IkGroups*>(world->find_calculation(kIkModuleName)))
-    ik->CheckReferences(world->scene());
-  out.metrics = ReadMetrics(top, world);
+  // Modules' references (IK groups' obstacles) may name those objects too.
+  world->CheckModuleReferences();
+  ReadSections(top, world);
+  out.metric_names = MetricNames(*world);
   out.models = Summarize();
-  loader::AddPaintLayer(f, root, top.Get("paint"), WorldValues(), arena_, world);
   out.record_every = ReadRecord(top);
   return out;
 }
@@ -542,37 +550,28 @@ void WorldLoader::BuildObstacles(const Fields& top, World* world) {
     ++index;
   }
 }
-// --- Metrics -------------------------------------------------------------------------------
+// --- Modules' sections ---------------------------------------------------------------------
 
-std::vector<SwarmMetricSpec> WorldLoader::ReadMetrics(const Fields& top, World* world) {
-  std::vector<SwarmMetricSpec> out;
+// The registered world-file sections (metrics:, paint:, ...), each read by
+// its module through an ObjectReader over the top level, in registration
+// order, whether its key is there or not.
+void WorldLoader::ReadSections(const Fields& top, World* world) {
   const ValueReader values = WorldValues();
-  std::vector<std::string> known;  // the registered metric modules
-  for (const ModuleDescriptor* metric : world->registry().ModulesOfKind("metric"))
-    known.push_back(metric->info.name);
-  for (const Field& element : loader::ListElements(*file_, top.Get("metrics"), "metrics")) {
-    SwarmMetricSpec spec;
-    Field name_field = element;
-    if (element.node.IsMap()) {
-      Fields f(*file_, element, "a metric");
-      f.Expect({"name", "every"});
-      name_field = f.Require("name");
-      if (f.Has("every"))
-        spec.every_steps = static_cast<int>(values.Integer(f.Get("every"), 1, 1 << 30));
-    }
-    name_field.name = "name";
-    spec.name = values.String(name_field);
-    if (std::find(known.begin(), known.end(), spec.name) == known.end())
-      file_->Fail(name_field.mark,
-                  "unknown metric '" + spec.name + "'" + loader::Suggest(spec.name, known));
-    try {
-      world->AddModule(spec.name, &spec.every_steps);
-    } catch (const Error& e) {
-      file_->Fail(name_field.mark, e.what());
-    }
-    out.push_back(spec);
+  const FieldsObjectReader reader(values, top, &meshes_, world_registry_);
+  WorldSectionContext context;
+  if (arena_) context.arena = {arena_->min_x, arena_->min_y, arena_->max_x, arena_->max_y};
+  for (const auto& section : registry_.world_sections()) section->read(reader, context, world);
+}
+
+// The metric modules the world made (kind "metric"), in creation order: the
+// columns a recording declares up front.
+std::vector<std::string> WorldLoader::MetricNames(const World& world) const {
+  std::vector<std::string> names;
+  for (const std::string& name : world.module_names()) {
+    const ModuleDescriptor* module = world.registry().FindModule(name);
+    if (module != nullptr && module->info.kind == "metric") names.push_back(name);
   }
-  return out;
+  return names;
 }
 
 }  // namespace swarmsim::loader

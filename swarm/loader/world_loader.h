@@ -17,7 +17,6 @@
 #include <vector>
 
 #include "framework/world.h"
-#include "modules/metrics/swarm_metrics.h"
 
 namespace swarmsim {
 
@@ -87,8 +86,9 @@ struct LoadedWorld {
   // The world's default run length: simulation.steps, or
   // round(simulation.duration / simulation.time_step). Empty if it gives neither.
   std::optional<int64_t> steps;
-  // The swarm metrics the world asked for (already added to the world as observers).
-  std::vector<SwarmMetricSpec> metrics;
+  // The metrics the world's `metrics:` asked for (already added to the
+  // world as modules of kind "metric"), in file order.
+  std::vector<std::string> metric_names;
   // The models entries, for `swarmsim describe`.
   std::vector<ModelSummary> models;
   // What may surprise without being an error ("file:line:col: ..."), for the

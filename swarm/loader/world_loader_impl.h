@@ -1,7 +1,7 @@
 // Internal to the world loader (swarm/loader), not for use outside it: the
 // WorldLoader class behind LoadWorld and the types it works with. Its members
 // are defined by topic: world_loader.cc (the world file's parameters, plugins,
-// simulation, arena, obstacles and metrics) and world_entries.cc (the
+// simulation, arena, obstacles, modules' sections) and world_entries.cc (the
 // `models:` entries: their parameters, objects and placement, and the copies
 // built from them).
 #pragma once
@@ -147,7 +147,8 @@ class WorldLoader {
   void BuildArena(const Fields& top, World* world);
   void BuildObstacles(const Fields& top, World* world);
   void AddObstacleFootprint(const ShapeData& shape, const Pose& X_WO);
-  std::vector<SwarmMetricSpec> ReadMetrics(const Fields& top, World* world);
+  void ReadSections(const Fields& top, World* world);
+  std::vector<std::string> MetricNames(const World& world) const;
   int64_t ReadRecord(const Fields& top) const;
 
   // The models entries (world_entries.cc), in the order Load runs them.

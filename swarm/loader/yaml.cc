@@ -119,6 +119,12 @@ Fields::Fields(const YamlFile& file, const Field& mapping, std::string what)
   }
 }
 
+Fields Fields::Single(const YamlFile& file, Field only, std::string what) {
+  Fields fields(file, std::move(what), only.mark);
+  fields.fields_.push_back(std::move(only));
+  return fields;
+}
+
 void Fields::Expect(std::span<const std::string> known) const {
   for (const Field& f : fields_) {
     if (std::find(known.begin(), known.end(), f.name) != known.end()) continue;

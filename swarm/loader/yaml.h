@@ -96,6 +96,9 @@ std::string Describe(const YAML::Node& node);
 class Fields {
  public:
   Fields(const YamlFile& file, const Field& mapping, std::string what);
+  // A value read as a mapping with the one key `only.name` (a bare name in
+  // a list of maps: `metrics: [covered_area]`).
+  static Fields Single(const YamlFile& file, Field only, std::string what);
   // Throws for a key not in `known`.
   void Expect(std::span<const std::string> known) const;
   void Expect(std::initializer_list<std::string_view> known) const;
@@ -111,6 +114,9 @@ class Fields {
   std::span<const Field> fields() const { return fields_; }
 
  private:
+  Fields(const YamlFile& file, std::string what, YAML::Mark mark)
+      : file_(file), what_(std::move(what)), mark_(mark) {}
+
   const YamlFile& file_;
   std::string what_;
   YAML::Mark mark_;

@@ -446,7 +446,7 @@ std::shared_ptr<ModuleRegistry> MakeRegistry() {
   ModuleDescriptor d;
   d.info = {"calculation", kControllerModule, "1",
             "a models entry's python_controller, called once a step with all its robots"};
-  d.phases = PhaseBit(ModulePhase::kActuate);
+  d.phases = PhaseBit(Phase::kActuate);
   d.order = 10;
   d.make = [](World*, const void* config) -> std::unique_ptr<Module> {
     return std::make_unique<ControllerModule>(*static_cast<const ControllerConfig*>(config));
@@ -504,7 +504,7 @@ class PyWorld {
       throw py::value_error(e.what());
     }
     World& world = *loaded_.world;
-    planar_ = world.settings().physics == "box2d";
+    planar_ = world.registry().dynamics_capabilities(world.settings().physics).planar;
     // Controllers: the world file's, then the constructor's (replacing them).
     std::map<std::string, ControllerConfig> configs;
     // A controller drives every robot of its model, so all the entries of

@@ -6,14 +6,15 @@
 #include <cstring>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <span>
 #include <unordered_map>
 
 #include "framework/error.h"
+#include "framework/floor_layer.h"
 #include "framework/object_type.h"
 #include "framework/scheduler.h"
 #include "framework/world.h"
 #include "modules/blobs/leds.h"
-#include "modules/paint/paint_layer.h"
 #include "modules/proximity/proximity_sensor.h"
 #include "swarm/record/chunk_writer.h"
 #include "swarm/record/format.h"
@@ -111,7 +112,7 @@ struct RunRecorder::Impl {
   bool has_leds = false;
   ObjectType sensor_type{};  // proximity sensors'
   bool has_sensors = false;
-  const paint::PaintLayer* paint = nullptr;
+  const FloorLayer* paint = nullptr;    // the world's floor layer (the paint layer), if any
   std::vector<uint8_t> paint_previous;  // rgb at the last step record (height x width x 3)
 
   // The recorded objects (ids) and, per robot, its id range.
@@ -186,7 +187,7 @@ json RunRecorder::Impl::Header() const {
     hi_x = std::max(hi_x, x1), hi_y = std::max(hi_y, y1);
   };
   if (paint != nullptr) {
-    const paint::PaintSettings& ps = paint->settings();
+    const FloorArea ps = paint->floor_area();
     cover(ps.min_x, ps.min_y, ps.max_x, ps.max_y);
   } else {
     const auto shapes = scene.shapes();
@@ -224,10 +225,10 @@ json RunRecorder::Impl::Header() const {
     j["environment"] = nullptr;
   }
   if (paint != nullptr) {
-    const paint::PaintSettings& ps = paint->settings();
+    const FloorArea ps = paint->floor_area();
     j["paint"] = {{"min", {ps.min_x, ps.min_y}}, {"max", {ps.max_x, ps.max_y}},
-                  {"resolution", ps.resolution}, {"width", paint->width()},
-                  {"height", paint->height()},   {"background", ColorJson(ps.background)}};
+                  {"resolution", ps.resolution}, {"width", ps.width},
+                  {"height", ps.height},         {"background", ColorJson(ps.background)}};
   } else {
     j["paint"] = nullptr;
   }
@@ -484,20 +485,20 @@ void RunRecorder::Impl::WriteStep(const World& w) {
   snap->reading = reading;
   // Paint: every painted cell in a keyframe, else the cells that changed.
   if (paint != nullptr) {
-    const std::vector<uint8_t>& rgb = paint->rgb();
-    const uint32_t width = static_cast<uint32_t>(paint->width());
+    const std::span<const uint8_t> rgb = paint->floor_rgb();
+    const uint32_t width = static_cast<uint32_t>(paint->floor_area().width);
     if (paint_previous.size() != rgb.size()) paint_previous.assign(rgb.size(), 0);
     const uint32_t cells = static_cast<uint32_t>(rgb.size() / 3);
     for (uint32_t c = 0; c < cells; ++c) {
       const bool take =
-          keyframe ? paint->painted(static_cast<int>(c % width), static_cast<int>(c / width))
+          keyframe ? paint->floor_marked(static_cast<int>(c % width), static_cast<int>(c / width))
                    : std::memcmp(&rgb[3 * c], &paint_previous[3 * c], 3) != 0;
       if (!take) continue;
       snap->paint_cells.push_back(c);
       snap->paint_rgba.push_back(rgb[3 * c] | (uint32_t{rgb[3 * c + 1]} << 8) |
                                  (uint32_t{rgb[3 * c + 2]} << 16) | (uint32_t{255} << 24));
     }
-    paint_previous = rgb;
+    paint_previous.assign(rgb.begin(), rgb.end());
   }
   // Metric names (all of them in a keyframe) and the samples since the last record.
   snap->first_name = static_cast<uint32_t>(keyframe ? 0 : names_written);
@@ -525,8 +526,7 @@ void RunRecorder::Start(World* world) {
   r.world = world;
   r.has_leds = world->scene().FindType(kLedTypeName, &r.led_type);
   r.has_sensors = proximity::FindSensorType(world->scene(), &r.sensor_type);
-  if (const Module* m = world->find_module("paint"); m != nullptr)
-    r.paint = dynamic_cast<const paint::PaintLayer*>(m);
+  r.paint = world->floor_layer();
   for (const std::string& name : r.settings.metric_names) r.MetricId(name);
   r.file->AddJson(static_cast<uint8_t>(ChunkKind::kHeader), 0, r.Header().dump());
   r.WriteStep(*world);

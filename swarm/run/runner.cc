@@ -22,6 +22,7 @@
 
 #include "framework/error.h"
 #include "framework/output_file.h"
+#include "framework/registry.h"
 #include "framework/script_host.h"
 #include "framework/state_hash.h"
 #include "framework/utf8.h"
@@ -275,8 +276,9 @@ class Progress {
 };
 
 // "box2d, 10 substeps"; "kinematic" (no physics engine steps: no substeps).
-std::string PhysicsLine(const WorldSettings& settings) {
-  if (settings.physics == "kinematic" || settings.physics == "null") return settings.physics;
+std::string PhysicsLine(const World& world) {
+  const WorldSettings& settings = world.settings();
+  if (!world.registry().dynamics_capabilities(settings.physics).substeps) return settings.physics;
   return settings.physics + ", " + std::to_string(settings.physics_substeps) +
          (settings.physics_substeps == 1 ? " physics substep" : " physics substeps");
 }
@@ -460,7 +462,7 @@ void PrintSummaryTable(const World& world, const RunResult& result, double lua_k
   const double ticks_per_s = result.wall_seconds > 0 ? robot_ticks / result.wall_seconds : 0;
   out << "robots          " << robots << "\n"
       << "steps           " << result.steps << " (time step " << world.settings().time_step
-      << " s, " << PhysicsLine(world.settings()) << ")\n"
+      << " s, " << PhysicsLine(world) << ")\n"
       << "simulated time  " << Fixed(sim_time, 2) << " s\n"
       << "wall time       " << Fixed(result.wall_seconds, 3) << " s on " << world.threads()
       << (world.threads() == 1 ? " thread\n" : " threads\n") << "real-time factor " << Fixed(rtf, 1)

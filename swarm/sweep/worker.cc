@@ -68,10 +68,15 @@ void ReadMetrics(const std::filesystem::path& path, RunOutcome* out) {
     if (c1 == std::string::npos || c2 == std::string::npos || c3 == std::string::npos || c3 < c2 ||
         c4 == c3)
       continue;
+    // Every field read before the row counts: a torn last line ("3,0.3,bot#0,x")
+    // must not leave an entry without values (a NaN metric named after a robot).
     try {
-      Acc& a = acc[Key{line.substr(c3 + 1, c4 - c3 - 1), std::stoll(line.substr(0, c1))}];
-      a.time = std::stod(line.substr(c1 + 1, c2 - c1 - 1));
-      a.sum += std::stod(line.substr(c4 + 1));
+      const int64_t step = std::stoll(line.substr(0, c1));
+      const double time = std::stod(line.substr(c1 + 1, c2 - c1 - 1));
+      const double value = std::stod(line.substr(c4 + 1));
+      Acc& a = acc[Key{line.substr(c3 + 1, c4 - c3 - 1), step}];
+      a.time = time;
+      a.sum += value;
       ++a.n;
     } catch (const std::exception&) {
       continue;  // nan/inf values or a torn last line

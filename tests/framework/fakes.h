@@ -32,7 +32,7 @@ class NullProximity : public ProximityBackend {
 // (modules/proximity: framework tests link it for that).
 inline ModuleRegistry NullRegistry() {
   ModuleRegistry r;
-  r.RegisterDynamics({"", "null", "1", "moves nothing"},
+  r.RegisterDynamics({"", "null", "1", "moves nothing"}, {.substeps = false},
                      [] { return std::make_unique<NullDynamics>(); });
   proximity::Register(&r, {"", "proximity", "1", "detects nothing"},
                       [] { return std::make_unique<NullProximity>(); });

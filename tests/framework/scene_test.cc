@@ -139,55 +139,6 @@ TEST(SceneTest, PathsResolveRelativeToTheCaller) {
   EXPECT_EQ(scene.PathOf(s1), "/robot/body/sensor");
 }
 
-TEST(SceneTest, DuplicatingAModelCopiesObjectsScriptsAndRemapsReferences) {
-  Scene scene;
-  const ObjectId outside = scene.AddDummy("landmark", {}, {});
-  ShapeData body_shape;
-  body_shape.kind = ShapeKind::kCylinder;
-  body_shape.dynamic = true;
-  const ObjectId root = scene.AddShape("body", {}, {{1, 0, 0}, {}}, body_shape);
-  const ObjectId motor = scene.AddJoint("motor", root, {{0, 0.1, 0}, {}}, JointData{});
-  const ObjectId tip = scene.AddDummy("tip", motor, {});
-  const ObjectId target = scene.AddDummy("target", root, {});
-  const ObjectId beacon = scene.AddDummy("beacon", root, {});
-  scene.LinkDummies(tip, target);      // internal reference
-  scene.LinkDummies(beacon, outside);  // reference to outside the model
-  auto source = std::make_shared<ScriptSource>(ScriptSource{"ctl.lua", "-- code"});
-  scene.AttachScript(root, source);
-  const int first = scene.MakeModelInstance(root, "bot", "bot#0");
-  EXPECT_EQ(first, 0);
-
-  const ObjectId copy = scene.DuplicateSubtree(root, {});
-  ASSERT_EQ(scene.instances().size(), 2u);
-  EXPECT_EQ(scene.instance_of(copy), 1);
-  EXPECT_EQ(scene.instance(1).model_name, "bot");
-  EXPECT_EQ(scene.instance(1).objects.size(), scene.instance(0).objects.size());
-  // Objects copied, with their data.
-  EXPECT_TRUE(scene.shape(copy).dynamic);
-  const ObjectId copy_motor = scene.FindObject("./motor", copy);
-  ASSERT_FALSE(copy_motor.IsNull());
-  EXPECT_NE(copy_motor, motor);
-  // Script copied, source shared (an asset, not a copy).
-  ASSERT_NE(scene.script(copy), nullptr);
-  EXPECT_EQ(scene.script(copy)->source.get(), source.get());
-  // Internal link remapped to the copy; external link kept.
-  const ObjectId copy_tip = scene.FindObject("./tip", copy);
-  const ObjectId copy_target = scene.FindObject("./target", copy);
-  EXPECT_EQ(scene.linked_dummy(copy_tip), copy_target);
-  EXPECT_EQ(scene.linked_dummy(tip), target);
-  EXPECT_EQ(scene.linked_dummy(scene.FindObject("./beacon", copy)), outside);
-  // Every object of the copy belongs to the new instance.
-  for (uint32_t s : scene.instance(1).objects) EXPECT_EQ(scene.instance_of_at(s), 1);
-
-  // Deleting the copy deletes its objects and retires its instance.
-  const size_t before = scene.object_count();
-  scene.RemoveSubtree(copy);
-  EXPECT_EQ(scene.object_count(), before - 5);
-  EXPECT_FALSE(scene.instance(1).alive);
-  EXPECT_FALSE(scene.IsValid(copy_tip));
-  EXPECT_EQ(scene.linked_dummy(tip), target);
-}
-
 TEST(SceneTest, TypedAccessChecksTheType) {
   Scene scene;
   const ObjectId d = scene.AddDummy("d", {}, {});

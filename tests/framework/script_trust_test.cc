@@ -385,28 +385,6 @@ TEST_F(TrustTest, MetricNamesAndPrintsAreCapped) {
 
 // --- Error texts ------------------------------------------------------------------------------
 
-TEST(CutErrorTextTest, CutsTheMiddleBetweenCharacters) {
-  EXPECT_EQ(CutErrorText("short"), "short");
-  const std::string long_text = "file.lua:3: " + std::string(10000, 'e') + " [in x]";
-  const std::string cut = CutErrorText(long_text);
-  EXPECT_LE(cut.size(), kMaxErrorTextBytes);
-  EXPECT_EQ(cut.rfind("file.lua:3: eee", 0), 0u);
-  EXPECT_CONTAINS(cut, " bytes cut) ... ");
-  EXPECT_EQ(cut.substr(cut.size() - 8), "e [in x]");
-  // Two-, three- and four-byte characters are never split.
-  for (const std::string character : {"\xC3\xA9", "\xE2\x82\xAC", "\xF0\x9F\x98\x80"}) {
-    for (size_t shift = 0; shift < 4; ++shift) {
-      std::string text(shift, 'a');
-      for (int i = 0; i < 5000; ++i) text += character;
-      const std::string c = CutErrorText(text);
-      EXPECT_LE(c.size(), kMaxErrorTextBytes);
-      EXPECT_TRUE(IsValidUtf8(c)) << shift;
-    }
-  }
-  // Every swarmsim::Error is cut so.
-  EXPECT_LE(std::string(Error(std::string(1 << 20, 'x')).what()).size(), kMaxErrorTextBytes);
-}
-
 TEST_F(TrustTest, AHugeScriptErrorIsCutAndStillNamesWhereItHappened) {
   const std::string error = Run("function sysCall_actuation()\n  error(('e'):rep(1e7))\nend\n");
   EXPECT_LE(error.size(), kMaxErrorTextBytes);

@@ -164,41 +164,6 @@ TEST(WorldModelEditsTest, CopyAndRemoveOfTheSameRobotInOneStepCopiesThenRemoves)
   EXPECT_EQ(w.log, (std::vector<std::string>{"[bot#0] init", "[bot#1] init"}));
 }
 
-TEST(WorldModelEditsTest, MistakesAreClearErrors) {
-  const auto error_of = [](const std::string& code) {
-    ModelWorld w;
-    w.AddRobot("function sysCall_actuation()\n" + code + "\nend");
-    w.AddRobot(R"(
-      function sysCall_actuation()
-        if sim.getSimulationTime() == 0 then sim.removeModel(sim.getObject(':')) end
-      end
-    )");
-    return ErrorOf([&] {
-      for (int i = 0; i < 3; ++i) w.world().Step();
-    });
-  };
-  // Copying a removed robot (removed at step 0).
-  EXPECT_CONTAINS(error_of("if REMOVED then sim.copyModel(REMOVED) end\n"
-                           "REMOVED = sim.getObject('/bot#1')"),
-                  "sim.copyModel: robot handle");
-  EXPECT_CONTAINS(error_of("if REMOVED then sim.copyModel(REMOVED) end\n"
-                           "REMOVED = sim.getObject('/bot#1')"),
-                  "is stale: the object was removed");
-  // Not a robot's root.
-  EXPECT_CONTAINS(error_of("sim.copyModel(sim.getObject('.'))"), "'/bot#0/body' (handle ");
-  EXPECT_CONTAINS(error_of("sim.removeObjects({sim.getObject(':'), sim.getObject('.')})"),
-                  "is not a robot");
-  EXPECT_CONTAINS(error_of("sim.copyModel(sim.getObject(':'), {1, 'a'})"),
-                  "pose {x, y, yaw} of three finite numbers expected");
-  EXPECT_CONTAINS(error_of("sim.copyPasteObjects({sim.getObject(':')}, 1)"), "only 0");
-  // Huge counts: a limit, not memory exhausted.
-  EXPECT_CONTAINS(error_of("for i = 1, 10000 do sim.copyModel(sim.getObject(':')) end"),
-                  "more than 1000 robot copies and removals queued in one step");
-  EXPECT_CONTAINS(error_of("local t = {} for i = 1, 10000 do t[i] = sim.getObject(':') end\n"
-                           "sim.copyPasteObjects(t)"),
-                  "more than 1000 handles");
-}
-
 TEST(WorldModelEditsTest, ManyCopiesInOneStepWork) {
   ModelWorld w;
   w.AddRobot(R"(

@@ -36,9 +36,9 @@ class ConveyorDynamics : public DynamicsBackend {
 
 ModuleRegistry MakeRegistry() {
   ModuleRegistry r = testing::NullRegistry();
-  r.RegisterDynamics({"", "conveyor", "1", ""},
+  r.RegisterDynamics({"", "conveyor", "1", ""}, {},
                      [] { return std::make_unique<ConveyorDynamics>(false); });
-  r.RegisterDynamics({"", "explode", "1", ""},
+  r.RegisterDynamics({"", "explode", "1", ""}, {},
                      [] { return std::make_unique<ConveyorDynamics>(true); });
   return r;
 }

@@ -4,18 +4,18 @@
 
 #include <vector>
 
-#include "framework/force_sensor.h"
 #include "framework/scene.h"
 #include "modules/dynamics/box2d/plane_world.h"
 #include "modules/dynamics/scene_walk.h"
+#include "modules/force_sensor/force_sensor.h"
 
 namespace swarmsim::box2d {
 
 void PlaneWorld::BuildForceSensors(const Scene& scene, const std::vector<int32_t>& body_of) {
-  const auto owners = scene.force_sensor_owners();
+  const Rows<ForceSensorData>& sensors = *force_sensor::RowsOf(scene);  // Build checked Any
   for (uint32_t row : dynamics::ForceSensorRowsInSlotOrder(scene)) {
-    const uint32_t s = owners[row];
-    if (scene.force_sensors()[row].broken) continue;
+    const uint32_t s = sensors.owners[row];
+    if (sensors.rows[row].broken) continue;
     const int32_t child_slot = dynamics::FirstDynamicShapeBelow(scene, s);
     if (child_slot < 0) continue;  // nothing dynamic to hold: no reading
     const int32_t child = body_of[child_slot];
@@ -34,6 +34,7 @@ void PlaneWorld::ReadForceSensors(Scene* scene) {
   if (!(last_dt_ > 0)) return;
   const float inv_dt = static_cast<float>(1.0 / last_dt_);
   const double inv_L = 1.0 / scale_;
+  Rows<ForceSensorData>& sensors = *force_sensor::RowsOf(scene);  // Build found some
   for (PlaneForceSensor& f : force_sensors_) {
     if (!f.weld) continue;
     // Reaction on body B (the child) at the anchor, Box2D units -> N, N m.
@@ -44,7 +45,7 @@ void PlaneWorld::ReadForceSensors(Scene* scene) {
     // The sensor's frame: the child body's yaw carries it (its scene pose is
     // refreshed only after the physics phase).
     const Quat q_SW = scene->world_pose_at(f.slot).q.Conjugate();
-    ForceSensorData& data = scene->force_sensors()[f.row];
+    ForceSensorData& data = sensors.rows[f.row];
     if (RecordForceSensorSample(&data, q_SW.Rotate(f_W), q_SW.Rotate(t_W))) {
       world_->DestroyJoint(f.weld);
       f.weld = nullptr;

@@ -205,7 +205,7 @@ void PlaneWorld::Build(const Scene& scene) {
   // 4. No wheels: Coulomb friction with the ground.
   BuildGroundFriction(scene);
   // 5. Force sensors.
-  if (!scene.force_sensors().empty()) BuildForceSensors(scene, body_of);
+  if (force_sensor::Any(scene)) BuildForceSensors(scene, body_of);
 }
 
 void PlaneWorld::Reset() {

@@ -1,19 +1,19 @@
 // Force sensors in ODE: a fixed joint with dJointSetFeedback per sensor.
 #include <vector>
 
-#include "framework/force_sensor.h"
 #include "framework/scene.h"
 #include "modules/dynamics/ode/ode_internal.h"
 #include "modules/dynamics/ode/ode_world.h"
 #include "modules/dynamics/scene_walk.h"
+#include "modules/force_sensor/force_sensor.h"
 
 namespace swarmsim::ode {
 
 void OdeWorld::BuildForceSensors(const Scene& scene, const std::vector<dBodyID>& body_of) {
-  const auto owners = scene.force_sensor_owners();
+  const Rows<ForceSensorData>& sensors = *force_sensor::RowsOf(scene);  // Build checked Any
   for (uint32_t row : dynamics::ForceSensorRowsInSlotOrder(scene)) {
-    const uint32_t s = owners[row];
-    if (scene.force_sensors()[row].broken) continue;
+    const uint32_t s = sensors.owners[row];
+    if (sensors.rows[row].broken) continue;
     const int32_t child_slot = dynamics::FirstDynamicShapeBelow(scene, s);
     if (child_slot < 0) continue;  // nothing dynamic to hold: no reading
     const dBodyID child = body_of[child_slot];
@@ -33,6 +33,8 @@ void OdeWorld::BuildForceSensors(const Scene& scene, const std::vector<dBodyID>&
 }
 
 void OdeWorld::ReadForceSensors(Scene* scene) {
+  if (force_sensors_.empty()) return;
+  Rows<ForceSensorData>& sensors = *force_sensor::RowsOf(scene);  // Build found some
   for (SimForceSensor& f : force_sensors_) {
     if (!f.joint) continue;
     // Feedback of the last substep: force and torque (about the child's
@@ -44,7 +46,7 @@ void OdeWorld::ReadForceSensors(Scene* scene) {
     // About the sensor origin: t_S = t_com + (p_com - p_S) x f.
     const Vec3 t_W = t_com_W + (X_WB.p - X_WS.p).Cross(f_W);
     const Quat q_SW = X_WS.q.Conjugate();
-    ForceSensorData& data = scene->force_sensors()[f.row];
+    ForceSensorData& data = sensors.rows[f.row];
     if (RecordForceSensorSample(&data, q_SW.Rotate(f_W), q_SW.Rotate(t_W))) {
       dJointAttach(f.joint, nullptr, nullptr);
       dJointDestroy(f.joint);

@@ -119,9 +119,11 @@ struct Carrier {
 };
 Carrier CarrierOf(const Scene& scene, const std::vector<dBodyID>& body_of, uint32_t slot) {
   Carrier carrier;
+  ObjectType sensor_type = ObjectType::kJoint;  // stays kJoint when there is no such type
+  force_sensor::FindType(scene, &sensor_type);
   for (int32_t p = scene.parent_at(slot); p >= 0; p = scene.parent_at(static_cast<uint32_t>(p))) {
     const uint32_t ps = static_cast<uint32_t>(p);
-    if (scene.type_at(ps) == ObjectType::kJoint || scene.type_at(ps) == ObjectType::kForceSensor)
+    if (scene.type_at(ps) == ObjectType::kJoint || scene.type_at(ps) == sensor_type)
       carrier.below_joint = true;
     const ShapeData* ancestor = ShapeAt(scene, ps);
     if (ancestor && ancestor->dynamic) {
@@ -249,7 +251,7 @@ void OdeWorld::Build(const Scene& scene) {
   // 3. Joints with a dynamic child body, in slot order.
   BuildJoints(scene, body_of);
   // 4. Force sensors.
-  if (!scene.force_sensors().empty()) BuildForceSensors(scene, body_of);
+  if (force_sensor::Any(scene)) BuildForceSensors(scene, body_of);
   commands_.assign(joints_.size(), JointData{});
 }
 

@@ -60,7 +60,7 @@ struct SimJoint {
 // nearest body above (or the world). ode_force_sensors.cc.
 struct SimForceSensor {
   dJointID joint;      // null once broken
-  uint32_t row;        // row in Scene::force_sensors()
+  uint32_t row;        // row in the force sensor rows (modules/force_sensor)
   dBodyID child_body;  // body 1 of the joint
   Pose X_BS;           // sensor frame in the child body
   dJointFeedback* feedback;

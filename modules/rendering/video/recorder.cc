@@ -401,7 +401,7 @@ ModuleDescriptor RecorderModule() {
   return {{"output", "recorder", "1.0",
            "PNG snapshots and H.264 video of a view every N steps (swarmsim run --snapshot-every, "
            "--video)"},
-          PhaseBit(ModulePhase::kRecord),
+          PhaseBit(Phase::kRecord),
           300,
           /*every_world=*/false,
           [](World* world, const void* config) -> std::unique_ptr<Module> {

@@ -1,9 +1,8 @@
 // A world's `environment: {octomap: ...}` end to end: the example world in
 // the shared real map (robots placed and kept in free space, the same hash
 // at 1, 2 and 4 threads), the map seen by scripts (a proximity reading of
-// sim.handle_world, range messages with line of sight), and bad map files
-// through the program (an error at the world key's file:line:col and a
-// nonzero exit, never a crash).
+// sim.handle_world, range messages with line of sight). The `environment`
+// key's own checks and bad map files: environment_test.cc.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -19,17 +18,14 @@
 #include "modules/environment/octomap_map.h"
 #include "modules/environment/voxel_merge.h"
 #include "swarm/loader/world_loader.h"
-#include "tests/framework/error_of.h"
 #include "tests/shared_maps.h"
-#include "tests/swarm/run_program.h"
+#include "tests/swarm/run_program.h"  // FreshTempDir
 
 namespace swarmsim {
 namespace {
 
 namespace fs = std::filesystem;
-using testing::ErrorOf;
 using testing::FreshTempDir;
-using testing::RunProgram;
 
 const std::string kCorridor = std::string(SWARMSIM_SOURCE_DIR) + "/worlds/octomap_corridor.yaml";
 
@@ -157,58 +153,6 @@ end
   EXPECT_EQ(last["object_is_world"], 1);
   EXPECT_GE(count["any"], 1);    // delivered without line of sight
   EXPECT_EQ(count["sight"], 0);  // hidden by the wall
-  fs::remove_all(dir);
-}
-
-// A world naming `map_file` (written into its folder with `bytes`, unless empty).
-fs::path MapWorld(const std::string& name, const std::string& map_file, const std::string& bytes) {
-  const fs::path dir = FreshTempDir("swarmsim_env", name);
-  fs::create_directories(dir);
-  std::ofstream(dir / "world.yaml") << "simulation: {physics: box2d, steps: 1}\n"
-                                       "environment:\n"
-                                       "  octomap: "
-                                    << map_file << "\n";
-  if (!bytes.empty()) std::ofstream(dir / map_file, std::ios::binary) << bytes;
-  return dir;
-}
-
-TEST(EnvironmentWorldTest, BadMapFilesAreErrorsAtTheWorldKeyThroughTheProgram) {
-  std::string whole;
-  const std::string map = testing::SharedMap("geb079.bt");
-  if (!map.empty()) {
-    std::ifstream in(map, std::ios::binary);
-    whole.assign(std::istreambuf_iterator<char>(in), {});
-  } else {  // a small stand-in: a header promising more than its body holds
-    whole = "# Octomap OcTree binary file\nid OcTree\nsize 9\nres 0.1\ndata\n";
-    whole += std::string(8, '\xff');
-  }
-  struct Case {
-    std::string name, file, bytes, expect;
-  };
-  const Case cases[] = {
-      {"truncated", "cut.bt", whole.substr(0, whole.size() * 2 / 3), "octomap cut.bt: truncated"},
-      {"header", "plain.bt", "just text\n", "octomap plain.bt: not an OctoMap file"},
-      {"missing", "nowhere.bt", "", "octomap nowhere.bt: no such file"},
-  };
-  for (const Case& c : cases) {
-    const fs::path dir = MapWorld(c.name, c.file, c.bytes);
-    const auto r = RunProgram("run " + (dir / "world.yaml").string() + " --quiet");
-    EXPECT_NE(r.exit_code, 0) << c.name;
-    EXPECT_LT(r.exit_code, 128) << c.name << ": not a crash\n" << r.output;
-    EXPECT_CONTAINS(r.output, "world.yaml:3:12: " + c.expect);
-    fs::remove_all(dir);
-  }
-}
-
-TEST(EnvironmentWorldTest, EnvironmentKeysAreChecked) {
-  const fs::path dir = MapWorld("keys", "x.bt", "");
-  std::ofstream(dir / "world.yaml") << "environment: {octomap: x.bt, z_rnage: [0, 1]}\n";
-  EXPECT_CONTAINS(ErrorOf([&] { Load(dir / "world.yaml", {}); }),
-                  "unknown key 'z_rnage' in 'environment'; did you mean 'z_range'?");
-  std::ofstream(dir / "world.yaml") << "environment: {octomap: x.bt, z_range: [1, 0]}\n";
-  EXPECT_CONTAINS(ErrorOf([&] { Load(dir / "world.yaml", {}); }), "min <= max");
-  std::ofstream(dir / "world.yaml") << "environment: {offset: [0, 0, 0]}\n";
-  EXPECT_CONTAINS(ErrorOf([&] { Load(dir / "world.yaml", {}); }), "'octomap' is required");
   fs::remove_all(dir);
 }
 

@@ -6,10 +6,10 @@
 #include <cmath>
 #include <string>
 
-#include "framework/ik_groups.h"
 #include "framework/registry.h"
 #include "framework/world.h"
 #include "modules/builtin.h"
+#include "modules/kinematics/ik_groups.h"
 #include "swarm/loader/world_loader.h"
 #include "tests/swarm/run_program.h"
 
@@ -54,7 +54,7 @@ TEST(HexapodTest, TwentyCopiesEachHaveSixIkGroups) {
   LoadedWorld loaded = Load("hexapod.yaml", 2, {{"robots", "20"}});
   World& world = *loaded.world;
   ASSERT_EQ(world.robot_count(), 20);
-  auto* ik = dynamic_cast<IkGroups*>(world.find_calculation(kIkModuleName));
+  auto* ik = kinematics::FindIkGroups(world);
   ASSERT_NE(ik, nullptr);
   EXPECT_EQ(ik->live_group_count(), 120);
   for (int r = 0; r < 20; ++r)

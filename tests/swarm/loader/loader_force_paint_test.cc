@@ -11,6 +11,7 @@
 #include "framework/registry.h"
 #include "framework/world.h"
 #include "modules/builtin.h"
+#include "modules/force_sensor/force_sensor.h"
 #include "swarm/loader/world_loader.h"
 #include "tests/swarm/loader/world_dir_test.h"
 
@@ -60,9 +61,9 @@ TEST_F(LoaderForcePaintTest, ForceSensorKeysAndScriptReading) {
   world.set_log_sink([](std::string_view) {});
   const ObjectId hook = world.scene().FindObject("/hanger#0/hook");
   ASSERT_FALSE(hook.IsNull());
-  EXPECT_EQ(world.scene().force_sensor(hook).break_after, 3);
-  EXPECT_EQ(world.scene().force_sensor(hook).filter_samples, 2);
-  EXPECT_EQ(world.scene().force_sensor(hook).force_threshold, 50);
+  EXPECT_EQ(force_sensor::Row(world.scene(), hook).break_after, 3);
+  EXPECT_EQ(force_sensor::Row(world.scene(), hook).filter_samples, 2);
+  EXPECT_EQ(force_sensor::Row(world.scene(), hook).force_threshold, 50);
   for (int i = 0; i < 30; ++i) world.Step();
   double state = -1, fz = 0;
   for (const MetricSample& m : world.TakeMetrics()) {

@@ -9,10 +9,10 @@
 #include <string>
 
 #include "framework/error.h"
-#include "framework/ik_groups.h"
 #include "framework/registry.h"
 #include "framework/world.h"
 #include "modules/builtin.h"
+#include "modules/kinematics/ik_groups.h"
 #include "swarm/loader/world_loader.h"
 
 namespace swarmsim {
@@ -87,7 +87,7 @@ TEST_F(LoaderIkTest, EveryCopyGetsItsGroupAndItSolvesEachStep) {
       "  - {name: reach, tips: [{tip: j1/j2/tip, target: target, constraints: [x, y]}], "
       "iterations: 50, tolerance: 1.0e-6}\n");
   World& world = *loaded.world;
-  auto* ik = dynamic_cast<IkGroups*>(world.find_calculation(kIkModuleName));
+  auto* ik = kinematics::FindIkGroups(world);
   ASSERT_NE(ik, nullptr);
   EXPECT_EQ(ik->live_group_count(), 3);
   world.Step();

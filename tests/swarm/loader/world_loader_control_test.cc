@@ -14,10 +14,10 @@
 #include <string>
 
 #include "framework/error.h"
-#include "framework/ik_groups.h"
 #include "framework/registry.h"
 #include "framework/world.h"
 #include "modules/builtin.h"
+#include "modules/kinematics/ik_groups.h"
 #include "swarm/loader/world_loader.h"
 #include "tests/framework/fakes.h"
 #include "tests/swarm/run_program.h"
@@ -44,7 +44,7 @@ class ControlLoaderTest : public ::testing::Test {
           "objects: {name: body, type: dummy, script: bot.lua}\n");
     Write("bot.lua", "function sysCall_init() end\n");
     Write("main.lua", "function sysCall_step() sim.handleDynamics() end\n");
-    registry_.RegisterDynamics({"", "kinematic", "1", "test"},
+    registry_.RegisterDynamics({"", "kinematic", "1", "test"}, {},
                                [] { return std::make_unique<testing::NullDynamics>(); });
     proximity::Register(&registry_, {"", "proximity", "1", "test"},
                         [] { return std::make_unique<testing::NullProximity>(); });
@@ -101,76 +101,6 @@ TEST_F(ControlLoaderTest, SimulationControlKeys) {
                   "world.yaml:1:60: 'duration' 0.01 s is shorter than one time step (0.1 s)");
 }
 
-TEST_F(ControlLoaderTest, EveryEntryOfAModelKeepsItsExplicitScripts) {
-  // Reading `script: {file:, explicit:}` once replaced that map by its file
-  // name in the parsed model (yaml-cpp's Node assignment writes through), so
-  // the second entry of the same model got a plain, self-running script.
-  Write("arm.yaml",
-        "model: arm\n"
-        "objects:\n"
-        "  {type: dummy, script: arm.lua,\n"
-        "   children: [{name: x, type: dummy, script: {file: x.lua, explicit: true}}]}\n");
-  Write("arm.lua",
-        "function sysCall_actuation()\n"
-        "  sim.recordMetric('doubled', sim.handleChildScript(sim.getObject('./x'), 21))\n"
-        "end\n");
-  Write("x.lua",
-        "function sysCall_actuation(a) sim.recordMetric('x_ran', a or -1) return 2 * a end\n");
-  LoadedWorld w = Load(
-      "simulation: {physics: kinematic}\n"
-      "models:\n"
-      "  - {model: arm.yaml, position: [0, 0]}\n"
-      "  - {model: arm.yaml, position: [1, 0]}\n"
-      "  - {model: arm.yaml, count: 2, distribute: {region: {min: [2, 2], max: [9, 9]}}}\n");
-  w.world->Step();
-  int doubled = 0, x_ran = 0;
-  for (const MetricSample& m : w.world->TakeMetrics()) {
-    if (m.name == "doubled") doubled += m.value == 42;
-    if (m.name == "x_ran") x_ran += m.value == 21;  // only when called, with its argument
-  }
-  EXPECT_EQ(doubled, 4);
-  EXPECT_EQ(x_ran, 4);
-}
-
-TEST_F(ControlLoaderTest, PerCopyParametersOverrideTheEntrysAndSetAppliesToAll) {
-  LoadedWorld w = Load(kThree);
-  const World& world = *w.world;
-  EXPECT_EQ(std::get<double>(*world.FindParameter(0, "speed")), 0.2);
-  EXPECT_EQ(std::get<double>(*world.FindParameter(1, "speed")), 0.4);
-  EXPECT_EQ(std::get<std::string>(*world.FindParameter(1, "label")), "special");
-  EXPECT_EQ(std::get<double>(*world.FindParameter(2, "speed")), 0.2);
-  LoadOptions set;
-  set.overrides = {{"bot.speed", "0.3"}};
-  LoadedWorld s = Load(kThree, set);
-  for (int i = 0; i < 3; ++i) EXPECT_EQ(std::get<double>(*s.world->FindParameter(i, "speed")), 0.3);
-  EXPECT_EQ(std::get<std::string>(*s.world->FindParameter(1, "label")), "special");
-  ASSERT_EQ(w.models.size(), 1u);
-  EXPECT_EQ(w.models[0].instances[0].second, "label=special, speed=0.4");
-}
-
-TEST_F(ControlLoaderTest, RangesAndInstanceMistakesNameFileLineAndColumn) {
-  std::string bad = kThree;
-  bad.replace(bad.find("speed: 0.4"), 10, "speed: 0.9");
-  EXPECT_CONTAINS(ErrorOf(bad),
-                  "world.yaml:8:40: parameter 'speed' of model 'bot' must be within "
-                  "[0, 0.5] m/s (got 0.9)");
-  bad = kThree;
-  bad.replace(bad.find("index: 1"), 8, "index: 3");
-  EXPECT_CONTAINS(ErrorOf(bad), "world.yaml:8:17: 'index' must be below the entry's count (3)");
-  bad = kThree;
-  bad.replace(bad.find("label: special"), 14, "colour: red");
-  EXPECT_CONTAINS(ErrorOf(bad), "model 'bot' has no parameter 'colour'");
-  LoadOptions set;
-  set.overrides = {{"bot.speed", "2"}};
-  EXPECT_CONTAINS(ErrorOf(kThree, set),
-                  "--set bot.speed=2: parameter 'speed' of model 'bot' "
-                  "must be within [0, 0.5]");
-  Write("bot.yaml",
-        "model: bot\nparameters:\n  speed: {default: 0.1, range: [1]}\n"
-        "objects: {name: body, type: dummy}\n");
-  EXPECT_CONTAINS(ErrorOf(kThree), "bot.yaml:3:32: 'range' must be [min, max]");
-}
-
 // A model whose objects use its parameters everywhere a value can.
 const char kGear[] =
     "model: gear\n"
@@ -219,7 +149,7 @@ TEST_F(ControlLoaderTest, PerCopyValuesReachEveryObjectValueThatUsesThem) {
   const LoadedWorld w = LoadWorld(dir_ / "world.yaml", {}, builtin);
   const Scene& scene = w.world->scene();
   ASSERT_EQ(scene.instances().size(), 3u);
-  const auto* ik = dynamic_cast<const IkGroups*>(w.world->find_calculation(kIkModuleName));
+  const auto* ik = kinematics::FindIkGroups(*w.world);
   ASSERT_NE(ik, nullptr);
   struct Expected {
     double r, size, lim, mass, damping;
@@ -262,31 +192,6 @@ TEST_F(ControlLoaderTest, PerCopyValuesReachEveryObjectValueThatUsesThem) {
   ASSERT_EQ(w.models[0].instances.size(), 2u);
   EXPECT_EQ(w.models[0].instances[0].second, "damping=0.2, lim=1, mass=2, r=1.8, size=0.4");
   EXPECT_EQ(w.models[0].instances[1].second, "");
-}
-
-TEST_F(ControlLoaderTest, ScaledCopiesWithTheirOwnValuesShareTheScaledMesh) {
-  Write("cube.obj",
-        "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n"
-        "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n");
-  Write("cube.yaml",
-        "model: cube\n"
-        "parameters: {m: 1}\n"
-        "objects: {type: shape, shape: mesh, file: cube.obj, dynamic: true, mass: $m}\n");
-  ModuleRegistry builtin;
-  RegisterBuiltinModules(&builtin);
-  Write("world.yaml",
-        "simulation: {physics: kinematic}\n"
-        "models:\n"
-        "  - {model: cube.yaml, count: 3, scale: 0.1, "
-        "distribute: {region: {min: [-5, -5], max: [5, 5]}},\n"
-        "     instances: [{index: 1, parameters: {m: 2}}]}\n");
-  const LoadedWorld w = LoadWorld(dir_ / "world.yaml", {}, builtin);
-  const Scene& scene = w.world->scene();
-  const ShapeData& own = scene.shape(scene.instance(1).root);
-  EXPECT_DOUBLE_EQ(own.mass, 2 * 0.001);  // its own mass, scaled by 0.1^3
-  EXPECT_DOUBLE_EQ(scene.shape(scene.instance(0).root).mass, 0.001);
-  for (int k : {0, 2}) EXPECT_EQ(scene.shape(scene.instance(k).root).mesh, own.mesh) << k;
-  EXPECT_DOUBLE_EQ(own.mesh->CenteredExtents().x, 0.2);
 }
 
 TEST_F(ControlLoaderTest, ACopysOwnValueThatBreaksAnObjectNamesTheCopy) {

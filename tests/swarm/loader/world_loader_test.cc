@@ -31,11 +31,12 @@ const std::string kDiffusion = std::string(SWARMSIM_SOURCE_DIR) + "/worlds/diffu
 ModuleRegistry TestRegistry() {
   ModuleRegistry r;
   for (const char* name : {"box2d", "null"})
-    r.RegisterDynamics({"", name, "1", "test double"},
+    r.RegisterDynamics({"", name, "1", "test double"}, {},
                        [] { return std::make_unique<testing::NullDynamics>(); });
   proximity::Register(&r, {"", "proximity", "1", "test double"},
                       [] { return std::make_unique<testing::NullProximity>(); });
   for (ModuleDescriptor& metric : metrics::SwarmMetricModules()) r.RegisterModule(metric);
+  r.RegisterWorldSection(metrics::MetricsSection());
   return r;
 }
 
@@ -95,9 +96,8 @@ TEST(WorldLoaderTest, DiffusionBuildsThreeHundredFootbots) {
   EXPECT_EQ(world.settings().seed, 1u);
   ASSERT_TRUE(loaded.steps.has_value());
   EXPECT_EQ(*loaded.steps, 600);  // 60 s at 10 Hz
-  ASSERT_EQ(loaded.metrics.size(), 1u);
-  EXPECT_EQ(loaded.metrics[0].name, "mean_nearest_neighbor_distance");
-  EXPECT_EQ(loaded.metrics[0].every_steps, 10);
+  // Its `metrics:` entry ({name: ..., every: 10}: tests/swarm/loader/world_sections_test.cc).
+  EXPECT_EQ(loaded.metric_names, std::vector<std::string>{"mean_nearest_neighbor_distance"});
   EXPECT_EQ(std::get<double>(world.parameters().at("robots")), 300);
 
   const ScriptSource* shared_script = nullptr;
@@ -456,7 +456,7 @@ TEST_F(MalformedWorldTest, MissingWorldFileIsNamed) {
 TEST_F(MalformedWorldTest, DefaultBackendMustExist) {
   // A registry without "box2d": a world that names no backend says so.
   ModuleRegistry registry;
-  registry.RegisterDynamics({"", "ode", "1", "test double"},
+  registry.RegisterDynamics({"", "ode", "1", "test double"}, {},
                             [] { return std::make_unique<testing::NullDynamics>(); });
   const fs::path file = Write("world.yaml", "arena: {size: 2}\n");
   const std::string message = ErrorOf([&] { LoadWorld(file, {}, registry); });

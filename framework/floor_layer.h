@@ -1,0 +1,34 @@
+// The floor image: a raster of the floor some module keeps (the paint layer,
+// modules/paint), read by those that show or sense the floor (the recorder,
+// the renderer; ground sensors next) without knowing which module it is.
+// World holds at most one (World::floor_layer); its provider sets it when it
+// is made and lives as long as the world.
+#pragma once
+
+#include <cstdint>
+#include <span>
+
+#include "framework/math.h"
+
+namespace swarmsim {
+
+// Image: row 0 is the area's +y edge (north up), column 0 its -x edge; pixel
+// (c, r) covers x in min_x + [c, c + 1) res and y in max_y - [r + 1, r) res.
+struct FloorArea {
+  double min_x = 0, min_y = 0, max_x = 0, max_y = 0;  // m, the floor area covered
+  double resolution = 0;                              // m, side of one pixel
+  int width = 0, height = 0;                          // pixels
+  Vec3 background;                                    // RGB in [0, 1], the bare floor
+};
+
+class FloorLayer {
+ public:
+  virtual ~FloorLayer() = default;
+  virtual FloorArea floor_area() const = 0;
+  // (height x width x 3) RGB bytes, row 0 first.
+  virtual std::span<const uint8_t> floor_rgb() const = 0;
+  // Whether the pixel was ever marked (else it shows the background).
+  virtual bool floor_marked(int column, int row) const = 0;
+};
+
+}  // namespace swarmsim

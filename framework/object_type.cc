@@ -1,0 +1,31 @@
+// ObjectReader's optional parts: a reader that does not read nested values
+// (a test's fake) refuses them.
+#include "framework/object_type.h"
+
+#include "framework/error.h"
+
+namespace swarmsim {
+
+namespace {
+[[noreturn]] void Unsupported(const char* what) {
+  throw Error(std::string("this reader does not read ") + what);
+}
+}  // namespace
+
+void ObjectReader::Require(std::string_view) const { Unsupported("required keys"); }
+
+std::unique_ptr<ObjectReader> ObjectReader::Map(std::string_view, const std::string&,
+                                                std::string_view) const {
+  Unsupported("nested mappings");
+}
+
+std::vector<std::unique_ptr<ObjectReader>> ObjectReader::Elements(std::string_view,
+                                                                  std::string_view,
+                                                                  const std::string&,
+                                                                  std::string_view) const {
+  Unsupported("lists of values");
+}
+
+void ObjectReader::FailHere(const std::string& message) const { throw Error(message); }
+
+}  // namespace swarmsim

@@ -1,0 +1,111 @@
+// sim.* joints (framework/lua_api_joints.cc): a robot writes its own joints
+// at once and another robot's after the phase, in handle order; it cannot
+// read another robot's targets.
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "framework/error.h"
+#include "framework/world.h"
+#include "tests/framework/error_of.h"
+#include "tests/framework/fakes.h"
+
+namespace swarmsim {
+namespace {
+
+std::shared_ptr<const ScriptSource> Source(std::string path, std::string code) {
+  return std::make_shared<const ScriptSource>(ScriptSource{std::move(path), std::move(code)});
+}
+
+// A world with null modules whose script output lands in `log`.
+class ScriptWorld {
+ public:
+  explicit ScriptWorld(int threads = 1, uint64_t seed = 1, WorldSettings settings = {})
+      : registry_(testing::NullRegistry()) {
+    settings.physics = "null";
+    settings.time_step = 0.1;
+    settings.threads = threads;
+    settings.seed = seed;
+    world_ = std::make_unique<World>(settings, registry_);
+    world_->set_log_sink([this](std::string_view line) { log.emplace_back(line); });
+  }
+  World& world() { return *world_; }
+  Scene& scene() { return world_->scene(); }
+
+  // A robot: a root dummy named like the instance (model root) carrying a
+  // `body` shape with joints `leftMotor` and `rightMotor`; `code` attached to
+  // the body unless empty. Returns the body.
+  ObjectId AddRobot(const std::string& name, const std::string& code,
+                    const std::string& path = "scripts/robot.lua") {
+    const ObjectId root = scene().AddDummy(name, {}, {{next_x_, 0, 0}, {}});
+    next_x_ += 1;
+    const ObjectId body = scene().AddShape("body", root, {}, {});
+    scene().AddJoint("leftMotor", body, {{0, 0.05, 0}, {}}, {});
+    scene().AddJoint("rightMotor", body, {{0, -0.05, 0}, {}}, {});
+    scene().MakeModelInstance(root, "bot", name);
+    if (!code.empty()) scene().AttachScript(body, Source(path, code));
+    return body;
+  }
+  ObjectId Joint(const std::string& path) { return scene().FindObject(path); }
+
+  std::vector<std::string> log;
+
+ private:
+  ModuleRegistry registry_;
+  std::unique_ptr<World> world_;
+  double next_x_ = 0;
+};
+
+using testing::ErrorOf;
+
+TEST(ScriptHostTest, WritesToAnotherRobotsJointAreDeferredToAfterThePhase) {
+  ScriptWorld w;
+  // bot#0 runs first (one thread) and writes bot#1's motor; bot#1 must not
+  // see it during the same phase, but its own writes at once.
+  w.AddRobot("bot#0", R"(
+    function sysCall_sensing()
+      sim.setJointTargetVelocity(sim.getObject('/bot#1/body/leftMotor'), 5)
+    end
+  )");
+  w.AddRobot("bot#1", R"(
+    local left, right
+    function sysCall_init() left, right = sim.getObject('./leftMotor'), sim.getObject('./rightMotor') end
+    function sysCall_actuation()
+      sim.setJointTargetVelocity(right, 3)
+      sim.recordMetric('left_target', sim.getJointTargetVelocity(left))
+      sim.recordMetric('right_target', sim.getJointTargetVelocity(right))
+      sim.recordMetric('left_velocity', sim.getJointVelocity(left))
+    end
+  )");
+  w.world().Start();
+  w.world().Step();
+  auto metrics = w.world().TakeMetrics();
+  ASSERT_EQ(metrics.size(), 3u);
+  EXPECT_EQ(metrics[0].value, 0.0);  // not yet: deferred
+  EXPECT_EQ(metrics[1].value, 3.0);  // own write: immediate
+  EXPECT_EQ(metrics[2].value, 0.0);
+  EXPECT_EQ(w.scene().joint(w.Joint("/bot#1/body/leftMotor")).target_velocity, 5.0);
+  w.world().Step();
+  metrics = w.world().TakeMetrics();
+  ASSERT_EQ(metrics.size(), 3u);
+  EXPECT_EQ(metrics[0].value, 5.0);  // applied after the first phase
+  EXPECT_EQ(metrics[2].value, 5.0);
+}
+
+TEST(ScriptHostTest, ReadingAnotherRobotsJointTargetIsAnError) {
+  ScriptWorld w;
+  w.AddRobot("bot#0",
+             "function sysCall_sensing()\n  "
+             "sim.getJointTargetVelocity(sim.getObject('/bot#1/body/leftMotor'))\nend",
+             "scripts/peek.lua");
+  w.AddRobot("bot#1", "");
+  w.world().Start();
+  EXPECT_CONTAINS(ErrorOf([&] { w.world().Step(); }),
+                  "scripts/peek.lua:2: sim.getJointTargetVelocity: joint '/bot#1/body/leftMotor' "
+                  "belongs to another robot");
+}
+
+}  // namespace
+}  // namespace swarmsim

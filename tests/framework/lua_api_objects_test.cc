@@ -1,0 +1,183 @@
+// sim.* objects (framework/lua_api_objects.cc): lookup by path from the
+// calling script (so copies of a model find their own objects), indexed
+// names, suggestions for a missing path, stale handles, and poses in the
+// world and relative frames.
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "framework/error.h"
+#include "framework/world.h"
+#include "modules/proximity/proximity_sensor.h"
+#include "tests/framework/error_of.h"
+#include "tests/framework/fakes.h"
+
+namespace swarmsim {
+namespace {
+
+std::shared_ptr<const ScriptSource> Source(std::string path, std::string code) {
+  return std::make_shared<const ScriptSource>(ScriptSource{std::move(path), std::move(code)});
+}
+
+// A world with null modules whose script output lands in `log`.
+class ScriptWorld {
+ public:
+  explicit ScriptWorld(int threads = 1, uint64_t seed = 1, WorldSettings settings = {})
+      : registry_(testing::NullRegistry()) {
+    settings.physics = "null";
+    settings.time_step = 0.1;
+    settings.threads = threads;
+    settings.seed = seed;
+    world_ = std::make_unique<World>(settings, registry_);
+    world_->set_log_sink([this](std::string_view line) { log.emplace_back(line); });
+  }
+  World& world() { return *world_; }
+  Scene& scene() { return world_->scene(); }
+
+  // A robot: a root dummy named like the instance (model root) carrying a
+  // `body` shape with joints `leftMotor` and `rightMotor`; `code` attached to
+  // the body unless empty. Returns the body.
+  ObjectId AddRobot(const std::string& name, const std::string& code,
+                    const std::string& path = "scripts/robot.lua") {
+    const ObjectId root = scene().AddDummy(name, {}, {{next_x_, 0, 0}, {}});
+    next_x_ += 1;
+    const ObjectId body = scene().AddShape("body", root, {}, {});
+    scene().AddJoint("leftMotor", body, {{0, 0.05, 0}, {}}, {});
+    scene().AddJoint("rightMotor", body, {{0, -0.05, 0}, {}}, {});
+    scene().MakeModelInstance(root, "bot", name);
+    if (!code.empty()) scene().AttachScript(body, Source(path, code));
+    return body;
+  }
+  ObjectId Joint(const std::string& path) { return scene().FindObject(path); }
+
+  std::vector<std::string> log;
+
+ private:
+  ModuleRegistry registry_;
+  std::unique_ptr<World> world_;
+  double next_x_ = 0;
+};
+
+using testing::ErrorOf;
+
+TEST(ScriptHostTest, StaleHandleIsAnError) {
+  ScriptWorld w;
+  w.AddRobot("bot#0", R"(
+    function sysCall_init() eye = sim.getObject('./eye') end
+    function sysCall_actuation() sim.getObjectPose(eye) end
+  )",
+             "scripts/stale.lua");
+  const ObjectId eye = w.scene().AddDummy("eye", w.scene().FindObject("/bot#0/body"), {});
+  w.world().Start();
+  w.world().Step();
+  w.scene().RemoveSubtree(eye);
+  EXPECT_CONTAINS(ErrorOf([&] { w.world().Step(); }),
+                  "scripts/stale.lua:3: sim.getObjectPose: "
+                  "object handle " +
+                      std::to_string(eye.ToInteger()) + " is stale");
+}
+
+TEST(ScriptHostTest, DuplicatedModelsFindTheirOwnObjects) {
+  ScriptWorld w;
+  const ObjectId body = w.AddRobot("bot#0", R"(
+    local left, right, me
+    function sysCall_init()
+      left = sim.getObject('./leftMotor')
+      right = sim.getObject(':/rightMotor')
+      me = sim.getObject('.')
+      assert(sim.getObject('./motor', {noError = true}) == -1)
+      assert(sim.getObjectParent(left) == me)
+      assert(sim.getObjectParent(sim.getObjectParent(me)) == -1)
+    end
+    function sysCall_actuation()
+      sim.setJointTargetVelocity(left, sim.getRobotIndex() + 1)
+      sim.setJointTargetVelocity(right, -(sim.getRobotIndex() + 1))
+    end
+  )");
+  const ObjectId root = w.scene().parent(body);
+  w.scene().DuplicateSubtree(root, {});
+  w.scene().DuplicateSubtree(root, {});
+  ASSERT_EQ(w.world().robot_count(), 3);
+  w.world().Step();
+  for (int r = 0; r < 3; ++r) {
+    const ObjectId root = w.scene().instance(r).root;
+    EXPECT_EQ(w.scene().joint(w.scene().FindObject("./body/leftMotor", root)).velocity, r + 1.0);
+    EXPECT_EQ(w.scene().joint(w.scene().FindObject("./body/rightMotor", root)).velocity,
+              -(r + 1.0));
+  }
+}
+
+TEST(ScriptHostTest, RepeatedNamesAreIndexed) {
+  ScriptWorld w;
+  const ObjectId body = w.AddRobot("bot#0", R"(
+    function sysCall_init()
+      for i = 0, 2 do
+        local h = sim.getObject('./prox[' .. i .. ']')
+        print(sim.getObjectName(h), sim.getObjectPosition(h, sim.getObject('.'))[2])
+      end
+      print(sim.getObject('./prox[3]', {noError = true}))
+    end
+  )");
+  for (int i = 0; i < 3; ++i)
+    proximity::AddSensor(&w.scene(), "prox", body, {{0, 0.5 * i, 0}, {}}, {});
+  w.world().Start();
+  const std::vector<std::string> expected = {"[bot#0] prox\t0.0", "[bot#0] prox\t0.5",
+                                             "[bot#0] prox\t1.0", "[bot#0] -1"};
+  EXPECT_EQ(w.log, expected);
+}
+
+TEST(ScriptHostTest, MissingObjectPathSuggestsTheNearestNameOrTheIndexRange) {
+  // path -> what the error must say, for a script on /bot#0/body (joints
+  // leftMotor and rightMotor, 12 sensors 'prox').
+  const std::pair<std::string, std::string> cases[] = {
+      {"./leftmotor",
+       "no object at path './leftmotor' (looked up from /bot#0/body); did you mean "
+       "'./leftMotor'?"},
+      {"./prox[12]",
+       "no object at path './prox[12]' (looked up from /bot#0/body); there are 12 objects named "
+       "'prox' there: prox[0]..prox[11]"},
+      {":/body/rigthMotor", "; did you mean ':/body/rightMotor'?"},
+      {"/bot#0/bdy/leftMotor", "; did you mean '/bot#0/body/leftMotor'?"},
+      {"./wheel",
+       "no object at path './wheel' (looked up from /bot#0/body); the names there: "
+       "leftMotor, prox, rightMotor"},
+  };
+  for (const auto& [path, message] : cases) {
+    ScriptWorld w;
+    const ObjectId body =
+        w.AddRobot("bot#0", "function sysCall_init() sim.getObject('" + path + "') end");
+    for (int i = 0; i < 12; ++i) proximity::AddSensor(&w.scene(), "prox", body, {}, {});
+    EXPECT_CONTAINS(ErrorOf([&] { w.world().Start(); }), message);
+  }
+}
+
+TEST(ScriptHostTest, PosesInWorldAndRelativeFrames) {
+  ScriptWorld w;
+  const ObjectId body = w.scene().AddDummy("base", {}, {{1, 2, 0}, Quat::FromYaw(M_PI / 2)});
+  w.scene().AddDummy("tip", body, {{0.5, 0, 0.25}, {}});
+  w.scene().MakeModelInstance(body, "arm", "arm#0");
+  w.scene().AttachScript(body, Source("scripts/pose.lua", R"(
+    function sysCall_init()
+      local tip, me = sim.getObject('./tip'), sim.getObject('.')
+      local function show(t) local s = {} for i, v in ipairs(t) do s[i] = string.format('%.3f', v) end return table.concat(s, ' ') end
+      print(show(sim.getObjectPosition(tip)))
+      print(show(sim.getObjectPosition(tip, me)))
+      print(show(sim.getObjectPose(tip, sim.handle_world)))
+      print(show(sim.getObjectOrientation(tip)))
+      print(show(sim.getObjectOrientation(me, tip)))
+    end
+  )"));
+  w.world().Start();
+  const double h = std::sqrt(0.5);
+  char pose[200];
+  std::snprintf(pose, sizeof pose, "[arm#0] 1.000 2.500 0.250 0.000 0.000 %.3f %.3f", h, h);
+  const std::vector<std::string> expected = {
+      "[arm#0] 1.000 2.500 0.250", "[arm#0] 0.500 0.000 0.250", pose, "[arm#0] 0.000 0.000 1.571",
+      "[arm#0] 0.000 0.000 0.000"};
+  EXPECT_EQ(w.log, expected);
+}
+
+}  // namespace
+}  // namespace swarmsim

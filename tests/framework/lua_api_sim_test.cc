@@ -1,0 +1,179 @@
+// sim.* simulation (framework/lua_api_sim.cc): print, metrics, per-robot
+// random streams and parameters (robot, then world, then default).
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "framework/error.h"
+#include "framework/world.h"
+#include "tests/framework/error_of.h"
+#include "tests/framework/fakes.h"
+
+namespace swarmsim {
+namespace {
+
+std::shared_ptr<const ScriptSource> Source(std::string path, std::string code) {
+  return std::make_shared<const ScriptSource>(ScriptSource{std::move(path), std::move(code)});
+}
+
+// A world with null modules whose script output lands in `log`.
+class ScriptWorld {
+ public:
+  explicit ScriptWorld(int threads = 1, uint64_t seed = 1, WorldSettings settings = {})
+      : registry_(testing::NullRegistry()) {
+    settings.physics = "null";
+    settings.time_step = 0.1;
+    settings.threads = threads;
+    settings.seed = seed;
+    world_ = std::make_unique<World>(settings, registry_);
+    world_->set_log_sink([this](std::string_view line) { log.emplace_back(line); });
+  }
+  World& world() { return *world_; }
+  Scene& scene() { return world_->scene(); }
+
+  // A robot: a root dummy named like the instance (model root) carrying a
+  // `body` shape with joints `leftMotor` and `rightMotor`; `code` attached to
+  // the body unless empty. Returns the body.
+  ObjectId AddRobot(const std::string& name, const std::string& code,
+                    const std::string& path = "scripts/robot.lua") {
+    const ObjectId root = scene().AddDummy(name, {}, {{next_x_, 0, 0}, {}});
+    next_x_ += 1;
+    const ObjectId body = scene().AddShape("body", root, {}, {});
+    scene().AddJoint("leftMotor", body, {{0, 0.05, 0}, {}}, {});
+    scene().AddJoint("rightMotor", body, {{0, -0.05, 0}, {}}, {});
+    scene().MakeModelInstance(root, "bot", name);
+    if (!code.empty()) scene().AttachScript(body, Source(path, code));
+    return body;
+  }
+  ObjectId Joint(const std::string& path) { return scene().FindObject(path); }
+
+  std::vector<std::string> log;
+
+ private:
+  ModuleRegistry registry_;
+  std::unique_ptr<World> world_;
+  double next_x_ = 0;
+};
+
+using testing::ErrorOf;
+
+TEST(ScriptHostTest, PrintWritesOnePrefixedTabSeparatedLine) {
+  ScriptWorld w;
+  w.AddRobot(
+      "bot#0",
+      R"(print('a', 1, 2.5, nil, true, setmetatable({}, {__tostring = function() return 'obj' end})))");
+  w.world().Start();
+  EXPECT_EQ(w.log, std::vector<std::string>{"[bot#0] a\t1\t2.5\tnil\ttrue\tobj"});
+}
+
+TEST(ScriptHostTest, RecordedMetricsReachTheWorld) {
+  ScriptWorld w;
+  w.AddRobot("bot#0", "function sysCall_actuation() sim.recordMetric('speed', 1.5) end");
+  w.AddRobot("bot#1", "function sysCall_actuation() sim.recordMetric('speed', 2.5) end");
+  w.world().Start();
+  w.world().Step();
+  w.world().Step();
+  const std::vector<MetricSample> metrics = w.world().TakeMetrics();
+  ASSERT_EQ(metrics.size(), 4u);
+  EXPECT_EQ(metrics[0].step, 0);
+  EXPECT_EQ(metrics[0].instance, 0);
+  EXPECT_EQ(metrics[0].name, "speed");
+  EXPECT_EQ(metrics[0].value, 1.5);
+  EXPECT_EQ(metrics[1].instance, 1);
+  EXPECT_EQ(metrics[1].value, 2.5);
+  EXPECT_EQ(metrics[3].step, 1);
+  EXPECT_DOUBLE_EQ(metrics[3].time, 0.1);
+  EXPECT_EQ(metrics[3].instance, 1);
+}
+
+TEST(ScriptHostTest, RandomNumbersArePerRobotAndReproducible) {
+  auto run = [](uint64_t seed) {
+    ScriptWorld w(2, seed);
+    for (int r = 0; r < 3; ++r)
+      w.AddRobot("bot#" + std::to_string(r), R"(
+        function sysCall_actuation()
+          sim.recordMetric('sim', sim.random())
+          sim.recordMetric('lua', math.random())
+        end
+      )");
+    w.world().Start();
+    w.world().Step();
+    w.world().Step();
+    std::vector<double> values;
+    for (const MetricSample& m : w.world().TakeMetrics()) values.push_back(m.value);
+    return values;
+  };
+  const std::vector<double> a = run(7), b = run(7), c = run(8);
+  ASSERT_EQ(a.size(), 12u);
+  EXPECT_EQ(a, b);
+  EXPECT_NE(a, c);
+  // Robots draw different numbers (step 0: robot 0, 1, 2; sim then lua).
+  EXPECT_NE(a[0], a[2]);
+  EXPECT_NE(a[2], a[4]);
+  EXPECT_NE(a[1], a[3]);
+  for (double v : a) {
+    EXPECT_GE(v, 0.0);
+    EXPECT_LT(v, 1.0);
+  }
+}
+
+TEST(ScriptHostTest, ParametersComeFromTheRobotThenTheWorldThenTheDefault) {
+  ScriptWorld w;
+  const std::string code = R"(
+    function sysCall_init()
+      print(sim.getParam('speed'), sim.getParam('name'), sim.getParam('fast'),
+            sim.getParam('missing', 3), sim.getParam('missing', nil))
+    end
+  )";
+  w.AddRobot("bot#0", code);
+  w.AddRobot("bot#1", code);
+  w.world().parameters()["speed"] = 0.5;
+  w.world().parameters()["name"] = std::string("world");
+  w.world().parameters()["fast"] = false;
+  auto own = std::make_shared<ParameterSet>();
+  (*own)["speed"] = 2.0;
+  (*own)["fast"] = true;
+  w.world().SetInstanceParameters(1, own);
+  w.world().Start();
+  const std::vector<std::string> expected = {"[bot#0] 0.5\tworld\tfalse\t3\tnil",
+                                             "[bot#1] 2\tworld\ttrue\t3\tnil"};
+  EXPECT_EQ(w.log, expected);
+}
+
+// Integral numbers (parameters, signals, sim.handleChildScripts arguments)
+// reach scripts as Lua integers, so '/st#' .. (i % robots) reads '/st#3'.
+TEST(ScriptHostTest, IntegralParametersAndSignalsAreLuaIntegers) {
+  ScriptWorld w;
+  w.AddRobot("bot#0", R"(
+    function sysCall_init()
+      local robots = sim.getParam('robots')
+      print('/st#' .. (13 % robots), math.type(robots), math.type(sim.getParam('speed')),
+            math.type(sim.getParam('exact')), math.type(sim.getParam('inexact')),
+            math.type(sim.getParam('negative')), sim.getParam('negative'))
+    end
+    function sysCall_actuation()
+      if sim.getSimulationTime() == 0 then
+        sim.setSignal('count', 4.0)
+        sim.setSignal('half', 0.5)
+      else
+        print('/st#' .. sim.getSignal('count'), sim.getSignal('half'))
+      end
+    end
+  )");
+  w.world().parameters()["robots"] = 10.0;
+  w.world().parameters()["speed"] = 0.5;
+  w.world().parameters()["exact"] = 9007199254740992.0;     // 2^53
+  w.world().parameters()["inexact"] = 18014398509481984.0;  // 2^54: a float
+  w.world().parameters()["negative"] = -3.0;
+  w.world().Start();
+  w.world().Step();
+  w.world().Step();
+  const std::vector<std::string> expected = {
+      "[bot#0] /st#3\tinteger\tfloat\tinteger\tfloat\tinteger\t-3", "[bot#0] /st#4\t0.5"};
+  EXPECT_EQ(w.log, expected);
+}
+
+}  // namespace
+}  // namespace swarmsim

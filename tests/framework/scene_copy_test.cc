@@ -1,0 +1,164 @@
+// Scene's copies and sizes (framework/scene_copy.cc): DuplicateSubtree
+// copies a model's objects, rows, scripts and links with references
+// remapped; ScaleSubtree and the per-object size factor.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+
+#include "framework/error.h"
+#include "framework/scene.h"
+#include "modules/proximity/proximity_sensor.h"
+
+namespace swarmsim {
+namespace {
+
+// A tetrahedron, closed, counter-clockwise seen from outside.
+std::shared_ptr<const TriangleMesh> Tetrahedron() {
+  return std::make_shared<const TriangleMesh>(
+      "tetra", std::vector<Vec3>{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}},
+      std::vector<MeshTriangle>{{{0, 2, 1}}, {{0, 1, 3}}, {{0, 3, 2}}, {{1, 2, 3}}});
+}
+
+TEST(SceneTest, DuplicatingAModelCopiesObjectsScriptsAndRemapsReferences) {
+  Scene scene;
+  const ObjectId outside = scene.AddDummy("landmark", {}, {});
+  ShapeData body_shape;
+  body_shape.kind = ShapeKind::kCylinder;
+  body_shape.dynamic = true;
+  const ObjectId root = scene.AddShape("body", {}, {{1, 0, 0}, {}}, body_shape);
+  const ObjectId motor = scene.AddJoint("motor", root, {{0, 0.1, 0}, {}}, JointData{});
+  const ObjectId tip = scene.AddDummy("tip", motor, {});
+  const ObjectId target = scene.AddDummy("target", root, {});
+  const ObjectId beacon = scene.AddDummy("beacon", root, {});
+  scene.LinkDummies(tip, target);      // internal reference
+  scene.LinkDummies(beacon, outside);  // reference to outside the model
+  auto source = std::make_shared<ScriptSource>(ScriptSource{"ctl.lua", "-- code"});
+  scene.AttachScript(root, source);
+  const int first = scene.MakeModelInstance(root, "bot", "bot#0");
+  EXPECT_EQ(first, 0);
+
+  const ObjectId copy = scene.DuplicateSubtree(root, {});
+  ASSERT_EQ(scene.instances().size(), 2u);
+  EXPECT_EQ(scene.instance_of(copy), 1);
+  EXPECT_EQ(scene.instance(1).model_name, "bot");
+  EXPECT_EQ(scene.instance(1).objects.size(), scene.instance(0).objects.size());
+  // Objects copied, with their data.
+  EXPECT_TRUE(scene.shape(copy).dynamic);
+  const ObjectId copy_motor = scene.FindObject("./motor", copy);
+  ASSERT_FALSE(copy_motor.IsNull());
+  EXPECT_NE(copy_motor, motor);
+  // Script copied, source shared (an asset, not a copy).
+  ASSERT_NE(scene.script(copy), nullptr);
+  EXPECT_EQ(scene.script(copy)->source.get(), source.get());
+  // Internal link remapped to the copy; external link kept.
+  const ObjectId copy_tip = scene.FindObject("./tip", copy);
+  const ObjectId copy_target = scene.FindObject("./target", copy);
+  EXPECT_EQ(scene.linked_dummy(copy_tip), copy_target);
+  EXPECT_EQ(scene.linked_dummy(tip), target);
+  EXPECT_EQ(scene.linked_dummy(scene.FindObject("./beacon", copy)), outside);
+  // Every object of the copy belongs to the new instance.
+  for (uint32_t s : scene.instance(1).objects) EXPECT_EQ(scene.instance_of_at(s), 1);
+
+  // Deleting the copy deletes its objects and retires its instance.
+  const size_t before = scene.object_count();
+  scene.RemoveSubtree(copy);
+  EXPECT_EQ(scene.object_count(), before - 5);
+  EXPECT_FALSE(scene.instance(1).alive);
+  EXPECT_FALSE(scene.IsValid(copy_tip));
+  EXPECT_EQ(scene.linked_dummy(tip), target);
+}
+
+TEST(SceneScaleTest, ScalesGeometryJointsSensorsAndMasses) {
+  Scene scene;
+  ShapeData body;
+  body.kind = ShapeKind::kBox;
+  body.size = {0.2, 0.1, 0.05};
+  body.mass = 2;
+  const ObjectId root = scene.AddShape("root", {}, {{5, 0, 1}, {}}, body);
+  JointData slider;
+  slider.type = JointType::kPrismatic;
+  slider.position = 0.1;
+  slider.min_position = -0.2;
+  slider.max_position = 0.3;
+  slider.max_force = 4;
+  const ObjectId prismatic = scene.AddJoint("slider", root, {{0, 0, 0.1}, {}}, slider);
+  JointData hinge;
+  hinge.position = 0.5;
+  hinge.max_force = 3;
+  const ObjectId revolute = scene.AddJoint("hinge", root, {{0.1, 0, 0}, {}}, hinge);
+  ShapeData mesh;
+  mesh.kind = ShapeKind::kMesh;
+  mesh.mesh = Tetrahedron();
+  mesh.size = mesh.mesh->CenteredExtents();
+  const ObjectId m1 = scene.AddShape("m1", prismatic, {}, mesh);
+  const ObjectId m2 = scene.AddShape("m2", revolute, {}, mesh);
+  ProximitySensorData sensor;
+  sensor.range = 0.1;
+  const ObjectId eye = proximity::AddSensor(&scene, "eye", root, {{0, 0.05, 0}, {}}, sensor);
+  const uint64_t version = scene.structure_version();
+
+  scene.ScaleSubtree(root, 2);
+  EXPECT_GT(scene.structure_version(), version);
+  // The root stays where it is; everything below scales about it.
+  EXPECT_DOUBLE_EQ(scene.world_pose(root).p.x, 5);
+  EXPECT_DOUBLE_EQ(scene.shape(root).size.x, 0.4);
+  EXPECT_DOUBLE_EQ(scene.shape(root).mass, 16);
+  EXPECT_DOUBLE_EQ(scene.local_pose(prismatic).p.z, 0.2);
+  EXPECT_DOUBLE_EQ(scene.joint(prismatic).position, 0.2);
+  EXPECT_DOUBLE_EQ(scene.joint(prismatic).min_position, -0.4);
+  EXPECT_DOUBLE_EQ(scene.joint(prismatic).max_position, 0.6);
+  EXPECT_DOUBLE_EQ(scene.joint(prismatic).max_force, 32);     // N: x s^3
+  EXPECT_DOUBLE_EQ(scene.joint(revolute).position, 0.5);      // angles unchanged
+  EXPECT_DOUBLE_EQ(scene.joint(revolute).max_force, 48);      // N m: x s^4
+  EXPECT_DOUBLE_EQ(scene.world_pose(m1).p.z, 1 + 0.2 + 0.2);  // offset + slider
+  EXPECT_DOUBLE_EQ(proximity::Sensor(scene, eye).range, 0.2);
+  // One scaled asset for both shapes that shared the original.
+  EXPECT_EQ(scene.shape(m1).mesh, scene.shape(m2).mesh);
+  EXPECT_NE(scene.shape(m1).mesh, mesh.mesh);
+  EXPECT_DOUBLE_EQ(scene.shape(m1).mesh->hi().x, 2);
+  EXPECT_DOUBLE_EQ(mesh.mesh->hi().x, 1);  // the original is untouched
+  EXPECT_DOUBLE_EQ(scene.shape(m1).size.x, 4);
+  for (ObjectId id : {root, prismatic, m1, eye}) EXPECT_DOUBLE_EQ(scene.size_factor(id), 2);
+
+  // Factors accumulate; a part can be scaled on its own.
+  scene.ScaleSubtree(prismatic, 0.5);
+  EXPECT_DOUBLE_EQ(scene.size_factor(root), 2);
+  EXPECT_DOUBLE_EQ(scene.size_factor(m1), 1);
+  EXPECT_DOUBLE_EQ(scene.shape(m1).mesh->hi().x, 1);
+}
+
+TEST(SceneScaleTest, DuplicatesKeepTheSizeFactor) {
+  Scene scene;
+  const ObjectId root = scene.AddShape("bot", {}, {}, ShapeData{});
+  const ObjectId child = scene.AddDummy("tip", root, {{0.1, 0, 0}, {}});
+  scene.MakeModelInstance(root, "bot", "bot#0");
+  EXPECT_DOUBLE_EQ(scene.size_factor(root), 1);
+  scene.ScaleSubtree(root, 1.5);
+  const ObjectId copy = scene.DuplicateSubtree(root, {});
+  EXPECT_DOUBLE_EQ(scene.size_factor(copy), 1.5);
+  const ObjectId copy_tip = scene.children(copy).at(0);
+  EXPECT_DOUBLE_EQ(scene.size_factor(copy_tip), 1.5);
+  EXPECT_NEAR(scene.local_pose(copy_tip).p.x, 0.15, 1e-15);
+  EXPECT_DOUBLE_EQ(scene.shape(copy).size.x, 0.15);
+  // A freed slot that is reused starts at 1 again.
+  scene.RemoveSubtree(child);
+  EXPECT_DOUBLE_EQ(scene.size_factor(scene.AddDummy("new", {}, {})), 1);
+}
+
+TEST(SceneScaleTest, BadFactorsAreRefused) {
+  Scene scene;
+  const ObjectId root = scene.AddDummy("d", {}, {});
+  for (double bad : {0.0, -1.0, double(NAN), double(INFINITY)}) {
+    try {
+      scene.ScaleSubtree(root, bad);
+      ADD_FAILURE() << bad;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("finite number above 0"), std::string::npos);
+    }
+  }
+  EXPECT_DOUBLE_EQ(scene.size_factor(root), 1);
+}
+
+}  // namespace
+}  // namespace swarmsim

@@ -1,0 +1,68 @@
+// The metrics module's world-file section `metrics:` (metrics_section.cc),
+// read through the loader: each entry adds its metric module, recording
+// every N steps, and its mistakes name file:line:column.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "tests/swarm/loader/world_dir_test.h"
+
+namespace swarmsim {
+namespace {
+
+class MetricsSectionTest : public testing::WorldDirTest {
+ protected:
+  // The loader's message for `world_text`, or "(no error)".
+  std::string ErrorOfWorld(const std::string& world_text) {
+    try {
+      Load(world_text);
+    } catch (const Error& e) {
+      return e.what();
+    }
+    return "(no error)";
+  }
+  void WriteBot() {
+    Write("bot.yaml",
+          "model: bot\nobjects:\n  type: shape\n  shape: box\n  size: [0.1, 0.1, 0.1]\n");
+  }
+};
+
+void ExpectHas(const std::string& message, const std::vector<std::string>& fragments) {
+  for (const std::string& fragment : fragments)
+    EXPECT_NE(message.find(fragment), std::string::npos)
+        << "expected '" << fragment << "' in: " << message;
+}
+
+TEST_F(MetricsSectionTest, MetricsEntriesAddTheirModulesEveryNSteps) {
+  WriteBot();
+  LoadedWorld w = Load(
+      "simulation: {physics: kinematic, time_step: 0.1}\narena: {size: 2}\n"
+      "models: [{model: bot.yaml, position: [0, 0]}]\n"
+      "metrics: [{name: covered_area, every: 10}, covered_area]\n");
+  EXPECT_EQ(w.metric_names, (std::vector<std::string>{"covered_area", "covered_area"}));
+  for (int i = 0; i < 20; ++i) w.world->Step();
+  int every_step = 0, tenth = 0;
+  for (const MetricSample& m : w.world->TakeMetrics()) {
+    ASSERT_EQ(m.name, "covered_area");
+    ++every_step;
+    if (m.step % 10 == 0) ++tenth;
+  }
+  EXPECT_EQ(every_step, 20 + 2);  // each step's row, and steps 10 and 20 again
+  EXPECT_EQ(tenth, 4);
+}
+
+TEST_F(MetricsSectionTest, MetricsMistakesNameTheirPlace) {
+  ExpectHas(ErrorOfWorld("metrics: [covered_aera]\n"),
+            {"world.yaml:1:11:", "unknown metric 'covered_aera'", "did you mean 'covered_area'?"});
+  ExpectHas(ErrorOfWorld("metrics: [{name: covered_area, evry: 3}]\n"),
+            {"world.yaml:1:32:", "unknown key 'evry' in a metric", "did you mean 'every'?"});
+  ExpectHas(ErrorOfWorld("metrics: [{every: 3}]\n"),
+            {"world.yaml:1:11:", "'name' is required in a metric"});
+  ExpectHas(ErrorOfWorld("metrics: [{name: covered_area, every: 0}]\n"), {"world.yaml:1:39:"});
+  ExpectHas(ErrorOfWorld("metrics: covered_area\n"),
+            {"world.yaml:1:10:", "'metrics' must be a list of metrics"});
+}
+
+}  // namespace
+}  // namespace swarmsim

@@ -1,0 +1,84 @@
+// swarmsim bench (swarm/cli/bench_command.cc): its world found from any folder
+// and checked before the table, its --threads checked like run's.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "tests/swarm/run_program.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+using Result = swarmsim::testing::CommandResult;
+using swarmsim::testing::RunProgram;
+
+std::string Data(const std::string& name) { return swarmsim::testing::CliData(name); }
+
+fs::path TempDir(const std::string& name) {
+  return swarmsim::testing::FreshTempDir("swarmsim_cli", name);
+}
+
+TEST(CliTest, BenchFindsItsWorldFromAnyFolder) {
+  // Without --world: worlds/diffusion.yaml beside the program, not in the current folder.
+  const fs::path elsewhere = TempDir("bench_elsewhere");
+  fs::create_directories(elsewhere);
+  Result r = swarmsim::testing::RunCommand("cd " + elsewhere.string() + " && " + SWARMSIM_BINARY +
+                                           " bench --robots 2 --threads 1 --steps 1");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("worlds/diffusion.yaml"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("box2d-only"), std::string::npos) << r.output;
+  fs::remove_all(elsewhere);
+}
+
+TEST(CliTest, BenchChecksItsWorldBeforeTheTable) {
+  Result missing = RunProgram("bench --world /nonexistent/world.yaml --robots 2 --steps 1");
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_NE(missing.output.find("world file '/nonexistent/world.yaml' not found"),
+            std::string::npos)
+      << missing.output;
+  EXPECT_EQ(missing.output.find("ticks/s"), std::string::npos) << missing.output;
+
+  // A world whose robot count is not the `robots` parameter.
+  const fs::path dir = TempDir("bench_no_robots");
+  fs::create_directories(dir);
+  const fs::path world = dir / "fixed_count.yaml";
+  std::ofstream(world) << "simulation: {physics: box2d, time_step: 0.1, physics_substeps: 5}\n"
+                       << "arena: {size: 3}\n"
+                       << "models:\n"
+                       << "  - model: " << Data("bot.yaml") << "\n"
+                       << "    count: 4\n"
+                       << "    distribute: {region: arena}\n";
+  for (const std::string mode : {"", " --scaling"}) {
+    Result r =
+        RunProgram("bench --world " + world.string() + " --robots 50 --threads 1 --steps 1" + mode);
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(r.output.find("has no parameter 'robots'; bench sets the robot count through it"),
+              std::string::npos)
+        << r.output;
+    EXPECT_NE(r.output.find("count: $robots"), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("robots=1"), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("ticks/s"), std::string::npos) << r.output;
+  }
+  fs::remove_all(dir);
+}
+
+TEST(CliTest, BenchThreadsAreCheckedLikeRun) {
+  const std::string expected = "--threads: expected a whole number from 1 to 1024, got '0'";
+  Result run = RunProgram("run " + Data("ok.yaml") + " --steps 1 --threads 0");
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.output.find(expected), std::string::npos) << run.output;
+  Result bench =
+      RunProgram("bench --world " + Data("ok.yaml") + " --robots 2 --steps 1 --threads 0");
+  EXPECT_EQ(bench.exit_code, 2) << bench.output;
+  EXPECT_NE(bench.output.find(expected), std::string::npos) << bench.output;
+  Result negative =
+      RunProgram("bench --world " + Data("ok.yaml") + " --robots 2 --steps 1 --threads 1,-1");
+  EXPECT_EQ(negative.exit_code, 2) << negative.output;
+  EXPECT_NE(negative.output.find("got '-1'"), std::string::npos) << negative.output;
+}
+
+}  // namespace

@@ -1,0 +1,199 @@
+// swarmsim run WORLD (swarm/cli/run_command.cc) as a user meets it: exit codes,
+// messages naming file and line, the summary and metrics it writes.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "tests/swarm/run_program.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+using Result = swarmsim::testing::CommandResult;
+using swarmsim::testing::RunProgram;
+
+std::string Data(const std::string& name) { return swarmsim::testing::CliData(name); }
+
+fs::path TempDir(const std::string& name) {
+  return swarmsim::testing::FreshTempDir("swarmsim_cli", name);
+}
+
+std::string HashOf(const std::string& output) {
+  const size_t at = output.find("state-hash: ");
+  return at == std::string::npos ? "" : output.substr(at + 12, 16);
+}
+
+TEST(CliTest, DurationIsWholeStepsAndNotLessThanOne) {
+  // ok.yaml steps 0.1 s.
+  Result short_run = RunProgram("run " + Data("ok.yaml") + " --duration 0.01");
+  EXPECT_EQ(short_run.exit_code, 2) << short_run.output;
+  EXPECT_NE(short_run.output.find("--duration 0.01 s is shorter than one time step (0.1 s)"),
+            std::string::npos)
+      << short_run.output;
+  // Not a multiple: the nearest whole number of steps, as --help says.
+  const fs::path out = TempDir("duration");
+  Result r =
+      RunProgram("run " + Data("ok.yaml") + " --duration 0.26 --quiet --out " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream summary_file(out / "summary.json");
+  ASSERT_TRUE(summary_file.good());
+  EXPECT_EQ(nlohmann::json::parse(summary_file)["steps"], 3);
+  EXPECT_NE(
+      RunProgram("run --help").output.find("rounded to the nearest whole number of time steps"),
+      std::string::npos);
+  fs::remove_all(out);
+}
+
+TEST(CliTest, MissingWorldFileIsNamed) {
+  Result r = RunProgram("run /nonexistent/world.yaml --steps 1");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("/nonexistent/world.yaml"), std::string::npos) << r.output;
+}
+
+TEST(CliTest, TypoInWorldNamesLineAndSuggests) {
+  Result r = RunProgram("run " + Data("typo.yaml") + " --steps 1");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("typo.yaml:4:"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("wall_thickness"), std::string::npos) << r.output;
+}
+
+TEST(CliTest, WorldThatDoesNotLoadWritesAnErrorSummaryWithOut) {
+  // The --out folder is created (nested) and summary.json says what went wrong.
+  const fs::path out = TempDir("load_error") / "run1";
+  const std::string command = std::string(SWARMSIM_BINARY) + " run " + Data("typo.yaml") +
+                              " --steps 1 --out " + out.string();
+  Result r = swarmsim::testing::RunCommand(command);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("error: "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("typo.yaml:4:3: unknown key 'wall_thicknes'"), std::string::npos)
+      << r.output;
+  std::ifstream summary_file(out / "summary.json");
+  ASSERT_TRUE(summary_file.good()) << "summary.json must be written when the world fails to load";
+  const auto summary = nlohmann::json::parse(summary_file);
+  EXPECT_EQ(summary["status"], "error");
+  const std::string error = summary["error"];
+  EXPECT_NE(error.find("typo.yaml:4:3: unknown key 'wall_thicknes'"), std::string::npos) << error;
+  EXPECT_NE(r.output.find("error: " + error), std::string::npos) << r.output;
+  EXPECT_EQ(summary["world"], Data("typo.yaml"));
+  EXPECT_EQ(summary["command"], command);
+  EXPECT_EQ("swarmsim " + summary["swarmsim_version"].get<std::string>() + "\n",
+            RunProgram("version").output);
+  EXPECT_FALSE(fs::exists(out / "metrics.csv"));
+  // A --duration the world cannot run is bad input too, and says so in the folder.
+  fs::remove_all(out);
+  r = RunProgram("run " + Data("ok.yaml") + " --duration 0.01 --out " + out.string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  std::ifstream duration_file(out / "summary.json");
+  ASSERT_TRUE(duration_file.good());
+  EXPECT_EQ(nlohmann::json::parse(duration_file)["error"],
+            "--duration 0.01 s is shorter than one time step (0.1 s)");
+  fs::remove_all(out.parent_path());
+}
+
+TEST(CliTest, RunWritesSummaryAndMetricsAndHashIsStable) {
+  const fs::path out = TempDir("ok");
+  Result r =
+      RunProgram("run " + Data("ok.yaml") + " --steps 20 --threads 2 --hash --out " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("robot-ticks/s"), std::string::npos) << r.output;
+  const std::string hash = HashOf(r.output);
+  ASSERT_EQ(hash.size(), 16u) << r.output;
+  // Same hash on one thread; another seed gives another.
+  EXPECT_EQ(
+      HashOf(
+          RunProgram("run " + Data("ok.yaml") + " --steps 20 --threads 1 --hash --quiet").output),
+      hash);
+  EXPECT_NE(
+      HashOf(RunProgram("run " + Data("ok.yaml") + " --steps 20 --seed 99 --hash --quiet").output),
+      hash);
+
+  std::ifstream summary_file(out / "summary.json");
+  ASSERT_TRUE(summary_file.good());
+  const auto summary = nlohmann::json::parse(summary_file);
+  EXPECT_EQ(summary["status"], "ok");
+  EXPECT_EQ(summary["robots"], 4);
+  EXPECT_EQ(summary["steps"], 20);
+  EXPECT_EQ(summary["threads"], 2);
+  EXPECT_EQ(summary["state_hash"], hash);
+
+  std::ifstream metrics(out / "metrics.csv");
+  std::string header, line;
+  std::getline(metrics, header);
+  EXPECT_EQ(header, "step,time,robot,metric,value");
+  int robot_rows = 0, swarm_rows = 0;
+  while (std::getline(metrics, line)) {
+    if (line.find(",x,") != std::string::npos) ++robot_rows;
+    if (line.find("mean_nearest_neighbor_distance") != std::string::npos) ++swarm_rows;
+  }
+  EXPECT_EQ(robot_rows, 4 * 20);  // each robot records x once per step
+  EXPECT_EQ(swarm_rows, 4);       // every 5 steps
+  fs::remove_all(out);
+}
+
+TEST(CliTest, ScriptErrorNamesRobotFileAndLineAndKeepsOutputs) {
+  const fs::path out = TempDir("broken");
+  Result r = RunProgram("run " + Data("broken.yaml") + " --steps 20 --out " + out.string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("brokenbot#0"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("broken.lua:4:"), std::string::npos) << r.output;
+  std::ifstream summary_file(out / "summary.json");
+  ASSERT_TRUE(summary_file.good()) << "summary.json must be written on error";
+  const auto summary = nlohmann::json::parse(summary_file);
+  EXPECT_EQ(summary["status"], "error");
+  EXPECT_EQ(summary["steps"], 5);  // steps at t = 0 .. 0.4 completed; the script fails at t = 0.5
+  EXPECT_TRUE(fs::exists(out / "metrics.csv"));
+  fs::remove_all(out);
+}
+
+// A world of `count` dummy robots whose script is `code`, in a fresh folder.
+std::string DummyWorld(const fs::path& dir, int count, const std::string& code) {
+  fs::create_directories(dir);
+  std::ofstream(dir / "dummy.yaml") << "model: dummy\nobjects: {name: body, type: dummy, script: "
+                                       "c.lua}\n";
+  std::ofstream(dir / "c.lua") << code;
+  std::ofstream(dir / "w.yaml") << "simulation: {physics: kinematic, time_step: 0.1, seed: 1}\n"
+                                   "arena: {size: 3}\nmodels:\n  - model: dummy.yaml\n    count: "
+                                << count << "\n    distribute: {region: arena}\n";
+  return (dir / "w.yaml").string();
+}
+
+TEST(CliTest, ScriptErrorInOneRobotKeepsEveryRobotsPrintsInRobotOrder) {
+  const fs::path dir = TempDir("prints");
+  // A cleanup error in robot 1 of 3: every cleanup's line, in robot order, and the error.
+  std::string world = DummyWorld(dir / "cleanup", 3,
+                                 "function sysCall_cleanup() print('cleanup ran'); "
+                                 "if sim.getRobotIndex() == 1 then error('boom') end end\n");
+  Result r = RunProgram("run " + world + " --steps 1 --quiet");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  const size_t p0 = r.output.find("[dummy#0] cleanup ran"),
+               p1 = r.output.find("[dummy#1] cleanup ran"),
+               p2 = r.output.find("[dummy#2] cleanup ran");
+  ASSERT_NE(p0, std::string::npos) << r.output;
+  ASSERT_NE(p1, std::string::npos) << r.output;
+  ASSERT_NE(p2, std::string::npos) << r.output;
+  EXPECT_TRUE(p0 < p1 && p1 < p2) << r.output;
+  EXPECT_NE(r.output.find("c.lua:1: boom [in sysCall_cleanup of /dummy#1]"), std::string::npos)
+      << r.output;
+  // A sysCall_init error in robot 5 of 10: every robot's init line.
+  world = DummyWorld(dir / "init", 10,
+                     "function sysCall_init() print('init ran'); "
+                     "if sim.getRobotIndex() == 5 then error('boom') end end\n");
+  r = RunProgram("run " + world + " --steps 1 --threads 2 --quiet");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  size_t last = 0;
+  for (int i = 0; i < 10; ++i) {
+    const size_t at = r.output.find("[dummy#" + std::to_string(i) + "] init ran");
+    ASSERT_NE(at, std::string::npos) << i << ": " << r.output;
+    EXPECT_GE(at, last) << r.output;
+    last = at;
+  }
+  EXPECT_NE(r.output.find("c.lua:1: boom [in sysCall_init of /dummy#5]"), std::string::npos)
+      << r.output;
+  fs::remove_all(dir);
+}
+
+}  // namespace

@@ -1,0 +1,112 @@
+// swarmsim view DIR (swarm/cli/view_command.cc): --export writes one page
+// holding the recording's whole chunks, and what cannot be shown is
+// refused before anything is served or written.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <string>
+
+#include "tests/swarm/run_program.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+using Result = swarmsim::testing::CommandResult;
+using swarmsim::testing::ReadFile;
+using swarmsim::testing::RunProgram;
+
+const fs::path kRecordings = fs::path(SWARMSIM_SOURCE_DIR) / "tests/data/recordings";
+
+fs::path TempDir(const std::string& name) {
+  const fs::path dir = swarmsim::testing::FreshTempDir("swarmsim_view_cli", name);
+  fs::create_directories(dir);
+  return dir;
+}
+
+// The base64 text of the recording inside an exported page.
+std::string EncodedRecording(const std::string& page) {
+  const std::string open = "<script id=\"swarmsim-recording\" type=\"application/octet-stream\">";
+  const size_t begin = page.find(open);
+  if (begin == std::string::npos) return "(none)";
+  const size_t from = begin + open.size();
+  return page.substr(from, page.find("</script>", from) - from);
+}
+
+size_t Base64Length(uint64_t bytes) { return 4 * ((bytes + 2) / 3); }
+
+TEST(ViewCommandTest, ExportWritesOnePageWithTheWholeRecording) {
+  const fs::path dir = TempDir("export");
+  const fs::path html = dir / "run.html";
+  const Result r =
+      RunProgram("view " + (kRecordings / "diffusion").string() + " --export " + html.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("swarmsim view: wrote " + html.string() + " (" +
+                          std::to_string(fs::file_size(html)) + " bytes)"),
+            std::string::npos)
+      << r.output;
+  const std::string recording = ReadFile(kRecordings / "diffusion/recording.swrec");
+  const std::string encoded = EncodedRecording(ReadFile(html));
+  EXPECT_EQ(encoded.size(), Base64Length(recording.size()));
+  EXPECT_EQ(encoded.substr(0, 4), "U1dS") << "base64 of the magic, SWR";
+  fs::remove_all(dir);
+}
+
+TEST(ViewCommandTest, ExportOfACutRecordingHoldsItsWholeChunksOnly) {
+  const fs::path dir = TempDir("export_cut");
+  const fs::path html = dir / "cut.html";
+  const Result r =
+      RunProgram("view " + (kRecordings / "truncated").string() + " --export " + html.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  // What it says of the file names where the last whole chunk ends.
+  std::smatch at;
+  ASSERT_TRUE(std::regex_search(r.output, at, std::regex("ends inside a chunk at byte ([0-9]+)")))
+      << r.output;
+  const uint64_t valid = std::stoull(at[1]);
+  EXPECT_LT(valid, fs::file_size(kRecordings / "truncated/recording.swrec"));
+  EXPECT_EQ(EncodedRecording(ReadFile(html)).size(), Base64Length(valid));
+  fs::remove_all(dir);
+}
+
+TEST(ViewCommandTest, WhatCannotBeShownIsRefusedFirst) {
+  const fs::path dir = TempDir("refused");
+  Result r =
+      RunProgram("view " + (dir / "nowhere").string() + " --export " + (dir / "x.html").string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("error: '" + (dir / "nowhere").string() +
+                          "' is not a folder: give the output folder of a run (swarmsim run "
+                          "WORLD --out DIR --record)"),
+            std::string::npos)
+      << r.output;
+  // Every step record is decoded before a page is written.
+  r = RunProgram("view " + (kRecordings / "corrupt").string() + " --export " +
+                 (dir / "x.html").string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("is corrupt: chunk 11 at byte"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "x.html"));
+  // A page that cannot be written: the run's folder was fine, the output not.
+  r = RunProgram("view " + (kRecordings / "diffusion").string() + " --export " +
+                 (dir / "no/such/folder/x.html").string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("error: "), std::string::npos) << r.output;
+  fs::remove_all(dir);
+}
+
+TEST(ViewCommandTest, OptionsSayWhatTheyExpect) {
+  const std::string run = (kRecordings / "diffusion").string();
+  Result r = RunProgram("view " + run + " --port 70000");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--port: expected a whole number from 0 to 65535, got '70000'"),
+            std::string::npos)
+      << r.output;
+  r = RunProgram("view " + run + " --export ''");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--export: expected a file"), std::string::npos) << r.output;
+  r = RunProgram("view ''");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("expected a folder"), std::string::npos) << r.output;
+}
+
+}  // namespace

@@ -1,0 +1,257 @@
+// The world file's `models:` entries (swarm/loader/world_entries.cc): each
+// entry's parameters, its copies with values of their own (instances:),
+// --set over them, scale, and where the copies go (distribute: or
+// position:), each mistake named at its file:line:column.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "framework/error.h"
+#include "framework/registry.h"
+#include "framework/world.h"
+#include "modules/builtin.h"
+#include "modules/proximity/proximity.h"
+#include "swarm/loader/world_loader.h"
+#include "tests/framework/fakes.h"
+
+namespace swarmsim {
+namespace {
+
+namespace fs = std::filesystem;
+
+#define EXPECT_CONTAINS(haystack, needle) \
+  EXPECT_NE(std::string(haystack).find(needle), std::string::npos) << (haystack)
+
+class ControlLoaderTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("swarmsim_world_entries_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    Write("bot.yaml",
+          "model: bot\n"
+          "parameters:\n"
+          "  speed: {default: 0.1, unit: m/s, range: [0, 0.5], description: forward speed}\n"
+          "  label: {default: plain}\n"
+          "objects: {name: body, type: dummy, script: bot.lua}\n");
+    Write("bot.lua", "function sysCall_init() end\n");
+    Write("main.lua", "function sysCall_step() sim.handleDynamics() end\n");
+    registry_.RegisterDynamics({"", "kinematic", "1", "test"}, {},
+                               [] { return std::make_unique<testing::NullDynamics>(); });
+    proximity::Register(&registry_, {"", "proximity", "1", "test"},
+                        [] { return std::make_unique<testing::NullProximity>(); });
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  void Write(const std::string& name, const std::string& text) {
+    std::ofstream(dir_ / name) << text;
+  }
+  LoadedWorld Load(const std::string& world, LoadOptions options = {}) {
+    Write("world.yaml", world);
+    return LoadWorld(dir_ / "world.yaml", options, registry_);
+  }
+  std::string ErrorOf(const std::string& world, LoadOptions options = {}) {
+    try {
+      Load(world, options);
+    } catch (const Error& e) {
+      return e.what();
+    }
+    return "NO ERROR";
+  }
+  fs::path dir_;
+  ModuleRegistry registry_;
+};
+
+const char kThree[] =
+    "simulation: {physics: kinematic}\n"
+    "models:\n"
+    "  - model: bot.yaml\n"
+    "    count: 3\n"
+    "    distribute: {region: {min: [-5, -5], max: [5, 5]}}\n"
+    "    parameters: {speed: 0.2}\n"
+    "    instances:\n"
+    "      - {index: 1, parameters: {speed: 0.4, label: special}}\n";
+
+TEST_F(ControlLoaderTest, EveryEntryOfAModelKeepsItsExplicitScripts) {
+  // Reading `script: {file:, explicit:}` once replaced that map by its file
+  // name in the parsed model (yaml-cpp's Node assignment writes through), so
+  // the second entry of the same model got a plain, self-running script.
+  Write("arm.yaml",
+        "model: arm\n"
+        "objects:\n"
+        "  {type: dummy, script: arm.lua,\n"
+        "   children: [{name: x, type: dummy, script: {file: x.lua, explicit: true}}]}\n");
+  Write("arm.lua",
+        "function sysCall_actuation()\n"
+        "  sim.recordMetric('doubled', sim.handleChildScript(sim.getObject('./x'), 21))\n"
+        "end\n");
+  Write("x.lua",
+        "function sysCall_actuation(a) sim.recordMetric('x_ran', a or -1) return 2 * a end\n");
+  LoadedWorld w = Load(
+      "simulation: {physics: kinematic}\n"
+      "models:\n"
+      "  - {model: arm.yaml, position: [0, 0]}\n"
+      "  - {model: arm.yaml, position: [1, 0]}\n"
+      "  - {model: arm.yaml, count: 2, distribute: {region: {min: [2, 2], max: [9, 9]}}}\n");
+  w.world->Step();
+  int doubled = 0, x_ran = 0;
+  for (const MetricSample& m : w.world->TakeMetrics()) {
+    if (m.name == "doubled") doubled += m.value == 42;
+    if (m.name == "x_ran") x_ran += m.value == 21;  // only when called, with its argument
+  }
+  EXPECT_EQ(doubled, 4);
+  EXPECT_EQ(x_ran, 4);
+}
+
+TEST_F(ControlLoaderTest, PerCopyParametersOverrideTheEntrysAndSetAppliesToAll) {
+  LoadedWorld w = Load(kThree);
+  const World& world = *w.world;
+  EXPECT_EQ(std::get<double>(*world.FindParameter(0, "speed")), 0.2);
+  EXPECT_EQ(std::get<double>(*world.FindParameter(1, "speed")), 0.4);
+  EXPECT_EQ(std::get<std::string>(*world.FindParameter(1, "label")), "special");
+  EXPECT_EQ(std::get<double>(*world.FindParameter(2, "speed")), 0.2);
+  LoadOptions set;
+  set.overrides = {{"bot.speed", "0.3"}};
+  LoadedWorld s = Load(kThree, set);
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(std::get<double>(*s.world->FindParameter(i, "speed")), 0.3);
+  EXPECT_EQ(std::get<std::string>(*s.world->FindParameter(1, "label")), "special");
+  ASSERT_EQ(w.models.size(), 1u);
+  EXPECT_EQ(w.models[0].instances[0].second, "label=special, speed=0.4");
+}
+
+TEST_F(ControlLoaderTest, RangesAndInstanceMistakesNameFileLineAndColumn) {
+  std::string bad = kThree;
+  bad.replace(bad.find("speed: 0.4"), 10, "speed: 0.9");
+  EXPECT_CONTAINS(ErrorOf(bad),
+                  "world.yaml:8:40: parameter 'speed' of model 'bot' must be within "
+                  "[0, 0.5] m/s (got 0.9)");
+  bad = kThree;
+  bad.replace(bad.find("index: 1"), 8, "index: 3");
+  EXPECT_CONTAINS(ErrorOf(bad), "world.yaml:8:17: 'index' must be below the entry's count (3)");
+  bad = kThree;
+  bad.replace(bad.find("label: special"), 14, "colour: red");
+  EXPECT_CONTAINS(ErrorOf(bad), "model 'bot' has no parameter 'colour'");
+  LoadOptions set;
+  set.overrides = {{"bot.speed", "2"}};
+  EXPECT_CONTAINS(ErrorOf(kThree, set),
+                  "--set bot.speed=2: parameter 'speed' of model 'bot' "
+                  "must be within [0, 0.5]");
+  Write("bot.yaml",
+        "model: bot\nparameters:\n  speed: {default: 0.1, range: [1]}\n"
+        "objects: {name: body, type: dummy}\n");
+  EXPECT_CONTAINS(ErrorOf(kThree), "bot.yaml:3:32: 'range' must be [min, max]");
+}
+
+TEST_F(ControlLoaderTest, ScaledCopiesWithTheirOwnValuesShareTheScaledMesh) {
+  Write("cube.obj",
+        "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n"
+        "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n");
+  Write("cube.yaml",
+        "model: cube\n"
+        "parameters: {m: 1}\n"
+        "objects: {type: shape, shape: mesh, file: cube.obj, dynamic: true, mass: $m}\n");
+  ModuleRegistry builtin;
+  RegisterBuiltinModules(&builtin);
+  Write("world.yaml",
+        "simulation: {physics: kinematic}\n"
+        "models:\n"
+        "  - {model: cube.yaml, count: 3, scale: 0.1, "
+        "distribute: {region: {min: [-5, -5], max: [5, 5]}},\n"
+        "     instances: [{index: 1, parameters: {m: 2}}]}\n");
+  const LoadedWorld w = LoadWorld(dir_ / "world.yaml", {}, builtin);
+  const Scene& scene = w.world->scene();
+  const ShapeData& own = scene.shape(scene.instance(1).root);
+  EXPECT_DOUBLE_EQ(own.mass, 2 * 0.001);  // its own mass, scaled by 0.1^3
+  EXPECT_DOUBLE_EQ(scene.shape(scene.instance(0).root).mass, 0.001);
+  for (int k : {0, 2}) EXPECT_EQ(scene.shape(scene.instance(k).root).mesh, own.mesh) << k;
+  EXPECT_DOUBLE_EQ(own.mesh->CenteredExtents().x, 0.2);
+}
+
+TEST_F(ControlLoaderTest, EntryParametersAreOfTheirDeclaredType) {
+  const std::string entry =
+      "simulation: {physics: kinematic}\n"
+      "models:\n"
+      "  - model: bot.yaml\n"
+      "    position: [0, 0]\n"
+      "    parameters: ";
+  EXPECT_CONTAINS(ErrorOf(entry + "{speed: fast}\n"),
+                  "world.yaml:5:25: parameter 'speed' of model 'bot' is a number (");
+  EXPECT_CONTAINS(ErrorOf(entry + "{speed: fast}\n"), "bot.yaml:3:20), got \"fast\"");
+  EXPECT_CONTAINS(ErrorOf(entry + "{sped: 0.2}\n"),
+                  "world.yaml:5:18: model 'bot' has no parameter 'sped'; did you mean 'speed'?");
+  // A text parameter takes whatever is given, as text.
+  LoadedWorld w = Load(entry + "{label: 5}\n");
+  EXPECT_EQ(std::get<std::string>(*w.world->FindParameter(0, "label")), "5");
+  // A model that declares none says so.
+  Write("plain.yaml", "model: plain\nobjects: {name: body, type: dummy}\n");
+  EXPECT_CONTAINS(
+      ErrorOf("simulation: {physics: kinematic}\n"
+              "models:\n  - {model: plain.yaml, position: [0, 0], parameters: {a: 1}}\n"),
+      "model 'plain' has no parameter 'a' (it declares none)");
+  // A copy given twice.
+  std::string twice = kThree;
+  twice += "      - {index: 1, parameters: {speed: 0.1}}\n";
+  EXPECT_CONTAINS(ErrorOf(twice), "world.yaml:9:17: copy 1 is given twice in 'instances'");
+}
+
+TEST_F(ControlLoaderTest, ACopyIsPlacedWhereItsEntrySays) {
+  LoadedWorld w = Load(
+      "simulation: {physics: kinematic}\n"
+      "models:\n"
+      "  - {model: bot.yaml, position: [1, 2], heading_deg: 90}\n"
+      "  - {model: bot.yaml, position: [3, 4, 0.5], count: 1}\n"
+      "  - model: bot.yaml\n"
+      "    count: 20\n"
+      "    distribute: {region: {min: [10, 20], max: [12, 21]}}\n");
+  const Scene& scene = w.world->scene();
+  ASSERT_EQ(scene.instances().size(), 22u);
+  const Pose first = scene.world_pose(scene.instance(0).root);
+  EXPECT_NEAR(first.p.x, 1, 1e-12);
+  EXPECT_NEAR(first.p.y, 2, 1e-12);
+  EXPECT_NEAR(first.p.z, 0, 1e-12) << "on the ground";
+  const Vec3 forward = first.q.Rotate({1, 0, 0});
+  EXPECT_NEAR(forward.x, 0, 1e-12);
+  EXPECT_NEAR(forward.y, 1, 1e-12) << "heading 90 degrees: facing +y";
+  EXPECT_NEAR(scene.world_pose(scene.instance(1).root).p.z, 0.5, 1e-12);
+  for (int k = 2; k < 22; ++k) {
+    const Vec3 p = scene.world_pose(scene.instance(k).root).p;
+    EXPECT_TRUE(p.x >= 10 && p.x <= 12 && p.y >= 20 && p.y <= 21)
+        << k << ": " << p.x << ", " << p.y;
+  }
+}
+
+TEST_F(ControlLoaderTest, PlacementMistakesSayWhatToGive) {
+  const std::string head = "simulation: {physics: kinematic}\nmodels:\n  - ";
+  EXPECT_CONTAINS(ErrorOf(head + "{model: bot.yaml}\n"),
+                  "world.yaml:3:5: a models entry needs 'distribute' (with 'count') to spread "
+                  "copies, or 'position: [x, y]' for a single copy");
+  EXPECT_CONTAINS(ErrorOf(head + "{model: bot.yaml, position: [0, 0], count: 2}\n"),
+                  "world.yaml:3:48: 'count' other than 1 needs 'distribute'");
+  EXPECT_CONTAINS(ErrorOf(head + "{model: bot.yaml, count: 2, position: [0, 0], distribute: {}}\n"),
+                  "world.yaml:3:33: 'position' places a single copy; it cannot be combined with "
+                  "'distribute' (use distribute.heading_deg for a fixed heading)");
+  EXPECT_CONTAINS(ErrorOf(head + "{model: bot.yaml, count: 2, distribute: {}}\n"),
+                  "distributing in the arena needs an 'arena' in the world; or give "
+                  "'region: {min: [x, y], max: [x, y]}'");
+  EXPECT_CONTAINS(
+      ErrorOf(head +
+              "{model: bot.yaml, count: 2, distribute: {region: {min: [0, 0], max: [1, 0]}}}\n"),
+      "'region' needs max greater than min in x and in y");
+  EXPECT_CONTAINS(ErrorOf(head + "{model: bot.yaml, count: 2, distribute: {region: 5}}\n"),
+                  "'region' must be 'arena' or {min: [x, y], max: [x, y]} (got \"5\")");
+  EXPECT_CONTAINS(ErrorOf(head + "{model: bot.yaml, count: 2, distribute: {regoin: arena}}\n"),
+                  "unknown key 'regoin' in 'distribute'; did you mean 'region'?");
+  Write("disc.yaml",
+        "model: disc\nobjects: {name: body, type: shape, shape: cylinder, radius: 0.5, "
+        "height: 0.1}\n");
+  EXPECT_CONTAINS(
+      ErrorOf(head +
+              "{model: disc.yaml, count: 1, distribute: {region: {min: [0, 0], max: [0.9, 5]}}}\n"),
+      "world.yaml:3:31: the region is too small for one disc (footprint radius 0.5 m)");
+}
+
+}  // namespace
+}  // namespace swarmsim

@@ -1,0 +1,133 @@
+// The loader's YAML reading (swarm/loader/yaml.cc): files that cannot be read
+// named with who referenced them, syntax errors at their line and column,
+// keys checked with a suggestion, lists and values described in messages.
+#include "swarm/loader/yaml.h"
+
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "tests/swarm/loader/yaml_file.h"
+
+namespace swarmsim::loader {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::ErrorOf;
+using testing::Root;
+using testing::Yaml;
+using testing::YamlDir;
+
+TEST(YamlTest, AFileThatCannotBeReadIsNamedWithWhoReferencedIt) {
+  const fs::path missing = YamlDir() / "models" / "x.yaml";
+  const auto load = [](const fs::path& path) {
+    return ErrorOf([&] { YamlFile::Load(path, "model file", "w.yaml:12:5", "models/x.yaml"); });
+  };
+  EXPECT_EQ(load(missing), "w.yaml:12:5: model file 'models/x.yaml' not found (looked for " +
+                               DisplayPath(missing) + ")");
+  fs::create_directories(YamlDir() / "folder.yaml");
+  EXPECT_EQ(load(YamlDir() / "folder.yaml"),
+            "w.yaml:12:5: model file 'models/x.yaml' is a directory, not a file (looked for " +
+                DisplayPath(YamlDir() / "folder.yaml") + ")");
+  ASSERT_EQ(::mkfifo((YamlDir() / "fifo.yaml").c_str(), 0600), 0);
+  EXPECT_EQ(load(YamlDir() / "fifo.yaml"),
+            "w.yaml:12:5: model file 'models/x.yaml' is not a regular file (looked for " +
+                DisplayPath(YamlDir() / "fifo.yaml") + ")");
+  // Without a referrer: the kind and the path alone.
+  EXPECT_EQ(ErrorOf([&] { YamlFile::Load(missing, "world file", "", DisplayPath(missing)); }),
+            "world file '" + DisplayPath(missing) + "' not found");
+  fs::remove_all(YamlDir());
+}
+
+TEST(YamlTest, SyntaxErrorsKeepTheirLineAndColumn) {
+  const std::string unclosed = ErrorOf([] { Yaml("a: [1, 2\nb: 3\n"); });
+  EXPECT_EQ(unclosed.rfind(DisplayPath(YamlDir() / "w.yaml") + ":", 0), 0u) << unclosed;
+  EXPECT_NE(unclosed.find(": YAML syntax error: "), std::string::npos) << unclosed;
+  EXPECT_EQ(unclosed.find("tabs"), std::string::npos) << unclosed;
+  // A tab in the indentation says so.
+  const std::string tab = ErrorOf([] { Yaml("a:\n\tb: 1\n"); });
+  EXPECT_NE(tab.find(DisplayPath(YamlDir() / "w.yaml") + ":2:"), std::string::npos) << tab;
+  EXPECT_NE(tab.find("(YAML does not allow tabs for indentation)"), std::string::npos) << tab;
+  fs::remove_all(YamlDir());
+}
+
+TEST(YamlTest, PlacesAreOneBasedLineAndColumn) {
+  const YamlFile file = Yaml("a: 1\nb:\n  c: here\n");
+  EXPECT_EQ(file.name(), DisplayPath(YamlDir() / "w.yaml"));
+  EXPECT_EQ(file.Where(file.root()["b"]["c"].Mark()), file.name() + ":3:6");
+  EXPECT_EQ(file.Where(YAML::Mark::null_mark()), file.name());
+  EXPECT_EQ(ErrorOf([&] { file.Fail(file.root()["a"].Mark(), "no"); }), file.name() + ":1:4: no");
+  fs::remove_all(YamlDir());
+}
+
+TEST(YamlTest, KeysAreCheckedWithASuggestion) {
+  const YamlFile file = Yaml("radius: 1\nheigth: 2\n");
+  const Fields fields(file, Root(file), "shape 'body'");
+  EXPECT_EQ(fields.keys(), (std::vector<std::string>{"radius", "heigth"}));
+  EXPECT_EQ(ErrorOf([&] {
+              fields.Expect({"radius", "height"});
+            }),
+            file.name() + ":2:1: unknown key 'heigth' in shape 'body'; did you mean 'height'?");
+  EXPECT_EQ(ErrorOf([&] { fields.Expect({"radius", "heigth"}); }), "");
+  EXPECT_TRUE(fields.Has("radius"));
+  EXPECT_FALSE(fields.Has("height"));
+  const Field radius = fields.Get("radius");
+  EXPECT_TRUE(radius.present());
+  EXPECT_EQ(file.Where(radius.mark), file.name() + ":1:9");
+  EXPECT_EQ(file.Where(radius.key_mark), file.name() + ":1:1");
+  EXPECT_FALSE(fields.Get("height").present());
+  EXPECT_EQ(ErrorOf([&] { fields.Require("height"); }),
+            file.name() + ":1:1: 'height' is required in shape 'body'");
+  fs::remove_all(YamlDir());
+}
+
+TEST(YamlTest, AMappingHasEachPlainKeyOnce) {
+  const YamlFile twice = Yaml("a: 1\nb: 2\na: 3\n");
+  EXPECT_EQ(ErrorOf([&] { Fields(twice, Root(twice), "'simulation'"); }),
+            twice.name() + ":3:1: duplicate key 'a' in 'simulation' (first given at " +
+                twice.name() + ":1:1)");
+  const YamlFile list = Yaml("[1, 2]\n");
+  EXPECT_EQ(ErrorOf([&] { Fields(list, Root(list), "'simulation'"); }),
+            list.name() + ":1:1: 'simulation' must be a mapping of keys to values (got a list)");
+  const YamlFile complex = Yaml("? [1, 2]\n: 3\n");
+  EXPECT_NE(ErrorOf([&] {
+              Fields(complex, Root(complex), "'simulation'");
+            }).find("keys in 'simulation' must be plain names (got a list)"),
+            std::string::npos);
+  fs::remove_all(YamlDir());
+}
+
+TEST(YamlTest, ListElementsAreNamedByTheirIndex) {
+  const YamlFile file = Yaml("models:\n  - a\n  - b\nnone:\nsome: 3\n");
+  const Fields fields(file, Root(file), "the world");
+  const std::vector<Field> models = ListElements(file, fields.Get("models"), "models");
+  ASSERT_EQ(models.size(), 2u);
+  EXPECT_EQ(models[1].name, "models[1]");
+  EXPECT_EQ(models[1].node.Scalar(), "b");
+  EXPECT_EQ(file.Where(models[1].mark), file.name() + ":3:5");
+  EXPECT_TRUE(ListElements(file, fields.Get("none"), "models").empty());
+  EXPECT_TRUE(ListElements(file, fields.Get("absent"), "models").empty());
+  EXPECT_EQ(ErrorOf([&] { ListElements(file, fields.Get("some"), "model entries"); }),
+            file.name() + ":5:7: 'some' must be a list of model entries (got \"3\")");
+  fs::remove_all(YamlDir());
+}
+
+TEST(YamlTest, ValuesAreDescribedInOnePrintableLine) {
+  const YamlFile file = Yaml(
+      "list: [1]\nmap: {a: 1}\nnothing:\ntext: \"a\\tb\"\nlong: "
+      "abcdefghijklmnopqrstuvwxyz0123456789ABCDEFGHIJ\n");
+  EXPECT_EQ(Describe(file.root()["list"]), "a list");
+  EXPECT_EQ(Describe(file.root()["map"]), "a mapping");
+  EXPECT_EQ(Describe(file.root()["nothing"]), "nothing");
+  EXPECT_EQ(Describe(file.root()["absent"]), "nothing");
+  EXPECT_EQ(Describe(file.root()["text"]), "\"a?b\"");
+  EXPECT_EQ(Describe(file.root()["long"]), "\"abcdefghijklmnopqrstuvwxyz0123456789A...\"");
+  fs::remove_all(YamlDir());
+}
+
+}  // namespace
+}  // namespace swarmsim::loader

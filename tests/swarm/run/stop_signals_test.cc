@@ -1,0 +1,90 @@
+// SIGINT, SIGTERM and SIGHUP as requests to stop (swarm/run/stop_signals.cc):
+// the first is noted, not acted on; a second acts as usual; the handlers
+// before are restored; a signal pending while blocked is noted on creation.
+#include "swarm/run/stop_signals.h"
+
+#include <gtest/gtest.h>
+#include <pthread.h>
+#include <signal.h>
+#include <unistd.h>
+
+namespace swarmsim {
+namespace {
+
+TEST(StopSignalsTest, TheFirstSignalIsNotedAndTheProgramGoesOn) {
+  for (const int sig : {SIGINT, SIGTERM, SIGHUP}) {
+    StopSignals stop;
+    EXPECT_EQ(StopSignals::Received(), 0);
+    ASSERT_EQ(raise(sig), 0);
+    EXPECT_EQ(StopSignals::Received(), sig);  // and this process still runs
+  }
+}
+
+TEST(StopSignalsTest, ANewOneForgetsAnOldSignalANestedOneKeepsIt) {
+  {
+    StopSignals outer;
+    ASSERT_EQ(raise(SIGHUP), 0);
+    StopSignals inner;  // the run's, inside the program's for the load
+    EXPECT_EQ(StopSignals::Received(), SIGHUP);
+  }
+  StopSignals next;
+  EXPECT_EQ(StopSignals::Received(), 0);
+}
+
+TEST(StopSignalsTest, ASecondSignalActsAsUsual) {
+  // A stuck program can still be stopped: the second Ctrl-C ends it.
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  EXPECT_EXIT(
+      {
+        StopSignals stop;
+        raise(SIGINT);
+        raise(SIGINT);
+        _exit(0);
+      },
+      ::testing::KilledBySignal(SIGINT), "");
+}
+
+volatile sig_atomic_t g_own_handler_calls = 0;
+extern "C" void OwnHandler(int) { g_own_handler_calls = g_own_handler_calls + 1; }
+
+TEST(StopSignalsTest, TheHandlersBeforeAreRestored) {
+  struct sigaction own {
+  }, before{};
+  own.sa_handler = OwnHandler;
+  sigemptyset(&own.sa_mask);
+  ASSERT_EQ(sigaction(SIGTERM, &own, &before), 0);
+  {
+    StopSignals stop;
+    raise(SIGTERM);
+    EXPECT_EQ(g_own_handler_calls, 0);
+    EXPECT_EQ(StopSignals::Received(), SIGTERM);
+  }
+  raise(SIGTERM);
+  EXPECT_EQ(g_own_handler_calls, 1);
+  sigaction(SIGTERM, &before, nullptr);
+}
+
+TEST(StopSignalsTest, ASignalPendingWhileBlockedIsNotedOnCreation) {
+  // A batch system's wrapper may start the program with them blocked.
+  sigset_t mask, old;
+  sigemptyset(&mask);
+  sigaddset(&mask, SIGTERM);
+  ASSERT_EQ(pthread_sigmask(SIG_BLOCK, &mask, &old), 0);
+  struct sigaction default_action {
+  }, before{};
+  default_action.sa_handler = SIG_DFL;
+  sigemptyset(&default_action.sa_mask);
+  sigaction(SIGTERM, &default_action, &before);
+  ASSERT_EQ(raise(SIGTERM), 0);  // pending: blocked
+  {
+    StopSignals stop;  // unblocks: the signal arrives, and is only noted
+    EXPECT_EQ(StopSignals::Received(), SIGTERM);
+  }
+  // Had it stayed pending, ignoring it discards it (instead of ending the tests).
+  signal(SIGTERM, SIG_IGN);
+  pthread_sigmask(SIG_SETMASK, &old, nullptr);
+  sigaction(SIGTERM, &before, nullptr);
+}
+
+}  // namespace
+}  // namespace swarmsim

@@ -1,0 +1,202 @@
+// Runs of a sweep as worker processes (swarm/sweep/worker.cc): a run that
+// fails or times out is recorded with its message and the sweep goes on.
+#include "swarm/sweep/worker.h"
+
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <algorithm>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "tests/swarm/run_program.h"
+#include "tests/swarm/sweep/sweep_db.h"
+
+namespace swarmsim {
+namespace {
+
+namespace fs = std::filesystem;
+
+using Result = swarmsim::testing::CommandResult;
+using swarmsim::testing::RunCommand;
+using swarmsim::testing::RunProgram;
+using sweep_testing::Count;
+using sweep_testing::kWorld;
+using sweep_testing::ReadRuns;
+using sweep_testing::RunRow;
+using sweep_testing::TempDir;
+
+TEST(SweepTest, FailedRunsAndTimeoutsAreRecordedAndTheSweepGoesOn) {
+  const fs::path dir = TempDir("fail");
+  const fs::path db = dir / "r.db";
+  // fail_at=0.2: a Lua error at t = 0.2 s; spin=1e9: far past the 1 s limit.
+  Result r = RunProgram("sweep " + kWorld + " --param fail_at=-1,0.2 --param spin=0,1000000000 " +
+                        "--seeds 2 --steps 10 --jobs 2 --timeout 1 --db " + db.string());
+  // Every run is attempted; failures make the exit status 1, after the summary.
+  ASSERT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("sweep: 2 ok, 6 failed, 0 not run, of 8 runs"), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("6 runs failed or timed out (exit status 1)"), std::string::npos)
+      << r.output;
+  const auto runs = ReadRuns(db);
+  ASSERT_EQ(runs.size(), 8u);
+  int ok = 0, lua = 0, timeout = 0;
+  for (const auto& [id, run] : runs) {
+    if (run.status == "ok") {
+      ++ok;
+      EXPECT_EQ(run.params.at("fail_at"), "-1");
+      EXPECT_EQ(run.params.at("spin"), "0");
+      EXPECT_EQ(run.hash.size(), 16u);
+    } else {
+      ASSERT_EQ(run.status, "failed") << id;
+      if (run.error.find("timed out") != std::string::npos) ++timeout;
+      if (run.error.find("bot.lua:13: planned failure") != std::string::npos) ++lua;
+    }
+  }
+  EXPECT_EQ(ok, 2);
+  EXPECT_EQ(lua, 2);      // fail_at=0.2, spin=0
+  EXPECT_EQ(timeout, 4);  // spin=1e9: the first step never ends, fail_at or not
+  EXPECT_EQ(Count(db,
+                  "SELECT count(*) FROM final_metrics JOIN runs ON id = run "
+                  "WHERE metric = 'x' AND status = 'ok'"),
+            2);
+  // The same command on the finished sweep runs nothing and still says it failed.
+  r = RunProgram("sweep " + kWorld + " --param fail_at=-1,0.2 --param spin=0,1000000000 " +
+                 "--seeds 2 --steps 10 --jobs 2 --timeout 1 --quiet --db " + db.string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  fs::remove_all(dir);
+}
+
+GridRun Run5() {
+  GridRun run;
+  run.id = 5;
+  run.seed = 7;
+  run.params = {{"robots", "5"}, {"bot.speed", "0.1"}};
+  return run;
+}
+
+TEST(WorkerTest, ARunIsTheRunCommandWithItsSeedAndParameters) {
+  WorkerConfig config;
+  config.world = "worlds/w.yaml";
+  config.steps = 12;
+  config.threads_per_run = 2;
+  EXPECT_EQ(RunArguments(config, Run5(), "/tmp/run-5"),
+            (std::vector<std::string>{"run", "worlds/w.yaml", "--seed", "7", "--set", "robots=5",
+                                      "--set", "bot.speed=0.1", "--steps", "12", "--threads", "2",
+                                      "--quiet", "--out", "/tmp/run-5"}));
+  // A duration when no steps are given, as `run` reads it back; neither: the world's own.
+  config.steps.reset();
+  config.duration = 2.5;
+  const auto with_duration = RunArguments(config, Run5(), "/tmp/run-5");
+  EXPECT_EQ(with_duration[8], "--duration");
+  EXPECT_EQ(with_duration[9], "2.5");
+  config.duration.reset();
+  const auto own_length = RunArguments(config, Run5(), "/tmp/run-5");
+  EXPECT_EQ(std::count(own_length.begin(), own_length.end(), "--steps") +
+                std::count(own_length.begin(), own_length.end(), "--duration"),
+            0);
+}
+
+// A run folder as `run --out` leaves it.
+fs::path RunFolder(const std::string& name, const std::string& summary, const std::string& metrics,
+                   const std::string& stderr_text = "") {
+  const fs::path dir = TempDir("worker_" + name);
+  if (!summary.empty()) std::ofstream(dir / "summary.json") << summary;
+  if (!metrics.empty()) std::ofstream(dir / "metrics.csv") << metrics;
+  if (!stderr_text.empty()) std::ofstream(dir / "stderr.txt") << stderr_text;
+  return dir;
+}
+
+constexpr int kExited0 = 0;  // waitpid statuses: exit code << 8, or the signal
+constexpr int Exited(int code) { return code << 8; }
+
+TEST(WorkerTest, AFinishedRunIsItsSummaryAndItsMetricsMeanOverRobots) {
+  const fs::path dir = RunFolder(
+      "ok", R"({"status": "ok", "steps": 2, "robots": 2, "state_hash": "00000000000000aa"})",
+      "step,time,robot,metric,value\n"
+      "1,0.1,bot#0,x,1\n1,0.1,bot#1,x,3\n1,0.1,,mnnd,0.5\n"
+      "2,0.2,bot#0,x,2\n2,0.2,bot#1,x,6\n2,0.2,,mnnd,0.75\n");
+  const RunOutcome o = CollectRun(5, dir, kExited0, false, 0);
+  EXPECT_EQ(o.id, 5);
+  EXPECT_TRUE(o.ok) << o.error;
+  EXPECT_EQ(o.steps, 2);
+  EXPECT_EQ(o.robots, 2);
+  EXPECT_EQ(o.state_hash, "00000000000000aa");
+  EXPECT_EQ(o.final_metrics.at("x"), 4);  // step 2: (2 + 6) / 2
+  EXPECT_EQ(o.final_metrics.at("mnnd"), 0.75);
+  ASSERT_EQ(o.series.size(), 4u);
+  std::map<std::pair<std::string, int64_t>, double> series;
+  for (const SeriesPoint& p : o.series) series[{p.metric, p.step}] = p.value;
+  EXPECT_EQ((series[{"x", 1}]), 2);
+  EXPECT_EQ((series[{"mnnd", 1}]), 0.5);
+  fs::remove_all(dir);
+}
+
+TEST(WorkerTest, ATornLastMetricsRowIsLeftOut) {
+  // A run killed while writing (a timeout): the rows before the torn one
+  // count, and the torn one adds no metric and no value.
+  for (const std::string torn : {"3,0.3,bot#0,x,", "3,0.3,bot#0,x", "3,0.3,b"}) {
+    const fs::path dir = RunFolder("torn", R"({"status": "running", "steps": 0})",
+                                   "step,time,robot,metric,value\n"
+                                   "1,0.1,bot#0,x,1\n2,0.2,bot#0,x,2\n" +
+                                       torn);
+    const RunOutcome o = CollectRun(1, dir, SIGKILL, true, 1.5);
+    EXPECT_EQ(o.final_metrics.size(), 1u) << torn;
+    EXPECT_EQ(o.final_metrics.count("x"), 1u) << torn;
+    if (o.final_metrics.count("x")) {
+      EXPECT_EQ(o.final_metrics.at("x"), 2) << torn;
+    }
+    EXPECT_EQ(o.series.size(), 2u) << torn;
+    fs::remove_all(dir);
+  }
+}
+
+TEST(WorkerTest, AFailedRunSaysWhy) {
+  const std::string summary_error =
+      R"({"status": "error", "error": "bot.lua:13: planned failure", "steps": 2})";
+  // The run's own error, from its summary.
+  fs::path dir = RunFolder("error", summary_error, "", "noise\n");
+  RunOutcome o = CollectRun(1, dir, Exited(1), false, 0);
+  EXPECT_FALSE(o.ok);
+  EXPECT_EQ(o.error, "bot.lua:13: planned failure");
+  EXPECT_EQ(o.steps, 2);
+  fs::remove_all(dir);
+  // Timed out: the limit, and no state hash (the state is not a final one).
+  dir = RunFolder("timeout", R"({"status": "running", "state_hash": "00000000000000aa"})", "");
+  o = CollectRun(1, dir, SIGKILL, true, 1.5);
+  EXPECT_FALSE(o.ok);
+  EXPECT_EQ(o.error, "timed out after 1.5 s (--timeout)");
+  EXPECT_EQ(o.state_hash, "");
+  fs::remove_all(dir);
+  // Crashed: the signal and the last three lines of its stderr.
+  dir = RunFolder("crash", "", "", "one\n\ntwo\nthree\nfour\n");
+  o = CollectRun(1, dir, SIGSEGV, false, 0);
+  EXPECT_EQ(o.error, "crashed: killed by signal " + std::to_string(SIGSEGV) + " (" +
+                         strsignal(SIGSEGV) + "): two | three | four");
+  fs::remove_all(dir);
+  // No summary and nothing on stderr: the exit status; 127: not started.
+  dir = RunFolder("status", "", "");
+  EXPECT_EQ(CollectRun(1, dir, Exited(3), false, 0).error, "exit status 3");
+  EXPECT_EQ(CollectRun(1, dir, Exited(127), false, 0).error, "cannot start the worker program");
+  // Exit 0 without an ok summary is no success.
+  EXPECT_EQ(CollectRun(1, dir, kExited0, false, 0).error, "the run wrote no valid summary.json");
+  std::ofstream(dir / "summary.json") << R"({"status": "ok", "steps": "many"})";
+  o = CollectRun(1, dir, kExited0, false, 0);
+  EXPECT_TRUE(o.ok);
+  EXPECT_EQ(o.steps, 0) << "a field of the wrong type is not read";
+  std::ofstream(dir / "summary.json") << "{\"status\": \"ok\", trunc";
+  EXPECT_EQ(CollectRun(1, dir, kExited0, false, 0).error, "the run wrote no valid summary.json");
+  fs::remove_all(dir);
+  // Whatever bytes stderr held, the error is UTF-8 (it goes to SQLite and JSON).
+  dir = RunFolder("bytes", "", "", "caf\xe9 au lait\n");
+  EXPECT_EQ(CollectRun(1, dir, Exited(1), false, 0).error, "caf\xef\xbf\xbd au lait");
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace swarmsim
