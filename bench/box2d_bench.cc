@@ -26,6 +26,7 @@
 #include "framework/dynamics_backend.h"
 #include "framework/scene.h"
 #include "modules/dynamics/box2d/box2d_backend.h"
+#include "modules/proximity/proximity_sensor.h"
 
 namespace swarmsim::box2d {
 namespace {
@@ -66,8 +67,8 @@ void AddProximityRing(Scene* scene, ObjectId body) {
   for (int i = 0; i < 24; ++i) {
     const double a = i * M_PI / 12;
     const Quat q_BS = Quat::FromYaw(a) * Quat::FromAxisAngle({0, 1, 0}, M_PI / 2);
-    scene->AddProximitySensor("prox", body,
-                              {{0.085 * std::cos(a), 0.085 * std::sin(a), -0.013}, q_BS}, sensor);
+    proximity::AddSensor(scene, "prox", body,
+                         {{0.085 * std::cos(a), 0.085 * std::sin(a), -0.013}, q_BS}, sensor);
   }
 }
 

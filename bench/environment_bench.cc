@@ -23,7 +23,6 @@
 #include <memory>
 #include <string>
 
-#include "framework/proximity_backend.h"
 #include "framework/scene.h"
 #include "modules/environment/octomap_map.h"
 #include "modules/environment/voxel_merge.h"

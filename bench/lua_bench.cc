@@ -62,10 +62,10 @@ ObjectId AddFootbot(Scene* scene, std::shared_ptr<const ScriptSource> script, do
       sensor.detected = true;
       sensor.distance = 0.05;
     }
-    scene->AddProximitySensor("prox", body,
-                              {{0.085 * std::cos(angle), 0.085 * std::sin(angle), 0},
-                               Quat::FromRollPitchYaw(0, M_PI / 2, angle)},
-                              sensor);
+    proximity::AddSensor(scene, "prox", body,
+                         {{0.085 * std::cos(angle), 0.085 * std::sin(angle), 0},
+                          Quat::FromRollPitchYaw(0, M_PI / 2, angle)},
+                         sensor);
   }
   scene->MakeModelInstance(body, "footbot", "footbot#" + std::to_string(scene->instances().size()));
   scene->AttachScript(body, std::move(script));

@@ -27,7 +27,6 @@
 #include <string>
 #include <vector>
 
-#include "framework/proximity_backend.h"
 #include "framework/scene.h"
 #include "framework/spatial_grid.h"
 #include "modules/proximity/proximity.h"
@@ -76,8 +75,8 @@ void AddRobot(Scene* scene, const Pose& X_WR, int index) {
     const double a = 2 * M_PI * k / kRaysPerRobot;
     // z axis radially out: turn z onto x, then yaw by a.
     const Quat q = Quat::FromYaw(a) * Quat::FromAxisAngle({0, 1, 0}, M_PI / 2);
-    scene->AddProximitySensor(
-        "ir", root, {{kBodyRadius * std::cos(a), kBodyRadius * std::sin(a), 0.06}, q}, ray);
+    proximity::AddSensor(scene, "ir", root,
+                         {{kBodyRadius * std::cos(a), kBodyRadius * std::sin(a), 0.06}, q}, ray);
   }
   scene->MakeModelInstance(root, "bot", "bot#" + std::to_string(index));
 }
@@ -146,7 +145,7 @@ void SenseRobots(benchmark::State& state, bool early_out, const std::vector<int>
     if (++k == count) k = 0;
   }
   int detected = 0;
-  for (const auto& r : swarm.scene.proximity_sensors()) detected += r.detected;
+  for (const auto& r : proximity::Sensors(swarm.scene).rows) detected += r.detected;
   SetPerRobotCounters(state, double(state.iterations()));
   state.counters["detected_rays"] = detected;
   state.counters["robots"] = double(count);

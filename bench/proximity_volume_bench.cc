@@ -17,7 +17,6 @@
 #include <cmath>
 #include <memory>
 
-#include "framework/proximity_backend.h"
 #include "framework/scene.h"
 #include "modules/proximity/proximity.h"
 
@@ -45,7 +44,7 @@ std::unique_ptr<OneSensor> Make(ProximityVolume volume, double angle_deg, double
   sensor.volume = volume;
   sensor.range = 3;
   sensor.more->angle = sensor.more->angle_y = angle_deg * M_PI / 180;
-  s->scene.AddProximitySensor("s", {}, {}, sensor);
+  proximity::AddSensor(&s->scene, "s", {}, {}, sensor);
   s->scene.AddShape("box", {}, {{box_x, box_y, 1}, {}}, Shape(ShapeKind::kBox, {0.2, 0.2, 0.2}));
   s->scene.AddShape("sphere", {}, {{0.3, 0.3, 1.5}, {}}, Shape(ShapeKind::kSphere, {0.1, 0, 0}));
   s->scene.AddShape("cylinder", {}, {{-0.3, 0.2, 1.6}, {}},
@@ -62,10 +61,10 @@ std::unique_ptr<OneSensor> Make(ProximityVolume volume, double angle_deg, double
 void Run(benchmark::State& state, OneSensor* s) {
   for (auto _ : state) {
     s->backend->SenseSceneSensors(&s->scene);
-    benchmark::DoNotOptimize(s->scene.proximity_sensors()[0].distance);
+    benchmark::DoNotOptimize(proximity::Sensors(s->scene).rows[0].distance);
   }
-  state.counters["distance"] = s->scene.proximity_sensors()[0].distance;
-  state.counters["detected"] = s->scene.proximity_sensors()[0].detected;
+  state.counters["distance"] = proximity::Sensors(s->scene).rows[0].distance;
+  state.counters["detected"] = proximity::Sensors(s->scene).rows[0].detected;
 }
 
 void BM_Ray(benchmark::State& state) {

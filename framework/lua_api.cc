@@ -362,9 +362,9 @@ void RegisterAreas(lua_State* L) {
   lua_pushinteger(L, kHandleWorld);
   lua_setfield(L, -2, "handle_world");
   for (auto area : kAreas) area(L);
-  // Each built-in object type's own area (joints, proximity, plugin
-  // sensors: framework/types/, object_type.h); the types and modules of a
-  // world's registry add theirs on first use (PushRegisteredTypeFunction).
+  // Each built-in object type's own area (joints, plugin sensors:
+  // framework/types/, object_type.h); the types and modules of a world's
+  // registry add theirs on first use (PushRegisteredTypeFunction).
   for (const ObjectTypeDescriptor* type : CoreObjectTypes())
     if (type->register_lua != nullptr) type->register_lua(L);
 }

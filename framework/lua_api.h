@@ -205,7 +205,6 @@ void PushParamValue(lua_State* L, const ParamValue& value);
 // (and, for base-library replacements such as print, to the globals).
 void RegisterObjectsApi(lua_State* L);
 void RegisterJointsApi(lua_State* L);
-void RegisterSensorsApi(lua_State* L);
 void RegisterSimApi(lua_State* L);
 void RegisterMessagesApi(lua_State* L);
 void RegisterControlApi(lua_State* L);

@@ -17,7 +17,7 @@
 #include <string>
 #include <variant>
 
-#include "framework/proximity_backend.h"
+#include "framework/line_of_sight.h"
 #include "framework/scene.h"
 #include "framework/scheduler.h"
 #include "framework/script_memory.h"
@@ -92,7 +92,7 @@ void Messaging::ApplySignalWrites() {
   apply_signals(scene_);
 }
 
-void Messaging::Deliver(Scene* scene, const ProximityBackend* proximity, TaskScheduler& scheduler) {
+void Messaging::Deliver(Scene* scene, const LineOfSight* line_of_sight, TaskScheduler& scheduler) {
   // Signals the scene's scripts wrote since the last control pass (a main
   // script after sim.handleChildScripts).
   ApplySignalWrites();
@@ -104,7 +104,7 @@ void Messaging::Deliver(Scene* scene, const ProximityBackend* proximity, TaskSch
     return;
   }
   IndexMessages(*scene);
-  FillRobotInboxes(*scene, proximity, scheduler);
+  FillRobotInboxes(*scene, line_of_sight, scheduler);
   FillSceneInbox();
 }
 
@@ -213,7 +213,7 @@ void Messaging::IndexMessages(const Scene& scene) {
   grid_.Build(items);
 }
 
-void Messaging::FillRobotInboxes(const Scene& scene, const ProximityBackend* proximity,
+void Messaging::FillRobotInboxes(const Scene& scene, const LineOfSight* line_of_sight,
                                  TaskScheduler& scheduler) {
   // Each robot fills its own inbox.
   const int robot_count = static_cast<int>(robots_.size());
@@ -245,8 +245,8 @@ void Messaging::FillRobotInboxes(const Scene& scene, const ProximityBackend* pro
           if (msg.sender_instance == r) return;
           const Vec3 d = origin_[item.id] - X_WR.p;
           if (d.x * d.x + d.y * d.y + d.z * d.z > msg.range * msg.range) return;
-          if (msg.line_of_sight && proximity != nullptr &&
-              proximity->SegmentBlocked(origin_[item.id], X_WR.p))
+          if (msg.line_of_sight && line_of_sight != nullptr &&
+              line_of_sight->SegmentBlocked(origin_[item.id], X_WR.p))
             return;
           push(item.id);
         });

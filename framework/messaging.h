@@ -23,7 +23,7 @@
 
 namespace swarmsim {
 
-class ProximityBackend;
+class LineOfSight;
 class Scene;
 class ScriptMemory;
 class StateHasher;
@@ -110,8 +110,9 @@ class Messaging {
   // Start of a step: applies what the scripts wrote in the last one (signal
   // writes, then custom data to `scene`, robots in index order, then the
   // scene's scripts) and fills every inbox with the messages sent (see
-  // messaging.cc). `proximity` (may be null) answers line-of-sight queries.
-  void Deliver(Scene* scene, const ProximityBackend* proximity, TaskScheduler& scheduler);
+  // messaging.cc). `line_of_sight` (may be null: nothing blocks) answers
+  // range messages that need line of sight.
+  void Deliver(Scene* scene, const LineOfSight* line_of_sight, TaskScheduler& scheduler);
 
   // Adds to `h` what the scripts left for the next step: the signals, then
   // each robot's messages, signal and custom-data writes not yet delivered
@@ -138,7 +139,7 @@ class Messaging {
   // The origin of each message; global ones listed, local and direct ones
   // bucketed by receiving robot, range ones into the grid.
   void IndexMessages(const Scene& scene);
-  void FillRobotInboxes(const Scene& scene, const ProximityBackend* proximity,
+  void FillRobotInboxes(const Scene& scene, const LineOfSight* line_of_sight,
                         TaskScheduler& scheduler);
   void FillSceneInbox();
 

@@ -13,16 +13,10 @@
 namespace swarmsim {
 
 // The built-in object types; types registered by modules and plugins
-// (Scene::RegisterType) take the values after kCollection.
-enum class ObjectType : uint8_t {
-  kDummy,
-  kShape,
-  kJoint,
-  kProximitySensor,
-  kPluginSensor,
-  kCollection
-};
-inline constexpr int kBuiltinObjectTypes = 6;
+// (Scene::RegisterType) take the values after kCollection (a module finds
+// its own by name: Scene::FindType).
+enum class ObjectType : uint8_t { kDummy, kShape, kJoint, kPluginSensor, kCollection };
+inline constexpr int kBuiltinObjectTypes = 5;
 inline constexpr int kMaxObjectTypes = 64;
 
 // One type's rows, whatever their C++ type.

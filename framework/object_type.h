@@ -157,7 +157,19 @@ struct ObjectTypeDescriptor {
   // The type's Lua API area: adds its sim.* functions to the table on top of
   // L's stack (framework/lua_api.h; sim.readProximitySensor, ...). Null: none.
   void (*register_lua)(lua_State* L) = nullptr;
+  // --- Listing ---------------------------------------------------------------------
+  // The name of a type this one is listed right after (world files' type
+  // lists and their messages, and the order the state hash adds types in),
+  // rather than after every type before it: a type that moved from the
+  // built-in ones into its module keeps its place, so hashes and messages
+  // stay (proximity_sensor: "joint"). Null, or a name not yet registered:
+  // after the types before it.
+  const char* listed_after = nullptr;
 };
+
+// The order `types` (by ObjectType value) are listed in: their indices,
+// each type after the one its `listed_after` names, else in value order.
+std::vector<size_t> ListingOrder(std::span<const ObjectTypeDescriptor* const> types);
 
 // The built-in types, in the order world files, messages and the state hash
 // list them (framework/types/core_types.cc).

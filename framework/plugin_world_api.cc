@@ -8,6 +8,9 @@
 #include "framework/plugin_object_type.h"
 #include "framework/plugin_sensors.h"
 #include "framework/world.h"
+// The readings, through the module's public header (inline lookups by the
+// type's name: nothing of the module is linked).
+#include "modules/proximity/proximity_sensor.h"
 
 namespace swarmsim {
 namespace {
@@ -57,12 +60,11 @@ int64_t RobotRoot(void* world, int robot) {
 }
 
 int ReadProximitySensor(void* world, int64_t sensor, double* distance) {
-  const Scene& scene = W(world).scene();
-  const ObjectId id = ObjectId::FromInteger(sensor);
-  if (!scene.IsValid(id) || scene.type(id) != ObjectType::kProximitySensor) return -1;
-  const ProximitySensorData& p = scene.proximity_sensor(id);
-  if (!p.detected) return 0;
-  *distance = p.distance;
+  const ProximitySensorData* p =
+      proximity::FindSensor(W(world).scene(), ObjectId::FromInteger(sensor));
+  if (p == nullptr) return -1;
+  if (!p->detected) return 0;
+  *distance = p->distance;
   return 1;
 }
 
@@ -117,15 +119,14 @@ int ReadProximitySensors(void* world, const int64_t* sensors, int count, double*
   int detected = 0;
   bool all_sensors = true;
   for (int i = 0; i < count; ++i) {
-    const ObjectId id = ObjectId::FromInteger(sensors[i]);
+    const ProximitySensorData* p = proximity::FindSensor(scene, ObjectId::FromInteger(sensors[i]));
     distances[i] = -1;
-    if (!scene.IsValid(id) || scene.type_at(id.index()) != ObjectType::kProximitySensor) {
+    if (p == nullptr) {
       all_sensors = false;
       continue;
     }
-    const ProximitySensorData& p = scene.proximity_sensors()[scene.row_at(id.index())];
-    if (!p.detected) continue;
-    distances[i] = p.distance;
+    if (!p->detected) continue;
+    distances[i] = p->distance;
     ++detected;
   }
   return all_sensors ? detected : -1;

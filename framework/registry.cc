@@ -5,7 +5,6 @@
 #include "framework/dynamics_backend.h"
 #include "framework/error.h"
 #include "framework/object_type.h"
-#include "framework/proximity_backend.h"
 #include "framework/vision_filter.h"
 #include "framework/world_section.h"
 

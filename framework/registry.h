@@ -19,7 +19,6 @@
 namespace swarmsim {
 
 class DynamicsBackend;
-class ProximityBackend;
 class Scene;
 struct ObjectTypeDescriptor;
 struct PluginControllerType;
@@ -59,7 +58,6 @@ struct PluginSensorType {
 class ModuleRegistry {
  public:
   using DynamicsFactory = std::function<std::unique_ptr<DynamicsBackend>()>;
-  using ProximityFactory = std::function<std::unique_ptr<ProximityBackend>()>;
   using CalculationFactory = std::function<std::unique_ptr<Module>()>;
   // The engine alone stepping a world's bodies `steps` times (swarmsim
   // bench's "<physics>-only" row): wall seconds.
@@ -79,9 +77,6 @@ class ModuleRegistry {
   const std::vector<std::shared_ptr<const ModuleDescriptor>>& module_descriptors() const {
     return module_descriptors_;
   }
-  // The proximity backend as a module made for every world (kind
-  // "proximity", sense phase, order 100; World::proximity()).
-  void RegisterProximity(ModuleInfo info, ProximityFactory factory);
   // A calculation module (IK groups, ...): kind "calculation", actuate
   // phase, order 100, made on request (World::module).
   void RegisterCalculation(ModuleInfo info, CalculationFactory factory);

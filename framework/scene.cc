@@ -96,6 +96,8 @@ ObjectType Scene::RegisterType(const ObjectTypeDescriptor& type) {
                 std::to_string(kMaxObjectTypes) + " object types");
   types_.push_back(&type);
   tables_.push_back(type.make_rows != nullptr ? type.make_rows(type) : nullptr);
+  listing_order_.clear();
+  for (const size_t t : ListingOrder(types_)) listing_order_.push_back(static_cast<ObjectType>(t));
   return static_cast<ObjectType>(types_.size() - 1);
 }
 
@@ -210,10 +212,6 @@ ObjectId Scene::AddShape(std::string name, ObjectId parent, const Pose& X_PO,
 ObjectId Scene::AddJoint(std::string name, ObjectId parent, const Pose& X_PO,
                          const JointData& joint) {
   return AddObject(ObjectType::kJoint, std::move(name), parent, X_PO, &joint);
-}
-ObjectId Scene::AddProximitySensor(std::string name, ObjectId parent, const Pose& X_PO,
-                                   const ProximitySensorData& sensor) {
-  return AddObject(ObjectType::kProximitySensor, std::move(name), parent, X_PO, &sensor);
 }
 
 void* Scene::row_data(ObjectId id) {
@@ -477,20 +475,10 @@ JointData& Scene::mutable_joint(ObjectId id) {
   ExpectType(*this, s, ObjectType::kJoint);
   return joints()[row_[s]];
 }
-const ProximitySensorData& Scene::proximity_sensor(ObjectId id) const {
-  const uint32_t s = SlotOf(id, "proximity sensor");
-  ExpectType(*this, s, ObjectType::kProximitySensor);
-  return proximity_sensors()[row_[s]];
-}
 uint32_t Scene::SlotOfType(ObjectId id, ObjectType type, std::string_view what) const {
   const uint32_t s = SlotOf(id, what);
   ExpectType(*this, s, type);
   return s;
-}
-ProximitySensorData& Scene::mutable_proximity_sensor(ObjectId id) {
-  const uint32_t s = SlotOf(id, "proximity sensor");
-  ExpectType(*this, s, ObjectType::kProximitySensor);
-  return proximity_sensors()[row_[s]];
 }
 
 void Scene::LinkDummies(ObjectId a, ObjectId b) {

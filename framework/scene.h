@@ -35,8 +35,8 @@ class ScriptMemory;
 class StateHasher;
 struct ObjectTypeDescriptor;
 
-// The name of a built-in type ("proximity_sensor"); Scene::type_name names
-// registered ones too.
+// The name of a built-in type ("joint"); Scene::type_name names registered
+// ones too.
 const char* ToString(ObjectType type);
 
 enum class ShapeKind : uint8_t { kBox, kCylinder, kSphere, kCapsule, kMesh };
@@ -142,71 +142,6 @@ struct JointData {
   void JumpTo(double q);
 };
 
-// The detection volume of a proximity sensor (modules/proximity/volume.h):
-// a ray along +z (V-REP's convention), random rays in a cone about +z, or a
-// solid volume (cone, pyramid, cylinder about +z; disc: a sector in the xy
-// plane about +x).
-enum class ProximityVolume : uint8_t { kRay, kRandomizedRay, kCone, kPyramid, kCylinder, kDisc };
-const char* ToString(ProximityVolume volume);
-
-// A copyable owning pointer: copying it copies the pointee (never null but
-// when moved from).
-template <class T>
-class ClonePtr {
- public:
-  ClonePtr() : p_(std::make_unique<T>()) {}
-  ClonePtr(const ClonePtr& o) : p_(std::make_unique<T>(*o.p_)) {}
-  ClonePtr(ClonePtr&&) noexcept = default;
-  ClonePtr& operator=(const ClonePtr& o) {
-    if (this != &o) p_ = std::make_unique<T>(*o.p_);
-    return *this;
-  }
-  ClonePtr& operator=(ClonePtr&&) noexcept = default;
-  T* operator->() { return p_.get(); }
-  const T* operator->() const { return p_.get(); }
-  T& operator*() { return *p_; }
-  const T& operator*() const { return *p_; }
-
- private:
-  std::unique_ptr<T> p_;
-};
-
-// A proximity sensor's volume settings (constant) and the point and normal
-// of its reading: apart from the row, which a ray sensor reads and writes
-// every step, so that a swarm's rows stay small (40 bytes).
-struct ProximityVolumeData {
-  double angle = 0.5235987755982988;    // rad: cone, randomized_ray half-angle; disc half sector
-  double angle_y = 0.5235987755982988;  // rad: pyramid half-angle about y (angle: about x)
-  double radius = 0.05;                 // m: cylinder
-  double thickness = 0.01;              // m: disc, along z
-  double blind_zone = 0;                // m: the volume starts at this distance along its axis
-  double max_detection_angle = 3.141592653589793;  // rad: reflectance cut-off (pi: none)
-  uint16_t ray_count = 16;                         // randomized_ray
-  bool detect_front = true;  // meshes: faces seen from outside (counter-clockwise)
-  bool detect_back = true;   // meshes: faces seen from inside
-  // What the sensor detects: a collection's or object subtree's path
-  // (framework/collections.h), resolved from the sensor; empty: everything.
-  std::string detectable;
-  std::string detectable_where;  // "file:line:column" of `detectable`, for errors
-  // The reading's detected point (volumes; a ray's is on +z, see p_SD())
-  // and the outward surface normal there, in the sensor frame.
-  Vec3 point, normal;
-};
-
-// A proximity sensor. 40 bytes: a robot's control step reads all of its
-// sensors' rows.
-struct ProximitySensorData {
-  double range = 0.1;  // m: nothing farther than this is detected
-  // Reading, written in the sense phase:
-  double distance = 0;       // m, from the sensor's origin to the detected point
-  ObjectId detected_object;  // shape that was hit
-  bool detected = false;
-  ProximityVolume volume = ProximityVolume::kRay;  // constant
-  ClonePtr<ProximityVolumeData> more;              // settings, point and normal
-  // The detected point in the sensor frame: for a ray, on its +z axis.
-  Vec3 p_SD() const { return volume == ProximityVolume::kRay ? Vec3{0, 0, distance} : more->point; }
-};
-
 // A script attached to an object. The source is shared by all copies.
 struct ScriptSource {
   std::string path;  // file the code came from (for messages)
@@ -261,6 +196,9 @@ class Scene {
   }
   // Every type, in ObjectType order.
   std::span<const ObjectTypeDescriptor* const> types() const { return types_; }
+  // Every type in listing order (ListingOrder, object_type.h): the order
+  // the state hash adds their rows in.
+  std::span<const ObjectType> listing_order() const { return listing_order_; }
   // The type named `name`; false if there is none.
   bool FindType(std::string_view name, ObjectType* type) const;
   const char* type_name(ObjectType type) const;
@@ -301,8 +239,6 @@ class Scene {
   ObjectId AddDummy(std::string name, ObjectId parent, const Pose& X_PO);
   ObjectId AddShape(std::string name, ObjectId parent, const Pose& X_PO, const ShapeData& shape);
   ObjectId AddJoint(std::string name, ObjectId parent, const Pose& X_PO, const JointData& joint);
-  ObjectId AddProximitySensor(std::string name, ObjectId parent, const Pose& X_PO,
-                              const ProximitySensorData& sensor);
   // Removes an object and all its descendants (their handles become stale).
   void RemoveSubtree(ObjectId root);
   // Copies a subtree under `new_parent` (null: a new root), with its scripts,
@@ -400,8 +336,6 @@ class Scene {
   void SetSurfaceVelocity(ObjectId id, const Vec3& v_S, const Vec3& w_S);
   const JointData& joint(ObjectId id) const;
   JointData& mutable_joint(ObjectId id);
-  const ProximitySensorData& proximity_sensor(ObjectId id) const;
-  ProximitySensorData& mutable_proximity_sensor(ObjectId id);
   // Dense typed tables of the built-in types. Row r belongs to the object at
   // slot *_owners()[r].
   std::span<ShapeData> shapes() { return Table<ShapeData>(ObjectType::kShape).rows; }
@@ -410,15 +344,6 @@ class Scene {
   std::span<JointData> joints() { return Table<JointData>(ObjectType::kJoint).rows; }
   std::span<const JointData> joints() const { return Table<JointData>(ObjectType::kJoint).rows; }
   std::span<const uint32_t> joint_owners() const { return Owners(ObjectType::kJoint); }
-  std::span<ProximitySensorData> proximity_sensors() {
-    return Table<ProximitySensorData>(ObjectType::kProximitySensor).rows;
-  }
-  std::span<const ProximitySensorData> proximity_sensors() const {
-    return Table<ProximitySensorData>(ObjectType::kProximitySensor).rows;
-  }
-  std::span<const uint32_t> proximity_sensor_owners() const {
-    return Owners(ObjectType::kProximitySensor);
-  }
   // Row of the object's typed data in its type's table, by slot.
   uint32_t row_at(uint32_t slot) const { return row_[slot]; }
   // The object's row (of its type's row type), or null for a type without rows.
@@ -550,6 +475,7 @@ class Scene {
   // for a type without rows).
   std::vector<const ObjectTypeDescriptor*> types_;
   std::vector<std::unique_ptr<RowTable>> tables_;
+  std::vector<ObjectType> listing_order_;  // ListingOrder(types_)
   std::shared_ptr<const EnvironmentMap> environment_;
   uint64_t environment_version_ = 0;
 

@@ -10,9 +10,9 @@
 #include "framework/calculation_module.h"
 #include "framework/dynamics_backend.h"
 #include "framework/error.h"
+#include "framework/line_of_sight.h"
 #include "framework/object_type.h"
 #include "framework/plugin_controllers.h"
-#include "framework/proximity_backend.h"
 #include "framework/registry.h"
 #include "framework/scheduler.h"
 #include "framework/state_hash.h"
@@ -308,7 +308,7 @@ void World::Step() {
     // 0. messages and signals sent in the last step become visible.
     {
       PhaseTimer t(&phase_times_[static_cast<size_t>(Phase::kControl)]);
-      messaging_.Deliver(&scene_, proximity_, *scheduler_);
+      messaging_.Deliver(&scene_, line_of_sight_, *scheduler_);
     }
     if (scripts_->has_main_script()) {
       // 1-4. the world's own main script runs the phases (sim.handleSensing(), ...).
@@ -645,10 +645,9 @@ uint64_t World::StateHash() const {
     h.AddValue(scene_.linear_velocity_at(s));
     h.AddValue(scene_.angular_velocity_at(s));
   }
-  // Each type's changing state, types in ObjectType order (object_type.h).
-  for (size_t t = 0; t < scene_.types().size(); ++t)
-    if (const auto hash_rows = scene_.types()[t]->hash_rows)
-      hash_rows(scene_, static_cast<ObjectType>(t), &h);
+  // Each type's changing state, types in listing order (object_type.h).
+  for (const ObjectType t : scene_.listing_order())
+    if (const auto hash_rows = scene_.type_descriptor(t).hash_rows) hash_rows(scene_, t, &h);
   // Robots removed at run time are not hashed.
   for (size_t r = 0; r < runtimes_.size(); ++r)
     if (scene_.instances()[r].alive) h.Add(runtimes_[r].rng.state(), 4 * sizeof(uint64_t));

@@ -36,7 +36,7 @@ struct PhaseCallback;
 class PluginControllers;
 struct PluginControllerType;
 struct PluginSensorType;
-class ProximityBackend;
+class LineOfSight;
 class TaskScheduler;
 class World;
 
@@ -228,7 +228,7 @@ class World : public PhaseHandlers {
   void SetInstanceParameters(int instance, SharedParameters parameters);
 
   // --- Lifecycle ------------------------------------------------------------------
-  // Builds the dynamics and proximity modules from the placed scene and runs
+  // Builds the dynamics backend and the modules from the placed scene and runs
   // every script's sysCall_init. Throws swarmsim::Error on bad input. On a
   // script error, Start, Step and Stop first pass what every robot printed
   // to the log sink, in robot order.
@@ -306,9 +306,11 @@ class World : public PhaseHandlers {
   TaskScheduler& scheduler() { return *scheduler_; }
   const ModuleRegistry& registry() const { return registry_; }
   DynamicsBackend* dynamics() { return dynamics_.get(); }
-  // The proximity module's backend (line-of-sight messages); null before Start.
-  ProximityBackend* proximity() { return proximity_; }
-  void set_proximity(ProximityBackend* proximity) { proximity_ = proximity; }
+  // Is a segment clear of the static environment (framework/line_of_sight.h:
+  // range messages with line of sight, blob cameras' occlusion)? Provided by
+  // a module when it starts (proximity); null: nothing blocks.
+  const LineOfSight* line_of_sight() const { return line_of_sight_; }
+  void set_line_of_sight(const LineOfSight* service) { line_of_sight_ = service; }
   ScriptHost* scripts() { return scripts_.get(); }
   // The floor image a module keeps (framework/floor_layer.h: the paint
   // layer), or null; its provider sets it and outlives the world's use of it.
@@ -404,7 +406,7 @@ class World : public PhaseHandlers {
   ParameterSet parameters_;
   std::unique_ptr<TaskScheduler> scheduler_;
   std::unique_ptr<DynamicsBackend> dynamics_;
-  ProximityBackend* proximity_ = nullptr;  // owned by its module
+  const LineOfSight* line_of_sight_ = nullptr;  // owned by the module that provides it
   std::unique_ptr<ScriptHost> scripts_;
   const FloorLayer* floor_layer_ = nullptr;         // owned by its module
   std::unique_ptr<PluginControllers> controllers_;  // null: no robot has a native controller

@@ -49,9 +49,11 @@ void RegisterBuiltinModules(ModuleRegistry* registry) {
   registry->RegisterDynamics(
       planar::ModuleInfo(), {.planar = true}, [] { return planar::MakeBackend(); },
       BareLoop<planar::TimeBareLoop>);
-  registry->RegisterProximity(proximity::ModuleInfo(), [] { return proximity::MakeBackend(); });
-  // The first types after the built-in ones: the state hash adds each type's
-  // rows in registration order, and force sensors' came before the others'.
+  // The first module types, registered right after the built-in ones so the
+  // state hash adds types' rows in the order it did when they were built in:
+  // proximity_sensor is listed right after joint (its listed_after), then
+  // the built-in plugin_sensor and collection, then force_sensor.
+  proximity::Register(registry);
   force_sensor::Register(registry);
   kinematics::Register(registry);
   paint::Register(registry);

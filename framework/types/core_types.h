@@ -9,7 +9,6 @@ namespace swarmsim {
 extern const ObjectTypeDescriptor kDummyType;
 extern const ObjectTypeDescriptor kShapeType;
 extern const ObjectTypeDescriptor kJointType;
-extern const ObjectTypeDescriptor kProximitySensorType;
 extern const ObjectTypeDescriptor kPluginSensorType;
 extern const ObjectTypeDescriptor kCollectionType;
 

@@ -5,8 +5,8 @@
 // 2. if any camera tests occlusion, every shape is placed at its pose and
 //    goes into a second grid, its (x, y) bounds as a circle (walls, larger
 //    than a cell, go to the grid's short list every query scans); the
-//    environment map's voxels are the proximity backend's, frozen when the
-//    world starts (SegmentBlocked);
+//    environment map's voxels are the world's line of sight (the proximity
+//    backend's, frozen when the world starts; SegmentBlocked);
 // 3. every camera, in parallel (each writes only its own row): the LEDs of
 //    the grid cells within its range, minus its own robot's, those within
 //    range in 3D and inside its field of view; each tested for occlusion
@@ -26,7 +26,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "framework/proximity_backend.h"
+#include "framework/line_of_sight.h"
 #include "framework/random.h"
 #include "framework/scene.h"
 #include "framework/scheduler.h"
@@ -232,7 +232,7 @@ void BlobCameraModule::Sense(World* world) {
   auto& cameras = static_cast<Rows<BlobCameraRow>&>(*scene.rows(camera_type_));
   if (cameras.size() == 0) return;
   const EnvironmentMap* map = scene.environment();
-  map_ = map != nullptr && !map->boxes.empty() ? world->proximity() : nullptr;
+  map_ = map != nullptr && !map->boxes.empty() ? world->line_of_sight() : nullptr;
   IndexLeds(scene, led_type_);
   // The heights every occlusion segment stays within: those of the lit
   // LEDs and of the cameras that test occlusion.

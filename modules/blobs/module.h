@@ -13,7 +13,7 @@
 
 namespace swarmsim {
 class ModuleRegistry;
-class ProximityBackend;
+class LineOfSight;
 struct BlobCameraRow;
 }  // namespace swarmsim
 
@@ -67,9 +67,10 @@ class BlobCameraModule final : public Module {
   bool types_found_ = false;
   bool have_types_ = false;
   ObjectType led_type_{}, camera_type_{};
-  // The environment map's voxels are the proximity backend's
-  // (SegmentBlocked); null when the scene has no map.
-  const ProximityBackend* map_ = nullptr;
+  // The environment map's voxels: the world's line of sight
+  // (framework/line_of_sight.h, the proximity module's); null when the
+  // scene has no map.
+  const LineOfSight* map_ = nullptr;
   std::vector<LitLed> leds_;         // lit LEDs (LED rows order)
   std::vector<GridItem> led_items_;  // their xy (leds_)
   SpatialGrid led_grid_;

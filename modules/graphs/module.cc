@@ -8,6 +8,7 @@
 #include "framework/world.h"
 #include "modules/collision/rows.h"  // DistanceRow: a plain struct, no FCL
 #include "modules/force_sensor/force_sensor.h"
+#include "modules/proximity/proximity_sensor.h"  // readings: inline lookups, nothing linked
 
 namespace swarmsim::graphs {
 
@@ -40,8 +41,8 @@ double Read(const Scene& scene, const StreamSpec& s, uint32_t slot) {
     case StreamKind::kJoint: return scene.joints()[scene.row_at(slot)].position;
     case StreamKind::kJointVelocity: return scene.joints()[scene.row_at(slot)].velocity;
     case StreamKind::kProximity: {
-      const ProximitySensorData& p = scene.proximity_sensors()[scene.row_at(slot)];
-      return p.detected ? p.distance : NAN;
+      const ProximitySensorData* p = proximity::FindSensor(scene, scene.IdAt(slot));
+      return p != nullptr && p->detected ? p->distance : NAN;
     }
     case StreamKind::kForce:
     case StreamKind::kTorque: {
@@ -88,7 +89,7 @@ ObjectId ResolveStream(const Scene& scene, ObjectId graph, const StreamSpec& str
       if (type != ObjectType::kJoint) want = "joint";
       break;
     case StreamKind::kProximity:
-      if (type != ObjectType::kProximitySensor) want = "proximity_sensor";
+      if (!proximity::IsSensorAt(scene, scene.SlotOf(id))) want = proximity::kSensorTypeName;
       break;
     case StreamKind::kForce:
     case StreamKind::kTorque: {

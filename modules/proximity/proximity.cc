@@ -41,6 +41,7 @@
 #include "framework/scene.h"
 #include "framework/spatial_grid.h"
 #include "modules/proximity/footprint_grid.h"
+#include "modules/proximity/proximity_sensor.h"
 #include "modules/proximity/ray_cast.h"
 #include "modules/proximity/static_index.h"
 #include "modules/proximity/volume.h"
@@ -52,31 +53,32 @@ struct SensorRay {  // 64 bytes
   Vec3 p_W;         // ray origin in the world
   Vec3 d_W;         // unit direction in the world
   double range;     // m
-  uint32_t row;     // row in Scene::proximity_sensors()
+  uint32_t row;     // row in the proximity sensors' table
 };
 
 struct SensorRef {  // 8 bytes
   uint32_t slot;    // the sensor object
-  uint32_t row;     // its row in Scene::proximity_sensors()
+  uint32_t row;     // its row in the proximity sensors' table
 };
 
-SensorRay MakeRay(const Scene& scene, uint32_t slot) {
+SensorRay MakeRay(const Scene& scene, std::span<const ProximitySensorData> readings,
+                  uint32_t slot) {
   const Pose& X_WS = scene.world_pose_at(slot);
   const uint32_t row = scene.row_at(slot);
   Vec3 d = X_WS.q.Rotate({0, 0, 1});
   // Unit already unless the pose's quaternion drifted; skip the sqrt then.
   const double norm2 = d.SquaredNorm();
   if (std::abs(norm2 - 1) > 1e-14 && norm2 > 0) d = d / std::sqrt(norm2);
-  return {X_WS.p, d, scene.proximity_sensors()[row].range, row};
+  return {X_WS.p, d, readings[row].range, row};
 }
 
 // The rays of `sensors`, in order (written field by field: copying a fresh
 // SensorRay whole stalls on store forwarding).
-void MakeRays(const Scene& scene, std::span<const SensorRef> sensors,
-              std::vector<SensorRay>* rays) {
+void MakeRays(const Scene& scene, std::span<const ProximitySensorData> readings,
+              std::span<const SensorRef> sensors, std::vector<SensorRay>* rays) {
   rays->resize(sensors.size());
   for (size_t i = 0; i < sensors.size(); ++i) {
-    const SensorRay ray = MakeRay(scene, sensors[i].slot);
+    const SensorRay ray = MakeRay(scene, readings, sensors[i].slot);
     SensorRay& out = (*rays)[i];
     out.p_W.x = ray.p_W.x, out.p_W.y = ray.p_W.y, out.p_W.z = ray.p_W.z;
     out.d_W.x = ray.d_W.x, out.d_W.y = ray.d_W.y, out.d_W.z = ray.d_W.z;
@@ -102,6 +104,7 @@ class OctreeGridProximity final : public ProximityBackend {
   explicit OctreeGridProximity(const BackendOptions& options) : options_(options) {}
 
   void Build(const Scene& scene, const ProximitySettings& settings) override {
+    have_sensor_type_ = FindSensorType(scene, &sensor_type_);
     static_.Build(scene, settings.octree_resolution);
     seed_ = settings.seed;
     static_lo_.clear();
@@ -118,6 +121,8 @@ class OctreeGridProximity final : public ProximityBackend {
   // Places every robot shape and dynamic shape and rebuilds the grid over
   // their footprints. Buffers keep their capacity: no allocation once warm.
   void Update(const Scene& scene) override {
+    // (A Scene made without a World gets the type with its first sensor.)
+    if (!have_sensor_type_) have_sensor_type_ = FindSensorType(scene, &sensor_type_);
     moving_.clear();
     footprints_.clear();
     squares_.clear();
@@ -154,13 +159,14 @@ class OctreeGridProximity final : public ProximityBackend {
     } else {
       grid_.Build(footprints_);
     }
-    if (!SensorListsCurrent(scene)) ListSensors(scene);
+    if (have_sensor_type_ && !SensorListsCurrent(scene)) ListSensors(scene);
   }
 
   void SetStep(uint64_t step) override { step_ = step; }
   void SetDetectableFilter(DetectableFilter filter) override { detectable_ = std::move(filter); }
 
   void SenseInstance(Scene* scene, int instance) const override {
+    if (!have_sensor_type_) return;  // no proximity sensor anywhere
     if (SensorListsCurrent(*scene)) {
       const size_t i = static_cast<size_t>(instance);
       SenseBatch({instance_sensors_.data() + instance_sensor_start_[i],
@@ -175,7 +181,7 @@ class OctreeGridProximity final : public ProximityBackend {
     sensors.clear();
     volumes.clear();
     for (uint32_t slot : scene->instance(instance).objects)
-      if (scene->type_at(slot) == ObjectType::kProximitySensor)
+      if (scene->type_at(slot) == sensor_type_)
         (IsRay(*scene, slot) ? sensors : volumes).push_back({slot, scene->row_at(slot)});
     SenseBatch(sensors, instance, {}, scene);
     for (const SensorRef& sensor : volumes) SenseVolume(sensor, instance, {}, scene);
@@ -191,11 +197,12 @@ class OctreeGridProximity final : public ProximityBackend {
   }
 
   void SenseSceneSensors(Scene* scene) const override {
+    if (!have_sensor_type_) return;
     if (SensorListsCurrent(*scene)) {
       for (const SensorRef& sensor : scene_sensors_) SenseSceneSensor(sensor, scene);
       return;
     }
-    const auto owners = scene->proximity_sensor_owners();
+    const std::span<const uint32_t> owners = Table(*scene).owners;
     for (size_t row = 0; row < owners.size(); ++row)
       if (scene->instance_of_at(owners[row]) < 0)
         SenseSceneSensor({owners[row], static_cast<uint32_t>(row)}, scene);
@@ -210,9 +217,17 @@ class OctreeGridProximity final : public ProximityBackend {
            listed_instances_ == scene.instances().size();
   }
 
+  // The proximity sensors' rows (the type FindSensorType gave).
+  Rows<ProximitySensorData>& Table(Scene* scene) const {
+    return scene->rows<ProximitySensorData>(sensor_type_);
+  }
+  const Rows<ProximitySensorData>& Table(const Scene& scene) const {
+    return scene.rows<ProximitySensorData>(sensor_type_);
+  }
+
   // A ray sensor (the batched fast path), or a volume or randomized rays?
-  static bool IsRay(const Scene& scene, uint32_t slot) {
-    return scene.proximity_sensors()[scene.row_at(slot)].volume == ProximityVolume::kRay;
+  bool IsRay(const Scene& scene, uint32_t slot) const {
+    return Table(scene).rows[scene.row_at(slot)].volume == ProximityVolume::kRay;
   }
 
   // Lists each robot's sensors (hierarchy order; rays apart from volumes)
@@ -225,14 +240,14 @@ class OctreeGridProximity final : public ProximityBackend {
     instance_volumes_.clear();
     for (const ModelInstance& instance : instances) {
       for (uint32_t slot : instance.objects)
-        if (scene.type_at(slot) == ObjectType::kProximitySensor)
+        if (scene.type_at(slot) == sensor_type_)
           (IsRay(scene, slot) ? instance_sensors_ : instance_volumes_)
               .push_back({slot, scene.row_at(slot)});
       instance_sensor_start_.push_back(static_cast<uint32_t>(instance_sensors_.size()));
       instance_volume_start_.push_back(static_cast<uint32_t>(instance_volumes_.size()));
     }
     scene_sensors_.clear();
-    const auto owners = scene.proximity_sensor_owners();
+    const std::span<const uint32_t> owners = Table(scene).owners;
     for (size_t row = 0; row < owners.size(); ++row)
       if (scene.instance_of_at(owners[row]) < 0)
         scene_sensors_.push_back({owners[row], static_cast<uint32_t>(row)});
@@ -265,7 +280,7 @@ class OctreeGridProximity final : public ProximityBackend {
     double lo_x = kInf, lo_y = kInf, lo_z = kInf, hi_x = -kInf, hi_y = -kInf, hi_z = -kInf;
     double longest = 0, sum = 0;
     uint64_t written = 0;  // zero if every reading already reads "nothing"
-    const auto readings = scene->proximity_sensors();
+    const std::span<ProximitySensorData> readings = Table(scene).rows;
     for (const SensorRef& sensor : sensors) {
       const Pose& X_WS = scene->world_pose_at(sensor.slot);
       const double x = X_WS.p.x, y = X_WS.p.y, z = X_WS.p.z;
@@ -310,7 +325,7 @@ class OctreeGridProximity final : public ProximityBackend {
     thread_local std::vector<SensorRay> rays;
     rays.clear();
     if (near_static) {
-      MakeRays(*scene, sensors, &rays);
+      MakeRays(*scene, readings, sensors, &rays);
       Vec3 ray_lo, ray_hi;
       RayBounds(rays, &ray_lo, &ray_hi);
       near_static = AnyOccupied(ray_lo, ray_hi);
@@ -346,8 +361,8 @@ class OctreeGridProximity final : public ProximityBackend {
         ReadNothing(&readings[sensor.row]);
         continue;
       }
-      SenseRay(rays.empty() ? MakeRay(*scene, sensor.slot) : rays[i], static_in_reach, candidates,
-               skip, scene);
+      SenseRay(rays.empty() ? MakeRay(*scene, readings, sensor.slot) : rays[i], static_in_reach,
+               candidates, skip, scene);
     }
   }
 
@@ -418,7 +433,7 @@ class OctreeGridProximity final : public ProximityBackend {
   void CastAll(std::span<const SensorRef> sensors, int instance, std::span<const ObjectId> skip,
                Scene* scene) const {
     thread_local std::vector<SensorRay> rays;
-    MakeRays(*scene, sensors, &rays);
+    MakeRays(*scene, Table(*scene).rows, sensors, &rays);
     Vec3 lo, hi;
     RayBounds(rays, &lo, &hi);
     // Most batches of a swarm are nowhere near a wall.
@@ -451,12 +466,12 @@ class OctreeGridProximity final : public ProximityBackend {
           best = t, hit = moving_[c].id, hit_shape = &moving_[c];
       }
     }
-    ProximitySensorData& reading = scene->proximity_sensors()[ray.row];
+    Rows<ProximitySensorData>& table = Table(scene);
+    ProximitySensorData& reading = table.rows[ray.row];
     reading.detected = best <= ray.range;
     // The surface normal at the hit, in the sensor frame, and the cut-off.
     if (reading.detected) {
-      const Quat q_SW =
-          scene->world_pose_at(scene->proximity_sensor_owners()[ray.row]).q.Conjugate();
+      const Quat q_SW = scene->world_pose_at(table.owners[ray.row]).q.Conjugate();
       reading.more->normal = q_SW.Rotate(SurfaceNormal(*hit_shape, ray.p_W + ray.d_W * best));
       if (reading.more->max_detection_angle < kPi && best > 0 &&
           -reading.more->normal.z < std::cos(reading.more->max_detection_angle))
@@ -518,7 +533,7 @@ class OctreeGridProximity final : public ProximityBackend {
   // detectable shapes' parts inside its volume.
   void SenseVolume(const SensorRef& sensor, int instance, std::span<const ObjectId> skip,
                    Scene* scene) const {
-    ProximitySensorData& reading = scene->proximity_sensors()[sensor.row];
+    ProximitySensorData& reading = Table(scene).rows[sensor.row];
     const Pose& X_WS = scene->world_pose_at(sensor.slot);
     const ObjectId sensor_id = scene->IdAt(sensor.slot);
     const Volume volume = MakeVolume(reading);
@@ -601,6 +616,8 @@ class OctreeGridProximity final : public ProximityBackend {
   std::vector<uint32_t> instance_volume_start_;  // the same for volume sensors (instances + 1)
   std::vector<SensorRef> instance_volumes_;      // robot volume sensors, grouped by instance
   std::vector<SensorRef> scene_sensors_;         // sensors of no robot, by row
+  ObjectType sensor_type_{};                     // the proximity_sensor type's value in the scene
+  bool have_sensor_type_ = false;  // false: the scene has no such type (so no sensors)
   uint64_t listed_version_ = ~uint64_t{0};
   size_t listed_instances_ = 0;
 };

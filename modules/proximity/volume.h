@@ -45,7 +45,7 @@
 //    (or after 20,000 sweeps); the point is accepted if it lies within 1e-9
 //    (relative) of every set.
 // Precision: within 1e-9 m at 1 m scale against the closed forms in
-// tests/modules/proximity_volume_test.cc. Cost (bench/proximity_volume_bench,
+// tests/modules/proximity/volume_test.cc. Cost (bench/proximity_volume_bench,
 // 2-core VM): a ray reading 0.37 us, a cone over four primitives 0.8 us
 // when step 1 answers, 1.1 us when a side cuts the box (step 2); step 4
 // takes ~1,000 sweeps (tens of microseconds). A shape whose bounding sphere
@@ -64,6 +64,7 @@
 
 #include "framework/math.h"
 #include "framework/scene.h"
+#include "modules/proximity/proximity_sensor.h"
 #include "modules/proximity/ray_cast.h"
 
 namespace swarmsim::proximity {

@@ -30,11 +30,13 @@ const std::vector<std::string> kCommonKeys = {
 // dummy tagged with the sensor type a plugin registers).
 const std::vector<std::string> kRingKeys = {"name",   "type",  "count",          "radius",
                                             "height", "range", "start_angle_deg"};
+// The type of a ring's sensors (modules/proximity's), found by name.
+constexpr char kRingSensorType[] = "proximity_sensor";
 
 // The object types a model may use: every type of the scene (the built-in
-// ones, then the registry's, in ObjectType order; object_type.h), with
+// ones, then the registry's, in listing order; object_type.h), with
 // proximity_ring (the loader's shorthand for a ring of sensors) after
-// proximity_sensor.
+// proximity_sensor when there is one.
 struct TypeList {
   std::vector<const ObjectTypeDescriptor*> types;  // by ObjectType value
   std::vector<std::string> names;                  // as world files write them
@@ -44,9 +46,9 @@ struct TypeList {
     types.assign(core.begin(), core.end());
     if (registry != nullptr)
       types.insert(types.end(), registry->object_types().begin(), registry->object_types().end());
-    for (const ObjectTypeDescriptor* t : types) {
-      names.push_back(t->name);
-      if (names.back() == "proximity_sensor") names.push_back("proximity_ring");
+    for (const size_t t : ListingOrder(types)) {
+      names.push_back(types[t]->name);
+      if (names.back() == kRingSensorType) names.push_back("proximity_ring");
     }
   }
   // The type named `name` (one of `names` but proximity_ring).
@@ -180,8 +182,8 @@ struct Builder {
     const double radius = values.Number(f.Require("radius"), kNonNegativeLength);
     const double height = f.Has("height") ? values.Number(f.Get("height"), kCoordinate) : 0.0;
     // Each sensor of the ring reads the ring's range like a proximity_sensor.
-    const ObjectTypeDescriptor& sensor_type =
-        *types.types[static_cast<size_t>(ObjectType::kProximitySensor)];
+    const ObjectType ring_type = types.Find(kRingSensorType);
+    const ObjectTypeDescriptor& sensor_type = *types.types[static_cast<size_t>(ring_type)];
     const std::shared_ptr<RowTable> sensor = NewRow(sensor_type);
     sensor_type.read(sensor_type, FieldsObjectReader(values, f, meshes, registry), sensor->At(0));
     const double start = f.Has("start_angle_deg")
@@ -194,7 +196,7 @@ struct Builder {
       const double theta = start + 2 * M_PI * static_cast<double>(i) / static_cast<double>(count);
       ObjectSpec spec;
       spec.name = name;
-      spec.type = ObjectType::kProximitySensor;
+      spec.type = ring_type;
       spec.row = sensor;  // shared: specs are not changed after they are read
       spec.X_PO = {{radius * std::cos(theta), radius * std::sin(theta), height},
                    Quat::FromYaw(theta) * z_to_x};

@@ -27,6 +27,7 @@
 #include "framework/state_hash.h"
 #include "framework/world.h"
 #include "modules/builtin.h"
+#include "modules/proximity/proximity_sensor.h"
 #include "swarm/loader/world_loader.h"
 
 namespace py = pybind11;
@@ -82,7 +83,9 @@ void Refresh(const World& world, const std::string& model, ModelLayout* layout) 
     return;
   const Scene& scene = world.scene();
   const ObjectType joint = TypeNamed(scene, "joint");
-  const ObjectType sensor = TypeNamed(scene, "proximity_sensor");
+  // Without the proximity module's type no object matches `sensor`.
+  ObjectType sensor = static_cast<ObjectType>(kMaxObjectTypes);
+  proximity::FindSensorType(scene, &sensor);
   *layout = ModelLayout{};
   layout->model = model;
   const auto instances = scene.instances();
@@ -240,7 +243,7 @@ Array Proximity(const Scene& scene, const ModelLayout& layout, const py::object&
   const auto s = static_cast<py::ssize_t>(layout.sensor_names.size());
   Array a = OutArray({n, s}, out);
   double* d = a.mutable_data();
-  const auto rows = scene.proximity_sensors();
+  const std::span<const ProximitySensorData> rows = proximity::Sensors(scene).rows;
   for (size_t k = 0; k < layout.sensor_slots.size(); ++k) {
     const ProximitySensorData& p = rows[scene.row_at(layout.sensor_slots[k])];
     d[k] = p.detected ? p.distance : std::numeric_limits<double>::infinity();

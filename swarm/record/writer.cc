@@ -15,6 +15,7 @@
 #include "framework/scheduler.h"
 #include "framework/world.h"
 #include "modules/blobs/leds.h"
+#include "modules/proximity/proximity_sensor.h"
 #include "swarm/record/chunk_writer.h"
 #include "swarm/record/format.h"
 #include "swarm/run/version.h"
@@ -109,6 +110,8 @@ struct RunRecorder::Impl {
   World* world = nullptr;
   ObjectType led_type{};
   bool has_leds = false;
+  ObjectType sensor_type{};  // proximity sensors'
+  bool has_sensors = false;
   const FloorLayer* paint = nullptr;    // the world's floor layer (the paint layer), if any
   std::vector<uint8_t> paint_previous;  // rgb at the last step record (height x width x 3)
 
@@ -243,12 +246,12 @@ void RunRecorder::Impl::BuildScene() {
   robot_index.clear();
   plan.clear();
   robot_plan.clear();
-  const ObjectType shape_type = ObjectType::kShape, sensor_type = ObjectType::kProximitySensor;
+  const ObjectType shape_type = ObjectType::kShape;
   const auto kind_of = [&](uint32_t slot, Kind* kind) {
     const ObjectType t = scene.type_at(slot);
     if (t == shape_type)
       *kind = Kind::kShape;
-    else if (t == sensor_type)
+    else if (has_sensors && t == sensor_type)
       *kind = Kind::kProximity;
     else if (has_leds && t == led_type)
       *kind = Kind::kLed;
@@ -293,7 +296,7 @@ void RunRecorder::Impl::BuildScene() {
         break;
       }
       case Kind::kProximity: {
-        const ProximitySensorData& p = scene.proximity_sensors()[t.row];
+        const ProximitySensorData& p = scene.rows<ProximitySensorData>(sensor_type).rows[t.row];
         o["type"] = "proximity_sensor";
         o["range"] = p.range;
         o["volume"] = ToString(p.volume);
@@ -402,7 +405,10 @@ void RunRecorder::Impl::Capture() {
   const Scene& scene = world->scene();
   const auto joints = scene.joints();
   const auto shapes = scene.shapes();
-  const auto sensors = scene.proximity_sensors();
+  const std::span<const ProximitySensorData> sensors =
+      has_sensors
+          ? std::span<const ProximitySensorData>(scene.rows<ProximitySensorData>(sensor_type).rows)
+          : std::span<const ProximitySensorData>();
   const Rows<LedRow>* leds =
       has_leds ? &static_cast<const Rows<LedRow>&>(*scene.rows(led_type)) : nullptr;
   const bool all = capture_all;
@@ -519,6 +525,7 @@ void RunRecorder::Start(World* world) {
   Impl& r = *impl_;
   r.world = world;
   r.has_leds = world->scene().FindType(kLedTypeName, &r.led_type);
+  r.has_sensors = proximity::FindSensorType(world->scene(), &r.sensor_type);
   r.paint = world->floor_layer();
   for (const std::string& name : r.settings.metric_names) r.MetricId(name);
   r.file->AddJson(static_cast<uint8_t>(ChunkKind::kHeader), 0, r.Header().dump());

@@ -4,9 +4,9 @@
 #include <memory>
 
 #include "framework/dynamics_backend.h"
-#include "framework/proximity_backend.h"
 #include "framework/registry.h"
 #include "framework/scene.h"
+#include "modules/proximity/proximity.h"
 
 namespace swarmsim::testing {
 
@@ -27,12 +27,14 @@ class NullProximity : public ProximityBackend {
   void SenseSceneSensors(Scene*) const override {}
 };
 
-// A registry with "null" dynamics and "proximity" (null) modules.
+// A registry with "null" dynamics and "proximity" (null) modules, the
+// latter with the proximity_sensor type and its Lua area
+// (modules/proximity: framework tests link it for that).
 inline ModuleRegistry NullRegistry() {
   ModuleRegistry r;
   r.RegisterDynamics({"", "null", "1", "moves nothing"}, {.substeps = false},
                      [] { return std::make_unique<NullDynamics>(); });
-  r.RegisterProximity({"", "proximity", "1", "detects nothing"},
+  proximity::Register(&r, {"", "proximity", "1", "detects nothing"},
                       [] { return std::make_unique<NullProximity>(); });
   return r;
 }

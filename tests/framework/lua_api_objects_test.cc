@@ -10,6 +10,7 @@
 
 #include "framework/error.h"
 #include "framework/world.h"
+#include "modules/proximity/proximity_sensor.h"
 #include "tests/framework/error_of.h"
 #include "tests/framework/fakes.h"
 
@@ -119,7 +120,8 @@ TEST(ScriptHostTest, RepeatedNamesAreIndexed) {
       print(sim.getObject('./prox[3]', {noError = true}))
     end
   )");
-  for (int i = 0; i < 3; ++i) w.scene().AddProximitySensor("prox", body, {{0, 0.5 * i, 0}, {}}, {});
+  for (int i = 0; i < 3; ++i)
+    proximity::AddSensor(&w.scene(), "prox", body, {{0, 0.5 * i, 0}, {}}, {});
   w.world().Start();
   const std::vector<std::string> expected = {"[bot#0] prox\t0.0", "[bot#0] prox\t0.5",
                                              "[bot#0] prox\t1.0", "[bot#0] -1"};
@@ -146,7 +148,7 @@ TEST(ScriptHostTest, MissingObjectPathSuggestsTheNearestNameOrTheIndexRange) {
     ScriptWorld w;
     const ObjectId body =
         w.AddRobot("bot#0", "function sysCall_init() sim.getObject('" + path + "') end");
-    for (int i = 0; i < 12; ++i) w.scene().AddProximitySensor("prox", body, {}, {});
+    for (int i = 0; i < 12; ++i) proximity::AddSensor(&w.scene(), "prox", body, {}, {});
     EXPECT_CONTAINS(ErrorOf([&] { w.world().Start(); }), message);
   }
 }

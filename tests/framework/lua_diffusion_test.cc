@@ -40,17 +40,17 @@ class DiffusionTest : public ::testing::Test {
     right_ = scene.AddJoint("rightMotor", body_, {{0, -0.07, 0}, {}}, motor);
     for (int i = 0; i < 24; ++i) {
       const double angle = 2 * M_PI * i / 24;
-      prox_[i] = scene.AddProximitySensor("prox", body_,
-                                          {{0.085 * std::cos(angle), 0.085 * std::sin(angle), 0},
-                                           Quat::FromRollPitchYaw(0, M_PI / 2, angle)},
-                                          {});
+      prox_[i] = proximity::AddSensor(&scene, "prox", body_,
+                                      {{0.085 * std::cos(angle), 0.085 * std::sin(angle), 0},
+                                       Quat::FromRollPitchYaw(0, M_PI / 2, angle)},
+                                      {});
     }
     scene.MakeModelInstance(body_, "footbot", "footbot#0");
     scene.AttachScript(body_, DiffusionScript());
   }
 
   void See(int sensor, double distance) {
-    ProximitySensorData& p = world_->scene().mutable_proximity_sensor(prox_[sensor]);
+    ProximitySensorData& p = proximity::MutableSensor(&world_->scene(), prox_[sensor]);
     p.detected = true;
     p.distance = distance;
   }
@@ -77,7 +77,7 @@ TEST_F(DiffusionTest, TurnsAwayFromObstacles) {
   const double speed = 0.05 / kWheelRadius;
   See(2, 0.05);  // 30 degrees to the left: turn right
   EXPECT_EQ(Step(), std::make_pair(speed, 0.0));
-  world_->scene().mutable_proximity_sensor(prox_[2]).detected = false;
+  proximity::MutableSensor(&world_->scene(), prox_[2]).detected = false;
   See(21, 0.05);  // 45 degrees to the right: turn left
   EXPECT_EQ(Step(), std::make_pair(0.0, speed));
 }

@@ -13,6 +13,7 @@
 #include "framework/dynamics_backend.h"
 #include "framework/error.h"
 #include "framework/object_type.h"
+#include "framework/phase.h"
 #include "framework/vision_filter.h"
 #include "tests/framework/error_of.h"
 #include "tests/framework/fakes.h"

@@ -8,6 +8,7 @@
 
 #include "framework/error.h"
 #include "framework/scene.h"
+#include "modules/proximity/proximity_sensor.h"
 
 namespace swarmsim {
 namespace {
@@ -94,7 +95,7 @@ TEST(SceneScaleTest, ScalesGeometryJointsSensorsAndMasses) {
   const ObjectId m2 = scene.AddShape("m2", revolute, {}, mesh);
   ProximitySensorData sensor;
   sensor.range = 0.1;
-  const ObjectId eye = scene.AddProximitySensor("eye", root, {{0, 0.05, 0}, {}}, sensor);
+  const ObjectId eye = proximity::AddSensor(&scene, "eye", root, {{0, 0.05, 0}, {}}, sensor);
   const uint64_t version = scene.structure_version();
 
   scene.ScaleSubtree(root, 2);
@@ -111,7 +112,7 @@ TEST(SceneScaleTest, ScalesGeometryJointsSensorsAndMasses) {
   EXPECT_DOUBLE_EQ(scene.joint(revolute).position, 0.5);      // angles unchanged
   EXPECT_DOUBLE_EQ(scene.joint(revolute).max_force, 48);      // N m: x s^4
   EXPECT_DOUBLE_EQ(scene.world_pose(m1).p.z, 1 + 0.2 + 0.2);  // offset + slider
-  EXPECT_DOUBLE_EQ(scene.proximity_sensor(eye).range, 0.2);
+  EXPECT_DOUBLE_EQ(proximity::Sensor(scene, eye).range, 0.2);
   // One scaled asset for both shapes that shared the original.
   EXPECT_EQ(scene.shape(m1).mesh, scene.shape(m2).mesh);
   EXPECT_NE(scene.shape(m1).mesh, mesh.mesh);

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "framework/error.h"
+#include "modules/proximity/proximity_sensor.h"
 
 namespace swarmsim {
 namespace {
@@ -197,8 +198,8 @@ RingBot AddRingBot(Scene* scene, const std::string& name, const Pose& X_WB) {
     for (int i = from; i < to; ++i) {
       const double a = i * M_PI / 12;
       const Quat q_BS = Quat::FromYaw(a) * Quat::FromAxisAngle({0, 1, 0}, M_PI / 2);
-      bot.ring.push_back(scene->AddProximitySensor(
-          "prox", bot.body, {{0.085 * std::cos(a), 0.085 * std::sin(a), -0.013}, q_BS}, {}));
+      bot.ring.push_back(proximity::AddSensor(
+          scene, "prox", bot.body, {{0.085 * std::cos(a), 0.085 * std::sin(a), -0.013}, q_BS}, {}));
     }
   };
   add_sensors(0, 12);
@@ -206,7 +207,7 @@ RingBot AddRingBot(Scene* scene, const std::string& name, const Pose& X_WB) {
   bot.arm_elbow = scene->AddJoint(
       "armElbow", bot.arm_base, {{0.1, 0, 0}, Quat::FromAxisAngle({1, 0, 0}, M_PI / 2)}, revolute);
   bot.gripper = scene->AddDummy("gripper", bot.arm_elbow, {{0.08, 0, 0}, {}});
-  scene->AddProximitySensor("gripperProx", bot.gripper, {{0.01, 0, 0}, {}}, {});
+  proximity::AddSensor(scene, "gripperProx", bot.gripper, {{0.01, 0, 0}, {}}, {});
   add_sensors(12, 24);
   JointData prismatic;
   prismatic.type = JointType::kPrismatic;

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "framework/error.h"
+#include "framework/line_of_sight.h"
 #include "framework/world.h"
 #include "tests/framework/error_of.h"
 #include "tests/framework/fakes.h"
@@ -81,9 +82,11 @@ std::string Receiver(const std::string& send) {
 }
 
 TEST(ScriptControlTest, RangeMessagesHonourRangeAndLineOfSight) {
-  // A proximity module in which the segment crossing x = 0.5 is blocked.
-  class Wall : public testing::NullProximity {
+  // A module that provides the world's line of sight (framework/line_of_sight.h,
+  // as the proximity module does) in which the segment crossing x = 0.5 is blocked.
+  class Wall final : public Module, public LineOfSight {
    public:
+    void Start(World* world) override { world->set_line_of_sight(this); }
     bool SegmentBlocked(const Vec3& a, const Vec3& b) const override {
       return (a.x - 0.5) * (b.x - 0.5) < 0;
     }
@@ -91,7 +94,12 @@ TEST(ScriptControlTest, RangeMessagesHonourRangeAndLineOfSight) {
   ModuleRegistry walled;
   walled.RegisterDynamics({"", "null", "1", ""}, {.substeps = false},
                           [] { return std::make_unique<testing::NullDynamics>(); });
-  walled.RegisterProximity({"", "proximity", "1", ""}, [] { return std::make_unique<Wall>(); });
+  walled.RegisterModule(
+      {{"sensor", "wall", "1", ""},
+       PhaseBit(Phase::kSense),
+       100,
+       /*every_world=*/true,
+       [](World*, const void*) -> std::unique_ptr<Module> { return std::make_unique<Wall>(); }});
   ScriptWorld w(1, {}, std::move(walled));
   w.AddRobot("s", Receiver("sim.sendRangeMessage('open', 2); sim.sendRangeMessage('los', 2, true)"),
              0, 0);

@@ -72,7 +72,7 @@ std::vector<ProximitySensorData> Readings(const ShapeData& shape, const Pose& X_
   for (const Pose& X_WR : poses) {
     ProximitySensorData ray;
     ray.range = 1.5;
-    sensors.push_back(scene.AddProximitySensor("s", {}, X_WR, ray));
+    sensors.push_back(proximity::AddSensor(&scene, "s", {}, X_WR, ray));
   }
   scene.UpdateWorldPoses();
   auto backend = proximity::MakeBackend();
@@ -84,7 +84,7 @@ std::vector<ProximitySensorData> Readings(const ShapeData& shape, const Pose& X_
     backend->SenseInstance(&scene, static_cast<int>(i));
   backend->SenseSceneSensors(&scene);
   std::vector<ProximitySensorData> out;
-  for (ObjectId s : sensors) out.push_back(scene.proximity_sensor(s));
+  for (ObjectId s : sensors) out.push_back(proximity::Sensor(scene, s));
   return out;
 }
 

@@ -13,6 +13,7 @@
 #include "framework/registry.h"
 #include "framework/world.h"
 #include "modules/builtin.h"
+#include "modules/proximity/proximity_sensor.h"
 
 namespace swarmsim {
 namespace {
@@ -43,19 +44,19 @@ TEST(EnvironmentCutTest, SensorsAndDistancesFollowAReplacedMap) {
   const ObjectId root = scene.AddShape("bot#0", {}, {{0, 0, 0.2}, {}}, body);
   ProximitySensorData ray;
   ray.range = 3;
-  const ObjectId eye = scene.AddProximitySensor(
-      "eye", root, {{0, 0, 0}, Quat::FromAxisAngle({0, 1, 0}, M_PI / 2)}, ray);
+  const ObjectId eye = proximity::AddSensor(
+      &scene, "eye", root, {{0, 0, 0}, Quat::FromAxisAngle({0, 1, 0}, M_PI / 2)}, ray);
   scene.MakeModelInstance(root, "bot", "bot#0");
   world.Start();
   world.Step();
-  EXPECT_TRUE(scene.proximity_sensor(eye).detected);
-  EXPECT_NEAR(scene.proximity_sensor(eye).distance, 1.0, 1e-9);
+  EXPECT_TRUE(proximity::Sensor(scene, eye).detected);
+  EXPECT_NEAR(proximity::Sensor(scene, eye).distance, 1.0, 1e-9);
   scene.set_environment(Wall(2.0));  // the wall moved back by a cut
   world.Step();
-  EXPECT_NEAR(scene.proximity_sensor(eye).distance, 2.0, 1e-9);
+  EXPECT_NEAR(proximity::Sensor(scene, eye).distance, 2.0, 1e-9);
   scene.set_environment(std::make_shared<EnvironmentMap>());  // all cut away
   world.Step();
-  EXPECT_FALSE(scene.proximity_sensor(eye).detected);
+  EXPECT_FALSE(proximity::Sensor(scene, eye).detected);
   world.Stop();
 }
 

@@ -131,6 +131,9 @@ ModuleRegistry TestRegistry() {
   ModuleRegistry r;
   r.RegisterDynamics({"", "box2d", "1", "test double"}, {},
                      [] { return std::make_unique<testing::NullDynamics>(); });
+  // The robots' proximity rings: the proximity module's type (a null backend).
+  proximity::Register(&r, {"", "proximity", "1", "test double"},
+                      [] { return std::make_unique<testing::NullProximity>(); });
   return r;
 }
 

@@ -14,6 +14,7 @@
 #include "framework/registry.h"
 #include "framework/world.h"
 #include "modules/builtin.h"
+#include "modules/proximity/proximity_sensor.h"
 #include "swarm/loader/world_loader.h"
 #include "tests/swarm/run_program.h"
 
@@ -118,7 +119,7 @@ TEST_F(ProximityVolumeLoaderTest, ScaleScalesLengthsNotAngles) {
   LoadedWorld loaded = Load();
   const Scene& scene = loaded.world->scene();
   const ProximitySensorData& s =
-      scene.proximity_sensor(scene.FindObject("./s", scene.instance(0).root));
+      proximity::Sensor(scene, scene.FindObject("./s", scene.instance(0).root));
   EXPECT_EQ(s.volume, ProximityVolume::kCylinder);
   EXPECT_DOUBLE_EQ(s.range, 1.0);
   EXPECT_DOUBLE_EQ(s.more->radius, 0.04);
@@ -164,8 +165,8 @@ TEST_F(ProximityVolumeLoaderTest, RandomizedRaysHashTheSameOnAnyThreadCount) {
   LoadedWorld loaded = Load();
   // Every copy has the model's sensor settings.
   const Scene& scene = loaded.world->scene();
-  ASSERT_EQ(scene.proximity_sensors().size(), 6u);
-  for (const ProximitySensorData& s : scene.proximity_sensors()) {
+  ASSERT_EQ(proximity::Sensors(scene).rows.size(), 6u);
+  for (const ProximitySensorData& s : proximity::Sensors(scene).rows) {
     EXPECT_EQ(s.volume, ProximityVolume::kRandomizedRay);
     EXPECT_EQ(s.more->ray_count, 8);
     EXPECT_NEAR(s.more->angle, 40 * kDeg, 1e-15);

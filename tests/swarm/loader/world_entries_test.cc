@@ -14,6 +14,7 @@
 #include "framework/registry.h"
 #include "framework/world.h"
 #include "modules/builtin.h"
+#include "modules/proximity/proximity.h"
 #include "swarm/loader/world_loader.h"
 #include "tests/framework/fakes.h"
 
@@ -41,8 +42,8 @@ class ControlLoaderTest : public ::testing::Test {
     Write("main.lua", "function sysCall_step() sim.handleDynamics() end\n");
     registry_.RegisterDynamics({"", "kinematic", "1", "test"}, {},
                                [] { return std::make_unique<testing::NullDynamics>(); });
-    registry_.RegisterProximity({"", "proximity", "1", "test"},
-                                [] { return std::make_unique<testing::NullProximity>(); });
+    proximity::Register(&registry_, {"", "proximity", "1", "test"},
+                        [] { return std::make_unique<testing::NullProximity>(); });
   }
   void TearDown() override { fs::remove_all(dir_); }
   void Write(const std::string& name, const std::string& text) {

@@ -33,7 +33,7 @@ ModuleRegistry TestRegistry() {
   for (const char* name : {"box2d", "null"})
     r.RegisterDynamics({"", name, "1", "test double"}, {},
                        [] { return std::make_unique<testing::NullDynamics>(); });
-  r.RegisterProximity({"", "proximity", "1", "test double"},
+  proximity::Register(&r, {"", "proximity", "1", "test double"},
                       [] { return std::make_unique<testing::NullProximity>(); });
   for (ModuleDescriptor& metric : metrics::SwarmMetricModules()) r.RegisterModule(metric);
   r.RegisterWorldSection(metrics::MetricsSection());
@@ -108,7 +108,7 @@ TEST(WorldLoaderTest, DiffusionBuildsThreeHundredFootbots) {
     EXPECT_EQ(scene.name(inst.root), inst.name);
     int sensors = 0, joints = 0, shapes = 0;
     for (uint32_t slot : inst.objects) {
-      sensors += scene.type_at(slot) == ObjectType::kProximitySensor;
+      sensors += proximity::IsSensorAt(scene, slot);
       joints += scene.type_at(slot) == ObjectType::kJoint;
       shapes += scene.type_at(slot) == ObjectType::kShape;
     }
@@ -176,7 +176,7 @@ TEST(WorldLoaderTest, FootbotGeometryFollowsTheConventions) {
     const double theta = 2 * M_PI * i / 24;
     ExpectNear(X_BS.p, {0.085 * std::cos(theta), 0.085 * std::sin(theta), -0.013});
     ExpectNear(X_BS.q.Rotate({0, 0, 1}), {std::cos(theta), std::sin(theta), 0});
-    EXPECT_DOUBLE_EQ(scene.proximity_sensor(s).range, 0.1);
+    EXPECT_DOUBLE_EQ(proximity::Sensor(scene, s).range, 0.1);
   }
 }
 

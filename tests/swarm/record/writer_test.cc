@@ -18,6 +18,7 @@
 #include "framework/world.h"
 #include "modules/blobs/leds.h"
 #include "modules/builtin.h"
+#include "modules/proximity/proximity_sensor.h"
 #include "swarm/loader/world_loader.h"
 #include "swarm/record/format.h"
 #include "swarm/record/reader.h"
@@ -43,7 +44,7 @@ std::vector<uint32_t> RecordedSlots(const Scene& scene) {
   const bool has_leds = scene.FindType(kLedTypeName, &led);
   const auto recorded = [&](uint32_t slot) {
     const ObjectType t = scene.type_at(slot);
-    return t == ObjectType::kShape || t == ObjectType::kProximitySensor || (has_leds && t == led);
+    return t == ObjectType::kShape || proximity::IsSensorAt(scene, slot) || (has_leds && t == led);
   };
   std::vector<uint32_t> slots;
   for (const ModelInstance& robot : scene.instances()) {

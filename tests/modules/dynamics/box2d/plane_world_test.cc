@@ -16,6 +16,7 @@
 #include "framework/scene.h"
 #include "framework/state_hash.h"
 #include "modules/dynamics/box2d/box2d_backend.h"
+#include "modules/proximity/proximity_sensor.h"
 #include "tests/modules/dynamics/box2d/box2d_scene.h"
 
 namespace swarmsim::box2d {
@@ -273,8 +274,9 @@ TEST(Box2dBackend, CarriedObjectsFollowTheBodyExactly) {
   for (int i = 0; i < 24; ++i) {
     const double a = i * M_PI / 12;
     const Quat q_BS = Quat::FromYaw(a) * Quat::FromAxisAngle({0, 1, 0}, M_PI / 2);
-    ring.push_back(scene.AddProximitySensor(
-        "prox", robot.body, {{0.085 * std::cos(a), 0.085 * std::sin(a), -0.013}, q_BS}, {}));
+    ring.push_back(proximity::AddSensor(&scene, "prox", robot.body,
+                                        {{0.085 * std::cos(a), 0.085 * std::sin(a), -0.013}, q_BS},
+                                        {}));
   }
   auto backend = Build(scene);
   SetWheelSpeeds(&scene, robot, 0.08, 0.03);  // a curve

@@ -1,4 +1,5 @@
-// sim.* sensors: proximity sensors.
+// sim.* proximity sensors (the Lua area of the proximity_sensor type):
+//   sim.readProximitySensor(h) and sim.readProximitySensors(handles [, out]).
 //
 // Readings are written in the sense phase and only read during the control
 // phase, so any robot may read any sensor.
@@ -7,8 +8,9 @@
 #include "framework/error.h"
 #include "framework/lua_api.h"
 #include "framework/scene.h"
+#include "modules/proximity/proximity_sensor.h"
 
-namespace swarmsim {
+namespace swarmsim::proximity {
 namespace {
 
 // sim.readProximitySensor(h) -> 0 when nothing is detected; else
@@ -17,12 +19,11 @@ namespace {
 // frame): CoppeliaSim's order. The no-detection path allocates nothing: a
 // robot calls this for each of its sensors every step.
 //
-// The sensor `id`; the fast check first, the Scene's accessor producing the
-// message on a bad handle.
+// The sensor `id`; the fast check first, Sensor() producing the message on
+// a bad handle.
 const ProximitySensorData& SensorOf(const Scene& scene, ObjectId id) {
-  return scene.IsValid(id) && scene.type_at(id.index()) == ObjectType::kProximitySensor
-             ? scene.proximity_sensors()[scene.row_at(id.index())]
-             : scene.proximity_sensor(id);
+  const ProximitySensorData* sensor = FindSensor(scene, id);
+  return sensor != nullptr ? *sensor : Sensor(scene, id);
 }
 
 int ReadProximitySensor(lua_State* L) {
@@ -92,7 +93,7 @@ int ReadProximitySensors(lua_State* L) {
 
 }  // namespace
 
-void RegisterSensorsApi(lua_State* L) {
+void RegisterProximityApi(lua_State* L) {
   static constexpr luaL_Reg kFunctions[] = {
       {"readProximitySensor", Guarded<ReadProximitySensor, "sim.readProximitySensor">},
       {"readProximitySensors", Guarded<ReadProximitySensors, "sim.readProximitySensors">},
@@ -101,4 +102,4 @@ void RegisterSensorsApi(lua_State* L) {
   luaL_setfuncs(L, kFunctions, 0);
 }
 
-}  // namespace swarmsim
+}  // namespace swarmsim::proximity

@@ -1,9 +1,14 @@
+// modules/proximity/static_index.cc: the octree of the static environment.
+//
 // Static shapes far from the origin (issue 26): the proximity module's
 // octree spans 65,536 voxels per axis (3,276.8 m at 0.05 m), but world
 // coordinates go to 1e6 m. A static environment away from the origin moves
 // the octree; one wider than it keeps the shapes beyond apart, tested one
 // by one. Either way the readings are the exact ones, as brute force finds
-// them, and nothing is an error.
+// them, and nothing is an error. And its coarse map (the early-out's first
+// test) is conservative.
+#include "modules/proximity/static_index.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -15,7 +20,6 @@
 #include "framework/scene.h"
 #include "modules/proximity/proximity.h"
 #include "modules/proximity/ray_cast.h"
-#include "modules/proximity/static_index.h"
 
 namespace swarmsim::proximity {
 namespace {
@@ -50,10 +54,10 @@ void ExpectExactReadings(const std::vector<Vec3>& centres, double resolution) {
       ProximitySensorData ray;
       ray.range = 1.5;
       sensors.push_back(
-          scene.AddProximitySensor("s", {},
-                                   {c + Vec3{offset(rng), offset(rng), offset(rng) / 4},
-                                    Quat::FromRollPitchYaw(angle(rng), angle(rng), angle(rng))},
-                                   ray));
+          proximity::AddSensor(&scene, "s", {},
+                               {c + Vec3{offset(rng), offset(rng), offset(rng) / 4},
+                                Quat::FromRollPitchYaw(angle(rng), angle(rng), angle(rng))},
+                               ray));
     }
   scene.UpdateWorldPoses();
   ProximitySettings settings;
@@ -72,7 +76,7 @@ void ExpectExactReadings(const std::vector<Vec3>& centres, double resolution) {
       ObjectId id;
       for (const PlacedShape& s : all)
         if (RayCast(s, X_WS.p, d, 1.5, &t) && t < best) best = t, id = s.id;
-      const ProximitySensorData& r = scene.proximity_sensor(sensors[i]);
+      const ProximitySensorData& r = proximity::Sensor(scene, sensors[i]);
       ASSERT_EQ(r.detected, std::isfinite(best)) << "sensor " << i;
       if (!r.detected) continue;
       ++detections;
@@ -147,6 +151,61 @@ TEST(ProximityFarTest, EnvironmentMapFarFromTheOriginIsIndexed) {
   EXPECT_NEAR(t, 1, 1e-9);
   ASSERT_TRUE(index.CastRay({1, 0, 0.1}, {-1, 0, 0}, 5, {}, &t, &s));
   EXPECT_NEAR(t, 0.9, 1e-9);
+}
+
+// --- The coarse map ------------------------------------------------------------------
+
+ShapeData Box(double x, double y, double z) {
+  ShapeData s;
+  s.kind = ShapeKind::kBox;
+  s.size = {x, y, z};
+  return s;
+}
+ShapeData Cylinder(double radius, double height) {
+  ShapeData s;
+  s.kind = ShapeKind::kCylinder;
+  s.size = {radius, 0, height};
+  return s;
+}
+ShapeData Sphere(double radius) {
+  ShapeData s;
+  s.kind = ShapeKind::kSphere;
+  s.size = {radius, 0, 0};
+  return s;
+}
+
+// The coarse map never says "nothing" where the octree has an occupied voxel.
+TEST(StaticIndexTest, CoarseMapIsConservative) {
+  std::mt19937_64 rng(77);
+  std::uniform_real_distribution<double> pos(-3, 3), size(0.01, 0.8), angle(-M_PI, M_PI),
+      extent(0, 0.5);
+  Scene scene;
+  for (int i = 0; i < 40; ++i) {
+    const ShapeData shape = i % 3 == 0   ? Box(size(rng), size(rng), size(rng))
+                            : i % 3 == 1 ? Cylinder(size(rng) / 2, size(rng))
+                                         : Sphere(size(rng) / 2);
+    scene.AddShape("o", {},
+                   {{pos(rng), pos(rng), pos(rng) / 2},
+                    Quat::FromRollPitchYaw(angle(rng), angle(rng), angle(rng))},
+                   shape);
+  }
+  scene.UpdateWorldPoses();
+  for (double resolution : {0.05, 0.011, 0.3}) {
+    StaticIndex index;
+    index.Build(scene, resolution);
+    int occupied = 0, ruled_out = 0;
+    for (int i = 0; i < 20000; ++i) {
+      const Vec3 lo{pos(rng) * 1.2, pos(rng) * 1.2, pos(rng) / 2};
+      const Vec3 hi = lo + Vec3{extent(rng), extent(rng), extent(rng)} * (i % 2 ? 0.2 : 1);
+      const bool any = index.AnyOccupied(lo, hi);
+      const bool may = index.MayBeOccupied(lo, hi);
+      ASSERT_TRUE(may || !any) << "box " << i << " at resolution " << resolution;
+      occupied += any;
+      ruled_out += !may;
+    }
+    EXPECT_GT(occupied, 1000) << resolution;
+    EXPECT_GT(ruled_out, 1000) << resolution;
+  }
 }
 
 }  // namespace

@@ -35,7 +35,7 @@ ProximitySensorData Ray(double range) {
 class EnvironmentProximityTest : public ::testing::Test {
  protected:
   ObjectId AddSensor(const Vec3& p, const Vec3& d, double range) {
-    return scene_.AddProximitySensor("s", {}, {p, LookAlong(d)}, Ray(range));
+    return proximity::AddSensor(&scene_, "s", {}, {p, LookAlong(d)}, Ray(range));
   }
   void Start(double resolution) {
     scene_.UpdateWorldPoses();
@@ -46,7 +46,7 @@ class EnvironmentProximityTest : public ::testing::Test {
     backend_->Update(scene_);
     backend_->SenseSceneSensors(&scene_);
   }
-  const ProximitySensorData& Reading(ObjectId sensor) { return scene_.proximity_sensor(sensor); }
+  const ProximitySensorData& Reading(ObjectId sensor) { return proximity::Sensor(scene_, sensor); }
 
   Scene scene_;
   std::unique_ptr<ProximityBackend> backend_;
@@ -102,7 +102,7 @@ TEST_F(EnvironmentProximityTest, AConeSeesTheSharedMap) {
   cone.range = 5;
   cone.more->angle = 10 * M_PI / 180;
   const ObjectId sensor =
-      scene_.AddProximitySensor("cone", {}, {{0.001, 0.001, 1}, LookAlong({0, 1, 0})}, cone);
+      proximity::AddSensor(&scene_, "cone", {}, {{0.001, 0.001, 1}, LookAlong({0, 1, 0})}, cone);
   Start(0.08);
   const ProximitySensorData& r = Reading(sensor);
   EXPECT_TRUE(r.detected);

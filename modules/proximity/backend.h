@@ -1,11 +1,14 @@
-// The interface of the proximity module: ray sensors against the static
-// environment and against other robots.
+// The proximity backend's interface (modules/proximity): ray and volume
+// sensors against the static environment and against other robots. The
+// module (module.cc) drives one per world; benchmarks and tests drive
+// one directly (proximity.h's MakeBackend).
 #pragma once
 
 #include <cstdint>
 #include <functional>
 
 #include "framework/handle.h"
+#include "framework/line_of_sight.h"
 #include "framework/math.h"
 
 namespace swarmsim {
@@ -24,10 +27,10 @@ struct ProximitySettings {
 // Scene's environment map.
 using DetectableFilter = std::function<bool(ObjectId sensor, ObjectId shape)>;
 
-class ProximityBackend {
+// Also the world's line-of-sight service (framework/line_of_sight.h): its
+// static index answers.
+class ProximityBackend : public LineOfSight {
  public:
-  virtual ~ProximityBackend() = default;
-
   // Indexes the static environment (shapes that belong to no robot and are
   // not dynamic, and the Scene's environment map, whose boxes a reading
   // reports as a null object). Called once at start.
@@ -47,7 +50,7 @@ class ProximityBackend {
   virtual void SetDetectableFilter(DetectableFilter filter) { (void)filter; }
   // Does a static shape cross the segment a-b (world frame, m)? Used for
   // line-of-sight messages. Thread-safe. Default: nothing blocks.
-  virtual bool SegmentBlocked(const Vec3& a_W, const Vec3& b_W) const {
+  bool SegmentBlocked(const Vec3& a_W, const Vec3& b_W) const override {
     (void)a_W;
     (void)b_W;
     return false;

@@ -1,17 +1,21 @@
-#include "framework/proximity_module.h"
-
+// The proximity backend (backend.h) as a module: built when the world
+// starts, sensing in the sense phase (framework/module.h), and the world's
+// line of sight (framework/line_of_sight.h) while it runs. Register() adds
+// it and the proximity_sensor type to a registry.
 #include <algorithm>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "framework/collections.h"
-#include "framework/proximity_backend.h"
+#include "framework/object_type.h"
 #include "framework/registry.h"
 #include "framework/scheduler.h"
 #include "framework/world.h"
+#include "modules/proximity/proximity.h"
+#include "modules/proximity/proximity_sensor.h"
 
-namespace swarmsim {
+namespace swarmsim::proximity {
 namespace {
 
 // "file:line:col: proximity sensor /bot#0/eye ('detectable')".
@@ -30,7 +34,7 @@ class ProximityModule final : public Module {
     settings_.seed = world->settings().seed;
     backend_->Build(world->scene(), settings_);
     environment_version_ = world->scene().environment_version();
-    world->set_proximity(backend_.get());
+    world->set_line_of_sight(backend_.get());
     RefreshDetectable(world->scene());
   }
 
@@ -66,17 +70,17 @@ class ProximityModule final : public Module {
       std::vector<std::vector<uint32_t>> of;  // by sensor slot: detectable shapes, ascending
     };
     auto sets = std::make_shared<Sets>();
-    const auto sensors = scene.proximity_sensors();
-    const auto owners = scene.proximity_sensor_owners();
-    for (size_t r = 0; r < sensors.size(); ++r) {
-      if (sensors[r].more->detectable.empty()) continue;
+    const Rows<ProximitySensorData>& sensors = Sensors(scene);
+    for (size_t r = 0; r < sensors.rows.size(); ++r) {
+      const ProximityVolumeData& more = *sensors.rows[r].more;
+      if (more.detectable.empty()) continue;
+      const uint32_t slot = sensors.owners[r];
       sets->used.resize(scene.slot_count(), 0);
       sets->of.resize(scene.slot_count());
-      const ObjectId sensor = scene.IdAt(owners[r]);
-      sets->of[owners[r]] =
-          EntitySlots(scene, sensors[r].more->detectable, sensor,
-                      DetectableWhat(scene, sensor, sensors[r].more->detectable_where));
-      sets->used[owners[r]] = 1;
+      const ObjectId sensor = scene.IdAt(slot);
+      sets->of[slot] = EntitySlots(scene, more.detectable, sensor,
+                                   DetectableWhat(scene, sensor, more.detectable_where));
+      sets->used[slot] = 1;
     }
     if (sets->used.empty()) {
       if (filtering_) backend_->SetDetectableFilter({});
@@ -100,17 +104,24 @@ class ProximityModule final : public Module {
 
 }  // namespace
 
-std::unique_ptr<Module> MakeProximityModule(std::unique_ptr<ProximityBackend> backend) {
+std::unique_ptr<Module> MakeModule(std::unique_ptr<ProximityBackend> backend) {
   return std::make_unique<ProximityModule>(std::move(backend));
 }
 
-// Defined beside the adapter it registers (registry.cc does not depend on it).
-void ModuleRegistry::RegisterProximity(ModuleInfo info, ProximityFactory factory) {
-  info.kind = "proximity";
-  RegisterModule({std::move(info), PhaseBit(Phase::kSense), 100, /*every_world=*/true,
-                  [factory = std::move(factory)](World*, const void*) {
-                    return MakeProximityModule(factory());
-                  }});
+void Register(ModuleRegistry* registry, BackendFactory factory) {
+  Register(registry, ModuleInfo(), std::move(factory));
 }
 
-}  // namespace swarmsim
+void Register(ModuleRegistry* registry, swarmsim::ModuleInfo info, BackendFactory factory) {
+  if (!factory) factory = [] { return MakeBackend(); };
+  info.kind = "proximity";
+  registry->RegisterModule(
+      {std::move(info), PhaseBit(Phase::kSense), 100,
+       /*every_world=*/true,
+       [factory = std::move(factory)](World*, const void*) { return MakeModule(factory()); }});
+  // The descriptor is a constant of this module: shared without an owner.
+  registry->RegisterObjectType(std::shared_ptr<const ObjectTypeDescriptor>(
+      std::shared_ptr<const ObjectTypeDescriptor>(), &SensorTypeDescriptor()));
+}
+
+}  // namespace swarmsim::proximity

@@ -65,7 +65,7 @@ Robot AddRobot(Scene* scene, const Pose& X_WR, double body_radius,
   robot.root = scene->AddDummy("bot", {}, X_WR);
   robot.body = scene->AddShape("body", robot.root, {{0, 0, 0.06}, {}}, Cylinder(body_radius, 0.12));
   for (const Pose& X_RS : sensor_poses)
-    robot.sensors.push_back(scene->AddProximitySensor("sensor", robot.root, X_RS, Ray(range)));
+    robot.sensors.push_back(proximity::AddSensor(scene, "sensor", robot.root, X_RS, Ray(range)));
   robot.instance = scene->MakeModelInstance(robot.root, "bot", "bot#" + std::to_string(k));
   return robot;
 }
@@ -87,7 +87,7 @@ class ProximityTest : public ::testing::Test {
       backend_->SenseInstance(&scene_, static_cast<int>(i));
     backend_->SenseSceneSensors(&scene_);
   }
-  const ProximitySensorData& Reading(ObjectId sensor) { return scene_.proximity_sensor(sensor); }
+  const ProximitySensorData& Reading(ObjectId sensor) { return proximity::Sensor(scene_, sensor); }
   void ExpectHit(ObjectId sensor, double distance, ObjectId object) {
     const ProximitySensorData& r = Reading(sensor);
     EXPECT_TRUE(r.detected);
@@ -109,21 +109,12 @@ class ProximityTest : public ::testing::Test {
   std::unique_ptr<ProximityBackend> backend_;
 };
 
-TEST(ProximityModuleTest, RegistersAsProximity) {
-  const auto info = ModuleInfo();
-  EXPECT_EQ(info.kind, "proximity");
-  EXPECT_EQ(info.name, "proximity");
-  EXPECT_FALSE(info.version.empty());
-  EXPECT_FALSE(info.description.empty());
-  EXPECT_NE(MakeBackend(), nullptr);
-}
-
 // --- The static environment (octree) -------------------------------------------------
 
 TEST_F(ProximityTest, WallFaceAlongX) {
   // A box wall whose near face is at x = 0.95 (its centre at x = 1).
   const ObjectId wall = scene_.AddShape("wall", {}, {{1.0, 0, 0}, {}}, Box(0.1, 2, 1));
-  const ObjectId sensor = scene_.AddProximitySensor("s", {}, Looking({0, 0, 0}, 0), Ray(2));
+  const ObjectId sensor = proximity::AddSensor(&scene_, "s", {}, Looking({0, 0, 0}, 0), Ray(2));
   Start();
   Sense();
   ExpectHit(sensor, 0.95, wall);
@@ -134,7 +125,7 @@ TEST_F(ProximityTest, DistancesAreNotQuantisedToVoxels) {
   // 0.05 m voxel grid; the reading must be exact, and equal at any resolution.
   scene_.AddShape("wall", {}, {{0.9321 + 0.25, 0.01, 0.013}, {}}, Box(0.5, 2, 1));
   const ObjectId sensor =
-      scene_.AddProximitySensor("s", {}, Looking({0.0123, 0.0071, 0.0312}, 0), Ray(2));
+      proximity::AddSensor(&scene_, "s", {}, Looking({0.0123, 0.0071, 0.0312}, 0), Ray(2));
   for (double resolution : {0.05, 0.2, 0.013}) {
     Start(resolution);
     Sense();
@@ -148,7 +139,7 @@ TEST_F(ProximityTest, BoxRotated30DegreesAboutZ) {
   // at y' = 0.1 tan 30 (well inside |y'| <= 0.3): t = 1 - 0.1 / cos 30.
   const ObjectId box =
       scene_.AddShape("box", {}, {{1, 0, 0}, Quat::FromYaw(M_PI / 6)}, Box(0.2, 0.6, 0.5));
-  const ObjectId sensor = scene_.AddProximitySensor("s", {}, Looking({0, 0, 0}, 0), Ray(2));
+  const ObjectId sensor = proximity::AddSensor(&scene_, "s", {}, Looking({0, 0, 0}, 0), Ray(2));
   Start();
   Sense();
   ExpectHit(sensor, 1 - 0.1 / std::cos(M_PI / 6), box);
@@ -157,9 +148,9 @@ TEST_F(ProximityTest, BoxRotated30DegreesAboutZ) {
 TEST_F(ProximityTest, VerticalCylinder) {
   const ObjectId post = scene_.AddShape("post", {}, {{1.3, 0, 0.2}, {}}, Cylinder(0.2, 1));
   const ObjectId offset = scene_.AddShape("post2", {}, {{1.3, 2.1, 0.2}, {}}, Cylinder(0.2, 1));
-  const ObjectId centred = scene_.AddProximitySensor("s", {}, Looking({0, 0, 0}, 0), Ray(2));
+  const ObjectId centred = proximity::AddSensor(&scene_, "s", {}, Looking({0, 0, 0}, 0), Ray(2));
   // 0.1 m beside the second post's axis: t = d - sqrt(r^2 - 0.1^2).
-  const ObjectId beside = scene_.AddProximitySensor("s2", {}, Looking({0, 2.0, 0}, 0), Ray(2));
+  const ObjectId beside = proximity::AddSensor(&scene_, "s2", {}, Looking({0, 2.0, 0}, 0), Ray(2));
   Start();
   Sense();
   ExpectHit(centred, 1.3 - 0.2, post);
@@ -169,7 +160,7 @@ TEST_F(ProximityTest, VerticalCylinder) {
 TEST_F(ProximityTest, CylinderCapFromBelow) {
   // A sensor looking straight up at a horizontal disc (cylinder lying flat).
   const ObjectId disc = scene_.AddShape("disc", {}, {{0.02, 0, 0.5}, {}}, Cylinder(0.3, 0.1));
-  const ObjectId up = scene_.AddProximitySensor("up", {}, {{0, 0, 0}, {}}, Ray(1));
+  const ObjectId up = proximity::AddSensor(&scene_, "up", {}, {{0, 0, 0}, {}}, Ray(1));
   Start();
   Sense();
   ExpectHit(up, 0.45, disc);
@@ -177,7 +168,7 @@ TEST_F(ProximityTest, CylinderCapFromBelow) {
 
 TEST_F(ProximityTest, Sphere) {
   const ObjectId ball = scene_.AddShape("ball", {}, {{0.7, 0, 0.1}, {}}, Sphere(0.15));
-  const ObjectId sensor = scene_.AddProximitySensor("s", {}, Looking({0, 0, 0}, 0), Ray(1));
+  const ObjectId sensor = proximity::AddSensor(&scene_, "s", {}, Looking({0, 0, 0}, 0), Ray(1));
   Start();
   Sense();
   ExpectHit(sensor, 0.7 - std::sqrt(0.15 * 0.15 - 0.1 * 0.1), ball);
@@ -187,8 +178,8 @@ TEST_F(ProximityTest, RayJustBesideAShapeSeesNothing) {
   // The box's lower face is 1e-7 m above the ray; the twin box is 1e-7 m into it.
   scene_.AddShape("miss", {}, {{1, 0.1 + 1e-7, 0}, {}}, Box(0.2, 0.2, 0.2));
   const ObjectId hit = scene_.AddShape("hit", {}, {{1, 5 + 0.1 - 1e-7, 0}, {}}, Box(0.2, 0.2, 0.2));
-  const ObjectId past = scene_.AddProximitySensor("a", {}, Looking({0, 0, 0}, 0), Ray(2));
-  const ObjectId grazing = scene_.AddProximitySensor("b", {}, Looking({0, 5, 0}, 0), Ray(2));
+  const ObjectId past = proximity::AddSensor(&scene_, "a", {}, Looking({0, 0, 0}, 0), Ray(2));
+  const ObjectId grazing = proximity::AddSensor(&scene_, "b", {}, Looking({0, 5, 0}, 0), Ray(2));
   Start();
   Sense();
   ExpectNothing(past);
@@ -197,9 +188,10 @@ TEST_F(ProximityTest, RayJustBesideAShapeSeesNothing) {
 
 TEST_F(ProximityTest, OutOfRangeSeesNothing) {
   const ObjectId wall = scene_.AddShape("wall", {}, {{1.0, 0, 0}, {}}, Box(0.1, 2, 1));
-  const ObjectId short_ray = scene_.AddProximitySensor("a", {}, Looking({0, 0, 0}, 0), Ray(0.9));
-  const ObjectId exact = scene_.AddProximitySensor("b", {}, Looking({0, 0.5, 0}, 0), Ray(0.95));
-  const ObjectId away = scene_.AddProximitySensor("c", {}, Looking({0, -0.5, 0}, M_PI), Ray(5));
+  const ObjectId short_ray =
+      proximity::AddSensor(&scene_, "a", {}, Looking({0, 0, 0}, 0), Ray(0.9));
+  const ObjectId exact = proximity::AddSensor(&scene_, "b", {}, Looking({0, 0.5, 0}, 0), Ray(0.95));
+  const ObjectId away = proximity::AddSensor(&scene_, "c", {}, Looking({0, -0.5, 0}, M_PI), Ray(5));
   Start();
   Sense();
   ExpectNothing(short_ray);
@@ -210,7 +202,7 @@ TEST_F(ProximityTest, OutOfRangeSeesNothing) {
 TEST_F(ProximityTest, NearestOfTwoObstacles) {
   scene_.AddShape("far", {}, {{1.0, 0, 0}, {}}, Box(0.1, 2, 1));
   const ObjectId near = scene_.AddShape("near", {}, {{0.5, 0, 0}, {}}, Sphere(0.05));
-  const ObjectId sensor = scene_.AddProximitySensor("s", {}, Looking({0, 0, 0}, 0), Ray(2));
+  const ObjectId sensor = proximity::AddSensor(&scene_, "s", {}, Looking({0, 0, 0}, 0), Ray(2));
   Start();
   Sense();
   ExpectHit(sensor, 0.45, near);
@@ -218,7 +210,7 @@ TEST_F(ProximityTest, NearestOfTwoObstacles) {
 
 TEST_F(ProximityTest, RayStartingInsideAWallReadsZero) {
   const ObjectId wall = scene_.AddShape("wall", {}, {{0, 0, 0}, {}}, Box(0.4, 0.4, 0.4));
-  const ObjectId sensor = scene_.AddProximitySensor("s", {}, Looking({0.1, 0, 0}, 0), Ray(1));
+  const ObjectId sensor = proximity::AddSensor(&scene_, "s", {}, Looking({0.1, 0, 0}, 0), Ray(1));
   Start();
   Sense();
   ExpectHit(sensor, 0, wall);
@@ -228,8 +220,8 @@ TEST_F(ProximityTest, SceneSensorIgnoresTheShapeItIsMountedOn) {
   const ObjectId wall = scene_.AddShape("wall", {}, {{0, 0, 0}, {}}, Box(0.2, 2, 1));
   scene_.AddShape("other", {}, {{1.0, 0, 0}, {}}, Box(0.1, 2, 1));
   // Mounted on the wall's face, looking away from it, and into it.
-  const ObjectId out = scene_.AddProximitySensor("out", wall, Looking({0.1, 0, 0}, 0), Ray(2));
-  const ObjectId in = scene_.AddProximitySensor("in", wall, Looking({0.1, 0, 0}, M_PI), Ray(2));
+  const ObjectId out = proximity::AddSensor(&scene_, "out", wall, Looking({0.1, 0, 0}, 0), Ray(2));
+  const ObjectId in = proximity::AddSensor(&scene_, "in", wall, Looking({0.1, 0, 0}, M_PI), Ray(2));
   Start();
   Sense();
   EXPECT_NEAR(Reading(out).distance, 0.95 - 0.1, kTol);
@@ -240,7 +232,7 @@ TEST_F(ProximityTest, BadSettingsAreUserErrors) {
   scene_.AddShape("wall", {}, {{1.0, 0, 0}, {}}, Box(0.1, 2, 1));
   EXPECT_THROW(Start(0), Error);
   EXPECT_THROW(Start(-1), Error);
-  // Shapes beyond the octree's keys are no error (proximity_far_test.cc).
+  // Shapes beyond the octree's keys are no error (static_index_test.cc).
   scene_.AddShape("far away", {}, {{5000, 0, 0}, {}}, Box(0.1, 2, 1));
   EXPECT_NO_THROW(Start(0.05));
   EXPECT_NO_THROW(Start(0.5));
@@ -293,9 +285,9 @@ TEST_F(ProximityTest, SceneSensorSeesRobotsAndDynamicShapes) {
   ShapeData crate = Box(0.2, 0.2, 0.2);
   crate.dynamic = true;
   const ObjectId box = scene_.AddShape("crate", {}, {{0, 1, 0.1}, {}}, crate);
-  const ObjectId east = scene_.AddProximitySensor("east", {}, Looking({0, 0, 0.05}, 0), Ray(2));
+  const ObjectId east = proximity::AddSensor(&scene_, "east", {}, Looking({0, 0, 0.05}, 0), Ray(2));
   const ObjectId north =
-      scene_.AddProximitySensor("north", {}, Looking({0, 0, 0.05}, M_PI / 2), Ray(2));
+      proximity::AddSensor(&scene_, "north", {}, Looking({0, 0, 0.05}, M_PI / 2), Ray(2));
   Start();
   Sense();
   ExpectHit(east, 0.9, bot.body);
@@ -313,7 +305,7 @@ TEST_F(ProximityTest, TiltedRobotShapeStillFoundByTheGrid) {
   const ObjectId plank = scene_.AddShape(
       "plank", root, {{0, 0, 0}, Quat::FromAxisAngle({0, 1, 0}, M_PI / 2)}, Box(0.1, 0.1, 1.6));
   scene_.MakeModelInstance(root, "bot", "bot#0");
-  const ObjectId sensor = scene_.AddProximitySensor("s", {}, Looking({-0.5, 0, 0}, 0), Ray(1));
+  const ObjectId sensor = proximity::AddSensor(&scene_, "s", {}, Looking({-0.5, 0, 0}, 0), Ray(1));
   Start();
   Sense();
   ExpectHit(sensor, 0.7, plank);
@@ -340,7 +332,7 @@ TEST_F(ProximityTest, MatchesBruteForceOnRandomScenes) {
   for (int i = 0; i < 3000; ++i) {
     poses.push_back({{pos(rng), pos(rng), pos(rng) / 4},
                      Quat::FromRollPitchYaw(angle(rng), angle(rng), angle(rng))});
-    sensors.push_back(scene_.AddProximitySensor("s", {}, poses.back(), Ray(1.5)));
+    sensors.push_back(proximity::AddSensor(&scene_, "s", {}, poses.back(), Ray(1.5)));
   }
   for (double resolution : {0.05, 0.17}) {
     Start(resolution);
@@ -383,8 +375,8 @@ TEST_F(ProximityTest, SwarmMatchesBruteForceAndConcurrentSensingMatchesSerial) {
   }
   Start();
   Sense();
-  std::vector<ProximitySensorData> serial(scene_.proximity_sensors().begin(),
-                                          scene_.proximity_sensors().end());
+  std::vector<ProximitySensorData> serial(proximity::Sensors(scene_).rows.begin(),
+                                          proximity::Sensors(scene_).rows.end());
   // Serial readings agree with testing every shape but the robot's own.
   std::vector<PlacedShape> all;
   for (size_t r = 0; r < scene_.shapes().size(); ++r) {
@@ -394,7 +386,7 @@ TEST_F(ProximityTest, SwarmMatchesBruteForceAndConcurrentSensingMatchesSerial) {
   }
   int detected = 0;
   for (size_t row = 0; row < serial.size(); ++row) {
-    const uint32_t slot = scene_.proximity_sensor_owners()[row];
+    const uint32_t slot = proximity::Sensors(scene_).owners[row];
     const Pose& X_WS = scene_.world_pose_at(slot);
     const Vec3 d = X_WS.q.Rotate({0, 0, 1});
     double best = INFINITY, t;
@@ -409,7 +401,7 @@ TEST_F(ProximityTest, SwarmMatchesBruteForceAndConcurrentSensingMatchesSerial) {
     EXPECT_EQ(serial[row].detected_object, id);
   }
   EXPECT_GT(detected, 50);
-  for (auto& r : scene_.proximity_sensors()) r = Ray(r.range);  // clear the readings
+  for (auto& r : proximity::MutableSensors(&scene_).rows) r = Ray(r.range);  // clear the readings
   std::vector<std::thread> threads;
   const int n = static_cast<int>(scene_.instances().size());
   for (int t = 0; t < 4; ++t)
@@ -418,7 +410,7 @@ TEST_F(ProximityTest, SwarmMatchesBruteForceAndConcurrentSensingMatchesSerial) {
     });
   for (auto& t : threads) t.join();
   for (size_t row = 0; row < serial.size(); ++row) {
-    const ProximitySensorData& r = scene_.proximity_sensors()[row];
+    const ProximitySensorData& r = proximity::Sensors(scene_).rows[row];
     ASSERT_EQ(r.detected, serial[row].detected) << row;
     ASSERT_EQ(r.distance, serial[row].distance) << row;
     ASSERT_EQ(r.detected_object, serial[row].detected_object) << row;
@@ -448,7 +440,7 @@ struct TwinBackends {
     cast_all->Build(scene, settings);
   }
   void Pass(ProximityBackend* backend) {
-    for (ProximitySensorData& r : scene.proximity_sensors()) {
+    for (ProximitySensorData& r : proximity::MutableSensors(&scene).rows) {
       r.detected = true;
       r.distance = -7;
       r.detected_object = ObjectId{12345, 6};
@@ -462,16 +454,16 @@ struct TwinBackends {
   int SenseBoth() {
     scene.UpdateWorldPoses();
     Pass(cast_all.get());
-    const std::vector<ProximitySensorData> expected(scene.proximity_sensors().begin(),
-                                                    scene.proximity_sensors().end());
+    const std::vector<ProximitySensorData> expected(proximity::Sensors(scene).rows.begin(),
+                                                    proximity::Sensors(scene).rows.end());
     Pass(early_out.get());
     int detected = 0, mismatches = 0;
     for (size_t row = 0; row < expected.size(); ++row) {
-      const ProximitySensorData& got = scene.proximity_sensors()[row];
+      const ProximitySensorData& got = proximity::Sensors(scene).rows[row];
       detected += expected[row].detected;
       if (SameBits(got, expected[row]) || ++mismatches > 5) continue;
       ADD_FAILURE() << "sensor row " << row << " ("
-                    << scene.PathOf(scene.IdAt(scene.proximity_sensor_owners()[row]))
+                    << scene.PathOf(scene.IdAt(proximity::Sensors(scene).owners[row]))
                     << "): early-out detected " << got.detected << " at " << got.distance
                     << ", casting every ray detected " << expected[row].detected << " at "
                     << expected[row].distance;
@@ -479,7 +471,7 @@ struct TwinBackends {
     EXPECT_EQ(mismatches, 0);
     return detected;
   }
-  const ProximitySensorData& Reading(ObjectId sensor) { return scene.proximity_sensor(sensor); }
+  const ProximitySensorData& Reading(ObjectId sensor) { return proximity::Sensor(scene, sensor); }
 
   Scene scene;
   std::unique_ptr<ProximityBackend> early_out, cast_all;
@@ -532,8 +524,8 @@ TEST(EarlyOutTest, MatchesCastingEveryRayOnRandomScenes) {
       scene.AddShape("wheel", robots.back().body,
                      {{0, 0.07, -0.03}, Quat::FromAxisAngle({1, 0, 0}, M_PI / 2)},
                      Cylinder(0.03, 0.02));
-      if (i % 10 == 0) scene.mutable_proximity_sensor(robots.back().sensors[9]).range = 0;
-      if (i % 10 == 1) scene.mutable_proximity_sensor(robots.back().sensors[9]).range = -1;
+      if (i % 10 == 0) proximity::MutableSensor(&scene, robots.back().sensors[9]).range = 0;
+      if (i % 10 == 1) proximity::MutableSensor(&scene, robots.back().sensors[9]).range = -1;
     }
     ShapeData crate = Box(0.15, 0.15, 0.15);
     crate.dynamic = true;
@@ -542,17 +534,17 @@ TEST(EarlyOutTest, MatchesCastingEveryRayOnRandomScenes) {
       crates.push_back(scene.AddShape(
           "crate", {}, {{uniform(-2, 2), uniform(-2, 2), 0.075}, Quat::FromYaw(angle(rng))},
           crate));
-    scene.AddProximitySensor("on_crate", crates[0], Looking({0.075, 0, 0}, 0), Ray(0.5));
-    scene.AddProximitySensor("into_crate", crates[0], Looking({0.075, 0, 0}, M_PI), Ray(0.5));
+    proximity::AddSensor(&scene, "on_crate", crates[0], Looking({0.075, 0, 0}, 0), Ray(0.5));
+    proximity::AddSensor(&scene, "into_crate", crates[0], Looking({0.075, 0, 0}, M_PI), Ray(0.5));
     for (int i = 0; i < 6; ++i)
-      scene.AddProximitySensor("free", {},
-                               {{uniform(-2, 2), uniform(-2, 2), uniform(0, 0.3)},
-                                Quat::FromRollPitchYaw(angle(rng), angle(rng), angle(rng))},
-                               Ray(uniform(0.05, 0.5)));
+      proximity::AddSensor(&scene, "free", {},
+                           {{uniform(-2, 2), uniform(-2, 2), uniform(0, 0.3)},
+                            Quat::FromRollPitchYaw(angle(rng), angle(rng), angle(rng))},
+                           Ray(uniform(0.05, 0.5)));
     twin.Start(scene_index % 4 == 3 ? 0.13 : 0.05);
     for (int step = 0; step < 3; ++step) {
       total_detected += twin.SenseBoth();
-      total_sensors += static_cast<int>(scene.proximity_sensors().size());
+      total_sensors += static_cast<int>(proximity::Sensors(scene).rows.size());
       // Each robot moves a little; some bump into their neighbours.
       for (const Robot& robot : robots) {
         Pose X = scene.world_pose(robot.root);
@@ -638,7 +630,7 @@ TEST(EarlyOutTest, RobotsAddedOrRemovedAfterTheStartAreRead) {
   ExpectReading(twin.Reading(b.sensors[0]), true, 0.95 - 0.885, wall);
   // A sensor added to a robot that has been read.
   const ObjectId extra =
-      scene.AddProximitySensor("extra", a.root, Looking({0.085, 0.02, 0.06}, 0), Ray(0.1));
+      proximity::AddSensor(&scene, "extra", a.root, Looking({0.085, 0.02, 0.06}, 0), Ray(0.1));
   twin.SenseBoth();
   ExpectReading(twin.Reading(extra), true, 0.95 - 0.885, wall);
   // A copy of b, then a removed: the copy reads, b still reads.
@@ -648,72 +640,6 @@ TEST(EarlyOutTest, RobotsAddedOrRemovedAfterTheStartAreRead) {
   twin.SenseBoth();
   ExpectReading(twin.Reading(b.sensors[0]), true, 0.95 - 0.885, wall);
   ExpectReading(twin.Reading(scene.FindObject("./sensor", copy)), true, 0.95 - 0.895, wall);
-}
-
-// The coarse map never says "nothing" where the octree has an occupied voxel.
-TEST(StaticIndexTest, CoarseMapIsConservative) {
-  std::mt19937_64 rng(77);
-  std::uniform_real_distribution<double> pos(-3, 3), size(0.01, 0.8), angle(-M_PI, M_PI),
-      extent(0, 0.5);
-  Scene scene;
-  for (int i = 0; i < 40; ++i) {
-    const ShapeData shape = i % 3 == 0   ? Box(size(rng), size(rng), size(rng))
-                            : i % 3 == 1 ? Cylinder(size(rng) / 2, size(rng))
-                                         : Sphere(size(rng) / 2);
-    scene.AddShape("o", {},
-                   {{pos(rng), pos(rng), pos(rng) / 2},
-                    Quat::FromRollPitchYaw(angle(rng), angle(rng), angle(rng))},
-                   shape);
-  }
-  scene.UpdateWorldPoses();
-  for (double resolution : {0.05, 0.011, 0.3}) {
-    StaticIndex index;
-    index.Build(scene, resolution);
-    int occupied = 0, ruled_out = 0;
-    for (int i = 0; i < 20000; ++i) {
-      const Vec3 lo{pos(rng) * 1.2, pos(rng) * 1.2, pos(rng) / 2};
-      const Vec3 hi = lo + Vec3{extent(rng), extent(rng), extent(rng)} * (i % 2 ? 0.2 : 1);
-      const bool any = index.AnyOccupied(lo, hi);
-      const bool may = index.MayBeOccupied(lo, hi);
-      ASSERT_TRUE(may || !any) << "box " << i << " at resolution " << resolution;
-      occupied += any;
-      ruled_out += !may;
-    }
-    EXPECT_GT(occupied, 1000) << resolution;
-    EXPECT_GT(ruled_out, 1000) << resolution;
-  }
-}
-
-// --- The primitives on their own -------------------------------------------------------
-
-TEST(RayPrimitivesTest, InsideStartsHitAtZero) {
-  double t = -1;
-  EXPECT_TRUE(RayBox({0, 0, 0}, {1, 0, 0}, {1, 1, 1}, 5, &t));
-  EXPECT_EQ(t, 0);
-  EXPECT_TRUE(RayCylinder({0.1, 0, 0.2}, {0, 0, 1}, 0.5, 0.5, 5, &t));
-  EXPECT_EQ(t, 0);
-  EXPECT_TRUE(RaySphere({0, 0.2, 0}, {0, 1, 0}, 0.5, 5, &t));
-  EXPECT_EQ(t, 0);
-}
-
-TEST(RayPrimitivesTest, BehindAndParallelRaysMiss) {
-  double t;
-  EXPECT_FALSE(RayBox({2, 0, 0}, {1, 0, 0}, {1, 1, 1}, 5, &t));         // pointing away
-  EXPECT_FALSE(RayBox({-2, 1.5, 0}, {1, 0, 0}, {1, 1, 1}, 5, &t));      // parallel, outside
-  EXPECT_FALSE(RayCylinder({-2, 0, 0.6}, {1, 0, 0}, 0.5, 0.5, 5, &t));  // above the top cap
-  EXPECT_FALSE(RayCylinder({0.6, 0, -3}, {0, 0, 1}, 0.5, 0.5, 5, &t));  // along the axis, outside
-  EXPECT_FALSE(RaySphere({-2, 0.51, 0}, {1, 0, 0}, 0.5, 5, &t));
-}
-
-TEST(RayPrimitivesTest, CapsSidesAndTangents) {
-  double t;
-  ASSERT_TRUE(RayCylinder({0.2, 0.1, -3}, {0, 0, 1}, 0.5, 0.5, 5, &t));  // bottom cap
-  EXPECT_NEAR(t, 2.5, 1e-15);
-  const Vec3 diagonal = Vec3{1, 0, 1}.Normalized();  // enters through the side
-  ASSERT_TRUE(RayCylinder({-1.5, 0, -1.0}, diagonal, 0.5, 0.5, 5, &t));
-  EXPECT_NEAR(t, std::sqrt(2.0), 1e-12);
-  ASSERT_TRUE(RaySphere({-2, 0.5, 0}, {1, 0, 0}, 0.5, 5, &t));  // tangent: touching counts
-  EXPECT_NEAR(t, 2, 1e-12);
 }
 
 }  // namespace

@@ -1,21 +1,26 @@
-// proximity_sensor: a ray along the sensor's +z axis, random rays in a cone,
-// or a detection volume (cone, pyramid, cylinder, disc) that reports the
-// nearest shape within its range (modules/proximity senses it).
+// The proximity_sensor object type (rows: proximity_sensor.h): a ray along
+// the sensor's +z axis, random rays in a cone, or a detection volume (cone,
+// pyramid, cylinder, disc) that reports the nearest shape within its range
+// (the backend, proximity.cc, senses it); its keys, reader, scaling and
+// hash, and the lookups proximity_sensor.h declares.
 #include <cmath>
 #include <cstdio>
 #include <string>
 #include <vector>
 
 #include "framework/collections.h"
+#include "framework/error.h"
 #include "framework/object_type.h"
 #include "framework/scene.h"
 #include "framework/state_hash.h"
-#include "framework/types/core_types.h"
+#include "modules/proximity/proximity_sensor.h"
 
 namespace swarmsim {
 
-// Its Lua API area (framework/lua_api_*.cc).
-void RegisterSensorsApi(lua_State* L);
+namespace proximity {
+// Its Lua API area (lua_api_proximity.cc).
+void RegisterProximityApi(lua_State* L);
+}  // namespace proximity
 
 const char* ToString(ProximityVolume volume) {
   switch (volume) {
@@ -69,10 +74,11 @@ void Scale(const ObjectTypeDescriptor&, void* row, double s, ScaleContext*) {
 
 // Ray sensors add what they always added (the golden hashes stay); volume
 // sensors add their normal too.
-void Hash(const Scene& scene, ObjectType, StateHasher* h) {
-  for (size_t r = 0; r < scene.proximity_sensors().size(); ++r) {
-    const ProximitySensorData& p = scene.proximity_sensors()[r];
-    h->AddValue(scene.proximity_sensor_owners()[r]);
+void Hash(const Scene& scene, ObjectType type, StateHasher* h) {
+  const Rows<ProximitySensorData>& sensors = scene.rows<ProximitySensorData>(type);
+  for (size_t r = 0; r < sensors.rows.size(); ++r) {
+    const ProximitySensorData& p = sensors.rows[r];
+    h->AddValue(sensors.owners[r]);
     h->AddValue(p.detected);
     h->AddValue(p.distance);
     h->AddValue(p.p_SD());
@@ -167,10 +173,8 @@ void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
                 "detect_front and detect_back are both false: the sensor would detect nothing");
 }
 
-}  // namespace
-
 constinit const ObjectTypeDescriptor kProximitySensorType{
-    .name = "proximity_sensor",
+    .name = proximity::kSensorTypeName,
     .description =
         "a ray along its +z axis, random rays in a cone, or a detection volume (cone, pyramid, "
         "cylinder, disc): the nearest shape within its range",
@@ -180,7 +184,43 @@ constinit const ObjectTypeDescriptor kProximitySensorType{
     .keys = kKeys,
     .read = Read,
     .check = Check,
-    .register_lua = RegisterSensorsApi,
+    .register_lua = proximity::RegisterProximityApi,
+    // Where it was when it was a built-in type: hashes and type lists stay.
+    .listed_after = "joint",
 };
 
+}  // namespace
+
+namespace proximity {
+
+const ObjectTypeDescriptor& SensorTypeDescriptor() { return kProximitySensorType; }
+
+ObjectType SensorType(Scene* scene) {
+  ObjectType type;
+  if (FindSensorType(*scene, &type)) return type;
+  return scene->RegisterType(kProximitySensorType);
+}
+
+ObjectId AddSensor(Scene* scene, std::string name, ObjectId parent, const Pose& X_PO,
+                   const ProximitySensorData& sensor) {
+  return scene->AddObject(SensorType(scene), std::move(name), parent, X_PO, &sensor);
+}
+
+const ProximitySensorData& Sensor(const Scene& scene, ObjectId id) {
+  const uint32_t slot = scene.SlotOf(id, "proximity sensor");
+  if (!IsSensorAt(scene, slot))
+    throw Error("object '" + scene.name_at(slot) + "' is a " +
+                scene.type_name(scene.type_at(slot)) + ", not a " + kSensorTypeName);
+  return scene.rows<ProximitySensorData>(scene.type_at(slot)).rows[scene.row_at(slot)];
+}
+
+ProximitySensorData& MutableSensor(Scene* scene, ObjectId id) {
+  return const_cast<ProximitySensorData&>(Sensor(*scene, id));
+}
+
+Rows<ProximitySensorData>& MutableSensors(Scene* scene) {
+  return scene->rows<ProximitySensorData>(SensorType(scene));
+}
+
+}  // namespace proximity
 }  // namespace swarmsim

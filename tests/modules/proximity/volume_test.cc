@@ -1,6 +1,8 @@
 // Proximity sensor detection volumes (modules/proximity/volume.h): the
 // reading is the nearest point of the part of each shape inside the volume,
 // checked against hand-computed cases.
+#include "modules/proximity/volume.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -13,7 +15,6 @@
 #include "framework/mesh.h"
 #include "framework/scene.h"
 #include "modules/proximity/proximity.h"
-#include "modules/proximity/volume.h"
 
 namespace swarmsim::proximity {
 namespace {
@@ -61,7 +62,7 @@ ProximitySensorData Sensor(ProximityVolume volume, double range) {
 class VolumeTest : public ::testing::Test {
  protected:
   ObjectId AddSensor(const ProximitySensorData& sensor, const Pose& X_WS = {}) {
-    return scene_->AddProximitySensor("s", {}, X_WS, sensor);
+    return proximity::AddSensor(scene_.get(), "s", {}, X_WS, sensor);
   }
   ObjectId AddShape(const ShapeData& shape, const Pose& X_WS) {
     return scene_->AddShape("shape", {}, X_WS, shape);
@@ -73,7 +74,7 @@ class VolumeTest : public ::testing::Test {
     backend_->Build(*scene_, ProximitySettings{});
     backend_->Update(*scene_);
     backend_->SenseSceneSensors(scene_.get());
-    return scene_->proximity_sensor(sensor);
+    return proximity::Sensor(*scene_, sensor);
   }
   static void ExpectPoint(const Vec3& got, const Vec3& want, double tol = kTol) {
     EXPECT_NEAR(got.x, want.x, tol);
@@ -110,10 +111,10 @@ TEST_F(VolumeTest, TiltedPlaneInsideACone) {
   ExpectPoint(r.more->normal, n * -1, 1e-12);
   EXPECT_EQ(r.detected_object, wall);
   // A narrower cone sees it farther: 0.5 / cos 35 at 10 deg.
-  scene_->proximity_sensors()[0].more->angle = 10 * kDeg;
+  proximity::MutableSensors(scene_.get()).rows[0].more->angle = 10 * kDeg;
   EXPECT_NEAR(Sense(sensor).distance, 0.5 / std::cos(35 * kDeg), kTol);
   // Facing it (n along the axis within the cone) the nearest point is its foot.
-  scene_->proximity_sensors()[0].more->angle = 50 * kDeg;
+  proximity::MutableSensors(scene_.get()).rows[0].more->angle = 50 * kDeg;
   EXPECT_NEAR(Sense(sensor).distance, 0.5, kTol);
   ExpectPoint(Sense(sensor).p_SD(), n * 0.5);
 }
@@ -143,7 +144,7 @@ TEST_F(VolumeTest, SphereAtThePyramidsEdgeReadsTheNearestPointOfItsInsidePart) {
   // Its own nearest point (0.8 m, at 25 deg) is outside: a ray would see nothing.
   EXPECT_GT(r.distance, 0.8 + 1e-3);
   // Wholly outside a 10 deg pyramid: nothing.
-  scene_->proximity_sensors()[0].more->angle = 10 * kDeg;
+  proximity::MutableSensors(scene_.get()).rows[0].more->angle = 10 * kDeg;
   EXPECT_FALSE(Sense(sensor).detected);
 }
 
@@ -198,7 +199,7 @@ TEST_F(VolumeTest, MeshCorner) {
   ExpectPoint(r.p_SD(), {0, 0, 1 - 0.1 * std::sqrt(3.0)});
   EXPECT_EQ(r.detected_object, cube);
   EXPECT_LT(r.more->normal.z, 0);  // a face seen from the sensor
-  scene_->proximity_sensors()[0].more->detect_front = false;
+  proximity::MutableSensors(scene_.get()).rows[0].more->detect_front = false;
   const ProximitySensorData& back = Sense(sensor);
   ASSERT_TRUE(back.detected);
   EXPECT_GT(back.distance, 1 - 0.1 * std::sqrt(3.0) + 0.01);
@@ -219,7 +220,7 @@ TEST_F(VolumeTest, MeshAndBoxOfTheSameCubeAgreeWhenCut) {
   const double a0 = std::atan2(std::hypot(nearest.x, nearest.y), nearest.z);
   // A cone 0.5 deg narrower cuts the cube: the reading is on its side, farther.
   cone.more->angle = a0 - 0.5 * kDeg;
-  scene_->proximity_sensors()[0].more->angle = cone.more->angle;
+  proximity::MutableSensors(scene_.get()).rows[0].more->angle = cone.more->angle;
   const ProximitySensorData box = Sense(sensor);
   ASSERT_TRUE(box.detected);
   EXPECT_NEAR(std::atan2(std::hypot(box.more->point.x, box.more->point.y), box.more->point.z),
@@ -242,12 +243,12 @@ TEST_F(VolumeTest, BlindZone) {
   const ObjectId sensor = AddSensor(cone);
   AddShape(Box(1, 1, 0.2), {{0, 0, 0.4}, {}});
   EXPECT_NEAR(Sense(sensor).distance, 0.3, kTol);
-  scene_->proximity_sensors()[0].more->blind_zone = 0.35;
+  proximity::MutableSensors(scene_.get()).rows[0].more->blind_zone = 0.35;
   const ProximitySensorData& r = Sense(sensor);
   ASSERT_TRUE(r.detected);
   EXPECT_NEAR(r.distance, 0.35, kTol);
   ExpectPoint(r.p_SD(), {0, 0, 0.35});
-  scene_->proximity_sensors()[0].more->blind_zone = 0.6;
+  proximity::MutableSensors(scene_.get()).rows[0].more->blind_zone = 0.6;
   EXPECT_FALSE(Sense(sensor).detected);
 }
 
@@ -266,9 +267,9 @@ TEST_F(VolumeTest, DetectionAngleCutOff) {
     const ProximitySensorData& seen = Sense(sensor);
     ASSERT_TRUE(seen.detected);
     EXPECT_NEAR(-seen.more->normal.z, 0.5, 1e-9);  // cos 60
-    scene_->proximity_sensors()[0].more->max_detection_angle = 45 * kDeg;
+    proximity::MutableSensors(scene_.get()).rows[0].more->max_detection_angle = 45 * kDeg;
     EXPECT_FALSE(Sense(sensor).detected);
-    scene_->proximity_sensors()[0].more->max_detection_angle = 70 * kDeg;
+    proximity::MutableSensors(scene_.get()).rows[0].more->max_detection_angle = 70 * kDeg;
     EXPECT_TRUE(Sense(sensor).detected);
   }
 }
@@ -288,13 +289,13 @@ TEST_F(VolumeTest, CylinderAndDisc) {
   ExpectPoint(r.p_SD(), Vec3{0.2, 0, 1} * (1 - 0.05 / d));
   // Cut by the side x = 0.17 of a cylinder of radius 0.17: the detected
   // point is on the side.
-  scene_->proximity_sensors()[0].more->radius = 0.17;
+  proximity::MutableSensors(scene_.get()).rows[0].more->radius = 0.17;
   const ProximitySensorData& cut = Sense(c);
   ASSERT_TRUE(cut.detected);
   EXPECT_NEAR(std::hypot(cut.more->point.x, cut.more->point.y), 0.17, 1e-9);
   EXPECT_GT(cut.distance, r.distance);
   // Wholly outside a cylinder of radius 0.1.
-  scene_->proximity_sensors()[0].more->radius = 0.1;
+  proximity::MutableSensors(scene_.get()).rows[0].more->radius = 0.1;
   EXPECT_FALSE(Sense(c).detected);
 
   Reset();
@@ -303,7 +304,7 @@ TEST_F(VolumeTest, CylinderAndDisc) {
   const ObjectId s = AddSensor(disc);
   AddShape(Box(0.1, 0.1, 0.1), {{std::cos(60 * kDeg), std::sin(60 * kDeg), 0}, {}});
   EXPECT_TRUE(Sense(s).detected);
-  scene_->proximity_sensors()[0].more->angle = 50 * kDeg;
+  proximity::MutableSensors(scene_.get()).rows[0].more->angle = 50 * kDeg;
   EXPECT_FALSE(Sense(s).detected);
 }
 
@@ -336,7 +337,7 @@ TEST_F(VolumeTest, BroadPhaseMissesNothing) {
   Sense(sensors[0]);
   int detected = 0;
   for (const ObjectId sensor : sensors) {
-    const ProximitySensorData& r = scene_->proximity_sensor(sensor);
+    const ProximitySensorData& r = proximity::Sensor(*scene_, sensor);
     const Volume volume = MakeVolume(r);
     const Pose X_SW = scene_->world_pose(sensor).Inverse();
     VolumeHit best{INFINITY, {}, {}};

@@ -1,0 +1,134 @@
+// modules/proximity/module.cc: what Register adds to a registry (the
+// module, the proximity_sensor type listed where it always was), the
+// module a world makes (sensing in the sense phase) and the world's line
+// of sight it provides when the world starts.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+
+#include "framework/line_of_sight.h"
+#include "framework/object_type.h"
+#include "framework/registry.h"
+#include "framework/world.h"
+#include "modules/builtin.h"
+#include "modules/proximity/proximity.h"
+#include "modules/proximity/proximity_sensor.h"
+
+namespace swarmsim::proximity {
+namespace {
+
+ShapeData Box(double x, double y, double z) {
+  ShapeData s;
+  s.kind = ShapeKind::kBox;
+  s.size = {x, y, z};
+  return s;
+}
+
+// A world of the built-in modules (kinematic physics: nothing moves) with
+// a static wall 0.2 m thick whose near face is at x = 0.9.
+class ModuleWorld {
+ public:
+  ModuleWorld() {
+    RegisterBuiltinModules(&registry_);
+    WorldSettings settings;
+    settings.physics = "kinematic";
+    settings.threads = 1;
+    world_ = std::make_unique<World>(settings, registry_);
+    wall_ = world_->scene().AddShape("wall", {}, {{1, 0, 0.5}, {}}, Box(0.2, 4, 1));
+  }
+  World& world() { return *world_; }
+  Scene& scene() { return world_->scene(); }
+  ObjectId wall() const { return wall_; }
+
+ private:
+  ModuleRegistry registry_;
+  std::unique_ptr<World> world_;
+  ObjectId wall_;
+};
+
+TEST(ProximityModuleTest, RegistersAsProximity) {
+  const auto info = ModuleInfo();
+  EXPECT_EQ(info.kind, "proximity");
+  EXPECT_EQ(info.name, "proximity");
+  EXPECT_FALSE(info.version.empty());
+  EXPECT_FALSE(info.description.empty());
+  EXPECT_NE(MakeBackend(), nullptr);
+}
+
+// The module for every world, and the type: listed (and hashed) right
+// after `joint`, where it was when it was a built-in type, so the golden
+// hashes and the loader's type lists stay.
+TEST(ProximityModuleTest, RegisterAddsTheModuleAndTheTypeAfterJoint) {
+  ModuleRegistry registry;
+  Register(&registry);
+  const ModuleDescriptor* module = registry.FindModule("proximity");
+  ASSERT_NE(module, nullptr);
+  EXPECT_EQ(module->info.kind, "proximity");
+  EXPECT_TRUE(module->every_world);
+  EXPECT_EQ(module->order, 100);
+  ASSERT_EQ(registry.object_types().size(), 1u);
+  EXPECT_EQ(registry.object_types()[0], &SensorTypeDescriptor());
+  EXPECT_STREQ(SensorTypeDescriptor().name, "proximity_sensor");
+
+  ModuleWorld w;  // every built-in module
+  ObjectType sensor, joint;
+  ASSERT_TRUE(FindSensorType(w.scene(), &sensor));
+  ASSERT_TRUE(w.scene().FindType("joint", &joint));
+  const auto order = w.scene().listing_order();
+  size_t at = 0;
+  while (at < order.size() && order[at] != joint) ++at;
+  ASSERT_LT(at + 1, order.size());
+  EXPECT_EQ(order[at + 1], sensor);
+}
+
+TEST(ProximityModuleTest, ProvidesTheWorldsLineOfSightWhenTheWorldStarts) {
+  ModuleWorld w;
+  EXPECT_EQ(w.world().line_of_sight(), nullptr);
+  w.world().Start();
+  const LineOfSight* line_of_sight = w.world().line_of_sight();
+  ASSERT_NE(line_of_sight, nullptr);
+  EXPECT_TRUE(line_of_sight->SegmentBlocked({0, 0, 0.5}, {2, 0, 0.5}));     // through the wall
+  EXPECT_FALSE(line_of_sight->SegmentBlocked({0, 0, 0.5}, {0.8, 0, 0.5}));  // short of it
+  EXPECT_FALSE(line_of_sight->SegmentBlocked({0, 0, 0.5}, {0, 2, 0.5}));    // along it
+  EXPECT_FALSE(line_of_sight->SegmentBlocked({2, 3, 0.5}, {0, 3, 0.5}));    // past its end
+}
+
+TEST(ProximityModuleTest, SensesInTheWorldsStep) {
+  ModuleWorld w;
+  ProximitySensorData ray;
+  ray.range = 5;
+  // Its +z along the world's +x.
+  const Pose X_WS{{0, 0, 0.5}, Quat::FromAxisAngle({0, 1, 0}, M_PI / 2)};
+  const ObjectId eye = AddSensor(&w.scene(), "eye", {}, X_WS, ray);
+  w.world().Step();
+  const ProximitySensorData& reading = Sensor(w.scene(), eye);
+  EXPECT_TRUE(reading.detected);
+  EXPECT_NEAR(reading.distance, 0.9, 1e-9);
+  EXPECT_EQ(reading.detected_object, w.wall());
+}
+
+// The lookups of proximity_sensor.h, as the recorder, Python and plugins use them.
+TEST(ProximityModuleTest, LookupsFindSensorsAndRefuseOtherObjects) {
+  ModuleWorld w;
+  const ObjectId eye = AddSensor(&w.scene(), "eye", {}, {}, {});
+  EXPECT_NE(FindSensor(w.scene(), eye), nullptr);
+  EXPECT_TRUE(IsSensorAt(w.scene(), eye.index()));
+  EXPECT_EQ(FindSensor(w.scene(), w.wall()), nullptr);
+  EXPECT_EQ(FindSensor(w.scene(), ObjectId{}), nullptr);
+  EXPECT_EQ(Sensors(w.scene()).rows.size(), 1u);
+  try {
+    Sensor(w.scene(), w.wall());
+    ADD_FAILURE() << "no error for a shape";
+  } catch (const std::exception& e) {
+    EXPECT_STREQ(e.what(), "object 'wall' is a shape, not a proximity_sensor");
+  }
+  // A Scene made without a World gets the type with its first sensor.
+  Scene bare;
+  EXPECT_EQ(Sensors(bare).rows.size(), 0u);
+  const ObjectId s = AddSensor(&bare, "s", {}, {}, {});
+  EXPECT_NE(FindSensor(bare, s), nullptr);
+}
+
+}  // namespace
+}  // namespace swarmsim::proximity
