@@ -16,53 +16,12 @@
 #include "framework/scene.h"
 #include "framework/world.h"
 #include "modules/builtin.h"
+#include "tests/modules/dynamics/ode/ode_test_world.h"
 
 namespace swarmsim::ode {
 namespace {
 
-struct Fixture {
-  ModuleRegistry registry;
-  std::unique_ptr<World> world;
-  explicit Fixture(double time_step = 0.01, int substeps = 1, double gravity = 9.81,
-                   std::string physics = "ode", int threads = 1) {
-    RegisterBuiltinModules(&registry);
-    WorldSettings s;
-    s.physics = std::move(physics);
-    s.time_step = time_step;
-    s.physics_substeps = substeps;
-    s.gravity = gravity;
-    s.threads = threads;
-    world = std::make_unique<World>(s, registry);
-    world->set_log_sink([](std::string_view) {});
-  }
-  Scene& scene() { return world->scene(); }
-};
-
-ShapeData Sphere(double r, bool dynamic, double mass = 1) {
-  ShapeData s;
-  s.kind = ShapeKind::kSphere;
-  s.size = {r, 0, 0};
-  s.dynamic = dynamic;
-  s.mass = mass;
-  return s;
-}
-
-ShapeData Box(const Vec3& size, bool dynamic, double mass = 1) {
-  ShapeData s;
-  s.kind = ShapeKind::kBox;
-  s.size = size;
-  s.dynamic = dynamic;
-  s.mass = mass;
-  return s;
-}
-
-JointData Joint(JointType type, JointMode mode) {
-  JointData j;
-  j.type = type;
-  j.mode = mode;
-  j.max_force = 100;
-  return j;
-}
+using namespace test;  // ode_test_world.h
 
 TEST(OdeBackend, RegistersAsOdeAndKinematic) {
   ModuleRegistry registry;
