@@ -57,7 +57,7 @@ ObjectId AddFootbot(Scene* scene, std::shared_ptr<const ScriptSource> script, do
   for (int i = 0; i < 24; ++i) {
     const double angle = 2 * M_PI * i / 24;
     ProximitySensorData sensor;
-    sensor.range = 0.1;
+    sensor.settings.Edit().range = 0.1;
     if (i < detections) {
       sensor.detected = true;
       sensor.distance = 0.05;

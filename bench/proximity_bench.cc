@@ -70,7 +70,7 @@ void AddRobot(Scene* scene, const Pose& X_WR, int index) {
   scene->AddShape("body", root, {{0, 0, 0.06}, {}},
                   Shape(ShapeKind::kCylinder, {kBodyRadius, 0, 0.12}));
   ProximitySensorData ray;
-  ray.range = kRange;
+  ray.settings.Edit().range = kRange;
   for (int k = 0; k < kRaysPerRobot; ++k) {
     const double a = 2 * M_PI * k / kRaysPerRobot;
     // z axis radially out: turn z onto x, then yaw by a.

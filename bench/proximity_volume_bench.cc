@@ -41,9 +41,10 @@ std::unique_ptr<OneSensor> Make(ProximityVolume volume, double angle_deg, double
                                 double box_y = 0) {
   auto s = std::make_unique<OneSensor>();
   ProximitySensorData sensor;
-  sensor.volume = volume;
-  sensor.range = 3;
-  sensor.more->angle = sensor.more->angle_y = angle_deg * M_PI / 180;
+  ProximitySensorSettings& settings = sensor.settings.Edit();
+  settings.volume = volume;
+  settings.range = 3;
+  settings.angle = settings.angle_y = angle_deg * M_PI / 180;
   proximity::AddSensor(&s->scene, "s", {}, {}, sensor);
   s->scene.AddShape("box", {}, {{box_x, box_y, 1}, {}}, Shape(ShapeKind::kBox, {0.2, 0.2, 0.2}));
   s->scene.AddShape("sphere", {}, {{0.3, 0.3, 1.5}, {}}, Shape(ShapeKind::kSphere, {0.1, 0, 0}));

@@ -39,7 +39,7 @@ int ReadProximitySensor(lua_State* L) {
   const double p_SD[3] = {p.x, p.y, p.z};
   PushNumberArray(L, p_SD, 3);
   lua_pushinteger(L, sensor.detected_object.IsNull() ? -1 : sensor.detected_object.ToInteger());
-  const double n_S[3] = {sensor.more->normal.x, sensor.more->normal.y, sensor.more->normal.z};
+  const double n_S[3] = {sensor.normal.x, sensor.normal.y, sensor.normal.z};
   PushNumberArray(L, n_S, 3);
   return 5;
 }

@@ -72,7 +72,7 @@ class ProximityModule final : public Module {
     auto sets = std::make_shared<Sets>();
     const Rows<ProximitySensorData>& sensors = Sensors(scene);
     for (size_t r = 0; r < sensors.rows.size(); ++r) {
-      const ProximityVolumeData& more = *sensors.rows[r].more;
+      const ProximitySensorSettings& more = *sensors.rows[r].settings;
       if (more.detectable.empty()) continue;
       const uint32_t slot = sensors.owners[r];
       sets->used.resize(scene.slot_count(), 0);

@@ -69,7 +69,7 @@ SensorRay MakeRay(const Scene& scene, std::span<const ProximitySensorData> readi
   // Unit already unless the pose's quaternion drifted; skip the sqrt then.
   const double norm2 = d.SquaredNorm();
   if (std::abs(norm2 - 1) > 1e-14 && norm2 > 0) d = d / std::sqrt(norm2);
-  return {X_WS.p, d, readings[row].range, row};
+  return {X_WS.p, d, readings[row].range(), row};
 }
 
 // The rays of `sensors`, in order (written field by field: copying a fresh
@@ -227,7 +227,7 @@ class OctreeGridProximity final : public ProximityBackend {
 
   // A ray sensor (the batched fast path), or a volume or randomized rays?
   bool IsRay(const Scene& scene, uint32_t slot) const {
-    return Table(scene).rows[scene.row_at(slot)].volume == ProximityVolume::kRay;
+    return Table(scene).rows[scene.row_at(slot)].volume() == ProximityVolume::kRay;
   }
 
   // Lists each robot's sensors (hierarchy order; rays apart from volumes)
@@ -285,7 +285,7 @@ class OctreeGridProximity final : public ProximityBackend {
       const Pose& X_WS = scene->world_pose_at(sensor.slot);
       const double x = X_WS.p.x, y = X_WS.p.y, z = X_WS.p.z;
       const ProximitySensorData& reading = readings[sensor.row];
-      const double range = reading.range;
+      const double range = reading.range();
       lo_x = std::min(lo_x, x), lo_y = std::min(lo_y, y), lo_z = std::min(lo_z, z);
       hi_x = std::max(hi_x, x), hi_y = std::max(hi_y, y), hi_z = std::max(hi_z, z);
       longest = std::max(longest, range);
@@ -340,7 +340,7 @@ class OctreeGridProximity final : public ProximityBackend {
         SegmentBox(rays[i], &a, &b);
       } else {
         const Vec3& p = scene->world_pose_at(sensor.slot).p;
-        const double range = readings[sensor.row].range;
+        const double range = readings[sensor.row].range();
         const double r = (range > 0 ? range : 0) + margin;
         a = {p.x - r, p.y - r, p.z - r};
         b = {p.x + r, p.y + r, p.z + r};
@@ -472,9 +472,9 @@ class OctreeGridProximity final : public ProximityBackend {
     // The surface normal at the hit, in the sensor frame, and the cut-off.
     if (reading.detected) {
       const Quat q_SW = scene->world_pose_at(table.owners[ray.row]).q.Conjugate();
-      reading.more->normal = q_SW.Rotate(SurfaceNormal(*hit_shape, ray.p_W + ray.d_W * best));
-      if (reading.more->max_detection_angle < kPi && best > 0 &&
-          -reading.more->normal.z < std::cos(reading.more->max_detection_angle))
+      reading.normal = q_SW.Rotate(SurfaceNormal(*hit_shape, ray.p_W + ray.d_W * best));
+      if (reading.settings->max_detection_angle < kPi && best > 0 &&
+          -reading.normal.z < std::cos(reading.settings->max_detection_angle))
         reading.detected = false;
     }
     reading.distance = reading.detected ? best : 0;
@@ -542,7 +542,7 @@ class OctreeGridProximity final : public ProximityBackend {
     WorldBox(X_WS, lo_S, hi_S, &lo, &hi);
     VolumeHit best{std::numeric_limits<double>::infinity(), {}, {}};
     ObjectId hit;
-    const bool usable = std::isfinite(X_WS.p.x + X_WS.p.y + X_WS.p.z + reading.range);
+    const bool usable = std::isfinite(X_WS.p.x + X_WS.p.y + X_WS.p.z + reading.range());
     if (usable && volume.kind == ProximityVolume::kRandomizedRay) {
       SenseRandomRays(reading, sensor, X_WS, lo, hi, instance, skip, &best, &hit, scene);
     } else if (usable) {
@@ -552,11 +552,11 @@ class OctreeGridProximity final : public ProximityBackend {
         if (NearestInVolume(volume, shape, X_SW, best.distance, &h)) best = h, hit = shape.id;
       });
     }
-    reading.detected = best.distance <= reading.range;
+    reading.detected = best.distance <= reading.range();
     reading.distance = reading.detected ? best.distance : 0;
     reading.detected_object = reading.detected ? hit : ObjectId{};
-    reading.more->point = reading.detected ? best.point : Vec3{};
-    reading.more->normal = reading.detected ? best.normal : Vec3{};
+    reading.point = reading.detected ? best.point : Vec3{};
+    reading.normal = reading.detected ? best.normal : Vec3{};
   }
 
   // `ray_count` rays in the cone, from the stream of (seed, sensor slot,
@@ -567,18 +567,19 @@ class OctreeGridProximity final : public ProximityBackend {
                        const Scene* scene) const {
     thread_local std::vector<Vec3> directions;
     thread_local std::vector<const PlacedShape*> shapes;
-    directions.resize(reading.more->ray_count);
+    directions.resize(reading.settings->ray_count);
     const uint64_t stream = (uint64_t{sensor.slot} << 40) ^ step_;
-    RandomRayDirections(seed_, stream, reading.more->angle, reading.more->ray_count,
+    RandomRayDirections(seed_, stream, reading.settings->angle, reading.settings->ray_count,
                         directions.data());
     shapes.clear();
     VisitShapesNear(scene->IdAt(sensor.slot), lo, hi, instance, skip,
                     [&](const PlacedShape& shape) { shapes.push_back(&shape); });
-    const double cos_cut =
-        reading.more->max_detection_angle < kPi ? std::cos(reading.more->max_detection_angle) : -2;
+    const double cos_cut = reading.settings->max_detection_angle < kPi
+                               ? std::cos(reading.settings->max_detection_angle)
+                               : -2;
     for (const Vec3& d_S : directions) {
       const Vec3 d_W = X_WS.q.Rotate(d_S);
-      double nearest = std::min(best->distance, reading.range);
+      double nearest = std::min(best->distance, reading.range());
       const PlacedShape* nearest_shape = nullptr;
       for (const PlacedShape* shape : shapes) {
         double t;

@@ -19,6 +19,7 @@
 #include "framework/math.h"
 #include "framework/object_rows.h"
 #include "framework/scene.h"
+#include "framework/shared_settings.h"
 
 namespace swarmsim {
 
@@ -30,32 +31,12 @@ struct ObjectTypeDescriptor;
 enum class ProximityVolume : uint8_t { kRay, kRandomizedRay, kCone, kPyramid, kCylinder, kDisc };
 const char* ToString(ProximityVolume volume);
 
-// A copyable owning pointer: copying it copies the pointee (never null but
-// when moved from).
-template <class T>
-class ClonePtr {
- public:
-  ClonePtr() : p_(std::make_unique<T>()) {}
-  ClonePtr(const ClonePtr& o) : p_(std::make_unique<T>(*o.p_)) {}
-  ClonePtr(ClonePtr&&) noexcept = default;
-  ClonePtr& operator=(const ClonePtr& o) {
-    if (this != &o) p_ = std::make_unique<T>(*o.p_);
-    return *this;
-  }
-  ClonePtr& operator=(ClonePtr&&) noexcept = default;
-  T* operator->() { return p_.get(); }
-  const T* operator->() const { return p_.get(); }
-  T& operator*() { return *p_; }
-  const T& operator*() const { return *p_; }
-
- private:
-  std::unique_ptr<T> p_;
-};
-
-// A proximity sensor's volume settings (constant) and the point and normal
-// of its reading: apart from the row, which a ray sensor reads and writes
-// every step, so that a swarm's rows stay small (40 bytes).
-struct ProximityVolumeData {
+// A proximity sensor's settings: constant while it runs, shared by every
+// copy made from one model entry (framework/shared_settings.h; Edit() is
+// copy on write).
+struct ProximitySensorSettings {
+  double range = 0.1;  // m: nothing farther than this is detected
+  ProximityVolume volume = ProximityVolume::kRay;
   double angle = 0.5235987755982988;    // rad: cone, randomized_ray half-angle; disc half sector
   double angle_y = 0.5235987755982988;  // rad: pyramid half-angle about y (angle: about x)
   double radius = 0.05;                 // m: cylinder
@@ -69,23 +50,23 @@ struct ProximityVolumeData {
   // (framework/collections.h), resolved from the sensor; empty: everything.
   std::string detectable;
   std::string detectable_where;  // "file:line:column" of `detectable`, for errors
-  // The reading's detected point (volumes; a ray's is on +z, see p_SD())
-  // and the outward surface normal there, in the sensor frame.
-  Vec3 point, normal;
 };
 
-// A proximity sensor. 40 bytes: a robot's control step reads all of its
-// sensors' rows.
+// A proximity sensor: its shared settings and its reading (80 bytes; a
+// robot's control step reads all of its sensors' rows).
 struct ProximitySensorData {
-  double range = 0.1;  // m: nothing farther than this is detected
+  Shared<ProximitySensorSettings> settings;
   // Reading, written in the sense phase:
   double distance = 0;       // m, from the sensor's origin to the detected point
   ObjectId detected_object;  // shape that was hit
   bool detected = false;
-  ProximityVolume volume = ProximityVolume::kRay;  // constant
-  ClonePtr<ProximityVolumeData> more;              // settings, point and normal
+  // The detected point (volumes; a ray's is on +z, see p_SD()) and the
+  // outward surface normal there, in the sensor frame.
+  Vec3 point, normal;
+  double range() const { return settings->range; }
+  ProximityVolume volume() const { return settings->volume; }
   // The detected point in the sensor frame: for a ray, on its +z axis.
-  Vec3 p_SD() const { return volume == ProximityVolume::kRay ? Vec3{0, 0, distance} : more->point; }
+  Vec3 p_SD() const { return volume() == ProximityVolume::kRay ? Vec3{0, 0, distance} : point; }
 };
 
 namespace proximity {

@@ -64,12 +64,13 @@ std::unique_ptr<RowTable> MakeRows(const ObjectTypeDescriptor&) {
 
 void Scale(const ObjectTypeDescriptor&, void* row, double s, ScaleContext*) {
   ProximitySensorData& p = *static_cast<ProximitySensorData*>(row);
-  p.range *= s;
+  ProximitySensorSettings& settings = p.settings.Edit();  // this copy's own, scaled
+  settings.range *= s;
+  settings.radius *= s;
+  settings.thickness *= s;
+  settings.blind_zone *= s;
   p.distance *= s;
-  p.more->radius *= s;
-  p.more->thickness *= s;
-  p.more->blind_zone *= s;
-  p.more->point = p.more->point * s;
+  p.point = p.point * s;
 }
 
 // Ray sensors add what they always added (the golden hashes stay); volume
@@ -83,7 +84,7 @@ void Hash(const Scene& scene, ObjectType type, StateHasher* h) {
     h->AddValue(p.distance);
     h->AddValue(p.p_SD());
     h->AddValue(p.detected_object);
-    if (p.volume != ProximityVolume::kRay) h->AddValue(p.more->normal);
+    if (p.volume() != ProximityVolume::kRay) h->AddValue(p.normal);
   }
 }
 
@@ -106,7 +107,7 @@ double ReadAngle(const ObjectReader& r, const char* key, double max_deg, bool ma
 
 // The detectable set's path matches objects.
 void Check(const Scene& scene, ObjectId id, const void* row) {
-  const ProximityVolumeData& v = *static_cast<const ProximitySensorData*>(row)->more;
+  const ProximitySensorSettings& v = *static_cast<const ProximitySensorData*>(row)->settings;
   if (v.detectable.empty()) return;
   EntitySlots(scene, v.detectable, id,
               (v.detectable_where.empty() ? "" : v.detectable_where + ": ") + "proximity sensor " +
@@ -114,7 +115,7 @@ void Check(const Scene& scene, ObjectId id, const void* row) {
 }
 
 void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
-  ProximitySensorData& p = *static_cast<ProximitySensorData*>(row);
+  ProximitySensorSettings& p = static_cast<ProximitySensorData*>(row)->settings.Edit();
   if (r.Has("range")) p.range = r.Number("range", kPositiveLength);
   static const std::vector<std::string> kVolumes = {"ray",     "randomized_ray", "cone",
                                                     "pyramid", "cylinder",       "disc"};
@@ -134,41 +135,41 @@ void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
   };
   if (applies("angle_deg", v == V::kCone || v == V::kRandomizedRay || v == V::kDisc,
               "cone, randomized_ray and disc"))
-    p.more->angle = v == V::kRandomizedRay ? ReadAngle(r, "angle_deg", 90, false, 0, false)
-                                           : ReadAngle(r, "angle_deg", 90, v == V::kDisc);
+    p.angle = v == V::kRandomizedRay ? ReadAngle(r, "angle_deg", 90, false, 0, false)
+                                     : ReadAngle(r, "angle_deg", 90, v == V::kDisc);
   if (applies("angle_x_deg", v == V::kPyramid, "pyramid"))
-    p.more->angle = ReadAngle(r, "angle_x_deg", 90, false);
+    p.angle = ReadAngle(r, "angle_x_deg", 90, false);
   if (applies("angle_y_deg", v == V::kPyramid, "pyramid"))
-    p.more->angle_y = ReadAngle(r, "angle_y_deg", 90, false);
+    p.angle_y = ReadAngle(r, "angle_y_deg", 90, false);
   if (applies("cylinder_radius", v == V::kCylinder, "cylinder"))
-    p.more->radius = r.Number("cylinder_radius", kPositiveLength);
+    p.radius = r.Number("cylinder_radius", kPositiveLength);
   if (applies("thickness", v == V::kDisc, "disc"))
-    p.more->thickness = r.Number("thickness", kPositiveLength);
+    p.thickness = r.Number("thickness", kPositiveLength);
   if (applies("ray_count", v == V::kRandomizedRay, "randomized_ray"))
-    p.more->ray_count = static_cast<uint16_t>(r.Integer("ray_count", 1, 1024));
+    p.ray_count = static_cast<uint16_t>(r.Integer("ray_count", 1, 1024));
   if (applies("blind_zone", solid, "cone, pyramid, cylinder and disc")) {
-    p.more->blind_zone = r.Number("blind_zone", kNonNegativeLength);
-    if (!(p.more->blind_zone < p.range))
-      r.Fail("blind_zone", "'blind_zone' (" + std::to_string(p.more->blind_zone) +
+    p.blind_zone = r.Number("blind_zone", kNonNegativeLength);
+    if (!(p.blind_zone < p.range))
+      r.Fail("blind_zone", "'blind_zone' (" + std::to_string(p.blind_zone) +
                                " m) must be less than the range (" + std::to_string(p.range) +
                                " m)");
   }
   if (r.Has("max_detection_angle_deg"))
-    p.more->max_detection_angle = ReadAngle(r, "max_detection_angle_deg", 180, true);
+    p.max_detection_angle = ReadAngle(r, "max_detection_angle_deg", 180, true);
   if (applies("detect_front", solid, "cone, pyramid, cylinder and disc"))
-    p.more->detect_front = r.Bool("detect_front");
+    p.detect_front = r.Bool("detect_front");
   if (applies("detect_back", solid, "cone, pyramid, cylinder and disc"))
-    p.more->detect_back = r.Bool("detect_back");
+    p.detect_back = r.Bool("detect_back");
   if (applies("detectable", v != V::kRay, "volume and randomized_ray")) {
-    p.more->detectable = r.String("detectable");
-    p.more->detectable_where = r.Where("detectable");
-    const std::string& path = p.more->detectable;
+    p.detectable = r.String("detectable");
+    p.detectable_where = r.Where("detectable");
+    const std::string& path = p.detectable;
     if (path.empty() || (path[0] != '/' && path[0] != ':' && path[0] != '.'))
       r.Fail("detectable", "'" + path +
                                "' is not an object path: start with '/' (absolute), ':' (this "
                                "model) or './' (below the sensor)");
   }
-  if (!p.more->detect_front && !p.more->detect_back)
+  if (!p.detect_front && !p.detect_back)
     r.FailAtKey(r.Has("detect_back") ? "detect_back" : "detect_front",
                 "detect_front and detect_back are both false: the sensor would detect nothing");
 }

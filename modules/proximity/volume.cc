@@ -426,17 +426,18 @@ bool NearestOnMesh(const Volume& v, const ConvexSet* volume_sets, int count,
 
 Volume MakeVolume(const ProximitySensorData& s) {
   Volume v;
-  v.kind = s.volume;
-  v.range = s.range;
-  v.cos_angle = std::cos(s.more->angle), v.sin_angle = std::sin(s.more->angle);
-  v.cos_x = std::cos(s.more->angle), v.sin_x = std::sin(s.more->angle);
-  v.cos_y = std::cos(s.more->angle_y), v.sin_y = std::sin(s.more->angle_y);
-  v.radius = s.more->radius;
-  v.half_thickness = 0.5 * s.more->thickness;
-  v.blind_zone = s.more->blind_zone;
-  v.cos_max_detection_angle =
-      s.more->max_detection_angle >= 3.141592653589793 ? -1 : std::cos(s.more->max_detection_angle);
-  v.detect_front = s.more->detect_front, v.detect_back = s.more->detect_back;
+  v.kind = s.volume();
+  v.range = s.range();
+  v.cos_angle = std::cos(s.settings->angle), v.sin_angle = std::sin(s.settings->angle);
+  v.cos_x = std::cos(s.settings->angle), v.sin_x = std::sin(s.settings->angle);
+  v.cos_y = std::cos(s.settings->angle_y), v.sin_y = std::sin(s.settings->angle_y);
+  v.radius = s.settings->radius;
+  v.half_thickness = 0.5 * s.settings->thickness;
+  v.blind_zone = s.settings->blind_zone;
+  v.cos_max_detection_angle = s.settings->max_detection_angle >= 3.141592653589793
+                                  ? -1
+                                  : std::cos(s.settings->max_detection_angle);
+  v.detect_front = s.settings->detect_front, v.detect_back = s.settings->detect_back;
   return v;
 }
 

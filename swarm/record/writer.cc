@@ -298,9 +298,9 @@ void RunRecorder::Impl::BuildScene() {
       case Kind::kProximity: {
         const ProximitySensorData& p = scene.rows<ProximitySensorData>(sensor_type).rows[t.row];
         o["type"] = "proximity_sensor";
-        o["range"] = p.range;
-        o["volume"] = ToString(p.volume);
-        if (p.volume != ProximityVolume::kRay) o["angle"] = p.more->angle;
+        o["range"] = p.range();
+        o["volume"] = ToString(p.volume());
+        if (p.volume() != ProximityVolume::kRay) o["angle"] = p.settings->angle;
         break;
       }
     }
@@ -430,9 +430,9 @@ void RunRecorder::Impl::Capture() {
       case Kind::kProximity: {
         const ProximitySensorData& p = sensors[t.row];
         uint16_t r = kNoDetection;
-        if (p.detected && p.range > 0)
+        if (p.detected && p.range() > 0)
           r = static_cast<uint16_t>(
-              std::lround(std::clamp(p.distance / p.range, 0.0, 1.0) * 65534));
+              std::lround(std::clamp(p.distance / p.range(), 0.0, 1.0) * 65534));
         reading[id] = r;
         break;
       }

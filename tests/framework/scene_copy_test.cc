@@ -94,7 +94,7 @@ TEST(SceneScaleTest, ScalesGeometryJointsSensorsAndMasses) {
   const ObjectId m1 = scene.AddShape("m1", prismatic, {}, mesh);
   const ObjectId m2 = scene.AddShape("m2", revolute, {}, mesh);
   ProximitySensorData sensor;
-  sensor.range = 0.1;
+  sensor.settings.Edit().range = 0.1;
   const ObjectId eye = proximity::AddSensor(&scene, "eye", root, {{0, 0.05, 0}, {}}, sensor);
   const uint64_t version = scene.structure_version();
 
@@ -112,7 +112,7 @@ TEST(SceneScaleTest, ScalesGeometryJointsSensorsAndMasses) {
   EXPECT_DOUBLE_EQ(scene.joint(revolute).position, 0.5);      // angles unchanged
   EXPECT_DOUBLE_EQ(scene.joint(revolute).max_force, 48);      // N m: x s^4
   EXPECT_DOUBLE_EQ(scene.world_pose(m1).p.z, 1 + 0.2 + 0.2);  // offset + slider
-  EXPECT_DOUBLE_EQ(proximity::Sensor(scene, eye).range, 0.2);
+  EXPECT_DOUBLE_EQ(proximity::Sensor(scene, eye).range(), 0.2);
   // One scaled asset for both shapes that shared the original.
   EXPECT_EQ(scene.shape(m1).mesh, scene.shape(m2).mesh);
   EXPECT_NE(scene.shape(m1).mesh, mesh.mesh);

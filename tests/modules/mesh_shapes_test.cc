@@ -71,7 +71,7 @@ std::vector<ProximitySensorData> Readings(const ShapeData& shape, const Pose& X_
   std::vector<ObjectId> sensors;
   for (const Pose& X_WR : poses) {
     ProximitySensorData ray;
-    ray.range = 1.5;
+    ray.settings.Edit().range = 1.5;
     sensors.push_back(proximity::AddSensor(&scene, "s", {}, X_WR, ray));
   }
   scene.UpdateWorldPoses();

@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdio>
 #include <new>
+#include <vector>
 
 #include "framework/plugin_api.h"
 
@@ -26,12 +27,11 @@ constexpr int kMaxSensors = 64;  // the ring's sensors looked for
 // One robot's state: what diffusion.lua's sysCall_init computes.
 struct Robot {
   int64_t left_motor = 0, right_motor = 0;
-  int64_t front = 0;  // the look-ahead sensor, if slow_distance > 0
-  int sensor_count = 0;
-  int64_t sensors[kMaxSensors];
-  double cos_a[kMaxSensors], sin_a[kMaxSensors];  // direction of each sensor
-  double wheel_speed = 0;                         // rad/s
-  double straight_angle = 0;                      // rad
+  int64_t front = 0;                 // the look-ahead sensor, if slow_distance > 0
+  std::vector<int64_t> sensors;      // the ring, as many as it has
+  std::vector<double> cos_a, sin_a;  // direction of each sensor
+  double wheel_speed = 0;            // rad/s
+  double straight_angle = 0;         // rad
   double delta = 0;
   double slow_distance = 0;  // m
 };
@@ -65,22 +65,31 @@ int Init(const SwarmsimCallContext* c, void** state, char* error, size_t error_s
     std::snprintf(error, error_size, "slow_distance > 0 needs a look-ahead sensor ./front");
     return -1;
   }
-  for (int i = 0; i < kMaxSensors; ++i) {
-    char path[32];
-    std::snprintf(path, sizeof path, "./prox[%d]", i);
-    if (!api.find_object(c->world, c->script_object, path, &robot->sensors[i])) break;
-    robot->sensor_count = i + 1;
-  }
-  if (robot->sensor_count == 0) {
-    std::snprintf(error, error_size, "the robot has no proximity ring ./prox[0], ./prox[1], ...");
+  try {
+    for (int i = 0; i < kMaxSensors; ++i) {
+      char path[32];
+      std::snprintf(path, sizeof path, "./prox[%d]", i);
+      int64_t sensor;
+      if (!api.find_object(c->world, c->script_object, path, &sensor)) break;
+      robot->sensors.push_back(sensor);
+    }
+    robot->sensors.shrink_to_fit();
+    const size_t n = robot->sensors.size();
+    robot->cos_a.resize(n);
+    robot->sin_a.resize(n);
+    for (size_t i = 0; i < n; ++i) {
+      // As Lua evaluates 2 * math.pi * i / 24: left to right, in doubles.
+      const double a = 2 * M_PI * static_cast<double>(i) / static_cast<double>(n);
+      robot->cos_a[i] = std::cos(a);
+      robot->sin_a[i] = std::sin(a);
+    }
+  } catch (const std::bad_alloc&) {
+    std::snprintf(error, error_size, "out of memory");
     return -1;
   }
-  const int n = robot->sensor_count;
-  for (int i = 0; i < n; ++i) {
-    // As Lua evaluates 2 * math.pi * i / 24: left to right, in doubles.
-    const double a = 2 * M_PI * static_cast<double>(i) / static_cast<double>(n);
-    robot->cos_a[i] = std::cos(a);
-    robot->sin_a[i] = std::sin(a);
+  if (robot->sensors.empty()) {
+    std::snprintf(error, error_size, "the robot has no proximity ring ./prox[0], ./prox[1], ...");
+    return -1;
   }
   return 0;
 }
@@ -90,12 +99,13 @@ int Step(const SwarmsimCallContext* c, void* state, char* error, size_t error_si
   const SwarmsimWorldApi& api = *c->api;
   // Sum of the readings as vectors pointing at what each sensor sees.
   double distances[kMaxSensors];
-  if (api.read_proximity_sensors(c->world, robot.sensors, robot.sensor_count, distances) < 0) {
+  if (api.read_proximity_sensors(c->world, robot.sensors.data(),
+                                 static_cast<int>(robot.sensors.size()), distances) < 0) {
     std::snprintf(error, error_size, "a sensor of the ring is gone");
     return -1;
   }
   double x = 0, y = 0;
-  for (int i = 0; i < robot.sensor_count; ++i) {
+  for (size_t i = 0; i < robot.sensors.size(); ++i) {
     if (distances[i] < 0) continue;
     const double value = 1 - distances[i] / kRange;
     x = x + value * robot.cos_a[i];

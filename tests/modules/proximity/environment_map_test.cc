@@ -28,7 +28,7 @@ Quat LookAlong(const Vec3& d) {
 
 ProximitySensorData Ray(double range) {
   ProximitySensorData d;
-  d.range = range;
+  d.settings.Edit().range = range;
   return d;
 }
 
@@ -98,9 +98,9 @@ TEST_F(EnvironmentProximityTest, AConeSeesTheSharedMap) {
   scene_.set_environment(
       std::make_shared<const EnvironmentMap>(environment::ReadOctomap(path, "geb079.bt", {})));
   ProximitySensorData cone;
-  cone.volume = ProximityVolume::kCone;
-  cone.range = 5;
-  cone.more->angle = 10 * M_PI / 180;
+  cone.settings.Edit().volume = ProximityVolume::kCone;
+  cone.settings.Edit().range = 5;
+  cone.settings.Edit().angle = 10 * M_PI / 180;
   const ObjectId sensor =
       proximity::AddSensor(&scene_, "cone", {}, {{0.001, 0.001, 1}, LookAlong({0, 1, 0})}, cone);
   Start(0.08);

@@ -79,7 +79,7 @@ TEST(ProximityLuaApiTest, ReadProximitySensorReturnsTheReading) {
   reading.detected = true;
   reading.distance = 0.0625;
   reading.detected_object = wall;
-  reading.more->normal = {0, 0, -1};
+  reading.normal = {0, 0, -1};
   w.world().Start();
   w.world().Step();  // the null proximity module leaves the readings alone
   // CoppeliaSim's order: result, distance, point, object, normal.

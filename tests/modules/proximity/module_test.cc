@@ -97,7 +97,7 @@ TEST(ProximityModuleTest, ProvidesTheWorldsLineOfSightWhenTheWorldStarts) {
 TEST(ProximityModuleTest, SensesInTheWorldsStep) {
   ModuleWorld w;
   ProximitySensorData ray;
-  ray.range = 5;
+  ray.settings.Edit().range = 5;
   // Its +z along the world's +x.
   const Pose X_WS{{0, 0, 0.5}, Quat::FromAxisAngle({0, 1, 0}, M_PI / 2)};
   const ObjectId eye = AddSensor(&w.scene(), "eye", {}, X_WS, ray);

@@ -46,7 +46,7 @@ Pose Looking(const Vec3& p, double yaw) { return {p, LookAlong(yaw)}; }
 
 ProximitySensorData Ray(double range) {
   ProximitySensorData d;
-  d.range = range;
+  d.settings.Edit().range = range;
   return d;
 }
 
@@ -401,7 +401,7 @@ TEST_F(ProximityTest, SwarmMatchesBruteForceAndConcurrentSensingMatchesSerial) {
     EXPECT_EQ(serial[row].detected_object, id);
   }
   EXPECT_GT(detected, 50);
-  for (auto& r : proximity::MutableSensors(&scene_).rows) r = Ray(r.range);  // clear the readings
+  for (auto& r : proximity::MutableSensors(&scene_).rows) r = Ray(r.range());  // clear the readings
   std::vector<std::thread> threads;
   const int n = static_cast<int>(scene_.instances().size());
   for (int t = 0; t < 4; ++t)
@@ -524,8 +524,10 @@ TEST(EarlyOutTest, MatchesCastingEveryRayOnRandomScenes) {
       scene.AddShape("wheel", robots.back().body,
                      {{0, 0.07, -0.03}, Quat::FromAxisAngle({1, 0, 0}, M_PI / 2)},
                      Cylinder(0.03, 0.02));
-      if (i % 10 == 0) proximity::MutableSensor(&scene, robots.back().sensors[9]).range = 0;
-      if (i % 10 == 1) proximity::MutableSensor(&scene, robots.back().sensors[9]).range = -1;
+      if (i % 10 == 0)
+        proximity::MutableSensor(&scene, robots.back().sensors[9]).settings.Edit().range = 0;
+      if (i % 10 == 1)
+        proximity::MutableSensor(&scene, robots.back().sensors[9]).settings.Edit().range = -1;
     }
     ShapeData crate = Box(0.15, 0.15, 0.15);
     crate.dynamic = true;

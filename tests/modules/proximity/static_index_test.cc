@@ -52,7 +52,7 @@ void ExpectExactReadings(const std::vector<Vec3>& centres, double resolution) {
   for (const Vec3& c : centres)
     for (int i = 0; i < 400; ++i) {
       ProximitySensorData ray;
-      ray.range = 1.5;
+      ray.settings.Edit().range = 1.5;
       sensors.push_back(
           proximity::AddSensor(&scene, "s", {},
                                {c + Vec3{offset(rng), offset(rng), offset(rng) / 4},

@@ -52,8 +52,8 @@ ShapeData CubeMesh(double h) {
 
 ProximitySensorData Sensor(ProximityVolume volume, double range) {
   ProximitySensorData d;
-  d.volume = volume;
-  d.range = range;
+  d.settings.Edit().volume = volume;
+  d.settings.Edit().range = range;
   return d;
 }
 
@@ -98,7 +98,7 @@ class VolumeTest : public ::testing::Test {
 // along u = (sin 30, 0, cos 30), at 0.5 / (n . u) = 0.5 / cos 15.
 TEST_F(VolumeTest, TiltedPlaneInsideACone) {
   ProximitySensorData cone = Sensor(ProximityVolume::kCone, 2);
-  cone.more->angle = 30 * kDeg;
+  cone.settings.Edit().angle = 30 * kDeg;
   const ObjectId sensor = AddSensor(cone);
   const Vec3 n{std::sin(45 * kDeg), 0, std::cos(45 * kDeg)};
   const ObjectId wall =
@@ -108,13 +108,13 @@ TEST_F(VolumeTest, TiltedPlaneInsideACone) {
   const double want = 0.5 / std::cos(15 * kDeg);
   EXPECT_NEAR(r.distance, want, kTol);
   ExpectPoint(r.p_SD(), Vec3{std::sin(30 * kDeg), 0, std::cos(30 * kDeg)} * want);
-  ExpectPoint(r.more->normal, n * -1, 1e-12);
+  ExpectPoint(r.normal, n * -1, 1e-12);
   EXPECT_EQ(r.detected_object, wall);
   // A narrower cone sees it farther: 0.5 / cos 35 at 10 deg.
-  proximity::MutableSensors(scene_.get()).rows[0].more->angle = 10 * kDeg;
+  proximity::MutableSensors(scene_.get()).rows[0].settings.Edit().angle = 10 * kDeg;
   EXPECT_NEAR(Sense(sensor).distance, 0.5 / std::cos(35 * kDeg), kTol);
   // Facing it (n along the axis within the cone) the nearest point is its foot.
-  proximity::MutableSensors(scene_.get()).rows[0].more->angle = 50 * kDeg;
+  proximity::MutableSensors(scene_.get()).rows[0].settings.Edit().angle = 50 * kDeg;
   EXPECT_NEAR(Sense(sensor).distance, 0.5, kTol);
   ExpectPoint(Sense(sensor).p_SD(), n * 0.5);
 }
@@ -126,8 +126,8 @@ TEST_F(VolumeTest, TiltedPlaneInsideACone) {
 // the side; its nearest point lies on the side, inside the sphere.
 TEST_F(VolumeTest, SphereAtThePyramidsEdgeReadsTheNearestPointOfItsInsidePart) {
   ProximitySensorData pyramid = Sensor(ProximityVolume::kPyramid, 2);
-  pyramid.more->angle = 20 * kDeg;
-  pyramid.more->angle_y = 20 * kDeg;
+  pyramid.settings.Edit().angle = 20 * kDeg;
+  pyramid.settings.Edit().angle_y = 20 * kDeg;
   const ObjectId sensor = AddSensor(pyramid);
   const Vec3 centre{std::sin(25 * kDeg), 0, std::cos(25 * kDeg)};
   const ObjectId ball = AddShape(Sphere(0.2), {centre, {}});
@@ -140,11 +140,11 @@ TEST_F(VolumeTest, SphereAtThePyramidsEdgeReadsTheNearestPointOfItsInsidePart) {
   ExpectPoint(r.p_SD(), side * want);
   EXPECT_EQ(r.detected_object, ball);
   // The normal: the sphere's, at its surface point nearest the detected one.
-  ExpectPoint(r.more->normal, (side * want - centre).Normalized(), 1e-6);
+  ExpectPoint(r.normal, (side * want - centre).Normalized(), 1e-6);
   // Its own nearest point (0.8 m, at 25 deg) is outside: a ray would see nothing.
   EXPECT_GT(r.distance, 0.8 + 1e-3);
   // Wholly outside a 10 deg pyramid: nothing.
-  proximity::MutableSensors(scene_.get()).rows[0].more->angle = 10 * kDeg;
+  proximity::MutableSensors(scene_.get()).rows[0].settings.Edit().angle = 10 * kDeg;
   EXPECT_FALSE(Sense(sensor).detected);
 }
 
@@ -166,7 +166,7 @@ TEST_F(VolumeTest, DetectableFilterHidesShapes) {
 // ray e enters the sphere: t = e.c - sqrt((e.c)^2 - |c|^2 + r^2).
 TEST_F(VolumeTest, SphereAcrossThePyramidsEdgeReadsOnTheEdge) {
   ProximitySensorData pyramid = Sensor(ProximityVolume::kPyramid, 2);
-  pyramid.more->angle = pyramid.more->angle_y = 20 * kDeg;
+  pyramid.settings.Edit().angle = pyramid.settings.Edit().angle_y = 20 * kDeg;
   const ObjectId sensor = AddSensor(pyramid);
   const double t22 = std::tan(22 * kDeg), t20 = std::tan(20 * kDeg);
   const Vec3 c = Vec3{t22, t22, 1}.Normalized();
@@ -186,7 +186,7 @@ TEST_F(VolumeTest, SphereAcrossThePyramidsEdgeReadsOnTheEdge) {
 // faces) are farther.
 TEST_F(VolumeTest, MeshCorner) {
   ProximitySensorData cone = Sensor(ProximityVolume::kCone, 2);
-  cone.more->angle = 20 * kDeg;
+  cone.settings.Edit().angle = 20 * kDeg;
   const ObjectId sensor = AddSensor(cone);
   // Turn (-1, -1, -1)/sqrt 3 onto -z.
   const Vec3 from = Vec3{-1, -1, -1}.Normalized(), to{0, 0, -1};
@@ -198,12 +198,12 @@ TEST_F(VolumeTest, MeshCorner) {
   EXPECT_NEAR(r.distance, 1 - 0.1 * std::sqrt(3.0), kTol);
   ExpectPoint(r.p_SD(), {0, 0, 1 - 0.1 * std::sqrt(3.0)});
   EXPECT_EQ(r.detected_object, cube);
-  EXPECT_LT(r.more->normal.z, 0);  // a face seen from the sensor
-  proximity::MutableSensors(scene_.get()).rows[0].more->detect_front = false;
+  EXPECT_LT(r.normal.z, 0);  // a face seen from the sensor
+  proximity::MutableSensors(scene_.get()).rows[0].settings.Edit().detect_front = false;
   const ProximitySensorData& back = Sense(sensor);
   ASSERT_TRUE(back.detected);
   EXPECT_GT(back.distance, 1 - 0.1 * std::sqrt(3.0) + 0.01);
-  EXPECT_GT(back.more->normal.z, 0);  // facing away
+  EXPECT_GT(back.normal.z, 0);  // facing away
 }
 
 // The mesh (a surface) and a box (a solid) of the same cube read the same
@@ -212,19 +212,19 @@ TEST_F(VolumeTest, MeshCorner) {
 TEST_F(VolumeTest, MeshAndBoxOfTheSameCubeAgreeWhenCut) {
   // A wide cone sees the cube's own nearest point, at some angle a0.
   ProximitySensorData cone = Sensor(ProximityVolume::kCone, 3);
-  cone.more->angle = 40 * kDeg;
+  cone.settings.Edit().angle = 40 * kDeg;
   const ObjectId sensor = AddSensor(cone);
   const Pose X_WC{{0.3, 0.1, 1}, Quat::FromRollPitchYaw(0.05, 0.03, 0.02)};
   AddShape(Box(0.2, 0.2, 0.2), X_WC);
-  const Vec3 nearest = Sense(sensor).more->point;
+  const Vec3 nearest = Sense(sensor).point;
   const double a0 = std::atan2(std::hypot(nearest.x, nearest.y), nearest.z);
   // A cone 0.5 deg narrower cuts the cube: the reading is on its side, farther.
-  cone.more->angle = a0 - 0.5 * kDeg;
-  proximity::MutableSensors(scene_.get()).rows[0].more->angle = cone.more->angle;
+  cone.settings.Edit().angle = a0 - 0.5 * kDeg;
+  proximity::MutableSensors(scene_.get()).rows[0].settings.Edit().angle = cone.settings->angle;
   const ProximitySensorData box = Sense(sensor);
   ASSERT_TRUE(box.detected);
-  EXPECT_NEAR(std::atan2(std::hypot(box.more->point.x, box.more->point.y), box.more->point.z),
-              cone.more->angle, 1e-9);
+  EXPECT_NEAR(std::atan2(std::hypot(box.point.x, box.point.y), box.point.z), cone.settings->angle,
+              1e-9);
   EXPECT_GT(box.distance, nearest.Norm() + 1e-3);  // 0.92 -> 0.95
   Reset();
   AddSensor(cone);
@@ -243,12 +243,12 @@ TEST_F(VolumeTest, BlindZone) {
   const ObjectId sensor = AddSensor(cone);
   AddShape(Box(1, 1, 0.2), {{0, 0, 0.4}, {}});
   EXPECT_NEAR(Sense(sensor).distance, 0.3, kTol);
-  proximity::MutableSensors(scene_.get()).rows[0].more->blind_zone = 0.35;
+  proximity::MutableSensors(scene_.get()).rows[0].settings.Edit().blind_zone = 0.35;
   const ProximitySensorData& r = Sense(sensor);
   ASSERT_TRUE(r.detected);
   EXPECT_NEAR(r.distance, 0.35, kTol);
   ExpectPoint(r.p_SD(), {0, 0, 0.35});
-  proximity::MutableSensors(scene_.get()).rows[0].more->blind_zone = 0.6;
+  proximity::MutableSensors(scene_.get()).rows[0].settings.Edit().blind_zone = 0.6;
   EXPECT_FALSE(Sense(sensor).detected);
 }
 
@@ -261,15 +261,15 @@ TEST_F(VolumeTest, DetectionAngleCutOff) {
     SCOPED_TRACE(ToString(volume));
     Reset();
     ProximitySensorData s = Sensor(volume, 2);
-    s.more->angle = 5 * kDeg;
+    s.settings.Edit().angle = 5 * kDeg;
     const ObjectId sensor = AddSensor(s);
     AddShape(Box(4, 4, 0.01), {{0, 0, 1.005}, Quat::FromAxisAngle({0, 1, 0}, 60 * kDeg)});
     const ProximitySensorData& seen = Sense(sensor);
     ASSERT_TRUE(seen.detected);
-    EXPECT_NEAR(-seen.more->normal.z, 0.5, 1e-9);  // cos 60
-    proximity::MutableSensors(scene_.get()).rows[0].more->max_detection_angle = 45 * kDeg;
+    EXPECT_NEAR(-seen.normal.z, 0.5, 1e-9);  // cos 60
+    proximity::MutableSensors(scene_.get()).rows[0].settings.Edit().max_detection_angle = 45 * kDeg;
     EXPECT_FALSE(Sense(sensor).detected);
-    proximity::MutableSensors(scene_.get()).rows[0].more->max_detection_angle = 70 * kDeg;
+    proximity::MutableSensors(scene_.get()).rows[0].settings.Edit().max_detection_angle = 70 * kDeg;
     EXPECT_TRUE(Sense(sensor).detected);
   }
 }
@@ -279,7 +279,7 @@ TEST_F(VolumeTest, DetectionAngleCutOff) {
 // disc of half sector 70 deg but not 50 deg.
 TEST_F(VolumeTest, CylinderAndDisc) {
   ProximitySensorData cylinder = Sensor(ProximityVolume::kCylinder, 2);
-  cylinder.more->radius = 0.3;
+  cylinder.settings.Edit().radius = 0.3;
   const ObjectId c = AddSensor(cylinder);
   AddShape(Sphere(0.05), {{0.2, 0, 1}, {}});
   const ProximitySensorData r = Sense(c);
@@ -289,22 +289,22 @@ TEST_F(VolumeTest, CylinderAndDisc) {
   ExpectPoint(r.p_SD(), Vec3{0.2, 0, 1} * (1 - 0.05 / d));
   // Cut by the side x = 0.17 of a cylinder of radius 0.17: the detected
   // point is on the side.
-  proximity::MutableSensors(scene_.get()).rows[0].more->radius = 0.17;
+  proximity::MutableSensors(scene_.get()).rows[0].settings.Edit().radius = 0.17;
   const ProximitySensorData& cut = Sense(c);
   ASSERT_TRUE(cut.detected);
-  EXPECT_NEAR(std::hypot(cut.more->point.x, cut.more->point.y), 0.17, 1e-9);
+  EXPECT_NEAR(std::hypot(cut.point.x, cut.point.y), 0.17, 1e-9);
   EXPECT_GT(cut.distance, r.distance);
   // Wholly outside a cylinder of radius 0.1.
-  proximity::MutableSensors(scene_.get()).rows[0].more->radius = 0.1;
+  proximity::MutableSensors(scene_.get()).rows[0].settings.Edit().radius = 0.1;
   EXPECT_FALSE(Sense(c).detected);
 
   Reset();
   ProximitySensorData disc = Sensor(ProximityVolume::kDisc, 2);
-  disc.more->angle = 70 * kDeg;
+  disc.settings.Edit().angle = 70 * kDeg;
   const ObjectId s = AddSensor(disc);
   AddShape(Box(0.1, 0.1, 0.1), {{std::cos(60 * kDeg), std::sin(60 * kDeg), 0}, {}});
   EXPECT_TRUE(Sense(s).detected);
-  proximity::MutableSensors(scene_.get()).rows[0].more->angle = 50 * kDeg;
+  proximity::MutableSensors(scene_.get()).rows[0].settings.Edit().angle = 50 * kDeg;
   EXPECT_FALSE(Sense(s).detected);
 }
 
@@ -326,10 +326,10 @@ TEST_F(VolumeTest, BroadPhaseMissesNothing) {
   std::vector<ObjectId> sensors;
   for (int i = 0; i < 40; ++i) {
     ProximitySensorData s = Sensor(kinds[i % 4], 1.5);
-    s.more->angle = 25 * kDeg;
-    s.more->angle_y = 15 * kDeg;
-    s.more->radius = 0.15;
-    s.more->thickness = 0.2;
+    s.settings.Edit().angle = 25 * kDeg;
+    s.settings.Edit().angle_y = 15 * kDeg;
+    s.settings.Edit().radius = 0.15;
+    s.settings.Edit().thickness = 0.2;
     sensors.push_back(
         AddSensor(s, {{2 * u(random), 2 * u(random), 0.5 * u(random)},
                       Quat::FromRollPitchYaw(3 * u(random), 3 * u(random), 3 * u(random))}));
@@ -348,7 +348,7 @@ TEST_F(VolumeTest, BroadPhaseMissesNothing) {
       VolumeHit h;
       if (NearestInVolume(volume, placed, X_SW, best.distance, &h)) best = h, nearest = shape;
     }
-    ASSERT_EQ(r.detected, best.distance <= r.range);
+    ASSERT_EQ(r.detected, best.distance <= r.range());
     if (!r.detected) continue;
     ++detected;
     EXPECT_EQ(r.distance, best.distance);
@@ -369,13 +369,13 @@ TEST(VolumePropertyTest, ReadingIsInsideAndNoSampledPointIsNearer) {
     for (int trial = 0; trial < 40; ++trial) {
       SCOPED_TRACE(std::string(ToString(kind)) + " trial " + std::to_string(trial));
       ProximitySensorData sensor;
-      sensor.volume = kind;
-      sensor.range = 3;
-      sensor.more->angle = (20 + 10 * u(random)) * kDeg;
-      sensor.more->angle_y = (15 + 5 * u(random)) * kDeg;
-      sensor.more->radius = 0.2;
-      sensor.more->thickness = 0.1;
-      sensor.more->blind_zone = 0.2;
+      sensor.settings.Edit().volume = kind;
+      sensor.settings.Edit().range = 3;
+      sensor.settings.Edit().angle = (20 + 10 * u(random)) * kDeg;
+      sensor.settings.Edit().angle_y = (15 + 5 * u(random)) * kDeg;
+      sensor.settings.Edit().radius = 0.2;
+      sensor.settings.Edit().thickness = 0.1;
+      sensor.settings.Edit().blind_zone = 0.2;
       const Volume volume = MakeVolume(sensor);
       // A shape around 1 m ahead along the volume's axis, off it by up to 0.5 m.
       const Vec3 half{0.1 + 0.1 * std::abs(u(random)), 0.1 + 0.1 * std::abs(u(random)),

@@ -43,7 +43,7 @@ TEST(EnvironmentCutTest, SensorsAndDistancesFollowAReplacedMap) {
   body.size = {0.2, 0.2, 0.2};
   const ObjectId root = scene.AddShape("bot#0", {}, {{0, 0, 0.2}, {}}, body);
   ProximitySensorData ray;
-  ray.range = 3;
+  ray.settings.Edit().range = 3;
   const ObjectId eye = proximity::AddSensor(
       &scene, "eye", root, {{0, 0, 0}, Quat::FromAxisAngle({0, 1, 0}, M_PI / 2)}, ray);
   scene.MakeModelInstance(root, "bot", "bot#0");

@@ -120,11 +120,11 @@ TEST_F(ProximityVolumeLoaderTest, ScaleScalesLengthsNotAngles) {
   const Scene& scene = loaded.world->scene();
   const ProximitySensorData& s =
       proximity::Sensor(scene, scene.FindObject("./s", scene.instance(0).root));
-  EXPECT_EQ(s.volume, ProximityVolume::kCylinder);
-  EXPECT_DOUBLE_EQ(s.range, 1.0);
-  EXPECT_DOUBLE_EQ(s.more->radius, 0.04);
-  EXPECT_DOUBLE_EQ(s.more->blind_zone, 0.2);
-  EXPECT_NEAR(s.more->max_detection_angle, 60 * kDeg, 1e-15);
+  EXPECT_EQ(s.volume(), ProximityVolume::kCylinder);
+  EXPECT_DOUBLE_EQ(s.range(), 1.0);
+  EXPECT_DOUBLE_EQ(s.settings->radius, 0.04);
+  EXPECT_DOUBLE_EQ(s.settings->blind_zone, 0.2);
+  EXPECT_NEAR(s.settings->max_detection_angle, 60 * kDeg, 1e-15);
 }
 
 // The wall's face is 1 m ahead (x = 1); a cone of 30 deg sees it at 1 m on
@@ -167,9 +167,9 @@ TEST_F(ProximityVolumeLoaderTest, RandomizedRaysHashTheSameOnAnyThreadCount) {
   const Scene& scene = loaded.world->scene();
   ASSERT_EQ(proximity::Sensors(scene).rows.size(), 6u);
   for (const ProximitySensorData& s : proximity::Sensors(scene).rows) {
-    EXPECT_EQ(s.volume, ProximityVolume::kRandomizedRay);
-    EXPECT_EQ(s.more->ray_count, 8);
-    EXPECT_NEAR(s.more->angle, 40 * kDeg, 1e-15);
+    EXPECT_EQ(s.volume(), ProximityVolume::kRandomizedRay);
+    EXPECT_EQ(s.settings->ray_count, 8);
+    EXPECT_NEAR(s.settings->angle, 40 * kDeg, 1e-15);
   }
   std::vector<std::string> log;
   loaded.world->set_log_sink([&](std::string_view line) { log.emplace_back(line); });

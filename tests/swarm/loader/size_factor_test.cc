@@ -88,8 +88,8 @@ TEST_F(SizeFactorTest, ScaledFootbotHasScaledSensorsWheelsBodyAndMass) {
   for (int i : {0, 7}) {
     const std::string path = "./prox[" + std::to_string(i) + "]";
     const ObjectId s_small = scene.FindObject(path, small), s_big = scene.FindObject(path, big);
-    EXPECT_DOUBLE_EQ(proximity::Sensor(scene, s_big).range,
-                     2 * proximity::Sensor(scene, s_small).range);
+    EXPECT_DOUBLE_EQ(proximity::Sensor(scene, s_big).range(),
+                     2 * proximity::Sensor(scene, s_small).range());
     EXPECT_NEAR(scene.local_pose(s_big).p.Norm(), 2 * scene.local_pose(s_small).p.Norm(), 1e-12);
   }
   // Both stand on the ground: the scaled body's centre twice as high.
@@ -163,7 +163,7 @@ TEST_F(SizeFactorTest, RuntimeRescaleTakesEffectNextStep) {
   // Applied after the control phase: the script read 1, the scene now has 3.
   EXPECT_DOUBLE_EQ(scene.size_factor(root), 3);
   EXPECT_DOUBLE_EQ(scene.size_factor(eye), 3);
-  EXPECT_NEAR(proximity::Sensor(scene, eye).range, 0.6, 1e-12);
+  EXPECT_NEAR(proximity::Sensor(scene, eye).range(), 0.6, 1e-12);
   EXPECT_NEAR(scene.shape(root).size.x, 0.3, 1e-12);
   EXPECT_NEAR(scene.shape(root).mass, 27, 1e-9);
   EXPECT_NEAR(scene.local_pose(eye).p.x, 0.3, 1e-12);

@@ -161,9 +161,9 @@ TEST_F(ControlLoaderTest, PerCopyValuesReachEveryObjectValueThatUsesThem) {
     const Expected& e = expected[k];
     const ObjectId root = scene.instance(k).root;
     EXPECT_EQ(std::get<double>(*w.world->FindParameter(k, "r")), e.r);
-    EXPECT_EQ(proximity::Sensor(scene, scene.FindObject("./s", root)).range, e.r);
+    EXPECT_EQ(proximity::Sensor(scene, scene.FindObject("./s", root)).range(), e.r);
     EXPECT_EQ(scene.local_pose(scene.FindObject("./s", root)).p.x, e.size);
-    EXPECT_EQ(proximity::Sensor(scene, scene.FindObject("./ring[1]", root)).range, e.r / 2);
+    EXPECT_EQ(proximity::Sensor(scene, scene.FindObject("./ring[1]", root)).range(), e.r / 2);
     EXPECT_EQ(scene.shape(root).size.x, e.size);
     EXPECT_EQ(scene.shape(root).size.z, 2 * e.size);
     EXPECT_EQ(scene.shape(root).mass, e.mass);
@@ -185,7 +185,7 @@ TEST_F(ControlLoaderTest, PerCopyValuesReachEveryObjectValueThatUsesThem) {
   const LoadedWorld s = LoadWorld(dir_ / "world.yaml", set, builtin);
   for (int k = 0; k < 3; ++k) {
     const ObjectId root = s.world->scene().instance(k).root;
-    EXPECT_EQ(proximity::Sensor(s.world->scene(), s.world->scene().FindObject("./s", root)).range,
+    EXPECT_EQ(proximity::Sensor(s.world->scene(), s.world->scene().FindObject("./s", root)).range(),
               1.2)
         << k;
   }

@@ -176,7 +176,7 @@ TEST(WorldLoaderTest, FootbotGeometryFollowsTheConventions) {
     const double theta = 2 * M_PI * i / 24;
     ExpectNear(X_BS.p, {0.085 * std::cos(theta), 0.085 * std::sin(theta), -0.013});
     ExpectNear(X_BS.q.Rotate({0, 0, 1}), {std::cos(theta), std::sin(theta), 0});
-    EXPECT_DOUBLE_EQ(proximity::Sensor(scene, s).range, 0.1);
+    EXPECT_DOUBLE_EQ(proximity::Sensor(scene, s).range(), 0.1);
   }
 }
 

@@ -1,0 +1,84 @@
+// Settings apart from state (MuJoCo's mjModel beside mjData).
+//
+// An object type's row holds its per-copy state (a joint's position, a
+// sensor's reading) beside a Shared<Settings>: the constant part (ranges,
+// limits, angles, names of what it detects), shared by every copy made from
+// one model entry. Copying a row, as placing ten thousand robots does,
+// copies the state and one pointer; the settings exist once per model entry.
+// Edit() is copy on write: when a script, a scale or a per-copy --set changes
+// one copy's setting, that row gets its own settings first and the other
+// copies keep theirs.
+//
+// Phase code reads settings through operator-> (const). The state hash reads
+// state only. Thread safety: rows of different robots may Edit() at the same
+// time (the reference count is atomic); one row is edited by one thread.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <utility>
+
+namespace swarmsim {
+
+template <class S>
+class Shared {
+ public:
+  // The default settings (S{}), shared by every default row without an
+  // allocation.
+  Shared() noexcept = default;
+  explicit Shared(S settings) : block_(new Block{{1}, std::move(settings)}) {}
+  Shared(const Shared& other) noexcept : block_(other.block_) { Retain(); }
+  Shared(Shared&& other) noexcept : block_(std::exchange(other.block_, nullptr)) {}
+  Shared& operator=(const Shared& other) noexcept {
+    if (block_ != other.block_) {
+      Release();
+      block_ = other.block_;
+      Retain();
+    }
+    return *this;
+  }
+  Shared& operator=(Shared&& other) noexcept {
+    if (this != &other) {
+      Release();
+      block_ = std::exchange(other.block_, nullptr);
+    }
+    return *this;
+  }
+  ~Shared() { Release(); }
+
+  const S& operator*() const { return block_ != nullptr ? block_->settings : kDefault; }
+  const S* operator->() const { return &**this; }
+
+  // This row's own settings, to change: copied first if other rows share
+  // them (or if they are the shared defaults).
+  S& Edit() {
+    if (block_ == nullptr || block_->refs.load(std::memory_order_acquire) != 1) {
+      Block* own = new Block{{1}, **this};
+      Release();
+      block_ = own;
+    }
+    return block_->settings;
+  }
+
+  // Whether `other` refers to the same settings (a copy that no one edited).
+  bool SameAs(const Shared& other) const { return &**this == &*other; }
+
+ private:
+  struct Block {
+    std::atomic<uint32_t> refs;
+    S settings;
+  };
+  void Retain() noexcept {
+    if (block_ != nullptr) block_->refs.fetch_add(1, std::memory_order_relaxed);
+  }
+  void Release() noexcept {
+    if (block_ != nullptr && block_->refs.fetch_sub(1, std::memory_order_acq_rel) == 1)
+      delete block_;
+    block_ = nullptr;
+  }
+
+  static inline const S kDefault{};
+  Block* block_ = nullptr;
+};
+
+}  // namespace swarmsim
