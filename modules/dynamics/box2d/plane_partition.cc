@@ -49,10 +49,12 @@ void PartitionedPlaneWorld::Build(const Scene& scene) {
   staging->Build(scene);
   regions_.clear();
   borders_.clear();
-  states_[0].assign(scene.slot_count(), {});
-  states_[1].assign(scene.slot_count(), {});
   current_ = 0;
   const std::vector<PlaneBody>& bodies = staging->bodies();
+  state_of_slot_.assign(scene.slot_count(), 0);
+  for (uint32_t b = 0; b < bodies.size(); ++b) state_of_slot_[bodies[b].slot] = b;
+  states_[0].assign(bodies.size(), {});
+  states_[1].assign(bodies.size(), {});
   const int64_t body_total = static_cast<int64_t>(bodies.size());
   int64_t count = settings_.partitions;
   if (count <= 0)
@@ -112,7 +114,7 @@ void PartitionedPlaneWorld::ReadCommands(const Scene& scene) {
   for (auto& region : regions_) region->ReadCommands(scene);
   if (regions_.size() == 1) return;
   Migrate();
-  for (auto& region : regions_) region->PublishStates(states_[current_].data());
+  for (auto& region : regions_) region->PublishStates(states_[current_].data(), state_of_slot_.data());
   UpdateGhosts();
 }
 
@@ -166,9 +168,9 @@ void PartitionedPlaneWorld::Substep(double dt, double fraction) {
   auto step = [&](int64_t begin, int64_t end) {
     for (int64_t r = begin; r < end; ++r) {
       PlaneWorld& region = *regions_[r];
-      region.RefreshGhosts(in);
+      region.RefreshGhosts(in, state_of_slot_.data());
       region.Substep(dt, fraction);
-      region.PublishStates(out);
+      region.PublishStates(out, state_of_slot_.data());
     }
   };
   const int64_t count = static_cast<int64_t>(regions_.size());

@@ -58,8 +58,10 @@ class PartitionedPlaneWorld {
   std::vector<double> borders_;  // (regions - 1), ascending, Box2D units
   double max_radius_ = 0;        // largest body's bounding radius, Box2D units
   double duration_ = 0;          // s, of the current step
-  // Published body states by slot: substeps read one, write the other.
+  // Published body states, one per body (not per scene slot: a robot's
+  // sensors have none): substeps read one, write the other.
   std::array<std::vector<PlaneBodyState>, 2> states_;
+  std::vector<uint32_t> state_of_slot_;  // by scene slot: the body's row in states_
   int current_ = 0;
 };
 

@@ -192,10 +192,11 @@ class PlaneWorld {
   // Makes the ghosts exactly `wanted` (slot, owner body), sorted by slot:
   // keeps those already there, destroys the others, creates the new ones.
   void SetGhosts(const std::vector<std::pair<uint32_t, const b2Body*>>& wanted);
-  // Moves every ghost to its owner's published state (slot-indexed).
-  void RefreshGhosts(const PlaneBodyState* states);
-  // Publishes every body's state at states[slot].
-  void PublishStates(PlaneBodyState* states) const;
+  // Moves every ghost to its owner's published state,
+  // states[state_of_slot[slot]].
+  void RefreshGhosts(const PlaneBodyState* states, const uint32_t* state_of_slot);
+  // Publishes every body's state at states[state_of_slot[slot]].
+  void PublishStates(PlaneBodyState* states, const uint32_t* state_of_slot) const;
   int ghost_count() const { return static_cast<int>(ghosts_.size()); }
 
  private:

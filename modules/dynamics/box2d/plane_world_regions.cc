@@ -192,9 +192,9 @@ void PlaneWorld::SetGhosts(const std::vector<std::pair<uint32_t, const b2Body*>>
   ghosts_ = std::move(ghosts);
 }
 
-void PlaneWorld::RefreshGhosts(const PlaneBodyState* states) {
+void PlaneWorld::RefreshGhosts(const PlaneBodyState* states, const uint32_t* state_of_slot) {
   for (const PlaneGhost& ghost : ghosts_) {
-    const PlaneBodyState& state = states[ghost.slot];
+    const PlaneBodyState& state = states[state_of_slot[ghost.slot]];
     b2Body* body = ghost.body;
     const b2Vec2 p(state.x, state.y);
     if (body->GetPosition() != p || body->GetAngle() != state.angle)
@@ -205,10 +205,10 @@ void PlaneWorld::RefreshGhosts(const PlaneBodyState* states) {
   }
 }
 
-void PlaneWorld::PublishStates(PlaneBodyState* states) const {
+void PlaneWorld::PublishStates(PlaneBodyState* states, const uint32_t* state_of_slot) const {
   for (const PlaneBody& plane_body : bodies_) {
     const b2Body* body = plane_body.body;
-    PlaneBodyState& state = states[plane_body.slot];
+    PlaneBodyState& state = states[state_of_slot[plane_body.slot]];
     state.x = body->GetPosition().x;
     state.y = body->GetPosition().y;
     state.angle = body->GetAngle();
