@@ -29,9 +29,10 @@ enum class VisualKind : uint8_t {
   kCylinder,  // size: [radius, 0, height], axis along z
   kSphere,    // size: [radius, 0, 0]
   kCapsule,   // size: [radius, 0, height with the caps], axis along z
-  kMesh,  // `mesh` (scale applied); size: the extents of the box centred on the frame that holds it
+  kMesh,      // `mesh` (scale applied); size: extents of the box that holds it
   // A light (an LED): a sphere of radius size.x at the origin that glows in
-  // `color` while `on`, and is drawn dark while off. Cameras see it.
+  // `color` while `on` (a black one emits nothing), drawn dark otherwise.
+  // Rendered images (vision sensors too) show it.
   kLight,
   // A marker, not a body: a segment from the origin along +z, size.x m
   // long, drawn to `hit` m when something is detected there. The viewer
