@@ -124,6 +124,7 @@ TEST(GroundSensorTest, IsRecordedWithItsColourStepByStep) {
   recorder->Finish(2, "ok", "");
 
   record::RecordingPlayer player(dir.path());
+  ASSERT_TRUE(player.Next());  // step 0, with the scene in force
   // The robot's root (a type with no visual) is a frame; the body and the
   // sensor are listed as their types declare them.
   const nlohmann::json scene = nlohmann::json::parse(player.scene_json());
@@ -138,7 +139,7 @@ TEST(GroundSensorTest, IsRecordedWithItsColourStepByStep) {
   EXPECT_EQ(objects[2]["visual"], "cylinder");
   EXPECT_EQ(objects[2]["size"], nlohmann::json::parse("[0.1, 0, 0.002]"));
   // Its colour, r | g << 8 | b << 16 | on << 24, at each step.
-  std::vector<uint32_t> colours;
+  std::vector<uint32_t> colours{player.color_rgba(2)};
   while (player.Next()) colours.push_back(player.color_rgba(2));
   EXPECT_EQ(colours, (std::vector<uint32_t>{0x01000000, 0x010000ff, 0x0100ff00}));
   // An object of a type without a visual outside any robot is not recorded:
