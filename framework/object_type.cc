@@ -1,5 +1,5 @@
 // ObjectReader's optional parts: a reader that does not read nested values
-// (a test's fake) refuses them.
+// (a test's fake) refuses them; the names of visual kinds (visual.h).
 #include "framework/object_type.h"
 
 #include "framework/error.h"
@@ -27,5 +27,19 @@ std::vector<std::unique_ptr<ObjectReader>> ObjectReader::Elements(std::string_vi
 }
 
 void ObjectReader::FailHere(const std::string& message) const { throw Error(message); }
+
+const char* ToString(VisualKind kind) {
+  switch (kind) {
+    case VisualKind::kNone: return "none";
+    case VisualKind::kBox: return "box";
+    case VisualKind::kCylinder: return "cylinder";
+    case VisualKind::kSphere: return "sphere";
+    case VisualKind::kCapsule: return "capsule";
+    case VisualKind::kMesh: return "mesh";
+    case VisualKind::kLight: return "light";
+    case VisualKind::kRay: return "ray";
+  }
+  return "none";
+}
 
 }  // namespace swarmsim

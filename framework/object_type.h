@@ -2,7 +2,8 @@
 // scene object, in one table entry (ARGoS's registered entities; MuJoCo's
 // plugin declarations). Scene, the world-file loader, the state hash and the
 // Lua host go through these entries; no code outside them switches over
-// object types.
+// object types. What an object looks like (the recorder, the renderer and
+// the viewer) is its type's `visual` hook (framework/visual.h).
 //
 // The built-in types are declared in framework/types/ (one file each) and
 // listed in framework/types/core_types.cc; a module or plugin adds its own
@@ -24,6 +25,7 @@
 #include "framework/math.h"
 #include "framework/number_rule.h"
 #include "framework/object_rows.h"
+#include "framework/visual.h"
 
 struct lua_State;
 
@@ -157,6 +159,14 @@ struct ObjectTypeDescriptor {
   // The type's Lua API area: adds its sim.* functions to the table on top of
   // L's stack (framework/lua_api.h; sim.readProximitySensor, ...). Null: none.
   void (*register_lua)(lua_State* L) = nullptr;
+  // --- Visuals ---------------------------------------------------------------------
+  // What the object at `row` of the type looks like (framework/visual.h):
+  // the recorder, the renderer and the viewer draw the type from this alone.
+  // Fill *out (a default ObjectVisual) from the row and return; it runs for
+  // every object of the type at every recorded step and rendered frame,
+  // from several threads at once. Null (or kind kNone): not drawn, and
+  // recorded only as a robot's root frame.
+  void (*visual)(const Scene& scene, ObjectType type, uint32_t row, ObjectVisual* out) = nullptr;
   // --- Listing ---------------------------------------------------------------------
   // The name of a type this one is listed right after (world files' type
   // lists and their messages, and the order the state hash adds types in),

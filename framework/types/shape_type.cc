@@ -135,6 +135,26 @@ bool InertiaIsValid(const std::array<double, 6>& i) {
   return xx <= yy + zz + slack && yy <= xx + zz + slack && zz <= xx + yy + slack;
 }
 
+namespace {
+
+// Drawn as its geometry, in its colour (which scripts may change).
+void Visual(const Scene& scene, ObjectType type, uint32_t row, ObjectVisual* out) {
+  const ShapeData& s = scene.rows<ShapeData>(type).rows[row];
+  switch (s.kind) {
+    case ShapeKind::kBox: out->kind = VisualKind::kBox; break;
+    case ShapeKind::kCylinder: out->kind = VisualKind::kCylinder; break;
+    case ShapeKind::kSphere: out->kind = VisualKind::kSphere; break;
+    case ShapeKind::kCapsule: out->kind = VisualKind::kCapsule; break;
+    case ShapeKind::kMesh: out->kind = VisualKind::kMesh; break;
+  }
+  out->size = s.size;
+  out->color = s.color;
+  out->mesh = s.mesh.get();
+  out->mesh_colors = s.mesh_colors && s.mesh != nullptr && !s.mesh->colors().empty();
+}
+
+}  // namespace
+
 constinit const ObjectTypeDescriptor kShapeType{
     .name = "shape",
     .description = "a rigid body's geometry: box, cylinder, sphere, capsule or triangle mesh",
@@ -142,6 +162,7 @@ constinit const ObjectTypeDescriptor kShapeType{
     .scale_row = Scale,
     .keys = kKeys,
     .read = Read,
+    .visual = Visual,
 };
 
 }  // namespace swarmsim

@@ -1,6 +1,7 @@
 // The `led` object type's row: a coloured light on a robot (ARGoS's LED
-// equipped entity), seen by blob cameras (blob_camera.h) and drawn by the
-// renderer and the video's top-down view.
+// equipped entity), seen by blob cameras (blob_camera.h). The recorder, the
+// renderer and the viewer draw it through its type's visual (objects.cc: a
+// light, framework/visual.h), not through this row.
 //
 // Public: code outside modules/blobs finds the type by name and casts its
 // table (no link dependency on this module):

@@ -117,6 +117,15 @@ void HashCameras(const Scene& scene, ObjectType type, StateHasher* h) {
   }
 }
 
+// Drawn as a light: glowing in its colour while on (and not black).
+void LedVisual(const Scene& scene, ObjectType type, uint32_t row, ObjectVisual* out) {
+  const LedRow& led = scene.rows<LedRow>(type).rows[row];
+  out->kind = VisualKind::kLight;
+  out->size = {led.radius, 0, 0};
+  out->color = led.color;
+  out->on = led.on;
+}
+
 std::shared_ptr<const ObjectTypeDescriptor> LedType() {
   auto t = std::make_shared<ObjectTypeDescriptor>();
   t->name = kLedTypeName;
@@ -129,6 +138,7 @@ std::shared_ptr<const ObjectTypeDescriptor> LedType() {
   t->keys = kLedKeys;
   t->read = ReadLed;
   t->register_lua = RegisterBlobsApi;
+  t->visual = LedVisual;
   return t;
 }
 

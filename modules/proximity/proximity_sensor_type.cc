@@ -174,6 +174,16 @@ void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
                 "detect_front and detect_back are both false: the sensor would detect nothing");
 }
 
+// Drawn as its ray (a marker): its range long, to the detected point, red
+// while it detects something, else blue.
+void Visual(const Scene& scene, ObjectType type, uint32_t row, ObjectVisual* out) {
+  const ProximitySensorData& p = scene.rows<ProximitySensorData>(type).rows[row];
+  out->kind = VisualKind::kRay;
+  out->size = {p.range(), 0, 0};
+  out->hit = p.detected ? p.distance : -1;
+  out->color = p.detected ? Vec3{1, 0.2, 0.2} : Vec3{0.3, 0.8, 1};
+}
+
 constinit const ObjectTypeDescriptor kProximitySensorType{
     .name = proximity::kSensorTypeName,
     .description =
@@ -186,6 +196,7 @@ constinit const ObjectTypeDescriptor kProximitySensorType{
     .read = Read,
     .check = Check,
     .register_lua = proximity::RegisterProximityApi,
+    .visual = Visual,
     // Where it was when it was a built-in type: hashes and type lists stay.
     .listed_after = "joint",
 };

@@ -7,9 +7,10 @@
 #include "framework/environment.h"
 #include "framework/floor_layer.h"
 #include "framework/mesh.h"
+#include "framework/object_type.h"
 #include "framework/scene.h"
+#include "framework/visual.h"
 #include "framework/world.h"
-#include "modules/blobs/leds.h"
 #include "modules/rendering/objects.h"
 
 namespace swarmsim::rendering {
@@ -194,6 +195,28 @@ void Append(DrawList* list, uint32_t slot, const Primitive& prim, const Vec3& sc
   }
 }
 
+// Calls f(slot, visual) for every live object whose type declares a visual
+// (framework/visual.h), types in ObjectType order, each type's rows in order.
+template <typename F>
+void ForEachVisual(const Scene& scene, F&& f) {
+  const auto types = scene.types();
+  for (size_t k = 0; k < types.size(); ++k) {
+    const auto hook = types[k]->visual;
+    const ObjectType type = static_cast<ObjectType>(k);
+    const RowTable* rows = scene.rows(type);
+    if (hook == nullptr || rows == nullptr) continue;
+    for (uint32_t r = 0; r < rows->size(); ++r) {
+      const uint32_t slot = rows->owners[r];
+      if (!scene.alive_at(slot)) continue;
+      ObjectVisual v;
+      hook(scene, type, r, &v);
+      f(slot, v);
+    }
+  }
+}
+
+bool IsBlack(const Vec3& c) { return !(c.x > 0 || c.y > 0 || c.z > 0); }
+
 }  // namespace
 
 void BuildDrawList(const World& world, int segments, DrawList* list, double min_led_radius) {
@@ -206,34 +229,31 @@ void BuildDrawList(const World& world, int segments, DrawList* list, double min_
   list->lo = list->hi = Vec3{};
   list->has_bounds = false;
   const Primitives& prims = PrimitivesFor(segments);
-  // Shapes, in row order.
-  const auto shapes = scene.shapes();
-  const auto owners = scene.shape_owners();
-  for (size_t r = 0; r < shapes.size(); ++r) {
-    const ShapeData& s = shapes[r];
-    const uint32_t slot = owners[r];
-    if (!scene.alive_at(slot)) continue;
+  // Solids, as their types declare them (shapes' geometry), in row order.
+  ForEachVisual(scene, [&](uint32_t slot, const ObjectVisual& v) {
     const Pose& X = scene.world_pose_at(slot);
-    switch (s.kind) {
-      case ShapeKind::kBox: Append(list, slot, prims.box, s.size, X, s.color, false); break;
-      case ShapeKind::kCylinder:
-        Append(list, slot, prims.cylinder, {s.size.x, s.size.x, s.size.z}, X, s.color, false);
+    const Vec3& size = v.size;
+    switch (v.kind) {
+      case VisualKind::kBox: Append(list, slot, prims.box, size, X, v.color, false); break;
+      case VisualKind::kCylinder:
+        Append(list, slot, prims.cylinder, {size.x, size.x, size.z}, X, v.color, false);
         break;
-      case ShapeKind::kSphere:
-        Append(list, slot, prims.sphere, {s.size.x, s.size.x, s.size.x}, X, s.color, false);
+      case VisualKind::kSphere:
+        Append(list, slot, prims.sphere, {size.x, size.x, size.x}, X, v.color, false);
         break;
-      case ShapeKind::kCapsule:
-        Append(list, slot, Capsule(segments, s.size.x, s.size.z), {s.size.x, s.size.x, s.size.x}, X,
-               s.color, false);
+      case VisualKind::kCapsule:
+        Append(list, slot, Capsule(segments, size.x, size.z), {size.x, size.x, size.x}, X, v.color,
+               false);
         break;
-      case ShapeKind::kMesh:
-        if (s.mesh) {
-          const Primitive& mesh = MeshFor(s.mesh.get());
-          Append(list, slot, mesh, {1, 1, 1}, X, s.color, false, s.mesh_colors && !mesh.c.empty());
+      case VisualKind::kMesh:
+        if (v.mesh != nullptr) {
+          const Primitive& mesh = MeshFor(v.mesh);
+          Append(list, slot, mesh, {1, 1, 1}, X, v.color, false, v.mesh_colors && !mesh.c.empty());
         }
         break;
+      default: break;  // lights below; rays are markers, not drawn here
     }
-  }
+  });
   // The environment map's boxes.
   if (const EnvironmentMap* env = scene.environment()) {
     const Vec3 color{0.55, 0.5, 0.45};
@@ -241,19 +261,15 @@ void BuildDrawList(const World& world, int segments, DrawList* list, double min_
       Append(list, kNoSlot, prims.box, b.hi - b.lo, Pose{(b.lo + b.hi) * 0.5, Quat{}}, color,
              false);
   }
-  // LEDs: spheres in their colour, unlit (emissive) while on, dark when off.
-  ObjectType led;
-  if (scene.FindType(kLedTypeName, &led)) {
-    const auto& leds = static_cast<const Rows<LedRow>&>(*scene.rows(led));
-    for (size_t r = 0; r < leds.size(); ++r) {
-      const uint32_t slot = leds.owners[r];
-      if (!scene.alive_at(slot)) continue;
-      const LedRow& l = leds.rows[r];
-      const double radius = std::max(l.radius, min_led_radius);
-      Append(list, slot, prims.sphere, {radius, radius, radius}, scene.world_pose_at(slot),
-             l.lit() ? l.color : Vec3{0.15, 0.15, 0.15}, /*emissive=*/l.lit());
-    }
-  }
+  // Lights (LEDs): spheres in their colour, unlit (emissive) while on and
+  // not black, dark otherwise.
+  ForEachVisual(scene, [&](uint32_t slot, const ObjectVisual& v) {
+    if (v.kind != VisualKind::kLight) return;
+    const bool lit = v.on && !IsBlack(v.color);
+    const double radius = std::max(v.size.x, min_led_radius);
+    Append(list, slot, prims.sphere, {radius, radius, radius}, scene.world_pose_at(slot),
+           lit ? v.color : Vec3{0.15, 0.15, 0.15}, /*emissive=*/lit);
+  });
   // Lights.
   CollectLights(scene, &list->lights, &list->scene_has_lights);
   list->step = world.step_count();

@@ -1,6 +1,7 @@
 // What the renderer draws, as world-frame triangles with normals and
-// colours (no OpenGL here): one item per shape, LED, environment box and the
-// floor. Built from the scene each time a frame or a sense step needs it;
+// colours (no OpenGL here): one item per object whose type declares a solid
+// or a light visual (framework/visual.h: shapes, LEDs, ...), per environment
+// box, and the floor. Built from the scene each time a frame or a sense step needs it;
 // items keep the scene's slot order, so the same scene gives the same arrays.
 #pragma once
 
@@ -59,8 +60,8 @@ struct DrawList {
 };
 
 // Fills *list from `world`'s scene. `segments`: sides of a cylinder and
-// slices of a sphere; LEDs are drawn at least `min_led_radius` m big (an
-// overview keeps them visible).
+// slices of a sphere; lights (LEDs) are drawn at least `min_led_radius` m
+// big (an overview keeps them visible). Ray visuals are markers: not drawn.
 void BuildDrawList(const World& world, int segments, DrawList* list, double min_led_radius = 0);
 
 struct DrawOptions {

@@ -9,7 +9,7 @@ namespace swarmsim::record {
 inline constexpr const char* kRecordingFileName = "recording.swrec";
 inline constexpr const char* kFormatName = "swarmsim-recording";
 inline constexpr int kVersionMajor = 1;
-inline constexpr int kVersionMinor = 0;
+inline constexpr int kVersionMinor = 1;  // 1.1: objects as their types declare their visuals
 
 inline constexpr uint8_t kMagic[4] = {'S', 'W', 'R', 'C'};
 inline constexpr uint32_t kChunkHeaderSize = 24;

@@ -1,6 +1,7 @@
 #include "swarm/record/writer.h"
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -13,9 +14,8 @@
 #include "framework/floor_layer.h"
 #include "framework/object_type.h"
 #include "framework/scheduler.h"
+#include "framework/visual.h"
 #include "framework/world.h"
-#include "modules/blobs/leds.h"
-#include "modules/proximity/proximity_sensor.h"
 #include "swarm/record/chunk_writer.h"
 #include "swarm/record/format.h"
 #include "swarm/run/version.h"
@@ -25,14 +25,15 @@ namespace {
 
 using nlohmann::json;
 
-// What a recorded object is drawn as.
-enum class Kind : uint8_t { kFrame, kShape, kLed, kProximity };
+// The hook that says what an object of a type looks like (framework/visual.h).
+using VisualHook = void (*)(const Scene&, ObjectType, uint32_t, ObjectVisual*);
 
 struct Tracked {  // 16 bytes
   uint32_t slot;
-  int32_t root;  // slot of its robot's root (its pose is X_RO), -1: X_WO (roots, scene objects)
-  uint32_t row;  // in its type's table
-  Kind kind;
+  int32_t root;     // slot of its robot's root (its pose is X_RO), -1: X_WO (roots, scene objects)
+  uint32_t row;     // in its type's table
+  ObjectType type;  // its type, whose `visual` hook draws it
+  VisualKind kind;  // kNone: a robot's root frame, not drawn
 };
 
 int32_t QuantizePosition(double metres) {
@@ -108,10 +109,6 @@ struct RunRecorder::Impl {
   bool finished = false;
 
   World* world = nullptr;
-  ObjectType led_type{};
-  bool has_leds = false;
-  ObjectType sensor_type{};  // proximity sensors'
-  bool has_sensors = false;
   const FloorLayer* paint = nullptr;    // the world's floor layer (the paint layer), if any
   std::vector<uint8_t> paint_previous;  // rgb at the last step record (height x width x 3)
 
@@ -246,63 +243,46 @@ void RunRecorder::Impl::BuildScene() {
   robot_index.clear();
   plan.clear();
   robot_plan.clear();
-  const ObjectType shape_type = ObjectType::kShape;
-  const auto kind_of = [&](uint32_t slot, Kind* kind) {
-    const ObjectType t = scene.type_at(slot);
-    if (t == shape_type)
-      *kind = Kind::kShape;
-    else if (has_sensors && t == sensor_type)
-      *kind = Kind::kProximity;
-    else if (has_leds && t == led_type)
-      *kind = Kind::kLed;
-    else
-      return false;
-    return true;
-  };
-  const auto led_row = [&](uint32_t slot) -> const LedRow& {
-    return static_cast<const Rows<LedRow>&>(*scene.rows(led_type)).rows[scene.row_at(slot)];
+  // What the object at `slot` looks like, by its type's declaration; false: not drawn.
+  const auto visual_of = [&](uint32_t slot, ObjectVisual* visual) {
+    const VisualHook hook = scene.type_descriptor(scene.type_at(slot)).visual;
+    if (hook == nullptr) return false;
+    hook(scene, scene.type_at(slot), scene.row_at(slot), visual);
+    return visual->kind != VisualKind::kNone;
   };
   json meshes = json::array();
   std::unordered_map<const TriangleMesh*, size_t> mesh_of;
-  // One object's description; `parent` as the format says.
-  const auto describe = [&](const Tracked& t, const std::string& name, int64_t parent) {
+  // One object's description (FORMAT.md "Scene chunk"): its type's name
+  // and what its visual declares; `parent` as the format says.
+  const auto describe = [&](const Tracked& t, const ObjectVisual& v, const std::string& name,
+                            int64_t parent) {
     json o;
     o["name"] = name;
     o["parent"] = parent;
-    switch (t.kind) {
-      case Kind::kFrame: o["type"] = "frame"; break;
-      case Kind::kShape: {
-        const ShapeData& s = scene.shapes()[t.row];
-        o["type"] = "shape";
-        o["shape"] = ToString(s.kind);
-        o["size"] = {s.size.x, s.size.y, s.size.z};
-        o["color"] = ColorJson(s.color);
-        o["dynamic"] = s.dynamic;
-        if (s.kind == ShapeKind::kMesh && s.mesh != nullptr) {
-          // The asset once per scene chunk, shared by every shape (and copy) using it.
-          auto [it, added] = mesh_of.emplace(s.mesh.get(), meshes.size());
-          if (added) meshes.push_back(MeshJson(*s.mesh));
-          o["mesh"] = it->second;
-          o["mesh_colors"] = s.mesh_colors && !s.mesh->colors().empty();
-        }
-        break;
+    if (t.kind == VisualKind::kNone) {
+      o["type"] = "frame";
+      return o;
+    }
+    o["type"] = scene.type_name(t.type);
+    o["visual"] = ToString(v.kind);
+    if (IsSolid(v.kind)) {
+      o["shape"] = ToString(v.kind);
+      o["size"] = {v.size.x, v.size.y, v.size.z};
+      o["color"] = ColorJson(v.color);
+      if (v.kind == VisualKind::kMesh && v.mesh != nullptr) {
+        // The asset once per scene chunk, shared by every object (and copy) using it.
+        auto [it, added] = mesh_of.emplace(v.mesh, meshes.size());
+        if (added) meshes.push_back(MeshJson(*v.mesh));
+        o["mesh"] = it->second;
+        o["mesh_colors"] = v.mesh_colors;
       }
-      case Kind::kLed: {
-        const LedRow& led = led_row(t.slot);
-        o["type"] = "led";
-        o["radius"] = led.radius;
-        o["color"] = ColorJson(led.color);
-        o["on"] = led.on;
-        break;
-      }
-      case Kind::kProximity: {
-        const ProximitySensorData& p = scene.rows<ProximitySensorData>(sensor_type).rows[t.row];
-        o["type"] = "proximity_sensor";
-        o["range"] = p.range();
-        o["volume"] = ToString(p.volume());
-        if (p.volume() != ProximityVolume::kRay) o["angle"] = p.settings->angle;
-        break;
-      }
+    } else if (v.kind == VisualKind::kLight) {
+      o["radius"] = v.size.x;
+      o["color"] = ColorJson(v.color);
+      o["on"] = v.on;
+    } else if (v.kind == VisualKind::kRay) {
+      o["range"] = v.size.x;
+      o["color"] = ColorJson(v.color);
     }
     return o;
   };
@@ -334,16 +314,17 @@ void RunRecorder::Impl::BuildScene() {
         if (scene.type_at(parent) == ObjectType::kJoint) e.joint_row = scene.row_at(parent);
       }
       entry_of_slot[slot] = static_cast<int32_t>(plan.size());
-      Kind kind = Kind::kFrame;
-      const bool drawn = kind_of(slot, &kind);
+      ObjectVisual visual;
+      const bool drawn = visual_of(slot, &visual);
       const bool recorded = drawn || slot == root;
       if (recorded) e.id = static_cast<uint32_t>(tracked.size());
       plan.push_back(e);
       if (!recorded) continue;
       const Tracked t{slot, slot == root ? -1 : static_cast<int32_t>(root), scene.row_at(slot),
-                      kind};
+                      scene.type_at(slot), drawn ? visual.kind : VisualKind::kNone};
       const int64_t parent = slot == root ? -1 : parent_id(slot) - first;
-      list.push_back(describe(t, slot == root ? std::string() : scene.name_at(slot), parent));
+      list.push_back(
+          describe(t, visual, slot == root ? std::string() : scene.name_at(slot), parent));
       id_of_slot[slot] = static_cast<uint32_t>(tracked.size());
       tracked.push_back(t);
     }
@@ -365,20 +346,21 @@ void RunRecorder::Impl::BuildScene() {
     robot_plan.emplace_back(plan_begin, static_cast<uint32_t>(plan.size()));
   }
   for (uint32_t slot = 0; slot < scene.slot_count(); ++slot) {
-    Kind kind = Kind::kFrame;
-    if (!scene.alive_at(slot) || scene.instance_of_at(slot) >= 0 || !kind_of(slot, &kind)) continue;
-    const Tracked t{slot, -1, scene.row_at(slot), kind};
-    json o = describe(t, scene.name_at(slot), parent_id(slot));
+    ObjectVisual visual;
+    if (!scene.alive_at(slot) || scene.instance_of_at(slot) >= 0 || !visual_of(slot, &visual))
+      continue;
+    const Tracked t{slot, -1, scene.row_at(slot), scene.type_at(slot), visual.kind};
+    json o = describe(t, visual, scene.name_at(slot), parent_id(slot));
     o["id"] = tracked.size();
     objects.push_back(std::move(o));
     id_of_slot[slot] = static_cast<uint32_t>(tracked.size());
     tracked.push_back(t);
   }
   SceneLists lists;
+  // Every drawn object's colour; rays' lengths too.
   for (uint32_t id = 0; id < tracked.size(); ++id) {
-    if (tracked[id].kind == Kind::kShape || tracked[id].kind == Kind::kLed)
-      lists.color_ids.push_back(id);
-    if (tracked[id].kind == Kind::kProximity) lists.proximity_ids.push_back(id);
+    if (tracked[id].kind != VisualKind::kNone) lists.color_ids.push_back(id);
+    if (tracked[id].kind == VisualKind::kRay) lists.proximity_ids.push_back(id);
   }
   const size_t n = tracked.size();
   lists.object_count = n;
@@ -397,20 +379,17 @@ void RunRecorder::Impl::BuildScene() {
   file->AddScene(static_cast<uint32_t>(world->step_count()), j.dump(), std::move(lists));
 }
 
-// This step's poses, colours and readings, robots in parallel. A robot
+// This step's poses, and colours and ray lengths as the objects' types
+// declare them (their `visual` hooks), robots in parallel. A robot
 // object's X_RO is made from the local poses down its branch, and only
 // where something on the branch moved (a joint, a local pose that changed):
 // the 24 sensors of a ring are not quantised again every step.
 void RunRecorder::Impl::Capture() {
   const Scene& scene = world->scene();
   const auto joints = scene.joints();
-  const auto shapes = scene.shapes();
-  const std::span<const ProximitySensorData> sensors =
-      has_sensors
-          ? std::span<const ProximitySensorData>(scene.rows<ProximitySensorData>(sensor_type).rows)
-          : std::span<const ProximitySensorData>();
-  const Rows<LedRow>* leds =
-      has_leds ? &static_cast<const Rows<LedRow>&>(*scene.rows(led_type)) : nullptr;
+  // Each type's hook, by ObjectType value.
+  std::array<VisualHook, kMaxObjectTypes> hooks{};
+  for (size_t k = 0; k < scene.types().size(); ++k) hooks[k] = scene.types()[k]->visual;
   const bool all = capture_all;
   // `entry`: its plan entry (robots' objects), or -1 (scene objects).
   const auto capture = [&](uint32_t id, int64_t entry) {
@@ -419,23 +398,16 @@ void RunRecorder::Impl::Capture() {
       pose[id] = Quantize(scene.world_pose_at(t.slot));
     else if (moved[entry])
       pose[id] = Quantize(relative[entry]);
-    switch (t.kind) {
-      case Kind::kFrame: break;
-      case Kind::kShape: color[id] = PackColor(shapes[t.row].color, true); break;
-      case Kind::kLed: {
-        const LedRow& led = leds->rows[t.row];
-        color[id] = PackColor(led.color, led.on);
-        break;
-      }
-      case Kind::kProximity: {
-        const ProximitySensorData& p = sensors[t.row];
-        uint16_t r = kNoDetection;
-        if (p.detected && p.range() > 0)
-          r = static_cast<uint16_t>(
-              std::lround(std::clamp(p.distance / p.range(), 0.0, 1.0) * 65534));
-        reading[id] = r;
-        break;
-      }
+    if (t.kind == VisualKind::kNone) return;
+    ObjectVisual v;
+    hooks[static_cast<size_t>(t.type)](scene, t.type, t.row, &v);
+    color[id] = PackColor(v.color, v.on);
+    if (t.kind == VisualKind::kRay) {
+      const double length = v.size.x;
+      uint16_t r = kNoDetection;
+      if (v.hit >= 0 && length > 0)
+        r = static_cast<uint16_t>(std::lround(std::clamp(v.hit / length, 0.0, 1.0) * 65534));
+      reading[id] = r;
     }
   };
   world->scheduler().ParallelFor(
@@ -524,8 +496,6 @@ RunRecorder::~RunRecorder() = default;
 void RunRecorder::Start(World* world) {
   Impl& r = *impl_;
   r.world = world;
-  r.has_leds = world->scene().FindType(kLedTypeName, &r.led_type);
-  r.has_sensors = proximity::FindSensorType(world->scene(), &r.sensor_type);
   r.paint = world->floor_layer();
   for (const std::string& name : r.settings.metric_names) r.MetricId(name);
   r.file->AddJson(static_cast<uint8_t>(ChunkKind::kHeader), 0, r.Header().dump());

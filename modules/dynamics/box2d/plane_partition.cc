@@ -114,7 +114,8 @@ void PartitionedPlaneWorld::ReadCommands(const Scene& scene) {
   for (auto& region : regions_) region->ReadCommands(scene);
   if (regions_.size() == 1) return;
   Migrate();
-  for (auto& region : regions_) region->PublishStates(states_[current_].data(), state_of_slot_.data());
+  for (auto& region : regions_)
+    region->PublishStates(states_[current_].data(), state_of_slot_.data());
   UpdateGhosts();
 }
 

@@ -44,7 +44,18 @@ function inflate(stored, rawSize, offset) {
   return raw;
 }
 
-// The scene chunk's objects as flat arrays by recording id.
+// What an object of a format 1.0 scene is drawn as (1.1 says it: `visual`).
+function visualOf1_0(o) {
+  if (o.type === 'shape') return o.shape || 'cylinder';
+  if (o.type === 'led') return 'light';
+  if (o.type === 'proximity_sensor') return 'ray';
+  return 'none';
+}
+
+// The scene chunk's objects as flat arrays by recording id; each object's
+// `visual` (box, cylinder, sphere, capsule, mesh, light, ray or none) as
+// FORMAT.md 1.1 has it, also for a 1.0 scene. `declaredColors`: rays carry
+// their colour in the step records (1.1).
 function expandScene(json) {
   const count = json.object_count;
   const objects = new Array(count);
@@ -64,9 +75,14 @@ function expandScene(json) {
   for (const o of json.objects || []) objects[o.id] = { ...o, robot: -1, templateObject: -1 };
   for (let id = 0; id < count; ++id)
     if (!objects[id]) objects[id] = { id, type: 'frame', name: '', parent: -1, robot: -1 };
+  let declaredColors = false;
+  for (const o of objects) {
+    if (o.visual !== undefined) declaredColors = true;
+    else o.visual = visualOf1_0(o);
+  }
   const robots = json.robots.map((r) => ({ ...r }));
   const robotByIndex = new Map(robots.map((r) => [r.index, r]));
-  return { count, objects, robotOf, rootOf, robots, robotByIndex };
+  return { count, objects, robotOf, rootOf, robots, robotByIndex, declaredColors };
 }
 
 // Where each section of a step record starts (FORMAT.md "Step records").

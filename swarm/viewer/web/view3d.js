@@ -1,6 +1,7 @@
-// The 3D view (three.js): the floor, the paint layer, every recorded shape
-// and LED as instances (one InstancedMesh per kind and size), proximity
-// rays, trails; camera with orbit/pan; picking robots.
+// The 3D view (three.js): the floor, the paint layer, every recorded object
+// as its type declares it (FORMAT.md: `visual`): solids and lights as
+// instances (one InstancedMesh per kind and size), rays as line segments;
+// trails; camera with orbit/pan; picking robots.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import { NO_DETECTION } from './recording.js';
@@ -12,7 +13,7 @@ import { NO_DETECTION } from './recording.js';
 function geometryOf(o, many) {
   const [a, b, c] = o.size || [0.05, 0.05, 0.05];
   const round = many ? 8 : 24;
-  switch (o.shape) {
+  switch (o.visual) {
     case 'box': case 'mesh': return new THREE.BoxGeometry(Math.max(a, 1e-4), Math.max(b, 1e-4), Math.max(c, 1e-4));
     case 'sphere': return new THREE.SphereGeometry(Math.max(a, 1e-4), round, round * 3 / 4);
     case 'capsule': return new THREE.CapsuleGeometry(Math.max(a, 1e-4), Math.max(c - 2 * a, 0), 4, round).rotateX(Math.PI / 2);
@@ -20,6 +21,8 @@ function geometryOf(o, many) {
       return new THREE.CylinderGeometry(Math.max(a, 1e-4), Math.max(a, 1e-4), Math.max(c, 1e-4), round).rotateX(Math.PI / 2);
   }
 }
+
+const SOLIDS = new Set(['box', 'cylinder', 'sphere', 'capsule', 'mesh']);
 
 // Above this many instances of a kind, the cheaper geometry.
 const MANY = 1000;
@@ -109,20 +112,22 @@ export class View3D {
       this.world.add(m);
     }
 
-    // Shapes and LEDs, instanced by kind and size. A swarm of thousands is
-    // drawn as its robots' bodies (root shapes) and LEDs only.
+    // Solids and lights, instanced by kind and size. A swarm of thousands is
+    // drawn as its robots' bodies (root solids) and lights only.
     const groups = new Map();
     const sensors = [];
     this.bodiesOnly = this.large;
+    this.rayColors = scene.declaredColors;
     for (const o of scene.objects) {
-      if (o.type === 'proximity_sensor') { sensors.push(o.id); continue; }
+      if (o.visual === 'ray') { sensors.push(o.id); continue; }
+      const solid = SOLIDS.has(o.visual);
       let key;
-      if (o.type === 'shape' && this.bodiesOnly && o.robot >= 0 && o.templateObject !== 0) continue;
-      if (o.type === 'shape') key = `s|${o.shape}|${(o.size || []).join(',')}`;
-      else if (o.type === 'led') key = `l|${o.radius}`;
+      if (solid && this.bodiesOnly && o.robot >= 0 && o.templateObject !== 0) continue;
+      if (solid) key = `s|${o.visual}|${(o.size || []).join(',')}`;
+      else if (o.visual === 'light') key = `l|${o.radius}`;
       else continue;
       let g = groups.get(key);
-      if (!g) groups.set(key, g = { key, led: o.type === 'led', sample: o, ids: [] });
+      if (!g) groups.set(key, g = { key, led: o.visual === 'light', sample: o, ids: [] });
       g.ids.push(o.id);
     }
     // The objects whose world pose is needed: drawn ones and robot roots
@@ -187,7 +192,7 @@ export class View3D {
   pointsOf(g) {
     const o = g.sample, n = g.ids.length;
     const [a, b] = o.size || [0.05, 0.05];
-    const diameter = g.led ? 2 * (o.radius || 0.01) : o.shape === 'box' || o.shape === 'mesh' ? Math.hypot(a, b) : 2 * a;
+    const diameter = g.led ? 2 * (o.radius || 0.01) : o.visual === 'box' || o.visual === 'mesh' ? Math.hypot(a, b) : 2 * a;
     if (!View3D.disc) {
       const canvas = document.createElement('canvas');
       canvas.width = canvas.height = 64;
@@ -312,6 +317,7 @@ export class View3D {
 
   updateRays() {
     const objects = this.sceneInfo.objects, P = this.worldPos, Q = this.worldQuat, prox = this.state.prox;
+    const rgba = this.state.rgba, srgb = (v) => (v <= 0.04045 ? v / 12.92 : Math.pow((v + 0.055) / 1.055, 2.4));
     const pos = this.rays.geometry.attributes.position.array, col = this.rays.geometry.attributes.color.array;
     for (let j = 0; j < this.sensorIds.length; ++j) {
       const id = this.sensorIds[j], range = objects[id].range || 0;
@@ -322,8 +328,15 @@ export class View3D {
       const dx = 2 * (x * z + y * w), dy = 2 * (y * z - x * w), dz = 1 - 2 * (x * x + y * y);
       pos.set([P[3 * id], P[3 * id + 1], P[3 * id + 2],
         P[3 * id] + dx * length, P[3 * id + 1] + dy * length, P[3 * id + 2] + dz * length], 6 * j);
-      const hit = reading !== NO_DETECTION;
-      col.set(hit ? [1, 0.2, 0.2, 1, 0.2, 0.2] : [0.3, 0.8, 1, 0.3, 0.8, 1], 6 * j);
+      if (this.rayColors) {
+        // Its colour as its type declares it (format 1.1), linear as three works.
+        const r = srgb(rgba[4 * id] / 255), g = srgb(rgba[4 * id + 1] / 255), b = srgb(rgba[4 * id + 2] / 255);
+        col.set([r, g, b, r, g, b], 6 * j);
+      } else {
+        // Format 1.0: red while it detects something, else blue.
+        const hit = reading !== NO_DETECTION;
+        col.set(hit ? [1, 0.2, 0.2, 1, 0.2, 0.2] : [0.3, 0.8, 1, 0.3, 0.8, 1], 6 * j);
+      }
     }
     this.rays.geometry.attributes.position.needsUpdate = true;
     this.rays.geometry.attributes.color.needsUpdate = true;

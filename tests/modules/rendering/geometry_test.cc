@@ -1,5 +1,6 @@
 // What the renderer draws (modules/rendering/geometry.cc): one item of
-// world-frame triangles per shape and LED, in row order, with unit normals
+// world-frame triangles per shape and LED (per object whose type declares a
+// solid or light visual), in row order, with unit normals
 // facing out, the shape's colour, a bounding sphere that holds them, LEDs
 // drawn unlit and at least a given size, and the scene's bounds.
 #include "modules/rendering/geometry.h"
@@ -9,6 +10,7 @@
 #include <cmath>
 #include <vector>
 
+#include "framework/object_type.h"
 #include "modules/blobs/leds.h"
 #include "tests/modules/module_world.h"
 
@@ -124,6 +126,53 @@ TEST(RenderGeometryTest, LedsAreUnlitAndAtLeastTheSizeAskedFor) {
   BuildDrawList(w.world(), 12, &off);
   const DrawItem* dark = ItemOf(off, w.scene().SlotOf(id));
   EXPECT_TRUE(dark == nullptr || !dark->emissive);
+}
+
+// A test type that is drawn as its row says: what the renderer knows of a
+// type is its visual declaration.
+struct LookRow {
+  VisualKind kind = VisualKind::kLight;
+};
+constinit const ObjectTypeDescriptor kLookType{
+    .name = "look",
+    .description = "a test type drawn as its row says",
+    .make_rows = [](const ObjectTypeDescriptor&) -> std::unique_ptr<RowTable> {
+      return std::make_unique<Rows<LookRow>>();
+    },
+    .visual =
+        [](const Scene& scene, ObjectType type, uint32_t row, ObjectVisual* out) {
+          out->kind = scene.rows<LookRow>(type).rows[row].kind;
+          out->size = {0.5, 0.5, 0.5};
+          out->color = {0, 1, 0};
+        },
+};
+
+TEST(RenderGeometryTest, ATypeIsDrawnAsItsVisualDeclaresItAndRaysAreNot) {
+  ModuleRegistry registry;
+  RegisterBuiltinModules(&registry);
+  registry.RegisterObjectType(std::shared_ptr<const ObjectTypeDescriptor>(
+      std::shared_ptr<const ObjectTypeDescriptor>(), &kLookType));
+  World world(WorldSettings{}, registry);
+  Scene& scene = world.scene();
+  ObjectType look{};
+  ASSERT_TRUE(scene.FindType("look", &look));
+  LookRow light, box, ray;
+  box.kind = VisualKind::kBox;
+  ray.kind = VisualKind::kRay;
+  const ObjectId l = scene.AddObject(look, "light", {}, {{1, 0, 0}, {}}, &light);
+  const ObjectId b = scene.AddObject(look, "box", {}, {{-1, 0, 0}, {}}, &box);
+  const ObjectId r = scene.AddObject(look, "ray", {}, {}, &ray);
+  DrawList list;
+  BuildDrawList(world, 8, &list);
+  const DrawItem* lit = ItemOf(list, scene.SlotOf(l));
+  ASSERT_NE(lit, nullptr);
+  EXPECT_TRUE(lit->emissive);
+  EXPECT_EQ(list.rgb[3 * lit->first + 1], 255);
+  const DrawItem* solid = ItemOf(list, scene.SlotOf(b));
+  ASSERT_NE(solid, nullptr);
+  EXPECT_FALSE(solid->emissive);
+  EXPECT_EQ(solid->count, 36u);  // a box: 12 triangles
+  EXPECT_EQ(ItemOf(list, scene.SlotOf(r)), nullptr);
 }
 
 }  // namespace

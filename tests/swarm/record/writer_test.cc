@@ -14,6 +14,7 @@
 
 #include "framework/error.h"
 #include "framework/floor_layer.h"
+#include "framework/object_type.h"
 #include "framework/registry.h"
 #include "framework/world.h"
 #include "modules/blobs/leds.h"
@@ -308,6 +309,79 @@ TEST(RecordingTest, RobotsCopiedAndRemovedAtRunTimeGetANewScene) {
                  "step " + std::to_string(step) + " id " + std::to_string(id));
   }
   EXPECT_EQ(player.step(), 30);
+  fs::remove_all(out);
+}
+
+// A test type that declares a ray visual: its length and colour are its
+// row's, which the test changes between steps.
+struct BeamRow {
+  double length = 2;
+  double hit = -1;
+  Vec3 color{0, 0, 1};
+};
+constinit const ObjectTypeDescriptor kBeamType{
+    .name = "beam",
+    .description = "a test marker",
+    .make_rows = [](const ObjectTypeDescriptor&) -> std::unique_ptr<RowTable> {
+      return std::make_unique<Rows<BeamRow>>();
+    },
+    .visual =
+        [](const Scene& scene, ObjectType type, uint32_t row, ObjectVisual* out) {
+          const BeamRow& b = scene.rows<BeamRow>(type).rows[row];
+          out->kind = VisualKind::kRay;
+          out->size = {b.length, 0, 0};
+          out->hit = b.hit;
+          out->color = b.color;
+        },
+};
+
+TEST(RecordingTest, ATypeIsRecordedAsItsVisualDeclaresIt) {
+  const fs::path out = TempDir("declared");
+  ModuleRegistry registry;
+  RegisterBuiltinModules(&registry);
+  registry.RegisterObjectType(std::shared_ptr<const ObjectTypeDescriptor>(
+      std::shared_ptr<const ObjectTypeDescriptor>(), &kBeamType));
+  WorldSettings ws;
+  ws.physics = "kinematic";
+  World world(ws, registry);
+  world.set_log_sink([](std::string_view) {});
+  Scene& scene = world.scene();
+  ObjectType beam{};
+  ASSERT_TRUE(scene.FindType("beam", &beam));
+  // A robot whose root (a dummy: no visual) holds a beam; a dummy outside
+  // any robot (not recorded).
+  const ObjectId root = scene.AddDummy("bot", {}, {});
+  scene.MakeModelInstance(root, "bot", "bot#0");
+  const ObjectId b = scene.AddObject(beam, "beam", root, {}, nullptr);
+  scene.AddDummy("lone", {}, {});
+  RecordSettings settings;
+  settings.out_dir = out;
+  RunRecorder* recorder = AddRecorder(&world, settings);
+  world.Start();
+  world.Step();
+  BeamRow& row = scene.row<BeamRow>(beam, b, "beam");
+  row.hit = 0.5;  // a quarter of its length
+  row.color = {1, 0, 0};
+  world.Step();
+  recorder->Finish(2, "ok", "");
+
+  RecordingPlayer player(out);
+  EXPECT_EQ(player.info().version_minor, kVersionMinor);
+  ASSERT_TRUE(player.Next());
+  const nlohmann::json j = nlohmann::json::parse(player.scene_json());
+  const nlohmann::json& objects = j["templates"][0]["objects"];
+  ASSERT_EQ(objects.size(), 2u);
+  EXPECT_EQ(objects[0]["type"], "frame");
+  EXPECT_EQ(objects[1]["type"], "beam");
+  EXPECT_EQ(objects[1]["visual"], "ray");
+  EXPECT_EQ(objects[1]["range"], 2);
+  EXPECT_EQ(j["objects"].size(), 0u);
+  std::vector<std::pair<uint16_t, uint32_t>> steps{{player.reading(1), player.color_rgba(1)}};
+  while (player.Next()) steps.emplace_back(player.reading(1), player.color_rgba(1));
+  const uint16_t quarter = static_cast<uint16_t>(std::lround(0.25 * 65534));
+  EXPECT_EQ(steps,
+            (std::vector<std::pair<uint16_t, uint32_t>>{
+                {kNoDetection, 0x01ff0000}, {kNoDetection, 0x01ff0000}, {quarter, 0x010000ff}}));
   fs::remove_all(out);
 }
 

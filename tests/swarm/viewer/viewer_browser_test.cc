@@ -93,6 +93,55 @@ TEST_F(ViewerBrowserTest, ServedPageDrawsTheRobotsWhereTheRecordingSays) {
   EXPECT_EQ(browser.ConsoleErrors(), std::vector<std::string>{});
 }
 
+// What the view draws, counted: objects drawn as solids, as lights, and rays.
+json DrawnCounts(Browser* browser) {
+  return browser->Run(
+      "const v = swarmsimViewer.view, count = (led) => v.groups.filter((g) => g.userData.led === "
+      "led).reduce((n, g) => n + g.userData.ids.length, 0);"
+      "return {solids: count(false), lights: count(true), rays: v.sensorIds.length};");
+}
+
+// A recording of format 1.1 lists its objects as their types declare their
+// visuals; one of format 1.0 (tests/data/recordings) by their types: both
+// are drawn.
+TEST_F(ViewerBrowserTest, DrawsTheObjectsOfFormat1_1And1_0Recordings) {
+  {
+    ViewServer server(run_->string(), (*run_ / "server_visuals.log").string());
+    Browser browser;
+    browser.Open(server.Address());
+    ASSERT_EQ(browser.WaitForViewer(), "");
+    // The two movers' bodies and the arena's four walls.
+    EXPECT_EQ(DrawnCounts(&browser), json::parse(R"({"solids": 6, "lights": 0, "rays": 0})"));
+    EXPECT_EQ(browser.ConsoleErrors(), std::vector<std::string>{});
+  }
+  const fs::path data = fs::path(SWARMSIM_SOURCE_DIR) / "tests/data/recordings";
+  {
+    // 9 robots with an LED each.
+    ViewServer server((data / "leds").string(), (*run_ / "server_leds.log").string());
+    Browser browser;
+    browser.Open(server.Address());
+    ASSERT_EQ(browser.WaitForViewer(), "");
+    const json counts = DrawnCounts(&browser);
+    EXPECT_EQ(counts["lights"], 9) << counts;
+    EXPECT_GE(counts["solids"], 9) << counts;
+    EXPECT_EQ(browser.ConsoleErrors(), std::vector<std::string>{});
+  }
+  {
+    // 10 robots with 24 proximity rays each, drawn red or blue by their readings.
+    ViewServer server((data / "diffusion").string(), (*run_ / "server_rays.log").string());
+    Browser browser;
+    browser.Open(server.Address());
+    ASSERT_EQ(browser.WaitForViewer(), "");
+    EXPECT_EQ(DrawnCounts(&browser)["rays"], 240);
+    browser.Run("swarmsimViewer.view.setShow('rays', true);");
+    EXPECT_EQ(browser.Run("const c = swarmsimViewer.view.rays.geometry.attributes.color.array;"
+                          "return [...c].every((v) => [1, 0.2, 0.3, 0.8].some((w) => "
+                          "Math.abs(v - w) < 1e-6));"),
+              true);
+    EXPECT_EQ(browser.ConsoleErrors(), std::vector<std::string>{});
+  }
+}
+
 TEST_F(ViewerBrowserTest, ClickingARobotShowsItsName) {
   ViewServer server(run_->string(), (*run_ / "server.log").string());
   Browser browser;
