@@ -117,7 +117,8 @@ const char* Scene::type_name(ObjectType type) const {
 
 // --- Slots ----------------------------------------------------------------------
 
-uint32_t Scene::AllocateSlot(std::string name, ObjectId parent, const Pose& X_PO, ObjectType type) {
+uint32_t Scene::AllocateSlot(std::string_view name, ObjectId parent, const Pose& X_PO,
+                             ObjectType type) {
   int32_t parent_slot = -1;
   if (!parent.IsNull()) parent_slot = static_cast<int32_t>(SlotOf(parent, "parent object"));
   uint32_t slot;
@@ -144,7 +145,7 @@ uint32_t Scene::AllocateSlot(std::string name, ObjectId parent, const Pose& X_PO
     generation_.push_back(0);
     alive_.push_back(0);
     model_root_.push_back(0);
-    name_.emplace_back();
+    name_.push_back(0);
     script_.push_back(-1);
     linked_dummy_.push_back(-1);
     custom_data_.emplace_back();
@@ -158,7 +159,7 @@ uint32_t Scene::AllocateSlot(std::string name, ObjectId parent, const Pose& X_PO
   simulated_[slot] = 0;
   alive_[slot] = 1;
   model_root_[slot] = 0;
-  name_[slot] = std::move(name);
+  name_[slot] = names_.Intern(name);
   script_[slot] = -1;
   linked_dummy_[slot] = -1;
   DropCustomData(slot);
@@ -187,8 +188,7 @@ void Scene::FreeSlot(uint32_t slot) {
   alive_[slot] = 0;
   DropCustomData(slot);
   ++generation_[slot];
-  name_[slot].clear();
-  name_[slot].shrink_to_fit();
+  names_.Release(name_[slot]);
   free_slots_.push_back(slot);
   --object_count_;
 }
@@ -287,8 +287,8 @@ void Scene::SetParent(ObjectId id, ObjectId new_parent, bool keep_world_pose) {
     parent_slot = static_cast<int32_t>(SlotOf(new_parent, "parent object"));
     for (int32_t a = parent_slot; a >= 0; a = parent_[a])
       if (a == static_cast<int32_t>(slot))
-        throw Error("cannot make '" + name_[slot] + "' a child of its own descendant '" +
-                    name_[parent_slot] + "'");
+        throw Error("cannot make '" + name_at(slot) + "' a child of its own descendant '" +
+                    name_at(parent_slot) + "'");
   }
   const Pose X_WO = X_WO_[slot];
   UnlinkChild(slot);
@@ -313,7 +313,12 @@ std::vector<ObjectId> Scene::children(ObjectId id) const {
   return out;
 }
 
-void Scene::set_name(ObjectId id, std::string name) { name_[SlotOf(id)] = std::move(name); }
+void Scene::set_name(ObjectId id, std::string name) {
+  const uint32_t slot = SlotOf(id);
+  const uint32_t old = name_[slot];
+  name_[slot] = names_.Intern(name);
+  names_.Release(old);
+}
 
 // --- Validity -----------------------------------------------------------------------
 
@@ -585,7 +590,7 @@ std::string Scene::PathOf(ObjectId id) const {
   for (int32_t s = static_cast<int32_t>(SlotOf(id)); s >= 0; s = parent_[s])
     chain.push_back(static_cast<uint32_t>(s));
   std::string path;
-  for (auto it = chain.rbegin(); it != chain.rend(); ++it) path += "/" + name_[*it];
+  for (auto it = chain.rbegin(); it != chain.rend(); ++it) path += "/" + name_at(*it);
   return path;
 }
 
@@ -676,7 +681,7 @@ ObjectId Scene::FindObject(std::string_view path, ObjectId from) const {
     current = -1;
     const int want = e.index < 0 ? 0 : e.index;
     for (uint32_t c : candidates) {
-      if (name_[c] != e.name) continue;
+      if (name_at(c) != e.name) continue;
       if (seen++ == want) {
         current = static_cast<int32_t>(c);
         break;
@@ -713,7 +718,7 @@ std::string Scene::ExplainMissingPath(std::string_view path, ObjectId from) cons
     int seen = 0;
     int32_t current = -1;
     for (uint32_t c : candidates) {
-      if (name_[c] != e.name) continue;
+      if (name_at(c) != e.name) continue;
       if (seen++ == std::max(e.index, 0)) {
         current = static_cast<int32_t>(c);
         break;
@@ -734,7 +739,7 @@ std::string Scene::ExplainMissingPath(std::string_view path, ObjectId from) cons
              (seen == 1 ? "" : ".." + name + "[" + std::to_string(seen - 1) + "]");
     // A misspelt name: the path with the nearest name of the objects it could reach.
     std::vector<std::string> names;
-    for (uint32_t c : candidates) names.push_back(name_[c]);
+    for (uint32_t c : candidates) names.push_back(name_at(c));
     std::sort(names.begin(), names.end());
     names.erase(std::unique(names.begin(), names.end()), names.end());
     if (const std::string* nearest = NearestName(e.name, names)) {

@@ -27,6 +27,7 @@
 #include "framework/handle.h"
 #include "framework/math.h"
 #include "framework/mesh.h"
+#include "framework/name_pool.h"
 #include "framework/object_rows.h"
 
 namespace swarmsim {
@@ -267,8 +268,8 @@ class Scene {
   ObjectId parent(ObjectId id) const;
   std::vector<ObjectId> children(ObjectId id) const;
   int32_t parent_at(uint32_t slot) const { return parent_[slot]; }
-  const std::string& name(ObjectId id) const { return name_[SlotOf(id)]; }
-  const std::string& name_at(uint32_t slot) const { return name_[slot]; }
+  const std::string& name(ObjectId id) const { return names_[name_[SlotOf(id)]]; }
+  const std::string& name_at(uint32_t slot) const { return names_[name_[slot]]; }
   void set_name(ObjectId id, std::string name);
   ObjectType type(ObjectId id) const { return type_[SlotOf(id)]; }
   ObjectType type_at(uint32_t slot) const { return type_[slot]; }
@@ -417,7 +418,7 @@ class Scene {
   uint64_t environment_version() const { return environment_version_; }
 
  private:
-  uint32_t AllocateSlot(std::string name, ObjectId parent, const Pose& X_PO, ObjectType type);
+  uint32_t AllocateSlot(std::string_view name, ObjectId parent, const Pose& X_PO, ObjectType type);
   void FreeSlot(uint32_t slot);
   void LinkChild(uint32_t parent, uint32_t child);
   void UnlinkChild(uint32_t child);
@@ -455,7 +456,8 @@ class Scene {
   std::vector<uint32_t> generation_;
   std::vector<uint8_t> alive_;
   std::vector<uint8_t> model_root_;
-  std::vector<std::string> name_;
+  std::vector<uint32_t> name_;  // the name's id in names_ (slots)
+  NamePool names_;
   std::vector<int32_t> script_;        // index into scripts_ or -1
   std::vector<int32_t> linked_dummy_;  // slot or -1
   // Custom data per slot, allocated only for objects that have some.

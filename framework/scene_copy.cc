@@ -14,12 +14,13 @@ namespace swarmsim {
 
 uint32_t Scene::CopyObject(uint32_t src, int32_t new_parent) {
   const ObjectId parent = new_parent >= 0 ? IdAt(static_cast<uint32_t>(new_parent)) : ObjectId{};
-  // Copy the name and pose first: AllocateSlot may grow (and move) the arrays.
-  std::string name = name_[src];
+  // Copy the pose first: AllocateSlot may grow (and move) the arrays (the
+  // name's string stays where it is).
+  const std::string& name = name_at(src);
   const Pose X_PO = X_PO_[src];
   // The copy's row from the source's, through the type's copy rule.
   const ObjectType type = type_[src];
-  const uint32_t slot = AllocateSlot(std::move(name), parent, X_PO, type);
+  const uint32_t slot = AllocateSlot(name, parent, X_PO, type);
   if (RowTable* table = tables_[static_cast<size_t>(type)].get())
     row_[slot] = table->AppendCopy(row_[src], slot, types_[static_cast<size_t>(type)]->copy_row);
   v_WO_[slot] = v_WO_[src];
@@ -91,7 +92,7 @@ ObjectId Scene::DuplicateSubtree(ObjectId root, ObjectId new_parent) {
     }
   }
   if (run != nullptr && run->limit() > 0 && run->taken() + charged > run->limit())
-    throw Error("copying '" + name_[root_slot] + "': its custom data blocks (" +
+    throw Error("copying '" + name_at(root_slot) + "': its custom data blocks (" +
                 std::to_string(charged >> 20) + " MiB) would take the run's scripts past " +
                 std::to_string(run->limit() >> 20) + " MiB (simulation.run_script_memory_mb)");
   // Pre-order guarantees a parent is copied before its children.
@@ -134,7 +135,7 @@ ObjectId Scene::DuplicateSubtree(ObjectId root, ObjectId new_parent) {
 void Scene::ScaleSubtree(ObjectId root, double s) {
   const uint32_t root_slot = SlotOf(root);
   if (!std::isfinite(s) || !(s > 0))
-    throw Error("cannot scale '" + name_[root_slot] + "' by " + std::to_string(s) +
+    throw Error("cannot scale '" + name_at(root_slot) + "' by " + std::to_string(s) +
                 ": the factor must be a finite number above 0");
   if (s == 1) return;
   std::vector<uint32_t> sub;
