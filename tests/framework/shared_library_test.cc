@@ -1,7 +1,8 @@
 // Opening libraries at run time (framework/shared_library.h): why a library
 // could not be opened, where swarmsim's own lazily opened modules are looked
 // for, and that the program maps none of the heavy libraries they hold
-// until something uses them (libav for videos, OMPL for planning).
+// until something uses them (libav for videos, OMPL for planning, assimp
+// for mesh files).
 #include "framework/shared_library.h"
 
 #include <gtest/gtest.h>
@@ -74,8 +75,9 @@ TEST(SharedLibraryTest, AModuleThatCannotBeLoadedIsAnErrorNamingEachPathAndWhy) 
 }
 
 // The libraries swarmsim opens only when a run needs them.
-constexpr const char* kLazyLibraries[] = {"libavcodec",        "libavformat", "libswscale",
-                                          "libswarmsim_libav", "libompl",     "libswarmsim_ompl"};
+constexpr const char* kLazyLibraries[] = {
+    "libavcodec", "libavformat",      "libswscale", "libswarmsim_libav",
+    "libompl",    "libswarmsim_ompl", "libassimp",  "libswarmsim_assimp"};
 
 TEST(SharedLibraryTest, TheProgramNeedsNoneOfItsLazyLibrariesToStart) {
   const testing::CommandResult r = testing::RunCommand("ldd " + std::string(SWARMSIM_BINARY));
