@@ -2,7 +2,8 @@
 // could not be opened, where swarmsim's own lazily opened modules are looked
 // for, and that the program maps none of the heavy libraries they hold
 // until something uses them (libav for videos, OMPL for planning, assimp
-// for mesh files).
+// for mesh files, cpp-httplib and the OpenSSL it is built with for the
+// viewer's server).
 #include "framework/shared_library.h"
 
 #include <gtest/gtest.h>
@@ -76,8 +77,9 @@ TEST(SharedLibraryTest, AModuleThatCannotBeLoadedIsAnErrorNamingEachPathAndWhy) 
 
 // The libraries swarmsim opens only when a run needs them.
 constexpr const char* kLazyLibraries[] = {
-    "libavcodec", "libavformat",      "libswscale", "libswarmsim_libav",
-    "libompl",    "libswarmsim_ompl", "libassimp",  "libswarmsim_assimp"};
+    "libavcodec",     "libavformat",      "libswscale", "libswarmsim_libav",
+    "libompl",        "libswarmsim_ompl", "libassimp",  "libswarmsim_assimp",
+    "libcpp-httplib", "libssl",           "libcrypto",  "libswarmsim_http"};
 
 TEST(SharedLibraryTest, TheProgramNeedsNoneOfItsLazyLibrariesToStart) {
   const testing::CommandResult r = testing::RunCommand("ldd " + std::string(SWARMSIM_BINARY));
