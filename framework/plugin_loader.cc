@@ -1,7 +1,5 @@
 #include "framework/plugin_loader.h"
 
-#include <dlfcn.h>
-
 #include <cstdio>
 #include <filesystem>
 
@@ -11,6 +9,7 @@
 #include "framework/plugin_controllers.h"
 #include "framework/plugin_object_type.h"
 #include "framework/registry.h"
+#include "framework/shared_library.h"
 #include "framework/vision_filter.h"
 
 namespace swarmsim {
@@ -181,15 +180,15 @@ void SetInfo(void* impl, const char* name, const char* version, const char* desc
 void LoadPlugin(const std::string& path, ModuleRegistry* registry) {
   // A bare name would be searched in the system's library path: say "./x.so".
   const std::string name = path.find('/') == std::string::npos ? "./" + path : path;
-  void* library = dlopen(name.c_str(), RTLD_NOW | RTLD_LOCAL);
-  if (library == nullptr) {
-    const char* message = dlerror();
-    throw Error("cannot load plugin '" + path + "': " + (message ? message : "unknown error"));
-  }
+  std::string why;
+  void* library = OpenSharedLibrary(name, &why);
+  if (library == nullptr) throw Error("cannot load plugin '" + path + "': " + why);
   using VersionFunction = int (*)();
   using RegisterFunction = int (*)(const SwarmsimRegistrar*);
-  auto version = reinterpret_cast<VersionFunction>(dlsym(library, "swarmsim_plugin_abi_version"));
-  auto do_register = reinterpret_cast<RegisterFunction>(dlsym(library, "swarmsim_plugin_register"));
+  auto version =
+      reinterpret_cast<VersionFunction>(FindSymbol(library, "swarmsim_plugin_abi_version"));
+  auto do_register =
+      reinterpret_cast<RegisterFunction>(FindSymbol(library, "swarmsim_plugin_register"));
   if (version == nullptr || do_register == nullptr)
     throw Error("plugin '" + path + "' is not a swarmsim plugin: it does not export " +
                 (version == nullptr ? "swarmsim_plugin_abi_version" : "swarmsim_plugin_register") +

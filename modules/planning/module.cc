@@ -141,7 +141,9 @@ void PlanningModule::Actuate(World* world) {
       job.obstacle_slots =
           geometry.ShapesOf(scene, EntitySlots(scene, e.path, scene.IdAt(owner), what));
   }
-  // The plans, one task per worker at a time (a plan is long).
+  // The plans, one task per worker at a time (a plan is long), on OMPL's
+  // module, opened here the first time (a missing one is an error here).
+  LoadPlanner();
   world->scheduler().ParallelFor(
       0, static_cast<int64_t>(jobs.size()), 1, [&](int64_t begin, int64_t end) {
         for (int64_t k = begin; k < end; ++k) {

@@ -153,7 +153,6 @@ std::shared_ptr<const ObjectTypeDescriptor> TaskType() {
 }  // namespace
 
 void Register(ModuleRegistry* registry) {
-  QuietOmpl();
   registry->RegisterModule(
       {{"calculation", kModuleName, "1.0",
         "path planning on OMPL 1.5 (planning_task type): RRT-Connect (se2, se3), RRT (dubins, "

@@ -1,5 +1,5 @@
-#include "modules/planning/planner.h"
-
+// The planner on OMPL, inside the OMPL module (ompl_module.h): Plan
+// (planner.h) behind plan.cc.
 #include <ompl/base/PlannerTerminationCondition.h>
 #include <ompl/base/ProblemDefinition.h>
 #include <ompl/base/SpaceInformation.h>
@@ -19,6 +19,7 @@
 #include <memory>
 
 #include "framework/random.h"
+#include "modules/planning/ompl_module.h"
 
 namespace swarmsim::planning {
 
@@ -392,36 +393,7 @@ bool InBounds(const PlanRequest& r, const Pose& X) {
   return IsPlanar(r.space) ? xy : xy && X.p.z >= r.lo.z && X.p.z <= r.hi.z;
 }
 
-}  // namespace
-
-bool ParseSpace(const std::string& text, Space* space) {
-  static constexpr std::pair<const char*, Space> kNames[] = {{"se2", Space::kSe2},
-                                                             {"se3", Space::kSe3},
-                                                             {"dubins", Space::kDubins},
-                                                             {"reeds_shepp", Space::kReedsShepp}};
-  for (const auto& [name, value] : kNames)
-    if (text == name) {
-      *space = value;
-      return true;
-    }
-  return false;
-}
-
-const char* SpaceName(Space space) {
-  switch (space) {
-    case Space::kSe2: return "se2";
-    case Space::kSe3: return "se3";
-    case Space::kDubins: return "dubins";
-    case Space::kReedsShepp: return "reeds_shepp";
-  }
-  return "?";
-}
-
-void QuietOmpl() { ompl::msg::setLogLevel(ompl::msg::LOG_NONE); }
-
-PlanResult Plan(const PlanRequest& request, const ValidityFn& valid) {
-  static const bool quiet = (QuietOmpl(), true);
-  (void)quiet;
+PlanResult PlanWithOmpl(const PlanRequest& request, const ValidityFn& valid) {
   PlanResult result;
   result.status = PlanStatus::kFailed;
   const auto fail = [&](const char* reason) {
@@ -459,4 +431,16 @@ PlanResult Plan(const PlanRequest& request, const ValidityFn& valid) {
   return fail("timeout");
 }
 
+}  // namespace
 }  // namespace swarmsim::planning
+
+// The module's table (ompl_module.h); OMPL's console is silenced when the
+// module is first asked for it, before any plan.
+extern "C" __attribute__((visibility("default"))) const void* swarmsim_ompl_module() {
+  static const swarmsim::planning::OmplModule module = [] {
+    ompl::msg::setLogLevel(ompl::msg::LOG_NONE);
+    return swarmsim::planning::OmplModule{swarmsim::planning::kOmplModuleVersion,
+                                          swarmsim::planning::PlanWithOmpl};
+  }();
+  return &module;
+}

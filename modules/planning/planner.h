@@ -1,4 +1,5 @@
-// The planner (internal to modules/planning; OMPL types stay in planner.cc):
+// The planner (internal to modules/planning; OMPL types stay in planner.cc,
+// built as a module of its own that Plan opens on first use: ompl_module.h):
 // one request -> one plan, deterministic. Holonomic spaces (se2, se3) use
 // RRT-Connect, car-like ones (dubins, reeds_shepp) RRT with a 5 % goal bias.
 //
@@ -57,9 +58,13 @@ struct PlanResult {
 // Is the robot frame at X_WR free of collision? Called from the planning thread only.
 using ValidityFn = std::function<bool(const Pose& X_WR)>;
 
+// Opens the OMPL module on first use; throws swarmsim::Error naming the
+// paths tried when it cannot be loaded.
 PlanResult Plan(const PlanRequest& request, const ValidityFn& valid);
 
-// Silences OMPL's console messages (process-wide; call before planning).
-void QuietOmpl();
+// Opens the OMPL module now if it is not open (Plan does on first use):
+// a caller about to plan on worker threads hears a missing module on its
+// own. Throws swarmsim::Error naming the paths tried.
+void LoadPlanner();
 
 }  // namespace swarmsim::planning

@@ -6,7 +6,6 @@
 
 #include <GL/gl.h>
 #include <GL/osmesa.h>
-#include <dlfcn.h>
 
 #include <algorithm>
 #include <cmath>
@@ -16,6 +15,7 @@
 #include <string>
 
 #include "framework/error.h"
+#include "framework/shared_library.h"
 #include "modules/rendering/geometry.h"
 
 namespace swarmsim::rendering {
@@ -53,17 +53,17 @@ const Gl& Library() {
     setenv("LP_NUM_THREADS", "0", /*overwrite=*/0);
     const char* name = std::getenv("SWARMSIM_OSMESA_LIBRARY");  // tests name a missing one
     const std::string file = name != nullptr && *name != '\0' ? name : "libOSMesa.so.8";
-    void* lib = dlopen(file.c_str(), RTLD_NOW | RTLD_LOCAL);
+    std::string why;
+    void* lib = OpenSharedLibrary(file, &why);
     if (lib == nullptr) {
-      const char* why = dlerror();
       g.error = "rendering needs Mesa's off-screen OpenGL, " + file +
                 " (Debian package libosmesa6; tools/setup.sh installs it), and it could not be "
                 "loaded: " +
-                (why != nullptr ? why : "unknown error");
+                why;
       return g;
     }
     const auto sym = [&](const char* symbol) {
-      void* p = dlsym(lib, symbol);
+      void* p = FindSymbol(lib, symbol);
       if (p == nullptr && g.error.empty())
         g.error = file + " lacks " + symbol + ": not a usable OSMesa library";
       return p;

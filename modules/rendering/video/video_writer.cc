@@ -1,4 +1,6 @@
-#include "modules/rendering/video/video_writer.h"
+// The H.264 writer inside the libav module (libav_module.h): the encoder
+// behind VideoWriter (video_writer.h).
+#include "modules/rendering/video/libav_module.h"
 
 extern "C" {
 #include <libavcodec/avcodec.h>
@@ -9,8 +11,10 @@ extern "C" {
 
 #include <algorithm>
 #include <cmath>
-
-#include "framework/error.h"
+#include <exception>
+#include <memory>
+#include <stdexcept>
+#include <string>
 
 namespace swarmsim::video {
 
@@ -48,156 +52,165 @@ void ToYuv420(const Image& image, uint8_t* const plane[], const int stride[]) {
   }
 }
 
-}  // namespace
+class LibavEncoder final : public FrameEncoder {
+ public:
+  // Throws std::runtime_error naming the file.
+  LibavEncoder(const std::string& path, const VideoSettings& settings);
+  ~LibavEncoder() override;
 
-struct VideoWriter::Impl {
-  std::string name;  // the file, for messages
-  VideoSettings settings;
-  AVFormatContext* format = nullptr;
-  AVCodecContext* codec = nullptr;
-  AVStream* stream = nullptr;
-  AVFrame* frame = nullptr;
-  AVPacket* packet = nullptr;
-  int64_t frames = 0;
-  bool finished = false;
+  std::string Write(const Image& image) override;
+  std::string Finish() override;
+  int64_t frames() const override { return frames_; }
 
-  ~Impl() {
-    av_packet_free(&packet);
-    av_frame_free(&frame);
-    avcodec_free_context(&codec);
-    if (format != nullptr) {
-      if (format->pb != nullptr) avio_closep(&format->pb);
-      avformat_free_context(format);
-    }
-  }
-
+ private:
   [[noreturn]] void Fail(const std::string& what, int code) const {
-    throw Error("video '" + name + "': " + what + ": " + AvError(code));
+    throw std::runtime_error("video '" + name_ + "': " + what + ": " + AvError(code));
   }
-
   // Sends `f` (null: the end) to the encoder and writes what comes out.
-  void Encode(const AVFrame* f) {
-    int rc = avcodec_send_frame(codec, f);
-    if (rc < 0) Fail("the H.264 encoder failed", rc);
-    for (;;) {
-      rc = avcodec_receive_packet(codec, packet);
-      if (rc == AVERROR(EAGAIN) || rc == AVERROR_EOF) return;
-      if (rc < 0) Fail("the H.264 encoder failed", rc);
-      av_packet_rescale_ts(packet, codec->time_base, stream->time_base);
-      packet->stream_index = stream->index;
-      rc = av_interleaved_write_frame(format, packet);  // takes the packet's data
-      if (rc < 0) Fail("cannot write", rc);
-    }
-  }
+  void Encode(const AVFrame* f);
+
+  std::string name_;  // the file, for messages
+  VideoSettings settings_;
+  AVFormatContext* format_ = nullptr;
+  AVCodecContext* codec_ = nullptr;
+  AVStream* stream_ = nullptr;
+  AVFrame* frame_ = nullptr;
+  AVPacket* packet_ = nullptr;
+  int64_t frames_ = 0;
+  bool finished_ = false;
 };
 
-VideoWriter::VideoWriter(const std::filesystem::path& path, const VideoSettings& settings)
-    : impl_(std::make_unique<Impl>()) {
-  Impl& v = *impl_;
-  v.name = path.string();
-  v.settings = settings;
-  if (settings.width <= 0 || settings.height <= 0 || settings.width % 2 != 0 ||
-      settings.height % 2 != 0)
-    throw Error("video '" + v.name + "': " + std::to_string(settings.width) + "x" +
-                std::to_string(settings.height) + " is not a size H.264 takes (even, > 0)");
-  if (!(settings.fps > 0)) throw Error("video '" + v.name + "': the frame rate must be > 0");
+LibavEncoder::~LibavEncoder() {
+  av_packet_free(&packet_);
+  av_frame_free(&frame_);
+  avcodec_free_context(&codec_);
+  if (format_ != nullptr) {
+    if (format_->pb != nullptr) avio_closep(&format_->pb);
+    avformat_free_context(format_);
+  }
+}
+
+void LibavEncoder::Encode(const AVFrame* f) {
+  int rc = avcodec_send_frame(codec_, f);
+  if (rc < 0) Fail("the H.264 encoder failed", rc);
+  for (;;) {
+    rc = avcodec_receive_packet(codec_, packet_);
+    if (rc == AVERROR(EAGAIN) || rc == AVERROR_EOF) return;
+    if (rc < 0) Fail("the H.264 encoder failed", rc);
+    av_packet_rescale_ts(packet_, codec_->time_base, stream_->time_base);
+    packet_->stream_index = stream_->index;
+    rc = av_interleaved_write_frame(format_, packet_);  // takes the packet's data
+    if (rc < 0) Fail("cannot write", rc);
+  }
+}
+
+LibavEncoder::LibavEncoder(const std::string& path, const VideoSettings& settings)
+    : name_(path), settings_(settings) {
   av_log_set_level(AV_LOG_ERROR);  // no banner or per-file statistics on stderr
 
-  int rc = avformat_alloc_output_context2(&v.format, nullptr, "mp4", v.name.c_str());
-  if (rc < 0 || v.format == nullptr) v.Fail("cannot make an MP4 muxer", rc);
+  int rc = avformat_alloc_output_context2(&format_, nullptr, "mp4", name_.c_str());
+  if (rc < 0 || format_ == nullptr) Fail("cannot make an MP4 muxer", rc);
   const AVCodec* encoder = avcodec_find_encoder_by_name("libx264");
   if (encoder == nullptr) encoder = avcodec_find_encoder(AV_CODEC_ID_H264);
   if (encoder == nullptr)
-    throw Error("video '" + v.name +
-                "': this FFmpeg has no H.264 encoder (Debian's libavcodec59 has libx264)");
-  v.stream = avformat_new_stream(v.format, nullptr);
-  v.codec = avcodec_alloc_context3(encoder);
-  v.frame = av_frame_alloc();
-  v.packet = av_packet_alloc();
-  if (v.stream == nullptr || v.codec == nullptr || v.frame == nullptr || v.packet == nullptr)
-    throw Error("video '" + v.name + "': out of memory");
+    throw std::runtime_error("video '" + name_ +
+                             "': this FFmpeg has no H.264 encoder (Debian's libavcodec59 has "
+                             "libx264)");
+  stream_ = avformat_new_stream(format_, nullptr);
+  codec_ = avcodec_alloc_context3(encoder);
+  frame_ = av_frame_alloc();
+  packet_ = av_packet_alloc();
+  if (stream_ == nullptr || codec_ == nullptr || frame_ == nullptr || packet_ == nullptr)
+    throw std::runtime_error("video '" + name_ + "': out of memory");
 
   // The encoder: 4:2:0, a keyframe (and so a fragment) every second.
   const AVRational rate = av_d2q(settings.fps, 100000);
-  v.codec->width = settings.width;
-  v.codec->height = settings.height;
-  v.codec->pix_fmt = AV_PIX_FMT_YUV420P;
-  v.codec->time_base = av_inv_q(rate);
-  v.codec->framerate = rate;
-  v.codec->gop_size = std::max(1, static_cast<int>(std::lround(settings.fps)));
-  v.codec->thread_count = 1;  // the recorder's own thread; the simulation has the cores
-  v.codec->color_range = AVCOL_RANGE_MPEG;
-  v.codec->colorspace = AVCOL_SPC_SMPTE170M;  // ToYuv420's matrix (BT.601), as players assume
-  v.codec->color_primaries = AVCOL_PRI_SMPTE170M;
-  v.codec->color_trc = AVCOL_TRC_SMPTE170M;
-  if (v.format->oformat->flags & AVFMT_GLOBALHEADER) v.codec->flags |= AV_CODEC_FLAG_GLOBAL_HEADER;
-  av_opt_set(v.codec->priv_data, "preset", settings.preset.c_str(), 0);
-  av_opt_set_int(v.codec->priv_data, "crf", settings.crf, 0);
-  rc = avcodec_open2(v.codec, encoder, nullptr);
+  codec_->width = settings.width;
+  codec_->height = settings.height;
+  codec_->pix_fmt = AV_PIX_FMT_YUV420P;
+  codec_->time_base = av_inv_q(rate);
+  codec_->framerate = rate;
+  codec_->gop_size = std::max(1, static_cast<int>(std::lround(settings.fps)));
+  codec_->thread_count = 1;  // the recorder's own thread; the simulation has the cores
+  codec_->color_range = AVCOL_RANGE_MPEG;
+  codec_->colorspace = AVCOL_SPC_SMPTE170M;  // ToYuv420's matrix (BT.601), as players assume
+  codec_->color_primaries = AVCOL_PRI_SMPTE170M;
+  codec_->color_trc = AVCOL_TRC_SMPTE170M;
+  if (format_->oformat->flags & AVFMT_GLOBALHEADER) codec_->flags |= AV_CODEC_FLAG_GLOBAL_HEADER;
+  av_opt_set(codec_->priv_data, "preset", settings.preset.c_str(), 0);
+  av_opt_set_int(codec_->priv_data, "crf", settings.crf, 0);
+  rc = avcodec_open2(codec_, encoder, nullptr);
   if (rc < 0)
-    v.Fail("the H.264 encoder refused " + std::to_string(settings.width) + "x" +
-               std::to_string(settings.height),
-           rc);
-  rc = avcodec_parameters_from_context(v.stream->codecpar, v.codec);
-  if (rc < 0) v.Fail("cannot set up the stream", rc);
-  v.stream->time_base = v.codec->time_base;
-  v.stream->avg_frame_rate = rate;
-  v.stream->r_frame_rate = rate;
+    Fail("the H.264 encoder refused " + std::to_string(settings.width) + "x" +
+             std::to_string(settings.height),
+         rc);
+  rc = avcodec_parameters_from_context(stream_->codecpar, codec_);
+  if (rc < 0) Fail("cannot set up the stream", rc);
+  stream_->time_base = codec_->time_base;
+  stream_->avg_frame_rate = rate;
+  stream_->r_frame_rate = rate;
 
   // The file: fragmented, each fragment flushed as it is written.
-  rc = avio_open(&v.format->pb, v.name.c_str(), AVIO_FLAG_WRITE);
-  if (rc < 0) throw Error("cannot write '" + v.name + "': " + AvError(rc));
-  v.format->flags |= AVFMT_FLAG_FLUSH_PACKETS;
+  rc = avio_open(&format_->pb, name_.c_str(), AVIO_FLAG_WRITE);
+  if (rc < 0) throw std::runtime_error("cannot write '" + name_ + "': " + AvError(rc));
+  format_->flags |= AVFMT_FLAG_FLUSH_PACKETS;
   AVDictionary* options = nullptr;
   av_dict_set(&options, "movflags", "frag_keyframe+empty_moov+default_base_moof", 0);
-  rc = avformat_write_header(v.format, &options);
+  rc = avformat_write_header(format_, &options);
   av_dict_free(&options);
-  if (rc < 0) v.Fail("cannot write the MP4 header", rc);
-  avio_flush(v.format->pb);
-  if (v.format->pb->error < 0)
-    throw Error("cannot write '" + v.name + "': " + AvError(v.format->pb->error));
+  if (rc < 0) Fail("cannot write the MP4 header", rc);
+  avio_flush(format_->pb);
+  if (format_->pb->error < 0)
+    throw std::runtime_error("cannot write '" + name_ + "': " + AvError(format_->pb->error));
 
-  v.frame->format = AV_PIX_FMT_YUV420P;
-  v.frame->width = settings.width;
-  v.frame->height = settings.height;
-  v.frame->color_range = AVCOL_RANGE_MPEG;
-  v.frame->colorspace = AVCOL_SPC_SMPTE170M;
-  rc = av_frame_get_buffer(v.frame, 0);
-  if (rc < 0) v.Fail("out of memory for a frame", rc);
+  frame_->format = AV_PIX_FMT_YUV420P;
+  frame_->width = settings.width;
+  frame_->height = settings.height;
+  frame_->color_range = AVCOL_RANGE_MPEG;
+  frame_->colorspace = AVCOL_SPC_SMPTE170M;
+  rc = av_frame_get_buffer(frame_, 0);
+  if (rc < 0) Fail("out of memory for a frame", rc);
 }
 
-VideoWriter::~VideoWriter() {
+std::string LibavEncoder::Write(const Image& image) try {
+  if (finished_) return "video '" + name_ + "': already finished";
+  if (image.width != settings_.width || image.height != settings_.height)
+    return "video '" + name_ + "': a " + std::to_string(image.width) + "x" +
+           std::to_string(image.height) + " frame in a " + std::to_string(settings_.width) + "x" +
+           std::to_string(settings_.height) + " video";
+  const int rc = av_frame_make_writable(frame_);  // the encoder may still hold the last one
+  if (rc < 0) Fail("out of memory for a frame", rc);
+  ToYuv420(image, frame_->data, frame_->linesize);
+  frame_->pts = frames_++;
+  Encode(frame_);
+  return "";
+} catch (const std::exception& e) {
+  return e.what();
+}
+
+std::string LibavEncoder::Finish() try {
+  if (finished_) return "";
+  finished_ = true;
+  Encode(nullptr);
+  int rc = av_write_trailer(format_);
+  if (rc < 0) Fail("cannot complete the file", rc);
+  rc = avio_closep(&format_->pb);
+  if (rc < 0) Fail("cannot complete the file", rc);
+  return "";
+} catch (const std::exception& e) {
+  return e.what();
+}
+
+}  // namespace
+
+FrameEncoder* OpenLibavEncoder(const std::string& path, const VideoSettings& settings,
+                               std::string* error) {
   try {
-    Finish();
-  } catch (const std::exception&) {  // the file is cut off; nothing more to do here
+    return new LibavEncoder(path, settings);
+  } catch (const std::exception& e) {
+    *error = e.what();
+    return nullptr;
   }
 }
-
-void VideoWriter::Write(const Image& image) {
-  Impl& v = *impl_;
-  if (v.finished) throw Error("video '" + v.name + "': already finished");
-  if (image.width != v.settings.width || image.height != v.settings.height)
-    throw Error("video '" + v.name + "': a " + std::to_string(image.width) + "x" +
-                std::to_string(image.height) + " frame in a " + std::to_string(v.settings.width) +
-                "x" + std::to_string(v.settings.height) + " video");
-  int rc = av_frame_make_writable(v.frame);  // the encoder may still hold the last one
-  if (rc < 0) v.Fail("out of memory for a frame", rc);
-  ToYuv420(image, v.frame->data, v.frame->linesize);
-  v.frame->pts = v.frames++;
-  v.Encode(v.frame);
-}
-
-void VideoWriter::Finish() {
-  Impl& v = *impl_;
-  if (v.finished) return;
-  v.finished = true;
-  v.Encode(nullptr);
-  int rc = av_write_trailer(v.format);
-  if (rc < 0) v.Fail("cannot complete the file", rc);
-  rc = avio_closep(&v.format->pb);
-  if (rc < 0) v.Fail("cannot complete the file", rc);
-}
-
-int64_t VideoWriter::frames() const { return impl_->frames; }
 
 }  // namespace swarmsim::video

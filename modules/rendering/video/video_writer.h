@@ -1,6 +1,9 @@
-// H.264 video in a fragmented MP4 file, through FFmpeg's libraries (libav
-// types stay in video_writer.cc), and a reader that decodes one back
-// (video_reader.cc) for tests and checks.
+// H.264 video in a fragmented MP4 file, through FFmpeg's libraries, and a
+// reader that decodes one back for tests and checks. The libav code is a
+// module of its own (libswarmsim_libav.so: video_writer.cc, video_reader.cc;
+// libav types stay there), opened on first use of either class
+// (libav_loader.h), so a run without video never maps FFmpeg. A module that
+// cannot be found or opened is a swarmsim::Error naming the paths tried.
 //
 // The file is written fragment by fragment (movflags
 // frag_keyframe+empty_moov+default_base_moof, a keyframe every second of
@@ -30,7 +33,7 @@ class VideoWriter {
  public:
   // Creates `path` (an existing file is replaced). Throws swarmsim::Error
   // naming the file when it cannot be written or the encoder refuses the
-  // settings.
+  // settings, or when the libav module cannot be loaded.
   VideoWriter(const std::filesystem::path& path, const VideoSettings& settings);
   ~VideoWriter();  // Finish(), errors ignored
   VideoWriter(const VideoWriter&) = delete;
@@ -53,7 +56,7 @@ class VideoWriter {
 class VideoReader {
  public:
   // Throws swarmsim::Error naming the file when it cannot be opened or has
-  // no video stream.
+  // no video stream, or when the libav module cannot be loaded.
   explicit VideoReader(const std::filesystem::path& path);
   ~VideoReader();
   VideoReader(const VideoReader&) = delete;

@@ -30,7 +30,8 @@ class MeshCliTest : public ::testing::Test {
   // under a 2 GiB address-space limit: a reader that grows without end
   // fails the test instead of the machine (and one that blocks, after 2
   // minutes: a guard, not a timing).
-  swarmsim::testing::CommandResult Run(const fs::path& file) {
+  // `env` is prefixed to the command (VARIABLE=value ...).
+  swarmsim::testing::CommandResult Run(const fs::path& file, const std::string& env = "") {
     if (file.parent_path() != dir_)
       fs::copy_file(file, dir_ / file.filename(), fs::copy_options::overwrite_existing);
     std::ofstream(dir_ / "world.yaml") << "simulation: {physics: kinematic, time_step: 0.1}\n"
@@ -38,8 +39,8 @@ class MeshCliTest : public ::testing::Test {
                                           "  - {name: part, shape: mesh, file: "
                                        << file.filename().string() << "}\n";
     fs::remove_all(dir_ / "out");
-    return swarmsim::testing::RunCommand("cd " + dir_.string() +
-                                         " && ulimit -v 2097152 && timeout 120 " + SWARMSIM_BINARY +
+    return swarmsim::testing::RunCommand("cd " + dir_.string() + " && ulimit -v 2097152 && " + env +
+                                         " timeout 120 " + SWARMSIM_BINARY +
                                          " run world.yaml --steps 1 --quiet --out out");
   }
   // The run failed as bad input does: exit 2, `message` on stderr and in
@@ -69,6 +70,15 @@ TEST_F(MeshCliTest, GoodColladaRuns) {
   std::ifstream summary_file(dir_ / "out/summary.json");
   ASSERT_TRUE(summary_file.good());
   EXPECT_EQ(nlohmann::json::parse(summary_file)["status"], "ok");
+}
+
+TEST_F(MeshCliTest, AMissingAssimpModuleIsRefusedNamingWhereItWasLookedFor) {
+  // assimp is a module opened on the first mesh file (swarm/loader/assimp_module.h).
+  const std::string nowhere = (dir_ / "nowhere" / "libswarmsim_assimp.so").string();
+  const auto r = Run(kMeshes / "cube.dae", "SWARMSIM_ASSIMP_MODULE=" + nowhere);
+  ExpectRefused(r, "mesh files need swarmsim's assimp module");
+  EXPECT_NE(r.output.find(nowhere + ": cannot open shared object file"), std::string::npos)
+      << r.output;
 }
 
 TEST_F(MeshCliTest, TrianglesWithTwoPLinesIsRefusedNotAborted) {

@@ -109,4 +109,23 @@ TEST(ViewCommandTest, OptionsSayWhatTheyExpect) {
   EXPECT_NE(r.output.find("expected a folder"), std::string::npos) << r.output;
 }
 
+TEST(ViewCommandTest, AMissingHttpModuleIsAnErrorNamingWhereItWasLookedFor) {
+  // The server is a module opened when it is made (swarm/viewer/http_module.h);
+  // --export needs none.
+  const fs::path dir = TempDir("missing_http");
+  const std::string nowhere = (dir / "nowhere" / "libswarmsim_http.so").string();
+  const std::string run = (kRecordings / "diffusion").string();
+  Result r = swarmsim::testing::RunCommand("SWARMSIM_HTTP_MODULE=" + nowhere + " " +
+                                           SWARMSIM_BINARY + " view " + run + " --port 0");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("error: the viewer's server needs swarmsim's HTTP module"),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find(nowhere + ": cannot open shared object file"), std::string::npos)
+      << r.output;
+  r = swarmsim::testing::RunCommand("SWARMSIM_HTTP_MODULE=" + nowhere + " " + SWARMSIM_BINARY +
+                                    " view " + run + " --export " + (dir / "x.html").string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+}
+
 }  // namespace

@@ -1,0 +1,61 @@
+#include "modules/rendering/video/libav_loader.h"
+
+#include <string>
+
+#include "framework/error.h"
+#include "framework/shared_library.h"
+
+namespace swarmsim::video {
+
+namespace {
+
+// Set by modules/rendering/video/CMakeLists.txt: the module's file name and
+// where this build put it.
+#ifndef SWARMSIM_LIBAV_MODULE_NAME
+#define SWARMSIM_LIBAV_MODULE_NAME "libswarmsim_libav.so"
+#endif
+#ifndef SWARMSIM_LIBAV_MODULE_PATH
+#define SWARMSIM_LIBAV_MODULE_PATH ""
+#endif
+
+const OwnLibrary& LibavLibrary() {
+  static const OwnLibrary library{
+      SWARMSIM_LIBAV_MODULE_NAME,
+      SWARMSIM_LIBAV_MODULE_PATH,
+      kLibavModuleVariable,
+      kLibavModuleEntry,
+      kLibavModuleVersion,
+      "videos need swarmsim's libav module (" SWARMSIM_LIBAV_MODULE_NAME
+      ", on FFmpeg's libavcodec, libavformat and libswscale: Debian's libavcodec59, "
+      "libavformat59 and libswscale6, which tools/setup.sh installs)"};
+  return library;
+}
+
+struct Loaded {
+  const LibavModule* module = nullptr;
+  std::string error;
+};
+
+}  // namespace
+
+std::vector<std::filesystem::path> LibavModuleCandidates() { return CandidatesOf(LibavLibrary()); }
+
+const LibavModule& LoadLibavModule(const std::vector<std::filesystem::path>& candidates) {
+  return *static_cast<const LibavModule*>(LoadOwnLibrary(LibavLibrary(), candidates));
+}
+
+const LibavModule& Libav() {
+  static const Loaded loaded = [] {
+    Loaded l;
+    try {
+      l.module = &LoadLibavModule(LibavModuleCandidates());
+    } catch (const Error& e) {
+      l.error = e.what();
+    }
+    return l;
+  }();
+  if (loaded.module == nullptr) throw Error(loaded.error);
+  return *loaded.module;
+}
+
+}  // namespace swarmsim::video
