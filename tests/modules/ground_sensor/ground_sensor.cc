@@ -25,11 +25,12 @@ std::unique_ptr<RowTable> MakeRows(const ObjectTypeDescriptor&) {
 }
 
 void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
-  if (r.Has("radius")) static_cast<GroundSensorRow*>(row)->radius = r.Number("radius", kPositive);
+  if (r.Has("radius"))
+    static_cast<GroundSensorRow*>(row)->settings.Edit().radius = r.Number("radius", kPositive);
 }
 
 void Scale(const ObjectTypeDescriptor&, void* row, double s, ScaleContext*) {
-  static_cast<GroundSensorRow*>(row)->radius *= s;
+  static_cast<GroundSensorRow*>(row)->settings.Edit().radius *= s;
 }
 
 // What the scripts read next.
@@ -45,7 +46,7 @@ void Hash(const Scene& scene, ObjectType type, StateHasher* h) {
 void Visual(const Scene& scene, ObjectType type, uint32_t row, ObjectVisual* out) {
   const GroundSensorRow& g = scene.rows<GroundSensorRow>(type).rows[row];
   out->kind = VisualKind::kCylinder;
-  out->size = {g.radius, 0, 0.002};
+  out->size = {g.settings->radius, 0, 0.002};
   out->color = g.seen;
 }
 

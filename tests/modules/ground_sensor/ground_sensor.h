@@ -10,6 +10,7 @@
 #pragma once
 
 #include "framework/math.h"
+#include "framework/shared_settings.h"
 
 namespace swarmsim {
 class ModuleRegistry;
@@ -19,9 +20,13 @@ namespace swarmsim::ground_sensor {
 
 inline constexpr const char* kTypeName = "ground_sensor";
 
+// Settings: shared by the copies of one model entry (shared_settings.h).
+struct GroundSensorSettings {
+  double radius = 0.005;  // m: drawn as a disc this big
+};
 struct GroundSensorRow {  // 32 bytes
-  double radius = 0.005;  // m, setting: drawn as a disc this big
-  Vec3 seen;              // RGB 0..1, state: the floor under it at the last sense phase
+  Shared<GroundSensorSettings> settings;
+  Vec3 seen;  // RGB 0..1, state: the floor under it at the last sense phase
 };
 
 // The ground_sensor type, its Lua area (sim.readGroundSensor) and the

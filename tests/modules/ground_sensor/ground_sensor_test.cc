@@ -73,7 +73,7 @@ struct SensorWorld {
     scene.AddShape("body", robot, {{0.3, 0, 0.025}, {}}, body);
     if (with_sensor) {
       GroundSensorRow row;
-      row.radius = 0.1;
+      row.settings.Edit().radius = 0.1;
       eye = scene.AddObject(sensor, "eye", robot, {{0, 0, 0.06}, {}}, &row);
     }
     // Something outside the robot to frame the arena by.
