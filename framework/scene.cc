@@ -207,7 +207,8 @@ ObjectId Scene::AddDummy(std::string name, ObjectId parent, const Pose& X_PO) {
 }
 ObjectId Scene::AddShape(std::string name, ObjectId parent, const Pose& X_PO,
                          const ShapeData& shape) {
-  return AddObject(ObjectType::kShape, std::move(name), parent, X_PO, &shape);
+  const Shared<ShapeData> row(shape);
+  return AddObject(ObjectType::kShape, std::move(name), parent, X_PO, &row);
 }
 ObjectId Scene::AddJoint(std::string name, ObjectId parent, const Pose& X_PO,
                          const JointData& joint) {
@@ -455,7 +456,7 @@ const ShapeData& Scene::shape(ObjectId id) const {
 ShapeData& Scene::mutable_shape(ObjectId id) {
   const uint32_t s = SlotOf(id, "shape");
   ExpectType(*this, s, ObjectType::kShape);
-  return shapes()[row_[s]];
+  return Table<Shared<ShapeData>>(ObjectType::kShape).rows[row_[s]].Edit();
 }
 void Scene::SetShapeDynamic(ObjectId id, bool dynamic) {
   ShapeData& shape = mutable_shape(id);

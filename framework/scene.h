@@ -29,6 +29,7 @@
 #include "framework/mesh.h"
 #include "framework/name_pool.h"
 #include "framework/object_rows.h"
+#include "framework/shared_settings.h"
 
 namespace swarmsim {
 
@@ -338,9 +339,12 @@ class Scene {
   const JointData& joint(ObjectId id) const;
   JointData& mutable_joint(ObjectId id);
   // Dense typed tables of the built-in types. Row r belongs to the object at
-  // slot *_owners()[r].
-  std::span<ShapeData> shapes() { return Table<ShapeData>(ObjectType::kShape).rows; }
-  std::span<const ShapeData> shapes() const { return Table<ShapeData>(ObjectType::kShape).rows; }
+  // slot *_owners()[r]. A shape is all settings: its row is a
+  // Shared<ShapeData> (shared_settings.h), one ShapeData for every copy made
+  // from one model entry; mutable_shape() gives the object its own first.
+  SettingsView<ShapeData> shapes() const {
+    return SettingsView<ShapeData>(Table<Shared<ShapeData>>(ObjectType::kShape).rows);
+  }
   std::span<const uint32_t> shape_owners() const { return Owners(ObjectType::kShape); }
   std::span<JointData> joints() { return Table<JointData>(ObjectType::kJoint).rows; }
   std::span<const JointData> joints() const { return Table<JointData>(ObjectType::kJoint).rows; }

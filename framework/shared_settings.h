@@ -15,7 +15,9 @@
 #pragma once
 
 #include <atomic>
+#include <cstddef>
 #include <cstdint>
+#include <span>
 #include <utility>
 
 namespace swarmsim {
@@ -79,6 +81,36 @@ class Shared {
 
   static inline const S kDefault{};
   Block* block_ = nullptr;
+};
+
+// The settings of a table whose rows are Shared<S> (shapes), read as a
+// span of S: view[r] is row r's settings.
+template <class S>
+class SettingsView {
+ public:
+  explicit SettingsView(std::span<const Shared<S>> rows) : rows_(rows) {}
+  size_t size() const { return rows_.size(); }
+  bool empty() const { return rows_.empty(); }
+  const S& operator[](size_t r) const { return *rows_[r]; }
+
+  class Iterator {
+   public:
+    explicit Iterator(const Shared<S>* at) : at_(at) {}
+    const S& operator*() const { return **at_; }
+    Iterator& operator++() {
+      ++at_;
+      return *this;
+    }
+    bool operator==(const Iterator& other) const { return at_ == other.at_; }
+
+   private:
+    const Shared<S>* at_;
+  };
+  Iterator begin() const { return Iterator(rows_.data()); }
+  Iterator end() const { return Iterator(rows_.data() + rows_.size()); }
+
+ private:
+  std::span<const Shared<S>> rows_;
 };
 
 }  // namespace swarmsim

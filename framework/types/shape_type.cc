@@ -32,13 +32,13 @@ constexpr ObjectKey kKeys[] = {
 };
 
 std::unique_ptr<RowTable> MakeRows(const ObjectTypeDescriptor&) {
-  return std::make_unique<Rows<ShapeData>>();
+  return std::make_unique<Rows<Shared<ShapeData>>>();
 }
 
 // Sizes and surface velocity x s (not its angular velocity), mass x s^3; a mesh gets a scaled copy
 // of its asset, one per asset per call (context), so copies duplicated afterwards share it.
 void Scale(const ObjectTypeDescriptor&, void* row, double s, ScaleContext* context) {
-  ShapeData& shape = *static_cast<ShapeData*>(row);
+  ShapeData& shape = static_cast<Shared<ShapeData>*>(row)->Edit();  // this copy's own
   shape.size = shape.size * s;
   shape.mass *= s * s * s;
   for (double& i : shape.inertia) i *= s * s * s * s * s;
@@ -60,7 +60,7 @@ void Scale(const ObjectTypeDescriptor&, void* row, double s, ScaleContext* conte
 
 // Each kind takes its own size keys; a key of another kind is a mistake.
 void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
-  ShapeData& s = *static_cast<ShapeData*>(row);
+  ShapeData& s = static_cast<Shared<ShapeData>*>(row)->Edit();
   const std::string kind =
       r.Choice("shape", {"box", "cylinder", "sphere", "capsule", "mesh"}, /*required=*/true);
   auto forbid = [&](const char* key, const char* hint) {
@@ -139,7 +139,7 @@ namespace {
 
 // Drawn as its geometry, in its colour (which scripts may change).
 void Visual(const Scene& scene, ObjectType type, uint32_t row, ObjectVisual* out) {
-  const ShapeData& s = scene.rows<ShapeData>(type).rows[row];
+  const ShapeData& s = *scene.rows<Shared<ShapeData>>(type).rows[row];
   switch (s.kind) {
     case ShapeKind::kBox: out->kind = VisualKind::kBox; break;
     case ShapeKind::kCylinder: out->kind = VisualKind::kCylinder; break;

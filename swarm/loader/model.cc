@@ -240,10 +240,10 @@ const std::vector<std::string>& PoseKeys() {
 }
 
 ShapeData ReadShape(const ValueReader& values, const Fields& f, MeshCache* meshes) {
-  ShapeData shape;
+  Shared<ShapeData> shape;  // the type's row
   const ObjectTypeDescriptor& type = *CoreObjectTypes()[static_cast<size_t>(ObjectType::kShape)];
   type.read(type, FieldsObjectReader(values, f, meshes, nullptr), &shape);
-  return shape;
+  return *shape;
 }
 
 Pose ReadPose(const ValueReader& values, const Fields& f) {
@@ -414,7 +414,7 @@ namespace {
 
 void Accumulate(const ObjectSpec& spec, const Pose& X_RP, Footprint* fp, bool* any) {
   const Pose X_RO = X_RP * spec.X_PO;
-  if (const ShapeData* shape = spec.As<ShapeData>(ObjectType::kShape)) {
+  if (const ShapeData* shape = spec.AsShape()) {
     const ShapeData& s = *shape;
     Vec3 half;  // half extents in the shape's frame
     switch (s.kind) {

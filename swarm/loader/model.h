@@ -35,6 +35,11 @@ struct ObjectSpec {
   const Row* As(ObjectType want) const {
     return type == want && row ? static_cast<const Row*>(row->At(0)) : nullptr;
   }
+  // A shape's settings (its row is a Shared<ShapeData>), else null.
+  const ShapeData* AsShape() const {
+    const auto* shape = As<Shared<ShapeData>>(ObjectType::kShape);
+    return shape != nullptr ? &**shape : nullptr;
+  }
   std::shared_ptr<const ScriptSource> script;
   bool script_explicit = false;  // script: {file: ..., explicit: true}
   std::vector<ObjectSpec> children;

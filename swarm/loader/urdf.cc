@@ -390,7 +390,7 @@ std::optional<ObjectSpec> Importer::Geometry(const urdf::Link& link, const urdf:
       "link '" + link.name + "' " + (visual ? "<visual>" : "<collision>") + " geometry";
   if (g == nullptr) return std::nullopt;
   ObjectSpec spec = NewObject(ObjectType::kShape, visual ? "visual" : "collision", ToPose(origin));
-  ShapeData& s = RowOf<ShapeData>(spec);
+  ShapeData& s = RowOf<Shared<ShapeData>>(spec).Edit();
   s.collidable = !visual;
   auto positive = [&](double v, const char* key) {
     if (!(v > 0) || !std::isfinite(v))
@@ -503,7 +503,7 @@ ObjectSpec Importer::LinkObject(const urdf::Link& link, bool top, bool is_root, 
     Inertia inertia{};
     GroupMass(link, Pose{}, &mass, &inertia);
     spec = NewObject(ObjectType::kShape, ObjectName(link.name), X_PO);
-    ShapeData& s = RowOf<ShapeData>(spec);
+    ShapeData& s = RowOf<Shared<ShapeData>>(spec).Edit();
     s.kind = ShapeKind::kSphere;
     s.size = {kUrdfCarrierRadius, 0, 0};
     s.collidable = false;
@@ -728,7 +728,7 @@ UrdfImport ImportUrdf(const fs::path& path, const std::string& where, const std:
 
 ObjectSpec WithFloatingBase(const ObjectSpec& root, const std::string& where) {
   ObjectSpec out = root;
-  const ShapeData* shape = root.As<ShapeData>(ObjectType::kShape);
+  const ShapeData* shape = root.AsShape();
   if (shape == nullptr || shape->dynamic) return out;
   if (!(shape->mass > 0))
     throw Error(where +
@@ -736,8 +736,9 @@ ObjectSpec WithFloatingBase(const ObjectSpec& root, const std::string& where) {
                 "links fixed to it have no <inertial> nor geometry)");
   const ObjectTypeDescriptor& type = *CoreObjectTypes()[static_cast<size_t>(ObjectType::kShape)];
   out.row = type.make_rows(type);
-  out.row->Append(shape, 0);
-  static_cast<ShapeData*>(out.row->At(0))->dynamic = true;
+  const Shared<ShapeData> row(*shape);
+  out.row->Append(&row, 0);
+  static_cast<Shared<ShapeData>*>(out.row->At(0))->Edit().dynamic = true;
   return out;
 }
 

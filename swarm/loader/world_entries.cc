@@ -65,7 +65,7 @@ using ScaledMeshes = std::map<const TriangleMesh*, std::shared_ptr<const Triangl
 // at the assets an earlier copy of the entry was scaled to, so that copies
 // built from their own description share them as duplicates do.
 void ShareScaledMeshes(const ObjectSpec& spec, ObjectId id, Scene* scene, ScaledMeshes* scaled) {
-  const ShapeData* shape = spec.As<ShapeData>(ObjectType::kShape);
+  const ShapeData* shape = spec.AsShape();
   if (shape != nullptr && shape->mesh) {
     const auto [it, added] = scaled->emplace(shape->mesh.get(), scene->shape(id).mesh);
     if (!added) scene->mutable_shape(id).mesh = it->second;

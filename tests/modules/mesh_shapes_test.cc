@@ -196,8 +196,20 @@ TEST(MeshAsset, CopiesOfAModelShareOneAsset) {
   scene.ReserveForCopies(root, 100);
   for (int i = 0; i < 100; ++i) scene.DuplicateSubtree(root, {});
   EXPECT_EQ(scene.instances().size(), 101u);
-  for (const ShapeData& s : scene.shapes()) EXPECT_EQ(s.mesh.get(), mesh.get());
-  EXPECT_EQ(mesh.use_count(), 1 + 101);  // this test's pointer and one per shape row
+  for (const ShapeData& s : scene.shapes()) {
+    EXPECT_EQ(s.mesh.get(), mesh.get());
+    EXPECT_EQ(&s, &scene.shape(body));  // one ShapeData for every copy (settings)
+  }
+  EXPECT_EQ(mesh.use_count(), 1 + 1);  // this test's pointer and the shared settings'
+  // A copy given its own colour gets its own settings, with the same asset.
+  const ObjectId seventh = scene.FindObject("./body", scene.instance(7).root);
+  const double before = scene.shape(body).color.x;
+  scene.mutable_shape(seventh).color = {1 - before, 0, 0};
+  EXPECT_EQ(mesh.use_count(), 1 + 2);
+  EXPECT_EQ(scene.shape(seventh).mesh.get(), mesh.get());
+  EXPECT_EQ(scene.shape(seventh).color.x, 1 - before);
+  EXPECT_EQ(scene.shape(scene.FindObject("./body", scene.instance(8).root)).color.x, before);
+  EXPECT_EQ(scene.shape(body).color.x, before);
   EXPECT_EQ(scene.shape(body).mesh->vertices().size(), 8u);
 }
 

@@ -20,9 +20,9 @@ using testing::ErrorOf;
 using testing::FakeReader;
 
 ShapeData Read(const FakeReader& reader) {
-  ShapeData shape;
+  Shared<ShapeData> shape;  // the type's row: settings shared by copies
   kShapeType.read(kShapeType, reader, &shape);
-  return shape;
+  return *shape;
 }
 
 TEST(ShapeTypeTest, EachKindReadsItsOwnSizeKeys) {

@@ -126,7 +126,7 @@ TEST(ModelTest, ObjectsAreResolvedWithTheEntrysParameters) {
   const ObjectSpec root = Resolve(m);
   EXPECT_EQ(root.name, "arm") << "the root is named after the model";
   EXPECT_EQ(root.type, ObjectType::kShape);
-  const ShapeData* body = root.As<ShapeData>(ObjectType::kShape);
+  const ShapeData* body = root.AsShape();
   ASSERT_NE(body, nullptr);
   EXPECT_EQ(body->size.x, 0.2) << "the entry's r, not the default";
   ASSERT_EQ(root.children.size(), 2u);
