@@ -85,4 +85,17 @@ const void* LoadOwnLibrary(const OwnLibrary& library,
               " names its file)");
 }
 
+LazyOwnLibrary::LazyOwnLibrary(const OwnLibrary& library) {
+  try {
+    table_ = LoadOwnLibrary(library, CandidatesOf(library));
+  } catch (const Error& e) {
+    error_ = e.what();
+  }
+}
+
+const void* LazyOwnLibrary::Get() const {
+  if (table_ == nullptr) throw Error(error_);
+  return table_;
+}
+
 }  // namespace swarmsim

@@ -51,4 +51,18 @@ std::vector<std::filesystem::path> CandidatesOf(const OwnLibrary& library);
 const void* LoadOwnLibrary(const OwnLibrary& library,
                            const std::vector<std::filesystem::path>& candidates);
 
+// `library`, opened once per process by the first use and kept, a failure
+// too: every Get() throws the first attempt's message. As a function-local
+// static: `static const LazyOwnLibrary ompl(OmplLibrary()); ompl.Get()`.
+class LazyOwnLibrary {
+ public:
+  explicit LazyOwnLibrary(const OwnLibrary& library);  // loads; never throws
+  // The library's table. Throws swarmsim::Error if it did not load.
+  const void* Get() const;
+
+ private:
+  const void* table_ = nullptr;
+  std::string error_;
+};
+
 }  // namespace swarmsim

@@ -21,32 +21,14 @@ namespace {
 #define SWARMSIM_OMPL_MODULE_PATH ""
 #endif
 
-struct Loaded {
-  const OmplModule* module = nullptr;
-  std::string error;
-};
-
 // The module, once per process: a failure is kept and thrown again.
 const OmplModule& Ompl() {
-  static const Loaded loaded = [] {
-    const OwnLibrary library{
-        SWARMSIM_OMPL_MODULE_NAME,
-        SWARMSIM_OMPL_MODULE_PATH,
-        kOmplModuleVariable,
-        kOmplModuleEntry,
-        kOmplModuleVersion,
-        "path planning needs swarmsim's OMPL module (" SWARMSIM_OMPL_MODULE_NAME
-        ", on OMPL 1.5: Debian's libompl16, which tools/setup.sh installs)"};
-    Loaded l;
-    try {
-      l.module = static_cast<const OmplModule*>(LoadOwnLibrary(library, CandidatesOf(library)));
-    } catch (const Error& e) {
-      l.error = e.what();
-    }
-    return l;
-  }();
-  if (loaded.module == nullptr) throw Error(loaded.error);
-  return *loaded.module;
+  static const LazyOwnLibrary library(
+      OwnLibrary{SWARMSIM_OMPL_MODULE_NAME, SWARMSIM_OMPL_MODULE_PATH, kOmplModuleVariable,
+                 kOmplModuleEntry, kOmplModuleVersion,
+                 "path planning needs swarmsim's OMPL module (" SWARMSIM_OMPL_MODULE_NAME
+                 ", on OMPL 1.5: Debian's libompl16, which tools/setup.sh installs)"});
+  return *static_cast<const OmplModule*>(library.Get());
 }
 
 }  // namespace

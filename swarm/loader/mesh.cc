@@ -30,32 +30,14 @@ namespace {
 #define SWARMSIM_ASSIMP_MODULE_PATH ""
 #endif
 
-struct Loaded {
-  const AssimpModule* module = nullptr;
-  std::string error;
-};
-
 // The module, once per process: a failure is kept and thrown again.
 const AssimpModule& Assimp() {
-  static const Loaded loaded = [] {
-    const OwnLibrary library{
-        SWARMSIM_ASSIMP_MODULE_NAME,
-        SWARMSIM_ASSIMP_MODULE_PATH,
-        kAssimpModuleVariable,
-        kAssimpModuleEntry,
-        kAssimpModuleVersion,
-        "mesh files need swarmsim's assimp module (" SWARMSIM_ASSIMP_MODULE_NAME
-        ", on assimp 5.2: Debian's libassimp5, which tools/setup.sh installs)"};
-    Loaded l;
-    try {
-      l.module = static_cast<const AssimpModule*>(LoadOwnLibrary(library, CandidatesOf(library)));
-    } catch (const Error& e) {
-      l.error = e.what();
-    }
-    return l;
-  }();
-  if (loaded.module == nullptr) throw Error(loaded.error);
-  return *loaded.module;
+  static const LazyOwnLibrary library(
+      OwnLibrary{SWARMSIM_ASSIMP_MODULE_NAME, SWARMSIM_ASSIMP_MODULE_PATH, kAssimpModuleVariable,
+                 kAssimpModuleEntry, kAssimpModuleVersion,
+                 "mesh files need swarmsim's assimp module (" SWARMSIM_ASSIMP_MODULE_NAME
+                 ", on assimp 5.2: Debian's libassimp5, which tools/setup.sh installs)"});
+  return *static_cast<const AssimpModule*>(library.Get());
 }
 
 // Reads the file's triangles (the assimp module), merging vertices at equal

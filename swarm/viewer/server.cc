@@ -28,32 +28,14 @@ namespace {
 #define SWARMSIM_HTTP_MODULE_PATH ""
 #endif
 
-struct Loaded {
-  const HttpModule* module = nullptr;
-  std::string error;
-};
-
 // The module, once per process: a failure is kept and thrown again.
 const HttpModule& Http() {
-  static const Loaded loaded = [] {
-    const OwnLibrary library{
-        SWARMSIM_HTTP_MODULE_NAME,
-        SWARMSIM_HTTP_MODULE_PATH,
-        kHttpModuleVariable,
-        kHttpModuleEntry,
-        kHttpModuleVersion,
-        "the viewer's server needs swarmsim's HTTP module (" SWARMSIM_HTTP_MODULE_NAME
-        ", on cpp-httplib: Debian's libcpp-httplib0.11, which tools/setup.sh installs)"};
-    Loaded l;
-    try {
-      l.module = static_cast<const HttpModule*>(LoadOwnLibrary(library, CandidatesOf(library)));
-    } catch (const Error& e) {
-      l.error = e.what();
-    }
-    return l;
-  }();
-  if (loaded.module == nullptr) throw Error(loaded.error);
-  return *loaded.module;
+  static const LazyOwnLibrary library(
+      OwnLibrary{SWARMSIM_HTTP_MODULE_NAME, SWARMSIM_HTTP_MODULE_PATH, kHttpModuleVariable,
+                 kHttpModuleEntry, kHttpModuleVersion,
+                 "the viewer's server needs swarmsim's HTTP module (" SWARMSIM_HTTP_MODULE_NAME
+                 ", on cpp-httplib: Debian's libcpp-httplib0.11, which tools/setup.sh installs)"});
+  return *static_cast<const HttpModule*>(library.Get());
 }
 
 }  // namespace

@@ -43,6 +43,20 @@ TEST(SharedLibraryTest, AFileThatCannotBeOpenedSaysWhy) {
   EXPECT_EQ(FindSymbol(libm, "swarmsim_no_such_symbol"), nullptr);
 }
 
+// A library that did not load says so on every use, with the first
+// attempt's reasons (it is not looked for again); one that loads gives its table.
+TEST(SharedLibraryTest, ALazyLibraryKeepsItsFirstOutcome) {
+  OwnLibrary missing = Example();
+  ASSERT_EQ(setenv(missing.variable.c_str(), "/nonexistent/libswarmsim_example.so", 1), 0);
+  const LazyOwnLibrary lazy(missing);
+  const std::string first = ErrorOf([&] { lazy.Get(); });
+  EXPECT_CONTAINS(first, "examples need swarmsim's example module");
+  EXPECT_CONTAINS(first, "/nonexistent/libswarmsim_example.so");
+  // Even once the file would be found, the outcome stays (no second search).
+  ASSERT_EQ(unsetenv(missing.variable.c_str()), 0);
+  EXPECT_EQ(ErrorOf([&] { lazy.Get(); }), first);
+}
+
 TEST(SharedLibraryTest, AModuleIsLookedForBesideTheProgramThenWhereTheBuildPutIt) {
   const OwnLibrary library = Example();
   ASSERT_EQ(unsetenv(library.variable.c_str()), 0);

@@ -31,11 +31,6 @@ const OwnLibrary& LibavLibrary() {
   return library;
 }
 
-struct Loaded {
-  const LibavModule* module = nullptr;
-  std::string error;
-};
-
 }  // namespace
 
 std::vector<std::filesystem::path> LibavModuleCandidates() { return CandidatesOf(LibavLibrary()); }
@@ -45,17 +40,8 @@ const LibavModule& LoadLibavModule(const std::vector<std::filesystem::path>& can
 }
 
 const LibavModule& Libav() {
-  static const Loaded loaded = [] {
-    Loaded l;
-    try {
-      l.module = &LoadLibavModule(LibavModuleCandidates());
-    } catch (const Error& e) {
-      l.error = e.what();
-    }
-    return l;
-  }();
-  if (loaded.module == nullptr) throw Error(loaded.error);
-  return *loaded.module;
+  static const LazyOwnLibrary library(LibavLibrary());
+  return *static_cast<const LibavModule*>(library.Get());
 }
 
 }  // namespace swarmsim::video
