@@ -109,6 +109,16 @@ void ModuleRegistry::RegisterWorldSection(std::shared_ptr<const WorldSectionDesc
   world_sections_.push_back(std::move(section));
 }
 
+void ModuleRegistry::RegisterEnvironmentFormat(
+    std::shared_ptr<const EnvironmentFormatDescriptor> format) {
+  if (!format || format->key.empty() || !format->read)
+    throw Error("an environment map format needs a key and a reader");
+  for (const auto& f : environment_formats_)
+    if (f->key == format->key)
+      throw Error("environment map format '" + format->key + "' is registered twice");
+  environment_formats_.push_back(std::move(format));
+}
+
 const VisionFilterDescriptor* ModuleRegistry::FindVisionFilter(std::string_view name) const {
   for (const auto& f : vision_filters_)
     if (f->name == name) return f.get();

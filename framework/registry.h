@@ -24,6 +24,7 @@ struct ObjectTypeDescriptor;
 struct PluginControllerType;
 struct VisionFilterDescriptor;
 struct WorldSectionDescriptor;
+struct EnvironmentFormatDescriptor;
 
 // A script command registered by a plugin (framework/plugin_api.h): sim.<name>.
 struct ScriptCommand {
@@ -117,6 +118,13 @@ class ModuleRegistry {
   const std::vector<std::shared_ptr<const WorldSectionDescriptor>>& world_sections() const {
     return world_sections_;
   }
+  // Map formats of the world's `environment:` key (framework/world_section.h).
+  // Throws swarmsim::Error if the key is taken.
+  void RegisterEnvironmentFormat(std::shared_ptr<const EnvironmentFormatDescriptor> format);
+  const std::vector<std::shared_ptr<const EnvironmentFormatDescriptor>>& environment_formats()
+      const {
+    return environment_formats_;
+  }
   // Native controllers (plugins, framework/plugin_controllers.h): kind
   // "controller". Throws swarmsim::Error if the name is taken.
   void RegisterController(ModuleInfo info, PluginControllerType controller);
@@ -159,6 +167,7 @@ class ModuleRegistry {
   std::vector<const ObjectTypeDescriptor*> object_types_;
   std::vector<std::shared_ptr<const VisionFilterDescriptor>> vision_filters_;
   std::vector<std::shared_ptr<const WorldSectionDescriptor>> world_sections_;
+  std::vector<std::shared_ptr<const EnvironmentFormatDescriptor>> environment_formats_;
   // Shared, stable addresses: a world's robots point at them.
   std::vector<std::shared_ptr<const PluginControllerType>> controllers_;
 };

@@ -7,11 +7,15 @@
 // ("did you mean 'paint'?").
 #pragma once
 
+#include <filesystem>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
+#include <vector>
 
+#include "framework/environment.h"
 #include "framework/object_type.h"
 
 namespace swarmsim {
@@ -38,6 +42,26 @@ struct WorldSectionDescriptor {
   // key is there or not (a world with paint nozzles gets a paint layer
   // without `paint:`). Errors name file:line:column through `top`.
   std::function<void(const ObjectReader& top, const WorldSectionContext& context, World* world)>
+      read;
+};
+
+// A map format of the world's `environment:` key (`environment: {octomap:
+// maps/building.bt, z_range: [0, 2]}`), declared by the module that reads
+// it (modules/environment: octomap). The loader takes the format whose key
+// the mapping holds and hands it the mapping: it names no format itself.
+struct EnvironmentFormatDescriptor {
+  std::string key;  // the key naming the map file: "octomap"
+  std::string doc;  // one line (worlds/README.md has its keys)
+  // The keys beside `key` (offset, z_range, ...), with their defaults and
+  // one documentation line each.
+  std::span<const ObjectKey> keys;
+  // Reads the map the mapping names (a path relative to `world_folder`).
+  // Errors name file:line:column through `r` (r.Fail(key, ...)); what may
+  // surprise without being wrong (a map without occupied voxels) goes to
+  // `warnings`, each starting with its place (r.Where(key)).
+  std::function<std::shared_ptr<const EnvironmentMap>(const ObjectReader& r,
+                                                      const std::filesystem::path& world_folder,
+                                                      std::vector<std::string>* warnings)>
       read;
 };
 

@@ -9,6 +9,7 @@
 #include "modules/dynamics/kinematic/kinematic_backend.h"
 #include "modules/dynamics/ode/ode_backend.h"
 #include "modules/dynamics/planar/planar_backend.h"
+#include "modules/environment/environment.h"
 #include "modules/force_sensor/force_sensor.h"
 #include "modules/graphs/graphs.h"
 #include "modules/kinematics/ik_groups.h"
@@ -61,6 +62,7 @@ void RegisterBuiltinModules(ModuleRegistry* registry) {
     registry->RegisterModule(std::move(metric));
   collision::Register(registry);
   mill::Register(registry);
+  environment::Register(registry);  // the `octomap` map format of `environment:`
   paths::Register(registry);
   planning::Register(registry);
   filters::Register(registry);

@@ -1,7 +1,9 @@
 #include "swarm/loader/environment.h"
 
 #include "framework/error.h"
-#include "modules/environment/octomap_map.h"
+#include "framework/registry.h"
+#include "framework/world_section.h"
+#include "swarm/loader/object_reader.h"
 
 namespace swarmsim::loader {
 
@@ -9,45 +11,39 @@ std::shared_ptr<const EnvironmentMap> ReadEnvironment(const YamlFile& file,
                                                       const Field& environment,
                                                       const ValueReader& values,
                                                       const std::filesystem::path& world_folder,
+                                                      const ModuleRegistry& registry,
                                                       std::vector<std::string>* warnings) {
   if (!environment.present()) return nullptr;
+  const auto& formats = registry.environment_formats();
+  std::string names;  // "octomap", for messages
+  for (const auto& format : formats) names += (names.empty() ? "" : ", ") + format->key;
   if (!environment.node.IsMap())
     file.Fail(environment.mark,
               "'environment' must be a mapping such as {octomap: maps/building.bt} (got " +
                   Describe(environment.node) + ")");
   Fields f(file, environment, "'environment'");
-  f.Expect({"octomap", "offset", "z_range", "occupancy_threshold", "max_memory_mb"});
-  const Field octomap = f.Require("octomap");
-  const std::string name = values.String(octomap);
-  if (name.empty()) values.Fail(octomap, "'octomap' must be the path of a .bt or .ot file");
-  environment::OctomapOptions options;
-  if (f.Has("offset")) options.offset = values.Vector3(f.Get("offset"), kCoordinate);
-  if (f.Has("z_range")) {
-    const Field range = f.Get("z_range");
-    const std::vector<double> z = values.Numbers(range, 2, 2, kCoordinate);
-    if (!(z[0] <= z[1])) values.Fail(range, "'z_range' needs [min, max] with min <= max");
-    options.z_min = z[0];
-    options.z_max = z[1];
+  // The format is the one whose key the mapping holds (exactly one).
+  const EnvironmentFormatDescriptor* format = nullptr;
+  for (const auto& candidate : formats) {
+    if (!f.Has(candidate->key)) continue;
+    if (format != nullptr)
+      values.Fail(f.Get(candidate->key), "'environment' names one map: '" + format->key + "' or '" +
+                                             candidate->key + "', not both");
+    format = candidate.get();
   }
-  if (f.Has("occupancy_threshold")) {
-    static constexpr NumberRule kProbability{"a probability between 0 and 1 (exclusive)", 0,
-                                             1 - 1e-12, true};
-    options.occupancy_threshold = values.Number(f.Get("occupancy_threshold"), kProbability);
+  if (format == nullptr) {
+    // A mapping of one format's other keys lacks that format's key.
+    for (const auto& candidate : formats)
+      for (const ObjectKey& key : candidate->keys)
+        if (f.Has(key.name)) f.Require(candidate->key);  // "'octomap' is required"
+    file.Fail(environment.mark,
+              "'environment' needs the map file under one of: " +
+                  (names.empty() ? std::string("(no map format registered)") : names));
   }
-  if (f.Has("max_memory_mb")) {
-    static constexpr NumberRule kMegabytes{"a positive number of MiB", 0, 1e9, true};
-    options.max_memory_mb = values.Number(f.Get("max_memory_mb"), kMegabytes);
-  }
-  environment::OctomapReport report;
-  try {
-    auto map = std::make_shared<const EnvironmentMap>(
-        environment::ReadOctomap(world_folder / name, name, options, &report));
-    for (const std::string& w : report.warnings)
-      warnings->push_back(file.Where(octomap.mark) + ": " + w);
-    return map;
-  } catch (const Error& e) {
-    values.Fail(octomap, e.what());
-  }
+  std::vector<std::string> known = {format->key};
+  for (const ObjectKey& key : format->keys) known.push_back(key.name);
+  f.Expect(known);
+  return format->read(FieldsObjectReader(values, f, nullptr, &registry), world_folder, warnings);
 }
 
 }  // namespace swarmsim::loader

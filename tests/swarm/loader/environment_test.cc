@@ -7,8 +7,10 @@
 #include <fstream>
 #include <string>
 
+#include "framework/number_rule.h"
 #include "framework/registry.h"
 #include "framework/world.h"
+#include "framework/world_section.h"
 #include "modules/builtin.h"
 #include "swarm/loader/world_loader.h"
 #include "tests/framework/error_of.h"
@@ -104,6 +106,56 @@ TEST(EnvironmentWorldTest, EnvironmentValuesSayWhatTheyExpectAtTheirKey) {
   // Every value is checked before the map is read: a missing map comes last.
   EXPECT_CONTAINS(error("{octomap: x.bt, z_range: [0, 1]}"), "world.yaml:1:24: octomap x.bt: ");
   EXPECT_EQ(error("").find("environment"), std::string::npos) << "no environment: no map";
+  fs::remove_all(dir);
+}
+
+// A map format is the registry's: one a module (here, this test) registers
+// is read by the loader with its own keys, no loader change; a mapping
+// naming two formats, or none, says which there are.
+TEST(EnvironmentFormatTest, ARegisteredFormatIsReadThroughTheLoader) {
+  ModuleRegistry registry;
+  RegisterBuiltinModules(&registry);
+  static constexpr ObjectKey kKeys[] = {{"height", "1", "m, of the one box"}};
+  auto format = std::make_shared<EnvironmentFormatDescriptor>();
+  format->key = "one_box";
+  format->doc = "a test format: one box, 1 m a side, standing at the origin";
+  format->keys = kKeys;
+  format->read = [](const ObjectReader& r, const fs::path& folder, std::vector<std::string>*) {
+    EXPECT_EQ(r.String("one_box"), "anything.box");
+    EXPECT_FALSE(folder.empty());
+    auto map = std::make_shared<EnvironmentMap>();
+    map->source = "anything.box";
+    map->resolution = 1;
+    const double h = r.Has("height") ? r.Number("height", kCoordinate) : 1;
+    map->boxes.push_back({{-0.5, -0.5, 0}, {0.5, 0.5, h}});
+    map->lo = map->boxes[0].lo;
+    map->hi = map->boxes[0].hi;
+    return std::shared_ptr<const EnvironmentMap>(std::move(map));
+  };
+  registry.RegisterEnvironmentFormat(format);
+  EXPECT_CONTAINS(ErrorOf([&] { registry.RegisterEnvironmentFormat(format); }),
+                  "environment map format 'one_box' is registered twice");
+
+  const fs::path dir = FreshTempDir("swarmsim_env", "format");
+  fs::create_directories(dir);
+  std::ofstream(dir / "world.yaml") << "simulation: {physics: kinematic}\n"
+                                       "environment: {one_box: anything.box, height: 2}\n";
+  LoadedWorld w = LoadWorld(dir / "world.yaml", {}, registry);
+  const EnvironmentMap* map = w.world->scene().environment();
+  ASSERT_NE(map, nullptr);
+  ASSERT_EQ(map->boxes.size(), 1u);
+  EXPECT_EQ(map->boxes[0].hi.z, 2);
+
+  std::ofstream(dir / "world.yaml") << "environment: {one_box: a.box, octomap: b.bt}\n";
+  EXPECT_CONTAINS(ErrorOf([&] { LoadWorld(dir / "world.yaml", {}, registry); }),
+                  "'environment' names one map: 'octomap' or 'one_box', not both");
+  std::ofstream(dir / "world.yaml") << "environment: {hight: 2}\n";
+  EXPECT_CONTAINS(
+      ErrorOf([&] { LoadWorld(dir / "world.yaml", {}, registry); }),
+      "world.yaml:1:14: 'environment' needs the map file under one of: octomap, one_box");
+  // The octomap format's keys are not this one's.
+  std::ofstream(dir / "world.yaml") << "environment: {one_box: a.box, z_range: [0, 1]}\n";
+  EXPECT_CONTAINS(ErrorOf([&] { LoadWorld(dir / "world.yaml", {}, registry); }), "z_range");
   fs::remove_all(dir);
 }
 
