@@ -11,52 +11,13 @@
 #include "framework/world.h"
 #include "tests/framework/error_of.h"
 #include "tests/framework/fakes.h"
+#include "tests/framework/script_world.h"
 
 namespace swarmsim {
 namespace {
 
-std::shared_ptr<const ScriptSource> Source(std::string path, std::string code) {
-  return std::make_shared<const ScriptSource>(ScriptSource{std::move(path), std::move(code)});
-}
-
-// A world with null modules whose script output lands in `log`.
-class ScriptWorld {
- public:
-  explicit ScriptWorld(int threads = 1, uint64_t seed = 1, WorldSettings settings = {})
-      : registry_(testing::NullRegistry()) {
-    settings.physics = "null";
-    settings.time_step = 0.1;
-    settings.threads = threads;
-    settings.seed = seed;
-    world_ = std::make_unique<World>(settings, registry_);
-    world_->set_log_sink([this](std::string_view line) { log.emplace_back(line); });
-  }
-  World& world() { return *world_; }
-  Scene& scene() { return world_->scene(); }
-
-  // A robot: a root dummy named like the instance (model root) carrying a
-  // `body` shape with joints `leftMotor` and `rightMotor`; `code` attached to
-  // the body unless empty. Returns the body.
-  ObjectId AddRobot(const std::string& name, const std::string& code,
-                    const std::string& path = "scripts/robot.lua") {
-    const ObjectId root = scene().AddDummy(name, {}, {{next_x_, 0, 0}, {}});
-    next_x_ += 1;
-    const ObjectId body = scene().AddShape("body", root, {}, {});
-    scene().AddJoint("leftMotor", body, {{0, 0.05, 0}, {}}, {});
-    scene().AddJoint("rightMotor", body, {{0, -0.05, 0}, {}}, {});
-    scene().MakeModelInstance(root, "bot", name);
-    if (!code.empty()) scene().AttachScript(body, Source(path, code));
-    return body;
-  }
-  ObjectId Joint(const std::string& path) { return scene().FindObject(path); }
-
-  std::vector<std::string> log;
-
- private:
-  ModuleRegistry registry_;
-  std::unique_ptr<World> world_;
-  double next_x_ = 0;
-};
+using script_test::ScriptWorld;
+using script_test::Source;
 
 using testing::ErrorOf;
 
@@ -64,12 +25,12 @@ TEST(ScriptHostTest, WritesToAnotherRobotsJointAreDeferredToAfterThePhase) {
   ScriptWorld w;
   // bot#0 runs first (one thread) and writes bot#1's motor; bot#1 must not
   // see it during the same phase, but its own writes at once.
-  w.AddRobot("bot#0", R"(
+  w.AddWheeledRobot("bot#0", R"(
     function sysCall_sensing()
       sim.setJointTargetVelocity(sim.getObject('/bot#1/body/leftMotor'), 5)
     end
   )");
-  w.AddRobot("bot#1", R"(
+  w.AddWheeledRobot("bot#1", R"(
     local left, right
     function sysCall_init() left, right = sim.getObject('./leftMotor'), sim.getObject('./rightMotor') end
     function sysCall_actuation()
@@ -96,11 +57,11 @@ TEST(ScriptHostTest, WritesToAnotherRobotsJointAreDeferredToAfterThePhase) {
 
 TEST(ScriptHostTest, ReadingAnotherRobotsJointTargetIsAnError) {
   ScriptWorld w;
-  w.AddRobot("bot#0",
-             "function sysCall_sensing()\n  "
-             "sim.getJointTargetVelocity(sim.getObject('/bot#1/body/leftMotor'))\nend",
-             "scripts/peek.lua");
-  w.AddRobot("bot#1", "");
+  w.AddWheeledRobot("bot#0",
+                    "function sysCall_sensing()\n  "
+                    "sim.getJointTargetVelocity(sim.getObject('/bot#1/body/leftMotor'))\nend",
+                    "scripts/peek.lua");
+  w.AddWheeledRobot("bot#1", "");
   w.world().Start();
   EXPECT_CONTAINS(ErrorOf([&] { w.world().Step(); }),
                   "scripts/peek.lua:2: sim.getJointTargetVelocity: joint '/bot#1/body/leftMotor' "

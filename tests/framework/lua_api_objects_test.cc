@@ -13,62 +13,23 @@
 #include "modules/proximity/proximity_sensor.h"
 #include "tests/framework/error_of.h"
 #include "tests/framework/fakes.h"
+#include "tests/framework/script_world.h"
 
 namespace swarmsim {
 namespace {
 
-std::shared_ptr<const ScriptSource> Source(std::string path, std::string code) {
-  return std::make_shared<const ScriptSource>(ScriptSource{std::move(path), std::move(code)});
-}
-
-// A world with null modules whose script output lands in `log`.
-class ScriptWorld {
- public:
-  explicit ScriptWorld(int threads = 1, uint64_t seed = 1, WorldSettings settings = {})
-      : registry_(testing::NullRegistry()) {
-    settings.physics = "null";
-    settings.time_step = 0.1;
-    settings.threads = threads;
-    settings.seed = seed;
-    world_ = std::make_unique<World>(settings, registry_);
-    world_->set_log_sink([this](std::string_view line) { log.emplace_back(line); });
-  }
-  World& world() { return *world_; }
-  Scene& scene() { return world_->scene(); }
-
-  // A robot: a root dummy named like the instance (model root) carrying a
-  // `body` shape with joints `leftMotor` and `rightMotor`; `code` attached to
-  // the body unless empty. Returns the body.
-  ObjectId AddRobot(const std::string& name, const std::string& code,
-                    const std::string& path = "scripts/robot.lua") {
-    const ObjectId root = scene().AddDummy(name, {}, {{next_x_, 0, 0}, {}});
-    next_x_ += 1;
-    const ObjectId body = scene().AddShape("body", root, {}, {});
-    scene().AddJoint("leftMotor", body, {{0, 0.05, 0}, {}}, {});
-    scene().AddJoint("rightMotor", body, {{0, -0.05, 0}, {}}, {});
-    scene().MakeModelInstance(root, "bot", name);
-    if (!code.empty()) scene().AttachScript(body, Source(path, code));
-    return body;
-  }
-  ObjectId Joint(const std::string& path) { return scene().FindObject(path); }
-
-  std::vector<std::string> log;
-
- private:
-  ModuleRegistry registry_;
-  std::unique_ptr<World> world_;
-  double next_x_ = 0;
-};
+using script_test::ScriptWorld;
+using script_test::Source;
 
 using testing::ErrorOf;
 
 TEST(ScriptHostTest, StaleHandleIsAnError) {
   ScriptWorld w;
-  w.AddRobot("bot#0", R"(
+  w.AddWheeledRobot("bot#0", R"(
     function sysCall_init() eye = sim.getObject('./eye') end
     function sysCall_actuation() sim.getObjectPose(eye) end
   )",
-             "scripts/stale.lua");
+                    "scripts/stale.lua");
   const ObjectId eye = w.scene().AddDummy("eye", w.scene().FindObject("/bot#0/body"), {});
   w.world().Start();
   w.world().Step();
@@ -81,7 +42,7 @@ TEST(ScriptHostTest, StaleHandleIsAnError) {
 
 TEST(ScriptHostTest, DuplicatedModelsFindTheirOwnObjects) {
   ScriptWorld w;
-  const ObjectId body = w.AddRobot("bot#0", R"(
+  const ObjectId body = w.AddWheeledRobot("bot#0", R"(
     local left, right, me
     function sysCall_init()
       left = sim.getObject('./leftMotor')
@@ -111,7 +72,7 @@ TEST(ScriptHostTest, DuplicatedModelsFindTheirOwnObjects) {
 
 TEST(ScriptHostTest, RepeatedNamesAreIndexed) {
   ScriptWorld w;
-  const ObjectId body = w.AddRobot("bot#0", R"(
+  const ObjectId body = w.AddWheeledRobot("bot#0", R"(
     function sysCall_init()
       for i = 0, 2 do
         local h = sim.getObject('./prox[' .. i .. ']')
@@ -147,7 +108,7 @@ TEST(ScriptHostTest, MissingObjectPathSuggestsTheNearestNameOrTheIndexRange) {
   for (const auto& [path, message] : cases) {
     ScriptWorld w;
     const ObjectId body =
-        w.AddRobot("bot#0", "function sysCall_init() sim.getObject('" + path + "') end");
+        w.AddWheeledRobot("bot#0", "function sysCall_init() sim.getObject('" + path + "') end");
     for (int i = 0; i < 12; ++i) proximity::AddSensor(&w.scene(), "prox", body, {}, {});
     EXPECT_CONTAINS(ErrorOf([&] { w.world().Start(); }), message);
   }

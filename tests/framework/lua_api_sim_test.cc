@@ -10,58 +10,19 @@
 #include "framework/world.h"
 #include "tests/framework/error_of.h"
 #include "tests/framework/fakes.h"
+#include "tests/framework/script_world.h"
 
 namespace swarmsim {
 namespace {
 
-std::shared_ptr<const ScriptSource> Source(std::string path, std::string code) {
-  return std::make_shared<const ScriptSource>(ScriptSource{std::move(path), std::move(code)});
-}
-
-// A world with null modules whose script output lands in `log`.
-class ScriptWorld {
- public:
-  explicit ScriptWorld(int threads = 1, uint64_t seed = 1, WorldSettings settings = {})
-      : registry_(testing::NullRegistry()) {
-    settings.physics = "null";
-    settings.time_step = 0.1;
-    settings.threads = threads;
-    settings.seed = seed;
-    world_ = std::make_unique<World>(settings, registry_);
-    world_->set_log_sink([this](std::string_view line) { log.emplace_back(line); });
-  }
-  World& world() { return *world_; }
-  Scene& scene() { return world_->scene(); }
-
-  // A robot: a root dummy named like the instance (model root) carrying a
-  // `body` shape with joints `leftMotor` and `rightMotor`; `code` attached to
-  // the body unless empty. Returns the body.
-  ObjectId AddRobot(const std::string& name, const std::string& code,
-                    const std::string& path = "scripts/robot.lua") {
-    const ObjectId root = scene().AddDummy(name, {}, {{next_x_, 0, 0}, {}});
-    next_x_ += 1;
-    const ObjectId body = scene().AddShape("body", root, {}, {});
-    scene().AddJoint("leftMotor", body, {{0, 0.05, 0}, {}}, {});
-    scene().AddJoint("rightMotor", body, {{0, -0.05, 0}, {}}, {});
-    scene().MakeModelInstance(root, "bot", name);
-    if (!code.empty()) scene().AttachScript(body, Source(path, code));
-    return body;
-  }
-  ObjectId Joint(const std::string& path) { return scene().FindObject(path); }
-
-  std::vector<std::string> log;
-
- private:
-  ModuleRegistry registry_;
-  std::unique_ptr<World> world_;
-  double next_x_ = 0;
-};
+using script_test::ScriptWorld;
+using script_test::Source;
 
 using testing::ErrorOf;
 
 TEST(ScriptHostTest, PrintWritesOnePrefixedTabSeparatedLine) {
   ScriptWorld w;
-  w.AddRobot(
+  w.AddWheeledRobot(
       "bot#0",
       R"(print('a', 1, 2.5, nil, true, setmetatable({}, {__tostring = function() return 'obj' end})))");
   w.world().Start();
@@ -70,8 +31,8 @@ TEST(ScriptHostTest, PrintWritesOnePrefixedTabSeparatedLine) {
 
 TEST(ScriptHostTest, RecordedMetricsReachTheWorld) {
   ScriptWorld w;
-  w.AddRobot("bot#0", "function sysCall_actuation() sim.recordMetric('speed', 1.5) end");
-  w.AddRobot("bot#1", "function sysCall_actuation() sim.recordMetric('speed', 2.5) end");
+  w.AddWheeledRobot("bot#0", "function sysCall_actuation() sim.recordMetric('speed', 1.5) end");
+  w.AddWheeledRobot("bot#1", "function sysCall_actuation() sim.recordMetric('speed', 2.5) end");
   w.world().Start();
   w.world().Step();
   w.world().Step();
@@ -92,7 +53,7 @@ TEST(ScriptHostTest, RandomNumbersArePerRobotAndReproducible) {
   auto run = [](uint64_t seed) {
     ScriptWorld w(2, seed);
     for (int r = 0; r < 3; ++r)
-      w.AddRobot("bot#" + std::to_string(r), R"(
+      w.AddWheeledRobot("bot#" + std::to_string(r), R"(
         function sysCall_actuation()
           sim.recordMetric('sim', sim.random())
           sim.recordMetric('lua', math.random())
@@ -127,8 +88,8 @@ TEST(ScriptHostTest, ParametersComeFromTheRobotThenTheWorldThenTheDefault) {
             sim.getParam('missing', 3), sim.getParam('missing', nil))
     end
   )";
-  w.AddRobot("bot#0", code);
-  w.AddRobot("bot#1", code);
+  w.AddWheeledRobot("bot#0", code);
+  w.AddWheeledRobot("bot#1", code);
   w.world().parameters()["speed"] = 0.5;
   w.world().parameters()["name"] = std::string("world");
   w.world().parameters()["fast"] = false;
@@ -146,7 +107,7 @@ TEST(ScriptHostTest, ParametersComeFromTheRobotThenTheWorldThenTheDefault) {
 // reach scripts as Lua integers, so '/st#' .. (i % robots) reads '/st#3'.
 TEST(ScriptHostTest, IntegralParametersAndSignalsAreLuaIntegers) {
   ScriptWorld w;
-  w.AddRobot("bot#0", R"(
+  w.AddWheeledRobot("bot#0", R"(
     function sysCall_init()
       local robots = sim.getParam('robots')
       print('/st#' .. (13 % robots), math.type(robots), math.type(sim.getParam('speed')),

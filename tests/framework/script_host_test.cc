@@ -10,52 +10,13 @@
 #include "framework/world.h"
 #include "tests/framework/error_of.h"
 #include "tests/framework/fakes.h"
+#include "tests/framework/script_world.h"
 
 namespace swarmsim {
 namespace {
 
-std::shared_ptr<const ScriptSource> Source(std::string path, std::string code) {
-  return std::make_shared<const ScriptSource>(ScriptSource{std::move(path), std::move(code)});
-}
-
-// A world with null modules whose script output lands in `log`.
-class ScriptWorld {
- public:
-  explicit ScriptWorld(int threads = 1, uint64_t seed = 1, WorldSettings settings = {})
-      : registry_(testing::NullRegistry()) {
-    settings.physics = "null";
-    settings.time_step = 0.1;
-    settings.threads = threads;
-    settings.seed = seed;
-    world_ = std::make_unique<World>(settings, registry_);
-    world_->set_log_sink([this](std::string_view line) { log.emplace_back(line); });
-  }
-  World& world() { return *world_; }
-  Scene& scene() { return world_->scene(); }
-
-  // A robot: a root dummy named like the instance (model root) carrying a
-  // `body` shape with joints `leftMotor` and `rightMotor`; `code` attached to
-  // the body unless empty. Returns the body.
-  ObjectId AddRobot(const std::string& name, const std::string& code,
-                    const std::string& path = "scripts/robot.lua") {
-    const ObjectId root = scene().AddDummy(name, {}, {{next_x_, 0, 0}, {}});
-    next_x_ += 1;
-    const ObjectId body = scene().AddShape("body", root, {}, {});
-    scene().AddJoint("leftMotor", body, {{0, 0.05, 0}, {}}, {});
-    scene().AddJoint("rightMotor", body, {{0, -0.05, 0}, {}}, {});
-    scene().MakeModelInstance(root, "bot", name);
-    if (!code.empty()) scene().AttachScript(body, Source(path, code));
-    return body;
-  }
-  ObjectId Joint(const std::string& path) { return scene().FindObject(path); }
-
-  std::vector<std::string> log;
-
- private:
-  ModuleRegistry registry_;
-  std::unique_ptr<World> world_;
-  double next_x_ = 0;
-};
+using script_test::ScriptWorld;
+using script_test::Source;
 
 using testing::ErrorOf;
 
@@ -63,7 +24,7 @@ using testing::ErrorOf;
 
 TEST(ScriptHostTest, CallbacksRunInOrderAcrossSteps) {
   ScriptWorld w;
-  w.AddRobot("bot#0", R"(
+  w.AddWheeledRobot("bot#0", R"(
     print('body')
     function sysCall_init() print('init', sim.getSimulationTime()) end
     function sysCall_sensing() print('sensing', sim.getSimulationTime()) end
@@ -105,7 +66,7 @@ TEST(ScriptHostTest, ScriptsRunParentBeforeChildSiblingsInCreationOrder) {
 
 TEST(ScriptHostTest, MissingCallbacksAreSkippedAndDisabledScriptsDoNotRun) {
   ScriptWorld w;
-  const ObjectId body = w.AddRobot("bot#0", "function sysCall_init() print('on') end");
+  const ObjectId body = w.AddWheeledRobot("bot#0", "function sysCall_init() print('on') end");
   const ObjectId eye = w.scene().AddDummy("eye", body, {});
   w.scene().AttachScript(eye, Source("scripts/eye.lua", "print('eye body')"));
   // Scene has no setter yet for ScriptAttachment::enabled (the world loader
@@ -120,7 +81,7 @@ TEST(ScriptHostTest, MissingCallbacksAreSkippedAndDisabledScriptsDoNotRun) {
 
 TEST(ScriptHostTest, EachScriptHasItsOwnGlobalsAndOnlySafeLibraries) {
   ScriptWorld w;
-  const ObjectId body = w.AddRobot("bot#0", R"(
+  const ObjectId body = w.AddWheeledRobot("bot#0", R"(
     secret = 42
     _G.also_secret = 1
     load('loaded = 7')()
@@ -152,7 +113,7 @@ TEST(ScriptHostTest, EachScriptHasItsOwnGlobalsAndOnlySafeLibraries) {
 
 TEST(ScriptHostTest, CoroutinesSeeTheirScriptsContext) {
   ScriptWorld w;
-  w.AddRobot("bot#0", R"(
+  w.AddWheeledRobot("bot#0", R"(
     function sysCall_init()
       local co = coroutine.wrap(function() coroutine.yield(sim.getObjectName(sim.getObject('.'))) end)
       print(co(), sim.getRobotName(), sim.getRobotIndex())
@@ -166,9 +127,10 @@ TEST(ScriptHostTest, CoroutinesSeeTheirScriptsContext) {
 
 TEST(ScriptHostTest, RuntimeErrorNamesRobotFileLineAndCallbackAndStopsTheWorld) {
   ScriptWorld w;
-  w.AddRobot("bot#0", "function sysCall_actuation() end");
-  w.AddRobot("bot#1", "function sysCall_actuation()\n  local wheel = 1\n  local v = speed * 2\nend",
-             "scripts/broken.lua");
+  w.AddWheeledRobot("bot#0", "function sysCall_actuation() end");
+  w.AddWheeledRobot("bot#1",
+                    "function sysCall_actuation()\n  local wheel = 1\n  local v = speed * 2\nend",
+                    "scripts/broken.lua");
   w.world().Start();
   const std::string msg = ErrorOf([&] { w.world().Step(); });
   EXPECT_CONTAINS(msg,
@@ -181,10 +143,10 @@ TEST(ScriptHostTest, TheLowestRobotsErrorIsReportedWhateverTheThreadCount) {
   for (int threads : {1, 2}) {
     ScriptWorld w(threads);
     for (int r = 0; r < 40; ++r)
-      w.AddRobot("bot#" + std::to_string(r),
-                 r < 17 ? "function sysCall_sensing() end"
-                        : "function sysCall_sensing() error('boom') end",
-                 "scripts/r" + std::to_string(r) + ".lua");
+      w.AddWheeledRobot("bot#" + std::to_string(r),
+                        r < 17 ? "function sysCall_sensing() end"
+                               : "function sysCall_sensing() error('boom') end",
+                        "scripts/r" + std::to_string(r) + ".lua");
     w.world().Start();
     const std::string msg = ErrorOf([&] { w.world().Step(); });
     EXPECT_CONTAINS(msg, "bot#17: scripts/r17.lua:1: boom [in sysCall_sensing of /bot#17/body]");
@@ -193,7 +155,7 @@ TEST(ScriptHostTest, TheLowestRobotsErrorIsReportedWhateverTheThreadCount) {
 
 TEST(ScriptHostTest, SyntaxErrorNamesRobotFileAndLine) {
   ScriptWorld w;
-  w.AddRobot("bot#0", "function sysCall_init()\n  local x = = 1\nend", "scripts/syntax.lua");
+  w.AddWheeledRobot("bot#0", "function sysCall_init()\n  local x = = 1\nend", "scripts/syntax.lua");
   const std::string msg = ErrorOf([&] { w.world().Start(); });
   EXPECT_CONTAINS(msg, "bot#0: scripts/syntax.lua:2: unexpected symbol near '='");
   EXPECT_CONTAINS(msg, "[in loading the script of /bot#0/body]");
@@ -202,14 +164,14 @@ TEST(ScriptHostTest, SyntaxErrorNamesRobotFileAndLine) {
 
 TEST(ScriptHostTest, UnclosedFunctionIsReportedAsInTheFile) {
   ScriptWorld w;
-  w.AddRobot("bot#0", "function sysCall_init()\n  print(1)\n", "scripts/open.lua");
+  w.AddWheeledRobot("bot#0", "function sysCall_init()\n  print(1)\n", "scripts/open.lua");
   EXPECT_CONTAINS(ErrorOf([&] { w.world().Start(); }),
                   "scripts/open.lua:3: 'end' expected (to close 'function' at line 1) near <eof>");
 }
 
 TEST(ScriptHostTest, ScriptCannotCloseItsWrapperEarly) {
   ScriptWorld w;
-  w.AddRobot("bot#0", "end, function() print('escaped')", "scripts/sneaky.lua");
+  w.AddWheeledRobot("bot#0", "end, function() print('escaped')", "scripts/sneaky.lua");
   EXPECT_CONTAINS(ErrorOf([&] { w.world().Start(); }), "bot#0: scripts/sneaky.lua:1:");
 }
 
@@ -234,8 +196,8 @@ TEST(ScriptHostTest, ErrorsInsideSimCallsCarryTheCallersLine) {
   };
   for (const Case& c : cases) {
     ScriptWorld w;
-    w.AddRobot("bot#0", "function sysCall_sensing()\n\n  local r = " + c.call + "\nend",
-               "scripts/call.lua");
+    w.AddWheeledRobot("bot#0", "function sysCall_sensing()\n\n  local r = " + c.call + "\nend",
+                      "scripts/call.lua");
     w.world().Start();
     const std::string msg = ErrorOf([&] { w.world().Step(); });
     EXPECT_CONTAINS(msg, "bot#0: scripts/call.lua:3: " + c.message);
@@ -245,7 +207,7 @@ TEST(ScriptHostTest, ErrorsInsideSimCallsCarryTheCallersLine) {
 
 TEST(ScriptHostTest, CleanupErrorIsReportedByStop) {
   ScriptWorld w;
-  w.AddRobot("bot#0", "function sysCall_cleanup()\n  error('bye')\nend", "scripts/c.lua");
+  w.AddWheeledRobot("bot#0", "function sysCall_cleanup()\n  error('bye')\nend", "scripts/c.lua");
   w.world().Start();
   EXPECT_CONTAINS(ErrorOf([&] { w.world().Stop(); }),
                   "bot#0: scripts/c.lua:2: bye [in sysCall_cleanup of /bot#0/body]");
@@ -255,7 +217,7 @@ TEST(ScriptHostTest, CleanupErrorIsReportedByStop) {
 
 TEST(ScriptHostTest, SceneScriptsRunAfterRobotsAndWriteDirectly) {
   ScriptWorld w;
-  w.AddRobot("bot#0", "function sysCall_actuation() print('robot') end");
+  w.AddWheeledRobot("bot#0", "function sysCall_actuation() print('robot') end");
   const ObjectId floor = w.scene().AddDummy("floor", {}, {});
   w.scene().AttachScript(floor, Source("scripts/main.lua", R"(
     function sysCall_init() print('scene init', sim.getRobotIndex(), sim.getRobotName()) end
@@ -290,7 +252,7 @@ TEST(ScriptHostTest, SameStateWhateverTheThreadCount) {
   auto run = [](int threads) {
     ScriptWorld w(threads, 42);
     for (int r = 0; r < 50; ++r)
-      w.AddRobot("bot#" + std::to_string(r), R"(
+      w.AddWheeledRobot("bot#" + std::to_string(r), R"(
         local left, right
         function sysCall_init() left, right = sim.getObject('./leftMotor'), sim.getObject('./rightMotor') end
         function sysCall_actuation()
@@ -320,7 +282,7 @@ TEST(ScriptHostTest, HandleChildScriptsPassesIntegralArgumentsAsIntegers) {
     end
   )");
   ScriptWorld w(1, 1, settings);
-  w.AddRobot("bot#0", R"(
+  w.AddWheeledRobot("bot#0", R"(
     function sysCall_sensing(...)
       local types = {}
       for i = 1, select('#', ...) do types[i] = math.type((select(i, ...))) end
@@ -369,8 +331,8 @@ TEST(ScriptHostTest, MainAndSceneScriptMessagesAreDeliveredAtTheNextStep) {
       end
     )");
     ScriptWorld w(threads, 1, settings);
-    w.AddRobot("a", kPrintMessages);
-    w.AddRobot("b", kPrintMessages);
+    w.AddWheeledRobot("a", kPrintMessages);
+    w.AddWheeledRobot("b", kPrintMessages);
     const ObjectId floor = w.scene().AddDummy("floor", {}, {});
     w.scene().AttachScript(floor, Source("scripts/floor.lua", std::string(kPrintMessages) + R"(
       function sysCall_sensing()
@@ -400,7 +362,7 @@ TEST(ScriptHostTest, RangeMessageFromTheMainScriptIsAnError) {
   settings.main_script =
       Source("main.lua", "function sysCall_step()\n  sim.sendRangeMessage('x', 1)\nend");
   ScriptWorld w(1, 1, settings);
-  w.AddRobot("a", kPrintMessages);
+  w.AddWheeledRobot("a", kPrintMessages);
   w.world().Start();
   EXPECT_CONTAINS(ErrorOf([&] { w.world().Step(); }),
                   "main.lua:2: sim.sendRangeMessage: the main script has no position: use "
@@ -409,8 +371,8 @@ TEST(ScriptHostTest, RangeMessageFromTheMainScriptIsAnError) {
 
 TEST(ScriptHostTest, MemoryIsReportedAndReleasedAtStop) {
   ScriptWorld w;
-  w.AddRobot("bot#0", "function sysCall_actuation() end");
-  w.AddRobot("bot#1", "");
+  w.AddWheeledRobot("bot#0", "function sysCall_actuation() end");
+  w.AddWheeledRobot("bot#1", "");
   w.world().Start();
   EXPECT_GT(w.world().script_memory_bytes(), 1000u);
   w.world().Stop();

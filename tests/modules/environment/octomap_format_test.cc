@@ -16,6 +16,7 @@
 #include "framework/error.h"
 #include "modules/environment/octomap_map.h"
 #include "tests/framework/error_of.h"
+#include "tests/modules/environment/octomap_files.h"
 #include "tests/shared_maps.h"
 
 namespace swarmsim::environment {
@@ -29,54 +30,10 @@ std::string ReadAll(const std::string& path) {
   return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
-// A file in a fresh temporary folder, removed with the fixture.
-class OctomapFileTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("swarmsim_octomap_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string Write(const std::string& name, const std::string& bytes) {
-    const fs::path p = dir_ / name;
-    std::ofstream(p, std::ios::binary) << bytes;
-    return p.string();
-  }
-  fs::path dir_;
-};
-
-std::string BinaryHeader(uint64_t size, const std::string& id = "OcTree") {
-  return "# Octomap OcTree binary file\n# made by a test\nid " + id + "\nsize " +
-         std::to_string(size) + "\nres 0.1\ndata\n";
-}
-
-// A .bt of one occupied voxel at key (32768, 32768, 32768), i.e. the cube
-// [0, 0.1]^3: the root's child 7, then child 0 at every level below.
-std::string OneVoxelBinary(unsigned leaf_code = 2) {
-  std::string body;
-  body += '\0';
-  body += static_cast<char>(0xC0);  // root: child 7 is an inner node (code 3 at bits 14-15)
-  for (int depth = 1; depth < 15; ++depth) body += "\x03", body += '\0';  // child 0 inner
-  body += static_cast<char>(leaf_code), body += '\0';  // depth 15: child 0 is a leaf
-  return BinaryHeader(17) + body;
-}
-
-// The same voxel as a .ot of `id` with leaf log-odds `leaf_value`.
-std::string OneVoxelFull(float leaf_value, const std::string& id = "OcTree") {
-  std::string out = "# Octomap OcTree file\nid " + id + "\nsize 17\nres 0.1\ndata\n";
-  auto node = [&](float value, unsigned char children) {
-    char bytes[4];
-    std::memcpy(bytes, &value, 4);
-    out.append(bytes, 4);
-    out += static_cast<char>(children);
-  };
-  node(0, 0x80);                                           // root: child 7
-  for (int depth = 1; depth < 16; ++depth) node(0, 0x01);  // child 0
-  node(leaf_value, 0);                                     // the voxel
-  return out;
-}
+using octomap_test::BinaryHeader;
+using octomap_test::OctomapFileTest;
+using octomap_test::OneVoxelBinary;
+using octomap_test::OneVoxelFull;
 
 TEST_F(OctomapFileTest, AWrongFirstLineIsNotAnOctomapFile) {
   const std::string file = Write("x.bt", "hello world\nid OcTree\nsize 1\nres 0.1\ndata\n\0\0");
