@@ -1,0 +1,53 @@
+// The Python binding's arrays (swarm/python/module.cc): one model's robots
+// laid out by slot, and the numpy arrays gathered from them (poses,
+// velocities, proximity readings, joints), written into `out=` when given.
+#pragma once
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "framework/world.h"
+
+namespace swarmsim::python {
+
+namespace py = pybind11;
+using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+// Slots of one model's robots' joints and proximity sensors, in the model's
+// hierarchy order, rebuilt when robots are copied or removed.
+struct ModelLayout {
+  std::string model;
+  std::vector<int> robots;                // instance indices, alive, ascending
+  std::vector<std::string> joint_names;   // per robot, hierarchy order
+  std::vector<std::string> sensor_names;  // proximity sensors, hierarchy order
+  std::vector<uint32_t> root_slots;       // per robot
+  std::vector<uint32_t> joint_slots;      // robots x joints
+  std::vector<uint32_t> sensor_slots;     // robots x sensors
+  int64_t robot_count = -1;               // World::robot_count() it was built at
+};
+
+// Rebuilds `layout` for `model` ("" : every robot) if robots came or went.
+void Refresh(const World& world, const std::string& model, ModelLayout* layout);
+
+// An output array of `shape`: `out` if it is one (float64, C-contiguous,
+// writeable, that shape), else a new one.
+Array OutArray(std::vector<py::ssize_t> shape, const py::object& out);
+
+// Poses of the layout's robots' roots: N x 3 (x, y, yaw) or N x 7 (x, y, z,
+// qw, qx, qy, qz).
+Array Poses(World& world, const ModelLayout& layout, bool planar, const py::object& out);
+
+Array Velocities(const Scene& scene, const ModelLayout& layout, const py::object& out);
+
+// Proximity readings, N x sensors: the distance to what each sensor sees,
+// +inf where it sees nothing.
+Array Proximity(const Scene& scene, const ModelLayout& layout, const py::object& out);
+
+// Joint positions (what = 0) or velocities (1), N x joints.
+Array Joints(const Scene& scene, const ModelLayout& layout, int what, const py::object& out);
+
+}  // namespace swarmsim::python
