@@ -220,9 +220,6 @@ bool PushPluginCommand(lua_State* L, std::string_view name);
 // Creates the global `sim` table and calls every Register...Api above.
 void RegisterAllApis(lua_State* L);
 
-// Opens the safe standard libraries (base without file access or binary
-// chunks, string, table, math, coroutine, utf8) into the globals.
-void OpenSafeLibraries(lua_State* L);
 // The libraries of a script state: the safe ones plus the sandboxed io,
 // os, require (lua_sandbox.cc), or all of Lua's under trust_scripts.
 void OpenSandbox(lua_State* L);

@@ -31,6 +31,7 @@
 #include <sstream>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "framework/display_path.h"
 #include "framework/error.h"
@@ -120,40 +121,151 @@ int SafeCollectGarbage(lua_State* L) {
   return lua_gettop(L);
 }
 
-// Replaces the global table `name` (and its package.loaded entry) by a copy
-// without the `dropped` fields, sized for what is left: a table's hash part
-// never shrinks, and every robot's state carries it.
-void Compact(lua_State* L, const char* name, std::initializer_list<const char*> dropped) {
-  lua_getglobal(L, name);
+[[noreturn]] void Refuse(lua_State* L, const std::string& what);
+
+// A standard library's entries that need nothing of the state they live in
+// (C functions without upvalues, and numbers), read once per process from a
+// scratch state, sorted by name.
+struct LibraryEntry {
+  std::string name;
+  int type = LUA_TNIL;
+  lua_CFunction function = nullptr;
+  bool is_integer = false;
+  lua_Integer integer = 0;
+  lua_Number number = 0;
+};
+struct LazyLibrary {
+  std::vector<LibraryEntry> entries;
+  const char* refused = nullptr;  // a field refused by name ("dump" of string), or null
+  const char* name = "";
+};
+
+LazyLibrary ReadLibrary(const char* name, lua_CFunction open,
+                        std::initializer_list<const char*> dropped, const char* refused) {
+  LazyLibrary library;
+  library.name = name;
+  library.refused = refused;
+  lua_State* L = luaL_newstate();
+  if (L == nullptr) throw std::bad_alloc();
+  luaL_requiref(L, name, open, 0);
+  for (lua_pushnil(L); lua_next(L, -2) != 0; lua_pop(L, 1)) {
+    if (lua_type(L, -2) != LUA_TSTRING) continue;
+    LibraryEntry e;
+    e.name = lua_tostring(L, -2);
+    const bool drop = std::any_of(dropped.begin(), dropped.end(),
+                                  [&](const char* field) { return e.name == field; });
+    e.type = lua_type(L, -1);
+    if (drop || e.name == (refused != nullptr ? refused : "")) continue;
+    if (e.type == LUA_TFUNCTION) {
+      if (!lua_iscfunction(L, -1)) continue;
+      if (lua_getupvalue(L, -1, 1) != nullptr) {  // its own state's (math.random's generator)
+        lua_pop(L, 1);
+        continue;
+      }
+      e.function = lua_tocfunction(L, -1);
+    } else if (e.type == LUA_TNUMBER) {
+      e.is_integer = lua_isinteger(L, -1);
+      e.integer = lua_tointeger(L, -1);
+      e.number = lua_tonumber(L, -1);
+    } else {
+      continue;
+    }
+    library.entries.push_back(std::move(e));
+  }
+  lua_close(L);
+  std::sort(library.entries.begin(), library.entries.end(),
+            [](const LibraryEntry& a, const LibraryEntry& b) { return a.name < b.name; });
+  return library;
+}
+
+// __index of a lazy library table (upvalue 1: its LazyLibrary): fetch the
+// entry, keep it in the table. A missing field is nil as usual, except the
+// one refused by name.
+const LibraryEntry* FindEntry(const LazyLibrary& library, std::string_view key) {
+  const auto it =
+      std::lower_bound(library.entries.begin(), library.entries.end(), key,
+                       [](const LibraryEntry& e, std::string_view k) { return e.name < k; });
+  return it == library.entries.end() || it->name != key ? nullptr : &*it;
+}
+
+// Pushes the entry, and keeps it in the table at index 1 under the key at
+// index 2 (an __index call's arguments).
+int KeepEntry(lua_State* L, const LibraryEntry& entry) {
+  switch (entry.type) {
+    case LUA_TFUNCTION: lua_pushcfunction(L, entry.function); break;
+    case LUA_TNUMBER:
+      if (entry.is_integer)
+        lua_pushinteger(L, entry.integer);
+      else
+        lua_pushnumber(L, entry.number);
+      break;
+    default: return 0;
+  }
+  lua_pushvalue(L, 2);
+  lua_pushvalue(L, -2);
+  lua_rawset(L, 1);
+  return 1;
+}
+
+int LazyLibraryIndex(lua_State* L) {
+  const auto& library = *static_cast<const LazyLibrary*>(lua_touserdata(L, lua_upvalueindex(1)));
+  if (lua_type(L, 2) != LUA_TSTRING) return 0;
+  const std::string_view key = lua_tostring(L, 2);
+  if (const LibraryEntry* entry = FindEntry(library, key)) return KeepEntry(L, *entry);
+  if (library.refused != nullptr && key == library.refused)
+    Refuse(L, std::string(library.name) + "." + library.refused);
+  return 0;
+}
+
+// The base library's functions, fetched into the globals on first use
+// (SandboxGlobalIndex), but for those the sandbox replaces or removes.
+const LazyLibrary& BaseLibrary() {
+  static const LazyLibrary base = ReadLibrary(
+      LUA_GNAME, luaopen_base,
+      {"load", "setmetatable", "collectgarbage", "dofile", "loadfile", "warn", "print"}, nullptr);
+  return base;
+}
+// Lua's own load and collectgarbage, which the sandbox wraps.
+lua_CFunction BaseFunction(const char* name) {
+  static const LazyLibrary all = ReadLibrary(LUA_GNAME, luaopen_base, {}, nullptr);
+  const LibraryEntry* entry = FindEntry(all, name);
+  SWARMSIM_CHECK(entry != nullptr && entry->function != nullptr, "Lua's base library changed");
+  return entry->function;
+}
+
+// Replaces the global table `name` (and its package.loaded entry), opened
+// already, by an empty table that fetches each entry of `library` on first
+// use: every robot's state carries its libraries, and a script uses a few
+// of their functions (math: 7 of 28 in diffusion.lua; ~3 KB per robot
+// less for math, string and table). Entries that hold something of the
+// state (math.random and math.randomseed share its generator) are copied
+// now. `pairs(math)` lists what the robot has used so far.
+void MakeLazy(lua_State* L, const LazyLibrary& library) {
+  lua_getglobal(L, library.name);
   const int old = lua_gettop(L);
-  int kept = 0;
-  for (lua_pushnil(L); lua_next(L, old) != 0; lua_pop(L, 1)) ++kept;
-  lua_createtable(L, 0, kept - static_cast<int>(dropped.size()));
+  lua_newtable(L);
   for (lua_pushnil(L); lua_next(L, old) != 0; lua_pop(L, 1)) {
-    bool drop = false;
-    for (const char* field : dropped)
-      drop =
-          drop || (lua_type(L, -2) == LUA_TSTRING && std::strcmp(lua_tostring(L, -2), field) == 0);
-    if (drop) continue;
+    if (lua_type(L, -1) != LUA_TFUNCTION || lua_getupvalue(L, -1, 1) == nullptr) continue;
+    lua_pop(L, 1);
     lua_pushvalue(L, -2);
     lua_pushvalue(L, -2);
     lua_rawset(L, -5);
   }
+  lua_createtable(L, 0, 1);
+  lua_pushlightuserdata(L, const_cast<LazyLibrary*>(&library));
+  lua_pushcclosure(L, (Guarded<LazyLibraryIndex, "">), 1);
+  lua_setfield(L, -2, "__index");
+  lua_setmetatable(L, -2);
   lua_pushvalue(L, -1);
-  lua_setglobal(L, name);
+  lua_setglobal(L, library.name);
   lua_getfield(L, LUA_REGISTRYINDEX, LUA_LOADED_TABLE);
   lua_insert(L, -2);
-  lua_setfield(L, -2, name);
+  lua_setfield(L, -2, library.name);
   lua_settop(L, old - 1);
 }
 
-// Replaces the global `name` with `wrapper`, which gets the original as its
-// upvalue 1; WrapField does the same for field `name` of the table at `table`.
-void Wrap(lua_State* L, const char* name, lua_CFunction wrapper) {
-  lua_getglobal(L, name);
-  lua_pushcclosure(L, wrapper, 1);
-  lua_setglobal(L, name);
-}
+// Replaces field `name` of the table at `table` with `wrapper`, which gets
+// the original as its upvalue 1.
 void WrapField(lua_State* L, int table, const char* name, lua_CFunction wrapper) {
   table = lua_absindex(L, table);
   lua_getfield(L, table, name);
@@ -174,14 +286,6 @@ int RefuseField(lua_State* L) {
   const char* library = lua_tostring(L, lua_upvalueindex(1));
   const char* field = lua_type(L, 2) == LUA_TSTRING ? lua_tostring(L, 2) : "?";
   Refuse(L, std::string(library) + "." + field);
-}
-
-// __index of the string table: string.dump, which makes binary chunks, is
-// refused by name; other missing fields are nil as usual ("s.x" reads them).
-int StringIndex(lua_State* L) {
-  if (lua_type(L, 2) == LUA_TSTRING && std::strcmp(lua_tostring(L, 2), "dump") == 0)
-    Refuse(L, "string.dump");
-  return 0;
 }
 
 // A table whose missing fields are refused; left on the stack.
@@ -491,6 +595,8 @@ int SandboxGlobalIndex(lua_State* L) {
   } else if (key == "dofile" || key == "loadfile") {
     lua_pushvalue(L, 2);
     lua_pushcclosure(L, (Guarded<RefuseFunction, "">), 1);
+  } else if (const LibraryEntry* entry = FindEntry(BaseLibrary(), key)) {
+    return KeepEntry(L, *entry);  // pairs, tostring, ... (OpenSafeLibraries)
   } else {
     return 0;
   }
@@ -527,6 +633,13 @@ void OpenTrusted(lua_State* L) {
 
 }  // namespace
 
+namespace {
+// The safe standard libraries (base without file access or binary chunks,
+// string, table, math; coroutine and utf8 on first use), each entry there
+// on first use through the globals' metatable (SandboxGlobalIndex).
+void OpenSafeLibraries(lua_State* L);
+}  // namespace
+
 void OpenSandbox(lua_State* L) {
   if (Context(L).world != nullptr && Context(L).world->settings().trust_scripts) {
     OpenTrusted(L);
@@ -541,11 +654,28 @@ void OpenSandbox(lua_State* L) {
   lua_pop(L, 1);
 }
 
+namespace {
 void OpenSafeLibraries(lua_State* L) {
-  // coroutine and utf8, which few controllers use, are opened on first use
-  // (SandboxGlobalIndex): ~1 KB less per robot.
+  // The base library's functions come on first use too (SandboxGlobalIndex
+  // through BaseLibrary), and coroutine and utf8, which few controllers use:
+  // the globals hold _G, _VERSION and the sandbox's own load, setmetatable
+  // and collectgarbage. No dofile, loadfile (refused by name) or warn (it
+  // writes to the process's stderr).
+  lua_pushglobaltable(L);
+  lua_pushvalue(L, -1);
+  lua_setfield(L, -2, LUA_GNAME);
+  lua_pushliteral(L, LUA_VERSION);
+  lua_setfield(L, -2, "_VERSION");
+  lua_pushcfunction(L, BaseFunction("load"));
+  lua_pushcclosure(L, (Guarded<SafeLoad, "">), 1);
+  lua_setfield(L, -2, "load");
+  lua_pushcfunction(L, BaseFunction("collectgarbage"));
+  lua_pushcclosure(L, (Guarded<SafeCollectGarbage, "collectgarbage">), 1);
+  lua_setfield(L, -2, "collectgarbage");
+  lua_pushcfunction(L, (Guarded<SafeSetMetatable, "setmetatable">));
+  lua_setfield(L, -2, "setmetatable");
+  lua_pop(L, 1);
   static constexpr luaL_Reg kLibraries[] = {
-      {LUA_GNAME, luaopen_base},
       {LUA_TABLIBNAME, luaopen_table},
       {LUA_STRLIBNAME, luaopen_string},
       {LUA_MATHLIBNAME, luaopen_math},
@@ -554,36 +684,26 @@ void OpenSafeLibraries(lua_State* L) {
     luaL_requiref(L, library.name, library.func, 1);
     lua_pop(L, 1);
   }
-  // No file access, no writing to the process's stderr.
-  for (const char* name : {"dofile", "loadfile", "warn"}) {
-    lua_pushnil(L);
-    lua_setglobal(L, name);
-  }
-  Wrap(L, "load", Guarded<SafeLoad, "">);
-  lua_pushcfunction(L, (Guarded<SafeSetMetatable, "setmetatable">));
-  lua_setglobal(L, "setmetatable");
-  Wrap(L, "collectgarbage", Guarded<SafeCollectGarbage, "collectgarbage">);
-  // string.dump makes binary chunks, which nothing here can load: the
-  // table's __index refuses it by name (kept out of the table, 16 entries
-  // fit its 16 slots). Strings' methods ("abc"):upper() come from the new
-  // table too.
-  Compact(L, LUA_STRLIBNAME, {"dump"});
-  lua_getglobal(L, LUA_STRLIBNAME);
-  lua_createtable(L, 0, 1);
-  lua_pushcfunction(L, (Guarded<StringIndex, "">));
-  lua_setfield(L, -2, "__index");
-  lua_setmetatable(L, -2);
+  // Each library fetches its entries on first use (MakeLazy). string.dump
+  // makes binary chunks, which nothing here can load: it is refused by
+  // name. Strings' methods ("abc"):upper() come from the new table too.
+  // Debian builds Lua with LUA_COMPAT_MATHLIB: the functions 5.4 deprecated
+  // (cosh, pow, ...) are left out.
+  static const LazyLibrary kString = ReadLibrary(LUA_STRLIBNAME, luaopen_string, {}, "dump");
+  static const LazyLibrary kTable = ReadLibrary(LUA_TABLIBNAME, luaopen_table, {}, nullptr);
+  static const LazyLibrary kMath =
+      ReadLibrary(LUA_MATHLIBNAME, luaopen_math,
+                  {"cosh", "sinh", "tanh", "pow", "frexp", "ldexp", "log10"}, nullptr);
+  for (const LazyLibrary* library : {&kString, &kTable, &kMath}) MakeLazy(L, *library);
   lua_pushliteral(L, "");
   lua_getmetatable(L, -1);
-  lua_pushvalue(L, -3);
+  lua_getglobal(L, LUA_STRLIBNAME);
   lua_setfield(L, -2, "__index");
-  lua_pop(L, 3);
-  // Debian builds Lua with LUA_COMPAT_MATHLIB: functions 5.4 deprecated, and
-  // 35 entries need a 64-slot table where 28 fit in 32 (~0.5 KB per robot).
-  Compact(L, LUA_MATHLIBNAME, {"cosh", "sinh", "tanh", "pow", "frexp", "ldexp", "log10"});
+  lua_pop(L, 2);
   lua_getglobal(L, LUA_MATHLIBNAME);
   WrapField(L, -1, "randomseed", Guarded<SafeRandomSeed, "math.randomseed">);
   lua_pop(L, 1);
 }
+}  // namespace
 
 }  // namespace swarmsim

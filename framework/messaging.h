@@ -91,6 +91,10 @@ class Messaging {
  public:
   // Mail for robots 0 .. robot_count - 1 (robots are only added).
   void Resize(int robot_count);
+  void Reserve(size_t robot_count) {
+    robots_.reserve(robot_count);
+    pending_.reserve(robot_count);
+  }
   RobotMail& robot_mail(int robot) { return robots_[robot]; }
   // A removed robot: its inbox, unsent messages and writes are dropped.
   void ClearRobot(int robot);

@@ -131,8 +131,7 @@ uint32_t Scene::AllocateSlot(std::string_view name, ObjectId parent, const Pose&
     slot = static_cast<uint32_t>(generation_.size());
     X_PO_.emplace_back();
     X_WO_.emplace_back();
-    v_WO_.emplace_back();
-    w_WO_.emplace_back();
+    motion_.push_back(kNoMotion);
     parent_.push_back(-1);
     first_child_.push_back(-1);
     last_child_.push_back(-1);
@@ -147,13 +146,18 @@ uint32_t Scene::AllocateSlot(std::string_view name, ObjectId parent, const Pose&
     model_root_.push_back(0);
     name_.push_back(0);
     script_.push_back(-1);
-    linked_dummy_.push_back(-1);
-    custom_data_.emplace_back();
-    size_factor_.push_back(1);
   }
   X_PO_[slot] = X_PO;
-  v_WO_[slot] = {};
-  w_WO_[slot] = {};
+  if (type == ObjectType::kShape) {
+    if (!free_motions_.empty()) {
+      motion_[slot] = free_motions_.back();
+      free_motions_.pop_back();
+      motions_[motion_[slot]] = {};
+    } else {
+      motion_[slot] = static_cast<uint32_t>(motions_.size());
+      motions_.emplace_back();
+    }
+  }
   type_[slot] = type;
   row_[slot] = 0;
   simulated_[slot] = 0;
@@ -161,9 +165,6 @@ uint32_t Scene::AllocateSlot(std::string_view name, ObjectId parent, const Pose&
   model_root_[slot] = 0;
   name_[slot] = names_.Intern(name);
   script_[slot] = -1;
-  linked_dummy_[slot] = -1;
-  DropCustomData(slot);
-  size_factor_[slot] = 1;
   parent_[slot] = -1;
   first_child_[slot] = last_child_[slot] = next_sibling_[slot] = prev_sibling_[slot] = -1;
   instance_[slot] = parent_slot >= 0 ? instance_[parent_slot] : -1;
@@ -183,9 +184,18 @@ void Scene::FreeSlot(uint32_t slot) {
   }
   if (script_[slot] >= 0) scripts_[script_[slot]] = {};
   // Unlink any dummy linked to this one.
-  if (linked_dummy_[slot] >= 0 && linked_dummy_[linked_dummy_[slot]] == static_cast<int32_t>(slot))
-    linked_dummy_[linked_dummy_[slot]] = -1;
+  if (const auto link = linked_dummy_.find(slot); link != linked_dummy_.end()) {
+    if (const auto back = linked_dummy_.find(link->second);
+        back != linked_dummy_.end() && back->second == slot)
+      linked_dummy_.erase(back);
+    linked_dummy_.erase(link);
+  }
+  size_factor_.erase(slot);
   alive_[slot] = 0;
+  if (motion_[slot] != kNoMotion) {
+    free_motions_.push_back(motion_[slot]);
+    motion_[slot] = kNoMotion;
+  }
   DropCustomData(slot);
   ++generation_[slot];
   names_.Release(name_[slot]);
@@ -491,48 +501,52 @@ void Scene::LinkDummies(ObjectId a, ObjectId b) {
   const uint32_t sa = SlotOf(a, "dummy"), sb = SlotOf(b, "dummy");
   ExpectType(*this, sa, ObjectType::kDummy);
   ExpectType(*this, sb, ObjectType::kDummy);
-  linked_dummy_[sa] = static_cast<int32_t>(sb);
-  linked_dummy_[sb] = static_cast<int32_t>(sa);
+  linked_dummy_[sa] = sb;
+  linked_dummy_[sb] = sa;
 }
 
 void Scene::WriteCustomData(ObjectId id, const std::string& tag, std::string data,
                             ScriptMemory* writer) {
-  auto& blocks = custom_data_[SlotOf(id)];
-  if (blocks) {
-    if (auto it = blocks->find(tag); it != blocks->end()) {
+  const uint32_t slot = SlotOf(id);
+  auto found = custom_data_.find(slot);
+  if (found != custom_data_.end()) {
+    CustomData& blocks = found->second;
+    if (auto it = blocks.find(tag); it != blocks.end()) {
       if (it->second.writer != nullptr)
         it->second.writer->Release(CustomDataBytes(tag.size(), it->second.data.size()));
-      if (data.empty()) blocks->erase(it);
+      if (data.empty()) blocks.erase(it);
     }
+    if (blocks.empty()) custom_data_.erase(found);
   }
   if (data.empty()) {
     if (writer != nullptr) writer->Release(CustomDataBytes(tag.size(), 0));
     return;
   }
-  if (!blocks) blocks = std::make_unique<CustomData>();
-  (*blocks)[tag] = {std::move(data), writer};
+  custom_data_[slot][tag] = {std::move(data), writer};
 }
 
 void Scene::DropCustomData(uint32_t slot) {
-  std::unique_ptr<CustomData> blocks = std::move(custom_data_[slot]);
-  if (!blocks) return;
-  for (const auto& [tag, block] : *blocks)
+  const auto found = custom_data_.find(slot);
+  if (found == custom_data_.end()) return;
+  const CustomData blocks = std::move(found->second);
+  custom_data_.erase(found);
+  for (const auto& [tag, block] : blocks)
     if (block.writer != nullptr)
       block.writer->Release(CustomDataBytes(tag.size(), block.data.size()));
 }
 
 const std::string* Scene::ReadCustomData(ObjectId id, const std::string& tag) const {
-  const auto& blocks = custom_data_[SlotOf(id)];
-  if (!blocks) return nullptr;
-  auto it = blocks->find(tag);
-  return it == blocks->end() ? nullptr : &it->second.data;
+  const auto found = custom_data_.find(SlotOf(id));
+  if (found == custom_data_.end()) return nullptr;
+  auto it = found->second.find(tag);
+  return it == found->second.end() ? nullptr : &it->second.data;
 }
 
 void Scene::HashCustomData(uint32_t slot, StateHasher* hasher) const {
-  const auto& blocks = custom_data_[slot];
-  if (!blocks) return;
+  const auto found = custom_data_.find(slot);
+  if (found == custom_data_.end()) return;
   hasher->AddValue(slot);
-  for (const auto& [tag, block] : *blocks) {
+  for (const auto& [tag, block] : found->second) {
     hasher->AddValue(tag.size());
     hasher->Add(tag.data(), tag.size());
     hasher->AddValue(block.data.size());
@@ -541,8 +555,8 @@ void Scene::HashCustomData(uint32_t slot, StateHasher* hasher) const {
 }
 
 ObjectId Scene::linked_dummy(ObjectId id) const {
-  const int32_t l = linked_dummy_[SlotOf(id, "dummy")];
-  return l >= 0 ? IdAt(static_cast<uint32_t>(l)) : ObjectId{};
+  const auto it = linked_dummy_.find(SlotOf(id, "dummy"));
+  return it != linked_dummy_.end() ? IdAt(it->second) : ObjectId{};
 }
 
 // --- Scripts ------------------------------------------------------------------------------

@@ -21,6 +21,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <unordered_map>
 #include <vector>
 
 #include "framework/environment.h"
@@ -293,8 +294,16 @@ class Scene {
   // --- Poses and velocities (hot, by slot) ------------------------------------
   const Pose& local_pose_at(uint32_t slot) const { return X_PO_[slot]; }
   const Pose& world_pose_at(uint32_t slot) const { return X_WO_[slot]; }
-  const Vec3& linear_velocity_at(uint32_t slot) const { return v_WO_[slot]; }
-  const Vec3& angular_velocity_at(uint32_t slot) const { return w_WO_[slot]; }
+  // Velocities are kept for shapes, the bodies dynamics backends simulate;
+  // every other object reads zero.
+  const Vec3& linear_velocity_at(uint32_t slot) const {
+    const uint32_t m = motion_[slot];
+    return m == kNoMotion ? kZeroVelocity : motions_[m].v_WO;
+  }
+  const Vec3& angular_velocity_at(uint32_t slot) const {
+    const uint32_t m = motion_[slot];
+    return m == kNoMotion ? kZeroVelocity : motions_[m].w_WO;
+  }
   Pose world_pose(ObjectId id) const { return X_WO_[SlotOf(id)]; }
   Pose local_pose(ObjectId id) const { return X_PO_[SlotOf(id)]; }
   // Sets X_PO and refreshes the world poses of the object and its subtree.
@@ -305,8 +314,7 @@ class Scene {
   // Inline: a backend calls it for every body every step.
   void SetSimulatedState(uint32_t slot, const Pose& X_WO, const Vec3& v_WO, const Vec3& w_WO) {
     X_WO_[slot] = X_WO;
-    v_WO_[slot] = v_WO;
-    w_WO_[slot] = w_WO;
+    if (const uint32_t m = motion_[slot]; m != kNoMotion) motions_[m] = {v_WO, w_WO};
     simulated_[slot] = 1;
   }
   // Recomputes world poses top-down (the pose of each simulated body is kept
@@ -394,8 +402,11 @@ class Scene {
   // --- Size factor (V-REP's) -----------------------------------------------------
   // Accumulated scale of the object: 1 unless it or an ancestor was scaled;
   // copied with duplication.
-  double size_factor(ObjectId id) const { return size_factor_[SlotOf(id)]; }
-  double size_factor_at(uint32_t slot) const { return size_factor_[slot]; }
+  double size_factor(ObjectId id) const { return size_factor_at(SlotOf(id)); }
+  double size_factor_at(uint32_t slot) const {
+    const auto it = size_factor_.find(slot);
+    return it == size_factor_.end() ? 1.0 : it->second;
+  }
   // Scales the subtree at `root` by `s` (finite, > 0) about the root's frame:
   // descendants' local positions, shape sizes, prismatic joint positions,
   // limits and speeds, sensor ranges and nozzle radii x s; masses and forces
@@ -446,10 +457,18 @@ class Scene {
   }
 
   // Per slot, hot.
-  std::vector<Pose> X_PO_;       // pose in parent (slots)
-  std::vector<Pose> X_WO_;       // pose in world, cached (slots)
-  std::vector<Vec3> v_WO_;       // linear velocity in world (slots)
-  std::vector<Vec3> w_WO_;       // angular velocity in world (slots)
+  std::vector<Pose> X_PO_;  // pose in parent (slots)
+  std::vector<Pose> X_WO_;  // pose in world, cached (slots)
+  // Velocities in world, for shapes only (a robot has 3 shapes in 29
+  // objects): motion_ (slots) indexes motions_, or is kNoMotion.
+  struct Motion {
+    Vec3 v_WO, w_WO;
+  };
+  static constexpr uint32_t kNoMotion = UINT32_MAX;
+  static constexpr Vec3 kZeroVelocity{};
+  std::vector<uint32_t> motion_;
+  std::vector<Motion> motions_;
+  std::vector<uint32_t> free_motions_;
   std::vector<int32_t> parent_;  // parent slot or -1 (slots)
   std::vector<int32_t> first_child_, last_child_, next_sibling_, prev_sibling_;  // (slots)
   std::vector<ObjectType> type_;                                                 // (slots)
@@ -462,18 +481,21 @@ class Scene {
   std::vector<uint8_t> model_root_;
   std::vector<uint32_t> name_;  // the name's id in names_ (slots)
   NamePool names_;
-  std::vector<int32_t> script_;        // index into scripts_ or -1
-  std::vector<int32_t> linked_dummy_;  // slot or -1
-  // Custom data per slot, allocated only for objects that have some.
+  std::vector<int32_t> script_;  // index into scripts_ or -1
+  // Rare per-slot values, kept only for the slots that have one (a robot
+  // has 29 objects, and none of these by default): written between phases,
+  // read by scripts in parallel.
+  std::unordered_map<uint32_t, uint32_t> linked_dummy_;  // slot -> its linked dummy's slot
+  // Custom data, for objects that have some.
   struct CustomDataBlock {
     std::string data;
     ScriptMemory* writer = nullptr;  // charged for it (WriteCustomData)
   };
   using CustomData = std::map<std::string, CustomDataBlock>;
-  std::vector<std::unique_ptr<CustomData>> custom_data_;
+  std::unordered_map<uint32_t, CustomData> custom_data_;
   // Releases the writers' charges for the slot's blocks and drops them.
   void DropCustomData(uint32_t slot);
-  std::vector<double> size_factor_;  // accumulated scale, 1 by default
+  std::unordered_map<uint32_t, double> size_factor_;  // accumulated scale where not 1
   std::vector<uint32_t> free_slots_;
   size_t object_count_ = 0;
 

@@ -23,15 +23,17 @@ uint32_t Scene::CopyObject(uint32_t src, int32_t new_parent) {
   const uint32_t slot = AllocateSlot(name, parent, X_PO, type);
   if (RowTable* table = tables_[static_cast<size_t>(type)].get())
     row_[slot] = table->AppendCopy(row_[src], slot, types_[static_cast<size_t>(type)]->copy_row);
-  v_WO_[slot] = v_WO_[src];
-  w_WO_[slot] = w_WO_[src];
+  if (motion_[src] != kNoMotion && motion_[slot] != kNoMotion)
+    motions_[motion_[slot]] = motions_[motion_[src]];
   model_root_[slot] = model_root_[src];
-  size_factor_[slot] = size_factor_[src];
-  if (custom_data_[src]) {
+  if (const auto factor = size_factor_.find(src); factor != size_factor_.end())
+    size_factor_[slot] = factor->second;
+  if (const auto data = custom_data_.find(src); data != custom_data_.end()) {
     // Each block a script wrote is charged again to its writer (the run's
     // limit was checked by DuplicateSubtree).
-    custom_data_[slot] = std::make_unique<CustomData>(*custom_data_[src]);
-    for (const auto& [tag, block] : *custom_data_[slot])
+    CustomData copy = data->second;  // (inserting may rehash)
+    const CustomData& blocks = custom_data_[slot] = std::move(copy);
+    for (const auto& [tag, block] : blocks)
       if (block.writer != nullptr)
         block.writer->Force(CustomDataBytes(tag.size(), block.data.size()));
   }
@@ -54,13 +56,13 @@ void Scene::ReserveForCopies(ObjectId root, size_t copies) {
   }
   const size_t slots = generation_.size() + sub.size() * copies;
   for (auto* v : {&X_PO_, &X_WO_}) v->reserve(slots);
-  for (auto* v : {&v_WO_, &w_WO_}) v->reserve(slots);
+  const size_t shapes = rows_of_type[static_cast<size_t>(ObjectType::kShape)];
+  motions_.reserve(motions_.size() + shapes * copies);
+  motion_.reserve(slots);
   for (auto* v : {&parent_, &first_child_, &last_child_, &next_sibling_, &prev_sibling_, &instance_,
-                  &script_, &linked_dummy_})
+                  &script_})
     v->reserve(slots);
-  size_factor_.reserve(slots);
   for (auto* v : {&simulated_, &alive_, &model_root_}) v->reserve(slots);
-  custom_data_.reserve(slots);
   type_.reserve(slots);
   row_.reserve(slots);
   generation_.reserve(slots);
@@ -84,8 +86,9 @@ ObjectId Scene::DuplicateSubtree(ObjectId root, ObjectId new_parent) {
   uint64_t charged = 0;
   const RunScriptMemory* run = nullptr;
   for (uint32_t src : sources) {
-    if (!custom_data_[src]) continue;
-    for (const auto& [tag, block] : *custom_data_[src]) {
+    const auto data = custom_data_.find(src);
+    if (data == custom_data_.end()) continue;
+    for (const auto& [tag, block] : data->second) {
       if (block.writer == nullptr) continue;
       charged += CustomDataBytes(tag.size(), block.data.size());
       run = block.writer->run();
@@ -106,10 +109,11 @@ ObjectId Scene::DuplicateSubtree(ObjectId root, ObjectId new_parent) {
   // Remap internal references: a link inside the subtree points at the copy;
   // a link to an object outside stays as it was.
   for (uint32_t src : sources) {
-    const int32_t link = linked_dummy_[src];
-    if (link < 0) continue;
-    auto it = copy_of.find(static_cast<uint32_t>(link));
-    linked_dummy_[copy_of[src]] = it != copy_of.end() ? static_cast<int32_t>(it->second) : link;
+    const auto linked = linked_dummy_.find(src);
+    if (linked == linked_dummy_.end()) continue;
+    const uint32_t link = linked->second;
+    auto it = copy_of.find(link);
+    linked_dummy_[copy_of[src]] = it != copy_of.end() ? it->second : link;
   }
   const uint32_t copy_root = copy_of.at(root_slot);
   RefreshSubtree(copy_root);
@@ -142,7 +146,7 @@ void Scene::ScaleSubtree(ObjectId root, double s) {
   CollectSubtree(root_slot, &sub);
   ScaleContext context;  // scaled assets (meshes), one per original within this call
   for (uint32_t slot : sub) {
-    size_factor_[slot] *= s;
+    size_factor_[slot] = size_factor_at(slot) * s;
     if (slot != root_slot) X_PO_[slot].p = X_PO_[slot].p * s;
     const size_t type = static_cast<size_t>(type_[slot]);
     if (types_[type]->scale_row != nullptr)

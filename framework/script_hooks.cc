@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "framework/script_state.h"
+#include "framework/small_blocks.h"
 
 namespace swarmsim {
 namespace lua_host {
@@ -136,13 +137,13 @@ void* LimitedAlloc(void* ud, void* ptr, size_t osize, size_t nsize) {
   ScriptMemory& account = *m.account;
   const size_t old = ptr != nullptr ? osize : 0;
   if (nsize == 0) {
-    std::free(ptr);
+    small_blocks::Free(ptr, old);
     m.used -= old;
     account.ShrinkHeap(old);
     return nullptr;
   }
   if (nsize <= old) {  // Lua assumes that shrinking never fails
-    void* p = std::realloc(ptr, nsize);
+    void* p = small_blocks::Resize(ptr, old, nsize);
     if (p == nullptr) return nullptr;
     m.used -= old - nsize;
     account.ShrinkHeap(old - nsize);
@@ -173,7 +174,7 @@ void* LimitedAlloc(void* ud, void* ptr, size_t osize, size_t nsize) {
     }
     if (refuse) return nullptr;
   }
-  void* p = std::realloc(ptr, nsize);
+  void* p = small_blocks::Resize(ptr, old, nsize);
   if (p == nullptr) {
     account.ShrinkHeap(grow);
     return nullptr;

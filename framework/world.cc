@@ -260,6 +260,12 @@ void World::EnsureRuntimes() {
   if (!started_) scene_runtime_.rng = Rng(settings_.seed, uint64_t{1} << 63);
 }
 
+void World::ReserveRobots(size_t robots) {
+  runtimes_.reserve(robots);
+  pending_.reserve(robots);
+  messaging_.Reserve(robots);
+}
+
 void World::SetInstanceParameters(int instance, SharedParameters parameters) {
   EnsureRuntimes();
   runtimes_.at(instance).parameters = std::move(parameters);

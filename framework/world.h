@@ -226,6 +226,9 @@ class World : public PhaseHandlers {
   const ParamValue* FindParameter(int instance, std::string_view name) const;
   // Sets the model parameters of a robot (call after the robot is created).
   void SetInstanceParameters(int instance, SharedParameters parameters);
+  // Room for `robots` robots in all (a loader about to add many): their
+  // per-robot state then grows without slack.
+  void ReserveRobots(size_t robots);
 
   // --- Lifecycle ------------------------------------------------------------------
   // Builds the dynamics backend and the modules from the placed scene and runs

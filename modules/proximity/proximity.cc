@@ -130,6 +130,17 @@ class OctreeGridProximity final : public ProximityBackend {
     ids_.clear();
     const auto shapes = scene.shapes();
     const auto owners = scene.shape_owners();
+    // At most one entry per shape: the first Update sizes every buffer for
+    // the whole swarm at once, leaving no slack from growing one by one.
+    if (moving_.capacity() < shapes.size()) {
+      const size_t n = std::max(shapes.size(), 2 * moving_.capacity());
+      moving_.reserve(n);
+      footprints_.reserve(n);
+      squares_.reserve(n);
+      instances_.reserve(n);
+      ids_.reserve(n);
+      footprint_memos_.reserve(n);
+    }
     footprint_memos_.resize(shapes.size());
     for (size_t r = 0; r < shapes.size(); ++r) {
       // The poses of a big swarm outgrow the cache, and shape rows stride

@@ -543,7 +543,10 @@ void WorldLoader::BuildCopies(World* world) {
         scene.ScaleSubtree(root, e.scale);
         if (!e.own_copies.empty()) ShareScaledMeshes(spec, root, &scene, &scaled_meshes);
       }
-      if (reserve) scene.ReserveForCopies(root, *reserve);
+      if (reserve) {
+        scene.ReserveForCopies(root, *reserve);
+        world->ReserveRobots(scene.instances().size() + 1 + *reserve);
+      }
       const int instance = scene.MakeModelInstance(
           root, name, name + "#" + std::to_string(scene.instances().size()));
       // IK groups of this copy; duplicates get theirs from the "ik" module.

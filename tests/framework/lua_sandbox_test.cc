@@ -189,6 +189,34 @@ TEST_F(SandboxTest, CoroutineAndUtf8AreThereOnFirstUse) {
   EXPECT_EQ(Log(), "[bot#0] true\n");
 }
 
+// math, string and table fetch each entry on first use (a robot's state
+// then holds the few its script uses): every function is there, string
+// methods work, math.random keeps its generator, and string.dump and the
+// deprecated math functions are not.
+TEST_F(SandboxTest, LibraryEntriesAreThereOnFirstUse) {
+  EXPECT_EQ(
+      Run("local used = 0\n"
+          "for _ in pairs(math) do used = used + 1 end\n"
+          "assert(used == 2, used)  -- random and randomseed, which share a generator\n"
+          "assert(math.sqrt(16) == 4 and math.pi > 3.14 and math.maxinteger == (1 << 63) - 1)\n"
+          "assert(math.type(1) == 'integer' and math.huge > 1e308)\n"
+          "assert(rawget(math, 'sqrt') == math.sqrt and rawget(math, 'floor') == nil)\n"
+          "assert(math.pow == nil and math.cosh == nil and math.log10 == nil)\n"
+          "assert(('abc'):upper() == 'ABC' and string.format('%03d', 7) == '007')\n"
+          "assert(('a,b'):find(',') == 2 and string.rep('x', 3) == 'xxx')\n"
+          "local t = {3, 1, 2}; table.sort(t); assert(table.concat(t, ' ') == '1 2 3')\n"
+          "assert(table.unpack({1, 2}) == 1 and table.pack(1, 2, 3).n == 3)\n"
+          "assert(string.nope == nil and math.nope == nil and table.nope == nil)\n"
+          "math.randomseed(3); local a = math.random(1000)\n"
+          "math.randomseed(3); assert(math.random(1000) == a)\n"
+          "print('ok')"),
+      "");
+  EXPECT_EQ(Log(), "[bot#0] ok\n");
+  EXPECT_CONTAINS(Run("\nlocal f = string.dump"),
+                  "scripts/robot.lua:2: string.dump is not allowed in a sandboxed script");
+  EXPECT_CONTAINS(Run("local f = ('x').dump"), "string.dump is not allowed");
+}
+
 // One rule for every refusal: it ends the callback, pcall or not, naming
 // the script and line (or disables the script under disable_script), so a
 // script cannot go on without the file, command or seed it asked for.

@@ -69,6 +69,55 @@ TEST(SceneTest, DuplicatingAModelCopiesObjectsScriptsAndRemapsReferences) {
   EXPECT_EQ(scene.linked_dummy(tip), target);
 }
 
+// Velocities are kept for shapes only (the bodies backends simulate), and a
+// slot's rare values (custom data, size factor, dummy link) only where set:
+// a copy takes them, a removed object's slot comes back without them.
+TEST(SceneTest, VelocitiesAndRareValuesFollowCopiesAndRemovals) {
+  Scene scene;
+  ShapeData body_shape;
+  body_shape.dynamic = true;
+  const ObjectId body = scene.AddShape("body", {}, {}, body_shape);
+  const ObjectId marker = scene.AddDummy("marker", body, {{0.1, 0, 0}, {}});
+  const ObjectId target = scene.AddDummy("target", body, {{0.2, 0, 0}, {}});
+  scene.MakeModelInstance(body, "bot", "bot#0");
+  scene.SetSimulatedState(scene.SlotOf(body), scene.world_pose(body), {0.5, 0, 0}, {0, 0, 2});
+  scene.SetSimulatedState(scene.SlotOf(marker), scene.world_pose(marker), {9, 9, 9}, {9, 9, 9});
+  EXPECT_EQ(scene.linear_velocity_at(scene.SlotOf(body)).x, 0.5);
+  EXPECT_EQ(scene.angular_velocity_at(scene.SlotOf(body)).z, 2);
+  // A dummy is never simulated with a velocity: it reads zero.
+  EXPECT_EQ(scene.linear_velocity_at(scene.SlotOf(marker)).x, 0);
+  scene.LinkDummies(marker, target);
+  scene.WriteCustomData(marker, "tag", "value", nullptr);
+  scene.ScaleSubtree(body, 2);
+
+  const ObjectId copy = scene.DuplicateSubtree(body, {});
+  const ObjectId copy_marker = scene.FindObject("./marker", copy);
+  const ObjectId copy_target = scene.FindObject("./target", copy);
+  ASSERT_FALSE(copy_marker.IsNull());
+  EXPECT_EQ(scene.linear_velocity_at(scene.SlotOf(copy)).x, 0.5);
+  EXPECT_EQ(scene.size_factor(copy_marker), 2);
+  ASSERT_NE(scene.ReadCustomData(copy_marker, "tag"), nullptr);
+  EXPECT_EQ(*scene.ReadCustomData(copy_marker, "tag"), "value");
+  EXPECT_EQ(scene.linked_dummy(copy_marker), copy_target);  // remapped inside the copy
+  EXPECT_EQ(scene.linked_dummy(marker), target);
+
+  // Removing the target unlinks the marker; new objects in the freed slots
+  // start clean.
+  scene.RemoveSubtree(target);
+  EXPECT_TRUE(scene.linked_dummy(marker).IsNull());
+  scene.RemoveSubtree(copy);
+  const ObjectId fresh_shape = scene.AddShape("fresh", {}, {}, body_shape);
+  const ObjectId fresh_dummy = scene.AddDummy("fresh_dummy", {}, {});
+  for (const ObjectId fresh : {fresh_shape, fresh_dummy}) {
+    EXPECT_EQ(scene.linear_velocity_at(scene.SlotOf(fresh)).x, 0);
+    EXPECT_EQ(scene.angular_velocity_at(scene.SlotOf(fresh)).z, 0);
+    EXPECT_EQ(scene.size_factor(fresh), 1);
+    EXPECT_EQ(scene.ReadCustomData(fresh, "tag"), nullptr);
+  }
+  EXPECT_TRUE(scene.linked_dummy(fresh_dummy).IsNull());
+  EXPECT_EQ(scene.linear_velocity_at(scene.SlotOf(body)).x, 0.5);  // the original keeps its own
+}
+
 TEST(SceneScaleTest, ScalesGeometryJointsSensorsAndMasses) {
   Scene scene;
   ShapeData body;

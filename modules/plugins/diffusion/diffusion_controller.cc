@@ -14,6 +14,9 @@
 //   models: [{model: models/footbot.yaml, ..., native_controller: diffusion}]
 #include <cmath>
 #include <cstdio>
+#include <map>
+#include <memory>
+#include <mutex>
 #include <new>
 #include <vector>
 
@@ -24,14 +27,40 @@ namespace {
 constexpr double kRange = 0.1;   // m, the proximity sensors' range (as diffusion.lua)
 constexpr int kMaxSensors = 64;  // the ring's sensors looked for
 
+// The direction of each sensor of a ring of n: the same for every robot
+// whose ring has n sensors, so made once per n and shared.
+struct Ring {
+  std::vector<double> cos_a, sin_a;
+};
+
+const Ring& RingOf(size_t n) {
+  static std::mutex mutex;
+  static std::map<size_t, std::unique_ptr<const Ring>> rings;
+  const std::lock_guard<std::mutex> lock(mutex);
+  std::unique_ptr<const Ring>& ring = rings[n];
+  if (!ring) {
+    auto made = std::make_unique<Ring>();
+    made->cos_a.resize(n);
+    made->sin_a.resize(n);
+    for (size_t i = 0; i < n; ++i) {
+      // As Lua evaluates 2 * math.pi * i / 24: left to right, in doubles.
+      const double a = 2 * M_PI * static_cast<double>(i) / static_cast<double>(n);
+      made->cos_a[i] = std::cos(a);
+      made->sin_a[i] = std::sin(a);
+    }
+    ring = std::move(made);
+  }
+  return *ring;
+}
+
 // One robot's state: what diffusion.lua's sysCall_init computes.
 struct Robot {
   int64_t left_motor = 0, right_motor = 0;
-  int64_t front = 0;                 // the look-ahead sensor, if slow_distance > 0
-  std::vector<int64_t> sensors;      // the ring, as many as it has
-  std::vector<double> cos_a, sin_a;  // direction of each sensor
-  double wheel_speed = 0;            // rad/s
-  double straight_angle = 0;         // rad
+  int64_t front = 0;             // the look-ahead sensor, if slow_distance > 0
+  std::vector<int64_t> sensors;  // the ring, as many as it has
+  const Ring* ring = nullptr;    // direction of each sensor
+  double wheel_speed = 0;        // rad/s
+  double straight_angle = 0;     // rad
   double delta = 0;
   double slow_distance = 0;  // m
 };
@@ -66,23 +95,15 @@ int Init(const SwarmsimCallContext* c, void** state, char* error, size_t error_s
     return -1;
   }
   try {
-    for (int i = 0; i < kMaxSensors; ++i) {
+    int64_t found[kMaxSensors];
+    int n = 0;
+    for (; n < kMaxSensors; ++n) {
       char path[32];
-      std::snprintf(path, sizeof path, "./prox[%d]", i);
-      int64_t sensor;
-      if (!api.find_object(c->world, c->script_object, path, &sensor)) break;
-      robot->sensors.push_back(sensor);
+      std::snprintf(path, sizeof path, "./prox[%d]", n);
+      if (!api.find_object(c->world, c->script_object, path, &found[n])) break;
     }
-    robot->sensors.shrink_to_fit();
-    const size_t n = robot->sensors.size();
-    robot->cos_a.resize(n);
-    robot->sin_a.resize(n);
-    for (size_t i = 0; i < n; ++i) {
-      // As Lua evaluates 2 * math.pi * i / 24: left to right, in doubles.
-      const double a = 2 * M_PI * static_cast<double>(i) / static_cast<double>(n);
-      robot->cos_a[i] = std::cos(a);
-      robot->sin_a[i] = std::sin(a);
-    }
+    robot->sensors.assign(found, found + n);  // one block of exactly n
+    robot->ring = &RingOf(robot->sensors.size());
   } catch (const std::bad_alloc&) {
     std::snprintf(error, error_size, "out of memory");
     return -1;
@@ -108,8 +129,8 @@ int Step(const SwarmsimCallContext* c, void* state, char* error, size_t error_si
   for (size_t i = 0; i < robot.sensors.size(); ++i) {
     if (distances[i] < 0) continue;
     const double value = 1 - distances[i] / kRange;
-    x = x + value * robot.cos_a[i];
-    y = y + value * robot.sin_a[i];
+    x = x + value * robot.ring->cos_a[i];
+    y = y + value * robot.ring->sin_a[i];
   }
   const double angle = std::atan2(y, x);
   double left, right;
