@@ -101,8 +101,7 @@ struct ChunkWriter::Job {
   std::unique_ptr<StepSnapshot> snap;  // step records
 };
 
-ChunkWriter::ChunkWriter(const std::filesystem::path& path, int zstd_level,
-                         uint32_t max_raw_bytes)
+ChunkWriter::ChunkWriter(const std::filesystem::path& path, int zstd_level, uint32_t max_raw_bytes)
     : path_(path), level_(zstd_level), max_raw_bytes_(max_raw_bytes) {
   fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd_ < 0) throw Error("cannot create " + path.string() + ": " + std::strerror(errno));
@@ -171,9 +170,8 @@ void ChunkWriter::Flush() {
   std::unique_lock lock(mutex_);
   // After a failure to write, nothing more will be; after a refused chunk,
   // the end chunk may be on its way.
-  changed_.wait(lock, [&] {
-    return (queue_.empty() && !busy_) || (!error_.empty() && !file_whole_);
-  });
+  changed_.wait(lock,
+                [&] { return (queue_.empty() && !busy_) || (!error_.empty() && !file_whole_); });
   if (!error_.empty()) throw Error(error_);
 }
 
@@ -198,8 +196,8 @@ void ChunkWriter::Run() {
       busy_ = true;
       // After a failure, nothing more; but the end chunk after a chunk
       // refused for its size (the file is whole).
-      failed = !error_.empty() &&
-               !(file_whole_ && job->kind == static_cast<uint8_t>(ChunkKind::kEnd));
+      failed =
+          !error_.empty() && !(file_whole_ && job->kind == static_cast<uint8_t>(ChunkKind::kEnd));
     }
     changed_.notify_all();
     std::string error;

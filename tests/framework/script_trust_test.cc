@@ -389,7 +389,8 @@ TEST_F(TrustTest, ARemovedRobotsCollectionsAndChargesGo) {
            "end\n");
   EXPECT_EQ(ErrorOf([&] { world_->Step(); }), "");
   EXPECT_EQ(world_->runtime(0).collections.size(), 100u);
-  EXPECT_GE(world_->script_memory(0).data(), 100 * (sizeof(CollectionRow) + sizeof(CollectionItem)));
+  EXPECT_GE(world_->script_memory(0).data(),
+            100 * (sizeof(CollectionRow) + sizeof(CollectionItem)));
   EXPECT_EQ(ErrorOf([&] {
               world_->Step();
               world_->Step();

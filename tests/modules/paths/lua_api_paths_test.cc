@@ -176,8 +176,9 @@ TEST(LuaApiPathsTest, PathsAScriptMakesCountAgainstItsMemoryLimit) {
       for i = 1, 20 do sim.createPath(points, {name = 'p' .. i}) end
     end
   )");
-  EXPECT_CONTAINS(error, "bot: script.lua:5: sim.createPath: the path would take the scripts "
-                         "past 16 MiB");
+  EXPECT_CONTAINS(error,
+                  "bot: script.lua:5: sim.createPath: the path would take the scripts "
+                  "past 16 MiB");
   EXPECT_CONTAINS(error, "simulation.script_memory_mb");
   const auto [fine, missing] = run(R"(
     local made = false

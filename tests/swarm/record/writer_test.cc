@@ -433,8 +433,7 @@ TEST(RecordingTest, AChunkPastTheReadersLimitEndsTheRecordingWhole) {
       error = e.what();
     }
   }
-  EXPECT_CONTAINS(error, (out / kRecordingFileName).string() +
-                             ": the scene of step 3 would hold ");
+  EXPECT_CONTAINS(error, (out / kRecordingFileName).string() + ": the scene of step 3 would hold ");
   EXPECT_CONTAINS(error, "bytes decompressed, past the 32768 bytes a recording chunk may hold");
   recorder->Finish(steps, "error", error);
 
