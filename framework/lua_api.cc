@@ -301,6 +301,21 @@ int ArgOption(lua_State* L, int arg, const char* def, const char* const options[
               (nearest != nullptr ? "; did you mean '" + *nearest + "'?" : std::string()) + ")");
 }
 
+namespace {
+int PushBytesUnprotected(lua_State* L) {
+  const auto* bytes = static_cast<const std::string_view*>(lua_touserdata(L, 1));
+  lua_pushlstring(L, bytes->data(), bytes->size());
+  return 1;
+}
+}  // namespace
+
+void PushBytes(lua_State* L, std::string_view bytes) {
+  // A light C function and a light userdata: neither allocates.
+  lua_pushcfunction(L, PushBytesUnprotected);
+  lua_pushlightuserdata(L, &bytes);
+  if (lua_pcall(L, 1, 1, 0) != LUA_OK) throw LuaErrorOnStack{};
+}
+
 void PushDeferredWrite(lua_State* L, const DeferredWrite& write) {
   ChargeScriptData(L, sizeof(DeferredWrite), "the write to another robot's object");
   Context(L).runtime->deferred.push_back(write);  // released by World::Actuate

@@ -161,6 +161,34 @@ int ArgOption(lua_State* L, int arg, const char* def, const char* const options[
 // limit ("the signal would take the scripts past 256 MiB ...").
 void ChargeScriptData(lua_State* L, uint64_t bytes, const char* what);
 
+// Bytes C++ holds for the calling script only while one sim.* call runs (a
+// string being packed, a copy of an array): charged to its robot's account
+// as they grow, as ChargeScriptData charges (and refuses), and released
+// when the call returns or throws.
+class CallCharge {
+ public:
+  CallCharge(lua_State* L, const char* what) : L_(L), what_(what) {}
+  ~CallCharge();
+  CallCharge(const CallCharge&) = delete;
+  CallCharge& operator=(const CallCharge&) = delete;
+  // Holds at least `bytes` from now on: charged a quarter ahead, so that a
+  // growing buffer is charged now and then, not at every append.
+  void Hold(uint64_t bytes) {
+    if (bytes > held_) Grow(bytes);
+  }
+
+ private:
+  void Grow(uint64_t bytes);
+  lua_State* L_;
+  const char* what_;
+  uint64_t held_ = 0;
+};
+
+// lua_pushlstring in protected mode, for a guarded function that holds C++
+// objects: a refused allocation throws (LuaErrorOnStack) instead of a
+// longjmp past their destructors.
+void PushBytes(lua_State* L, std::string_view bytes);
+
 // Queues a write to an object another robot (or the scene) owns, applied
 // after the control phase (RobotRuntime::deferred), charged to the robot.
 void PushDeferredWrite(lua_State* L, const DeferredWrite& write);
@@ -168,8 +196,15 @@ void PushDeferredWrite(lua_State* L, const DeferredWrite& write);
 // Queues `add` to run on the scene when the caller's copies and removals
 // of robots are applied (after the control phase, robots in index order):
 // how a module's Lua area makes objects (sim.createPath) the same way for
-// any thread count (lua_api_models.cc).
-void QueueSceneAddition(lua_State* L, std::function<void(Scene*)> add);
+// any thread count (lua_api_models.cc). `bytes`, what the queued objects
+// hold (kSceneObjectBytes each, and their rows' data), are charged to the
+// caller's robot for its lifetime (refused as ChargeScriptData refuses,
+// naming `what`), released when the robot is removed.
+void QueueSceneAddition(lua_State* L, std::function<void(Scene*)> add, uint64_t bytes,
+                        const char* what);
+// What one object a script makes costs beyond its row's own data: its slot
+// in the scene's arrays, its name, its row, the queued closure.
+inline constexpr uint64_t kSceneObjectBytes = 512;
 
 // An object handle argument (an integer, ObjectId::ToInteger()).
 inline ObjectId CheckObject(lua_State* L, int arg) {

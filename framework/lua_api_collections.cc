@@ -46,6 +46,7 @@ int CreateCollection(lua_State* L) {
     throw Error("a robot may make at most " + std::to_string(kMaxScriptCollections) +
                 " collections");
   ChargeScriptData(L, sizeof(CollectionRow), "the collection");  // for the robot's lifetime
+  Context(L).runtime->lifetime_bytes += sizeof(CollectionRow);
   all.emplace_back();
   lua_pushinteger(L, kScriptCollectionBase - static_cast<lua_Integer>(all.size() - 1));
   return 1;
@@ -80,6 +81,7 @@ int AddItemToCollection(lua_State* L) {
   }
   item.exclude = !lua_isnoneornil(L, 4) && (ArgInteger(L, 4) & 1) != 0;
   ChargeScriptData(L, sizeof(CollectionItem), "the collection item");
+  Context(L).runtime->lifetime_bytes += sizeof(CollectionItem);
   collection.items.push_back(item);
   return 0;
 }

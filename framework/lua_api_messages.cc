@@ -183,11 +183,20 @@ int GetSignal(lua_State* L) {
 
 // --- Packing ---------------------------------------------------------------------------
 
+// The packed string is charged to the robot while the call builds it
+// (CallCharge) and pushed in protected mode (PushBytes): a table whose
+// length is a border far past its entries ({[1] = 1, [2^40] = 1} may have
+// #t = 2^40) is refused before anything is allocated for it.
 template <typename T>
 int PackArray(lua_State* L) {
   ArgType(L, 1, LUA_TTABLE);
   const lua_Integer n = static_cast<lua_Integer>(lua_rawlen(L, 1));
-  std::string out(static_cast<size_t>(n) * sizeof(T), '\0');
+  const uint64_t bytes = static_cast<uint64_t>(n) <= (uint64_t{1} << 48)
+                             ? static_cast<uint64_t>(n) * sizeof(T)
+                             : UINT64_MAX;  // refused (a string's size cannot be that)
+  CallCharge charge(L, "the packed string");
+  charge.Hold(bytes);
+  std::string out(bytes, '\0');
   for (lua_Integer i = 1; i <= n; ++i) {
     lua_rawgeti(L, 1, i);
     T v;
@@ -205,7 +214,7 @@ int PackArray(lua_State* L) {
     lua_pop(L, 1);
     std::memcpy(out.data() + (i - 1) * sizeof(T), &v, sizeof(T));
   }
-  lua_pushlstring(L, out.data(), out.size());
+  PushBytes(L, out);
   return 1;
 }
 
@@ -244,28 +253,41 @@ void ReserveStack(lua_State* L) {
     throw Error("not enough memory for the Lua stack of a nested table");
 }
 
-void PackValue(lua_State* L, int index, int depth, std::string* out) {
-  auto append = [out](const void* p, size_t n) { out->append(static_cast<const char*>(p), n); };
+// The packed string as it grows, charged to the robot (a table that holds
+// one long string many times packs to many copies of it).
+struct Packed {
+  explicit Packed(lua_State* L) : charge(L, "the packed table") {}
+  void Append(const void* p, size_t n) {
+    charge.Hold(bytes.size() + n);
+    bytes.append(static_cast<const char*>(p), n);
+  }
+  void Append(char tag) { Append(&tag, 1); }
+  CallCharge charge;
+  std::string bytes;
+};
+
+void PackValue(lua_State* L, int index, int depth, Packed* out) {
   switch (lua_type(L, index)) {
     case LUA_TNUMBER:
       if (lua_isinteger(L, index)) {
         const int64_t v = lua_tointeger(L, index);
-        out->push_back('i');
-        append(&v, sizeof v);
+        out->Append('i');
+        out->Append(&v, sizeof v);
       } else {
         const double v = lua_tonumber(L, index);
-        out->push_back('n');
-        append(&v, sizeof v);
+        out->Append('n');
+        out->Append(&v, sizeof v);
       }
       break;
-    case LUA_TBOOLEAN: out->push_back(lua_toboolean(L, index) ? 'T' : 'F'); break;
+    case LUA_TBOOLEAN: out->Append(lua_toboolean(L, index) ? 'T' : 'F'); break;
     case LUA_TSTRING: {
       size_t length = 0;
       const char* s = lua_tolstring(L, index, &length);
+      if (length > UINT32_MAX) throw Error("cannot pack a string of 4 GiB or more");
       const uint32_t n = static_cast<uint32_t>(length);
-      out->push_back('s');
-      append(&n, sizeof n);
-      append(s, length);
+      out->Append('s');
+      out->Append(&n, sizeof n);
+      out->Append(s, length);
       break;
     }
     case LUA_TTABLE: {
@@ -276,8 +298,8 @@ void PackValue(lua_State* L, int index, int depth, std::string* out) {
       index = lua_absindex(L, index);
       uint32_t count = 0;
       for (lua_pushnil(L); lua_next(L, index) != 0; lua_pop(L, 1)) ++count;
-      out->push_back('t');
-      append(&count, sizeof count);
+      out->Append('t');
+      out->Append(&count, sizeof count);
       for (lua_pushnil(L); lua_next(L, index) != 0; lua_pop(L, 1)) {
         PackValue(L, -2, depth + 1, out);
         PackValue(L, -1, depth + 1, out);
@@ -293,14 +315,14 @@ void PackValue(lua_State* L, int index, int depth, std::string* out) {
 int PackTable(lua_State* L) {
   ArgType(L, 1, LUA_TTABLE);
   lua_settop(L, 1);
-  std::string out;
+  Packed out(L);
   try {
     PackValue(L, 1, 0, &out);
   } catch (...) {
     lua_settop(L, 1);  // the keys and values of the levels left, for the error message's room
     throw;
   }
-  lua_pushlstring(L, out.data(), out.size());
+  PushBytes(L, out.bytes);
   return 1;
 }
 

@@ -46,11 +46,21 @@ void Queue(lua_State* L, const ModelEdit& edit) {
 
 }  // namespace
 
-void QueueSceneAddition(lua_State* L, std::function<void(Scene*)> add) {
+void QueueSceneAddition(lua_State* L, std::function<void(Scene*)> add, uint64_t bytes,
+                        const char* what) {
   ModelEdit edit;
   edit.kind = ModelEdit::Kind::kAdd;
   edit.add = std::move(add);
   Queue(L, edit);
+  // Charged once queued (Queue may refuse), for the robot's lifetime.
+  RobotRuntime& runtime = *Context(L).runtime;
+  try {
+    ChargeScriptData(L, bytes, what);
+  } catch (...) {
+    runtime.model_edits.pop_back();
+    throw;
+  }
+  runtime.lifetime_bytes += bytes;
 }
 
 namespace {

@@ -16,6 +16,27 @@ namespace {
 
 constexpr int kMaxResults = 16;
 
+struct PluginResults {
+  const SwarmsimValue* values;
+  int count;
+};
+
+// Pushes a command's results (argument 1: its PluginResults).
+int PushResults(lua_State* L) {
+  const auto& results = *static_cast<const PluginResults*>(lua_touserdata(L, 1));
+  for (int i = 0; i < results.count; ++i) {
+    const SwarmsimValue& r = results.values[i];
+    switch (r.type) {
+      // Whole numbers as Lua integers (3, not 3.0), as getParam gives them.
+      case kSwarmsimNumber: PushValueNumber(L, r.number); break;
+      case kSwarmsimString: lua_pushlstring(L, r.text != nullptr ? r.text : "", r.size); break;
+      case kSwarmsimNumbers: PushNumberArray(L, r.numbers, static_cast<int>(r.size)); break;
+      default: lua_pushnil(L); break;
+    }
+  }
+  return results.count;
+}
+
 // The closure every plugin command becomes; upvalue 1: its ScriptCommand.
 int CallPluginCommand(lua_State* L) {
   const auto* command = static_cast<const ScriptCommand*>(lua_touserdata(L, lua_upvalueindex(1)));
@@ -24,6 +45,10 @@ int CallPluginCommand(lua_State* L) {
   std::vector<SwarmsimValue> args(n);
   std::vector<std::vector<double>> arrays;
   arrays.reserve(n);
+  // The arrays' copies, charged to the robot: a table's length may be a
+  // border far past its entries ({[1] = 1, [2^40] = 1}).
+  CallCharge charge(L, "the copy of an array argument");
+  uint64_t copied = 0;
   for (int i = 1; i <= n; ++i) {
     SwarmsimValue& v = args[i - 1];
     v = {};
@@ -33,6 +58,9 @@ int CallPluginCommand(lua_State* L) {
       case LUA_TBOOLEAN: v.type = kSwarmsimNumber, v.number = lua_toboolean(L, i); break;
       case LUA_TSTRING: v.type = kSwarmsimString, v.text = lua_tolstring(L, i, &v.size); break;
       case LUA_TTABLE: {
+        const uint64_t length = lua_rawlen(L, i);
+        copied = length <= (uint64_t{1} << 48) ? copied + length * sizeof(double) : UINT64_MAX;
+        charge.Hold(copied);
         std::vector<double>& a = arrays.emplace_back(lua_rawlen(L, i));
         for (size_t k = 0; k < a.size(); ++k) {
           lua_rawgeti(L, i, static_cast<lua_Integer>(k + 1));
@@ -60,18 +88,13 @@ int CallPluginCommand(lua_State* L) {
                                       sizeof error, command->user_data);
   if (count < 0 || count > kMaxResults)
     RaiseError(L, "sim." + command->name + ": " + (error[0] ? error : "the plugin command failed"));
-  if (!lua_checkstack(L, count))
+  if (!lua_checkstack(L, count + 2))
     RaiseError(L, "sim." + command->name + ": its results do not fit on Lua's stack");
-  for (int i = 0; i < count; ++i) {
-    const SwarmsimValue& r = results[i];
-    switch (r.type) {
-      // Whole numbers as Lua integers (3, not 3.0), as getParam gives them.
-      case kSwarmsimNumber: PushValueNumber(L, r.number); break;
-      case kSwarmsimString: lua_pushlstring(L, r.text != nullptr ? r.text : "", r.size); break;
-      case kSwarmsimNumbers: PushNumberArray(L, r.numbers, static_cast<int>(r.size)); break;
-      default: lua_pushnil(L); break;
-    }
-  }
+  // In protected mode: the arguments' copies are still alive.
+  PluginResults pushed{results, count};
+  lua_pushcfunction(L, PushResults);
+  lua_pushlightuserdata(L, &pushed);
+  if (lua_pcall(L, 1, count, 0) != LUA_OK) throw LuaErrorOnStack{};
   return count;
 }
 

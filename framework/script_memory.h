@@ -5,7 +5,9 @@
 // and every copy of its scripts' data that C++ holds for it: lines printed
 // and metrics recorded until the world takes them, messages until the next
 // ones are delivered, signals and custom data blocks until overwritten or
-// cleared, deferred writes, collections. Against simulation.script_memory_mb
+// cleared, deferred writes, collections and objects scripts make (for the
+// robot's lifetime), strings a sim.* call builds while it runs (CallCharge,
+// framework/lua_api.h). Against simulation.script_memory_mb
 // the Lua heap may go a little past the limit before the script fails (the
 // garbage is collected first); a C++ copy is refused outright.
 //

@@ -210,4 +210,22 @@ void ChargeScriptData(lua_State* L, uint64_t bytes, const char* what) {
               lua_host::MemoryLimitTail(state->memory));
 }
 
+void CallCharge::Grow(uint64_t bytes) {
+  ScriptMemory* account = Context(L_).memory;
+  if (account == nullptr) return;
+  // A quarter ahead (at least 64 KiB) if that fits, else the bytes themselves.
+  const uint64_t extra = std::max<uint64_t>(bytes / 4, uint64_t{64} << 10);
+  const uint64_t ahead = bytes <= UINT64_MAX - extra ? bytes + extra : bytes;
+  if (account->Charge(ahead - held_) == ScriptMemory::kOk) {
+    held_ = ahead;
+    return;
+  }
+  ChargeScriptData(L_, bytes - held_, what_);  // throws if they do not fit
+  held_ = bytes;
+}
+
+CallCharge::~CallCharge() {
+  if (held_ > 0) Context(L_).memory->Release(held_);
+}
+
 }  // namespace swarmsim

@@ -189,6 +189,10 @@ struct RobotRuntime {
   int64_t print_step = -1;
   std::vector<std::string> disabled;       // scripts disabled this phase (disable_script), why
   std::vector<CollectionRow> collections;  // the scripts' own (sim.createCollection)
+  // Bytes charged to the robot's ScriptMemory for its lifetime: its
+  // collections and the objects its scripts made (sim.createPath), released
+  // when it is removed.
+  uint64_t lifetime_bytes = 0;
   // Its messages, signal and custom-data writes: Messaging::robot_mail.
 };
 

@@ -116,6 +116,10 @@ void World::RemoveRobot(ObjectId root) {
   rt.model_edits.clear();
   pending_[robot] |= kPendingOutput;
   messaging_.ClearRobot(robot);
+  // Its collections, and the charge for them and for the objects its
+  // scripts made (gone with its subtree).
+  rt.collections = {};
+  robot_script_memory_[robot].Release(std::exchange(rt.lifetime_bytes, 0));
   if (!cleanup_error.empty()) {
     FlushBuffersAfterError();
     throw Error(cleanup_error);

@@ -44,6 +44,11 @@ class PathCurve {
   Pose PoseAt(double s) const;
   // The arc length of control point i (it lies on the curve).
   double LengthAtPoint(size_t i) const { return segment_start_[i]; }
+  // Bytes it holds beyond its own size (its arrays).
+  size_t HeldBytes() const {
+    return points_.capacity() * sizeof(Vec3) + orientations_.capacity() * sizeof(Quat) +
+           (segment_start_.capacity() + table_.capacity()) * sizeof(double);
+  }
 
  private:
   size_t segments() const { return closed_ ? points_.size() : points_.size() - 1; }

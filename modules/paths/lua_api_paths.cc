@@ -223,12 +223,18 @@ int CreatePath(lua_State* L) {
   PathRow row;
   row.curve = std::make_shared<const PathCurve>(std::move(points), interpolation, closed);
   row.velocity = velocity;
-  QueueSceneAddition(L, [row = std::move(row), name, parent](Scene* scene) {
-    ObjectType type;
-    if (!scene->FindType(kTypeName, &type)) return;
-    if (!parent.IsNull() && !scene->IsValid(parent)) return;  // removed meanwhile
-    scene->AddObject(type, name, parent, Pose{}, &row);
-  });
+  // Charged to the robot for its lifetime: the path lives as long as it.
+  const uint64_t bytes =
+      kSceneObjectBytes + sizeof(PathCurve) + row.curve->HeldBytes() + 2 * name.size();
+  QueueSceneAddition(
+      L,
+      [row = std::move(row), name, parent](Scene* scene) {
+        ObjectType type;
+        if (!scene->FindType(kTypeName, &type)) return;
+        if (!parent.IsNull() && !scene->IsValid(parent)) return;  // removed meanwhile
+        scene->AddObject(type, name, parent, Pose{}, &row);
+      },
+      bytes, "the path");
   return 0;
 }
 

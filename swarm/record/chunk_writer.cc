@@ -18,6 +18,27 @@ namespace {
 // Step records the simulation may run ahead of the file by.
 constexpr size_t kMaxQueued = 8;
 
+// A chunk refused for its size: the file is still whole.
+struct ChunkTooLarge : Error {
+  using Error::Error;
+};
+
+const char* ChunkName(uint8_t kind) {
+  switch (static_cast<ChunkKind>(kind)) {
+    case ChunkKind::kHeader: return "header";
+    case ChunkKind::kScene: return "scene";
+    case ChunkKind::kKeyframe: return "keyframe";
+    case ChunkKind::kDelta: return "step record";
+    case ChunkKind::kEnd: return "end";
+  }
+  return "chunk";
+}
+
+std::string Size(uint64_t bytes) {
+  if (bytes < (uint64_t{1} << 20)) return std::to_string(bytes) + " bytes";
+  return std::to_string((bytes + (uint64_t{1} << 20) - 1) >> 20) + " MiB";
+}
+
 // Fills in a chunk's header before its stored payload (FORMAT.md "Chunks").
 void FillChunkHeader(uint8_t kind, uint32_t step, size_t stored, size_t raw, uint8_t* h) {
   std::memcpy(h, kMagic, 4);
@@ -80,8 +101,8 @@ struct ChunkWriter::Job {
   std::unique_ptr<StepSnapshot> snap;  // step records
 };
 
-ChunkWriter::ChunkWriter(const std::filesystem::path& path, int zstd_level)
-    : path_(path), level_(zstd_level) {
+ChunkWriter::ChunkWriter(const std::filesystem::path& path, int zstd_level, uint32_t max_raw_bytes)
+    : path_(path), level_(zstd_level), max_raw_bytes_(max_raw_bytes) {
   fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd_ < 0) throw Error("cannot create " + path.string() + ": " + std::strerror(errno));
   cctx_ = ZSTD_createCCtx();
@@ -102,7 +123,8 @@ ChunkWriter::~ChunkWriter() {
 void ChunkWriter::Push(std::unique_ptr<Job> job) {
   std::unique_lock lock(mutex_);
   changed_.wait(lock, [&] { return queue_.size() < kMaxQueued || !error_.empty(); });
-  if (!error_.empty()) throw Error(error_);
+  if (!error_.empty() && !(file_whole_ && job->kind == static_cast<uint8_t>(ChunkKind::kEnd)))
+    throw Error(error_);
   queue_.push_back(std::move(job));
   changed_.notify_all();
 }
@@ -146,7 +168,10 @@ std::unique_ptr<StepSnapshot> ChunkWriter::TakeSnapshot() {
 
 void ChunkWriter::Flush() {
   std::unique_lock lock(mutex_);
-  changed_.wait(lock, [&] { return (queue_.empty() && !busy_) || !error_.empty(); });
+  // After a failure to write, nothing more will be; after a refused chunk,
+  // the end chunk may be on its way.
+  changed_.wait(lock,
+                [&] { return (queue_.empty() && !busy_) || (!error_.empty() && !file_whole_); });
   if (!error_.empty()) throw Error(error_);
 }
 
@@ -169,18 +194,26 @@ void ChunkWriter::Run() {
       job = std::move(queue_.front());
       queue_.pop_front();
       busy_ = true;
-      failed = !error_.empty();
+      // After a failure, nothing more; but the end chunk after a chunk
+      // refused for its size (the file is whole).
+      failed =
+          !error_.empty() && !(file_whole_ && job->kind == static_cast<uint8_t>(ChunkKind::kEnd));
     }
     changed_.notify_all();
     std::string error;
+    bool whole = true;
     try {
-      if (!failed) Write(job.get());  // after a failure, nothing more
+      if (!failed) Write(job.get());
+    } catch (const ChunkTooLarge& e) {
+      error = e.what();
     } catch (const std::exception& e) {
       error = e.what();
+      whole = false;
     }
     {
       const std::lock_guard lock(mutex_);
       busy_ = false;
+      if (!whole) file_whole_ = false;
       if (!error.empty() && error_.empty()) error_ = error;
       if (job->snap && spare_.size() < kMaxQueued) spare_.push_back(std::move(job->snap));
     }
@@ -275,6 +308,15 @@ void ChunkWriter::Encode(StepSnapshot* snap, std::vector<uint8_t>* payload) {
 }
 
 void ChunkWriter::WriteChunk(uint8_t kind, uint32_t step, const void* raw, size_t size) {
+  // Nothing a reader would refuse (FORMAT.md "Limits"): the chunks before
+  // stay the whole recording.
+  if (size > max_raw_bytes_)
+    throw ChunkTooLarge(path_.string() + ": the " + ChunkName(kind) + " of step " +
+                        std::to_string(step) + " would hold " + Size(size) +
+                        " decompressed, past the " + Size(max_raw_bytes_) +
+                        " a recording chunk may hold (what readers accept: FORMAT.md, "
+                        "\"Limits\"); the recording ends before it. Record fewer objects or "
+                        "metric samples (a smaller world, record: every N)");
   const size_t bound = ZSTD_compressBound(size);
   chunk_.resize(kChunkHeaderSize + bound);
   const size_t stored = ZSTD_compressCCtx(

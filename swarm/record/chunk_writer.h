@@ -14,6 +14,8 @@
 #include <thread>
 #include <vector>
 
+#include "swarm/record/format.h"
+
 namespace swarmsim::record {
 
 // A pose in the file's integers: position in kPositionUnit, quaternion in 1/32767.
@@ -55,7 +57,12 @@ struct SceneLists {
 class ChunkWriter {
  public:
   // Creates (truncates) `path`. Throws swarmsim::Error naming it when it cannot.
-  ChunkWriter(const std::filesystem::path& path, int zstd_level);
+  // A chunk whose payload would pass `max_raw_bytes` decompressed (what
+  // every reader accepts, FORMAT.md "Limits"; tests lower it) is not
+  // written: an error naming it, after which only the end chunk is (the
+  // file stays whole and readable).
+  ChunkWriter(const std::filesystem::path& path, int zstd_level,
+              uint32_t max_raw_bytes = kMaxChunkRawBytes);
   ~ChunkWriter();  // writes what is queued, then stops
   ChunkWriter(const ChunkWriter&) = delete;
   ChunkWriter& operator=(const ChunkWriter&) = delete;
@@ -84,6 +91,7 @@ class ChunkWriter {
   std::filesystem::path path_;
   int fd_ = -1;
   int level_;
+  uint32_t max_raw_bytes_;
   void* cctx_ = nullptr;  // ZSTD_CCtx
   std::vector<uint8_t> chunk_, payload_;
   // The writer thread's own: the state at the previous step record.
@@ -98,6 +106,7 @@ class ChunkWriter {
   std::vector<std::unique_ptr<StepSnapshot>> spare_;
   bool busy_ = false, stopping_ = false;
   std::string error_;
+  bool file_whole_ = true;  // after an error: no chunk was cut (the end chunk may follow)
   uint64_t bytes_ = 0;
   std::thread thread_;
 };

@@ -487,8 +487,8 @@ RunRecorder::RunRecorder(const RecordSettings& settings) : impl_(std::make_uniqu
   r.settings = settings;
   r.settings.every = std::max<int64_t>(1, settings.every);
   r.settings.keyframe_every = std::max<int64_t>(1, settings.keyframe_every);
-  r.file =
-      std::make_unique<ChunkWriter>(settings.out_dir / kRecordingFileName, settings.zstd_level);
+  r.file = std::make_unique<ChunkWriter>(settings.out_dir / kRecordingFileName, settings.zstd_level,
+                                         settings.max_chunk_raw_bytes);
 }
 
 RunRecorder::~RunRecorder() = default;

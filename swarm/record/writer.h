@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "framework/module.h"
+#include "swarm/record/format.h"
 
 namespace swarmsim {
 class World;
@@ -26,6 +27,8 @@ struct RecordSettings {
   int64_t steps_planned = 0;
   std::vector<std::string> metric_names;  // the world's metrics: entries, known at the start
   int zstd_level = 3;
+  // What one chunk may hold, decompressed: what every reader accepts (tests lower it).
+  uint32_t max_chunk_raw_bytes = kMaxChunkRawBytes;
 };
 
 class RunRecorder final : public Module {

@@ -304,6 +304,104 @@ TEST_F(TrustTest, DataTheSimCallsKeepCountsAgainstTheRobotsMemoryLimit) {
   }
 }
 
+// The same for what a call holds for the robot's lifetime (collections)
+// or while it runs (a packed string). The error's text may take the Lua
+// heap a little past the limit (it may pass it by some slack); what C++
+// holds never does.
+TEST_F(TrustTest, CollectionsAndPackedStringsCountAgainstTheRobotsMemoryLimit) {
+  settings_.script_memory_limit = 4 << 20;
+  const std::vector<std::pair<std::string, std::string>> calls = {
+      // A collection item each call, for the robot's lifetime.
+      {"local c = sim.createCollection() "
+       "for i = 1, 1e6 do sim.addItemToCollection(c, sim.handle_all, -1) end",
+       "sim.addItemToCollection: the collection item would take the scripts past 4 MiB"},
+      // 200 copies of one string: 20 MB packed from a table that holds it once.
+      {"local t = {} for i = 1, 200 do t[i] = block end sim.packTable(t)",
+       "sim.packTable: the packed table would take the scripts past 4 MiB"},
+  };
+  for (const auto& [call, message] : calls) {
+    SCOPED_TRACE(call);
+    const std::string error =
+        Run("local block = ('x'):rep(100000)\n"
+            "function sysCall_actuation()\n"
+            "  " +
+            call +
+            "\n"
+            "end\n");
+    EXPECT_CONTAINS(error, "bot#0: scripts/robot.lua:3: " + message);
+    EXPECT_CONTAINS(error, "of data the sim.* calls keep for them");
+    EXPECT_CONTAINS(error, "simulation.script_memory_mb");
+    EXPECT_LE(world_->script_memory(0).data(), uint64_t{4} << 20);
+  }
+}
+
+// A packed string is charged while the call builds it and released when it
+// returns: a table whose length is a border far past its entries (#t is
+// 2^40 here) is refused before anything is allocated for it, and modest
+// packing goes on step after step.
+TEST_F(TrustTest, PackingIsChargedWhileTheCallRuns) {
+  settings_.script_memory_limit = 8 << 20;
+  // A constructor sizes the hash part for all 41 keys: no rehash moves 1, 2
+  // and 4 into an array part, and the border search doubles up to 2^40.
+  std::string sparse = "local t = {";
+  for (int k = 0; k <= 40; ++k) sparse += "[1 << " + std::to_string(k) + "] = 1, ";
+  sparse += "}\nassert(#t == 1 << 40)\n";
+  for (const std::string pack : {"sim.packFloats(t)", "sim.packDoubles(t)", "sim.packInt32s(t)"}) {
+    SCOPED_TRACE(pack);
+    const std::string error = Run(sparse + "function sysCall_actuation()\n  " + pack + "\nend\n");
+    EXPECT_CONTAINS(error, "bot#0: scripts/robot.lua:4: sim.pack");
+    EXPECT_CONTAINS(error, ": the packed string would take the scripts past 8 MiB");
+    EXPECT_CONTAINS(error, "simulation.script_memory_mb");
+    EXPECT_EQ(world_->script_memory(0).data(), 0u) << "the call's charge is released";
+  }
+  // pcall around a refused packTable: the charge goes back each time.
+  EXPECT_EQ(Run("local big = {} for i = 1, 40 do big[i] = ('x'):rep(1e5) .. i end\n"
+                "local t = {} for i = 1, 1000 do t[i] = {i, 'n' .. i, i / 3, true} end\n"
+                "function sysCall_actuation()\n"
+                "  local ok, e = pcall(sim.packTable, {big, big, big, big})\n"
+                "  assert(not ok and e:find('the packed table would take'), e)\n"
+                "  assert(#sim.unpackTable(sim.packTable(t)) == 1000)\n"
+                "  assert(#sim.unpackFloats(sim.packFloats({1, 2, 3})) == 3)\n"
+                "end\n",
+                20),
+            "");
+  EXPECT_EQ(world_->script_memory(0).data(), 0u);
+}
+
+// A removed robot's collections go with it, and so does every charge it
+// held but for its signals and custom data (which outlive it).
+TEST_F(TrustTest, ARemovedRobotsCollectionsAndChargesGo) {
+  MakeWorld();
+  AddRobot("bot#0",
+           "function sysCall_actuation()\n"
+           "  for i = 1, 100 do\n"
+           "    local c = sim.createCollection()\n"
+           "    sim.addItemToCollection(c, sim.handle_tree, sim.getObject(':'))\n"
+           "  end\n"
+           "  sim.sendGlobalMessage(('m'):rep(1000))\n"
+           "  print('made')\n"
+           "end\n");
+  AddRobot("bot#1",
+           "local n = 0\n"
+           "function sysCall_actuation()\n"
+           "  n = n + 1\n"
+           "  if n == 2 then sim.removeModel(sim.getObject('/bot#0')) end\n"
+           "end\n");
+  EXPECT_EQ(ErrorOf([&] { world_->Step(); }), "");
+  EXPECT_EQ(world_->runtime(0).collections.size(), 100u);
+  EXPECT_GE(world_->script_memory(0).data(),
+            100 * (sizeof(CollectionRow) + sizeof(CollectionItem)));
+  EXPECT_EQ(ErrorOf([&] {
+              world_->Step();
+              world_->Step();
+            }),
+            "");
+  EXPECT_FALSE(world_->scene().instance(0).alive);
+  EXPECT_TRUE(world_->runtime(0).collections.empty());
+  EXPECT_EQ(world_->script_memory(0).data(), 0u);
+  EXPECT_EQ(world_->script_memory(0).used(), 0u) << "its Lua state is closed too";
+}
+
 // What is overwritten, cleared or delivered is released: a robot may set a
 // 1 MiB signal and block and send a 1 MiB message every step for good.
 TEST_F(TrustTest, DataIsReleasedWhenOverwrittenClearedOrDelivered) {

@@ -27,12 +27,15 @@ namespace swarmsim::testing {
 class ModuleWorld {
  public:
   // Kinematic physics by default: nothing moves unless a module moves it.
-  explicit ModuleWorld(std::string physics = "kinematic", int threads = 1, double time_step = 0.1) {
+  // `script_memory_limit`: bytes (simulation.script_memory_mb), -1: the default.
+  explicit ModuleWorld(std::string physics = "kinematic", int threads = 1, double time_step = 0.1,
+                       int64_t script_memory_limit = -1) {
     RegisterBuiltinModules(&registry_);
     WorldSettings settings;
     settings.physics = std::move(physics);
     settings.threads = threads;
     settings.time_step = time_step;
+    if (script_memory_limit >= 0) settings.script_memory_limit = script_memory_limit;
     world_ = std::make_unique<World>(settings, registry_);
     world_->set_log_sink([this](std::string_view line) { log_.emplace_back(line); });
   }

@@ -6,6 +6,7 @@
 
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "modules/paths/curve.h"
@@ -153,6 +154,42 @@ TEST(LuaApiPathsTest, CreatePathMakesAPathFromTheNextStep) {
   ASSERT_FALSE(made.IsNull());
   EXPECT_EQ(s.w.scene().parent(made), s.bot);
   EXPECT_DOUBLE_EQ(s.row(made).velocity, 0.25);
+}
+
+// A path a script makes is charged to its robot for the robot's lifetime
+// (simulation.script_memory_mb): a loop of long paths is refused naming
+// the call, a few short ones work.
+TEST(LuaApiPathsTest, PathsAScriptMakesCountAgainstItsMemoryLimit) {
+  const auto run = [](const std::string& code) {
+    ModuleWorld w("kinematic", 1, 0.1, int64_t{16} << 20);
+    const ObjectId bot = w.Robot("bot", {});
+    w.Script(bot, code);
+    const std::string error = w.Run(2);
+    EXPECT_LE(w.world().script_memory(0).used(), uint64_t{16} << 20);
+    return std::pair(error, w.scene().FindObject("/bot/p3", {}).IsNull());
+  };
+  // 100,000 points a path: ~3 MiB each in C++.
+  const auto [error, none] = run(R"(
+    local points = {}
+    for i = 1, 100000 do points[i] = {i * 0.01, 0, 0} end
+    function sysCall_actuation()
+      for i = 1, 20 do sim.createPath(points, {name = 'p' .. i}) end
+    end
+  )");
+  EXPECT_CONTAINS(error,
+                  "bot: script.lua:5: sim.createPath: the path would take the scripts "
+                  "past 16 MiB");
+  EXPECT_CONTAINS(error, "simulation.script_memory_mb");
+  const auto [fine, missing] = run(R"(
+    local made = false
+    function sysCall_actuation()
+      if made then return end
+      made = true
+      for i = 1, 5 do sim.createPath({{0, 0, 0}, {1, i, 0}}, {name = 'p' .. i}) end
+    end
+  )");
+  EXPECT_EQ(fine, "");
+  EXPECT_FALSE(missing);
 }
 
 }  // namespace

@@ -23,6 +23,8 @@
 #include "swarm/loader/world_loader.h"
 #include "swarm/record/format.h"
 #include "swarm/record/reader.h"
+#include "tests/framework/error_of.h"
+#include "tests/swarm/run_program.h"
 
 namespace swarmsim::record {
 namespace {
@@ -382,6 +384,74 @@ TEST(RecordingTest, ATypeIsRecordedAsItsVisualDeclaresIt) {
   EXPECT_EQ(steps,
             (std::vector<std::pair<uint16_t, uint32_t>>{
                 {kNoDetection, 0x01ff0000}, {kNoDetection, 0x01ff0000}, {quarter, 0x010000ff}}));
+  fs::remove_all(out);
+}
+
+// A chunk a reader would refuse (past kMaxChunkRawBytes decompressed,
+// lowered here) is never written: the run fails naming the chunk, its step
+// and the limit, and the file keeps every chunk before it and the end
+// chunk, so that record-info and the viewer read it whole.
+TEST(RecordingTest, AChunkPastTheReadersLimitEndsTheRecordingWhole) {
+  const fs::path out = TempDir("too_large");
+  ModuleRegistry registry;
+  RegisterBuiltinModules(&registry);
+  WorldSettings ws;
+  ws.physics = "kinematic";
+  World world(ws, registry);
+  world.set_log_sink([](std::string_view) {});
+  Scene& scene = world.scene();
+  const ObjectId root = scene.AddDummy("bot", {}, {});
+  scene.MakeModelInstance(root, "bot", "bot#0");
+  ShapeData box;
+  box.kind = ShapeKind::kBox;
+  box.size = {0.1, 0.1, 0.1};
+  scene.AddShape("body", root, {}, box);
+  // At step 3, robot 0 copies itself 500 times: a scene of ~45 KB.
+  scene.AttachScript(root, std::make_shared<const ScriptSource>(ScriptSource{"robot.lua", R"(
+    local step = 0
+    function sysCall_actuation()
+      step = step + 1
+      if step == 3 and sim.getRobotIndex() == 0 then
+        for i = 1, 500 do sim.copyModel(sim.getObject(':')) end
+      end
+    end
+  )"}));
+  RecordSettings settings;
+  settings.out_dir = out;
+  settings.max_chunk_raw_bytes = 32 << 10;
+  RunRecorder* recorder = AddRecorder(&world, settings);
+  world.Start();
+  // The error comes back from the recorder's thread at a later step, or at the end.
+  std::string error;
+  int steps = 0;
+  while (steps < 20 && error.empty()) {
+    try {
+      world.Step();
+      ++steps;
+      if (steps == 20) recorder->WriteOutputs(out);
+    } catch (const Error& e) {
+      error = e.what();
+    }
+  }
+  EXPECT_CONTAINS(error, (out / kRecordingFileName).string() + ": the scene of step 3 would hold ");
+  EXPECT_CONTAINS(error, "bytes decompressed, past the 32768 bytes a recording chunk may hold");
+  recorder->Finish(steps, "error", error);
+
+  RecordingPlayer player(out);
+  EXPECT_FALSE(player.info().truncated);
+  ASSERT_FALSE(player.info().chunks.empty());
+  EXPECT_EQ(player.info().chunks.back().kind, static_cast<uint8_t>(ChunkKind::kEnd));
+  for (const ChunkInfo& c : player.info().chunks) EXPECT_LE(c.raw_size, uint32_t{32} << 10);
+  EXPECT_EQ(player.info().step_records, 3) << "steps 0, 1 and 2";
+  int64_t last = -1;
+  while (player.Next()) last = player.step();
+  EXPECT_EQ(last, 2);
+  // The program reads it back whole, and says how the run ended.
+  const testing::CommandResult info = testing::RunProgram("record-info " + out.string());
+  EXPECT_EQ(info.exit_code, 0) << info.output;
+  EXPECT_CONTAINS(info.output, "3 step records (steps 0..2)");
+  EXPECT_CONTAINS(info.output, "the run ended (error: ");
+  EXPECT_CONTAINS(info.output, "a recording chunk may hold");
   fs::remove_all(out);
 }
 
