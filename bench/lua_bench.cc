@@ -46,7 +46,7 @@ ObjectId AddFootbot(Scene* scene, std::shared_ptr<const ScriptSource> script, do
   wheel.kind = ShapeKind::kCylinder;
   wheel.size = {0.029, 0, 0.02};
   JointData motor;
-  motor.mode = JointMode::kVelocity;
+  motor.settings.Edit().mode = JointMode::kVelocity;
   for (const char* side : {"left", "right"}) {
     const double y = side[0] == 'l' ? 0.07 : -0.07;
     const ObjectId joint =

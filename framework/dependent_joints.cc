@@ -11,7 +11,7 @@ namespace swarmsim {
 namespace {
 
 const JointDependency* DependencyAt(const Scene& scene, uint32_t slot) {
-  return scene.joints()[scene.row_at(slot)].depends.get();
+  return scene.joints()[scene.row_at(slot)].depends();
 }
 
 }  // namespace
@@ -69,7 +69,7 @@ void DependentJoints::Refresh(const Scene& scene) {
   const auto owners = scene.joint_owners();
   for (uint32_t row = 0; row < owners.size(); ++row) {
     const uint32_t slot = owners[row];
-    if (!scene.alive_at(slot) || scene.joints()[row].depends == nullptr) continue;
+    if (!scene.alive_at(slot) || scene.joints()[row].depends() == nullptr) continue;
     uint32_t depth = 0;
     for (uint32_t s = slot; DependencyAt(scene, s) != nullptr && depth <= owners.size(); ++depth)
       s = JointMasterSlot(scene, s);
@@ -88,13 +88,14 @@ bool DependentJoints::Apply(Scene* scene, bool targets) {
   for (const Link& l : links_) {
     JointData& j = joints[l.row];
     const JointData& m = joints[l.master_row];
-    const double q = j.depends->offset + j.depends->factor * m.position;
+    const JointDependency& d = *j.depends();
+    const double q = d.offset + d.factor * m.position;
     if (j.simulated) {
       if (targets) j.target_position = q;
       continue;
     }
     j.position = q;
-    j.velocity = j.depends->factor * m.velocity;
+    j.velocity = d.factor * m.velocity;
   }
   return !links_.empty();
 }

@@ -75,11 +75,11 @@ int SetJointPosition(lua_State* L) {
     throw Error("joint '" + path +
                 "' is simulated by the dynamics: use sim.setJointTargetPosition (position "
                 "mode) or sim.setJointTargetVelocity");
-  if (joint.depends)
-    throw Error("joint '" + path + "' follows its master '" + joint.depends->master +
+  if (joint.depends())
+    throw Error("joint '" + path + "' follows its master '" + joint.depends()->master +
                 "': set the master's position");
-  if (joint.type == JointType::kSpherical || joint.type == JointType::kFixed)
-    throw Error("joint '" + path + "' is " + ToString(joint.type) + ": it has no position");
+  if (joint.type() == JointType::kSpherical || joint.type() == JointType::kFixed)
+    throw Error("joint '" + path + "' is " + ToString(joint.type()) + ": it has no position");
   if (c.instance < 0)
     joint.JumpTo(value);
   else

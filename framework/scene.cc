@@ -63,12 +63,12 @@ double ShapeData::BoundingRadius() const {
 }
 
 Pose JointData::Motion() const {
-  switch (type) {
+  switch (settings->type) {
     case JointType::kRevolute: return {{}, Quat::FromAxisAngle({0, 0, 1}, position)};
     case JointType::kPrismatic: return {{0, 0, position}, {}};
     case JointType::kSpherical: return {{}, ball};
     case JointType::kScrew:
-      return {{0, 0, pitch * position}, Quat::FromAxisAngle({0, 0, 1}, position)};
+      return {{0, 0, settings->pitch * position}, Quat::FromAxisAngle({0, 0, 1}, position)};
     case JointType::kFixed: break;
   }
   return {};
@@ -77,7 +77,7 @@ Pose JointData::Motion() const {
 void JointData::JumpTo(double q) {
   position = q;
   velocity = 0;
-  if (mode == JointMode::kPosition) target_position = q;
+  if (settings->mode == JointMode::kPosition) target_position = q;
 }
 
 Scene::Scene() {

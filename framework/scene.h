@@ -111,34 +111,48 @@ struct JointDependency {
   std::string where;  // file:line:column of `master`, for errors
 };
 
+// A joint's settings: constant while it runs, shared by every copy made
+// from one model entry (framework/shared_settings.h; Edit() is copy on
+// write: a scale, or a copy's own `instances:` values, give it its own).
+struct JointSettings {
+  JointType type = JointType::kRevolute;
+  JointMode mode = JointMode::kVelocity;
+  double max_force = 10;            // N or N m
+  double max_velocity = 10;         // rad/s or m/s, position mode
+  double damping = 0;               // N m s/rad or N s/m: viscous -damping * velocity (ode)
+  double min_position = -INFINITY;  // limits, rad or m (infinite: unlimited)
+  double max_position = INFINITY;
+  double pitch = 0;                                // screw joints: m per rad, finite and nonzero
+  std::shared_ptr<const JointDependency> depends;  // null: an independent joint
+};
+
 // A joint moves its children along/about its own z axis (V-REP's convention):
 // X_W(child) = X_WJ * Motion(position) * X_J(child). A spherical joint turns
 // them by `ball` (position and velocity unused); a fixed joint does not move.
 // A screw joint turns them by `position` (rad) about z and moves them
 // pitch * position (m) along z.
+//
+// A row is its shared settings and its state (88 bytes): what the actuate
+// and physics phases, scripts and IK write. The state hash reads the state.
 struct JointData {
-  JointType type = JointType::kRevolute;
-  JointMode mode = JointMode::kVelocity;
-  double position = 0;              // rad or m
-  double velocity = 0;              // rad/s or m/s
-  double target_velocity = 0;       // velocity mode
-  double target_position = 0;       // position mode
-  double max_force = 10;            // N or N m
-  double max_velocity = 10;         // rad/s or m/s, position mode
-  double target_force = 0;          // N or N m, force mode
-  double damping = 0;               // N m s/rad or N s/m: viscous -damping * velocity (ode)
-  double min_position = -INFINITY;  // limits, rad or m (infinite: unlimited)
-  double max_position = INFINITY;
-  Quat ball;                                       // spherical joints: rotation of the children
-  double pitch = 0;                                // screw joints: m per rad, finite and nonzero
-  std::shared_ptr<const JointDependency> depends;  // null: an independent joint
+  Shared<JointSettings> settings;  // read: settings->max_force; write: settings.Edit()
+  double position = 0;             // rad or m
+  double velocity = 0;             // rad/s or m/s
+  double target_velocity = 0;      // velocity mode (scripts set it every step)
+  double target_position = 0;      // position mode
+  double target_force = 0;         // N or N m, force mode
+  Quat ball;                       // spherical joints: rotation of the children
   // Set by a dynamics backend that integrates this joint's position and
   // velocity itself; World::Actuate then leaves them alone.
   bool simulated = false;
   // IK mode (V-REP's joint IK mode): a frozen joint keeps its value while
-  // IK groups solve (the `ik` key, sim.setJointIkMode).
+  // IK groups solve (the `ik` key, sim.setJointIkMode, which scripts may
+  // switch at any step: state, hashed when set).
   bool ik_frozen = false;
 
+  JointType type() const { return settings->type; }
+  JointMode mode() const { return settings->mode; }
+  const JointDependency* depends() const { return settings->depends.get(); }  // null: independent
   Pose Motion() const;  // transform produced by `position` about/along z
   // sim.setJointPosition on a joint nothing simulates: it jumps to q and
   // stays (a position-mode joint's target becomes q, its velocity 0).
@@ -354,6 +368,9 @@ class Scene {
     return SettingsView<ShapeData>(Table<Shared<ShapeData>>(ObjectType::kShape).rows);
   }
   std::span<const uint32_t> shape_owners() const { return Owners(ObjectType::kShape); }
+  // A joint's row is its state beside a Shared<JointSettings>: writing
+  // through joints() or mutable_joint() changes state; a setting changes
+  // through row.settings.Edit(), which gives that joint its own first.
   std::span<JointData> joints() { return Table<JointData>(ObjectType::kJoint).rows; }
   std::span<const JointData> joints() const { return Table<JointData>(ObjectType::kJoint).rows; }
   std::span<const uint32_t> joint_owners() const { return Owners(ObjectType::kJoint); }

@@ -512,7 +512,7 @@ void World::Actuate() {
     }
     JointData& j = scene_.mutable_joint(w.object);
     if (w.kind == DeferredWrite::Kind::kJointPosition) {
-      if (!j.simulated && !j.depends) j.JumpTo(w.value);  // checked when the script called
+      if (!j.simulated && !j.depends()) j.JumpTo(w.value);  // checked when the script called
       continue;
     }
     if (w.kind == DeferredWrite::Kind::kJointTargetVelocity)
@@ -526,15 +526,16 @@ void World::Actuate() {
   // velocity mode at the target velocity, position mode at up to max_velocity.
   const double dt = settings_.time_step;
   for (JointData& j : scene_.joints()) {
-    if (j.simulated || j.depends) continue;  // the dynamics backend, or its master, moves it
-    switch (j.mode) {
+    if (j.simulated || j.depends()) continue;  // the dynamics backend, or its master, moves it
+    switch (j.mode()) {
       case JointMode::kVelocity:
         j.velocity = j.target_velocity;
         j.position += j.velocity * dt;
         break;
       case JointMode::kPosition: {
         const double error = j.target_position - j.position;
-        const double step = std::clamp(error, -j.max_velocity * dt, j.max_velocity * dt);
+        const double max_step = j.settings->max_velocity * dt;
+        const double step = std::clamp(error, -max_step, max_step);
         j.velocity = step / dt;
         j.position += step;
         break;

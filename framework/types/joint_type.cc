@@ -44,32 +44,35 @@ std::unique_ptr<RowTable> MakeRows(const ObjectTypeDescriptor&) {
 }
 
 // Prismatic: lengths x s, forces (N) x s^3; revolute and others: angles
-// unchanged, torques (N m) x s^4.
+// unchanged, torques (N m) x s^4. The settings scaled are this copy's own
+// (copy on write): the other copies keep theirs.
 void Scale(const ObjectTypeDescriptor&, void* row, double s, ScaleContext*) {
   JointData& j = *static_cast<JointData*>(row);
+  JointSettings& settings = j.settings.Edit();
   const double s3 = s * s * s, s4 = s3 * s;
-  if (j.type == JointType::kPrismatic) {
+  if (settings.type == JointType::kPrismatic) {
     for (double* v : {&j.position, &j.velocity, &j.target_velocity, &j.target_position,
-                      &j.max_velocity, &j.min_position, &j.max_position})
+                      &settings.max_velocity, &settings.min_position, &settings.max_position})
       *v *= s;
-    j.max_force *= s3;
+    settings.max_force *= s3;
     j.target_force *= s3;
-    j.damping *= s * s;  // N s/m
+    settings.damping *= s * s;  // N s/m
   } else {
-    if (j.type == JointType::kScrew) j.pitch *= s;  // m per rad
-    j.max_force *= s4;
+    if (settings.type == JointType::kScrew) settings.pitch *= s;  // m per rad
+    settings.max_force *= s4;
     j.target_force *= s4;
-    j.damping *= s4;  // N m s/rad
+    settings.damping *= s4;  // N m s/rad
   }
   // A prismatic joint's offset is a length (the factor's units depend on
   // the master's kind and stay as they are).
-  if (j.depends && j.type == JointType::kPrismatic) {
-    auto d = std::make_shared<JointDependency>(*j.depends);
+  if (settings.depends && settings.type == JointType::kPrismatic) {
+    auto d = std::make_shared<JointDependency>(*settings.depends);
     d->offset *= s;
-    j.depends = std::move(d);
+    settings.depends = std::move(d);
   }
 }
 
+// State only: the settings are the model's.
 void Hash(const Scene& scene, ObjectType, StateHasher* h) {
   for (size_t r = 0; r < scene.joints().size(); ++r) {
     const JointData& j = scene.joints()[r];
@@ -84,20 +87,21 @@ void Hash(const Scene& scene, ObjectType, StateHasher* h) {
 
 void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
   JointData& j = *static_cast<JointData*>(row);
+  JointSettings& settings = j.settings.Edit();  // this row's own (a fresh row's, when loading)
   if (r.Has("joint")) {
     const std::string type =
         r.Choice("joint", {"revolute", "prismatic", "screw", "spherical", "fixed"});
-    j.type = type == "revolute"    ? JointType::kRevolute
-             : type == "prismatic" ? JointType::kPrismatic
-             : type == "screw"     ? JointType::kScrew
-             : type == "spherical" ? JointType::kSpherical
-                                   : JointType::kFixed;
+    settings.type = type == "revolute"    ? JointType::kRevolute
+                    : type == "prismatic" ? JointType::kPrismatic
+                    : type == "screw"     ? JointType::kScrew
+                    : type == "spherical" ? JointType::kSpherical
+                                          : JointType::kFixed;
   }
-  if (j.type == JointType::kScrew) {
+  if (settings.type == JointType::kScrew) {
     if (!r.Has("pitch"))
       r.FailAtKey("joint", "a screw joint needs 'pitch' (m of travel per rad, nonzero)");
-    j.pitch = r.Number("pitch", kAnyNumber);
-    if (!std::isfinite(j.pitch) || j.pitch == 0)
+    settings.pitch = r.Number("pitch", kAnyNumber);
+    if (!std::isfinite(settings.pitch) || settings.pitch == 0)
       r.Fail("pitch", "'pitch' must be a finite, nonzero number of m per rad");
   } else if (r.Has("pitch")) {
     r.FailAtKey("pitch", "'pitch' is for screw joints (joint: screw)");
@@ -112,7 +116,7 @@ void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
     if (r.Has("factor")) d->factor = r.Number("factor", kAnyNumber);
     if (r.Has("offset")) d->offset = r.Number("offset", kAnyNumber);
     d->where = r.Where("master");
-    j.depends = std::move(d);
+    settings.depends = std::move(d);
   } else {
     for (const char* key : {"factor", "offset"})
       if (r.Has(key))
@@ -120,23 +124,23 @@ void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
   }
   if (r.Has("mode")) {
     const std::string mode = r.Choice("mode", {"passive", "velocity", "position", "force"});
-    j.mode = mode == "passive"    ? JointMode::kPassive
-             : mode == "velocity" ? JointMode::kVelocity
-             : mode == "position" ? JointMode::kPosition
-                                  : JointMode::kForce;
+    settings.mode = mode == "passive"    ? JointMode::kPassive
+                    : mode == "velocity" ? JointMode::kVelocity
+                    : mode == "position" ? JointMode::kPosition
+                                         : JointMode::kForce;
   }
   if (r.Has("ik")) j.ik_frozen = r.Choice("ik", {"active", "frozen"}) == "frozen";
   if (r.Has("target_force")) j.target_force = r.Number("target_force", kAnyNumber);
-  if (r.Has("damping")) j.damping = r.Number("damping", kNonNegative);
+  if (r.Has("damping")) settings.damping = r.Number("damping", kNonNegative);
   if (r.Has("limits")) {
     // [min, max] in rad or m, like initial_position.
     const std::vector<double> v = r.Numbers("limits", 2, 2, kAnyNumber);
     if (!(v[0] <= v[1])) r.Fail("limits", "'limits' must be [min, max] with min <= max");
-    j.min_position = v[0];
-    j.max_position = v[1];
+    settings.min_position = v[0];
+    settings.max_position = v[1];
   }
-  if (r.Has("max_force")) j.max_force = r.Number("max_force", kPositive);
-  if (r.Has("max_velocity")) j.max_velocity = r.Number("max_velocity", kPositive);
+  if (r.Has("max_force")) settings.max_force = r.Number("max_force", kPositive);
+  if (r.Has("max_velocity")) settings.max_velocity = r.Number("max_velocity", kPositive);
   if (r.Has("target_velocity")) j.target_velocity = r.Number("target_velocity", kAnyNumber);
   if (r.Has("target_position")) j.target_position = r.Number("target_position", kAnyNumber);
   if (r.Has("initial_position")) j.position = r.Number("initial_position", kAnyNumber);

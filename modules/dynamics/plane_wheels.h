@@ -48,7 +48,7 @@ void ForEachPlaneWheel(const Scene& scene, const std::vector<int32_t>& body_of,
   for (uint32_t s = 0; s < scene.slot_count(); ++s) {
     if (!scene.alive_at(s) || scene.type_at(s) != ObjectType::kJoint) continue;
     const JointData& joint = scene.joints()[scene.row_at(s)];
-    if (joint.type != JointType::kRevolute || joint.mode != JointMode::kVelocity) continue;
+    if (joint.type() != JointType::kRevolute || joint.mode() != JointMode::kVelocity) continue;
     const int32_t b = NearestBodyAbove(scene, body_of, s, -1);
     if (b < 0) continue;
     const ShapeData* wheel_shape = WheelShapeOf(scene, s);

@@ -161,7 +161,7 @@ void GraphModule::Refresh(Scene* scene) {
       s.sources[i] = target.index();
       // A joint's unit, now that its type is known.
       if (spec.kind == StreamKind::kJoint || spec.kind == StreamKind::kJointVelocity) {
-        const bool linear = scene->joint(target).type == JointType::kPrismatic;
+        const bool linear = scene->joint(target).type() == JointType::kPrismatic;
         s.settings.streams[i].unit =
             spec.kind == StreamKind::kJoint ? (linear ? "m" : "rad") : (linear ? "m/s" : "rad/s");
       }

@@ -41,13 +41,19 @@ Chain Chain::FromScene(const Scene& scene, ObjectId base, ObjectId tip) {
     X_acc = X_acc * scene.local_pose_at(slot);
     if (scene.type_at(slot) != ObjectType::kJoint) continue;
     const JointData& j = scene.joints()[scene.row_at(slot)];
-    ChainJoint c{X_acc, ChainJointKind::kRevolute, 0, j.min_position, j.max_position, j.ball, slot};
-    switch (j.type) {
+    ChainJoint c{X_acc,
+                 ChainJointKind::kRevolute,
+                 0,
+                 j.settings->min_position,
+                 j.settings->max_position,
+                 j.ball,
+                 slot};
+    switch (j.type()) {
       case JointType::kRevolute: break;
       case JointType::kPrismatic: c.kind = ChainJointKind::kPrismatic; break;
       case JointType::kScrew:
         c.kind = ChainJointKind::kScrew;
-        c.pitch = j.pitch;
+        c.pitch = j.settings->pitch;
         break;
       case JointType::kSpherical: c.kind = ChainJointKind::kSpherical; break;
       case JointType::kFixed: X_acc = X_acc * j.Motion(); continue;

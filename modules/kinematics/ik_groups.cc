@@ -68,9 +68,10 @@ uint32_t RootMaster(const Scene& scene, uint32_t slot, double* factor, double* o
   *offset = 0;
   for (size_t hops = 0; hops <= scene.joints().size(); ++hops) {
     const JointData& j = scene.joints()[scene.row_at(slot)];
-    if (j.depends == nullptr) return slot;
-    *offset += *factor * j.depends->offset;
-    *factor *= j.depends->factor;
+    const JointDependency* d = j.depends();
+    if (d == nullptr) return slot;
+    *offset += *factor * d->offset;
+    *factor *= d->factor;
     slot = JointMasterSlot(scene, slot);
   }
   CheckJointDependency(scene, scene.IdAt(slot));  // a cycle: throws
@@ -318,7 +319,7 @@ class IkGroupsImpl final : public IkGroups {
                     "positions, and a spherical joint has none)");
       // Dependent joints follow their master's column, or keep their value
       // if it is not an unknown of the group (whatever their weight).
-      if (j.depends == nullptr || problem.is_ball_part(c)) continue;
+      if (j.depends() == nullptr || problem.is_ball_part(c)) continue;
       double factor, offset;
       const int master = column_of(RootMaster(scene, slots[c], &factor, &offset));
       if (master >= 0 && !problem.is_ball_part(master))

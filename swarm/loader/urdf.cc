@@ -578,8 +578,11 @@ ObjectSpec Importer::LinkObject(const urdf::Link& link, bool top, bool is_root, 
     ObjectSpec j =
         NewObject(ObjectType::kJoint, ObjectName(joint->name), X_LJ * Pose{{}, z_to_axis});
     JointData& d = RowOf<JointData>(j);
-    d.type = joint->type == urdf::Joint::PRISMATIC ? JointType::kPrismatic : JointType::kRevolute;
-    d.mode = joint->type == urdf::Joint::CONTINUOUS ? JointMode::kVelocity : JointMode::kPosition;
+    JointSettings& settings = d.settings.Edit();  // this entry's, shared by its copies
+    settings.type =
+        joint->type == urdf::Joint::PRISMATIC ? JointType::kPrismatic : JointType::kRevolute;
+    settings.mode =
+        joint->type == urdf::Joint::CONTINUOUS ? JointMode::kVelocity : JointMode::kPosition;
     ++joint_kinds_[joint->type == urdf::Joint::CONTINUOUS  ? "continuous"
                    : joint->type == urdf::Joint::PRISMATIC ? "prismatic"
                                                            : "revolute"];
@@ -587,29 +590,31 @@ ObjectSpec Importer::LinkObject(const urdf::Link& link, bool top, bool is_root, 
       if (joint->type != urdf::Joint::CONTINUOUS) {
         if (!(joint->limits->lower <= joint->limits->upper))
           Fail(line, "joint '" + joint->name + "': <limit lower> is above upper");
-        d.min_position = joint->limits->lower;
-        d.max_position = joint->limits->upper;
+        settings.min_position = joint->limits->lower;
+        settings.max_position = joint->limits->upper;
         // Start inside the limits.
-        d.position = d.target_position = std::clamp(0.0, d.min_position, d.max_position);
+        d.position = d.target_position =
+            std::clamp(0.0, settings.min_position, settings.max_position);
       }
       if (joint->limits->effort > 0)
-        d.max_force = joint->limits->effort;
+        settings.max_force = joint->limits->effort;
       else
-        d.max_force = kUrdfDefaultEffort;
-      d.max_velocity = joint->limits->velocity > 0 ? joint->limits->velocity : kUrdfDefaultVelocity;
+        settings.max_force = kUrdfDefaultEffort;
+      settings.max_velocity =
+          joint->limits->velocity > 0 ? joint->limits->velocity : kUrdfDefaultVelocity;
     } else {
-      d.max_force = kUrdfDefaultEffort;
-      d.max_velocity = kUrdfDefaultVelocity;
+      settings.max_force = kUrdfDefaultEffort;
+      settings.max_velocity = kUrdfDefaultVelocity;
     }
-    if (joint->dynamics) d.damping = joint->dynamics->damping;
+    if (joint->dynamics) settings.damping = joint->dynamics->damping;
     if (joint->mimic) {
       auto dep = std::make_shared<JointDependency>();
       dep->master = ":/" + ObjectName(joint->mimic->joint_name);
       dep->factor = joint->mimic->multiplier;
       dep->offset = joint->mimic->offset;
       dep->where = name_ + ":" + std::to_string(xml_.mimic_line[joint->name]);
-      d.depends = std::move(dep);
-      d.mode = JointMode::kPosition;
+      settings.depends = std::move(dep);
+      settings.mode = JointMode::kPosition;
       ++mimics_;
     }
     j.children.push_back(LinkObject(*child, true, false, Pose{{}, z_to_axis.Conjugate()}, Pose{}));

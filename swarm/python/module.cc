@@ -159,14 +159,14 @@ void ApplyTargets(World* world, const ModelLayout& layout, const ControllerConfi
         throw Error(config.where + ": the controller's '" + name + "' for robot '" +
                     scene.instance(layout.robots[i]).name + "' is not finite");
       JointData& joint = rows[scene.row_at(layout.joint_slots[i * joints + column])];
-      if (joint.mode == JointMode::kVelocity)
+      if (joint.mode() == JointMode::kVelocity)
         joint.target_velocity = x;
-      else if (joint.mode == JointMode::kPosition)
+      else if (joint.mode() == JointMode::kPosition)
         joint.target_position = x;
-      else if (!joint.simulated && !joint.depends)
+      else if (!joint.simulated && !joint.depends())
         joint.JumpTo(x);
       else
-        throw Error(config.where + ": joint '" + name + "' is in " + ToString(joint.mode) +
+        throw Error(config.where + ": joint '" + name + "' is in " + ToString(joint.mode()) +
                     " mode: a controller sets velocity- and position-mode joints");
     }
   }

@@ -25,7 +25,7 @@ JointData Follower(const std::string& master, double factor, double offset,
   d->factor = factor;
   d->offset = offset;
   d->where = where;
-  j.depends = std::move(d);
+  j.settings.Edit().depends = std::move(d);
   return j;
 }
 

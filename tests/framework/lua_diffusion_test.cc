@@ -35,7 +35,7 @@ class DiffusionTest : public ::testing::Test {
     // from the front.
     body_ = scene.AddShape("body", {}, {}, {});
     JointData motor;
-    motor.mode = JointMode::kVelocity;
+    motor.settings.Edit().mode = JointMode::kVelocity;
     left_ = scene.AddJoint("leftMotor", body_, {{0, 0.07, 0}, {}}, motor);
     right_ = scene.AddJoint("rightMotor", body_, {{0, -0.07, 0}, {}}, motor);
     for (int i = 0; i < 24; ++i) {

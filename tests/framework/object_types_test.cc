@@ -70,16 +70,16 @@ TEST(ObjectTypesTest, CopyScaleAndRemoveUseEachTypesRules) {
   Scene scene;
   const ObjectId root = scene.AddDummy("bot", {}, {});
   JointData slide;
-  slide.type = JointType::kPrismatic;
-  slide.max_position = 0.5;
+  slide.settings.Edit().type = JointType::kPrismatic;
+  slide.settings.Edit().max_position = 0.5;
   const ObjectId joint = scene.AddJoint("slide", root, {}, slide);
   const ObjectId copy = scene.DuplicateSubtree(root, {});
   scene.ScaleSubtree(copy, 2);
-  EXPECT_EQ(scene.joint(scene.FindObject("./slide", copy)).max_position, 1.0);
-  EXPECT_EQ(scene.joint(joint).max_position, 0.5);
+  EXPECT_EQ(scene.joint(scene.FindObject("./slide", copy)).settings->max_position, 1.0);
+  EXPECT_EQ(scene.joint(joint).settings->max_position, 0.5);
   scene.RemoveSubtree(root);
   ASSERT_EQ(scene.joints().size(), 1u);
-  EXPECT_EQ(scene.joints()[0].max_position, 1.0);
+  EXPECT_EQ(scene.joints()[0].settings->max_position, 1.0);
   EXPECT_EQ(scene.joint_owners()[0], scene.FindObject("./slide", copy).index());
 }
 

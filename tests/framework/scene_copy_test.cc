@@ -126,15 +126,15 @@ TEST(SceneScaleTest, ScalesGeometryJointsSensorsAndMasses) {
   body.mass = 2;
   const ObjectId root = scene.AddShape("root", {}, {{5, 0, 1}, {}}, body);
   JointData slider;
-  slider.type = JointType::kPrismatic;
+  slider.settings.Edit().type = JointType::kPrismatic;
   slider.position = 0.1;
-  slider.min_position = -0.2;
-  slider.max_position = 0.3;
-  slider.max_force = 4;
+  slider.settings.Edit().min_position = -0.2;
+  slider.settings.Edit().max_position = 0.3;
+  slider.settings.Edit().max_force = 4;
   const ObjectId prismatic = scene.AddJoint("slider", root, {{0, 0, 0.1}, {}}, slider);
   JointData hinge;
   hinge.position = 0.5;
-  hinge.max_force = 3;
+  hinge.settings.Edit().max_force = 3;
   const ObjectId revolute = scene.AddJoint("hinge", root, {{0.1, 0, 0}, {}}, hinge);
   ShapeData mesh;
   mesh.kind = ShapeKind::kMesh;
@@ -155,12 +155,12 @@ TEST(SceneScaleTest, ScalesGeometryJointsSensorsAndMasses) {
   EXPECT_DOUBLE_EQ(scene.shape(root).mass, 16);
   EXPECT_DOUBLE_EQ(scene.local_pose(prismatic).p.z, 0.2);
   EXPECT_DOUBLE_EQ(scene.joint(prismatic).position, 0.2);
-  EXPECT_DOUBLE_EQ(scene.joint(prismatic).min_position, -0.4);
-  EXPECT_DOUBLE_EQ(scene.joint(prismatic).max_position, 0.6);
-  EXPECT_DOUBLE_EQ(scene.joint(prismatic).max_force, 32);     // N: x s^3
-  EXPECT_DOUBLE_EQ(scene.joint(revolute).position, 0.5);      // angles unchanged
-  EXPECT_DOUBLE_EQ(scene.joint(revolute).max_force, 48);      // N m: x s^4
-  EXPECT_DOUBLE_EQ(scene.world_pose(m1).p.z, 1 + 0.2 + 0.2);  // offset + slider
+  EXPECT_DOUBLE_EQ(scene.joint(prismatic).settings->min_position, -0.4);
+  EXPECT_DOUBLE_EQ(scene.joint(prismatic).settings->max_position, 0.6);
+  EXPECT_DOUBLE_EQ(scene.joint(prismatic).settings->max_force, 32);  // N: x s^3
+  EXPECT_DOUBLE_EQ(scene.joint(revolute).position, 0.5);             // angles unchanged
+  EXPECT_DOUBLE_EQ(scene.joint(revolute).settings->max_force, 48);   // N m: x s^4
+  EXPECT_DOUBLE_EQ(scene.world_pose(m1).p.z, 1 + 0.2 + 0.2);         // offset + slider
   EXPECT_DOUBLE_EQ(proximity::Sensor(scene, eye).range(), 0.2);
   // One scaled asset for both shapes that shared the original.
   EXPECT_EQ(scene.shape(m1).mesh, scene.shape(m2).mesh);

@@ -86,7 +86,7 @@ TEST(SceneTest, ChildWorldPoseFollowsParent) {
 TEST(SceneTest, JointMotionMovesChildren) {
   Scene scene;
   JointData j;
-  j.type = JointType::kRevolute;
+  j.settings.Edit().type = JointType::kRevolute;
   const ObjectId joint = scene.AddJoint("j", {}, {}, j);
   const ObjectId arm = scene.AddDummy("arm", joint, {{1, 0, 0}, {}});
   scene.mutable_joint(joint).position = M_PI / 2;
@@ -94,7 +94,7 @@ TEST(SceneTest, JointMotionMovesChildren) {
   ExpectNear(scene.world_pose(arm).p, {0, 1, 0});
 
   JointData p;
-  p.type = JointType::kPrismatic;
+  p.settings.Edit().type = JointType::kPrismatic;
   const ObjectId slider =
       scene.AddJoint("s", {}, {{0, 0, 0}, Quat::FromAxisAngle({0, 1, 0}, M_PI / 2)}, p);
   const ObjectId carriage = scene.AddDummy("c", slider, {});
@@ -210,7 +210,7 @@ RingBot AddRingBot(Scene* scene, const std::string& name, const Pose& X_WB) {
   proximity::AddSensor(scene, "gripperProx", bot.gripper, {{0.01, 0, 0}, {}}, {});
   add_sensors(12, 24);
   JointData prismatic;
-  prismatic.type = JointType::kPrismatic;
+  prismatic.settings.Edit().type = JointType::kPrismatic;
   bot.slider = scene->AddJoint("slider", bot.body, {{0, 0, 0.08}, {}}, prismatic);
   scene->AddDummy("carriage", bot.slider, {{0, 0.01, 0}, {}});
   scene->AddDummy("carriageTip", bot.slider, {{0, 0.02, 0.01}, Quat::FromYaw(0.3)});

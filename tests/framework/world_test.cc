@@ -83,12 +83,12 @@ TEST(WorldTest, JointsMoveTowardTheirTargets) {
   settings.time_step = 0.1;
   World world(settings, registry);
   JointData v;
-  v.mode = JointMode::kVelocity;
+  v.settings.Edit().mode = JointMode::kVelocity;
   v.target_velocity = 2.0;
   JointData p;
-  p.mode = JointMode::kPosition;
+  p.settings.Edit().mode = JointMode::kPosition;
   p.target_position = 1.0;
-  p.max_velocity = 1.0;
+  p.settings.Edit().max_velocity = 1.0;
   const ObjectId jv = world.scene().AddJoint("v", {}, {}, v);
   const ObjectId jp = world.scene().AddJoint("p", {}, {}, p);
   world.Start();
@@ -129,7 +129,7 @@ TEST(WorldTest, JointRunningToInfinityIsAnErrorNamingTheJoint) {
   settings.time_step = 0.1;
   World world(settings, registry);
   JointData v;
-  v.mode = JointMode::kVelocity;
+  v.settings.Edit().mode = JointMode::kVelocity;
   v.target_velocity = 1e308;  // finite, but its position overflows after ~18 steps
   world.scene().AddJoint("wheel", {}, {}, v);
   world.Start();

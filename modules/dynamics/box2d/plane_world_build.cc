@@ -398,7 +398,7 @@ void PlaneWorld::AddWheel(uint32_t joint_slot, const JointData& joint, uint32_t 
   wheel.f_y = geometry.f_y;
   wheel.radius_m = radius;
   wheel.coulomb_rate = geometry.shape->friction;  // times m g / n (BuildWheels)
-  wheel.motor_rate = std::max(0.0, joint.max_force) / radius * L;
+  wheel.motor_rate = std::max(0.0, joint.settings->max_force) / radius * L;
   // Inverse effective mass at the contact point: K = [m^-1 + I^-1 py^2, -I^-1 px py;
   // -I^-1 px py, m^-1 + I^-1 px^2], inverted.
   const double im = body.inverse_mass, ii = body.inverse_inertia;

@@ -252,7 +252,7 @@ void OdeWorld::Build(const Scene& scene) {
   BuildJoints(scene, body_of);
   // 4. Force sensors.
   if (force_sensor::Any(scene)) BuildForceSensors(scene, body_of);
-  commands_.assign(joints_.size(), JointData{});
+  commands_.assign(joints_.size(), JointCommand{});
 }
 
 dSpaceID OdeWorld::SpaceOf(int32_t instance) {
@@ -398,16 +398,17 @@ void OdeWorld::AddJoint(const Scene& scene, uint32_t slot, dBodyID child, dBodyI
   j.X_AJ = parent ? BodyPose(parent).Inverse() * X_WJ : X_WJ;
   j.q_JB0 = X_WJ.q.Conjugate() * BodyPose(child).q;
   j.ball0 = data.ball;
-  switch (data.type) {
+  const JointSettings& settings = *data.settings;
+  switch (settings.type) {
     case JointType::kRevolute:
       j.joint = dJointCreateHinge(world_, nullptr);
       dJointAttach(j.joint, child, parent);
       dJointSetHingeAnchor(j.joint, X_WJ.p.x, X_WJ.p.y, X_WJ.p.z);
       dJointSetHingeAxis(j.joint, axis.x, axis.y, axis.z);
       // ODE's stops live in (-pi, pi] around the Build position.
-      if (data.min_position - j.offset >= -M_PI && data.max_position - j.offset <= M_PI) {
-        dJointSetHingeParam(j.joint, dParamLoStop, data.min_position - j.offset);
-        dJointSetHingeParam(j.joint, dParamHiStop, data.max_position - j.offset);
+      if (settings.min_position - j.offset >= -M_PI && settings.max_position - j.offset <= M_PI) {
+        dJointSetHingeParam(j.joint, dParamLoStop, settings.min_position - j.offset);
+        dJointSetHingeParam(j.joint, dParamHiStop, settings.max_position - j.offset);
       }
       j.last_angle = dJointGetHingeAngle(j.joint);
       break;
@@ -415,10 +416,10 @@ void OdeWorld::AddJoint(const Scene& scene, uint32_t slot, dBodyID child, dBodyI
       j.joint = dJointCreateSlider(world_, nullptr);
       dJointAttach(j.joint, child, parent);
       dJointSetSliderAxis(j.joint, axis.x, axis.y, axis.z);
-      if (std::isfinite(data.min_position))
-        dJointSetSliderParam(j.joint, dParamLoStop, data.min_position - j.offset);
-      if (std::isfinite(data.max_position))
-        dJointSetSliderParam(j.joint, dParamHiStop, data.max_position - j.offset);
+      if (std::isfinite(settings.min_position))
+        dJointSetSliderParam(j.joint, dParamLoStop, settings.min_position - j.offset);
+      if (std::isfinite(settings.max_position))
+        dJointSetSliderParam(j.joint, dParamHiStop, settings.max_position - j.offset);
       break;
     case JointType::kSpherical:
       j.joint = dJointCreateBall(world_, nullptr);
@@ -468,7 +469,18 @@ void OdeWorld::SyncFromScene(const Scene& scene, double duration) {
 }
 
 void OdeWorld::ReadCommands(const Scene& scene) {
-  for (size_t k = 0; k < joints_.size(); ++k) commands_[k] = scene.joints()[joints_[k].row];
+  for (size_t k = 0; k < joints_.size(); ++k) {
+    const JointData& j = scene.joints()[joints_[k].row];
+    const JointSettings& settings = *j.settings;
+    commands_[k] = {.type = settings.type,
+                    .mode = settings.mode,
+                    .target_velocity = j.target_velocity,
+                    .target_position = j.target_position,
+                    .target_force = j.target_force,
+                    .max_force = settings.max_force,
+                    .max_velocity = settings.max_velocity,
+                    .damping = settings.damping};
+  }
   for (MovingSurface& surface : surfaces_) {
     const ShapeData& shape = scene.shapes()[scene.row_at(surface.slot)];
     surface.v_S = shape.surface_velocity;
@@ -479,7 +491,7 @@ void OdeWorld::ReadCommands(const Scene& scene) {
 void OdeWorld::ApplyMotors(double dt) {
   for (size_t k = 0; k < joints_.size(); ++k) {
     const SimJoint& j = joints_[k];
-    const JointData& c = commands_[k];
+    const JointCommand& c = commands_[k];
     const bool hinge = c.type == JointType::kRevolute;
     if (!hinge && c.type != JointType::kPrismatic) continue;
     double velocity = 0, max_force = 0;

@@ -72,8 +72,8 @@ ObjectId AddPlaneRobot(Scene* scene, double speed, double y = 0) {
   const ObjectId root = scene->AddShape("bot", {}, {{0, y, 0.05}, {}}, body);
   scene->MakeModelInstance(root, "bot", "bot#" + std::to_string(scene->instances().size()));
   JointData motor;
-  motor.type = JointType::kRevolute;
-  motor.mode = JointMode::kVelocity;
+  motor.settings.Edit().type = JointType::kRevolute;
+  motor.settings.Edit().mode = JointMode::kVelocity;
   ShapeData wheel;
   wheel.kind = ShapeKind::kCylinder;
   wheel.size = {0.029, 0, 0.01};
@@ -109,10 +109,10 @@ ObjectId AddWheeledRobot(Scene* scene, double omega, double y = 0) {
   wheel.friction = 1.0;
   for (int side : {1, -1}) {
     JointData m;
-    m.type = JointType::kRevolute;
-    m.mode = JointMode::kVelocity;
+    m.settings.Edit().type = JointType::kRevolute;
+    m.settings.Edit().mode = JointMode::kVelocity;
     m.target_velocity = side * omega;
-    m.max_force = 5;
+    m.settings.Edit().max_force = 5;
     const ObjectId motor = scene->AddJoint(
         "motor", root, {{0.05, side * 0.13, 0}, Quat::FromAxisAngle({1, 0, 0}, -side * M_PI / 2)},
         m);

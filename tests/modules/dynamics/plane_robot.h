@@ -38,8 +38,8 @@ inline Robot AddRobot(Scene* scene, const std::string& name, double x, double y,
   // Joint z axis along the body's +y (left) or -y (right).
   const double wheel_z = spec.wheel_radius - spec.height / 2;
   JointData motor;
-  motor.type = JointType::kRevolute;
-  motor.mode = JointMode::kVelocity;
+  motor.settings.Edit().type = JointType::kRevolute;
+  motor.settings.Edit().mode = JointMode::kVelocity;
   robot.left = scene->AddJoint(
       "leftMotor", robot.body,
       {{0, spec.half_axle, wheel_z}, Quat::FromAxisAngle({1, 0, 0}, -M_PI / 2)}, motor);

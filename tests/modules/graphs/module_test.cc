@@ -98,12 +98,12 @@ TEST(GraphModuleTest, AFullBufferKeepsTheFirstSamplesOrCyclicTheLast) {
 TEST(GraphModuleTest, JointsOrientationsAndScriptStreamsRead) {
   ModuleWorld w("kinematic", 1, kStep);
   JointData slider;
-  slider.type = JointType::kPrismatic;
-  slider.mode = JointMode::kVelocity;
+  slider.settings.Edit().type = JointType::kPrismatic;
+  slider.settings.Edit().mode = JointMode::kVelocity;
   slider.target_velocity = 0.4;
   w.scene().AddJoint("slider", {}, {}, slider);
   JointData hinge;
-  hinge.type = JointType::kRevolute;
+  hinge.settings.Edit().type = JointType::kRevolute;
   w.scene().AddJoint("hinge", {}, {}, hinge);
   w.Box("turned", {}, {{0, 0, 0}, Quat::FromYaw(0.75)}, {0.1, 0.1, 0.1});
   const GraphRow row =

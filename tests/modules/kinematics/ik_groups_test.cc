@@ -45,7 +45,7 @@ struct Arm {
 Arm AddArm(Scene* scene, const Pose& X_WRoot) {
   Arm a;
   JointData joint;
-  joint.mode = JointMode::kPassive;
+  joint.settings.Edit().mode = JointMode::kPassive;
   a.root = scene->AddDummy("arm", {}, X_WRoot);
   a.j1 = scene->AddJoint("j1", a.root, {}, joint);
   joint.position = 0.3;  // away from the straight singularity
@@ -186,7 +186,7 @@ TEST(IkGroupsTest, SeveralTipsAndAClosedChain) {
   // Two arms on one base: arm A's tip must meet a dummy on arm B (a closed
   // chain: both arms' joints move), and arm B's tip a fixed target.
   JointData joint;
-  joint.mode = JointMode::kPassive;
+  joint.settings.Edit().mode = JointMode::kPassive;
   const ObjectId root = scene.AddDummy("base", {}, {});
   const ObjectId a1 = scene.AddJoint("a1", root, {}, joint);
   joint.position = 0.4;
@@ -235,7 +235,7 @@ struct Arm3 {
 Arm3 AddArm3(Scene* scene, const JointData& second) {
   Arm3 a;
   JointData joint;
-  joint.mode = JointMode::kPassive;
+  joint.settings.Edit().mode = JointMode::kPassive;
   a.root = scene->AddDummy("arm", {}, {});
   a.j1 = scene->AddJoint("j1", a.root, {}, joint);
   a.j2 = scene->AddJoint("j2", a.j1, {{0.5, 0, 0}, {}}, second);
@@ -254,7 +254,7 @@ TEST(IkGroupsTest, FrozenJointKeepsItsValueWhileTheOthersReach) {
     auto world = MakeWorld(1);
     Scene& scene = world->scene();
     JointData second;
-    second.mode = JointMode::kPassive;
+    second.settings.Edit().mode = JointMode::kPassive;
     second.position = 0.3;
     second.ik_frozen = frozen;
     const Arm3 arm = AddArm3(&scene, second);
@@ -279,12 +279,12 @@ TEST(IkGroupsTest, DependentJointMovesWithItsMasterDuringTheSolve) {
   auto world = MakeWorld(1);
   Scene& scene = world->scene();
   JointData second;
-  second.mode = JointMode::kPassive;
+  second.settings.Edit().mode = JointMode::kPassive;
   auto depends = std::make_shared<JointDependency>();
   depends->master = ":/j1";
   depends->factor = -1;
   depends->offset = 0.1;
-  second.depends = depends;
+  second.settings.Edit().depends = depends;
   second.position = 0.1;
   const Arm3 arm = AddArm3(&scene, second);
   // Reachable with q1 = 0.5, q3 = 0.9 (q2 = -0.4): link 2 always points
@@ -309,9 +309,9 @@ TEST(IkGroupsTest, ScrewJointTurnsAndTravelsToTheTarget) {
   auto world = MakeWorld(1);
   Scene& scene = world->scene();
   JointData screw;
-  screw.type = JointType::kScrew;
-  screw.mode = JointMode::kPassive;
-  screw.pitch = 0.1;
+  screw.settings.Edit().type = JointType::kScrew;
+  screw.settings.Edit().mode = JointMode::kPassive;
+  screw.settings.Edit().pitch = 0.1;
   const ObjectId root = scene.AddDummy("screw", {}, {});
   const ObjectId joint = scene.AddJoint("j", root, {}, screw);
   const ObjectId tip = scene.AddDummy("tip", joint, {{0.2, 0, 0}, {}});
@@ -336,10 +336,10 @@ TEST(IkGroupsTest, SphericalJointOrientsWhereARevoluteChainCannot) {
     auto world = MakeWorld(1);
     Scene& scene = world->scene();
     JointData joint;
-    joint.mode = JointMode::kPassive;
+    joint.settings.Edit().mode = JointMode::kPassive;
     const ObjectId root = scene.AddDummy("arm", {}, {});
     const ObjectId shoulder = scene.AddJoint("shoulder", root, {}, joint);
-    joint.type = wrist;
+    joint.settings.Edit().type = wrist;
     const ObjectId j2 = scene.AddJoint("wrist", shoulder, {{0.5, 0, 0}, {}}, joint);
     const ObjectId tip = scene.AddDummy("tip", j2, {{0.3, 0, 0}, {}});
     const ObjectId target = scene.AddDummy("target", root, X_WTarget);
@@ -367,7 +367,7 @@ TEST(IkGroupsTest, SphericalJointInATargetsModeGroupIsAnError) {
   auto world = MakeWorld(1);
   Scene& scene = world->scene();
   JointData joint;
-  joint.type = JointType::kSpherical;
+  joint.settings.Edit().type = JointType::kSpherical;
   const ObjectId root = scene.AddDummy("arm", {}, {});
   const ObjectId ball = scene.AddJoint("ball", root, {}, joint);
   const ObjectId tip = scene.AddDummy("tip", ball, {{0.3, 0, 0}, {}});

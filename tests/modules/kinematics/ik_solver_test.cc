@@ -16,10 +16,10 @@ using testing::AddUr5;
 
 JointData Revolute(double min = -INFINITY, double max = INFINITY) {
   JointData j;
-  j.type = JointType::kRevolute;
-  j.mode = JointMode::kPassive;
-  j.min_position = min;
-  j.max_position = max;
+  j.settings.Edit().type = JointType::kRevolute;
+  j.settings.Edit().mode = JointMode::kPassive;
+  j.settings.Edit().min_position = min;
+  j.settings.Edit().max_position = max;
   return j;
 }
 

@@ -28,8 +28,8 @@ inline Ur5 AddUr5(Scene* scene, const Pose& X_WBase = {}) {
   ObjectId parent = arm.base;
   for (int i = 0; i < 6; ++i) {
     JointData j;
-    j.type = JointType::kRevolute;
-    j.mode = JointMode::kPassive;
+    j.settings.Edit().type = JointType::kRevolute;
+    j.settings.Edit().mode = JointMode::kPassive;
     const ObjectId joint = scene->AddJoint("joint" + std::to_string(i + 1), parent, {}, j);
     arm.joints.push_back(joint);
     parent =

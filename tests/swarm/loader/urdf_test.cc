@@ -175,7 +175,7 @@ class UrdfTest : public testing::WorldDirTest {
         const Pose X_WJ = scene.world_pose(j), X_WC = scene.world_pose(c);
         const Vec3 d = X_WJ.q.Conjugate().Rotate(X_WC.p - X_WJ.p);  // in the joint frame
         const double off_axis =
-            scene.joint(j).type == JointType::kPrismatic ? std::hypot(d.x, d.y) : d.Norm();
+            scene.joint(j).type() == JointType::kPrismatic ? std::hypot(d.x, d.y) : d.Norm();
         worst = std::max(worst, off_axis);
       }
     }
@@ -441,7 +441,7 @@ TEST_F(UrdfTest, JointDampingSlowsAPendulumUnderOde) {
 TEST_F(UrdfTest, UrdfJointDampingIsImported) {
   NEED_SHARED_URDF(dir);
   LoadedWorld w = LoadRobot(dir, kPanda, "kinematic");
-  EXPECT_EQ(w.world->scene().joint(Find(*w.world, "panda_joint1")).damping, 0.003);
+  EXPECT_EQ(w.world->scene().joint(Find(*w.world, "panda_joint1")).settings->damping, 0.003);
 }
 
 TEST_F(UrdfTest, AnIkGroupFromTheEntryDrivesTheImportedFanucUnderOde) {

@@ -79,13 +79,13 @@ TEST_F(WorldLoader3dTest, ReadsCapsulesJointTypesForceModeAndLimits) {
   EXPECT_EQ(scene.shape(link).kind, ShapeKind::kCapsule);
   EXPECT_DOUBLE_EQ(scene.shape(link).size.z, 0.3);
   const JointData& shoulder = scene.joint(scene.FindObject("/arm#0/shoulder"));
-  EXPECT_EQ(shoulder.mode, JointMode::kForce);
+  EXPECT_EQ(shoulder.mode(), JointMode::kForce);
   EXPECT_DOUBLE_EQ(shoulder.target_force, 0.5);
-  EXPECT_DOUBLE_EQ(shoulder.min_position, -0.5);
-  EXPECT_DOUBLE_EQ(shoulder.max_position, 0.5);
-  EXPECT_EQ(scene.joint(scene.FindObject("/arm#0/shoulder/link/wrist")).type,
+  EXPECT_DOUBLE_EQ(shoulder.settings->min_position, -0.5);
+  EXPECT_DOUBLE_EQ(shoulder.settings->max_position, 0.5);
+  EXPECT_EQ(scene.joint(scene.FindObject("/arm#0/shoulder/link/wrist")).type(),
             JointType::kSpherical);
-  EXPECT_EQ(scene.joint(scene.FindObject("/arm#0/shoulder/link/weld")).type, JointType::kFixed);
+  EXPECT_EQ(scene.joint(scene.FindObject("/arm#0/shoulder/link/weld")).type(), JointType::kFixed);
 }
 
 TEST_F(WorldLoader3dTest, OdeWorldRunsAndTheForceJointHitsItsLimit) {

@@ -167,8 +167,8 @@ TEST_F(ControlLoaderTest, PerCopyValuesReachEveryObjectValueThatUsesThem) {
     EXPECT_EQ(scene.shape(root).size.x, e.size);
     EXPECT_EQ(scene.shape(root).size.z, 2 * e.size);
     EXPECT_EQ(scene.shape(root).mass, e.mass);
-    EXPECT_EQ(scene.joint(scene.FindObject("./j", root)).min_position, -e.lim);
-    EXPECT_EQ(scene.joint(scene.FindObject("./j", root)).max_position, e.lim);
+    EXPECT_EQ(scene.joint(scene.FindObject("./j", root)).settings->min_position, -e.lim);
+    EXPECT_EQ(scene.joint(scene.FindObject("./j", root)).settings->max_position, e.lim);
     EXPECT_EQ(ik->spec(ik->FindGroup("reach", k)).damping, e.damping);
     // Each copy stands on the ground by its own height.
     EXPECT_DOUBLE_EQ(scene.world_pose(root).p.z, e.size);

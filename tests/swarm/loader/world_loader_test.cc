@@ -162,8 +162,8 @@ TEST(WorldLoaderTest, FootbotGeometryFollowsTheConventions) {
   // Both axles (joint z) along the body's +y: positive velocity rolls forward.
   ExpectNear(X_BL.q.Rotate({0, 0, 1}), {0, 1, 0});
   ExpectNear((X_WB.Inverse() * scene.world_pose(right)).q.Rotate({0, 0, 1}), {0, 1, 0});
-  EXPECT_EQ(scene.joint(left).mode, JointMode::kVelocity);
-  EXPECT_EQ(scene.joint(left).type, JointType::kRevolute);
+  EXPECT_EQ(scene.joint(left).mode(), JointMode::kVelocity);
+  EXPECT_EQ(scene.joint(left).type(), JointType::kRevolute);
   const ObjectId wheel = scene.FindObject("./leftMotor/leftWheel", root);
   ASSERT_FALSE(wheel.IsNull());
   EXPECT_DOUBLE_EQ(scene.shape(wheel).size.x, 0.029);

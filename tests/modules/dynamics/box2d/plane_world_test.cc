@@ -236,7 +236,7 @@ TEST(Box2dBackend, EachRobotMovesExactlyAsIfAlone) {
     name += std::to_string(i);
     Robot robot = AddRobot(scene, name, 10.0 * static_cast<double>(i), 0, 0.4 * i);
     for (ObjectId motor : {robot.left, robot.right}) {
-      scene->mutable_joint(motor).max_force = setup.max_force;
+      scene->mutable_joint(motor).settings.Edit().max_force = setup.max_force;
       scene->mutable_shape(scene->children(motor).front()).friction = setup.wheel_friction;
     }
     SetWheelSpeeds(scene, robot, setup.v_left, setup.v_right);

@@ -52,7 +52,7 @@ Wheeled AddWheeledRobot(Scene* scene, const Vec3& at, double omega) {
   for (int side : {1, -1}) {
     JointData m = Joint(JointType::kRevolute, JointMode::kVelocity);
     m.target_velocity = side * omega;  // mirror-mounted: the right wheel turns the other way
-    m.max_force = 5;
+    m.settings.Edit().max_force = 5;
     // Joint z along +y (left) or -y (right): Rx(-90 deg) turns z onto +y.
     const Quat q = Quat::FromAxisAngle({1, 0, 0}, -side * M_PI / 2);
     const ObjectId motor =

@@ -56,9 +56,9 @@ ShapeData Box(const Vec3& size, bool dynamic, double mass = 1) {
 
 JointData Joint(JointType type, JointMode mode) {
   JointData j;
-  j.type = type;
-  j.mode = mode;
-  j.max_force = 100;
+  j.settings.Edit().type = type;
+  j.settings.Edit().mode = mode;
+  j.settings.Edit().max_force = 100;
   return j;
 }
 

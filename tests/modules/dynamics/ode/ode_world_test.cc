@@ -59,7 +59,7 @@ TEST(OdeBackend, PositionServoHoldsAPendulumAtItsTargetWithinMaxVelocity) {
   Fixture f(0.01, 5);
   JointData j = Joint(JointType::kRevolute, JointMode::kPosition);
   j.target_position = 0.5;
-  j.max_velocity = 1.0;
+  j.settings.Edit().max_velocity = 1.0;
   // Axis horizontal (joint z along world y): gravity pulls the bar down.
   const Arm arm = AddArm(&f.scene(), j, {{0, 0, 1}, Quat::FromAxisAngle({1, 0, 0}, M_PI / 2)});
   for (int i = 0; i < 20; ++i) f.world->Step();  // 0.2 s at <= 1 rad/s
@@ -74,7 +74,7 @@ TEST(OdeBackend, WeakServoCannotLiftTheLoad) {
   Fixture f(0.01, 5);
   JointData j = Joint(JointType::kRevolute, JointMode::kPosition);
   j.target_position = 0.5;
-  j.max_force = 0.1;  // N m, the bar needs m g l = 1.2 N m
+  j.settings.Edit().max_force = 0.1;  // N m, the bar needs m g l = 1.2 N m
   const Arm arm = AddArm(&f.scene(), j, {{0, 0, 1}, Quat::FromAxisAngle({1, 0, 0}, M_PI / 2)});
   for (int i = 0; i < 100; ++i) f.world->Step();
   EXPECT_LT(f.scene().joint(arm.joint).position, 0.0);  // sags the other way
@@ -95,8 +95,8 @@ TEST(OdeBackend, ForceModeGivesTheExpectedAngularAcceleration) {
 TEST(OdeBackend, PassiveJointStopsAtItsLimits) {
   Fixture f(0.01, 5);
   JointData j = Joint(JointType::kRevolute, JointMode::kPassive);
-  j.min_position = -0.3;
-  j.max_position = 0.3;
+  j.settings.Edit().min_position = -0.3;
+  j.settings.Edit().max_position = 0.3;
   const Arm arm = AddArm(&f.scene(), j, {{0, 0, 1}, Quat::FromAxisAngle({1, 0, 0}, M_PI / 2)});
   for (int i = 0; i < 200; ++i) f.world->Step();
   EXPECT_NEAR(f.scene().joint(arm.joint).position, -0.3, 0.02);
@@ -163,7 +163,7 @@ Wheeled AddWheeledRobot(Scene* scene, const Vec3& at, double omega) {
   for (int side : {1, -1}) {
     JointData m = Joint(JointType::kRevolute, JointMode::kVelocity);
     m.target_velocity = side * omega;  // mirror-mounted: the right wheel turns the other way
-    m.max_force = 5;
+    m.settings.Edit().max_force = 5;
     // Joint z along +y (left) or -y (right): Rx(-90 deg) turns z onto +y.
     const Quat q = Quat::FromAxisAngle({1, 0, 0}, -side * M_PI / 2);
     const ObjectId motor =
