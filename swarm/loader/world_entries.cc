@@ -12,7 +12,7 @@
 #include "framework/error.h"
 #include "framework/plugin_controllers.h"
 #include "framework/registry.h"
-#include "modules/environment/voxel_merge.h"
+#include "framework/world_section.h"
 #include "swarm/loader/urdf.h"
 #include "swarm/loader/world_loader_impl.h"
 
@@ -461,9 +461,11 @@ void WorldLoader::ReadSinglePosition(const Fields& f, const ValueReader& world_v
 // The environment map's voxels that a copy standing on the ground would
 // meet (those reaching into the band from the ground to the tallest copy's
 // top, less 1 mm at either end: a floor whose top is at z = 0 is not one),
-// projected to the plane: placement keeps copies clear of them.
+// projected to the plane by the map's format (its occupied_plane query):
+// placement keeps copies clear of them.
 void WorldLoader::KeepPlacementClearOfTheMap() {
   if (!environment_ || entries_.empty()) return;
+  if (!environment_format_ || !environment_format_->occupied_plane) return;
   double height = 0;
   for (const EntryPlan& e : entries_) {
     height = std::max(height, e.footprint.top - e.footprint.bottom);
@@ -472,7 +474,8 @@ void WorldLoader::KeepPlacementClearOfTheMap() {
   }
   constexpr double kOverlap = 1e-3;  // m, as the physics backends' rule
   try {
-    placer_->SetMapCells(environment::ProjectBand(*environment_, kOverlap, height - kOverlap));
+    placer_->SetMapCells(
+        environment_format_->occupied_plane(*environment_, kOverlap, height - kOverlap));
   } catch (const Error& e) {
     file_->Fail(environment_field_.mark, e.what());
   }

@@ -116,7 +116,7 @@ LoadedWorld WorldLoader::Load() {
   BuildObstacles(top, world);
   environment_field_ = top.Get("environment");
   environment_ = loader::ReadEnvironment(f, environment_field_, WorldValues(), path_.parent_path(),
-                                         world->registry(), &out.warnings);
+                                         world->registry(), &out.warnings, &environment_format_);
   if (environment_) world->scene().set_environment(environment_);
   for (EntryPlan& entry : entries_) ResolveEntry(&entry);
   KeepPlacementClearOfTheMap();

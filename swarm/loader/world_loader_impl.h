@@ -23,6 +23,10 @@
 #include "swarm/loader/world_loader.h"
 #include "swarm/loader/yaml.h"
 
+namespace swarmsim {
+struct EnvironmentFormatDescriptor;
+}  // namespace swarmsim
+
 namespace swarmsim::loader {
 
 inline constexpr int64_t kMaxCount = 1000000;  // copies per models entry
@@ -195,6 +199,7 @@ class WorldLoader {
   std::optional<Region2> arena_;
   Field environment_field_;                            // `environment:` (absent: none)
   std::shared_ptr<const EnvironmentMap> environment_;  // the map it names, or null
+  const EnvironmentFormatDescriptor* environment_format_ = nullptr;  // the format that read it
   std::unique_ptr<Placer> placer_;
   std::vector<std::filesystem::path> package_path_;  // the world's, then --package-path
   std::vector<std::string> warnings_;                // found before the World exists
