@@ -5,6 +5,7 @@
 #include "framework/dynamics_backend.h"
 #include "framework/error.h"
 #include "framework/object_type.h"
+#include "framework/view_recorder.h"
 #include "framework/vision_filter.h"
 #include "framework/world_section.h"
 
@@ -117,6 +118,12 @@ void ModuleRegistry::RegisterEnvironmentFormat(
     if (f->key == format->key)
       throw Error("environment map format '" + format->key + "' is registered twice");
   environment_formats_.push_back(std::move(format));
+}
+
+void ModuleRegistry::RegisterViewRecorder(std::shared_ptr<const ViewRecorderDescriptor> recorder) {
+  if (!recorder || !recorder->add) throw Error("a view recorder needs an 'add' function");
+  if (view_recorder_) throw Error("a view recorder is registered twice");
+  view_recorder_ = std::move(recorder);
 }
 
 const VisionFilterDescriptor* ModuleRegistry::FindVisionFilter(std::string_view name) const {

@@ -25,6 +25,7 @@ struct PluginControllerType;
 struct VisionFilterDescriptor;
 struct WorldSectionDescriptor;
 struct EnvironmentFormatDescriptor;
+struct ViewRecorderDescriptor;
 
 // A script command registered by a plugin (framework/plugin_api.h): sim.<name>.
 struct ScriptCommand {
@@ -125,6 +126,12 @@ class ModuleRegistry {
       const {
     return environment_formats_;
   }
+  // The recorder of snapshots and videos (framework/view_recorder.h): one
+  // per program (modules/rendering/video). Throws swarmsim::Error if one is
+  // registered already or the descriptor has no `add`.
+  void RegisterViewRecorder(std::shared_ptr<const ViewRecorderDescriptor> recorder);
+  // Null when none is registered.
+  const ViewRecorderDescriptor* view_recorder() const { return view_recorder_.get(); }
   // Native controllers (plugins, framework/plugin_controllers.h): kind
   // "controller". Throws swarmsim::Error if the name is taken.
   void RegisterController(ModuleInfo info, PluginControllerType controller);
@@ -168,6 +175,7 @@ class ModuleRegistry {
   std::vector<std::shared_ptr<const VisionFilterDescriptor>> vision_filters_;
   std::vector<std::shared_ptr<const WorldSectionDescriptor>> world_sections_;
   std::vector<std::shared_ptr<const EnvironmentFormatDescriptor>> environment_formats_;
+  std::shared_ptr<const ViewRecorderDescriptor> view_recorder_;
   // Shared, stable addresses: a world's robots point at them.
   std::vector<std::shared_ptr<const PluginControllerType>> controllers_;
 };

@@ -41,7 +41,7 @@ struct RunArgs {
   bool trust_scripts = false;
   std::vector<std::string> plugins;
   std::vector<std::string> package_path;  // --package-path: URDF packages' folders
-  // Snapshots and video (modules/rendering/video/recorder.h).
+  // Snapshots and video (framework/view_recorder.h).
   int64_t snapshot_every = 0;             // 0: none
   std::string camera;                     // empty: the arena seen from above
   bool video = false;                     // --video given

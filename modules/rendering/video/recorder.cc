@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "framework/error.h"
+#include "framework/registry.h"
 #include "framework/world.h"
 #include "modules/paint/png_io.h"
 #include "modules/rendering/geometry.h"
@@ -408,6 +409,15 @@ ModuleDescriptor RecorderModule() {
             if (config == nullptr) throw Error("the recorder module needs its settings");
             return std::make_unique<Recorder>(world, *static_cast<const RecorderSettings*>(config));
           }};
+}
+
+void Register(ModuleRegistry* registry) {
+  registry->RegisterModule(RecorderModule());
+  auto recorder = std::make_shared<ViewRecorderDescriptor>();
+  recorder->add = [](World* world, const ViewRecorderSettings& settings) -> ViewRecorder* {
+    return static_cast<Recorder*>(world->AddModule("recorder", &settings));
+  };
+  registry->RegisterViewRecorder(std::move(recorder));
 }
 
 }  // namespace swarmsim::video
