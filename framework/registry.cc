@@ -4,6 +4,7 @@
 
 #include "framework/dynamics_backend.h"
 #include "framework/error.h"
+#include "framework/model_section.h"
 #include "framework/object_type.h"
 #include "framework/view_recorder.h"
 #include "framework/vision_filter.h"
@@ -118,6 +119,15 @@ void ModuleRegistry::RegisterEnvironmentFormat(
     if (f->key == format->key)
       throw Error("environment map format '" + format->key + "' is registered twice");
   environment_formats_.push_back(std::move(format));
+}
+
+void ModuleRegistry::RegisterModelSection(std::shared_ptr<const ModelSectionDescriptor> section) {
+  if (!section || section->key.empty() || !section->read || !section->apply)
+    throw Error("a model-file section needs a key, a reader and an apply step");
+  for (const auto& s : model_sections_)
+    if (s->key == section->key)
+      throw Error("model-file section '" + section->key + "' is registered twice");
+  model_sections_.push_back(std::move(section));
 }
 
 void ModuleRegistry::RegisterViewRecorder(std::shared_ptr<const ViewRecorderDescriptor> recorder) {
