@@ -22,6 +22,9 @@ struct ViewRecorderSettings {
   std::string camera;             // a camera or vision sensor's path; empty: the arena view
   int width = 0, height = 0;      // pixels; 0: 640x480 for the arena, a camera's own resolution
   double video_fps = 30;          // frames per simulated second wanted
+  // Draw the objects whose visual is a ray (proximity sensors), as the
+  // viewer does with its rays switch (framework/visual.h); --no-rays: not.
+  bool rays = true;
 };
 
 // What the program asks of the recorder it added to a world.

@@ -48,7 +48,8 @@ struct RunArgs {
   std::string video_file;                 // its FILE; empty: DIR/video.mp4
   int video_width = 0, video_height = 0;  // --video-size; 0: the view's default
   double video_fps = 30;
-  bool record = false;  // --record: DIR/recording.swrec (swarm/record/writer.h)
+  bool no_rays = false;  // --no-rays: snapshots and video without proximity sensors' rays
+  bool record = false;   // --record: DIR/recording.swrec (swarm/record/writer.h)
   // --view: record, and serve DIR to the viewer page while the run goes.
   bool view = false;
   int view_port = 8600;  // 0: a free port

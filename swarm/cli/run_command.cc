@@ -76,6 +76,7 @@ std::optional<ViewRecorderSettings> RecorderSettingsOf(const RunArgs& args, std:
   if (!recording) {
     if (!args.camera.empty()) *error = "--camera names the view of --snapshot-every or --video";
     if (args.video_width > 0) *error = "--video-size is the size of --snapshot-every or --video";
+    if (args.no_rays) *error = "--no-rays hides the rays in --snapshot-every or --video";
     return std::nullopt;
   }
   ViewRecorderSettings settings;
@@ -85,6 +86,7 @@ std::optional<ViewRecorderSettings> RecorderSettingsOf(const RunArgs& args, std:
   settings.width = args.video_width;
   settings.height = args.video_height;
   settings.video_fps = args.video_fps;
+  settings.rays = !args.no_rays;
   if (args.video) {
     if (!args.video_file.empty()) {
       settings.video = args.video_file;  // relative to the current folder, as typed
@@ -174,6 +176,9 @@ CLI::App* AddRunCommand(CLI::App* app, RunArgs* args) {
                   "time_step)) steps, at least 1")
       ->check(NumberCheck(false))
       ->needs(video);
+  run->add_flag("--no-rays", args->no_rays,
+                "Snapshots and video without the sensors' rays (drawn by default: proximity "
+                "sensors' rays, red where they detect something)");
   run->add_flag("--record", args->record,
                 "Record the run for swarmsim view: DIR/recording.swrec (needs --out; a world's "
                 "record: setting does the same)");

@@ -217,7 +217,7 @@ struct Recorder::Impl {
     // A view from above keeps LEDs at least 3 pixels across, as Render does.
     const double pixel =
         job.view.orthographic ? job.view.ortho_width / std::max(1, job.view.width) : 0;
-    rendering::BuildDrawList(world, SegmentsFor(job.view), &job.list, 1.5 * pixel);
+    rendering::BuildDrawList(world, SegmentsFor(job.view), &job.list, 1.5 * pixel, settings.rays);
     MarkClosed(world.scene(), job.list, &job.closed);
     // The paint layer changes in the next steps: the frame gets a copy.
     rendering::FloorLayer& floor = job.list.floor;
