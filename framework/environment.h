@@ -5,6 +5,7 @@
 // modules/environment (no OctoMap types here). Mills cut it (voxels go).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -30,6 +31,18 @@ struct EnvironmentMap {
   // physics' boxes, placement) may take, bytes: the world file's
   // `max_memory_mb`, which also bounds the map itself.
   double max_grid_bytes = 2048.0 * (1 << 20);
+};
+
+// The occupied cells of the xy plane within a z band, at the map's
+// resolution: what an environment format's `occupied_plane` query gives
+// (world_section.h) and placement keeps robots clear of. Cell (i, j)
+// covers [x0 + i cell, x0 + (i + 1) cell] x [y0 + j cell, ...].
+struct EnvironmentPlaneGrid {
+  double x0 = 0, y0 = 0, cell = 0;  // m
+  int nx = 0, ny = 0;
+  std::vector<uint8_t> occupied;  // (ny x nx), row-major: j * nx + i
+  bool empty() const { return occupied.empty(); }
+  bool at(int i, int j) const { return occupied[size_t(j) * size_t(nx) + size_t(i)] != 0; }
 };
 
 }  // namespace swarmsim

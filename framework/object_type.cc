@@ -28,6 +28,15 @@ std::vector<std::unique_ptr<ObjectReader>> ObjectReader::Elements(std::string_vi
 
 void ObjectReader::FailHere(const std::string& message) const { throw Error(message); }
 
+std::vector<std::unique_ptr<ObjectReader>> ObjectReader::Maps(std::string_view, std::string_view,
+                                                              const std::string&) const {
+  Unsupported("lists of maps");
+}
+bool ObjectReader::IsList(std::string_view) const { Unsupported("lists"); }
+std::vector<std::string> ObjectReader::Keys() const { Unsupported("keys as names"); }
+std::string ObjectReader::WhereKey(std::string_view) const { return {}; }
+std::string ObjectReader::WhereHere() const { return {}; }
+
 const char* ToString(VisualKind kind) {
   switch (kind) {
     case VisualKind::kNone: return "none";

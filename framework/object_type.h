@@ -109,6 +109,21 @@ class ObjectReader {
                                                               std::string_view scalar_key) const;
   // An error at this entry itself (where its mapping starts).
   [[noreturn]] virtual void FailHere(const std::string& message) const;
+  // --- Lists of maps, keys as names (model-file sections, model_section.h) ---------
+  // The elements of the list at `key`, each a map read as itself (messages
+  // name it `what`); an element that is not a map is an error "<what> must
+  // be a mapping of keys to values (got ...)". None when absent.
+  virtual std::vector<std::unique_ptr<ObjectReader>> Maps(std::string_view key,
+                                                          std::string_view list_what,
+                                                          const std::string& what) const;
+  // Whether the value at `key` is a list (`constraints: [x, y]` beside `constraints: pose`).
+  virtual bool IsList(std::string_view key) const;
+  // This entry's keys, in file order (`weights: {j1: 0, j1/j2: 1}`: keys that are names).
+  virtual std::vector<std::string> Keys() const;
+  // "file:line:column" of the key itself, and of this entry (where its
+  // mapping starts), for errors found after loading.
+  virtual std::string WhereKey(std::string_view key) const;
+  virtual std::string WhereHere() const;
 };
 
 // One world-file key of a type: its name, its default as the docs show it,

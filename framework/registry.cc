@@ -4,7 +4,9 @@
 
 #include "framework/dynamics_backend.h"
 #include "framework/error.h"
+#include "framework/model_section.h"
 #include "framework/object_type.h"
+#include "framework/view_recorder.h"
 #include "framework/vision_filter.h"
 #include "framework/world_section.h"
 
@@ -117,6 +119,21 @@ void ModuleRegistry::RegisterEnvironmentFormat(
     if (f->key == format->key)
       throw Error("environment map format '" + format->key + "' is registered twice");
   environment_formats_.push_back(std::move(format));
+}
+
+void ModuleRegistry::RegisterModelSection(std::shared_ptr<const ModelSectionDescriptor> section) {
+  if (!section || section->key.empty() || !section->read || !section->apply)
+    throw Error("a model-file section needs a key, a reader and an apply step");
+  for (const auto& s : model_sections_)
+    if (s->key == section->key)
+      throw Error("model-file section '" + section->key + "' is registered twice");
+  model_sections_.push_back(std::move(section));
+}
+
+void ModuleRegistry::RegisterViewRecorder(std::shared_ptr<const ViewRecorderDescriptor> recorder) {
+  if (!recorder || !recorder->add) throw Error("a view recorder needs an 'add' function");
+  if (view_recorder_) throw Error("a view recorder is registered twice");
+  view_recorder_ = std::move(recorder);
 }
 
 const VisionFilterDescriptor* ModuleRegistry::FindVisionFilter(std::string_view name) const {

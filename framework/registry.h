@@ -25,6 +25,8 @@ struct PluginControllerType;
 struct VisionFilterDescriptor;
 struct WorldSectionDescriptor;
 struct EnvironmentFormatDescriptor;
+struct ViewRecorderDescriptor;
+struct ModelSectionDescriptor;
 
 // A script command registered by a plugin (framework/plugin_api.h): sim.<name>.
 struct ScriptCommand {
@@ -118,6 +120,14 @@ class ModuleRegistry {
   const std::vector<std::shared_ptr<const WorldSectionDescriptor>>& world_sections() const {
     return world_sections_;
   }
+  // Model-file sections (framework/model_section.h): a model file's key a
+  // module reads itself (`ik_groups`). Throws swarmsim::Error if the key is
+  // taken or the descriptor lacks `read` or `apply`.
+  void RegisterModelSection(std::shared_ptr<const ModelSectionDescriptor> section);
+  // In registration order, the order the loader reads and applies them in.
+  const std::vector<std::shared_ptr<const ModelSectionDescriptor>>& model_sections() const {
+    return model_sections_;
+  }
   // Map formats of the world's `environment:` key (framework/world_section.h).
   // Throws swarmsim::Error if the key is taken.
   void RegisterEnvironmentFormat(std::shared_ptr<const EnvironmentFormatDescriptor> format);
@@ -125,6 +135,12 @@ class ModuleRegistry {
       const {
     return environment_formats_;
   }
+  // The recorder of snapshots and videos (framework/view_recorder.h): one
+  // per program (modules/rendering/video). Throws swarmsim::Error if one is
+  // registered already or the descriptor has no `add`.
+  void RegisterViewRecorder(std::shared_ptr<const ViewRecorderDescriptor> recorder);
+  // Null when none is registered.
+  const ViewRecorderDescriptor* view_recorder() const { return view_recorder_.get(); }
   // Native controllers (plugins, framework/plugin_controllers.h): kind
   // "controller". Throws swarmsim::Error if the name is taken.
   void RegisterController(ModuleInfo info, PluginControllerType controller);
@@ -168,6 +184,8 @@ class ModuleRegistry {
   std::vector<std::shared_ptr<const VisionFilterDescriptor>> vision_filters_;
   std::vector<std::shared_ptr<const WorldSectionDescriptor>> world_sections_;
   std::vector<std::shared_ptr<const EnvironmentFormatDescriptor>> environment_formats_;
+  std::shared_ptr<const ViewRecorderDescriptor> view_recorder_;
+  std::vector<std::shared_ptr<const ModelSectionDescriptor>> model_sections_;
   // Shared, stable addresses: a world's robots point at them.
   std::vector<std::shared_ptr<const PluginControllerType>> controllers_;
 };

@@ -36,8 +36,8 @@ enum class VisualKind : uint8_t {
   kLight,
   // A marker, not a body: a segment from the origin along +z, size.x m
   // long, drawn to `hit` m when something is detected there. The viewer
-  // draws it (its "rays" switch) in `color`; rendered images (snapshots,
-  // video, vision sensors) do not.
+  // draws it (its "rays" switch) in `color`, and so do snapshots and video
+  // (a line; `swarmsim run --no-rays`: not); vision sensors do not see it.
   kRay,
 };
 

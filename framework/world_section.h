@@ -63,6 +63,14 @@ struct EnvironmentFormatDescriptor {
                                                       const std::filesystem::path& world_folder,
                                                       std::vector<std::string>* warnings)>
       read;
+  // The map's occupied cells of the xy plane within the z band (z_lo, z_hi)
+  // m, at the map's resolution: a cell is occupied if a voxel of its column
+  // reaches into the band. Placement keeps robots clear of them (the band
+  // from the ground to the tallest copy). Throws swarmsim::Error when the
+  // grid would take more than the map allows. Null: placement does not
+  // see the map.
+  std::function<EnvironmentPlaneGrid(const EnvironmentMap& map, double z_lo, double z_hi)>
+      occupied_plane;
 };
 
 }  // namespace swarmsim

@@ -69,7 +69,7 @@ void RegisterBuiltinModules(ModuleRegistry* registry) {
   rendering::RegisterObjects(registry);
   graphs::Register(registry);
   blobs::Register(registry);
-  registry->RegisterModule(video::RecorderModule());
+  video::Register(registry);  // snapshots and video: the program's view recorder
   // World-file sections, in the order the loader reads them.
   registry->RegisterWorldSection(metrics::MetricsSection());
   registry->RegisterWorldSection(paint::PaintSection());

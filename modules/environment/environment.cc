@@ -9,6 +9,7 @@
 #include "framework/registry.h"
 #include "framework/world_section.h"
 #include "modules/environment/octomap_map.h"
+#include "modules/environment/voxel_merge.h"
 
 namespace swarmsim::environment {
 namespace {
@@ -63,6 +64,7 @@ void Register(ModuleRegistry* registry) {
   format->doc = "an OctoMap file (.bt or .ot): its occupied voxels, merged into boxes";
   format->keys = kOctomapKeys;
   format->read = ReadOctomapEntry;
+  format->occupied_plane = ProjectBand;
   registry->RegisterEnvironmentFormat(std::move(format));
 }
 

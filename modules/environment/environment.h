@@ -1,8 +1,8 @@
 // modules/environment's public header: the `octomap` map format of a
 // world's `environment:` key, registered with the ModuleRegistry (the
-// loader reads the key through the registry and names no format), and the
-// map's occupied cells in a horizontal band for placing robots around them
-// (voxel_merge.h's ProjectBand).
+// loader reads the key through the registry and names no format), with
+// its `occupied_plane` query: the map's occupied cells in a horizontal band
+// for placing robots around them (voxel_merge.h's ProjectBand).
 #pragma once
 
 namespace swarmsim {

@@ -14,8 +14,8 @@
 // corner. It covers exactly the occupied cells; it is not the fewest boxes.
 //
 // The map's boxes must lie on its voxel grid (those ReadOctomap makes do).
-// No third-party types here: the engines (modules/dynamics) and the loader's
-// placement use it.
+// No third-party types here: the engines (modules/dynamics) use it, and
+// the loader's placement asks for ProjectBand through the registered format.
 #pragma once
 
 #include <cstdint>
@@ -33,15 +33,9 @@ std::vector<EnvironmentBox> MergeBand3D(const EnvironmentMap& map, double z_lo, 
 // voxel layers (2D: the Box2D backend).
 std::vector<EnvironmentBox> MergeBand2D(const EnvironmentMap& map, double z_lo, double z_hi);
 
-// The projected band as a grid (placement): cell (i, j) covers
-// [x0 + i cell, x0 + (i + 1) cell] x [y0 + j cell, ...].
-struct PlaneGrid {
-  double x0 = 0, y0 = 0, cell = 0;  // m
-  int nx = 0, ny = 0;
-  std::vector<uint8_t> occupied;  // (ny x nx), row-major: j * nx + i
-  bool empty() const { return occupied.empty(); }
-  bool at(int i, int j) const { return occupied[size_t(j) * size_t(nx) + size_t(i)] != 0; }
-};
+// The projected band as a grid (placement, through the `octomap` format's
+// `occupied_plane` query: framework/world_section.h).
+using PlaneGrid = EnvironmentPlaneGrid;
 PlaneGrid ProjectBand(const EnvironmentMap& map, double z_lo, double z_hi);
 
 // Cells of a band's grid, at most (1 GiB of bytes: e.g. 16,000 x 16,000 x 4).

@@ -12,6 +12,7 @@
 #include "framework/state_hash.h"
 #include "framework/world.h"
 #include "modules/collision/module.h"
+#include "modules/kinematics/ik_model_section.h"
 #include "modules/kinematics/ik_solver.h"
 
 namespace swarmsim::kinematics {
@@ -487,6 +488,7 @@ void Register(ModuleRegistry* registry) {
          return std::make_unique<IkGroupsImpl>();
        },
        RegisterIkApi});
+  registry->RegisterModelSection(IkGroupsSection());  // `ik_groups:` of model files
 }
 
 }  // namespace swarmsim::kinematics

@@ -219,13 +219,16 @@ bool IsBlack(const Vec3& c) { return !(c.x > 0 || c.y > 0 || c.z > 0); }
 
 }  // namespace
 
-void BuildDrawList(const World& world, int segments, DrawList* list, double min_led_radius) {
+void BuildDrawList(const World& world, int segments, DrawList* list, double min_led_radius,
+                   bool rays) {
   const Scene& scene = world.scene();
   list->xyz.clear();
   list->normal.clear();
   list->rgb.clear();
   list->items.clear();
   list->lights.clear();
+  list->ray_xyz.clear();
+  list->ray_rgb.clear();
   list->lo = list->hi = Vec3{};
   list->has_bounds = false;
   const Primitives& prims = PrimitivesFor(segments);
@@ -270,6 +273,19 @@ void BuildDrawList(const World& world, int segments, DrawList* list, double min_
     Append(list, slot, prims.sphere, {radius, radius, radius}, scene.world_pose_at(slot),
            lit ? v.color : Vec3{0.15, 0.15, 0.15}, /*emissive=*/lit);
   });
+  // Rays (markers, asked for): a segment along +z, to the hit or full length.
+  if (rays)
+    ForEachVisual(scene, [&](uint32_t slot, const ObjectVisual& v) {
+      if (v.kind != VisualKind::kRay) return;
+      const Pose& X = scene.world_pose_at(slot);
+      const double length = v.hit >= 0 ? std::min(v.hit, v.size.x) : v.size.x;
+      const Vec3 a = X.p, b = X.p + X.q.Rotate(Vec3{0, 0, 1}) * length;
+      list->ray_xyz.insert(list->ray_xyz.end(), {static_cast<float>(a.x), static_cast<float>(a.y),
+                                                 static_cast<float>(a.z), static_cast<float>(b.x),
+                                                 static_cast<float>(b.y), static_cast<float>(b.z)});
+      const uint8_t r = Byte(v.color.x), g = Byte(v.color.y), bl = Byte(v.color.z);
+      list->ray_rgb.insert(list->ray_rgb.end(), {r, g, bl, r, g, bl});
+    });
   // Lights.
   CollectLights(scene, &list->lights, &list->scene_has_lights);
   list->step = world.step_count();

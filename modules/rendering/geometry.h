@@ -54,15 +54,23 @@ struct DrawList {
   std::vector<LightSource> lights;  // on, in scene order (at most 8 are used)
   bool scene_has_lights = false;    // light objects exist (on or off)
   FloorLayer floor;
-  int64_t step = -1;        // the world's step when built (the paint layer's version)
-  Vec3 lo, hi;              // bounds of the shapes and the environment (zero when none)
-  bool has_bounds = false;  // lo, hi hold something
+  // Ray visuals (proximity sensors' rays) as line segments, 2 vertices
+  // each, when BuildDrawList is asked for them (snapshots and video; never
+  // a vision sensor's image: markers are not bodies).
+  std::vector<float> ray_xyz;    // 6 per ray
+  std::vector<uint8_t> ray_rgb;  // 6 per ray
+  int64_t step = -1;             // the world's step when built (the paint layer's version)
+  Vec3 lo, hi;                   // bounds of the shapes and the environment (zero when none)
+  bool has_bounds = false;       // lo, hi hold something
 };
 
 // Fills *list from `world`'s scene. `segments`: sides of a cylinder and
 // slices of a sphere; lights (LEDs) are drawn at least `min_led_radius` m
-// big (an overview keeps them visible). Ray visuals are markers: not drawn.
-void BuildDrawList(const World& world, int segments, DrawList* list, double min_led_radius = 0);
+// big (an overview keeps them visible). Ray visuals are markers, drawn as
+// lines only with `rays` (from the object's origin along its +z axis, to
+// what it detects or its full length, in its colour).
+void BuildDrawList(const World& world, int segments, DrawList* list, double min_led_radius = 0,
+                   bool rays = false);
 
 struct DrawOptions {
   const std::vector<uint8_t>* visible = nullptr;  // by slot: 1 drawn (null: every slot)

@@ -33,7 +33,7 @@ struct Gl {
   X(glTexCoordPointer) X(glDrawArrays) X(glFinish) X(glReadPixels) \
   X(glPixelStorei) X(glGenTextures) X(glBindTexture) X(glTexImage2D) \
   X(glTexParameteri) X(glShadeModel) X(glDepthFunc) X(glColor3f) X(glNormal3f) \
-  X(glTexEnvi) X(glDepthMask) X(glGetError)
+  X(glTexEnvi) X(glDepthMask) X(glGetError) X(glLineWidth)
   // clang-format on
 #define SWARMSIM_DECLARE(name) decltype(&::name) name = nullptr;
   SWARMSIM_GL_FUNCTIONS(SWARMSIM_DECLARE)
@@ -353,6 +353,16 @@ void Draw(const DrawList& list, const View& view, const DrawOptions& options, Im
       }
     }
     if (run_count > 0) gl.glDrawArrays(GL_TRIANGLES, static_cast<GLint>(run_first), run_count);
+  }
+  // Rays (markers): unlit lines one pixel wide, in front of what they start in.
+  if (!list.ray_xyz.empty()) {
+    gl.glDisable(GL_LIGHTING);
+    gl.glDisableClientState(GL_NORMAL_ARRAY);
+    gl.glLineWidth(1);
+    gl.glVertexPointer(3, GL_FLOAT, 0, list.ray_xyz.data());
+    gl.glColorPointer(3, GL_UNSIGNED_BYTE, 0, list.ray_rgb.data());
+    gl.glDrawArrays(GL_LINES, 0, static_cast<GLsizei>(list.ray_xyz.size() / 3));
+    gl.glEnableClientState(GL_NORMAL_ARRAY);
   }
   gl.glFinish();
 

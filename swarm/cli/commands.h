@@ -41,14 +41,15 @@ struct RunArgs {
   bool trust_scripts = false;
   std::vector<std::string> plugins;
   std::vector<std::string> package_path;  // --package-path: URDF packages' folders
-  // Snapshots and video (modules/rendering/video/recorder.h).
+  // Snapshots and video (framework/view_recorder.h).
   int64_t snapshot_every = 0;             // 0: none
   std::string camera;                     // empty: the arena seen from above
   bool video = false;                     // --video given
   std::string video_file;                 // its FILE; empty: DIR/video.mp4
   int video_width = 0, video_height = 0;  // --video-size; 0: the view's default
   double video_fps = 30;
-  bool record = false;  // --record: DIR/recording.swrec (swarm/record/writer.h)
+  bool no_rays = false;  // --no-rays: snapshots and video without proximity sensors' rays
+  bool record = false;   // --record: DIR/recording.swrec (swarm/record/writer.h)
   // --view: record, and serve DIR to the viewer page while the run goes.
   bool view = false;
   int view_port = 8600;  // 0: a free port

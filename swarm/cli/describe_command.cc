@@ -46,7 +46,7 @@ void PrintDescription(const LoadedWorld& w, std::ostream& out) {
           << (m.python.keep_scripts ? " (beside the Lua scripts)" : " (instead of the Lua scripts)")
           << "\n";
     if (!m.native_controller.empty()) out << "  native controller: " << m.native_controller << "\n";
-    if (m.ik_groups > 0) out << "  module: ik (" << m.ik_groups << " IK groups)\n";
+    for (const std::string& module : m.modules) out << "  module: " << module << "\n";
     if (m.parameters.empty()) out << "  parameters: none\n";
     for (const ParameterSummary& p : m.parameters) {
       out << "  " << m.name << "." << p.name << " = " << p.value;

@@ -15,7 +15,7 @@
 #include "framework/plugin_loader.h"
 #include "framework/registry.h"
 #include "framework/utf8.h"
-#include "modules/rendering/video/recorder.h"
+#include "framework/view_recorder.h"
 #include "swarm/cli/commands.h"
 #include "swarm/cli/options.h"
 #include "swarm/loader/world_loader.h"
@@ -71,20 +71,22 @@ bool ParseVideoSize(const std::string& text, int* width, int* height) {
 }
 
 // The recorder's settings from the command line; nullopt when none is asked for.
-std::optional<video::RecorderSettings> RecorderSettingsOf(const RunArgs& args, std::string* error) {
+std::optional<ViewRecorderSettings> RecorderSettingsOf(const RunArgs& args, std::string* error) {
   const bool recording = args.snapshot_every > 0 || args.video;
   if (!recording) {
     if (!args.camera.empty()) *error = "--camera names the view of --snapshot-every or --video";
     if (args.video_width > 0) *error = "--video-size is the size of --snapshot-every or --video";
+    if (args.no_rays) *error = "--no-rays hides the rays in --snapshot-every or --video";
     return std::nullopt;
   }
-  video::RecorderSettings settings;
+  ViewRecorderSettings settings;
   if (!args.out_dir.empty()) settings.out_dir = args.out_dir;
   settings.snapshot_every = args.snapshot_every;
   settings.camera = args.camera;
   settings.width = args.video_width;
   settings.height = args.video_height;
   settings.video_fps = args.video_fps;
+  settings.rays = !args.no_rays;
   if (args.video) {
     if (!args.video_file.empty()) {
       settings.video = args.video_file;  // relative to the current folder, as typed
@@ -174,6 +176,9 @@ CLI::App* AddRunCommand(CLI::App* app, RunArgs* args) {
                   "time_step)) steps, at least 1")
       ->check(NumberCheck(false))
       ->needs(video);
+  run->add_flag("--no-rays", args->no_rays,
+                "Snapshots and video without the sensors' rays (drawn by default: proximity "
+                "sensors' rays, red where they detect something)");
   run->add_flag("--record", args->record,
                 "Record the run for swarmsim view: DIR/recording.swrec (needs --out; a world's "
                 "record: setting does the same)");
@@ -254,14 +259,16 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
   options.quiet = args.quiet;
   // Snapshots and video: the recorder module, checked before the run starts.
   std::string recorder_error;
-  const std::optional<video::RecorderSettings> recording =
-      RecorderSettingsOf(args, &recorder_error);
+  const std::optional<ViewRecorderSettings> recording = RecorderSettingsOf(args, &recorder_error);
   if (!recorder_error.empty()) return bad_input(recorder_error);
-  video::Recorder* recorder = nullptr;
+  ViewRecorder* recorder = nullptr;
   if (recording) {
+    const ViewRecorderDescriptor* view_recorder = loaded.world->registry().view_recorder();
+    if (view_recorder == nullptr)
+      return bad_input("this build of swarmsim records no snapshots or video");
     try {
       if (options.out_dir) CreateOutputFolder(*options.out_dir);  // for DIR/video.mp4
-      recorder = static_cast<video::Recorder*>(loaded.world->AddModule("recorder", &*recording));
+      recorder = view_recorder->add(loaded.world.get(), *recording);
     } catch (const Error& e) {
       return bad_input(e.what());
     }

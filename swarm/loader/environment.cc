@@ -7,12 +7,11 @@
 
 namespace swarmsim::loader {
 
-std::shared_ptr<const EnvironmentMap> ReadEnvironment(const YamlFile& file,
-                                                      const Field& environment,
-                                                      const ValueReader& values,
-                                                      const std::filesystem::path& world_folder,
-                                                      const ModuleRegistry& registry,
-                                                      std::vector<std::string>* warnings) {
+std::shared_ptr<const EnvironmentMap> ReadEnvironment(
+    const YamlFile& file, const Field& environment, const ValueReader& values,
+    const std::filesystem::path& world_folder, const ModuleRegistry& registry,
+    std::vector<std::string>* warnings, const EnvironmentFormatDescriptor** format_out) {
+  *format_out = nullptr;
   if (!environment.present()) return nullptr;
   const auto& formats = registry.environment_formats();
   std::string names;  // "octomap", for messages
@@ -43,6 +42,7 @@ std::shared_ptr<const EnvironmentMap> ReadEnvironment(const YamlFile& file,
   std::vector<std::string> known = {format->key};
   for (const ObjectKey& key : format->keys) known.push_back(key.name);
   f.Expect(known);
+  *format_out = format;
   return format->read(FieldsObjectReader(values, f, nullptr, &registry), world_folder, warnings);
 }
 

@@ -15,7 +15,8 @@
 
 namespace swarmsim {
 class ModuleRegistry;
-}
+struct EnvironmentFormatDescriptor;
+}  // namespace swarmsim
 
 namespace swarmsim::loader {
 
@@ -23,12 +24,11 @@ namespace swarmsim::loader {
 // through the format of `registry` whose key it holds. Null when the world
 // gives no `environment`. Errors name the key's
 // file:line:column and the map's own problem; what may surprise without
-// being wrong (a map without occupied voxels) goes to `warnings`.
-std::shared_ptr<const EnvironmentMap> ReadEnvironment(const YamlFile& file,
-                                                      const Field& environment,
-                                                      const ValueReader& values,
-                                                      const std::filesystem::path& world_folder,
-                                                      const ModuleRegistry& registry,
-                                                      std::vector<std::string>* warnings);
+// being wrong (a map without occupied voxels) goes to `warnings`. The
+// format that read it goes to `format` (its occupied_plane: placement).
+std::shared_ptr<const EnvironmentMap> ReadEnvironment(
+    const YamlFile& file, const Field& environment, const ValueReader& values,
+    const std::filesystem::path& world_folder, const ModuleRegistry& registry,
+    std::vector<std::string>* warnings, const EnvironmentFormatDescriptor** format);
 
 }  // namespace swarmsim::loader

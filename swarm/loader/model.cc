@@ -282,7 +282,8 @@ bool IsParameterName(std::string_view name) {
   return true;
 }
 
-ModelFile ReadModelFile(YamlFile file, const std::string& used_by) {
+ModelFile ReadModelFile(YamlFile file, const std::string& used_by,
+                        std::span<const std::string> section_keys) {
   ModelFile model{std::move(file), {}, {}, {}, {}, {}, {}, {}};
   const YamlFile& f = model.file;
   Field top{"model file", f.root(), f.root().Mark().is_null() ? YAML::Mark() : f.root().Mark(), {}};
@@ -291,8 +292,11 @@ ModelFile ReadModelFile(YamlFile file, const std::string& used_by) {
            "a model file must be a mapping with 'model', 'parameters' and 'objects' (got " +
                Describe(f.root()) + "; used by " + used_by + ")");
   Fields fields(f, top, "the model file");
-  fields.Expect({"model", "description", "parameters", "objects", "ik_groups"});
-  model.ik_groups = fields.Get("ik_groups");
+  // The loader's keys, then the modules' sections (read with the model's values).
+  std::vector<std::string> keys = {"model", "description", "parameters", "objects"};
+  keys.insert(keys.end(), section_keys.begin(), section_keys.end());
+  fields.Expect(keys);
+  model.top = top;
   const Field name_field = fields.Require("model");
   if (!name_field.node.IsScalar())
     f.Fail(name_field.mark,

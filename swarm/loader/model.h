@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -73,8 +74,10 @@ struct ModelFile {
   YamlFile file;
   std::string name;  // "footbot"
   std::vector<ModelParameterDecl> parameters;
-  Field root;       // the root object
-  Field ik_groups;  // IK groups (swarm/loader/ik.h), not present if none
+  Field root;  // the root object
+  // The file's top-level mapping: registered model-file sections
+  // (framework/model_section.h: `ik_groups`) read their keys from it.
+  Field top;
   // A model imported from another format (a URDF file, swarm/loader/urdf.h):
   // its objects, built once; `file` is then the world file naming it (the
   // entry's keys are read there) and `root` is not present.
@@ -84,8 +87,10 @@ struct ModelFile {
 };
 
 // `used_by` (file:line:column of the reference) is named when the file is
-// not a model at all.
-ModelFile ReadModelFile(YamlFile file, const std::string& used_by);
+// not a model at all. `section_keys`: the registered model-file sections'
+// keys (framework/model_section.h), accepted beside the loader's own.
+ModelFile ReadModelFile(YamlFile file, const std::string& used_by,
+                        std::span<const std::string> section_keys = {});
 
 // The world file's `objects:`: objects of the scene that belong to no model
 // (collections, distance objects, markers), each an entry as in a model file.

@@ -99,3 +99,19 @@ std::vector<std::unique_ptr<ObjectReader>> FieldsObjectReader::Elements(
 }
 
 }  // namespace swarmsim::loader
+
+namespace swarmsim::loader {
+
+std::vector<std::unique_ptr<ObjectReader>> FieldsObjectReader::Maps(std::string_view key,
+                                                                    std::string_view list_what,
+                                                                    const std::string& what) const {
+  std::vector<std::unique_ptr<ObjectReader>> out;
+  for (const Field& element : ListElements(values_.file(), fields_.Get(key), list_what)) {
+    auto fields = std::make_unique<Fields>(values_.file(), element, what);
+    out.push_back(std::unique_ptr<ObjectReader>(
+        new FieldsObjectReader(values_, std::move(fields), meshes_, registry_)));
+  }
+  return out;
+}
+
+}  // namespace swarmsim::loader

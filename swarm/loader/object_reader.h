@@ -70,6 +70,16 @@ class FieldsObjectReader final : public ObjectReader {
   [[noreturn]] void FailHere(const std::string& message) const override {
     values_.file().Fail(fields_.mark(), message);
   }
+  std::vector<std::unique_ptr<ObjectReader>> Maps(std::string_view key, std::string_view list_what,
+                                                  const std::string& what) const override;
+  bool IsList(std::string_view key) const override {
+    return !single_value_ && fields_.Get(key).node.IsSequence();
+  }
+  std::vector<std::string> Keys() const override { return fields_.keys(); }
+  std::string WhereKey(std::string_view key) const override {
+    return values_.file().Where(fields_.Get(key).key_mark);
+  }
+  std::string WhereHere() const override { return values_.file().Where(fields_.mark()); }
 
  private:
   // An item's reader owns its map's fields; `single_value`: a bare value

@@ -15,8 +15,8 @@
 #include <utility>
 #include <vector>
 
+#include "framework/environment.h"
 #include "framework/random.h"
-#include "modules/environment/voxel_merge.h"
 
 namespace swarmsim {
 
@@ -57,9 +57,9 @@ class Placer {
 
   void AddObstacle(const Obstacle2& obstacle) { obstacles_.push_back(obstacle); }
   // The environment map's occupied cells in the plane (a grid of squares,
-  // environment::ProjectBand): copies keep `clearance` from each like from
-  // an obstacle.
-  void SetMapCells(environment::PlaneGrid cells) { map_ = std::move(cells); }
+  // the map format's occupied_plane, framework/world_section.h): copies
+  // keep `clearance` from each like from an obstacle.
+  void SetMapCells(EnvironmentPlaneGrid cells) { map_ = std::move(cells); }
   // A copy placed by other means (a fixed position): later copies keep clear of it.
   void AddBody(double x, double y, double radius);
 
@@ -110,7 +110,7 @@ class Placer {
   uint64_t seed_;
   std::vector<Body> bodies_;
   std::vector<Obstacle2> obstacles_;
-  environment::PlaneGrid map_;  // map cells (empty: none)
+  EnvironmentPlaneGrid map_;  // map cells (empty: none)
   double max_body_radius_ = 0;
   // Bodies by cell: the cell edge is at least the largest body diameter, so
   // a query looks at a small block of cells.

@@ -10,9 +10,11 @@
 #include <utility>
 
 #include "framework/error.h"
+#include "framework/model_section.h"
 #include "framework/plugin_controllers.h"
 #include "framework/registry.h"
-#include "modules/environment/voxel_merge.h"
+#include "framework/world_section.h"
+#include "swarm/loader/object_reader.h"
 #include "swarm/loader/urdf.h"
 #include "swarm/loader/world_loader_impl.h"
 
@@ -64,6 +66,32 @@ using ScaledMeshes = std::map<const TriangleMesh*, std::shared_ptr<const Triangl
 // Points the mesh shapes of the copy at `id` (built from `spec`, then scaled)
 // at the assets an earlier copy of the entry was scaled to, so that copies
 // built from their own description share them as duplicates do.
+void CollectPaths(const ObjectSpec& spec, const std::string& prefix,
+                  std::vector<std::string>* out) {
+  for (const ObjectSpec& child : spec.children) {
+    const std::string path = prefix.empty() ? child.name : prefix + "/" + child.name;
+    out->push_back(path);
+    CollectPaths(child, path, out);
+  }
+}
+
+// The model's sections (and the entry's own) applied to a copy built from
+// `spec` at `root`, in registration order.
+void ApplyModelSections(const ModuleRegistry& registry,
+                        const std::vector<std::shared_ptr<const ModelSectionData>>& sections,
+                        const std::vector<std::shared_ptr<const ModelSectionData>>& entry_sections,
+                        const ObjectSpec& spec, ObjectId root, const std::string& model,
+                        World* world) {
+  std::vector<std::string> paths;
+  const auto& descriptors = registry.model_sections();
+  for (size_t i = 0; i < descriptors.size(); ++i)
+    for (const auto* list : {&sections, &entry_sections}) {
+      if (i >= list->size() || !(*list)[i]) continue;
+      if (paths.empty()) CollectPaths(spec, "", &paths);
+      descriptors[i]->apply(*(*list)[i], ModelCopy{root, model, spec.name, paths}, world);
+    }
+}
+
 void ShareScaledMeshes(const ObjectSpec& spec, ObjectId id, Scene* scene, ScaledMeshes* scaled) {
   const ShapeData* shape = spec.AsShape();
   if (shape != nullptr && shape->mesh) {
@@ -78,11 +106,33 @@ void ShareScaledMeshes(const ObjectSpec& spec, ObjectId id, Scene* scene, Scaled
 
 // --- Resolving an entry ----------------------------------------------------------------
 
+std::vector<std::string> ModelSectionKeys(const ModuleRegistry& registry) {
+  std::vector<std::string> keys;
+  for (const auto& section : registry.model_sections()) keys.push_back(section->key);
+  return keys;
+}
+
+std::vector<std::string> EntryKeys(const ModuleRegistry& registry) {
+  std::vector<std::string> keys = {
+      "model",      "count",     "distribute", "position", "heading_deg", "orientation_deg",
+      "parameters", "instances", "scale",      "base",     "objects",     "scripts"};
+  for (std::string& key : ModelSectionKeys(registry)) keys.push_back(std::move(key));
+  keys.insert(keys.end(), {"python_controller", "native_controller"});
+  return keys;
+}
+
+std::vector<std::shared_ptr<const ModelSectionData>> ReadModelSections(
+    const ModuleRegistry& registry, const ObjectReader& top, const std::string& model) {
+  std::vector<std::shared_ptr<const ModelSectionData>> out;
+  for (const auto& section : registry.model_sections()) out.push_back(section->read(top, model));
+  return out;
+}
+
 void WorldLoader::ResolveEntry(EntryPlan* entry) {
   const ModelFile& model = *entry->model;
   const ValueReader world_values = WorldValues();
   Fields f(*file_, entry->field, "the models entry for '" + model.name + "'");
-  f.Expect(kEntryKeys);
+  f.Expect(EntryKeys(registry_));
   DeclaredParameters declared;
   ResolveEntryParameters(f, world_values, &declared, entry);
   ReadOwnCopies(f, world_values, &declared, entry);
@@ -295,13 +345,19 @@ void WorldLoader::ResolveObjects(const Fields& f, const ValueReader& world_value
     entry->footprint.bottom *= entry->scale;
     entry->footprint.top *= entry->scale;
   }
-  entry->ik_groups = loader::ReadIkGroups(model, model_values);
-  if (f.Has("ik_groups")) {
-    // The entry's own groups (an imported robot's): paths and messages in the world file.
-    entry->entry_model = std::make_shared<ModelFile>(
-        ModelFile{*file_, model.name, {}, {}, f.Get("ik_groups"), nullptr, {}, {}});
-    entry->entry_ik_groups = loader::ReadIkGroups(*entry->entry_model, world_values);
-  }
+  // The model file's sections (IK groups), and the entry's own keys of the
+  // same name (an imported robot's): paths and messages in the world file.
+  const auto read_sections = [&](const ValueReader& values) {
+    if (!model.top.present())  // an imported model: only the entry's own keys
+      return std::vector<std::shared_ptr<const ModelSectionData>>(
+          registry_.model_sections().size());
+    const Fields top(model.file, model.top, "the model file");
+    return ReadModelSections(registry_, FieldsObjectReader(values, top, &meshes_, world_registry_),
+                             model.name);
+  };
+  entry->sections = read_sections(model_values);
+  entry->entry_sections = ReadModelSections(
+      registry_, FieldsObjectReader(world_values, f, &meshes_, world_registry_), model.name);
   // A copy with values of its own gets objects of its own: every value of
   // the model that uses a parameter (a sensor's range, a size, a limit, a
   // mass, an IK setting) takes the copy's value.
@@ -311,7 +367,7 @@ void WorldLoader::ResolveObjects(const Fields& f, const ValueReader& world_value
     try {
       own.spec = loader::ResolveModel(model, own_values, &scripts_, &meshes_, world_registry_);
       ExtendObjects(f, world_values, *entry, &*own.spec);
-      own.ik_groups = loader::ReadIkGroups(model, own_values);
+      own.sections = read_sections(own_values);
     } catch (const Error& e) {
       throw Error(std::string(e.what()) + " (with the parameters of copy " +
                   std::to_string(own.index) + " given at " + file_->Where(own.field.mark) + ")");
@@ -461,9 +517,11 @@ void WorldLoader::ReadSinglePosition(const Fields& f, const ValueReader& world_v
 // The environment map's voxels that a copy standing on the ground would
 // meet (those reaching into the band from the ground to the tallest copy's
 // top, less 1 mm at either end: a floor whose top is at z = 0 is not one),
-// projected to the plane: placement keeps copies clear of them.
+// projected to the plane by the map's format (its occupied_plane query):
+// placement keeps copies clear of them.
 void WorldLoader::KeepPlacementClearOfTheMap() {
   if (!environment_ || entries_.empty()) return;
+  if (!environment_format_ || !environment_format_->occupied_plane) return;
   double height = 0;
   for (const EntryPlan& e : entries_) {
     height = std::max(height, e.footprint.top - e.footprint.bottom);
@@ -472,7 +530,8 @@ void WorldLoader::KeepPlacementClearOfTheMap() {
   }
   constexpr double kOverlap = 1e-3;  // m, as the physics backends' rule
   try {
-    placer_->SetMapCells(environment::ProjectBand(*environment_, kOverlap, height - kOverlap));
+    placer_->SetMapCells(
+        environment_format_->occupied_plane(*environment_, kOverlap, height - kOverlap));
   } catch (const Error& e) {
     file_->Fail(environment_field_.mark, e.what());
   }
@@ -534,7 +593,8 @@ void WorldLoader::BuildCopies(World* world) {
     size_t duplicates = poses.size();
     for (const EntryPlan::OwnCopy& own : e.own_copies) duplicates -= own.spec.has_value();
     ScaledMeshes scaled_meshes;
-    auto build = [&](const ObjectSpec& spec, const std::vector<loader::IkGroupDef>& ik_groups,
+    auto build = [&](const ObjectSpec& spec,
+                     const std::vector<std::shared_ptr<const ModelSectionData>>& sections,
                      std::optional<size_t> reserve) {
       const ObjectId root = loader::AddToScene(spec, {}, &scene);
       // Scaled once, before duplication: copies share the scaled mesh assets
@@ -549,9 +609,9 @@ void WorldLoader::BuildCopies(World* world) {
       }
       const int instance = scene.MakeModelInstance(
           root, name, name + "#" + std::to_string(scene.instances().size()));
-      // IK groups of this copy; duplicates get theirs from the "ik" module.
-      loader::AddIkGroups(*e.model, ik_groups, spec, root, world);
-      if (e.entry_model) loader::AddIkGroups(*e.entry_model, e.entry_ik_groups, spec, root, world);
+      // The model's sections for this copy (its IK groups); duplicates get
+      // theirs from the modules, which follow copies.
+      ApplyModelSections(registry_, sections, e.entry_sections, spec, root, name, world);
       return std::pair(root, instance);
     };
     ObjectId first;  // the entry's first copy built from its own description
@@ -561,9 +621,9 @@ void WorldLoader::BuildCopies(World* world) {
       ObjectId root;
       int instance;
       if (own && own->spec) {
-        std::tie(root, instance) = build(*own->spec, own->ik_groups, std::nullopt);
+        std::tie(root, instance) = build(*own->spec, own->sections, std::nullopt);
       } else if (first.IsNull()) {
-        std::tie(root, instance) = build(e.spec, e.ik_groups, duplicates - 1);
+        std::tie(root, instance) = build(e.spec, e.sections, duplicates - 1);
         first = root;
       } else {
         root = scene.DuplicateSubtree(first, {});
@@ -621,7 +681,9 @@ std::vector<ModelSummary> WorldLoader::Summarize() const {
       }
     for (const auto& [file, where] : scripts) m.scripts.push_back(file + " " + where);
     m.scale = e.scale;
-    m.ik_groups = static_cast<int>(e.ik_groups.size() + e.entry_ik_groups.size());
+    for (const auto* sections : {&e.sections, &e.entry_sections})
+      for (const auto& section : *sections)
+        if (section && !section->Describe().empty()) m.modules.push_back(section->Describe());
     if (e.model->imported) {
       m.file = e.model->imported_file;
       m.imported = e.model->import_summary;

@@ -116,7 +116,7 @@ LoadedWorld WorldLoader::Load() {
   BuildObstacles(top, world);
   environment_field_ = top.Get("environment");
   environment_ = loader::ReadEnvironment(f, environment_field_, WorldValues(), path_.parent_path(),
-                                         world->registry(), &out.warnings);
+                                         world->registry(), &out.warnings, &environment_format_);
   if (environment_) world->scene().set_environment(environment_);
   for (EntryPlan& entry : entries_) ResolveEntry(&entry);
   KeepPlacementClearOfTheMap();
@@ -287,8 +287,8 @@ const ModelFile& WorldLoader::LoadModel(const Field& field, const std::string& t
   }
   if (it == models_.end()) {
     const std::string where = file_->Where(field.mark);
-    auto model = std::make_unique<ModelFile>(
-        loader::ReadModelFile(YamlFile::Load(path, "model file", where, text), where));
+    auto model = std::make_unique<ModelFile>(loader::ReadModelFile(
+        YamlFile::Load(path, "model file", where, text), where, ModelSectionKeys(registry_)));
     it = models_.emplace(key, std::move(model)).first;
   }
   return *it->second;
@@ -298,7 +298,7 @@ void WorldLoader::ReadModelEntries(const Fields& top) {
   for (const Field& element : loader::ListElements(*file_, top.Get("models"), "model entries")) {
     Fields entry(*file_, element, "a models entry");
     // A misspelled 'model' is an unknown key (with a suggestion), not a missing one.
-    if (!entry.Has("model")) entry.Expect(kEntryKeys);
+    if (!entry.Has("model")) entry.Expect(EntryKeys(registry_));
     const Field model = entry.Require("model");
     if (!model.node.IsScalar())
       file_->Fail(model.mark,

@@ -74,7 +74,9 @@ struct ModelSummary {
   // from the model root: "bot.lua on :, :/arm (explicit)".
   std::vector<std::string> scripts;
   double scale = 1;  // `scale:` of the entry
-  int ik_groups = 0;
+  // What the model's sections (framework/model_section.h) add to each
+  // copy: "ik (2 IK groups)".
+  std::vector<std::string> modules;
   std::vector<std::string> imported;  // a URDF model: what was imported (links, joints, meshes)
   PythonController python;            // python_controller:, if any
   std::string native_controller;      // native_controller:, if any

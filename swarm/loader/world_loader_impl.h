@@ -15,7 +15,6 @@
 #include <string>
 #include <vector>
 
-#include "swarm/loader/ik.h"
 #include "swarm/loader/mesh.h"
 #include "swarm/loader/model.h"
 #include "swarm/loader/placement.h"
@@ -23,25 +22,27 @@
 #include "swarm/loader/world_loader.h"
 #include "swarm/loader/yaml.h"
 
+namespace swarmsim {
+class ModelSectionData;
+class ObjectReader;
+class ModuleRegistry;
+struct EnvironmentFormatDescriptor;
+}  // namespace swarmsim
+
 namespace swarmsim::loader {
 
 inline constexpr int64_t kMaxCount = 1000000;  // copies per models entry
 
-inline const std::vector<std::string> kEntryKeys = {"model",
-                                                    "count",
-                                                    "distribute",
-                                                    "position",
-                                                    "heading_deg",
-                                                    "orientation_deg",
-                                                    "parameters",
-                                                    "instances",
-                                                    "scale",
-                                                    "base",
-                                                    "objects",
-                                                    "scripts",
-                                                    "ik_groups",
-                                                    "python_controller",
-                                                    "native_controller"};
+// A models entry's keys: the loader's own, with the registered model-file
+// sections' (framework/model_section.h: an imported robot's `ik_groups`)
+// after `scripts`.
+std::vector<std::string> EntryKeys(const ModuleRegistry& registry);
+// The registered model-file sections' keys, in registration order.
+std::vector<std::string> ModelSectionKeys(const ModuleRegistry& registry);
+// What each registered model-file section reads from `top` (a model file's
+// top level or a models entry), in registration order (null: absent).
+std::vector<std::shared_ptr<const ModelSectionData>> ReadModelSections(
+    const ModuleRegistry& registry, const ObjectReader& top, const std::string& model);
 
 // One --set, split into its target.
 struct Override {
@@ -76,10 +77,11 @@ struct EntryPlan {
   double clearance = 0;
   std::optional<double> heading;
   std::vector<Placement2> placements;
-  std::vector<loader::IkGroupDef> ik_groups;
-  // The entry's own `ik_groups` (read in the world file, through `entry_model`).
-  std::shared_ptr<ModelFile> entry_model;
-  std::vector<loader::IkGroupDef> entry_ik_groups;
+  // What the model file's sections (framework/model_section.h) read, one
+  // per registered section (null: the key is absent), and what the entry's
+  // own keys of the same name read (in the world file, with its values).
+  std::vector<std::shared_ptr<const ModelSectionData>> sections;
+  std::vector<std::shared_ptr<const ModelSectionData>> entry_sections;
   PythonController python;  // python_controller: (file empty: none)
   // native_controller: (null: none); the plugin's controller every copy runs.
   const PluginControllerType* native = nullptr;
@@ -94,7 +96,7 @@ struct EntryPlan {
     // is duplicated from the entry's first copy like the others.
     std::optional<ObjectSpec> spec;
     loader::Footprint footprint;  // of the scaled copy (spec present)
-    std::vector<loader::IkGroupDef> ik_groups;
+    std::vector<std::shared_ptr<const ModelSectionData>> sections;  // read with its values
   };
   std::vector<OwnCopy> own_copies;
   std::map<int64_t, size_t> own_copy_of;  // copy index -> own_copies position
@@ -195,6 +197,7 @@ class WorldLoader {
   std::optional<Region2> arena_;
   Field environment_field_;                            // `environment:` (absent: none)
   std::shared_ptr<const EnvironmentMap> environment_;  // the map it names, or null
+  const EnvironmentFormatDescriptor* environment_format_ = nullptr;  // the format that read it
   std::unique_ptr<Placer> placer_;
   std::vector<std::filesystem::path> package_path_;  // the world's, then --package-path
   std::vector<std::string> warnings_;                // found before the World exists

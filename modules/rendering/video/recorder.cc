@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "framework/error.h"
+#include "framework/registry.h"
 #include "framework/world.h"
 #include "modules/paint/png_io.h"
 #include "modules/rendering/geometry.h"
@@ -216,7 +217,7 @@ struct Recorder::Impl {
     // A view from above keeps LEDs at least 3 pixels across, as Render does.
     const double pixel =
         job.view.orthographic ? job.view.ortho_width / std::max(1, job.view.width) : 0;
-    rendering::BuildDrawList(world, SegmentsFor(job.view), &job.list, 1.5 * pixel);
+    rendering::BuildDrawList(world, SegmentsFor(job.view), &job.list, 1.5 * pixel, settings.rays);
     MarkClosed(world.scene(), job.list, &job.closed);
     // The paint layer changes in the next steps: the frame gets a copy.
     rendering::FloorLayer& floor = job.list.floor;
@@ -408,6 +409,15 @@ ModuleDescriptor RecorderModule() {
             if (config == nullptr) throw Error("the recorder module needs its settings");
             return std::make_unique<Recorder>(world, *static_cast<const RecorderSettings*>(config));
           }};
+}
+
+void Register(ModuleRegistry* registry) {
+  registry->RegisterModule(RecorderModule());
+  auto recorder = std::make_shared<ViewRecorderDescriptor>();
+  recorder->add = [](World* world, const ViewRecorderSettings& settings) -> ViewRecorder* {
+    return static_cast<Recorder*>(world->AddModule("recorder", &settings));
+  };
+  registry->RegisterViewRecorder(std::move(recorder));
 }
 
 }  // namespace swarmsim::video

@@ -3,7 +3,9 @@
 // the arena from above, or a named camera or vision sensor) and writes PNG
 // snapshots (DIR/snapshots/step_000120.png) and/or the frames of an H.264
 // video (video_writer.h). Made on request: World::AddModule("recorder",
-// &settings), as `swarmsim run --snapshot-every/--video` does.
+// &settings), or through the registry's view recorder
+// (framework/view_recorder.h), as `swarmsim run --snapshot-every/--video`
+// does.
 //
 // The simulation's thread collects each frame's triangles (it reads the
 // scene); one thread of the recorder's own draws them (OSMesa), compresses
@@ -18,23 +20,21 @@
 #include <vector>
 
 #include "framework/module.h"
+#include "framework/view_recorder.h"
+
+namespace swarmsim {
+class ModuleRegistry;
+}
 
 namespace swarmsim::video {
 
-struct RecorderSettings {
-  std::filesystem::path out_dir;  // the run's output folder: snapshots/ and relative paths
-  int64_t snapshot_every = 0;     // steps between snapshots (step 0 too); 0: none
-  std::filesystem::path video;    // the MP4 file; empty: no video
-  std::string camera;             // a camera or vision sensor's path; empty: the arena view
-  int width = 0, height = 0;      // pixels; 0: 640x480 for the arena, a camera's own resolution
-  double video_fps = 30;          // frames per simulated second wanted
-};
+using RecorderSettings = ViewRecorderSettings;
 
 // The frames a video at `fps` frames per simulated second gets with a time
 // step of `time_step` s: one every round(1 / (fps time_step)) steps, at least 1.
 int64_t FramePeriod(double fps, double time_step);
 
-class Recorder final : public Module {
+class Recorder final : public Module, public ViewRecorder {
  public:
   // Checks the settings against the world (the camera exists, the size
   // fits) and creates the video file and the snapshots folder. Throws
@@ -48,16 +48,11 @@ class Recorder final : public Module {
   void WriteOutputs(const std::filesystem::path& dir) const override;
   void ListOutputs(std::vector<OutputFile>* out) const override;
 
-  // Waits for the frames in hand, completes the video file; later calls do
-  // nothing. Throws swarmsim::Error if a frame or file could not be written.
-  void Finish() const;
-  // For the progress bar: "video 120 frames, 12 snapshots".
-  std::string ProgressNote() const;
-  // What the settings became where they could not be met exactly (the frame
-  // rate the time step allows, a size rounded to even), one line each.
-  const std::vector<std::string>& notes() const;
-  // One line about the video when done: "out/video.mp4: 601 frames, 640x480, 10 frames/s".
-  std::string VideoLine() const;
+  // ViewRecorder (framework/view_recorder.h).
+  void Finish() const override;
+  std::string ProgressNote() const override;
+  const std::vector<std::string>& notes() const override;
+  std::string VideoLine() const override;
 
  private:
   struct Impl;
@@ -65,6 +60,8 @@ class Recorder final : public Module {
 };
 
 ModuleDescriptor RecorderModule();
+// Registers the module and the program's view recorder (its `add`).
+void Register(ModuleRegistry* registry);
 
 // Paths of the scene's cameras and vision sensors, in slot order.
 std::vector<std::string> CameraPaths(const Scene& scene);

@@ -329,6 +329,68 @@ TEST(VideoCli, AVideoThatCannotBeWrittenMidRunFailsTheRunWithTheOutputsSoFar) {
   EXPECT_GE(DecodeAll(&reader).size(), 10u);
 }
 
+// Proximity sensors' rays (their type's `ray` visual, framework/visual.h)
+// are drawn as the viewer draws them: a line along the sensor's +z axis,
+// cyan to its full range while it detects nothing, red up to what it
+// detects. --no-rays leaves them out.
+TEST(VideoCli, SnapshotsDrawProximityRaysUnlessToldNot) {
+  // The red box stands at (-0.5, 0.75); `free` looks along +x at y = -0.75
+  // and sees nothing in its 2 m, `seeing` looks along +x at y = 0.75 from
+  // x = -2 and meets the box's face at x = -0.65, 1.35 m on.
+  const auto dir =
+      MarkerWorld("rays", -0.5, 0,
+                  "  - {name: free, type: proximity_sensor, range: 2, position: [-1, -0.75, 0.1], "
+                  "orientation_deg: [0, 90, 0]}\n"
+                  "  - {name: seeing, type: proximity_sensor, range: 2, position: [-2, 0.75, 0.1], "
+                  "orientation_deg: [0, 90, 0]}\n");
+  const auto snapshot = [&](const std::string& flags) {
+    const auto out = dir / ("out" + flags);
+    const auto r =
+        RunProgram("run " + (dir / "world.yaml").string() +
+                   " --steps 1 --snapshot-every 1 --quiet --out " + out.string() + " " + flags);
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    return paint::ReadPng(out / "snapshots" / "step_000001.png");
+  };
+  const auto cyan = [](int r, int g, int b) { return r < 140 && g > 150 && b > 180; };
+  const auto red = [](int r, int g, int b) { return r > 200 && g < 90 && b < 90; };
+  // Pixels of `match` in the image's column x, within 2 rows of y.
+  const auto near = [](const paint::RgbImage& png, double x, double y, auto match) {
+    int n = 0;
+    const int column = static_cast<int>(std::lround(x));
+    for (int row = static_cast<int>(std::lround(y)) - 2; row <= std::lround(y) + 2; ++row) {
+      if (row < 0 || row >= png.height || column < 0 || column >= png.width) continue;
+      const uint8_t* p = &png.rgb[(static_cast<size_t>(row) * png.width + column) * 3];
+      n += match(p[0], p[1], p[2]);
+    }
+    return n;
+  };
+  // Columns of `match` near the ray at world y from x = x0 to x1, every 0.1 m.
+  const auto columns = [&](const paint::RgbImage& png, const Frame& f, int x0_dm, int x1_dm,
+                           double y, auto match) {
+    int n = 0;
+    for (int dm = x0_dm; dm <= x1_dm; ++dm) n += near(png, f.X(dm / 10.0), f.Y(y), match) > 0;
+    return n;
+  };
+  const paint::RgbImage with = snapshot("");
+  const Frame f = Markers(with.width, with.height, with.rgb);
+  // The free ray from just past its start to just before its end, and not past its range.
+  EXPECT_EQ(columns(with, f, -8, 8, -0.75, cyan), 17);
+  EXPECT_EQ(columns(with, f, 13, 15, -0.75, cyan), 0) << "past its range";
+  // The seeing ray is red up to the box, not cyan anywhere.
+  EXPECT_EQ(columns(with, f, -18, -8, 0.75, red), 11);
+  EXPECT_EQ(columns(with, f, -18, 15, 0.75, cyan), 0);
+  // --no-rays: none of it.
+  const paint::RgbImage without = snapshot("--no-rays");
+  EXPECT_EQ(columns(without, f, -8, 8, -0.75, cyan), 0);
+  EXPECT_EQ(columns(without, f, -18, -8, 0.75, red), 0);
+  // --no-rays belongs to pictures.
+  const auto r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 1 --no-rays");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--no-rays hides the rays in --snapshot-every or --video"),
+            std::string::npos)
+      << r.output;
+}
+
 TEST(VideoCli, BadVideoOptionsAreNamedAndStopTheRunBeforeItStarts) {
   const auto dir = MarkerWorld("bad", 1.0, 0, "  - {name: overhead, type: camera}\n");
   const std::string world = (dir / "world.yaml").string();

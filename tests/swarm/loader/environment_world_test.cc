@@ -14,9 +14,8 @@
 
 #include "framework/registry.h"
 #include "framework/world.h"
+#include "framework/world_section.h"
 #include "modules/builtin.h"
-#include "modules/environment/octomap_map.h"
-#include "modules/environment/voxel_merge.h"
 #include "swarm/loader/world_loader.h"
 #include "tests/shared_maps.h"
 #include "tests/swarm/run_program.h"  // FreshTempDir
@@ -29,19 +28,24 @@ using testing::FreshTempDir;
 
 const std::string kCorridor = std::string(SWARMSIM_SOURCE_DIR) + "/worlds/octomap_corridor.yaml";
 
-LoadedWorld Load(const fs::path& file, LoadOptions options) {
+const ModuleRegistry& Registry() {
   static const ModuleRegistry registry = [] {
     ModuleRegistry r;
     RegisterBuiltinModules(&r);
     return r;
   }();
+  return registry;
+}
+
+LoadedWorld Load(const fs::path& file, LoadOptions options) {
+  const ModuleRegistry& registry = Registry();
   LoadedWorld loaded = LoadWorld(file, options, registry);
   loaded.world->set_log_sink([](std::string_view) {});
   return loaded;
 }
 
 // Distance from (x, y) to the nearest occupied cell of `grid`.
-double DistanceToCells(const environment::PlaneGrid& grid, double x, double y) {
+double DistanceToCells(const EnvironmentPlaneGrid& grid, double x, double y) {
   double best = INFINITY;
   for (int j = 0; j < grid.ny; ++j)
     for (int i = 0; i < grid.nx; ++i) {
@@ -65,8 +69,14 @@ TEST(EnvironmentWorldTest, TheCorridorWorldPlacesAndKeepsRobotsInFreeSpace) {
   ASSERT_NE(scene.environment(), nullptr);
   EXPECT_EQ(scene.environment()->boxes.size(), 143729u);
   ASSERT_EQ(scene.instances().size(), 50u);
-  // The map's voxels at foot-bot height (0 to 0.146 m), in the plane.
-  const environment::PlaneGrid walls = environment::ProjectBand(*scene.environment(), 1e-3, 0.145);
+  // The map's voxels at foot-bot height (0 to 0.146 m), in the plane, as
+  // the octomap format's query gives them to placement.
+  const EnvironmentFormatDescriptor* octomap = nullptr;
+  for (const auto& format : Registry().environment_formats())
+    if (format->key == "octomap") octomap = format.get();
+  ASSERT_NE(octomap, nullptr);
+  ASSERT_TRUE(octomap->occupied_plane);
+  const EnvironmentPlaneGrid walls = octomap->occupied_plane(*scene.environment(), 1e-3, 0.145);
   auto check = [&](double keep, const char* when) {
     for (const ModelInstance& robot : scene.instances()) {
       const Vec3 p = scene.world_pose(robot.root).p;

@@ -48,6 +48,8 @@ class ControlLoaderTest : public ::testing::Test {
                                [] { return std::make_unique<testing::NullDynamics>(); });
     proximity::Register(&registry_, {"", "proximity", "1", "test"},
                         [] { return std::make_unique<testing::NullProximity>(); });
+    // The gear's `ik_groups:` is the kinematics module's model-file section.
+    kinematics::Register(&registry_);
   }
   void TearDown() override { fs::remove_all(dir_); }
   void Write(const std::string& name, const std::string& text) {

@@ -1,6 +1,7 @@
-// `ik_groups:` in model files: read, copied with each robot, driven from
-// Lua with sim.handleIkGroup; mistakes reported with file:line:column and
-// the nearest known name.
+// `ik_groups:` in model files (modules/kinematics/ik_model_section.cc, a
+// model-file section the loader reads through the registry): read, copied
+// with each robot, driven from Lua with sim.handleIkGroup; mistakes
+// reported with file:line:column and the nearest known name.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -42,12 +43,12 @@ objects:
 ik_groups:
 )";
 
-class LoaderIkTest : public ::testing::Test {
+class IkModelSectionTest : public ::testing::Test {
  protected:
   void SetUp() override {
     RegisterBuiltinModules(&registry_);
     dir_ = fs::temp_directory_path() /
-           ("swarmsim_loader_ik_" + std::to_string(::getpid()) + "_" +
+           ("swarmsim_ik_model_section_" + std::to_string(::getpid()) + "_" +
             ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(dir_);
     fs::create_directories(dir_);
@@ -82,7 +83,7 @@ class LoaderIkTest : public ::testing::Test {
   std::string log_;
 };
 
-TEST_F(LoaderIkTest, EveryCopyGetsItsGroupAndItSolvesEachStep) {
+TEST_F(IkModelSectionTest, EveryCopyGetsItsGroupAndItSolvesEachStep) {
   LoadedWorld loaded = Load(
       "  - {name: reach, tips: [{tip: j1/j2/tip, target: target, constraints: [x, y]}], "
       "iterations: 50, tolerance: 1.0e-6}\n");
@@ -101,7 +102,7 @@ TEST_F(LoaderIkTest, EveryCopyGetsItsGroupAndItSolvesEachStep) {
   }
 }
 
-TEST_F(LoaderIkTest, ScriptsHandleTheirOwnGroupExplicitly) {
+TEST_F(IkModelSectionTest, ScriptsHandleTheirOwnGroupExplicitly) {
   LoadedWorld loaded = Load(
       "  - {name: reach, tips: [{tip: j1/j2/tip, target: target, constraints: position}], "
       "automatic: false, iterations: 50}\n",
@@ -115,7 +116,7 @@ TEST_F(LoaderIkTest, ScriptsHandleTheirOwnGroupExplicitly) {
 }
 
 // A handle is not taken modulo 2^32: g + 2^32 is no group.
-TEST_F(LoaderIkTest, HandlesBeyondTheIntRangeAreNoGroup) {
+TEST_F(IkModelSectionTest, HandlesBeyondTheIntRangeAreNoGroup) {
   LoadedWorld loaded =
       Load("  - {name: reach, tips: [{tip: j1/j2/tip, target: target}], automatic: false}\n",
            "function sysCall_actuation()\n"
@@ -129,7 +130,7 @@ TEST_F(LoaderIkTest, HandlesBeyondTheIntRangeAreNoGroup) {
 
 // The README's `weights: {path: w}`, in flow and block form: weight 0
 // freezes j1, so only j2 moves; with no weights both do.
-TEST_F(LoaderIkTest, WeightsFromTheModelFileChangeTheSolution) {
+TEST_F(IkModelSectionTest, WeightsFromTheModelFileChangeTheSolution) {
   const auto joints_after_a_step = [&](const std::string& weights) {
     LoadedWorld loaded = Load(
         "  - name: reach\n"
@@ -154,7 +155,7 @@ TEST_F(LoaderIkTest, WeightsFromTheModelFileChangeTheSolution) {
   }
 }
 
-TEST_F(LoaderIkTest, MistakesNameTheLineAndTheNearestName) {
+TEST_F(IkModelSectionTest, MistakesNameTheLineAndTheNearestName) {
   const std::string bad_path =
       ErrorOf("  - {name: reach, tips: [{tip: j1/j2/tpi, target: target}]}\n");
   EXPECT_NE(bad_path.find("arm.yaml:20:"), std::string::npos) << bad_path;
