@@ -218,6 +218,7 @@ std::vector<OutputFile> World::ListOutputs() const {
 std::vector<MetricSample> World::TakeMetrics() {
   std::vector<MetricSample> out;
   out.swap(metrics_);
+  ++metrics_taken_;
   // In step order, whatever order the scripts and observers recorded in
   // (already sorted in the usual case: then no sort).
   const auto by_step = [](const MetricSample& a, const MetricSample& b) { return a.step < b.step; };

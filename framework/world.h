@@ -302,6 +302,9 @@ class World : public PhaseHandlers {
   std::vector<OutputFile> ListOutputs() const;
   // Metric samples recorded since the last call, in (step, robot, order) order.
   std::vector<MetricSample> TakeMetrics();
+  // How many times TakeMetrics has been called: a module whose Record reads
+  // the samples so far (the recorder) knows by it when they were taken.
+  uint64_t metrics_taken() const { return metrics_taken_; }
   // Scripts disabled under on_script_error: disable_script so far, each with
   // its error (robot order within a step, then the scene's).
   const std::vector<std::string>& disabled_scripts() const { return disabled_scripts_; }
@@ -441,6 +444,7 @@ class World : public PhaseHandlers {
   Module* InstallModule(std::string name, int order, uint32_t phases,
                         std::unique_ptr<Module> instance);
   std::vector<MetricSample> metrics_;
+  uint64_t metrics_taken_ = 0;
   std::vector<std::string> disabled_scripts_;
   std::function<void(std::string_view)> log_sink_;
   PhaseTimes phase_times_{};

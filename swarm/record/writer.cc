@@ -144,6 +144,9 @@ struct RunRecorder::Impl {
   std::vector<std::string> metric_names;
   size_t names_written = 0;
   std::vector<SampleRow> samples;
+  // Where the world's samples not taken yet stand (Record).
+  uint64_t metrics_taken = 0;
+  size_t metrics_seen = 0;
 
   int64_t records = 0;
 
@@ -505,10 +508,19 @@ void RunRecorder::Start(World* world) {
 void RunRecorder::Record(const World& world, std::vector<MetricSample>* out) {
   Impl& r = *impl_;
   const int64_t step = world.step_count();
-  // This step's samples (the runner takes them after every step).
-  for (const MetricSample& m : *out)
-    if (m.step == step)
-      r.samples.push_back({r.MetricId(m.name), m.instance, static_cast<uint32_t>(m.step), m.value});
+  // The samples added since the last call: the scripts' of this step
+  // (stamped with the step they ran in, one before this) and the
+  // observers'. `out` holds what nobody has taken yet (the runner takes
+  // them after every step; a binding may not).
+  if (world.metrics_taken() != r.metrics_taken) {
+    r.metrics_taken = world.metrics_taken();
+    r.metrics_seen = 0;
+  }
+  for (size_t i = std::min(r.metrics_seen, out->size()); i < out->size(); ++i) {
+    const MetricSample& m = (*out)[i];
+    r.samples.push_back({r.MetricId(m.name), m.instance, static_cast<uint32_t>(m.step), m.value});
+  }
+  r.metrics_seen = out->size();
   if (step % r.settings.every != 0) return;
   r.WriteStep(world);
 }

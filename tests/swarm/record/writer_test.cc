@@ -11,6 +11,8 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <string>
+#include <tuple>
 
 #include "framework/error.h"
 #include "framework/floor_layer.h"
@@ -105,6 +107,49 @@ void ExpectNear(const Pose& recorded, const Pose& actual, const std::string& wha
   const double dot = std::abs(recorded.q.w * actual.q.w + recorded.q.x * actual.q.x +
                               recorded.q.y * actual.q.y + recorded.q.z * actual.q.z);
   EXPECT_GT(dot, 1 - 1e-7) << what;
+}
+
+// The samples scripts record (sim.recordMetric, stamped with the step their
+// callback ran in) are in the recording with the observers', each once,
+// whether or not the runner takes them after every step.
+TEST(RecordingTest, ScriptMetricsAreRecordedOnceEach) {
+  for (const bool taken_every_step : {true, false}) {
+    const fs::path out = TempDir(taken_every_step ? "script_metrics_taken" : "script_metrics");
+    Loaded l;
+    RegisterBuiltinModules(&l.registry);
+    LoadOptions options;
+    options.threads = 2;
+    l.loaded =
+        LoadWorld(std::string(SWARMSIM_SOURCE_DIR) + "/worlds/milling.yaml", options, l.registry);
+    l.loaded.world->set_log_sink([](std::string_view) {});
+    RecordSettings settings;
+    settings.out_dir = out;
+    settings.world_file = "worlds/milling.yaml";
+    l.recorder = AddRecorder(l.loaded.world.get(), settings);
+    World& world = *l.loaded.world;
+    std::vector<MetricSample> run;
+    world.Start();
+    for (int i = 0; i < 12; ++i) {
+      world.Step();
+      if (taken_every_step)
+        for (MetricSample& m : world.TakeMetrics()) run.push_back(std::move(m));
+    }
+    l.recorder->Finish(12, "ok", "");
+    if (!taken_every_step) run = world.TakeMetrics();
+
+    std::multiset<std::tuple<std::string, int, int64_t, double>> expected, recorded;
+    for (const MetricSample& m : run) expected.emplace(m.name, m.instance, m.step, m.value);
+    RecordingPlayer player(out);
+    while (player.Next())
+      for (const auto& s : player.samples())
+        recorded.emplace(std::string(s.name), s.robot, s.step, s.value);
+    EXPECT_EQ(recorded, expected) << "taken every step: " << taken_every_step;
+    // Each robot's script recorded `milled` in every one of the 12 steps.
+    size_t milled = 0;
+    for (const auto& [name, robot, step, value] : recorded)
+      milled += name == "milled" && robot >= 0;
+    EXPECT_EQ(milled, 4u * 12u) << "taken every step: " << taken_every_step;
+  }
 }
 
 TEST(RecordingTest, PosesAndMetricsReadBackAsTheRunHadThem) {

@@ -161,9 +161,10 @@ TEST_F(ViewerBrowserTest, ClickingARobotShowsItsName) {
   const std::string info = browser.Run("return document.getElementById('info').textContent;");
   EXPECT_NE(info.find("model mover"), std::string::npos) << info;
   EXPECT_NE(info.find("speed1"), std::string::npos) << info;
-  // The world's metric is there to plot.
+  // The world's metric and the one the movers' script records (x) are there
+  // to plot.
   EXPECT_EQ(browser.Run("return swarmsimViewer.metricNames();"),
-            json::array({"mean_nearest_neighbor_distance"}));
+            json::array({"mean_nearest_neighbor_distance", "x"}));
   EXPECT_EQ(browser.ConsoleErrors(), std::vector<std::string>{});
 }
 
