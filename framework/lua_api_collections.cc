@@ -27,7 +27,7 @@ constexpr size_t kMaxScriptCollections = 10000;
 std::vector<CollectionRow>& ScriptCollections(lua_State* L) {
   RobotRuntime* runtime = Context(L).runtime;
   if (runtime == nullptr) throw Error("no robot to hold the collection");
-  return runtime->collections;
+  return runtime->collections.get();
 }
 
 CollectionRow& ScriptCollection(lua_State* L, lua_Integer handle) {

@@ -37,7 +37,7 @@ int CheckRobotRoot(const Scene& scene, ObjectId id) {
 
 // Queues `edit` for the caller's state, up to kMaxModelEditsPerStep a step.
 void Queue(lua_State* L, const ModelEdit& edit) {
-  std::vector<ModelEdit>& queued = Context(L).runtime->model_edits;
+  std::vector<ModelEdit>& queued = Context(L).runtime->model_edits.get();
   if (queued.size() >= kMaxModelEditsPerStep)
     throw Error("more than " + std::to_string(kMaxModelEditsPerStep) +
                 " robot copies and removals queued in one step by these scripts");

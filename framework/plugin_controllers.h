@@ -39,6 +39,9 @@ class PluginControllers {
   // them), so that its random_uniform draws are the ones sim.random would
   // have given and a controller ported from Lua gives the same results.
   void Assign(int robot, const PluginControllerType* type, bool in_place_of_scripts);
+  // Room for `robots` robots (World::ReserveRobots): assigned one by one,
+  // they then leave no slack.
+  void Reserve(size_t robots) { robots_.reserve(robots); }
   // The controller of `robot`, or null.
   const PluginControllerType* type_of(int robot) const {
     return robot >= 0 && robot < static_cast<int>(robots_.size()) ? robots_[robot].type : nullptr;

@@ -622,6 +622,7 @@ void World::SetNativeController(int robot, const PluginControllerType* type,
                                 bool in_place_of_scripts) {
   if (started_) throw Error("native controllers are attached before the world starts");
   if (!controllers_) controllers_ = std::make_unique<PluginControllers>(this);
+  controllers_->Reserve(runtimes_.capacity());  // as many as ReserveRobots said
   controllers_->Assign(robot, type, in_place_of_scripts);
 }
 

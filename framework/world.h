@@ -3,7 +3,10 @@
 // caller; one process can hold many.
 #pragma once
 
+#include <sched.h>
+
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <deque>
 #include <filesystem>
@@ -17,6 +20,7 @@
 
 #include "framework/collections.h"
 #include "framework/dependent_joints.h"
+#include "framework/lazy_vector.h"
 #include "framework/messaging.h"
 #include "framework/module.h"
 #include "framework/parameters.h"
@@ -126,7 +130,7 @@ struct DeferredWrite {
 // watchdog may drain it from its own thread when a step never ends, so that
 // what was printed before is not lost. Hence the lock (never contended
 // outside that case).
-class LogBuffer {
+class LogBuffer {  // 16 bytes: one per robot
  public:
   LogBuffer() = default;
   LogBuffer(LogBuffer&& other) noexcept : lines_(std::move(other.lines_)) {}
@@ -152,8 +156,19 @@ class LogBuffer {
   }
 
  private:
-  mutable std::mutex mutex_;
-  std::vector<std::string> lines_;
+  // A one-byte lock: uncontended but for the watchdog's drain.
+  class SpinLock {
+   public:
+    void lock() {
+      while (flag_.test_and_set(std::memory_order_acquire)) sched_yield();
+    }
+    void unlock() { flag_.clear(std::memory_order_release); }
+
+   private:
+    std::atomic_flag flag_ = ATOMIC_FLAG_INIT;
+  };
+  mutable SpinLock mutex_;
+  LazyVector<std::string> lines_;
 };
 
 // A copy or removal of a robot asked for by a script (sim.copyModel,
@@ -176,19 +191,20 @@ inline constexpr size_t kMaxModelEditsPerStep = 1000;
 
 struct RobotRuntime {
   Rng rng;
-  SharedParameters parameters;          // the instance's model parameters
-  LogBuffer log;                        // lines printed during the phase
-  std::vector<MetricSample> metrics;    // samples recorded this step
-  std::vector<DeferredWrite> deferred;  // writes to other robots' objects
-  std::vector<ModelEdit> model_edits;   // copies and removals of robots, call order
-  std::string error;                    // a script error in this phase
+  SharedParameters parameters;        // the instance's model parameters
+  LogBuffer log;                      // lines printed during the phase
+  std::vector<MetricSample> metrics;  // samples recorded this step
+  // The lists most robots never fill take 8 bytes until used (lazy_vector.h).
+  LazyVector<DeferredWrite> deferred;  // writes to other robots' objects
+  LazyVector<ModelEdit> model_edits;   // copies and removals of robots, call order
+  std::string error;                   // a script error in this phase
   // Bytes of `log` and `metrics` charged to the robot's ScriptMemory,
   // released when the world takes them; bytes printed in step print_step.
   uint64_t log_bytes = 0, metric_bytes = 0;
   uint64_t printed_bytes = 0;
   int64_t print_step = -1;
-  std::vector<std::string> disabled;       // scripts disabled this phase (disable_script), why
-  std::vector<CollectionRow> collections;  // the scripts' own (sim.createCollection)
+  LazyVector<std::string> disabled;       // scripts disabled this phase (disable_script), why
+  LazyVector<CollectionRow> collections;  // the scripts' own (sim.createCollection)
   // Bytes charged to the robot's ScriptMemory for its lifetime: its
   // collections and the objects its scripts made (sim.createPath), released
   // when it is removed.

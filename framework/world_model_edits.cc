@@ -35,7 +35,7 @@ void World::ApplyModelEdits() {
   for (size_t r = 0; r < runtimes_.size(); ++r) {
     if (!(pending_[r] & kPendingModelEdits)) continue;
     pending_[r] &= ~kPendingModelEdits;
-    std::vector<ModelEdit>& queued = runtimes_[r].model_edits;
+    std::vector<ModelEdit>& queued = runtimes_[r].model_edits.get();
     edits.insert(edits.end(), queued.begin(), queued.end());
     queued.clear();
   }
