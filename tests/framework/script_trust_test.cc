@@ -67,6 +67,27 @@ class TrustTest : public ::testing::Test {
     if (!code.empty()) scene.AttachScript(body, Source("scripts/robot.lua", code));
     return body;
   }
+  // Runs each call (script code with `block`, a 100 kB string, in scope) in
+  // a robot's sysCall_actuation under a 4 MiB script_memory_mb: each must
+  // fail on line 3 with its message and the setting named, and the robot's
+  // account stay within the limit (its data and Lua heap, or its data).
+  void ExpectEachRefusedPastTheLimit(const std::vector<std::pair<std::string, std::string>>& calls,
+                                     bool lua_heap_too) {
+    for (const auto& [call, message] : calls) {
+      SCOPED_TRACE(call);
+      const std::string error =
+          Run("local block = ('x'):rep(100000)\n"
+              "function sysCall_actuation()\n"
+              "  " +
+              call + "\nend\n");
+      EXPECT_CONTAINS(error, "bot#0: scripts/robot.lua:3: " + message);
+      EXPECT_CONTAINS(error, "of data the sim.* calls keep for them");
+      EXPECT_CONTAINS(error, "simulation.script_memory_mb");
+      const ScriptMemory& account = world_->script_memory(0);
+      EXPECT_LE(lua_heap_too ? account.used() : account.data(), uint64_t{4} << 20);
+    }
+  }
+
   // One robot running `code` for `steps` steps; the error, or "".
   std::string Run(const std::string& code, int steps = 1) {
     MakeWorld();
@@ -288,20 +309,7 @@ TEST_F(TrustTest, DataTheSimCallsKeepCountsAgainstTheRobotsMemoryLimit) {
       {"for i = 1, 80000 do sim.recordMetric(('m'):rep(200), i) end",
        "sim.recordMetric: the metric sample would take the scripts past 4 MiB"},
   };
-  for (const auto& [call, message] : calls) {
-    SCOPED_TRACE(call);
-    const std::string error =
-        Run("local block = ('x'):rep(100000)\n"
-            "function sysCall_actuation()\n"
-            "  " +
-            call +
-            "\n"
-            "end\n");
-    EXPECT_CONTAINS(error, "bot#0: scripts/robot.lua:3: " + message);
-    EXPECT_CONTAINS(error, "of data the sim.* calls keep for them");
-    EXPECT_CONTAINS(error, "simulation.script_memory_mb");
-    EXPECT_LE(world_->script_memory(0).used(), uint64_t{4} << 20);
-  }
+  ExpectEachRefusedPastTheLimit(calls, /*lua_heap_too=*/true);
 }
 
 // The same for what a call holds for the robot's lifetime (collections)
@@ -319,20 +327,7 @@ TEST_F(TrustTest, CollectionsAndPackedStringsCountAgainstTheRobotsMemoryLimit) {
       {"local t = {} for i = 1, 200 do t[i] = block end sim.packTable(t)",
        "sim.packTable: the packed table would take the scripts past 4 MiB"},
   };
-  for (const auto& [call, message] : calls) {
-    SCOPED_TRACE(call);
-    const std::string error =
-        Run("local block = ('x'):rep(100000)\n"
-            "function sysCall_actuation()\n"
-            "  " +
-            call +
-            "\n"
-            "end\n");
-    EXPECT_CONTAINS(error, "bot#0: scripts/robot.lua:3: " + message);
-    EXPECT_CONTAINS(error, "of data the sim.* calls keep for them");
-    EXPECT_CONTAINS(error, "simulation.script_memory_mb");
-    EXPECT_LE(world_->script_memory(0).data(), uint64_t{4} << 20);
-  }
+  ExpectEachRefusedPastTheLimit(calls, /*lua_heap_too=*/false);
 }
 
 // A packed string is charged while the call builds it and released when it
