@@ -90,41 +90,53 @@ struct ThreadCache {
   char* bump = nullptr;  // the current slab's unused rest
   char* bump_end = nullptr;
 
-  ~ThreadCache() {
+  ~ThreadCache();
+
+  void* Carve(size_t c);
+};
+// Set when the thread's cache is gone (thread exit, or the main thread's
+// static destruction): later calls on that thread go to the shared lists.
+thread_local bool cache_gone = false;
+thread_local ThreadCache cache;
+
+ThreadCache::~ThreadCache() {
+  {
     // A finished thread's blocks go to the shared lists (the rest of its
     // slab is lost: at most 64 KiB per thread).
     Shared& shared = SharedLists();
     const std::lock_guard<std::mutex> lock(shared.mutex);
     for (size_t c = 0; c < kClasses; ++c) lists[c].MoveTo(&shared.lists[c], lists[c].count);
   }
+  cache_gone = true;
+}
 
-  void* Carve(size_t c) {
-    const size_t bytes = BytesOf(c);
-    if (static_cast<size_t>(bump_end - bump) < bytes) {
-      // The rest of the old slab becomes free blocks of the biggest class
-      // that fits, then a new slab.
-      while (static_cast<size_t>(bump_end - bump) >= 8) {
-        const size_t fit = FitClass(static_cast<size_t>(bump_end - bump));
-        lists[fit].Push(bump);
-        bump += BytesOf(fit);
-      }
-      char* slab = static_cast<char*>(std::malloc(kSlabBytes));
-      if (slab == nullptr) return nullptr;
-      slab_bytes.fetch_add(kSlabBytes, std::memory_order_relaxed);
-      bump = slab;
-      bump_end = slab + kSlabBytes;
+void* ThreadCache::Carve(size_t c) {
+  const size_t bytes = BytesOf(c);
+  if (static_cast<size_t>(bump_end - bump) < bytes) {
+    // The rest of the old slab becomes free blocks of the biggest class
+    // that fits, then a new slab.
+    while (static_cast<size_t>(bump_end - bump) >= 8) {
+      const size_t fit = FitClass(static_cast<size_t>(bump_end - bump));
+      lists[fit].Push(bump);
+      bump += BytesOf(fit);
     }
-    void* block = bump;
-    bump += bytes;
-    return block;
+    char* slab = static_cast<char*>(std::malloc(kSlabBytes));
+    if (slab == nullptr) return nullptr;
+    slab_bytes.fetch_add(kSlabBytes, std::memory_order_relaxed);
+    bump = slab;
+    bump_end = slab + kSlabBytes;
   }
-};
-thread_local ThreadCache cache;
+  void* block = bump;
+  bump += bytes;
+  return block;
+}
 
 }  // namespace
 
 void* Allocate(size_t size) {
-  if (!kPooled || size > kMaxSmallBlock) return std::malloc(size);
+  // (With the thread's cache gone, malloc's: a block is any memory of its
+  // size, and Free then keeps it in the shared lists.)
+  if (!kPooled || size > kMaxSmallBlock || cache_gone) return std::malloc(size);
   const size_t c = ClassOf(size);
   FreeList& list = cache.lists[c];
   if (list.count == 0) {
@@ -141,6 +153,12 @@ void Free(void* block, size_t size) {
   if (block == nullptr) return;
   if (!kPooled || size > kMaxSmallBlock) {
     std::free(block);
+    return;
+  }
+  if (cache_gone) {
+    Shared& shared = SharedLists();
+    const std::lock_guard<std::mutex> lock(shared.mutex);
+    shared.lists[ClassOf(size)].Push(block);
     return;
   }
   FreeList& list = cache.lists[ClassOf(size)];
