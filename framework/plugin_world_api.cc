@@ -7,10 +7,8 @@
 #include "framework/plugin_controllers.h"
 #include "framework/plugin_object_type.h"
 #include "framework/plugin_sensors.h"
+#include "framework/proximity_readings.h"
 #include "framework/world.h"
-// The readings, through the module's public header (inline lookups by the
-// type's name: nothing of the module is linked).
-#include "modules/proximity/proximity_sensor.h"
 
 namespace swarmsim {
 namespace {
@@ -60,12 +58,9 @@ int64_t RobotRoot(void* world, int robot) {
 }
 
 int ReadProximitySensor(void* world, int64_t sensor, double* distance) {
-  const ProximitySensorData* p =
-      proximity::FindSensor(W(world).scene(), ObjectId::FromInteger(sensor));
-  if (p == nullptr) return -1;
-  if (!p->detected) return 0;
-  *distance = p->distance;
-  return 1;
+  const ProximityReadings* readings = W(world).proximity_readings();
+  if (readings == nullptr) return -1;
+  return readings->Read(W(world).scene(), ObjectId::FromInteger(sensor), distance);
 }
 
 int SetJointTargetVelocity(void* world, int robot, int64_t joint, double velocity) {
@@ -116,17 +111,21 @@ int RecordMetric(void* world, int robot, const char* name, double value) {
 
 int ReadProximitySensors(void* world, const int64_t* sensors, int count, double* distances) {
   const Scene& scene = W(world).scene();
+  const ProximityReadings* readings = W(world).proximity_readings();
   int detected = 0;
   bool all_sensors = true;
   for (int i = 0; i < count; ++i) {
-    const ProximitySensorData* p = proximity::FindSensor(scene, ObjectId::FromInteger(sensors[i]));
+    double distance = 0;
+    const int read = readings != nullptr
+                         ? readings->Read(scene, ObjectId::FromInteger(sensors[i]), &distance)
+                         : -1;
     distances[i] = -1;
-    if (p == nullptr) {
+    if (read < 0) {
       all_sensors = false;
       continue;
     }
-    if (!p->detected) continue;
-    distances[i] = p->distance;
+    if (read == 0) continue;
+    distances[i] = distance;
     ++detected;
   }
   return all_sensors ? detected : -1;

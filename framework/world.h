@@ -41,6 +41,7 @@ class PluginControllers;
 struct PluginControllerType;
 struct PluginSensorType;
 class LineOfSight;
+class ProximityReadings;
 class TaskScheduler;
 class World;
 
@@ -337,6 +338,11 @@ class World : public PhaseHandlers {
   // a module when it starts (proximity); null: nothing blocks.
   const LineOfSight* line_of_sight() const { return line_of_sight_; }
   void set_line_of_sight(const LineOfSight* service) { line_of_sight_ = service; }
+  // What proximity sensors read (framework/proximity_readings.h: the
+  // plugins' C API). Provided by a module when it starts (proximity); null:
+  // no object is a proximity sensor.
+  const ProximityReadings* proximity_readings() const { return proximity_readings_; }
+  void set_proximity_readings(const ProximityReadings* service) { proximity_readings_ = service; }
   ScriptHost* scripts() { return scripts_.get(); }
   // The floor image a module keeps (framework/floor_layer.h: the paint
   // layer), or null; its provider sets it and outlives the world's use of it.
@@ -432,7 +438,8 @@ class World : public PhaseHandlers {
   ParameterSet parameters_;
   std::unique_ptr<TaskScheduler> scheduler_;
   std::unique_ptr<DynamicsBackend> dynamics_;
-  const LineOfSight* line_of_sight_ = nullptr;  // owned by the module that provides it
+  const LineOfSight* line_of_sight_ = nullptr;             // owned by the module that provides it
+  const ProximityReadings* proximity_readings_ = nullptr;  // the same
   std::unique_ptr<ScriptHost> scripts_;
   const FloorLayer* floor_layer_ = nullptr;         // owned by its module
   std::unique_ptr<PluginControllers> controllers_;  // null: no robot has a native controller

@@ -1,6 +1,7 @@
 // The proximity backend (backend.h) as a module: built when the world
 // starts, sensing in the sense phase (framework/module.h), and the world's
-// line of sight (framework/line_of_sight.h) while it runs. Register() adds
+// line of sight (framework/line_of_sight.h) and proximity readings
+// (framework/proximity_readings.h: the plugins' C API) while it runs. Register() adds
 // it and the proximity_sensor type to a registry.
 #include <algorithm>
 #include <memory>
@@ -9,6 +10,7 @@
 
 #include "framework/collections.h"
 #include "framework/object_type.h"
+#include "framework/proximity_readings.h"
 #include "framework/registry.h"
 #include "framework/scheduler.h"
 #include "framework/world.h"
@@ -24,7 +26,7 @@ std::string DetectableWhat(const Scene& scene, ObjectId sensor, const std::strin
          " ('detectable')";
 }
 
-class ProximityModule final : public Module {
+class ProximityModule final : public Module, public ProximityReadings {
  public:
   explicit ProximityModule(std::unique_ptr<ProximityBackend> backend)
       : backend_(std::move(backend)) {}
@@ -35,7 +37,16 @@ class ProximityModule final : public Module {
     backend_->Build(world->scene(), settings_);
     environment_version_ = world->scene().environment_version();
     world->set_line_of_sight(backend_.get());
+    world->set_proximity_readings(this);
     RefreshDetectable(world->scene());
+  }
+
+  int Read(const Scene& scene, ObjectId id, double* distance) const noexcept override {
+    const ProximitySensorData* p = FindSensor(scene, id);
+    if (p == nullptr) return -1;
+    if (!p->detected) return 0;
+    *distance = p->distance;
+    return 1;
   }
 
   // Every robot's sensors, robots in parallel, then the scene's own sensors.
