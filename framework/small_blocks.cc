@@ -74,10 +74,16 @@ struct FreeList {
 };
 
 // What threads give back and take: one list per class, under one mutex
-// (taken once per kMaxCached / 2 frees or carves of a class at most).
+// (taken once per kMaxCached / 2 frees of a class, and by a thread that
+// runs out of a class only when the shared list has some).
 struct Shared {
   std::mutex mutex;
   FreeList lists[kClasses];
+  // Each list's length, readable without the mutex: a thread whose own list
+  // is empty looks here before it locks (most times there is nothing).
+  std::atomic<size_t> available[kClasses] = {};
+
+  void Published(size_t c) { available[c].store(lists[c].count, std::memory_order_relaxed); }
 };
 Shared& SharedLists() {
   static Shared* shared = new Shared;  // never destroyed: threads may outlive statics
@@ -105,7 +111,10 @@ ThreadCache::~ThreadCache() {
     // slab is lost: at most 64 KiB per thread).
     Shared& shared = SharedLists();
     const std::lock_guard<std::mutex> lock(shared.mutex);
-    for (size_t c = 0; c < kClasses; ++c) lists[c].MoveTo(&shared.lists[c], lists[c].count);
+    for (size_t c = 0; c < kClasses; ++c) {
+      lists[c].MoveTo(&shared.lists[c], lists[c].count);
+      shared.Published(c);
+    }
   }
   cache_gone = true;
 }
@@ -141,9 +150,12 @@ void* Allocate(size_t size) {
   FreeList& list = cache.lists[c];
   if (list.count == 0) {
     Shared& shared = SharedLists();
-    const std::lock_guard<std::mutex> lock(shared.mutex);
-    FreeList& from = shared.lists[c];
-    from.MoveTo(&list, std::min(from.count, kMaxCached / 2));
+    if (shared.available[c].load(std::memory_order_relaxed) > 0) {
+      const std::lock_guard<std::mutex> lock(shared.mutex);
+      FreeList& from = shared.lists[c];
+      from.MoveTo(&list, std::min(from.count, kMaxCached / 2));
+      shared.Published(c);
+    }
   }
   if (list.count > 0) return list.Pop();
   return cache.Carve(c);
@@ -159,6 +171,7 @@ void Free(void* block, size_t size) {
     Shared& shared = SharedLists();
     const std::lock_guard<std::mutex> lock(shared.mutex);
     shared.lists[ClassOf(size)].Push(block);
+    shared.Published(ClassOf(size));
     return;
   }
   FreeList& list = cache.lists[ClassOf(size)];
@@ -167,6 +180,7 @@ void Free(void* block, size_t size) {
     Shared& shared = SharedLists();
     const std::lock_guard<std::mutex> lock(shared.mutex);
     list.MoveTo(&shared.lists[ClassOf(size)], kMaxCached / 2);
+    shared.Published(ClassOf(size));
   }
 }
 
