@@ -21,6 +21,7 @@
 #include "modules/rendering/filters/filters.h"
 #include "tests/framework/error_of.h"
 #include "tests/modules/rendering/filters/filter_list_reader.h"
+#include "tests/modules/rendering/filters/test_images.h"
 
 namespace swarmsim::filters {
 namespace {
@@ -34,16 +35,7 @@ FilterChain Chain(std::vector<FilterItem> items, const ModuleRegistry* registry 
   return ParseFilterChain(FilterListReader(std::move(items), registry), "filters", registry);
 }
 
-Image Filled(int w, int h, uint8_t r, uint8_t g, uint8_t b) {
-  Image image;
-  image.Resize(w, h);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      uint8_t* p = image.Pixel(x, y);
-      p[0] = r, p[1] = g, p[2] = b;
-    }
-  return image;
-}
+using swarmsim::testing::Filled;
 
 TEST(VisionFiltersTest, HsvThresholdPicksThePixelsInItsRanges) {
   // One pixel per colour: which hsv_threshold keeps (green hue, saturated, bright).
