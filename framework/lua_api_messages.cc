@@ -184,19 +184,16 @@ int GetSignal(lua_State* L) {
 // --- Packing ---------------------------------------------------------------------------
 
 // The packed string is charged to the robot while the call builds it
-// (CallCharge) and pushed in protected mode (PushBytes): a table whose
-// length is a border far past its entries ({[1] = 1, [2^40] = 1} may have
-// #t = 2^40) is refused before anything is allocated for it.
+// (CallCharge: as it grows) and pushed in protected mode (PushBytes). It
+// grows element by element, never sized from #t: a table whose length is a
+// border far past its entries ({[1] = 1, [2^40] = 1} may have #t = 2^40)
+// fails at its first missing element, whatever the memory limits.
 template <typename T>
 int PackArray(lua_State* L) {
   ArgType(L, 1, LUA_TTABLE);
   const lua_Integer n = static_cast<lua_Integer>(lua_rawlen(L, 1));
-  const uint64_t bytes = static_cast<uint64_t>(n) <= (uint64_t{1} << 48)
-                             ? static_cast<uint64_t>(n) * sizeof(T)
-                             : UINT64_MAX;  // refused (a string's size cannot be that)
   CallCharge charge(L, "the packed string");
-  charge.Hold(bytes);
-  std::string out(bytes, '\0');
+  std::string out;
   for (lua_Integer i = 1; i <= n; ++i) {
     lua_rawgeti(L, 1, i);
     T v;
@@ -212,7 +209,8 @@ int PackArray(lua_State* L) {
       if (!ok) throw Error("element " + std::to_string(i) + " is not a number");
     }
     lua_pop(L, 1);
-    std::memcpy(out.data() + (i - 1) * sizeof(T), &v, sizeof(T));
+    charge.Hold(out.size() + sizeof(T));
+    out.append(reinterpret_cast<const char*>(&v), sizeof(T));
   }
   PushBytes(L, out);
   return 1;

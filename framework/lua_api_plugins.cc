@@ -58,16 +58,18 @@ int CallPluginCommand(lua_State* L) {
       case LUA_TBOOLEAN: v.type = kSwarmsimNumber, v.number = lua_toboolean(L, i); break;
       case LUA_TSTRING: v.type = kSwarmsimString, v.text = lua_tolstring(L, i, &v.size); break;
       case LUA_TTABLE: {
+        // Element by element, never sized from #t (a border may lie far
+        // past the entries): a missing element ends it at once.
         const uint64_t length = lua_rawlen(L, i);
-        copied = length <= (uint64_t{1} << 48) ? copied + length * sizeof(double) : UINT64_MAX;
-        charge.Hold(copied);
-        std::vector<double>& a = arrays.emplace_back(lua_rawlen(L, i));
-        for (size_t k = 0; k < a.size(); ++k) {
+        std::vector<double>& a = arrays.emplace_back();
+        for (uint64_t k = 0; k < length; ++k) {
           lua_rawgeti(L, i, static_cast<lua_Integer>(k + 1));
           if (!lua_isnumber(L, -1))
             RaiseError(L, "sim." + command->name + ": argument " + std::to_string(i) +
                               " must be an array of numbers");
-          a[k] = lua_tonumber(L, -1);
+          copied += sizeof(double);
+          charge.Hold(copied);
+          a.push_back(lua_tonumber(L, -1));
           lua_pop(L, 1);
         }
         v.type = kSwarmsimNumbers, v.numbers = a.data(), v.size = a.size();

@@ -82,7 +82,7 @@ class ScriptMemory {  // 48 bytes
   // Charges `bytes`: kOk, or (nothing charged) kPastLimit if the robot's
   // scripts would hold more than their limit, kPastRunLimit if the run's.
   Result Charge(uint64_t bytes) {
-    if (limit_ > 0 && (used_ + bytes > limit_ || used_ + bytes < used_)) return kPastLimit;
+    if (used_ + bytes < used_ || (limit_ > 0 && used_ + bytes > limit_)) return kPastLimit;
     if (!GrowHeap(bytes)) return kPastRunLimit;
     data_ += bytes;
     return kOk;

@@ -332,8 +332,8 @@ TEST_F(TrustTest, CollectionsAndPackedStringsCountAgainstTheRobotsMemoryLimit) {
 
 // A packed string is charged while the call builds it and released when it
 // returns: a table whose length is a border far past its entries (#t is
-// 2^40 here) is refused before anything is allocated for it, and modest
-// packing goes on step after step.
+// 2^40 here) fails at its first missing element, nothing sized from #t, and
+// modest packing goes on step after step.
 TEST_F(TrustTest, PackingIsChargedWhileTheCallRuns) {
   settings_.script_memory_limit = 8 << 20;
   // A constructor sizes the hash part for all 41 keys: no rehash moves 1, 2
@@ -341,14 +341,21 @@ TEST_F(TrustTest, PackingIsChargedWhileTheCallRuns) {
   std::string sparse = "local t = {";
   for (int k = 0; k <= 40; ++k) sparse += "[1 << " + std::to_string(k) + "] = 1, ";
   sparse += "}\nassert(#t == 1 << 40)\n";
-  for (const std::string pack : {"sim.packFloats(t)", "sim.packDoubles(t)", "sim.packInt32s(t)"}) {
-    SCOPED_TRACE(pack);
-    const std::string error = Run(sparse + "function sysCall_actuation()\n  " + pack + "\nend\n");
-    EXPECT_CONTAINS(error, "bot#0: scripts/robot.lua:4: sim.pack");
-    EXPECT_CONTAINS(error, ": the packed string would take the scripts past 8 MiB");
-    EXPECT_CONTAINS(error, "simulation.script_memory_mb");
-    EXPECT_EQ(world_->script_memory(0).data(), 0u) << "the call's charge is released";
+  // The packing grows element by element: it stops at t[3], the first
+  // missing one, with or without memory limits (without, sizing from #t
+  // would try 8 TB).
+  for (const uint64_t limit : {uint64_t{8} << 20, uint64_t{0}}) {
+    settings_.script_memory_limit = static_cast<int64_t>(limit);
+    for (const std::string pack :
+         {"sim.packFloats(t)", "sim.packDoubles(t)", "sim.packInt32s(t)"}) {
+      SCOPED_TRACE(pack + " with a limit of " + std::to_string(limit));
+      const std::string error = Run(sparse + "function sysCall_actuation()\n  " + pack + "\nend\n");
+      EXPECT_CONTAINS(error, "bot#0: scripts/robot.lua:4: sim.pack");
+      EXPECT_CONTAINS(error, ": element 3 is not a ");
+      EXPECT_EQ(world_->script_memory(0).data(), 0u) << "the call's charge is released";
+    }
   }
+  settings_.script_memory_limit = 8 << 20;
   // pcall around a refused packTable: the charge goes back each time.
   EXPECT_EQ(Run("local big = {} for i = 1, 40 do big[i] = ('x'):rep(1e5) .. i end\n"
                 "local t = {} for i = 1, 1000 do t[i] = {i, 'n' .. i, i / 3, true} end\n"
