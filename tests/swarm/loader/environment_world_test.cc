@@ -5,6 +5,7 @@
 // key's own checks and bad map files: environment_test.cc.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -77,6 +78,8 @@ TEST(EnvironmentWorldTest, TheCorridorWorldPlacesAndKeepsRobotsInFreeSpace) {
   ASSERT_NE(octomap, nullptr);
   ASSERT_TRUE(octomap->occupied_plane);
   const EnvironmentPlaneGrid walls = octomap->occupied_plane(*scene.environment(), 1e-3, 0.145);
+  // The corridor's walls are there (an empty answer would pass every check below).
+  ASSERT_GT(std::count(walls.occupied.begin(), walls.occupied.end(), 1), 1000);
   auto check = [&](double keep, const char* when) {
     for (const ModelInstance& robot : scene.instances()) {
       const Vec3 p = scene.world_pose(robot.root).p;
