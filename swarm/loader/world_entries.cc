@@ -63,9 +63,7 @@ void CollectScripts(const ObjectSpec& spec, const std::string& path,
 // Scaled mesh assets of one entry, by the asset they scale.
 using ScaledMeshes = std::map<const TriangleMesh*, std::shared_ptr<const TriangleMesh>>;
 
-// Points the mesh shapes of the copy at `id` (built from `spec`, then scaled)
-// at the assets an earlier copy of the entry was scaled to, so that copies
-// built from their own description share them as duplicates do.
+// The paths of the objects below `spec` ("a", "a/b", ...), in model order.
 void CollectPaths(const ObjectSpec& spec, const std::string& prefix,
                   std::vector<std::string>* out) {
   for (const ObjectSpec& child : spec.children) {
@@ -92,6 +90,9 @@ void ApplyModelSections(const ModuleRegistry& registry,
     }
 }
 
+// Points the mesh shapes of the copy at `id` (built from `spec`, then scaled)
+// at the assets an earlier copy of the entry was scaled to, so that copies
+// built from their own description share them as duplicates do.
 void ShareScaledMeshes(const ObjectSpec& spec, ObjectId id, Scene* scene, ScaledMeshes* scaled) {
   const ShapeData* shape = spec.AsShape();
   if (shape != nullptr && shape->mesh) {
@@ -519,9 +520,18 @@ void WorldLoader::ReadSinglePosition(const Fields& f, const ValueReader& world_v
 // top, less 1 mm at either end: a floor whose top is at z = 0 is not one),
 // projected to the plane by the map's format (its occupied_plane query):
 // placement keeps copies clear of them.
-void WorldLoader::KeepPlacementClearOfTheMap() {
+void WorldLoader::KeepPlacementClearOfTheMap(std::vector<std::string>* warnings) {
   if (!environment_ || entries_.empty()) return;
-  if (!environment_format_ || !environment_format_->occupied_plane) return;
+  if (!environment_format_ || !environment_format_->occupied_plane) {
+    // A format that cannot say which cells it fills: robots are placed as
+    // if it were not there, which the user is told.
+    warnings->push_back(
+        "the environment map's format" +
+        std::string(environment_format_ ? " '" + environment_format_->key + "'" : std::string()) +
+        " cannot list its occupied cells: placement does not keep robots clear "
+        "of the map");
+    return;
+  }
   double height = 0;
   for (const EntryPlan& e : entries_) {
     height = std::max(height, e.footprint.top - e.footprint.bottom);

@@ -119,7 +119,7 @@ LoadedWorld WorldLoader::Load() {
                                          world->registry(), &out.warnings, &environment_format_);
   if (environment_) world->scene().set_environment(environment_);
   for (EntryPlan& entry : entries_) ResolveEntry(&entry);
-  KeepPlacementClearOfTheMap();
+  KeepPlacementClearOfTheMap(&out.warnings);
   PlaceEntries();
   BuildCopies(world);
   // The scene's own objects (collections, distance objects, ...), after the

@@ -171,7 +171,7 @@ class WorldLoader {
   void ResolveNativeController(const Fields& f, const ValueReader& world_values, EntryPlan* entry);
   void ReadDistribution(const Fields& f, const ValueReader& world_values, EntryPlan* entry);
   void ReadSinglePosition(const Fields& f, const ValueReader& world_values, EntryPlan* entry);
-  void KeepPlacementClearOfTheMap();
+  void KeepPlacementClearOfTheMap(std::vector<std::string>* warnings);
   void PlaceEntries();
   void BuildCopies(World* world);
   std::vector<ModelSummary> Summarize() const;

@@ -156,6 +156,21 @@ TEST(EnvironmentFormatTest, ARegisteredFormatIsReadThroughTheLoader) {
   // The octomap format's keys are not this one's.
   std::ofstream(dir / "world.yaml") << "environment: {one_box: a.box, z_range: [0, 1]}\n";
   EXPECT_CONTAINS(ErrorOf([&] { LoadWorld(dir / "world.yaml", {}, registry); }), "z_range");
+  // This format cannot list its occupied cells (no occupied_plane): robots
+  // placed beside its map are placed as if it were not there, and the user
+  // is told so.
+  std::ofstream(dir / "world.yaml") << "simulation: {physics: kinematic}\n"
+                                       "arena: {size: 4}\n"
+                                       "environment: {one_box: anything.box}\n"
+                                       "models:\n"
+                                       "  - {model: " SWARMSIM_SOURCE_DIR
+                                       "/worlds/models/footbot.yaml, count: 2,\n"
+                                       "     distribute: {region: arena, clearance: 0.05}}\n";
+  const LoadedWorld placed = LoadWorld(dir / "world.yaml", {}, registry);
+  ASSERT_EQ(placed.warnings.size(), 1u);
+  EXPECT_CONTAINS(placed.warnings[0],
+                  "format 'one_box' cannot list its occupied cells: placement does not keep "
+                  "robots clear of the map");
   fs::remove_all(dir);
 }
 
