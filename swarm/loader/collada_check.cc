@@ -102,6 +102,18 @@ class ColladaCheck {
   [[noreturn]] void Fail(const XMLElement* e, const std::string& message) const {
     loader::Fail(name_, e ? e->GetLineNum() : 0, message);
   }
+  // The text of a list of numbers (<p>, <vcount>, <float_array>). assimp
+  // separates numbers by space, tab, CR, LF and form feed only: at any other
+  // character its integer reader neither advances nor fails, and the <p>
+  // loop appends zeros until memory runs out (1.6 GB for three vertical
+  // tabs), so a vertical tab is refused here.
+  std::string_view NumbersOf(const XMLElement* e) const {
+    const std::string_view text = TextOf(e);
+    if (const size_t at = text.find('\v'); at != std::string_view::npos)
+      Fail(e, "<" + std::string(e->Name()) +
+                  "> separates its numbers with a vertical tab (0x0B); use spaces");
+    return text;
+  }
   uint64_t CountAttribute(const XMLElement* e, const char* key, uint64_t fallback,
                           uint64_t max = 4294967295u) const;
   void Sanitize();
@@ -222,7 +234,7 @@ void ColladaCheck::CheckArrays(const XMLElement* geometries) {
     const char* id = e->Attribute("id");
     const uint64_t count = CountAttribute(e, "count", 0);
     uint64_t seen = 0;
-    ForEachToken(TextOf(e), [&](std::string_view t) {
+    ForEachToken(NumbersOf(e), [&](std::string_view t) {
       if (seen >= count) return false;
       double v;
       if (numbers && !ParseFinite(t, &v))
@@ -375,7 +387,7 @@ double ColladaCheck::CheckPrimitive(const XMLElement* element, Primitive kind,
     } else if (kind_name == "vcount" && count > 0) {
       if (vcount_seen) Fail(e, what + " has a second <vcount>");
       vcount_seen = true;
-      ForEachToken(TextOf(e), [&](std::string_view t) {
+      ForEachToken(NumbersOf(e), [&](std::string_view t) {
         if (vcount.size() >= count) return false;
         uint64_t v = 0;
         if (!ParseUnsigned(t, 1u << 30, &v) || v == 0)
@@ -405,7 +417,7 @@ double ColladaCheck::CheckPrimitive(const XMLElement* element, Primitive kind,
       for (const Input& in : inputs)
         if (in.limit < limit[in.offset]) limit[in.offset] = in.limit, limiting[in.offset] = &in;
       uint64_t tokens = 0;
-      ForEachToken(TextOf(e), [&](std::string_view t) {
+      ForEachToken(NumbersOf(e), [&](std::string_view t) {
         uint64_t index = 0;
         if (!ParseUnsigned(t, 2147483647, &index))
           Fail(e, "<p> index " + Quoted(t) + " is not a non-negative integer");

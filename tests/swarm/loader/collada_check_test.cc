@@ -115,6 +115,23 @@ TEST(MeshCheckTest, ColladaArraysAndAccessorsHoldWhatTheySay) {
             "2,147,483,647");
 }
 
+// assimp reads numbers separated by space, tab, CR, LF and form feed; at a
+// vertical tab its <p> loop appended zeros until 1.6 GB (a fuzz finding,
+// tests/data/fuzz/mesh_dae/crashes/oom-vertical-tab-in-p.dae).
+TEST(MeshCheckTest, ColladaNumbersAreSeparatedAsAssimpReadsThem) {
+  EXPECT_EQ(ColladaError(Cube("<p>0 2 1 0", "<p>0\v2\v1 0")),
+            "part.dae:31"
+                ": <p> separates its numbers with a vertical tab (0x0B); use spaces");
+  EXPECT_EQ(ColladaError(Cube("count=\"24\">-0.5", "count=\"24\">\v-0.5")),
+            "part.dae:21: <float_array> separates its numbers with a vertical tab (0x0B); use "
+            "spaces");
+  EXPECT_EQ(ColladaError(Cube("<p>0 2 1 0", "<p>0\t2\r\n1\f0")), "no error");
+  const fs::path finding =
+      fs::path(SWARMSIM_SOURCE_DIR) / "tests/data/fuzz/mesh_dae/crashes/oom-vertical-tab-in-p.dae";
+  EXPECT_EQ(ColladaError(ReadAll(finding)),
+            "part.dae:7: <p> separates its numbers with a vertical tab (0x0B); use spaces");
+}
+
 TEST(MeshCheckTest, ColladaNodesNeitherCycleNorExplode) {
   EXPECT_EQ(
       ColladaError(Cube("<node id=\"cube\">", "<node id=\"cube\"><instance_node url=\"#cube\"/>")),
