@@ -22,11 +22,11 @@
 #include <string>
 #include <string_view>
 
-#include "framework/number_rule.h"
-#include "framework/object_type.h"
 #include "framework/random.h"
 
 namespace swarmsim {
+
+class ObjectReader;
 
 struct NoiseSettings {  // 24 bytes
   double gaussian = 0;  // std dev
@@ -75,15 +75,8 @@ inline bool Fails(const NoiseSettings& n, Rng& rng) {
 // Reads `<prefix>noise`, `<prefix>noise_uniform` and `<prefix>failure_probability`
 // (prefix "" for a one-reading device; "range_" for a reading among
 // several). `max` bounds the two noise widths (in the reading's units);
-// the probability is 0..1. Keys absent leave *out as it is.
-inline void ReadNoise(const ObjectReader& r, std::string_view prefix, double max,
-                      NoiseSettings* out) {
-  const NumberRule width{"a non-negative number", 0, max};
-  const std::string p(prefix);
-  if (r.Has(p + "noise")) out->gaussian = r.Number(p + "noise", width);
-  if (r.Has(p + "noise_uniform")) out->uniform = r.Number(p + "noise_uniform", width);
-  if (r.Has(p + "failure_probability"))
-    out->failure = r.Number(p + "failure_probability", kFraction);
-}
+// the probability is 0..1. Keys absent leave *out as it is
+// (sensor_noise.cc).
+void ReadNoise(const ObjectReader& r, std::string_view prefix, double max, NoiseSettings* out);
 
 }  // namespace swarmsim
