@@ -30,6 +30,7 @@
 #include "framework/mesh.h"
 #include "framework/name_pool.h"
 #include "framework/object_rows.h"
+#include "framework/sensor_noise.h"
 #include "framework/shared_settings.h"
 
 namespace swarmsim {
@@ -124,6 +125,15 @@ struct JointSettings {
   double max_position = INFINITY;
   double pitch = 0;                                // screw joints: m per rad, finite and nonzero
   std::shared_ptr<const JointDependency> depends;  // null: an independent joint
+  // Actuation noise, velocity mode (a wheel's motor): the speed driven is
+  // target * (1 - slip) * (1 + N(0, velocity_noise_factor)) + noise, and
+  // zero in a step the motor fails (framework/sensor_noise.h; keys
+  // velocity_noise, velocity_noise_uniform, velocity_noise_factor,
+  // velocity_failure_probability, slip). World::Actuate draws it.
+  NoiseSettings velocity_noise;
+  double velocity_noise_factor = 0;
+  double slip = 0;  // 0..1: the fraction of the commanded speed lost
+  bool drive_noisy() const { return velocity_noise.any() || velocity_noise_factor > 0 || slip > 0; }
 };
 
 // A joint moves its children along/about its own z axis (V-REP's convention):
@@ -132,16 +142,20 @@ struct JointSettings {
 // A screw joint turns them by `position` (rad) about z and moves them
 // pitch * position (m) along z.
 //
-// A row is its shared settings and its state (88 bytes): what the actuate
+// A row is its shared settings and its state (96 bytes): what the actuate
 // and physics phases, scripts and IK write. The state hash reads the state.
 struct JointData {
   Shared<JointSettings> settings;  // read: settings->max_force; write: settings.Edit()
   double position = 0;             // rad or m
   double velocity = 0;             // rad/s or m/s
   double target_velocity = 0;      // velocity mode (scripts set it every step)
-  double target_position = 0;      // position mode
-  double target_force = 0;         // N or N m, force mode
-  Quat ball;                       // spherical joints: rotation of the children
+  // The speed driven this step when the joint has actuation noise (set by
+  // World::Actuate; DriveVelocity() reads it): derived from the target and
+  // the step's draws, so not hashed.
+  double drive_velocity = 0;
+  double target_position = 0;  // position mode
+  double target_force = 0;     // N or N m, force mode
+  Quat ball;                   // spherical joints: rotation of the children
   // Set by a dynamics backend that integrates this joint's position and
   // velocity itself; World::Actuate then leaves them alone.
   bool simulated = false;
@@ -153,6 +167,11 @@ struct JointData {
   JointType type() const { return settings->type; }
   JointMode mode() const { return settings->mode; }
   const JointDependency* depends() const { return settings->depends.get(); }  // null: independent
+  // What a velocity-mode motor drives: the target, or with actuation noise
+  // this step's noisy speed. The dynamics backends read this.
+  double DriveVelocity() const {
+    return settings->drive_noisy() ? drive_velocity : target_velocity;
+  }
   Pose Motion() const;  // transform produced by `position` about/along z
   // sim.setJointPosition on a joint nothing simulates: it jumps to q and
   // stays (a position-mode joint's target becomes q, its velocity 0).

@@ -9,6 +9,7 @@
 #include "framework/dependent_joints.h"
 #include "framework/object_type.h"
 #include "framework/scene.h"
+#include "framework/sensor_noise.h"
 #include "framework/state_hash.h"
 #include "framework/types/core_types.h"
 
@@ -37,6 +38,15 @@ constexpr ObjectKey kKeys[] = {
     {"factor", "1", "dependent joints: factor of the master's position"},
     {"offset", "0", "dependent joints: rad or m added"},
     {"ik", "active", "active (IK groups move it) or frozen (IK keeps its value)"},
+    {"velocity_noise", "0",
+     "rad/s or m/s, >= 0, velocity mode: std dev of Gaussian noise on the speed driven"},
+    {"velocity_noise_uniform", "0",
+     "rad/s or m/s, >= 0, velocity mode: half width of uniform noise on the speed driven"},
+    {"velocity_noise_factor", "0",
+     ">= 0, velocity mode: std dev of a Gaussian factor about 1 multiplying the speed driven"},
+    {"velocity_failure_probability", "0",
+     "0..1, velocity mode: chance that the motor drives nothing in a step"},
+    {"slip", "0", "0..1, velocity mode: fraction of the target speed lost (wheel slip)"},
 };
 
 std::unique_ptr<RowTable> MakeRows(const ObjectTypeDescriptor&) {
@@ -51,8 +61,10 @@ void Scale(const ObjectTypeDescriptor&, void* row, double s, ScaleContext*) {
   JointSettings& settings = j.settings.Edit();
   const double s3 = s * s * s, s4 = s3 * s;
   if (settings.type == JointType::kPrismatic) {
-    for (double* v : {&j.position, &j.velocity, &j.target_velocity, &j.target_position,
-                      &settings.max_velocity, &settings.min_position, &settings.max_position})
+    for (double* v :
+         {&j.position, &j.velocity, &j.target_velocity, &j.target_position, &j.drive_velocity,
+          &settings.max_velocity, &settings.min_position, &settings.max_position,
+          &settings.velocity_noise.gaussian, &settings.velocity_noise.uniform})
       *v *= s;
     settings.max_force *= s3;
     j.target_force *= s3;
@@ -139,6 +151,16 @@ void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
     settings.min_position = v[0];
     settings.max_position = v[1];
   }
+  ReadNoise(r, "velocity_", 1e6, &settings.velocity_noise);
+  if (r.Has("velocity_noise_factor"))
+    settings.velocity_noise_factor =
+        r.Number("velocity_noise_factor", {"a number from 0 to 10", 0, 10});
+  if (r.Has("slip")) settings.slip = r.Number("slip", kFraction);
+  if (settings.drive_noisy() && settings.mode != JointMode::kVelocity)
+    for (const char* key : {"velocity_noise", "velocity_noise_uniform", "velocity_noise_factor",
+                            "velocity_failure_probability", "slip"})
+      if (r.Has(key))
+        r.FailAtKey(key, std::string("'") + key + "' is for velocity-mode joints (mode: velocity)");
   if (r.Has("max_force")) settings.max_force = r.Number("max_force", kPositive);
   if (r.Has("max_velocity")) settings.max_velocity = r.Number("max_velocity", kPositive);
   if (r.Has("target_velocity")) j.target_velocity = r.Number("target_velocity", kAnyNumber);

@@ -19,6 +19,7 @@
 #include "framework/math.h"
 #include "framework/object_rows.h"
 #include "framework/scene.h"
+#include "framework/sensor_noise.h"
 
 namespace swarmsim {
 
@@ -33,6 +34,11 @@ struct ForceSensorData {
   double force_threshold = INFINITY;   // N, |F| above it counts as a violation
   double torque_threshold = INFINITY;  // N m, |T| above it counts as a violation
   int break_after = 1;                 // consecutive violating steps that break the link
+  // Noise on what scripts read (sim.readForceSensor), not on the link: per
+  // component of force (N) and torque (N m), and failure (no reading that
+  // step), drawn at read time from the stream of (seed, slot, step)
+  // (framework/sensor_noise.h), so two reads in one step agree.
+  NoiseSettings force_noise, torque_noise;
   // State, written by the dynamics backend in the physics phase.
   bool has_reading = false;  // a backend simulates the link and sampled it
   bool broken = false;       // the link broke: parent and child move apart

@@ -23,6 +23,12 @@ constexpr ObjectKey kKeys[] = {
     {"force_threshold", "none", "N, a step whose (filtered) |F| exceeds it is a violation"},
     {"torque_threshold", "none", "N m, likewise for |T|"},
     {"break_after", "1", "consecutive violating steps that break the link, 1..1000000"},
+    {"noise", "0", "N, >= 0: std dev of Gaussian noise on each force component read"},
+    {"noise_uniform", "0", "N, >= 0: half width of uniform noise on each force component read"},
+    {"torque_noise", "0", "N m, >= 0: std dev of Gaussian noise on each torque component read"},
+    {"torque_noise_uniform", "0",
+     "N m, >= 0: half width of uniform noise on each torque component"},
+    {"failure_probability", "0", "0..1: chance that a step's reading is missing (state 0)"},
 };
 
 std::unique_ptr<RowTable> MakeRows(const ObjectTypeDescriptor&) {
@@ -37,12 +43,16 @@ void Copy(const void* source, void* row) {
   to.force_threshold = from.force_threshold;
   to.torque_threshold = from.torque_threshold;
   to.break_after = from.break_after;
+  to.force_noise = from.force_noise;
+  to.torque_noise = from.torque_noise;
 }
 
 void Scale(const ObjectTypeDescriptor&, void* row, double s, ScaleContext*) {
   ForceSensorData& f = *static_cast<ForceSensorData*>(row);
   f.force_threshold *= s * s * s;
   f.torque_threshold *= s * s * s * s;
+  for (double* v : {&f.force_noise.gaussian, &f.force_noise.uniform}) *v *= s * s * s;
+  for (double* v : {&f.torque_noise.gaussian, &f.torque_noise.uniform}) *v *= s * s * s * s;
 }
 
 void Hash(const Scene& scene, ObjectType type, StateHasher* h) {
@@ -64,6 +74,9 @@ void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
   if (r.Has("force_threshold")) s.force_threshold = r.Number("force_threshold", kPositive);
   if (r.Has("torque_threshold")) s.torque_threshold = r.Number("torque_threshold", kPositive);
   if (r.Has("break_after")) s.break_after = static_cast<int>(r.Integer("break_after", 1, 1000000));
+  ReadNoise(r, "", 1e12, &s.force_noise);
+  ReadNoise(r, "torque_", 1e12, &s.torque_noise);
+  s.torque_noise.failure = s.force_noise.failure;  // one reading: both fail together
 }
 
 constinit const ObjectTypeDescriptor kForceSensorType{

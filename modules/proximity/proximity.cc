@@ -490,6 +490,29 @@ class OctreeGridProximity final : public ProximityBackend {
     }
     reading.distance = reading.detected ? best : 0;
     reading.detected_object = reading.detected ? hit : ObjectId{};
+    if (reading.detected && reading.settings->noise.any())
+      AddNoise(table.owners[ray.row], &reading);
+  }
+
+  // Noise and failure on a detection (sensor_noise.h), from the stream of
+  // (seed, sensor slot, step): the same whatever thread reads the sensor.
+  // Nothing is added to a sensor that detects nothing: noise moves a
+  // detection or loses it, it never makes one.
+  void AddNoise(uint32_t slot, ProximitySensorData* reading) const {
+    const NoiseSettings& noise = reading->settings->noise;
+    Rng rng = NoiseStream(seed_, slot, static_cast<int64_t>(step_), NoisePurpose::kProximity);
+    if (Fails(noise, rng)) {
+      reading->detected = false;
+      reading->distance = 0;
+      reading->detected_object = ObjectId{};
+      reading->point = reading->normal = Vec3{};
+      return;
+    }
+    if (!noise.perturbs()) return;
+    const double d = std::clamp(Perturb(noise, reading->distance, rng), 0.0, reading->range());
+    if (reading->volume() != ProximityVolume::kRay && reading->distance > 0)
+      reading->point = reading->point * (d / reading->distance);
+    reading->distance = d;
   }
 
   // --- Volume sensors (volume.h) and randomized rays -------------------------
@@ -568,6 +591,7 @@ class OctreeGridProximity final : public ProximityBackend {
     reading.detected_object = reading.detected ? hit : ObjectId{};
     reading.point = reading.detected ? best.point : Vec3{};
     reading.normal = reading.detected ? best.normal : Vec3{};
+    if (reading.detected && reading.settings->noise.any()) AddNoise(sensor.slot, &reading);
   }
 
   // `ray_count` rays in the cone, from the stream of (seed, sensor slot,

@@ -19,6 +19,7 @@
 #include "framework/math.h"
 #include "framework/object_rows.h"
 #include "framework/scene.h"
+#include "framework/sensor_noise.h"
 #include "framework/shared_settings.h"
 
 namespace swarmsim {
@@ -50,6 +51,10 @@ struct ProximitySensorSettings {
   // (framework/collections.h), resolved from the sensor; empty: everything.
   std::string detectable;
   std::string detectable_where;  // "file:line:column" of `detectable`, for errors
+  // Noise on the distance of a detection and failure (framework/sensor_noise.h:
+  // `noise`, `noise_uniform`, `failure_probability`): a detected distance d
+  // reads clamp(d + noise, 0, range); a failed sensor detects nothing.
+  NoiseSettings noise;
 };
 
 // A proximity sensor: its shared settings and its reading (80 bytes; a

@@ -54,6 +54,9 @@ constexpr ObjectKey kKeys[] = {
     {"detectable", "everything",
      "volumes and randomized_ray: only the shapes of this collection or object subtree (a path, "
      "':/parts' or '/walls')"},
+    {"noise", "0", "m, >= 0: std dev of Gaussian noise on a detection's distance"},
+    {"noise_uniform", "0", "m, >= 0: half width of uniform noise on a detection's distance"},
+    {"failure_probability", "0", "0..1: chance that the sensor detects nothing in a step"},
 };
 
 constexpr double kDeg = 3.141592653589793 / 180;
@@ -117,6 +120,7 @@ void Check(const Scene& scene, ObjectId id, const void* row) {
 void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
   ProximitySensorSettings& p = static_cast<ProximitySensorData*>(row)->settings.Edit();
   if (r.Has("range")) p.range = r.Number("range", kPositiveLength);
+  ReadNoise(r, "", kMaxLength, &p.noise);
   static const std::vector<std::string> kVolumes = {"ray",     "randomized_ray", "cone",
                                                     "pyramid", "cylinder",       "disc"};
   if (r.Has("volume")) {

@@ -28,8 +28,16 @@ const std::vector<std::string> kCommonKeys = {
     "name", "type", "position", "orientation_deg", "heading_deg", "children", "script"};
 // Two loader-only types: a ring of proximity sensors, and a plugin sensor (a
 // dummy tagged with the sensor type a plugin registers).
-const std::vector<std::string> kRingKeys = {"name",   "type",  "count",          "radius",
-                                            "height", "range", "start_angle_deg"};
+const std::vector<std::string> kRingKeys = {"name",
+                                            "type",
+                                            "count",
+                                            "radius",
+                                            "height",
+                                            "range",
+                                            "start_angle_deg",
+                                            "noise",
+                                            "noise_uniform",
+                                            "failure_probability"};
 // The type of a ring's sensors (modules/proximity's), found by name.
 constexpr char kRingSensorType[] = "proximity_sensor";
 

@@ -75,7 +75,7 @@ void PlaneWorld::ReadCommands(const Scene& scene) {
   for (uint32_t b : wheeled_) bodies_[b].commanded = false;
   for (PlaneWheel& wheel : wheels_) {
     const JointData& joint = scene.joints()[scene.row_at(wheel.joint_slot)];
-    const double target = joint.mode() == JointMode::kVelocity ? joint.target_velocity : 0.0;
+    const double target = joint.mode() == JointMode::kVelocity ? joint.DriveVelocity() : 0.0;
     wheel.surface_speed = target * wheel.radius_m * scale_;
     if (target != 0) bodies_[wheel.body].commanded = true;
   }

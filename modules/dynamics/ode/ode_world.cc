@@ -474,7 +474,7 @@ void OdeWorld::ReadCommands(const Scene& scene) {
     const JointSettings& settings = *j.settings;
     commands_[k] = {.type = settings.type,
                     .mode = settings.mode,
-                    .target_velocity = j.target_velocity,
+                    .target_velocity = j.DriveVelocity(),
                     .target_position = j.target_position,
                     .target_force = j.target_force,
                     .max_force = settings.max_force,

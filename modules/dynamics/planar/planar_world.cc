@@ -336,7 +336,7 @@ void PlanarWorld::ReadCommands(const Scene& scene) {
       const PlanarWheel& wheel = wheels_[k];
       const JointData& joint = joints[scene.row_at(wheel.joint_slot)];
       const double speed =
-          (joint.mode() == JointMode::kVelocity ? joint.target_velocity : 0.0) * wheel.radius;
+          (joint.mode() == JointMode::kVelocity ? joint.DriveVelocity() : 0.0) * wheel.radius;
       vx += wheel.g_vx * speed;
       vy += wheel.g_vy * speed;
       w += wheel.g_w * speed;

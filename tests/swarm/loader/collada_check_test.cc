@@ -121,7 +121,7 @@ TEST(MeshCheckTest, ColladaArraysAndAccessorsHoldWhatTheySay) {
 TEST(MeshCheckTest, ColladaNumbersAreSeparatedAsAssimpReadsThem) {
   EXPECT_EQ(ColladaError(Cube("<p>0 2 1 0", "<p>0\v2\v1 0")),
             "part.dae:31"
-                ": <p> separates its numbers with a vertical tab (0x0B); use spaces");
+            ": <p> separates its numbers with a vertical tab (0x0B); use spaces");
   EXPECT_EQ(ColladaError(Cube("count=\"24\">-0.5", "count=\"24\">\v-0.5")),
             "part.dae:21: <float_array> separates its numbers with a vertical tab (0x0B); use "
             "spaces");

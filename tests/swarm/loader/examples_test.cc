@@ -85,6 +85,42 @@ std::vector<double> Values(const std::vector<MetricSample>& metrics, const std::
 // The claim of worlds/respawn.yaml: robots fail (remove themselves) and the
 // main script copies live ones, so the population stays at `robots`; the
 // same at 1 and 2 threads; the program writes the metrics.
+// worlds/diffusion_noisy.yaml (worlds/README.md, Noise): the foot-bots
+// diffuse with 5 mm of noise on every proximity ray and 10% on every
+// wheel's speed. Noise changes each robot's path (another state hash) but
+// not what the swarm does: the robots spread as the noiseless ones do and
+// keep as clear of each other; the same hash at 1 and 2 threads.
+TEST(ExamplesTest, DiffusionWithNoisySensorsAndWheelsSpreadsLikeTheNoiselessOne) {
+  const WorldRun clean = RunWorld("diffusion.yaml", 2, 600);
+  const WorldRun noisy = RunWorld("diffusion_noisy.yaml", 2, 600);
+  EXPECT_NE(noisy.hash, clean.hash);
+  EXPECT_EQ(RunWorld("diffusion_noisy.yaml", 1, 100).hash,
+            RunWorld("diffusion_noisy.yaml", 2, 100).hash);
+  ASSERT_EQ(clean.metrics.size(), noisy.metrics.size());
+  ASSERT_GE(clean.metrics.size(), 60u);
+  // Mean nearest-neighbour distance over the last 20 s, and at the start.
+  auto late = [](const WorldRun& run) {
+    double sum = 0;
+    int n = 0;
+    for (const MetricSample& m : run.metrics)
+      if (m.step >= 400) sum += m.value, ++n;
+    return sum / n;
+  };
+  const double start = clean.metrics.front().value;
+  EXPECT_NEAR(noisy.metrics.front().value, start, 0.005);  // the same placement, one step on
+  EXPECT_NEAR(late(noisy) / late(clean), 1.0, 0.1);
+}
+
+// The foot-bot's noise is a model parameter, so `--set` and sweeps vary it
+// (`--param footbot.prox_noise=0,0.01,0.05`): 0 is the noiseless world bit
+// for bit, anything else another run.
+TEST(ExamplesTest, TheFootbotsNoiseIsAParameterASweepCanVary) {
+  const uint64_t plain = RunWorld("diffusion.yaml", 1, 50).hash;
+  EXPECT_EQ(RunWorld("diffusion.yaml", 1, 50, {{"footbot.prox_noise", "0"}}).hash, plain);
+  EXPECT_NE(RunWorld("diffusion.yaml", 1, 50, {{"footbot.prox_noise", "0.01"}}).hash, plain);
+  EXPECT_NE(RunWorld("diffusion.yaml", 1, 50, {{"footbot.wheel_noise", "0.05"}}).hash, plain);
+}
+
 TEST(ExamplesTest, RespawnKeepsThePopulationWithCopiesAndIsIndependentOfThreadCount) {
   const std::vector<std::pair<std::string, std::string>> set = {{"failure_rate", "0.05"}};
   const WorldRun one = RunWorld("respawn.yaml", 1, 200, set);
