@@ -35,7 +35,8 @@ struct BlobCameraRow {
   bool occlusion = true;                    // shapes hide LEDs
   double angle_noise = 0;                   // rad: std dev of the noise on bearing and elevation
   double distance_noise = 0;                // std dev of the noise on distance, x distance
-  bool enabled = true;                      // off: sees nothing
+  double failure = 0;   // probability that the camera sees nothing in a step (sensor_noise.h)
+  bool enabled = true;  // off: sees nothing
   // The reading, written in the sense phase: sorted by bearing, then
   // distance, then the LED's handle.
   std::vector<Blob> blobs;

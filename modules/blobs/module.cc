@@ -30,6 +30,7 @@
 #include "framework/random.h"
 #include "framework/scene.h"
 #include "framework/scheduler.h"
+#include "framework/sensor_noise.h"
 #include "framework/world.h"
 #include "modules/blobs/blob_camera.h"
 #include "modules/blobs/leds.h"
@@ -200,6 +201,12 @@ void BlobCameraModule::See(const Scene& scene, uint32_t slot, BlobCameraRow* cam
       if (!Hidden(scene, p_W, leds_[seen[k]], c.blobs[k].distance, occluders))
         c.blobs[kept++] = c.blobs[k];
     c.blobs.resize(kept);
+  }
+  // A failing camera sees nothing this step (its own stream: the noise
+  // draws below stay what they were without failures).
+  if (c.failure > 0 && !c.blobs.empty()) {
+    Rng rng = NoiseStream(seed_, slot, static_cast<int64_t>(step_), NoisePurpose::kBlobCamera);
+    if (Fails(NoiseSettings{.failure = c.failure}, rng)) c.blobs.clear();
   }
   if (c.angle_noise > 0 || c.distance_noise > 0) AddNoise(slot, &c);
   std::sort(c.blobs.begin(), c.blobs.end(), BlobBefore);

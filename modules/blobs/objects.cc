@@ -38,6 +38,7 @@ constexpr ObjectKey kCameraKeys[] = {
     {"occlusion", "true", "shapes between the camera and an LED hide it"},
     {"angle_noise_deg", "0", "std dev of Gaussian noise added to bearing and elevation, 0..90"},
     {"distance_noise", "0", "std dev of Gaussian noise on distance, as a fraction of it, 0..1"},
+    {"failure_probability", "0", "0..1: chance that the camera sees nothing in a step"},
     {"enabled", "true", "off: the camera sees nothing"},
 };
 
@@ -69,6 +70,7 @@ void ReadCamera(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
   static constexpr NumberRule kNoiseDeg{"an angle from 0 to 90 degrees", 0, 90};
   if (r.Has("angle_noise_deg")) c.angle_noise = r.Number("angle_noise_deg", kNoiseDeg) * kDeg;
   if (r.Has("distance_noise")) c.distance_noise = r.Number("distance_noise", kFraction);
+  if (r.Has("failure_probability")) c.failure = r.Number("failure_probability", kFraction);
   if (r.Has("enabled")) c.enabled = r.Bool("enabled");
 }
 

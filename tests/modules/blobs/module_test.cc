@@ -243,6 +243,28 @@ TEST(BlobCameraTest, NoiseSpreadsReadingsByTheGivenDeviationsTheSameEveryRun) {
   EXPECT_NE(a[0].bearing, a[1].bearing);  // a new draw each step
 }
 
+// failure_probability: the camera sees nothing in that share of the steps
+// (within 4 binomial standard deviations), and exactly what is there in the
+// others.
+TEST(BlobCameraTest, AFailingCameraSeesNothingAtTheConfiguredRate) {
+  BlobWorld w;
+  BlobCameraRow row;
+  row.failure = 0.3;
+  const ObjectId camera = w.CameraRobot(0, 0, 0, row);
+  w.Led(w.Robot(0.5, 0, 0, false), {0, 0, 0.127}, kRed);
+  int blind = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const std::vector<Blob> blobs = w.See(camera);
+    if (blobs.empty()) {
+      ++blind;
+    } else {
+      ASSERT_EQ(blobs.size(), 1u);
+      EXPECT_NEAR(blobs[0].distance, 0.5, 1e-9);
+    }
+  }
+  EXPECT_NEAR(blind, 600, 4 * std::sqrt(2000 * 0.3 * 0.7));
+}
+
 TEST(BlobCameraTest, CopiesOfAModelWithAnLedAndACameraSeeEachOther) {
   BlobWorld w;
   const ObjectId first = w.Robot(0, 0);
