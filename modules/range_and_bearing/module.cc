@@ -1,0 +1,279 @@
+// Range-and-bearing boards: who hears whom, and what.
+//
+// Each sense phase:
+// 1. every board's origin goes into a 2D grid over its (x, y);
+// 2. if a board tests robot occlusion, every shape of a robot is placed at
+//    its pose and goes into a second grid, its (x, y) bounds as a circle;
+// 3. every board, in parallel (each writes only its own row):
+//    - with failure_probability, it hears nothing this step (a draw);
+//    - the boards of the grid cells within its range, minus those of its
+//      own robot (a board of no robot: minus itself), within range in 3D,
+//      sorted by distance, then by the sender's slot (handle order);
+//    - nearest first, each is tested for occlusion (the segment between the
+//      two boards' origins: the world's line of sight, i.e. static shapes
+//      and the map, with `occlusion`; the robots' shapes but the two
+//      boards' own, with `robot_occlusion`), then lost with probability
+//      min(1, loss_probability + loss_at_range (d / range)^2);
+//    - with `capacity` and `nearest`, the first `capacity` that pass are
+//      kept (and the rest are not tested); with `random`, `capacity` of
+//      those that pass are drawn without replacement, kept in the nearest-
+//      first order;
+//    - each kept reading gets its range, bearing and elevation in the
+//      receiver board's frame, then its noise, and its sender's payload.
+// Every draw comes from framework/sensor_noise.h's streams keyed by (seed,
+// the receiving board's slot, step, purpose), in the nearest-first order
+// above: nothing depends on the grid, the thread count or which worker ran
+// which board. A board without loss, noise, failure or random capacity
+// draws nothing.
+#include "modules/range_and_bearing/module.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "framework/line_of_sight.h"
+#include "framework/scene.h"
+#include "framework/scheduler.h"
+#include "framework/world.h"
+
+namespace swarmsim::range_and_bearing {
+
+namespace {
+
+constexpr double kPi = 3.141592653589793;
+constexpr double kTwoPi = 6.283185307179586;
+// The occlusion segment stops this short of each board (m), so that a
+// shape a board sits on the surface of does not block it.
+constexpr double kEndMargin = 1e-6;
+// Boards per task: a board costs about a microsecond.
+constexpr int64_t kBoardGrain = 32;
+
+// Is `ancestor` above `slot` in the tree?
+bool IsAncestor(const Scene& scene, uint32_t ancestor, uint32_t slot) {
+  for (int32_t s = scene.parent_at(slot); s >= 0; s = scene.parent_at(static_cast<uint32_t>(s)))
+    if (static_cast<uint32_t>(s) == ancestor) return true;
+  return false;
+}
+
+// Does the segment p + t v, t in [0, 1], meet the box [lo, hi]?
+bool SegmentMeetsBox(const Vec3& p, const Vec3& v, const Vec3& lo, const Vec3& hi) {
+  double t0 = 0, t1 = 1;
+  const double ps[3] = {p.x, p.y, p.z}, vs[3] = {v.x, v.y, v.z};
+  const double los[3] = {lo.x, lo.y, lo.z}, his[3] = {hi.x, hi.y, hi.z};
+  for (int i = 0; i < 3; ++i) {
+    if (vs[i] == 0) {
+      if (ps[i] < los[i] || ps[i] > his[i]) return false;
+      continue;
+    }
+    const double inv = 1 / vs[i];
+    double a = (los[i] - ps[i]) * inv, b = (his[i] - ps[i]) * inv;
+    if (a > b) std::swap(a, b);
+    t0 = std::max(t0, a);
+    t1 = std::min(t1, b);
+    if (t0 > t1) return false;
+  }
+  return true;
+}
+
+// An angle in (-pi, pi].
+double Wrap(double a) {
+  a = std::remainder(a, kTwoPi);
+  return a == -kPi ? kPi : a;
+}
+
+}  // namespace
+
+void RangeAndBearingModule::IndexBoards(const Scene& scene, const Rows<RangeAndBearingRow>& rows) {
+  boards_.resize(rows.size());
+  board_items_.resize(rows.size());
+  for (size_t r = 0; r < rows.size(); ++r) {
+    const uint32_t slot = rows.owners[r];
+    const Vec3& p = scene.world_pose_at(slot).p;
+    boards_[r] = {p, scene.instance_of_at(slot), slot, static_cast<uint32_t>(r)};
+    board_items_[r] = {p.x, p.y, 0, static_cast<uint32_t>(r)};
+  }
+  board_grid_.Build(board_items_);
+}
+
+void RangeAndBearingModule::IndexRobotShapes(const Scene& scene) {
+  occluders_.clear();
+  occluder_items_.clear();
+  const auto shapes = scene.shapes();
+  const auto owners = scene.shape_owners();
+  for (size_t r = 0; r < shapes.size(); ++r) {
+    const uint32_t slot = owners[r];
+    const int instance = scene.instance_of_at(slot);
+    if (instance < 0) continue;  // static ones: the line of sight
+    Occluder& o = occluders_.emplace_back();
+    o.shape = proximity::PlaceShape(shapes[r], scene.world_pose_at(slot), scene.IdAt(slot),
+                                    instance);
+    o.slot = slot;
+    proximity::WorldBounds(o.shape, &o.lo, &o.hi);
+    // Grown a little: the exact test decides, these only must not miss.
+    const double margin = 1e-9 * (1 + std::abs(o.lo.x) + std::abs(o.lo.y) + std::abs(o.lo.z) +
+                                  std::abs(o.hi.x) + std::abs(o.hi.y) + std::abs(o.hi.z));
+    o.lo = o.lo - Vec3{margin, margin, margin};
+    o.hi = o.hi + Vec3{margin, margin, margin};
+    occluder_items_.push_back({0.5 * (o.lo.x + o.hi.x), 0.5 * (o.lo.y + o.hi.y),
+                               0.5 * std::hypot(o.hi.x - o.lo.x, o.hi.y - o.lo.y),
+                               static_cast<uint32_t>(occluder_items_.size())});
+  }
+  occluder_grid_.Build(occluder_items_);
+}
+
+bool RangeAndBearingModule::Blocked(const Scene& scene, const Board& from, const Board& to,
+                                    double distance, bool statics, bool robots,
+                                    const std::vector<uint32_t>& occluders) const {
+  const double length = distance - 2 * kEndMargin;
+  if (!(length > 0)) return false;
+  const Vec3 d_W = (to.p_W - from.p_W) / distance;
+  const Vec3 start = from.p_W + d_W * kEndMargin;
+  const Vec3 v_W = d_W * length;
+  if (robots) {
+    for (uint32_t j : occluders) {
+      const Occluder& o = occluders_[j];
+      // The sender's own shapes never block it (the receiver's were left out).
+      if (to.instance >= 0 ? o.shape.instance == to.instance : IsAncestor(scene, o.slot, to.slot))
+        continue;
+      if (!SegmentMeetsBox(start, v_W, o.lo, o.hi)) continue;
+      double hit = 0;
+      if (proximity::RayCast(o.shape, start, d_W, length, &hit)) return true;
+    }
+  }
+  return statics && line_of_sight_ != nullptr &&
+         line_of_sight_->SegmentBlocked(start, start + v_W);
+}
+
+void RangeAndBearingModule::Hear(const Scene& scene, const Rows<RangeAndBearingRow>& rows,
+                                 uint32_t row, RangeAndBearingRow* rab) const {
+  const RangeAndBearingSettings& s = *rab->settings;
+  rab->readings.clear();
+  rab->received.clear();
+  const Board& self = boards_[row];
+  // A board that fails hears nothing this step.
+  if (s.range_noise.failure > 0) {
+    Rng fail = NoiseStream(seed_, self.slot, step_, NoisePurpose::kRangeAndBearingLoss);
+    if (Fails(s.range_noise, fail)) return;
+  }
+  // The boards in range, nearest first.
+  thread_local std::vector<uint32_t> near, occluders;
+  thread_local std::vector<Heard> heard;
+  board_grid_.QueryCircle(self.p_W.x, self.p_W.y, s.range, &near);
+  heard.clear();
+  const double range2 = s.range * s.range;
+  for (uint32_t i : near) {
+    const Board& other = boards_[i];
+    if (i == row || (self.instance >= 0 && other.instance == self.instance)) continue;
+    const double d2 = (other.p_W - self.p_W).SquaredNorm();
+    if (!(d2 <= range2)) continue;
+    heard.push_back({std::sqrt(d2), i});
+  }
+  if (heard.empty()) return;
+  std::sort(heard.begin(), heard.end(), [this](const Heard& a, const Heard& b) {
+    return a.distance != b.distance ? a.distance < b.distance
+                                    : boards_[a.board].slot < boards_[b.board].slot;
+  });
+  // Occlusion, loss and capacity, nearest first.
+  const bool robots = s.robot_occlusion && have_occluders_;
+  if (robots) {
+    occluder_grid_.QueryCircle(self.p_W.x, self.p_W.y, s.range, &occluders);
+    size_t kept = 0;
+    for (uint32_t j : occluders) {
+      const Occluder& o = occluders_[j];
+      const bool own = self.instance >= 0 ? o.shape.instance == self.instance
+                                          : IsAncestor(scene, o.slot, self.slot);
+      if (!own) occluders[kept++] = j;
+    }
+    occluders.resize(kept);
+  }
+  const bool lossy = s.loss_probability > 0 || s.loss_at_range > 0;
+  Rng loss = lossy ? NoiseStream(seed_, self.slot, step_, NoisePurpose::kRangeAndBearingLoss)
+                   : Rng();
+  if (lossy && s.range_noise.failure > 0) loss.Uniform();  // the failure's draw, as above
+  const size_t capacity = s.capacity > 0 && s.capacity_order == CapacityOrder::kNearest
+                              ? s.capacity
+                              : heard.size();
+  size_t kept = 0;
+  for (size_t k = 0; k < heard.size() && kept < capacity; ++k) {
+    const Board& other = boards_[heard[k].board];
+    if ((s.occlusion || robots) &&
+        Blocked(scene, self, other, heard[k].distance, s.occlusion, robots, occluders))
+      continue;
+    if (lossy) {
+      const double p = s.LossAt(heard[k].distance);
+      if (p > 0 && loss.Uniform() < p) continue;
+    }
+    heard[kept++] = heard[k];
+  }
+  heard.resize(kept);
+  // A random `capacity` of them, in the same order.
+  if (s.capacity > 0 && s.capacity_order == CapacityOrder::kRandom && heard.size() > s.capacity) {
+    Rng pick = NoiseStream(seed_, self.slot, step_, NoisePurpose::kCapacity);
+    for (size_t k = 0; k < s.capacity; ++k)
+      std::swap(heard[k], heard[static_cast<size_t>(
+                              pick.UniformInt(static_cast<int64_t>(k),
+                                              static_cast<int64_t>(heard.size()) - 1))]);
+    heard.resize(s.capacity);
+    std::sort(heard.begin(), heard.end(), [this](const Heard& a, const Heard& b) {
+      return a.distance != b.distance ? a.distance < b.distance
+                                      : boards_[a.board].slot < boards_[b.board].slot;
+    });
+  }
+  // The readings, in the receiver's frame, with their noise and payloads.
+  const Quat q_RW = scene.world_pose_at(self.slot).q.Conjugate();
+  const bool noisy = s.range_noise.perturbs() || s.bearing_noise.perturbs();
+  Rng noise =
+      noisy ? NoiseStream(seed_, self.slot, step_, NoisePurpose::kRangeAndBearing) : Rng();
+  rab->readings.reserve(heard.size());
+  for (const Heard& h : heard) {
+    const Board& other = boards_[h.board];
+    const RangeAndBearingRow& sender = rows.rows[other.row];
+    const Vec3 d_R = q_RW.Rotate(other.p_W - self.p_W);
+    RangeAndBearingReading reading;
+    reading.range = h.distance;
+    reading.bearing = Wrap(std::atan2(d_R.y, d_R.x));
+    reading.elevation = std::atan2(d_R.z, std::hypot(d_R.x, d_R.y));
+    if (noisy) {
+      if (s.range_noise.perturbs())
+        reading.range = std::max(0.0, Perturb(s.range_noise, reading.range, noise));
+      if (s.bearing_noise.perturbs()) {
+        reading.bearing = Wrap(Perturb(s.bearing_noise, reading.bearing, noise));
+        reading.elevation =
+            std::clamp(Perturb(s.bearing_noise, reading.elevation, noise), -0.5 * kPi, 0.5 * kPi);
+      }
+    }
+    reading.sender = scene.IdAt(other.slot);
+    const uint32_t size = sender.settings->payload_size;
+    reading.data_offset = static_cast<uint32_t>(rab->received.size());
+    reading.data_size = size;
+    const size_t set = std::min<size_t>(sender.data.size(), size);
+    rab->received.insert(rab->received.end(), sender.data.begin(), sender.data.begin() + set);
+    rab->received.resize(rab->received.size() + (size - set), 0);
+    rab->readings.push_back(reading);
+  }
+}
+
+void RangeAndBearingModule::Sense(World* world) {
+  Scene& scene = world->scene();
+  if (!type_found_) {
+    have_type_ = scene.FindType(kTypeName, &type_);
+    type_found_ = true;
+  }
+  if (!have_type_) return;
+  auto& rows = scene.rows<RangeAndBearingRow>(type_);
+  if (rows.size() == 0) return;
+  seed_ = world->settings().seed;
+  step_ = world->step_count();
+  line_of_sight_ = world->line_of_sight();
+  IndexBoards(scene, rows);
+  bool robot_occlusion = false;
+  for (const RangeAndBearingRow& rab : rows.rows) robot_occlusion |= rab.settings->robot_occlusion;
+  have_occluders_ = robot_occlusion;
+  if (robot_occlusion) IndexRobotShapes(scene);
+  world->scheduler().ParallelFor(0, static_cast<int64_t>(rows.size()), kBoardGrain,
+                                 [&](int64_t begin, int64_t end) {
+                                   for (int64_t r = begin; r < end; ++r)
+                                     Hear(scene, rows, static_cast<uint32_t>(r), &rows.rows[r]);
+                                 });
+}
+
+}  // namespace swarmsim::range_and_bearing
