@@ -24,8 +24,8 @@ constexpr ObjectKey kKeys[] = {
     {"loss_at_range", "0",
      "0..1: added to the loss probability times (distance / range)^2: "
      "p = min(1, loss_probability + loss_at_range (d / range)^2)"},
-    {"range_noise", "0", "m, std dev of Gaussian noise on each reading's range, 0..range"},
-    {"range_noise_uniform", "0", "m, half width of uniform noise on each reading's range, 0..range"},
+    {"range_noise", "0", "m, >= 0: std dev of Gaussian noise on each reading's range"},
+    {"range_noise_uniform", "0", "m, >= 0: half width of uniform noise on each reading's range"},
     {"bearing_noise_deg", "0", "std dev of Gaussian noise on bearing and elevation, 0..180 degrees"},
     {"bearing_noise_uniform_deg", "0",
      "half width of uniform noise on bearing and elevation, 0..180 degrees"},
