@@ -2,17 +2,23 @@
 //
 // Each sense phase:
 // 1. every board's origin goes into a 2D grid over its (x, y);
-// 2. if a board tests robot occlusion, every shape of a robot is placed at
-//    its pose and goes into a second grid, its (x, y) bounds as a circle;
+// 2. if a board tests occlusion, every shape of no robot (static or not)
+//    that reaches the boards' heights is placed at its pose and goes into
+//    a grid, its (x, y) bounds as a circle (walls longer than a cell go to
+//    the grid's short list every query scans); if a board tests robot
+//    occlusion, every robot's shape goes into another;
 // 3. every board, in parallel (each writes only its own row):
 //    - with failure_probability, it hears nothing this step (a draw);
 //    - the boards of the grid cells within its range, minus those of its
 //      own robot (a board of no robot: minus itself), within range in 3D,
 //      sorted by distance, then by the sender's slot (handle order);
-//    - nearest first, each is tested for occlusion (the segment between the
-//      two boards' origins: the world's line of sight, i.e. static shapes
-//      and the map, with `occlusion`; the robots' shapes but the two
-//      boards' own, with `robot_occlusion`), then lost with probability
+//    - nearest first, each is tested for occlusion: the segment between the
+//      two boards' origins against the shapes listed once per receiver
+//      (those whose bounds meet its range's box at the boards' heights;
+//      bounding box first, then modules/proximity/ray_cast.h's exact test)
+//      and against the environment map's voxels (the world's line of
+//      sight), with `occlusion`; against the robots' shapes but the two
+//      boards' own, with `robot_occlusion`; then lost with probability
 //      min(1, loss_probability + loss_at_range (d / range)^2);
 //    - with `capacity` and `nearest`, the first `capacity` that pass are
 //      kept (and the rest are not tested); with `random`, `capacity` of
@@ -29,7 +35,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
+#include "framework/environment.h"
 #include "framework/line_of_sight.h"
 #include "framework/scene.h"
 #include "framework/scheduler.h"
@@ -85,25 +93,31 @@ double Wrap(double a) {
 void RangeAndBearingModule::IndexBoards(const Scene& scene, const Rows<RangeAndBearingRow>& rows) {
   boards_.resize(rows.size());
   board_items_.resize(rows.size());
+  z_lo_ = INFINITY, z_hi_ = -INFINITY;
   for (size_t r = 0; r < rows.size(); ++r) {
     const uint32_t slot = rows.owners[r];
     const Vec3& p = scene.world_pose_at(slot).p;
     boards_[r] = {p, scene.instance_of_at(slot), slot, static_cast<uint32_t>(r)};
     board_items_[r] = {p.x, p.y, 0, static_cast<uint32_t>(r)};
+    z_lo_ = std::min(z_lo_, p.z), z_hi_ = std::max(z_hi_, p.z);
   }
   board_grid_.Build(board_items_);
 }
 
-void RangeAndBearingModule::IndexRobotShapes(const Scene& scene) {
-  occluders_.clear();
-  occluder_items_.clear();
+void RangeAndBearingModule::IndexShapes(const Scene& scene, bool statics, bool robots) {
+  for (ShapeIndex* index : {&statics_, &robot_shapes_}) {
+    index->shapes.clear();
+    index->items.clear();
+  }
   const auto shapes = scene.shapes();
   const auto owners = scene.shape_owners();
   for (size_t r = 0; r < shapes.size(); ++r) {
     const uint32_t slot = owners[r];
     const int instance = scene.instance_of_at(slot);
-    if (instance < 0) continue;  // static ones: the line of sight
-    Occluder& o = occluders_.emplace_back();
+    ShapeIndex* index = instance >= 0 ? (robots ? &robot_shapes_ : nullptr)
+                                      : (statics ? &statics_ : nullptr);
+    if (index == nullptr) continue;
+    Occluder o;
     o.shape = proximity::PlaceShape(shapes[r], scene.world_pose_at(slot), scene.IdAt(slot),
                                     instance);
     o.slot = slot;
@@ -113,34 +127,70 @@ void RangeAndBearingModule::IndexRobotShapes(const Scene& scene) {
                                   std::abs(o.hi.x) + std::abs(o.hi.y) + std::abs(o.hi.z));
     o.lo = o.lo - Vec3{margin, margin, margin};
     o.hi = o.hi + Vec3{margin, margin, margin};
-    occluder_items_.push_back({0.5 * (o.lo.x + o.hi.x), 0.5 * (o.lo.y + o.hi.y),
-                               0.5 * std::hypot(o.hi.x - o.lo.x, o.hi.y - o.lo.y),
-                               static_cast<uint32_t>(occluder_items_.size())});
+    // No segment between two boards leaves their heights.
+    if (o.hi.z < z_lo_ || o.lo.z > z_hi_) continue;
+    o.cx = 0.5 * (o.lo.x + o.hi.x), o.cy = 0.5 * (o.lo.y + o.hi.y);
+    o.r = 0.5 * std::hypot(o.hi.x - o.lo.x, o.hi.y - o.lo.y);
+    index->items.push_back({o.cx, o.cy, o.r, static_cast<uint32_t>(index->shapes.size())});
+    index->shapes.push_back(o);
   }
-  occluder_grid_.Build(occluder_items_);
+  for (ShapeIndex* index : {&statics_, &robot_shapes_})
+    if (!index->items.empty()) index->grid.Build(index->items);
+}
+
+template <class Skip>
+void RangeAndBearingModule::ShapeIndex::List(double x, double y, double r, double z_lo,
+                                             double z_hi, Skip skip,
+                                             std::vector<uint32_t>* out) const {
+  out->clear();
+  if (items.empty()) return;
+  grid.QueryCircle(x, y, r, out);
+  size_t kept = 0;
+  for (uint32_t j : *out) {
+    const Occluder& o = shapes[j];
+    if (o.hi.x < x - r || o.lo.x > x + r || o.hi.y < y - r || o.lo.y > y + r || o.hi.z < z_lo ||
+        o.lo.z > z_hi || skip(o))
+      continue;
+    (*out)[kept++] = j;
+  }
+  out->resize(kept);
 }
 
 bool RangeAndBearingModule::Blocked(const Scene& scene, const Board& from, const Board& to,
-                                    double distance, bool statics, bool robots,
-                                    const std::vector<uint32_t>& occluders) const {
+                                    double distance, const std::vector<uint32_t>& statics,
+                                    bool map, const std::vector<uint32_t>& robots) const {
   const double length = distance - 2 * kEndMargin;
   if (!(length > 0)) return false;
   const Vec3 d_W = (to.p_W - from.p_W) / distance;
   const Vec3 start = from.p_W + d_W * kEndMargin;
   const Vec3 v_W = d_W * length;
-  if (robots) {
-    for (uint32_t j : occluders) {
-      const Occluder& o = occluders_[j];
-      // The sender's own shapes never block it (the receiver's were left out).
-      if (to.instance >= 0 ? o.shape.instance == to.instance : IsAncestor(scene, o.slot, to.slot))
-        continue;
-      if (!SegmentMeetsBox(start, v_W, o.lo, o.hi)) continue;
-      double hit = 0;
-      if (proximity::RayCast(o.shape, start, d_W, length, &hit)) return true;
-    }
+  double hit = 0;
+  // Does the segment's (x, y) pass within o's footprint circle? A cheap
+  // first test for the robots' bodies and the walls far to one side.
+  const double inv_len2 = 1 / (v_W.x * v_W.x + v_W.y * v_W.y);
+  const auto near = [&](const Occluder& o) {
+    const double ex = o.cx - start.x, ey = o.cy - start.y;
+    double t = std::isfinite(inv_len2) ? (ex * v_W.x + ey * v_W.y) * inv_len2 : 0;
+    t = std::clamp(t, 0.0, 1.0);
+    const double dx = ex - t * v_W.x, dy = ey - t * v_W.y;
+    return dx * dx + dy * dy <= o.r * o.r;
+  };
+  for (uint32_t j : statics) {
+    const Occluder& o = statics_.shapes[j];
+    if (!near(o) || !SegmentMeetsBox(start, v_W, o.lo, o.hi)) continue;
+    // A board of no robot is not blocked by the shapes it hangs from.
+    if (to.instance < 0 && IsAncestor(scene, o.slot, to.slot)) continue;
+    if (proximity::RayCast(o.shape, start, d_W, length, &hit)) return true;
   }
-  return statics && line_of_sight_ != nullptr &&
-         line_of_sight_->SegmentBlocked(start, start + v_W);
+  for (uint32_t j : robots) {
+    const Occluder& o = robot_shapes_.shapes[j];
+    if (!near(o) || !SegmentMeetsBox(start, v_W, o.lo, o.hi)) continue;
+    // The sender's own shapes never block it (the receiver's were left out).
+    if (to.instance >= 0 ? o.shape.instance == to.instance : IsAncestor(scene, o.slot, to.slot))
+      continue;
+    if (proximity::RayCast(o.shape, start, d_W, length, &hit)) return true;
+  }
+  return map && line_of_sight_->SegmentBlocked(start, start + v_W);
 }
 
 void RangeAndBearingModule::Hear(const Scene& scene, const Rows<RangeAndBearingRow>& rows,
@@ -155,7 +205,7 @@ void RangeAndBearingModule::Hear(const Scene& scene, const Rows<RangeAndBearingR
     if (Fails(s.range_noise, fail)) return;
   }
   // The boards in range, nearest first.
-  thread_local std::vector<uint32_t> near, occluders;
+  thread_local std::vector<uint32_t> near, statics, robots;
   thread_local std::vector<Heard> heard;
   board_grid_.QueryCircle(self.p_W.x, self.p_W.y, s.range, &near);
   heard.clear();
@@ -172,19 +222,25 @@ void RangeAndBearingModule::Hear(const Scene& scene, const Rows<RangeAndBearingR
     return a.distance != b.distance ? a.distance < b.distance
                                     : boards_[a.board].slot < boards_[b.board].slot;
   });
-  // Occlusion, loss and capacity, nearest first.
-  const bool robots = s.robot_occlusion && have_occluders_;
-  if (robots) {
-    occluder_grid_.QueryCircle(self.p_W.x, self.p_W.y, s.range, &occluders);
-    size_t kept = 0;
-    for (uint32_t j : occluders) {
-      const Occluder& o = occluders_[j];
-      const bool own = self.instance >= 0 ? o.shape.instance == self.instance
-                                          : IsAncestor(scene, o.slot, self.slot);
-      if (!own) occluders[kept++] = j;
-    }
-    occluders.resize(kept);
-  }
+  // Occlusion, loss and capacity, nearest first. The shapes that may
+  // block: those near the receiver at the boards' heights, but its own.
+  statics.clear();
+  robots.clear();
+  if (s.occlusion && have_statics_)
+    statics_.List(
+        self.p_W.x, self.p_W.y, s.range, z_lo_, z_hi_,
+        [&](const Occluder& o) { return self.instance < 0 && IsAncestor(scene, o.slot, self.slot); },
+        &statics);
+  if (s.robot_occlusion && have_robot_shapes_)
+    robot_shapes_.List(
+        self.p_W.x, self.p_W.y, s.range, z_lo_, z_hi_,
+        [&](const Occluder& o) {
+          return self.instance >= 0 ? o.shape.instance == self.instance
+                                    : IsAncestor(scene, o.slot, self.slot);
+        },
+        &robots);
+  const bool map = s.occlusion && have_map_;
+  const bool occluded = map || !statics.empty() || !robots.empty();
   const bool lossy = s.loss_probability > 0 || s.loss_at_range > 0;
   Rng loss = lossy ? NoiseStream(seed_, self.slot, step_, NoisePurpose::kRangeAndBearingLoss)
                    : Rng();
@@ -195,9 +251,7 @@ void RangeAndBearingModule::Hear(const Scene& scene, const Rows<RangeAndBearingR
   size_t kept = 0;
   for (size_t k = 0; k < heard.size() && kept < capacity; ++k) {
     const Board& other = boards_[heard[k].board];
-    if ((s.occlusion || robots) &&
-        Blocked(scene, self, other, heard[k].distance, s.occlusion, robots, occluders))
-      continue;
+    if (occluded && Blocked(scene, self, other, heard[k].distance, statics, map, robots)) continue;
     if (lossy) {
       const double p = s.LossAt(heard[k].distance);
       if (p > 0 && loss.Uniform() < p) continue;
@@ -223,15 +277,22 @@ void RangeAndBearingModule::Hear(const Scene& scene, const Rows<RangeAndBearingR
   const bool noisy = s.range_noise.perturbs() || s.bearing_noise.perturbs();
   Rng noise =
       noisy ? NoiseStream(seed_, self.slot, step_, NoisePurpose::kRangeAndBearing) : Rng();
-  rab->readings.reserve(heard.size());
-  for (const Heard& h : heard) {
-    const Board& other = boards_[h.board];
+  size_t bytes = 0;
+  for (const Heard& h : heard) bytes += rows.rows[boards_[h.board].row].settings->payload_size;
+  rab->received.assign(bytes, 0);
+  rab->readings.resize(heard.size());
+  uint32_t offset = 0;
+  for (size_t k = 0; k < heard.size(); ++k) {
+    const Board& other = boards_[heard[k].board];
     const RangeAndBearingRow& sender = rows.rows[other.row];
     const Vec3 d_R = q_RW.Rotate(other.p_W - self.p_W);
-    RangeAndBearingReading reading;
-    reading.range = h.distance;
-    reading.bearing = Wrap(std::atan2(d_R.y, d_R.x));
-    reading.elevation = std::atan2(d_R.z, std::hypot(d_R.x, d_R.y));
+    RangeAndBearingReading& reading = rab->readings[k];
+    reading.range = heard[k].distance;
+    reading.bearing = std::atan2(d_R.y, d_R.x);
+    if (reading.bearing == -kPi) reading.bearing = kPi;  // (-pi, pi]: straight behind is +pi
+    // Boards at one height (the usual case) spare an atan2.
+    reading.elevation =
+        d_R.z == 0 ? 0 : std::atan2(d_R.z, std::sqrt(d_R.x * d_R.x + d_R.y * d_R.y));
     if (noisy) {
       if (s.range_noise.perturbs())
         reading.range = std::max(0.0, Perturb(s.range_noise, reading.range, noise));
@@ -242,13 +303,13 @@ void RangeAndBearingModule::Hear(const Scene& scene, const Rows<RangeAndBearingR
       }
     }
     reading.sender = scene.IdAt(other.slot);
+    // Its payload: what the sender set, then zeros up to its payload size.
     const uint32_t size = sender.settings->payload_size;
-    reading.data_offset = static_cast<uint32_t>(rab->received.size());
+    reading.data_offset = offset;
     reading.data_size = size;
     const size_t set = std::min<size_t>(sender.data.size(), size);
-    rab->received.insert(rab->received.end(), sender.data.begin(), sender.data.begin() + set);
-    rab->received.resize(rab->received.size() + (size - set), 0);
-    rab->readings.push_back(reading);
+    if (set > 0) std::memcpy(rab->received.data() + offset, sender.data.data(), set);
+    offset += size;
   }
 }
 
@@ -264,11 +325,17 @@ void RangeAndBearingModule::Sense(World* world) {
   seed_ = world->settings().seed;
   step_ = world->step_count();
   line_of_sight_ = world->line_of_sight();
+  const EnvironmentMap* environment = scene.environment();
+  have_map_ = line_of_sight_ != nullptr && environment != nullptr && !environment->boxes.empty();
   IndexBoards(scene, rows);
-  bool robot_occlusion = false;
-  for (const RangeAndBearingRow& rab : rows.rows) robot_occlusion |= rab.settings->robot_occlusion;
-  have_occluders_ = robot_occlusion;
-  if (robot_occlusion) IndexRobotShapes(scene);
+  bool statics = false, robots = false;
+  for (const RangeAndBearingRow& rab : rows.rows) {
+    statics |= rab.settings->occlusion;
+    robots |= rab.settings->robot_occlusion;
+  }
+  if (statics || robots) IndexShapes(scene, statics, robots);
+  have_statics_ = statics && !statics_.items.empty();
+  have_robot_shapes_ = robots && !robot_shapes_.items.empty();
   world->scheduler().ParallelFor(0, static_cast<int64_t>(rows.size()), kBoardGrain,
                                  [&](int64_t begin, int64_t end) {
                                    for (int64_t r = begin; r < end; ++r)
