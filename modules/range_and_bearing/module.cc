@@ -313,6 +313,36 @@ void RangeAndBearingModule::Hear(const Scene& scene, const Rows<RangeAndBearingR
   }
 }
 
+int RangeAndBearingModule::SetData(Scene* scene, int robot, ObjectId id, const uint8_t* data,
+                                   size_t size) const noexcept {
+  ObjectType type;
+  if (!scene->FindType(kTypeName, &type) || !scene->IsValid(id) || scene->type(id) != type ||
+      robot < 0 || scene->instance_of(id) != robot)
+    return -1;
+  RangeAndBearingRow& rab = scene->rows<RangeAndBearingRow>(type).rows[scene->row_at(scene->SlotOf(id))];
+  if (size > rab.settings->payload_size) return -1;
+  try {
+    rab.data.assign(data, data + size);  // at most kMaxPayloadSize bytes
+  } catch (const std::exception&) {
+    return -1;  // out of memory
+  }
+  return 0;
+}
+
+int RangeAndBearingModule::Read(const Scene& scene, ObjectId id,
+                                SwarmsimRangeAndBearingReading* out, int max) const noexcept {
+  ObjectType type;
+  if (!scene.FindType(kTypeName, &type) || !scene.IsValid(id) || scene.type(id) != type) return -1;
+  const RangeAndBearingRow& rab =
+      scene.rows<RangeAndBearingRow>(type).rows[scene.row_at(scene.SlotOf(id))];
+  const int count = static_cast<int>(rab.readings.size());
+  for (int i = 0; i < count && i < max; ++i) {
+    const RangeAndBearingReading& r = rab.readings[static_cast<size_t>(i)];
+    out[i] = {rab.received.data() + r.data_offset, r.data_size, r.range, r.bearing, r.elevation};
+  }
+  return count;
+}
+
 void RangeAndBearingModule::Sense(World* world) {
   Scene& scene = world->scene();
   if (!type_found_) {

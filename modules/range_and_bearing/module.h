@@ -9,6 +9,7 @@
 
 #include "framework/module.h"
 #include "framework/object_rows.h"
+#include "framework/range_and_bearing_access.h"
 #include "framework/spatial_grid.h"
 #include "modules/proximity/ray_cast.h"
 #include "modules/range_and_bearing/range_and_bearing.h"
@@ -27,9 +28,14 @@ inline constexpr const char* kModuleName = "range_and_bearing";
 // sim.readRangeAndBearing (lua_api_range_and_bearing.cc).
 void RegisterRangeAndBearingApi(lua_State* L);
 
-class RangeAndBearingModule final : public Module {
+// Also the plugins' access to the boards (framework/range_and_bearing_access.h).
+class RangeAndBearingModule final : public Module, public RangeAndBearingAccess {
  public:
   void Sense(World* world) override;
+  int SetData(Scene* scene, int robot, ObjectId id, const uint8_t* data,
+              size_t size) const noexcept override;
+  int Read(const Scene& scene, ObjectId id, SwarmsimRangeAndBearingReading* out,
+           int max) const noexcept override;
 
  private:
   struct Board {       // 40 bytes
