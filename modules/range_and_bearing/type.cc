@@ -101,6 +101,21 @@ void Hash(const Scene& scene, ObjectType type, StateHasher* h) {
   }
 }
 
+// Drawn as a small puck (2 cm across, 1 cm high): green while it hears
+// another board, grey otherwise.
+void Visual(const Scene& scene, ObjectType type, uint32_t row, ObjectVisual* out) {
+  const RangeAndBearingRow& rab = scene.rows<RangeAndBearingRow>(type).rows[row];
+  out->kind = VisualKind::kCylinder;
+  out->size = {0.02, 0, 0.01};
+  out->color = rab.readings.empty() ? Vec3{0.5, 0.5, 0.5} : Vec3{0.2, 0.9, 0.4};
+}
+
+// The boards it heard in the last sense phase (the recorder's links).
+void Links(const Scene& scene, ObjectType type, uint32_t row, std::vector<ObjectId>* out) {
+  for (const RangeAndBearingReading& r : scene.rows<RangeAndBearingRow>(type).rows[row].readings)
+    out->push_back(r.sender);
+}
+
 std::unique_ptr<RowTable> MakeRows(const ObjectTypeDescriptor&) {
   return std::make_unique<Rows<RangeAndBearingRow>>();
 }
@@ -117,6 +132,8 @@ constinit const ObjectTypeDescriptor kRangeAndBearingType{
     .keys = kKeys,
     .read = Read,
     .register_lua = RegisterRangeAndBearingApi,
+    .visual = Visual,
+    .links = Links,
 };
 
 }  // namespace
