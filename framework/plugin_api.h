@@ -75,7 +75,8 @@ typedef struct SwarmsimMessage {
 // One reading of a range-and-bearing board (ABI 7), as
 // sim.readRangeAndBearing gives it.
 typedef struct SwarmsimRangeAndBearingReading {
-  const uint8_t* data;  // the sender's payload (payload_size bytes), valid until the next sense phase
+  // The sender's payload (payload_size bytes), valid until the next sense phase.
+  const uint8_t* data;
   size_t size;
   double range;      // m, between the two boards' origins (noise added)
   double bearing;    // rad, in (-pi, pi]: in the receiving board's xy plane from its +x, CCW

@@ -245,8 +245,7 @@ int SetRangeAndBearingData(void* world, int robot, int64_t board, const uint8_t*
   return boards->SetData(&w.scene(), robot, ObjectId::FromInteger(board), data, size);
 }
 
-int ReadRangeAndBearing(void* world, int64_t board, SwarmsimRangeAndBearingReading* out,
-                        int max) {
+int ReadRangeAndBearing(void* world, int64_t board, SwarmsimRangeAndBearingReading* out, int max) {
   World& w = W(world);
   const RangeAndBearingAccess* boards = Boards(w);
   if (boards == nullptr) return -1;

@@ -114,12 +114,12 @@ void RangeAndBearingModule::IndexShapes(const Scene& scene, bool statics, bool r
   for (size_t r = 0; r < shapes.size(); ++r) {
     const uint32_t slot = owners[r];
     const int instance = scene.instance_of_at(slot);
-    ShapeIndex* index = instance >= 0 ? (robots ? &robot_shapes_ : nullptr)
-                                      : (statics ? &statics_ : nullptr);
+    ShapeIndex* index =
+        instance >= 0 ? (robots ? &robot_shapes_ : nullptr) : (statics ? &statics_ : nullptr);
     if (index == nullptr) continue;
     Occluder o;
-    o.shape = proximity::PlaceShape(shapes[r], scene.world_pose_at(slot), scene.IdAt(slot),
-                                    instance);
+    o.shape =
+        proximity::PlaceShape(shapes[r], scene.world_pose_at(slot), scene.IdAt(slot), instance);
     o.slot = slot;
     proximity::WorldBounds(o.shape, &o.lo, &o.hi);
     // Grown a little: the exact test decides, these only must not miss.
@@ -139,9 +139,8 @@ void RangeAndBearingModule::IndexShapes(const Scene& scene, bool statics, bool r
 }
 
 template <class Skip>
-void RangeAndBearingModule::ShapeIndex::List(double x, double y, double r, double z_lo,
-                                             double z_hi, Skip skip,
-                                             std::vector<uint32_t>* out) const {
+void RangeAndBearingModule::ShapeIndex::List(double x, double y, double r, double z_lo, double z_hi,
+                                             Skip skip, std::vector<uint32_t>* out) const {
   out->clear();
   if (items.empty()) return;
   grid.QueryCircle(x, y, r, out);
@@ -157,8 +156,8 @@ void RangeAndBearingModule::ShapeIndex::List(double x, double y, double r, doubl
 }
 
 bool RangeAndBearingModule::Blocked(const Scene& scene, const Board& from, const Board& to,
-                                    double distance, const std::vector<uint32_t>& statics,
-                                    bool map, const std::vector<uint32_t>& robots) const {
+                                    double distance, const std::vector<uint32_t>& statics, bool map,
+                                    const std::vector<uint32_t>& robots) const {
   const double length = distance - 2 * kEndMargin;
   if (!(length > 0)) return false;
   const Vec3 d_W = (to.p_W - from.p_W) / distance;
@@ -229,7 +228,9 @@ void RangeAndBearingModule::Hear(const Scene& scene, const Rows<RangeAndBearingR
   if (s.occlusion && have_statics_)
     statics_.List(
         self.p_W.x, self.p_W.y, s.range, z_lo_, z_hi_,
-        [&](const Occluder& o) { return self.instance < 0 && IsAncestor(scene, o.slot, self.slot); },
+        [&](const Occluder& o) {
+          return self.instance < 0 && IsAncestor(scene, o.slot, self.slot);
+        },
         &statics);
   if (s.robot_occlusion && have_robot_shapes_)
     robot_shapes_.List(
@@ -242,12 +243,11 @@ void RangeAndBearingModule::Hear(const Scene& scene, const Rows<RangeAndBearingR
   const bool map = s.occlusion && have_map_;
   const bool occluded = map || !statics.empty() || !robots.empty();
   const bool lossy = s.loss_probability > 0 || s.loss_at_range > 0;
-  Rng loss = lossy ? NoiseStream(seed_, self.slot, step_, NoisePurpose::kRangeAndBearingLoss)
-                   : Rng();
+  Rng loss =
+      lossy ? NoiseStream(seed_, self.slot, step_, NoisePurpose::kRangeAndBearingLoss) : Rng();
   if (lossy && s.range_noise.failure > 0) loss.Uniform();  // the failure's draw, as above
-  const size_t capacity = s.capacity > 0 && s.capacity_order == CapacityOrder::kNearest
-                              ? s.capacity
-                              : heard.size();
+  const size_t capacity =
+      s.capacity > 0 && s.capacity_order == CapacityOrder::kNearest ? s.capacity : heard.size();
   size_t kept = 0;
   for (size_t k = 0; k < heard.size() && kept < capacity; ++k) {
     const Board& other = boards_[heard[k].board];
@@ -263,9 +263,8 @@ void RangeAndBearingModule::Hear(const Scene& scene, const Rows<RangeAndBearingR
   if (s.capacity > 0 && s.capacity_order == CapacityOrder::kRandom && heard.size() > s.capacity) {
     Rng pick = NoiseStream(seed_, self.slot, step_, NoisePurpose::kCapacity);
     for (size_t k = 0; k < s.capacity; ++k)
-      std::swap(heard[k], heard[static_cast<size_t>(
-                              pick.UniformInt(static_cast<int64_t>(k),
-                                              static_cast<int64_t>(heard.size()) - 1))]);
+      std::swap(heard[k], heard[static_cast<size_t>(pick.UniformInt(
+                              static_cast<int64_t>(k), static_cast<int64_t>(heard.size()) - 1))]);
     heard.resize(s.capacity);
     std::sort(heard.begin(), heard.end(), [this](const Heard& a, const Heard& b) {
       return a.distance != b.distance ? a.distance < b.distance
@@ -275,8 +274,7 @@ void RangeAndBearingModule::Hear(const Scene& scene, const Rows<RangeAndBearingR
   // The readings, in the receiver's frame, with their noise and payloads.
   const Quat q_RW = scene.world_pose_at(self.slot).q.Conjugate();
   const bool noisy = s.range_noise.perturbs() || s.bearing_noise.perturbs();
-  Rng noise =
-      noisy ? NoiseStream(seed_, self.slot, step_, NoisePurpose::kRangeAndBearing) : Rng();
+  Rng noise = noisy ? NoiseStream(seed_, self.slot, step_, NoisePurpose::kRangeAndBearing) : Rng();
   size_t bytes = 0;
   for (const Heard& h : heard) bytes += rows.rows[boards_[h.board].row].settings->payload_size;
   rab->received.assign(bytes, 0);
@@ -319,7 +317,8 @@ int RangeAndBearingModule::SetData(Scene* scene, int robot, ObjectId id, const u
   if (!scene->FindType(kTypeName, &type) || !scene->IsValid(id) || scene->type(id) != type ||
       robot < 0 || scene->instance_of(id) != robot)
     return -1;
-  RangeAndBearingRow& rab = scene->rows<RangeAndBearingRow>(type).rows[scene->row_at(scene->SlotOf(id))];
+  RangeAndBearingRow& rab =
+      scene->rows<RangeAndBearingRow>(type).rows[scene->row_at(scene->SlotOf(id))];
   if (size > rab.settings->payload_size) return -1;
   try {
     rab.data.assign(data, data + size);  // at most kMaxPayloadSize bytes

@@ -48,8 +48,8 @@ class RangeAndBearingModule final : public Module, public RangeAndBearingAccess 
   // robot (occlusion).
   struct Occluder {
     proximity::PlacedShape shape;
-    Vec3 lo, hi;        // its world bounds, grown for rounding
-    double cx, cy, r;   // a circle about its (x, y) bounds
+    Vec3 lo, hi;       // its world bounds, grown for rounding
+    double cx, cy, r;  // a circle about its (x, y) bounds
     uint32_t slot;
   };
   // The shapes of one kind, placed, and a grid over their footprints.
@@ -89,14 +89,14 @@ class RangeAndBearingModule final : public Module, public RangeAndBearingAccess 
   bool have_type_ = false;
   ObjectType type_{};
   const LineOfSight* line_of_sight_ = nullptr;  // the world's: asked for the map's voxels
-  std::vector<Board> boards_;           // every board (rows order)
-  std::vector<GridItem> board_items_;   // their xy (boards_)
+  std::vector<Board> boards_;                   // every board (rows order)
+  std::vector<GridItem> board_items_;           // their xy (boards_)
   SpatialGrid board_grid_;
-  double z_lo_ = 0, z_hi_ = 0;           // the boards' heights (m)
-  ShapeIndex statics_;                   // shapes of no robot, when a board asks
-  ShapeIndex robot_shapes_;              // robots' shapes, when a board asks
+  double z_lo_ = 0, z_hi_ = 0;  // the boards' heights (m)
+  ShapeIndex statics_;          // shapes of no robot, when a board asks
+  ShapeIndex robot_shapes_;     // robots' shapes, when a board asks
   bool have_statics_ = false, have_robot_shapes_ = false;
-  bool have_map_ = false;                // the scene has a map: ask the line of sight
+  bool have_map_ = false;  // the scene has a map: ask the line of sight
 };
 
 }  // namespace swarmsim::range_and_bearing

@@ -42,9 +42,9 @@ enum class CapacityOrder : uint8_t {
 
 // Settings: shared by the copies of one model entry (shared_settings.h).
 struct RangeAndBearingSettings {
-  double range = 3;              // m: a board hears the senders within it
-  uint32_t payload_size = 10;    // bytes a board sends every step
-  uint32_t capacity = 0;         // readings kept per step at most; 0: all
+  double range = 3;            // m: a board hears the senders within it
+  uint32_t payload_size = 10;  // bytes a board sends every step
+  uint32_t capacity = 0;       // readings kept per step at most; 0: all
   CapacityOrder capacity_order = CapacityOrder::kNearest;
   double loss_probability = 0;   // p0: every message is lost with p0 + ...
   double loss_at_range = 0;      // ... + p1 (d / range)^2 (clamped to 1)
@@ -64,15 +64,15 @@ struct RangeAndBearingSettings {
 // One message heard in the last sense phase, in the receiver board's frame
 // (its +x the bearing 0, +z up).
 struct RangeAndBearingReading {  // 40 bytes
-  double range = 0;       // m, from the receiver board's origin to the sender's (noise added)
-  double bearing = 0;     // rad, in (-pi, pi]: about +z from +x, counter-clockwise
-  double elevation = 0;   // rad, in [-pi/2, pi/2]: above the board's xy plane
-  ObjectId sender;        // the sending board (not given to scripts: ARGoS gives no identity)
+  double range = 0;          // m, from the receiver board's origin to the sender's (noise added)
+  double bearing = 0;        // rad, in (-pi, pi]: about +z from +x, counter-clockwise
+  double elevation = 0;      // rad, in [-pi/2, pi/2]: above the board's xy plane
+  ObjectId sender;           // the sending board (not given to scripts: ARGoS gives no identity)
   uint32_t data_offset = 0;  // its payload: received[data_offset, + data_size)
   uint32_t data_size = 0;
 };
 
-struct RangeAndBearingRow {
+struct RangeAndBearingRow {  // 80 bytes
   Shared<RangeAndBearingSettings> settings;
   // State (hashed). What this board sends (at most payload_size bytes; the
   // message is padded with zeros to payload_size), kept until changed.

@@ -18,15 +18,18 @@ namespace {
 constexpr double kDeg = 3.141592653589793 / 180;
 
 constexpr ObjectKey kKeys[] = {
-    {"range", "3", "m, > 0: the board hears the boards of other robots within it (foot-bot 3, e-puck 0.8)"},
+    {"range", "3",
+     "m, > 0: the board hears the boards of other robots within it (foot-bot 3, e-puck 0.8)"},
     {"payload_size", "10", "bytes sent every step, 1..1024 (foot-bot 10, e-puck 4)"},
-    {"loss_probability", "0", "0..1: every message is lost with this probability (plus loss_at_range's term)"},
+    {"loss_probability", "0",
+     "0..1: every message is lost with this probability (plus loss_at_range's term)"},
     {"loss_at_range", "0",
      "0..1: added to the loss probability times (distance / range)^2: "
      "p = min(1, loss_probability + loss_at_range (d / range)^2)"},
     {"range_noise", "0", "m, >= 0: std dev of Gaussian noise on each reading's range"},
     {"range_noise_uniform", "0", "m, >= 0: half width of uniform noise on each reading's range"},
-    {"bearing_noise_deg", "0", "std dev of Gaussian noise on bearing and elevation, 0..180 degrees"},
+    {"bearing_noise_deg", "0",
+     "std dev of Gaussian noise on bearing and elevation, 0..180 degrees"},
     {"bearing_noise_uniform_deg", "0",
      "half width of uniform noise on bearing and elevation, 0..180 degrees"},
     {"failure_probability", "0", "0..1: the board hears nothing at a step"},

@@ -27,9 +27,9 @@ struct ModelLayout {
   std::vector<uint32_t> root_slots;       // per robot
   std::vector<uint32_t> joint_slots;      // robots x joints
   std::vector<uint32_t> sensor_slots;     // robots x sensors
-  std::vector<uint32_t> board_slots;      // per robot: its first range-and-bearing board, or kNoBoard
+  std::vector<uint32_t> board_slots;  // per robot: its first range-and-bearing board, or kNoBoard
   static constexpr uint32_t kNoBoard = UINT32_MAX;
-  int64_t robot_count = -1;               // World::robot_count() it was built at
+  int64_t robot_count = -1;  // World::robot_count() it was built at
 };
 
 // Rebuilds `layout` for `model` ("" : every robot) if robots came or went.

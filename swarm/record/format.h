@@ -9,7 +9,8 @@ namespace swarmsim::record {
 inline constexpr const char* kRecordingFileName = "recording.swrec";
 inline constexpr const char* kFormatName = "swarmsim-recording";
 inline constexpr int kVersionMajor = 1;
-inline constexpr int kVersionMinor = 2;  // 1.1: objects as their types declare their visuals; 1.2: links
+inline constexpr int kVersionMinor =
+    2;  // 1.1: objects as their types declare their visuals; 1.2: links
 
 inline constexpr uint8_t kMagic[4] = {'S', 'W', 'R', 'C'};
 inline constexpr uint32_t kChunkHeaderSize = 24;

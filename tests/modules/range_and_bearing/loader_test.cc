@@ -22,7 +22,8 @@ using RangeAndBearingLoaderTest = testing::WorldDirTest;
 
 TEST_F(RangeAndBearingLoaderTest, BadValuesAreFileLineColumnErrors) {
   const char* t = kTypeName;
-  EXPECT_CONTAINS(ErrorOf(t, "  range: -1\n"), "thing.yaml:4:10: 'range' must be a positive number");
+  EXPECT_CONTAINS(ErrorOf(t, "  range: -1\n"),
+                  "thing.yaml:4:10: 'range' must be a positive number");
   EXPECT_CONTAINS(ErrorOf(t, "  range: 0\n"), "thing.yaml:4:10:");
   EXPECT_CONTAINS(ErrorOf(t, "  loss_probability: 1.5\n"), "thing.yaml:4:21:");
   EXPECT_CONTAINS(ErrorOf(t, "  loss_probability: -0.1\n"), "thing.yaml:4:21:");

@@ -18,7 +18,7 @@ namespace {
 // e-puck's). Runs `steps` steps; returns what the scripts printed, and the
 // error in *error.
 std::vector<std::string> RunScripts(const std::string& code0, const std::string& code1, int steps,
-                             std::string* error) {
+                                    std::string* error) {
   RabWorld w;
   RangeAndBearingSettings s;
   s.range = 2;
@@ -30,8 +30,8 @@ std::vector<std::string> RunScripts(const std::string& code0, const std::string&
   for (int i = 0; i < 2; ++i) {
     const uint32_t slot = w.scene().SlotOf(boards[i]);
     const ObjectId root = w.scene().IdAt(static_cast<uint32_t>(w.scene().parent_at(slot)));
-    w.scene().AttachScript(root, std::make_shared<const ScriptSource>(ScriptSource{
-                                     "bot" + std::to_string(i) + ".lua", codes[i]}));
+    w.scene().AttachScript(root, std::make_shared<const ScriptSource>(
+                                     ScriptSource{"bot" + std::to_string(i) + ".lua", codes[i]}));
   }
   try {
     w.world().Start();
@@ -70,7 +70,7 @@ TEST(RangeAndBearingLuaTest, ScriptsSetDataAndReadWhatOthersSent) {
       if n == 2 then sim.setRangeAndBearingData(rab, {7, 0, 255, 1}) end
     end
   )",
-                       4, &error);
+                              4, &error);
   EXPECT_EQ(error, "");
   std::vector<std::string> lines;
   for (const std::string& l : log) lines.push_back(l.substr(l.find(']') + 2));
@@ -85,8 +85,8 @@ TEST(RangeAndBearingLuaTest, ScriptsSetDataAndReadWhatOthersSent) {
 
 std::string ErrorOf(const std::string& code) {
   std::string error;
-  RunScripts("function sysCall_init()\n  rab = sim.getObject('./rab')\n  " + code + "\nend\n", "", 1,
-      &error);
+  RunScripts("function sysCall_init()\n  rab = sim.getObject('./rab')\n  " + code + "\nend\n", "",
+             1, &error);
   return error;
 }
 
@@ -107,10 +107,8 @@ TEST(RangeAndBearingLuaTest, OtherMistakesAreScriptErrorsToo) {
   EXPECT_NE(ErrorOf("sim.setRangeAndBearingData(rab, {1, 256})")
                 .find("element 2 of the data must be an integer from 0 to 255"),
             std::string::npos);
-  EXPECT_NE(ErrorOf("sim.setRangeAndBearingData(rab, {1.5})").find("element 1"),
-            std::string::npos);
-  EXPECT_NE(ErrorOf("sim.setRangeAndBearingData(rab, {'a'})").find("element 1"),
-            std::string::npos);
+  EXPECT_NE(ErrorOf("sim.setRangeAndBearingData(rab, {1.5})").find("element 1"), std::string::npos);
+  EXPECT_NE(ErrorOf("sim.setRangeAndBearingData(rab, {'a'})").find("element 1"), std::string::npos);
   EXPECT_NE(ErrorOf("sim.setRangeAndBearingData(rab, 12)").find("bad argument #2"),
             std::string::npos);
   EXPECT_NE(ErrorOf("sim.setRangeAndBearingData(sim.getObject('/bot#1/rab'), 'x')")

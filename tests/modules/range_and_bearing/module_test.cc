@@ -261,7 +261,8 @@ struct CapacityWorld {
     const double distances[] = {1.5, 0.5, 2.5, 1.0, 2.0};  // sender i sends i + 1
     for (int i = 0; i < 5; ++i) {
       const double a = 1.3 * i;
-      const ObjectId b = w.Robot(distances[i] * std::cos(a), distances[i] * std::sin(a), 0, Board());
+      const ObjectId b =
+          w.Robot(distances[i] * std::cos(a), distances[i] * std::sin(a), 0, Board());
       w.SetData(b, std::string(1, static_cast<char>(i + 1)));
     }
   }
@@ -330,7 +331,8 @@ TEST(RangeAndBearingTest, DataIsKeptUntilChanged) {
   const ObjectId receiver = w.Robot(0, 0, 0, Board());
   const ObjectId sender = w.Robot(1, 0, 0, Board());
   w.SetData(sender, "abc");
-  for (int i = 0; i < 3; ++i) EXPECT_EQ(w.Step(receiver)[0].data.substr(0, 4), std::string("abc\0", 4));
+  for (int i = 0; i < 3; ++i)
+    EXPECT_EQ(w.Step(receiver)[0].data.substr(0, 4), std::string("abc\0", 4));
   w.SetData(sender, "z");
   EXPECT_EQ(w.Step(receiver)[0].data.substr(0, 2), std::string("z\0", 2));
 }

@@ -53,8 +53,8 @@ TEST_F(RangeAndBearingNativeTest, ControllersSetDataAndReadWhatOthersSent) {
   ASSERT_TRUE(scene.FindType(kTypeName, &type));
   const auto& rows = scene.rows<RangeAndBearingRow>(type);
   const auto reading = [&](int robot, size_t k) {
-    const RangeAndBearingRow& row =
-        rows.rows[scene.row_at(scene.SlotOf(scene.FindObject("./rab", scene.instance(robot).root)))];
+    const RangeAndBearingRow& row = rows.rows[scene.row_at(
+        scene.SlotOf(scene.FindObject("./rab", scene.instance(robot).root)))];
     EXPECT_LT(k, row.readings.size());
     const RangeAndBearingReading& r = row.readings.at(k);
     return std::vector<int>(row.received.begin() + r.data_offset,
@@ -81,9 +81,9 @@ TEST_F(RangeAndBearingNativeTest, DataLongerThanThePayloadIsRefused) {
 TEST_F(RangeAndBearingNativeTest, APluginBuiltForAbi6StillLoadsAndRuns) {
   Write("bot.yaml", "model: bot\nobjects:\n  type: dummy\n  script: bot.lua\n");
   Write("bot.lua", "function sysCall_actuation() print('time ' .. sim.abi6Time()) end\n");
-  LoadedWorld w =
-      Load("plugins: [abi6_plugin]\nsimulation: {physics: kinematic, time_step: 0.1}\n"
-           "models: [{model: bot.yaml, position: [0, 0]}]\n");
+  LoadedWorld w = Load(
+      "plugins: [abi6_plugin]\nsimulation: {physics: kinematic, time_step: 0.1}\n"
+      "models: [{model: bot.yaml, position: [0, 0]}]\n");
   std::vector<std::string> log;
   w.world->set_log_sink([&](std::string_view line) { log.emplace_back(line); });
   w.world->Start();

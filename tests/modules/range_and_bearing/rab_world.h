@@ -90,8 +90,7 @@ class RabWorld {
     const RangeAndBearingRow& row = Row(board);
     std::vector<Heard> out;
     for (const RangeAndBearingReading& r : row.readings)
-      out.push_back({std::string(reinterpret_cast<const char*>(row.received.data()) +
-                                     r.data_offset,
+      out.push_back({std::string(reinterpret_cast<const char*>(row.received.data()) + r.data_offset,
                                  r.data_size),
                      r.range, r.bearing, r.elevation, r.sender});
     return out;

@@ -23,7 +23,8 @@ TEST(RangeAndBearingRecordTest, EveryStepRecordKnowsWhoHeardWhom) {
   const fs::path out = testing::FreshTempDir("swarmsim_rab_record", "links");
   const auto r = testing::RunProgram("run " + std::string(SWARMSIM_SOURCE_DIR) +
                                      "/tests/data/viewer/rab_links/world.yaml --quiet --record "
-                                     "--out " + out.string());
+                                     "--out " +
+                                     out.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   RecordingPlayer player(out);
   EXPECT_EQ(player.info().version_minor, 2);

@@ -21,9 +21,9 @@ class RabLinksBrowserTest : public ::testing::Test {
   void SetUp() override {
     if (const std::string missing = BrowserMissing(); !missing.empty()) GTEST_SKIP() << missing;
     run_ = FreshTempDir("viewer_browser", "rab_links");
-    const CommandResult run =
-        RunProgram("run " + std::string(SWARMSIM_SOURCE_DIR) +
-                   "/tests/data/viewer/rab_links/world.yaml --quiet --record --out " + run_.string());
+    const CommandResult run = RunProgram(
+        "run " + std::string(SWARMSIM_SOURCE_DIR) +
+        "/tests/data/viewer/rab_links/world.yaml --quiet --record --out " + run_.string());
     ASSERT_EQ(run.exit_code, 0) << run.output;
   }
   void TearDown() override {
@@ -37,7 +37,8 @@ class RabLinksBrowserTest : public ::testing::Test {
 bool CyanNear(const Image& image, double x, double y) {
   for (int dy = -2; dy <= 2; ++dy)
     for (int dx = -2; dx <= 2; ++dx) {
-      const int px = static_cast<int>(std::lround(x)) + dx, py = static_cast<int>(std::lround(y)) + dy;
+      const int px = static_cast<int>(std::lround(x)) + dx,
+                py = static_cast<int>(std::lround(y)) + dy;
       if (px < 0 || py < 0 || px >= image.width || py >= image.height) continue;
       const uint8_t* c = image.At(px, py);
       if (c[2] > 100 && c[1] > 100 && c[0] + 30 < c[1]) return true;
@@ -52,9 +53,10 @@ TEST_F(RabLinksBrowserTest, LinesJoinTheRobotsThatHeardEachOtherAndTheBoxHidesTh
   browser.Open(server.Address());
   ASSERT_EQ(browser.WaitForViewer(), "");
   browser.Run("swarmsimViewer.topDown(); swarmsimViewer.setRecord(3);");
-  EXPECT_EQ(browser.Run("const v = swarmsimViewer.view;"
-                        "return {lines: v.linkCount, mutual: v.mutualLinks, shown: v.links.visible};"),
-            json::parse(R"({"lines": 2, "mutual": 1, "shown": true})"));
+  EXPECT_EQ(
+      browser.Run("const v = swarmsimViewer.view;"
+                  "return {lines: v.linkCount, mutual: v.mutualLinks, shown: v.links.visible};"),
+      json::parse(R"({"lines": 2, "mutual": 1, "shown": true})"));
   // The a-b line runs from a's board to b's: 0.1 m up, 1 m apart on x.
   const json ends = browser.Run(
       "const p = swarmsimViewer.view.links.geometry.attributes.position.array;"

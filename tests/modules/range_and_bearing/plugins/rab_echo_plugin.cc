@@ -32,9 +32,9 @@ int Step(const SwarmsimCallContext* c, void* state, char* error, size_t error_si
     std::snprintf(error, error_size, "read_range_and_bearing failed");
     return -1;
   }
-  const uint8_t data[3] = {static_cast<uint8_t>(c->robot), static_cast<uint8_t>(n),
-                           static_cast<uint8_t>(n > 0 && readings[0].size > 0 ? readings[0].data[0]
-                                                                               : 0)};
+  const uint8_t data[3] = {
+      static_cast<uint8_t>(c->robot), static_cast<uint8_t>(n),
+      static_cast<uint8_t>(n > 0 && readings[0].size > 0 ? readings[0].data[0] : 0)};
   double too_long = 0;
   c->api->number_parameter(c->world, c->robot, "too_long", &too_long);
   const uint8_t big[11] = {};
