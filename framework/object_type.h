@@ -190,6 +190,15 @@ struct ObjectTypeDescriptor {
   // stay (proximity_sensor: "joint"). Null, or a name not yet registered:
   // after the types before it.
   const char* listed_after = nullptr;
+  // --- Links ----------------------------------------------------------------------
+  // The objects the object at `row` was linked to at the last sense phase
+  // (a range-and-bearing board: the boards it heard), appended to *out.
+  // The recorder writes them at every recorded step (swarm/record/FORMAT.md,
+  // "Links chunk") and the viewer draws a line for each, between recorded
+  // objects (the object's type and the linked objects' types declare a
+  // visual). Called between steps, on one thread. Null: no links.
+  void (*links)(const Scene& scene, ObjectType type, uint32_t row,
+                std::vector<ObjectId>* out) = nullptr;
 };
 
 // The order `types` (by ObjectType value) are listed in: their indices,

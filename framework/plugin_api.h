@@ -13,18 +13,23 @@
 // 4) that model files place like built-in ones; and vision-sensor filter
 // elements (ABI 5) that a sensor's `filters:` list names; and native
 // controllers (ABI 6) that a models entry attaches with `native_controller:`,
-// called once per robot per step in the control phase. Arguments and
+// called once per robot per step in the control phase; their world API
+// reads and sets range-and-bearing boards (ABI 7). Arguments and
 // results are numbers, strings and number arrays (SwarmsimValue); no Lua
 // type crosses this interface. Everything here is plain C, so a plugin
 // built with another compiler works as long as the ABI version matches; the
-// version changes whenever a struct below does.
+// version changes whenever a struct below does (a plugin of a version from
+// SWARMSIM_PLUGIN_ABI_OLDEST up loads: later versions only add at the end).
 #ifndef SWARMSIM_PLUGIN_API_H_
 #define SWARMSIM_PLUGIN_API_H_
 
 #include <stddef.h>
 #include <stdint.h>
 
-#define SWARMSIM_PLUGIN_ABI_VERSION 6
+#define SWARMSIM_PLUGIN_ABI_VERSION 7
+// The oldest ABI this swarmsim still loads: ABI 7 only added functions at
+// the end of SwarmsimWorldApi, so a plugin built for ABI 6 runs unchanged.
+#define SWARMSIM_PLUGIN_ABI_OLDEST 6
 
 #ifdef __cplusplus
 extern "C" {
@@ -66,6 +71,17 @@ typedef struct SwarmsimMessage {
   double distance;   // m, from the receiver's model root to the sender
   double bearing;    // rad, of the sender in the receiver's root frame (0 = +x, CCW)
 } SwarmsimMessage;
+
+// One reading of a range-and-bearing board (ABI 7), as
+// sim.readRangeAndBearing gives it.
+typedef struct SwarmsimRangeAndBearingReading {
+  // The sender's payload (payload_size bytes), valid until the next sense phase.
+  const uint8_t* data;
+  size_t size;
+  double range;      // m, between the two boards' origins (noise added)
+  double bearing;    // rad, in (-pi, pi]: in the receiving board's xy plane from its +x, CCW
+  double elevation;  // rad, in [-pi/2, pi/2]: above that plane
+} SwarmsimRangeAndBearingReading;
 
 // A narrow, read-mostly view of the world the command runs in.
 typedef struct SwarmsimWorldApi {
@@ -144,6 +160,19 @@ typedef struct SwarmsimWorldApi {
   // A uniform number in [0, 1) from `robot`'s own random stream (keyed by
   // seed and robot index, sim.random's). Only from that robot's controller.
   double (*random_uniform)(void* world, int robot);
+  // --- ABI 7 ---
+  // Sets the bytes a range-and-bearing board sends every step from the next
+  // sense phase on (sim.setRangeAndBearingData's rules: kept until set
+  // again, padded with zeros to its payload_size). `robot` must be the
+  // caller's and own the board. Returns 0, or -1 if `board` is not a live
+  // board of `robot`, or `size` is more than its payload_size.
+  int (*set_range_and_bearing_data)(void* world, int robot, int64_t board, const uint8_t* data,
+                                    size_t size);
+  // The readings of a board's last sense phase, nearest first
+  // (sim.readRangeAndBearing's), into out[0..max); returns how many there
+  // are (possibly more than max), or -1 if `board` is not a live board.
+  int (*read_range_and_bearing)(void* world, int64_t board, SwarmsimRangeAndBearingReading* out,
+                                int max);
 } SwarmsimWorldApi;
 
 // Who is calling: the robot and the script's object.

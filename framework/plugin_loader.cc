@@ -193,10 +193,14 @@ void LoadPlugin(const std::string& path, ModuleRegistry* registry) {
     throw Error("plugin '" + path + "' is not a swarmsim plugin: it does not export " +
                 (version == nullptr ? "swarmsim_plugin_abi_version" : "swarmsim_plugin_register") +
                 " (see framework/plugin_api.h)");
-  if (const int v = version(); v != SWARMSIM_PLUGIN_ABI_VERSION)
+  // Versions from the oldest up only added at the end of the structs: an
+  // older plugin sees the prefix it was built for.
+  if (const int v = version(); v < SWARMSIM_PLUGIN_ABI_OLDEST || v > SWARMSIM_PLUGIN_ABI_VERSION)
     throw Error("plugin '" + path + "' was built for plugin ABI version " + std::to_string(v) +
                 ", this swarmsim has version " + std::to_string(SWARMSIM_PLUGIN_ABI_VERSION) +
-                "; rebuild it against this framework/plugin_api.h");
+                " (and loads plugins of versions " + std::to_string(SWARMSIM_PLUGIN_ABI_OLDEST) +
+                " to " + std::to_string(SWARMSIM_PLUGIN_ABI_VERSION) +
+                "); rebuild it against this framework/plugin_api.h");
   Registration r;
   r.info.name.assign(path);
   r.info.version.assign("unversioned");

@@ -8,6 +8,7 @@
 #include "framework/plugin_object_type.h"
 #include "framework/plugin_sensors.h"
 #include "framework/proximity_readings.h"
+#include "framework/range_and_bearing_access.h"
 #include "framework/world.h"
 
 namespace swarmsim {
@@ -231,6 +232,26 @@ double RandomUniform(void* world, int robot) {
   return w.runtime(robot).rng.Uniform();
 }
 
+// The range_and_bearing module's world instance, if the world has one.
+const RangeAndBearingAccess* Boards(World& w) {
+  return dynamic_cast<const RangeAndBearingAccess*>(w.find_module("range_and_bearing"));
+}
+
+int SetRangeAndBearingData(void* world, int robot, int64_t board, const uint8_t* data,
+                           size_t size) {
+  World& w = W(world);
+  const RangeAndBearingAccess* boards = Boards(w);
+  if (boards == nullptr || (data == nullptr && size > 0)) return -1;
+  return boards->SetData(&w.scene(), robot, ObjectId::FromInteger(board), data, size);
+}
+
+int ReadRangeAndBearing(void* world, int64_t board, SwarmsimRangeAndBearingReading* out, int max) {
+  World& w = W(world);
+  const RangeAndBearingAccess* boards = Boards(w);
+  if (boards == nullptr) return -1;
+  return boards->Read(w.scene(), ObjectId::FromInteger(board), out, out != nullptr ? max : 0);
+}
+
 constexpr SwarmsimWorldApi kWorldApi = {WorldTime,
                                         ObjectPosition,
                                         NumberParameter,
@@ -251,7 +272,9 @@ constexpr SwarmsimWorldApi kWorldApi = {WorldTime,
                                         Parameter,
                                         SendMessage,
                                         ReceiveMessage,
-                                        RandomUniform};
+                                        RandomUniform,
+                                        SetRangeAndBearingData,
+                                        ReadRangeAndBearing};
 
 }  // namespace
 

@@ -19,6 +19,7 @@
 #include "modules/paths/paths.h"
 #include "modules/planning/planning.h"
 #include "modules/proximity/proximity.h"
+#include "modules/range_and_bearing/range_and_bearing.h"
 #include "modules/rendering/filters/filters.h"
 #include "modules/rendering/objects.h"
 #include "modules/rendering/video/recorder.h"
@@ -70,6 +71,7 @@ void RegisterBuiltinModules(ModuleRegistry* registry) {
   graphs::Register(registry);
   blobs::Register(registry);
   video::Register(registry);  // snapshots and video: the program's view recorder
+  range_and_bearing::Register(registry);
   // World-file sections, in the order the loader reads them.
   registry->RegisterWorldSection(metrics::MetricsSection());
   registry->RegisterWorldSection(paint::PaintSection());

@@ -10,6 +10,7 @@
 #include "framework/scene.h"
 #include "framework/scheduler.h"
 #include "modules/proximity/proximity_sensor.h"
+#include "modules/range_and_bearing/range_and_bearing.h"
 
 namespace swarmsim::python {
 
@@ -50,6 +51,8 @@ void Refresh(const World& world, const std::string& model, ModelLayout* layout) 
   // Without the proximity module's type no object matches `sensor`.
   ObjectType sensor = static_cast<ObjectType>(kMaxObjectTypes);
   proximity::FindSensorType(scene, &sensor);
+  ObjectType board = static_cast<ObjectType>(kMaxObjectTypes);
+  scene.FindType(range_and_bearing::kTypeName, &board);
   *layout = ModelLayout{};
   layout->model = model;
   const auto instances = scene.instances();
@@ -59,7 +62,9 @@ void Refresh(const World& world, const std::string& model, ModelLayout* layout) 
     if (!inst.alive || (!model.empty() && inst.model_name != model)) continue;
     std::vector<std::string> joints, sensors;
     std::vector<uint32_t> joint_slots, sensor_slots;
+    uint32_t board_slot = ModelLayout::kNoBoard;
     for (const uint32_t slot : inst.objects) {
+      if (scene.type_at(slot) == board && board_slot == ModelLayout::kNoBoard) board_slot = slot;
       if (scene.type_at(slot) == joint) {
         joints.push_back(scene.name_at(slot));
         joint_slots.push_back(slot);
@@ -88,6 +93,7 @@ void Refresh(const World& world, const std::string& model, ModelLayout* layout) 
     }
     layout->robots.push_back(static_cast<int>(i));
     layout->root_slots.push_back(scene.SlotOf(inst.root));
+    layout->board_slots.push_back(board_slot);
     if (layout->joint_names.size() == joint_slots.size())
       layout->joint_slots.insert(layout->joint_slots.end(), joint_slots.begin(), joint_slots.end());
     if (layout->sensor_names.size() == sensor_slots.size())
@@ -219,6 +225,95 @@ Array Proximity(const Scene& scene, const ModelLayout& layout, const py::object&
     d[k] = p.detected ? p.distance : std::numeric_limits<double>::infinity();
   }
   return a;
+}
+
+py::dict RangeAndBearing(const Scene& scene, const ModelLayout& layout) {
+  using range_and_bearing::RangeAndBearingRow;
+  const size_t n = layout.robots.size();
+  ObjectType type;
+  const RangeAndBearingRow* rows = nullptr;
+  if (scene.FindType(range_and_bearing::kTypeName, &type))
+    rows = scene.rows<RangeAndBearingRow>(type).rows.data();
+  const auto board = [&](size_t i) -> const RangeAndBearingRow* {
+    const uint32_t slot = layout.board_slots[i];
+    return slot == ModelLayout::kNoBoard || rows == nullptr ? nullptr : &rows[scene.row_at(slot)];
+  };
+  size_t m = 0, width = 0;
+  for (size_t i = 0; i < n; ++i)
+    if (const RangeAndBearingRow* b = board(i)) {
+      m += b->readings.size();
+      for (const auto& r : b->readings) width = std::max<size_t>(width, r.data_size);
+    }
+  const auto sm = static_cast<py::ssize_t>(m), sw = static_cast<py::ssize_t>(width);
+  py::array_t<int64_t> offsets(static_cast<py::ssize_t>(n + 1)), sender(sm);
+  Array range(sm), bearing(sm), elevation(sm);
+  py::array_t<uint8_t> data({sm, sw});
+  int64_t* o = offsets.mutable_data();
+  int64_t* who = sender.mutable_data();
+  double *ra = range.mutable_data(), *be = bearing.mutable_data(), *el = elevation.mutable_data();
+  uint8_t* bytes = data.mutable_data();
+  if (m > 0) std::fill(bytes, bytes + m * width, uint8_t{0});
+  size_t k = 0;
+  for (size_t i = 0; i < n; ++i) {
+    o[i] = static_cast<int64_t>(k);
+    const RangeAndBearingRow* b = board(i);
+    if (b == nullptr) continue;
+    for (const auto& r : b->readings) {
+      ra[k] = r.range, be[k] = r.bearing, el[k] = r.elevation;
+      who[k] = scene.IsValid(r.sender) ? scene.instance_of(r.sender) : -1;
+      std::copy_n(b->received.data() + r.data_offset, r.data_size, bytes + k * width);
+      ++k;
+    }
+  }
+  o[n] = static_cast<int64_t>(k);
+  py::dict out;
+  out["offsets"] = offsets;
+  out["range"] = range;
+  out["bearing"] = bearing;
+  out["elevation"] = elevation;
+  out["sender"] = sender;
+  out["data"] = data;
+  return out;
+}
+
+void SetRangeAndBearingData(Scene* scene, const ModelLayout& layout, const py::object& data) {
+  using range_and_bearing::RangeAndBearingRow;
+  const size_t n = layout.robots.size();
+  py::array_t<int64_t, py::array::c_style | py::array::forcecast> a;
+  try {
+    a = py::cast<py::array_t<int64_t, py::array::c_style | py::array::forcecast>>(data);
+  } catch (const py::cast_error&) {
+    throw py::value_error("range-and-bearing data must be an array of bytes, one row per robot");
+  }
+  if (a.ndim() != 2 || static_cast<size_t>(a.shape(0)) != n)
+    throw py::value_error("range-and-bearing data must have shape (" + std::to_string(n) +
+                          ", bytes): one row per robot");
+  ObjectType type;
+  if (!scene->FindType(range_and_bearing::kTypeName, &type))
+    throw py::value_error("no range-and-bearing boards in this world");
+  auto& rows = scene->rows<RangeAndBearingRow>(type).rows;
+  const size_t k = static_cast<size_t>(a.shape(1));
+  const int64_t* v = a.data();
+  for (size_t i = 0; i < k * n; ++i)
+    if (v[i] < 0 || v[i] > 255)
+      throw py::value_error("range-and-bearing data must be bytes, 0..255 (got " +
+                            std::to_string(v[i]) + ")");
+  for (size_t i = 0; i < n; ++i) {
+    const uint32_t slot = layout.board_slots[i];
+    const std::string& robot = scene->instance(layout.robots[i]).name;
+    if (slot == ModelLayout::kNoBoard)
+      throw py::value_error("robot '" + robot + "' has no range-and-bearing board");
+    const uint32_t payload = rows[scene->row_at(slot)].settings->payload_size;
+    if (k > payload)
+      throw py::value_error("range-and-bearing data of " + std::to_string(k) +
+                            " bytes, more than robot '" + robot + "''s payload_size (" +
+                            std::to_string(payload) + " bytes)");
+  }
+  for (size_t i = 0; i < n; ++i) {
+    std::vector<uint8_t>& bytes = rows[scene->row_at(layout.board_slots[i])].data;
+    bytes.resize(k);
+    for (size_t j = 0; j < k; ++j) bytes[j] = static_cast<uint8_t>(v[i * k + j]);
+  }
 }
 
 // Joint positions (what = 0) or velocities (1), N x joints.

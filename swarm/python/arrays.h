@@ -27,7 +27,9 @@ struct ModelLayout {
   std::vector<uint32_t> root_slots;       // per robot
   std::vector<uint32_t> joint_slots;      // robots x joints
   std::vector<uint32_t> sensor_slots;     // robots x sensors
-  int64_t robot_count = -1;               // World::robot_count() it was built at
+  std::vector<uint32_t> board_slots;  // per robot: its first range-and-bearing board, or kNoBoard
+  static constexpr uint32_t kNoBoard = UINT32_MAX;
+  int64_t robot_count = -1;  // World::robot_count() it was built at
 };
 
 // Rebuilds `layout` for `model` ("" : every robot) if robots came or went.
@@ -46,6 +48,17 @@ Array Velocities(const Scene& scene, const ModelLayout& layout, const py::object
 // Proximity readings, N x sensors: the distance to what each sensor sees,
 // +inf where it sees nothing.
 Array Proximity(const Scene& scene, const ModelLayout& layout, const py::object& out);
+
+// What each robot's first range-and-bearing board heard in the last sense
+// phase, as flat arrays: robot i's readings are rows offsets[i] to
+// offsets[i + 1] - 1 (nearest first; none for a robot without a board):
+// offsets (N + 1, int64), range (m), bearing, elevation (rad) (M, float64),
+// sender (M, int64: the sending robot's index, -1 for a board of no robot)
+// and data (M x the largest payload, uint8, zero-padded).
+py::dict RangeAndBearing(const Scene& scene, const ModelLayout& layout);
+// Sets what each robot's first board sends: row i of `data` (N x k, bytes
+// 0..255, k at most the payload size) for robot i. Throws ValueError.
+void SetRangeAndBearingData(Scene* scene, const ModelLayout& layout, const py::object& data);
 
 // Joint positions (what = 0) or velocities (1), N x joints.
 Array Joints(const Scene& scene, const ModelLayout& layout, int what, const py::object& out);

@@ -72,6 +72,13 @@ class Robots {
   py::object joint_velocities() {
     return Cached(&joint_velocities_, [&] { return Joints(Sc(), *layout_, 1, py::none()); });
   }
+  py::object range_and_bearing() {
+    return Cached(&range_and_bearing_, [&] { return RangeAndBearing(Sc(), *layout_); });
+  }
+  // What each robot's first board sends from the next sense phase on.
+  void set_range_and_bearing_data(const py::object& data) {
+    SetRangeAndBearingData(&world_->scene(), *layout_, data);
+  }
   // A model parameter of every robot, as an array (numbers and booleans).
   Array param(const std::string& name) const {
     Array a(static_cast<py::ssize_t>(layout_->robots.size()));
@@ -99,7 +106,8 @@ class Robots {
   World* world_;
   const ModelLayout* layout_;
   bool planar_;
-  py::object poses_, velocities_, proximity_, joint_positions_, joint_velocities_;
+  py::object poses_, velocities_, proximity_, joint_positions_, joint_velocities_,
+      range_and_bearing_;
 };
 
 struct ControllerConfig {
@@ -405,6 +413,15 @@ class PyWorld {
   std::vector<std::string> sensor_names(const std::string& model) {
     return Layout(model).sensor_names;
   }
+  // What each robot's first range-and-bearing board heard (arrays.h).
+  py::dict range_and_bearing(const std::string& model) {
+    return RangeAndBearing(Any().scene(), Layout(model));
+  }
+  // Sets what each robot's first board sends, from the next sense phase on.
+  void set_range_and_bearing_data(const std::string& model, const py::object& data) {
+    World& w = Live();
+    SetRangeAndBearingData(&w.scene(), Layout(model), data);
+  }
   // Sets joint targets of a model's robots from Python between steps.
   void set_joint_targets(const std::string& model, const py::dict& targets) {
     World& w = Live();
@@ -538,6 +555,8 @@ PYBIND11_MODULE(_swarmsim, m) {
       .def_property_readonly("proximity", &Robots::proximity)
       .def_property_readonly("joint_positions", &Robots::joint_positions)
       .def_property_readonly("joint_velocities", &Robots::joint_velocities)
+      .def_property_readonly("range_and_bearing", &Robots::range_and_bearing)
+      .def("set_range_and_bearing_data", &Robots::set_range_and_bearing_data, py::arg("data"))
       .def("param", &Robots::param, py::arg("name"));
   py::class_<PyWorld>(m, "World")
       .def(py::init<const std::string&, std::optional<uint64_t>,
@@ -567,6 +586,9 @@ PYBIND11_MODULE(_swarmsim, m) {
       .def("joint_names", &PyWorld::joint_names, py::arg("model") = "")
       .def("sensor_names", &PyWorld::sensor_names, py::arg("model") = "")
       .def("set_joint_targets", &PyWorld::set_joint_targets, py::arg("model"), py::arg("targets"))
+      .def("range_and_bearing", &PyWorld::range_and_bearing, py::arg("model") = "")
+      .def("set_range_and_bearing_data", &PyWorld::set_range_and_bearing_data, py::arg("model"),
+           py::arg("data"))
       .def_property_readonly("metrics", &PyWorld::metrics)
       .def("robot_metric", &PyWorld::robot_metric, py::arg("name"))
       .def("metric_history", &PyWorld::metric_history, py::arg("name"))

@@ -79,6 +79,7 @@ std::string ChunkKindName(uint8_t kind) {
     case ChunkKind::kKeyframe: return "keyframe";
     case ChunkKind::kDelta: return "delta";
     case ChunkKind::kEnd: return "end";
+    case ChunkKind::kLinks: return "links";
   }
   return "kind " + std::to_string(kind);
 }

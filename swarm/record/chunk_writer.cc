@@ -30,6 +30,7 @@ const char* ChunkName(uint8_t kind) {
     case ChunkKind::kKeyframe: return "keyframe";
     case ChunkKind::kDelta: return "step record";
     case ChunkKind::kEnd: return "end";
+    case ChunkKind::kLinks: return "links chunk";
   }
   return "chunk";
 }
@@ -229,8 +230,20 @@ void ChunkWriter::Write(Job* job) {
     reading_.assign(lists_.object_count, 0);
   }
   if (job->snap) {
-    Encode(job->snap.get(), &payload_);
+    StepSnapshot& snap = *job->snap;
+    Encode(&snap, &payload_);
     WriteChunk(job->kind, job->step, payload_.data(), payload_.size());
+    if (snap.links) {
+      // The links chunk (FORMAT.md "Links chunk"), complete at every record.
+      Out out(&payload_);
+      out.Put<uint32_t>(snap.record);
+      out.PutIds(snap.link_from);
+      out.PutArray(snap.link_to);
+      WriteChunk(static_cast<uint8_t>(ChunkKind::kLinks), job->step, payload_.data(),
+                 payload_.size());
+      snap.link_from.clear();
+      snap.link_to.clear();
+    }
   } else {
     WriteChunk(job->kind, job->step, job->text.data(), job->text.size());
   }

@@ -45,6 +45,11 @@ struct StepSnapshot {
   uint32_t first_name = 0;                        // metric names from this id on
   std::vector<std::string> names;
   std::vector<SampleRow> samples;
+  // Links (1.2): written as a links chunk after the step record when
+  // `links` (the scene has objects whose type declares links): pairs of
+  // recorded ids, ascending by `link_from`.
+  bool links = false;
+  std::vector<uint32_t> link_from, link_to;
 };
 
 // The scene's lists the encoder needs, sent with every scene chunk.

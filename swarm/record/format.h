@@ -9,12 +9,20 @@ namespace swarmsim::record {
 inline constexpr const char* kRecordingFileName = "recording.swrec";
 inline constexpr const char* kFormatName = "swarmsim-recording";
 inline constexpr int kVersionMajor = 1;
-inline constexpr int kVersionMinor = 1;  // 1.1: objects as their types declare their visuals
+inline constexpr int kVersionMinor =
+    2;  // 1.1: objects as their types declare their visuals; 1.2: links
 
 inline constexpr uint8_t kMagic[4] = {'S', 'W', 'R', 'C'};
 inline constexpr uint32_t kChunkHeaderSize = 24;
 
-enum class ChunkKind : uint8_t { kHeader = 1, kScene = 2, kKeyframe = 3, kDelta = 4, kEnd = 5 };
+enum class ChunkKind : uint8_t {
+  kHeader = 1,
+  kScene = 2,
+  kKeyframe = 3,
+  kDelta = 4,
+  kEnd = 5,
+  kLinks = 6,  // 1.2: who was linked to whom at the step record before it
+};
 
 // Quantisation of the step records' poses.
 inline constexpr double kPositionUnit = 1e-4;      // m per position integer

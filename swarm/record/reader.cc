@@ -85,6 +85,10 @@ void CheckChunk(RecordingInfo* info, size_t index, const ChunkInfo& c, const std
       info->end_error = end.error;
       break;
     }
+    case ChunkKind::kLinks:  // decoded by RecordingPlayer, with the step record before it
+      if (info->step_records == 0 || c.step != static_cast<uint64_t>(info->last_step))
+        throw Error(where + ": a links chunk that does not follow a step record of its step");
+      break;
   }
 }
 
@@ -126,8 +130,8 @@ void ScanChunks(const RecordingFile& file, RecordingInfo* info) {
       break;
     }
     CheckChecksum(stored, c, where);
-    // Unknown kinds (above 5) are skipped, as FORMAT.md says.
-    if (c.kind <= static_cast<uint8_t>(ChunkKind::kEnd)) {
+    // Unknown kinds (above 6) are skipped, as FORMAT.md says.
+    if (c.kind <= static_cast<uint8_t>(ChunkKind::kLinks)) {
       try {
         CheckChunk(info, index, c, stored, where);
       } catch (const std::bad_alloc&) {
@@ -261,6 +265,16 @@ bool RecordingPlayer::Next() {
       }
       if (scene_json_.empty()) throw Error(where + ": a step record before any scene chunk");
       Decode(ReadPayload(*file_, c, where), kind == ChunkKind::kKeyframe, where);
+      // Its links, if the links chunk of its step follows it.
+      links_.clear();
+      if (next_chunk_ < info_.chunks.size() &&
+          info_.chunks[next_chunk_].kind == static_cast<uint8_t>(ChunkKind::kLinks) &&
+          info_.chunks[next_chunk_].step == c.step) {
+        const size_t links = next_chunk_++;
+        const std::string links_where =
+            ChunkPlace(info_.file, static_cast<int64_t>(links), info_.chunks[links]);
+        DecodeLinks(ReadPayload(*file_, info_.chunks[links], links_where), links_where);
+      }
     } catch (const std::bad_alloc&) {
       throw Error(where + ": not enough memory to read it");
     }
@@ -318,6 +332,32 @@ Pose RecordingPlayer::frame_pose(uint32_t id) const {
 Pose RecordingPlayer::world_pose(uint32_t id) const {
   const int64_t root = root_.at(id);
   return root < 0 ? frame_pose(id) : frame_pose(static_cast<uint32_t>(root)) * frame_pose(id);
+}
+
+// A links chunk (FORMAT.md "Links chunk"): every id checked against the
+// scene in force, every count against the bytes left.
+void RecordingPlayer::DecodeLinks(const std::string& payload, const std::string& where) {
+  const auto* data = reinterpret_cast<const uint8_t*>(payload.data());
+  const auto u32 = [&](size_t at) {
+    uint32_t v;
+    std::memcpy(&v, data + at, 4);
+    return v;
+  };
+  if (payload.size() < 8) throw Error(where + ": a links chunk shorter than its counts");
+  const uint64_t n = u32(4);
+  if (payload.size() != 8 + 8 * n)
+    throw Error(where + ": a links chunk of " + std::to_string(n) + " links holds " +
+                std::to_string(payload.size()) + " bytes, not " + std::to_string(8 + 8 * n));
+  links_.resize(n);
+  uint64_t from = 0;
+  for (uint64_t i = 0; i < n; ++i) {
+    from += u32(8 + 4 * i);
+    const uint32_t to = u32(8 + 4 * n + 4 * i);
+    if (from >= pose_.size() || to >= pose_.size())
+      throw Error(where + ": link " + std::to_string(i) + " names an object past the scene's " +
+                  std::to_string(pose_.size()));
+    links_[i] = {static_cast<uint32_t>(from), to};
+  }
 }
 
 // A step record (FORMAT.md "Step records"). Every count is checked against

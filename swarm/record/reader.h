@@ -134,6 +134,10 @@ class RecordingPlayer {
   const std::vector<uint8_t>& paint_rgb() const { return paint_; }
   // The metric samples of the last decoded step record.
   const std::vector<RecordedSample>& samples() const { return samples_; }
+  // The links of the last decoded step record (format 1.2): (id, id) pairs,
+  // the first object linked to the second (a range-and-bearing board that
+  // heard another), ascending by the first; empty without a links chunk.
+  const std::vector<std::pair<uint32_t, uint32_t>>& links() const { return links_; }
 
  private:
   struct Quantized {
@@ -142,6 +146,7 @@ class RecordingPlayer {
   };
   void LoadScene(std::string text, const std::string& where);
   void Decode(const std::string& payload, bool keyframe, const std::string& where);
+  void DecodeLinks(const std::string& payload, const std::string& where);
 
   std::unique_ptr<RecordingFile> file_;
   RecordingInfo info_;
@@ -164,6 +169,7 @@ class RecordingPlayer {
   uint8_t paint_background_[3] = {255, 255, 255};
   std::vector<std::string> metric_names_;
   std::vector<RecordedSample> samples_;
+  std::vector<std::pair<uint32_t, uint32_t>> links_;
 };
 
 }  // namespace swarmsim::record

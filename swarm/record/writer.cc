@@ -134,6 +134,12 @@ struct RunRecorder::Impl {
   std::vector<uint8_t> moved;                             // (plan)
   bool capture_all = true;                                // after a new scene: every pose afresh
 
+  // Objects whose type declares links (ids, ascending), and the recorded id
+  // of every recorded object's slot.
+  std::vector<uint32_t> link_ids;
+  std::unordered_map<uint32_t, uint32_t> id_of_slot;
+  std::vector<ObjectId> linked;  // scratch
+
   // The state at this step, by id.
   std::vector<QuantizedPose> pose;
   std::vector<uint32_t> color;
@@ -290,7 +296,7 @@ void RunRecorder::Impl::BuildScene() {
     return o;
   };
   // The nearest recorded ancestor of `slot`, by `id_of_slot`.
-  std::unordered_map<uint32_t, uint32_t> id_of_slot;
+  id_of_slot.clear();
   const auto parent_id = [&](uint32_t slot) -> int64_t {
     for (int32_t p = scene.parent_at(slot); p >= 0; p = scene.parent_at(static_cast<uint32_t>(p)))
       if (const auto it = id_of_slot.find(static_cast<uint32_t>(p)); it != id_of_slot.end())
@@ -359,6 +365,11 @@ void RunRecorder::Impl::BuildScene() {
     id_of_slot[slot] = static_cast<uint32_t>(tracked.size());
     tracked.push_back(t);
   }
+  link_ids.clear();
+  for (uint32_t id = 0; id < tracked.size(); ++id)
+    if (tracked[id].kind != VisualKind::kNone &&
+        scene.type_descriptor(tracked[id].type).links != nullptr)
+      link_ids.push_back(id);
   SceneLists lists;
   // Every drawn object's colour; rays' lengths too.
   for (uint32_t id = 0; id < tracked.size(); ++id) {
@@ -481,6 +492,23 @@ void RunRecorder::Impl::WriteStep(const World& w) {
   names_written = metric_names.size();
   snap->samples.swap(samples);
   samples.clear();
+  // Links: every linked pair of recorded objects, by the linking object's id.
+  snap->links = !link_ids.empty();
+  snap->link_from.clear();
+  snap->link_to.clear();
+  const Scene& scene = w.scene();
+  for (const uint32_t id : link_ids) {
+    const Tracked& t = tracked[id];
+    linked.clear();
+    scene.type_descriptor(t.type).links(scene, t.type, t.row, &linked);
+    for (const ObjectId other : linked) {
+      if (!scene.IsValid(other)) continue;
+      const auto it = id_of_slot.find(scene.SlotOf(other));
+      if (it == id_of_slot.end()) continue;  // not recorded
+      snap->link_from.push_back(id);
+      snap->link_to.push_back(it->second);
+    }
+  }
   file->AddStep(std::move(snap));
   ++records;
 }

@@ -28,10 +28,14 @@ TEST(PluginTest, LoadErrorsNameThePathAndTheProblem) {
   ModuleRegistry registry;
   EXPECT_CONTAINS(ErrorOf([&] { LoadPlugin("/nonexistent/p.so", &registry); }),
                   "cannot load plugin '/nonexistent/p.so': ");
-  EXPECT_CONTAINS(ErrorOf([&] { LoadPlugin(PluginPath("wrong_abi_plugin.so"), &registry); }),
-                  "was built for plugin ABI version 7, this swarmsim has version 6");
-  EXPECT_CONTAINS(ErrorOf([&] { LoadPlugin(PluginPath("old_abi_plugin.so"), &registry); }),
-                  "was built for plugin ABI version 3, this swarmsim has version 6; rebuild it");
+  EXPECT_CONTAINS(
+      ErrorOf([&] { LoadPlugin(PluginPath("wrong_abi_plugin.so"), &registry); }),
+      "was built for plugin ABI version 8, this swarmsim has version 7 (and loads plugins "
+      "of versions 6 to 7)");
+  EXPECT_CONTAINS(
+      ErrorOf([&] { LoadPlugin(PluginPath("old_abi_plugin.so"), &registry); }),
+      "was built for plugin ABI version 3, this swarmsim has version 7 (and loads plugins "
+      "of versions 6 to 7); rebuild it");
   EXPECT_CONTAINS(ErrorOf([&] { LoadPlugin("libm.so.6", &registry); }), "cannot load plugin");
   LoadPlugin(PluginPath("example_plugin.so"), &registry);
   EXPECT_CONTAINS(ErrorOf([&] { LoadPlugin(PluginPath("example_plugin.so"), &registry); }),

@@ -2,7 +2,7 @@
 // the scene, and the step records, applied to a State to show any step.
 import { decompress } from 'fzstd';
 
-const KIND_HEADER = 1, KIND_SCENE = 2, KIND_KEYFRAME = 3, KIND_DELTA = 4, KIND_END = 5;
+const KIND_HEADER = 1, KIND_SCENE = 2, KIND_KEYFRAME = 3, KIND_DELTA = 4, KIND_END = 5, KIND_LINKS = 6;
 const SUPPORTED_MAJOR = 1;
 export const NO_DETECTION = 65535;
 
@@ -141,6 +141,7 @@ export class State {
     });
     this.clearPaint();
     this.record = -1;       // the step record shown
+    this.links = null;      // its links [from, to, ...] (format 1.2), or null
     this.changedPaint = true;
   }
   clearPaint() {
@@ -269,7 +270,31 @@ export class Recording {
         scene: this.scenes.length - 1 });
     } else if (kind === KIND_END) {
       this.ended = JSON.parse(utf8.decode(inflate(stored, rawSize, offset)));
+    } else if (kind === KIND_LINKS) {
+      // Format 1.2: the links of the step record right before it.
+      const last = this.records[this.records.length - 1];
+      if (last && last.step === step) last.links = { stored: stored.slice(), rawSize, offset };
     }
+  }
+
+  // The links of step record `index` (FORMAT.md "Links chunk") as a
+  // Uint32Array [from0, to0, from1, to1, ...], or null without a links chunk.
+  linksOf(index) {
+    const l = this.records[index]?.links;
+    if (!l) return null;
+    const raw = inflate(l.stored, l.rawSize, l.offset);
+    const dv = new DataView(raw.buffer, raw.byteOffset, raw.byteLength);
+    const n = raw.byteLength >= 8 ? dv.getUint32(4, true) : 0;
+    if (raw.byteLength !== 8 + 8 * n)
+      throw new Error(`recording: the links chunk at byte ${l.offset} is ${raw.byteLength} bytes, not ${8 + 8 * n}`);
+    const out = new Uint32Array(2 * n);
+    let from = 0;
+    for (let i = 0; i < n; ++i) {
+      from += dv.getUint32(8 + 4 * i, true);
+      out[2 * i] = from;
+      out[2 * i + 1] = dv.getUint32(8 + 4 * n + 4 * i, true);
+    }
+    return out;
   }
 
   decode(index) {
@@ -296,6 +321,7 @@ export class Recording {
       last = state.apply(this.decode(i), this.records[i].kind === KIND_KEYFRAME);
       state.record = i;
     }
+    state.links = this.linksOf(index);
     return last;
   }
 

@@ -47,7 +47,9 @@ export class View3D {
     this.scene.add(sun);
     this.world = new THREE.Group();
     this.scene.add(this.world);
-    this.show = { rays: false, leds: true, trails: false, paint: true };
+    this.show = { rays: false, leds: true, trails: false, paint: true, links: true };
+    this.linkCount = 0;     // lines drawn for the links shown (tests read them)
+    this.mutualLinks = 0;   // of which between objects linked both ways
     this.followRobot = -1;
     this.dirty = true;
     new ResizeObserver(() => this.resize()).observe(container);
@@ -171,7 +173,70 @@ export class View3D {
     this.trails.frustumCulled = false;
     this.trails.visible = this.show.trails;
     this.world.add(this.trails);
+    // Links (format 1.2: range-and-bearing boards that heard each other):
+    // one segment per pair, grown as needed.
+    this.links = new THREE.LineSegments(new THREE.BufferGeometry(),
+      new THREE.LineBasicMaterial({ vertexColors: true }));
+    this.links.frustumCulled = false;
+    this.linkCapacity = 0;
+    this.world.add(this.links);
     this.update();
+  }
+
+  // The world position of recorded object `id` from the state's integers.
+  worldPoint(id, out, o) {
+    const { xyz, q } = this.state, unit = this.unit;
+    const px = xyz[3 * id] * unit, py = xyz[3 * id + 1] * unit, pz = xyz[3 * id + 2] * unit;
+    const r = this.sceneInfo.rootOf[id];
+    if (r < 0) { out[o] = px; out[o + 1] = py; out[o + 2] = pz; return; }
+    let rw = q[4 * r], rx = q[4 * r + 1], ry = q[4 * r + 2], rz = q[4 * r + 3];
+    const norm = Math.hypot(rw, rx, ry, rz) || 1;
+    rw /= norm; rx /= norm; ry /= norm; rz /= norm;
+    const tx = 2 * (ry * pz - rz * py), ty = 2 * (rz * px - rx * pz), tz = 2 * (rx * py - ry * px);
+    out[o] = xyz[3 * r] * unit + px + rw * tx + (ry * tz - rz * ty);
+    out[o + 1] = xyz[3 * r + 1] * unit + py + rw * ty + (rz * tx - rx * tz);
+    out[o + 2] = xyz[3 * r + 2] * unit + pz + rw * tz + (rx * ty - ry * tx);
+  }
+
+  // A line per linked pair: bright where both heard each other, dim where
+  // one heard the other only.
+  updateLinks() {
+    const links = this.state.links;
+    this.linkCount = 0;
+    this.mutualLinks = 0;
+    this.links.visible = this.show.links && !!links;
+    if (!this.links.visible) return;
+    const n = links.length / 2;
+    // Where each object's links start (links are sorted by their first id).
+    const start = new Map();
+    for (let i = n - 1; i >= 0; --i) start.set(links[2 * i], i);
+    const heard = (a, b) => {
+      for (let i = start.get(a) ?? n; i < n && links[2 * i] === a; ++i) if (links[2 * i + 1] === b) return true;
+      return false;
+    };
+    if (this.linkCapacity < Math.max(n, 1)) {
+      this.linkCapacity = Math.max(n, 2 * this.linkCapacity, 16);
+      const g = this.links.geometry;
+      g.setAttribute('position', new THREE.BufferAttribute(new Float32Array(6 * this.linkCapacity), 3));
+      g.setAttribute('color', new THREE.BufferAttribute(new Float32Array(6 * this.linkCapacity), 3));
+    }
+    const pos = this.links.geometry.attributes.position.array, col = this.links.geometry.attributes.color.array;
+    let k = 0;
+    for (let i = 0; i < n; ++i) {
+      const a = links[2 * i], b = links[2 * i + 1];
+      const mutual = heard(b, a);
+      if (mutual && a > b) continue;  // drawn once, from the lower id
+      this.worldPoint(a, pos, 6 * k);
+      this.worldPoint(b, pos, 6 * k + 3);
+      const c = mutual ? [0.3, 0.9, 1] : [0.1, 0.35, 0.45];
+      col.set([...c, ...c], 6 * k);
+      if (mutual) ++this.mutualLinks;
+      ++k;
+    }
+    this.linkCount = k;
+    this.links.geometry.setDrawRange(0, 2 * k);
+    this.links.geometry.attributes.position.needsUpdate = true;
+    this.links.geometry.attributes.color.needsUpdate = true;
   }
 
   // One InstancedMesh for the objects of group `g` (same kind and size).
@@ -293,6 +358,7 @@ export class View3D {
       if (this.state.changedPaint) { this.paintTexture.needsUpdate = true; this.state.changedPaint = false; }
     }
     this.updateTrails();
+    this.updateLinks();
     if (this.followRobot >= 0) this.follow();
     this.dirty = true;
   }

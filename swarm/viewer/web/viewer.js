@@ -161,7 +161,7 @@ function wireControls() {
     viewer.view.followRobot = e.target.value === '' ? -1 : Number(e.target.value);
     viewer.view.update();
   };
-  for (const what of ['rays', 'leds', 'trails', 'paint']) {
+  for (const what of ['rays', 'leds', 'trails', 'paint', 'links']) {
     const box = $(`show-${what}`);
     viewer.view.show[what] = box.checked;
     box.onchange = () => viewer.view.setShow(what, box.checked);
