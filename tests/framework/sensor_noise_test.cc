@@ -19,16 +19,15 @@ TEST(SensorNoiseTest, EachDeviceStepAndPurposeHasItsOwnStream) {
   std::set<uint64_t> seen;
   for (uint32_t slot : {0u, 1u, 2u, 1000u, (1u << 25) + 3})
     for (int64_t step : {0, 1, 2, 100000})
-      for (NoisePurpose p : {NoisePurpose::kProximity, NoisePurpose::kWheels,
-                             NoisePurpose::kRangeAndBearing})
+      for (NoisePurpose p :
+           {NoisePurpose::kProximity, NoisePurpose::kWheels, NoisePurpose::kRangeAndBearing})
         seen.insert(First(1, slot, step, p));
   EXPECT_EQ(seen.size(), 5u * 4u * 3u);
   // The same key is the same stream; another seed another.
   EXPECT_EQ(First(1, 7, 9, NoisePurpose::kLight), First(1, 7, 9, NoisePurpose::kLight));
   EXPECT_NE(First(1, 7, 9, NoisePurpose::kLight), First(2, 7, 9, NoisePurpose::kLight));
   // Never a robot's own stream (World: Rng(seed, robot index)).
-  for (uint64_t robot = 0; robot < 100; ++robot)
-    EXPECT_EQ(seen.count(Rng(1, robot).NextU64()), 0u);
+  for (uint64_t robot = 0; robot < 100; ++robot) EXPECT_EQ(seen.count(Rng(1, robot).NextU64()), 0u);
 }
 
 TEST(SensorNoiseTest, NoNoiseDrawsNothing) {

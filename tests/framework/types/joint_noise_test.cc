@@ -80,8 +80,8 @@ class JointNoiseTest : public ::testing::Test {
   // Two-wheeled robots (the foot-bot's wheels) whose script drives both
   // wheels at 0.05 m/s for `steps` steps under `physics`; returns how far
   // each robot's body went.
-  std::vector<double> Drive(const std::string& physics, const std::string& wheel_keys,
-                            int threads, int robots = 1, int steps = 100) {
+  std::vector<double> Drive(const std::string& physics, const std::string& wheel_keys, int threads,
+                            int robots = 1, int steps = 100) {
     std::ofstream(dir_ / "drive.lua") << "function sysCall_init()\n"
                                          "  l = sim.getObject('./leftMotor')\n"
                                          "  r = sim.getObject('./rightMotor')\n"

@@ -184,7 +184,8 @@ TEST_F(ProximityNoiseTest, BadNoiseKeysNameTheirPlace) {
   EXPECT_NE(LoadError("noise: -0.01,").find("'noise' must be a non-negative number"),
             std::string::npos)
       << LoadError("noise: -0.01,");
-  EXPECT_NE(LoadError("failure_probability: 1.5,").find("bot.yaml:6:78: 'failure_probability' must be at most 1"),
+  EXPECT_NE(LoadError("failure_probability: 1.5,")
+                .find("bot.yaml:6:78: 'failure_probability' must be at most 1"),
             std::string::npos)
       << LoadError("failure_probability: 1.5,");
 }
