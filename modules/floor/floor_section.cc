@@ -22,7 +22,7 @@ constexpr ObjectKey kKeys[] = {
      "{min: [x, y], max: [x, y]} m, the floor drawn (outside it: the background)"},
     {"resolution", "the image's pixel size, else 0.01",
      "m, side of one pixel of the floor raster (at most 64 megapixels)"},
-    {"background", "[1, 1, 1]", "RGB 0..1 (or one grey level 0..1), the bare floor"},
+    {"background", "1", "a grey level 0..1 or [r, g, b], the bare floor"},
     {"image", "none",
      "{file: images/nest.png, min: [x, y], max: [x, y]}: a PNG (at most 64 megapixels, relative "
      "to the world file) and where its lower-left and upper-right corners lie (m; default: the "

@@ -334,5 +334,7 @@ TEST_F(GroundSensorWorldTest, BadSensorsNameTheirPlace) {
             {"bad.yaml:5:", "range"});
 }
 
+TEST_F(GroundSensorWorldTest, EveryKeyIsDocumented) { ExpectDocumented({"ground_sensor"}); }
+
 }  // namespace
 }  // namespace swarmsim
