@@ -27,6 +27,8 @@ struct ModelLayout {
   std::vector<uint32_t> root_slots;       // per robot
   std::vector<uint32_t> joint_slots;      // robots x joints
   std::vector<uint32_t> sensor_slots;     // robots x sensors
+  std::vector<std::string> ground_names;  // ground sensors, hierarchy order
+  std::vector<uint32_t> ground_slots;     // robots x ground sensors
   int64_t robot_count = -1;               // World::robot_count() it was built at
 };
 
@@ -46,6 +48,10 @@ Array Velocities(const Scene& scene, const ModelLayout& layout, const py::object
 // Proximity readings, N x sensors: the distance to what each sensor sees,
 // +inf where it sees nothing.
 Array Proximity(const Scene& scene, const ModelLayout& layout, const py::object& out);
+
+// Ground sensor readings, N x ground sensors: each one's value (its grey
+// level, 0/1 in binary mode, a colour sensor's grey level).
+Array Ground(const Scene& scene, const ModelLayout& layout, const py::object& out);
 
 // Joint positions (what = 0) or velocities (1), N x joints.
 Array Joints(const Scene& scene, const ModelLayout& layout, int what, const py::object& out);
