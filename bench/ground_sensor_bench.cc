@@ -66,7 +66,8 @@ std::unique_ptr<Swarm> MakeSwarm(int robots, int threads, bool sensors, bool noi
     row.settings.Edit().noise.gaussian = 0.02;
     row.settings.Edit().noise.failure = 0.01;
   }
-  const double points[4][2] = {{0.063, 0.0116}, {-0.063, 0.0116}, {-0.063, -0.0116}, {0.063, -0.0116}};
+  const double points[4][2] = {
+      {0.063, 0.0116}, {-0.063, 0.0116}, {-0.063, -0.0116}, {0.063, -0.0116}};
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> jitter(-0.3, 0.3), yaw(-M_PI, M_PI);
   ShapeData body;
@@ -76,8 +77,7 @@ std::unique_ptr<Swarm> MakeSwarm(int robots, int threads, bool sensors, bool noi
     const double x = -side / 2 + 0.5 + i % per_row + jitter(rng);
     const double y = -side / 2 + 0.5 + i / per_row + jitter(rng);
     const std::string name = "bot#" + std::to_string(i);
-    const ObjectId root =
-        scene.AddShape(name, {}, {{x, y, 0.073}, Quat::FromYaw(yaw(rng))}, body);
+    const ObjectId root = scene.AddShape(name, {}, {{x, y, 0.073}, Quat::FromYaw(yaw(rng))}, body);
     scene.MakeModelInstance(root, "bot", name);
     if (!sensors) continue;
     for (const auto& p : points)

@@ -73,7 +73,7 @@ void RegisterBuiltinModules(ModuleRegistry* registry) {
   blobs::Register(registry);
   ground_sensor::Register(registry);
   floors::Register(registry);  // the floor (floor:), ground sensors' and the paint layer's base
-  video::Register(registry);  // snapshots and video: the program's view recorder
+  video::Register(registry);   // snapshots and video: the program's view recorder
   // World-file sections, in the order the loader reads them.
   registry->RegisterWorldSection(metrics::MetricsSection());
   registry->RegisterWorldSection(floors::FloorSection());  // before paint: paint starts from it

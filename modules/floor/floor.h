@@ -40,11 +40,11 @@ inline constexpr int64_t kMaxFloorPixels = 64'000'000;
 struct FloorShape {
   enum class Kind { kCircle, kRectangle, kLinearGradient, kRadialGradient };
   Kind kind = Kind::kCircle;
-  Vec3 a, b;            // circle, radial: a = centre; rectangle: a = min, b = max;
-                        // linear: a = from, b = to (z unused)
-  double radius = 0;    // m: circle, radial gradient
-  Vec3 color, color2;   // RGB 0..1: the colour; a gradient's start and end
-  bool bounded = false; // linear gradient: drawn only within [lo, hi] (else everywhere)
+  Vec3 a, b;             // circle, radial: a = centre; rectangle: a = min, b = max;
+                         // linear: a = from, b = to (z unused)
+  double radius = 0;     // m: circle, radial gradient
+  Vec3 color, color2;    // RGB 0..1: the colour; a gradient's start and end
+  bool bounded = false;  // linear gradient: drawn only within [lo, hi] (else everywhere)
   Vec3 lo, hi;
 };
 

@@ -58,9 +58,7 @@ void ShapeBox(const FloorShape& s, double* x0, double* y0, double* x1, double* y
       *x0 = s.a.x - s.radius, *y0 = s.a.y - s.radius;
       *x1 = s.a.x + s.radius, *y1 = s.a.y + s.radius;
       return;
-    case FloorShape::Kind::kRectangle:
-      *x0 = s.a.x, *y0 = s.a.y, *x1 = s.b.x, *y1 = s.b.y;
-      return;
+    case FloorShape::Kind::kRectangle: *x0 = s.a.x, *y0 = s.a.y, *x1 = s.b.x, *y1 = s.b.y; return;
     case FloorShape::Kind::kLinearGradient:
       if (s.bounded) {
         *x0 = s.lo.x, *y0 = s.lo.y, *x1 = s.hi.x, *y1 = s.hi.y;
@@ -87,13 +85,14 @@ FloorRaster::FloorRaster(World* world, const FloorSettings& settings) : world_(w
                 std::to_string(static_cast<int64_t>(rows)) + " raster is over " +
                 std::to_string(kMaxFloorPixels / 1'000'000) +
                 " megapixels; use a coarser resolution");
-  area_ = {settings.min_x, settings.min_y, settings.max_x, settings.max_y, res,
+  area_ = {settings.min_x,         settings.min_y,         settings.max_x,     settings.max_y, res,
            static_cast<int>(cols), static_cast<int>(rows), settings.background};
   const size_t n = static_cast<size_t>(area_.width) * static_cast<size_t>(area_.height);
   const uint8_t bg[3] = {ToByte(settings.background.x), ToByte(settings.background.y),
                          ToByte(settings.background.z)};
   rgb_.resize(3 * n);
-  for (size_t p = 0; p < n; ++p) std::copy(bg, bg + 3, rgb_.begin() + static_cast<ptrdiff_t>(3 * p));
+  for (size_t p = 0; p < n; ++p)
+    std::copy(bg, bg + 3, rgb_.begin() + static_cast<ptrdiff_t>(3 * p));
   std::vector<uint8_t> drawn(n, 0);
   const auto centre_x = [&](int c) { return area_.min_x + (c + 0.5) * res; };
   const auto centre_y = [&](int r) { return area_.max_y - (r + 0.5) * res; };
@@ -104,15 +103,18 @@ FloorRaster::FloorRaster(World* world, const FloorSettings& settings) : world_(w
     for (int r = 0; r < area_.height; ++r) {
       const double y = centre_y(r);
       if (y < settings.image_min_y || y >= settings.image_max_y) continue;
-      const int ir = std::min(settings.image_height - 1,
-                              static_cast<int>((settings.image_max_y - y) / ih * settings.image_height));
+      const int ir =
+          std::min(settings.image_height - 1,
+                   static_cast<int>((settings.image_max_y - y) / ih * settings.image_height));
       for (int c = 0; c < area_.width; ++c) {
         const double x = centre_x(c);
         if (x < settings.image_min_x || x >= settings.image_max_x) continue;
-        const int ic = std::min(settings.image_width - 1,
-                                static_cast<int>((x - settings.image_min_x) / iw * settings.image_width));
+        const int ic =
+            std::min(settings.image_width - 1,
+                     static_cast<int>((x - settings.image_min_x) / iw * settings.image_width));
         const size_t p = static_cast<size_t>(r) * area_.width + c;
-        const uint8_t* src = &settings.image_rgb[3 * (static_cast<size_t>(ir) * settings.image_width + ic)];
+        const uint8_t* src =
+            &settings.image_rgb[3 * (static_cast<size_t>(ir) * settings.image_width + ic)];
         std::copy(src, src + 3, rgb_.begin() + static_cast<ptrdiff_t>(3 * p));
         drawn[p] = 1;
       }
@@ -124,9 +126,11 @@ FloorRaster::FloorRaster(World* world, const FloorSettings& settings) : world_(w
     double x0 = 0, y0 = 0, x1 = 0, y1 = 0;
     ShapeBox(s, &x0, &y0, &x1, &y1);
     const int c0 = static_cast<int>(std::clamp(std::floor((x0 - area_.min_x) / res), 0.0, cols));
-    const int c1 = static_cast<int>(std::clamp(std::floor((x1 - area_.min_x) / res), -1.0, cols - 1));
+    const int c1 =
+        static_cast<int>(std::clamp(std::floor((x1 - area_.min_x) / res), -1.0, cols - 1));
     const int r0 = static_cast<int>(std::clamp(std::floor((area_.max_y - y1) / res), 0.0, rows));
-    const int r1 = static_cast<int>(std::clamp(std::floor((area_.max_y - y0) / res), -1.0, rows - 1));
+    const int r1 =
+        static_cast<int>(std::clamp(std::floor((area_.max_y - y0) / res), -1.0, rows - 1));
     for (int r = r0; r <= r1; ++r)
       for (int c = c0; c <= c1; ++c) {
         Vec3 color;

@@ -81,7 +81,8 @@ FloorShape ReadShape(const ObjectReader& r) {
     Corners(r, "a rectangle", &s.a, &s.b);
     s.color = Color(r, "color", {0, 0, 0});
   } else {
-    r.Expect(std::vector<std::string>{"type", "from", "to", "from_color", "to_color", "min", "max"});
+    r.Expect(
+        std::vector<std::string>{"type", "from", "to", "from_color", "to_color", "min", "max"});
     s.kind = FloorShape::Kind::kLinearGradient;
     s.a = Point(r, "from");
     s.b = Point(r, "to");
@@ -107,8 +108,8 @@ void ReadFloor(const ObjectReader& top, const WorldSectionContext& context, Worl
   // The image: its file, then where its corners lie.
   bool image_placed = false;
   if (floor->Has("image")) {
-    const std::unique_ptr<ObjectReader> image = floor->Map(
-        "image", "'image'", "{file: images/nest.png, min: [x, y], max: [x, y]}");
+    const std::unique_ptr<ObjectReader> image =
+        floor->Map("image", "'image'", "{file: images/nest.png, min: [x, y], max: [x, y]}");
     if (!image) floor->Fail("image", "'image' must be {file: name.png, min: [x, y], max: [x, y]}");
     image->Expect(std::vector<std::string>{"file", "min", "max"});
     image->Require("file");

@@ -42,9 +42,9 @@ inline double Grey(const Vec3& rgb) {
 
 // Settings: shared by the copies of one model entry (shared_settings.h).
 struct GroundSensorSettings {  // 48 bytes
-  double radius = 0.005;  // m: drawn as a disc this big
-  double threshold = 0.5;  // binary: 1 when the (noisy) grey level is >= it
-  NoiseSettings noise;     // on the grey level (each channel in colour mode); failure reads 0
+  double radius = 0.005;       // m: drawn as a disc this big
+  double threshold = 0.5;      // binary: 1 when the (noisy) grey level is >= it
+  NoiseSettings noise;         // on the grey level (each channel in colour mode); failure reads 0
   Mode mode = Mode::kGrey;
 };
 struct GroundSensorRow {  // 40 bytes

@@ -22,7 +22,8 @@ namespace {
 constexpr ObjectKey kKeys[] = {
     {"mode", "grey", "color (r, g, b), grey (0.299 r + 0.587 g + 0.114 b) or binary (0 or 1)"},
     {"threshold", "0.5", "binary: reads 1 when the grey level is at or above it, else 0; 0..1"},
-    {"noise", "0", "std dev of Gaussian noise on the grey level (each channel in colour mode), 0..1"},
+    {"noise", "0",
+     "std dev of Gaussian noise on the grey level (each channel in colour mode), 0..1"},
     {"noise_uniform", "0", "half width of uniform noise, as `noise`, 0..1"},
     {"failure_probability", "0", "probability 0..1 that it reads nothing (0, black) in a step"},
     {"disc_radius", "0.005", "m, the size of the disc it is drawn as (snapshots, viewer)"},

@@ -1,10 +1,11 @@
 // The ground_sensor module: every world senses its ground sensors in the
 // sense phase (order 120, after proximity), rows in parallel.
+#include "framework/module.h"
+
 #include <algorithm>
 #include <memory>
 
 #include "framework/floor_layer.h"
-#include "framework/module.h"
 #include "framework/registry.h"
 #include "framework/scene.h"
 #include "framework/scheduler.h"
@@ -105,14 +106,13 @@ void SenseRows(const Scene& scene, const FloorLayer* floor, uint64_t seed, int64
 }
 
 void RegisterModule(ModuleRegistry* registry) {
-  registry->RegisterModule(
-      {{"sensor", "ground_sensor", "1.0",
-        "the floor under each ground sensor: colour, grey level or binary"},
-       PhaseBit(Phase::kSense),
-       120,
-       /*every_world=*/true,
-       [](World*, const void*) { return std::make_unique<Sensing>(); },
-       nullptr});
+  registry->RegisterModule({{"sensor", "ground_sensor", "1.0",
+                             "the floor under each ground sensor: colour, grey level or binary"},
+                            PhaseBit(Phase::kSense),
+                            120,
+                            /*every_world=*/true,
+                            [](World*, const void*) { return std::make_unique<Sensing>(); },
+                            nullptr});
 }
 
 }  // namespace swarmsim::ground_sensor

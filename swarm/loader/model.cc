@@ -143,12 +143,11 @@ struct Builder {
       name = values.String(name_field);
       CheckObjectName(values, name_field, name);
     }
-    const std::string what =
-        is_root ? root_what
-                : (type == "proximity_ring"  ? "proximity ring '"
-                   : type == "ground_array" ? "ground array '"
-                                            : "object '") +
-                      name + "'";
+    const std::string what = is_root ? root_what
+                                     : (type == "proximity_ring" ? "proximity ring '"
+                                        : type == "ground_array" ? "ground array '"
+                                                                 : "object '") +
+                                           name + "'";
     Fields named(values.file(), field, what);
 
     if (type == "proximity_ring" && is_root)
@@ -239,8 +238,8 @@ struct Builder {
                                            ring_key + "' (a ring), not both");
       const std::vector<Field> points = ListElements(values.file(), f.Get("points"), "points");
       if (points.empty() || points.size() > static_cast<size_t>(kMaxRingCount))
-        values.Fail(f.Get("points"), "'points' must list 1 to " + std::to_string(kMaxRingCount) +
-                                         " points [x, y]");
+        values.Fail(f.Get("points"),
+                    "'points' must list 1 to " + std::to_string(kMaxRingCount) + " points [x, y]");
       for (const Field& point : points) {
         const std::vector<double> p = values.Numbers(point, 2, 2, kCoordinate);
         xy.emplace_back(p[0], p[1]);
@@ -254,8 +253,7 @@ struct Builder {
                                ? values.Number(f.Get("start_angle_deg"), kAngleDeg) * kDegToRad
                                : 0;
       for (int64_t i = 0; i < count; ++i) {
-        const double theta =
-            start + 2 * M_PI * static_cast<double>(i) / static_cast<double>(count);
+        const double theta = start + 2 * M_PI * static_cast<double>(i) / static_cast<double>(count);
         xy.emplace_back(radius * std::cos(theta), radius * std::sin(theta));
       }
     }

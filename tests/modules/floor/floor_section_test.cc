@@ -14,6 +14,7 @@
 #include "modules/floor/floor.h"
 #include "modules/paint/paint_layer.h"
 #include "modules/paint/png_io.h"
+#include "modules/rendering/video/recorder.h"
 #include "swarm/record/reader.h"
 #include "swarm/record/writer.h"
 #include "tests/swarm/loader/world_dir_test.h"
@@ -34,7 +35,8 @@ Rgb At(const FloorLayer& floor, double x, double y) {
   const FloorArea a = floor.floor_area();
   const int64_t p = FloorPixelAt(a, x, y);
   if (p < 0)
-    return {static_cast<int>(a.background.x * 255 + 0.5), static_cast<int>(a.background.y * 255 + 0.5),
+    return {static_cast<int>(a.background.x * 255 + 0.5),
+            static_cast<int>(a.background.y * 255 + 0.5),
             static_cast<int>(a.background.z * 255 + 0.5)};
   const uint8_t* c = &floor.floor_rgb()[3 * p];
   return {c[0], c[1], c[2]};
@@ -59,7 +61,7 @@ class FloorSectionTest : public testing::WorldDirTest {
   // A 4 x 2 image: top row red, black, white, grey (128); bottom row
   // green, blue, yellow, magenta.
   void WriteQuadrants(const std::string& name) {
-    const std::vector<uint8_t> rgb = {255, 0, 0, 0,   0,   0,   255, 255, 255, 128, 128, 128,
+    const std::vector<uint8_t> rgb = {255, 0,   0, 0, 0, 0,   255, 255, 255, 128, 128, 128,
                                       0,   255, 0, 0, 0, 255, 255, 255, 0,   255, 0,   255};
     paint::WritePng(dir_ / name, 4, 2, rgb);
   }
@@ -139,7 +141,7 @@ TEST_F(FloorSectionTest, ShapesAreDrawnInOrderOverTheImage) {
   EXPECT_EQ(At(floor, 0.51, -0.01), (Rgb{0, 0, 255}));  // outside: the rectangle
   EXPECT_EQ(At(floor, 0, -0.49), (Rgb{0, 0, 0}));
   EXPECT_EQ(At(floor, 0, -0.51), (Rgb{0, 0, 255}));
-  EXPECT_EQ(At(floor, 0.35, 0.35), (Rgb{0, 0, 0}));  // 0.495 m from the centre
+  EXPECT_EQ(At(floor, 0.35, 0.35), (Rgb{0, 0, 0}));        // 0.495 m from the centre
   EXPECT_EQ(At(floor, 0.36, 0.36), (Rgb{255, 255, 255}));  // 0.509 m: the image (white)
   // The later circle over the first.
   EXPECT_EQ(At(floor, 0.45, 0.45), (Rgb{255, 255, 0}));
@@ -166,8 +168,8 @@ TEST_F(FloorSectionTest, GradientsRunBetweenTheirEnds) {
   }
   EXPECT_EQ(At(floor, -0.5, 0.05), (Rgb{255, 0, 0}));  // above its bounds: background
   // Radial: blue at the centre, fading to black at 0.4 m; background beyond.
-  EXPECT_EQ(At(floor, 0.005, 0.505), (Rgb{0, 0, static_cast<int>(std::lround(
-                                                 (1 - std::sqrt(2) * 0.005 / 0.4) * 255))}));
+  EXPECT_EQ(At(floor, 0.005, 0.505),
+            (Rgb{0, 0, static_cast<int>(std::lround((1 - std::sqrt(2) * 0.005 / 0.4) * 255))}));
   EXPECT_EQ(At(floor, 0.205, 0.505),
             (Rgb{0, 0, static_cast<int>(std::lround((1 - std::hypot(0.205, 0.005) / 0.4) * 255))}));
   EXPECT_EQ(At(floor, 0.45, 0.5), (Rgb{255, 0, 0}));
@@ -223,10 +225,10 @@ TEST_F(FloorSectionTest, BadFloorsNameTheirPlace) {
             {"world.yaml:5:46:", "radius", "non-negative"});
   ExpectHas(ErrorOfWorld(arena + "floor:\n  shapes:\n    - {type: circel, center: [0, 0]}\n"),
             {"world.yaml:5:14:", "did you mean 'circle'"});
-  ExpectHas(ErrorOfWorld(arena +
-                         "floor:\n  shapes:\n    - {type: rectangle, min: [0, 0], max: [1, 1], "
-                         "radius: 1}\n"),
-            {"world.yaml:5:", "radius"});
+  ExpectHas(
+      ErrorOfWorld(arena + "floor:\n  shapes:\n    - {type: rectangle, min: [0, 0], max: [1, 1], "
+                           "radius: 1}\n"),
+      {"world.yaml:5:", "radius"});
   ExpectHas(ErrorOfWorld(arena +
                          "floor:\n  shapes:\n    - {type: rectangle, min: [1, 0], max: [0, 1]}\n"),
             {"world.yaml:5:", "max greater than min"});
@@ -234,9 +236,9 @@ TEST_F(FloorSectionTest, BadFloorsNameTheirPlace) {
             {"world.yaml:4:", "background"});
   // No area to draw on; a misspelt key; a raster over the limit.
   ExpectHas(ErrorOfWorld(sim_ + "floor: {background: 0}\n"), {"world.yaml:2:", "area"});
-  ExpectHas(ErrorOfWorld(arena + "floor: {shape: []}\n"), {"world.yaml:3:", "did you mean 'shapes'"});
-  ExpectHas(ErrorOfWorld(arena + "floor: {resolution: 0.0001}\n"),
-            {"world.yaml:3:", "megapixels"});
+  ExpectHas(ErrorOfWorld(arena + "floor: {shape: []}\n"),
+            {"world.yaml:3:", "did you mean 'shapes'"});
+  ExpectHas(ErrorOfWorld(arena + "floor: {resolution: 0.0001}\n"), {"world.yaml:3:", "megapixels"});
   // With a floor, paint's background is the floor's.
   ExpectHas(ErrorOfWorld(arena + "floor: {background: 0}\npaint: {background: [1, 1, 1]}\n"),
             {"world.yaml:4:9:", "background"});
@@ -295,12 +297,13 @@ TEST_F(FloorSectionTest, PaintIsDrawnOverTheFloor) {
 }
 
 TEST_F(FloorSectionTest, TheFloorIsRecordedForTheViewer) {
-  LoadedWorld w = Load(sim_ +
-                       "arena: {size: 2}\n"
-                       "floor:\n"
-                       "  resolution: 0.1\n"
-                       "  background: [0, 0, 1]\n"
-                       "  shapes: [{type: rectangle, min: [0, 0], max: [1, 1], color: [1, 0, 0]}]\n");
+  LoadedWorld w =
+      Load(sim_ +
+           "arena: {size: 2}\n"
+           "floor:\n"
+           "  resolution: 0.1\n"
+           "  background: [0, 0, 1]\n"
+           "  shapes: [{type: rectangle, min: [0, 0], max: [1, 1], color: [1, 0, 0]}]\n");
   record::RecordSettings settings;
   settings.out_dir = dir_;
   record::RunRecorder* recorder = record::AddRecorder(w.world.get(), settings);
@@ -319,6 +322,40 @@ TEST_F(FloorSectionTest, TheFloorIsRecordedForTheViewer) {
   EXPECT_EQ(at(15, 5), (Rgb{255, 0, 0}));
   EXPECT_EQ(at(5, 5), (Rgb{0, 0, 255}));
   EXPECT_EQ(at(15, 15), (Rgb{0, 0, 255}));
+}
+
+TEST_F(FloorSectionTest, SnapshotsShowTheFloor) {
+  // A red left half and a blue right half; no robots, nothing else on the floor.
+  LoadedWorld w =
+      Load(sim_ +
+           "arena: {size: 2, wall_height: 0.01}\n"
+           "floor:\n"
+           "  resolution: 0.02\n"
+           "  shapes: [{type: rectangle, min: [-1, -1], max: [0, 1], color: [1, 0, 0]},\n"
+           "           {type: rectangle, min: [0, -1], max: [1, 1], color: [0, 0, 1]}]\n");
+  video::RecorderSettings settings;
+  settings.out_dir = dir_;
+  settings.snapshot_every = 1;
+  settings.width = 160;
+  settings.height = 120;
+  w.world->AddModule("recorder", &settings);
+  w.world->Start();
+  w.world->Step();
+  w.world->WriteOutputs(dir_);
+  const paint::RgbImage image = paint::ReadPng(dir_ / "snapshots" / "step_000001.png");
+  ASSERT_EQ(image.width, 160);
+  // Reddish pixels lie left of bluish ones (the camera looks down, north up).
+  int red = 0, blue = 0;
+  double red_x = 0, blue_x = 0;
+  for (int r = 0; r < image.height; ++r)
+    for (int c = 0; c < image.width; ++c) {
+      const uint8_t* p = &image.rgb[3 * (static_cast<size_t>(r) * image.width + c)];
+      if (p[0] > 120 && p[1] < 60 && p[2] < 60) ++red, red_x += c;
+      if (p[2] > 120 && p[0] < 60 && p[1] < 60) ++blue, blue_x += c;
+    }
+  EXPECT_GT(red, 1000);
+  EXPECT_GT(blue, 1000);
+  EXPECT_LT(red_x / std::max(red, 1), blue_x / std::max(blue, 1));
 }
 
 }  // namespace

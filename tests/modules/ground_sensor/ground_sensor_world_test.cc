@@ -67,11 +67,11 @@ const char kEyesModel[] =
 
 TEST_F(GroundSensorWorldTest, ARobotReadsTheRegionItIsOver) {
   Write("eyes.yaml", kEyesModel);
-  LoadedWorld w = Load(ThirdsWorld(
-      "  - {model: eyes.yaml, position: [-1, 0, 0]}\n"    // red
-      "  - {model: eyes.yaml, position: [0, 0.3, 0]}\n"   // black
-      "  - {model: eyes.yaml, position: [1.2, -0.4, 0]}\n"  // white
-      "  - {model: eyes.yaml, position: [1.8, 0, 0]}\n"));  // the background, 0.5
+  LoadedWorld w =
+      Load(ThirdsWorld("  - {model: eyes.yaml, position: [-1, 0, 0]}\n"      // red
+                       "  - {model: eyes.yaml, position: [0, 0.3, 0]}\n"     // black
+                       "  - {model: eyes.yaml, position: [1.2, -0.4, 0]}\n"  // white
+                       "  - {model: eyes.yaml, position: [1.8, 0, 0]}\n"));  // the background, 0.5
   w.world->Start();
   w.world->Step();
   struct Expected {
@@ -79,7 +79,7 @@ TEST_F(GroundSensorWorldTest, ARobotReadsTheRegionItIsOver) {
     double grey;
     double binary;
   };
-  const double bg = 128 / 255.0;  // 0.5 stored as a byte
+  const double bg = 128 / 255.0;                       // 0.5 stored as a byte
   const Expected expected[] = {{{1, 0, 0}, 0.299, 1},  // 0.299 >= 0.25
                                {{0, 0, 0}, 0, 0},
                                {{1, 1, 1}, 1, 1},
@@ -146,7 +146,8 @@ TEST_F(GroundSensorWorldTest, ASensorReadsTheNestToWithinAPixelOfItsEdge) {
   LoadedWorld w = Load(
       "simulation: {physics: kinematic}\narena: {size: 2}\n"
       "floor: {resolution: 0.01, shapes: [{type: circle, center: [0, 0], radius: 0.5, color: 0}]}\n"
-      "models:\n" + models);
+      "models:\n" +
+      models);
   w.world->Start();
   w.world->Step();
   for (int i = 0; i < 8; ++i)
@@ -215,9 +216,10 @@ class GroundNoiseTest : public GroundSensorWorldTest {
  protected:
   std::vector<double> Samples(const std::string& keys, int steps, int threads = 1,
                               uint64_t* hash = nullptr) {
-    Write("noisy.yaml", "model: noisy\nobjects:\n  type: dummy\n  children:\n"
-                        "    - {type: ground_array, name: eye, count: 200, radius: 0.1, " +
-                            keys + "}\n");
+    Write("noisy.yaml",
+          "model: noisy\nobjects:\n  type: dummy\n  children:\n"
+          "    - {type: ground_array, name: eye, count: 200, radius: 0.1, " +
+              keys + "}\n");
     LoadedWorld w = Load(
         "simulation: {physics: kinematic, seed: 7}\narena: {size: 2}\n"
         "floor: {background: 0.5}\n"
@@ -277,8 +279,10 @@ TEST_F(GroundNoiseTest, FailuresReadZeroAtTheConfiguredRate) {
   const std::vector<double> v = Samples("failure_probability: 0.2", 25);
   int failed = 0;
   for (double x : v) {
-    if (x == 0) ++failed;
-    else ASSERT_EQ(x, 128 / 255.0);
+    if (x == 0)
+      ++failed;
+    else
+      ASSERT_EQ(x, 128 / 255.0);
   }
   // Binomial(5000, 0.2): mean 1000, std dev 28.3; within 5 of them.
   EXPECT_NEAR(failed, 1000, 5 * std::sqrt(5000 * 0.2 * 0.8));
@@ -299,7 +303,8 @@ TEST_F(GroundNoiseTest, BinaryNoiseFlipsReadingsNearTheThreshold) {
 
 TEST_F(GroundNoiseTest, NoisyReadingsAreTheSameAtAnyThreadCount) {
   uint64_t h1 = 0, h2 = 0;
-  const std::string keys = "mode: color, noise: 0.05, noise_uniform: 0.02, failure_probability: 0.1";
+  const std::string keys =
+      "mode: color, noise: 0.05, noise_uniform: 0.02, failure_probability: 0.1";
   const std::vector<double> one = Samples(keys, 5, 1, &h1);
   const std::vector<double> two = Samples(keys, 5, 2, &h2);
   EXPECT_EQ(one, two);
@@ -313,8 +318,9 @@ TEST_F(GroundNoiseTest, NoisyReadingsAreTheSameAtAnyThreadCount) {
 TEST_F(GroundSensorWorldTest, BadSensorsNameTheirPlace) {
   auto error_of = [&](const std::string& child) {
     Write("bad.yaml", "model: bad\nobjects:\n  type: dummy\n  children:\n    - " + child + "\n");
-    return ErrorOfWorld("simulation: {physics: kinematic}\n"
-                        "models: [{model: bad.yaml, position: [0, 0, 0]}]\n");
+    return ErrorOfWorld(
+        "simulation: {physics: kinematic}\n"
+        "models: [{model: bad.yaml, position: [0, 0, 0]}]\n");
   };
   ExpectHas(error_of("{name: g, type: ground_sensor, mode: gray}"),
             {"bad.yaml:5:", "did you mean 'grey'"});

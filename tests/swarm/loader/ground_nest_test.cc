@@ -44,8 +44,7 @@ Outcome RunNest(int threads, int64_t steps, const std::string& nest_radius = "")
   const double radius = nest_radius.empty() ? 0.6 : std::stod(nest_radius);
   for (const ModelInstance& robot : scene.instances()) {
     ++out.robots;
-    const LedRow& led =
-        scene.row<LedRow>(led_type, scene.FindObject("./led", robot.root), "led");
+    const LedRow& led = scene.row<LedRow>(led_type, scene.FindObject("./led", robot.root), "led");
     const bool red = led.color.x == 1 && led.color.y == 0 && led.color.z == 0;
     if (!red) {
       EXPECT_EQ(led.color.y, 1) << robot.name << ": an LED neither green nor red";
