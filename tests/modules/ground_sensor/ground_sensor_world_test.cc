@@ -340,6 +340,27 @@ TEST_F(GroundSensorWorldTest, BadSensorsNameTheirPlace) {
             {"bad.yaml:5:", "range"});
 }
 
+TEST_F(GroundSensorWorldTest, AScriptReadingSomethingElseGetsItsLineNamed) {
+  Write("bad.lua",
+        "function sysCall_sensing()\n"
+        "  local h = {sim.getObject('./g'), sim.getObject('.')}\n"
+        "  sim.readGroundSensors(h)\n"
+        "end\n");
+  Write("bot.yaml",
+        "model: bot\nobjects:\n  type: dummy\n  script: bad.lua\n"
+        "  children: [{name: g, type: ground_sensor}]\n");
+  LoadedWorld w = Load("simulation: {physics: kinematic}\n"
+                       "models: [{model: bot.yaml, position: [0, 0, 0]}]\n");
+  w.world->Start();
+  std::string message = "(no error)";
+  try {
+    w.world->Step();
+  } catch (const Error& e) {
+    message = e.what();
+  }
+  ExpectHas(message, {"bot#0", "bad.lua:3", "sim.readGroundSensors", "handles[2]", "dummy"});
+}
+
 TEST_F(GroundSensorWorldTest, EveryKeyIsDocumented) { ExpectDocumented({"ground_sensor"}); }
 
 }  // namespace
