@@ -349,8 +349,9 @@ TEST_F(GroundSensorWorldTest, AScriptReadingSomethingElseGetsItsLineNamed) {
   Write("bot.yaml",
         "model: bot\nobjects:\n  type: dummy\n  script: bad.lua\n"
         "  children: [{name: g, type: ground_sensor}]\n");
-  LoadedWorld w = Load("simulation: {physics: kinematic}\n"
-                       "models: [{model: bot.yaml, position: [0, 0, 0]}]\n");
+  LoadedWorld w = Load(
+      "simulation: {physics: kinematic}\n"
+      "models: [{model: bot.yaml, position: [0, 0, 0]}]\n");
   w.world->Start();
   std::string message = "(no error)";
   try {
