@@ -20,7 +20,7 @@ namespace {
 constexpr ObjectKey kKeys[] = {
     {"area", "the arena's inner area, else the image's corners",
      "{min: [x, y], max: [x, y]} m, the floor drawn (outside it: the background)"},
-    {"resolution", "the image's pixel size, else 0.01",
+    {"resolution", "0.01, or the image's pixel size if finer",
      "m, side of one pixel of the floor raster (at most 64 megapixels)"},
     {"background", "1", "a grey level 0..1 or [r, g, b], the bare floor"},
     {"image", "none",
@@ -152,13 +152,13 @@ void ReadFloor(const ObjectReader& top, const WorldSectionContext& context, Worl
     settings.image_min_x = settings.min_x, settings.image_min_y = settings.min_y;
     settings.image_max_x = settings.max_x, settings.image_max_y = settings.max_y;
   }
-  // The resolution: given, else the image's pixel size, else 1 cm.
+  // The resolution: given, else 1 cm, or the image's pixel size if finer.
   if (floor->Has("resolution")) {
     settings.resolution = floor->Number("resolution", kPositiveLength);
   } else if (!settings.image_rgb.empty()) {
     settings.resolution =
-        std::min((settings.image_max_x - settings.image_min_x) / settings.image_width,
-                 (settings.image_max_y - settings.image_min_y) / settings.image_height);
+        std::min({0.01, (settings.image_max_x - settings.image_min_x) / settings.image_width,
+                  (settings.image_max_y - settings.image_min_y) / settings.image_height});
   }
   for (const std::unique_ptr<ObjectReader>& shape :
        floor->Maps("shapes", "floor shapes", "a floor shape"))

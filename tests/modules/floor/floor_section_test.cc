@@ -104,15 +104,14 @@ TEST_F(FloorSectionTest, AnImageLiesWhereItsCornersSay) {
 TEST_F(FloorSectionTest, AnImageIsScaledToItsCornersAndSetsTheDefaults) {
   WriteQuadrants("quads.png");
   // Stretched to 8 x 1 m (2 m by 0.5 m per image pixel); no area and no
-  // arena: the image's corners are the area, its smaller pixel side the
-  // resolution (0.5 m).
+  // arena: the image's corners are the area, at the default 1 cm.
   LoadedWorld w = Load(sim_ + "floor: {image: {file: quads.png, min: [-4, 0], max: [4, 1]}}\n");
   const FloorLayer* floor = w.world->floor_layer();
   ASSERT_NE(floor, nullptr);
   const FloorArea a = floor->floor_area();
-  EXPECT_DOUBLE_EQ(a.resolution, 0.5);
-  EXPECT_EQ(a.width, 16);
-  EXPECT_EQ(a.height, 2);
+  EXPECT_DOUBLE_EQ(a.resolution, 0.01);
+  EXPECT_EQ(a.width, 800);
+  EXPECT_EQ(a.height, 100);
   EXPECT_EQ(At(*floor, -3.9, 0.9), (Rgb{255, 0, 0}));
   EXPECT_EQ(At(*floor, -2.1, 0.6), (Rgb{255, 0, 0}));
   EXPECT_EQ(At(*floor, -1.9, 0.6), (Rgb{0, 0, 0}));
@@ -121,6 +120,12 @@ TEST_F(FloorSectionTest, AnImageIsScaledToItsCornersAndSetsTheDefaults) {
   LoadedWorld c = Load(sim_ + "arena: {size: 2}\nfloor: {image: {file: quads.png}}\n");
   EXPECT_EQ(At(*c.world->floor_layer(), -0.9, 0.9), (Rgb{255, 0, 0}));
   EXPECT_EQ(At(*c.world->floor_layer(), 0.9, -0.9), (Rgb{255, 0, 255}));
+  // An image finer than 1 cm sets the resolution: copied pixel for pixel.
+  LoadedWorld f =
+      Load(sim_ + "floor: {image: {file: quads.png, min: [0, 0], max: [0.02, 0.01]}}\n");
+  EXPECT_DOUBLE_EQ(f.world->floor_layer()->floor_area().resolution, 0.005);
+  EXPECT_EQ(f.world->floor_layer()->floor_area().width, 4);
+  EXPECT_EQ(At(*f.world->floor_layer(), 0.0175, 0.0025), (Rgb{255, 0, 255}));
 }
 
 TEST_F(FloorSectionTest, ShapesAreDrawnInOrderOverTheImage) {
