@@ -1,10 +1,12 @@
-// The floor image: a raster of the floor some module keeps (the paint layer,
-// modules/paint), read by those that show or sense the floor (the recorder,
-// the renderer; ground sensors next) without knowing which module it is.
+// The floor image: a raster of the floor some module keeps (the floor,
+// modules/floor, or the paint layer, modules/paint, which starts from the
+// floor when there is one), read by those that show or sense the floor (the
+// recorder, the renderer, ground sensors) without knowing which module it is.
 // World holds at most one (World::floor_layer); its provider sets it when it
 // is made and lives as long as the world.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <span>
 
@@ -30,5 +32,14 @@ class FloorLayer {
   // Whether the pixel was ever marked (else it shows the background).
   virtual bool floor_marked(int column, int row) const = 0;
 };
+
+// The pixel of `a` under the point (x, y) m: row * width + column, or -1
+// outside the area (where the floor is the background).
+inline int64_t FloorPixelAt(const FloorArea& a, double x, double y) {
+  const double c = std::floor((x - a.min_x) / a.resolution);
+  const double r = std::floor((a.max_y - y) / a.resolution);
+  if (!(c >= 0 && r >= 0 && c < a.width && r < a.height)) return -1;
+  return static_cast<int64_t>(r) * a.width + static_cast<int64_t>(c);
+}
 
 }  // namespace swarmsim

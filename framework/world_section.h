@@ -27,7 +27,8 @@ struct WorldSectionContext {
   struct Area {
     double min_x, min_y, max_x, max_y;  // m
   };
-  std::optional<Area> arena;  // the inner area of the world's `arena:`, if it has one
+  std::optional<Area> arena;           // the inner area of the world's `arena:`, if it has one
+  std::filesystem::path world_folder;  // the world file's folder: files it names are relative to it
 };
 
 struct WorldSectionDescriptor {

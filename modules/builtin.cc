@@ -10,8 +10,10 @@
 #include "modules/dynamics/ode/ode_backend.h"
 #include "modules/dynamics/planar/planar_backend.h"
 #include "modules/environment/environment.h"
+#include "modules/floor/floor.h"
 #include "modules/force_sensor/force_sensor.h"
 #include "modules/graphs/graphs.h"
+#include "modules/ground_sensor/ground_sensor.h"
 #include "modules/kinematics/ik_groups.h"
 #include "modules/metrics/swarm_metrics.h"
 #include "modules/mill/mill.h"
@@ -70,10 +72,13 @@ void RegisterBuiltinModules(ModuleRegistry* registry) {
   rendering::RegisterObjects(registry);
   graphs::Register(registry);
   blobs::Register(registry);
-  video::Register(registry);  // snapshots and video: the program's view recorder
+  ground_sensor::Register(registry);
+  floors::Register(registry);  // the floor (floor:), ground sensors' and the paint layer's base
+  video::Register(registry);   // snapshots and video: the program's view recorder
   range_and_bearing::Register(registry);
   // World-file sections, in the order the loader reads them.
   registry->RegisterWorldSection(metrics::MetricsSection());
+  registry->RegisterWorldSection(floors::FloorSection());  // before paint: paint starts from it
   registry->RegisterWorldSection(paint::PaintSection());
 }
 

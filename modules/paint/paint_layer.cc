@@ -44,6 +44,24 @@ PaintLayer::PaintLayer(World* world, const PaintSettings& settings)
                          ToByte(settings_.background.z)};
   for (size_t p = 0; p < n; ++p)
     std::copy(bg, bg + 3, rgb_.begin() + static_cast<ptrdiff_t>(3 * p));
+  // Over a floor: each pixel starts as the floor's colour at its centre.
+  if (const FloorLayer* floor = world_->floor_layer()) {
+    const FloorArea area = floor->floor_area();
+    const std::span<const uint8_t> floor_rgb = floor->floor_rgb();
+    floor_marked_.assign(n, 0);
+    for (int row = 0; row < height_; ++row)
+      for (int col = 0; col < width_; ++col) {
+        const Vec3 c = PixelCentre(col, row);
+        const int64_t pixel = FloorPixelAt(area, c.x, c.y);
+        if (pixel < 0 || !floor->floor_marked(static_cast<int>(pixel % area.width),
+                                              static_cast<int>(pixel / area.width)))
+          continue;  // the floor's background there: ours
+        const size_t p = static_cast<size_t>(row) * width_ + col;
+        std::copy(&floor_rgb[3 * pixel], &floor_rgb[3 * pixel] + 3,
+                  rgb_.begin() + static_cast<ptrdiff_t>(3 * p));
+        floor_marked_[p] = 1;
+      }
+  }
   world_->set_floor_layer(this);
 }
 

@@ -9,6 +9,12 @@
 // lie within its radius of its (x, y), when it is above the floor (z >= 0);
 // parts of the disc outside the area are dropped.
 //
+// With a floor (the world's floor layer when the paint layer is made: the
+// `floor:` section, modules/floor), the layer starts from it: each pixel
+// takes the floor's colour at its centre, and the paint layer becomes the
+// world's floor layer in its place, so paint is drawn over the floor and
+// ground sensors, snapshots and the viewer see both.
+//
 // Image: row 0 is the area's +y edge (north up), column 0 its -x edge; pixel
 // (c, r) covers x in min_x + [c, c + 1) res and y in max_y - [r + 1, r) res.
 #pragma once
@@ -42,13 +48,18 @@ ModuleDescriptor PaintModule();
 class PaintLayer final : public Observer, public FloorLayer {
  public:
   // Throws swarmsim::Error for a bad resolution or area, or an image over
-  // 100 megapixels. Becomes `world`'s floor layer.
+  // 100 megapixels. Starts from `world`'s floor layer if it has one, and
+  // becomes its floor layer.
   PaintLayer(World* world, const PaintSettings& settings);
   ~PaintLayer() override;
 
   FloorArea floor_area() const override;
   std::span<const uint8_t> floor_rgb() const override { return rgb_; }
-  bool floor_marked(int column, int row) const override { return painted(column, row); }
+  // Painted, or drawn on the floor it started from.
+  bool floor_marked(int column, int row) const override {
+    return painted(column, row) ||
+           (!floor_marked_.empty() && floor_marked_[row * width_ + column] != 0);
+  }
 
   void Record(const World& world, std::vector<MetricSample>* out) override;
   // Writes paint.png into `dir`.
@@ -79,6 +90,7 @@ class PaintLayer final : public Observer, public FloorLayer {
   int width_ = 0, height_ = 0;
   std::vector<uint8_t> rgb_;                        // (height x width x 3)
   std::vector<uint8_t> painted_;                    // (height x width)
+  std::vector<uint8_t> floor_marked_;               // (height x width), empty without a floor
   const Rows<PaintNozzleData>* nozzles_ = nullptr;  // the scene's, since the last Record
   uint64_t nozzles_version_ = ~uint64_t{0};
   std::vector<std::vector<uint32_t>> robot_nozzles_;  // nozzle slots per robot (robots)

@@ -3,12 +3,14 @@
 // outputs as paint.png. Read through the loader's ObjectReader after the
 // world's objects exist; a world with paint nozzles gets a layer with the
 // defaults even without the key, and its area defaults to the arena's inner
-// area.
+// area. Over a floor (`floor:`, read before this section), the layer starts
+// from the floor, and its area, resolution and background are the floor's.
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "framework/error.h"
+#include "framework/floor_layer.h"
 #include "framework/registry.h"
 #include "framework/world.h"
 #include "framework/world_section.h"
@@ -21,10 +23,12 @@ namespace swarmsim::paint {
 namespace {
 
 constexpr ObjectKey kKeys[] = {
-    {"resolution", "0.01", "m, side of one pixel (at most 100 megapixels)"},
-    {"area", "the arena's inner area",
+    {"resolution", "0.01 (with a floor: the floor's)",
+     "m, side of one pixel (at most 100 megapixels)"},
+    {"area", "the arena's inner area (with a floor: the floor's)",
      "{min: [x, y], max: [x, y]} m, the floor covered (required without an arena)"},
-    {"background", "[1, 1, 1]", "RGB 0..1, the unpainted floor"},
+    {"background", "[1, 1, 1]",
+     "RGB 0..1, the unpainted floor (with a `floor:` section: the floor, and this key is refused)"},
 };
 
 bool HasNozzles(const Scene& scene) {
@@ -59,10 +63,21 @@ void ReadPaint(const ObjectReader& top, const WorldSectionContext& context, Worl
   // Errors without a value of their own point at `paint:`, else at the file.
   const ObjectReader& where = paint ? *paint : top;
   PaintSettings settings;
+  // Over a floor: its area, resolution and background unless given.
+  const FloorLayer* floor = world->floor_layer();
+  if (floor != nullptr) {
+    const FloorArea a = floor->floor_area();
+    settings.resolution = a.resolution;
+    settings.background = a.background;
+  }
   bool area_given = false;
   if (paint) {
     const std::vector<std::string> keys = {"resolution", "area", "background"};
     paint->Expect(keys);
+    if (floor != nullptr && paint->Has("background"))
+      paint->FailAtKey("background",
+                       "the unpainted floor is the world's 'floor:' (its background is the "
+                       "floor's 'background'); remove 'background' from 'paint'");
     if (paint->Has("resolution"))
       settings.resolution = paint->Number("resolution", kPositiveLength);
     if (paint->Has("background")) settings.background = paint->Vector3("background", kFraction);
@@ -71,7 +86,11 @@ void ReadPaint(const ObjectReader& top, const WorldSectionContext& context, Worl
       area_given = true;
     }
   }
-  if (!area_given) {
+  if (!area_given && floor != nullptr) {
+    const FloorArea a = floor->floor_area();
+    settings.min_x = a.min_x, settings.min_y = a.min_y, settings.max_x = a.max_x,
+    settings.max_y = a.max_y;
+  } else if (!area_given) {
     if (!context.arena)
       where.FailHere(
           "the paint layer (for paint nozzles) covers the arena: give an 'arena', or "

@@ -36,12 +36,18 @@ void WritePng(const std::filesystem::path& path, int width, int height,
   WriteFileAtomically(path, std::string_view(reinterpret_cast<const char*>(bytes.data()), size));
 }
 
-RgbImage ReadPng(const std::filesystem::path& path) {
+RgbImage ReadPng(const std::filesystem::path& path, int64_t max_pixels) {
   png_image image;
   std::memset(&image, 0, sizeof image);
   image.version = PNG_IMAGE_VERSION;
   if (!png_image_begin_read_from_file(&image, path.c_str()))
     throw Error("cannot read '" + path.string() + "': " + image.message);
+  if (int64_t{image.width} * int64_t{image.height} > max_pixels) {
+    png_image_free(&image);
+    throw Error("'" + path.string() + "' is " + std::to_string(image.width) + " x " +
+                std::to_string(image.height) + " pixels, over the limit of " +
+                std::to_string(max_pixels) + " pixels");
+  }
   image.format = PNG_FORMAT_RGB;
   RgbImage out;
   out.width = static_cast<int>(image.width);

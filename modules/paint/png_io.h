@@ -12,11 +12,13 @@ namespace swarmsim::paint {
 void WritePng(const std::filesystem::path& path, int width, int height,
               const std::vector<uint8_t>& rgb);
 
-// Reads an image as 8-bit RGB. Throws swarmsim::Error on failure.
+// Reads an image as 8-bit RGB. Throws swarmsim::Error on failure, and for
+// an image of more than `max_pixels` pixels (checked from its header, before
+// decoding it).
 struct RgbImage {
   int width = 0, height = 0;
   std::vector<uint8_t> rgb;  // (height x width x 3), rows from the top
 };
-RgbImage ReadPng(const std::filesystem::path& path);
+RgbImage ReadPng(const std::filesystem::path& path, int64_t max_pixels = INT64_MAX);
 
 }  // namespace swarmsim::paint

@@ -40,11 +40,16 @@ const std::vector<std::string> kRingKeys = {"name",
                                             "failure_probability"};
 // The type of a ring's sensors (modules/proximity's), found by name.
 constexpr char kRingSensorType[] = "proximity_sensor";
+// A third: a set of ground sensors (modules/ground_sensor's type), on a ring
+// or at listed points, with the keys of every ground sensor besides these.
+const std::vector<std::string> kGroundArrayKeys = {
+    "name", "type", "count", "radius", "start_angle_deg", "points", "height"};
+constexpr char kGroundSensorType[] = "ground_sensor";
 
 // The object types a model may use: every type of the scene (the built-in
 // ones, then the registry's, in listing order; object_type.h), with
 // proximity_ring (the loader's shorthand for a ring of sensors) after
-// proximity_sensor when there is one.
+// proximity_sensor, and ground_array after ground_sensor, when there are.
 struct TypeList {
   std::vector<const ObjectTypeDescriptor*> types;  // by ObjectType value
   std::vector<std::string> names;                  // as world files write them
@@ -57,9 +62,10 @@ struct TypeList {
     for (const size_t t : ListingOrder(types)) {
       names.push_back(types[t]->name);
       if (names.back() == kRingSensorType) names.push_back("proximity_ring");
+      if (names.back() == kGroundSensorType) names.push_back("ground_array");
     }
   }
-  // The type named `name` (one of `names` but proximity_ring).
+  // The type named `name` (one of `names` but proximity_ring and ground_array).
   ObjectType Find(const std::string& name) const {
     for (size_t t = 0; t < types.size(); ++t)
       if (name == types[t]->name) return static_cast<ObjectType>(t);
@@ -68,6 +74,12 @@ struct TypeList {
   // The keys an object of the type named `name` takes.
   std::vector<std::string> KeysOf(const std::string& name) const {
     if (name == "proximity_ring") return kRingKeys;
+    if (name == "ground_array") {
+      std::vector<std::string> keys = kGroundArrayKeys;
+      for (const ObjectKey& key : types[static_cast<size_t>(Find(kGroundSensorType))]->keys)
+        keys.push_back(key.name);
+      return keys;
+    }
     std::vector<std::string> keys = kCommonKeys;
     for (const ObjectKey& key : types[static_cast<size_t>(Find(name))]->keys)
       keys.push_back(key.name);
@@ -139,16 +151,24 @@ struct Builder {
       name = values.String(name_field);
       CheckObjectName(values, name_field, name);
     }
-    const std::string what =
-        is_root ? root_what
-                : (type == "proximity_ring" ? "proximity ring '" : "object '") + name + "'";
+    const std::string what = is_root ? root_what
+                                     : (type == "proximity_ring" ? "proximity ring '"
+                                        : type == "ground_array" ? "ground array '"
+                                                                 : "object '") +
+                                           name + "'";
     Fields named(values.file(), field, what);
 
     if (type == "proximity_ring" && is_root)
       values.Fail(type_field, "a proximity ring cannot be the root object of a model");
+    if (type == "ground_array" && is_root)
+      values.Fail(type_field, "a ground array cannot be the root object of a model");
     named.Expect(types.KeysOf(type));
     if (type == "proximity_ring") {
       Ring(named, name, out);
+      return;
+    }
+    if (type == "ground_array") {
+      GroundArray(named, field, name, out);
       return;
     }
 
@@ -208,6 +228,55 @@ struct Builder {
       spec.row = sensor;  // shared: specs are not changed after they are read
       spec.X_PO = {{radius * std::cos(theta), radius * std::sin(theta), height},
                    Quat::FromYaw(theta) * z_to_x};
+      out->push_back(std::move(spec));
+    }
+  }
+
+  // Ground sensors named `name`, in the parent's frame at z = height: either
+  // `count` on a circle of `radius` (sensor i at angle start + 2 pi i / count
+  // counter-clockwise from +x), or one at each of `points` ([x, y] m). Each
+  // reads the array's ground-sensor keys (mode, threshold, noise, ...).
+  void GroundArray(const Fields& f, const Field& field, const std::string& name,
+                   std::vector<ObjectSpec>* out) {
+    std::vector<std::pair<double, double>> xy;
+    if (f.Has("points")) {
+      for (const char* ring_key : {"count", "radius", "start_angle_deg"})
+        if (f.Has(ring_key))
+          values.Fail(f.Get(ring_key), std::string("a ground array takes 'points' or '") +
+                                           ring_key + "' (a ring), not both");
+      const std::vector<Field> points = ListElements(values.file(), f.Get("points"), "points");
+      if (points.empty() || points.size() > static_cast<size_t>(kMaxRingCount))
+        values.Fail(f.Get("points"),
+                    "'points' must list 1 to " + std::to_string(kMaxRingCount) + " points [x, y]");
+      for (const Field& point : points) {
+        const std::vector<double> p = values.Numbers(point, 2, 2, kCoordinate);
+        xy.emplace_back(p[0], p[1]);
+      }
+    } else {
+      if (!f.Has("count"))
+        values.Fail(field, "a ground array needs 'points: [[x, y], ...]' or 'count' and 'radius'");
+      const int64_t count = values.Integer(f.Require("count"), 1, kMaxRingCount);
+      const double radius = values.Number(f.Require("radius"), kNonNegativeLength);
+      const double start = f.Has("start_angle_deg")
+                               ? values.Number(f.Get("start_angle_deg"), kAngleDeg) * kDegToRad
+                               : 0;
+      for (int64_t i = 0; i < count; ++i) {
+        const double theta = start + 2 * M_PI * static_cast<double>(i) / static_cast<double>(count);
+        xy.emplace_back(radius * std::cos(theta), radius * std::sin(theta));
+      }
+    }
+    const double height = f.Has("height") ? values.Number(f.Get("height"), kCoordinate) : 0.0;
+    const ObjectType sensor_type = types.Find(kGroundSensorType);
+    const ObjectTypeDescriptor& descriptor = *types.types[static_cast<size_t>(sensor_type)];
+    const std::shared_ptr<RowTable> sensor = NewRow(descriptor);
+    descriptor.read(descriptor, FieldsObjectReader(values, f, meshes, registry), sensor->At(0));
+    Count(field, static_cast<int>(xy.size()));
+    for (const auto& [x, y] : xy) {
+      ObjectSpec spec;
+      spec.name = name;
+      spec.type = sensor_type;
+      spec.row = sensor;  // shared: specs are not changed after they are read
+      spec.X_PO = {{x, y, height}, {}};
       out->push_back(std::move(spec));
     }
   }

@@ -560,6 +560,7 @@ void WorldLoader::ReadSections(const Fields& top, World* world) {
   const FieldsObjectReader reader(values, top, &meshes_, world_registry_);
   WorldSectionContext context;
   if (arena_) context.arena = {arena_->min_x, arena_->min_y, arena_->max_x, arena_->max_y};
+  context.world_folder = path_.parent_path();
   for (const auto& section : registry_.world_sections()) section->read(reader, context, world);
 }
 

@@ -9,6 +9,7 @@
 #include "framework/error.h"
 #include "framework/scene.h"
 #include "framework/scheduler.h"
+#include "modules/ground_sensor/ground_sensor.h"
 #include "modules/proximity/proximity_sensor.h"
 #include "modules/range_and_bearing/range_and_bearing.h"
 
@@ -53,6 +54,8 @@ void Refresh(const World& world, const std::string& model, ModelLayout* layout) 
   proximity::FindSensorType(scene, &sensor);
   ObjectType board = static_cast<ObjectType>(kMaxObjectTypes);
   scene.FindType(range_and_bearing::kTypeName, &board);
+  ObjectType ground = static_cast<ObjectType>(kMaxObjectTypes);
+  ground_sensor::FindSensorType(scene, &ground);
   *layout = ModelLayout{};
   layout->model = model;
   const auto instances = scene.instances();
@@ -60,8 +63,8 @@ void Refresh(const World& world, const std::string& model, ModelLayout* layout) 
   for (size_t i = 0; i < instances.size(); ++i) {
     const ModelInstance& inst = instances[i];
     if (!inst.alive || (!model.empty() && inst.model_name != model)) continue;
-    std::vector<std::string> joints, sensors;
-    std::vector<uint32_t> joint_slots, sensor_slots;
+    std::vector<std::string> joints, sensors, grounds;
+    std::vector<uint32_t> joint_slots, sensor_slots, ground_slots;
     uint32_t board_slot = ModelLayout::kNoBoard;
     for (const uint32_t slot : inst.objects) {
       if (scene.type_at(slot) == board && board_slot == ModelLayout::kNoBoard) board_slot = slot;
@@ -71,25 +74,34 @@ void Refresh(const World& world, const std::string& model, ModelLayout* layout) 
       } else if (scene.type_at(slot) == sensor) {
         sensors.push_back(scene.name_at(slot));
         sensor_slots.push_back(slot);
+      } else if (scene.type_at(slot) == ground) {
+        grounds.push_back(scene.name_at(slot));
+        ground_slots.push_back(slot);
       }
     }
     IndexRepeats(&joints);
     IndexRepeats(&sensors);
+    IndexRepeats(&grounds);
     if (first) {
       layout->joint_names = joints;
       layout->sensor_names = sensors;
+      layout->ground_names = grounds;
       first = false;
-    } else if (joints != layout->joint_names || sensors != layout->sensor_names) {
+    } else if (joints != layout->joint_names || sensors != layout->sensor_names ||
+               grounds != layout->ground_names) {
       if (!model.empty())
         throw Error("robot '" + inst.name + "' of model '" + model +
                     "' has other joints or sensors than the first copy: arrays need one layout");
       // Mixed models: arrays over every robot have no common columns.
       layout->joint_names.clear();
       layout->sensor_names.clear();
+      layout->ground_names.clear();
       joint_slots.clear();
       sensor_slots.clear();
+      ground_slots.clear();
       layout->joint_slots.clear();
       layout->sensor_slots.clear();
+      layout->ground_slots.clear();
     }
     layout->robots.push_back(static_cast<int>(i));
     layout->root_slots.push_back(scene.SlotOf(inst.root));
@@ -99,6 +111,9 @@ void Refresh(const World& world, const std::string& model, ModelLayout* layout) 
     if (layout->sensor_names.size() == sensor_slots.size())
       layout->sensor_slots.insert(layout->sensor_slots.end(), sensor_slots.begin(),
                                   sensor_slots.end());
+    if (layout->ground_names.size() == ground_slots.size())
+      layout->ground_slots.insert(layout->ground_slots.end(), ground_slots.begin(),
+                                  ground_slots.end());
   }
   const size_t n = layout->robots.size();
   if (layout->joint_slots.size() != n * layout->joint_names.size()) {
@@ -108,6 +123,10 @@ void Refresh(const World& world, const std::string& model, ModelLayout* layout) 
   if (layout->sensor_slots.size() != n * layout->sensor_names.size()) {
     layout->sensor_names.clear();
     layout->sensor_slots.clear();
+  }
+  if (layout->ground_slots.size() != n * layout->ground_names.size()) {
+    layout->ground_names.clear();
+    layout->ground_slots.clear();
   }
   layout->robot_count = world.robot_count();
 }
@@ -314,6 +333,19 @@ void SetRangeAndBearingData(Scene* scene, const ModelLayout& layout, const py::o
     bytes.resize(k);
     for (size_t j = 0; j < k; ++j) bytes[j] = static_cast<uint8_t>(v[i * k + j]);
   }
+// Ground sensor readings, N x ground sensors.
+Array Ground(const Scene& scene, const ModelLayout& layout, const py::object& out) {
+  const auto n = static_cast<py::ssize_t>(layout.robots.size());
+  const auto s = static_cast<py::ssize_t>(layout.ground_names.size());
+  Array a = OutArray({n, s}, out);
+  double* d = a.mutable_data();
+  ObjectType type;
+  if (!ground_sensor::FindSensorType(scene, &type)) return a;  // no columns
+  const std::vector<ground_sensor::GroundSensorRow>& rows =
+      scene.rows<ground_sensor::GroundSensorRow>(type).rows;
+  for (size_t k = 0; k < layout.ground_slots.size(); ++k)
+    d[k] = rows[scene.row_at(layout.ground_slots[k])].value;
+  return a;
 }
 
 // Joint positions (what = 0) or velocities (1), N x joints.

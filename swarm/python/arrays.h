@@ -29,7 +29,9 @@ struct ModelLayout {
   std::vector<uint32_t> sensor_slots;     // robots x sensors
   std::vector<uint32_t> board_slots;  // per robot: its first range-and-bearing board, or kNoBoard
   static constexpr uint32_t kNoBoard = UINT32_MAX;
-  int64_t robot_count = -1;  // World::robot_count() it was built at
+  std::vector<std::string> ground_names;  // ground sensors, hierarchy order
+  std::vector<uint32_t> ground_slots;     // robots x ground sensors
+  int64_t robot_count = -1;               // World::robot_count() it was built at
 };
 
 // Rebuilds `layout` for `model` ("" : every robot) if robots came or went.
@@ -59,6 +61,9 @@ py::dict RangeAndBearing(const Scene& scene, const ModelLayout& layout);
 // Sets what each robot's first board sends: row i of `data` (N x k, bytes
 // 0..255, k at most the payload size) for robot i. Throws ValueError.
 void SetRangeAndBearingData(Scene* scene, const ModelLayout& layout, const py::object& data);
+// Ground sensor readings, N x ground sensors: each one's value (its grey
+// level, 0/1 in binary mode, a colour sensor's grey level).
+Array Ground(const Scene& scene, const ModelLayout& layout, const py::object& out);
 
 // Joint positions (what = 0) or velocities (1), N x joints.
 Array Joints(const Scene& scene, const ModelLayout& layout, int what, const py::object& out);

@@ -66,6 +66,10 @@ class Robots {
   py::object proximity() {
     return Cached(&proximity_, [&] { return Proximity(Sc(), *layout_, py::none()); });
   }
+  py::object ground() {
+    return Cached(&ground_, [&] { return Ground(Sc(), *layout_, py::none()); });
+  }
+  const std::vector<std::string>& ground_names() const { return layout_->ground_names; }
   py::object joint_positions() {
     return Cached(&joint_positions_, [&] { return Joints(Sc(), *layout_, 0, py::none()); });
   }
@@ -106,7 +110,7 @@ class Robots {
   World* world_;
   const ModelLayout* layout_;
   bool planar_;
-  py::object poses_, velocities_, proximity_, joint_positions_, joint_velocities_,
+  py::object poses_, velocities_, proximity_, ground_, joint_positions_, joint_velocities_,
       range_and_bearing_;
 };
 
@@ -401,6 +405,12 @@ class PyWorld {
   py::object proximity(const std::string& model, const py::object& out) {
     return Proximity(Any().scene(), Layout(model), out);
   }
+  py::object ground(const std::string& model, const py::object& out) {
+    return Ground(Any().scene(), Layout(model), out);
+  }
+  std::vector<std::string> ground_names(const std::string& model) {
+    return Layout(model).ground_names;
+  }
   py::object joint_positions(const std::string& model, const py::object& out) {
     return Joints(Any().scene(), Layout(model), 0, out);
   }
@@ -553,6 +563,8 @@ PYBIND11_MODULE(_swarmsim, m) {
       .def_property_readonly("poses", &Robots::poses)
       .def_property_readonly("velocities", &Robots::velocities)
       .def_property_readonly("proximity", &Robots::proximity)
+      .def_property_readonly("ground", &Robots::ground)
+      .def_property_readonly("ground_names", &Robots::ground_names)
       .def_property_readonly("joint_positions", &Robots::joint_positions)
       .def_property_readonly("joint_velocities", &Robots::joint_velocities)
       .def_property_readonly("range_and_bearing", &Robots::range_and_bearing)
@@ -579,6 +591,8 @@ PYBIND11_MODULE(_swarmsim, m) {
            py::arg("columns") = 0)
       .def("velocities", &PyWorld::velocities, py::arg("model") = "", py::arg("out") = py::none())
       .def("proximity", &PyWorld::proximity, py::arg("model") = "", py::arg("out") = py::none())
+      .def("ground", &PyWorld::ground, py::arg("model") = "", py::arg("out") = py::none())
+      .def("ground_names", &PyWorld::ground_names, py::arg("model") = "")
       .def("joint_positions", &PyWorld::joint_positions, py::arg("model") = "",
            py::arg("out") = py::none())
       .def("joint_velocities", &PyWorld::joint_velocities, py::arg("model") = "",

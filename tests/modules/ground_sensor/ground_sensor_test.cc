@@ -1,9 +1,10 @@
 // framework/README.md's worked example, "Adding a sensor: one folder, one
-// line": the ground sensor (ground_sensor.cc beside this file), registered
-// with its one line and nothing else changed, is sensed, read by scripts,
-// recorded with its colour changing step by step, and drawn in a snapshot;
-// an object of a type that declares no visual is recorded as a plain frame.
-#include "tests/modules/ground_sensor/ground_sensor.h"
+// line": the ground sensor (modules/ground_sensor), registered with its one
+// line in modules/builtin.cc and nothing else changed, is sensed, read by
+// scripts, recorded with its colour changing step by step, and drawn in a
+// snapshot; an object of a type that declares no visual is recorded as a
+// plain frame.
+#include "modules/ground_sensor/ground_sensor.h"
 
 #include <gtest/gtest.h>
 
@@ -50,11 +51,10 @@ class HalfAndHalfFloor final : public FloorLayer {
   std::vector<uint8_t> rgb_;
 };
 
-// A world of the built-in modules plus the example's one line.
+// A world of the built-in modules (ground_sensor::Register is one line of them).
 struct SensorWorld {
   explicit SensorWorld(bool with_sensor = true) {
     RegisterBuiltinModules(&registry);
-    ground_sensor::Register(&registry);  // the one line (modules/builtin.cc, in the tree)
     registry.RegisterObjectType(std::shared_ptr<const ObjectTypeDescriptor>(
         std::shared_ptr<const ObjectTypeDescriptor>(), &kPlainType));
     WorldSettings settings;
@@ -74,6 +74,7 @@ struct SensorWorld {
     if (with_sensor) {
       GroundSensorRow row;
       row.settings.Edit().radius = 0.1;
+      row.settings.Edit().mode = Mode::kColor;
       eye = scene.AddObject(sensor, "eye", robot, {{0, 0, 0.06}, {}}, &row);
     }
     // Something outside the robot to frame the arena by.
@@ -98,15 +99,16 @@ TEST(GroundSensorTest, ScriptsReadTheFloorUnderIt) {
       std::make_shared<const ScriptSource>(ScriptSource{
           "bot.lua",
           "function sysCall_sensing()\n"
-          "  print(string.format('%g %g %g', sim.readGroundSensor(sim.getObject('./eye'))))\n"
+          "  print(string.format('%g %g %g %g', sim.readGroundSensor(sim.getObject('./eye'))))\n"
           "end\n"}));
   w.world->Start();
   w.world->Step();  // x = -0.5: red
   w.world->scene().SetLocalPose(w.robot, {{0.5, 0, 0}, {}});
   w.world->Step();  // x = 0.5: green
   ASSERT_EQ(log.size(), 2u);
-  EXPECT_NE(log[0].find("1 0 0"), std::string::npos) << log[0];
-  EXPECT_NE(log[1].find("0 1 0"), std::string::npos) << log[1];
+  // value (the colour's grey level 0.299 r + 0.587 g + 0.114 b), r, g, b.
+  EXPECT_NE(log[0].find("0.299 1 0 0"), std::string::npos) << log[0];
+  EXPECT_NE(log[1].find("0.587 0 1 0"), std::string::npos) << log[1];
 }
 
 TEST(GroundSensorTest, IsRecordedWithItsColourStepByStep) {
