@@ -333,6 +333,8 @@ void SetRangeAndBearingData(Scene* scene, const ModelLayout& layout, const py::o
     bytes.resize(k);
     for (size_t j = 0; j < k; ++j) bytes[j] = static_cast<uint8_t>(v[i * k + j]);
   }
+}
+
 // Ground sensor readings, N x ground sensors.
 Array Ground(const Scene& scene, const ModelLayout& layout, const py::object& out) {
   const auto n = static_cast<py::ssize_t>(layout.robots.size());
