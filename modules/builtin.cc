@@ -13,6 +13,7 @@
 #include "modules/force_sensor/force_sensor.h"
 #include "modules/graphs/graphs.h"
 #include "modules/kinematics/ik_groups.h"
+#include "modules/light/light.h"
 #include "modules/metrics/swarm_metrics.h"
 #include "modules/mill/mill.h"
 #include "modules/paint/paint_nozzle.h"
@@ -69,6 +70,7 @@ void RegisterBuiltinModules(ModuleRegistry* registry) {
   rendering::RegisterObjects(registry);
   graphs::Register(registry);
   blobs::Register(registry);
+  light::Register(registry);  // light sources and light sensors
   video::Register(registry);  // snapshots and video: the program's view recorder
   // World-file sections, in the order the loader reads them.
   registry->RegisterWorldSection(metrics::MetricsSection());

@@ -30,8 +30,27 @@ const std::vector<std::string> kCommonKeys = {
 // dummy tagged with the sensor type a plugin registers).
 const std::vector<std::string> kRingKeys = {"name",   "type",  "count",          "radius",
                                             "height", "range", "start_angle_deg"};
-// The type of a ring's sensors (modules/proximity's), found by name.
-constexpr char kRingSensorType[] = "proximity_sensor";
+// The loader's rings (shorthands for `count` sensors round the parent's z
+// axis), each of a module's sensor type found by name: proximity_ring
+// (modules/proximity: each ray, its +z, points outwards; of the sensor's
+// keys only `range`) and light_sensor_ring (modules/light: each sensor's
+// +x points outwards; every light_sensor key).
+struct RingKind {
+  const char* name;         // the world-file type
+  const char* sensor_type;  // its sensors'
+  bool z_outwards;          // the sensor's +z points outwards (else its +x)
+  bool all_sensor_keys;     // the ring takes every key of the sensor type (else `range` only)
+  const char* what;         // "proximity ring": messages
+};
+constexpr RingKind kRings[] = {
+    {"proximity_ring", "proximity_sensor", true, false, "proximity ring"},
+    {"light_sensor_ring", "light_sensor", false, true, "light sensor ring"},
+};
+const RingKind* FindRing(const std::string& type) {
+  for (const RingKind& ring : kRings)
+    if (type == ring.name) return &ring;
+  return nullptr;
+}
 
 // The object types a model may use: every type of the scene (the built-in
 // ones, then the registry's, in listing order; object_type.h), with
@@ -48,10 +67,14 @@ struct TypeList {
       types.insert(types.end(), registry->object_types().begin(), registry->object_types().end());
     for (const size_t t : ListingOrder(types)) {
       names.push_back(types[t]->name);
-      if (names.back() == kRingSensorType) names.push_back("proximity_ring");
+      for (const RingKind& ring : kRings)
+        if (names.back() == ring.sensor_type) {
+          names.push_back(ring.name);
+          break;
+        }
     }
   }
-  // The type named `name` (one of `names` but proximity_ring).
+  // The type named `name` (one of `names` but a ring).
   ObjectType Find(const std::string& name) const {
     for (size_t t = 0; t < types.size(); ++t)
       if (name == types[t]->name) return static_cast<ObjectType>(t);
@@ -59,8 +82,15 @@ struct TypeList {
   }
   // The keys an object of the type named `name` takes.
   std::vector<std::string> KeysOf(const std::string& name) const {
-    if (name == "proximity_ring") return kRingKeys;
-    std::vector<std::string> keys = kCommonKeys;
+    const RingKind* ring = FindRing(name);
+    if (ring != nullptr && !ring->all_sensor_keys) return kRingKeys;
+    std::vector<std::string> keys = ring != nullptr ? kRingKeys : kCommonKeys;
+    if (ring != nullptr) {
+      keys.erase(std::find(keys.begin(), keys.end(), "range"));
+      for (const ObjectKey& key : types[static_cast<size_t>(Find(ring->sensor_type))]->keys)
+        keys.push_back(key.name);
+      return keys;
+    }
     for (const ObjectKey& key : types[static_cast<size_t>(Find(name))]->keys)
       keys.push_back(key.name);
     return keys;
@@ -131,16 +161,18 @@ struct Builder {
       name = values.String(name_field);
       CheckObjectName(values, name_field, name);
     }
+    const RingKind* ring = FindRing(type);
     const std::string what =
         is_root ? root_what
-                : (type == "proximity_ring" ? "proximity ring '" : "object '") + name + "'";
+                : (ring != nullptr ? std::string(ring->what) + " '" : "object '") + name + "'";
     Fields named(values.file(), field, what);
 
-    if (type == "proximity_ring" && is_root)
-      values.Fail(type_field, "a proximity ring cannot be the root object of a model");
+    if (ring != nullptr && is_root)
+      values.Fail(type_field, "a " + std::string(ring->what) +
+                                  " cannot be the root object of a model");
     named.Expect(types.KeysOf(type));
-    if (type == "proximity_ring") {
-      Ring(named, name, out);
+    if (ring != nullptr) {
+      Ring(*ring, named, name, out);
       return;
     }
 
@@ -174,15 +206,17 @@ struct Builder {
     out->push_back(std::move(spec));
   }
 
-  // `count` proximity sensors named `name` in a ring around the parent's z
-  // axis: sensor i at angle start + 2 pi i / count counter-clockwise from the
-  // parent's +x, its z axis (the ray) pointing radially outwards.
-  void Ring(const Fields& f, const std::string& name, std::vector<ObjectSpec>* out) {
+  // `count` sensors named `name` in a ring around the parent's z axis:
+  // sensor i at angle start + 2 pi i / count counter-clockwise from the
+  // parent's +x, its z axis (a proximity ray) or its x axis (a light
+  // sensor) pointing radially outwards.
+  void Ring(const RingKind& kind, const Fields& f, const std::string& name,
+            std::vector<ObjectSpec>* out) {
     const int64_t count = values.Integer(f.Require("count"), 1, kMaxRingCount);
     const double radius = values.Number(f.Require("radius"), kNonNegativeLength);
     const double height = f.Has("height") ? values.Number(f.Get("height"), kCoordinate) : 0.0;
-    // Each sensor of the ring reads the ring's range like a proximity_sensor.
-    const ObjectType ring_type = types.Find(kRingSensorType);
+    // Each sensor of the ring reads the ring's keys as its type does.
+    const ObjectType ring_type = types.Find(kind.sensor_type);
     const ObjectTypeDescriptor& sensor_type = *types.types[static_cast<size_t>(ring_type)];
     const std::shared_ptr<RowTable> sensor = NewRow(sensor_type);
     sensor_type.read(sensor_type, FieldsObjectReader(values, f, meshes, registry), sensor->At(0));
@@ -199,7 +233,7 @@ struct Builder {
       spec.type = ring_type;
       spec.row = sensor;  // shared: specs are not changed after they are read
       spec.X_PO = {{radius * std::cos(theta), radius * std::sin(theta), height},
-                   Quat::FromYaw(theta) * z_to_x};
+                   kind.z_outwards ? Quat::FromYaw(theta) * z_to_x : Quat::FromYaw(theta)};
       out->push_back(std::move(spec));
     }
   }

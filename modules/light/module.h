@@ -1,0 +1,69 @@
+// The light sensing module (internal to modules/light): in the sense phase
+// it lists the lit light sources (and, if a sensor asks, the shapes that
+// may hide them), then fills every light sensor's reading, sensors in
+// parallel.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "framework/module.h"
+#include "framework/object_rows.h"
+#include "framework/spatial_grid.h"
+#include "modules/proximity/ray_cast.h"
+
+struct lua_State;
+
+namespace swarmsim {
+class LineOfSight;
+}
+
+namespace swarmsim::light {
+
+struct LightSensorRow;
+
+inline constexpr const char* kModuleName = "light";
+
+// The Lua area of both types (lua_api_light.cc).
+void RegisterLightApi(lua_State* L);
+
+class LightSensingModule final : public Module {
+ public:
+  void Sense(World* world) override;
+
+ private:
+  struct LitSource {   // 48 bytes
+    Vec3 p_W;          // its centre
+    double intensity;  // > 0
+    int32_t instance;  // its robot, or -1
+    uint32_t slot;
+  };
+  // A shape that moves (a robot's, or dynamic): what `robot_occlusion` tests.
+  struct Occluder {
+    proximity::PlacedShape shape;
+    Vec3 lo, hi;  // its world bounds, grown for rounding
+    uint32_t slot;
+  };
+
+  void IndexSources(const Scene& scene);
+  void IndexOccluders(const Scene& scene);
+  // Fills one sensor's reading. Thread-safe across sensors.
+  void Read(const Scene& scene, uint32_t slot, LightSensorRow* sensor) const;
+  // Does a moving shape (but those of the sensor's robot and the light's,
+  // or those either hangs from) cross the segment from p_W to q_W?
+  bool HiddenByShapes(const Scene& scene, const Vec3& p_W, const Vec3& q_W, int sensor_instance,
+                      uint32_t sensor_slot, const LitSource& source) const;
+
+  uint64_t seed_ = 0;  // the world's
+  int64_t step_ = 0;   // the step being sensed
+  bool types_found_ = false;
+  bool have_types_ = false;
+  ObjectType source_type_{}, sensor_type_{};
+  const LineOfSight* line_of_sight_ = nullptr;  // the world's, or null: nothing static hides
+  std::vector<LitSource> sources_;              // lit light sources (row order)
+  std::vector<Occluder> occluders_;             // moving shapes (shape row order)
+  std::vector<GridItem> occluder_items_;        // their xy footprint circles (occluders_)
+  SpatialGrid occluder_grid_;
+};
+
+}  // namespace swarmsim::light

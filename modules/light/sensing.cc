@@ -1,0 +1,220 @@
+// Light sensors: what each reads of the lit light sources (light.h has the
+// formula).
+//
+// Each sense phase:
+// 1. the lit light sources (on, intensity > 0) are listed with their world
+//    positions (a world has a few: every sensor tests every one);
+// 2. if a sensor tests robot occlusion, every moving shape (a robot's, or
+//    a dynamic one) is placed at its pose and goes into a 2D grid over its
+//    (x, y) bounds;
+// 3. every sensor, in parallel (each writes only its own row): for each
+//    light, but its own robot's, the distance and the angle off its +x
+//    axis; a light out of range or outside the field of view adds nothing
+//    and costs no occlusion test. Then, in this order, the cheaper first:
+//    static shapes and the map (the world's line of sight, a segment from
+//    the sensor's origin to the light's centre stopping 1 um short of it,
+//    so the shape a light sits on does not hide it), and, with
+//    robot_occlusion, the moving shapes the grid lists along the segment
+//    (their boxes, then the exact ray tests of modules/proximity).
+//    The sum then gets the sensor's noise, drawn from the stream of
+//    (the world's seed, the sensor's slot, the step, kLight): the same
+//    readings whatever the thread count or row order.
+#include <algorithm>
+#include <cmath>
+
+#include "framework/line_of_sight.h"
+#include "framework/scene.h"
+#include "framework/scheduler.h"
+#include "framework/sensor_noise.h"
+#include "framework/world.h"
+#include "modules/light/light.h"
+#include "modules/light/module.h"
+
+namespace swarmsim::light {
+
+namespace {
+
+constexpr double kPi = 3.141592653589793;
+// The occlusion segment stops this short of the light (m).
+constexpr double kEndMargin = 1e-6;
+// A light nearer than this (m) counts as this near: the reading stays finite.
+constexpr double kMinDistance = 1e-3;
+// Sensors per task: a sensor costs tens of nanoseconds per light.
+constexpr int64_t kSensorGrain = 256;
+
+// Is `ancestor` above `slot` in the tree?
+bool IsAncestor(const Scene& scene, uint32_t ancestor, uint32_t slot) {
+  for (int32_t s = scene.parent_at(slot); s >= 0; s = scene.parent_at(static_cast<uint32_t>(s)))
+    if (static_cast<uint32_t>(s) == ancestor) return true;
+  return false;
+}
+
+// Does the segment p + t v, t in [0, 1], meet the box [lo, hi]?
+bool SegmentMeetsBox(const Vec3& p, const Vec3& v, const Vec3& lo, const Vec3& hi) {
+  double t0 = 0, t1 = 1;
+  const double ps[3] = {p.x, p.y, p.z}, vs[3] = {v.x, v.y, v.z};
+  const double los[3] = {lo.x, lo.y, lo.z}, his[3] = {hi.x, hi.y, hi.z};
+  for (int i = 0; i < 3; ++i) {
+    if (vs[i] == 0) {
+      if (ps[i] < los[i] || ps[i] > his[i]) return false;
+      continue;
+    }
+    const double inv = 1 / vs[i];
+    double a = (los[i] - ps[i]) * inv, b = (his[i] - ps[i]) * inv;
+    if (a > b) std::swap(a, b);
+    t0 = std::max(t0, a);
+    t1 = std::min(t1, b);
+    if (t0 > t1) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+void LightSensingModule::IndexSources(const Scene& scene) {
+  sources_.clear();
+  const Rows<LightSourceRow>& rows = scene.rows<LightSourceRow>(source_type_);
+  for (size_t r = 0; r < rows.size(); ++r) {
+    const LightSourceRow& l = rows.rows[r];
+    if (!l.lit()) continue;
+    const uint32_t slot = rows.owners[r];
+    sources_.push_back(
+        {scene.world_pose_at(slot).p, l.intensity, scene.instance_of_at(slot), slot});
+  }
+}
+
+void LightSensingModule::IndexOccluders(const Scene& scene) {
+  occluders_.clear();
+  occluder_items_.clear();
+  const auto shapes = scene.shapes();
+  const auto owners = scene.shape_owners();
+  for (size_t r = 0; r < shapes.size(); ++r) {
+    const uint32_t slot = owners[r];
+    const int instance = scene.instance_of_at(slot);
+    if (instance < 0 && !shapes[r].dynamic) continue;  // static: the line of sight's
+    Occluder& o = occluders_.emplace_back();
+    o.shape = proximity::PlaceShape(shapes[r], scene.world_pose_at(slot), scene.IdAt(slot),
+                                    instance);
+    o.slot = slot;
+    proximity::WorldBounds(o.shape, &o.lo, &o.hi);
+    // Grown a little: the exact test decides, these only must not miss.
+    const double margin = 1e-9 * (1 + std::abs(o.lo.x) + std::abs(o.lo.y) + std::abs(o.lo.z) +
+                                  std::abs(o.hi.x) + std::abs(o.hi.y) + std::abs(o.hi.z));
+    o.lo = o.lo - Vec3{margin, margin, margin};
+    o.hi = o.hi + Vec3{margin, margin, margin};
+    occluder_items_.push_back({0.5 * (o.lo.x + o.hi.x), 0.5 * (o.lo.y + o.hi.y),
+                               0.5 * std::hypot(o.hi.x - o.lo.x, o.hi.y - o.lo.y),
+                               static_cast<uint32_t>(occluder_items_.size())});
+  }
+  occluder_grid_.Build(occluder_items_);
+}
+
+bool LightSensingModule::HiddenByShapes(const Scene& scene, const Vec3& p_W, const Vec3& q_W,
+                                        int sensor_instance, uint32_t sensor_slot,
+                                        const LitSource& source) const {
+  if (occluders_.empty()) return false;
+  const Vec3 v_W = q_W - p_W;
+  const double length = v_W.Norm();
+  if (!(length > 0)) return false;
+  const Vec3 d_W = v_W / length;
+  // The segment in pieces about two cells long, each piece's box asked of
+  // the grid: the shapes listed stay near the segment however long it is.
+  // A shape listed twice (near a piece's end) is only tested twice.
+  const double piece = 2 * occluder_grid_.cell_size();
+  const int pieces =
+      std::clamp(static_cast<int>(std::hypot(v_W.x, v_W.y) / piece) + 1, 1, 1 << 16);
+  thread_local std::vector<uint32_t> near;
+  for (int k = 0; k < pieces; ++k) {
+    const Vec3 a = p_W + v_W * (static_cast<double>(k) / pieces);
+    const Vec3 b = p_W + v_W * (static_cast<double>(k + 1) / pieces);
+    occluder_grid_.QueryAabb(
+        {std::min(a.x, b.x), std::min(a.y, b.y), std::max(a.x, b.x), std::max(a.y, b.y)}, &near);
+    for (const uint32_t j : near) {
+      const Occluder& o = occluders_[j];
+      const int owner = o.shape.instance;
+      // Neither the sensor's robot nor the light's hides it (a robot's own
+      // light shines through its body, as ARGoS has it).
+      if (owner >= 0 ? owner == sensor_instance || owner == source.instance
+                     : IsAncestor(scene, o.slot, sensor_slot) ||
+                           IsAncestor(scene, o.slot, source.slot))
+        continue;
+      if (!SegmentMeetsBox(p_W, v_W, o.lo, o.hi)) continue;
+      double hit = 0;
+      if (proximity::RayCast(o.shape, p_W, d_W, length, &hit)) return true;
+    }
+  }
+  return false;
+}
+
+void LightSensingModule::Read(const Scene& scene, uint32_t slot, LightSensorRow* sensor) const {
+  const LightSensorSettings& s = *sensor->settings;
+  const Pose& X_WS = scene.world_pose_at(slot);
+  const Vec3& p_W = X_WS.p;
+  const Vec3 axis_W = X_WS.q.Rotate({1, 0, 0});
+  const int instance = scene.instance_of_at(slot);
+  const double half_fov = 0.5 * s.fov;
+  const double range2 = s.range > 0 ? s.range * s.range : INFINITY;
+  double sum = 0;
+  for (const LitSource& light : sources_) {
+    if (instance >= 0 && light.instance == instance) continue;  // its own robot's
+    const Vec3 d_W = light.p_W - p_W;
+    const double d2 = d_W.SquaredNorm();
+    if (!(d2 <= range2)) continue;
+    const double d = std::sqrt(d2);
+    // The angle off the axis; a light at the sensor's origin is on it.
+    const double c = d > 0 ? std::clamp(axis_W.Dot(d_W) / d, -1.0, 1.0) : 1.0;
+    const double theta = std::acos(c);
+    if (!(theta < half_fov)) continue;
+    const double response = 1 - theta / half_fov;
+    // Occlusion: the cheaper static test first.
+    if (s.occlusion || s.robot_occlusion) {
+      const double length = d - kEndMargin;
+      if (length > 0) {
+        const Vec3 end = p_W + d_W * (length / d);
+        if (s.occlusion && line_of_sight_ != nullptr && line_of_sight_->SegmentBlocked(p_W, end))
+          continue;
+        if (s.robot_occlusion && HiddenByShapes(scene, p_W, end, instance, slot, light)) continue;
+      }
+    }
+    const double dm = std::max(d, kMinDistance);
+    sum += light.intensity * response / (dm * dm);
+  }
+  if (s.noise.any()) {
+    Rng rng = NoiseStream(seed_, slot, step_, NoisePurpose::kLight);
+    sum = Fails(s.noise, rng) ? 0 : std::max(0.0, Perturb(s.noise, sum, rng));
+  }
+  if (s.saturation > 0) sum = std::min(sum, s.saturation);
+  sensor->reading = sum;
+}
+
+void LightSensingModule::Sense(World* world) {
+  Scene& scene = world->scene();
+  if (!types_found_) {
+    have_types_ = scene.FindType(kLightSourceTypeName, &source_type_) &&
+                  scene.FindType(kLightSensorTypeName, &sensor_type_);
+    types_found_ = true;
+  }
+  if (!have_types_) return;
+  Rows<LightSensorRow>& sensors = scene.rows<LightSensorRow>(sensor_type_);
+  if (sensors.size() == 0) return;
+  seed_ = world->settings().seed;
+  step_ = world->step_count();
+  line_of_sight_ = world->line_of_sight();
+  IndexSources(scene);
+  bool robot_occlusion = false;
+  if (!sources_.empty())
+    for (const LightSensorRow& row : sensors.rows)
+      if (row.settings->robot_occlusion) {
+        robot_occlusion = true;
+        break;
+      }
+  occluders_.clear();
+  if (robot_occlusion) IndexOccluders(scene);
+  world->scheduler().ParallelFor(0, static_cast<int64_t>(sensors.size()), kSensorGrain,
+                                 [&](int64_t begin, int64_t end) {
+                                   for (int64_t r = begin; r < end; ++r)
+                                     Read(scene, sensors.owners[r], &sensors.rows[r]);
+                                 });
+}
+
+}  // namespace swarmsim::light
