@@ -9,6 +9,7 @@
 #include "framework/error.h"
 #include "framework/scene.h"
 #include "framework/scheduler.h"
+#include "modules/light/light.h"
 #include "modules/proximity/proximity_sensor.h"
 
 namespace swarmsim::python {
@@ -50,6 +51,8 @@ void Refresh(const World& world, const std::string& model, ModelLayout* layout) 
   // Without the proximity module's type no object matches `sensor`.
   ObjectType sensor = static_cast<ObjectType>(kMaxObjectTypes);
   proximity::FindSensorType(scene, &sensor);
+  ObjectType light_sensor = static_cast<ObjectType>(kMaxObjectTypes);
+  light::FindSensorType(scene, &light_sensor);
   *layout = ModelLayout{};
   layout->model = model;
   const auto instances = scene.instances();
@@ -57,8 +60,8 @@ void Refresh(const World& world, const std::string& model, ModelLayout* layout) 
   for (size_t i = 0; i < instances.size(); ++i) {
     const ModelInstance& inst = instances[i];
     if (!inst.alive || (!model.empty() && inst.model_name != model)) continue;
-    std::vector<std::string> joints, sensors;
-    std::vector<uint32_t> joint_slots, sensor_slots;
+    std::vector<std::string> joints, sensors, lights;
+    std::vector<uint32_t> joint_slots, sensor_slots, light_slots;
     for (const uint32_t slot : inst.objects) {
       if (scene.type_at(slot) == joint) {
         joints.push_back(scene.name_at(slot));
@@ -66,15 +69,21 @@ void Refresh(const World& world, const std::string& model, ModelLayout* layout) 
       } else if (scene.type_at(slot) == sensor) {
         sensors.push_back(scene.name_at(slot));
         sensor_slots.push_back(slot);
+      } else if (scene.type_at(slot) == light_sensor) {
+        lights.push_back(scene.name_at(slot));
+        light_slots.push_back(slot);
       }
     }
     IndexRepeats(&joints);
     IndexRepeats(&sensors);
+    IndexRepeats(&lights);
     if (first) {
       layout->joint_names = joints;
       layout->sensor_names = sensors;
+      layout->light_names = lights;
       first = false;
-    } else if (joints != layout->joint_names || sensors != layout->sensor_names) {
+    } else if (joints != layout->joint_names || sensors != layout->sensor_names ||
+               lights != layout->light_names) {
       if (!model.empty())
         throw Error("robot '" + inst.name + "' of model '" + model +
                     "' has other joints or sensors than the first copy: arrays need one layout");
@@ -85,6 +94,9 @@ void Refresh(const World& world, const std::string& model, ModelLayout* layout) 
       sensor_slots.clear();
       layout->joint_slots.clear();
       layout->sensor_slots.clear();
+      layout->light_names.clear();
+      light_slots.clear();
+      layout->light_slots.clear();
     }
     layout->robots.push_back(static_cast<int>(i));
     layout->root_slots.push_back(scene.SlotOf(inst.root));
@@ -93,6 +105,8 @@ void Refresh(const World& world, const std::string& model, ModelLayout* layout) 
     if (layout->sensor_names.size() == sensor_slots.size())
       layout->sensor_slots.insert(layout->sensor_slots.end(), sensor_slots.begin(),
                                   sensor_slots.end());
+    if (layout->light_names.size() == light_slots.size())
+      layout->light_slots.insert(layout->light_slots.end(), light_slots.begin(), light_slots.end());
   }
   const size_t n = layout->robots.size();
   if (layout->joint_slots.size() != n * layout->joint_names.size()) {
@@ -102,6 +116,10 @@ void Refresh(const World& world, const std::string& model, ModelLayout* layout) 
   if (layout->sensor_slots.size() != n * layout->sensor_names.size()) {
     layout->sensor_names.clear();
     layout->sensor_slots.clear();
+  }
+  if (layout->light_slots.size() != n * layout->light_names.size()) {
+    layout->light_names.clear();
+    layout->light_slots.clear();
   }
   layout->robot_count = world.robot_count();
 }
@@ -218,6 +236,19 @@ Array Proximity(const Scene& scene, const ModelLayout& layout, const py::object&
     const ProximitySensorData& p = rows[scene.row_at(layout.sensor_slots[k])];
     d[k] = p.detected ? p.distance : std::numeric_limits<double>::infinity();
   }
+  return a;
+}
+
+// Light sensor readings, N x light sensors.
+Array Light(const Scene& scene, const ModelLayout& layout, const py::object& out) {
+  const auto n = static_cast<py::ssize_t>(layout.robots.size());
+  const auto s = static_cast<py::ssize_t>(layout.light_names.size());
+  Array a = OutArray({n, s}, out);
+  double* d = a.mutable_data();
+  std::span<const uint32_t> owners;
+  const std::span<const light::LightSensorRow> rows = light::Sensors(scene, &owners);
+  for (size_t k = 0; k < layout.light_slots.size(); ++k)
+    d[k] = rows[scene.row_at(layout.light_slots[k])].reading;
   return a;
 }
 

@@ -1,6 +1,6 @@
 // The Python binding's arrays (swarm/python/module.cc): one model's robots
 // laid out by slot, and the numpy arrays gathered from them (poses,
-// velocities, proximity readings, joints), written into `out=` when given.
+// velocities, proximity and light readings, joints), written into `out=` when given.
 #pragma once
 
 #include <pybind11/numpy.h>
@@ -27,6 +27,8 @@ struct ModelLayout {
   std::vector<uint32_t> root_slots;       // per robot
   std::vector<uint32_t> joint_slots;      // robots x joints
   std::vector<uint32_t> sensor_slots;     // robots x sensors
+  std::vector<std::string> light_names;   // light sensors (modules/light), hierarchy order
+  std::vector<uint32_t> light_slots;      // robots x light sensors
   int64_t robot_count = -1;               // World::robot_count() it was built at
 };
 
@@ -46,6 +48,9 @@ Array Velocities(const Scene& scene, const ModelLayout& layout, const py::object
 // Proximity readings, N x sensors: the distance to what each sensor sees,
 // +inf where it sees nothing.
 Array Proximity(const Scene& scene, const ModelLayout& layout, const py::object& out);
+
+// Light sensor readings (modules/light), N x light sensors.
+Array Light(const Scene& scene, const ModelLayout& layout, const py::object& out);
 
 // Joint positions (what = 0) or velocities (1), N x joints.
 Array Joints(const Scene& scene, const ModelLayout& layout, int what, const py::object& out);

@@ -66,6 +66,10 @@ class Robots {
   py::object proximity() {
     return Cached(&proximity_, [&] { return Proximity(Sc(), *layout_, py::none()); });
   }
+  const std::vector<std::string>& light_sensor_names() const { return layout_->light_names; }
+  py::object light() {
+    return Cached(&light_, [&] { return Light(Sc(), *layout_, py::none()); });
+  }
   py::object joint_positions() {
     return Cached(&joint_positions_, [&] { return Joints(Sc(), *layout_, 0, py::none()); });
   }
@@ -99,7 +103,7 @@ class Robots {
   World* world_;
   const ModelLayout* layout_;
   bool planar_;
-  py::object poses_, velocities_, proximity_, joint_positions_, joint_velocities_;
+  py::object poses_, velocities_, proximity_, light_, joint_positions_, joint_velocities_;
 };
 
 struct ControllerConfig {
@@ -393,6 +397,12 @@ class PyWorld {
   py::object proximity(const std::string& model, const py::object& out) {
     return Proximity(Any().scene(), Layout(model), out);
   }
+  py::object light(const std::string& model, const py::object& out) {
+    return Light(Any().scene(), Layout(model), out);
+  }
+  std::vector<std::string> light_sensor_names(const std::string& model) {
+    return Layout(model).light_names;
+  }
   py::object joint_positions(const std::string& model, const py::object& out) {
     return Joints(Any().scene(), Layout(model), 0, out);
   }
@@ -536,6 +546,8 @@ PYBIND11_MODULE(_swarmsim, m) {
       .def_property_readonly("poses", &Robots::poses)
       .def_property_readonly("velocities", &Robots::velocities)
       .def_property_readonly("proximity", &Robots::proximity)
+      .def_property_readonly("light", &Robots::light)
+      .def_property_readonly("light_sensor_names", &Robots::light_sensor_names)
       .def_property_readonly("joint_positions", &Robots::joint_positions)
       .def_property_readonly("joint_velocities", &Robots::joint_velocities)
       .def("param", &Robots::param, py::arg("name"));
@@ -560,6 +572,8 @@ PYBIND11_MODULE(_swarmsim, m) {
            py::arg("columns") = 0)
       .def("velocities", &PyWorld::velocities, py::arg("model") = "", py::arg("out") = py::none())
       .def("proximity", &PyWorld::proximity, py::arg("model") = "", py::arg("out") = py::none())
+      .def("light", &PyWorld::light, py::arg("model") = "", py::arg("out") = py::none())
+      .def("light_sensor_names", &PyWorld::light_sensor_names, py::arg("model") = "")
       .def("joint_positions", &PyWorld::joint_positions, py::arg("model") = "",
            py::arg("out") = py::none())
       .def("joint_velocities", &PyWorld::joint_velocities, py::arg("model") = "",
