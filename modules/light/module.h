@@ -38,32 +38,47 @@ class LightSensingModule final : public Module {
     int32_t instance;  // its robot, or -1
     uint32_t slot;
   };
-  // A shape that moves (a robot's, or dynamic): what `robot_occlusion` tests.
+  // A shape that may hide a light.
   struct Occluder {
     proximity::PlacedShape shape;
     Vec3 lo, hi;  // its world bounds, grown for rounding
     uint32_t slot;
   };
+  // Shapes of one kind (static ones, or moving ones: a robot's or dynamic),
+  // with a 2D grid over their (x, y) bounds when there are many.
+  struct OccluderSet {
+    std::vector<Occluder> occluders;
+    std::vector<GridItem> items;  // their xy footprint circles (occluders)
+    SpatialGrid grid;
+    bool use_grid = false;  // else every segment scans them all
+    void Clear() {
+      occluders.clear();
+      items.clear();
+      use_grid = false;
+    }
+  };
 
   void IndexSources(const Scene& scene);
-  void IndexOccluders(const Scene& scene);
+  // The shapes of the scene, static ones into static_ (if `static_shapes`)
+  // and moving ones into moving_ (if `moving_shapes`).
+  void IndexOccluders(const Scene& scene, bool static_shapes, bool moving_shapes);
   // Fills one sensor's reading. Thread-safe across sensors.
   void Read(const Scene& scene, uint32_t slot, LightSensorRow* sensor) const;
-  // Does a moving shape (but those of the sensor's robot and the light's,
+  // Does a shape of `set` (but those of the sensor's robot and the light's,
   // or those either hangs from) cross the segment from p_W to q_W?
-  bool HiddenByShapes(const Scene& scene, const Vec3& p_W, const Vec3& q_W, int sensor_instance,
-                      uint32_t sensor_slot, const LitSource& source) const;
+  bool Hidden(const Scene& scene, const OccluderSet& set, const Vec3& p_W, const Vec3& q_W,
+              int sensor_instance, uint32_t sensor_slot, const LitSource& source) const;
 
   uint64_t seed_ = 0;  // the world's
   int64_t step_ = 0;   // the step being sensed
   bool types_found_ = false;
   bool have_types_ = false;
   ObjectType source_type_{}, sensor_type_{};
-  const LineOfSight* line_of_sight_ = nullptr;  // the world's, or null: nothing static hides
-  std::vector<LitSource> sources_;              // lit light sources (row order)
-  std::vector<Occluder> occluders_;             // moving shapes (shape row order)
-  std::vector<GridItem> occluder_items_;        // their xy footprint circles (occluders_)
-  SpatialGrid occluder_grid_;
+  // The world's line of sight (framework/line_of_sight.h), asked only for
+  // the environment map's voxels: null when the scene has no map.
+  const LineOfSight* map_ = nullptr;
+  std::vector<LitSource> sources_;  // lit light sources (row order)
+  OccluderSet static_, moving_;     // shapes (shape row order)
 };
 
 }  // namespace swarmsim::light

@@ -4,24 +4,31 @@
 // Each sense phase:
 // 1. the lit light sources (on, intensity > 0) are listed with their world
 //    positions (a world has a few: every sensor tests every one);
-// 2. if a sensor tests robot occlusion, every moving shape (a robot's, or
-//    a dynamic one) is placed at its pose and goes into a 2D grid over its
-//    (x, y) bounds;
+// 2. the shapes the sensors' occlusion tests need, placed at their poses:
+//    static ones (a shape of no robot that is not dynamic: walls,
+//    obstacles) if a sensor has `occlusion`, moving ones (a robot's, or
+//    dynamic) if one has `robot_occlusion`; each kind scanned whole when
+//    there are few (a walled arena: 4 box tests), else put in a 2D grid
+//    over its (x, y) bounds;
 // 3. every sensor, in parallel (each writes only its own row): for each
 //    light, but its own robot's, the distance and the angle off its +x
 //    axis; a light out of range or outside the field of view adds nothing
-//    and costs no occlusion test. Then, in this order, the cheaper first:
-//    static shapes and the map (the world's line of sight, a segment from
-//    the sensor's origin to the light's centre stopping 1 um short of it,
-//    so the shape a light sits on does not hide it), and, with
-//    robot_occlusion, the moving shapes the grid lists along the segment
-//    (their boxes, then the exact ray tests of modules/proximity).
+//    and costs no occlusion test. Occlusion is tested on the segment from
+//    the sensor's origin to the light's centre, stopping 1 um short of it
+//    (the shape a light sits on does not hide it): the static shapes, the
+//    moving ones (robot_occlusion; the grid's shapes along the segment, in
+//    pieces about two cells long), each by its box and then the exact ray
+//    test of modules/proximity; the shapes of the sensor's robot and of
+//    the light's, or those either hangs from, never hide it. Then the
+//    environment map's voxels, if the scene has a map (the world's line of
+//    sight, framework/line_of_sight.h: a voxel walk along the segment).
 //    The sum then gets the sensor's noise, drawn from the stream of
 //    (the world's seed, the sensor's slot, the step, kLight): the same
 //    readings whatever the thread count or row order.
 #include <algorithm>
 #include <cmath>
 
+#include "framework/environment.h"
 #include "framework/line_of_sight.h"
 #include "framework/scene.h"
 #include "framework/scheduler.h"
@@ -41,6 +48,9 @@ constexpr double kEndMargin = 1e-6;
 constexpr double kMinDistance = 1e-3;
 // Sensors per task: a sensor costs tens of nanoseconds per light.
 constexpr int64_t kSensorGrain = 256;
+// Up to this many shapes of a kind, a segment tests them all (a box test
+// each); more go into a grid.
+constexpr size_t kScanLimit = 16;
 
 // Is `ancestor` above `slot` in the tree?
 bool IsAncestor(const Scene& scene, uint32_t ancestor, uint32_t slot) {
@@ -83,16 +93,19 @@ void LightSensingModule::IndexSources(const Scene& scene) {
   }
 }
 
-void LightSensingModule::IndexOccluders(const Scene& scene) {
-  occluders_.clear();
-  occluder_items_.clear();
+void LightSensingModule::IndexOccluders(const Scene& scene, bool static_shapes,
+                                        bool moving_shapes) {
+  static_.Clear();
+  moving_.Clear();
   const auto shapes = scene.shapes();
   const auto owners = scene.shape_owners();
   for (size_t r = 0; r < shapes.size(); ++r) {
     const uint32_t slot = owners[r];
     const int instance = scene.instance_of_at(slot);
-    if (instance < 0 && !shapes[r].dynamic) continue;  // static: the line of sight's
-    Occluder& o = occluders_.emplace_back();
+    const bool moving = instance >= 0 || shapes[r].dynamic;
+    if (!(moving ? moving_shapes : static_shapes)) continue;
+    OccluderSet& set = moving ? moving_ : static_;
+    Occluder& o = set.occluders.emplace_back();
     o.shape = proximity::PlaceShape(shapes[r], scene.world_pose_at(slot), scene.IdAt(slot),
                                     instance);
     o.slot = slot;
@@ -102,46 +115,57 @@ void LightSensingModule::IndexOccluders(const Scene& scene) {
                                   std::abs(o.hi.x) + std::abs(o.hi.y) + std::abs(o.hi.z));
     o.lo = o.lo - Vec3{margin, margin, margin};
     o.hi = o.hi + Vec3{margin, margin, margin};
-    occluder_items_.push_back({0.5 * (o.lo.x + o.hi.x), 0.5 * (o.lo.y + o.hi.y),
-                               0.5 * std::hypot(o.hi.x - o.lo.x, o.hi.y - o.lo.y),
-                               static_cast<uint32_t>(occluder_items_.size())});
+    set.items.push_back({0.5 * (o.lo.x + o.hi.x), 0.5 * (o.lo.y + o.hi.y),
+                         0.5 * std::hypot(o.hi.x - o.lo.x, o.hi.y - o.lo.y),
+                         static_cast<uint32_t>(set.items.size())});
   }
-  occluder_grid_.Build(occluder_items_);
+  for (OccluderSet* set : {&static_, &moving_}) {
+    set->use_grid = set->occluders.size() > kScanLimit;
+    if (set->use_grid) set->grid.Build(set->items);
+  }
 }
 
-bool LightSensingModule::HiddenByShapes(const Scene& scene, const Vec3& p_W, const Vec3& q_W,
-                                        int sensor_instance, uint32_t sensor_slot,
-                                        const LitSource& source) const {
-  if (occluders_.empty()) return false;
+bool LightSensingModule::Hidden(const Scene& scene, const OccluderSet& set, const Vec3& p_W,
+                                const Vec3& q_W, int sensor_instance, uint32_t sensor_slot,
+                                const LitSource& source) const {
+  if (set.occluders.empty()) return false;
   const Vec3 v_W = q_W - p_W;
   const double length = v_W.Norm();
   if (!(length > 0)) return false;
   const Vec3 d_W = v_W / length;
+  // One shape: its box first (most miss it); skipped when it is the
+  // sensor's robot's or the light's (a robot's own light shines through
+  // its body, as ARGoS has it), or one either hangs from; then the exact
+  // ray test.
+  const auto hides = [&](const Occluder& o) {
+    if (!SegmentMeetsBox(p_W, v_W, o.lo, o.hi)) return false;
+    const int owner = o.shape.instance;
+    if (owner >= 0 ? owner == sensor_instance || owner == source.instance
+                   : IsAncestor(scene, o.slot, sensor_slot) ||
+                         IsAncestor(scene, o.slot, source.slot))
+      return false;
+    double hit = 0;
+    return proximity::RayCast(o.shape, p_W, d_W, length, &hit);
+  };
+  if (!set.use_grid) {
+    for (const Occluder& o : set.occluders)
+      if (hides(o)) return true;
+    return false;
+  }
   // The segment in pieces about two cells long, each piece's box asked of
   // the grid: the shapes listed stay near the segment however long it is.
   // A shape listed twice (near a piece's end) is only tested twice.
-  const double piece = 2 * occluder_grid_.cell_size();
+  const double piece = 2 * set.grid.cell_size();
   const int pieces =
       std::clamp(static_cast<int>(std::hypot(v_W.x, v_W.y) / piece) + 1, 1, 1 << 16);
   thread_local std::vector<uint32_t> near;
   for (int k = 0; k < pieces; ++k) {
     const Vec3 a = p_W + v_W * (static_cast<double>(k) / pieces);
     const Vec3 b = p_W + v_W * (static_cast<double>(k + 1) / pieces);
-    occluder_grid_.QueryAabb(
+    set.grid.QueryAabb(
         {std::min(a.x, b.x), std::min(a.y, b.y), std::max(a.x, b.x), std::max(a.y, b.y)}, &near);
-    for (const uint32_t j : near) {
-      const Occluder& o = occluders_[j];
-      const int owner = o.shape.instance;
-      // Neither the sensor's robot nor the light's hides it (a robot's own
-      // light shines through its body, as ARGoS has it).
-      if (owner >= 0 ? owner == sensor_instance || owner == source.instance
-                     : IsAncestor(scene, o.slot, sensor_slot) ||
-                           IsAncestor(scene, o.slot, source.slot))
-        continue;
-      if (!SegmentMeetsBox(p_W, v_W, o.lo, o.hi)) continue;
-      double hit = 0;
-      if (proximity::RayCast(o.shape, p_W, d_W, length, &hit)) return true;
-    }
+    for (const uint32_t j : near)
+      if (hides(set.occluders[j])) return true;
   }
   return false;
 }
@@ -153,6 +177,7 @@ void LightSensingModule::Read(const Scene& scene, uint32_t slot, LightSensorRow*
   const Vec3 axis_W = X_WS.q.Rotate({1, 0, 0});
   const int instance = scene.instance_of_at(slot);
   const double half_fov = 0.5 * s.fov;
+  const bool narrow = half_fov <= 0.5 * kPi;
   const double range2 = s.range > 0 ? s.range * s.range : INFINITY;
   double sum = 0;
   for (const LitSource& light : sources_) {
@@ -160,9 +185,11 @@ void LightSensingModule::Read(const Scene& scene, uint32_t slot, LightSensorRow*
     const Vec3 d_W = light.p_W - p_W;
     const double d2 = d_W.SquaredNorm();
     if (!(d2 <= range2)) continue;
+    const double dot = axis_W.Dot(d_W);
+    if (narrow && !(dot > 0)) continue;  // behind a field of view of 180 deg or less
     const double d = std::sqrt(d2);
     // The angle off the axis; a light at the sensor's origin is on it.
-    const double c = d > 0 ? std::clamp(axis_W.Dot(d_W) / d, -1.0, 1.0) : 1.0;
+    const double c = d > 0 ? std::clamp(dot / d, -1.0, 1.0) : 1.0;
     const double theta = std::acos(c);
     if (!(theta < half_fov)) continue;
     const double response = 1 - theta / half_fov;
@@ -171,9 +198,10 @@ void LightSensingModule::Read(const Scene& scene, uint32_t slot, LightSensorRow*
       const double length = d - kEndMargin;
       if (length > 0) {
         const Vec3 end = p_W + d_W * (length / d);
-        if (s.occlusion && line_of_sight_ != nullptr && line_of_sight_->SegmentBlocked(p_W, end))
+        if (s.occlusion && Hidden(scene, static_, p_W, end, instance, slot, light)) continue;
+        if (s.robot_occlusion && Hidden(scene, moving_, p_W, end, instance, slot, light))
           continue;
-        if (s.robot_occlusion && HiddenByShapes(scene, p_W, end, instance, slot, light)) continue;
+        if (s.occlusion && map_ != nullptr && map_->SegmentBlocked(p_W, end)) continue;
       }
     }
     const double dm = std::max(d, kMinDistance);
@@ -199,17 +227,20 @@ void LightSensingModule::Sense(World* world) {
   if (sensors.size() == 0) return;
   seed_ = world->settings().seed;
   step_ = world->step_count();
-  line_of_sight_ = world->line_of_sight();
+  const EnvironmentMap* map = scene.environment();
+  map_ = map != nullptr && !map->boxes.empty() ? world->line_of_sight() : nullptr;
   IndexSources(scene);
-  bool robot_occlusion = false;
+  // The shapes only the sensors that test them need.
+  bool static_shapes = false, moving_shapes = false;
   if (!sources_.empty())
-    for (const LightSensorRow& row : sensors.rows)
-      if (row.settings->robot_occlusion) {
-        robot_occlusion = true;
-        break;
-      }
-  occluders_.clear();
-  if (robot_occlusion) IndexOccluders(scene);
+    for (const LightSensorRow& row : sensors.rows) {
+      static_shapes = static_shapes || row.settings->occlusion;
+      moving_shapes = moving_shapes || row.settings->robot_occlusion;
+      if (static_shapes && moving_shapes) break;
+    }
+  static_.Clear();
+  moving_.Clear();
+  if (static_shapes || moving_shapes) IndexOccluders(scene, static_shapes, moving_shapes);
   world->scheduler().ParallelFor(0, static_cast<int64_t>(sensors.size()), kSensorGrain,
                                  [&](int64_t begin, int64_t end) {
                                    for (int64_t r = begin; r < end; ++r)

@@ -165,7 +165,9 @@ models:
   // light[2] looks along +y: the lamp 1.9 m straight ahead.
   EXPECT_NEAR(r[2], 4 / (1.9 * 1.9), 1e-12);
   for (int i = 0; i < 8; ++i)
-    if (i != 2) EXPECT_LT(r[i], r[2]) << i;
+    if (i != 2) {
+      EXPECT_LT(r[i], r[2]) << i;
+    }
   EXPECT_EQ(r[5], 0);
   EXPECT_EQ(r[6], 0);
   EXPECT_EQ(r[7], 0);
