@@ -70,8 +70,7 @@ std::unique_ptr<Swarm> MakeSwarm(int robots, int lights, int threads, Variant va
   for (int l = 0; l < lights; ++l) {
     const double q = lights == 1 ? 0 : side / 4;
     light::LightSourceRow lamp;
-    scene.AddObject(source_type, "lamp", {},
-                    {{l % 2 ? q : -q, l / 2 ? q : -q, 0.5}, {}}, &lamp);
+    scene.AddObject(source_type, "lamp", {}, {{l % 2 ? q : -q, l / 2 ? q : -q, 0.5}, {}}, &lamp);
   }
   light::LightSensorSettings s;
   s.occlusion = variant != kNoOcclusion;
@@ -110,8 +109,8 @@ std::unique_ptr<Swarm> MakeSwarm(int robots, int lights, int threads, Variant va
 
 void Sense(benchmark::State& state, Variant variant) {
   const int robots = static_cast<int>(state.range(0));
-  auto swarm = MakeSwarm(robots, static_cast<int>(state.range(1)),
-                         static_cast<int>(state.range(2)), variant);
+  auto swarm = MakeSwarm(robots, static_cast<int>(state.range(1)), static_cast<int>(state.range(2)),
+                         variant);
   Module* module = swarm->world->find_module("light");
   for (auto _ : state) module->Sense(swarm->world.get());
   state.counters["per_robot"] = benchmark::Counter(

@@ -52,10 +52,10 @@ struct LightSourceSettings {
   Vec3 color{1, 1, 1};   // RGB 0..1: how it is drawn (sensors read intensity only)
   double radius = 0.02;  // m: the sphere it is drawn as
 };
-struct LightSourceRow {                    // 24 bytes
-  Shared<LightSourceSettings> settings;    // Edit() to change one copy's
-  double intensity = 1;                    // >= 0, state: scripts dim it (hashed)
-  bool on = true;                          // state: scripts switch it (hashed)
+struct LightSourceRow {                  // 24 bytes
+  Shared<LightSourceSettings> settings;  // Edit() to change one copy's
+  double intensity = 1;                  // >= 0, state: scripts dim it (hashed)
+  bool on = true;                        // state: scripts switch it (hashed)
   bool lit() const { return on && intensity > 0; }
 };
 

@@ -106,8 +106,8 @@ void LightSensingModule::IndexOccluders(const Scene& scene, bool static_shapes,
     if (!(moving ? moving_shapes : static_shapes)) continue;
     OccluderSet& set = moving ? moving_ : static_;
     Occluder& o = set.occluders.emplace_back();
-    o.shape = proximity::PlaceShape(shapes[r], scene.world_pose_at(slot), scene.IdAt(slot),
-                                    instance);
+    o.shape =
+        proximity::PlaceShape(shapes[r], scene.world_pose_at(slot), scene.IdAt(slot), instance);
     o.slot = slot;
     proximity::WorldBounds(o.shape, &o.lo, &o.hi);
     // Grown a little: the exact test decides, these only must not miss.
@@ -140,9 +140,9 @@ bool LightSensingModule::Hidden(const Scene& scene, const OccluderSet& set, cons
   const auto hides = [&](const Occluder& o) {
     if (!SegmentMeetsBox(p_W, v_W, o.lo, o.hi)) return false;
     const int owner = o.shape.instance;
-    if (owner >= 0 ? owner == sensor_instance || owner == source.instance
-                   : IsAncestor(scene, o.slot, sensor_slot) ||
-                         IsAncestor(scene, o.slot, source.slot))
+    if (owner >= 0
+            ? owner == sensor_instance || owner == source.instance
+            : IsAncestor(scene, o.slot, sensor_slot) || IsAncestor(scene, o.slot, source.slot))
       return false;
     double hit = 0;
     return proximity::RayCast(o.shape, p_W, d_W, length, &hit);
@@ -156,8 +156,7 @@ bool LightSensingModule::Hidden(const Scene& scene, const OccluderSet& set, cons
   // the grid: the shapes listed stay near the segment however long it is.
   // A shape listed twice (near a piece's end) is only tested twice.
   const double piece = 2 * set.grid.cell_size();
-  const int pieces =
-      std::clamp(static_cast<int>(std::hypot(v_W.x, v_W.y) / piece) + 1, 1, 1 << 16);
+  const int pieces = std::clamp(static_cast<int>(std::hypot(v_W.x, v_W.y) / piece) + 1, 1, 1 << 16);
   thread_local std::vector<uint32_t> near;
   for (int k = 0; k < pieces; ++k) {
     const Vec3 a = p_W + v_W * (static_cast<double>(k) / pieces);
@@ -199,8 +198,7 @@ void LightSensingModule::Read(const Scene& scene, uint32_t slot, LightSensorRow*
       if (length > 0) {
         const Vec3 end = p_W + d_W * (length / d);
         if (s.occlusion && Hidden(scene, static_, p_W, end, instance, slot, light)) continue;
-        if (s.robot_occlusion && Hidden(scene, moving_, p_W, end, instance, slot, light))
-          continue;
+        if (s.robot_occlusion && Hidden(scene, moving_, p_W, end, instance, slot, light)) continue;
         if (s.occlusion && map_ != nullptr && map_->SegmentBlocked(p_W, end)) continue;
       }
     }

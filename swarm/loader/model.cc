@@ -168,8 +168,8 @@ struct Builder {
     Fields named(values.file(), field, what);
 
     if (ring != nullptr && is_root)
-      values.Fail(type_field, "a " + std::string(ring->what) +
-                                  " cannot be the root object of a model");
+      values.Fail(type_field,
+                  "a " + std::string(ring->what) + " cannot be the root object of a model");
     named.Expect(types.KeysOf(type));
     if (ring != nullptr) {
       Ring(*ring, named, name, out);

@@ -69,8 +69,9 @@ TEST_F(LightLoaderTest, RingMistakesAreFileLineColumnErrors) {
   EXPECT_CONTAINS(ring_error("{type: light_sensor_ring, name: l, count: 8, radius: 0.1, "
                              "failure_probability: 2}"),
                   "thing.yaml:5:");
-  EXPECT_CONTAINS(ring_error("{type: light_sensor_ring, name: l, count: 8, radius: 0.1, fov_dg: 9}"),
-                  "did you mean 'fov_deg'?");
+  EXPECT_CONTAINS(
+      ring_error("{type: light_sensor_ring, name: l, count: 8, radius: 0.1, fov_dg: 9}"),
+      "did you mean 'fov_deg'?");
   EXPECT_EQ(ring_error("{type: light_sensor_ring, name: l, count: 8, radius: 0.1, range: 2, "
                        "noise: 0.1, robot_occlusion: true}"),
             "(no error)");
@@ -135,8 +136,8 @@ models:
     // The copies of one entry share one settings block; the scaled copy
     // has its own, its range doubled.
     EXPECT_TRUE(s.settings.SameAs(RowOf<LightSensorRow>(*w.world, "/bot#0/light[0]").settings));
-    const LightSensorRow& big = RowOf<LightSensorRow>(*w.world, "/bot#1/light[" +
-                                                                   std::to_string(i) + "]");
+    const LightSensorRow& big =
+        RowOf<LightSensorRow>(*w.world, "/bot#1/light[" + std::to_string(i) + "]");
     EXPECT_EQ(big.settings->range, 10);
   }
   EXPECT_EQ(scene.FindObject("/bot#0/light[8]"), ObjectId{});

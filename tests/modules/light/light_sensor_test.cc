@@ -353,13 +353,13 @@ SwarmRun RunSwarm(int threads) {
   std::vector<ObjectId> eyes;
   for (int i = 0; i < 300; ++i) {
     const double a = 0.37 * i, r = 0.3 + 0.01 * i;
-    const ObjectId bot =
-        w.Robot("bot" + std::to_string(i), {{r * std::cos(a), r * std::sin(a), 0.1},
-                                            Quat::FromYaw(0.9 * i)});
+    const ObjectId bot = w.Robot("bot" + std::to_string(i),
+                                 {{r * std::cos(a), r * std::sin(a), 0.1}, Quat::FromYaw(0.9 * i)});
     w.Box("body", bot, {}, {0.15, 0.15, 0.15});
     for (int k = 0; k < 8; ++k)
-      eyes.push_back(w.Sensor(bot, {{0.08 * std::cos(k * kPi / 4), 0.08 * std::sin(k * kPi / 4), 0},
-                                    Quat::FromYaw(k * kPi / 4)},
+      eyes.push_back(w.Sensor(bot,
+                              {{0.08 * std::cos(k * kPi / 4), 0.08 * std::sin(k * kPi / 4), 0},
+                               Quat::FromYaw(k * kPi / 4)},
                               s));
     if (i % 10 == 0) w.Lamp({0, 0, 0.1}, 0.5, true, bot);
   }

@@ -44,8 +44,8 @@ PhotoRun RunPhototaxis(int threads, const std::string& intensity) {
   LoadOptions options;
   options.threads = threads;
   options.overrides.push_back({"intensity", intensity});
-  LoadedWorld w = LoadWorld(std::string(SWARMSIM_SOURCE_DIR) + "/worlds/phototaxis.yaml",
-                            options, registry);
+  LoadedWorld w =
+      LoadWorld(std::string(SWARMSIM_SOURCE_DIR) + "/worlds/phototaxis.yaml", options, registry);
   w.world->set_log_sink([](std::string_view) {});
   PhotoRun run;
   run.start = MeanDistance(w.world->scene());
@@ -67,7 +67,6 @@ std::string GoldenHash(int threads) {
     if (line.rfind(key, 0) == 0) return line.substr(key.size());
   return "(no row)";
 }
-
 
 TEST(PhototaxisTest, RobotsGatherUnderTheLampOnlyWhenItShines) {
   const PhotoRun lit = RunPhototaxis(1, "1");
