@@ -11,13 +11,13 @@ from common import world
 class LightArraysTest(unittest.TestCase):
     def test_light_array_matches_the_lamp(self):
         w = swarmsim.World(world("phototaxis.yaml"), seed=1)
-        names = w.light_sensor_names("lightbot")
+        names = w.light_sensor_names("photobot")
         self.assertEqual(names, [f"light[{i}]" for i in range(8)])
-        self.assertEqual(w.light("lightbot").shape, (20, 8))
-        self.assertTrue(np.all(w.light("lightbot") == 0), "nothing read before the first step")
-        p = w.poses("lightbot")  # what the first step's sense phase sees
+        self.assertEqual(w.light("photobot").shape, (20, 8))
+        self.assertTrue(np.all(w.light("photobot") == 0), "nothing read before the first step")
+        p = w.poses("photobot")  # what the first step's sense phase sees
         w.step(1)
-        r = w.light("lightbot")
+        r = w.light("photobot")
         self.assertTrue(np.all(r >= 0))
         # Every robot not in the pillar's shadow reads the lamp on some sensor,
         # most on the one facing it: the sensor whose axis is nearest the
@@ -42,9 +42,9 @@ class LightArraysTest(unittest.TestCase):
         # Switched off through a parameter: nothing to read.
         dark = swarmsim.World(world("phototaxis.yaml"), seed=1, set={"intensity": 0})
         dark.step(1)
-        self.assertTrue(np.all(dark.light("lightbot") == 0))
+        self.assertTrue(np.all(dark.light("photobot") == 0))
         out = np.empty((20, 8))
-        self.assertIs(w.light("lightbot", out=out), out)
+        self.assertIs(w.light("photobot", out=out), out)
         np.testing.assert_array_equal(out, r)
 
     def test_controller_sees_light(self):
@@ -53,7 +53,7 @@ class LightArraysTest(unittest.TestCase):
         def control(robots):
             seen.append((robots.light.shape, list(robots.light_sensor_names)))
 
-        w = swarmsim.World(world("phototaxis.yaml"), seed=1, controllers={"lightbot": control})
+        w = swarmsim.World(world("phototaxis.yaml"), seed=1, controllers={"photobot": control})
         w.step(2)
         self.assertEqual(seen[-1][0], (20, 8))
         self.assertEqual(seen[-1][1][0], "light[0]")
