@@ -6,9 +6,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "framework/environment.h"
 #include "framework/scene.h"
 #include "framework/world.h"
 #include "modules/light/light.h"
@@ -134,6 +136,43 @@ TEST(LightSensorTest, AWallBetweenHidesTheLightUnlessOcclusionIsOff) {
   EXPECT_EQ(w.Reading(eye), 0);
   EXPECT_NEAR(w.Reading(xray), 0.25, 1e-12);
   EXPECT_NEAR(w.Reading(high), Expected({2, 0, -2.9}, 1.0, kPi), 1e-12);
+}
+
+TEST(LightSensorTest, TheMapsVoxelsHideTheLight) {
+  // A map block across +x between the sensor and a light 2 m ahead; a
+  // second light to the left is in clear view.
+  LightWorld w;
+  w.Lamp({2, 0, 0.1}, 1.0);
+  w.Lamp({0.5, 1, 0.1}, 1.0);
+  auto map = std::make_shared<EnvironmentMap>();
+  map->source = "test";
+  map->resolution = 0.05;
+  map->boxes.push_back({{1.0, -0.2, 0}, {1.05, 0.2, 0.4}});
+  map->lo = map->boxes[0].lo;
+  map->hi = map->boxes[0].hi;
+  w.scene().set_environment(map);
+  const ObjectId eye = w.Sensor({}, {{0, 0, 0.1}, {}});
+  LightSensorSettings see_through;
+  see_through.occlusion = false;
+  const ObjectId xray = w.Sensor({}, {{0, 0, 0.1}, {}}, see_through);
+  ASSERT_EQ(w.Run(1), "");
+  const double left = Expected({0.5, 1, 0}, 1.0, kPi);
+  EXPECT_NEAR(w.Reading(eye), left, 1e-12);
+  EXPECT_NEAR(w.Reading(xray), left + 0.25, 1e-12);
+}
+
+TEST(LightSensorTest, ALampInsideTheShadeItHangsFromShines) {
+  // A lamp inside a static shade (its parent) reads; one inside a static
+  // crate it does not hang from is hidden.
+  LightWorld w;
+  const ObjectId shade = w.Box("shade", {}, {{1, 0, 0.5}, {}}, {0.2, 0.2, 0.2});
+  w.Lamp({0, 0, 0}, 1.0, true, shade);  // at (1, 0, 0.5)
+  w.Box("crate", {}, {{0, -1, 0.5}, {}}, {0.2, 0.2, 0.2});
+  w.Lamp({0, -1, 0.5}, 1.0);
+  LightSensorSettings all_round;
+  all_round.fov = 2 * kPi;
+  const ObjectId eye = w.Sensor({}, {{0, 0, 0.5}, {}}, all_round);
+  EXPECT_NEAR(w.SenseOnce(eye), 1.0, 1e-12);
 }
 
 TEST(LightSensorTest, OtherRobotsHideTheLightWhenRobotOcclusionIsOn) {
