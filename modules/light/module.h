@@ -62,6 +62,12 @@ class LightSensingModule final : public Module {
   // The shapes of the scene, static ones into static_ (if `static_shapes`)
   // and moving ones into moving_ (if `moving_shapes`).
   void IndexOccluders(const Scene& scene, bool static_shapes, bool moving_shapes);
+  // robot_clear_: for each robot with light sensors and each lit light,
+  // whether every segment from one of its sensors to the light surely
+  // misses every static shape (the segment from its root to the light
+  // misses their boxes grown by the farthest sensor's distance from the
+  // root): its sensors then skip the static shapes for that light.
+  void ClearRobots(World* world, const Rows<LightSensorRow>& sensors);
   // Fills one sensor's reading. Thread-safe across sensors.
   void Read(const Scene& scene, uint32_t slot, LightSensorRow* sensor) const;
   // Does a shape of `set` (but those of the sensor's robot and the light's,
@@ -77,8 +83,11 @@ class LightSensingModule final : public Module {
   // The world's line of sight (framework/line_of_sight.h), asked only for
   // the environment map's voxels: null when the scene has no map.
   const LineOfSight* map_ = nullptr;
-  std::vector<LitSource> sources_;  // lit light sources (row order)
-  OccluderSet static_, moving_;     // shapes (shape row order)
+  std::vector<LitSource> sources_;    // lit light sources (row order)
+  OccluderSet static_, moving_;       // shapes (shape row order)
+  std::vector<double> reach_;         // per robot: its sensors' farthest distance from its root
+  std::vector<Vec3> roots_;           // per robot: its root's position (where reach_ >= 0)
+  std::vector<uint8_t> robot_clear_;  // robots x sources_ (ClearRobots); empty: none known
 };
 
 }  // namespace swarmsim::light

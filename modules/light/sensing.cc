@@ -51,6 +51,8 @@ constexpr int64_t kSensorGrain = 256;
 // Up to this many shapes of a kind, a segment tests them all (a box test
 // each); more go into a grid.
 constexpr size_t kScanLimit = 16;
+// Robots per task of ClearRobots.
+constexpr int64_t kRobotGrain = 64;
 
 // Is `ancestor` above `slot` in the tree?
 bool IsAncestor(const Scene& scene, uint32_t ancestor, uint32_t slot) {
@@ -59,25 +61,30 @@ bool IsAncestor(const Scene& scene, uint32_t ancestor, uint32_t slot) {
   return false;
 }
 
-// Does the segment p + t v, t in [0, 1], meet the box [lo, hi]?
-bool SegmentMeetsBox(const Vec3& p, const Vec3& v, const Vec3& lo, const Vec3& hi) {
-  double t0 = 0, t1 = 1;
-  const double ps[3] = {p.x, p.y, p.z}, vs[3] = {v.x, v.y, v.z};
-  const double los[3] = {lo.x, lo.y, lo.z}, his[3] = {hi.x, hi.y, hi.z};
-  for (int i = 0; i < 3; ++i) {
-    if (vs[i] == 0) {
-      if (ps[i] < los[i] || ps[i] > his[i]) return false;
-      continue;
+// A segment p + t v, t in [0, 1], with what its box tests need once.
+struct Segment {
+  double p[3], inv[3];  // inv: 1 / v per axis (inf for 0)
+  explicit Segment(const Vec3& from, const Vec3& v)
+      : p{from.x, from.y, from.z}, inv{1 / v.x, 1 / v.y, 1 / v.z} {}
+  // Does it meet the box [lo, hi]? (Slabs; along an axis it does not move
+  // on, it must lie within the box's slab.)
+  bool MeetsBox(const Vec3& lo, const Vec3& hi) const {
+    double t0 = 0, t1 = 1;
+    const double los[3] = {lo.x, lo.y, lo.z}, his[3] = {hi.x, hi.y, hi.z};
+    for (int i = 0; i < 3; ++i) {
+      if (std::isinf(inv[i])) {
+        if (p[i] < los[i] || p[i] > his[i]) return false;
+        continue;
+      }
+      double ta = (los[i] - p[i]) * inv[i], tb = (his[i] - p[i]) * inv[i];
+      if (ta > tb) std::swap(ta, tb);
+      t0 = std::max(t0, ta);
+      t1 = std::min(t1, tb);
+      if (t0 > t1) return false;
     }
-    const double inv = 1 / vs[i];
-    double a = (los[i] - ps[i]) * inv, b = (his[i] - ps[i]) * inv;
-    if (a > b) std::swap(a, b);
-    t0 = std::max(t0, a);
-    t1 = std::min(t1, b);
-    if (t0 > t1) return false;
+    return true;
   }
-  return true;
-}
+};
 
 }  // namespace
 
@@ -133,12 +140,13 @@ bool LightSensingModule::Hidden(const Scene& scene, const OccluderSet& set, cons
   const double length = v_W.Norm();
   if (!(length > 0)) return false;
   const Vec3 d_W = v_W / length;
+  const Segment segment(p_W, v_W);
   // One shape: its box first (most miss it); skipped when it is the
   // sensor's robot's or the light's (a robot's own light shines through
   // its body, as ARGoS has it), or one either hangs from; then the exact
   // ray test.
   const auto hides = [&](const Occluder& o) {
-    if (!SegmentMeetsBox(p_W, v_W, o.lo, o.hi)) return false;
+    if (!segment.MeetsBox(o.lo, o.hi)) return false;
     const int owner = o.shape.instance;
     if (owner >= 0
             ? owner == sensor_instance || owner == source.instance
@@ -169,6 +177,42 @@ bool LightSensingModule::Hidden(const Scene& scene, const OccluderSet& set, cons
   return false;
 }
 
+void LightSensingModule::ClearRobots(World* world, const Rows<LightSensorRow>& sensors) {
+  const Scene& scene = world->scene();
+  const size_t robots = scene.instances().size(), lights = sources_.size();
+  reach_.assign(robots, -1);
+  roots_.resize(robots);
+  for (size_t r = 0; r < sensors.size(); ++r) {
+    const uint32_t slot = sensors.owners[r];
+    const int i = scene.instance_of_at(slot);
+    if (i < 0 || !sensors.rows[r].settings->occlusion) continue;
+    if (reach_[i] < 0) roots_[i] = scene.world_pose(scene.instances()[i].root).p;
+    reach_[i] = std::max(reach_[i], (scene.world_pose_at(slot).p - roots_[i]).Norm());
+  }
+  robot_clear_.assign(robots * lights, 0);
+  world->scheduler().ParallelFor(0, static_cast<int64_t>(robots), kRobotGrain,
+                                 [&](int64_t begin, int64_t end) {
+                                   for (int64_t i = begin; i < end; ++i) {
+                                     const double reach = reach_[i];
+                                     if (reach < 0) continue;
+                                     const Vec3& root = roots_[i];
+                                     // Grown a little more than the reach, for rounding.
+                                     const double grow = reach * (1 + 1e-9) + 1e-9;
+                                     const Vec3 g{grow, grow, grow};
+                                     for (size_t l = 0; l < lights; ++l) {
+                                       const Segment segment(root, sources_[l].p_W - root);
+                                       bool clear = true;
+                                       for (const Occluder& o : static_.occluders)
+                                         if (segment.MeetsBox(o.lo - g, o.hi + g)) {
+                                           clear = false;
+                                           break;
+                                         }
+                                       robot_clear_[static_cast<size_t>(i) * lights + l] = clear;
+                                     }
+                                   }
+                                 });
+}
+
 void LightSensingModule::Read(const Scene& scene, uint32_t slot, LightSensorRow* sensor) const {
   const LightSensorSettings& s = *sensor->settings;
   const Pose& X_WS = scene.world_pose_at(slot);
@@ -179,7 +223,11 @@ void LightSensingModule::Read(const Scene& scene, uint32_t slot, LightSensorRow*
   const bool narrow = half_fov <= 0.5 * kPi;
   const double range2 = s.range > 0 ? s.range * s.range : INFINITY;
   double sum = 0;
-  for (const LitSource& light : sources_) {
+  const uint8_t* clear = instance >= 0 && !robot_clear_.empty()
+                             ? &robot_clear_[static_cast<size_t>(instance) * sources_.size()]
+                             : nullptr;
+  for (size_t l = 0; l < sources_.size(); ++l) {
+    const LitSource& light = sources_[l];
     if (instance >= 0 && light.instance == instance) continue;  // its own robot's
     const Vec3 d_W = light.p_W - p_W;
     const double d2 = d_W.SquaredNorm();
@@ -197,7 +245,9 @@ void LightSensingModule::Read(const Scene& scene, uint32_t slot, LightSensorRow*
       const double length = d - kEndMargin;
       if (length > 0) {
         const Vec3 end = p_W + d_W * (length / d);
-        if (s.occlusion && Hidden(scene, static_, p_W, end, instance, slot, light)) continue;
+        if (s.occlusion && !(clear != nullptr && clear[l]) &&
+            Hidden(scene, static_, p_W, end, instance, slot, light))
+          continue;
         if (s.robot_occlusion && Hidden(scene, moving_, p_W, end, instance, slot, light)) continue;
         if (s.occlusion && map_ != nullptr && map_->SegmentBlocked(p_W, end)) continue;
       }
@@ -239,6 +289,10 @@ void LightSensingModule::Sense(World* world) {
   static_.Clear();
   moving_.Clear();
   if (static_shapes || moving_shapes) IndexOccluders(scene, static_shapes, moving_shapes);
+  // Robots far from every static shape skip them (a few shapes only: many
+  // are in a grid, which each segment asks).
+  robot_clear_.clear();
+  if (!static_.occluders.empty() && !static_.use_grid) ClearRobots(world, sensors);
   world->scheduler().ParallelFor(0, static_cast<int64_t>(sensors.size()), kSensorGrain,
                                  [&](int64_t begin, int64_t end) {
                                    for (int64_t r = begin; r < end; ++r)

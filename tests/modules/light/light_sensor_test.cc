@@ -138,6 +138,48 @@ TEST(LightSensorTest, AWallBetweenHidesTheLightUnlessOcclusionIsOff) {
   EXPECT_NEAR(w.Reading(high), Expected({2, 0, -2.9}, 1.0, kPi), 1e-12);
 }
 
+// The formula for a sensor at p looking along the unit axis a.
+double ExpectedAt(const Vec3& p, const Vec3& a, const Vec3& light, double intensity) {
+  const Vec3 d = light - p;
+  const double theta = std::acos(a.Dot(d) / d.Norm());
+  return theta < kPi / 2 ? intensity / d.SquaredNorm() * (1 - theta / (kPi / 2)) : 0.0;
+}
+
+TEST(LightSensorTest, AWallShadesSomeSensorsOfARingAndNotOthers) {
+  // A robot's ring of 8 sensors (radius 0.1 m) near a wall that reaches
+  // from y = 0.05 to 1 m at x = 0.5 m, a light 2 m ahead: the sensor at
+  // 45 deg is in the wall's shadow (its line to the light crosses x = 0.5
+  // at y = 0.055), those at 0 and -45 deg are not. A second robot far
+  // from the wall reads all three.
+  LightWorld w;
+  const Vec3 light{2, 0, 0.1};
+  w.Lamp(light, 1.0);
+  w.Box("wall", {}, {{0.5, 0.525, 0.5}, {}}, {0.02, 0.95, 1});
+  std::vector<std::vector<ObjectId>> rings;
+  for (const double y : {0.0, -3.0}) {
+    const ObjectId bot = w.Robot("bot", {{0, y, 0.1}, {}});
+    rings.emplace_back();
+    for (int k = 0; k < 8; ++k) {
+      const double a = k * kPi / 4;
+      rings.back().push_back(
+          w.Sensor(bot, {{0.1 * std::cos(a), 0.1 * std::sin(a), 0}, Quat::FromYaw(a)}));
+    }
+  }
+  ASSERT_EQ(w.Run(1), "");
+  const auto expected = [&](double y, int k) {
+    const double a = k * kPi / 4;
+    return ExpectedAt({0.1 * std::cos(a), y + 0.1 * std::sin(a), 0.1},
+                      {std::cos(a), std::sin(a), 0}, light, 1.0);
+  };
+  EXPECT_NEAR(w.Reading(rings[0][0]), expected(0, 0), 1e-12);
+  EXPECT_GT(w.Reading(rings[0][0]), 0.2);
+  EXPECT_EQ(w.Reading(rings[0][1]), 0);  // shaded
+  EXPECT_GT(expected(0, 1), 0.1);        // what it would read
+  EXPECT_NEAR(w.Reading(rings[0][7]), expected(0, 7), 1e-12);
+  for (const int k : {0, 1, 7}) EXPECT_NEAR(w.Reading(rings[1][k]), expected(-3, k), 1e-12) << k;
+  for (const int k : {2, 3, 4, 5, 6}) EXPECT_EQ(w.Reading(rings[0][k]), 0) << k;  // facing away
+}
+
 TEST(LightSensorTest, TheMapsVoxelsHideTheLight) {
   // A map block across +x between the sensor and a light 2 m ahead; a
   // second light to the left is in clear view.
