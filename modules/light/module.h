@@ -4,6 +4,7 @@
 // parallel.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -50,11 +51,13 @@ class LightSensingModule final : public Module {
     std::vector<Occluder> occluders;
     std::vector<GridItem> items;  // their xy footprint circles (occluders)
     SpatialGrid grid;
-    bool use_grid = false;  // else every segment scans them all
+    bool use_grid = false;                     // else every segment scans them all
+    double z_lo = INFINITY, z_hi = -INFINITY;  // the heights their bounds span
     void Clear() {
       occluders.clear();
       items.clear();
       use_grid = false;
+      z_lo = INFINITY, z_hi = -INFINITY;
     }
   };
 

@@ -122,6 +122,8 @@ void LightSensingModule::IndexOccluders(const Scene& scene, bool static_shapes,
                                   std::abs(o.hi.x) + std::abs(o.hi.y) + std::abs(o.hi.z));
     o.lo = o.lo - Vec3{margin, margin, margin};
     o.hi = o.hi + Vec3{margin, margin, margin};
+    set.z_lo = std::min(set.z_lo, o.lo.z);
+    set.z_hi = std::max(set.z_hi, o.hi.z);
     set.items.push_back({0.5 * (o.lo.x + o.hi.x), 0.5 * (o.lo.y + o.hi.y),
                          0.5 * std::hypot(o.hi.x - o.lo.x, o.hi.y - o.lo.y),
                          static_cast<uint32_t>(set.items.size())});
@@ -160,15 +162,27 @@ bool LightSensingModule::Hidden(const Scene& scene, const OccluderSet& set, cons
       if (hides(o)) return true;
     return false;
   }
-  // The segment in pieces about two cells long, each piece's box asked of
-  // the grid: the shapes listed stay near the segment however long it is.
-  // A shape listed twice (near a piece's end) is only tested twice.
+  // Only the part of the segment at the shapes' heights can meet one (a
+  // lamp high above the robots: the few centimetres next to the sensor).
+  double t0 = 0, t1 = 1;
+  if (v_W.z != 0) {
+    double ta = (set.z_lo - p_W.z) / v_W.z, tb = (set.z_hi - p_W.z) / v_W.z;
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta), t1 = std::min(t1, tb);
+    if (!(t0 <= t1)) return false;
+  } else if (p_W.z < set.z_lo || p_W.z > set.z_hi) {
+    return false;
+  }
+  // That part in pieces about two cells long, each piece's box asked of the
+  // grid: the shapes listed stay near the segment however long it is. A
+  // shape listed twice (near a piece's end) is only tested twice.
   const double piece = 2 * set.grid.cell_size();
-  const int pieces = std::clamp(static_cast<int>(std::hypot(v_W.x, v_W.y) / piece) + 1, 1, 1 << 16);
+  const int pieces =
+      std::clamp(static_cast<int>((t1 - t0) * std::hypot(v_W.x, v_W.y) / piece) + 1, 1, 1 << 16);
   thread_local std::vector<uint32_t> near;
   for (int k = 0; k < pieces; ++k) {
-    const Vec3 a = p_W + v_W * (static_cast<double>(k) / pieces);
-    const Vec3 b = p_W + v_W * (static_cast<double>(k + 1) / pieces);
+    const Vec3 a = p_W + v_W * (t0 + (t1 - t0) * k / pieces);
+    const Vec3 b = p_W + v_W * (t0 + (t1 - t0) * (k + 1) / pieces);
     set.grid.QueryAabb(
         {std::min(a.x, b.x), std::min(a.y, b.y), std::max(a.x, b.x), std::max(a.y, b.y)}, &near);
     for (const uint32_t j : near)
