@@ -83,7 +83,7 @@ void ModuleRegistry::RegisterObjectType(std::shared_ptr<const ObjectTypeDescript
     if (name == t->name) throw Error("object type '" + name + "' is a built-in type");
   // The loader's own shorthand: a registered type of the same name would
   // never be reached (model files would build a ring of sensors instead).
-  if (name == "proximity_ring" || name == "ground_array")
+  if (name == "proximity_ring" || name == "ground_array" || name == "light_sensor_ring")
     throw Error("object type '" + name + "' is a world-file type of the loader's");
   for (const ObjectTypeDescriptor* t : object_types_)
     if (name == t->name) throw Error("object type '" + name + "' is registered twice");

@@ -15,6 +15,7 @@
 #include "modules/graphs/graphs.h"
 #include "modules/ground_sensor/ground_sensor.h"
 #include "modules/kinematics/ik_groups.h"
+#include "modules/light/light.h"
 #include "modules/metrics/swarm_metrics.h"
 #include "modules/mill/mill.h"
 #include "modules/paint/paint_nozzle.h"
@@ -74,6 +75,7 @@ void RegisterBuiltinModules(ModuleRegistry* registry) {
   blobs::Register(registry);
   ground_sensor::Register(registry);
   floors::Register(registry);  // the floor (floor:), ground sensors' and the paint layer's base
+  light::Register(registry);   // light sources and light sensors
   video::Register(registry);   // snapshots and video: the program's view recorder
   range_and_bearing::Register(registry);
   // World-file sections, in the order the loader reads them.

@@ -28,6 +28,9 @@ const std::vector<std::string> kCommonKeys = {
     "name", "type", "position", "orientation_deg", "heading_deg", "children", "script"};
 // Two loader-only types: a ring of proximity sensors, and a plugin sensor (a
 // dummy tagged with the sensor type a plugin registers).
+// proximity_ring's keys; a ring that takes every key of its sensor type
+// (light_sensor_ring) takes these but `range`, `noise`, `noise_uniform` and
+// `failure_probability`, which its type has.
 const std::vector<std::string> kRingKeys = {"name",
                                             "type",
                                             "count",
@@ -38,10 +41,29 @@ const std::vector<std::string> kRingKeys = {"name",
                                             "noise",
                                             "noise_uniform",
                                             "failure_probability"};
-// The type of a ring's sensors (modules/proximity's), found by name.
-constexpr char kRingSensorType[] = "proximity_sensor";
-// A third: a set of ground sensors (modules/ground_sensor's type), on a ring
-// or at listed points, with the keys of every ground sensor besides these.
+// The loader's rings (shorthands for `count` sensors round the parent's z
+// axis), each of a module's sensor type found by name: proximity_ring
+// (modules/proximity: each ray, its +z, points outwards; of the sensor's
+// keys only `range` and the noise keys) and light_sensor_ring
+// (modules/light: each sensor's +x points outwards; every light_sensor key).
+struct RingKind {
+  const char* name;         // the world-file type
+  const char* sensor_type;  // its sensors'
+  bool z_outwards;          // the sensor's +z points outwards (else its +x)
+  bool all_sensor_keys;     // the ring takes every key of the sensor type (else kRingKeys)
+  const char* what;         // "proximity ring": messages
+};
+constexpr RingKind kRings[] = {
+    {"proximity_ring", "proximity_sensor", true, false, "proximity ring"},
+    {"light_sensor_ring", "light_sensor", false, true, "light sensor ring"},
+};
+const RingKind* FindRing(const std::string& type) {
+  for (const RingKind& ring : kRings)
+    if (type == ring.name) return &ring;
+  return nullptr;
+}
+// A set of ground sensors (modules/ground_sensor's type), on a ring or at
+// listed points, with the keys of every ground sensor besides these.
 const std::vector<std::string> kGroundArrayKeys = {
     "name", "type", "count", "radius", "start_angle_deg", "points", "height"};
 constexpr char kGroundSensorType[] = "ground_sensor";
@@ -61,11 +83,15 @@ struct TypeList {
       types.insert(types.end(), registry->object_types().begin(), registry->object_types().end());
     for (const size_t t : ListingOrder(types)) {
       names.push_back(types[t]->name);
-      if (names.back() == kRingSensorType) names.push_back("proximity_ring");
+      for (const RingKind& ring : kRings)
+        if (names.back() == ring.sensor_type) {
+          names.push_back(ring.name);
+          break;
+        }
       if (names.back() == kGroundSensorType) names.push_back("ground_array");
     }
   }
-  // The type named `name` (one of `names` but proximity_ring and ground_array).
+  // The type named `name` (one of `names` but a ring and ground_array).
   ObjectType Find(const std::string& name) const {
     for (size_t t = 0; t < types.size(); ++t)
       if (name == types[t]->name) return static_cast<ObjectType>(t);
@@ -73,10 +99,21 @@ struct TypeList {
   }
   // The keys an object of the type named `name` takes.
   std::vector<std::string> KeysOf(const std::string& name) const {
-    if (name == "proximity_ring") return kRingKeys;
     if (name == "ground_array") {
       std::vector<std::string> keys = kGroundArrayKeys;
       for (const ObjectKey& key : types[static_cast<size_t>(Find(kGroundSensorType))]->keys)
+        keys.push_back(key.name);
+      return keys;
+    }
+    const RingKind* ring = FindRing(name);
+    if (ring != nullptr && !ring->all_sensor_keys) return kRingKeys;
+    if (ring != nullptr) {
+      std::vector<std::string> keys;
+      for (const std::string& key : kRingKeys)
+        if (key != "range" && key != "noise" && key != "noise_uniform" &&
+            key != "failure_probability")
+          keys.push_back(key);
+      for (const ObjectKey& key : types[static_cast<size_t>(Find(ring->sensor_type))]->keys)
         keys.push_back(key.name);
       return keys;
     }
@@ -151,20 +188,22 @@ struct Builder {
       name = values.String(name_field);
       CheckObjectName(values, name_field, name);
     }
+    const RingKind* ring = FindRing(type);
     const std::string what = is_root ? root_what
-                                     : (type == "proximity_ring" ? "proximity ring '"
+                                     : (ring != nullptr ? std::string(ring->what) + " '"
                                         : type == "ground_array" ? "ground array '"
                                                                  : "object '") +
                                            name + "'";
     Fields named(values.file(), field, what);
 
-    if (type == "proximity_ring" && is_root)
-      values.Fail(type_field, "a proximity ring cannot be the root object of a model");
+    if (ring != nullptr && is_root)
+      values.Fail(type_field,
+                  "a " + std::string(ring->what) + " cannot be the root object of a model");
     if (type == "ground_array" && is_root)
       values.Fail(type_field, "a ground array cannot be the root object of a model");
     named.Expect(types.KeysOf(type));
-    if (type == "proximity_ring") {
-      Ring(named, name, out);
+    if (ring != nullptr) {
+      Ring(*ring, named, name, out);
       return;
     }
     if (type == "ground_array") {
@@ -202,15 +241,17 @@ struct Builder {
     out->push_back(std::move(spec));
   }
 
-  // `count` proximity sensors named `name` in a ring around the parent's z
-  // axis: sensor i at angle start + 2 pi i / count counter-clockwise from the
-  // parent's +x, its z axis (the ray) pointing radially outwards.
-  void Ring(const Fields& f, const std::string& name, std::vector<ObjectSpec>* out) {
+  // `count` sensors named `name` in a ring around the parent's z axis:
+  // sensor i at angle start + 2 pi i / count counter-clockwise from the
+  // parent's +x, its z axis (a proximity ray) or its x axis (a light
+  // sensor) pointing radially outwards.
+  void Ring(const RingKind& kind, const Fields& f, const std::string& name,
+            std::vector<ObjectSpec>* out) {
     const int64_t count = values.Integer(f.Require("count"), 1, kMaxRingCount);
     const double radius = values.Number(f.Require("radius"), kNonNegativeLength);
     const double height = f.Has("height") ? values.Number(f.Get("height"), kCoordinate) : 0.0;
-    // Each sensor of the ring reads the ring's range like a proximity_sensor.
-    const ObjectType ring_type = types.Find(kRingSensorType);
+    // Each sensor of the ring reads the ring's keys as its type does.
+    const ObjectType ring_type = types.Find(kind.sensor_type);
     const ObjectTypeDescriptor& sensor_type = *types.types[static_cast<size_t>(ring_type)];
     const std::shared_ptr<RowTable> sensor = NewRow(sensor_type);
     sensor_type.read(sensor_type, FieldsObjectReader(values, f, meshes, registry), sensor->At(0));
@@ -227,7 +268,7 @@ struct Builder {
       spec.type = ring_type;
       spec.row = sensor;  // shared: specs are not changed after they are read
       spec.X_PO = {{radius * std::cos(theta), radius * std::sin(theta), height},
-                   Quat::FromYaw(theta) * z_to_x};
+                   kind.z_outwards ? Quat::FromYaw(theta) * z_to_x : Quat::FromYaw(theta)};
       out->push_back(std::move(spec));
     }
   }

@@ -10,6 +10,7 @@
 #include "framework/scene.h"
 #include "framework/scheduler.h"
 #include "modules/ground_sensor/ground_sensor.h"
+#include "modules/light/light.h"
 #include "modules/proximity/proximity_sensor.h"
 #include "modules/range_and_bearing/range_and_bearing.h"
 
@@ -56,6 +57,8 @@ void Refresh(const World& world, const std::string& model, ModelLayout* layout) 
   scene.FindType(range_and_bearing::kTypeName, &board);
   ObjectType ground = static_cast<ObjectType>(kMaxObjectTypes);
   ground_sensor::FindSensorType(scene, &ground);
+  ObjectType light_sensor = static_cast<ObjectType>(kMaxObjectTypes);
+  light::FindSensorType(scene, &light_sensor);
   *layout = ModelLayout{};
   layout->model = model;
   const auto instances = scene.instances();
@@ -63,8 +66,8 @@ void Refresh(const World& world, const std::string& model, ModelLayout* layout) 
   for (size_t i = 0; i < instances.size(); ++i) {
     const ModelInstance& inst = instances[i];
     if (!inst.alive || (!model.empty() && inst.model_name != model)) continue;
-    std::vector<std::string> joints, sensors, grounds;
-    std::vector<uint32_t> joint_slots, sensor_slots, ground_slots;
+    std::vector<std::string> joints, sensors, grounds, lights;
+    std::vector<uint32_t> joint_slots, sensor_slots, ground_slots, light_slots;
     uint32_t board_slot = ModelLayout::kNoBoard;
     for (const uint32_t slot : inst.objects) {
       if (scene.type_at(slot) == board && board_slot == ModelLayout::kNoBoard) board_slot = slot;
@@ -77,18 +80,23 @@ void Refresh(const World& world, const std::string& model, ModelLayout* layout) 
       } else if (scene.type_at(slot) == ground) {
         grounds.push_back(scene.name_at(slot));
         ground_slots.push_back(slot);
+      } else if (scene.type_at(slot) == light_sensor) {
+        lights.push_back(scene.name_at(slot));
+        light_slots.push_back(slot);
       }
     }
     IndexRepeats(&joints);
     IndexRepeats(&sensors);
     IndexRepeats(&grounds);
+    IndexRepeats(&lights);
     if (first) {
       layout->joint_names = joints;
       layout->sensor_names = sensors;
       layout->ground_names = grounds;
+      layout->light_names = lights;
       first = false;
     } else if (joints != layout->joint_names || sensors != layout->sensor_names ||
-               grounds != layout->ground_names) {
+               grounds != layout->ground_names || lights != layout->light_names) {
       if (!model.empty())
         throw Error("robot '" + inst.name + "' of model '" + model +
                     "' has other joints or sensors than the first copy: arrays need one layout");
@@ -102,6 +110,9 @@ void Refresh(const World& world, const std::string& model, ModelLayout* layout) 
       layout->joint_slots.clear();
       layout->sensor_slots.clear();
       layout->ground_slots.clear();
+      layout->light_names.clear();
+      light_slots.clear();
+      layout->light_slots.clear();
     }
     layout->robots.push_back(static_cast<int>(i));
     layout->root_slots.push_back(scene.SlotOf(inst.root));
@@ -114,6 +125,8 @@ void Refresh(const World& world, const std::string& model, ModelLayout* layout) 
     if (layout->ground_names.size() == ground_slots.size())
       layout->ground_slots.insert(layout->ground_slots.end(), ground_slots.begin(),
                                   ground_slots.end());
+    if (layout->light_names.size() == light_slots.size())
+      layout->light_slots.insert(layout->light_slots.end(), light_slots.begin(), light_slots.end());
   }
   const size_t n = layout->robots.size();
   if (layout->joint_slots.size() != n * layout->joint_names.size()) {
@@ -127,6 +140,9 @@ void Refresh(const World& world, const std::string& model, ModelLayout* layout) 
   if (layout->ground_slots.size() != n * layout->ground_names.size()) {
     layout->ground_names.clear();
     layout->ground_slots.clear();
+  if (layout->light_slots.size() != n * layout->light_names.size()) {
+    layout->light_names.clear();
+    layout->light_slots.clear();
   }
   layout->robot_count = world.robot_count();
 }
@@ -347,6 +363,16 @@ Array Ground(const Scene& scene, const ModelLayout& layout, const py::object& ou
       scene.rows<ground_sensor::GroundSensorRow>(type).rows;
   for (size_t k = 0; k < layout.ground_slots.size(); ++k)
     d[k] = rows[scene.row_at(layout.ground_slots[k])].value;
+// Light sensor readings, N x light sensors.
+Array Light(const Scene& scene, const ModelLayout& layout, const py::object& out) {
+  const auto n = static_cast<py::ssize_t>(layout.robots.size());
+  const auto s = static_cast<py::ssize_t>(layout.light_names.size());
+  Array a = OutArray({n, s}, out);
+  double* d = a.mutable_data();
+  std::span<const uint32_t> owners;
+  const std::span<const light::LightSensorRow> rows = light::Sensors(scene, &owners);
+  for (size_t k = 0; k < layout.light_slots.size(); ++k)
+    d[k] = rows[scene.row_at(layout.light_slots[k])].reading;
   return a;
 }
 

@@ -1,6 +1,6 @@
 // The Python binding's arrays (swarm/python/module.cc): one model's robots
 // laid out by slot, and the numpy arrays gathered from them (poses,
-// velocities, proximity readings, joints), written into `out=` when given.
+// velocities, proximity and light readings, joints), written into `out=` when given.
 #pragma once
 
 #include <pybind11/numpy.h>
@@ -31,6 +31,8 @@ struct ModelLayout {
   static constexpr uint32_t kNoBoard = UINT32_MAX;
   std::vector<std::string> ground_names;  // ground sensors, hierarchy order
   std::vector<uint32_t> ground_slots;     // robots x ground sensors
+  std::vector<std::string> light_names;   // light sensors (modules/light), hierarchy order
+  std::vector<uint32_t> light_slots;      // robots x light sensors
   int64_t robot_count = -1;               // World::robot_count() it was built at
 };
 
@@ -64,6 +66,8 @@ void SetRangeAndBearingData(Scene* scene, const ModelLayout& layout, const py::o
 // Ground sensor readings, N x ground sensors: each one's value (its grey
 // level, 0/1 in binary mode, a colour sensor's grey level).
 Array Ground(const Scene& scene, const ModelLayout& layout, const py::object& out);
+// Light sensor readings (modules/light), N x light sensors.
+Array Light(const Scene& scene, const ModelLayout& layout, const py::object& out);
 
 // Joint positions (what = 0) or velocities (1), N x joints.
 Array Joints(const Scene& scene, const ModelLayout& layout, int what, const py::object& out);

@@ -70,6 +70,10 @@ class Robots {
     return Cached(&ground_, [&] { return Ground(Sc(), *layout_, py::none()); });
   }
   const std::vector<std::string>& ground_names() const { return layout_->ground_names; }
+  const std::vector<std::string>& light_sensor_names() const { return layout_->light_names; }
+  py::object light() {
+    return Cached(&light_, [&] { return Light(Sc(), *layout_, py::none()); });
+  }
   py::object joint_positions() {
     return Cached(&joint_positions_, [&] { return Joints(Sc(), *layout_, 0, py::none()); });
   }
@@ -110,8 +114,8 @@ class Robots {
   World* world_;
   const ModelLayout* layout_;
   bool planar_;
-  py::object poses_, velocities_, proximity_, ground_, joint_positions_, joint_velocities_,
-      range_and_bearing_;
+  py::object poses_, velocities_, proximity_, ground_, light_, joint_positions_,
+      joint_velocities_, range_and_bearing_;
 };
 
 struct ControllerConfig {
@@ -411,6 +415,12 @@ class PyWorld {
   std::vector<std::string> ground_names(const std::string& model) {
     return Layout(model).ground_names;
   }
+  py::object light(const std::string& model, const py::object& out) {
+    return Light(Any().scene(), Layout(model), out);
+  }
+  std::vector<std::string> light_sensor_names(const std::string& model) {
+    return Layout(model).light_names;
+  }
   py::object joint_positions(const std::string& model, const py::object& out) {
     return Joints(Any().scene(), Layout(model), 0, out);
   }
@@ -565,6 +575,8 @@ PYBIND11_MODULE(_swarmsim, m) {
       .def_property_readonly("proximity", &Robots::proximity)
       .def_property_readonly("ground", &Robots::ground)
       .def_property_readonly("ground_names", &Robots::ground_names)
+      .def_property_readonly("light", &Robots::light)
+      .def_property_readonly("light_sensor_names", &Robots::light_sensor_names)
       .def_property_readonly("joint_positions", &Robots::joint_positions)
       .def_property_readonly("joint_velocities", &Robots::joint_velocities)
       .def_property_readonly("range_and_bearing", &Robots::range_and_bearing)
@@ -593,6 +605,8 @@ PYBIND11_MODULE(_swarmsim, m) {
       .def("proximity", &PyWorld::proximity, py::arg("model") = "", py::arg("out") = py::none())
       .def("ground", &PyWorld::ground, py::arg("model") = "", py::arg("out") = py::none())
       .def("ground_names", &PyWorld::ground_names, py::arg("model") = "")
+      .def("light", &PyWorld::light, py::arg("model") = "", py::arg("out") = py::none())
+      .def("light_sensor_names", &PyWorld::light_sensor_names, py::arg("model") = "")
       .def("joint_positions", &PyWorld::joint_positions, py::arg("model") = "",
            py::arg("out") = py::none())
       .def("joint_velocities", &PyWorld::joint_velocities, py::arg("model") = "",
