@@ -29,7 +29,7 @@ TEST(RecordCliTest, RecordInfoNamesWhatIsWrong) {
       << corrupt.output;
   const auto newer = RunProgram("record-info " + data + "newer_version");
   EXPECT_EQ(newer.exit_code, 2);
-  EXPECT_NE(newer.output.find("format version 2.0, newer than this swarmsim reads (1.1)"),
+  EXPECT_NE(newer.output.find("format version 2.0, newer than this swarmsim reads (1.2)"),
             std::string::npos)
       << newer.output;
   const auto truncated = RunProgram("record-info " + data + "truncated");

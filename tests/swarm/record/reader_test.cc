@@ -106,7 +106,7 @@ TEST(RecordingReaderTest, ACorruptChunkIsNamedWithItsOffset) {
 
 TEST(RecordingReaderTest, ANewerMajorVersionIsRefusedNamingBoth) {
   EXPECT_NE(ErrorOf(Data("newer_version"))
-                .find("is a recording of format version 2.0, newer than this swarmsim reads (1.1)"),
+                .find("is a recording of format version 2.0, newer than this swarmsim reads (1.2)"),
             std::string::npos)
       << ErrorOf(Data("newer_version"));
   // A newer minor version reads.
