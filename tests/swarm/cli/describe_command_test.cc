@@ -22,10 +22,10 @@ TEST(CliTest, DescribeNamesTheModulesAWorldGets) {
   Result describe =
       RunProgram("describe " + std::string(SWARMSIM_SOURCE_DIR) + "/worlds/hexapod.yaml");
   EXPECT_EQ(describe.exit_code, 0) << describe.output;
-  EXPECT_NE(
-      describe.output.find(
-          "modules: ik paint proximity collision mill paths planning rendering graphs blobs\n"),
-      std::string::npos)
+  EXPECT_NE(describe.output.find(
+                "modules: ik paint proximity collision mill paths planning rendering graphs blobs "
+                "range_and_bearing\n"),
+            std::string::npos)
       << describe.output;
 }
 
