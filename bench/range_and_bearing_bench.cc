@@ -1,8 +1,8 @@
 // Range-and-bearing boards (modules/range_and_bearing): the sense phase of
 // 10,000 robots, each hearing about 10 others.
 //
-// N robots on a jittered grid (1.68 m apart: 0.354 robots per m^2, so
-// about 10 others within a foot-bot board's 3 m) in a walled square arena
+// N robots on a jittered grid (1.53 m apart: 0.43 robots per m^2, so
+// about 10 others heard within a foot-bot board's 3 m) in a walled square arena
 // with 40 interior walls (0.1 m thick, 4 m long, 0.3 m high) and random
 // headings: a cylinder body (r 0.085 m, 0.146 m high) and a board 0.05 m
 // above its centre, range 3 m, 10-byte payloads. Kinematic physics and no
@@ -62,7 +62,7 @@ std::unique_ptr<Swarm> MakeSwarm(int robots, int threads, Mode mode) {
   swarm->world = std::make_unique<World>(settings, swarm->registry);
   Scene& scene = swarm->world->scene();
   scene.FindType(range_and_bearing::kTypeName, &swarm->type);
-  const double spacing = 1.68;
+  const double spacing = 1.53;
   const int per_row = static_cast<int>(std::ceil(std::sqrt(robots)));
   const double side = per_row * spacing, t = 0.1, h = 0.3, c = side / 2 + t / 2;
   scene.AddShape("wall_s", {}, {{0, -c, h / 2}, {}}, Shape(ShapeKind::kBox, {side + 2 * t, t, h}));

@@ -156,8 +156,8 @@ void RangeAndBearingModule::ShapeIndex::List(double x, double y, double r, doubl
 }
 
 bool RangeAndBearingModule::Blocked(const Scene& scene, const Board& from, const Board& to,
-                                    double distance, const std::vector<uint32_t>& statics, bool map,
-                                    const std::vector<uint32_t>& robots) const {
+                                    double distance, const std::vector<Footprint>& statics,
+                                    bool map, const std::vector<Footprint>& robots) const {
   const double length = distance - 2 * kEndMargin;
   if (!(length > 0)) return false;
   const Vec3 d_W = (to.p_W - from.p_W) / distance;
@@ -167,23 +167,25 @@ bool RangeAndBearingModule::Blocked(const Scene& scene, const Board& from, const
   // Does the segment's (x, y) pass within o's footprint circle? A cheap
   // first test for the robots' bodies and the walls far to one side.
   const double inv_len2 = 1 / (v_W.x * v_W.x + v_W.y * v_W.y);
-  const auto near = [&](const Occluder& o) {
-    const double ex = o.cx - start.x, ey = o.cy - start.y;
-    double t = std::isfinite(inv_len2) ? (ex * v_W.x + ey * v_W.y) * inv_len2 : 0;
-    t = std::clamp(t, 0.0, 1.0);
+  const bool planar = std::isfinite(inv_len2);
+  const auto near = [&](const Footprint& f) {
+    const double ex = f.cx - start.x, ey = f.cy - start.y;
+    const double t = planar ? std::clamp((ex * v_W.x + ey * v_W.y) * inv_len2, 0.0, 1.0) : 0;
     const double dx = ex - t * v_W.x, dy = ey - t * v_W.y;
-    return dx * dx + dy * dy <= o.r * o.r;
+    return dx * dx + dy * dy <= f.r2;
   };
-  for (uint32_t j : statics) {
-    const Occluder& o = statics_.shapes[j];
-    if (!near(o) || !SegmentMeetsBox(start, v_W, o.lo, o.hi)) continue;
+  for (const Footprint& f : statics) {
+    if (!near(f)) continue;
+    const Occluder& o = statics_.shapes[f.shape];
+    if (!SegmentMeetsBox(start, v_W, o.lo, o.hi)) continue;
     // A board of no robot is not blocked by the shapes it hangs from.
     if (to.instance < 0 && IsAncestor(scene, o.slot, to.slot)) continue;
     if (proximity::RayCast(o.shape, start, d_W, length, &hit)) return true;
   }
-  for (uint32_t j : robots) {
-    const Occluder& o = robot_shapes_.shapes[j];
-    if (!near(o) || !SegmentMeetsBox(start, v_W, o.lo, o.hi)) continue;
+  for (const Footprint& f : robots) {
+    if (!near(f)) continue;
+    const Occluder& o = robot_shapes_.shapes[f.shape];
+    if (!SegmentMeetsBox(start, v_W, o.lo, o.hi)) continue;
     // The sender's own shapes never block it (the receiver's were left out).
     if (to.instance >= 0 ? o.shape.instance == to.instance : IsAncestor(scene, o.slot, to.slot))
       continue;
@@ -205,6 +207,7 @@ void RangeAndBearingModule::Hear(const Scene& scene, const Rows<RangeAndBearingR
   }
   // The boards in range, nearest first.
   thread_local std::vector<uint32_t> near, statics, robots;
+  thread_local std::vector<Footprint> static_footprints, robot_footprints;
   thread_local std::vector<Heard> heard;
   board_grid_.QueryCircle(self.p_W.x, self.p_W.y, s.range, &near);
   heard.clear();
@@ -240,6 +243,17 @@ void RangeAndBearingModule::Hear(const Scene& scene, const Rows<RangeAndBearingR
                                     : IsAncestor(scene, o.slot, self.slot);
         },
         &robots);
+  // Their footprints, packed for the test of each segment.
+  const auto pack = [](const ShapeIndex& index, const std::vector<uint32_t>& listed,
+                       std::vector<Footprint>* out) {
+    out->clear();
+    for (uint32_t j : listed) {
+      const Occluder& o = index.shapes[j];
+      out->push_back({o.cx, o.cy, o.r * o.r, j});
+    }
+  };
+  pack(statics_, statics, &static_footprints);
+  pack(robot_shapes_, robots, &robot_footprints);
   const bool map = s.occlusion && have_map_;
   const bool occluded = map || !statics.empty() || !robots.empty();
   const bool lossy = s.loss_probability > 0 || s.loss_at_range > 0;
@@ -251,7 +265,9 @@ void RangeAndBearingModule::Hear(const Scene& scene, const Rows<RangeAndBearingR
   size_t kept = 0;
   for (size_t k = 0; k < heard.size() && kept < capacity; ++k) {
     const Board& other = boards_[heard[k].board];
-    if (occluded && Blocked(scene, self, other, heard[k].distance, statics, map, robots)) continue;
+    if (occluded &&
+        Blocked(scene, self, other, heard[k].distance, static_footprints, map, robot_footprints))
+      continue;
     if (lossy) {
       const double p = s.LossAt(heard[k].distance);
       if (p > 0 && loss.Uniform() < p) continue;

@@ -64,6 +64,11 @@ class RangeAndBearingModule final : public Module, public RangeAndBearingAccess 
     void List(double x, double y, double r, double z_lo, double z_hi, Skip skip,
               std::vector<uint32_t>* out) const;
   };
+  // A listed occluder's footprint circle, packed for the per-segment test.
+  struct Footprint {  // 32 bytes
+    double cx, cy, r2;
+    uint32_t shape;  // in its ShapeIndex
+  };
   // A board in range of a receiver: its distance and index in boards_.
   struct Heard {
     double distance;
@@ -80,8 +85,8 @@ class RangeAndBearingModule final : public Module, public RangeAndBearingAccess 
   // from), or the map, or one of `robots` (but the sender's robot's: the
   // receiver's were left out) cross the segment between the boards?
   bool Blocked(const Scene& scene, const Board& from, const Board& to, double distance,
-               const std::vector<uint32_t>& statics, bool map,
-               const std::vector<uint32_t>& robots) const;
+               const std::vector<Footprint>& statics, bool map,
+               const std::vector<Footprint>& robots) const;
 
   uint64_t seed_ = 0;  // the world's
   int64_t step_ = 0;   // the step being sensed

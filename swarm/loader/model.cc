@@ -190,7 +190,7 @@ struct Builder {
     }
     const RingKind* ring = FindRing(type);
     const std::string what = is_root ? root_what
-                                     : (ring != nullptr ? std::string(ring->what) + " '"
+                                     : (ring != nullptr          ? std::string(ring->what) + " '"
                                         : type == "ground_array" ? "ground array '"
                                                                  : "object '") +
                                            name + "'";

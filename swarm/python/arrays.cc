@@ -140,6 +140,7 @@ void Refresh(const World& world, const std::string& model, ModelLayout* layout) 
   if (layout->ground_slots.size() != n * layout->ground_names.size()) {
     layout->ground_names.clear();
     layout->ground_slots.clear();
+  }
   if (layout->light_slots.size() != n * layout->light_names.size()) {
     layout->light_names.clear();
     layout->light_slots.clear();
@@ -363,6 +364,9 @@ Array Ground(const Scene& scene, const ModelLayout& layout, const py::object& ou
       scene.rows<ground_sensor::GroundSensorRow>(type).rows;
   for (size_t k = 0; k < layout.ground_slots.size(); ++k)
     d[k] = rows[scene.row_at(layout.ground_slots[k])].value;
+  return a;
+}
+
 // Light sensor readings, N x light sensors.
 Array Light(const Scene& scene, const ModelLayout& layout, const py::object& out) {
   const auto n = static_cast<py::ssize_t>(layout.robots.size());

@@ -114,8 +114,8 @@ class Robots {
   World* world_;
   const ModelLayout* layout_;
   bool planar_;
-  py::object poses_, velocities_, proximity_, ground_, light_, joint_positions_,
-      joint_velocities_, range_and_bearing_;
+  py::object poses_, velocities_, proximity_, ground_, light_, joint_positions_, joint_velocities_,
+      range_and_bearing_;
 };
 
 struct ControllerConfig {
