@@ -121,6 +121,26 @@ TEST(ExamplesTest, TheFootbotsNoiseIsAParameterASweepCanVary) {
   EXPECT_NE(RunWorld("diffusion.yaml", 1, 50, {{"footbot.wheel_noise", "0.05"}}).hash, plain);
 }
 
+// worlds/foraging.yaml: foot-bots find items, carry them home by the lamp
+// over the nest (light sensors) and drop them where the floor is black
+// (ground sensors). In 5 min with the lamp on they deliver several times
+// as many items as with it off (then a carrier finds the nest only by
+// chance): 19 against 4 at seed 1, and at least twice as many at seeds 2-4
+// (12/2, 16/2, 9/4).
+TEST(ExamplesTest, ForagersBringMoreItemsHomeWithTheLampOverTheNest) {
+  auto delivered = [](const WorldRun& run) {
+    double last = -1;
+    for (const MetricSample& m : run.metrics)
+      if (m.name == "items_delivered") last = m.value;
+    return last;
+  };
+  const double lit = delivered(RunWorld("foraging.yaml", 2, 3000));
+  const double dark = delivered(RunWorld("foraging.yaml", 2, 3000, {{"intensity", "0"}}));
+  EXPECT_GE(lit, 10);
+  EXPECT_GE(lit, 2.5 * dark) << lit << " vs " << dark;
+  EXPECT_EQ(RunWorld("foraging.yaml", 1, 300).hash, RunWorld("foraging.yaml", 2, 300).hash);
+}
+
 TEST(ExamplesTest, RespawnKeepsThePopulationWithCopiesAndIsIndependentOfThreadCount) {
   const std::vector<std::pair<std::string, std::string>> set = {{"failure_rate", "0.05"}};
   const WorldRun one = RunWorld("respawn.yaml", 1, 200, set);
