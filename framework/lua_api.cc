@@ -285,6 +285,13 @@ void ArgType(lua_State* L, int arg, int type) {
   if (lua_type(L, arg) != type) ArgError(L, arg, lua_typename(L, type));
 }
 
+void HandleArrayError(lua_State* L, lua_Integer i, const char* why) {
+  if (why == nullptr)
+    throw Error("handles[" + std::to_string(i) + "] is not an object handle (got " +
+                luaL_typename(L, -1) + ")");
+  throw Error("handles[" + std::to_string(i) + "]: " + why);
+}
+
 int ArgOption(lua_State* L, int arg, const char* def, const char* const options[]) {
   const char* name = def != nullptr && lua_isnoneornil(L, arg) ? def : ArgString(L, arg);
   for (int i = 0; options[i] != nullptr; ++i)

@@ -154,6 +154,41 @@ void ArgType(lua_State* L, int arg, int type);
 // listing the options (and the nearest, for a typo).
 int ArgOption(lua_State* L, int arg, const char* def, const char* const options[]);
 
+// The array readers' protocol (sim.readProximitySensors, readGroundSensors,
+// readLightSensors): argument 1 is a table of handles, argument 2 an
+// optional table filled in place (entries 1 .. #handles; the rest left
+// alone), so that a script passing the same table every step allocates
+// nothing, else a new table. push(id) pushes one handle's value; an entry
+// that is not a handle, or that push rejects by throwing, is an error
+// naming it ("handles[2]: ..."). Leaves the filled table at index 2.
+// (HandleArrayError in lua_api.cc builds the messages.)
+[[noreturn]] void HandleArrayError(lua_State* L, lua_Integer i, const char* why);
+template <class Push>
+void FillFromHandles(lua_State* L, Push&& push) {
+  ArgType(L, 1, LUA_TTABLE);
+  if (lua_isnoneornil(L, 2)) {
+    lua_settop(L, 1);
+    lua_createtable(L, static_cast<int>(lua_rawlen(L, 1)), 0);
+  } else {
+    ArgType(L, 2, LUA_TTABLE);
+    lua_settop(L, 2);
+  }
+  const lua_Integer n = static_cast<lua_Integer>(lua_rawlen(L, 1));
+  for (lua_Integer i = 1; i <= n; ++i) {
+    lua_rawgeti(L, 1, i);
+    int ok = 0;
+    const lua_Integer handle = lua_tointegerx(L, -1, &ok);
+    if (!ok) HandleArrayError(L, i, nullptr);
+    lua_pop(L, 1);
+    try {
+      push(ObjectId::FromInteger(handle));
+    } catch (const std::exception& e) {
+      HandleArrayError(L, i, e.what());
+    }
+    lua_rawseti(L, 2, i);
+  }
+}
+
 // Charges `bytes` of the calling script's data that C++ keeps for it to its
 // robot's account (ScriptMemory: lines printed, metrics, messages, signals,
 // custom data, deferred writes). When they do not fit, collects the state's

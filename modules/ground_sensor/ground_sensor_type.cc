@@ -94,32 +94,7 @@ int ReadGroundSensor(lua_State* L) {
 // the call allocates nothing) or into a new table when it is absent or nil.
 int ReadGroundSensors(lua_State* L) {
   const Scene& scene = *Context(L).scene;
-  ArgType(L, 1, LUA_TTABLE);
-  if (lua_isnoneornil(L, 2)) {
-    lua_settop(L, 1);
-    lua_createtable(L, static_cast<int>(lua_rawlen(L, 1)), 0);
-  } else {
-    ArgType(L, 2, LUA_TTABLE);
-    lua_settop(L, 2);
-  }
-  const lua_Integer n = static_cast<lua_Integer>(lua_rawlen(L, 1));
-  for (lua_Integer i = 1; i <= n; ++i) {
-    lua_rawgeti(L, 1, i);
-    int ok = 0;
-    const lua_Integer handle = lua_tointegerx(L, -1, &ok);
-    if (!ok)
-      throw Error("handles[" + std::to_string(i) + "] is not an object handle (got " +
-                  luaL_typename(L, -1) + ")");
-    lua_pop(L, 1);
-    const GroundSensorRow* g = nullptr;
-    try {
-      g = &SensorOf(scene, ObjectId::FromInteger(handle));
-    } catch (const std::exception& e) {
-      throw Error("handles[" + std::to_string(i) + "]: " + e.what());
-    }
-    lua_pushnumber(L, g->value);
-    lua_rawseti(L, 2, i);
-  }
+  FillFromHandles(L, [&](ObjectId id) { lua_pushnumber(L, SensorOf(scene, id).value); });
   return 1;
 }
 

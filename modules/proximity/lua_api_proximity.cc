@@ -53,39 +53,16 @@ int ReadProximitySensor(lua_State* L) {
 // into a new table when it is absent or nil.
 int ReadProximitySensors(lua_State* L) {
   const Scene& scene = *Context(L).scene;
-  ArgType(L, 1, LUA_TTABLE);
-  if (lua_isnoneornil(L, 2)) {
-    lua_settop(L, 1);
-    lua_createtable(L, static_cast<int>(lua_rawlen(L, 1)), 0);
-  } else {
-    ArgType(L, 2, LUA_TTABLE);
-    lua_settop(L, 2);
-  }
-  const lua_Integer n = static_cast<lua_Integer>(lua_rawlen(L, 1));
   lua_Integer count = 0;
-  for (lua_Integer i = 1; i <= n; ++i) {
-    lua_rawgeti(L, 1, i);
-    int ok = 0;
-    const lua_Integer handle = lua_tointegerx(L, -1, &ok);
-    if (!ok)
-      throw Error("handles[" + std::to_string(i) + "] is not an object handle (got " +
-                  luaL_typename(L, -1) + ")");
-    lua_pop(L, 1);
-    const ObjectId id = ObjectId::FromInteger(handle);
-    const ProximitySensorData* sensor = nullptr;
-    try {
-      sensor = &SensorOf(scene, id);
-    } catch (const std::exception& e) {
-      throw Error("handles[" + std::to_string(i) + "]: " + e.what());
-    }
-    if (sensor->detected) {
+  FillFromHandles(L, [&](ObjectId id) {
+    const ProximitySensorData& sensor = SensorOf(scene, id);
+    if (sensor.detected) {
       ++count;
-      lua_pushnumber(L, sensor->distance);
+      lua_pushnumber(L, sensor.distance);
     } else {
       lua_pushinteger(L, -1);
     }
-    lua_rawseti(L, 2, i);
-  }
+  });
   lua_pushinteger(L, count);
   lua_insert(L, 2);
   return 2;
