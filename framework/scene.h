@@ -303,6 +303,12 @@ class Scene {
   ObjectId parent(ObjectId id) const;
   std::vector<ObjectId> children(ObjectId id) const;
   int32_t parent_at(uint32_t slot) const { return parent_[slot]; }
+  // Is `ancestor` above `slot` in the tree (its parent, or its parent's, ...)?
+  bool IsAbove(uint32_t ancestor, uint32_t slot) const {
+    for (int32_t s = parent_[slot]; s >= 0; s = parent_[static_cast<uint32_t>(s)])
+      if (static_cast<uint32_t>(s) == ancestor) return true;
+    return false;
+  }
   const std::string& name(ObjectId id) const { return names_[name_[SlotOf(id)]]; }
   const std::string& name_at(uint32_t slot) const { return names_[name_[slot]]; }
   void set_name(ObjectId id, std::string name);

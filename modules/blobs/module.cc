@@ -47,33 +47,6 @@ constexpr double kEndMargin = 1e-6;
 // Cameras per task: a camera costs about a microsecond.
 constexpr int64_t kCameraGrain = 16;
 
-// Is `ancestor` above `slot` in the tree?
-bool IsAncestor(const Scene& scene, uint32_t ancestor, uint32_t slot) {
-  for (int32_t s = scene.parent_at(slot); s >= 0; s = scene.parent_at(static_cast<uint32_t>(s)))
-    if (static_cast<uint32_t>(s) == ancestor) return true;
-  return false;
-}
-
-// Does the segment p + t v, t in [0, 1], meet the box [lo, hi]?
-bool SegmentMeetsBox(const Vec3& p, const Vec3& v, const Vec3& lo, const Vec3& hi) {
-  double t0 = 0, t1 = 1;
-  const double ps[3] = {p.x, p.y, p.z}, vs[3] = {v.x, v.y, v.z};
-  const double los[3] = {lo.x, lo.y, lo.z}, his[3] = {hi.x, hi.y, hi.z};
-  for (int i = 0; i < 3; ++i) {
-    if (vs[i] == 0) {
-      if (ps[i] < los[i] || ps[i] > his[i]) return false;
-      continue;
-    }
-    const double inv = 1 / vs[i];
-    double a = (los[i] - ps[i]) * inv, b = (his[i] - ps[i]) * inv;
-    if (a > b) std::swap(a, b);
-    t0 = std::max(t0, a);
-    t1 = std::min(t1, b);
-    if (t0 > t1) return false;
-  }
-  return true;
-}
-
 bool BlobBefore(const Blob& a, const Blob& b) {
   if (a.bearing != b.bearing) return a.bearing < b.bearing;
   if (a.distance != b.distance) return a.distance < b.distance;
@@ -133,7 +106,7 @@ void BlobCameraModule::ListOccluders(const Scene& scene, const Vec3& p_W, double
   for (uint32_t j : *out) {
     const Occluder& o = occluders_[j];
     const int owner = o.shape.instance;
-    if (owner >= 0 ? owner == instance : IsAncestor(scene, o.slot, slot)) continue;
+    if (owner >= 0 ? owner == instance : scene.IsAbove(o.slot, slot)) continue;
     if (o.hi.z < z_lo || o.lo.z > z_hi) continue;
     (*out)[kept++] = j;
   }
@@ -150,8 +123,8 @@ bool BlobCameraModule::Hidden(const Scene& scene, const Vec3& p_W, const LitLed&
   for (uint32_t j : occluders) {
     const Occluder& o = occluders_[j];
     const int owner = o.shape.instance;
-    if (owner >= 0 ? owner == led.instance : IsAncestor(scene, o.slot, led.slot)) continue;
-    if (!SegmentMeetsBox(p_W, v_W, o.lo, o.hi)) continue;
+    if (owner >= 0 ? owner == led.instance : scene.IsAbove(o.slot, led.slot)) continue;
+    if (!proximity::SegmentMeetsBox(p_W, v_W, o.lo, o.hi)) continue;
     double hit = 0;
     if (proximity::RayCast(o.shape, p_W, d_W, length, &hit)) return true;
   }

@@ -54,13 +54,6 @@ constexpr size_t kScanLimit = 16;
 // Robots per task of ClearRobots.
 constexpr int64_t kRobotGrain = 64;
 
-// Is `ancestor` above `slot` in the tree?
-bool IsAncestor(const Scene& scene, uint32_t ancestor, uint32_t slot) {
-  for (int32_t s = scene.parent_at(slot); s >= 0; s = scene.parent_at(static_cast<uint32_t>(s)))
-    if (static_cast<uint32_t>(s) == ancestor) return true;
-  return false;
-}
-
 // A segment p + t v, t in [0, 1], with what its box tests need once.
 struct Segment {
   double p[3], inv[3];  // inv: 1 / v per axis (inf for 0)
@@ -150,9 +143,8 @@ bool LightSensingModule::Hidden(const Scene& scene, const OccluderSet& set, cons
   const auto hides = [&](const Occluder& o) {
     if (!segment.MeetsBox(o.lo, o.hi)) return false;
     const int owner = o.shape.instance;
-    if (owner >= 0
-            ? owner == sensor_instance || owner == source.instance
-            : IsAncestor(scene, o.slot, sensor_slot) || IsAncestor(scene, o.slot, source.slot))
+    if (owner >= 0 ? owner == sensor_instance || owner == source.instance
+                   : scene.IsAbove(o.slot, sensor_slot) || scene.IsAbove(o.slot, source.slot))
       return false;
     double hit = 0;
     return proximity::RayCast(o.shape, p_W, d_W, length, &hit);

@@ -65,4 +65,8 @@ double WorldFootprintRadius(const ShapeData& shape, const Pose& X_WS, FootprintM
 // box and a capsule around its axis.
 bool MayOverlapCube(const PlacedShape& shape, const Vec3& centre, double half, double margin);
 
+// Does the segment p + t v, t in [0, 1], meet the box [lo, hi]? (The
+// broad phase of occlusion tests: blob cameras, range-and-bearing, light.)
+bool SegmentMeetsBox(const Vec3& p, const Vec3& v, const Vec3& lo, const Vec3& hi);
+
 }  // namespace swarmsim::proximity

@@ -55,33 +55,6 @@ constexpr double kEndMargin = 1e-6;
 // Boards per task: a board costs about a microsecond.
 constexpr int64_t kBoardGrain = 32;
 
-// Is `ancestor` above `slot` in the tree?
-bool IsAncestor(const Scene& scene, uint32_t ancestor, uint32_t slot) {
-  for (int32_t s = scene.parent_at(slot); s >= 0; s = scene.parent_at(static_cast<uint32_t>(s)))
-    if (static_cast<uint32_t>(s) == ancestor) return true;
-  return false;
-}
-
-// Does the segment p + t v, t in [0, 1], meet the box [lo, hi]?
-bool SegmentMeetsBox(const Vec3& p, const Vec3& v, const Vec3& lo, const Vec3& hi) {
-  double t0 = 0, t1 = 1;
-  const double ps[3] = {p.x, p.y, p.z}, vs[3] = {v.x, v.y, v.z};
-  const double los[3] = {lo.x, lo.y, lo.z}, his[3] = {hi.x, hi.y, hi.z};
-  for (int i = 0; i < 3; ++i) {
-    if (vs[i] == 0) {
-      if (ps[i] < los[i] || ps[i] > his[i]) return false;
-      continue;
-    }
-    const double inv = 1 / vs[i];
-    double a = (los[i] - ps[i]) * inv, b = (his[i] - ps[i]) * inv;
-    if (a > b) std::swap(a, b);
-    t0 = std::max(t0, a);
-    t1 = std::min(t1, b);
-    if (t0 > t1) return false;
-  }
-  return true;
-}
-
 // An angle in (-pi, pi].
 double Wrap(double a) {
   a = std::remainder(a, kTwoPi);
@@ -177,17 +150,17 @@ bool RangeAndBearingModule::Blocked(const Scene& scene, const Board& from, const
   for (const Footprint& f : statics) {
     if (!near(f)) continue;
     const Occluder& o = statics_.shapes[f.shape];
-    if (!SegmentMeetsBox(start, v_W, o.lo, o.hi)) continue;
+    if (!proximity::SegmentMeetsBox(start, v_W, o.lo, o.hi)) continue;
     // A board of no robot is not blocked by the shapes it hangs from.
-    if (to.instance < 0 && IsAncestor(scene, o.slot, to.slot)) continue;
+    if (to.instance < 0 && scene.IsAbove(o.slot, to.slot)) continue;
     if (proximity::RayCast(o.shape, start, d_W, length, &hit)) return true;
   }
   for (const Footprint& f : robots) {
     if (!near(f)) continue;
     const Occluder& o = robot_shapes_.shapes[f.shape];
-    if (!SegmentMeetsBox(start, v_W, o.lo, o.hi)) continue;
+    if (!proximity::SegmentMeetsBox(start, v_W, o.lo, o.hi)) continue;
     // The sender's own shapes never block it (the receiver's were left out).
-    if (to.instance >= 0 ? o.shape.instance == to.instance : IsAncestor(scene, o.slot, to.slot))
+    if (to.instance >= 0 ? o.shape.instance == to.instance : scene.IsAbove(o.slot, to.slot))
       continue;
     if (proximity::RayCast(o.shape, start, d_W, length, &hit)) return true;
   }
@@ -231,16 +204,14 @@ void RangeAndBearingModule::Hear(const Scene& scene, const Rows<RangeAndBearingR
   if (s.occlusion && have_statics_)
     statics_.List(
         self.p_W.x, self.p_W.y, s.range, z_lo_, z_hi_,
-        [&](const Occluder& o) {
-          return self.instance < 0 && IsAncestor(scene, o.slot, self.slot);
-        },
+        [&](const Occluder& o) { return self.instance < 0 && scene.IsAbove(o.slot, self.slot); },
         &statics);
   if (s.robot_occlusion && have_robot_shapes_)
     robot_shapes_.List(
         self.p_W.x, self.p_W.y, s.range, z_lo_, z_hi_,
         [&](const Occluder& o) {
           return self.instance >= 0 ? o.shape.instance == self.instance
-                                    : IsAncestor(scene, o.slot, self.slot);
+                                    : scene.IsAbove(o.slot, self.slot);
         },
         &robots);
   // Their footprints, packed for the test of each segment.
