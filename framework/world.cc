@@ -526,21 +526,21 @@ void World::Actuate() {
   // Joints move kinematically toward their targets over the control step:
   // velocity mode at the target velocity, position mode at up to max_velocity.
   const double dt = settings_.time_step;
-  // Motors with actuation noise (scene.h: JointSettings::velocity_noise):
-  // this step's speed, from the stream of (seed, joint slot, step).
+  // One pass over the joints. Motors with actuation noise (scene.h:
+  // JointSettings::velocity_noise) draw this step's speed first, from the
+  // stream of (seed, joint slot, step): the backends drive it too.
   const std::span<JointData> joints = scene_.joints();
   for (size_t r = 0; r < joints.size(); ++r) {
     JointData& j = joints[r];
-    if (j.mode() != JointMode::kVelocity || !j.settings->drive_noisy()) continue;
-    const JointSettings& s = *j.settings;
-    Rng rng =
-        NoiseStream(settings_.seed, scene_.joint_owners()[r], step_count_, NoisePurpose::kWheels);
-    double v = j.target_velocity * (1 - s.slip);
-    if (s.velocity_noise_factor > 0) v *= 1 + rng.Normal(0, s.velocity_noise_factor);
-    v = Perturb(s.velocity_noise, v, rng);
-    j.drive_velocity = Fails(s.velocity_noise, rng) ? 0.0 : v;
-  }
-  for (JointData& j : joints) {
+    if (j.mode() == JointMode::kVelocity && j.settings->drive_noisy()) {
+      const JointSettings& s = *j.settings;
+      Rng rng =
+          NoiseStream(settings_.seed, scene_.joint_owners()[r], step_count_, NoisePurpose::kWheels);
+      double v = j.target_velocity * (1 - s.slip);
+      if (s.velocity_noise_factor > 0) v *= 1 + rng.Normal(0, s.velocity_noise_factor);
+      v = Perturb(s.velocity_noise, v, rng);
+      j.drive_velocity = Fails(s.velocity_noise, rng) ? 0.0 : v;
+    }
     if (j.simulated || j.depends()) continue;  // the dynamics backend, or its master, moves it
     switch (j.mode()) {
       case JointMode::kVelocity:

@@ -119,12 +119,12 @@ bool BlobCameraModule::Hidden(const Scene& scene, const Vec3& p_W, const LitLed&
   if (!(length > 0)) return false;
   const Vec3 d_W = (led.p_W - p_W) / distance;
   const Vec3 end = p_W + d_W * length;
-  const Vec3 v_W = end - p_W;
+  const proximity::Segment segment(p_W, end - p_W);
   for (uint32_t j : occluders) {
     const Occluder& o = occluders_[j];
     const int owner = o.shape.instance;
     if (owner >= 0 ? owner == led.instance : scene.IsAbove(o.slot, led.slot)) continue;
-    if (!proximity::SegmentMeetsBox(p_W, v_W, o.lo, o.hi)) continue;
+    if (!segment.MeetsBox(o.lo, o.hi)) continue;
     double hit = 0;
     if (proximity::RayCast(o.shape, p_W, d_W, length, &hit)) return true;
   }

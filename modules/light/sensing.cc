@@ -54,30 +54,7 @@ constexpr size_t kScanLimit = 16;
 // Robots per task of ClearRobots.
 constexpr int64_t kRobotGrain = 64;
 
-// A segment p + t v, t in [0, 1], with what its box tests need once.
-struct Segment {
-  double p[3], inv[3];  // inv: 1 / v per axis (inf for 0)
-  explicit Segment(const Vec3& from, const Vec3& v)
-      : p{from.x, from.y, from.z}, inv{1 / v.x, 1 / v.y, 1 / v.z} {}
-  // Does it meet the box [lo, hi]? (Slabs; along an axis it does not move
-  // on, it must lie within the box's slab.)
-  bool MeetsBox(const Vec3& lo, const Vec3& hi) const {
-    double t0 = 0, t1 = 1;
-    const double los[3] = {lo.x, lo.y, lo.z}, his[3] = {hi.x, hi.y, hi.z};
-    for (int i = 0; i < 3; ++i) {
-      if (std::isinf(inv[i])) {
-        if (p[i] < los[i] || p[i] > his[i]) return false;
-        continue;
-      }
-      double ta = (los[i] - p[i]) * inv[i], tb = (his[i] - p[i]) * inv[i];
-      if (ta > tb) std::swap(ta, tb);
-      t0 = std::max(t0, ta);
-      t1 = std::min(t1, tb);
-      if (t0 > t1) return false;
-    }
-    return true;
-  }
-};
+using proximity::Segment;
 
 }  // namespace
 

@@ -227,23 +227,4 @@ bool MayOverlapCube(const PlacedShape& shape, const Vec3& centre, double half, d
   return true;
 }
 
-bool SegmentMeetsBox(const Vec3& p, const Vec3& v, const Vec3& lo, const Vec3& hi) {
-  double t0 = 0, t1 = 1;
-  const double ps[3] = {p.x, p.y, p.z}, vs[3] = {v.x, v.y, v.z};
-  const double los[3] = {lo.x, lo.y, lo.z}, his[3] = {hi.x, hi.y, hi.z};
-  for (int i = 0; i < 3; ++i) {
-    if (vs[i] == 0) {
-      if (ps[i] < los[i] || ps[i] > his[i]) return false;
-      continue;
-    }
-    const double inv = 1 / vs[i];
-    double a = (los[i] - ps[i]) * inv, b = (his[i] - ps[i]) * inv;
-    if (a > b) std::swap(a, b);
-    t0 = std::max(t0, a);
-    t1 = std::min(t1, b);
-    if (t0 > t1) return false;
-  }
-  return true;
-}
-
 }  // namespace swarmsim::proximity

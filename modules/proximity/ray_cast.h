@@ -8,9 +8,11 @@
 // pushed into a wall reads "detected, distance 0" rather than seeing out of it.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <compare>  // framework/handle.h uses operator<=> without including <compare>
 #include <cstdint>
+#include <utility>
 
 #include "framework/handle.h"
 #include "framework/math.h"
@@ -65,8 +67,31 @@ double WorldFootprintRadius(const ShapeData& shape, const Pose& X_WS, FootprintM
 // box and a capsule around its axis.
 bool MayOverlapCube(const PlacedShape& shape, const Vec3& centre, double half, double margin);
 
-// Does the segment p + t v, t in [0, 1], meet the box [lo, hi]? (The
-// broad phase of occlusion tests: blob cameras, range-and-bearing, light.)
-bool SegmentMeetsBox(const Vec3& p, const Vec3& v, const Vec3& lo, const Vec3& hi);
+// A segment p + t v, t in [0, 1], for the broad phase of occlusion tests
+// (blob cameras, range-and-bearing, light): its inverse direction is
+// computed once, then each box costs a slab test.
+struct Segment {
+  double p[3], inv[3];  // inv: 1 / v per axis (inf for 0)
+  Segment(const Vec3& from, const Vec3& v)
+      : p{from.x, from.y, from.z}, inv{1 / v.x, 1 / v.y, 1 / v.z} {}
+  // Does it meet the box [lo, hi]? (Along an axis it does not move on, it
+  // must lie within the box's slab.)
+  bool MeetsBox(const Vec3& lo, const Vec3& hi) const {
+    double t0 = 0, t1 = 1;
+    const double los[3] = {lo.x, lo.y, lo.z}, his[3] = {hi.x, hi.y, hi.z};
+    for (int i = 0; i < 3; ++i) {
+      if (std::isinf(inv[i])) {
+        if (p[i] < los[i] || p[i] > his[i]) return false;
+        continue;
+      }
+      double ta = (los[i] - p[i]) * inv[i], tb = (his[i] - p[i]) * inv[i];
+      if (ta > tb) std::swap(ta, tb);
+      t0 = std::max(t0, ta);
+      t1 = std::min(t1, tb);
+      if (t0 > t1) return false;
+    }
+    return true;
+  }
+};
 
 }  // namespace swarmsim::proximity

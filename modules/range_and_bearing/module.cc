@@ -147,10 +147,11 @@ bool RangeAndBearingModule::Blocked(const Scene& scene, const Board& from, const
     const double dx = ex - t * v_W.x, dy = ey - t * v_W.y;
     return dx * dx + dy * dy <= f.r2;
   };
+  const proximity::Segment segment(start, v_W);
   for (const Footprint& f : statics) {
     if (!near(f)) continue;
     const Occluder& o = statics_.shapes[f.shape];
-    if (!proximity::SegmentMeetsBox(start, v_W, o.lo, o.hi)) continue;
+    if (!segment.MeetsBox(o.lo, o.hi)) continue;
     // A board of no robot is not blocked by the shapes it hangs from.
     if (to.instance < 0 && scene.IsAbove(o.slot, to.slot)) continue;
     if (proximity::RayCast(o.shape, start, d_W, length, &hit)) return true;
@@ -158,7 +159,7 @@ bool RangeAndBearingModule::Blocked(const Scene& scene, const Board& from, const
   for (const Footprint& f : robots) {
     if (!near(f)) continue;
     const Occluder& o = robot_shapes_.shapes[f.shape];
-    if (!proximity::SegmentMeetsBox(start, v_W, o.lo, o.hi)) continue;
+    if (!segment.MeetsBox(o.lo, o.hi)) continue;
     // The sender's own shapes never block it (the receiver's were left out).
     if (to.instance >= 0 ? o.shape.instance == to.instance : scene.IsAbove(o.slot, to.slot))
       continue;
