@@ -168,10 +168,12 @@ TEST_F(ProximityNoiseTest, AFailingSensorLosesDetectionsAtTheConfiguredRate) {
   EXPECT_NEAR(s.max, 0.3, 1e-12);
 }
 
+// 300 robots: more than one task's share (the sense phase hands out 64
+// robots a task), so two threads really split them.
 TEST_F(ProximityNoiseTest, TheDrawsAreTheSameAtAnyThreadCountAndDifferPerSensor) {
-  LoadedWorld one = Load("noise: 0.01,", 1, 40);
+  LoadedWorld one = Load("noise: 0.01,", 1, 300);
   const std::vector<double> a0 = Readings(one, 50, 0), a7 = Readings(one, 50, 7);
-  LoadedWorld two = Load("noise: 0.01,", 2, 40);
+  LoadedWorld two = Load("noise: 0.01,", 2, 300);
   const std::vector<double> b0 = Readings(two, 50, 0), b7 = Readings(two, 50, 7);
   EXPECT_EQ(a0, b0);
   EXPECT_EQ(a7, b7);
