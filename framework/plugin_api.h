@@ -14,7 +14,9 @@
 // elements (ABI 5) that a sensor's `filters:` list names; and native
 // controllers (ABI 6) that a models entry attaches with `native_controller:`,
 // called once per robot per step in the control phase; their world API
-// reads and sets range-and-bearing boards (ABI 7). Arguments and
+// reads and sets range-and-bearing boards (ABI 7), and reads light and
+// ground sensors, sets LEDs and sends and hears IR messages (ABI 8: what a
+// Kilobot's firmware needs). Arguments and
 // results are numbers, strings and number arrays (SwarmsimValue); no Lua
 // type crosses this interface. Everything here is plain C, so a plugin
 // built with another compiler works as long as the ABI version matches; the
@@ -26,9 +28,9 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#define SWARMSIM_PLUGIN_ABI_VERSION 7
-// The oldest ABI this swarmsim still loads: ABI 7 only added functions at
-// the end of SwarmsimWorldApi, so a plugin built for ABI 6 runs unchanged.
+#define SWARMSIM_PLUGIN_ABI_VERSION 8
+// The oldest ABI this swarmsim still loads: ABI 7 and 8 only added functions
+// at the end of SwarmsimWorldApi, so a plugin built for ABI 6 runs unchanged.
 #define SWARMSIM_PLUGIN_ABI_OLDEST 6
 
 #ifdef __cplusplus
@@ -82,6 +84,14 @@ typedef struct SwarmsimRangeAndBearingReading {
   double bearing;    // rad, in (-pi, pi]: in the receiving board's xy plane from its +x, CCW
   double elevation;  // rad, in [-pi/2, pi/2]: above that plane
 } SwarmsimRangeAndBearingReading;
+
+// A message an IR transceiver heard (ABI 8), as sim.readIrMessages gives it.
+typedef struct SwarmsimIrMessage {
+  // The sender's bytes (as it queued them), valid until the next sense phase.
+  const uint8_t* data;
+  size_t size;
+  double distance;  // m, the receiver's estimate of the distance between the two transceivers
+} SwarmsimIrMessage;
 
 // A narrow, read-mostly view of the world the command runs in.
 typedef struct SwarmsimWorldApi {
@@ -173,6 +183,33 @@ typedef struct SwarmsimWorldApi {
   // are (possibly more than max), or -1 if `board` is not a live board.
   int (*read_range_and_bearing)(void* world, int64_t board, SwarmsimRangeAndBearingReading* out,
                                 int max);
+  // --- ABI 8 ---
+  // The last reading of a sensor whose reading is one number: a light_sensor
+  // (sim.readLightSensor's value) or a ground_sensor (sim.readGroundSensor's
+  // value), into *value. Returns 0, or -1 if `sensor` is neither (or stale).
+  int (*read_sensor_value)(void* world, int64_t sensor, double* value);
+  // Sets an LED's colour (RGB, each clamped to 0..1) and switches it on (on
+  // != 0) or off, as sim.setLedColor / sim.setLedOn. `robot` must be the
+  // caller's and own the LED. Returns 0, or -1 if `led` is not a live LED of
+  // `robot`.
+  int (*set_led)(void* world, int robot, int64_t led, double red, double green, double blue,
+                 int on);
+  // Queues `data` on IR transceiver `ir` of `robot`, to go out once in the
+  // next sense phase (replacing a message queued earlier and not yet sent).
+  // There it is sent unless the transceiver hears another transmission
+  // already on the air (carrier sense): then nothing goes out and the caller
+  // queues it again later. Returns 0, or -1 if `ir` is not a live transceiver
+  // of `robot` or `size` is more than its payload_size.
+  int (*ir_send)(void* world, int robot, int64_t ir, const uint8_t* data, size_t size);
+  // Whether a message of transceiver `ir` went out in the last sense phase:
+  // 1 if it did, 0 if not (none was queued, or the channel was busy), -1 if
+  // `ir` is not a live transceiver.
+  int (*ir_sent)(void* world, int64_t ir);
+  // The messages transceiver `ir` heard in the last sense phase, in the
+  // order they arrived (collided ones are lost), into out[0..max); returns
+  // how many there are (possibly more than max), or -1 if `ir` is not a live
+  // transceiver.
+  int (*ir_receive)(void* world, int64_t ir, SwarmsimIrMessage* out, int max);
 } SwarmsimWorldApi;
 
 // Who is calling: the robot and the script's object.

@@ -252,6 +252,13 @@ int ReadRangeAndBearing(void* world, int64_t board, SwarmsimRangeAndBearingReadi
   return boards->Read(w.scene(), ObjectId::FromInteger(board), out, out != nullptr ? max : 0);
 }
 
+// --- ABI 8 (stubs until the modules implement them) ---
+int ReadSensorValue(void*, int64_t, double*) { return -1; }
+int SetLed(void*, int, int64_t, double, double, double, int) { return -1; }
+int IrSend(void*, int, int64_t, const uint8_t*, size_t) { return -1; }
+int IrSent(void*, int64_t) { return -1; }
+int IrReceive(void*, int64_t, SwarmsimIrMessage*, int) { return -1; }
+
 constexpr SwarmsimWorldApi kWorldApi = {WorldTime,
                                         ObjectPosition,
                                         NumberParameter,
@@ -274,7 +281,12 @@ constexpr SwarmsimWorldApi kWorldApi = {WorldTime,
                                         ReceiveMessage,
                                         RandomUniform,
                                         SetRangeAndBearingData,
-                                        ReadRangeAndBearing};
+                                        ReadRangeAndBearing,
+                                        ReadSensorValue,
+                                        SetLed,
+                                        IrSend,
+                                        IrSent,
+                                        IrReceive};
 
 }  // namespace
 

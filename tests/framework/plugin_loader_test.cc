@@ -30,12 +30,12 @@ TEST(PluginTest, LoadErrorsNameThePathAndTheProblem) {
                   "cannot load plugin '/nonexistent/p.so': ");
   EXPECT_CONTAINS(
       ErrorOf([&] { LoadPlugin(PluginPath("wrong_abi_plugin.so"), &registry); }),
-      "was built for plugin ABI version 8, this swarmsim has version 7 (and loads plugins "
-      "of versions 6 to 7)");
+      "was built for plugin ABI version 9, this swarmsim has version 8 (and loads plugins "
+      "of versions 6 to 8)");
   EXPECT_CONTAINS(
       ErrorOf([&] { LoadPlugin(PluginPath("old_abi_plugin.so"), &registry); }),
-      "was built for plugin ABI version 3, this swarmsim has version 7 (and loads plugins "
-      "of versions 6 to 7); rebuild it");
+      "was built for plugin ABI version 3, this swarmsim has version 8 (and loads plugins "
+      "of versions 6 to 8); rebuild it");
   EXPECT_CONTAINS(ErrorOf([&] { LoadPlugin("libm.so.6", &registry); }), "cannot load plugin");
   LoadPlugin(PluginPath("example_plugin.so"), &registry);
   EXPECT_CONTAINS(ErrorOf([&] { LoadPlugin(PluginPath("example_plugin.so"), &registry); }),
