@@ -136,4 +136,40 @@ std::vector<Placement2> Placer::Distribute(const Region2& region, int64_t count,
   return out;
 }
 
+std::vector<Placement2> Placer::Lattice(const Region2& region, int64_t count, double radius,
+                                        double spacing, bool hexagonal, int64_t columns,
+                                        uint64_t stream, std::optional<double> heading,
+                                        int64_t* first_bad) {
+  std::vector<Placement2> out;
+  *first_bad = -1;
+  if (count <= 0 || columns <= 0) return out;
+  const int64_t rows = (count + columns - 1) / columns;
+  const int64_t used_columns = std::min(columns, count);
+  const double pitch = hexagonal ? spacing * std::sqrt(3.0) / 2 : spacing;
+  // The block's extent (a hexagonal block's shifted rows reach half a spacing further).
+  const double width = static_cast<double>(used_columns - 1) * spacing +
+                       (hexagonal && rows > 1 ? spacing / 2 : 0);
+  const double height = static_cast<double>(rows - 1) * pitch;
+  const double x0 = (region.min_x + region.max_x - width) / 2;
+  const double y0 = (region.min_y + region.max_y - height) / 2;
+  Rng rng(seed_, kPlacementStream + stream);
+  out.reserve(static_cast<size_t>(count));
+  for (int64_t k = 0; k < count; ++k) {
+    const int64_t row = k / columns, column = k % columns;
+    const double x = x0 + static_cast<double>(column) * spacing +
+                     (hexagonal && row % 2 == 1 ? spacing / 2 : 0);
+    const double y = y0 + static_cast<double>(row) * pitch;
+    const bool inside = x - radius >= region.min_x && x + radius <= region.max_x &&
+                        y - radius >= region.min_y && y + radius <= region.max_y;
+    if (!inside || !IsFree(x, y, radius, 0)) {
+      *first_bad = k;
+      out.clear();
+      return out;
+    }
+    out.push_back({x, y, heading ? *heading : rng.Uniform(-M_PI, M_PI)});
+  }
+  for (const Placement2& p : out) AddBody(p.x, p.y, radius);
+  return out;
+}
+
 }  // namespace swarmsim

@@ -80,6 +80,19 @@ class Placer {
                                      double max_radius, double clearance, uint64_t stream,
                                      std::optional<double> heading = std::nullopt);
 
+  // `count` copies on a lattice (a world's `distribute: {lattice: ...}`):
+  // `columns` per row (copy k in row k / columns, column k % columns), rows
+  // `spacing` apart on a square lattice or spacing * sqrt(3) / 2 apart on a
+  // hexagonal one (odd rows shifted by spacing / 2 along x), the block
+  // centred in `region`; copy 0 at its lower-left (least x, least y).
+  // Headings as Distribute's. The result has fewer than `count` poses when
+  // copy k's disc of `radius` leaves the region or touches an obstacle or
+  // a placed body (*first_bad = k); bodies are kept only on success.
+  std::vector<Placement2> Lattice(const Region2& region, int64_t count, double radius,
+                                  double spacing, bool hexagonal, int64_t columns,
+                                  uint64_t stream, std::optional<double> heading,
+                                  int64_t* first_bad);
+
   // True if a disc at (x, y) of `radius` keeps `clearance` from every body
   // and obstacle (what Distribute checks for each candidate).
   bool IsFree(double x, double y, double radius, double clearance) const;

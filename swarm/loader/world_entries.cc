@@ -457,7 +457,7 @@ void WorldLoader::ReadDistribution(const Fields& f, const ValueReader& world_val
   entry->count_field = f.Require("count");
   entry->count = world_values.Integer(entry->count_field, 0, kMaxCount);
   Fields d(*file_, f.Get("distribute"), "'distribute'");
-  d.Expect({"region", "clearance", "heading_deg"});
+  d.Expect({"region", "clearance", "heading_deg", "lattice"});
   const Field region = d.Get("region");
   if (!region.present() || (region.node.IsScalar() && world_values.String(region) == "arena")) {
     if (!arena_)
@@ -486,11 +486,45 @@ void WorldLoader::ReadDistribution(const Fields& f, const ValueReader& world_val
   if (d.Has("heading_deg"))
     entry->heading = world_values.Number(d.Get("heading_deg"), kAngleDeg) * kDegToRad;
   const double r = entry->MaxFootprintRadius();
+  if (d.Has("lattice")) ReadLattice(d, world_values, r, entry);
   if (entry->count > 0 && (entry->region.max_x - entry->region.min_x < 2 * r ||
                            entry->region.max_y - entry->region.min_y < 2 * r))
     file_->Fail(entry->count_field.mark, "the region is too small for one " + model.name +
                                              " (footprint radius " + loader::FormatNumber(r) +
                                              " m)");
+}
+
+// distribute.lattice: {spacing, shape: square | hexagonal, columns}.
+void WorldLoader::ReadLattice(const Fields& d, const ValueReader& world_values,
+                              double footprint_radius, EntryPlan* entry) {
+  if (d.Has("clearance"))
+    file_->Fail(d.Get("clearance").key_mark,
+                "'clearance' is for random placement; a lattice's 'spacing' sets the gap");
+  const Field field = d.Get("lattice");
+  Fields l(*file_, field, "'lattice'");
+  l.Expect({"spacing", "shape", "columns"});
+  EntryPlan::LatticePlan plan;
+  plan.field = field;
+  const Field spacing = l.Require("spacing");
+  plan.spacing = world_values.Number(spacing, kPositiveLength);
+  if (plan.spacing < 2 * footprint_radius)
+    file_->Fail(spacing.mark, "a lattice 'spacing' of " + loader::FormatNumber(plan.spacing) +
+                                  " m is less than a " + entry->model->name +
+                                  "'s footprint diameter (" +
+                                  loader::FormatNumber(2 * footprint_radius) +
+                                  " m): neighbouring copies would overlap");
+  if (l.Has("shape")) {
+    const std::string shape = world_values.String(l.Get("shape"));
+    if (shape != "square" && shape != "hexagonal")
+      file_->Fail(l.Get("shape").mark,
+                  "'shape' must be square or hexagonal (got '" + shape + "')");
+    plan.hexagonal = shape == "hexagonal";
+  }
+  const int64_t square_side =
+      static_cast<int64_t>(std::ceil(std::sqrt(static_cast<double>(std::max<int64_t>(entry->count, 1)))));
+  plan.columns = l.Has("columns") ? world_values.Integer(l.Get("columns"), 1, kMaxCount)
+                                  : square_side;
+  entry->lattice = plan;
 }
 
 // position: one copy at a fixed pose.
@@ -563,6 +597,20 @@ void WorldLoader::PlaceEntries() {
   uint64_t stream = 0;
   for (EntryPlan& e : entries_) {
     if (!e.distribute) continue;
+    if (e.lattice) {
+      int64_t bad = -1;
+      e.placements = placer_->Lattice(e.region, e.count, e.MaxFootprintRadius(), e.lattice->spacing,
+                                      e.lattice->hexagonal, e.lattice->columns, stream++,
+                                      e.heading, &bad);
+      if (bad >= 0)
+        file_->Fail(e.lattice->field.mark,
+                    "the lattice does not fit: " + e.model->name + " copy " +
+                        std::to_string(bad) + " of " + std::to_string(e.count) + " would " +
+                        "leave " + e.region_text +
+                        " or overlap a wall, an obstacle, the map or another placed copy; "
+                        "enlarge the region, or reduce 'spacing' or 'count'");
+      continue;
+    }
     if (e.own_copies.empty()) {
       e.placements = placer_->Distribute(e.region, e.count, e.footprint.radius, e.clearance,
                                          stream++, e.heading);

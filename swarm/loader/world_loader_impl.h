@@ -76,6 +76,14 @@ struct EntryPlan {
   std::string region_text;  // "the arena", "the region [..] - [..]"
   double clearance = 0;
   std::optional<double> heading;
+  // distribute.lattice: copies on a square or hexagonal lattice instead of at random.
+  struct LatticePlan {
+    double spacing = 0;  // m
+    bool hexagonal = false;
+    int64_t columns = 0;
+    Field field;  // for messages
+  };
+  std::optional<LatticePlan> lattice;
   std::vector<Placement2> placements;
   // What the model file's sections (framework/model_section.h) read, one
   // per registered section (null: the key is absent), and what the entry's
@@ -170,6 +178,8 @@ class WorldLoader {
   void ResolvePythonController(const Fields& f, const ValueReader& world_values, EntryPlan* entry);
   void ResolveNativeController(const Fields& f, const ValueReader& world_values, EntryPlan* entry);
   void ReadDistribution(const Fields& f, const ValueReader& world_values, EntryPlan* entry);
+  void ReadLattice(const Fields& d, const ValueReader& world_values, double footprint_radius,
+                   EntryPlan* entry);
   void ReadSinglePosition(const Fields& f, const ValueReader& world_values, EntryPlan* entry);
   void KeepPlacementClearOfTheMap(std::vector<std::string>* warnings);
   void PlaceEntries();

@@ -193,5 +193,60 @@ TEST(PlacementTest, TooFullArenaIsAClearError) {
   }
 }
 
+
+// --- distribute.lattice ---------------------------------------------------------------
+
+TEST(PlacementTest, SquareLatticeIsCentredRowByRowFromTheLowerLeft) {
+  Placer placer(1);
+  int64_t bad = 0;
+  const Region2 region{-1, -1, 1, 1};
+  const std::vector<Placement2> p =
+      placer.Lattice(region, 7, 0.0165, 0.05, false, 3, 0, 0.0, &bad);
+  EXPECT_EQ(bad, -1);
+  ASSERT_EQ(p.size(), 7u);
+  // 3 columns, 3 rows (the last holds one): a 0.1 x 0.1 block centred at the origin.
+  EXPECT_DOUBLE_EQ(p[0].x, -0.05);
+  EXPECT_DOUBLE_EQ(p[0].y, -0.05);
+  EXPECT_DOUBLE_EQ(p[2].x, 0.05);
+  EXPECT_DOUBLE_EQ(p[3].y, 0.0);
+  EXPECT_DOUBLE_EQ(p[6].x, -0.05);
+  EXPECT_DOUBLE_EQ(p[6].y, 0.05);
+  for (const Placement2& q : p) EXPECT_EQ(q.yaw, 0.0);
+  EXPECT_EQ(placer.body_count(), 7u);  // later entries keep clear of them
+  EXPECT_FALSE(placer.IsFree(0, 0, 0.01, 0));
+}
+
+TEST(PlacementTest, HexagonalLatticeNeighboursAreAllOneSpacingApart) {
+  Placer placer(1);
+  int64_t bad = 0;
+  const double s = 0.06;
+  const std::vector<Placement2> p =
+      placer.Lattice({-1, -1, 1, 1}, 25, 0.0165, s, true, 5, 0, std::nullopt, &bad);
+  ASSERT_EQ(p.size(), 25u);
+  // Copy 12 (row 2, column 2) has six neighbours at exactly the spacing, no
+  // other copy closer than the spacing.
+  int at_spacing = 0;
+  for (size_t k = 0; k < p.size(); ++k) {
+    if (k == 12) continue;
+    const double d = std::hypot(p[k].x - p[12].x, p[k].y - p[12].y);
+    EXPECT_GE(d, s - 1e-12);
+    if (std::abs(d - s) < 1e-12) ++at_spacing;
+  }
+  EXPECT_EQ(at_spacing, 6);
+  EXPECT_GT(HeadingSpread(p), 1.0);  // random headings without heading_deg
+}
+
+TEST(PlacementTest, LatticeThatDoesNotFitNamesTheFirstCopyAndPlacesNothing) {
+  Placer placer(1);
+  placer.AddObstacle({Obstacle2::Kind::kCircle, 0.05, 0, 0.01});
+  int64_t bad = 0;
+  EXPECT_TRUE(placer.Lattice({-1, -1, 1, 1}, 9, 0.0165, 0.05, false, 3, 0, 0.0, &bad).empty());
+  EXPECT_EQ(bad, 5);  // row 1, column 2: (0.05, 0)
+  EXPECT_EQ(placer.body_count(), 0u);
+  EXPECT_TRUE(placer.Lattice({-0.05, -0.05, 0.05, 0.05}, 9, 0.0165, 0.05, false, 3, 0, 0.0, &bad)
+                  .empty());
+  EXPECT_EQ(bad, 0);  // the block is wider than the region
+}
+
 }  // namespace
 }  // namespace swarmsim

@@ -253,5 +253,39 @@ TEST_F(ControlLoaderTest, PlacementMistakesSayWhatToGive) {
       "world.yaml:3:31: the region is too small for one disc (footprint radius 0.5 m)");
 }
 
+TEST_F(ControlLoaderTest, ALatticePlacesCopiesInIndexOrderAtTheSpacing) {
+  Write("disc.yaml",
+        "model: disc\n"
+        "objects: {name: body, type: shape, shape: cylinder, radius: 0.0165, height: 0.03}\n");
+  LoadedWorld w = Load(
+      "simulation: {physics: kinematic}\n"
+      "models:\n"
+      "  - model: disc.yaml\n"
+      "    count: 6\n"
+      "    distribute: {region: {min: [1, 1], max: [2, 2]}, heading_deg: 0,\n"
+      "                 lattice: {spacing: 0.05, columns: 3}}\n");
+  const Scene& scene = w.world->scene();
+  ASSERT_EQ(scene.instances().size(), 6u);
+  for (int k = 0; k < 6; ++k) {
+    const Pose X = scene.world_pose(scene.instance(k).root);
+    EXPECT_NEAR(X.p.x, 1.45 + 0.05 * (k % 3), 1e-12) << k;
+    EXPECT_NEAR(X.p.y, 1.475 + 0.05 * (k / 3), 1e-12) << k;
+    EXPECT_NEAR(X.q.Yaw(), 0, 1e-12);
+  }
+  const std::string head =
+      "simulation: {physics: kinematic}\nmodels:\n  - {model: disc.yaml, count: 400, "
+      "distribute: {region: {min: [0, 0], max: [0.5, 0.5]}, ";
+  EXPECT_CONTAINS(ErrorOf(head + "lattice: {spacing: 0.03}}}\n"),
+                  "world.yaml:3:108: a lattice 'spacing' of 0.03 m is less than a disc's "
+                  "footprint diameter (0.033 m): neighbouring copies would overlap");
+  EXPECT_CONTAINS(ErrorOf(head + "lattice: {spacing: 0.05}}}\n"),
+                  "world.yaml:3:98: the lattice does not fit: disc copy 0 of 400 would leave the "
+                  "region from [0, 0] to [0.5, 0.5] or overlap");
+  EXPECT_CONTAINS(ErrorOf(head + "lattice: {spacing: 0.05, shape: round}}}\n"),
+                  "'shape' must be square or hexagonal (got 'round')");
+  EXPECT_CONTAINS(ErrorOf(head + "clearance: 0.01, lattice: {spacing: 0.05}}}\n"),
+                  "'clearance' is for random placement; a lattice's 'spacing' sets the gap");
+}
+
 }  // namespace
 }  // namespace swarmsim
