@@ -477,8 +477,8 @@ static int Init(const SwarmsimCallContext *c, void **state, char *error, size_t 
   uint64_t hard_seed = (uint64_t)(uniform(c->world, c->robot) * 4294967296.0);
   hard_seed = hard_seed << 32 | (uint64_t)(uniform(c->world, c->robot) * 4294967296.0);
   r->last_time = c->api->time(c->world);
-  double uid = c->robot;
-  c->api->number_parameter(c->world, c->robot, "kilo_uid", &uid);
+  double uid = Param(c, "kilo_uid", -1);
+  if (uid < 0) uid = c->robot;
 
   /* The program's main(): kilo_init, callbacks, kilo_start. */
   const kilobot_copy_t *t = copy->table;
