@@ -340,6 +340,7 @@ typedef struct {
   int crc_check;
   double tx_clock;           /* clock cycles since the last transmission */
   double tx_wait;            /* cycles of back-off left */
+  uint64_t backoff_state;    /* the back-off's generator (an LCG) */
   int tx_pending;            /* a message was queued last step */
   double last_time;
   int set_up;                /* setup() ran */
@@ -476,6 +477,7 @@ static int Init(const SwarmsimCallContext *c, void **state, char *error, size_t 
   r->tx_clock = 3906 * uniform(c->world, c->robot); /* robots start out of step */
   uint64_t hard_seed = (uint64_t)(uniform(c->world, c->robot) * 4294967296.0);
   hard_seed = hard_seed << 32 | (uint64_t)(uniform(c->world, c->robot) * 4294967296.0);
+  r->backoff_state = hard_seed ^ 0x5851f42d4c957f2dULL;
   r->last_time = c->api->time(c->world);
   double uid = Param(c, "kilo_uid", -1);
   if (uid < 0) uid = c->robot;
@@ -542,8 +544,9 @@ static int Step(const SwarmsimCallContext *c, void *state, char *error, size_t e
       what = "kilo_message_tx_success()", call.void_fn = *t->tx_success;
       sig = Guarded(&call);
     } else {
-      r->tx_wait = (double)(rt->hard_state >> 56); /* up to 255 cycles, as kilolib's rand() & 0xFF */
-      rt->hard_state = rt->hard_state * 6364136223846793005ULL + 1442695040888963407ULL;
+      /* 0..255 cycles, as kilolib's rand() & 0xFF */
+      r->backoff_state = r->backoff_state * 6364136223846793005ULL + 1442695040888963407ULL;
+      r->tx_wait = (double)(r->backoff_state >> 56);
     }
   }
   /* Messages heard, in arrival order (kilolib's receive interrupt). */

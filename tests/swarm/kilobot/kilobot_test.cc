@@ -16,9 +16,11 @@
 #include <set>
 #include <string>
 
+#include "framework/plugin_world_api.h"
 #include "framework/registry.h"
 #include "framework/scene.h"
 #include "framework/world.h"
+#include "modules/blobs/leds.h"
 #include "modules/builtin.h"
 #include "swarm/loader/world_loader.h"
 #include "tests/swarm/run_program.h"
@@ -287,6 +289,50 @@ int main() { kilo_init(); kilo_start(setup, loop); return 0; }
   const std::vector<Pose2> end = Run(dir / "world.yaml", 32, 1);
   for (size_t i = 0; i < start.size(); ++i)
     EXPECT_NEAR(AngleDifference(end[i].yaw, start[i].yaw), 0, 2 * kPi / 180) << "robot " << i;
+  fs::remove_all(dir);
+}
+
+// ---- LED ----
+
+// set_color's 2-bit channels reach the LED ./led: r/3, g/3, b/3, off for
+// RGB(0, 0, 0). (Skipped while the world API's set_led is a stub.)
+TEST(KilobotTest, SetColorReachesTheLed) {
+  const fs::path dir = Dir("color");
+  const CommandResult built = Build(dir, "colors", R"(#include <kilolib.h>
+void setup() {}
+void loop() {
+  if (kilo_uid == 0) set_color(RGB(3, 0, 0));
+  else if (kilo_uid == 1) set_color(RGB(1, 2, 3));
+  else set_color(RGB(0, 0, 0));
+}
+int main() { kilo_init(); kilo_start(setup, loop); return 0; }
+)");
+  ASSERT_EQ(built.exit_code, 0) << built.output;
+  Write(dir / "world.yaml", World("colors", "planar", 3, 0.5));
+  ModuleRegistry registry;
+  RegisterBuiltinModules(&registry);
+  LoadedWorld w = LoadWorld((dir / "world.yaml").string(), LoadOptions{}, registry);
+  w.world->set_log_sink([](std::string_view) {});
+  Scene& scene = w.world->scene();
+  const ObjectId led0 = scene.FindObject("./led", scene.instance(0).root);
+  if (PluginWorldApi()->set_led(w.world.get(), 0, led0.ToInteger(), 1, 1, 1, 1) != 0)
+    GTEST_SKIP() << "the world API's set_led is a stub on this build";
+  w.world->Start();
+  w.world->Step();
+  ObjectType led_type;
+  ASSERT_TRUE(scene.FindType(kLedTypeName, &led_type));
+  const auto led = [&](int robot) {
+    return scene.row<LedRow>(led_type, scene.FindObject("./led", scene.instance(robot).root),
+                             "led");
+  };
+  EXPECT_TRUE(led(0).on);
+  EXPECT_EQ(led(0).color.x, 1);
+  EXPECT_EQ(led(0).color.y, 0);
+  EXPECT_NEAR(led(1).color.x, 1.0 / 3, 1e-12);
+  EXPECT_NEAR(led(1).color.y, 2.0 / 3, 1e-12);
+  EXPECT_EQ(led(1).color.z, 1);
+  EXPECT_FALSE(led(2).on);
+  w.world->Stop();
   fs::remove_all(dir);
 }
 
