@@ -124,7 +124,9 @@ TEST(KilobotTest, GlobalsAreEachRobotsOwnAtAnyThreadCount) {
     }
     // kilo_uid is the robot index: 150 distinct ones.
     EXPECT_EQ(uids.size(), 150u) << run.output.substr(0, 2000);
-    if (!uids.empty()) EXPECT_EQ(*uids.rbegin(), 149);
+    if (!uids.empty()) {
+      EXPECT_EQ(*uids.rbegin(), 149);
+    }
   }
   fs::remove_all(dir);
 }
@@ -197,7 +199,7 @@ struct Pose2 {
   double x, y, yaw;
 };
 
-std::vector<Pose2> Run(const fs::path& world, int steps, int threads, uint64_t* hash = nullptr) {
+std::vector<Pose2> RunWorld(const fs::path& world, int steps, int threads, uint64_t* hash = nullptr) {
   ModuleRegistry registry;
   RegisterBuiltinModules(&registry);
   LoadOptions options;
@@ -235,8 +237,8 @@ TEST_P(KilobotMotionTest, MotorsMoveAtThePublishedSpeeds) {
   Write(dir / "world.yaml", world);
   const int steps = 64;  // 2 s
   const double seconds = steps / 32.0;
-  const std::vector<Pose2> start = Run(dir / "world.yaml", 0, 1);
-  const std::vector<Pose2> end = Run(dir / "world.yaml", steps, 1);
+  const std::vector<Pose2> start = RunWorld(dir / "world.yaml", 0, 1);
+  const std::vector<Pose2> end = RunWorld(dir / "world.yaml", steps, 1);
   ASSERT_EQ(end.size(), 5u);
   // Straight: about 1 cm/s along +x (Rubenstein et al. 2012), no turn.
   EXPECT_NEAR((end[0].x - start[0].x) / seconds, 0.01, 0.001);
@@ -285,8 +287,8 @@ int main() { kilo_init(); kilo_start(setup, loop); return 0; }
   EXPECT_GT(pairs.size(), 10u) << run.output;
   // Straight on its own values: heading kept within rounding (one duty unit
   // in 56..84 turns it at most ~1 deg/s).
-  const std::vector<Pose2> start = Run(dir / "world.yaml", 0, 1);
-  const std::vector<Pose2> end = Run(dir / "world.yaml", 32, 1);
+  const std::vector<Pose2> start = RunWorld(dir / "world.yaml", 0, 1);
+  const std::vector<Pose2> end = RunWorld(dir / "world.yaml", 32, 1);
   for (size_t i = 0; i < start.size(); ++i)
     EXPECT_NEAR(AngleDifference(end[i].yaw, start[i].yaw), 0, 2 * kPi / 180) << "robot " << i;
   fs::remove_all(dir);
@@ -362,11 +364,11 @@ TEST(KilobotTest, SameHashAtOneAndTwoThreadsWhicheverCopyRanARobot) {
   ASSERT_EQ(built.exit_code, 0) << built.output;
   Write(dir / "world.yaml", World("walk", "planar", 400, 1.2));
   uint64_t one = 0, two = 0;
-  const std::vector<Pose2> a = Run(dir / "world.yaml", 100, 1, &one);
-  const std::vector<Pose2> b = Run(dir / "world.yaml", 100, 2, &two);
+  const std::vector<Pose2> a = RunWorld(dir / "world.yaml", 100, 1, &one);
+  const std::vector<Pose2> b = RunWorld(dir / "world.yaml", 100, 2, &two);
   EXPECT_EQ(one, two);
   // They moved, and not all alike.
-  const std::vector<Pose2> start = Run(dir / "world.yaml", 0, 1);
+  const std::vector<Pose2> start = RunWorld(dir / "world.yaml", 0, 1);
   std::set<long> headings;
   for (size_t i = 0; i < a.size(); ++i) {
     EXPECT_GT(std::hypot(a[i].x - start[i].x, a[i].y - start[i].y) +
