@@ -126,7 +126,7 @@ static int AddCopy(const kilobot_copy_t *table) {
 /* Copy 0 is this one; the others are loaded from this file. */
 static int LoadCopies(void) {
   long cpus = sysconf(_SC_NPROCESSORS_ONLN);
-  int wanted = cpus > 0 ? (int)(2 * cpus) : 2;
+  int wanted = cpus > 0 ? (int)(8 * cpus) : 8;
   const char *env = getenv("SWARMSIM_KILOBOT_COPIES");
   if (env != NULL && atoi(env) > 0) wanted = atoi(env);
   if (wanted > kMaxCopies) wanted = kMaxCopies;
@@ -145,6 +145,19 @@ static void Lock(Copy *c) {
   while (atomic_flag_test_and_set_explicit(&c->lock, memory_order_acquire)) sched_yield();
 }
 static void Unlock(Copy *c) { atomic_flag_clear_explicit(&c->lock, memory_order_release); }
+
+/* The copy robot `robot` runs on: its block of kBlock robots, hashed, so
+ * that two workers on two contiguous ranges that meet on one copy part at
+ * the next block instead of going on in step. */
+static int CopyOf(int robot) {
+  uint32_t block = (uint32_t)robot / kBlock;
+  block ^= block >> 16;
+  block *= 0x7feb352dU;
+  block ^= block >> 15;
+  block *= 0x846ca68bU;
+  block ^= block >> 16;
+  return (int)(block % (uint32_t)g_copy_count);
+}
 
 /* ---- faults and the watchdog ---- */
 
@@ -330,7 +343,7 @@ static int Guarded(Call *call) {
 
 typedef struct {
   int copy;
-  char *image;               /* its data then bss */
+  char *image;               /* its region (right after this struct) */
   int64_t left, right;       /* ./leftMotor, ./rightMotor */
   int64_t led, light, ir;    /* 0: none */
   double true_left, true_right; /* duty cycles giving forward_speed */
@@ -427,19 +440,19 @@ static int Init(const SwarmsimCallContext *c, void **state, char *error, size_t 
     snprintf(error, error_size, "the plugin could not load its program: %s", g_load_error);
     return -1;
   }
-  Robot *r = calloc(1, sizeof *r);
+  const int copy_index = CopyOf(c->robot);
+  Copy *copy = &g_copies[copy_index];
+  /* The robot's host state and its image in one block: fewer cache lines. */
+  const size_t head = (sizeof(Robot) + 63) / 64 * 64;
+  Robot *r = aligned_alloc(64, head + (copy->size + 63) / 64 * 64);
   if (r == NULL) {
     snprintf(error, error_size, "out of memory");
     return -1;
   }
+  memset(r, 0, sizeof *r);
   *state = r;
-  r->copy = (c->robot / kBlock) % g_copy_count;
-  Copy *copy = &g_copies[r->copy];
-  r->image = malloc(copy->size + 1);
-  if (r->image == NULL) {
-    snprintf(error, error_size, "out of memory");
-    return -1;
-  }
+  r->copy = copy_index;
+  r->image = (char *)r + head;
   memcpy(r->image, copy->pristine, copy->size);
   r->left = Find(c, "./leftMotor");
   r->right = Find(c, "./rightMotor");
@@ -612,10 +625,7 @@ static int Step(const SwarmsimCallContext *c, void *state, char *error, size_t e
 
 static void Cleanup(const SwarmsimCallContext *c, void *state, void *unused) {
   (void)c, (void)unused;
-  Robot *r = state;
-  if (r == NULL) return;
-  free(r->image);
-  free(r);
+  free(state); /* the Robot and its image */
 }
 
 __attribute__((visibility("default"))) int swarmsim_plugin_abi_version(void) {
