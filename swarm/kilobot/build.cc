@@ -108,8 +108,10 @@ int Rename(const fs::path& object, bool program) {
     return 1;
   }
   std::vector<std::string> argv = {Tool("OBJCOPY", "objcopy")};
-  for (const std::string& name : info.data) argv.push_back("--rename-section=" + name + "=kilo_data");
-  for (const std::string& name : info.bss) argv.push_back("--rename-section=" + name + "=kilo_data,alloc,load,contents,data");
+  for (const std::string& name : info.data)
+    argv.push_back("--rename-section=" + name + "=kilo_data");
+  for (const std::string& name : info.bss)
+    argv.push_back("--rename-section=" + name + "=kilo_data,alloc,load,contents,data");
   if (program) argv.push_back("--redefine-sym=main=kilobot_program_main");
   argv.push_back(object.string());
   return Run(argv);
@@ -156,7 +158,8 @@ std::string RuntimeFolder() {
     return SWARMSIM_KILOBOT_SOURCE_DIR;
   // An install: bin/swarmsim and share/swarmsim/kilobot.
   const fs::path installed = ProgramFolder() / ".." / "share" / "swarmsim" / "kilobot";
-  if (fs::exists(installed / "runtime" / "host.c", ec)) return installed.lexically_normal().string();
+  if (fs::exists(installed / "runtime" / "host.c", ec))
+    return installed.lexically_normal().string();
   throw Error(std::string("cannot find the Kilobot runtime (include/, runtime/): not at ") +
               SWARMSIM_KILOBOT_SOURCE_DIR + " nor " + installed.string() +
               " ($SWARMSIM_KILOBOT_DIR names its folder)");
@@ -180,8 +183,8 @@ int Build(const BuildOptions& options) {
   if (!fs::exists(root / "framework" / "plugin_api.h", ec)) root = folder;
   TempFolder temp;
   const std::string cc = Tool("CC", "cc");
-  const std::vector<std::string> common = {"-fPIC", "-O2", "-fno-common", "-g0",
-                                           "-DSWARMSIM_KILOBOT=1", "-I" + include.string()};
+  const std::vector<std::string> common = {
+      "-fPIC", "-O2", "-fno-common", "-g0", "-DSWARMSIM_KILOBOT=1", "-I" + include.string()};
   const auto compile = [&](const fs::path& file, const fs::path& object,
                            const std::vector<std::string>& extra) {
     std::vector<std::string> argv = {cc};
@@ -243,8 +246,8 @@ int Build(const BuildOptions& options) {
                                          "-ldl"};
   if (const int status = Run(link); status != 0) {
     fs::remove(partial, ec);
-    std::cerr << "error: " << source.string() << " does not link (" << cc
-              << " exited with status " << status << "; its messages are above)\n";
+    std::cerr << "error: " << source.string() << " does not link (" << cc << " exited with status "
+              << status << "; its messages are above)\n";
     return 2;
   }
   fs::rename(partial, output, ec);

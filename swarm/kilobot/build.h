@@ -14,11 +14,11 @@
 namespace swarmsim::kilobot {
 
 struct BuildOptions {
-  std::string source;                // the program, a .c file
-  std::string output;                // the plugin; empty: NAME.so beside the source
-  std::string name;                  // the controller; empty: the source's stem
-  std::vector<std::string> cc_flags; // passed to the compiler after ours
-  bool quiet = false;                // no "built ..." line
+  std::string source;                 // the program, a .c file
+  std::string output;                 // the plugin; empty: NAME.so beside the source
+  std::string name;                   // the controller; empty: the source's stem
+  std::vector<std::string> cc_flags;  // passed to the compiler after ours
+  bool quiet = false;                 // no "built ..." line
 };
 
 // Builds the plugin. Returns 0, or a nonzero exit code after printing why

@@ -15,7 +15,7 @@
 #include "message_crc.h"
 
 /* LED colour from 2-bit channels (0 off .. 3 full): set_color(RGB(0, 3, 0)). */
-#define RGB(r, g, b) (((r) & 3) | (((g) & 3) << 2) | (((b) & 3) << 4))
+#define RGB(r, g, b) (((r)&3) | (((g)&3) << 2) | (((b)&3) << 4))
 /* kilo_ticks per second (the clock ticks about every 32 ms). */
 #define TICKS_PER_SEC 31
 

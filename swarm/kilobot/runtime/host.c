@@ -96,7 +96,8 @@ static const kilobot_copy_t *LoadCopy(const char *path) {
   if (in >= 0) close(in);
   close(out);
   void *handle = ok ? dlopen(temp, RTLD_NOW | RTLD_LOCAL) : NULL;
-  if (!ok) snprintf(g_load_error, sizeof g_load_error, "cannot copy %s to %s", path, temp);
+  if (!ok)
+    snprintf(g_load_error, sizeof g_load_error, "cannot copy %s to %s", path, temp);
   else if (handle == NULL)
     snprintf(g_load_error, sizeof g_load_error, "cannot load a copy of %s: %s", path, dlerror());
   unlink(temp);
@@ -163,15 +164,15 @@ static int CopyOf(int robot) {
 
 typedef struct {
   pthread_t thread;
-  atomic_ulong calls;   /* calls into the program begun */
-  atomic_int busy;      /* in the program now */
-  atomic_int expired;   /* the watchdog interrupted it */
+  atomic_ulong calls; /* calls into the program begun */
+  atomic_int busy;    /* in the program now */
+  atomic_int expired; /* the watchdog interrupted it */
 } Slot;
 
 enum { kMaxSlots = 512 };
 static Slot g_slots[kMaxSlots];
 static atomic_int g_slot_count;
-static atomic_int g_timeout_ms;  /* 0: no watchdog */
+static atomic_int g_timeout_ms; /* 0: no watchdog */
 static pthread_once_t g_signals_once = PTHREAD_ONCE_INIT;
 static pthread_once_t g_watchdog_once = PTHREAD_ONCE_INIT;
 static struct sigaction g_old_actions[65];
@@ -180,7 +181,7 @@ static const int kFaultSignals[] = {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT};
 
 /* Per thread, in one block (one TLS lookup in a loaded library). */
 typedef struct {
-  sigjmp_buf *jump;             /* where a fault in the program returns to */
+  sigjmp_buf *jump;              /* where a fault in the program returns to */
   volatile sig_atomic_t in_user; /* the thread runs the program's code */
   Slot *slot;
   char *stack_low; /* lowest address of the thread's stack */
@@ -343,20 +344,20 @@ static int Guarded(Call *call) {
 
 typedef struct {
   int copy;
-  char *image;               /* its region (right after this struct) */
-  int64_t left, right;       /* ./leftMotor, ./rightMotor */
-  int64_t led, light, ir;    /* 0: none */
+  char *image;                  /* its region (right after this struct) */
+  int64_t left, right;          /* ./leftMotor, ./rightMotor */
+  int64_t led, light, ir;       /* 0: none */
   double true_left, true_right; /* duty cycles giving forward_speed */
   double speed, leg_radius, stall;
   double ambient_scale;
   int16_t voltage, temperature;
   int crc_check;
-  double tx_clock;           /* clock cycles since the last transmission */
-  double tx_wait;            /* cycles of back-off left */
-  uint64_t backoff_state;    /* the back-off's generator (an LCG) */
-  int tx_pending;            /* a message was queued last step */
+  double tx_clock;        /* clock cycles since the last transmission */
+  double tx_wait;         /* cycles of back-off left */
+  uint64_t backoff_state; /* the back-off's generator (an LCG) */
+  int tx_pending;         /* a message was queued last step */
   double last_time;
-  int set_up;                /* setup() ran */
+  int set_up;                             /* setup() ran */
   uint8_t motor_left, motor_right, color; /* as last applied */
   int motors_applied, color_applied;
 } Robot;
@@ -415,12 +416,10 @@ static void Failure(const SwarmsimCallContext *c, int sig, const char *what, cha
 static const double kCyclesPerSecond = 8e6 / 1024;
 
 static void ApplyOutputs(const SwarmsimCallContext *c, Robot *r, const kilobot_robot_t *rt) {
-  if (!r->motors_applied || rt->motor_left != r->motor_left ||
-      rt->motor_right != r->motor_right) {
+  if (!r->motors_applied || rt->motor_left != r->motor_left || rt->motor_right != r->motor_right) {
     r->motor_left = rt->motor_left, r->motor_right = rt->motor_right, r->motors_applied = 1;
     const double left = r->motor_left < r->stall ? 0 : r->speed * r->motor_left / r->true_left;
-    const double right =
-        r->motor_right < r->stall ? 0 : r->speed * r->motor_right / r->true_right;
+    const double right = r->motor_right < r->stall ? 0 : r->speed * r->motor_right / r->true_right;
     c->api->set_joint_target_velocity(c->world, c->robot, r->left, left / r->leg_radius);
     c->api->set_joint_target_velocity(c->world, c->robot, r->right, right / r->leg_radius);
   }
@@ -500,7 +499,8 @@ static int Init(const SwarmsimCallContext *c, void **state, char *error, size_t 
   Lock(copy);
   SwapIn(copy, r);
   *t->uid = (uint16_t)uid;
-  const double left = lround(r->true_left + error_left), right = lround(r->true_right + error_right);
+  const double left = lround(r->true_left + error_left),
+               right = lround(r->true_right + error_right);
   *t->straight_left = *t->turn_left = (uint8_t)(left < 0 ? 0 : left > 255 ? 255 : left);
   *t->straight_right = *t->turn_right = (uint8_t)(right < 0 ? 0 : right > 255 ? 255 : right);
   t->robot->hard_state = hard_seed;
@@ -637,6 +637,6 @@ __attribute__((visibility("default"))) int swarmsim_plugin_register(const Swarms
     snprintf(g_load_error, sizeof g_load_error, "out of memory");
   pthread_once(&g_signals_once, InstallHandlers);
   r->set_info(r->impl, KILOBOT_NAME, "1.0", "Kilobot program " KILOBOT_SOURCE " (swarm/kilobot)");
-  return r->add_controller(r->impl, KILOBOT_NAME, "runs the Kilobot program " KILOBOT_SOURCE,
-                           Init, Step, Cleanup, NULL);
+  return r->add_controller(r->impl, KILOBOT_NAME, "runs the Kilobot program " KILOBOT_SOURCE, Init,
+                           Step, Cleanup, NULL);
 }

@@ -15,11 +15,11 @@
 typedef struct {
   void (*setup)(void); /* kilo_start's */
   void (*loop)(void);
-  uint8_t motor_left, motor_right; /* set_motors' duty cycles */
-  uint8_t color;                   /* set_color's */
-  uint8_t started;                 /* kilo_start was called */
-  int16_t ambient;                 /* get_ambientlight's value this step (-1: none) */
-  int16_t voltage, temperature;    /* get_voltage's, get_temperature's */
+  uint8_t motor_left, motor_right;     /* set_motors' duty cycles */
+  uint8_t color;                       /* set_color's */
+  uint8_t started;                     /* kilo_start was called */
+  int16_t ambient;                     /* get_ambientlight's value this step (-1: none) */
+  int16_t voltage, temperature;        /* get_voltage's, get_temperature's */
   uint8_t soft_seed, soft_accumulator; /* rand_soft's generator (kilolib's) */
   uint64_t hard_state;                 /* rand_hard's generator, seeded by the host */
   uint32_t libc_rand;                  /* rand()'s state (avr-libc's algorithm) */

@@ -52,8 +52,8 @@ std::string Model() { return std::string(SWARMSIM_SOURCE_DIR) + "/worlds/models/
 
 // A world of Kilobots running `program`: `robots` copies spread over a
 // square of side `size`, or one robot per entry of `positions`.
-std::string World(const std::string& program, const std::string& physics, int robots,
-                  double size, const std::string& parameters = "{}") {
+std::string World(const std::string& program, const std::string& physics, int robots, double size,
+                  const std::string& parameters = "{}") {
   return "plugins: [" + program + "]\nsimulation: {physics: " + physics +
          ", time_step: 0.03125, physics_substeps: 4, seed: 1}\n"
          "arena: {size: " +
@@ -106,10 +106,9 @@ TEST(KilobotTest, GlobalsAreEachRobotsOwnAtAnyThreadCount) {
   ASSERT_TRUE(fs::exists(dir / "counter.so"));
   Write(dir / "world.yaml", World("counter", "planar", 150, 1.5));
   for (int threads : {1, 2}) {
-    const CommandResult run = RunProgram("run " + (dir / "world.yaml").string() +
-                                         " --steps 200 --quiet --threads " +
-                                         std::to_string(threads) + " --out " +
-                                         (dir / "out").string());
+    const CommandResult run =
+        RunProgram("run " + (dir / "world.yaml").string() + " --steps 200 --quiet --threads " +
+                   std::to_string(threads) + " --out " + (dir / "out").string());
     ASSERT_EQ(run.exit_code, 0) << run.output;
     std::set<int> uids;
     const std::regex line("uid (\\d+) loops (\\d+) counter (\\d+) calls (\\d+)");
@@ -153,9 +152,8 @@ int main() { kilo_init(); kilo_start(setup, loop); return 0; }
 )");
   ASSERT_EQ(built.exit_code, 0) << built.output;
   Write(dir / "world.yaml", World("randsoft", "planar", 1, 0.5));
-  const CommandResult run =
-      RunProgram("run " + (dir / "world.yaml").string() + " --steps 1 --quiet --out " +
-                 (dir / "out").string());
+  const CommandResult run = RunProgram("run " + (dir / "world.yaml").string() +
+                                       " --steps 1 --quiet --out " + (dir / "out").string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
   // kilolib.c's rand_soft: seed 0xaa, accumulator 0; rand_seed sets the
   // seed only (the accumulator goes on).
@@ -199,7 +197,8 @@ struct Pose2 {
   double x, y, yaw;
 };
 
-std::vector<Pose2> RunWorld(const fs::path& world, int steps, int threads, uint64_t* hash = nullptr) {
+std::vector<Pose2> RunWorld(const fs::path& world, int steps, int threads,
+                            uint64_t* hash = nullptr) {
   ModuleRegistry registry;
   RegisterBuiltinModules(&registry);
   LoadOptions options;
@@ -382,8 +381,8 @@ TEST(KilobotTest, SameHashAtOneAndTwoThreadsWhicheverCopyRanARobot) {
   std::string hashes[2];
   for (int k = 0; k < 2; ++k) {
     const CommandResult run = testing::RunCommand(
-        std::string("SWARMSIM_KILOBOT_COPIES=") + (k == 0 ? "1" : "3") + " " +
-        SWARMSIM_BINARY + " run " + (dir / "world.yaml").string() + " --steps 100 --hash --threads " +
+        std::string("SWARMSIM_KILOBOT_COPIES=") + (k == 0 ? "1" : "3") + " " + SWARMSIM_BINARY +
+        " run " + (dir / "world.yaml").string() + " --steps 100 --hash --threads " +
         (k == 0 ? "1" : "2") + " --quiet --out " + (dir / "out").string());
     ASSERT_EQ(run.exit_code, 0) << run.output;
     const size_t at = run.output.find("state-hash: ");
@@ -421,23 +420,22 @@ int main() { kilo_init(); kilo_start(setup, loop); return 0; }
 // A program that fails on robot 3 only (after a few ticks): the run ends
 // with an error naming the program and the robot, exit 1, summary.json
 // written with status error.
-void ExpectRunFails(const std::string& name, const std::string& body,
-                    const std::string& message) {
+void ExpectRunFails(const std::string& name, const std::string& body, const std::string& message) {
   const fs::path dir = Dir(name);
-  const CommandResult built =
-      Build(dir, name,
-            "#include <kilolib.h>\n" + body +
-                "\nvoid setup() {}\nint main() { kilo_init(); kilo_start(setup, loop); return 0; }\n");
+  const CommandResult built = Build(
+      dir, name,
+      "#include <kilolib.h>\n" + body +
+          "\nvoid setup() {}\nint main() { kilo_init(); kilo_start(setup, loop); return 0; }\n");
   ASSERT_EQ(built.exit_code, 0) << built.output;
-  Write(dir / "world.yaml",
-        World(name, "planar", 8, 0.5, "{program_timeout: 0.5}"));
-  const CommandResult run = RunProgram("run " + (dir / "world.yaml").string() +
-                                       " --steps 40 --quiet --threads 2 --out " +
-                                       (dir / "out").string());
+  Write(dir / "world.yaml", World(name, "planar", 8, 0.5, "{program_timeout: 0.5}"));
+  const CommandResult run =
+      RunProgram("run " + (dir / "world.yaml").string() + " --steps 40 --quiet --threads 2 --out " +
+                 (dir / "out").string());
   EXPECT_EQ(run.exit_code, 1) << run.output;
   const std::string expected =
       (dir / (name + ".c")).string() + " (kilobot program '" + name + "'), robot 3: " + message;
-  EXPECT_NE(run.output.find(expected), std::string::npos) << run.output << "\nexpected: " << expected;
+  EXPECT_NE(run.output.find(expected), std::string::npos)
+      << run.output << "\nexpected: " << expected;
   std::ifstream summary(dir / "out" / "summary.json");
   ASSERT_TRUE(summary.good());
   EXPECT_EQ(nlohmann::json::parse(summary)["status"], "error");
