@@ -165,10 +165,10 @@ int main() { kilo_init(); kilo_start(setup, loop); return 0; }
     return static_cast<int>(seed);
   };
   std::string expected = "default";
-  for (int i = 0; i < 12; ++i) expected += " " + std::to_string(next());
+  for (int i = 0; i < 12; ++i) expected.append(" ").append(std::to_string(next()));
   expected += "\nseed42";
   seed = 42;
-  for (int i = 0; i < 12; ++i) expected += " " + std::to_string(next());
+  for (int i = 0; i < 12; ++i) expected.append(" ").append(std::to_string(next()));
   EXPECT_NE(run.output.find(expected), std::string::npos) << run.output << "\nexpected:\n"
                                                           << expected;
   fs::remove_all(dir);
