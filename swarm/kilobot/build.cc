@@ -257,7 +257,8 @@ int Build(const BuildOptions& options) {
   }
   if (!options.quiet)
     std::cout << "built " << output.string() << ": native controller '" << name
-              << "' (a world loads it with plugins: [" << name << "])\n";
+              << "' (a world: plugins: [" << output.stem().string()
+              << "], and native_controller: " << name << ")\n";
   return 0;
 }
 
