@@ -130,6 +130,54 @@ TEST(KilobotTest, GlobalsAreEachRobotsOwnAtAnyThreadCount) {
   fs::remove_all(dir);
 }
 
+// A program written for Kilombo: its USERDATA (mydata) is each robot's own,
+// built as for a Kilobot (AVR headers included) and with -DSIMULATOR.
+TEST(KilobotTest, KilomboProgramsKeepTheirUserdataPerRobot) {
+  const fs::path dir = Dir("kilombo");
+  const std::string program = R"(#include <kilombo.h>
+#ifdef SIMULATOR
+#include <stdio.h>
+#else
+#include <avr/io.h>
+#include <util/delay.h>
+#define DEBUG
+#include <debug.h>
+#endif
+typedef struct { uint32_t sum; uint32_t loops; } USERDATA;
+REGISTER_USERDATA(USERDATA)
+void setup() { mydata->sum = 0; }
+void loop() {
+  mydata->sum += kilo_uid + 1;
+  if (++mydata->loops == 10) printf("uid %u sum %u\n", kilo_uid, mydata->sum);
+}
+#ifdef SIMULATOR
+char *botinfo(void) { return "a Kilombo hook, never called"; }
+#endif
+int main() { kilo_init(); SET_CALLBACK(botinfo, botinfo); kilo_start(setup, loop); return 0; }
+)";
+  std::ofstream(dir / "kilombo_avr.c") << program;
+  std::ofstream(dir / "kilombo_sim.c") << program;
+  const CommandResult avr = RunProgram("kilobot build " + (dir / "kilombo_avr.c").string());
+  ASSERT_EQ(avr.exit_code, 0) << avr.output;
+  const CommandResult sim =
+      RunProgram("kilobot build " + (dir / "kilombo_sim.c").string() + " -- -DSIMULATOR");
+  ASSERT_EQ(sim.exit_code, 0) << sim.output;
+  for (const std::string name : {"kilombo_avr", "kilombo_sim"}) {
+    Write(dir / "world.yaml", World(name, "planar", 30, 1));
+    const CommandResult run =
+        RunProgram("run " + (dir / "world.yaml").string() +
+                   " --steps 12 --quiet --threads 2 --out " + (dir / "out").string());
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    int seen = 0;
+    const std::regex line("uid (\\d+) sum (\\d+)");
+    for (std::sregex_iterator it(run.output.begin(), run.output.end(), line), end; it != end;
+         ++it, ++seen)
+      EXPECT_EQ(std::stol((*it)[2]), 10 * (std::stol((*it)[1]) + 1)) << name;
+    EXPECT_EQ(seen, 30) << name << ": " << run.output;
+  }
+  fs::remove_all(dir);
+}
+
 // ---- kilolib's software generator ----
 
 TEST(KilobotTest, RandSoftGivesKilolibsSequence) {
