@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "swarm/bench/scaling.h"
+#include "swarm/kilobot/build.h"
 #include "swarm/sweep/report.h"
 #include "swarm/sweep/sweep.h"
 
@@ -58,6 +59,13 @@ struct RunArgs {
 CLI::App* AddRunCommand(CLI::App* app, RunArgs* args);
 // Loads the world (the plugins first into `registry`) and runs it.
 int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegistry* registry);
+
+// swarmsim kilobot build PROG.c (kilobot_command.cc)
+struct KilobotArgs {
+  kilobot::BuildOptions options;
+};
+CLI::App* AddKilobotCommand(CLI::App* app, KilobotArgs* args);
+int KilobotCommand(const KilobotArgs& args);
 
 // swarmsim record-info DIR (record_info_command.cc)
 CLI::App* AddRecordInfoCommand(CLI::App* app, std::string* path);

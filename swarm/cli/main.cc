@@ -45,6 +45,8 @@ int Main(int argc, char** argv) {
   const CLI::App* version = AddVersionCommand(&app);
   std::string record_info_path;
   const CLI::App* record_info = AddRecordInfoCommand(&app, &record_info_path);
+  KilobotArgs kilobot_args;
+  const CLI::App* kilobot = AddKilobotCommand(&app, &kilobot_args);
 
   const std::vector<std::string> args(argv + std::min(argc, 1), argv + argc);
   try {
@@ -74,6 +76,7 @@ int Main(int argc, char** argv) {
 
   if (*version) return VersionCommand();
   if (*record_info) return RecordInfoCommand(record_info_path);
+  if (*kilobot) return KilobotCommand(kilobot_args);
   if (*describe) return DescribeCommand(describe_args, registry);
   if (*modules) return ModulesCommand(registry);
   if (*view) return ViewCommand(view_args);
