@@ -203,10 +203,14 @@ TEST(KilobotMessagingTest, GradientFormsAndRobotsSendTwiceASecond) {
   world.robots = 12;
   RunSteps(c, &world, 32 * 20);  // 20 s
   // Robot i is ceil(i / 2) hops from robot 0 (neighbours within 100 mm are
-  // 1 or 2 places away); the LED shows the hop count modulo 4.
-  const std::array<double, 3> colors[4] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 0}};
-  for (int i = 0; i < world.robots; ++i)
-    EXPECT_EQ(world.led[i], colors[((i + 1) / 2) % 4]) << "robot " << i;
+  // 1 or 2 places away); the LED shows the hop count + 1 in base 4 (red
+  // ones, green fours, blue sixteens, each channel 0..3 as 0..1).
+  for (int i = 0; i < world.robots; ++i) {
+    const int code = (i + 1) / 2 + 1;
+    const std::array<double, 3> color = {(code & 3) / 3.0, ((code >> 2) & 3) / 3.0,
+                                         ((code >> 4) & 3) / 3.0};
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(world.led[i][k], color[k], 1e-12) << "robot " << i;
+  }
   // kilo_tx_period 3906 cycles of 8 MHz / 1024: 0.5 s.
   for (int i = 0; i < world.robots; ++i) EXPECT_NEAR(world.attempts[i], 40, 2) << "robot " << i;
   fs::remove_all(dir);

@@ -1,0 +1,79 @@
+// Orbit: one robot circles a stationary one, keeping its distance.
+//
+// Written here from kilolib's documentation as the classic Kilobot "orbit"
+// exercise. The star (kilo_uid 0) stays still and broadcasts; the planet
+// (every other robot) uses estimate_distance on each message from the star
+// and steers: too close -> straight ahead (away, once it has turned past
+// the star), closer than DESIRED -> turn left, farther -> turn right. Its
+// distance to the star then stays in a band about DESIRED while it travels
+// around it. LED: the star blue; the planet green while turning left, red
+// while turning right, white while going straight.
+//
+//   swarmsim kilobot build worlds/kilobot/orbit.c
+//   swarmsim run worlds/kilobot/orbit.yaml
+#include <kilolib.h>
+
+#define STAR_UID 0
+#define DESIRED_MM 60
+#define TOO_CLOSE_MM 40
+
+enum motion { STOP, FORWARD, LEFT, RIGHT };
+
+uint8_t motion = STOP;
+uint8_t distance_mm = 0;
+uint8_t heard = 0;
+message_t message;
+
+void set_motion(uint8_t next) {
+  if (next == motion) return;
+  motion = next;
+  if (next == STOP) {
+    set_motors(0, 0);
+    return;
+  }
+  spinup_motors();
+  if (next == FORWARD) {
+    set_motors(kilo_straight_left, kilo_straight_right);
+    set_color(RGB(1, 1, 1));
+  } else if (next == LEFT) {
+    set_motors(kilo_turn_left, 0);
+    set_color(RGB(0, 1, 0));
+  } else {
+    set_motors(0, kilo_turn_right);
+    set_color(RGB(1, 0, 0));
+  }
+}
+
+void setup(void) {
+  message.type = NORMAL;
+  message.data[0] = 0;
+  message.crc = message_crc(&message);
+  if (kilo_uid == STAR_UID) set_color(RGB(0, 0, 1));
+}
+
+void loop(void) {
+  if (kilo_uid == STAR_UID || !heard) return;
+  heard = 0;
+  if (distance_mm < TOO_CLOSE_MM)
+    set_motion(FORWARD);
+  else if (distance_mm < DESIRED_MM)
+    set_motion(LEFT);
+  else
+    set_motion(RIGHT);
+}
+
+message_t* message_tx(void) { return kilo_uid == STAR_UID ? &message : 0; }
+
+void message_rx(message_t* m, distance_measurement_t* d) {
+  (void)m;
+  distance_mm = estimate_distance(d);
+  heard = 1;
+}
+
+int main(void) {
+  kilo_init();
+  kilo_message_tx = message_tx;
+  kilo_message_rx = message_rx;
+  kilo_start(setup, loop);
+  return 0;
+}
