@@ -1,4 +1,4 @@
--- A forager (worlds/foraging.yaml, models/forager.yaml), after ARGoS's
+-- A forager (worlds/experiments/foraging.yaml, models/forager.yaml), after ARGoS's
 -- foot-bot foraging example. Two states:
 --   exploring (LED green): drive straight, turning now and then at random,
 --     and away from the light while on the nest, so that the robots spread

@@ -121,7 +121,7 @@ TEST(ExamplesTest, TheFootbotsNoiseIsAParameterASweepCanVary) {
   EXPECT_NE(RunWorld("diffusion.yaml", 1, 50, {{"footbot.wheel_noise", "0.05"}}).hash, plain);
 }
 
-// worlds/foraging.yaml: foot-bots find items, carry them home by the lamp
+// worlds/experiments/foraging.yaml: foot-bots find items, carry them home by the lamp
 // over the nest (light sensors) and drop them where the floor is black
 // (ground sensors). In 5 min with the lamp on they deliver several times
 // as many items as with it off (then a carrier finds the nest only by
@@ -134,11 +134,13 @@ TEST(ExamplesTest, ForagersBringMoreItemsHomeWithTheLampOverTheNest) {
       if (m.name == "items_delivered") last = m.value;
     return last;
   };
-  const double lit = delivered(RunWorld("foraging.yaml", 2, 3000));
-  const double dark = delivered(RunWorld("foraging.yaml", 2, 3000, {{"intensity", "0"}}));
+  const double lit = delivered(RunWorld("experiments/foraging.yaml", 2, 3000));
+  const double dark =
+      delivered(RunWorld("experiments/foraging.yaml", 2, 3000, {{"intensity", "0"}}));
   EXPECT_GE(lit, 10);
   EXPECT_GE(lit, 2.5 * dark) << lit << " vs " << dark;
-  EXPECT_EQ(RunWorld("foraging.yaml", 1, 300).hash, RunWorld("foraging.yaml", 2, 300).hash);
+  EXPECT_EQ(RunWorld("experiments/foraging.yaml", 1, 300).hash,
+            RunWorld("experiments/foraging.yaml", 2, 300).hash);
 }
 
 TEST(ExamplesTest, RespawnKeepsThePopulationWithCopiesAndIsIndependentOfThreadCount) {
@@ -166,7 +168,7 @@ TEST(ExamplesTest, RespawnKeepsThePopulationWithCopiesAndIsIndependentOfThreadCo
 }
 
 TEST(ExamplesTest, FlockingAlignsHeadingsAndIsIndependentOfThreadCount) {
-  const WorldRun one = RunWorld("flocking.yaml", 1, 300);
+  const WorldRun one = RunWorld("experiments/flocking.yaml", 1, 300);
   const std::vector<double> alignment = Values(one.metrics, "alignment");
   const std::vector<double> cohesion = Values(one.metrics, "cohesion");
   // Step 0, then every 10 steps (the main script's samples of the last step
@@ -178,7 +180,7 @@ TEST(ExamplesTest, FlockingAlignsHeadingsAndIsIndependentOfThreadCount) {
   EXPECT_GT(alignment.back(), 0.95);
   EXPECT_LT(cohesion.back(), 1.5 * cohesion.front());
   for (int threads : {2, 4}) {
-    const WorldRun other = RunWorld("flocking.yaml", threads, 300);
+    const WorldRun other = RunWorld("experiments/flocking.yaml", threads, 300);
     EXPECT_EQ(other.hash, one.hash) << threads << " threads";
     EXPECT_EQ(Values(other.metrics, "alignment"), alignment) << threads << " threads";
   }
