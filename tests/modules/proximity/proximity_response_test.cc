@@ -44,7 +44,7 @@ class ProximityResponseTest : public testing::WorldDirTest {
     Write("bot.yaml", "model: bot\nobjects:\n  name: body\n  type: dummy\n  script: probe.lua\n"
                       "  children:\n"
                       "    - {name: ir, type: proximity_sensor, response: " +
-                          std::string(kCurve) + ", " + keys +
+                          std::string(kCurve) + ", " + keys + (keys.empty() ? "" : ",") +
                           "\n       position: [0, 0, 0.1], orientation_deg: [0, 90, " +
                           std::to_string(yaw_deg) +
                           "]}\n"
@@ -165,7 +165,8 @@ TEST_F(ProximityResponseTest, ReadingTheValueOfASensorWithoutACurveIsAScriptErro
         "function sysCall_sensing() sim.readProximityValue(sim.getObject('./plain')) end\n");
   Write("bot.yaml", "model: bot\nobjects:\n  name: body\n  type: dummy\n  script: s.lua\n"
                     "  children: [{name: plain, type: proximity_sensor}]\n");
-  LoadedWorld w = Load("simulation: {physics: kinematic}\nmodels: [{model: bot.yaml}]\n");
+  LoadedWorld w =
+      Load("simulation: {physics: kinematic}\nmodels: [{model: bot.yaml, position: [0, 0]}]\n");
   w.world->Start();
   const std::string message = testing::ErrorOf([&] { w.world->Step(); });
   EXPECT_CONTAINS(message, "s.lua:1: sim.readProximityValue: proximity sensor /bot#0/plain has "
