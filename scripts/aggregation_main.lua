@@ -5,11 +5,11 @@
 --     each other being in one cluster (1/robots: all apart; 1: one cluster);
 --   clusters: how many clusters of two robots or more there are.
 
-local robots, every, link, step = {}, 10, 0.1, 0
+local robots, every, link, step = {}, 10, 0.13, 0
 
 function sysCall_init()
   every = sim.getParam('metric_every', 10)
-  link = sim.getParam('cluster_distance', 0.1)
+  link = sim.getParam('cluster_distance', 0.13)
   for i = 0, sim.getParam('robots') - 1 do
     robots[#robots + 1] = sim.getObject('/epuck#' .. i)
   end

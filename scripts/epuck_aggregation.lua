@@ -1,20 +1,23 @@
 -- e-puck aggregation (worlds/experiments/aggregation.yaml), after the
 -- probabilistic aggregation of Jeanson et al. (2005) and Correll & Martinoli
--- (2011) on e-pucks and Alice robots: a robot random-walks (straight, with
--- a random turn now and then, turning away from what its front IR sensors
--- read); when its range-and-bearing board hears another robot within
--- JOIN_RANGE it stops, and a stopped robot leaves with a probability that
--- falls with the number of robots around it (LEAVE / n^2 per step), so
--- bigger clusters hold their robots longer and grow. With `aggregate:
--- false` (the control) it only random-walks.
+-- (2011): a robot random-walks (straight, with a random turn now and then,
+-- turning away from what its front IR sensors read); when its
+-- range-and-bearing board hears another robot within JOIN_RANGE it stops,
+-- and a stopped robot leaves with a probability that falls with the number
+-- of robots around it (LEAVE / n^2 per step), so bigger clusters hold their
+-- robots longer and grow. A stopped robot says so in its board's first byte,
+-- and a walker that hears one within ATTRACT_RANGE steers toward the
+-- nearest (the cue of cue-based aggregation). With `aggregate: false` (the
+-- control) it only random-walks.
 --
 -- Parameters (sim.getParam): wheel_speed (m/s), wheel_radius (m),
 -- ir_threshold (raw IR value), aggregate (true/false).
 
-local JOIN_RANGE = 0.1     -- m, board to board (e-pucks 3 cm apart or less)
-local LEAVE = 0.02         -- per-step probability of leaving with one neighbour
+local JOIN_RANGE = 0.12    -- m, board to board (e-pucks 5 cm apart or less)
+local LEAVE = 0.002        -- per-step probability of leaving with one neighbour
 local TURN_PROBABILITY = 0.05  -- per step, while walking: start a random turn
 local ESCAPE_STEPS = 30    -- after leaving, steps of walking that ignore the others
+local ATTRACT_RANGE = 0.4  -- m: a walker steers toward a stopped robot this close
 
 local BEARINGS_DEG = {-17.2, -45.9, -90, -151.5, 151.2, 90, 45.8, 17.1}
 
@@ -39,11 +42,13 @@ function sysCall_init()
 end
 
 function sysCall_actuation()
-  -- Robots close by, by the board.
-  local near = 0
+  -- Robots close by, by the board, and the nearest stopped one.
+  local near, cue = 0, nil
   for _, m in ipairs(sim.readRangeAndBearing(rab)) do
     if m.range <= JOIN_RANGE then near = near + 1 end
+    if cue == nil and string.byte(m.data, 1) == 1 and m.range <= ATTRACT_RANGE then cue = m end
   end
+  sim.setRangeAndBearingData(rab, {staying and 1 or 0})
   if escape > 0 then escape = escape - 1 end
   if staying then
     if near == 0 or math.random() < LEAVE / (near * near) then
@@ -56,6 +61,7 @@ function sysCall_actuation()
     end
   elseif aggregate and escape == 0 and near > 0 then
     staying = true
+    sim.setRangeAndBearingData(rab, {1})
     sim.setJointTargetVelocity(left_motor, 0)
     sim.setJointTargetVelocity(right_motor, 0)
     return
@@ -69,6 +75,11 @@ function sysCall_actuation()
     for i = 1, 8 do y = y + values[i] * sin_a[i] end
     turn_sign = y > 0 and -1 or 1   -- away from the side that reads more
     left, right = -turn_sign * speed, turn_sign * speed
+    turn_steps = 0
+  elseif aggregate and escape == 0 and cue ~= nil then
+    -- Toward the stopped robot: turn in proportion to its bearing.
+    local turn = math.max(-1, math.min(1, 2 * cue.bearing / math.pi))
+    left, right = speed * (1 - turn), speed * (1 + turn)
     turn_steps = 0
   elseif turn_steps > 0 then
     turn_steps = turn_steps - 1

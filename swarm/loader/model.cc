@@ -178,6 +178,18 @@ struct Builder {
     const std::string root_what = "the root object of model '" + model.name + "'";
     Fields fields(values.file(), field,
                   is_root ? root_what : "an object of model '" + model.name + "'");
+    // `if: false` (usually `if: $with_x`) leaves the object and its subtree
+    // out. It is still read, so that its mistakes are errors, unless its
+    // type is none this world has (a device of a module the registry lacks).
+    bool enabled = true;
+    if (fields.Has("if")) {
+      if (is_root) values.Fail(fields.Get("if"), "the root object of a model cannot have 'if'");
+      enabled = values.Bool(fields.Get("if"));
+      if (!enabled && fields.Has("type") && fields.Get("type").node.IsScalar() &&
+          std::find(types.names.begin(), types.names.end(),
+                    fields.Get("type").node.Scalar()) == types.names.end())
+        return;
+    }
     // A misspelled 'type' or 'name' is an unknown key (with a suggestion),
     // not a missing one: without them, check the keys first.
     if (!fields.Has("type")) fields.Expect(types.AllKeys());
@@ -206,18 +218,12 @@ struct Builder {
     if (type == "ground_array" && is_root)
       values.Fail(type_field, "a ground array cannot be the root object of a model");
     named.Expect(types.KeysOf(type));
-    // `if: false` (usually `if: $with_x`): the object and its subtree are
-    // read (so their mistakes are still found) and left out of the model.
-    if (named.Has("if")) {
-      if (is_root)
-        values.Fail(named.Get("if"), "the root object of a model cannot have 'if'");
-      if (!values.Bool(named.Get("if"))) {
-        std::vector<ObjectSpec> dropped;
-        const int counted = objects;
-        ObjectUnconditional(named, field, depth, type, ring, name, &dropped);
-        objects = counted;
-        return;
-      }
+    if (!enabled) {  // read, then dropped
+      std::vector<ObjectSpec> dropped;
+      const int counted = objects;
+      ObjectUnconditional(named, field, depth, type, ring, name, &dropped);
+      objects = counted;
+      return;
     }
     ObjectUnconditional(named, field, depth, type, ring, name, out);
   }
