@@ -493,12 +493,17 @@ class OctreeGridProximity final : public ProximityBackend {
     if (reading.detected) Finish(table.owners[ray.row], &reading);
   }
 
-  // A detection's noise (and failure), and its value on a response curve.
+  // A detection's noise (and failure), and its value on a response curve
+  // (out of line: the plain ray's path stays as short as it was).
   void Finish(uint32_t slot, ProximitySensorData* reading) const {
     const ProximitySensorSettings& settings = *reading->settings;
-    if (settings.noise.any()) {
+    if (settings.noise.any() || settings.has_response()) [[unlikely]]
+      FinishNoisyOrCurved(slot, reading);
+  }
+  [[gnu::noinline]] void FinishNoisyOrCurved(uint32_t slot, ProximitySensorData* reading) const {
+    if (reading->settings->noise.any()) {
       AddNoise(slot, reading);
-    } else if (settings.has_response()) {
+    } else {
       reading->value = static_cast<float>(ResponseValue(*reading));
     }
   }
