@@ -123,10 +123,10 @@ TEST(ExamplesTest, TheFootbotsNoiseIsAParameterASweepCanVary) {
 
 // worlds/experiments/foraging.yaml: foot-bots find items, carry them home by the lamp
 // over the nest (light sensors) and drop them where the floor is black
-// (ground sensors). In 5 min with the lamp on they deliver several times
-// as many items as with it off (then a carrier finds the nest only by
-// chance): 19 against 4 at seed 1, and at least twice as many at seeds 2-4
-// (12/2, 16/2, 9/4).
+// (ground sensors): complete foot-bots (models/footbot.yaml). In 5 min
+// with the lamp on they deliver several times as many items as with it off
+// (then a carrier finds the nest only by chance): 13 against 4 at seed 1,
+// and at least three times as many at seeds 2-4 (10/2, 16/2, 12/4).
 TEST(ExamplesTest, ForagersBringMoreItemsHomeWithTheLampOverTheNest) {
   auto delivered = [](const WorldRun& run) {
     double last = -1;
