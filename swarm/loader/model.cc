@@ -186,8 +186,8 @@ struct Builder {
       if (is_root) values.Fail(fields.Get("if"), "the root object of a model cannot have 'if'");
       enabled = values.Bool(fields.Get("if"));
       if (!enabled && fields.Has("type") && fields.Get("type").node.IsScalar() &&
-          std::find(types.names.begin(), types.names.end(),
-                    fields.Get("type").node.Scalar()) == types.names.end())
+          std::find(types.names.begin(), types.names.end(), fields.Get("type").node.Scalar()) ==
+              types.names.end())
         return;
     }
     // A misspelled 'type' or 'name' is an unknown key (with a suggestion),

@@ -41,21 +41,23 @@ class ProximityResponseTest : public testing::WorldDirTest {
           "  local v = sim.readProximityValues({ir, back}, out)\n"
           "  sim.recordMetric('both', v[1] + v[2])\n"
           "end\n");
-    Write("bot.yaml", "model: bot\nobjects:\n  name: body\n  type: dummy\n  script: probe.lua\n"
-                      "  children:\n"
-                      "    - {name: ir, type: proximity_sensor, response: " +
-                          std::string(kCurve) + ", " + keys + (keys.empty() ? "" : ",") +
-                          "\n       position: [0, 0, 0.1], orientation_deg: [0, 90, " +
-                          std::to_string(yaw_deg) +
-                          "]}\n"
-                          "    - {name: back, type: proximity_sensor, response: " +
-                          kCurve + ", position: [0, 0, 0.1], orientation_deg: [0, -90, 0]}\n");
-    LoadedWorld w = Load("simulation: {physics: kinematic, seed: 3}\n"
-                         "obstacles:\n"
-                         "  - {name: wall, shape: box, size: [0.2, 20, 1], position: [" +
-                         std::to_string(gap + 0.1) +
-                         ", 0, 0.5]}\n"
-                         "models: [{model: bot.yaml, position: [0, 0]}]\n");
+    Write("bot.yaml",
+          "model: bot\nobjects:\n  name: body\n  type: dummy\n  script: probe.lua\n"
+          "  children:\n"
+          "    - {name: ir, type: proximity_sensor, response: " +
+              std::string(kCurve) + ", " + keys + (keys.empty() ? "" : ",") +
+              "\n       position: [0, 0, 0.1], orientation_deg: [0, 90, " +
+              std::to_string(yaw_deg) +
+              "]}\n"
+              "    - {name: back, type: proximity_sensor, response: " +
+              kCurve + ", position: [0, 0, 0.1], orientation_deg: [0, -90, 0]}\n");
+    LoadedWorld w = Load(
+        "simulation: {physics: kinematic, seed: 3}\n"
+        "obstacles:\n"
+        "  - {name: wall, shape: box, size: [0.2, 20, 1], position: [" +
+        std::to_string(gap + 0.1) +
+        ", 0, 0.5]}\n"
+        "models: [{model: bot.yaml, position: [0, 0]}]\n");
     w.world->Start();
     return w;
   }
@@ -80,9 +82,9 @@ TEST_F(ProximityResponseTest, AWallReadsTheCurveAtItsDistance) {
     double gap, value;
   };
   // Table points and midpoints (linear interpolation).
-  for (const Case c : {Case{0.005, 2133.33}, Case{0.0125, (1465.73 + 601.46) / 2},
-                       Case{0.02, 383.84}, Case{0.035, (234.93 + 158.03) / 2},
-                       Case{0.065, (104.09 + 67.19) / 2}}) {
+  for (const Case c :
+       {Case{0.005, 2133.33}, Case{0.0125, (1465.73 + 601.46) / 2}, Case{0.02, 383.84},
+        Case{0.035, (234.93 + 158.03) / 2}, Case{0.065, (104.09 + 67.19) / 2}}) {
     LoadedWorld w = LoadAt(c.gap, "");
     double both = 0;
     EXPECT_NEAR(ValueAfterStep(w, &both), c.value, 0.01) << c.gap << " m";
@@ -129,12 +131,14 @@ TEST_F(ProximityResponseTest, NoiseMovesTheValueWithinTheCurve) {
 }
 
 TEST_F(ProximityResponseTest, AProximityRingTakesACurve) {
-  Write("ring.yaml", "model: ring\nobjects:\n  name: body\n  type: dummy\n  children:\n"
-                     "    - {type: proximity_ring, name: p, count: 4, radius: 0, height: 0.1,\n"
-                     "       response: [[0, 1000], [0.2, 10]]}\n");
-  LoadedWorld w = Load("simulation: {physics: kinematic}\n"
-                       "obstacles: [{shape: box, size: [0.2, 20, 1], position: [0.2, 0, 0.5]}]\n"
-                       "models: [{model: ring.yaml, position: [0, 0]}]\n");
+  Write("ring.yaml",
+        "model: ring\nobjects:\n  name: body\n  type: dummy\n  children:\n"
+        "    - {type: proximity_ring, name: p, count: 4, radius: 0, height: 0.1,\n"
+        "       response: [[0, 1000], [0.2, 10]]}\n");
+  LoadedWorld w = Load(
+      "simulation: {physics: kinematic}\n"
+      "obstacles: [{shape: box, size: [0.2, 20, 1], position: [0.2, 0, 0.5]}]\n"
+      "models: [{model: ring.yaml, position: [0, 0]}]\n");
   w.world->Start();
   w.world->Step();
   const ProximitySensorData& ahead = RowOf<ProximitySensorData>(*w.world, "/ring#0/p[0]");
@@ -153,8 +157,7 @@ TEST_F(ProximityResponseTest, BadCurvesAreErrorsNamingTheLine) {
   EXPECT_NE(error("response: [[0, 10], [0.1]]").find("thing.yaml:"), std::string::npos);
   EXPECT_NE(error("response: [[-0.1, 10], [0.1, 5]]").find("non-negative"), std::string::npos);
   EXPECT_NE(error("response_incidence: none").find("needs a 'response'"), std::string::npos);
-  EXPECT_NE(error("response: [[0, 10], [0.1, 5]]\n  response_incidence: cos")
-                .find("lambertian"),
+  EXPECT_NE(error("response: [[0, 10], [0.1, 5]]\n  response_incidence: cos").find("lambertian"),
             std::string::npos);
   EXPECT_EQ(error("response: [[0, 10], [0.1, 5]]"), "(no error)");
 }
@@ -163,14 +166,16 @@ TEST_F(ProximityResponseTest, BadCurvesAreErrorsNamingTheLine) {
 TEST_F(ProximityResponseTest, ReadingTheValueOfASensorWithoutACurveIsAScriptError) {
   Write("s.lua",
         "function sysCall_sensing() sim.readProximityValue(sim.getObject('./plain')) end\n");
-  Write("bot.yaml", "model: bot\nobjects:\n  name: body\n  type: dummy\n  script: s.lua\n"
-                    "  children: [{name: plain, type: proximity_sensor}]\n");
+  Write("bot.yaml",
+        "model: bot\nobjects:\n  name: body\n  type: dummy\n  script: s.lua\n"
+        "  children: [{name: plain, type: proximity_sensor}]\n");
   LoadedWorld w =
       Load("simulation: {physics: kinematic}\nmodels: [{model: bot.yaml, position: [0, 0]}]\n");
   w.world->Start();
   const std::string message = testing::ErrorOf([&] { w.world->Step(); });
-  EXPECT_CONTAINS(message, "s.lua:1: sim.readProximityValue: proximity sensor /bot#0/plain has "
-                           "no 'response' curve");
+  EXPECT_CONTAINS(message,
+                  "s.lua:1: sim.readProximityValue: proximity sensor /bot#0/plain has "
+                  "no 'response' curve");
 }
 
 TEST_F(ProximityResponseTest, EveryKeyIsDocumented) { ExpectDocumented({"proximity_sensor"}); }

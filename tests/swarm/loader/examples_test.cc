@@ -426,8 +426,7 @@ TEST(ExamplesTest, EpucksAggregateIntoClustersAndTheRandomWalkControlDoesNot) {
   const WorldRun agg = RunWorld("experiments/aggregation.yaml", 2, 1800);
   const WorldRun control =
       RunWorld("experiments/aggregation.yaml", 2, 1800, {{"aggregate", "false"}});
-  EXPECT_GE(late(agg, "largest_cluster_fraction"),
-            1.5 * late(control, "largest_cluster_fraction"));
+  EXPECT_GE(late(agg, "largest_cluster_fraction"), 1.5 * late(control, "largest_cluster_fraction"));
   EXPECT_GE(late(agg, "largest_cluster_fraction"), 0.25);
   EXPECT_LT(late(agg, "mean_nearest_neighbor_distance"),
             0.75 * late(control, "mean_nearest_neighbor_distance"));
@@ -449,8 +448,7 @@ TEST(ExamplesTest, EpuckDiffusionKeepsTheRobotsApartByTheirIrSensors) {
     return sum / n;
   };
   const WorldRun seeing = RunWorld("epuck_diffusion.yaml", 2, 600);
-  const WorldRun blind =
-      RunWorld("epuck_diffusion.yaml", 2, 600, {{"epuck.ir_threshold", "5000"}});
+  const WorldRun blind = RunWorld("epuck_diffusion.yaml", 2, 600, {{"epuck.ir_threshold", "5000"}});
   EXPECT_GT(late(seeing), 1.25 * late(blind));
   EXPECT_EQ(RunWorld("epuck_diffusion.yaml", 1, 200).hash,
             RunWorld("epuck_diffusion.yaml", 2, 200).hash);

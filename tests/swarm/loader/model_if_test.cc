@@ -33,8 +33,10 @@ class ModelIfTest : public testing::WorldDirTest {
           "    - {if: $b, name: y, type: dummy}\n"
           "    - {if: \"= a or not b\", type: proximity_ring, name: ring, count: 4, radius: 0.1}\n"
           "    - {if: $a, type: ground_array, name: g, points: [[0, 0], [0.1, 0]]}\n");
-    return Load("simulation: {physics: kinematic}\nmodels: [{model: bot.yaml, position: [0, 0], parameters: {" +
-                parameters + "}}]\n");
+    return Load(
+        "simulation: {physics: kinematic}\nmodels: [{model: bot.yaml, position: [0, 0], "
+        "parameters: {" +
+        parameters + "}}]\n");
   }
   static bool Has(LoadedWorld& w, const std::string& path) {
     return !w.world->scene().FindObject(path).IsNull();
@@ -66,16 +68,19 @@ TEST_F(ModelIfTest, MistakesAreErrorsEvenInObjectsLeftOut) {
   Write("bot.yaml",
         "model: bot\nobjects:\n  name: body\n  type: dummy\n  children:\n"
         "    - {if: false, name: x, type: dummy, raduis: 1}\n");
-  EXPECT_CONTAINS(testing::ErrorOf([&] { Load("models: [{model: bot.yaml, position: [0, 0]}]\n"); }),
-                  "bot.yaml:6:");
+  EXPECT_CONTAINS(
+      testing::ErrorOf([&] { Load("models: [{model: bot.yaml, position: [0, 0]}]\n"); }),
+      "bot.yaml:6:");
   Write("bot.yaml",
         "model: bot\nobjects:\n  name: body\n  type: dummy\n  children:\n"
         "    - {if: maybe, name: x, type: dummy}\n");
-  EXPECT_CONTAINS(testing::ErrorOf([&] { Load("models: [{model: bot.yaml, position: [0, 0]}]\n"); }),
-                  "bot.yaml:6:");
+  EXPECT_CONTAINS(
+      testing::ErrorOf([&] { Load("models: [{model: bot.yaml, position: [0, 0]}]\n"); }),
+      "bot.yaml:6:");
   Write("bot.yaml", "model: bot\nobjects:\n  if: true\n  name: body\n  type: dummy\n");
-  EXPECT_CONTAINS(testing::ErrorOf([&] { Load("models: [{model: bot.yaml, position: [0, 0]}]\n"); }),
-                  "the root object of a model cannot have 'if'");
+  EXPECT_CONTAINS(
+      testing::ErrorOf([&] { Load("models: [{model: bot.yaml, position: [0, 0]}]\n"); }),
+      "the root object of a model cannot have 'if'");
 }
 
 }  // namespace

@@ -40,16 +40,16 @@ class RobotModelsTest : public testing::WorldDirTest {
               record + "\nend\n");
     LoadedWorld w = Load("simulation: {physics: " + physics +
                          ", time_step: 0.1, physics_substeps: 10, seed: 1}\n"
-                         "parameters: " + wheels + "\n" +
-                         extra + "models:\n" + models);
+                         "parameters: " +
+                         wheels + "\n" + extra + "models:\n" + models);
     w.world->Start();
     return w;
   }
   std::string Robot(const std::string& model, const std::string& where,
                     const std::string& parameters = "") {
-    return "  - {model: " + kModels + model + ", " + where + ", parameters: {controller: " +
-           (dir_ / "drive.lua").string() + (parameters.empty() ? "" : ", " + parameters) +
-           "}}\n";
+    return "  - {model: " + kModels + model + ", " + where +
+           ", parameters: {controller: " + (dir_ / "drive.lua").string() +
+           (parameters.empty() ? "" : ", " + parameters) + "}}\n";
   }
   static double Last(const std::vector<MetricSample>& metrics, const std::string& name) {
     double v = NAN;
@@ -63,9 +63,9 @@ class RobotModelsTest : public testing::WorldDirTest {
   // start-up transient).
   void Measure(const std::string& physics, const std::string& model, double left, double right,
                double* speed, double* turn_rate) {
-    LoadedWorld w = LoadRobots(physics, Robot(model, "position: [0, 0]"), "", "",
-                               "{left: " + std::to_string(left) +
-                                   ", right: " + std::to_string(right) + "}");
+    LoadedWorld w =
+        LoadRobots(physics, Robot(model, "position: [0, 0]"), "", "",
+                   "{left: " + std::to_string(left) + ", right: " + std::to_string(right) + "}");
     const ObjectId root = w.world->scene().instance(0).root;
     for (int i = 0; i < 10; ++i) w.world->Step();
     const Pose start = w.world->scene().world_pose(root);
@@ -116,14 +116,13 @@ TEST_F(RobotModelsTest, TheEpucksFrontIrReadsTheCurveAtKnownDistancesFromAWall) 
   };
   for (const char* physics : {"box2d", "planar"}) {
     for (const Case c : {Case{0.002, 4095 + (2133.33 - 4095) * 0.4}, Case{0.01, 1465.73},
-                         Case{0.03, 234.93},
-                         Case{0.045, (158.03 + 120) / 2}, Case{0.1, 67.19}}) {
-      LoadedWorld w = LoadRobots(
-          physics, Robot("epuck.yaml", "position: [0, 0], heading_deg: 17.2"),
-          "obstacles: [{shape: box, size: [0.1, 2, 0.2], position: [" +
-              std::to_string(0.035 + c.gap + 0.05 + 1e-6) + ", 0, 0.1]}]\n",
-          "sim.recordMetric('ir0', sim.readProximityValue(sim.getObject('./ir[0]')))\n"
-          "sim.recordMetric('ir3', sim.readProximityValue(sim.getObject('./ir[3]')))");
+                         Case{0.03, 234.93}, Case{0.045, (158.03 + 120) / 2}, Case{0.1, 67.19}}) {
+      LoadedWorld w =
+          LoadRobots(physics, Robot("epuck.yaml", "position: [0, 0], heading_deg: 17.2"),
+                     "obstacles: [{shape: box, size: [0.1, 2, 0.2], position: [" +
+                         std::to_string(0.035 + c.gap + 0.05 + 1e-6) + ", 0, 0.1]}]\n",
+                     "sim.recordMetric('ir0', sim.readProximityValue(sim.getObject('./ir[0]')))\n"
+                     "sim.recordMetric('ir3', sim.readProximityValue(sim.getObject('./ir[3]')))");
       w.world->Step();
       w.world->Step();
       const std::vector<MetricSample> m = w.world->TakeMetrics();
@@ -184,8 +183,8 @@ TEST_F(RobotModelsTest, TheEpucksBoardAndCameraSeeWhatTheyShould) {
 // The bare foot-bot has no optional device; `complete: true` has them all;
 // `with_rab: true` the board only.
 TEST_F(RobotModelsTest, TheFootbotsOptionalDevicesAreThereOnlyWhenAskedFor) {
-  const char* devices[] = {"rab",           "base_ground[7]", "motor_ground[3]", "light[23]",
-                           "omni_camera",   "led[11]",        "beacon"};
+  const char* devices[] = {"rab",         "base_ground[7]", "motor_ground[3]", "light[23]",
+                           "omni_camera", "led[11]",        "beacon"};
   LoadedWorld bare = LoadRobots("planar", Robot("footbot.yaml", "position: [0, 0]"));
   LoadedWorld full =
       LoadRobots("planar", Robot("footbot.yaml", "position: [0, 0]", "complete: true"));
