@@ -67,8 +67,7 @@ class Robots {
     return Cached(&proximity_, [&] { return Proximity(Sc(), *layout_, py::none()); });
   }
   py::object proximity_values() {
-    return Cached(&proximity_values_,
-                  [&] { return ProximityValues(Sc(), *layout_, py::none()); });
+    return Cached(&proximity_values_, [&] { return ProximityValues(Sc(), *layout_, py::none()); });
   }
   py::object ground() {
     return Cached(&ground_, [&] { return Ground(Sc(), *layout_, py::none()); });
