@@ -1,4 +1,5 @@
--- A forager (worlds/foraging.yaml, models/forager.yaml), after ARGoS's
+-- A forager (worlds/experiments/foraging.yaml: the complete foot-bot of
+-- models/footbot.yaml, its beacon, 24 light and 4 motor ground sensors), after ARGoS's
 -- foot-bot foraging example. Two states:
 --   exploring (LED green): drive straight, turning now and then at random,
 --     and away from the light while on the nest, so that the robots spread
@@ -29,16 +30,19 @@ function sysCall_init()
   me = sim.getObject(':')
   left_motor = sim.getObject('./leftMotor')
   right_motor = sim.getObject('./rightMotor')
-  led = sim.getObject('./led')
-  for i = 0, 7 do
+  led = sim.getObject('./beacon')
+  sim.setLedOn(led, true)
+  -- The complete foot-bot's 24 light sensors, from 7.5 deg every 15 deg.
+  for i = 0, 23 do
     lights[i + 1] = sim.getObject('./light[' .. i .. ']')
-    light_cos[i + 1], light_sin[i + 1] = math.cos(math.pi * i / 4), math.sin(math.pi * i / 4)
+    local a = math.rad(7.5 + 15 * i)
+    light_cos[i + 1], light_sin[i + 1] = math.cos(a), math.sin(a)
   end
   for i = 0, 23 do
     prox[i + 1] = sim.getObject('./prox[' .. i .. ']')
     prox_cos[i + 1], prox_sin[i + 1] = math.cos(math.pi * i / 12), math.sin(math.pi * i / 12)
   end
-  for i = 0, 3 do ground[i + 1] = sim.getObject('./ground[' .. i .. ']') end
+  for i = 0, 3 do ground[i + 1] = sim.getObject('./motor_ground[' .. i .. ']') end
 end
 
 local function on_nest()

@@ -1,4 +1,4 @@
--- Main script of worlds/foraging.yaml: the default step, then the
+-- Main script of worlds/experiments/foraging.yaml: the default step, then the
 -- "loop functions" of ARGoS's foraging example. Items (/item0 ...) lie on
 -- the floor outside the nest; a robot that drives within `pick_radius` of
 -- one while carrying nothing takes it (the message 'pick'), and the item

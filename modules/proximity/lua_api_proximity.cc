@@ -1,5 +1,7 @@
 // sim.* proximity sensors (the Lua area of the proximity_sensor type):
-//   sim.readProximitySensor(h) and sim.readProximitySensors(handles [, out]).
+//   sim.readProximitySensor(h) and sim.readProximitySensors(handles [, out]);
+//   sim.readProximityValue(h) and sim.readProximityValues(handles [, out]) for
+//   sensors with a response curve (`response:`).
 //
 // Readings are written in the sense phase and only read during the control
 // phase, so any robot may read any sensor.
@@ -68,12 +70,43 @@ int ReadProximitySensors(lua_State* L) {
   return 2;
 }
 
+// The value of a sensor with a response curve: its last reading's, or the
+// curve's far end when it detects nothing. A sensor without one is an error
+// naming it (throws: Guarded and FillFromHandles turn it into a Lua error).
+double ValueOf(const Scene& scene, ObjectId id) {
+  const ProximitySensorData& sensor = SensorOf(scene, id);
+  const ProximitySensorSettings& settings = *sensor.settings;
+  if (!settings.has_response())
+    throw Error("proximity sensor " + scene.PathOf(id) +
+                " has no 'response' curve (worlds/README.md, proximity_sensor): read its "
+                "distance with sim.readProximitySensor");
+  return sensor.detected ? static_cast<double>(sensor.value) : settings.response.back().second;
+}
+
+// sim.readProximityValue(h) -> the sensor's value on its response curve
+// (the far end's value when it detects nothing).
+int ReadProximityValue(lua_State* L) {
+  lua_pushnumber(L, ValueOf(*Context(L).scene, CheckObject(L, 1)));
+  return 1;
+}
+
+// sim.readProximityValues(handles [, values]) -> values: each sensor's
+// sim.readProximityValue, into `values` (entries 1 .. #handles, reused in
+// place: no allocation) or a new table.
+int ReadProximityValues(lua_State* L) {
+  const Scene& scene = *Context(L).scene;
+  FillFromHandles(L, [&](ObjectId id) { lua_pushnumber(L, ValueOf(scene, id)); });
+  return 1;
+}
+
 }  // namespace
 
 void RegisterProximityApi(lua_State* L) {
   static constexpr luaL_Reg kFunctions[] = {
       {"readProximitySensor", Guarded<ReadProximitySensor, "sim.readProximitySensor">},
       {"readProximitySensors", Guarded<ReadProximitySensors, "sim.readProximitySensors">},
+      {"readProximityValue", Guarded<ReadProximityValue, "sim.readProximityValue">},
+      {"readProximityValues", Guarded<ReadProximityValues, "sim.readProximityValues">},
       {nullptr, nullptr},
   };
   luaL_setfuncs(L, kFunctions, 0);

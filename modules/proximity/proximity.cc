@@ -490,8 +490,31 @@ class OctreeGridProximity final : public ProximityBackend {
     }
     reading.distance = reading.detected ? best : 0;
     reading.detected_object = reading.detected ? hit : ObjectId{};
-    if (reading.detected && reading.settings->noise.any())
-      AddNoise(table.owners[ray.row], &reading);
+    if (reading.detected) Finish(table.owners[ray.row], &reading);
+  }
+
+  // A detection's noise (and failure), and its value on a response curve
+  // (out of line: the plain ray's path stays as short as it was).
+  void Finish(uint32_t slot, ProximitySensorData* reading) const {
+    const ProximitySensorSettings& settings = *reading->settings;
+    if (settings.noise.any() || settings.has_response()) [[unlikely]]
+      FinishNoisyOrCurved(slot, reading);
+  }
+  [[gnu::noinline]] void FinishNoisyOrCurved(uint32_t slot, ProximitySensorData* reading) const {
+    if (reading->settings->noise.any()) {
+      AddNoise(slot, reading);
+    } else {
+      reading->value = static_cast<float>(ResponseValue(*reading));
+    }
+  }
+
+  // A detection's value on its sensor's response curve: the curve at the
+  // distance, its part above the far end times the cosine of the angle
+  // between the line of sight and the surface normal (Lambertian).
+  static double ResponseValue(const ProximitySensorData& reading) {
+    const double d = reading.distance;
+    const double cos_i = d > 0 ? -reading.normal.Dot(reading.p_SD()) / d : 1.0;
+    return reading.settings->ResponseAt(d, cos_i);
   }
 
   // Noise and failure on a detection (sensor_noise.h), from the stream of
@@ -506,6 +529,15 @@ class OctreeGridProximity final : public ProximityBackend {
       reading->distance = 0;
       reading->detected_object = ObjectId{};
       reading->point = reading->normal = Vec3{};
+      return;
+    }
+    // A response curve's value is what the noise perturbs, within the curve's values.
+    if (reading->settings->has_response()) {
+      double v = ResponseValue(*reading);
+      if (noise.perturbs())
+        v = std::clamp(Perturb(noise, v, rng), reading->settings->ResponseMin(),
+                       reading->settings->ResponseMax());
+      reading->value = static_cast<float>(v);
       return;
     }
     if (!noise.perturbs()) return;
@@ -591,7 +623,7 @@ class OctreeGridProximity final : public ProximityBackend {
     reading.detected_object = reading.detected ? hit : ObjectId{};
     reading.point = reading.detected ? best.point : Vec3{};
     reading.normal = reading.detected ? best.normal : Vec3{};
-    if (reading.detected && reading.settings->noise.any()) AddNoise(sensor.slot, &reading);
+    if (reading.detected) Finish(sensor.slot, &reading);
   }
 
   // `ray_count` rays in the cone, from the stream of (seed, sensor slot,

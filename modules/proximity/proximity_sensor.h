@@ -14,6 +14,8 @@
 #include <cstring>
 #include <memory>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "framework/handle.h"
 #include "framework/math.h"
@@ -55,16 +57,60 @@ struct ProximitySensorSettings {
   // `noise`, `noise_uniform`, `failure_probability`): a detected distance d
   // reads clamp(d + noise, 0, range); a failed sensor detects nothing.
   NoiseSettings noise;
+  // The response curve (`response:`, a real IR sensor's raw value against
+  // distance): [distance (m), value] pairs, distances strictly increasing,
+  // interpolated linearly; nearer than the first: the first value; nothing
+  // detected (or farther than the last): the last value. Empty: the sensor
+  // reads distances only (no value), as before. With a response, `noise`
+  // and `noise_uniform` perturb the value, not the distance.
+  std::vector<std::pair<double, double>> response;
+  // The value's part above the far end scales with cos(angle of incidence)
+  // (Lambertian reflection; `response_incidence: lambertian`), or not (`none`).
+  bool response_lambertian = true;
+  bool has_response() const { return !response.empty(); }
+  // The table's value at distance `d` (m), cosine of incidence `cos_i`.
+  double ResponseAt(double d, double cos_i) const {
+    const auto& t = response;
+    const double far = t.back().second;
+    double v = far;
+    if (d <= t.front().first) {
+      v = t.front().second;
+    } else {
+      for (size_t i = 1; i < t.size(); ++i)
+        if (d < t[i].first) {
+          const double f = (d - t[i - 1].first) / (t[i].first - t[i - 1].first);
+          v = t[i - 1].second + f * (t[i].second - t[i - 1].second);
+          break;
+        }
+    }
+    if (response_lambertian) v = far + (v - far) * (cos_i < 0 ? 0.0 : cos_i > 1 ? 1.0 : cos_i);
+    return v;
+  }
+  // The table's smallest and largest values (noise clamps to them).
+  double ResponseMin() const {
+    double m = response.front().second;
+    for (const auto& [d, v] : response) m = v < m ? v : m;
+    return m;
+  }
+  double ResponseMax() const {
+    double m = response.front().second;
+    for (const auto& [d, v] : response) m = v > m ? v : m;
+    return m;
+  }
 };
 
 // A proximity sensor: its shared settings and its reading (80 bytes; a
-// robot's control step reads all of its sensors' rows).
+// robot's control step reads all of its sensors' rows; `value` sits in the
+// padding after `detected`).
 struct ProximitySensorData {
   Shared<ProximitySensorSettings> settings;
   // Reading, written in the sense phase:
   double distance = 0;       // m, from the sensor's origin to the detected point
   ObjectId detected_object;  // shape that was hit
   bool detected = false;
+  // A sensor with a response curve: its value (the curve at the distance,
+  // with noise), also when nothing is detected (the far end). Else 0.
+  float value = 0;
   // The detected point (volumes; a ray's is on +z, see p_SD()) and the
   // outward surface normal there, in the sensor frame.
   Vec3 point, normal;
@@ -73,6 +119,7 @@ struct ProximitySensorData {
   // The detected point in the sensor frame: for a ray, on its +z axis.
   Vec3 p_SD() const { return volume() == ProximityVolume::kRay ? Vec3{0, 0, distance} : point; }
 };
+static_assert(sizeof(ProximitySensorData) <= 80, "a proximity reading stays 80 bytes");
 
 namespace proximity {
 

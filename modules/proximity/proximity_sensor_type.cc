@@ -57,6 +57,12 @@ constexpr ObjectKey kKeys[] = {
     {"noise", "0", "m, >= 0: std dev of Gaussian noise on a detection's distance"},
     {"noise_uniform", "0", "m, >= 0: half width of uniform noise on a detection's distance"},
     {"failure_probability", "0", "0..1: chance that the sensor detects nothing in a step"},
+    {"response", "none",
+     "[[distance m, value], ...]: the raw value against distance (an IR sensor's curve), "
+     "interpolated; nothing detected reads the last value; noise then perturbs the value"},
+    {"response_incidence", "lambertian",
+     "lambertian (the value above the far end times the cosine of the angle of incidence) or "
+     "none"},
 };
 
 constexpr double kDeg = 3.141592653589793 / 180;
@@ -72,12 +78,13 @@ void Scale(const ObjectTypeDescriptor&, void* row, double s, ScaleContext*) {
   settings.radius *= s;
   settings.thickness *= s;
   settings.blind_zone *= s;
+  for (auto& [distance, value] : settings.response) distance *= s;
   p.distance *= s;
   p.point = p.point * s;
 }
 
 // Ray sensors add what they always added (the golden hashes stay); volume
-// sensors add their normal too.
+// sensors add their normal too, sensors with a response curve their value.
 void Hash(const Scene& scene, ObjectType type, StateHasher* h) {
   const Rows<ProximitySensorData>& sensors = scene.rows<ProximitySensorData>(type);
   for (size_t r = 0; r < sensors.rows.size(); ++r) {
@@ -88,6 +95,7 @@ void Hash(const Scene& scene, ObjectType type, StateHasher* h) {
     h->AddValue(p.p_SD());
     h->AddValue(p.detected_object);
     if (p.volume() != ProximityVolume::kRay) h->AddValue(p.normal);
+    if (p.settings->has_response() && p.detected) h->AddValue(p.value);
   }
 }
 
@@ -115,6 +123,35 @@ void Check(const Scene& scene, ObjectId id, const void* row) {
   EntitySlots(scene, v.detectable, id,
               (v.detectable_where.empty() ? "" : v.detectable_where + ": ") + "proximity sensor " +
                   scene.PathOf(id) + " ('detectable')");
+}
+
+// `response: [[distance, value], ...]` (at least two pairs, distances from
+// 0 and strictly increasing) and `response_incidence`. Without a `range`,
+// the range is the table's last distance.
+void ReadResponse(const ObjectReader& r, ProximitySensorSettings* p) {
+  if (r.Has("response_incidence")) {
+    if (!r.Has("response"))
+      r.FailAtKey("response_incidence", "'response_incidence' needs a 'response' curve");
+    p->response_lambertian = r.Choice("response_incidence", {"lambertian", "none"}) == "lambertian";
+  }
+  if (!r.Has("response")) return;
+  static constexpr NumberRule kValue{"a number", -1e12, 1e12};
+  const auto pairs = r.Elements("response", "[distance, value] pairs", "'response'", "pair");
+  if (pairs.size() < 2 || pairs.size() > 1024)
+    r.Fail("response", "'response' must list 2 to 1024 [distance, value] pairs");
+  p->response.clear();
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    const std::vector<double> pair = pairs[i]->Numbers("pair", 2, 2, kValue);
+    if (pair[0] < 0 || pair[0] > kMaxLength)
+      r.FailAtElement("response", i, "a response distance must be a non-negative number of m");
+    if (i > 0 && !(pair[0] > p->response.back().first))
+      r.FailAtElement("response", i,
+                      "response distances must increase strictly (" + std::to_string(pair[0]) +
+                          " m after " + std::to_string(p->response.back().first) + " m)");
+    p->response.emplace_back(pair[0], pair[1]);
+  }
+  if (!r.Has("range")) p->range = p->response.back().first;
+  if (!(p->range > 0)) r.Fail("response", "the last response distance must be above 0 m");
 }
 
 void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
@@ -173,6 +210,7 @@ void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
                                "' is not an object path: start with '/' (absolute), ':' (this "
                                "model) or './' (below the sensor)");
   }
+  ReadResponse(r, &p);
   if (!p.detect_front && !p.detect_back)
     r.FailAtKey(r.Has("detect_back") ? "detect_back" : "detect_front",
                 "detect_front and detect_back are both false: the sensor would detect nothing");

@@ -25,12 +25,13 @@ constexpr int64_t kMaxRingCount = 1024;
 constexpr double kDegToRad = M_PI / 180.0;
 
 const std::vector<std::string> kCommonKeys = {
-    "name", "type", "position", "orientation_deg", "heading_deg", "children", "script"};
+    "name", "type", "position", "orientation_deg", "heading_deg", "children", "script", "if"};
 // Two loader-only types: a ring of proximity sensors, and a plugin sensor (a
 // dummy tagged with the sensor type a plugin registers).
 // proximity_ring's keys; a ring that takes every key of its sensor type
-// (light_sensor_ring) takes these but `range`, `noise`, `noise_uniform` and
-// `failure_probability`, which its type has.
+// (light_sensor_ring) takes these but `range`, `noise`, `noise_uniform`,
+// `failure_probability` and the proximity response keys (its type has the
+// first four, and no response).
 const std::vector<std::string> kRingKeys = {"name",
                                             "type",
                                             "count",
@@ -40,7 +41,10 @@ const std::vector<std::string> kRingKeys = {"name",
                                             "start_angle_deg",
                                             "noise",
                                             "noise_uniform",
-                                            "failure_probability"};
+                                            "failure_probability",
+                                            "response",
+                                            "response_incidence",
+                                            "if"};
 // The loader's rings (shorthands for `count` sensors round the parent's z
 // axis), each of a module's sensor type found by name: proximity_ring
 // (modules/proximity: each ray, its +z, points outwards; of the sensor's
@@ -65,7 +69,7 @@ const RingKind* FindRing(const std::string& type) {
 // A set of ground sensors (modules/ground_sensor's type), on a ring or at
 // listed points, with the keys of every ground sensor besides these.
 const std::vector<std::string> kGroundArrayKeys = {
-    "name", "type", "count", "radius", "start_angle_deg", "points", "height"};
+    "name", "type", "count", "radius", "start_angle_deg", "points", "height", "if"};
 constexpr char kGroundSensorType[] = "ground_sensor";
 
 // The object types a model may use: every type of the scene (the built-in
@@ -111,7 +115,7 @@ struct TypeList {
       std::vector<std::string> keys;
       for (const std::string& key : kRingKeys)
         if (key != "range" && key != "noise" && key != "noise_uniform" &&
-            key != "failure_probability")
+            key != "failure_probability" && key != "response" && key != "response_incidence")
           keys.push_back(key);
       for (const ObjectKey& key : types[static_cast<size_t>(Find(ring->sensor_type))]->keys)
         keys.push_back(key.name);
@@ -174,6 +178,18 @@ struct Builder {
     const std::string root_what = "the root object of model '" + model.name + "'";
     Fields fields(values.file(), field,
                   is_root ? root_what : "an object of model '" + model.name + "'");
+    // `if: false` (usually `if: $with_x`) leaves the object and its subtree
+    // out. It is still read, so that its mistakes are errors, unless its
+    // type is none this world has (a device of a module the registry lacks).
+    bool enabled = true;
+    if (fields.Has("if")) {
+      if (is_root) values.Fail(fields.Get("if"), "the root object of a model cannot have 'if'");
+      enabled = values.Bool(fields.Get("if"));
+      if (!enabled && fields.Has("type") && fields.Get("type").node.IsScalar() &&
+          std::find(types.names.begin(), types.names.end(), fields.Get("type").node.Scalar()) ==
+              types.names.end())
+        return;
+    }
     // A misspelled 'type' or 'name' is an unknown key (with a suggestion),
     // not a missing one: without them, check the keys first.
     if (!fields.Has("type")) fields.Expect(types.AllKeys());
@@ -202,6 +218,20 @@ struct Builder {
     if (type == "ground_array" && is_root)
       values.Fail(type_field, "a ground array cannot be the root object of a model");
     named.Expect(types.KeysOf(type));
+    if (!enabled) {  // read, then dropped
+      std::vector<ObjectSpec> dropped;
+      const int counted = objects;
+      ObjectUnconditional(named, field, depth, type, ring, name, &dropped);
+      objects = counted;
+      return;
+    }
+    ObjectUnconditional(named, field, depth, type, ring, name, out);
+  }
+
+  // The object `named` (already checked) into `out`.
+  void ObjectUnconditional(const Fields& named, const Field& field, int depth,
+                           const std::string& type, const RingKind* ring, const std::string& name,
+                           std::vector<ObjectSpec>* out) {
     if (ring != nullptr) {
       Ring(*ring, named, name, out);
       return;

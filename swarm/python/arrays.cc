@@ -263,6 +263,22 @@ Array Proximity(const Scene& scene, const ModelLayout& layout, const py::object&
   return a;
 }
 
+Array ProximityValues(const Scene& scene, const ModelLayout& layout, const py::object& out) {
+  const auto n = static_cast<py::ssize_t>(layout.robots.size());
+  const auto s = static_cast<py::ssize_t>(layout.sensor_names.size());
+  Array a = OutArray({n, s}, out);
+  double* d = a.mutable_data();
+  const std::span<const ProximitySensorData> rows = proximity::Sensors(scene).rows;
+  for (size_t k = 0; k < layout.sensor_slots.size(); ++k) {
+    const ProximitySensorData& p = rows[scene.row_at(layout.sensor_slots[k])];
+    const ProximitySensorSettings& settings = *p.settings;
+    d[k] = !settings.has_response() ? std::numeric_limits<double>::quiet_NaN()
+           : p.detected             ? static_cast<double>(p.value)
+                                    : settings.response.back().second;
+  }
+  return a;
+}
+
 py::dict RangeAndBearing(const Scene& scene, const ModelLayout& layout) {
   using range_and_bearing::RangeAndBearingRow;
   const size_t n = layout.robots.size();

@@ -52,6 +52,9 @@ Array Velocities(const Scene& scene, const ModelLayout& layout, const py::object
 // Proximity readings, N x sensors: the distance to what each sensor sees,
 // +inf where it sees nothing.
 Array Proximity(const Scene& scene, const ModelLayout& layout, const py::object& out);
+// N x sensors: each sensor's value on its response curve (`response:`; the
+// far end where it sees nothing), NaN for a sensor without one.
+Array ProximityValues(const Scene& scene, const ModelLayout& layout, const py::object& out);
 
 // What each robot's first range-and-bearing board heard in the last sense
 // phase, as flat arrays: robot i's readings are rows offsets[i] to

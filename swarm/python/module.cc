@@ -66,6 +66,9 @@ class Robots {
   py::object proximity() {
     return Cached(&proximity_, [&] { return Proximity(Sc(), *layout_, py::none()); });
   }
+  py::object proximity_values() {
+    return Cached(&proximity_values_, [&] { return ProximityValues(Sc(), *layout_, py::none()); });
+  }
   py::object ground() {
     return Cached(&ground_, [&] { return Ground(Sc(), *layout_, py::none()); });
   }
@@ -114,8 +117,8 @@ class Robots {
   World* world_;
   const ModelLayout* layout_;
   bool planar_;
-  py::object poses_, velocities_, proximity_, ground_, light_, joint_positions_, joint_velocities_,
-      range_and_bearing_;
+  py::object poses_, velocities_, proximity_, proximity_values_, ground_, light_, joint_positions_,
+      joint_velocities_, range_and_bearing_;
 };
 
 struct ControllerConfig {
@@ -409,6 +412,9 @@ class PyWorld {
   py::object proximity(const std::string& model, const py::object& out) {
     return Proximity(Any().scene(), Layout(model), out);
   }
+  py::object proximity_values(const std::string& model, const py::object& out) {
+    return ProximityValues(Any().scene(), Layout(model), out);
+  }
   py::object ground(const std::string& model, const py::object& out) {
     return Ground(Any().scene(), Layout(model), out);
   }
@@ -573,6 +579,7 @@ PYBIND11_MODULE(_swarmsim, m) {
       .def_property_readonly("poses", &Robots::poses)
       .def_property_readonly("velocities", &Robots::velocities)
       .def_property_readonly("proximity", &Robots::proximity)
+      .def_property_readonly("proximity_values", &Robots::proximity_values)
       .def_property_readonly("ground", &Robots::ground)
       .def_property_readonly("ground_names", &Robots::ground_names)
       .def_property_readonly("light", &Robots::light)
@@ -603,6 +610,8 @@ PYBIND11_MODULE(_swarmsim, m) {
            py::arg("columns") = 0)
       .def("velocities", &PyWorld::velocities, py::arg("model") = "", py::arg("out") = py::none())
       .def("proximity", &PyWorld::proximity, py::arg("model") = "", py::arg("out") = py::none())
+      .def("proximity_values", &PyWorld::proximity_values, py::arg("model") = "",
+           py::arg("out") = py::none())
       .def("ground", &PyWorld::ground, py::arg("model") = "", py::arg("out") = py::none())
       .def("ground_names", &PyWorld::ground_names, py::arg("model") = "")
       .def("light", &PyWorld::light, py::arg("model") = "", py::arg("out") = py::none())

@@ -93,6 +93,25 @@ class WorldTest(unittest.TestCase):
         with self.assertRaises(ValueError):
             w.poses(columns=4)
 
+    def test_proximity_values_read_the_response_curve(self):
+        # e-pucks (worlds/models/epuck.yaml): 8 IR sensors with Webots's curve,
+        # 67.19 (the far end) where nothing is seen, more where something is.
+        w = swarmsim.World(world("epuck_diffusion.yaml"), seed=3,
+                           set={"robots": 200, "density": 20.0})
+        w.step(5)
+        d = w.proximity("epuck")
+        v = w.proximity_values("epuck")
+        self.assertEqual(v.shape, (200, 8))
+        seen = np.isfinite(d)
+        self.assertTrue(seen.any(), "in a dense swarm some sensor sees something")
+        self.assertTrue(np.allclose(v[~seen], 67.19, atol=1e-3))
+        self.assertTrue(np.all((v[seen] >= 67.19 - 1e-3) & (v[seen] <= 4095)))
+        self.assertTrue((v[seen] > 100).any())
+        # A foot-bot's rays have no curve: NaN.
+        f = swarmsim.World(world("diffusion.yaml"), seed=3, set={"robots": 10})
+        f.step(1)
+        self.assertTrue(np.isnan(f.proximity_values("footbot")).all())
+
     def test_sensor_and_joint_arrays(self):
         w = swarmsim.World(world("diffusion.yaml"), seed=3, set={"robots": 200, "density": 4.0})
         self.assertEqual(w.sensor_names("footbot")[:2], ["prox[0]", "prox[1]"])
