@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <memory>
 
+#include "framework/device_access.h"
 #include "framework/floor_layer.h"
 #include "framework/registry.h"
 #include "framework/scene.h"
@@ -20,8 +21,18 @@ namespace {
 
 constexpr int64_t kRowGrain = 512;
 
-class Sensing final : public Module {
+// Also the plugins' read_sensor_value for ground sensors (framework/device_access.h).
+class Sensing final : public Module, public SensorValueAccess {
  public:
+  int ReadValue(const Scene& scene, ObjectId id, double* value) const noexcept override {
+    ObjectType type;
+    if (!FindSensorType(scene, &type) || !scene.IsValid(id)) return -1;
+    const uint32_t slot = scene.SlotOf(id);
+    if (scene.type_at(slot) != type) return -1;
+    *value = scene.rows<GroundSensorRow>(type).rows[scene.row_at(slot)].value;
+    return 0;
+  }
+
   void Sense(World* world) override {
     Scene& scene = world->scene();
     ObjectType type;

@@ -164,6 +164,13 @@ const LightSensorRow* FindSensor(const Scene& scene, ObjectId id) {
   return &scene.rows<LightSensorRow>(type).rows[scene.row_at(slot)];
 }
 
+int LightSensingModule::ReadValue(const Scene& scene, ObjectId id, double* value) const noexcept {
+  const LightSensorRow* sensor = FindSensor(scene, id);
+  if (sensor == nullptr) return -1;
+  *value = sensor->reading;
+  return 0;
+}
+
 void Register(ModuleRegistry* registry) {
   registry->RegisterModule(
       {{"sensor", kModuleName, "1.0",
