@@ -201,9 +201,10 @@ void BlobCameraModule::AddNoise(uint32_t slot, BlobCameraRow* camera) const {
 
 int BlobCameraModule::SetLed(Scene* scene, int robot, ObjectId id, const Vec3& color,
                              bool on) const noexcept {
-  ObjectType type;
-  if (!scene->FindType(kLedTypeName, &type) || !scene->IsValid(id) || robot < 0 ||
-      scene->instance_of(id) != robot)
+  // The type the sense phase found, once it looked (no search by name).
+  ObjectType type = led_type_;
+  if (!(types_found_ ? have_types_ : scene->FindType(kLedTypeName, &type)) || !scene->IsValid(id) ||
+      robot < 0 || scene->instance_of(id) != robot)
     return -1;
   const uint32_t slot = scene->SlotOf(id);
   if (scene->type_at(slot) != type) return -1;
