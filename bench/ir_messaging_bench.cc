@@ -4,9 +4,9 @@
 // jittered by up to 5 mm, each with a transceiver (the Kilobot's defaults:
 // 10 cm, 12-byte messages of 4 ms, carrier sense, collisions, 2 mm noise),
 // so that about 12 others are within range. Each step one robot in 16
-// queues a 12-byte message (robot i when (i + step) % 16 == 0: every 0.5 s
-// at 1/32 s steps, as kilolib sends), as a controller would before the
-// sense phase. Kinematic physics, no scripts.
+// queues a 12-byte message (each robot every 16th step, at a random phase:
+// every 0.5 s at 1/32 s steps, as kilolib sends), as a controller would
+// before the sense phase. Kinematic physics, no scripts.
 //
 //   BM_Sense/N/threads  the module's sense phase alone (queuing included)
 //   BM_Step/N/threads   the whole world step (sense, control with nothing
@@ -40,12 +40,13 @@ struct Swarm {
   std::unique_ptr<World> world;
   ObjectType type{};
   int64_t step = 0;
+  std::vector<std::vector<uint32_t>> by_phase;  // the robots that queue at step % 16
   size_t heard = 0, queued = 0, sent = 0;
   Rows<IrTransceiverRow>& rows() { return world->scene().rows<IrTransceiverRow>(type); }
   // One robot in 16 queues its message.
   void Queue() {
     Rows<IrTransceiverRow>& r = rows();
-    for (size_t i = static_cast<size_t>((16 - step % 16) % 16); i < r.size(); i += 16) {
+    for (uint32_t i : by_phase[static_cast<size_t>(step % 16)]) {
       r.rows[i].outgoing.assign(12, static_cast<uint8_t>(i));
       r.rows[i].queued = true;
     }
@@ -74,7 +75,9 @@ std::unique_ptr<Swarm> MakeSwarm(int robots, int threads) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> jitter(-0.005, 0.005);
   const Shared<IrSettings> shared(IrSettings{});
+  swarm->by_phase.resize(16);
   for (int i = 0; i < robots; ++i) {
+    swarm->by_phase[rng() % 16].push_back(static_cast<uint32_t>(i));
     const double x = spacing * (i % per_row) + jitter(rng);
     const double y = spacing * (i / per_row) + jitter(rng);
     const std::string name = "bot#" + std::to_string(i);

@@ -55,7 +55,7 @@ constexpr double kMaxCellsPerItem = 4;
 void IrMessagingModule::Grid::Build(const std::vector<Transmission>& t, double cell) {
   cells_x = cells_y = 0;
   start.clear();
-  items.clear();
+  points.clear();
   if (t.empty()) return;
   double x1 = -INFINITY, y1 = -INFINITY;
   x0 = INFINITY, y0 = INFINITY;
@@ -80,10 +80,10 @@ void IrMessagingModule::Grid::Build(const std::vector<Transmission>& t, double c
   };
   for (const Transmission& m : t) ++start[cell_of(m) + 1];
   for (size_t c = 0; c < cells; ++c) start[c + 1] += start[c];
-  items.resize(t.size());
-  std::vector<uint32_t>& fill = fill_;
-  fill.assign(start.begin(), start.end() - 1);
-  for (size_t i = 0; i < t.size(); ++i) items[fill[cell_of(t[i])]++] = static_cast<uint32_t>(i);
+  points.resize(t.size());
+  fill_.assign(start.begin(), start.end() - 1);
+  for (size_t i = 0; i < t.size(); ++i)
+    points[fill_[cell_of(t[i])]++] = {t[i].x, t[i].y, t[i].z, static_cast<uint32_t>(i)};
 }
 
 template <class Visit>
@@ -97,7 +97,7 @@ void IrMessagingModule::Grid::Near(double x, double y, Visit&& visit) const {
   const int y_lo = std::max(0, iy - 1), y_hi = std::min(cells_y - 1, iy + 1);
   for (int cy = y_lo; cy <= y_hi; ++cy) {
     const size_t row = static_cast<size_t>(cy) * static_cast<size_t>(cells_x);
-    for (size_t e = start[row + x_lo]; e < start[row + x_hi + 1]; ++e) visit(items[e]);
+    for (size_t e = start[row + x_lo]; e < start[row + x_hi + 1]; ++e) visit(points[e]);
   }
 }
 
@@ -124,7 +124,8 @@ void IrMessagingModule::Transmit(double time_step) {
     bool busy = false;
     if (m.carrier_sense) {
       const double range2 = m.range * m.range;
-      grid_.Near(m.x, m.y, [&](uint32_t j) {
+      grid_.Near(m.x, m.y, [&](const Grid::Point& point) {
+        const uint32_t j = point.index;
         if (busy || j >= i || went_out_[j] == 0) return;
         const Transmission& o = queued_[j];
         if (!(o.start < m.start && m.start < o.end)) return;
@@ -153,16 +154,17 @@ void IrMessagingModule::Hear(const Scene& scene, const Rows<IrTransceiverRow>& r
   // Its own transmission, if it went out (half duplex).
   double own_start = 0, own_end = 0;
   bool own = false;
-  grid_.Near(p.x, p.y, [&](uint32_t i) {
-    const Transmission& m = on_air_[i];
+  grid_.Near(p.x, p.y, [&](const Grid::Point& point) {
+    const double dx = point.x - p.x, dy = point.y - p.y, dz = point.z - p.z;
+    const double d2 = dx * dx + dy * dy + dz * dz;
+    if (d2 > range2) return;  // also its own: at distance 0, always in range
+    const Transmission& m = on_air_[point.index];
     if (m.slot == slot) {
       own = true, own_start = m.start, own_end = m.end;
       return;
     }
     if (instance >= 0 && m.instance == instance) return;  // a robot never hears itself
-    const double dx = m.x - p.x, dy = m.y - p.y, dz = m.z - p.z;
-    const double d2 = dx * dx + dy * dy + dz * dz;
-    if (d2 <= range2) heard.push_back({i, std::sqrt(d2)});
+    heard.push_back({point.index, std::sqrt(d2)});
   });
   if (heard.empty()) return;
   // Arrival order (on_air_ is by start time); a few items: insertion sort.

@@ -51,13 +51,18 @@ class IrMessagingModule final : public Module, public IrAccess {
   // largest range: a receiver's 3 x 3 block of cells holds every sender
   // within its range), as CSR arrays.
   struct Grid {
+    // An item's position and index, stored by cell: a query reads memory in order.
+    struct Point {  // 32 bytes
+      double x, y, z;
+      uint32_t index;
+    };
     double x0 = 0, y0 = 0, inv_cell = 1;
     int cells_x = 0, cells_y = 0;
     std::vector<uint32_t> start;  // first entry of each cell (cells + 1)
-    std::vector<uint32_t> items;  // indices, by cell, ascending in a cell
+    std::vector<Point> points;    // by cell, ascending index in a cell
     std::vector<uint32_t> fill_;  // build scratch
     void Build(const std::vector<Transmission>& t, double cell);
-    // Calls visit(index) for every item in the 3 x 3 cells about (x, y).
+    // Calls visit(point) for every item in the 3 x 3 cells about (x, y).
     template <class Visit>
     void Near(double x, double y, Visit&& visit) const;
   };
