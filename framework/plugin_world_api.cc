@@ -4,6 +4,7 @@
 #include <span>
 #include <variant>
 
+#include "framework/device_access.h"
 #include "framework/plugin_controllers.h"
 #include "framework/plugin_object_type.h"
 #include "framework/plugin_sensors.h"
@@ -252,12 +253,47 @@ int ReadRangeAndBearing(void* world, int64_t board, SwarmsimRangeAndBearingReadi
   return boards->Read(w.scene(), ObjectId::FromInteger(board), out, out != nullptr ? max : 0);
 }
 
-// --- ABI 8 (stubs until the modules implement them) ---
-int ReadSensorValue(void*, int64_t, double*) { return -1; }
-int SetLed(void*, int, int64_t, double, double, double, int) { return -1; }
-int IrSend(void*, int, int64_t, const uint8_t*, size_t) { return -1; }
-int IrSent(void*, int64_t) { return -1; }
-int IrReceive(void*, int64_t, SwarmsimIrMessage*, int) { return -1; }
+// --- ABI 8 ---------------------------------------------------------------------------
+// Each through the narrow service of the module that owns the device
+// (framework/device_access.h): the framework names no module's types.
+
+// The world's services, found when it started (framework/world.h).
+const World::DeviceServices& Services(void* world) { return W(world).device_services(); }
+
+int ReadSensorValue(void* world, int64_t sensor, double* value) {
+  World& w = W(world);
+  if (value == nullptr) return -1;
+  const ObjectId id = ObjectId::FromInteger(sensor);
+  for (const SensorValueAccess* s : {Services(world).light, Services(world).ground})
+    if (s != nullptr && s->ReadValue(w.scene(), id, value) == 0) return 0;
+  return -1;
+}
+
+int SetLed(void* world, int robot, int64_t led, double red, double green, double blue, int on) {
+  const LedAccess* leds = Services(world).leds;
+  if (leds == nullptr) return -1;
+  return leds->SetLed(&W(world).scene(), robot, ObjectId::FromInteger(led), {red, green, blue},
+                      on != 0);
+}
+
+int IrSend(void* world, int robot, int64_t ir, const uint8_t* data, size_t size) {
+  const IrAccess* transceivers = Services(world).ir;
+  if (transceivers == nullptr || (data == nullptr && size > 0)) return -1;
+  return transceivers->Send(&W(world).scene(), robot, ObjectId::FromInteger(ir), data, size);
+}
+
+int IrSent(void* world, int64_t ir) {
+  const IrAccess* transceivers = Services(world).ir;
+  if (transceivers == nullptr) return -1;
+  return transceivers->Sent(W(world).scene(), ObjectId::FromInteger(ir));
+}
+
+int IrReceive(void* world, int64_t ir, SwarmsimIrMessage* out, int max) {
+  const IrAccess* transceivers = Services(world).ir;
+  if (transceivers == nullptr) return -1;
+  return transceivers->Receive(W(world).scene(), ObjectId::FromInteger(ir), out,
+                               out != nullptr ? max : 0);
+}
 
 constexpr SwarmsimWorldApi kWorldApi = {WorldTime,
                                         ObjectPosition,

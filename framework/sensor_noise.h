@@ -48,6 +48,8 @@ enum class NoisePurpose : uint32_t {
   kWheels = 7,
   kBlobCamera = 8,
   kCapacity = 9,
+  kIrTransmit = 10,  // an IR message's start time (the sender's stream)
+  kIrReceive = 11,   // an IR receiver's failure, losses and distance noise
 };
 
 // The stream of one device (object slot) at one step for one purpose. Slots

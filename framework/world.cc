@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "framework/calculation_module.h"
+#include "framework/device_access.h"
 #include "framework/dynamics_backend.h"
 #include "framework/error.h"
 #include "framework/line_of_sight.h"
@@ -292,6 +293,10 @@ void World::Start() {
       InstallModule(descriptor->info.name, descriptor->order, descriptor->phases,
                     descriptor->make(this, nullptr));
   for (const ModuleEntry& e : modules_) e.instance->Start(this);
+  device_services_ = {dynamic_cast<const SensorValueAccess*>(find_module("light")),
+                      dynamic_cast<const SensorValueAccess*>(find_module("ground_sensor")),
+                      dynamic_cast<const LedAccess*>(find_module("blobs")),
+                      dynamic_cast<const IrAccess*>(find_module("ir_messaging"))};
   scripts_ = MakeScriptHost(this);
   started_ = true;
   try {

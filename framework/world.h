@@ -35,6 +35,9 @@ namespace swarmsim {
 using CalculationModule = Module;  // framework/calculation_module.h
 class DynamicsBackend;
 class FloorLayer;
+class IrAccess;
+class LedAccess;
+class SensorValueAccess;
 class ModuleRegistry;
 struct PhaseCallback;
 class PluginControllers;
@@ -379,6 +382,15 @@ class World : public PhaseHandlers {
   void SetNativeController(int robot, const PluginControllerType* type, bool in_place_of_scripts);
   // Null when no robot has one.
   PluginControllers* plugin_controllers() { return controllers_.get(); }
+  // The device services of the plugins' world API (framework/device_access.h),
+  // found once when the world starts (null without the module, and before).
+  struct DeviceServices {
+    const SensorValueAccess* light = nullptr;   // the "light" module's
+    const SensorValueAccess* ground = nullptr;  // the "ground_sensor" module's
+    const LedAccess* leds = nullptr;            // the "blobs" module's
+    const IrAccess* ir = nullptr;               // the "ir_messaging" module's
+  };
+  const DeviceServices& device_services() const { return device_services_; }
 
   // --- Messages and signals ------------------------------------------------------------
   // Delivered at the start of each step; signal writes applied when a
@@ -441,7 +453,8 @@ class World : public PhaseHandlers {
   const LineOfSight* line_of_sight_ = nullptr;             // owned by the module that provides it
   const ProximityReadings* proximity_readings_ = nullptr;  // the same
   std::unique_ptr<ScriptHost> scripts_;
-  const FloorLayer* floor_layer_ = nullptr;         // owned by its module
+  const FloorLayer* floor_layer_ = nullptr;  // owned by its module
+  DeviceServices device_services_;
   std::unique_ptr<PluginControllers> controllers_;  // null: no robot has a native controller
   std::vector<RobotRuntime> runtimes_;
   // Per robot, which of its RobotRuntime buffers may hold something (kPending*

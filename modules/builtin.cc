@@ -14,6 +14,7 @@
 #include "modules/force_sensor/force_sensor.h"
 #include "modules/graphs/graphs.h"
 #include "modules/ground_sensor/ground_sensor.h"
+#include "modules/ir_messaging/ir_messaging.h"
 #include "modules/kinematics/ik_groups.h"
 #include "modules/light/light.h"
 #include "modules/metrics/swarm_metrics.h"
@@ -78,6 +79,7 @@ void RegisterBuiltinModules(ModuleRegistry* registry) {
   light::Register(registry);   // light sources and light sensors
   video::Register(registry);   // snapshots and video: the program's view recorder
   range_and_bearing::Register(registry);
+  ir_messaging::Register(registry);  // IR transceivers (Kilobot messaging)
   // World-file sections, in the order the loader reads them.
   registry->RegisterWorldSection(metrics::MetricsSection());
   registry->RegisterWorldSection(floors::FloorSection());  // before paint: paint starts from it

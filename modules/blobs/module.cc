@@ -199,6 +199,23 @@ void BlobCameraModule::AddNoise(uint32_t slot, BlobCameraRow* camera) const {
   }
 }
 
+int BlobCameraModule::SetLed(Scene* scene, int robot, ObjectId id, const Vec3& color,
+                             bool on) const noexcept {
+  // The type the sense phase found, once it looked (no search by name).
+  ObjectType type = led_type_;
+  if (!(types_found_ ? have_types_ : scene->FindType(kLedTypeName, &type)) || !scene->IsValid(id) ||
+      robot < 0 || scene->instance_of(id) != robot)
+    return -1;
+  const uint32_t slot = scene->SlotOf(id);
+  if (scene->type_at(slot) != type) return -1;
+  LedRow& led = static_cast<Rows<LedRow>&>(*scene->rows(type)).rows[scene->row_at(slot)];
+  // Each channel clamped to 0..1 (NaN reads 0).
+  const auto channel = [](double v) { return v > 0 ? (v < 1 ? v : 1.0) : 0.0; };
+  led.color = {channel(color.x), channel(color.y), channel(color.z)};
+  led.on = on;
+  return 0;
+}
+
 void BlobCameraModule::Sense(World* world) {
   Scene& scene = world->scene();
   if (!types_found_) {

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "framework/device_access.h"
 #include "framework/module.h"
 #include "framework/object_rows.h"
 #include "framework/spatial_grid.h"
@@ -24,9 +25,12 @@ inline constexpr const char* kModuleName = "blobs";
 // The metrics of colour clustering (metrics.cc).
 void RegisterColorMetrics(ModuleRegistry* registry);
 
-class BlobCameraModule final : public Module {
+// Also the plugins' set_led (framework/device_access.h).
+class BlobCameraModule final : public Module, public LedAccess {
  public:
   void Sense(World* world) override;
+  int SetLed(Scene* scene, int robot, ObjectId id, const Vec3& color,
+             bool on) const noexcept override;
 
  private:
   struct LitLed {  // 64 bytes

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <memory>
 
+#include "framework/device_access.h"
 #include "framework/floor_layer.h"
 #include "framework/registry.h"
 #include "framework/scene.h"
@@ -20,13 +21,27 @@ namespace {
 
 constexpr int64_t kRowGrain = 512;
 
-class Sensing final : public Module {
+// Also the plugins' read_sensor_value for ground sensors (framework/device_access.h).
+class Sensing final : public Module, public SensorValueAccess {
  public:
+  int ReadValue(const Scene& scene, ObjectId id, double* value) const noexcept override {
+    // The type the sense phase found, once it looked (no search by name).
+    ObjectType type = type_;
+    if (!(type_found_ ? have_type_ : FindSensorType(scene, &type)) || !scene.IsValid(id)) return -1;
+    const uint32_t slot = scene.SlotOf(id);
+    if (scene.type_at(slot) != type) return -1;
+    *value = scene.rows<GroundSensorRow>(type).rows[scene.row_at(slot)].value;
+    return 0;
+  }
+
   void Sense(World* world) override {
     Scene& scene = world->scene();
-    ObjectType type;
-    if (!FindSensorType(scene, &type)) return;
-    Rows<GroundSensorRow>& rows = scene.rows<GroundSensorRow>(type);
+    if (!type_found_) {
+      have_type_ = FindSensorType(scene, &type_);
+      type_found_ = true;
+    }
+    if (!have_type_) return;
+    Rows<GroundSensorRow>& rows = scene.rows<GroundSensorRow>(type_);
     if (rows.size() == 0) return;
     const FloorLayer* floor = world->floor_layer();
     const uint64_t seed = world->settings().seed;
@@ -37,6 +52,11 @@ class Sensing final : public Module {
                     static_cast<size_t>(end));
         });
   }
+
+ private:
+  bool type_found_ = false;  // looked for the type (first sense phase)
+  bool have_type_ = false;
+  ObjectType type_{};
 };
 
 }  // namespace

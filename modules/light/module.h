@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "framework/device_access.h"
 #include "framework/module.h"
 #include "framework/object_rows.h"
 #include "framework/spatial_grid.h"
@@ -28,9 +29,11 @@ inline constexpr const char* kModuleName = "light";
 // The Lua area of both types (lua_api_light.cc).
 void RegisterLightApi(lua_State* L);
 
-class LightSensingModule final : public Module {
+// Also the plugins' read_sensor_value for light sensors (framework/device_access.h).
+class LightSensingModule final : public Module, public SensorValueAccess {
  public:
   void Sense(World* world) override;
+  int ReadValue(const Scene& scene, ObjectId id, double* value) const noexcept override;
 
  private:
   struct LitSource {   // 48 bytes

@@ -164,6 +164,19 @@ const LightSensorRow* FindSensor(const Scene& scene, ObjectId id) {
   return &scene.rows<LightSensorRow>(type).rows[scene.row_at(slot)];
 }
 
+int LightSensingModule::ReadValue(const Scene& scene, ObjectId id, double* value) const noexcept {
+  // The type the sense phase found, once there was one (no search by name).
+  const LightSensorRow* sensor = nullptr;
+  if (!types_found_) {
+    sensor = FindSensor(scene, id);
+  } else if (have_types_ && scene.IsValid(id) && scene.type_at(scene.SlotOf(id)) == sensor_type_) {
+    sensor = &scene.rows<LightSensorRow>(sensor_type_).rows[scene.row_at(scene.SlotOf(id))];
+  }
+  if (sensor == nullptr) return -1;
+  *value = sensor->reading;
+  return 0;
+}
+
 void Register(ModuleRegistry* registry) {
   registry->RegisterModule(
       {{"sensor", kModuleName, "1.0",

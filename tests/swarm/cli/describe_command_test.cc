@@ -24,7 +24,7 @@ TEST(CliTest, DescribeNamesTheModulesAWorldGets) {
   EXPECT_EQ(describe.exit_code, 0) << describe.output;
   EXPECT_NE(describe.output.find(
                 "modules: ik paint proximity collision mill paths planning rendering graphs blobs "
-                "ground_sensor light range_and_bearing\n"),
+                "ground_sensor light range_and_bearing ir_messaging\n"),
             std::string::npos)
       << describe.output;
 }
