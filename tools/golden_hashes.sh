@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Writes tests/data/golden_hashes.tsv: the state hash of every example world
-# (worlds/*.yaml, worlds/experiments/*.yaml, bench/worlds/*.yaml) and of the coverage worlds
+# (worlds/*.yaml, worlds/experiments/*.yaml, worlds/kilobot/*.yaml, bench/worlds/*.yaml) and of the coverage worlds
 # (tests/data/worlds/golden_*.yaml: every object type, copied and scaled) after a fixed number of steps, for two
 # seeds and 1 and 2 threads, as `swarmsim run WORLD --hash` prints it.
 # tests/swarm/run/golden_hashes_test.cc fails when any of them drifts.
@@ -25,7 +25,7 @@ missing_map() {
   done
   return 1
 }
-for world in worlds/*.yaml worlds/experiments/*.yaml bench/worlds/*.yaml tests/data/worlds/golden_*.yaml; do
+for world in worlds/*.yaml worlds/experiments/*.yaml worlds/kilobot/*.yaml bench/worlds/*.yaml tests/data/worlds/golden_*.yaml; do
   if map=$(missing_map "$world"); then
     echo "golden_hashes: $world: $map is not here; its rows are kept" >&2
     grep -P "^\Q$world\E\t" "$table" >>"$tmp" || true

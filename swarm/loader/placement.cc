@@ -147,8 +147,8 @@ std::vector<Placement2> Placer::Lattice(const Region2& region, int64_t count, do
   const int64_t used_columns = std::min(columns, count);
   const double pitch = hexagonal ? spacing * std::sqrt(3.0) / 2 : spacing;
   // The block's extent (a hexagonal block's shifted rows reach half a spacing further).
-  const double width = static_cast<double>(used_columns - 1) * spacing +
-                       (hexagonal && rows > 1 ? spacing / 2 : 0);
+  const double width =
+      static_cast<double>(used_columns - 1) * spacing + (hexagonal && rows > 1 ? spacing / 2 : 0);
   const double height = static_cast<double>(rows - 1) * pitch;
   const double x0 = (region.min_x + region.max_x - width) / 2;
   const double y0 = (region.min_y + region.max_y - height) / 2;
@@ -156,8 +156,8 @@ std::vector<Placement2> Placer::Lattice(const Region2& region, int64_t count, do
   out.reserve(static_cast<size_t>(count));
   for (int64_t k = 0; k < count; ++k) {
     const int64_t row = k / columns, column = k % columns;
-    const double x = x0 + static_cast<double>(column) * spacing +
-                     (hexagonal && row % 2 == 1 ? spacing / 2 : 0);
+    const double x =
+        x0 + static_cast<double>(column) * spacing + (hexagonal && row % 2 == 1 ? spacing / 2 : 0);
     const double y = y0 + static_cast<double>(row) * pitch;
     const bool inside = x - radius >= region.min_x && x + radius <= region.max_x &&
                         y - radius >= region.min_y && y + radius <= region.max_y;

@@ -89,9 +89,8 @@ class Placer {
   // copy k's disc of `radius` leaves the region or touches an obstacle or
   // a placed body (*first_bad = k); bodies are kept only on success.
   std::vector<Placement2> Lattice(const Region2& region, int64_t count, double radius,
-                                  double spacing, bool hexagonal, int64_t columns,
-                                  uint64_t stream, std::optional<double> heading,
-                                  int64_t* first_bad);
+                                  double spacing, bool hexagonal, int64_t columns, uint64_t stream,
+                                  std::optional<double> heading, int64_t* first_bad);
 
   // True if a disc at (x, y) of `radius` keeps `clearance` from every body
   // and obstacle (what Distribute checks for each candidate).

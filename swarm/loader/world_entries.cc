@@ -516,14 +516,13 @@ void WorldLoader::ReadLattice(const Fields& d, const ValueReader& world_values,
   if (l.Has("shape")) {
     const std::string shape = world_values.String(l.Get("shape"));
     if (shape != "square" && shape != "hexagonal")
-      file_->Fail(l.Get("shape").mark,
-                  "'shape' must be square or hexagonal (got '" + shape + "')");
+      file_->Fail(l.Get("shape").mark, "'shape' must be square or hexagonal (got '" + shape + "')");
     plan.hexagonal = shape == "hexagonal";
   }
-  const int64_t square_side =
-      static_cast<int64_t>(std::ceil(std::sqrt(static_cast<double>(std::max<int64_t>(entry->count, 1)))));
-  plan.columns = l.Has("columns") ? world_values.Integer(l.Get("columns"), 1, kMaxCount)
-                                  : square_side;
+  const int64_t square_side = static_cast<int64_t>(
+      std::ceil(std::sqrt(static_cast<double>(std::max<int64_t>(entry->count, 1)))));
+  plan.columns =
+      l.Has("columns") ? world_values.Integer(l.Get("columns"), 1, kMaxCount) : square_side;
   entry->lattice = plan;
 }
 
@@ -599,14 +598,13 @@ void WorldLoader::PlaceEntries() {
     if (!e.distribute) continue;
     if (e.lattice) {
       int64_t bad = -1;
-      e.placements = placer_->Lattice(e.region, e.count, e.MaxFootprintRadius(), e.lattice->spacing,
-                                      e.lattice->hexagonal, e.lattice->columns, stream++,
-                                      e.heading, &bad);
+      e.placements =
+          placer_->Lattice(e.region, e.count, e.MaxFootprintRadius(), e.lattice->spacing,
+                           e.lattice->hexagonal, e.lattice->columns, stream++, e.heading, &bad);
       if (bad >= 0)
         file_->Fail(e.lattice->field.mark,
-                    "the lattice does not fit: " + e.model->name + " copy " +
-                        std::to_string(bad) + " of " + std::to_string(e.count) + " would " +
-                        "leave " + e.region_text +
+                    "the lattice does not fit: " + e.model->name + " copy " + std::to_string(bad) +
+                        " of " + std::to_string(e.count) + " would " + "leave " + e.region_text +
                         " or overlap a wall, an obstacle, the map or another placed copy; "
                         "enlarge the region, or reduce 'spacing' or 'count'");
       continue;

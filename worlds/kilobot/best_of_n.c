@@ -44,9 +44,12 @@ uint8_t heard[2] = {255, 255};  // the last two opinions heard (255: none)
 uint32_t last_ticks = 0;
 message_t message;
 
-// True with probability about 1 / mean_ticks (a geometric duration).
+// True with probability about 1 / mean_ticks (a geometric duration). Two
+// bytes of rand_hard: kilolib's rand_soft is an 8-bit generator whose
+// consecutive bytes are far from independent (after a 0 the next byte is
+// small), which would erase the difference between the two qualities.
 uint8_t ends_now(uint16_t mean_ticks) {
-  uint16_t r = ((uint16_t)rand_soft() << 8) | rand_soft();
+  uint16_t r = ((uint16_t)rand_hard() << 8) | rand_hard();
   return r < 65535u / mean_ticks;
 }
 
@@ -88,7 +91,6 @@ void decide(void) {
 }
 
 void setup(void) {
-  rand_seed(rand_hard());
   opinion = kilo_uid % 2;
   compose();
   show();
@@ -109,7 +111,7 @@ void loop(void) {
       }
     }
     if (motion == STOP || ends_now(STEER_TICKS)) {
-      uint8_t r = rand_soft() % 4;
+      uint8_t r = rand_hard() % 4;
       set_motion(r < 2 ? FORWARD : (r == 2 ? LEFT : RIGHT));
     }
   }

@@ -3,11 +3,14 @@
 // Written here from kilolib's documentation as the classic Kilobot "orbit"
 // exercise. The star (kilo_uid 0) stays still and broadcasts; the planet
 // (every other robot) uses estimate_distance on each message from the star
-// and steers: too close -> straight ahead (away, once it has turned past
-// the star), closer than DESIRED -> turn left, farther -> turn right. Its
-// distance to the star then stays in a band about DESIRED while it travels
-// around it. LED: the star blue; the planet green while turning left, red
-// while turning right, white while going straight.
+// and steers: straight ahead, but turning right (towards the star) while
+// it is more than BAND_MM farther than DESIRED_MM and not getting closer,
+// and left (away) while it is too close and not getting farther, so that it
+// ends up heading along the circle. Started beside the star
+// facing along the circle (the star on its right), it goes round clockwise
+// and its distance stays in a band about DESIRED_MM. LED: the star blue;
+// the planet green while turning left, red while turning right, white while
+// going straight.
 //
 //   swarmsim kilobot build worlds/kilobot/orbit.c
 //   swarmsim run worlds/kilobot/orbit.yaml
@@ -15,12 +18,13 @@
 
 #define STAR_UID 0
 #define DESIRED_MM 60
-#define TOO_CLOSE_MM 40
+#define BAND_MM 5
 
 enum motion { STOP, FORWARD, LEFT, RIGHT };
 
 uint8_t motion = STOP;
 uint8_t distance_mm = 0;
+uint8_t previous_mm = 0;  // the distance at the last decision
 uint8_t heard = 0;
 message_t message;
 
@@ -54,12 +58,15 @@ void setup(void) {
 void loop(void) {
   if (kilo_uid == STAR_UID || !heard) return;
   heard = 0;
-  if (distance_mm < TOO_CLOSE_MM)
-    set_motion(FORWARD);
-  else if (distance_mm < DESIRED_MM)
+  // Turn only while the distance moves the wrong way: heading along the
+  // circle it stays put, so the planet ends up going round.
+  if (distance_mm > DESIRED_MM + BAND_MM && distance_mm >= previous_mm)
+    set_motion(RIGHT);
+  else if (distance_mm < DESIRED_MM - BAND_MM && distance_mm <= previous_mm)
     set_motion(LEFT);
   else
-    set_motion(RIGHT);
+    set_motion(FORWARD);
+  previous_mm = distance_mm;
 }
 
 message_t* message_tx(void) { return kilo_uid == STAR_UID ? &message : 0; }

@@ -7,8 +7,8 @@
 // wraps. It sends its clock's current value with every message (the value is
 // taken in kilo_message_tx, when the message goes out). For each message it
 // hears it notes how far ahead the sender's clock is (between -PERIOD/2 and
-// PERIOD/2); each time its own clock wraps it moves its clock by half the
-// average of those offsets. The clocks of a connected group converge: the
+// PERIOD/2); each time its own clock wraps it moves its clock by a quarter
+// of the average of those offsets (what falls below a tick is carried). The clocks of a connected group converge: the
 // robots flash together. Robots do not move.
 //
 //   swarmsim kilobot build worlds/kilobot/sync.c
@@ -22,6 +22,7 @@ uint32_t last_ticks = 0;
 uint8_t clock = 0;           // 0 .. PERIOD - 1
 int16_t offset_sum = 0;
 uint8_t offset_count = 0;
+int16_t fraction = 0;        // the part of a correction below a tick, in 1/16 ticks
 message_t message;
 
 void setup(void) {
@@ -36,7 +37,12 @@ void loop(void) {
     if (++clock >= PERIOD) {
       clock = 0;
       if (offset_count > 0) {
-        int16_t shift = offset_sum / offset_count / 2;
+        // A quarter of the mean offset, kept in 1/16 ticks so that what a
+        // whole tick cannot hold carries over to the next period (rounding
+        // each period would let every hop of the swarm keep a tick or two).
+        int16_t correction = (int16_t)(offset_sum * 4 / offset_count) + fraction;
+        int16_t shift = correction / 16;
+        fraction = correction - shift * 16;
         clock = (uint8_t)((clock + PERIOD + shift) % PERIOD);
       }
       offset_sum = 0;

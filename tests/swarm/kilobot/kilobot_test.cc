@@ -16,7 +16,6 @@
 #include <set>
 #include <string>
 
-#include "framework/plugin_world_api.h"
 #include "framework/registry.h"
 #include "framework/scene.h"
 #include "framework/world.h"
@@ -344,7 +343,7 @@ int main() { kilo_init(); kilo_start(setup, loop); return 0; }
 // ---- LED ----
 
 // set_color's 2-bit channels reach the LED ./led: r/3, g/3, b/3, off for
-// RGB(0, 0, 0). (Skipped while the world API's set_led is a stub.)
+// RGB(0, 0, 0).
 TEST(KilobotTest, SetColorReachesTheLed) {
   const fs::path dir = Dir("color");
   const CommandResult built = Build(dir, "colors", R"(#include <kilolib.h>
@@ -363,9 +362,6 @@ int main() { kilo_init(); kilo_start(setup, loop); return 0; }
   LoadedWorld w = LoadWorld((dir / "world.yaml").string(), LoadOptions{}, registry);
   w.world->set_log_sink([](std::string_view) {});
   Scene& scene = w.world->scene();
-  const ObjectId led0 = scene.FindObject("./led", scene.instance(0).root);
-  if (PluginWorldApi()->set_led(w.world.get(), 0, led0.ToInteger(), 1, 1, 1, 1) != 0)
-    GTEST_SKIP() << "the world API's set_led is a stub on this build";
   w.world->Start();
   w.world->Step();
   ObjectType led_type;

@@ -193,15 +193,13 @@ TEST(PlacementTest, TooFullArenaIsAClearError) {
   }
 }
 
-
 // --- distribute.lattice ---------------------------------------------------------------
 
 TEST(PlacementTest, SquareLatticeIsCentredRowByRowFromTheLowerLeft) {
   Placer placer(1);
   int64_t bad = 0;
   const Region2 region{-1, -1, 1, 1};
-  const std::vector<Placement2> p =
-      placer.Lattice(region, 7, 0.0165, 0.05, false, 3, 0, 0.0, &bad);
+  const std::vector<Placement2> p = placer.Lattice(region, 7, 0.0165, 0.05, false, 3, 0, 0.0, &bad);
   EXPECT_EQ(bad, -1);
   ASSERT_EQ(p.size(), 7u);
   // 3 columns, 3 rows (the last holds one): a 0.1 x 0.1 block centred at the origin.
@@ -243,8 +241,8 @@ TEST(PlacementTest, LatticeThatDoesNotFitNamesTheFirstCopyAndPlacesNothing) {
   EXPECT_TRUE(placer.Lattice({-1, -1, 1, 1}, 9, 0.0165, 0.05, false, 3, 0, 0.0, &bad).empty());
   EXPECT_EQ(bad, 5);  // row 1, column 2: (0.05, 0)
   EXPECT_EQ(placer.body_count(), 0u);
-  EXPECT_TRUE(placer.Lattice({-0.05, -0.05, 0.05, 0.05}, 9, 0.0165, 0.05, false, 3, 0, 0.0, &bad)
-                  .empty());
+  EXPECT_TRUE(
+      placer.Lattice({-0.05, -0.05, 0.05, 0.05}, 9, 0.0165, 0.05, false, 3, 0, 0.0, &bad).empty());
   EXPECT_EQ(bad, 0);  // the block is wider than the region
 }
 

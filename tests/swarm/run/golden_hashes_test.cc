@@ -89,7 +89,8 @@ TEST(GoldenHashesTest, EveryExampleWorldHasItsCheckedInHash) {
 TEST(GoldenHashesTest, TheTableCoversEveryExampleWorld) {
   std::set<std::string> listed;
   for (const GoldenRow& row : ReadTable()) listed.insert(row.world);
-  for (const char* folder : {"worlds", "worlds/experiments", "bench/worlds", "tests/data/worlds"}) {
+  for (const char* folder :
+       {"worlds", "worlds/experiments", "worlds/kilobot", "bench/worlds", "tests/data/worlds"}) {
     for (const auto& entry : fs::directory_iterator(fs::path(SWARMSIM_SOURCE_DIR) / folder)) {
       if (entry.path().extension() != ".yaml") continue;
       if (std::string(folder) == "tests/data/worlds" &&
