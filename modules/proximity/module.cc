@@ -52,6 +52,10 @@ class ProximityModule final : public Module, public ProximityReadings {
   // Every robot's sensors, robots in parallel, then the scene's own sensors.
   void Sense(World* world) override {
     Scene& scene = world->scene();
+    // No proximity sensor anywhere (Kilobots, say): nothing reads the
+    // placed shapes, so do not place them (a sensor copied in later brings
+    // the work back from the next sense phase).
+    if (Sensors(scene).rows.empty()) return;
     // A mill cut the map (Scene::set_environment): the static index again.
     if (environment_version_ != scene.environment_version()) {
       backend_->Build(scene, settings_);
