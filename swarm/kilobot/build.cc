@@ -49,11 +49,13 @@ std::string ReadFile(const fs::path& path) {
 }
 
 // What the build needs to know of a relocatable ELF64 object: its writable
-// data sections (renamed so that each robot gets its own copy) and whether
-// it defines main.
+// data sections (renamed so that each robot gets its own copy), whether
+// it defines main, and whether it calls delay() (the runtime then runs
+// setup() and loop() on a stack of the robot's own, so that delay can wait).
 struct ObjectInfo {
   std::set<std::string> data, bss;  // section names: initialised, zeroed
   bool defines_main = false;
+  bool calls_delay = false;
   bool ok = false;
 };
 
@@ -91,6 +93,8 @@ ObjectInfo Inspect(const fs::path& path) {
         if (sym.st_shndx != SHN_UNDEF && ELF64_ST_BIND(sym.st_info) == STB_GLOBAL &&
             text_at(strings, sym.st_name) == "main")
           info.defines_main = true;
+        if (sym.st_shndx == SHN_UNDEF && text_at(strings, sym.st_name) == "delay")
+          info.calls_delay = true;
       }
     }
   }
@@ -203,7 +207,8 @@ int Build(const BuildOptions& options) {
                 << " exited with status " << status << "; its messages are above)\n";
     return 2;
   }
-  if (!Inspect(program).defines_main) {
+  const ObjectInfo program_info = Inspect(program);
+  if (!program_info.defines_main) {
     std::cerr << "error: " << source.string()
               << " defines no main(): a Kilobot program's main() calls kilo_init() and "
                  "kilo_start(setup, loop)\n";
@@ -214,7 +219,8 @@ int Build(const BuildOptions& options) {
   if (compile(runtime / "kilolib.c", kilolib, {"-I" + runtime.string()}) != 0 ||
       compile(runtime / "host.c", host,
               {"-I" + runtime.string(), "-I" + root.string(), "-pthread",
-               "-DKILOBOT_NAME=" + Quoted(name), "-DKILOBOT_SOURCE=" + Quoted(source.string())}) !=
+               "-DKILOBOT_NAME=" + Quoted(name), "-DKILOBOT_SOURCE=" + Quoted(source.string()),
+               program_info.calls_delay ? "-DKILOBOT_DELAY=1" : "-DKILOBOT_DELAY=0"}) !=
           0) {
     std::cerr << "error: kilobot build: the runtime in " << runtime.string()
               << " does not compile with " << cc << "\n";

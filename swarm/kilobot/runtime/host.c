@@ -35,7 +35,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
 #include <time.h>
+#include <ucontext.h>
 #include <unistd.h>
 
 #include "framework/plugin_api.h"
@@ -46,6 +48,9 @@
 #endif
 #ifndef KILOBOT_SOURCE
 #define KILOBOT_SOURCE "kilobot.c"
+#endif
+#ifndef KILOBOT_DELAY /* the program calls delay() (the build says so) */
+#define KILOBOT_DELAY 0
 #endif
 
 void kilobot_fill_copy(kilobot_copy_t *c); /* kilolib.c */
@@ -292,9 +297,84 @@ static void StartWatchdog(void) {
   pthread_attr_destroy(&attr);
 }
 
+/* ---- delay(): the program on a stack of the robot's own ----
+ *
+ * A program that calls delay() (the build looks for the call) runs setup()
+ * and loop() on a coroutine: delay(ms) notes when to wake and switches back
+ * to the host, which returns from the robot's step; the steps until then
+ * only deliver messages (kilolib's interrupts go on during a delay) and
+ * transmissions; the step at which the time has come switches back into
+ * the program, right after its delay() call. Its locals live on its stack,
+ * its globals are swapped in and out as for every call. Programs without
+ * delay() call setup() and loop() directly (no switch, no stack). */
+
+typedef struct {
+  ucontext_t self, back;       /* the program's context; the host's while it runs */
+  const kilobot_copy_t *table; /* its copy's */
+  char *map;                   /* the stack's mapping: a guard page, then the stack */
+  size_t map_size;
+  double wake;  /* s: simulated time delay() waits for (0: not waiting) */
+  int in_setup; /* in setup() (for messages) */
+  int waited;   /* the current loop() has called delay() */
+} Coroutine;
+
+enum { kStackSize = 64 * 1024 };
+static __thread Coroutine *t_coroutine; /* the one running on this thread */
+static __thread double t_now;           /* s: the step's time, for delay() */
+
+static void CoroutineBody(void) {
+  Coroutine *const co = t_coroutine;
+  co->in_setup = 1;
+  if (co->table->robot->setup != NULL) co->table->robot->setup();
+  co->in_setup = 0;
+  /* A loop() that ran straight through ends the robot's step (one loop()
+   * a step); one that waited in delay() is followed at once by the next, as
+   * on a Kilobot, in the step its wait ended. */
+  for (;;) {
+    co->waited = 0;
+    if (co->table->robot->loop != NULL) co->table->robot->loop();
+    if (!co->waited) swapcontext(&co->self, &co->back);
+  }
+}
+
+static Coroutine *NewCoroutine(const kilobot_copy_t *table) {
+  Coroutine *co = calloc(1, sizeof *co);
+  if (co == NULL) return NULL;
+  const size_t page = (size_t)sysconf(_SC_PAGESIZE);
+  co->map_size = kStackSize + page;
+  co->map = mmap(NULL, co->map_size, PROT_READ | PROT_WRITE,
+                 MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE, -1, 0);
+  if (co->map == MAP_FAILED) {
+    free(co);
+    return NULL;
+  }
+  mprotect(co->map, page, PROT_NONE); /* a stack overflow faults here */
+  co->table = table;
+  getcontext(&co->self);
+  co->self.uc_stack.ss_sp = co->map + page;
+  co->self.uc_stack.ss_size = kStackSize;
+  co->self.uc_link = NULL;
+  makecontext(&co->self, CoroutineBody, 0);
+  return co;
+}
+
+static void FreeCoroutine(Coroutine *co) {
+  if (co == NULL) return;
+  munmap(co->map, co->map_size);
+  free(co);
+}
+
+void kilobot_wait(uint16_t ms) {
+  Coroutine *const co = t_coroutine;
+  if (co == NULL || ms == 0) return; /* main() or a callback: nothing to suspend */
+  co->waited = 1;
+  co->wake = t_now + ms / 1000.0;
+  swapcontext(&co->self, &co->back);
+}
+
 /* ---- one call into the program ---- */
 
-enum CallKind { kMain, kVoid, kRx, kTx };
+enum CallKind { kMain, kVoid, kRx, kTx, kResume };
 
 typedef struct {
   enum CallKind kind;
@@ -305,6 +385,7 @@ typedef struct {
   message_t *message;
   distance_measurement_t *distance;
   message_t *result;
+  Coroutine *coroutine;
 } Call;
 
 /* Runs `call`; returns 0, or the signal that ended it. */
@@ -317,6 +398,7 @@ static int Guarded(Call *call) {
   if (sig != 0) {
     atomic_store_explicit(&ts->slot->busy, 0, memory_order_relaxed);
     ts->jump = outer;
+    t_coroutine = NULL;
     return sig;
   }
   ts->jump = &jump;
@@ -333,6 +415,11 @@ static int Guarded(Call *call) {
     case kVoid: call->void_fn(); break;
     case kRx: call->rx(call->message, call->distance); break;
     case kTx: call->result = call->tx(); break;
+    case kResume:
+      t_coroutine = call->coroutine;
+      swapcontext(&call->coroutine->back, &call->coroutine->self);
+      t_coroutine = NULL;
+      break;
   }
   ts->in_user = 0;
   atomic_store_explicit(&slot->busy, 0, memory_order_relaxed);
@@ -360,6 +447,7 @@ typedef struct {
   int set_up;                             /* setup() ran */
   uint8_t motor_left, motor_right, color; /* as last applied */
   int motors_applied, color_applied;
+  Coroutine *coroutine; /* programs that call delay(): their stack (null until the first step) */
 } Robot;
 
 static atomic_int g_warned_crc;
@@ -398,7 +486,7 @@ static const char *SignalText(int sig) {
 }
 
 static void Failure(const SwarmsimCallContext *c, int sig, const char *what, char *error,
-                    size_t size) {
+                    size_t size, const Coroutine *co) {
   if (sig == g_watchdog_signal) {
     snprintf(error, size, "%s (kilobot program '%s'), robot %d: %s did not return within %g s",
              KILOBOT_SOURCE, KILOBOT_NAME, c->robot, what, atomic_load(&g_timeout_ms) / 1000.0);
@@ -406,8 +494,11 @@ static void Failure(const SwarmsimCallContext *c, int sig, const char *what, cha
   }
   const ThreadState *ts = &t_state;
   const char *address = (const char *)ts->fault_address;
-  const int overflow = sig == SIGSEGV && ts->stack_low != NULL && address != NULL &&
-                       address < ts->stack_low + 65536 && address + 65536 * 16 > ts->stack_low;
+  int overflow = sig == SIGSEGV && ts->stack_low != NULL && address != NULL &&
+                 address < ts->stack_low + 65536 && address + 65536 * 16 > ts->stack_low;
+  if (co != NULL && sig == SIGSEGV && address >= co->map &&
+      address < co->map + (co->map_size - kStackSize))
+    overflow = 1; /* the coroutine's guard page */
   snprintf(error, size, "%s (kilobot program '%s'), robot %d: %s%s in %s", KILOBOT_SOURCE,
            KILOBOT_NAME, c->robot, SignalText(sig), overflow ? " (stack overflow)" : "", what);
 }
@@ -511,7 +602,7 @@ static int Init(const SwarmsimCallContext *c, void **state, char *error, size_t 
   if (sig == 0) SwapOut(copy, r);
   Unlock(copy);
   if (sig != 0) {
-    Failure(c, sig, "main()", error, error_size);
+    Failure(c, sig, "main()", error, error_size, NULL);
     return -1;
   }
   return 0;
@@ -577,14 +668,31 @@ static int Step(const SwarmsimCallContext *c, void *state, char *error, size_t e
     sig = Guarded(&call);
   }
   /* setup() once, then loop() (kilolib: after the run message). */
-  if (sig == 0 && rt->started && !r->set_up) {
-    r->set_up = 1;
-    call.kind = kVoid, call.void_fn = rt->setup, what = "setup()";
-    sig = call.void_fn != NULL ? Guarded(&call) : 0;
-  }
-  if (sig == 0 && rt->started && rt->loop != NULL) {
-    call.kind = kVoid, call.void_fn = rt->loop, what = "loop()";
-    sig = Guarded(&call);
+  if (KILOBOT_DELAY && sig == 0 && rt->started) {
+    /* On the robot's own stack, resumed unless a delay() still waits. */
+    if (r->coroutine == NULL && (r->coroutine = NewCoroutine(t)) == NULL) {
+      Unlock(copy);
+      snprintf(error, error_size, "out of memory (a program stack for delay())");
+      return -1;
+    }
+    if (r->coroutine->wake <= now + 1e-9) {
+      r->coroutine->wake = 0;
+      r->set_up = 1;
+      t_now = now;
+      call.kind = kResume, call.coroutine = r->coroutine;
+      sig = Guarded(&call);
+      what = r->coroutine->in_setup ? "setup()" : "loop()";
+    }
+  } else {
+    if (sig == 0 && rt->started && !r->set_up) {
+      r->set_up = 1;
+      call.kind = kVoid, call.void_fn = rt->setup, what = "setup()";
+      sig = call.void_fn != NULL ? Guarded(&call) : 0;
+    }
+    if (sig == 0 && rt->started && rt->loop != NULL) {
+      call.kind = kVoid, call.void_fn = rt->loop, what = "loop()";
+      sig = Guarded(&call);
+    }
   }
   /* Every kilo_tx_period cycles, a message to send. */
   uint8_t outgoing[sizeof(message_t)];
@@ -606,7 +714,7 @@ static int Step(const SwarmsimCallContext *c, void *state, char *error, size_t e
   kilobot_robot_t outputs = *rt;
   Unlock(copy);
   if (sig != 0) {
-    Failure(c, sig, what, error, error_size);
+    Failure(c, sig, what, error, error_size, r->coroutine);
     return -1;
   }
   if (send) {
@@ -625,6 +733,7 @@ static int Step(const SwarmsimCallContext *c, void *state, char *error, size_t e
 
 static void Cleanup(const SwarmsimCallContext *c, void *state, void *unused) {
   (void)c, (void)unused;
+  if (state != NULL) FreeCoroutine(((Robot *)state)->coroutine);
   free(state); /* the Robot and its image */
 }
 

@@ -39,6 +39,11 @@ typedef struct {
   message_tx_success_t *tx_success;
 } kilobot_copy_t;
 
+/* delay(ms) (host.c): suspends the robot's setup()/loop() for ms of
+ * simulated time when the program runs on a stack of its own (programs that
+ * call delay); elsewhere (main(), the message callbacks) it returns at once. */
+void kilobot_wait(uint16_t ms);
+
 /* Exported by every copy (host.c): its table. */
 const kilobot_copy_t *swarmsim_kilobot_copy(void);
 

@@ -42,7 +42,9 @@ void kilo_start(void (*setup)(void), void (*loop)(void)) {
   kilobot_rt.started = 1;
 }
 
-void delay(uint16_t ms) { (void)ms; }
+/* The host waits: the robot's program is suspended for ms of simulated
+ * time (host.c, kilobot_wait). */
+void delay(uint16_t ms) { kilobot_wait(ms); }
 
 void set_motors(uint8_t left, uint8_t right) {
   kilobot_rt.motor_left = left;

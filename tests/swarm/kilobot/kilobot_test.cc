@@ -381,6 +381,61 @@ int main() { kilo_init(); kilo_start(setup, loop); return 0; }
   fs::remove_all(dir);
 }
 
+// ---- delay() ----
+
+// delay(ms) suspends the robot's program for ms of simulated time: an LED
+// blinking with delay(500) is red for half a second, then blue; messages
+// keep arriving meanwhile (kilolib's interrupts), kilo_ticks goes on, and
+// a delay() in setup() (the random start of kilobotics' sync lab) delays
+// the first loop().
+const char* kBlink = R"(#include <kilolib.h>
+uint8_t heard = 0;
+uint32_t first_loop = 0;
+void rx(message_t *m, distance_measurement_t *d) { ++heard; }
+void setup() { delay(250 * kilo_uid); }
+void loop() {
+  if (first_loop == 0) first_loop = kilo_ticks + 1;
+  set_color(RGB(3, 0, 0));
+  delay(500);
+  set_color(RGB(0, 0, 3));
+  delay(500);
+}
+int main() { kilo_init(); kilo_message_rx = rx; kilo_start(setup, loop); return 0; }
+)";
+
+TEST(KilobotTest, DelaySuspendsTheProgramForSimulatedTime) {
+  const fs::path dir = Dir("delay");
+  const CommandResult built = Build(dir, "blink", kBlink);
+  ASSERT_EQ(built.exit_code, 0) << built.output;
+  Write(dir / "world.yaml", World("blink", "planar", 2, 0.5));
+  ModuleRegistry registry;
+  RegisterBuiltinModules(&registry);
+  LoadedWorld w = LoadWorld((dir / "world.yaml").string(), LoadOptions{}, registry);
+  w.world->set_log_sink([](std::string_view) {});
+  Scene& scene = w.world->scene();
+  ObjectType led_type;
+  ASSERT_TRUE(scene.FindType(kLedTypeName, &led_type));
+  const auto red = [&](int robot) {
+    const LedRow& led = scene.row<LedRow>(
+        led_type, scene.FindObject("./led", scene.instance(robot).root), "led");
+    return led.on && led.color.x == 1;
+  };
+  w.world->Start();
+  // Robot 0 (no start delay): red on steps 0..15 (0.5 s at 1/32 s), blue
+  // on 16..31, red again from 32; robot 1 waits 250 ms (8 steps) first.
+  std::vector<int> switches0, switches1;
+  bool was0 = false, was1 = false;
+  for (int step = 0; step < 96; ++step) {
+    w.world->Step();
+    if (red(0) != was0) switches0.push_back(step), was0 = !was0;
+    if (red(1) != was1) switches1.push_back(step), was1 = !was1;
+  }
+  EXPECT_EQ(switches0, (std::vector<int>{0, 16, 32, 48, 64, 80}));
+  EXPECT_EQ(switches1, (std::vector<int>{8, 24, 40, 56, 72, 88}));
+  w.world->Stop();
+  fs::remove_all(dir);
+}
+
 // ---- determinism ----
 
 // A random walk: straight or turning for a random number of ticks.
@@ -514,6 +569,25 @@ TEST(KilobotTest, DivisionByZeroEndsTheRunNamingIt) {
                  "volatile int zero;\n"
                  "void loop() { if (kilo_uid == 3 && kilo_ticks > 4) zero = 10 / zero; }",
                  "arithmetic exception");
+}
+
+// The same faults in a program that calls delay() (it runs on a stack of
+// its own): named the same way.
+TEST(KilobotTest, FaultsAfterADelayEndTheRunNamingThem) {
+  ExpectRunFails("segv_delay",
+                 "int *volatile nowhere;\n"
+                 "void loop() { delay(40); if (kilo_uid == 3 && kilo_ticks > 4) *nowhere = 1; }",
+                 "segmentation fault in loop()");
+  ExpectRunFails("deep_delay",
+                 "volatile int sink;\n"
+                 "int down(int n) { volatile char pad[512]; pad[n & 511] = (char)n;\n"
+                 "  return n < 0 ? 0 : down(n + 1) + pad[(n * 7) & 511]; }\n"
+                 "void loop() { delay(40); if (kilo_uid == 3 && kilo_ticks > 4) sink = down(0); }",
+                 "segmentation fault (stack overflow) in loop()");
+  ExpectRunFails("spin_delay",
+                 "volatile int x;\n"
+                 "void loop() { delay(40); if (kilo_uid == 3 && kilo_ticks > 4) for (;;) x++; }",
+                 "loop() did not return within 0.5 s");
 }
 
 }  // namespace
