@@ -116,7 +116,11 @@ int Rename(const fs::path& object, bool program) {
     argv.push_back("--rename-section=" + name + "=kilo_data");
   for (const std::string& name : info.bss)
     argv.push_back("--rename-section=" + name + "=kilo_data,alloc,load,contents,data");
-  if (program) argv.push_back("--redefine-sym=main=kilobot_program_main");
+  if (program) {
+    argv.push_back("--redefine-sym=main=kilobot_program_main");
+    // exit() would end swarmsim: the runtime's ends the run naming the robot.
+    argv.push_back("--redefine-sym=exit=kilobot_exit");
+  }
   argv.push_back(object.string());
   return Run(argv);
 }

@@ -191,6 +191,7 @@ typedef struct {
   Slot *slot;
   char *stack_low; /* lowest address of the thread's stack */
   volatile void *fault_address;
+  int exit_status; /* the program called exit(exit_status) */
 } ThreadState;
 static __thread ThreadState t_state;
 static Slot g_spare_slot; /* threads past kMaxSlots: no watchdog */
@@ -296,6 +297,26 @@ static void StartWatchdog(void) {
   pthread_sigmask(SIG_SETMASK, &old, NULL);
   pthread_attr_destroy(&attr);
 }
+
+/* What Guarded returns when the program called exit() (not a signal). */
+enum { kCalledExit = 4096 };
+
+/* The program's exit() (the build renames its calls): ends the robot's
+ * call like a fault, so the run ends naming the robot, not swarmsim. */
+void kilobot_exit(int status) {
+  ThreadState *ts = &t_state;
+  if (ts->in_user && ts->jump != NULL) {
+    ts->in_user = 0;
+    ts->exit_status = status;
+    siglongjmp(*ts->jump, kCalledExit);
+  }
+  exit(status);
+}
+
+/* The step (its time, in microseconds) at which a call timed out: the
+ * other robots skip that step's calls, so that a program stuck on every
+ * robot ends the run after one timeout instead of one per robot. */
+static atomic_llong g_timed_out_at = -1;
 
 /* ---- delay(): the program on a stack of the robot's own ----
  *
@@ -487,6 +508,11 @@ static const char *SignalText(int sig) {
 
 static void Failure(const SwarmsimCallContext *c, int sig, const char *what, char *error,
                     size_t size, const Coroutine *co) {
+  if (sig == kCalledExit) {
+    snprintf(error, size, "%s (kilobot program '%s'), robot %d: exit(%d) called in %s",
+             KILOBOT_SOURCE, KILOBOT_NAME, c->robot, t_state.exit_status, what);
+    return;
+  }
   if (sig == g_watchdog_signal) {
     snprintf(error, size, "%s (kilobot program '%s'), robot %d: %s did not return within %g s",
              KILOBOT_SOURCE, KILOBOT_NAME, c->robot, what, atomic_load(&g_timeout_ms) / 1000.0);
@@ -615,7 +641,11 @@ static int Step(const SwarmsimCallContext *c, void *state, char *error, size_t e
   Copy *copy = &g_copies[r->copy];
   const kilobot_copy_t *t = copy->table;
   const SwarmsimWorldApi *api = c->api;
+
   const double now = api->time(c->world);
+  const long long now_us = llround(now * 1e6);
+  if (atomic_load_explicit(&g_timed_out_at, memory_order_relaxed) == now_us)
+    return 0; /* another robot's program hung in this step: the run is ending */
   const double dt = now - r->last_time;
   r->last_time = now;
   /* The world's readings, before taking the lock. */
@@ -714,6 +744,7 @@ static int Step(const SwarmsimCallContext *c, void *state, char *error, size_t e
   kilobot_robot_t outputs = *rt;
   Unlock(copy);
   if (sig != 0) {
+    if (sig == g_watchdog_signal) atomic_store(&g_timed_out_at, now_us);
     Failure(c, sig, what, error, error_size, r->coroutine);
     return -1;
   }

@@ -590,5 +590,12 @@ TEST(KilobotTest, FaultsAfterADelayEndTheRunNamingThem) {
                  "loop() did not return within 0.5 s");
 }
 
+// exit() in a program would end swarmsim itself: it ends the run instead,
+// naming the robot, the program and the status.
+TEST(KilobotTest, ExitEndsTheRunNamingTheRobot) {
+  ExpectRunFails("quits", "#include <stdlib.h>\nvoid loop() { if (kilo_uid == 3) exit(3); }",
+                 "exit(3) called in loop()");
+}
+
 }  // namespace
 }  // namespace swarmsim
