@@ -234,12 +234,16 @@ void WorldLoader::ResolveNativeController(const Fields& f, const ValueReader& wo
     const std::vector<std::string> known = world_registry_->ControllerNames();
     std::string list;
     for (const std::string& k : known) list += (list.empty() ? "" : ", ") + k;
-    file_->Fail(name_field.mark,
-                "'native_controller': no controller '" + name + "' (" +
-                    (known.empty() ? std::string("no plugin of the world's 'plugins:' registers "
-                                                 "one")
-                                   : "registered: " + list) +
-                    ")" + loader::Suggest(name, known));
+    file_->Fail(
+        name_field.mark,
+        "'native_controller': no controller '" + name + "' (" +
+            (known.empty() ? std::string("no plugin of the world's 'plugins:' registers "
+                                         "one")
+                           : "registered: " + list) +
+            ")" + [&]() -> std::string {  // the list is there: only a near name
+          const std::string* near = NearestName(name, known);
+          return near != nullptr ? "; did you mean '" + *near + "'?" : "";
+        }());
   }
   if (!keep_scripts) {
     entry->native_replaces_scripts = HasScripts(entry->spec);
