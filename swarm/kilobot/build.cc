@@ -224,8 +224,7 @@ int Build(const BuildOptions& options) {
       compile(runtime / "host.c", host,
               {"-I" + runtime.string(), "-I" + root.string(), "-pthread",
                "-DKILOBOT_NAME=" + Quoted(name), "-DKILOBOT_SOURCE=" + Quoted(source.string()),
-               program_info.calls_delay ? "-DKILOBOT_DELAY=1" : "-DKILOBOT_DELAY=0"}) !=
-          0) {
+               program_info.calls_delay ? "-DKILOBOT_DELAY=1" : "-DKILOBOT_DELAY=0"}) != 0) {
     std::cerr << "error: kilobot build: the runtime in " << runtime.string()
               << " does not compile with " << cc << "\n";
     return 1;

@@ -416,8 +416,8 @@ TEST(KilobotTest, DelaySuspendsTheProgramForSimulatedTime) {
   ObjectType led_type;
   ASSERT_TRUE(scene.FindType(kLedTypeName, &led_type));
   const auto red = [&](int robot) {
-    const LedRow& led = scene.row<LedRow>(
-        led_type, scene.FindObject("./led", scene.instance(robot).root), "led");
+    const LedRow& led =
+        scene.row<LedRow>(led_type, scene.FindObject("./led", scene.instance(robot).root), "led");
     return led.on && led.color.x == 1;
   };
   w.world->Start();
