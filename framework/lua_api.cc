@@ -130,34 +130,55 @@ int IsYieldable(lua_State* L) {
   return 1;
 }
 
+// Pushes the entry `key` of one Lua area (an object type's or a module's
+// register_lua), if the area has it.
+bool PushAreaEntry(lua_State* L, void (*register_lua)(lua_State*), std::string_view key) {
+  lua_newtable(L);
+  register_lua(L);
+  lua_pushlstring(L, key.data(), key.size());
+  lua_rawget(L, -2);
+  if (!lua_isnil(L, -1)) {
+    lua_remove(L, -2);
+    return true;
+  }
+  lua_pop(L, 2);
+  return false;
+}
+
 // Pushes the entry `key` of the Lua area of an object type or a module the
-// world's registry holds (object_type.h, module.h), if one has it. The
-// areas are merged into one table per Lua state at its first such lookup
-// (kept in the registry): a name no area has costs one table lookup, not a
-// table built per area each time (65 us a miss: `if sim.x then` in a loop,
-// or a fuzzed script recursing through a misspelt name, took seconds).
+// world's registry holds (object_type.h, module.h), if one has it. A name
+// no area has is remembered as missing (a table per Lua state, in the
+// registry): looking for it again costs one lookup, not a table built per
+// area (65 us: `if sim.x then` in a loop, or a fuzzed script recursing
+// through a misspelt name, took seconds).
 bool PushRegisteredTypeFunction(lua_State* L, std::string_view key) {
   const LuaContext& c = Context(L);
   if (c.world == nullptr) return false;
-  static const char kAreas = 0;  // its address: the registry key
-  if (lua_rawgetp(L, LUA_REGISTRYINDEX, &kAreas) != LUA_TTABLE) {
+  static const char kMissing = 0;  // its address: the registry key
+  if (lua_rawgetp(L, LUA_REGISTRYINDEX, &kMissing) != LUA_TTABLE) {
     lua_pop(L, 1);
     lua_newtable(L);
-    // Lowest precedence first, so that the first area naming a key wins
-    // (object types in registration order, then modules), as one by one.
-    const auto& modules = c.world->registry().module_descriptors();
-    for (auto m = modules.rbegin(); m != modules.rend(); ++m)
-      if ((*m)->register_lua != nullptr) (*m)->register_lua(L);
-    const auto& types = c.world->registry().object_types();
-    for (auto t = types.rbegin(); t != types.rend(); ++t)
-      if ((*t)->register_lua != nullptr) (*t)->register_lua(L);
     lua_pushvalue(L, -1);
-    lua_rawsetp(L, LUA_REGISTRYINDEX, &kAreas);
+    lua_rawsetp(L, LUA_REGISTRYINDEX, &kMissing);
   }
   lua_pushlstring(L, key.data(), key.size());
-  lua_rawget(L, -2);
-  lua_remove(L, -2);
-  if (!lua_isnil(L, -1)) return true;
+  const bool known_missing = lua_rawget(L, -2) != LUA_TNIL;
+  lua_pop(L, 1);  // the missing table stays below, for the end
+  if (!known_missing) {
+    for (const ObjectTypeDescriptor* type : c.world->registry().object_types())
+      if (type->register_lua != nullptr && PushAreaEntry(L, type->register_lua, key)) {
+        lua_remove(L, -2);
+        return true;
+      }
+    for (const auto& module : c.world->registry().module_descriptors())
+      if (module->register_lua != nullptr && PushAreaEntry(L, module->register_lua, key)) {
+        lua_remove(L, -2);
+        return true;
+      }
+    lua_pushlstring(L, key.data(), key.size());
+    lua_pushboolean(L, 1);
+    lua_rawset(L, -3);
+  }
   lua_pop(L, 1);
   return false;
 }
