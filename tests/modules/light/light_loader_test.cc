@@ -179,5 +179,29 @@ TEST_F(LightLoaderTest, EveryKeyIsDocumented) {
   ExpectDocumented({"light_source", "light_sensor"});
 }
 
+// A name no module's Lua area has is remembered as missing per Lua state
+// (framework/lua_api.cc): it stays nil however often it is read, and the
+// areas' own functions still resolve before and after such misses.
+TEST_F(LightLoaderTest, MissingSimNamesStayNilAndAreaFunctionsStillResolve) {
+  Write("bot.yaml",
+        "model: bot\nobjects:\n  type: dummy\n  script: bot.lua\n  children:\n"
+        "    - {name: eye, type: light_sensor}\n");
+  Write("bot.lua",
+        "function sysCall_init()\n"
+        "  for i = 1, 3 do assert(sim.readLightSensorz == nil) end\n"
+        "  assert(type(sim.readLightSensor) == 'function')\n"
+        "  assert(sim.readLightSensorz == nil and sim.nothingLikeThis == nil)\n"
+        "  assert(type(sim.setLightSourceOn) == 'function')\n"
+        "  sim.recordMetric('ok', sim.readLightSensor(sim.getObject('./eye')) + 1)\n"
+        "end\n");
+  LoadedWorld w =
+      Load("simulation: {physics: kinematic}\nmodels: [{model: bot.yaml, position: [0, 0]}]\n");
+  w.world->Start();
+  const std::vector<MetricSample> metrics = w.world->TakeMetrics();
+  ASSERT_EQ(metrics.size(), 1u);
+  EXPECT_EQ(metrics[0].name, "ok");
+  EXPECT_EQ(metrics[0].value, 1);
+}
+
 }  // namespace
 }  // namespace swarmsim
