@@ -93,9 +93,24 @@ int CopyModel(lua_State* L) {
   const LuaContext& c = Context(L);
   ModelEdit edit;
   edit.root = CheckObject(L, 1);
-  CheckRobotRoot(*c.scene, edit.root);
+  const int source = CheckRobotRoot(*c.scene, edit.root);
   ReadPose(L, 2, &edit);
+  // The copy's objects count against the run's script memory from this
+  // call (World::ApplyModelEdits hands the bytes to the copy's own account):
+  // a script copying robots without end is stopped here, at its line, not
+  // by the machine.
+  RunScriptMemory* run = c.memory != nullptr ? c.memory->run() : nullptr;
+  const ModelInstance& copied = c.scene->instance(source);
+  if (run != nullptr) edit.charged = CopyChargeBytes(copied.objects.size());
   Queue(L, edit);
+  if (edit.charged > 0 && !run->Take(edit.charged)) {
+    c.runtime->model_edits.pop_back();
+    throw Error("the copy of '" + copied.name + "' (" + std::to_string(copied.objects.size()) +
+                " objects) would take the run's scripts past " +
+                std::to_string(run->limit() >> 20) +
+                " MiB (simulation.run_script_memory_mb; a copy counts " +
+                std::to_string(kCopyBytesPerObject) + " bytes an object)");
+  }
   return 0;
 }
 

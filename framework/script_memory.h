@@ -25,6 +25,13 @@
 
 namespace swarmsim {
 
+// What a robot copied at run time (sim.copyModel) charges its own account,
+// taken from the run's whatever its own limit: its scene objects' rows,
+// names and poses, about this much an object (a foot-bot's 40 objects,
+// 40 KiB). Released when the copy is removed.
+constexpr uint64_t kCopyBytesPerObject = 1024;
+constexpr uint64_t CopyChargeBytes(size_t objects) { return objects * kCopyBytesPerObject; }
+
 class RunScriptMemory {
  public:
   // 0: no limit.
@@ -64,6 +71,7 @@ class ScriptMemory {  // 48 bytes
   uint64_t used() const { return used_; }    // Lua heaps + data
   uint64_t data() const { return data_; }    // of which C++ copies of script data
   const RunScriptMemory* run() const { return run_; }
+  RunScriptMemory* run() { return run_; }
 
   // --- The Lua heap (the allocator: hot) -----------------------------------------
   // `bytes` more; false (nothing counted) if the run cannot give them. The

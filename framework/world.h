@@ -188,6 +188,9 @@ struct ModelEdit {
   bool has_pose = false;  // kCopy: place the copy at (x, y, yaw), else at the source's pose
   double x = 0, y = 0;    // m, world frame
   double yaw = 0;         // rad
+  // kCopy: bytes taken from the run's script memory at the call, handed to
+  // the copy's account when it is made, given back if it is not.
+  uint64_t charged = 0;
 };
 // Copies and removals one script state may queue between two applications
 // (one step): a clear error past it, so a runaway loop cannot exhaust memory.
@@ -228,7 +231,7 @@ inline constexpr int64_t kRobotGrain = 8;
 // Wall-clock seconds spent in each phase (framework/phase.h), summed over the run.
 using PhaseTimes = std::array<double, kPhaseCount>;
 
-class World : public PhaseHandlers {
+class World final : public PhaseHandlers {
  public:
   World(const WorldSettings& settings, const ModuleRegistry& registry);
   // Same, keeping `registry` alive as long as the world (a world file's

@@ -46,16 +46,29 @@ void World::ApplyModelEdits() {
   // robot copied and removed in the same step is copied, then removed).
   const int first_new = robot_count();
   std::vector<std::pair<int, int>> copies;  // (new robot, source robot)
+  std::vector<uint64_t> charged;            // by copy: bytes taken at the call
   for (const ModelEdit& edit : edits) {
-    if (edit.kind != ModelEdit::Kind::kCopy || !scene_.IsValid(edit.root)) continue;
+    if (edit.kind != ModelEdit::Kind::kCopy) continue;
+    if (!scene_.IsValid(edit.root)) {
+      run_script_memory_.Give(edit.charged);
+      continue;
+    }
     const int source = scene_.instance_of(edit.root);
     const ObjectId copy = CopyRobot(edit);
     copies.emplace_back(scene_.instance_of(copy), source);
+    charged.push_back(edit.charged);
   }
   if (!copies.empty()) {
     EnsureRuntimes();
-    for (const auto& [robot, source] : copies)
+    for (size_t i = 0; i < copies.size(); ++i) {
+      const auto [robot, source] = copies[i];
       runtimes_[robot].parameters = runtimes_[source].parameters;
+      // Its objects, on its own account from now until it is removed (the
+      // bytes sim.copyModel took from the run's, handed over).
+      run_script_memory_.Give(charged[i]);
+      robot_script_memory_[robot].Force(charged[i]);
+      runtimes_[robot].lifetime_bytes += charged[i];
+    }
     scripts_->StartInstances(first_new);
     // A copy runs its source's native controller, from a fresh init.
     if (controllers_) {
@@ -111,8 +124,10 @@ void World::RemoveRobot(ObjectId root) {
     cleanup_error = e.what();
   }
   scene_.RemoveSubtree(root);
-  // What its cleanup queued (copies, removals) goes with it; what it
-  // printed and recorded is flushed by the caller.
+  // What its cleanup queued (copies, removals) goes with it, and what the
+  // copies took from the run's script memory; what it printed and recorded
+  // is flushed by the caller.
+  for (const ModelEdit& edit : rt.model_edits) run_script_memory_.Give(edit.charged);
   rt.model_edits.clear();
   pending_[robot] |= kPendingOutput;
   messaging_.ClearRobot(robot);

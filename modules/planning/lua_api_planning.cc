@@ -75,9 +75,13 @@ Pose GoalArg(lua_State* L, int arg, Space space) {
   return {{v[0], v[1], v[2]}, q.Normalized()};
 }
 
+// As the world file's time_limit (objects.cc): at most an hour of planner
+// iterations, so a script cannot ask for a plan that never ends.
+constexpr double kMaxTimeLimit = 3600;
+
 double TimeLimit(double value, const char* what) {
-  if (!std::isfinite(value) || value <= 0)
-    throw Error(std::string(what) + " must be a positive number of seconds (got " +
+  if (!std::isfinite(value) || value <= 0 || value > kMaxTimeLimit)
+    throw Error(std::string(what) + " must be a positive number of seconds, at most 3600 (got " +
                 (std::isfinite(value) ? std::to_string(value) : std::string("not a number")) +
                 "): it is the planner's budget");
   return value;

@@ -466,6 +466,53 @@ TEST_F(TrustTest, TheRunsScriptsTogetherHoldAtMostTheRunsLimit) {
   }
 }
 
+// Robots copied at run time count against the run's limit, even copies
+// that run no script (which no Lua heap would otherwise count): a script
+// copying robots without end is stopped at its line, and removing the
+// copies gives their bytes back.
+TEST_F(TrustTest, RobotsCopiedByScriptsCountAgainstTheRunsLimit) {
+  settings_.run_script_memory_limit = 4 << 20;
+  const auto make = [&](const std::string& code) {
+    MakeWorld();
+    // A script-less robot of 200 objects: 200 KiB a copy.
+    Scene& scene = world_->scene();
+    const ObjectId crate = scene.AddDummy("crate#0", {}, {});
+    for (int i = 1; i < 200; ++i) scene.AddDummy("part" + std::to_string(i), crate, {});
+    scene.MakeModelInstance(crate, "crate", "crate#0");
+    AddRobot("bot#1", code);
+  };
+  make(
+      "function sysCall_actuation()\n"
+      "  for i = 1, 10 do sim.copyModel(sim.getObject('/crate#0')) end\n"
+      "end\n");
+  const std::string error = ErrorOf([&] {
+    for (int i = 0; i < 10; ++i) world_->Step();
+  });
+  EXPECT_CONTAINS(error, "bot#1: scripts/robot.lua:2: ");
+  EXPECT_CONTAINS(error,
+                  "the copy of 'crate#0' (200 objects) would take the run's scripts past 4 "
+                  "MiB (simulation.run_script_memory_mb; a copy counts 1024 bytes an object)");
+  EXPECT_LE(world_->run_script_memory().taken(), uint64_t{4} << 20);
+  EXPECT_GT(world_->robot_count(), 2) << "copies within the limit were made";
+  EXPECT_LT(world_->robot_count(), 2 + 4 * 1024 / 200 + 1);
+
+  // Copying one and removing it every step goes on for good.
+  // (40 copies of 200 KiB would be twice the limit.)
+  make(
+      "local k = 1\n"
+      "function sysCall_actuation()\n"
+      "  if k > 1 then sim.removeModel(sim.getObject('/crate#' .. k)) end\n"
+      "  k = k + 1\n"
+      "  sim.copyModel(sim.getObject('/crate#0'))\n"
+      "end\n");
+  EXPECT_EQ(ErrorOf([&] {
+              for (int i = 0; i < 40; ++i) world_->Step();
+            }),
+            "");
+  EXPECT_EQ(world_->live_robot_count(), 3);
+  EXPECT_LT(world_->run_script_memory().taken(), uint64_t{2} << 20);
+}
+
 TEST_F(TrustTest, MetricNamesAndPrintsAreCapped) {
   EXPECT_CONTAINS(Run("sim.recordMetric(('m'):rep(1 << 20), 1)"),
                   "sim.recordMetric: the metric name is 1048576 bytes long; at most 256");

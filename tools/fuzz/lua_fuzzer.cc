@@ -22,7 +22,7 @@ simulation:
   physics_substeps: 2
   seed: 1
   steps: 3
-  instruction_budget: 200000
+  instruction_budget: 50000
   script_memory_mb: 32
   octree_resolution: 0.25
 arena: {size: 1.2}

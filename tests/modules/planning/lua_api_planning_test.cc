@@ -94,6 +94,12 @@ TEST(LuaApiPlanningTest, MistakesAreErrorsNamingWhatIsWrong) {
                   "the goal: element 2 is not a finite number");
   EXPECT_CONTAINS(ErrorOfLine("sim.planPath(sim.getObject('./task'), {1, 1, 0}, -1)"),
                   "the time limit must be a positive number of seconds");
+  // A budget past an hour (72 million planner iterations) would be a plan
+  // that never ends, as a world file's time_limit cannot ask for.
+  EXPECT_CONTAINS(ErrorOfLine("sim.planPath(sim.getObject('./task'), {1, 1, 0}, 1e9)"),
+                  "the time limit must be a positive number of seconds, at most 3600 (got");
+  EXPECT_CONTAINS(ErrorOfLine("sim.setPlanningTask(sim.getObject('./task'), {time_limit = 3601})"),
+                  "time_limit must be a positive number of seconds, at most 3600");
   EXPECT_CONTAINS(ErrorOfLine("sim.planPath(sim.getObject('/other'), {1, 1, 0})"),
                   "planning task '/other' belongs to another robot");
   EXPECT_CONTAINS(ErrorOfLine("sim.readPlan(sim.getObject('./body'))"),
