@@ -46,11 +46,12 @@ class AgentArrays:
     ``observations`` (N, D), after the step; ``actions`` (N, A), the actions of this step
     (zeros for inactive agents); ``poses`` and ``previous_poses`` (N, 3: x, y, yaw in
     planar worlds; N x 7 x, y, z, qw, qx, qy, qz otherwise), after and before the step;
-    ``step``, the episode's step count (1 after the first step); ``model``, the model's name.
+    ``step``, the episode's step count (1 after the first step); ``env``, the environment's
+    index in a VectorEnv (0 in a ParallelEnv); ``model``, the model's name.
     Rows of agents whose robot is gone hold their last values."""
 
     __slots__ = ("names", "active", "present", "observations", "actions", "poses",
-                 "previous_poses", "step", "model")
+                 "previous_poses", "step", "env", "model")
 
 
 class _WorldSlot:
@@ -292,26 +293,41 @@ class Core:
         arrays.poses = self.poses[k]
         arrays.previous_poses = self.previous_poses[k]
         arrays.step = int(self.episode_steps[k])
+        arrays.env = k
         arrays.model = self.model
         return arrays
 
-    def score(self, k):
-        """After a step of world k (not a reset's): its rewards, terminations and
-        truncations, and the agents still active."""
-        self.episode_steps[k] += 1
-        acting = self.active[k].copy()
-        world = self.slots[k].world
-        arrays = self.agent_arrays(k)
-        arrays.active = acting
-        rewards = self.spec["reward"](world, arrays, self, k)
-        done = ~self.present[k] & acting  # robots removed from the world
-        if self.spec["terminate"] is not None:
-            done |= _bools(self.spec["terminate"](world, arrays), self.N, "terminate")
-        self.terminated[k] = done & acting
-        limit = self.max_steps is not None and self.episode_steps[k] >= self.max_steps
-        self.truncated[k] = acting & ~self.terminated[k] if limit else False
-        self.rewards[k] = np.where(acting, rewards, 0.0)
-        self.active[k] = acting & ~self.terminated[k] & ~self.truncated[k]
+    def score(self, mask):
+        """After a step of the worlds of mask (K,) bools (not a reset's step): their
+        rewards, terminations and truncations, and the agents still active."""
+        ks = np.flatnonzero(mask)
+        if not len(ks):
+            return
+        self.episode_steps[ks] += 1
+        acting = self.active[ks]
+        reward = self.spec["reward"]
+        terminate = self.spec["terminate"]
+        batched = getattr(reward, "batched", None)
+        rewards = batched(self, ks) if batched is not None else np.zeros((len(ks), self.N))
+        done = ~self.present[ks] & acting  # robots removed from the world
+        if batched is None or terminate is not None:
+            for j, k in enumerate(ks):
+                world = self.slots[k].world
+                arrays = self.agent_arrays(k)
+                arrays.active = acting[j]
+                if batched is None:
+                    rewards[j] = reward(world, arrays, self, k)
+                if terminate is not None:
+                    done[j] |= _bools(terminate(world, arrays), self.N, "terminate")
+        terminated = done & acting
+        self.terminated[ks] |= terminated  # True from its step until the world resets
+        if self.max_steps is not None:
+            limit = (self.episode_steps[ks] >= self.max_steps)[:, None]
+            self.truncated[ks] = acting & ~terminated & limit
+        else:
+            self.truncated[ks] = False
+        self.rewards[ks] = np.where(acting, rewards, 0.0)
+        self.active[ks] = acting & ~terminated & ~self.truncated[ks]
 
     def close(self):
         for slot in self.slots:

@@ -268,8 +268,17 @@ def wheel_speeds(max_speed=0.1, wheel_radius=0.029, joints=None):
 # --- Rewards ---------------------------------------------------------------------------
 
 def _distance_reward(world, agents, core, k):
-    d = agents.poses[:, :2] - agents.previous_poses[:, :2]
-    return np.where(agents.present, np.sqrt(d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1]), 0.0)
+    return _distance_reward.batched(core, [k])[0]
+
+
+def _distance_batched(core, ks):
+    # Metres each agent's robot moved in the step (0 for robots gone), all worlds at once.
+    d = core.poses[ks, :, :2] - core.previous_poses[ks, :, :2]
+    return np.where(core.present[ks], np.sqrt(d[..., 0] * d[..., 0] + d[..., 1] * d[..., 1]),
+                    0.0)
+
+
+_distance_reward.batched = _distance_batched
 
 
 def _metric_reward(name):
@@ -516,7 +525,7 @@ class ParallelEnv(_ParallelBase):
         core.set_actions(0, batch)
         core.step_all()
         core.observe()
-        core.score(0)
+        core.score(np.ones(1, dtype=bool))
         obs = core.obs[0]
         rewards, term, trunc = core.rewards[0], core.terminated[0], core.truncated[0]
         result = (
@@ -728,11 +737,8 @@ class VectorEnv(_VectorBase):
                 core.set_actions(k, checked[k])
         core.step_all()
         core.observe()
-        for k in range(core.K):
-            if resetting[k]:
-                core.active[k] = core.present[k]
-            else:
-                core.score(k)
+        core.active[resetting] = core.present[resetting]
+        core.score(~resetting)
         self._ended = ~core.active.any(axis=1)
         return (core.obs.copy(), core.rewards.copy(), core.terminated.copy(),
                 core.truncated.copy(), self._infos())

@@ -1,0 +1,113 @@
+"""swarmsim.env throughput (issue 30's target: 64 environments x 16 robots, a numpy policy,
+2 threads, >= 100,000 agent-steps/s from Python), run by hand, never by the tests:
+
+    PYTHONPATH=build/python /usr/bin/python3 bench/python/env_throughput.py [--envs 64]
+        [--robots 16] [--steps 300] [--max-steps 100] [--repeats 3]
+
+A VectorEnv over worlds/python/diffusion_numpy.yaml (foot-bots; 24 proximity readings in,
+two wheel speeds out), a numpy policy (a fixed linear map of the observations, the
+Braitenberg avoidance diffusion does), observations and actions crossing the boundary every
+step, episodes of --max-steps steps with next-step autoreset (so resets are counted).
+Agent-steps/s = envs x robots x steps / wall time of the step loop (median of --repeats).
+
+Modes: "step_worlds" steps the K worlds with swarmsim.step_worlds on --threads threads (only
+when the module has it); "loop" steps them one after the other, each world on 1 thread and on
+--threads threads. Also printed: the share of the wall time spent inside the worlds' steps, and agent-steps
+per CPU-second of the process (user + system time of all its threads: on a shared machine
+the wall-clock rate depends on what else runs; this one much less).
+"""
+
+import argparse
+import pathlib
+import statistics
+import time
+
+import numpy as np
+
+import swarmsim
+from swarmsim import _env_core
+from swarmsim.env import VectorEnv
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+WORLD = ROOT / "worlds" / "python" / "diffusion_numpy.yaml"
+
+
+def policy_weights(sensors=24):
+    # A Braitenberg vehicle as a (24, 2) matrix: what the front-left sensors see slows the
+    # right wheel and the front-right ones the left wheel, so the robot turns away.
+    angles = 2 * np.pi * np.arange(sensors) / sensors
+    front = np.cos(angles) > 0
+    left = np.sin(angles) > 0
+    w = np.zeros((sensors, 2))
+    w[front & left, 1] = -0.15
+    w[front & ~left, 0] = -0.15
+    return w
+
+
+def run(args, threads, parallel):
+    saved = getattr(swarmsim._swarmsim, "step_worlds", None)
+    if not parallel and saved is not None:
+        delattr(swarmsim._swarmsim, "step_worlds")  # the fallback loop, for comparison
+    try:
+        env = VectorEnv(str(WORLD), args.envs, set={"robots": args.robots},
+                        max_steps=args.max_steps, threads=threads)
+        w = policy_weights()
+        obs, _ = env.reset(seed=1)
+        stepping = [0.0]
+        step_all = env._core.step_all
+
+        def timed():
+            t = time.perf_counter()
+            step_all()
+            stepping[0] += time.perf_counter() - t
+        env._core.step_all = timed
+        t = time.perf_counter()
+        cpu = time.process_time()
+        for _ in range(args.steps):
+            actions = np.clip(0.08 + obs @ w, -0.1, 0.1)
+            obs, rewards, terminations, truncations, infos = env.step(actions)
+        elapsed = time.perf_counter() - t
+        cpu = time.process_time() - cpu
+        env.close()
+    finally:
+        if not parallel and saved is not None:
+            swarmsim._swarmsim.step_worlds = saved
+    agent_steps = args.envs * args.robots * args.steps
+    return agent_steps / elapsed, stepping[0] / elapsed, agent_steps / cpu
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--envs", type=int, default=64)
+    parser.add_argument("--robots", type=int, default=16)
+    parser.add_argument("--steps", type=int, default=300)
+    parser.add_argument("--max-steps", type=int, default=100)
+    parser.add_argument("--threads", type=int, default=2)
+    parser.add_argument("--repeats", type=int, default=3)
+    args = parser.parse_args()
+
+    modes = []
+    if _env_core.has_parallel_step():
+        modes.append((f"step_worlds, {args.threads} threads", args.threads, True))
+    else:
+        print("swarmsim.step_worlds: not in this build (only the loop is measured)")
+    modes += [("loop, 1 thread a world", 1, False),
+              (f"loop, {args.threads} threads a world", args.threads, False)]
+    print(f"{args.envs} environments x {args.robots} robots, {args.steps} steps, episodes of "
+          f"{args.max_steps} steps (autoreset), World.reset: "
+          f"{'yes' if _env_core.has_reset() else 'no (reload)'}; median of {args.repeats}")
+    for name, threads, parallel in modes:
+        rates, shares, cpu_rates = [], [], []
+        for _ in range(args.repeats):
+            rate, share, cpu_rate = run(args, threads, parallel)
+            rates.append(rate)
+            shares.append(share)
+            cpu_rates.append(cpu_rate)
+        print(f"  {name:28s} {statistics.median(rates):10,.0f} agent-steps/s "
+              f"(min {min(rates):,.0f}, max {max(rates):,.0f}; "
+              f"{100 * statistics.median(shares):.0f}% inside the worlds' steps; "
+              f"{statistics.median(cpu_rates):,.0f} per CPU-second of the process)")
+
+
+if __name__ == "__main__":
+    main()
