@@ -24,7 +24,6 @@ import time
 
 import numpy as np
 
-import swarmsim
 from swarmsim import _env_core
 from swarmsim.env import VectorEnv
 
@@ -45,33 +44,28 @@ def policy_weights(sensors=24):
 
 
 def run(args, threads, parallel):
-    saved = getattr(swarmsim._swarmsim, "step_worlds", None)
-    if not parallel and saved is not None:
-        delattr(swarmsim._swarmsim, "step_worlds")  # the fallback loop, for comparison
-    try:
-        env = VectorEnv(str(WORLD), args.envs, set={"robots": args.robots},
-                        max_steps=args.max_steps, threads=threads)
-        w = policy_weights()
-        obs, _ = env.reset(seed=1)
-        stepping = [0.0]
-        step_all = env._core.step_all
+    env = VectorEnv(str(WORLD), args.envs, set={"robots": args.robots},
+                    max_steps=args.max_steps, threads=1 if parallel else threads,
+                    step_threads=threads)
+    env._core.parallel = parallel  # False: the fallback loop, for comparison
+    w = policy_weights()
+    obs, _ = env.reset(seed=1)
+    stepping = [0.0]
+    step_all = env._core.step_all
 
-        def timed():
-            t = time.perf_counter()
-            step_all()
-            stepping[0] += time.perf_counter() - t
-        env._core.step_all = timed
+    def timed():
         t = time.perf_counter()
-        cpu = time.process_time()
-        for _ in range(args.steps):
-            actions = np.clip(0.08 + obs @ w, -0.1, 0.1)
-            obs, rewards, terminations, truncations, infos = env.step(actions)
-        elapsed = time.perf_counter() - t
-        cpu = time.process_time() - cpu
-        env.close()
-    finally:
-        if not parallel and saved is not None:
-            swarmsim._swarmsim.step_worlds = saved
+        step_all()
+        stepping[0] += time.perf_counter() - t
+    env._core.step_all = timed
+    t = time.perf_counter()
+    cpu = time.process_time()
+    for _ in range(args.steps):
+        actions = np.clip(0.08 + obs @ w, -0.1, 0.1)
+        obs, rewards, terminations, truncations, infos = env.step(actions)
+    elapsed = time.perf_counter() - t
+    cpu = time.process_time() - cpu
+    env.close()
     agent_steps = args.envs * args.robots * args.steps
     return agent_steps / elapsed, stepping[0] / elapsed, agent_steps / cpu
 

@@ -18,12 +18,13 @@ World = _swarmsim.World
 MAX_SEED = 2**31  # seeds drawn for later episodes lie in [0, MAX_SEED)
 
 
-def step_worlds(worlds, n=1):
-    """Steps worlds n times: swarmsim.step_worlds (the K worlds in parallel, the GIL
-    released) when the module has it, else one after the other."""
-    parallel = getattr(_swarmsim, "step_worlds", None)
-    if parallel is not None:
-        parallel(list(worlds), n)
+def step_worlds(worlds, n=1, threads=0, parallel=True):
+    """Steps worlds n times: with swarmsim.step_worlds (the worlds in parallel on `threads`
+    workers, 0: every core, the GIL released) when the module has it and parallel is True,
+    else one after the other (each on its own threads)."""
+    step = getattr(_swarmsim, "step_worlds", None) if parallel else None
+    if step is not None and len(worlds) > 1:
+        step(list(worlds), n, threads)
     else:
         for w in worlds:
             w.step(n)
@@ -32,6 +33,12 @@ def step_worlds(worlds, n=1):
 def has_parallel_step():
     """True if this build has swarmsim.step_worlds (else environments step in a loop)."""
     return hasattr(_swarmsim, "step_worlds")
+
+
+def has_keep_scripts():
+    """True if this build's World takes keep_scripts= (drops the Lua scripts of the models
+    a Python controller drives)."""
+    return "keep_scripts" in (World.__init__.__doc__ or "")
 
 
 def has_reset():
@@ -80,6 +87,7 @@ class Core:
         if self.K < 1:
             raise ValueError(f"num_envs must be >= 1, got {num_envs}")
         self.slots = [_WorldSlot() for _ in range(self.K)]
+        self.parallel = True  # step the worlds with swarmsim.step_worlds where it exists
         if self.model is None:
             self.model = self._find_model(spec["seed"])
         # The first world tells the agents, joints and sizes.
@@ -172,6 +180,13 @@ class Core:
         options = dict(self.spec["world_options"])
         controllers = dict(options.pop("controllers", {}))
         controllers[self.model] = self._controller(slot)
+        if not self.spec["keep_scripts"]:
+            if not has_keep_scripts():
+                raise ValueError("keep_scripts=False: this build's swarmsim.World has no "
+                                 "keep_scripts; use a world whose models entry has a "
+                                 "python_controller (its Lua scripts are dropped), such as "
+                                 "worlds/python/diffusion_numpy.yaml")
+            options["keep_scripts"] = False
         slot.world = World(self.path, seed=seed, set=self.spec["set"],
                            threads=self.spec["threads"], controllers=controllers, **options)
         slot.seed = seed
@@ -200,10 +215,11 @@ class Core:
         if old is not None and old.shape == slot.targets.shape:
             slot.targets[:] = old
 
-    def reset_world(self, k, seed=None):
+    def reset_world(self, k, seed=None, poses=None):
         """Puts world k at the start of an episode (not yet stepped: the caller's next
         step_all() is its first, with every joint target 0). seed None: the world's next
-        seed (base seed + k the first time, then drawn from the last seed)."""
+        seed (base seed + k the first time, then drawn from the last seed). poses: the
+        agents' robots' poses (N, 3 or 7), through World.set_poses."""
         slot = self.slots[k]
         if seed is None:
             if slot.rng is None:
@@ -223,6 +239,16 @@ class Core:
         slot.fresh = False
         slot.seed = seed
         self._map(k)
+        if poses is not None:
+            setter = getattr(slot.world, "set_poses", None)
+            if setter is None:
+                raise ValueError("reset(options={'poses': ...}) needs World.set_poses, which "
+                                 "this build of swarmsim does not have")
+            poses = np.asarray(poses)
+            if not slot.identity or poses.ndim != 2 or poses.shape[0] != self.N:
+                raise ValueError(f"reset: options['poses'] must have one row per agent "
+                                 f"({self.N}, 3 or 7), got shape {poses.shape}")
+            setter(self.model, poses)
         slot.targets[:] = 0
         self.episode_steps[k] = 0
         self.last_actions[k] = 0
@@ -246,10 +272,13 @@ class Core:
             has = slot.row_of >= 0
             slot.targets[:, slot.row_of[has]] = targets[has].T
 
+    def step_list(self, worlds):
+        step_worlds(worlds, 1, self.spec["step_threads"], self.parallel)
+
     def step_all(self):
         for slot in self.slots:
             slot.called = False
-        step_worlds([s.world for s in self.slots])
+        self.step_list([s.world for s in self.slots])
         for slot in self.slots:
             if not slot.called and slot.indices:
                 self._remap(slot, [], [])  # the model's robots are gone

@@ -40,13 +40,14 @@ See swarm/python/README.md for the full reference.
 import numpy as np
 
 from . import spaces
-from ._env_core import AgentArrays, Core, has_parallel_step, has_reset, step_worlds
+from ._env_core import (AgentArrays, Core, has_keep_scripts, has_parallel_step, has_reset,
+                        step_worlds)
 
 __all__ = [
     "ParallelEnv", "VectorEnv", "Observation", "JointTargets", "AgentArrays", "wheel_speeds",
     "proximity", "proximity_distance", "proximity_values", "ground", "light", "pose",
     "velocity", "joint_positions", "joint_velocities", "range_and_bearing", "step_worlds",
-    "has_parallel_step", "has_reset",
+    "has_parallel_step", "has_reset", "has_keep_scripts",
 ]
 
 INF = float("inf")
@@ -323,7 +324,7 @@ def _reward(reward):
 
 
 def _spec(world, observations, actions, reward, terminate, max_steps, model, seed, set,
-          threads, world_options):
+          threads, world_options, keep_scripts=True, step_threads=0):
     if observations is None:
         observations = ["proximity"]
     if isinstance(observations, (str, Observation)) or callable(observations):
@@ -344,6 +345,7 @@ def _spec(world, observations, actions, reward, terminate, max_steps, model, see
         "actions": actions, "reward": _reward(reward), "terminate": terminate,
         "max_steps": max_steps, "model": model, "seed": seed, "set": dict(set or {}),
         "threads": threads, "world_options": dict(world_options or {}),
+        "keep_scripts": bool(keep_scripts), "step_threads": int(step_threads),
     }
 
 
@@ -405,9 +407,9 @@ class ParallelEnv(_ParallelBase):
 
     def __init__(self, world, observations=None, actions=None, reward=None, terminate=None,
                  max_steps="world", model=None, seed=None, set=None, threads=0,
-                 clip_actions=False, world_options=None):
+                 clip_actions=False, keep_scripts=True, world_options=None):
         spec = _spec(world, observations, actions, reward, terminate, max_steps, model, seed,
-                     set, threads, world_options)
+                     set, threads, world_options, keep_scripts)
         self._core = Core(spec, 1)
         self._clip = bool(clip_actions)
         core = self._core
@@ -467,15 +469,19 @@ class ParallelEnv(_ParallelBase):
     def reset(self, seed=None, options=None):
         """Starts an episode: the world at its start (seed: its seed; None: the world file's
         the first time, then one drawn from the last seed) after one step with every joint
-        target 0, so that the sensors have read. Returns (observations, infos)."""
+        target 0, so that the sensors have read. options={"poses": (N, 3) x, y, yaw or
+        (N, 7)} places the agents' robots first (World.set_poses, in builds that have it).
+        Returns (observations, infos)."""
         if self._core.closed:
             raise RuntimeError("the environment is closed")
+        options = dict(options or {})
+        poses = options.pop("poses", None)
         if options:
-            raise ValueError(f"reset: options are not supported, got {sorted(options)}")
+            raise ValueError(f"reset: unknown options {sorted(options)} (known: 'poses')")
         if seed is not None and (int(seed) != seed or seed < 0):
             raise ValueError(f"seed must be an integer >= 0, got {seed}")
         core = self._core
-        core.reset_world(0, seed)
+        core.reset_world(0, seed, poses)
         core.step_all()
         core.observe()
         core.present[0] = core.slots[0].row_of >= 0
@@ -595,9 +601,10 @@ class VectorEnv(_VectorBase):
 
     def __init__(self, world, num_envs, observations=None, actions=None, reward=None,
                  terminate=None, max_steps="world", model=None, seed=None, set=None,
-                 threads=1, clip_actions=False, world_options=None):
+                 threads=1, step_threads=0, clip_actions=False, keep_scripts=True,
+                 world_options=None):
         spec = _spec(world, observations, actions, reward, terminate, max_steps, model, seed,
-                     set, threads, world_options)
+                     set, threads, world_options, keep_scripts, step_threads)
         self._core = Core(spec, num_envs)
         core = self._core
         self._clip = bool(clip_actions)
@@ -655,8 +662,9 @@ class VectorEnv(_VectorBase):
     def reset(self, seed=None, options=None):
         """Resets every environment (or those of ``options={"reset_mask": (K,) bools}``).
         seed: None (each environment's next seed: the world file's + k the first time), an
-        int s (environment k gets s + k) or a list of K seeds. Returns (observations,
-        infos)."""
+        int s (environment k gets s + k) or a list of K seeds. ``options={"poses": (K, N, 3
+        or 7)}`` places the robots (World.set_poses, in builds that have it). Returns
+        (observations, infos)."""
         core = self._core
         if core.closed:
             raise RuntimeError("the environment is closed")
@@ -669,8 +677,10 @@ class VectorEnv(_VectorBase):
                 raise ValueError(f"reset: options['reset_mask'] must be ({K},) bools")
             if not self._started and not mask.all():
                 raise ValueError("reset: the first reset resets every environment")
+        poses = options.pop("poses", None)
         if options:
-            raise ValueError(f"reset: unknown options {sorted(options)}")
+            raise ValueError(f"reset: unknown options {sorted(options)} (known: 'reset_mask', "
+                             f"'poses')")
         if seed is None:
             seeds = [None] * K
         elif np.ndim(seed) == 0:
@@ -683,7 +693,7 @@ class VectorEnv(_VectorBase):
                 raise ValueError(f"reset: {len(seeds)} seeds for {K} environments")
         ks = [k for k in range(K) if mask[k]]
         for k in ks:
-            core.reset_world(k, seeds[k])
+            core.reset_world(k, seeds[k], None if poses is None else poses[k])
         self._step_some(ks)
         core.observe()
         for k in ks:
@@ -700,7 +710,7 @@ class VectorEnv(_VectorBase):
         # Only some worlds: step those (the others keep their state).
         for slot in core.slots:
             slot.called = False
-        step_worlds([core.slots[k].world for k in ks])
+        core.step_list([core.slots[k].world for k in ks])
         for k in ks:
             slot = core.slots[k]
             if not slot.called and slot.indices:
