@@ -64,7 +64,8 @@ class AgentArrays:
 class _WorldSlot:
     """One world and where its agents are in the model's rows."""
 
-    def __init__(self):
+    def __init__(self, k):
+        self.k = k                 # its index among the K worlds
         self.world = None
         self.seed = None           # the seed of the current episode
         self.rng = None            # draws the seeds of later episodes
@@ -86,7 +87,7 @@ class Core:
         self.K = int(num_envs)
         if self.K < 1:
             raise ValueError(f"num_envs must be >= 1, got {num_envs}")
-        self.slots = [_WorldSlot() for _ in range(self.K)]
+        self.slots = [_WorldSlot(k) for k in range(self.K)]
         self.parallel = True  # step the worlds with swarmsim.step_worlds where it exists
         if self.model is None:
             self.model = self._find_model(spec["seed"])
@@ -153,8 +154,9 @@ class Core:
         def control(robots):
             slot.called = True
             indices = robots.indices
-            if indices != slot.indices:
+            if indices != slot.indices:  # robots came or went in this step
                 self._remap(slot, indices, robots.names)
+                self._write_targets(slot, self.actions.targets(self.last_actions[slot.k]))
             return {name: slot.targets[j] for j, name in enumerate(self.joint_names)}
         return control
 
@@ -258,13 +260,17 @@ class Core:
         self.truncated[k] = False
         self.rewards[k] = 0
 
-    def set_actions(self, k, actions):
-        """Joint targets of world k's next step from actions (N, A), already checked;
-        inactive agents' rows count as 0."""
-        slot = self.slots[k]
-        acting = self.active[k]
-        self.last_actions[k] = np.where(acting[:, None], actions, 0.0)
-        targets = self.actions.targets(self.last_actions[k])  # (N, J)
+    def set_actions(self, ks, actions):
+        """Joint targets of the next step of worlds ks from their actions (len(ks), N, A),
+        already checked; inactive agents' rows count as 0."""
+        acts = np.where(self.active[ks][..., None], actions, 0.0)
+        self.last_actions[ks] = acts
+        targets = self.actions.targets(acts)  # (len(ks), N, J)
+        for j, k in enumerate(ks):
+            self._write_targets(self.slots[k], targets[j])
+
+    def _write_targets(self, slot, targets):
+        # targets (N, J) in agent order -> the slot's (J, rows).
         if slot.identity:
             slot.targets[:] = targets.T
         else:

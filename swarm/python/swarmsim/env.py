@@ -528,7 +528,7 @@ class ParallelEnv(_ParallelBase):
                                  f"action space's is ({core.A},) ({self.joint_names})")
             batch[index[a]] = _check_actions(core, act[None], lambda m, a=a: f"agent {a!r}",
                                              self._clip)[0]
-        core.set_actions(0, batch)
+        core.set_actions([0], batch[None])
         core.step_all()
         core.observe()
         core.score(np.ones(1, dtype=bool))
@@ -740,11 +740,10 @@ class VectorEnv(_VectorBase):
                 core, acts[counts],
                 lambda m: f"environment {where[m][0]}, agent {agents[where[m][1]]!r}",
                 self._clip)
-        for k in range(core.K):
-            if resetting[k]:
-                core.reset_world(k)
-            else:
-                core.set_actions(k, checked[k])
+        for k in np.flatnonzero(resetting):
+            core.reset_world(int(k))
+        going = np.flatnonzero(~resetting)
+        core.set_actions(going, checked[going])
         core.step_all()
         core.observe()
         core.active[resetting] = core.present[resetting]
