@@ -292,6 +292,38 @@ class EpisodeTest(unittest.TestCase):
         env.close()
 
 
+class LeavingRobotsTest(unittest.TestCase):
+    def test_robots_removed_by_their_scripts_terminate_and_copies_are_not_agents(self):
+        # worlds/respawn.yaml: robots fail at random and remove themselves; the main script
+        # copies live ones (footbot#100, ...). failure_rate 1/s: most fail within 3 s.
+        env = senv.ParallelEnv(world("respawn.yaml"), set={"robots": 8, "failure_rate": 1.0},
+                               observations=["proximity", "pose"], max_steps=None)
+        env.reset(seed=4)
+        left = set()
+        for _ in range(30):
+            live = list(env.agents)
+            if not live:
+                break
+            obs, _, terminations, _, _ = env.step({a: np.full(2, 0.02) for a in live})
+            names = env.world.robots["names"]
+            for a in live:
+                # An agent terminates exactly when its robot is gone.
+                self.assertEqual(terminations[a], a not in names, a)
+            left |= {a for a in live if terminations[a]}
+            # The live agents' observations are their own robots' (robots' rows moved).
+            poses = env.world.poses("footbot")
+            prox = env.world.proximity("footbot")
+            for a in env.agents:
+                row = names.index(a)
+                np.testing.assert_array_equal(obs[a][24:26], poses[row, :2])
+                np.testing.assert_array_equal(obs[a][:24], np.clip(1 - prox[row] / 0.1, 0, 1))
+        self.assertGreater(len(left), 0)
+        self.assertTrue(any(n.startswith("footbot#1") and len(n) > 9
+                            for n in env.world.robots["names"]))  # copies appeared
+        self.assertTrue(set(env.agents) <= set(env.possible_agents))
+        env.close()
+
+
 class RewardTest(unittest.TestCase):
     def test_a_reward_function_sees_the_agents_arrays(self):
         seen = []
