@@ -9,6 +9,7 @@ import unittest
 
 import numpy as np
 
+import swarmsim
 from common import world
 from swarmsim import env as senv
 from swarmsim import spaces
@@ -236,6 +237,28 @@ class ActionTest(unittest.TestCase):
         env.close()
         with self.assertRaisesRegex(RuntimeError, "closed"):
             env.reset()
+
+
+class ResetOptionsTest(unittest.TestCase):
+    def test_reset_places_the_robots_at_the_poses_given(self):
+        env = make(3, observations=["pose"], set={"density": 0.2})
+        poses = np.array([[0.8, 0.8, 0.0], [-0.8, 0.8, math.pi / 2], [0.0, -0.8, math.pi]])
+        if not hasattr(swarmsim.World, "set_poses"):
+            with self.assertRaisesRegex(ValueError, "set_poses"):
+                env.reset(seed=1, options={"poses": poses})
+            return
+        obs, _ = env.reset(seed=1, options={"poses": poses})
+        for i, a in enumerate(env.possible_agents):
+            x, y, c, s = obs[a]
+            self.assertAlmostEqual(x, poses[i, 0], places=3)
+            self.assertAlmostEqual(y, poses[i, 1], places=3)
+            self.assertAlmostEqual(c, math.cos(poses[i, 2]), places=3)
+            self.assertAlmostEqual(s, math.sin(poses[i, 2]), places=3)
+        with self.assertRaisesRegex(ValueError, "one row per agent"):
+            env.reset(seed=1, options={"poses": poses[:2]})
+        with self.assertRaisesRegex(ValueError, "unknown options"):
+            env.reset(seed=1, options={"pose": poses})
+        env.close()
 
 
 class EpisodeTest(unittest.TestCase):
@@ -474,16 +497,21 @@ class VectorEnvTest(unittest.TestCase):
         venv.close()
 
     def test_same_seed_same_arrays_at_any_thread_count(self):
-        def run(threads):
-            venv = self.make(2, 6, threads=threads)
+        # threads: each world's; parallel: the worlds stepped by swarmsim.step_worlds (where
+        # the module has it) on 2 workers, or one after the other.
+        def run(threads, parallel=True):
+            venv = self.make(3, 6, threads=threads, step_threads=2)
+            venv._core.parallel = parallel
             out = [venv.reset(seed=7)[0]]
             rng = np.random.default_rng(3)
             for _ in range(5):
-                obs, rewards, *_ = venv.step(rng.uniform(-0.1, 0.1, size=(2, 6, 2)))
+                obs, rewards, *_ = venv.step(rng.uniform(-0.1, 0.1, size=(3, 6, 2)))
                 out += [obs, rewards]
             venv.close()
             return b"".join(x.tobytes() for x in out)
-        self.assertEqual(run(1), run(2))
+        first = run(1)
+        self.assertEqual(first, run(2))
+        self.assertEqual(first, run(1, parallel=False))
 
     def test_next_step_autoreset(self):
         venv = self.make(2, 4, max_steps=3)

@@ -235,7 +235,10 @@ class Core:
         if slot.fresh and slot.seed == seed:
             pass  # loaded with this seed and never stepped
         elif slot.world is not None and has_reset():
-            slot.world.reset(seed=seed)
+            try:
+                slot.world.reset(seed=seed)
+            except RuntimeError:  # a world stopped by an error: load it again
+                self._load(k, seed)
         else:
             self._load(k, seed)
         slot.fresh = False
