@@ -239,6 +239,27 @@ class ActionTest(unittest.TestCase):
             env.reset()
 
 
+class ScriptsTest(unittest.TestCase):
+    def test_actions_win_over_the_robots_lua_scripts_or_the_scripts_are_dropped(self):
+        def episode(path, **kw):
+            env = senv.ParallelEnv(path, set={"robots": 6}, **kw)
+            out = [env.reset(seed=3)[0]]
+            for _ in range(5):
+                out.append(env.step({a: np.array([0.05, -0.02]) for a in env.agents})[0])
+            env.close()
+            return b"".join(o[a].tobytes() for o in out for a in sorted(o))
+        # diffusion_numpy.yaml drops the foot-bot's Lua script (its python_controller,
+        # which the environment replaces). worlds/diffusion.yaml keeps it: the script sets
+        # the wheels every step, and the actions, applied after it, win.
+        dropped = episode(DIFFUSION)
+        self.assertEqual(dropped, episode(world("diffusion.yaml")))
+        if senv.has_keep_scripts():
+            self.assertEqual(dropped, episode(world("diffusion.yaml"), keep_scripts=False))
+        else:
+            with self.assertRaisesRegex(ValueError, "keep_scripts.*python_controller"):
+                episode(world("diffusion.yaml"), keep_scripts=False)
+
+
 class ResetOptionsTest(unittest.TestCase):
     def test_reset_places_the_robots_at_the_poses_given(self):
         env = make(3, observations=["pose"], set={"density": 0.2})
