@@ -12,7 +12,8 @@ Agent-steps/s = envs x robots x steps / wall time of the step loop (median of --
 
 Modes: "step_worlds" steps the K worlds with swarmsim.step_worlds on --threads threads (only
 when the module has it); "loop" steps them one after the other, each world on 1 thread and on
---threads threads. Also printed: the share of the wall time spent inside the worlds' steps, and agent-steps
+--threads threads. Also printed: the cost of one environment's reset (World.reset where the module has it, else
+a new World loaded from the file), the share of the wall time spent inside the worlds' steps, and agent-steps
 per CPU-second of the process (user + system time of all its threads: on a shared machine
 the wall-clock rate depends on what else runs; this one much less).
 """
@@ -70,6 +71,20 @@ def run(args, threads, parallel):
     return agent_steps / elapsed, stepping[0] / elapsed, agent_steps / cpu
 
 
+def reset_cost(args, repeats=20):
+    """ms for one environment's reset (World.reset in place, or a new World), its first
+    step not included."""
+    env = VectorEnv(str(WORLD), 1, set={"robots": args.robots}, threads=1)
+    env.reset(seed=1)
+    env.step(np.zeros((1, args.robots, 2)))
+    t = time.perf_counter()
+    for i in range(repeats):
+        env._core.reset_world(0, 100 + i)
+    elapsed = time.perf_counter() - t
+    env.close()
+    return elapsed / repeats * 1e3
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--envs", type=int, default=64)
@@ -90,6 +105,8 @@ def main():
     print(f"{args.envs} environments x {args.robots} robots, {args.steps} steps, episodes of "
           f"{args.max_steps} steps (autoreset), World.reset: "
           f"{'yes' if _env_core.has_reset() else 'no (reload)'}; median of {args.repeats}")
+    print(f"  one environment's reset: {reset_cost(args):.1f} ms "
+          f"({'World.reset' if _env_core.has_reset() else 'a new World'}, {args.robots} robots)")
     for name, threads, parallel in modes:
         rates, shares, cpu_rates = [], [], []
         for _ in range(args.repeats):
