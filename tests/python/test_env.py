@@ -611,6 +611,78 @@ class VectorEnvTest(unittest.TestCase):
         venv.close()
 
 
+# Stand-ins for the names Gymnasium 1.x and PettingZoo document (gymnasium.spaces.Box,
+# gymnasium.vector.VectorEnv and AutoresetMode, pettingzoo.ParallelEnv), to check that
+# swarmsim.spaces and swarmsim.env take them when the libraries are importable.
+STUBS = {
+    "gymnasium/__init__.py": "from . import spaces, vector\n",
+    "gymnasium/spaces.py": (
+        "import numpy as np\n"
+        "class Box:\n"
+        "    def __init__(self, low, high, shape=None, dtype=np.float32, seed=None):\n"
+        "        self.dtype = np.dtype(dtype)\n        self.shape = tuple(shape)\n"
+        "        self.low = np.broadcast_to(low, shape).astype(dtype)\n"
+        "        self.high = np.broadcast_to(high, shape).astype(dtype)\n"
+        "    def contains(self, x):\n"
+        "        return bool(x.shape == self.shape and np.all(x >= self.low)\n"
+        "                    and np.all(x <= self.high))\n"),
+    "gymnasium/vector.py": (
+        "import enum\n"
+        "class AutoresetMode(enum.Enum):\n"
+        "    NEXT_STEP = 'NextStep'\n    SAME_STEP = 'SameStep'\n    DISABLED = 'Disabled'\n"
+        "class VectorEnv:\n"
+        "    metadata = {}\n    closed = False\n"
+        "    def close(self, **kwargs):\n        self.closed = True\n"
+        "    def __del__(self):\n"
+        "        if not getattr(self, 'closed', True):\n            self.close()\n"),
+    "pettingzoo/__init__.py": (
+        "class ParallelEnv:\n"
+        "    def observation_space(self, agent):\n        raise NotImplementedError\n"
+        "    @property\n    def num_agents(self):\n        return len(self.agents)\n"
+        "    @property\n    def unwrapped(self):\n        return self\n"),
+}
+
+CHECK_WITH_STUBS = """
+import numpy as np, gymnasium, pettingzoo
+from swarmsim import env, spaces
+assert spaces.GYMNASIUM and spaces.Box is gymnasium.spaces.Box
+assert issubclass(env.VectorEnv, gymnasium.vector.VectorEnv)
+assert issubclass(env.ParallelEnv, pettingzoo.ParallelEnv)
+assert env.VectorEnv.metadata["autoreset_mode"] is gymnasium.vector.AutoresetMode.NEXT_STEP
+p = env.ParallelEnv(PATH, set={"robots": 3})
+obs, _ = p.reset(seed=1)
+assert type(p.observation_space("footbot#0")) is gymnasium.spaces.Box
+assert p.unwrapped is p and p.num_agents == 3
+p.step({a: np.zeros(2) for a in p.agents})
+v = env.VectorEnv(PATH, 2, set={"robots": 3})
+obs, _ = v.reset(seed=1)
+assert type(v.single_observation_space) is gymnasium.spaces.Box
+assert v.observation_space.contains(v.step(np.zeros((2, 3, 2)))[0])
+v.close()
+assert v.closed
+print("ok")
+"""
+
+
+class LibrariesTest(unittest.TestCase):
+    def test_gymnasium_and_pettingzoo_types_are_used_when_importable(self):
+        import os
+        import subprocess
+        import sys
+        import tempfile
+        with tempfile.TemporaryDirectory() as folder:
+            for name, text in STUBS.items():
+                os.makedirs(os.path.join(folder, os.path.dirname(name)), exist_ok=True)
+                with open(os.path.join(folder, name), "w") as f:
+                    f.write(text)
+            path = folder + os.pathsep + os.environ.get("PYTHONPATH", "")
+            script = f"PATH = {DIFFUSION!r}\n" + CHECK_WITH_STUBS
+            p = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                               env={**os.environ, "PYTHONPATH": path}, timeout=300)
+            self.assertEqual(p.returncode, 0, p.stderr)
+            self.assertEqual(p.stdout.strip(), "ok")
+
+
 class SpacesTest(unittest.TestCase):
     def test_the_fallback_box_is_used_without_gymnasium(self):
         if importlib.util.find_spec("gymnasium") is None:
