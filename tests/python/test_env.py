@@ -148,6 +148,25 @@ class DeterminismTest(unittest.TestCase):
         env.close()
         fresh_env.close()
 
+    def test_a_seeded_reset_is_the_world_loaded_with_that_seed(self):
+        # Whether the environment resets the World in place (World.reset) or loads it again,
+        # the episode starts as a World loaded with the seed and stepped once with the
+        # wheels still.
+        env = make(8, observations=["proximity_distance", "pose"])
+        env.reset(seed=21)
+        env.step({a: np.full(2, 0.05) for a in env.agents})
+        obs, _ = env.reset(seed=22)
+        still = {"footbot": lambda robots: {"leftMotor": 0.0, "rightMotor": 0.0}}
+        w = swarmsim.World(DIFFUSION, seed=22, set={"robots": 8}, controllers=still)
+        w.step()
+        self.assertEqual(env.world.state_hash(), w.state_hash())
+        prox, poses = w.proximity("footbot"), w.poses("footbot")
+        for i, a in enumerate(env.possible_agents):
+            np.testing.assert_array_equal(obs[a][:24], prox[i])
+            np.testing.assert_array_equal(obs[a][24:26], poses[i, :2])
+        w.close()
+        env.close()
+
     def test_resets_without_a_seed_draw_reproducible_new_episodes(self):
         def starts():
             env = make(6)
