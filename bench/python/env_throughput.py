@@ -12,7 +12,7 @@ Agent-steps/s = envs x robots x steps / wall time of the step loop (median of --
 
 Modes: "step_worlds" steps the K worlds with swarmsim.step_worlds on --threads threads (only
 when the module has it); "loop" steps them one after the other, each world on 1 thread and on
---threads threads. Also printed: the cost of one environment's reset (World.reset where the module has it, else
+--threads threads. Also printed: one ParallelEnv's rate (the dict API, one world), the cost of one environment's reset (World.reset where the module has it, else
 a new World loaded from the file), the share of the wall time spent inside the worlds' steps, and agent-steps
 per CPU-second of the process (user + system time of all its threads: on a shared machine
 the wall-clock rate depends on what else runs; this one much less).
@@ -26,7 +26,7 @@ import time
 import numpy as np
 
 from swarmsim import _env_core
-from swarmsim.env import VectorEnv
+from swarmsim.env import ParallelEnv, VectorEnv
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 WORLD = ROOT / "worlds" / "python" / "diffusion_numpy.yaml"
@@ -85,6 +85,21 @@ def reset_cost(args, repeats=20):
     return elapsed / repeats * 1e3
 
 
+def parallel_env_rate(args, steps=200):
+    """Agent-steps/s of one ParallelEnv (dicts keyed by agent name), the same world and
+    policy, its World on 1 thread."""
+    env = ParallelEnv(str(WORLD), set={"robots": args.robots}, max_steps=None, threads=1)
+    w = policy_weights()
+    obs, _ = env.reset(seed=1)
+    t = time.perf_counter()
+    for _ in range(steps):
+        actions = {a: np.clip(0.08 + o @ w, -0.1, 0.1) for a, o in obs.items()}
+        obs, rewards, terminations, truncations, infos = env.step(actions)
+    elapsed = time.perf_counter() - t
+    env.close()
+    return args.robots * steps / elapsed
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--envs", type=int, default=64)
@@ -107,6 +122,7 @@ def main():
           f"{'yes' if _env_core.has_reset() else 'no (reload)'}; median of {args.repeats}")
     print(f"  one environment's reset: {reset_cost(args):.1f} ms "
           f"({'World.reset' if _env_core.has_reset() else 'a new World'}, {args.robots} robots)")
+    print(f"  one ParallelEnv (dicts), 1 thread: {parallel_env_rate(args):,.0f} agent-steps/s")
     for name, threads, parallel in modes:
         rates, shares, cpu_rates = [], [], []
         for _ in range(args.repeats):

@@ -520,14 +520,19 @@ class ParallelEnv(_ParallelBase):
         if missing:
             raise ValueError(f"step: no action for agent {missing[0]!r} (one action for each "
                              f"of env.agents)")
-        batch = np.zeros((core.N, core.A))
+        rows = []
         for a in live:
             act = np.asarray(actions[a])
             if act.shape != (core.A,):
                 raise ValueError(f"the action for agent {a!r} has shape {act.shape}, the "
                                  f"action space's is ({core.A},) ({self.joint_names})")
-            batch[index[a]] = _check_actions(core, act[None], lambda m, a=a: f"agent {a!r}",
-                                             self._clip)[0]
+            if act.dtype.kind not in "iuf":
+                raise ValueError(f"the action for agent {a!r} must be real numbers, got "
+                                 f"dtype {act.dtype}")
+            rows.append(act)
+        batch = np.zeros((core.N, core.A))
+        batch[[index[a] for a in live]] = _check_actions(
+            core, np.stack(rows), lambda m: f"agent {live[m]!r}", self._clip)
         core.set_actions([0], batch[None])
         core.step_all()
         core.observe()
