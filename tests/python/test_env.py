@@ -230,6 +230,7 @@ class ActionTest(unittest.TestCase):
         self.assertEqual(env.world.steps, 1)
         # float32 policies: float32(0.1) is inside [-0.1, 0.1].
         env.step({a: np.full(2, 0.1, dtype=np.float32) for a in env.agents})
+        env.step({**ok, "footbot#0": np.full(2, 0.1, dtype=np.float32)})  # mixed dtypes
         env.close()
 
     def test_clip_actions_clips_to_the_bounds(self):

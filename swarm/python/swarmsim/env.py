@@ -520,7 +520,7 @@ class ParallelEnv(_ParallelBase):
         if missing:
             raise ValueError(f"step: no action for agent {missing[0]!r} (one action for each "
                              f"of env.agents)")
-        rows = []
+        groups = {}  # actions checked in their own precision, one pass per dtype
         for a in live:
             act = np.asarray(actions[a])
             if act.shape != (core.A,):
@@ -529,10 +529,13 @@ class ParallelEnv(_ParallelBase):
             if act.dtype.kind not in "iuf":
                 raise ValueError(f"the action for agent {a!r} must be real numbers, got "
                                  f"dtype {act.dtype}")
-            rows.append(act)
+            groups.setdefault(act.dtype, []).append((a, act))
         batch = np.zeros((core.N, core.A))
-        batch[[index[a] for a in live]] = _check_actions(
-            core, np.stack(rows), lambda m: f"agent {live[m]!r}", self._clip)
+        for group in groups.values():
+            names = [a for a, _ in group]
+            batch[[index[a] for a in names]] = _check_actions(
+                core, np.stack([act for _, act in group]), lambda m: f"agent {names[m]!r}",
+                self._clip)
         core.set_actions([0], batch[None])
         core.step_all()
         core.observe()
