@@ -22,6 +22,7 @@ import argparse
 import pathlib
 import statistics
 import time
+import warnings
 
 import numpy as np
 
@@ -78,11 +79,14 @@ def reset_cost(args, repeats=20):
     env.reset(seed=1)
     env.step(np.zeros((1, args.robots, 2)))
     t = time.perf_counter()
-    for i in range(repeats):
-        env._core.reset_world(0, 100 + i)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for i in range(repeats):
+            env._core.reset_world(0, 100 + i)
     elapsed = time.perf_counter() - t
+    failed = env._core.reset_failures
     env.close()
-    return elapsed / repeats * 1e3
+    return elapsed / repeats * 1e3, failed
 
 
 def parallel_env_rate(args, steps=200):
@@ -120,8 +124,11 @@ def main():
     print(f"{args.envs} environments x {args.robots} robots, {args.steps} steps, episodes of "
           f"{args.max_steps} steps (autoreset), World.reset: "
           f"{'yes' if _env_core.has_reset() else 'no (reload)'}; median of {args.repeats}")
-    print(f"  one environment's reset: {reset_cost(args):.1f} ms "
-          f"({'World.reset' if _env_core.has_reset() else 'a new World'}, {args.robots} robots)")
+    ms, failed = reset_cost(args)
+    how = "a new World"
+    if _env_core.has_reset():
+        how = "World.reset" if not failed else f"World.reset failed {failed} times: a new World"
+    print(f"  one environment's reset: {ms:.1f} ms ({how}, {args.robots} robots)")
     print(f"  one ParallelEnv (dicts), 1 thread: {parallel_env_rate(args):,.0f} agent-steps/s")
     for name, threads, parallel in modes:
         rates, shares, cpu_rates = [], [], []

@@ -167,6 +167,25 @@ class DeterminismTest(unittest.TestCase):
         w.close()
         env.close()
 
+    def test_a_world_that_cannot_reset_in_place_is_loaded_again_with_a_warning(self):
+        from unittest import mock
+        from swarmsim import _env_core
+
+        class NoReset(swarmsim.World):
+            def reset(self, seed=None):
+                raise RuntimeError("snapshot: a module cannot save its state")
+        plain = make(5)
+        expected, _ = plain.reset(seed=2)
+        plain.close()
+        with mock.patch.object(_env_core, "World", NoReset):
+            env = make(5)
+            with self.assertWarnsRegex(RuntimeWarning, "World.reset failed.*cannot save"):
+                obs, _ = env.reset(seed=2)
+            self.assertEqual(env._core.reset_failures, 1)
+            for a in env.possible_agents:
+                self.assertEqual(obs[a].tobytes(), expected[a].tobytes())
+            env.close()
+
     def test_resets_without_a_seed_draw_reproducible_new_episodes(self):
         def starts():
             env = make(6)

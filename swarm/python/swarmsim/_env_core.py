@@ -9,6 +9,7 @@ all K worlds.
 """
 
 import re
+import warnings
 
 import numpy as np
 
@@ -89,6 +90,7 @@ class Core:
             raise ValueError(f"num_envs must be >= 1, got {num_envs}")
         self.slots = [_WorldSlot(k) for k in range(self.K)]
         self.parallel = True  # step the worlds with swarmsim.step_worlds where it exists
+        self.reset_failures = 0  # World.reset calls that failed (the world was loaded again)
         if self.model is None:
             self.model = self._find_model(spec["seed"])
         # The first world tells the agents, joints and sizes.
@@ -237,7 +239,13 @@ class Core:
         elif slot.world is not None and has_reset():
             try:
                 slot.world.reset(seed=seed)
-            except RuntimeError:  # a world stopped by an error: load it again
+            except RuntimeError as e:
+                # A world stopped by an error, or one World.reset cannot put back (a module
+                # that cannot save its state): load it again, and say so once.
+                if not self.reset_failures:
+                    warnings.warn(f"{self.path}: World.reset failed ({e}); the environment "
+                                  f"loads the world again instead", RuntimeWarning, stacklevel=3)
+                self.reset_failures += 1
                 self._load(k, seed)
         else:
             self._load(k, seed)
