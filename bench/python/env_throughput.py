@@ -12,8 +12,9 @@ Agent-steps/s = envs x robots x steps / wall time of the step loop (median of --
 
 Modes: "step_worlds" steps the K worlds with swarmsim.step_worlds on --threads threads (only
 when the module has it); "loop" steps them one after the other, each world on 1 thread and on
---threads threads. Also printed: one ParallelEnv's rate (the dict API, one world), the cost of one environment's reset (World.reset where the module has it, else
-a new World loaded from the file), the share of the wall time spent inside the worlds' steps, and agent-steps
+--threads threads. Also printed: one ParallelEnv's rate (the dict API, one world), the cost
+of one environment's reset (World.reset where the module has it, else a new World loaded
+from the file), the share of the wall time spent inside the worlds' steps, and agent-steps
 per CPU-second of the process (user + system time of all its threads: on a shared machine
 the wall-clock rate depends on what else runs; this one much less).
 """
