@@ -1,12 +1,88 @@
 // The 3D view (three.js): the floor, the paint layer, every recorded object
 // as its type declares it (FORMAT.md: `visual`): solids and lights as
-// instances (one InstancedMesh per kind and size), rays as line segments;
+// instances (one InstancedMesh per kind and size; a mesh asset's geometry
+// once, instanced over every object that uses it), rays as line segments;
 // trails; camera with orbit/pan; picking robots.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import { NO_DETECTION } from './recording.js';
 
+// Triangles of meshes drawn (each copy counted) above which meshes are drawn
+// as their bounding boxes: the page's `mesh_budget` URL parameter (or
+// `swarmsim view --mesh-budget`) changes it.
+export const DEFAULT_MESH_BUDGET = 4e6;
 
+// "2.7 M", "135 k", "624": a triangle count for the status line.
+export function triangleText(n) {
+  if (n >= 1e6) return `${(n / 1e6).toFixed(n >= 1e7 ? 0 : 1).replace(/\.0$/, '')} M`;
+  if (n >= 1e4) return `${Math.round(n / 1e3)} k`;
+  return String(n);
+}
+
+// A mesh asset's bounds in its frame: {lo: [x, y, z], hi: [x, y, z]}.
+function boundsOf(asset) {
+  const v = asset.vertices, lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+  for (let i = 0; i < v.length; i += 3)
+    for (let k = 0; k < 3; ++k) { lo[k] = Math.min(lo[k], v[i + k]); hi[k] = Math.max(hi[k], v[i + k]); }
+  return { lo, hi };
+}
+
+// Whether object `o` names an embedded mesh asset that can be drawn: its
+// triangles name its vertices (the recording's reader in C++ checks this too).
+function assetOf(o, meshes) {
+  if (o.visual !== 'mesh' || !Number.isInteger(o.mesh) || !meshes || o.mesh < 0 || o.mesh >= meshes.length) return null;
+  const asset = meshes[o.mesh];
+  if (asset.checked === undefined) {
+    const n = asset.vertices.length / 3;
+    asset.checked = asset.triangles.length > 0 && asset.triangles.length % 3 === 0 &&
+      asset.vertices.length % 3 === 0 && asset.triangles.every((i) => i < n);
+  }
+  return asset.checked ? asset : null;
+}
+
+// Whether `o` is drawn in its mesh's own per-triangle colours (FORMAT.md
+// `mesh_colors`) rather than its recorded colour.
+function ownColorsOf(o, asset) {
+  return !!o.mesh_colors && asset.colors.length === asset.triangles.length;
+}
+
+// A mesh asset as one indexed BufferGeometry (the welded vertices shared,
+// flat-shaded by its material). In its own colours: its triangles sorted by
+// colour into groups, one material each (a file has few materials), so the
+// geometry stays indexed. Returns {geometry, colors: [THREE.Color per group] | null}.
+function meshGeometryOf(asset, ownColors) {
+  const geometry = new THREE.BufferGeometry();
+  geometry.setAttribute('position', new THREE.BufferAttribute(asset.vertices, 3));
+  const small = asset.vertices.length / 3 <= 65536;
+  const tri = asset.triangles, n = tri.length / 3;
+  if (!ownColors) {
+    geometry.setIndex(new THREE.BufferAttribute(small ? Uint16Array.from(tri) : tri, 1));
+    return { geometry, colors: null };
+  }
+  const c = asset.colors, byte = (v) => Math.round(Math.min(1, Math.max(0, v)) * 255);
+  const keys = new Uint32Array(n), first = new Map();
+  for (let t = 0; t < n; ++t) {
+    const key = (byte(c[3 * t]) << 16) | (byte(c[3 * t + 1]) << 8) | byte(c[3 * t + 2]);
+    keys[t] = key;
+    const e = first.get(key);
+    if (e) ++e.count; else first.set(key, { count: 1, start: 0, at: 0, t });
+  }
+  const index = small ? new Uint16Array(3 * n) : new Uint32Array(3 * n);
+  const colors = [];
+  let start = 0;
+  for (const e of first.values()) {
+    e.start = e.at = start;
+    geometry.addGroup(3 * start, 3 * e.count, colors.length);
+    colors.push(new THREE.Color().setRGB(c[3 * e.t], c[3 * e.t + 1], c[3 * e.t + 2], THREE.SRGBColorSpace));
+    start += e.count;
+  }
+  for (let t = 0; t < n; ++t) {
+    const e = first.get(keys[t]);
+    index.set(tri.subarray(3 * t, 3 * t + 3), 3 * e.at++);
+  }
+  geometry.setIndex(new THREE.BufferAttribute(index, 1));
+  return { geometry, colors };
+}
 
 // Fewer triangles per round shape when there are many of them (a software
 // renderer draws 10,000 robots at 30 frames/s only so).
@@ -28,8 +104,11 @@ const SOLIDS = new Set(['box', 'cylinder', 'sphere', 'capsule', 'mesh']);
 const MANY = 1000;
 
 export class View3D {
-  // `large`: a scene of thousands of robots (no antialiasing, 1 pixel per CSS pixel).
-  constructor(container, large) {
+  // `large`: a scene of thousands of robots (no antialiasing, 1 pixel per CSS
+  // pixel). `options.meshBudget`: triangles of meshes drawn as meshes (above:
+  // as their bounding boxes).
+  constructor(container, large, options = {}) {
+    this.meshBudget = options.meshBudget ?? DEFAULT_MESH_BUDGET;
     this.container = container;
     this.renderer = new THREE.WebGLRenderer({ antialias: !large, powerPreference: 'high-performance' });
     this.renderer.setPixelRatio(large ? 1 : window.devicePixelRatio || 1);
@@ -69,7 +148,10 @@ export class View3D {
   build(header, scene, state) {
     for (const child of [...this.world.children]) {
       this.world.remove(child);
-      child.traverse((c) => { c.geometry?.dispose(); c.material?.map?.dispose(); c.material?.dispose(); });
+      child.traverse((c) => {
+        c.geometry?.dispose();
+        for (const m of [c.material || []].flat()) { m.map?.dispose(); m.dispose(); }
+      });
     }
     this.header = header;
     this.sceneInfo = scene;
@@ -120,16 +202,30 @@ export class View3D {
     const sensors = [];
     this.bodiesOnly = this.large;
     this.rayColors = scene.declaredColors;
+    // Meshes (the scene's embedded assets): their triangles, each copy
+    // counted; past the budget every mesh is drawn as its bounding box.
+    // A swarm of thousands draws its bodies as discs whatever they are.
+    const meshes = this.large ? [] : scene.meshes || [];
+    let meshTriangles = 0;
+    for (const o of scene.objects) {
+      const asset = assetOf(o, meshes);
+      if (asset) meshTriangles += asset.triangles.length / 3;
+    }
+    const asBoxes = meshTriangles > this.meshBudget;
+    this.meshInfo = { triangles: meshTriangles, budget: this.meshBudget, asBoxes };
     for (const o of scene.objects) {
       if (o.visual === 'ray') { sensors.push(o.id); continue; }
       const solid = SOLIDS.has(o.visual);
-      let key;
+      let key, asset = null, ownColors = false;
       if (solid && this.bodiesOnly && o.robot >= 0 && o.templateObject !== 0) continue;
-      if (solid) key = `s|${o.visual}|${(o.size || []).join(',')}`;
+      if (solid && (asset = assetOf(o, meshes))) {
+        ownColors = !asBoxes && ownColorsOf(o, asset);
+        key = `${asBoxes ? 'b' : 'm'}|${o.mesh}|${ownColors ? 1 : 0}`;
+      } else if (solid) key = `s|${o.visual}|${(o.size || []).join(',')}`;
       else if (o.visual === 'light') key = `l|${o.radius}`;
       else continue;
       let g = groups.get(key);
-      if (!g) groups.set(key, g = { key, led: o.visual === 'light', sample: o, ids: [] });
+      if (!g) groups.set(key, g = { key, led: o.visual === 'light', sample: o, ids: [], asset, ownColors, asBox: asBoxes });
       g.ids.push(o.id);
     }
     // The objects whose world pose is needed: drawn ones and robot roots
@@ -239,17 +335,46 @@ export class View3D {
     this.links.geometry.attributes.color.needsUpdate = true;
   }
 
-  // One InstancedMesh for the objects of group `g` (same kind and size).
+  // One InstancedMesh for the objects of group `g` (same kind and size, or
+  // the same mesh asset: its geometry once for all of them).
   instancesOf(g) {
     const many = g.ids.length > MANY;
-    const geometry = g.led ? new THREE.SphereGeometry(Math.max(g.sample.radius || 0.01, 1e-4), many ? 6 : 10, many ? 4 : 8)
-      : geometryOf(g.sample, many);
-    const material = g.led ? new THREE.MeshBasicMaterial({ color: 0xffffff })
-      : new THREE.MeshLambertMaterial({ color: 0xffffff });
+    let geometry, material, colors = null;
+    if (g.asset && !g.asBox) {
+      ({ geometry, colors } = meshGeometryOf(g.asset, g.ownColors));
+      material = colors ? colors.map((color) => new THREE.MeshLambertMaterial({ color, flatShading: true }))
+        : new THREE.MeshLambertMaterial({ color: 0xffffff, flatShading: true });
+    } else {
+      if (g.asset) {
+        // Past the budget: the box that holds the mesh, where it is in the object's frame.
+        const { lo, hi } = boundsOf(g.asset);
+        geometry = new THREE.BoxGeometry(Math.max(hi[0] - lo[0], 1e-4), Math.max(hi[1] - lo[1], 1e-4),
+          Math.max(hi[2] - lo[2], 1e-4)).translate((lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2);
+      } else if (g.led) geometry = new THREE.SphereGeometry(Math.max(g.sample.radius || 0.01, 1e-4), many ? 6 : 10, many ? 4 : 8);
+      else geometry = geometryOf(g.sample, many);
+      material = g.led ? new THREE.MeshBasicMaterial({ color: 0xffffff })
+        : new THREE.MeshLambertMaterial({ color: 0xffffff });
+    }
     const mesh = new THREE.InstancedMesh(geometry, material, g.ids.length);
     mesh.instanceMatrix.setUsage(THREE.DynamicDrawUsage);
     mesh.setColorAt(0, new THREE.Color(1, 1, 1));
+    mesh.instanceColor.array.fill(1);
+    if (g.asset) {
+      mesh.userData.mesh = { asset: g.sample.mesh, file: g.asset.file, asBox: g.asBox,
+        triangles: g.asBox ? 0 : g.asset.triangles.length / 3, colors: colors && colors.map((c) => c.getHex(THREE.SRGBColorSpace)) };
+      mesh.userData.ownColors = !!colors;
+    }
     return mesh;
+  }
+
+  // What the meshes are drawn as, for tests and the status line: per group,
+  // the asset, its file, the triangles drawn per copy (0: drawn as a box),
+  // its own colours (sRGB 0xRRGGBB per material) or null, and each copy's
+  // recorded colour (sRGB 0xRRGGBB, as drawn).
+  meshGroups() {
+    return this.groups.filter((g) => g.userData.mesh).map((g) => ({ ...g.userData.mesh,
+      instances: g.count, geometryTriangles: (g.geometry.index ? g.geometry.index.count : g.geometry.attributes.position.count) / 3,
+      instanceColors: Array.from({ length: g.count }, (_, j) => new THREE.Color().fromArray(g.instanceColor.array, 3 * j).getHex(THREE.SRGBColorSpace)) }));
   }
 
   // A swarm of thousands: each object a disc of its size seen from any side
@@ -332,7 +457,7 @@ export class View3D {
     for (const mesh of this.groups) {
       if (mesh.userData.points) { this.updatePoints(mesh); continue; }
       const ids = mesh.userData.ids, m = mesh.instanceMatrix.array, c = mesh.instanceColor.array;
-      const led = mesh.userData.led, showLeds = this.show.leds;
+      const led = mesh.userData.led, showLeds = this.show.leds, own = mesh.userData.ownColors;
       for (let j = 0; j < ids.length; ++j) {
         const id = ids[j];
         const x = Q[4 * id], y = Q[4 * id + 1], z = Q[4 * id + 2], w = Q[4 * id + 3];
@@ -342,7 +467,9 @@ export class View3D {
         m[o + 4] = 2 * (x * y - z * w) * s; m[o + 5] = (1 - 2 * (x * x + z * z)) * s; m[o + 6] = 2 * (y * z + x * w) * s; m[o + 7] = 0;
         m[o + 8] = 2 * (x * z + y * w) * s; m[o + 9] = 2 * (y * z - x * w) * s; m[o + 10] = (1 - 2 * (x * x + y * y)) * s; m[o + 11] = 0;
         m[o + 12] = P[3 * id]; m[o + 13] = P[3 * id + 1]; m[o + 14] = P[3 * id + 2]; m[o + 15] = 1;
-        // sRGB bytes to the linear colours three works in; an LED that is off is dim.
+        // sRGB bytes to the linear colours three works in; an LED that is off
+        // is dim; a mesh in its own colours keeps them (white instances).
+        if (own) continue;
         const dim = led && rgba[4 * id + 3] === 0 ? 0.12 : 1;
         for (let k = 0; k < 3; ++k) {
           const v = rgba[4 * id + k] / 255;
