@@ -10,7 +10,7 @@ import { NO_DETECTION } from './recording.js';
 // Triangles of meshes drawn (each copy counted) above which meshes are drawn
 // as their bounding boxes: the page's `mesh_budget` URL parameter (or
 // `swarmsim view --mesh-budget`) changes it.
-export const DEFAULT_MESH_BUDGET = 4e6;
+export const DEFAULT_MESH_BUDGET = 1e6;
 
 // "2.7 M", "135 k", "624": a triangle count for the status line.
 export function triangleText(n) {
@@ -38,6 +38,54 @@ function assetOf(o, meshes) {
       asset.vertices.length % 3 === 0 && asset.triangles.every((i) => i < n);
   }
   return asset.checked ? asset : null;
+}
+
+// The fewest triangles a simplified mesh keeps; below, it is drawn as its box.
+const MIN_SIMPLIFIED = 12;
+
+// Mesh asset `asset` simplified to at most `target` triangles by vertex
+// clustering (Rossignac and Borrel 1993): its bounding box cut into R x R x R
+// cells, the vertices of a cell merged into their mean, triangles left with
+// fewer than three corners dropped; the finest R (256, 181, 128, ... 2: each
+// about halves the triangles) that keeps at most `target`. Its silhouette stays within a cell of the original's.
+// Returns an asset ({vertices, triangles, colors, file}), or null when even
+// R = 2 keeps more, or fewer than MIN_SIMPLIFIED.
+function simplify(asset, target) {
+  const v = asset.vertices, tri = asset.triangles, c = asset.colors, n = tri.length / 3;
+  const ownColors = c.length === tri.length;
+  const { lo, hi } = boundsOf(asset);
+  for (let R = 256; R >= 2; R = R === 3 ? 2 : Math.round(R / Math.SQRT2)) {
+    const scale = [0, 1, 2].map((k) => R / Math.max(hi[k] - lo[k], 1e-9));
+    const cellOf = new Map(), remap = new Uint32Array(v.length / 3), sums = [];
+    for (let i = 0; i < v.length / 3; ++i) {
+      let key = 0;
+      for (let k = 0; k < 3; ++k) key = key * (R + 1) + Math.min(R - 1, Math.floor((v[3 * i + k] - lo[k]) * scale[k]));
+      let cell = cellOf.get(key);
+      if (cell === undefined) { cell = cellOf.size; cellOf.set(key, cell); sums.push(0, 0, 0, 0); }
+      remap[i] = cell;
+      sums[4 * cell] += v[3 * i]; sums[4 * cell + 1] += v[3 * i + 1]; sums[4 * cell + 2] += v[3 * i + 2]; ++sums[4 * cell + 3];
+    }
+    const kept = [];
+    for (let t = 0; t < n; ++t) {
+      const a = remap[tri[3 * t]], b = remap[tri[3 * t + 1]], d = remap[tri[3 * t + 2]];
+      if (a !== b && b !== d && a !== d) kept.push(t);
+      if (kept.length > target) break;
+    }
+    if (kept.length > target) continue;
+    if (kept.length < MIN_SIMPLIFIED) return null;
+    const vertices = new Float32Array(3 * cellOf.size);
+    for (let cell = 0; cell < cellOf.size; ++cell)
+      for (let k = 0; k < 3; ++k) vertices[3 * cell + k] = sums[4 * cell + k] / sums[4 * cell + 3];
+    const triangles = new Uint32Array(3 * kept.length), colors = new Float32Array(ownColors ? 3 * kept.length : 0);
+    kept.forEach((t, j) => {
+      for (let k = 0; k < 3; ++k) {
+        triangles[3 * j + k] = remap[tri[3 * t + k]];
+        if (ownColors) colors[3 * j + k] = c[3 * t + k];
+      }
+    });
+    return { file: asset.file, vertices, triangles, colors };
+  }
+  return null;
 }
 
 // Whether `o` is drawn in its mesh's own per-triangle colours (FORMAT.md
@@ -85,10 +133,11 @@ function meshGeometryOf(asset, ownColors) {
 }
 
 // Fewer triangles per round shape when there are many of them (a software
-// renderer draws 10,000 robots at 30 frames/s only so).
+// renderer draws 10,000 robots at 30 frames/s only so), or when it is
+// smaller than a centimetre (an imported robot's mass carriers).
 function geometryOf(o, many) {
   const [a, b, c] = o.size || [0.05, 0.05, 0.05];
-  const round = many ? 8 : 24;
+  const round = many || a < 0.01 ? 8 : 24;
   switch (o.visual) {
     case 'box': case 'mesh': return new THREE.BoxGeometry(Math.max(a, 1e-4), Math.max(b, 1e-4), Math.max(c, 1e-4));
     case 'sphere': return new THREE.SphereGeometry(Math.max(a, 1e-4), round, round * 3 / 4);
@@ -211,21 +260,31 @@ export class View3D {
       const asset = assetOf(o, meshes);
       if (asset) meshTriangles += asset.triangles.length / 3;
     }
-    const asBoxes = meshTriangles > this.meshBudget;
-    this.meshInfo = { triangles: meshTriangles, budget: this.meshBudget, asBoxes };
+    // Past the budget, each asset is simplified to its share of the budget
+    // (the same fraction of its triangles for all), or drawn as its box
+    // when that leaves it too few (a budget of 0: every mesh a box).
+    const over = meshTriangles > this.meshBudget, share = over ? this.meshBudget / meshTriangles : 1;
+    const drawnAssets = new Map();  // asset index -> the asset drawn, or null (its box)
+    const drawnOf = (o, asset) => {
+      if (!over) return asset;
+      if (!drawnAssets.has(o.mesh)) drawnAssets.set(o.mesh, simplify(asset, Math.floor(share * asset.triangles.length / 3)));
+      return drawnAssets.get(o.mesh);
+    };
     for (const o of scene.objects) {
       if (o.visual === 'ray') { sensors.push(o.id); continue; }
       const solid = SOLIDS.has(o.visual);
       let key, asset = null, ownColors = false;
       if (solid && this.bodiesOnly && o.robot >= 0 && o.templateObject !== 0) continue;
+      let drawn = null;
       if (solid && (asset = assetOf(o, meshes))) {
-        ownColors = !asBoxes && ownColorsOf(o, asset);
-        key = `${asBoxes ? 'b' : 'm'}|${o.mesh}|${ownColors ? 1 : 0}`;
+        drawn = drawnOf(o, asset);
+        ownColors = !!drawn && ownColorsOf(o, asset);
+        key = `${drawn ? 'm' : 'b'}|${o.mesh}|${ownColors ? 1 : 0}`;
       } else if (solid) key = `s|${o.visual}|${(o.size || []).join(',')}`;
       else if (o.visual === 'light') key = `l|${o.radius}`;
       else continue;
       let g = groups.get(key);
-      if (!g) groups.set(key, g = { key, led: o.visual === 'light', sample: o, ids: [], asset, ownColors, asBox: asBoxes });
+      if (!g) groups.set(key, g = { key, led: o.visual === 'light', sample: o, ids: [], asset, drawn, ownColors });
       g.ids.push(o.id);
     }
     // The objects whose world pose is needed: drawn ones and robot roots
@@ -234,6 +293,18 @@ export class View3D {
     for (const g of groups.values()) for (const id of g.ids) drawn[id] = 1;
     for (const r of scene.robots) drawn[r.first] = 1;
     for (let id = 0; id < scene.count; ++id) if (scene.rootOf[id] < 0) drawn[id] = 1;
+    // What the meshes cost as drawn (the status line shows it).
+    let drawnTriangles = 0, boxes = 0, simplified = 0;
+    for (const g of groups.values()) {
+      if (!g.asset) continue;
+      if (!g.drawn) boxes += g.ids.length;
+      else {
+        drawnTriangles += g.ids.length * g.drawn.triangles.length / 3;
+        if (g.drawn !== g.asset) simplified += g.ids.length;
+      }
+    }
+    this.meshInfo = { triangles: meshTriangles, budget: this.meshBudget, drawnTriangles, boxes, simplified,
+      asBoxes: boxes > 0 && simplified === 0 && drawnTriangles === 0 };
     this.drawnIds = Uint32Array.from(drawn.reduce((list, on, id) => (on && list.push(id), list), []));
     this.drawnAndSensorIds = Uint32Array.from([...this.drawnIds, ...sensors].sort((a, b) => a - b));
     this.groups = [];
@@ -340,8 +411,8 @@ export class View3D {
   instancesOf(g) {
     const many = g.ids.length > MANY;
     let geometry, material, colors = null;
-    if (g.asset && !g.asBox) {
-      ({ geometry, colors } = meshGeometryOf(g.asset, g.ownColors));
+    if (g.drawn) {
+      ({ geometry, colors } = meshGeometryOf(g.drawn, g.ownColors));
       material = colors ? colors.map((color) => new THREE.MeshLambertMaterial({ color, flatShading: true }))
         : new THREE.MeshLambertMaterial({ color: 0xffffff, flatShading: true });
     } else {
@@ -360,8 +431,9 @@ export class View3D {
     mesh.setColorAt(0, new THREE.Color(1, 1, 1));
     mesh.instanceColor.array.fill(1);
     if (g.asset) {
-      mesh.userData.mesh = { asset: g.sample.mesh, file: g.asset.file, asBox: g.asBox,
-        triangles: g.asBox ? 0 : g.asset.triangles.length / 3, colors: colors && colors.map((c) => c.getHex(THREE.SRGBColorSpace)) };
+      mesh.userData.mesh = { asset: g.sample.mesh, file: g.asset.file, asBox: !g.drawn,
+        simplified: !!g.drawn && g.drawn !== g.asset, fileTriangles: g.asset.triangles.length / 3,
+        triangles: g.drawn ? g.drawn.triangles.length / 3 : 0, colors: colors && colors.map((c) => c.getHex(THREE.SRGBColorSpace)) };
       mesh.userData.ownColors = !!colors;
     }
     return mesh;

@@ -50,9 +50,12 @@ function setStatus() {
     `${r.records.length} steps recorded`];
   if (viewer.view?.bodiesOnly) parts.push('large swarm: bodies and LEDs only');
   const mesh = viewer.view?.meshInfo;
-  if (mesh?.asBoxes)
-    parts.push(`meshes as boxes: ${triangleText(mesh.triangles)} triangles > budget ${triangleText(mesh.budget)} (URL ?mesh_budget=N)`);
-  else if (mesh?.triangles) parts.push(`meshes: ${triangleText(mesh.triangles)} triangles`);
+  if (mesh?.triangles > mesh?.budget) {
+    // Past the budget: simplified, or boxes where simplifying leaves too little.
+    const how = mesh.asBoxes ? 'meshes as boxes'
+      : `meshes simplified${mesh.boxes ? ` (${mesh.boxes} as boxes)` : ''} to ${triangleText(mesh.drawnTriangles)}`;
+    parts.push(`${how}: ${triangleText(mesh.triangles)} triangles > budget ${triangleText(mesh.budget)} (URL ?mesh_budget=N)`);
+  } else if (mesh?.triangles) parts.push(`meshes: ${triangleText(mesh.triangles)} triangles`);
   if (viewer.budgetWarning) parts.push(viewer.budgetWarning);
   if (r.ended) parts.push(r.ended.status === 'ok' ? 'run complete' : `run ${r.ended.status}`);
   else if (viewer.live) parts.push('live: following the run');
