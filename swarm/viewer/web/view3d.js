@@ -7,9 +7,9 @@ import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import { NO_DETECTION } from './recording.js';
 
-// Triangles of meshes drawn (each copy counted) above which meshes are drawn
-// as their bounding boxes: the page's `mesh_budget` URL parameter (or
-// `swarmsim view --mesh-budget`) changes it.
+// Triangles of meshes (each copy counted) above which meshes are simplified
+// (or drawn as their bounding boxes): the page's `mesh_budget` URL
+// parameter changes it.
 export const DEFAULT_MESH_BUDGET = 1e6;
 
 // "2.7 M", "135 k", "624": a triangle count for the status line.

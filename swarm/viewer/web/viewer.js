@@ -24,13 +24,11 @@ const viewer = {
 };
 
 // The triangle budget of meshes (view3d.js): the page's `mesh_budget` URL
-// parameter (2500000, 2.5M, 500k; 0: every mesh as its box), else the one
-// `swarmsim view --mesh-budget` wrote into the page, else the default.
-// A value that is not a count is named in the status line and ignored.
+// parameter (2500000, 2.5M, 500k; 0: every mesh as its box), else the
+// default. A value that is not a count is named in the status line and ignored.
 function readMeshBudget() {
-  const fromUrl = new URLSearchParams(window.location.search).get('mesh_budget');
-  const text = fromUrl ?? document.getElementById('swarmsim-options')?.dataset.meshBudget;
-  if (text === undefined || text === null) return DEFAULT_MESH_BUDGET;
+  const text = new URLSearchParams(window.location.search).get('mesh_budget');
+  if (text === null) return DEFAULT_MESH_BUDGET;
   const m = /^\s*(\d+(?:\.\d+)?(?:e\d+)?)\s*([kKmM]?)\s*$/.exec(text);
   if (!m) {
     viewer.budgetWarning = `mesh_budget '${text}' is not a triangle count (such as 2000000, 2M or 500k): using ${triangleText(DEFAULT_MESH_BUDGET)}`;
