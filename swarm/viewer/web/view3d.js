@@ -8,9 +8,30 @@ import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import { NO_DETECTION } from './recording.js';
 
 // Triangles of meshes (each copy counted) above which meshes are simplified
-// (or drawn as their bounding boxes): the page's `mesh_budget` URL
-// parameter changes it.
+// (or drawn as their bounding boxes): 1 M on a GPU, 100 k on a software
+// renderer (SwiftShader, llvmpipe: headless Chromium, a machine without a
+// GPU), which draws a few million triangles a second; the page's
+// `mesh_budget` URL parameter changes it.
 export const DEFAULT_MESH_BUDGET = 1e6;
+export const SOFTWARE_MESH_BUDGET = 1e5;
+
+// Whether WebGL draws in software here (its unmasked renderer's name says
+// so): such a renderer gets no antialiasing and the smaller mesh budget.
+let software = null;
+export function softwareRenderer() {
+  if (software !== null) return software;
+  software = false;
+  try {
+    const gl = document.createElement('canvas').getContext('webgl2') || document.createElement('canvas').getContext('webgl');
+    const info = gl?.getExtension('WEBGL_debug_renderer_info');
+    const name = info ? String(gl.getParameter(info.UNMASKED_RENDERER_WEBGL)) : '';
+    software = /swiftshader|llvmpipe|softpipe|software/i.test(name);
+    gl?.getExtension('WEBGL_lose_context')?.loseContext();
+  } catch (e) {
+    software = false;
+  }
+  return software;
+}
 
 // "2.7 M", "135 k", "624": a triangle count for the status line.
 export function triangleText(n) {
@@ -88,6 +109,22 @@ function simplify(asset, target) {
   return null;
 }
 
+// The largest number of triangles c such that the meshes, each kept whole
+// if it has at most c and cut to c otherwise, fit `budget`:
+// sum of copies x min(triangles, c) <= budget. `assets`: [triangles, copies].
+function capFor(assets, budget) {
+  assets.sort((a, b) => a[0] - b[0]);
+  let whole = 0, copiesLeft = assets.reduce((n, [, k]) => n + k, 0);
+  for (const [n, k] of assets) {
+    // Every asset from here on is cut to c <= n: the rest of the budget shared.
+    const c = Math.floor((budget - whole) / copiesLeft);
+    if (c < n) return Math.max(0, c);
+    whole += n * k;
+    copiesLeft -= k;
+  }
+  return Infinity;
+}
+
 // Whether `o` is drawn in its mesh's own per-triangle colours (FORMAT.md
 // `mesh_colors`) rather than its recorded colour.
 function ownColorsOf(o, asset) {
@@ -137,7 +174,7 @@ function meshGeometryOf(asset, ownColors) {
 // smaller than a centimetre (an imported robot's mass carriers).
 function geometryOf(o, many) {
   const [a, b, c] = o.size || [0.05, 0.05, 0.05];
-  const round = many || a < 0.01 ? 8 : 24;
+  const round = many ? 8 : a < 0.01 ? 6 : 24;
   switch (o.visual) {
     case 'box': case 'mesh': return new THREE.BoxGeometry(Math.max(a, 1e-4), Math.max(b, 1e-4), Math.max(c, 1e-4));
     case 'sphere': return new THREE.SphereGeometry(Math.max(a, 1e-4), round, round * 3 / 4);
@@ -154,12 +191,13 @@ const MANY = 1000;
 
 export class View3D {
   // `large`: a scene of thousands of robots (no antialiasing, 1 pixel per CSS
-  // pixel). `options.meshBudget`: triangles of meshes drawn as meshes (above:
-  // as their bounding boxes).
+  // pixel; nor on a software renderer). `options.meshBudget`: triangles of
+  // meshes drawn in full (above: simplified, or boxes).
   constructor(container, large, options = {}) {
-    this.meshBudget = options.meshBudget ?? DEFAULT_MESH_BUDGET;
+    this.software = softwareRenderer();
+    this.meshBudget = options.meshBudget ?? (this.software ? SOFTWARE_MESH_BUDGET : DEFAULT_MESH_BUDGET);
     this.container = container;
-    this.renderer = new THREE.WebGLRenderer({ antialias: !large, powerPreference: 'high-performance' });
+    this.renderer = new THREE.WebGLRenderer({ antialias: !large && !this.software, powerPreference: 'high-performance' });
     this.renderer.setPixelRatio(large ? 1 : window.devicePixelRatio || 1);
     this.large = large;
     container.prepend(this.renderer.domElement);
@@ -256,18 +294,23 @@ export class View3D {
     // A swarm of thousands draws its bodies as discs whatever they are.
     const meshes = this.large ? [] : scene.meshes || [];
     let meshTriangles = 0;
+    const copies = new Map();  // asset index -> objects drawing it
     for (const o of scene.objects) {
       const asset = assetOf(o, meshes);
-      if (asset) meshTriangles += asset.triangles.length / 3;
+      if (!asset) continue;
+      meshTriangles += asset.triangles.length / 3;
+      copies.set(o.mesh, (copies.get(o.mesh) || 0) + 1);
     }
-    // Past the budget, each asset is simplified to its share of the budget
-    // (the same fraction of its triangles for all), or drawn as its box
-    // when that leaves it too few (a budget of 0: every mesh a box).
-    const over = meshTriangles > this.meshBudget, share = over ? this.meshBudget / meshTriangles : 1;
+    // Past the budget, no asset keeps more than `cap` triangles: the largest
+    // cap with which the copies fit the budget (meshes smaller than it stay
+    // whole, larger ones are simplified to it); one that would keep fewer
+    // than MIN_SIMPLIFIED is drawn as its box (a budget of 0: every mesh).
+    const over = meshTriangles > this.meshBudget;
+    const cap = over ? capFor([...copies].map(([i, k]) => [meshes[i].triangles.length / 3, k]), this.meshBudget) : Infinity;
     const drawnAssets = new Map();  // asset index -> the asset drawn, or null (its box)
     const drawnOf = (o, asset) => {
-      if (!over) return asset;
-      if (!drawnAssets.has(o.mesh)) drawnAssets.set(o.mesh, simplify(asset, Math.floor(share * asset.triangles.length / 3)));
+      if (asset.triangles.length / 3 <= cap) return asset;
+      if (!drawnAssets.has(o.mesh)) drawnAssets.set(o.mesh, cap < MIN_SIMPLIFIED ? null : simplify(asset, cap));
       return drawnAssets.get(o.mesh);
     };
     for (const o of scene.objects) {

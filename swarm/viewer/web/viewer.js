@@ -2,7 +2,7 @@
 // following a run in progress, or embedded in an exported file), plays it
 // in the 3D view, and exposes window.swarmsimViewer for tests.
 import { Recording, State } from './recording.js';
-import { View3D, DEFAULT_MESH_BUDGET, triangleText } from './view3d.js';
+import { View3D, DEFAULT_MESH_BUDGET, SOFTWARE_MESH_BUDGET, softwareRenderer, triangleText } from './view3d.js';
 import { drawPlot } from './plot.js';
 
 const $ = (id) => document.getElementById(id);
@@ -25,14 +25,16 @@ const viewer = {
 
 // The triangle budget of meshes (view3d.js): the page's `mesh_budget` URL
 // parameter (2500000, 2.5M, 500k; 0: every mesh as its box), else the
-// default. A value that is not a count is named in the status line and ignored.
+// default (a software renderer's is smaller). A value that is not a count
+// is named in the status line and ignored.
 function readMeshBudget() {
   const text = new URLSearchParams(window.location.search).get('mesh_budget');
-  if (text === null) return DEFAULT_MESH_BUDGET;
+  const fallback = softwareRenderer() ? SOFTWARE_MESH_BUDGET : DEFAULT_MESH_BUDGET;
+  if (text === null) return fallback;
   const m = /^\s*(\d+(?:\.\d+)?(?:e\d+)?)\s*([kKmM]?)\s*$/.exec(text);
   if (!m) {
-    viewer.budgetWarning = `mesh_budget '${text}' is not a triangle count (such as 2000000, 2M or 500k): using ${triangleText(DEFAULT_MESH_BUDGET)}`;
-    return DEFAULT_MESH_BUDGET;
+    viewer.budgetWarning = `mesh_budget '${text}' is not a triangle count (such as 2000000, 2M or 500k): using ${triangleText(fallback)}`;
+    return fallback;
   }
   return Math.round(Number(m[1]) * ({ k: 1e3, m: 1e6 }[m[2].toLowerCase()] ?? 1));
 }
@@ -47,6 +49,7 @@ function setStatus() {
   const parts = [`${r.header.world}`, `${viewer.state ? viewer.sceneInfo.robots.length : 0} robots`,
     `${r.records.length} steps recorded`];
   if (viewer.view?.bodiesOnly) parts.push('large swarm: bodies and LEDs only');
+  if (viewer.view?.software) parts.push('software renderer');
   const mesh = viewer.view?.meshInfo;
   if (mesh?.triangles > mesh?.budget) {
     // Past the budget: simplified, or boxes where simplifying leaves too little.
