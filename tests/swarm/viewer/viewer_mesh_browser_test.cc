@@ -70,7 +70,8 @@ json SceneOf(const fs::path& folder) {
 int Hex(const json& rgb) {
   int hex = 0;
   for (int k = 0; k < 3; ++k)
-    hex = hex << 8 | static_cast<int>(std::lround(std::clamp(rgb[k].get<double>(), 0.0, 1.0) * 255));
+    hex =
+        hex << 8 | static_cast<int>(std::lround(std::clamp(rgb[k].get<double>(), 0.0, 1.0) * 255));
   return hex;
 }
 
@@ -87,8 +88,10 @@ class ViewerMeshTest : public ::testing::Test {
         << "simulation: {physics: kinematic, time_step: 0.1, seed: 1, duration: 0.5}\n"
            "arena: {size: 4, wall_thickness: 0.05, wall_height: 0.05}\n"
            "objects:\n"
-           "  - {name: ball_a, type: shape, shape: mesh, file: ball.obj, position: [-1, 0.8, 0.3]}\n"
-           "  - {name: ball_b, type: shape, shape: mesh, file: ball.obj, position: [-1, -0.8, 0.3]}\n"
+           "  - {name: ball_a, type: shape, shape: mesh, file: ball.obj,"
+           " position: [-1, 0.8, 0.3]}\n"
+           "  - {name: ball_b, type: shape, shape: mesh, file: ball.obj,"
+           " position: [-1, -0.8, 0.3]}\n"
            "  - {name: green, type: shape, shape: mesh, file: ball.obj, position: [1, 0, 0.3],"
            " color: [0, 1, 0]}\n";
     const CommandResult run = RunProgram("run " + (*dir_ / "world.yaml").string() +
@@ -245,7 +248,8 @@ TEST(ViewerMeshUrdfTest, DrawsAnImportedArmsMeshesWithTheirTrianglesAndMaterials
       << "simulation: {physics: kinematic, time_step: 0.02, seed: 1, duration: 0.1}\n"
          "models:\n  - model: "
       << urdf << "/panda/example-robot-data/robots/panda_description/urdf/panda.urdf\n"
-      << "    count: 3\n    distribute: {region: {min: [-1.5, -1], max: [1.5, 1]}, clearance: 0.5}\n";
+      << "    count: 3\n"
+         "    distribute: {region: {min: [-1.5, -1], max: [1.5, 1]}, clearance: 0.5}\n";
   const CommandResult run = RunProgram("run " + (dir / "world.yaml").string() +
                                        " --quiet --record --out " + (dir / "out").string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
