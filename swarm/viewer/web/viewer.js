@@ -55,7 +55,7 @@ function setStatus() {
     // Past the budget: simplified, or boxes where simplifying leaves too little.
     const how = mesh.asBoxes ? 'meshes as boxes'
       : `meshes simplified${mesh.boxes ? ` (${mesh.boxes} as boxes)` : ''} to ${triangleText(mesh.drawnTriangles)}`;
-    parts.push(`${how}: ${triangleText(mesh.triangles)} triangles > budget ${triangleText(mesh.budget)} (URL ?mesh_budget=N)`);
+    parts.push(`${how}: ${triangleText(mesh.triangles)} triangles > budget ${triangleText(mesh.budget)} (?mesh_budget=N)`);
   } else if (mesh?.triangles) parts.push(`meshes: ${triangleText(mesh.triangles)} triangles`);
   if (viewer.budgetWarning) parts.push(viewer.budgetWarning);
   if (r.ended) parts.push(r.ended.status === 'ok' ? 'run complete' : `run ${r.ended.status}`);
