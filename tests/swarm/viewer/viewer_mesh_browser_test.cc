@@ -61,7 +61,7 @@ void WriteBall(const fs::path& dir) {
 
 // The scene chunk of a recording, read with swarmsim's own reader.
 json SceneOf(const fs::path& folder) {
-  RecordingPlayer player(folder / "recording.swrec");
+  record::RecordingPlayer player(folder / "recording.swrec");
   EXPECT_TRUE(player.Next());
   return json::parse(player.scene_json());
 }
