@@ -99,14 +99,13 @@ TEST(MeshRenderTest, AMeshInItsOwnColoursShowsThemAndNotTheShapesColour) {
   // The top face red, every other face green; the shape's own colour blue-ish
   // grey is not used while it draws its mesh's colours.
   ModuleWorld w;
-  w.scene().AddShape("prism", {}, {},
-                     MeshShape(Prism({{1, 0, 0}, {0, 1, 0}}), {0.3, 0.3, 0.6}, true));
+  const ObjectId prism = w.scene().AddShape(
+      "prism", {}, {}, MeshShape(Prism({{1, 0, 0}, {0, 1, 0}}), {0.3, 0.3, 0.6}, true));
   ASSERT_EQ(w.Run(0), "");
   const Image top = Draw(w.world());
   EXPECT_TRUE(IsRed(At(top, -0.3, -0.3)));
   // Turned upside down (about x), its bottom face shows: green.
-  w.scene().SetLocalPose(w.scene().FindObject("prism"),
-                         {{0, 0, 0.1}, Quat::FromAxisAngle({1, 0, 0}, M_PI)});
+  w.scene().SetLocalPose(prism, {{0, 0, 0.1}, Quat::FromAxisAngle({1, 0, 0}, M_PI)});
   ASSERT_EQ(w.Run(1), "");
   const Image bottom = Draw(w.world());
   // Turned, it covers the half above the other diagonal (y >= x).
