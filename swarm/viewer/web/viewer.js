@@ -24,12 +24,14 @@ const viewer = {
 };
 
 // The triangle budget of meshes (view3d.js): the page's `mesh_budget` URL
-// parameter (2500000, 2.5M, 500k; 0: every mesh as its box), else the
-// default (a software renderer's is smaller). A value that is not a count
-// is named in the status line and ignored.
+// parameter (2500000, 2.5M, 500k; 0: every mesh as its box), else
+// `swarmsim view --mesh-budget N` (written into the page), else the default
+// (a software renderer's is smaller). A value that is not a count is named
+// in the status line and ignored.
 function readMeshBudget() {
   const text = new URLSearchParams(window.location.search).get('mesh_budget');
-  const fallback = softwareRenderer() ? SOFTWARE_MESH_BUDGET : DEFAULT_MESH_BUDGET;
+  const fallback = Number.isInteger(window.swarmsimMeshBudget) && window.swarmsimMeshBudget >= 0
+    ? window.swarmsimMeshBudget : softwareRenderer() ? SOFTWARE_MESH_BUDGET : DEFAULT_MESH_BUDGET;
   if (text === null) return fallback;
   const m = /^\s*(\d+(?:\.\d+)?(?:e\d+)?)\s*([kKmM]?)\s*$/.exec(text);
   if (!m) {

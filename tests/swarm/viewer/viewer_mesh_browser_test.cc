@@ -220,6 +220,40 @@ TEST_F(ViewerMeshTest, PastTheBudgetMeshesAreSimplifiedOrBoxesAsTheStatusLineSay
   }
 }
 
+// `swarmsim view --mesh-budget N` sets the page's budget, served and
+// exported; the URL's mesh_budget still overrides it.
+TEST_F(ViewerMeshTest, TheViewCommandsMeshBudgetSetsThePagesAndTheUrlOverridesIt) {
+  ViewServer server((*dir_ / "out").string(), (*dir_ / "server_flag.log").string(),
+                    {"--mesh-budget", "0"});
+  ASSERT_FALSE(server.Address().empty()) << server.Output();
+  {
+    Browser browser;
+    OpenAt(&browser, &server, "");
+    const std::string status = browser.Run("return swarmsimViewer.status;");
+    EXPECT_NE(status.find("meshes as boxes: 2880 triangles > budget 0"), std::string::npos)
+        << status;
+  }
+  {
+    Browser browser;
+    OpenAt(&browser, &server, "mesh_budget=5k");
+    EXPECT_EQ(browser.Run("return swarmsimViewer.meshes().drawnTriangles;"), 3 * kBallTriangles);
+  }
+  const fs::path html = *dir_ / "boxes.html";
+  const CommandResult exported = RunProgram("view " + (*dir_ / "out").string() + " --export " +
+                                            html.string() + " --mesh-budget 1000");
+  ASSERT_EQ(exported.exit_code, 0) << exported.output;
+  Browser browser;
+  browser.Open("file://" + html.string());
+  ASSERT_EQ(browser.WaitForViewer(), "");
+  const std::string status = browser.Run("return swarmsimViewer.status;");
+  EXPECT_NE(status.find("2880 triangles > budget 1000"), std::string::npos) << status;
+  // Not a count: the program says so.
+  const CommandResult bad = RunProgram("view " + (*dir_ / "out").string() + " --export " +
+                                       html.string() + " --mesh-budget lots");
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE(bad.output.find("--mesh-budget"), std::string::npos) << bad.output;
+}
+
 // ../shared/urdf beside the source tree, or $SWARMSIM_URDF_DIR; "" if absent
 // (as tests/swarm/loader/urdf_test.cc finds it).
 std::string SharedUrdf() {
