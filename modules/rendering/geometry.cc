@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <mutex>
+#include <string>
 
 #include "framework/environment.h"
 #include "framework/floor_layer.h"
@@ -136,13 +137,42 @@ Primitive MeshPrimitive(const TriangleMesh& mesh) {
   return m;
 }
 
+// The primitive of a mesh asset, made once. Cached by address and checked
+// against what the asset holds (sizes, bounds, name): a mesh freed (a
+// world gone, a shape scaled to a new mesh) may leave its address to
+// another, which must not be drawn as the first.
+struct MeshKey {
+  const TriangleMesh* mesh;
+  size_t vertices, triangles;
+  Vec3 lo, hi;
+  std::string name;
+  explicit MeshKey(const TriangleMesh* m)
+      : mesh(m),
+        vertices(m->vertices().size()),
+        triangles(m->triangles().size()),
+        lo(m->lo()),
+        hi(m->hi()),
+        name(m->name()) {}
+  bool Same(const MeshKey& o) const {
+    return vertices == o.vertices && triangles == o.triangles && lo == o.lo && hi == o.hi &&
+           name == o.name;
+  }
+};
+
 const Primitive& MeshFor(const TriangleMesh* mesh) {
   static std::mutex mutex;
-  static std::vector<std::pair<const TriangleMesh*, std::unique_ptr<Primitive>>> cache;
+  static std::vector<std::pair<MeshKey, std::unique_ptr<Primitive>>> cache;
   const std::lock_guard lock(mutex);
-  for (const auto& [m, p] : cache)
-    if (m == mesh) return *p;
-  cache.emplace_back(mesh, std::make_unique<Primitive>(MeshPrimitive(*mesh)));
+  const MeshKey key(mesh);
+  for (auto& [k, p] : cache) {
+    if (k.mesh != mesh) continue;
+    if (!k.Same(key)) {  // another mesh at a freed one's address
+      k = key;
+      p = std::make_unique<Primitive>(MeshPrimitive(*mesh));
+    }
+    return *p;
+  }
+  cache.emplace_back(key, std::make_unique<Primitive>(MeshPrimitive(*mesh)));
   return *cache.back().second;
 }
 

@@ -127,8 +127,9 @@ int DescribeCommand(const DescribeArgs& args, const ModuleRegistry& registry);
 struct ViewArgs {
   std::string folder;
   std::string host = "127.0.0.1";
-  int port = 8600;          // 0: a free port
-  std::string export_file;  // --export FILE.html; empty: serve
+  int port = 8600;           // 0: a free port
+  std::string export_file;   // --export FILE.html; empty: serve
+  int64_t mesh_budget = -1;  // --mesh-budget: triangles of meshes drawn in full; -1: the page's
 };
 CLI::App* AddViewCommand(CLI::App* app, ViewArgs* args);
 int ViewCommand(const ViewArgs& args);

@@ -30,6 +30,11 @@ CLI::App* AddViewCommand(CLI::App* app, ViewArgs* args) {
                    "offline from disk, instead of serving")
       ->option_text("FILE.html")
       ->check(NonEmpty("a file"));
+  view->add_option("--mesh-budget", args->mesh_budget,
+                   "Triangles of meshes (each copy counted) the page draws in full; past it, "
+                   "simplified or boxes (default 1000000, 100000 on a software renderer; the "
+                   "page's ?mesh_budget=N overrides it)")
+      ->transform(WholeNumberCheck(0, int64_t{1} << 40, ""));
   return view;
 }
 
@@ -77,7 +82,8 @@ int ViewCommand(const ViewArgs& args) {
   std::cerr << ValidUtf8(info.Describe()) << "\n";
   if (!args.export_file.empty()) {
     try {
-      viewer::ExportFolder(args.folder, info.valid_size, args.export_file);
+      viewer::ExportFolder(args.folder, info.valid_size, args.export_file,
+                           {.mesh_budget = args.mesh_budget});
     } catch (const Error& e) {
       std::cerr << "error: " << ValidUtf8(e.what()) << "\n";
       return kExitRunError;
@@ -86,7 +92,7 @@ int ViewCommand(const ViewArgs& args) {
               << fs::file_size(args.export_file, error) << " bytes)\n";
     return 0;
   }
-  viewer::Server server(args.folder);
+  viewer::Server server(args.folder, {.mesh_budget = args.mesh_budget});
   if (const int code = BindViewServer(args.host, args.port, &server)) return code;
   server.Run();
   return 0;

@@ -13,6 +13,13 @@ namespace {
 
 constexpr std::string_view kScriptsMark = "<!--SWARMSIM_SCRIPTS-->";
 
+// The page's options as a script that runs before the page's own.
+std::string OptionsScript(const PageOptions& options) {
+  if (options.mesh_budget < 0) return "";
+  return "<script>window.swarmsimMeshBudget = " + std::to_string(options.mesh_budget) +
+         ";</script>\n";
+}
+
 std::string WithScripts(std::string_view scripts) {
   std::string html(PageHtml());
   const size_t mark = html.find(kScriptsMark);
@@ -62,22 +69,25 @@ std::string InlineScript(std::string_view script) {
 
 }  // namespace
 
-std::string ServedPage() { return WithScripts("<script src=\"viewer.js\"></script>"); }
+std::string ServedPage(const PageOptions& options) {
+  return WithScripts(OptionsScript(options) + "<script src=\"viewer.js\"></script>");
+}
 
-std::string ExportedPage(std::string_view recording) {
-  return WithScripts("<script id=\"swarmsim-recording\" type=\"application/octet-stream\">" +
+std::string ExportedPage(std::string_view recording, const PageOptions& options) {
+  return WithScripts(OptionsScript(options) +
+                     "<script id=\"swarmsim-recording\" type=\"application/octet-stream\">" +
                      Base64(recording) + "</script>\n<script>" + InlineScript(PageScript()) +
                      "</script>");
 }
 
 void ExportFolder(const std::filesystem::path& folder, uint64_t size,
-                  const std::filesystem::path& html_file) {
+                  const std::filesystem::path& html_file, const PageOptions& options) {
   const std::filesystem::path recording_file = folder / kRecordingFile;
   std::ifstream in(recording_file, std::ios::binary);
   std::string bytes(size, '\0');
   if (!in.read(bytes.data(), static_cast<std::streamsize>(size)))
     throw Error("cannot read '" + recording_file.string() + "'");
-  WriteFileAtomically(html_file, ExportedPage(bytes));  // whole or not at all
+  WriteFileAtomically(html_file, ExportedPage(bytes, options));  // whole or not at all
 }
 
 }  // namespace swarmsim::viewer

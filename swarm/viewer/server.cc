@@ -46,10 +46,10 @@ struct Server::Impl {
   int port = 0;
 };
 
-Server::Server(fs::path folder) : impl_(std::make_unique<Impl>()) {
+Server::Server(fs::path folder, const PageOptions& options) : impl_(std::make_unique<Impl>()) {
   std::string error;
   impl_->http.reset(
-      Http().make_server(HttpSite{std::move(folder), ServedPage(), PageScript()}, &error));
+      Http().make_server(HttpSite{std::move(folder), ServedPage(options), PageScript()}, &error));
   if (impl_->http == nullptr) throw Error("the viewer's server: " + error);
 }
 

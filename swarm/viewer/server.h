@@ -12,6 +12,8 @@
 #include <string_view>
 #include <thread>
 
+#include "swarm/viewer/page.h"
+
 namespace swarmsim::viewer {
 
 // The file `request_path` (a URL path below the folder, already
@@ -23,8 +25,8 @@ std::optional<std::filesystem::path> FileInside(const std::filesystem::path& fol
 
 class Server {
  public:
-  // Serves `folder` (an existing output folder).
-  explicit Server(std::filesystem::path folder);
+  // Serves `folder` (an existing output folder), the page with `options`.
+  explicit Server(std::filesystem::path folder, const PageOptions& options = {});
   ~Server();  // stops the server
   Server(const Server&) = delete;
   Server& operator=(const Server&) = delete;

@@ -82,7 +82,12 @@ function expandScene(json) {
   }
   const robots = json.robots.map((r) => ({ ...r }));
   const robotByIndex = new Map(robots.map((r) => [r.index, r]));
-  return { count, objects, robotOf, rootOf, robots, robotByIndex, declaredColors };
+  // Mesh assets (once each, however many objects use them): vertices in
+  // the shape's frame, triangles, per-triangle colours or none.
+  const meshes = (json.meshes || []).map((m) => ({ file: m.file,
+    vertices: Float32Array.from(m.vertices || []), triangles: Uint32Array.from(m.triangles || []),
+    colors: Float32Array.from(m.colors || []) }));
+  return { count, objects, robotOf, rootOf, robots, robotByIndex, declaredColors, meshes };
 }
 
 // Where each section of a step record starts (FORMAT.md "Step records").

@@ -1,18 +1,180 @@
 // The 3D view (three.js): the floor, the paint layer, every recorded object
 // as its type declares it (FORMAT.md: `visual`): solids and lights as
-// instances (one InstancedMesh per kind and size), rays as line segments;
+// instances (one InstancedMesh per kind and size; a mesh asset's geometry
+// once, instanced over every object that uses it), rays as line segments;
 // trails; camera with orbit/pan; picking robots.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import { NO_DETECTION } from './recording.js';
 
+// Triangles of meshes (each copy counted) above which meshes are simplified
+// (or drawn as their bounding boxes): 1 M on a GPU, 100 k on a software
+// renderer (SwiftShader, llvmpipe: headless Chromium, a machine without a
+// GPU), which draws a few million triangles a second; the page's
+// `mesh_budget` URL parameter changes it.
+export const DEFAULT_MESH_BUDGET = 1e6;
+export const SOFTWARE_MESH_BUDGET = 1e5;
 
+// Whether WebGL draws in software here (its unmasked renderer's name says
+// so): such a renderer gets no antialiasing and the smaller mesh budget.
+let software = null;
+export function softwareRenderer() {
+  if (software !== null) return software;
+  software = false;
+  try {
+    const gl = document.createElement('canvas').getContext('webgl2') || document.createElement('canvas').getContext('webgl');
+    const info = gl?.getExtension('WEBGL_debug_renderer_info');
+    const name = info ? String(gl.getParameter(info.UNMASKED_RENDERER_WEBGL)) : '';
+    software = /swiftshader|llvmpipe|softpipe|software/i.test(name);
+    gl?.getExtension('WEBGL_lose_context')?.loseContext();
+  } catch (e) {
+    software = false;
+  }
+  return software;
+}
+
+// "2.7 M", "135 k", "624": a triangle count for the status line.
+export function triangleText(n) {
+  if (n >= 1e6) return `${(n / 1e6).toFixed(n >= 1e7 ? 0 : 1).replace(/\.0$/, '')} M`;
+  if (n >= 1e4) return `${Math.round(n / 1e3)} k`;
+  return String(n);
+}
+
+// A mesh asset's bounds in its frame: {lo: [x, y, z], hi: [x, y, z]}.
+function boundsOf(asset) {
+  const v = asset.vertices, lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+  for (let i = 0; i < v.length; i += 3)
+    for (let k = 0; k < 3; ++k) { lo[k] = Math.min(lo[k], v[i + k]); hi[k] = Math.max(hi[k], v[i + k]); }
+  return { lo, hi };
+}
+
+// Whether object `o` names an embedded mesh asset that can be drawn: its
+// triangles name its vertices (the recording's reader in C++ checks this too).
+function assetOf(o, meshes) {
+  if (o.visual !== 'mesh' || !Number.isInteger(o.mesh) || !meshes || o.mesh < 0 || o.mesh >= meshes.length) return null;
+  const asset = meshes[o.mesh];
+  if (asset.checked === undefined) {
+    const n = asset.vertices.length / 3;
+    asset.checked = asset.triangles.length > 0 && asset.triangles.length % 3 === 0 &&
+      asset.vertices.length % 3 === 0 && asset.triangles.every((i) => i < n);
+  }
+  return asset.checked ? asset : null;
+}
+
+// The fewest triangles a simplified mesh keeps; below, it is drawn as its box.
+const MIN_SIMPLIFIED = 12;
+
+// Mesh asset `asset` simplified to at most `target` triangles by vertex
+// clustering (Rossignac and Borrel 1993): its bounding box cut into R x R x R
+// cells, the vertices of a cell merged into their mean, triangles left with
+// fewer than three corners dropped; the finest R (256, 181, 128, ... 2: each
+// about halves the triangles) that keeps at most `target`. Its silhouette stays within a cell of the original's.
+// Returns an asset ({vertices, triangles, colors, file}), or null when even
+// R = 2 keeps more, or fewer than MIN_SIMPLIFIED.
+function simplify(asset, target) {
+  const v = asset.vertices, tri = asset.triangles, c = asset.colors, n = tri.length / 3;
+  const ownColors = c.length === tri.length;
+  const { lo, hi } = boundsOf(asset);
+  for (let R = 256; R >= 2; R = R === 3 ? 2 : Math.round(R / Math.SQRT2)) {
+    const scale = [0, 1, 2].map((k) => R / Math.max(hi[k] - lo[k], 1e-9));
+    const cellOf = new Map(), remap = new Uint32Array(v.length / 3), sums = [];
+    for (let i = 0; i < v.length / 3; ++i) {
+      let key = 0;
+      for (let k = 0; k < 3; ++k) key = key * (R + 1) + Math.min(R - 1, Math.floor((v[3 * i + k] - lo[k]) * scale[k]));
+      let cell = cellOf.get(key);
+      if (cell === undefined) { cell = cellOf.size; cellOf.set(key, cell); sums.push(0, 0, 0, 0); }
+      remap[i] = cell;
+      sums[4 * cell] += v[3 * i]; sums[4 * cell + 1] += v[3 * i + 1]; sums[4 * cell + 2] += v[3 * i + 2]; ++sums[4 * cell + 3];
+    }
+    const kept = [];
+    for (let t = 0; t < n; ++t) {
+      const a = remap[tri[3 * t]], b = remap[tri[3 * t + 1]], d = remap[tri[3 * t + 2]];
+      if (a !== b && b !== d && a !== d) kept.push(t);
+      if (kept.length > target) break;
+    }
+    if (kept.length > target) continue;
+    if (kept.length < MIN_SIMPLIFIED) return null;
+    const vertices = new Float32Array(3 * cellOf.size);
+    for (let cell = 0; cell < cellOf.size; ++cell)
+      for (let k = 0; k < 3; ++k) vertices[3 * cell + k] = sums[4 * cell + k] / sums[4 * cell + 3];
+    const triangles = new Uint32Array(3 * kept.length), colors = new Float32Array(ownColors ? 3 * kept.length : 0);
+    kept.forEach((t, j) => {
+      for (let k = 0; k < 3; ++k) {
+        triangles[3 * j + k] = remap[tri[3 * t + k]];
+        if (ownColors) colors[3 * j + k] = c[3 * t + k];
+      }
+    });
+    return { file: asset.file, vertices, triangles, colors };
+  }
+  return null;
+}
+
+// The largest number of triangles c such that the meshes, each kept whole
+// if it has at most c and cut to c otherwise, fit `budget`:
+// sum of copies x min(triangles, c) <= budget. `assets`: [triangles, copies].
+function capFor(assets, budget) {
+  assets.sort((a, b) => a[0] - b[0]);
+  let whole = 0, copiesLeft = assets.reduce((n, [, k]) => n + k, 0);
+  for (const [n, k] of assets) {
+    // Every asset from here on is cut to c <= n: the rest of the budget shared.
+    const c = Math.floor((budget - whole) / copiesLeft);
+    if (c < n) return Math.max(0, c);
+    whole += n * k;
+    copiesLeft -= k;
+  }
+  return Infinity;
+}
+
+// Whether `o` is drawn in its mesh's own per-triangle colours (FORMAT.md
+// `mesh_colors`) rather than its recorded colour.
+function ownColorsOf(o, asset) {
+  return !!o.mesh_colors && asset.colors.length === asset.triangles.length;
+}
+
+// A mesh asset as one indexed BufferGeometry (the welded vertices shared,
+// flat-shaded by its material). In its own colours: its triangles sorted by
+// colour into groups, one material each (a file has few materials), so the
+// geometry stays indexed. Returns {geometry, colors: [THREE.Color per group] | null}.
+function meshGeometryOf(asset, ownColors) {
+  const geometry = new THREE.BufferGeometry();
+  geometry.setAttribute('position', new THREE.BufferAttribute(asset.vertices, 3));
+  const small = asset.vertices.length / 3 <= 65536;
+  const tri = asset.triangles, n = tri.length / 3;
+  if (!ownColors) {
+    geometry.setIndex(new THREE.BufferAttribute(small ? Uint16Array.from(tri) : tri, 1));
+    return { geometry, colors: null };
+  }
+  const c = asset.colors, byte = (v) => Math.round(Math.min(1, Math.max(0, v)) * 255);
+  const keys = new Uint32Array(n), first = new Map();
+  for (let t = 0; t < n; ++t) {
+    const key = (byte(c[3 * t]) << 16) | (byte(c[3 * t + 1]) << 8) | byte(c[3 * t + 2]);
+    keys[t] = key;
+    const e = first.get(key);
+    if (e) ++e.count; else first.set(key, { count: 1, start: 0, at: 0, t });
+  }
+  const index = small ? new Uint16Array(3 * n) : new Uint32Array(3 * n);
+  const colors = [];
+  let start = 0;
+  for (const e of first.values()) {
+    e.start = e.at = start;
+    geometry.addGroup(3 * start, 3 * e.count, colors.length);
+    colors.push(new THREE.Color().setRGB(c[3 * e.t], c[3 * e.t + 1], c[3 * e.t + 2], THREE.SRGBColorSpace));
+    start += e.count;
+  }
+  for (let t = 0; t < n; ++t) {
+    const e = first.get(keys[t]);
+    index.set(tri.subarray(3 * t, 3 * t + 3), 3 * e.at++);
+  }
+  geometry.setIndex(new THREE.BufferAttribute(index, 1));
+  return { geometry, colors };
+}
 
 // Fewer triangles per round shape when there are many of them (a software
-// renderer draws 10,000 robots at 30 frames/s only so).
+// renderer draws 10,000 robots at 30 frames/s only so), or when it is
+// smaller than a centimetre (an imported robot's mass carriers).
 function geometryOf(o, many) {
   const [a, b, c] = o.size || [0.05, 0.05, 0.05];
-  const round = many ? 8 : 24;
+  const round = many ? 8 : a < 0.01 ? 6 : 24;
   switch (o.visual) {
     case 'box': case 'mesh': return new THREE.BoxGeometry(Math.max(a, 1e-4), Math.max(b, 1e-4), Math.max(c, 1e-4));
     case 'sphere': return new THREE.SphereGeometry(Math.max(a, 1e-4), round, round * 3 / 4);
@@ -28,10 +190,14 @@ const SOLIDS = new Set(['box', 'cylinder', 'sphere', 'capsule', 'mesh']);
 const MANY = 1000;
 
 export class View3D {
-  // `large`: a scene of thousands of robots (no antialiasing, 1 pixel per CSS pixel).
-  constructor(container, large) {
+  // `large`: a scene of thousands of robots (no antialiasing, 1 pixel per CSS
+  // pixel; nor on a software renderer). `options.meshBudget`: triangles of
+  // meshes drawn in full (above: simplified, or boxes).
+  constructor(container, large, options = {}) {
+    this.software = softwareRenderer();
+    this.meshBudget = options.meshBudget ?? (this.software ? SOFTWARE_MESH_BUDGET : DEFAULT_MESH_BUDGET);
     this.container = container;
-    this.renderer = new THREE.WebGLRenderer({ antialias: !large, powerPreference: 'high-performance' });
+    this.renderer = new THREE.WebGLRenderer({ antialias: !large && !this.software, powerPreference: 'high-performance' });
     this.renderer.setPixelRatio(large ? 1 : window.devicePixelRatio || 1);
     this.large = large;
     container.prepend(this.renderer.domElement);
@@ -69,7 +235,10 @@ export class View3D {
   build(header, scene, state) {
     for (const child of [...this.world.children]) {
       this.world.remove(child);
-      child.traverse((c) => { c.geometry?.dispose(); c.material?.map?.dispose(); c.material?.dispose(); });
+      child.traverse((c) => {
+        c.geometry?.dispose();
+        for (const m of [c.material || []].flat()) { m.map?.dispose(); m.dispose(); }
+      });
     }
     this.header = header;
     this.sceneInfo = scene;
@@ -120,16 +289,45 @@ export class View3D {
     const sensors = [];
     this.bodiesOnly = this.large;
     this.rayColors = scene.declaredColors;
+    // Meshes (the scene's embedded assets): their triangles, each copy
+    // counted; past the budget every mesh is drawn as its bounding box.
+    // A swarm of thousands draws its bodies as discs whatever they are.
+    const meshes = this.large ? [] : scene.meshes || [];
+    let meshTriangles = 0;
+    const copies = new Map();  // asset index -> objects drawing it
+    for (const o of scene.objects) {
+      const asset = assetOf(o, meshes);
+      if (!asset) continue;
+      meshTriangles += asset.triangles.length / 3;
+      copies.set(o.mesh, (copies.get(o.mesh) || 0) + 1);
+    }
+    // Past the budget, no asset keeps more than `cap` triangles: the largest
+    // cap with which the copies fit the budget (meshes smaller than it stay
+    // whole, larger ones are simplified to it); one that would keep fewer
+    // than MIN_SIMPLIFIED is drawn as its box (a budget of 0: every mesh).
+    const over = meshTriangles > this.meshBudget;
+    const cap = over ? capFor([...copies].map(([i, k]) => [meshes[i].triangles.length / 3, k]), this.meshBudget) : Infinity;
+    const drawnAssets = new Map();  // asset index -> the asset drawn, or null (its box)
+    const drawnOf = (o, asset) => {
+      if (asset.triangles.length / 3 <= cap) return asset;
+      if (!drawnAssets.has(o.mesh)) drawnAssets.set(o.mesh, cap < MIN_SIMPLIFIED ? null : simplify(asset, cap));
+      return drawnAssets.get(o.mesh);
+    };
     for (const o of scene.objects) {
       if (o.visual === 'ray') { sensors.push(o.id); continue; }
       const solid = SOLIDS.has(o.visual);
-      let key;
+      let key, asset = null, ownColors = false;
       if (solid && this.bodiesOnly && o.robot >= 0 && o.templateObject !== 0) continue;
-      if (solid) key = `s|${o.visual}|${(o.size || []).join(',')}`;
+      let drawn = null;
+      if (solid && (asset = assetOf(o, meshes))) {
+        drawn = drawnOf(o, asset);
+        ownColors = !!drawn && ownColorsOf(o, asset);
+        key = `${drawn ? 'm' : 'b'}|${o.mesh}|${ownColors ? 1 : 0}`;
+      } else if (solid) key = `s|${o.visual}|${(o.size || []).join(',')}`;
       else if (o.visual === 'light') key = `l|${o.radius}`;
       else continue;
       let g = groups.get(key);
-      if (!g) groups.set(key, g = { key, led: o.visual === 'light', sample: o, ids: [] });
+      if (!g) groups.set(key, g = { key, led: o.visual === 'light', sample: o, ids: [], asset, drawn, ownColors });
       g.ids.push(o.id);
     }
     // The objects whose world pose is needed: drawn ones and robot roots
@@ -138,6 +336,18 @@ export class View3D {
     for (const g of groups.values()) for (const id of g.ids) drawn[id] = 1;
     for (const r of scene.robots) drawn[r.first] = 1;
     for (let id = 0; id < scene.count; ++id) if (scene.rootOf[id] < 0) drawn[id] = 1;
+    // What the meshes cost as drawn (the status line shows it).
+    let drawnTriangles = 0, boxes = 0, simplified = 0;
+    for (const g of groups.values()) {
+      if (!g.asset) continue;
+      if (!g.drawn) boxes += g.ids.length;
+      else {
+        drawnTriangles += g.ids.length * g.drawn.triangles.length / 3;
+        if (g.drawn !== g.asset) simplified += g.ids.length;
+      }
+    }
+    this.meshInfo = { triangles: meshTriangles, budget: this.meshBudget, drawnTriangles, boxes, simplified,
+      asBoxes: boxes > 0 && simplified === 0 && drawnTriangles === 0 };
     this.drawnIds = Uint32Array.from(drawn.reduce((list, on, id) => (on && list.push(id), list), []));
     this.drawnAndSensorIds = Uint32Array.from([...this.drawnIds, ...sensors].sort((a, b) => a - b));
     this.groups = [];
@@ -239,17 +449,47 @@ export class View3D {
     this.links.geometry.attributes.color.needsUpdate = true;
   }
 
-  // One InstancedMesh for the objects of group `g` (same kind and size).
+  // One InstancedMesh for the objects of group `g` (same kind and size, or
+  // the same mesh asset: its geometry once for all of them).
   instancesOf(g) {
     const many = g.ids.length > MANY;
-    const geometry = g.led ? new THREE.SphereGeometry(Math.max(g.sample.radius || 0.01, 1e-4), many ? 6 : 10, many ? 4 : 8)
-      : geometryOf(g.sample, many);
-    const material = g.led ? new THREE.MeshBasicMaterial({ color: 0xffffff })
-      : new THREE.MeshLambertMaterial({ color: 0xffffff });
+    let geometry, material, colors = null;
+    if (g.drawn) {
+      ({ geometry, colors } = meshGeometryOf(g.drawn, g.ownColors));
+      material = colors ? colors.map((color) => new THREE.MeshLambertMaterial({ color, flatShading: true }))
+        : new THREE.MeshLambertMaterial({ color: 0xffffff, flatShading: true });
+    } else {
+      if (g.asset) {
+        // Past the budget: the box that holds the mesh, where it is in the object's frame.
+        const { lo, hi } = boundsOf(g.asset);
+        geometry = new THREE.BoxGeometry(Math.max(hi[0] - lo[0], 1e-4), Math.max(hi[1] - lo[1], 1e-4),
+          Math.max(hi[2] - lo[2], 1e-4)).translate((lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2);
+      } else if (g.led) geometry = new THREE.SphereGeometry(Math.max(g.sample.radius || 0.01, 1e-4), many ? 6 : 10, many ? 4 : 8);
+      else geometry = geometryOf(g.sample, many);
+      material = g.led ? new THREE.MeshBasicMaterial({ color: 0xffffff })
+        : new THREE.MeshLambertMaterial({ color: 0xffffff });
+    }
     const mesh = new THREE.InstancedMesh(geometry, material, g.ids.length);
     mesh.instanceMatrix.setUsage(THREE.DynamicDrawUsage);
     mesh.setColorAt(0, new THREE.Color(1, 1, 1));
+    mesh.instanceColor.array.fill(1);
+    if (g.asset) {
+      mesh.userData.mesh = { asset: g.sample.mesh, file: g.asset.file, asBox: !g.drawn,
+        simplified: !!g.drawn && g.drawn !== g.asset, fileTriangles: g.asset.triangles.length / 3,
+        triangles: g.drawn ? g.drawn.triangles.length / 3 : 0, colors: colors && colors.map((c) => c.getHex(THREE.SRGBColorSpace)) };
+      mesh.userData.ownColors = !!colors;
+    }
     return mesh;
+  }
+
+  // What the meshes are drawn as, for tests and the status line: per group,
+  // the asset, its file, the triangles drawn per copy (0: drawn as a box),
+  // its own colours (sRGB 0xRRGGBB per material) or null, and each copy's
+  // recorded colour (sRGB 0xRRGGBB, as drawn).
+  meshGroups() {
+    return this.groups.filter((g) => g.userData.mesh).map((g) => ({ ...g.userData.mesh,
+      instances: g.count, geometryTriangles: (g.geometry.index ? g.geometry.index.count : g.geometry.attributes.position.count) / 3,
+      instanceColors: Array.from({ length: g.count }, (_, j) => new THREE.Color().fromArray(g.instanceColor.array, 3 * j).getHex(THREE.SRGBColorSpace)) }));
   }
 
   // A swarm of thousands: each object a disc of its size seen from any side
@@ -332,7 +572,7 @@ export class View3D {
     for (const mesh of this.groups) {
       if (mesh.userData.points) { this.updatePoints(mesh); continue; }
       const ids = mesh.userData.ids, m = mesh.instanceMatrix.array, c = mesh.instanceColor.array;
-      const led = mesh.userData.led, showLeds = this.show.leds;
+      const led = mesh.userData.led, showLeds = this.show.leds, own = mesh.userData.ownColors;
       for (let j = 0; j < ids.length; ++j) {
         const id = ids[j];
         const x = Q[4 * id], y = Q[4 * id + 1], z = Q[4 * id + 2], w = Q[4 * id + 3];
@@ -342,7 +582,9 @@ export class View3D {
         m[o + 4] = 2 * (x * y - z * w) * s; m[o + 5] = (1 - 2 * (x * x + z * z)) * s; m[o + 6] = 2 * (y * z + x * w) * s; m[o + 7] = 0;
         m[o + 8] = 2 * (x * z + y * w) * s; m[o + 9] = 2 * (y * z - x * w) * s; m[o + 10] = (1 - 2 * (x * x + y * y)) * s; m[o + 11] = 0;
         m[o + 12] = P[3 * id]; m[o + 13] = P[3 * id + 1]; m[o + 14] = P[3 * id + 2]; m[o + 15] = 1;
-        // sRGB bytes to the linear colours three works in; an LED that is off is dim.
+        // sRGB bytes to the linear colours three works in; an LED that is off
+        // is dim; a mesh in its own colours keeps them (white instances).
+        if (own) continue;
         const dim = led && rgba[4 * id + 3] === 0 ? 0.12 : 1;
         for (let k = 0; k < 3; ++k) {
           const v = rgba[4 * id + k] / 255;

@@ -2,7 +2,7 @@
 // following a run in progress, or embedded in an exported file), plays it
 // in the 3D view, and exposes window.swarmsimViewer for tests.
 import { Recording, State } from './recording.js';
-import { View3D } from './view3d.js';
+import { View3D, DEFAULT_MESH_BUDGET, SOFTWARE_MESH_BUDGET, softwareRenderer, triangleText } from './view3d.js';
 import { drawPlot } from './plot.js';
 
 const $ = (id) => document.getElementById(id);
@@ -23,6 +23,24 @@ const viewer = {
   sceneIndex: -1,
 };
 
+// The triangle budget of meshes (view3d.js): the page's `mesh_budget` URL
+// parameter (2500000, 2.5M, 500k; 0: every mesh as its box), else
+// `swarmsim view --mesh-budget N` (written into the page), else the default
+// (a software renderer's is smaller). A value that is not a count is named
+// in the status line and ignored.
+function readMeshBudget() {
+  const text = new URLSearchParams(window.location.search).get('mesh_budget');
+  const fallback = Number.isInteger(window.swarmsimMeshBudget) && window.swarmsimMeshBudget >= 0
+    ? window.swarmsimMeshBudget : softwareRenderer() ? SOFTWARE_MESH_BUDGET : DEFAULT_MESH_BUDGET;
+  if (text === null) return fallback;
+  const m = /^\s*(\d+(?:\.\d+)?(?:e\d+)?)\s*([kKmM]?)\s*$/.exec(text);
+  if (!m) {
+    viewer.budgetWarning = `mesh_budget '${text}' is not a triangle count (such as 2000000, 2M or 500k): using ${triangleText(fallback)}`;
+    return fallback;
+  }
+  return Math.round(Number(m[1]) * ({ k: 1e3, m: 1e6 }[m[2].toLowerCase()] ?? 1));
+}
+
 function showError(message) {
   $('error').textContent = message;
   viewer.error = message;
@@ -33,6 +51,15 @@ function setStatus() {
   const parts = [`${r.header.world}`, `${viewer.state ? viewer.sceneInfo.robots.length : 0} robots`,
     `${r.records.length} steps recorded`];
   if (viewer.view?.bodiesOnly) parts.push('large swarm: bodies and LEDs only');
+  if (viewer.view?.software) parts.push('software renderer');
+  const mesh = viewer.view?.meshInfo;
+  if (mesh?.triangles > mesh?.budget) {
+    // Past the budget: simplified, or boxes where simplifying leaves too little.
+    const how = mesh.asBoxes ? 'meshes as boxes'
+      : `meshes simplified${mesh.boxes ? ` (${mesh.boxes} as boxes)` : ''} to ${triangleText(mesh.drawnTriangles)}`;
+    parts.push(`${how}: ${triangleText(mesh.triangles)} triangles > budget ${triangleText(mesh.budget)} (?mesh_budget=N)`);
+  } else if (mesh?.triangles) parts.push(`meshes: ${triangleText(mesh.triangles)} triangles`);
+  if (viewer.budgetWarning) parts.push(viewer.budgetWarning);
   if (r.ended) parts.push(r.ended.status === 'ok' ? 'run complete' : `run ${r.ended.status}`);
   else if (viewer.live) parts.push('live: following the run');
   else parts.push('recording ends early (truncated)');
@@ -235,7 +262,7 @@ function start() {
   const r = viewer.recording;
   viewer.started = true;
   const robots = r.scenes[r.scenes.length - 1].scene.robots.length;
-  viewer.view = new View3D($('view'), robots > 2000);
+  viewer.view = new View3D($('view'), robots > 2000, { meshBudget: readMeshBudget() });
   wireControls();
   show(viewer.live ? r.records.length - 1 : 0);
   viewer.view.frame(false);
@@ -270,6 +297,9 @@ window.swarmsimViewer = {
   get ended() { return !!viewer.recording.ended; },
   get robotCount() { return viewer.sceneInfo?.robots.length || 0; },
   get view() { return viewer.view; },
+  get status() { return $('status').textContent; },
+  // The meshes drawn (view3d.js meshGroups) and their count against the budget.
+  meshes() { return { groups: viewer.view.meshGroups(), ...viewer.view.meshInfo }; },
   get metricsRead() { return !!viewer.metricsRead; },  // for measurements
   setRecord(i) { setPlaying(false); show(i); viewer.view.render(); return viewer.record; },
   // World position [x, y, z] of robot `index` at the record shown.
