@@ -857,13 +857,19 @@ class PyWorld {
 
 // --- Many worlds at once ---------------------------------------------------------------
 
-// A scheduler per thread count, made on first use and kept for the process
-// (never destroyed: oneTBB arenas outlive the interpreter's teardown).
+// The scheduler of the last thread count asked for, kept between calls
+// (made again when the count changes: oneTBB applies the smallest
+// parallelism limit alive, so old ones are not kept). Never destroyed at
+// exit: oneTBB arenas outlive the interpreter's teardown.
 TaskScheduler& WorldsScheduler(int threads) {
-  static std::map<int, TaskScheduler*> schedulers;
-  TaskScheduler*& s = schedulers[threads];
-  if (s == nullptr) s = new TaskScheduler(threads);
-  return *s;
+  static TaskScheduler* scheduler = nullptr;
+  static int made_for = -1;
+  if (scheduler == nullptr || made_for != threads) {
+    delete scheduler;
+    scheduler = new TaskScheduler(threads);
+    made_for = threads;
+  }
+  return *scheduler;
 }
 
 // Steps each world n steps, the worlds in parallel on `threads` workers

@@ -157,12 +157,17 @@ class SensorArraysTest(unittest.TestCase):
         w = swarmsim.World(self.path)
         w.step()
         blobs = w.blob_cameras("eyebot")
-        self.assertEqual(list(blobs["offsets"]), [0, 2, 4, 6])
-        self.assertEqual(blobs["color"].shape, (6, 3))
-        np.testing.assert_allclose(blobs["color"], np.tile([0, 1, 0], (6, 1)))
-        first = slice(blobs["offsets"][0], blobs["offsets"][1])
-        self.assertEqual(sorted(blobs["robot"][first]), [1, 2])
-        np.testing.assert_allclose(sorted(blobs["distance"][first]), [0.4, 0.8], atol=0.02)
+        # In a row, the middle robot (its hanging weight at the cameras' height) hides
+        # each end robot's LED from the other end: #0 sees #1, #1 sees #0 and #2.
+        self.assertEqual(list(blobs["offsets"]), [0, 1, 3, 4])
+        self.assertEqual(blobs["color"].shape, (4, 3))
+        np.testing.assert_allclose(blobs["color"], np.tile([0, 1, 0], (4, 1)))
+        self.assertEqual(list(blobs["robot"]), [1, 2, 0, 1] if blobs["bearing"][1] < blobs["bearing"][2]
+                         else [1, 0, 2, 1])
+        np.testing.assert_allclose(blobs["distance"], 0.4, atol=0.02)
+        # Ahead (+x) of #0 at bearing 0, behind #2 at bearing pi.
+        self.assertAlmostEqual(blobs["bearing"][0], 0, delta=0.05)
+        self.assertAlmostEqual(abs(blobs["bearing"][3]), np.pi, delta=0.05)
 
     def test_force_sensors_hold_the_weight(self):
         w = swarmsim.World(self.path)
