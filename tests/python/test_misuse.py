@@ -259,5 +259,23 @@ class MisuseTest(unittest.TestCase):
         """)
 
 
+class DocstringTest(unittest.TestCase):
+    def test_every_class_method_and_property_says_what_it_does(self):
+        import swarmsim
+        self.assertIn("step_worlds", swarmsim.__doc__)
+        for cls in (swarmsim.World, swarmsim.Robots):
+            self.assertGreater(len(cls.__doc__ or ""), 100, cls)
+            for name, member in vars(cls).items():
+                if name.startswith("_"):
+                    continue
+                doc = member.__doc__ or ""
+                # pybind11 puts the signature first: a description must follow it.
+                lines = [l for l in doc.splitlines() if l.strip() and not l.startswith(name + "(")]
+                self.assertTrue(lines, f"{cls.__name__}.{name} has no description")
+        lines = [l for l in swarmsim.step_worlds.__doc__.splitlines()
+                 if l.strip() and not l.startswith("step_worlds(")]
+        self.assertTrue(any("ValueError" in l for l in lines))
+
+
 if __name__ == "__main__":
     unittest.main()
