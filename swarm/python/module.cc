@@ -20,8 +20,8 @@
 #include <optional>
 #include <set>
 #include <sstream>
-#include <thread>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -92,8 +92,8 @@ class Robots {
   void Expire() {
     world_ = nullptr;
     layout_ = nullptr;
-    for (py::object* o : {&poses_, &velocities_, &proximity_, &proximity_values_, &ground_,
-                          &light_, &joint_positions_, &joint_velocities_, &range_and_bearing_})
+    for (py::object* o : {&poses_, &velocities_, &proximity_, &proximity_values_, &ground_, &light_,
+                          &joint_positions_, &joint_velocities_, &range_and_bearing_})
       *o = py::object();
   }
   int64_t count() const { return static_cast<int64_t>(L().robots.size()); }
@@ -661,8 +661,7 @@ class PyWorld {
   }
   py::dict blob_cameras(const std::string& model, const std::string& sensor) {
     return Read(model, [&](const Scene& s, const ModelLayout& l) {
-      return BlobCameras(s,
-                         DeviceColumnSlots(s, l, "blob_camera", sensor, "blob camera", nullptr));
+      return BlobCameras(s, DeviceColumnSlots(s, l, "blob_camera", sensor, "blob camera", nullptr));
     });
   }
   Array force_sensors(const std::string& model, const py::object& out) {
@@ -699,7 +698,8 @@ class PyWorld {
     GateLock lock(gate_.get());
     World& w = Live();
     const ModelLayout& layout = Layout(model);
-    Translate([&] { SetJointTargets(&w.scene(), layout, ReadJointTargets(w.scene(), layout, targets)); });
+    Translate(
+        [&] { SetJointTargets(&w.scene(), layout, ReadJointTargets(w.scene(), layout, targets)); });
   }
   void set_poses(const std::string& model, const py::object& poses) {
     NotWritingFromController("set_poses()");
@@ -1090,14 +1090,14 @@ PYBIND11_MODULE(_swarmsim, m) {
             return w.device_names(model, "vision_sensor");
           },
           py::arg("model") = "", "Vision sensors on each robot of the model, hierarchy order.")
-      .def("vision_images", &PyWorld::vision_images, py::arg("model") = "",
-           py::arg("sensor") = "", py::arg("filtered") = false, py::arg("out") = py::none(),
+      .def("vision_images", &PyWorld::vision_images, py::arg("model") = "", py::arg("sensor") = "",
+           py::arg("filtered") = false, py::arg("out") = py::none(),
            "(N, H, W, 3) uint8 RGB images, rows top to bottom, of vision sensor `sensor` (''\n"
            ": the robots' only one) of each robot, from the last sense phase it rendered in\n"
            "(its `rate`); filtered=True: its filter chain's image. Zeros before the first\n"
            "step. ValueError for an unknown or ambiguous sensor or different resolutions.")
-      .def("vision_depths", &PyWorld::vision_depths, py::arg("model") = "",
-           py::arg("sensor") = "", py::arg("out") = py::none(),
+      .def("vision_depths", &PyWorld::vision_depths, py::arg("model") = "", py::arg("sensor") = "",
+           py::arg("out") = py::none(),
            "(N, H, W) float32 depth images, m along the view axis (`far` where nothing is\n"
            "seen). ValueError for a sensor with `depth: false`.")
       .def(
@@ -1146,8 +1146,7 @@ PYBIND11_MODULE(_swarmsim, m) {
            "bool, 'offsets': (K+1,) int64, 'points': (M, 3) contact points, world frame};\n"
            "object k's points are rows offsets[k] to offsets[k+1]-1.")
       // Writing state between steps.
-      .def("set_joint_targets", &PyWorld::set_joint_targets, py::arg("model"),
-           py::arg("targets"),
+      .def("set_joint_targets", &PyWorld::set_joint_targets, py::arg("model"), py::arg("targets"),
            "Sets joint targets {joint name: (N,) array or one number}: the target velocity of\n"
            "velocity-mode joints, the target position of position-mode ones. Nothing is set\n"
            "unless all are right: ValueError for an unknown joint, a wrong shape or a value\n"
@@ -1175,8 +1174,7 @@ PYBIND11_MODULE(_swarmsim, m) {
           py::arg("model"), py::arg("velocities"),
           "Sets (N, joints) joint velocities of joints nothing simulates (what\n"
           "joint_velocities() reads until the next step; motors follow their targets).")
-      .def("set_param", &PyWorld::set_param, py::arg("model"), py::arg("name"),
-           py::arg("values"),
+      .def("set_param", &PyWorld::set_param, py::arg("model"), py::arg("name"), py::arg("values"),
            "Sets a model parameter of every robot of `model`: one number or (N,) array\n"
            "(booleans: 0 or 1). Scripts and controllers read it from then on. ValueError for\n"
            "an unknown parameter (the message lists them) or a shape, TypeError for text.")

@@ -63,8 +63,7 @@ std::vector<std::pair<uint32_t, const Row*>> LiveRows(const Scene& scene, const 
   if (const Rows<Row>* rows = RowsNamed<Row>(scene, name))
     for (size_t r = 0; r < rows->rows.size(); ++r)
       if (scene.alive_at(rows->owners[r])) out.emplace_back(rows->owners[r], &rows->rows[r]);
-  std::sort(out.begin(), out.end(),
-            [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   return out;
 }
 
@@ -113,7 +112,7 @@ size_t DeviceColumn(const DeviceTable& table, const std::string& name, const cha
     throw py::value_error(std::string("the robots have ") +
                           (table.names.empty() ? std::string("no ") + what
                                                : std::to_string(table.names.size()) + " " + what +
-                                                     "s (" + known + "): name one") );
+                                                     "s (" + known + "): name one"));
   }
   for (size_t j = 0; j < table.names.size(); ++j)
     if (table.names[j] == name) return j;
@@ -130,7 +129,8 @@ py::array VisionImages(const Scene& scene, const std::vector<uint32_t>& slots, b
   uint8_t* d = a.mutable_data();
   const size_t size = static_cast<size_t>(w) * static_cast<size_t>(h) * 3;
   for (size_t i = 0; i < readings.size(); ++i, d += size) {
-    const Image* image = filtered && readings[i].filtered ? readings[i].filtered : readings[i].image;
+    const Image* image =
+        filtered && readings[i].filtered ? readings[i].filtered : readings[i].image;
     if (image != nullptr && image->rgb.size() == size)
       std::memcpy(d, image->rgb.data(), size);
     else
@@ -139,8 +139,8 @@ py::array VisionImages(const Scene& scene, const std::vector<uint32_t>& slots, b
   return a;
 }
 
-py::array VisionDepths(const Scene& scene, const std::vector<uint32_t>& slots, const py::object& out,
-                       const std::vector<std::string>& who) {
+py::array VisionDepths(const Scene& scene, const std::vector<uint32_t>& slots,
+                       const py::object& out, const std::vector<std::string>& who) {
   const std::vector<rendering::VisionReading> readings = VisionReadings(scene, slots, who);
   const int w = readings.empty() ? 0 : readings[0].width;
   const int h = readings.empty() ? 0 : readings[0].height;
@@ -211,8 +211,8 @@ Array ForceSensors(const Scene& scene, const DeviceTable& table, size_t robots,
 }
 
 py::array ForceSensorsBroken(const Scene& scene, const DeviceTable& table, size_t robots) {
-  py::array_t<bool> a({static_cast<py::ssize_t>(robots),
-                       static_cast<py::ssize_t>(table.names.size())});
+  py::array_t<bool> a(
+      {static_cast<py::ssize_t>(robots), static_cast<py::ssize_t>(table.names.size())});
   bool* d = a.mutable_data();
   const Rows<ForceSensorData>* rows = force_sensor::RowsOf(scene);
   for (size_t k = 0; k < table.slots.size(); ++k)

@@ -30,8 +30,8 @@ size_t DeviceColumn(const DeviceTable& table, const std::string& name, const cha
 // or depth of a sensor with `depth: false`.
 py::array VisionImages(const Scene& scene, const std::vector<uint32_t>& slots, bool filtered,
                        const py::object& out, const std::vector<std::string>& who);
-py::array VisionDepths(const Scene& scene, const std::vector<uint32_t>& slots, const py::object& out,
-                       const std::vector<std::string>& who);
+py::array VisionDepths(const Scene& scene, const std::vector<uint32_t>& slots,
+                       const py::object& out, const std::vector<std::string>& who);
 
 // What the blob camera at slots[i] (one per robot) saw in the last sense
 // phase, as flat arrays: robot i's blobs are rows offsets[i] to

@@ -17,8 +17,7 @@ namespace {
 
 std::string ShapeText(const py::array& a) {
   std::string s = "(";
-  for (py::ssize_t d = 0; d < a.ndim(); ++d)
-    s += (d ? ", " : "") + std::to_string(a.shape(d));
+  for (py::ssize_t d = 0; d < a.ndim(); ++d) s += (d ? ", " : "") + std::to_string(a.shape(d));
   return s + (a.ndim() == 1 ? ",)" : ")");
 }
 
@@ -63,16 +62,18 @@ Array RealNumbers(const py::handle& value, const std::string& what) {
   if (kind == 'c')
     throw WriteError(true, what + " is complex numbers: joint targets and states are real");
   if (kind != 'f' && kind != 'i' && kind != 'u')
-    throw WriteError(true, what + " is not numbers (dtype " + std::string(py::str(a.dtype())) +
-                               ")");
+    throw WriteError(true,
+                     what + " is not numbers (dtype " + std::string(py::str(a.dtype())) + ")");
   return py::cast<Array>(a);  // a C-contiguous float64 copy when it is not one already
 }
 
 JointTargets ReadJointTargets(const Scene& scene, const ModelLayout& layout,
                               const py::handle& targets) {
   if (!py::isinstance<py::dict>(targets))
-    throw WriteError(true, "joint targets are a dict {joint name: array of one value per robot}, "
-                           "got " + std::string(py::str(py::type::of(targets).attr("__name__"))));
+    throw WriteError(true,
+                     "joint targets are a dict {joint name: array of one value per robot}, "
+                     "got " +
+                         std::string(py::str(py::type::of(targets).attr("__name__"))));
   const size_t n = layout.robots.size();
   const size_t joints = layout.joint_names.size();
   const auto rows = scene.joints();
@@ -131,8 +132,8 @@ void SetJointTargets(Scene* scene, const ModelLayout& layout, const JointTargets
 void SetPoses(World* world, const ModelLayout& layout, const py::object& poses) {
   Scene& scene = world->scene();
   const size_t n = layout.robots.size();
-  const Array a = Table(poses, n, {3, 7}, "set_poses",
-                        "(N, 3) x, y, yaw or (N, 7) x, y, z, qw, qx, qy, qz");
+  const Array a =
+      Table(poses, n, {3, 7}, "set_poses", "(N, 3) x, y, yaw or (N, 7) x, y, z, qw, qx, qy, qz");
   const size_t columns = static_cast<size_t>(a.shape(1));
   const double* d = a.data();
   std::vector<Pose> out(n);
@@ -171,9 +172,9 @@ void SetJointStates(World* world, const ModelLayout& layout, int what, const py:
   Scene& scene = world->scene();
   const size_t n = layout.robots.size(), joints = layout.joint_names.size();
   const std::string call = what == 0 ? "set_joint_positions" : "set_joint_velocities";
-  const Array a = Table(values, n, {joints}, call,
-                        "(N, " + std::to_string(joints) + "): one column per joint (" +
-                            JointList(layout) + ")");
+  const Array a = Table(
+      values, n, {joints}, call,
+      "(N, " + std::to_string(joints) + "): one column per joint (" + JointList(layout) + ")");
   const double* d = a.data();
   const auto rows = scene.joints();
   for (size_t k = 0; k < n * joints; ++k) {
@@ -224,8 +225,8 @@ void SetParam(World* world, const ModelLayout& layout, const std::string& name,
       std::string known;
       if (rt.parameters)
         for (const auto& [k, value] : *rt.parameters) known += (known.empty() ? "" : ", ") + k;
-      throw WriteError(false, "set_param: model '" + layout.model + "' has no parameter '" +
-                                  name + "' (" + (known.empty() ? "it has none" : known) + ")");
+      throw WriteError(false, "set_param: model '" + layout.model + "' has no parameter '" + name +
+                                  "' (" + (known.empty() ? "it has none" : known) + ")");
     }
     const double x = scalar ? v[0] : v[i];
     if (!std::isfinite(x))
@@ -235,12 +236,13 @@ void SetParam(World* world, const ModelLayout& layout, const std::string& name,
       next[i] = x;
     } else if (std::holds_alternative<bool>(*old)) {
       if (x != 0 && x != 1)
-        throw WriteError(false, "set_param('" + name + "') is a boolean: 0 or 1, got " +
-                                    std::to_string(x));
+        throw WriteError(
+            false, "set_param('" + name + "') is a boolean: 0 or 1, got " + std::to_string(x));
       next[i] = x != 0;
     } else {
-      throw WriteError(true, "set_param('" + name + "') is text: only numbers and booleans are "
-                             "set from arrays");
+      throw WriteError(true, "set_param('" + name +
+                                 "') is text: only numbers and booleans are "
+                                 "set from arrays");
     }
   }
   // Robots that shared one set and get one value share the new one.

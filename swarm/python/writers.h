@@ -27,8 +27,8 @@ Array RealNumbers(const py::handle& value, const std::string& what);
 // Joint targets {joint name: N values or one number}, read and checked
 // (names, shapes, finite values, joint modes) before any is set.
 struct JointTargets {
-  std::vector<size_t> columns;               // joint column in the layout
-  std::vector<std::vector<double>> values;   // per column: N values
+  std::vector<size_t> columns;              // joint column in the layout
+  std::vector<std::vector<double>> values;  // per column: N values
 };
 JointTargets ReadJointTargets(const Scene& scene, const ModelLayout& layout,
                               const py::handle& targets);
