@@ -13,6 +13,7 @@
 #include "framework/scene.h"
 #include "framework/state_hash.h"
 #include "modules/rendering/module.h"
+#include "modules/rendering/vision_sensor.h"
 
 namespace swarmsim::rendering {
 
@@ -256,6 +257,22 @@ void CollectLights(const Scene& scene, std::vector<LightSource>* lights, bool* a
     if (l.range > 0) s.attenuation[1] = 1 / l.range;
     lights->push_back(s);
   }
+}
+
+bool ReadVisionSensor(const Scene& scene, uint32_t slot, VisionReading* out) {
+  ObjectType type;
+  if (!scene.FindType("vision_sensor", &type) || scene.type_at(slot) != type) return false;
+  const VisionSensorRow& s = scene.rows<VisionSensorRow>(type).rows[scene.row_at(slot)];
+  *out = {};
+  out->width = s.lens.width;
+  out->height = s.lens.height;
+  out->depth = s.depth;
+  out->rendered_step = s.rendered_step;
+  if (s.rendered_step >= 0) {
+    out->image = &s.image;
+    if (!s.filters.empty()) out->filtered = &s.output.image;
+  }
+  return true;
 }
 
 void RegisterObjects(ModuleRegistry* registry) {

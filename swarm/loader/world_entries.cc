@@ -129,6 +129,10 @@ std::vector<std::shared_ptr<const ModelSectionData>> ReadModelSections(
   return out;
 }
 
+namespace {
+void DropScripts(ObjectSpec* spec);
+}  // namespace
+
 void WorldLoader::ResolveEntry(EntryPlan* entry) {
   const ModelFile& model = *entry->model;
   const ValueReader world_values = WorldValues();
@@ -141,6 +145,13 @@ void WorldLoader::ResolveEntry(EntryPlan* entry) {
   ResolvePlacement(f, world_values, entry);
   ResolveNativeController(f, world_values, entry);
   ResolvePythonController(f, world_values, entry);
+  // Models Python drives without their Lua scripts (World(..., keep_scripts=False)).
+  if (std::find(options_.drop_scripts.begin(), options_.drop_scripts.end(), model.name) !=
+      options_.drop_scripts.end()) {
+    DropScripts(&entry->spec);
+    for (EntryPlan::OwnCopy& own : entry->own_copies)
+      if (own.spec) DropScripts(&*own.spec);
+  }
 }
 
 namespace {

@@ -44,6 +44,9 @@ struct LoadOptions {
   // Whether the caller runs `python_controller:` entries (swarm/python does;
   // the program does not, and a world naming one is an error there).
   bool python_controllers = false;
+  // Models whose Lua scripts are dropped, every entry's (a Python caller
+  // drives them: World(..., controllers=..., keep_scripts=False)).
+  std::vector<std::string> drop_scripts;
   // Called now and then while the world loads (between model copies); may
   // throw swarmsim::Error to abandon the load (the program's stop signals).
   // Empty: never.

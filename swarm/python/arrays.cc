@@ -24,7 +24,6 @@ ObjectType TypeNamed(const Scene& scene, const char* name) {
 }
 }  // namespace
 
-namespace {
 // Names that repeat within a robot (a proximity ring's `prox`) get the index
 // scripts use: prox[0], prox[1], ...
 void IndexRepeats(std::vector<std::string>* names) {
@@ -38,7 +37,6 @@ void IndexRepeats(std::vector<std::string>* names) {
       n += ']';
     }
 }
-}  // namespace
 
 // Rebuilds `layout` for `model` ("" : every robot) if robots came or went.
 void Refresh(const World& world, const std::string& model, ModelLayout* layout) {

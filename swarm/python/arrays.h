@@ -36,6 +36,10 @@ struct ModelLayout {
   int64_t robot_count = -1;               // World::robot_count() it was built at
 };
 
+// Names that repeat within a robot (a proximity ring's `prox`) get the index
+// scripts use: prox[0], prox[1], ...
+void IndexRepeats(std::vector<std::string>* names);
+
 // Rebuilds `layout` for `model` ("" : every robot) if robots came or went.
 void Refresh(const World& world, const std::string& model, ModelLayout* layout);
 

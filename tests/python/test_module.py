@@ -197,9 +197,9 @@ class ErrorTest(unittest.TestCase):
             w.step(-1)
         with self.assertRaises(ValueError):
             w.poses("no_such_model")
-        with self.assertRaises(RuntimeError):
+        with self.assertRaises(ValueError):
             w.set_joint_targets("footbot", {"leftMotor": np.zeros(3)})
-        with self.assertRaises(RuntimeError):
+        with self.assertRaises(ValueError):
             w.set_joint_targets("footbot", {"noMotor": np.zeros(10)})
         with self.assertRaises(TypeError):
             swarmsim.World(world("diffusion.yaml"), controllers={"footbot": 3})

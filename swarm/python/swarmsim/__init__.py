@@ -11,20 +11,31 @@ or one may be given here (``World(..., controllers={"footbot": fn})``): it is ca
 once per step with a :class:`Robots` holding the arrays of all the model's robots and
 returns ``{joint name: array of one target per robot}``. See README.md, "Python".
 
+Many worlds at once: ``swarmsim.step_worlds([w1, w2, ...], n, threads=2)`` steps them in
+parallel, each ending exactly as stepping it alone would.
+
+Between steps Python may write state: ``set_poses``, ``set_joint_positions``,
+``set_joint_velocities``, ``set_joint_targets``, ``set_param``. Every sensor reads as
+an array: proximity, ground, light, range-and-bearing, vision images and depth, blob
+cameras, force sensors, distance and collision objects.
+
 Errors: a world that does not load raises ValueError with the message the command
 line prints (file:line:column); a script or controller error while stepping raises
 RuntimeError (with the controller's traceback) and the world cannot be stepped again.
-Every array is a copy (pass ``out=`` to reuse one).
+Wrong shapes, names and values raise ValueError, non-numbers TypeError. A World is
+used by one thread at a time (another thread's call waits); a controller may read its
+world but not step, close or write it (RuntimeError). A ``Robots`` object kept after
+its step raises RuntimeError. Every array is a copy (pass ``out=`` to reuse one).
 """
 
 import sys
 
 try:
     import numpy  # noqa: F401  (the arrays' type; Debian's python3-numpy)
-    from ._swarmsim import Robots, World
+    from ._swarmsim import Robots, World, step_worlds
 except ImportError as e:
     raise ImportError(
         f"swarmsim is built for Debian's Python, /usr/bin/python3 (with python3-numpy); "
         f"this is {sys.executable}: run your script with /usr/bin/python3 ({e})") from e
 
-__all__ = ["World", "Robots"]
+__all__ = ["World", "Robots", "step_worlds"]

@@ -1,0 +1,281 @@
+"""Misuse of the Python binding raises a clear Python exception instead of crashing
+the interpreter (issue 30, part 1). Each case runs in a child interpreter, where a
+crash shows as a signal exit instead of killing the test run."""
+
+import os
+import subprocess
+import textwrap
+import unittest
+
+from common import PYTHON, ROOT, world
+
+PRELUDE = f"""
+import sys, threading, numpy as np, swarmsim
+WORLD = {world("diffusion.yaml")!r}
+def expect(exception, fragment, call, *args, **kwargs):
+    try:
+        call(*args, **kwargs)
+    except exception as e:
+        assert fragment in str(e), f"{{fragment!r}} not in {{e!r}}"
+        return e
+    raise AssertionError(f"{{call}} raised nothing, expected {{exception.__name__}}")
+"""
+
+
+def child(code, timeout=120):
+    """Runs `code` in a fresh interpreter; returns (exit status, output)."""
+    p = subprocess.run([PYTHON, "-c", PRELUDE + textwrap.dedent(code)], cwd=ROOT,
+                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                       env=dict(os.environ), timeout=timeout)
+    return p.returncode, p.stdout
+
+
+class MisuseTest(unittest.TestCase):
+    def run_child(self, code):
+        status, out = child(textwrap.dedent(code) + "\nprint('CHILD-OK')\n")
+        self.assertEqual(status, 0, f"the child exited with {status} (a negative status is a "
+                                    f"signal: a crash):\n{out}")
+        self.assertIn("CHILD-OK", out)
+        return out
+
+    def test_a_kept_robots_object_raises_after_its_step(self):
+        self.run_child("""
+            kept = []
+            def keep(robots):
+                kept.append(robots)
+                kept.append(robots.poses)       # an array taken during the call
+                return None
+            w = swarmsim.World(WORLD, seed=1, set={"robots": 4}, controllers={"footbot": keep})
+            w.step(2)
+            robots, poses = kept[2], kept[3]
+            e = expect(RuntimeError, "belongs to step 1, which is over", lambda: robots.poses)
+            expect(RuntimeError, "which is over", lambda: robots.count)
+            expect(RuntimeError, "which is over", lambda: len(robots))
+            expect(RuntimeError, "which is over", robots.param, "wheel_speed")
+            expect(RuntimeError, "which is over", lambda: robots.range_and_bearing)
+            assert "expired" in repr(robots)
+            assert poses.shape == (4, 3) and np.all(np.isfinite(poses)), "the copy stays valid"
+            w.close()
+            expect(RuntimeError, "which is over", lambda: robots.poses)
+            del w
+            import gc; gc.collect()
+            expect(RuntimeError, "which is over", lambda: robots.joint_positions)
+        """)
+
+    def test_close_inside_a_controller_raises_and_the_world_stays_usable(self):
+        self.run_child("""
+            holder = {}
+            def closer(robots):
+                try:
+                    holder["w"].close()
+                except RuntimeError as e:
+                    holder["error"] = str(e)
+                return None
+            w = swarmsim.World(WORLD, seed=1, set={"robots": 4}, controllers={"footbot": closer})
+            holder["w"] = w
+            w.step(3)
+            assert "close() inside a controller" in holder["error"], holder
+            assert w.steps == 3
+            w.step()
+            assert w.steps == 4 and len(w.state_hash()) == 16
+        """)
+
+    def test_step_inside_a_controller_raises_and_an_uncaught_one_stops_the_run_clearly(self):
+        self.run_child("""
+            holder = {"caught": 0}
+            def stepper(robots):
+                try:
+                    holder["w"].step()
+                except RuntimeError as e:
+                    holder["caught"] += 1
+                    holder["error"] = str(e)
+                return None
+            w = swarmsim.World(WORLD, seed=1, set={"robots": 4}, controllers={"footbot": stepper})
+            holder["w"] = w
+            w.step(2)
+            assert holder["caught"] == 2 and "step() inside a controller" in holder["error"]
+            assert w.steps == 2
+
+            def uncaught(robots):
+                holder["v"].step()
+            v = swarmsim.World(WORLD, seed=1, set={"robots": 4}, controllers={"footbot": uncaught})
+            holder["v"] = v
+            expect(RuntimeError, "step() inside a controller", v.step)
+            expect(RuntimeError, "cannot be stepped again", v.step)
+            v.poses()   # reading what the world holds still works
+        """)
+
+    def test_writers_and_step_worlds_inside_a_controller_raise(self):
+        self.run_child("""
+            seen = []
+            def writer(robots):
+                for call in (lambda: holder["w"].set_poses("footbot", np.zeros((4, 3))),
+                             lambda: holder["w"].set_joint_targets("footbot", {"leftMotor": 0.0}),
+                             lambda: swarmsim.step_worlds([holder["w"]])):
+                    try:
+                        call()
+                    except RuntimeError as e:
+                        seen.append(str(e))
+                holder["poses"] = holder["w"].poses()   # reads work inside
+                return None
+            holder = {}
+            w = swarmsim.World(WORLD, seed=1, set={"robots": 4}, controllers={"footbot": writer})
+            holder["w"] = w
+            w.step()
+            assert len(seen) == 3, seen
+            assert "while the world is stepping" in seen[0] and "while the world is stepping" in seen[1]
+            assert "inside a controller" in seen[2] and "worlds[0]" in seen[2]
+            assert holder["poses"].shape == (4, 3)
+        """)
+
+    def test_two_python_threads_stepping_one_world_take_turns(self):
+        self.run_child("""
+            w = swarmsim.World(WORLD, seed=5, set={"robots": 30}, threads=2)
+            errors = []
+            def run():
+                try:
+                    for _ in range(20):
+                        w.step()
+                        w.poses()
+                except BaseException as e:
+                    errors.append(e)
+            threads = [threading.Thread(target=run) for _ in range(3)]
+            for t in threads: t.start()
+            for t in threads: t.join()
+            assert not errors, errors
+            assert w.steps == 60, w.steps
+            alone = swarmsim.World(WORLD, seed=5, set={"robots": 30}, threads=1)
+            alone.step(60)
+            assert w.state_hash() == alone.state_hash(), "the steps interleaved whole"
+        """)
+
+    def test_close_from_another_thread_waits_for_the_step(self):
+        self.run_child("""
+            import time
+            started = threading.Event()
+            def slow(robots):
+                started.set()
+                time.sleep(0.05)   # releases the GIL inside the step
+                return None
+            w = swarmsim.World(WORLD, seed=1, set={"robots": 4}, controllers={"footbot": slow})
+            t = threading.Thread(target=lambda: w.step(5))
+            t.start()
+            started.wait()
+            w.close()              # waits until the other thread's step ends
+            t.join()
+            expect(RuntimeError, "closed", w.step)
+            expect(RuntimeError, "closed", w.poses)
+        """)
+
+    def test_keyboard_interrupt_and_system_exit_propagate_and_the_world_goes_on(self):
+        self.run_child("""
+            for exc in (KeyboardInterrupt, SystemExit):
+                state = {"n": 0}
+                def ctl(robots):
+                    state["n"] += 1
+                    if state["n"] == 3:
+                        raise exc("stop here")
+                    return {"leftMotor": 1.0, "rightMotor": 1.0}
+                w = swarmsim.World(WORLD, seed=1, set={"robots": 4}, controllers={"footbot": ctl})
+                try:
+                    w.step(10)
+                except exc as e:
+                    assert "stop here" in str(e)
+                else:
+                    raise AssertionError("no " + exc.__name__)
+                assert w.steps == 3, w.steps       # the step it was raised in finished
+                w.step(2)
+                assert w.steps == 5
+        """)
+
+    def test_thread_counts_outside_the_range_are_refused(self):
+        self.run_child("""
+            for bad in (-1, 1000):
+                e = expect(ValueError, "0 (every core", swarmsim.World, WORLD, threads=bad)
+                assert "1 to 256" in str(e) and str(bad) in str(e)
+            expect(ValueError, "1 to 256", swarmsim.step_worlds, [], threads=-1)
+            swarmsim.World(WORLD, set={"robots": 2}, threads=256).step()
+        """)
+
+    def test_wrong_shapes_and_names_are_value_errors(self):
+        self.run_child("""
+            w = swarmsim.World(WORLD, set={"robots": 10})
+            expect(ValueError, "expected (10,)", w.set_joint_targets, "footbot",
+                   {"leftMotor": np.zeros(3)})
+            expect(ValueError, "not one of its joints (leftMotor, rightMotor)",
+                   w.set_joint_targets, "footbot", {"noMotor": np.zeros(10)})
+            expect(ValueError, "no model 'nope'", w.set_joint_targets, "nope", {})
+            expect(ValueError, "(N, 3) x, y, yaw", w.set_poses, "footbot", np.zeros((10, 4)))
+            expect(ValueError, "wrong shape", w.poses, out=np.empty((11, 3)))
+        """)
+
+    def test_unknown_metrics_are_key_errors_listing_the_known_ones(self):
+        self.run_child("""
+            w = swarmsim.World(WORLD, set={"robots": 5})
+            # A metric the world declares is known before its first sample.
+            steps, values = w.metric_history("mean_nearest_neighbor_distance")
+            assert len(steps) == 0
+            e = expect(KeyError, "no metric 'nope'", w.metric_history, "nope")
+            assert "mean_nearest_neighbor_distance" in str(e), e
+            w.step(10)
+            steps, values = w.metric_history("mean_nearest_neighbor_distance")
+            assert list(steps) == [10], steps
+            expect(KeyError, "no robot-level metric 'nope'", w.robot_metric, "nope")
+        """)
+
+    def test_complex_bool_and_nan_actions_are_refused_naming_the_robot(self):
+        self.run_child("""
+            w = swarmsim.World(WORLD, set={"robots": 3})
+            before = w.state_hash()
+            expect(TypeError, "complex", w.set_joint_targets, "footbot",
+                   {"leftMotor": np.ones(3, dtype=complex)})
+            expect(TypeError, "boolean", w.set_joint_targets, "footbot",
+                   {"leftMotor": np.ones(3, dtype=bool)})
+            expect(TypeError, "boolean", w.set_joint_targets, "footbot", {"leftMotor": True})
+            expect(TypeError, "not numbers", w.set_joint_targets, "footbot", {"leftMotor": "fast"})
+            e = expect(ValueError, "for robot 'footbot#1' is not finite", w.set_joint_targets,
+                       "footbot", {"rightMotor": np.array([0.0, np.nan, 0.0])})
+            # Nothing was set by the refused calls, the good key included.
+            expect(ValueError, "not finite", w.set_joint_targets, "footbot",
+                   {"leftMotor": np.ones(3), "rightMotor": np.full(3, np.inf)})
+            assert w.state_hash() == before
+            np.testing.assert_array_equal(w.joint_velocities(), 0)
+
+            def complex_controller(robots):
+                return {"leftMotor": np.ones(robots.count, dtype=complex)}
+            c = swarmsim.World(WORLD, set={"robots": 3}, controllers={"footbot": complex_controller})
+            expect(RuntimeError, "complex", c.step)
+        """)
+
+    def test_step_worlds_refuses_duplicates_closed_worlds_and_other_objects(self):
+        self.run_child("""
+            a = swarmsim.World(WORLD, set={"robots": 3}, threads=1)
+            b = swarmsim.World(WORLD, set={"robots": 3}, threads=1)
+            expect(ValueError, "worlds[2] is worlds[0]", swarmsim.step_worlds, [a, b, a])
+            expect(TypeError, "worlds[1] is a str", swarmsim.step_worlds, [a, "b"])
+            b.close()
+            expect(RuntimeError, "worlds[1]", swarmsim.step_worlds, [a, b])
+            assert a.steps == 0, "nothing stepped when the list is refused"
+        """)
+
+
+class DocstringTest(unittest.TestCase):
+    def test_every_class_method_and_property_says_what_it_does(self):
+        import swarmsim
+        self.assertIn("step_worlds", swarmsim.__doc__)
+        for cls in (swarmsim.World, swarmsim.Robots):
+            self.assertGreater(len(cls.__doc__ or ""), 100, cls)
+            for name, member in vars(cls).items():
+                if name.startswith("_"):
+                    continue
+                doc = member.__doc__ or ""
+                # pybind11 puts the signature first: a description must follow it.
+                lines = [l for l in doc.splitlines() if l.strip() and not l.startswith(name + "(")]
+                self.assertTrue(lines, f"{cls.__name__}.{name} has no description")
+        lines = [l for l in swarmsim.step_worlds.__doc__.splitlines()
+                 if l.strip() and not l.startswith("step_worlds(")]
+        self.assertTrue(any("ValueError" in l for l in lines))
+
+
+if __name__ == "__main__":
+    unittest.main()
