@@ -19,6 +19,21 @@ void ModuleRegistry::RegisterDynamics(ModuleInfo info, DynamicsCapabilities capa
   modules_.push_back(std::move(info));
 }
 
+void ModuleRegistry::RegisterDynamicsSection(const std::string& name, DynamicsSection section) {
+  for (Dynamics& d : dynamics_)
+    if (d.name == name) {
+      d.section = std::make_shared<const DynamicsSection>(std::move(section));
+      return;
+    }
+  throw Error("no dynamics backend '" + name + "' to give a settings section");
+}
+
+const DynamicsSection* ModuleRegistry::FindDynamicsSection(const std::string& name) const {
+  for (const Dynamics& d : dynamics_)
+    if (d.name == name) return d.section.get();
+  return nullptr;
+}
+
 void ModuleRegistry::RegisterModule(ModuleDescriptor module) {
   if (module.info.name.empty() || !module.make)
     throw Error("a module needs a name and a way to make it");

@@ -102,6 +102,9 @@ namespace swarmsim::ode {
 swarmsim::ModuleInfo ModuleInfo();
 std::unique_ptr<DynamicsBackend> MakeBackend();
 std::unique_ptr<DynamicsBackend> MakeBackend(const Options& options);
+// The world file's `simulation.ode` mapping: its keys and reader
+// (ode_section.cc), registered beside the backend (modules/builtin.cc).
+DynamicsSection Section();
 
 // ODE alone, for the bench's `ode-only` row: builds the same ODE world from
 // `scene`, reads the joint commands once, then runs steps x substeps ODE
