@@ -11,9 +11,9 @@
 
 #include "framework/error.h"
 #include "framework/model_section.h"
+#include "framework/object_type.h"
 #include "framework/plugin_controllers.h"
 #include "framework/registry.h"
-#include "framework/object_type.h"
 #include "framework/world_section.h"
 #include "swarm/loader/object_reader.h"
 #include "swarm/loader/urdf.h"
@@ -137,9 +137,9 @@ std::vector<std::string> ModelSectionKeys(const ModuleRegistry& registry) {
 
 std::vector<std::string> EntryKeys(const ModuleRegistry& registry) {
   std::vector<std::string> keys = {
-      "model",      "count",     "distribute", "position", "heading_deg", "orientation_deg",
-      "parameters", "instances", "scale",      "base",     "objects",     "scripts",
-      "joints"};
+      "model",           "count",      "distribute", "position", "heading_deg",
+      "orientation_deg", "parameters", "instances",  "scale",    "base",
+      "objects",         "scripts",    "joints"};
   for (std::string& key : ModelSectionKeys(registry)) keys.push_back(std::move(key));
   keys.insert(keys.end(), {"python_controller", "native_controller"});
   return keys;

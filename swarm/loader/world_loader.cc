@@ -360,11 +360,21 @@ WorldSettings WorldLoader::ReadSimulation(const Fields& top, std::optional<int64
     Fields f(*file_, sim, "'simulation'");
     // The loader's keys, and a mapping per backend with settings of its own
     // (`ode: {...}`: ModuleRegistry::RegisterDynamicsSection).
-    std::vector<std::string> known = {
-        "physics",      "time_step",       "physics_substeps",  "physics_partitions",
-        "seed",         "duration",        "steps",             "gravity",
-        "octree_resolution", "main_script", "instruction_budget", "script_memory_mb",
-        "run_script_memory_mb", "step_timeout", "on_script_error"};
+    std::vector<std::string> known = {"physics",
+                                      "time_step",
+                                      "physics_substeps",
+                                      "physics_partitions",
+                                      "seed",
+                                      "duration",
+                                      "steps",
+                                      "gravity",
+                                      "octree_resolution",
+                                      "main_script",
+                                      "instruction_budget",
+                                      "script_memory_mb",
+                                      "run_script_memory_mb",
+                                      "step_timeout",
+                                      "on_script_error"};
     for (const std::string& name : registry_.DynamicsNames())
       if (registry_.FindDynamicsSection(name)) known.push_back(name);
     f.Expect(std::span<const std::string>(known));

@@ -265,8 +265,8 @@ void OdeWorld::Build(const Scene& scene) {
     case Solver::kWorld: exact_solver_ = true; break;
     case Solver::kQuickStep: exact_solver_ = options_.iterations <= 0; break;
     case Solver::kAuto:
-      exact_solver_ = options_.iterations <= 0 ||
-                      bodies_.size() <= static_cast<size_t>(kExactSolverBodies);
+      exact_solver_ =
+          options_.iterations <= 0 || bodies_.size() <= static_cast<size_t>(kExactSolverBodies);
       break;
   }
 }

@@ -203,7 +203,7 @@ class OdeWorld {
   // Each joint's motor velocity this substep (ApplyMotors): a dependent
   // joint's feed-forward is its master's.
   std::vector<double> motor_velocity_;
-  bool exact_solver_ = false;  // dWorldStep (Options::solver, or auto by body count; Build)
+  bool exact_solver_ = false;   // dWorldStep (Options::solver, or auto by body count; Build)
   double step_dt_ = 0;          // substep length, for the servo
   uint64_t substeps_done_ = 0;  // seeds each substep's constraint shuffles
   bool broken_ = false;         // an ODE call was unwound by an error (Substep)

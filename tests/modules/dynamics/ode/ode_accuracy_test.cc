@@ -7,11 +7,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <map>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -50,31 +51,30 @@ using Configuration = std::map<std::string, double>;
 // Three configurations inside the Panda's limits, with gravity loading the
 // shoulder and elbow differently.
 const std::vector<Configuration>& Configurations() {
-  static const std::vector<Configuration> c = {
-      {{"panda_joint1", 0},
-       {"panda_joint2", -0.3},
-       {"panda_joint3", 0},
-       {"panda_joint4", -2.2},
-       {"panda_joint5", 0},
-       {"panda_joint6", 2.0},
-       {"panda_joint7", 0.785},
-       {"panda_finger_joint1", 0.02}},
-      {{"panda_joint1", 0.3},
-       {"panda_joint2", -0.5},
-       {"panda_joint3", 0.7},
-       {"panda_joint4", -2.0},
-       {"panda_joint5", 0.4},
-       {"panda_joint6", 1.9},
-       {"panda_joint7", -0.6},
-       {"panda_finger_joint1", 0.03}},
-      {{"panda_joint1", -0.8},
-       {"panda_joint2", 0.7},
-       {"panda_joint3", -0.4},
-       {"panda_joint4", -1.2},
-       {"panda_joint5", 1.0},
-       {"panda_joint6", 1.2},
-       {"panda_joint7", 0.3},
-       {"panda_finger_joint1", 0.01}}};
+  static const std::vector<Configuration> c = {{{"panda_joint1", 0},
+                                                {"panda_joint2", -0.3},
+                                                {"panda_joint3", 0},
+                                                {"panda_joint4", -2.2},
+                                                {"panda_joint5", 0},
+                                                {"panda_joint6", 2.0},
+                                                {"panda_joint7", 0.785},
+                                                {"panda_finger_joint1", 0.02}},
+                                               {{"panda_joint1", 0.3},
+                                                {"panda_joint2", -0.5},
+                                                {"panda_joint3", 0.7},
+                                                {"panda_joint4", -2.0},
+                                                {"panda_joint5", 0.4},
+                                                {"panda_joint6", 1.9},
+                                                {"panda_joint7", -0.6},
+                                                {"panda_finger_joint1", 0.03}},
+                                               {{"panda_joint1", -0.8},
+                                                {"panda_joint2", 0.7},
+                                                {"panda_joint3", -0.4},
+                                                {"panda_joint4", -1.2},
+                                                {"panda_joint5", 1.0},
+                                                {"panda_joint6", 1.2},
+                                                {"panda_joint7", 0.3},
+                                                {"panda_finger_joint1", 0.01}}};
   return c;
 }
 
@@ -115,7 +115,8 @@ class OdeAccuracyTest : public testing::WorldDirTest {
               double seconds = 3) {
     LoadedWorld ode = LoadPanda(dir, simulation);
     World& world = *ode.world;
-    for (const auto& [name, value] : q) world.scene().mutable_joint(Find(world, name)).target_position = value;
+    for (const auto& [name, value] : q)
+      world.scene().mutable_joint(Find(world, name)).target_position = value;
     Outcome out;
     world.Start();
     const double dt = world.settings().time_step;
@@ -129,13 +130,14 @@ class OdeAccuracyTest : public testing::WorldDirTest {
       if (k * dt > 0.1) out.finger_spread = std::max(out.finger_spread, std::abs(q1 - q2));
       if (k * dt > seconds - 1) lo = std::min(lo, q1), hi = std::max(hi, q1);
     }
-    out.step_us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0)
-                      .count() /
-                  steps;
+    out.step_us =
+        std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count() /
+        steps;
     out.finger_range = hi - lo;
     // The forward kinematics of the commanded configuration.
     LoadedWorld fk = LoadPanda(dir, "physics: kinematic");
-    for (const auto& [name, value] : q) fk.world->scene().mutable_joint(Find(*fk.world, name)).position = value;
+    for (const auto& [name, value] : q)
+      fk.world->scene().mutable_joint(Find(*fk.world, name)).position = value;
     fk.world->scene().mutable_joint(Find(*fk.world, "panda_finger_joint2")).position =
         q.at("panda_finger_joint1");
     fk.world->scene().UpdateWorldPoses();
@@ -190,6 +192,30 @@ TEST_F(OdeAccuracyTest, SolverAndCfmKeysTradeAccuracy) {
   EXPECT_LT(stiff, exact / 10);
 }
 
+// The figures of worlds/README.md's "ODE settings" table (not a check: run
+// with --gtest_also_run_disabled_tests --gtest_filter='*Table*').
+TEST_F(OdeAccuracyTest, DISABLED_Table) {
+  NEED_SHARED_URDF(dir);
+  for (const char* ode :
+       {"", "solver: world, cfm: 1e-9", "solver: world, cfm: 1e-5", "solver: world, cfm: 1e-4",
+        "solver: quickstep, iterations: 10", "solver: quickstep, iterations: 20",
+        "solver: quickstep", "solver: quickstep, erp: 0.8", "solver: quickstep, iterations: 100",
+        "solver: quickstep, iterations: 400"}) {
+    Outcome worst;
+    std::vector<double> times;
+    for (const Configuration& q : Configurations()) {
+      const Outcome o =
+          Run(dir, std::string("physics: ode, time_step: 0.01, ode: {") + ode + "}", q);
+      worst.link_error = std::max(worst.link_error, o.link_error);
+      worst.finger_spread = std::max(worst.finger_spread, o.finger_spread);
+      times.push_back(o.step_us);
+    }
+    std::sort(times.begin(), times.end());
+    std::printf("| `%s` | %.2g | %.2g | %.0f |\n", ode, worst.link_error, worst.finger_spread,
+                times[1]);
+  }
+}
+
 // A bar held out level by a revolute joint's limit: how far gravity pushes
 // it past the limit depends on the limits' CFM (the world's, a models
 // entry's `joints:`, the joint's own, in that order of precedence).
@@ -204,13 +230,14 @@ class OdeLimitTest : public testing::WorldDirTest {
           "  type: dummy\n"
           "  children:\n"
           "    - {name: hinge, type: joint, joint: revolute, mode: passive, limits: [0, 0.5],\n"
-          "       orientation_deg: [90, 0, 0]" + joint_keys + ",\n"
-          "       children: [{name: arm, type: shape, shape: box, size: [1, 0.05, 0.05],\n"
-          "                   position: [0.5, 0, 0], dynamic: true, mass: 10,\n"
-          "                   collidable: false}]}\n");
+          "       orientation_deg: [90, 0, 0]" +
+              joint_keys +
+              ",\n"
+              "       children: [{name: arm, type: shape, shape: box, size: [1, 0.05, 0.05],\n"
+              "                   position: [0.5, 0, 0], dynamic: true, mass: 10,\n"
+              "                   collidable: false}]}\n");
     LoadedWorld w = Load("simulation: {physics: ode, time_step: 0.01" + ode +
-                         "}\nmodels:\n  - model: bar.yaml\n    position: [0, 0, 1]\n" +
-                         entry_keys);
+                         "}\nmodels:\n  - model: bar.yaml\n    position: [0, 0, 1]\n" + entry_keys);
     w.world->Start();
     for (int k = 0; k < 100; ++k) w.world->Step();
     const Scene& scene = w.world->scene();
@@ -261,10 +288,10 @@ TEST_F(OdeLimitTest, BadValuesAreErrorsNamingTheirPlace) {
   // The same keys are checked under another backend (and are then unused).
   EXPECT_CONTAINS(error("simulation: {physics: box2d, ode: {cfm: -1}}\n"), "world.yaml:1:41: ");
   // A joint's own, and a models entry's.
-  Write("j.yaml",
-        "model: j\nobjects:\n  type: joint\n  limit_cfm: -1\n");
-  EXPECT_CONTAINS(error("simulation: {physics: ode}\nmodels: [{model: j.yaml, position: [0, 0]}]\n"),
-                  "j.yaml:4:14: ");
+  Write("j.yaml", "model: j\nobjects:\n  type: joint\n  limit_cfm: -1\n");
+  EXPECT_CONTAINS(
+      error("simulation: {physics: ode}\nmodels: [{model: j.yaml, position: [0, 0]}]\n"),
+      "j.yaml:4:14: ");
   Write("k.yaml", "model: k\nobjects:\n  type: joint\n");
   EXPECT_CONTAINS(error("simulation: {physics: ode}\nmodels:\n  - model: k.yaml\n"
                         "    position: [0, 0]\n    joints: {limit_erp: 1.5}\n"),
@@ -283,9 +310,9 @@ TEST(OdeSectionTest, EveryKeyIsDocumented) {
   const size_t section = readme.find("#### ODE settings");
   ASSERT_NE(section, std::string::npos);
   for (const ObjectKey& key : ode::Section().keys)
-    EXPECT_NE(readme.find("| `" + std::string(key.name) + "` | `" + key.default_text + "` |",
-                          section),
-              std::string::npos)
+    EXPECT_NE(
+        readme.find("| `" + std::string(key.name) + "` | `" + key.default_text + "` |", section),
+        std::string::npos)
         << key.name;
 }
 
