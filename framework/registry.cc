@@ -15,7 +15,7 @@ namespace swarmsim {
 void ModuleRegistry::RegisterDynamics(ModuleInfo info, DynamicsCapabilities capabilities,
                                       DynamicsFactory factory, BareLoop bare_loop) {
   info.kind = "dynamics";
-  dynamics_.push_back({info.name, capabilities, std::move(factory), std::move(bare_loop)});
+  dynamics_.push_back({info.name, capabilities, std::move(factory), std::move(bare_loop), nullptr});
   modules_.push_back(std::move(info));
 }
 

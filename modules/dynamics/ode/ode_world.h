@@ -69,9 +69,9 @@ struct SimJoint {
   Quat q_JB0, ball0;    // spherical: child rotation in J and ball at Build
   dBodyID child_body;
   // A dependent joint (a URDF mimic) whose master ODE simulates too: its
-  // index in joints_, and q = offset + factor * q_master. -1: none.
+  // index in joints_, and q = master_offset + master_factor * q_master. -1: none.
   int32_t master = -1;
-  double factor = 1, offset = 0;
+  double master_factor = 1, master_offset = 0;
 };
 
 // A force sensor: a fixed joint with feedback between its child body and the
