@@ -15,6 +15,14 @@ class Scene;
 class StateHasher;
 class TaskScheduler;
 
+// A backend's own settings, read from the world file's `simulation.<backend>`
+// mapping (`simulation: {physics: ode, ode: {erp: 0.2}}`) by the reader the
+// backend registered (ModuleRegistry::RegisterDynamicsSection). Each backend
+// derives its own and casts back in Build.
+struct DynamicsOptions {
+  virtual ~DynamicsOptions() = default;
+};
+
 struct DynamicsSettings {
   double gravity = 9.81;  // m/s^2, magnitude; 2D backends use it for ground friction
   // Regions of the arena stepped independently (simulation.physics_partitions):
@@ -25,6 +33,9 @@ struct DynamicsSettings {
   // changes results: the same world gives the same state for any thread
   // count. Null: everything on the caller's thread.
   TaskScheduler* scheduler = nullptr;
+  // The world's `simulation.<backend>` settings (WorldSettings::physics_options),
+  // or null: the backend's defaults.
+  std::shared_ptr<const DynamicsOptions> options;
 };
 
 // What a backend simulates, declared when it registers

@@ -15,8 +15,23 @@ namespace swarmsim {
 void ModuleRegistry::RegisterDynamics(ModuleInfo info, DynamicsCapabilities capabilities,
                                       DynamicsFactory factory, BareLoop bare_loop) {
   info.kind = "dynamics";
-  dynamics_.push_back({info.name, capabilities, std::move(factory), std::move(bare_loop)});
+  dynamics_.push_back({info.name, capabilities, std::move(factory), std::move(bare_loop), nullptr});
   modules_.push_back(std::move(info));
+}
+
+void ModuleRegistry::RegisterDynamicsSection(const std::string& name, DynamicsSection section) {
+  for (Dynamics& d : dynamics_)
+    if (d.name == name) {
+      d.section = std::make_shared<const DynamicsSection>(std::move(section));
+      return;
+    }
+  throw Error("no dynamics backend '" + name + "' to give a settings section");
+}
+
+const DynamicsSection* ModuleRegistry::FindDynamicsSection(const std::string& name) const {
+  for (const Dynamics& d : dynamics_)
+    if (d.name == name) return d.section.get();
+  return nullptr;
 }
 
 void ModuleRegistry::RegisterModule(ModuleDescriptor module) {

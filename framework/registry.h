@@ -19,7 +19,9 @@
 namespace swarmsim {
 
 class DynamicsBackend;
+class ObjectReader;
 class Scene;
+struct ObjectKey;
 struct ObjectTypeDescriptor;
 struct PluginControllerType;
 struct VisionFilterDescriptor;
@@ -58,6 +60,15 @@ struct PluginSensorType {
   int max_values = SWARMSIM_SENSOR_MAX_VALUES;  // numbers one reading holds at most
 };
 
+// A backend's own mapping in the world's `simulation:` section, under the
+// backend's name (`simulation: {physics: ode, ode: {solver: world}}`): its
+// keys with defaults and docs (worlds/README.md lists them) and a reader.
+struct DynamicsSection {
+  std::span<const ObjectKey> keys;
+  // Reads the mapping (errors name file:line:column through the reader).
+  std::function<std::shared_ptr<const DynamicsOptions>(const ObjectReader& reader)> read;
+};
+
 class ModuleRegistry {
  public:
   using DynamicsFactory = std::function<std::unique_ptr<DynamicsBackend>()>;
@@ -70,6 +81,11 @@ class ModuleRegistry {
   // Dynamics backends: kind "dynamics", chosen by a world's `physics:`.
   void RegisterDynamics(ModuleInfo info, DynamicsCapabilities capabilities, DynamicsFactory factory,
                         BareLoop bare_loop = {});
+  // The settings section of the registered backend `name` (throws Error if
+  // there is no such backend).
+  void RegisterDynamicsSection(const std::string& name, DynamicsSection section);
+  // Null if backend `name` has none (or is not registered).
+  const DynamicsSection* FindDynamicsSection(const std::string& name) const;
   // Modules (framework/module.h): every other kind. Throws swarmsim::Error
   // if the name is taken or the descriptor has no `make`.
   void RegisterModule(ModuleDescriptor module);
@@ -170,6 +186,7 @@ class ModuleRegistry {
     DynamicsCapabilities capabilities;
     DynamicsFactory factory;
     BareLoop bare_loop;
+    std::shared_ptr<const DynamicsSection> section;  // null: none
   };
   std::vector<Dynamics> dynamics_;
   // Shared: a world's copy of the registry (plus its plugins) keeps them.

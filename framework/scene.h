@@ -123,7 +123,11 @@ struct JointSettings {
   double damping = 0;               // N m s/rad or N s/m: viscous -damping * velocity (ode)
   double min_position = -INFINITY;  // limits, rad or m (infinite: unlimited)
   double max_position = INFINITY;
-  double pitch = 0;                                // screw joints: m per rad, finite and nonzero
+  double pitch = 0;  // screw joints: m per rad, finite and nonzero
+  // ode: the limits' (stops') ERP, 0..1, and CFM, 0..1; negative: the
+  // world's (simulation.ode.limit_erp, limit_cfm).
+  double limit_erp = -1;
+  double limit_cfm = -1;
   std::shared_ptr<const JointDependency> depends;  // null: an independent joint
   // Actuation noise, velocity mode (a wheel's motor): the speed driven is
   // target * (1 - slip) * (1 + N(0, velocity_noise_factor)) + noise, and

@@ -282,6 +282,7 @@ void World::Start() {
   dynamics_settings.gravity = settings_.gravity;
   dynamics_settings.partitions = settings_.physics_partitions;
   dynamics_settings.scheduler = scheduler_.get();
+  dynamics_settings.options = settings_.physics_options;
   dynamics_->Build(scene_, dynamics_settings);
   dynamics_->MarkSimulatedJoints(&scene_);
   // Dependent joints start where their masters put them.

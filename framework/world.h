@@ -34,6 +34,7 @@ namespace swarmsim {
 
 using CalculationModule = Module;  // framework/calculation_module.h
 class DynamicsBackend;
+struct DynamicsOptions;
 class FloorLayer;
 class IrAccess;
 class LedAccess;
@@ -67,6 +68,9 @@ struct WorldSettings {
   int threads = 0;                  // <= 0: all cores
   double gravity = 9.81;            // m/s^2
   double octree_resolution = 0.05;  // m
+  // The backend's own settings (`simulation: {ode: {...}}`, read by the
+  // section it registered), or null: its defaults.
+  std::shared_ptr<const DynamicsOptions> physics_options;
   // The world's own main script (null: the default step). Its sysCall_step
   // runs the phases through sim.handleSensing(), sim.handleChildScripts(), ...
   std::shared_ptr<const ScriptSource> main_script;

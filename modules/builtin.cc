@@ -50,6 +50,7 @@ void RegisterBuiltinModules(ModuleRegistry* registry) {
   registry->RegisterDynamics(
       ode::ModuleInfo(), {.planar = false}, [] { return ode::MakeBackend(); },
       BareLoop<ode::TimeBareLoop>);
+  registry->RegisterDynamicsSection("ode", ode::Section());  // simulation: {ode: {...}}
   registry->RegisterDynamics(kinematic::ModuleInfo(), {.planar = false, .substeps = false},
                              [] { return kinematic::MakeBackend(); });
   registry->RegisterDynamics(

@@ -34,6 +34,10 @@ constexpr ObjectKey kKeys[] = {
     {"damping", "0",
      "N m s/rad or N s/m, >= 0: a viscous torque or force -damping * velocity (ode)"},
     {"limits", "none", "[min, max], rad or m: ODE stops, and IK keeps solutions inside"},
+    {"limit_erp", "simulation.ode's",
+     "0..1, ode: how much of a limit's violation is corrected each substep (1: all)"},
+    {"limit_cfm", "simulation.ode's",
+     "0..1, ode: the limits' softness (0: hard; larger: they give under load)"},
     {"master", "none", "path of the joint this one follows: q = offset + factor * q_master"},
     {"factor", "1", "dependent joints: factor of the master's position"},
     {"offset", "0", "dependent joints: rad or m added"},
@@ -151,6 +155,8 @@ void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
     settings.min_position = v[0];
     settings.max_position = v[1];
   }
+  if (r.Has("limit_erp")) settings.limit_erp = r.Number("limit_erp", kFraction);
+  if (r.Has("limit_cfm")) settings.limit_cfm = r.Number("limit_cfm", kFraction);
   ReadNoise(r, "velocity_", 1e6, &settings.velocity_noise);
   if (r.Has("velocity_noise_factor"))
     settings.velocity_noise_factor =

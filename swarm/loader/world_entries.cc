@@ -11,6 +11,7 @@
 
 #include "framework/error.h"
 #include "framework/model_section.h"
+#include "framework/object_type.h"
 #include "framework/plugin_controllers.h"
 #include "framework/registry.h"
 #include "framework/world_section.h"
@@ -103,6 +104,27 @@ void ShareScaledMeshes(const ObjectSpec& spec, ObjectId id, Scene* scene, Scaled
   for (size_t i = 0; i < spec.children.size() && i < children.size(); ++i)
     ShareScaledMeshes(spec.children[i], children[i], scene, scaled);
 }
+
+// The entry's `joints:` settings on every joint of `spec` that has no value
+// of its own (a negative limit_erp, limit_cfm: an imported robot's joints),
+// each in a row of its own (rows may be shared with other entries).
+void SetJointLimitSoftness(double limit_erp, double limit_cfm, ObjectSpec* spec) {
+  if (const JointData* joint = spec->As<JointData>(ObjectType::kJoint)) {
+    const bool erp = limit_erp >= 0 && joint->settings->limit_erp < 0;
+    const bool cfm = limit_cfm >= 0 && joint->settings->limit_cfm < 0;
+    if (erp || cfm) {
+      const ObjectTypeDescriptor& type =
+          *CoreObjectTypes()[static_cast<size_t>(ObjectType::kJoint)];
+      std::shared_ptr<RowTable> row = type.make_rows(type);
+      row->Append(joint, 0);
+      JointSettings& settings = static_cast<JointData*>(row->At(0))->settings.Edit();
+      if (erp) settings.limit_erp = limit_erp;
+      if (cfm) settings.limit_cfm = limit_cfm;
+      spec->row = std::move(row);
+    }
+  }
+  for (ObjectSpec& child : spec->children) SetJointLimitSoftness(limit_erp, limit_cfm, &child);
+}
 }  // namespace
 
 // --- Resolving an entry ----------------------------------------------------------------
@@ -115,8 +137,9 @@ std::vector<std::string> ModelSectionKeys(const ModuleRegistry& registry) {
 
 std::vector<std::string> EntryKeys(const ModuleRegistry& registry) {
   std::vector<std::string> keys = {
-      "model",      "count",     "distribute", "position", "heading_deg", "orientation_deg",
-      "parameters", "instances", "scale",      "base",     "objects",     "scripts"};
+      "model",           "count",      "distribute", "position", "heading_deg",
+      "orientation_deg", "parameters", "instances",  "scale",    "base",
+      "objects",         "scripts",    "joints"};
   for (std::string& key : ModelSectionKeys(registry)) keys.push_back(std::move(key));
   keys.insert(keys.end(), {"python_controller", "native_controller"});
   return keys;
@@ -409,6 +432,16 @@ void WorldLoader::ExtendObjects(const Fields& f, const ValueReader& world_values
                         "'base' applies to URDF models (a model file says which shapes "
                         "are dynamic itself)");
     if (kind == "floating") *spec = loader::WithFloatingBase(*spec, file_->Where(base.mark));
+  }
+  if (f.Has("joints")) {
+    // Joint settings for every joint of the model without its own (ode).
+    Fields joints(*file_, f.Get("joints"), "'joints'");
+    joints.Expect({"limit_erp", "limit_cfm"});
+    const double erp =
+        joints.Has("limit_erp") ? world_values.Number(joints.Get("limit_erp"), kFraction) : -1;
+    const double cfm =
+        joints.Has("limit_cfm") ? world_values.Number(joints.Get("limit_cfm"), kFraction) : -1;
+    SetJointLimitSoftness(erp, cfm, spec);
   }
   if (f.Has("objects")) {
     std::vector<ObjectSpec> extra = loader::ReadSceneObjects(*file_, f.Get("objects"), world_values,

@@ -358,9 +358,26 @@ WorldSettings WorldLoader::ReadSimulation(const Fields& top, std::optional<int64
   const Field sim = top.Get("simulation");
   if (sim.present()) {
     Fields f(*file_, sim, "'simulation'");
-    f.Expect({"physics", "time_step", "physics_substeps", "physics_partitions", "seed", "duration",
-              "steps", "gravity", "octree_resolution", "main_script", "instruction_budget",
-              "script_memory_mb", "run_script_memory_mb", "step_timeout", "on_script_error"});
+    // The loader's keys, and a mapping per backend with settings of its own
+    // (`ode: {...}`: ModuleRegistry::RegisterDynamicsSection).
+    std::vector<std::string> known = {"physics",
+                                      "time_step",
+                                      "physics_substeps",
+                                      "physics_partitions",
+                                      "seed",
+                                      "duration",
+                                      "steps",
+                                      "gravity",
+                                      "octree_resolution",
+                                      "main_script",
+                                      "instruction_budget",
+                                      "script_memory_mb",
+                                      "run_script_memory_mb",
+                                      "step_timeout",
+                                      "on_script_error"};
+    for (const std::string& name : registry_.DynamicsNames())
+      if (registry_.FindDynamicsSection(name)) known.push_back(name);
+    f.Expect(std::span<const std::string>(known));
     if (f.Has("main_script")) {
       const Field main = f.Get("main_script");
       const std::string text = values.String(main);
@@ -397,6 +414,21 @@ WorldSettings WorldLoader::ReadSimulation(const Fields& top, std::optional<int64
                                  (hint.starts_with(";") ? hint : "") +
                                  " (available: " + (list.empty() ? "none" : list) + ")");
       }
+    }
+    // Each backend's own mapping is read and checked whatever `physics` is
+    // (a bad value is an error either way); the chosen backend's is used.
+    for (const std::string& name : registry_.DynamicsNames()) {
+      const DynamicsSection* section = registry_.FindDynamicsSection(name);
+      if (!section || !f.Has(name)) continue;
+      const FieldsObjectReader sim_reader(values, f, nullptr, &registry_);
+      const std::unique_ptr<ObjectReader> r =
+          sim_reader.Map(name, "'simulation." + name + "'", "a mapping of " + name + " settings");
+      if (!r) continue;
+      std::vector<std::string> keys;
+      for (const ObjectKey& key : section->keys) keys.emplace_back(key.name);
+      r->Expect(keys);
+      std::shared_ptr<const DynamicsOptions> options = section->read(*r);
+      if (name == s.physics) s.physics_options = std::move(options);
     }
     if (f.Has("time_step"))
       s.time_step =

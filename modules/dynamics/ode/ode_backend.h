@@ -31,9 +31,21 @@
 //     kinematic (moved by World::Actuate). Modes: passive (free, limits
 //     only), velocity (motor to target_velocity with max_force), position
 //     (servo: motor velocity 0.5 error / dt clamped to max_velocity, with
-//     max_force), force (target_force applied each substep). Limits
-//     (min/max_position) become ODE stops. Revolute positions are unwrapped
-//     (a wheel's angle keeps growing).
+//     max_force), force (target_force applied each substep). A dependent
+//     joint (JointSettings::depends, a URDF mimic) whose master ODE simulates
+//     is servoed every substep to offset + factor * the master's position, at
+//     factor * the master's motor speed plus a correction. Limits
+//     (min/max_position) become ODE stops, with their own ERP and CFM (the
+//     joint's limit_erp/limit_cfm, else Options::limit_erp/limit_cfm, else
+//     erp/cfm) and a fudge factor of 0 (no jump when a motor drives a joint
+//     away from its stop). Revolute positions are unwrapped (a wheel's angle
+//     keeps growing).
+//
+// Solver (Options::solver, the world's `simulation.ode`): dWorldStep (exact)
+// or dWorldQuickStep (iterative); `auto` takes the exact one for worlds of at
+// most kExactSolverBodies dynamic bodies at Build (an arm holds its
+// commanded configuration to the joints' CFM under load, 3e-6 m for the
+// Panda), quickstep above (swarms: the solver is the cost).
 //
 // Contacts: up to Options::max_contacts per geom pair, friction the geometric
 // mean of the two shapes' (pyramid approximation), restitution the larger of
@@ -102,6 +114,9 @@ namespace swarmsim::ode {
 swarmsim::ModuleInfo ModuleInfo();
 std::unique_ptr<DynamicsBackend> MakeBackend();
 std::unique_ptr<DynamicsBackend> MakeBackend(const Options& options);
+// The world file's `simulation.ode` mapping: its keys and reader
+// (ode_section.cc), registered beside the backend (modules/builtin.cc).
+DynamicsSection Section();
 
 // ODE alone, for the bench's `ode-only` row: builds the same ODE world from
 // `scene`, reads the joint commands once, then runs steps x substeps ODE

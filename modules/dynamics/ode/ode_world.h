@@ -68,6 +68,10 @@ struct SimJoint {
   Pose X_AJ;            // joint frame in A (in the world if A is null)
   Quat q_JB0, ball0;    // spherical: child rotation in J and ball at Build
   dBodyID child_body;
+  // A dependent joint (a URDF mimic) whose master ODE simulates too: its
+  // index in joints_, and q = master_offset + master_factor * q_master. -1: none.
+  int32_t master = -1;
+  double master_factor = 1, master_offset = 0;
 };
 
 // A force sensor: a fixed joint with feedback between its child body and the
@@ -151,6 +155,8 @@ class OdeWorld {
   // ODE's trimesh data for a mesh asset, made once per world (ode_world.cc).
   dTriMeshDataID MeshData(const std::shared_ptr<const TriangleMesh>& mesh);
   void ApplyMotors(double dt);
+  // Links each dependent joint to its master's index (SimJoint::master).
+  void LinkDependentJoints(const Scene& scene);
   void TrackJointPositions();
   // The space holding the geoms of `instance` (the top-level space for -1).
   dSpaceID SpaceOf(int32_t instance);
@@ -194,6 +200,10 @@ class OdeWorld {
   std::vector<std::vector<MeshTriangle>> single_triangle_meshes_;
   // Joint commands, read once per control step (rows of joints_).
   std::vector<JointCommand> commands_;
+  // Each joint's motor velocity this substep (ApplyMotors): a dependent
+  // joint's feed-forward is its master's.
+  std::vector<double> motor_velocity_;
+  bool exact_solver_ = false;   // dWorldStep (Options::solver, or auto by body count; Build)
   double step_dt_ = 0;          // substep length, for the servo
   uint64_t substeps_done_ = 0;  // seeds each substep's constraint shuffles
   bool broken_ = false;         // an ODE call was unwound by an error (Substep)
