@@ -29,6 +29,7 @@
 #include "modules/builtin.h"
 #include "swarm/loader/world_loader.h"
 #include "swarm/python/arrays.h"
+#include "swarm/python/snapshot.h"
 
 namespace py = pybind11;
 
@@ -198,6 +199,8 @@ void ApplyTargets(World* world, const ModelLayout& layout, const ControllerConfi
 class ControllerModule : public Module {
  public:
   explicit ControllerModule(const ControllerConfig& config) : config_(config) {}
+  // Snapshots: the controller's own memory is the Python program's, not saved.
+  bool SaveState(StateWriter*) const override { return true; }
   ~ControllerModule() override {
     py::gil_scoped_acquire gil;
     config_.function = py::object();
@@ -274,7 +277,8 @@ class PyWorld {
   PyWorld(const std::string& path, std::optional<uint64_t> seed,
           const std::map<std::string, py::object>& set, int threads,
           const std::map<std::string, py::object>& controllers,
-          const std::vector<std::string>& package_path) {
+          const std::vector<std::string>& package_path)
+      : args_{path, seed, set, threads, controllers, package_path} {
     LoadOptions options;
     for (const std::string& dir : package_path) options.package_path.emplace_back(dir);
     options.seed = seed;
@@ -295,6 +299,7 @@ class PyWorld {
       throw py::value_error(e.what());
     }
     World& world = *loaded_.world;
+    loaded_seed_ = world.settings().seed;
     planar_ = world.registry().dynamics_capabilities(world.settings().physics).planar;
     // Controllers: the world file's, then the constructor's (replacing them).
     std::map<std::string, ControllerConfig> configs;
@@ -326,6 +331,75 @@ class PyWorld {
     }
   }
   ~PyWorld() { Close(); }
+
+  // --- Snapshots, reset and pickling (snapshot.cc; framework/world_state.h) -----------
+  py::bytes snapshot() {
+    World& w = Live();
+    std::string bytes;
+    try {
+      py::gil_scoped_release release;
+      bytes = PackSnapshot(&w, Metrics());
+    } catch (const Error& e) {
+      throw std::runtime_error(e.what());
+    }
+    return py::bytes(bytes);
+  }
+  void restore(const py::bytes& data) {
+    World& w = Live();
+    const std::string_view bytes(PyBytes_AS_STRING(data.ptr()),
+                                 static_cast<size_t>(PyBytes_GET_SIZE(data.ptr())));
+    try {
+      py::gil_scoped_release release;
+      UnpackSnapshot(bytes, &w, Metrics());
+    } catch (const Error& e) {
+      throw py::value_error(e.what());
+    }
+  }
+  // The world as a fresh load with `seed` (None: the seed it was loaded
+  // with) leaves it, in place: the snapshot of the world before its first
+  // step (taken then, or from a load with the same arguments if it has
+  // stepped), with the seed's random streams and the robots placed as the
+  // loader places them with it.
+  void reset(std::optional<uint64_t> seed) {
+    World& w = Live();
+    if (initial_.empty()) {
+      if (w.step_count() == 0 && history_.empty()) {
+        initial_ = snapshot();
+      } else {
+        PyWorld fresh(args_.path, loaded_seed_, args_.set, args_.threads, args_.controllers,
+                      args_.package_path);
+        initial_ = fresh.snapshot();
+      }
+    }
+    const uint64_t s = seed.value_or(loaded_seed_);
+    const std::string_view bytes(initial_);
+    try {
+      py::gil_scoped_release release;
+      if (s == loaded_seed_) {
+        UnpackSnapshot(bytes, &w, Metrics());
+      } else {
+        const std::vector<std::pair<int, Pose>> roots = loaded_.placement(s);
+        const World::Reseed reseed{s, roots};
+        UnpackSnapshot(bytes, &w, Metrics(), &reseed);
+      }
+    } catch (const Error& e) {
+      throw py::value_error(e.what());
+    }
+  }
+  py::tuple getstate() {
+    return py::make_tuple(args_.path, args_.seed, args_.set, args_.threads, args_.controllers,
+                          args_.package_path, snapshot());
+  }
+  static std::unique_ptr<PyWorld> setstate(const py::tuple& t) {
+    if (t.size() != 7) throw py::value_error("World.__setstate__: not a pickled World");
+    auto w = std::make_unique<PyWorld>(
+        t[0].cast<std::string>(), t[1].cast<std::optional<uint64_t>>(),
+        t[2].cast<std::map<std::string, py::object>>(), t[3].cast<int>(),
+        t[4].cast<std::map<std::string, py::object>>(), t[5].cast<std::vector<std::string>>());
+    w->restore(t[6].cast<py::bytes>());
+    return w;
+  }
+  MetricMaps Metrics() { return {&swarm_metrics_, &robot_metrics_, &history_}; }
 
   void Step(int64_t n) {
     World& w = Live();
@@ -555,6 +629,18 @@ class PyWorld {
   std::map<std::string, double> swarm_metrics_;
   std::map<std::string, std::map<int, double>> robot_metrics_;
   std::map<std::string, std::vector<std::pair<int64_t, double>>> history_;
+  // The constructor's arguments (pickling, reset with another seed), the
+  // seed the world was loaded with, and fresh worlds' snapshots by seed.
+  struct Args {
+    std::string path;
+    std::optional<uint64_t> seed;
+    std::map<std::string, py::object> set;
+    int threads;
+    std::map<std::string, py::object> controllers;
+    std::vector<std::string> package_path;
+  } args_;
+  uint64_t loaded_seed_ = 0;
+  std::string initial_;  // reset: the snapshot before the first step ("": not yet taken)
 };
 
 }  // namespace
@@ -629,6 +715,14 @@ PYBIND11_MODULE(_swarmsim, m) {
       .def_property_readonly("metrics", &PyWorld::metrics)
       .def("robot_metric", &PyWorld::robot_metric, py::arg("name"))
       .def("metric_history", &PyWorld::metric_history, py::arg("name"))
+      .def("snapshot", &PyWorld::snapshot,
+           "The world's state as bytes (README.md, Python: snapshots); restore() puts it back")
+      .def("restore", &PyWorld::restore, py::arg("state"),
+           "Puts the world in the state snapshot() saved (ValueError for another world's or "
+           "corrupt bytes)")
+      .def("reset", &PyWorld::reset, py::arg("seed") = py::none(),
+           "Back to the state of a fresh load with `seed` (None: the world's own), in place")
+      .def(py::pickle([](PyWorld& w) { return w.getstate(); }, &PyWorld::setstate))
       .def("describe", &PyWorld::describe)
       .def_property_readonly("warnings", &PyWorld::warnings);
 }
