@@ -86,7 +86,7 @@ class Module : public SceneListener {
   // between steps returns true writing nothing. The default, false, makes
   // World::SaveState refuse the world, naming the module: a module is not
   // saved by accident.
-  virtual bool SaveState(StateWriter* /*out*/) const { return false; }
+  virtual bool SaveState(const World& /*world*/, StateWriter* /*out*/) const { return false; }
   virtual void LoadState(StateReader* /*in*/, World* /*world*/) {}
   // Once the loader has built every object: throws swarmsim::Error (naming
   // the file:line:column the module kept) for a reference that matches

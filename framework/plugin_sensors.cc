@@ -19,7 +19,7 @@ class PluginSensors final : public Module {
   void Sense(World* world) override;
   bool Reading(const Scene& scene, ObjectId id, std::span<const double>* values) const;
   // Snapshots: a world without plugin sensors has nothing here.
-  bool SaveState(StateWriter*) const override { return sensors_.empty(); }
+  bool SaveState(const World&, StateWriter*) const override { return sensors_.empty(); }
 
  private:
   struct Sensor {  // 40 bytes

@@ -458,6 +458,10 @@ class World : public PhaseHandlers {
   void WriteFingerprint(StateWriter* out) const;
   void CheckFingerprint(StateReader* in) const;
   void RebuildDynamics();
+  // The world file's content hash, read at the first snapshot or restore
+  // (0: no file, or unreadable).
+  mutable uint64_t file_hash_ = 0;
+  mutable bool file_hashed_ = false;
   WorldSettings settings_;
   const ModuleRegistry& registry_;
   std::shared_ptr<const ModuleRegistry> owned_registry_;  // null unless given by shared_ptr

@@ -112,7 +112,11 @@ std::string World::SnapshotRefusal() const {
 
 void World::WriteFingerprint(StateWriter* out) const {
   out->PutString(settings_.file);
-  out->Put(FileHash(settings_.file));
+  if (!file_hashed_) {
+    file_hash_ = FileHash(settings_.file);
+    file_hashed_ = true;
+  }
+  out->Put(file_hash_);
   StateHasher settings;
   settings.Add(settings_.physics.data(), settings_.physics.size());
   settings.AddValue(settings_.time_step);
@@ -139,21 +143,34 @@ void World::CheckFingerprint(StateReader* in) const {
   StateWriter mine;
   WriteFingerprint(&mine);
   StateReader expected(mine.bytes());
-  const std::string file = in->GetString(), my_file = expected.GetString();
-  const std::string of = "the snapshot is of world '" + file + "', this world is '" + my_file + "'";
-  if (in->Get<uint64_t>() != expected.Get<uint64_t>())
+  struct Parts {
+    std::string file;
+    uint64_t file_hash, settings, robots, objects, structure;
+  };
+  const auto read = [](StateReader* r) {
+    Parts p;
+    p.file = r->GetString();
+    p.file_hash = r->Get<uint64_t>();
+    p.settings = r->Get<uint64_t>();
+    p.robots = r->Get<uint64_t>();
+    p.objects = r->Get<uint64_t>();
+    p.structure = r->Get<uint64_t>();
+    return p;
+  };
+  const Parts theirs = read(in), ours = read(&expected);
+  const std::string of =
+      "the snapshot is of world '" + theirs.file + "', this world is '" + ours.file + "'";
+  if (theirs.file_hash != ours.file_hash)
     throw Error("snapshot: " + of + ", and their world files differ: restore into a world "
                 "loaded from the same file");
-  if (in->Get<uint64_t>() != expected.Get<uint64_t>())
+  if (theirs.robots != ours.robots || theirs.objects != ours.objects)
+    throw Error("snapshot: " + of + "; it holds " + std::to_string(theirs.robots) +
+                " robots and " + std::to_string(theirs.objects) + " objects, this world " +
+                std::to_string(ours.robots) + " and " + std::to_string(ours.objects));
+  if (theirs.settings != ours.settings)
     throw Error("snapshot: " + of + ", loaded with other settings or parameters (--set): " +
                 "restore into a world loaded with the same ones");
-  const auto robots = in->Get<uint64_t>(), my_robots = expected.Get<uint64_t>();
-  const auto objects = in->Get<uint64_t>(), my_objects = expected.Get<uint64_t>();
-  if (robots != my_robots || objects != my_objects)
-    throw Error("snapshot: " + of + "; it holds " + std::to_string(robots) + " robots and " +
-                std::to_string(objects) + " objects, this world " + std::to_string(my_robots) +
-                " and " + std::to_string(my_objects));
-  if (in->Get<uint64_t>() != expected.Get<uint64_t>())
+  if (theirs.structure != ours.structure)
     throw Error("snapshot: " + of + "; their objects, names or modules differ (robots copied or "
                 "removed at run time, or controllers given to only one of them)");
 }
@@ -200,7 +217,7 @@ std::string World::SaveState() {
   for (const ModuleEntry& e : modules_) {
     const size_t before = out.bytes().size();
     out.Put<uint64_t>(0);  // the module's bytes, below
-    if (!e.instance->SaveState(&out))
+    if (!e.instance->SaveState(*this, &out))
       throw Error("snapshot: the world's module '" + e.name + "' cannot save its state");
     const uint64_t size = out.bytes().size() - before - sizeof(uint64_t);
     std::memcpy(out.bytes().data() + before, &size, sizeof size);

@@ -30,7 +30,7 @@ void RobotPositions(const World& world, std::vector<GridItem>* out) {
 class MeanNearestNeighborDistance : public Observer {
  public:
   explicit MeanNearestNeighborDistance(int every) : every_(every) {}
-  bool SaveState(StateWriter*) const override { return true; }  // nothing kept between steps
+  bool SaveState(const World&, StateWriter*) const override { return true; }  // nothing kept between steps
   void Record(const World& world, std::vector<MetricSample>* out) override {
     if (world.step_count() % every_ != 0) return;
     RobotPositions(world, &items_);
@@ -66,7 +66,7 @@ class CoveredArea : public Observer {
  public:
   explicit CoveredArea(int every) : every_(every) {}
   // Snapshots: the cells visited so far, in ascending order.
-  bool SaveState(StateWriter* out) const override {
+  bool SaveState(const World&, StateWriter* out) const override {
     std::vector<uint64_t> cells(visited_.begin(), visited_.end());
     std::sort(cells.begin(), cells.end());
     out->Put<uint64_t>(cells.size());

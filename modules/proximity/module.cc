@@ -43,7 +43,7 @@ class ProximityModule final : public Module, public ProximityReadings {
 
   // Snapshots: the readings are the rows'; only the seed may change (a
   // snapshot of another seed: the backend draws from it).
-  bool SaveState(StateWriter*) const override { return true; }
+  bool SaveState(const World&, StateWriter*) const override { return true; }
   void LoadState(StateReader*, World* world) override {
     if (settings_.seed == world->settings().seed) return;
     settings_.seed = world->settings().seed;

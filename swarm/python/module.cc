@@ -200,7 +200,7 @@ class ControllerModule : public Module {
  public:
   explicit ControllerModule(const ControllerConfig& config) : config_(config) {}
   // Snapshots: the controller's own memory is the Python program's, not saved.
-  bool SaveState(StateWriter*) const override { return true; }
+  bool SaveState(const World&, StateWriter*) const override { return true; }
   ~ControllerModule() override {
     py::gil_scoped_acquire gil;
     config_.function = py::object();
@@ -333,16 +333,15 @@ class PyWorld {
   ~PyWorld() { Close(); }
 
   // --- Snapshots, reset and pickling (snapshot.cc; framework/world_state.h) -----------
-  py::bytes snapshot() {
+  py::bytes snapshot() { return py::bytes(SnapshotBytes()); }
+  std::string SnapshotBytes() {
     World& w = Live();
-    std::string bytes;
     try {
       py::gil_scoped_release release;
-      bytes = PackSnapshot(&w, Metrics());
+      return PackSnapshot(&w, Metrics());
     } catch (const Error& e) {
       throw std::runtime_error(e.what());
     }
-    return py::bytes(bytes);
   }
   void restore(const py::bytes& data) {
     World& w = Live();
@@ -364,11 +363,11 @@ class PyWorld {
     World& w = Live();
     if (initial_.empty()) {
       if (w.step_count() == 0 && history_.empty()) {
-        initial_ = snapshot();
+        initial_ = SnapshotBytes();
       } else {
         PyWorld fresh(args_.path, loaded_seed_, args_.set, args_.threads, args_.controllers,
                       args_.package_path);
-        initial_ = fresh.snapshot();
+        initial_ = fresh.SnapshotBytes();
       }
     }
     const uint64_t s = seed.value_or(loaded_seed_);

@@ -41,7 +41,7 @@ class Counter : public Observer {
   void Record(const World& world, std::vector<MetricSample>* out) override {
     out->push_back({world.step_count(), world.time(), -1, "count", double(++count_)});
   }
-  bool SaveState(StateWriter* out) const override {
+  bool SaveState(const World&, StateWriter* out) const override {
     if (saves_) out->Put(count_);
     return saves_;
   }
@@ -89,7 +89,7 @@ void Drive(World* world) {
   world->scene().joints()[0].target_velocity = 0.5 + 0.1 * double(world->step_count() % 3);
 }
 
-void Run(World* world, int steps) {
+void StepDriven(World* world, int steps) {
   for (int i = 0; i < steps; ++i) {
     Drive(world);
     world->Step();
@@ -98,16 +98,16 @@ void Run(World* world, int steps) {
 
 TEST(WorldStateTest, RestorePlusStepsEqualsTheUninterruptedRun) {
   auto original = MakeWorld(2);
-  Run(original.get(), 3);
+  StepDriven(original.get(), 3);
   const std::string bytes = original->SaveState();
-  Run(original.get(), 4);
+  StepDriven(original.get(), 4);
   const uint64_t expected = original->StateHash();
   const auto metrics = original->TakeMetrics();
 
   auto restored = MakeWorld(2);
   restored->RestoreState(bytes);
   EXPECT_EQ(restored->step_count(), 3);
-  Run(restored.get(), 4);
+  StepDriven(restored.get(), 4);
   EXPECT_EQ(restored->StateHash(), expected);
   // The metric's running count came back too (7 at step 7, not 4).
   const auto again = restored->TakeMetrics();
@@ -116,16 +116,16 @@ TEST(WorldStateTest, RestorePlusStepsEqualsTheUninterruptedRun) {
   EXPECT_EQ(again.back().value, metrics.back().value);
   // Restoring into the original takes it back as well.
   original->RestoreState(bytes);
-  Run(original.get(), 4);
+  StepDriven(original.get(), 4);
   EXPECT_EQ(original->StateHash(), expected);
 }
 
 TEST(WorldStateTest, TruncatedOrMutatedBytesAreErrorsThatChangeNothing) {
   auto source = MakeWorld(2);
-  Run(source.get(), 2);
+  StepDriven(source.get(), 2);
   const std::string bytes = source->SaveState();
   auto world = MakeWorld(2);
-  Run(world.get(), 5);
+  StepDriven(world.get(), 5);
   const uint64_t before = world->StateHash();
   int errors = 0, tries = 0;
   for (size_t size = 0; size < bytes.size(); size += 1 + size / 7) {
@@ -149,7 +149,7 @@ TEST(WorldStateTest, TruncatedOrMutatedBytesAreErrorsThatChangeNothing) {
   }
   EXPECT_EQ(errors, tries);
   EXPECT_EQ(world->StateHash(), before);
-  Run(world.get(), 1);  // still steps
+  StepDriven(world.get(), 1);  // still steps
   EXPECT_EQ(world->step_count(), 6);
 }
 

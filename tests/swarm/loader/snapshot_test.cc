@@ -53,7 +53,7 @@ void Drive(World* world) {
   }
 }
 
-void Run(World* world, int64_t until) {
+void StepDriven(World* world, int64_t until) {
   while (world->step_count() < until) {
     Drive(world);
     world->Step();
@@ -68,7 +68,7 @@ TEST_P(SnapshotTest, RestorePlusStepsEqualsTheUninterruptedRun) {
   std::map<int64_t, std::string> snapshots;
   std::map<int64_t, uint64_t> hashes;
   for (const int64_t at : {0, 6, 19, 30, 40}) {
-    Run(original.world.get(), at);
+    StepDriven(original.world.get(), at);
     if (at == 0 || at == 6 || at == 19) snapshots[at] = original.world->SaveState();
     hashes[at] = original.world->StateHash();
   }
@@ -81,7 +81,7 @@ TEST_P(SnapshotTest, RestorePlusStepsEqualsTheUninterruptedRun) {
     EXPECT_EQ(restored.world->StateHash(), hashes[at]) << GetParam() << " restored at " << at;
     for (const int64_t later : {19, 30, 40}) {
       if (later <= at) continue;
-      Run(restored.world.get(), later);
+      StepDriven(restored.world.get(), later);
       EXPECT_EQ(restored.world->StateHash(), hashes[later])
           << GetParam() << ": restored at step " << at << ", compared at " << later;
     }
@@ -94,25 +94,25 @@ TEST_P(SnapshotTest, RestorePlusStepsEqualsTheUninterruptedRun) {
 TEST_P(SnapshotTest, ReseededRestoreEqualsAFreshLoadWithThatSeed) {
   LoadedWorld first = Load(GetParam(), 1);
   const std::string initial = first.world->SaveState();
-  Run(first.world.get(), 5);
+  StepDriven(first.world.get(), 5);
   const auto roots = first.placement(9);
   ASSERT_EQ(roots.size(), 30u);
   const World::Reseed reseed{9, roots};
   first.world->RestoreState(initial, &reseed);
   EXPECT_EQ(first.world->step_count(), 0);
   EXPECT_EQ(first.world->settings().seed, 9u);
-  Run(first.world.get(), 12);
+  StepDriven(first.world.get(), 12);
 
   LoadedWorld fresh = Load(GetParam(), 9);
   fresh.world->Start();
-  Run(fresh.world.get(), 12);
+  StepDriven(fresh.world.get(), 12);
   EXPECT_EQ(first.world->StateHash(), fresh.world->StateHash()) << GetParam();
   // And back to the world's own seed: the world as it was loaded.
   first.world->RestoreState(initial);
   LoadedWorld again = Load(GetParam(), 1);
   again.world->Start();
-  Run(first.world.get(), 4);
-  Run(again.world.get(), 4);
+  StepDriven(first.world.get(), 4);
+  StepDriven(again.world.get(), 4);
   EXPECT_EQ(first.world->StateHash(), again.world->StateHash()) << GetParam();
 }
 
