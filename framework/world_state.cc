@@ -78,11 +78,13 @@ void StateReader::Expect(uint64_t value, uint64_t expected, std::string_view wha
          std::to_string(expected));
 }
 
-// --- World ----------------------------------------------------------------------------------------
+// --- World
+// ----------------------------------------------------------------------------------------
 
 std::string World::SnapshotRefusal() const {
-  const std::string why = ", whose state cannot be saved; drive the robots from Python "
-                          "(python_controller or World(controllers=...)) instead";
+  const std::string why =
+      ", whose state cannot be saved; drive the robots from Python "
+      "(python_controller or World(controllers=...)) instead";
   if (settings_.main_script)
     return "the world runs the main script '" + settings_.main_script->path + "'" + why;
   for (uint32_t s = 0; s < scene_.slot_count(); ++s) {
@@ -161,17 +163,19 @@ void World::CheckFingerprint(StateReader* in) const {
   const std::string of =
       "the snapshot is of world '" + theirs.file + "', this world is '" + ours.file + "'";
   if (theirs.file_hash != ours.file_hash)
-    throw Error("snapshot: " + of + ", and their world files differ: restore into a world "
+    throw Error("snapshot: " + of +
+                ", and their world files differ: restore into a world "
                 "loaded from the same file");
   if (theirs.robots != ours.robots || theirs.objects != ours.objects)
-    throw Error("snapshot: " + of + "; it holds " + std::to_string(theirs.robots) +
-                " robots and " + std::to_string(theirs.objects) + " objects, this world " +
+    throw Error("snapshot: " + of + "; it holds " + std::to_string(theirs.robots) + " robots and " +
+                std::to_string(theirs.objects) + " objects, this world " +
                 std::to_string(ours.robots) + " and " + std::to_string(ours.objects));
   if (theirs.settings != ours.settings)
     throw Error("snapshot: " + of + ", loaded with other settings or parameters (--set): " +
                 "restore into a world loaded with the same ones");
   if (theirs.structure != ours.structure)
-    throw Error("snapshot: " + of + "; their objects, names or modules differ (robots copied or "
+    throw Error("snapshot: " + of +
+                "; their objects, names or modules differ (robots copied or "
                 "removed at run time, or controllers given to only one of them)");
 }
 
@@ -279,8 +283,8 @@ void World::RestoreState(std::string_view bytes, const Reseed* reseed) {
       for (const auto& [robot, X_WR] : reseed->roots)
         scene_.SetWorldPose(scene_.instance(robot).root, X_WR);
     }
-    metrics_.resize(in.GetCount(sizeof(int64_t) + sizeof(double) + sizeof(int) +
-                                sizeof(uint64_t) + sizeof(double)));
+    metrics_.resize(in.GetCount(sizeof(int64_t) + sizeof(double) + sizeof(int) + sizeof(uint64_t) +
+                                sizeof(double)));
     for (MetricSample& m : metrics_) {
       m.step = in.Get<int64_t>();
       m.time = in.Get<double>();

@@ -11,8 +11,8 @@
 #include "framework/scene.h"
 #include "framework/sensor_noise.h"
 #include "framework/state_hash.h"
-#include "framework/world_state.h"
 #include "framework/types/core_types.h"
+#include "framework/world_state.h"
 
 namespace swarmsim {
 

@@ -30,7 +30,9 @@ void RobotPositions(const World& world, std::vector<GridItem>* out) {
 class MeanNearestNeighborDistance : public Observer {
  public:
   explicit MeanNearestNeighborDistance(int every) : every_(every) {}
-  bool SaveState(const World&, StateWriter*) const override { return true; }  // nothing kept between steps
+  bool SaveState(const World&, StateWriter*) const override {
+    return true;
+  }  // nothing kept between steps
   void Record(const World& world, std::vector<MetricSample>* out) override {
     if (world.step_count() % every_ != 0) return;
     RobotPositions(world, &items_);

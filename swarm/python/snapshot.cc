@@ -54,7 +54,8 @@ std::string PackSnapshot(World* world, const MetricMaps& metrics) {
 
 void UnpackSnapshot(std::string_view bytes, World* world, const MetricMaps& metrics,
                     const World::Reseed* reseed) {
-  if (bytes.size() < sizeof kMagic || bytes.substr(0, sizeof kMagic) != std::string_view(kMagic, sizeof kMagic))
+  if (bytes.size() < sizeof kMagic ||
+      bytes.substr(0, sizeof kMagic) != std::string_view(kMagic, sizeof kMagic))
     throw Error("snapshot: these bytes are not a swarmsim World snapshot (" +
                 std::to_string(bytes.size()) + " bytes)");
   if (bytes.size() < sizeof kMagic + sizeof(uint64_t))

@@ -430,14 +430,13 @@ void StepWatched(World* world, const RunOptions& options, Clock::time_point star
     // --save-state: the world's state after step save_state_at (-1: the last).
     const auto save_state = [&] {
       if (!options.save_state) return;
-      const int64_t at = options.save_state_at >= 0 ? options.save_state_at
-                                                    : result.first_step + options.steps;
+      const int64_t at =
+          options.save_state_at >= 0 ? options.save_state_at : result.first_step + options.steps;
       if (world->step_count() != at) return;
       const std::string bytes = world->SaveState();
       if (const std::string reason = TryWriteFileAtomically(*options.save_state, bytes);
           !reason.empty())
-        throw Error("--save-state: cannot write '" + options.save_state->string() + "': " +
-                    reason);
+        throw Error("--save-state: cannot write '" + options.save_state->string() + "': " + reason);
       result.saved_step = at;
     };
     save_state();

@@ -43,7 +43,7 @@ struct RunResult {
   double wall_seconds = 0;
   uint64_t state_hash = 0;
   double peak_rss_mb = 0;
-  int signal = 0;  // SIGINT/SIGTERM/SIGHUP that interrupted the run, else 0
+  int signal = 0;           // SIGINT/SIGTERM/SIGHUP that interrupted the run, else 0
   int64_t first_step = 0;   // the world's step count when the run started (--load-state)
   int64_t saved_step = -1;  // the step whose state --save-state wrote, else -1
 };
