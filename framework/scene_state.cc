@@ -11,29 +11,32 @@
 namespace swarmsim {
 
 void Scene::AddStructure(StateHasher* hasher) const {
-  hasher->AddValue(slot_count());
-  for (uint32_t s = 0; s < slot_count(); ++s) {
-    hasher->AddValue(alive_[s]);
-    if (alive_[s] == 0) continue;
-    hasher->AddValue(type_[s]);
-    hasher->AddValue(parent_[s]);
-    hasher->AddValue(instance_[s]);
-    hasher->AddValue(row_[s]);
-    hasher->AddValue(motion_[s] != kNoMotion);
-    const std::string& name = name_at(s);
-    hasher->AddValue(name.size());
-    hasher->Add(name.data(), name.size());
-  }
+  // Whole arrays at once (a robot has ~30 objects: 30,000 slots hash in
+  // well under a millisecond); names by their pool ids, which the same
+  // loads give the same.
+  const auto add = [hasher](const auto& values) {
+    hasher->AddValue(values.size());
+    hasher->Add(values.data(), values.size() * sizeof(values[0]));
+  };
+  add(alive_);
+  add(type_);
+  add(parent_);
+  add(instance_);
+  add(row_);
+  add(motion_);
+  add(name_);
   for (size_t t = 0; t < tables_.size(); ++t) {
     const size_t rows = tables_[t] ? tables_[t]->size() : 0;
     hasher->AddValue(rows);
-    if (rows > 0) hasher->Add(tables_[t]->owners.data(), rows * sizeof(uint32_t));
+    if (rows > 0) add(tables_[t]->owners);
   }
   hasher->AddValue(instances_.size());
   for (const ModelInstance& instance : instances_) hasher->AddValue(instance.alive);
 }
 
 void Scene::SaveState(StateWriter* out) const {
+  out->bytes().reserve(out->bytes().size() + slot_count() * (2 * sizeof(Pose) + 1) +
+                       motions_.size() * sizeof(Motion) + 4096);
   // Poses, velocities and the simulated flag of every live object.
   for (uint32_t s = 0; s < slot_count(); ++s) {
     if (alive_[s] == 0) continue;

@@ -15,8 +15,9 @@
 //   snapshot rebuilds the engine from the scene (as a hybrid switch does),
 //   and restoring rebuilds it from the same scene, so the world a snapshot
 //   was taken from and every world it is restored into continue identically.
-//   Taking a snapshot therefore settles the contact caches: for box2d and
-//   ode the snapshotted run differs from one that never took one.
+//   Taking a snapshot therefore settles the contact caches: for box2d, ode
+//   and planar (neighbour lists, its own headings) the snapshotted run
+//   differs from one that never took one; kinematic keeps nothing.
 // - refused with an Error naming why: Lua scripts (a robot's or the
 //   world's), native controllers and plugin phase callbacks (their memory is
 //   not ours), messages or signals in flight, a type whose rows change but
