@@ -11,6 +11,11 @@ or one may be given here (``World(..., controllers={"footbot": fn})``): it is ca
 once per step with a :class:`Robots` holding the arrays of all the model's robots and
 returns ``{joint name: array of one target per robot}``. See README.md, "Python".
 
+``w.snapshot()`` -> bytes and ``w.restore(bytes)`` save and restore the state (restore + k
+steps gives the hash of the uninterrupted run), ``w.reset(seed=None)`` goes back in place to
+a fresh load with that seed, and ``pickle`` goes through them; worlds whose robots run Lua
+scripts are refused (README.md, "Python": snapshots).
+
 Errors: a world that does not load raises ValueError with the message the command
 line prints (file:line:column); a script or controller error while stepping raises
 RuntimeError (with the controller's traceback) and the world cannot be stepped again.
