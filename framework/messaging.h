@@ -122,6 +122,14 @@ class Messaging {
   // each robot's messages, signal and custom-data writes not yet delivered
   // (robots in index order, then the scene's scripts).
   void HashState(StateHasher* h) const;
+  // No signal set and nothing sent or written for the next step (a
+  // snapshot saves nothing of the messaging then: world_state.h).
+  bool Quiet() const {
+    if (!signals_.empty() || scene_.has_writes()) return false;
+    for (const RobotMail& mail : robots_)
+      if (mail.has_writes()) return false;
+    return true;
+  }
 
   // Messages delivered this step (RobotMail::inbox indexes into it).
   const std::vector<Message>& messages() const { return messages_; }

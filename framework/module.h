@@ -43,6 +43,8 @@ struct lua_State;
 namespace swarmsim {
 
 class StateHasher;
+class StateReader;
+class StateWriter;
 class World;
 struct MetricSample;
 
@@ -75,6 +77,17 @@ class Module : public SceneListener {
   virtual void ListOutputs(std::vector<OutputFile>* /*out*/) const {}
   // Folds state that is not in the scene and changes the future into the hash.
   virtual void HashState(StateHasher* /*hasher*/) const {}
+  // Snapshots (framework/world_state.h): writes the module's own state that
+  // changes the future or its outputs (what HashState adds, a metric's
+  // running values, a layer's pixels) and returns true; LoadState reads it
+  // back into the same module of a world loaded from the same file (after
+  // the scene, the rows and the seed are restored: a module that keeps the
+  // seed reads world->settings().seed again). A module with nothing to save
+  // between steps returns true writing nothing. The default, false, makes
+  // World::SaveState refuse the world, naming the module: a module is not
+  // saved by accident.
+  virtual bool SaveState(const World& /*world*/, StateWriter* /*out*/) const { return false; }
+  virtual void LoadState(StateReader* /*in*/, World* /*world*/) {}
   // Once the loader has built every object: throws swarmsim::Error (naming
   // the file:line:column the module kept) for a reference that matches
   // nothing, such as an IK group's obstacle path (World::CheckModuleReferences).

@@ -34,6 +34,8 @@ namespace swarmsim {
 class ModuleRegistry;
 class Scene;
 class StateHasher;
+class StateReader;
+class StateWriter;
 class TriangleMesh;
 
 // What a type's `read` hook sees of one object entry in a model file: the
@@ -199,6 +201,14 @@ struct ObjectTypeDescriptor {
   // visual). Called between steps, on one thread. Null: no links.
   void (*links)(const Scene& scene, ObjectType type, uint32_t row,
                 std::vector<ObjectId>* out) = nullptr;
+  // --- Snapshots (framework/world_state.h) ---------------------------------------------
+  // Writes the rows' changing state (what hash_rows adds, and what else of
+  // it changes the future), in row order; load_rows reads it back into a
+  // scene with the same rows (World::RestoreState checks that first). A
+  // type with hash_rows and rows but no save_rows makes World::SaveState
+  // refuse, naming the type. Null for both: nothing of the rows changes.
+  void (*save_rows)(const Scene& scene, ObjectType type, StateWriter* out) = nullptr;
+  void (*load_rows)(Scene* scene, ObjectType type, StateReader* in) = nullptr;
 };
 
 // The order `types` (by ObjectType value) are listed in: their indices,

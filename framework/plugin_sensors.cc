@@ -18,6 +18,8 @@ class PluginSensors final : public Module {
  public:
   void Sense(World* world) override;
   bool Reading(const Scene& scene, ObjectId id, std::span<const double>* values) const;
+  // Snapshots: a world without plugin sensors has nothing here.
+  bool SaveState(const World&, StateWriter*) const override { return sensors_.empty(); }
 
  private:
   struct Sensor {  // 40 bytes

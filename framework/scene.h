@@ -37,6 +37,8 @@ namespace swarmsim {
 
 class ScriptMemory;
 class StateHasher;
+class StateReader;
+class StateWriter;
 struct ObjectTypeDescriptor;
 
 // The name of a built-in type ("joint"); Scene::type_name names registered
@@ -462,6 +464,15 @@ class Scene {
   // (one per asset per call: copies duplicated afterwards share it). A
   // structural change: dynamics backends rebuild. Not thread-safe.
   void ScaleSubtree(ObjectId root, double s);
+
+  // Snapshots (framework/world_state.h; scene_state.cc): every live
+  // object's poses, velocities and simulated flag, and the custom data;
+  // LoadState into a scene of the same structure (AddStructure equal).
+  void SaveState(StateWriter* out) const;
+  void LoadState(StateReader* in);
+  // Folds the tree into a hash: slots, liveness, types, parents, robots,
+  // names and row counts (a snapshot's fingerprint).
+  void AddStructure(StateHasher* hasher) const;
 
   // Monotonic counter bumped on every structural change (add, remove, reparent).
   uint64_t structure_version() const { return structure_version_; }

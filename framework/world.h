@@ -288,6 +288,28 @@ class World final : public PhaseHandlers {
   // readings, random streams and time. Equal hashes, equal futures.
   uint64_t StateHash() const;
 
+  // --- Snapshots (framework/world_state.h, world_state.cc) ---------------------------------
+  // The world's state as bytes: restore + k steps gives the state of k more
+  // steps from here. Starts the world if it has not started, and rebuilds
+  // the dynamics engine from the scene (world_state.h: why). Throws
+  // swarmsim::Error naming what cannot be saved (a robot's Lua script, a
+  // native controller, a module or type without save hooks).
+  std::string SaveState();
+  // Puts the world in the state `bytes` hold (from SaveState of a world
+  // loaded from the same file and settings, any seed). Throws
+  // swarmsim::Error for bytes of another world, corrupt or truncated ones,
+  // before changing anything. With `reseed`, the bytes of a world that has
+  // not stepped become that world as a load with `reseed->seed` makes it:
+  // that seed, its random streams, and the robots' root poses the loader
+  // placed with it (LoadedWorld::placement): World.reset(seed).
+  struct Reseed {
+    uint64_t seed = 0;
+    std::span<const std::pair<int, Pose>> roots;  // (robot index, root world pose)
+  };
+  void RestoreState(std::string_view bytes, const Reseed* reseed = nullptr);
+  // Why SaveState would refuse this world, or "" if it would not.
+  std::string SnapshotRefusal() const;
+
   // --- Outputs ----------------------------------------------------------------------
   // Script `print` lines are passed here, prefixed by the robot instance
   // name, in robot order after each phase. Default: standard output.
@@ -438,6 +460,15 @@ class World final : public PhaseHandlers {
     return phase_callbacks_[static_cast<size_t>(phase) * 2 + static_cast<size_t>(edge)];
   }
   void CallPhaseCallbacks(const std::vector<const PhaseCallback*>& callbacks);
+  // world_state.cc: the fingerprint parts a snapshot carries, and the
+  // dynamics rebuilt from the scene.
+  void WriteFingerprint(StateWriter* out) const;
+  void CheckFingerprint(StateReader* in) const;
+  void RebuildDynamics();
+  // The world file's content hash, read at the first snapshot or restore
+  // (0: no file, or unreadable).
+  mutable uint64_t file_hash_ = 0;
+  mutable bool file_hashed_ = false;
   WorldSettings settings_;
   const ModuleRegistry& registry_;
   std::shared_ptr<const ModuleRegistry> owned_registry_;  // null unless given by shared_ptr

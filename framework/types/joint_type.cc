@@ -12,6 +12,7 @@
 #include "framework/sensor_noise.h"
 #include "framework/state_hash.h"
 #include "framework/types/core_types.h"
+#include "framework/world_state.h"
 
 namespace swarmsim {
 
@@ -98,6 +99,29 @@ void Hash(const Scene& scene, ObjectType, StateHasher* h) {
     h->AddValue(j.target_velocity);
     h->AddValue(j.target_position);
     if (j.ik_frozen) h->AddValue(j.ik_frozen);  // (only when set: older hashes stay)
+  }
+}
+
+// Snapshots (framework/world_state.h): the state, settings stay the model's.
+void Save(const Scene& scene, ObjectType, StateWriter* out) {
+  for (const JointData& j : scene.joints()) {
+    for (const double v : {j.position, j.velocity, j.target_velocity, j.drive_velocity,
+                           j.target_position, j.target_force})
+      out->Put(v);
+    out->Put(j.ball);
+    out->Put<uint8_t>(j.simulated);
+    out->Put<uint8_t>(j.ik_frozen);
+  }
+}
+
+void Load(Scene* scene, ObjectType, StateReader* in) {
+  for (JointData& j : scene->joints()) {
+    for (double* v : {&j.position, &j.velocity, &j.target_velocity, &j.drive_velocity,
+                      &j.target_position, &j.target_force})
+      *v = in->Get<double>();
+    j.ball = in->Get<Quat>();
+    j.simulated = in->GetBool();
+    j.ik_frozen = in->GetBool();
   }
 }
 
@@ -190,6 +214,8 @@ constinit const ObjectTypeDescriptor kJointType{
     .read = Read,
     .check = Check,
     .register_lua = RegisterJointsApi,
+    .save_rows = Save,
+    .load_rows = Load,
 };
 
 }  // namespace swarmsim

@@ -28,6 +28,9 @@ void RegisterColorMetrics(ModuleRegistry* registry);
 // Also the plugins' set_led (framework/device_access.h).
 class BlobCameraModule final : public Module, public LedAccess {
  public:
+  // Snapshots (framework/world_state.h): its objects' rows (no save_rows) make
+  // World::SaveState refuse while the world has any; without them it is idle.
+  bool SaveState(const World&, StateWriter*) const override { return true; }
   void Sense(World* world) override;
   int SetLed(Scene* scene, int robot, ObjectId id, const Vec3& color,
              bool on) const noexcept override;

@@ -17,6 +17,9 @@ inline constexpr const char* kModuleName = "collision";
 
 class CollisionModule final : public Module {
  public:
+  // Snapshots (framework/world_state.h): its objects' rows (no save_rows) make
+  // World::SaveState refuse while the world has any; without them it is idle.
+  bool SaveState(const World&, StateWriter*) const override { return true; }
   void Start(World* world) override;
   void AfterPhysics(World* world) override;
   void Record(const World& world, std::vector<MetricSample>* out) override;

@@ -69,6 +69,8 @@ class FloorRaster final : public Module, public FloorLayer {
   FloorRaster(World* world, const FloorSettings& settings);
   ~FloorRaster() override;
 
+  // Snapshots: drawn once when the world loads, never changed.
+  bool SaveState(const World&, StateWriter*) const override { return true; }
   FloorArea floor_area() const override { return area_; }
   std::span<const uint8_t> floor_rgb() const override { return rgb_; }
   // Drawn by the image or a shape, in a colour other than the background.

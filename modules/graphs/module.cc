@@ -202,6 +202,13 @@ void GraphModule::Sample(Scene* scene, Series* series, double time) {
   if (out != nullptr) out[0] = time;
 }
 
+bool GraphModule::SaveState(const World& world, StateWriter*) const {
+  ObjectType type;
+  const Scene& scene = world.scene();
+  return !(scene.FindType("graph", &type) && scene.rows(type) != nullptr &&
+           scene.rows(type)->size() > 0);
+}
+
 void GraphModule::Start(World* world) {
   Refresh(&world->scene());
   std::vector<MetricSample> none;

@@ -65,6 +65,9 @@ class GraphModule final : public Module {
   // graphs/<path>.csv for every graph, and .png (gnuplot) for the first kMaxPngs.
   void WriteOutputs(const std::filesystem::path& dir) const override;
   void ListOutputs(std::vector<OutputFile>* out) const override;
+  // Snapshots (framework/world_state.h): a graph's series is not saved, so a
+  // world with graphs is refused; without them the module is idle.
+  bool SaveState(const World& world, StateWriter* out) const override;
 
   // The series of the graph `id`, or null (scripts' reads).
   const Series* Find(ObjectId id) const;

@@ -9,6 +9,7 @@
 #include "framework/registry.h"
 #include "framework/scene.h"
 #include "framework/state_hash.h"
+#include "framework/world_state.h"
 #include "modules/ground_sensor/ground_sensor.h"
 
 namespace swarmsim::ground_sensor {
@@ -60,6 +61,21 @@ void Hash(const Scene& scene, ObjectType type, StateHasher* h) {
     h->AddValue(rows.owners[r]);
     h->AddValue(rows.rows[r].color);
     h->AddValue(rows.rows[r].value);
+  }
+}
+
+// Snapshots (framework/world_state.h): the readings.
+void Save(const Scene& scene, ObjectType type, StateWriter* out) {
+  for (const GroundSensorRow& g : scene.rows<GroundSensorRow>(type).rows) {
+    out->Put(g.color);
+    out->Put(g.value);
+  }
+}
+
+void Load(Scene* scene, ObjectType type, StateReader* in) {
+  for (GroundSensorRow& g : scene->rows<GroundSensorRow>(type).rows) {
+    g.color = in->Get<Vec3>();
+    g.value = in->Get<double>();
   }
 }
 
@@ -117,6 +133,8 @@ constinit const ObjectTypeDescriptor kGroundSensorType{
     .read = Read,
     .register_lua = RegisterLua,
     .visual = Visual,
+    .save_rows = Save,
+    .load_rows = Load,
 };
 
 }  // namespace

@@ -34,6 +34,9 @@ class Sensing final : public Module, public SensorValueAccess {
     return 0;
   }
 
+  // Snapshots: the readings are the rows'; the seed is read at each sense.
+  bool SaveState(const World&, StateWriter*) const override { return true; }
+
   void Sense(World* world) override {
     Scene& scene = world->scene();
     if (!type_found_) {

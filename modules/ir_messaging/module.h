@@ -23,6 +23,9 @@ void RegisterIrMessagingApi(lua_State* L);
 // Also the plugins' access to the transceivers (framework/device_access.h).
 class IrMessagingModule final : public Module, public IrAccess {
  public:
+  // Snapshots (framework/world_state.h): its objects' rows (no save_rows) make
+  // World::SaveState refuse while the world has any; without them it is idle.
+  bool SaveState(const World&, StateWriter*) const override { return true; }
   void Start(World* world) override;
   void Sense(World* world) override;
   int Send(Scene* scene, int robot, ObjectId id, const uint8_t* data,

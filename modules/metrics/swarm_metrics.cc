@@ -1,5 +1,6 @@
 #include "modules/metrics/swarm_metrics.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <unordered_set>
@@ -7,6 +8,7 @@
 #include "framework/error.h"
 #include "framework/spatial_grid.h"
 #include "framework/world.h"
+#include "framework/world_state.h"
 
 namespace swarmsim {
 
@@ -28,6 +30,9 @@ void RobotPositions(const World& world, std::vector<GridItem>* out) {
 class MeanNearestNeighborDistance : public Observer {
  public:
   explicit MeanNearestNeighborDistance(int every) : every_(every) {}
+  bool SaveState(const World&, StateWriter*) const override {
+    return true;
+  }  // nothing kept between steps
   void Record(const World& world, std::vector<MetricSample>* out) override {
     if (world.step_count() % every_ != 0) return;
     RobotPositions(world, &items_);
@@ -62,6 +67,19 @@ class MeanNearestNeighborDistance : public Observer {
 class CoveredArea : public Observer {
  public:
   explicit CoveredArea(int every) : every_(every) {}
+  // Snapshots: the cells visited so far, in ascending order.
+  bool SaveState(const World&, StateWriter* out) const override {
+    std::vector<uint64_t> cells(visited_.begin(), visited_.end());
+    std::sort(cells.begin(), cells.end());
+    out->Put<uint64_t>(cells.size());
+    out->PutBytes(cells.data(), cells.size() * sizeof(uint64_t));
+    return true;
+  }
+  void LoadState(StateReader* in, World*) override {
+    std::vector<uint64_t> cells(in->GetCount(sizeof(uint64_t)));
+    in->GetBytes(cells.data(), cells.size() * sizeof(uint64_t));
+    visited_ = std::unordered_set<uint64_t>(cells.begin(), cells.end());
+  }
   void Record(const World& world, std::vector<MetricSample>* out) override {
     const Scene& scene = world.scene();
     for (const ModelInstance& inst : scene.instances()) {

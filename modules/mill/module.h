@@ -37,6 +37,9 @@ inline constexpr double kMaxWorldVoxels = 4e9;
 
 class MillModule final : public Module {
  public:
+  // Snapshots (framework/world_state.h): its objects' rows (no save_rows) make
+  // World::SaveState refuse while the world has any; without them it is idle.
+  bool SaveState(const World&, StateWriter*) const override { return true; }
   explicit MillModule(World* world) : world_(world) {}
   void AfterPhysics(World* world) override;
   void Record(const World& world, std::vector<MetricSample>* out) override;

@@ -17,6 +17,9 @@ uint32_t FindFollower(const Scene& scene, uint32_t path_slot, const std::string&
 
 class PathsModule final : public Module {
  public:
+  // Snapshots (framework/world_state.h): its objects' rows (no save_rows) make
+  // World::SaveState refuse while the world has any; without them it is idle.
+  bool SaveState(const World&, StateWriter*) const override { return true; }
   // Places the followers at their paths' starting positions; makes the
   // conveyors' belts and sets their surfaces moving.
   void Start(World* world) override;

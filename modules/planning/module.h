@@ -14,6 +14,9 @@ struct PlanningTaskRow;
 
 class PlanningModule final : public Module {
  public:
+  // Snapshots (framework/world_state.h): its objects' rows (no save_rows) make
+  // World::SaveState refuse while the world has any; without them it is idle.
+  bool SaveState(const World&, StateWriter*) const override { return true; }
   // Makes each task's result path.
   void Start(World* world) override;
   // Plans every requested task (tasks in parallel, each on one worker,

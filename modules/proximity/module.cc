@@ -41,6 +41,16 @@ class ProximityModule final : public Module, public ProximityReadings {
     RefreshDetectable(world->scene());
   }
 
+  // Snapshots: the readings are the rows'; only the seed may change (a
+  // snapshot of another seed: the backend draws from it).
+  bool SaveState(const World&, StateWriter*) const override { return true; }
+  void LoadState(StateReader*, World* world) override {
+    if (settings_.seed == world->settings().seed) return;
+    settings_.seed = world->settings().seed;
+    backend_->Build(world->scene(), settings_);
+    environment_version_ = world->scene().environment_version();
+  }
+
   int Read(const Scene& scene, ObjectId id, double* distance) const noexcept override {
     const ProximitySensorData* p = FindSensor(scene, id);
     if (p == nullptr) return -1;

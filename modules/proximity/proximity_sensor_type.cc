@@ -13,6 +13,7 @@
 #include "framework/object_type.h"
 #include "framework/scene.h"
 #include "framework/state_hash.h"
+#include "framework/world_state.h"
 #include "modules/proximity/proximity_sensor.h"
 
 namespace swarmsim {
@@ -96,6 +97,29 @@ void Hash(const Scene& scene, ObjectType type, StateHasher* h) {
     h->AddValue(p.detected_object);
     if (p.volume() != ProximityVolume::kRay) h->AddValue(p.normal);
     if (p.settings->has_response() && p.detected) h->AddValue(p.value);
+  }
+}
+
+// Snapshots (framework/world_state.h): the readings.
+void Save(const Scene& scene, ObjectType type, StateWriter* out) {
+  for (const ProximitySensorData& p : scene.rows<ProximitySensorData>(type).rows) {
+    out->Put(p.distance);
+    out->Put(p.detected_object);
+    out->Put<uint8_t>(p.detected);
+    out->Put(p.value);
+    out->Put(p.point);
+    out->Put(p.normal);
+  }
+}
+
+void Load(Scene* scene, ObjectType type, StateReader* in) {
+  for (ProximitySensorData& p : scene->rows<ProximitySensorData>(type).rows) {
+    p.distance = in->Get<double>();
+    p.detected_object = in->Get<ObjectId>();
+    p.detected = in->GetBool();
+    p.value = in->Get<float>();
+    p.point = in->Get<Vec3>();
+    p.normal = in->Get<Vec3>();
   }
 }
 
@@ -241,6 +265,8 @@ constinit const ObjectTypeDescriptor kProximitySensorType{
     .visual = Visual,
     // Where it was when it was a built-in type: hashes and type lists stay.
     .listed_after = "joint",
+    .save_rows = Save,
+    .load_rows = Load,
 };
 
 }  // namespace

@@ -50,6 +50,16 @@ View ViewOf(const Scene& scene, uint32_t slot, const Lens& lens, bool depth) {
   return v;
 }
 
+bool RenderingModule::SaveState(const World& world, StateWriter*) const {
+  const Scene& scene = world.scene();
+  for (const char* name : {"vision_sensor", "camera"}) {
+    ObjectType type;
+    if (scene.FindType(name, &type) && scene.rows(type) != nullptr && scene.rows(type)->size() > 0)
+      return false;
+  }
+  return true;
+}
+
 void RenderingModule::Start(World* world) { RenderDue(world, /*all=*/true); }
 
 void RenderingModule::Sense(World* world) { RenderDue(world, /*all=*/false); }

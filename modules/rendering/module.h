@@ -19,6 +19,9 @@ class RenderingModule final : public Module {
  public:
   void Start(World* world) override;
   void Sense(World* world) override;
+  // Snapshots (framework/world_state.h): vision sensors' and cameras' images
+  // are not saved, so a world with them is refused; without them it is idle.
+  bool SaveState(const World& world, StateWriter* out) const override;
 
  private:
   void RenderDue(World* world, bool all);

@@ -55,6 +55,10 @@ struct RunArgs {
   bool view = false;
   int view_port = 8600;  // 0: a free port
   std::string view_host = "127.0.0.1";
+  // World snapshots (framework/world_state.h): --save-state FILE at the end
+  // or after step --save-state-at; --load-state FILE to continue from one.
+  std::string save_state, load_state;
+  int64_t save_state_at = -1;  // -1: at the end
 };
 CLI::App* AddRunCommand(CLI::App* app, RunArgs* args);
 // Loads the world (the plugins first into `registry`) and runs it.

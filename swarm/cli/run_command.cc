@@ -6,7 +6,9 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
+#include <iterator>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -192,6 +194,23 @@ CLI::App* AddRunCommand(CLI::App* app, RunArgs* args) {
                   "Address --view listens on (default 127.0.0.1: this machine only)")
       ->check(NonEmpty("an address"))
       ->needs(view);
+  auto* save_state =
+      run->add_option("--save-state", args->save_state,
+                      "Write the world's state to FILE at the end of the run (or after step "
+                      "--save-state-at); --load-state continues from it. Worlds whose robots run "
+                      "Lua scripts or native controllers are refused (README.md, Snapshots)")
+          ->option_text("FILE")
+          ->check(NonEmpty("a file"));
+  run->add_option("--save-state-at", args->save_state_at,
+                  "The step after which --save-state writes the state (the world's step count, "
+                  "counted from 0 or from the step --load-state resumed at)")
+      ->transform(WholeNumberCheck(0, kInt64Max, "steps"))
+      ->needs(save_state);
+  run->add_option("--load-state", args->load_state,
+                  "Continue from the state --save-state wrote (a run of the same world file, "
+                  "--set values and --seed); --steps then counts the steps run from there")
+      ->option_text("FILE")
+      ->check(NonEmpty("a file"));
   run->callback([args, video] { args->video = video->count() > 0; });
   return run;
 }
@@ -307,6 +326,34 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
     if (const int code = BindViewServer(args.view_host, args.view_port, view_server.get()))
       return code;
     view_server->Start();
+  }
+  // Snapshots: checked (and a state loaded) before the run starts.
+  if (!args.save_state.empty() || !args.load_state.empty()) {
+    const std::string why = loaded.world->SnapshotRefusal();
+    if (!why.empty())
+      return bad_input(std::string(args.load_state.empty() ? "--save-state" : "--load-state") +
+                       ": " + why);
+  }
+  if (!args.load_state.empty()) {
+    std::ifstream in(args.load_state, std::ios::binary);
+    if (!in) return bad_input("--load-state: cannot read '" + args.load_state + "'");
+    const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    try {
+      loaded.world->RestoreState(bytes);
+    } catch (const Error& e) {
+      return bad_input("--load-state " + args.load_state + ": " + e.what());
+    }
+    options.resumed_from = args.load_state;
+  }
+  if (!args.save_state.empty()) {
+    options.save_state = args.save_state;
+    options.save_state_at = args.save_state_at;
+    const int64_t first = loaded.world->step_count();
+    if (args.save_state_at >= 0 &&
+        (args.save_state_at < first || args.save_state_at > first + options.steps))
+      return bad_input("--save-state-at " + std::to_string(args.save_state_at) +
+                       ": the run goes from step " + std::to_string(first) + " to " +
+                       std::to_string(first + options.steps));
   }
   const RunResult result = RunWorld(loaded.world.get(), options, std::cout, std::cerr);
   stop_signals.reset();

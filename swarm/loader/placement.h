@@ -54,6 +54,13 @@ class Placer {
   static constexpr int kMaxAttempts = 2000;
 
   explicit Placer(uint64_t seed) : seed_(seed) {}
+  // The same walls, obstacles, map and bodies, drawing from another seed
+  // (World.reset(seed): the placement a load with that seed makes).
+  Placer WithSeed(uint64_t seed) const {
+    Placer copy = *this;
+    copy.seed_ = seed;
+    return copy;
+  }
 
   void AddObstacle(const Obstacle2& obstacle) { obstacles_.push_back(obstacle); }
   // The environment map's occupied cells in the plane (a grid of squares,

@@ -738,11 +738,33 @@ void WorldLoader::BuildCopies(World* world) {
       Pose X_MR = e.SpecOf(static_cast<int64_t>(k)).X_PO;
       X_MR.p = X_MR.p * e.scale;
       scene.SetWorldPose(root, poses[k] * X_MR);
+      copy_instances_.push_back(instance);
       world->SetInstanceParameters(instance, own ? own->parameters : e.parameters);
       if (e.native != nullptr)
         world->SetNativeController(instance, e.native, e.native_replaces_scripts);
     }
   }
+}
+
+std::vector<std::pair<int, Pose>> WorldLoader::Placements(uint64_t seed) {
+  placer_ = std::make_unique<Placer>(unplaced_->WithSeed(seed));
+  PlaceEntries();
+  // The root poses as BuildCopies sets them.
+  std::vector<std::pair<int, Pose>> out;
+  size_t copy = 0;
+  for (const EntryPlan& e : entries_) {
+    const size_t copies = e.distribute ? e.placements.size() : 1;
+    for (size_t k = 0; k < copies; ++k, ++copy) {
+      if (!e.distribute) continue;
+      const Placement2& p = e.placements[k];
+      const Pose X_WM{{p.x, p.y, -e.FootprintOf(static_cast<int64_t>(k)).bottom},
+                      Quat::FromYaw(p.yaw)};
+      Pose X_MR = e.SpecOf(static_cast<int64_t>(k)).X_PO;
+      X_MR.p = X_MR.p * e.scale;
+      out.emplace_back(copy_instances_.at(copy), X_WM * X_MR);
+    }
+  }
+  return out;
 }
 
 std::vector<ModelSummary> WorldLoader::Summarize() const {

@@ -120,6 +120,7 @@ LoadedWorld WorldLoader::Load() {
   if (environment_) world->scene().set_environment(environment_);
   for (EntryPlan& entry : entries_) ResolveEntry(&entry);
   KeepPlacementClearOfTheMap(&out.warnings);
+  unplaced_ = std::make_unique<Placer>(*placer_);
   PlaceEntries();
   BuildCopies(world);
   // The scene's own objects (collections, distance objects, ...), after the
@@ -613,9 +614,11 @@ namespace swarmsim {
 
 LoadedWorld LoadWorld(const std::filesystem::path& file, const LoadOptions& options,
                       const ModuleRegistry& registry) {
-  loader::WorldLoader loader(file, options, registry);
+  auto loader = std::make_shared<loader::WorldLoader>(file, options, registry);
   try {
-    return loader.Load();
+    LoadedWorld out = loader->Load();
+    out.placement = [loader](uint64_t seed) { return loader->Placements(seed); };
+    return out;
   } catch (const Error&) {
     throw;
   } catch (const YAML::Exception& e) {

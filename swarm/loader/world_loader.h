@@ -101,6 +101,11 @@ struct LoadedWorld {
   std::vector<std::string> warnings;
   // The world's `record:` setting: a step record every N steps; 0: not asked for.
   int64_t record_every = 0;
+  // The distributed robots' root poses (robot index, world pose) as a load
+  // of the same file and options with another seed places them (World.reset,
+  // swarm/python/snapshot.h): the loader's parsed files, kept. Throws
+  // swarmsim::Error when the copies do not fit with that seed.
+  std::function<std::vector<std::pair<int, Pose>>(uint64_t seed)> placement;
 };
 
 // Reads `file`, resolves parameters (after `options.overrides`), builds the

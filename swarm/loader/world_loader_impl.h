@@ -139,6 +139,11 @@ class WorldLoader {
       : path_(file), options_(options), registry_(registry) {}
 
   LoadedWorld Load();
+  // After Load: each distributed robot's root pose as a load with `seed`
+  // places it (robot index, world pose), robots in index order
+  // (LoadedWorld::placement). Throws swarmsim::Error as Load does when the
+  // copies do not fit.
+  std::vector<std::pair<int, Pose>> Placements(uint64_t seed);
 
  private:
   // A model's declared parameters, for the messages about values given for them.
@@ -192,7 +197,7 @@ class WorldLoader {
   }
 
   std::filesystem::path path_;
-  const LoadOptions& options_;
+  const LoadOptions options_;  // a copy: the loader outlives LoadWorld (Placements)
   const ModuleRegistry& registry_;
   const ModuleRegistry* world_registry_ = nullptr;  // registry_ plus the world's plugins
   std::unique_ptr<YamlFile> file_;
@@ -209,6 +214,10 @@ class WorldLoader {
   std::shared_ptr<const EnvironmentMap> environment_;  // the map it names, or null
   const EnvironmentFormatDescriptor* environment_format_ = nullptr;  // the format that read it
   std::unique_ptr<Placer> placer_;
+  // Placements: the placer before the entries were placed, and the robot
+  // each copy became (entries in order, copies in order).
+  std::unique_ptr<Placer> unplaced_;
+  std::vector<int> copy_instances_;
   std::vector<std::filesystem::path> package_path_;  // the world's, then --package-path
   std::vector<std::string> warnings_;                // found before the World exists
 };

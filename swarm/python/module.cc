@@ -34,6 +34,7 @@
 #include "swarm/loader/world_loader.h"
 #include "swarm/python/arrays.h"
 #include "swarm/python/sensor_arrays.h"
+#include "swarm/python/snapshot.h"
 #include "swarm/python/writers.h"
 
 namespace py = pybind11;
@@ -193,6 +194,8 @@ struct ControllerConfig {
 class ControllerModule : public Module {
  public:
   explicit ControllerModule(const ControllerConfig& config) : config_(config) {}
+  // Snapshots: the controller's own memory is the Python program's, not saved.
+  bool SaveState(const World&, StateWriter*) const override { return true; }
   ~ControllerModule() override {
     py::gil_scoped_acquire gil;
     config_.function = py::object();
@@ -312,7 +315,8 @@ class PyWorld {
   PyWorld(const std::string& path, std::optional<uint64_t> seed,
           const std::map<std::string, py::object>& set, int threads,
           const std::map<std::string, py::object>& controllers,
-          const std::vector<std::string>& package_path, bool keep_scripts) {
+          const std::vector<std::string>& package_path, bool keep_scripts)
+      : args_{path, seed, set, threads, controllers, package_path, keep_scripts} {
     CheckThreads(threads, "World(threads=...)");
     LoadOptions options;
     if (!keep_scripts)
@@ -336,6 +340,7 @@ class PyWorld {
       throw py::value_error(e.what());
     }
     World& world = *loaded_.world;
+    loaded_seed_ = world.settings().seed;
     planar_ = world.registry().dynamics_capabilities(world.settings().physics).planar;
     // Controllers: the world file's, then the constructor's (replacing them).
     std::map<std::string, ControllerConfig> configs;
@@ -376,6 +381,75 @@ class PyWorld {
     }
     loaded_.world.reset();
   }
+
+  // --- Snapshots, reset and pickling (snapshot.cc; framework/world_state.h) -----------
+  py::bytes snapshot() { return py::bytes(SnapshotBytes()); }
+  std::string SnapshotBytes() {
+    World& w = Live();
+    try {
+      py::gil_scoped_release release;
+      return PackSnapshot(&w, Metrics());
+    } catch (const Error& e) {
+      throw std::runtime_error(e.what());
+    }
+  }
+  void restore(const py::bytes& data) {
+    World& w = Live();
+    const std::string_view bytes(PyBytes_AS_STRING(data.ptr()),
+                                 static_cast<size_t>(PyBytes_GET_SIZE(data.ptr())));
+    try {
+      py::gil_scoped_release release;
+      UnpackSnapshot(bytes, &w, Metrics());
+    } catch (const Error& e) {
+      throw py::value_error(e.what());
+    }
+  }
+  // The world as a fresh load with `seed` (None: the seed it was loaded
+  // with) leaves it, in place: the snapshot of the world before its first
+  // step (taken then, or from a load with the same arguments if it has
+  // stepped), with the seed's random streams and the robots placed as the
+  // loader places them with it.
+  void reset(std::optional<uint64_t> seed) {
+    World& w = Live();
+    if (initial_.empty()) {
+      if (w.step_count() == 0 && history_.empty()) {
+        initial_ = SnapshotBytes();
+      } else {
+        PyWorld fresh(args_.path, loaded_seed_, args_.set, args_.threads, args_.controllers,
+                      args_.package_path, args_.keep_scripts);
+        initial_ = fresh.SnapshotBytes();
+      }
+    }
+    const uint64_t s = seed.value_or(loaded_seed_);
+    const std::string_view bytes(initial_);
+    try {
+      py::gil_scoped_release release;
+      if (s == loaded_seed_) {
+        UnpackSnapshot(bytes, &w, Metrics());
+      } else {
+        const std::vector<std::pair<int, Pose>> roots = loaded_.placement(s);
+        const World::Reseed reseed{s, roots};
+        UnpackSnapshot(bytes, &w, Metrics(), &reseed);
+      }
+    } catch (const Error& e) {
+      throw py::value_error(e.what());
+    }
+  }
+  py::tuple getstate() {
+    return py::make_tuple(args_.path, args_.seed, args_.set, args_.threads, args_.controllers,
+                          args_.package_path, args_.keep_scripts, snapshot());
+  }
+  static std::unique_ptr<PyWorld> setstate(const py::tuple& t) {
+    if (t.size() != 8) throw py::value_error("World.__setstate__: not a pickled World");
+    auto w =
+        std::make_unique<PyWorld>(t[0].cast<std::string>(), t[1].cast<std::optional<uint64_t>>(),
+                                  t[2].cast<std::map<std::string, py::object>>(), t[3].cast<int>(),
+                                  t[4].cast<std::map<std::string, py::object>>(),
+                                  t[5].cast<std::vector<std::string>>(), t[6].cast<bool>());
+    w->restore(t[7].cast<py::bytes>());
+    return w;
+  }
+  MetricMaps Metrics() { return {&swarm_metrics_, &robot_metrics_, &history_}; }
 
   void Step(int64_t n) {
     if (n < 0) throw py::value_error("step(n): n must be >= 0, got " + std::to_string(n));
@@ -853,6 +927,19 @@ class PyWorld {
   std::map<std::string, double> swarm_metrics_;
   std::map<std::string, std::map<int, double>> robot_metrics_;
   std::map<std::string, std::vector<std::pair<int64_t, double>>> history_;
+  // The constructor's arguments (pickling, reset with another seed), the
+  // seed the world was loaded with, and fresh worlds' snapshots by seed.
+  struct Args {
+    std::string path;
+    std::optional<uint64_t> seed;
+    std::map<std::string, py::object> set;
+    int threads;
+    std::map<std::string, py::object> controllers;
+    std::vector<std::string> package_path;
+    bool keep_scripts = true;
+  } args_;
+  uint64_t loaded_seed_ = 0;
+  std::string initial_;  // reset: the snapshot before the first step ("": not yet taken)
 };
 
 // --- Many worlds at once ---------------------------------------------------------------
@@ -1190,7 +1277,20 @@ PYBIND11_MODULE(_swarmsim, m) {
            "a metric the world neither declares nor has recorded, listing the known ones.")
       .def("metric_history", &PyWorld::metric_history, py::arg("name"),
            "(steps, values): every swarm-level sample of `name` so far (float64 arrays).\n"
-           "KeyError for an unknown metric, listing the known ones.");
+           "KeyError for an unknown metric, listing the known ones.")
+      // Snapshots, reset and pickling.
+      .def("snapshot", &PyWorld::snapshot,
+           "The world's state as bytes (README.md, Python: snapshots); restore() puts it back.\n"
+           "RuntimeError naming what cannot be saved (robots running Lua scripts, ...).")
+      .def("restore", &PyWorld::restore, py::arg("state"),
+           "Puts the world in the state snapshot() saved: restore + k steps gives the state\n"
+           "hash of the uninterrupted run. ValueError for another world's or corrupt bytes\n"
+           "(the world is then unchanged).")
+      .def("reset", &PyWorld::reset, py::arg("seed") = py::none(),
+           "Back, in place, to the state a fresh load with `seed` (None: the world's own)\n"
+           "leaves: robots placed as the loader places them with that seed, every random\n"
+           "stream from it. No file is read again.")
+      .def(py::pickle([](PyWorld& w) { return w.getstate(); }, &PyWorld::setstate));
 
   m.def("step_worlds", &swarmsim::python::StepWorlds, py::arg("worlds"), py::arg("n") = 1,
         py::arg("threads") = 0,

@@ -310,6 +310,10 @@ std::string WriteSummary(const World& world, const RunOptions& options, const Ru
   j["physics"] = world.settings().physics;
   j["robots"] = robots;
   j["steps"] = result.steps;
+  if (!options.resumed_from.empty())
+    j["resumed_from"] = {{"file", options.resumed_from}, {"step", result.first_step}};
+  if (result.saved_step >= 0)
+    j["state_saved"] = {{"file", options.save_state->string()}, {"step", result.saved_step}};
   j["time_step"] = world.settings().time_step;
   j["physics_substeps"] = world.settings().physics_substeps;
   j["simulated_time"] = sim_time;
@@ -422,6 +426,20 @@ void StepWatched(World* world, const RunOptions& options, Clock::time_point star
       metrics = std::make_unique<MetricsWriter>(*options.out_dir / "metrics.csv", *world);
     }
     world->Start();
+    result.first_step = world->step_count();
+    // --save-state: the world's state after step save_state_at (-1: the last).
+    const auto save_state = [&] {
+      if (!options.save_state) return;
+      const int64_t at =
+          options.save_state_at >= 0 ? options.save_state_at : result.first_step + options.steps;
+      if (world->step_count() != at) return;
+      const std::string bytes = world->SaveState();
+      if (const std::string reason = TryWriteFileAtomically(*options.save_state, bytes);
+          !reason.empty())
+        throw Error("--save-state: cannot write '" + options.save_state->string() + "': " + reason);
+      result.saved_step = at;
+    };
+    save_state();
     done(options.steps > 0 ? step_name() : "the stop of the world");
     for (int64_t i = 0; i < options.steps; ++i) {
       if (const int sig = StopSignals::Received(); sig != 0) {
@@ -435,6 +453,7 @@ void StepWatched(World* world, const RunOptions& options, Clock::time_point star
         const std::lock_guard lock(watchdog.io_mutex());
         ++result.steps;
       }
+      save_state();
       done(result.steps < options.steps ? step_name() : "the stop of the world");
       progress.Update(result.steps, world->time());
     }
@@ -460,6 +479,9 @@ void PrintSummaryTable(const World& world, const RunResult& result, double lua_k
   const double robot_ticks = static_cast<double>(robots) * static_cast<double>(result.steps);
   const double rtf = result.wall_seconds > 0 ? sim_time / result.wall_seconds : 0;
   const double ticks_per_s = result.wall_seconds > 0 ? robot_ticks / result.wall_seconds : 0;
+  if (result.first_step > 0)
+    out << "resumed at      step " << result.first_step << " (--load-state)\n";
+  if (result.saved_step >= 0) out << "state saved     after step " << result.saved_step << "\n";
   out << "robots          " << robots << "\n"
       << "steps           " << result.steps << " (time step " << world.settings().time_step
       << " s, " << PhysicsLine(world) << ")\n"

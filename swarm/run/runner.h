@@ -27,6 +27,13 @@ struct RunOptions {
   // What else the run produces, appended to the progress line ("video 120
   // frames"); null: nothing.
   std::function<std::string()> progress_note;
+  // Snapshots (framework/world_state.h): the world's state written to
+  // `save_state` after step `save_state_at` (the world's step count; -1:
+  // at the end of the run); the run resumed from `resumed_from`'s state
+  // (the file, for the summary), its steps counted from there.
+  std::optional<std::filesystem::path> save_state;
+  int64_t save_state_at = -1;
+  std::string resumed_from;
 };
 
 struct RunResult {
@@ -36,7 +43,9 @@ struct RunResult {
   double wall_seconds = 0;
   uint64_t state_hash = 0;
   double peak_rss_mb = 0;
-  int signal = 0;  // SIGINT/SIGTERM/SIGHUP that interrupted the run, else 0
+  int signal = 0;           // SIGINT/SIGTERM/SIGHUP that interrupted the run, else 0
+  int64_t first_step = 0;   // the world's step count when the run started (--load-state)
+  int64_t saved_step = -1;  // the step whose state --save-state wrote, else -1
 };
 
 // Steps `world` (starting it if needed), printing progress to `progress`

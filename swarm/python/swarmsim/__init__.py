@@ -19,6 +19,11 @@ Between steps Python may write state: ``set_poses``, ``set_joint_positions``,
 an array: proximity, ground, light, range-and-bearing, vision images and depth, blob
 cameras, force sensors, distance and collision objects.
 
+``w.snapshot()`` -> bytes and ``w.restore(bytes)`` save and restore the state (restore + k
+steps gives the hash of the uninterrupted run), ``w.reset(seed=None)`` goes back in place to
+a fresh load with that seed, and ``pickle`` goes through them; worlds whose robots run Lua
+scripts are refused (README.md, "Python": snapshots).
+
 Errors: a world that does not load raises ValueError with the message the command
 line prints (file:line:column); a script or controller error while stepping raises
 RuntimeError (with the controller's traceback) and the world cannot be stepped again.
