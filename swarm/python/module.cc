@@ -383,7 +383,13 @@ class PyWorld {
   }
 
   // --- Snapshots, reset and pickling (snapshot.cc; framework/world_state.h) -----------
-  py::bytes snapshot() { return py::bytes(SnapshotBytes()); }
+  // Each a whole call between steps: refused inside a controller, and
+  // waiting for another thread's step (the World's gate).
+  py::bytes snapshot() {
+    NotFromController("snapshot()");
+    GateLock lock(gate_.get());
+    return py::bytes(SnapshotBytes());
+  }
   std::string SnapshotBytes() {
     World& w = Live();
     try {
@@ -394,6 +400,8 @@ class PyWorld {
     }
   }
   void restore(const py::bytes& data) {
+    NotFromController("restore()");
+    GateLock lock(gate_.get());
     World& w = Live();
     const std::string_view bytes(PyBytes_AS_STRING(data.ptr()),
                                  static_cast<size_t>(PyBytes_GET_SIZE(data.ptr())));
@@ -410,6 +418,8 @@ class PyWorld {
   // stepped), with the seed's random streams and the robots placed as the
   // loader places them with it.
   void reset(std::optional<uint64_t> seed) {
+    NotFromController("reset()");
+    GateLock lock(gate_.get());
     World& w = Live();
     if (initial_.empty()) {
       if (w.step_count() == 0 && history_.empty()) {

@@ -128,6 +128,29 @@ class MisuseTest(unittest.TestCase):
             assert holder["poses"].shape == (4, 3)
         """)
 
+    def test_snapshot_restore_and_reset_inside_a_controller_raise(self):
+        self.run_child("""
+            seen = []
+            def meddler(robots):
+                for call in (lambda: holder["w"].snapshot(),
+                             lambda: holder["w"].restore(b"x"),
+                             lambda: holder["w"].reset(seed=3)):
+                    try:
+                        call()
+                    except RuntimeError as e:
+                        seen.append(str(e))
+                return None
+            holder = {}
+            w = swarmsim.World(WORLD, seed=1, set={"robots": 4}, controllers={"footbot": meddler},
+                               keep_scripts=False)
+            holder["w"] = w
+            w.step(2)
+            assert len(seen) == 6, seen
+            for name, text in zip(("snapshot()", "restore()", "reset()"), seen):
+                assert name + " inside a controller" in text, (name, text)
+            assert w.steps == 2
+        """)
+
     def test_two_python_threads_stepping_one_world_take_turns(self):
         self.run_child("""
             w = swarmsim.World(WORLD, seed=5, set={"robots": 30}, threads=2)
