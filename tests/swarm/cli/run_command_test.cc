@@ -52,6 +52,7 @@ TEST(CliTest, DurationIsWholeStepsAndNotLessThanOne) {
 // refused before the run (no summary table printed), naming the path.
 TEST(CliTest, OutThatIsNotAFolderIsABadCommandLine) {
   const fs::path dir = TempDir("out_not_folder");
+  fs::create_directories(dir);
   const fs::path file = dir / "a_file";
   std::ofstream(file) << "kept\n";
   for (const std::string& out : {file.string(), std::string("/proc/swarmsim_no_such_dir")}) {
