@@ -1,7 +1,9 @@
 // sim.* simulation: time, parameters, random numbers, metrics, the robot's
 // identity, and print.
+#include <algorithm>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "framework/error.h"
 #include "framework/lua_api.h"
@@ -66,11 +68,24 @@ int RecordMetric(lua_State* L) {
   if (length > kMaxMetricNameBytes)
     throw Error("the metric name is " + std::to_string(length) + " bytes long; at most " +
                 std::to_string(kMaxMetricNameBytes));
-  const uint64_t bytes = length + sizeof(MetricSample);
+  // What the sample holds in C++: the robot's vector of samples as it
+  // grows (its capacity, charged when it doubles: the slots it really
+  // holds, not just the ones used) and the name's own block when it is too
+  // long for the string's inline buffer. Released, buffer and all, when the
+  // World takes the samples after the phase (World::FlushRobotBuffers).
+  std::vector<MetricSample>& samples = c.runtime->metrics;
+  static const size_t kInlineName = std::string().capacity();
+  uint64_t bytes = length > kInlineName ? length + 1 : 0;
+  size_t capacity = samples.capacity();
+  if (samples.size() == capacity) {
+    capacity = std::max<size_t>(16, 2 * capacity);
+    bytes += (capacity - samples.capacity()) * sizeof(MetricSample);
+  }
   ChargeScriptData(L, bytes, "the metric sample");
-  c.runtime->metrics.push_back(
-      {c.world->step_count(), c.world->time(), c.instance, std::string(name, length), value});
   c.runtime->metric_bytes += bytes;
+  samples.reserve(capacity);
+  samples.push_back(
+      {c.world->step_count(), c.world->time(), c.instance, std::string(name, length), value});
   return 0;
 }
 

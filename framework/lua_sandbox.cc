@@ -318,12 +318,14 @@ fs::path Canonical(const fs::path& path) {
 // the runner's files (swarm/run: summary.json, metrics.csv; swarm/record:
 // recording.swrec; --video without a FILE: video.mp4), a sweep's stderr.txt
 // (swarm/sweep/worker.cc), the modules' (paint.png, mill.csv) and the
-// folders they fill (graphs/, snapshots/). Beyond this list, every file the
+// folders they fill (graphs/, snapshots/), and the room the runner keeps
+// aside for the final summary on a full disk (framework/output_file.cc:
+// .swarmsim-reserve; a script emptying it would lose the summary). Beyond this list, every file the
 // world's modules list as theirs (World::ListOutputs: a --video FILE inside
 // the folder, the snapshots so far) is protected too.
-constexpr std::string_view kRunOutputs[] = {"summary.json", "metrics.csv", "recording.swrec",
-                                            "video.mp4",    "stderr.txt",  "paint.png",
-                                            "mill.csv",     "graphs",      "snapshots"};
+constexpr std::string_view kRunOutputs[] = {
+    "summary.json", "metrics.csv", "recording.swrec", "video.mp4", "stderr.txt",
+    "paint.png",    "mill.csv",    "graphs",          "snapshots", ".swarmsim-reserve"};
 
 // Is `name` the output `output`, or a name a writer may give it while it
 // writes it aside (summary.json.tmp, .summary.json.1234)? A folder's name

@@ -440,14 +440,27 @@ void World::MarkAllPending() {
   messaging_.MarkAllPending();
 }
 
+namespace {
+// Moves a robot's samples into the World's `out` and frees the robot's
+// buffer, as its account is released (sim.recordMetric charges the
+// buffer's capacity). The first buffer becomes the World's as it is.
+void TakeSamples(std::vector<MetricSample>* samples, std::vector<MetricSample>* out) {
+  if (out->empty()) {
+    out->swap(*samples);
+  } else {
+    for (MetricSample& m : *samples) out->push_back(std::move(m));
+  }
+  std::vector<MetricSample>().swap(*samples);
+}
+}  // namespace
+
 void World::FlushRobotBuffers() {
   // Logs and metrics in robot order, then the scene's; the lowest robot's
   // error wins, so the report does not depend on the thread count.
   std::string first_error;
   auto flush = [&](RobotRuntime& rt, ScriptMemory& memory) {
     DrainLog(rt, memory);
-    for (MetricSample& m : rt.metrics) metrics_.push_back(std::move(m));
-    rt.metrics.clear();
+    TakeSamples(&rt.metrics, &metrics_);
     memory.Release(std::exchange(rt.metric_bytes, 0));
     if (!rt.error.empty() && first_error.empty()) first_error = rt.error;
     rt.error.clear();
@@ -465,8 +478,7 @@ void World::FlushRobotBuffers() {
 
 void World::FlushSceneBuffers() {
   DrainLog(scene_runtime_, scene_script_memory_);
-  for (MetricSample& m : scene_runtime_.metrics) metrics_.push_back(std::move(m));
-  scene_runtime_.metrics.clear();
+  TakeSamples(&scene_runtime_.metrics, &metrics_);
   scene_script_memory_.Release(std::exchange(scene_runtime_.metric_bytes, 0));
 }
 

@@ -220,6 +220,23 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
   if (!args.out_dir.empty()) options.out_dir = args.out_dir;
   options.world_file = args.world_file;
   options.command_line = command_line;
+  // --out must be a folder we can make: a bad one is a bad command line
+  // (exit 2 before the run), not an error after the run's summary.
+  if (options.out_dir) {
+    std::error_code ec;
+    const auto status = std::filesystem::status(*options.out_dir, ec);
+    if (std::filesystem::exists(status) && !std::filesystem::is_directory(status)) {
+      std::cerr << "error: --out '" << options.out_dir->string()
+                << "' is not a folder; pass a folder (it is made if missing)\n";
+      return kExitBadInput;
+    }
+    try {
+      CreateOutputFolder(*options.out_dir);
+    } catch (const Error& e) {
+      std::cerr << "error: --out: " << swarmsim::ValidUtf8(e.what()) << "\n";
+      return kExitBadInput;
+    }
+  }
   // A world that does not load (or does not fit the command line): with
   // --out, summary.json says so too, for a batch system watching the folder.
   const auto bad_input = [&](const std::string& message) {
@@ -317,6 +334,11 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
       } catch (const Error& e) {
         return bad_input(e.what());
       }
+      // A run the watchdog ends (it exits from its own thread) closes the
+      // recording too: record-info then says how it ended.
+      options.on_stuck_end = [run_recorder](const RunResult& stuck) {
+        run_recorder->Finish(stuck.steps, stuck.signal != 0 ? "interrupted" : "error", stuck.error);
+      };
     }
   }
   // --view: the page follows the recording while the run writes it.
@@ -381,7 +403,8 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
   }
   if (!result.ok) {
     std::cerr << "error: " << swarmsim::ValidUtf8(result.error) << "\n";
-    if (options.out_dir && std::filesystem::is_directory(*options.out_dir))
+    // Only when there is something to find (a disk full from the start: nothing).
+    if (options.out_dir && std::filesystem::exists(*options.out_dir / "summary.json"))
       std::cerr << "outputs up to step " << result.steps << " are in " << options.out_dir->string()
                 << "\n";
     // The shell's convention for a run ended by a signal: 128 + its number.

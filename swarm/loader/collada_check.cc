@@ -392,6 +392,9 @@ double ColladaCheck::CheckPrimitive(const XMLElement* element, Primitive kind,
         uint64_t v = 0;
         if (!ParseUnsigned(t, 1u << 30, &v) || v == 0)
           Fail(e, "<vcount> value " + Quoted(t) + " is not a positive integer");
+        if (v > static_cast<uint64_t>(kMaxFaceCorners))
+          Fail(e, "<vcount>: a face of " + Count(static_cast<int64_t>(v)) + " corners; at most " +
+                      Count(kMaxFaceCorners) + " (split a larger polygon into smaller faces)");
         vcount.push_back(v);
         return true;
       });
@@ -468,6 +471,10 @@ double ColladaCheck::CheckPrimitive(const XMLElement* element, Primitive kind,
             Fail(e, "<p> of " + what + " holds " + Count(static_cast<int64_t>(tokens)) +
                         " indices: " + std::to_string(offsets) + " per corner, at least " +
                         std::to_string(least) + " corners");
+          if (kind == Primitive::kPolygons && points > static_cast<uint64_t>(kMaxFaceCorners))
+            Fail(e, "<p> of <polygons>: a face of " + Count(static_cast<int64_t>(points)) +
+                        " corners; at most " + Count(kMaxFaceCorners) +
+                        " (split a larger polygon into smaller faces)");
           if (kind != Primitive::kLineStrips) triangles += static_cast<double>(points - 2);
           break;
         }

@@ -142,6 +142,10 @@ void CheckObjBytes(const std::string& bytes, const std::string& name) {
         ++n;
         return true;
       });
+      if (n > kMaxFaceCorners)
+        Fail(name, line,
+             "a face of " + Count(n) + " corners; at most " + Count(kMaxFaceCorners) +
+                 " (split a larger polygon into smaller faces)");
       corners += n;
       if (n >= 3) triangles += n - 2;
       CheckTriangleCount(name, line, triangles, "the faces up to here make");

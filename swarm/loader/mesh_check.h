@@ -6,9 +6,16 @@
 // instances that recurse without end. tinyxml2 stays in mesh_check.cc.
 #pragma once
 
+#include <cstdint>
 #include <string>
 
 namespace swarmsim::loader {
+
+// Corners of one polygon face (an OBJ `f` line, a COLLADA <polylist>
+// <vcount> value or <polygons> <p>): assimp splits a polygon into triangles
+// in time quadratic in its corners (60,000: 10 s), so a larger face is
+// refused before assimp sees it. worlds/README.md, Limits.
+inline constexpr int64_t kMaxFaceCorners = 1000;
 
 // STL: a binary file's header count against its size (84 + 50 bytes per
 // triangle), an ASCII file's facets; both within kMaxMeshTriangles. Throws
@@ -17,7 +24,8 @@ void CheckStlBytes(const std::string& bytes, const std::string& name);
 
 // OBJ: every face's indices integers that name vertices the file defines
 // (negative ones: relative); positions finite; the triangles (a face of n
-// corners makes n - 2) within kMaxMeshTriangles. Throws swarmsim::Error
+// corners makes n - 2) within kMaxMeshTriangles, each face within
+// kMaxFaceCorners. Throws swarmsim::Error
 // "<name>:<line>: ...".
 void CheckObjBytes(const std::string& bytes, const std::string& name);
 

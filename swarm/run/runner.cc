@@ -1,10 +1,13 @@
 #include "swarm/run/runner.h"
 
+#include <fcntl.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <array>
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -286,6 +289,27 @@ std::string PhysicsLine(const World& world) {
 // A double that JSON should show as an integer: whole and exact (|v| <= 2^53).
 bool IsWholeNumber(double v) { return std::abs(v) <= 9007199254740992.0 && v == std::trunc(v); }
 
+// Writes `bytes` over the file at `path` in the blocks it already holds:
+// on a full disk there is no room for a copy beside it, but the summary
+// written at the start (status "running") has room for the last one. Only
+// when `bytes` fit in what the file holds (a cut JSON is worse than the
+// old one); false otherwise.
+bool OverwriteInPlace(const std::filesystem::path& path, std::string_view bytes) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
+  if (fd < 0) return false;
+  struct stat st {};
+  bool ok = ::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) &&
+            static_cast<uint64_t>(st.st_blocks) * 512 >= bytes.size();
+  for (size_t done = 0; ok && done < bytes.size();) {
+    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    ok = n > 0;
+    if (ok) done += static_cast<size_t>(n);
+  }
+  ok = ok && ::ftruncate(fd, static_cast<off_t>(bytes.size())) == 0;
+  return ::close(fd) == 0 && ok;
+}
+
 // summary.json, written whole or not at all (WriteFileAtomically); returns
 // "" or why it could not be written. `complete`: the world is between steps;
 // else a step is stuck (Watchdog) and what a running step may change is
@@ -350,9 +374,20 @@ std::string WriteSummary(const World& world, const RunOptions& options, const Ru
           {{"kind", file.kind}, {"path", file.path}, {"description", file.description}});
   j["outputs"] = outputs;
   // Invalid UTF-8 (from a world file, a script, a --set) is replaced, not fatal.
-  return TryWriteFileAtomically(
-      *options.out_dir / "summary.json",
-      j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+  const std::filesystem::path path = *options.out_dir / "summary.json";
+  const std::string text = j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+  const std::string reason = TryWriteFileAtomically(path, text);
+  if (reason.empty()) return "";
+  // No room beside it (a full disk): over the summary already there, whole,
+  // or its first lines (how the run ended) if the whole does not fit.
+  if (OverwriteInPlace(path, text)) return "";
+  nlohmann::json last;
+  for (const char* key : {"swarmsim_version", "world", "command", "status", "error", "steps"})
+    if (j.contains(key)) last[key] = j[key];
+  if (OverwriteInPlace(path,
+                       last.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n"))
+    return "";
+  return reason;
 }
 
 // What a run has produced so far, shared by its step loop, the watchdog's
@@ -386,6 +421,7 @@ void StepWatched(World* world, const RunOptions& options, Clock::time_point star
       if (metrics) metrics->Flush();
     } catch (const Error&) {  // the summary says what stopped the run
     }
+    if (options.on_stuck_end) options.on_stuck_end(stuck);  // the recording's end chunk
     record->summary_room.Release();
     if (options.out_dir && std::filesystem::is_directory(*options.out_dir))
       WriteSummary(*world, options, stuck, 0, /*complete=*/false);
@@ -565,6 +601,15 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
       }
     }
   }
+  // A stop signal after the last step's check (while the world stopped or
+  // the outputs were written: a large video's end takes seconds) is not
+  // lost: the run ends as interrupted, saying that every step was run.
+  if (const int sig = StopSignals::Received(); sig != 0 && result.ok) {
+    result.ok = false;
+    result.signal = sig;
+    result.error = std::string("interrupted by SIG") + sigabbrev_np(sig) + " after all " +
+                   std::to_string(result.steps) + " steps, while the run wrote its outputs";
+  }
   result.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
   result.state_hash = world->StateHash();
   result.peak_rss_mb = PeakRssMb();
@@ -585,8 +630,8 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
       if (result.ok) {
         result.ok = false;
         result.error = message;
-      } else {
-        result.error += "; " + message;
+      } else if (result.error.find(message) == std::string::npos) {
+        result.error += "; " + message;  // said once (the first summary's failure may be it)
       }
     }
   }

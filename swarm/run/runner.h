@@ -14,6 +14,8 @@
 
 namespace swarmsim {
 
+struct RunResult;
+
 struct RunOptions {
   int64_t steps = 0;
   std::optional<std::filesystem::path> out_dir;  // summary.json, metrics.csv
@@ -34,6 +36,11 @@ struct RunOptions {
   std::optional<std::filesystem::path> save_state;
   int64_t save_state_at = -1;
   std::string resumed_from;
+  // Called once with how the run ended when the watchdog ends it (a step or
+  // the stop stuck past simulation.step_timeout, a stop signal during a
+  // stuck step), from the watchdog's thread just before the process exits:
+  // the recording's end chunk. (A run that returns is the caller's to close.)
+  std::function<void(const RunResult&)> on_stuck_end;
 };
 
 struct RunResult {

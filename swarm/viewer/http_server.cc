@@ -10,6 +10,7 @@
 #include <charconv>
 #include <chrono>
 #include <condition_variable>
+#include <cstdint>
 #include <exception>
 #include <functional>
 #include <memory>
@@ -35,10 +36,15 @@ constexpr uint64_t kMaxRecordingAnswer = 64ull << 20;
 // are sent, so a connection holds no more of them (kMaxConnections at once).
 constexpr size_t kAnswerPiece = 64 << 10;
 
-// Answers `file`'s bytes from `from` on, at most kMaxRecordingAnswer of
-// them, read piece by piece as they are sent; `*size`: the file's size.
-// False when the file cannot be read.
-bool AnswerFile(const fs::path& file, uint64_t from, const std::string& content_type,
+// Answers `file`'s bytes from `from` on, at most `max_length` of them, read
+// piece by piece as they are sent; `*size`: the file's size. A request's
+// `Range: bytes=A-B` (one range) is answered here, not by httplib (whose
+// 0.11 answers a start past the end with a 206 of a wrapped length): 206 with
+// the bytes from A to B (B past the end: to the end; `bytes=-N`: the last N),
+// 416 when A is past the end; several ranges are ignored (the whole answer,
+// as RFC 9110 allows). False when the file cannot be read.
+bool AnswerFile(const fs::path& file, uint64_t from, uint64_t max_length,
+                const std::string& content_type, const httplib::Request& req,
                 httplib::Response* res, uint64_t* size) {
   // Only a regular file: a FIFO put in place after FileInside's check is
   // refused, never waited on.
@@ -46,7 +52,37 @@ bool AnswerFile(const fs::path& file, uint64_t from, const std::string& content_
   const std::shared_ptr<const RegularFile> open = RegularFile::Open(file, &why);
   if (!open || open->CurrentSize() < 0) return false;
   *size = static_cast<uint64_t>(open->CurrentSize());
-  const uint64_t length = from >= *size ? 0 : std::min(*size - from, kMaxRecordingAnswer);
+  uint64_t length = from >= *size ? 0 : std::min(*size - from, max_length);
+  // httplib parsed the ranges into the request; taken from it here so that
+  // it does not apply them again (the Request is httplib's own, not const).
+  const httplib::Ranges ranges = req.ranges;
+  const_cast<httplib::Request&>(req).ranges.clear();
+  if (ranges.size() == 1) {
+    const uint64_t available = length;
+    const auto [first, last] = ranges.front();
+    uint64_t start = 0, end = 0;  // [start, end) of the answer after `from`
+    if (first < 0) {              // bytes=-N: the last N
+      const uint64_t n = static_cast<uint64_t>(std::max<int64_t>(last, 0));
+      start = available - std::min(n, available);
+      end = n == 0 ? start : available;
+    } else {
+      start = static_cast<uint64_t>(first);
+      end = last < 0 ? available : std::min(static_cast<uint64_t>(last) + 1, available);
+    }
+    if (start >= available || end <= start) {
+      res->status = 416;
+      res->set_header("Content-Range", "bytes */" + std::to_string(available));
+      res->set_content(
+          "range not satisfiable: the answer has " + std::to_string(available) + " bytes\n",
+          "text/plain");
+      return true;
+    }
+    res->status = 206;
+    res->set_header("Content-Range", "bytes " + std::to_string(start) + "-" +
+                                         std::to_string(end - 1) + "/" + std::to_string(available));
+    from += start;
+    length = end - start;
+  }
   if (length == 0) {
     res->set_content("", content_type);
     return true;
@@ -201,7 +237,8 @@ HttplibServer::HttplibServer(HttpSite site) : site_(std::move(site)) {
     }
     const std::optional<fs::path> file = FileInside(site_.folder, kRecordingFile);
     uint64_t size = 0;
-    if (!file || !AnswerFile(*file, from, "application/octet-stream", &res, &size)) {
+    if (!file || !AnswerFile(*file, from, kMaxRecordingAnswer, "application/octet-stream", req,
+                             &res, &size)) {
       res.status = 404;
       return;
     }
@@ -209,11 +246,13 @@ HttplibServer::HttplibServer(HttpSite site) : site_(std::move(site)) {
     res.set_header("X-Swarmsim-Size", std::to_string(size));
   });
 
-  // Other files of the folder the page may need (summary.json, meshes).
+  // Other files of the folder the page may need (summary.json, meshes):
+  // whole, however large (streamed piece by piece), never cut.
   http.Get("/files/(.+)", [this](const httplib::Request& req, httplib::Response& res) {
     const std::optional<fs::path> file = FileInside(site_.folder, req.matches[1].str());
     uint64_t size = 0;
-    if (!file || !AnswerFile(*file, 0, ContentType(*file), &res, &size)) res.status = 404;
+    if (!file || !AnswerFile(*file, 0, UINT64_MAX, ContentType(*file), req, &res, &size))
+      res.status = 404;
   });
 }
 

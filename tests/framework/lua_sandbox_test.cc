@@ -131,6 +131,21 @@ TEST_F(SandboxTest, WritesOnlyUnderTheOutputFolder) {
   EXPECT_CONTAINS(Run("io.open('sneaky/data.txt', 'w')"), "is outside the run's output folder");
 }
 
+// The room kept aside for the final summary on a full disk is the run's own:
+// a script that emptied it would lose summary.json when the disk fills.
+TEST_F(SandboxTest, TheDiskReserveIsOneOfTheRunsOwnOutputs) {
+  const std::string kept(4096, 'r');
+  Write(root_ / "out" / ".swarmsim-reserve", kept);
+  for (const char* mode : {"w", "a", "r+", "w+"}) {
+    const std::string error =
+        Run(std::string("local f = io.open('.swarmsim-reserve', '") + mode + "'); f:close()");
+    EXPECT_CONTAINS(error, "'.swarmsim-reserve' is one of the run's own outputs");
+    EXPECT_CONTAINS(error, "bot#0: scripts/robot.lua:1:");
+  }
+  EXPECT_CONTAINS(Run("io.open('./.swarmsim-reserve', 'w')"), "one of the run's own outputs");
+  EXPECT_EQ(fs::file_size(root_ / "out" / ".swarmsim-reserve"), kept.size());
+}
+
 TEST_F(SandboxTest, RequireLoadsModulesFromTheWorldFoldersOncePerState) {
   Write(root_ / "world" / "scripts" / "util.lua",
         "count = (count or 0) + 1\nprint('loading util')\n"

@@ -312,6 +312,35 @@ TEST_F(TrustTest, DataTheSimCallsKeepCountsAgainstTheRobotsMemoryLimit) {
   ExpectEachRefusedPastTheLimit(calls, /*lua_heap_too=*/true);
 }
 
+// sim.recordMetric charges what a sample really holds: the robot's vector of
+// samples grows by doubling (its capacity is held, used or not), so the
+// samples recorded before the refusal fit in a vector whose capacity (the
+// next power of two from 16) is within the limit; after the step the
+// buffer is freed with the account. (Charging the used slots only let the
+// capacity reach ~2x the limit: 64 MiB -> 145 MB peak.)
+TEST_F(TrustTest, MetricSamplesChargeTheCapacityTheyHold) {
+  settings_.script_memory_limit = 3 << 20;
+  const std::string error =
+      Run("function sysCall_actuation()\n"
+          "  local n = 0\n"
+          "  pcall(function() for i = 1, 10000000 do sim.recordMetric('m' .. (i % 100), i) n = i "
+          "end end)\n"
+          "  print('recorded', n)\n"
+          "end\n");
+  EXPECT_EQ(error, "");
+  ASSERT_EQ(log_.size(), 1u);
+  const size_t n = std::stoul(log_[0].substr(log_[0].find('\t') + 1));
+  size_t capacity = 16;
+  while (capacity < n) capacity *= 2;
+  EXPECT_LE(capacity * sizeof(MetricSample), size_t{3} << 20) << n << " samples";
+  // Not charged far beyond what they hold either: at least a quarter of the limit.
+  EXPECT_GE(n * sizeof(MetricSample), size_t{3} << 18) << n << " samples";
+  // The step is over: the samples are the World's, the robot holds none.
+  EXPECT_EQ(world_->TakeMetrics().size(), n);
+  EXPECT_EQ(world_->runtime(0).metrics.capacity(), 0u);
+  EXPECT_EQ(world_->script_memory(0).data(), 0u);
+}
+
 // The same for what a call holds for the robot's lifetime (collections)
 // or while it runs (a packed string). The error's text may take the Lua
 // heap a little past the limit (it may pass it by some slack); what C++

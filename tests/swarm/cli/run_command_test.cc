@@ -48,6 +48,25 @@ TEST(CliTest, DurationIsWholeStepsAndNotLessThanOne) {
   fs::remove_all(out);
 }
 
+// --out that is a file, or a folder that cannot be made: a bad command line,
+// refused before the run (no summary table printed), naming the path.
+TEST(CliTest, OutThatIsNotAFolderIsABadCommandLine) {
+  const fs::path dir = TempDir("out_not_folder");
+  fs::create_directories(dir);
+  const fs::path file = dir / "a_file";
+  std::ofstream(file) << "kept\n";
+  for (const std::string& out : {file.string(), std::string("/proc/swarmsim_no_such_dir")}) {
+    Result r = RunProgram("run " + Data("ok.yaml") + " --steps 2 --out " + out);
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(r.output.find("--out"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find(out), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("state-hash"), std::string::npos) << "the run did not start";
+    EXPECT_EQ(r.output.find("steps "), std::string::npos) << r.output;
+  }
+  EXPECT_EQ(swarmsim::testing::ReadFile(file), "kept\n");
+  fs::remove_all(dir);
+}
+
 TEST(CliTest, MissingWorldFileIsNamed) {
   Result r = RunProgram("run /nonexistent/world.yaml --steps 1");
   EXPECT_EQ(r.exit_code, 2);

@@ -91,6 +91,34 @@ TEST(MeshCheckTest, ColladaPrimitivesAgreeWithTheirCounts) {
             "part.dae:29: <tristrips> count=\"0\" has 1 <p> (one per strip or fan)");
 }
 
+// A polygon of more than kMaxFaceCorners corners, in a <polylist> or a
+// <polygons>, is refused before assimp splits it (quadratic time).
+TEST(MeshCheckTest, ColladaFacesHaveAtMostAThousandCorners) {
+  const auto polygon = [](int corners) {
+    std::string p = "<p>";
+    for (int k = 0; k < corners; ++k) p += std::to_string(k % 8) + " ";
+    return p + "</p>";
+  };
+  std::string list = Cube("<triangles count=\"12\"", "<polylist count=\"1\"");
+  list.replace(list.find("</triangles>"), 12, "</polylist>");
+  std::string fits = list, big = list;
+  fits.replace(fits.find(kTriangles), kTriangles.size(), "<vcount>1000</vcount>" + polygon(1000));
+  big.replace(big.find(kTriangles), kTriangles.size(), "<vcount>60000</vcount>" + polygon(60000));
+  EXPECT_EQ(ColladaError(fits), "no error");
+  EXPECT_EQ(ColladaError(big),
+            "part.dae:31: <vcount>: a face of 60,000 corners; at most 1,000 (split a larger "
+            "polygon into smaller faces)");
+  std::string polygons = Cube("<triangles count=\"12\"", "<polygons count=\"1\"");
+  polygons.replace(polygons.find("</triangles>"), 12, "</polygons>");
+  std::string fits_p = polygons, big_p = polygons;
+  fits_p.replace(fits_p.find(kTriangles), kTriangles.size(), polygon(1000));
+  big_p.replace(big_p.find(kTriangles), kTriangles.size(), polygon(1001));
+  EXPECT_EQ(ColladaError(fits_p), "no error");
+  EXPECT_EQ(ColladaError(big_p),
+            "part.dae:31: <p> of <polygons>: a face of 1,001 corners; at most 1,000 (split a "
+            "larger polygon into smaller faces)");
+}
+
 TEST(MeshCheckTest, ColladaIndicesAreIntegersWithinTheirSources) {
   for (const std::string token : {".NaN", "inf", "1e-320", "0x7fffffff", "-1", "+1", "2147483648"})
     EXPECT_EQ(ColladaError(Cube("<p>0 2 1", "<p>0 " + token + " 1")),

@@ -83,5 +83,21 @@ TEST(MeshCheckTest, ObjFacesNameVerticesTheFileDefines) {
             "part.obj:2: vertex coordinate 'inf' is not a finite number");
 }
 
+// A polygon's split into triangles takes assimp time quadratic in its
+// corners (60,000: 10 s): a face past kMaxFaceCorners is refused first.
+TEST(MeshCheckTest, ObjFacesHaveAtMostAThousandCorners) {
+  const std::string v = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+  const auto face = [](int corners) {
+    std::string f = "f";
+    for (int k = 0; k < corners; ++k) f += " " + std::to_string(k % 3 + 1);
+    return f + "\n";
+  };
+  EXPECT_EQ(ObjError(v + face(1000)), "no error");
+  EXPECT_EQ(ObjError(v + "f 1 2 3\n" + face(1001)),
+            "part.obj:5: a face of 1,001 corners; at most 1,000 (split a larger polygon into "
+            "smaller faces)");
+  EXPECT_EQ(ObjError(v + face(60000)).substr(0, 38), "part.obj:4: a face of 60,000 corners; ");
+}
+
 }  // namespace
 }  // namespace swarmsim::loader

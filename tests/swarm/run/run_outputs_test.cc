@@ -197,6 +197,43 @@ TEST(RunOutputsTest, StuckStepEndsTheRunNamingTheScriptAndKeepsTheOutputs) {
   fs::remove_all(dir);
 }
 
+// A run the watchdog ends still closes its recording with the end chunk
+// (record-info says how it ended, not "no end yet").
+TEST(RunOutputsTest, StuckStepClosesTheRecording) {
+  const fs::path dir = StuckWorld("stuck_record", "1");
+  const auto r = RunProgram("run " + (dir / "world.yaml").string() +
+                            " --steps 100 --quiet --record --out " + (dir / "out").string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  const auto info = RunProgram("record-info " + (dir / "out" / "recording.swrec").string());
+  EXPECT_EQ(info.exit_code, 0) << info.output;
+  EXPECT_EQ(info.output.find("no end yet"), std::string::npos) << info.output;
+  EXPECT_NE(info.output.find("the run ended (error: step 4 of 100 did not finish within 1 s"),
+            std::string::npos)
+      << info.output;
+  fs::remove_all(dir);
+}
+
+// A stop signal after the last step's check (here from the script's
+// cleanup, while the world stops) is not lost: the run ends as interrupted,
+// 128 + the signal, saying every step was run.
+TEST(RunOutputsTest, StopSignalAfterTheLastStepEndsTheRunAsInterrupted) {
+  const fs::path dir =
+      ProbeWorld("swarmsim_outputs", "late_signal", "",
+                 "function sysCall_cleanup() os.execute('kill -TERM $PPID') end\n");
+  const fs::path out = dir / "out";
+  const auto r = RunProgram("run " + (dir / "world.yaml").string() +
+                            " --steps 3 --quiet --trust-scripts --record --out " + out.string());
+  EXPECT_EQ(r.exit_code, 128 + SIGTERM) << r.output;
+  EXPECT_NE(r.output.find("error: interrupted by SIGTERM after all 3 steps"), std::string::npos)
+      << r.output;
+  const auto summary = nlohmann::json::parse(ReadFile(out / "summary.json"));
+  EXPECT_EQ(summary["status"], "interrupted");
+  EXPECT_EQ(summary["steps"], 3);
+  const auto info = RunProgram("record-info " + (out / "recording.swrec").string());
+  EXPECT_NE(info.output.find("the run ended (interrupted"), std::string::npos) << info.output;
+  fs::remove_all(dir);
+}
+
 // Without a timeout, a stop signal still ends a stuck step: a few seconds
 // after it, with status 'interrupted' and 128 + signal.
 TEST(RunOutputsTest, StopSignalEndsAStuckStep) {

@@ -141,6 +141,66 @@ TEST_F(ServerTest, SurvivesHostileRequestsAndGoesOnAnswering) {
   EXPECT_NE(Get(port, "/recording.swrec").find("\r\n\r\nRECORDING"), std::string::npos);
 }
 
+// The Content-Length header of an answer, -1 without one.
+long long ContentLength(const std::string& answer) {
+  const size_t at = answer.find("Content-Length: ");
+  if (at == std::string::npos) return -1;
+  return std::stoll(answer.substr(at + 16, answer.find("\r\n", at) - at - 16));
+}
+
+// The body of an answer: what follows the headers.
+std::string Body(const std::string& answer) {
+  const size_t at = answer.find("\r\n\r\n");
+  return at == std::string::npos ? "" : answer.substr(at + 4);
+}
+
+std::string GetRange(int port, const std::string& target, const std::string& range) {
+  return Exchange(port, "GET " + target + " HTTP/1.1\r\nHost: x\r\nRange: " + range +
+                            "\r\nConnection: close\r\n\r\n");
+}
+
+// A range past the end is refused (416), an end past the file is clamped:
+// never a length the body does not have.
+TEST_F(ServerTest, RangesPastTheEndAreRefusedOrClamped) {
+  Server server(run_);
+  const int port = server.Bind("127.0.0.1", 0);
+  server.Start();
+  for (const char* target : {"/recording.swrec", "/files/recording.swrec"}) {
+    const std::string past = GetRange(port, target, "bytes=999999999-");
+    EXPECT_NE(past.find(" 416 "), std::string::npos) << target << past;
+    EXPECT_NE(past.find("Content-Range: bytes */9"), std::string::npos) << past;
+    EXPECT_EQ(ContentLength(past), static_cast<long long>(Body(past).size())) << past;
+
+    const std::string clamped = GetRange(port, target, "bytes=3-999999999999");
+    EXPECT_NE(clamped.find(" 206 "), std::string::npos) << target << clamped;
+    EXPECT_NE(clamped.find("Content-Range: bytes 3-8/9"), std::string::npos) << clamped;
+    EXPECT_EQ(ContentLength(clamped), 6) << clamped;
+    EXPECT_EQ(Body(clamped), "ORDING");
+
+    const std::string middle = GetRange(port, target, "bytes=2-4");
+    EXPECT_NE(middle.find(" 206 "), std::string::npos) << middle;
+    EXPECT_EQ(Body(middle), "COR");
+    EXPECT_EQ(Body(GetRange(port, target, "bytes=-3")), "ING");
+  }
+  // The page's own question (?from=) combines with a range over what is left.
+  EXPECT_EQ(Body(GetRange(port, "/recording.swrec?from=3", "bytes=1-2")), "RD");
+}
+
+// A file larger than one recording answer (64 MiB) comes whole from
+// /files/, never a 200 with a cut body.
+TEST_F(ServerTest, LargeFilesAreServedWhole) {
+  const uintmax_t size = (64ull << 20) + 12345;
+  std::ofstream(run_ / "big.bin").close();
+  fs::resize_file(run_ / "big.bin", size);
+  Server server(run_);
+  const int port = server.Bind("127.0.0.1", 0);
+  server.Start();
+  const std::string answer = Get(port, "/files/big.bin");
+  ASSERT_NE(answer.find(" 200 "), std::string::npos) << answer.substr(0, 200);
+  EXPECT_EQ(ContentLength(answer), static_cast<long long>(size));
+  EXPECT_EQ(Body(answer).size(), size);
+}
+
 TEST_F(ServerTest, ProgramSaysWhenThePortIsInUseOrTheFolderHasNoRecording) {
   // A real recording, so only the port stands in the way.
   fs::copy_file(
