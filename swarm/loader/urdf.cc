@@ -483,9 +483,13 @@ MassProperties Importer::LinkMass(const urdf::Link& link) {
   const urdf::Inertial& in = *link.inertial;
   part.mass = in.mass;
   part.inertia = {in.ixx, in.iyy, in.izz, in.ixy, in.ixz, in.iyz};
-  // A zero diagonal is a point mass (a body's products of inertia are then
-  // zero too: CAD exports leave 1e-35 in them).
-  const bool point = in.ixx == 0 && in.iyy == 0 && in.izz == 0;
+  // A diagonal of zeros is a point mass (a body's products of inertia are
+  // then zero too): zeros to within the mass x 1e-12 m^2, a radius of
+  // gyration under 1 um (CAD exports leave -5e-20 in the diagonal, 2e-35
+  // in the products).
+  const double zero = in.mass * kUrdfPointMassTolerance;
+  const bool point =
+      std::abs(in.ixx) <= zero && std::abs(in.iyy) <= zero && std::abs(in.izz) <= zero;
   if (point) part.inertia = {};
   if (!point && !InertiaIsPhysical(part.inertia)) {
     const auto it = xml_.inertia_line.find(link.name);

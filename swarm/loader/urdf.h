@@ -28,6 +28,8 @@ inline constexpr double kUrdfDefaultInertia = 1e-4;  // kg m^2, about each axis
 // A body of point masses only (zero <inertia>): mass x this about each axis
 // (the default body's squared radius of gyration).
 inline constexpr double kUrdfPointMassGyration = kUrdfDefaultInertia / kUrdfDefaultMass;  // m^2
+// An <inertia> whose diagonal is within mass x this of zero is a point mass.
+inline constexpr double kUrdfPointMassTolerance = 1e-12;  // m^2
 inline constexpr double kUrdfDefaultEffort = 100;    // N or N m, a <limit effort="0">
 inline constexpr double kUrdfDefaultVelocity = 10;   // rad/s or m/s, no <limit velocity>
 inline constexpr double kUrdfCarrierRadius = 0.001;  // m, the body carrier's sphere
