@@ -62,9 +62,12 @@ struct ShapeData {
                              // height); sphere: (radius, -, -)
   bool dynamic = false;      // simulated by the dynamics backend, else static or kinematic
   double mass = 1.0;         // kg, dynamic shapes only
-  // Inertia about the shape's origin in its frame, kg m^2: (ixx, iyy, izz,
-  // ixy, ixz, iyz); all zero: the dynamics backend derives it from the geometry.
+  // Inertia about the centre of mass in the shape's axes, kg m^2: (ixx, iyy,
+  // izz, ixy, ixz, iyz); all zero: the dynamics backend derives it from the geometry.
   std::array<double, 6> inertia{};
+  // m, in the shape's frame: where the dynamics backend puts the mass (ode:
+  // a URDF body's combined centre of mass); zero: the shape's origin.
+  Vec3 center_of_mass;
   // false: no contacts in the dynamics backends (a URDF visual, a body's
   // mass carrier); sensors still see it.
   bool collidable = true;

@@ -41,6 +41,7 @@ void Scale(const ObjectTypeDescriptor&, void* row, double s, ScaleContext* conte
   ShapeData& shape = static_cast<Shared<ShapeData>*>(row)->Edit();  // this copy's own
   shape.size = shape.size * s;
   shape.mass *= s * s * s;
+  shape.center_of_mass = shape.center_of_mass * s;
   for (double& i : shape.inertia) i *= s * s * s * s * s;
   shape.surface_velocity = shape.surface_velocity * s;
   if (!shape.mesh) return;

@@ -7,6 +7,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <utility>
 
 #include "framework/display_path.h"
 #include "framework/error.h"
@@ -71,10 +72,15 @@ std::shared_ptr<const TriangleMesh> MeshCache::Get(const fs::path& path, const V
                   (scale.x == 1 && scale.y == 1 && scale.z == 1 ? "" : "scaled ") + "at " + text_v);
     }
   }
+  // A mirror (an odd count of negative factors, a URDF's scale="1 -1 1")
+  // turns the triangles inside out: their winding is reversed.
+  std::vector<MeshTriangle> triangles = file->second->triangles;
+  if (scale.x * scale.y * scale.z < 0)
+    for (MeshTriangle& t : triangles) std::swap(t.v[1], t.v[2]);
   std::shared_ptr<const TriangleMesh> mesh;
   try {
     mesh = std::make_shared<const TriangleMesh>(DisplayPath(path), std::move(vertices),
-                                                file->second->triangles, file->second->colors);
+                                                std::move(triangles), file->second->colors);
   } catch (const Error& e) {
     throw Error((where.empty() ? "" : where + ": ") + e.what());
   }

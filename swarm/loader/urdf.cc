@@ -18,6 +18,7 @@
 #include "framework/display_path.h"
 #include "framework/error.h"
 #include "framework/object_type.h"
+#include "swarm/loader/urdf_inertia.h"
 #include "swarm/loader/urdf_numbers.h"
 #include "swarm/loader/yaml.h"
 
@@ -26,8 +27,6 @@ namespace swarmsim::loader {
 namespace fs = std::filesystem;
 
 namespace {
-
-using Inertia = std::array<double, 6>;  // ixx, iyy, izz, ixy, ixz, iyz
 
 std::string Num(double v) {
   char buffer[32];
@@ -40,6 +39,10 @@ std::string Num(double v) {
 struct XmlFacts {
   std::map<std::string, int> link_line, joint_line, mimic_line;
   std::map<std::string, std::vector<int>> visual_lines, collision_lines;  // per link, in order
+  std::map<std::string, int> inertia_line;  // per link with an <inertia>
+  // Each visual's colour, per link in order (its material's <color rgba>,
+  // inline or the named material's); none: no colour (alpha 0 included).
+  std::map<std::string, std::vector<std::optional<Vec3>>> visual_colors;
   std::map<std::string, int> joint_order;  // document order of each joint
   // Ignored elements, by kind: count and first line.
   std::map<std::string, std::pair<int, int>> ignored;
@@ -77,7 +80,10 @@ class Importer {
   std::optional<ObjectSpec> Geometry(const urdf::Link& link, const urdf::Geometry* geometry,
                                      const urdf::Pose& origin, bool visual, int line,
                                      const Vec3* color);
-  void GroupMass(const urdf::Link& link, const Pose& X_TL, double* mass, Inertia* inertia);
+  MassProperties LinkMass(const urdf::Link& link);
+  void GroupMass(const urdf::Link& link, const Pose& X_TL, MassProperties* body,
+                 bool* has_geometry);
+  MassProperties BodyMass(const urdf::Link& top, bool is_root);
   ObjectSpec LinkObject(const urdf::Link& link, bool top, bool is_root, const Pose& X_PO,
                         const Pose& X_TL);
   std::vector<urdf::JointSharedPtr> ChildJoints(const urdf::Link& link) const;
@@ -88,8 +94,9 @@ class Importer {
   MeshCache* meshes_;
   XmlFacts xml_;
   std::map<std::string, std::optional<fs::path>> packages_;
-  std::set<std::string> default_mass_links_;
-  std::vector<std::string> isotropic_links_;  // bodies whose inertia was made isotropic
+  std::vector<std::string> default_mass_links_;  // bodies' top links given the default mass
+  std::vector<std::string> repaired_links_;      // links and bodies whose inertia was balanced
+  int links_merged_ = 0;  // links joined to their body's top link by fixed joints
   int frames_ = 0, bodies_ = 0, meshes_count_ = 0, visuals_ = 0, collisions_ = 0;
   std::map<std::string, int> mesh_formats_;
   std::map<std::string, int> joint_kinds_;
@@ -109,6 +116,8 @@ void Importer::ReadXml(const std::string& bytes) {
   std::map<std::string, std::string> parent_joint;                // child link -> joint
   std::map<std::string, std::string> parent_link;                 // child link -> parent link
   std::vector<std::tuple<std::string, std::string, int>> mimics;  // joint, master, line
+  // Each visual's <material> (or null), per link in order, resolved below.
+  std::vector<std::pair<std::string, const tinyxml2::XMLElement*>> visual_materials;
   int order = 0;
   for (const tinyxml2::XMLElement* e = robot->FirstChildElement(); e; e = e->NextSiblingElement()) {
     const std::string kind = e->Name();
@@ -141,6 +150,8 @@ void Importer::ReadXml(const std::string& bytes) {
                                                       : c->GetLineNum());
           if (const tinyxml2::XMLElement* m = c->FirstChildElement("material"))
             if (m->FirstChildElement("texture")) Ignore("<texture> (materials' textures)", line);
+          if (part == "visual")
+            visual_materials.emplace_back(name, c->FirstChildElement("material"));
         } else if (part == "inertial") {
           double mass = 0;
           const tinyxml2::XMLElement* m = c->FirstChildElement("mass");
@@ -148,23 +159,8 @@ void Importer::ReadXml(const std::string& bytes) {
               !(mass >= 0 && std::isfinite(mass)))
             Fail(m->GetLineNum(), "link '" + std::string(name) + "': <mass value=\"" + Num(mass) +
                                       "\"> must be a non-negative number of kg");
-          const tinyxml2::XMLElement* in = c->FirstChildElement("inertia");
-          if (in) {
-            Inertia i{};
-            const char* keys[6] = {"ixx", "iyy", "izz", "ixy", "ixz", "iyz"};
-            for (int k = 0; k < 6; ++k) in->QueryDoubleAttribute(keys[k], &i[k]);
-            const bool zero = std::all_of(i.begin(), i.end(), [](double v) { return v == 0; });
-            const double m2 = i[0] * i[1] - i[3] * i[3];
-            const double m3 = i[0] * (i[1] * i[2] - i[5] * i[5]) -
-                              i[3] * (i[3] * i[2] - i[5] * i[4]) +
-                              i[4] * (i[3] * i[5] - i[1] * i[4]);
-            const bool definite = i[0] > 0 && m2 > 0 && m3 > 0;
-            if (!definite && !(zero && mass == 0))
-              Fail(in->GetLineNum(),
-                   "link '" + std::string(name) + "': <inertia> is not positive definite (ixx " +
-                       Num(i[0]) + ", iyy " + Num(i[1]) + ", izz " + Num(i[2]) + ", ixy " +
-                       Num(i[3]) + ", ixz " + Num(i[4]) + ", iyz " + Num(i[5]) + ")");
-          }
+          if (const tinyxml2::XMLElement* in = c->FirstChildElement("inertia"))
+            xml_.inertia_line[name] = in->GetLineNum();
         } else {
           Ignore("<" + part + "> in a link", c->GetLineNum());
         }
@@ -258,6 +254,37 @@ void Importer::ReadXml(const std::string& bytes) {
     if (!xml_.joint_line.contains(master))
       Fail(line, "joint '" + joint + "': <mimic joint=\"" + master +
                      "\"> names a joint the file does not define");
+  // Colours: a visual's own <color rgba>, else its named material's, a
+  // robot-level <material> (the first of a name) or one a visual defined
+  // with a colour (urdfdom's rule). rgba's alpha is not imported (0: none).
+  auto rgb = [](const tinyxml2::XMLElement* material) -> std::optional<std::optional<Vec3>> {
+    const tinyxml2::XMLElement* color = material ? material->FirstChildElement("color") : nullptr;
+    const char* rgba = color ? color->Attribute("rgba") : nullptr;
+    if (rgba == nullptr) return std::nullopt;  // no colour of its own
+    double v[4] = {0, 0, 0, 1};
+    char* end = const_cast<char*>(rgba);
+    for (double& x : v) x = std::strtod(end, &end);  // four finite numbers (FindBadNumber)
+    if (!(v[3] > 0)) return std::optional<Vec3>();
+    return std::optional<Vec3>(
+        Vec3{std::clamp(v[0], 0.0, 1.0), std::clamp(v[1], 0.0, 1.0), std::clamp(v[2], 0.0, 1.0)});
+  };
+  std::map<std::string, std::optional<Vec3>> named;
+  for (const tinyxml2::XMLElement* m = robot->FirstChildElement("material"); m;
+       m = m->NextSiblingElement("material"))
+    if (const char* name = m->Attribute("name"))
+      if (auto color = rgb(m)) named.emplace(name, *color);
+  for (const auto& [link, material] : visual_materials)
+    if (const char* name = material ? material->Attribute("name") : nullptr)
+      if (auto color = rgb(material)) named.emplace(name, *color);
+  for (const auto& [link, material] : visual_materials) {
+    std::optional<Vec3> color;
+    if (auto own = rgb(material)) {
+      color = *own;
+    } else if (const char* name = material ? material->Attribute("name") : nullptr) {
+      if (auto it = named.find(name); it != named.end()) color = it->second;
+    }
+    xml_.visual_colors[link].push_back(color);
+  }
 }
 
 // --- package:// ---------------------------------------------------------------------
@@ -418,8 +445,14 @@ std::optional<ObjectSpec> Importer::Geometry(const urdf::Link& link, const urdf:
     case urdf::Geometry::MESH: {
       const auto* m = static_cast<const urdf::Mesh*>(g);
       const fs::path file = ResolveUri(m->filename, line, what);
-      const Vec3 scale{positive(m->scale.x, "mesh scale x"), positive(m->scale.y, "mesh scale y"),
-                       positive(m->scale.z, "mesh scale z")};
+      // Negative factors mirror (ROS's left and right arms from one mesh).
+      auto nonzero = [&](double v, const char* key) {
+        if (!(v != 0) || !std::isfinite(v))
+          Fail(line, what + ": " + key + " must be a nonzero number (got " + Num(v) + ")");
+        return v;
+      };
+      const Vec3 scale{nonzero(m->scale.x, "mesh scale x"), nonzero(m->scale.y, "mesh scale y"),
+                       nonzero(m->scale.z, "mesh scale z")};
       s.kind = ShapeKind::kMesh;
       s.mesh =
           meshes_->Get(file, scale, name_ + ":" + std::to_string(line) + ": " + what, m->filename);
@@ -440,49 +473,82 @@ std::optional<ObjectSpec> Importer::Geometry(const urdf::Link& link, const urdf:
   return spec;
 }
 
-// The mass of `link` and the links fixed to it, and their inertia about the
-// group's top frame T (X_TL: the link in T).
-void Importer::GroupMass(const urdf::Link& link, const Pose& X_TL, double* mass, Inertia* inertia) {
-  double m = 0;
-  Pose X_LC;      // the centre of mass in the link
-  Inertia I_C{};  // about the centre of mass, its frame
-  if (link.inertial) {
-    m = link.inertial->mass;
-    X_LC = ToPose(link.inertial->origin);
-    const auto& in = *link.inertial;
-    I_C = {in.ixx, in.iyy, in.izz, in.ixy, in.ixz, in.iyz};
-  } else if (!link.collision_array.empty() || !link.visual_array.empty()) {
-    m = kUrdfDefaultMass;
-    I_C = {kUrdfDefaultInertia, kUrdfDefaultInertia, kUrdfDefaultInertia, 0, 0, 0};
-    default_mass_links_.insert(link.name);
+// The mass of `link` in its frame: its <inertial>, the inertia rotated from
+// the <inertial> frame into the link's. A link whose inertia no rigid body
+// has is repaired (BalancedInertia; all zero: a point mass, kept); no mass:
+// nothing.
+MassProperties Importer::LinkMass(const urdf::Link& link) {
+  MassProperties part;
+  if (!link.inertial || !(link.inertial->mass > 0)) return part;
+  const urdf::Inertial& in = *link.inertial;
+  part.mass = in.mass;
+  part.inertia = {in.ixx, in.iyy, in.izz, in.ixy, in.ixz, in.iyz};
+  // A diagonal of zeros is a point mass (a body's products of inertia are
+  // then zero too): zeros to within the mass x 1e-12 m^2, a radius of
+  // gyration under 1 um (CAD exports leave -5e-20 in the diagonal, 2e-35
+  // in the products).
+  const double zero = in.mass * kUrdfPointMassTolerance;
+  const bool point =
+      std::abs(in.ixx) <= zero && std::abs(in.iyy) <= zero && std::abs(in.izz) <= zero;
+  if (point) part.inertia = {};
+  if (!point && !InertiaIsPhysical(part.inertia)) {
+    const auto it = xml_.inertia_line.find(link.name);
+    const int line = it != xml_.inertia_line.end() ? it->second : xml_.link_line[link.name];
+    if (!(in.ixx + in.iyy + in.izz > 0))
+      Fail(line, "link '" + link.name +
+                     "': <inertia> cannot be repaired: its principal moments sum to " +
+                     Num(in.ixx + in.iyy + in.izz) + " kg m^2 (ixx " + Num(in.ixx) + ", iyy " +
+                     Num(in.iyy) + ", izz " + Num(in.izz) + "); a body's are positive");
+    part.inertia = BalancedInertia(part.inertia);
+    repaired_links_.push_back(link.name);
   }
-  if (m > 0) {
-    const Pose X_TC = X_TL * X_LC;
-    // R I R^T, then the parallel-axis term m (|p|^2 E - p p^T).
-    const double I[3][3] = {
-        {I_C[0], I_C[3], I_C[4]}, {I_C[3], I_C[1], I_C[5]}, {I_C[4], I_C[5], I_C[2]}};
-    double R[3][3];
-    for (int c = 0; c < 3; ++c) {
-      const Vec3 col = X_TC.q.Rotate({c == 0 ? 1.0 : 0.0, c == 1 ? 1.0 : 0.0, c == 2 ? 1.0 : 0.0});
-      R[0][c] = col.x, R[1][c] = col.y, R[2][c] = col.z;
-    }
-    double J[3][3] = {};
-    for (int a = 0; a < 3; ++a)
-      for (int b = 0; b < 3; ++b)
-        for (int k = 0; k < 3; ++k)
-          for (int l = 0; l < 3; ++l) J[a][b] += R[a][k] * I[k][l] * R[b][l];
-    const double p[3] = {X_TC.p.x, X_TC.p.y, X_TC.p.z};
-    const double p2 = p[0] * p[0] + p[1] * p[1] + p[2] * p[2];
-    for (int a = 0; a < 3; ++a)
-      for (int b = 0; b < 3; ++b) J[a][b] += m * ((a == b ? p2 : 0) - p[a] * p[b]);
-    const Inertia add{J[0][0], J[1][1], J[2][2], J[0][1], J[0][2], J[1][2]};
-    *mass += m;
-    for (int k = 0; k < 6; ++k) (*inertia)[k] += add[k];
-  }
+  const Pose X_LI = ToPose(in.origin);  // the <inertial> frame in the link
+  return Transformed(part, X_LI);
+}
+
+// Adds `link` and the links fixed to it to `body`, in the frame T of the
+// body's top link (X_TL: the link in T).
+void Importer::GroupMass(const urdf::Link& link, const Pose& X_TL, MassProperties* body,
+                         bool* has_geometry) {
+  AddMass(Transformed(LinkMass(link), X_TL), body);
+  if (!link.collision_array.empty() || !link.visual_array.empty()) *has_geometry = true;
   for (const urdf::JointSharedPtr& joint : ChildJoints(link))
     if (joint->type == urdf::Joint::FIXED || joint->type == urdf::Joint::PLANAR)
-      if (const urdf::LinkConstSharedPtr child = ChildLink(link, *joint))
-        GroupMass(*child, X_TL * ToPose(joint->parent_to_joint_origin_transform), mass, inertia);
+      if (const urdf::LinkConstSharedPtr child = ChildLink(link, *joint)) {
+        ++links_merged_;
+        GroupMass(*child, X_TL * ToPose(joint->parent_to_joint_origin_transform), body,
+                  has_geometry);
+      }
+}
+
+// The body whose top link is `top`: its links' mass combined about their
+// centre of mass; the default when it can move and has none (a moving
+// joint's child, or the root holding geometry: it may float); its inertia
+// balanced when no rigid body has it (point masses alone).
+MassProperties Importer::BodyMass(const urdf::Link& top, bool is_root) {
+  MassProperties body;
+  bool has_geometry = false;
+  GroupMass(top, Pose{}, &body, &has_geometry);
+  if (!(body.mass > 0)) {
+    if (is_root && !has_geometry) return body;  // a frame, never simulated
+    body.mass = kUrdfDefaultMass;
+    body.center = {};
+    body.inertia = {kUrdfDefaultInertia, kUrdfDefaultInertia, kUrdfDefaultInertia, 0, 0, 0};
+    default_mass_links_.push_back(top.name);
+    return body;
+  }
+  if (!InertiaIsPhysical(body.inertia)) {
+    body.inertia = BalancedInertia(body.inertia);
+    // Point masses alone (a mean moment under the mass's at 1e-9 m^2):
+    // the default link's radius of gyration.
+    const double least = body.mass * kUrdfPointMassGyration;
+    if (!(body.inertia[0] > 1e-9 * body.mass))
+      body.inertia = {least, least, least, 0, 0, 0};
+    if (std::find(repaired_links_.begin(), repaired_links_.end(), top.name) ==
+        repaired_links_.end())
+      repaired_links_.push_back(top.name);
+  }
+  return body;
 }
 
 std::vector<urdf::JointSharedPtr> Importer::ChildJoints(const urdf::Link& link) const {
@@ -499,39 +565,31 @@ ObjectSpec Importer::LinkObject(const urdf::Link& link, bool top, bool is_root, 
                                 const Pose& X_TL) {
   ObjectSpec spec;
   if (top) {
-    double mass = 0;
-    Inertia inertia{};
-    GroupMass(link, Pose{}, &mass, &inertia);
+    const MassProperties body = BodyMass(link, is_root);
     spec = NewObject(ObjectType::kShape, ObjectName(link.name), X_PO);
     ShapeData& s = RowOf<Shared<ShapeData>>(spec).Edit();
     s.kind = ShapeKind::kSphere;
     s.size = {kUrdfCarrierRadius, 0, 0};
     s.collidable = false;
-    s.mass = mass;  // 0: a frame, never simulated
-    s.dynamic = mass > 0 && !is_root;
-    if (mass > 0 && !InertiaIsValid(inertia)) {
-      // Each link's tensor is positive definite (checked), but CAD exports
-      // break the triangle inequality ODE needs: keep the mean moment.
-      const double mean = (inertia[0] + inertia[1] + inertia[2]) / 3;
-      inertia = {mean > 0 ? mean : mass * kUrdfDefaultInertia, 0, 0, 0, 0, 0};
-      inertia[1] = inertia[2] = inertia[0];
-      isotropic_links_.push_back(link.name);
-    }
-    if (mass > 0) s.inertia = inertia;
-    if (mass > 0) {
+    s.mass = body.mass;  // 0: a frame, never simulated
+    s.dynamic = body.mass > 0 && !is_root;
+    if (body.mass > 0) {
+      s.inertia = body.inertia;
+      s.center_of_mass = body.center;
       ++bodies_;
-      total_mass_ += mass;
+      total_mass_ += body.mass;
     } else {
       ++frames_;
     }
   } else {
     spec = NewObject(ObjectType::kDummy, ObjectName(link.name), X_PO);
   }
-  // The link's colour: its first visual's material.
+  // The link's colour (its collision shapes'): its first coloured visual's.
+  const std::vector<std::optional<Vec3>>& colors = xml_.visual_colors[link.name];
   std::optional<Vec3> color;
-  for (const auto& v : link.visual_array)
-    if (v->material && v->material->color.a > 0) {
-      color = Vec3{v->material->color.r, v->material->color.g, v->material->color.b};
+  for (const std::optional<Vec3>& c : colors)
+    if (c) {
+      color = c;
       break;
     }
   const std::vector<int>& collision_lines = xml_.collision_lines[link.name];
@@ -546,9 +604,7 @@ ObjectSpec Importer::LinkObject(const urdf::Link& link, bool top, bool is_root, 
   for (size_t k = 0; k < link.visual_array.size(); ++k) {
     const auto& v = *link.visual_array[k];
     const int line = k < visual_lines.size() ? visual_lines[k] : xml_.link_line[link.name];
-    std::optional<Vec3> own;
-    if (v.material && v.material->color.a > 0)
-      own = Vec3{v.material->color.r, v.material->color.g, v.material->color.b};
+    const std::optional<Vec3> own = k < colors.size() ? colors[k] : std::nullopt;
     if (auto shape = Geometry(link, v.geometry.get(), v.origin, true, line, own ? &*own : nullptr))
       spec.children.push_back(std::move(*shape));
   }
@@ -681,10 +737,12 @@ UrdfImport Importer::Run(const std::string& where, const std::string& text) {
   for (const auto& [kind, n] : joint_kinds_) joint_count += n;
   out.summary.push_back("urdf: robot '" + model->getName() + "', root link '" +
                         model->getRoot()->name + "'");
-  out.summary.push_back("  links: " + std::to_string(xml_.link_line.size()) + " (" +
-                        std::to_string(bodies_) + " bodies with mass, " + Num(total_mass_) +
+  out.summary.push_back("  links: " + std::to_string(xml_.link_line.size()) + ", " +
+                        std::to_string(links_merged_) + " merged by fixed joints into " +
+                        std::to_string(bodies_) + " bodies with mass (" + Num(total_mass_) +
                         " kg in all; " + std::to_string(default_mass_links_.size()) +
-                        " with the default mass)");
+                        " with the default mass, " + std::to_string(repaired_links_.size()) +
+                        " inertias repaired)");
   out.summary.push_back("  joints: " + std::to_string(joint_count) +
                         (joints.empty() ? "" : " (" + joints + ")") +
                         (mimics_ ? ", " + std::to_string(mimics_) + " mimic (dependent)" : ""));
@@ -696,23 +754,31 @@ UrdfImport Importer::Run(const std::string& where, const std::string& text) {
     out.warnings.push_back(name_ + ":" + std::to_string(count_line.second) + ": ignored " +
                            std::to_string(count_line.first) + " " + kind +
                            (count_line.first == 1 ? "" : " (first here)"));
-  if (!isotropic_links_.empty()) {
-    std::string names;
-    for (const std::string& n : isotropic_links_) names += (names.empty() ? "" : ", ") + n;
-    out.warnings.push_back(name_ + ": the inertia of " + std::to_string(isotropic_links_.size()) +
-                           " bod" + (isotropic_links_.size() == 1 ? "y" : "ies") + " (" + names +
-                           ") breaks the triangle inequality of principal moments: replaced by "
-                           "its mean moment about each axis");
-  }
-  if (!default_mass_links_.empty()) {
-    std::string names;
-    for (const std::string& n : default_mass_links_) names += (names.empty() ? "" : ", ") + n;
+  auto list = [](const std::vector<std::string>& names) {
+    std::string out;
+    for (const std::string& n : names) out += (out.empty() ? "" : ", ") + n;
+    return out;
+  };
+  const auto plural = [](size_t n, const char* one, const char* many) {
+    return std::to_string(n) + " " + (n == 1 ? one : many);
+  };
+  if (!repaired_links_.empty())
     out.warnings.push_back(
-        name_ + ": " + std::to_string(default_mass_links_.size()) + " link" +
-        (default_mass_links_.size() == 1 ? " has" : "s have") + " geometry but no <inertial> (" +
-        names + "): each gets the default mass " + Num(kUrdfDefaultMass) + " kg and inertia " +
-        Num(kUrdfDefaultInertia) + " kg m^2 about each axis at the link origin");
-  }
+        name_ + ": the inertia of " + plural(repaired_links_.size(), "link", "links") + " (" +
+        list(repaired_links_) +
+        ") is no rigid body's (not positive definite, or a principal moment above the sum of "
+        "the other two): balanced as MuJoCo's balanceinertia does, each principal moment "
+        "replaced by their mean (a body of point masses only: its mass x " +
+        Num(kUrdfPointMassGyration) + " m^2 about each axis)");
+  if (!default_mass_links_.empty())
+    out.warnings.push_back(
+        name_ + ": " + plural(default_mass_links_.size(), "link", "links") +
+        " that can move (a moving joint's child, or the root with geometry) " +
+        (default_mass_links_.size() == 1 ? "has" : "have") +
+        " no mass, nor links fixed to " + (default_mass_links_.size() == 1 ? "it" : "them") +
+        " (" + list(default_mass_links_) + "): each gets the default mass " +
+        Num(kUrdfDefaultMass) + " kg and inertia " + Num(kUrdfDefaultInertia) +
+        " kg m^2 about each axis at the link origin");
   return out;
 }
 

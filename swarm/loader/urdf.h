@@ -4,7 +4,8 @@
 //
 // Links become shapes: each rigid group of links (joined by fixed joints)
 // is one body, a non-collidable carrier shape at the group's top link frame
-// holding the group's mass and inertia (about that origin); each link's
+// holding the group's mass, centre of mass and inertia about it
+// (urdf_inertia.h: merged, repaired, defaulted); each link's
 // <collision> and <visual> geometry are shapes below it (visuals do not
 // collide). Moving joints become joints whose z axis is the URDF axis;
 // mimic joints become dependent joints. worlds/README.md ("URDF models")
@@ -20,9 +21,15 @@
 
 namespace swarmsim::loader {
 
-// The mass and inertia of a link without <inertial> that has geometry.
+// The mass and inertia of a body that can move and has no mass (its links
+// have no <inertial> or mass 0): at its top link's origin.
 inline constexpr double kUrdfDefaultMass = 0.1;      // kg
 inline constexpr double kUrdfDefaultInertia = 1e-4;  // kg m^2, about each axis
+// A body of point masses only (zero <inertia>): mass x this about each axis
+// (the default body's squared radius of gyration).
+inline constexpr double kUrdfPointMassGyration = kUrdfDefaultInertia / kUrdfDefaultMass;  // m^2
+// An <inertia> whose diagonal is within mass x this of zero is a point mass.
+inline constexpr double kUrdfPointMassTolerance = 1e-12;  // m^2
 inline constexpr double kUrdfDefaultEffort = 100;    // N or N m, a <limit effort="0">
 inline constexpr double kUrdfDefaultVelocity = 10;   // rad/s or m/s, no <limit velocity>
 inline constexpr double kUrdfCarrierRadius = 0.001;  // m, the body carrier's sphere

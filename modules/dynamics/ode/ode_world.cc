@@ -60,7 +60,7 @@ dGeomID MakeGeom(dSpaceID space, const ShapeData& shape, dTriMeshDataID mesh_dat
 dMass CalcMass(const ShapeData& shape) {
   dMass m;
   const Vec3& s = shape.size;
-  if (shape.inertia[0] > 0) {  // given (a URDF <inertial>): about the origin, in the shape's frame
+  if (shape.inertia[0] > 0) {  // given (a URDF <inertial>): about the centre of mass, shape's axes
     const auto& i = shape.inertia;
     dMassSetParameters(&m, shape.mass, 0, 0, 0, i[0], i[1], i[2], i[3], i[4], i[5]);
     return m;
@@ -88,6 +88,22 @@ dMass CalcMass(const ShapeData& shape) {
     }
   }
   return m;
+}
+
+// A dynamic shape's body sits at its centre of mass p_SC (ODE's bodies
+// have theirs at their origin): the body's pose and velocity from the
+// shape's, and back.
+// (No arithmetic at all for a centre at the origin, so that those
+// shapes' states stay bit for bit what they were.)
+Pose BodyPoseOf(const Pose& X_WS, const Vec3& p_SC) {
+  return p_SC == Vec3{} ? X_WS : Pose{X_WS * p_SC, X_WS.q};
+}
+Pose ShapePoseOf(const Pose& X_WC, const Vec3& p_SC) {
+  return p_SC == Vec3{} ? X_WC : Pose{X_WC * -p_SC, X_WC.q};
+}
+// The velocity of the point at `offset` (world axes) from one moving at v, w.
+Vec3 PointVelocity(const Vec3& v, const Vec3& w, const Vec3& offset) {
+  return offset == Vec3{} ? v : v + w.Cross(offset);
 }
 
 double WrapAngle(double a) {
@@ -358,20 +374,22 @@ void OdeWorld::BuildBodies(const Scene& scene, std::vector<dBodyID>* body_of) {
     if (!geom && shape->collidable)
       throw Error("ode: dynamic shape '" + PathAt(scene, s) + "' needs a positive size");
     dBodyID body = dBodyCreate(world_);
-    SetBodyPose(body, X_WS);
-    const Vec3& v = scene.linear_velocity_at(s);
+    const Vec3& p_SC = shape->center_of_mass;
+    SetBodyPose(body, BodyPoseOf(X_WS, p_SC));
     const Vec3& w = scene.angular_velocity_at(s);
+    const Vec3 v = PointVelocity(scene.linear_velocity_at(s), w, X_WS.q.Rotate(p_SC));
     dBodySetLinearVel(body, v.x, v.y, v.z);
     dBodySetAngularVel(body, w.x, w.y, w.z);
     const dMass mass = CalcMass(*shape);
     dBodySetMass(body, &mass);
     if (geom) {
       dGeomSetBody(geom, body);
+      if (!(p_SC == Vec3{})) dGeomSetOffsetPosition(geom, -p_SC.x, -p_SC.y, -p_SC.z);
       AddGeom(geom, scene.instance_of_at(s), shape->friction, shape->restitution);
       AddSurface(*shape, s);
     }
     (*body_of)[s] = body;
-    bodies_.push_back({body, s, X_WS});
+    bodies_.push_back({body, s, X_WS, p_SC});
   }
 }
 
@@ -500,9 +518,9 @@ void OdeWorld::SyncFromScene(const Scene& scene, double duration) {
   for (DynamicBody& b : bodies_) {
     const Pose& X_WB = scene.world_pose_at(b.slot);
     if (X_WB == b.X_WB_written) continue;
-    SetBodyPose(b.body, X_WB);
-    const Vec3& v = scene.linear_velocity_at(b.slot);
+    SetBodyPose(b.body, BodyPoseOf(X_WB, b.p_SC));
     const Vec3& w = scene.angular_velocity_at(b.slot);
+    const Vec3 v = PointVelocity(scene.linear_velocity_at(b.slot), w, X_WB.q.Rotate(b.p_SC));
     dBodySetLinearVel(b.body, v.x, v.y, v.z);
     dBodySetAngularVel(b.body, w.x, w.y, w.z);
     b.X_WB_written = X_WB;
@@ -668,10 +686,13 @@ void OdeWorld::WriteBack(Scene* scene) {
   if (!force_sensors_.empty()) ReadForceSensors(scene);
   for (KinematicBody& k : kinematic_) SetBodyPose(k.body, k.X_WB_to);
   for (DynamicBody& b : bodies_) {
-    const Pose X_WB = BodyPose(b.body);
-    scene->SetSimulatedState(b.slot, X_WB, ToVec3(dBodyGetLinearVel(b.body)),
-                             ToVec3(dBodyGetAngularVel(b.body)));
-    b.X_WB_written = X_WB;
+    const Pose X_WC = BodyPose(b.body);
+    const Pose X_WS = ShapePoseOf(X_WC, b.p_SC);
+    const Vec3 w = ToVec3(dBodyGetAngularVel(b.body));
+    const Vec3 p_CS = b.p_SC == Vec3{} ? Vec3{} : X_WS.p - X_WC.p;
+    scene->SetSimulatedState(b.slot, X_WS, PointVelocity(ToVec3(dBodyGetLinearVel(b.body)), w, p_CS),
+                             w);
+    b.X_WB_written = X_WS;
   }
   for (size_t k = 0; k < joints_.size(); ++k) {
     const SimJoint& j = joints_[k];

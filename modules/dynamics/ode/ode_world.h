@@ -29,10 +29,11 @@ class SolverThreads;  // ode_threading.h
 std::string SolverThreading();
 
 // A dynamic body: one per dynamic shape.
-struct DynamicBody {  // 72 bytes
-  dBodyID body;
+struct DynamicBody {  // 96 bytes
+  dBodyID body;       // ODE's body sits at the shape's centre of mass
   uint32_t slot;
-  Pose X_WB_written;  // pose last written to the scene (detects teleports)
+  Pose X_WB_written;  // the shape's pose last written to the scene (detects teleports)
+  Vec3 p_SC;          // the centre of mass in the shape (ShapeData::center_of_mass)
 };
 
 // A non-dynamic shape moved by the scene and pushed into ODE.

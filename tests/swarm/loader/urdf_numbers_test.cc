@@ -8,6 +8,8 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "framework/error.h"
 #include "swarm/loader/urdf.h"
@@ -126,6 +128,83 @@ TEST_F(UrdfNumbersTest, JointNumbersNameTheJoint) {
   EXPECT_EQ(Message(Robot("", "    <safety_controller k_velocity=\"fast\"/>")),
             "r.urdf:8: joint 'j': <safety_controller k_velocity=\"fast\">: 'fast' is not a finite "
             "number");
+}
+
+
+// Every numeric attribute urdfdom 3 reads (its parsers, listed here from
+// urdfdom's link.cpp, joint.cpp and pose.cpp, not from urdf_numbers.cc),
+// holding a word: an error naming the line, the element and the attribute.
+TEST_F(UrdfNumbersTest, EveryAttributeUrdfdomReadsIsCheckedWithItsLine) {
+  struct Case {
+    bool in_joint;        // in the joint (line 8), else in the base link (line 4)
+    std::string snippet;  // "@" marks the attribute's value
+    std::string element;  // "<origin xyz" as the message shows it
+  };
+  std::vector<Case> cases;
+  const std::string inertia_keys[] = {"ixx", "iyy", "izz", "ixy", "ixz", "iyz"};
+  for (const std::string& key : inertia_keys) {
+    std::string inertia = "<inertia";
+    for (const std::string& k : inertia_keys) inertia += " " + k + "=\"" + (k == key ? "@" : "1") + "\"";
+    cases.push_back({false, "<inertial><mass value=\"1\"/>" + inertia + "/></inertial>",
+                     "<inertia " + key});
+  }
+  cases.push_back({false, "<inertial><mass value=\"@\"/></inertial>", "<mass value"});
+  for (const char* key : {"xyz", "rpy"})
+    cases.push_back({false, std::string("<inertial><origin ") + key + "=\"@\"/><mass value=\"1\"/>"
+                            "<inertia ixx=\"1\" iyy=\"1\" izz=\"1\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/>"
+                            "</inertial>",
+                     std::string("<origin ") + key});
+  for (const char* part : {"visual", "collision"}) {
+    const std::string open = std::string("<") + part + ">", close = std::string("</") + part + ">";
+    for (const char* key : {"xyz", "rpy"})
+      cases.push_back({false,
+                       open + "<origin " + key + "=\"@\"/><geometry><sphere radius=\"1\"/>"
+                              "</geometry>" + close,
+                       std::string("<origin ") + key});
+    for (const auto& [geometry, element] :
+         {std::pair<std::string, std::string>{"<box size=\"@\"/>", "<box size"},
+          {"<cylinder radius=\"@\" length=\"1\"/>", "<cylinder radius"},
+          {"<cylinder radius=\"1\" length=\"@\"/>", "<cylinder length"},
+          {"<sphere radius=\"@\"/>", "<sphere radius"},
+          {"<mesh filename=\"m.stl\" scale=\"@\"/>", "<mesh scale"}})
+      cases.push_back({false, open + "<geometry>" + geometry + "</geometry>" + close, element});
+  }
+  cases.push_back({false,
+                   "<visual><geometry><sphere radius=\"1\"/></geometry><material name=\"m\">"
+                   "<color rgba=\"@\"/></material></visual>",
+                   "<color rgba"});
+  cases.push_back({true, "<origin xyz=\"@\"/>", "<origin xyz"});
+  cases.push_back({true, "<origin rpy=\"@\"/>", "<origin rpy"});
+  cases.push_back({true, "<axis xyz=\"@\"/>", "<axis xyz"});
+  for (const char* key : {"lower", "upper", "effort", "velocity"}) {
+    std::string limit = "<limit";
+    for (const char* k : {"lower", "upper", "effort", "velocity"})
+      limit += std::string(" ") + k + "=\"" + (std::string(k) == key ? "@" : "1") + "\"";
+    cases.push_back({true, limit + "/>", std::string("<limit ") + key});
+  }
+  for (const char* key : {"damping", "friction"})
+    cases.push_back({true, std::string("<dynamics ") + key + "=\"@\"/>",
+                     std::string("<dynamics ") + key});
+  for (const char* key : {"multiplier", "offset"})
+    cases.push_back({true, std::string("<mimic joint=\"j\" ") + key + "=\"@\"/>",
+                     std::string("<mimic ") + key});
+  for (const char* key : {"soft_lower_limit", "soft_upper_limit", "k_position", "k_velocity"})
+    cases.push_back({true, std::string("<safety_controller ") + key + "=\"@\"/>",
+                     std::string("<safety_controller ") + key});
+  for (const char* key : {"rising", "falling"})
+    cases.push_back({true, std::string("<calibration ") + key + "=\"@\"/>",
+                     std::string("<calibration ") + key});
+  for (const Case& c : cases) {
+    std::string snippet = "    " + c.snippet;
+    snippet.replace(snippet.find('@'), 1, "abc");
+    const std::string e = Message(c.in_joint ? Robot("", snippet) : Robot(snippet, ""));
+    EXPECT_EQ(e.substr(0, 9), c.in_joint ? "r.urdf:8:" : "r.urdf:4:") << c.snippet << ": " << e;
+    EXPECT_NE(e.find(c.element + "=\"abc\">: 'abc' is not a finite number"), std::string::npos)
+        << c.snippet << ": " << e;
+  }
+  // The robot's own materials.
+  EXPECT_EQ(Message(Robot("", "", "  <material name=\"m\"><color rgba=\"abc\"/></material>\n")),
+            "r.urdf:12: material 'm': <color rgba=\"abc\">: 'abc' is not a finite number");
 }
 
 }  // namespace
