@@ -286,8 +286,13 @@ void OdeWorld::Build(const Scene& scene) {
     case Solver::kWorld: exact_solver_ = true; break;
     case Solver::kQuickStep: exact_solver_ = options_.iterations <= 0; break;
     case Solver::kAuto:
+      // Exact for small, mostly articulated worlds (at least a joint for
+      // every two bodies); a pile of free bodies in contact (boxes stacked
+      // into towers) makes the direct solve's LCP degenerate ("LCP internal
+      // error", the towers fall), where quickstep holds them.
       exact_solver_ =
-          options_.iterations <= 0 || bodies_.size() <= static_cast<size_t>(kExactSolverBodies);
+          options_.iterations <= 0 || (bodies_.size() <= static_cast<size_t>(kExactSolverBodies) &&
+                                       2 * joints_.size() >= bodies_.size());
       break;
   }
 }
@@ -690,8 +695,8 @@ void OdeWorld::WriteBack(Scene* scene) {
     const Pose X_WS = ShapePoseOf(X_WC, b.p_SC);
     const Vec3 w = ToVec3(dBodyGetAngularVel(b.body));
     const Vec3 p_CS = b.p_SC == Vec3{} ? Vec3{} : X_WS.p - X_WC.p;
-    scene->SetSimulatedState(b.slot, X_WS, PointVelocity(ToVec3(dBodyGetLinearVel(b.body)), w, p_CS),
-                             w);
+    scene->SetSimulatedState(b.slot, X_WS,
+                             PointVelocity(ToVec3(dBodyGetLinearVel(b.body)), w, p_CS), w);
     b.X_WB_written = X_WS;
   }
   for (size_t k = 0; k < joints_.size(); ++k) {
