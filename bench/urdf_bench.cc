@@ -24,7 +24,8 @@ namespace fs = std::filesystem;
 
 fs::path Folder() {
   static const fs::path dir = [] {
-    const fs::path d = fs::temp_directory_path() / ("swarmsim_urdf_bench_" + std::to_string(::getpid()));
+    const fs::path d =
+        fs::temp_directory_path() / ("swarmsim_urdf_bench_" + std::to_string(::getpid()));
     fs::create_directories(d);
     return d;
   }();
@@ -37,11 +38,13 @@ fs::path HundredLinks() {
   if (fs::exists(path)) return path;
   const std::string stl =
       std::string(SWARMSIM_SOURCE_DIR) + "/worlds/models/simple_arm_description/meshes/tool.stl";
-  std::string u = "<?xml version=\"1.0\"?>\n<robot name=\"hundred\">\n"
-                  "  <material name=\"orange\"><color rgba=\"0.95 0.45 0.1 1\"/></material>\n";
+  std::string u =
+      "<?xml version=\"1.0\"?>\n<robot name=\"hundred\">\n"
+      "  <material name=\"orange\"><color rgba=\"0.95 0.45 0.1 1\"/></material>\n";
   for (int i = 0; i < 100; ++i) {
     const std::string n = std::to_string(i);
-    u += "  <link name=\"l" + n + "\">\n"
+    u += "  <link name=\"l" + n +
+         "\">\n"
          "    <inertial><origin xyz=\"0 0 0.02\"/><mass value=\"0.2\"/><inertia ixx=\"2e-4\" "
          "iyy=\"2e-4\" izz=\"1e-4\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial>\n"
          "    <collision><origin xyz=\"0 0 0.02\"/><geometry><box size=\"0.03 0.03 0.04\"/>"
@@ -53,11 +56,15 @@ fs::path HundredLinks() {
     u += "  </link>\n";
     if (i == 0) continue;
     const bool fixed = i % 4 == 0;
-    u += "  <joint name=\"j" + n + "\" type=\"" + (fixed ? "fixed" : "revolute") + "\">"
-         "<parent link=\"l" + std::to_string(i - 1) + "\"/><child link=\"l" + n + "\"/>"
+    u += "  <joint name=\"j" + n + "\" type=\"" + (fixed ? "fixed" : "revolute") +
+         "\">"
+         "<parent link=\"l" +
+         std::to_string(i - 1) + "\"/><child link=\"l" + n +
+         "\"/>"
          "<origin xyz=\"0 0 0.04\" rpy=\"0 0 0.3\"/>" +
-         (fixed ? "" : "<axis xyz=\"0 1 0\"/><limit lower=\"-1\" upper=\"1\" effort=\"5\" "
-                       "velocity=\"2\"/>") +
+         (fixed ? ""
+                : "<axis xyz=\"0 1 0\"/><limit lower=\"-1\" upper=\"1\" effort=\"5\" "
+                  "velocity=\"2\"/>") +
          "</joint>\n";
   }
   u += "</robot>\n";

@@ -29,8 +29,8 @@ class MeshCache {
   // The mesh in `path` (STL, ASCII or binary, OBJ or COLLADA: its unit
   // applies, its up axis does not), each vertex scaled by
   // `scale` (nonzero factors; a mirror, an odd count of negative ones,
-  // reverses the triangles' winding so they still face out). Throws swarmsim::Error "<where>: mesh file 'text' ..."
-  // for a missing, unreadable, unsupported or empty file, and
+  // reverses the triangles' winding so they still face out). Throws swarmsim::Error "<where>: mesh
+  // file 'text' ..." for a missing, unreadable, unsupported or empty file, and
   // "<where>: <file>:<line>: ..." for one that breaks a limit above or that
   // assimp would not survive (mesh_check.h); a vertex, once scaled, is
   // finite and within kMaxCoordinate of the file's origin.

@@ -542,8 +542,7 @@ MassProperties Importer::BodyMass(const urdf::Link& top, bool is_root) {
     // Point masses alone (a mean moment under the mass's at 1e-9 m^2):
     // the default link's radius of gyration.
     const double least = body.mass * kUrdfPointMassGyration;
-    if (!(body.inertia[0] > 1e-9 * body.mass))
-      body.inertia = {least, least, least, 0, 0, 0};
+    if (!(body.inertia[0] > 1e-9 * body.mass)) body.inertia = {least, least, least, 0, 0, 0};
     if (std::find(repaired_links_.begin(), repaired_links_.end(), top.name) ==
         repaired_links_.end())
       repaired_links_.push_back(top.name);
@@ -737,12 +736,11 @@ UrdfImport Importer::Run(const std::string& where, const std::string& text) {
   for (const auto& [kind, n] : joint_kinds_) joint_count += n;
   out.summary.push_back("urdf: robot '" + model->getName() + "', root link '" +
                         model->getRoot()->name + "'");
-  out.summary.push_back("  links: " + std::to_string(xml_.link_line.size()) + ", " +
-                        std::to_string(links_merged_) + " merged by fixed joints into " +
-                        std::to_string(bodies_) + " bodies with mass (" + Num(total_mass_) +
-                        " kg in all; " + std::to_string(default_mass_links_.size()) +
-                        " with the default mass, " + std::to_string(repaired_links_.size()) +
-                        " inertias repaired)");
+  out.summary.push_back(
+      "  links: " + std::to_string(xml_.link_line.size()) + ", " + std::to_string(links_merged_) +
+      " merged by fixed joints into " + std::to_string(bodies_) + " bodies with mass (" +
+      Num(total_mass_) + " kg in all; " + std::to_string(default_mass_links_.size()) +
+      " with the default mass, " + std::to_string(repaired_links_.size()) + " inertias repaired)");
   out.summary.push_back("  joints: " + std::to_string(joint_count) +
                         (joints.empty() ? "" : " (" + joints + ")") +
                         (mimics_ ? ", " + std::to_string(mimics_) + " mimic (dependent)" : ""));
@@ -774,11 +772,10 @@ UrdfImport Importer::Run(const std::string& where, const std::string& text) {
     out.warnings.push_back(
         name_ + ": " + plural(default_mass_links_.size(), "link", "links") +
         " that can move (a moving joint's child, or the root with geometry) " +
-        (default_mass_links_.size() == 1 ? "has" : "have") +
-        " no mass, nor links fixed to " + (default_mass_links_.size() == 1 ? "it" : "them") +
-        " (" + list(default_mass_links_) + "): each gets the default mass " +
-        Num(kUrdfDefaultMass) + " kg and inertia " + Num(kUrdfDefaultInertia) +
-        " kg m^2 about each axis at the link origin");
+        (default_mass_links_.size() == 1 ? "has" : "have") + " no mass, nor links fixed to " +
+        (default_mass_links_.size() == 1 ? "it" : "them") + " (" + list(default_mass_links_) +
+        "): each gets the default mass " + Num(kUrdfDefaultMass) + " kg and inertia " +
+        Num(kUrdfDefaultInertia) + " kg m^2 about each axis at the link origin");
   return out;
 }
 

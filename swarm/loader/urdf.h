@@ -30,9 +30,9 @@ inline constexpr double kUrdfDefaultInertia = 1e-4;  // kg m^2, about each axis
 inline constexpr double kUrdfPointMassGyration = kUrdfDefaultInertia / kUrdfDefaultMass;  // m^2
 // An <inertia> whose diagonal is within mass x this of zero is a point mass.
 inline constexpr double kUrdfPointMassTolerance = 1e-12;  // m^2
-inline constexpr double kUrdfDefaultEffort = 100;    // N or N m, a <limit effort="0">
-inline constexpr double kUrdfDefaultVelocity = 10;   // rad/s or m/s, no <limit velocity>
-inline constexpr double kUrdfCarrierRadius = 0.001;  // m, the body carrier's sphere
+inline constexpr double kUrdfDefaultEffort = 100;         // N or N m, a <limit effort="0">
+inline constexpr double kUrdfDefaultVelocity = 10;        // rad/s or m/s, no <limit velocity>
+inline constexpr double kUrdfCarrierRadius = 0.001;       // m, the body carrier's sphere
 
 struct UrdfImport {
   ObjectSpec root;                    // the root link's object, base fixed (not dynamic)

@@ -16,7 +16,11 @@ Matrix ToMatrix(const Inertia& i) {
 
 Inertia FromMatrix(const Matrix& m) {
   // Symmetrised: R I R^T is symmetric up to rounding.
-  return {m[0][0], m[1][1], m[2][2], 0.5 * (m[0][1] + m[1][0]), 0.5 * (m[0][2] + m[2][0]),
+  return {m[0][0],
+          m[1][1],
+          m[2][2],
+          0.5 * (m[0][1] + m[1][0]),
+          0.5 * (m[0][2] + m[2][0]),
           0.5 * (m[1][2] + m[2][1])};
 }
 
@@ -77,7 +81,8 @@ std::array<double, 3> PrincipalMoments(const Inertia& inertia) {
       for (int q = p + 1; q < 3; ++q) {
         if (A[p][q] == 0) continue;
         const double theta = (A[q][q] - A[p][p]) / (2 * A[p][q]);
-        const double t = (theta >= 0 ? 1.0 : -1.0) / (std::abs(theta) + std::sqrt(theta * theta + 1));
+        const double t =
+            (theta >= 0 ? 1.0 : -1.0) / (std::abs(theta) + std::sqrt(theta * theta + 1));
         const double c = 1 / std::sqrt(t * t + 1), s = t * c;
         // A <- J^T A J, J the rotation in the (p, q) plane.
         for (int k = 0; k < 3; ++k) {

@@ -15,8 +15,8 @@ namespace swarmsim::loader {
 using Inertia = std::array<double, 6>;
 
 struct MassProperties {
-  double mass = 0;   // kg
-  Vec3 center;       // m: the centre of mass in the frame
+  double mass = 0;    // kg
+  Vec3 center;        // m: the centre of mass in the frame
   Inertia inertia{};  // kg m^2: about `center`, in the frame's axes
 };
 

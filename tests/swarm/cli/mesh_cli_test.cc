@@ -115,12 +115,19 @@ TEST_F(MeshCliTest, StlAndObjHeadersAndIndicesAreChecked) {
                 "107,374,182,484 bytes, but the file has 84");
   ExpectRefused(Run(kMeshes / "bad/obj_bad_index.obj"),
                 "obj_bad_index.obj:5: face index 'x' is not a nonzero integer");
-  // An OBJ polygon of 2.4 million corners: more triangles than a mesh may have.
-  std::string obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf";
-  for (int k = 0; k < 800000; ++k) obj += " 1 2 3";
-  Write("huge.obj", obj + "\n");
+  // 2,100 OBJ polygons of 1,000 corners (998 triangles each, at the corner
+  // limit): more triangles than a mesh may have, past the 2,005th face.
+  std::string face = "f";
+  for (int k = 0; k < 1000; ++k) {
+    face += ' ';
+    face += static_cast<char>('1' + k % 3);
+  }
+  face += '\n';
+  std::string obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+  for (int k = 0; k < 2100; ++k) obj += face;
+  Write("huge.obj", obj);
   ExpectRefused(Run(dir_ / "huge.obj"),
-                "huge.obj:4: the faces up to here make more than 2,000,000 triangles");
+                "huge.obj:2008: the faces up to here make more than 2,000,000 triangles");
 }
 
 TEST_F(MeshCliTest, MaterialLibraryThatIsAFifoDoesNotBlock) {

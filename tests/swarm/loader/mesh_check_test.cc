@@ -89,8 +89,12 @@ TEST(MeshCheckTest, ObjFacesHaveAtMostAThousandCorners) {
   const std::string v = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
   const auto face = [](int corners) {
     std::string f = "f";
-    for (int k = 0; k < corners; ++k) f += " " + std::to_string(k % 3 + 1);
-    return f + "\n";
+    for (int k = 0; k < corners; ++k) {
+      f += ' ';
+      f += static_cast<char>('1' + k % 3);
+    }
+    f += '\n';
+    return f;
   };
   EXPECT_EQ(ObjError(v + face(1000)), "no error");
   EXPECT_EQ(ObjError(v + "f 1 2 3\n" + face(1001)),

@@ -19,33 +19,13 @@
 
 #include "framework/world.h"
 #include "swarm/loader/world_loader.h"
+#include "tests/shared_urdf.h"
 #include "tests/swarm/loader/world_dir_test.h"
 
 namespace swarmsim {
 namespace {
 
 namespace fs = std::filesystem;
-
-// ../shared/urdf-corpus beside the source tree, or $SWARMSIM_URDF_CORPUS; "" if absent.
-std::string Corpus() {
-  std::vector<fs::path> folders;
-  if (const char* dir = std::getenv("SWARMSIM_URDF_CORPUS")) folders.emplace_back(dir);
-  folders.push_back(fs::path(SWARMSIM_SOURCE_DIR) / ".." / "shared" / "urdf-corpus");
-  folders.emplace_back("/work/shared/urdf-corpus");
-  for (const fs::path& f : folders) {
-    std::error_code ec;
-    const fs::path p = fs::weakly_canonical(f, ec);
-    if (!ec && fs::is_regular_file(p / "MANIFEST.tsv", ec)) return p.string();
-  }
-  return "";
-}
-
-#define NEED_CORPUS(dir)                                                                  \
-  const std::string dir = Corpus();                                                       \
-  if (dir.empty())                                                                        \
-  GTEST_SKIP() << "the URDF corpus (../shared/urdf-corpus) is not here; set "             \
-                  "SWARMSIM_URDF_CORPUS to the folder holding bolt, hyq, icub, tiago, ... " \
-                  "and MANIFEST.tsv"
 
 // Every URDF of the corpus: robot folder (its package path), file below it.
 struct CorpusFile {
@@ -217,8 +197,8 @@ TEST_F(UrdfCorpusTest, EveryFileLoadsAndHangsUnderOdeForTwoSeconds) {
         finite = finite && std::isfinite(X.p.x + X.p.y + X.p.z + X.q.w + X.q.x + X.q.y + X.q.z);
         farthest = std::max(farthest, (X.p - start[s]).Norm());
         if (scene.type_at(s) == ObjectType::kShape && scene.shape(scene.IdAt(s)).dynamic)
-          kinetic += 0.5 * scene.shape(scene.IdAt(s)).mass *
-                     scene.linear_velocity_at(s).SquaredNorm();
+          kinetic +=
+              0.5 * scene.shape(scene.IdAt(s)).mass * scene.linear_velocity_at(s).SquaredNorm();
       }
       most_kinetic = std::max(most_kinetic, kinetic);
     }

@@ -54,14 +54,14 @@ TEST(UrdfInertiaTest, APartMovesAndTurnsIntoTheBodysFrame) {
   ExpectInertia(in_b.inertia, {0.02, 0.01, 0.03, 0, 0, 0});
   // 45 degrees about z: Ixx' = Iyy' = (0.01 + 0.02) / 2, Ixy' = (0.01 - 0.02) / 2 ... sign:
   // R diag(a, b) R^T with c = s = 1/sqrt(2): xy = c s (a - b) = -0.005.
-  const MassProperties turned = Transformed(part, Pose{{}, Quat::FromAxisAngle({0, 0, 1}, M_PI / 4)});
+  const MassProperties turned =
+      Transformed(part, Pose{{}, Quat::FromAxisAngle({0, 0, 1}, M_PI / 4)});
   ExpectInertia(turned.inertia, {0.015, 0.015, 0.03, -0.005, 0, 0});
 }
 
 TEST(UrdfInertiaTest, PrincipalMomentsAreTheEigenvalues) {
   const MassProperties part{1, {}, {0.3, 0.1, 0.25, 0, 0, 0}};
-  const MassProperties turned =
-      Transformed(part, Pose{{}, Quat::FromRollPitchYaw(0.3, -1.1, 2.0)});
+  const MassProperties turned = Transformed(part, Pose{{}, Quat::FromRollPitchYaw(0.3, -1.1, 2.0)});
   const auto moments = PrincipalMoments(turned.inertia);
   EXPECT_NEAR(moments[0], 0.1, 1e-14);
   EXPECT_NEAR(moments[1], 0.25, 1e-14);

@@ -20,32 +20,13 @@
 #include "framework/world.h"
 #include "swarm/loader/world_loader.h"
 #include "tests/framework/error_of.h"
+#include "tests/shared_urdf.h"
 #include "tests/swarm/loader/world_dir_test.h"
 
 namespace swarmsim {
 namespace {
 
 namespace fs = std::filesystem;
-
-// ../shared/urdf beside the source tree, or $SWARMSIM_URDF_DIR; "" if absent.
-std::string SharedUrdf() {
-  std::vector<fs::path> folders;
-  if (const char* dir = std::getenv("SWARMSIM_URDF_DIR")) folders.emplace_back(dir);
-  folders.push_back(fs::path(SWARMSIM_SOURCE_DIR) / ".." / "shared" / "urdf");
-  folders.emplace_back("/work/shared/urdf");
-  for (const fs::path& f : folders) {
-    std::error_code ec;
-    const fs::path p = fs::weakly_canonical(f, ec);
-    if (!ec && fs::is_regular_file(p / "README.md", ec)) return p.string();
-  }
-  return "";
-}
-
-#define NEED_SHARED_URDF(dir)                                                  \
-  const std::string dir = SharedUrdf();                                        \
-  if (dir.empty())                                                             \
-  GTEST_SKIP() << "the shared URDF robots (../shared/urdf) are not here; set " \
-                  "SWARMSIM_URDF_DIR to the folder holding fanuc_m10ia, panda, turtlebot3_waffle"
 
 const char* kFanuc = "fanuc_m10ia/moveit_resources_fanuc_description/urdf/fanuc.urdf";
 const char* kPanda = "panda/example-robot-data/robots/panda_description/urdf/panda.urdf";
@@ -497,7 +478,9 @@ TEST_F(UrdfTest, MergedLinksKeepTheirCentreOfMassAndTheInertiaAboutIt) {
             "<inertia ixx=\"0.001\" iyy=\"0.001\" izz=\"0.001\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/>"
             "</inertial></link>\n"
             "  <joint name=\"j\" type=\"revolute\"><parent link=\"base\"/><child link=\"arm\"/>"
-            "<axis xyz=\"0 0 1\"/>" + kLimit + "</joint>\n"
+            "<axis xyz=\"0 0 1\"/>" +
+            kLimit +
+            "</joint>\n"
             "  <link name=\"weight\"><inertial><mass value=\"3\"/>"
             "<inertia ixx=\"0.01\" iyy=\"0.02\" izz=\"0.03\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/>"
             "</inertial></link>\n"
@@ -561,19 +544,25 @@ TEST_F(UrdfTest, InertiasNoBodyHasAreRepairedAndMasslessMovingLinksDefaultedOneW
     urdf += std::string("  <link name=\"antenna_") + side +
             "\"><inertial><mass value=\"1e-6\"/><inertia ixx=\"1e-6\" iyy=\"1e-6\" izz=\"1e-6\" "
             "ixy=\"1e-6\" ixz=\"1e-6\" iyz=\"1e-6\"/></inertial></link>\n"
-            "  <joint name=\"antenna_" + side + "_joint\" type=\"fixed\"><parent link=\"base\"/>"
-            "<child link=\"antenna_" + side + "\"/></joint>\n";
+            "  <joint name=\"antenna_" +
+            side +
+            "_joint\" type=\"fixed\"><parent link=\"base\"/>"
+            "<child link=\"antenna_" +
+            side + "\"/></joint>\n";
   urdf +=
       "  <link name=\"head\"><inertial><origin xyz=\"0 0 0.1\"/><mass value=\"2\"/>"
       "<inertia ixx=\"0\" iyy=\"0\" izz=\"0\" ixy=\"0\" ixz=\"2.4e-35\" iyz=\"0\"/></inertial>"
       "</link>\n"
       "  <joint name=\"neck\" type=\"revolute\"><parent link=\"base\"/><child link=\"head\"/>"
-      "<origin xyz=\"0 0 0.5\"/><axis xyz=\"0 0 1\"/>" + std::string(kLimit) + "</joint>\n"
+      "<origin xyz=\"0 0 0.5\"/><axis xyz=\"0 0 1\"/>" +
+      std::string(kLimit) +
+      "</joint>\n"
       "  <link name=\"wheel\"/>\n"
       "  <joint name=\"axle\" type=\"continuous\"><parent link=\"base\"/><child link=\"wheel\"/>"
       "<origin xyz=\"0.3 0 0\"/><axis xyz=\"0 1 0\"/></joint>\n</robot>\n";
   Write("r.urdf", urdf);
-  LoadedWorld w = Load("simulation: {physics: ode}\nmodels: [{model: r.urdf, position: [0, 0, 1]}]\n");
+  LoadedWorld w =
+      Load("simulation: {physics: ode}\nmodels: [{model: r.urdf, position: [0, 0, 1]}]\n");
   ASSERT_EQ(w.warnings.size(), 2u);
   EXPECT_CONTAINS(w.warnings[0],
                   "r.urdf: the inertia of 3 links (antenna_left, antenna_right, head) is no rigid "
@@ -621,7 +610,8 @@ TEST_F(UrdfTest, MaterialColoursBecomeTheShapesColours) {
   LoadedWorld w = Load("models: [{model: c.urdf, position: [0, 0, 0]}]\n");
   const Scene& scene = w.world->scene();
   std::vector<Vec3> colors;  // collisions first, then visuals, in file order
-  for (ObjectId c : scene.children(scene.instances()[0].root)) colors.push_back(scene.shape(c).color);
+  for (ObjectId c : scene.children(scene.instances()[0].root))
+    colors.push_back(scene.shape(c).color);
   const Vec3 grey = ShapeData{}.color, blue{0, 0, 1}, red{1, 0, 0};
   ASSERT_EQ(colors.size(), 5u);
   EXPECT_EQ(colors[0], blue);  // the collision box
@@ -637,10 +627,15 @@ TEST_F(UrdfTest, ANegativeMeshScaleMirrorsTheMeshKeepingItsTrianglesFacingOut) {
   // volume (outward triangles: positive) stays the original's.
   const std::string stl =
       std::string(SWARMSIM_SOURCE_DIR) + "/worlds/models/simple_arm_description/meshes/tool.stl";
-  Write("m.urdf", "<robot name=\"m\">\n  <link name=\"base\">\n"
-                  "    <visual><geometry><mesh filename=\"" + stl + "\"/></geometry></visual>\n"
-                  "    <visual><geometry><mesh filename=\"" + stl + "\" scale=\"1 -1 1\"/>"
-                  "</geometry></visual>\n  </link>\n</robot>\n");
+  Write("m.urdf",
+        "<robot name=\"m\">\n  <link name=\"base\">\n"
+        "    <visual><geometry><mesh filename=\"" +
+            stl +
+            "\"/></geometry></visual>\n"
+            "    <visual><geometry><mesh filename=\"" +
+            stl +
+            "\" scale=\"1 -1 1\"/>"
+            "</geometry></visual>\n  </link>\n</robot>\n");
   LoadedWorld w = Load("models: [{model: m.urdf, position: [0, 0, 0]}]\n");
   const Scene& scene = w.world->scene();
   const std::vector<ObjectId> visuals = scene.children(scene.instances()[0].root);

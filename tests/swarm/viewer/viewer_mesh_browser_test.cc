@@ -16,6 +16,7 @@
 #include <string>
 
 #include "swarm/record/reader.h"
+#include "tests/shared_urdf.h"
 #include "tests/swarm/run_program.h"
 #include "tests/swarm/viewer/browser.h"
 
@@ -254,26 +255,11 @@ TEST_F(ViewerMeshTest, TheViewCommandsMeshBudgetSetsThePagesAndTheUrlOverridesIt
   EXPECT_NE(bad.output.find("--mesh-budget"), std::string::npos) << bad.output;
 }
 
-// ../shared/urdf beside the source tree, or $SWARMSIM_URDF_DIR; "" if absent
-// (as tests/swarm/loader/urdf_test.cc finds it).
-std::string SharedUrdf() {
-  std::vector<fs::path> folders;
-  if (const char* dir = std::getenv("SWARMSIM_URDF_DIR")) folders.emplace_back(dir);
-  folders.push_back(fs::path(SWARMSIM_SOURCE_DIR) / ".." / "shared" / "urdf");
-  folders.emplace_back("/work/shared/urdf");
-  for (const fs::path& f : folders) {
-    std::error_code ec;
-    const fs::path p = fs::weakly_canonical(f, ec);
-    if (!ec && fs::is_regular_file(p / "README.md", ec)) return p.string();
-  }
-  return "";
-}
-
 // Three Pandas imported from their URDF: every mesh file's triangles drawn,
 // and the COLLADA visuals in their materials' colours (white and dark grey).
 TEST(ViewerMeshUrdfTest, DrawsAnImportedArmsMeshesWithTheirTrianglesAndMaterials) {
   if (const std::string missing = BrowserMissing(); !missing.empty()) GTEST_SKIP() << missing;
-  const std::string urdf = SharedUrdf();
+  const std::string urdf = testing::SharedUrdf();
   if (urdf.empty())
     GTEST_SKIP() << "the shared URDF robots (../shared/urdf) are not here; set SWARMSIM_URDF_DIR";
   const fs::path dir = FreshTempDir("viewer_mesh", "panda");

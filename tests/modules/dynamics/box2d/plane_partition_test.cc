@@ -87,7 +87,7 @@ uint64_t BusyHash(int robots_count, int partitions, int threads, int* regions = 
   for (uint32_t s = 0; s < scene.slot_count(); ++s) hasher.AddValue(scene.world_pose_at(s));
   world.backend->HashState(&hasher);
   if (regions) {
-    PartitionedPlaneWorld probe(Options{}, {.partitions = partitions});
+    PartitionedPlaneWorld probe(Options{}, {.partitions = partitions, .options = nullptr});
     probe.Build(scene);
     *regions = probe.region_count();
   }
@@ -116,7 +116,7 @@ TEST(Box2dPartition, MorePartitionsThanBodiesIsOneRegionPerBody) {
   Scene scene;
   AddRobot(&scene, "a", 0, 0, 0);
   AddRobot(&scene, "b", 1, 0, 0);
-  PartitionedPlaneWorld world(Options{}, {.partitions = 64});
+  PartitionedPlaneWorld world(Options{}, {.partitions = 64, .options = nullptr});
   world.Build(scene);
   EXPECT_EQ(world.region_count(), 2);
   EXPECT_EQ(world.body_count(), 2);

@@ -18,31 +18,13 @@
 
 #include "modules/dynamics/ode/ode_backend.h"
 #include "tests/framework/error_of.h"
+#include "tests/shared_urdf.h"
 #include "tests/swarm/loader/world_dir_test.h"
 
 namespace swarmsim {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string SharedUrdf() {
-  std::vector<fs::path> folders;
-  if (const char* dir = std::getenv("SWARMSIM_URDF_DIR")) folders.emplace_back(dir);
-  folders.push_back(fs::path(SWARMSIM_SOURCE_DIR) / ".." / "shared" / "urdf");
-  folders.emplace_back("/work/shared/urdf");
-  for (const fs::path& f : folders) {
-    std::error_code ec;
-    const fs::path p = fs::weakly_canonical(f, ec);
-    if (!ec && fs::is_regular_file(p / "README.md", ec)) return p.string();
-  }
-  return "";
-}
-
-#define NEED_SHARED_URDF(dir)                                                  \
-  const std::string dir = SharedUrdf();                                        \
-  if (dir.empty())                                                             \
-  GTEST_SKIP() << "the shared URDF robots (../shared/urdf) are not here; set " \
-                  "SWARMSIM_URDF_DIR to the folder holding fanuc_m10ia, panda, turtlebot3_waffle"
 
 const char* kPanda = "panda/example-robot-data/robots/panda_description/urdf/panda.urdf";
 
