@@ -130,7 +130,6 @@ TEST_F(UrdfNumbersTest, JointNumbersNameTheJoint) {
             "number");
 }
 
-
 // Every numeric attribute urdfdom 3 reads (its parsers, listed here from
 // urdfdom's link.cpp, joint.cpp and pose.cpp, not from urdf_numbers.cc),
 // holding a word: an error naming the line, the element and the attribute.
@@ -144,22 +143,27 @@ TEST_F(UrdfNumbersTest, EveryAttributeUrdfdomReadsIsCheckedWithItsLine) {
   const std::string inertia_keys[] = {"ixx", "iyy", "izz", "ixy", "ixz", "iyz"};
   for (const std::string& key : inertia_keys) {
     std::string inertia = "<inertia";
-    for (const std::string& k : inertia_keys) inertia += " " + k + "=\"" + (k == key ? "@" : "1") + "\"";
-    cases.push_back({false, "<inertial><mass value=\"1\"/>" + inertia + "/></inertial>",
-                     "<inertia " + key});
+    for (const std::string& k : inertia_keys)
+      inertia += " " + k + "=\"" + (k == key ? "@" : "1") + "\"";
+    cases.push_back(
+        {false, "<inertial><mass value=\"1\"/>" + inertia + "/></inertial>", "<inertia " + key});
   }
   cases.push_back({false, "<inertial><mass value=\"@\"/></inertial>", "<mass value"});
   for (const char* key : {"xyz", "rpy"})
-    cases.push_back({false, std::string("<inertial><origin ") + key + "=\"@\"/><mass value=\"1\"/>"
-                            "<inertia ixx=\"1\" iyy=\"1\" izz=\"1\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/>"
-                            "</inertial>",
+    cases.push_back({false,
+                     std::string("<inertial><origin ") + key +
+                         "=\"@\"/><mass value=\"1\"/>"
+                         "<inertia ixx=\"1\" iyy=\"1\" izz=\"1\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/>"
+                         "</inertial>",
                      std::string("<origin ") + key});
   for (const char* part : {"visual", "collision"}) {
     const std::string open = std::string("<") + part + ">", close = std::string("</") + part + ">";
     for (const char* key : {"xyz", "rpy"})
       cases.push_back({false,
-                       open + "<origin " + key + "=\"@\"/><geometry><sphere radius=\"1\"/>"
-                              "</geometry>" + close,
+                       open + "<origin " + key +
+                           "=\"@\"/><geometry><sphere radius=\"1\"/>"
+                           "</geometry>" +
+                           close,
                        std::string("<origin ") + key});
     for (const auto& [geometry, element] :
          {std::pair<std::string, std::string>{"<box size=\"@\"/>", "<box size"},
@@ -183,8 +187,8 @@ TEST_F(UrdfNumbersTest, EveryAttributeUrdfdomReadsIsCheckedWithItsLine) {
     cases.push_back({true, limit + "/>", std::string("<limit ") + key});
   }
   for (const char* key : {"damping", "friction"})
-    cases.push_back({true, std::string("<dynamics ") + key + "=\"@\"/>",
-                     std::string("<dynamics ") + key});
+    cases.push_back(
+        {true, std::string("<dynamics ") + key + "=\"@\"/>", std::string("<dynamics ") + key});
   for (const char* key : {"multiplier", "offset"})
     cases.push_back({true, std::string("<mimic joint=\"j\" ") + key + "=\"@\"/>",
                      std::string("<mimic ") + key});
