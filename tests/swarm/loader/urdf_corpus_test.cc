@@ -20,12 +20,16 @@
 #include "framework/world.h"
 #include "swarm/loader/world_loader.h"
 #include "tests/shared_urdf.h"
+#include "tests/swarm/loader/urdf_xml_kinematics.h"
 #include "tests/swarm/loader/world_dir_test.h"
 
 namespace swarmsim {
 namespace {
 
 namespace fs = std::filesystem;
+using testing::ForwardKinematics;
+using testing::ReadJoints;
+using testing::XmlJoint;
 
 // Every URDF of the corpus: robot folder (its package path), file below it.
 struct CorpusFile {
@@ -55,71 +59,8 @@ constexpr CorpusFile kFiles[] = {
 
 // --- The URDF's kinematics, read from the XML here ------------------------------------
 
-struct XmlJoint {
-  std::string name, type, parent, child;
-  Pose origin;
-  Vec3 axis{1, 0, 0};
-  std::string mimic;  // master joint, or ""
-  double multiplier = 1, offset = 0;
-};
-
-Vec3 ParseVec(const char* text, Vec3 fallback) {
-  if (!text) return fallback;
-  std::istringstream in(text);
-  Vec3 v;
-  in >> v.x >> v.y >> v.z;
-  return v;
-}
-
-// The robot's <joint> elements (not those inside <transmission>) and links.
-std::vector<XmlJoint> ReadJoints(const std::string& path, std::vector<std::string>* links) {
-  tinyxml2::XMLDocument doc;
-  EXPECT_EQ(doc.LoadFile(path.c_str()), tinyxml2::XML_SUCCESS) << path;
-  std::vector<XmlJoint> out;
-  const tinyxml2::XMLElement* robot = doc.RootElement();
-  for (auto* e = robot->FirstChildElement("link"); e; e = e->NextSiblingElement("link"))
-    links->push_back(e->Attribute("name"));
-  for (auto* e = robot->FirstChildElement("joint"); e; e = e->NextSiblingElement("joint")) {
-    XmlJoint j;
-    j.name = e->Attribute("name");
-    j.type = e->Attribute("type");
-    j.parent = e->FirstChildElement("parent")->Attribute("link");
-    j.child = e->FirstChildElement("child")->Attribute("link");
-    if (auto* o = e->FirstChildElement("origin")) {
-      const Vec3 rpy = ParseVec(o->Attribute("rpy"), {});
-      j.origin = {ParseVec(o->Attribute("xyz"), {}), Quat::FromRollPitchYaw(rpy.x, rpy.y, rpy.z)};
-    }
-    if (auto* a = e->FirstChildElement("axis")) j.axis = ParseVec(a->Attribute("xyz"), {1, 0, 0});
-    if (auto* m = e->FirstChildElement("mimic")) {
-      j.mimic = m->Attribute("joint");
-      m->QueryDoubleAttribute("multiplier", &j.multiplier);
-      m->QueryDoubleAttribute("offset", &j.offset);
-    }
-    out.push_back(j);
-  }
-  return out;
-}
-
 bool Moves(const XmlJoint& j) {
   return j.type == "revolute" || j.type == "continuous" || j.type == "prismatic";
-}
-
-// Pose of every link in the root link's frame for joint values `q`
-// (floating and planar joints at their origin, as imported).
-std::map<std::string, Pose> ForwardKinematics(const std::vector<XmlJoint>& joints,
-                                              const std::string& root,
-                                              const std::map<std::string, double>& q) {
-  std::map<std::string, Pose> X{{root, Pose{}}};
-  for (size_t pass = 0; pass <= joints.size(); ++pass)
-    for (const XmlJoint& j : joints) {
-      if (!X.contains(j.parent) || X.contains(j.child)) continue;
-      const double v = q.contains(j.name) ? q.at(j.name) : 0.0;
-      Pose motion;
-      if (j.type == "revolute" || j.type == "continuous") motion.q = Quat::FromAxisAngle(j.axis, v);
-      if (j.type == "prismatic") motion.p = j.axis.Normalized() * v;
-      X[j.child] = X[j.parent] * j.origin * motion;
-    }
-  return X;
 }
 
 // Joint values of configuration `k` (0: all zero), mimic joints following
@@ -233,7 +174,7 @@ TEST_F(UrdfCorpusTest, LinksSitWhereTheXmlJointsPutThemAtThreeConfigurations) {
         scene.mutable_joint(joint).position = value;
       }
       scene.UpdateWorldPoses();
-      const std::map<std::string, Pose> expected = ForwardKinematics(joints, root, q);
+      const std::map<std::string, Pose> expected = ForwardKinematics(joints, q);
       ASSERT_EQ(expected.size(), links.size());
       const Pose X_WR = scene.world_pose(robot);
       for (const auto& [link, X_RL] : expected) {

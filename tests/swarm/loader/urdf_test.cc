@@ -21,71 +21,22 @@
 #include "swarm/loader/world_loader.h"
 #include "tests/framework/error_of.h"
 #include "tests/shared_urdf.h"
+#include "tests/swarm/loader/urdf_xml_kinematics.h"
 #include "tests/swarm/loader/world_dir_test.h"
 
 namespace swarmsim {
 namespace {
 
 namespace fs = std::filesystem;
+using testing::ForwardKinematics;
+using testing::ReadJoints;
+using testing::XmlJoint;
 
 const char* kFanuc = "fanuc_m10ia/moveit_resources_fanuc_description/urdf/fanuc.urdf";
 const char* kPanda = "panda/example-robot-data/robots/panda_description/urdf/panda.urdf";
 const char* kTurtlebot = "turtlebot3_waffle/nav2_minimal_tb3_sim/urdf/turtlebot3_waffle.urdf";
 
 // --- The URDF's kinematics, read from the XML here ------------------------------------
-
-struct XmlJoint {
-  std::string name, type, parent, child;
-  Pose origin;
-  Vec3 axis{1, 0, 0};
-};
-
-Vec3 ParseVec(const char* text, Vec3 fallback) {
-  if (!text) return fallback;
-  std::istringstream in(text);
-  Vec3 v;
-  in >> v.x >> v.y >> v.z;
-  return v;
-}
-
-std::vector<XmlJoint> ReadJoints(const std::string& path) {
-  tinyxml2::XMLDocument doc;
-  EXPECT_EQ(doc.LoadFile(path.c_str()), tinyxml2::XML_SUCCESS);
-  std::vector<XmlJoint> out;
-  for (auto* e = doc.RootElement()->FirstChildElement("joint"); e;
-       e = e->NextSiblingElement("joint")) {
-    XmlJoint j;
-    j.name = e->Attribute("name");
-    j.type = e->Attribute("type");
-    j.parent = e->FirstChildElement("parent")->Attribute("link");
-    j.child = e->FirstChildElement("child")->Attribute("link");
-    if (auto* o = e->FirstChildElement("origin")) {
-      const Vec3 rpy = ParseVec(o->Attribute("rpy"), {});
-      j.origin = {ParseVec(o->Attribute("xyz"), {}), Quat::FromRollPitchYaw(rpy.x, rpy.y, rpy.z)};
-    }
-    if (auto* a = e->FirstChildElement("axis")) j.axis = ParseVec(a->Attribute("xyz"), {1, 0, 0});
-    out.push_back(j);
-  }
-  return out;
-}
-
-// Pose of every link in the robot's root frame for joint values `q`.
-std::map<std::string, Pose> ForwardKinematics(const std::vector<XmlJoint>& joints,
-                                              const std::map<std::string, double>& q) {
-  std::map<std::string, Pose> X;
-  for (const XmlJoint& j : joints) X.emplace(j.parent, Pose{});  // roots stay at identity
-  for (const XmlJoint& j : joints) X.erase(j.child);
-  for (size_t pass = 0; pass < joints.size(); ++pass)
-    for (const XmlJoint& j : joints) {
-      if (!X.contains(j.parent) || X.contains(j.child)) continue;
-      const double v = q.contains(j.name) ? q.at(j.name) : 0.0;
-      Pose motion;
-      if (j.type == "revolute" || j.type == "continuous") motion.q = Quat::FromAxisAngle(j.axis, v);
-      if (j.type == "prismatic") motion.p = j.axis.Normalized() * v;
-      X[j.child] = X[j.parent] * j.origin * motion;
-    }
-  return X;
-}
 
 class UrdfTest : public testing::WorldDirTest {
  protected:
