@@ -2,7 +2,7 @@ local slow = sim.getParam('slow') == 1
 function sysCall_actuation()
   if slow then
     if sim.getRobotIndex() == 0 then
-      for i = 1, 2000000 do end
+      for i = 1, 20000000 do end  -- tens of ms a step: a few rows a second on any machine
       sim.recordMetric('t', sim.getSimulationTime())
     end
     return

@@ -97,9 +97,9 @@ size_t WaitForRows(const fs::path& csv) {
   return 0;
 }
 
-// A slow run with sparse rows (one ~40-byte row a step, a step taking
-// milliseconds): rows must reach the file while it is far smaller than a
-// stream buffer, i.e. flushed by time, not when a buffer fills.
+// A slow run with sparse rows (one ~25-byte row a step, a step taking tens
+// of milliseconds, so a few hundred bytes a second on any machine): rows must reach the file while
+// it is far smaller than a stream buffer, i.e. flushed by time, not when a buffer fills.
 TEST(RunOutputsTest, SparseMetricsReachTheFileWhileTheRunGoesOn) {
   const fs::path out = TempDir("sparse");
   const pid_t pid = Spawn({"run", Data("outputs.yaml"), "--set", "outputs.slow=1", "--steps",
