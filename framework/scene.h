@@ -71,6 +71,10 @@ struct ShapeData {
   // false: no contacts in the dynamics backends (a URDF visual, a body's
   // mass carrier); sensors still see it.
   bool collidable = true;
+  // false: not drawn (viewer, recording, snapshots, video, vision sensors);
+  // it still collides and proximity sensors still detect it (a URDF link's
+  // collision geometry when the link has visuals).
+  bool visible = true;
   double friction = 0.7;  // Coulomb coefficient
   double restitution = 0.0;
   Vec3 color{0.7, 0.7, 0.7};  // RGB in [0, 1]

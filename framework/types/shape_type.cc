@@ -23,6 +23,9 @@ constexpr ObjectKey kKeys[] = {
     {"inertia", "from the geometry",
      "[ixx, iyy, izz, ixy, ixz, iyz] kg m^2 about the shape's origin (dynamic shapes, ode)"},
     {"collidable", "true", "false: no contacts in the physics backends (sensors still see it)"},
+    {"visible", "true",
+     "false: not drawn (viewer, snapshots, video, vision sensors); still collides and proximity "
+     "sensors still detect it"},
     {"friction", "0.7", "Coulomb coefficient, >= 0"},
     {"restitution", "0", "0..1"},
     {"color", "[0.7, 0.7, 0.7]", "RGB, each 0..1"},
@@ -113,6 +116,7 @@ void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
     std::copy(i.begin(), i.end(), s.inertia.begin());
   }
   if (r.Has("collidable")) s.collidable = r.Bool("collidable");
+  if (r.Has("visible")) s.visible = r.Bool("visible");
   if (r.Has("friction")) s.friction = r.Number("friction", kNonNegative);
   if (r.Has("restitution")) s.restitution = r.Number("restitution", kFraction);
   if (r.Has("color")) {
@@ -141,6 +145,7 @@ namespace {
 // Drawn as its geometry, in its colour (which scripts may change).
 void Visual(const Scene& scene, ObjectType type, uint32_t row, ObjectVisual* out) {
   const ShapeData& s = *scene.rows<Shared<ShapeData>>(type).rows[row];
+  if (!s.visible) return;  // kNone: drawn by nothing
   switch (s.kind) {
     case ShapeKind::kBox: out->kind = VisualKind::kBox; break;
     case ShapeKind::kCylinder: out->kind = VisualKind::kCylinder; break;

@@ -570,6 +570,7 @@ ObjectSpec Importer::LinkObject(const urdf::Link& link, bool top, bool is_root, 
     s.kind = ShapeKind::kSphere;
     s.size = {kUrdfCarrierRadius, 0, 0};
     s.collidable = false;
+    s.visible = false;   // a mass, not a part: nothing to see
     s.mass = body.mass;  // 0: a frame, never simulated
     s.dynamic = body.mass > 0 && !is_root;
     if (body.mass > 0) {
@@ -597,8 +598,12 @@ ObjectSpec Importer::LinkObject(const urdf::Link& link, bool top, bool is_root, 
     const auto& c = *link.collision_array[k];
     const int line = k < collision_lines.size() ? collision_lines[k] : xml_.link_line[link.name];
     if (auto shape =
-            Geometry(link, c.geometry.get(), c.origin, false, line, color ? &*color : nullptr))
+            Geometry(link, c.geometry.get(), c.origin, false, line, color ? &*color : nullptr)) {
+      // Drawn only when the link has nothing else to show: the visuals are
+      // what the robot looks like, the collision geometry what it touches.
+      if (!link.visual_array.empty()) RowOf<Shared<ShapeData>>(*shape).Edit().visible = false;
       spec.children.push_back(std::move(*shape));
+    }
   }
   for (size_t k = 0; k < link.visual_array.size(); ++k) {
     const auto& v = *link.visual_array[k];

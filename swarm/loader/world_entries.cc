@@ -125,6 +125,20 @@ void SetJointLimitSoftness(double limit_erp, double limit_cfm, ObjectSpec* spec)
   }
   for (ObjectSpec& child : spec->children) SetJointLimitSoftness(limit_erp, limit_cfm, &child);
 }
+
+// `show_collision: true`: every hidden shape named `collision` below `spec`
+// (an imported link's collision geometry) drawn, in a row of its own.
+void ShowCollisionShapes(ObjectSpec* spec) {
+  const auto* shape = spec->As<Shared<ShapeData>>(ObjectType::kShape);
+  if (shape != nullptr && spec->name == "collision" && !(*shape)->visible) {
+    const ObjectTypeDescriptor& type = *CoreObjectTypes()[static_cast<size_t>(ObjectType::kShape)];
+    std::shared_ptr<RowTable> row = type.make_rows(type);
+    row->Append(shape, 0);
+    static_cast<Shared<ShapeData>*>(row->At(0))->Edit().visible = true;
+    spec->row = std::move(row);
+  }
+  for (ObjectSpec& child : spec->children) ShowCollisionShapes(&child);
+}
 }  // namespace
 
 // --- Resolving an entry ----------------------------------------------------------------
@@ -139,7 +153,7 @@ std::vector<std::string> EntryKeys(const ModuleRegistry& registry) {
   std::vector<std::string> keys = {
       "model",           "count",      "distribute", "position", "heading_deg",
       "orientation_deg", "parameters", "instances",  "scale",    "base",
-      "objects",         "scripts",    "joints"};
+      "show_collision",  "objects",    "scripts",    "joints"};
   for (std::string& key : ModelSectionKeys(registry)) keys.push_back(std::move(key));
   keys.insert(keys.end(), {"python_controller", "native_controller"});
   return keys;
@@ -432,6 +446,14 @@ void WorldLoader::ExtendObjects(const Fields& f, const ValueReader& world_values
                         "'base' applies to URDF models (a model file says which shapes "
                         "are dynamic itself)");
     if (kind == "floating") *spec = loader::WithFloatingBase(*spec, file_->Where(base.mark));
+  }
+  if (f.Has("show_collision")) {
+    const Field show = f.Get("show_collision");
+    if (!model.imported)
+      world_values.Fail(show,
+                        "'show_collision' applies to URDF models (a model file says which "
+                        "shapes are visible itself)");
+    if (world_values.Bool(show)) ShowCollisionShapes(spec);
   }
   if (f.Has("joints")) {
     // Joint settings for every joint of the model without its own (ode).

@@ -52,6 +52,7 @@ TEST(ShapeTypeTest, TheOtherKeysReachTheRow) {
                                       {"dynamic", true},
                                       {"mass", 0.4},
                                       {"collidable", false},
+                                      {"visible", false},
                                       {"friction", 0.2},
                                       {"restitution", 0.5},
                                       {"color", std::vector<double>{1, 0, 0.5}},
@@ -59,6 +60,7 @@ TEST(ShapeTypeTest, TheOtherKeysReachTheRow) {
   EXPECT_TRUE(s.dynamic);
   EXPECT_EQ(s.mass, 0.4);
   EXPECT_FALSE(s.collidable);
+  EXPECT_FALSE(s.visible);
   EXPECT_EQ(s.friction, 0.2);
   EXPECT_EQ(s.restitution, 0.5);
   EXPECT_EQ(s.color.x, 1);
@@ -70,6 +72,7 @@ TEST(ShapeTypeTest, TheOtherKeysReachTheRow) {
   EXPECT_FALSE(d.dynamic);
   EXPECT_EQ(d.mass, 1);
   EXPECT_TRUE(d.collidable);
+  EXPECT_TRUE(d.visible);
   EXPECT_EQ(d.friction, 0.7);
   EXPECT_EQ(d.color.y, 0.7);
   EXPECT_EQ(d.inertia, (std::array<double, 6>{}));

@@ -12,6 +12,7 @@
 #include "framework/error.h"
 #include "framework/world.h"
 #include "modules/paint/png_io.h"
+#include "modules/proximity/proximity_sensor.h"
 #include "modules/rendering/objects.h"
 #include "modules/rendering/render.h"
 #include "swarm/loader/world_loader.h"
@@ -89,6 +90,29 @@ TEST_F(RenderingTest, ObjectsOutsideTheDetectableSetAreNotSeen) {
   EXPECT_FALSE(centre[0] > 120 && centre[1] < 60) << "the cube is not detectable";
   EXPECT_GT(image.Pixel(2, 45)[0], 100) << "the sensor rendered: it sees the floor";
   EXPECT_NEAR(image.depth[24 * 64 + 32], 10.0, 1e-3) << "nothing at the cube's place: far";
+}
+
+// `visible: false` (an imported link's collision geometry): cameras do not
+// see the cube, a proximity ray along the same axis still detects it.
+TEST_F(RenderingTest, AnInvisibleShapeIsNotSeenButStillDetected) {
+  std::string world = kRedCube;
+  world.replace(world.find("color: [0.9, 0.1, 0.1]}"), 23,
+                "color: [0.9, 0.1, 0.1], visible: false}");
+  world +=
+      "  - {name: ray, type: proximity_sensor, range: 5, position: [0, 0, 0.25], "
+      "orientation_deg: [0, 90, 0]}\n";
+  LoadedWorld w = Load(world);
+  w.world->Start();
+  w.world->Step();
+  const Image& image = Sensor(*w.world, "/eye").image;
+  const uint8_t* centre = image.Pixel(32, 24);
+  EXPECT_FALSE(centre[0] > 120 && centre[1] < 60) << "the invisible cube is not drawn";
+  EXPECT_NEAR(image.depth[24 * 64 + 32], 10.0, 1e-3) << "nothing at the cube's place: far";
+  const ObjectId ray = w.world->scene().FindObject("/ray");
+  ASSERT_FALSE(ray.IsNull());
+  const auto& reading = *static_cast<const ProximitySensorData*>(w.world->scene().row_data(ray));
+  EXPECT_TRUE(reading.detected) << "the ray still meets the cube";
+  EXPECT_NEAR(reading.distance, 1.75, 1e-6);
 }
 
 TEST_F(RenderingTest, AnOrthographicSensorLookingDownSeesTheCubeFromAbove) {

@@ -572,6 +572,59 @@ TEST_F(UrdfTest, MaterialColoursBecomeTheShapesColours) {
   EXPECT_EQ(colors[4], red);
 }
 
+// What a robot looks like is its visuals: a link's collision geometry is
+// hidden when the link has visuals (drawn when it has none, or with the
+// entry's `show_collision: true`); the body's mass carrier is never drawn.
+TEST_F(UrdfTest, CollisionShapesAreHiddenBehindTheLinksVisuals) {
+  Write("v.urdf",
+        "<robot name=\"v\">\n"
+        "  <link name=\"base\">\n"
+        "    <visual><geometry><box size=\"0.1 0.1 0.1\"/></geometry></visual>\n"
+        "    <collision><geometry><box size=\"0.2 0.2 0.2\"/></geometry></collision>\n"
+        "  </link>\n"
+        "  <link name=\"arm\">\n"
+        "    <inertial><mass value=\"1\"/><inertia ixx=\"0.01\" iyy=\"0.01\" izz=\"0.01\" "
+        "ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial>\n"
+        "    <collision><geometry><sphere radius=\"0.05\"/></geometry></collision>\n"
+        "  </link>\n"
+        "  <joint name=\"j\" type=\"revolute\"><parent link=\"base\"/><child link=\"arm\"/>"
+        "<axis xyz=\"0 0 1\"/><limit lower=\"-1\" upper=\"1\" effort=\"1\" velocity=\"1\"/>"
+        "</joint>\n</robot>\n");
+  // name -> (collision shapes drawn, hidden), per link object.
+  const auto shown = [](const Scene& scene) {
+    std::map<std::string, std::pair<int, int>> drawn;
+    std::vector<ObjectId> stack{scene.instances()[0].root};
+    while (!stack.empty()) {
+      const ObjectId id = stack.back();
+      stack.pop_back();
+      for (ObjectId c : scene.children(id)) stack.push_back(c);
+      if (scene.type(id) != ObjectType::kShape) continue;
+      const std::string name = scene.name(id) == "collision" || scene.name(id) == "visual"
+                                   ? scene.name(scene.parent(id)) + "/" + scene.name(id)
+                                   : scene.name(id);
+      auto& [on, off] = drawn[name];
+      (scene.shape(id).visible ? on : off)++;
+    }
+    return drawn;
+  };
+  LoadedWorld w = Load("models: [{model: v.urdf, position: [0, 0, 0]}]\n");
+  auto drawn = shown(w.world->scene());
+  EXPECT_EQ(drawn["v#0/visual"], std::make_pair(1, 0));
+  EXPECT_EQ(drawn["v#0/collision"], std::make_pair(0, 1)) << "behind the base's visual";
+  EXPECT_EQ(drawn["arm/collision"], std::make_pair(1, 0)) << "the arm has nothing else to show";
+  EXPECT_EQ(drawn["arm"], std::make_pair(0, 1)) << "the arm body's 1 mm mass carrier";
+  LoadedWorld all = Load("models: [{model: v.urdf, position: [0, 0, 0], show_collision: true}]\n");
+  drawn = shown(all.world->scene());
+  EXPECT_EQ(drawn["v#0/collision"], std::make_pair(1, 0));
+  EXPECT_EQ(drawn["arm"], std::make_pair(0, 1)) << "still not a part to see";
+  // The key is the importer's: a model file says what is visible itself.
+  Write("m.yaml", "model: m\nobjects: {name: body, type: shape, shape: box, size: [1, 1, 1]}\n");
+  const std::string e = testing::ErrorOf(
+      [&] { Load("models: [{model: m.yaml, position: [0, 0, 0], show_collision: true}]\n"); });
+  EXPECT_NE(e.find("world.yaml:1:"), std::string::npos) << e;
+  EXPECT_NE(e.find("'show_collision' applies to URDF models"), std::string::npos) << e;
+}
+
 TEST_F(UrdfTest, ANegativeMeshScaleMirrorsTheMeshKeepingItsTrianglesFacingOut) {
   // ROS descriptions mirror one arm's meshes for the other (TIAGo's
   // scale="1 -1 1"): the mirrored mesh's y extent flips, and its signed
