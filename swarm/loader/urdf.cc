@@ -14,6 +14,9 @@
 #include <mutex>
 #include <optional>
 #include <set>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "framework/display_path.h"
 #include "framework/error.h"
@@ -87,6 +90,9 @@ class Importer {
   ObjectSpec LinkObject(const urdf::Link& link, bool top, bool is_root, const Pose& X_PO,
                         const Pose& X_TL);
   std::vector<urdf::JointSharedPtr> ChildJoints(const urdf::Link& link) const;
+  void NameObjects();
+  const std::string& LinkName(const std::string& link) const { return link_names_.at(link); }
+  const std::string& JointName(const std::string& joint) const { return joint_names_.at(joint); }
 
   fs::path path_;
   std::string name_;
@@ -96,7 +102,11 @@ class Importer {
   std::map<std::string, std::optional<fs::path>> packages_;
   std::vector<std::string> default_mass_links_;  // bodies' top links given the default mass
   std::vector<std::string> repaired_links_;      // links and bodies whose inertia was balanced
-  int links_merged_ = 0;  // links joined to their body's top link by fixed joints
+  std::vector<std::string> point_mass_links_;    // bodies of point masses only (their top links)
+  // Each link's and joint's object name (NameObjects): unique in the robot.
+  std::map<std::string, std::string> link_names_, joint_names_;
+  std::vector<std::string> renamed_;  // "link 'a b' is 'a_b_2'", for the warning
+  int links_merged_ = 0;              // links joined to their body's top link by fixed joints
   int frames_ = 0, bodies_ = 0, meshes_count_ = 0, visuals_ = 0, collisions_ = 0;
   std::map<std::string, int> mesh_formats_;
   std::map<std::string, int> joint_kinds_;
@@ -542,12 +552,54 @@ MassProperties Importer::BodyMass(const urdf::Link& top, bool is_root) {
     // Point masses alone (a mean moment under the mass's at 1e-9 m^2):
     // the default link's radius of gyration.
     const double least = body.mass * kUrdfPointMassGyration;
-    if (!(body.inertia[0] > 1e-9 * body.mass)) body.inertia = {least, least, least, 0, 0, 0};
-    if (std::find(repaired_links_.begin(), repaired_links_.end(), top.name) ==
-        repaired_links_.end())
-      repaired_links_.push_back(top.name);
+    std::vector<std::string>* note = &repaired_links_;
+    if (!(body.inertia[0] > 1e-9 * body.mass)) {
+      body.inertia = {least, least, least, 0, 0, 0};
+      note = &point_mass_links_;
+    }
+    if (std::find(note->begin(), note->end(), top.name) == note->end()) note->push_back(top.name);
   }
   return body;
+}
+
+// Object names are unique in a robot, so that sim.getObject('./name') finds
+// the one meant: joints keep their names (scripts drive them), a link named
+// as a joint becomes NAME_link (ANYmal's LF_HAA link and joint), and names
+// that clean to the same one (ObjectName: 'upper arm' and 'upper_arm') get
+// _2, _3 in document order.
+void Importer::NameObjects() {
+  std::set<std::string> used;
+  const auto unique = [&](std::string name) {
+    if (used.contains(name))
+      for (int k = 2;; ++k)
+        if (!used.contains(name + "_" + std::to_string(k))) {
+          name += "_" + std::to_string(k);
+          break;
+        }
+    used.insert(name);
+    return name;
+  };
+  const auto in_order = [](const std::map<std::string, int>& order) {
+    std::vector<std::pair<int, std::string>> v;
+    for (const auto& [name, k] : order) v.emplace_back(k, name);
+    std::sort(v.begin(), v.end());
+    return v;
+  };
+  std::set<std::string> joint_names;
+  for (const auto& [order, joint] : in_order(xml_.joint_order)) {
+    const std::string clean = ObjectName(joint);
+    joint_names_[joint] = unique(clean);
+    joint_names.insert(clean);
+    if (joint_names_[joint] != clean)
+      renamed_.push_back("joint '" + joint + "' is '" + joint_names_[joint] + "'");
+  }
+  for (const auto& [line, link] : in_order(xml_.link_line)) {
+    const std::string clean = ObjectName(link);
+    link_names_[link] = unique(joint_names.contains(clean) ? clean + "_link" : clean);
+    if (link_names_[link] != clean)
+      renamed_.push_back("link '" + link + "' is '" + link_names_[link] + "'" +
+                         (joint_names.contains(clean) ? " (a joint has its name)" : ""));
+  }
 }
 
 std::vector<urdf::JointSharedPtr> Importer::ChildJoints(const urdf::Link& link) const {
@@ -565,7 +617,7 @@ ObjectSpec Importer::LinkObject(const urdf::Link& link, bool top, bool is_root, 
   ObjectSpec spec;
   if (top) {
     const MassProperties body = BodyMass(link, is_root);
-    spec = NewObject(ObjectType::kShape, ObjectName(link.name), X_PO);
+    spec = NewObject(ObjectType::kShape, LinkName(link.name), X_PO);
     ShapeData& s = RowOf<Shared<ShapeData>>(spec).Edit();
     s.kind = ShapeKind::kSphere;
     s.size = {kUrdfCarrierRadius, 0, 0};
@@ -582,7 +634,7 @@ ObjectSpec Importer::LinkObject(const urdf::Link& link, bool top, bool is_root, 
       ++frames_;
     }
   } else {
-    spec = NewObject(ObjectType::kDummy, ObjectName(link.name), X_PO);
+    spec = NewObject(ObjectType::kDummy, LinkName(link.name), X_PO);
   }
   // The link's colour (its collision shapes'): its first coloured visual's.
   const std::vector<std::optional<Vec3>>& colors = xml_.visual_colors[link.name];
@@ -636,7 +688,7 @@ ObjectSpec Importer::LinkObject(const urdf::Link& link, bool top, bool is_root, 
     axis = axis.Normalized();
     const Quat z_to_axis = ZTo(axis);
     ObjectSpec j =
-        NewObject(ObjectType::kJoint, ObjectName(joint->name), X_LJ * Pose{{}, z_to_axis});
+        NewObject(ObjectType::kJoint, JointName(joint->name), X_LJ * Pose{{}, z_to_axis});
     JointData& d = RowOf<JointData>(j);
     JointSettings& settings = d.settings.Edit();  // this entry's, shared by its copies
     settings.type =
@@ -669,7 +721,7 @@ ObjectSpec Importer::LinkObject(const urdf::Link& link, bool top, bool is_root, 
     if (joint->dynamics) settings.damping = joint->dynamics->damping;
     if (joint->mimic) {
       auto dep = std::make_shared<JointDependency>();
-      dep->master = ":/" + ObjectName(joint->mimic->joint_name);
+      dep->master = ":/" + JointName(joint->mimic->joint_name);
       dep->factor = joint->mimic->multiplier;
       dep->offset = joint->mimic->offset;
       dep->where = name_ + ":" + std::to_string(xml_.mimic_line[joint->name]);
@@ -729,6 +781,7 @@ UrdfImport Importer::Run(const std::string& where, const std::string& text) {
   out.name = ObjectName(model->getName());
   for (char& c : out.name)
     if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-') c = '_';
+  NameObjects();
   out.root = LinkObject(*model->getRoot(), true, true, Pose{}, Pose{});
 
   std::string joints;
@@ -771,8 +824,16 @@ UrdfImport Importer::Run(const std::string& where, const std::string& text) {
         list(repaired_links_) +
         ") is no rigid body's (not positive definite, or a principal moment above the sum of "
         "the other two): balanced as MuJoCo's balanceinertia does, each principal moment "
-        "replaced by their mean (a body of point masses only: its mass x " +
-        Num(kUrdfPointMassGyration) + " m^2 about each axis)");
+        "replaced by their mean");
+  if (!point_mass_links_.empty())
+    out.warnings.push_back(
+        name_ + ": " + plural(point_mass_links_.size(), "body is", "bodies are") +
+        " point masses only, with no inertia (" + list(point_mass_links_) +
+        "): each gets its mass x " + Num(kUrdfPointMassGyration) + " m^2 about each axis");
+  if (!renamed_.empty())
+    out.warnings.push_back(name_ + ": " + plural(renamed_.size(), "name was", "names were") +
+                           " changed so that scripts find each object by its name (" +
+                           list(renamed_) + ")");
   if (!default_mass_links_.empty())
     out.warnings.push_back(
         name_ + ": " + plural(default_mass_links_.size(), "link", "links") +

@@ -472,6 +472,7 @@ void WorldLoader::ExtendObjects(const Fields& f, const ValueReader& world_values
   }
   if (f.Has("scripts")) {
     Fields scripts(*file_, f.Get("scripts"), "'scripts'");
+    std::map<const ObjectSpec*, std::string> given;  // object -> the key that gave its script
     for (const Field& s : scripts.fields()) {
       // ':' (or '.') the root; else the first object of that name, in hierarchy order.
       ObjectSpec* target = nullptr;
@@ -491,6 +492,10 @@ void WorldLoader::ExtendObjects(const Fields& f, const ValueReader& world_values
         file_->Fail(s.key_mark, "no object '" + s.name + "' in model '" + model.name +
                                     "' to attach a script to (':' is the root)" +
                                     loader::Suggest(s.name, names));
+      if (const auto [it, added] = given.emplace(target, s.name); !added)
+        file_->Fail(s.key_mark, "'" + s.name + "' and '" + it->second +
+                                    "' name the same object of model '" + model.name +
+                                    "' (an object runs one script: give it one)");
       const std::string text = world_values.String(s);
       if (text.empty()) world_values.Fail(s, "a script must be a file name");
       target->script = scripts_.Get(path_.parent_path() / text, file_->Where(s.mark), text);

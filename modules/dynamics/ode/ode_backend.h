@@ -43,9 +43,11 @@
 //
 // Solver (Options::solver, the world's `simulation.ode`): dWorldStep (exact)
 // or dWorldQuickStep (iterative); `auto` takes the exact one for worlds of at
-// most kExactSolverBodies dynamic bodies at Build (an arm holds its
-// commanded configuration to the joints' CFM under load, 3e-6 m for the
-// Panda), quickstep above (swarms: the solver is the cost).
+// most kExactSolverBodies dynamic bodies at Build, two thirds of them
+// hanging from a fixed base (an arm holds its commanded configuration to
+// the joints' CFM under load, 3e-6 m for the Panda), quickstep above
+// (swarms: the solver is the cost) and for floating robots and free bodies
+// in contact (the exact solve's LCP degenerates there).
 //
 // Contacts: up to Options::max_contacts per geom pair, friction the geometric
 // mean of the two shapes' (pyramid approximation), restitution the larger of

@@ -13,16 +13,16 @@ namespace swarmsim::ode {
 
 // Which ODE stepper solves the constraints.
 enum class Solver : uint8_t {
-  kAuto,       // kWorld for worlds of at most kExactSolverBodies dynamic bodies with at
-               // least a joint for every two bodies (mechanisms), else kQuickStep
+  kAuto,       // kWorld for worlds of at most kExactSolverBodies dynamic bodies, two
+               // thirds of them hanging from a fixed base (arms), else kQuickStep
   kWorld,      // dWorldStep: exact (Dantzig LCP) per island; cost grows with rows^3
   kQuickStep,  // dWorldQuickStep: `iterations` sweeps of projected Gauss-Seidel
 };
 
 // `auto` takes the exact solver up to this many dynamic bodies (an arm, a few
 // legged robots), quickstep above (swarms, where the solver is the cost) and
-// for worlds of mostly free bodies (stacks of boxes, where the exact solve
-// degenerates).
+// for worlds of mostly free bodies (stacks of boxes, floating robots on the
+// ground, where the exact solve degenerates).
 constexpr int kExactSolverBodies = 64;
 
 struct Options {

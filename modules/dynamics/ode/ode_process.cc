@@ -87,6 +87,21 @@ bool ProbeSolverShuffle() {
   return ours;
 }
 
+// ODE's message handler: ODE prints notes such as "LCP internal error, s <=
+// 0" (its exact solver meeting a degenerate contact set) straight to stderr,
+// one per step. Ours says the first once, as a warning with what to do.
+void NoteOdeMessage(int number, const char* message, va_list arguments) {
+  static std::atomic<bool> said{false};
+  if (said.exchange(true)) return;
+  char text[512];
+  std::vsnprintf(text, sizeof text, message, arguments);
+  std::fprintf(stderr,
+               "warning: ode: message %d: %s (ODE's exact solver met a degenerate set of "
+               "contacts; `simulation: {ode: {solver: quickstep}}` avoids it); further ODE "
+               "messages are not shown\n",
+               number, text);
+}
+
 bool g_solver_shuffle_is_ours = false;
 bool g_single_threaded_islands = false;  // SolverThreads' probe
 
@@ -98,6 +113,7 @@ void InitOdeOnce() {
     dInitODE2(0);
     dSetErrorHandler(ThrowOdeError);
     dSetDebugHandler(ThrowOdeError);
+    dSetMessageHandler(NoteOdeMessage);
     dAllocateODEDataForThread(dAllocateMaskAll);
     g_solver_shuffle_is_ours = ProbeSolverShuffle();
     if (g_solver_shuffle_is_ours)

@@ -14,7 +14,8 @@ namespace {
 constexpr ObjectKey kKeys[] = {
     {"solver", "auto",
      "auto, world or quickstep: world is ODE's exact stepper (dWorldStep), quickstep its "
-     "iterative one; auto takes world for worlds of at most 64 dynamic bodies, quickstep above"},
+     "iterative one; auto takes world for worlds of at most 64 dynamic bodies, two thirds of "
+     "them hanging from a fixed base (arms), quickstep otherwise"},
     {"iterations", "40", "quickstep's iterations per substep, 1..100000"},
     {"erp", "0.2", "error reduction parameter of joints and contacts, 0..1"},
     {"cfm", "1e-6", "constraint force mixing of joints, motors and contacts, 0..1"},

@@ -5,6 +5,9 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <unordered_map>
+#include <utility>
+#include <vector>
 
 #include "framework/dependent_joints.h"
 #include "framework/error.h"
@@ -286,15 +289,45 @@ void OdeWorld::Build(const Scene& scene) {
     case Solver::kWorld: exact_solver_ = true; break;
     case Solver::kQuickStep: exact_solver_ = options_.iterations <= 0; break;
     case Solver::kAuto:
-      // Exact for small, mostly articulated worlds (at least a joint for
-      // every two bodies); a pile of free bodies in contact (boxes stacked
-      // into towers) makes the direct solve's LCP degenerate ("LCP internal
-      // error", the towers fall), where quickstep holds them.
+      // Exact for small worlds of mostly fixed-base mechanisms (arms: two
+      // thirds of the bodies or more hang through joints from the world or
+      // a kinematic base). Free bodies in contact make the direct solve's
+      // LCP degenerate: boxes stacked into towers fall, a wheeled base
+      // dropped on the ground lands yawed ("LCP internal error"), a
+      // humanoid standing on its feet with 2 mg finger links stops the run
+      // (dxLDLTRemove); quickstep holds them all.
       exact_solver_ =
           options_.iterations <= 0 || (bodies_.size() <= static_cast<size_t>(kExactSolverBodies) &&
-                                       2 * joints_.size() >= bodies_.size());
+                                       3 * AnchoredBodies() >= 2 * bodies_.size());
       break;
   }
+}
+
+size_t OdeWorld::AnchoredBodies() const {
+  // Union-find over the dynamic bodies; index bodies_.size() stands for the
+  // world and every kinematic body (a robot's fixed base).
+  std::unordered_map<dBodyID, size_t> index;
+  for (size_t k = 0; k < bodies_.size(); ++k) index.emplace(bodies_[k].body, k);
+  const size_t anchor = bodies_.size();
+  std::vector<size_t> up(bodies_.size() + 1);
+  for (size_t k = 0; k < up.size(); ++k) up[k] = k;
+  const auto find = [&](size_t k) {
+    while (up[k] != k) k = up[k] = up[up[k]];
+    return k;
+  };
+  const auto node = [&](dBodyID body) {
+    const auto it = body == nullptr ? index.end() : index.find(body);
+    return it == index.end() ? anchor : it->second;  // the world, or a kinematic body
+  };
+  for (const SimJoint& j : joints_) {
+    size_t a = find(node(j.parent_body)), b = find(node(j.child_body));
+    if (a == b) continue;
+    if (b == anchor) std::swap(a, b);
+    up[b] = a;  // the anchor stays a root
+  }
+  size_t anchored = 0;
+  for (size_t k = 0; k < bodies_.size(); ++k) anchored += find(k) == anchor;
+  return anchored;
 }
 
 void OdeWorld::LinkDependentJoints(const Scene& scene) {
@@ -677,10 +710,20 @@ void OdeWorld::StepOnce(double dt, double fraction) {
   ++substeps_done_;
   if (solver_threads_)
     solver_threads_->set_shuffle_seed(Mix64(Mix64(options_.seed) ^ substeps_done_));
-  const int stepped = exact_solver_ ? dWorldStep(world_, dt) : dWorldQuickStep(world_, dt);
-  if (solver_threads_) {
-    if (std::exception_ptr failure = solver_threads_->TakeFailure())
-      std::rethrow_exception(failure);
+  int stepped = 0;
+  try {
+    stepped = exact_solver_ ? dWorldStep(world_, dt) : dWorldQuickStep(world_, dt);
+    if (solver_threads_) {
+      if (std::exception_ptr failure = solver_threads_->TakeFailure())
+        std::rethrow_exception(failure);
+    }
+  } catch (const Error& e) {
+    if (!exact_solver_) throw;
+    throw Error(std::string(e.what()) +
+                "; this world uses ODE's exact solver (`solver: world`, or `auto` for a small "
+                "world of fixed-base arms), which fails on degenerate constraint sets (links of "
+                "a few milligrams, many contacts): `simulation: {ode: {solver: quickstep}}` may "
+                "hold it");
   }
   if (!stepped) throw Error("ode: the solver could not step (out of memory?)");
   dJointGroupEmpty(contacts_);

@@ -158,6 +158,9 @@ class OdeWorld {
   void ApplyMotors(double dt);
   // Links each dependent joint to its master's index (SimJoint::master).
   void LinkDependentJoints(const Scene& scene);
+  // The dynamic bodies that hang through joints from the world or a
+  // kinematic body (a fixed base): Solver::kAuto's measure of "an arm".
+  size_t AnchoredBodies() const;
   void TrackJointPositions();
   // The space holding the geoms of `instance` (the top-level space for -1).
   dSpaceID SpaceOf(int32_t instance);

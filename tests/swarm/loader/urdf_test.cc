@@ -514,12 +514,16 @@ TEST_F(UrdfTest, InertiasNoBodyHasAreRepairedAndMasslessMovingLinksDefaultedOneW
   Write("r.urdf", urdf);
   LoadedWorld w =
       Load("simulation: {physics: ode}\nmodels: [{model: r.urdf, position: [0, 0, 1]}]\n");
-  ASSERT_EQ(w.warnings.size(), 2u);
+  ASSERT_EQ(w.warnings.size(), 3u);
   EXPECT_CONTAINS(w.warnings[0],
-                  "r.urdf: the inertia of 3 links (antenna_left, antenna_right, head) is no rigid "
+                  "r.urdf: the inertia of 2 links (antenna_left, antenna_right) is no rigid "
                   "body's");
-  EXPECT_CONTAINS(w.warnings[1], "1 link that can move");
-  EXPECT_CONTAINS(w.warnings[1], "(wheel): each gets the default mass 0.1 kg");
+  EXPECT_EQ(w.warnings[0].find("point mass"), std::string::npos) << "the antennas are not";
+  EXPECT_CONTAINS(w.warnings[1],
+                  "r.urdf: 1 body is point masses only, with no inertia (head): "
+                  "each gets its mass x 0.001 m^2 about each axis");
+  EXPECT_CONTAINS(w.warnings[2], "1 link that can move");
+  EXPECT_CONTAINS(w.warnings[2], "(wheel): each gets the default mass 0.1 kg");
   const Scene& scene = w.world->scene();
   // The head: its mass at its centre, 2 kg x 0.001 m^2 about each axis.
   const ShapeData& head = scene.shape(Find(*w.world, "head"));
@@ -537,6 +541,101 @@ TEST_F(UrdfTest, InertiasNoBodyHasAreRepairedAndMasslessMovingLinksDefaultedOneW
   w.world->Start();
   for (int k = 0; k < 100; ++k) w.world->Step();
   EXPECT_TRUE(std::isfinite(scene.world_pose(Find(*w.world, "head")).p.z));
+}
+
+// Legal URDF that scripts could not tell apart: a link named as a joint
+// (ANYmal's LF_HAA) and names that clean to the same one. Joints keep their
+// names; the others are renamed, with one warning listing them.
+TEST_F(UrdfTest, NamesStayUniqueSoScriptsFindTheObjectMeant) {
+  Write("n.urdf",
+        "<robot name=\"n\">\n  <link name=\"base\"/>\n"
+        "  <link name=\"LF_HAA\"><inertial><mass value=\"1\"/><inertia ixx=\"0.01\" "
+        "iyy=\"0.01\" izz=\"0.01\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial></link>\n"
+        "  <joint name=\"LF_HAA\" type=\"revolute\"><parent link=\"base\"/>"
+        "<child link=\"LF_HAA\"/><axis xyz=\"1 0 0\"/>" +
+            std::string(kLimit) +
+            "</joint>\n"
+            "  <link name=\"upper arm/left\"/>\n  <link name=\"upper_arm_left\"/>\n"
+            "  <joint name=\"a\" type=\"fixed\"><parent link=\"LF_HAA\"/>"
+            "<child link=\"upper arm/left\"/></joint>\n"
+            "  <joint name=\"b\" type=\"fixed\"><parent link=\"LF_HAA\"/>"
+            "<child link=\"upper_arm_left\"/></joint>\n</robot>\n");
+  LoadedWorld w = Load("models: [{model: n.urdf, position: [0, 0, 1]}]\n");
+  const Scene& scene = w.world->scene();
+  EXPECT_EQ(scene.type(Find(*w.world, "LF_HAA")), ObjectType::kJoint);
+  EXPECT_EQ(scene.type(Find(*w.world, "LF_HAA_link")), ObjectType::kShape);
+  const ObjectId first = Find(*w.world, "upper_arm_left"),
+                 second = Find(*w.world, "upper_arm_left_2");
+  EXPECT_NE(first, second);
+  ASSERT_EQ(w.warnings.size(), 1u);
+  EXPECT_CONTAINS(w.warnings[0],
+                  "n.urdf: 2 names were changed so that scripts find each object "
+                  "by its name (link 'LF_HAA' is 'LF_HAA_link' (a joint has its "
+                  "name), link 'upper_arm_left' is 'upper_arm_left_2')");
+}
+
+// A floating robot standing on the ground with a 2 mg finger link (NAO's
+// published hands): ODE's exact solver fails on it (dxLDLTRemove), so
+// `auto` takes quickstep for floating robots and the robot stands for 2 s;
+// forcing the exact solver ends the run with a message that says what to do.
+TEST_F(UrdfTest, AFloatingRobotWithMilligramLinksStandsOnTheGroundUnderOde) {
+  const std::string inertial =
+      "<inertia ixx=\"1.1e-09\" iyy=\"1.1e-09\" izz=\"1.1e-09\" "
+      "ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial></link>\n";
+  Write("tiny.urdf",
+        "<robot name=\"tiny\">\n  <link name=\"body\"><inertial><mass value=\"1\"/>"
+        "<inertia ixx=\"0.01\" iyy=\"0.01\" izz=\"0.01\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/>"
+        "</inertial><collision><geometry><box size=\"0.2 0.2 0.1\"/></geometry></collision>"
+        "</link>\n"
+        "  <link name=\"l1\"><inertial><origin xyz=\"0.03 0 0\"/><mass value=\"0.18\"/>"
+        "<inertia ixx=\"7e-05\" iyy=\"0.000135\" izz=\"0.000133\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/>"
+        "</inertial></link>\n"
+        "  <link name=\"finger\"><inertial><mass value=\"2e-06\"/>" +
+            inertial +
+            "  <joint name=\"j1\" type=\"revolute\"><parent link=\"body\"/><child link=\"l1\"/>"
+            "<origin xyz=\"0.1 0 0.1\"/><axis xyz=\"0 1 0\"/>"
+            "<limit effort=\"1.5\" lower=\"-2\" upper=\"2\" velocity=\"8\"/></joint>\n"
+            "  <joint name=\"hand\" type=\"revolute\"><parent link=\"l1\"/>"
+            "<child link=\"finger\"/><origin xyz=\"0.05775 0 -0.01231\"/><axis xyz=\"1 0 0\"/>"
+            "<limit effort=\"0.292\" lower=\"0\" upper=\"1\" velocity=\"8.33\"/></joint>\n"
+            "</robot>\n");
+  const auto world = [](const std::string& ode) {
+    return "simulation: {physics: ode, time_step: 0.005" + ode +
+           "}\nmodels: [{model: tiny.urdf, position: [0, 0], base: floating}]\n";
+  };
+  LoadedWorld w = Load(world(""));
+  w.world->Start();
+  for (int k = 0; k < 400; ++k) ASSERT_NO_THROW(w.world->Step()) << "at step " << k;
+  const Pose X = w.world->scene().world_pose(w.world->scene().instances()[0].root);
+  EXPECT_NEAR(X.p.z, 0.05, 0.01) << "the body rests on the ground";
+  LoadedWorld exact = Load(world(", ode: {solver: world}"));
+  exact.world->Start();
+  std::string why;
+  try {
+    for (int k = 0; k < 400; ++k) exact.world->Step();
+  } catch (const Error& e) {
+    why = e.what();
+  }
+  // (ODE 0.16's exact solver stops at step 100; should a later ODE hold
+  // it, this half has nothing left to check and may go.)
+  EXPECT_CONTAINS(why, "dxLDLTRemove");
+  EXPECT_CONTAINS(why, "`simulation: {ode: {solver: quickstep}}` may hold it");
+}
+
+// An object runs one script: two keys of an entry's `scripts` naming the
+// same object (the root by its URDF name and by ':') are an error, not one
+// of them silently dropped.
+TEST_F(UrdfTest, TwoScriptKeysForOneObjectAreAnError) {
+  Write("s.urdf", "<robot name=\"s\"><link name=\"base\"/></robot>\n");
+  Write("a.lua", "");
+  Write("b.lua", "");
+  const std::string e = testing::ErrorOf([&] {
+    Load(
+        "models:\n  - model: s.urdf\n    position: [0, 0]\n"
+        "    scripts: {base: a.lua, ':': b.lua}\n");
+  });
+  EXPECT_CONTAINS(e, "world.yaml:4:");
+  EXPECT_CONTAINS(e, "':' and 'base' name the same object of model 's'");
 }
 
 TEST_F(UrdfTest, MaterialColoursBecomeTheShapesColours) {
