@@ -271,6 +271,9 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
       throw Error(std::string("interrupted by SIG") + sigabbrev_np(sig) +
                   " while the world was loading");
   };
+  load.note = [](const std::string& note) {
+    std::cerr << "note: " << swarmsim::ValidUtf8(note) << std::endl;
+  };
   LoadedWorld loaded;
   try {
     load.overrides = ParseSets(args.sets);
