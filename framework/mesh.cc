@@ -134,8 +134,7 @@ TriangleMesh::TriangleMesh(std::string name, std::vector<Vec3> vertices,
   std::vector<uint64_t> edges;
   edges.reserve(3 * triangles_.size());
   for (const MeshTriangle& tri : triangles_)
-    for (int k = 0; k < 3; ++k)
-      edges.push_back(uint64_t{tri.v[k]} << 32 | tri.v[(k + 1) % 3]);
+    for (int k = 0; k < 3; ++k) edges.push_back(uint64_t{tri.v[k]} << 32 | tri.v[(k + 1) % 3]);
   std::sort(edges.begin(), edges.end());
   closed_ = std::adjacent_find(edges.begin(), edges.end()) == edges.end();
   for (size_t i = 0; closed_ && i < edges.size(); ++i)

@@ -87,10 +87,10 @@ struct LuaMemory {
   // raises then (LUA_ERRMEM: Lua calls no message handler for it, and the
   // host sees its stack unwound): its size, and where it was asked for.
   // Plain data: written inside the allocator (RecordRefusalPlace).
-  size_t refusal_bytes = 0;                 // 0: none in this callback
+  size_t refusal_bytes = 0;                  // 0: none in this callback
   char refusal_where[LUA_IDSIZE + 16] = "";  // "file:line: " of the innermost Lua function, or ""
-  int refusal_script_line = 0;              // the running script's own innermost line, or 0
-  const Script* refusal_script = nullptr;   // that script
+  int refusal_script_line = 0;               // the running script's own innermost line, or 0
+  const Script* refusal_script = nullptr;    // that script
   // How the errors name what holds the memory and the limit's setting.
   const char* holder = "the scripts";
   bool plural = true;  // "the scripts hold", "the expression holds"

@@ -329,8 +329,8 @@ const ColladaCheck::Accessor* ColladaCheck::AccessorOf(const XMLElement* input) 
 // semantic assimp reads a <source> with an accessor, whose array exists.
 void ColladaCheck::CheckReference(const XMLElement* input, bool per_vertex,
                                   const std::map<std::string_view, uint64_t>& vertex_limit) const {
-  static const std::string_view kRead[] = {"POSITION", "NORMAL",      "TEXCOORD",   "COLOR",
-                                           "TANGENT",  "TEXTANGENT", "BINORMAL",   "TEXBINORMAL"};
+  static const std::string_view kRead[] = {"POSITION", "NORMAL",     "TEXCOORD", "COLOR",
+                                           "TANGENT",  "TEXTANGENT", "BINORMAL", "TEXBINORMAL"};
   const char* semantic_text = input->Attribute("semantic");
   const std::string_view semantic = semantic_text ? semantic_text : "";
   const char* source_text = input->Attribute("source");
@@ -356,12 +356,11 @@ void ColladaCheck::CheckReference(const XMLElement* input, bool per_vertex,
                     ") has no <technique_common><accessor>");
   const std::string_view array_id = Fragment(accessor->second.e->Attribute("source"));
   if (!arrays_.contains(array_id))
-    Fail(accessor->second.e, "<accessor source=\"" +
-                                 Shown(accessor->second.e->Attribute("source")
-                                           ? accessor->second.e->Attribute("source")
-                                           : "") +
-                                 "\">: the file's geometries have no array with id " +
-                                 Quoted(array_id));
+    Fail(accessor->second.e,
+         "<accessor source=\"" +
+             Shown(accessor->second.e->Attribute("source") ? accessor->second.e->Attribute("source")
+                                                           : "") +
+             "\">: the file's geometries have no array with id " + Quoted(array_id));
 }
 
 // A <mesh>'s primitive elements; returns its triangles.
@@ -694,7 +693,8 @@ std::string ColladaCheck::Run() {
           text.remove_suffix(1);
         double value = 0;
         if (!ParseFinite(text, &value) || !(value > 0))
-          Fail(unit, "<unit meter=\"" + Shown(meter) + "\"> must be a positive number (metres per unit)");
+          Fail(unit,
+               "<unit meter=\"" + Shown(meter) + "\"> must be a positive number (metres per unit)");
       }
 
   tinyxml2::XMLPrinter printer(nullptr, /*compact=*/true);

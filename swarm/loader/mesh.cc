@@ -44,11 +44,10 @@ const AssimpModule& Assimp() {
 // Reads the file's triangles (the assimp module), merging vertices at equal
 // positions (STL repeats each corner per facet) so that closed meshes are
 // seen closed. `stop_requested` is asked now and then (StopCheck).
-std::shared_ptr<const MeshCache::Welded> ReadMeshFile(const fs::path& path,
-                                                      const std::string& where,
-                                                      const std::string& text,
-                                                      const std::function<bool()>& stop_requested,
-                                                      const std::function<void(const std::string&)>& note);
+std::shared_ptr<const MeshCache::Welded> ReadMeshFile(
+    const fs::path& path, const std::string& where, const std::string& text,
+    const std::function<bool()>& stop_requested,
+    const std::function<void(const std::string&)>& note);
 
 // A stop request during a mesh file's read: the check's own error (the
 // program's "interrupted by SIGTERM while the world was loading") once it
@@ -134,11 +133,10 @@ std::shared_ptr<const TriangleMesh> MeshCache::Get(const fs::path& path, const V
 
 namespace {
 
-std::shared_ptr<const MeshCache::Welded> ReadMeshFile(const fs::path& path,
-                                                      const std::string& where,
-                                                      const std::string& text,
-                                                      const std::function<bool()>& stop_requested,
-                                                      const std::function<void(const std::string&)>& note) {
+std::shared_ptr<const MeshCache::Welded> ReadMeshFile(
+    const fs::path& path, const std::string& where, const std::string& text,
+    const std::function<bool()>& stop_requested,
+    const std::function<void(const std::string&)>& note) {
   const std::string prefix = where.empty() ? "" : where + ": ";
   std::string ext = path.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),

@@ -3,7 +3,6 @@
 // checked (mesh_check.h).
 #include <assimp/DefaultIOSystem.h>
 #include <assimp/MemoryIOWrapper.h>
-#include <assimp/ProgressHandler.hpp>
 #include <assimp/config.h>
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
@@ -12,6 +11,7 @@
 #include <algorithm>
 #include <array>
 #include <assimp/Importer.hpp>
+#include <assimp/ProgressHandler.hpp>
 #include <bit>
 #include <cmath>
 #include <cstring>
@@ -139,7 +139,7 @@ std::string ReadWithAssimp(const std::string& path, const std::string& bytes,
                            const std::string& text, const std::function<bool()>& stop_requested,
                            MeshCache::Welded* out) try {
   Assimp::Importer importer;
-  importer.SetIOHandler(new CheckedFiles(path, &bytes));  // the importer owns it
+  importer.SetIOHandler(new CheckedFiles(path, &bytes));       // the importer owns it
   importer.SetProgressHandler(new StopCheck(stop_requested));  // and this
   // COLLADA: the file's <unit> applies, its up axis does not (assimp would
   // turn a Z_UP file to Y-up): coordinates stay in the file's own frame,

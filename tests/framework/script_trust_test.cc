@@ -630,9 +630,9 @@ TEST_F(TrustTest, AnAllocationRefusedInsideACFunctionNamesTheLine) {
   for (const auto& [call, message] : calls) {
     SCOPED_TRACE(call);
     for (const std::string callback : {"sysCall_actuation", "sysCall_thread"}) {
-      const std::string error = Run(
-          "local block = ('x'):rep(100000) local mb = block:rep(10)\nfunction " + callback +
-          "()\n  " + call + "\nend\n");
+      const std::string error =
+          Run("local block = ('x'):rep(100000) local mb = block:rep(10)\nfunction " + callback +
+              "()\n  " + call + "\nend\n");
       EXPECT_EQ(error.rfind("bot#0: scripts/robot.lua:3: " + message, 0), 0u) << error;
       EXPECT_CONTAINS(error, " the scripts past 4 MiB of Lua memory (simulation.script_memory_mb");
       EXPECT_CONTAINS(error, "[in " + callback + " of /bot#0/body]");
@@ -642,10 +642,10 @@ TEST_F(TrustTest, AnAllocationRefusedInsideACFunctionNamesTheLine) {
   for (const std::string run : {"coroutine.wrap(f)()", "coroutine.resume(coroutine.create(f))",
                                 "pcall(coroutine.wrap(function() coroutine.wrap(f)() end))"}) {
     SCOPED_TRACE(run);
-    const std::string error = Run(
-        "local function f()\n  local s = string.rep('x', 1e9)\nend\n"
-        "function sysCall_actuation()\n  " +
-        run + "\n  error('went on')\nend\n");
+    const std::string error =
+        Run("local function f()\n  local s = string.rep('x', 1e9)\nend\n"
+            "function sysCall_actuation()\n  " +
+            run + "\n  error('went on')\nend\n");
     EXPECT_EQ(error.rfind("bot#0: scripts/robot.lua:", 0), 0u) << error;
     EXPECT_CONTAINS(error, "robot.lua:2: an allocation of 953 MiB would take");
   }
@@ -659,9 +659,10 @@ TEST_F(TrustTest, AnAllocationRefusedInsideACFunctionNamesTheLine) {
   // Past the run's limit: the line too.
   settings_.script_memory_limit = 0;
   settings_.run_script_memory_limit = 8 << 20;
-  EXPECT_CONTAINS(Run("local x = 1\nfunction sysCall_actuation()\n  local s = ('x'):rep(1e8)\nend\n"),
-                  "bot#0: scripts/robot.lua:3: an allocation of 95 MiB would take the run's "
-                  "scripts past 8 MiB");
+  EXPECT_CONTAINS(
+      Run("local x = 1\nfunction sysCall_actuation()\n  local s = ('x'):rep(1e8)\nend\n"),
+      "bot#0: scripts/robot.lua:3: an allocation of 95 MiB would take the run's "
+      "scripts past 8 MiB");
 }
 
 // An error raised in a module the script required names the module's line

@@ -203,9 +203,9 @@ TEST(MeshCheckTest, ColladaReferencesAndEntitiesNameTheirLine) {
             "part.dae:48: <instance_visual_scene url=\"#nowhere\">: the file has no "
             "<visual_scene> with id 'nowhere'");
   for (const std::string meter : {"abc", "0", "-1", "nan"})
-    EXPECT_EQ(ColladaError(Cube("meter=\"0.01\"", "meter=\"" + meter + "\"")),
-              "part.dae:4: <unit meter=\"" + meter +
-                  "\"> must be a positive number (metres per unit)");
+    EXPECT_EQ(
+        ColladaError(Cube("meter=\"0.01\"", "meter=\"" + meter + "\"")),
+        "part.dae:4: <unit meter=\"" + meter + "\"> must be a positive number (metres per unit)");
   EXPECT_EQ(ColladaError(Cube("<COLLADA", "<!DOCTYPE COLLADA [<!ENTITY h \"0.5\">]>\n<COLLADA")),
             "part.dae:3: a <!DOCTYPE> with declarations ([...]): the COLLADA reader applies no "
             "DTD, so its entities and defaults would be lost; write the values out and remove "
