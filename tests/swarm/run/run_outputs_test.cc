@@ -234,6 +234,31 @@ TEST(RunOutputsTest, StopSignalAfterTheLastStepEndsTheRunAsInterrupted) {
   fs::remove_all(dir);
 }
 
+// A stop signal after summary.json was written (here raised inside the
+// program as it writes the recording's end, its last output, by
+// late_signal_preload.cc) changes nothing: the run is complete, the program
+// exits 0 as its summary says, and the recording is closed. (The signals
+// used to be let go once the summary was written: such a signal killed the
+// program before the recording's end.)
+TEST(RunOutputsTest, StopSignalAfterTheSummaryChangesNothing) {
+  const fs::path dir =
+      ProbeWorld("swarmsim_outputs", "after_summary", "", "function sysCall_actuation() end\n");
+  const fs::path out = dir / "out";
+  const auto r = swarmsim::testing::RunCommand(
+      std::string("LD_PRELOAD=" LATE_SIGNAL_PRELOAD
+                  " ASAN_OPTIONS=\"$ASAN_OPTIONS:verify_asan_link_order=0\" " SWARMSIM_BINARY
+                  " run ") +
+      (dir / "world.yaml").string() + " --steps 3 --quiet --record --out " + out.string());
+  ASSERT_TRUE(fs::exists(out / "late_signal_raised")) << "no signal was raised:\n" << r.output;
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  const auto summary = nlohmann::json::parse(ReadFile(out / "summary.json"));
+  EXPECT_EQ(summary["status"], "ok");
+  EXPECT_EQ(summary["steps"], 3);
+  const auto info = RunProgram("record-info " + (out / "recording.swrec").string());
+  EXPECT_NE(info.output.find("the run ended (ok"), std::string::npos) << info.output;
+  fs::remove_all(dir);
+}
+
 // Without a timeout, a stop signal still ends a stuck step: a few seconds
 // after it, with status 'interrupted' and 128 + signal.
 TEST(RunOutputsTest, StopSignalEndsAStuckStep) {
@@ -293,7 +318,8 @@ TEST(RunOutputsTest, StopSignalDuringALargeMeshLoadEndsTheRunThere) {
   posix_spawn_file_actions_adddup2(&actions, pipe_fds[1], STDERR_FILENO);
   posix_spawn_file_actions_addclose(&actions, pipe_fds[0]);
   std::vector<std::string> args = {SWARMSIM_BINARY, "run", (dir / "world.yaml").string(),
-                                   "--steps", "10", "--out", out.string()};
+                                   "--steps",       "10",  "--out",
+                                   out.string()};
   std::vector<char*> argv;
   for (std::string& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
