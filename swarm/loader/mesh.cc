@@ -56,7 +56,7 @@ class StopCheck {
  public:
   StopCheck(const std::function<void()>& check_stop, const std::string& text)
       : check_stop_(check_stop), text_(text) {}
-  // Does the check throw? (Noted: Throw() throws it again.)
+  // Does the check throw? (Noted: ThrowIfRequested throws it again.)
   bool Requested() {
     if (!check_stop_ || !error_.empty()) return !error_.empty();
     try {
