@@ -74,6 +74,10 @@ struct LuaContext {
   const char* budget_subject = "the callback";
   const char* budget_setting = "simulation.instruction_budget";  // "": no setting to name
   lua_State* thread = nullptr;  // the script thread being resumed, else null
+  // The coroutine the sandbox's coroutine.resume/wrap/close is running (the
+  // innermost one), else null: the running callback's root (RootOf). The
+  // allocator names its line when it refuses (LimitedAlloc).
+  lua_State* running = nullptr;
   // The running callback (or thread resume) used up its instruction budget:
   // every further instruction raises budget_error, and the host reports it.
   bool budget_exhausted = false;

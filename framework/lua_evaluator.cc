@@ -47,7 +47,7 @@ bool LimitedLua::Call(int nargs, int nresults, std::string* error) {
   LuaContext& c = state.context;
   c.budget_exhausted = false;
   c.budget_error.clear();
-  state.memory.refused = false;
+  state.memory.refusal_bytes = 0;
   lua_host::SetBudget(L, c);
   const int status = lua_pcall(L, nargs, nresults, 0);
   lua_sethook(L, nullptr, 0, 0);

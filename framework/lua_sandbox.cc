@@ -532,12 +532,27 @@ int RefuseFunction(lua_State* L) { Refuse(L, lua_tostring(L, lua_upvalueindex(1)
 // under pcall) would get control back unhooked and go on; here it fails
 // instead, so no thread of the state runs Lua code again in that callback
 // (a suspended coroutine can only run through these functions).
+//
+// While it runs, LuaContext::running names the coroutine (resume's and
+// close's first argument, or the thread a wrap function holds as its
+// upvalue), so that a refused allocation names the coroutine's line.
 int CheckedCall(lua_State* L) {
-  if (Context(L).budget_exhausted) FailCallback(L);
+  LuaContext& c = Context(L);
+  if (c.budget_exhausted) FailCallback(L);
+  lua_State* const resumer = c.running;
+  lua_State* co = nullptr;
+  if (lua_getupvalue(L, lua_upvalueindex(1), 1) != nullptr) {  // a wrap function's thread
+    co = lua_tothread(L, -1);
+    lua_pop(L, 1);
+  } else {
+    co = lua_tothread(L, 1);
+  }
   lua_pushvalue(L, lua_upvalueindex(1));
   lua_insert(L, 1);
+  if (co != nullptr) c.running = co;
   const int status = lua_pcall(L, lua_gettop(L) - 1, LUA_MULTRET, 0);
-  if (Context(L).budget_exhausted) FailCallback(L);
+  c.running = resumer;
+  if (c.budget_exhausted) FailCallback(L);
   if (status != LUA_OK) return lua_error(L);  // the error as Lua raised it
   return lua_gettop(L);
 }

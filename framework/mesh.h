@@ -16,6 +16,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <string>
 #include <vector>
@@ -46,9 +47,11 @@ class TriangleMesh {
   // no triangles, an index out of range or a non-finite vertex. Triangles
   // whose corners coincide are dropped; the others are reordered by the BVH.
   // `colors`: none, or one RGB (0..1) per triangle, the file's materials
-  // (they follow their triangles).
+  // (they follow their triangles). `check`, if given, is called now and
+  // then while a large mesh is built (seconds at a million triangles); it
+  // may throw to abandon the build (the loader's stop signals).
   TriangleMesh(std::string name, std::vector<Vec3> vertices, std::vector<MeshTriangle> triangles,
-               std::vector<Vec3> colors = {});
+               std::vector<Vec3> colors = {}, const std::function<void()>& check = {});
 
   const std::string& name() const { return name_; }  // the file, for messages
   std::span<const Vec3> vertices() const { return vertices_; }
@@ -76,8 +79,9 @@ class TriangleMesh {
  private:
   // Fills node `index` with triangles [first, first + count) and its subtree.
   // `origin`: each triangle's index in the constructor's list, reordered alike.
+  // `check` (may be empty) is called at each node of kCheckTriangles or more.
   void Build(uint32_t index, uint32_t first, uint32_t count, std::vector<Vec3>* centroids,
-             std::vector<uint32_t>* origin);
+             std::vector<uint32_t>* origin, const std::function<void()>& check);
   // Nearest triangle hit in (0 <= t <= max_t); *entering: the ray enters there.
   bool NearestHit(const Vec3& o, const Vec3& d, double max_t, double* t, bool* entering) const;
 

@@ -73,11 +73,11 @@ void BudgetHook(lua_State* L, lua_Debug* ar) {
 void MemoryHook(lua_State* L, lua_Debug* ar) {
   auto* state = static_cast<ScriptState*>(Context(L).host_state);
   LuaMemory& m = state->memory;
-  if (const size_t refused = std::exchange(m.refused_bytes, 0); refused > 0) {
+  if (std::exchange(m.refused_bytes, 0) > 0) {
+    // Where it was asked for (a coroutine's line, when the refusal ended
+    // one that the script resumed), else where the hook fired.
     ExhaustBudget(L, [&] {
-      return HookWhere(L, ar) + "an allocation of " + FormatBytes(refused) + " would take " +
-             (m.refused_by_run ? RunLimitTail(*m.account)
-                               : m.holder + std::string(" past ") + MemoryLimitTail(m));
+      return (m.refusal_where[0] != '\0' ? "" : HookWhere(L, ar)) + RefusalText(*state);
     });
   }
   lua_gc(L, LUA_GCCOLLECT);
@@ -96,6 +96,20 @@ void MemoryHook(lua_State* L, lua_Debug* ar) {
     lua_sethook(L, ExhaustedHook, LUA_MASKCOUNT, 1);
     lua_sethook(RootOf(state->context), ExhaustedHook, LUA_MASKCOUNT, 1);
   }
+}
+
+// May the allocator read the running thread's stack (lua_getinfo) while
+// it is asked to grow the block `ptr`? Lua 5.4.4 (Debian 12's) reallocates
+// a stack into a fresh block, the old one intact meanwhile; from 5.4.5 it
+// reallocates the stack in place, its frames' pointers turned into offsets
+// for the time of the call, which lua_getinfo would read as pointers. There,
+// only fresh blocks (strings, buffers, new tables) are located.
+bool CanReadStackInAllocator([[maybe_unused]] const void* ptr) {
+#if LUA_VERSION_RELEASE_NUM <= 50404
+  return true;
+#else
+  return ptr == nullptr;
+#endif
 }
 
 }  // namespace
@@ -157,9 +171,17 @@ void* LimitedAlloc(void* ud, void* ptr, size_t osize, size_t nsize) {
   if (!refuse && !account.GrowHeap(grow)) refuse = by_run = true;
   if (refuse || (limit > 0 && after > limit)) {
     if (refuse) {
-      m.refused = true;
       m.refused_by_run = by_run;
       m.refused_bytes = grow;
+      // Lua raises LUA_ERRMEM for it, which names no line: where it was
+      // asked for is noted now, while the stack is there (ErrorText).
+      m.refusal_bytes = grow;
+      m.refusal_where[0] = '\0';
+      m.refusal_script_line = 0;
+      if (state->L != nullptr && CanReadStackInAllocator(ptr)) {
+        const LuaContext& c = state->context;
+        RecordRefusalPlace(*state, c.running != nullptr ? c.running : RootOf(c));
+      }
     }
     if (state->L != nullptr) {
       // Armed on every thread whose hook is another (a callback's budget hook
@@ -180,7 +202,6 @@ void* LimitedAlloc(void* ud, void* ptr, size_t osize, size_t nsize) {
     return nullptr;
   }
   m.used += grow;
-  m.refused = false;
   return p;
 }
 

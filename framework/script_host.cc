@@ -81,7 +81,9 @@ void Call(ScriptState& state, Script& script, int nargs, const char* what) {
   SetCurrent(state, script);
   state.context.budget_exhausted = false;
   state.context.data_collected = false;
+  state.context.running = nullptr;
   state.memory.refused_bytes = 0;  // reported with the callback that made it
+  state.memory.refusal_bytes = 0;
   SetBudget(state.L, state.context);
   script.running = true;
   // LocateError below the function: errors name a line where Lua has one.
@@ -336,7 +338,9 @@ void ResumeThread(ScriptState* state, Script& script) {
   c.thread = co;
   c.budget_exhausted = false;
   c.data_collected = false;
+  c.running = nullptr;
   state->memory.refused_bytes = 0;  // reported with the callback that made it
+  state->memory.refusal_bytes = 0;
   c.slice_fires = 0;
   c.slice_yielded = false;
   // A fresh slice. After a yield from the hook, Lua itself left it so: it

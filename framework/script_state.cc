@@ -100,15 +100,35 @@ std::string RunLimitTail(const ScriptMemory& account) {
          " MiB (simulation.run_script_memory_mb: every robot's Lua memory and data together)";
 }
 
+void RecordRefusalPlace(ScriptState& state, lua_State* running) {
+  LuaMemory& m = state.memory;
+  const auto* script = static_cast<const Script*>(state.context.host_script);
+  const ErrorPlace place = FindErrorPlace(running, 0, ScriptFile(script));
+  std::memcpy(m.refusal_where, place.where, sizeof m.refusal_where);
+  m.refusal_where[sizeof m.refusal_where - 1] = '\0';
+  m.refusal_script_line = place.script_line;
+  m.refusal_script = script;
+}
+
+std::string RefusalText(const ScriptState& state) {
+  const LuaMemory& m = state.memory;
+  std::string text = m.refusal_where;
+  const std::string* file = ScriptFile(m.refusal_script);
+  if (file != nullptr && m.refusal_script_line > 0 &&
+      !StartsWithFile(text.data(), text.size(), *file))
+    text.insert(0, *file + ":" + std::to_string(m.refusal_script_line) + ": ");
+  return text + "an allocation of " + FormatBytes(m.refusal_bytes) + " would take " +
+         (m.refused_by_run ? RunLimitTail(*m.account)
+                           : m.holder + std::string(" past ") + MemoryLimitTail(m));
+}
+
 std::string ErrorText(lua_State* L, int status) {
   if (status == LUA_ERRMEM) {
+    // Lua raised it for a refusal (its stack unwound by now): the place
+    // LimitedAlloc noted.
     const auto* state = static_cast<const ScriptState*>(Context(L).host_state);
-    if (state != nullptr && state->memory.refused)
-      return std::string("an allocation would take ") +
-             (state->memory.refused_by_run
-                  ? RunLimitTail(*state->memory.account)
-                  : state->memory.holder + std::string(" past ") + MemoryLimitTail(state->memory));
-    return "not enough memory";
+    if (state == nullptr || state->memory.refusal_bytes == 0) return "not enough memory";
+    return RefusalText(*state);
   }
   if (status != LUA_ERRRUN && status != LUA_ERRSYNTAX && status != LUA_ERRERR)
     return "internal error: a C++ exception crossed a Lua frame (please report this)";

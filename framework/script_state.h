@@ -81,9 +81,16 @@ struct LuaMemory {
   size_t used = 0;               // bytes of this state's Lua heap
   ScriptMemory own;              // the account of a state that has no robot's (LimitedLua)
   ScriptMemory* account = &own;  // the robot's (World::script_memory)
-  bool refused = false;          // the last allocation was refused (limit + slack, or the run's)
-  bool refused_by_run = false;   // ... by the run's limit
+  bool refused_by_run = false;   // the last allocation refused was refused by the run's limit
   size_t refused_bytes = 0;  // the size of a refused allocation MemoryHook has not reported, or 0
+  // The last allocation refused in the running callback, for the error Lua
+  // raises then (LUA_ERRMEM: Lua calls no message handler for it, and the
+  // host sees its stack unwound): its size, and where it was asked for.
+  // Plain data: written inside the allocator (RecordRefusalPlace).
+  size_t refusal_bytes = 0;                  // 0: none in this callback
+  char refusal_where[LUA_IDSIZE + 16] = "";  // "file:line: " of the innermost Lua function, or ""
+  int refusal_script_line = 0;               // the running script's own innermost line, or 0
+  const Script* refusal_script = nullptr;    // that script
   // How the errors name what holds the memory and the limit's setting.
   const char* holder = "the scripts";
   bool plural = true;  // "the scripts hold", "the expression holds"
@@ -147,8 +154,21 @@ std::string MemoryLimitTail(const LuaMemory& memory);
 // "the run's scripts past 4096 MiB (simulation.run_script_memory_mb)".
 std::string RunLimitTail(const ScriptMemory& account);
 
-// The text of the error value on top of the stack.
+// The text of the error value on top of the stack; of an allocation the
+// memory limit refused (LUA_ERRMEM), where it was asked for and what it
+// would have taken.
 std::string ErrorText(lua_State* L, int status);
+
+// "file:line: an allocation of 953 MiB would take the scripts past ...":
+// the last allocation refused in the running callback, where it was asked
+// for (the running script's own line in front when that is another file's).
+std::string RefusalText(const ScriptState& state);
+
+// Notes in state.memory where the allocation being refused was asked for:
+// the innermost Lua function of `running` (the thread running Lua code).
+// Called inside the allocator: reads the stack with lua_getstack and
+// lua_getinfo("Sl"), which allocate nothing.
+void RecordRefusalPlace(ScriptState& state, lua_State* running);
 
 // Message handler of the host's protected calls of script code (lua_pcall's
 // msgh): the error's text (a value that is not a string named by its type),

@@ -253,10 +253,10 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
     return sig != 0 ? 128 + sig : kExitBadInput;
   };
   // SIGINT, SIGTERM, SIGHUP while a large world loads: the load stops between
-  // model copies and the run ends as interrupted, with its summary.json.
-  // Held until the run is over (the run's own nest inside and keep a signal
-  // noted in between); after it, the signals act as usual again (--view's
-  // serving ends with Ctrl-C).
+  // model copies (or inside a large mesh file's read) and the run ends as
+  // interrupted, with its summary.json. Held until the program exits (the
+  // run's own nest inside and keep a signal noted in between); only --view's
+  // serving after the run lets them act as usual again (it ends with Ctrl-C).
   std::optional<StopSignals> stop_signals;
   stop_signals.emplace();
   LoadOptions load;
@@ -270,6 +270,9 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
     if (const int sig = StopSignals::Received(); sig != 0)
       throw Error(std::string("interrupted by SIG") + sigabbrev_np(sig) +
                   " while the world was loading");
+  };
+  load.note = [](const std::string& note) {
+    std::cerr << "note: " << swarmsim::ValidUtf8(note) << std::endl;
   };
   LoadedWorld loaded;
   try {
@@ -378,13 +381,17 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
                        std::to_string(first + options.steps));
   }
   const RunResult result = RunWorld(loaded.world.get(), options, std::cout, std::cerr);
-  stop_signals.reset();
+  // summary.json is written: its word is final. A stop signal from now on
+  // is noted and changes nothing (the run is complete, the exit status is
+  // the summary's); the signals stay caught until the program exits, so
+  // that one cannot kill it halfway through closing the recording.
   if (run_recorder != nullptr)
     run_recorder->Finish(result.steps,
                          result.ok ? "ok" : (result.signal != 0 ? "interrupted" : "error"),
                          result.ok ? "" : result.error);
   if (view_server && result.signal == 0) {
     // The run is over, the page stays: serve until Ctrl-C (its default action).
+    stop_signals.reset();
     std::cout << "swarmsim run: the run ended; still serving " << view_server->Address()
               << " (Ctrl-C to stop)" << std::endl;
     for (;;) ::pause();

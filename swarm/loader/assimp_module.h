@@ -7,6 +7,7 @@
 // (kAssimpModuleVersion guards a stale module).
 #pragma once
 
+#include <functional>
 #include <string>
 
 #include "swarm/loader/mesh.h"
@@ -14,7 +15,7 @@
 namespace swarmsim::loader {
 
 // Bumped whenever anything in this file or in MeshCache::Welded changes.
-inline constexpr int kAssimpModuleVersion = 1;
+inline constexpr int kAssimpModuleVersion = 2;
 
 // What the module exports, through kAssimpModuleEntry.
 struct AssimpModule {
@@ -22,9 +23,12 @@ struct AssimpModule {
   // The triangles of the mesh file `path`, whose checked contents are
   // `bytes` (files beside it, an OBJ's material library, are read from
   // disk), welded into *out. "" or what went wrong, naming the file as
-  // `text` ("cannot read mesh file 'text': ...").
+  // `text` ("cannot read mesh file 'text': ..."). `stop_requested` is asked
+  // now and then (assimp's progress reports, every 65,536 faces welded):
+  // once it says yes, the read is abandoned ("", *out incomplete).
   std::string (*read_mesh)(const std::string& path, const std::string& bytes,
-                           const std::string& text, MeshCache::Welded* out) = nullptr;
+                           const std::string& text, const std::function<bool()>& stop_requested,
+                           MeshCache::Welded* out) = nullptr;
 };
 
 // The module's one exported symbol: extern "C" const void* NAME(), the

@@ -73,6 +73,54 @@ std::string Count(int64_t n) {
   throw Error(name + (line > 0 ? ":" + std::to_string(line) : "") + ": " + message);
 }
 
+void CheckXmlHasNoDtd(std::string_view bytes, const std::string& name, const char* format) {
+  int line = 1;
+  // Skips to just past `end` from `i`, counting lines; false at the end of the bytes.
+  const auto skip_past = [&](size_t* i, std::string_view end) {
+    const size_t at = bytes.find(end, *i);
+    const size_t stop = at == std::string_view::npos ? bytes.size() : at + end.size();
+    for (size_t k = *i; k < stop; ++k) line += bytes[k] == '\n';
+    *i = stop;
+  };
+  for (size_t i = 0; i < bytes.size();) {
+    const std::string_view rest = bytes.substr(i);
+    if (rest.starts_with("<!--")) {
+      skip_past(&i, "-->");
+    } else if (rest.starts_with("<![CDATA[")) {
+      skip_past(&i, "]]>");
+    } else if (rest.starts_with("<?")) {
+      skip_past(&i, "?>");
+    } else if (rest.starts_with("<!DOCTYPE")) {
+      const size_t close = rest.find_first_of(">[");
+      if (close != std::string_view::npos && rest[close] == '[')
+        Fail(name, line,
+             "a <!DOCTYPE> with declarations ([...]): the " + std::string(format) +
+                 " reader applies no DTD, so its entities and defaults would be lost; write the "
+                 "values out and remove them");
+      skip_past(&i, ">");
+    } else if (rest[0] == '&') {
+      size_t end = 1;
+      while (end < rest.size() && end <= 40 &&
+             (std::isalnum(static_cast<unsigned char>(rest[end])) || rest[end] == '_' ||
+              rest[end] == '-' || rest[end] == '.' || rest[end] == ':' || rest[end] == '#'))
+        ++end;
+      if (end < rest.size() && rest[end] == ';' && end > 1) {
+        const std::string_view entity = rest.substr(1, end - 1);
+        if (entity[0] != '#' && entity != "lt" && entity != "gt" && entity != "amp" &&
+            entity != "quot" && entity != "apos")
+          Fail(name, line,
+               Quoted(rest.substr(0, end + 1)) + " refers to an entity the " + format +
+                   " reader does not know (it knows XML's own: &lt; &gt; &amp; &quot; &apos; and "
+                   "&#...;); write the value out");
+      }
+      ++i;
+    } else {
+      line += rest[0] == '\n';
+      ++i;
+    }
+  }
+}
+
 void CheckTriangleCount(const std::string& name, int line, int64_t triangles, const char* what) {
   if (triangles > kMaxMeshTriangles)
     Fail(name, line,

@@ -45,6 +45,14 @@ std::string Count(int64_t n);
 // Throws swarmsim::Error "name:line: message" (no ":line" when line <= 0).
 [[noreturn]] void Fail(const std::string& name, int line, const std::string& message);
 
+// XML the loader's readers (tinyxml2, and urdfdom and assimp behind them)
+// would misread, found in a file's bytes before they parse it: a DOCTYPE
+// with declarations (its entities and attribute defaults are never
+// applied), and a reference to an entity other than XML's own five and
+// character references (kept as its literal text). Fails "name:line: ..."
+// at the first; `format` names the file's kind ("URDF", "COLLADA").
+void CheckXmlHasNoDtd(std::string_view bytes, const std::string& name, const char* format);
+
 // Fails when a mesh file's triangles pass kMaxMeshTriangles (mesh.h).
 void CheckTriangleCount(const std::string& name, int line, int64_t triangles, const char* what);
 

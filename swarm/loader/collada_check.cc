@@ -2,6 +2,7 @@
 #include <tinyxml2.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -124,6 +125,8 @@ class ColladaCheck {
   double CheckPrimitive(const XMLElement* element, Primitive kind,
                         const std::map<std::string_view, uint64_t>& vertex_limit);
   const Accessor* AccessorOf(const XMLElement* input) const;
+  void CheckReference(const XMLElement* input, bool per_vertex,
+                      const std::map<std::string_view, uint64_t>& vertex_limit) const;
   NodeTotals Visit(const XMLElement* node, int depth);
 
   const std::string& bytes_;
@@ -319,6 +322,47 @@ const ColladaCheck::Accessor* ColladaCheck::AccessorOf(const XMLElement* input) 
   return it == accessors_.end() ? nullptr : &it->second;
 }
 
+// An <input> of a <vertices> (`per_vertex`) or of a primitive element names
+// what assimp resolves, or assimp's own error would name no line ("Unable
+// to resolve library reference", "Unsupported vertex referencing scheme"):
+// a primitive's VERTEX input the mesh's <vertices>; any other input of a
+// semantic assimp reads a <source> with an accessor, whose array exists.
+void ColladaCheck::CheckReference(const XMLElement* input, bool per_vertex,
+                                  const std::map<std::string_view, uint64_t>& vertex_limit) const {
+  static const std::string_view kRead[] = {"POSITION", "NORMAL",     "TEXCOORD", "COLOR",
+                                           "TANGENT",  "TEXTANGENT", "BINORMAL", "TEXBINORMAL"};
+  const char* semantic_text = input->Attribute("semantic");
+  const std::string_view semantic = semantic_text ? semantic_text : "";
+  const char* source_text = input->Attribute("source");
+  const std::string what = "<input semantic=\"" + Shown(semantic) + "\" source=\"" +
+                           Shown(source_text ? source_text : "") + "\">";
+  const std::string_view id = Fragment(source_text);
+  if (semantic == "VERTEX" && !per_vertex) {
+    if (vertex_limit.contains(id)) return;
+    std::string ids;
+    for (const auto& [vertices_id, limit] : vertex_limit)
+      ids += (ids.empty() ? "'" : ", '") + std::string(vertices_id) + "'";
+    Fail(input, what + " must name its <mesh>'s <vertices> (" +
+                    (ids.empty() ? std::string("the mesh has none") : "id " + ids) + ")");
+  }
+  if (std::find(std::begin(kRead), std::end(kRead), semantic) == std::end(kRead)) return;
+  const auto source = sources_.find(id);
+  if (source == sources_.end())
+    Fail(input, what + ": the file's geometries have no <source> with id " + Quoted(id));
+  const auto accessor = accessors_.find(id);
+  if (accessor == accessors_.end())
+    Fail(input, what + ": <source> " + Quoted(id) + " (line " +
+                    std::to_string(source->second->GetLineNum()) +
+                    ") has no <technique_common><accessor>");
+  const std::string_view array_id = Fragment(accessor->second.e->Attribute("source"));
+  if (!arrays_.contains(array_id))
+    Fail(accessor->second.e,
+         "<accessor source=\"" +
+             Shown(accessor->second.e->Attribute("source") ? accessor->second.e->Attribute("source")
+                                                           : "") +
+             "\">: the file's geometries have no array with id " + Quoted(array_id));
+}
+
 // A <mesh>'s primitive elements; returns its triangles.
 double ColladaCheck::CheckMesh(const XMLElement* mesh) {
   std::vector<const XMLElement*> below;
@@ -330,13 +374,15 @@ double ColladaCheck::CheckMesh(const XMLElement* mesh) {
     if (std::string_view(e->Name()) != "vertices") continue;
     uint64_t limit = UINT64_MAX;
     for (const XMLElement* input = e->FirstChildElement("input"); input;
-         input = input->NextSiblingElement("input"))
+         input = input->NextSiblingElement("input")) {
+      CheckReference(input, /*per_vertex=*/true, vertex_limit);
       if (const Accessor* a = AccessorOf(input)) {
         limit = std::min(limit, a->count);
         if (input->Attribute("semantic", "COLOR") && a->size > 4)
           Fail(input, "<input semantic=\"COLOR\"> names an accessor of " + std::to_string(a->size) +
                           " components (at most 4)");
       }
+    }
     vertex_limit[e->Attribute("id") ? e->Attribute("id") : ""] = limit;
   }
   double triangles = 0;
@@ -358,6 +404,7 @@ double ColladaCheck::CheckPrimitive(const XMLElement* element, Primitive kind,
     uint64_t offset;
     uint64_t limit;  // indices below this
     std::string semantic, source;
+    const XMLElement* e;
   };
   std::vector<Input> inputs;
   std::vector<uint64_t> vcount;
@@ -370,6 +417,7 @@ double ColladaCheck::CheckPrimitive(const XMLElement* element, Primitive kind,
     const std::string_view kind_name = e->Name();
     if (kind_name == "input") {
       Input in;
+      in.e = e;
       in.offset = CountAttribute(e, "offset", 0, 63);
       in.semantic = e->Attribute("semantic") ? e->Attribute("semantic") : "";
       in.source = std::string(Fragment(e->Attribute("source")));
@@ -479,6 +527,8 @@ double ColladaCheck::CheckPrimitive(const XMLElement* element, Primitive kind,
           break;
         }
       }
+      // What the inputs name resolves (assimp resolves them as it reads the <p>).
+      for (const Input& in : inputs) CheckReference(in.e, /*per_vertex=*/false, vertex_limit);
     }
   }
   // assimp asserts that the <p> elements made `count` primitives.
@@ -566,6 +616,7 @@ std::string ColladaCheck::Run() {
         loader::Fail(name_, 0,
                      "has more than " + Count(kMaxColladaElements) +
                          " XML elements, the limit for a COLLADA file");
+  CheckXmlHasNoDtd(bytes_, name_, "COLLADA");
   if (doc_.Parse(bytes_.data(), bytes_.size()) != tinyxml2::XML_SUCCESS)
     loader::Fail(name_, doc_.ErrorLineNum(),
                  std::string("malformed XML: ") + doc_.ErrorName() +
@@ -619,6 +670,32 @@ std::string ColladaCheck::Run() {
       }
     }
   for (const XMLElement* node : nodes) Visit(node, 0);
+  // The scene: a visual scene the file has (assimp's error would name no line).
+  if (const XMLElement* scene = root->FirstChildElement("scene"))
+    if (const XMLElement* instance = scene->FirstChildElement("instance_visual_scene")) {
+      const char* url = instance->Attribute("url");
+      const auto [begin, end] = nodes_.equal_range(Fragment(url));
+      if (std::none_of(begin, end, [](const auto& n) {
+            return std::string_view(n.second->Name()) == "visual_scene";
+          }))
+        Fail(instance, "<instance_visual_scene url=\"" + Shown(url ? url : "") +
+                           "\">: the file has no <visual_scene> with id " + Quoted(Fragment(url)));
+    }
+  // The unit: a positive number of metres (assimp reads "abc" as 0: every
+  // vertex at the origin, "no triangles" without a line).
+  if (const XMLElement* asset = root->FirstChildElement("asset"))
+    if (const XMLElement* unit = asset->FirstChildElement("unit"))
+      if (const char* meter = unit->Attribute("meter")) {
+        std::string_view text = meter;
+        while (!text.empty() && std::isspace(static_cast<unsigned char>(text.front())))
+          text.remove_prefix(1);
+        while (!text.empty() && std::isspace(static_cast<unsigned char>(text.back())))
+          text.remove_suffix(1);
+        double value = 0;
+        if (!ParseFinite(text, &value) || !(value > 0))
+          Fail(unit,
+               "<unit meter=\"" + Shown(meter) + "\"> must be a positive number (metres per unit)");
+      }
 
   tinyxml2::XMLPrinter printer(nullptr, /*compact=*/true);
   doc_.Print(&printer);

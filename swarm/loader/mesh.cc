@@ -43,10 +43,39 @@ const AssimpModule& Assimp() {
 
 // Reads the file's triangles (the assimp module), merging vertices at equal
 // positions (STL repeats each corner per facet) so that closed meshes are
-// seen closed.
-std::shared_ptr<const MeshCache::Welded> ReadMeshFile(const fs::path& path,
-                                                      const std::string& where,
-                                                      const std::string& text);
+// seen closed. `stop_requested` is asked now and then (StopCheck).
+std::shared_ptr<const MeshCache::Welded> ReadMeshFile(
+    const fs::path& path, const std::string& where, const std::string& text,
+    const std::function<bool()>& stop_requested,
+    const std::function<void(const std::string&)>& note);
+
+// A stop request during a mesh file's read: the check's own error (the
+// program's "interrupted by SIGTERM while the world was loading") once it
+// threw, naming the file.
+class StopCheck {
+ public:
+  StopCheck(const std::function<void()>& check_stop, const std::string& text)
+      : check_stop_(check_stop), text_(text) {}
+  // Does the check throw? (Noted: ThrowIfRequested throws it again.)
+  bool Requested() {
+    if (!check_stop_ || !error_.empty()) return !error_.empty();
+    try {
+      check_stop_();
+    } catch (const Error& e) {
+      error_ = e.what();
+    }
+    return !error_.empty();
+  }
+  // Throws the check's error, if it threw (now or before).
+  void ThrowIfRequested() {
+    if (Requested()) throw Error(error_ + ", reading mesh file '" + text_ + "'");
+  }
+
+ private:
+  const std::function<void()>& check_stop_;
+  const std::string& text_;
+  std::string error_;
+};
 
 }  // namespace
 
@@ -58,8 +87,15 @@ std::shared_ptr<const TriangleMesh> MeshCache::Get(const fs::path& path, const V
   if (ec) key = fs::absolute(path, ec).lexically_normal();
   const std::array<double, 3> s{scale.x, scale.y, scale.z};
   if (auto it = meshes_.find({key, s}); it != meshes_.end()) return it->second;
+  StopCheck stop(check_stop_, text);
   auto file = files_.find(key);
-  if (file == files_.end()) file = files_.emplace(key, ReadMeshFile(path, where, text)).first;
+  if (file == files_.end()) {
+    const std::function<bool()> stop_requested = [&stop] { return stop.Requested(); };
+    stop.ThrowIfRequested();
+    std::shared_ptr<const Welded> welded = ReadMeshFile(path, where, text, stop_requested, note_);
+    stop.ThrowIfRequested();  // the read was abandoned, or ended as the signal came
+    file = files_.emplace(key, std::move(welded)).first;
+  }
   std::vector<Vec3> vertices = file->second->vertices;
   for (Vec3& v : vertices) {
     v = {v.x * scale.x, v.y * scale.y, v.z * scale.z};
@@ -77,10 +113,17 @@ std::shared_ptr<const TriangleMesh> MeshCache::Get(const fs::path& path, const V
   std::vector<MeshTriangle> triangles = file->second->triangles;
   if (scale.x * scale.y * scale.z < 0)
     for (MeshTriangle& t : triangles) std::swap(t.v[1], t.v[2]);
+  // Building a large one takes seconds: the check abandons it.
+  struct Stopped {};
+  const std::function<void()> check = [&stop] {
+    if (stop.Requested()) throw Stopped{};
+  };
   std::shared_ptr<const TriangleMesh> mesh;
   try {
     mesh = std::make_shared<const TriangleMesh>(DisplayPath(path), std::move(vertices),
-                                                std::move(triangles), file->second->colors);
+                                                std::move(triangles), file->second->colors, check);
+  } catch (const Stopped&) {
+    stop.ThrowIfRequested();
   } catch (const Error& e) {
     throw Error((where.empty() ? "" : where + ": ") + e.what());
   }
@@ -90,9 +133,10 @@ std::shared_ptr<const TriangleMesh> MeshCache::Get(const fs::path& path, const V
 
 namespace {
 
-std::shared_ptr<const MeshCache::Welded> ReadMeshFile(const fs::path& path,
-                                                      const std::string& where,
-                                                      const std::string& text) {
+std::shared_ptr<const MeshCache::Welded> ReadMeshFile(
+    const fs::path& path, const std::string& where, const std::string& text,
+    const std::function<bool()>& stop_requested,
+    const std::function<void(const std::string&)>& note) {
   const std::string prefix = where.empty() ? "" : where + ": ";
   std::string ext = path.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
@@ -102,6 +146,8 @@ std::shared_ptr<const MeshCache::Welded> ReadMeshFile(const fs::path& path,
                 "' must be STL, OBJ or COLLADA (a .stl, .obj or .dae name)");
   const std::string bytes = ReadFileOrThrow(path, "mesh file", where, text);
   if (bytes.empty()) throw Error(prefix + "mesh file '" + text + "' is empty");
+  if (note && bytes.size() >= MeshCache::kNoteMeshBytes)
+    note("reading mesh file '" + text + "' (" + std::to_string(bytes.size() >> 20) + " MiB)");
   // What assimp reads: the bytes, checked (mesh_check.h); of a COLLADA
   // file, the parts the loader uses.
   std::string checked;
@@ -122,8 +168,9 @@ std::shared_ptr<const MeshCache::Welded> ReadMeshFile(const fs::path& path,
     throw Error(prefix + e.what());
   }
   auto out = std::make_shared<MeshCache::Welded>();
-  if (std::string error = assimp->read_mesh(path.string(), read, text, out.get()); !error.empty())
-    throw Error(prefix + error);
+  std::string error = assimp->read_mesh(path.string(), read, text, stop_requested, out.get());
+  if (stop_requested()) return out;  // abandoned: the caller throws
+  if (!error.empty()) throw Error(prefix + error);
   if (out->triangles.empty()) throw Error(prefix + "mesh file '" + text + "' has no triangles");
   return out;
 }

@@ -6,6 +6,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -38,6 +39,16 @@ class MeshCache {
                                           const std::string& where, const std::string& text);
   // Files read so far (each once, whatever the scales).
   size_t files_read() const { return files_.size(); }
+  // `check_stop` is called now and then while a file is read and its mesh
+  // built (a large one takes seconds); it may throw swarmsim::Error to
+  // abandon the load (LoadOptions::check_stop): Get throws it naming the
+  // file. `note` is told when a file of kNoteMeshBytes or more is read.
+  void set_load_hooks(std::function<void()> check_stop,
+                      std::function<void(const std::string&)> note) {
+    check_stop_ = std::move(check_stop);
+    note_ = std::move(note);
+  }
+  static constexpr size_t kNoteMeshBytes = size_t{8} << 20;
 
   // A file's triangles, vertices at equal positions merged, unscaled.
   struct Welded {
@@ -47,6 +58,8 @@ class MeshCache {
   };
 
  private:
+  std::function<void()> check_stop_;
+  std::function<void(const std::string&)> note_;
   std::map<std::filesystem::path, std::shared_ptr<const Welded>> files_;
   std::map<std::pair<std::filesystem::path, std::array<double, 3>>,
            std::shared_ptr<const TriangleMesh>>

@@ -21,6 +21,7 @@
 #include "framework/display_path.h"
 #include "framework/error.h"
 #include "framework/object_type.h"
+#include "swarm/loader/check_text.h"
 #include "swarm/loader/urdf_inertia.h"
 #include "swarm/loader/urdf_numbers.h"
 #include "swarm/loader/yaml.h"
@@ -115,6 +116,7 @@ class Importer {
 };
 
 void Importer::ReadXml(const std::string& bytes) {
+  CheckXmlHasNoDtd(bytes, name_, "URDF");
   tinyxml2::XMLDocument doc;
   if (doc.Parse(bytes.data(), bytes.size()) != tinyxml2::XML_SUCCESS)
     Fail(doc.ErrorLineNum(), std::string("malformed XML: ") + doc.ErrorName() +

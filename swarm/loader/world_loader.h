@@ -51,6 +51,10 @@ struct LoadOptions {
   // throw swarmsim::Error to abandon the load (the program's stop signals).
   // Empty: never.
   std::function<void()> check_stop;
+  // Called with a line as a slow part of the load starts (a mesh file of
+  // 8 MiB or more: "reading mesh file 'rock.stl' (62 MiB)"); the program
+  // prints it on stderr. Empty: not said.
+  std::function<void(const std::string&)> note;
 };
 
 // A models entry's `python_controller:` (swarm/python runs it; the program

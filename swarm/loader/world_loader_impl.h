@@ -136,7 +136,9 @@ class WorldLoader {
  public:
   WorldLoader(const std::filesystem::path& file, const LoadOptions& options,
               const ModuleRegistry& registry)
-      : path_(file), options_(options), registry_(registry) {}
+      : path_(file), options_(options), registry_(registry) {
+    meshes_.set_load_hooks(options_.check_stop, options_.note);
+  }
 
   LoadedWorld Load();
   // After Load: each distributed robot's root pose as a load with `seed`

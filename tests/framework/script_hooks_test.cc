@@ -184,8 +184,8 @@ TEST(ScriptControlTest, OneAllocationPastTheLimitIsRefused) {
   w.AddRobot("bot#0", "function sysCall_actuation() local s = string.rep('x', 1e8) end");
   EXPECT_CONTAINS(
       ErrorOf([&] { w.Steps(1); }),
-      "bot#0: scripts/robot.lua: an allocation would take the scripts past 4 MiB of Lua "
-      "memory");
+      "bot#0: scripts/robot.lua:1: an allocation of 95 MiB would take the scripts past 4 MiB "
+      "of Lua memory");
 }
 
 // Under disable_script, a refused allocation disables its script only: the

@@ -607,6 +607,64 @@ TEST_F(TrustTest, EveryScriptErrorNamesRobotScriptLineAndCallback) {
   EXPECT_CONTAINS(error, "[in sysCall_actuation of /bot#0/body]");
 }
 
+// An allocation past the memory limit inside one C function (string.rep,
+// table.concat, a concatenation, a sim.* call's argument being built) is
+// refused, and Lua raises its memory error without calling the message
+// handler that names the line: the allocator notes where it was asked
+// for. Every such error names the line, in a callback, a thread, a
+// coroutine of the script's own and a module it required.
+TEST_F(TrustTest, AnAllocationRefusedInsideACFunctionNamesTheLine) {
+  settings_.script_memory_limit = 4 << 20;
+  // 25 operands of 1 MB: one 25 MB string, past the limit and its slack.
+  std::string concatenation = "local s = mb";
+  for (int i = 0; i < 24; ++i) concatenation += " .. mb";
+  const std::vector<std::pair<std::string, std::string>> calls = {
+      {"local s = string.rep('x', 1e9)", "an allocation of 953 MiB would take"},
+      {"local s = ('x'):rep(1e9) .. 'y'", "an allocation of 953 MiB would take"},
+      {"local t = {} for i = 1, 300 do t[i] = block end local s = table.concat(t)",
+       "an allocation of "},
+      {concatenation, "an allocation of 23 MiB would take"},
+      {"sim.setSignal('s', block:rep(300))", "an allocation of 28 MiB would take"},
+      {"local s = mb:gsub('x', ('y'):rep(25))", "an allocation of "},
+  };
+  for (const auto& [call, message] : calls) {
+    SCOPED_TRACE(call);
+    for (const std::string callback : {"sysCall_actuation", "sysCall_thread"}) {
+      const std::string error =
+          Run("local block = ('x'):rep(100000) local mb = block:rep(10)\nfunction " + callback +
+              "()\n  " + call + "\nend\n");
+      EXPECT_EQ(error.rfind("bot#0: scripts/robot.lua:3: " + message, 0), 0u) << error;
+      EXPECT_CONTAINS(error, " the scripts past 4 MiB of Lua memory (simulation.script_memory_mb");
+      EXPECT_CONTAINS(error, "[in " + callback + " of /bot#0/body]");
+    }
+  }
+  // In a coroutine of the script's own: the coroutine's line.
+  for (const std::string run : {"coroutine.wrap(f)()", "coroutine.resume(coroutine.create(f))",
+                                "pcall(coroutine.wrap(function() coroutine.wrap(f)() end))"}) {
+    SCOPED_TRACE(run);
+    const std::string error =
+        Run("local function f()\n  local s = string.rep('x', 1e9)\nend\n"
+            "function sysCall_actuation()\n  " +
+            run + "\n  error('went on')\nend\n");
+    EXPECT_EQ(error.rfind("bot#0: scripts/robot.lua:", 0), 0u) << error;
+    EXPECT_CONTAINS(error, "robot.lua:2: an allocation of 953 MiB would take");
+  }
+  // In a module: its line, and the script's.
+  std::ofstream(root_ / "world" / "helper.lua")
+      << "return function()\n  return string.rep('x', 1e9)\nend\n";
+  const std::string error =
+      Run("local helper = require('helper')\nfunction sysCall_actuation()\n  helper()\nend\n");
+  EXPECT_EQ(error.rfind("bot#0: scripts/robot.lua:3: ", 0), 0u) << error;
+  EXPECT_CONTAINS(error, "helper.lua:2: an allocation of 953 MiB would take");
+  // Past the run's limit: the line too.
+  settings_.script_memory_limit = 0;
+  settings_.run_script_memory_limit = 8 << 20;
+  EXPECT_CONTAINS(
+      Run("local x = 1\nfunction sysCall_actuation()\n  local s = ('x'):rep(1e8)\nend\n"),
+      "bot#0: scripts/robot.lua:3: an allocation of 95 MiB would take the run's "
+      "scripts past 8 MiB");
+}
+
 // An error raised in a module the script required names the module's line
 // and the script's.
 TEST_F(TrustTest, AnErrorInARequiredModuleNamesTheScriptsLineToo) {

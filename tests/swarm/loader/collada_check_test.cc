@@ -185,6 +185,36 @@ TEST(MeshCheckTest, ColladaNodesNeitherCycleNorExplode) {
             std::string::npos);
 }
 
+// What assimp resolves by id names its line when it resolves to nothing
+// (assimp's own "Unable to resolve library reference" named none), as do a
+// unit that is not a positive number, a DOCTYPE's declarations and an
+// entity tinyxml2 would keep as text.
+TEST(MeshCheckTest, ColladaReferencesAndEntitiesNameTheirLine) {
+  EXPECT_EQ(ColladaError(Cube("source=\"#cube-vtx\"", "source=\"#nowhere\"")),
+            "part.dae:30: <input semantic=\"VERTEX\" source=\"#nowhere\"> must name its "
+            "<mesh>'s <vertices> (id 'cube-vtx')");
+  EXPECT_EQ(ColladaError(Cube("source=\"#cube-pos\"/>", "source=\"#nowhere\"/>")),
+            "part.dae:28: <input semantic=\"POSITION\" source=\"#nowhere\">: the file's "
+            "geometries have no <source> with id 'nowhere'");
+  EXPECT_EQ(ColladaError(Cube("source=\"#cube-pos-array\"", "source=\"#nowhere\"")),
+            "part.dae:23: <accessor source=\"#nowhere\">: the file's geometries have no array "
+            "with id 'nowhere'");
+  EXPECT_EQ(ColladaError(Cube("url=\"#scene\"", "url=\"#nowhere\"")),
+            "part.dae:48: <instance_visual_scene url=\"#nowhere\">: the file has no "
+            "<visual_scene> with id 'nowhere'");
+  for (const std::string meter : {"abc", "0", "-1", "nan"})
+    EXPECT_EQ(
+        ColladaError(Cube("meter=\"0.01\"", "meter=\"" + meter + "\"")),
+        "part.dae:4: <unit meter=\"" + meter + "\"> must be a positive number (metres per unit)");
+  EXPECT_EQ(ColladaError(Cube("<COLLADA", "<!DOCTYPE COLLADA [<!ENTITY h \"0.5\">]>\n<COLLADA")),
+            "part.dae:3: a <!DOCTYPE> with declarations ([...]): the COLLADA reader applies no "
+            "DTD, so its entities and defaults would be lost; write the values out and remove "
+            "them");
+  EXPECT_EQ(ColladaError(Cube("-0.5 -0.5 -0.5 0.5", "-0.5 -0.5 &h; 0.5")),
+            "part.dae:21: '&h;' refers to an entity the COLLADA reader does not know (it knows "
+            "XML's own: &lt; &gt; &amp; &quot; &apos; and &#...;); write the value out");
+}
+
 TEST(MeshCheckTest, ColladaIsWellFormedXmlOfAtMostAMillionElements) {
   EXPECT_NE(ColladaError(kCube.substr(0, 600)).find("part.dae:"), std::string::npos);
   EXPECT_NE(ColladaError(kCube.substr(0, 600)).find("malformed XML"), std::string::npos);

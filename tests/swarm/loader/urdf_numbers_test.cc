@@ -211,5 +211,30 @@ TEST_F(UrdfNumbersTest, EveryAttributeUrdfdomReadsIsCheckedWithItsLine) {
             "r.urdf:12: material 'm': <color rgba=\"abc\">: 'abc' is not a finite number");
 }
 
+// What tinyxml2 (and urdfdom behind it) would misread is refused with its
+// line: a DOCTYPE's declarations are never applied, and an entity other
+// than XML's own is kept as its literal text ('&len;' as a link's name).
+TEST_F(UrdfNumbersTest, DtdDeclarationsAndUnknownEntitiesNameTheirLine) {
+  const auto with_doctype = [&](const std::string& doctype, const std::string& link) {
+    std::string text = Robot(link, "");
+    text.insert(text.find('\n') + 1, doctype);
+    return text;
+  };
+  EXPECT_EQ(Message(with_doctype("<!DOCTYPE robot [\n  <!ENTITY len \"0.5\">\n]>\n",
+                                 "    <visual><geometry><box size=\"&len; 1 1\"/></geometry>"
+                                 "</visual>")),
+            "r.urdf:2: a <!DOCTYPE> with declarations ([...]): the URDF reader applies no DTD, so "
+            "its entities and defaults would be lost; write the values out and remove them");
+  EXPECT_EQ(Message(Robot("", "", "  <link name=\"&tool;\"/>\n")),
+            "r.urdf:12: '&tool;' refers to an entity the URDF reader does not know (it knows "
+            "XML's own: &lt; &gt; &amp; &quot; &apos; and &#...;); write the value out");
+  // A DOCTYPE that declares nothing, XML's own entities and character
+  // references, and anything in a comment or CDATA load.
+  EXPECT_EQ(ErrorOf(with_doctype("<!DOCTYPE robot SYSTEM \"urdf.dtd\">\n",
+                                 "    <!-- &len; --><visual name=\"a&amp;b&#67;&#x44;&lt;\">"
+                                 "<geometry><box size=\"1 1 1\"/></geometry></visual>")),
+            "no error");
+}
+
 }  // namespace
 }  // namespace swarmsim::loader

@@ -234,6 +234,31 @@ TEST(RunOutputsTest, StopSignalAfterTheLastStepEndsTheRunAsInterrupted) {
   fs::remove_all(dir);
 }
 
+// A stop signal after summary.json was written (here raised inside the
+// program as it writes the recording's end, its last output, by
+// late_signal_preload.cc) changes nothing: the run is complete, the program
+// exits 0 as its summary says, and the recording is closed. (The signals
+// used to be let go once the summary was written: such a signal killed the
+// program before the recording's end.)
+TEST(RunOutputsTest, StopSignalAfterTheSummaryChangesNothing) {
+  const fs::path dir =
+      ProbeWorld("swarmsim_outputs", "after_summary", "", "function sysCall_actuation() end\n");
+  const fs::path out = dir / "out";
+  const auto r = swarmsim::testing::RunCommand(
+      std::string("LD_PRELOAD=" LATE_SIGNAL_PRELOAD
+                  " ASAN_OPTIONS=\"$ASAN_OPTIONS:verify_asan_link_order=0\" " SWARMSIM_BINARY
+                  " run ") +
+      (dir / "world.yaml").string() + " --steps 3 --quiet --record --out " + out.string());
+  ASSERT_TRUE(fs::exists(out / "late_signal_raised")) << "no signal was raised:\n" << r.output;
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  const auto summary = nlohmann::json::parse(ReadFile(out / "summary.json"));
+  EXPECT_EQ(summary["status"], "ok");
+  EXPECT_EQ(summary["steps"], 3);
+  const auto info = RunProgram("record-info " + (out / "recording.swrec").string());
+  EXPECT_NE(info.output.find("the run ended (ok"), std::string::npos) << info.output;
+  fs::remove_all(dir);
+}
+
 // Without a timeout, a stop signal still ends a stuck step: a few seconds
 // after it, with status 'interrupted' and 128 + signal.
 TEST(RunOutputsTest, StopSignalEndsAStuckStep) {
@@ -251,6 +276,82 @@ TEST(RunOutputsTest, StopSignalEndsAStuckStep) {
       << error;
   EXPECT_NE(error.find("probe#0: "), std::string::npos) << error;
   EXPECT_EQ(Lines(ReadFile(out / "metrics.csv")).size(), 1u + 3);
+  fs::remove_all(dir);
+}
+
+// A binary STL of `triangles` triangles, each with corners of its own (a
+// scattered cloud: nothing to weld), written to `path`.
+void WriteScatteredStl(const fs::path& path, uint32_t triangles) {
+  std::string bytes(80, '\0');
+  bytes.append(reinterpret_cast<const char*>(&triangles), 4);
+  uint32_t state = 12345;
+  const auto next = [&state] {  // in [-5, 5)
+    state = state * 1664525u + 1013904223u;
+    return static_cast<float>(state >> 8) / static_cast<float>(1 << 24) * 10.0f - 5.0f;
+  };
+  for (uint32_t i = 0; i < triangles; ++i) {
+    const float x = next(), y = next(), z = next() * 0.1f + 1.0f;
+    const float facet[12] = {0, 0, 1, x, y, z, x + 0.01f, y, z, x, y + 0.01f, z + 0.005f};
+    bytes.append(reinterpret_cast<const char*>(facet), sizeof facet);
+    bytes.append(2, '\0');
+  }
+  std::ofstream(path, std::ios::binary) << bytes;
+}
+
+// A stop signal while one large mesh file loads (seconds for a million
+// triangles) ends the run then, not once the load is over: the loader asks
+// for it inside the mesh's read and build, and says where it stopped.
+TEST(RunOutputsTest, StopSignalDuringALargeMeshLoadEndsTheRunThere) {
+  const fs::path dir = swarmsim::testing::FreshTempDir("swarmsim_outputs", "mesh_signal");
+  fs::create_directories(dir);
+  WriteScatteredStl(dir / "big.stl", 400000);
+  std::ofstream(dir / "world.yaml") << "simulation: {physics: ode, time_step: 0.01}\n"
+                                       "obstacles:\n"
+                                       "  - {name: rock, shape: mesh, file: big.stl}\n";
+  const fs::path out = dir / "out";
+  // Its output on a pipe: the note that the mesh file is being read.
+  int pipe_fds[2];
+  ASSERT_EQ(pipe(pipe_fds), 0);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_adddup2(&actions, pipe_fds[1], STDOUT_FILENO);
+  posix_spawn_file_actions_adddup2(&actions, pipe_fds[1], STDERR_FILENO);
+  posix_spawn_file_actions_addclose(&actions, pipe_fds[0]);
+  std::vector<std::string> args = {SWARMSIM_BINARY, "run", (dir / "world.yaml").string(),
+                                   "--steps",       "10",  "--out",
+                                   out.string()};
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  ASSERT_EQ(posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ), 0);
+  posix_spawn_file_actions_destroy(&actions);
+  close(pipe_fds[1]);
+  FILE* output = fdopen(pipe_fds[0], "r");
+  std::string text;
+  char line[4096];
+  bool signalled = false;
+  while (fgets(line, sizeof line, output) != nullptr) {
+    text += line;
+    if (!signalled && text.find("note: reading mesh file 'big.stl'") != std::string::npos) {
+      EXPECT_EQ(kill(pid, SIGTERM), 0);
+      signalled = true;
+    }
+  }
+  fclose(output);
+  int status = 0;
+  ASSERT_EQ(waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(signalled) << "the load never said it read the mesh file:\n" << text;
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status);
+  EXPECT_EQ(WEXITSTATUS(status), 128 + SIGTERM) << text;
+  // Noticed inside the mesh's load: without the checks there, the load
+  // would run to its end and the signal be noticed only after it.
+  EXPECT_NE(text.find("error: interrupted by SIGTERM while the world was loading, reading mesh "
+                      "file 'big.stl'"),
+            std::string::npos)
+      << text;
+  const auto summary = nlohmann::json::parse(ReadFile(out / "summary.json"));
+  EXPECT_EQ(summary["status"], "interrupted");
   fs::remove_all(dir);
 }
 
