@@ -82,6 +82,8 @@ struct BenchArgs {
   int child_robots = 0, child_threads = 1;
   bool scaling = false;  // --scaling
   ScalingOptions scaling_options;
+  bool scaling_robots = false;       // --scaling-robots
+  std::vector<std::string> configs;  // --configs lua,cpp,planar-cpp
 };
 CLI::App* AddBenchCommand(CLI::App* app, BenchArgs* args);
 // `command`: what AddBenchCommand returned (was --threads given?).
