@@ -39,6 +39,7 @@ struct RunArgs {
   std::vector<std::string> sets;  // NAME=VALUE
   std::string out_dir;
   bool hash = false, quiet = false;
+  bool progress = false;  // --progress: the loading line also when stderr is not a terminal
   bool trust_scripts = false;
   std::vector<std::string> plugins;
   std::vector<std::string> package_path;  // --package-path: URDF packages' folders

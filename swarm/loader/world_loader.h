@@ -51,6 +51,10 @@ struct LoadOptions {
   // throw swarmsim::Error to abandon the load (the program's stop signals).
   // Empty: never.
   std::function<void()> check_stop;
+  // Called as model copies are built (every 256 copies, and after the
+  // last): copies built so far and in all, over every models entry. For a
+  // progress line while a large world loads. Empty: never.
+  std::function<void(int64_t built, int64_t total)> copy_progress;
 };
 
 // A models entry's `python_controller:` (swarm/python runs it; the program
