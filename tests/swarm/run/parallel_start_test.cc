@@ -47,7 +47,8 @@ TEST(ParallelStartTest, SysCallInitGivesTheSameWorldOnOneAndTwoThreads) {
                                      "  name: body\n"
                                      "  type: shape\n"
                                      "  shape: cylinder\n"
-                                     "  size: [0.1, 0.1, 0.05]\n"
+                                     "  radius: 0.05\n"
+                                     "  height: 0.05\n"
                                      "  script: bot.lua\n";
   std::ofstream(dir / "bot.lua")
       << "local offset\n"
