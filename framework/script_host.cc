@@ -3,10 +3,11 @@
 // One lua_State per robot (model instance) and one for the scripts outside
 // any robot. Each script runs in its own environment table whose __index is
 // the state's shared globals (sim, the safe libraries), so globals of one
-// script do not leak into another. A source is compiled once per state as
-// `function(_ENV, ...) <code> end` and called once per script with that
-// script's environment; the callbacks it defines are looked up once, kept as
-// registry references, and called without string lookups every step.
+// script do not leak into another. A source is compiled once as
+// `function(_ENV, ...) <code> end` (the robots' states load its bytecode,
+// dumped by the first state that compiled it: no parsing per robot) and
+// called once per script with that script's environment; the callbacks it defines are looked up
+// once, kept as registry references, and called without string lookups every step.
 //
 // Child scripts run in hierarchy order (a parent's before its descendants',
 // siblings in scene order). An explicit script runs only when an ancestor's
@@ -37,8 +38,10 @@
 #include <climits>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <string_view>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -146,14 +149,62 @@ const char* ReadPieces(lua_State*, void* data, size_t* size) {
   return piece.data();
 }
 
+// Each distinct script source compiled once for every state: the bytecode
+// of its factory chunk (lua_dump, debug information kept, so messages name
+// the same file and lines), loaded by the other states without parsing.
+// Filled by whichever state compiles a source first; shared by the threads
+// that start robots.
+class CompiledChunks {
+ public:
+  // The bytecode of `source`'s factory, or null when none is kept yet.
+  const std::string* Find(const ScriptSource& source) {
+    const std::lock_guard lock(mutex_);
+    const auto it = chunks_.find(&source);
+    // A source at an address a freed one had is another source: compare.
+    if (it == chunks_.end() || it->second.path != source.path || it->second.code != source.code)
+      return nullptr;
+    return &it->second.bytecode;  // entries are never erased: the string stays put
+  }
+  void Add(const ScriptSource& source, std::string bytecode) {
+    const std::lock_guard lock(mutex_);
+    Entry& entry = chunks_[&source];
+    entry.path = source.path;
+    entry.code = source.code;
+    entry.bytecode = std::move(bytecode);
+  }
+
+ private:
+  struct Entry {
+    std::string path, code, bytecode;
+  };
+  std::mutex mutex_;
+  std::unordered_map<const ScriptSource*, Entry> chunks_;
+};
+
+int AppendBytes(lua_State*, const void* bytes, size_t size, void* out) {
+  static_cast<std::string*>(out)->append(static_cast<const char*>(bytes), size);
+  return 0;
+}
+
 // Compiles `source` into a function(_ENV, ...) running its code, left on
 // the stack. The prefix shares the first line, so line numbers in messages
 // are the file's own. Returns "" or the compiler's message (for a broken
 // source, the message of compiling it as it is, so that it reads naturally).
-std::string CompileFactory(lua_State* L, const ScriptSource& source) {
+// With `chunks`, a source compiled before (by any state) is loaded from its
+// bytecode, and one compiled here is added.
+std::string CompileFactory(lua_State* L, const ScriptSource& source,
+                           CompiledChunks* chunks = nullptr) {
   const std::string chunkname = "@" + (source.path.empty() ? std::string("?") : source.path);
+  if (const std::string* bytecode = chunks ? chunks->Find(source) : nullptr) {
+    int status = luaL_loadbufferx(L, bytecode->data(), bytecode->size(), chunkname.c_str(), "b");
+    if (status == LUA_OK) status = lua_pcall(L, 0, 1, 0);
+    if (status == LUA_OK) return "";
+    lua_pop(L, 1);  // out of memory: compile the text below, which reports it
+  }
   ChunkPieces chunk{{"return function(_ENV, ...) ", source.code, "\nend"}};
   int status = lua_load(L, ReadPieces, &chunk, chunkname.c_str(), "t");
+  std::string bytecode;
+  if (status == LUA_OK && chunks != nullptr) lua_dump(L, AppendBytes, &bytecode, 0);
   if (status == LUA_OK) status = lua_pcall(L, 0, 1, 0);
   if (status == LUA_OK && lua_isfunction(L, -1)) {
     // The function must end at our own 'end': a source like "end, function()"
@@ -163,7 +214,10 @@ std::string CompileFactory(lua_State* L, const ScriptSource& source) {
     lua_getinfo(L, ">S", &ar);
     const int last_line =
         2 + static_cast<int>(std::count(source.code.begin(), source.code.end(), '\n'));
-    if (ar.linedefined == 1 && ar.lastlinedefined == last_line) return "";
+    if (ar.linedefined == 1 && ar.lastlinedefined == last_line) {
+      if (chunks != nullptr && !bytecode.empty()) chunks->Add(source, std::move(bytecode));
+      return "";
+    }
   }
   std::string message = status == LUA_OK ? std::string() : ErrorText(L, status);
   lua_pop(L, 1);
@@ -255,7 +309,8 @@ std::unique_ptr<ScriptState> NewState(World* world, int instance, RobotRuntime* 
 }
 
 // Runs every script's body, then every sysCall_init, in hierarchy order.
-void Initialize(ScriptState* state) {
+// `chunks`: the sources compiled by the other states, and where this one's go.
+void Initialize(ScriptState* state, CompiledChunks* chunks = nullptr) {
   lua_State* L = state->L;
   // Bodies. Each distinct source is compiled once for the state.
   std::vector<std::pair<const ScriptSource*, int>> factories;
@@ -264,7 +319,7 @@ void Initialize(ScriptState* state) {
     auto it = std::find_if(factories.begin(), factories.end(),
                            [&](const auto& f) { return f.first == &source; });
     if (it == factories.end()) {
-      std::string message = CompileFactory(L, source);
+      std::string message = CompileFactory(L, source, chunks);
       if (!message.empty())
         ThrowScriptError(*state, script, std::move(message), "loading the script");
       factories.emplace_back(&source, luaL_ref(L, LUA_REGISTRYINDEX));
@@ -485,6 +540,7 @@ class LuaScriptHost final : public ScriptHost {
   std::unique_ptr<ScriptState> scene_;                // null: no scene scripts
   std::unique_ptr<ScriptState> main_;                 // null: the default main script
   std::vector<ParamValue> child_args_;                // of the running sim.handleChildScripts
+  CompiledChunks chunks_;                             // the robots' sources, compiled once
   uint64_t main_steps_ = 0;                           // sysCall_step calls of the main script
   bool started_ = false;
   bool stopped_ = false;
@@ -544,7 +600,7 @@ void LuaScriptHost::StartRobots(int first) {
       try {
         robots_[r] = NewState(&world, static_cast<int>(r), &world.runtime(static_cast<int>(r)),
                               instance.name, instance.objects);
-        if (robots_[r]) Initialize(robots_[r].get());
+        if (robots_[r]) Initialize(robots_[r].get(), &chunks_);
       } catch (const std::exception& e) {
         errors[r] = e.what();
       }

@@ -37,14 +37,14 @@ std::vector<fs::path> BenchPluginDirectories() {
 
 constexpr const char* kCsvHeader =
     "config,robots,threads,steps,wall_s,robot_ticks_per_s,us_sense,us_control,us_actuate,"
-    "us_physics,us_record,peak_rss_mb,kb_per_robot";
+    "us_physics,us_record,peak_rss_mb,kb_per_robot,startup_s";
 
 std::string ToCsv(const BenchRow& r) {
   std::ostringstream s;
   s << std::setprecision(8) << r.config << ',' << r.robots << ',' << r.threads << ',' << r.steps
     << ',' << r.wall_s << ',' << r.robot_ticks_per_s;
   for (double us : r.us_per_tick) s << ',' << us;
-  s << ',' << r.peak_rss_mb << ',' << r.kb_per_robot;
+  s << ',' << r.peak_rss_mb << ',' << r.kb_per_robot << ',' << r.startup_s;
   return s.str();
 }
 
@@ -53,7 +53,7 @@ bool FromCsv(const std::string& line, BenchRow* r) {
   std::string field;
   std::vector<std::string> f;
   while (std::getline(s, field, ',')) f.push_back(field);
-  if (f.size() != 13) return false;
+  if (f.size() != 14) return false;
   try {
     r->config = f[0];
     r->robots = std::stoi(f[1]);
@@ -64,6 +64,7 @@ bool FromCsv(const std::string& line, BenchRow* r) {
     for (int i = 0; i < 5; ++i) r->us_per_tick[i] = std::stod(f[6 + i]);
     r->peak_rss_mb = std::stod(f[11]);
     r->kb_per_robot = std::stod(f[12]);
+    r->startup_s = std::stod(f[13]);
   } catch (const std::exception&) {
     return false;
   }
@@ -112,10 +113,15 @@ int RunBenchChild(const BenchOptions& options, const std::string& config, int ro
   load.seed = 1;
   load.threads = threads;
   load.plugin_directories = BenchPluginDirectories();
+  // Start-up: the world loaded (models copied, robots placed) and started
+  // (engine built, Lua states made, sysCall_init run), up to its first step.
+  const auto load_start = std::chrono::steady_clock::now();
   LoadedWorld loaded = LoadWorld(options.world, load, registry);
   World& world = *loaded.world;
   world.set_log_sink([](std::string_view) {});
   world.Start();
+  const double startup_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
   // Warm-up through the full pipeline: scripts set the wheel commands.
   for (int64_t i = 0; i < options.warmup_steps; ++i) world.Step();
 
@@ -124,6 +130,7 @@ int RunBenchChild(const BenchOptions& options, const std::string& config, int ro
   row.robots = world.robot_count();
   row.threads = bare ? 1 : world.threads();
   row.steps = options.steps;
+  row.startup_s = startup_s;
   const double ticks = static_cast<double>(row.robots) * static_cast<double>(options.steps);
   if (config == "diffusion") {
     const PhaseTimes before = world.phase_times();
@@ -147,18 +154,20 @@ int RunBenchChild(const BenchOptions& options, const std::string& config, int ro
   return 0;
 }
 
-std::string DefaultBenchWorld() {
+std::string FindInSourceTree(const std::string& relative) {
   // The source tree beside the program: build/swarmsim -> worlds/diffusion.yaml.
   std::error_code ec;
   const fs::path exe = fs::canonical("/proc/self/exe", ec);
   if (!ec) {
-    const fs::path beside = exe.parent_path().parent_path() / kDefaultWorld;
+    const fs::path beside = exe.parent_path().parent_path() / relative;
     if (fs::is_regular_file(beside, ec)) return DisplayPath(beside);
   }
   // Else the current folder (a repository root).
-  if (fs::is_regular_file(kDefaultWorld, ec)) return kDefaultWorld;
+  if (fs::is_regular_file(relative, ec)) return relative;
   return "";
 }
+
+std::string DefaultBenchWorld() { return FindInSourceTree(kDefaultWorld); }
 
 std::string PrepareBench(BenchOptions* options) {
   // The world: the one given, else the diffusion world found beside the program.
@@ -199,6 +208,21 @@ std::string PrepareBench(BenchOptions* options) {
   }
 }
 
+bool MeasureInChild(const BenchOptions& options, const std::string& config, int robots, int threads,
+                    BenchRow* row) {
+  const std::vector<std::string> args{options.self_exe,  "bench",
+                                      "--child",         config,
+                                      "--child-robots",  std::to_string(robots),
+                                      "--child-threads", std::to_string(threads),
+                                      "--child-warmup",  std::to_string(options.warmup_steps),
+                                      "--steps",         std::to_string(options.steps),
+                                      "--world",         options.world};
+  std::string output;
+  int status = 0;
+  return RunChild(args, &output, &status) && WIFEXITED(status) && WEXITSTATUS(status) == 0 &&
+         FromCsv(output.substr(0, output.find('\n')), row);
+}
+
 int RunBench(BenchOptions options, std::ostream& out, std::ostream& err) {
   // Everything that can be checked is, before the table's header.
   const std::string bare = PrepareBench(&options);
@@ -219,17 +243,8 @@ int RunBench(BenchOptions options, std::ostream& out, std::ostream& err) {
       << std::string(12 + 8 + 8 + 14 + 9 * 5 + 10 + 9, '-') << "\n"
       << std::flush;
   auto measure = [&](const std::string& config, int robots, int threads) {
-    std::vector<std::string> args{options.self_exe,  "bench",
-                                  "--child",         config,
-                                  "--child-robots",  std::to_string(robots),
-                                  "--child-threads", std::to_string(threads),
-                                  "--steps",         std::to_string(options.steps),
-                                  "--world",         options.world};
-    std::string output;
-    int status = 0;
     BenchRow row;
-    if (!RunChild(args, &output, &status) || !WIFEXITED(status) || WEXITSTATUS(status) != 0 ||
-        !FromCsv(output.substr(0, output.find('\n')), &row)) {
+    if (!MeasureInChild(options, config, robots, threads, &row)) {
       err << "bench: " << config << " with " << robots << " robots on " << threads
           << " threads failed\n";
       return false;

@@ -30,6 +30,7 @@ struct BenchRow {
   double us_per_tick[5] = {0, 0, 0, 0, 0};  // sense, control, actuate, physics, record
   double peak_rss_mb = 0;
   double kb_per_robot = 0;
+  double startup_s = 0;  // loading the world and starting it (sysCall_init): load to first step
 };
 
 // The world `bench` measures without --world: worlds/diffusion.yaml of the
@@ -37,6 +38,11 @@ struct BenchRow {
 // ../worlds/diffusion.yaml), else of the current folder. Empty when neither
 // has it.
 std::string DefaultBenchWorld();
+
+// `relative` (a path in the repository, "worlds/diffusion_native.yaml") in
+// the source tree the program was built in, else in the current folder, as
+// DefaultBenchWorld finds its world. Empty when neither has it.
+std::string FindInSourceTree(const std::string& relative);
 
 // What `bench` checks before it prints anything: fills in the default world,
 // checks that the world loads and has the `robots` parameter the bench sets
@@ -50,6 +56,12 @@ std::string PrepareBench(BenchOptions* options);
 // the CSV. Returns the process exit code; throws swarmsim::Error (before any
 // output) for a world PrepareBench rejects.
 int RunBench(BenchOptions options, std::ostream& out, std::ostream& err);
+
+// Measures one configuration in a fresh child process (`options.self_exe
+// bench --child ...`: options.world, steps and warm-up steps) into `row`.
+// False when the child failed (its stderr passes through).
+bool MeasureInChild(const BenchOptions& options, const std::string& config, int robots, int threads,
+                    BenchRow* row);
 
 // The child side: measures one configuration in this process and prints one
 // CSV row (no header) to `out`. `config` is "diffusion" or "box2d-only".

@@ -1,9 +1,13 @@
 // swarmsim bench: robot-ticks/s over robots x threads, one child process per
-// configuration (bench --child is that child); --scaling adds the sweep jobs.
+// configuration (bench --child is that child); --scaling adds the sweep jobs;
+// --scaling-robots measures the cost per robot-tick over robot counts.
 #include <CLI/CLI.hpp>
+#include <filesystem>
 #include <iostream>
 
+#include "framework/error.h"
 #include "swarm/bench/bench.h"
+#include "swarm/bench/robot_scaling.h"
 #include "swarm/bench/scaling.h"
 #include "swarm/cli/commands.h"
 #include "swarm/cli/options.h"
@@ -30,6 +34,7 @@ CLI::App* AddBenchCommand(CLI::App* app, BenchArgs* args) {
   bench->add_option("--child", args->child_config)->group("");  // internal: one config
   bench->add_option("--child-robots", args->child_robots)->group("");
   bench->add_option("--child-threads", args->child_threads)->group("");
+  bench->add_option("--child-warmup", options.warmup_steps)->group("");
   ScalingOptions& scaling = args->scaling_options;  // bench --scaling (issue 5)
   bench->add_flag("--scaling", args->scaling,
                   "Speed-up over threads 1..cores and sweep --jobs 1..cores; CSV + PNG");
@@ -41,11 +46,42 @@ CLI::App* AddBenchCommand(CLI::App* app, BenchArgs* args) {
   bench->add_option("--plot", scaling.plot, "With --scaling: the PNG plot")
       ->capture_default_str()
       ->check(NonEmpty("a file"));
+  // bench --scaling-robots (issue 32): cost per robot-tick over robot counts.
+  CLI::Option* robots_flag = bench->add_flag(
+      "--scaling-robots", args->scaling_robots,
+      "Microseconds per robot-tick by phase, start-up and memory over --robots (default "
+      "1000,10000,100000) for the Lua, C++ and planar + C++ diffusion worlds; CSV + log-log PNG");
+  bench
+      ->add_option("--configs", args->configs,
+                   "With --scaling-robots: which of lua, cpp, planar-cpp (default all)")
+      ->delimiter(',');
+  robots_flag->excludes("--scaling");
   return bench;
 }
 
+namespace {
+
+int ScalingRobots(const BenchArgs& args, const CLI::App& command) {
+  RobotScalingOptions o;
+  o.self_exe = args.options.self_exe;
+  if (command.count("--robots") > 0) o.robots = args.options.robots;
+  if (command.count("--threads") > 0) o.threads = args.options.threads;
+  if (command.count("--steps") > 0) o.steps = args.options.steps;
+  if (args.options.csv) o.csv = *args.options.csv;
+  if (command.count("--plot") > 0) o.plot = args.scaling_options.plot;
+  if (!args.configs.empty() && !args.options.world.empty())
+    throw Error("bench: --configs and --world: give one or the other");
+  if (!args.configs.empty()) o.configs = SelectScalingConfigs(args.configs);
+  if (!args.options.world.empty())
+    o.configs = {{std::filesystem::path(args.options.world).stem().string(), args.options.world}};
+  return RunRobotScalingBench(o, std::cout, std::cerr);
+}
+
+}  // namespace
+
 int BenchCommand(BenchArgs args, const CLI::App& command) {
   args.options.self_exe = "/proc/self/exe";
+  if (args.scaling_robots) return ScalingRobots(args, command);
   if (args.scaling) {
     ScalingOptions& scaling = args.scaling_options;
     scaling.bench = args.options;

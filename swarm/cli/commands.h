@@ -39,6 +39,7 @@ struct RunArgs {
   std::vector<std::string> sets;  // NAME=VALUE
   std::string out_dir;
   bool hash = false, quiet = false;
+  bool progress = false;  // --progress: the loading line also when stderr is not a terminal
   bool trust_scripts = false;
   std::vector<std::string> plugins;
   std::vector<std::string> package_path;  // --package-path: URDF packages' folders
@@ -82,6 +83,8 @@ struct BenchArgs {
   int child_robots = 0, child_threads = 1;
   bool scaling = false;  // --scaling
   ScalingOptions scaling_options;
+  bool scaling_robots = false;       // --scaling-robots
+  std::vector<std::string> configs;  // --configs lua,cpp,planar-cpp
 };
 CLI::App* AddBenchCommand(CLI::App* app, BenchArgs* args);
 // `command`: what AddBenchCommand returned (was --threads given?).

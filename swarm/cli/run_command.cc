@@ -3,10 +3,12 @@
 
 #include <CLI/CLI.hpp>
 #include <charconv>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <iterator>
 #include <memory>
@@ -28,6 +30,56 @@
 
 namespace swarmsim::cli {
 namespace {
+
+// The line on stderr while a large world loads (--progress, or stderr a
+// terminal; never with --quiet): "loading: 45,056 of 100,000 robots built",
+// redrawn in place on a terminal (a new line each time otherwise) at most
+// twice a second, once the load has taken half a second; then, for a world
+// that showed it (always with --progress), "loaded 100,000 robots in 3.4 s;
+// starting them". The run's own progress follows.
+class LoadProgress {
+ public:
+  LoadProgress(bool forced, bool tty) : forced_(forced), tty_(tty) {}
+
+  void Copies(int64_t built, int64_t total) {
+    total_ = total;
+    const double now = Seconds();
+    if (now < 0.5 || (shown_ && now - last_ < 0.5)) return;
+    last_ = now;
+    shown_ = true;
+    std::cerr << (tty_ ? "\r" : "") << "loading: " << Grouped(built) << " of " << Grouped(total)
+              << " robots built" << (tty_ ? "" : "\n") << std::flush;
+  }
+  // The load failed: an error message goes on a line of its own.
+  void Abandon() {
+    if (tty_ && shown_) std::cerr << "\n";
+  }
+  void Loaded() {
+    if (!shown_ && !forced_) return;
+    std::cerr << (tty_ && shown_ ? "\r" : "") << "loaded " << Grouped(total_) << " robots in "
+              << std::fixed << std::setprecision(1) << Seconds() << std::defaultfloat
+              << " s; starting them" << (tty_ && shown_ ? "\033[K" : "") << "\n"
+              << std::flush;
+  }
+
+ private:
+  double Seconds() const {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  }
+  static std::string Grouped(int64_t n) {  // 100000 -> "100,000"
+    std::string digits = std::to_string(n), out;
+    for (size_t i = 0; i < digits.size(); ++i) {
+      if (i > 0 && (digits.size() - i) % 3 == 0) out += ',';
+      out += digits[i];
+    }
+    return out;
+  }
+  const std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+  const bool forced_, tty_;
+  bool shown_ = false;
+  double last_ = 0;
+  int64_t total_ = 0;
+};
 
 // The number of steps: --steps, else --duration rounded to whole time steps,
 // else the world's own; nullopt and `*error` set when none fits.
@@ -127,6 +179,8 @@ CLI::App* AddRunCommand(CLI::App* app, RunArgs* args) {
       ->check(NonEmpty("a folder"));
   run->add_flag("--hash", args->hash, "Print the final state hash");
   run->add_flag("--quiet", args->quiet, "No progress bar and no summary table");
+  run->add_flag("--progress", args->progress,
+                "Show loading progress (robots built) also when stderr is not a terminal");
   run->add_option("--plugin", args->plugins, "Load a plugin (shared library) before the world")
       ->allow_extra_args(false);
   run->add_option("--package-path", args->package_path,
@@ -274,6 +328,11 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
   load.note = [](const std::string& note) {
     std::cerr << "note: " << swarmsim::ValidUtf8(note) << std::endl;
   };
+  std::optional<LoadProgress> load_progress;
+  if (!args.quiet && (args.progress || isatty(STDERR_FILENO))) {
+    load_progress.emplace(args.progress, isatty(STDERR_FILENO) != 0);
+    load.copy_progress = [&](int64_t built, int64_t total) { load_progress->Copies(built, total); };
+  }
   LoadedWorld loaded;
   try {
     load.overrides = ParseSets(args.sets);
@@ -281,13 +340,16 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
     for (const std::string& plugin : args.plugins) LoadPlugin(plugin, registry);
     loaded = LoadWorld(args.world_file, load, *registry);
   } catch (const Error& e) {
+    if (load_progress) load_progress->Abandon();
     return bad_input(e.what());
   }
   try {
     load.check_stop();  // a signal at the end of the load
   } catch (const Error& e) {
+    if (load_progress) load_progress->Abandon();
     return bad_input(e.what());
   }
+  if (load_progress) load_progress->Loaded();
   for (const std::string& warning : loaded.warnings)
     std::cerr << "warning: " << swarmsim::ValidUtf8(warning) << "\n";
   std::string length_error;

@@ -704,6 +704,9 @@ void WorldLoader::PlaceEntries() {
 
 void WorldLoader::BuildCopies(World* world) {
   Scene& scene = world->scene();
+  int64_t total = 0, built = 0;  // copies, for options_.copy_progress
+  for (const EntryPlan& e : entries_)
+    total += e.distribute ? static_cast<int64_t>(e.placements.size()) : 1;
   for (EntryPlan& e : entries_) {
     std::vector<Pose> poses;
     if (!e.distribute) {
@@ -748,6 +751,8 @@ void WorldLoader::BuildCopies(World* world) {
     ObjectId first;  // the entry's first copy built from its own description
     for (size_t k = 0; k < poses.size(); ++k) {
       if (options_.check_stop && k % 256 == 0) options_.check_stop();
+      if (options_.copy_progress && built % 256 == 0) options_.copy_progress(built, total);
+      ++built;
       const EntryPlan::OwnCopy* own = e.FindOwnCopy(static_cast<int64_t>(k));
       ObjectId root;
       int instance;
@@ -771,6 +776,7 @@ void WorldLoader::BuildCopies(World* world) {
         world->SetNativeController(instance, e.native, e.native_replaces_scripts);
     }
   }
+  if (options_.copy_progress) options_.copy_progress(built, total);
 }
 
 std::vector<std::pair<int, Pose>> WorldLoader::Placements(uint64_t seed) {

@@ -55,6 +55,10 @@ struct LoadOptions {
   // 8 MiB or more: "reading mesh file 'rock.stl' (62 MiB)"); the program
   // prints it on stderr. Empty: not said.
   std::function<void(const std::string&)> note;
+  // Called as model copies are built (every 256 copies, and after the
+  // last): copies built so far and in all, over every models entry. For a
+  // progress line while a large world loads. Empty: never.
+  std::function<void(int64_t built, int64_t total)> copy_progress;
 };
 
 // A models entry's `python_controller:` (swarm/python runs it; the program

@@ -99,9 +99,10 @@ void PartitionedPlaneWorld::Build(const Scene& scene) {
     region->CopyGround(*staging, axis_, region_lo - pad, region_hi + pad);
     regions_.push_back(std::move(region));
   }
+  // Copied, not moved: the staging world goes whole when Build returns.
   for (uint32_t b = 0; b < bodies.size(); ++b) {
     const int r = RegionOf(AlongAxis(bodies[b].body->GetPosition(), axis_));
-    staging->MoveBody(b, regions_[r].get());
+    staging->CopyBody(b, regions_[r].get());
   }
 }
 

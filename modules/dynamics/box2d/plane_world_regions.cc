@@ -65,8 +65,8 @@ void PlaneWorld::CopyGround(const PlaneWorld& from, int axis, double lo, double 
   }
 }
 
-void PlaneWorld::MoveBody(uint32_t b, PlaneWorld* to) {
-  PlaneBody& plane_body = bodies_[b];
+void PlaneWorld::CopyBody(uint32_t b, PlaneWorld* to) const {
+  const PlaneBody& plane_body = bodies_[b];
   b2Body* body = plane_body.body;
   b2BodyDef def;
   def.type = b2_dynamicBody;
@@ -103,8 +103,12 @@ void PlaneWorld::MoveBody(uint32_t b, PlaneWorld* to) {
   to->bodies_.push_back(copy);
   to->body_poses_.push_back(body_poses_[b]);
   if (copy.wheel_count > 0) to->wheeled_.push_back(index);
-  world_->DestroyBody(body);
-  plane_body.body = nullptr;  // a hole until Compact()
+}
+
+void PlaneWorld::MoveBody(uint32_t b, PlaneWorld* to) {
+  CopyBody(b, to);
+  world_->DestroyBody(bodies_[b].body);
+  bodies_[b].body = nullptr;  // a hole until Compact()
 }
 
 void PlaneWorld::Compact() {

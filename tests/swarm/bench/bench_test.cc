@@ -97,7 +97,7 @@ TEST(BenchTest, AChildMeasuresOneConfigurationAsOneCsvRow) {
     const std::string text = out.str();
     ASSERT_EQ(text.find('\n'), text.size() - 1) << "one row: " << text;
     const std::vector<std::string> f = Fields(text.substr(0, text.size() - 1));
-    ASSERT_EQ(f.size(), 13u) << text;
+    ASSERT_EQ(f.size(), 14u) << text;
     EXPECT_EQ(f[0], config);
     EXPECT_EQ(f[1], "4");
     EXPECT_EQ(f[2], config == "diffusion" ? "2" : "1") << "the bare engine runs on one thread";
@@ -107,6 +107,7 @@ TEST(BenchTest, AChildMeasuresOneConfigurationAsOneCsvRow) {
     EXPECT_NEAR(rate, 4 * 3 / wall, 1e-6 * rate) << "robot-ticks per second";
     EXPECT_GT(std::stod(f[9]), 0) << "physics time per tick: " << text;
     EXPECT_GT(std::stod(f[11]), 0) << "peak memory: " << text;
+    EXPECT_GT(std::stod(f[13]), 0) << "start-up (load to first step): " << text;
   }
   std::ostringstream out;
   try {
@@ -137,7 +138,8 @@ TEST(BenchTest, ARunIsOneProcessPerRowIntoTheTableAndTheCsv) {
   for (std::string line; std::getline(csv, line);) rows.push_back(Fields(line));
   ASSERT_EQ(rows.size(), 5u) << "the header, then diffusion and box2d-only for 2 and 3 robots";
   EXPECT_EQ(rows[0].front(), "config");
-  EXPECT_EQ(rows[0].size(), 13u);
+  EXPECT_EQ(rows[0].size(), 14u);
+  EXPECT_EQ(rows[0].back(), "startup_s");
   const std::vector<std::pair<std::string, std::string>> expected = {
       {"diffusion", "2"}, {"box2d-only", "2"}, {"diffusion", "3"}, {"box2d-only", "3"}};
   for (size_t i = 0; i < expected.size(); ++i) {

@@ -215,4 +215,19 @@ TEST(CliTest, ScriptErrorInOneRobotKeepsEveryRobotsPrintsInRobotOrder) {
   fs::remove_all(dir);
 }
 
+TEST(CliTest, ProgressShowsTheRobotsLoadedUnlessQuiet) {
+  // Not a terminal here: the line comes with --progress only, and never with --quiet.
+  const std::string run = "run " + std::string(SWARMSIM_SOURCE_DIR) +
+                          "/worlds/diffusion.yaml --set robots=300 --steps 1";
+  Result shown = RunProgram(run + " --progress");
+  EXPECT_EQ(shown.exit_code, 0) << shown.output;
+  EXPECT_NE(shown.output.find("loaded 300 robots in "), std::string::npos) << shown.output;
+  EXPECT_NE(shown.output.find(" s; starting them\n"), std::string::npos) << shown.output;
+  for (const std::string flags : {"", " --progress --quiet"}) {
+    Result hidden = RunProgram(run + flags);
+    EXPECT_EQ(hidden.exit_code, 0) << hidden.output;
+    EXPECT_EQ(hidden.output.find("loaded 300"), std::string::npos) << flags << hidden.output;
+  }
+}
+
 }  // namespace

@@ -1,0 +1,247 @@
+#include "swarm/bench/robot_scaling.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <map>
+#include <ostream>
+#include <sstream>
+#include <thread>
+#include <utility>
+
+#include "framework/error.h"
+#include "swarm/bench/bench.h"
+
+namespace swarmsim {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The default configurations: name, world in the repository.
+constexpr std::pair<const char*, const char*> kConfigs[] = {
+    {"lua", "worlds/diffusion.yaml"},
+    {"cpp", "worlds/diffusion_native.yaml"},
+    {"planar-cpp", "bench/worlds/diffusion_planar_native.yaml"},
+};
+
+constexpr double kTicksPerRow = 2e6;
+constexpr int64_t kMinSteps = 3, kMaxSteps = 1000;
+
+// One measured row, with what the table derives from the child's.
+struct ScalingRow {
+  std::string config;
+  BenchRow bench;
+  double us_other = 0;  // wall per tick minus sense, control, physics: actuate, record, delivery
+  double us_total = 0;  // wall time per robot-tick
+  double ratio = 1;     // us_total over the config's first robot count (same threads)
+};
+
+constexpr const char* kCsvHeader =
+    "config,world,robots,threads,steps,robot_ticks_per_s,us_sense,us_control,us_physics,"
+    "us_other,us_total,cost_ratio,startup_s,peak_rss_mb,kb_per_robot";
+
+std::string CsvRow(const ScalingRow& r, const std::string& world) {
+  const BenchRow& b = r.bench;
+  std::ostringstream s;
+  s << std::setprecision(8) << r.config << ',' << world << ',' << b.robots << ',' << b.threads
+    << ',' << b.steps << ',' << b.robot_ticks_per_s << ',' << b.us_per_tick[0] << ','
+    << b.us_per_tick[1] << ',' << b.us_per_tick[3] << ',' << r.us_other << ',' << r.us_total << ','
+    << r.ratio << ',' << b.startup_s << ',' << b.peak_rss_mb << ',' << b.kb_per_robot;
+  return s.str();
+}
+
+void PrintHeader(std::ostream& out) {
+  out << std::left << std::setw(12) << "config" << std::right << std::setw(9) << "robots"
+      << std::setw(4) << "thr" << std::setw(6) << "steps" << std::setw(11) << "ticks/s"
+      << std::setw(8) << "sense" << std::setw(8) << "control" << std::setw(8) << "physics"
+      << std::setw(8) << "other" << std::setw(8) << "total" << std::setw(7) << "vs 1st"
+      << std::setw(9) << "start s" << std::setw(10) << "peak MiB" << std::setw(9) << "KB/robot"
+      << "\n"
+      << std::string(12 + 9 + 4 + 6 + 11 + 8 * 5 + 7 + 9 + 10 + 9, '-') << "\n"
+      << std::flush;
+}
+
+void PrintRow(const ScalingRow& r, std::ostream& out) {
+  const BenchRow& b = r.bench;
+  out << std::left << std::setw(12) << r.config << std::right << std::setw(9) << b.robots
+      << std::setw(4) << b.threads << std::setw(6) << b.steps << std::setw(11) << std::fixed
+      << std::setprecision(0) << b.robot_ticks_per_s << std::setprecision(2) << std::setw(8)
+      << b.us_per_tick[0] << std::setw(8) << b.us_per_tick[1] << std::setw(8) << b.us_per_tick[3]
+      << std::setw(8) << r.us_other << std::setw(8) << r.us_total << std::setw(7) << r.ratio
+      << std::setw(9) << b.startup_s << std::setw(10) << std::setprecision(0) << b.peak_rss_mb
+      << std::setw(9) << std::setprecision(1) << b.kb_per_robot << "\n"
+      << std::defaultfloat << std::flush;
+}
+
+// gnuplot's single-quoted string: a quote is doubled.
+std::string Quoted(const std::string& text) {
+  std::string q = "'";
+  for (char c : text) q += c == '\'' ? std::string("''") : std::string(1, c);
+  return q + "'";
+}
+
+// Two log-log panels: microseconds per robot-tick against robots (the total
+// solid, each phase dashed in the configuration's colour), and start-up
+// seconds against robots. False (and a message) when gnuplot fails or is missing.
+bool Plot(const std::vector<ScalingRow>& rows, const RobotScalingOptions& o, std::ostream& out,
+          std::ostream& err) {
+  // Series: config (and threads, when more than one count was measured).
+  std::map<std::string, std::vector<const ScalingRow*>> series;
+  std::vector<std::string> order;
+  for (const ScalingRow& r : rows) {
+    std::string key = r.config;
+    if (o.threads.size() > 1) key += ", " + std::to_string(r.bench.threads) + " thr";
+    if (!series.contains(key)) order.push_back(key);
+    series[key].push_back(&r);
+  }
+  std::ostringstream script;
+  script << "set terminal pngcairo size 1200,640 enhanced font 'sans,10'\n"
+         << "set output " << Quoted(o.plot) << "\n"
+         << "set logscale xy\nset grid\nset key below horizontal maxcols 5 noenhanced\n"
+         << "set format x '10^{%L}'\nset xlabel 'robots'\n"
+         << "set multiplot layout 1,2 title 'swarmsim: cost per robot-tick over robot counts'\n";
+  int block = 0;
+  for (const std::string& key : order) {
+    script << "$d" << block++ << " << EOD\n";
+    for (const ScalingRow* r : series[key]) {
+      const BenchRow& b = r->bench;
+      // robots total sense control physics other startup
+      script << b.robots << ' ' << r->us_total << ' ' << std::max(b.us_per_tick[0], 1e-3) << ' '
+             << std::max(b.us_per_tick[1], 1e-3) << ' ' << std::max(b.us_per_tick[3], 1e-3) << ' '
+             << std::max(r->us_other, 1e-3) << ' ' << std::max(b.startup_s, 1e-3) << "\n";
+    }
+    script << "EOD\n";
+  }
+  const char* phases[] = {"sense", "control", "physics", "other"};
+  script << "set ylabel 'microseconds per robot-tick'\nplot ";
+  for (int i = 0; i < block; ++i) {
+    const std::string d = "$d" + std::to_string(i);
+    const std::string colour = " lc " + std::to_string(i + 1);
+    script << (i ? ", " : "") << d << " using 1:2 with linespoints lw 2 pt 7" << colour << " title "
+           << Quoted(order[i] + " total");
+    for (int p = 0; p < 4; ++p)
+      script << ", " << d << " using 1:" << 3 + p << " with linespoints dt " << 2 + p << " lw 1 pt "
+             << 1 + p << colour << " title " << Quoted(order[i] + " " + phases[p]);
+  }
+  script << "\nset ylabel 'start-up seconds (load to first step)'\nplot ";
+  for (int i = 0; i < block; ++i)
+    script << (i ? ", " : "") << "$d" << i << " using 1:7 with linespoints lw 2 pt 7 lc " << i + 1
+           << " title " << Quoted(order[i]);
+  script << "\nunset multiplot\n";
+  std::fflush(nullptr);
+  FILE* gp = popen("gnuplot 2>&1", "w");
+  const std::string text = script.str();
+  if (gp) fwrite(text.data(), 1, text.size(), gp);
+  const int status = gp ? pclose(gp) : -1;
+  if (status != 0) {
+    err << "bench: gnuplot failed or is missing (install gnuplot-nox); no plot\n";
+    return false;
+  }
+  out << "plot: " << o.plot << "\n";
+  return true;
+}
+
+}  // namespace
+
+int64_t AutoScalingSteps(int robots) {
+  const double steps = std::floor(kTicksPerRow / std::max(robots, 1));
+  return std::clamp(static_cast<int64_t>(steps), kMinSteps, kMaxSteps);
+}
+
+int64_t AutoWarmupSteps(int64_t steps) { return std::clamp<int64_t>(steps / 10, 2, 20); }
+
+std::vector<ScalingConfig> DefaultScalingConfigs() {
+  std::vector<ScalingConfig> configs;
+  for (const auto& [name, relative] : kConfigs) {
+    const std::string world = FindInSourceTree(relative);
+    if (world.empty())
+      throw Error(std::string("bench: the ") + name + " configuration's world " + relative +
+                  " was found neither beside the program nor in the current folder; pass "
+                  "--world FILE");
+    configs.push_back({name, world});
+  }
+  return configs;
+}
+
+std::vector<ScalingConfig> SelectScalingConfigs(const std::vector<std::string>& names) {
+  std::vector<ScalingConfig> selected;
+  for (const std::string& name : names) {
+    const auto it = std::find_if(std::begin(kConfigs), std::end(kConfigs),
+                                 [&](const auto& c) { return name == c.first; });
+    if (it == std::end(kConfigs)) {
+      std::string known;
+      for (const auto& c : kConfigs) known += std::string(known.empty() ? "" : ", ") + c.first;
+      throw Error("bench: unknown configuration '" + name + "' (known: " + known + ")");
+    }
+    const std::string world = FindInSourceTree(it->second);
+    if (world.empty())
+      throw Error(std::string("bench: the ") + name + " configuration's world " + it->second +
+                  " was found neither beside the program nor in the current folder");
+    selected.push_back({name, world});
+  }
+  return selected;
+}
+
+int RunRobotScalingBench(RobotScalingOptions o, std::ostream& out, std::ostream& err) {
+  // Everything that can be checked is, before any output.
+  if (o.configs.empty()) o.configs = DefaultScalingConfigs();
+  for (ScalingConfig& c : o.configs) {
+    BenchOptions check;
+    check.world = c.world;
+    PrepareBench(&check);
+  }
+  if (o.threads.empty())
+    o.threads = {static_cast<int>(std::max(1u, std::thread::hardware_concurrency()))};
+  std::ofstream csv(o.csv);
+  if (!csv) throw Error("cannot write '" + o.csv + "'");
+  csv << kCsvHeader << "\n" << std::flush;
+
+  out << "microseconds per robot-tick by phase (a tick = one robot for one control step); "
+         "one process per row;\nsteps: "
+      << (o.steps > 0 ? std::to_string(o.steps) : std::string("about 2,000,000 robot-ticks a row"))
+      << "; vs 1st: total over the configuration's first robot count; start s: load to first "
+         "step\n";
+  for (const ScalingConfig& c : o.configs) out << "  " << c.name << ": " << c.world << "\n";
+  out << "\n";
+  PrintHeader(out);
+  std::vector<ScalingRow> rows;
+  bool ok = true;
+  for (const ScalingConfig& c : o.configs) {
+    for (int threads : o.threads) {
+      double first_total = 0;
+      for (int robots : o.robots) {
+        BenchOptions bench;
+        bench.world = c.world;
+        bench.self_exe = o.self_exe;
+        bench.steps = o.steps > 0 ? o.steps : AutoScalingSteps(robots);
+        bench.warmup_steps = o.warmup_steps >= 0 ? o.warmup_steps : AutoWarmupSteps(bench.steps);
+        ScalingRow row;
+        row.config = c.name;
+        if (!MeasureInChild(bench, "diffusion", robots, threads, &row.bench)) {
+          err << "bench: " << c.name << " with " << robots << " robots on " << threads
+              << " threads failed\n";
+          ok = false;
+          continue;
+        }
+        const BenchRow& b = row.bench;
+        const double ticks = static_cast<double>(b.robots) * static_cast<double>(b.steps);
+        row.us_total = ticks > 0 ? 1e6 * b.wall_s / ticks : 0;
+        row.us_other =
+            std::max(0.0, row.us_total - b.us_per_tick[0] - b.us_per_tick[1] - b.us_per_tick[3]);
+        if (first_total == 0) first_total = row.us_total;
+        row.ratio = first_total > 0 ? row.us_total / first_total : 0;
+        PrintRow(row, out);
+        csv << CsvRow(row, c.world) << "\n" << std::flush;
+        rows.push_back(row);
+      }
+    }
+  }
+  out << "csv: " << o.csv << "\n";
+  if (!rows.empty()) ok = Plot(rows, o, out, err) && ok;
+  return ok ? 0 : 1;
+}
+
+}  // namespace swarmsim
