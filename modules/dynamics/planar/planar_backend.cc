@@ -35,7 +35,14 @@ class PlanarBackend final : public DynamicsBackend {
     world_->SyncFromScene(*scene);
     world_->ReadCommands(*scene);
     world_->Advance(duration);
+    world_->EndPushes();
     world_->WriteBack(scene, duration);
+  }
+
+  bool TakeVelocities(Scene* scene, std::span<const uint32_t> slots) override {
+    if (!world_ || scene->structure_version() != built_version_) return false;  // Build reads
+    world_->Push(*scene, slots);
+    return true;
   }
 
   void HashState(StateHasher* hasher) const override {

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "framework/dynamics_backend.h"
@@ -51,6 +52,12 @@ class PlanarWorld {
   void SyncFromScene(const Scene& scene);
   // Each body's velocity from its wheels' commands.
   void ReadCommands(const Scene& scene);
+  // Velocities set from outside (World::SetVelocities) for the shapes at
+  // `slots`: each of them that is a body moves at its scene velocity (world
+  // frame, taken now) on top of its wheels' for the next Advance only (no
+  // inertia here); EndPushes, after that Advance, forgets them.
+  void Push(const Scene& scene, std::span<const uint32_t> slots);
+  void EndPushes();
   // Moves every body by its wheels for `duration` seconds and resolves the
   // overlaps, in internal steps small enough that nothing tunnels.
   void Advance(double duration);
@@ -78,6 +85,11 @@ class PlanarWorld {
   std::vector<double> inner_;                          // inner radius, m (bodies)
   std::vector<double> inverse_mass_;                   // 1/kg (bodies)
   std::vector<double> v_x_, v_y_, w_;                  // commanded velocity, body frame (bodies)
+  struct PushedBody {                                  // 32 bytes
+    uint32_t body;
+    double vx, vy, w;                                  // world frame (m/s, rad/s)
+  };
+  std::vector<PushedBody> pushes_;                     // Push, until EndPushes (body order)
   std::vector<double> start_x_, start_y_, start_yaw_;  // at the start of Advance (bodies)
   std::vector<PlanarBodyCold> cold_;                   // (bodies)
   std::vector<PlanarWheel> wheels_;                    // grouped by body
