@@ -100,8 +100,7 @@ py::dict IrMessages(const Scene& scene, const std::vector<uint32_t>& slots, cons
       d[k] = message.distance;
       from[k] = scene.IsValid(message.sender) ? scene.instance_of(message.sender) : -1;
       bytes[k] = message.data_size;
-      std::copy_n(ir.received.data() + message.data_offset, message.data_size,
-                  payload + k * width);
+      std::copy_n(ir.received.data() + message.data_offset, message.data_size, payload + k * width);
       ++k;
     }
   }

@@ -94,9 +94,9 @@ class Robots {
   void Expire() {
     world_ = nullptr;
     layout_ = nullptr;
-    for (py::object* o : {&poses_, &velocities_, &proximity_, &proximity_values_, &ground_, &light_,
-                          &joint_positions_, &joint_velocities_, &range_and_bearing_,
-                          &ir_messages_})
+    for (py::object* o :
+         {&poses_, &velocities_, &proximity_, &proximity_values_, &ground_, &light_,
+          &joint_positions_, &joint_velocities_, &range_and_bearing_, &ir_messages_})
       *o = py::object();
   }
   int64_t count() const { return static_cast<int64_t>(L().robots.size()); }
@@ -1262,8 +1262,8 @@ PYBIND11_MODULE(_swarmsim, m) {
           "blob_camera_names",
           [](PyWorld& w, const std::string& model) { return w.device_names(model, "blob_camera"); },
           py::arg("model") = "", "Blob cameras on each robot of the model.")
-      .def("ir_messages", &PyWorld::ir_messages, py::arg("model") = "",
-           py::arg("transceiver") = "", py::arg("out") = py::none(),
+      .def("ir_messages", &PyWorld::ir_messages, py::arg("model") = "", py::arg("transceiver") = "",
+           py::arg("out") = py::none(),
            "What each robot's IR transceiver `transceiver` ('': its only one) heard in the\n"
            "last sense phase, as flat arrays: {'offsets': (N+1,) int64, 'distance': (M,) m\n"
            "(the receiver's estimate), 'sender': (M,) int64 sending robot or -1, 'size': (M,)\n"

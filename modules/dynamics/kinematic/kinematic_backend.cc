@@ -27,7 +27,8 @@ class KinematicBackend final : public DynamicsBackend {
     for (const int robot : moving_) {
       const ObjectId root = scene->instance(robot).root;
       const uint32_t root_slot = scene->SlotOf(root);
-      const Vec3 v = scene->linear_velocity_at(root_slot), w = scene->angular_velocity_at(root_slot);
+      const Vec3 v = scene->linear_velocity_at(root_slot),
+                 w = scene->angular_velocity_at(root_slot);
       Pose X = scene->world_pose_at(root_slot);
       X.p = X.p + v * duration;
       const double turn = std::sqrt(w.Dot(w)) * duration;

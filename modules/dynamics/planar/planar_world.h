@@ -76,6 +76,12 @@ class PlanarWorld {
   template <class F>
   void ForBodies(F&& body);
 
+  // A velocity set from outside for one step (Push).
+  struct PushedBody {  // 32 bytes
+    uint32_t body;
+    double vx, vy, w;  // world frame (m/s, rad/s)
+  };
+
   Options options_;
   DynamicsSettings settings_;
   // Bodies, slot order.
@@ -85,10 +91,6 @@ class PlanarWorld {
   std::vector<double> inner_;                          // inner radius, m (bodies)
   std::vector<double> inverse_mass_;                   // 1/kg (bodies)
   std::vector<double> v_x_, v_y_, w_;                  // commanded velocity, body frame (bodies)
-  struct PushedBody {                                  // 32 bytes
-    uint32_t body;
-    double vx, vy, w;                                  // world frame (m/s, rad/s)
-  };
   std::vector<PushedBody> pushes_;                     // Push, until EndPushes (body order)
   std::vector<double> start_x_, start_y_, start_yaw_;  // at the start of Advance (bodies)
   std::vector<PlanarBodyCold> cold_;                   // (bodies)

@@ -82,7 +82,8 @@ void Drive(World* world) {
     leds[r].on = (r + step) % 5 != 0;
   }
   auto& lights = RowsOf<light::LightSourceRow>(&scene, light::kLightSourceTypeName);
-  for (size_t r = 0; r < lights.size(); ++r) lights[r].intensity = 0.2 + 0.1 * double((r + step) % 7);
+  for (size_t r = 0; r < lights.size(); ++r)
+    lights[r].intensity = 0.2 + 0.1 * double((r + step) % 7);
 }
 
 void StepDriven(World* world, int64_t until) {
@@ -138,7 +139,8 @@ Activity ActivityOf(World* world) {
     a.rab += b.readings.size();
   for (const auto& ir : RowsOf<ir_messaging::IrTransceiverRow>(&scene, "ir_transceiver"))
     a.ir += ir.inbox.size();
-  for (const auto& c : RowsOf<BlobCameraRow>(&scene, kBlobCameraTypeName)) a.blobs += c.blobs.size();
+  for (const auto& c : RowsOf<BlobCameraRow>(&scene, kBlobCameraTypeName))
+    a.blobs += c.blobs.size();
   // Pixels in the nozzles' colour, (0.9, 0.1, 0.1) as bytes.
   const std::span<const uint8_t> rgb = world->floor_layer()->floor_rgb();
   for (size_t p = 0; p + 2 < rgb.size(); p += 3)
