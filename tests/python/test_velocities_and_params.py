@@ -60,9 +60,11 @@ class SetVelocitiesTest(unittest.TestCase):
                 np.testing.assert_allclose(got[:, [0, 1, 5]], v, atol=1e-12)
                 w.step(1)
                 end = w.poses(columns=7)
-                np.testing.assert_allclose(end[:, :2] - start[:, :2], v[:, :2] * 0.1, atol=1.5e-3)
+                # Exact without an engine; Box2D keeps float32 positions, ODE integrates.
+                tol = 1e-9 if physics in ("kinematic", "planar") else 1e-4
+                np.testing.assert_allclose(end[:, :2] - start[:, :2], v[:, :2] * 0.1, atol=tol)
                 turned = (w.poses(columns=3)[:, 2] - yaw0 + math.pi) % (2 * math.pi) - math.pi
-                np.testing.assert_allclose(turned, v[:, 2] * 0.1, atol=1e-2)
+                np.testing.assert_allclose(turned, v[:, 2] * 0.1, atol=tol)
                 # And the height is kept (the bodies stay on the ground).
                 np.testing.assert_allclose(end[:, 2], start[:, 2], atol=1e-3)
 

@@ -33,7 +33,7 @@ class PlanarBackend final : public DynamicsBackend {
     // Advance cuts it where a body would move too far (planar_backend.h).
     const double duration = dt * substeps;
     world_->SyncFromScene(*scene);
-    world_->ReadCommands(*scene);
+    world_->ReadCommands(*scene, duration);
     world_->Advance(duration);
     world_->EndPushes();
     world_->WriteBack(scene, duration);

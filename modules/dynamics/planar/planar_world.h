@@ -50,8 +50,9 @@ class PlanarWorld {
   void Build(const Scene& scene);
   // Moves bodies whose scene pose was set from outside since the last write.
   void SyncFromScene(const Scene& scene);
-  // Each body's velocity from its wheels' commands.
-  void ReadCommands(const Scene& scene);
+  // Each body's velocity from its wheels' commands (and Push's, which the
+  // body then moves by exactly over `duration` s when nothing stops it).
+  void ReadCommands(const Scene& scene, double duration = 0);
   // Velocities set from outside (World::SetVelocities) for the shapes at
   // `slots`: each of them that is a body moves at its scene velocity (world
   // frame, taken now) on top of its wheels' for the next Advance only (no
