@@ -6,7 +6,9 @@
 // joints it drives. Engine types never leave the module.
 #pragma once
 
+#include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 
 namespace swarmsim {
@@ -70,6 +72,15 @@ class DynamicsBackend {
   // engine integrates (World::Actuate then skips them). Called after Build;
   // a backend that rebuilds itself in Step marks them again there.
   virtual void MarkSimulatedJoints(Scene* /*scene*/) const {}
+  // The scene's velocities of the shapes at `slots` were set between steps
+  // (World::SetVelocities: Python's World.set_velocities, robots' roots and
+  // the shapes on them). Returns true once the engine has taken them (the
+  // kinematic and planar backends: a robot moves at its velocity for the
+  // next step); false (the default) makes World build the engine again from
+  // the scene, which reads every body's velocity (box2d, ode).
+  virtual bool TakeVelocities(Scene* /*scene*/, std::span<const uint32_t> /*slots*/) {
+    return false;
+  }
   // Number of bodies the engine simulates (for summaries).
   virtual int body_count() const = 0;
 };

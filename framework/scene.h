@@ -369,6 +369,14 @@ class Scene {
     if (const uint32_t m = motion_[slot]; m != kNoMotion) motions_[m] = {v_WO, w_WO};
     simulated_[slot] = 1;
   }
+  // Sets the velocity of a shape (an object with a velocity) from outside the
+  // dynamics (World::SetVelocities); false, and nothing set, for any other object.
+  bool SetVelocityAt(uint32_t slot, const Vec3& v_WO, const Vec3& w_WO) {
+    const uint32_t m = motion_[slot];
+    if (m == kNoMotion) return false;
+    motions_[m] = {v_WO, w_WO};
+    return true;
+  }
   // Recomputes world poses top-down (the pose of each simulated body is kept
   // and its local pose derived from it).
   void UpdateWorldPoses();

@@ -693,6 +693,8 @@ uint64_t World::StateHash() const {
   for (size_t r = 0; r < runtimes_.size(); ++r)
     if (scene_.instances()[r].alive) h.Add(runtimes_[r].rng.state(), 4 * sizeof(uint64_t));
   h.Add(scene_runtime_.rng.state(), 4 * sizeof(uint64_t));
+  // Model parameters set after load (Python's set_param), only when there are.
+  if (!loaded_parameters_.empty()) HashWrittenParameters(&h);
   // What scripts left for the next step: signals and mail not yet delivered
   // (Messaging), custom data blocks.
   messaging_.HashState(&h);

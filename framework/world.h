@@ -11,6 +11,7 @@
 #include <deque>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <span>
@@ -257,6 +258,10 @@ class World final : public PhaseHandlers {
   const ParamValue* FindParameter(int instance, std::string_view name) const;
   // Sets the model parameters of a robot (call after the robot is created).
   void SetInstanceParameters(int instance, SharedParameters parameters);
+  // The same for a value set after load (Python's World.set_param): from
+  // then on the robot's parameters are part of the state hash and of
+  // snapshots (world_writes.cc). Worlds nobody writes to hash as before.
+  void WriteInstanceParameters(int instance, SharedParameters parameters);
   // Room for `robots` robots in all (a loader about to add many): their
   // per-robot state then grows without slack.
   void ReserveRobots(size_t robots);
@@ -287,6 +292,15 @@ class World final : public PhaseHandlers {
   // Hash of every object's pose and velocity, joint states, sensor
   // readings, random streams and time. Equal hashes, equal futures.
   uint64_t StateHash() const;
+
+  // Sets the velocities of robots between steps (Python's World.set_velocities;
+  // world_writes.cc): robot robots[i]'s root moves at v_W[i] (m/s) turning at
+  // w_W[i] (rad/s, world frame), and every shape on it with the same rigid
+  // motion. The dynamics backend takes them at the next step
+  // (DynamicsBackend::TakeVelocities). Throws swarmsim::Error, before
+  // setting anything, for a robot whose root is not a shape or that was removed.
+  void SetVelocities(std::span<const int> robots, std::span<const Vec3> v_W,
+                     std::span<const Vec3> w_W);
 
   // --- Snapshots (framework/world_state.h, world_state.cc) ---------------------------------
   // The world's state as bytes: restore + k steps gives the state of k more
@@ -465,6 +479,13 @@ class World final : public PhaseHandlers {
   void WriteFingerprint(StateWriter* out) const;
   void CheckFingerprint(StateReader* in) const;
   void RebuildDynamics();
+  // world_writes.cc: the parameters written after load, in the hash and in snapshots.
+  void HashWrittenParameters(StateHasher* hasher) const;
+  void SaveWrittenParameters(StateWriter* out) const;
+  void LoadWrittenParameters(StateReader* in);
+  // Robots whose parameters were written after load (WriteInstanceParameters),
+  // with their parameters as loaded (what a restore without them puts back).
+  std::map<int, SharedParameters> loaded_parameters_;
   // The world file's content hash, read at the first snapshot or restore
   // (0: no file, or unreadable).
   mutable uint64_t file_hash_ = 0;

@@ -21,7 +21,7 @@ namespace {
 
 // The bytes: magic, format version, payload size, payload checksum, payload.
 constexpr char kMagic[16] = "swarmsim-state";  // 14 characters and two zeros
-constexpr uint32_t kVersion = 1;
+constexpr uint32_t kVersion = 2;  // 2: the swarm devices' rows, parameters set after load
 constexpr size_t kHeaderBytes = sizeof kMagic + sizeof(uint32_t) + 2 * sizeof(uint64_t);
 
 uint64_t Checksum(std::string_view payload) { return XXH3_64bits(payload.data(), payload.size()); }
@@ -184,6 +184,7 @@ void World::RebuildDynamics() {
   dynamics_settings.gravity = settings_.gravity;
   dynamics_settings.partitions = settings_.physics_partitions;
   dynamics_settings.scheduler = scheduler_.get();
+  dynamics_settings.options = settings_.physics_options;  // as Start gives them
   dynamics_->Build(scene_, dynamics_settings);
   dynamics_->MarkSimulatedJoints(&scene_);
 }
@@ -210,6 +211,7 @@ std::string World::SaveState() {
   out.Put<uint64_t>(runtimes_.size());
   for (const RobotRuntime& rt : runtimes_) out.PutBytes(rt.rng.state(), sizeof(Rng));
   out.PutBytes(scene_runtime_.rng.state(), sizeof(Rng));
+  SaveWrittenParameters(&out);
   out.Put<uint64_t>(metrics_.size());
   for (const MetricSample& m : metrics_) {
     out.Put(m.step);
@@ -274,6 +276,7 @@ void World::RestoreState(std::string_view bytes, const Reseed* reseed) {
     in.Expect(in.Get<uint64_t>(), runtimes_.size(), "the number of robot random streams");
     for (RobotRuntime& rt : runtimes_) in.GetBytes(&rt.rng, sizeof(Rng));
     in.GetBytes(&scene_runtime_.rng, sizeof(Rng));
+    LoadWrittenParameters(&in);
     if (reseed != nullptr) {
       // As EnsureRuntimes and the loader make them for that seed.
       if (step_count_ != 0) in.Fail("a reseed needs a snapshot of a world that has not stepped");

@@ -7,9 +7,13 @@
 // What a snapshot holds, and what it refuses (the design, README.md
 // "Snapshots"):
 // - exactly what the world owns: time and step, the seed, every object's
-//   poses and velocities, each type's changing rows (through its hooks),
-//   custom data, the random streams, metric samples not yet taken, and each
-//   module's own state (through its hooks);
+//   poses and velocities, each type's changing rows (through its hooks: the
+//   swarm devices' too, what range-and-bearing boards and IR transceivers
+//   send and heard, light, LED and blob camera states and readings, ground
+//   sensors, paint nozzles), custom data, the random streams, model
+//   parameters set after load (World::WriteInstanceParameters), metric
+//   samples not yet taken, and each module's own state (through its hooks:
+//   the paint layer's painted pixels, covered_area's cells);
 // - the dynamics engine is not serialised: Box2D and ODE keep contact caches
 //   (warm starting) and broad-phase trees we cannot write out. Taking a
 //   snapshot rebuilds the engine from the scene (as a hybrid switch does),
@@ -21,7 +25,9 @@
 // - refused with an Error naming why: Lua scripts (a robot's or the
 //   world's), native controllers and plugin phase callbacks (their memory is
 //   not ours), messages or signals in flight, a type whose rows change but
-//   have no save hook, a module with no save hook.
+//   have no save hook (force sensors, paths, conveyors, mills, planning
+//   tasks, collision and distance objects, rendering lights), a module with
+//   no save hook (graphs, vision sensors, the video recorder).
 // The bytes carry a fingerprint of the world (the world file's content, its
 // settings, robot and object counts and names); restoring into another world,
 // or corrupt or truncated bytes, is an Error and leaves the world as it was.

@@ -58,6 +58,8 @@ void ColoredRobots(const World& world, std::vector<ColoredRobot>* out) {
 class SameColorNeighborFraction : public Observer {
  public:
   explicit SameColorNeighborFraction(int every) : every_(every) {}
+  // Snapshots: nothing kept between steps (the vectors are this step's).
+  bool SaveState(const World&, StateWriter*) const override { return true; }
   void Record(const World& world, std::vector<MetricSample>* out) override {
     if (world.step_count() % every_ != 0) return;
     ColoredRobots(world, &robots_);
@@ -100,6 +102,8 @@ class SameColorNeighborFraction : public Observer {
 class ColorDispersion : public Observer {
  public:
   explicit ColorDispersion(int every) : every_(every) {}
+  // Snapshots: nothing kept between steps.
+  bool SaveState(const World&, StateWriter*) const override { return true; }
   void Record(const World& world, std::vector<MetricSample>* out) override {
     if (world.step_count() % every_ != 0) return;
     ColoredRobots(world, &robots_);

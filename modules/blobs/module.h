@@ -28,8 +28,9 @@ void RegisterColorMetrics(ModuleRegistry* registry);
 // Also the plugins' set_led (framework/device_access.h).
 class BlobCameraModule final : public Module, public LedAccess {
  public:
-  // Snapshots (framework/world_state.h): its objects' rows (no save_rows) make
-  // World::SaveState refuse while the world has any; without them it is idle.
+  // Snapshots (framework/world_state.h): nothing to save here: the LEDs' and cameras' rows
+  // (objects.cc) hold every state a step carries to the next; the indexes above are rebuilt each
+  // sense phase.
   bool SaveState(const World&, StateWriter*) const override { return true; }
   void Sense(World* world) override;
   int SetLed(Scene* scene, int robot, ObjectId id, const Vec3& color,

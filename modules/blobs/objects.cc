@@ -7,6 +7,7 @@
 #include "framework/registry.h"
 #include "framework/scene.h"
 #include "framework/state_hash.h"
+#include "framework/world_state.h"
 #include "modules/blobs/blob_camera.h"
 #include "modules/blobs/blobs.h"
 #include "modules/blobs/leds.h"
@@ -119,6 +120,36 @@ void HashCameras(const Scene& scene, ObjectType type, StateHasher* h) {
   }
 }
 
+// Snapshots: an LED's colour and switch (what scripts and plugins change), a
+// camera's switch and what it saw (what HashLeds and HashCameras add).
+void SaveLeds(const Scene& scene, ObjectType type, StateWriter* out) {
+  for (const LedRow& led : scene.rows<LedRow>(type).rows) {
+    out->Put(led.color);
+    out->Put<uint8_t>(led.on);
+  }
+}
+void LoadLeds(Scene* scene, ObjectType type, StateReader* in) {
+  for (LedRow& led : scene->rows<LedRow>(type).rows) {
+    led.color = in->Get<Vec3>();
+    led.on = in->GetBool();
+  }
+}
+static_assert(sizeof(Blob) == 56, "no padding: written as bytes");
+void SaveCameras(const Scene& scene, ObjectType type, StateWriter* out) {
+  for (const BlobCameraRow& c : scene.rows<BlobCameraRow>(type).rows) {
+    out->Put<uint8_t>(c.enabled);
+    out->Put<uint64_t>(c.blobs.size());
+    out->PutBytes(c.blobs.data(), c.blobs.size() * sizeof(Blob));
+  }
+}
+void LoadCameras(Scene* scene, ObjectType type, StateReader* in) {
+  for (BlobCameraRow& c : scene->rows<BlobCameraRow>(type).rows) {
+    c.enabled = in->GetBool();
+    c.blobs.resize(in->GetCount(sizeof(Blob)));
+    in->GetBytes(c.blobs.data(), c.blobs.size() * sizeof(Blob));
+  }
+}
+
 // Drawn as a light: glowing in its colour while on (and not black).
 void LedVisual(const Scene& scene, ObjectType type, uint32_t row, ObjectVisual* out) {
   const LedRow& led = scene.rows<LedRow>(type).rows[row];
@@ -141,6 +172,8 @@ std::shared_ptr<const ObjectTypeDescriptor> LedType() {
   t->read = ReadLed;
   t->register_lua = RegisterBlobsApi;
   t->visual = LedVisual;
+  t->save_rows = SaveLeds;
+  t->load_rows = LoadLeds;
   return t;
 }
 
@@ -157,6 +190,8 @@ std::shared_ptr<const ObjectTypeDescriptor> CameraType() {
   t->hash_rows = HashCameras;
   t->keys = kCameraKeys;
   t->read = ReadCamera;
+  t->save_rows = SaveCameras;
+  t->load_rows = LoadCameras;
   return t;
 }
 

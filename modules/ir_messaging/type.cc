@@ -7,6 +7,7 @@
 #include "framework/registry.h"
 #include "framework/scene.h"
 #include "framework/state_hash.h"
+#include "framework/world_state.h"
 #include "modules/ir_messaging/ir_messaging.h"
 #include "modules/ir_messaging/module.h"
 
@@ -86,6 +87,41 @@ void Hash(const Scene& scene, ObjectType type, StateHasher* h) {
   }
 }
 
+// Snapshots: what each transceiver has queued, whether it sent, and what
+// it heard (with the payload offsets the readers use), as Hash adds them.
+static_assert(sizeof(IrReceived) == 24, "no padding: written as bytes");
+void Save(const Scene& scene, ObjectType type, StateWriter* out) {
+  for (const IrTransceiverRow& ir : scene.rows<IrTransceiverRow>(type).rows) {
+    out->Put<uint8_t>(ir.queued);
+    out->Put<uint8_t>(ir.sent);
+    out->Put<uint64_t>(ir.outgoing.size());
+    out->PutBytes(ir.outgoing.data(), ir.outgoing.size());
+    out->Put<uint64_t>(ir.inbox.size());
+    out->PutBytes(ir.inbox.data(), ir.inbox.size() * sizeof(IrReceived));
+    out->Put<uint64_t>(ir.received.size());
+    out->PutBytes(ir.received.data(), ir.received.size());
+  }
+}
+
+void Load(Scene* scene, ObjectType type, StateReader* in) {
+  for (IrTransceiverRow& ir : scene->rows<IrTransceiverRow>(type).rows) {
+    ir.queued = in->GetBool();
+    ir.sent = in->GetBool();
+    ir.outgoing.resize(in->GetCount(1));
+    in->GetBytes(ir.outgoing.data(), ir.outgoing.size());
+    if (ir.outgoing.size() > ir.settings->payload_size)
+      in->Fail("an IR message of " + std::to_string(ir.outgoing.size()) +
+               " bytes, more than its transceiver's payload_size");
+    ir.inbox.resize(in->GetCount(sizeof(IrReceived)));
+    in->GetBytes(ir.inbox.data(), ir.inbox.size() * sizeof(IrReceived));
+    ir.received.resize(in->GetCount(1));
+    in->GetBytes(ir.received.data(), ir.received.size());
+    for (const IrReceived& m : ir.inbox)
+      if (m.data_offset > ir.received.size() || m.data_size > ir.received.size() - m.data_offset)
+        in->Fail("an IR message's bytes lie outside the bytes received");
+  }
+}
+
 // Drawn as a small disc (1.5 cm across, 2 mm high): red when its message
 // went out, green when it heard one, grey otherwise.
 void Visual(const Scene& scene, ObjectType type, uint32_t row, ObjectVisual* out) {
@@ -121,6 +157,8 @@ constinit const ObjectTypeDescriptor kIrTransceiverType{
     .register_lua = RegisterIrMessagingApi,
     .visual = Visual,
     .links = Links,
+    .save_rows = Save,
+    .load_rows = Load,
 };
 
 }  // namespace

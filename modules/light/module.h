@@ -32,8 +32,9 @@ void RegisterLightApi(lua_State* L);
 // Also the plugins' read_sensor_value for light sensors (framework/device_access.h).
 class LightSensingModule final : public Module, public SensorValueAccess {
  public:
-  // Snapshots (framework/world_state.h): its objects' rows (no save_rows) make
-  // World::SaveState refuse while the world has any; without them it is idle.
+  // Snapshots (framework/world_state.h): nothing to save here: the sources' and sensors' rows
+  // (objects.cc) hold every state a step carries to the next; the indexes above are rebuilt each
+  // sense phase.
   bool SaveState(const World&, StateWriter*) const override { return true; }
   void Sense(World* world) override;
   int ReadValue(const Scene& scene, ObjectId id, double* value) const noexcept override;

@@ -7,6 +7,7 @@
 #include "framework/registry.h"
 #include "framework/scene.h"
 #include "framework/state_hash.h"
+#include "framework/world_state.h"
 #include "modules/light/light.h"
 #include "modules/light/module.h"
 
@@ -106,6 +107,26 @@ void HashSensors(const Scene& scene, ObjectType type, StateHasher* h) {
   }
 }
 
+// Snapshots: what HashSources and HashSensors add.
+void SaveSources(const Scene& scene, ObjectType type, StateWriter* out) {
+  for (const LightSourceRow& l : scene.rows<LightSourceRow>(type).rows) {
+    out->Put(l.intensity);
+    out->Put<uint8_t>(l.on);
+  }
+}
+void LoadSources(Scene* scene, ObjectType type, StateReader* in) {
+  for (LightSourceRow& l : scene->rows<LightSourceRow>(type).rows) {
+    l.intensity = in->Get<double>();
+    l.on = in->GetBool();
+  }
+}
+void SaveSensors(const Scene& scene, ObjectType type, StateWriter* out) {
+  for (const LightSensorRow& l : scene.rows<LightSensorRow>(type).rows) out->Put(l.reading);
+}
+void LoadSensors(Scene* scene, ObjectType type, StateReader* in) {
+  for (LightSensorRow& l : scene->rows<LightSensorRow>(type).rows) l.reading = in->Get<double>();
+}
+
 // A glowing sphere in its colour while lit, dark otherwise.
 void SourceVisual(const Scene& scene, ObjectType type, uint32_t row, ObjectVisual* out) {
   const LightSourceRow& l = scene.rows<LightSourceRow>(type).rows[row];
@@ -125,6 +146,8 @@ constinit const ObjectTypeDescriptor kLightSourceType{
     .read = ReadSource,
     .register_lua = RegisterLightApi,
     .visual = SourceVisual,
+    .save_rows = SaveSources,
+    .load_rows = LoadSources,
 };
 
 constinit const ObjectTypeDescriptor kLightSensorType{
@@ -137,6 +160,8 @@ constinit const ObjectTypeDescriptor kLightSensorType{
     .keys = kSensorKeys,
     .read = ReadSensor,
     .register_lua = RegisterLightApi,
+    .save_rows = SaveSensors,
+    .load_rows = LoadSensors,
 };
 
 }  // namespace

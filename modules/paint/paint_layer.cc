@@ -7,6 +7,7 @@
 #include "framework/error.h"
 #include "framework/scene.h"
 #include "framework/scheduler.h"
+#include "framework/world_state.h"
 #include "modules/paint/png_io.h"
 
 namespace swarmsim::paint {
@@ -40,29 +41,78 @@ PaintLayer::PaintLayer(World* world, const PaintSettings& settings)
   const size_t n = static_cast<size_t>(width_) * static_cast<size_t>(height_);
   painted_.assign(n, 0);
   rgb_.resize(3 * n);
-  const uint8_t bg[3] = {ToByte(settings_.background.x), ToByte(settings_.background.y),
-                         ToByte(settings_.background.z)};
-  for (size_t p = 0; p < n; ++p)
-    std::copy(bg, bg + 3, rgb_.begin() + static_cast<ptrdiff_t>(3 * p));
   // Over a floor: each pixel starts as the floor's colour at its centre.
-  if (const FloorLayer* floor = world_->floor_layer()) {
-    const FloorArea area = floor->floor_area();
-    const std::span<const uint8_t> floor_rgb = floor->floor_rgb();
+  floor_ = world_->floor_layer();
+  if (floor_ != nullptr) {
+    const FloorArea area = floor_->floor_area();
     floor_marked_.assign(n, 0);
     for (int row = 0; row < height_; ++row)
       for (int col = 0; col < width_; ++col) {
         const Vec3 c = PixelCentre(col, row);
         const int64_t pixel = FloorPixelAt(area, c.x, c.y);
-        if (pixel < 0 || !floor->floor_marked(static_cast<int>(pixel % area.width),
-                                              static_cast<int>(pixel / area.width)))
+        if (pixel < 0 || !floor_->floor_marked(static_cast<int>(pixel % area.width),
+                                               static_cast<int>(pixel / area.width)))
           continue;  // the floor's background there: ours
-        const size_t p = static_cast<size_t>(row) * width_ + col;
-        std::copy(&floor_rgb[3 * pixel], &floor_rgb[3 * pixel] + 3,
-                  rgb_.begin() + static_cast<ptrdiff_t>(3 * p));
-        floor_marked_[p] = 1;
+        floor_marked_[static_cast<size_t>(row) * width_ + col] = 1;
       }
   }
+  for (size_t p = 0; p < n; ++p) StartColor(p, &rgb_[3 * p]);
   world_->set_floor_layer(this);
+}
+
+void PaintLayer::StartColor(size_t p, uint8_t out[3]) const {
+  if (!floor_marked_.empty() && floor_marked_[p] != 0) {
+    const FloorArea area = floor_->floor_area();
+    const Vec3 c = PixelCentre(static_cast<int>(p % width_), static_cast<int>(p / width_));
+    const int64_t pixel = FloorPixelAt(area, c.x, c.y);
+    std::copy_n(&floor_->floor_rgb()[3 * pixel], 3, out);
+    return;
+  }
+  out[0] = ToByte(settings_.background.x);
+  out[1] = ToByte(settings_.background.y);
+  out[2] = ToByte(settings_.background.z);
+}
+
+bool PaintLayer::SaveState(const World&, StateWriter* out) const {
+  // Runs of painted pixels: (first, count), then their RGB.
+  const size_t n = painted_.size();
+  std::vector<std::pair<uint32_t, uint32_t>> runs;
+  for (size_t p = 0; p < n;) {
+    if (painted_[p] == 0) {
+      ++p;
+      continue;
+    }
+    const size_t first = p;
+    while (p < n && painted_[p] != 0) ++p;
+    runs.emplace_back(static_cast<uint32_t>(first), static_cast<uint32_t>(p - first));
+  }
+  out->Put<uint64_t>(runs.size());
+  for (const auto& [first, count] : runs) {
+    out->Put(first);
+    out->Put(count);
+    out->PutBytes(&rgb_[3 * size_t{first}], 3 * size_t{count});
+  }
+  return true;
+}
+
+void PaintLayer::LoadState(StateReader* in, World*) {
+  const size_t n = painted_.size();
+  for (size_t p = 0; p < n; ++p)
+    if (painted_[p] != 0) {
+      painted_[p] = 0;
+      StartColor(p, &rgb_[3 * p]);
+    }
+  const uint64_t runs = in->GetCount(2 * sizeof(uint32_t));
+  size_t end = 0;  // runs come in order and do not touch
+  for (uint64_t i = 0; i < runs; ++i) {
+    const auto first = in->Get<uint32_t>();
+    const auto count = in->Get<uint32_t>();
+    if (first < end || count == 0 || count > n - std::min<size_t>(first, n))
+      in->Fail("a run of painted pixels outside the paint layer or out of order");
+    in->GetBytes(&rgb_[3 * size_t{first}], 3 * size_t{count});
+    std::fill_n(painted_.begin() + first, count, uint8_t{1});
+    end = size_t{first} + count + 1;
+  }
 }
 
 PaintLayer::~PaintLayer() {

@@ -62,6 +62,11 @@ class PaintLayer final : public Observer, public FloorLayer {
   }
 
   void Record(const World& world, std::vector<MetricSample>* out) override;
+  // Snapshots (framework/world_state.h): the painted pixels and their
+  // colours, as runs; LoadState returns the other pixels to the floor (or
+  // the background) they started from.
+  bool SaveState(const World& world, StateWriter* out) const override;
+  void LoadState(StateReader* in, World* world) override;
   // Writes paint.png into `dir`.
   void WriteOutputs(const std::filesystem::path& dir) const override;
   void ListOutputs(std::vector<OutputFile>* out) const override;
@@ -84,6 +89,8 @@ class PaintLayer final : public Observer, public FloorLayer {
   const Rows<PaintNozzleData>& Nozzles(const Scene& scene) const;
   void Stamp(const Scene& scene, uint32_t slot, std::vector<Stroke>* out) const;
   void Apply(std::vector<Stroke>* strokes);
+  // The colour pixel p started with: the floor's under its centre, or the background.
+  void StartColor(size_t p, uint8_t out[3]) const;
 
   World* world_;
   PaintSettings settings_;
@@ -91,6 +98,7 @@ class PaintLayer final : public Observer, public FloorLayer {
   std::vector<uint8_t> rgb_;                        // (height x width x 3)
   std::vector<uint8_t> painted_;                    // (height x width)
   std::vector<uint8_t> floor_marked_;               // (height x width), empty without a floor
+  const FloorLayer* floor_ = nullptr;               // the floor it started from, if any
   const Rows<PaintNozzleData>* nozzles_ = nullptr;  // the scene's, since the last Record
   uint64_t nozzles_version_ = ~uint64_t{0};
   std::vector<std::vector<uint32_t>> robot_nozzles_;  // nozzle slots per robot (robots)

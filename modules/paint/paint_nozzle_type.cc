@@ -1,6 +1,8 @@
 // paint_nozzle: marks the floor paint layer under it each step while enabled
 // (modules/paint).
 #include "framework/object_type.h"
+#include "framework/scene.h"
+#include "framework/world_state.h"
 #include "modules/paint/paint_nozzle.h"
 #include "modules/paint/paint_type.h"
 
@@ -32,6 +34,21 @@ void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
   if (r.Has("enabled")) n.enabled = r.Bool("enabled");
 }
 
+// Snapshots: what scripts change (sim.setPaintNozzle): colour and switch.
+void Save(const Scene& scene, ObjectType type, StateWriter* out) {
+  for (const PaintNozzleData& n : scene.rows<PaintNozzleData>(type).rows) {
+    out->Put(n.color);
+    out->Put<uint8_t>(n.enabled);
+  }
+}
+
+void Load(Scene* scene, ObjectType type, StateReader* in) {
+  for (PaintNozzleData& n : scene->rows<PaintNozzleData>(type).rows) {
+    n.color = in->Get<Vec3>();
+    n.enabled = in->GetBool();
+  }
+}
+
 }  // namespace
 
 constinit const ObjectTypeDescriptor kPaintNozzleType{
@@ -42,6 +59,8 @@ constinit const ObjectTypeDescriptor kPaintNozzleType{
     .keys = kKeys,
     .read = Read,
     .register_lua = RegisterPaintApi,
+    .save_rows = Save,
+    .load_rows = Load,
 };
 
 }  // namespace swarmsim::paint

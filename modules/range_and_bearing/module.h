@@ -31,8 +31,9 @@ void RegisterRangeAndBearingApi(lua_State* L);
 // Also the plugins' access to the boards (framework/range_and_bearing_access.h).
 class RangeAndBearingModule final : public Module, public RangeAndBearingAccess {
  public:
-  // Snapshots (framework/world_state.h): its objects' rows (no save_rows) make
-  // World::SaveState refuse while the world has any; without them it is idle.
+  // Snapshots (framework/world_state.h): nothing to save here: the boards' rows (type.cc: what they
+  // send and heard) hold every state a step carries to the next; the indexes above are rebuilt each
+  // sense phase.
   bool SaveState(const World&, StateWriter*) const override { return true; }
   void Sense(World* world) override;
   int SetData(Scene* scene, int robot, ObjectId id, const uint8_t* data,

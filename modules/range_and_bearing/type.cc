@@ -8,6 +8,7 @@
 #include "framework/registry.h"
 #include "framework/scene.h"
 #include "framework/state_hash.h"
+#include "framework/world_state.h"
 #include "modules/range_and_bearing/module.h"
 #include "modules/range_and_bearing/range_and_bearing.h"
 
@@ -104,6 +105,37 @@ void Hash(const Scene& scene, ObjectType type, StateHasher* h) {
   }
 }
 
+// Snapshots: what each board sends and what it heard, as Hash adds them
+// (the readings' payload offsets too, which the Lua and Python readers use).
+static_assert(sizeof(RangeAndBearingReading) == 40, "no padding: written as bytes");
+void Save(const Scene& scene, ObjectType type, StateWriter* out) {
+  for (const RangeAndBearingRow& rab : scene.rows<RangeAndBearingRow>(type).rows) {
+    out->Put<uint64_t>(rab.data.size());
+    out->PutBytes(rab.data.data(), rab.data.size());
+    out->Put<uint64_t>(rab.readings.size());
+    out->PutBytes(rab.readings.data(), rab.readings.size() * sizeof(RangeAndBearingReading));
+    out->Put<uint64_t>(rab.received.size());
+    out->PutBytes(rab.received.data(), rab.received.size());
+  }
+}
+
+void Load(Scene* scene, ObjectType type, StateReader* in) {
+  for (RangeAndBearingRow& rab : scene->rows<RangeAndBearingRow>(type).rows) {
+    rab.data.resize(in->GetCount(1));
+    in->GetBytes(rab.data.data(), rab.data.size());
+    if (rab.data.size() > rab.settings->payload_size)
+      in->Fail("a range-and-bearing board sends " + std::to_string(rab.data.size()) +
+               " bytes, more than its payload_size");
+    rab.readings.resize(in->GetCount(sizeof(RangeAndBearingReading)));
+    in->GetBytes(rab.readings.data(), rab.readings.size() * sizeof(RangeAndBearingReading));
+    rab.received.resize(in->GetCount(1));
+    in->GetBytes(rab.received.data(), rab.received.size());
+    for (const RangeAndBearingReading& r : rab.readings)
+      if (r.data_offset > rab.received.size() || r.data_size > rab.received.size() - r.data_offset)
+        in->Fail("a range-and-bearing reading's payload lies outside the bytes received");
+  }
+}
+
 // Drawn as a small puck (2 cm across, 1 cm high): green while it hears
 // another board, grey otherwise.
 void Visual(const Scene& scene, ObjectType type, uint32_t row, ObjectVisual* out) {
@@ -137,6 +169,8 @@ constinit const ObjectTypeDescriptor kRangeAndBearingType{
     .register_lua = RegisterRangeAndBearingApi,
     .visual = Visual,
     .links = Links,
+    .save_rows = Save,
+    .load_rows = Load,
 };
 
 }  // namespace

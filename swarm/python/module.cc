@@ -33,6 +33,7 @@
 #include "modules/builtin.h"
 #include "swarm/loader/world_loader.h"
 #include "swarm/python/arrays.h"
+#include "swarm/python/ir_arrays.h"
 #include "swarm/python/sensor_arrays.h"
 #include "swarm/python/snapshot.h"
 #include "swarm/python/writers.h"
@@ -93,8 +94,9 @@ class Robots {
   void Expire() {
     world_ = nullptr;
     layout_ = nullptr;
-    for (py::object* o : {&poses_, &velocities_, &proximity_, &proximity_values_, &ground_, &light_,
-                          &joint_positions_, &joint_velocities_, &range_and_bearing_})
+    for (py::object* o :
+         {&poses_, &velocities_, &proximity_, &proximity_values_, &ground_, &light_,
+          &joint_positions_, &joint_velocities_, &range_and_bearing_, &ir_messages_})
       *o = py::object();
   }
   int64_t count() const { return static_cast<int64_t>(L().robots.size()); }
@@ -142,6 +144,18 @@ class Robots {
   void set_range_and_bearing_data(const py::object& data) {
     SetRangeAndBearingData(&W().scene(), L(), data);
   }
+  // IR messages (ir_arrays.h): what each robot's only transceiver heard, and
+  // messages it sends at the next sense phase.
+  py::object ir_messages() {
+    return Cached(&ir_messages_, [&] {
+      return IrMessages(Sc(), IrTransceivers(Sc(), L(), "", nullptr), py::none());
+    });
+  }
+  void send_ir_messages(const py::object& data, const py::object& send) {
+    std::vector<std::string> who;
+    const auto slots = IrTransceivers(Sc(), L(), "", &who);
+    SendIrMessages(&W().scene(), slots, who, data, send);
+  }
   // A model parameter of every robot, as an array (numbers and booleans).
   Array param(const std::string& name) const { return ParamArray(W(), L(), name); }
   std::string repr() const {
@@ -176,7 +190,7 @@ class Robots {
   bool planar_;
   int64_t step_;
   py::object poses_, velocities_, proximity_, proximity_values_, ground_, light_, joint_positions_,
-      joint_velocities_, range_and_bearing_;
+      joint_velocities_, range_and_bearing_, ir_messages_;
 };
 
 struct ControllerConfig {
@@ -748,6 +762,12 @@ class PyWorld {
       return BlobCameras(s, DeviceColumnSlots(s, l, "blob_camera", sensor, "blob camera", nullptr));
     });
   }
+  py::dict ir_messages(const std::string& model, const std::string& transceiver,
+                       const py::object& out) {
+    return Read(model, [&](const Scene& s, const ModelLayout& l) {
+      return IrMessages(s, IrTransceivers(s, l, transceiver, nullptr), out);
+    });
+  }
   Array force_sensors(const std::string& model, const py::object& out) {
     return Read(model, [&](const Scene& s, const ModelLayout& l) {
       return ForceSensors(s, Devices(s, l, "force_sensor"), l.robots.size(), out);
@@ -776,6 +796,17 @@ class PyWorld {
     World& w = Live();
     SetRangeAndBearingData(&w.scene(), Layout(model), data);
   }
+  // Queues IR messages for the next sense phase (ir_arrays.h).
+  void send_ir_messages(const std::string& model, const py::object& data, const py::object& send,
+                        const std::string& transceiver) {
+    NotWritingFromController("send_ir_messages()");
+    GateLock lock(gate_.get());
+    World& w = Live();
+    const ModelLayout& layout = Layout(model);
+    std::vector<std::string> who;
+    const auto slots = IrTransceivers(w.scene(), layout, transceiver, &who);
+    SendIrMessages(&w.scene(), slots, who, data, send);
+  }
   // Sets joint targets of a model's robots from Python between steps.
   void set_joint_targets(const std::string& model, const py::object& targets) {
     NotWritingFromController("set_joint_targets()");
@@ -791,6 +822,13 @@ class PyWorld {
     World& w = Live();
     const ModelLayout& layout = Layout(model);
     Translate([&] { SetPoses(&w, layout, poses); });
+  }
+  void set_velocities(const std::string& model, const py::object& velocities) {
+    NotWritingFromController("set_velocities()");
+    GateLock lock(gate_.get());
+    World& w = Live();
+    const ModelLayout& layout = Layout(model);
+    Translate([&] { SetVelocities(&w, layout, velocities); });
   }
   void set_joint_states(const std::string& model, const py::object& values, int what) {
     NotWritingFromController(what == 0 ? "set_joint_positions()" : "set_joint_velocities()");
@@ -1087,6 +1125,14 @@ PYBIND11_MODULE(_swarmsim, m) {
       .def("set_range_and_bearing_data", &Robots::set_range_and_bearing_data, py::arg("data"),
            "Sets what each robot's first board sends from the next sense phase on: an (N, k)\n"
            "array of bytes 0..255, k at most the payload size. Raises ValueError.")
+      .def_property_readonly("ir_messages", &Robots::ir_messages,
+                             "What each robot's IR transceiver heard: a dict of flat arrays "
+                             "(see World.ir_messages).")
+      .def("send_ir_messages", &Robots::send_ir_messages, py::arg("data"),
+           py::arg("send") = py::none(),
+           "Queues row i of data ((N, k) bytes 0..255, k at most the payload size) as robot\n"
+           "i's IR message for the next sense phase; send: (N,) bools, which robots send\n"
+           "(None: all). Raises ValueError or TypeError, sending nothing.")
       .def("param", &Robots::param, py::arg("name"),
            "A model parameter of every robot: (N,) float64 (booleans 0/1). KeyError if the\n"
            "model has none of that name, TypeError for text.");
@@ -1216,6 +1262,15 @@ PYBIND11_MODULE(_swarmsim, m) {
           "blob_camera_names",
           [](PyWorld& w, const std::string& model) { return w.device_names(model, "blob_camera"); },
           py::arg("model") = "", "Blob cameras on each robot of the model.")
+      .def("ir_messages", &PyWorld::ir_messages, py::arg("model") = "", py::arg("transceiver") = "",
+           py::arg("out") = py::none(),
+           "What each robot's IR transceiver `transceiver` ('': its only one) heard in the\n"
+           "last sense phase, as flat arrays: {'offsets': (N+1,) int64, 'distance': (M,) m\n"
+           "(the receiver's estimate), 'sender': (M,) int64 sending robot or -1, 'size': (M,)\n"
+           "int64 bytes, 'data': (M, largest size) uint8 zero-padded, 'sent': (N,) bool (the\n"
+           "robot's own message went out)}; robot i's messages are rows offsets[i] to\n"
+           "offsets[i+1]-1, in arrival order. out=: a dict it returned before, whose arrays\n"
+           "are refilled where their shapes still fit (and replaced where not).")
       .def("blob_cameras", &PyWorld::blob_cameras, py::arg("model") = "", py::arg("sensor") = "",
            "What each robot's blob camera `sensor` ('': its only one) saw in the last sense\n"
            "phase: {'offsets': (N+1,) int64, 'color': (M, 3) RGB 0..1, 'distance': (M,) m,\n"
@@ -1254,6 +1309,14 @@ PYBIND11_MODULE(_swarmsim, m) {
            "kept) or (N, 7) x, y, z, qw, qx, qy, qz (normalised). The physics engine takes\n"
            "them at the next step (velocities kept by ode, zeroed by box2d). ValueError for\n"
            "shapes and values, TypeError for non-numbers, RuntimeError if closed or stepping.")
+      .def("set_velocities", &PyWorld::set_velocities, py::arg("model"), py::arg("velocities"),
+           "Sets the robots' velocities, world frame: (N, 6) vx, vy, vz (m/s), wx, wy, wz\n"
+           "(rad/s) or (N, 3) vx, vy, wz (vz, wx, wy kept), as velocities() reads them; every\n"
+           "shape on a robot gets the same rigid motion. box2d and ode take them as the\n"
+           "bodies' velocities at the next step (friction and motors act from there);\n"
+           "kinematic and planar move the robot at them for the next step only (no inertia).\n"
+           "ValueError for shapes, values not finite or robots without a body, TypeError for\n"
+           "non-numbers, RuntimeError if closed or stepping.")
       .def(
           "set_joint_positions",
           [](PyWorld& w, const std::string& model, const py::object& v) {
@@ -1273,8 +1336,17 @@ PYBIND11_MODULE(_swarmsim, m) {
           "joint_velocities() reads until the next step; motors follow their targets).")
       .def("set_param", &PyWorld::set_param, py::arg("model"), py::arg("name"), py::arg("values"),
            "Sets a model parameter of every robot of `model`: one number or (N,) array\n"
-           "(booleans: 0 or 1). Scripts and controllers read it from then on. ValueError for\n"
-           "an unknown parameter (the message lists them) or a shape, TypeError for text.")
+           "(booleans: 0 or 1). Scripts and controllers read it from then on; the state hash\n"
+           "and snapshots hold it. ValueError for an unknown parameter (the message lists\n"
+           "them) or a shape, TypeError for text.")
+      .def("send_ir_messages", &PyWorld::send_ir_messages, py::arg("model"), py::arg("data"),
+           py::arg("send") = py::none(), py::arg("transceiver") = "",
+           "Queues row i of data ((N, k) bytes 0..255, k from 1 to the payload size) as\n"
+           "robot i's IR message (its transceiver `transceiver`, '': its only one) for the\n"
+           "next sense phase, for the robots whose send ((N,) bools; None: all) is true.\n"
+           "The module then decides who hears it (range, carrier sense, collisions, loss).\n"
+           "ValueError for shapes, values or sizes, TypeError for non-integers (nothing is\n"
+           "queued then), RuntimeError if closed or stepping.")
       .def("set_range_and_bearing_data", &PyWorld::set_range_and_bearing_data, py::arg("model"),
            py::arg("data"),
            "Sets what each robot's first board sends from the next sense phase on: (N, k)\n"

@@ -168,6 +168,34 @@ void SetPoses(World* world, const ModelLayout& layout, const py::object& poses) 
   for (size_t i = 0; i < n; ++i) scene.SetWorldPose(scene.IdAt(layout.root_slots[i]), out[i]);
 }
 
+void SetVelocities(World* world, const ModelLayout& layout, const py::object& velocities) {
+  Scene& scene = world->scene();
+  const size_t n = layout.robots.size();
+  const Array a = Table(velocities, n, {3, 6}, "set_velocities",
+                        "(N, 3) vx, vy, wz or (N, 6) vx, vy, vz, wx, wy, wz");
+  const size_t columns = static_cast<size_t>(a.shape(1));
+  const double* d = a.data();
+  std::vector<Vec3> v(n), w(n);
+  for (size_t i = 0; i < n; ++i) {
+    const double* r = d + i * columns;
+    for (size_t c = 0; c < columns; ++c)
+      if (!std::isfinite(r[c]) || std::abs(r[c]) > kMaxCoordinate)
+        throw WriteError(false, "set_velocities: the velocity of robot '" +
+                                    RobotName(scene, layout, i) +
+                                    "' is not a finite number within +-1e6 (m/s, rad/s)");
+    const uint32_t root = layout.root_slots[i];
+    if (columns == 3) {
+      // vx, vy and the turn about z set; the rest kept.
+      v[i] = scene.linear_velocity_at(root), w[i] = scene.angular_velocity_at(root);
+      v[i].x = r[0], v[i].y = r[1], w[i].z = r[2];
+    } else {
+      v[i] = {r[0], r[1], r[2]};
+      w[i] = {r[3], r[4], r[5]};
+    }
+  }
+  world->SetVelocities(layout.robots, v, w);
+}
+
 void SetJointStates(World* world, const ModelLayout& layout, int what, const py::object& values) {
   Scene& scene = world->scene();
   const size_t n = layout.robots.size(), joints = layout.joint_names.size();
@@ -256,7 +284,7 @@ void SetParam(World* world, const ModelLayout& layout, const std::string& name,
       (*copy)[name] = next[i];
       mine = std::move(copy);
     }
-    world->SetInstanceParameters(robot, mine);
+    world->WriteInstanceParameters(robot, mine);  // hashed and saved from now on
   }
 }
 

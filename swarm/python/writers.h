@@ -40,6 +40,11 @@ void SetJointTargets(Scene* scene, const ModelLayout& layout, const JointTargets
 // z, qw, qx, qy, qz; the quaternion normalised). The dynamics backend
 // teleports the bodies at the next step.
 void SetPoses(World* world, const ModelLayout& layout, const py::object& poses);
+// Robots' velocities: N x 6 (vx, vy, vz m/s, wx, wy, wz rad/s, world
+// frame) or N x 3 (vx, vy, wz: vz, wx, wy kept), as set_poses' two forms.
+// The root and every shape on it get the rigid motion; the dynamics backend
+// takes them at the next step (World::SetVelocities).
+void SetVelocities(World* world, const ModelLayout& layout, const py::object& velocities);
 // Joint positions (what = 0) or velocities (1), N x joints, of joints
 // nothing simulates (the dynamics backend's own joints are refused).
 void SetJointStates(World* world, const ModelLayout& layout, int what, const py::object& values);

@@ -14,6 +14,7 @@ import swarmsim
 from common import ROOT, world
 
 SNAPSHOT_WORLD = str(ROOT / "tests" / "data" / "worlds" / "snapshot.yaml")
+DEVICES_WORLD = str(ROOT / "tests" / "data" / "worlds" / "snapshot_devices.yaml")
 BACKENDS = ["kinematic", "planar", "box2d", "ode"]
 
 
@@ -61,6 +62,61 @@ class SnapshotTest(unittest.TestCase):
                     w.restore(state)
                     w.step(41 - at)
                     self.assertEqual(w.state_hash(), hashes[41])
+
+    def test_swarm_devices_come_back_with_their_readings(self):
+        # Robots with a range-and-bearing board, an IR transceiver, a light sensor and a
+        # light, an LED and a blob camera, a ground sensor and a paint nozzle, driven from
+        # Python between steps; every reading an observation holds must come back.
+        def drive(w):
+            n, k = 12, w.steps
+            i = np.arange(n)
+            mode = (i + k // 6) % 3
+            left = np.where(mode == 2, -2.0, 4.0)
+            right = np.where(mode == 1, -2.0, 4.0)
+            w.set_joint_targets("devicebot", {"leftMotor": left, "rightMotor": right})
+            w.set_range_and_bearing_data("devicebot", np.stack([i, np.full(n, k % 256), (i * k) % 256], 1))
+            w.send_ir_messages("devicebot", np.stack([i, np.full(n, k % 256)], 1), send=(i + k) % 2 == 0)
+
+        def readings(w):
+            out = {"poses": w.poses(), "light": w.light("devicebot"), "ground": w.ground("devicebot")}
+            for name, d in (("rab", w.range_and_bearing("devicebot")), ("ir", w.ir_messages("devicebot")),
+                            ("blobs", w.blob_cameras("devicebot"))):
+                for key, a in d.items():
+                    out[name + "." + key] = a
+            return out
+
+        def same(a, b, why):
+            self.assertEqual(a.keys(), b.keys())
+            for key in a:
+                np.testing.assert_array_equal(a[key], b[key], err_msg=f"{why}: {key}")
+
+        for physics in ("kinematic", "box2d"):
+            with self.subTest(physics=physics):
+                w = swarmsim.World(DEVICES_WORLD, set={"physics": physics}, threads=2)
+                for _ in range(8):
+                    drive(w)
+                    w.step()
+                state = w.snapshot()
+                at = readings(w)
+                later = {}
+                for k in (1, 6, 15):
+                    while w.steps < 8 + k:
+                        drive(w)
+                        w.step()
+                    later[k] = (w.state_hash(), readings(w))
+                # Not trivial: messages heard and blobs seen.
+                self.assertGreater(later[15][1]["rab.offsets"][-1], 0)
+                self.assertGreater(later[15][1]["ir.offsets"][-1], 0)
+                self.assertGreater(later[15][1]["blobs.offsets"][-1], 0)
+                r = swarmsim.World(DEVICES_WORLD, set={"physics": physics}, threads=1)
+                r.restore(state)
+                same(readings(r), at, "restored")
+                for k, (h, expected) in later.items():
+                    while r.steps < 8 + k:
+                        drive(r)
+                        r.step()
+                    self.assertEqual(r.state_hash(), h, f"{physics}, k = {k}")
+                    same(readings(r), expected, f"{physics}, k = {k}")
 
     def test_pickling_goes_through_the_snapshot(self):
         for physics in ("box2d", "ode"):

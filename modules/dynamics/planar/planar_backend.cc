@@ -33,9 +33,16 @@ class PlanarBackend final : public DynamicsBackend {
     // Advance cuts it where a body would move too far (planar_backend.h).
     const double duration = dt * substeps;
     world_->SyncFromScene(*scene);
-    world_->ReadCommands(*scene);
+    world_->ReadCommands(*scene, duration);
     world_->Advance(duration);
+    world_->EndPushes();
     world_->WriteBack(scene, duration);
+  }
+
+  bool TakeVelocities(Scene* scene, std::span<const uint32_t> slots) override {
+    if (!world_ || scene->structure_version() != built_version_) return false;  // Build reads
+    world_->Push(*scene, slots);
+    return true;
   }
 
   void HashState(StateHasher* hasher) const override {

@@ -326,7 +326,7 @@ void PlanarWorld::SyncFromScene(const Scene& scene) {
   }
 }
 
-void PlanarWorld::ReadCommands(const Scene& scene) {
+void PlanarWorld::ReadCommands(const Scene& scene, double duration) {
   max_speed_ratio_ = 0;
   const auto joints = scene.joints();
   for (uint32_t b : wheeled_) {
@@ -349,6 +349,42 @@ void PlanarWorld::ReadCommands(const Scene& scene) {
     const double speed = std::hypot(vx, vy) + std::abs(w) * bound_[b];
     max_speed_ratio_ = std::max(max_speed_ratio_, speed / (options_.max_move_fraction * inner_[b]));
   }
+  // Velocities set from outside, in the body's frame, on top of its wheels'.
+  // A body turning at w moves along an arc (Advance): the world velocity is
+  // turned to the arc's chord, half the turn on (and lengthened by
+  // (t/2) / sin(t/2)), so that it ends at p + v duration.
+  for (const PushedBody& p : pushes_) {
+    const uint32_t b = p.body;
+    const PlaneShape& shape = shapes_[b];
+    const bool wheeled = cold_[b].wheel_count > 0;
+    const double half = 0.5 * p.w * duration;
+    const double stretch = half != 0 ? half / std::sin(half) : 1.0;
+    const double c = std::cos(half), s = std::sin(half);
+    const double vx = stretch * (c * p.vx + s * p.vy), vy = stretch * (-s * p.vx + c * p.vy);
+    v_x_[b] = (wheeled ? v_x_[b] : 0) + shape.c * vx + shape.s * vy;
+    v_y_[b] = (wheeled ? v_y_[b] : 0) - shape.s * vx + shape.c * vy;
+    w_[b] = (wheeled ? w_[b] : 0) + p.w;
+    const double speed = std::hypot(v_x_[b], v_y_[b]) + std::abs(w_[b]) * bound_[b];
+    max_speed_ratio_ = std::max(max_speed_ratio_, speed / (options_.max_move_fraction * inner_[b]));
+  }
+}
+
+void PlanarWorld::Push(const Scene& scene, std::span<const uint32_t> slots) {
+  std::vector<uint8_t> listed(scene.slot_count(), 0);
+  for (const uint32_t slot : slots) listed[slot] = 1;
+  pushes_.clear();
+  for (uint32_t b = 0; b < cold_.size(); ++b) {
+    const uint32_t slot = cold_[b].slot;
+    if (listed[slot] == 0) continue;
+    const Vec3& v = scene.linear_velocity_at(slot);
+    pushes_.push_back({b, v.x, v.y, scene.angular_velocity_at(slot).z});
+  }
+}
+
+void PlanarWorld::EndPushes() {
+  for (const PushedBody& p : pushes_)
+    if (cold_[p.body].wheel_count == 0) v_x_[p.body] = v_y_[p.body] = w_[p.body] = 0;
+  pushes_.clear();
 }
 
 void PlanarWorld::RebuildPairs() {

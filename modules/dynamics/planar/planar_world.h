@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "framework/dynamics_backend.h"
@@ -49,8 +50,15 @@ class PlanarWorld {
   void Build(const Scene& scene);
   // Moves bodies whose scene pose was set from outside since the last write.
   void SyncFromScene(const Scene& scene);
-  // Each body's velocity from its wheels' commands.
-  void ReadCommands(const Scene& scene);
+  // Each body's velocity from its wheels' commands (and Push's, which the
+  // body then moves by exactly over `duration` s when nothing stops it).
+  void ReadCommands(const Scene& scene, double duration = 0);
+  // Velocities set from outside (World::SetVelocities) for the shapes at
+  // `slots`: each of them that is a body moves at its scene velocity (world
+  // frame, taken now) on top of its wheels' for the next Advance only (no
+  // inertia here); EndPushes, after that Advance, forgets them.
+  void Push(const Scene& scene, std::span<const uint32_t> slots);
+  void EndPushes();
   // Moves every body by its wheels for `duration` seconds and resolves the
   // overlaps, in internal steps small enough that nothing tunnels.
   void Advance(double duration);
@@ -69,6 +77,12 @@ class PlanarWorld {
   template <class F>
   void ForBodies(F&& body);
 
+  // A velocity set from outside for one step (Push).
+  struct PushedBody {  // 32 bytes
+    uint32_t body;
+    double vx, vy, w;  // world frame (m/s, rad/s)
+  };
+
   Options options_;
   DynamicsSettings settings_;
   // Bodies, slot order.
@@ -78,6 +92,7 @@ class PlanarWorld {
   std::vector<double> inner_;                          // inner radius, m (bodies)
   std::vector<double> inverse_mass_;                   // 1/kg (bodies)
   std::vector<double> v_x_, v_y_, w_;                  // commanded velocity, body frame (bodies)
+  std::vector<PushedBody> pushes_;                     // Push, until EndPushes (body order)
   std::vector<double> start_x_, start_y_, start_yaw_;  // at the start of Advance (bodies)
   std::vector<PlanarBodyCold> cold_;                   // (bodies)
   std::vector<PlanarWheel> wheels_;                    // grouped by body

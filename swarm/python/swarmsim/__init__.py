@@ -14,9 +14,10 @@ returns ``{joint name: array of one target per robot}``. See README.md, "Python"
 Many worlds at once: ``swarmsim.step_worlds([w1, w2, ...], n, threads=2)`` steps them in
 parallel, each ending exactly as stepping it alone would.
 
-Between steps Python may write state: ``set_poses``, ``set_joint_positions``,
-``set_joint_velocities``, ``set_joint_targets``, ``set_param``. Every sensor reads as
-an array: proximity, ground, light, range-and-bearing, vision images and depth, blob
+Between steps Python may write state: ``set_poses``, ``set_velocities``,
+``set_joint_positions``, ``set_joint_velocities``, ``set_joint_targets``, ``set_param``,
+``set_range_and_bearing_data``, ``send_ir_messages``. Every sensor reads as an array:
+proximity, ground, light, range-and-bearing, IR messages, vision images and depth, blob
 cameras, force sensors, distance and collision objects.
 
 ``w.snapshot()`` -> bytes and ``w.restore(bytes)`` save and restore the state (restore + k
