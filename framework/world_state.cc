@@ -48,6 +48,7 @@ void StateReader::GetBytes(void* out, size_t size) {
   if (size > remaining())
     Fail("truncated: " + std::to_string(size) + " more bytes needed at offset " +
          std::to_string(offset_) + ", " + std::to_string(remaining()) + " left");
+  if (size == 0) return;  // (an empty vector's data() may be null: no memcpy)
   std::memcpy(out, bytes_.data() + offset_, size);
   offset_ += size;
 }

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <array>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -18,6 +19,19 @@ struct CommandResult {
   int exit_code = -1;  // 128 + signal number when the command was killed
   std::string output;  // stdout and stderr together
 };
+
+// "ulimit -v KB; " for a shell command: an address-space cap, to show that
+// a program refuses input within modest memory. Empty under AddressSanitizer,
+// which reserves terabytes of address space for its shadow at start (the
+// cap would stop every program before main); the messages are still checked.
+inline std::string AddressSpaceLimit(int64_t kb) {
+#if defined(__SANITIZE_ADDRESS__)
+  (void)kb;
+  return "";
+#else
+  return "ulimit -v " + std::to_string(kb) + "; ";
+#endif
+}
 
 inline CommandResult RunCommand(const std::string& command) {
   CommandResult r;

@@ -182,7 +182,13 @@ OdeWorld::~OdeWorld() {
 void OdeWorld::Clear() {
   if (broken_) {
     // Unwound out of an ODE call: its space may still be locked and its
-    // destructors would assert again. The process ends with the run; leak.
+    // destructors would assert again. The process ends with the run; leak,
+    // kept reachable from a global so that leak checkers see a choice
+    // (LeakSanitizer reports only what nothing points to).
+    static auto* const unwound = new std::vector<const void*>;
+    unwound->insert(unwound->end(), {contacts_, space_, world_, threading_,
+                                     static_cast<const void*>(solver_threads_.get())});
+    for (const auto& [mesh, data] : meshes_) unwound->push_back(data);
     contacts_ = nullptr;
     space_ = nullptr;
     world_ = nullptr;

@@ -68,6 +68,8 @@ class LibavEncoder final : public FrameEncoder {
   }
   // Sends `f` (null: the end) to the encoder and writes what comes out.
   void Encode(const AVFrame* f);
+  void Open(const VideoSettings& settings);  // the constructor's work; throws
+  void Free();                               // what Open allocated, as far as it got
 
   std::string name_;  // the file, for messages
   VideoSettings settings_;
@@ -80,13 +82,16 @@ class LibavEncoder final : public FrameEncoder {
   bool finished_ = false;
 };
 
-LibavEncoder::~LibavEncoder() {
+LibavEncoder::~LibavEncoder() { Free(); }
+
+void LibavEncoder::Free() {
   av_packet_free(&packet_);
   av_frame_free(&frame_);
   avcodec_free_context(&codec_);
   if (format_ != nullptr) {
     if (format_->pb != nullptr) avio_closep(&format_->pb);
     avformat_free_context(format_);
+    format_ = nullptr;
   }
 }
 
@@ -106,6 +111,15 @@ void LibavEncoder::Encode(const AVFrame* f) {
 
 LibavEncoder::LibavEncoder(const std::string& path, const VideoSettings& settings)
     : name_(path), settings_(settings) {
+  try {
+    Open(settings);
+  } catch (...) {
+    Free();  // no destructor runs for a constructor that throws
+    throw;
+  }
+}
+
+void LibavEncoder::Open(const VideoSettings& settings) {
   av_log_set_level(AV_LOG_ERROR);  // no banner or per-file statistics on stderr
 
   int rc = avformat_alloc_output_context2(&format_, nullptr, "mp4", name_.c_str());

@@ -39,9 +39,9 @@ class MeshCliTest : public ::testing::Test {
                                           "  - {name: part, shape: mesh, file: "
                                        << file.filename().string() << "}\n";
     fs::remove_all(dir_ / "out");
-    return swarmsim::testing::RunCommand("cd " + dir_.string() + " && ulimit -v 2097152 && " + env +
-                                         " timeout 120 " + SWARMSIM_BINARY +
-                                         " run world.yaml --steps 1 --quiet --out out");
+    return swarmsim::testing::RunCommand(
+        "cd " + dir_.string() + " && " + swarmsim::testing::AddressSpaceLimit(2097152) + env +
+        " timeout 120 " + SWARMSIM_BINARY + " run world.yaml --steps 1 --quiet --out out");
   }
   // The run failed as bad input does: exit 2, `message` on stderr and in
   // out/summary.json (status error).

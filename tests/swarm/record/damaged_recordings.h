@@ -138,7 +138,7 @@ inline void SetHeaderField(std::string* bytes, uint64_t chunk_offset, int field_
 // the suite); `limit_kb`: its address space, if not 0.
 inline swarmsim::testing::CommandResult Swarmsim(const std::string& args, int limit_kb = 0) {
   std::string command = "timeout 60 " + std::string(SWARMSIM_BINARY) + " " + args;
-  if (limit_kb > 0) command = "ulimit -v " + std::to_string(limit_kb) + "; " + command;
+  if (limit_kb > 0) command = swarmsim::testing::AddressSpaceLimit(limit_kb) + command;
   return swarmsim::testing::RunCommand(command);
 }
 
