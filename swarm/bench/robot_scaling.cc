@@ -14,6 +14,7 @@
 
 #include "framework/error.h"
 #include "swarm/bench/bench.h"
+#include "swarm/bench/scaling.h"
 
 namespace swarmsim {
 namespace {
@@ -132,14 +133,7 @@ bool Plot(const std::vector<ScalingRow>& rows, const RobotScalingOptions& o, std
            << " title " << Quoted(order[i]);
   script << "\nunset multiplot\n";
   std::fflush(nullptr);
-  FILE* gp = popen("gnuplot 2>&1", "w");
-  const std::string text = script.str();
-  if (gp) fwrite(text.data(), 1, text.size(), gp);
-  const int status = gp ? pclose(gp) : -1;
-  if (status != 0) {
-    err << "bench: gnuplot failed or is missing (install gnuplot-nox); no plot\n";
-    return false;
-  }
+  if (!RunGnuplot(script.str(), err)) return false;
   out << "plot: " << o.plot << "\n";
   return true;
 }

@@ -129,14 +129,7 @@ bool PlotSpeedup(const std::map<std::string, std::vector<Point>>& series, int ma
   script << "plot ";
   for (size_t i = 0; i < plots.size(); ++i) script << (i ? ", " : "") << plots[i];
   script << "\n";
-  FILE* gp = popen("gnuplot 2>&1", "w");
-  const std::string text = script.str();
-  if (gp) fwrite(text.data(), 1, text.size(), gp);
-  const int status = gp ? pclose(gp) : -1;
-  if (status != 0) {
-    err << "bench: gnuplot failed or is missing (install gnuplot-nox); no plot\n";
-    return false;
-  }
+  if (!RunGnuplot(script.str(), err)) return false;
   out << "plot: " << plot << "\n";
   return true;
 }
@@ -189,6 +182,17 @@ int RunScalingBench(ScalingOptions o, std::ostream& out, std::ostream& err) {
   for (const Point& p : points) max_workers = std::max(max_workers, p.workers);
   ok = PlotSpeedup(series, max_workers, cores, o.plot, out, err) && ok;
   return ok ? 0 : 1;
+}
+
+bool RunGnuplot(const std::string& script, std::ostream& err) {
+  FILE* gp = popen("gnuplot 2>&1", "w");
+  if (gp) fwrite(script.data(), 1, script.size(), gp);
+  const int status = gp ? pclose(gp) : -1;
+  if (status != 0) {
+    err << "bench: gnuplot failed or is missing (install gnuplot-nox); no plot\n";
+    return false;
+  }
+  return true;
 }
 
 }  // namespace swarmsim

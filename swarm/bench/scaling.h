@@ -24,4 +24,8 @@ struct ScalingOptions {
 
 int RunScalingBench(ScalingOptions options, std::ostream& out, std::ostream& err);
 
+// Runs gnuplot on `script` (the plots of the bench commands); false, with a
+// line on `err`, when gnuplot is missing or fails.
+bool RunGnuplot(const std::string& script, std::ostream& err);
+
 }  // namespace swarmsim
