@@ -4,7 +4,6 @@
 
 #include <gtest/gtest.h>
 
-#include <regex>
 #include <string>
 
 #include "tests/swarm/run_program.h"
@@ -15,9 +14,12 @@ namespace {
 // The VERSION of CMakeLists.txt's project() line.
 std::string ProjectVersion() {
   const std::string cmake = testing::ReadFile(std::string(SWARMSIM_SOURCE_DIR) + "/CMakeLists.txt");
-  std::smatch m;
-  if (!std::regex_search(cmake, m, std::regex(R"(project\(swarmsim VERSION ([0-9.]+))"))) return "";
-  return m[1];
+  const std::string key = "project(swarmsim VERSION ";
+  const size_t at = cmake.find(key);
+  if (at == std::string::npos) return "";
+  const size_t begin = at + key.size();
+  const size_t end = cmake.find_first_not_of("0123456789.", begin);
+  return cmake.substr(begin, end == std::string::npos ? std::string::npos : end - begin);
 }
 
 TEST(VersionTest, IsTheProjectsVersion) {
