@@ -29,6 +29,9 @@ class LibavDecoder final : public FrameDecoder {
   std::string Next(Image* image, bool* decoded) override;
 
  private:
+  void Open();  // the constructor's work; throws
+  void Free();  // what Open allocated, as far as it got
+
   std::string name_;
   AVFormatContext* format_ = nullptr;
   AVCodecContext* codec_ = nullptr;
@@ -40,8 +43,11 @@ class LibavDecoder final : public FrameDecoder {
   bool draining_ = false;  // the file has ended; the decoder gives what it holds
 };
 
-LibavDecoder::~LibavDecoder() {
+LibavDecoder::~LibavDecoder() { Free(); }
+
+void LibavDecoder::Free() {
   sws_freeContext(sws_);
+  sws_ = nullptr;
   av_packet_free(&packet_);
   av_frame_free(&frame_);
   avcodec_free_context(&codec_);
@@ -49,6 +55,15 @@ LibavDecoder::~LibavDecoder() {
 }
 
 LibavDecoder::LibavDecoder(const std::string& path) : name_(path) {
+  try {
+    Open();
+  } catch (...) {
+    Free();  // no destructor runs for a constructor that throws
+    throw;
+  }
+}
+
+void LibavDecoder::Open() {
   av_log_set_level(AV_LOG_ERROR);
   const auto fail = [&](const std::string& what, int rc) {
     char text[AV_ERROR_MAX_STRING_SIZE] = {};
