@@ -380,6 +380,20 @@ def _fmt(values):
     return f"{values[0]:g}" if values.size == 1 else str(values.tolist())
 
 
+class _AgentsOfAModel:
+    """What both environments say of their agents' model (their `_core` holds it)."""
+
+    @property
+    def model(self):
+        """The name of the model whose robots are the agents."""
+        return self._core.model
+
+    @property
+    def joint_names(self):
+        """The joints the actions drive, in action order."""
+        return list(self._core.actions.joints)
+
+
 # --- The PettingZoo-style environment ----------------------------------------------------
 
 try:  # a subclass of PettingZoo's ParallelEnv when PettingZoo is installed
@@ -388,7 +402,7 @@ except ImportError:
     _ParallelBase = object
 
 
-class ParallelEnv(_ParallelBase):
+class ParallelEnv(_AgentsOfAModel, _ParallelBase):
     """Every robot of one model of a world is an agent; all act at once (PettingZoo's Parallel
     API: ``reset(seed=None, options=None) -> (observations, infos)``, ``step(actions) ->
     (observations, rewards, terminations, truncations, infos)``, dicts keyed by agent name).
@@ -428,16 +442,6 @@ class ParallelEnv(_ParallelBase):
     def world(self):
         """The swarmsim.World being stepped (read any array from it; do not step it)."""
         return self._core.slots[0].world
-
-    @property
-    def model(self):
-        """The name of the model whose robots are the agents."""
-        return self._core.model
-
-    @property
-    def joint_names(self):
-        """The joints the actions drive, in action order."""
-        return list(self._core.actions.joints)
 
     @property
     def num_agents(self):
@@ -582,7 +586,7 @@ except ImportError:
     NEXT_STEP = "NextStep"
 
 
-class VectorEnv(_VectorBase):
+class VectorEnv(_AgentsOfAModel, _VectorBase):
     """K copies of one world (K "environments"), each with the same N agents, as arrays:
     observations (K, N, D), actions (K, N, A), rewards, terminations and truncations (K, N).
     Gymnasium's vector conventions: ``reset(seed=None, options=None) -> (observations,
@@ -641,14 +645,6 @@ class VectorEnv(_VectorBase):
     def worlds(self):
         """The K swarmsim.World objects (read any array from them; do not step them)."""
         return [s.world for s in self._core.slots]
-
-    @property
-    def model(self):
-        return self._core.model
-
-    @property
-    def joint_names(self):
-        return list(self._core.actions.joints)
 
     @property
     def max_steps(self):
