@@ -86,11 +86,12 @@
 // plane_partition.h). With N > 1 the plane is cut into N strips across the
 // longer side of the bodies' bounding box at Build, borders placed so that
 // each strip holds the same number of body centres then (fixed until the
-// next rebuild; from the scene only, never from the thread count). Each strip
-// is its own Box2D world with the traction model above, owning the bodies
-// whose centre lies in it. `auto` (0): one strip per 250 bodies, at most 16
-// (under 500 bodies: one world). A world with belts or force sensors stays
-// one world (riders and welds are not split).
+// next rebuild; from the scene only, never from the thread count); past 16
+// regions the strips are columns, each cut the same way into rows (near-square
+// regions). Each region is its own Box2D world with the traction model above,
+// owning the bodies whose centre lies in it. `auto` (0): one region per 250
+// bodies, at most 1,024 (under 500 bodies: one world). A world with belts or
+// force sensors stays one world (riders and welds are not split).
 //   - Static geometry (walls, obstacles, map voxels) is copied into every
 //     strip it reaches, widened by 1 m plus four of the largest body's radius:
 //     a wall across all strips is solid in each.

@@ -6,6 +6,7 @@
 #include <box2d/b2_common.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <utility>
@@ -39,16 +40,67 @@ PartitionedPlaneWorld::PartitionedPlaneWorld(const Options& options,
 
 PartitionedPlaneWorld::~PartitionedPlaneWorld() = default;
 
-int PartitionedPlaneWorld::RegionOf(double position) const {
-  return static_cast<int>(std::upper_bound(borders_.begin(), borders_.end(), position) -
+int PartitionedPlaneWorld::ColumnOf(double along) const {
+  return static_cast<int>(std::upper_bound(borders_.begin(), borders_.end(), along) -
                           borders_.begin());
 }
+
+int PartitionedPlaneWorld::RowOf(int column, double across) const {
+  if (rows_ == 1) return 0;
+  const std::vector<double>& borders = row_borders_[static_cast<size_t>(column)];
+  return static_cast<int>(std::upper_bound(borders.begin(), borders.end(), across) -
+                          borders.begin());
+}
+
+int PartitionedPlaneWorld::RegionOf(const b2Vec2& p) const {
+  const int column = ColumnOf(AlongAxis(p, axis_));
+  return column * rows_ + RowOf(column, AlongAxis(p, 1 - axis_));
+}
+
+template <class Fn>
+void PartitionedPlaneWorld::ForEachRegion(Fn&& fn) {
+  const int64_t count = static_cast<int64_t>(regions_.size());
+  auto run = [&](int64_t begin, int64_t end) {
+    for (int64_t r = begin; r < end; ++r) fn(static_cast<size_t>(r));
+  };
+  if (settings_.scheduler && count > 1)
+    settings_.scheduler->ParallelFor(0, count, 1, run);
+  else
+    run(0, count);
+}
+
+namespace {
+
+// Borders cutting sorted positions into `parts` groups of the same size,
+// each halfway between the last of one group and the first of the next.
+// (Fewer positions than parts: the extra groups are empty, past the end.)
+std::vector<double> QuantileBorders(const std::vector<double>& sorted, int64_t parts) {
+  std::vector<double> borders;
+  const int64_t n = static_cast<int64_t>(sorted.size());
+  for (int64_t k = 1; k < parts; ++k) {
+    const int64_t i = k * n / parts;
+    if (n == 0)
+      borders.push_back(0);
+    else if (i == 0)
+      borders.push_back(sorted.front() - 1);
+    else if (i >= n)
+      borders.push_back(sorted.back() + 1);
+    else
+      borders.push_back(0.5 *
+                        (sorted[static_cast<size_t>(i - 1)] + sorted[static_cast<size_t>(i)]));
+  }
+  return borders;
+}
+
+}  // namespace
 
 void PartitionedPlaneWorld::Build(const Scene& scene) {
   auto staging = std::make_unique<PlaneWorld>(options_, settings_);
   staging->Build(scene);
   regions_.clear();
   borders_.clear();
+  row_borders_.clear();
+  rows_ = 1;
   current_ = 0;
   const std::vector<PlaneBody>& bodies = staging->bodies();
   state_of_slot_.assign(scene.slot_count(), 0);
@@ -64,9 +116,10 @@ void PartitionedPlaneWorld::Build(const Scene& scene) {
     regions_.push_back(std::move(staging));
     return;
   }
-  // Strips across the longer side of the bodies' bounding box, each holding
+  // Columns across the longer side of the bodies' bounding box, each holding
   // the same number of body centres at Build (borders halfway between two
-  // neighbouring centres).
+  // neighbouring centres); up to kMaxStrips regions they are the regions
+  // (strips), beyond it each column is cut the same way into rows.
   double lo[2] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
   double hi[2] = {-lo[0], -lo[1]};
   max_radius_ = 0;
@@ -79,63 +132,98 @@ void PartitionedPlaneWorld::Build(const Scene& scene) {
     max_radius_ = std::max(max_radius_, PlaneWorld::BoundingRadius(body.body));
   }
   axis_ = hi[0] - lo[0] >= hi[1] - lo[1] ? 0 : 1;
+  int64_t columns = count;
+  const double length = hi[axis_] - lo[axis_], width = hi[1 - axis_] - lo[1 - axis_];
+  if (count > kMaxStrips && width > 0) {
+    // Near-square regions: columns / rows as length / width.
+    const double ideal = std::sqrt(static_cast<double>(count) * length / width);
+    columns = std::clamp<int64_t>(std::llround(ideal), 1, count);
+    rows_ = static_cast<int>(std::max<int64_t>(1, count / columns));
+  }
   std::vector<double> along;
   along.reserve(bodies.size());
   for (const PlaneBody& body : bodies) along.push_back(AlongAxis(body.body->GetPosition(), axis_));
   std::sort(along.begin(), along.end());
-  for (int64_t k = 1; k < count; ++k) {
-    const size_t i = static_cast<size_t>(k * body_total / count);
-    borders_.push_back(0.5 * (along[i - 1] + along[i]));
+  borders_ = QuantileBorders(along, columns);
+  if (rows_ > 1) {
+    std::vector<std::vector<double>> across(static_cast<size_t>(columns));
+    for (const PlaneBody& body : bodies) {
+      const b2Vec2& p = body.body->GetPosition();
+      across[static_cast<size_t>(ColumnOf(AlongAxis(p, axis_)))].push_back(AlongAxis(p, 1 - axis_));
+    }
+    for (std::vector<double>& column : across) {
+      std::sort(column.begin(), column.end());
+      row_borders_.push_back(QuantileBorders(column, rows_));
+    }
   }
   // Each region: the ground fixtures within reach, then its bodies in slot
   // order.
   const double pad = kGroundPad * options_.length_scale + 4 * max_radius_;
   const double infinity = std::numeric_limits<double>::infinity();
-  for (int64_t r = 0; r < count; ++r) {
-    auto region = std::make_unique<PlaneWorld>(options_, settings_);
-    region->BuildEmpty();
-    const double region_lo = r == 0 ? -infinity : borders_[r - 1];
-    const double region_hi = r == count - 1 ? infinity : borders_[r];
-    region->CopyGround(*staging, axis_, region_lo - pad, region_hi + pad);
-    regions_.push_back(std::move(region));
+  for (int64_t c = 0; c < columns; ++c) {
+    const double column_lo = c == 0 ? -infinity : borders_[static_cast<size_t>(c - 1)];
+    const double column_hi = c == columns - 1 ? infinity : borders_[static_cast<size_t>(c)];
+    for (int r = 0; r < rows_; ++r) {
+      auto region = std::make_unique<PlaneWorld>(options_, settings_);
+      region->BuildEmpty();
+      double row_lo = -infinity, row_hi = infinity;
+      if (rows_ > 1) {
+        const std::vector<double>& row_borders = row_borders_[static_cast<size_t>(c)];
+        if (r > 0) row_lo = row_borders[static_cast<size_t>(r - 1)];
+        if (r < rows_ - 1) row_hi = row_borders[static_cast<size_t>(r)];
+      }
+      region->CopyGround(*staging, axis_, column_lo - pad, column_hi + pad, row_lo - pad,
+                         row_hi + pad);
+      regions_.push_back(std::move(region));
+    }
   }
   // Copied, not moved: the staging world goes whole when Build returns.
-  for (uint32_t b = 0; b < bodies.size(); ++b) {
-    const int r = RegionOf(AlongAxis(bodies[b].body->GetPosition(), axis_));
-    staging->CopyBody(b, regions_[r].get());
-  }
+  for (uint32_t b = 0; b < bodies.size(); ++b)
+    staging->CopyBody(b,
+                      regions_[static_cast<size_t>(RegionOf(bodies[b].body->GetPosition()))].get());
 }
 
 void PartitionedPlaneWorld::SyncFromScene(const Scene& scene, double duration) {
   duration_ = duration;
-  for (auto& region : regions_) region->SyncFromScene(scene, duration);
+  ForEachRegion([&](size_t r) { regions_[r]->SyncFromScene(scene, duration); });
 }
 
 void PartitionedPlaneWorld::ReadCommands(const Scene& scene) {
-  for (auto& region : regions_) region->ReadCommands(scene);
+  ForEachRegion([&](size_t r) { regions_[r]->ReadCommands(scene); });
   if (regions_.size() == 1) return;
   Migrate();
-  for (auto& region : regions_)
-    region->PublishStates(states_[current_].data(), state_of_slot_.data());
+  PlaneBodyState* states = states_[current_].data();
+  ForEachRegion([&](size_t r) { regions_[r]->PublishStates(states, state_of_slot_.data()); });
   UpdateGhosts();
 }
 
 void PartitionedPlaneWorld::Migrate() {
-  for (size_t r = 0; r < regions_.size(); ++r) {
-    PlaneWorld& region = *regions_[r];
+  // Who leaves, found on every worker; the moves in region and body order.
+  std::vector<std::vector<std::pair<uint32_t, int>>> leaving(regions_.size());
+  ForEachRegion([&](size_t r) {
+    const PlaneWorld& region = *regions_[r];
     for (uint32_t b = 0; b < region.bodies().size(); ++b) {
       const b2Body* body = region.bodies()[b].body;
       if (!body) continue;
-      const int to = RegionOf(AlongAxis(body->GetPosition(), axis_));
-      if (to != static_cast<int>(r)) region.MoveBody(b, regions_[to].get());
+      const int to = RegionOf(body->GetPosition());
+      if (to != static_cast<int>(r)) leaving[r].emplace_back(b, to);
     }
-  }
-  for (auto& region : regions_) region->Compact();
+  });
+  bool moved = false;
+  for (size_t r = 0; r < regions_.size(); ++r)
+    for (const auto& [b, to] : leaving[r]) {
+      regions_[r]->MoveBody(b, regions_[static_cast<size_t>(to)].get());
+      moved = true;
+    }
+  if (moved) ForEachRegion([&](size_t r) { regions_[r]->Compact(); });
 }
 
 void PartitionedPlaneWorld::UpdateGhosts() {
-  std::vector<std::vector<std::pair<uint32_t, const b2Body*>>> wanted(regions_.size());
-  for (size_t r = 0; r < regions_.size(); ++r) {
+  // Per region, the ghosts its bodies need elsewhere (region, slot, body),
+  // found on every worker; then each region's wanted list, sorted by slot.
+  using Want = std::pair<uint32_t, const b2Body*>;
+  std::vector<std::vector<std::pair<int, Want>>> needs(regions_.size());
+  ForEachRegion([&](size_t r) {
     const PlaneWorld& region = *regions_[r];
     for (uint32_t b = 0; b < region.bodies().size(); ++b) {
       const b2Body* body = region.bodies()[b].body;
@@ -143,17 +231,26 @@ void PartitionedPlaneWorld::UpdateGhosts() {
       // step, and Box2D's broad-phase fattening.
       const double reach = PlaneWorld::BoundingRadius(body) + max_radius_ +
                            kTravelFactor * region.SpeedBound(b) * duration_ + b2_aabbExtension;
-      const double p = AlongAxis(body->GetPosition(), axis_);
-      const int first = RegionOf(p - reach), last = RegionOf(p + reach);
-      for (int t = first; t <= last; ++t)
-        if (t != static_cast<int>(r)) wanted[t].emplace_back(region.bodies()[b].slot, body);
+      const b2Vec2& p = body->GetPosition();
+      const double along = AlongAxis(p, axis_), across = AlongAxis(p, 1 - axis_);
+      const int first = ColumnOf(along - reach), last = ColumnOf(along + reach);
+      for (int c = first; c <= last; ++c) {
+        const int row_first = RowOf(c, across - reach), row_last = RowOf(c, across + reach);
+        for (int row = row_first; row <= row_last; ++row) {
+          const int t = c * rows_ + row;
+          if (t != static_cast<int>(r)) needs[r].push_back({t, {region.bodies()[b].slot, body}});
+        }
+      }
     }
-  }
-  for (size_t t = 0; t < regions_.size(); ++t) {
+  });
+  std::vector<std::vector<Want>> wanted(regions_.size());
+  for (const auto& list : needs)
+    for (const auto& [t, want] : list) wanted[static_cast<size_t>(t)].push_back(want);
+  ForEachRegion([&](size_t t) {
     std::sort(wanted[t].begin(), wanted[t].end(),
-              [](const auto& a, const auto& b) { return a.first < b.first; });
+              [](const Want& a, const Want& b) { return a.first < b.first; });
     regions_[t]->SetGhosts(wanted[t]);
-  }
+  });
 }
 
 void PartitionedPlaneWorld::Substep(double dt, double fraction) {
@@ -184,7 +281,8 @@ void PartitionedPlaneWorld::Substep(double dt, double fraction) {
 }
 
 void PartitionedPlaneWorld::WriteBack(Scene* scene) {
-  for (auto& region : regions_) region->WriteBack(scene);
+  // Each region writes its own bodies' slots.
+  ForEachRegion([&](size_t r) { regions_[r]->WriteBack(scene); });
 }
 
 void PartitionedPlaneWorld::Hash(StateHasher* hasher) const {

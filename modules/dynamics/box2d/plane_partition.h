@@ -23,7 +23,11 @@ class PartitionedPlaneWorld {
   // `auto` (settings.partitions 0): one region per this many bodies...
   static constexpr int kAutoBodiesPerRegion = 250;
   // ...and at most this many regions.
-  static constexpr int kAutoMaxRegions = 16;
+  static constexpr int kAutoMaxRegions = 1024;
+  // Up to this many regions are strips across the longer side; more are a
+  // grid: columns across the longer side, each cut into the same number of
+  // rows (so regions stay near square and ghosts few).
+  static constexpr int kMaxStrips = 16;
 
   PartitionedPlaneWorld(const Options& options, const DynamicsSettings& settings);
   ~PartitionedPlaneWorld();
@@ -40,11 +44,22 @@ class PartitionedPlaneWorld {
 
   // Regions in use (1 when the world could not be split), and ghosts now.
   int region_count() const { return static_cast<int>(regions_.size()); }
+  // Columns and rows of the grid (strips: region_count() columns of 1 row).
+  int column_count() const { return static_cast<int>(borders_.size()) + 1; }
+  int row_count() const { return rows_; }
   int ghost_count() const;
 
  private:
-  // The region holding a position along the axis, Box2D units.
-  int RegionOf(double position) const;
+  // The column holding a position along the axis, and the row of column
+  // `column` holding a position across it; the region of a point (Box2D
+  // units). Regions are numbered column by column.
+  int ColumnOf(double along) const;
+  int RowOf(int column, double across) const;
+  int RegionOf(const b2Vec2& p) const;
+  // Calls fn(region) for every region, concurrently on the run's workers
+  // when there are several (each call touches its region only).
+  template <class Fn>
+  void ForEachRegion(Fn&& fn);
   // Bodies whose centre left their region move to the one holding it, in
   // region and body order.
   void Migrate();
@@ -54,10 +69,13 @@ class PartitionedPlaneWorld {
   Options options_;
   DynamicsSettings settings_;
   std::vector<std::unique_ptr<PlaneWorld>> regions_;
-  int axis_ = 0;                 // 0: strips across x, 1: across y
-  std::vector<double> borders_;  // (regions - 1), ascending, Box2D units
-  double max_radius_ = 0;        // largest body's bounding radius, Box2D units
-  double duration_ = 0;          // s, of the current step
+  int axis_ = 0;                 // 0: columns across x, 1: across y
+  std::vector<double> borders_;  // (columns - 1), ascending, Box2D units, along axis_
+  int rows_ = 1;                 // rows per column
+  // Per column, (rows - 1) ascending borders across axis_ (empty with one row).
+  std::vector<std::vector<double>> row_borders_;
+  double max_radius_ = 0;  // largest body's bounding radius, Box2D units
+  double duration_ = 0;    // s, of the current step
   // Published body states, one per body (not per scene slot: a robot's
   // sensors have none): substeps read one, write the other.
   std::array<std::vector<PlaneBodyState>, 2> states_;

@@ -176,8 +176,10 @@ class PlaneWorld {
   bool CanPartition() const { return belts_.empty() && force_sensors_.empty(); }
   const std::vector<PlaneBody>& bodies() const { return bodies_; }
   // Adds to this world's ground the ground fixtures of `from` whose AABB
-  // reaches into [lo, hi] along `axis` (0: x, 1: y), Box2D units.
-  void CopyGround(const PlaneWorld& from, int axis, double lo, double hi);
+  // reaches into [lo, hi] along `axis` (0: x, 1: y) and [cross_lo, cross_hi]
+  // along the other axis, Box2D units.
+  void CopyGround(const PlaneWorld& from, int axis, double lo, double hi, double cross_lo,
+                  double cross_hi);
   // Moves body `b` with its wheels, ground friction, pose record, velocity
   // and awake state to the end of `to`'s bodies, leaving a hole here that
   // Compact() closes. Contact warm starts of the body are lost.

@@ -44,7 +44,8 @@ void CloneFixtures(const b2Body* from, b2Body* to) {
 
 }  // namespace
 
-void PlaneWorld::CopyGround(const PlaneWorld& from, int axis, double lo, double hi) {
+void PlaneWorld::CopyGround(const PlaneWorld& from, int axis, double lo, double hi, double cross_lo,
+                            double cross_hi) {
   std::vector<const b2Fixture*> fixtures;
   for (const b2Fixture* f = from.ground_->GetFixtureList(); f; f = f->GetNext())
     fixtures.push_back(f);
@@ -57,7 +58,9 @@ void PlaneWorld::CopyGround(const PlaneWorld& from, int axis, double lo, double 
       f->GetShape()->ComputeAABB(&box, from.ground_->GetTransform(), c);
       const double a_lo = axis == 0 ? box.lowerBound.x : box.lowerBound.y;
       const double a_hi = axis == 0 ? box.upperBound.x : box.upperBound.y;
-      reaches = a_hi >= lo && a_lo <= hi;
+      const double c_lo = axis == 0 ? box.lowerBound.y : box.lowerBound.x;
+      const double c_hi = axis == 0 ? box.upperBound.y : box.upperBound.x;
+      reaches = a_hi >= lo && a_lo <= hi && c_hi >= cross_lo && c_lo <= cross_hi;
     }
     if (!reaches) continue;
     const b2FixtureDef def = DefinitionOf(f);

@@ -111,6 +111,41 @@ TEST(Box2dPartition, AutoPicksRegionsFromTheSceneNotTheThreads) {
   EXPECT_EQ(regions, 1);  // small swarms stay in one world
 }
 
+// Past kMaxStrips regions the arena is a grid (columns cut into rows), near
+// square here, and the result is still the same for any thread count.
+TEST(Box2dPartition, ManyRegionsAreAGridAndGiveTheSameHashForAnyThreadCount) {
+  int regions = 0;
+  const uint64_t one = BusyHash(1500, 36, 1, &regions);
+  EXPECT_EQ(regions, 36);
+  EXPECT_EQ(BusyHash(1500, 36, 2), one);
+  EXPECT_EQ(BusyHash(1500, 36, 3), one);
+  EXPECT_NE(BusyHash(1500, 6, 2), one);
+  Scene scene;
+  for (int i = 0; i < 1600; ++i) AddRobot(&scene, Name("r", i), 0.5 * (i % 40), 0.5 * (i / 40), 0);
+  PartitionedPlaneWorld grid(Options{}, {.partitions = 36, .options = nullptr});
+  grid.Build(scene);
+  EXPECT_EQ(grid.column_count(), 6);
+  EXPECT_EQ(grid.row_count(), 6);
+  EXPECT_EQ(grid.body_count(), 1600);
+  PartitionedPlaneWorld strips(Options{}, {.partitions = 16, .options = nullptr});
+  strips.Build(scene);
+  EXPECT_EQ(strips.column_count(), 16);
+  EXPECT_EQ(strips.row_count(), 1);
+  // A long arena (40 x 10 m) gets more columns than rows: regions stay near
+  // square, and near the number asked for.
+  Scene corridor;
+  for (int i = 0; i < 1600; ++i)
+    AddRobot(&corridor, Name("r", i), 0.5 * (i % 80), 0.5 * (i / 80), 0);
+  PartitionedPlaneWorld long_grid(Options{}, {.partitions = 40, .options = nullptr});
+  long_grid.Build(corridor);
+  EXPECT_GT(long_grid.column_count(), long_grid.row_count());
+  const double aspect = (39.5 / long_grid.column_count()) / (9.5 / long_grid.row_count());
+  EXPECT_GT(aspect, 0.5);
+  EXPECT_LT(aspect, 2.0);
+  EXPECT_LE(long_grid.region_count(), 40);
+  EXPECT_GE(long_grid.region_count(), 30);
+}
+
 // More regions than bodies: one region per body, none empty.
 TEST(Box2dPartition, MorePartitionsThanBodiesIsOneRegionPerBody) {
   Scene scene;
@@ -201,6 +236,7 @@ DiffusionFigures RunDiffusion(int partitions) {
 TEST(Box2dPartition, DiffusionStatisticsMatchOneWorld) {
   const DiffusionFigures one = RunDiffusion(1);
   const DiffusionFigures four = RunDiffusion(4);
+  const DiffusionFigures grid = RunDiffusion(25);  // 5 x 5 regions of 16 robots: corners
   std::printf(
       "diffusion 400 robots 60 s: partitions 1 / 4: mean free path %.3f / %.3f m, robot "
       "contacts %d / %d, wall contacts %d / %d, wall penetration %.2f / %.2f mm, robot overlap "
@@ -214,6 +250,16 @@ TEST(Box2dPartition, DiffusionStatisticsMatchOneWorld) {
   EXPECT_NEAR(static_cast<double>(four.wall_contacts) / one.wall_contacts, 1, 0.15);
   EXPECT_LT(four.wall_penetration, one.wall_penetration + 0.001);
   EXPECT_LT(four.robot_penetration, one.robot_penetration + 0.002);
+  std::printf(
+      "grid of 25: mean free path %.3f m, robot contacts %d, wall contacts %d, wall penetration "
+      "%.2f mm, robot overlap %.2f mm\n",
+      grid.mean_free_path, grid.robot_contacts, grid.wall_contacts, 1e3 * grid.wall_penetration,
+      1e3 * grid.robot_penetration);
+  EXPECT_NEAR(grid.mean_free_path / one.mean_free_path, 1, 0.15);
+  EXPECT_NEAR(static_cast<double>(grid.robot_contacts) / one.robot_contacts, 1, 0.15);
+  EXPECT_NEAR(static_cast<double>(grid.wall_contacts) / one.wall_contacts, 1, 0.15);
+  EXPECT_LT(grid.wall_penetration, one.wall_penetration + 0.001);
+  EXPECT_LT(grid.robot_penetration, one.robot_penetration + 0.002);
 }
 
 }  // namespace
