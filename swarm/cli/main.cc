@@ -14,6 +14,7 @@
 #include "swarm/cli/commands.h"
 #include "swarm/cli/options.h"
 #include "swarm/cli/parse_error.h"
+#include "swarm/run/huge_pages.h"
 #include "swarm/run/version.h"
 
 namespace swarmsim::cli {
@@ -91,6 +92,7 @@ int Main(int argc, char** argv) {
 }  // namespace swarmsim::cli
 
 int main(int argc, char** argv) {
+  swarmsim::RestartWithHugePages(argv);
   try {
     return swarmsim::cli::Main(argc, argv);
   } catch (const swarmsim::Error& e) {

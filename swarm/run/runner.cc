@@ -29,6 +29,7 @@
 #include "framework/script_host.h"
 #include "framework/state_hash.h"
 #include "framework/utf8.h"
+#include "swarm/run/huge_pages.h"
 #include "swarm/run/stop_signals.h"
 #include "swarm/run/version.h"
 
@@ -345,6 +346,7 @@ std::string WriteSummary(const World& world, const RunOptions& options, const Ru
   j["real_time_factor"] = result.wall_seconds > 0 ? sim_time / result.wall_seconds : 0;
   j["robot_ticks_per_s"] = result.wall_seconds > 0 ? robot_ticks / result.wall_seconds : 0;
   j["peak_rss_mb"] = result.peak_rss_mb;
+  j["huge_pages"] = HugePagesRequested();
   j["lua_memory_kib"] = lua_kib;
   j["state_hash"] = complete ? nlohmann::json(StateHasher::ToHex(result.state_hash)) : nullptr;
   if (complete) j["disabled_scripts"] = world.disabled_scripts();
