@@ -93,6 +93,7 @@ int Main(int argc, char** argv) {
 
 int main(int argc, char** argv) {
   swarmsim::RestartWithHugePages(argv);
+  swarmsim::TuneMalloc();
   try {
     return swarmsim::cli::Main(argc, argv);
   } catch (const swarmsim::Error& e) {

@@ -1,6 +1,9 @@
 #include "swarm/run/huge_pages.h"
 
 #include <unistd.h>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 #include <cstdlib>
 #include <string>
@@ -34,6 +37,14 @@ void RestartWithHugePages(char** argv) {
     unsetenv("GLIBC_TUNABLES");
 #else
   (void)argv;
+#endif
+}
+
+void TuneMalloc() {
+#if defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__) && !defined(__SANITIZE_THREAD__)
+  mallopt(M_MMAP_THRESHOLD, 32 << 20);
+  mallopt(M_TOP_PAD, 64 << 20);
+  mallopt(M_TRIM_THRESHOLD, 512 << 20);
 #endif
 }
 

@@ -17,6 +17,14 @@ namespace swarmsim {
 // only when it did not restart (also when the restart failed).
 void RestartWithHugePages(char** argv);
 
+// glibc's malloc kept from handing memory back and forth with the kernel
+// while a large world is built: blocks under 32 MiB come from the heap (not
+// a mapping of their own, faulted in anew each time a vector grows), 64 MiB
+// of padding each time the heap grows, and up to 512 MiB free at its top
+// kept rather than trimmed. Starting 100,000 Lua robots: 164,000 page
+// faults -> 4,000. No-op outside glibc.
+void TuneMalloc();
+
 // Whether this process's malloc was asked for huge pages (summary.json's
 // `huge_pages`). Whether the kernel gives them is its own setting
 // (/sys/kernel/mm/transparent_hugepage/enabled: `always` or `madvise`).
