@@ -673,36 +673,37 @@ ObjectId Scene::FindObject(std::string_view path, ObjectId from) const {
   const std::vector<PathElement> elements = SplitPath(path, full);
   if (elements.empty()) return scope.empty() ? ObjectId{} : IdAt(scope.front());
 
-  // First element: roots (absolute) or any descendant of the scope.
-  std::vector<uint32_t> candidates;
-  if (!search_descendants) {
-    for (uint32_t s = 0; s < generation_.size(); ++s)
-      if (alive_[s] && parent_[s] < 0) candidates.push_back(s);
-  } else {
-    std::vector<uint32_t> sub;
-    CollectSubtree(scope.front(), &sub);
-    candidates.assign(sub.begin() + 1, sub.end());
-  }
+  // First element: roots (absolute) or any descendant of the scope; each
+  // following one: descendants of the current match; hierarchy order (a
+  // pre-order walk, children in insertion order, as CollectSubtree lists
+  // them), without collecting the subtree: a robot's script looks up each
+  // of its sensors at start.
+  const auto next_in_subtree = [&](int32_t s, int32_t root) -> int32_t {
+    if (first_child_[s] >= 0) return first_child_[s];
+    for (; s != root; s = parent_[s])
+      if (next_sibling_[s] >= 0) return next_sibling_[s];
+    return -1;
+  };
   int32_t current = -1;
   for (size_t k = 0; k < elements.size(); ++k) {
     const PathElement& e = elements[k];
-    if (k > 0) {
-      // Following elements: descendants of the current match, hierarchy order.
-      std::vector<uint32_t> sub;
-      CollectSubtree(static_cast<uint32_t>(current), &sub);
-      candidates.assign(sub.begin() + 1, sub.end());
-    }
-    int seen = 0;
-    current = -1;
     const int want = e.index < 0 ? 0 : e.index;
-    for (uint32_t c : candidates) {
-      if (name_at(c) != e.name) continue;
-      if (seen++ == want) {
-        current = static_cast<int32_t>(c);
-        break;
-      }
+    int seen = 0;
+    int32_t match = -1;
+    const auto matches = [&](uint32_t c) { return name_at(c) == e.name && seen++ == want; };
+    if (k == 0 && !search_descendants) {
+      for (uint32_t s = 0; s < generation_.size() && match < 0; ++s)
+        if (alive_[s] && parent_[s] < 0 && matches(s)) match = static_cast<int32_t>(s);
+    } else {
+      const int32_t root = k == 0 ? static_cast<int32_t>(scope.front()) : current;
+      for (int32_t c = next_in_subtree(root, root); c >= 0; c = next_in_subtree(c, root))
+        if (matches(static_cast<uint32_t>(c))) {
+          match = c;
+          break;
+        }
     }
-    if (current < 0) return {};
+    if (match < 0) return {};
+    current = match;
   }
   return IdAt(static_cast<uint32_t>(current));
 }

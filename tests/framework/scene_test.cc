@@ -139,6 +139,31 @@ TEST(SceneTest, PathsResolveRelativeToTheCaller) {
   EXPECT_EQ(scene.PathOf(s1), "/robot/body/sensor");
 }
 
+// Matches count in hierarchy order (depth first, children in the order they
+// were added), and a search never leaves the subtree it starts from.
+TEST(SceneTest, PathIndicesCountInHierarchyOrderWithinTheSubtree) {
+  Scene scene;
+  const ObjectId robot = scene.AddDummy("robot", {}, {});
+  const ObjectId a = scene.AddDummy("a", robot, {});
+  const ObjectId x = scene.AddDummy("sensor", a, {});
+  const ObjectId b = scene.AddDummy("sensor", robot, {});
+  const ObjectId y = scene.AddDummy("sensor", b, {});
+  const ObjectId leaf = scene.AddDummy("leaf", robot, {});
+  const ObjectId z = scene.AddDummy("sensor", robot, {});
+  EXPECT_EQ(scene.FindObject("./sensor", robot), x);
+  EXPECT_EQ(scene.FindObject("./sensor[1]", robot), b);
+  EXPECT_EQ(scene.FindObject("./sensor[2]", robot), y);
+  EXPECT_EQ(scene.FindObject("./sensor[3]", robot), z);
+  EXPECT_TRUE(scene.FindObject("./sensor[4]", robot).IsNull());
+  // Each element takes its match and searches below it, no backtracking.
+  EXPECT_TRUE(scene.FindObject("./sensor/sensor", robot).IsNull());  // below x: nothing
+  EXPECT_EQ(scene.FindObject("./sensor[1]/sensor", robot), y);
+  EXPECT_EQ(scene.FindObject("./a/sensor", robot), x);
+  EXPECT_TRUE(scene.FindObject("./sensor[1]", a).IsNull());  // not b: a's subtree only
+  EXPECT_TRUE(scene.FindObject("./sensor", leaf).IsNull());  // not z, its next sibling
+  EXPECT_EQ(scene.FindObject("./sensor", b), y);
+}
+
 TEST(SceneTest, TypedAccessChecksTheType) {
   Scene scene;
   const ObjectId d = scene.AddDummy("d", {}, {});
