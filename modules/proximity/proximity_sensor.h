@@ -131,9 +131,12 @@ inline bool FindSensorType(const Scene& scene, ObjectType* type) {
   return scene.FindType(kSensorTypeName, type);
 }
 
-// Is the object at `slot` (live) a proximity sensor? One name compare.
+// Is the object at `slot` (live) a proximity sensor? The type's name is
+// kSensorTypeName itself (one pointer compare: scripts read every sensor
+// every step), or, from another registration, equal to it.
 inline bool IsSensorAt(const Scene& scene, uint32_t slot) {
-  return std::strcmp(scene.type_name(scene.type_at(slot)), kSensorTypeName) == 0;
+  const char* name = scene.type_name(scene.type_at(slot));
+  return name == kSensorTypeName || std::strcmp(name, kSensorTypeName) == 0;
 }
 
 // Every proximity sensor's row (row r belongs to the object at slot
