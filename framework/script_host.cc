@@ -153,29 +153,34 @@ const char* ReadPieces(lua_State*, void* data, size_t* size) {
 // of its factory chunk (lua_dump, debug information kept, so messages name
 // the same file and lines), loaded by the other states without parsing.
 // Filled by whichever state compiles a source first; shared by the threads
-// that start robots.
+// that start robots. Two threads may compile a source at the same time
+// before either has added it: the first one added is kept, and a reader
+// holds its bytecode (shared) while it loads, so no Add changes the bytes
+// under it.
 class CompiledChunks {
  public:
   // The bytecode of `source`'s factory, or null when none is kept yet.
-  const std::string* Find(const ScriptSource& source) {
+  std::shared_ptr<const std::string> Find(const ScriptSource& source) {
     const std::lock_guard lock(mutex_);
     const auto it = chunks_.find(&source);
     // A source at an address a freed one had is another source: compare.
     if (it == chunks_.end() || it->second.path != source.path || it->second.code != source.code)
       return nullptr;
-    return &it->second.bytecode;  // entries are never erased: the string stays put
+    return it->second.bytecode;
   }
   void Add(const ScriptSource& source, std::string bytecode) {
     const std::lock_guard lock(mutex_);
     Entry& entry = chunks_[&source];
+    if (entry.bytecode && entry.path == source.path && entry.code == source.code) return;
     entry.path = source.path;
     entry.code = source.code;
-    entry.bytecode = std::move(bytecode);
+    entry.bytecode = std::make_shared<const std::string>(std::move(bytecode));
   }
 
  private:
   struct Entry {
-    std::string path, code, bytecode;
+    std::string path, code;
+    std::shared_ptr<const std::string> bytecode;
   };
   std::mutex mutex_;
   std::unordered_map<const ScriptSource*, Entry> chunks_;
@@ -195,7 +200,7 @@ int AppendBytes(lua_State*, const void* bytes, size_t size, void* out) {
 std::string CompileFactory(lua_State* L, const ScriptSource& source,
                            CompiledChunks* chunks = nullptr) {
   const std::string chunkname = "@" + (source.path.empty() ? std::string("?") : source.path);
-  if (const std::string* bytecode = chunks ? chunks->Find(source) : nullptr) {
+  if (const std::shared_ptr<const std::string> bytecode = chunks ? chunks->Find(source) : nullptr) {
     int status = luaL_loadbufferx(L, bytecode->data(), bytecode->size(), chunkname.c_str(), "b");
     if (status == LUA_OK) status = lua_pcall(L, 0, 1, 0);
     if (status == LUA_OK) return "";
