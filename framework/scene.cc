@@ -647,11 +647,11 @@ std::vector<PathElement> SplitPath(std::string_view path, std::string_view full)
 
 ObjectId Scene::FindObject(std::string_view path, ObjectId from) const {
   const std::string_view full = path;
-  std::vector<uint32_t> scope;  // candidate subtree roots whose descendants are searched
+  int32_t scope = -1;  // the subtree root whose descendants are searched
   bool search_descendants = true;
   if (path.starts_with("./") || path == ".") {
     if (!IsValid(from)) return {};
-    scope.push_back(from.index());
+    scope = static_cast<int32_t>(from.index());
     path.remove_prefix(path.size() >= 2 ? 2 : 1);
   } else if (path.starts_with(":/") || path == ":") {
     if (!IsValid(from)) return {};
@@ -661,7 +661,7 @@ ObjectId Scene::FindObject(std::string_view path, ObjectId from) const {
         root = a;
         break;
       }
-    scope.push_back(static_cast<uint32_t>(root));
+    scope = root;
     path.remove_prefix(path.size() >= 2 ? 2 : 1);
   } else if (path.starts_with("/")) {
     path.remove_prefix(1);
@@ -671,7 +671,7 @@ ObjectId Scene::FindObject(std::string_view path, ObjectId from) const {
                 "': start with '/' (absolute), './' (below this object) or ':/' (in this model)");
   }
   const std::vector<PathElement> elements = SplitPath(path, full);
-  if (elements.empty()) return scope.empty() ? ObjectId{} : IdAt(scope.front());
+  if (elements.empty()) return scope < 0 ? ObjectId{} : IdAt(static_cast<uint32_t>(scope));
 
   // First element: roots (absolute) or any descendant of the scope; each
   // following one: descendants of the current match; hierarchy order (a
@@ -695,7 +695,7 @@ ObjectId Scene::FindObject(std::string_view path, ObjectId from) const {
       for (uint32_t s = 0; s < generation_.size() && match < 0; ++s)
         if (alive_[s] && parent_[s] < 0 && matches(s)) match = static_cast<int32_t>(s);
     } else {
-      const int32_t root = k == 0 ? static_cast<int32_t>(scope.front()) : current;
+      const int32_t root = k == 0 ? scope : current;
       for (int32_t c = next_in_subtree(root, root); c >= 0; c = next_in_subtree(c, root))
         if (matches(static_cast<uint32_t>(c))) {
           match = c;

@@ -5,6 +5,8 @@
 #include <malloc.h>
 #endif
 
+#include <algorithm>
+#include <cctype>
 #include <cstdlib>
 #include <string>
 
@@ -14,25 +16,35 @@ namespace {
 
 constexpr const char* kTunable = "glibc.malloc.hugetlb";
 
-bool TunableSet() {
-  const char* tunables = std::getenv("GLIBC_TUNABLES");
-  return tunables != nullptr && std::string(tunables).find(kTunable) != std::string::npos;
+}  // namespace
+
+std::string TunablesWithHugePages(const char* tunables) {
+  const std::string given = tunables != nullptr ? tunables : "";
+  if (given.find(kTunable) != std::string::npos) return "";
+  const std::string ours = std::string(kTunable) + "=1";
+  return given.empty() ? ours : given + ":" + ours;
 }
 
-}  // namespace
+bool HugePagesTurnedOff(const char* value) {
+  if (value == nullptr) return false;
+  std::string v(value);
+  std::transform(v.begin(), v.end(), v.begin(), [](unsigned char c) { return std::tolower(c); });
+  return v == "0" || v == "off" || v == "false" || v == "no";
+}
 
 void RestartWithHugePages(char** argv) {
 #if defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__) && !defined(__SANITIZE_THREAD__)
-  const char* off = std::getenv("SWARMSIM_HUGEPAGES");
-  if ((off != nullptr && std::string(off) == "0") || TunableSet()) return;
+  if (HugePagesTurnedOff(std::getenv("SWARMSIM_HUGEPAGES"))) return;
   const char* tunables = std::getenv("GLIBC_TUNABLES");
-  std::string value = std::string(kTunable) + "=1";
-  if (tunables != nullptr && *tunables != '\0') value = std::string(tunables) + ":" + value;
+  const std::string value = TunablesWithHugePages(tunables);
+  if (value.empty()) return;
+  const std::string kept = tunables != nullptr ? tunables : "";
+  const bool had = tunables != nullptr;
   if (setenv("GLIBC_TUNABLES", value.c_str(), 1) != 0) return;
   execv("/proc/self/exe", argv);
   // Not restarted (no /proc, say): go on as we are, and say so truthfully.
-  if (tunables != nullptr)
-    setenv("GLIBC_TUNABLES", tunables, 1);
+  if (had)
+    setenv("GLIBC_TUNABLES", kept.c_str(), 1);
   else
     unsetenv("GLIBC_TUNABLES");
 #else

@@ -199,7 +199,9 @@ void PartitionedPlaneWorld::ReadCommands(const Scene& scene) {
 
 void PartitionedPlaneWorld::Migrate() {
   // Who leaves, found on every worker; the moves in region and body order.
-  std::vector<std::vector<std::pair<uint32_t, int>>> leaving(regions_.size());
+  auto& leaving = leaving_;
+  leaving.resize(regions_.size());
+  for (auto& list : leaving) list.clear();
   ForEachRegion([&](size_t r) {
     const PlaneWorld& region = *regions_[r];
     for (uint32_t b = 0; b < region.bodies().size(); ++b) {
@@ -221,8 +223,9 @@ void PartitionedPlaneWorld::Migrate() {
 void PartitionedPlaneWorld::UpdateGhosts() {
   // Per region, the ghosts its bodies need elsewhere (region, slot, body),
   // found on every worker; then each region's wanted list, sorted by slot.
-  using Want = std::pair<uint32_t, const b2Body*>;
-  std::vector<std::vector<std::pair<int, Want>>> needs(regions_.size());
+  auto& needs = needs_;
+  needs.resize(regions_.size());
+  for (auto& list : needs) list.clear();
   ForEachRegion([&](size_t r) {
     const PlaneWorld& region = *regions_[r];
     for (uint32_t b = 0; b < region.bodies().size(); ++b) {
@@ -243,7 +246,9 @@ void PartitionedPlaneWorld::UpdateGhosts() {
       }
     }
   });
-  std::vector<std::vector<Want>> wanted(regions_.size());
+  auto& wanted = wanted_;
+  wanted.resize(regions_.size());
+  for (auto& list : wanted) list.clear();
   for (const auto& list : needs)
     for (const auto& [t, want] : list) wanted[static_cast<size_t>(t)].push_back(want);
   ForEachRegion([&](size_t t) {

@@ -6,6 +6,7 @@
 #include <array>
 #include <memory>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "framework/dynamics_backend.h"
@@ -80,6 +81,12 @@ class PartitionedPlaneWorld {
   // sensors have none): substeps read one, write the other.
   std::array<std::vector<PlaneBodyState>, 2> states_;
   std::vector<uint32_t> state_of_slot_;  // by scene slot: the body's row in states_
+  // Per-step scratch, by region (kept for their capacity): bodies leaving
+  // (body, region), ghosts wanted elsewhere (region, want), ghosts wanted here.
+  using Want = std::pair<uint32_t, const b2Body*>;  // (slot, owner body)
+  std::vector<std::vector<std::pair<uint32_t, int>>> leaving_;
+  std::vector<std::vector<std::pair<int, Want>>> needs_;
+  std::vector<std::vector<Want>> wanted_;
   int current_ = 0;
 };
 

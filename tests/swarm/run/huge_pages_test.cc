@@ -2,6 +2,8 @@
 // malloc asked for transparent huge pages, and summary.json says whether it
 // was; SWARMSIM_HUGEPAGES=0 turns it off, and a user's own GLIBC_TUNABLES
 // still apply.
+#include "swarm/run/huge_pages.h"
+
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -32,6 +34,7 @@ TEST(HugePagesTest, RunsAskForHugePagesUnlessTurnedOff) {
 #endif
   EXPECT_EQ(RunAndReadSummary("", "default")["huge_pages"], true);
   EXPECT_EQ(RunAndReadSummary("SWARMSIM_HUGEPAGES=0", "off")["huge_pages"], false);
+  EXPECT_EQ(RunAndReadSummary("SWARMSIM_HUGEPAGES=Off", "off_word")["huge_pages"], false);
   // A user's tunables are kept beside it, and a user's own choice wins.
   EXPECT_EQ(RunAndReadSummary("GLIBC_TUNABLES=glibc.malloc.arena_max=2", "merged")["huge_pages"],
             true);
@@ -41,6 +44,23 @@ TEST(HugePagesTest, RunsAskForHugePagesUnlessTurnedOff) {
   const auto bad = swarmsim::testing::RunProgram("run no_such_world.yaml --steps 1");
   EXPECT_EQ(bad.exit_code, 2) << bad.output;
   EXPECT_NE(bad.output.find("no_such_world.yaml"), std::string::npos) << bad.output;
+}
+
+// The value the restart sets: the user's tunables kept, ours added once,
+// theirs winning when they name it.
+TEST(HugePagesTest, TheUsersTunablesAreKeptAndTheirHugetlbWins) {
+  using swarmsim::TunablesWithHugePages;
+  EXPECT_EQ(TunablesWithHugePages(nullptr), "glibc.malloc.hugetlb=1");
+  EXPECT_EQ(TunablesWithHugePages(""), "glibc.malloc.hugetlb=1");
+  EXPECT_EQ(TunablesWithHugePages("glibc.malloc.arena_max=2"),
+            "glibc.malloc.arena_max=2:glibc.malloc.hugetlb=1");
+  EXPECT_EQ(TunablesWithHugePages("glibc.malloc.hugetlb=0"), "");
+  EXPECT_EQ(TunablesWithHugePages("glibc.malloc.check=0:glibc.malloc.hugetlb=2"), "");
+  for (const char* off : {"0", "off", "OFF", "false", "no"})
+    EXPECT_TRUE(swarmsim::HugePagesTurnedOff(off)) << off;
+  for (const char* on : {"1", "on", "yes", ""})
+    EXPECT_FALSE(swarmsim::HugePagesTurnedOff(on)) << on;
+  EXPECT_FALSE(swarmsim::HugePagesTurnedOff(nullptr));
 }
 
 }  // namespace
