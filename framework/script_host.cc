@@ -35,6 +35,7 @@
 #include "framework/script_host.h"
 
 #include <algorithm>
+#include <atomic>
 #include <climits>
 #include <cstdint>
 #include <memory>
@@ -47,6 +48,7 @@
 
 #include "framework/error.h"
 #include "framework/lua_api.h"
+#include "framework/memory_forecast.h"
 #include "framework/scene.h"
 #include "framework/scheduler.h"
 #include "framework/script_calls.h"
@@ -598,8 +600,15 @@ void LuaScriptHost::StartRobots(int first) {
   const int robot_count = world.robot_count();
   robots_.resize(robot_count);
   std::vector<std::string> errors(robot_count);
+  // A world whose states will not fit in memory stops with a message (not
+  // the kernel's out-of-memory kill); the robots not yet started are skipped.
+  MemoryForecast forecast("robots' Lua states", robot_count - first, world.settings().max_memory);
+  std::atomic<int64_t> started{0};
+  std::string refusal;
+  std::atomic<bool> refused{false};
   world.scheduler().ParallelFor(first, robot_count, kStartGrain, [&](int64_t begin, int64_t end) {
     for (int64_t r = begin; r < end; ++r) {
+      if (refused.load(std::memory_order_relaxed)) return;
       const ModelInstance& instance = scene.instance(static_cast<int>(r));
       if (!instance.alive) continue;
       try {
@@ -609,8 +618,13 @@ void LuaScriptHost::StartRobots(int first) {
       } catch (const std::exception& e) {
         errors[r] = e.what();
       }
+      if (std::string why = forecast.Built(started.fetch_add(1) + 1); !why.empty()) {
+        refusal = std::move(why);  // one thread only: the forecast says it once
+        refused.store(true);
+      }
     }
   });
+  if (refused.load()) throw Error(refusal);
   for (const std::string& error : errors)
     if (!error.empty()) throw Error(error);
 }

@@ -92,8 +92,9 @@ World::World(const WorldSettings& settings, const ModuleRegistry& registry)
   if (!(settings_.time_step > 0) || !std::isfinite(settings_.time_step))
     throw Error("time step must be a positive number of seconds");
   if (settings_.physics_substeps < 1) throw Error("physics substeps must be at least 1");
-  run_script_memory_.set_limit(
-      static_cast<uint64_t>(std::max<int64_t>(settings_.run_script_memory_limit, 0)));
+  run_script_memory_.set_limit(static_cast<uint64_t>(settings_.run_script_memory_limit < 0
+                                                         ? WorldSettings::kDefaultRunScriptMemory
+                                                         : settings_.run_script_memory_limit));
   scene_script_memory_.Attach(&run_script_memory_, static_cast<uint64_t>(std::max<int64_t>(
                                                        settings_.script_memory_limit, 0)));
   messaging_.scene_mail().memory = &scene_script_memory_;
@@ -298,6 +299,10 @@ void World::Start() {
                       dynamic_cast<const SensorValueAccess*>(find_module("ground_sensor")),
                       dynamic_cast<const LedAccess*>(find_module("blobs")),
                       dynamic_cast<const IrAccess*>(find_module("ir_messaging"))};
+  if (settings_.run_script_memory_limit < 0)
+    run_script_memory_.set_limit(
+        static_cast<uint64_t>(std::max(WorldSettings::kDefaultRunScriptMemory,
+                                       WorldSettings::kRunScriptMemoryPerRobot * robot_count())));
   scripts_ = MakeScriptHost(this);
   started_ = true;
   try {

@@ -84,8 +84,16 @@ struct WorldSettings {
   // limit).
   int64_t script_memory_limit = int64_t{256} << 20;
   // Bytes every script of the run may hold together (0: no limit): 20
-  // robots x 256 MiB would otherwise be 5 GiB.
-  int64_t run_script_memory_limit = int64_t{4} << 30;
+  // robots x 256 MiB would otherwise be 5 GiB. Negative (the default): set
+  // at Start, kDefaultRunScriptMemory or kRunScriptMemoryPerRobot a robot,
+  // whichever is more (a robot's Lua state alone takes ~16 KiB).
+  int64_t run_script_memory_limit = -1;
+  static constexpr int64_t kDefaultRunScriptMemory = int64_t{4} << 30;
+  static constexpr int64_t kRunScriptMemoryPerRobot = int64_t{64} << 10;
+  // Bytes the whole process may hold (swarmsim run --max-memory; 0: what
+  // the machine has): a world whose robot copies or Lua states will not fit
+  // is refused while they are built (framework/memory_forecast.h).
+  uint64_t max_memory = 0;
   // Wall-clock seconds one step (or the start or stop of the world) may take
   // before the runner ends the run as stuck, naming the script calls in
   // progress (0: no limit). A safety net for what the instruction budget

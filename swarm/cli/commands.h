@@ -41,6 +41,7 @@ struct RunArgs {
   bool hash = false, quiet = false;
   bool progress = false;  // --progress: the loading line also when stderr is not a terminal
   bool trust_scripts = false;
+  std::string max_memory;  // --max-memory SIZE; empty: what the machine has
   std::vector<std::string> plugins;
   std::vector<std::string> package_path;  // --package-path: URDF packages' folders
   // Snapshots and video (framework/view_recorder.h).

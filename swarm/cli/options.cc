@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "framework/error.h"
+#include "framework/memory_forecast.h"
 
 namespace swarmsim::cli {
 
@@ -69,6 +70,17 @@ CLI::Validator NonEmpty(const std::string& what) {
         return text.empty() ? "expected " + what + ", got an empty name" : "";
       },
       "");
+}
+
+CLI::Validator MemorySizeCheck() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        uint64_t bytes = 0;
+        return ParseMemorySize(text, &bytes)
+                   ? ""
+                   : "expected a memory size such as 500M, 2G or 1.5GiB, got '" + text + "'";
+      },
+      "SIZE");
 }
 
 std::vector<std::filesystem::path> PluginDirectories() {

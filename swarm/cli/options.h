@@ -39,6 +39,9 @@ CLI::Validator SeedCheck();
 // A file or folder name that must not be empty (`what`: "a folder").
 CLI::Validator NonEmpty(const std::string& what);
 
+// A memory size: 500M, 2G, 1.5GiB (K/M/G/T: powers of 1024), or bytes.
+CLI::Validator MemorySizeCheck();
+
 // Where a world's `plugins: [name]` are looked for: plugins/ beside the
 // program (the build tree), and lib/swarmsim/plugins of an installed one.
 std::vector<std::filesystem::path> PluginDirectories();

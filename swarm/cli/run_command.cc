@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "framework/error.h"
+#include "framework/memory_forecast.h"
 #include "framework/plugin_loader.h"
 #include "framework/registry.h"
 #include "framework/utf8.h"
@@ -187,6 +188,10 @@ CLI::App* AddRunCommand(CLI::App* app, RunArgs* args) {
                   "A folder holding the ROS packages of URDF models' package:// URIs (after the "
                   "world's package_path); repeat for more")
       ->allow_extra_args(false);
+  run->add_option("--max-memory", args->max_memory,
+                  "Refuse a world whose robot copies or Lua states would take the process past "
+                  "SIZE (e.g. 8G); without it, past what the machine (or cgroup) has")
+      ->check(MemorySizeCheck());
   run->add_flag("--trust-scripts", args->trust_scripts,
                 "Lift the script sandbox: full Lua libraries (os, io, debug, package)");
   run->add_option("--snapshot-every", args->snapshot_every,
@@ -318,6 +323,7 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
   load.threads = args.threads;
   if (!args.out_dir.empty()) load.output_directory = args.out_dir;
   load.trust_scripts = args.trust_scripts;
+  if (!args.max_memory.empty()) ParseMemorySize(args.max_memory, &load.max_memory);
   load.plugin_directories = PluginDirectories();
   load.package_path.assign(args.package_path.begin(), args.package_path.end());
   load.check_stop = [] {

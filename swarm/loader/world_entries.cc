@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "framework/error.h"
+#include "framework/memory_forecast.h"
 #include "framework/model_section.h"
 #include "framework/object_type.h"
 #include "framework/plugin_controllers.h"
@@ -707,6 +708,7 @@ void WorldLoader::BuildCopies(World* world) {
   int64_t total = 0, built = 0;  // copies, for options_.copy_progress
   for (const EntryPlan& e : entries_)
     total += e.distribute ? static_cast<int64_t>(e.placements.size()) : 1;
+  MemoryForecast forecast("robot copies", total, options_.max_memory);
   for (EntryPlan& e : entries_) {
     std::vector<Pose> poses;
     if (!e.distribute) {
@@ -752,6 +754,7 @@ void WorldLoader::BuildCopies(World* world) {
     for (size_t k = 0; k < poses.size(); ++k) {
       if (options_.check_stop && k % 256 == 0) options_.check_stop();
       if (options_.copy_progress && built % 256 == 0) options_.copy_progress(built, total);
+      if (std::string refusal = forecast.Built(built); !refusal.empty()) throw Error(refusal);
       ++built;
       const EntryPlan::OwnCopy* own = e.FindOwnCopy(static_cast<int64_t>(k));
       ObjectId root;

@@ -355,6 +355,7 @@ WorldSettings WorldLoader::ReadSimulation(const Fields& top, std::optional<int64
   s.threads = options_.threads;
   s.output_directory = options_.output_directory;
   s.trust_scripts = options_.trust_scripts;
+  s.max_memory = options_.max_memory;
   const ValueReader values = WorldValues();
   const Field sim = top.Get("simulation");
   if (sim.present()) {

@@ -59,6 +59,10 @@ struct LoadOptions {
   // last): copies built so far and in all, over every models entry. For a
   // progress line while a large world loads. Empty: never.
   std::function<void(int64_t built, int64_t total)> copy_progress;
+  // --max-memory: bytes the whole process may hold (0: what the machine
+  // has). Copies that will not fit end the load with an error
+  // (framework/memory_forecast.h); WorldSettings::max_memory for the rest.
+  uint64_t max_memory = 0;
 };
 
 // A models entry's `python_controller:` (swarm/python runs it; the program

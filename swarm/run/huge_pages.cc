@@ -5,10 +5,10 @@
 #include <malloc.h>
 #endif
 
-#include <algorithm>
-#include <cctype>
 #include <cstdlib>
 #include <string>
+
+#include "framework/memory_forecast.h"
 
 namespace swarmsim {
 
@@ -25,12 +25,7 @@ std::string TunablesWithHugePages(const char* tunables) {
   return given.empty() ? ours : given + ":" + ours;
 }
 
-bool HugePagesTurnedOff(const char* value) {
-  if (value == nullptr) return false;
-  std::string v(value);
-  std::transform(v.begin(), v.end(), v.begin(), [](unsigned char c) { return std::tolower(c); });
-  return v == "0" || v == "off" || v == "false" || v == "no";
-}
+bool HugePagesTurnedOff(const char* value) { return IsOffValue(value); }
 
 void RestartWithHugePages(char** argv) {
 #if defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__) && !defined(__SANITIZE_THREAD__)

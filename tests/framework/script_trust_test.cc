@@ -495,6 +495,30 @@ TEST_F(TrustTest, TheRunsScriptsTogetherHoldAtMostTheRunsLimit) {
   }
 }
 
+// By default the run's limit grows with the swarm: 4 GiB, or 64 KiB a
+// robot past 65,536 robots (each robot's Lua state takes ~16 KiB: 300,000
+// robots were refused at ~250,000 under a flat 4 GiB). A limit the world
+// sets stays as set.
+TEST_F(TrustTest, TheRunsDefaultLimitGrowsWithTheSwarm) {
+  const auto limit_with = [&](int robots, int64_t setting) {
+    settings_.run_script_memory_limit = setting;
+    MakeWorld();
+    Scene& scene = world_->scene();
+    for (int r = 1; r < robots; ++r) {
+      const std::string name = "crate#" + std::to_string(r);
+      scene.MakeModelInstance(scene.AddDummy(name, {}, {}), "crate", name);
+    }
+    AddRobot("bot#0", "function sysCall_init() end\n");
+    world_->Start();
+    EXPECT_EQ(world_->robot_count(), robots);
+    return world_->run_script_memory().limit();
+  };
+  EXPECT_EQ(limit_with(10, -1), uint64_t{4} << 30);
+  EXPECT_EQ(limit_with(100'000, -1), uint64_t{100'000} * (64 << 10));
+  EXPECT_EQ(limit_with(100'000, int64_t{40} << 20), uint64_t{40} << 20);
+  EXPECT_EQ(limit_with(100'000, 0), 0u) << "0: no limit";
+}
+
 // Robots copied at run time count against the run's limit, even copies
 // that run no script (which no Lua heap would otherwise count): a script
 // copying robots without end is stopped at its line, and removing the

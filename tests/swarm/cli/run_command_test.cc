@@ -231,3 +231,30 @@ TEST(CliTest, ProgressShowsTheRobotsLoadedUnlessQuiet) {
 }
 
 }  // namespace
+
+// A world that will not fit in memory is refused with a message while it is
+// built, not killed by the kernel: --max-memory stands in for a small
+// machine here. 20,000 Lua foot-bots take ~600 MiB; under 400 MiB the
+// forecast stops their Lua states (or, in a build whose copies are bigger,
+// the copies), naming the cap, and summary.json says so.
+TEST(CliTest, AWorldThatWillNotFitIsRefusedWithAMessage) {
+  const fs::path out = TempDir("max_memory");
+  Result r = RunProgram("run " + std::string(SWARMSIM_SOURCE_DIR) +
+                        "/worlds/diffusion.yaml --set robots=20000 --steps 1 --quiet "
+                        "--max-memory 400M --out " +
+                        out.string());
+  EXPECT_NE(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("not enough memory for 20,000 robot"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("(--max-memory 400 MiB). About "), std::string::npos) << r.output;
+  std::ifstream summary(out / "summary.json");
+  ASSERT_TRUE(summary.good()) << r.output;
+  const auto json = nlohmann::json::parse(summary);
+  EXPECT_EQ(json["status"], "error");
+  EXPECT_NE(json["error"].get<std::string>().find("not enough memory"), std::string::npos);
+
+  Result bad = RunProgram("run " + Data("ok.yaml") + " --steps 1 --max-memory 12X");
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_NE(bad.output.find("expected a memory size such as 500M, 2G or 1.5GiB, got '12X'"),
+            std::string::npos)
+      << bad.output;
+}

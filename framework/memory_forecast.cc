@@ -1,0 +1,217 @@
+// Memory forecasts for large worlds (memory_forecast.h).
+#include "framework/memory_forecast.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <utility>
+
+namespace swarmsim {
+namespace {
+
+// Checks start once this many items are built (fewer give a noisy growth:
+// with huge pages the resident size moves 2 MiB at a time).
+constexpr int64_t kFirstCheck = 1000;
+// Worlds smaller than this are never checked.
+constexpr int64_t kMinItems = 2000;
+
+uint64_t ResidentBytes() {
+  std::ifstream in("/proc/self/statm");
+  uint64_t size = 0, resident = 0;
+  if (!(in >> size >> resident)) return 0;
+  return resident * static_cast<uint64_t>(sysconf(_SC_PAGESIZE));
+}
+
+// MemAvailable + SwapFree from /proc/meminfo; UINT64_MAX if unreadable.
+uint64_t MachineAvailable() {
+  std::ifstream in("/proc/meminfo");
+  std::string key, unit;
+  uint64_t value = 0, available = 0, swap_free = 0;
+  bool found = false;
+  while (in >> key >> value) {
+    std::getline(in, unit);
+    if (key == "MemAvailable:") {
+      available = value * 1024;
+      found = true;
+    } else if (key == "SwapFree:") {
+      swap_free = value * 1024;
+    }
+  }
+  return found ? available + swap_free : UINT64_MAX;
+}
+
+uint64_t ReadNumber(const std::string& path, bool* ok) {
+  std::ifstream in(path);
+  std::string text;
+  *ok = false;
+  if (!(in >> text)) return 0;
+  char* end = nullptr;
+  const unsigned long long v = std::strtoull(text.c_str(), &end, 10);
+  if (end == text.c_str() || *end != '\0') return 0;  // "max"
+  *ok = true;
+  return v;
+}
+
+// The least room a cgroup (v2) limit leaves, over the process's cgroup and
+// its ancestors; UINT64_MAX without one.
+uint64_t CgroupAvailable() {
+  std::ifstream in("/proc/self/cgroup");
+  std::string line, path;
+  while (std::getline(in, line))
+    if (line.rfind("0::", 0) == 0) path = line.substr(3);
+  if (path.empty()) return UINT64_MAX;
+  uint64_t room = UINT64_MAX;
+  for (;;) {
+    const std::string dir = "/sys/fs/cgroup" + (path == "/" ? std::string() : path);
+    bool has_max = false, has_current = false;
+    const uint64_t max = ReadNumber(dir + "/memory.max", &has_max);
+    const uint64_t current = ReadNumber(dir + "/memory.current", &has_current);
+    if (has_max && has_current) room = std::min(room, max > current ? max - current : 0);
+    if (path == "/" || path.empty()) break;
+    const size_t slash = path.rfind('/');
+    path = slash == 0 || slash == std::string::npos ? "/" : path.substr(0, slash);
+  }
+  return room;
+}
+
+// 1234567 -> "1,234,567" (n >= 0).
+std::string Grouped(int64_t n) {
+  const std::string digits = std::to_string(n);
+  std::string out;
+  for (size_t i = 0; i < digits.size(); ++i) {
+    if (i > 0 && (digits.size() - i) % 3 == 0) out += ',';
+    out += digits[i];
+  }
+  return out;
+}
+
+}  // namespace
+
+bool IsOffValue(const char* value) {
+  if (value == nullptr) return false;
+  std::string v(value);
+  std::transform(v.begin(), v.end(), v.begin(), [](unsigned char c) { return std::tolower(c); });
+  return v == "0" || v == "off" || v == "false" || v == "no";
+}
+
+std::string FormatBytes(double bytes) {
+  static const char* const kUnits[] = {"bytes", "KiB", "MiB", "GiB", "TiB"};
+  int unit = 0;
+  while (bytes >= 1024 && unit < 4) {
+    bytes /= 1024;
+    ++unit;
+  }
+  char text[48];
+  if (unit == 0)
+    std::snprintf(text, sizeof text, "%.0f bytes", bytes);
+  else
+    std::snprintf(text, sizeof text, bytes < 100 ? "%.1f %s" : "%.0f %s", bytes, kUnits[unit]);
+  return text;
+}
+
+bool ParseMemorySize(const std::string& text, uint64_t* bytes) {
+  size_t end = 0;
+  double value = 0;
+  try {
+    value = std::stod(text, &end);
+  } catch (const std::exception&) {
+    return false;
+  }
+  std::string unit = text.substr(end);
+  std::transform(unit.begin(), unit.end(), unit.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
+  double scale = 1;
+  if (unit == "k" || unit == "kib" || unit == "kb")
+    scale = 1024.0;
+  else if (unit == "m" || unit == "mib" || unit == "mb")
+    scale = 1024.0 * 1024;
+  else if (unit == "g" || unit == "gib" || unit == "gb")
+    scale = 1024.0 * 1024 * 1024;
+  else if (unit == "t" || unit == "tib" || unit == "tb")
+    scale = 1024.0 * 1024 * 1024 * 1024;
+  else if (!unit.empty() && unit != "b")
+    return false;
+  const double b = value * scale;
+  if (!std::isfinite(b) || b < 1 || b > 1.8e19 || text.empty() || std::isspace(text[0]))
+    return false;
+  *bytes = static_cast<uint64_t>(b);
+  return true;
+}
+
+MemoryRoom ReadMemoryRoom(uint64_t cap) {
+  MemoryRoom room;
+  room.resident = ResidentBytes();
+  const uint64_t machine = MachineAvailable();
+  if (machine != UINT64_MAX) {
+    room.available = machine;
+    room.bound = "this machine's available memory and swap";
+  }
+  if (const uint64_t group = CgroupAvailable(); group < room.available) {
+    room.available = group;
+    room.bound = "the memory limit of the process's cgroup (memory.max)";
+  }
+  if (cap > 0) {
+    const uint64_t left = cap > room.resident ? cap - room.resident : 0;
+    if (left < room.available) {
+      room.available = left;
+      room.bound = "--max-memory " + FormatBytes(static_cast<double>(cap));
+    }
+  }
+  return room;
+}
+
+MemoryForecast::MemoryForecast(std::string items, int64_t total, uint64_t cap)
+    : items_(std::move(items)), total_(total), cap_(cap) {
+  if (total_ < kMinItems || IsOffValue(std::getenv("SWARMSIM_MEMORY_CHECK"))) return;
+  stride_ = std::max<int64_t>(kFirstCheck, total_ / 64);
+}
+
+std::string MemoryForecast::Built(int64_t built) {
+  if (stride_ == 0 || built <= 0 || built >= total_ || built % stride_ != 0) return "";
+  if (refused_.load(std::memory_order_relaxed)) return "";
+  if (built == stride_) {
+    // The growth is measured from here: the first items also pay for what
+    // all share (arrays reserved for every copy, each touched in 2 MiB
+    // pages), which would make the rest look far costlier than it is.
+    base_resident_.store(ResidentBytes());
+    return "";
+  }
+  // Growth over at least an eighth of the items: with huge pages the
+  // resident size moves 2 MiB at a time per growing array.
+  if (built < total_ / 8 || built < 2 * stride_) return "";
+  const uint64_t base = base_resident_.load();
+  if (base == 0) return "";
+  const MemoryRoom room = ReadMemoryRoom(cap_);
+  const uint64_t grown = room.resident > base ? room.resident - base : 0;
+  std::string verdict = Verdict(items_, total_, built, built - stride_, grown, room);
+  if (!verdict.empty() && refused_.exchange(true)) return "";  // said once
+  return verdict;
+}
+
+std::string MemoryForecast::Verdict(const std::string& items, int64_t total, int64_t built,
+                                    int64_t measured, uint64_t grown, const MemoryRoom& room) {
+  if (measured <= 0 || built >= total || room.available == UINT64_MAX) return "";
+  const double each = static_cast<double>(grown) / static_cast<double>(measured);
+  const double need = each * static_cast<double>(total - built);
+  if (need <= static_cast<double>(room.available)) return "";
+  const int64_t fit = built + static_cast<int64_t>(static_cast<double>(room.available) / each);
+  std::ostringstream s;
+  s << "not enough memory for " << Grouped(total) << " " << items << ": with " << Grouped(built)
+    << " built, the last " << Grouped(measured) << " took "
+    << FormatBytes(static_cast<double>(grown)) << " (" << FormatBytes(each)
+    << " each), so the other " << Grouped(total - built) << " need about " << FormatBytes(need)
+    << " more, and the process may take " << FormatBytes(static_cast<double>(room.available))
+    << " more (" << room.bound << "). About " << Grouped(fit)
+    << " would fit: run fewer robots or give the run more memory (README, \"A world that does not "
+       "fit\"); "
+       "SWARMSIM_MEMORY_CHECK=0 skips this check";
+  return s.str();
+}
+
+}  // namespace swarmsim

@@ -1,0 +1,70 @@
+// Refuses, with a message, a world that will not fit in memory, before the
+// kernel's out-of-memory killer ends the run without one.
+//
+// While many like items are built (a large world's robot copies, their Lua
+// states), a MemoryForecast measures how much the process's resident size
+// grows per item (from the first checkpoint, at 1,000 items or 1/64 of the
+// way, on), and, once an eighth of the items are built, at every further
+// checkpoint compares what the rest would need with the room left: the machine's
+// available memory (MemAvailable + SwapFree), its cgroup's (memory.max -
+// memory.current, for a container or a cluster job), and a cap the user
+// set (`swarmsim run --max-memory`), whichever is smallest. Past it the
+// check returns an error naming how many items fit. It never refuses a
+// world of fewer than 2,000 items, nor anything when SWARMSIM_MEMORY_CHECK
+// is 0, off, false or no.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <string>
+
+namespace swarmsim {
+
+// What the process holds and may still take, in bytes.
+struct MemoryRoom {
+  uint64_t resident = 0;            // resident size now (/proc/self/statm)
+  uint64_t available = UINT64_MAX;  // more it may take; UINT64_MAX: unknown
+  std::string bound;                // what `available` is ("--max-memory 2 GiB", ...)
+};
+
+// Reads the room left; `cap`: bytes the whole process may hold (0: none).
+MemoryRoom ReadMemoryRoom(uint64_t cap);
+
+// "1.5 GiB", "300 MiB", "16.9 KiB".
+std::string FormatBytes(double bytes);
+
+// Parses a size: "500M", "2G", "2GiB", "1.5g", "4096" (bytes); K/M/G/T are
+// powers of 1024. False on anything else (or zero).
+bool ParseMemorySize(const std::string& text, uint64_t* bytes);
+
+// Whether an environment variable's value turns a feature off: 0, off,
+// false or no, any case (SWARMSIM_MEMORY_CHECK, SWARMSIM_HUGEPAGES).
+bool IsOffValue(const char* value);
+
+class MemoryForecast {
+ public:
+  // `items`: what is built, plural ("robot copies", "robots' Lua states");
+  // `total`: how many; `cap`: as ReadMemoryRoom's.
+  MemoryForecast(std::string items, int64_t total, uint64_t cap);
+
+  // Notes that `built` items of `total` are built (any thread; each count
+  // once). At a checkpoint, reads the memory and returns the error text
+  // when the rest will not fit; "" otherwise.
+  std::string Built(int64_t built);
+
+  // The check, for a given reading (tests): `built` of `total` items are
+  // built, the last `measured` of them grew the process by `grown` bytes.
+  // "" when the rest fits.
+  static std::string Verdict(const std::string& items, int64_t total, int64_t built,
+                             int64_t measured, uint64_t grown, const MemoryRoom& room);
+
+ private:
+  std::string items_;
+  int64_t total_;
+  uint64_t cap_;
+  int64_t stride_ = 0;                      // items between checkpoints; 0: no checks
+  std::atomic<uint64_t> base_resident_{0};  // at the first checkpoint
+  std::atomic<bool> refused_{false};
+};
+
+}  // namespace swarmsim
