@@ -31,6 +31,7 @@
 #include <sstream>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "framework/display_path.h"
@@ -233,24 +234,16 @@ lua_CFunction BaseFunction(const char* name) {
   return entry->function;
 }
 
-// Replaces the global table `name` (and its package.loaded entry), opened
-// already, by an empty table that fetches each entry of `library` on first
-// use: every robot's state carries its libraries, and a script uses a few
-// of their functions (math: 7 of 28 in diffusion.lua; ~3 KB per robot
-// less for math, string and table). Entries that hold something of the
-// state (math.random and math.randomseed share its generator) are copied
-// now. `pairs(math)` lists what the robot has used so far.
-void MakeLazy(lua_State* L, const LazyLibrary& library) {
-  lua_getglobal(L, library.name);
-  const int old = lua_gettop(L);
-  lua_newtable(L);
-  for (lua_pushnil(L); lua_next(L, old) != 0; lua_pop(L, 1)) {
-    if (lua_type(L, -1) != LUA_TFUNCTION || lua_getupvalue(L, -1, 1) == nullptr) continue;
-    lua_pop(L, 1);
-    lua_pushvalue(L, -2);
-    lua_pushvalue(L, -2);
-    lua_rawset(L, -5);
-  }
+// Makes the global table `library.name` (and its package.loaded entry) an
+// empty table that fetches each entry of `library` on first use, and leaves
+// it on the stack: every robot's state carries its libraries, and a script
+// uses a few of their functions (math: 7 of 28 in diffusion.lua; ~3 KB per
+// robot less for math, string and table). The library is never opened in
+// the robot's state (that would build its full table, then drop it): what
+// opening it leaves besides its entries comes from LibraryExtras. `pairs(math)`
+// lists what the robot has used so far. `fields`: those the caller adds.
+void OpenLazy(lua_State* L, const LazyLibrary& library, int fields) {
+  lua_createtable(L, 0, fields);
   lua_createtable(L, 0, 1);
   lua_pushlightuserdata(L, const_cast<LazyLibrary*>(&library));
   lua_pushcclosure(L, (Guarded<LazyLibraryIndex, "">), 1);
@@ -258,10 +251,54 @@ void MakeLazy(lua_State* L, const LazyLibrary& library) {
   lua_setmetatable(L, -2);
   lua_pushvalue(L, -1);
   lua_setglobal(L, library.name);
-  lua_getfield(L, LUA_REGISTRYINDEX, LUA_LOADED_TABLE);
-  lua_insert(L, -2);
+  luaL_getsubtable(L, LUA_REGISTRYINDEX, LUA_LOADED_TABLE);
+  lua_pushvalue(L, -2);
   lua_setfield(L, -2, library.name);
-  lua_settop(L, old - 1);
+  lua_pop(L, 1);
+}
+
+// What opening string and math leaves in a state besides their tables'
+// entries, read once per process from a scratch state: the metamethods of
+// the strings' metatable (arithmetic on numeric strings: "10" + 1), and
+// math.random and math.randomseed, C functions sharing one upvalue (the
+// generator, a userdata of `generator_bytes`).
+struct LibraryExtras {
+  std::vector<std::pair<std::string, lua_CFunction>> string_metamethods;  // all but __index
+  lua_CFunction random = nullptr;
+  lua_CFunction randomseed = nullptr;
+  size_t generator_bytes = 0;
+};
+
+const LibraryExtras& Extras() {
+  static const LibraryExtras extras = [] {
+    LibraryExtras e;
+    lua_State* L = luaL_newstate();
+    if (L == nullptr) throw std::bad_alloc();
+    luaL_requiref(L, LUA_STRLIBNAME, luaopen_string, 0);
+    lua_pushliteral(L, "");
+    SWARMSIM_CHECK(lua_getmetatable(L, -1) != 0, "Lua's string library set no metatable");
+    for (lua_pushnil(L); lua_next(L, -2) != 0; lua_pop(L, 1)) {
+      if (lua_type(L, -2) != LUA_TSTRING || !lua_iscfunction(L, -1)) continue;  // __index
+      SWARMSIM_CHECK(lua_getupvalue(L, -1, 1) == nullptr, "a string metamethod has an upvalue");
+      e.string_metamethods.emplace_back(lua_tostring(L, -2), lua_tocfunction(L, -1));
+    }
+    std::sort(e.string_metamethods.begin(), e.string_metamethods.end());
+    lua_settop(L, 0);
+    luaL_requiref(L, LUA_MATHLIBNAME, luaopen_math, 0);
+    lua_getfield(L, 1, "random");
+    lua_getfield(L, 1, "randomseed");
+    e.random = lua_tocfunction(L, 2);
+    e.randomseed = lua_tocfunction(L, 3);
+    SWARMSIM_CHECK(e.random != nullptr && e.randomseed != nullptr &&
+                       lua_getupvalue(L, 2, 1) != nullptr && lua_getupvalue(L, 3, 1) != nullptr &&
+                       lua_type(L, 4) == LUA_TUSERDATA && lua_rawequal(L, 4, 5) &&
+                       lua_getupvalue(L, 2, 2) == nullptr,
+                   "Lua's math.random changed");
+    e.generator_bytes = lua_rawlen(L, 4);
+    lua_close(L);
+    return e;
+  }();
+  return extras;
 }
 
 // Replaces field `name` of the table at `table` with `wrapper`, which gets
@@ -692,32 +729,42 @@ void OpenSafeLibraries(lua_State* L) {
   lua_pushcfunction(L, (Guarded<SafeSetMetatable, "setmetatable">));
   lua_setfield(L, -2, "setmetatable");
   lua_pop(L, 1);
-  static constexpr luaL_Reg kLibraries[] = {
-      {LUA_TABLIBNAME, luaopen_table},
-      {LUA_STRLIBNAME, luaopen_string},
-      {LUA_MATHLIBNAME, luaopen_math},
-  };
-  for (const luaL_Reg& library : kLibraries) {
-    luaL_requiref(L, library.name, library.func, 1);
-    lua_pop(L, 1);
-  }
-  // Each library fetches its entries on first use (MakeLazy). string.dump
+  // Each library fetches its entries on first use (OpenLazy). string.dump
   // makes binary chunks, which nothing here can load: it is refused by
-  // name. Strings' methods ("abc"):upper() come from the new table too.
-  // Debian builds Lua with LUA_COMPAT_MATHLIB: the functions 5.4 deprecated
-  // (cosh, pow, ...) are left out.
+  // name. Debian builds Lua with LUA_COMPAT_MATHLIB: the functions 5.4
+  // deprecated (cosh, pow, ...) are left out.
   static const LazyLibrary kString = ReadLibrary(LUA_STRLIBNAME, luaopen_string, {}, "dump");
   static const LazyLibrary kTable = ReadLibrary(LUA_TABLIBNAME, luaopen_table, {}, nullptr);
   static const LazyLibrary kMath =
       ReadLibrary(LUA_MATHLIBNAME, luaopen_math,
                   {"cosh", "sinh", "tanh", "pow", "frexp", "ldexp", "log10"}, nullptr);
-  for (const LazyLibrary* library : {&kString, &kTable, &kMath}) MakeLazy(L, *library);
-  lua_pushliteral(L, "");
-  lua_getmetatable(L, -1);
-  lua_getglobal(L, LUA_STRLIBNAME);
+  const LibraryExtras& extras = Extras();
+  OpenLazy(L, kTable, 0);
+  lua_pop(L, 1);
+  // The strings' metatable, as luaopen_string makes it: their methods
+  // ("abc"):upper() from the lazy table, arithmetic on numeric strings.
+  OpenLazy(L, kString, 0);
+  lua_createtable(L, 0, static_cast<int>(extras.string_metamethods.size()) + 1);
+  for (const auto& [name, function] : extras.string_metamethods) {
+    lua_pushcfunction(L, function);
+    lua_setfield(L, -2, name.c_str());
+  }
+  lua_insert(L, -2);
   lua_setfield(L, -2, "__index");
-  lua_pop(L, 2);
-  lua_getglobal(L, LUA_MATHLIBNAME);
+  lua_pushliteral(L, "");
+  lua_insert(L, -2);
+  lua_setmetatable(L, -2);
+  lua_pop(L, 1);
+  // math.random and math.randomseed share the state's own generator (seeded
+  // per robot by the caller, through the wrapped randomseed).
+  OpenLazy(L, kMath, 2);
+  // Zeroed until seeded (luaopen_math seeds it from the clock).
+  std::memset(lua_newuserdatauv(L, extras.generator_bytes, 0), 0, extras.generator_bytes);
+  lua_pushvalue(L, -1);
+  lua_pushcclosure(L, extras.random, 1);
+  lua_setfield(L, -3, "random");
+  lua_pushcclosure(L, extras.randomseed, 1);
+  lua_setfield(L, -2, "randomseed");
   WrapField(L, -1, "randomseed", Guarded<SafeRandomSeed, "math.randomseed">);
   lua_pop(L, 1);
 }

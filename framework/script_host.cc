@@ -385,7 +385,11 @@ void Initialize(ScriptState* state, CompiledChunks* chunks = nullptr) {
   // holds (the incremental default lets it double between cycles: 10,000
   // robots would carry ~20 KB of garbage each). In Lua 5.4.4 a full
   // collection in generational mode leaves the next target at twice the
-  // heap; one young step after it sets the target from the live size.
+  // heap; one young step after it sets the target from the live size. A
+  // full incremental collection first: without it the diffusion robot's
+  // heap settles 0.56 KiB higher for good (17.11 vs 16.55 KiB, measured
+  // over 30 steps) since its libraries are no longer opened in full.
+  lua_gc(L, LUA_GCCOLLECT);
   lua_gc(L, LUA_GCGEN, 0, 0);
   lua_gc(L, LUA_GCCOLLECT);
   lua_gc(L, LUA_GCSTEP, 0);
