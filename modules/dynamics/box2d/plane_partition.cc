@@ -157,30 +157,34 @@ void PartitionedPlaneWorld::Build(const Scene& scene) {
     }
   }
   // Each region: the ground fixtures within reach, then its bodies in slot
-  // order.
+  // order; the regions are built on every worker (each writes only its own
+  // Box2D world and reads the staging one), with the same result as one
+  // after the other.
   const double pad = kGroundPad * options_.length_scale + 4 * max_radius_;
   const double infinity = std::numeric_limits<double>::infinity();
-  for (int64_t c = 0; c < columns; ++c) {
+  regions_.resize(static_cast<size_t>(columns * rows_));
+  std::vector<std::vector<uint32_t>> bodies_of(regions_.size());
+  for (uint32_t b = 0; b < bodies.size(); ++b)
+    bodies_of[static_cast<size_t>(RegionOf(bodies[b].body->GetPosition()))].push_back(b);
+  ForEachRegion([&](size_t index) {
+    const int64_t c = static_cast<int64_t>(index) / rows_;
+    const int r = static_cast<int>(static_cast<int64_t>(index) % rows_);
     const double column_lo = c == 0 ? -infinity : borders_[static_cast<size_t>(c - 1)];
     const double column_hi = c == columns - 1 ? infinity : borders_[static_cast<size_t>(c)];
-    for (int r = 0; r < rows_; ++r) {
-      auto region = std::make_unique<PlaneWorld>(options_, settings_);
-      region->BuildEmpty();
-      double row_lo = -infinity, row_hi = infinity;
-      if (rows_ > 1) {
-        const std::vector<double>& row_borders = row_borders_[static_cast<size_t>(c)];
-        if (r > 0) row_lo = row_borders[static_cast<size_t>(r - 1)];
-        if (r < rows_ - 1) row_hi = row_borders[static_cast<size_t>(r)];
-      }
-      region->CopyGround(*staging, axis_, column_lo - pad, column_hi + pad, row_lo - pad,
-                         row_hi + pad);
-      regions_.push_back(std::move(region));
+    auto region = std::make_unique<PlaneWorld>(options_, settings_);
+    region->BuildEmpty();
+    double row_lo = -infinity, row_hi = infinity;
+    if (rows_ > 1) {
+      const std::vector<double>& row_borders = row_borders_[static_cast<size_t>(c)];
+      if (r > 0) row_lo = row_borders[static_cast<size_t>(r - 1)];
+      if (r < rows_ - 1) row_hi = row_borders[static_cast<size_t>(r)];
     }
-  }
-  // Copied, not moved: the staging world goes whole when Build returns.
-  for (uint32_t b = 0; b < bodies.size(); ++b)
-    staging->CopyBody(b,
-                      regions_[static_cast<size_t>(RegionOf(bodies[b].body->GetPosition()))].get());
+    region->CopyGround(*staging, axis_, column_lo - pad, column_hi + pad, row_lo - pad,
+                       row_hi + pad);
+    // Copied, not moved: the staging world goes whole when Build returns.
+    for (uint32_t b : bodies_of[index]) staging->CopyBody(b, region.get());
+    regions_[index] = std::move(region);
+  });
 }
 
 void PartitionedPlaneWorld::SyncFromScene(const Scene& scene, double duration) {
