@@ -62,9 +62,13 @@ struct LuaContext {
   ObjectId script_object;
   int script_env_ref = LUA_NOREF;  // its environment table, in the registry
   ScriptMailbox* mailbox = nullptr;
-  void* host_state = nullptr;     // the host's ScriptState (script_state.h)
-  void* host_script = nullptr;    // the host's Script being run (script_state.h)
-  bool is_main = false;           // the main script's state
+  void* host_state = nullptr;   // the host's ScriptState (script_state.h)
+  void* host_script = nullptr;  // the host's Script being run (script_state.h)
+  bool is_main = false;         // the main script's state
+  // Whether closing the state could run code or write: io was opened (file
+  // handles flush and close in their finalizers), or the sandbox is lifted.
+  // Sandboxed scripts cannot set __gc otherwise (lua_sandbox.cc).
+  bool may_finalize = false;
   bool in_sensing = false;        // running a sysCall_sensing (sim.handleChildScript follows it)
   bool dynamics_handled = false;  // the main script called sim.handleDynamics() this step
   int64_t slice_fires = 0;        // time-slice hook calls since the thread was resumed

@@ -616,6 +616,7 @@ int SandboxGlobalIndex(lua_State* L) {
   if (lua_type(L, 2) != LUA_TSTRING) return 0;
   const std::string_view key = lua_tostring(L, 2);
   if (key == "io") {
+    Context(L).may_finalize = true;
     luaL_requiref(L, LUA_IOLIBNAME, luaopen_io, 0);
     NewRestrictedTable(L, "io", 4);
     for (const char* kept : {"open", "lines", "type", "close"}) {
@@ -665,6 +666,7 @@ int SandboxGlobalIndex(lua_State* L) {
 // io.open / io.lines take relative paths from the world's folder (reading)
 // or the output folder (writing).
 void OpenTrusted(lua_State* L) {
+  Context(L).may_finalize = true;
   luaL_openlibs(L);
   lua_getglobal(L, LUA_LOADLIBNAME);
   std::string path;

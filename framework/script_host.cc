@@ -65,6 +65,18 @@ namespace {
 // bodies and sysCall_init, a few tens of microseconds.
 constexpr int64_t kStartGrain = 4;
 
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kSanitized = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+constexpr bool kSanitized = true;
+#else
+constexpr bool kSanitized = false;
+#endif
+#else
+constexpr bool kSanitized = false;
+#endif
+
 // Registry key of the metatable shared by the script environments of a state.
 const char kEnvironmentMetatableKey = 0;
 
@@ -691,6 +703,11 @@ void LuaScriptHost::Stop() {
       } catch (const std::exception& e) {
         errors[r] = e.what();
       }
+      // The process ends next (swarmsim run): a state whose closing runs no
+      // code is left to the system rather than freed one object at a time
+      // (1.3 s of a 100,000-robot run's end). Not under ASan (leak checks).
+      if (!kSanitized && world_->process_ends_after_stop() && !robots_[r]->context.may_finalize)
+        robots_[r]->L = nullptr;
       robots_[r].reset();
     }
   });

@@ -336,6 +336,11 @@ class World final : public PhaseHandlers {
   // Script `print` lines are passed here, prefixed by the robot instance
   // name, in robot order after each phase. Default: standard output.
   void set_log_sink(std::function<void(std::string_view)> sink) { log_sink_ = std::move(sink); }
+  // The process ends soon after this world stops (swarmsim run): Stop leaves
+  // the scripts' Lua states that could run no code as they close (no io
+  // file, sandboxed) to the system instead of freeing them object by object.
+  void set_process_ends_after_stop(bool ends) { process_ends_after_stop_ = ends; }
+  bool process_ends_after_stop() const { return process_ends_after_stop_; }
   // For the plugins' world API (record_metric): a metrics row of this step
   // for `robot` (-1: swarm-level), from the record phase's plugin callbacks
   // only (any thread). False outside that phase, for a bad robot or an
@@ -558,6 +563,7 @@ class World final : public PhaseHandlers {
   bool started_ = false;
   bool stopped_ = false;
   bool failed_ = false;
+  bool process_ends_after_stop_ = false;
 };
 
 }  // namespace swarmsim

@@ -448,6 +448,9 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
                        ": the run goes from step " + std::to_string(first) + " to " +
                        std::to_string(first + options.steps));
   }
+  // Nothing runs this world again: its end need not free every Lua object
+  // (--view serves the recording's files, not the world).
+  loaded.world->set_process_ends_after_stop(true);
   const RunResult result = RunWorld(loaded.world.get(), options, std::cout, std::cerr);
   // summary.json is written: its word is final. A stop signal from now on
   // is noted and changes nothing (the run is complete, the exit status is

@@ -53,6 +53,33 @@ TEST(SandboxCliTest, EachEscapeFromAWorldFileIsRefusedWithScriptAndLine) {
   EXPECT_FALSE(fs::exists("/tmp/swarmsim_pwned"));
 }
 
+// What a script's state does as it closes still happens at the run's end:
+// a file it never closed is complete, and (with --trust-scripts) its
+// finalizers run. The program leaves states to the system at its end only
+// when closing them runs no code (no io, sandboxed).
+TEST(SandboxCliTest, WhatClosingAScriptsStateDoesHappensAtTheRunsEnd) {
+  fs::path dir = MakeWorld("log = assert(io.open('log.txt', 'w')); log:write('started')");
+  Result r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 3 --quiet --out " +
+                        (dir / "out").string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  std::string text;
+  std::getline(std::ifstream(dir / "out" / "log.txt"), text);
+  EXPECT_EQ(text, "started");
+  fs::remove_all(dir);
+
+  dir = MakeWorld("keep = setmetatable({}, {__gc = function() local f = io.open('" +
+                  (fs::temp_directory_path() / "swarmsim_gc_probe.txt").string() +
+                  "', 'w'); f:write('finalized'); f:close() end})");
+  fs::remove(fs::temp_directory_path() / "swarmsim_gc_probe.txt");
+  r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 3 --quiet --trust-scripts");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  text.clear();
+  std::getline(std::ifstream(fs::temp_directory_path() / "swarmsim_gc_probe.txt"), text);
+  EXPECT_EQ(text, "finalized");
+  fs::remove(fs::temp_directory_path() / "swarmsim_gc_probe.txt");
+  fs::remove_all(dir);
+}
+
 TEST(SandboxCliTest, OutFolderIsWritableAndTrustScriptsLiftsTheSandbox) {
   fs::path dir = MakeWorld(
       "local v = io.open('data.txt'):read('n'); local f = assert(io.open('copy.txt', 'w')); "
