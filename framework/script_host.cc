@@ -49,6 +49,7 @@
 #include "framework/error.h"
 #include "framework/lua_api.h"
 #include "framework/memory_forecast.h"
+#include "framework/sanitizers.h"
 #include "framework/scene.h"
 #include "framework/scheduler.h"
 #include "framework/script_calls.h"
@@ -64,18 +65,6 @@ namespace {
 // Robots started per task: starting one compiles its scripts and runs their
 // bodies and sysCall_init, a few tens of microseconds.
 constexpr int64_t kStartGrain = 4;
-
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kSanitized = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr bool kSanitized = true;
-#else
-constexpr bool kSanitized = false;
-#endif
-#else
-constexpr bool kSanitized = false;
-#endif
 
 // Registry key of the metatable shared by the script environments of a state.
 const char kEnvironmentMetatableKey = 0;
@@ -706,7 +695,8 @@ void LuaScriptHost::Stop() {
       // The process ends next (swarmsim run): a state whose closing runs no
       // code is left to the system rather than freed one object at a time
       // (1.3 s of a 100,000-robot run's end). Not under ASan (leak checks).
-      if (!kSanitized && world_->process_ends_after_stop() && !robots_[r]->context.may_finalize)
+      if (!kAddressSanitizer && world_->process_ends_after_stop() &&
+          !robots_[r]->context.may_finalize)
         robots_[r]->L = nullptr;
       robots_[r].reset();
     }

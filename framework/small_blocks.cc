@@ -7,20 +7,12 @@
 #include <cstring>
 #include <mutex>
 
+#include "framework/sanitizers.h"
+
 namespace swarmsim::small_blocks {
 namespace {
 
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kPooled = false;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr bool kPooled = false;
-#else
-constexpr bool kPooled = true;
-#endif
-#else
-constexpr bool kPooled = true;
-#endif
+constexpr bool kPooled = !kAddressSanitizer;
 
 // Size classes: 8-byte steps up to 256 bytes (Lua's objects, strings),
 // then 16-byte steps up to kMaxSmallBlock (arrays and hash parts of tables,

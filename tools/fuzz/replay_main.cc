@@ -29,6 +29,7 @@
 #include <string>
 #include <vector>
 
+#include "framework/sanitizers.h"
 #include "tools/fuzz/fuzz_support.h"
 
 namespace {
@@ -37,17 +38,7 @@ namespace fs = std::filesystem;
 
 constexpr rlim_t kMaxMemoryBytes = rlim_t{4} << 30;
 
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kAddressSanitizer = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr bool kAddressSanitizer = true;
-#else
-constexpr bool kAddressSanitizer = false;
-#endif
-#else
-constexpr bool kAddressSanitizer = false;
-#endif
+using swarmsim::kAddressSanitizer;
 
 std::set<std::string> SplitExtensions(const std::string& list) {
   std::set<std::string> out;
