@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <initializer_list>
 #include <sstream>
 #include <utility>
 
@@ -58,24 +59,59 @@ uint64_t ReadNumber(const std::string& path, bool* ok) {
   return v;
 }
 
-// The least room a cgroup (v2) limit leaves, over the process's cgroup and
-// its ancestors; UINT64_MAX without one.
+// The sum of `keys`' values in a cgroup's memory.stat ("file 123" lines).
+uint64_t StatSum(const std::string& path, std::initializer_list<const char*> keys) {
+  std::ifstream in(path);
+  std::string key;
+  uint64_t value = 0, sum = 0;
+  while (in >> key >> value)
+    for (const char* k : keys)
+      if (key == k) sum += value;
+  return sum;
+}
+
+// Room under one cgroup's limit: the limit less what the group holds, its
+// page cache (reclaimable, as in MemAvailable) not counted.
+uint64_t RoomUnder(uint64_t limit, uint64_t usage, uint64_t cache) {
+  const uint64_t held = usage > cache ? usage - cache : 0;
+  return limit > held ? limit - held : 0;
+}
+
+// The least room a cgroup limit leaves (v2: the process's group and its
+// ancestors; v1: the memory controller's hierarchical limit); UINT64_MAX
+// without one.
 uint64_t CgroupAvailable() {
   std::ifstream in("/proc/self/cgroup");
-  std::string line, path;
-  while (std::getline(in, line))
-    if (line.rfind("0::", 0) == 0) path = line.substr(3);
-  if (path.empty()) return UINT64_MAX;
+  std::string line, v2_path, v1_path;
+  while (std::getline(in, line)) {
+    if (line.rfind("0::", 0) == 0) v2_path = line.substr(3);
+    const size_t memory = line.find(":memory:");
+    if (memory != std::string::npos) v1_path = line.substr(memory + 8);
+  }
   uint64_t room = UINT64_MAX;
-  for (;;) {
+  for (std::string path = v2_path; !path.empty();) {
     const std::string dir = "/sys/fs/cgroup" + (path == "/" ? std::string() : path);
     bool has_max = false, has_current = false;
     const uint64_t max = ReadNumber(dir + "/memory.max", &has_max);
     const uint64_t current = ReadNumber(dir + "/memory.current", &has_current);
-    if (has_max && has_current) room = std::min(room, max > current ? max - current : 0);
-    if (path == "/" || path.empty()) break;
+    if (has_max && has_current)
+      room = std::min(
+          room,
+          RoomUnder(max, current, StatSum(dir + "/memory.stat", {"active_file", "inactive_file"})));
+    if (path == "/") break;
     const size_t slash = path.rfind('/');
     path = slash == 0 || slash == std::string::npos ? "/" : path.substr(0, slash);
+  }
+  if (!v1_path.empty()) {
+    const std::string dir = "/sys/fs/cgroup/memory" + (v1_path == "/" ? std::string() : v1_path);
+    bool has_usage = false;
+    const uint64_t usage = ReadNumber(dir + "/memory.usage_in_bytes", &has_usage);
+    const uint64_t limit = StatSum(dir + "/memory.stat", {"hierarchical_memory_limit"});
+    // Unlimited reads as the largest page-aligned number (~2^63).
+    if (has_usage && limit > 0 && limit < (uint64_t{1} << 62))
+      room = std::min(room, RoomUnder(limit, usage,
+                                      StatSum(dir + "/memory.stat",
+                                              {"total_active_file", "total_inactive_file"})));
   }
   return room;
 }
@@ -154,7 +190,7 @@ MemoryRoom ReadMemoryRoom(uint64_t cap) {
   }
   if (const uint64_t group = CgroupAvailable(); group < room.available) {
     room.available = group;
-    room.bound = "the memory limit of the process's cgroup (memory.max)";
+    room.bound = "the memory limit of the process's cgroup";
   }
   if (cap > 0) {
     const uint64_t left = cap > room.resident ? cap - room.resident : 0;

@@ -5,13 +5,14 @@
 // states), a MemoryForecast measures how much the process's resident size
 // grows per item (from the first checkpoint, at 1,000 items or 1/64 of the
 // way, on), and, once an eighth of the items are built, at every further
-// checkpoint compares what the rest would need with the room left: the machine's
-// available memory (MemAvailable + SwapFree), its cgroup's (memory.max -
-// memory.current, for a container or a cluster job), and a cap the user
-// set (`swarmsim run --max-memory`), whichever is smallest. Past it the
-// check returns an error naming how many items fit. It never refuses a
-// world of fewer than 2,000 items, nor anything when SWARMSIM_MEMORY_CHECK
-// is 0, off, false or no.
+// checkpoint compares what the rest would need with the room left: the
+// machine's available memory (MemAvailable + SwapFree), its cgroup's (a
+// container's or a cluster job's limit less what the group holds, its page
+// cache not counted; cgroup v2 and v1), and a cap the user set (`swarmsim
+// run --max-memory`), whichever is smallest. Past it the check returns an
+// error naming how many items fit. It never refuses a world of fewer than
+// 2,000 items, nor anything when SWARMSIM_MEMORY_CHECK is 0, off, false or
+// no.
 #pragma once
 
 #include <atomic>
