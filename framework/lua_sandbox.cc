@@ -289,10 +289,12 @@ const LibraryExtras& Extras() {
     lua_getfield(L, 1, "randomseed");
     e.random = lua_tocfunction(L, 2);
     e.randomseed = lua_tocfunction(L, 3);
-    SWARMSIM_CHECK(e.random != nullptr && e.randomseed != nullptr &&
-                       lua_getupvalue(L, 2, 1) != nullptr && lua_getupvalue(L, 3, 1) != nullptr &&
-                       lua_type(L, 4) == LUA_TUSERDATA && lua_rawequal(L, 4, 5) &&
-                       lua_getupvalue(L, 2, 2) == nullptr,
+    // Each with one upvalue, the same generator (pushed at 4 and 5).
+    const bool one_upvalue_each = lua_getupvalue(L, 2, 1) != nullptr &&
+                                  lua_getupvalue(L, 3, 1) != nullptr &&
+                                  lua_getupvalue(L, 2, 2) == nullptr;
+    SWARMSIM_CHECK(e.random != nullptr && e.randomseed != nullptr && one_upvalue_each &&
+                       lua_type(L, 4) == LUA_TUSERDATA && lua_rawequal(L, 4, 5),
                    "Lua's math.random changed");
     e.generator_bytes = lua_rawlen(L, 4);
     lua_close(L);

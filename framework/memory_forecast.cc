@@ -116,9 +116,10 @@ uint64_t CgroupAvailable() {
   return room;
 }
 
-// 1234567 -> "1,234,567" (n >= 0).
-std::string Grouped(int64_t n) {
-  const std::string digits = std::to_string(n);
+}  // namespace
+
+std::string GroupThousands(int64_t n) {
+  const std::string digits = std::to_string(n < 0 ? 0 : n);
   std::string out;
   for (size_t i = 0; i < digits.size(); ++i) {
     if (i > 0 && (digits.size() - i) % 3 == 0) out += ',';
@@ -127,8 +128,6 @@ std::string Grouped(int64_t n) {
   return out;
 }
 
-}  // namespace
-
 bool IsOffValue(const char* value) {
   if (value == nullptr) return false;
   std::string v(value);
@@ -136,7 +135,7 @@ bool IsOffValue(const char* value) {
   return v == "0" || v == "off" || v == "false" || v == "no";
 }
 
-std::string FormatBytes(double bytes) {
+std::string FormatSize(double bytes) {
   static const char* const kUnits[] = {"bytes", "KiB", "MiB", "GiB", "TiB"};
   int unit = 0;
   while (bytes >= 1024 && unit < 4) {
@@ -196,7 +195,7 @@ MemoryRoom ReadMemoryRoom(uint64_t cap) {
     const uint64_t left = cap > room.resident ? cap - room.resident : 0;
     if (left < room.available) {
       room.available = left;
-      room.bound = "--max-memory " + FormatBytes(static_cast<double>(cap));
+      room.bound = "--max-memory " + FormatSize(static_cast<double>(cap));
     }
   }
   return room;
@@ -238,12 +237,12 @@ std::string MemoryForecast::Verdict(const std::string& items, int64_t total, int
   if (need <= static_cast<double>(room.available)) return "";
   const int64_t fit = built + static_cast<int64_t>(static_cast<double>(room.available) / each);
   std::ostringstream s;
-  s << "not enough memory for " << Grouped(total) << " " << items << ": with " << Grouped(built)
-    << " built, the last " << Grouped(measured) << " took "
-    << FormatBytes(static_cast<double>(grown)) << " (" << FormatBytes(each)
-    << " each), so the other " << Grouped(total - built) << " need about " << FormatBytes(need)
-    << " more, and the process may take " << FormatBytes(static_cast<double>(room.available))
-    << " more (" << room.bound << "). About " << Grouped(fit)
+  s << "not enough memory for " << GroupThousands(total) << " " << items << ": with "
+    << GroupThousands(built) << " built, the last " << GroupThousands(measured) << " took "
+    << FormatSize(static_cast<double>(grown)) << " (" << FormatSize(each) << " each), so the other "
+    << GroupThousands(total - built) << " need about " << FormatSize(need)
+    << " more, and the process may take " << FormatSize(static_cast<double>(room.available))
+    << " more (" << room.bound << "). About " << GroupThousands(fit)
     << " would fit: run fewer robots or give the run more memory (README, \"A world that does not "
        "fit\"); "
        "SWARMSIM_MEMORY_CHECK=0 skips this check";

@@ -31,8 +31,12 @@ struct MemoryRoom {
 // Reads the room left; `cap`: bytes the whole process may hold (0: none).
 MemoryRoom ReadMemoryRoom(uint64_t cap);
 
-// "1.5 GiB", "300 MiB", "16.9 KiB".
-std::string FormatBytes(double bytes);
+// "1.5 GiB", "300 MiB", "16.9 KiB": a decimal below 100 of a unit (a
+// robot's share; script_state.h's FormatBytes gives whole MiB and KiB).
+std::string FormatSize(double bytes);
+
+// 1234567 -> "1,234,567" (negative: "0"), as the progress lines print counts.
+std::string GroupThousands(int64_t n);
 
 // Parses a size: "500M", "2G", "2GiB", "1.5g", "4096" (bytes); K/M/G/T are
 // powers of 1024. False on anything else (or zero).

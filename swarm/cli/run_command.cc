@@ -48,8 +48,8 @@ class LoadProgress {
     if (now < 0.5 || (shown_ && now - last_ < 0.5)) return;
     last_ = now;
     shown_ = true;
-    std::cerr << (tty_ ? "\r" : "") << "loading: " << Grouped(built) << " of " << Grouped(total)
-              << " robots built" << (tty_ ? "" : "\n") << std::flush;
+    std::cerr << (tty_ ? "\r" : "") << "loading: " << GroupThousands(built) << " of "
+              << GroupThousands(total) << " robots built" << (tty_ ? "" : "\n") << std::flush;
   }
   // The load failed: an error message goes on a line of its own.
   void Abandon() {
@@ -57,23 +57,16 @@ class LoadProgress {
   }
   void Loaded() {
     if (!shown_ && !forced_) return;
-    std::cerr << (tty_ && shown_ ? "\r" : "") << "loaded " << Grouped(total_) << " robots in "
-              << std::fixed << std::setprecision(1) << Seconds() << std::defaultfloat
-              << " s; starting them" << (tty_ && shown_ ? "\033[K" : "") << "\n"
+    std::cerr << (tty_ && shown_ ? "\r" : "") << "loaded " << GroupThousands(total_)
+              << " robots in " << std::fixed << std::setprecision(1) << Seconds()
+              << std::defaultfloat << " s; starting them" << (tty_ && shown_ ? "\033[K" : "")
+              << "\n"
               << std::flush;
   }
 
  private:
   double Seconds() const {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-  }
-  static std::string Grouped(int64_t n) {  // 100000 -> "100,000"
-    std::string digits = std::to_string(n), out;
-    for (size_t i = 0; i < digits.size(); ++i) {
-      if (i > 0 && (digits.size() - i) % 3 == 0) out += ',';
-      out += digits[i];
-    }
-    return out;
   }
   const std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
   const bool forced_, tty_;

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "framework/memory_forecast.h"
+#include "framework/sanitizers.h"
 
 namespace swarmsim {
 
@@ -28,7 +29,8 @@ std::string TunablesWithHugePages(const char* tunables) {
 bool HugePagesTurnedOff(const char* value) { return IsOffValue(value); }
 
 void RestartWithHugePages(char** argv) {
-#if defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__) && !defined(__SANITIZE_THREAD__)
+#if defined(__GLIBC__) && !defined(__SANITIZE_THREAD__)
+  if (kAddressSanitizer) return;  // malloc is ASan's: the tunable does not apply
   if (HugePagesTurnedOff(std::getenv("SWARMSIM_HUGEPAGES"))) return;
   const char* tunables = std::getenv("GLIBC_TUNABLES");
   const std::string value = TunablesWithHugePages(tunables);
@@ -48,7 +50,8 @@ void RestartWithHugePages(char** argv) {
 }
 
 void TuneMalloc() {
-#if defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__) && !defined(__SANITIZE_THREAD__)
+#if defined(__GLIBC__) && !defined(__SANITIZE_THREAD__)
+  if (kAddressSanitizer) return;
   mallopt(M_MMAP_THRESHOLD, 32 << 20);
   mallopt(M_TOP_PAD, 64 << 20);
   mallopt(M_TRIM_THRESHOLD, 512 << 20);
@@ -56,10 +59,13 @@ void TuneMalloc() {
 }
 
 bool HugePagesRequested() {
-#if defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__) && !defined(__SANITIZE_THREAD__)
+#if defined(__GLIBC__) && !defined(__SANITIZE_THREAD__)
+  // hugetlb=1 (madvise, ours) or 2 (a user's preallocated huge pages).
   const char* tunables = std::getenv("GLIBC_TUNABLES");
-  return tunables != nullptr &&
-         std::string(tunables).find(std::string(kTunable) + "=1") != std::string::npos;
+  if (kAddressSanitizer || tunables == nullptr) return false;
+  const std::string value(tunables);
+  return value.find(std::string(kTunable) + "=1") != std::string::npos ||
+         value.find(std::string(kTunable) + "=2") != std::string::npos;
 #else
   return false;
 #endif

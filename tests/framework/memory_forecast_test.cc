@@ -29,9 +29,12 @@ TEST(MemoryForecastTest, SizesReadAsUsersWriteThem) {
   EXPECT_EQ(bytes, 4096u);
   for (const char* bad : {"", "abc", "-1G", "2X", "0", " 5G", "5 G", "nan", "1e30T"})
     EXPECT_FALSE(ParseMemorySize(bad, &bytes)) << bad;
-  EXPECT_EQ(FormatBytes(1536), "1.5 KiB");
-  EXPECT_EQ(FormatBytes(300.0 * kMiB), "300 MiB");
-  EXPECT_EQ(FormatBytes(512), "512 bytes");
+  EXPECT_EQ(FormatSize(1536), "1.5 KiB");
+  EXPECT_EQ(FormatSize(300.0 * kMiB), "300 MiB");
+  EXPECT_EQ(FormatSize(512), "512 bytes");
+  EXPECT_EQ(GroupThousands(1234567), "1,234,567");
+  EXPECT_EQ(GroupThousands(999), "999");
+  EXPECT_EQ(GroupThousands(100000), "100,000");
   for (const char* off : {"0", "off", "OFF", "false", "No"}) EXPECT_TRUE(IsOffValue(off)) << off;
   for (const char* on : {"1", "on", "", "yes"}) EXPECT_FALSE(IsOffValue(on)) << on;
   EXPECT_FALSE(IsOffValue(nullptr));
