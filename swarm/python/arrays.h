@@ -1,6 +1,7 @@
-// The Python binding's arrays (swarm/python/module.cc): one model's robots
-// laid out by slot, and the numpy arrays gathered from them (poses,
-// velocities, proximity and light readings, joints), written into `out=` when given.
+// The Python binding's arrays (read by swarm/python/world.cc and
+// controller.cc): one model's robots laid out by slot, and the numpy arrays
+// gathered from them (poses, velocities, proximity and light readings,
+// joints), written into `out=` when given.
 #pragma once
 
 #include <pybind11/numpy.h>

@@ -1,5 +1,5 @@
 // The Python binding's IR messages (modules/ir_messaging, the Kilobot's
-// messaging; swarm/python/module.cc): what each robot's transceiver heard in
+// messaging; swarm/python/world.cc): what each robot's transceiver heard in
 // the last sense phase as flat arrays (the form of range_and_bearing and
 // blob_cameras), and the messages Python queues for the next sense phase.
 #pragma once

@@ -1,5 +1,5 @@
 // The Python binding's arrays of the devices beyond arrays.h (swarm/python/
-// module.cc): vision-sensor images and depth, blob cameras, force sensors,
+// world.cc): vision-sensor images and depth, blob cameras, force sensors,
 // distance and collision objects. One model's robots' devices of one type,
 // found by type and name on each robot (ModelLayout, arrays.h).
 #pragma once

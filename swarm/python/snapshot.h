@@ -15,7 +15,7 @@
 
 namespace swarmsim::python {
 
-// The metrics a Python World keeps beside its world (module.cc).
+// The metrics a Python World keeps beside its world (world.h).
 struct MetricMaps {
   std::map<std::string, double>* swarm;
   std::map<std::string, std::map<int, double>>* robots;

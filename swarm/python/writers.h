@@ -1,4 +1,4 @@
-// What Python writes into a world between steps (swarm/python/module.cc):
+// What Python writes into a world between steps (swarm/python/world.cc):
 // joint targets, robots' poses, joint states and model parameters, each
 // checked whole before anything is written, so a refused call changes nothing.
 #pragma once

@@ -1,6 +1,6 @@
-"""Python controllers: one vectorised call per step drives a whole model (README.md, "Python")."""
+"""Python controllers (swarm/python/controller.cc): one vectorised call per step drives a
+whole model (README.md, "Python")."""
 
-import os
 import pathlib
 import tempfile
 import unittest
