@@ -1,0 +1,230 @@
+#include "swarm/loader/urdf_xml.h"
+
+#include <tinyxml2.h>
+
+#include <cstdio>
+#include <functional>
+#include <tuple>
+
+#include "framework/error.h"
+#include "swarm/loader/check_text.h"
+#include "swarm/loader/urdf_numbers.h"
+
+namespace swarmsim::loader {
+namespace {
+
+std::string Num(double v) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%g", v);
+  return buffer;
+}
+
+class XmlReader {
+ public:
+  explicit XmlReader(const std::string& name) : name_(name) {}
+  UrdfXmlFacts Read(const std::string& bytes);
+
+ private:
+  [[noreturn]] void Fail(int line, const std::string& message) const {
+    throw Error(name_ + (line > 0 ? ":" + std::to_string(line) : "") + ": " + message);
+  }
+  void Ignore(const std::string& kind, int line) {
+    auto [it, added] = facts_.ignored.emplace(kind, std::make_pair(0, line));
+    ++it->second.first;
+  }
+  const std::string& name_;
+  UrdfXmlFacts facts_;
+};
+
+UrdfXmlFacts XmlReader::Read(const std::string& bytes) {
+  CheckXmlHasNoDtd(bytes, name_, "URDF");
+  tinyxml2::XMLDocument doc;
+  if (doc.Parse(bytes.data(), bytes.size()) != tinyxml2::XML_SUCCESS)
+    Fail(doc.ErrorLineNum(), std::string("malformed XML: ") + doc.ErrorName() +
+                                 (doc.ErrorStr() ? std::string(" (") + doc.ErrorStr() + ")" : ""));
+  const tinyxml2::XMLElement* robot = doc.RootElement();
+  if (!robot || std::string(robot->Name()) != "robot")
+    Fail(robot ? robot->GetLineNum() : 1, "a URDF file's root element must be <robot>");
+  if (!robot->Attribute("name")) Fail(robot->GetLineNum(), "<robot> needs a 'name' attribute");
+  std::map<std::string, std::string> parent_joint;                // child link -> joint
+  std::map<std::string, std::string> parent_link;                 // child link -> parent link
+  std::vector<std::tuple<std::string, std::string, int>> mimics;  // joint, master, line
+  // Each visual's <material> (or null), per link in order, resolved below.
+  std::vector<std::pair<std::string, const tinyxml2::XMLElement*>> visual_materials;
+  int order = 0;
+  for (const tinyxml2::XMLElement* e = robot->FirstChildElement(); e; e = e->NextSiblingElement()) {
+    const std::string kind = e->Name();
+    const int line = e->GetLineNum();
+    if (kind == "link" || kind == "joint" || kind == "material")
+      if (const std::optional<BadNumber> bad = FindBadNumber(e)) Fail(bad->line, bad->message);
+    if (kind == "link") {
+      const char* name = e->Attribute("name");
+      if (!name || !*name) Fail(line, "<link> needs a 'name' attribute");
+      if (!facts_.link_line.emplace(name, line).second)
+        Fail(line, "link '" + std::string(name) + "' is defined twice (first at line " +
+                       std::to_string(facts_.link_line[name]) + ")");
+      for (const tinyxml2::XMLElement* c = e->FirstChildElement(); c; c = c->NextSiblingElement()) {
+        const std::string part = c->Name();
+        if (part == "visual" || part == "collision") {
+          auto& lines = part == "visual" ? facts_.visual_lines[name] : facts_.collision_lines[name];
+          const tinyxml2::XMLElement* g = c->FirstChildElement("geometry");
+          const tinyxml2::XMLElement* shape = g ? g->FirstChildElement() : nullptr;
+          const std::string what = "link '" + std::string(name) + "' <" + part + ">";
+          if (!shape)
+            Fail(c->GetLineNum(),
+                 what + " needs <geometry> holding a box, cylinder, sphere or mesh");
+          const std::string kind = shape->Name();
+          if (kind != "box" && kind != "cylinder" && kind != "sphere" && kind != "mesh")
+            Fail(shape->GetLineNum(),
+                 what + ": unknown geometry <" + kind + "> (box, cylinder, sphere or mesh)");
+          if (kind == "mesh" && !shape->Attribute("filename"))
+            Fail(shape->GetLineNum(), what + ": <mesh> needs a 'filename'");
+          lines.push_back(g && g->FirstChildElement() ? g->FirstChildElement()->GetLineNum()
+                                                      : c->GetLineNum());
+          if (const tinyxml2::XMLElement* m = c->FirstChildElement("material"))
+            if (m->FirstChildElement("texture")) Ignore("<texture> (materials' textures)", line);
+          if (part == "visual")
+            visual_materials.emplace_back(name, c->FirstChildElement("material"));
+        } else if (part == "inertial") {
+          double mass = 0;
+          const tinyxml2::XMLElement* m = c->FirstChildElement("mass");
+          if (m && m->QueryDoubleAttribute("value", &mass) == tinyxml2::XML_SUCCESS &&
+              !(mass >= 0 && std::isfinite(mass)))
+            Fail(m->GetLineNum(), "link '" + std::string(name) + "': <mass value=\"" + Num(mass) +
+                                      "\"> must be a non-negative number of kg");
+          if (const tinyxml2::XMLElement* in = c->FirstChildElement("inertia"))
+            facts_.inertia_line[name] = in->GetLineNum();
+        } else {
+          Ignore("<" + part + "> in a link", c->GetLineNum());
+        }
+      }
+    } else if (kind == "joint") {
+      const char* name = e->Attribute("name");
+      if (!name || !*name) Fail(line, "<joint> needs a 'name' attribute");
+      if (!facts_.joint_line.emplace(name, line).second)
+        Fail(line, "joint '" + std::string(name) + "' is defined twice (first at line " +
+                       std::to_string(facts_.joint_line[name]) + ")");
+      facts_.joint_order[name] = order++;
+      const std::string type = e->Attribute("type") ? e->Attribute("type") : "";
+      if (type != "revolute" && type != "continuous" && type != "prismatic" && type != "fixed" &&
+          type != "floating" && type != "planar")
+        Fail(line, "joint '" + std::string(name) + "': unknown type '" + type +
+                       "' (revolute, continuous, prismatic, fixed, floating or planar)");
+      if ((type == "revolute" || type == "prismatic") && !e->FirstChildElement("limit"))
+        Fail(line, "joint '" + std::string(name) + "' is " + type +
+                       " and needs <limit lower upper effort velocity>");
+      const tinyxml2::XMLElement* p = e->FirstChildElement("parent");
+      const tinyxml2::XMLElement* c = e->FirstChildElement("child");
+      const char* parent = p ? p->Attribute("link") : nullptr;
+      const char* child = c ? c->Attribute("link") : nullptr;
+      if (!parent)
+        Fail(p ? p->GetLineNum() : line,
+             "joint '" + std::string(name) + "' needs <parent link=\"...\"/>");
+      if (!child)
+        Fail(c ? c->GetLineNum() : line,
+             "joint '" + std::string(name) + "' needs <child link=\"...\"/>");
+      if (auto [it, added] = parent_joint.emplace(child, name); !added)
+        Fail(c->GetLineNum(), "link '" + std::string(child) + "' is the child of two joints, '" +
+                                  it->second + "' (line " +
+                                  std::to_string(facts_.joint_line[it->second]) + ") and '" + name +
+                                  "': the kinematic tree has a loop");
+      parent_link[child] = parent;
+      if (const tinyxml2::XMLElement* m = e->FirstChildElement("mimic")) {
+        facts_.mimic_line[name] = m->GetLineNum();
+        mimics.emplace_back(name, m->Attribute("joint") ? m->Attribute("joint") : "",
+                            m->GetLineNum());
+      }
+      for (const tinyxml2::XMLElement* k = e->FirstChildElement(); k; k = k->NextSiblingElement()) {
+        const std::string part = k->Name();
+        if (part == "safety_controller" || part == "calibration")
+          Ignore("<" + part + "> in a joint", k->GetLineNum());
+        if (part == "dynamics") {
+          double damping = 0, friction = 0;
+          k->QueryDoubleAttribute("damping", &damping);
+          k->QueryDoubleAttribute("friction", &friction);
+          if (!(damping >= 0) || !std::isfinite(damping))
+            Fail(k->GetLineNum(), "joint '" + std::string(name) + "': <dynamics damping=\"" +
+                                      Num(damping) + "\"> must be a non-negative number");
+          if (friction != 0) Ignore("joint <dynamics> friction (not simulated)", k->GetLineNum());
+        }
+      }
+    } else if (kind != "material") {
+      Ignore("<" + kind + ">", line);
+    }
+  }
+  // Every joint names links the file defines; one root; no loops.
+  for (const auto& [child, joint] : parent_joint) {
+    const int line = facts_.joint_line[joint];
+    if (!facts_.link_line.contains(child))
+      Fail(line, "joint '" + joint + "' names child link '" + child +
+                     "', which the file does not define");
+    const std::string& parent = parent_link[child];
+    if (!facts_.link_line.contains(parent))
+      Fail(line, "joint '" + joint + "' names parent link '" + parent +
+                     "', which the file does not define");
+    if (parent == child) Fail(line, "joint '" + joint + "' joins link '" + child + "' to itself");
+  }
+  if (facts_.link_line.empty()) Fail(robot->GetLineNum(), "the robot has no <link>");
+  std::vector<std::string> roots;
+  for (const auto& [link, line] : facts_.link_line)
+    if (!parent_joint.contains(link)) roots.push_back(link);
+  // Links that do not reach a root through their parents are on a loop.
+  for (const auto& [link, line] : facts_.link_line) {
+    std::string at = link;
+    for (size_t steps = 0; parent_link.contains(at); ++steps) {
+      at = parent_link[at];
+      if (steps > facts_.link_line.size()) {
+        const std::string& joint = parent_joint[link];
+        Fail(facts_.joint_line[joint],
+             "the kinematic tree has a loop through link '" + link + "' (joint '" + joint + "')");
+      }
+    }
+  }
+  if (roots.size() > 1)
+    Fail(facts_.link_line[roots[1]], "the robot has several root links ('" + roots[0] + "', '" +
+                                       roots[1] + "'): every link but one must be a joint's child");
+  for (const auto& [joint, master, line] : mimics)
+    if (!facts_.joint_line.contains(master))
+      Fail(line, "joint '" + joint + "': <mimic joint=\"" + master +
+                     "\"> names a joint the file does not define");
+  // Colours: a visual's own <color rgba>, else its named material's, a
+  // robot-level <material> (the first of a name) or one a visual defined
+  // with a colour (urdfdom's rule). rgba's alpha is not imported (0: none).
+  auto rgb = [](const tinyxml2::XMLElement* material) -> std::optional<std::optional<Vec3>> {
+    const tinyxml2::XMLElement* color = material ? material->FirstChildElement("color") : nullptr;
+    const char* rgba = color ? color->Attribute("rgba") : nullptr;
+    if (rgba == nullptr) return std::nullopt;  // no colour of its own
+    double v[4] = {0, 0, 0, 1};
+    char* end = const_cast<char*>(rgba);
+    for (double& x : v) x = std::strtod(end, &end);  // four finite numbers (FindBadNumber)
+    if (!(v[3] > 0)) return std::optional<Vec3>();
+    return std::optional<Vec3>(
+        Vec3{std::clamp(v[0], 0.0, 1.0), std::clamp(v[1], 0.0, 1.0), std::clamp(v[2], 0.0, 1.0)});
+  };
+  std::map<std::string, std::optional<Vec3>> named;
+  for (const tinyxml2::XMLElement* m = robot->FirstChildElement("material"); m;
+       m = m->NextSiblingElement("material"))
+    if (const char* name = m->Attribute("name"))
+      if (auto color = rgb(m)) named.emplace(name, *color);
+  for (const auto& [link, material] : visual_materials)
+    if (const char* name = material ? material->Attribute("name") : nullptr)
+      if (auto color = rgb(material)) named.emplace(name, *color);
+  for (const auto& [link, material] : visual_materials) {
+    std::optional<Vec3> color;
+    if (auto own = rgb(material)) {
+      color = *own;
+    } else if (const char* name = material ? material->Attribute("name") : nullptr) {
+      if (auto it = named.find(name); it != named.end()) color = it->second;
+    }
+    facts_.visual_colors[link].push_back(color);
+  }
+  return std::move(facts_);
+}
+
+}  // namespace
+
+UrdfXmlFacts ReadUrdfXml(const std::string& bytes, const std::string& name) {
+  return XmlReader(name).Read(bytes);
+}
+
+}  // namespace swarmsim::loader
