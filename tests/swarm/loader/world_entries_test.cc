@@ -13,7 +13,6 @@
 #include "framework/error.h"
 #include "framework/registry.h"
 #include "framework/world.h"
-#include "modules/builtin.h"
 #include "modules/proximity/proximity.h"
 #include "swarm/loader/world_loader.h"
 #include "tests/framework/fakes.h"
@@ -145,31 +144,6 @@ TEST_F(ControlLoaderTest, RangesAndInstanceMistakesNameFileLineAndColumn) {
   EXPECT_CONTAINS(ErrorOf(kThree), "bot.yaml:3:32: 'range' must be [min, max]");
 }
 
-TEST_F(ControlLoaderTest, ScaledCopiesWithTheirOwnValuesShareTheScaledMesh) {
-  Write("cube.obj",
-        "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n"
-        "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n");
-  Write("cube.yaml",
-        "model: cube\n"
-        "parameters: {m: 1}\n"
-        "objects: {type: shape, shape: mesh, file: cube.obj, dynamic: true, mass: $m}\n");
-  ModuleRegistry builtin;
-  RegisterBuiltinModules(&builtin);
-  Write("world.yaml",
-        "simulation: {physics: kinematic}\n"
-        "models:\n"
-        "  - {model: cube.yaml, count: 3, scale: 0.1, "
-        "distribute: {region: {min: [-5, -5], max: [5, 5]}},\n"
-        "     instances: [{index: 1, parameters: {m: 2}}]}\n");
-  const LoadedWorld w = LoadWorld(dir_ / "world.yaml", {}, builtin);
-  const Scene& scene = w.world->scene();
-  const ShapeData& own = scene.shape(scene.instance(1).root);
-  EXPECT_DOUBLE_EQ(own.mass, 2 * 0.001);  // its own mass, scaled by 0.1^3
-  EXPECT_DOUBLE_EQ(scene.shape(scene.instance(0).root).mass, 0.001);
-  for (int k : {0, 2}) EXPECT_EQ(scene.shape(scene.instance(k).root).mesh, own.mesh) << k;
-  EXPECT_DOUBLE_EQ(own.mesh->CenteredExtents().x, 0.2);
-}
-
 TEST_F(ControlLoaderTest, EntryParametersAreOfTheirDeclaredType) {
   const std::string entry =
       "simulation: {physics: kinematic}\n"
@@ -195,32 +169,6 @@ TEST_F(ControlLoaderTest, EntryParametersAreOfTheirDeclaredType) {
   std::string twice = kThree;
   twice += "      - {index: 1, parameters: {speed: 0.1}}\n";
   EXPECT_CONTAINS(ErrorOf(twice), "world.yaml:9:17: copy 1 is given twice in 'instances'");
-}
-
-TEST_F(ControlLoaderTest, ACopyIsPlacedWhereItsEntrySays) {
-  LoadedWorld w = Load(
-      "simulation: {physics: kinematic}\n"
-      "models:\n"
-      "  - {model: bot.yaml, position: [1, 2], heading_deg: 90}\n"
-      "  - {model: bot.yaml, position: [3, 4, 0.5], count: 1}\n"
-      "  - model: bot.yaml\n"
-      "    count: 20\n"
-      "    distribute: {region: {min: [10, 20], max: [12, 21]}}\n");
-  const Scene& scene = w.world->scene();
-  ASSERT_EQ(scene.instances().size(), 22u);
-  const Pose first = scene.world_pose(scene.instance(0).root);
-  EXPECT_NEAR(first.p.x, 1, 1e-12);
-  EXPECT_NEAR(first.p.y, 2, 1e-12);
-  EXPECT_NEAR(first.p.z, 0, 1e-12) << "on the ground";
-  const Vec3 forward = first.q.Rotate({1, 0, 0});
-  EXPECT_NEAR(forward.x, 0, 1e-12);
-  EXPECT_NEAR(forward.y, 1, 1e-12) << "heading 90 degrees: facing +y";
-  EXPECT_NEAR(scene.world_pose(scene.instance(1).root).p.z, 0.5, 1e-12);
-  for (int k = 2; k < 22; ++k) {
-    const Vec3 p = scene.world_pose(scene.instance(k).root).p;
-    EXPECT_TRUE(p.x >= 10 && p.x <= 12 && p.y >= 20 && p.y <= 21)
-        << k << ": " << p.x << ", " << p.y;
-  }
 }
 
 TEST_F(ControlLoaderTest, PlacementMistakesSayWhatToGive) {
@@ -251,40 +199,6 @@ TEST_F(ControlLoaderTest, PlacementMistakesSayWhatToGive) {
       ErrorOf(head +
               "{model: disc.yaml, count: 1, distribute: {region: {min: [0, 0], max: [0.9, 5]}}}\n"),
       "world.yaml:3:31: the region is too small for one disc (footprint radius 0.5 m)");
-}
-
-TEST_F(ControlLoaderTest, ALatticePlacesCopiesInIndexOrderAtTheSpacing) {
-  Write("disc.yaml",
-        "model: disc\n"
-        "objects: {name: body, type: shape, shape: cylinder, radius: 0.0165, height: 0.03}\n");
-  LoadedWorld w = Load(
-      "simulation: {physics: kinematic}\n"
-      "models:\n"
-      "  - model: disc.yaml\n"
-      "    count: 6\n"
-      "    distribute: {region: {min: [1, 1], max: [2, 2]}, heading_deg: 0,\n"
-      "                 lattice: {spacing: 0.05, columns: 3}}\n");
-  const Scene& scene = w.world->scene();
-  ASSERT_EQ(scene.instances().size(), 6u);
-  for (int k = 0; k < 6; ++k) {
-    const Pose X = scene.world_pose(scene.instance(k).root);
-    EXPECT_NEAR(X.p.x, 1.45 + 0.05 * (k % 3), 1e-12) << k;
-    EXPECT_NEAR(X.p.y, 1.475 + 0.05 * (k / 3), 1e-12) << k;
-    EXPECT_NEAR(X.q.Yaw(), 0, 1e-12);
-  }
-  const std::string head =
-      "simulation: {physics: kinematic}\nmodels:\n  - {model: disc.yaml, count: 400, "
-      "distribute: {region: {min: [0, 0], max: [0.5, 0.5]}, ";
-  EXPECT_CONTAINS(ErrorOf(head + "lattice: {spacing: 0.03}}}\n"),
-                  "world.yaml:3:108: a lattice 'spacing' of 0.03 m is less than a disc's "
-                  "footprint diameter (0.033 m): neighbouring copies would overlap");
-  EXPECT_CONTAINS(ErrorOf(head + "lattice: {spacing: 0.05}}}\n"),
-                  "world.yaml:3:98: the lattice does not fit: disc copy 0 of 400 would leave the "
-                  "region from [0, 0] to [0.5, 0.5] or overlap");
-  EXPECT_CONTAINS(ErrorOf(head + "lattice: {spacing: 0.05, shape: round}}}\n"),
-                  "'shape' must be square or hexagonal (got 'round')");
-  EXPECT_CONTAINS(ErrorOf(head + "clearance: 0.01, lattice: {spacing: 0.05}}}\n"),
-                  "'clearance' is for random placement; a lattice's 'spacing' sets the gap");
 }
 
 }  // namespace

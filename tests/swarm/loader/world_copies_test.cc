@@ -1,0 +1,143 @@
+// Placing and building the `models:` entries' copies (swarm/loader/
+// world_copies.cc): fixed copies where their entry says, distributed ones
+// in their region or on a lattice in index order, copies with values of
+// their own sharing the scaled mesh; placement mistakes found only while
+// placing (a lattice that does not fit) named at their file:line:column.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "framework/world.h"
+#include "swarm/loader/world_loader.h"
+#include "tests/framework/error_of.h"
+#include "tests/swarm/loader/world_dir_test.h"
+
+namespace swarmsim {
+namespace {
+
+class WorldCopiesTest : public testing::WorldDirTest {
+ protected:
+  void SetUp() override {
+    WorldDirTest::SetUp();
+    Write("bot.yaml", "model: bot\nobjects: {name: body, type: dummy}\n");
+  }
+  std::string ErrorOfWorld(const std::string& world) {
+    return testing::ErrorOf([&] { Load(world); });
+  }
+};
+
+TEST_F(WorldCopiesTest, ACopyIsPlacedWhereItsEntrySays) {
+  LoadedWorld w = Load(
+      "simulation: {physics: kinematic}\n"
+      "models:\n"
+      "  - {model: bot.yaml, position: [1, 2], heading_deg: 90}\n"
+      "  - {model: bot.yaml, position: [3, 4, 0.5], count: 1}\n"
+      "  - model: bot.yaml\n"
+      "    count: 20\n"
+      "    distribute: {region: {min: [10, 20], max: [12, 21]}}\n");
+  const Scene& scene = w.world->scene();
+  ASSERT_EQ(scene.instances().size(), 22u);
+  const Pose first = scene.world_pose(scene.instance(0).root);
+  EXPECT_NEAR(first.p.x, 1, 1e-12);
+  EXPECT_NEAR(first.p.y, 2, 1e-12);
+  EXPECT_NEAR(first.p.z, 0, 1e-12) << "on the ground";
+  const Vec3 forward = first.q.Rotate({1, 0, 0});
+  EXPECT_NEAR(forward.x, 0, 1e-12);
+  EXPECT_NEAR(forward.y, 1, 1e-12) << "heading 90 degrees: facing +y";
+  EXPECT_NEAR(scene.world_pose(scene.instance(1).root).p.z, 0.5, 1e-12);
+  for (int k = 2; k < 22; ++k) {
+    const Vec3 p = scene.world_pose(scene.instance(k).root).p;
+    EXPECT_TRUE(p.x >= 10 && p.x <= 12 && p.y >= 20 && p.y <= 21)
+        << k << ": " << p.x << ", " << p.y;
+  }
+}
+
+TEST_F(WorldCopiesTest, ALatticePlacesCopiesInIndexOrderAtTheSpacing) {
+  Write("disc.yaml",
+        "model: disc\n"
+        "objects: {name: body, type: shape, shape: cylinder, radius: 0.0165, height: 0.03}\n");
+  LoadedWorld w = Load(
+      "simulation: {physics: kinematic}\n"
+      "models:\n"
+      "  - model: disc.yaml\n"
+      "    count: 6\n"
+      "    distribute: {region: {min: [1, 1], max: [2, 2]}, heading_deg: 0,\n"
+      "                 lattice: {spacing: 0.05, columns: 3}}\n");
+  const Scene& scene = w.world->scene();
+  ASSERT_EQ(scene.instances().size(), 6u);
+  for (int k = 0; k < 6; ++k) {
+    const Pose X = scene.world_pose(scene.instance(k).root);
+    EXPECT_NEAR(X.p.x, 1.45 + 0.05 * (k % 3), 1e-12) << k;
+    EXPECT_NEAR(X.p.y, 1.475 + 0.05 * (k / 3), 1e-12) << k;
+    EXPECT_NEAR(X.q.Yaw(), 0, 1e-12);
+  }
+  const std::string head =
+      "simulation: {physics: kinematic}\nmodels:\n  - {model: disc.yaml, count: 400, "
+      "distribute: {region: {min: [0, 0], max: [0.5, 0.5]}, ";
+  EXPECT_CONTAINS(ErrorOfWorld(head + "lattice: {spacing: 0.03}}}\n"),
+                  "world.yaml:3:108: a lattice 'spacing' of 0.03 m is less than a disc's "
+                  "footprint diameter (0.033 m): neighbouring copies would overlap");
+  EXPECT_CONTAINS(ErrorOfWorld(head + "lattice: {spacing: 0.05}}}\n"),
+                  "world.yaml:3:98: the lattice does not fit: disc copy 0 of 400 would leave the "
+                  "region from [0, 0] to [0.5, 0.5] or overlap");
+  EXPECT_CONTAINS(ErrorOfWorld(head + "lattice: {spacing: 0.05, shape: round}}}\n"),
+                  "'shape' must be square or hexagonal (got 'round')");
+  EXPECT_CONTAINS(ErrorOfWorld(head + "clearance: 0.01, lattice: {spacing: 0.05}}}\n"),
+                  "'clearance' is for random placement; a lattice's 'spacing' sets the gap");
+}
+
+TEST_F(WorldCopiesTest, CopiesThatCannotBePlacedApartAreNamedWithTheirCount) {
+  Write("disc.yaml",
+        "model: disc\nobjects: {name: body, type: shape, shape: cylinder, radius: 0.5, "
+        "height: 0.1}\n");
+  // Two fixed copies on one spot: the second is refused at its position.
+  EXPECT_CONTAINS(ErrorOfWorld("simulation: {physics: kinematic}\nmodels:\n"
+                               "  - {model: disc.yaml, position: [0, 0]}\n"
+                               "  - {model: disc.yaml, position: [0.5, 0]}\n"),
+                  "world.yaml:4:34: this disc at [0.5, 0] overlaps a wall, an obstacle, the map "
+                  "or another placed copy");
+  // Distributed copies keep clear of fixed ones listed after them, and too
+  // many for their region are refused naming how many fitted.
+  LoadedWorld w = Load(
+      "simulation: {physics: kinematic}\nmodels:\n"
+      "  - {model: disc.yaml, count: 3, distribute: {region: {min: [0, 0], max: [6, 3]}}}\n"
+      "  - {model: disc.yaml, position: [3, 1.5]}\n");
+  const Scene& scene = w.world->scene();
+  ASSERT_EQ(scene.instances().size(), 4u);
+  for (int k = 0; k < 3; ++k) {
+    const Vec3 p = scene.world_pose(scene.instance(k).root).p;
+    EXPECT_GE(std::hypot(p.x - 3, p.y - 1.5), 1 - 1e-9) << k;
+  }
+  const std::string e = ErrorOfWorld(
+      "simulation: {physics: kinematic}\nmodels:\n"
+      "  - {model: disc.yaml, count: 9, distribute: {region: {min: [0, 0], max: [3, 1]}}}\n");
+  EXPECT_CONTAINS(e, "world.yaml:3:");
+  EXPECT_CONTAINS(e, "cannot place 9 disc copies in the region");
+  EXPECT_CONTAINS(e, "without overlap (placed ");
+}
+
+TEST_F(WorldCopiesTest, ScaledCopiesWithTheirOwnValuesShareTheScaledMesh) {
+  Write("cube.obj",
+        "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n"
+        "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n");
+  Write("cube.yaml",
+        "model: cube\n"
+        "parameters: {m: 1}\n"
+        "objects: {type: shape, shape: mesh, file: cube.obj, dynamic: true, mass: $m}\n");
+  const LoadedWorld w = Load(
+        "simulation: {physics: kinematic}\n"
+        "models:\n"
+        "  - {model: cube.yaml, count: 3, scale: 0.1, "
+        "distribute: {region: {min: [-5, -5], max: [5, 5]}},\n"
+        "     instances: [{index: 1, parameters: {m: 2}}]}\n");
+  const Scene& scene = w.world->scene();
+  const ShapeData& own = scene.shape(scene.instance(1).root);
+  EXPECT_DOUBLE_EQ(own.mass, 2 * 0.001);  // its own mass, scaled by 0.1^3
+  EXPECT_DOUBLE_EQ(scene.shape(scene.instance(0).root).mass, 0.001);
+  for (int k : {0, 2}) EXPECT_EQ(scene.shape(scene.instance(k).root).mesh, own.mesh) << k;
+  EXPECT_DOUBLE_EQ(own.mesh->CenteredExtents().x, 0.2);
+}
+
+}  // namespace
+}  // namespace swarmsim
