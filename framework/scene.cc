@@ -121,6 +121,11 @@ uint32_t Scene::AllocateSlot(std::string_view name, ObjectId parent, const Pose&
                              ObjectType type) {
   int32_t parent_slot = -1;
   if (!parent.IsNull()) parent_slot = static_cast<int32_t>(SlotOf(parent, "parent object"));
+  return AllocateSlotNamed(names_.Intern(name), parent_slot, X_PO, type);
+}
+
+uint32_t Scene::AllocateSlotNamed(uint32_t name, int32_t parent_slot, const Pose& X_PO,
+                                  ObjectType type) {
   uint32_t slot;
   if (!free_slots_.empty()) {
     // Reuse the lowest free slot so that slot order stays deterministic.
@@ -163,7 +168,7 @@ uint32_t Scene::AllocateSlot(std::string_view name, ObjectId parent, const Pose&
   simulated_[slot] = 0;
   alive_[slot] = 1;
   model_root_[slot] = 0;
-  name_[slot] = names_.Intern(name);
+  name_[slot] = name;
   script_[slot] = -1;
   parent_[slot] = -1;
   first_child_[slot] = last_child_[slot] = next_sibling_[slot] = prev_sibling_[slot] = -1;

@@ -292,8 +292,10 @@ class Scene {
   void RemoveSubtree(ObjectId root);
   // Copies a subtree under `new_parent` (null: a new root), with its scripts,
   // model marks and internal references (dummy links) remapped to the copy.
-  // Returns the copy's root.
-  ObjectId DuplicateSubtree(ObjectId root, ObjectId new_parent);
+  // Returns the copy's root. With `X_PO`, the copy's root is placed there
+  // (in its new parent's frame) as part of the copy: the same as
+  // SetWorldPose after it for a new root, without computing the poses twice.
+  ObjectId DuplicateSubtree(ObjectId root, ObjectId new_parent, const Pose* X_PO = nullptr);
   void SetParent(ObjectId id, ObjectId new_parent, bool keep_world_pose);
   // Listeners are told of duplications and removals; not owned.
   void AddListener(SceneListener* listener) { listeners_.push_back(listener); }
@@ -506,6 +508,10 @@ class Scene {
 
  private:
   uint32_t AllocateSlot(std::string_view name, ObjectId parent, const Pose& X_PO, ObjectType type);
+  // The same with a name id the caller holds a reference to (a copy's: its
+  // source's name, retained instead of looked up again).
+  uint32_t AllocateSlotNamed(uint32_t name, int32_t parent_slot, const Pose& X_PO,
+                             ObjectType type);
   void FreeSlot(uint32_t slot);
   void LinkChild(uint32_t parent, uint32_t child);
   void UnlinkChild(uint32_t child);
@@ -514,7 +520,7 @@ class Scene {
   void UpdatePoses(std::span<const uint32_t> slots);
   void RebuildOrder() const;
   void RebuildInstanceObjects(int instance);
-  uint32_t CopyObject(uint32_t src, int32_t new_parent);
+  uint32_t CopyObject(uint32_t src, int32_t new_parent, const Pose& X_PO);
   // A built-in type's table (the descriptor made Rows<Row> for it).
   template <typename Row>
   Rows<Row>& Table(ObjectType type) {

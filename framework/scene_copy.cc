@@ -12,15 +12,12 @@ namespace swarmsim {
 
 // --- Duplication ----------------------------------------------------------------------
 
-uint32_t Scene::CopyObject(uint32_t src, int32_t new_parent) {
-  const ObjectId parent = new_parent >= 0 ? IdAt(static_cast<uint32_t>(new_parent)) : ObjectId{};
-  // Copy the pose first: AllocateSlot may grow (and move) the arrays (the
-  // name's string stays where it is).
-  const std::string& name = name_at(src);
-  const Pose X_PO = X_PO_[src];
-  // The copy's row from the source's, through the type's copy rule.
+uint32_t Scene::CopyObject(uint32_t src, int32_t new_parent, const Pose& X_PO) {
+  // The copy's row from the source's, through the type's copy rule. The
+  // pose is a copy: AllocateSlot may grow (and move) the arrays.
   const ObjectType type = type_[src];
-  const uint32_t slot = AllocateSlot(name, parent, X_PO, type);
+  names_.Retain(name_[src]);
+  const uint32_t slot = AllocateSlotNamed(name_[src], new_parent, X_PO, type);
   if (RowTable* table = tables_[static_cast<size_t>(type)].get())
     row_[slot] = table->AppendCopy(row_[src], slot, types_[static_cast<size_t>(type)]->copy_row);
   if (motion_[src] != kNoMotion && motion_[slot] != kNoMotion)
@@ -75,7 +72,7 @@ void Scene::ReserveForCopies(ObjectId root, size_t copies) {
   instances_.reserve(instances_.size() + copies);
 }
 
-ObjectId Scene::DuplicateSubtree(ObjectId root, ObjectId new_parent) {
+ObjectId Scene::DuplicateSubtree(ObjectId root, ObjectId new_parent, const Pose* X_PO) {
   const uint32_t root_slot = SlotOf(root);
   int32_t parent_slot = -1;
   if (!new_parent.IsNull()) parent_slot = static_cast<int32_t>(SlotOf(new_parent, "parent object"));
@@ -104,7 +101,8 @@ ObjectId Scene::DuplicateSubtree(ObjectId root, ObjectId new_parent) {
   for (uint32_t src : sources) {
     const int32_t p =
         src == root_slot ? parent_slot : static_cast<int32_t>(copy_of.at(parent_[src]));
-    copy_of[src] = CopyObject(src, p);
+    const Pose pose = src == root_slot && X_PO != nullptr ? *X_PO : X_PO_[src];
+    copy_of[src] = CopyObject(src, p, pose);
   }
   // Remap internal references: a link inside the subtree points at the copy;
   // a link to an object outside stays as it was.

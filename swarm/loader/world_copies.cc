@@ -220,22 +220,24 @@ void WorldLoader::BuildCopies(World* world) {
       if (std::string refusal = forecast.Built(built); !refusal.empty()) throw Error(refusal);
       ++built;
       const EntryPlan::OwnCopy* own = e.FindOwnCopy(static_cast<int64_t>(k));
+      // The root's pose in the model frame (scaled with the copy).
+      Pose X_MR = e.SpecOf(static_cast<int64_t>(k)).X_PO;
+      X_MR.p = X_MR.p * e.scale;
+      const Pose X_WR = poses[k] * X_MR;
       ObjectId root;
       int instance;
       if (own && own->spec) {
         std::tie(root, instance) = build(*own->spec, own->sections, std::nullopt);
+        scene.SetWorldPose(root, X_WR);
       } else if (first.IsNull()) {
         std::tie(root, instance) = build(e.spec, e.sections, duplicates - 1);
+        scene.SetWorldPose(root, X_WR);
         first = root;
       } else {
-        root = scene.DuplicateSubtree(first, {});
+        root = scene.DuplicateSubtree(first, {}, &X_WR);  // a new root: placed at X_WR
         instance = scene.instance_of(root);
       }
       scene.set_name(root, scene.instance(instance).name);
-      // The root's pose in the model frame (scaled with the copy).
-      Pose X_MR = e.SpecOf(static_cast<int64_t>(k)).X_PO;
-      X_MR.p = X_MR.p * e.scale;
-      scene.SetWorldPose(root, poses[k] * X_MR);
       copy_instances_.push_back(instance);
       world->SetInstanceParameters(instance, own ? own->parameters : e.parameters);
       if (e.native != nullptr)

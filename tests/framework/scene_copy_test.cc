@@ -72,6 +72,37 @@ TEST(SceneTest, DuplicatingAModelCopiesObjectsScriptsAndRemapsReferences) {
 // Velocities are kept for shapes only (the bodies backends simulate), and a
 // slot's rare values (custom data, size factor, dummy link) only where set:
 // a copy takes them, a removed object's slot comes back without them.
+// A copy placed as it is made is where placing it afterwards puts it, its
+// objects' names shared with the source's (and kept when the source goes).
+TEST(SceneTest, ACopyPlacedAsItIsMadeMatchesOnePlacedAfter) {
+  Scene scene;
+  const ObjectId root = scene.AddDummy("body", {}, {{1, 0, 0}, Quat::FromYaw(0.3)});
+  const ObjectId arm = scene.AddDummy("arm", root, {{0, 0.1, 0.2}, Quat::FromYaw(-1)});
+  scene.AddDummy("hand", arm, {{0.05, 0, 0}, {}});
+  scene.MakeModelInstance(root, "bot", "bot#0");
+  const Pose X{{4, -2, 0.5}, Quat::FromYaw(2)};
+  const ObjectId placed_after = scene.DuplicateSubtree(root, {});
+  scene.SetWorldPose(placed_after, X);
+  const ObjectId placed_now = scene.DuplicateSubtree(root, {}, &X);
+  for (const char* path : {".", "./arm", "./arm/hand"}) {
+    const Pose a = scene.world_pose(path[1] ? scene.FindObject(path, placed_after) : placed_after);
+    const Pose b = scene.world_pose(path[1] ? scene.FindObject(path, placed_now) : placed_now);
+    EXPECT_EQ(a.p.x, b.p.x) << path;
+    EXPECT_EQ(a.p.y, b.p.y) << path;
+    EXPECT_EQ(a.p.z, b.p.z) << path;
+    EXPECT_EQ(a.q.w, b.q.w) << path;
+    EXPECT_EQ(a.q.z, b.q.z) << path;
+  }
+  EXPECT_NEAR(scene.world_pose(placed_now).p.x, 4, 1e-15);
+  // The source unchanged; names shared, and still there once the source is removed.
+  EXPECT_NEAR(scene.world_pose(root).p.x, 1, 1e-15);
+  EXPECT_EQ(scene.name(scene.FindObject("./arm/hand", placed_now)), "hand");
+  scene.RemoveSubtree(root);
+  scene.RemoveSubtree(placed_after);
+  EXPECT_EQ(scene.name(scene.FindObject("./arm/hand", placed_now)), "hand");
+  EXPECT_EQ(scene.name(scene.FindObject("./arm", placed_now)), "arm");
+}
+
 TEST(SceneTest, VelocitiesAndRareValuesFollowCopiesAndRemovals) {
   Scene scene;
   ShapeData body_shape;
