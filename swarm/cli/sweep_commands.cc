@@ -39,6 +39,11 @@ CLI::App* AddSweepCommand(CLI::App* app, SweepArgs* args) {
       ->capture_default_str();
   sweep->add_option("--timeout", options.timeout_s, "Per-run time limit, s (0: none)")
       ->check(NonNegativeCheck());
+  sweep
+      ->add_option("--max-memory", options.max_memory,
+                   "Each run's --max-memory (e.g. 8G); default with several jobs: the memory "
+                   "available at the start shared between them")
+      ->check(MemorySizeCheck());
   sweep->add_option("--db", options.db, "Results database (SQLite)")
       ->required()
       ->check(NonEmpty("a database file"));

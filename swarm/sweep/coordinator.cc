@@ -3,7 +3,9 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
+#include <cstdint>
 #include <csignal>
 #include <cstring>
 #include <deque>
@@ -14,6 +16,7 @@
 #include <thread>
 
 #include "framework/error.h"
+#include "framework/memory_forecast.h"
 #include "framework/registry.h"
 #include "modules/builtin.h"
 #include "swarm/loader/world_loader.h"
@@ -40,7 +43,13 @@ void CheckWorld(const SweepOptions& o, const GridRun& first) {
 
 }  // namespace
 
-WorkerConfig MakeWorkerConfig(const SweepOptions& o) {
+std::string RunMemoryCap(const std::string& max_memory, int jobs, uint64_t available) {
+  if (!max_memory.empty()) return max_memory;
+  if (jobs <= 1 || available == UINT64_MAX) return "";
+  return std::to_string(std::max<uint64_t>(available / static_cast<uint64_t>(jobs), 1));
+}
+
+WorkerConfig MakeWorkerConfig(const SweepOptions& o, int jobs) {
   WorkerConfig c;
   c.self_exe = o.self_exe;
   c.world = o.world;
@@ -48,6 +57,7 @@ WorkerConfig MakeWorkerConfig(const SweepOptions& o) {
   c.duration = o.duration;
   c.threads_per_run = o.threads_per_run;
   c.timeout_s = o.timeout_s;
+  c.max_memory = RunMemoryCap(o.max_memory, jobs, ReadMemoryRoom(0).available);
   c.scratch =
       std::filesystem::temp_directory_path() / ("swarmsim-sweep-" + std::to_string(getpid()));
   return c;
@@ -141,7 +151,7 @@ int CoordinateSweep(const SweepOptions& o, RemoteWorkers* remote, std::ostream& 
         << (jobs == 1 ? " job" : " jobs") << (remote ? " here plus the other ranks" : "") << "\n";
 
   SweepProgress progress(err, shard_total, already, isatty(STDERR_FILENO) != 0, !o.quiet);
-  RunPool pool(MakeWorkerConfig(o), jobs);
+  RunPool pool(MakeWorkerConfig(o, jobs), jobs);
   const std::string me = WorkerName();
   auto next = [&]() -> std::optional<GridRun> {
     if (pending.empty()) return std::nullopt;

@@ -24,6 +24,11 @@ struct SweepOptions {
   int jobs = 0;  // concurrent runs; <= 0: all cores (1 per rank with --mpi)
   int threads_per_run = 1;
   double timeout_s = 0;  // per run; 0: none
+  // --max-memory SIZE for every run ("8G"); empty: with more than one job,
+  // each run gets an equal share of the memory available when the sweep
+  // starts (a large world refused with a message instead of the jobs
+  // together running the machine out of memory).
+  std::string max_memory;
   std::string db;
   bool allow_changed_world = false;
   bool retry_failed = false;
@@ -34,8 +39,14 @@ struct SweepOptions {
   std::string command_line;
 };
 
-// How the worker processes of a sweep run (shared by local and MPI sweeps).
-WorkerConfig MakeWorkerConfig(const SweepOptions& options);
+// How the worker processes of a sweep run (shared by local and MPI sweeps),
+// `jobs` of them at once on this machine.
+WorkerConfig MakeWorkerConfig(const SweepOptions& options, int jobs);
+
+// Each run's --max-memory: `max_memory` if given, else with more than one
+// job `available` (bytes the machine or cgroup has; UINT64_MAX: unknown)
+// shared equally between the jobs, as bytes; "" for none.
+std::string RunMemoryCap(const std::string& max_memory, int jobs, uint64_t available);
 
 // The content hash of a world file (hex), as stored in the sweep table.
 std::string WorldFileHash(const std::string& path);

@@ -122,7 +122,7 @@ class MpiWorkers : public RemoteWorkers {
 
 // A rank other than 0: ask for a run, run it, send the result with the next request.
 int WorkerLoop(const SweepOptions& o) {
-  const WorkerConfig config = MakeWorkerConfig(o);
+  const WorkerConfig config = MakeWorkerConfig(o, 1);
   RunPool pool(config, 1);
   std::string result;
   while (true) {

@@ -113,6 +113,10 @@ std::vector<std::string> RunArguments(const WorkerConfig& config, const GridRun&
   }
   args.push_back("--threads");
   args.push_back(std::to_string(config.threads_per_run));
+  if (!config.max_memory.empty()) {
+    args.push_back("--max-memory");
+    args.push_back(config.max_memory);
+  }
   args.push_back("--quiet");
   args.push_back("--out");
   args.push_back(out_dir.string());

@@ -22,6 +22,7 @@ struct WorkerConfig {
   std::optional<double> duration;  // --duration, else the world's own length
   int threads_per_run = 1;
   double timeout_s = 0;           // per run; 0: no limit
+  std::string max_memory;         // each run's --max-memory ("": none)
   std::filesystem::path scratch;  // run outputs go to scratch/run-<id>, removed after reading
 };
 

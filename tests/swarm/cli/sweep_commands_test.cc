@@ -1,5 +1,5 @@
 // swarmsim sweep, report and merge as their command lines read them
-// (swarm/cli/sweep_commands.cc): --duration and --shard handed to the sweep,
+// (swarm/cli/sweep_commands.cc): --duration, --shard and --max-memory handed to the sweep,
 // the options' checks, and what report and merge require.
 #include <gtest/gtest.h>
 
@@ -65,6 +65,7 @@ TEST(SweepCommandsTest, OptionsSayWhatTheyExpect) {
       {" --jobs 2.5", "--jobs: expected a whole number of jobs, got '2.5'"},
       {" --threads 0", "--threads: expected a whole number from 1 to 1024, got '0'"},
       {" --timeout -1", "--timeout: must be >= 0, got -1"},
+      {" --max-memory 12X", "expected a memory size such as 500M, 2G or 1.5GiB, got '12X'"},
       {" --shard 1/2x", "--shard expects i/n (e.g. 0/10 for the first of 10 shards), got '1/2x'"},
   };
   for (const auto& [args, message] : cases) {
@@ -84,6 +85,26 @@ TEST(SweepCommandsTest, OptionsSayWhatTheyExpect) {
   r = RunProgram("sweep " + kWorld);
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("--db is required"), std::string::npos) << r.output;
+  fs::remove_all(dir);
+}
+
+// --max-memory reaches every run: a world too large for it fails that run
+// with the memory check's message (the sweep goes on and says so).
+TEST(SweepCommandsTest, MaxMemoryIsEveryRunsCap) {
+  const fs::path dir = TempDir("max_memory");
+  const fs::path db = dir / "r.db", csv = dir / "runs.csv";
+  Result r = RunProgram("sweep " + std::string(SWARMSIM_SOURCE_DIR) +
+                        "/worlds/diffusion.yaml --param robots=20000 --steps 1 --jobs 1 "
+                        "--max-memory 400M --quiet --db " +
+                        db.string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  r = RunProgram("report " + db.string() + " --csv " + csv.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto rows = Csv(csv);
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[1][3], "failed");
+  EXPECT_NE(r.output.find("not enough memory for 20,000 robot"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("(--max-memory 400 MiB)"), std::string::npos) << r.output;
   fs::remove_all(dir);
 }
 

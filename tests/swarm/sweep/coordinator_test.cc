@@ -296,7 +296,7 @@ TEST(CoordinatorTest, WorkersRunThisProgramWithTheSweepsSettings) {
   options.threads_per_run = 3;
   options.timeout_s = 2.5;
   options.self_exe = SWARMSIM_BINARY;
-  const WorkerConfig config = MakeWorkerConfig(options);
+  const WorkerConfig config = MakeWorkerConfig(options, 1);
   EXPECT_EQ(config.self_exe, SWARMSIM_BINARY);
   EXPECT_EQ(config.world, kWorld);
   EXPECT_EQ(config.steps, std::optional<int64_t>(12));
@@ -305,6 +305,23 @@ TEST(CoordinatorTest, WorkersRunThisProgramWithTheSweepsSettings) {
   EXPECT_EQ(config.timeout_s, 2.5);
   // A scratch folder of this process's own (a killed sweep's is cleared by the next).
   EXPECT_EQ(config.scratch.filename(), "swarmsim-sweep-" + std::to_string(getpid()));
+}
+
+// Jobs side by side share the memory: each run's --max-memory is the user's,
+// else with several jobs an equal share of what is available at the start.
+TEST(CoordinatorTest, EachRunGetsTheUsersMemoryCapOrItsShare) {
+  constexpr uint64_t k8GiB = uint64_t{8} << 30;
+  EXPECT_EQ(RunMemoryCap("6G", 4, k8GiB), "6G");
+  EXPECT_EQ(RunMemoryCap("", 4, k8GiB), std::to_string(uint64_t{2} << 30));
+  EXPECT_EQ(RunMemoryCap("", 3, 9000), "3000");
+  EXPECT_EQ(RunMemoryCap("", 1, k8GiB), "") << "one job: the run's own check is enough";
+  EXPECT_EQ(RunMemoryCap("", 4, UINT64_MAX), "") << "unknown room: no cap";
+  SweepOptions options;
+  options.world = kWorld;
+  options.max_memory = "3G";
+  EXPECT_EQ(MakeWorkerConfig(options, 2).max_memory, "3G");
+  options.max_memory.clear();
+  EXPECT_EQ(MakeWorkerConfig(options, 1).max_memory, "");
 }
 
 TEST(CoordinatorTest, AWorldWithoutARunLengthNeedsStepsOrDuration) {

@@ -96,6 +96,12 @@ TEST(WorkerTest, ARunIsTheRunCommandWithItsSeedAndParameters) {
   EXPECT_EQ(with_duration[8], "--duration");
   EXPECT_EQ(with_duration[9], "2.5");
   config.duration.reset();
+  config.max_memory = "2147483648";  // the sweep's share or --max-memory, passed on
+  const auto capped = RunArguments(config, Run5(), "/tmp/run-5");
+  const auto cap = std::find(capped.begin(), capped.end(), "--max-memory");
+  ASSERT_NE(cap, capped.end());
+  EXPECT_EQ(*(cap + 1), "2147483648");
+  config.max_memory.clear();
   const auto own_length = RunArguments(config, Run5(), "/tmp/run-5");
   EXPECT_EQ(std::count(own_length.begin(), own_length.end(), "--steps") +
                 std::count(own_length.begin(), own_length.end(), "--duration"),
