@@ -510,8 +510,7 @@ class Scene {
   uint32_t AllocateSlot(std::string_view name, ObjectId parent, const Pose& X_PO, ObjectType type);
   // The same with a name id the caller holds a reference to (a copy's: its
   // source's name, retained instead of looked up again).
-  uint32_t AllocateSlotNamed(uint32_t name, int32_t parent_slot, const Pose& X_PO,
-                             ObjectType type);
+  uint32_t AllocateSlotNamed(uint32_t name, int32_t parent_slot, const Pose& X_PO, ObjectType type);
   void FreeSlot(uint32_t slot);
   void LinkChild(uint32_t parent, uint32_t child);
   void UnlinkChild(uint32_t child);

@@ -182,7 +182,8 @@ UrdfXmlFacts XmlReader::Read(const std::string& bytes) {
   }
   if (roots.size() > 1)
     Fail(facts_.link_line[roots[1]], "the robot has several root links ('" + roots[0] + "', '" +
-                                       roots[1] + "'): every link but one must be a joint's child");
+                                         roots[1] +
+                                         "'): every link but one must be a joint's child");
   for (const auto& [joint, master, line] : mimics)
     if (!facts_.joint_line.contains(master))
       Fail(line, "joint '" + joint + "': <mimic joint=\"" + master +

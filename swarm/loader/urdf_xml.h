@@ -27,7 +27,6 @@ struct UrdfXmlFacts {
   std::map<std::string, std::pair<int, int>> ignored;
 };
 
-
 // The facts of `bytes`, a URDF's text. Throws Error "NAME:LINE: ..." (name:
 // the file as messages show it) for malformed XML, a DTD, a root that is not
 // <robot>, and the structural mistakes above.

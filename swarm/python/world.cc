@@ -70,9 +70,9 @@ auto PyWorld::Read(const std::string& model, F&& read) {
 }
 
 PyWorld::PyWorld(const std::string& path, std::optional<uint64_t> seed,
-        const std::map<std::string, py::object>& set, int threads,
-        const std::map<std::string, py::object>& controllers,
-        const std::vector<std::string>& package_path, bool keep_scripts)
+                 const std::map<std::string, py::object>& set, int threads,
+                 const std::map<std::string, py::object>& controllers,
+                 const std::vector<std::string>& package_path, bool keep_scripts)
     : args_{path, seed, set, threads, controllers, package_path, keep_scripts} {
   CheckThreads(threads, "World(threads=...)");
   LoadOptions options;
@@ -413,8 +413,8 @@ std::vector<std::string> PyWorld::device_names(const std::string& model, const c
 }
 
 std::vector<uint32_t> PyWorld::DeviceColumnSlots(const Scene& scene, const ModelLayout& layout,
-                                        const char* type, const std::string& name,
-                                        const char* what, std::vector<std::string>* who) {
+                                                 const char* type, const std::string& name,
+                                                 const char* what, std::vector<std::string>* who) {
   const DeviceTable table = Devices(scene, layout, type);
   const size_t column = DeviceColumn(table, name, what);
   std::vector<uint32_t> slots;
@@ -426,7 +426,7 @@ std::vector<uint32_t> PyWorld::DeviceColumnSlots(const Scene& scene, const Model
 }
 
 py::array PyWorld::vision_images(const std::string& model, const std::string& sensor, bool filtered,
-                        const py::object& out) {
+                                 const py::object& out) {
   return Read(model, [&](const Scene& s, const ModelLayout& l) {
     std::vector<std::string> who;
     const auto slots = DeviceColumnSlots(s, l, "vision_sensor", sensor, "vision sensor", &who);
@@ -435,7 +435,7 @@ py::array PyWorld::vision_images(const std::string& model, const std::string& se
 }
 
 py::array PyWorld::vision_depths(const std::string& model, const std::string& sensor,
-                        const py::object& out) {
+                                 const py::object& out) {
   return Read(model, [&](const Scene& s, const ModelLayout& l) {
     std::vector<std::string> who;
     const auto slots = DeviceColumnSlots(s, l, "vision_sensor", sensor, "vision sensor", &who);
@@ -444,7 +444,7 @@ py::array PyWorld::vision_depths(const std::string& model, const std::string& se
 }
 
 py::array PyWorld::vision_sensor(const std::string& path, bool depth, bool filtered,
-                        const py::object& out) {
+                                 const py::object& out) {
   auto r = Reading();
   const Scene& scene = Any().scene();
   const ObjectId id = scene.FindObject(path);
@@ -472,7 +472,7 @@ py::dict PyWorld::blob_cameras(const std::string& model, const std::string& sens
 }
 
 py::dict PyWorld::ir_messages(const std::string& model, const std::string& transceiver,
-                     const py::object& out) {
+                              const py::object& out) {
   return Read(model, [&](const Scene& s, const ModelLayout& l) {
     return IrMessages(s, IrTransceivers(s, l, transceiver, nullptr), out);
   });
@@ -507,8 +507,8 @@ void PyWorld::set_range_and_bearing_data(const std::string& model, const py::obj
   SetRangeAndBearingData(&w.scene(), Layout(model), data);
 }
 
-void PyWorld::send_ir_messages(const std::string& model, const py::object& data, const py::object& send,
-                      const std::string& transceiver) {
+void PyWorld::send_ir_messages(const std::string& model, const py::object& data,
+                               const py::object& send, const std::string& transceiver) {
   NotWritingFromController("send_ir_messages()");
   GateLock lock(gate_.get());
   World& w = Live();
@@ -551,7 +551,8 @@ void PyWorld::set_joint_states(const std::string& model, const py::object& value
   Translate([&] { SetJointStates(&w, layout, what, values); });
 }
 
-void PyWorld::set_param(const std::string& model, const std::string& name, const py::object& values) {
+void PyWorld::set_param(const std::string& model, const std::string& name,
+                        const py::object& values) {
   NotWritingFromController("set_param()");
   GateLock lock(gate_.get());
   World& w = Live();
@@ -609,8 +610,7 @@ std::string PyWorld::describe() {
           << "\n";
     for (const std::string& s : m.scripts) out << "  script: " << s << "\n";
     if (!m.python.file.empty())
-      out << "  python controller: " << m.python.file.string() << ":" << m.python.function
-          << "\n";
+      out << "  python controller: " << m.python.file.string() << ":" << m.python.function << "\n";
   }
   return out.str();
 }

@@ -72,14 +72,12 @@ class PyWorld {
   World& Live();
   const World& Any() const;
 
-
   double time();
   int64_t steps();
   std::string state_hash();
   int threads() const { return Any().threads(); }
   bool planar() const { return planar_; }
   std::optional<int64_t> default_steps() const { return loaded_.steps; }
-
 
   py::dict robots();
 
@@ -205,6 +203,5 @@ class PyWorld {
   uint64_t loaded_seed_ = 0;
   std::string initial_;  // reset: the snapshot before the first step ("": not yet taken)
 };
-
 
 }  // namespace swarmsim::python

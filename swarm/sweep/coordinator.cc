@@ -5,8 +5,8 @@
 
 #include <algorithm>
 #include <array>
-#include <cstdint>
 #include <csignal>
+#include <cstdint>
 #include <cstring>
 #include <deque>
 #include <fstream>

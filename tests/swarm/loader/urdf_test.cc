@@ -777,8 +777,6 @@ TEST_F(UrdfErrorTest, MalformedFilesNameTheFileTheElementAndTheLine) {
   EXPECT_CONTAINS(e, "bad.urdf:");
   EXPECT_CONTAINS(e, "malformed XML");
 
-
-
   e = ErrorOfUrdf(std::string(kHead) +
                   "  <link name=\"a\">\n    <visual><geometry><mesh filename=\"missing.stl\"/>"
                   "</geometry></visual>\n  </link>\n</robot>\n");
@@ -805,9 +803,6 @@ TEST_F(UrdfErrorTest, MalformedFilesNameTheFileTheElementAndTheLine) {
   EXPECT_CONTAINS(e,
                   "bad.urdf:6: link 'a': <inertia> cannot be repaired: its principal moments sum "
                   "to -1 kg m^2");
-
-
-
 }
 
 // urdfdom hands some messages, the file's text inside, to printf as the

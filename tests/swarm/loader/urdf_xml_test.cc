@@ -21,21 +21,25 @@ std::string ErrorOfXml(const std::string& body) {
 }
 
 TEST(UrdfXmlTest, RecordsTheLinesMessagesName) {
-  const UrdfXmlFacts f = ReadUrdfXml(
-      std::string(kHead) +
-          "  <link name=\"base\">\n"                                                  // 3
-          "    <visual><geometry><box size=\"1 1 1\"/></geometry></visual>\n"         // 4
-          "    <collision>\n      <geometry><sphere radius=\"1\"/></geometry>\n"      // 5, 6
-          "    </collision>\n"                                                        // 7
-          "    <inertial><mass value=\"1\"/>\n"                                       // 8
-          "      <inertia ixx=\"1\" iyy=\"1\" izz=\"1\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/>\n"  // 9
-          "    </inertial>\n  </link>\n"                                              // 10, 11
-          "  <link name=\"a\"/>\n  <link name=\"b\"/>\n"                              // 12, 13
-          "  <joint name=\"jb\" type=\"continuous\"><parent link=\"a\"/><child link=\"b\"/>\n"  // 14
-          "    <mimic joint=\"ja\"/>\n  </joint>\n"                                   // 15, 16
-          "  <joint name=\"ja\" type=\"fixed\"><parent link=\"base\"/><child link=\"a\"/>"
-          "</joint>\n</robot>\n",                                                     // 17
-      "r.urdf");
+  const UrdfXmlFacts f =
+      ReadUrdfXml(std::string(kHead) +
+                      "  <link name=\"base\">\n"                                              // 3
+                      "    <visual><geometry><box size=\"1 1 1\"/></geometry></visual>\n"     // 4
+                      "    <collision>\n      <geometry><sphere radius=\"1\"/></geometry>\n"  // 5,
+                                                                                              // 6
+                      "    </collision>\n"                                                    // 7
+                      "    <inertial><mass value=\"1\"/>\n"                                   // 8
+                      "      <inertia ixx=\"1\" iyy=\"1\" izz=\"1\" ixy=\"0\" ixz=\"0\" "
+                      "iyz=\"0\"/>\n"                                 // 9
+                      "    </inertial>\n  </link>\n"                  // 10, 11
+                      "  <link name=\"a\"/>\n  <link name=\"b\"/>\n"  // 12, 13
+                      "  <joint name=\"jb\" type=\"continuous\"><parent link=\"a\"/><child "
+                      "link=\"b\"/>\n"                           // 14
+                      "    <mimic joint=\"ja\"/>\n  </joint>\n"  // 15, 16
+                      "  <joint name=\"ja\" type=\"fixed\"><parent link=\"base\"/><child "
+                      "link=\"a\"/>"
+                      "</joint>\n</robot>\n",  // 17
+                  "r.urdf");
   EXPECT_EQ(f.link_line.at("base"), 3);
   EXPECT_EQ(f.link_line.at("b"), 13);
   EXPECT_EQ(f.joint_line.at("jb"), 14);
@@ -56,12 +60,24 @@ TEST(UrdfXmlTest, ColoursComeFromTheVisualsMaterialAsUrdfdomResolvesThem) {
   const UrdfXmlFacts f = ReadUrdfXml(
       std::string(kHead) + "  <material name=\"blue\"><color rgba=\"0 0 1 1\"/></material>\n" +
           "  <link name=\"a\">\n"
-          "    <visual>" + box + "<material name=\"own\"><color rgba=\"1 0.5 0 1\"/></material></visual>\n"
-          "    <visual>" + box + "<material name=\"blue\"/></visual>\n"
-          "    <visual>" + box + "<material name=\"own\"/></visual>\n"
-          "    <visual>" + box + "</visual>\n"
-          "    <visual>" + box + "<material name=\"clear\"><color rgba=\"1 1 1 0\"/></material></visual>\n"
-          "    <visual>" + box + "<material name=\"nowhere\"/></visual>\n"
+          "    <visual>" +
+          box +
+          "<material name=\"own\"><color rgba=\"1 0.5 0 1\"/></material></visual>\n"
+          "    <visual>" +
+          box +
+          "<material name=\"blue\"/></visual>\n"
+          "    <visual>" +
+          box +
+          "<material name=\"own\"/></visual>\n"
+          "    <visual>" +
+          box +
+          "</visual>\n"
+          "    <visual>" +
+          box +
+          "<material name=\"clear\"><color rgba=\"1 1 1 0\"/></material></visual>\n"
+          "    <visual>" +
+          box +
+          "<material name=\"nowhere\"/></visual>\n"
           "  </link>\n</robot>\n",
       "r.urdf");
   const auto& c = f.visual_colors.at("a");
@@ -82,12 +98,12 @@ TEST(UrdfXmlTest, ColoursComeFromTheVisualsMaterialAsUrdfdomResolvesThem) {
 TEST(UrdfXmlTest, IgnoredElementsAreCountedWithTheirFirstLine) {
   const UrdfXmlFacts f = ReadUrdfXml(
       std::string(kHead) +
-          "  <link name=\"a\"/>\n  <link name=\"b\"/>\n"                            // 3, 4
-          "  <gazebo reference=\"a\"/>\n"                                           // 5
+          "  <link name=\"a\"/>\n  <link name=\"b\"/>\n"  // 3, 4
+          "  <gazebo reference=\"a\"/>\n"                 // 5
           "  <joint name=\"j\" type=\"continuous\"><parent link=\"a\"/><child link=\"b\"/>\n"  // 6
-          "    <dynamics damping=\"0.1\" friction=\"0.2\"/>\n"                      // 7
-          "    <calibration rising=\"0\"/>\n  </joint>\n"                           // 8, 9
-          "  <transmission name=\"t\"/>\n  <gazebo/>\n</robot>\n",                  // 10, 11
+          "    <dynamics damping=\"0.1\" friction=\"0.2\"/>\n"                                 // 7
+          "    <calibration rising=\"0\"/>\n  </joint>\n"           // 8, 9
+          "  <transmission name=\"t\"/>\n  <gazebo/>\n</robot>\n",  // 10, 11
       "r.urdf");
   EXPECT_EQ(f.ignored.at("<gazebo>"), std::make_pair(2, 5));
   EXPECT_EQ(f.ignored.at("<transmission>"), std::make_pair(1, 10));
@@ -96,8 +112,7 @@ TEST(UrdfXmlTest, IgnoredElementsAreCountedWithTheirFirstLine) {
 }
 
 TEST(UrdfXmlTest, StructuralMistakesNameTheFileAndTheLine) {
-  EXPECT_CONTAINS(ErrorOfXml("  <link name=\"a\">\n  <link name=\"b\"/>\n</robot>\n"),
-                  "r.urdf:");
+  EXPECT_CONTAINS(ErrorOfXml("  <link name=\"a\">\n  <link name=\"b\"/>\n</robot>\n"), "r.urdf:");
   EXPECT_CONTAINS(ErrorOfXml("  <link name=\"a\">\n  <link name=\"b\"/>\n</robot>\n"),
                   "malformed XML");
   EXPECT_CONTAINS(testing::ErrorOf([] { ReadUrdfXml("<model name=\"x\"/>", "r.urdf"); }),

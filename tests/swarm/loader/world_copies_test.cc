@@ -126,11 +126,11 @@ TEST_F(WorldCopiesTest, ScaledCopiesWithTheirOwnValuesShareTheScaledMesh) {
         "parameters: {m: 1}\n"
         "objects: {type: shape, shape: mesh, file: cube.obj, dynamic: true, mass: $m}\n");
   const LoadedWorld w = Load(
-        "simulation: {physics: kinematic}\n"
-        "models:\n"
-        "  - {model: cube.yaml, count: 3, scale: 0.1, "
-        "distribute: {region: {min: [-5, -5], max: [5, 5]}},\n"
-        "     instances: [{index: 1, parameters: {m: 2}}]}\n");
+      "simulation: {physics: kinematic}\n"
+      "models:\n"
+      "  - {model: cube.yaml, count: 3, scale: 0.1, "
+      "distribute: {region: {min: [-5, -5], max: [5, 5]}},\n"
+      "     instances: [{index: 1, parameters: {m: 2}}]}\n");
   const Scene& scene = w.world->scene();
   const ShapeData& own = scene.shape(scene.instance(1).root);
   EXPECT_DOUBLE_EQ(own.mass, 2 * 0.001);  // its own mass, scaled by 0.1^3
