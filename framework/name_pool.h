@@ -37,6 +37,12 @@ class NamePool {
     ids_.emplace(strings_[id], id);  // a view of the stored string (a deque's stay put)
     return id;
   }
+  // The id of `name` if some object is named so, else kNone (nothing interned).
+  static constexpr uint32_t kNone = UINT32_MAX;
+  uint32_t Find(std::string_view name) const {
+    const auto it = ids_.find(name);
+    return it == ids_.end() ? kNone : it->second;
+  }
   // One more reference to the name `id` (a copy of an object).
   void Retain(uint32_t id) { ++refs_[id]; }
   // One fewer; the string goes with its last reference.

@@ -618,18 +618,20 @@ namespace {
 
 struct PathElement {
   std::string_view name;
-  int index = -1;  // -1: the first match
+  int index = -1;   // -1: the first match
+  uint32_t id = 0;  // FindObject: the name's id in the scene's names
 };
 
-// Parses "a/b[2]/c" into elements; throws on a malformed index.
-std::vector<PathElement> SplitPath(std::string_view path, std::string_view full) {
-  std::vector<PathElement> out;
+// Parses "a/b[2]/c" into `out` (cleared first); throws on a malformed index.
+void SplitPath(std::string_view path, std::string_view full, std::vector<PathElement>* elements) {
+  std::vector<PathElement>& out = *elements;
+  out.clear();
   while (!path.empty()) {
     const size_t slash = path.find('/');
     std::string_view part = path.substr(0, slash);
     path = slash == std::string_view::npos ? std::string_view{} : path.substr(slash + 1);
     if (part.empty()) continue;
-    PathElement e{part, -1};
+    PathElement e{part, -1, 0};
     if (part.back() == ']') {
       const size_t open = part.rfind('[');
       if (open == std::string_view::npos)
@@ -645,7 +647,6 @@ std::vector<PathElement> SplitPath(std::string_view path, std::string_view full)
     }
     out.push_back(e);
   }
-  return out;
 }
 
 }  // namespace
@@ -675,8 +676,17 @@ ObjectId Scene::FindObject(std::string_view path, ObjectId from) const {
     throw Error("malformed object path '" + std::string(full) +
                 "': start with '/' (absolute), './' (below this object) or ':/' (in this model)");
   }
-  const std::vector<PathElement> elements = SplitPath(path, full);
+  // The elements in a buffer of this thread's (robots' scripts and
+  // controllers look up their objects by path at start, on every thread),
+  // each name as its id: no object has a name the pool lacks, and the walk
+  // compares ids, not strings.
+  thread_local std::vector<PathElement> elements;
+  SplitPath(path, full, &elements);
   if (elements.empty()) return scope < 0 ? ObjectId{} : IdAt(static_cast<uint32_t>(scope));
+  for (PathElement& e : elements) {
+    e.id = names_.Find(e.name);
+    if (e.id == NamePool::kNone) return {};
+  }
 
   // First element: roots (absolute) or any descendant of the scope; each
   // following one: descendants of the current match; hierarchy order (a
@@ -695,7 +705,7 @@ ObjectId Scene::FindObject(std::string_view path, ObjectId from) const {
     const int want = e.index < 0 ? 0 : e.index;
     int seen = 0;
     int32_t match = -1;
-    const auto matches = [&](uint32_t c) { return name_at(c) == e.name && seen++ == want; };
+    const auto matches = [&](uint32_t c) { return name_[c] == e.id && seen++ == want; };
     if (k == 0 && !search_descendants) {
       for (uint32_t s = 0; s < generation_.size() && match < 0; ++s)
         if (alive_[s] && parent_[s] < 0 && matches(s)) match = static_cast<int32_t>(s);
@@ -734,7 +744,8 @@ std::string Scene::ExplainMissingPath(std::string_view path, ObjectId from) cons
   } else {
     return "";
   }
-  const std::vector<PathElement> elements = SplitPath(path.substr(path[0] == '/' ? 1 : 2), full);
+  std::vector<PathElement> elements;
+  SplitPath(path.substr(path[0] == '/' ? 1 : 2), full, &elements);
   for (const PathElement& e : elements) {
     int seen = 0;
     int32_t current = -1;
