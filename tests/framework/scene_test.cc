@@ -136,7 +136,18 @@ TEST(SceneTest, PathsResolveRelativeToTheCaller) {
   EXPECT_TRUE(scene.FindObject("/nothing").IsNull());
   EXPECT_THROW(scene.FindObject("./sensor[x]", body), Error);
   EXPECT_THROW(scene.FindObject("sensor", body), Error);
+  EXPECT_THROW(scene.FindObject("./nothing[x]", body), Error) << "malformed, whatever the name";
   EXPECT_EQ(scene.PathOf(s1), "/robot/body/sensor");
+  // Renamed and removed objects: found by their names now only.
+  scene.set_name(s1, "eye");
+  EXPECT_TRUE(scene.FindObject("./sensor[1]", body).IsNull());
+  EXPECT_EQ(scene.FindObject("./eye", body), s1);
+  scene.RemoveSubtree(s0);
+  EXPECT_TRUE(scene.FindObject("./sensor", body).IsNull());
+  EXPECT_EQ(scene.FindObject("/robot/body/eye"), s1);
+  const ObjectId s2 = scene.AddDummy("sensor", s1, {});  // the name back, elsewhere
+  EXPECT_EQ(scene.FindObject("./sensor", body), s2);
+  EXPECT_EQ(scene.FindObject("./eye/sensor", body), s2);
 }
 
 // Matches count in hierarchy order (depth first, children in the order they
