@@ -43,6 +43,11 @@ void CheckWorld(const SweepOptions& o, const GridRun& first) {
 
 }  // namespace
 
+int RunsSideBySide(int jobs, size_t pending) {
+  return static_cast<int>(
+      std::min<size_t>(static_cast<size_t>(std::max(jobs, 1)), std::max<size_t>(pending, 1)));
+}
+
 std::string RunMemoryCap(const std::string& max_memory, int jobs, uint64_t available) {
   if (!max_memory.empty()) return max_memory;
   if (jobs <= 1 || available == UINT64_MAX) return "";
@@ -151,7 +156,7 @@ int CoordinateSweep(const SweepOptions& o, RemoteWorkers* remote, std::ostream& 
         << (jobs == 1 ? " job" : " jobs") << (remote ? " here plus the other ranks" : "") << "\n";
 
   SweepProgress progress(err, shard_total, already, isatty(STDERR_FILENO) != 0, !o.quiet);
-  RunPool pool(MakeWorkerConfig(o, jobs), jobs);
+  RunPool pool(MakeWorkerConfig(o, RunsSideBySide(jobs, pending.size())), jobs);
   const std::string me = WorkerName();
   auto next = [&]() -> std::optional<GridRun> {
     if (pending.empty()) return std::nullopt;

@@ -3,6 +3,7 @@
 // under MPI, to the other ranks) and records what they return.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <iosfwd>
@@ -42,6 +43,11 @@ struct SweepOptions {
 // How the worker processes of a sweep run (shared by local and MPI sweeps),
 // `jobs` of them at once on this machine.
 WorkerConfig MakeWorkerConfig(const SweepOptions& options, int jobs);
+
+// How many runs can be side by side: the jobs, but no more than the runs
+// left (at least 1). The memory is shared between these: --jobs 8 for 2
+// runs gives each half, not an eighth.
+int RunsSideBySide(int jobs, size_t pending);
 
 // Each run's --max-memory: `max_memory` if given, else with more than one
 // job `available` (bytes the machine or cgroup has; UINT64_MAX: unknown)

@@ -316,6 +316,11 @@ TEST(CoordinatorTest, EachRunGetsTheUsersMemoryCapOrItsShare) {
   EXPECT_EQ(RunMemoryCap("", 3, 9000), "3000");
   EXPECT_EQ(RunMemoryCap("", 1, k8GiB), "") << "one job: the run's own check is enough";
   EXPECT_EQ(RunMemoryCap("", 4, UINT64_MAX), "") << "unknown room: no cap";
+  // Shared by the runs that can be side by side, not by jobs that have no run.
+  EXPECT_EQ(RunsSideBySide(8, 2), 2);
+  EXPECT_EQ(RunsSideBySide(2, 100), 2);
+  EXPECT_EQ(RunsSideBySide(4, 0), 1);
+  EXPECT_EQ(RunMemoryCap("", RunsSideBySide(8, 1), k8GiB), "") << "one run left: no share";
   SweepOptions options;
   options.world = kWorld;
   options.max_memory = "3G";
