@@ -8,6 +8,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace swarmsim {
@@ -37,6 +38,8 @@ class RowTable {
   virtual uint32_t SwapRemove(uint32_t row) = 0;
   virtual void Reserve(size_t rows) = 0;
   virtual void* At(uint32_t row) = 0;
+  // The rows' reserved room past the last row: its start and bytes.
+  virtual std::pair<const void*, size_t> Spare() const = 0;
 
   std::vector<uint32_t> owners;  // slot of each row's object (rows)
 };
@@ -78,6 +81,9 @@ class Rows final : public RowTable {
     owners.reserve(n);
   }
   void* At(uint32_t row) override { return &rows[row]; }
+  std::pair<const void*, size_t> Spare() const override {
+    return {rows.data() + rows.size(), (rows.capacity() - rows.size()) * sizeof(Row)};
+  }
 
   std::vector<Row> rows;
 };

@@ -35,6 +35,7 @@
 
 namespace swarmsim {
 
+class Prefault;
 class ScriptMemory;
 class StateHasher;
 class StateReader;
@@ -301,8 +302,10 @@ class Scene {
   void AddListener(SceneListener* listener) { listeners_.push_back(listener); }
   // Reserves room for `copies` more duplicates of the subtree at `root`, so
   // placing ten thousand robots grows no array (and peak memory stays at
-  // what the robots use).
-  void ReserveForCopies(ObjectId root, size_t copies);
+  // what the robots use). With `prefault`, the room reserved is added to it,
+  // for the caller to populate on every thread before copying
+  // (framework/prefault.h).
+  void ReserveForCopies(ObjectId root, size_t copies, Prefault* prefault = nullptr);
 
   // --- Validity ---------------------------------------------------------------
   bool IsValid(ObjectId id) const;

@@ -5,6 +5,7 @@
 
 #include "framework/error.h"
 #include "framework/object_type.h"
+#include "framework/prefault.h"
 #include "framework/scene.h"
 #include "framework/script_memory.h"
 
@@ -42,7 +43,7 @@ uint32_t Scene::CopyObject(uint32_t src, int32_t new_parent, const Pose& X_PO) {
   return slot;
 }
 
-void Scene::ReserveForCopies(ObjectId root, size_t copies) {
+void Scene::ReserveForCopies(ObjectId root, size_t copies, Prefault* prefault) {
   std::vector<uint32_t> sub;
   CollectSubtree(SlotOf(root), &sub);
   std::vector<size_t> rows_of_type(types_.size(), 0);
@@ -70,6 +71,22 @@ void Scene::ReserveForCopies(ObjectId root, size_t copies) {
       tables_[t]->Reserve(tables_[t]->size() + rows_of_type[t] * copies);
   scripts_.reserve(scripts_.size() + scripts * copies);
   instances_.reserve(instances_.size() + copies);
+  if (prefault == nullptr) return;
+  for (auto* v : {&X_PO_, &X_WO_}) prefault->AddSpare(*v);
+  prefault->AddSpare(motions_);
+  for (auto* v : {&motion_, &name_, &generation_, &row_}) prefault->AddSpare(*v);
+  for (auto* v : {&parent_, &first_child_, &last_child_, &next_sibling_, &prev_sibling_, &instance_,
+                  &script_})
+    prefault->AddSpare(*v);
+  for (auto* v : {&simulated_, &alive_, &model_root_}) prefault->AddSpare(*v);
+  prefault->AddSpare(type_);
+  for (size_t t = 0; t < types_.size(); ++t)
+    if (tables_[t] && rows_of_type[t] > 0) {
+      const auto [begin, bytes] = tables_[t]->Spare();
+      prefault->Add(begin, bytes);
+      prefault->AddSpare(tables_[t]->owners);
+    }
+  prefault->AddSpare(scripts_);
 }
 
 ObjectId Scene::DuplicateSubtree(ObjectId root, ObjectId new_parent, const Pose* X_PO) {

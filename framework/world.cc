@@ -14,6 +14,7 @@
 #include "framework/line_of_sight.h"
 #include "framework/object_type.h"
 #include "framework/plugin_controllers.h"
+#include "framework/prefault.h"
 #include "framework/registry.h"
 #include "framework/scheduler.h"
 #include "framework/state_hash.h"
@@ -263,10 +264,11 @@ void World::EnsureRuntimes() {
   if (!started_) scene_runtime_.rng = Rng(settings_.seed, uint64_t{1} << 63);
 }
 
-void World::ReserveRobots(size_t robots) {
+void World::ReserveRobots(size_t robots, Prefault* prefault) {
   runtimes_.reserve(robots);
   pending_.reserve(robots);
   messaging_.Reserve(robots);
+  if (prefault != nullptr) prefault->AddSpare(runtimes_);
 }
 
 void World::SetInstanceParameters(int instance, SharedParameters parameters) {

@@ -271,8 +271,9 @@ class World final : public PhaseHandlers {
   // snapshots (world_writes.cc). Worlds nobody writes to hash as before.
   void WriteInstanceParameters(int instance, SharedParameters parameters);
   // Room for `robots` robots in all (a loader about to add many): their
-  // per-robot state then grows without slack.
-  void ReserveRobots(size_t robots);
+  // per-robot state then grows without slack. With `prefault`, the room is
+  // added to it (framework/prefault.h), for the caller to populate.
+  void ReserveRobots(size_t robots, Prefault* prefault = nullptr);
 
   // --- Lifecycle ------------------------------------------------------------------
   // Builds the dynamics backend and the modules from the placed scene and runs

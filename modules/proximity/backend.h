@@ -14,10 +14,14 @@
 namespace swarmsim {
 
 class Scene;
+class TaskScheduler;
 
 struct ProximitySettings {
   double octree_resolution = 0.05;  // m, voxel size of the static environment's octree
   uint64_t seed = 1;                // the world's seed: randomized-ray sensors draw from it
+  // The world's threads: the first Update populates its buffers' pages on
+  // them (framework/prefault.h). Null: on the caller, as it writes them.
+  TaskScheduler* scheduler = nullptr;
 };
 
 // May the sensor `sensor` detect the shape `shape`? The hook for per-sensor

@@ -34,6 +34,7 @@ class ProximityModule final : public Module, public ProximityReadings {
   void Start(World* world) override {
     settings_.octree_resolution = world->settings().octree_resolution;
     settings_.seed = world->settings().seed;
+    settings_.scheduler = &world->scheduler();
     backend_->Build(world->scene(), settings_);
     environment_version_ = world->scene().environment_version();
     world->set_line_of_sight(backend_.get());

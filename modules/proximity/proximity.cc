@@ -38,6 +38,7 @@
 #include <span>
 #include <vector>
 
+#include "framework/prefault.h"
 #include "framework/scene.h"
 #include "framework/spatial_grid.h"
 #include "modules/proximity/footprint_grid.h"
@@ -107,6 +108,7 @@ class OctreeGridProximity final : public ProximityBackend {
     have_sensor_type_ = FindSensorType(scene, &sensor_type_);
     static_.Build(scene, settings.octree_resolution);
     seed_ = settings.seed;
+    scheduler_ = settings.scheduler;
     static_lo_.clear();
     static_hi_.clear();
     for (const PlacedShape& shape : static_.shapes()) {
@@ -140,6 +142,17 @@ class OctreeGridProximity final : public ProximityBackend {
       instances_.reserve(n);
       ids_.reserve(n);
       footprint_memos_.reserve(n);
+      if (scheduler_ != nullptr) {
+        // A large swarm's buffers are fresh pages: populated on every thread.
+        Prefault prefault;
+        prefault.AddSpare(moving_);
+        prefault.AddSpare(footprints_);
+        prefault.AddSpare(squares_);
+        prefault.AddSpare(instances_);
+        prefault.AddSpare(ids_);
+        prefault.AddSpare(footprint_memos_);
+        prefault.Run(*scheduler_);
+      }
     }
     footprint_memos_.resize(shapes.size());
     for (size_t r = 0; r < shapes.size(); ++r) {
@@ -668,6 +681,7 @@ class OctreeGridProximity final : public ProximityBackend {
   StaticIndex static_;
   std::vector<Vec3> static_lo_, static_hi_;  // world bounds of static_.shapes() (static shapes)
   uint64_t seed_ = 1;                        // the world's seed
+  TaskScheduler* scheduler_ = nullptr;       // populates the first sizing's pages
   uint64_t step_ = 0;                        // the step being sensed
   DetectableFilter detectable_;              // unset: every shape is detectable
   std::vector<PlacedShape> moving_;   // robot and dynamic shapes, by shape row order (moving)

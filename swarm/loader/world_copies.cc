@@ -14,6 +14,7 @@
 #include "framework/memory_forecast.h"
 #include "framework/model_section.h"
 #include "framework/plugin_controllers.h"
+#include "framework/prefault.h"
 #include "framework/registry.h"
 #include "framework/world_section.h"
 #include "swarm/loader/world_loader_impl.h"
@@ -203,8 +204,12 @@ void WorldLoader::BuildCopies(World* world) {
         if (!e.own_copies.empty()) ShareScaledMeshes(spec, root, &scene, &scaled_meshes);
       }
       if (reserve) {
-        scene.ReserveForCopies(root, *reserve);
-        world->ReserveRobots(scene.instances().size() + 1 + *reserve);
+        // The copies' rows are written into pages populated on every thread
+        // first (the kernel zeroing them was most of a large world's copies).
+        Prefault prefault;
+        scene.ReserveForCopies(root, *reserve, &prefault);
+        world->ReserveRobots(scene.instances().size() + 1 + *reserve, &prefault);
+        prefault.Run(world->scheduler());
       }
       const int instance = scene.MakeModelInstance(
           root, name, name + "#" + std::to_string(scene.instances().size()));
