@@ -12,11 +12,29 @@ StateHasher::StateHasher() : state_(XXH3_createState()) {
 
 StateHasher::~StateHasher() { XXH3_freeState(static_cast<XXH3_state_t*>(state_)); }
 
+void StateHasher::Flush() const {
+  if (used_ == 0) return;
+  XXH3_64bits_update(static_cast<XXH3_state_t*>(state_), buffer_, used_);
+  used_ = 0;
+}
+
 void StateHasher::Add(const void* data, size_t bytes) {
-  XXH3_64bits_update(static_cast<XXH3_state_t*>(state_), data, bytes);
+  if (bytes <= kBuffer - used_) {
+    if (bytes > 0) std::memcpy(buffer_ + used_, data, bytes);
+    used_ += bytes;
+    return;
+  }
+  Flush();
+  if (bytes >= kBuffer) {
+    XXH3_64bits_update(static_cast<XXH3_state_t*>(state_), data, bytes);
+    return;
+  }
+  std::memcpy(buffer_, data, bytes);
+  used_ = bytes;
 }
 
 uint64_t StateHasher::Digest() const {
+  Flush();
   return XXH3_64bits_digest(static_cast<const XXH3_state_t*>(state_));
 }
 

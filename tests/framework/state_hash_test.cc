@@ -43,6 +43,35 @@ TEST(StateHasherTest, TheDigestDependsOnTheBytesNotOnHowTheyWereAdded) {
   EXPECT_NE(pieces.Digest(), before);
 }
 
+// Values are gathered a few KiB at a time before XXH3 sees them: arrays
+// longer than that, values across its edge, and a digest read halfway give
+// what one call over all the bytes gives.
+TEST(StateHasherTest, ManySmallValuesHashAsTheirBytesInOneCall) {
+  std::vector<uint64_t> values(5000);
+  for (size_t i = 0; i < values.size(); ++i) values[i] = i * 0x9e3779b97f4a7c15ULL;
+  StateHasher whole;
+  whole.Add(values.data(), values.size() * sizeof(uint64_t));  // one call, longer than the buffer
+  StateHasher one_by_one;
+  for (uint64_t v : values) one_by_one.AddValue(v);
+  EXPECT_EQ(one_by_one.Digest(), whole.Digest());
+  StateHasher mixed;  // odd sizes, a long run in the middle, a digest read halfway
+  const auto* bytes = reinterpret_cast<const unsigned char*>(values.data());
+  const size_t total = values.size() * sizeof(uint64_t);
+  size_t at = 0;
+  for (size_t cut : {size_t{3}, size_t{4093}, size_t{7}, size_t{9000}, size_t{1}}) {
+    mixed.Add(bytes + at, cut);
+    at += cut;
+    (void)mixed.Digest();
+  }
+  mixed.Add(bytes + at, total - at);
+  EXPECT_EQ(mixed.Digest(), whole.Digest());
+  // A byte changed anywhere, even one still gathered, changes the digest.
+  values.back() ^= 1;
+  StateHasher changed;
+  for (uint64_t v : values) changed.AddValue(v);
+  EXPECT_NE(changed.Digest(), whole.Digest());
+}
+
 TEST(StateHasherTest, OrderSignAndEveryBitChangeTheDigest) {
   const auto digest = [](std::initializer_list<double> values) {
     StateHasher h;

@@ -215,6 +215,30 @@ TEST(CliTest, ScriptErrorInOneRobotKeepsEveryRobotsPrintsInRobotOrder) {
   fs::remove_all(dir);
 }
 
+// The run leaves its world to the system at its end (a large world's blocks
+// are not freed one by one), stopped first: every robot's cleanup still
+// runs, after a run that ends well and after one a script error ends.
+TEST(CliTest, EveryCleanupRunsAtTheEndOfARunWhateverItsEnd) {
+  const fs::path dir = TempDir("cleanups");
+  const std::string cleanup = "function sysCall_cleanup() print('cleanup ran') end\n";
+  for (const bool fails : {false, true}) {
+    const std::string world = DummyWorld(
+        dir / (fails ? "fails" : "ends"), 3,
+        cleanup + (fails ? "function sysCall_actuation() if sim.getRobotIndex() == 1 and "
+                           "sim.getSimulationTime() > 0.15 then error('late') end end\n"
+                         : ""));
+    const Result r = RunProgram("run " + world + " --steps 5 --threads 2 --quiet");
+    EXPECT_EQ(r.exit_code, fails ? 1 : 0) << r.output;
+    for (int i = 0; i < 3; ++i)
+      EXPECT_NE(r.output.find("[dummy#" + std::to_string(i) + "] cleanup ran"), std::string::npos)
+          << (fails ? "after an error: " : "") << r.output;
+    if (fails) {
+      EXPECT_NE(r.output.find("late"), std::string::npos) << r.output;
+    }
+  }
+  fs::remove_all(dir);
+}
+
 TEST(CliTest, ProgressShowsTheRobotsLoadedUnlessQuiet) {
   // Not a terminal here: the line comes with --progress only, and never with --quiet.
   const std::string run = "run " + std::string(SWARMSIM_SOURCE_DIR) +
