@@ -265,8 +265,11 @@ void Scene::UnlinkChild(uint32_t child) {
 }
 
 void Scene::CollectSubtree(uint32_t slot, std::vector<uint32_t>* out) const {
-  // Iterative DFS pre-order, children in insertion order.
-  std::vector<uint32_t> stack{slot};
+  // Iterative DFS pre-order, children in insertion order. (The stack is
+  // the thread's own: a loader copying a million robots collects a subtree
+  // per copy.)
+  thread_local std::vector<uint32_t> stack;
+  stack.assign(1, slot);
   while (!stack.empty()) {
     const uint32_t s = stack.back();
     stack.pop_back();

@@ -1,7 +1,10 @@
 // Scene: copy-paste of subtrees (with their rows through each type's
 // copy rule, scripts, model marks and dummy links) and the size factor
 // (each type's scale rule). scene.cc has the rest of the scene.
-#include <unordered_map>
+#include <algorithm>
+#include <span>
+#include <utility>
+#include <vector>
 
 #include "framework/error.h"
 #include "framework/object_type.h"
@@ -26,7 +29,8 @@ uint32_t Scene::CopyObject(uint32_t src, int32_t new_parent, const Pose& X_PO) {
   model_root_[slot] = model_root_[src];
   if (const auto factor = size_factor_.find(src); factor != size_factor_.end())
     size_factor_[slot] = factor->second;
-  if (const auto data = custom_data_.find(src); data != custom_data_.end()) {
+  if (const auto data = custom_data_.empty() ? custom_data_.end() : custom_data_.find(src);
+      data != custom_data_.end()) {
     // Each block a script wrote is charged again to its writer (the run's
     // limit was checked by DuplicateSubtree).
     CustomData copy = data->second;  // (inserting may rehash)
@@ -99,7 +103,7 @@ ObjectId Scene::DuplicateSubtree(ObjectId root, ObjectId new_parent, const Pose*
   // refused before anything is copied if the run cannot hold them.
   uint64_t charged = 0;
   const RunScriptMemory* run = nullptr;
-  for (uint32_t src : sources) {
+  for (uint32_t src : custom_data_.empty() ? std::span<const uint32_t>{} : sources) {
     const auto data = custom_data_.find(src);
     if (data == custom_data_.end()) continue;
     for (const auto& [tag, block] : data->second) {
@@ -112,25 +116,36 @@ ObjectId Scene::DuplicateSubtree(ObjectId root, ObjectId new_parent, const Pose*
     throw Error("copying '" + name_at(root_slot) + "': its custom data blocks (" +
                 std::to_string(charged >> 20) + " MiB) would take the run's scripts past " +
                 std::to_string(run->limit() >> 20) + " MiB (simulation.run_script_memory_mb)");
-  // Pre-order guarantees a parent is copied before its children.
-  std::unordered_map<uint32_t, uint32_t> copy_of;
-  copy_of.reserve(sources.size());
-  for (uint32_t src : sources) {
+  // Pre-order guarantees a parent is copied before its children. The
+  // copies sit by the sources' order; a source's index is found by its slot
+  // in a sorted list (a robot's ~30 objects: no hash table per copy).
+  std::vector<std::pair<uint32_t, uint32_t>> index_of(sources.size());  // (source slot, index)
+  for (uint32_t i = 0; i < sources.size(); ++i) index_of[i] = {sources[i], i};
+  std::sort(index_of.begin(), index_of.end());
+  const auto find = [&index_of](uint32_t slot) -> const std::pair<uint32_t, uint32_t>* {
+    const auto it =
+        std::lower_bound(index_of.begin(), index_of.end(), std::pair<uint32_t, uint32_t>{slot, 0});
+    return it != index_of.end() && it->first == slot ? &*it : nullptr;
+  };
+  std::vector<uint32_t> copies(sources.size());
+  for (size_t i = 0; i < sources.size(); ++i) {
+    const uint32_t src = sources[i];
     const int32_t p =
-        src == root_slot ? parent_slot : static_cast<int32_t>(copy_of.at(parent_[src]));
-    const Pose pose = src == root_slot && X_PO != nullptr ? *X_PO : X_PO_[src];
-    copy_of[src] = CopyObject(src, p, pose);
+        i == 0 ? parent_slot : static_cast<int32_t>(copies[find(parent_[src])->second]);
+    const Pose pose = i == 0 && X_PO != nullptr ? *X_PO : X_PO_[src];
+    copies[i] = CopyObject(src, p, pose);
   }
   // Remap internal references: a link inside the subtree points at the copy;
   // a link to an object outside stays as it was.
-  for (uint32_t src : sources) {
-    const auto linked = linked_dummy_.find(src);
-    if (linked == linked_dummy_.end()) continue;
-    const uint32_t link = linked->second;
-    auto it = copy_of.find(link);
-    linked_dummy_[copy_of[src]] = it != copy_of.end() ? it->second : link;
-  }
-  const uint32_t copy_root = copy_of.at(root_slot);
+  if (!linked_dummy_.empty())
+    for (size_t i = 0; i < sources.size(); ++i) {
+      const auto linked = linked_dummy_.find(sources[i]);
+      if (linked == linked_dummy_.end()) continue;
+      const uint32_t link = linked->second;
+      const auto* inside = find(link);
+      linked_dummy_[copies[i]] = inside != nullptr ? copies[inside->second] : link;
+    }
+  const uint32_t copy_root = copies[0];
   RefreshSubtree(copy_root);
   // A copy of a whole robot is a new robot.
   const int src_instance = instance_[root_slot];
@@ -140,12 +155,7 @@ ObjectId Scene::DuplicateSubtree(ObjectId root, ObjectId new_parent, const Pose*
     MakeModelInstance(IdAt(copy_root), model_name,
                       model_name + "#" + std::to_string(instances_.size()));
   }
-  if (!listeners_.empty()) {
-    std::vector<uint32_t> copies;
-    copies.reserve(sources.size());
-    for (uint32_t src : sources) copies.push_back(copy_of.at(src));
-    for (SceneListener* l : listeners_) l->OnSubtreeDuplicated(*this, sources, copies);
-  }
+  for (SceneListener* l : listeners_) l->OnSubtreeDuplicated(*this, sources, copies);
   return IdAt(copy_root);
 }
 
