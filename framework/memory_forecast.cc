@@ -229,6 +229,23 @@ std::string MemoryForecast::Built(int64_t built) {
   return verdict;
 }
 
+std::string MemoryForecast::Reserved(uint64_t bytes) const {
+  if (stride_ == 0) return "";
+  const MemoryRoom room = ReadMemoryRoom(cap_);
+  if (room.available == UINT64_MAX || bytes <= room.available) return "";
+  const double each = static_cast<double>(bytes) / static_cast<double>(total_);
+  const int64_t fit = static_cast<int64_t>(static_cast<double>(room.available) / each);
+  std::ostringstream s;
+  s << "not enough memory for " << GroupThousands(total_) << " " << items_
+    << ": the arrays reserved for them take " << FormatSize(static_cast<double>(bytes)) << " ("
+    << FormatSize(each) << " each) before anything else, and the process may take "
+    << FormatSize(static_cast<double>(room.available)) << " more (" << room.bound
+    << "). Fewer than " << GroupThousands(fit)
+    << " would fit: run fewer robots or give the run more memory (README, \"A world that does "
+       "not fit\"); SWARMSIM_MEMORY_CHECK=0 skips this check";
+  return s.str();
+}
+
 std::string MemoryForecast::Verdict(const std::string& items, int64_t total, int64_t built,
                                     int64_t measured, uint64_t grown, const MemoryRoom& room) {
   if (measured <= 0 || built >= total || room.available == UINT64_MAX) return "";

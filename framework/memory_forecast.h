@@ -57,6 +57,15 @@ class MemoryForecast {
   // when the rest will not fit; "" otherwise.
   std::string Built(int64_t built);
 
+  // Before the items are built: `bytes` of memory reserved for all of them
+  // that building them will touch (a loader's arrays for every copy, about
+  // to be populated at once: framework/prefault.h). The error text when
+  // those bytes alone exceed the room left; "" otherwise, and under the
+  // same rules as Built (nothing for fewer than 2,000 items or with the
+  // check off). Without it, populating them could end the process through
+  // the kernel's out-of-memory killer before any checkpoint.
+  std::string Reserved(uint64_t bytes) const;
+
   // The check, for a given reading (tests): `built` of `total` items are
   // built, the last `measured` of them grew the process by `grown` bytes.
   // "" when the rest fits.

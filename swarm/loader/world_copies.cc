@@ -209,6 +209,11 @@ void WorldLoader::BuildCopies(World* world) {
         Prefault prefault;
         scene.ReserveForCopies(root, *reserve, &prefault);
         world->ReserveRobots(scene.instances().size() + 1 + *reserve, &prefault);
+        // Populated at once, so checked at once: a world whose arrays alone
+        // do not fit is refused here with a message, not ended by the
+        // kernel's out-of-memory killer while they are populated.
+        if (std::string refusal = forecast.Reserved(prefault.bytes()); !refusal.empty())
+          throw Error(refusal);
         prefault.Run(world->scheduler());
       }
       const int instance = scene.MakeModelInstance(

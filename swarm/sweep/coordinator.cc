@@ -155,8 +155,18 @@ int CoordinateSweep(const SweepOptions& o, RemoteWorkers* remote, std::ostream& 
         << ", " << already << " already finished, " << pending.size() << " to run on " << jobs
         << (jobs == 1 ? " job" : " jobs") << (remote ? " here plus the other ranks" : "") << "\n";
 
+  const int side_by_side = RunsSideBySide(jobs, pending.size());
+  const WorkerConfig config = MakeWorkerConfig(o, side_by_side);
+  // A cap the user did not give shows up in a refused run's message as
+  // "--max-memory ...": say here where it comes from.
+  if (!o.quiet && o.max_memory.empty() && !config.max_memory.empty())
+    err << "sweep: each run may take up to "
+        << FormatSize(static_cast<double>(std::stoull(config.max_memory)))
+        << " (the memory available now, shared by " << side_by_side
+        << " runs side by side; sweep --max-memory sets it)\n";
+
   SweepProgress progress(err, shard_total, already, isatty(STDERR_FILENO) != 0, !o.quiet);
-  RunPool pool(MakeWorkerConfig(o, RunsSideBySide(jobs, pending.size())), jobs);
+  RunPool pool(config, jobs);
   const std::string me = WorkerName();
   auto next = [&]() -> std::optional<GridRun> {
     if (pending.empty()) return std::nullopt;

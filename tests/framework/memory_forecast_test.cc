@@ -79,6 +79,28 @@ TEST(MemoryForecastTest, TheVerdictSaysWhatTheRestNeedsAndHowManyFit) {
             "");
 }
 
+// Arrays reserved for every item, about to be populated at once, are
+// checked before anything is built: refused past the room (naming it),
+// fine within it, and under the same rules as the checkpoints (a small
+// world, the check off: nothing).
+TEST(MemoryForecastTest, ReservedArraysPastTheRoomAreRefusedBeforeAnythingIsBuilt) {
+  const uint64_t cap = ReadMemoryRoom(0).resident + 64 * kMiB;
+  const MemoryForecast forecast("robot copies", 100'000, cap);
+  const std::string no = forecast.Reserved(kGiB);
+  EXPECT_NE(no.find("not enough memory for 100,000 robot copies: the arrays reserved for them "
+                    "take 1.0 GiB (10.5 KiB each) before anything else"),
+            std::string::npos)
+      << no;
+  EXPECT_NE(no.find("(--max-memory "), std::string::npos) << no;
+  EXPECT_NE(no.find("Fewer than "), std::string::npos) << no;
+  EXPECT_EQ(forecast.Reserved(16 * kMiB), "");
+  EXPECT_EQ(MemoryForecast("robot copies", 1'000, cap).Reserved(kGiB), "") << "a small world";
+  setenv("SWARMSIM_MEMORY_CHECK", "0", 1);
+  const MemoryForecast off("robot copies", 100'000, cap);
+  unsetenv("SWARMSIM_MEMORY_CHECK");
+  EXPECT_EQ(off.Reserved(kGiB), "");
+}
+
 // Items that each take 64 KiB, under a cap 64 MiB above the start: the
 // forecast refuses them (once); without a cap, in a small world, or with
 // the check turned off, it says nothing.

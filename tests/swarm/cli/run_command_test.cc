@@ -276,6 +276,28 @@ TEST(CliTest, AWorldThatWillNotFitIsRefusedWithAMessage) {
   EXPECT_EQ(json["status"], "error");
   EXPECT_NE(json["error"].get<std::string>().find("not enough memory"), std::string::npos);
 
+  // The copies' arrays are populated at once (framework/prefault.h), so
+  // they are checked at once: 20,000 planar C++ foot-bots reserve ~140 MiB
+  // of rows, refused under an 80 MiB cap before any copy is made (not left
+  // to populate and, on a real machine, meet the out-of-memory killer).
+  const fs::path out2 = TempDir("max_memory_reserved");
+  r = RunProgram("run " + std::string(SWARMSIM_SOURCE_DIR) +
+                 "/bench/worlds/diffusion_planar_native.yaml --set robots=20000 --steps 1 "
+                 "--progress --max-memory 80M --out " +
+                 out2.string());
+  EXPECT_NE(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("not enough memory for 20,000 robot copies: the arrays reserved for "
+                          "them take "),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("(--max-memory 80.0 MiB). Fewer than "), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("1,024 of 20,000 robots built"), std::string::npos)
+      << "refused before the copies: " << r.output;
+  std::ifstream summary2(out2 / "summary.json");
+  ASSERT_TRUE(summary2.good()) << r.output;
+  EXPECT_NE(nlohmann::json::parse(summary2)["error"].get<std::string>().find("arrays reserved"),
+            std::string::npos);
+
   Result bad = RunProgram("run " + Data("ok.yaml") + " --steps 1 --max-memory 12X");
   EXPECT_EQ(bad.exit_code, 2) << bad.output;
   EXPECT_NE(bad.output.find("expected a memory size such as 500M, 2G or 1.5GiB, got '12X'"),

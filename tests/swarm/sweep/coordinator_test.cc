@@ -329,6 +329,24 @@ TEST(CoordinatorTest, EachRunGetsTheUsersMemoryCapOrItsShare) {
   EXPECT_EQ(MakeWorkerConfig(options, 1).max_memory, "");
 }
 
+// The share is a cap the user did not give: the sweep says where a refused
+// run's "--max-memory ..." comes from, and says nothing when it is theirs.
+TEST(CoordinatorTest, TheSweepSaysEachRunsShareOfTheMemory) {
+  const fs::path dir = TempDir("share");
+  const std::string base =
+      "sweep " + kWorld + " --param robots=2 --seeds 1-3 --steps 2 --jobs 2 --db ";
+  Result r = RunProgram(base + (dir / "a.db").string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("sweep: each run may take up to "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("shared by 2 runs side by side; sweep --max-memory sets it)"),
+            std::string::npos)
+      << r.output;
+  r = RunProgram(base + (dir / "b.db").string() + " --max-memory 3G");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.output.find("each run may take"), std::string::npos) << r.output;
+  fs::remove_all(dir);
+}
+
 TEST(CoordinatorTest, AWorldWithoutARunLengthNeedsStepsOrDuration) {
   const fs::path dir = TempDir("no_length");
   for (const char* f : {"bot.yaml", "bot.lua"})
