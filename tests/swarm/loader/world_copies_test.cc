@@ -97,17 +97,23 @@ TEST_F(WorldCopiesTest, CopiesThatCannotBePlacedApartAreNamedWithTheirCount) {
                                "  - {model: disc.yaml, position: [0.5, 0]}\n"),
                   "world.yaml:4:34: this disc at [0.5, 0] overlaps a wall, an obstacle, the map "
                   "or another placed copy");
-  // Distributed copies keep clear of fixed ones listed after them, and too
-  // many for their region are refused naming how many fitted.
+  // Distributed copies keep clear of fixed ones listed after them: 100
+  // pebbles around a disc that fills a fifth of their region (placed
+  // blindly, each would land on it with a chance of about 1 in 4, all 100
+  // missing it with one of 1e-13), and too many for their region are
+  // refused naming how many fitted.
+  Write("pebble.yaml",
+        "model: pebble\nobjects: {name: body, type: shape, shape: cylinder, radius: 0.05, "
+        "height: 0.1}\n");
   LoadedWorld w = Load(
       "simulation: {physics: kinematic}\nmodels:\n"
-      "  - {model: disc.yaml, count: 3, distribute: {region: {min: [0, 0], max: [6, 3]}}}\n"
-      "  - {model: disc.yaml, position: [3, 1.5]}\n");
+      "  - {model: pebble.yaml, count: 100, distribute: {region: {min: [0, 0], max: [2, 2]}}}\n"
+      "  - {model: disc.yaml, position: [1, 1]}\n");
   const Scene& scene = w.world->scene();
-  ASSERT_EQ(scene.instances().size(), 4u);
-  for (int k = 0; k < 3; ++k) {
+  ASSERT_EQ(scene.instances().size(), 101u);
+  for (int k = 0; k < 100; ++k) {
     const Vec3 p = scene.world_pose(scene.instance(k).root).p;
-    EXPECT_GE(std::hypot(p.x - 3, p.y - 1.5), 1 - 1e-9) << k;
+    EXPECT_GE(std::hypot(p.x - 1, p.y - 1), 0.55 - 1e-9) << k;
   }
   const std::string e = ErrorOfWorld(
       "simulation: {physics: kinematic}\nmodels:\n"
