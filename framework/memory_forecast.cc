@@ -234,15 +234,23 @@ std::string MemoryForecast::Reserved(uint64_t bytes) const {
   const MemoryRoom room = ReadMemoryRoom(cap_);
   if (room.available == UINT64_MAX || bytes <= room.available) return "";
   const double each = static_cast<double>(bytes) / static_cast<double>(total_);
-  const int64_t fit = static_cast<int64_t>(static_cast<double>(room.available) / each);
   std::ostringstream s;
   s << "not enough memory for " << GroupThousands(total_) << " " << items_
     << ": the arrays reserved for them take " << FormatSize(static_cast<double>(bytes)) << " ("
-    << FormatSize(each) << " each) before anything else, and the process may take "
-    << FormatSize(static_cast<double>(room.available)) << " more (" << room.bound
-    << "). Fewer than " << GroupThousands(fit)
-    << " would fit: run fewer robots or give the run more memory (README, \"A world that does "
-       "not fit\"); SWARMSIM_MEMORY_CHECK=0 skips this check";
+    << FormatSize(each) << " each) before anything else, and ";
+  if (room.available == 0) {
+    // Past the room already (a cap below what the program itself holds).
+    s << "the process holds " << FormatSize(static_cast<double>(room.resident))
+      << " already, with no room left (" << room.bound
+      << "). Give the run more memory (README, \"A world that does not fit\")";
+  } else {
+    const int64_t fit = static_cast<int64_t>(static_cast<double>(room.available) / each);
+    s << "the process may take " << FormatSize(static_cast<double>(room.available)) << " more ("
+      << room.bound << "). Fewer than " << GroupThousands(fit)
+      << " would fit: run fewer robots or give the run more memory (README, \"A world that does "
+         "not fit\")";
+  }
+  s << "; SWARMSIM_MEMORY_CHECK=0 skips this check";
   return s.str();
 }
 
@@ -252,17 +260,22 @@ std::string MemoryForecast::Verdict(const std::string& items, int64_t total, int
   const double each = static_cast<double>(grown) / static_cast<double>(measured);
   const double need = each * static_cast<double>(total - built);
   if (need <= static_cast<double>(room.available)) return "";
-  const int64_t fit = built + static_cast<int64_t>(static_cast<double>(room.available) / each);
   std::ostringstream s;
   s << "not enough memory for " << GroupThousands(total) << " " << items << ": with "
     << GroupThousands(built) << " built, the last " << GroupThousands(measured) << " took "
     << FormatSize(static_cast<double>(grown)) << " (" << FormatSize(each) << " each), so the other "
-    << GroupThousands(total - built) << " need about " << FormatSize(need)
-    << " more, and the process may take " << FormatSize(static_cast<double>(room.available))
-    << " more (" << room.bound << "). About " << GroupThousands(fit)
-    << " would fit: run fewer robots or give the run more memory (README, \"A world that does not "
-       "fit\"); "
-       "SWARMSIM_MEMORY_CHECK=0 skips this check";
+    << GroupThousands(total - built) << " need about " << FormatSize(need) << " more, and ";
+  if (room.available == 0) {
+    // The ones built already hold more than the room (a small cap).
+    s << "the process holds " << FormatSize(static_cast<double>(room.resident))
+      << " already, with no room left (" << room.bound << "). Fewer than " << GroupThousands(built);
+  } else {
+    const int64_t fit = built + static_cast<int64_t>(static_cast<double>(room.available) / each);
+    s << "the process may take " << FormatSize(static_cast<double>(room.available)) << " more ("
+      << room.bound << "). About " << GroupThousands(fit);
+  }
+  s << " would fit: run fewer robots or give the run more memory (README, \"A world that does not "
+       "fit\"); SWARMSIM_MEMORY_CHECK=0 skips this check";
   return s.str();
 }
 

@@ -28,6 +28,12 @@ std::string WriteAll(int fd, std::string_view bytes) {
 
 }  // namespace
 
+std::string CannotWrite(const std::filesystem::path& path) {
+  const int error = errno;
+  return "cannot write '" + path.string() + "'" +
+         (error != 0 ? std::string(": ") + std::strerror(error) : std::string());
+}
+
 std::string TryWriteFileAtomically(const std::filesystem::path& path, std::string_view bytes) {
   std::filesystem::path partial = path;
   partial += ".partial";

@@ -23,6 +23,11 @@ void WriteFileAtomically(const std::filesystem::path& path, std::string_view byt
 // written. For paths that must not throw (a run's last words).
 std::string TryWriteFileAtomically(const std::filesystem::path& path, std::string_view bytes);
 
+// "cannot write 'PATH': REASON", REASON from errno as an open or a write of
+// PATH just left it (nothing when errno is 0): for a stream that would not
+// open.
+std::string CannotWrite(const std::filesystem::path& path);
+
 // Space kept aside in an output folder so that the run's last file
 // (summary.json) can still be written when the disk fills up during the run
 // (a video, a recording). Reserve() writes a hidden file of `bytes`;

@@ -3,6 +3,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -13,6 +14,7 @@
 
 #include "framework/display_path.h"
 #include "framework/error.h"
+#include "framework/output_file.h"
 #include "framework/registry.h"
 #include "modules/builtin.h"
 #include "swarm/loader/world_loader.h"
@@ -188,12 +190,14 @@ std::string PrepareBench(BenchOptions* options) {
   LoadOptions load;
   load.overrides = {{"robots", "1"}};
   load.plugin_directories = BenchPluginDirectories();
-  try {
-    const LoadedWorld loaded = LoadWorld(options->world, load, registry);
-    // The bare-engine row of the world's backend, if it registered a bare
-    // loop (kinematic has none: its row is the box2d one, as before).
+  // The bare-engine row of the world's backend, if it registered a bare
+  // loop (kinematic has none: its row is the box2d one, as before).
+  const auto bare_row = [&registry](const LoadedWorld& loaded) {
     const std::string& physics = loaded.world->settings().physics;
     return registry.FindBareLoop(physics) != nullptr ? physics + "-only" : "box2d-only";
+  };
+  try {
+    return bare_row(LoadWorld(options->world, load, registry));
   } catch (const Error&) {
     // Tell a missing `robots` parameter from the file's own mistakes, which
     // loading it as written reports (and throws).
@@ -204,7 +208,10 @@ std::string PrepareBench(BenchOptions* options) {
       throw Error("bench: world '" + options->world +
                   "' has no parameter 'robots'; bench sets the robot count through it "
                   "(declare parameters: {robots: N} and use count: $robots in its models entry)");
-    throw;
+    // A world that loads as written but not with one robot (an arena sized
+    // by the count, too small for its obstacles at one): the counts asked
+    // for are measured; each one that does not load says why in its row.
+    return bare_row(as_written);
   }
 }
 
@@ -230,26 +237,32 @@ int RunBench(BenchOptions options, std::ostream& out, std::ostream& err) {
   std::unique_ptr<std::ofstream> csv;
   if (options.csv) {
     csv = std::make_unique<std::ofstream>(*options.csv);
-    if (!*csv) throw Error("cannot write '" + *options.csv + "'");
+    if (!*csv) throw Error(CannotWrite(*options.csv));
     *csv << kCsvHeader << "\n" << std::flush;
   }
+  // The whole world's rows are named after its file (diffusion for the
+  // default world), in the table and the CSV alike.
+  const std::string world_label = fs::path(options.world).stem().string();
+  const int width = std::max(12, static_cast<int>(world_label.size()) + 2);  // of the first column
   out << "world " << options.world << ", " << options.steps << " measured steps after "
       << options.warmup_steps << " warm-up steps; one process per row\n\n";
-  out << std::left << std::setw(12) << "config" << std::right << std::setw(8) << "robots"
+  out << std::left << std::setw(width) << "config" << std::right << std::setw(8) << "robots"
       << std::setw(8) << "threads" << std::setw(14) << "ticks/s" << std::setw(9) << "sense"
       << std::setw(9) << "control" << std::setw(9) << "actuate" << std::setw(9) << "physics"
       << std::setw(9) << "record" << std::setw(10) << "peak MiB" << std::setw(9) << "KB/robot"
       << "\n"
-      << std::string(12 + 8 + 8 + 14 + 9 * 5 + 10 + 9, '-') << "\n"
+      << std::string(static_cast<size_t>(width) + 8 + 8 + 14 + 9 * 5 + 10 + 9, '-') << "\n"
       << std::flush;
   auto measure = [&](const std::string& config, int robots, int threads) {
     BenchRow row;
+    const std::string label = config == "diffusion" ? world_label : config;
     if (!MeasureInChild(options, config, robots, threads, &row)) {
-      err << "bench: " << config << " with " << robots << " robots on " << threads
-          << " threads failed\n";
+      err << "bench: " << label << " with " << robots << (robots == 1 ? " robot" : " robots")
+          << " on " << threads << (threads == 1 ? " thread" : " threads") << " failed\n";
       return false;
     }
-    out << std::left << std::setw(12) << row.config << std::right << std::setw(8) << row.robots
+    row.config = label;
+    out << std::left << std::setw(width) << row.config << std::right << std::setw(8) << row.robots
         << std::setw(8) << row.threads << std::setw(14) << std::fixed << std::setprecision(0)
         << row.robot_ticks_per_s << std::setprecision(3);
     for (double us : row.us_per_tick) out << std::setw(9) << us;

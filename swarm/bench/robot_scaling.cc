@@ -13,6 +13,7 @@
 #include <utility>
 
 #include "framework/error.h"
+#include "framework/output_file.h"
 #include "swarm/bench/bench.h"
 #include "swarm/bench/scaling.h"
 
@@ -190,7 +191,7 @@ int RunRobotScalingBench(RobotScalingOptions o, std::ostream& out, std::ostream&
   if (o.threads.empty())
     o.threads = {static_cast<int>(std::max(1u, std::thread::hardware_concurrency()))};
   std::ofstream csv(o.csv);
-  if (!csv) throw Error("cannot write '" + o.csv + "'");
+  if (!csv) throw Error(CannotWrite(o.csv));
   csv << kCsvHeader << "\n" << std::flush;
 
   out << "microseconds per robot-tick by phase (a tick = one robot for one control step); "

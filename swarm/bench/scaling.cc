@@ -14,6 +14,7 @@
 #include <thread>
 
 #include "framework/error.h"
+#include "framework/output_file.h"
 
 namespace swarmsim {
 namespace {
@@ -165,7 +166,7 @@ int RunScalingBench(ScalingOptions o, std::ostream& out, std::ostream& err) {
   // 3. The speed-up table and the CSV.
   out << "\n== speed-up (throughput / throughput on 1 thread or job)\n";
   std::ofstream csv(o.csv);
-  if (!csv) throw Error("cannot write '" + o.csv + "'");
+  if (!csv) throw Error(CannotWrite(o.csv));
   csv << "series,workers,throughput,unit,speedup\n";
   std::map<std::string, std::vector<Point>> series;
   for (const Point& p : points) {

@@ -43,8 +43,10 @@ CLI::App* AddBenchCommand(CLI::App* app, BenchArgs* args) {
       ->transform(WholeNumberCheck(1, kIntMax, "jobs"));
   bench->add_option("--sweep-runs", scaling.sweep_runs, "With --scaling: runs per sweep")
       ->transform(WholeNumberCheck(1, kIntMax, "runs"));
-  bench->add_option("--plot", scaling.plot, "With --scaling: the PNG plot")
-      ->capture_default_str()
+  bench
+      ->add_option("--plot", scaling.plot,
+                   "With --scaling or --scaling-robots: the PNG plot (default scaling.png, "
+                   "scaling_robots.png)")
       ->check(NonEmpty("a file"));
   // bench --scaling-robots (issue 32): cost per robot-tick over robot counts.
   CLI::Option* robots_flag = bench->add_flag(
@@ -81,6 +83,15 @@ int ScalingRobots(const BenchArgs& args, const CLI::App& command) {
 
 int BenchCommand(BenchArgs args, const CLI::App& command) {
   args.options.self_exe = "/proc/self/exe";
+  // A flag of one kind of bench given to another would be ignored: refused.
+  const auto only_with = [&command](const char* flag, bool allowed, const char* kinds) {
+    if (command.count(flag) > 0 && !allowed)
+      throw Error(std::string("bench: ") + flag + " is for bench " + kinds);
+  };
+  only_with("--plot", args.scaling || args.scaling_robots, "--scaling and --scaling-robots");
+  only_with("--jobs", args.scaling, "--scaling");
+  only_with("--sweep-runs", args.scaling, "--scaling");
+  only_with("--configs", args.scaling_robots, "--scaling-robots");
   if (args.scaling_robots) return ScalingRobots(args, command);
   if (args.scaling) {
     ScalingOptions& scaling = args.scaling_options;

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "framework/error.h"
+#include "framework/output_file.h"
 #include "framework/suggest.h"
 #include "swarm/sweep/results_db.h"
 #include "swarm/sweep/stats.h"
@@ -312,7 +313,7 @@ int RunReport(const ReportOptions& o, std::ostream& out, std::ostream& err) {
 
   if (o.csv) {
     std::ofstream f(*o.csv);
-    if (!f) throw Error("cannot write '" + *o.csv + "'");
+    if (!f) throw Error(CannotWrite(*o.csv));
     WriteCsv(d, f);
     err << "csv: " << *o.csv << " (one row per run)\n";
   }

@@ -77,6 +77,18 @@ TEST(MemoryForecastTest, TheVerdictSaysWhatTheRestNeedsAndHowManyFit) {
   room.available = UINT64_MAX;
   EXPECT_EQ(MemoryForecast::Verdict("robot copies", 1'000'000, 20'000, 10'240, 160 * kMiB, room),
             "");
+  // Past the room already (a cap below what the built ones hold): said so,
+  // and fewer than those built would fit, not "about" them.
+  room.available = 0;
+  room.resident = 900 * kMiB;
+  room.bound = "--max-memory 500 MiB";
+  const std::string past =
+      MemoryForecast::Verdict("robots' Lua states", 30'000, 20'000, 10'240, 160 * kMiB, room);
+  EXPECT_NE(past.find("the process holds 900 MiB already, with no room left (--max-memory 500 "
+                      "MiB). Fewer than 20,000 would fit"),
+            std::string::npos)
+      << past;
+  EXPECT_EQ(past.find("About"), std::string::npos) << past;
 }
 
 // Arrays reserved for every item, about to be populated at once, are
@@ -94,6 +106,13 @@ TEST(MemoryForecastTest, ReservedArraysPastTheRoomAreRefusedBeforeAnythingIsBuil
   EXPECT_NE(no.find("(--max-memory "), std::string::npos) << no;
   EXPECT_NE(no.find("Fewer than "), std::string::npos) << no;
   EXPECT_EQ(forecast.Reserved(16 * kMiB), "");
+  // A cap below what the program holds before any copy: no "fewer than 0".
+  const std::string none = MemoryForecast("robot copies", 100'000, 4096).Reserved(kGiB);
+  EXPECT_NE(none.find("already, with no room left (--max-memory 4.0 KiB). Give the run more "
+                      "memory"),
+            std::string::npos)
+      << none;
+  EXPECT_EQ(none.find("Fewer than"), std::string::npos) << none;
   EXPECT_EQ(MemoryForecast("robot copies", 1'000, cap).Reserved(kGiB), "") << "a small world";
   setenv("SWARMSIM_MEMORY_CHECK", "0", 1);
   const MemoryForecast off("robot copies", 100'000, cap);

@@ -6,6 +6,8 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "tests/swarm/run_program.h"
 
@@ -79,6 +81,22 @@ TEST(CliTest, BenchThreadsAreCheckedLikeRun) {
       RunProgram("bench --world " + Data("ok.yaml") + " --robots 2 --steps 1 --threads 1,-1");
   EXPECT_EQ(negative.exit_code, 2) << negative.output;
   EXPECT_NE(negative.output.find("got '-1'"), std::string::npos) << negative.output;
+}
+
+// A flag of one kind of bench given to another is refused, not ignored.
+TEST(CliTest, BenchRefusesTheFlagsOfAnotherKindOfBench) {
+  const std::string base = "bench --world " + Data("ok.yaml") + " --robots 2 --steps 1";
+  for (const auto& [flags, expected] : std::vector<std::pair<std::string, std::string>>{
+           {" --plot p.png", "error: bench: --plot is for bench --scaling and --scaling-robots"},
+           {" --jobs 2", "error: bench: --jobs is for bench --scaling"},
+           {" --sweep-runs 3", "error: bench: --sweep-runs is for bench --scaling"},
+           {" --configs lua", "error: bench: --configs is for bench --scaling-robots"},
+           {" --scaling-robots --jobs 2", "error: bench: --jobs is for bench --scaling"}}) {
+    const Result r = RunProgram(base + flags);
+    EXPECT_EQ(r.exit_code, 2) << flags << ": " << r.output;
+    EXPECT_NE(r.output.find(expected), std::string::npos) << flags << ": " << r.output;
+    EXPECT_EQ(r.output.find("ticks/s"), std::string::npos) << flags << ": nothing measured";
+  }
 }
 
 }  // namespace
