@@ -48,6 +48,9 @@ struct RunResult {
   std::string error;  // the message when !ok
   int64_t steps = 0;  // steps completed
   double wall_seconds = 0;
+  // Of wall_seconds, starting the world (modules, robots' scripts and their
+  // sysCall_init, native controllers) before its first step.
+  double start_seconds = 0;
   uint64_t state_hash = 0;
   double peak_rss_mb = 0;
   int signal = 0;           // SIGINT/SIGTERM/SIGHUP that interrupted the run, else 0

@@ -409,4 +409,33 @@ TEST(RunOutputsTest, SummaryListsTheOverridesAndWholeNumbersAsIntegers) {
   fs::remove_all(dir);
 }
 
+// The wall time of a run includes starting its world (the robots'
+// sysCall_init), which the phases do not: summary.json's start_time and the
+// table say how much of it that was.
+TEST(RunOutputsTest, TheSummarySaysHowMuchOfTheWallTimeStartedTheWorld) {
+  const fs::path dir = TempDir("start_time");
+  fs::create_directories(dir);
+  std::ofstream(dir / "world.yaml") << "simulation: {physics: kinematic, time_step: 0.1}\n"
+                                       "models:\n  - {model: slow.yaml, position: [0, 0]}\n";
+  std::ofstream(dir / "slow.yaml") << "model: slow\n"
+                                      "objects: {name: body, type: dummy, script: slow.lua}\n";
+  // Three million additions at start, nothing in the step.
+  std::ofstream(dir / "slow.lua") << "function sysCall_init()\n"
+                                     "  local x = 0\n"
+                                     "  for i = 1, 3000000 do x = x + i end\n"
+                                     "end\n";
+  const auto r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 2 --out " +
+                            (dir / "out").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find(" s starting the world"), std::string::npos) << r.output;
+  const auto summary = nlohmann::json::parse(ReadFile(dir / "out" / "summary.json"));
+  const double start = summary["start_time"], wall = summary["wall_time"];
+  double phases = 0;
+  for (const auto& [phase, seconds] : summary["phase_seconds"].items())
+    phases += seconds.get<double>();
+  EXPECT_GT(start, 5 * phases) << summary.dump(2);
+  EXPECT_LE(start, wall) << summary.dump(2);
+  fs::remove_all(dir);
+}
+
 }  // namespace
