@@ -14,11 +14,13 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
+#include <variant>
 
 #include "framework/error.h"
 #include "framework/memory_forecast.h"
 #include "framework/registry.h"
 #include "modules/builtin.h"
+#include "swarm/loader/values.h"
 #include "swarm/loader/world_loader.h"
 #include "swarm/run/stop_signals.h"
 #include "swarm/run/version.h"
@@ -28,8 +30,10 @@ namespace swarmsim {
 namespace {
 
 // Loads the world once with the first run's parameters, so that a misspelt
-// --param or a bad value is one clear error instead of every run failing.
-void CheckWorld(const SweepOptions& o, const GridRun& first) {
+// --param or a bad value is one clear error instead of every run failing;
+// every other value of a world parameter is checked against its type there
+// (a number, true/false; text takes anything) as `run --set` would.
+void CheckWorld(const SweepOptions& o, const GridRun& first, const std::vector<ParamSpec>& params) {
   ModuleRegistry registry;
   RegisterBuiltinModules(&registry);
   LoadOptions load;
@@ -39,6 +43,16 @@ void CheckWorld(const SweepOptions& o, const GridRun& first) {
   LoadedWorld loaded = LoadWorld(o.world, load, registry);
   if (!o.steps && !o.duration && !loaded.steps)
     throw Error(o.world + " gives no run length; pass --steps N or --duration SECONDS");
+  for (const ParamSpec& p : params) {
+    const auto declared = loaded.world->parameters().find(p.name);
+    if (declared == loaded.world->parameters().end() ||
+        std::holds_alternative<std::string>(declared->second))
+      continue;  // a model's parameter (checked by the first run), or text
+    for (const std::string& value : p.values)
+      if (loader::ParseScalar(value, false).index() != declared->second.index())
+        throw Error("--param " + p.name + "=" + p.spec + ": parameter '" + p.name + "' is " +
+                    loader::TypeName(declared->second) + ", got \"" + value + "\"");
+  }
 }
 
 }  // namespace
@@ -110,7 +124,7 @@ int CoordinateSweep(const SweepOptions& o, RemoteWorkers* remote, std::ostream& 
   if (o.db.empty()) throw Error("sweep needs --db FILE for the results");
 
   // A new sweep: check the world and parameters before creating the database.
-  if (!std::filesystem::exists(o.db)) CheckWorld(o, grid.front());
+  if (!std::filesystem::exists(o.db)) CheckWorld(o, grid.front(), params);
   ResultsDb db(o.db);
   if (std::optional<SweepRecord> existing = db.ReadSweep()) {
     if (existing->space_json != space)
