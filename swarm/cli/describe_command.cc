@@ -50,7 +50,8 @@ void PrintDescription(const LoadedWorld& w, std::ostream& out) {
     if (m.parameters.empty()) out << "  parameters: none\n";
     for (const ParameterSummary& p : m.parameters) {
       out << "  " << m.name << "." << p.name << " = " << p.value;
-      if (!p.unit.empty()) out << " " << p.unit;
+      // Unit "1" (SI's for a ratio or a factor) reads as a stray digit after the value.
+      if (!p.unit.empty() && p.unit != "1") out << " " << p.unit;
       out << "  (default " << p.default_value;
       if (!p.range.empty()) out << ", range " << p.range;
       out << ")";

@@ -44,6 +44,12 @@ TEST(CliTest, DescribeShowsTheWorldAsSetWithoutRunningIt) {
   for (const std::string& line : lines)
     EXPECT_NE(r.output.find(line), std::string::npos) << line << "\n" << r.output;
   EXPECT_EQ(r.output.find("robot-ticks/s"), std::string::npos) << "nothing ran";
+  // A ratio's unit "1" is not printed after the value (it read as a digit).
+  r = RunProgram("describe " + std::string(SWARMSIM_SOURCE_DIR) + "/worlds/diffusion.yaml");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("  footbot.wheel_noise = 0  (default 0)"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("  footbot.prox_noise = 0 m  (default 0)"), std::string::npos)
+      << r.output;
   // Mistakes are the loader's, named at their place, with exit code 2.
   r = RunProgram("describe " + swarmsim::testing::CliData("typo.yaml"));
   EXPECT_EQ(r.exit_code, 2) << r.output;
