@@ -1,6 +1,7 @@
 #include "swarm/bench/robot_scaling.h"
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -105,6 +106,12 @@ bool Plot(const std::vector<ScalingRow>& rows, const RobotScalingOptions& o, std
          << "set logscale xy\nset grid\nset key below horizontal maxcols 5 noenhanced\n"
          << "set format x '10^{%L}'\nset xlabel 'robots'\n"
          << "set multiplot layout 1,2 title 'swarmsim: cost per robot-tick over robot counts'\n";
+  // One robot count: a range about it (gnuplot would warn of an empty one).
+  int lowest = INT_MAX, highest = 0;
+  for (const ScalingRow& r : rows)
+    lowest = std::min(lowest, r.bench.robots), highest = std::max(highest, r.bench.robots);
+  if (!rows.empty() && lowest == highest)
+    script << "set xrange [" << lowest / 2.0 << ":" << highest * 2.0 << "]\n";
   int block = 0;
   for (const std::string& key : order) {
     script << "$d" << block++ << " << EOD\n";
@@ -128,7 +135,15 @@ bool Plot(const std::vector<ScalingRow>& rows, const RobotScalingOptions& o, std
       script << ", " << d << " using 1:" << 3 + p << " with linespoints dt " << 2 + p << " lw 1 pt "
              << 1 + p << colour << " title " << Quoted(order[i] + " " + phases[p]);
   }
-  script << "\nset ylabel 'start-up seconds (load to first step)'\nplot ";
+  // Start-up of one count and configuration: a range about it (as above).
+  double first_startup = rows.empty() ? 0 : std::max(rows.front().bench.startup_s, 1e-3);
+  bool one_startup = true;
+  for (const ScalingRow& r : rows)
+    one_startup = one_startup && std::max(r.bench.startup_s, 1e-3) == first_startup;
+  script << "\n";
+  if (!rows.empty() && one_startup)
+    script << "set yrange [" << first_startup / 10 << ":" << first_startup * 10 << "]\n";
+  script << "set ylabel 'start-up seconds (load to first step)'\nplot ";
   for (int i = 0; i < block; ++i)
     script << (i ? ", " : "") << "$d" << i << " using 1:7 with linespoints lw 2 pt 7 lc " << i + 1
            << " title " << Quoted(order[i]);

@@ -114,6 +114,22 @@ TEST(RobotScalingTest, ATableACsvAndAPlotOfEveryConfigurationAndCount) {
   fs::remove_all(dir);
 }
 
+// One count of one configuration: the plot's axes get a range about it, with
+// no warning from gnuplot about an empty one.
+TEST(RobotScalingTest, OneCountIsPlottedWithoutAWarning) {
+  if (testing::RunCommand("command -v gnuplot").exit_code != 0) GTEST_SKIP() << "no gnuplot";
+  const fs::path dir = testing::FreshTempDir("robot_scaling_test", "one");
+  fs::create_directories(dir);
+  const fs::path plot = dir / "one.png";
+  const testing::CommandResult r = testing::RunProgram(
+      "bench --scaling-robots --robots 100 --threads 1 --steps 2 --configs planar-cpp --csv " +
+      (dir / "one.csv").string() + " --plot " + plot.string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.output.find("Warning"), std::string::npos) << r.output;
+  EXPECT_EQ(paint::ReadPng(plot).width, 1200);
+  fs::remove_all(dir);
+}
+
 TEST(RobotScalingTest, ConfigurationsAreCheckedBeforeAnyOutput) {
   const testing::CommandResult unknown =
       testing::RunProgram("bench --scaling-robots --robots 2 --configs lua,pyhton");
