@@ -21,26 +21,45 @@ double Obstacle2::BoundingRadius() const {
   return kind == Kind::kCircle ? radius : std::hypot(half_x, half_y);
 }
 
-Placer::CellKey Placer::CellOf(double x, double y) const {
-  return {static_cast<int64_t>(std::floor(x / cell_size_)),
-          static_cast<int64_t>(std::floor(y / cell_size_))};
-}
-
 void Placer::Insert(uint32_t body) {
   const Body& b = bodies_[body];
-  cells_[CellOf(b.x, b.y)].push_back(body);
+  const int64_t i = CellIndex(b.x, grid_x0_), j = CellIndex(b.y, grid_y0_);
+  if (i < 0 || i >= grid_nx_ || j < 0 || j >= grid_ny_) {
+    outside_.push_back(body);
+    return;
+  }
+  int32_t& head = head_[static_cast<size_t>(j * grid_nx_ + i)];
+  next_[body] = head;
+  head = static_cast<int32_t>(body);
 }
 
-void Placer::Rebuild(double cell_size) {
-  cell_size_ = cell_size;
-  cells_.clear();
+void Placer::Rebuild(double cell_size, double lo_x, double lo_y, double hi_x, double hi_y,
+                     size_t bodies) {
+  // At most four cells per body to come (and 65,536 at least): a larger
+  // cell than asked where the region is sparse. Any cell of at least
+  // `cell_size` finds the same bodies.
+  const double limit = std::max(65536.0, 4.0 * static_cast<double>(bodies));
+  const double w = std::max(hi_x - lo_x, 0.0), h = std::max(hi_y - lo_y, 0.0);
+  cell_size_ = std::max(cell_size, std::sqrt(w * h / limit));
+  while ((std::floor(w / cell_size_) + 1) * (std::floor(h / cell_size_) + 1) > limit)
+    cell_size_ *= 1.5;  // a long thin region
+  grid_x0_ = lo_x;
+  grid_y0_ = lo_y;
+  grid_nx_ = static_cast<int64_t>(std::floor(w / cell_size_)) + 1;
+  grid_ny_ = static_cast<int64_t>(std::floor(h / cell_size_)) + 1;
+  head_.assign(static_cast<size_t>(grid_nx_ * grid_ny_), -1);
+  next_.assign(bodies_.size(), -1);
+  outside_.clear();
   for (uint32_t i = 0; i < bodies_.size(); ++i) Insert(i);
 }
 
 void Placer::AddBody(double x, double y, double radius) {
   bodies_.push_back({x, y, radius});
   max_body_radius_ = std::max(max_body_radius_, radius);
-  if (cell_size_ > 0) Insert(static_cast<uint32_t>(bodies_.size() - 1));
+  if (cell_size_ > 0) {
+    next_.push_back(-1);
+    Insert(static_cast<uint32_t>(bodies_.size() - 1));
+  }
 }
 
 bool Placer::NearMapCell(double x, double y, double keep) const {
@@ -81,16 +100,19 @@ bool Placer::IsFree(double x, double y, double radius, double clearance) const {
       if (!clear_of(b)) return false;
     return true;
   }
-  // Bodies: the cells within reach of any body that could touch this disc.
+  // Bodies: the cells within reach of any body that could touch this disc
+  // (cells past the grid hold none), and those outside the grid.
   const double reach = radius + max_body_radius_ + clearance;
-  const CellKey lo = CellOf(x - reach, y - reach), hi = CellOf(x + reach, y + reach);
-  for (int64_t cx = lo.x; cx <= hi.x; ++cx)
-    for (int64_t cy = lo.y; cy <= hi.y; ++cy) {
-      auto it = cells_.find({cx, cy});
-      if (it == cells_.end()) continue;
-      for (uint32_t i : it->second)
-        if (!clear_of(bodies_[i])) return false;
-    }
+  const int64_t i0 = std::max<int64_t>(CellIndex(x - reach, grid_x0_), 0);
+  const int64_t i1 = std::min<int64_t>(CellIndex(x + reach, grid_x0_), grid_nx_ - 1);
+  const int64_t j0 = std::max<int64_t>(CellIndex(y - reach, grid_y0_), 0);
+  const int64_t j1 = std::min<int64_t>(CellIndex(y + reach, grid_y0_), grid_ny_ - 1);
+  for (int64_t j = j0; j <= j1; ++j)
+    for (int64_t i = i0; i <= i1; ++i)
+      for (int32_t b = head_[static_cast<size_t>(j * grid_nx_ + i)]; b >= 0; b = next_[b])
+        if (!clear_of(bodies_[static_cast<size_t>(b)])) return false;
+  for (uint32_t b : outside_)
+    if (!clear_of(bodies_[b])) return false;
   return true;
 }
 
@@ -115,7 +137,17 @@ std::vector<Placement2> Placer::Distribute(const Region2& region, int64_t count,
   max_body_radius_ = std::max(max_body_radius_, max_radius);
   const double extent = std::max(hi_x - lo_x, hi_y - lo_y);
   const double cell = std::max({2 * max_body_radius_ + clearance, 1e-3, extent * 1e-9});
-  if (cell != cell_size_) Rebuild(cell);
+  // The grid covers where this region's discs may go (and a disc's reach
+  // about it); rebuilt for another cell size or region.
+  const double margin = 2 * max_body_radius_ + clearance;
+  const double g_lo_x = region.min_x - margin, g_lo_y = region.min_y - margin;
+  const double g_hi_x = region.max_x + margin, g_hi_y = region.max_y + margin;
+  const size_t bodies = bodies_.size() + static_cast<size_t>(count);
+  if (cell_size_ <= 0 || cell > cell_size_ || g_lo_x < grid_x0_ || g_lo_y < grid_y0_ ||
+      g_hi_x > grid_x0_ + static_cast<double>(grid_nx_) * cell_size_ ||
+      g_hi_y > grid_y0_ + static_cast<double>(grid_ny_) * cell_size_ ||
+      (cell_size_ > cell && 4 * bodies > head_.size()))  // coarser than needed for these many
+    Rebuild(cell, g_lo_x, g_lo_y, g_hi_x, g_hi_y, bodies);
   out.reserve(static_cast<size_t>(count));
   Rng rng(seed_, kPlacementStream + stream);
   for (int64_t k = 0; k < count; ++k) {

@@ -8,10 +8,10 @@
 // deterministic: the same seed, stream and calls give the same poses.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <optional>
-#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -109,32 +109,32 @@ class Placer {
   struct Body {
     double x, y, radius;
   };
-  struct CellKey {
-    int64_t x, y;
-    bool operator==(const CellKey&) const = default;
-  };
-  struct CellHash {
-    size_t operator()(const CellKey& k) const {
-      return static_cast<size_t>(static_cast<uint64_t>(k.x) * 0x9e3779b97f4a7c15ull ^
-                                 static_cast<uint64_t>(k.y));
-    }
-  };
-
-  CellKey CellOf(double x, double y) const;
   // Does a map cell come closer than `keep` to (x, y)?
   bool NearMapCell(double x, double y, double keep) const;
   void Insert(uint32_t body);
-  void Rebuild(double cell_size);
+  // A grid of cells of at least `cell_size` over [lo_x, hi_x] x [lo_y, hi_y]
+  // sized for `bodies` bodies, every body filed in it.
+  void Rebuild(double cell_size, double lo_x, double lo_y, double hi_x, double hi_y, size_t bodies);
+  // The grid cell index along an axis, unclamped (may lie outside 0..n-1).
+  int64_t CellIndex(double v, double origin) const {
+    return static_cast<int64_t>(std::floor((v - origin) / cell_size_));
+  }
 
   uint64_t seed_;
   std::vector<Body> bodies_;
   std::vector<Obstacle2> obstacles_;
   EnvironmentPlaneGrid map_;  // map cells (empty: none)
   double max_body_radius_ = 0;
-  // Bodies by cell: the cell edge is at least the largest body diameter, so
-  // a query looks at a small block of cells.
+  // Bodies by cell of a dense grid over the region being filled (a list per
+  // cell: head_ by cell, next_ by body, -1 ends): the cell edge is at least
+  // the largest body diameter, so a query looks at a small block of cells.
+  // Bodies outside the grid (fixed copies elsewhere) are checked one by one.
   double cell_size_ = 0;
-  std::unordered_map<CellKey, std::vector<uint32_t>, CellHash> cells_;
+  double grid_x0_ = 0, grid_y0_ = 0;  // the grid's lower-left corner
+  int64_t grid_nx_ = 0, grid_ny_ = 0;
+  std::vector<int32_t> head_;
+  std::vector<int32_t> next_;
+  std::vector<uint32_t> outside_;
 };
 
 }  // namespace swarmsim
