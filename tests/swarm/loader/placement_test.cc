@@ -5,8 +5,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "framework/error.h"
 #include "framework/registry.h"
@@ -84,6 +87,46 @@ TEST(PlacementTest, KeepsClearOfObstaclesAndEarlierBodies) {
   std::vector<Placement2> all = p;
   all.insert(all.end(), more.begin(), more.end());
   EXPECT_GE(MinGap(all, r), clearance);
+}
+
+// Bodies are filed in a grid over the region being filled: those placed in
+// another region before (a grid of its own, rebuilt), fixed ones outside
+// the grid, bigger discs than the grid's cells were for, and regions far
+// larger than their copies all keep the same rule: no two discs closer
+// than their radii and the clearance.
+TEST(PlacementTest, EveryBodyIsKeptClearOfWhateverRegionsItWasPlacedIn) {
+  Placer placer(5);
+  const double clearance = 0.02;
+  std::vector<std::pair<Placement2, double>> all;  // every disc, with its radius
+  const auto add = [&all](const std::vector<Placement2>& p, double r) {
+    for (const Placement2& q : p) all.push_back({q, r});
+  };
+  // Fixed bodies inside and outside the regions to come.
+  for (const auto& [x, y, r] : std::vector<std::array<double, 3>>{
+           {0.5, 0.5, 0.3}, {3.2, 0.4, 0.2}, {-0.4, 2.5, 0.25}, {10, 10, 1}}) {
+    placer.AddBody(x, y, r);
+    all.push_back({{x, y, 0}, r});
+  }
+  add(placer.Distribute({0, 0, 3, 3}, 300, 0.05, clearance, 0), 0.05);
+  // A query anywhere sees every body: the far fixed one outside this grid,
+  // and a disc placed in it.
+  EXPECT_FALSE(placer.IsFree(10.5, 10, 0.1, 0));
+  EXPECT_TRUE(placer.IsFree(12, 12, 0.1, 0));
+  EXPECT_FALSE(placer.IsFree(all.back().first.x + 0.05, all.back().first.y, 0.05, 0));
+  // An overlapping region: a new grid, the first batch filed in it.
+  add(placer.Distribute({1.5, 1.5, 4, 4}, 150, 0.05, clearance, 1), 0.05);
+  // Bigger discs than the grid was built for, and a region reaching the far body.
+  add(placer.Distribute({0, 0, 11, 11}, 40, 0.3, clearance, 2), 0.3);
+  // A sparse region: few copies in a wide one (coarser cells).
+  add(placer.Distribute({-500, -500, 500, 500}, 20, 0.1, clearance, 3), 0.1);
+  ASSERT_EQ(all.size(), 4u + 300 + 150 + 40 + 20);
+  for (size_t i = 0; i < all.size(); ++i)
+    for (size_t j = i + 1; j < all.size(); ++j) {
+      const auto& [a, ra] = all[i];
+      const auto& [b, rb] = all[j];
+      if (i < 4 && j < 4) continue;  // the fixed ones among themselves need not keep clear
+      ASSERT_GE(std::hypot(a.x - b.x, a.y - b.y), ra + rb + clearance - 1e-12) << i << " " << j;
+    }
 }
 
 TEST(PlacementTest, BoxDistanceIsExact) {
