@@ -357,6 +357,7 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
   if (!steps) return bad_input(length_error);
   options.steps = *steps;
   options.print_hash = args.hash;
+  options.state_hash = false;  // only where it is seen: --hash, summary.json (--out)
   options.quiet = args.quiet;
   // Snapshots and video: the recorder module, checked before the run starts.
   std::string recorder_error;

@@ -617,7 +617,8 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
                    std::to_string(result.steps) + " steps, while the run wrote its outputs";
   }
   result.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
-  result.state_hash = world->StateHash();
+  if (options.state_hash || options.print_hash || options.out_dir)
+    result.state_hash = world->StateHash();
   result.peak_rss_mb = PeakRssMb();
 
   // The summary.
