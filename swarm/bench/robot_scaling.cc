@@ -217,38 +217,73 @@ int RunRobotScalingBench(RobotScalingOptions o, std::ostream& out, std::ostream&
   for (const ScalingConfig& c : o.configs) out << "  " << c.name << ": " << c.world << "\n";
   out << "\n";
   PrintHeader(out);
-  std::vector<ScalingRow> rows;
+  // The rows in table order: (configuration, threads, robots).
+  struct Cell {
+    const ScalingConfig* config;
+    int threads, robots;
+    std::vector<ScalingRow> runs;  // one per round that measured it
+  };
+  std::vector<Cell> cells;
+  for (const ScalingConfig& c : o.configs)
+    for (int threads : o.threads)
+      for (int robots : o.robots) cells.push_back({&c, threads, robots, {}});
+  const int rounds = std::max(o.repeat, 1);
   bool ok = true;
-  for (const ScalingConfig& c : o.configs) {
-    for (int threads : o.threads) {
-      double first_total = 0;
-      for (int robots : o.robots) {
-        BenchOptions bench;
-        bench.world = c.world;
-        bench.self_exe = o.self_exe;
-        bench.steps = o.steps > 0 ? o.steps : AutoScalingSteps(robots);
-        bench.warmup_steps = o.warmup_steps >= 0 ? o.warmup_steps : AutoWarmupSteps(bench.steps);
-        ScalingRow row;
-        row.config = c.name;
-        if (!MeasureInChild(bench, "diffusion", robots, threads, &row.bench)) {
-          err << "bench: " << c.name << " with " << robots << " robots on " << threads
-              << " threads failed\n";
-          ok = false;
-          continue;
-        }
-        const BenchRow& b = row.bench;
-        const double ticks = static_cast<double>(b.robots) * static_cast<double>(b.steps);
-        row.us_total = ticks > 0 ? 1e6 * b.wall_s / ticks : 0;
-        row.us_other =
-            std::max(0.0, row.us_total - b.us_per_tick[0] - b.us_per_tick[1] - b.us_per_tick[3]);
-        if (first_total == 0) first_total = row.us_total;
-        row.ratio = first_total > 0 ? row.us_total / first_total : 0;
-        PrintRow(row, out);
-        csv << CsvRow(row, c.world) << "\n" << std::flush;
-        rows.push_back(row);
+  std::vector<ScalingRow> rows;
+  // The row of a cell: its round of median total, its ratio to the
+  // configuration's first count (same threads) as reported.
+  double first_total = 0;
+  const ScalingConfig* first_of = nullptr;
+  int first_threads = 0;
+  const auto report = [&](Cell& cell) {
+    if (cell.runs.empty()) return;
+    std::sort(cell.runs.begin(), cell.runs.end(),
+              [](const ScalingRow& a, const ScalingRow& b) { return a.us_total < b.us_total; });
+    ScalingRow row = cell.runs[(cell.runs.size() - 1) / 2];
+    if (first_of != cell.config || first_threads != cell.threads) {
+      first_of = cell.config;
+      first_threads = cell.threads;
+      first_total = row.us_total;
+    }
+    row.ratio = first_total > 0 ? row.us_total / first_total : 0;
+    PrintRow(row, out);
+    csv << CsvRow(row, cell.config->world) << "\n" << std::flush;
+    rows.push_back(row);
+  };
+  for (int round = 1; round <= rounds; ++round) {
+    for (Cell& cell : cells) {
+      const ScalingConfig& c = *cell.config;
+      BenchOptions bench;
+      bench.world = c.world;
+      bench.self_exe = o.self_exe;
+      bench.steps = o.steps > 0 ? o.steps : AutoScalingSteps(cell.robots);
+      bench.warmup_steps = o.warmup_steps >= 0 ? o.warmup_steps : AutoWarmupSteps(bench.steps);
+      ScalingRow row;
+      row.config = c.name;
+      if (!MeasureInChild(bench, "diffusion", cell.robots, cell.threads, &row.bench)) {
+        err << "bench: " << c.name << " with " << cell.robots << " robots on " << cell.threads
+            << (cell.threads == 1 ? " thread" : " threads") << " failed\n";
+        ok = false;
+        continue;
+      }
+      const BenchRow& b = row.bench;
+      const double ticks = static_cast<double>(b.robots) * static_cast<double>(b.steps);
+      row.us_total = ticks > 0 ? 1e6 * b.wall_s / ticks : 0;
+      row.us_other =
+          std::max(0.0, row.us_total - b.us_per_tick[0] - b.us_per_tick[1] - b.us_per_tick[3]);
+      cell.runs.push_back(row);
+      if (rounds == 1) {
+        report(cell);  // as it comes
+      } else {
+        err << "bench: round " << round << " of " << rounds << ": " << c.name << ", " << cell.robots
+            << " robots, " << cell.threads << " thr: " << std::fixed << std::setprecision(2)
+            << row.us_total << " us per robot-tick\n"
+            << std::defaultfloat << std::flush;
       }
     }
   }
+  if (rounds > 1)
+    for (Cell& cell : cells) report(cell);
   out << "csv: " << o.csv << "\n";
   if (!rows.empty()) ok = Plot(rows, o, out, err) && ok;
   return ok ? 0 : 1;

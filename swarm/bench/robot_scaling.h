@@ -25,6 +25,10 @@ struct RobotScalingOptions {
   std::vector<int> threads;   // empty: every core
   int64_t steps = 0;          // measured steps per row; 0: AutoScalingSteps(robots)
   int64_t warmup_steps = -1;  // -1: AutoWarmupSteps(steps)
+  // Rounds: every row measured once per round, rounds one after the other
+  // (a machine whose speed drifts then weighs on every row alike); each row
+  // reports its round of median total.
+  int repeat = 1;
   std::string csv = "scaling_robots.csv";
   std::string plot = "scaling_robots.png";
   std::string self_exe;  // this program, re-run once per row

@@ -57,6 +57,11 @@ CLI::App* AddBenchCommand(CLI::App* app, BenchArgs* args) {
       ->add_option("--configs", args->configs,
                    "With --scaling-robots: which of lua, cpp, planar-cpp (default all)")
       ->delimiter(',');
+  bench
+      ->add_option("--repeat", args->repeat,
+                   "With --scaling-robots: rounds of every row, one after the other; each row "
+                   "reports its median round (default 1)")
+      ->transform(WholeNumberCheck(1, 100, "repeat"));
   robots_flag->excludes("--scaling");
   return bench;
 }
@@ -71,6 +76,7 @@ int ScalingRobots(const BenchArgs& args, const CLI::App& command) {
   if (command.count("--steps") > 0) o.steps = args.options.steps;
   if (args.options.csv) o.csv = *args.options.csv;
   if (command.count("--plot") > 0) o.plot = args.scaling_options.plot;
+  o.repeat = args.repeat;
   if (!args.configs.empty() && !args.options.world.empty())
     throw Error("bench: --configs and --world: give one or the other");
   if (!args.configs.empty()) o.configs = SelectScalingConfigs(args.configs);
@@ -92,6 +98,7 @@ int BenchCommand(BenchArgs args, const CLI::App& command) {
   only_with("--jobs", args.scaling, "--scaling");
   only_with("--sweep-runs", args.scaling, "--scaling");
   only_with("--configs", args.scaling_robots, "--scaling-robots");
+  only_with("--repeat", args.scaling_robots, "--scaling-robots");
   if (args.scaling_robots) return ScalingRobots(args, command);
   if (args.scaling) {
     ScalingOptions& scaling = args.scaling_options;

@@ -86,6 +86,7 @@ struct BenchArgs {
   ScalingOptions scaling_options;
   bool scaling_robots = false;       // --scaling-robots
   std::vector<std::string> configs;  // --configs lua,cpp,planar-cpp
+  int repeat = 1;                    // --repeat N (with --scaling-robots)
 };
 CLI::App* AddBenchCommand(CLI::App* app, BenchArgs* args);
 // `command`: what AddBenchCommand returned (was --threads given?).

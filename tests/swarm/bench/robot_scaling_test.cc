@@ -130,6 +130,45 @@ TEST(RobotScalingTest, OneCountIsPlottedWithoutAWarning) {
   fs::remove_all(dir);
 }
 
+// --repeat N: every row measured once a round, rounds one after the other
+// (all rows of round 1, then of round 2, ...), and each row reports its
+// median round, the ratios taken between those.
+TEST(RobotScalingTest, RoundsAreInterleavedAndEachRowIsItsMedianRound) {
+  const fs::path dir = testing::FreshTempDir("robot_scaling_test", "repeat");
+  fs::create_directories(dir);
+  // Through the program: the C++ configuration loads its plugin from beside it.
+  const fs::path csv = dir / "r.csv";
+  const testing::CommandResult r = testing::RunProgram(
+      "bench --scaling-robots --configs planar-cpp --robots 60,120 --threads 1 --steps 2 "
+      "--repeat 3 --csv " +
+      csv.string() + " --plot " + (dir / "r.png").string());
+  // The rounds' lines, in order: 60, 120, 60, 120, 60, 120 robots.
+  std::vector<std::pair<int, double>> runs;  // robots, us per robot-tick
+  std::istringstream lines(r.output);
+  for (std::string line; std::getline(lines, line);) {
+    const size_t at = line.find("planar-cpp, ");
+    if (line.find("bench: round ") != 0 || at == std::string::npos) continue;
+    const int robots = std::stoi(line.substr(at + 12));
+    runs.push_back({robots, std::stod(line.substr(line.rfind(": ") + 2))});
+  }
+  ASSERT_EQ(runs.size(), 6u) << r.output;
+  for (size_t i = 0; i < runs.size(); ++i) EXPECT_EQ(runs[i].first, i % 2 == 0 ? 60 : 120) << i;
+  std::ifstream in(csv);
+  std::vector<std::vector<std::string>> rows;
+  for (std::string line; std::getline(in, line);) rows.push_back(Fields(line));
+  ASSERT_EQ(rows.size(), 3u) << "the header and one row per count";
+  double totals[2];
+  for (int k = 0; k < 2; ++k) {
+    std::vector<double> mine;
+    for (size_t i = static_cast<size_t>(k); i < runs.size(); i += 2) mine.push_back(runs[i].second);
+    std::sort(mine.begin(), mine.end());
+    totals[k] = std::stod(rows[static_cast<size_t>(k) + 1][10]);
+    EXPECT_NEAR(totals[k], mine[1], 0.0051) << "row " << k << ": the median of its rounds";
+  }
+  EXPECT_NEAR(std::stod(rows[2][11]), totals[1] / totals[0], 1e-5);
+  fs::remove_all(dir);
+}
+
 TEST(RobotScalingTest, ConfigurationsAreCheckedBeforeAnyOutput) {
   const testing::CommandResult unknown =
       testing::RunProgram("bench --scaling-robots --robots 2 --configs lua,pyhton");
