@@ -5,6 +5,8 @@
 #include <malloc.h>
 #endif
 
+#include <cctype>
+#include <cstdio>
 #include <cstdlib>
 #include <string>
 
@@ -28,6 +30,13 @@ std::string TunablesWithHugePages(const char* tunables) {
 
 bool HugePagesTurnedOff(const char* value) { return IsOffValue(value); }
 
+bool HugePagesValueUnclear(const char* value) {
+  if (value == nullptr || value[0] == '\0' || IsOffValue(value)) return false;
+  std::string v(value);
+  for (char& c : v) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return v != "1" && v != "on" && v != "true" && v != "yes";
+}
+
 void RestartWithHugePages(char** argv) {
 #if defined(__GLIBC__) && !defined(__SANITIZE_THREAD__)
   if (kAddressSanitizer) return;  // malloc is ASan's: the tunable does not apply
@@ -35,6 +44,12 @@ void RestartWithHugePages(char** argv) {
   const char* tunables = std::getenv("GLIBC_TUNABLES");
   const std::string value = TunablesWithHugePages(tunables);
   if (value.empty()) return;
+  // Said by the process that restarts (once): a value meant to turn them off.
+  if (const char* asked = std::getenv("SWARMSIM_HUGEPAGES"); HugePagesValueUnclear(asked))
+    std::fprintf(stderr,
+                 "warning: SWARMSIM_HUGEPAGES='%s' is neither 0, off, false, no nor 1, on, true, "
+                 "yes: huge pages stay on\n",
+                 asked);
   const std::string kept = tunables != nullptr ? tunables : "";
   const bool had = tunables != nullptr;
   if (setenv("GLIBC_TUNABLES", value.c_str(), 1) != 0) return;

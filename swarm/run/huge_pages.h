@@ -20,6 +20,10 @@ std::string TunablesWithHugePages(const char* tunables);
 // Does SWARMSIM_HUGEPAGES's value (null: unset) turn huge pages off? "0",
 // "off", "false" and "no" do (any case).
 bool HugePagesTurnedOff(const char* value);
+// Is `value` neither off (HugePagesTurnedOff) nor 1, on, true, yes (any
+// case) nor empty or unset? RestartWithHugePages warns of it (huge pages
+// stay on).
+bool HugePagesValueUnclear(const char* value);
 
 // Restarts the program (same executable, same arguments) with
 // glibc.malloc.hugetlb=1 in GLIBC_TUNABLES, unless the tunable is set

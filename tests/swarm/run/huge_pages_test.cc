@@ -61,6 +61,20 @@ TEST(HugePagesTest, TheUsersTunablesAreKeptAndTheirHugetlbWins) {
   for (const char* on : {"1", "on", "yes", ""})
     EXPECT_FALSE(swarmsim::HugePagesTurnedOff(on)) << on;
   EXPECT_FALSE(swarmsim::HugePagesTurnedOff(nullptr));
+  // A value that is neither is said, once (not again by the restarted process).
+  for (const char* clear : {"0", "off", "YES", "True", "1", "", static_cast<const char*>(nullptr)})
+    EXPECT_FALSE(swarmsim::HugePagesValueUnclear(clear)) << (clear ? clear : "(unset)");
+  EXPECT_TRUE(swarmsim::HugePagesValueUnclear("maybe"));
+#if !defined(__SANITIZE_ADDRESS__)
+  const auto r = swarmsim::testing::RunCommand(
+      std::string("SWARMSIM_HUGEPAGES=maybe ") + SWARMSIM_BINARY + " run " +
+      swarmsim::testing::CliData("ok.yaml") + " --steps 1 --quiet");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  const std::string warning = "warning: SWARMSIM_HUGEPAGES='maybe' is neither 0, off, false, no";
+  const size_t at = r.output.find(warning);
+  EXPECT_NE(at, std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find(warning, at + 1), std::string::npos) << "said once: " << r.output;
+#endif
 }
 
 }  // namespace
