@@ -622,7 +622,9 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
   result.peak_rss_mb = PeakRssMb();
 
   // The summary.
-  if (!options.quiet) PrintSummaryTable(*world, result, record.lua_kib, out);
+  // (Not for a run that failed before its first step: the error says it all.)
+  if (!options.quiet && (result.ok || result.steps > 0))
+    PrintSummaryTable(*world, result, record.lua_kib, out);
   if (options.print_hash) out << "state-hash: " << StateHasher::ToHex(result.state_hash) << "\n";
   out << std::flush;
 

@@ -409,6 +409,30 @@ TEST(RunOutputsTest, SummaryListsTheOverridesAndWholeNumbersAsIntegers) {
   fs::remove_all(dir);
 }
 
+// A run that fails before its first step prints its error, not a table of
+// zeros; one that fails later prints the table of what it ran.
+TEST(RunOutputsTest, ARunThatNeverSteppedPrintsNoSummaryTable) {
+  const fs::path dir = TempDir("never_stepped");
+  fs::create_directories(dir);
+  std::ofstream(dir / "world.yaml") << "simulation: {physics: kinematic, time_step: 0.1}\n"
+                                       "models:\n  - {model: bot.yaml, position: [0, 0]}\n";
+  std::ofstream(dir / "bot.yaml") << "model: bot\n"
+                                     "objects: {name: body, type: dummy, script: bot.lua}\n";
+  std::ofstream(dir / "bot.lua") << "function sysCall_init() error('no start') end\n";
+  auto r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 3");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("no start"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("robot-ticks/s"), std::string::npos) << r.output;
+  std::ofstream(dir / "bot.lua") << "local n = 0\n"
+                                    "function sysCall_actuation() n = n + 1\n"
+                                    "  if n == 2 then error('second step') end end\n";
+  r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 3");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("second step"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("robot-ticks/s"), std::string::npos) << r.output;
+  fs::remove_all(dir);
+}
+
 // The wall time of a run includes starting its world (the robots'
 // sysCall_init), which the phases do not: summary.json's start_time and the
 // table say how much of it that was.
