@@ -409,16 +409,23 @@ TEST(RunOutputsTest, SummaryListsTheOverridesAndWholeNumbersAsIntegers) {
   fs::remove_all(dir);
 }
 
-// A run that fails before its first step prints its error, not a table of
-// zeros; one that fails later prints the table of what it ran.
-TEST(RunOutputsTest, ARunThatNeverSteppedPrintsNoSummaryTable) {
-  const fs::path dir = TempDir("never_stepped");
+// A folder with a world of one robot (a dummy) whose script is `lua` (bot.lua).
+fs::path OneScriptedRobot(const std::string& name, const std::string& lua) {
+  const fs::path dir = TempDir(name);
   fs::create_directories(dir);
   std::ofstream(dir / "world.yaml") << "simulation: {physics: kinematic, time_step: 0.1}\n"
                                        "models:\n  - {model: bot.yaml, position: [0, 0]}\n";
   std::ofstream(dir / "bot.yaml") << "model: bot\n"
                                      "objects: {name: body, type: dummy, script: bot.lua}\n";
-  std::ofstream(dir / "bot.lua") << "function sysCall_init() error('no start') end\n";
+  std::ofstream(dir / "bot.lua") << lua;
+  return dir;
+}
+
+// A run that fails before its first step prints its error, not a table of
+// zeros; one that fails later prints the table of what it ran.
+TEST(RunOutputsTest, ARunThatNeverSteppedPrintsNoSummaryTable) {
+  const fs::path dir =
+      OneScriptedRobot("never_stepped", "function sysCall_init() error('no start') end\n");
   auto r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 3");
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_NE(r.output.find("no start"), std::string::npos) << r.output;
@@ -437,17 +444,12 @@ TEST(RunOutputsTest, ARunThatNeverSteppedPrintsNoSummaryTable) {
 // sysCall_init), which the phases do not: summary.json's start_time and the
 // table say how much of it that was.
 TEST(RunOutputsTest, TheSummarySaysHowMuchOfTheWallTimeStartedTheWorld) {
-  const fs::path dir = TempDir("start_time");
-  fs::create_directories(dir);
-  std::ofstream(dir / "world.yaml") << "simulation: {physics: kinematic, time_step: 0.1}\n"
-                                       "models:\n  - {model: slow.yaml, position: [0, 0]}\n";
-  std::ofstream(dir / "slow.yaml") << "model: slow\n"
-                                      "objects: {name: body, type: dummy, script: slow.lua}\n";
   // Three million additions at start, nothing in the step.
-  std::ofstream(dir / "slow.lua") << "function sysCall_init()\n"
-                                     "  local x = 0\n"
-                                     "  for i = 1, 3000000 do x = x + i end\n"
-                                     "end\n";
+  const fs::path dir = OneScriptedRobot("start_time",
+                                        "function sysCall_init()\n"
+                                        "  local x = 0\n"
+                                        "  for i = 1, 3000000 do x = x + i end\n"
+                                        "end\n");
   const auto r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 2 --out " +
                             (dir / "out").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
