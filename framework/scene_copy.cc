@@ -149,21 +149,13 @@ ObjectId Scene::DuplicateSubtree(ObjectId root, ObjectId new_parent, const Pose*
   // (AllocateSlotNamed), parents first, from its parent's copy as it is now
   // (a joint's row is copied before its children are made).
   const uint32_t copy_root = copies[0];
-  // A copy of a whole robot is a new robot (MakeModelInstance, with the
-  // copies as its objects: they are its subtree in hierarchy order).
+  // A copy of a whole robot is a new robot.
   const int src_instance = instance_[root_slot];
   if (model_root_[root_slot] && src_instance >= 0 && instances_[src_instance].root == root &&
       instance_[copy_root] < 0) {
-    model_root_[copy_root] = 1;
-    bool nested = false;  // under a model: part of its ancestor's instance
-    for (int32_t a = parent_[copy_root]; a >= 0 && !nested; a = parent_[a]) nested = model_root_[a];
-    if (!nested) {
-      const int index = static_cast<int>(instances_.size());
-      const std::string model_name = instances_[src_instance].model_name;
-      instances_.push_back(
-          {model_name + "#" + std::to_string(index), model_name, IdAt(copy_root), true, copies});
-      for (uint32_t s : copies) instance_[s] = index;
-    }
+    const std::string model_name = instances_[src_instance].model_name;
+    MakeModelInstance(IdAt(copy_root), model_name,
+                      model_name + "#" + std::to_string(instances_.size()));
   }
   for (SceneListener* l : listeners_) l->OnSubtreeDuplicated(*this, sources, copies);
   return IdAt(copy_root);
