@@ -243,6 +243,13 @@ const char* TypeName(const ParamValue& value) {
   return "a string";
 }
 
+std::optional<ParamValue> AsDeclaredType(const std::string& text, const ParamValue& declared) {
+  if (std::holds_alternative<std::string>(declared)) return ParamValue(text);
+  ParamValue parsed = ParseScalar(text, false);
+  if (parsed.index() == declared.index()) return parsed;
+  return std::nullopt;
+}
+
 // --- ValueReader ----------------------------------------------------------------------
 
 ParamValue ValueReader::Resolve(const Field& field) const {

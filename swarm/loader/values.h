@@ -114,5 +114,9 @@ ParamValue ParseScalar(std::string_view text, bool quoted);
 std::string FormatNumber(double value);
 // "a number", "a boolean", "a string".
 const char* TypeName(const ParamValue& value);
+// `text` (a --set or --param value) as a value of the parameter `declared`'s
+// type: the text itself for a string parameter, else what it reads as if
+// that is a number or boolean like `declared`; nothing when it is not.
+std::optional<ParamValue> AsDeclaredType(const std::string& text, const ParamValue& declared);
 
 }  // namespace swarmsim::loader

@@ -70,9 +70,7 @@ void CheckObjects(Scene& scene) {
 // parameter takes the text as is; a number or boolean must read as one.
 ParamValue CoerceOverride(const Override& o, const ParamValue& declared,
                           const std::string& declared_where) {
-  const ParamValue parsed = loader::ParseScalar(o.value, false);
-  if (std::holds_alternative<std::string>(declared)) return o.value;
-  if (parsed.index() == declared.index()) return parsed;
+  if (std::optional<ParamValue> value = loader::AsDeclaredType(o.value, declared)) return *value;
   throw Error("--set " + o.text + ": parameter '" + (o.model.empty() ? "" : o.model + ".") +
               o.name + "' is " + loader::TypeName(declared) + " (" + declared_where + "), got \"" +
               o.value + "\"");

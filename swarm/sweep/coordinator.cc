@@ -14,7 +14,6 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
-#include <variant>
 
 #include "framework/error.h"
 #include "framework/memory_forecast.h"
@@ -45,11 +44,9 @@ void CheckWorld(const SweepOptions& o, const GridRun& first, const std::vector<P
     throw Error(o.world + " gives no run length; pass --steps N or --duration SECONDS");
   for (const ParamSpec& p : params) {
     const auto declared = loaded.world->parameters().find(p.name);
-    if (declared == loaded.world->parameters().end() ||
-        std::holds_alternative<std::string>(declared->second))
-      continue;  // a model's parameter (checked by the first run), or text
+    if (declared == loaded.world->parameters().end()) continue;  // a model's (the first run's)
     for (const std::string& value : p.values)
-      if (loader::ParseScalar(value, false).index() != declared->second.index())
+      if (!loader::AsDeclaredType(value, declared->second))
         throw Error("--param " + p.name + "=" + p.spec + ": parameter '" + p.name + "' is " +
                     loader::TypeName(declared->second) + ", got \"" + value + "\"");
   }
