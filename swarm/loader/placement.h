@@ -8,6 +8,7 @@
 // deterministic: the same seed, stream and calls give the same poses.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <functional>
@@ -115,9 +116,11 @@ class Placer {
   // A grid of cells of at least `cell_size` over [lo_x, hi_x] x [lo_y, hi_y]
   // sized for `bodies` bodies, every body filed in it.
   void Rebuild(double cell_size, double lo_x, double lo_y, double hi_x, double hi_y, size_t bodies);
-  // The grid cell index along an axis, unclamped (may lie outside 0..n-1).
+  // The grid cell index along an axis (may lie outside 0..n-1; clamped to
+  // -1 .. 2^50 so that a far coordinate still converts to an integer).
   int64_t CellIndex(double v, double origin) const {
-    return static_cast<int64_t>(std::floor((v - origin) / cell_size_));
+    const double cell = std::floor((v - origin) / cell_size_);
+    return static_cast<int64_t>(cell > -1 ? std::min(cell, 0x1p50) : -1.0);
   }
 
   uint64_t seed_;

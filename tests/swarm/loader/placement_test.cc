@@ -112,6 +112,7 @@ TEST(PlacementTest, EveryBodyIsKeptClearOfWhateverRegionsItWasPlacedIn) {
   // and a disc placed in it.
   EXPECT_FALSE(placer.IsFree(10.5, 10, 0.1, 0));
   EXPECT_TRUE(placer.IsFree(12, 12, 0.1, 0));
+  EXPECT_TRUE(placer.IsFree(1e300, -1e300, 0.1, 0)) << "a far point: no cell, no body";
   EXPECT_FALSE(placer.IsFree(all.back().first.x + 0.05, all.back().first.y, 0.05, 0));
   // An overlapping region: a new grid, the first batch filed in it.
   add(placer.Distribute({1.5, 1.5, 4, 4}, 150, 0.05, clearance, 1), 0.05);
