@@ -168,6 +168,57 @@ std::vector<Placement2> Placer::Distribute(const Region2& region, int64_t count,
   return out;
 }
 
+namespace {
+
+// The index of cell (x, y) along the Hilbert curve over an n x n grid
+// (n a power of two; x, y < n).
+uint64_t HilbertIndex(uint64_t n, uint64_t x, uint64_t y) {
+  uint64_t d = 0;
+  for (uint64_t s = n / 2; s > 0; s /= 2) {
+    const uint64_t rx = (x & s) != 0 ? 1 : 0, ry = (y & s) != 0 ? 1 : 0;
+    d += s * s * ((3 * rx) ^ ry);
+    if (ry == 0) {  // rotate the quadrant
+      if (rx == 1) {
+        x = n - 1 - x;
+        y = n - 1 - y;
+      }
+      std::swap(x, y);
+    }
+  }
+  return d;
+}
+
+}  // namespace
+
+void SortAlongCurve(std::vector<Placement2>* placements, double cell) {
+  std::vector<Placement2>& p = *placements;
+  if (p.size() < 2) return;
+  double lo_x = p[0].x, lo_y = p[0].y, hi_x = p[0].x, hi_y = p[0].y;
+  for (const Placement2& q : p) {
+    lo_x = std::min(lo_x, q.x);
+    lo_y = std::min(lo_y, q.y);
+    hi_x = std::max(hi_x, q.x);
+    hi_y = std::max(hi_y, q.y);
+  }
+  // At most 2^24 cells a side (a far finer grid than any arena needs).
+  const double extent = std::max(hi_x - lo_x, hi_y - lo_y);
+  const double size = std::max({cell, extent / static_cast<double>(1 << 24), 1e-9});
+  uint64_t n = 1;
+  while (static_cast<double>(n) * size <= extent) n *= 2;
+  const auto index = [&](double v, double lo) {
+    const double c = std::floor((v - lo) / size);
+    return static_cast<uint64_t>(std::clamp(c, 0.0, static_cast<double>(n - 1)));
+  };
+  std::vector<std::pair<uint64_t, uint32_t>> keys(p.size());
+  for (size_t k = 0; k < p.size(); ++k)
+    keys[k] = {HilbertIndex(n, index(p[k].x, lo_x), index(p[k].y, lo_y)), static_cast<uint32_t>(k)};
+  std::sort(keys.begin(), keys.end());  // ties by the old number: a total order
+  std::vector<Placement2> sorted;
+  sorted.reserve(p.size());
+  for (const auto& [key, k] : keys) sorted.push_back(p[k]);
+  p = std::move(sorted);
+}
+
 std::vector<Placement2> Placer::Lattice(const Region2& region, int64_t count, double radius,
                                         double spacing, bool hexagonal, int64_t columns,
                                         uint64_t stream, std::optional<double> heading,

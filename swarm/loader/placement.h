@@ -49,6 +49,15 @@ struct Placement2 {     // a copy's root in the plane
   double yaw = 0;       // rad
 };
 
+// Renumbers `placements` along a Hilbert curve over their bounding box, in
+// square cells of `cell` m (about one copy each): copies that stand near
+// each other get near numbers. Every phase of a step walks robots in the
+// order of their numbers and keeps each robot's rows, body and script in
+// that order in memory, so neighbours (whose shapes a robot's sensors meet,
+// whose bodies touch its own) are then near in memory too. Deterministic:
+// copies in one cell keep their order.
+void SortAlongCurve(std::vector<Placement2>* placements, double cell);
+
 class Placer {
  public:
   // Tries per copy before the region counts as full.

@@ -152,6 +152,10 @@ void WorldLoader::PlaceEntries() {
     if (e.own_copies.empty()) {
       e.placements = placer_->Distribute(e.region, e.count, e.footprint.radius, e.clearance,
                                          stream++, e.heading);
+      // order: spatial: numbered along a space-filling curve, so that
+      // neighbours are near in memory (never with `instances`: the loader
+      // refuses the two together).
+      if (e.spatial_order) SortAlongCurve(&e.placements, 2 * e.footprint.radius + e.clearance);
     } else {
       // Copies whose own values change their size have footprints of their own.
       e.placements = placer_->Distribute(

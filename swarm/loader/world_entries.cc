@@ -471,7 +471,7 @@ void WorldLoader::ReadDistribution(const Fields& f, const ValueReader& world_val
   entry->count_field = f.Require("count");
   entry->count = world_values.Integer(entry->count_field, 0, kMaxCount);
   Fields d(*file_, f.Get("distribute"), "'distribute'");
-  d.Expect({"region", "clearance", "heading_deg", "lattice"});
+  d.Expect({"region", "clearance", "heading_deg", "order", "lattice"});
   const Field region = d.Get("region");
   if (!region.present() || (region.node.IsScalar() && world_values.String(region) == "arena")) {
     if (!arena_)
@@ -499,6 +499,22 @@ void WorldLoader::ReadDistribution(const Fields& f, const ValueReader& world_val
     entry->clearance = world_values.Number(d.Get("clearance"), kNonNegativeLength);
   if (d.Has("heading_deg"))
     entry->heading = world_values.Number(d.Get("heading_deg"), kAngleDeg) * kDegToRad;
+  if (d.Has("order")) {
+    const Field order = d.Get("order");
+    const std::string text = world_values.String(order);
+    if (text != "random" && text != "spatial")
+      file_->Fail(order.mark, "'order' must be random or spatial (got '" + text + "')");
+    entry->spatial_order = text == "spatial";
+    if (d.Has("lattice"))
+      file_->Fail(order.key_mark,
+                  "'order' is for random placement; a lattice numbers its "
+                  "copies row by row");
+    if (entry->spatial_order && !entry->own_copies.empty())
+      file_->Fail(order.mark,
+                  "'order: spatial' renumbers the copies by where they stand, "
+                  "and 'instances' gives values to copies by number: use one "
+                  "or the other");
+  }
   const double r = entry->MaxFootprintRadius();
   if (d.Has("lattice")) ReadLattice(d, world_values, r, entry);
   if (entry->count > 0 && (entry->region.max_x - entry->region.min_x < 2 * r ||

@@ -76,6 +76,9 @@ struct EntryPlan {
   std::string region_text;  // "the arena", "the region [..] - [..]"
   double clearance = 0;
   std::optional<double> heading;
+  // distribute.order: spatial: copies numbered along a space-filling curve
+  // (SortAlongCurve) instead of in the order they were drawn.
+  bool spatial_order = false;
   // distribute.lattice: copies on a square or hexagonal lattice instead of at random.
   struct LatticePlan {
     double spacing = 0;  // m

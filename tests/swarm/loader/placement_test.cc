@@ -8,6 +8,7 @@
 #include <array>
 #include <cmath>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -235,6 +236,56 @@ TEST(PlacementTest, TooFullArenaIsAClearError) {
         << message;
     EXPECT_NE(message.find("enlarge the arena or reduce count"), std::string::npos) << message;
   }
+}
+
+// --- distribute.order: spatial -------------------------------------------------------
+
+// Mean distance from copy k to copy k + 1, m.
+double MeanStep(const std::vector<Placement2>& p) {
+  double sum = 0;
+  for (size_t k = 1; k < p.size(); ++k) sum += std::hypot(p[k].x - p[k - 1].x, p[k].y - p[k - 1].y);
+  return sum / static_cast<double>(p.size() - 1);
+}
+
+TEST(PlacementTest, SpatialOrderRenumbersTheSameCopiesSoThatNeighboursGetNearNumbers) {
+  // 10,000 foot-bots at one per m^2: drawn at random, copy k + 1 is on
+  // average about half the arena's side (52 m) from copy k; along the
+  // curve, about one cell (a footprint, 0.19 m) to a few.
+  const double r = 0.085, clearance = 0.02, half = 50;
+  Placer placer(1);
+  const std::vector<Placement2> drawn =
+      placer.Distribute({-half, -half, half, half}, 10000, r, clearance, 0);
+  ASSERT_EQ(drawn.size(), 10000u);
+  std::vector<Placement2> sorted = drawn;
+  SortAlongCurve(&sorted, 2 * r + clearance);
+  EXPECT_GT(MeanStep(drawn), 30);
+  EXPECT_LT(MeanStep(sorted), 2);
+  // Every copy within 4 m of the one before it, but for a few jumps
+  // between the curve's quadrants.
+  int far = 0;
+  for (size_t k = 1; k < sorted.size(); ++k)
+    far += std::hypot(sorted[k].x - sorted[k - 1].x, sorted[k].y - sorted[k - 1].y) > 4;
+  EXPECT_LT(far, 20);
+  // The same poses, only renumbered.
+  const auto key = [](const Placement2& a, const Placement2& b) {
+    return std::tie(a.x, a.y, a.yaw) < std::tie(b.x, b.y, b.yaw);
+  };
+  std::vector<Placement2> a = drawn, b = sorted;
+  std::sort(a.begin(), a.end(), key);
+  std::sort(b.begin(), b.end(), key);
+  for (size_t k = 0; k < a.size(); ++k) {
+    ASSERT_EQ(a[k].x, b[k].x);
+    ASSERT_EQ(a[k].y, b[k].y);
+    ASSERT_EQ(a[k].yaw, b[k].yaw);
+  }
+  // Copies in one cell keep their order; a single copy or none is left alone.
+  std::vector<Placement2> same = {{1, 1, 0.1}, {1, 1, 0.2}, {1, 1, 0.3}};
+  SortAlongCurve(&same, 0.2);
+  EXPECT_EQ(same[0].yaw, 0.1);
+  EXPECT_EQ(same[2].yaw, 0.3);
+  std::vector<Placement2> none;
+  SortAlongCurve(&none, 0.2);
+  EXPECT_TRUE(none.empty());
 }
 
 // --- distribute.lattice ---------------------------------------------------------------

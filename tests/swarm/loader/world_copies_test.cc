@@ -5,8 +5,11 @@
 // placing (a lattice that does not fit) named at their file:line:column.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "framework/world.h"
 #include "swarm/loader/world_loader.h"
@@ -85,6 +88,58 @@ TEST_F(WorldCopiesTest, ALatticePlacesCopiesInIndexOrderAtTheSpacing) {
                   "'shape' must be square or hexagonal (got 'round')");
   EXPECT_CONTAINS(ErrorOfWorld(head + "clearance: 0.01, lattice: {spacing: 0.05}}}\n"),
                   "'clearance' is for random placement; a lattice's 'spacing' sets the gap");
+}
+
+TEST_F(WorldCopiesTest, SpatialOrderNumbersTheDrawnCopiesAlongTheArena) {
+  Write("disc.yaml",
+        "model: disc\nobjects: {name: body, type: shape, shape: cylinder, radius: 0.05, "
+        "height: 0.1}\n");
+  const auto world = [](const std::string& order) {
+    return "simulation: {physics: kinematic, seed: 3}\nmodels:\n"
+           "  - {model: disc.yaml, count: 400, distribute: {region: {min: [0, 0], max: [10, "
+           "10]}" +
+           order + "}}\n";
+  };
+  const auto positions = [](const LoadedWorld& w) {
+    std::vector<std::pair<double, double>> p;
+    for (const ModelInstance& inst : w.world->scene().instances()) {
+      const Pose X = w.world->scene().world_pose(inst.root);
+      p.emplace_back(X.p.x, X.p.y);
+    }
+    return p;
+  };
+  const auto mean_step = [](const std::vector<std::pair<double, double>>& p) {
+    double sum = 0;
+    for (size_t k = 1; k < p.size(); ++k)
+      sum += std::hypot(p[k].first - p[k - 1].first, p[k].second - p[k - 1].second);
+    return sum / static_cast<double>(p.size() - 1);
+  };
+  const auto drawn = positions(Load(world("")));
+  const auto same = positions(Load(world(", order: random")));
+  auto spatial = positions(Load(world(", order: spatial")));
+  ASSERT_EQ(drawn.size(), 400u);
+  EXPECT_EQ(drawn, same);  // random: the default
+  // Drawn, copy k + 1 is anywhere (about 5 m on average in a 10 m square);
+  // numbered along the curve, it stands near copy k.
+  EXPECT_GT(mean_step(drawn), 3);
+  EXPECT_LT(mean_step(spatial), 1);
+  // The same places, renumbered.
+  auto sorted_drawn = drawn;
+  std::sort(sorted_drawn.begin(), sorted_drawn.end());
+  std::sort(spatial.begin(), spatial.end());
+  EXPECT_EQ(sorted_drawn, spatial);
+  // Mistakes, at their place in the file.
+  EXPECT_CONTAINS(ErrorOfWorld(world(", order: sideways")),
+                  "world.yaml:3:94: 'order' must be random or spatial (got 'sideways')");
+  EXPECT_CONTAINS(ErrorOfWorld(world(", order: spatial, lattice: {spacing: 0.2}")),
+                  "'order' is for random placement; a lattice numbers its copies row by row");
+  EXPECT_CONTAINS(
+      ErrorOfWorld("simulation: {physics: kinematic}\nmodels:\n"
+                   "  - {model: disc.yaml, count: 4, distribute: {order: spatial, region: "
+                   "{min: [0, 0], max: [2, 2]}},\n"
+                   "     instances: [{index: 1, parameters: {}}]}\n"),
+      "'order: spatial' renumbers the copies by where they stand, and 'instances' gives values "
+      "to copies by number: use one or the other");
 }
 
 TEST_F(WorldCopiesTest, CopiesThatCannotBePlacedApartAreNamedWithTheirCount) {
