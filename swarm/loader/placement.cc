@@ -200,7 +200,7 @@ void SortAlongCurve(std::vector<Placement2>* placements, double cell) {
     hi_x = std::max(hi_x, q.x);
     hi_y = std::max(hi_y, q.y);
   }
-  // At most 2^24 cells a side (a far finer grid than any arena needs).
+  // At most 2^25 cells a side (a far finer grid than any arena needs).
   const double extent = std::max(hi_x - lo_x, hi_y - lo_y);
   const double size = std::max({cell, extent / static_cast<double>(1 << 24), 1e-9});
   uint64_t n = 1;
