@@ -8,13 +8,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
-#include <regex>
 #include <set>
 #include <string>
+#include <vector>
 
 #include "framework/registry.h"
 #include "framework/scene.h"
@@ -32,6 +33,28 @@ using testing::CommandResult;
 using testing::RunProgram;
 
 constexpr double kPi = 3.14159265358979323846;
+
+// The numbers of each line of `output` that holds `format` (sscanf's, of
+// `count` integers, e.g. "uid %ld sum %ld"; the line may start with the
+// robot's "[kilobot#3] " prefix): one vector per matching line, in order.
+// (Not std::regex: GCC 12 warns inside <regex> under the sanitizers.)
+std::vector<std::vector<long>> Matches(const std::string& output, const char* format, int count) {
+  const std::string head(format, std::string(format).find(' '));  // the first word
+  std::vector<std::vector<long>> out;
+  size_t start = 0;
+  while (start < output.size()) {
+    size_t end = output.find('\n', start);
+    if (end == std::string::npos) end = output.size();
+    const std::string line = output.substr(start, end - start);
+    start = end + 1;
+    const size_t at = line.find(head + " ");
+    if (at == std::string::npos) continue;
+    long v[5] = {};
+    if (std::sscanf(line.c_str() + at, format, &v[0], &v[1], &v[2], &v[3], &v[4]) == count)
+      out.emplace_back(v, v + count);
+  }
+  return out;
+}
 
 fs::path Dir(const std::string& name) {
   const fs::path dir = testing::FreshTempDir("swarmsim_kilobot", name);
@@ -110,14 +133,13 @@ TEST(KilobotTest, GlobalsAreEachRobotsOwnAtAnyThreadCount) {
                    std::to_string(threads) + " --out " + (dir / "out").string());
     ASSERT_EQ(run.exit_code, 0) << run.output;
     std::set<int> uids;
-    const std::regex line("uid (\\d+) loops (\\d+) counter (\\d+) calls (\\d+)");
-    for (std::sregex_iterator it(run.output.begin(), run.output.end(), line), end; it != end;
-         ++it) {
-      const int uid = std::stoi((*it)[1]);
-      const long loops = std::stol((*it)[2]);
+    for (const std::vector<long>& m :
+         Matches(run.output, "uid %ld loops %ld counter %ld calls %ld", 4)) {
+      const int uid = static_cast<int>(m[0]);
+      const long loops = m[1];
       EXPECT_EQ(loops, uid + 5);
-      EXPECT_EQ(std::stol((*it)[3]), (uid + 1) * loops) << "robot " << uid;
-      EXPECT_EQ(std::stol((*it)[4]), loops) << "robot " << uid;
+      EXPECT_EQ(m[2], (uid + 1) * loops) << "robot " << uid;
+      EXPECT_EQ(m[3], loops) << "robot " << uid;
       uids.insert(uid);
     }
     // kilo_uid is the robot index: 150 distinct ones.
@@ -168,10 +190,10 @@ int main() { kilo_init(); SET_CALLBACK(botinfo, botinfo); kilo_start(setup, loop
                    " --steps 12 --quiet --threads 2 --out " + (dir / "out").string());
     ASSERT_EQ(run.exit_code, 0) << run.output;
     int seen = 0;
-    const std::regex line("uid (\\d+) sum (\\d+)");
-    for (std::sregex_iterator it(run.output.begin(), run.output.end(), line), end; it != end;
-         ++it, ++seen)
-      EXPECT_EQ(std::stol((*it)[2]), 10 * (std::stol((*it)[1]) + 1)) << name;
+    for (const std::vector<long>& m : Matches(run.output, "uid %ld sum %ld", 2)) {
+      EXPECT_EQ(m[1], 10 * (m[0] + 1)) << name;
+      ++seen;
+    }
     EXPECT_EQ(seen, 30) << name << ": " << run.output;
   }
   fs::remove_all(dir);
@@ -324,11 +346,10 @@ int main() { kilo_init(); kilo_start(setup, loop); return 0; }
                                        " --steps 1 --quiet --out " + (dir / "out").string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
   std::set<std::pair<int, int>> pairs;
-  const std::regex line("calibration (\\d+) (\\d+) (\\d+) (\\d+) (\\d+)");
-  for (std::sregex_iterator it(run.output.begin(), run.output.end(), line), end; it != end; ++it) {
-    pairs.insert({std::stoi((*it)[2]), std::stoi((*it)[3])});
-    EXPECT_EQ((*it)[2], (*it)[4]);
-    EXPECT_EQ((*it)[3], (*it)[5]);
+  for (const std::vector<long>& m : Matches(run.output, "calibration %ld %ld %ld %ld %ld", 5)) {
+    pairs.insert({static_cast<int>(m[1]), static_cast<int>(m[2])});
+    EXPECT_EQ(m[1], m[3]);
+    EXPECT_EQ(m[2], m[4]);
   }
   EXPECT_GT(pairs.size(), 10u) << run.output;
   // Straight on its own values: heading kept within rounding (one duty unit
