@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "framework/sanitizers.h"
 #include "tests/swarm/run_program.h"
 
 namespace {
@@ -254,6 +255,16 @@ TEST(CliTest, ProgressShowsTheRobotsLoadedUnlessQuiet) {
   }
 }
 
+// Does `output` name the cap `cap` ("400 MiB") and go on with `next` (the
+// forecast: ". About ", ". Fewer than ")? Under AddressSanitizer the program
+// holds more than these caps before any robot (its shadow memory), so the
+// message may be the one for a cap already used up instead.
+bool NamesTheCap(const std::string& output, const std::string& cap, const std::string& next) {
+  if (output.find("(--max-memory " + cap + ")" + next) != std::string::npos) return true;
+  return swarmsim::kAddressSanitizer &&
+         output.find("with no room left (--max-memory " + cap + ")") != std::string::npos;
+}
+
 }  // namespace
 
 // A world that will not fit in memory is refused with a message while it is
@@ -269,7 +280,7 @@ TEST(CliTest, AWorldThatWillNotFitIsRefusedWithAMessage) {
                         out.string());
   EXPECT_NE(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("not enough memory for 20,000 robot"), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find("(--max-memory 400 MiB). About "), std::string::npos) << r.output;
+  EXPECT_TRUE(NamesTheCap(r.output, "400 MiB", ". About ")) << r.output;
   std::ifstream summary(out / "summary.json");
   ASSERT_TRUE(summary.good()) << r.output;
   const auto json = nlohmann::json::parse(summary);
@@ -290,7 +301,7 @@ TEST(CliTest, AWorldThatWillNotFitIsRefusedWithAMessage) {
                           "them take "),
             std::string::npos)
       << r.output;
-  EXPECT_NE(r.output.find("(--max-memory 80.0 MiB). Fewer than "), std::string::npos) << r.output;
+  EXPECT_TRUE(NamesTheCap(r.output, "80.0 MiB", ". Fewer than ")) << r.output;
   EXPECT_EQ(r.output.find("1,024 of 20,000 robots built"), std::string::npos)
       << "refused before the copies: " << r.output;
   std::ifstream summary2(out2 / "summary.json");
