@@ -128,11 +128,24 @@ std::string GroupThousands(int64_t n) {
   return out;
 }
 
-bool IsOffValue(const char* value) {
-  if (value == nullptr) return false;
+namespace {
+std::string Lowered(const char* value) {
   std::string v(value);
   std::transform(v.begin(), v.end(), v.begin(), [](unsigned char c) { return std::tolower(c); });
+  return v;
+}
+}  // namespace
+
+bool IsOffValue(const char* value) {
+  if (value == nullptr) return false;
+  const std::string v = Lowered(value);
   return v == "0" || v == "off" || v == "false" || v == "no";
+}
+
+bool IsOnValue(const char* value) {
+  if (value == nullptr) return false;
+  const std::string v = Lowered(value);
+  return v == "1" || v == "on" || v == "true" || v == "yes";
 }
 
 std::string FormatSize(double bytes) {

@@ -45,6 +45,8 @@ bool ParseMemorySize(const std::string& text, uint64_t* bytes);
 // Whether an environment variable's value turns a feature off: 0, off,
 // false or no, any case (SWARMSIM_MEMORY_CHECK, SWARMSIM_HUGEPAGES).
 bool IsOffValue(const char* value);
+// Whether it turns a feature on: 1, on, true or yes, any case.
+bool IsOnValue(const char* value);
 
 class MemoryForecast {
  public:

@@ -5,7 +5,6 @@
 #include <malloc.h>
 #endif
 
-#include <cctype>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -31,10 +30,7 @@ std::string TunablesWithHugePages(const char* tunables) {
 bool HugePagesTurnedOff(const char* value) { return IsOffValue(value); }
 
 bool HugePagesValueUnclear(const char* value) {
-  if (value == nullptr || value[0] == '\0' || IsOffValue(value)) return false;
-  std::string v(value);
-  for (char& c : v) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return v != "1" && v != "on" && v != "true" && v != "yes";
+  return value != nullptr && value[0] != '\0' && !IsOffValue(value) && !IsOnValue(value);
 }
 
 void RestartWithHugePages(char** argv) {

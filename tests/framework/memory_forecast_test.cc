@@ -38,6 +38,9 @@ TEST(MemoryForecastTest, SizesReadAsUsersWriteThem) {
   for (const char* off : {"0", "off", "OFF", "false", "No"}) EXPECT_TRUE(IsOffValue(off)) << off;
   for (const char* on : {"1", "on", "", "yes"}) EXPECT_FALSE(IsOffValue(on)) << on;
   EXPECT_FALSE(IsOffValue(nullptr));
+  for (const char* on : {"1", "On", "TRUE", "yes"}) EXPECT_TRUE(IsOnValue(on)) << on;
+  for (const char* other : {"0", "off", "", "maybe"}) EXPECT_FALSE(IsOnValue(other)) << other;
+  EXPECT_FALSE(IsOnValue(nullptr));
 }
 
 TEST(MemoryForecastTest, TheRoomIsTheSmallestOfMachineCgroupAndCap) {
