@@ -302,6 +302,11 @@ void RegisterAllApis(lua_State* L);
 // os, require (lua_sandbox.cc), or all of Lua's under trust_scripts.
 void OpenSandbox(lua_State* L);
 
+// The generator behind the state's math.random (a userdata; `bytes` its
+// size), kept alive by a registry reference whatever the scripts do to
+// math; null if math.random is not Lua's. May raise (memory): protected.
+void* PinRandomGenerator(lua_State* L, size_t* bytes);
+
 // Constant shared with scripts.
 constexpr lua_Integer kHandleWorld = -1;
 // A script's own collections (lua_api_collections.cc): kScriptCollectionBase

@@ -26,13 +26,15 @@ LimitedLua::LimitedLua(const char* subject, size_t memory_limit, int64_t instruc
   c.instruction_budget = instruction_budget;
   c.budget_subject = subject;
   c.budget_setting = "";
-  state.memory.own.Attach(nullptr, memory_limit);
-  c.memory = &state.memory.own;
-  state.memory.holder = subject;
-  state.memory.plural = false;
-  state.memory.setting = "the limit of one evaluation";
-  state.L = lua_newstate(lua_host::LimitedAlloc, &state);
+  state.heap->memory.own.Attach(nullptr, memory_limit);
+  c.memory = &state.heap->memory.own;
+  state.heap->memory.holder = subject;
+  state.heap->memory.plural = false;
+  state.heap->memory.setting = "the limit of one evaluation";
+  state.L = lua_newstate(lua_host::LimitedAlloc, state.heap.get());
   if (state.L == nullptr) throw Error(std::string("not enough memory for a Lua state"));
+  state.heap->L = state.L;
+  state.heap->current = &state;
   lua_atpanic(state.L, ThrowOnPanic);
   SetContext(state.L, &c);
 }
@@ -47,7 +49,7 @@ bool LimitedLua::Call(int nargs, int nresults, std::string* error) {
   LuaContext& c = state.context;
   c.budget_exhausted = false;
   c.budget_error.clear();
-  state.memory.refusal_bytes = 0;
+  state.heap->memory.refusal_bytes = 0;
   lua_host::SetBudget(L, c);
   const int status = lua_pcall(L, nargs, nresults, 0);
   lua_sethook(L, nullptr, 0, 0);

@@ -491,7 +491,7 @@ std::array<fs::path, 3> ModuleFolders(lua_State* L) {
 
 // require(name): a Lua module (name.lua, dots for folders) from the world's
 // folder, then its scripts/ folder, then the scripts/ folder beside it. Run
-// once per state in an environment of its own; its result is cached.
+// once per robot in an environment of its own; its result is cached.
 int SafeRequire(lua_State* L) {
   const std::string name = ArgString(L, 1);
   lua_settop(L, 1);
@@ -502,6 +502,16 @@ int SafeRequire(lua_State* L) {
     lua_pushvalue(L, -1);
     lua_rawsetp(L, LUA_REGISTRYINDEX, &kModulesKey);
   }
+  // One cache a robot: robots sharing a state (robots_per_lua_state) each
+  // get their own module, as with a state each.
+  const lua_Integer robot = Context(L).instance;
+  if (lua_rawgeti(L, 2, robot) != LUA_TTABLE) {
+    lua_pop(L, 1);
+    lua_newtable(L);
+    lua_pushvalue(L, -1);
+    lua_rawseti(L, 2, robot);
+  }
+  lua_replace(L, 2);
   lua_getfield(L, 2, name.c_str());
   if (lua_touserdata(L, -1) == &kLoadingSentinel)
     RaiseError(L, "require: module '" + name + "' requires itself (a loop)");
@@ -710,6 +720,27 @@ void OpenSandbox(lua_State* L) {
   lua_setfield(L, -2, "__index");
   lua_setmetatable(L, -2);
   lua_pop(L, 1);
+}
+
+void* PinRandomGenerator(lua_State* L, size_t* bytes) {
+  void* generator = nullptr;
+  lua_getglobal(L, LUA_MATHLIBNAME);
+  if (lua_type(L, -1) == LUA_TTABLE) {
+    lua_pushliteral(L, "random");
+    lua_rawget(L, -2);
+    if (lua_tocfunction(L, -1) != nullptr && lua_getupvalue(L, -1, 1) != nullptr) {
+      if (lua_type(L, -1) == LUA_TUSERDATA) {
+        *bytes = lua_rawlen(L, -1);
+        generator = lua_touserdata(L, -1);
+        lua_pushvalue(L, -1);
+        luaL_ref(L, LUA_REGISTRYINDEX);
+      }
+      lua_pop(L, 1);
+    }
+    lua_pop(L, 1);
+  }
+  lua_pop(L, 1);
+  return generator;
 }
 
 namespace {

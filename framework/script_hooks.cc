@@ -72,7 +72,7 @@ void BudgetHook(lua_State* L, lua_Debug* ar) {
 // Count hook armed when a state's memory passed the limit (LuaMemory).
 void MemoryHook(lua_State* L, lua_Debug* ar) {
   auto* state = static_cast<ScriptState*>(Context(L).host_state);
-  LuaMemory& m = state->memory;
+  LuaMemory& m = state->heap->memory;
   if (std::exchange(m.refused_bytes, 0) > 0) {
     // Where it was asked for (a coroutine's line, when the refusal ended
     // one that the script resumed), else where the hook fired.
@@ -146,8 +146,8 @@ void SliceHook(lua_State* L, lua_Debug* ar) {
 }
 
 void* LimitedAlloc(void* ud, void* ptr, size_t osize, size_t nsize) {
-  auto* state = static_cast<ScriptState*>(ud);
-  LuaMemory& m = state->memory;
+  auto* heap = static_cast<LuaHeap*>(ud);
+  LuaMemory& m = heap->memory;
   ScriptMemory& account = *m.account;
   const size_t old = ptr != nullptr ? osize : 0;
   if (nsize == 0) {
@@ -178,21 +178,22 @@ void* LimitedAlloc(void* ud, void* ptr, size_t osize, size_t nsize) {
       m.refusal_bytes = grow;
       m.refusal_where[0] = '\0';
       m.refusal_script_line = 0;
-      if (state->L != nullptr && CanReadStackInAllocator(ptr)) {
-        const LuaContext& c = state->context;
-        RecordRefusalPlace(*state, c.running != nullptr ? c.running : RootOf(c));
+      if (heap->L != nullptr && heap->current != nullptr && CanReadStackInAllocator(ptr)) {
+        const LuaContext& c = heap->current->context;
+        RecordRefusalPlace(*heap->current, c.running != nullptr ? c.running : RootOf(c));
       }
     }
-    if (state->L != nullptr) {
+    if (heap->L != nullptr) {
       // Armed on every thread whose hook is another (a callback's budget hook
       // set since would otherwise leave only the hard cap). lua_sethook may
       // be called at any point (even from a signal handler).
       const auto arm = [](lua_State* T) {
         if (lua_gethook(T) != MemoryHook) lua_sethook(T, MemoryHook, LUA_MASKCOUNT, 1);
       };
-      arm(state->L);
-      for (const Script& script : state->scripts)
-        if (script.thread != nullptr) arm(script.thread);
+      arm(heap->L);
+      if (heap->current != nullptr)
+        for (const Script& script : heap->current->scripts)
+          if (script.thread != nullptr) arm(script.thread);
     }
     if (refuse) return nullptr;
   }

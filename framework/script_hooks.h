@@ -30,7 +30,7 @@ void SetBudget(lua_State* L, const LuaContext& c);
 // comparator), the instruction budget applies instead.
 void SliceHook(lua_State* L, lua_Debug* ar);
 
-// lua_Alloc of every state (`ud`: its ScriptState): realloc/free, counting
+// lua_Alloc of every state (`ud`: its LuaHeap): realloc/free, counting
 // against the state's memory limit.
 void* LimitedAlloc(void* ud, void* ptr, size_t osize, size_t nsize);
 

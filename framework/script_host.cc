@@ -1,9 +1,16 @@
 // The Lua scripting host: the life of its states (script_host.h).
 //
-// One lua_State per robot (model instance) and one for the scripts outside
-// any robot. Each script runs in its own environment table whose __index is
-// the state's shared globals (sim, the safe libraries), so globals of one
-// script do not leak into another. A source is compiled once as
+// One lua_State per robot (model instance), or per n robots with
+// simulation.robots_per_lua_state (robots r / n share one: LuaHeap), and one
+// for the scripts outside any robot. Each script runs in its own environment
+// table whose __index is the state's shared globals (sim, the safe
+// libraries), so globals of one script do not leak into another. Robots
+// sharing a state keep their own context (the state's extra space while
+// one runs: MakeCurrent), math.random generator (copied in and out of the
+// state's), required modules (lua_sandbox.cc) and threads; a state's robots
+// are started, run and stopped on one thread at a time (its mutex), so
+// results are those of a state per robot for scripts that leave the
+// library tables alone. A source is compiled once as
 // `function(_ENV, ...) <code> end` (the robots' states load its bytecode,
 // dumped by the first state that compiled it: no parsing per robot) and
 // called once per script with that script's environment; the callbacks it defines are looked up
@@ -84,12 +91,13 @@ int ThrowOnPanic(lua_State* L) {
 // error reported, whatever error value the call returns.
 void Call(ScriptState& state, Script& script, int nargs, const char* what) {
   const CallInProgress in_progress(state, what);
+  MakeCurrent(state);
   SetCurrent(state, script);
   state.context.budget_exhausted = false;
   state.context.data_collected = false;
   state.context.running = nullptr;
-  state.memory.refused_bytes = 0;  // reported with the callback that made it
-  state.memory.refusal_bytes = 0;
+  state.heap->memory.refused_bytes = 0;  // reported with the callback that made it
+  state.heap->memory.refusal_bytes = 0;
   SetBudget(state.L, state.context);
   script.running = true;
   // LocateError below the function: errors name a line where Lua has one.
@@ -116,7 +124,9 @@ void Call(ScriptState& state, Script& script, int nargs, const char* what) {
   lua_settop(L, handler - 1);
 }
 
-// Protected part of creating a state. Arguments: two integers seeding math.random.
+// Protected part of creating a state. Arguments: two integers seeding
+// math.random, and for a state robots share, its LuaHeap (light userdata),
+// whose generator it notes.
 int SetUpState(lua_State* L) {
   OpenSandbox(L);
   RegisterAllApis(L);
@@ -132,6 +142,24 @@ int SetUpState(lua_State* L) {
   lua_pushglobaltable(L);
   lua_setfield(L, -2, "__index");
   lua_rawsetp(L, LUA_REGISTRYINDEX, &kEnvironmentMetatableKey);
+  if (auto* heap = static_cast<LuaHeap*>(lua_touserdata(L, 3)); heap != nullptr) {
+    size_t bytes = 0;
+    heap->generator = PinRandomGenerator(L, &bytes);
+    if (heap->generator == nullptr || bytes != kGeneratorBytes)
+      return luaL_error(L, "math.random's generator is not Lua 5.4's (%d bytes)",
+                        static_cast<int>(bytes));
+  }
+  return 0;
+}
+
+// Seeds math.random of a robot joining a shared state (its generator is in
+// the state: MakeCurrent). Arguments: two integers.
+int SeedRandom(lua_State* L) {
+  lua_getglobal(L, LUA_MATHLIBNAME);
+  lua_getfield(L, -1, "randomseed");
+  lua_pushvalue(L, 1);
+  lua_pushvalue(L, 2);
+  lua_call(L, 2, 0);
   return 0;
 }
 
@@ -263,10 +291,12 @@ void CheckIsFunction(ScriptState& state, const Script& script, const char* name)
 }
 
 // A state for the enabled scripts on `slots` (hierarchy order), or null if
-// there are none.
+// there are none. With `group`, the robot shares the Lua state *group
+// (robots_per_lua_state), made here if null.
 std::unique_ptr<ScriptState> NewState(World* world, int instance, RobotRuntime* runtime,
                                       std::string name, const std::vector<uint32_t>& slots,
-                                      const ScriptSource* main_source = nullptr) {
+                                      const ScriptSource* main_source = nullptr,
+                                      std::shared_ptr<LuaHeap>* group = nullptr) {
   Scene& scene = world->scene();
   auto state = std::make_unique<ScriptState>();
   for (uint32_t slot : slots) {
@@ -300,28 +330,89 @@ std::unique_ptr<ScriptState> NewState(World* world, int instance, RobotRuntime* 
   c.host_state = state.get();
   c.instruction_budget = world->settings().instruction_budget;
   // The robot's account (the scene's for the scene's scripts and the main
-  // script), which the data its sim.* calls keep charges too.
-  state->memory.account = &world->script_memory(instance);
-  c.memory = state->memory.account;
-  lua_State* L = lua_newstate(LimitedAlloc, state.get());
+  // script), which the data its sim.* calls keep charges too; a shared
+  // state's heap has an account of its own.
+  ScriptMemory& account = world->script_memory(instance);
+  c.memory = &account;
+  const lua_Integer seeds[2] = {static_cast<lua_Integer>(runtime->rng.NextU64()),
+                                static_cast<lua_Integer>(runtime->rng.NextU64())};
+  if (group != nullptr && *group != nullptr) {
+    // Joins the group's state: its own generator, seeded as its own state's.
+    state->heap = *group;
+    state->L = state->heap->L;
+    lua_State* L = state->L;
+    MakeCurrent(*state);
+    lua_pushcfunction(L, SeedRandom);
+    lua_pushinteger(L, seeds[0]);
+    lua_pushinteger(L, seeds[1]);
+    if (const int status = lua_pcall(L, 2, 0, 0); status != LUA_OK)
+      throw Error(c.name + ": cannot set up the Lua state: " + ErrorText(L, status));
+    return state;
+  }
+  LuaHeap& heap = *state->heap;
+  heap.memory.account = &account;
+  if (group != nullptr) {
+    const int robots = world->settings().robots_per_lua_state;
+    heap.shared = true;
+    heap.account.Attach(account.run(), account.limit() * static_cast<uint64_t>(robots));
+    heap.memory.account = &heap.account;
+    heap.holder = "the scripts of the " + std::to_string(robots) +
+                  " robots sharing a Lua state with " + c.name;
+    heap.memory.holder = heap.holder.c_str();
+    heap.memory.setting =
+        "simulation.script_memory_mb, times simulation.robots_per_lua_state for a state robots "
+        "share; raise it if the data is real";
+  }
+  lua_State* L = lua_newstate(LimitedAlloc, &heap);
   if (L == nullptr) throw Error(c.name + ": not enough memory for a Lua state");
-  state->L = L;
+  state->L = heap.L = L;
+  heap.current = state.get();
   lua_atpanic(L, ThrowOnPanic);
   SetContext(L, &c);
   lua_pushcfunction(L, SetUpState);
-  lua_pushinteger(L, static_cast<lua_Integer>(runtime->rng.NextU64()));
-  lua_pushinteger(L, static_cast<lua_Integer>(runtime->rng.NextU64()));
-  if (const int status = lua_pcall(L, 2, 0, 0); status != LUA_OK)
+  lua_pushinteger(L, seeds[0]);
+  lua_pushinteger(L, seeds[1]);
+  lua_pushlightuserdata(L, heap.shared ? &heap : nullptr);
+  if (const int status = lua_pcall(L, 3, 0, 0); status != LUA_OK)
     throw Error(c.name + ": cannot set up the Lua state: " + ErrorText(L, status));
+  if (group != nullptr) *group = state->heap;
   return state;
 }
 
+// The sources compiled in a state (registry references to their factories).
+using Factories = std::vector<std::pair<const ScriptSource*, int>>;
+
+// Drops a state's factories and leaves its collector in generational mode,
+// once its robots are initialized.
+void Settle(lua_State* L, Factories& factories) {
+  // The bodies' code is not needed any more (the callbacks they defined
+  // keep their own prototypes).
+  for (const auto& factory : factories) luaL_unref(L, LUA_REGISTRYINDEX, factory.second);
+  factories.clear();
+  // Generational collection keeps a robot's heap within ~20% of what it
+  // holds (the incremental default lets it double between cycles: 10,000
+  // robots would carry ~20 KB of garbage each). In Lua 5.4.4 a full
+  // collection in generational mode leaves the next target at twice the
+  // heap; one young step after it sets the target from the live size. A
+  // full incremental collection first: without it the diffusion robot's
+  // heap settles 0.56 KiB higher for good (17.11 vs 16.55 KiB, measured
+  // over 30 steps) since its libraries are no longer opened in full.
+  lua_gc(L, LUA_GCCOLLECT);
+  lua_gc(L, LUA_GCGEN, 0, 0);
+  lua_gc(L, LUA_GCCOLLECT);
+  lua_gc(L, LUA_GCSTEP, 0);
+}
+
 // Runs every script's body, then every sysCall_init, in hierarchy order.
-// `chunks`: the sources compiled by the other states, and where this one's go.
-void Initialize(ScriptState* state, CompiledChunks* chunks = nullptr) {
+// `chunks`: the sources compiled by the other states, and where this one's
+// go. With `group` (a robot sharing its state), the factories compiled in
+// the state so far, kept for the next robot; the caller settles the state.
+void Initialize(ScriptState* state, CompiledChunks* chunks = nullptr, Factories* group = nullptr) {
   lua_State* L = state->L;
+  MakeCurrent(*state);
   // Bodies. Each distinct source is compiled once for the state.
-  std::vector<std::pair<const ScriptSource*, int>> factories;
+  Factories own;
+  Factories& factories = group != nullptr ? *group : own;
   for (Script& script : state->scripts) {
     const ScriptSource& source = *script.source;
     auto it = std::find_if(factories.begin(), factories.end(),
@@ -351,9 +442,6 @@ void Initialize(ScriptState* state, CompiledChunks* chunks = nullptr) {
       if (!Disable(*state, script, e.what())) throw;
     }
   }
-  // The bodies' code is not needed any more (the callbacks they defined
-  // keep their own prototypes).
-  for (const auto& factory : factories) luaL_unref(L, LUA_REGISTRYINDEX, factory.second);
   // sysCall_init, then the per-step callbacks (sysCall_init may define them).
   for (Script& script : state->scripts) {
     if (script.disabled) continue;  // its main chunk failed (disable_script)
@@ -382,18 +470,7 @@ void Initialize(ScriptState* state, CompiledChunks* chunks = nullptr) {
           SliceInstructions(script.slice_instructions, state->context.instruction_budget);
     }
   }
-  // Generational collection keeps a robot's heap within ~20% of what it
-  // holds (the incremental default lets it double between cycles: 10,000
-  // robots would carry ~20 KB of garbage each). In Lua 5.4.4 a full
-  // collection in generational mode leaves the next target at twice the
-  // heap; one young step after it sets the target from the live size. A
-  // full incremental collection first: without it the diffusion robot's
-  // heap settles 0.56 KiB higher for good (17.11 vs 16.55 KiB, measured
-  // over 30 steps) since its libraries are no longer opened in full.
-  lua_gc(L, LUA_GCCOLLECT);
-  lua_gc(L, LUA_GCGEN, 0, 0);
-  lua_gc(L, LUA_GCCOLLECT);
-  lua_gc(L, LUA_GCSTEP, 0);
+  if (group == nullptr) Settle(L, own);
 }
 
 // Resumes a script's thread until it yields, returns or fails.
@@ -401,13 +478,14 @@ void ResumeThread(ScriptState* state, Script& script) {
   lua_State* co = script.thread;
   LuaContext& c = state->context;
   const CallInProgress in_progress(*state, kCallbackNames[kThread]);
+  MakeCurrent(*state);
   SetCurrent(*state, script);
   c.thread = co;
   c.budget_exhausted = false;
   c.data_collected = false;
   c.running = nullptr;
-  state->memory.refused_bytes = 0;  // reported with the callback that made it
-  state->memory.refusal_bytes = 0;
+  state->heap->memory.refused_bytes = 0;  // reported with the callback that made it
+  state->heap->memory.refusal_bytes = 0;
   c.slice_fires = 0;
   c.slice_yielded = false;
   // A fresh slice. After a yield from the hook, Lua itself left it so: it
@@ -502,9 +580,16 @@ void Cleanup(ScriptState* state) {
   if (!first_error.empty()) throw Error(first_error);
 }
 
+// Holds a shared state's mutex (robots sharing a state may be run from
+// different threads), or nothing.
+std::unique_lock<std::mutex> Lock(ScriptState& state) {
+  if (!state.heap->shared) return {};
+  return std::unique_lock<std::mutex>(state.heap->mutex);
+}
+
 size_t StateBytes(const ScriptState* state) {
   if (state == nullptr || state->L == nullptr) return 0;
-  return state->memory.used;
+  return state->heap->memory.used;
 }
 
 // Slots of the objects outside any robot, hierarchy order (roots in slot
@@ -611,24 +696,47 @@ void LuaScriptHost::StartRobots(int first) {
   std::atomic<int64_t> started{0};
   std::string refusal;
   std::atomic<bool> refused{false};
-  world.scheduler().ParallelFor(first, robot_count, kStartGrain, [&](int64_t begin, int64_t end) {
-    for (int64_t r = begin; r < end; ++r) {
-      if (refused.load(std::memory_order_relaxed)) return;
-      const ModelInstance& instance = scene.instance(static_cast<int>(r));
-      if (!instance.alive) continue;
-      try {
-        robots_[r] = NewState(&world, static_cast<int>(r), &world.runtime(static_cast<int>(r)),
-                              instance.name, instance.objects);
-        if (robots_[r]) Initialize(robots_[r].get(), &chunks_);
-      } catch (const std::exception& e) {
-        errors[r] = e.what();
-      }
-      if (std::string why = forecast.Built(started.fetch_add(1) + 1); !why.empty()) {
-        refusal = std::move(why);  // one thread only: the forecast says it once
-        refused.store(true);
-      }
+  // Robots r / n share a state (robots_per_lua_state: n), made by the first
+  // of them that has scripts; each state is built on one thread.
+  const int64_t n = world.settings().robots_per_lua_state;
+  const auto start = [&](int64_t r, std::shared_ptr<LuaHeap>* group, Factories* factories) {
+    const ModelInstance& instance = scene.instance(static_cast<int>(r));
+    if (!instance.alive) return;
+    try {
+      robots_[r] = NewState(&world, static_cast<int>(r), &world.runtime(static_cast<int>(r)),
+                            instance.name, instance.objects, nullptr, group);
+      if (robots_[r]) Initialize(robots_[r].get(), &chunks_, factories);
+    } catch (const std::exception& e) {
+      errors[r] = e.what();
     }
-  });
+    if (std::string why = forecast.Built(started.fetch_add(1) + 1); !why.empty()) {
+      refusal = std::move(why);  // one thread only: the forecast says it once
+      refused.store(true);
+    }
+  };
+  if (n <= 1) {
+    world.scheduler().ParallelFor(first, robot_count, kStartGrain, [&](int64_t begin, int64_t end) {
+      for (int64_t r = begin; r < end; ++r) {
+        if (refused.load(std::memory_order_relaxed)) return;
+        start(r, nullptr, nullptr);
+      }
+    });
+  } else {
+    world.scheduler().ParallelFor(first / n, (robot_count + n - 1) / n, 1,
+                                  [&](int64_t begin, int64_t end) {
+                                    for (int64_t g = begin; g < end; ++g) {
+                                      std::shared_ptr<LuaHeap> group;
+                                      Factories factories;
+                                      for (int64_t r = std::max<int64_t>(first, g * n);
+                                           r < std::min<int64_t>(robot_count, (g + 1) * n); ++r) {
+                                        if (refused.load(std::memory_order_relaxed)) break;
+                                        start(r, &group, &factories);
+                                      }
+                                      if (group != nullptr && group->L != nullptr)
+                                        Settle(group->L, factories);
+                                    }
+                                  });
+  }
   if (refused.load()) throw Error(refusal);
   for (const std::string& error : errors)
     if (!error.empty()) throw Error(error);
@@ -652,7 +760,14 @@ void LuaScriptHost::StartInstances(int first) {
 void LuaScriptHost::StopInstance(int instance) {
   if (!started_ || stopped_ || instance < 0 || instance >= static_cast<int>(robots_.size())) return;
   std::unique_ptr<ScriptState> state = std::move(robots_[instance]);
-  if (state) Cleanup(state.get());  // the state closes as `state` goes, error or not
+  if (!state) return;
+  std::unique_lock lock = Lock(*state);
+  try {
+    Cleanup(state.get());
+  } catch (...) {
+    lock.unlock();  // ~ScriptState takes it
+    throw;          // the state closes as `state` goes (the last robot's), error or not
+  }
 }
 
 void LuaScriptHost::RunMainScript() {
@@ -668,6 +783,7 @@ void LuaScriptHost::RunInstance(int instance, ScriptPass pass) {
   if (stopped_ || instance < 0 || instance >= static_cast<int>(robots_.size())) return;
   ScriptState* state = robots_[instance].get();
   if (state == nullptr) return;
+  const std::unique_lock lock = Lock(*state);
   if (pass != ScriptPass::kActuation) RunCallback(state, kSensing, child_args_);
   if (pass != ScriptPass::kSensing) RunCallback(state, kActuation, child_args_, main_steps_);
 }
@@ -687,17 +803,20 @@ void LuaScriptHost::Stop() {
   world_->scheduler().ParallelFor(0, robot_count, kStartGrain, [&](int64_t begin, int64_t end) {
     for (int64_t r = begin; r < end; ++r) {
       if (!robots_[r]) continue;
-      try {
-        Cleanup(robots_[r].get());
-      } catch (const std::exception& e) {
-        errors[r] = e.what();
+      {
+        const std::unique_lock lock = Lock(*robots_[r]);
+        try {
+          Cleanup(robots_[r].get());
+        } catch (const std::exception& e) {
+          errors[r] = e.what();
+        }
+        // The process ends next (swarmsim run): a state whose closing runs
+        // no code is left to the system rather than freed one object at a
+        // time (1.3 s of a 100,000-robot run's end). Not under ASan (leak
+        // checks). ~ScriptState looks at may_finalize.
+        if (!kAddressSanitizer && world_->process_ends_after_stop())
+          robots_[r]->heap->leave_to_system = true;
       }
-      // The process ends next (swarmsim run): a state whose closing runs no
-      // code is left to the system rather than freed one object at a time
-      // (1.3 s of a 100,000-robot run's end). Not under ASan (leak checks).
-      if (!kAddressSanitizer && world_->process_ends_after_stop() &&
-          !robots_[r]->context.may_finalize)
-        robots_[r]->L = nullptr;
       robots_[r].reset();
     }
   });
@@ -716,7 +835,12 @@ void LuaScriptHost::Stop() {
 
 size_t LuaScriptHost::MemoryBytes() const {
   size_t total = StateBytes(scene_.get()) + StateBytes(main_.get());
-  for (const auto& state : robots_) total += StateBytes(state.get());
+  const LuaHeap* last = nullptr;  // robots sharing a state are neighbours
+  for (const auto& state : robots_) {
+    if (!state || state->heap.get() == last) continue;
+    last = state->heap.get();
+    total += StateBytes(state.get());
+  }
   return total;
 }
 

@@ -1,8 +1,9 @@
 // The Lua scripting host: World's ScriptHost (framework/phase_handlers.h),
 // made by MakeScriptHost.
 //
-// One lua_State per model instance (robot); each script attached to an
-// object of the robot is a separate environment in it. Scripts outside any
+// One lua_State per model instance (robot), or per n robots
+// (simulation.robots_per_lua_state); each script attached to an object of
+// a robot is a separate environment in it. Scripts outside any
 // model share one scene state that runs on the calling thread. Lua types
 // stay inside the host's .cc files (lua_api.h is internal to them).
 //

@@ -83,6 +83,44 @@ std::string FormatBytes(uint64_t bytes) {
   return text;
 }
 
+ScriptState::~ScriptState() {
+  if (L == nullptr) return;
+  std::unique_lock<std::mutex> lock(heap->mutex, std::defer_lock);
+  if (heap->shared) lock.lock();
+  if (context.may_finalize) heap->may_finalize = true;
+  if (heap.use_count() > 1) {
+    // Other robots go on in the state: this one's references go (its
+    // environments and functions become garbage). The heap outlives the
+    // lock: the robots still holding it wait for the mutex.
+    for (Script& script : scripts) {
+      luaL_unref(L, LUA_REGISTRYINDEX, script.env_ref);
+      luaL_unref(L, LUA_REGISTRYINDEX, script.thread_ref);
+      for (int& ref : script.callbacks) luaL_unref(L, LUA_REGISTRYINDEX, ref);
+    }
+    if (heap->current == this) heap->current = nullptr;
+    heap.reset();
+    return;
+  }
+  if (heap->leave_to_system && !heap->may_finalize) return;  // the process ends
+  // Finalizers (a file io opened) run with this robot's context.
+  heap->current = this;
+  SetContext(L, &context);
+  lua_close(L);
+  heap->L = nullptr;
+}
+
+void MakeCurrent(ScriptState& state) {
+  LuaHeap& heap = *state.heap;
+  if (heap.current == &state) return;
+  if (heap.generator != nullptr) {
+    if (heap.current != nullptr)
+      std::memcpy(heap.current->generator, heap.generator, kGeneratorBytes);
+    std::memcpy(heap.generator, state.generator, kGeneratorBytes);
+  }
+  heap.current = &state;
+  SetContext(state.L, &state.context);
+}
+
 std::string MemoryLimitTail(const LuaMemory& memory) {
   const ScriptMemory& account = *memory.account;
   const std::string limit = std::to_string(account.limit() >> 20) + " MiB";
@@ -101,7 +139,7 @@ std::string RunLimitTail(const ScriptMemory& account) {
 }
 
 void RecordRefusalPlace(ScriptState& state, lua_State* running) {
-  LuaMemory& m = state.memory;
+  LuaMemory& m = state.heap->memory;
   const auto* script = static_cast<const Script*>(state.context.host_script);
   const ErrorPlace place = FindErrorPlace(running, 0, ScriptFile(script));
   std::memcpy(m.refusal_where, place.where, sizeof m.refusal_where);
@@ -111,7 +149,7 @@ void RecordRefusalPlace(ScriptState& state, lua_State* running) {
 }
 
 std::string RefusalText(const ScriptState& state) {
-  const LuaMemory& m = state.memory;
+  const LuaMemory& m = state.heap->memory;
   std::string text = m.refusal_where;
   const std::string* file = ScriptFile(m.refusal_script);
   if (file != nullptr && m.refusal_script_line > 0 &&
@@ -127,7 +165,7 @@ std::string ErrorText(lua_State* L, int status) {
     // Lua raised it for a refusal (its stack unwound by now): the place
     // LimitedAlloc noted.
     const auto* state = static_cast<const ScriptState*>(Context(L).host_state);
-    if (state == nullptr || state->memory.refusal_bytes == 0) return "not enough memory";
+    if (state == nullptr || state->heap->memory.refusal_bytes == 0) return "not enough memory";
     return RefusalText(*state);
   }
   if (status != LUA_ERRRUN && status != LUA_ERRSYNTAX && status != LUA_ERRERR)
@@ -226,8 +264,12 @@ void ChargeScriptData(lua_State* L, uint64_t bytes, const char* what) {
   const auto* state = static_cast<const lua_host::ScriptState*>(c.host_state);
   if (result == ScriptMemory::kPastRunLimit || state == nullptr)
     throw Error(std::string(what) + " would take " + lua_host::RunLimitTail(*account));
-  throw Error(std::string(what) + " would take " + state->memory.holder + " past " +
-              lua_host::MemoryLimitTail(state->memory));
+  if (state->heap->shared)  // the robot's account holds its data only (its heap is the state's)
+    throw Error(std::string(what) + " would take the data the sim.* calls keep for " + c.name +
+                " past " + std::to_string(account->limit() >> 20) +
+                " MiB (simulation.script_memory_mb; raise it if the data is real)");
+  throw Error(std::string(what) + " would take " + state->heap->memory.holder + " past " +
+              lua_host::MemoryLimitTail(state->heap->memory));
 }
 
 void CallCharge::Grow(uint64_t bytes) {

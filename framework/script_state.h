@@ -11,6 +11,8 @@
 #include <climits>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
+#include <mutex>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -98,6 +100,10 @@ struct LuaMemory {
 };
 inline constexpr size_t kMemorySlack = size_t{16} << 20;
 
+// Bytes of the generator behind math.random (Lua 5.4's xoshiro256**: 32);
+// checked against Lua's when a shared state is made.
+inline constexpr size_t kGeneratorBytes = 32;
+
 // A global named sysCall_* that no one calls (a typo, a CoppeliaSim-only
 // callback), found at load (script_hints.cc).
 struct UncalledSysCall {
@@ -106,12 +112,35 @@ struct UncalledSysCall {
   std::string warning;  // the line to log
 };
 
-// One lua_State and its scripts: a robot's, or the scene's.
-struct ScriptState {
+// A lua_State and its heap: one robot's, or several robots' when they
+// share a state (simulation.robots_per_lua_state), or the scene's. The
+// allocator's `ud`. Robots sharing a state run on one thread at a time
+// (`mutex`); `current` is the robot whose script runs or is being set up
+// (its context is the state's extra space then: SetContext).
+struct LuaHeap {
   lua_State* L = nullptr;
+  LuaMemory memory;
+  struct ScriptState* current = nullptr;
+  bool shared = false;  // several robots' (the mutex is taken)
+  std::mutex mutex;
+  // Shared states only: their account (the limit is the robots' limits
+  // together; memory.account points here), the name the memory errors give
+  // them ("the scripts of footbot#0 .. footbot#63"), and math.random's
+  // generator (a userdata: each robot's own is copied in while it runs).
+  ScriptMemory account;
+  std::string holder;
+  void* generator = nullptr;
+  bool may_finalize = false;     // a member's closing could run code (LuaContext::may_finalize)
+  bool leave_to_system = false;  // the process ends: not closed (LuaScriptHost::Stop)
+};
+
+// One robot's scripts (or the scene's), in a Lua state of their own or one
+// they share with other robots (`heap`).
+struct ScriptState {
+  std::shared_ptr<LuaHeap> heap = std::make_shared<LuaHeap>();
+  lua_State* L = nullptr;  // heap->L
   LuaContext context;
   std::vector<Script> scripts;  // hierarchy order
-  LuaMemory memory;
   // With a main script: the LuaScriptHost::main_steps_ of the step whose
   // sim.handleChildScripts resumed the threads (once a step).
   uint64_t threads_resumed_step = 0;
@@ -121,14 +150,20 @@ struct ScriptState {
   // Start only: sysCall_* names no one calls, for LuaScriptHost::Start to log
   // once per file and name.
   std::vector<UncalledSysCall> warnings;
+  // In a shared state: this robot's math.random generator, while another
+  // robot's is in the state (LuaHeap::generator).
+  alignas(8) unsigned char generator[kGeneratorBytes] = {};
 
   ScriptState() = default;
   ScriptState(const ScriptState&) = delete;
   ScriptState& operator=(const ScriptState&) = delete;
-  ~ScriptState() {
-    if (L != nullptr) lua_close(L);
-  }
+  // Releases the scripts' references; the last robot of a state closes it.
+  ~ScriptState();
 };
+
+// Makes `state` the robot its Lua state runs: its context in the state's
+// extra space, its math.random generator in the state (a shared state).
+void MakeCurrent(ScriptState& state);
 
 // The lua_State the host called or resumed for the running callback: the
 // script's thread, or the state's main thread.

@@ -405,8 +405,14 @@ void World::HandleDynamics() {
 void World::Control(ScriptPass pass) {
   RunPhaseCallbacks(Phase::kControl, PhaseEdge::kStart);
   const auto& instances = scene_.instances();
-  scheduler_->ParallelFor(0, static_cast<int64_t>(instances.size()), kRobotGrain,
-                          [&](int64_t begin, int64_t end) {
+  // Robots sharing a Lua state (robots_per_lua_state: n, robots r / n) run
+  // on one thread: the range is split between groups only.
+  const int64_t count = static_cast<int64_t>(instances.size());
+  const int64_t n = std::max(1, settings_.robots_per_lua_state);
+  scheduler_->ParallelFor(0, (count + n - 1) / n, std::max<int64_t>(1, kRobotGrain / n),
+                          [&](int64_t first_group, int64_t end_group) {
+                            const int64_t begin = first_group * n;
+                            const int64_t end = std::min(count, end_group * n);
                             for (int64_t r = begin; r < end; ++r) {
                               if (!instances[r].alive) continue;
                               try {

@@ -83,6 +83,13 @@ struct WorldSettings {
   // (framework/script_memory.h), before a script fails with an error (0: no
   // limit).
   int64_t script_memory_limit = int64_t{256} << 20;
+  // Robots whose scripts share one Lua state (1: a state each). Robots
+  // r / n share; each keeps its own environments, math.random generator,
+  // required modules and context, so well-behaved scripts give the same
+  // results as with a state each, in less memory (their compiled functions,
+  // libraries and sim table once per state). script_memory_limit then
+  // applies to a state as n times the limit.
+  int robots_per_lua_state = 1;
   // Bytes every script of the run may hold together (0: no limit): 20
   // robots x 256 MiB would otherwise be 5 GiB. Negative (the default): set
   // at Start, kDefaultRunScriptMemory or kRunScriptMemoryPerRobot a robot,

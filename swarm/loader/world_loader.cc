@@ -373,6 +373,7 @@ WorldSettings WorldLoader::ReadSimulation(const Fields& top, std::optional<int64
                                       "instruction_budget",
                                       "script_memory_mb",
                                       "run_script_memory_mb",
+                                      "robots_per_lua_state",
                                       "step_timeout",
                                       "on_script_error"};
     for (const std::string& name : registry_.DynamicsNames())
@@ -391,6 +392,9 @@ WorldSettings WorldLoader::ReadSimulation(const Fields& top, std::optional<int64
     if (f.Has("run_script_memory_mb"))
       s.run_script_memory_limit = values.Integer(f.Get("run_script_memory_mb"), 0, int64_t{1} << 30)
                                   << 20;
+    if (f.Has("robots_per_lua_state"))
+      s.robots_per_lua_state =
+          static_cast<int>(values.Integer(f.Get("robots_per_lua_state"), 1, 4096));
     if (f.Has("step_timeout"))
       s.step_timeout =
           values.Number(f.Get("step_timeout"), {"a non-negative number of seconds", 0, 1e9});

@@ -1,7 +1,10 @@
 #include "framework/script_host.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
+#include <filesystem>
+#include <fstream>
 #include <memory>
 #include <string>
 #include <vector>
@@ -393,6 +396,122 @@ TEST(ScriptHostTest, RangeMessageFromTheMainScriptIsAnError) {
   EXPECT_CONTAINS(ErrorOf([&] { w.world().Step(); }),
                   "main.lua:2: sim.sendRangeMessage: the main script has no position: use "
                   "sim.sendGlobalMessage or sim.sendDirectMessage");
+}
+
+// --- Robots sharing a Lua state (simulation.robots_per_lua_state) ----------------------
+
+// A temporary world folder holding the module `counter.lua`.
+class SharedStateTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() /
+           ("swarmsim_shared_state_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::create_directories(dir_);
+    std::ofstream(dir_ / "counter.lua")
+        << "local n = 0\nreturn {next = function() n = n + 1 return n end}\n";
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+
+  // `robots` robots running `code` for `steps` steps, `per_state` robots a
+  // Lua state, on `threads` threads: the log, then the state hash.
+  std::vector<std::string> Run(int robots, int per_state, int threads, const std::string& code,
+                               int steps = 4) {
+    WorldSettings settings;
+    settings.directory = dir_;
+    settings.robots_per_lua_state = per_state;
+    ScriptWorld w(threads, 7, settings);
+    for (int r = 0; r < robots; ++r) w.AddWheeledRobot("bot#" + std::to_string(r), code);
+    w.world().Start();
+    w.Steps(steps);
+    w.world().Stop();
+    w.log.push_back("hash " + std::to_string(w.world().StateHash()));
+    return w.log;
+  }
+
+  std::filesystem::path dir_;
+};
+
+// What a robot sees of its own: globals, math.random's stream, a module it
+// required, its threads and coroutines, its removal. Each robot's line
+// differs from its neighbours' (its own random numbers).
+constexpr char kOwnThings[] = R"(
+  local me = sim.getRobotIndex()
+  local counter = require('counter')
+  count = 0
+  function sysCall_actuation()
+    count = count + 1
+    local co = coroutine.wrap(function() coroutine.yield(math.random(1000000)) end)
+    print(me, count, counter.next(), math.random(1000000), co(), string.format('%.9f', sim.random()))
+    if me == 2 and count == 2 then sim.removeModel(sim.getObject(':')) end
+  end
+  function sysCall_thread()
+    while true do
+      print(me, 'thread', math.random(1000))
+      sim.step()
+    end
+  end
+  function sysCall_cleanup() print(me, 'cleanup', count) end
+)";
+
+TEST_F(SharedStateTest, RobotsSharingAStateSeeWhatAStateOfTheirOwnWouldShow) {
+  const std::vector<std::string> own = Run(10, 1, 1, kOwnThings);
+  ASSERT_EQ(own.size(), 10u * 4 * 2 - 4 + 10 + 1) << ::testing::PrintToString(own);
+  EXPECT_NE(own[0].substr(own[0].find('\t')), own[2].substr(own[2].find('\t')));
+  EXPECT_EQ(Run(10, 4, 1, kOwnThings), own);   // states of 4, 4 and 2 robots
+  EXPECT_EQ(Run(10, 3, 2, kOwnThings), own);   // on two threads
+  EXPECT_EQ(Run(10, 64, 2, kOwnThings), own);  // all in one
+}
+
+TEST_F(SharedStateTest, SharedStatesTakeAFractionOfTheMemory) {
+  const auto bytes = [&](int per_state) {
+    WorldSettings settings;
+    settings.directory = dir_;
+    settings.robots_per_lua_state = per_state;
+    ScriptWorld w(1, 7, settings);
+    for (int r = 0; r < 64; ++r) w.AddWheeledRobot("bot#" + std::to_string(r), kOwnThings);
+    w.world().Start();
+    w.Steps(1);
+    return w.world().script_memory_bytes();
+  };
+  const size_t own = bytes(1), shared = bytes(64);
+  EXPECT_LT(shared * 3, own) << own << " bytes with a state each, " << shared << " shared";
+}
+
+TEST_F(SharedStateTest, AnErrorNamesTheRobotWhoseScriptRaisedIt) {
+  WorldSettings settings;
+  settings.robots_per_lua_state = 8;
+  ScriptWorld w(2, 7, settings);
+  for (int r = 0; r < 8; ++r)
+    w.AddWheeledRobot("bot#" + std::to_string(r), R"(
+      function sysCall_actuation()
+        if sim.getRobotIndex() == 5 then error('boom') end
+      end)");
+  w.world().Start();
+  const std::string message = ErrorOf([&] { w.world().Step(); });
+  EXPECT_CONTAINS(message, "bot#5: scripts/robot.lua:3: boom");
+}
+
+TEST_F(SharedStateTest, TheMemoryLimitIsTheRobotsLimitsTogether) {
+  WorldSettings settings;
+  settings.robots_per_lua_state = 4;
+  settings.script_memory_limit = int64_t{1} << 20;  // 4 MiB for a state of 4
+  ScriptWorld w(1, 7, settings);
+  for (int r = 0; r < 4; ++r)
+    w.AddWheeledRobot("bot#" + std::to_string(r), R"(
+      local t = {}
+      function sysCall_actuation()
+        -- 2 MiB: past one robot's limit, within the state's
+        if sim.getRobotIndex() == 1 and #t == 0 then t[1] = string.rep('x', 2 << 20) end
+        -- then 6 MiB: past the state's
+        if sim.getRobotIndex() == 3 and sim.getSimulationTime() > 0 then t[1] = string.rep('y', 6 << 20) end
+      end)");
+  w.world().Start();
+  w.world().Step();
+  const std::string message = ErrorOf([&] { w.world().Step(); });
+  EXPECT_CONTAINS(message, "bot#3: scripts/robot.lua:");  // where the hook fired
+  EXPECT_CONTAINS(message, "the 4 robots sharing a Lua state with bot#0");
+  EXPECT_CONTAINS(message, "robots_per_lua_state");
 }
 
 TEST(ScriptHostTest, MemoryIsReportedAndReleasedAtStop) {

@@ -94,7 +94,7 @@ TEST(SweepCommandsTest, MaxMemoryIsEveryRunsCap) {
   const fs::path dir = TempDir("max_memory");
   const fs::path db = dir / "r.db", csv = dir / "runs.csv";
   Result r = RunProgram("sweep " + std::string(SWARMSIM_SOURCE_DIR) +
-                        "/worlds/diffusion.yaml --param robots=20000 --steps 1 --jobs 1 "
+                        "/worlds/diffusion.yaml --param robots=40000 --steps 1 --jobs 1 "
                         "--max-memory 400M --quiet --db " +
                         db.string());
   EXPECT_EQ(r.exit_code, 1) << r.output;
@@ -103,7 +103,7 @@ TEST(SweepCommandsTest, MaxMemoryIsEveryRunsCap) {
   const auto rows = Csv(csv);
   ASSERT_EQ(rows.size(), 2u);
   EXPECT_EQ(rows[1][3], "failed");
-  EXPECT_NE(r.output.find("not enough memory for 20,000 robot"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("not enough memory for 40,000 robot"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("(--max-memory 400 MiB)"), std::string::npos) << r.output;
   fs::remove_all(dir);
 }

@@ -91,6 +91,13 @@ TEST_F(ControlLoaderTest, SimulationControlKeys) {
   EXPECT_CONTAINS(w.world->settings().main_script->code, "sim.handleDynamics()");
   LoadedWorld d = Load("simulation: {physics: kinematic}\n");
   EXPECT_EQ(d.world->settings().on_script_error, ScriptErrorPolicy::kStop);
+  EXPECT_EQ(d.world->settings().robots_per_lua_state, 1);  // a state each unless asked
+  EXPECT_EQ(Load("simulation: {physics: kinematic, robots_per_lua_state: 64}\n")
+                .world->settings()
+                .robots_per_lua_state,
+            64);
+  EXPECT_CONTAINS(ErrorOf("simulation: {physics: kinematic, robots_per_lua_state: 0}\n"),
+                  "world.yaml:1:56:");
   EXPECT_FALSE(d.world->settings().main_script);
   EXPECT_CONTAINS(ErrorOf("simulation: {physics: kinematic, on_script_error: ignore}\n"),
                   "world.yaml:1:51:");
