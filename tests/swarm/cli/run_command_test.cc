@@ -269,14 +269,15 @@ bool NamesTheCap(const std::string& output, const std::string& cap, const std::s
 
 // A world that will not fit in memory is refused with a message while it is
 // built, not killed by the kernel: --max-memory stands in for a small
-// machine here. 20,000 Lua foot-bots take ~600 MiB; under 400 MiB the
+// machine here. 20,000 Lua foot-bots with a Lua state each take ~600 MiB;
+// under 400 MiB the
 // forecast stops their Lua states (or, in a build whose copies are bigger,
 // the copies), naming the cap, and summary.json says so.
 TEST(CliTest, AWorldThatWillNotFitIsRefusedWithAMessage) {
   const fs::path out = TempDir("max_memory");
   Result r = RunProgram("run " + std::string(SWARMSIM_SOURCE_DIR) +
-                        "/worlds/diffusion.yaml --set robots=20000 --steps 1 --quiet "
-                        "--max-memory 400M --out " +
+                        "/tests/data/worlds/lua_state_each.yaml --set robots=20000 --steps 1 "
+                        "--quiet --max-memory 400M --out " +
                         out.string());
   EXPECT_NE(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("not enough memory for 20,000 robot"), std::string::npos) << r.output;

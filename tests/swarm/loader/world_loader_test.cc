@@ -209,7 +209,7 @@ TEST(WorldLoaderTest, BadOverridesAreErrorsWithSuggestions) {
   const std::string type = ErrorOf([] { LoadDiffusion({{"robots", "many"}}); });
   EXPECT_NE(type.find("--set robots=many"), std::string::npos) << type;
   EXPECT_NE(type.find("is a number"), std::string::npos) << type;
-  EXPECT_NE(type.find("diffusion.yaml:13:11"), std::string::npos) << type;
+  EXPECT_NE(type.find("diffusion.yaml:14:11"), std::string::npos) << type;
   const std::string negative = ErrorOf([] { LoadDiffusion({{"robots", "-5"}}); });
   EXPECT_NE(negative.find("'size'"), std::string::npos) << negative;
 }
