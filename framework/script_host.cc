@@ -336,7 +336,7 @@ std::unique_ptr<ScriptState> NewState(World* world, int instance, RobotRuntime* 
   c.memory = &account;
   const lua_Integer seeds[2] = {static_cast<lua_Integer>(runtime->rng.NextU64()),
                                 static_cast<lua_Integer>(runtime->rng.NextU64())};
-  if (group != nullptr && *group != nullptr) {
+  if (group != nullptr && (*group)->L != nullptr) {
     // Joins the group's state: its own generator, seeded as its own state's.
     state->heap = *group;
     state->L = state->heap->L;
@@ -349,20 +349,9 @@ std::unique_ptr<ScriptState> NewState(World* world, int instance, RobotRuntime* 
       throw Error(c.name + ": cannot set up the Lua state: " + ErrorText(L, status));
     return state;
   }
+  if (group != nullptr) state->heap = *group;  // the shared state's, made by StartRobots
   LuaHeap& heap = *state->heap;
-  heap.memory.account = &account;
-  if (group != nullptr) {
-    const int robots = world->settings().robots_per_lua_state;
-    heap.shared = true;
-    heap.account.Attach(account.run(), account.limit() * static_cast<uint64_t>(robots));
-    heap.memory.account = &heap.account;
-    heap.holder = "the scripts of the " + std::to_string(robots) +
-                  " robots sharing a Lua state with " + c.name;
-    heap.memory.holder = heap.holder.c_str();
-    heap.memory.setting =
-        "simulation.script_memory_mb, times simulation.robots_per_lua_state for a state robots "
-        "share; raise it if the data is real";
-  }
+  if (!heap.shared) heap.memory.account = &account;
   lua_State* L = lua_newstate(LimitedAlloc, &heap);
   if (L == nullptr) throw Error(c.name + ": not enough memory for a Lua state");
   state->L = heap.L = L;
@@ -375,8 +364,34 @@ std::unique_ptr<ScriptState> NewState(World* world, int instance, RobotRuntime* 
   lua_pushlightuserdata(L, heap.shared ? &heap : nullptr);
   if (const int status = lua_pcall(L, 3, 0, 0); status != LUA_OK)
     throw Error(c.name + ": cannot set up the Lua state: " + ErrorText(L, status));
-  if (group != nullptr) *group = state->heap;
   return state;
+}
+
+// Has any of `slots` an enabled script (NewState makes a state for it)?
+bool HasScripts(const Scene& scene, const std::vector<uint32_t>& slots) {
+  return std::any_of(slots.begin(), slots.end(), [&](uint32_t slot) {
+    const ScriptAttachment* attachment = scene.script_at(slot);
+    return attachment != nullptr && attachment->enabled;
+  });
+}
+
+// The heap the robots `members` (two or more, with scripts) will share:
+// its memory limit is their limits together, and its errors name them.
+std::shared_ptr<LuaHeap> SharedHeap(World& world, const std::vector<int64_t>& members) {
+  auto heap = std::make_shared<LuaHeap>();
+  heap->shared = true;
+  ScriptMemory& first = world.script_memory(static_cast<int>(members.front()));
+  heap->account.Attach(first.run(), first.limit() * members.size());
+  heap->memory.account = &heap->account;
+  const Scene& scene = world.scene();
+  heap->holder = "the scripts of " + scene.instance(static_cast<int>(members.front())).name +
+                 " .. " + scene.instance(static_cast<int>(members.back())).name + " (" +
+                 std::to_string(members.size()) + " robots sharing a Lua state)";
+  heap->memory.holder = heap->holder.c_str();
+  heap->memory.setting =
+      "simulation.script_memory_mb, times the robots sharing the state "
+      "(simulation.robots_per_lua_state); raise it if the data is real";
+  return heap;
 }
 
 // The sources compiled in a state (registry references to their factories).
@@ -648,6 +663,14 @@ void LuaScriptHost::Start() {
   started_ = true;
   World& world = *world_;
   const Scene& scene = world.scene();
+  if (world.settings().trust_scripts && world.settings().robots_per_lua_state > 1 &&
+      world.robot_count() > 1)
+    world.Log(
+        "warning: --trust-scripts: every robot gets a Lua state of its own "
+        "(simulation.robots_per_lua_state " +
+        std::to_string(world.settings().robots_per_lua_state) +
+        " is not used: with the sandbox lifted, Lua's own require, load and package would "
+        "be shared by the robots of a state)");
   StartRobots(0);
   // Then the scene's scripts, on this thread.
   scene_ = NewState(&world, -1, &world.scene_runtime(), "scene", SceneObjectSlots(scene));
@@ -696,9 +719,11 @@ void LuaScriptHost::StartRobots(int first) {
   std::atomic<int64_t> started{0};
   std::string refusal;
   std::atomic<bool> refused{false};
-  // Robots r / n share a state (robots_per_lua_state: n), made by the first
-  // of them that has scripts; each state is built on one thread.
-  const int64_t n = world.settings().robots_per_lua_state;
+  // Robots r / n share a state (robots_per_lua_state: n), those of them
+  // that have scripts; each state is built on one thread. Not with the
+  // sandbox lifted: Lua's own require, load and package keep one copy per
+  // state, which robots would then share (Start says so).
+  const int64_t n = world.settings().trust_scripts ? 1 : world.settings().robots_per_lua_state;
   const auto start = [&](int64_t r, std::shared_ptr<LuaHeap>* group, Factories* factories) {
     const ModelInstance& instance = scene.instance(static_cast<int>(r));
     if (!instance.alive) return;
@@ -722,20 +747,31 @@ void LuaScriptHost::StartRobots(int first) {
       }
     });
   } else {
-    world.scheduler().ParallelFor(first / n, (robot_count + n - 1) / n, 1,
-                                  [&](int64_t begin, int64_t end) {
-                                    for (int64_t g = begin; g < end; ++g) {
-                                      std::shared_ptr<LuaHeap> group;
-                                      Factories factories;
-                                      for (int64_t r = std::max<int64_t>(first, g * n);
-                                           r < std::min<int64_t>(robot_count, (g + 1) * n); ++r) {
-                                        if (refused.load(std::memory_order_relaxed)) break;
-                                        start(r, &group, &factories);
-                                      }
-                                      if (group != nullptr && group->L != nullptr)
-                                        Settle(group->L, factories);
-                                    }
-                                  });
+    world.scheduler().ParallelFor(
+        first / n, (robot_count + n - 1) / n, 1, [&](int64_t begin, int64_t end) {
+          for (int64_t g = begin; g < end; ++g) {
+            std::vector<int64_t> members;
+            for (int64_t r = std::max<int64_t>(first, g * n);
+                 r < std::min<int64_t>(robot_count, (g + 1) * n); ++r) {
+              const ModelInstance& instance = scene.instance(static_cast<int>(r));
+              if (instance.alive && HasScripts(scene, instance.objects))
+                members.push_back(r);
+              else
+                start(r, nullptr, nullptr);  // no state: counted
+            }
+            if (members.size() < 2) {  // a state of its own
+              for (int64_t r : members) start(r, nullptr, nullptr);
+              continue;
+            }
+            std::shared_ptr<LuaHeap> group = SharedHeap(world, members);
+            Factories factories;
+            for (int64_t r : members) {
+              if (refused.load(std::memory_order_relaxed)) break;
+              start(r, &group, &factories);
+            }
+            if (group->L != nullptr) Settle(group->L, factories);
+          }
+        });
   }
   if (refused.load()) throw Error(refusal);
   for (const std::string& error : errors)

@@ -20,6 +20,9 @@ void PrintDescription(const LoadedWorld& w, std::ostream& out) {
   out << "world: " << s.file << "\n"
       << "physics: " << s.physics << ", time step " << s.time_step << " s, seed " << s.seed << "\n"
       << "main script: " << (s.main_script ? s.main_script->path : "(default step)") << "\n";
+  if (s.robots_per_lua_state > 1)
+    out << "Lua states: " << s.robots_per_lua_state
+        << " robots a state (simulation.robots_per_lua_state)\n";
   // The world's modules (framework/module.h), in the order they run within a phase.
   out << "modules:";
   for (const std::string& name : w.world->module_names()) out << " " << name;
@@ -38,6 +41,7 @@ void PrintDescription(const LoadedWorld& w, std::ostream& out) {
     out << "\nmodel " << m.name << " (" << m.file << "): " << m.count
         << (m.count == 1 ? " copy" : " copies");
     if (m.scale != 1) out << ", scale " << m.scale;
+    if (m.spatial_order) out << ", numbered along the region (order: spatial)";
     out << "\n";
     for (const std::string& line : m.imported) out << "  " << line << "\n";
     for (const std::string& script : m.scripts) out << "  script: " << script << "\n";

@@ -289,6 +289,7 @@ std::vector<ModelSummary> WorldLoader::Summarize() const {
     m.name = e.model->name;
     m.file = e.model->file.name();
     m.count = e.count;
+    m.spatial_order = e.spatial_order;
     const ValueReader defaults(e.model->file, &expressions_, {&parameters_, nullptr});
     for (const auto& decl : e.model->parameters) {
       ParameterSummary p;

@@ -88,7 +88,8 @@ struct ModelSummary {
   // Script files in tree order, each with the objects it is on, as paths
   // from the model root: "bot.lua on :, :/arm (explicit)".
   std::vector<std::string> scripts;
-  double scale = 1;  // `scale:` of the entry
+  double scale = 1;            // `scale:` of the entry
+  bool spatial_order = false;  // distribute: {order: spatial}: copies numbered along a curve
   // What the model's sections (framework/model_section.h) add to each
   // copy: "ik (2 IK groups)".
   std::vector<std::string> modules;

@@ -603,8 +603,12 @@ std::string PyWorld::describe() {
   out << "world: " << loaded_.file.string() << "\n";
   out << "physics: " << w.settings().physics << ", time step " << w.settings().time_step
       << " s, seed " << w.settings().seed << ", threads " << w.threads() << "\n";
+  if (w.settings().robots_per_lua_state > 1)
+    out << "Lua states: " << w.settings().robots_per_lua_state
+        << " robots a state (simulation.robots_per_lua_state)\n";
   for (const ModelSummary& m : loaded_.models) {
-    out << "model " << m.name << " (" << m.file << "), " << m.count << " copies\n";
+    out << "model " << m.name << " (" << m.file << "), " << m.count << " copies"
+        << (m.spatial_order ? ", numbered along the region (order: spatial)" : "") << "\n";
     for (const ParameterSummary& p : m.parameters)
       out << "  parameter " << p.name << " = " << p.value << (p.unit.empty() ? "" : " " + p.unit)
           << "\n";

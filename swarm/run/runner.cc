@@ -349,6 +349,9 @@ std::string WriteSummary(const World& world, const RunOptions& options, const Ru
   j["peak_rss_mb"] = result.peak_rss_mb;
   j["huge_pages"] = HugePagesRequested();
   j["lua_memory_kib"] = lua_kib;
+  // Robots a Lua state (simulation.robots_per_lua_state; 1 under --trust-scripts).
+  j["robots_per_lua_state"] =
+      world.settings().trust_scripts ? 1 : world.settings().robots_per_lua_state;
   j["state_hash"] = complete ? nlohmann::json(StateHasher::ToHex(result.state_hash)) : nullptr;
   if (complete) j["disabled_scripts"] = world.disabled_scripts();
   nlohmann::json phases;

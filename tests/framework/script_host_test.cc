@@ -510,8 +510,59 @@ TEST_F(SharedStateTest, TheMemoryLimitIsTheRobotsLimitsTogether) {
   w.world().Step();
   const std::string message = ErrorOf([&] { w.world().Step(); });
   EXPECT_CONTAINS(message, "bot#3: scripts/robot.lua:");  // where the hook fired
-  EXPECT_CONTAINS(message, "the 4 robots sharing a Lua state with bot#0");
+  EXPECT_CONTAINS(message,
+                  "the scripts of bot#0 .. bot#3 (4 robots sharing a Lua state) hold more "
+                  "than 4 MiB");
   EXPECT_CONTAINS(message, "robots_per_lua_state");
+}
+
+TEST_F(SharedStateTest, AStateOfFewerRobotsHasTheirLimitsOnly) {
+  WorldSettings settings;
+  settings.robots_per_lua_state = 4;
+  settings.script_memory_limit = int64_t{1} << 20;
+  ScriptWorld w(1, 7, settings);
+  // Robots 4 and 5 share the second state: 2 MiB between them.
+  for (int r = 0; r < 6; ++r)
+    w.AddWheeledRobot("bot#" + std::to_string(r), R"(
+      local t
+      function sysCall_actuation()
+        if sim.getRobotIndex() == 5 then t = string.rep('z', 3 << 20) end
+      end)");
+  w.world().Start();
+  const std::string message = ErrorOf([&] { w.world().Step(); });
+  EXPECT_CONTAINS(message, "bot#5: scripts/robot.lua:");
+  EXPECT_CONTAINS(message,
+                  "the scripts of bot#4 .. bot#5 (2 robots sharing a Lua state) hold more "
+                  "than 2 MiB");
+}
+
+// With the sandbox lifted, Lua's own load and require would be shared by the
+// robots of a state: each robot gets its own, and the run says so.
+TEST_F(SharedStateTest, TrustedScriptsGetAStateEach) {
+  const auto run = [&](int per_state) {
+    WorldSettings settings;
+    settings.robots_per_lua_state = per_state;
+    settings.trust_scripts = true;
+    settings.directory = dir_;
+    ScriptWorld w(1, 7, settings);
+    for (int r = 0; r < 4; ++r)
+      w.AddWheeledRobot("bot#" + std::to_string(r), R"(
+        function sysCall_actuation()
+          print(seen)
+          load('seen = "a neighbour"')()  -- the state's globals, unsandboxed
+        end)");
+    w.world().Start();
+    w.world().Step();
+    return w.log;
+  };
+  const std::vector<std::string> own = run(1);
+  ASSERT_EQ(own.size(), 4u);
+  EXPECT_EQ(own[1], "[bot#1] nil");
+  std::vector<std::string> asked = run(4);
+  ASSERT_EQ(asked.size(), 5u);
+  EXPECT_CONTAINS(asked[0], "warning: --trust-scripts: every robot gets a Lua state of its own");
+  asked.erase(asked.begin());
+  EXPECT_EQ(asked, own);
 }
 
 TEST(ScriptHostTest, MemoryIsReportedAndReleasedAtStop) {

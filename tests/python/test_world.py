@@ -145,6 +145,8 @@ class WorldTest(unittest.TestCase):
         self.assertIn("model footbot", text)
         self.assertIn("12 copies", text)
         self.assertRegex(text, r"\n  script: \S*scripts/diffusion.lua on :")
+        self.assertIn("12 copies, numbered along the region (order: spatial)", text)
+        self.assertIn("\nLua states: 64 robots a state (simulation.robots_per_lua_state)\n", text)
 
 
 class UrdfTest(unittest.TestCase):

@@ -50,6 +50,15 @@ TEST(CliTest, DescribeShowsTheWorldAsSetWithoutRunningIt) {
   EXPECT_NE(r.output.find("  footbot.wheel_noise = 0  (default 0)"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("  footbot.prox_noise = 0 m  (default 0)"), std::string::npos)
       << r.output;
+  // How its robots' scripts and numbers are laid out (ok.yaml says neither).
+  EXPECT_NE(r.output.find("\nLua states: 64 robots a state (simulation.robots_per_lua_state)\n"),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find(": 100 copies, numbered along the region (order: spatial)\n"),
+            std::string::npos)
+      << r.output;
+  EXPECT_EQ(RunProgram("describe " + ok).output.find("Lua states"), std::string::npos);
+  EXPECT_EQ(RunProgram("describe " + ok).output.find("numbered along"), std::string::npos);
   // Mistakes are the loader's, named at their place, with exit code 2.
   r = RunProgram("describe " + swarmsim::testing::CliData("typo.yaml"));
   EXPECT_EQ(r.exit_code, 2) << r.output;

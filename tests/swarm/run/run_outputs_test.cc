@@ -368,6 +368,7 @@ TEST(RunOutputsTest, FailedRunReportsItsLuaMemory) {
   const auto summary = nlohmann::json::parse(ReadFile(dir / "out" / "summary.json"));
   EXPECT_EQ(summary["status"], "error");
   EXPECT_GT(summary["lua_memory_kib"].get<double>(), 100) << "the 100 kB string at least";
+  EXPECT_EQ(summary["robots_per_lua_state"], 1);  // the world does not ask for sharing
   fs::remove_all(dir);
 }
 
