@@ -20,6 +20,7 @@ int ThrowOnPanic(lua_State* L) {
 LimitedLua::LimitedLua(const char* subject, size_t memory_limit, int64_t instruction_budget)
     : state_(std::make_unique<lua_host::ScriptState>()) {
   lua_host::ScriptState& state = *state_;
+  state.heap = std::make_shared<lua_host::LuaHeap>();
   LuaContext& c = state.context;
   c.name = subject;
   c.host_state = &state;

@@ -349,7 +349,8 @@ std::unique_ptr<ScriptState> NewState(World* world, int instance, RobotRuntime* 
       throw Error(c.name + ": cannot set up the Lua state: " + ErrorText(L, status));
     return state;
   }
-  if (group != nullptr) state->heap = *group;  // the shared state's, made by StartRobots
+  // A state of its own, or the first of a shared one (made by StartRobots).
+  state->heap = group != nullptr ? *group : std::make_shared<LuaHeap>();
   LuaHeap& heap = *state->heap;
   if (!heap.shared) heap.memory.account = &account;
   lua_State* L = lua_newstate(LimitedAlloc, &heap);

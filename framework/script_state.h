@@ -137,8 +137,8 @@ struct LuaHeap {
 // One robot's scripts (or the scene's), in a Lua state of their own or one
 // they share with other robots (`heap`).
 struct ScriptState {
-  std::shared_ptr<LuaHeap> heap = std::make_shared<LuaHeap>();
-  lua_State* L = nullptr;  // heap->L
+  std::shared_ptr<LuaHeap> heap;  // set with L (NewState, LimitedLua)
+  lua_State* L = nullptr;         // heap->L
   LuaContext context;
   std::vector<Script> scripts;  // hierarchy order
   // With a main script: the LuaScriptHost::main_steps_ of the step whose
