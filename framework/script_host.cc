@@ -60,6 +60,7 @@
 #include "framework/scene.h"
 #include "framework/scheduler.h"
 #include "framework/script_calls.h"
+#include "framework/script_chunks.h"
 #include "framework/script_hints.h"
 #include "framework/script_hooks.h"
 #include "framework/script_state.h"
@@ -124,19 +125,25 @@ void Call(ScriptState& state, Script& script, int nargs, const char* what) {
   lua_settop(L, handler - 1);
 }
 
-// Protected part of creating a state. Arguments: two integers seeding
-// math.random, and for a state robots share, its LuaHeap (light userdata),
-// whose generator it notes.
-int SetUpState(lua_State* L) {
-  OpenSandbox(L);
-  RegisterAllApis(L);
-  // Lua's own math.random, reproducible per robot.
+// Seeds math.random, reproducibly per robot: a robot's own state's, or its
+// generator in a shared state (MakeCurrent). Arguments: two integers.
+int SeedRandom(lua_State* L) {
   lua_getglobal(L, LUA_MATHLIBNAME);
   lua_getfield(L, -1, "randomseed");
   lua_pushvalue(L, 1);
   lua_pushvalue(L, 2);
   lua_call(L, 2, 0);
   lua_pop(L, 1);
+  return 0;
+}
+
+// Protected part of creating a state. Arguments: two integers seeding
+// math.random, and for a state robots share, its LuaHeap (light userdata),
+// whose generator it notes.
+int SetUpState(lua_State* L) {
+  OpenSandbox(L);
+  RegisterAllApis(L);
+  SeedRandom(L);
   // Script environments read what they do not define from the shared globals.
   lua_createtable(L, 0, 1);
   lua_pushglobaltable(L);
@@ -150,117 +157,6 @@ int SetUpState(lua_State* L) {
                         static_cast<int>(bytes));
   }
   return 0;
-}
-
-// Seeds math.random of a robot joining a shared state (its generator is in
-// the state: MakeCurrent). Arguments: two integers.
-int SeedRandom(lua_State* L) {
-  lua_getglobal(L, LUA_MATHLIBNAME);
-  lua_getfield(L, -1, "randomseed");
-  lua_pushvalue(L, 1);
-  lua_pushvalue(L, 2);
-  lua_call(L, 2, 0);
-  return 0;
-}
-
-// Feeds lua_load the wrapped source without copying it.
-struct ChunkPieces {
-  std::string_view pieces[3];
-  int next = 0;
-};
-const char* ReadPieces(lua_State*, void* data, size_t* size) {
-  auto* chunk = static_cast<ChunkPieces*>(data);
-  while (chunk->next < 3 && chunk->pieces[chunk->next].empty()) ++chunk->next;
-  if (chunk->next == 3) {
-    *size = 0;
-    return nullptr;
-  }
-  const std::string_view piece = chunk->pieces[chunk->next++];
-  *size = piece.size();
-  return piece.data();
-}
-
-// Each distinct script source compiled once for every state: the bytecode
-// of its factory chunk (lua_dump, debug information kept, so messages name
-// the same file and lines), loaded by the other states without parsing.
-// Filled by whichever state compiles a source first; shared by the threads
-// that start robots. Two threads may compile a source at the same time
-// before either has added it: the first one added is kept, and a reader
-// holds its bytecode (shared) while it loads, so no Add changes the bytes
-// under it.
-class CompiledChunks {
- public:
-  // The bytecode of `source`'s factory, or null when none is kept yet.
-  std::shared_ptr<const std::string> Find(const ScriptSource& source) {
-    const std::lock_guard lock(mutex_);
-    const auto it = chunks_.find(&source);
-    // A source at an address a freed one had is another source: compare.
-    if (it == chunks_.end() || it->second.path != source.path || it->second.code != source.code)
-      return nullptr;
-    return it->second.bytecode;
-  }
-  void Add(const ScriptSource& source, std::string bytecode) {
-    const std::lock_guard lock(mutex_);
-    Entry& entry = chunks_[&source];
-    if (entry.bytecode && entry.path == source.path && entry.code == source.code) return;
-    entry.path = source.path;
-    entry.code = source.code;
-    entry.bytecode = std::make_shared<const std::string>(std::move(bytecode));
-  }
-
- private:
-  struct Entry {
-    std::string path, code;
-    std::shared_ptr<const std::string> bytecode;
-  };
-  std::mutex mutex_;
-  std::unordered_map<const ScriptSource*, Entry> chunks_;
-};
-
-int AppendBytes(lua_State*, const void* bytes, size_t size, void* out) {
-  static_cast<std::string*>(out)->append(static_cast<const char*>(bytes), size);
-  return 0;
-}
-
-// Compiles `source` into a function(_ENV, ...) running its code, left on
-// the stack. The prefix shares the first line, so line numbers in messages
-// are the file's own. Returns "" or the compiler's message (for a broken
-// source, the message of compiling it as it is, so that it reads naturally).
-// With `chunks`, a source compiled before (by any state) is loaded from its
-// bytecode, and one compiled here is added.
-std::string CompileFactory(lua_State* L, const ScriptSource& source,
-                           CompiledChunks* chunks = nullptr) {
-  const std::string chunkname = "@" + (source.path.empty() ? std::string("?") : source.path);
-  if (const std::shared_ptr<const std::string> bytecode = chunks ? chunks->Find(source) : nullptr) {
-    int status = luaL_loadbufferx(L, bytecode->data(), bytecode->size(), chunkname.c_str(), "b");
-    if (status == LUA_OK) status = lua_pcall(L, 0, 1, 0);
-    if (status == LUA_OK) return "";
-    lua_pop(L, 1);  // out of memory: compile the text below, which reports it
-  }
-  ChunkPieces chunk{{"return function(_ENV, ...) ", source.code, "\nend"}};
-  int status = lua_load(L, ReadPieces, &chunk, chunkname.c_str(), "t");
-  std::string bytecode;
-  if (status == LUA_OK && chunks != nullptr) lua_dump(L, AppendBytes, &bytecode, 0);
-  if (status == LUA_OK) status = lua_pcall(L, 0, 1, 0);
-  if (status == LUA_OK && lua_isfunction(L, -1)) {
-    // The function must end at our own 'end': a source like "end, function()"
-    // would otherwise close it early and compile into something else.
-    lua_Debug ar;
-    lua_pushvalue(L, -1);
-    lua_getinfo(L, ">S", &ar);
-    const int last_line =
-        2 + static_cast<int>(std::count(source.code.begin(), source.code.end(), '\n'));
-    if (ar.linedefined == 1 && ar.lastlinedefined == last_line) {
-      if (chunks != nullptr && !bytecode.empty()) chunks->Add(source, std::move(bytecode));
-      return "";
-    }
-  }
-  std::string message = status == LUA_OK ? std::string() : ErrorText(L, status);
-  lua_pop(L, 1);
-  status = luaL_loadbufferx(L, source.code.data(), source.code.size(), chunkname.c_str(), "t");
-  if (status != LUA_OK) message = ErrorText(L, status);
-  lua_pop(L, 1);
-  return message.empty() ? chunkname.substr(1) + ": the script does not compile" : message;
 }
 
 // A registry reference to the callback `name` the script defines (not one
@@ -496,6 +392,7 @@ void ResumeThread(ScriptState* state, Script& script) {
   const CallInProgress in_progress(*state, kCallbackNames[kThread]);
   MakeCurrent(*state);
   SetCurrent(*state, script);
+  SetContext(co, &c);  // its robot's, whoever resumed it last (CheckedCall)
   c.thread = co;
   c.budget_exhausted = false;
   c.data_collected = false;

@@ -536,6 +536,32 @@ TEST_F(SharedStateTest, AStateOfFewerRobotsHasTheirLimitsOnly) {
                   "than 2 MiB");
 }
 
+// A coroutine one robot hands another through a library table (the one
+// thing robots of a state share) runs as the robot resuming it, also once
+// its maker is gone.
+TEST_F(SharedStateTest, ACoroutineRunsAsTheRobotResumingIt) {
+  WorldSettings settings;
+  settings.robots_per_lua_state = 2;
+  ScriptWorld w(1, 7, settings);
+  for (int r = 0; r < 2; ++r)
+    w.AddWheeledRobot("bot#" + std::to_string(r), R"(
+      local me = sim.getRobotIndex()
+      function sysCall_init()
+        if me == 0 then
+          string.shared = coroutine.wrap(function()
+            while true do print('in the coroutine', sim.getRobotIndex()) coroutine.yield() end
+          end)
+        end
+      end
+      function sysCall_actuation()
+        if me == 0 then sim.removeModel(sim.getObject(':')) else string.shared() end
+      end)");
+  w.world().Start();
+  w.Steps(3);
+  const std::vector<std::string> expected(3, "[bot#1] in the coroutine\t1");
+  EXPECT_EQ(w.log, expected);
+}
+
 // With the sandbox lifted, Lua's own load and require would be shared by the
 // robots of a state: each robot gets its own, and the run says so.
 TEST_F(SharedStateTest, TrustedScriptsGetAStateEach) {
