@@ -58,6 +58,9 @@ class MemoryForecast {
   // once). At a checkpoint, reads the memory and returns the error text
   // when the rest will not fit; "" otherwise.
   std::string Built(int64_t built);
+  // Built measures only when `built` is a multiple of this (0: never): a
+  // caller building items in batches ends a batch there.
+  int64_t stride() const { return stride_; }
 
   // Before the items are built: `bytes` of memory reserved for all of them
   // that building them will touch (a loader's arrays for every copy, about

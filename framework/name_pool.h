@@ -43,8 +43,11 @@ class NamePool {
     const auto it = ids_.find(name);
     return it == ids_.end() ? kNone : it->second;
   }
-  // One more reference to the name `id` (a copy of an object).
-  void Retain(uint32_t id) { ++refs_[id]; }
+  // `times` more references to the name `id` (copies of an object).
+  void Retain(uint32_t id, uint32_t times = 1) { refs_[id] += times; }
+  // Room for `more` distinct names without rehashing (a loader about to
+  // name a million copies model#k).
+  void Reserve(size_t more) { ids_.reserve(ids_.size() + more); }
   // One fewer; the string goes with its last reference.
   void Release(uint32_t id) {
     if (--refs_[id] > 0) return;

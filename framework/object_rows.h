@@ -37,6 +37,14 @@ class RowTable {
   // whose row index is now `row`, or kNoOwner when `row` was the last.
   virtual uint32_t SwapRemove(uint32_t row) = 0;
   virtual void Reserve(size_t rows) = 0;
+  // `n` default rows at the end (owners kNoOwner), for CopyInto to fill: a
+  // bulk copy's rows (Scene::DuplicateSubtrees), written on several threads.
+  virtual void Grow(size_t n) = 0;
+  // Row `row`, a default row Grow added, becomes a copy of row `source`
+  // through `copy(source, row)` (or the whole row when `copy` is null), owned
+  // by `owner`. Different rows may be written so on different threads.
+  virtual void CopyInto(uint32_t source, uint32_t row, uint32_t owner,
+                        void (*copy)(const void* source, void* row)) = 0;
   virtual void* At(uint32_t row) = 0;
   // The rows' reserved room past the last row: its start and bytes.
   virtual std::pair<const void*, size_t> Spare() const = 0;
@@ -79,6 +87,18 @@ class Rows final : public RowTable {
   void Reserve(size_t n) override {
     rows.reserve(n);
     owners.reserve(n);
+  }
+  void Grow(size_t n) override {
+    rows.resize(rows.size() + n);
+    owners.resize(owners.size() + n, kNoOwner);
+  }
+  void CopyInto(uint32_t source, uint32_t row, uint32_t owner,
+                void (*copy)(const void* source, void* row)) override {
+    if (copy != nullptr)
+      copy(&rows[source], &rows[row]);
+    else
+      rows[row] = rows[source];
+    owners[row] = owner;
   }
   void* At(uint32_t row) override { return &rows[row]; }
   std::pair<const void*, size_t> Spare() const override {

@@ -40,6 +40,7 @@ class ScriptMemory;
 class StateHasher;
 class StateReader;
 class StateWriter;
+class TaskScheduler;
 struct ObjectTypeDescriptor;
 
 // The name of a built-in type ("joint"); Scene::type_name names registered
@@ -297,6 +298,15 @@ class Scene {
   // (in its new parent's frame) as part of the copy: the same as
   // SetWorldPose after it for a new root, without computing the poses twice.
   ObjectId DuplicateSubtree(ObjectId root, ObjectId new_parent, const Pose* X_PO = nullptr);
+  // X_WR.size() copies of the subtree at `root`, each a new root placed at
+  // X_WR[i] (world frame): the same slots, rows, names, scripts, robots and
+  // listener calls as DuplicateSubtree(root, {}, &X_WR[i]) for each i in
+  // turn, with the copies' columns and rows (types without a copy rule)
+  // written on `scheduler`'s threads. Copies one at a time where the
+  // sources hold what only that path handles (custom data, dummy links) or
+  // freed slots would be reused. Returns the copies' roots, in order.
+  std::vector<ObjectId> DuplicateSubtrees(ObjectId root, std::span<const Pose> X_WR,
+                                          TaskScheduler& scheduler);
   void SetParent(ObjectId id, ObjectId new_parent, bool keep_world_pose);
   // Listeners are told of duplications and removals; not owned.
   void AddListener(SceneListener* listener) { listeners_.push_back(listener); }

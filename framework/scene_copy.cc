@@ -2,6 +2,7 @@
 // copy rule, scripts, model marks and dummy links) and the size factor
 // (each type's scale rule). scene.cc has the rest of the scene.
 #include <algorithm>
+#include <functional>
 #include <span>
 #include <utility>
 #include <vector>
@@ -10,6 +11,7 @@
 #include "framework/object_type.h"
 #include "framework/prefault.h"
 #include "framework/scene.h"
+#include "framework/scheduler.h"
 #include "framework/script_memory.h"
 
 namespace swarmsim {
@@ -75,6 +77,8 @@ void Scene::ReserveForCopies(ObjectId root, size_t copies, Prefault* prefault) {
       tables_[t]->Reserve(tables_[t]->size() + rows_of_type[t] * copies);
   scripts_.reserve(scripts_.size() + scripts * copies);
   instances_.reserve(instances_.size() + copies);
+  // Room for a name of its own per copy (a loader names each copy model#k).
+  names_.Reserve(copies);
   if (prefault == nullptr) return;
   for (auto* v : {&X_PO_, &X_WO_}) prefault->AddSpare(*v);
   prefault->AddSpare(motions_);
@@ -159,6 +163,168 @@ ObjectId Scene::DuplicateSubtree(ObjectId root, ObjectId new_parent, const Pose*
   }
   for (SceneListener* l : listeners_) l->OnSubtreeDuplicated(*this, sources, copies);
   return IdAt(copy_root);
+}
+
+std::vector<ObjectId> Scene::DuplicateSubtrees(ObjectId root, std::span<const Pose> X_WR,
+                                               TaskScheduler& scheduler) {
+  std::vector<ObjectId> roots;
+  roots.reserve(X_WR.size());
+  const uint32_t root_slot = SlotOf(root);
+  std::vector<uint32_t> sources;
+  CollectSubtree(root_slot, &sources);
+  bool bulk = X_WR.size() > 1 && free_slots_.empty() && free_motions_.empty();
+  for (size_t i = 0; bulk && i < sources.size(); ++i)
+    bulk = !custom_data_.contains(sources[i]) && !linked_dummy_.contains(sources[i]);
+  if (!bulk) {
+    for (const Pose& X : X_WR) roots.push_back(DuplicateSubtree(root, {}, &X));
+    return roots;
+  }
+  // Where each source's copy goes, as DuplicateSubtree would put it: the
+  // copies' slots follow one another, copy after copy in the sources'
+  // (pre-)order, and so do each table's rows, the motions and the scripts.
+  const size_t k = sources.size(), n = X_WR.size();
+  std::vector<std::pair<uint32_t, uint32_t>> index_of(k);  // (source slot, index)
+  for (uint32_t i = 0; i < k; ++i) index_of[i] = {sources[i], i};
+  std::sort(index_of.begin(), index_of.end());
+  const auto index = [&index_of](int32_t slot) -> int32_t {  // -1: none
+    if (slot < 0) return -1;
+    const auto it = std::lower_bound(index_of.begin(), index_of.end(),
+                                     std::pair<uint32_t, uint32_t>{uint32_t(slot), 0});
+    return static_cast<int32_t>(it->second);  // inside: a source's relatives are sources
+  };
+  struct Source {
+    int32_t parent, first_child, last_child, next_sibling, prev_sibling;  // indices, -1 none
+    uint32_t rank = 0;         // among the sources of its type with a table
+    uint32_t motion = 0;       // among the sources with a motion
+    int32_t script = -1;       // among the sources with a script attached
+    bool serial_copy = false;  // a type whose copy rule runs on this thread
+  };
+  std::vector<Source> src(k);
+  std::vector<uint32_t> rows_of_type(types_.size(), 0);
+  uint32_t motions = 0, scripted = 0;
+  for (size_t i = 0; i < k; ++i) {
+    const uint32_t s = sources[i];
+    Source& o = src[i];
+    o.parent = i == 0 ? -1 : index(parent_[s]);
+    o.first_child = index(first_child_[s]);
+    o.last_child = index(last_child_[s]);
+    o.next_sibling = i == 0 ? -1 : index(next_sibling_[s]);
+    o.prev_sibling = i == 0 ? -1 : index(prev_sibling_[s]);
+    const size_t t = static_cast<size_t>(type_[s]);
+    if (tables_[t]) {
+      o.rank = rows_of_type[t]++;
+      o.serial_copy = types_[t]->copy_row != nullptr;
+    }
+    if (type_[s] == ObjectType::kShape) o.motion = motions++;
+    if (script_[s] >= 0 && scripts_[script_[s]].source) o.script = static_cast<int32_t>(scripted++);
+  }
+  const uint32_t slot_base = slot_count();
+  const size_t motion_base = motions_.size(), script_base = scripts_.size();
+  std::vector<uint32_t> row_base(types_.size(), 0);
+  for (size_t t = 0; t < types_.size(); ++t)
+    if (tables_[t]) row_base[t] = static_cast<uint32_t>(tables_[t]->size());
+  const int src_instance = instance_[root_slot];
+  const bool robots =
+      model_root_[root_slot] && src_instance >= 0 && instances_[src_instance].root == root;
+  const int instance_base = static_cast<int>(instances_.size());
+  // The arrays grow first (each on a thread: growing writes every new
+  // element), then every copy is written on some thread.
+  const size_t slots = slot_base + n * k;
+  std::vector<std::function<void()>> grow = {
+      [&] { X_PO_.resize(slots); }, [&] { X_WO_.resize(slots); },
+      [&] {
+        motion_.resize(slots);
+        motions_.resize(motion_base + n * motions);
+        for (auto* v : {&parent_, &first_child_, &last_child_, &next_sibling_, &prev_sibling_,
+                        &instance_, &script_})
+          v->resize(slots);
+        type_.resize(slots);
+        for (auto* v : {&row_, &generation_, &name_}) v->resize(slots);
+        for (auto* v : {&simulated_, &alive_, &model_root_}) v->resize(slots);
+        scripts_.resize(script_base + n * scripted);
+      }};
+  for (size_t t = 0; t < types_.size(); ++t)
+    if (tables_[t] && rows_of_type[t] > 0)
+      grow.push_back([&, t] { tables_[t]->Grow(n * rows_of_type[t]); });
+  scheduler.ParallelFor(0, static_cast<int64_t>(grow.size()), 1, [&](int64_t b, int64_t e) {
+    for (int64_t g = b; g < e; ++g) grow[static_cast<size_t>(g)]();
+  });
+  const auto copy_slot = [&](size_t c, int32_t i) -> int32_t {
+    return i < 0 ? -1 : static_cast<int32_t>(slot_base + c * k + static_cast<size_t>(i));
+  };
+  scheduler.ParallelFor(0, static_cast<int64_t>(n), 64, [&](int64_t b, int64_t e) {
+    for (size_t c = static_cast<size_t>(b); c < static_cast<size_t>(e); ++c)
+      for (size_t i = 0; i < k; ++i) {
+        const uint32_t s = sources[i];
+        const Source& o = src[i];
+        const uint32_t slot = static_cast<uint32_t>(copy_slot(c, static_cast<int32_t>(i)));
+        const size_t t = static_cast<size_t>(type_[s]);
+        type_[slot] = type_[s];
+        name_[slot] = name_[s];
+        generation_[slot] = 0;
+        alive_[slot] = 1;
+        simulated_[slot] = 0;
+        model_root_[slot] = model_root_[s];
+        instance_[slot] = robots ? instance_base + static_cast<int>(c) : -1;
+        parent_[slot] = copy_slot(c, o.parent);
+        first_child_[slot] = copy_slot(c, o.first_child);
+        last_child_[slot] = copy_slot(c, o.last_child);
+        next_sibling_[slot] = copy_slot(c, o.next_sibling);
+        prev_sibling_[slot] = copy_slot(c, o.prev_sibling);
+        if (type_[s] == ObjectType::kShape) {
+          const size_t m = motion_base + c * motions + o.motion;
+          motion_[slot] = static_cast<uint32_t>(m);
+          motions_[m] = motion_[s] != kNoMotion ? motions_[motion_[s]] : Motion{};
+        } else {
+          motion_[slot] = kNoMotion;
+        }
+        row_[slot] = 0;
+        if (tables_[t]) {
+          row_[slot] = row_base[t] + static_cast<uint32_t>(c * rows_of_type[t] + o.rank);
+          if (!o.serial_copy) tables_[t]->CopyInto(row_[s], row_[slot], slot, nullptr);
+        }
+        script_[slot] = -1;
+        if (o.script >= 0) {
+          const size_t a = script_base + c * scripted + static_cast<size_t>(o.script);
+          script_[slot] = static_cast<int32_t>(a);
+          scripts_[a] = scripts_[script_[s]];
+        }
+        X_PO_[slot] = i == 0 ? X_WR[c] : X_PO_[s];
+        // Parents first (pre-order), a joint's row before its children.
+        X_WO_[slot] = o.parent < 0 ? X_PO_[slot]
+                                   : ChildFrameAt(static_cast<uint32_t>(copy_slot(c, o.parent))) *
+                                         X_PO_[slot];
+      }
+  });
+  // On this thread, in DuplicateSubtree's order: the copy rules, the size
+  // factors, the names' references, the robots, the listeners.
+  for (size_t c = 0; c < n; ++c)
+    for (size_t i = 0; i < k; ++i) {
+      const uint32_t s = sources[i], slot = static_cast<uint32_t>(copy_slot(c, int32_t(i)));
+      if (src[i].serial_copy) {
+        const size_t t = static_cast<size_t>(type_[s]);
+        tables_[t]->CopyInto(row_[s], row_[slot], slot, types_[t]->copy_row);
+      }
+      if (const auto f = size_factor_.find(s); f != size_factor_.end())
+        size_factor_[slot] = f->second;
+    }
+  for (uint32_t s : sources) names_.Retain(name_[s], static_cast<uint32_t>(n));
+  object_count_ += n * k;
+  structure_version_ += n * k;
+  order_dirty_ = true;
+  std::vector<uint32_t> copies(k);
+  for (size_t c = 0; c < n; ++c) {
+    const uint32_t copy_root = static_cast<uint32_t>(copy_slot(c, 0));
+    for (size_t i = 0; i < k; ++i) copies[i] = copy_root + static_cast<uint32_t>(i);
+    if (robots) {
+      const std::string& model_name = instances_[src_instance].model_name;
+      instances_.push_back({model_name + "#" + std::to_string(instances_.size()), model_name,
+                            IdAt(copy_root), true, copies});
+    }
+    for (SceneListener* l : listeners_) l->OnSubtreeDuplicated(*this, sources, copies);
+    roots.push_back(IdAt(copy_root));
+  }
+  return roots;
 }
 
 // --- Size factor ---------------------------------------------------------------------

@@ -228,34 +228,62 @@ void WorldLoader::BuildCopies(World* world) {
       return std::pair(root, instance);
     };
     ObjectId first;  // the entry's first copy built from its own description
-    for (size_t k = 0; k < poses.size(); ++k) {
-      if (options_.check_stop && k % 256 == 0) options_.check_stop();
-      if (options_.copy_progress && built % 256 == 0) options_.copy_progress(built, total);
-      if (std::string refusal = forecast.Built(built); !refusal.empty()) throw Error(refusal);
-      ++built;
-      const EntryPlan::OwnCopy* own = e.FindOwnCopy(static_cast<int64_t>(k));
-      // The root's pose in the model frame (scaled with the copy).
+    // The root's pose in the model frame (scaled with the copy).
+    const auto root_pose = [&](size_t k) {
       Pose X_MR = e.SpecOf(static_cast<int64_t>(k)).X_PO;
       X_MR.p = X_MR.p * e.scale;
-      const Pose X_WR = poses[k] * X_MR;
-      ObjectId root;
-      int instance;
-      if (own && own->spec) {
-        std::tie(root, instance) = build(*own->spec, own->sections, std::nullopt);
-        scene.SetWorldPose(root, X_WR);
-      } else if (first.IsNull()) {
-        std::tie(root, instance) = build(e.spec, e.sections, duplicates - 1);
-        scene.SetWorldPose(root, X_WR);
-        first = root;
-      } else {
-        root = scene.DuplicateSubtree(first, {}, &X_WR);  // a new root: placed at X_WR
-        instance = scene.instance_of(root);
-      }
+      return poses[k] * X_MR;
+    };
+    // What each copy gets once it exists: its name, values and controller.
+    const auto finish = [&](ObjectId root, int instance, const EntryPlan::OwnCopy* own) {
       scene.set_name(root, scene.instance(instance).name);
       copy_instances_.push_back(instance);
       world->SetInstanceParameters(instance, own ? own->parameters : e.parameters);
       if (e.native != nullptr)
         world->SetNativeController(instance, e.native, e.native_replaces_scripts);
+    };
+    std::vector<Pose> batch;
+    for (size_t k = 0; k < poses.size();) {
+      if (options_.check_stop && built % 256 == 0) options_.check_stop();
+      if (options_.copy_progress && built % 256 == 0) options_.copy_progress(built, total);
+      if (std::string refusal = forecast.Built(built); !refusal.empty()) throw Error(refusal);
+      const EntryPlan::OwnCopy* own = e.FindOwnCopy(static_cast<int64_t>(k));
+      if ((own && own->spec) || first.IsNull()) {
+        ++built;
+        ObjectId root;
+        int instance;
+        if (own && own->spec) {
+          std::tie(root, instance) = build(*own->spec, own->sections, std::nullopt);
+        } else {
+          std::tie(root, instance) = build(e.spec, e.sections, duplicates - 1);
+          first = root;
+        }
+        scene.SetWorldPose(root, root_pose(k));
+        finish(root, instance, own);
+        ++k;
+        continue;
+      }
+      // Duplicates of the first copy, built together (on every thread) up to
+      // the next copy of its own, progress report or memory checkpoint.
+      size_t end = k + 1;
+      const auto stop_at = [&](int64_t b) {
+        const int64_t stride = forecast.stride();
+        return b % 256 == 0 || (stride > 0 && b % stride == 0);
+      };
+      while (end < poses.size() && !stop_at(built + static_cast<int64_t>(end - k))) {
+        const EntryPlan::OwnCopy* next = e.FindOwnCopy(static_cast<int64_t>(end));
+        if (next && next->spec) break;
+        ++end;
+      }
+      batch.clear();
+      for (size_t j = k; j < end; ++j) batch.push_back(root_pose(j));
+      const std::vector<ObjectId> roots = scene.DuplicateSubtrees(first, batch, world->scheduler());
+      for (size_t j = k; j < end; ++j) {
+        const ObjectId root = roots[j - k];
+        finish(root, scene.instance_of(root), e.FindOwnCopy(static_cast<int64_t>(j)));
+      }
+      built += static_cast<int64_t>(end - k);
+      k = end;
     }
   }
   if (options_.copy_progress) options_.copy_progress(built, total);

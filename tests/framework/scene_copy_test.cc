@@ -4,10 +4,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <memory>
+#include <vector>
 
 #include "framework/error.h"
 #include "framework/scene.h"
+#include "framework/scheduler.h"
+#include "framework/state_hash.h"
 #include "modules/proximity/proximity_sensor.h"
 
 namespace swarmsim {
@@ -67,6 +71,125 @@ TEST(SceneTest, DuplicatingAModelCopiesObjectsScriptsAndRemapsReferences) {
   EXPECT_FALSE(scene.instance(1).alive);
   EXPECT_FALSE(scene.IsValid(copy_tip));
   EXPECT_EQ(scene.linked_dummy(tip), target);
+}
+
+// A robot: a shape with a velocity, a turned joint carrying a dummy (its
+// world pose goes through the joint), a proximity sensor (settings shared
+// between copies), a script, a size factor; made a model instance.
+struct Robot {
+  Scene scene;
+  ObjectId root;
+  std::vector<std::pair<std::vector<uint32_t>, std::vector<uint32_t>>> heard;  // listener calls
+
+  Robot() {
+    ShapeData body;
+    body.kind = ShapeKind::kCylinder;
+    body.dynamic = true;
+    root = scene.AddShape("body", {}, {{1, 0, 0}, Quat::FromYaw(0.2)}, body);
+    JointData motor;
+    motor.position = 0.7;
+    const ObjectId joint = scene.AddJoint("motor", root, {{0, 0.1, 0}, Quat::FromYaw(1)}, motor);
+    scene.AddDummy("tip", joint, {{0.05, 0, 0.01}, {}});
+    ShapeData wheel;
+    wheel.kind = ShapeKind::kCylinder;
+    scene.AddShape("wheel", joint, {{0, 0, -0.02}, {}}, wheel);
+    ProximitySensorData sensor;
+    sensor.settings.Edit().range = 0.1;
+    sensor.distance = 0.04;
+    proximity::AddSensor(&scene, "eye", root, {{0, 0.05, 0}, {}}, sensor);
+    scene.AttachScript(root, std::make_shared<ScriptSource>(ScriptSource{"ctl.lua", "-- code"}));
+    scene.ScaleSubtree(root, 1.5);
+    scene.SetSimulatedState(scene.SlotOf(root), scene.world_pose(root), {0.5, 0, 0}, {0, 0, 2});
+    scene.MakeModelInstance(root, "bot", "bot#0");
+    scene.AddListener(&listener);
+  }
+  struct Listener : SceneListener {
+    Robot* robot;
+    explicit Listener(Robot* r) : robot(r) {}
+    void OnSubtreeDuplicated(const Scene&, std::span<const uint32_t> sources,
+                             std::span<const uint32_t> copies) override {
+      robot->heard.emplace_back(std::vector<uint32_t>(sources.begin(), sources.end()),
+                                std::vector<uint32_t>(copies.begin(), copies.end()));
+    }
+    void OnSubtreeRemoved(const Scene&, std::span<const uint32_t>) override {}
+  } listener{this};
+};
+
+uint64_t Structure(const Scene& scene) {
+  StateHasher hasher;
+  scene.AddStructure(&hasher);
+  return hasher.Digest();
+}
+
+// Copies made together on two threads are the copies made one by one: the
+// same slots, handles, names, rows, poses (bit for bit), scripts, size
+// factors, robots and listener calls.
+TEST(SceneTest, CopiesMadeTogetherAreTheCopiesMadeOneByOne) {
+  Robot one, together;
+  std::vector<Pose> poses;
+  for (int i = 0; i < 300; ++i)
+    poses.push_back({{0.3 * i, -0.1 * i, 0.02}, Quat::FromYaw(0.01 * i)});
+  std::vector<ObjectId> roots_one;
+  for (const Pose& X : poses) roots_one.push_back(one.scene.DuplicateSubtree(one.root, {}, &X));
+  TaskScheduler scheduler(2);
+  const std::vector<ObjectId> roots =
+      together.scene.DuplicateSubtrees(together.root, poses, scheduler);
+  EXPECT_EQ(roots, roots_one);
+  const Scene& a = one.scene;
+  const Scene& b = together.scene;
+  ASSERT_EQ(b.slot_count(), a.slot_count());
+  EXPECT_EQ(b.object_count(), a.object_count());
+  EXPECT_EQ(Structure(b), Structure(a));
+  for (uint32_t s = 0; s < a.slot_count(); ++s) {
+    SCOPED_TRACE(s);
+    ASSERT_EQ(b.IdAt(s), a.IdAt(s));
+    EXPECT_EQ(b.name_at(s), a.name_at(s));
+    EXPECT_EQ(b.parent(b.IdAt(s)), a.parent(a.IdAt(s)));
+    EXPECT_EQ(b.children(b.IdAt(s)), a.children(a.IdAt(s)));
+    EXPECT_EQ(b.type_at(s), a.type_at(s));
+    EXPECT_EQ(b.instance_of_at(s), a.instance_of_at(s));
+    EXPECT_EQ(b.size_factor_at(s), a.size_factor_at(s));
+    const Pose& pa = a.world_pose_at(s);
+    const Pose& pb = b.world_pose_at(s);
+    EXPECT_EQ(std::memcmp(&pa, &pb, sizeof(Pose)), 0) << b.PathOf(b.IdAt(s));
+    EXPECT_EQ(b.linear_velocity_at(s).x, a.linear_velocity_at(s).x);
+    EXPECT_EQ(b.script_at(s) != nullptr, a.script_at(s) != nullptr);
+    if (b.script_at(s)) {  // the source's script, shared (an asset)
+      EXPECT_EQ(b.script_at(s)->source, b.script(together.root)->source);
+    }
+  }
+  ASSERT_EQ(b.instances().size(), 301u);
+  for (size_t i = 0; i < b.instances().size(); ++i) {
+    EXPECT_EQ(b.instance(static_cast<int>(i)).name, a.instance(static_cast<int>(i)).name);
+    EXPECT_EQ(b.instance(static_cast<int>(i)).objects, a.instance(static_cast<int>(i)).objects);
+  }
+  const ObjectId last = roots.back();
+  EXPECT_EQ(b.instance(b.instance_of(last)).name, "bot#300");
+  EXPECT_DOUBLE_EQ(b.joint(b.FindObject("./motor", last)).position, 0.7);
+  EXPECT_DOUBLE_EQ(proximity::Sensor(b, b.FindObject("./eye", last)).distance, 0.04 * 1.5);
+  EXPECT_TRUE(
+      proximity::Sensor(b, b.FindObject("./eye", last))
+          .settings.SameAs(proximity::Sensor(b, b.FindObject("./eye", together.root)).settings));
+  EXPECT_EQ(together.heard, one.heard);
+  ASSERT_EQ(together.heard.size(), 300u);
+}
+
+// A source the copies together do not handle (a dummy link remapped per
+// copy) is copied one by one, with the same result.
+TEST(SceneTest, CopiesTogetherOfALinkedModelAreMadeOneByOne) {
+  Robot one, together;
+  for (Robot* r : {&one, &together})
+    r->scene.LinkDummies(r->scene.FindObject("./motor/tip", r->root),
+                         r->scene.AddDummy("target", r->root, {}));
+  const std::vector<Pose> poses(5, Pose{{2, 0, 0}, {}});
+  for (const Pose& X : poses) one.scene.DuplicateSubtree(one.root, {}, &X);
+  TaskScheduler scheduler(2);
+  const std::vector<ObjectId> roots =
+      together.scene.DuplicateSubtrees(together.root, poses, scheduler);
+  EXPECT_EQ(Structure(together.scene), Structure(one.scene));
+  const Scene& b = together.scene;
+  EXPECT_EQ(b.linked_dummy(b.FindObject("./motor/tip", roots[4])),
+            b.FindObject("./target", roots[4]));
 }
 
 // Velocities are kept for shapes only (the bodies backends simulate), and a

@@ -107,7 +107,19 @@ void PlanarWorld::Build(const Scene& scene) {
   wheels_.clear();
   wheeled_.clear();
   obstacles_.clear();
-  // 1. A body per dynamic shape, in slot order: circle or rectangle.
+  // 1. A body per dynamic shape, in slot order: circle or rectangle. Room
+  // for every shape (a robot's wheels are shapes too): reserved, never
+  // touched, it costs no memory, where growing would copy a million bodies
+  // into fresh pages the kernel zeroes again and again.
+  const size_t shape_count = scene.rows(ObjectType::kShape)->size();
+  const size_t joint_count = scene.rows(ObjectType::kJoint)->size();
+  shapes_.reserve(shape_count);
+  bound_.reserve(shape_count);
+  inner_.reserve(shape_count);
+  inverse_mass_.reserve(shape_count);
+  cold_.reserve(shape_count);
+  wheels_.reserve(joint_count);
+  wheeled_.reserve(shape_count);
   std::vector<int32_t> body_of(scene.slot_count(), -1);
   HeightRange dynamic_range{std::numeric_limits<double>::infinity(),
                             -std::numeric_limits<double>::infinity()};
@@ -186,6 +198,8 @@ void PlanarWorld::Build(const Scene& scene) {
   // 3. Wheels, grouped by body; each body's least-squares rolling solve.
   std::vector<std::pair<uint32_t, dynamics::PlaneWheelGeometry>> found;
   std::vector<uint32_t> joint_of;
+  found.reserve(joint_count);
+  joint_of.reserve(joint_count);
   dynamics::ForEachPlaneWheel(
       scene, body_of, [&](uint32_t b) { return cold_[b].slot; },
       [&](uint32_t joint_slot, const JointData& /*joint*/, uint32_t body,
