@@ -15,10 +15,37 @@
 #include "framework/script_memory.h"
 
 namespace swarmsim {
+namespace {
+
+// A copy's sources by slot: the index of a source (where its copy goes) from
+// its slot, through a sorted list (a robot's ~30 objects: no hash table per
+// copy).
+class SourceIndex {
+ public:
+  explicit SourceIndex(std::span<const uint32_t> sources) : by_slot_(sources.size()) {
+    for (uint32_t i = 0; i < sources.size(); ++i) by_slot_[i] = {sources[i], i};
+    std::sort(by_slot_.begin(), by_slot_.end());
+  }
+  // The index of the source at `slot`; -1 for no slot (-1) or one outside.
+  int32_t operator()(int64_t slot) const {
+    if (slot < 0) return -1;
+    const auto it = std::lower_bound(by_slot_.begin(), by_slot_.end(),
+                                     std::pair<uint32_t, uint32_t>{uint32_t(slot), 0});
+    return it != by_slot_.end() && it->first == slot ? static_cast<int32_t>(it->second) : -1;
+  }
+
+ private:
+  std::vector<std::pair<uint32_t, uint32_t>> by_slot_;  // (slot, index)
+};
+
+}  // namespace
 
 // --- Duplication ----------------------------------------------------------------------
 
 uint32_t Scene::CopyObject(uint32_t src, int32_t new_parent, const Pose& X_PO) {
+  // DuplicateSubtrees writes what this and AllocateSlotNamed write, for a
+  // batch of copies at once: a column added here goes there too
+  // (SceneTest.CopiesMadeTogetherAreTheCopiesMadeOneByOne compares them).
   // The copy's row from the source's, through the type's copy rule. The
   // pose is a copy: AllocateSlot may grow (and move) the arrays.
   const ObjectType type = type_[src];
@@ -121,21 +148,12 @@ ObjectId Scene::DuplicateSubtree(ObjectId root, ObjectId new_parent, const Pose*
                 std::to_string(charged >> 20) + " MiB) would take the run's scripts past " +
                 std::to_string(run->limit() >> 20) + " MiB (simulation.run_script_memory_mb)");
   // Pre-order guarantees a parent is copied before its children. The
-  // copies sit by the sources' order; a source's index is found by its slot
-  // in a sorted list (a robot's ~30 objects: no hash table per copy).
-  std::vector<std::pair<uint32_t, uint32_t>> index_of(sources.size());  // (source slot, index)
-  for (uint32_t i = 0; i < sources.size(); ++i) index_of[i] = {sources[i], i};
-  std::sort(index_of.begin(), index_of.end());
-  const auto find = [&index_of](uint32_t slot) -> const std::pair<uint32_t, uint32_t>* {
-    const auto it =
-        std::lower_bound(index_of.begin(), index_of.end(), std::pair<uint32_t, uint32_t>{slot, 0});
-    return it != index_of.end() && it->first == slot ? &*it : nullptr;
-  };
+  // copies sit by the sources' order.
+  const SourceIndex index(sources);
   std::vector<uint32_t> copies(sources.size());
   for (size_t i = 0; i < sources.size(); ++i) {
     const uint32_t src = sources[i];
-    const int32_t p =
-        i == 0 ? parent_slot : static_cast<int32_t>(copies[find(parent_[src])->second]);
+    const int32_t p = i == 0 ? parent_slot : static_cast<int32_t>(copies[index(parent_[src])]);
     const Pose pose = i == 0 && X_PO != nullptr ? *X_PO : X_PO_[src];
     copies[i] = CopyObject(src, p, pose);
   }
@@ -146,8 +164,8 @@ ObjectId Scene::DuplicateSubtree(ObjectId root, ObjectId new_parent, const Pose*
       const auto linked = linked_dummy_.find(sources[i]);
       if (linked == linked_dummy_.end()) continue;
       const uint32_t link = linked->second;
-      const auto* inside = find(link);
-      linked_dummy_[copies[i]] = inside != nullptr ? copies[inside->second] : link;
+      const int32_t inside = index(link);
+      linked_dummy_[copies[i]] = inside >= 0 ? copies[inside] : link;
     }
   // The copies' world poses are in place: each was computed as it was made
   // (AllocateSlotNamed), parents first, from its parent's copy as it is now
@@ -183,15 +201,7 @@ std::vector<ObjectId> Scene::DuplicateSubtrees(ObjectId root, std::span<const Po
   // copies' slots follow one another, copy after copy in the sources'
   // (pre-)order, and so do each table's rows, the motions and the scripts.
   const size_t k = sources.size(), n = X_WR.size();
-  std::vector<std::pair<uint32_t, uint32_t>> index_of(k);  // (source slot, index)
-  for (uint32_t i = 0; i < k; ++i) index_of[i] = {sources[i], i};
-  std::sort(index_of.begin(), index_of.end());
-  const auto index = [&index_of](int32_t slot) -> int32_t {  // -1: none
-    if (slot < 0) return -1;
-    const auto it = std::lower_bound(index_of.begin(), index_of.end(),
-                                     std::pair<uint32_t, uint32_t>{uint32_t(slot), 0});
-    return static_cast<int32_t>(it->second);  // inside: a source's relatives are sources
-  };
+  const SourceIndex index(sources);  // a source's relatives are sources
   struct Source {
     int32_t parent, first_child, last_child, next_sibling, prev_sibling;  // indices, -1 none
     uint32_t rank = 0;         // among the sources of its type with a table
@@ -297,7 +307,8 @@ std::vector<ObjectId> Scene::DuplicateSubtrees(ObjectId root, std::span<const Po
       }
   });
   // On this thread, in DuplicateSubtree's order: the copy rules, the size
-  // factors, the names' references, the robots, the listeners.
+  // factors, the names' references, the robots, the listeners (told of
+  // each copy in turn once the whole batch exists).
   for (size_t c = 0; c < n; ++c)
     for (size_t i = 0; i < k; ++i) {
       const uint32_t s = sources[i], slot = static_cast<uint32_t>(copy_slot(c, int32_t(i)));

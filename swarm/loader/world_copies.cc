@@ -242,6 +242,11 @@ void WorldLoader::BuildCopies(World* world) {
       if (e.native != nullptr)
         world->SetNativeController(instance, e.native, e.native_replaces_scripts);
     };
+    // Where a batch of duplicates ends: a count the progress or the memory
+    // forecast looks at.
+    const auto stop_at = [&forecast](int64_t b) {
+      return b % 256 == 0 || (forecast.stride() > 0 && b % forecast.stride() == 0);
+    };
     std::vector<Pose> batch;
     for (size_t k = 0; k < poses.size();) {
       if (options_.check_stop && built % 256 == 0) options_.check_stop();
@@ -266,10 +271,6 @@ void WorldLoader::BuildCopies(World* world) {
       // Duplicates of the first copy, built together (on every thread) up to
       // the next copy of its own, progress report or memory checkpoint.
       size_t end = k + 1;
-      const auto stop_at = [&](int64_t b) {
-        const int64_t stride = forecast.stride();
-        return b % 256 == 0 || (stride > 0 && b % stride == 0);
-      };
       while (end < poses.size() && !stop_at(built + static_cast<int64_t>(end - k))) {
         const EntryPlan::OwnCopy* next = e.FindOwnCopy(static_cast<int64_t>(end));
         if (next && next->spec) break;

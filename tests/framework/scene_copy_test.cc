@@ -80,6 +80,7 @@ struct Robot {
   Scene scene;
   ObjectId root;
   std::vector<std::pair<std::vector<uint32_t>, std::vector<uint32_t>>> heard;  // listener calls
+  std::vector<size_t> objects_then;  // the scene's objects at each call
 
   Robot() {
     ShapeData body;
@@ -106,8 +107,9 @@ struct Robot {
   struct Listener : SceneListener {
     Robot* robot;
     explicit Listener(Robot* r) : robot(r) {}
-    void OnSubtreeDuplicated(const Scene&, std::span<const uint32_t> sources,
+    void OnSubtreeDuplicated(const Scene& scene, std::span<const uint32_t> sources,
                              std::span<const uint32_t> copies) override {
+      robot->objects_then.push_back(scene.object_count());
       robot->heard.emplace_back(std::vector<uint32_t>(sources.begin(), sources.end()),
                                 std::vector<uint32_t>(copies.begin(), copies.end()));
     }
@@ -172,6 +174,10 @@ TEST(SceneTest, CopiesMadeTogetherAreTheCopiesMadeOneByOne) {
           .settings.SameAs(proximity::Sensor(b, b.FindObject("./eye", together.root)).settings));
   EXPECT_EQ(together.heard, one.heard);
   ASSERT_EQ(together.heard.size(), 300u);
+  // Made together indeed (not one by one, which the rest would not tell):
+  // the listeners heard of the first copy once all were there.
+  EXPECT_EQ(together.objects_then.front(), b.object_count());
+  EXPECT_LT(one.objects_then.front(), a.object_count());
 }
 
 // A source the copies together do not handle (a dummy link remapped per
@@ -190,6 +196,7 @@ TEST(SceneTest, CopiesTogetherOfALinkedModelAreMadeOneByOne) {
   const Scene& b = together.scene;
   EXPECT_EQ(b.linked_dummy(b.FindObject("./motor/tip", roots[4])),
             b.FindObject("./target", roots[4]));
+  EXPECT_EQ(together.objects_then, one.objects_then);  // one by one: told as each was made
 }
 
 // Velocities are kept for shapes only (the bodies backends simulate), and a

@@ -413,15 +413,24 @@ class SharedStateTest : public ::testing::Test {
   }
   void TearDown() override { std::filesystem::remove_all(dir_); }
 
+  // `per_state` robots a Lua state; the scripts' modules in dir_.
+  WorldSettings Sharing(int per_state) const {
+    WorldSettings settings;
+    settings.directory = dir_;
+    settings.robots_per_lua_state = per_state;
+    return settings;
+  }
+  // Robots bot#0 .. bot#n-1, each running `code`.
+  static void AddRobots(ScriptWorld* w, int n, const std::string& code) {
+    for (int r = 0; r < n; ++r) w->AddWheeledRobot("bot#" + std::to_string(r), code);
+  }
+
   // `robots` robots running `code` for `steps` steps, `per_state` robots a
   // Lua state, on `threads` threads: the log, then the state hash.
   std::vector<std::string> Run(int robots, int per_state, int threads, const std::string& code,
                                int steps = 4) {
-    WorldSettings settings;
-    settings.directory = dir_;
-    settings.robots_per_lua_state = per_state;
-    ScriptWorld w(threads, 7, settings);
-    for (int r = 0; r < robots; ++r) w.AddWheeledRobot("bot#" + std::to_string(r), code);
+    ScriptWorld w(threads, 7, Sharing(per_state));
+    AddRobots(&w, robots, code);
     w.world().Start();
     w.Steps(steps);
     w.world().Stop();
@@ -465,11 +474,8 @@ TEST_F(SharedStateTest, RobotsSharingAStateSeeWhatAStateOfTheirOwnWouldShow) {
 
 TEST_F(SharedStateTest, SharedStatesTakeAFractionOfTheMemory) {
   const auto bytes = [&](int per_state) {
-    WorldSettings settings;
-    settings.directory = dir_;
-    settings.robots_per_lua_state = per_state;
-    ScriptWorld w(1, 7, settings);
-    for (int r = 0; r < 64; ++r) w.AddWheeledRobot("bot#" + std::to_string(r), kOwnThings);
+    ScriptWorld w(1, 7, Sharing(per_state));
+    AddRobots(&w, 64, kOwnThings);
     w.world().Start();
     w.Steps(1);
     return w.world().script_memory_bytes();
@@ -479,11 +485,8 @@ TEST_F(SharedStateTest, SharedStatesTakeAFractionOfTheMemory) {
 }
 
 TEST_F(SharedStateTest, AnErrorNamesTheRobotWhoseScriptRaisedIt) {
-  WorldSettings settings;
-  settings.robots_per_lua_state = 8;
-  ScriptWorld w(2, 7, settings);
-  for (int r = 0; r < 8; ++r)
-    w.AddWheeledRobot("bot#" + std::to_string(r), R"(
+  ScriptWorld w(2, 7, Sharing(8));
+  AddRobots(&w, 8, R"(
       function sysCall_actuation()
         if sim.getRobotIndex() == 5 then error('boom') end
       end)");
@@ -493,12 +496,10 @@ TEST_F(SharedStateTest, AnErrorNamesTheRobotWhoseScriptRaisedIt) {
 }
 
 TEST_F(SharedStateTest, TheMemoryLimitIsTheRobotsLimitsTogether) {
-  WorldSettings settings;
-  settings.robots_per_lua_state = 4;
+  WorldSettings settings = Sharing(4);
   settings.script_memory_limit = int64_t{1} << 20;  // 4 MiB for a state of 4
   ScriptWorld w(1, 7, settings);
-  for (int r = 0; r < 4; ++r)
-    w.AddWheeledRobot("bot#" + std::to_string(r), R"(
+  AddRobots(&w, 4, R"(
       local t = {}
       function sysCall_actuation()
         -- 2 MiB: past one robot's limit, within the state's
@@ -517,13 +518,11 @@ TEST_F(SharedStateTest, TheMemoryLimitIsTheRobotsLimitsTogether) {
 }
 
 TEST_F(SharedStateTest, AStateOfFewerRobotsHasTheirLimitsOnly) {
-  WorldSettings settings;
-  settings.robots_per_lua_state = 4;
+  WorldSettings settings = Sharing(4);
   settings.script_memory_limit = int64_t{1} << 20;
   ScriptWorld w(1, 7, settings);
   // Robots 4 and 5 share the second state: 2 MiB between them.
-  for (int r = 0; r < 6; ++r)
-    w.AddWheeledRobot("bot#" + std::to_string(r), R"(
+  AddRobots(&w, 6, R"(
       local t
       function sysCall_actuation()
         if sim.getRobotIndex() == 5 then t = string.rep('z', 3 << 20) end
@@ -540,11 +539,8 @@ TEST_F(SharedStateTest, AStateOfFewerRobotsHasTheirLimitsOnly) {
 // thing robots of a state share) runs as the robot resuming it, also once
 // its maker is gone.
 TEST_F(SharedStateTest, ACoroutineRunsAsTheRobotResumingIt) {
-  WorldSettings settings;
-  settings.robots_per_lua_state = 2;
-  ScriptWorld w(1, 7, settings);
-  for (int r = 0; r < 2; ++r)
-    w.AddWheeledRobot("bot#" + std::to_string(r), R"(
+  ScriptWorld w(1, 7, Sharing(2));
+  AddRobots(&w, 2, R"(
       local me = sim.getRobotIndex()
       function sysCall_init()
         if me == 0 then
@@ -566,13 +562,10 @@ TEST_F(SharedStateTest, ACoroutineRunsAsTheRobotResumingIt) {
 // robots of a state: each robot gets its own, and the run says so.
 TEST_F(SharedStateTest, TrustedScriptsGetAStateEach) {
   const auto run = [&](int per_state) {
-    WorldSettings settings;
-    settings.robots_per_lua_state = per_state;
+    WorldSettings settings = Sharing(per_state);
     settings.trust_scripts = true;
-    settings.directory = dir_;
     ScriptWorld w(1, 7, settings);
-    for (int r = 0; r < 4; ++r)
-      w.AddWheeledRobot("bot#" + std::to_string(r), R"(
+    AddRobots(&w, 4, R"(
         function sysCall_actuation()
           print(seen)
           load('seen = "a neighbour"')()  -- the state's globals, unsandboxed
