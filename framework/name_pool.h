@@ -43,6 +43,11 @@ class NamePool {
     const auto it = ids_.find(name);
     return it == ids_.end() ? kNone : it->second;
   }
+  // Whether the name `id` is `name` (an id remembered from an earlier Find
+  // still names it).
+  bool Holds(uint32_t id, std::string_view name) const {
+    return id < strings_.size() && refs_[id] > 0 && strings_[id] == name;
+  }
   // `times` more references to the name `id` (copies of an object).
   void Retain(uint32_t id, uint32_t times = 1) { refs_[id] += times; }
   // Room for `more` distinct names without rehashing (a loader about to

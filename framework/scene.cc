@@ -1,6 +1,7 @@
 #include "framework/scene.h"
 
 #include <algorithm>
+#include <array>
 #include <charconv>
 #include <unordered_map>
 
@@ -654,6 +655,34 @@ void SplitPath(std::string_view path, std::string_view full, std::vector<PathEle
 
 }  // namespace
 
+namespace {
+
+// names.Find(name), remembering this thread's last few answers: a swarm's
+// scripts and controllers look up the same few names ("prox", "leftMotor")
+// once per robot at start, and in a pool holding a million robots' own
+// names each lookup is a cache miss in its table. A remembered id is used
+// only while the pool still holds it under that name (pools of other
+// scenes, renames, removals).
+uint32_t FindNameRemembered(const NamePool& names, std::string_view name) {
+  struct Remembered {
+    std::string name;
+    uint32_t id = NamePool::kNone;
+  };
+  thread_local std::array<Remembered, 8> remembered;
+  thread_local size_t next = 0;
+  for (const Remembered& r : remembered)
+    if (r.id != NamePool::kNone && r.name == name && names.Holds(r.id, name)) return r.id;
+  const uint32_t id = names.Find(name);
+  if (id != NamePool::kNone) {
+    remembered[next].name.assign(name);
+    remembered[next].id = id;
+    next = (next + 1) % remembered.size();
+  }
+  return id;
+}
+
+}  // namespace
+
 ObjectId Scene::FindObject(std::string_view path, ObjectId from) const {
   const std::string_view full = path;
   int32_t scope = -1;  // the subtree root whose descendants are searched
@@ -687,7 +716,7 @@ ObjectId Scene::FindObject(std::string_view path, ObjectId from) const {
   SplitPath(path, full, &elements);
   if (elements.empty()) return scope < 0 ? ObjectId{} : IdAt(static_cast<uint32_t>(scope));
   for (PathElement& e : elements) {
-    e.id = names_.Find(e.name);
+    e.id = FindNameRemembered(names_, e.name);
     if (e.id == NamePool::kNone) return {};
   }
 

@@ -13,6 +13,7 @@
 #include "framework/scene.h"
 #include "framework/scheduler.h"
 #include "framework/script_memory.h"
+#include "framework/shared_settings.h"
 
 namespace swarmsim {
 namespace {
@@ -263,6 +264,10 @@ std::vector<ObjectId> Scene::DuplicateSubtrees(ObjectId root, std::span<const Po
     return i < 0 ? -1 : static_cast<int32_t>(slot_base + c * k + static_cast<size_t>(i));
   };
   scheduler.ParallelFor(0, static_cast<int64_t>(n), 64, [&](int64_t b, int64_t e) {
+    // The copies' settings references, added once per task: the sources
+    // hold theirs throughout, and rows without a copy rule are plain copies
+    // into default rows (nothing released, nothing edited).
+    const CountCopiesLocally count_locally;
     for (size_t c = static_cast<size_t>(b); c < static_cast<size_t>(e); ++c)
       for (size_t i = 0; i < k; ++i) {
         const uint32_t s = sources[i];

@@ -12,6 +12,12 @@
 // Phase code reads settings through operator-> (const). The state hash reads
 // state only. Thread safety: rows of different robots may Edit() at the same
 // time (the reference count is atomic); one row is edited by one thread.
+//
+// Bulk copies (a million robots' rows written on every thread) would make
+// every thread increment the same few reference counts, one cache line
+// passed between cores per row. Inside a CountCopiesLocally scope, a
+// thread's copies count their references in the scope and add them once
+// when it ends.
 #pragma once
 
 #include <atomic>
@@ -21,6 +27,51 @@
 #include <utility>
 
 namespace swarmsim {
+
+namespace shared_detail {
+// The references copies on this thread have taken inside CountCopiesLocally
+// scopes and not yet added: a few blocks' counts (a robot's rows share a
+// handful of settings).
+struct LocalCounts {
+  static constexpr int kBlocks = 8;
+  std::atomic<uint32_t>* refs[kBlocks];
+  uint32_t count[kBlocks];
+  int used = 0;
+  int depth = 0;  // scopes open on this thread
+
+  // Counts one reference to `r` here; false when the table is full (the
+  // caller adds it at once).
+  bool Count(std::atomic<uint32_t>* r) {
+    for (int i = 0; i < used; ++i)
+      if (refs[i] == r) return ++count[i], true;
+    if (used == kBlocks) return false;
+    refs[used] = r;
+    count[used++] = 1;
+    return true;
+  }
+  void AddAll() {
+    for (int i = 0; i < used; ++i) refs[i]->fetch_add(count[i], std::memory_order_relaxed);
+    used = 0;
+  }
+};
+inline thread_local LocalCounts local_counts;
+}  // namespace shared_detail
+
+// While one is open on a thread, Shared copies made on that thread add
+// their references when it closes, not one by one. Only around copies of
+// rows that stay alive through the scope and that nothing releases or
+// Edit()s in it (their counts are short until it closes): Scene's bulk row
+// copies.
+class CountCopiesLocally {
+ public:
+  CountCopiesLocally() { ++shared_detail::local_counts.depth; }
+  ~CountCopiesLocally() {
+    shared_detail::LocalCounts& local = shared_detail::local_counts;
+    if (--local.depth == 0) local.AddAll();
+  }
+  CountCopiesLocally(const CountCopiesLocally&) = delete;
+  CountCopiesLocally& operator=(const CountCopiesLocally&) = delete;
+};
 
 template <class S>
 class Shared {
@@ -71,7 +122,10 @@ class Shared {
     S settings;
   };
   void Retain() noexcept {
-    if (block_ != nullptr) block_->refs.fetch_add(1, std::memory_order_relaxed);
+    if (block_ == nullptr) return;
+    shared_detail::LocalCounts& local = shared_detail::local_counts;
+    if (local.depth > 0 && local.Count(&block_->refs)) return;
+    block_->refs.fetch_add(1, std::memory_order_relaxed);
   }
   void Release() noexcept {
     if (block_ != nullptr && block_->refs.fetch_sub(1, std::memory_order_acq_rel) == 1)

@@ -46,6 +46,19 @@ bool IsFinite(const Pose& X) {
          std::isfinite(X.q.z);
 }
 
+// Every object's world pose from its parent's: each robot's subtree on its
+// own worker, then the scene's objects (all in one pass when some robot hangs
+// from another or from a scene object).
+void UpdateWorldPoses(Scene* scene, TaskScheduler& scheduler) {
+  if (!scene->InstancesAreIndependent()) return scene->UpdateWorldPoses();
+  const int64_t n = static_cast<int64_t>(scene->instances().size());
+  scheduler.ParallelFor(0, n, kRobotGrain, [&](int64_t begin, int64_t end) {
+    for (int64_t r = begin; r < end; ++r)
+      if (scene->instances()[r].alive) scene->UpdateWorldPoses(static_cast<int>(r));
+  });
+  scene->UpdateSceneObjectPoses();
+}
+
 }  // namespace
 
 const char* ToString(Phase phase) {
@@ -279,7 +292,7 @@ void World::SetInstanceParameters(int instance, SharedParameters parameters) {
 void World::Start() {
   if (started_) return;
   EnsureRuntimes();
-  scene_.UpdateWorldPoses();
+  UpdateWorldPoses(&scene_, *scheduler_);
   dynamics_ = registry_.MakeDynamics(settings_.physics);
   DynamicsSettings dynamics_settings;
   dynamics_settings.gravity = settings_.gravity;
@@ -599,18 +612,8 @@ void World::Physics() {
                   settings_.physics_substeps);
   // Joints that follow a master the dynamics moved, before their children's poses.
   dependent_joints_.Apply(&scene_, false);
-  // Objects carried by the simulated bodies follow them: each robot's
-  // subtree on its own worker, then the scene's objects.
-  if (scene_.InstancesAreIndependent()) {
-    const int64_t n = static_cast<int64_t>(scene_.instances().size());
-    scheduler_->ParallelFor(0, n, kRobotGrain, [&](int64_t begin, int64_t end) {
-      for (int64_t r = begin; r < end; ++r)
-        if (scene_.instances()[r].alive) scene_.UpdateWorldPoses(static_cast<int>(r));
-    });
-    scene_.UpdateSceneObjectPoses();
-  } else {
-    scene_.UpdateWorldPoses();
-  }
+  // Objects carried by the simulated bodies follow them.
+  UpdateWorldPoses(&scene_, *scheduler_);
   ++step_count_;
   time_ = static_cast<double>(step_count_) * settings_.time_step;
   // NaNs and infinities out of physics are a user-visible error, not garbage

@@ -150,6 +150,34 @@ TEST(SceneTest, PathsResolveRelativeToTheCaller) {
   EXPECT_EQ(scene.FindObject("./eye/sensor", body), s2);
 }
 
+// Lookups by path remember the names they met (a swarm looks up the same
+// few a million times): two scenes whose pools number the same name
+// differently, and a name whose number went to another name, still find
+// what each scene holds now.
+TEST(SceneTest, PathLookupsAnswerForEachSceneAsItIsNow) {
+  Scene a, b;
+  const ObjectId a_robot = a.AddDummy("robot", {}, {});
+  const ObjectId a_eye = a.AddDummy("eye", a_robot, {});
+  const ObjectId b_robot = b.AddDummy("robot", {}, {});
+  b.AddDummy("wheel", b_robot, {});  // "eye" gets another number in b's pool
+  const ObjectId b_eye = b.AddDummy("eye", b_robot, {});
+  for (int round = 0; round < 3; ++round) {
+    EXPECT_EQ(a.FindObject("./eye", a_robot), a_eye);
+    EXPECT_EQ(b.FindObject("./eye", b_robot), b_eye);
+    EXPECT_TRUE(a.FindObject("./wheel", a_robot).IsNull());
+  }
+  // "eye" leaves a's pool and its number goes to a new name.
+  a.RemoveSubtree(a_eye);
+  const ObjectId a_arm = a.AddDummy("arm", a_robot, {});
+  EXPECT_TRUE(a.FindObject("./eye", a_robot).IsNull());
+  EXPECT_EQ(a.FindObject("./arm", a_robot), a_arm);
+  EXPECT_EQ(b.FindObject("./eye", b_robot), b_eye);
+  // Renamed: found by its new name only.
+  b.set_name(b_eye, "arm");
+  EXPECT_TRUE(b.FindObject("./eye", b_robot).IsNull());
+  EXPECT_EQ(b.FindObject("./arm", b_robot), b_eye);
+}
+
 // Matches count in hierarchy order (depth first, children in the order they
 // were added), and a search never leaves the subtree it starts from.
 TEST(SceneTest, PathIndicesCountInHierarchyOrderWithinTheSubtree) {

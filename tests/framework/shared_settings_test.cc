@@ -93,5 +93,61 @@ TEST(SharedSettingsTest, ConcurrentEditsOfDifferentRowsAreSafe) {
   EXPECT_DOUBLE_EQ(model->range, 0.5);
 }
 
+// A bulk copy on several threads (Scene::DuplicateSubtrees) counts its
+// references in CountCopiesLocally scopes: once the scopes close, the
+// counts are whole again. If they were short, editing one copy would change
+// the settings every copy shares (it would seem the last holder), and
+// dropping the copies would free the settings under the model (a double
+// free under the sanitizer preset).
+TEST(SharedSettingsTest, CopiesCountedLocallyAreCountedOnceTheScopeCloses) {
+  // More distinct settings than a scope keeps counts of (8): the rest are
+  // counted at once.
+  std::vector<Shared<Settings>> models;
+  for (int m = 0; m < 12; ++m)
+    models.emplace_back(Settings{static_cast<double>(m), "model " + std::to_string(m)});
+  std::vector<std::vector<Shared<Settings>>> copies(models.size(),
+                                                    std::vector<Shared<Settings>>(400));
+  std::vector<std::thread> threads;
+  for (int t = 0; t < 2; ++t)
+    threads.emplace_back([&, t] {
+      const CountCopiesLocally scope;
+      for (size_t c = t; c < 400; c += 2)
+        for (size_t m = 0; m < models.size(); ++m) copies[m][c] = models[m];
+    });
+  for (std::thread& t : threads) t.join();
+  for (size_t m = 0; m < models.size(); ++m) {
+    for (const Shared<Settings>& c : copies[m]) ASSERT_TRUE(c.SameAs(models[m]));
+    // Editing a copy gives it its own; the model and the other copies keep theirs.
+    copies[m][5].Edit().range = 100;
+    EXPECT_DOUBLE_EQ(models[m]->range, static_cast<double>(m));
+    EXPECT_DOUBLE_EQ(copies[m][6]->range, static_cast<double>(m));
+    EXPECT_FALSE(copies[m][5].SameAs(models[m]));
+  }
+  // Every copy gone: the models are the last holders, and edit in place.
+  copies.clear();
+  for (Shared<Settings>& model : models) {
+    const Settings* before = &*model;
+    model.Edit().name = "edited";
+    EXPECT_EQ(&*model, before);
+  }
+}
+
+TEST(SharedSettingsTest, NestedScopesCountOnceTheOutermostCloses) {
+  Shared<Settings> model(Settings{0.2, "ring"});
+  std::vector<Shared<Settings>> copies;
+  copies.reserve(10);
+  {
+    const CountCopiesLocally outer;
+    {
+      const CountCopiesLocally inner;
+      for (int i = 0; i < 5; ++i) copies.push_back(model);
+    }
+    for (int i = 0; i < 5; ++i) copies.push_back(model);
+  }
+  copies[0].Edit().range = 7;  // not the last holder: a copy of its own
+  EXPECT_DOUBLE_EQ(model->range, 0.2);
+  EXPECT_DOUBLE_EQ(copies[9]->range, 0.2);
+}
+
 }  // namespace
 }  // namespace swarmsim
