@@ -40,6 +40,7 @@
 
 #include "framework/prefault.h"
 #include "framework/scene.h"
+#include "framework/scheduler.h"
 #include "framework/spatial_grid.h"
 #include "modules/proximity/footprint_grid.h"
 #include "modules/proximity/proximity_sensor.h"
@@ -122,20 +123,38 @@ class OctreeGridProximity final : public ProximityBackend {
 
   // Places every robot shape and dynamic shape and rebuilds the grid over
   // their footprints. Buffers keep their capacity: no allocation once warm.
+  // The shapes are placed on every thread, in blocks of shape rows whose
+  // places in the arrays a first pass counts: the same arrays, in shape row
+  // order, for any thread count.
   void Update(const Scene& scene) override {
     // (A Scene made without a World gets the type with its first sensor.)
     if (!have_sensor_type_) have_sensor_type_ = FindSensorType(scene, &sensor_type_);
-    moving_.clear();
-    footprints_.clear();
-    squares_.clear();
-    instances_.clear();
-    ids_.clear();
     const auto shapes = scene.shapes();
     const auto owners = scene.shape_owners();
+    const size_t rows = shapes.size();
+    // Moving: a robot's shape or a dynamic one.
+    const auto moving = [&](size_t r) {
+      return shapes[r].dynamic || scene.instance_of_at(owners[r]) >= 0;
+    };
+    const size_t blocks = (rows + kPlaceBlock - 1) / kPlaceBlock;
+    block_start_.assign(blocks + 1, 0);
+    ForEachBlock(blocks, [&](size_t b) {
+      uint32_t count = 0;
+      for (size_t r = b * kPlaceBlock; r < std::min(rows, (b + 1) * kPlaceBlock); ++r)
+        count += moving(r) ? 1 : 0;
+      block_start_[b + 1] = count;
+    });
+    for (size_t b = 0; b < blocks; ++b) block_start_[b + 1] += block_start_[b];
+    const size_t placed = block_start_[blocks];
     // At most one entry per shape: the first Update sizes every buffer for
     // the whole swarm at once, leaving no slack from growing one by one.
-    if (moving_.capacity() < shapes.size()) {
-      const size_t n = std::max(shapes.size(), 2 * moving_.capacity());
+    if (moving_.capacity() < placed || footprint_memos_.capacity() < rows) {
+      moving_.clear();
+      footprints_.clear();
+      squares_.clear();
+      instances_.clear();
+      ids_.clear();
+      const size_t n = std::max(rows, 2 * moving_.capacity());
       moving_.reserve(n);
       footprints_.reserve(n);
       squares_.reserve(n);
@@ -154,29 +173,38 @@ class OctreeGridProximity final : public ProximityBackend {
         prefault.Run(*scheduler_);
       }
     }
-    footprint_memos_.resize(shapes.size());
-    for (size_t r = 0; r < shapes.size(); ++r) {
-      // The poses of a big swarm outgrow the cache, and shape rows stride
-      // through them: ask for one a few rows ahead.
-      constexpr size_t kAhead = 8;
-      if (r + kAhead < shapes.size()) __builtin_prefetch(&scene.world_pose_at(owners[r + kAhead]));
-      const uint32_t slot = owners[r];
-      const int instance = scene.instance_of_at(slot);
-      if (instance < 0 && !shapes[r].dynamic) continue;
-      const Pose& X_WS = scene.world_pose_at(slot);
-      const ObjectId id = scene.IdAt(slot);
-      const double x = X_WS.p.x, y = X_WS.p.y;
-      const double radius = WorldFootprintRadius(shapes[r], X_WS, &footprint_memos_[r]);
-      const uint32_t index = static_cast<uint32_t>(moving_.size());
-      footprints_.push_back({x, y, radius, index});
-      // Its bounding square, grown by the margin (the rounding of the exact
-      // tests is relative to the footprint's coordinates too).
-      const double half = radius + kReachMargin * (std::abs(x) + std::abs(y) + radius);
-      squares_.push_back({x - half, y - half, x + half, y + half});
-      instances_.push_back(instance);
-      ids_.push_back(id);
-      moving_.push_back(PlaceShape(shapes[r], X_WS, id, instance));
-    }
+    footprint_memos_.resize(rows);
+    moving_.resize(placed);
+    footprints_.resize(placed);
+    squares_.resize(placed);
+    instances_.resize(placed);
+    ids_.resize(placed);
+    ForEachBlock(blocks, [&](size_t b) {
+      uint32_t index = block_start_[b];
+      const size_t end = std::min(rows, (b + 1) * kPlaceBlock);
+      for (size_t r = b * kPlaceBlock; r < end; ++r) {
+        // The poses of a big swarm outgrow the cache, and shape rows stride
+        // through them: ask for one a few rows ahead.
+        constexpr size_t kAhead = 8;
+        if (r + kAhead < end) __builtin_prefetch(&scene.world_pose_at(owners[r + kAhead]));
+        if (!moving(r)) continue;
+        const uint32_t slot = owners[r];
+        const int instance = scene.instance_of_at(slot);
+        const Pose& X_WS = scene.world_pose_at(slot);
+        const ObjectId id = scene.IdAt(slot);
+        const double x = X_WS.p.x, y = X_WS.p.y;
+        const double radius = WorldFootprintRadius(shapes[r], X_WS, &footprint_memos_[r]);
+        footprints_[index] = {x, y, radius, index};
+        // Its bounding square, grown by the margin (the rounding of the exact
+        // tests is relative to the footprint's coordinates too).
+        const double half = radius + kReachMargin * (std::abs(x) + std::abs(y) + radius);
+        squares_[index] = {x - half, y - half, x + half, y + half};
+        instances_[index] = instance;
+        ids_[index] = id;
+        moving_[index] = PlaceShape(shapes[r], X_WS, id, instance);
+        ++index;
+      }
+    });
     // The early-out's own broad phase, or (casting every ray) the spatial grid.
     if (options_.early_out) {
       footprint_grid_.Build(squares_, instances_, ids_);
@@ -677,6 +705,22 @@ class OctreeGridProximity final : public ProximityBackend {
 
   static constexpr double kPi = 3.141592653589793;
 
+  // Shape rows a block of Update's placing: one task's work.
+  static constexpr size_t kPlaceBlock = 4096;
+
+  // place(b) for blocks b = 0 .. blocks - 1, on every thread if there is a
+  // scheduler (each block writes only its own entries).
+  template <class Place>
+  void ForEachBlock(size_t blocks, Place&& place) const {
+    if (scheduler_ == nullptr || blocks < 2) {
+      for (size_t b = 0; b < blocks; ++b) place(b);
+      return;
+    }
+    scheduler_->ParallelFor(0, static_cast<int64_t>(blocks), 1, [&](int64_t begin, int64_t end) {
+      for (int64_t b = begin; b < end; ++b) place(static_cast<size_t>(b));
+    });
+  }
+
   BackendOptions options_;
   StaticIndex static_;
   std::vector<Vec3> static_lo_, static_hi_;  // world bounds of static_.shapes() (static shapes)
@@ -690,6 +734,7 @@ class OctreeGridProximity final : public ProximityBackend {
   std::vector<int32_t> instances_;    // moving_[i].instance (moving)
   std::vector<ObjectId> ids_;         // moving_[i].id (moving)
   std::vector<FootprintMemo> footprint_memos_;  // by shape row (shapes)
+  std::vector<uint32_t> block_start_;           // Update: first entry of each block of shape rows
   FootprintGrid footprint_grid_;                // with the early-out
   SpatialGrid grid_;                            // casting every ray
   // The sensors by owner, as of ListSensors() (see SensorListsCurrent).

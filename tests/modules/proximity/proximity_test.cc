@@ -13,6 +13,7 @@
 
 #include "framework/error.h"
 #include "framework/scene.h"
+#include "framework/scheduler.h"
 #include "modules/proximity/ray_cast.h"
 #include "modules/proximity/static_index.h"
 
@@ -414,6 +415,89 @@ TEST_F(ProximityTest, SwarmMatchesBruteForceAndConcurrentSensingMatchesSerial) {
     ASSERT_EQ(r.detected, serial[row].detected) << row;
     ASSERT_EQ(r.distance, serial[row].distance) << row;
     ASSERT_EQ(r.detected_object, serial[row].detected_object) << row;
+  }
+}
+
+// Update places the moving shapes on every thread, in blocks of shape rows:
+// a swarm spanning several blocks, with static shapes (not placed) and free
+// dynamic ones (placed) among the robots' rows, reads the same bits as with
+// the shapes placed on one thread, and what testing every shape reads.
+TEST_F(ProximityTest, ShapesPlacedOnSeveralThreadsAreSeenAsWhenPlacedOnOne) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> pos(0.2, 29.8), yaw(-M_PI, M_PI);
+  std::vector<Pose> ring;
+  for (int k = 0; k < 4; ++k)
+    ring.push_back(Looking({0.085 * std::cos(k * M_PI / 2), 0.085 * std::sin(k * M_PI / 2), 0.06},
+                           k * M_PI / 2));
+  for (int i = 0; i < 10000; ++i) {
+    AddRobot(&scene_, {{pos(rng), pos(rng), 0}, Quat::FromYaw(yaw(rng))}, 0.085, ring, 0.3);
+    if (i % 5 == 0)
+      scene_.AddShape("post", {}, {{pos(rng), pos(rng), 0.1}, {}}, Cylinder(0.05, 0.2));
+    if (i % 7 == 0) {
+      ShapeData crate = Box(0.2, 0.2, 0.2);
+      crate.dynamic = true;
+      scene_.AddShape("crate", {}, {{pos(rng), pos(rng), 0.1}, {}}, crate);
+    }
+  }
+  ASSERT_GT(scene_.shapes().size(), 3 * 4096u);  // several blocks
+  scene_.UpdateWorldPoses();
+  auto& rows = proximity::MutableSensors(&scene_).rows;
+  const auto sense = [&](TaskScheduler* scheduler) {
+    for (ProximitySensorData& r : rows) {  // scribbled first
+      r.detected = true;
+      r.distance = -7;
+      r.detected_object = ObjectId{12345, 6};
+    }
+    ProximitySettings settings;
+    settings.scheduler = scheduler;
+    std::unique_ptr<ProximityBackend> backend = MakeBackend();
+    backend->Build(scene_, settings);
+    backend->Update(scene_);
+    for (size_t i = 0; i < scene_.instances().size(); ++i)
+      backend->SenseInstance(&scene_, static_cast<int>(i));
+    return std::vector<ProximitySensorData>(rows.begin(), rows.end());
+  };
+  const std::vector<ProximitySensorData> one = sense(nullptr);
+  TaskScheduler two_threads(2);
+  const std::vector<ProximitySensorData> two = sense(&two_threads);
+  int detected = 0;
+  for (size_t row = 0; row < rows.size(); ++row) {
+    ASSERT_EQ(two[row].detected, one[row].detected) << row;
+    ASSERT_EQ(std::bit_cast<uint64_t>(two[row].distance),
+              std::bit_cast<uint64_t>(one[row].distance))
+        << row;
+    ASSERT_EQ(two[row].detected_object, one[row].detected_object) << row;
+    detected += one[row].detected;
+  }
+  EXPECT_GT(detected, 1000);
+  // Every 97th sensor against every shape but its robot's own: the nearest,
+  // and on a tie (a ray starting inside two shapes reads 0 for both) a
+  // static shape before a moving one, then the lower shape row.
+  std::vector<PlacedShape> all;
+  for (size_t r = 0; r < scene_.shapes().size(); ++r) {
+    const uint32_t slot = scene_.shape_owners()[r];
+    all.push_back(PlaceShape(scene_.shapes()[r], scene_.world_pose_at(slot), scene_.IdAt(slot),
+                             scene_.instance_of_at(slot)));
+  }
+  for (size_t row = 0; row < rows.size(); row += 97) {
+    const uint32_t slot = proximity::Sensors(scene_).owners[row];
+    const Pose& X_WS = scene_.world_pose_at(slot);
+    const Vec3 d = X_WS.q.Rotate({0, 0, 1});
+    double best = INFINITY, t;
+    bool best_static = false;
+    ObjectId id;
+    for (size_t r = 0; r < all.size(); ++r) {
+      const PlacedShape& shape = all[r];
+      if (shape.instance == scene_.instance_of_at(slot) || !RayCast(shape, X_WS.p, d, 0.3, &t))
+        continue;
+      const bool is_static = shape.instance < 0 && !scene_.shapes()[r].dynamic;
+      if (t < best || (t == best && is_static && !best_static))
+        best = t, best_static = is_static, id = shape.id;
+    }
+    ASSERT_EQ(two[row].detected, std::isfinite(best)) << row;
+    if (!two[row].detected) continue;
+    EXPECT_NEAR(two[row].distance, best, 1e-12) << row;
+    EXPECT_EQ(two[row].detected_object, id) << row;
   }
 }
 
