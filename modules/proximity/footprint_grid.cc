@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "framework/prefault.h"
+
 namespace swarmsim::proximity {
 namespace {
 
@@ -18,14 +20,39 @@ bool Meets(const Aabb2& a, const Aabb2& b) {
 }  // namespace
 
 void FootprintGrid::Build(std::span<const Aabb2> squares, std::span<const int32_t> instances,
-                          std::span<const ObjectId> ids) {
+                          std::span<const ObjectId> ids, TaskScheduler* scheduler) {
   const size_t n = squares.size();
-  squares_.assign(squares.begin(), squares.end());
-  ids_.assign(ids.begin(), ids.end());
-
   // One group per robot (the union of its squares), one per shape of no robot.
   int32_t max_instance = -1;
-  for (int32_t instance : instances) max_instance = std::max(max_instance, instance);
+  size_t no_robot = 0;
+  for (int32_t instance : instances) {
+    max_instance = std::max(max_instance, instance);
+    no_robot += instance < 0 ? 1 : 0;
+  }
+  if (scheduler != nullptr) {
+    // At most a group per robot and per shape of no robot.
+    const size_t groups = std::min(n, size_t(max_instance + 1) + no_robot);
+    Prefault prefault;
+    const auto grow = [&](auto& v, size_t size) {
+      if (v.capacity() >= size) return;
+      v.clear();
+      v.reserve(size);
+      prefault.AddSpare(v);
+    };
+    grow(squares_, n);
+    grow(ids_, n);
+    grow(group_of_shape_, n);
+    grow(members_, n);
+    grow(group_of_instance_, size_t(max_instance + 1));
+    grow(group_squares_, groups);
+    grow(group_instance_, groups);
+    grow(group_start_, groups + 1);
+    grow(cell_of_group_, groups);
+    grow(cell_entries_, groups);
+    prefault.Run(*scheduler);
+  }
+  squares_.assign(squares.begin(), squares.end());
+  ids_.assign(ids.begin(), ids.end());
   group_of_instance_.assign(size_t(max_instance + 1), -1);
   group_squares_.clear();
   group_instance_.clear();

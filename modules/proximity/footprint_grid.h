@@ -23,14 +23,20 @@
 #include "framework/handle.h"
 #include "framework/spatial_grid.h"
 
+namespace swarmsim {
+class TaskScheduler;
+}
+
 namespace swarmsim::proximity {
 
 class FootprintGrid {
  public:
   // Indexes shapes i = 0..n-1: square[i] (finite or not), the robot
-  // instance[i] it belongs to (or -1) and its id[i] (copied).
+  // instance[i] it belongs to (or -1) and its id[i] (copied). With a
+  // scheduler, arrays that must grow have their pages populated on its
+  // threads first (a large swarm's first build: fresh memory).
   void Build(std::span<const Aabb2> squares, std::span<const int32_t> instances,
-             std::span<const ObjectId> ids);
+             std::span<const ObjectId> ids, TaskScheduler* scheduler = nullptr);
 
   // Is there a shape whose square meets `box` (closed) and that is neither
   // of robot `instance` (if >= 0) nor listed in `skip`?

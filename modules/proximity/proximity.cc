@@ -207,7 +207,7 @@ class OctreeGridProximity final : public ProximityBackend {
     });
     // The early-out's own broad phase, or (casting every ray) the spatial grid.
     if (options_.early_out) {
-      footprint_grid_.Build(squares_, instances_, ids_);
+      footprint_grid_.Build(squares_, instances_, ids_, scheduler_);
     } else {
       grid_.Build(footprints_);
     }

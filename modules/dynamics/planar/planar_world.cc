@@ -10,6 +10,7 @@
 #include <string>
 
 #include "framework/error.h"
+#include "framework/prefault.h"
 #include "framework/scene.h"
 #include "framework/scheduler.h"
 #include "framework/state_hash.h"
@@ -99,28 +100,34 @@ void PlanarWorld::ForBodies(F&& body) {
 }
 
 void PlanarWorld::Build(const Scene& scene) {
-  shapes_.clear();
-  bound_.clear();
-  inner_.clear();
-  inverse_mass_.clear();
-  cold_.clear();
-  wheels_.clear();
-  wheeled_.clear();
-  obstacles_.clear();
-  // 1. A body per dynamic shape, in slot order: circle or rectangle. Room
-  // for every shape (a robot's wheels are shapes too): reserved, never
-  // touched, it costs no memory, where growing would copy a million bodies
-  // into fresh pages the kernel zeroes again and again.
-  const size_t shape_count = scene.rows(ObjectType::kShape)->size();
+  // 1. A body per dynamic shape, in slot order: circle or rectangle. The
+  // bodies are counted first, and every per-body array is reserved at that
+  // size with its pages populated on every thread: a million bodies' arrays
+  // are fresh memory, which the kernel zeroed page by page on this thread as
+  // they filled (most of this build's time on a VM whose memory was cold).
+  size_t bodies = 0;
+  for (const ShapeData& shape : scene.shapes()) bodies += shape.dynamic ? 1 : 0;
   const size_t joint_count = scene.rows(ObjectType::kJoint)->size();
-  shapes_.reserve(shape_count);
-  bound_.reserve(shape_count);
-  inner_.reserve(shape_count);
-  inverse_mass_.reserve(shape_count);
-  cold_.reserve(shape_count);
-  wheels_.reserve(joint_count);
-  wheeled_.reserve(shape_count);
-  std::vector<int32_t> body_of(scene.slot_count(), -1);
+  Prefault prefault;
+  const auto reserve = [&](auto& v, size_t n) {
+    v.clear();
+    if (v.capacity() >= n) return;
+    v.reserve(n);
+    prefault.AddSpare(v);
+  };
+  for (auto* v : {&shapes_, &next_}) reserve(*v, bodies);
+  for (auto* v : {&bound_, &inner_, &inverse_mass_, &v_x_, &v_y_, &w_, &start_x_, &start_y_,
+                  &start_yaw_, &ref_x_, &ref_y_})
+    reserve(*v, bodies);
+  for (auto* v : {&near_, &near_obstacles_}) reserve(*v, bodies);
+  reserve(cold_, bodies);
+  reserve(wheeled_, bodies);
+  reserve(wheels_, joint_count);
+  obstacles_.clear();
+  std::vector<int32_t> body_of;
+  reserve(body_of, scene.slot_count());
+  if (settings_.scheduler != nullptr) prefault.Run(*settings_.scheduler);
+  body_of.assign(scene.slot_count(), -1);
   HeightRange dynamic_range{std::numeric_limits<double>::infinity(),
                             -std::numeric_limits<double>::infinity()};
   for (uint32_t s = 0; s < scene.slot_count(); ++s) {
