@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <charconv>
 #include <unordered_map>
 
@@ -82,6 +83,8 @@ void JointData::JumpTo(double q) {
 }
 
 Scene::Scene() {
+  static std::atomic<uint64_t> scenes{0};
+  serial_ = ++scenes;
   for (const ObjectTypeDescriptor* type : CoreObjectTypes()) RegisterType(*type);
 }
 Scene::~Scene() = default;
@@ -338,6 +341,7 @@ void Scene::set_name(ObjectId id, std::string name) {
   const uint32_t old = name_[slot];
   name_[slot] = names_.Intern(name);
   names_.Release(old);
+  ++renames_;
 }
 
 // --- Validity -----------------------------------------------------------------------
@@ -681,6 +685,23 @@ uint32_t FindNameRemembered(const NamePool& names, std::string_view name) {
   return id;
 }
 
+// Where a path lookup's walk for one element stopped: the `index`th object
+// named `name` below `root` (hierarchy order) is `match`, in the scene
+// numbered `serial` at that structure version and rename count.
+struct LookupCursor {
+  uint64_t serial = 0, structure = 0, renames = 0;
+  int32_t root = -1;
+  uint32_t name = NamePool::kNone;
+  int index = -1;
+  int32_t match = -1;
+
+  // May a walk for `next` (match unset) start after this one's match?
+  bool Resumes(const LookupCursor& next) const {
+    return match >= 0 && serial == next.serial && structure == next.structure &&
+           renames == next.renames && root == next.root && name == next.name && index < next.index;
+  }
+};
+
 }  // namespace
 
 ObjectId Scene::FindObject(std::string_view path, ObjectId from) const {
@@ -743,11 +764,25 @@ ObjectId Scene::FindObject(std::string_view path, ObjectId from) const {
         if (alive_[s] && parent_[s] < 0 && matches(s)) match = static_cast<int32_t>(s);
     } else {
       const int32_t root = k == 0 ? scope : current;
-      for (int32_t c = next_in_subtree(root, root); c >= 0; c = next_in_subtree(c, root))
+      int32_t c = next_in_subtree(root, root);
+      // A robot looking up ./prox[0], ./prox[1], ... in turn: resume after
+      // this thread's last match of the name under the same object, if the
+      // scene is the same, unchanged since, and that match came earlier.
+      thread_local LookupCursor cursor;
+      const LookupCursor here{serial_, structure_version_, renames_, root, e.id, want, -1};
+      if (cursor.Resumes(here)) {
+        seen = cursor.index + 1;
+        c = next_in_subtree(cursor.match, root);
+      }
+      for (; c >= 0; c = next_in_subtree(c, root))
         if (matches(static_cast<uint32_t>(c))) {
           match = c;
           break;
         }
+      if (match >= 0) {
+        cursor = here;
+        cursor.match = match;
+      }
     }
     if (match < 0) return {};
     current = match;

@@ -606,6 +606,11 @@ class Scene {
   mutable bool instances_independent_ = true;
   mutable bool order_dirty_ = true;
   uint64_t structure_version_ = 0;
+  // What a path lookup's walk depends on besides the structure: which scene
+  // this is (a number no other scene in the process has) and its renames.
+  // FindObject resumes a thread's last walk only while all three are as then.
+  uint64_t serial_ = 0;
+  uint64_t renames_ = 0;
   std::vector<SceneListener*> listeners_;
 };
 

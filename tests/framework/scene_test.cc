@@ -178,6 +178,54 @@ TEST(SceneTest, PathLookupsAnswerForEachSceneAsItIsNow) {
   EXPECT_EQ(b.FindObject("./arm", b_robot), b_eye);
 }
 
+// A robot looks up ./sensor[0], ./sensor[1], ... in turn, and each lookup
+// resumes where the thread's last one stopped: only in the same scene,
+// unchanged since.
+TEST(SceneTest, PathLookupsInTurnSeeTheSceneAsItIsNow) {
+  Scene scene;
+  const ObjectId robot = scene.AddDummy("robot", {}, {});
+  std::vector<ObjectId> sensors;
+  for (int i = 0; i < 4; ++i) sensors.push_back(scene.AddDummy("sensor", robot, {}));
+  const auto find = [&](int i) {
+    return scene.FindObject("./sensor[" + std::to_string(i) + "]", robot);
+  };
+  for (int i = 0; i < 4; ++i) EXPECT_EQ(find(i), sensors[i]);
+  EXPECT_TRUE(find(4).IsNull());
+  for (int i = 3; i >= 0; --i) EXPECT_EQ(find(i), sensors[i]);  // backwards: from the start
+  // A sensor added under the first one comes second in hierarchy order.
+  EXPECT_EQ(find(1), sensors[1]);
+  const ObjectId inner = scene.AddDummy("sensor", sensors[0], {});
+  EXPECT_EQ(find(2), sensors[1]);
+  EXPECT_EQ(find(1), inner);
+  // The first one renamed: the others move up.
+  EXPECT_EQ(find(2), sensors[1]);
+  scene.set_name(sensors[0], "eye");
+  EXPECT_EQ(find(3), sensors[3]);
+  EXPECT_TRUE(find(4).IsNull());
+}
+
+// Two scenes with the same slots, names and number of changes, whose
+// sensors come in different orders: a lookup in one does not resume a walk
+// made in the other.
+TEST(SceneTest, PathLookupsInTurnDoNotCrossScenes) {
+  Scene a, b;
+  const ObjectId a_robot = a.AddDummy("robot", {}, {});
+  a.AddDummy("x", a_robot, {});
+  a.AddDummy("y", a_robot, {});
+  const ObjectId a_first = a.AddDummy("sensor", a_robot, {});
+  const ObjectId a_second = a.AddDummy("sensor", a_robot, {});
+  const ObjectId b_robot = b.AddDummy("robot", {}, {});
+  b.AddDummy("x", b_robot, {});
+  const ObjectId b_y = b.AddDummy("y", b_robot, {});
+  const ObjectId b_second = b.AddDummy("sensor", b_robot, {});  // slot 3, after y's subtree
+  const ObjectId b_first = b.AddDummy("sensor", b_y, {});       // slot 4, under y
+  ASSERT_EQ(a_first.index(), b_second.index());
+  EXPECT_EQ(a.FindObject("./sensor[0]", a_robot), a_first);
+  EXPECT_EQ(b.FindObject("./sensor[1]", b_robot), b_second);
+  EXPECT_EQ(a.FindObject("./sensor[1]", a_robot), a_second);
+  EXPECT_EQ(b.FindObject("./sensor[0]", b_robot), b_first);
+}
+
 // Matches count in hierarchy order (depth first, children in the order they
 // were added), and a search never leaves the subtree it starts from.
 TEST(SceneTest, PathIndicesCountInHierarchyOrderWithinTheSubtree) {
