@@ -27,6 +27,16 @@ class Prefault {
   void AddSpare(const std::vector<T>& v) {
     Add(v.data() + v.size(), (v.capacity() - v.size()) * sizeof(T));
   }
+  // Room for `n` elements in `v` (its contents kept): when it must grow,
+  // the room it grew to is added, for Run to populate before `v` is filled
+  // to `n`. Clear `v` first when its contents are not needed (growing does
+  // not copy them then).
+  template <typename T>
+  void Reserve(std::vector<T>& v, size_t n) {
+    if (v.capacity() >= n) return;
+    v.reserve(n);
+    AddSpare(v);
+  }
   // [begin, begin + bytes): memory the caller owns. The whole pages inside it
   // are populated; ranges under a page add nothing.
   void Add(const void* begin, size_t bytes);

@@ -33,11 +33,10 @@ void FootprintGrid::Build(std::span<const Aabb2> squares, std::span<const int32_
     // At most a group per robot and per shape of no robot.
     const size_t groups = std::min(n, size_t(max_instance + 1) + no_robot);
     Prefault prefault;
+    // (Every array is written whole below: its contents need no keeping.)
     const auto grow = [&](auto& v, size_t size) {
-      if (v.capacity() >= size) return;
-      v.clear();
-      v.reserve(size);
-      prefault.AddSpare(v);
+      if (v.capacity() < size) v.clear();
+      prefault.Reserve(v, size);
     };
     grow(squares_, n);
     grow(ids_, n);

@@ -155,23 +155,15 @@ class OctreeGridProximity final : public ProximityBackend {
       instances_.clear();
       ids_.clear();
       const size_t n = std::max(rows, 2 * moving_.capacity());
-      moving_.reserve(n);
-      footprints_.reserve(n);
-      squares_.reserve(n);
-      instances_.reserve(n);
-      ids_.reserve(n);
-      footprint_memos_.reserve(n);
-      if (scheduler_ != nullptr) {
-        // A large swarm's buffers are fresh pages: populated on every thread.
-        Prefault prefault;
-        prefault.AddSpare(moving_);
-        prefault.AddSpare(footprints_);
-        prefault.AddSpare(squares_);
-        prefault.AddSpare(instances_);
-        prefault.AddSpare(ids_);
-        prefault.AddSpare(footprint_memos_);
-        prefault.Run(*scheduler_);
-      }
+      // A large swarm's buffers are fresh pages: populated on every thread.
+      Prefault prefault;
+      prefault.Reserve(moving_, n);
+      prefault.Reserve(footprints_, n);
+      prefault.Reserve(squares_, n);
+      prefault.Reserve(instances_, n);
+      prefault.Reserve(ids_, n);
+      prefault.Reserve(footprint_memos_, n);  // the memos are kept
+      if (scheduler_ != nullptr) prefault.Run(*scheduler_);
     }
     footprint_memos_.resize(rows);
     moving_.resize(placed);

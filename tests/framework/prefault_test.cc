@@ -78,6 +78,30 @@ TEST(PrefaultTest, RangesUnderAPageAddNothing) {
   EXPECT_EQ(prefault.Run(scheduler), 0u);
 }
 
+TEST(PrefaultTest, ReserveGrowsKeepingTheContentsAndNamesOnlyTheNewRoom) {
+  const size_t page = static_cast<size_t>(sysconf(_SC_PAGESIZE));
+  std::vector<uint32_t> v = {7, 8, 9};
+  Prefault prefault;
+  prefault.Reserve(v, 3 * page);  // room for 12 pages of uint32_t
+  ASSERT_GE(v.capacity(), 3 * page);
+  EXPECT_EQ(v, (std::vector<uint32_t>{7, 8, 9})) << "the contents are kept";
+  const size_t spare = (v.capacity() - v.size()) * sizeof(uint32_t);
+  EXPECT_GE(prefault.bytes(), spare - 2 * page);
+  EXPECT_LE(prefault.bytes(), spare);
+  // Room enough already: nothing more to populate, the vector untouched.
+  const size_t before = prefault.bytes();
+  const uint32_t* data = v.data();
+  prefault.Reserve(v, 2 * page);
+  prefault.Reserve(v, v.capacity());
+  EXPECT_EQ(prefault.bytes(), before);
+  EXPECT_EQ(v.data(), data);
+  TaskScheduler scheduler(2);
+  prefault.Run(scheduler);
+  v.resize(3 * page);
+  EXPECT_EQ(v[2], 9u);
+  EXPECT_EQ(v[3], 0u);
+}
+
 TEST(PrefaultTest, ReservingForCopiesNamesEveryArrayTheCopiesFill) {
   Scene scene;
   ShapeData body;

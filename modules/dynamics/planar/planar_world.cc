@@ -111,9 +111,7 @@ void PlanarWorld::Build(const Scene& scene) {
   Prefault prefault;
   const auto reserve = [&](auto& v, size_t n) {
     v.clear();
-    if (v.capacity() >= n) return;
-    v.reserve(n);
-    prefault.AddSpare(v);
+    prefault.Reserve(v, n);
   };
   for (auto* v : {&shapes_, &next_}) reserve(*v, bodies);
   for (auto* v : {&bound_, &inner_, &inverse_mass_, &v_x_, &v_y_, &w_, &start_x_, &start_y_,

@@ -136,6 +136,10 @@ TEST(ProximityLuaApiTest, ReadProximitySensorsNamesABadHandle) {
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"sim.readProximitySensors({sim.getObject('./prox'), 123456})",
        "sim.readProximitySensors: handles[2]: proximity sensor handle 123456 does not exist"},
+      // After sensors, an object of another type (read by the sensors' type).
+      {"sim.readProximitySensors({sim.getObject('./prox'), sim.getObject('./prox'), "
+       "sim.getObject('.')})",
+       "sim.readProximitySensors: handles[3]: object 'body' is a shape, not a proximity_sensor"},
       {"sim.readProximitySensors({sim.getObject('./prox'), 'x'})",
        "sim.readProximitySensors: handles[2] is not an object handle (got string)"},
       {"sim.readProximitySensors(3)",
