@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "framework/error.h"
+#include "framework/memory_forecast.h"
 #include "framework/model_section.h"
 #include "framework/object_type.h"
 #include "framework/plugin_controllers.h"
@@ -144,6 +145,37 @@ void DropScripts(ObjectSpec* spec) {
   for (ObjectSpec& child : spec->children) DropScripts(&child);
 }
 }  // namespace
+
+// From this many robots, the defaults below cost enough to say so (README,
+// "Performance": at 100,000 robots a state each takes twice the memory of
+// 64 robots a state, and random numbering 1.3x the time a step).
+constexpr int64_t kLargeSwarm = 10000;
+
+void WorldLoader::AddLargeSwarmHints(const WorldSettings& settings,
+                                     std::vector<std::string>* warnings) const {
+  int64_t lua_robots = 0;
+  for (const EntryPlan& e : entries_) {
+    if (HasScripts(e.spec) && !(e.native != nullptr && e.native_replaces_scripts))
+      lua_robots += e.count;
+    if (!e.distribute || e.lattice || e.order_given || e.count < kLargeSwarm ||
+        !e.own_copies.empty())
+      continue;
+    warnings->push_back(file_->Where(e.count_field.mark) + ": " + GroupThousands(e.count) +
+                        " copies of '" + e.model->name +
+                        "' numbered in the order they were drawn; with 'distribute: {order: "
+                        "spatial}' they are numbered along a curve, so that neighbours lie near "
+                        "each other in memory and a step takes less time, unless the "
+                        "controller gives robots roles by their number (worlds/README.md, "
+                        "\"Placement\"; 'order: random' keeps this order without this note)");
+  }
+  if (lua_robots < kLargeSwarm || robots_per_lua_state_given_ || settings.trust_scripts) return;
+  warnings->push_back(file_->name() + ": " + GroupThousands(lua_robots) +
+                      " robots run Lua scripts, a Lua state each; with 'simulation: "
+                      "{robots_per_lua_state: 64}' 64 robots share a state, each with its own "
+                      "globals, in less memory and time (a foot-bot's Lua: about 4 KiB instead "
+                      "of 17; worlds/README.md, \"Robots sharing a Lua state\"; "
+                      "'robots_per_lua_state: 1' keeps a state each without this note)");
+}
 
 // python_controller: FILE.py, FILE.py:function, or {file, function, keep_scripts}.
 void WorldLoader::ResolvePythonController(const Fields& f, const ValueReader& world_values,
@@ -505,6 +537,7 @@ void WorldLoader::ReadDistribution(const Fields& f, const ValueReader& world_val
     if (text != "random" && text != "spatial")
       file_->Fail(order.mark, "'order' must be random or spatial (got '" + text + "')");
     entry->spatial_order = text == "spatial";
+    entry->order_given = true;
     if (d.Has("lattice"))
       file_->Fail(order.key_mark,
                   "'order' is for random placement; a lattice numbers its "

@@ -118,6 +118,7 @@ LoadedWorld WorldLoader::Load() {
   if (environment_) world->scene().set_environment(environment_);
   for (EntryPlan& entry : entries_) ResolveEntry(&entry);
   KeepPlacementClearOfTheMap(&out.warnings);
+  AddLargeSwarmHints(settings, &out.warnings);
   unplaced_ = std::make_unique<Placer>(*placer_);
   PlaceEntries();
   BuildCopies(world);
@@ -392,7 +393,8 @@ WorldSettings WorldLoader::ReadSimulation(const Fields& top, std::optional<int64
     if (f.Has("run_script_memory_mb"))
       s.run_script_memory_limit = values.Integer(f.Get("run_script_memory_mb"), 0, int64_t{1} << 30)
                                   << 20;
-    if (f.Has("robots_per_lua_state"))
+    robots_per_lua_state_given_ = f.Has("robots_per_lua_state");
+    if (robots_per_lua_state_given_)
       s.robots_per_lua_state =
           static_cast<int>(values.Integer(f.Get("robots_per_lua_state"), 1, 4096));
     if (f.Has("step_timeout"))

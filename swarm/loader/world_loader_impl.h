@@ -79,6 +79,7 @@ struct EntryPlan {
   // distribute.order: spatial: copies numbered along a space-filling curve
   // (SortAlongCurve) instead of in the order they were drawn.
   bool spatial_order = false;
+  bool order_given = false;  // distribute: {order: ...} written (no hint either way)
   // distribute.lattice: copies on a square or hexagonal lattice instead of at random.
   struct LatticePlan {
     double spacing = 0;  // m
@@ -192,6 +193,10 @@ class WorldLoader {
                    EntryPlan* entry);
   void ReadSinglePosition(const Fields& f, const ValueReader& world_values, EntryPlan* entry);
   void KeepPlacementClearOfTheMap(std::vector<std::string>* warnings);
+  // Large swarms left on the defaults that are slow at their size (a Lua
+  // state per robot, copies numbered at random): a line each saying which
+  // setting to write.
+  void AddLargeSwarmHints(const WorldSettings& settings, std::vector<std::string>* warnings) const;
   void PlaceEntries();
   void BuildCopies(World* world);
   std::vector<ModelSummary> Summarize() const;
@@ -225,6 +230,7 @@ class WorldLoader {
   std::vector<int> copy_instances_;
   std::vector<std::filesystem::path> package_path_;  // the world's, then --package-path
   std::vector<std::string> warnings_;                // found before the World exists
+  bool robots_per_lua_state_given_ = false;          // simulation.robots_per_lua_state written
 };
 
 }  // namespace swarmsim::loader

@@ -201,5 +201,49 @@ TEST_F(ControlLoaderTest, PlacementMistakesSayWhatToGive) {
       "world.yaml:3:31: the region is too small for one disc (footprint radius 0.5 m)");
 }
 
+// A large swarm left on the defaults that cost most at its size (a Lua
+// state per robot, copies numbered at random) is told which setting to
+// write, with where; writing either setting, either way, or a smaller
+// swarm, gets no note.
+TEST_F(ControlLoaderTest, LargeSwarmsOnSlowDefaultsAreToldWhatToWrite) {
+  Write("plain.yaml", "model: plain\nobjects: {name: body, type: dummy}\n");
+  const auto world = [](const std::string& simulation, const std::string& model,
+                        const std::string& count, const std::string& order) {
+    return "simulation: {physics: kinematic" + simulation +
+           "}\n"
+           "models:\n"
+           "  - model: " +
+           model + "\n    count: " + count +
+           "\n"
+           "    distribute: {region: {min: [-60, -60], max: [60, 60]}" +
+           order + "}\n";
+  };
+  const auto notes = [&](const std::string& text) { return Load(text).warnings; };
+
+  const std::vector<std::string> both = notes(world("", "bot.yaml", "10000", ""));
+  ASSERT_EQ(both.size(), 2u);
+  EXPECT_CONTAINS(both[0], "world.yaml:4:12: 10,000 copies of 'bot' numbered in the order");
+  EXPECT_CONTAINS(both[0], "'distribute: {order: spatial}'");
+  EXPECT_CONTAINS(both[1], "world.yaml: 10,000 robots run Lua scripts, a Lua state each");
+  EXPECT_CONTAINS(both[1], "'simulation: {robots_per_lua_state: 64}'");
+
+  // Each note goes when its setting is written, whichever value.
+  for (const char* order : {", order: spatial", ", order: random"}) {
+    const std::vector<std::string> w = notes(world("", "bot.yaml", "10000", order));
+    ASSERT_EQ(w.size(), 1u) << order;
+    EXPECT_CONTAINS(w[0], "robots run Lua scripts");
+  }
+  for (const char* rpl : {", robots_per_lua_state: 64", ", robots_per_lua_state: 1"}) {
+    const std::vector<std::string> w = notes(world(rpl, "bot.yaml", "10000", ""));
+    ASSERT_EQ(w.size(), 1u) << rpl;
+    EXPECT_CONTAINS(w[0], "numbered in the order they were drawn");
+  }
+  // No scripts: no Lua note. Fewer robots: no note at all.
+  const std::vector<std::string> plain = notes(world("", "plain.yaml", "10000", ""));
+  ASSERT_EQ(plain.size(), 1u);
+  EXPECT_CONTAINS(plain[0], "copies of 'plain'");
+  EXPECT_TRUE(notes(world("", "bot.yaml", "9999", "")).empty());
+}
+
 }  // namespace
 }  // namespace swarmsim
