@@ -95,6 +95,7 @@ ObjectType Scene::RegisterType(const ObjectTypeDescriptor& type) {
     throw Error("cannot register object type '" + std::string(type.name) + "': at most " +
                 std::to_string(kMaxObjectTypes) + " object types");
   types_.push_back(&type);
+  type_names_.push_back(type.name);
   tables_.push_back(type.make_rows != nullptr ? type.make_rows(type) : nullptr);
   listing_order_.clear();
   for (const size_t t : ListingOrder(types_)) listing_order_.push_back(static_cast<ObjectType>(t));
@@ -108,11 +109,6 @@ bool Scene::FindType(std::string_view name, ObjectType* type) const {
     return true;
   }
   return false;
-}
-
-const char* Scene::type_name(ObjectType type) const {
-  const size_t t = static_cast<size_t>(type);
-  return t < types_.size() ? types_[t]->name : "?";
 }
 
 // --- Slots ----------------------------------------------------------------------
@@ -341,11 +337,6 @@ void Scene::set_name(ObjectId id, std::string name) {
 }
 
 // --- Validity -----------------------------------------------------------------------
-
-bool Scene::IsValid(ObjectId id) const {
-  if (id.IsNull() || id.index() >= generation_.size()) return false;
-  return alive_[id.index()] && generation_[id.index()] == id.generation;
-}
 
 uint32_t Scene::SlotOf(ObjectId id, std::string_view what) const {
   if (IsValid(id)) return id.index();

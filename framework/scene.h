@@ -252,7 +252,10 @@ class Scene {
   std::span<const ObjectType> listing_order() const { return listing_order_; }
   // The type named `name`; false if there is none.
   bool FindType(std::string_view name, ObjectType* type) const;
-  const char* type_name(ObjectType type) const;
+  const char* type_name(ObjectType type) const {
+    const size_t t = static_cast<size_t>(type);
+    return t < type_names_.size() ? type_names_[t] : "?";
+  }
   // The rows of a type (null for a type without rows, such as dummy).
   RowTable* rows(ObjectType type) { return tables_[static_cast<size_t>(type)].get(); }
   const RowTable* rows(ObjectType type) const { return tables_[static_cast<size_t>(type)].get(); }
@@ -318,7 +321,10 @@ class Scene {
   void ReserveForCopies(ObjectId root, size_t copies, Prefault* prefault = nullptr);
 
   // --- Validity ---------------------------------------------------------------
-  bool IsValid(ObjectId id) const;
+  bool IsValid(ObjectId id) const {  // inline: every sim.* call checks its handles
+    const uint32_t i = id.index();
+    return !id.IsNull() && i < generation_.size() && alive_[i] && generation_[i] == id.generation;
+  }
   // Slot of a valid handle; throws swarmsim::Error naming `what` for a null,
   // stale or out-of-range one.
   uint32_t SlotOf(ObjectId id, std::string_view what = "object") const;
@@ -592,6 +598,7 @@ class Scene {
   // Object types and their row tables, by ObjectType value (a table is null
   // for a type without rows).
   std::vector<const ObjectTypeDescriptor*> types_;
+  std::vector<const char*> type_names_;  // types_[t]->name, for type_name() inline
   std::vector<std::unique_ptr<RowTable>> tables_;
   std::vector<ObjectType> listing_order_;  // ListingOrder(types_)
   std::shared_ptr<const EnvironmentMap> environment_;

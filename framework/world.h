@@ -217,20 +217,23 @@ struct ModelEdit {
 inline constexpr size_t kMaxModelEditsPerStep = 1000;
 
 struct RobotRuntime {
-  Rng rng;
-  SharedParameters parameters;        // the instance's model parameters
+  // First, side by side: what the World looks at after every robot's
+  // control (World::PendingBits), 96 bytes, so that a robot whose
+  // controller left them empty costs two cache lines, not three or four.
   LogBuffer log;                      // lines printed during the phase
   std::vector<MetricSample> metrics;  // samples recorded this step
   // The lists most robots never fill take 8 bytes until used (lazy_vector.h).
   LazyVector<DeferredWrite> deferred;  // writes to other robots' objects
   LazyVector<ModelEdit> model_edits;   // copies and removals of robots, call order
+  LazyVector<std::string> disabled;    // scripts disabled this phase (disable_script), why
   std::string error;                   // a script error in this phase
+  Rng rng;
+  SharedParameters parameters;  // the instance's model parameters
   // Bytes of `log` and `metrics` charged to the robot's ScriptMemory,
   // released when the world takes them; bytes printed in step print_step.
   uint64_t log_bytes = 0, metric_bytes = 0;
   uint64_t printed_bytes = 0;
   int64_t print_step = -1;
-  LazyVector<std::string> disabled;       // scripts disabled this phase (disable_script), why
   LazyVector<CollectionRow> collections;  // the scripts' own (sim.createCollection)
   // Bytes charged to the robot's ScriptMemory for its lifetime: its
   // collections and the objects its scripts made (sim.createPath), released
