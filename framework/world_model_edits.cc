@@ -35,7 +35,10 @@ void World::ApplyModelEdits() {
   for (size_t r = 0; r < runtimes_.size(); ++r) {
     if (!(pending_[r] & kPendingModelEdits)) continue;
     pending_[r] &= ~kPendingModelEdits;
-    std::vector<ModelEdit>& queued = runtimes_[r].model_edits.get();
+    // (Not get(): a robot marked pending without edits, as every robot is
+    // after MarkAllPending, must not be given a list; each step's
+    // PendingBits would then read it from the heap.)
+    LazyVector<ModelEdit>& queued = runtimes_[r].model_edits;
     edits.insert(edits.end(), queued.begin(), queued.end());
     queued.clear();
   }
