@@ -56,20 +56,8 @@ int ReadProximitySensor(lua_State* L) {
 int ReadProximitySensors(lua_State* L) {
   const Scene& scene = *Context(L).scene;
   lua_Integer count = 0;
-  // The type and rows of the last sensor found: an array's other sensors
-  // are of the same type, known by one compare instead of by its name.
-  ObjectType known_type{};
-  const Rows<ProximitySensorData>* known_rows = nullptr;
   FillFromHandles(L, [&](ObjectId id) {
-    const uint32_t slot = id.index();
-    const bool known =
-        known_rows != nullptr && scene.IsValid(id) && scene.type_at(slot) == known_type;
-    const ProximitySensorData& sensor =
-        known ? known_rows->rows[scene.row_at(slot)] : SensorOf(scene, id);
-    if (!known) {
-      known_type = scene.type_at(slot);
-      known_rows = &scene.rows<ProximitySensorData>(known_type);
-    }
+    const ProximitySensorData& sensor = SensorOf(scene, id);
     if (sensor.detected) {
       ++count;
       lua_pushnumber(L, sensor.distance);
