@@ -27,6 +27,7 @@ namespace fs = std::filesystem;
 constexpr std::pair<const char*, const char*> kConfigs[] = {
     {"lua", "worlds/diffusion.yaml"},
     {"cpp", "worlds/diffusion_native.yaml"},
+    {"planar-lua", "worlds/diffusion_planar.yaml"},
     {"planar-cpp", "bench/worlds/diffusion_planar_native.yaml"},
 };
 

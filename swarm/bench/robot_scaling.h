@@ -1,6 +1,6 @@
 // `swarmsim bench --scaling-robots`: what a robot-tick costs from 1,000 to
-// 1,000,000 robots, per phase, for the Lua, C++ and planar + C++ diffusion
-// worlds; one table, a CSV and a log-log PNG, with start-up time and peak
+// 1,000,000 robots, per phase, for the Lua, C++, planar + Lua and planar +
+// C++ diffusion worlds; one table, a CSV and a log-log PNG, with start-up time and peak
 // memory per row (issue 32).
 #pragma once
 
@@ -12,7 +12,8 @@
 namespace swarmsim {
 
 // One world measured at every robot count: "lua" (worlds/diffusion.yaml),
-// "cpp" (worlds/diffusion_native.yaml), "planar-cpp"
+// "cpp" (worlds/diffusion_native.yaml), "planar-lua"
+// (worlds/diffusion_planar.yaml), "planar-cpp"
 // (bench/worlds/diffusion_planar_native.yaml), or a --world's file stem.
 struct ScalingConfig {
   std::string name;
@@ -20,7 +21,7 @@ struct ScalingConfig {
 };
 
 struct RobotScalingOptions {
-  std::vector<ScalingConfig> configs;  // empty: the three diffusion worlds (DefaultScalingConfigs)
+  std::vector<ScalingConfig> configs;  // empty: the four diffusion worlds (DefaultScalingConfigs)
   std::vector<int> robots{1000, 10000, 100000};
   std::vector<int> threads;   // empty: every core
   int64_t steps = 0;          // measured steps per row; 0: AutoScalingSteps(robots)
@@ -40,7 +41,7 @@ int64_t AutoScalingSteps(int robots);
 // A tenth of the measured steps, from 2 to 20: wheel commands settle.
 int64_t AutoWarmupSteps(int64_t steps);
 
-// The three diffusion worlds of the source tree the program was built in
+// The four diffusion worlds of the source tree the program was built in
 // (else of the current folder). Throws swarmsim::Error naming a missing one.
 std::vector<ScalingConfig> DefaultScalingConfigs();
 // The default configurations named in `names` ("lua,planar-cpp"); throws

@@ -55,7 +55,7 @@ CLI::App* AddBenchCommand(CLI::App* app, BenchArgs* args) {
       "1000,10000,100000) for the Lua, C++ and planar + C++ diffusion worlds; CSV + log-log PNG");
   bench
       ->add_option("--configs", args->configs,
-                   "With --scaling-robots: which of lua, cpp, planar-cpp (default all)")
+                   "With --scaling-robots: which of lua, cpp, planar-lua, planar-cpp (default all)")
       ->delimiter(',');
   bench
       ->add_option("--repeat", args->repeat,

@@ -85,7 +85,7 @@ struct BenchArgs {
   bool scaling = false;  // --scaling
   ScalingOptions scaling_options;
   bool scaling_robots = false;       // --scaling-robots
-  std::vector<std::string> configs;  // --configs lua,cpp,planar-cpp
+  std::vector<std::string> configs;  // --configs lua,cpp,planar-lua,planar-cpp
   int repeat = 1;                    // --repeat N (with --scaling-robots)
 };
 CLI::App* AddBenchCommand(CLI::App* app, BenchArgs* args);

@@ -49,7 +49,8 @@ TEST(RobotScalingTest, ATableACsvAndAPlotOfEveryConfigurationAndCount) {
   const fs::path csv = dir / "s.csv", plot = dir / "s.png";
   // Through the program: the C++ configurations load its plugins from beside it.
   const testing::CommandResult r = testing::RunProgram(
-      "bench --scaling-robots --robots 100,400 --threads 2 --steps 2 --configs lua,planar-cpp "
+      "bench --scaling-robots --robots 100,400 --threads 2 --steps 2 --configs "
+      "lua,planar-lua,planar-cpp "
       "--csv " +
       csv.string() + " --plot " + plot.string());
   const bool gnuplot = testing::RunCommand("command -v gnuplot").exit_code == 0;
@@ -60,19 +61,21 @@ TEST(RobotScalingTest, ATableACsvAndAPlotOfEveryConfigurationAndCount) {
        {"sense", "control", "physics", "other", "start s", "peak MiB", "KB/robot"})
     EXPECT_NE(r.output.find(column), std::string::npos) << column << "\n" << r.output;
   EXPECT_NE(r.output.find("worlds/diffusion.yaml"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("worlds/diffusion_planar.yaml"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("diffusion_planar_native.yaml"), std::string::npos) << r.output;
 
   std::ifstream in(csv);
   std::vector<std::vector<std::string>> rows;
   for (std::string line; std::getline(in, line);) rows.push_back(Fields(line));
-  ASSERT_EQ(rows.size(), 5u) << r.output;
+  ASSERT_EQ(rows.size(), 7u) << r.output;
   const std::vector<std::string> header{
       "config",    "world",       "robots",      "threads",  "steps",    "robot_ticks_per_s",
       "us_sense",  "us_control",  "us_physics",  "us_other", "us_total", "cost_ratio",
       "startup_s", "peak_rss_mb", "kb_per_robot"};
   EXPECT_EQ(rows[0], header);
   const std::vector<std::pair<std::string, std::string>> expected = {
-      {"lua", "100"}, {"lua", "400"}, {"planar-cpp", "100"}, {"planar-cpp", "400"}};
+      {"lua", "100"},        {"lua", "400"},        {"planar-lua", "100"},
+      {"planar-lua", "400"}, {"planar-cpp", "100"}, {"planar-cpp", "400"}};
   for (size_t i = 0; i < expected.size(); ++i) {
     const std::vector<std::string>& f = rows[i + 1];
     ASSERT_EQ(f.size(), header.size()) << i;
@@ -97,6 +100,7 @@ TEST(RobotScalingTest, ATableACsvAndAPlotOfEveryConfigurationAndCount) {
   // Each configuration's first count is its own base.
   EXPECT_EQ(rows[1][11], "1");
   EXPECT_EQ(rows[3][11], "1");
+  EXPECT_EQ(rows[5][11], "1");
   EXPECT_NEAR(std::stod(rows[2][11]), std::stod(rows[2][10]) / std::stod(rows[1][10]), 1e-5);
 
   if (gnuplot) {
@@ -173,11 +177,23 @@ TEST(RobotScalingTest, ConfigurationsAreCheckedBeforeAnyOutput) {
   const testing::CommandResult unknown =
       testing::RunProgram("bench --scaling-robots --robots 2 --configs lua,pyhton");
   EXPECT_EQ(unknown.exit_code, 2) << unknown.output;
-  EXPECT_NE(
-      unknown.output.find("bench: unknown configuration 'pyhton' (known: lua, cpp, planar-cpp)"),
-      std::string::npos)
+  EXPECT_NE(unknown.output.find(
+                "bench: unknown configuration 'pyhton' (known: lua, cpp, planar-lua, planar-cpp)"),
+            std::string::npos)
       << unknown.output;
   EXPECT_EQ(unknown.output.find("ticks/s"), std::string::npos) << unknown.output;
+
+  // The four default worlds, in the table's order, each a file that exists.
+  const std::vector<ScalingConfig> all = DefaultScalingConfigs();
+  ASSERT_EQ(all.size(), 4u);
+  const char* names[] = {"lua", "cpp", "planar-lua", "planar-cpp"};
+  const char* files[] = {"diffusion.yaml", "diffusion_native.yaml", "diffusion_planar.yaml",
+                         "diffusion_planar_native.yaml"};
+  for (size_t i = 0; i < all.size(); ++i) {
+    EXPECT_EQ(all[i].name, names[i]);
+    EXPECT_EQ(fs::path(all[i].world).filename(), files[i]) << all[i].world;
+    EXPECT_TRUE(fs::exists(all[i].world)) << all[i].world;
+  }
 
   // A world without the `robots` parameter, as plain bench refuses it.
   const fs::path dir = testing::FreshTempDir("robot_scaling_test", "refused");
