@@ -25,6 +25,11 @@ CLI::App* AddBenchCommand(CLI::App* app, BenchArgs* args) {
       ->transform(ThreadCountCheck());
   bench->add_option("--steps", options.steps, "Measured steps per configuration")
       ->transform(WholeNumberCheck(1, kInt64Max, "steps"));
+  bench
+      ->add_option("--warmup", options.warmup_steps,
+                   "Unmeasured steps before the measured ones, e.g. 3000 to measure a swarm "
+                   "that has moved (default 20; --scaling-robots: a tenth of the steps, 2 to 20)")
+      ->transform(WholeNumberCheck(0, kInt64Max, "warm-up steps"));
   bench->add_option("--csv", options.csv, "Write one CSV row per measurement")
       ->check(NonEmpty("a file"));
   bench
@@ -52,7 +57,8 @@ CLI::App* AddBenchCommand(CLI::App* app, BenchArgs* args) {
   CLI::Option* robots_flag = bench->add_flag(
       "--scaling-robots", args->scaling_robots,
       "Microseconds per robot-tick by phase, start-up and memory over --robots (default "
-      "1000,10000,100000) for the Lua, C++ and planar + C++ diffusion worlds; CSV + log-log PNG");
+      "1000,10000,100000) for the Lua diffusion world, its C++ controller, and both with "
+      "the planar backend (--configs); CSV + log-log PNG");
   bench
       ->add_option("--configs", args->configs,
                    "With --scaling-robots: which of lua, cpp, planar-lua, planar-cpp (default all)")
@@ -74,6 +80,7 @@ int ScalingRobots(const BenchArgs& args, const CLI::App& command) {
   if (command.count("--robots") > 0) o.robots = args.options.robots;
   if (command.count("--threads") > 0) o.threads = args.options.threads;
   if (command.count("--steps") > 0) o.steps = args.options.steps;
+  if (command.count("--warmup") > 0) o.warmup_steps = args.options.warmup_steps;
   if (args.options.csv) o.csv = *args.options.csv;
   if (command.count("--plot") > 0) o.plot = args.scaling_options.plot;
   o.repeat = args.repeat;

@@ -59,7 +59,14 @@ int Main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::cerr << ParseErrorMessage(app, args, e);
+    // An empty list entry first: CLI11's own message for `--robots ,` is vaguer.
+    const std::string empty_entry = EmptyListEntry(args);
+    std::cerr << (empty_entry.empty() ? ParseErrorMessage(app, args, e) : empty_entry);
+    return kExitBadInput;
+  }
+  // `bench --robots 1000,,2` parses (CLI11 drops the empty entry): refused.
+  if (const std::string message = EmptyListEntry(args); !message.empty()) {
+    std::cerr << message;
     return kExitBadInput;
   }
   // `run --set a=1 b=2` parses (b=2 as the world) but is the same mistake.

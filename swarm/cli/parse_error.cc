@@ -64,6 +64,34 @@ std::string SecondValueOfRepeatable(const std::vector<std::string>& args) {
   return "";
 }
 
+std::string EmptyListEntry(const std::vector<std::string>& args) {
+  const auto options_end = std::find(args.begin(), args.end(), "--");
+  for (auto it = args.begin(); it != options_end; ++it) {
+    const std::string option = it->substr(0, it->find('='));
+    if (option != "--robots" && option != "--threads" && option != "--jobs" &&
+        option != "--configs")
+      continue;
+    const bool joined = option.size() < it->size();
+    if (!joined && std::next(it) == options_end) break;
+    const std::string value = joined ? it->substr(option.size() + 1) : *std::next(it);
+    if (value.empty() || value.starts_with(',') || value.ends_with(',') ||
+        value.find(",,") != std::string::npos) {
+      std::string cleaned;
+      size_t start = 0;
+      for (size_t comma; start <= value.size(); start = comma + 1) {
+        comma = std::min(value.find(',', start), value.size());
+        if (comma > start)
+          cleaned += (cleaned.empty() ? "" : ",") + value.substr(start, comma - start);
+      }
+      return "error: " + option + " '" + value + "': an empty entry in the list" +
+             (cleaned.empty() ? " (give one or more values, e.g. " + option + " 1000,10000)"
+                              : " (did you mean " + option + " " + cleaned + "?)") +
+             "\n";
+    }
+  }
+  return "";
+}
+
 std::string ParseErrorMessage(CLI::App& app, const std::vector<std::string>& args,
                               const CLI::ParseError& error) {
   std::vector<std::string> commands;

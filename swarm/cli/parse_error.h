@@ -13,6 +13,12 @@ namespace swarmsim::cli {
 // (argv without the program) have no such value; an existing file is a world.
 std::string SecondValueOfRepeatable(const std::vector<std::string>& args);
 
+// `bench --robots 1000,,2` (or `1000,`, `,2`): a comma list with an empty
+// entry, which CLI11 would drop without a word. Returns the message naming
+// the option and the list, or "" when no list option (--robots, --threads,
+// --jobs, --configs) of `args` has one.
+std::string EmptyListEntry(const std::vector<std::string>& args);
+
 // What CLI11 rejected, in this program's words: an unknown option or command
 // with the nearest known one, a second value after --set, else CLI11's own
 // message. `args` is argv without the program.

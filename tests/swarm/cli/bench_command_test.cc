@@ -83,6 +83,38 @@ TEST(CliTest, BenchThreadsAreCheckedLikeRun) {
   EXPECT_NE(negative.output.find("got '-1'"), std::string::npos) << negative.output;
 }
 
+// A comma list with an empty entry is refused (CLI11 would drop it), with
+// the list as it was probably meant.
+TEST(CliTest, BenchListsWithAnEmptyEntryAreRefused) {
+  const std::string base = "bench --world " + Data("ok.yaml") + " --steps 1";
+  for (const auto& [flags, expected] : std::vector<std::pair<std::string, std::string>>{
+           {" --robots 1000,,2",
+            "error: --robots '1000,,2': an empty entry in the list (did "
+            "you mean --robots 1000,2?)"},
+           {" --robots=2,",
+            "error: --robots '2,': an empty entry in the list (did you mean "
+            "--robots 2?)"},
+           {" --robots 2 --threads ,1", "error: --threads ',1': an empty entry"},
+           {" --robots ,", "error: --robots ',': an empty entry in the list (give one or more"}}) {
+    const Result r = RunProgram(base + flags);
+    EXPECT_EQ(r.exit_code, 2) << flags << ": " << r.output;
+    EXPECT_NE(r.output.find(expected), std::string::npos) << flags << ": " << r.output;
+    EXPECT_EQ(r.output.find("ticks/s"), std::string::npos) << flags << ": nothing measured";
+  }
+}
+
+// --warmup: the unmeasured steps before the measured ones, said in the
+// table's heading; a negative count is refused.
+TEST(CliTest, BenchWarmupIsTheStepsBeforeTheMeasuredOnes) {
+  const std::string base = "bench --world " + Data("ok.yaml") + " --robots 2 --threads 1";
+  const Result r = RunProgram(base + " --steps 3 --warmup 7");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("3 measured steps after 7 warm-up steps"), std::string::npos) << r.output;
+  const Result negative = RunProgram(base + " --steps 3 --warmup -1");
+  EXPECT_EQ(negative.exit_code, 2) << negative.output;
+  EXPECT_NE(negative.output.find("--warmup"), std::string::npos) << negative.output;
+}
+
 // A flag of one kind of bench given to another is refused, not ignored.
 TEST(CliTest, BenchRefusesTheFlagsOfAnotherKindOfBench) {
   const std::string base = "bench --world " + Data("ok.yaml") + " --robots 2 --steps 1";
