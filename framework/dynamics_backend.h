@@ -49,7 +49,9 @@ struct DynamicsCapabilities {
   bool planar = false;
   // An engine integrates bodies in substeps (simulation.physics_substeps);
   // false for a backend that only moves what scripts and joints move
-  // (kinematic).
+  // (kinematic) or takes the control step in one (planar: exact motion, cut
+  // only where a body would tunnel). The run's summary names substeps only
+  // where they are taken.
   bool substeps = true;
 };
 

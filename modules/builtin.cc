@@ -54,8 +54,8 @@ void RegisterBuiltinModules(ModuleRegistry* registry) {
   registry->RegisterDynamics(kinematic::ModuleInfo(), {.planar = false, .substeps = false},
                              [] { return kinematic::MakeBackend(); });
   registry->RegisterDynamics(
-      planar::ModuleInfo(), {.planar = true}, [] { return planar::MakeBackend(); },
-      BareLoop<planar::TimeBareLoop>);
+      planar::ModuleInfo(), {.planar = true, .substeps = false},
+      [] { return planar::MakeBackend(); }, BareLoop<planar::TimeBareLoop>);
   // The first module types, registered right after the built-in ones so the
   // state hash adds types' rows in the order it did when they were built in:
   // proximity_sensor is listed right after joint (its listed_after), then

@@ -334,6 +334,7 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
     load.copy_progress = [&](int64_t built, int64_t total) { load_progress->Copies(built, total); };
   }
   LoadedWorld loaded;
+  const auto load_start = std::chrono::steady_clock::now();
   try {
     load.overrides = ParseSets(args.sets);
     options.overrides = load.overrides;
@@ -350,6 +351,8 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
     return bad_input(e.what());
   }
   if (load_progress) load_progress->Loaded();
+  options.load_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
   for (const std::string& warning : loaded.warnings)
     std::cerr << "warning: " << swarmsim::ValidUtf8(warning) << "\n";
   std::string length_error;

@@ -344,6 +344,7 @@ std::string WriteSummary(const World& world, const RunOptions& options, const Ru
   j["simulated_time"] = sim_time;
   j["wall_time"] = result.wall_seconds;
   j["start_time"] = result.start_seconds;  // of wall_time: starting the world
+  if (options.load_seconds >= 0) j["load_time"] = options.load_seconds;  // before wall_time
   j["real_time_factor"] = result.wall_seconds > 0 ? sim_time / result.wall_seconds : 0;
   j["robot_ticks_per_s"] = result.wall_seconds > 0 ? robot_ticks / result.wall_seconds : 0;
   j["peak_rss_mb"] = result.peak_rss_mb;
@@ -516,8 +517,8 @@ void StepWatched(World* world, const RunOptions& options, Clock::time_point star
 }
 
 // The summary table a run prints unless --quiet.
-void PrintSummaryTable(const World& world, const RunResult& result, double lua_kib,
-                       std::ostream& out) {
+void PrintSummaryTable(const World& world, const RunOptions& options, const RunResult& result,
+                       double lua_kib, std::ostream& out) {
   const int robots = world.live_robot_count();  // removed robots are not counted
   const double sim_time = world.time();
   const double robot_ticks = static_cast<double>(robots) * static_cast<double>(result.steps);
@@ -532,8 +533,11 @@ void PrintSummaryTable(const World& world, const RunResult& result, double lua_k
       << "simulated time  " << Fixed(sim_time, 2) << " s\n"
       << "wall time       " << Fixed(result.wall_seconds, 3) << " s on " << world.threads()
       << (world.threads() == 1 ? " thread" : " threads") << ", of which "
-      << Fixed(result.start_seconds, 3) << " s starting the world\n"
-      << "real-time factor " << Fixed(rtf, 1) << "x\n"
+      << Fixed(result.start_seconds, 3) << " s starting the world\n";
+  if (options.load_seconds >= 0)
+    out << "load time       " << Fixed(options.load_seconds, 3)
+        << " s before that (reading the world, building its robots)\n";
+  out << "real-time factor " << Fixed(rtf, 1) << "x\n"
       << "robot-ticks/s   " << Fixed(ticks_per_s, 0) << "\n"
       << "peak memory     " << Fixed(result.peak_rss_mb, 1) << " MiB ("
       << Fixed(robots > 0 ? result.peak_rss_mb * 1024 / robots : 0, 1)
@@ -627,7 +631,7 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
   // The summary.
   // (Not for a run that failed before its first step: the error says it all.)
   if (!options.quiet && (result.ok || result.steps > 0))
-    PrintSummaryTable(*world, result, record.lua_kib, out);
+    PrintSummaryTable(*world, options, result, record.lua_kib, out);
   if (options.print_hash) out << "state-hash: " << StateHasher::ToHex(result.state_hash) << "\n";
   out << std::flush;
 

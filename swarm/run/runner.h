@@ -40,6 +40,10 @@ struct RunOptions {
   std::optional<std::filesystem::path> save_state;
   int64_t save_state_at = -1;
   std::string resumed_from;
+  // Seconds the caller spent loading the world (reading the file, building
+  // its robots) before handing it to the run: not in the wall time; the
+  // table and summary.json's load_time say it. Negative: not known.
+  double load_seconds = -1;
   // Called once with how the run ended when the watchdog ends it (a step or
   // the stop stuck past simulation.step_timeout, a stop signal during a
   // stuck step), from the watchdog's thread just before the process exits:

@@ -462,6 +462,37 @@ TEST(RunOutputsTest, TheSummarySaysHowMuchOfTheWallTimeStartedTheWorld) {
     phases += seconds.get<double>();
   EXPECT_GT(start, 5 * phases) << summary.dump(2);
   EXPECT_LE(start, wall) << summary.dump(2);
+  // Loading (reading the file, building the robot) came before the wall time.
+  ASSERT_TRUE(summary.contains("load_time")) << summary.dump(2);
+  const double load = summary["load_time"];
+  EXPECT_GT(load, 0) << summary.dump(2);
+  EXPECT_LT(load, start) << "the one robot loads faster than its init runs";
+  EXPECT_NE(r.output.find("load time "), std::string::npos) << r.output;
+  fs::remove_all(dir);
+}
+
+// The summary's steps line names the substeps a backend takes, and none for
+// one that takes the control step in one (planar) or has no engine.
+TEST(RunOutputsTest, TheSummaryNamesSubstepsOnlyWhereTheyAreTaken) {
+  const fs::path dir = TempDir("substeps");
+  fs::create_directories(dir);
+  std::ofstream(dir / "bot.yaml") << "model: bot\n"
+                                     "objects: {name: body, type: shape, shape: cylinder, "
+                                     "radius: 0.05, height: 0.1, dynamic: true}\n";
+  for (const std::string physics : {"box2d", "planar", "kinematic"}) {
+    std::ofstream(dir / "world.yaml")
+        << "simulation: {physics: " << physics << ", time_step: 0.1, physics_substeps: 7}\n"
+        << "models:\n  - {model: bot.yaml, position: [0, 0]}\n";
+    const auto r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 1");
+    ASSERT_EQ(r.exit_code, 0) << physics << ": " << r.output;
+    const bool substeps = physics == "box2d";
+    EXPECT_EQ(r.output.find("s, " + physics + ", 7 physics substeps)") != std::string::npos,
+              substeps)
+        << r.output;
+    if (!substeps) {
+      EXPECT_NE(r.output.find("s, " + physics + ")"), std::string::npos) << r.output;
+    }
+  }
   fs::remove_all(dir);
 }
 
