@@ -51,7 +51,11 @@ std::string_view Trim(std::string_view s) {
 
 std::string FormatNumber(double value) {
   char buf[32];
-  const auto result = std::to_chars(buf, buf + sizeof buf, value);
+  // Whole numbers as digits (2000000, not the shorter 2e+06: a count a
+  // user wrote reads back as written); the rest in the shortest form.
+  const bool whole = value == std::floor(value) && std::abs(value) < 1e15;
+  const auto result = whole ? std::to_chars(buf, buf + sizeof buf, value, std::chars_format::fixed)
+                            : std::to_chars(buf, buf + sizeof buf, value);
   return std::string(buf, result.ptr);
 }
 

@@ -43,6 +43,10 @@ TEST(ValuesTest, NumbersAreWrittenShortestAndReadBackTheSame) {
   EXPECT_EQ(FormatNumber(3), "3");
   EXPECT_EQ(FormatNumber(-2.5), "-2.5");
   EXPECT_EQ(FormatNumber(1e21), "1e+21");
+  EXPECT_EQ(FormatNumber(2e6), "2000000") << "a count reads back as written";
+  EXPECT_EQ(FormatNumber(-100000), "-100000");
+  EXPECT_EQ(FormatNumber(2.5e6), "2500000");
+  EXPECT_EQ(FormatNumber(1e-7), "1e-07");
   for (const double v : {0.1 + 0.2, 1.0 / 3, 6.02214076e23, -1e-300})
     EXPECT_EQ(std::stod(FormatNumber(v)), v) << FormatNumber(v);
 }

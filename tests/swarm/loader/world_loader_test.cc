@@ -329,7 +329,7 @@ TEST_F(MalformedWorldTest, EachMistakeHasAClearMessage) {
       {"inf size", "arena: {size: inf}\n", {"positive number"}},
       {"huge size",
        "arena: {size: 1e300}\n",
-       {"world.yaml:1:15:", "'size' must be at most 1e+06 (got \"1e300\")"}},
+       {"world.yaml:1:15:", "'size' must be at most 1000000 (got \"1e300\")"}},
       {"expression gives a negative size",
        "parameters: {robots: 4}\narena: {size: '= -sqrt(robots)'}\n",
        {"world.yaml:2:15:", "positive number", "-2 from"}},
