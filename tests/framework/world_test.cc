@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include "framework/error.h"
 #include "tests/framework/fakes.h"
@@ -14,7 +15,10 @@ namespace {
 // Moves every dynamic shape along +x at 1 m/s; can be told to explode.
 class ConveyorDynamics : public DynamicsBackend {
  public:
-  explicit ConveyorDynamics(bool explode_at_step2) : explode_(explode_at_step2) {}
+  // explode_some: at step 2 only every 1,000th body from the 778th gets a
+  // NaN velocity, and every body from the 5,000th a NaN pose.
+  explicit ConveyorDynamics(bool explode_at_step2, bool explode_some = false)
+      : explode_(explode_at_step2), some_(explode_some) {}
   void Build(const Scene&, const DynamicsSettings&) override {}
   void Step(Scene* scene, double dt, int substeps) override {
     ++steps_;
@@ -24,13 +28,18 @@ class ConveyorDynamics : public DynamicsBackend {
       Pose X = scene->world_pose_at(slot);
       X.p.x += dt * substeps;
       if (explode_ && steps_ == 2) X.p.y = std::numeric_limits<double>::quiet_NaN();
-      scene->SetSimulatedState(slot, X, {1, 0, 0}, {});
+      Vec3 v{1, 0, 0};
+      if (some_ && steps_ == 2) {
+        if (r % 1000 == 777) v.z = std::numeric_limits<double>::infinity();
+        if (r >= 5000) X.q.w = std::numeric_limits<double>::quiet_NaN();
+      }
+      scene->SetSimulatedState(slot, X, v, {});
     }
   }
   int body_count() const override { return 0; }
 
  private:
-  bool explode_;
+  bool explode_, some_;
   int steps_ = 0;
 };
 
@@ -40,6 +49,8 @@ ModuleRegistry MakeRegistry() {
                      [] { return std::make_unique<ConveyorDynamics>(false); });
   r.RegisterDynamics({"", "explode", "1", ""}, {},
                      [] { return std::make_unique<ConveyorDynamics>(true); });
+  r.RegisterDynamics({"", "explode_some", "1", ""}, {},
+                     [] { return std::make_unique<ConveyorDynamics>(false, true); });
   return r;
 }
 
@@ -120,6 +131,32 @@ TEST(WorldTest, NonFinitePhysicsIsAnErrorNamingTheObject) {
     EXPECT_NE(msg.find("step 2"), std::string::npos) << msg;
   }
   EXPECT_THROW(world.Step(), Error);  // no stepping on after a failure
+}
+
+// Many bodies checked on every thread: the error names the first bad one
+// (by row) and what is wrong with it, the same for any thread count.
+TEST(WorldTest, NonFinitePhysicsNamesTheFirstBadBodyForAnyThreadCount) {
+  const ModuleRegistry registry = MakeRegistry();
+  for (const int threads : {1, 2}) {
+    WorldSettings settings;
+    settings.physics = "explode_some";
+    settings.threads = threads;
+    World world(settings, registry);
+    ShapeData body;
+    body.dynamic = true;
+    for (int i = 0; i < 20000; ++i)
+      world.scene().AddShape("body" + std::to_string(i), {}, {{double(i), 0, 0}, {}}, body);
+    world.Start();
+    world.Step();
+    try {
+      world.Step();
+      FAIL() << "NaN accepted, threads " << threads;
+    } catch (const Error& e) {
+      const std::string msg = e.what();
+      EXPECT_NE(msg.find("non-finite velocity for '/body777' at step 2"), std::string::npos)
+          << threads << ": " << msg;
+    }
+  }
 }
 
 TEST(WorldTest, JointRunningToInfinityIsAnErrorNamingTheJoint) {
