@@ -10,7 +10,9 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <set>
 #include <sstream>
+#include <string_view>
 
 #include "framework/display_path.h"
 #include "framework/error.h"
@@ -23,6 +25,9 @@
 namespace swarmsim {
 
 namespace {
+
+// A child's line after its CSV row: one of the world's load-time warnings.
+constexpr std::string_view kWarningLine = "warning: ";
 
 namespace fs = std::filesystem;
 
@@ -153,6 +158,7 @@ int RunBenchChild(const BenchOptions& options, const std::string& config, int ro
   row.peak_rss_mb = PeakRssMb();
   row.kb_per_robot = row.robots > 0 ? row.peak_rss_mb * 1024.0 / row.robots : 0;
   out << ToCsv(row) << "\n";
+  for (const std::string& warning : loaded.warnings) out << kWarningLine << warning << "\n";
   return 0;
 }
 
@@ -216,7 +222,7 @@ std::string PrepareBench(BenchOptions* options) {
 }
 
 bool MeasureInChild(const BenchOptions& options, const std::string& config, int robots, int threads,
-                    BenchRow* row) {
+                    BenchRow* row, std::vector<std::string>* warnings) {
   const std::vector<std::string> args{options.self_exe,  "bench",
                                       "--child",         config,
                                       "--child-robots",  std::to_string(robots),
@@ -226,8 +232,15 @@ bool MeasureInChild(const BenchOptions& options, const std::string& config, int 
                                       "--world",         options.world};
   std::string output;
   int status = 0;
-  return RunChild(args, &output, &status) && WIFEXITED(status) && WEXITSTATUS(status) == 0 &&
-         FromCsv(output.substr(0, output.find('\n')), row);
+  if (!(RunChild(args, &output, &status) && WIFEXITED(status) && WEXITSTATUS(status) == 0 &&
+        FromCsv(output.substr(0, output.find('\n')), row)))
+    return false;
+  if (warnings != nullptr) {
+    std::istringstream lines(output);
+    for (std::string line; std::getline(lines, line);)
+      if (line.starts_with(kWarningLine)) warnings->push_back(line.substr(kWarningLine.size()));
+  }
+  return true;
 }
 
 int RunBench(BenchOptions options, std::ostream& out, std::ostream& err) {
@@ -253,10 +266,15 @@ int RunBench(BenchOptions options, std::ostream& out, std::ostream& err) {
       << "\n"
       << std::string(static_cast<size_t>(width) + 8 + 8 + 14 + 9 * 5 + 10 + 9, '-') << "\n"
       << std::flush;
+  std::set<std::string> warned;  // each of the world's warnings said once
   auto measure = [&](const std::string& config, int robots, int threads) {
     BenchRow row;
     const std::string label = config == "diffusion" ? world_label : config;
-    if (!MeasureInChild(options, config, robots, threads, &row)) {
+    std::vector<std::string> warnings;
+    const bool measured = MeasureInChild(options, config, robots, threads, &row, &warnings);
+    for (const std::string& warning : warnings)
+      if (warned.insert(warning).second) err << "warning: " << warning << "\n" << std::flush;
+    if (!measured) {
       err << "bench: " << label << " with " << robots << (robots == 1 ? " robot" : " robots")
           << " on " << threads << (threads == 1 ? " thread" : " threads") << " failed\n";
       return false;

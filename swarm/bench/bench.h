@@ -59,12 +59,15 @@ int RunBench(BenchOptions options, std::ostream& out, std::ostream& err);
 
 // Measures one configuration in a fresh child process (`options.self_exe
 // bench --child ...`: options.world, steps and warm-up steps) into `row`.
-// False when the child failed (its stderr passes through).
+// False when the child failed (its stderr passes through). The world's
+// load-time warnings at that robot count (the large-swarm notes, say) are
+// appended to `warnings` if given.
 bool MeasureInChild(const BenchOptions& options, const std::string& config, int robots, int threads,
-                    BenchRow* row);
+                    BenchRow* row, std::vector<std::string>* warnings = nullptr);
 
 // The child side: measures one configuration in this process and prints one
-// CSV row (no header) to `out`. `config` is "diffusion" or "box2d-only".
+// CSV row (no header) to `out`, then a "warning: ..." line for each of the
+// world's load-time warnings. `config` is "diffusion" or "box2d-only".
 int RunBenchChild(const BenchOptions& options, const std::string& config, int robots, int threads,
                   std::ostream& out);
 

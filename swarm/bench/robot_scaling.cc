@@ -9,6 +9,7 @@
 #include <iomanip>
 #include <map>
 #include <ostream>
+#include <set>
 #include <sstream>
 #include <thread>
 #include <utility>
@@ -251,6 +252,7 @@ int RunRobotScalingBench(RobotScalingOptions o, std::ostream& out, std::ostream&
     csv << CsvRow(row, cell.config->world) << "\n" << std::flush;
     rows.push_back(row);
   };
+  std::set<std::string> warned;  // each world's load-time warnings said once
   for (int round = 1; round <= rounds; ++round) {
     for (Cell& cell : cells) {
       const ScalingConfig& c = *cell.config;
@@ -261,7 +263,12 @@ int RunRobotScalingBench(RobotScalingOptions o, std::ostream& out, std::ostream&
       bench.warmup_steps = o.warmup_steps >= 0 ? o.warmup_steps : AutoWarmupSteps(bench.steps);
       ScalingRow row;
       row.config = c.name;
-      if (!MeasureInChild(bench, "diffusion", cell.robots, cell.threads, &row.bench)) {
+      std::vector<std::string> warnings;
+      const bool measured =
+          MeasureInChild(bench, "diffusion", cell.robots, cell.threads, &row.bench, &warnings);
+      for (const std::string& warning : warnings)
+        if (warned.insert(warning).second) err << "warning: " << warning << "\n" << std::flush;
+      if (!measured) {
         err << "bench: " << c.name << " with " << cell.robots << " robots on " << cell.threads
             << (cell.threads == 1 ? " thread" : " threads") << " failed\n";
         ok = false;

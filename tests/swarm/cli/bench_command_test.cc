@@ -115,6 +115,38 @@ TEST(CliTest, BenchWarmupIsTheStepsBeforeTheMeasuredOnes) {
   EXPECT_NE(negative.output.find("--warmup"), std::string::npos) << negative.output;
 }
 
+// The world's load-time warnings at the measured count (here the
+// large-swarm note about `order`) reach the user once, as `run` prints
+// them, though every row's child loads the world.
+TEST(CliTest, BenchPassesOnTheWorldsWarningsOnce) {
+  const fs::path dir = TempDir("bench_warnings");
+  fs::create_directories(dir);
+  std::ofstream(dir / "dot.yaml") << "model: dot\n"
+                                     "objects: {name: body, type: shape, shape: cylinder, "
+                                     "radius: 0.05, height: 0.05}\n";
+  std::ofstream(dir / "world.yaml") << "simulation: {physics: kinematic, time_step: 0.1}\n"
+                                       "parameters: {robots: 10}\n"
+                                       "arena: {size: 150}\n"
+                                       "models:\n"
+                                       "  - model: dot.yaml\n"
+                                       "    count: $robots\n"
+                                       "    distribute: {region: arena}\n";
+  const std::string note = "numbered in the order they were drawn";
+  const Result large = RunProgram("bench --world " + (dir / "world.yaml").string() +
+                                  " --robots 10000 --threads 1,2 --steps 1 --warmup 0");
+  EXPECT_EQ(large.exit_code, 0) << large.output;
+  const size_t at = large.output.find(note);
+  ASSERT_NE(at, std::string::npos) << large.output;
+  EXPECT_EQ(large.output.find(note, at + 1), std::string::npos) << "said once: " << large.output;
+  EXPECT_NE(large.output.find("world.yaml:6:12: 10,000 copies of 'dot'"), std::string::npos)
+      << large.output;
+  const Result small = RunProgram("bench --world " + (dir / "world.yaml").string() +
+                                  " --robots 100 --threads 1 --steps 1 --warmup 0");
+  EXPECT_EQ(small.exit_code, 0) << small.output;
+  EXPECT_EQ(small.output.find(note), std::string::npos) << small.output;
+  fs::remove_all(dir);
+}
+
 // A flag of one kind of bench given to another is refused, not ignored.
 TEST(CliTest, BenchRefusesTheFlagsOfAnotherKindOfBench) {
   const std::string base = "bench --world " + Data("ok.yaml") + " --robots 2 --steps 1";
