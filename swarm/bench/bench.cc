@@ -18,6 +18,7 @@
 #include "framework/error.h"
 #include "framework/output_file.h"
 #include "framework/registry.h"
+#include "framework/utf8.h"
 #include "modules/builtin.h"
 #include "swarm/loader/world_loader.h"
 #include "swarm/run/runner.h"
@@ -158,7 +159,11 @@ int RunBenchChild(const BenchOptions& options, const std::string& config, int ro
   row.peak_rss_mb = PeakRssMb();
   row.kb_per_robot = row.robots > 0 ? row.peak_rss_mb * 1024.0 / row.robots : 0;
   out << ToCsv(row) << "\n";
-  for (const std::string& warning : loaded.warnings) out << kWarningLine << warning << "\n";
+  for (std::string warning : loaded.warnings) {  // one line each, as run prints them
+    warning = ValidUtf8(warning);
+    std::replace(warning.begin(), warning.end(), '\n', ' ');
+    out << kWarningLine << warning << "\n";
+  }
   return 0;
 }
 
