@@ -288,6 +288,15 @@ py::dict RangeAndBearing(const Scene& scene, const ModelLayout& layout) {
     const uint32_t slot = layout.board_slots[i];
     return slot == ModelLayout::kNoBoard || rows == nullptr ? nullptr : &rows[scene.row_at(slot)];
   };
+  // A model none of whose robots has a board is a mistake, as for IR
+  // messages and set_range_and_bearing_data (robots without one among
+  // others just hear nothing).
+  bool any_board = false;
+  for (size_t i = 0; i < n && !any_board; ++i) any_board = board(i) != nullptr;
+  if (n > 0 && !any_board)
+    throw py::value_error(
+        "the robots have no range-and-bearing board (worlds/README.md, "
+        "\"range_and_bearing\")");
   size_t m = 0, width = 0;
   for (size_t i = 0; i < n; ++i)
     if (const RangeAndBearingRow* b = board(i)) {

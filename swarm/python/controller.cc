@@ -199,8 +199,9 @@ class ControllerModule : public Module {
         trace = e.what();
       }
       throw Error(config_.where + ": the Python controller of model '" + config_.model +
-                  "' raised an exception at step " + std::to_string(world->step_count() + 1) +
-                  ":\n" + trace);
+                  "' raised an exception in step " + std::to_string(world->step_count() + 1) +
+                  " of the run (its Robots.step was " + std::to_string(world->step_count()) +
+                  "):\n" + trace);
     }
   }
 

@@ -37,6 +37,31 @@ namespace {
 // (made again when the count changes: oneTBB applies the smallest
 // parallelism limit alive, so old ones are not kept). Never destroyed at
 // exit: oneTBB arenas outlive the interpreter's teardown.
+// A whole-number argument as the README promises: a bool, a float or text
+// raises TypeError (Python's bool is an int, which pybind11 would take).
+int64_t IntArg(const py::handle& value, const std::string& what) {
+  if (py::isinstance<py::bool_>(value) || PyIndex_Check(value.ptr()) == 0)
+    throw py::type_error(what + " must be an integer, not " +
+                         py::str(py::type::of(value).attr("__name__")).cast<std::string>());
+  return value.cast<int64_t>();
+}
+
+// A seed: None (the world's own) or an integer from 0 to 2^64 - 1.
+std::optional<uint64_t> SeedArg(const py::object& value, const std::string& what) {
+  if (value.is_none()) return std::nullopt;
+  if (py::isinstance<py::bool_>(value) || PyIndex_Check(value.ptr()) == 0)
+    throw py::type_error(what + " must be None or an integer from 0 to 18446744073709551615, not " +
+                         py::str(py::type::of(value).attr("__name__")).cast<std::string>());
+  const py::int_ number = py::reinterpret_steal<py::int_>(PyNumber_Index(value.ptr()));
+  const unsigned long long seed = PyLong_AsUnsignedLongLong(number.ptr());
+  if (PyErr_Occurred() != nullptr) {
+    PyErr_Clear();
+    throw py::value_error(what + " must be from 0 to 18446744073709551615, got " +
+                          number.attr("__str__")().cast<std::string>());
+  }
+  return static_cast<uint64_t>(seed);
+}
+
 TaskScheduler& WorldsScheduler(int threads) {
   static TaskScheduler* scheduler = nullptr;
   static int made_for = -1;
@@ -140,21 +165,30 @@ PYBIND11_MODULE(_swarmsim, m) {
       "Threads: one thread uses a World at a time. A second Python thread's call waits\n"
       "until the first one's step ends. A controller may read its world but not step,\n"
       "close or write it (RuntimeError).")
-      .def(py::init<const std::string&, std::optional<uint64_t>,
-                    const std::map<std::string, py::object>&, int,
-                    const std::map<std::string, py::object>&, const std::vector<std::string>&,
-                    bool>(),
+      .def(py::init([](const std::string& path, const py::object& seed,
+                       const std::map<std::string, py::object>& set, int threads,
+                       const std::map<std::string, py::object>& controllers,
+                       const std::vector<std::string>& package_path, bool keep_scripts) {
+             return std::make_unique<PyWorld>(
+                 path, swarmsim::python::SeedArg(seed, "World(seed=...)"), set, threads,
+                 controllers, package_path, keep_scripts);
+           }),
            py::arg("path"), py::arg("seed") = py::none(),
            py::arg("set") = std::map<std::string, py::object>{}, py::arg("threads") = 0,
            py::arg("controllers") = std::map<std::string, py::object>{},
            py::arg("package_path") = std::vector<std::string>{}, py::arg("keep_scripts") = true)
       // Stepping and state.
-      .def("step", &PyWorld::Step, py::arg("n") = 1,
-           "Runs n control steps (sense, control, actuate, physics, record).\n\n"
-           "Raises RuntimeError when a script or controller fails (the world then cannot be\n"
-           "stepped again), when the world is closed, or from inside its own controller.\n"
-           "A KeyboardInterrupt or SystemExit raised in a controller ends that step without\n"
-           "the controllers' targets, then propagates as itself; the world stays usable.")
+      .def(
+          "step",
+          [](PyWorld& w, const py::object& n) {
+            w.Step(swarmsim::python::IntArg(n, "step(n): n"));
+          },
+          py::arg("n") = 1,
+          "Runs n control steps (sense, control, actuate, physics, record).\n\n"
+          "Raises RuntimeError when a script or controller fails (the world then cannot be\n"
+          "stepped again), when the world is closed, or from inside its own controller.\n"
+          "A KeyboardInterrupt or SystemExit raised in a controller ends that step without\n"
+          "the controllers' targets, then propagates as itself; the world stays usable.")
       .def("close", &PyWorld::Close,
            "Runs the scripts' cleanup and frees the world; later calls raise RuntimeError.\n"
            "RuntimeError from inside one of its controllers.")
@@ -210,7 +244,8 @@ PYBIND11_MODULE(_swarmsim, m) {
            "What each robot's first range-and-bearing board heard in the last sense phase:\n"
            "{'offsets': (N+1,) int64, 'range': (M,) m, 'bearing', 'elevation': (M,) rad,\n"
            "'sender': (M,) int64 robot index or -1, 'data': (M, bytes) uint8}; robot i's\n"
-           "readings are rows offsets[i] to offsets[i+1]-1, nearest first.")
+           "readings are rows offsets[i] to offsets[i+1]-1, nearest first. ValueError when\n"
+           "none of the model's robots has a board.")
       // Devices: vision sensors, blob cameras, force sensors, distance and collision objects.
       .def(
           "vision_sensor_names",
@@ -353,10 +388,15 @@ PYBIND11_MODULE(_swarmsim, m) {
            "Puts the world in the state snapshot() saved: restore + k steps gives the state\n"
            "hash of the uninterrupted run. ValueError for another world's or corrupt bytes\n"
            "(the world is then unchanged).")
-      .def("reset", &PyWorld::reset, py::arg("seed") = py::none(),
-           "Back, in place, to the state a fresh load with `seed` (None: the world's own)\n"
-           "leaves: robots placed as the loader places them with that seed, every random\n"
-           "stream from it. No file is read again.")
+      .def(
+          "reset",
+          [](PyWorld& w, const py::object& seed) {
+            w.reset(swarmsim::python::SeedArg(seed, "reset(seed)"));
+          },
+          py::arg("seed") = py::none(),
+          "Back, in place, to the state a fresh load with `seed` (None: the world's own)\n"
+          "leaves: robots placed as the loader places them with that seed, every random\n"
+          "stream from it. No file is read again.")
       .def(py::pickle([](PyWorld& w) { return w.getstate(); }, &PyWorld::setstate));
 
   m.def("step_worlds", &swarmsim::python::StepWorlds, py::arg("worlds"), py::arg("n") = 1,

@@ -220,6 +220,39 @@ class MisuseTest(unittest.TestCase):
             swarmsim.World(WORLD, set={"robots": 2}, threads=256).step()
         """)
 
+    def test_step_counts_and_seeds_are_whole_numbers(self):
+        self.run_child("""
+            w = swarmsim.World(WORLD, set={"robots": 2})
+            for bad in (True, 1.0, "1", None):
+                expect(TypeError, "step(n): n must be an integer", w.step, bad)
+            assert w.steps == 0, "nothing stepped"
+            expect(ValueError, "n must be >= 0", w.step, -1)
+            w.step(np.int64(2))
+            assert w.steps == 2
+            for bad in (-1, 2**64):
+                e = expect(ValueError, "must be from 0 to 18446744073709551615", swarmsim.World,
+                           WORLD, seed=bad)
+                assert str(bad) in str(e)
+                expect(ValueError, "reset(seed) must be from 0", w.reset, bad)
+            for bad in (True, 1.5, "7"):
+                expect(TypeError, "World(seed=...) must be None or an integer", swarmsim.World,
+                       WORLD, seed=bad)
+                expect(TypeError, "reset(seed) must be None or an integer", w.reset, bad)
+            a = swarmsim.World(WORLD, seed=2**64 - 1, set={"robots": 2})
+            b = swarmsim.World(WORLD, seed=np.uint64(2**64 - 1), set={"robots": 2})
+            assert a.state_hash() == b.state_hash()
+        """)
+
+    def test_a_model_without_range_and_bearing_boards_is_a_value_error(self):
+        self.run_child("""
+            w = swarmsim.World(WORLD, set={"robots": 2})   # foot-bots without the board
+            expect(ValueError, "no range-and-bearing board", w.range_and_bearing, "footbot")
+            w2 = swarmsim.World(WORLD, set={"robots": 2, "footbot.with_rab": True})
+            w2.step()
+            r = w2.range_and_bearing("footbot")
+            assert r["offsets"].shape == (3,)
+        """)
+
     def test_wrong_shapes_and_names_are_value_errors(self):
         self.run_child("""
             w = swarmsim.World(WORLD, set={"robots": 10})
