@@ -240,9 +240,12 @@ std::string Scene::ExplainMissingPath(std::string_view path, ObjectId from) cons
     std::sort(names.begin(), names.end());
     names.erase(std::unique(names.begin(), names.end()), names.end());
     if (const std::string* nearest = NearestName(e.name, names)) {
+      // Suggested only if the path with it names an object ('/bot#9/eye'
+      // is not mended by '/bot#0/eye' when bot#0 has no eye either).
       const size_t at = static_cast<size_t>(e.name.data() - full.data());
-      return "; did you mean '" + std::string(full.substr(0, at)) + *nearest +
-             std::string(full.substr(at + e.name.size())) + "'?";
+      const std::string mended =
+          std::string(full.substr(0, at)) + *nearest + std::string(full.substr(at + e.name.size()));
+      if (!FindObject(mended, from).IsNull()) return "; did you mean '" + mended + "'?";
     }
     if (names.empty()) return "; there is no object there";
     constexpr size_t kListed = 20;

@@ -112,6 +112,14 @@ TEST(ScriptHostTest, MissingObjectPathSuggestsTheNearestNameOrTheIndexRange) {
     for (int i = 0; i < 12; ++i) proximity::AddSensor(&w.scene(), "prox", body, {}, {});
     EXPECT_CONTAINS(ErrorOf([&] { w.world().Start(); }), message);
   }
+  // A nearest name whose path names nothing either is not suggested: bot#0
+  // has no 'eye', so '/bot#0/body/eye' would be a second dead end.
+  ScriptWorld w;
+  w.AddWheeledRobot("bot#0", "function sysCall_init() sim.getObject('/bot#9/body/eye') end");
+  const std::string error = ErrorOf([&] { w.world().Start(); });
+  EXPECT_CONTAINS(error, "no object at path '/bot#9/body/eye'");
+  EXPECT_CONTAINS(error, "; the names there: bot#0");
+  EXPECT_EQ(error.find("did you mean"), std::string::npos) << error;
 }
 
 TEST(ScriptHostTest, PosesInWorldAndRelativeFrames) {
