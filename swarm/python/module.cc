@@ -43,7 +43,12 @@ int64_t IntArg(const py::handle& value, const std::string& what) {
   if (py::isinstance<py::bool_>(value) || PyIndex_Check(value.ptr()) == 0)
     throw py::type_error(what + " must be an integer, not " +
                          py::str(py::type::of(value).attr("__name__")).cast<std::string>());
-  return value.cast<int64_t>();
+  try {
+    return value.cast<int64_t>();
+  } catch (const py::cast_error&) {
+    throw py::value_error(what + " is out of range (at most 2^63 - 1), got " +
+                          py::str(value).cast<std::string>());
+  }
 }
 
 // A seed: None (the world's own) or an integer from 0 to 2^64 - 1.

@@ -227,6 +227,7 @@ class MisuseTest(unittest.TestCase):
                 expect(TypeError, "step(n): n must be an integer", w.step, bad)
             assert w.steps == 0, "nothing stepped"
             expect(ValueError, "n must be >= 0", w.step, -1)
+            expect(ValueError, "out of range", w.step, 2**70)
             w.step(np.int64(2))
             assert w.steps == 2
             for bad in (-1, 2**64):
