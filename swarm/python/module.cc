@@ -31,18 +31,20 @@ namespace py = pybind11;
 namespace swarmsim::python {
 namespace {
 
-// --- Many worlds at once ---------------------------------------------------------------
+// --- Whole-number arguments -------------------------------------------------------------
 
-// The scheduler of the last thread count asked for, kept between calls
-// (made again when the count changes: oneTBB applies the smallest
-// parallelism limit alive, so old ones are not kept). Never destroyed at
-// exit: oneTBB arenas outlive the interpreter's teardown.
-// A whole-number argument as the README promises: a bool, a float or text
-// raises TypeError (Python's bool is an int, which pybind11 would take).
+// Is `value` an integer as the README promises (int, a numpy integer: it
+// has __index__), not a bool (Python's bool is an int, which pybind11 takes)?
+bool IsInteger(const py::handle& value) {
+  return !py::isinstance<py::bool_>(value) && PyIndex_Check(value.ptr()) != 0;
+}
+std::string TypeName(const py::handle& value) {
+  return py::str(py::type::of(value).attr("__name__")).cast<std::string>();
+}
+
+// A count: TypeError for a bool, float or text, ValueError past 2^63 - 1.
 int64_t IntArg(const py::handle& value, const std::string& what) {
-  if (py::isinstance<py::bool_>(value) || PyIndex_Check(value.ptr()) == 0)
-    throw py::type_error(what + " must be an integer, not " +
-                         py::str(py::type::of(value).attr("__name__")).cast<std::string>());
+  if (!IsInteger(value)) throw py::type_error(what + " must be an integer, not " + TypeName(value));
   try {
     return value.cast<int64_t>();
   } catch (const py::cast_error&) {
@@ -54,9 +56,9 @@ int64_t IntArg(const py::handle& value, const std::string& what) {
 // A seed: None (the world's own) or an integer from 0 to 2^64 - 1.
 std::optional<uint64_t> SeedArg(const py::object& value, const std::string& what) {
   if (value.is_none()) return std::nullopt;
-  if (py::isinstance<py::bool_>(value) || PyIndex_Check(value.ptr()) == 0)
+  if (!IsInteger(value))
     throw py::type_error(what + " must be None or an integer from 0 to 18446744073709551615, not " +
-                         py::str(py::type::of(value).attr("__name__")).cast<std::string>());
+                         TypeName(value));
   const py::int_ number = py::reinterpret_steal<py::int_>(PyNumber_Index(value.ptr()));
   const unsigned long long seed = PyLong_AsUnsignedLongLong(number.ptr());
   if (PyErr_Occurred() != nullptr) {
@@ -67,6 +69,12 @@ std::optional<uint64_t> SeedArg(const py::object& value, const std::string& what
   return static_cast<uint64_t>(seed);
 }
 
+// --- Many worlds at once ---------------------------------------------------------------
+
+// The scheduler of the last thread count asked for, kept between calls
+// (made again when the count changes: oneTBB applies the smallest
+// parallelism limit alive, so old ones are not kept). Never destroyed at
+// exit: oneTBB arenas outlive the interpreter's teardown.
 TaskScheduler& WorldsScheduler(int threads) {
   static TaskScheduler* scheduler = nullptr;
   static int made_for = -1;
@@ -81,7 +89,8 @@ TaskScheduler& WorldsScheduler(int threads) {
 // Steps each world n steps, the worlds in parallel on `threads` workers
 // (each one's own step is as deterministic as ever: the same state as
 // stepping it alone), the GIL released but for Python controllers.
-void StepWorlds(const py::sequence& worlds, int64_t n, int threads) {
+void StepWorlds(const py::sequence& worlds, const py::object& count, int threads) {
+  const int64_t n = IntArg(count, "step_worlds(n): n");
   if (n < 0) throw py::value_error("step_worlds: n must be >= 0, got " + std::to_string(n));
   CheckThreads(threads, "step_worlds");
   const size_t k = py::len(worlds);

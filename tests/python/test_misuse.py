@@ -228,6 +228,10 @@ class MisuseTest(unittest.TestCase):
             assert w.steps == 0, "nothing stepped"
             expect(ValueError, "n must be >= 0", w.step, -1)
             expect(ValueError, "out of range", w.step, 2**70)
+            for bad in (True, 2.0):
+                expect(TypeError, "step_worlds(n): n must be an integer", swarmsim.step_worlds,
+                       [w], n=bad)
+            assert w.steps == 0, "nothing stepped"
             w.step(np.int64(2))
             assert w.steps == 2
             for bad in (-1, 2**64):
