@@ -291,8 +291,10 @@ void World::SetInstanceParameters(int instance, SharedParameters parameters) {
 
 void World::Start() {
   if (started_) return;
+  StartStage("world poses");
   EnsureRuntimes();
   UpdateWorldPoses(&scene_, *scheduler_);
+  StartStage("physics (" + settings_.physics + ")");
   dynamics_ = registry_.MakeDynamics(settings_.physics);
   DynamicsSettings dynamics_settings;
   dynamics_settings.gravity = settings_.gravity;
@@ -309,7 +311,10 @@ void World::Start() {
     if (descriptor->every_world && find_module(descriptor->info.name) == nullptr)
       InstallModule(descriptor->info.name, descriptor->order, descriptor->phases,
                     descriptor->make(this, nullptr));
-  for (const ModuleEntry& e : modules_) e.instance->Start(this);
+  for (const ModuleEntry& e : modules_) {
+    StartStage("module " + e.name);
+    e.instance->Start(this);
+  }
   device_services_ = {dynamic_cast<const SensorValueAccess*>(find_module("light")),
                       dynamic_cast<const SensorValueAccess*>(find_module("ground_sensor")),
                       dynamic_cast<const LedAccess*>(find_module("blobs")),
@@ -318,14 +323,19 @@ void World::Start() {
     run_script_memory_.set_limit(
         static_cast<uint64_t>(std::max(WorldSettings::kDefaultRunScriptMemory,
                                        WorldSettings::kRunScriptMemoryPerRobot * robot_count())));
+  StartStage("scripts (Lua states, sysCall_init)");
   scripts_ = MakeScriptHost(this);
   started_ = true;
   try {
     scripts_->Start();
     // Native controllers' init, after the scripts' sysCall_init.
-    if (controllers_) controllers_->Init(0);
+    if (controllers_) {
+      StartStage("native controllers' init");
+      controllers_->Init(0);
+    }
     MarkAllPending();  // sysCall_init may have left anything anywhere
     FlushRobotBuffers();
+    StartStage("");
   } catch (...) {
     failed_ = true;
     FlushBuffersAfterError();  // the other robots' sysCall_init prints

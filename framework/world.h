@@ -291,6 +291,14 @@ class World final : public PhaseHandlers {
   // script error, Start, Step and Stop first pass what every robot printed
   // to the log sink, in robot order.
   void Start();
+  // Called as Start() begins each of its stages, with the stage's name
+  // ("world poses", "physics (planar)", "module proximity", "scripts (Lua
+  // states, sysCall_init)", "native controllers' init"), and with "" when it
+  // has started: a large world's start takes seconds, and the command line
+  // says which part it is in.
+  void set_start_progress(std::function<void(const std::string& stage)> progress) {
+    start_progress_ = std::move(progress);
+  }
   // One control step: sense, control, actuate, physics, record. Throws
   // swarmsim::Error on a script error or a non-finite physics state; the
   // world is then stopped and may not be stepped again.
@@ -535,6 +543,10 @@ class World final : public PhaseHandlers {
   std::unique_ptr<DynamicsBackend> dynamics_;
   const LineOfSight* line_of_sight_ = nullptr;             // owned by the module that provides it
   const ProximityReadings* proximity_readings_ = nullptr;  // the same
+  std::function<void(const std::string&)> start_progress_;
+  void StartStage(const std::string& stage) const {
+    if (start_progress_) start_progress_(stage);
+  }
   std::unique_ptr<ScriptHost> scripts_;
   const FloorLayer* floor_layer_ = nullptr;  // owned by its module
   DeviceServices device_services_;

@@ -34,11 +34,13 @@ namespace swarmsim::cli {
 namespace {
 
 // The line on stderr while a large world loads (--progress, or stderr a
-// terminal; never with --quiet): "loading: 45,056 of 100,000 robots built",
+// terminal; never with --quiet): "loading: 45,056 of 100,000 robots built"
+// ("loading: 100,000 robots placed; building them" before the first),
 // redrawn in place on a terminal (a new line each time otherwise) at most
 // twice a second, once the load has taken half a second; then, for a world
 // that showed it (always with --progress), "loaded 100,000 robots in 3.4 s;
-// starting them". The run's own progress follows.
+// starting them", and the stages of the start (Starting). The run's own
+// progress follows.
 class LoadProgress {
  public:
   LoadProgress(bool forced, bool tty) : forced_(forced), tty_(tty) {}
@@ -49,12 +51,53 @@ class LoadProgress {
     if (now < 0.5 || (shown_ && now - last_ < 0.5)) return;
     last_ = now;
     shown_ = true;
-    std::cerr << (tty_ ? "\r" : "") << "loading: " << GroupThousands(built) << " of "
-              << GroupThousands(total) << " robots built" << (tty_ ? "" : "\n") << std::flush;
+    // Before the first copy (placing them took the time): none built yet.
+    std::cerr << (tty_ ? "\r" : "") << "loading: ";
+    if (built == 0)
+      std::cerr << GroupThousands(total) << " robots placed; building them";
+    else
+      std::cerr << GroupThousands(built) << " of " << GroupThousands(total) << " robots built";
+    std::cerr << (tty_ ? "\033[K" : "\n") << std::flush;
   }
   // The load failed: an error message goes on a line of its own.
   void Abandon() {
     if (tty_ && shown_) std::cerr << "\n";
+  }
+  // The world's start begins `stage` ("": it has started). For a world
+  // whose load was shown (or --progress): on a terminal, the stage under
+  // way, redrawn in place ("starting: module proximity (at 1.6 s)") and
+  // cleared at the end; otherwise a line for each stage that took 0.05 s or
+  // more as it ends ("started module proximity in 2.2 s") and the total
+  // ("started in 3.9 s").
+  void Starting(const std::string& stage) {
+    if (!shown_ && !forced_) return;
+    const auto now = std::chrono::steady_clock::now();
+    if (!starting_) starting_ = stage_start_ = now;
+    const auto seconds = [](std::chrono::steady_clock::duration d) {
+      std::ostringstream text;
+      text << std::fixed << std::setprecision(1) << std::chrono::duration<double>(d).count();
+      return text.str();
+    };
+    if (tty_) {
+      // The line of the stage before, rewritten (the cursor stays below it,
+      // so that an error in the start comes on a line of its own).
+      if (stage_shown_) std::cerr << "\033[A\r";
+      if (!stage.empty())
+        std::cerr << "starting: " << swarmsim::ValidUtf8(stage) << " (at "
+                  << seconds(now - *starting_) << " s)\033[K\n";
+      else
+        std::cerr << "\033[K";
+      std::cerr << std::flush;
+      stage_shown_ = !stage.empty();
+    } else {
+      if (!stage_.empty() && now - stage_start_ >= std::chrono::milliseconds(50))
+        std::cerr << "started " << swarmsim::ValidUtf8(stage_) << " in "
+                  << seconds(now - stage_start_) << " s\n";
+      if (stage.empty()) std::cerr << "started in " << seconds(now - *starting_) << " s\n";
+      std::cerr << std::flush;
+    }
+    stage_ = stage;
+    stage_start_ = now;
   }
   void Loaded() {
     if (!shown_ && !forced_) return;
@@ -74,6 +117,10 @@ class LoadProgress {
   bool shown_ = false;
   double last_ = 0;
   int64_t total_ = 0;
+  std::optional<std::chrono::steady_clock::time_point> starting_;  // the first stage's
+  std::string stage_;                                              // under way
+  bool stage_shown_ = false;                           // on a terminal: its line is the one above
+  std::chrono::steady_clock::time_point stage_start_;  // its beginning
 };
 
 // The number of steps: --steps, else --duration rounded to whole time steps,
@@ -350,7 +397,11 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
     if (load_progress) load_progress->Abandon();
     return bad_input(e.what());
   }
-  if (load_progress) load_progress->Loaded();
+  if (load_progress) {
+    load_progress->Loaded();
+    loaded.world->set_start_progress(
+        [&load_progress](const std::string& stage) { load_progress->Starting(stage); });
+  }
   options.load_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
   for (const std::string& warning : loaded.warnings)

@@ -6,9 +6,12 @@
 
 #include <cmath>
 #include <memory>
+#include <string>
+#include <utility>
 
 #include "framework/line_of_sight.h"
 #include "framework/object_type.h"
+#include "framework/proximity_readings.h"
 #include "framework/registry.h"
 #include "framework/world.h"
 #include "modules/builtin.h"
@@ -106,6 +109,84 @@ TEST(ProximityModuleTest, SensesInTheWorldsStep) {
   EXPECT_TRUE(reading.detected);
   EXPECT_NEAR(reading.distance, 0.9, 1e-9);
   EXPECT_EQ(reading.detected_object, w.wall());
+}
+
+// What a native controller reads (World::proximity_readings(), the
+// plugins' read_proximity_sensor): each sensor's row as the sense phase
+// left it, also after a write through MutableSensor, a snapshot restored or
+// a sensor added since (what any cache of the readings behind Read() must
+// keep right: never a stale copy, never one too short for a new slot).
+TEST(ProximityModuleTest, ReadingsReadAsTheRowsAfterEveryChange) {
+  ModuleWorld w;
+  Scene& scene = w.scene();
+  ProximitySensorData ray;
+  ray.settings.Edit().range = 5;
+  const Quat along_x = Quat::FromAxisAngle({0, 1, 0}, M_PI / 2);
+  const Quat along_minus_x = Quat::FromAxisAngle({0, 1, 0}, -M_PI / 2);
+  // A robot: a dummy with one sensor towards the wall, one away from it.
+  const ObjectId bot = scene.AddDummy("bot", {}, {{0.5, 0, 0}, {}});
+  const ObjectId front = AddSensor(&scene, "front", bot, {{0, 0, 0.5}, along_x}, ray);
+  const ObjectId back = AddSensor(&scene, "back", bot, {{0, 0, 0.5}, along_minus_x}, ray);
+  scene.MakeModelInstance(bot, "bot", "bot#0");
+  // A sensor of no robot.
+  const ObjectId eye = AddSensor(&scene, "eye", {}, {{0, 0, 0.5}, along_x}, ray);
+  const ProximityReadings* readings = nullptr;
+  // Read() as 1 / 0 / -1, and the distance read.
+  const auto read = [&](ObjectId id) {
+    double d = -7;
+    const int r = readings->Read(scene, id, &d);
+    return std::pair(r, r == 1 ? d : -7.0);
+  };
+  // Every sensor reads as its row.
+  const auto as_rows = [&](const char* when) {
+    for (const ObjectId id : {front, back, eye}) {
+      const ProximitySensorData& row = Sensor(scene, id);
+      EXPECT_EQ(read(id), std::pair(row.detected ? 1 : 0, row.detected ? row.distance : -7.0))
+          << scene.PathOf(id) << " " << when;
+    }
+  };
+  w.world().Step();
+  readings = w.world().proximity_readings();
+  ASSERT_NE(readings, nullptr);
+  EXPECT_EQ(read(front).first, 1);
+  EXPECT_NEAR(read(front).second, 0.4, 1e-9);
+  EXPECT_EQ(read(back), std::pair(0, -7.0));
+  EXPECT_NEAR(read(eye).second, 0.9, 1e-9);
+  as_rows("after a step");
+  // Not sensors, or gone: -1.
+  EXPECT_EQ(read(bot).first, -1);
+  EXPECT_EQ(read(w.wall()).first, -1);
+  EXPECT_EQ(read(ObjectId{}).first, -1);
+  EXPECT_EQ(read(ObjectId::FromInteger(1'000'000)).first, -1);
+
+  // A test writes a reading: read as written until the next sense phase.
+  MutableSensor(&scene, eye).distance = 0.25;
+  EXPECT_EQ(read(eye), std::pair(1, 0.25));
+  w.world().Step();
+  EXPECT_NEAR(read(eye).second, 0.9, 1e-9);
+
+  // A snapshot restored: its readings, not those of the steps since.
+  const std::string saved = w.world().SaveState();
+  scene.SetWorldPose(bot, {{0.7, 0, 0}, {}});
+  w.world().Step();
+  EXPECT_NEAR(read(front).second, 0.2, 1e-9);
+  w.world().RestoreState(saved);
+  EXPECT_NEAR(read(front).second, 0.4, 1e-9);
+  as_rows("after a snapshot restored");
+
+  // A sensor added after the sense phase: its row (nothing yet), not "no
+  // such sensor" (its slot is past the packed copy).
+  const ObjectId late = AddSensor(&scene, "late", {}, {{0, 0, 0.5}, along_x}, ray);
+  EXPECT_EQ(read(late), std::pair(0, -7.0));
+  w.world().Step();
+  EXPECT_NEAR(read(late).second, 0.9, 1e-9);
+  as_rows("after a sensor was added");
+  // One removed: -1.
+  scene.RemoveSubtree(eye);
+  EXPECT_EQ(read(eye).first, -1);
+  w.world().Step();
+  EXPECT_EQ(read(eye).first, -1);
+  EXPECT_NEAR(read(late).second, 0.9, 1e-9);
 }
 
 // The lookups of proximity_sensor.h, as the recorder, Python and plugins use them.

@@ -248,10 +248,20 @@ TEST(CliTest, ProgressShowsTheRobotsLoadedUnlessQuiet) {
   EXPECT_EQ(shown.exit_code, 0) << shown.output;
   EXPECT_NE(shown.output.find("loaded 300 robots in "), std::string::npos) << shown.output;
   EXPECT_NE(shown.output.find(" s; starting them\n"), std::string::npos) << shown.output;
+  // Then how long the start took (each stage of 0.05 s or more before it,
+  // "started module proximity in 0.1 s"), before the run's first step.
+  const size_t loaded = shown.output.find(" s; starting them\n");
+  const size_t started = shown.output.find("\nstarted in ");
+  EXPECT_LT(loaded, started) << shown.output;
+  EXPECT_NE(shown.output.find(" s\n", started), std::string::npos) << shown.output;
+  for (size_t line = shown.output.find("\nstarted ", loaded); line < started;
+       line = shown.output.find("\nstarted ", line + 1))
+    EXPECT_NE(shown.output.substr(line, 80).find(" in "), std::string::npos) << shown.output;
   for (const std::string flags : {"", " --progress --quiet"}) {
     Result hidden = RunProgram(run + flags);
     EXPECT_EQ(hidden.exit_code, 0) << hidden.output;
     EXPECT_EQ(hidden.output.find("loaded 300"), std::string::npos) << flags << hidden.output;
+    EXPECT_EQ(hidden.output.find("starting: "), std::string::npos) << flags << hidden.output;
   }
 }
 
