@@ -5,6 +5,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <iomanip>
+#include <sstream>
 #include <utility>
 
 #include "framework/calculation_module.h"
@@ -39,6 +41,10 @@ class PhaseTimer {
 
 bool IsFinite(const Vec3& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+bool InWorldBounds(const Vec3& p) {
+  return std::abs(p.x) <= kMaxCoordinate && std::abs(p.y) <= kMaxCoordinate &&
+         std::abs(p.z) <= kMaxCoordinate;
 }
 bool IsFinite(const Pose& X) {
   return std::isfinite(X.p.x) && std::isfinite(X.p.y) && std::isfinite(X.p.z) &&
@@ -633,12 +639,27 @@ void World::Physics() {
                  scene_.PathOf(scene_.IdAt(slot)) + "' at step " + std::to_string(step_count_) +
                  " (check masses, sizes and joint targets)");
   };
+  const auto out_of_bounds = [&](uint32_t slot, const Vec3& p) {
+    std::ostringstream m;
+    m << std::setprecision(10) << "physics moved '" << scene_.PathOf(scene_.IdAt(slot)) << "' to ("
+      << p.x << ", " << p.y << ", " << p.z << ") m at step " << step_count_
+      << ", beyond the 1e6 m a world may use: the simulation blew up (check masses, sizes and "
+         "joint targets; "
+         "try a smaller time_step or more physics_substeps";
+    if (settings_.physics == "ode") m << ", or ode: {solver: world}";
+    m << ")";
+    return Error(m.str());
+  };
   for (uint32_t row = 0; row < scene_.shapes().size(); ++row) {
     const uint32_t slot = scene_.shape_owners()[row];
     if (!scene_.shapes()[row].dynamic) continue;
-    if (!IsFinite(scene_.world_pose_at(slot))) throw non_finite(slot, "pose");
+    const Pose& X_WB = scene_.world_pose_at(slot);
+    if (!IsFinite(X_WB)) throw non_finite(slot, "pose");
     if (!IsFinite(scene_.linear_velocity_at(slot)) || !IsFinite(scene_.angular_velocity_at(slot)))
       throw non_finite(slot, "velocity");
+    // A body past the world's bounds: the simulation blew up (a finite
+    // 1e96 m is as much garbage as a NaN, only later).
+    if (!InWorldBounds(X_WB.p)) throw out_of_bounds(slot, X_WB.p);
   }
   const auto joints = scene_.joints();
   for (uint32_t row = 0; row < joints.size(); ++row)

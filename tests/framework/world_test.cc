@@ -133,6 +133,31 @@ TEST(WorldTest, NonFinitePhysicsIsAnErrorNamingTheObject) {
   EXPECT_THROW(world.Step(), Error);  // no stepping on after a failure
 }
 
+// A body that physics moves past the 1e6 m a world may use has blown up:
+// an error naming it, not a run that ends "ok" with bodies at 1e96 m.
+TEST(WorldTest, ABodyPhysicsMovesOutOfTheWorldIsAnError) {
+  const ModuleRegistry registry = MakeRegistry();
+  WorldSettings settings;
+  settings.physics = "conveyor";  // +x at 1 m/s
+  settings.time_step = 0.1;
+  World world(settings, registry);
+  ShapeData body;
+  body.dynamic = true;
+  world.scene().AddShape("near", {}, {{999'999.85, 0, 0}, {}}, body);
+  world.Start();
+  world.Step();  // 999,999.95: still in
+  try {
+    world.Step();
+    FAIL() << "a body at 1,000,000.05 m accepted";
+  } catch (const Error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("physics moved '/near' to (1000000.05, 0, 0) m at step 2, beyond the 1e6 m"),
+              std::string::npos)
+        << msg;
+    EXPECT_NE(msg.find("smaller time_step"), std::string::npos) << msg;
+  }
+}
+
 // Many bodies checked on every thread: the error names the first bad one
 // (by row) and what is wrong with it, the same for any thread count.
 TEST(WorldTest, NonFinitePhysicsNamesTheFirstBadBodyForAnyThreadCount) {
