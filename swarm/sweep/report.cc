@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -94,7 +95,8 @@ void Plot(const ReportData& data, const ReportOptions& o, const std::string& x,
   if (o.by.empty())
     script << "set key off\n";
   else
-    script << "set key outside right top noenhanced title " << GnuplotQuote(o.by) << "\n";
+    script << "set key outside right top noenhanced title " << GnuplotQuote(o.by)
+           << " noenhanced\n";  // its own flag: 'a_b' is not a subscript
   const bool log_x = data.param_kind.count(x) && data.param_kind.at(x) == "log" && numeric_x;
   // Lines of different --by values are dodged sideways by 1% of the x span so
   // their error bars do not hide each other; the x range hugs the data.
@@ -158,7 +160,13 @@ void Plot(const ReportData& data, const ReportOptions& o, const std::string& x,
   for (size_t i = 0; i < lines.size(); ++i) script << (i ? ", \\\n     " : "") << lines[i];
   script << "\n";
 
-  FILE* gp = popen("gnuplot 2>&1", "w");
+  // gnuplot draws on its stdout when it cannot open the file: a folder
+  // that is not there is refused first, and its stdout goes nowhere (its
+  // messages, on stderr, to ours).
+  const std::filesystem::path folder = std::filesystem::path(*o.plot).parent_path();
+  if (!folder.empty() && !std::filesystem::is_directory(folder))
+    throw Error("cannot write the plot '" + *o.plot + "': no folder '" + folder.string() + "'");
+  FILE* gp = popen("gnuplot >/dev/null", "w");
   if (!gp) throw Error("cannot run gnuplot; install gnuplot-nox (tools/setup.sh)");
   const std::string text = script.str();
   fwrite(text.data(), 1, text.size(), gp);

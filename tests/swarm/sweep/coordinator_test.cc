@@ -236,6 +236,21 @@ TEST(SweepTest, SameSeedSameHashAsRunAndChangedWorldIsRefused) {
   r = RunProgram("sweep " + world + " --param robtos=2 --db " + (dir / "typo.db").string());
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("robots"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("error: --param robtos=2: no parameter 'robtos'"), std::string::npos)
+      << "named as the user wrote it: " << r.output;
+  r = RunProgram("sweep " + world + " --param robots=2 --param nosuch.x=1 --seeds 7 --db " +
+                 (dir / "typo2.db").string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("error: --param nosuch.x=1: no model 'nosuch'"), std::string::npos)
+      << r.output;
+  // A first run whose world does not load (2,000 robots in 3 m x 3 m) is named.
+  r = RunProgram("sweep " + world + " --param robots=2000,2 --seeds 2 --db " +
+                 (dir / "crowded.db").string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("error: the sweep's first run (robots=2000, seed 1) does not load, so "
+                          "the sweep does not start: "),
+            std::string::npos)
+      << r.output;
   // So is a value of the wrong type anywhere in the list, not only the first.
   const fs::path bad_db = dir / "bad_value.db";
   r = RunProgram("sweep " + world + " --param robots=2,abc --steps 2 --db " + bad_db.string());

@@ -75,6 +75,16 @@ TEST(SweepTest, ReportTableCsvColumnsAndPlot) {
   } else {
     std::cout << "gnuplot not installed: plot not checked\n";
   }
+  // A plot into a folder that is not there: refused, and no PNG on stdout
+  // (gnuplot draws there when it cannot open the file).
+  r = RunProgram("report " + db.string() + " --x robots --y x --plot " +
+                 (dir / "no/p.png").string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("cannot write the plot '" + (dir / "no/p.png").string() +
+                          "': no folder '" + (dir / "no").string() + "'"),
+            std::string::npos)
+      << r.output;
+  EXPECT_EQ(r.output.find("PNG"), std::string::npos) << r.output;
   r = RunProgram("report " + db.string() + " --by nosuch");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   fs::remove_all(dir);

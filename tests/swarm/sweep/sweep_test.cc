@@ -4,7 +4,10 @@
 // (failures), grid_test, report_test, results_merge_test, mpi_test.
 #include "swarm/sweep/sweep.h"
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/file.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <string>
@@ -66,6 +69,34 @@ TEST(SweepTest, AShardTakesEveryNthRun) {
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("--shard 3/3: need 0 <= i < n"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(dir / "bad.db"));
+  fs::remove_all(dir);
+}
+
+// A second sweep on a database another sweep is running on is refused
+// (it would take the first's runs in progress for a stopped sweep's and run
+// them again beside it); once the first is over, the same command resumes.
+TEST(SweepTest, ASecondSweepOnTheSameDatabaseIsRefused) {
+  const fs::path dir = TempDir("locked");
+  const fs::path db = dir / "s.db";
+  const std::string sweep =
+      "sweep " + kWorld + " --param robots=2,3 --seeds 1 --steps 2 --quiet --db " + db.string();
+  // The first sweep, as the second sees it: its lock held, its pid inside.
+  const std::string lock_path = db.string() + ".lock";
+  const int fd = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);
+  ASSERT_EQ(::write(fd, "4242\n", 5), 5);
+  auto r = RunProgram(sweep);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("another sweep (process 4242) is running on '" + db.string() +
+                          "'; wait for it to finish"),
+            std::string::npos)
+      << r.output;
+  ::close(fd);  // the first sweep is over
+  r = RunProgram(sweep);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(Count(db, "SELECT count(*) FROM runs WHERE status = 'ok'"), 2);
+  EXPECT_FALSE(fs::exists(lock_path)) << "the lock is removed when the sweep ends";
   fs::remove_all(dir);
 }
 
