@@ -132,7 +132,28 @@ std::string ParseErrorMessage(CLI::App& app, const std::vector<std::string>& arg
   if (!left_over.empty())
     return "error: unexpected argument '" + left_over.front() + "' for '" + command->get_name() +
            "'\n" + help;
-  return "error: " + std::string(error.what()) + "\n" + help;
+  return "error: " + PlainOptionError(error.what()) + "\n" + help;
+}
+
+std::string PlainOptionError(const std::string& what) {
+  // CLI11's "--steps: At Most 1 required but received 2".
+  const size_t colon = what.find(": ");
+  if (colon == std::string::npos || !what.starts_with('-')) return what;
+  const std::string option = what.substr(0, colon);
+  const std::string_view rest = std::string_view(what).substr(colon + 2);
+  constexpr std::string_view kAtMostOne = "At Most 1 required but received ";
+  if (rest.starts_with(kAtMostOne))
+    return option + " given " + std::string(rest.substr(kAtMostOne.size())) +
+           " times; it takes one value (give it once)";
+  // "--steps: 1 required INT:NUMBER >= 0 missing" (the option ended the line).
+  constexpr std::string_view kOneRequired = "1 required ";
+  constexpr std::string_view kMissing = " missing";
+  if (rest.starts_with(kOneRequired) && rest.ends_with(kMissing)) {
+    const std::string_view type =
+        rest.substr(kOneRequired.size(), rest.size() - kOneRequired.size() - kMissing.size());
+    return option + " needs a value (" + std::string(type) + ")";
+  }
+  return what;
 }
 
 }  // namespace swarmsim::cli

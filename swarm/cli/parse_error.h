@@ -21,8 +21,15 @@ std::string EmptyListEntry(const std::vector<std::string>& args);
 
 // What CLI11 rejected, in this program's words: an unknown option or command
 // with the nearest known one, a second value after --set, else CLI11's own
-// message. `args` is argv without the program.
+// message (PlainOptionError). `args` is argv without the program.
 std::string ParseErrorMessage(CLI::App& app, const std::vector<std::string>& args,
                               const CLI::ParseError& error);
+
+// CLI11's message about one option, in plain words where it has a known
+// form: "--steps: At Most 1 required but received 2" -> "--steps given 2
+// times; it takes one value (give it once)"; "--steps: 1 required
+// INT:NUMBER >= 0 missing" -> "--steps needs a value (INT:NUMBER >= 0)".
+// Any other message as it is.
+std::string PlainOptionError(const std::string& what);
 
 }  // namespace swarmsim::cli

@@ -337,7 +337,14 @@ uint64_t ValueReader::Seed(const Field& field) const {
       return seed;
     }
   }
-  return static_cast<uint64_t>(Integer(field, 0, int64_t{1} << 53));
+  // Not digits alone ($seed, an expression, -1, 1.5): a double, exact up to 2^53.
+  const char* const text =
+      "a whole number from 0 to 18446744073709551615 (written out in digits; "
+      "from a parameter or an expression, at most 9007199254740992)";
+  const double value = Number(field, NumberRule{text, -1e300, 1e300});
+  if (value != std::floor(value) || value < 0 || value > 9007199254740992.0)
+    Fail(field, "'" + field.name + "' must be " + text + " (got " + Got(field, value) + ")");
+  return static_cast<uint64_t>(value);
 }
 
 bool ValueReader::Bool(const Field& field) const {

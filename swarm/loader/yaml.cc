@@ -60,6 +60,17 @@ YamlFile YamlFile::Load(const fs::path& path, std::string_view kind,
   file.path_ = path;
   file.name_ = DisplayPath(path);
   const std::string text = ReadFileOrThrow(path, kind, referenced_by, reference_text);
+  // A NUL byte: yaml-cpp reads it as the end of a line and reports something
+  // else on the next one.
+  if (const size_t nul = text.find('\0'); nul != std::string::npos) {
+    YAML::Mark mark;
+    const size_t line_start = text.rfind('\n', nul == 0 ? 0 : nul - 1);
+    mark.line = static_cast<int>(std::count(text.begin(), text.begin() + nul, '\n'));
+    mark.column =
+        static_cast<int>(line_start == std::string::npos || nul == 0 ? nul : nul - line_start - 1);
+    file.Fail(mark, "a NUL byte (\\0) in the file: a " + std::string(kind) +
+                        " is text (was it saved by a program that pads with zeros?)");
+  }
   try {
     file.root_ = YAML::Load(text);
   } catch (const YAML::ParserException& e) {

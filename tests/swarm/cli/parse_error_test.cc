@@ -34,6 +34,20 @@ TEST(CliTest, UnknownFlagIsAClearErrorWithNonzeroExit) {
   EXPECT_NE(bad_set.output.find("name=value"), std::string::npos) << bad_set.output;
 }
 
+// An option given twice, or with no value at the end of the line: said
+// plainly, not in CLI11's words ("At Most 1 required but received 2").
+TEST(CliTest, AnOptionTwiceOrWithoutItsValueIsSaidPlainly) {
+  Result twice = RunProgram("run " + Data("ok.yaml") + " --steps 5 --steps 6");
+  EXPECT_EQ(twice.exit_code, 2) << twice.output;
+  EXPECT_NE(twice.output.find("error: --steps given 2 times; it takes one value (give it once)\n"),
+            std::string::npos)
+      << twice.output;
+  Result bare = RunProgram("run " + Data("ok.yaml") + " --steps");
+  EXPECT_EQ(bare.exit_code, 2) << bare.output;
+  EXPECT_NE(bare.output.find("error: --steps needs a value ("), std::string::npos) << bare.output;
+  EXPECT_EQ(bare.output.find("missing"), std::string::npos) << bare.output;
+}
+
 TEST(CliTest, UnknownCommandSuggestsTheNearestAndListsThem) {
   Result r = RunProgram("runn " + Data("ok.yaml"));
   EXPECT_EQ(r.exit_code, 2);

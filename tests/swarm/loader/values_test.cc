@@ -166,6 +166,13 @@ TEST(ValuesTest, EachKindOfValueSaysWhatItExpects) {
             r.Where("seed_over") +
                 ": 'seed_over' must be a whole number from 0 to 18446744073709551615 (got "
                 "\"18446744073709551616\")");
+  // Not digits alone: the same range, and why an expression's stops at 2^53.
+  EXPECT_EQ(error([&] { r.values.Seed(r["half"]); }),
+            r.Where("half") +
+                ": 'half' must be a whole number from 0 to 18446744073709551615 (written out "
+                "in digits; from a parameter or an expression, at most 9007199254740992) (got "
+                "\"2.5\")");
+  EXPECT_EQ(r.values.Seed(r["big"]), 2000u);
   EXPECT_TRUE(r.values.Bool(r["litbool"]));
   EXPECT_EQ(error([&] { r.values.Bool(r["one"]); }),
             r.Where("one") + ": 'one' must be true or false (got \"1\")");

@@ -55,6 +55,17 @@ TEST(YamlTest, SyntaxErrorsKeepTheirLineAndColumn) {
   fs::remove_all(YamlDir());
 }
 
+TEST(YamlTest, ANulByteIsNamedWhereItIs) {
+  // yaml-cpp would report "unknown escape character" on the line after it.
+  const std::string nul = ErrorOf([] { Yaml(std::string("a: 1\nseed: 3\0\nb: 2\n", 19)); });
+  EXPECT_EQ(nul, DisplayPath(YamlDir() / "w.yaml") +
+                     ":2:8: a NUL byte (\\0) in the file: a world file is text (was it saved "
+                     "by a program that pads with zeros?)");
+  const std::string first = ErrorOf([] { Yaml(std::string("\0a: 1\n", 7)); });
+  EXPECT_NE(first.find("w.yaml:1:1: a NUL byte"), std::string::npos) << first;
+  fs::remove_all(YamlDir());
+}
+
 TEST(YamlTest, PlacesAreOneBasedLineAndColumn) {
   const YamlFile file = Yaml("a: 1\nb:\n  c: here\n");
   EXPECT_EQ(file.name(), DisplayPath(YamlDir() / "w.yaml"));
