@@ -417,6 +417,11 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
   std::string recorder_error;
   const std::optional<ViewRecorderSettings> recording = RecorderSettingsOf(args, &recorder_error);
   if (!recorder_error.empty()) return bad_input(recorder_error);
+  // An --out folder an earlier run wrote to: its files go before this run
+  // writes any (else old snapshots and video sit beside new metrics).
+  if (options.out_dir)
+    if (const std::string note = RemoveEarlierOutputs(*options.out_dir); !note.empty())
+      std::cerr << "note: " << swarmsim::ValidUtf8(note) << "\n";
   ViewRecorder* recorder = nullptr;
   if (recording) {
     const ViewRecorderDescriptor* view_recorder = loaded.world->registry().view_recorder();

@@ -19,7 +19,9 @@
 #include <functional>
 #include <iomanip>
 #include <iostream>
+#include <map>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 #include <thread>
 
@@ -560,6 +562,39 @@ void CreateOutputFolder(const std::filesystem::path& dir) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) throw Error("cannot create output folder '" + dir.string() + "': " + ec.message());
+}
+
+std::string RemoveEarlierOutputs(const std::filesystem::path& dir) {
+  namespace fs = std::filesystem;
+  std::ifstream in(dir / "summary.json");
+  if (!in) return "";
+  const nlohmann::json j = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+  if (!j.is_object() || !j.contains("outputs") || !j["outputs"].is_array()) return "";
+  std::map<std::string, int> removed;  // kind -> files
+  std::set<fs::path> folders;
+  for (const nlohmann::json& file : j["outputs"]) {
+    if (!file.is_object() || !file.contains("path") || !file["path"].is_string()) continue;
+    const fs::path path = fs::path(file["path"].get<std::string>()).lexically_normal();
+    // Only what the earlier run wrote inside DIR.
+    if (path.empty() || path.is_absolute() || *path.begin() == "..") continue;
+    std::error_code ec;
+    if (!fs::is_regular_file(dir / path, ec) || !fs::remove(dir / path, ec)) continue;
+    ++removed[file.contains("kind") && file["kind"].is_string() ? file["kind"].get<std::string>()
+                                                                : "file"];
+    for (fs::path up = path.parent_path(); !up.empty(); up = up.parent_path()) folders.insert(up);
+  }
+  // Deepest first: a folder emptied by the files above (not one holding others).
+  for (auto it = folders.rbegin(); it != folders.rend(); ++it) {
+    std::error_code ec;
+    if (fs::is_empty(dir / *it, ec)) fs::remove(dir / *it, ec);
+  }
+  if (removed.empty()) return "";
+  std::string what;
+  for (const auto& [kind, count] : removed)
+    what +=
+        (what.empty() ? "" : ", ") + std::to_string(count) + " " + kind + (count == 1 ? "" : "s");
+  return "removed the outputs of the earlier run in '" + dir.string() + "' (" + what +
+         "), so that the folder holds this run's alone";
 }
 
 std::string WriteErrorSummary(const RunOptions& options, const std::string& error,

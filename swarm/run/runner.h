@@ -87,6 +87,13 @@ std::string WriteErrorSummary(const RunOptions& options, const std::string& erro
 // naming it when it cannot.
 void CreateOutputFolder(const std::filesystem::path& dir);
 
+// A run with --out DIR where an earlier run wrote: removes the files that
+// run's summary.json lists as its outputs (snapshots, video, recording,
+// graphs; paths inside DIR only) and the folders they leave empty, so that
+// DIR holds one run, not a mix. Returns the note to print ("" if there was
+// nothing), naming what went.
+std::string RemoveEarlierOutputs(const std::filesystem::path& dir);
+
 // Peak resident set size of this process, in MiB.
 double PeakRssMb();
 

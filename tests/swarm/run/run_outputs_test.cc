@@ -424,6 +424,39 @@ fs::path OneScriptedRobot(const std::string& name, const std::string& lua) {
 
 // A run that fails before its first step prints its error, not a table of
 // zeros; one that fails later prints the table of what it ran.
+// --out DIR again: the earlier run's outputs (as its summary.json lists
+// them) go, so the folder holds one run, not new metrics beside an old
+// recording. Nothing else is touched: files of the user's, paths outside DIR.
+TEST(RunOutputsTest, AnOutFolderUsedAgainHoldsTheNewRunAlone) {
+  const fs::path out = TempDir("again");
+  auto r = RunProgram("run " + Data("outputs.yaml") + " --steps 2 --quiet --record --out " +
+                      out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  ASSERT_TRUE(fs::exists(out / "recording.swrec"));
+  std::ofstream(out / "notes.txt") << "mine\n";
+  r = RunProgram("run " + Data("outputs.yaml") + " --steps 3 --quiet --out " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("note: removed the outputs of the earlier run in '" + out.string() +
+                          "' (1 recording)"),
+            std::string::npos)
+      << r.output;
+  EXPECT_FALSE(fs::exists(out / "recording.swrec")) << "the earlier run's, not this one's";
+  EXPECT_TRUE(fs::exists(out / "notes.txt"));
+  EXPECT_NE(ReadFile(out / "summary.json").find("\"steps\": 3"), std::string::npos);
+  // A summary.json naming files outside the folder removes none of them.
+  const fs::path outside = out.parent_path() / "again_outside.txt";
+  std::ofstream(outside) << "not ours\n";
+  std::ofstream(out / "summary.json")
+      << R"({"outputs": [{"kind": "video", "path": "../again_outside.txt"},)"
+      << R"( {"kind": "video", "path": ")" << outside.string() << R"("}]})";
+  r = RunProgram("run " + Data("outputs.yaml") + " --steps 1 --quiet --out " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(fs::exists(outside));
+  EXPECT_EQ(r.output.find("removed the outputs"), std::string::npos) << r.output;
+  fs::remove(outside);
+  fs::remove_all(out);
+}
+
 TEST(RunOutputsTest, ARunThatNeverSteppedPrintsNoSummaryTable) {
   const fs::path dir =
       OneScriptedRobot("never_stepped", "function sysCall_init() error('no start') end\n");
