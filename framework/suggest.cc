@@ -1,6 +1,7 @@
 #include "framework/suggest.h"
 
 #include <algorithm>
+#include <string>
 #include <vector>
 
 namespace swarmsim {
@@ -42,8 +43,13 @@ std::string Suggest(std::string_view name, std::span<const std::string> candidat
   if (candidates.empty()) return "";
   if (const std::string* nearest = NearestName(name, candidates))
     return "; did you mean '" + *nearest + "'?";
+  // A model's every path can be hundreds: the first dozen and a count.
+  constexpr size_t kListed = 12;
   std::string list;
-  for (const std::string& c : candidates) list += (list.empty() ? "" : ", ") + c;
+  for (size_t i = 0; i < candidates.size() && i < kListed; ++i)
+    list += (list.empty() ? "" : ", ") + candidates[i];
+  if (candidates.size() > kListed)
+    list += ", ... (" + std::to_string(candidates.size() - kListed) + " more)";
   return " (expected one of: " + list + ")";
 }
 

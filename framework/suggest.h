@@ -18,7 +18,8 @@ int EditDistance(std::string_view a, std::string_view b);
 const std::string* NearestName(std::string_view name, std::span<const std::string> candidates);
 
 // "; did you mean 'radius'?" for the nearest candidate if it is close enough,
-// else " (expected one of: a, b, c)", or "" when there are no candidates.
+// else " (expected one of: a, b, c)" (the first 12 and "... (N more)"), or
+// "" when there are no candidates.
 std::string Suggest(std::string_view name, std::span<const std::string> candidates);
 
 }  // namespace swarmsim

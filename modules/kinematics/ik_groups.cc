@@ -318,6 +318,14 @@ class IkGroupsImpl final : public IkGroups {
         throw Error(group + ": the spherical joint '" + scene.PathOf(scene.IdAt(slots[c])) +
                     "' can only be solved in direct mode (mode: targets sets target "
                     "positions, and a spherical joint has none)");
+      // A velocity-mode joint ignores the target position targets mode sets:
+      // the group would report success with the arm where it was.
+      if (g->spec.mode == IkMode::kJointTargets && !problem.is_ball_part(c) &&
+          j.depends() == nullptr && j.mode() == JointMode::kVelocity)
+        throw Error(group + ": the joint '" + scene.PathOf(scene.IdAt(slots[c])) +
+                    "' is in velocity mode, which ignores the target positions mode: targets "
+                    "sets (a URDF continuous joint is imported in velocity mode); use mode: "
+                    "direct, or give the joint mode: position");
       // Dependent joints follow their master's column, or keep their value
       // if it is not an unknown of the group (whatever their weight).
       if (j.depends() == nullptr || problem.is_ball_part(c)) continue;

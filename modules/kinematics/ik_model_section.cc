@@ -1,5 +1,6 @@
 #include "modules/kinematics/ik_model_section.h"
 
+#include <algorithm>
 #include <optional>
 #include <set>
 #include <string>
@@ -159,9 +160,17 @@ void Apply(const ModelSectionData& section, const ModelCopy& copy, World* world)
     }
     // The root is named after the copy; its name in the file (a URDF's root link) names it too.
     if (id.IsNull() && def.path == copy.root_name) id = copy.root;
-    if (id.IsNull())
-      fail(def.where, "no object '" + def.path + "' in model '" + copy.model + "'" +
-                          Suggest(def.path, copy.paths));
+    if (id.IsNull()) {
+      // A typo in a bare name is nearer the name than its whole path.
+      std::vector<std::string> names(copy.paths.begin(), copy.paths.end());
+      for (const std::string& path : copy.paths)
+        if (const size_t slash = path.rfind('/'); slash != std::string::npos)
+          names.push_back(path.substr(slash + 1));
+      std::sort(names.begin(), names.end());
+      names.erase(std::unique(names.begin(), names.end()), names.end());
+      fail(def.where,
+           "no object '" + def.path + "' in model '" + copy.model + "'" + Suggest(def.path, names));
+    }
     return id;
   };
   for (const IkGroupDef& def : data.groups) {

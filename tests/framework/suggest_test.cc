@@ -55,6 +55,12 @@ TEST(SuggestTest, SuggestNamesTheNearestOrListsThemAll) {
   const std::vector<std::string> keys = {"physics", "time_step", "seed"};
   EXPECT_EQ(Suggest("phyiscs", keys), "; did you mean 'physics'?");
   EXPECT_EQ(Suggest("colour", keys), " (expected one of: physics, time_step, seed)");
+  // A long list (every path of a URDF model): the first dozen and a count.
+  std::vector<std::string> many;
+  for (int i = 0; i < 40; ++i) many.push_back("link_" + std::to_string(i));
+  EXPECT_EQ(Suggest("gripper", many),
+            " (expected one of: link_0, link_1, link_2, link_3, link_4, link_5, link_6, link_7, "
+            "link_8, link_9, link_10, link_11, ... (28 more))");
   EXPECT_EQ(Suggest("anything", std::vector<std::string>{}), "");
 }
 

@@ -177,6 +177,40 @@ TEST_F(IkAvoidanceErrorTest, MistakesAreFileLineColumnErrors) {
                   "arm.yaml:28:5:");
   EXPECT_CONTAINS(ErrorOf("              joint: spherical\n", "    mode: targets\n"),
                   "the spherical joint '/base/j1/link1/j2' can only be solved in direct mode");
+  // A velocity-mode joint in such a group: it would ignore the targets.
+  for (const std::string mode : {"targets", "direct"}) {
+    std::string arm = ArmModel("", "    mode: " + mode + "\n");
+    const std::string passive = "mode: passive\n              position: [0.25";
+    arm.replace(arm.find(passive), 13, "mode: velocity");
+    Write("arm.yaml", arm);
+    Write("arm.lua", "");
+    std::string error = "(no error)";
+    try {
+      Load(kArmWorld);
+    } catch (const Error& e) {
+      error = e.what();
+    }
+    if (mode == "targets")
+      EXPECT_CONTAINS(error,
+                      "the joint '/base/j1/link1/j2' is in velocity mode, which ignores the "
+                      "target positions mode: targets sets");
+    else
+      EXPECT_EQ(error, "(no error)");
+  }
+  // A typo in a tip named by its bare name: the name suggested, not a path.
+  {
+    std::string arm = ArmModel("", "");
+    const std::string tip = "tip: j1/link1/j2/tip";
+    arm.replace(arm.find(tip), tip.size(), "tip: tpi");
+    Write("arm.yaml", arm);
+    std::string error = "(no error)";
+    try {
+      Load(kArmWorld);
+    } catch (const Error& e) {
+      error = e.what();
+    }
+    EXPECT_CONTAINS(error, "no object 'tpi' in model 'arm'; did you mean 'tip'?");
+  }
   EXPECT_CONTAINS(ErrorOf("              ik: sometimes\n", ""), "arm.yaml:24:");
 }
 
