@@ -20,9 +20,16 @@ struct NumericAttribute {
   const char* element;
   const char* attribute;
   int count;
+  // Each number's bounds, and what they are in words (null: any finite number).
+  double min = -1e308, max = 1e308;
+  const char* rule = nullptr;
 };
+// Lengths within what a world may use (framework/math.h's kMaxCoordinate:
+// a world file, a script, a mesh are held to it too).
+constexpr const char* kCoordinateRule = "a coordinate from -1e6 to 1e6 m";
+constexpr const char* kSizeRule = "a size from 0 to 1e6 m";
 constexpr NumericAttribute kNumericAttributes[] = {
-    {"origin", "xyz", 3},
+    {"origin", "xyz", 3, -1e6, 1e6, kCoordinateRule},
     {"origin", "rpy", 3},
     {"mass", "value", 1},
     {"inertia", "ixx", 1},
@@ -31,17 +38,17 @@ constexpr NumericAttribute kNumericAttributes[] = {
     {"inertia", "iyy", 1},
     {"inertia", "iyz", 1},
     {"inertia", "izz", 1},
-    {"box", "size", 3},
-    {"cylinder", "radius", 1},
-    {"cylinder", "length", 1},
-    {"sphere", "radius", 1},
+    {"box", "size", 3, 0, 1e6, kSizeRule},
+    {"cylinder", "radius", 1, 0, 1e6, kSizeRule},
+    {"cylinder", "length", 1, 0, 1e6, kSizeRule},
+    {"sphere", "radius", 1, 0, 1e6, kSizeRule},
     {"mesh", "scale", 3},
     {"color", "rgba", 4},
     {"axis", "xyz", 3},
     {"limit", "lower", 1},
     {"limit", "upper", 1},
-    {"limit", "effort", 1},
-    {"limit", "velocity", 1},
+    {"limit", "effort", 1, 0, 1e308, "0 or more (N or N m)"},
+    {"limit", "velocity", 1, 0, 1e308, "0 or more (m/s or rad/s)"},
     {"dynamics", "damping", 1},
     {"dynamics", "friction", 1},
     {"mimic", "multiplier", 1},
@@ -76,6 +83,10 @@ std::optional<BadNumber> CheckNumbers(const tinyxml2::XMLElement* e, const std::
       double number;
       if (!ParseFinite(token, &number)) {
         bad = BadNumber{e->GetLineNum(), what + ": " + Quoted(token) + " is not a finite number"};
+        return false;
+      }
+      if (a.rule != nullptr && (number < a.min || number > a.max)) {
+        bad = BadNumber{e->GetLineNum(), what + ": " + Quoted(token) + " is not " + a.rule};
         return false;
       }
       ++found;

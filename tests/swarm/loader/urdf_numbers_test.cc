@@ -82,6 +82,29 @@ TEST_F(UrdfNumbersTest, ReadableNumbersLoad) {
             "no error");
 }
 
+// Lengths past what a world may use (1e6 m), sizes below 0, negative
+// limits: refused as the world file refuses them, naming the element.
+TEST_F(UrdfNumbersTest, NumbersOutsideTheirRangeAreErrors) {
+  EXPECT_EQ(
+      Message(Robot("    <visual><geometry><box size=\"1 1e10 1\"/></geometry></visual>", "")),
+      "r.urdf:4: link 'base' <visual>: <box size=\"1 1e10 1\">: '1e10' is not a size from "
+      "0 to 1e6 m");
+  EXPECT_EQ(Message(Robot("", "    <origin xyz=\"1e12 0 0.1\"/>")),
+            "r.urdf:8: joint 'j': <origin xyz=\"1e12 0 0.1\">: '1e12' is not a coordinate from "
+            "-1e6 to 1e6 m");
+  EXPECT_EQ(Message(Robot("    <collision><geometry><sphere radius=\"-0.1\"/></geometry>"
+                          "</collision>",
+                          "")),
+            "r.urdf:4: link 'base' <collision>: <sphere radius=\"-0.1\">: '-0.1' is not a size "
+            "from 0 to 1e6 m");
+  std::string negative = Robot("", "");
+  const std::string limit = "effort=\"1\" velocity=\"1\"";
+  negative.replace(negative.find(limit), limit.size(), "effort=\"1\" velocity=\"-5\"");
+  EXPECT_EQ(Message(negative),
+            "r.urdf:10: joint 'j': <limit velocity=\"-5\">: '-5' is not 0 or more (m/s or "
+            "rad/s)");
+}
+
 TEST_F(UrdfNumbersTest, UnreadableMassIsAnErrorNotAMasslessLink) {
   EXPECT_EQ(Message(Robot("    <inertial><mass value=\"abc\"/>"
                           "<inertia ixx=\"1\" iyy=\"1\" izz=\"1\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/>"
