@@ -190,12 +190,16 @@ class ControllerModule : public Module {
         return;
       }
       // The traceback, as Python prints it.
+      // An error raised before the controller's first line (a function that
+      // takes no argument) has no traceback: None, not a null handle.
       std::string trace;
       try {
+        const auto or_none = [](const py::object& o) { return o ? o : py::none(); };
         py::module_ tb = py::module_::import("traceback");
-        py::list lines = tb.attr("format_exception")(e.type(), e.value(), e.trace());
+        py::list lines =
+            tb.attr("format_exception")(or_none(e.type()), or_none(e.value()), or_none(e.trace()));
         for (const auto& line : lines) trace += py::str(line).cast<std::string>();
-      } catch (py::error_already_set&) {
+      } catch (const std::exception&) {
         trace = e.what();
       }
       throw Error(config_.where + ": the Python controller of model '" + config_.model +

@@ -175,12 +175,19 @@ void PyWorld::reset(std::optional<uint64_t> seed) {
   GateLock lock(gate_.get());
   World& w = Live();
   if (initial_.empty()) {
-    if (w.step_count() == 0 && history_.empty()) {
-      initial_ = SnapshotBytes();
-    } else {
-      PyWorld fresh(args_.path, loaded_seed_, args_.set, args_.threads, args_.controllers,
-                    args_.package_path, args_.keep_scripts);
-      initial_ = fresh.SnapshotBytes();
+    try {
+      if (w.step_count() == 0 && history_.empty()) {
+        initial_ = SnapshotBytes();
+      } else {
+        PyWorld fresh(args_.path, loaded_seed_, args_.set, args_.threads, args_.controllers,
+                      args_.package_path, args_.keep_scripts);
+        initial_ = fresh.SnapshotBytes();
+      }
+    } catch (const std::runtime_error& e) {
+      // reset() is a snapshot of the start restored: say so in its words.
+      std::string why = e.what();
+      if (why.rfind("snapshot: ", 0) == 0) why.erase(0, 10);
+      throw std::runtime_error("reset(): " + why + ", or make a new World from the file");
     }
   }
   const uint64_t s = seed.value_or(loaded_seed_);

@@ -127,6 +127,20 @@ class ControllerTest(unittest.TestCase):
             w.step()
         self.assertIn("cannot be stepped again", str(again.exception))
 
+    def test_a_controller_taking_no_argument_is_named_with_pythons_message(self):
+        # Python raises before the function's first line: no traceback of it.
+        def no_robots():
+            return {}
+
+        w = swarmsim.World(world("diffusion.yaml"), set={"robots": 2},
+                           controllers={"footbot": no_robots})
+        with self.assertRaises(RuntimeError) as e:
+            w.step()
+        message = str(e.exception)
+        self.assertIn("the Python controller of model 'footbot' raised an exception", message)
+        self.assertIn("TypeError", message)
+        self.assertIn("takes 0 positional arguments but 1 was given", message)
+
     def test_bad_returns_are_clear_errors(self):
         cases = [
             (lambda r: {"leftMotor": np.zeros(r.count + 1)}, "expected (5,): one value per robot"),

@@ -191,6 +191,11 @@ class SnapshotTest(unittest.TestCase):
             w.snapshot()
         with self.assertRaisesRegex(RuntimeError, "Lua script"):
             pickle.dumps(w)
+        # reset() is a snapshot of the start restored: refused in its own name.
+        with self.assertRaisesRegex(
+                RuntimeError, r"^reset\(\): robot 'footbot#0' runs Lua script .*"
+                              r"or make a new World from the file$"):
+            w.reset()
         w.step(1)  # refusing changed nothing
 
 
