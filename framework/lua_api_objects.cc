@@ -112,19 +112,25 @@ void CheckNumbers(lua_State* L, int arg, double* out, int n) {
   }
 }
 
-// sim.setObjectPose(h, {x, y, z, qx, qy, qz, qw} [, relTo]) and
-// sim.setObjectPosition(h, {x, y, z} [, relTo]) (the older argument order
-// (h, relTo, values) works too). The move is queued and applied after the
-// control phase in handle order, like writes to other robots, so every
-// script reads the poses of the start of the phase.
-int SetObjectPoseOrPosition(lua_State* L, bool position_only) {
+// What a sim.setObject* call sets.
+enum class PoseArgument { kPose, kPosition, kOrientation };
+
+// sim.setObjectPose(h, {x, y, z, qx, qy, qz, qw} [, relTo]),
+// sim.setObjectPosition(h, {x, y, z} [, relTo]) and
+// sim.setObjectOrientation(h, {roll, pitch, yaw} [, relTo]) (radians, as
+// sim.getObjectOrientation gives them; the older argument order (h, relTo,
+// values) works too). The move is queued and applied after the control
+// phase in handle order, like writes to other robots, so every script reads
+// the poses of the start of the phase.
+int SetObjectPoseOrPart(lua_State* L, PoseArgument what) {
+  const bool position_only = what == PoseArgument::kPosition;
   const LuaContext& c = Context(L);
   const ObjectId id = CheckObject(L, 1);
   const uint32_t slot = c.scene->SlotOf(id);
   const bool new_order = lua_istable(L, 2);
   const int values_arg = new_order ? 2 : 3, relative_arg = new_order ? 3 : 2;
   double v[7];
-  CheckNumbers(L, values_arg, v, position_only ? 3 : 7);
+  CheckNumbers(L, values_arg, v, what == PoseArgument::kPose ? 7 : 3);
   const ObjectId relative_to = OptRelativeTo(L, relative_arg);
   const Pose X_WR =
       relative_to.IsNull()
@@ -133,6 +139,8 @@ int SetObjectPoseOrPosition(lua_State* L, bool position_only) {
   Pose X_WO = c.scene->world_pose_at(slot);
   if (position_only) {
     X_WO.p = X_WR * Vec3{v[0], v[1], v[2]};
+  } else if (what == PoseArgument::kOrientation) {
+    X_WO.q = (X_WR.q * Quat::FromRollPitchYaw(v[0], v[1], v[2])).Normalized();
   } else {
     const Quat q = Quat{v[6], v[3], v[4], v[5]}.Normalized();
     X_WO = X_WR * Pose{{v[0], v[1], v[2]}, q};
@@ -152,8 +160,11 @@ int SetObjectPoseOrPosition(lua_State* L, bool position_only) {
   PushDeferredWrite(L, w);
   return 0;
 }
-int SetObjectPose(lua_State* L) { return SetObjectPoseOrPosition(L, false); }
-int SetObjectPosition(lua_State* L) { return SetObjectPoseOrPosition(L, true); }
+int SetObjectPose(lua_State* L) { return SetObjectPoseOrPart(L, PoseArgument::kPose); }
+int SetObjectPosition(lua_State* L) { return SetObjectPoseOrPart(L, PoseArgument::kPosition); }
+int SetObjectOrientation(lua_State* L) {
+  return SetObjectPoseOrPart(L, PoseArgument::kOrientation);
+}
 
 // sim.getObjectSizeFactor(h) -> the object's accumulated scale (1 unless it
 // or an ancestor was placed scaled or rescaled), as of the start of the phase.
@@ -195,6 +206,7 @@ void RegisterObjectsApi(lua_State* L) {
       {"getObjectParent", Guarded<GetObjectParent, "sim.getObjectParent">},
       {"setObjectPose", Guarded<SetObjectPose, "sim.setObjectPose">},
       {"setObjectPosition", Guarded<SetObjectPosition, "sim.setObjectPosition">},
+      {"setObjectOrientation", Guarded<SetObjectOrientation, "sim.setObjectOrientation">},
       {"getObjectSizeFactor", Guarded<GetObjectSizeFactor, "sim.getObjectSizeFactor">},
       {"setObjectSizeFactor", Guarded<SetObjectSizeFactor, "sim.setObjectSizeFactor">},
       {nullptr, nullptr},

@@ -148,5 +148,46 @@ TEST(ScriptHostTest, PosesInWorldAndRelativeFrames) {
   EXPECT_EQ(w.log, expected);
 }
 
+// sim.setObjectOrientation: getObjectOrientation's roll, pitch, yaw back
+// (in the world, or relative to an object), the position kept; applied
+// after the control phase like the other moves.
+TEST(ScriptHostTest, SetObjectOrientationIsGetObjectOrientationsInverse) {
+  ScriptWorld w;
+  const ObjectId body = w.scene().AddDummy("base", {}, {{1, 2, 0}, Quat::FromYaw(M_PI / 2)});
+  w.scene().AddDummy("tip", body, {{0.5, 0, 0.25}, {}});
+  w.scene().MakeModelInstance(body, "arm", "arm#0");
+  w.scene().AttachScript(body, Source("scripts/orient.lua", R"(
+    local n = 0
+    local function show(t)
+      local s = {}
+      for i, v in ipairs(t) do
+        if math.abs(v) < 1e-12 then v = 0 end  -- rounding's -1e-17 is 0
+        s[i] = string.format('%.6f', v)
+      end
+      return table.concat(s, ' ')
+    end
+    function sysCall_actuation()
+      local tip, me = sim.getObject('./tip'), sim.getObject('.')
+      if n == 0 then
+        sim.setObjectOrientation(tip, {0.1, -0.2, 0.3})
+        print('same step: ' .. show(sim.getObjectOrientation(tip)))
+      elseif n == 1 then
+        print(show(sim.getObjectOrientation(tip)))
+        print(show(sim.getObjectPosition(tip)))
+        sim.setObjectOrientation(tip, {0, 0, 0.5}, me)
+      else
+        print(show(sim.getObjectOrientation(tip, me)))
+      end
+      n = n + 1
+    end
+  )"));
+  w.world().Start();
+  for (int i = 0; i < 3; ++i) w.world().Step();
+  const std::vector<std::string> expected = {
+      "[arm#0] same step: 0.000000 0.000000 1.570796", "[arm#0] 0.100000 -0.200000 0.300000",
+      "[arm#0] 1.000000 2.500000 0.250000", "[arm#0] 0.000000 0.000000 0.500000"};
+  EXPECT_EQ(w.log, expected);
+}
+
 }  // namespace
 }  // namespace swarmsim
