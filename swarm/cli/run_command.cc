@@ -2,6 +2,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <cctype>
 #include <charconv>
 #include <chrono>
 #include <cmath>
@@ -417,6 +418,14 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
   std::string recorder_error;
   const std::optional<ViewRecorderSettings> recording = RecorderSettingsOf(args, &recorder_error);
   if (!recorder_error.empty()) return bad_input(recorder_error);
+  if (recording && !recording->video.empty()) {
+    std::string extension = recording->video.extension().string();
+    for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (extension != ".mp4")
+      std::cerr << "note: --video " << swarmsim::ValidUtf8(recording->video.string())
+                << ": the video is H.264 in an MP4 container whatever the file is called "
+                   "(name it .mp4 for players that go by the name)\n";
+  }
   // An --out folder an earlier run wrote to: its files go before this run
   // writes any (else old snapshots and video sit beside new metrics).
   if (options.out_dir)

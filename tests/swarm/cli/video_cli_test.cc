@@ -430,6 +430,17 @@ TEST(VideoCli, BadVideoOptionsAreNamedAndStopTheRunBeforeItStarts) {
   r = RunProgram("run --steps 2 --video " + world + " --out " + out.string());
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("put the world before --video"), std::string::npos) << r.output;
+  // A name that is not .mp4: an MP4 all the same, and a note says so (.MP4 is no surprise).
+  r = RunProgram("run " + world + " --steps 1 --video " + (dir / "film.avi").string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("note: --video " + (dir / "film.avi").string() +
+                          ": the video is H.264 in an MP4 container whatever the file is called"),
+            std::string::npos)
+      << r.output;
+  EXPECT_TRUE(std::filesystem::exists(dir / "film.avi"));
+  r = RunProgram("run " + world + " --steps 1 --video " + (dir / "film.MP4").string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.output.find("MP4 container"), std::string::npos) << r.output;
   // --video with no file and no folder.
   r = RunProgram("run " + world + " --steps 2 --video");
   EXPECT_EQ(r.exit_code, 2) << r.output;
