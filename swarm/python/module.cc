@@ -388,6 +388,9 @@ PYBIND11_MODULE(_swarmsim, m) {
       // Metrics.
       .def_property_readonly("metrics", &PyWorld::metrics,
                              "{name: last value} of the swarm-level metrics.")
+      .def_property_readonly("metric_names", &PyWorld::metric_names,
+                             "The swarm-level metrics the world declares (its metrics:), in\n"
+                             "order; robot-level ones are whatever the robots record.")
       .def("robot_metric", &PyWorld::robot_metric, py::arg("name"),
            "(N,) last value of a robot-level metric per robot (NaN: none yet). KeyError for\n"
            "a metric the world neither declares nor has recorded, listing the known ones.")

@@ -574,6 +574,11 @@ py::dict PyWorld::metrics() {
   return out;
 }
 
+std::vector<std::string> PyWorld::metric_names() {
+  auto r = Reading();
+  return loaded_.metric_names;
+}
+
 Array PyWorld::robot_metric(const std::string& name) {
   auto r = Reading();
   const ModelLayout& layout = Layout("");

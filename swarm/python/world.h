@@ -132,6 +132,8 @@ class PyWorld {
 
   // Swarm-level metrics: the last value of each.
   py::dict metrics();
+  // The swarm-level metrics the world declares (its `metrics:`), in order.
+  std::vector<std::string> metric_names();
   // A robot-level metric's last value per robot (NaN: none yet), robots as `robots`.
   Array robot_metric(const std::string& name);
   // Every swarm-level sample of `name` so far: (steps, values).

@@ -427,6 +427,15 @@ class RewardTest(unittest.TestCase):
             self.assertAlmostEqual(rewards[a], 0.1 * i)
         env.close()
 
+    def test_a_misspelt_swarm_metric_reward_is_refused_at_construction(self):
+        # Not at the first step, after the world had moved (British spelling).
+        self.assertIn("mean_nearest_neighbor_distance", make(2).world.metric_names)
+        with self.assertRaisesRegex(ValueError, r"^reward: the world declares no metric "
+                                                r"'mean_nearest_neighbour_distance'; did you mean "
+                                                r"'mean_nearest_neighbor_distance'\?"):
+            make(2, reward="mean_nearest_neighbour_distance")
+        make(2, reward="my_own_robot_metric").close()  # a robot-level one: the robots record it
+
     def test_a_swarm_metric_as_the_reward(self):
         env = make(6, reward="mean_nearest_neighbor_distance")
         env.reset(seed=1)
@@ -465,6 +474,24 @@ class DeclarationTest(unittest.TestCase):
             make(2, max_steps=0)
         with self.assertRaisesRegex(ValueError, "does not exist|no such|cannot|not found"):
             senv.ParallelEnv(world("nope.yaml"))
+        # Seeds and counts are integers, said by name (int("x") said nothing of a seed).
+        with self.assertRaisesRegex(TypeError, r"^seed must be an integer >= 0, got 1.5"):
+            make(2, seed=1.5)
+        with self.assertRaisesRegex(TypeError, r"^num_envs must be an integer >= 1, got 2.5"):
+            senv.VectorEnv(DIFFUSION, 2.5, set={"robots": 2})
+        with self.assertRaisesRegex(TypeError, r"^num_envs must be an integer >= 1, got True"):
+            senv.VectorEnv(DIFFUSION, True, set={"robots": 2})
+        env = make(2)
+        with self.assertRaisesRegex(TypeError, r"^reset: seed must be an integer >= 0, got 'x'"):
+            env.reset(seed="x")
+        with self.assertRaisesRegex(ValueError, r"^reset: seed must be an integer >= 0, got -1"):
+            env.reset(seed=-1)
+        env.reset(seed=np.int64(3))  # numpy integers are integers
+        env.close()
+        venv = senv.VectorEnv(DIFFUSION, 2, set={"robots": 2})
+        with self.assertRaisesRegex(TypeError, r"^reset: seed\[1\] must be an integer"):
+            venv.reset(seed=[1, 2.0])
+        venv.close()
 
     def test_pose_block_is_the_worlds_pose(self):
         env = make(5, observations=["pose"])

@@ -8,6 +8,7 @@ read after the step into (K, N, D) buffers and transformed in one numpy call per
 all K worlds.
 """
 
+import difflib
 import re
 import warnings
 
@@ -17,6 +18,17 @@ from . import _swarmsim
 
 World = _swarmsim.World
 MAX_SEED = 2**31  # seeds drawn for later episodes lie in [0, MAX_SEED)
+
+
+def whole_number(value, what, minimum=0):
+    """`value` as an int if it is a whole number (int or numpy integer, not a bool) of at
+    least `minimum`; else TypeError or ValueError naming `what` (``"seed"``)."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+        raise TypeError(f"{what} must be an integer >= {minimum}, got {value!r} "
+                        f"({type(value).__name__})")
+    if value < minimum:
+        raise ValueError(f"{what} must be an integer >= {minimum}, got {value}")
+    return int(value)
 
 
 def step_worlds(worlds, n=1, threads=0, parallel=True):
@@ -85,9 +97,7 @@ class Core:
         self.spec = spec
         self.path = str(spec["world"])
         self.model = spec["model"]
-        self.K = int(num_envs)
-        if self.K < 1:
-            raise ValueError(f"num_envs must be >= 1, got {num_envs}")
+        self.K = whole_number(num_envs, "num_envs", 1)
         self.slots = [_WorldSlot(k) for k in range(self.K)]
         self.parallel = True  # step the worlds with swarmsim.step_worlds where it exists
         self.reset_failures = 0  # World.reset calls that failed (the world was loaded again)
@@ -97,6 +107,7 @@ class Core:
         first = self._load(0, spec["seed"])
         self.slots[0].fresh = True
         self.base_seed = spec["seed"] if spec["seed"] is not None else _file_seed(first)
+        self._check_reward_metric(first)
         robots = first.robots
         models = sorted(set(robots["models"]))
         if self.model not in models:
@@ -161,6 +172,18 @@ class Core:
                 self._write_targets(slot, self.actions.targets(self.last_actions[slot.k]))
             return {name: slot.targets[j] for j, name in enumerate(self.joint_names)}
         return control
+
+    def _check_reward_metric(self, world):
+        # A reward named by a metric: a robot-level one is whatever the robots record (known
+        # only once they have), but a near miss of a declared swarm-level one is a typo.
+        name = getattr(self.spec["reward"], "metric", None)
+        declared = list(getattr(world, "metric_names", []))
+        if name is None or name in declared:
+            return
+        near = difflib.get_close_matches(name, declared, n=1)
+        if near:
+            raise ValueError(f"reward: the world declares no metric '{name}'; did you mean "
+                             f"'{near[0]}'? (declared: {', '.join(declared)})")
 
     def _find_model(self, seed):
         """The world's only model with joints (a probe load, without our controller)."""

@@ -41,7 +41,7 @@ import numpy as np
 
 from . import spaces
 from ._env_core import (AgentArrays, Core, has_keep_scripts, has_parallel_step, has_reset,
-                        step_worlds)
+                        step_worlds, whole_number)
 
 __all__ = [
     "ParallelEnv", "VectorEnv", "Observation", "JointTargets", "AgentArrays", "wheel_speeds",
@@ -296,6 +296,7 @@ def _metric_reward(name):
         has = (row_of >= 0) & (row_of < len(mine))
         out[has] = mine[row_of[has]]
         return np.nan_to_num(out, nan=0.0)
+    reward.metric = name
     return reward
 
 
@@ -338,8 +339,8 @@ def _spec(world, observations, actions, reward, terminate, max_steps, model, see
     if max_steps is not None and max_steps != "world" and (int(max_steps) != max_steps
                                                           or max_steps < 1):
         raise ValueError(f"max_steps: a number of steps >= 1, 'world' or None, got {max_steps}")
-    if seed is not None and (int(seed) != seed or seed < 0):
-        raise ValueError(f"seed must be an integer >= 0, got {seed}")
+    if seed is not None:
+        seed = whole_number(seed, "seed")
     return {
         "world": str(world), "observations": [_observation(o) for o in observations],
         "actions": actions, "reward": _reward(reward), "terminate": terminate,
@@ -482,8 +483,8 @@ class ParallelEnv(_AgentsOfAModel, _ParallelBase):
         poses = options.pop("poses", None)
         if options:
             raise ValueError(f"reset: unknown options {sorted(options)} (known: 'poses')")
-        if seed is not None and (int(seed) != seed or seed < 0):
-            raise ValueError(f"seed must be an integer >= 0, got {seed}")
+        if seed is not None:
+            seed = whole_number(seed, "reset: seed")
         core = self._core
         core.reset_world(0, seed, poses)
         core.step_all()
@@ -688,13 +689,13 @@ class VectorEnv(_AgentsOfAModel, _VectorBase):
         if seed is None:
             seeds = [None] * K
         elif np.ndim(seed) == 0:
-            if int(seed) != seed or seed < 0:
-                raise ValueError(f"seed must be an integer >= 0, got {seed}")
-            seeds = [int(seed) + k for k in range(K)]
+            seeds = [whole_number(seed, "reset: seed") + k for k in range(K)]
         else:
             seeds = list(seed)
             if len(seeds) != K:
                 raise ValueError(f"reset: {len(seeds)} seeds for {K} environments")
+            seeds = [None if x is None else whole_number(x, f"reset: seed[{k}]")
+                     for k, x in enumerate(seeds)]
         ks = [k for k in range(K) if mask[k]]
         for k in ks:
             core.reset_world(k, seeds[k], None if poses is None else poses[k])
