@@ -563,7 +563,7 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
     std::cerr << "error: " << swarmsim::ValidUtf8(result.error) << "\n";
     // Only when there is something to find (a disk full from the start: nothing).
     if (options.out_dir && std::filesystem::exists(*options.out_dir / "summary.json"))
-      std::cerr << "outputs up to step " << result.steps << " are in " << options.out_dir->string()
+      std::cerr << swarmsim::ValidUtf8(OutputsOfFinishedSteps(result.steps, *options.out_dir))
                 << "\n";
     // The shell's convention for a run ended by a signal: 128 + its number.
     return result.signal != 0 ? 128 + result.signal : kExitRunError;

@@ -568,6 +568,7 @@ void PyWorld::set_param(const std::string& model, const std::string& name,
 }
 
 py::dict PyWorld::metrics() {
+  Any();  // RuntimeError once closed, as every other accessor
   auto r = Reading();
   py::dict out;
   for (const auto& [name, value] : swarm_metrics_) out[py::str(name)] = value;
@@ -575,6 +576,7 @@ py::dict PyWorld::metrics() {
 }
 
 std::vector<std::string> PyWorld::metric_names() {
+  Any();
   auto r = Reading();
   return loaded_.metric_names;
 }

@@ -140,7 +140,10 @@ class PyWorld {
   py::tuple metric_history(const std::string& name);
 
   std::string describe();
-  std::vector<std::string> warnings() const { return loaded_.warnings; }
+  std::vector<std::string> warnings() const {
+    Any();  // RuntimeError once closed, as every other accessor
+    return loaded_.warnings;
+  }
 
  private:
   // Reads wait for a step another thread runs; inside one of the world's

@@ -439,8 +439,7 @@ void StepWatched(World* world, const RunOptions& options, Clock::time_point star
     std::fflush(stdout);
     std::cerr << "error: " << ValidUtf8(error) << "\n";
     if (options.out_dir && std::filesystem::is_directory(*options.out_dir))
-      std::cerr << "outputs up to step " << stuck.steps << " are in " << options.out_dir->string()
-                << "\n";
+      std::cerr << OutputsOfFinishedSteps(stuck.steps, *options.out_dir) << "\n";
     std::cerr.flush();
     std::_Exit(signal != 0 ? 128 + signal : 1);  // 1: the run failed, as main's
   };
@@ -562,6 +561,14 @@ void CreateOutputFolder(const std::filesystem::path& dir) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) throw Error("cannot create output folder '" + dir.string() + "': " + ec.message());
+}
+
+std::string OutputsOfFinishedSteps(int64_t steps, const std::filesystem::path& dir) {
+  const std::string which = steps == 0 ? " (no step finished)"
+                            : steps == 1
+                                ? " of the 1 step that finished"
+                                : " of the " + std::to_string(steps) + " steps that finished";
+  return "outputs" + which + " are in " + dir.string();
 }
 
 std::string RemoveEarlierOutputs(const std::filesystem::path& dir) {

@@ -83,6 +83,11 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
 std::string WriteErrorSummary(const RunOptions& options, const std::string& error,
                               const std::string& status = "error");
 
+// The line after a failed run's error: "outputs of the 3 steps that
+// finished are in DIR" ("of the 1 step", "(no step finished)"), counting as
+// the progress bar does (the error named step 4).
+std::string OutputsOfFinishedSteps(int64_t steps, const std::filesystem::path& dir);
+
 // Creates the run's output folder (and its parents). Throws swarmsim::Error
 // naming it when it cannot.
 void CreateOutputFolder(const std::filesystem::path& dir);

@@ -32,6 +32,11 @@ class WorldTest(unittest.TestCase):
         self.assertEqual(w.state_hash(), program_hash(world("diffusion.yaml"), 7, 25, 1,
                                                       ["robots=30"]))
         w.close()
+        # Closed: every accessor says so, the metrics and warnings too (they returned values).
+        for read in (lambda: w.metrics, lambda: w.warnings, lambda: w.metric_names,
+                     lambda: w.poses()):
+            with self.assertRaisesRegex(RuntimeError, "closed"):
+                read()
 
     def test_an_ode_world_steps_as_in_the_program(self):
         # ODE's solver threads and its constraint shuffle (the program's own

@@ -181,7 +181,8 @@ TEST(RunOutputsTest, StuckStepEndsTheRunNamingTheScriptAndKeepsTheOutputs) {
       << r.output;
   EXPECT_NE(r.output.find("probe.lua, in sysCall_actuation of /probe#0"), std::string::npos)
       << r.output;
-  EXPECT_NE(r.output.find("outputs up to step 3 are in"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("outputs of the 3 steps that finished are in"), std::string::npos)
+      << "steps counted as in the error (step 4 did not finish): " << r.output;
   // What the script printed in the stuck step comes before the error.
   const size_t printed = r.output.find("[probe#0] about to get stuck\n");
   EXPECT_NE(printed, std::string::npos) << r.output;
