@@ -90,6 +90,7 @@ class Importer {
   int frames_ = 0, bodies_ = 0, meshes_count_ = 0, visuals_ = 0, collisions_ = 0;
   std::map<std::string, int> mesh_formats_;
   std::map<std::string, int> joint_kinds_;
+  std::vector<std::string> held_joints_;  // moving joints whose <limit lower> = upper
   int mimics_ = 0;
   double total_mass_ = 0;
 };
@@ -501,6 +502,7 @@ ObjectSpec Importer::LinkObject(const urdf::Link& link, bool top, bool is_root, 
           Fail(line, "joint '" + joint->name + "': <limit lower> is above upper");
         settings.min_position = joint->limits->lower;
         settings.max_position = joint->limits->upper;
+        if (joint->limits->lower == joint->limits->upper) held_joints_.push_back(joint->name);
         // Start inside the limits.
         d.position = d.target_position =
             std::clamp(0.0, settings.min_position, settings.max_position);
@@ -627,6 +629,12 @@ UrdfImport Importer::Run(const std::string& where, const std::string& text) {
         name_ + ": " + plural(point_mass_links_.size(), "body is", "bodies are") +
         " point masses only, with no inertia (" + list(point_mass_links_) +
         "): each gets its mass x " + Num(kUrdfPointMassGyration) + " m^2 about each axis");
+  if (!held_joints_.empty())
+    out.warnings.push_back(
+        name_ + ": " + plural(held_joints_.size(), "joint has", "joints have") +
+        " <limit lower> equal to upper (" + list(held_joints_) +
+        "): held there as by a fixed joint; a models entry's joints: {limits: false} frees "
+        "them, joints: {mode: passive} lets them swing");
   if (!renamed_.empty())
     out.warnings.push_back(name_ + ": " + plural(renamed_.size(), "name was", "names were") +
                            " changed so that scripts find each object by its name (" +

@@ -45,25 +45,41 @@ std::string RangeError(const loader::ModelParameterDecl& decl, const std::string
   return what + " must be within " + range + " (got " + ShowParamValue(value) + ")";
 }
 
-// The entry's `joints:` settings on every joint of `spec` that has no value
-// of its own (a negative limit_erp, limit_cfm: an imported robot's joints),
-// each in a row of its own (rows may be shared with other entries).
-void SetJointLimitSoftness(double limit_erp, double limit_cfm, ObjectSpec* spec) {
+// A models entry's `joints:` (an imported robot's joints, which a URDF
+// cannot set): limit_erp, limit_cfm for joints without their own (negative:
+// none); `mode` for every joint that follows no master; `limits: false`
+// frees every joint's limits.
+struct EntryJoints {
+  double limit_erp = -1, limit_cfm = -1;
+  std::optional<JointMode> mode;
+  bool free_limits = false;
+};
+
+// `joints` on every joint of `spec`, each changed one in a row of its own
+// (rows may be shared with other entries).
+void SetEntryJoints(const EntryJoints& joints, ObjectSpec* spec) {
   if (const JointData* joint = spec->As<JointData>(ObjectType::kJoint)) {
-    const bool erp = limit_erp >= 0 && joint->settings->limit_erp < 0;
-    const bool cfm = limit_cfm >= 0 && joint->settings->limit_cfm < 0;
-    if (erp || cfm) {
+    const bool erp = joints.limit_erp >= 0 && joint->settings->limit_erp < 0;
+    const bool cfm = joints.limit_cfm >= 0 && joint->settings->limit_cfm < 0;
+    const bool mode =
+        joints.mode && joint->settings->depends == nullptr && joint->settings->mode != *joints.mode;
+    const bool free = joints.free_limits && (std::isfinite(joint->settings->min_position) ||
+                                             std::isfinite(joint->settings->max_position));
+    if (erp || cfm || mode || free) {
       const ObjectTypeDescriptor& type =
           *CoreObjectTypes()[static_cast<size_t>(ObjectType::kJoint)];
       std::shared_ptr<RowTable> row = type.make_rows(type);
       row->Append(joint, 0);
-      JointSettings& settings = static_cast<JointData*>(row->At(0))->settings.Edit();
-      if (erp) settings.limit_erp = limit_erp;
-      if (cfm) settings.limit_cfm = limit_cfm;
+      JointData& copy = *static_cast<JointData*>(row->At(0));
+      JointSettings& settings = copy.settings.Edit();
+      if (erp) settings.limit_erp = joints.limit_erp;
+      if (cfm) settings.limit_cfm = joints.limit_cfm;
+      if (mode) settings.mode = *joints.mode;
+      if (free) settings.min_position = -INFINITY, settings.max_position = INFINITY;
       spec->row = std::move(row);
     }
   }
-  for (ObjectSpec& child : spec->children) SetJointLimitSoftness(limit_erp, limit_cfm, &child);
+  for (ObjectSpec& child : spec->children) SetEntryJoints(joints, &child);
 }
 
 // `show_collision: true`: every hidden shape named `collision` below `spec`
@@ -429,12 +445,29 @@ void WorldLoader::ExtendObjects(const Fields& f, const ValueReader& world_values
   if (f.Has("joints")) {
     // Joint settings for every joint of the model without its own (ode).
     Fields joints(*file_, f.Get("joints"), "'joints'");
-    joints.Expect({"limit_erp", "limit_cfm"});
-    const double erp =
-        joints.Has("limit_erp") ? world_values.Number(joints.Get("limit_erp"), kFraction) : -1;
-    const double cfm =
-        joints.Has("limit_cfm") ? world_values.Number(joints.Get("limit_cfm"), kFraction) : -1;
-    SetJointLimitSoftness(erp, cfm, spec);
+    joints.Expect({"limit_erp", "limit_cfm", "mode", "limits"});
+    EntryJoints settings;
+    if (joints.Has("limit_erp"))
+      settings.limit_erp = world_values.Number(joints.Get("limit_erp"), kFraction);
+    if (joints.Has("limit_cfm"))
+      settings.limit_cfm = world_values.Number(joints.Get("limit_cfm"), kFraction);
+    if (joints.Has("mode")) {
+      const std::string mode =
+          world_values.Choice(joints.Get("mode"), {"passive", "velocity", "position", "force"});
+      settings.mode = mode == "passive"    ? JointMode::kPassive
+                      : mode == "velocity" ? JointMode::kVelocity
+                      : mode == "position" ? JointMode::kPosition
+                                           : JointMode::kForce;
+    }
+    if (joints.Has("limits")) {
+      const Field limits = joints.Get("limits");
+      if (world_values.Bool(limits))
+        file_->Fail(limits.mark,
+                    "'limits' takes false (free every joint's limits); a joint's "
+                    "own limits are its own");
+      settings.free_limits = true;
+    }
+    SetEntryJoints(settings, spec);
   }
   if (f.Has("objects")) {
     std::vector<ObjectSpec> extra = loader::ReadSceneObjects(*file_, f.Get("objects"), world_values,

@@ -154,6 +154,44 @@ TEST_F(UrdfCorpusTest, EveryFileLoadsAndHangsUnderOdeForTwoSeconds) {
   }
 }
 
+// The published double pendulum's revolute joints say lower = upper = 0:
+// held there (a warning says so and how to free them); with the models
+// entry's joints: {mode: passive, limits: false} it swings under gravity
+// (the base tilted 20 degrees about the joints' x axis: upright, the links
+// would balance for seconds before falling).
+TEST_F(UrdfCorpusTest, TheDoublePendulumHeldByItsLimitsSwingsOnceFreed) {
+  NEED_CORPUS(dir);
+  const std::string robot = dir + "/double_pendulum";
+  const std::string urdf =
+      robot + "/example-robot-data/robots/double_pendulum_description/urdf/double_pendulum.urdf";
+  const auto world = [&](const std::string& joints) {
+    return "simulation: {physics: ode, time_step: 0.01}\npackage_path: [" + robot +
+           "]\nmodels:\n  - model: " + urdf +
+           "\n    position: [0, 0, 1]\n    orientation_deg: [20, 0, 0]\n" + joints;
+  };
+  const auto swing = [&](LoadedWorld* w) {
+    w->world->Start();
+    const ObjectId joint = Find(w->world->scene(), "joint1", true);
+    EXPECT_FALSE(joint.IsNull());
+    double most = 0;
+    for (int k = 0; k < 150; ++k) {
+      w->world->Step();
+      most = std::max(most, std::abs(w->world->scene().joint(joint).position));
+    }
+    return most;
+  };
+  LoadedWorld held = Load(world(""));
+  bool warned = false;
+  for (const std::string& warning : held.warnings)
+    warned = warned || (warning.find("2 joints have <limit lower> equal to upper (joint1, "
+                                     "joint2): held there") != std::string::npos &&
+                        warning.find("joints: {limits: false}") != std::string::npos);
+  EXPECT_TRUE(warned) << "no warning of the held joints";
+  EXPECT_LT(swing(&held), 0.05);
+  LoadedWorld freed = Load(world("    joints: {mode: passive, limits: false}\n"));
+  EXPECT_GT(swing(&freed), 0.3) << "a pendulum started off its rest position swings";
+}
+
 TEST_F(UrdfCorpusTest, LinksSitWhereTheXmlJointsPutThemAtThreeConfigurations) {
   NEED_CORPUS(dir);
   for (const CorpusFile& f : kFiles) {

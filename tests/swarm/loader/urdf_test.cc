@@ -341,6 +341,40 @@ TEST_F(UrdfTest, TheExampleArmsFollowTheirTargets) {
   }
 }
 
+// A models entry's joints: {mode, limits: false} sets what a URDF cannot:
+// every imported joint's mode, and free limits; mistakes name their place.
+TEST_F(UrdfTest, AnEntrysJointsSetTheModeAndFreeTheLimits) {
+  const std::string arm = (fs::path(SWARMSIM_SOURCE_DIR) / "worlds" / "models" /
+                           "simple_arm_description" / "urdf" / "simple_arm.urdf")
+                              .string();
+  const std::string head = "simulation: {physics: kinematic}\npackage_path: [" +
+                           (fs::path(SWARMSIM_SOURCE_DIR) / "worlds" / "models").string() +
+                           "]\nmodels:\n  - model: " + arm + "\n    position: [0, 0]\n    joints: ";
+  const auto joints_of = [](const LoadedWorld& w) {
+    std::vector<const JointData*> out;
+    for (const JointData& j : w.world->scene().joints()) out.push_back(&j);
+    return out;
+  };
+  LoadedWorld as_imported = Load(head + "{}\n");
+  ASSERT_FALSE(joints_of(as_imported).empty());
+  bool limited = false;
+  for (const JointData* j : joints_of(as_imported)) {
+    EXPECT_EQ(j->mode(), JointMode::kPosition);
+    limited = limited || std::isfinite(j->settings->max_position);
+  }
+  EXPECT_TRUE(limited) << "the arm's URDF limits its joints";
+  LoadedWorld freed = Load(head + "{mode: passive, limits: false}\n");
+  for (const JointData* j : joints_of(freed)) {
+    EXPECT_EQ(j->mode(), JointMode::kPassive);
+    EXPECT_EQ(j->settings->min_position, -INFINITY);
+    EXPECT_EQ(j->settings->max_position, INFINITY);
+  }
+  EXPECT_CONTAINS(testing::ErrorOf([&] { Load(head + "{limits: true}\n"); }),
+                  "world.yaml:6:22: 'limits' takes false");
+  EXPECT_CONTAINS(testing::ErrorOf([&] { Load(head + "{mode: passiv}\n"); }),
+                  "did you mean 'passive'?");
+}
+
 TEST_F(UrdfTest, JointDampingSlowsAPendulumUnderOde) {
   // A 1 kg box on a passive hinge about y, released horizontal: without
   // damping it swings on; with 2 N m s/rad it settles hanging.
