@@ -313,8 +313,7 @@ void WorldLoader::ResolveEntryParameters(const Fields& f, const ValueReader& wor
     for (const auto& decl : model.parameters)
       if (decl.name == o.name)
         if (std::string e = RangeError(decl, model.name, it->second); !e.empty())
-          throw Error("--set " + o.text + ": " + e + " (declared at " + declared->where[o.name] +
-                      ")");
+          throw Error(o.text + ": " + e + " (declared at " + declared->where[o.name] + ")");
   }
   entry->parameters = params;
 }

@@ -37,13 +37,13 @@ std::vector<std::string> TopKeys(const ModuleRegistry& registry) {
 std::vector<Override> SplitOverrides(const LoadOptions& options) {
   std::vector<Override> out;
   for (const auto& [name, value] : options.overrides) {
-    Override o{name + "=" + value, "", name, value};
+    Override o{options.override_option + " " + name + "=" + value, "", name, value};
     if (const size_t dot = name.find('.'); dot != std::string::npos) {
       o.model = name.substr(0, dot);
       o.name = name.substr(dot + 1);
     }
     if (o.name.empty() || (o.model.empty() && name.find('.') != std::string::npos))
-      throw Error("--set " + o.text + ": expected name=value or model.name=value");
+      throw Error(o.text + ": expected name=value or model.name=value");
     out.push_back(std::move(o));
   }
   return out;
@@ -71,9 +71,8 @@ void CheckObjects(Scene& scene) {
 ParamValue CoerceOverride(const Override& o, const ParamValue& declared,
                           const std::string& declared_where) {
   if (std::optional<ParamValue> value = loader::AsDeclaredType(o.value, declared)) return *value;
-  throw Error("--set " + o.text + ": parameter '" + (o.model.empty() ? "" : o.model + ".") +
-              o.name + "' is " + loader::TypeName(declared) + " (" + declared_where + "), got \"" +
-              o.value + "\"");
+  throw Error(o.text + ": parameter '" + (o.model.empty() ? "" : o.model + ".") + o.name + "' is " +
+              loader::TypeName(declared) + " (" + declared_where + "), got \"" + o.value + "\"");
 }
 
 LoadedWorld WorldLoader::Load() {
@@ -324,9 +323,9 @@ void WorldLoader::CheckOverrides() {
       // A model parameter given without its model: point at the full name.
       for (const std::string& k : known)
         if (k.ends_with("." + o.name))
-          throw Error("--set " + o.text + ": no world parameter '" + o.name + "' in " +
-                      file_->name() + "; did you mean '" + k + "'?");
-      throw Error("--set " + o.text + ": no parameter '" + o.name + "' in " + file_->name() +
+          throw Error(o.text + ": no world parameter '" + o.name + "' in " + file_->name() +
+                      "; did you mean '" + k + "'?");
+      throw Error(o.text + ": no parameter '" + o.name + "' in " + file_->name() +
                   loader::Suggest(o.name, known));
     }
     const ModelFile* model = nullptr;
@@ -334,13 +333,13 @@ void WorldLoader::CheckOverrides() {
       if (m->name == o.model) model = m.get();
     const std::string full = o.model + "." + o.name;
     if (!model)
-      throw Error("--set " + o.text + ": no model '" + o.model + "' in " + file_->name() +
+      throw Error(o.text + ": no model '" + o.model + "' in " + file_->name() +
                   loader::Suggest(full, known));
     bool found = false;
     for (const auto& p : model->parameters) found |= p.name == o.name;
     if (!found)
-      throw Error("--set " + o.text + ": model '" + o.model + "' has no parameter '" + o.name +
-                  "'" + loader::Suggest(full, known));
+      throw Error(o.text + ": model '" + o.model + "' has no parameter '" + o.name + "'" +
+                  loader::Suggest(full, known));
   }
 }
 

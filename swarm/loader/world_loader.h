@@ -28,6 +28,9 @@ struct LoadOptions {
   // The value is read as a YAML scalar (number, true/false, else text) and
   // must have the type of the parameter's value in the file.
   std::vector<std::pair<std::string, std::string>> overrides;
+  // How errors name an override, as the user gave it: "--set" (run),
+  // "--param" (sweep), "World(set=...)" (Python).
+  std::string override_option = "--set";
   std::optional<uint64_t> seed;  // --seed: replaces simulation.seed
   int threads = 0;               // --threads: <= 0 all cores
   // The run's output folder (--out), where sandboxed scripts may write;

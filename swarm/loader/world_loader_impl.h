@@ -46,7 +46,7 @@ std::vector<std::shared_ptr<const ModelSectionData>> ReadModelSections(
 
 // One --set, split into its target.
 struct Override {
-  std::string text;   // "name=value", for messages
+  std::string text;   // "--set name=value" (LoadOptions::override_option), for messages
   std::string model;  // "" for a world parameter
   std::string name;
   std::string value;

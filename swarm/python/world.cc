@@ -91,6 +91,7 @@ PyWorld::PyWorld(const std::string& path, std::optional<uint64_t> seed,
       text = py::str(value).cast<std::string>();
     options.overrides.emplace_back(name, text);
   }
+  options.override_option = "World(set=...)";
   try {
     loaded_ = LoadWorld(path, options, Registry());
   } catch (const Error& e) {

@@ -40,15 +40,15 @@ void CheckWorld(const SweepOptions& o, const GridRun& first, const std::vector<P
   RegisterBuiltinModules(&registry);
   LoadOptions load;
   load.overrides = first.params;
+  load.override_option = "--param";
   load.seed = first.seed;
   load.threads = 1;
   LoadedWorld loaded;
   try {
     loaded = LoadWorld(o.world, load, registry);
   } catch (const Error& e) {
-    // The loader names overrides as --set gives them: here they are --param's.
-    std::string message = e.what();
-    if (message.rfind("--set ", 0) == 0) throw Error("--param " + message.substr(6));
+    const std::string message = e.what();
+    if (message.starts_with(load.override_option + " ")) throw;  // names the --param already
     std::string point;
     for (const auto& [name, value] : first.params) point += name + "=" + value + ", ";
     throw Error("the sweep's first run (" + point + "seed " + std::to_string(first.seed) +

@@ -220,6 +220,16 @@ class MisuseTest(unittest.TestCase):
             swarmsim.World(WORLD, set={"robots": 2}, threads=256).step()
         """)
 
+    def test_set_mistakes_name_set_not_the_programs_option(self):
+        # The loader's messages name the override as the user gave it (not '--set').
+        self.run_child('''
+            e = expect(ValueError, "World(set=...) robtos=4: no parameter 'robtos'",
+                       swarmsim.World, WORLD, set={"robtos": 4})
+            assert "--set" not in str(e), e
+            expect(ValueError, "World(set=...) robots=abc: parameter 'robots' is a number",
+                   swarmsim.World, WORLD, set={"robots": "abc"})
+        ''')
+
     def test_step_counts_and_seeds_are_whole_numbers(self):
         self.run_child("""
             w = swarmsim.World(WORLD, set={"robots": 2})
