@@ -248,6 +248,12 @@ bool MeasureInChild(const BenchOptions& options, const std::string& config, int 
   return true;
 }
 
+void SayNewWarnings(const std::vector<std::string>& warnings, std::set<std::string>* said,
+                    std::ostream& err) {
+  for (const std::string& warning : warnings)
+    if (said->insert(warning).second) err << "warning: " << warning << "\n" << std::flush;
+}
+
 int RunBench(BenchOptions options, std::ostream& out, std::ostream& err) {
   // Everything that can be checked is, before the table's header.
   const std::string bare = PrepareBench(&options);
@@ -277,8 +283,7 @@ int RunBench(BenchOptions options, std::ostream& out, std::ostream& err) {
     const std::string label = config == "diffusion" ? world_label : config;
     std::vector<std::string> warnings;
     const bool measured = MeasureInChild(options, config, robots, threads, &row, &warnings);
-    for (const std::string& warning : warnings)
-      if (warned.insert(warning).second) err << "warning: " << warning << "\n" << std::flush;
+    SayNewWarnings(warnings, &warned, err);
     if (!measured) {
       err << "bench: " << label << " with " << robots << (robots == 1 ? " robot" : " robots")
           << " on " << threads << (threads == 1 ? " thread" : " threads") << " failed\n";

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <iosfwd>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -64,6 +65,12 @@ int RunBench(BenchOptions options, std::ostream& out, std::ostream& err);
 // appended to `warnings` if given.
 bool MeasureInChild(const BenchOptions& options, const std::string& config, int robots, int threads,
                     BenchRow* row, std::vector<std::string>* warnings = nullptr);
+
+// Prints each of `warnings` ("warning: ..." on `err`) that is not in `said`
+// yet, and adds it there: a world's load-time warnings once per bench,
+// whatever the rows that bring them.
+void SayNewWarnings(const std::vector<std::string>& warnings, std::set<std::string>* said,
+                    std::ostream& err);
 
 // The child side: measures one configuration in this process and prints one
 // CSV row (no header) to `out`, then a "warning: ..." line for each of the

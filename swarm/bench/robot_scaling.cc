@@ -266,8 +266,7 @@ int RunRobotScalingBench(RobotScalingOptions o, std::ostream& out, std::ostream&
       std::vector<std::string> warnings;
       const bool measured =
           MeasureInChild(bench, "diffusion", cell.robots, cell.threads, &row.bench, &warnings);
-      for (const std::string& warning : warnings)
-        if (warned.insert(warning).second) err << "warning: " << warning << "\n" << std::flush;
+      SayNewWarnings(warnings, &warned, err);
       if (!measured) {
         err << "bench: " << c.name << " with " << cell.robots << " robots on " << cell.threads
             << (cell.threads == 1 ? " thread" : " threads") << " failed\n";

@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "framework/math.h"
 #include "swarm/loader/check_text.h"
 
 namespace swarmsim::loader {
@@ -29,7 +30,7 @@ struct NumericAttribute {
 constexpr const char* kCoordinateRule = "a coordinate from -1e6 to 1e6 m";
 constexpr const char* kSizeRule = "a size from 0 to 1e6 m";
 constexpr NumericAttribute kNumericAttributes[] = {
-    {"origin", "xyz", 3, -1e6, 1e6, kCoordinateRule},
+    {"origin", "xyz", 3, -kMaxCoordinate, kMaxCoordinate, kCoordinateRule},
     {"origin", "rpy", 3},
     {"mass", "value", 1},
     {"inertia", "ixx", 1},
@@ -38,10 +39,10 @@ constexpr NumericAttribute kNumericAttributes[] = {
     {"inertia", "iyy", 1},
     {"inertia", "iyz", 1},
     {"inertia", "izz", 1},
-    {"box", "size", 3, 0, 1e6, kSizeRule},
-    {"cylinder", "radius", 1, 0, 1e6, kSizeRule},
-    {"cylinder", "length", 1, 0, 1e6, kSizeRule},
-    {"sphere", "radius", 1, 0, 1e6, kSizeRule},
+    {"box", "size", 3, 0, kMaxCoordinate, kSizeRule},
+    {"cylinder", "radius", 1, 0, kMaxCoordinate, kSizeRule},
+    {"cylinder", "length", 1, 0, kMaxCoordinate, kSizeRule},
+    {"sphere", "radius", 1, 0, kMaxCoordinate, kSizeRule},
     {"mesh", "scale", 3},
     {"color", "rgba", 4},
     {"axis", "xyz", 3},

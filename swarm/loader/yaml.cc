@@ -64,10 +64,9 @@ YamlFile YamlFile::Load(const fs::path& path, std::string_view kind,
   // else on the next one.
   if (const size_t nul = text.find('\0'); nul != std::string::npos) {
     YAML::Mark mark;
-    const size_t line_start = text.rfind('\n', nul == 0 ? 0 : nul - 1);
+    const size_t newline = text.rfind('\n', nul);  // the one before it (text[nul] is none)
     mark.line = static_cast<int>(std::count(text.begin(), text.begin() + nul, '\n'));
-    mark.column =
-        static_cast<int>(line_start == std::string::npos || nul == 0 ? nul : nul - line_start - 1);
+    mark.column = static_cast<int>(newline == std::string::npos ? nul : nul - newline - 1);
     file.Fail(mark, "a NUL byte (\\0) in the file: a " + std::string(kind) +
                         " is text (was it saved by a program that pads with zeros?)");
   }
