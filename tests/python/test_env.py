@@ -515,6 +515,26 @@ class DeclarationTest(unittest.TestCase):
         self.assertEqual(env.observation_space("footbot#0").shape, (25,))
         env.close()
 
+    def test_a_block_that_reads_nan_is_an_error_naming_it_and_the_agent(self):
+        def late_nan(world, model):
+            values = np.zeros((len(world.poses(model)), 2))
+            if world.steps >= 3:
+                values[2, 1] = np.nan  # the third robot's second column
+            return values
+        env = make(3, observations=["proximity", senv.Observation("broken", late_nan)])
+        env.reset(seed=1)
+        env.step({a: np.zeros(2) for a in env.agents})  # steps 2: still numbers
+        with self.assertRaises(ValueError) as e:
+            env.step({a: np.zeros(2) for a in env.agents})
+        self.assertIn("observation 'broken': column 1 is NaN for agent 'footbot#2'",
+                      str(e.exception))
+        env.close()
+        # inf is a reading, not an error: rays that see nothing.
+        env = make(3, observations=[senv.proximity_distance()])
+        obs, _ = env.reset(seed=1)
+        self.assertTrue(np.isinf(obs["footbot#0"]).any())
+        env.close()
+
     def test_range_and_bearing_ground_and_light_blocks(self):
         env = make(6, set={"footbot.with_rab": True, "footbot.with_ground": True,
                            "footbot.with_light": True},

@@ -350,7 +350,20 @@ class Core:
             self.present[k] = slot.row_of >= 0
         for (item, _, a, b), raw in zip(self.blocks, self.raw):
             self.obs[:, :, a:b] = item.transform(raw)
+            self._check_not_nan(item, a, b)
         # Agents whose robot is gone keep their last observation.
+
+    def _check_not_nan(self, item, a, b):
+        # inf is a reading (a ray that sees nothing); NaN is a broken block, which a
+        # learner would take in silently.
+        block = self.obs[:, :, a:b]
+        if not np.isnan(block).any():
+            return
+        k, i, c = (int(v) for v in np.argwhere(np.isnan(block))[0])
+        where = f" of environment {k}" if self.K > 1 else ""
+        raise ValueError(f"observation '{item.name}': column {c} is NaN for agent "
+                         f"'{self.agents[i]}'{where} (after {int(self.episode_steps[k])} "
+                         f"steps of the episode); read() or transform() must return numbers")
 
     def agent_arrays(self, k):
         arrays = AgentArrays()
