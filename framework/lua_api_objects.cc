@@ -146,8 +146,7 @@ int SetObjectPoseOrPart(lua_State* L, PoseArgument what) {
     X_WO = X_WR * Pose{{v[0], v[1], v[2]}, q};
   }
   // Within what a world file may use (the engines cannot take much more).
-  if (!(std::abs(X_WO.p.x) <= kMaxCoordinate && std::abs(X_WO.p.y) <= kMaxCoordinate &&
-        std::abs(X_WO.p.z) <= kMaxCoordinate)) {
+  if (!WithinWorld(X_WO.p)) {
     char text[160];
     std::snprintf(text, sizeof text,
                   "the position (%g, %g, %g) is beyond +-1e6 m, the largest coordinate a world "

@@ -54,6 +54,12 @@ struct Vec3 {  // 24 bytes
   }
 };
 
+// Whether p lies within kMaxCoordinate on every axis (false for NaN).
+inline bool WithinWorld(const Vec3& p) {
+  return std::abs(p.x) <= kMaxCoordinate && std::abs(p.y) <= kMaxCoordinate &&
+         std::abs(p.z) <= kMaxCoordinate;
+}
+
 constexpr Vec3 operator*(double s, const Vec3& v) { return v * s; }
 
 // Unit quaternion (w, x, y, z) for rotations.

@@ -42,10 +42,6 @@ class PhaseTimer {
 bool IsFinite(const Vec3& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
-bool InWorldBounds(const Vec3& p) {
-  return std::abs(p.x) <= kMaxCoordinate && std::abs(p.y) <= kMaxCoordinate &&
-         std::abs(p.z) <= kMaxCoordinate;
-}
 bool IsFinite(const Pose& X) {
   return std::isfinite(X.p.x) && std::isfinite(X.p.y) && std::isfinite(X.p.z) &&
          std::isfinite(X.q.w) && std::isfinite(X.q.x) && std::isfinite(X.q.y) &&
@@ -659,7 +655,7 @@ void World::Physics() {
       throw non_finite(slot, "velocity");
     // A body past the world's bounds: the simulation blew up (a finite
     // 1e96 m is as much garbage as a NaN, only later).
-    if (!InWorldBounds(X_WB.p)) throw out_of_bounds(slot, X_WB.p);
+    if (!WithinWorld(X_WB.p)) throw out_of_bounds(slot, X_WB.p);
   }
   const auto joints = scene_.joints();
   for (uint32_t row = 0; row < joints.size(); ++row)

@@ -99,8 +99,7 @@ std::shared_ptr<const TriangleMesh> MeshCache::Get(const fs::path& path, const V
   std::vector<Vec3> vertices = file->second->vertices;
   for (Vec3& v : vertices) {
     v = {v.x * scale.x, v.y * scale.y, v.z * scale.z};
-    if (!(std::abs(v.x) <= kMaxCoordinate && std::abs(v.y) <= kMaxCoordinate &&
-          std::abs(v.z) <= kMaxCoordinate)) {
+    if (!WithinWorld(v)) {
       char text_v[128];
       std::snprintf(text_v, sizeof text_v, "(%g, %g, %g) m; coordinates are at most %g m", v.x, v.y,
                     v.z, kMaxCoordinate);
