@@ -25,6 +25,17 @@ int EditDistance(std::string_view a, std::string_view b) {
   return prev[m];
 }
 
+// Whether `word` is one of the '_'-separated words of `name` (not all of it).
+bool IsWordOf(std::string_view word, std::string_view name) {
+  if (word.empty() || word.size() >= name.size()) return false;
+  for (size_t start = 0; start <= name.size();) {
+    const size_t end = std::min(name.find('_', start), name.size());
+    if (name.substr(start, end - start) == word) return true;
+    start = end + 1;
+  }
+  return false;
+}
+
 const std::string* NearestName(std::string_view name, std::span<const std::string> candidates) {
   const std::string* best = nullptr;
   int best_distance = 0;
@@ -36,6 +47,9 @@ const std::string* NearestName(std::string_view name, std::span<const std::strin
   // Close enough to be a typo: up to 2 edits, or a third of the longer name.
   const int longest = static_cast<int>(std::max(name.size(), best->size()));
   if ((best_distance <= 2 || best_distance * 3 <= longest) && best_distance < longest) return best;
+  // Or one is a whole word of the other ('noise_std' for 'noise').
+  for (const std::string& c : candidates)
+    if (IsWordOf(c, name) || IsWordOf(name, c)) return &c;
   return nullptr;
 }
 
@@ -43,13 +57,17 @@ std::string Suggest(std::string_view name, std::span<const std::string> candidat
   if (candidates.empty()) return "";
   if (const std::string* nearest = NearestName(name, candidates))
     return "; did you mean '" + *nearest + "'?";
-  // A model's every path can be hundreds: the first dozen and a count.
-  constexpr size_t kListed = 12;
+  // Every key of a section fits; a model's every path can be hundreds: as
+  // many as fit in about five lines, and a count.
+  constexpr size_t kListedCharacters = 400;
   std::string list;
-  for (size_t i = 0; i < candidates.size() && i < kListed; ++i)
-    list += (list.empty() ? "" : ", ") + candidates[i];
-  if (candidates.size() > kListed)
-    list += ", ... (" + std::to_string(candidates.size() - kListed) + " more)";
+  size_t listed = 0;
+  for (; listed < candidates.size(); ++listed) {
+    if (listed > 0 && list.size() + candidates[listed].size() > kListedCharacters) break;
+    list += (list.empty() ? "" : ", ") + candidates[listed];
+  }
+  if (listed < candidates.size())
+    list += ", ... (" + std::to_string(candidates.size() - listed) + " more)";
   return " (expected one of: " + list + ")";
 }
 

@@ -14,11 +14,14 @@ int EditDistance(std::string_view a, std::string_view b);
 
 // The candidate nearest to `name` if it is close enough to be a typo (up to
 // 2 edits, or a third of the longer name, and not a different word
-// altogether), else null. The first of equally near candidates wins.
+// altogether), else the first candidate that is a whole '_'-separated word of
+// `name` or has `name` as one ('noise' for 'noise_std', 'max_range' for
+// 'range'), else null. The first of equally near candidates wins.
 const std::string* NearestName(std::string_view name, std::span<const std::string> candidates);
 
 // "; did you mean 'radius'?" for the nearest candidate if it is close enough,
-// else " (expected one of: a, b, c)" (the first 12 and "... (N more)"), or
+// else " (expected one of: a, b, c)" (as many as fit in 400 characters, then
+// "... (N more)"), or
 // "" when there are no candidates.
 std::string Suggest(std::string_view name, std::span<const std::string> candidates);
 

@@ -49,18 +49,34 @@ TEST(SuggestTest, NearestNameIsATypoOfACandidateOrNothing) {
   EXPECT_EQ(*NearestName("xate", tied), "rate");
   const std::vector<std::string> tied_reversed = {"gate", "rate"};
   EXPECT_EQ(*NearestName("xate", tied_reversed), "gate");
+  // A whole word of the other: a key with a unit or a qualifier added or dropped.
+  const std::vector<std::string> sensor = {"range", "noise", "max_speed", "aperture"};
+  EXPECT_EQ(*NearestName("noise_std", sensor), "noise");
+  EXPECT_EQ(*NearestName("speed", sensor), "max_speed");
+  EXPECT_EQ(NearestName("noisy_std", sensor), nullptr);  // words must match whole
+  EXPECT_EQ(NearestName("fov", sensor), nullptr);
 }
 
 TEST(SuggestTest, SuggestNamesTheNearestOrListsThemAll) {
   const std::vector<std::string> keys = {"physics", "time_step", "seed"};
   EXPECT_EQ(Suggest("phyiscs", keys), "; did you mean 'physics'?");
   EXPECT_EQ(Suggest("colour", keys), " (expected one of: physics, time_step, seed)");
-  // A long list (every path of a URDF model): the first dozen and a count.
+  // Every key of a section, however many.
+  std::vector<std::string> keys20;
+  for (int i = 0; i < 20; ++i) keys20.push_back("key_number_" + std::to_string(i));
+  const std::string all = Suggest("colour", keys20);
+  EXPECT_NE(all.find("key_number_0, key_number_1,"), std::string::npos) << all;
+  EXPECT_NE(all.find(", key_number_19)"), std::string::npos) << all;
+  EXPECT_EQ(all.find("more"), std::string::npos) << all;
+  // A long list (every path of a URDF model): what fits in 400 characters and a count.
   std::vector<std::string> many;
-  for (int i = 0; i < 40; ++i) many.push_back("link_" + std::to_string(i));
-  EXPECT_EQ(Suggest("gripper", many),
-            " (expected one of: link_0, link_1, link_2, link_3, link_4, link_5, link_6, link_7, "
-            "link_8, link_9, link_10, link_11, ... (28 more))");
+  for (int i = 0; i < 100; ++i) many.push_back("/robot/base/link_" + std::to_string(i));
+  const std::string cut = Suggest("gripper", many);
+  EXPECT_NE(cut.find(" (expected one of: /robot/base/link_0, /robot/base/link_1,"),
+            std::string::npos)
+      << cut;
+  EXPECT_NE(cut.find(", ... (81 more))"), std::string::npos) << cut;
+  EXPECT_LT(cut.size(), 460u);
   EXPECT_EQ(Suggest("anything", std::vector<std::string>{}), "");
 }
 
