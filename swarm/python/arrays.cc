@@ -338,12 +338,24 @@ py::dict RangeAndBearing(const Scene& scene, const ModelLayout& layout) {
 void SetRangeAndBearingData(Scene* scene, const ModelLayout& layout, const py::object& data) {
   using range_and_bearing::RangeAndBearingRow;
   const size_t n = layout.robots.size();
-  py::array_t<int64_t, py::array::c_style | py::array::forcecast> a;
-  try {
-    a = py::cast<py::array_t<int64_t, py::array::c_style | py::array::forcecast>>(data);
-  } catch (const py::cast_error&) {
+  // Bytes as integers, or floats that are whole numbers (np.zeros makes
+  // floats); never booleans or fractions cast away in silence.
+  const py::array raw = py::array::ensure(data);
+  if (!raw)
     throw py::value_error("range-and-bearing data must be an array of bytes, one row per robot");
+  const char kind = raw.dtype().kind();
+  if (kind == 'b') throw py::type_error("range-and-bearing data is booleans, not bytes (0..255)");
+  if (kind != 'i' && kind != 'u' && kind != 'f')
+    throw py::type_error("range-and-bearing data must be bytes, 0..255, not dtype " +
+                         py::str(raw.dtype()).cast<std::string>());
+  if (kind == 'f') {
+    const auto f = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(raw);
+    for (py::ssize_t i = 0; i < f.size(); ++i)
+      if (!(f.data()[i] >= 0 && f.data()[i] <= 255 && f.data()[i] == std::floor(f.data()[i])))
+        throw py::value_error("range-and-bearing data must be bytes, whole numbers 0..255 (got " +
+                              py::str(py::float_(f.data()[i])).cast<std::string>() + ")");
   }
+  const auto a = py::array_t<int64_t, py::array::c_style | py::array::forcecast>::ensure(raw);
   if (a.ndim() != 2 || static_cast<size_t>(a.shape(0)) != n)
     throw py::value_error("range-and-bearing data must have shape (" + std::to_string(n) +
                           ", bytes): one row per robot");

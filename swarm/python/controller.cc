@@ -203,9 +203,9 @@ class ControllerModule : public Module {
         trace = e.what();
       }
       throw Error(config_.where + ": the Python controller of model '" + config_.model +
-                  "' raised an exception in step " + std::to_string(world->step_count() + 1) +
-                  " of the run (its Robots.step was " + std::to_string(world->step_count()) +
-                  "):\n" + trace);
+                  "' raised an exception during step " + std::to_string(world->step_count() + 1) +
+                  " of the run (called with robots.step == " + std::to_string(world->step_count()) +
+                  ", the steps finished):\n" + trace);
     }
   }
 

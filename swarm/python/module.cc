@@ -18,11 +18,14 @@
 #include <exception>
 #include <map>
 #include <memory>
+#include <new>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "framework/scheduler.h"
+#include "framework/utf8.h"
 #include "swarm/python/controller.h"
 #include "swarm/python/world.h"
 
@@ -67,6 +70,69 @@ std::optional<uint64_t> SeedArg(const py::object& value, const std::string& what
                           number.attr("__str__")().cast<std::string>());
   }
   return static_cast<uint64_t>(seed);
+}
+
+// --- File paths -----------------------------------------------------------------------
+
+// A file path as Python gives one: str (a name that is not UTF-8 arrives
+// with surrogate escapes, as os.listdir returns it), bytes or any os.PathLike,
+// turned into the file system's bytes by os.fsencode.
+std::string FsPath(const py::handle& value, const std::string& what) {
+  if (py::isinstance<py::bytes>(value)) return value.cast<std::string>();
+  try {
+    return py::module_::import("os").attr("fsencode")(value).cast<std::string>();
+  } catch (const py::error_already_set& e) {
+    if (!e.matches(PyExc_TypeError)) throw;
+    throw py::type_error(what + " must be a path (str, bytes or os.PathLike), not " +
+                         TypeName(value));
+  }
+}
+std::vector<std::string> FsPaths(const py::handle& value, const std::string& what) {
+  if (py::isinstance<py::str>(value) || py::isinstance<py::bytes>(value) ||
+      !py::isinstance<py::sequence>(value))
+    throw py::type_error(what + " must be a list of paths, not " + TypeName(value));
+  std::vector<std::string> paths;
+  for (const py::handle item : value) paths.push_back(FsPath(item, what + " entries"));
+  return paths;
+}
+
+// --- Error text ---------------------------------------------------------------------------
+
+// Messages quote world files, scripts and file names, whose bytes may not be
+// UTF-8; Python's exception text must be, and one that is not would arrive
+// empty (PyErr_SetString fails to decode it). Such a message is raised with
+// each invalid sequence replaced by U+FFFD, as the program prints it; the
+// exception types are pybind11's (a registered translator runs first).
+void SetErrorText(PyObject* type, const char* what) {
+  PyErr_SetString(type, ValidUtf8(what).c_str());
+}
+PyObject* StandardErrorType(const std::exception& e) {
+  if (dynamic_cast<const std::bad_alloc*>(&e) != nullptr) return PyExc_MemoryError;
+  if (dynamic_cast<const std::out_of_range*>(&e) != nullptr) return PyExc_IndexError;
+  if (dynamic_cast<const std::overflow_error*>(&e) != nullptr) return PyExc_OverflowError;
+  if (dynamic_cast<const std::invalid_argument*>(&e) != nullptr ||
+      dynamic_cast<const std::domain_error*>(&e) != nullptr ||
+      dynamic_cast<const std::length_error*>(&e) != nullptr ||
+      dynamic_cast<const std::range_error*>(&e) != nullptr)
+    return PyExc_ValueError;
+  return PyExc_RuntimeError;
+}
+void TranslateNonUtf8Messages(std::exception_ptr error) {
+  try {
+    if (error) std::rethrow_exception(error);
+  } catch (const py::error_already_set&) {
+    throw;  // a Python exception already
+  } catch (const py::builtin_exception& e) {
+    if (IsValidUtf8(e.what())) throw;
+    e.set_error();  // sets the type (its text failed to decode)
+    PyObject* type = PyErr_Occurred();
+    Py_XINCREF(type);
+    SetErrorText(type != nullptr ? type : PyExc_RuntimeError, e.what());
+    Py_XDECREF(type);
+  } catch (const std::exception& e) {
+    if (IsValidUtf8(e.what())) throw;
+    SetErrorText(StandardErrorType(e), e.what());
+  }
 }
 
 // --- Many worlds at once ---------------------------------------------------------------
@@ -157,6 +223,7 @@ void StepWorlds(const py::sequence& worlds, const py::object& count, int threads
 PYBIND11_MODULE(_swarmsim, m) {
   using swarmsim::python::PyWorld;
   m.doc() = "swarmsim: load a world, step it, read and drive the swarm with numpy";
+  py::register_exception_translator(&swarmsim::python::TranslateNonUtf8Messages);
 
   // --- Robots: what a controller receives (controller.cc) --------------------------------
   swarmsim::python::BindRobots(m);
@@ -179,18 +246,19 @@ PYBIND11_MODULE(_swarmsim, m) {
       "Threads: one thread uses a World at a time. A second Python thread's call waits\n"
       "until the first one's step ends. A controller may read its world but not step,\n"
       "close or write it (RuntimeError).")
-      .def(py::init([](const std::string& path, const py::object& seed,
+      .def(py::init([](const py::object& path, const py::object& seed,
                        const std::map<std::string, py::object>& set, int threads,
                        const std::map<std::string, py::object>& controllers,
-                       const std::vector<std::string>& package_path, bool keep_scripts) {
+                       const py::object& package_path, bool keep_scripts) {
              return std::make_unique<PyWorld>(
-                 path, swarmsim::python::SeedArg(seed, "World(seed=...)"), set, threads,
-                 controllers, package_path, keep_scripts);
+                 swarmsim::python::FsPath(path, "World(path)"),
+                 swarmsim::python::SeedArg(seed, "World(seed=...)"), set, threads, controllers,
+                 swarmsim::python::FsPaths(package_path, "World(package_path=...)"), keep_scripts);
            }),
            py::arg("path"), py::arg("seed") = py::none(),
            py::arg("set") = std::map<std::string, py::object>{}, py::arg("threads") = 0,
            py::arg("controllers") = std::map<std::string, py::object>{},
-           py::arg("package_path") = std::vector<std::string>{}, py::arg("keep_scripts") = true)
+           py::arg("package_path") = py::list(), py::arg("keep_scripts") = true)
       // Stepping and state.
       .def(
           "step",

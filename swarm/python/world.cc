@@ -125,8 +125,12 @@ PyWorld::PyWorld(const std::string& path, std::optional<uint64_t> seed,
                       gate_.get()};
   }
   for (auto& [model, config] : configs) {
-    if (!HasModel(model))
-      throw py::value_error("controllers: the world has no model '" + model + "'");
+    if (!HasModel(model)) {
+      std::string known;
+      for (const std::string& m : ModelNames()) known += (known.empty() ? "" : ", ") + m;
+      throw py::value_error("controllers: the world has no model '" + model + "' (it has " +
+                            (known.empty() ? std::string("none") : known) + ")");
+    }
     world.AddModule(kControllerModule, &config);
   }
 }

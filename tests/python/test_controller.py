@@ -121,7 +121,7 @@ class ControllerTest(unittest.TestCase):
         message = str(e.exception)
         self.assertIn("ZeroDivisionError", message)
         self.assertIn("in broken", message)
-        self.assertIn("in step 3 of the run (its Robots.step was 2)", message)
+        self.assertIn("during step 3 of the run (called with robots.step == 2, the steps finished)", message)
         self.assertEqual(w.steps, 2, "the steps before the error stand")
         with self.assertRaises(RuntimeError) as again:
             w.step()

@@ -104,6 +104,14 @@ class ParallelApiTest(unittest.TestCase):
         np.testing.assert_array_equal(action.low, [-0.1, -0.1])
         np.testing.assert_array_equal(action.high, [0.1, 0.1])
         self.assertEqual(env.joint_names, ["leftMotor", "rightMotor"])
+        # state(): every agent's observation in one row, in state_space.
+        obs, _ = env.reset(seed=3)
+        state = env.state()
+        self.assertEqual(env.state_space.shape, (4 * 30,))
+        self.assertEqual(state.shape, env.state_space.shape)
+        np.testing.assert_array_equal(state[30:60], obs["footbot#1"])
+        np.testing.assert_array_equal(env.state_space.low[30:60], space.low)
+        self.assertTrue(env.state_space.contains(state))
         env.close()
 
 
@@ -320,6 +328,38 @@ class ResetOptionsTest(unittest.TestCase):
             env.reset(seed=1, options={"pose": poses})
         env.close()
 
+    def test_a_refused_reset_leaves_the_episode_as_it_was(self):
+        env = make(3, observations=["pose"], set={"density": 0.2})
+        env.reset(seed=1)
+        for _ in range(4):
+            obs, *_ = env.step({a: np.full(2, 0.05) for a in env.agents})
+        world = env._core.slots[0].world
+        hash_before, steps_before = world.state_hash(), world.steps
+        bad = np.zeros((3, 3))
+        bad[1, 0] = np.nan
+        with self.assertRaisesRegex(ValueError, r"row 1 \('footbot#1'\) is not finite"):
+            env.reset(seed=2, options={"poses": bad})
+        bad[1, 0] = 2e6
+        with self.assertRaisesRegex(ValueError, r"row 1 \('footbot#1'\) is beyond \+-1e6 m"):
+            env.reset(seed=2, options={"poses": bad})
+        with self.assertRaisesRegex(TypeError, "must be numbers"):
+            env.reset(seed=2, options={"poses": np.full((3, 3), "x")})
+        # The world was not reset: the episode goes on from where it was.
+        self.assertEqual((world.state_hash(), world.steps), (hash_before, steps_before))
+        after, *_ = env.step({a: np.full(2, 0.05) for a in env.agents})
+        self.assertEqual(world.steps, steps_before + 1)
+        self.assertFalse(np.array_equal(after["footbot#0"], obs["footbot#0"]))  # driving on
+        env.close()
+        venv = senv.VectorEnv(DIFFUSION, 2, set={"robots": 3, "density": 0.2})
+        venv.reset(seed=1)
+        hashes = [s.world.state_hash() for s in venv._core.slots]
+        bad = np.zeros((2, 3, 3))
+        bad[1, 2, 1] = np.inf  # the second environment's: the first is not reset either
+        with self.assertRaisesRegex(ValueError, "row 2 \\('footbot#2'\\) is not finite"):
+            venv.reset(seed=5, options={"poses": bad})
+        self.assertEqual([s.world.state_hash() for s in venv._core.slots], hashes)
+        venv.close()
+
 
 class EpisodeTest(unittest.TestCase):
     def test_truncation_at_max_steps(self):
@@ -468,7 +508,8 @@ class DeclarationTest(unittest.TestCase):
             make(2, observations=["sonar"])
         with self.assertRaisesRegex(ValueError, r"no joint \['wheel'\].*leftMotor"):
             make(2, actions=senv.JointTargets(["wheel"]))
-        with self.assertRaisesRegex(ValueError, "no model 'kilobot'"):
+        with self.assertRaisesRegex(
+                ValueError, r"model='kilobot': the world has no model 'kilobot' \(it has footbot\)"):
             make(2, model="kilobot")
         with self.assertRaisesRegex(ValueError, "max_steps"):
             make(2, max_steps=0)

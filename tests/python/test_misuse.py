@@ -258,6 +258,34 @@ class MisuseTest(unittest.TestCase):
             assert a.state_hash() == b.state_hash()
         """)
 
+    def test_paths_as_python_gives_them_and_messages_with_bytes_that_are_not_utf8(self):
+        self.run_child(r"""
+            import os, pathlib, tempfile
+            # pathlib.Path, bytes and str all name the world file.
+            for path in (pathlib.Path(WORLD), os.fsencode(WORLD), WORLD):
+                swarmsim.World(path, set={"robots": 2}).close()
+            expect(TypeError, "World(path) must be a path (str, bytes or os.PathLike), not int",
+                   swarmsim.World, 5)
+            expect(TypeError, "World(package_path=...) must be a list of paths",
+                   swarmsim.World, WORLD, package_path="models")
+            folder = os.fsencode(tempfile.mkdtemp())
+            with open(os.path.join(folder, b"bot.yaml"), "wb") as f:
+                f.write(b"model: bot\nobjects: {type: dummy, script: bad.lua}\n")
+            with open(os.path.join(folder, b"bad.lua"), "wb") as f:
+                f.write(b"function sysCall_actuation() error('bad \xff byte') end\n")
+            # A file name that is not UTF-8, as os.listdir gives it (surrogate escapes).
+            with open(os.path.join(folder, b"w\xff.yaml"), "wb") as f:
+                f.write(b"simulation: {physics: kinematic, time_step: 0.1}\n"
+                        b"models:\n  - {model: bot.yaml, position: [0, 0]}\n")
+            listed = [n for n in os.listdir(os.fsdecode(folder)) if n.startswith("w")]
+            assert listed == ["w\udcff.yaml"], listed
+            w = swarmsim.World(os.path.join(os.fsdecode(folder), listed[0]))
+            # Messages quoting such bytes arrive whole, each bad byte as U+FFFD.
+            expect(RuntimeError, "bad \ufffd byte", w.step)
+            e = expect(ValueError, "nothing\ufffd", swarmsim.World,
+                       os.path.join(folder, b"nothing\xff.yaml"))
+        """)
+
     def test_a_model_without_range_and_bearing_boards_is_a_value_error(self):
         self.run_child("""
             w = swarmsim.World(WORLD, set={"robots": 2})   # foot-bots without the board

@@ -63,6 +63,19 @@ class RangeAndBearingTest(unittest.TestCase):
             w.set_range_and_bearing_data("bot", np.full((3, 1), 256))
         with self.assertRaisesRegex(ValueError, r"shape \(3, bytes\)"):
             w.set_range_and_bearing_data("bot", np.zeros((2, 1)))
+        # Fractions and NaN are not cut to bytes in silence; booleans are not bytes.
+        with self.assertRaisesRegex(ValueError, r"whole numbers 0..255 \(got 1.7\)"):
+            w.set_range_and_bearing_data("bot", np.full((3, 1), 1.7))
+        with self.assertRaisesRegex(ValueError, r"whole numbers 0..255 \(got nan\)"):
+            w.set_range_and_bearing_data("bot", np.full((3, 1), np.nan))
+        with self.assertRaisesRegex(TypeError, "booleans, not bytes"):
+            w.set_range_and_bearing_data("bot", np.ones((3, 1), dtype=bool))
+        with self.assertRaisesRegex(TypeError, "not dtype <U1"):
+            w.set_range_and_bearing_data("bot", [["a"], ["b"], ["c"]])
+        # Whole floats (np.zeros makes floats) are bytes.
+        w.set_range_and_bearing_data("bot", np.array([[7.0], [8.0], [255.0]]))
+        w.step(1)
+        self.assertEqual(w.range_and_bearing("bot")["data"][:, 0].tolist(), [8, 7])
 
 
 if __name__ == "__main__":

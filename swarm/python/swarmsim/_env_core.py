@@ -17,6 +17,7 @@ import numpy as np
 from . import _swarmsim
 
 World = _swarmsim.World
+MAX_COORDINATE = 1e6  # m, framework/math.h's kMaxCoordinate
 MAX_SEED = 2**31  # seeds drawn for later episodes lie in [0, MAX_SEED)
 
 
@@ -104,7 +105,14 @@ class Core:
         if self.model is None:
             self.model = self._find_model(spec["seed"])
         # The first world tells the agents, joints and sizes.
-        first = self._load(0, spec["seed"])
+        try:
+            first = self._load(0, spec["seed"])
+        except ValueError as e:  # the model= given is not the world's: say model=, not controllers
+            head = f"controllers: the world has no model '{self.model}'"
+            if not str(e).startswith(head):
+                raise
+            raise ValueError(f"{self.path}: model={self.model!r}: {str(e)[len('controllers: '):]}"
+                             ) from None
         self.slots[0].fresh = True
         self.base_seed = spec["seed"] if spec["seed"] is not None else _file_seed(first)
         self._check_reward_metric(first)
@@ -256,6 +264,8 @@ class Core:
         seed = int(seed)
         if seed < 0:
             raise ValueError(f"seed must be >= 0, got {seed}")
+        if poses is not None:
+            poses = self.checked_poses(poses)  # before the world changes
         slot.rng = np.random.default_rng(seed)
         if slot.fresh and slot.seed == seed:
             pass  # loaded with this seed and never stepped
@@ -280,8 +290,7 @@ class Core:
             if setter is None:
                 raise ValueError("reset(options={'poses': ...}) needs World.set_poses, which "
                                  "this build of swarmsim does not have")
-            poses = np.asarray(poses)
-            if not slot.identity or poses.ndim != 2 or poses.shape[0] != self.N:
+            if not slot.identity:
                 raise ValueError(f"reset: options['poses'] must have one row per agent "
                                  f"({self.N}, 3 or 7), got shape {poses.shape}")
             setter(self.model, poses)
@@ -293,6 +302,30 @@ class Core:
         self.terminated[k] = False
         self.truncated[k] = False
         self.rewards[k] = 0
+
+    def checked_poses(self, poses):
+        # What World.set_poses would refuse, refused before a reset begins: a failed
+        # reset(options=...) leaves the environment as it was.
+        if isinstance(poses, (str, bytes)):
+            raise TypeError(f"reset: options['poses'] must be an array, not {type(poses).__name__}")
+        array = np.asarray(poses)
+        if array.dtype.kind not in "iuf":
+            raise TypeError(f"reset: options['poses'] must be numbers, got dtype {array.dtype}")
+        array = array.astype(np.float64)
+        if array.ndim != 2 or array.shape[0] != self.N or array.shape[1] not in (3, 7):
+            raise ValueError(f"reset: options['poses'] must have one row per agent "
+                             f"({self.N}, 3 or 7), got shape {array.shape}")
+        bad = ~np.isfinite(array).all(axis=1)
+        if bad.any():
+            i = int(np.argmax(bad))
+            raise ValueError(f"reset: options['poses'] row {i} ('{self.agents[i]}') is not finite")
+        position = array[:, :2] if array.shape[1] == 3 else array[:, :3]
+        far = (np.abs(position) > MAX_COORDINATE).any(axis=1)
+        if far.any():
+            i = int(np.argmax(far))
+            raise ValueError(f"reset: options['poses'] row {i} ('{self.agents[i]}') is beyond "
+                             f"+-1e6 m, the largest coordinate a world may use")
+        return array
 
     def set_actions(self, ks, actions):
         """Joint targets of the next step of worlds ks from their actions (len(ks), N, A),

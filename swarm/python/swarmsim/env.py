@@ -433,6 +433,10 @@ class ParallelEnv(_AgentsOfAModel, _ParallelBase):
         self.observation_spaces = {a: self._obs_space() for a in self.possible_agents}
         self.action_spaces = {a: spaces.Box(core.actions.low, core.actions.high, (core.A,),
                                             np.float64) for a in self.possible_agents}
+        # PettingZoo's state_space: what state() returns, N x D values in one row.
+        n = len(self.possible_agents)
+        self.state_space = spaces.Box(np.tile(core.obs_low, n), np.tile(core.obs_high, n),
+                                      (n * core.D,), np.float64)
         self._started = False
 
     def _obs_space(self):
@@ -697,6 +701,11 @@ class VectorEnv(_AgentsOfAModel, _VectorBase):
             seeds = [None if x is None else whole_number(x, f"reset: seed[{k}]")
                      for k, x in enumerate(seeds)]
         ks = [k for k in range(K) if mask[k]]
+        if poses is not None:  # every environment's checked before any resets
+            if isinstance(poses, (str, bytes)) or np.ndim(poses) != 3 or len(poses) != K:
+                raise ValueError(f"reset: options['poses'] must be (K={K}, N, 3 or 7), got "
+                                 f"shape {np.shape(poses)}")
+            poses = [core.checked_poses(poses[k]) for k in range(K)]
         for k in ks:
             core.reset_world(k, seeds[k], None if poses is None else poses[k])
         self._step_some(ks)
