@@ -187,6 +187,10 @@ class ControllerModule : public Module {
         gate.interrupt_type = e.type();
         gate.interrupt_value = e.value();
         gate.interrupt_trace = e.trace();
+        if (gate.in_run)
+          throw Error(config_.where + ": the Python controller of model '" + config_.model +
+                      "' raised " +
+                      (e.matches(PyExc_KeyboardInterrupt) ? "KeyboardInterrupt" : "SystemExit"));
         return;
       }
       // The traceback, as Python prints it.

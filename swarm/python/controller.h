@@ -35,6 +35,10 @@ struct WorldGate {
   // finishes without the controllers' targets, then it is raised again.
   py::object interrupt_type, interrupt_value, interrupt_trace;
   bool interrupted() const { return static_cast<bool>(interrupt_type); }
+  // World.run() is stepping (swarm/run's loop, which knows nothing of
+  // Python): a controller's KeyboardInterrupt or SystemExit also ends the
+  // step with an error, so that the run stops and writes its outputs.
+  bool in_run = false;
 };
 
 // Holds a world's gate for one call (the GIL held on entry and exit).

@@ -261,6 +261,25 @@ PYBIND11_MODULE(_swarmsim, m) {
            py::arg("package_path") = py::list(), py::arg("keep_scripts") = true)
       // Stepping and state.
       .def(
+          "run",
+          [](PyWorld& w, const py::object& steps, const py::object& out_dir, bool quiet,
+             bool hash) {
+            std::optional<int64_t> n;
+            if (!steps.is_none()) n = swarmsim::python::IntArg(steps, "run(steps)");
+            std::optional<std::string> dir;
+            if (!out_dir.is_none()) dir = swarmsim::python::FsPath(out_dir, "run(out_dir=...)");
+            return w.Run(n, dir, quiet, hash);
+          },
+          py::arg("steps") = py::none(), py::arg("out_dir") = py::none(), py::arg("quiet") = false,
+          py::arg("hash") = false,
+          "Runs the world as `swarmsim run` does: steps (None: the world's duration), a\n"
+          "progress bar and summary table on stderr/stdout unless quiet, 'state-hash: ...'\n"
+          "printed when hash, and with out_dir (a folder, made if missing) summary.json and\n"
+          "metrics.csv written as the run goes. The world is stopped at the end (its\n"
+          "scripts' cleanups run): it can be read, not stepped. Returns {steps,\n"
+          "wall_seconds, start_seconds, peak_rss_mb, state_hash}; raises RuntimeError for\n"
+          "the run's error (its outputs written) and KeyboardInterrupt for Ctrl-C.")
+      .def(
           "step",
           [](PyWorld& w, const py::object& n) {
             w.Step(swarmsim::python::IntArg(n, "step(n): n"));

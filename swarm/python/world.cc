@@ -4,6 +4,7 @@
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -92,11 +93,15 @@ PyWorld::PyWorld(const std::string& path, std::optional<uint64_t> seed,
     options.overrides.emplace_back(name, text);
   }
   options.override_option = "World(set=...)";
+  loaded_overrides_ = options.overrides;
+  const auto load_start = std::chrono::steady_clock::now();
   try {
     loaded_ = LoadWorld(path, options, Registry());
   } catch (const Error& e) {
     throw py::value_error(e.what());
   }
+  load_seconds_ =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
   World& world = *loaded_.world;
   loaded_seed_ = world.settings().seed;
   planar_ = world.registry().dynamics_capabilities(world.settings().physics).planar;
@@ -291,6 +296,10 @@ void PyWorld::FinishSteps(const std::string& who) {
 
 World& PyWorld::Live() {
   if (!loaded_.world) throw std::runtime_error("the world is closed");
+  if (ran_)
+    throw std::runtime_error(
+        "the world's run() ran it to its end (its scripts' sysCall_cleanup ran): it can be "
+        "read, not stepped; load it again to run more");
   if (!failed_.empty())
     throw std::runtime_error("the world stopped after an error and cannot be stepped again: " +
                              failed_);
@@ -690,8 +699,10 @@ py::object PyWorld::LoadFunction(const PythonController& c) {
   }
 }
 
-void PyWorld::TakeMetrics() {
-  for (const MetricSample& s : loaded_.world->TakeMetrics()) {
+void PyWorld::TakeMetrics() { KeepMetrics(loaded_.world->TakeMetrics()); }
+
+void PyWorld::KeepMetrics(const std::vector<MetricSample>& samples) {
+  for (const MetricSample& s : samples) {
     if (s.instance < 0) {
       swarm_metrics_[s.name] = s.value;
       history_[s.name].emplace_back(s.step, s.value);

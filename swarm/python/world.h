@@ -50,6 +50,16 @@ class PyWorld {
   static std::unique_ptr<PyWorld> setstate(const py::tuple& t);
 
   void Step(int64_t n);
+  // run(): `swarmsim run`'s loop (swarm/run/runner.h) over this world: the
+  // steps (None: the world's duration), progress and summary table unless
+  // quiet, the state hash printed when asked, and with `out` (a folder)
+  // summary.json and metrics.csv written as the run goes. The world is
+  // stopped at the end (its scripts' cleanups run): readable, not steppable.
+  // Returns the run's figures; raises RuntimeError (the run's error, after
+  // its outputs are written) or KeyboardInterrupt (a stop signal, or one a
+  // controller raised).
+  py::dict Run(std::optional<int64_t> steps, const std::optional<std::string>& out, bool quiet,
+               bool hash);
 
   void Close();
 
@@ -184,12 +194,16 @@ class PyWorld {
   static py::object LoadFunction(const PythonController& c);
 
   void TakeMetrics();
+  void KeepMetrics(const std::vector<MetricSample>& samples);
 
   std::unique_ptr<WorldGate> gate_ = std::make_unique<WorldGate>();  // outlives loaded_.world
   LoadedWorld loaded_;
   bool planar_ = true;
   std::string failed_;
-  bool reported_ = false;  // failed_ was raised by the step that failed
+  bool reported_ = false;     // failed_ was raised by the step that failed
+  bool ran_ = false;          // run() ended the world
+  double load_seconds_ = -1;  // the constructor's load, for run()'s summary
+  std::vector<std::pair<std::string, std::string>> loaded_overrides_;  // set=, as text
   std::map<std::string, ModelLayout> layouts_;
   std::map<std::string, double> swarm_metrics_;
   std::map<std::string, std::map<int, double>> robot_metrics_;

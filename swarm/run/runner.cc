@@ -447,9 +447,15 @@ void StepWatched(World* world, const RunOptions& options, Clock::time_point star
                     end_stuck_run);
   // Outputs of the step just done, then the next unit of work for the
   // watchdog's message; under its lock, so it never writes at the same time.
+  const auto take_metrics = [&] {
+    if (!metrics && !options.on_metrics) return;  // kept in the world
+    const std::vector<MetricSample> samples = world->TakeMetrics();
+    if (metrics) metrics->Write(samples);
+    if (options.on_metrics) options.on_metrics(samples);
+  };
   const auto done = [&](std::string next) {
     const std::lock_guard lock(watchdog.io_mutex());
-    if (metrics) metrics->Write(world->TakeMetrics());
+    take_metrics();
     watchdog.Progress(std::move(next));
   };
   const auto step_name = [&] {
@@ -513,7 +519,7 @@ void StepWatched(World* world, const RunOptions& options, Clock::time_point star
     result.error = e.what();
     // The states are still open after an error: what they held then.
     lua_kib = static_cast<double>(world->script_memory_bytes()) / 1024.0;
-    if (metrics) metrics->Write(world->TakeMetrics());  // whatever was recorded before the error
+    take_metrics();  // whatever was recorded before the error
   }
 }
 

@@ -49,6 +49,10 @@ struct RunOptions {
   // stuck step), from the watchdog's thread just before the process exits:
   // the recording's end chunk. (A run that returns is the caller's to close.)
   std::function<void(const RunResult&)> on_stuck_end;
+  // Called with each step's metric samples (after metrics.csv has them),
+  // from the run's thread: the Python World keeps its history from them.
+  // Null: with out_dir, metrics.csv takes them; else the world keeps them.
+  std::function<void(const std::vector<MetricSample>&)> on_metrics;
 };
 
 struct RunResult {

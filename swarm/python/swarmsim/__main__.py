@@ -1,11 +1,15 @@
-"""python3 -m swarmsim run WORLD [--steps N] [--seed S] [--threads T] [--set NAME=VALUE]... [--hash]
+"""python3 -m swarmsim run WORLD [--steps N] [--seed S] [--threads T] [--set NAME=VALUE]...
+                          [--out DIR] [--quiet] [--hash]
 
 Runs a world from Python, for worlds whose models name a python_controller (which
-the swarmsim program cannot run). Exit status: 0 done, 1 error while running,
-2 bad input (a world that does not load, a bad option).
+the swarmsim program cannot run), with `swarmsim run`'s progress, summary table and,
+with --out DIR, its summary.json and metrics.csv. Exit status: 0 done, 1 error while
+running (the outputs of the steps that finished are kept), 2 bad input (a world that
+does not load, a bad option), 128 + N for a stop signal N (Ctrl-C: 130).
 """
 
 import argparse
+import signal
 import sys
 
 from . import World
@@ -31,6 +35,10 @@ def main(argv=None):
     run.add_argument("--seed", type=int)
     run.add_argument("--threads", type=int, default=0)
     run.add_argument("--set", action="append", default=[], metavar="NAME=VALUE")
+    run.add_argument("--out", metavar="DIR",
+                     help="write summary.json and metrics.csv to DIR (made if missing)")
+    run.add_argument("--quiet", action="store_true",
+                     help="no progress and no summary table (errors still go to stderr)")
     run.add_argument("--hash", action="store_true", help="print the final state hash")
     args = parser.parse_args(argv)
 
@@ -51,13 +59,19 @@ def main(argv=None):
         print(f"error: {args.world} gives no duration: pass --steps N", file=sys.stderr)
         return 2
     try:
-        world.step(steps)
+        world.run(steps, out_dir=args.out, quiet=args.quiet, hash=args.hash)
+    except ValueError as e:  # --out is not a folder we can use
+        print(f"error: {e}", file=sys.stderr)
+        return 2
     except RuntimeError as e:
         print(f"error: {e}", file=sys.stderr)
         return 1
-    if args.hash:
-        print(f"state-hash: {world.state_hash()}")
-    world.close()
+    except KeyboardInterrupt as e:
+        if str(e):
+            print(f"error: {e}", file=sys.stderr)
+        return 128 + getattr(e, "signal", signal.SIGINT)
+    finally:
+        world.close()
     return 0
 
 

@@ -1,0 +1,129 @@
+// World.run(): the program's run loop (swarm/run/runner.h) over a world
+// loaded from Python, so that worlds whose models name a python_controller
+// (which `swarmsim run` refuses) get the same progress, summary table,
+// summary.json and metrics.csv (`python3 -m swarmsim run --out DIR`).
+#include <pybind11/stl.h>
+
+#include <filesystem>
+#include <iostream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "framework/error.h"
+#include "framework/state_hash.h"
+#include "framework/utf8.h"
+#include "swarm/python/world.h"
+#include "swarm/run/runner.h"
+
+namespace swarmsim::python {
+
+namespace {
+
+// The command that is running, for summary.json: the interpreter's argv.
+std::string CommandLine() {
+  std::string line = "python3";
+  try {
+    bool first = true;
+    for (const py::handle arg : py::module_::import("sys").attr("argv")) {
+      std::string text = py::str(arg).cast<std::string>();
+      // `python3 -m swarmsim`: argv[0] is the package's __main__.py.
+      const std::filesystem::path path(text);
+      if (first && path.filename() == "__main__.py" && path.parent_path().filename() == "swarmsim")
+        text = "-m swarmsim";
+      line.append(" ").append(text);
+      first = false;
+    }
+  } catch (const py::error_already_set&) {
+    // An embedding without sys.argv: the interpreter alone.
+  }
+  return line;
+}
+
+void FlushPythonStreams() {
+  py::module_ sys = py::module_::import("sys");
+  for (const char* stream : {"stdout", "stderr"}) {
+    const py::object s = sys.attr(stream);
+    if (!s.is_none()) s.attr("flush")();
+  }
+}
+
+}  // namespace
+
+py::dict PyWorld::Run(std::optional<int64_t> steps, const std::optional<std::string>& out,
+                      bool quiet, bool hash) {
+  NotFromController("run()");
+  GateLock lock(gate_.get());
+  World& world = Live();
+  if (!steps) steps = loaded_.steps;
+  if (!steps)
+    throw py::value_error("run(): " + file() +
+                          " gives no duration (simulation.duration): pass steps=N");
+  if (*steps < 0) throw py::value_error("run(): steps must be >= 0, got " + std::to_string(*steps));
+  RunOptions options;
+  options.steps = *steps;
+  options.print_hash = hash;
+  options.state_hash = hash || out.has_value();
+  options.quiet = quiet;
+  options.world_file = file();
+  options.command_line = CommandLine();
+  options.overrides = loaded_overrides_;
+  options.load_seconds = load_seconds_;
+  options.on_metrics = [this](const std::vector<MetricSample>& samples) { KeepMetrics(samples); };
+  if (out) {
+    const std::filesystem::path dir(*out);
+    std::error_code ec;
+    if (std::filesystem::exists(dir, ec) && !std::filesystem::is_directory(dir, ec))
+      throw py::value_error("run(out=...): '" + dir.string() +
+                            "' is not a folder; pass a folder (it is made if missing)");
+    try {
+      CreateOutputFolder(dir);
+    } catch (const Error& e) {
+      throw py::value_error(std::string("run(out=...): ") + e.what());
+    }
+    if (const std::string note = RemoveEarlierOutputs(dir); !note.empty())
+      std::cerr << "note: " << ValidUtf8(note) << std::endl;
+    options.out_dir = dir;
+  }
+  FlushPythonStreams();  // before the run's own lines
+  RunResult result;
+  gate_->in_run = true;
+  {
+    py::gil_scoped_release release;
+    result = RunWorld(&world, options, std::cout, std::cerr);
+    std::cout.flush();
+  }
+  gate_->in_run = false;
+  ran_ = true;                 // stopped at its end, or failed partway
+  if (gate_->interrupted()) {  // a controller's KeyboardInterrupt or SystemExit, as itself
+    PyErr_Restore(gate_->interrupt_type.release().ptr(), gate_->interrupt_value.release().ptr(),
+                  gate_->interrupt_trace.release().ptr());
+    throw py::error_already_set();
+  }
+  if (!result.ok) {
+    failed_ = result.error;
+    reported_ = true;
+    std::string message = result.error;
+    if (options.out_dir && std::filesystem::exists(*options.out_dir / "summary.json"))
+      message += "\n" + OutputsOfFinishedSteps(result.steps, *options.out_dir);
+    if (result.signal != 0) {  // KeyboardInterrupt, its .signal the number (SIGTERM: 15)
+      py::object error =
+          py::reinterpret_borrow<py::object>(PyExc_KeyboardInterrupt)(py::str(ValidUtf8(message)));
+      error.attr("signal") = result.signal;
+      PyErr_SetObject(PyExc_KeyboardInterrupt, error.ptr());
+      throw py::error_already_set();
+    }
+    throw std::runtime_error(message);
+  }
+  py::dict figures;
+  figures["steps"] = result.steps;
+  figures["wall_seconds"] = result.wall_seconds;
+  figures["start_seconds"] = result.start_seconds;
+  figures["peak_rss_mb"] = result.peak_rss_mb;
+  figures["state_hash"] = options.state_hash
+                              ? py::object(py::str(StateHasher::ToHex(result.state_hash)))
+                              : py::object(py::none());
+  return figures;
+}
+
+}  // namespace swarmsim::python
