@@ -214,6 +214,17 @@ MemoryRoom ReadMemoryRoom(uint64_t cap) {
   return room;
 }
 
+std::string NoRoomLeft(int64_t robots, const std::string& after, uint64_t cap) {
+  if (robots < kMinItems || IsOffValue(std::getenv("SWARMSIM_MEMORY_CHECK"))) return "";
+  const MemoryRoom room = ReadMemoryRoom(cap);
+  if (room.available != 0) return "";
+  return "not enough memory for " + GroupThousands(robots) + " robots: after " + after +
+         " the process holds " + FormatSize(static_cast<double>(room.resident)) +
+         ", with no room left (" + room.bound +
+         "). Run fewer robots or give the run more memory (README, \"A world that does not "
+         "fit\"); SWARMSIM_MEMORY_CHECK=0 skips this check";
+}
+
 MemoryForecast::MemoryForecast(std::string items, int64_t total, uint64_t cap)
     : items_(std::move(items)), total_(total), cap_(cap) {
   if (total_ < kMinItems || IsOffValue(std::getenv("SWARMSIM_MEMORY_CHECK"))) return;

@@ -48,6 +48,13 @@ bool IsOffValue(const char* value);
 // Whether it turns a feature on: 1, on, true or yes, any case.
 bool IsOnValue(const char* value);
 
+// After a stage that takes memory in proportion to a world's robots (its
+// start: physics, each module, ...): the error text when the process has no
+// room left (it holds its cap or its cgroup's limit already), naming the
+// stage (`after`: "starting module proximity"), else "". Nothing for fewer
+// than 2,000 robots or with the check off, as MemoryForecast.
+std::string NoRoomLeft(int64_t robots, const std::string& after, uint64_t cap);
+
 class MemoryForecast {
  public:
   // `items`: what is built, plural ("robot copies", "robots' Lua states");

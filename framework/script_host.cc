@@ -613,7 +613,19 @@ void LuaScriptHost::StartRobots(int first) {
   std::vector<std::string> errors(robot_count);
   // A world whose states will not fit in memory stops with a message (not
   // the kernel's out-of-memory kill); the robots not yet started are skipped.
-  MemoryForecast forecast("robots' Lua states", robot_count - first, world.settings().max_memory);
+  // It counts the robots that get a state: those with scripts (a world of
+  // native controllers has none, and nothing to forecast).
+  std::atomic<int64_t> scripted{0};
+  constexpr int64_t kCountGrain = 4096;  // robots a task: a few objects' flags each
+  world.scheduler().ParallelFor(first, robot_count, kCountGrain, [&](int64_t begin, int64_t end) {
+    int64_t n = 0;
+    for (int64_t r = begin; r < end; ++r) {
+      const ModelInstance& instance = scene.instance(static_cast<int>(r));
+      n += instance.alive && HasScripts(scene, instance.objects) ? 1 : 0;
+    }
+    scripted.fetch_add(n);
+  });
+  MemoryForecast forecast("robots' Lua states", scripted.load(), world.settings().max_memory);
   std::atomic<int64_t> started{0};
   std::string refusal;
   std::atomic<bool> refused{false};
@@ -632,6 +644,7 @@ void LuaScriptHost::StartRobots(int first) {
     } catch (const std::exception& e) {
       errors[r] = e.what();
     }
+    if (!robots_[r]) return;  // no scripts, no state: not what the forecast counts
     if (std::string why = forecast.Built(started.fetch_add(1) + 1); !why.empty()) {
       refusal = std::move(why);  // one thread only: the forecast says it once
       refused.store(true);

@@ -14,6 +14,7 @@
 #include "framework/dynamics_backend.h"
 #include "framework/error.h"
 #include "framework/line_of_sight.h"
+#include "framework/memory_forecast.h"
 #include "framework/object_type.h"
 #include "framework/plugin_controllers.h"
 #include "framework/prefault.h"
@@ -78,6 +79,11 @@ const char* ToString(Phase phase) {
 std::string ShowParamValue(const ParamValue& value) {
   if (const double* d = std::get_if<double>(&value)) {
     char buf[32];
+    // Whole numbers as written (100000, not the shortest form 1e+05).
+    if (*d == std::floor(*d) && std::abs(*d) < 1e15) {
+      const auto whole = std::to_chars(buf, buf + sizeof buf, static_cast<int64_t>(*d));
+      return std::string(buf, whole.ptr);
+    }
     const auto result = std::to_chars(buf, buf + sizeof buf, *d);
     return std::string(buf, result.ptr);
   }
@@ -293,10 +299,21 @@ void World::SetInstanceParameters(int instance, SharedParameters parameters) {
 
 void World::Start() {
   if (started_) return;
-  StartStage("world poses");
+  // Each stage below takes memory in proportion to the robots; the loader's
+  // and the Lua states' forecasts see only their own items. A stage that
+  // took the process past what it may hold (--max-memory, a cgroup's limit)
+  // stops the start there, with a message, before the next takes more.
+  std::string last_stage = "loading the world";
+  const auto stage = [&](const std::string& next) {
+    if (std::string why = NoRoomLeft(robot_count(), last_stage, settings_.max_memory); !why.empty())
+      throw Error(why);
+    last_stage = "starting " + next;
+    StartStage(next);
+  };
+  stage("world poses");
   EnsureRuntimes();
   UpdateWorldPoses(&scene_, *scheduler_);
-  StartStage("physics (" + settings_.physics + ")");
+  stage("physics (" + settings_.physics + ")");
   dynamics_ = registry_.MakeDynamics(settings_.physics);
   DynamicsSettings dynamics_settings;
   dynamics_settings.gravity = settings_.gravity;
@@ -314,7 +331,7 @@ void World::Start() {
       InstallModule(descriptor->info.name, descriptor->order, descriptor->phases,
                     descriptor->make(this, nullptr));
   for (const ModuleEntry& e : modules_) {
-    StartStage("module " + e.name);
+    stage("module " + e.name);
     e.instance->Start(this);
   }
   device_services_ = {dynamic_cast<const SensorValueAccess*>(find_module("light")),
@@ -325,19 +342,19 @@ void World::Start() {
     run_script_memory_.set_limit(
         static_cast<uint64_t>(std::max(WorldSettings::kDefaultRunScriptMemory,
                                        WorldSettings::kRunScriptMemoryPerRobot * robot_count())));
-  StartStage("scripts (Lua states, sysCall_init)");
+  stage("scripts (Lua states, sysCall_init)");
   scripts_ = MakeScriptHost(this);
   started_ = true;
   try {
     scripts_->Start();
     // Native controllers' init, after the scripts' sysCall_init.
     if (controllers_) {
-      StartStage("native controllers' init");
+      stage("native controllers' init");
       controllers_->Init(0);
     }
     MarkAllPending();  // sysCall_init may have left anything anywhere
     FlushRobotBuffers();
-    StartStage("");
+    stage("");
   } catch (...) {
     failed_ = true;
     FlushBuffersAfterError();  // the other robots' sysCall_init prints

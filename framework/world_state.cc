@@ -97,7 +97,13 @@ std::string World::SnapshotRefusal() const {
                                        : "object '" + scene_.PathOf(scene_.IdAt(s)) + "'";
     return who + " runs Lua script '" + script->source->path + "'" + why;
   }
-  if (controllers_) return "robots run native (plugin) controllers, whose memory cannot be saved";
+  if (controllers_)
+    for (int r = 0; r < robot_count(); ++r)
+      if (const PluginControllerType* type = controllers_->type_of(r); type != nullptr)
+        return "robot '" + scene_.instance(r).name + "' runs the native controller '" + type->name +
+               "' (" + type->plugin +
+               "), whose memory cannot be saved; drive the robots from Python "
+               "(python_controller or World(controllers=...)) to snapshot the world";
   for (const auto& callbacks : phase_callbacks_)
     if (!callbacks.empty())
       return "a plugin hooks the step's phases (its own memory cannot be saved)";

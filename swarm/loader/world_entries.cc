@@ -533,7 +533,13 @@ void WorldLoader::ReadDistribution(const Fields& f, const ValueReader& world_val
                       "'distribute' (use distribute.heading_deg for a fixed heading)");
   entry->distribute = true;
   entry->count_field = f.Require("count");
-  entry->count = world_values.Integer(entry->count_field, 0, kMaxCount);
+  entry->count = world_values.Integer(entry->count_field, 0, INT64_MAX / 2);
+  if (entry->count > kMaxCount)
+    file_->Fail(entry->count_field.mark,
+                "'count' is at most 1,000,000 copies a models entry (got " +
+                    std::to_string(entry->count) +
+                    "): give a larger swarm as several entries of the model, each with its own "
+                    "count and region");
   Fields d(*file_, f.Get("distribute"), "'distribute'");
   d.Expect({"region", "clearance", "heading_deg", "order", "lattice"});
   const Field region = d.Get("region");

@@ -4,6 +4,7 @@
 #include <array>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -12,6 +13,7 @@
 
 #include "framework/error.h"
 #include "framework/floor_layer.h"
+#include "framework/memory_forecast.h"
 #include "framework/object_type.h"
 #include "framework/scheduler.h"
 #include "framework/visual.h"
@@ -160,6 +162,11 @@ struct RunRecorder::Impl {
   void BuildScene();
   void Capture();
   void WriteStep(const World& world);
+  // Every keyframe holds each recorded object's id and pose, and each
+  // colour's and ray length's: a world whose keyframes would not fit in a
+  // chunk (FORMAT.md, "Limits") is refused as its scene is listed, not a
+  // step into the run. Throws swarmsim::Error.
+  void CheckKeyframeFits(size_t objects, const SceneLists& lists) const;
   uint32_t MetricId(std::string_view name) {
     if (const auto it = metric_ids.find(name); it != metric_ids.end()) return it->second;
     const uint32_t id = static_cast<uint32_t>(metric_names.size());
@@ -377,6 +384,7 @@ void RunRecorder::Impl::BuildScene() {
     if (tracked[id].kind == VisualKind::kRay) lists.proximity_ids.push_back(id);
   }
   const size_t n = tracked.size();
+  CheckKeyframeFits(n, lists);
   lists.object_count = n;
   pose.assign(n, {});
   color.assign(n, 0);
@@ -452,6 +460,23 @@ void RunRecorder::Impl::Capture() {
       robot_ids.empty() ? 0 : robot_ids.back().first + robot_ids.back().second;
   for (uint32_t id = scene_first; id < tracked.size(); ++id) capture(id, -1);
   capture_all = false;
+}
+
+void RunRecorder::Impl::CheckKeyframeFits(size_t objects, const SceneLists& lists) const {
+  const double bytes = (4.0 + kPoseBytes) * static_cast<double>(objects) +
+                       8.0 * static_cast<double>(lists.color_ids.size()) +
+                       6.0 * static_cast<double>(lists.proximity_ids.size());
+  const double limit = settings.max_chunk_raw_bytes;
+  if (bytes <= limit) return;
+  const int robots = world->robot_count();
+  throw Error("the recording: every keyframe of this world would hold at least " +
+              FormatSize(bytes) + " (" + GroupThousands(static_cast<int64_t>(objects)) +
+              " recorded objects), past the " + FormatSize(limit) +
+              " a recording chunk may hold (what readers accept: FORMAT.md, \"Limits\"); "
+              "record fewer robots (about " +
+              GroupThousands(static_cast<int64_t>(std::floor(robots * limit / bytes))) +
+              " of these " + GroupThousands(robots) +
+              " would fit) or run this one without recording");
 }
 
 void RunRecorder::Impl::WriteStep(const World& w) {

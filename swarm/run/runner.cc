@@ -138,6 +138,7 @@ class Watchdog {
 
   // `instruction_budget`: the world's (simulation.instruction_budget), for
   // the message: with none, an endless Lua loop is also stopped only here.
+  // `timeout`: for the first unit, the start of the world.
   Watchdog(double timeout, int64_t instruction_budget, EndRun end_run)
       : timeout_(timeout),
         instruction_budget_(instruction_budget),
@@ -156,11 +157,12 @@ class Watchdog {
 
   std::mutex& io_mutex() { return io_mutex_; }
   // One more unit of progress (the start, a step, the stop); `what` names
-  // the next one for the message ("step 12").
-  void Progress(std::string what) {
+  // the next one for the message ("step 12"), `timeout` what it may take.
+  void Progress(std::string what, double timeout) {
     const std::lock_guard lock(wake_mutex_);
     ++progress_;
     next_ = std::move(what);
+    timeout_ = timeout;
   }
 
  private:
@@ -185,7 +187,8 @@ class Watchdog {
       } else if (timeout_ > 0 && stalled >= timeout_) {
         std::ostringstream limit;
         limit << timeout_;
-        error = next_ + " did not finish within " + limit.str() + " s (simulation.step_timeout)";
+        error = next_ + " did not finish within " + limit.str() + " s (simulation.step_timeout" +
+                (next_.starts_with("step ") ? "" : ", for each 10,000 robots") + ")";
       } else {
         continue;
       }
@@ -213,7 +216,7 @@ class Watchdog {
     }
   }
 
-  const double timeout_;
+  double timeout_;  // of the unit under way (wake_mutex_)
   const int64_t instruction_budget_;
   const EndRun end_run_;
   std::mutex io_mutex_;
@@ -443,8 +446,13 @@ void StepWatched(World* world, const RunOptions& options, Clock::time_point star
     std::cerr.flush();
     std::_Exit(signal != 0 ? 128 + signal : 1);  // 1: the run failed, as main's
   };
-  Watchdog watchdog(world->settings().step_timeout, world->settings().instruction_budget,
-                    end_stuck_run);
+  // A step may take simulation.step_timeout; the start and the stop of the
+  // world, whose work grows with the robots (a million Lua robots start in
+  // about 45 s on a 2-core VM), that much for each 10,000 robots.
+  const double step_timeout = world->settings().step_timeout;
+  const double whole_world_timeout =
+      step_timeout * std::max(1.0, static_cast<double>(world->robot_count()) / 10000.0);
+  Watchdog watchdog(whole_world_timeout, world->settings().instruction_budget, end_stuck_run);
   // Outputs of the step just done, then the next unit of work for the
   // watchdog's message; under its lock, so it never writes at the same time.
   const auto take_metrics = [&] {
@@ -456,7 +464,8 @@ void StepWatched(World* world, const RunOptions& options, Clock::time_point star
   const auto done = [&](std::string next) {
     const std::lock_guard lock(watchdog.io_mutex());
     take_metrics();
-    watchdog.Progress(std::move(next));
+    const bool step = next.starts_with("step ");
+    watchdog.Progress(std::move(next), step ? step_timeout : whole_world_timeout);
   };
   const auto step_name = [&] {
     return "step " + std::to_string(result.steps + 1) + " of " + std::to_string(options.steps);

@@ -169,5 +169,23 @@ TEST(MemoryForecastTest, ItemsThatWillNotFitAreRefusedEarlyAndOnce) {
   EXPECT_EQ(refusals, 0);
 }
 
+// A world's start (physics, each module, the scripts) is checked after each
+// stage: one that took the process past its cap stops it, naming the stage.
+TEST(MemoryForecastTest, AStartStagePastTheCapIsNamed) {
+  const uint64_t tiny = 1;  // below what the program holds: no room left
+  const std::string why = NoRoomLeft(100000, "starting module proximity", tiny);
+  EXPECT_NE(why.find("not enough memory for 100,000 robots: after starting module proximity the "
+                     "process holds "),
+            std::string::npos)
+      << why;
+  EXPECT_NE(why.find(", with no room left (--max-memory 1 bytes)"), std::string::npos) << why;
+  EXPECT_NE(why.find("SWARMSIM_MEMORY_CHECK=0"), std::string::npos) << why;
+  EXPECT_EQ(NoRoomLeft(100000, "starting module proximity", 0), "") << "no cap: the machine's room";
+  EXPECT_EQ(NoRoomLeft(1999, "starting physics", tiny), "") << "small worlds pass";
+  setenv("SWARMSIM_MEMORY_CHECK", "no", 1);
+  EXPECT_EQ(NoRoomLeft(100000, "starting physics", tiny), "");
+  unsetenv("SWARMSIM_MEMORY_CHECK");
+}
+
 }  // namespace
 }  // namespace swarmsim

@@ -69,6 +69,17 @@ TEST(SaveStateTest, WhatCannotBeSavedOrLoadedIsAnErrorBeforeTheRun) {
   EXPECT_EQ(lua.exit_code, 2) << lua.output;
   EXPECT_NE(lua.output.find("robot 'footbot#0' runs Lua script"), std::string::npos) << lua.output;
   EXPECT_FALSE(fs::exists(dir / "x.bin"));
+  // Native controllers: the robot, the controller and its plugin named, and what to do.
+  const auto native = RunProgram("run " + std::string(SWARMSIM_SOURCE_DIR) +
+                                 "/worlds/diffusion_native.yaml --set robots=3 --steps 2 "
+                                 "--save-state " +
+                                 (dir / "x.bin").string());
+  EXPECT_EQ(native.exit_code, 2) << native.output;
+  EXPECT_NE(native.output.find("robot 'footbot#0' runs the native controller 'diffusion' ("),
+            std::string::npos)
+      << native.output;
+  EXPECT_NE(native.output.find("drive the robots from Python"), std::string::npos) << native.output;
+  EXPECT_FALSE(fs::exists(dir / "x.bin"));
   // A missing file, another world's state, a corrupt one.
   const auto missing = RunProgram("run " + kWorld + " --load-state " + (dir / "none.bin").string());
   EXPECT_EQ(missing.exit_code, 2) << missing.output;

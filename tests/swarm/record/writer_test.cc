@@ -500,5 +500,42 @@ TEST(RecordingTest, AChunkPastTheReadersLimitEndsTheRecordingWhole) {
   fs::remove_all(out);
 }
 
+// A world whose every keyframe would be past what a chunk may hold is
+// refused as the recorder starts, saying how many robots would fit, not a
+// step into the run by the recorder's thread.
+TEST(RecordingTest, AWorldWhoseKeyframesCannotFitIsRefusedAtTheStart) {
+  const fs::path out = TempDir("keyframe_too_large");
+  ModuleRegistry registry;
+  RegisterBuiltinModules(&registry);
+  WorldSettings ws;
+  ws.physics = "kinematic";
+  World world(ws, registry);
+  world.set_log_sink([](std::string_view) {});
+  Scene& scene = world.scene();
+  ShapeData box;
+  box.kind = ShapeKind::kBox;
+  box.size = {0.1, 0.1, 0.1};
+  for (int i = 0; i < 100; ++i) {  // a dummy and a box each: 2 objects, 1 colour
+    const ObjectId root = scene.AddDummy("bot", {}, Pose{{i * 1.0, 0, 0}, {}});
+    scene.MakeModelInstance(root, "bot", "bot#" + std::to_string(i));
+    scene.AddShape("body", root, {}, box);
+  }
+  RecordSettings settings;
+  settings.out_dir = out;
+  settings.max_chunk_raw_bytes = 4 << 10;  // 100 robots' keyframe: 200 x 28 + 100 x 8 bytes
+  AddRecorder(&world, settings);
+  std::string error;
+  try {
+    world.Start();
+  } catch (const Error& e) {
+    error = e.what();
+  }
+  EXPECT_CONTAINS(error,
+                  "the recording: every keyframe of this world would hold at least 6.2 KiB "
+                  "(200 recorded objects), past the 4.0 KiB a recording chunk may hold");
+  EXPECT_CONTAINS(error, "record fewer robots (about 64 of these 100 would fit)");
+  fs::remove_all(out);
+}
+
 }  // namespace
 }  // namespace swarmsim::record

@@ -198,6 +198,40 @@ TEST(RunOutputsTest, StuckStepEndsTheRunNamingTheScriptAndKeepsTheOutputs) {
   fs::remove_all(dir);
 }
 
+// The start of the world (every robot's sysCall_init) is watched too, and
+// may take simulation.step_timeout for each 10,000 robots: a million Lua
+// robots take about 45 s to start on a 2-core VM, and must not be ended as
+// stuck for being many.
+TEST(RunOutputsTest, AStuckStartEndsTheRunWithALimitThatGrowsWithTheRobots) {
+  const fs::path dir = swarmsim::testing::FreshTempDir("swarmsim_outputs", "stuck_start");
+  fs::create_directories(dir);
+  std::ofstream(dir / "probe.yaml") << "model: probe\n"
+                                       "objects: {name: body, type: dummy, script: probe.lua}\n";
+  std::ofstream(dir / "probe.lua") << "function sysCall_init()\n"
+                                      "  return string.rep('a', 300000):find('.-.-b')\n"
+                                      "end\n";
+  for (const auto& [robots, limit] : {std::pair{1, "1"}, std::pair{20000, "2"}}) {
+    std::ofstream(dir / "world.yaml") << "simulation: {physics: kinematic, time_step: 0.1, "
+                                         "step_timeout: 1}\n"
+                                         "arena: {size: 300}\n"
+                                         "models:\n  - {model: probe.yaml, count: "
+                                      << robots << ", distribute: {region: arena}}\n";
+    const auto r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 5 --quiet --out " +
+                              (dir / "out").string());
+    EXPECT_EQ(r.exit_code, 1) << r.output;
+    EXPECT_NE(
+        r.output.find(std::string("error: the start of the world did not finish within ") + limit +
+                      " s (simulation.step_timeout, for each 10,000 robots); "
+                      "running: probe#"),
+        std::string::npos)
+        << robots << " robots: " << r.output;
+    const auto summary = nlohmann::json::parse(ReadFile(dir / "out" / "summary.json"));
+    EXPECT_EQ(summary["status"], "error");
+    EXPECT_EQ(summary["steps"], 0);
+  }
+  fs::remove_all(dir);
+}
+
 // A run the watchdog ends still closes its recording with the end chunk
 // (record-info says how it ended, not "no end yet").
 TEST(RunOutputsTest, StuckStepClosesTheRecording) {
