@@ -57,6 +57,22 @@ class ErrorTest(unittest.TestCase):
             w.poses()
 
 
+def write_python_world(folder, controller_code, count, extra=""):
+    """A world in `folder` of `count` foot-bots driven by `controller_code`'s control()."""
+    with open(os.path.join(folder, "ctl.py"), "w") as f:
+        f.write(controller_code)
+    path = os.path.join(folder, "w.yaml")
+    with open(path, "w") as f:
+        f.write("simulation: {physics: box2d, time_step: 0.1, seed: 1}\n"
+                "arena: {size: 4, wall_thickness: 0.1, wall_height: 0.2}\n"
+                "models:\n"
+                f"  - model: {world('models', 'footbot.yaml')}\n"
+                f"    count: {count}\n"
+                "    distribute: {region: arena}\n"
+                "    python_controller: ctl.py:control\n" + extra)
+    return path
+
+
 class RunTest(unittest.TestCase):
     def test_run_is_the_programs_run_and_ends_the_world(self):
         w = swarmsim.World(world("diffusion.yaml"), set={"robots": 10})
@@ -156,21 +172,12 @@ class ProgramTest(unittest.TestCase):
 
     def test_a_failing_controller_keeps_the_outputs_of_the_steps_that_finished(self):
         with tempfile.TemporaryDirectory() as d:
-            with open(os.path.join(d, "ctl.py"), "w") as f:
-                f.write("def control(robots):\n"
-                        "    if robots.step == 12:\n"
-                        "        raise ValueError('bad reading')\n"
-                        "    return {'leftMotor': 0.05, 'rightMotor': 0.05}\n")
-            path = os.path.join(d, "w.yaml")
-            with open(path, "w") as f:
-                f.write("simulation: {physics: box2d, time_step: 0.1, seed: 1}\n"
-                        "arena: {size: 4, wall_thickness: 0.1, wall_height: 0.2}\n"
-                        "models:\n"
-                        f"  - model: {world('models', 'footbot.yaml')}\n"
-                        "    count: 4\n"
-                        "    distribute: {region: arena}\n"
-                        "    python_controller: ctl.py:control\n"
-                        "metrics:\n  - {name: mean_nearest_neighbor_distance, every: 5}\n")
+            path = write_python_world(
+                d, "def control(robots):\n"
+                   "    if robots.step == 12:\n"
+                   "        raise ValueError('bad reading')\n"
+                   "    return {'leftMotor': 0.05, 'rightMotor': 0.05}\n", 4,
+                "metrics:\n  - {name: mean_nearest_neighbor_distance, every: 5}\n")
             out_dir = os.path.join(d, "out")
             code, out = run([PYTHON, "-m", "swarmsim", "run", path, "--steps", "40",
                              "--out", out_dir, "--quiet"])
@@ -186,22 +193,13 @@ class ProgramTest(unittest.TestCase):
 
     def test_ctrl_c_ends_the_run_as_interrupted_with_its_outputs(self):
         with tempfile.TemporaryDirectory() as d:
-            with open(os.path.join(d, "ctl.py"), "w") as f:
-                f.write("import pathlib, time\n"
-                        "def control(robots):\n"
-                        "    if robots.step == 5:\n"
-                        f"        pathlib.Path({d!r}, 'started').touch()\n"
-                        "    time.sleep(0.02)\n"  # a slow controller: the run is long enough
-                        "    return {}\n")
-            path = os.path.join(d, "w.yaml")
-            with open(path, "w") as f:
-                f.write("simulation: {physics: box2d, time_step: 0.1, seed: 1}\n"
-                        "arena: {size: 4, wall_thickness: 0.1, wall_height: 0.2}\n"
-                        "models:\n"
-                        f"  - model: {world('models', 'footbot.yaml')}\n"
-                        "    count: 2\n"
-                        "    distribute: {region: arena}\n"
-                        "    python_controller: ctl.py:control\n")
+            path = write_python_world(
+                d, "import pathlib, time\n"
+                   "def control(robots):\n"
+                   "    if robots.step == 5:\n"
+                   f"        pathlib.Path({d!r}, 'started').touch()\n"
+                   "    time.sleep(0.02)\n"  # a slow controller: the run is long enough
+                   "    return {}\n", 2)
             out_dir = os.path.join(d, "out")
             p = subprocess.Popen([PYTHON, "-m", "swarmsim", "run", path, "--steps", "100000",
                                   "--out", out_dir, "--quiet"], stdout=subprocess.PIPE,
