@@ -48,6 +48,7 @@ double Read(const Scene& scene, const StreamSpec& s, uint32_t slot) {
     case StreamKind::kTorque: {
       const ForceSensorData& f = force_sensor::RowsOf(scene)->rows[scene.row_at(slot)];
       if (!f.has_reading) return NAN;
+      if (f.broken) return 0.0;  // as sim.readForceSensor reads a broken link
       return ComponentOf(s.kind == StreamKind::kForce ? f.force : f.torque, s.component);
     }
     case StreamKind::kDistance: {

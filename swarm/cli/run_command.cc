@@ -15,6 +15,7 @@
 #include <memory>
 #include <optional>
 #include <sstream>
+#include <thread>
 
 #include "framework/error.h"
 #include "framework/memory_forecast.h"
@@ -541,11 +542,16 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
                          result.ok ? "ok" : (result.signal != 0 ? "interrupted" : "error"),
                          result.ok ? "" : result.error);
   if (view_server && result.signal == 0) {
-    // The run is over, the page stays: serve until Ctrl-C (its default action).
-    stop_signals.reset();
+    // The run is over, the page stays: serve until Ctrl-C, SIGTERM or SIGHUP,
+    // which end the serving and leave the run's exit status as its summary
+    // says (the signals stay caught: StopSignals notes them).
     std::cout << "swarmsim run: the run ended; still serving " << view_server->Address()
               << " (Ctrl-C to stop)" << std::endl;
-    for (;;) ::pause();
+    // (Polled: the signal may be delivered to a server thread, not this one.)
+    while (StopSignals::Received() == 0)
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    view_server.reset();
+    return result.ok ? 0 : kExitRunError;
   }
   if (recorder != nullptr) {
     // The video's end, also without --out (with it, the run's outputs did it).

@@ -87,13 +87,16 @@ py::dict PyWorld::Run(std::optional<int64_t> steps, const std::optional<std::str
   }
   FlushPythonStreams();  // before the run's own lines
   RunResult result;
-  gate_->in_run = true;
   {
+    struct InRun {  // however RunWorld returns
+      WorldGate* gate;
+      explicit InRun(WorldGate* g) : gate(g) { gate->in_run = true; }
+      ~InRun() { gate->in_run = false; }
+    } in_run(gate_.get());
     py::gil_scoped_release release;
     result = RunWorld(&world, options, std::cout, std::cerr);
     std::cout.flush();
   }
-  gate_->in_run = false;
   ran_ = true;                 // stopped at its end, or failed partway
   if (gate_->interrupted()) {  // a controller's KeyboardInterrupt or SystemExit, as itself
     PyErr_Restore(gate_->interrupt_type.release().ptr(), gate_->interrupt_value.release().ptr(),

@@ -138,9 +138,11 @@ class Watchdog {
 
   // `instruction_budget`: the world's (simulation.instruction_budget), for
   // the message: with none, an endless Lua loop is also stopped only here.
-  // `timeout`: for the first unit, the start of the world.
-  Watchdog(double timeout, int64_t instruction_budget, EndRun end_run)
-      : timeout_(timeout),
+  // A step may take `step_timeout`; the start and the stop of the world
+  // (the first unit is the start) `world_timeout`.
+  Watchdog(double step_timeout, double world_timeout, int64_t instruction_budget, EndRun end_run)
+      : step_timeout_(step_timeout),
+        world_timeout_(world_timeout),
         instruction_budget_(instruction_budget),
         end_run_(std::move(end_run)),
         thread_([this] { Watch(); }) {}
@@ -157,12 +159,12 @@ class Watchdog {
 
   std::mutex& io_mutex() { return io_mutex_; }
   // One more unit of progress (the start, a step, the stop); `what` names
-  // the next one for the message ("step 12"), `timeout` what it may take.
-  void Progress(std::string what, double timeout) {
+  // the next one for the message ("step 12"), `step` whether it is a step.
+  void Progress(std::string what, bool step) {
     const std::lock_guard lock(wake_mutex_);
     ++progress_;
     next_ = std::move(what);
-    timeout_ = timeout;
+    step_ = step;
   }
 
  private:
@@ -184,11 +186,12 @@ class Watchdog {
         error = std::string("interrupted by SIG") + sigabbrev_np(sig) + " during " + next_ +
                 ", which did not finish within " + Fixed(kSignalGrace, 0) + " s of the signal";
         end_signal = sig;
-      } else if (timeout_ > 0 && stalled >= timeout_) {
+      } else if (const double timeout = step_ ? step_timeout_ : world_timeout_;
+                 timeout > 0 && stalled >= timeout) {
         std::ostringstream limit;
-        limit << timeout_;
+        limit << timeout;
         error = next_ + " did not finish within " + limit.str() + " s (simulation.step_timeout" +
-                (next_.starts_with("step ") ? "" : ", for each 10,000 robots") + ")";
+                (step_ ? "" : ", for each 10,000 robots") + ")";
       } else {
         continue;
       }
@@ -216,7 +219,8 @@ class Watchdog {
     }
   }
 
-  double timeout_;  // of the unit under way (wake_mutex_)
+  const double step_timeout_, world_timeout_;
+  bool step_ = false;  // the unit under way is a step, not the start or stop (wake_mutex_)
   const int64_t instruction_budget_;
   const EndRun end_run_;
   std::mutex io_mutex_;
@@ -450,9 +454,10 @@ void StepWatched(World* world, const RunOptions& options, Clock::time_point star
   // world, whose work grows with the robots (a million Lua robots start in
   // about 45 s on a 2-core VM), that much for each 10,000 robots.
   const double step_timeout = world->settings().step_timeout;
-  const double whole_world_timeout =
-      step_timeout * std::max(1.0, static_cast<double>(world->robot_count()) / 10000.0);
-  Watchdog watchdog(whole_world_timeout, world->settings().instruction_budget, end_stuck_run);
+  Watchdog watchdog(
+      step_timeout,
+      step_timeout * std::max(1.0, static_cast<double>(world->robot_count()) / 10000.0),
+      world->settings().instruction_budget, end_stuck_run);
   // Outputs of the step just done, then the next unit of work for the
   // watchdog's message; under its lock, so it never writes at the same time.
   const auto take_metrics = [&] {
@@ -461,11 +466,10 @@ void StepWatched(World* world, const RunOptions& options, Clock::time_point star
     if (metrics) metrics->Write(samples);
     if (options.on_metrics) options.on_metrics(samples);
   };
-  const auto done = [&](std::string next) {
+  const auto done = [&](std::string next, bool step) {
     const std::lock_guard lock(watchdog.io_mutex());
     take_metrics();
-    const bool step = next.starts_with("step ");
-    watchdog.Progress(std::move(next), step ? step_timeout : whole_world_timeout);
+    watchdog.Progress(std::move(next), step);
   };
   const auto step_name = [&] {
     return "step " + std::to_string(result.steps + 1) + " of " + std::to_string(options.steps);
@@ -501,7 +505,7 @@ void StepWatched(World* world, const RunOptions& options, Clock::time_point star
       result.saved_step = at;
     };
     save_state();
-    done(options.steps > 0 ? step_name() : "the stop of the world");
+    done(options.steps > 0 ? step_name() : "the stop of the world", options.steps > 0);
     for (int64_t i = 0; i < options.steps; ++i) {
       if (const int sig = StopSignals::Received(); sig != 0) {
         result.signal = sig;
@@ -515,13 +519,14 @@ void StepWatched(World* world, const RunOptions& options, Clock::time_point star
         ++result.steps;
       }
       save_state();
-      done(result.steps < options.steps ? step_name() : "the stop of the world");
+      done(result.steps < options.steps ? step_name() : "the stop of the world",
+           result.steps < options.steps);
       progress.Update(result.steps, world->time());
     }
     lua_kib =
         static_cast<double>(world->script_memory_bytes()) / 1024.0;  // before the states close
     world->Stop();
-    done("writing the outputs");
+    done("writing the outputs", false);
     result.ok = true;
   } catch (const std::exception& e) {
     const std::lock_guard lock(watchdog.io_mutex());

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "modules/force_sensor/force_sensor.h"
 #include "modules/graphs/module.h"
 #include "modules/graphs/rows.h"
 #include "tests/modules/module_world.h"
@@ -55,6 +56,32 @@ TEST(GraphOutputsTest, TheCsvHoldsEverySampleExactly) {
   EXPECT_EQ(outputs[0].kind, "graph");
   EXPECT_EQ(outputs[0].path, "graphs/trace.csv");
   EXPECT_EQ(outputs[0].description, "graph /trace: time graph, 2 streams, 3 samples");
+}
+
+// A force stream reads what sim.readForceSensor reads: nan without a
+// reading, the force while the link holds, 0 once it broke (it had gone on
+// with the last force before the break).
+TEST(GraphOutputsTest, AForceStreamReadsZeroOnceTheLinkBroke) {
+  ModuleWorld w("kinematic", 1, kStep);
+  const ObjectId beam = w.Box("beam", {}, {}, {0.1, 0.1, 0.1});
+  const ForceSensorData settings;
+  const ObjectId hook = w.Add("force_sensor", "hook", beam, {}, &settings);
+  GraphRow row = Graph({"force /beam/hook z"});
+  w.Add("graph", "load", {}, {}, &row);
+  ForceSensorData& sensor = w.RowOf<ForceSensorData>("force_sensor", hook);
+  ASSERT_EQ(w.Run(0), "");  // no reading: nothing simulates the link
+  sensor.has_reading = true;
+  sensor.force = {0, 0, 19.62};
+  ASSERT_EQ(w.Run(1), "");
+  sensor.broken = true;
+  ASSERT_EQ(w.Run(1), "");
+  TempDir dir;
+  w.world().WriteOutputs(dir.path());
+  EXPECT_EQ(ReadFile(dir.path() / "graphs" / "load.csv"),
+            "time,force /beam/hook z\n"
+            "0,nan\n"
+            "0.125,19.62\n"
+            "0.25,0\n");
 }
 
 TEST(GraphOutputsTest, ARobotsGraphIsInItsRobotsFolderAndAFullBufferIsSaid) {

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <vector>
@@ -62,6 +63,28 @@ TEST(PathsModuleTest, StartPlacesTheFollowersAtTheStartKeepingTheirOffsets) {
   // In the world, once a step has run: the path's own pose composed.
   ASSERT_EQ(s.w.Run(1), "");
   ExpectNear(s.w.scene().world_pose(s.rider).p, {3, 3, 0.2}, 1e-12);
+}
+
+// A follower outside any robot carrying a static shape is moved, but the
+// modules that index static shapes once (proximity, distance, collision,
+// physics) keep it where it was: the start says so, once. A dynamic rider,
+// or one inside a robot, is not named.
+TEST(PathsModuleTest, AStaticShapeRidingAPathOutsideARobotIsWarnedOf) {
+  const auto warnings = [](const std::vector<std::string>& log) {
+    return std::count_if(log.begin(), log.end(), [](const std::string& line) {
+      return line.find(
+                 "warning: path follower /path/rider carries static shapes outside any "
+                 "robot: proximity sensors, distance and collision objects and the physics "
+                 "keep them where the world file put them") != std::string::npos;
+    });
+  };
+  PathScene s({{0, 0, 0}, {2, 0, 0}}, false, 0.5);
+  ASSERT_EQ(s.w.Run(3), "");
+  EXPECT_EQ(warnings(s.w.log()), 1) << "once, at the start";
+  PathScene robot({{0, 0, 0}, {2, 0, 0}}, false, 0.5);
+  robot.w.scene().MakeModelInstance(robot.path, "conveyor", "conveyor#0");
+  ASSERT_EQ(robot.w.Run(1), "");
+  EXPECT_EQ(warnings(robot.w.log()), 0);
 }
 
 TEST(PathsModuleTest, FollowersMoveAtTheVelocityAndStopAtAnOpenPathsEnd) {
