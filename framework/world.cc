@@ -325,15 +325,21 @@ void World::Start() {
   // Dependent joints start where their masters put them.
   if (dependent_joints_.Apply(&scene_, true)) scene_.UpdateWorldPoses();
   // The modules every world has (proximity), in registration order; then
-  // every module starts, in creation order.
+  // every module starts, in creation order: first those that act on the
+  // world, then those that only observe it (the record phase's: graphs,
+  // metrics, the recording, snapshots and video), so that what they take
+  // at the start is the world as the others left it (a path's followers
+  // placed, a conveyor's belt built), not as the file put it.
   for (const auto& descriptor : registry_.module_descriptors())
     if (descriptor->every_world && find_module(descriptor->info.name) == nullptr)
       InstallModule(descriptor->info.name, descriptor->order, descriptor->phases,
                     descriptor->make(this, nullptr));
-  for (const ModuleEntry& e : modules_) {
-    stage("module " + e.name);
-    e.instance->Start(this);
-  }
+  for (const bool observers : {false, true})
+    for (const ModuleEntry& e : modules_) {
+      if ((e.phases == PhaseBit(Phase::kRecord)) != observers) continue;
+      stage("module " + e.name);
+      e.instance->Start(this);
+    }
   device_services_ = {dynamic_cast<const SensorValueAccess*>(find_module("light")),
                       dynamic_cast<const SensorValueAccess*>(find_module("ground_sensor")),
                       dynamic_cast<const LedAccess*>(find_module("blobs")),

@@ -103,6 +103,10 @@ void PathsModule::Start(World* world) {
   }
   DriveConveyors(scene);
   Move(scene, 0.0);
+  // The followers' world poses where Move put them: what the modules that
+  // observe the start (the first frame, step 0's graph sample) and the
+  // first sense phase see.
+  if (PathRows(scene) != nullptr && PathRows(scene)->size() > 0) scene->UpdateWorldPoses();
 }
 
 void PathsModule::Actuate(World* world) {

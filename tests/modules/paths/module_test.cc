@@ -12,6 +12,7 @@
 #include <memory>
 #include <vector>
 
+#include "modules/graphs/rows.h"
 #include "modules/paths/curve.h"
 #include "modules/paths/rows.h"
 #include "tests/modules/module_world.h"
@@ -85,6 +86,24 @@ TEST(PathsModuleTest, AStaticShapeRidingAPathOutsideARobotIsWarnedOf) {
   robot.w.scene().MakeModelInstance(robot.path, "conveyor", "conveyor#0");
   ASSERT_EQ(robot.w.Run(1), "");
   EXPECT_EQ(warnings(robot.w.log()), 0);
+}
+
+// What observes the start (a graph's step-0 sample here; the recording's
+// and the video's first frame alike) sees the followers where the path put
+// them, not where the file did: modules that only observe start last, and
+// the start places the followers in the world.
+TEST(PathsModuleTest, TheStartsObserversSeeTheFollowersWhereThePathPutThem) {
+  PathScene s({{0, 0, 0}, {2, 0, 0}}, false, 0.5, /*start=*/1);
+  graphs::GraphRow row;
+  graphs::ParseStream("position /path/rider x", &row.streams);
+  row.png = false;
+  s.w.Add("graph", "trace", {}, {}, &row);
+  ASSERT_EQ(s.w.Run(1), "");
+  testing::TempDir dir;
+  s.w.world().WriteOutputs(dir.path());
+  // The path's frame at x = 1, its rider 1 m along: x = 2 at time 0, 2.0625 after a step.
+  EXPECT_EQ(testing::ReadFile(dir.path() / "graphs" / "trace.csv"),
+            "time,position /path/rider x\n0,2\n0.125,2.0625\n");
 }
 
 TEST(PathsModuleTest, FollowersMoveAtTheVelocityAndStopAtAnOpenPathsEnd) {
