@@ -10,6 +10,7 @@
 #include <string>
 #include <utility>
 
+#include "framework/script_calls.h"
 #include "framework/script_state.h"
 #include "framework/small_blocks.h"
 
@@ -204,6 +205,52 @@ void* LimitedAlloc(void* ud, void* ptr, size_t osize, size_t nsize) {
   }
   m.used += grow;
   return p;
+}
+
+void ResumeThread(ScriptState* state, Script& script) {
+  lua_State* co = script.thread;
+  LuaContext& c = state->context;
+  const CallInProgress in_progress(*state, kCallbackNames[kThread]);
+  MakeCurrent(*state);
+  SetCurrent(*state, script);
+  SetContext(co, &c);  // its robot's, whoever resumed it last (CheckedCall)
+  c.thread = co;
+  c.budget_exhausted = false;
+  c.data_collected = false;
+  c.running = nullptr;
+  state->heap->memory.refused_bytes = 0;  // reported with the callback that made it
+  state->heap->memory.refusal_bytes = 0;
+  c.slice_fires = 0;
+  c.slice_yielded = false;
+  // A fresh slice. After a yield from the hook, Lua itself left it so: it
+  // set the count to 1 and marked the interrupted instruction, which is
+  // executed again on resume; that execution resets the count to the slice
+  // and, seeing the mark, skips the hook. Resetting the count here would let
+  // the mark swallow the next firing instead: two slices in that step.
+  if (!script.slice_yielded || lua_gethook(co) != SliceHook ||
+      lua_gethookcount(co) != script.slice_instructions)
+    lua_sethook(co, SliceHook, LUA_MASKCOUNT, script.slice_instructions);
+  int results = 0;
+  script.running = true;
+  const int status = lua_resume(co, state->L, 0, &results);
+  script.running = false;
+  c.thread = nullptr;
+  script.slice_yielded = c.slice_yielded;
+  if (status == LUA_YIELD && !c.budget_exhausted) {
+    lua_pop(co, results);
+    return;
+  }
+  std::string error;
+  if (c.budget_exhausted)
+    error = c.budget_error;
+  else if (status != LUA_OK)
+    error = LocatedErrorText(co, status, script);
+  // Finished or failed: the coroutine is not resumed again.
+  lua_settop(co, 0);
+  luaL_unref(state->L, LUA_REGISTRYINDEX, script.thread_ref);
+  script.thread = nullptr;
+  script.thread_ref = LUA_NOREF;
+  if (!error.empty()) ThrowScriptError(*state, script, std::move(error), "sysCall_thread");
 }
 
 }  // namespace lua_host

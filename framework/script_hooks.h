@@ -1,5 +1,6 @@
 // Internal to the Lua host (script_*.cc, lua_api_control.cc): the count
-// hooks that bound what a script may run and hold.
+// hooks that bound what a script may run and hold, and the resuming of a
+// threaded script under its time slice.
 //
 // Every non-threaded callback runs under an instruction budget (a count
 // hook that raises an error); explicit scripts run on their caller's. Once a
@@ -29,6 +30,13 @@ void SetBudget(lua_State* L, const LuaContext& c);
 // call that cannot yield (a C function calling Lua, e.g. a table.sort
 // comparator), the instruction budget applies instead.
 void SliceHook(lua_State* L, lua_Debug* ar);
+
+struct Script;
+struct ScriptState;
+// Resumes `script`'s thread (sysCall_thread) under a fresh time slice until
+// it yields, returns or fails; a failure or a spent budget ends the thread
+// and throws the script's error (ThrowScriptError).
+void ResumeThread(ScriptState* state, Script& script);
 
 // lua_Alloc of every state (`ud`: its LuaHeap): realloc/free, counting
 // against the state's memory limit.

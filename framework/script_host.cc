@@ -36,7 +36,7 @@
 //
 // The rest of the host, one topic a file: script_state.h (a state, its
 // scripts, their errors), script_hooks.h (budget, time slice and memory
-// hooks), script_calls.h (the calls in progress, for the watchdog),
+// hooks; resuming a thread), script_calls.h (the calls in progress, for the watchdog),
 // script_hints.h (sysCall_* names never called), lua_api_control.cc (the
 // sim.* functions that run scripts and phases).
 #include "framework/script_host.h"
@@ -383,53 +383,6 @@ void Initialize(ScriptState* state, CompiledChunks* chunks = nullptr, Factories*
     }
   }
   if (group == nullptr) Settle(L, own);
-}
-
-// Resumes a script's thread until it yields, returns or fails.
-void ResumeThread(ScriptState* state, Script& script) {
-  lua_State* co = script.thread;
-  LuaContext& c = state->context;
-  const CallInProgress in_progress(*state, kCallbackNames[kThread]);
-  MakeCurrent(*state);
-  SetCurrent(*state, script);
-  SetContext(co, &c);  // its robot's, whoever resumed it last (CheckedCall)
-  c.thread = co;
-  c.budget_exhausted = false;
-  c.data_collected = false;
-  c.running = nullptr;
-  state->heap->memory.refused_bytes = 0;  // reported with the callback that made it
-  state->heap->memory.refusal_bytes = 0;
-  c.slice_fires = 0;
-  c.slice_yielded = false;
-  // A fresh slice. After a yield from the hook, Lua itself left it so: it
-  // set the count to 1 and marked the interrupted instruction, which is
-  // executed again on resume; that execution resets the count to the slice
-  // and, seeing the mark, skips the hook. Resetting the count here would let
-  // the mark swallow the next firing instead: two slices in that step.
-  if (!script.slice_yielded || lua_gethook(co) != SliceHook ||
-      lua_gethookcount(co) != script.slice_instructions)
-    lua_sethook(co, SliceHook, LUA_MASKCOUNT, script.slice_instructions);
-  int results = 0;
-  script.running = true;
-  const int status = lua_resume(co, state->L, 0, &results);
-  script.running = false;
-  c.thread = nullptr;
-  script.slice_yielded = c.slice_yielded;
-  if (status == LUA_YIELD && !c.budget_exhausted) {
-    lua_pop(co, results);
-    return;
-  }
-  std::string error;
-  if (c.budget_exhausted)
-    error = c.budget_error;
-  else if (status != LUA_OK)
-    error = LocatedErrorText(co, status, script);
-  // Finished or failed: the coroutine is not resumed again.
-  lua_settop(co, 0);
-  luaL_unref(state->L, LUA_REGISTRYINDEX, script.thread_ref);
-  script.thread = nullptr;
-  script.thread_ref = LUA_NOREF;
-  if (!error.empty()) ThrowScriptError(*state, script, std::move(error), "sysCall_thread");
 }
 
 // Pushes the callback `ref` of `script` and `args` (from
