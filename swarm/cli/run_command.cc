@@ -325,13 +325,6 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
   // --out must be a folder we can make: a bad one is a bad command line
   // (exit 2 before the run), not an error after the run's summary.
   if (options.out_dir) {
-    std::error_code ec;
-    const auto status = std::filesystem::status(*options.out_dir, ec);
-    if (std::filesystem::exists(status) && !std::filesystem::is_directory(status)) {
-      std::cerr << "error: --out '" << options.out_dir->string()
-                << "' is not a folder; pass a folder (it is made if missing)\n";
-      return kExitBadInput;
-    }
     try {
       CreateOutputFolder(*options.out_dir);
     } catch (const Error& e) {

@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "framework/math.h"
 #include "framework/scheduler.h"
 #include "framework/utf8.h"
 #include "swarm/python/controller.h"
@@ -224,6 +225,8 @@ PYBIND11_MODULE(_swarmsim, m) {
   using swarmsim::python::PyWorld;
   m.doc() = "swarmsim: load a world, step it, read and drive the swarm with numpy";
   py::register_exception_translator(&swarmsim::python::TranslateNonUtf8Messages);
+  // m, the largest coordinate a world may use (framework/math.h): set_poses's bound.
+  m.attr("MAX_COORDINATE") = swarmsim::kMaxCoordinate;
 
   // --- Robots: what a controller receives (controller.cc) --------------------------------
   swarmsim::python::BindRobots(m);

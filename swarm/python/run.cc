@@ -72,14 +72,10 @@ py::dict PyWorld::Run(std::optional<int64_t> steps, const std::optional<std::str
   options.on_metrics = [this](const std::vector<MetricSample>& samples) { KeepMetrics(samples); };
   if (out) {
     const std::filesystem::path dir(*out);
-    std::error_code ec;
-    if (std::filesystem::exists(dir, ec) && !std::filesystem::is_directory(dir, ec))
-      throw py::value_error("run(out=...): '" + dir.string() +
-                            "' is not a folder; pass a folder (it is made if missing)");
     try {
       CreateOutputFolder(dir);
     } catch (const Error& e) {
-      throw py::value_error(std::string("run(out=...): ") + e.what());
+      throw py::value_error(std::string("run(out_dir=...): ") + e.what());
     }
     if (const std::string note = RemoveEarlierOutputs(dir); !note.empty())
       std::cerr << "note: " << ValidUtf8(note) << std::endl;

@@ -4,7 +4,6 @@
 #include <array>
 #include <cerrno>
 #include <cmath>
-#include <cstdio>
 #include <cstring>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -472,11 +471,13 @@ void RunRecorder::Impl::CheckKeyframeFits(size_t objects, const SceneLists& list
   throw Error("the recording: every keyframe of this world would hold at least " +
               FormatSize(bytes) + " (" + GroupThousands(static_cast<int64_t>(objects)) +
               " recorded objects), past the " + FormatSize(limit) +
-              " a recording chunk may hold (what readers accept: FORMAT.md, \"Limits\"); "
-              "record fewer robots (about " +
-              GroupThousands(static_cast<int64_t>(std::floor(robots * limit / bytes))) +
-              " of these " + GroupThousands(robots) +
-              " would fit) or run this one without recording");
+              " a recording chunk may hold (what readers accept: FORMAT.md, \"Limits\"); " +
+              (robots > 0
+                   ? "record fewer robots (about " +
+                         GroupThousands(static_cast<int64_t>(std::floor(robots * limit / bytes))) +
+                         " of these " + GroupThousands(robots) + " would fit)"
+                   : std::string("record fewer objects")) +
+              " or run this one without recording");
 }
 
 void RunRecorder::Impl::WriteStep(const World& w) {

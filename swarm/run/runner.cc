@@ -579,6 +579,8 @@ void PrintSummaryTable(const World& world, const RunOptions& options, const RunR
 
 void CreateOutputFolder(const std::filesystem::path& dir) {
   std::error_code ec;
+  if (std::filesystem::exists(dir, ec) && !std::filesystem::is_directory(dir, ec))
+    throw Error("'" + dir.string() + "' is not a folder; pass a folder (it is made if missing)");
   std::filesystem::create_directories(dir, ec);
   if (ec) throw Error("cannot create output folder '" + dir.string() + "': " + ec.message());
 }

@@ -93,7 +93,7 @@ std::string WriteErrorSummary(const RunOptions& options, const std::string& erro
 std::string OutputsOfFinishedSteps(int64_t steps, const std::filesystem::path& dir);
 
 // Creates the run's output folder (and its parents). Throws swarmsim::Error
-// naming it when it cannot.
+// naming it when it cannot (a file of that name: "'DIR' is not a folder").
 void CreateOutputFolder(const std::filesystem::path& dir);
 
 // A run with --out DIR where an earlier run wrote: removes the files that

@@ -168,7 +168,8 @@ class ProgramTest(unittest.TestCase):
             code, out = run([PYTHON, "-m", "swarmsim", "run", numpy_world, "--steps", "3",
                              "--out", os.path.join(out_dir, "summary.json")])
             self.assertEqual(code, 2, out)
-            self.assertIn("is not a folder", out)
+            self.assertIn("error: run(out_dir=...): '" + os.path.join(out_dir, "summary.json") +
+                          "' is not a folder", out)
 
     def test_a_failing_controller_keeps_the_outputs_of_the_steps_that_finished(self):
         with tempfile.TemporaryDirectory() as d:

@@ -17,7 +17,6 @@ import numpy as np
 from . import _swarmsim
 
 World = _swarmsim.World
-MAX_COORDINATE = 1e6  # m, framework/math.h's kMaxCoordinate
 MAX_SEED = 2**31  # seeds drawn for later episodes lie in [0, MAX_SEED)
 
 
@@ -107,12 +106,14 @@ class Core:
         # The first world tells the agents, joints and sizes.
         try:
             first = self._load(0, spec["seed"])
-        except ValueError as e:  # the model= given is not the world's: say model=, not controllers
-            head = f"controllers: the world has no model '{self.model}'"
-            if not str(e).startswith(head):
-                raise
-            raise ValueError(f"{self.path}: model={self.model!r}: {str(e)[len('controllers: '):]}"
-                             ) from None
+        except ValueError:
+            # A model= the world does not have fails as our controller's model: say model=.
+            models = self._models_without_controller(spec["seed"])
+            if models is not None and self.model not in models:
+                raise ValueError(f"{self.path}: model={self.model!r}: the world has no model "
+                                 f"'{self.model}' (it has {', '.join(models) or 'none'})"
+                                 ) from None
+            raise
         self.slots[0].fresh = True
         self.base_seed = spec["seed"] if spec["seed"] is not None else _file_seed(first)
         self._check_reward_metric(first)
@@ -193,11 +194,25 @@ class Core:
             raise ValueError(f"reward: the world declares no metric '{name}'; did you mean "
                              f"'{near[0]}'? (declared: {', '.join(declared)})")
 
+    def _probe(self, seed):
+        """The world loaded without our controller."""
+        options = dict(self.spec["world_options"])
+        return World(self.path, seed=seed, set=self.spec["set"], threads=self.spec["threads"],
+                     **options)
+
+    def _models_without_controller(self, seed):
+        """The world's models, or None if it does not load without our controller either."""
+        try:
+            probe = self._probe(seed)
+        except ValueError:
+            return None
+        models = sorted(set(probe.robots["models"]))
+        probe.close()
+        return models
+
     def _find_model(self, seed):
         """The world's only model with joints (a probe load, without our controller)."""
-        options = dict(self.spec["world_options"])
-        probe = World(self.path, seed=seed, set=self.spec["set"], threads=self.spec["threads"],
-                      **options)
+        probe = self._probe(seed)
         robots = probe.robots
         models = sorted(set(robots["models"]))
         driven = [m for m in models if probe.joint_names(m)]
@@ -320,7 +335,7 @@ class Core:
             i = int(np.argmax(bad))
             raise ValueError(f"reset: options['poses'] row {i} ('{self.agents[i]}') is not finite")
         position = array[:, :2] if array.shape[1] == 3 else array[:, :3]
-        far = (np.abs(position) > MAX_COORDINATE).any(axis=1)
+        far = (np.abs(position) > _swarmsim.MAX_COORDINATE).any(axis=1)
         if far.any():
             i = int(np.argmax(far))
             raise ValueError(f"reset: options['poses'] row {i} ('{self.agents[i]}') is beyond "

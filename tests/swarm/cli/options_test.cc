@@ -64,6 +64,15 @@ TEST(CliTest, EmptyOutIsRejected) {
   Result r = RunProgram("run " + Data("ok.yaml") + " --steps 1 --quiet --out ''");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("--out: expected a folder"), std::string::npos) << r.output;
+  // A file where the folder would be: bad input before the world loads.
+  const std::string file = ::testing::TempDir() + "/swarmsim_out_is_a_file";
+  std::ofstream(file) << "x";
+  r = RunProgram("run " + Data("ok.yaml") + " --steps 1 --quiet --out " + file);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("error: --out: '" + file + "' is not a folder; pass a folder"),
+            std::string::npos)
+      << r.output;
+  std::filesystem::remove(file);
 }
 
 }  // namespace
