@@ -348,7 +348,12 @@ void World::Start() {
     run_script_memory_.set_limit(
         static_cast<uint64_t>(std::max(WorldSettings::kDefaultRunScriptMemory,
                                        WorldSettings::kRunScriptMemoryPerRobot * robot_count())));
-  stage("scripts (Lua states, sysCall_init)");
+  // (A Lua world finds a script at its first robot; one of native or Python
+  // controllers looks at every slot once.)
+  bool any_script = settings_.main_script != nullptr;
+  for (uint32_t s = 0; s < scene_.slot_count() && !any_script; ++s)
+    any_script = scene_.script_at(s) != nullptr;
+  stage(any_script ? "scripts (Lua states, sysCall_init)" : "scripts (none)");
   scripts_ = MakeScriptHost(this);
   started_ = true;
   try {

@@ -217,6 +217,7 @@ struct Geometry::Impl {
   std::vector<std::unique_ptr<Object>> objects;  // by slot; null: not a shape
   std::vector<uint32_t> moving;                  // slots of shapes that may move
   std::vector<uint32_t> fixed;                   // slots of static shapes (ascending)
+  std::vector<Pose> fixed_poses;                 // their world poses in fixed_tree (fixed)
   std::vector<std::unique_ptr<Object>> map_boxes;
   std::vector<Prism> prisms;      // by slot (kNone: not a vertical prism)
   std::vector<Prism> map_prisms;  // by map box
@@ -329,7 +330,11 @@ struct Geometry::Impl {
       }
     }
     std::vector<Object*> list;
-    for (uint32_t slot : fixed) list.push_back(objects[slot].get());
+    fixed_poses.clear();
+    for (uint32_t slot : fixed) {
+      list.push_back(objects[slot].get());
+      fixed_poses.push_back(scene.world_pose_at(slot));
+    }
     for (auto& o : map_boxes) list.push_back(o.get());
     fixed_tree.clear();
     fixed_tree.registerObjects(list);
@@ -353,6 +358,20 @@ void Geometry::Refresh(const Scene& scene) {
     return;
   }
   const auto shapes = scene.shapes();
+  // Static shapes a script, a path or a joint moved: moved in the
+  // environment tree too (few, and most never move).
+  std::vector<Object*> moved;
+  for (size_t i = 0; i < m.fixed.size(); ++i) {
+    const uint32_t slot = m.fixed[i];
+    const Pose& X = scene.world_pose_at(slot);
+    if (X == m.fixed_poses[i]) continue;
+    m.fixed_poses[i] = X;
+    m.objects[slot]->setTransform(ToFcl(X));
+    m.objects[slot]->computeAABB();
+    m.prisms[slot] = PrismOf(shapes[scene.row_at(slot)], X);
+    moved.push_back(m.objects[slot].get());
+  }
+  if (!moved.empty()) m.fixed_tree.update(moved);
   for (uint32_t slot : m.moving) {
     const Pose& X = scene.world_pose_at(slot);
     m.objects[slot]->setTransform(ToFcl(X));

@@ -2,7 +2,8 @@
 // stay in geometry.cc): one FCL collision object per shape of the scene,
 // its geometry shared between copies (one BVH per mesh asset, one primitive
 // per kind and size), and two broad phases: the environment (static shapes
-// and the map's boxes, built once) and the moving shapes (refit each step).
+// and the map's boxes: built when they change, a static shape that a script
+// or a path moved updated in place) and the moving shapes (refit each step).
 //
 // Queries read only; Refresh() writes. Queries from scripts run robots in
 // parallel between refreshes.

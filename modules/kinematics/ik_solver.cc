@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <limits>
 
 #include "framework/error.h"
 
@@ -141,7 +142,24 @@ IkResult IkProblem::Solve(const IkSettings& settings, std::vector<double>* q_io,
   Jacobian J(target_rows + static_cast<int>(avoid_.size()), n);
   RowVector err(target_rows + static_cast<int>(avoid_.size()));
   IkResult result;
-  const double lambda2 = settings.damping * settings.damping;
+  // Levenberg-Marquardt damping: a step that leaves the error larger than
+  // it found it is taken back and tried again damped 10x more; a step that
+  // helps lets the damping fall back towards settings.damping. So the error
+  // never grows from one iterate to the next (a target out of reach: the
+  // mechanism turns towards it and stays, instead of swinging about the
+  // singular stretched pose), and steps that help are taken as before.
+  // (Problems with avoidance links step undamped by this: a link's row that
+  // turns on adds error by design.)
+  const double lambda2_min = settings.damping * settings.damping;
+  double lambda2 = lambda2_min;
+  constexpr double kDampingGrowth = 100;  // on lambda^2: 10x on lambda
+  double last_cost = std::numeric_limits<double>::infinity();
+  std::vector<double> q_last;
+  std::vector<Quat> ball_last;
+  IkResult last_result;
+  Jacobian J_last;
+  RowVector err_last;
+  int r_last = 0;
 
   // The chain's joint values (q per joint, balls) from the columns.
   const auto chain_values = [&](const Chain& chain, const std::vector<int>& columns) {
@@ -256,6 +274,31 @@ IkResult IkProblem::Solve(const IkSettings& settings, std::vector<double>* q_io,
         clear) {
       result.solved = true;
       break;
+    }
+    if (avoid_.empty()) {
+      const double cost = err.head(r).squaredNorm();
+      if (iteration > 0 && !(cost <= last_cost)) {  // (NaN too)
+        // The last step made it worse: back to where it started, to step
+        // again from there (its errors and Jacobian) damped more.
+        q = q_last;
+        ball = ball_last;
+        result = last_result;
+        result.iterations = iteration;
+        J = J_last;
+        err = err_last;
+        r = r_last;
+        lambda2 = std::max(lambda2 * kDampingGrowth, 1e-6);  // (from damping 0 too)
+        if (iteration >= settings.max_iterations || !std::isfinite(lambda2)) break;
+      } else {
+        if (iteration > 0) lambda2 = std::max(lambda2_min, lambda2 / kDampingGrowth);
+        last_cost = cost;
+        q_last = q;
+        ball_last = ball;
+        last_result = result;
+        J_last = J;
+        err_last = err;
+        r_last = r;
+      }
     }
     if (iteration >= settings.max_iterations) break;
     // Damped least squares step, weighted (frozen and dependent columns:

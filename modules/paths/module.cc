@@ -54,46 +54,8 @@ uint32_t FindFollower(const Scene& scene, uint32_t path_slot, const std::string&
   return kNoSlot;
 }
 
-namespace {
-
-// Whether the subtree at `id` holds a shape that sensing, distance and
-// collision objects and the physics take for static: not dynamic and in no
-// robot. They index such shapes once, where the world file put them.
-bool HoldsStaticShape(const Scene& scene, ObjectId id) {
-  if (scene.type_at(id.index()) == ObjectType::kShape && !scene.shape(id).dynamic) return true;
-  for (const ObjectId child : scene.children(id))
-    if (HoldsStaticShape(scene, child)) return true;
-  return false;
-}
-
-}  // namespace
-
 void PathsModule::Start(World* world) {
   Scene* scene = &world->scene();
-  // Followers outside any robot carrying static shapes: moved for scripts,
-  // cameras and recordings, but not for the modules that froze them (a
-  // known limit: worlds/README.md, "Paths"). Said once, at the start.
-  if (Rows<PathRow>* paths = PathRows(scene)) {
-    std::vector<std::string> frozen;
-    for (size_t r = 0; r < paths->size(); ++r) {
-      if (paths->rows[r].velocity == 0 && paths->rows[r].followers.empty()) continue;
-      for (const std::string& name : paths->rows[r].followers) {
-        const uint32_t slot = FindFollower(*scene, paths->owners[r], name);
-        if (slot == kNoSlot || scene->instance_of_at(slot) >= 0) continue;
-        if (HoldsStaticShape(*scene, scene->IdAt(slot)))
-          frozen.push_back(scene->PathOf(scene->IdAt(slot)));
-      }
-    }
-    if (!frozen.empty())
-      world->Log("warning: path follower" + std::string(frozen.size() > 1 ? "s " : " ") +
-                 frozen.front() +
-                 (frozen.size() > 1 ? " and " + std::to_string(frozen.size() - 1) + " more" : "") +
-                 " carr" + (frozen.size() > 1 ? "y" : "ies") +
-                 " static shapes outside any robot: proximity sensors, distance and collision "
-                 "objects and the physics keep them where the world file put them. Put what "
-                 "moves in a model (a models: entry), or make its shapes dynamic, to have it "
-                 "seen where it goes (worlds/README.md, \"Paths\")");
-  }
   if (Rows<ConveyorRow>* conveyors = ConveyorRows(scene)) {
     // Belts of conveyors loaded from files (a copy made later has its own).
     for (size_t r = 0; r < conveyors->size(); ++r)

@@ -39,6 +39,11 @@ class ProximityBackend : public LineOfSight {
   // not dynamic, and the Scene's environment map, whose boxes a reading
   // reports as a null object). Called once at start.
   virtual void Build(const Scene& scene, const ProximitySettings& settings) = 0;
+  // Follows the static shapes: one that a script, a path or a joint moved
+  // is sensed where it is from then on (placed with the moving shapes), and
+  // one added or removed is indexed again. Called once per step before
+  // Update(), also when no sensor exists (the line of sight reads them).
+  virtual void FollowStaticShapes(const Scene& scene) { (void)scene; }
   // Rebuilds per-step acceleration structures (the spatial grid of robots)
   // from the current poses. Called once per step before Sense().
   virtual void Update(const Scene& scene) = 0;
@@ -52,8 +57,8 @@ class ProximityBackend : public LineOfSight {
   virtual void SetStep(uint64_t step) { (void)step; }
   // Sets (or, empty, clears) the detectable-set filter.
   virtual void SetDetectableFilter(DetectableFilter filter) { (void)filter; }
-  // Does a static shape cross the segment a-b (world frame, m)? Used for
-  // line-of-sight messages. Thread-safe. Default: nothing blocks.
+  // Does a static shape (where it is now) cross the segment a-b (world
+  // frame, m)? Used for line-of-sight messages. Thread-safe. Default: nothing blocks.
   bool SegmentBlocked(const Vec3& a_W, const Vec3& b_W) const override {
     (void)a_W;
     (void)b_W;

@@ -63,6 +63,7 @@ class ProximityModule final : public Module, public ProximityReadings {
   // Every robot's sensors, robots in parallel, then the scene's own sensors.
   void Sense(World* world) override {
     Scene& scene = world->scene();
+    backend_->FollowStaticShapes(scene);  // for the line of sight too
     // No proximity sensor anywhere (Kilobots, say): nothing reads the
     // placed shapes, so do not place them (a sensor copied in later brings
     // the work back from the next sense phase).

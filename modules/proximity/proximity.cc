@@ -34,8 +34,10 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "framework/prefault.h"
@@ -107,18 +109,50 @@ class OctreeGridProximity final : public ProximityBackend {
 
   void Build(const Scene& scene, const ProximitySettings& settings) override {
     have_sensor_type_ = FindSensorType(scene, &sensor_type_);
-    static_.Build(scene, settings.octree_resolution);
+    resolution_ = settings.octree_resolution;
     seed_ = settings.seed;
     scheduler_ = settings.scheduler;
-    static_lo_.clear();
-    static_hi_.clear();
-    for (const PlacedShape& shape : static_.shapes()) {
-      Vec3 lo, hi;
-      WorldBounds(shape, &lo, &hi);
-      static_lo_.push_back(lo);
-      static_hi_.push_back(hi);
-    }
+    IndexStatic(scene);
+    PlaceMovedStatic(scene);
     Update(scene);
+  }
+
+  void FollowStaticShapes(const Scene& scene) override {
+    bool index_again = false;
+    if (static_version_ != scene.structure_version()) {
+      // Objects added or removed: the static shapes now, those known to
+      // move staying with the moving ones.
+      std::vector<uint32_t> now;
+      const auto shapes = scene.shapes();
+      const auto owners = scene.shape_owners();
+      for (size_t r = 0; r < shapes.size(); ++r)
+        if (IsStaticShape(scene, owners[r], shapes[r])) now.push_back(owners[r]);
+      std::sort(now.begin(), now.end());
+      std::vector<uint32_t> moved, fixed;
+      std::set_intersection(moved_static_.begin(), moved_static_.end(), now.begin(), now.end(),
+                            std::back_inserter(moved));
+      std::set_difference(now.begin(), now.end(), moved.begin(), moved.end(),
+                          std::back_inserter(fixed));
+      moved_static_ = std::move(moved);
+      index_again = fixed != static_slots_;
+      // Rescaled (sim.scaleObject): indexed at its new size.
+      for (size_t i = 0; i < static_slots_.size() && !index_again; ++i)
+        index_again = !(shapes[scene.row_at(static_slots_[i])].size == static_sizes_[i]);
+      static_version_ = scene.structure_version();
+    }
+    if (!index_again) {
+      // Moved since they were indexed: moving from now on.
+      const size_t known = moved_static_.size();
+      for (size_t i = 0; i < static_slots_.size(); ++i)
+        if (!(scene.world_pose_at(static_slots_[i]) == static_poses_[i]))
+          moved_static_.push_back(static_slots_[i]);
+      if (moved_static_.size() != known) {
+        std::sort(moved_static_.begin(), moved_static_.end());
+        index_again = true;
+      }
+    }
+    if (index_again) IndexStatic(scene);
+    PlaceMovedStatic(scene);
   }
 
   // Places every robot shape and dynamic shape and rebuilds the grid over
@@ -132,9 +166,11 @@ class OctreeGridProximity final : public ProximityBackend {
     const auto shapes = scene.shapes();
     const auto owners = scene.shape_owners();
     const size_t rows = shapes.size();
-    // Moving: a robot's shape or a dynamic one.
+    // Moving: a robot's shape, a dynamic one, or a static one that moved.
     const auto moving = [&](size_t r) {
-      return shapes[r].dynamic || scene.instance_of_at(owners[r]) >= 0;
+      return shapes[r].dynamic || scene.instance_of_at(owners[r]) >= 0 ||
+             (!moved_static_.empty() &&
+              std::binary_search(moved_static_.begin(), moved_static_.end(), owners[r]));
     };
     const size_t blocks = (rows + kPlaceBlock - 1) / kPlaceBlock;
     block_start_.assign(blocks + 1, 0);
@@ -234,10 +270,14 @@ class OctreeGridProximity final : public ProximityBackend {
   bool SegmentBlocked(const Vec3& a_W, const Vec3& b_W) const override {
     const Vec3 d = b_W - a_W;
     const double length = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
-    if (!(length > 0) || static_.empty()) return false;
+    if (!(length > 0)) return false;
+    const Vec3 d_W = d * (1 / length);
     double t = 0;
     uint32_t shape = 0;
-    return static_.CastRay(a_W, d * (1 / length), length, {}, &t, &shape);
+    if (!static_.empty() && static_.CastRay(a_W, d_W, length, {}, &t, &shape)) return true;
+    for (const PlacedShape& moved : moved_placed_)
+      if (RayCast(moved, a_W, d_W, length, &t)) return true;
+    return false;
   }
 
   void SenseSceneSensors(Scene* scene) const override {
@@ -253,6 +293,41 @@ class OctreeGridProximity final : public ProximityBackend {
   }
 
  private:
+  // A shape of no robot that is not dynamic (static_index.h's static shape).
+  static bool IsStaticShape(const Scene& scene, uint32_t slot, const ShapeData& shape) {
+    return scene.alive_at(slot) && scene.instance_of_at(slot) < 0 && !shape.dynamic;
+  }
+
+  // The static index of the static shapes but those known to move, and
+  // their bounds and poses as indexed.
+  void IndexStatic(const Scene& scene) {
+    static_.Build(scene, resolution_, moved_static_);
+    static_lo_.clear();
+    static_hi_.clear();
+    static_slots_.clear();
+    static_poses_.clear();
+    static_sizes_.clear();
+    for (const PlacedShape& shape : static_.shapes()) {
+      Vec3 lo, hi;
+      WorldBounds(shape, &lo, &hi);
+      static_lo_.push_back(lo);
+      static_hi_.push_back(hi);
+      if (shape.id.IsNull()) continue;  // a voxel of the environment map
+      static_slots_.push_back(shape.id.index());
+      static_poses_.push_back(scene.world_pose_at(shape.id.index()));
+      static_sizes_.push_back(scene.shapes()[scene.row_at(shape.id.index())].size);
+    }
+    static_version_ = scene.structure_version();
+  }
+
+  // The static shapes known to move, where they are now (the line of sight's).
+  void PlaceMovedStatic(const Scene& scene) {
+    moved_placed_.clear();
+    for (uint32_t slot : moved_static_)
+      moved_placed_.push_back(PlaceShape(scene.shapes()[scene.row_at(slot)],
+                                         scene.world_pose_at(slot), scene.IdAt(slot), -1));
+  }
+
   // Are the sensor lists of ListSensors() those of the scene as it is now?
   // Every change that adds, removes or moves a sensor between robots bumps
   // the structure version or adds an instance.
@@ -716,15 +791,26 @@ class OctreeGridProximity final : public ProximityBackend {
   BackendOptions options_;
   StaticIndex static_;
   std::vector<Vec3> static_lo_, static_hi_;  // world bounds of static_.shapes() (static shapes)
-  uint64_t seed_ = 1;                        // the world's seed
-  TaskScheduler* scheduler_ = nullptr;       // populates the first sizing's pages
-  uint64_t step_ = 0;                        // the step being sensed
-  DetectableFilter detectable_;              // unset: every shape is detectable
-  std::vector<PlacedShape> moving_;   // robot and dynamic shapes, by shape row order (moving)
-  std::vector<GridItem> footprints_;  // their footprints, item i: moving_[i] (moving)
-  std::vector<Aabb2> squares_;        // bounding squares, grown (moving)
-  std::vector<int32_t> instances_;    // moving_[i].instance (moving)
-  std::vector<ObjectId> ids_;         // moving_[i].id (moving)
+  double resolution_ = 0.05;                 // of the static index's octree, m
+  // The static shapes as indexed: slots (ascending), world poses and sizes then.
+  std::vector<uint32_t> static_slots_;
+  std::vector<Pose> static_poses_;
+  std::vector<Vec3> static_sizes_;
+  uint64_t static_version_ = ~uint64_t{0};  // the scene structure they were listed at
+  // Static shapes that moved since they were indexed (ascending slots):
+  // placed with the moving shapes, and (moved_placed_) blocking the line of
+  // sight where they are.
+  std::vector<uint32_t> moved_static_;
+  std::vector<PlacedShape> moved_placed_;
+  uint64_t seed_ = 1;                   // the world's seed
+  TaskScheduler* scheduler_ = nullptr;  // populates the first sizing's pages
+  uint64_t step_ = 0;                   // the step being sensed
+  DetectableFilter detectable_;         // unset: every shape is detectable
+  std::vector<PlacedShape> moving_;     // robot and dynamic shapes, by shape row order (moving)
+  std::vector<GridItem> footprints_;    // their footprints, item i: moving_[i] (moving)
+  std::vector<Aabb2> squares_;          // bounding squares, grown (moving)
+  std::vector<int32_t> instances_;      // moving_[i].instance (moving)
+  std::vector<ObjectId> ids_;           // moving_[i].id (moving)
   std::vector<FootprintMemo> footprint_memos_;  // by shape row (shapes)
   std::vector<uint32_t> block_start_;           // Update: first entry of each block of shape rows
   FootprintGrid footprint_grid_;                // with the early-out

@@ -196,7 +196,7 @@ int StaticIndex::ClampedKey(double coordinate, int axis) const {
 
 size_t StaticIndex::octree_node_count() const { return tree_ ? tree_->size() : 0; }
 
-void StaticIndex::Build(const Scene& scene, double resolution) {
+void StaticIndex::Build(const Scene& scene, double resolution, std::span<const uint32_t> left_out) {
   if (!(resolution > 0) || !std::isfinite(resolution)) {
     std::ostringstream m;
     m << "proximity: octree_resolution must be a positive number of metres, got " << resolution;
@@ -221,6 +221,7 @@ void StaticIndex::Build(const Scene& scene, double resolution) {
   for (size_t r = 0; r < shape_rows.size(); ++r) {
     const uint32_t slot = owners[r];
     if (!scene.alive_at(slot) || scene.instance_of_at(slot) >= 0 || shape_rows[r].dynamic) continue;
+    if (std::binary_search(left_out.begin(), left_out.end(), slot)) continue;
     shapes_.push_back(PlaceShape(shape_rows[r], scene.world_pose_at(slot), scene.IdAt(slot), -1));
     if (shape_rows[r].mesh) meshes_.push_back(shape_rows[r].mesh);
   }

@@ -1,7 +1,9 @@
 // The static environment of the proximity module: the shapes that belong to
 // no robot and are not dynamic, and the voxels of the scene's environment
-// map (framework/environment.h, as boxes of no object), frozen at Build()
-// time, indexed in an OctoMap octree.
+// map (framework/environment.h, as boxes of no object), as they are at
+// Build() time, indexed in an OctoMap octree. (The backend builds it again
+// when static shapes come or go, and leaves out those that moved: it places
+// them with the moving shapes.)
 //
 // Every voxel a shape may overlap (conservatively) is marked occupied. Shape
 // lists are kept per *bucket* of 4x4x4 voxels (a map from the bucket's key to
@@ -54,10 +56,12 @@ class StaticIndex {
   StaticIndex(const StaticIndex&) = delete;
   StaticIndex& operator=(const StaticIndex&) = delete;
 
-  // Indexes the static shapes of `scene` at `resolution` (m). Throws
-  // swarmsim::Error for a bad resolution, a static shape whose pose or size
-  // is not finite, or an environment too large for the octree at it.
-  void Build(const Scene& scene, double resolution);
+  // Indexes the static shapes of `scene` at `resolution` (m), but those at
+  // the slots `left_out` (ascending: static shapes that move, which the
+  // backend places with the moving ones). Throws swarmsim::Error for a bad
+  // resolution, a static shape whose pose or size is not finite, or an
+  // environment too large for the octree at it.
+  void Build(const Scene& scene, double resolution, std::span<const uint32_t> left_out = {});
 
   bool empty() const { return shapes_.empty(); }
   std::span<const PlacedShape> shapes() const { return shapes_; }

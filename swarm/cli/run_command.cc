@@ -22,6 +22,7 @@
 #include "framework/plugin_loader.h"
 #include "framework/registry.h"
 #include "framework/sanitizers.h"
+#include "framework/scheduler.h"
 #include "framework/utf8.h"
 #include "framework/view_recorder.h"
 #include "swarm/cli/commands.h"
@@ -401,6 +402,11 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
       std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
   for (const std::string& warning : loaded.warnings)
     std::cerr << "warning: " << swarmsim::ValidUtf8(warning) << "\n";
+  if (const int cores = TaskScheduler::HardwareThreads(); loaded.world->threads() > cores)
+    std::cerr << "note: " << loaded.world->threads() << " threads on " << cores
+              << " hardware threads: the steps wait for threads that cannot run at once, so "
+                 "the run is slower than with --threads "
+              << cores << " (the results are the same for any thread count)\n";
   std::string length_error;
   const std::optional<int64_t> steps = RunLength(args, loaded, &length_error);
   if (!steps) return bad_input(length_error);

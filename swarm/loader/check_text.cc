@@ -1,9 +1,12 @@
 #include "swarm/loader/check_text.h"
 
+#include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdlib>
+#include <string>
+#include <vector>
 
 #include "framework/error.h"
 #include "swarm/loader/mesh.h"
@@ -119,6 +122,112 @@ void CheckXmlHasNoDtd(std::string_view bytes, const std::string& name, const cha
       ++i;
     }
   }
+}
+
+namespace {
+
+// "<name> (line 3)".
+std::string Element(std::string_view name, int line) {
+  std::string out = "<";
+  out.append(name);
+  out += "> (line ";
+  out += std::to_string(line);
+  out += ')';
+  return out;
+}
+
+}  // namespace
+
+std::string XmlNestingProblem(std::string_view bytes, int* line_out) {
+  struct Open {
+    std::string_view name;
+    int line;
+  };
+  std::vector<Open> open;
+  int line = 1;
+  *line_out = 0;
+  const auto count_lines = [&](size_t from, size_t to) {
+    for (size_t k = from; k < to && k < bytes.size(); ++k) line += bytes[k] == '\n';
+  };
+  const auto is_name_char = [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.' ||
+           c == ':' || static_cast<unsigned char>(c) >= 0x80;
+  };
+  size_t i = 0;
+  while (i < bytes.size()) {
+    const size_t lt = bytes.find('<', i);
+    if (lt == std::string_view::npos) break;
+    count_lines(i, lt);
+    const std::string_view rest = bytes.substr(lt);
+    std::string_view end = ">";
+    if (rest.starts_with("<!--"))
+      end = "-->";
+    else if (rest.starts_with("<![CDATA["))
+      end = "]]>";
+    else if (rest.starts_with("<?"))
+      end = "?>";
+    if (end != ">" || rest.starts_with("<!")) {
+      const size_t at = bytes.find(end, lt);
+      const size_t stop = at == std::string_view::npos ? bytes.size() : at + end.size();
+      count_lines(lt, stop);
+      i = stop;
+      continue;
+    }
+    const bool closing = rest.size() > 1 && rest[1] == '/';
+    size_t k = lt + (closing ? 2 : 1);
+    const size_t name_start = k;
+    while (k < bytes.size() && is_name_char(bytes[k])) ++k;
+    const std::string_view name = bytes.substr(name_start, k - name_start);
+    const int tag_line = line;
+    // To the tag's end, past quoted attribute values.
+    char quote = 0;
+    for (; k < bytes.size(); ++k) {
+      const char c = bytes[k];
+      if (c == '\n') ++line;
+      if (quote != 0) {
+        if (c == quote) quote = 0;
+      } else if (c == '"' || c == '\'') {
+        quote = c;
+      } else if (c == '>') {
+        break;
+      }
+    }
+    if (name.empty()) {  // not a tag the parser would take: its own message
+      i = k + 1;
+      continue;
+    }
+    const bool self_closing = !closing && k < bytes.size() && k > lt && bytes[k - 1] == '/';
+    if (closing) {
+      std::string message = "</";
+      message.append(name);
+      message += "> ";
+      if (open.empty()) {
+        *line_out = tag_line;
+        return message + "closes no open element";
+      }
+      if (open.back().name != name) {
+        *line_out = tag_line;
+        const Open& top = open.back();
+        const bool opened_below = std::any_of(open.rbegin() + 1, open.rend(),
+                                              [&](const Open& o) { return o.name == name; });
+        if (opened_below) {
+          message += "comes before " + Element(top.name, top.line) + " is closed: it needs its </";
+          message.append(top.name);
+          return message + "> first (or to end with />)";
+        }
+        return message + "does not close " + Element(top.name, top.line) + ": is it misspelt?";
+      }
+      open.pop_back();
+    } else if (!self_closing) {
+      open.push_back({name, tag_line});
+    }
+    i = k + 1;
+  }
+  if (!open.empty()) {
+    *line_out = open.back().line;
+    return Element(open.back().name, open.back().line) + " is never closed (the file ends first)";
+  }
+  return "";
 }
 
 void CheckTriangleCount(const std::string& name, int line, int64_t triangles, const char* what) {

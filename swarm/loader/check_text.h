@@ -53,6 +53,13 @@ std::string Count(int64_t n);
 // at the first; `format` names the file's kind ("URDF", "COLLADA").
 void CheckXmlHasNoDtd(std::string_view bytes, const std::string& name, const char* format);
 
+// Where an XML file's elements do not nest, found in its bytes for a file
+// the parser refused (tinyxml2 names the line of the element it was in,
+// not of the tag that broke it): "line N: </robt> does not close <robot>
+// (line 2)", "<link> (line 3) is never closed". Empty when the tags nest.
+// *line: the line to name (0 with an empty answer).
+std::string XmlNestingProblem(std::string_view bytes, int* line);
+
 // Fails when a mesh file's triangles pass kMaxMeshTriangles (mesh.h).
 void CheckTriangleCount(const std::string& name, int line, int64_t triangles, const char* what);
 

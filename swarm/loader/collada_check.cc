@@ -617,10 +617,14 @@ std::string ColladaCheck::Run() {
                      "has more than " + Count(kMaxColladaElements) +
                          " XML elements, the limit for a COLLADA file");
   CheckXmlHasNoDtd(bytes_, name_, "COLLADA");
-  if (doc_.Parse(bytes_.data(), bytes_.size()) != tinyxml2::XML_SUCCESS)
+  if (doc_.Parse(bytes_.data(), bytes_.size()) != tinyxml2::XML_SUCCESS) {
+    int line = 0;
+    if (const std::string nesting = loader::XmlNestingProblem(bytes_, &line); !nesting.empty())
+      loader::Fail(name_, line, "malformed XML: " + nesting);
     loader::Fail(name_, doc_.ErrorLineNum(),
                  std::string("malformed XML: ") + doc_.ErrorName() +
                      (doc_.ErrorStr() ? std::string(" (") + doc_.ErrorStr() + ")" : ""));
+  }
   const XMLElement* root = doc_.RootElement();
   if (!root || std::string_view(root->Name()) != "COLLADA")
     Fail(root, "a COLLADA file's root element must be <COLLADA>, not <" +

@@ -39,9 +39,15 @@ class XmlReader {
 UrdfXmlFacts XmlReader::Read(const std::string& bytes) {
   CheckXmlHasNoDtd(bytes, name_, "URDF");
   tinyxml2::XMLDocument doc;
-  if (doc.Parse(bytes.data(), bytes.size()) != tinyxml2::XML_SUCCESS)
+  if (doc.Parse(bytes.data(), bytes.size()) != tinyxml2::XML_SUCCESS) {
+    // Tags that do not nest: named at the tag that broke them (tinyxml2
+    // names the element it was in: <robot> for a misspelt </robt>).
+    int line = 0;
+    if (const std::string nesting = XmlNestingProblem(bytes, &line); !nesting.empty())
+      Fail(line, "malformed XML: " + nesting);
     Fail(doc.ErrorLineNum(), std::string("malformed XML: ") + doc.ErrorName() +
                                  (doc.ErrorStr() ? std::string(" (") + doc.ErrorStr() + ")" : ""));
+  }
   const tinyxml2::XMLElement* robot = doc.RootElement();
   if (!robot || std::string(robot->Name()) != "robot")
     Fail(robot ? robot->GetLineNum() : 1, "a URDF file's root element must be <robot>");

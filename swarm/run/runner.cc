@@ -349,7 +349,12 @@ std::string WriteSummary(const World& world, const RunOptions& options, const Ru
   if (result.saved_step >= 0)
     j["state_saved"] = {{"file", options.save_state->string()}, {"step", result.saved_step}};
   j["time_step"] = world.settings().time_step;
-  j["physics_substeps"] = world.settings().physics_substeps;
+  // null where the backend takes no substeps (kinematic, planar), as the
+  // table's physics line leaves them out.
+  if (world.registry().dynamics_capabilities(world.settings().physics).substeps)
+    j["physics_substeps"] = world.settings().physics_substeps;
+  else
+    j["physics_substeps"] = nullptr;
   j["simulated_time"] = sim_time;
   j["wall_time"] = result.wall_seconds;
   j["start_time"] = result.start_seconds;  // of wall_time: starting the world

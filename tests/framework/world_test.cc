@@ -2,9 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <string>
+#include <vector>
 
 #include "framework/error.h"
 #include "tests/framework/fakes.h"
@@ -85,6 +88,27 @@ TEST(WorldTest, StepsPhysicsAndChildrenFollow) {
   EXPECT_EQ(metrics.back().step, 10);
   EXPECT_EQ(metrics.back().value, 1.0);
   EXPECT_TRUE(world.TakeMetrics().empty());
+}
+
+// The start names its stages for the progress line: the scripts' stage
+// speaks of Lua states only in a world that has scripts.
+TEST(WorldTest, TheStartNamesTheScriptsStageByWhatTheWorldHas) {
+  for (const bool scripted : {false, true}) {
+    const ModuleRegistry registry = MakeRegistry();
+    WorldSettings settings;
+    settings.physics = "null";
+    World world(settings, registry);
+    const ObjectId root = world.scene().AddDummy("bot", {}, {});
+    world.scene().MakeModelInstance(root, "bot", "bot#0");
+    if (scripted)
+      world.scene().AttachScript(root, std::make_shared<const ScriptSource>(
+                                           ScriptSource{"bot.lua", "function sysCall_init() end"}));
+    std::vector<std::string> stages;
+    world.set_start_progress([&](const std::string& stage) { stages.push_back(stage); });
+    world.Start();
+    const std::string expected = scripted ? "scripts (Lua states, sysCall_init)" : "scripts (none)";
+    EXPECT_NE(std::find(stages.begin(), stages.end(), expected), stages.end()) << scripted;
+  }
 }
 
 TEST(WorldTest, JointsMoveTowardTheirTargets) {

@@ -97,6 +97,7 @@ std::vector<double> QuantileBorders(const std::vector<double>& sorted, int64_t p
 void PartitionedPlaneWorld::Build(const Scene& scene) {
   auto staging = std::make_unique<PlaneWorld>(options_, settings_);
   staging->Build(scene);
+  obstacle_poses_ = staging->obstacle_poses();
   regions_.clear();
   borders_.clear();
   row_borders_.clear();

@@ -36,6 +36,9 @@ class PartitionedPlaneWorld {
   void Build(const Scene& scene);
   void MarkJoints(Scene* /*scene*/) const {}
   void SyncFromScene(const Scene& scene, double duration);
+  // Has a shape behind a ground fixture (a static shape) moved since Build?
+  // Then the backend builds again (engine_backend.h).
+  bool NeedsRebuild(const Scene& scene) const { return obstacle_poses_.Moved(scene); }
   // Commands, then (with regions) migration and the ghost sets for the step.
   void ReadCommands(const Scene& scene);
   void Substep(double dt, double fraction);
@@ -88,6 +91,7 @@ class PartitionedPlaneWorld {
   std::vector<std::vector<std::pair<int, Want>>> needs_;
   std::vector<std::vector<Want>> wanted_;
   int current_ = 0;
+  dynamics::ObstaclePoses obstacle_poses_;  // as the staging world built them
 };
 
 }  // namespace swarmsim::box2d

@@ -18,6 +18,7 @@
 #include "framework/math.h"
 #include "modules/dynamics/box2d/box2d_options.h"
 #include "modules/dynamics/height_range.h"
+#include "modules/dynamics/obstacle_poses.h"
 
 namespace swarmsim {
 class Scene;
@@ -175,6 +176,8 @@ class PlaneWorld {
   // friction is per belt) or force sensors (welds between bodies).
   bool CanPartition() const { return belts_.empty() && force_sensors_.empty(); }
   const std::vector<PlaneBody>& bodies() const { return bodies_; }
+  // The scene shapes Build made ground fixtures of, and their poses then.
+  const dynamics::ObstaclePoses& obstacle_poses() const { return obstacle_poses_; }
   // Adds to this world's ground the ground fixtures of `from` whose AABB
   // reaches into [lo, hi] along `axis` (0: x, 1: y) and [cross_lo, cross_hi]
   // along the other axis, Box2D units.
@@ -251,12 +254,13 @@ class PlaneWorld {
   double scale_;  // Box2D units per metre
   std::unique_ptr<b2World> world_;
   b2Body* ground_ = nullptr;
-  std::vector<PlaneBody> bodies_;          // (bodies), slot order
-  std::vector<PlaneBodyPose> body_poses_;  // (bodies)
-  std::vector<uint32_t> wheeled_;          // bodies with wheels, ascending
-  std::vector<PlaneWheel> wheels_;         // (wheels), grouped by body
-  std::vector<PlaneBelt> belts_;           // slot order
-  std::vector<PlaneRider> riders_;         // bodies without wheels, when there are belts
+  dynamics::ObstaclePoses obstacle_poses_;  // the shapes behind ground_'s fixtures
+  std::vector<PlaneBody> bodies_;           // (bodies), slot order
+  std::vector<PlaneBodyPose> body_poses_;   // (bodies)
+  std::vector<uint32_t> wheeled_;           // bodies with wheels, ascending
+  std::vector<PlaneWheel> wheels_;          // (wheels), grouped by body
+  std::vector<PlaneBelt> belts_;            // slot order
+  std::vector<PlaneRider> riders_;          // bodies without wheels, when there are belts
   static constexpr size_t kTractionBlock = 64;
   std::array<TractionSolve, kTractionBlock> traction_;  // ApplyTraction scratch, one block
   // Force sensors: weld joint (null once broken), scene row, sensor slot.

@@ -218,6 +218,7 @@ void PlaneWorld::Reset() {
   riders_.clear();
   force_sensors_.clear();
   ghosts_.clear();
+  obstacle_poses_.Clear();
   b2BodyDef ground_def;
   ground_ = world_->CreateBody(&ground_def);
 }
@@ -286,6 +287,7 @@ void PlaneWorld::BuildObstacles(const Scene& scene, const std::vector<int32_t>& 
     if (shape->HasMovingSurface()) continue;
     const Pose& X_WS = scene.world_pose_at(s);
     ThrowIfNotFinite("box2d", scene, s, X_WS);
+    obstacle_poses_.Add(s, X_WS);  // out of the height range too: it may move into it
     const HeightRange range = CalcHeightRange(*shape, X_WS);
     if (range.hi <= dynamic_range.lo + kHeightOverlap ||
         range.lo >= dynamic_range.hi - kHeightOverlap)

@@ -61,6 +61,7 @@ void OdeWorld::Collide(dGeomID a, dGeomID b) {
   const GeomInfo& ib = geom_info_[reinterpret_cast<uintptr_t>(dGeomGetData(b)) - 1];
   if (ia.instance >= 0 && ia.instance == ib.instance) return;
   if (ba && bb && dAreConnectedExcluding(ba, bb, dJointTypeContact)) return;
+  if (has_mounts_ && HeldApart(a, ba, b, bb)) return;
   // Geom data: build index + 1.
   uint64_t first = reinterpret_cast<uintptr_t>(dGeomGetData(a));
   uint64_t second = reinterpret_cast<uintptr_t>(dGeomGetData(b));

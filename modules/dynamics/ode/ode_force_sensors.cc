@@ -19,6 +19,7 @@ void OdeWorld::BuildForceSensors(const Scene& scene, const std::vector<dBodyID>&
     const dBodyID child = body_of[child_slot];
     const dBodyID parent = dynamics::NearestBodyAbove<dBodyID>(scene, body_of, s, nullptr);
     SimForceSensor f{};
+    f.mount = parent == nullptr ? MountGeom(scene, s) : nullptr;
     f.row = row;
     f.child_body = child;
     f.X_BS = BodyPose(child).Inverse() * scene.world_pose_at(s);
@@ -28,8 +29,28 @@ void OdeWorld::BuildForceSensors(const Scene& scene, const std::vector<dBodyID>&
     dJointAttach(f.joint, child, parent);
     dJointSetFixed(f.joint);
     dJointSetFeedback(f.joint, f.feedback);
+    has_mounts_ = has_mounts_ || f.mount != nullptr;
     force_sensors_.push_back(f);
   }
+}
+
+dGeomID OdeWorld::MountGeom(const Scene& scene, uint32_t sensor_slot) const {
+  int32_t p = scene.parent_at(sensor_slot);
+  while (p >= 0 && scene.type_at(static_cast<uint32_t>(p)) != ObjectType::kShape)
+    p = scene.parent_at(static_cast<uint32_t>(p));
+  if (p < 0) return nullptr;
+  for (const StaticGeom& g : static_geoms_)
+    if (g.slot == static_cast<uint32_t>(p)) return g.geom;
+  return nullptr;
+}
+
+bool OdeWorld::HeldApart(dGeomID a, dBodyID ba, dGeomID b, dBodyID bb) const {
+  if (ba != nullptr && bb != nullptr) return false;  // bodies: the joint connects them
+  const dGeomID mount = ba == nullptr ? a : b;
+  const dBodyID child = ba == nullptr ? bb : ba;
+  for (const SimForceSensor& f : force_sensors_)
+    if (f.mount == mount && f.child_body == child && f.joint != nullptr) return true;
+  return false;
 }
 
 void OdeWorld::ReadForceSensors(Scene* scene) {

@@ -211,8 +211,10 @@ void OdeWorld::Clear() {
   world_ = nullptr;
   bodies_.clear();
   kinematic_.clear();
+  static_geoms_.clear();
   joints_.clear();
   force_sensors_.clear();
+  has_mounts_ = false;
   feedback_.clear();
   geom_info_.clear();
   surfaces_.clear();
@@ -464,6 +466,7 @@ void OdeWorld::BuildNonDynamicShapes(const Scene& scene, std::vector<dBodyID>* b
       dGeomSetPosition(geom, X_WS.p.x, X_WS.p.y, X_WS.p.z);
       const dQuaternion q = {X_WS.q.w, X_WS.q.x, X_WS.q.y, X_WS.q.z};
       dGeomSetQuaternion(geom, q);
+      static_geoms_.push_back({geom, s, X_WS});
     }
   }
 }
@@ -569,6 +572,22 @@ void OdeWorld::SyncFromScene(const Scene& scene, double duration) {
     dBodySetAngularVel(b.body, w.x, w.y, w.z);
     b.X_WB_written = X_WB;
   }
+  // A static shape that a script, a path or a joint moved becomes a kinematic
+  // body from where it was: it sweeps to its new pose over the step and
+  // pushes what it meets, and is followed like the others from then on.
+  size_t kept = 0;
+  for (const StaticGeom& g : static_geoms_) {
+    if (scene.world_pose_at(g.slot) == g.X_WS) {
+      static_geoms_[kept++] = g;
+      continue;
+    }
+    dBodyID body = dBodyCreate(world_);
+    dBodySetKinematic(body);
+    SetBodyPose(body, g.X_WS);
+    dGeomSetBody(g.geom, body);
+    kinematic_.push_back({body, g.slot, g.X_WS, g.X_WS, {}, {}});
+  }
+  static_geoms_.resize(kept);
   // Kinematic bodies go from where they were to where the scene has them.
   for (KinematicBody& k : kinematic_) {
     k.X_WB_from = k.X_WB_to;

@@ -37,6 +37,13 @@ struct DynamicBody {  // 96 bytes
 };
 
 // A non-dynamic shape moved by the scene and pushed into ODE.
+// A static shape's geom (no body), and the world pose it was built at.
+struct StaticGeom {
+  dGeomID geom;
+  uint32_t slot;
+  Pose X_WS;
+};
+
 struct KinematicBody {  // 128 bytes
   dBodyID body;
   uint32_t slot;
@@ -83,6 +90,10 @@ struct SimForceSensor {
   dBodyID child_body;  // body 1 of the joint
   Pose X_BS;           // sensor frame in the child body
   dJointFeedback* feedback;
+  // The static geom the sensor hangs from when its parent has no body (a
+  // static shape): while the link holds, the child does not touch it (the
+  // joint, not a contact, carries the load, as between two bodies).
+  dGeomID mount;
 };
 
 // Per geom: owner info for the contact filter and materials.
@@ -117,6 +128,9 @@ class OdeWorld {
   void MarkJoints(Scene* scene) const;
   // Moves bodies teleported by scripts and reads the kinematic bodies' new
   // poses (to be reached over `duration` seconds).
+  // Never: a static shape that moves becomes a kinematic body in
+  // SyncFromScene (engine_backend.h).
+  bool NeedsRebuild(const Scene& /*scene*/) const { return false; }
   void SyncFromScene(const Scene& scene, double duration);
   // Reads the joint commands (targets, forces) that set the motors.
   void ReadCommands(const Scene& scene);
@@ -145,6 +159,12 @@ class OdeWorld {
   void StepOnce(double dt, double fraction);  // Substep's work
   // Fixed joints with feedback for the scene's force sensors (ode_force_sensors.cc).
   void BuildForceSensors(const Scene& scene, const std::vector<dBodyID>& body_of);
+  // The geom of the static shape a force sensor hangs from (nearest shape
+  // above it), or null.
+  dGeomID MountGeom(const Scene& scene, uint32_t sensor_slot) const;
+  // Is (a, b) a force sensor's child against the static shape it hangs
+  // from, the link holding? (ba, bb: their bodies.)
+  bool HeldApart(dGeomID a, dBodyID ba, dGeomID b, dBodyID bb) const;
   // Samples each sensor's joint feedback and breaks links over their threshold.
   void ReadForceSensors(Scene* scene);
   void AddGeom(dGeomID geom, int32_t instance, double friction, double restitution);
@@ -181,6 +201,7 @@ class OdeWorld {
   std::unique_ptr<SolverThreads> solver_threads_;  // the solver's threads (CreateWorld), or null
   std::vector<DynamicBody> bodies_;
   std::vector<KinematicBody> kinematic_;
+  std::vector<StaticGeom> static_geoms_;  // slot order; those that never moved
   std::vector<SimJoint> joints_;
   std::vector<SimForceSensor> force_sensors_;
   std::vector<std::unique_ptr<dJointFeedback>> feedback_;  // (force_sensors_), stable addresses
@@ -207,6 +228,7 @@ class OdeWorld {
   // Each joint's motor velocity this substep (ApplyMotors): a dependent
   // joint's feed-forward is its master's.
   std::vector<double> motor_velocity_;
+  bool has_mounts_ = false;     // some force sensor hangs from a static shape (Build)
   bool exact_solver_ = false;   // dWorldStep (Options::solver, or auto by body count; Build)
   double step_dt_ = 0;          // substep length, for the servo
   uint64_t substeps_done_ = 0;  // seeds each substep's constraint shuffles

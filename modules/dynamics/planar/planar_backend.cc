@@ -23,8 +23,9 @@ class PlanarBackend final : public DynamicsBackend {
   void Step(Scene* scene, double dt, int substeps) override {
     SWARMSIM_CHECK(world_ != nullptr, "planar: Step() before Build()");
     dynamics::CheckStepArguments("planar", dt, substeps);
-    // Objects added or removed, or switched between dynamic and static.
-    if (scene->structure_version() != built_version_) {
+    // Objects added or removed, or switched between dynamic and static, or a
+    // static shape moved by a script, a path or a joint.
+    if (scene->structure_version() != built_version_ || world_->NeedsRebuild(*scene)) {
       world_->Build(*scene);
       built_version_ = scene->structure_version();
     }
@@ -40,7 +41,9 @@ class PlanarBackend final : public DynamicsBackend {
   }
 
   bool TakeVelocities(Scene* scene, std::span<const uint32_t> slots) override {
-    if (!world_ || scene->structure_version() != built_version_) return false;  // Build reads
+    // Build reads them when the next step builds again.
+    if (!world_ || scene->structure_version() != built_version_ || world_->NeedsRebuild(*scene))
+      return false;
     world_->Push(*scene, slots);
     return true;
   }

@@ -122,6 +122,7 @@ void PlanarWorld::Build(const Scene& scene) {
   reserve(wheeled_, bodies);
   reserve(wheels_, joint_count);
   obstacles_.clear();
+  obstacle_poses_.Clear();
   std::vector<int32_t> body_of;
   reserve(body_of, scene.slot_count());
   if (settings_.scheduler != nullptr) prefault.Run(*settings_.scheduler);
@@ -187,6 +188,8 @@ void PlanarWorld::Build(const Scene& scene) {
         continue;
       if (shape->HasMovingSurface()) continue;  // a belt: no obstacle (as in box2d)
       const Pose& X_WS = scene.world_pose_at(s);
+      ThrowIfNotFinite("planar", scene, s, X_WS);
+      obstacle_poses_.Add(s, X_WS);  // out of the height range too: it may move into it
       const HeightRange range = CalcHeightRange(*shape, X_WS);
       if (range.hi <= dynamic_range.lo + kHeightOverlap ||
           range.lo >= dynamic_range.hi - kHeightOverlap)

@@ -11,6 +11,7 @@
 #include "framework/dynamics_backend.h"
 #include "framework/math.h"
 #include "framework/spatial_grid.h"
+#include "modules/dynamics/obstacle_poses.h"
 #include "modules/dynamics/planar/planar_contact.h"
 #include "modules/dynamics/planar/planar_options.h"
 
@@ -48,6 +49,9 @@ class PlanarWorld {
 
   // Bodies, obstacles and wheels from the scene (discarding any previous).
   void Build(const Scene& scene);
+  // Has a shape behind an obstacle (a static shape) moved since Build? Then
+  // the backend builds again.
+  bool NeedsRebuild(const Scene& scene) const { return obstacle_poses_.Moved(scene); }
   // Moves bodies whose scene pose was set from outside since the last write.
   void SyncFromScene(const Scene& scene);
   // Each body's velocity from its wheels' commands (and Push's, which the
@@ -97,9 +101,11 @@ class PlanarWorld {
   std::vector<PlanarBodyCold> cold_;                   // (bodies)
   std::vector<PlanarWheel> wheels_;                    // grouped by body
   std::vector<uint32_t> wheeled_;                      // bodies with wheels, ascending
-  // Static obstacles and their grid (built once).
+  // Static obstacles and their grid (built with the world; a static shape
+  // that moved makes the backend build again: NeedsRebuild).
   std::vector<PlaneShape> obstacles_;
   SpatialGrid obstacle_grid_;
+  dynamics::ObstaclePoses obstacle_poses_;  // the shapes behind obstacles_
   // Verlet lists: candidates within bound + skin at the last rebuild.
   double skin_ = 0;                                    // m
   std::vector<double> ref_x_, ref_y_;                  // positions at the last rebuild (bodies)

@@ -79,5 +79,36 @@ TEST(CollisionGeometryTest, CoherenceNeverChangesTheAnswer) {
   }
 }
 
+// A static shape (no robot, not dynamic) moved by a script, a path or a
+// joint: distances to the environment and collisions with it are measured
+// where it is now, each time it moves (the environment tree follows it).
+TEST(CollisionGeometryTest, MeasuresAStaticShapeWhereItWasMoved) {
+  Scene scene;
+  const ObjectId pillar =
+      scene.AddShape("pillar", {}, At(2, 0, 0.15), Shape(ShapeKind::kBox, {0.2, 0.2, 0.3}));
+  const ObjectId body =
+      scene.AddShape("body", {}, At(0, 0, 0.15), Shape(ShapeKind::kBox, {0.2, 0.2, 0.3}));
+  scene.MakeModelInstance(body, "bot", "bot#0");
+  scene.UpdateWorldPoses();
+  Geometry geometry;
+  geometry.Refresh(scene);
+  const std::vector<uint32_t> a = {body.index()};
+  const Target environment{EntitySpec::kEnvironment, {}};
+  EXPECT_NEAR(geometry.Distance(a, environment, 10, kNoSlot, kNoSlot).distance, 1.8, 1e-9);
+  for (double x : {1.0, 3.0, 0.5}) {
+    scene.SetWorldPose(pillar, At(x, 0, 0.15));
+    geometry.Refresh(scene);
+    const DistanceAnswer d = geometry.Distance(a, environment, 10, kNoSlot, kNoSlot);
+    EXPECT_NEAR(d.distance, x - 0.2, 1e-9) << x;
+    EXPECT_EQ(d.s2, pillar.index());
+    EXPECT_FALSE(geometry.Collide(a, environment, 0).colliding) << x;
+  }
+  scene.SetWorldPose(pillar, At(0.1, 0, 0.15));
+  geometry.Refresh(scene);
+  const CollisionAnswer hit = geometry.Collide(a, environment, 0);
+  EXPECT_TRUE(hit.colliding);
+  EXPECT_EQ(hit.s2, pillar.index());
+}
+
 }  // namespace
 }  // namespace swarmsim::collision

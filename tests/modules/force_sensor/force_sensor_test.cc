@@ -84,6 +84,31 @@ TEST(ForceSensorTest, ReadsWeightOfHangingMassInOde) {
   EXPECT_NEAR(f.scene().world_pose(ball).p.z, 1.7, 1e-3);  // still held
 }
 
+// A box standing on a static table through a force sensor on the table's
+// top: the link, not a contact between the box and the table, carries the
+// box (its weight read in full); once the link breaks, the table holds the
+// box up by contact.
+TEST(ForceSensorTest, ReadsTheWeightOfAMassRestingOnItsStaticParentInOde) {
+  Fixture f;
+  const ObjectId table = f.scene().AddShape("table", {}, {{0, 0, 0.25}, {}},
+                                            Shape(ShapeKind::kBox, {1, 1, 0.5}, false));
+  ForceSensorData settings;
+  settings.force_threshold = 1000;  // N: held at first (broken below by lowering it)
+  const ObjectId sensor = AddForceSensor(&f.scene(), "sensor", table, {{0, 0, 0.25}, {}}, settings);
+  const ObjectId box = f.scene().AddShape("box", sensor, {{0, 0, 0.1}, {}},
+                                          Shape(ShapeKind::kBox, {0.2, 0.2, 0.2}, true, kMass));
+  f.world->Start();
+  for (int i = 0; i < 100; ++i) f.world->Step();
+  const ForceSensorData& s = force_sensor::Row(f.scene(), sensor);
+  ASSERT_TRUE(s.has_reading);
+  EXPECT_NEAR(s.force.z, kMass * kGravity, 0.01 * kMass * kGravity);
+  force_sensor::RowsOf(&f.scene())->rows[f.scene().row_at(sensor.index())].force_threshold =
+      1;  // N: breaks now
+  for (int i = 0; i < 100; ++i) f.world->Step();
+  EXPECT_TRUE(force_sensor::Row(f.scene(), sensor).broken);
+  EXPECT_NEAR(f.scene().world_pose(box).p.z, 0.6, 2e-3) << "on the table, not through it";
+}
+
 TEST(ForceSensorTest, TorqueOfOffsetMassAboutSensorOrigin) {
   Fixture f;
   const ObjectId beam = f.scene().AddShape("beam", {}, {{0, 0, 2}, {}},

@@ -79,6 +79,41 @@ TEST(InverseKinematics, UnreachableTargetIsReportedAndLeavesJointsAlone) {
   EXPECT_LT((ik.chain(0).CalcTipPose(q).p - target).Norm(), distance_before - 0.3);
 }
 
+// A two-link planar arm (1 m in all) and a target 2 m away along y: the
+// best it can do is to point straight at it. Unconditional solving gets it
+// there and keeps it there as the solve repeats each step (the error never
+// grows from one iterate to the next), wherever the arm starts, also from
+// the stretched (singular) pose and for any damping.
+TEST(InverseKinematics, OutOfReachTargetStretchesTheArmTowardsItAndStays) {
+  Scene scene;
+  const ObjectId j1 = scene.AddJoint("j1", {}, {}, Revolute());
+  const ObjectId j2 = scene.AddJoint("j2", j1, {{0.5, 0, 0}, {}}, Revolute());
+  const ObjectId tip = scene.AddDummy("tip", j2, {{0.5, 0, 0}, {}});
+  IkProblem ik;
+  const Vec3 target{0, 2, 0};
+  ik.AddElement(Chain::FromScene(scene, {}, tip), {target, {}}, kX | kY);
+  for (const double damping : {1e-3, 0.0, 0.1}) {
+    for (const std::vector<double>& start :
+         {std::vector<double>{0, 0}, {0.3, 0.4}, {-2.5, 1.0}, {1.2, 0}}) {
+      IkSettings settings;
+      settings.apply_only_when_solved = false;
+      settings.damping = damping;
+      settings.max_iterations = 50;
+      std::vector<double> q = start;
+      double last = INFINITY;
+      for (int step = 0; step < 20; ++step) {
+        const IkResult r = ik.Solve(settings, &q);
+        EXPECT_FALSE(r.solved);
+        const double distance = (ik.chain(0).CalcTipPose(q).p - target).Norm();
+        EXPECT_LE(distance, last + 1e-12) << "damping " << damping << ", step " << step;
+        last = distance;
+      }
+      EXPECT_NEAR(last, 1.0, 1e-3) << "damping " << damping << ", from " << start[0];
+      EXPECT_NEAR(std::remainder(q[0] - M_PI / 2, 2 * M_PI), 0, 0.05) << "pointing along +y";
+    }
+  }
+}
+
 TEST(InverseKinematics, RespectsJointLimits) {
   Scene scene;
   const double l1 = 0.5, l2 = 0.5;

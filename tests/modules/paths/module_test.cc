@@ -15,6 +15,7 @@
 #include "modules/graphs/rows.h"
 #include "modules/paths/curve.h"
 #include "modules/paths/rows.h"
+#include "modules/proximity/proximity_sensor.h"
 #include "tests/modules/module_world.h"
 
 namespace swarmsim::paths {
@@ -66,26 +67,25 @@ TEST(PathsModuleTest, StartPlacesTheFollowersAtTheStartKeepingTheirOffsets) {
   ExpectNear(s.w.scene().world_pose(s.rider).p, {3, 3, 0.2}, 1e-12);
 }
 
-// A follower outside any robot carrying a static shape is moved, but the
-// modules that index static shapes once (proximity, distance, collision,
-// physics) keep it where it was: the start says so, once. A dynamic rider,
-// or one inside a robot, is not named.
-TEST(PathsModuleTest, AStaticShapeRidingAPathOutsideARobotIsWarnedOf) {
-  const auto warnings = [](const std::vector<std::string>& log) {
-    return std::count_if(log.begin(), log.end(), [](const std::string& line) {
-      return line.find(
-                 "warning: path follower /path/rider carries static shapes outside any "
-                 "robot: proximity sensors, distance and collision objects and the physics "
-                 "keep them where the world file put them") != std::string::npos;
-    });
-  };
-  PathScene s({{0, 0, 0}, {2, 0, 0}}, false, 0.5);
-  ASSERT_EQ(s.w.Run(3), "");
-  EXPECT_EQ(warnings(s.w.log()), 1) << "once, at the start";
-  PathScene robot({{0, 0, 0}, {2, 0, 0}}, false, 0.5);
-  robot.w.scene().MakeModelInstance(robot.path, "conveyor", "conveyor#0");
-  ASSERT_EQ(robot.w.Run(1), "");
-  EXPECT_EQ(warnings(robot.w.log()), 0);
+// A follower outside any robot carrying a static shape is sensed where the
+// path has put it (the static index follows it), not where the file did:
+// a robot's sensor across the path sees the rider pass, and only then.
+TEST(PathsModuleTest, AStaticShapeRidingAPathIsSensedWhereItGoes) {
+  PathScene s({{0, 0, 0}, {2, 0, 0}}, false, 0.5);  // the rider at x = 1 + n / 16 after n steps
+  const ObjectId bot = s.w.Robot("bot", {{2.5, 0, 0}, {}});
+  ProximitySensorData ray;
+  ray.settings.Edit().range = 5;
+  const ObjectId eye = proximity::AddSensor(
+      &s.w.scene(), "eye", bot, {{0, 0, 0.2}, Quat::FromAxisAngle({1, 0, 0}, -M_PI / 2)},
+      ray);  // looking along +y, across the path
+  ASSERT_EQ(s.w.Run(1), "");
+  EXPECT_FALSE(proximity::Sensor(s.w.scene(), eye).detected);
+  ASSERT_EQ(s.w.Run(24), "");  // sensed as step 24 left it: at x = 2.5
+  EXPECT_TRUE(proximity::Sensor(s.w.scene(), eye).detected);
+  EXPECT_NEAR(proximity::Sensor(s.w.scene(), eye).distance, 1.95, 1e-9);
+  EXPECT_EQ(proximity::Sensor(s.w.scene(), eye).detected_object, s.rider);
+  ASSERT_EQ(s.w.Run(8), "");  // gone by, at x = 3
+  EXPECT_FALSE(proximity::Sensor(s.w.scene(), eye).detected);
 }
 
 // What observes the start (a graph's step-0 sample here; the recording's

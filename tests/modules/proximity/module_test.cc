@@ -111,6 +111,43 @@ TEST(ProximityModuleTest, SensesInTheWorldsStep) {
   EXPECT_EQ(reading.detected_object, w.wall());
 }
 
+// The wall moved by a script (as sim.setObjectPose), a path or a joint, or
+// removed, or rescaled: a robot's sensor and the line of sight find it
+// where it is now, from the next sense phase on, as often as it moves.
+TEST(ProximityModuleTest, SensesAStaticShapeWhereAScriptOrAPathMovedIt) {
+  ModuleWorld w;
+  Scene& scene = w.scene();
+  ProximitySensorData ray;
+  ray.settings.Edit().range = 5;
+  const ObjectId bot = scene.AddDummy("bot", {}, {});
+  const ObjectId eye =
+      AddSensor(&scene, "eye", bot, {{0, 0, 0.5}, Quat::FromAxisAngle({0, 1, 0}, M_PI / 2)}, ray);
+  scene.MakeModelInstance(bot, "bot", "bot#0");
+  w.world().Step();
+  EXPECT_NEAR(Sensor(scene, eye).distance, 0.9, 1e-9);
+  const LineOfSight& sight = *w.world().line_of_sight();
+  for (double x : {2.5, 1.7, 3.1}) {  // near face at x - 0.1
+    scene.SetWorldPose(w.wall(), {{x, 0, 0.5}, {}});
+    w.world().Step();
+    EXPECT_TRUE(Sensor(scene, eye).detected);
+    EXPECT_NEAR(Sensor(scene, eye).distance, x - 0.1, 1e-9);
+    EXPECT_EQ(Sensor(scene, eye).detected_object, w.wall());
+    EXPECT_FALSE(sight.SegmentBlocked({0, 0, 0.5}, {x - 0.2, 0, 0.5})) << "short of it now";
+    EXPECT_TRUE(sight.SegmentBlocked({0, 0, 0.5}, {x + 0.2, 0, 0.5})) << "through it now";
+  }
+  // Another static shape added by a script, then scaled: indexed as it is.
+  const ObjectId post = scene.AddShape("post", {}, {{0.6, 0, 0.5}, {}}, Box(0.2, 0.2, 1));
+  w.world().Step();
+  EXPECT_NEAR(Sensor(scene, eye).distance, 0.5, 1e-9);
+  EXPECT_EQ(Sensor(scene, eye).detected_object, post);
+  scene.ScaleSubtree(post, 2);
+  w.world().Step();
+  EXPECT_NEAR(Sensor(scene, eye).distance, 0.4, 1e-9);
+  scene.RemoveSubtree(post);
+  w.world().Step();
+  EXPECT_NEAR(Sensor(scene, eye).distance, 3.0, 1e-9) << "the moved wall again";
+}
+
 // What a native controller reads (World::proximity_readings(), the
 // plugins' read_proximity_sensor): each sensor's row as the sense phase
 // left it, also after a write through MutableSensor, a snapshot restored or

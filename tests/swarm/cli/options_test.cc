@@ -2,10 +2,12 @@
 // seeds, thread counts and folder names, each refused with what it expects.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <thread>
 
 #include "tests/swarm/run_program.h"
 
@@ -33,6 +35,23 @@ TEST(CliTest, OutOfRangeNumbersAreClearErrors) {
   Result negative = RunProgram("run " + Data("ok.yaml") + " --steps -1");
   EXPECT_EQ(negative.exit_code, 2);
   EXPECT_NE(negative.output.find("must be >= 0"), std::string::npos) << negative.output;
+}
+
+// More threads than the machine runs at once: a note (slower, same results);
+// as many as it runs: none.
+TEST(CliTest, MoreThreadsThanCoresGetANote) {
+  const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  const Result over = RunProgram("run " + Data("ok.yaml") + " --steps 1 --quiet --threads " +
+                                 std::to_string(cores + 1));
+  EXPECT_EQ(over.exit_code, 0) << over.output;
+  EXPECT_NE(over.output.find("note: " + std::to_string(cores + 1) + " threads on "),
+            std::string::npos)
+      << over.output;
+  EXPECT_NE(over.output.find(" hardware threads: the steps wait for threads that cannot run"),
+            std::string::npos)
+      << over.output;
+  const Result fits = RunProgram("run " + Data("ok.yaml") + " --steps 1 --quiet --threads 1");
+  EXPECT_EQ(fits.output.find("hardware threads"), std::string::npos) << fits.output;
 }
 
 TEST(CliTest, WholeNumberOptionsSayWhatTheyExpect) {

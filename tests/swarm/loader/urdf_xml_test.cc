@@ -112,9 +112,16 @@ TEST(UrdfXmlTest, IgnoredElementsAreCountedWithTheirFirstLine) {
 }
 
 TEST(UrdfXmlTest, StructuralMistakesNameTheFileAndTheLine) {
-  EXPECT_CONTAINS(ErrorOfXml("  <link name=\"a\">\n  <link name=\"b\"/>\n</robot>\n"), "r.urdf:");
+  // Tags that do not nest: named at the tag that broke them.
   EXPECT_CONTAINS(ErrorOfXml("  <link name=\"a\">\n  <link name=\"b\"/>\n</robot>\n"),
-                  "malformed XML");
+                  "r.urdf:5: malformed XML: </robot> comes before <link> (line 3) is closed: it "
+                  "needs its </link> first (or to end with />)");
+  EXPECT_CONTAINS(ErrorOfXml("  <link name=\"a\"/>\n  <!-- </robot> -->\n</robt>\n"),
+                  "r.urdf:5: malformed XML: </robt> does not close <robot> (line 2): is it "
+                  "misspelt?");
+  EXPECT_CONTAINS(ErrorOfXml("  <link name=\"a>b\">\n  </link>\n"),
+                  "r.urdf:2: malformed XML: <robot> (line 2) is never closed (the file ends "
+                  "first)");
   EXPECT_CONTAINS(testing::ErrorOf([] { ReadUrdfXml("<model name=\"x\"/>", "r.urdf"); }),
                   "r.urdf:1: a URDF file's root element must be <robot>");
   EXPECT_CONTAINS(ErrorOfXml("</robot>\n"), "r.urdf:2: the robot has no <link>");

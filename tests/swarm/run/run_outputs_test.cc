@@ -551,9 +551,16 @@ TEST(RunOutputsTest, TheSummaryNamesSubstepsOnlyWhereTheyAreTaken) {
     std::ofstream(dir / "world.yaml")
         << "simulation: {physics: " << physics << ", time_step: 0.1, physics_substeps: 7}\n"
         << "models:\n  - {model: bot.yaml, position: [0, 0]}\n";
-    const auto r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 1");
+    const auto r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 1 --out " +
+                              (dir / "out").string());
     ASSERT_EQ(r.exit_code, 0) << physics << ": " << r.output;
     const bool substeps = physics == "box2d";
+    const nlohmann::json summary = nlohmann::json::parse(ReadFile(dir / "out" / "summary.json"));
+    if (substeps) {
+      EXPECT_EQ(summary["physics_substeps"], 7);
+    } else {
+      EXPECT_TRUE(summary["physics_substeps"].is_null()) << physics;
+    }
     EXPECT_EQ(r.output.find("s, " + physics + ", 7 physics substeps)") != std::string::npos,
               substeps)
         << r.output;

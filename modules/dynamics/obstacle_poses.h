@@ -1,0 +1,40 @@
+// The scene shapes a planar engine (box2d, planar) built into fixed
+// obstacles, with the world pose each had then. A static shape is fixed in
+// the engine but not in the scene: a script (sim.setObjectPose), a path
+// follower or a joint outside any robot may move it. Moved() tells the
+// backend so, and it rebuilds its world from the scene on that step, so that
+// robots meet the shape where it is now. Engine-neutral (slots and poses).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "framework/scene.h"
+
+namespace swarmsim::dynamics {
+
+class ObstaclePoses {
+ public:
+  void Clear() {
+    slots_.clear();
+    poses_.clear();
+  }
+  void Add(uint32_t slot, const Pose& X_WS) {
+    slots_.push_back(slot);
+    poses_.push_back(X_WS);
+  }
+  // Has any of them a world pose other than the one it was built at? (Bit
+  // for bit: a NaN pose counts as moved, and the rebuild refuses it.)
+  bool Moved(const Scene& scene) const {
+    for (size_t i = 0; i < slots_.size(); ++i)
+      if (!(scene.world_pose_at(slots_[i]) == poses_[i])) return true;
+    return false;
+  }
+  bool empty() const { return slots_.empty(); }
+
+ private:
+  std::vector<uint32_t> slots_;
+  std::vector<Pose> poses_;
+};
+
+}  // namespace swarmsim::dynamics

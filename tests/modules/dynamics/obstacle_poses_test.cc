@@ -1,0 +1,77 @@
+// Static shapes that move (modules/dynamics/obstacle_poses.h): a wall of no
+// robot moved by a script (Scene::SetWorldPose, as sim.setObjectPose does)
+// or a path stops robots where it is now, not where the world file put it,
+// in every engine: box2d and planar build their world again, ODE turns its
+// geom into a kinematic body.
+#include "modules/dynamics/obstacle_poses.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "tests/modules/dynamics/plane_robot.h"
+#include "tests/modules/module_world.h"
+
+namespace swarmsim {
+namespace {
+
+using testing::ModuleWorld;
+
+TEST(ObstaclePosesTest, TellsAMoveOfAnyShapeItHolds) {
+  Scene scene;
+  const ObjectId a = plane_test::AddWall(&scene, 1, 0, 0.1, 1);
+  const ObjectId b = plane_test::AddWall(&scene, 2, 0, 0.1, 1);
+  dynamics::ObstaclePoses poses;
+  EXPECT_FALSE(poses.Moved(scene));
+  poses.Add(a.index(), scene.world_pose(a));
+  poses.Add(b.index(), scene.world_pose(b));
+  EXPECT_FALSE(poses.Moved(scene));
+  scene.SetWorldPose(b, {{2, 1e-9, 0.1}, {}});
+  EXPECT_TRUE(poses.Moved(scene));
+  poses.Clear();
+  EXPECT_FALSE(poses.Moved(scene));
+}
+
+// A robot drives at 0.1 m/s towards a wall (face at x = 0.45) and stops
+// there; the wall is moved to x = 1.2 (face at 1.15): the robot drives on
+// through where it was and stops at its new place.
+class PlanarEnginesTest : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(PlanarEnginesTest, ARobotMeetsAMovedWallWhereItIsNow) {
+  ModuleWorld w(GetParam(), 1, 0.1);
+  plane_test::AddFloor(&w.scene());
+  const plane_test::Robot robot = plane_test::AddRobot(&w.scene(), "bot", 0, 0, 0);
+  plane_test::SetWheelSpeeds(&w.scene(), robot, 0.1, 0.1);
+  const ObjectId wall = plane_test::AddWall(&w.scene(), 0.5, 0, 0.1, 1);
+  const double radius = robot.spec.radius;
+  ASSERT_EQ(w.Run(60), "");  // 6 s: 0.6 m, were there no wall
+  EXPECT_NEAR(w.scene().world_pose(robot.body).p.x, 0.45 - radius, 5e-3);
+  w.scene().SetWorldPose(wall, {{1.2, 0, 0.1}, {}});
+  ASSERT_EQ(w.Run(120), "");  // 12 s more: 1.2 m more, were there no wall
+  EXPECT_NEAR(w.scene().world_pose(robot.body).p.x, 1.15 - radius, 5e-3)
+      << "stopped at the wall's new place, having passed its old one";
+}
+
+INSTANTIATE_TEST_SUITE_P(Engines, PlanarEnginesTest, ::testing::Values("box2d", "planar"),
+                         [](const auto& info) { return info.param; });
+
+// ODE: a ball dropped on a table (its top at z = 0.5) rests on it; the
+// table moved away, the ball falls to the ground plane.
+TEST(OdeObstacleTest, ABallFallsWhenItsTableIsMovedAway) {
+  ModuleWorld w("ode", 1, 0.05);
+  ShapeData ball;
+  ball.kind = ShapeKind::kSphere;
+  ball.size = {0.1, 0, 0};
+  ball.dynamic = true;
+  ball.mass = 1;
+  const ObjectId b = w.scene().AddShape("ball", {}, {{0, 0, 0.8}, {}}, ball);
+  const ObjectId table = w.Box("table", {}, {{0, 0, 0.25}, {}}, {1, 1, 0.5});
+  ASSERT_EQ(w.Run(40), "");  // 2 s
+  EXPECT_NEAR(w.scene().world_pose(b).p.z, 0.6, 0.01);
+  w.scene().SetWorldPose(table, {{5, 0, 0.25}, {}});
+  ASSERT_EQ(w.Run(40), "");
+  EXPECT_NEAR(w.scene().world_pose(b).p.z, 0.1, 0.01) << "on the ground, not on the table";
+}
+
+}  // namespace
+}  // namespace swarmsim
