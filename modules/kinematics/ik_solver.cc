@@ -307,11 +307,26 @@ IkResult IkProblem::Solve(const IkSettings& settings, std::vector<double>* q_io,
     for (int c = 0; c < n; ++c) weights(c) = frozen_[c] || master_[c] >= 0 ? 0.0 : weights_[c];
     const Jacobian Jr = J.topRows(r);  // the target rows and the active avoidance rows
     const RowVector er = err.head(r);
-    const Jacobian JW = Jr * weights.asDiagonal();
-    Square A = JW * Jr.transpose();
-    A.diagonal().array() += lambda2;
-    const RowVector y = A.ldlt().solve(er);
-    const ColVector dq = JW.transpose() * y;
+    ColVector dq;
+    // A joint at a limit that the step would push past it sits this step
+    // out, and the others' step is solved again without it (else the clamp
+    // throws its share away and the others' share alone may not help: an
+    // arm stopped short of a reachable target with one joint at a limit).
+    for (int pass = 0; pass <= n; ++pass) {
+      const Jacobian JW = Jr * weights.asDiagonal();
+      Square A = JW * Jr.transpose();
+      A.diagonal().array() += lambda2;
+      const RowVector y = A.ldlt().solve(er);
+      dq = JW.transpose() * y;
+      bool dropped = false;
+      for (int c = 0; c < n; ++c)
+        if (kind_[c] == kOne && weights(c) != 0 &&
+            ((q[c] >= max_[c] && dq(c) > 0) || (q[c] <= min_[c] && dq(c) < 0))) {
+          weights(c) = 0;
+          dropped = true;
+        }
+      if (!dropped) break;
+    }
     for (int c = 0; c < n; ++c) {
       if (weights(c) == 0 && kind_[c] == kOne) continue;  // keeps its value (and limits)
       if (kind_[c] == kBallX) {

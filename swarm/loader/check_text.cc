@@ -192,6 +192,13 @@ std::string XmlNestingProblem(std::string_view bytes, int* line_out) {
         break;
       }
     }
+    if (quote != 0 && !name.empty()) {
+      *line_out = tag_line;  // the tag whose value runs away (its quote pairs with a later one)
+      std::string message = "an attribute value of <";
+      message.append(name);
+      message += "> (line " + std::to_string(tag_line) + ") has no closing ";
+      return message + (quote == '"' ? "\" (a quote missing?)" : "' (a quote missing?)");
+    }
     if (name.empty()) {  // not a tag the parser would take: its own message
       i = k + 1;
       continue;

@@ -56,7 +56,9 @@ void CheckXmlHasNoDtd(std::string_view bytes, const std::string& name, const cha
 // Where an XML file's elements do not nest, found in its bytes for a file
 // the parser refused (tinyxml2 names the line of the element it was in,
 // not of the tag that broke it): "line N: </robt> does not close <robot>
-// (line 2)", "<link> (line 3) is never closed". Empty when the tags nest.
+// (line 2)", "<link> (line 3) is never closed", a closing tag with none
+// open (after the root's end), an attribute value missing its closing quote.
+// Empty when the tags nest.
 // *line: the line to name (0 with an empty answer).
 std::string XmlNestingProblem(std::string_view bytes, int* line);
 

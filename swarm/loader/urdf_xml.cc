@@ -48,9 +48,17 @@ UrdfXmlFacts XmlReader::Read(const std::string& bytes) {
     Fail(doc.ErrorLineNum(), std::string("malformed XML: ") + doc.ErrorName() +
                                  (doc.ErrorStr() ? std::string(" (") + doc.ErrorStr() + ")" : ""));
   }
+  // What tinyxml2 lets pass: a stray closing tag after the root's end, a
+  // second top-level element.
+  int nesting_line = 0;
+  if (const std::string nesting = XmlNestingProblem(bytes, &nesting_line); !nesting.empty())
+    Fail(nesting_line, "malformed XML: " + nesting);
   const tinyxml2::XMLElement* robot = doc.RootElement();
   if (!robot || std::string(robot->Name()) != "robot")
     Fail(robot ? robot->GetLineNum() : 1, "a URDF file's root element must be <robot>");
+  if (const tinyxml2::XMLElement* more = robot->NextSiblingElement())
+    Fail(more->GetLineNum(), std::string("<") + more->Name() +
+                                 "> after </robot>: a URDF file holds one <robot> element");
   if (!robot->Attribute("name")) Fail(robot->GetLineNum(), "<robot> needs a 'name' attribute");
   std::map<std::string, std::string> parent_joint;                // child link -> joint
   std::map<std::string, std::string> parent_link;                 // child link -> parent link

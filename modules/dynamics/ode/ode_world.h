@@ -5,6 +5,7 @@
 #include <ode/ode.h>
 
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -44,11 +45,15 @@ struct StaticGeom {
   Pose X_WS;
 };
 
-struct KinematicBody {  // 128 bytes
+struct KinematicBody {  // 136 bytes
   dBodyID body;
   uint32_t slot;
   Pose X_WB_from, X_WB_to;  // pose at the start and end of the current step
   Vec3 v_WB, w_WB;
+  // A step's move longer than this (m) is a jump: the body is put at its new
+  // pose, at rest, instead of sweeping there (a static shape that a script
+  // or a path moved; a robot's kinematic parts always sweep).
+  double jump = std::numeric_limits<double>::infinity();
 };
 
 // A joint's command for one step, copied from its row and its settings

@@ -9,6 +9,7 @@
 
 #include <string>
 
+#include "modules/force_sensor/force_sensor.h"
 #include "tests/modules/dynamics/plane_robot.h"
 #include "tests/modules/module_world.h"
 
@@ -71,6 +72,60 @@ TEST(OdeObstacleTest, ABallFallsWhenItsTableIsMovedAway) {
   w.scene().SetWorldPose(table, {{5, 0, 0.25}, {}});
   ASSERT_EQ(w.Run(40), "");
   EXPECT_NEAR(w.scene().world_pose(b).p.z, 0.1, 0.01) << "on the ground, not on the table";
+}
+
+ShapeData Dynamic(ShapeKind kind, const Vec3& size, double mass) {
+  ShapeData s;
+  s.kind = kind;
+  s.size = size;
+  s.dynamic = true;
+  s.mass = mass;
+  return s;
+}
+
+// ODE: a static shape that jumps (2 m in one step: a path's follower put
+// at the path's start, a door toggled) is put there, not swept through what
+// lies between: a crate on the way is not thrown.
+TEST(OdeObstacleTest, AJumpDoesNotRamWhatLiesOnTheWay) {
+  ModuleWorld w("ode", 1, 0.1);
+  const ObjectId crate = w.scene().AddShape("crate", {}, {{-1, 0, 0.1}, {}},
+                                            Dynamic(ShapeKind::kBox, {0.2, 0.2, 0.2}, 1));
+  const ObjectId puck = w.Box("puck", {}, {{0, 0, 0.1}, {}}, {0.4, 0.4, 0.2});
+  ASSERT_EQ(w.Run(5), "");
+  w.scene().SetWorldPose(puck, {{-2, 0, 0.1}, {}});
+  ASSERT_EQ(w.Run(10), "");
+  EXPECT_NEAR(w.scene().world_pose(crate).p.x, -1, 1e-3) << "left where it was";
+  EXPECT_NEAR(w.scene().world_pose(crate).p.z, 0.1, 1e-2);
+}
+
+// ODE: a static table moved 4 mm a step carries a dynamic crate that hangs
+// from it in the scene tree 1:1 (the scene moves the crate with it; the
+// table's motion adds no friction drag on top), as box2d and planar do; and
+// a force sensor under a static beam that moves carries its load along.
+TEST(OdeObstacleTest, WhatHangsFromAMovedStaticShapeMovesWithIt) {
+  ModuleWorld w("ode", 1, 0.05);
+  const ObjectId table = w.Box("table", {}, {{0, 0, 0.25}, {}}, {1, 1, 0.5});
+  const ObjectId crate = w.scene().AddShape("crate", table, {{0, 0, 0.35}, {}},
+                                            Dynamic(ShapeKind::kBox, {0.2, 0.2, 0.2}, 2));
+  const ObjectId beam = w.Box("beam", {}, {{3, 0, 2}, {}}, {0.2, 0.2, 0.05});
+  ObjectType sensor_type;
+  ASSERT_TRUE(force_sensor::FindType(w.scene(), &sensor_type));
+  ForceSensorData settings;
+  const ObjectId hook =
+      w.scene().AddObject(sensor_type, "hook", beam, {{0, 0, -0.05}, {}}, &settings);
+  const ObjectId load = w.scene().AddShape("load", hook, {{0, 0, -0.25}, {}},
+                                           Dynamic(ShapeKind::kSphere, {0.05, 0, 0}, 2));
+  ASSERT_EQ(w.Run(20), "");
+  for (int step = 1; step <= 40; ++step) {
+    w.scene().SetWorldPose(table, {{0.004 * step, 0, 0.25}, {}});
+    w.scene().SetWorldPose(beam, {{3 + 0.004 * step, 0, 2}, {}});
+    w.scene().UpdateWorldPoses();
+    ASSERT_EQ(w.Run(1), "");
+  }
+  ASSERT_EQ(w.Run(20), "");
+  EXPECT_NEAR(w.scene().world_pose(crate).p.x, 0.16, 5e-3) << "not twice as far";
+  EXPECT_NEAR(w.scene().world_pose(load).p.x, 3.16, 5e-3) << "the load follows its hook";
+  EXPECT_NEAR(force_sensor::Row(w.scene(), hook).force.z, 2 * 9.81, 0.2);
 }
 
 }  // namespace

@@ -119,6 +119,13 @@ TEST(UrdfXmlTest, StructuralMistakesNameTheFileAndTheLine) {
   EXPECT_CONTAINS(ErrorOfXml("  <link name=\"a\"/>\n  <!-- </robot> -->\n</robt>\n"),
                   "r.urdf:5: malformed XML: </robt> does not close <robot> (line 2): is it "
                   "misspelt?");
+  EXPECT_CONTAINS(ErrorOfXml("  <link name=\"a\"/>\n</robot>\n</robot>\n"),
+                  "r.urdf:5: malformed XML: </robot> closes no open element");
+  EXPECT_CONTAINS(ErrorOfXml("  <link name=\"a\"/>\n</robot>\n<extra/>\n"),
+                  "r.urdf:5: <extra> after </robot>: a URDF file holds one <robot> element");
+  EXPECT_CONTAINS(ErrorOfXml("  <link name=\"a/>\n  <link name=\"b\"/>\n</robot>\n"),
+                  "r.urdf:3: malformed XML: an attribute value of <link> (line 3) has no "
+                  "closing \" (a quote missing?)");
   EXPECT_CONTAINS(ErrorOfXml("  <link name=\"a>b\">\n  </link>\n"),
                   "r.urdf:2: malformed XML: <robot> (line 2) is never closed (the file ends "
                   "first)");
