@@ -2,11 +2,13 @@
 // obstacles, with the world pose each had then. A static shape is fixed in
 // the engine but not in the scene: a script (sim.setObjectPose), a path
 // follower or a joint outside any robot may move it. Moved() tells the
-// backend so, and it rebuilds its world from the scene on that step, so that
-// robots meet the shape where it is now. Engine-neutral (slots and poses).
+// engine so, and it builds its obstacles again (planar) or its whole world
+// (box2d) on that step, so that robots meet the shape where it is now.
+// Engine-neutral (slots and poses).
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "framework/scene.h"
@@ -31,6 +33,11 @@ class ObstaclePoses {
     return false;
   }
   bool empty() const { return slots_.empty(); }
+  std::span<const uint32_t> slots() const { return slots_; }
+  // Takes their poses as they are now (an engine that moved its obstacles).
+  void Refresh(const Scene& scene) {
+    for (size_t i = 0; i < slots_.size(); ++i) poses_[i] = scene.world_pose_at(slots_[i]);
+  }
 
  private:
   std::vector<uint32_t> slots_;

@@ -306,7 +306,8 @@ void WorldLoader::ReadModelEntries(const Fields& top) {
                       loader::Describe(model.node) + ")");
     EntryPlan plan;
     plan.field = element;
-    plan.model = &LoadModel(model, model.node.Scalar());
+    // A world parameter may name it (`model: $robot_file`, set by --set or a sweep).
+    plan.model = &LoadModel(model, WorldValues().String(model));
     entries_.push_back(std::move(plan));
   }
 }

@@ -23,9 +23,8 @@ class PlanarBackend final : public DynamicsBackend {
   void Step(Scene* scene, double dt, int substeps) override {
     SWARMSIM_CHECK(world_ != nullptr, "planar: Step() before Build()");
     dynamics::CheckStepArguments("planar", dt, substeps);
-    // Objects added or removed, or switched between dynamic and static, or a
-    // static shape moved by a script, a path or a joint.
-    if (scene->structure_version() != built_version_ || world_->NeedsRebuild(*scene)) {
+    // Objects added or removed, or switched between dynamic and static.
+    if (scene->structure_version() != built_version_) {
       world_->Build(*scene);
       built_version_ = scene->structure_version();
     }
@@ -41,9 +40,7 @@ class PlanarBackend final : public DynamicsBackend {
   }
 
   bool TakeVelocities(Scene* scene, std::span<const uint32_t> slots) override {
-    // Build reads them when the next step builds again.
-    if (!world_ || scene->structure_version() != built_version_ || world_->NeedsRebuild(*scene))
-      return false;
+    if (!world_ || scene->structure_version() != built_version_) return false;  // Build reads
     world_->Push(*scene, slots);
     return true;
   }

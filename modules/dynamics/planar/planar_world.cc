@@ -122,6 +122,7 @@ void PlanarWorld::Build(const Scene& scene) {
   reserve(wheeled_, bodies);
   reserve(wheels_, joint_count);
   obstacles_.clear();
+  shape_obstacles_ = 0;
   obstacle_poses_.Clear();
   std::vector<int32_t> body_of;
   reserve(body_of, scene.slot_count());
@@ -181,21 +182,17 @@ void PlanarWorld::Build(const Scene& scene) {
   start_yaw_.assign(n, 0);
   // 2. Obstacles: static shapes that are no part of a body and reach into the
   // bodies' height range, and the environment map's voxels there.
+  dynamic_range_ = dynamic_range;
   if (n > 0) {
+    // (Out of the height range too: they may move into it.)
     for (uint32_t s = 0; s < scene.slot_count(); ++s) {
       const ShapeData* shape = ShapeAt(scene, s);
       if (!shape || shape->dynamic || dynamics::NearestBodyAbove(scene, body_of, s, -1) >= 0)
         continue;
       if (shape->HasMovingSurface()) continue;  // a belt: no obstacle (as in box2d)
-      const Pose& X_WS = scene.world_pose_at(s);
-      ThrowIfNotFinite("planar", scene, s, X_WS);
-      obstacle_poses_.Add(s, X_WS);  // out of the height range too: it may move into it
-      const HeightRange range = CalcHeightRange(*shape, X_WS);
-      if (range.hi <= dynamic_range.lo + kHeightOverlap ||
-          range.lo >= dynamic_range.hi - kHeightOverlap)
-        continue;
-      AddObstacle(*shape, X_WS);
+      obstacle_poses_.Add(s, scene.world_pose_at(s));
     }
+    PlaceShapeObstacles(scene);
     ShapeData voxels;
     voxels.kind = ShapeKind::kBox;
     for (const EnvironmentBox& box : dynamics::EnvironmentObstacles(scene, dynamic_range, true)) {
@@ -268,16 +265,34 @@ void PlanarWorld::Build(const Scene& scene) {
   double sum = 0;
   for (double b : bound_) sum += b;
   skin_ = n > 0 ? sum / static_cast<double>(n) : 0;
-  items_.clear();
-  for (uint32_t k = 0; k < obstacles_.size(); ++k)
-    items_.push_back({obstacles_[k].x, obstacles_[k].y, BoundOf(obstacles_[k]) + 0.5 * skin_, k});
-  obstacle_grid_.Build(items_);
   ref_x_.assign(n, 0);
   ref_y_.assign(n, 0);
   near_.assign(n, {});
   near_obstacles_.assign(n, {});
-  pairs_valid_ = false;
+  IndexObstacles();
   max_speed_ratio_ = 0;
+}
+
+void PlanarWorld::PlaceShapeObstacles(const Scene& scene) {
+  for (uint32_t s : obstacle_poses_.slots()) {
+    const ShapeData& shape = scene.shapes()[scene.row_at(s)];
+    const Pose& X_WS = scene.world_pose_at(s);
+    ThrowIfNotFinite("planar", scene, s, X_WS);
+    const HeightRange range = CalcHeightRange(shape, X_WS);
+    if (range.hi <= dynamic_range_.lo + kHeightOverlap ||
+        range.lo >= dynamic_range_.hi - kHeightOverlap)
+      continue;
+    AddObstacle(shape, X_WS);
+  }
+  shape_obstacles_ = obstacles_.size();
+}
+
+void PlanarWorld::IndexObstacles() {
+  items_.clear();
+  for (uint32_t k = 0; k < obstacles_.size(); ++k)
+    items_.push_back({obstacles_[k].x, obstacles_[k].y, BoundOf(obstacles_[k]) + 0.5 * skin_, k});
+  obstacle_grid_.Build(items_);
+  pairs_valid_ = false;
 }
 
 void PlanarWorld::AddObstacle(const ShapeData& shape, const Pose& X_WS) {
@@ -331,6 +346,16 @@ void PlanarWorld::AddObstacle(const ShapeData& shape, const Pose& X_WS) {
 }
 
 void PlanarWorld::SyncFromScene(const Scene& scene) {
+  // A static shape that a script, a path or a joint moved: the obstacles
+  // where they are now (the map's voxels stay), the bodies as they are.
+  if (obstacle_poses_.Moved(scene)) {
+    const std::vector<PlaneShape> voxels(obstacles_.begin() + shape_obstacles_, obstacles_.end());
+    obstacles_.clear();
+    PlaceShapeObstacles(scene);
+    obstacles_.insert(obstacles_.end(), voxels.begin(), voxels.end());
+    obstacle_poses_.Refresh(scene);
+    IndexObstacles();
+  }
   for (size_t b = 0; b < shapes_.size(); ++b) {
     PlanarBodyCold& cold = cold_[b];
     const Pose& X_WB = scene.world_pose_at(cold.slot);

@@ -11,6 +11,7 @@
 #include "framework/dynamics_backend.h"
 #include "framework/math.h"
 #include "framework/spatial_grid.h"
+#include "modules/dynamics/height_range.h"
 #include "modules/dynamics/obstacle_poses.h"
 #include "modules/dynamics/planar/planar_contact.h"
 #include "modules/dynamics/planar/planar_options.h"
@@ -49,10 +50,8 @@ class PlanarWorld {
 
   // Bodies, obstacles and wheels from the scene (discarding any previous).
   void Build(const Scene& scene);
-  // Has a shape behind an obstacle (a static shape) moved since Build? Then
-  // the backend builds again.
-  bool NeedsRebuild(const Scene& scene) const { return obstacle_poses_.Moved(scene); }
-  // Moves bodies whose scene pose was set from outside since the last write.
+  // Moves bodies whose scene pose was set from outside since the last write,
+  // and the obstacles when a static shape behind one moved.
   void SyncFromScene(const Scene& scene);
   // Each body's velocity from its wheels' commands (and Push's, which the
   // body then moves by exactly over `duration` s when nothing stops it).
@@ -76,6 +75,11 @@ class PlanarWorld {
 
  private:
   void AddObstacle(const ShapeData& shape, const Pose& X_WS);
+  // The static shapes of obstacle_poses_ that reach into dynamic_range_, as
+  // obstacles (appended), where they are now.
+  void PlaceShapeObstacles(const Scene& scene);
+  // The obstacles' grid; the neighbour lists are built again.
+  void IndexObstacles();
   void RebuildPairs();
   // Parallel over bodies (inline without a scheduler).
   template <class F>
@@ -101,11 +105,14 @@ class PlanarWorld {
   std::vector<PlanarBodyCold> cold_;                   // (bodies)
   std::vector<PlanarWheel> wheels_;                    // grouped by body
   std::vector<uint32_t> wheeled_;                      // bodies with wheels, ascending
-  // Static obstacles and their grid (built with the world; a static shape
-  // that moved makes the backend build again: NeedsRebuild).
+  // Static obstacles and their grid: the static shapes' (the first
+  // shape_obstacles_, placed again when one of them moved: SyncFromScene),
+  // then the environment map's voxels'.
   std::vector<PlaneShape> obstacles_;
+  size_t shape_obstacles_ = 0;
   SpatialGrid obstacle_grid_;
-  dynamics::ObstaclePoses obstacle_poses_;  // the shapes behind obstacles_
+  dynamics::ObstaclePoses obstacle_poses_;     // the shapes that may be obstacles
+  dynamics::HeightRange dynamic_range_{0, 0};  // of the bodies, at Build
   // Verlet lists: candidates within bound + skin at the last rebuild.
   double skin_ = 0;                                    // m
   std::vector<double> ref_x_, ref_y_;                  // positions at the last rebuild (bodies)

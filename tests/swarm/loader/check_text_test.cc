@@ -99,5 +99,32 @@ TEST(CheckTextTest, FailuresNameTheFileAndLine) {
             "or split it into parts)");
 }
 
+// Tags that nest pass, whatever comments, CDATA, processing instructions,
+// a DOCTYPE and quoted '>' hold; the first tag that breaks the nesting is
+// named with its line.
+TEST(CheckTextTest, XmlNestingNamesTheTagThatBreaksIt) {
+  int line = -1;
+  EXPECT_EQ(XmlNestingProblem("<?xml version=\"1.0\"?>\n<!DOCTYPE r>\n<r a='x>y' b=\"</r>\">\n"
+                              "<!-- </q> --><![CDATA[ </q> <x> ]]><e/>\n<f>t</f></r>\n",
+                              &line),
+            "");
+  EXPECT_EQ(line, 0);
+  EXPECT_EQ(XmlNestingProblem("<r>\n<a>\n</b>\n</r>\n", &line),
+            "</b> does not close <a> (line 2): is it misspelt?");
+  EXPECT_EQ(line, 3);
+  EXPECT_EQ(
+      XmlNestingProblem("<r>\n<a>\n</r>\n", &line),
+      "</r> comes before <a> (line 2) is closed: it needs its </a> first (or to end with />)");
+  EXPECT_EQ(line, 3);
+  EXPECT_EQ(XmlNestingProblem("<r/>\n</r>\n", &line), "</r> closes no open element");
+  EXPECT_EQ(line, 2);
+  EXPECT_EQ(XmlNestingProblem("<r>\n<a>\n", &line),
+            "<a> (line 2) is never closed (the file ends first)");
+  EXPECT_EQ(line, 2);
+  EXPECT_EQ(XmlNestingProblem("<r>\n<a n='x/>\n</r>\n", &line),
+            "an attribute value of <a> (line 2) has no closing ' (a quote missing?)");
+  EXPECT_EQ(line, 2);
+}
+
 }  // namespace
 }  // namespace swarmsim::loader

@@ -279,6 +279,21 @@ TEST_F(MalformedWorldTest, ValidBaseLoads) {
   EXPECT_FALSE(loaded.steps.has_value());
 }
 
+// A world parameter may name the model file (a sweep over robots): its
+// default, then --set's; a parameter naming no file is the usual error.
+TEST_F(MalformedWorldTest, AParameterMayNameTheModelFile) {
+  Write("other.yaml", std::string(kBot).replace(7, 3, "other"));  // "model: other"
+  const fs::path world = Write("world.yaml",
+                               "parameters: {robot_file: bot.yaml}\n"
+                               "models:\n  - {model: $robot_file, position: [0, 0]}\n");
+  EXPECT_EQ(Load(world).world->scene().instance(0).model_name, "bot");
+  LoadOptions options;
+  options.overrides = {{"robot_file", "other.yaml"}};
+  EXPECT_EQ(Load(world, options).world->scene().instance(0).model_name, "other");
+  options.overrides = {{"robot_file", "missing.yaml"}};
+  EXPECT_NE(ErrorOf([&] { Load(world, options); }).find("missing.yaml"), std::string::npos);
+}
+
 TEST_F(MalformedWorldTest, PhysicsPartitionsIsAutoOrACount) {
   EXPECT_EQ(Load(Write("world.yaml", std::string("arena: {size: 2}\n") + kModels))
                 .world->settings()
