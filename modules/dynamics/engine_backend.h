@@ -10,9 +10,6 @@
 //                                                 nothing (not even a write-back)
 //   World(const Options&, const DynamicsSettings&);  checks them (throws Error)
 //   void Build(const Scene&);             (re)builds everything from the scene
-//   bool NeedsRebuild(const Scene&) const;  a shape the engine holds fixed
-//                                         (a static shape) has moved in the
-//                                         scene: build again
 //   void MarkJoints(Scene*) const;        sets JointData::simulated
 //   void SyncFromScene(const Scene&, double duration);  what scripts moved
 //                                         since the last write-back; `duration`
@@ -66,10 +63,10 @@ class EngineBackend final : public DynamicsBackend {
   void Step(Scene* scene, double dt, int substeps) override {
     SWARMSIM_CHECK(world_ != nullptr, std::string(World::kName) + ": Step() before Build()");
     CheckStepArguments(World::kName, dt, substeps);
-    // Objects added or removed, or switched between dynamic and kinematic, or
-    // a static shape moved by a script, a path or a joint: rebuild from the
-    // scene (velocities and joint positions included).
-    if (scene->structure_version() != built_version_ || world_->NeedsRebuild(*scene)) {
+    // Objects added or removed, or switched between dynamic and kinematic:
+    // rebuild from the scene (velocities and joint positions included).
+    // (A static shape that moved is each engine's own: SyncFromScene.)
+    if (scene->structure_version() != built_version_) {
       world_->Build(*scene);
       world_->MarkJoints(scene);
       built_version_ = scene->structure_version();

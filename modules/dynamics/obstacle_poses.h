@@ -2,8 +2,8 @@
 // obstacles, with the world pose each had then. A static shape is fixed in
 // the engine but not in the scene: a script (sim.setObjectPose), a path
 // follower or a joint outside any robot may move it. Moved() tells the
-// engine so, and it builds its obstacles again (planar) or its whole world
-// (box2d) on that step, so that robots meet the shape where it is now.
+// engine so, and it places those obstacles again on that step, so that
+// robots meet the shape where it is now.
 // Engine-neutral (slots and poses).
 #pragma once
 
@@ -31,6 +31,12 @@ class ObstaclePoses {
     for (size_t i = 0; i < slots_.size(); ++i)
       if (!(scene.world_pose_at(slots_[i]) == poses_[i])) return true;
     return false;
+  }
+  // The slots of those that moved (ascending as added), into *out (cleared).
+  void MovedSlots(const Scene& scene, std::vector<uint32_t>* out) const {
+    out->clear();
+    for (size_t i = 0; i < slots_.size(); ++i)
+      if (!(scene.world_pose_at(slots_[i]) == poses_[i])) out->push_back(slots_[i]);
   }
   bool empty() const { return slots_.empty(); }
   std::span<const uint32_t> slots() const { return slots_; }

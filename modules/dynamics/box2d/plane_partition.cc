@@ -98,7 +98,9 @@ void PartitionedPlaneWorld::Build(const Scene& scene) {
   auto staging = std::make_unique<PlaneWorld>(options_, settings_);
   staging->Build(scene);
   obstacle_poses_ = staging->obstacle_poses();
+  dynamic_range_ = staging->dynamic_range();
   regions_.clear();
+  ground_reach_.clear();
   borders_.clear();
   row_borders_.clear();
   rows_ = 1;
@@ -115,6 +117,8 @@ void PartitionedPlaneWorld::Build(const Scene& scene) {
   count = std::min(count, body_total);
   if (count <= 1 || !staging->CanPartition()) {
     regions_.push_back(std::move(staging));
+    const double infinity = std::numeric_limits<double>::infinity();
+    ground_reach_.push_back({-infinity, infinity, -infinity, infinity});
     return;
   }
   // Columns across the longer side of the bodies' bounding box, each holding
@@ -164,6 +168,7 @@ void PartitionedPlaneWorld::Build(const Scene& scene) {
   const double pad = kGroundPad * options_.length_scale + 4 * max_radius_;
   const double infinity = std::numeric_limits<double>::infinity();
   regions_.resize(static_cast<size_t>(columns * rows_));
+  ground_reach_.resize(regions_.size());
   std::vector<std::vector<uint32_t>> bodies_of(regions_.size());
   for (uint32_t b = 0; b < bodies.size(); ++b)
     bodies_of[static_cast<size_t>(RegionOf(bodies[b].body->GetPosition()))].push_back(b);
@@ -180,8 +185,9 @@ void PartitionedPlaneWorld::Build(const Scene& scene) {
       if (r > 0) row_lo = row_borders[static_cast<size_t>(r - 1)];
       if (r < rows_ - 1) row_hi = row_borders[static_cast<size_t>(r)];
     }
-    region->CopyGround(*staging, axis_, column_lo - pad, column_hi + pad, row_lo - pad,
-                       row_hi + pad);
+    ground_reach_[index] = {column_lo - pad, column_hi + pad, row_lo - pad, row_hi + pad};
+    const std::array<double, 4>& reach = ground_reach_[index];
+    region->CopyGround(*staging, axis_, reach[0], reach[1], reach[2], reach[3]);
     // Copied, not moved: the staging world goes whole when Build returns.
     for (uint32_t b : bodies_of[index]) staging->CopyBody(b, region.get());
     regions_[index] = std::move(region);
@@ -190,7 +196,21 @@ void PartitionedPlaneWorld::Build(const Scene& scene) {
 
 void PartitionedPlaneWorld::SyncFromScene(const Scene& scene, double duration) {
   duration_ = duration;
+  if (obstacle_poses_.Moved(scene)) MoveObstacles(scene);
   ForEachRegion([&](size_t r) { regions_[r]->SyncFromScene(scene, duration); });
+}
+
+void PartitionedPlaneWorld::MoveObstacles(const Scene& scene) {
+  obstacle_poses_.MovedSlots(scene, &moved_);
+  PlaneWorld moved(options_, settings_);
+  moved.BuildEmpty();
+  moved.AddShapeObstacles(scene, moved_, dynamic_range_);
+  ForEachRegion([&](size_t r) {
+    regions_[r]->RemoveShapeObstacles(moved_);
+    const std::array<double, 4>& reach = ground_reach_[r];
+    regions_[r]->CopyGround(moved, axis_, reach[0], reach[1], reach[2], reach[3]);
+  });
+  obstacle_poses_.Refresh(scene);
 }
 
 void PartitionedPlaneWorld::ReadCommands(const Scene& scene) {

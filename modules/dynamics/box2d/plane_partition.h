@@ -35,10 +35,8 @@ class PartitionedPlaneWorld {
 
   void Build(const Scene& scene);
   void MarkJoints(Scene* /*scene*/) const {}
+  // Also places again the ground fixtures of static shapes that moved.
   void SyncFromScene(const Scene& scene, double duration);
-  // Has a shape behind a ground fixture (a static shape) moved since Build?
-  // Then the backend builds again (engine_backend.h).
-  bool NeedsRebuild(const Scene& scene) const { return obstacle_poses_.Moved(scene); }
   // Commands, then (with regions) migration and the ghost sets for the step.
   void ReadCommands(const Scene& scene);
   void Substep(double dt, double fraction);
@@ -91,7 +89,15 @@ class PartitionedPlaneWorld {
   std::vector<std::vector<std::pair<int, Want>>> needs_;
   std::vector<std::vector<Want>> wanted_;
   int current_ = 0;
+  // Static shapes that moved: their ground fixtures out of every region, and
+  // in again where they are now, in the regions they reach.
+  void MoveObstacles(const Scene& scene);
   dynamics::ObstaclePoses obstacle_poses_;  // as the staging world built them
+  HeightRange dynamic_range_{0, 0};         // the staging world's
+  // Per region, the box its ground copies come from (CopyGround's lo, hi,
+  // cross_lo, cross_hi along axis_), Box2D units.
+  std::vector<std::array<double, 4>> ground_reach_;
+  std::vector<uint32_t> moved_;  // scratch: slots of the static shapes that moved
 };
 
 }  // namespace swarmsim::box2d

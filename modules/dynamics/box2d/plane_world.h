@@ -176,11 +176,22 @@ class PlaneWorld {
   // friction is per belt) or force sensors (welds between bodies).
   bool CanPartition() const { return belts_.empty() && force_sensors_.empty(); }
   const std::vector<PlaneBody>& bodies() const { return bodies_; }
-  // The scene shapes Build made ground fixtures of, and their poses then.
+  // The scene shapes Build made ground fixtures of, and their poses then;
+  // the dynamic shapes' height range.
   const dynamics::ObstaclePoses& obstacle_poses() const { return obstacle_poses_; }
+  const HeightRange& dynamic_range() const { return dynamic_range_; }
+  // Static shapes that moved (PartitionedPlaneWorld::SyncFromScene): adds
+  // their ground fixtures where they are now (those in `dynamic_range`), to
+  // a world made by BuildEmpty, to be copied into the regions; and drops a
+  // region's fixtures of the shapes at `slots` (ascending).
+  void AddShapeObstacles(const Scene& scene, std::span<const uint32_t> slots,
+                         const HeightRange& dynamic_range);
+  void RemoveShapeObstacles(std::span<const uint32_t> slots);
   // Adds to this world's ground the ground fixtures of `from` whose AABB
   // reaches into [lo, hi] along `axis` (0: x, 1: y) and [cross_lo, cross_hi]
   // along the other axis, Box2D units.
+  // The bodies that fixtures copied there may overlap are woken (a sleeping
+  // body does not notice a new static fixture).
   void CopyGround(const PlaneWorld& from, int axis, double lo, double hi, double cross_lo,
                   double cross_hi);
   // Moves body `b` with its wheels, ground friction, pose record, velocity
@@ -221,7 +232,8 @@ class PlaneWorld {
   // that do.
   void BuildObstacles(const Scene& scene, const std::vector<int32_t>& body_of,
                       const HeightRange& dynamic_range);
-  void AddObstacle(const ShapeData& shape, const Pose& X_WS);
+  // `tag` (the fixtures' user data): the shape's slot + 1, 0 for map voxels.
+  void AddObstacle(const ShapeData& shape, const Pose& X_WS, uintptr_t tag = 0);
   // 3. Wheels, grouped by body, each with its share of the body's weight.
   void BuildWheels(const Scene& scene, const std::vector<int32_t>& body_of);
   void AddWheel(uint32_t joint_slot, const JointData& joint, uint32_t body_index,
@@ -255,6 +267,7 @@ class PlaneWorld {
   std::unique_ptr<b2World> world_;
   b2Body* ground_ = nullptr;
   dynamics::ObstaclePoses obstacle_poses_;  // the shapes behind ground_'s fixtures
+  HeightRange dynamic_range_{0, 0};         // of the bodies, at Build
   std::vector<PlaneBody> bodies_;           // (bodies), slot order
   std::vector<PlaneBodyPose> body_poses_;   // (bodies)
   std::vector<uint32_t> wheeled_;           // bodies with wheels, ascending

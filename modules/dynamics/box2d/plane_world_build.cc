@@ -194,6 +194,7 @@ void PlaneWorld::Build(const Scene& scene) {
   // 1. A body per dynamic shape, in slot order.
   std::vector<int32_t> body_of(scene.slot_count(), -1);  // body index of a dynamic shape (slots)
   const HeightRange dynamic_range = BuildBodies(scene, &body_of);
+  dynamic_range_ = dynamic_range;
   // 2. Obstacles: non-dynamic shapes that are not parts of a body, projected
   // to the plane, as fixtures of the ground body.
   if (!bodies_.empty()) BuildObstacles(scene, body_of, dynamic_range);
@@ -285,15 +286,10 @@ void PlaneWorld::BuildObstacles(const Scene& scene, const std::vector<int32_t>& 
       continue;
     // A moving surface (a belt) carries bodies: no obstacle (BuildBelts).
     if (shape->HasMovingSurface()) continue;
-    const Pose& X_WS = scene.world_pose_at(s);
-    ThrowIfNotFinite("box2d", scene, s, X_WS);
-    obstacle_poses_.Add(s, X_WS);  // out of the height range too: it may move into it
-    const HeightRange range = CalcHeightRange(*shape, X_WS);
-    if (range.hi <= dynamic_range.lo + kHeightOverlap ||
-        range.lo >= dynamic_range.hi - kHeightOverlap)
-      continue;
-    AddObstacle(*shape, X_WS);
+    obstacle_poses_.Add(
+        s, scene.world_pose_at(s));  // out of the height range too: it may move into it
   }
+  AddShapeObstacles(scene, obstacle_poses_.slots(), dynamic_range);
   // The environment map's voxels in that range, projected and merged into
   // rectangles (fixtures of the ground body like the shapes above).
   ShapeData voxels;  // the default material
@@ -304,9 +300,34 @@ void PlaneWorld::BuildObstacles(const Scene& scene, const std::vector<int32_t>& 
   }
 }
 
-void PlaneWorld::AddObstacle(const ShapeData& shape, const Pose& X_WS) {
+void PlaneWorld::AddShapeObstacles(const Scene& scene, std::span<const uint32_t> slots,
+                                   const HeightRange& dynamic_range) {
+  for (uint32_t s : slots) {
+    const ShapeData& shape = scene.shapes()[scene.row_at(s)];
+    const Pose& X_WS = scene.world_pose_at(s);
+    ThrowIfNotFinite("box2d", scene, s, X_WS);
+    const HeightRange range = CalcHeightRange(shape, X_WS);
+    if (range.hi <= dynamic_range.lo + kHeightOverlap ||
+        range.lo >= dynamic_range.hi - kHeightOverlap)
+      continue;
+    AddObstacle(shape, X_WS, uintptr_t{s} + 1);
+  }
+}
+
+void PlaneWorld::RemoveShapeObstacles(std::span<const uint32_t> slots) {
+  std::vector<b2Fixture*> doomed;
+  for (b2Fixture* f = ground_->GetFixtureList(); f; f = f->GetNext()) {
+    const uintptr_t tag = f->GetUserData().pointer;
+    if (tag != 0 && std::binary_search(slots.begin(), slots.end(), static_cast<uint32_t>(tag - 1)))
+      doomed.push_back(f);
+  }
+  for (b2Fixture* f : doomed) ground_->DestroyFixture(f);
+}
+
+void PlaneWorld::AddObstacle(const ShapeData& shape, const Pose& X_WS, uintptr_t tag) {
   const double L = scale_;
   b2FixtureDef fixture;
+  fixture.userData.pointer = tag;
   fixture.friction = static_cast<float>(shape.friction);
   fixture.restitution = static_cast<float>(shape.restitution);
   fixture.restitutionThreshold = static_cast<float>(kRestitutionThreshold * L);

@@ -5,6 +5,8 @@
 #include <box2d/b2_fixture.h>
 #include <box2d/b2_friction_joint.h>
 #include <box2d/b2_polygon_shape.h>
+#include <box2d/b2_world.h>
+#include <box2d/b2_world_callbacks.h>
 
 #include <algorithm>
 #include <cmath>
@@ -27,6 +29,7 @@ b2FixtureDef DefinitionOf(const b2Fixture* f) {
   def.density = f->GetDensity();
   def.isSensor = f->IsSensor();
   def.filter = f->GetFilterData();
+  def.userData = const_cast<b2Fixture*>(f)->GetUserData();  // (Box2D 2.4 has no const getter)
   return def;
 }
 
@@ -46,6 +49,12 @@ void CloneFixtures(const b2Body* from, b2Body* to) {
 
 void PlaneWorld::CopyGround(const PlaneWorld& from, int axis, double lo, double hi, double cross_lo,
                             double cross_hi) {
+  struct Wake final : b2QueryCallback {
+    bool ReportFixture(b2Fixture* fixture) override {
+      if (fixture->GetBody()->GetType() == b2_dynamicBody) fixture->GetBody()->SetAwake(true);
+      return true;
+    }
+  } wake;
   std::vector<const b2Fixture*> fixtures;
   for (const b2Fixture* f = from.ground_->GetFixtureList(); f; f = f->GetNext())
     fixtures.push_back(f);
@@ -64,7 +73,10 @@ void PlaneWorld::CopyGround(const PlaneWorld& from, int axis, double lo, double 
     }
     if (!reaches) continue;
     const b2FixtureDef def = DefinitionOf(f);
-    ground_->CreateFixture(&def);
+    const b2Fixture* copy = ground_->CreateFixture(&def);
+    // Bodies asleep where it lands wake to meet it.
+    for (int c = 0; c < copy->GetShape()->GetChildCount(); ++c)
+      world_->QueryAABB(&wake, copy->GetAABB(c));
   }
 }
 

@@ -133,9 +133,6 @@ class OdeWorld {
   void MarkJoints(Scene* scene) const;
   // Moves bodies teleported by scripts and reads the kinematic bodies' new
   // poses (to be reached over `duration` seconds).
-  // Never: a static shape that moves becomes a kinematic body in
-  // SyncFromScene (engine_backend.h).
-  bool NeedsRebuild(const Scene& /*scene*/) const { return false; }
   void SyncFromScene(const Scene& scene, double duration);
   // Reads the joint commands (targets, forces) that set the motors.
   void ReadCommands(const Scene& scene);

@@ -8,7 +8,12 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <string_view>
+#include <vector>
 
+#include "framework/registry.h"
+#include "framework/world.h"
+#include "modules/builtin.h"
 #include "modules/force_sensor/force_sensor.h"
 #include "tests/modules/dynamics/plane_robot.h"
 #include "tests/modules/module_world.h"
@@ -51,6 +56,38 @@ TEST_P(PlanarEnginesTest, ARobotMeetsAMovedWallWhereItIsNow) {
   ASSERT_EQ(w.Run(120), "");  // 12 s more: 1.2 m more, were there no wall
   EXPECT_NEAR(w.scene().world_pose(robot.body).p.x, 1.15 - radius, 5e-3)
       << "stopped at the wall's new place, having passed its old one";
+}
+
+// box2d cut into regions (two strips here, one robot in each): a wall
+// across both, moved, is taken out of each region and put in again where it
+// is now, in every region it reaches.
+TEST(Box2dObstacleTest, AMovedWallStopsTheRobotsOfEveryRegion) {
+  ModuleRegistry registry;
+  RegisterBuiltinModules(&registry);
+  WorldSettings settings;
+  settings.physics = "box2d";
+  settings.time_step = 0.1;
+  settings.physics_partitions = 2;
+  settings.threads = 2;
+  World world(settings, registry);
+  world.set_log_sink([](std::string_view) {});
+  Scene& scene = world.scene();
+  plane_test::AddFloor(&scene);
+  std::vector<plane_test::Robot> robots;
+  for (double y : {-4.0, 4.0}) {
+    robots.push_back(plane_test::AddRobot(&scene, "bot", 0, y, 0));
+    plane_test::SetWheelSpeeds(&scene, robots.back(), 0.1, 0.1);
+  }
+  const ObjectId wall = plane_test::AddWall(&scene, 0.5, 0, 0.1, 12);
+  world.Start();
+  for (int i = 0; i < 60; ++i) world.Step();
+  const double radius = robots[0].spec.radius;
+  for (const plane_test::Robot& robot : robots)
+    EXPECT_NEAR(scene.world_pose(robot.body).p.x, 0.45 - radius, 5e-3);
+  scene.SetWorldPose(wall, {{1.2, 0, 0.1}, {}});
+  for (int i = 0; i < 120; ++i) world.Step();
+  for (const plane_test::Robot& robot : robots)
+    EXPECT_NEAR(scene.world_pose(robot.body).p.x, 1.15 - radius, 5e-3);
 }
 
 INSTANTIATE_TEST_SUITE_P(Engines, PlanarEnginesTest, ::testing::Values("box2d", "planar"),
