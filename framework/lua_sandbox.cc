@@ -231,6 +231,14 @@ std::string CheckedPath(lua_State* L, const char* function, const std::string& t
                       "': the run has no output folder (swarmsim run --out DIR)");
   root = Canonical(fs::absolute(root));
   const fs::path path = fs::path(text).is_absolute() ? fs::path(text) : root / text;
+  // A symlink to nothing (yet): resolving stops at it, but opening it to
+  // write creates its target, wherever that is. Refused, to wherever it points.
+  std::error_code ec;
+  if (fs::is_symlink(fs::symlink_status(path, ec)) && !fs::exists(path, ec))
+    RaiseRefusal(L, std::string(function) + ": '" + text +
+                        "' is a symlink to a file that does not exist (" +
+                        fs::read_symlink(path, ec).string() +
+                        "); scripts are sandboxed (run with --trust-scripts to lift it)");
   // Symlinks are resolved first: one inside the folder pointing out is refused.
   const fs::path resolved = Canonical(path);
   if (!IsInside(resolved, root))

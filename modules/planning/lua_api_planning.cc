@@ -12,6 +12,7 @@
 //     time_limit=, bounds=, obstacles=}): adjusts the task's settings
 // A script plans with its own robot's tasks only (a scene script with any).
 #include <cmath>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -75,6 +76,15 @@ Pose GoalArg(lua_State* L, int arg, Space space) {
   return {{v[0], v[1], v[2]}, q.Normalized()};
 }
 
+// A number for a message: "0.5", "inf", "-inf", "nan".
+std::string NumberText(double v) {
+  if (std::isnan(v)) return "nan";
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  std::ostringstream out;
+  out << v;
+  return out.str();
+}
+
 // As the world file's time_limit (objects.cc): at most an hour of planner
 // iterations, so a script cannot ask for a plan that never ends.
 constexpr double kMaxTimeLimit = 3600;
@@ -82,8 +92,7 @@ constexpr double kMaxTimeLimit = 3600;
 double TimeLimit(double value, const char* what) {
   if (!std::isfinite(value) || value <= 0 || value > kMaxTimeLimit)
     throw Error(std::string(what) + " must be a positive number of seconds, at most 3600 (got " +
-                (std::isfinite(value) ? std::to_string(value) : std::string("not a number")) +
-                "): it is the planner's budget");
+                NumberText(value) + "): it is the planner's budget");
   return value;
 }
 
@@ -186,7 +195,8 @@ int SetPlanningTask(lua_State* L) {
     next.turning_radius = v;
   }
   if (number("resolution", &v)) {
-    if (!(v > 0 && std::isfinite(v))) throw Error("resolution must be a positive number");
+    if (!(v >= 1e-4 && std::isfinite(v)))
+      throw Error("resolution must be a number of metres from 0.0001 (got " + NumberText(v) + ")");
     next.resolution = v;
   }
   if (number("time_limit", &v)) next.time_limit = TimeLimit(v, "time_limit");

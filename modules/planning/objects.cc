@@ -35,13 +35,17 @@ constexpr ObjectKey kTaskKeys[] = {
      "frame: where the robot's frame may go; default: the box of the static shapes' centres "
      "(inside the arena's walls)"},
     {"turning_radius", "0.5", "m, > 0: the car's smallest turning radius (dubins, reeds_shepp)"},
-    {"resolution", "0.05", "m, > 0: motions are checked for collisions every this far"},
+    {"resolution", "0.05", "m, >= 0.0001: motions are checked for collisions every this far"},
     {"time_limit", "1",
      "s, > 0: the planning budget, counted in planner iterations (20,000 per second), never "
      "the wall clock, so results do not depend on the machine's load"},
 };
 
 constexpr NumberRule kTimeLimit{"a positive number of seconds", 0, 3600, true};
+// Motions are checked every `resolution` m: below 0.1 mm a plan across a
+// yard would check millions of states a motion (QA: 1e-9 grew to 800 MB).
+constexpr double kMinResolution = 1e-4;
+constexpr NumberRule kResolution{"a number of metres from 0.0001", kMinResolution, kMaxLength};
 
 void ReadTask(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
   PlanningTaskRow& t = *static_cast<PlanningTaskRow*>(row);
@@ -81,7 +85,7 @@ void ReadTask(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
                  std::string(n == 4 ? "" : " with z: [xmin, ymin, zmin, xmax, ymax, zmax]") + ")");
   }
   if (r.Has("turning_radius")) t.turning_radius = r.Number("turning_radius", kPositiveLength);
-  if (r.Has("resolution")) t.resolution = r.Number("resolution", kPositiveLength);
+  if (r.Has("resolution")) t.resolution = r.Number("resolution", kResolution);
   if (r.Has("time_limit")) t.time_limit = r.Number("time_limit", kTimeLimit);
   if (t.where.empty()) t.where = r.Where(r.Has("space") ? "space" : "time_limit");
 }

@@ -31,7 +31,12 @@ namespace {
 using Se2State = ob::SE2StateSpace::StateType;
 using Se3State = ob::SE3StateSpace::StateType;
 
-double WrapAngle(double a) { return std::remainder(a, 2 * M_PI); }
+// An angle in [-pi, pi), where OMPL's SO2 bounds hold it (pi itself is out:
+// a goal heading of exactly pi was never reached).
+double WrapAngle(double a) {
+  const double w = std::remainder(a, 2 * M_PI);
+  return w >= M_PI ? w - 2 * M_PI : w;
+}
 
 // Every draw of the planner: uniform states in the bounds from the
 // request's stream (OMPL's own samplers seed themselves from a process-wide
@@ -262,7 +267,7 @@ void FromPose(const Pose& X, bool planar, ob::State* state) {
   if (planar) {
     auto* s = state->as<Se2State>();
     s->setXY(X.p.x, X.p.y);
-    s->setYaw(X.q.Yaw());
+    s->setYaw(WrapAngle(X.q.Yaw()));
     return;
   }
   auto* s = state->as<Se3State>();

@@ -39,7 +39,8 @@ double ToDouble(const std::string& text, const std::string& context) {
 int64_t ToCount(const std::string& text, const std::string& context) {
   const double v = ToDouble(text, context);
   if (v < 1 || v != std::floor(v) || v > 1e6)
-    throw Error(context + ": the number of values '" + text + "' must be a whole number >= 1");
+    throw Error(context + ": the number of values '" + text +
+                "' must be a whole number from 1 to 10^6");
   return static_cast<int64_t>(v);
 }
 
@@ -122,7 +123,10 @@ std::vector<uint64_t> ParseSeeds(const std::string& spec) {
     if (b < a)
       throw Error(context + ": a seed range A-B needs A <= B (got " + first + " > " + last + ")");
     if (b - a >= 1000000) throw Error(context + ": more than a million seeds");
-    for (uint64_t s = a; s <= b; ++s) seeds.push_back(s);
+    for (uint64_t s = a;; ++s) {  // (not s <= b: b may be 2^64 - 1)
+      seeds.push_back(s);
+      if (s == b) break;
+    }
   } else if (spec.find_first_not_of("0123456789") == std::string::npos) {
     // A count K (out of range for any number of digits).
     uint64_t k = 0;
@@ -148,8 +152,22 @@ std::vector<GridRun> ExpandGrid(const std::vector<ParamSpec>& params,
   std::set<std::string> names;
   for (const ParamSpec& p : params)
     if (!names.insert(p.name).second) throw Error("--param " + p.name + " is given twice");
+  // At most a million runs: a sweep's runs are listed whole (the database,
+  // the grid's hash) before the first one starts.
+  constexpr int64_t kMaxRuns = 1000000;
   int64_t points = 1;
-  for (const ParamSpec& p : params) points *= static_cast<int64_t>(p.values.size());
+  bool too_many = false;
+  std::string shape;
+  for (const ParamSpec& p : params) {
+    const int64_t n = static_cast<int64_t>(p.values.size());
+    shape += std::to_string(n) + " values of " + p.name + " x ";
+    too_many = too_many || points > kMaxRuns / n;
+    if (!too_many) points *= n;
+  }
+  if (too_many || points > kMaxRuns / static_cast<int64_t>(seeds.size()))
+    throw Error("the sweep would have more than 10^6 runs (" + shape +
+                std::to_string(seeds.size()) +
+                " seeds): sweep fewer values, or split it into several sweeps");
   std::vector<GridRun> runs;
   runs.reserve(static_cast<size_t>(points) * seeds.size());
   for (int64_t point = 0; point < points; ++point) {

@@ -129,6 +129,12 @@ TEST_F(SandboxTest, WritesOnlyUnderTheOutputFolder) {
                   "the run has no output folder (swarmsim run --out DIR)");
   fs::create_symlink(root_ / "world", root_ / "out" / "sneaky");
   EXPECT_CONTAINS(Run("io.open('sneaky/data.txt', 'w')"), "is outside the run's output folder");
+  // A symlink to a file not there yet, outside: opening it would create it
+  // there (QA). Refused, and nothing is created.
+  fs::create_symlink("../outside.txt", root_ / "out" / "notes.txt");
+  EXPECT_CONTAINS(Run("io.open('notes.txt', 'w')"),
+                  "'notes.txt' is a symlink to a file that does not exist (../outside.txt)");
+  EXPECT_FALSE(fs::exists(root_ / "outside.txt"));
 }
 
 // The room kept aside for the final summary on a full disk is the run's own:

@@ -100,6 +100,11 @@ TEST(LuaApiPlanningTest, MistakesAreErrorsNamingWhatIsWrong) {
                   "the time limit must be a positive number of seconds, at most 3600 (got");
   EXPECT_CONTAINS(ErrorOfLine("sim.setPlanningTask(sim.getObject('./task'), {time_limit = 3601})"),
                   "time_limit must be a positive number of seconds, at most 3600");
+  EXPECT_CONTAINS(ErrorOfLine("sim.planPath(sim.getObject('./task'), {1, 1, 0}, 1/0)"),
+                  "at most 3600 (got inf)");
+  // Checks every nanometre would never end (QA: 800 MB in 15 s).
+  EXPECT_CONTAINS(ErrorOfLine("sim.setPlanningTask(sim.getObject('./task'), {resolution = 1e-9})"),
+                  "resolution must be a number of metres from 0.0001 (got 1e-09)");
   EXPECT_CONTAINS(ErrorOfLine("sim.planPath(sim.getObject('/other'), {1, 1, 0})"),
                   "planning task '/other' belongs to another robot");
   EXPECT_CONTAINS(ErrorOfLine("sim.readPlan(sim.getObject('./body'))"),

@@ -121,6 +121,20 @@ TEST(Planner, DubinsPlanRespectsTheTurningRadius) {
   EXPECT_NEAR(p.dense.back().q.Yaw(), M_PI / 2, 1e-6);
 }
 
+// A heading of exactly +pi (and a start facing -x, whose yaw reads +pi) is
+// as good as -pi: solved in every planar space (QA: never solved, and the
+// planner waited out its time on the wall clock).
+TEST(Planner, AHeadingOfPiIsSolved) {
+  for (const Space space : {Space::kSe2, Space::kDubins, Space::kReedsShepp}) {
+    PlanRequest r = Request(space, 8.5, 8.5);
+    r.goal.q = Quat::FromYaw(M_PI);
+    r.start.q = Quat::FromYaw(M_PI);
+    const PlanResult p = Plan(r, [](const Pose&) { return true; });
+    ASSERT_EQ(p.status, PlanStatus::kSolved) << SpaceName(space) << ": " << p.reason;
+    EXPECT_NEAR(std::abs(p.dense.back().q.Yaw()), M_PI, 1e-6);
+  }
+}
+
 TEST(Planner, ReedsSheppAndSe3Solve) {
   const auto boxes = Clutter();
   const PlanResult rs = PlanIn(boxes, Request(Space::kReedsShepp, 8.5, 8.5));

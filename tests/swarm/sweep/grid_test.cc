@@ -62,6 +62,34 @@ TEST(SweepGridTest, Seeds) {
   EXPECT_EQ(ParseSeeds("11,3,7"), (std::vector<uint64_t>{11, 3, 7}));
   for (const char* bad : {"0", "x", "8-5", "1,1", "-3", "1.5"})
     EXPECT_THROW(ParseSeeds(bad), Error) << bad;
+  // A range up to the last seed ends there (QA: it ran on past 2^64 - 1 and
+  // took 16 GB).
+  EXPECT_EQ(ParseSeeds("18446744073709551614-18446744073709551615"),
+            (std::vector<uint64_t>{18446744073709551614u, 18446744073709551615u}));
+  EXPECT_EQ(ParseSeeds("18446744073709551615-18446744073709551615").size(), 1u);
+}
+
+// More than a million runs in all is refused with the grid's shape, before
+// anything is listed (QA: two parameters of 10^6 values were a bad_alloc).
+TEST(SweepGridTest, AGridOfMoreThanAMillionRunsIsRefused) {
+  const std::vector<ParamSpec> big = {ParseParamSpec("k=1:2:1000000"),
+                                      ParseParamSpec("work=1:2:1000000")};
+  try {
+    ExpandGrid(big, {1});
+    ADD_FAILURE() << "not refused";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(),
+                 "the sweep would have more than 10^6 runs (1000000 values of k x 1000000 values "
+                 "of work x 1 seeds): sweep fewer values, or split it into several sweeps");
+  }
+  EXPECT_THROW(ExpandGrid({ParseParamSpec("k=1:2:1000")}, ParseSeeds("1001")), Error);
+  EXPECT_EQ(ExpandGrid({ParseParamSpec("k=1:2:1000")}, ParseSeeds("1000")).size(), 1000000u);
+  try {
+    ParseParamSpec("k=1:2:1000001");
+    ADD_FAILURE() << "not refused";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("from 1 to 10^6"), std::string::npos) << e.what();
+  }
 }
 
 TEST(SweepGridTest, CartesianProductTimesSeedsLastParameterFastest) {
