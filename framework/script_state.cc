@@ -170,7 +170,19 @@ std::string ErrorText(lua_State* L, int status) {
   }
   if (status != LUA_ERRRUN && status != LUA_ERRSYNTAX && status != LUA_ERRERR)
     return "internal error: a C++ exception crossed a Lua frame (please report this)";
-  if (lua_type(L, -1) == LUA_TSTRING) return lua_tostring(L, -1);
+  if (lua_type(L, -1) == LUA_TSTRING) {
+    // Whole, also past a NUL byte (shown as \0: a C string would end there).
+    size_t length = 0;
+    const char* text = lua_tolstring(L, -1, &length);
+    std::string message;
+    for (size_t i = 0; i < length; ++i) {
+      if (text[i] == '\0')
+        message += "\\0";
+      else
+        message += text[i];
+    }
+    return message;
+  }
   return std::string("(error object is a ") + luaL_typename(L, -1) + " value)";
 }
 

@@ -56,6 +56,10 @@ void CheckWorld(const SweepOptions& o, const GridRun& first, const std::vector<P
   }
   if (!o.steps && !o.duration && !loaded.steps)
     throw Error(o.world + " gives no run length; pass --steps N or --duration SECONDS");
+  // As `run` refuses it, before any run (else every run fails the same way).
+  if (!o.steps && o.duration && *o.duration > 0 && *o.duration < loaded.world->settings().time_step)
+    throw Error("--duration " + FormatNumber(*o.duration) + " s is shorter than one time step (" +
+                FormatNumber(loaded.world->settings().time_step) + " s)");
   for (const ParamSpec& p : params) {
     const auto declared = loaded.world->parameters().find(p.name);
     if (declared == loaded.world->parameters().end()) continue;  // a model's (the first run's)

@@ -4,6 +4,8 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <map>
 #include <set>
 
 #include "framework/error.h"
@@ -98,9 +100,19 @@ ParamSpec ParseParamSpec(const std::string& name_equals_spec) {
       p.values.push_back(v);
     }
   }
-  std::set<std::string> seen;
-  for (const std::string& v : p.values)
-    if (!seen.insert(v).second) throw Error(context + ": value '" + v + "' appears twice");
+  // Twice the same value, also spelled two ways (1.0 and 1e0 are one number
+  // to the world file: the same runs twice).
+  std::map<std::string, std::string> seen;  // the value as a world reads it -> as given
+  for (const std::string& v : p.values) {
+    std::string key = v;
+    char* end = nullptr;
+    const double number = std::strtod(v.c_str(), &end);
+    if (end != v.c_str() && *end == '\0' && std::isfinite(number)) key = FormatNumber(number);
+    const auto [it, added] = seen.emplace(key, v);
+    if (!added)
+      throw Error(context + ": value '" + v + "' appears twice" +
+                  (it->second == v ? "" : " (as '" + it->second + "')"));
+  }
   return p;
 }
 

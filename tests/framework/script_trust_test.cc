@@ -608,6 +608,7 @@ TEST_F(TrustTest, EveryScriptErrorNamesRobotScriptLineAndCallback) {
       {"error()", "scripts/robot.lua:3: (error object is a nil value)"},
       {"error({})", "scripts/robot.lua:3: (error object is a table value)"},
       {"error('plain', 0)", "scripts/robot.lua:3: plain"},
+      {"error('nul\\0byte after', 0)", "scripts/robot.lua:3: nul\\0byte after"},
       {"coroutine.yield()", "scripts/robot.lua:3: attempt to yield from outside a coroutine"},
       {"math.max(nil, 1)", "scripts/robot.lua:3: "},
       {"print(setmetatable({}, {__tostring = function(s) return tostring(s) end}))",

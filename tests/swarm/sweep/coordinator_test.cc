@@ -387,6 +387,13 @@ TEST(CoordinatorTest, AWorldWithoutARunLengthNeedsStepsOrDuration) {
   r = RunProgram(base + (dir / "b.db").string() + " --duration 0.3");
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_EQ(Count(dir / "b.db", "SELECT steps FROM runs"), 3);
+  // Shorter than a step: refused before any run, no database made (QA).
+  r = RunProgram(base + (dir / "c.db").string() + " --duration 0.01");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--duration 0.01 s is shorter than one time step (0.1 s)"),
+            std::string::npos)
+      << r.output;
+  EXPECT_FALSE(fs::exists(dir / "c.db"));
   fs::remove_all(dir);
 }
 

@@ -53,6 +53,14 @@ TEST(SweepGridTest, MalformedSpecsAreClearErrors) {
       EXPECT_NE(std::string(e.what()).find("--param"), std::string::npos) << e.what();
     }
   }
+  // One number spelled two ways is the same runs twice (QA: 1.0,1,1e0 made 3).
+  try {
+    ParseParamSpec("k=1.0,2,1e0");
+    ADD_FAILURE() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "--param k=1.0,2,1e0: value '1e0' appears twice (as '1.0')");
+  }
+  EXPECT_EQ(ParseParamSpec("mode=a,b,1,01x").values.size(), 4u);  // words stay words
 }
 
 TEST(SweepGridTest, Seeds) {
