@@ -2,6 +2,9 @@
 
 #include <ctime>
 #include <nlohmann/json.hpp>
+#include <string>
+#include <system_error>
+#include <vector>
 
 #include "framework/error.h"
 
@@ -44,7 +47,36 @@ std::string UtcNow() {
   return buf;
 }
 
-ResultsDb::ResultsDb(const std::filesystem::path& path, bool read_only) : db_(path, read_only) {
+namespace {
+
+// `path`, once a look at it without writing shows it is new, empty or a
+// sweep's: a database of something else is refused before the sweep's
+// tables (and WAL mode) would be added to it.
+const std::filesystem::path& SweepDatabase(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec) || std::filesystem::file_size(path, ec) == 0) return path;
+  SqliteDb look(path, /*read_only=*/true);
+  SqliteStatement tables(&look, "SELECT name FROM sqlite_master WHERE type = 'table'");
+  std::vector<std::string> names;
+  bool sweep = false;
+  while (tables.Step()) {
+    names.push_back(tables.Text(0));
+    sweep = sweep || names.back() == "sweep";
+  }
+  if (!names.empty() && !sweep) {
+    std::string list;
+    for (size_t i = 0; i < names.size() && i < 5; ++i) list += (i ? ", " : "") + names[i];
+    if (names.size() > 5) list += ", ...";
+    throw Error("database '" + path.string() + "' is not a sweep's (it holds the tables " + list +
+                "): name a new file for --db, or one a sweep made");
+  }
+  return path;
+}
+
+}  // namespace
+
+ResultsDb::ResultsDb(const std::filesystem::path& path, bool read_only)
+    : db_(SweepDatabase(path), read_only) {
   if (!read_only) db_.Exec(kSchema);
 }
 

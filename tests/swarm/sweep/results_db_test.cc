@@ -6,10 +6,13 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
+#include "framework/error.h"
 #include "swarm/sweep/grid.h"
+#include "swarm/sweep/sqlite_db.h"
 #include "tests/swarm/sweep/sweep_db.h"
 
 namespace swarmsim {
@@ -164,6 +167,40 @@ TEST(ResultsDbTest, InterruptedAndFailedRunsGoBackToPending) {
   // Claimed again, a run counts its attempts.
   db.Claim(1, "host:2");
   EXPECT_EQ(ReadRuns(file).at(1).attempts, 2);
+  fs::remove_all(dir);
+}
+
+// --db naming another program's database is refused before anything is
+// written to it (QA: the sweep's tables and WAL mode were added first); a
+// sweep's own, and an empty file, open.
+TEST(ResultsDbTest, ADatabaseOfSomethingElseIsRefusedUntouched) {
+  const fs::path dir = TempDir("results_foreign");
+  const fs::path other = dir / "other.db";
+  {
+    SqliteDb db(other);
+    db.Exec("PRAGMA journal_mode=DELETE");
+    db.Exec("CREATE TABLE measurements (x REAL)");
+  }
+  const auto before = fs::file_size(other);
+  try {
+    ResultsDb db(other);
+    ADD_FAILURE() << "opened";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "database '" + other.string() +
+                  "' is not a sweep's (it holds the tables measurements): name a new file for "
+                  "--db, or one a sweep made");
+  }
+  EXPECT_EQ(fs::file_size(other), before);
+  EXPECT_FALSE(fs::exists(dir / "other.db-wal"));
+  EXPECT_EQ(Count(other, "SELECT count(*) FROM sqlite_master WHERE name = 'sweep'"), 0);
+  {
+    ResultsDb db(dir / "r.db");
+    db.CreateSweep(kRecord, Runs());
+  }
+  EXPECT_NO_THROW(ResultsDb(dir / "r.db"));
+  std::ofstream(dir / "empty.db").flush();
+  EXPECT_NO_THROW(ResultsDb(dir / "empty.db"));
   fs::remove_all(dir);
 }
 
