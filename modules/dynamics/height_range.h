@@ -21,6 +21,12 @@ struct HeightRange {
   double lo, hi;
 };
 
+// Does a static shape of heights `range` reach into the dynamic shapes'
+// `dynamic` range: is it an obstacle?
+inline bool ReachesInto(const HeightRange& range, const HeightRange& dynamic) {
+  return range.hi > dynamic.lo + kHeightOverlap && range.lo < dynamic.hi - kHeightOverlap;
+}
+
 // Height range of a shape at pose X_WS, m.
 inline HeightRange CalcHeightRange(const ShapeData& shape, const Pose& X_WS) {
   const double z = X_WS.p.z;

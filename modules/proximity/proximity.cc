@@ -34,7 +34,6 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
-#include <iterator>
 #include <limits>
 #include <span>
 #include <utility>
@@ -47,6 +46,7 @@
 #include "modules/proximity/footprint_grid.h"
 #include "modules/proximity/proximity_sensor.h"
 #include "modules/proximity/ray_cast.h"
+#include "modules/proximity/static_follower.h"
 #include "modules/proximity/static_index.h"
 #include "modules/proximity/volume.h"
 
@@ -113,46 +113,13 @@ class OctreeGridProximity final : public ProximityBackend {
     seed_ = settings.seed;
     scheduler_ = settings.scheduler;
     IndexStatic(scene);
-    PlaceMovedStatic(scene);
+    follower_.PlaceMoved(scene);
     Update(scene);
   }
 
   void FollowStaticShapes(const Scene& scene) override {
-    bool index_again = false;
-    if (static_version_ != scene.structure_version()) {
-      // Objects added or removed: the static shapes now, those known to
-      // move staying with the moving ones.
-      std::vector<uint32_t> now;
-      const auto shapes = scene.shapes();
-      const auto owners = scene.shape_owners();
-      for (size_t r = 0; r < shapes.size(); ++r)
-        if (IsStaticShape(scene, owners[r], shapes[r])) now.push_back(owners[r]);
-      std::sort(now.begin(), now.end());
-      std::vector<uint32_t> moved, fixed;
-      std::set_intersection(moved_static_.begin(), moved_static_.end(), now.begin(), now.end(),
-                            std::back_inserter(moved));
-      std::set_difference(now.begin(), now.end(), moved.begin(), moved.end(),
-                          std::back_inserter(fixed));
-      moved_static_ = std::move(moved);
-      index_again = fixed != static_slots_;
-      // Rescaled (sim.scaleObject): indexed at its new size.
-      for (size_t i = 0; i < static_slots_.size() && !index_again; ++i)
-        index_again = !(shapes[scene.row_at(static_slots_[i])].size == static_sizes_[i]);
-      static_version_ = scene.structure_version();
-    }
-    if (!index_again) {
-      // Moved since they were indexed: moving from now on.
-      const size_t known = moved_static_.size();
-      for (size_t i = 0; i < static_slots_.size(); ++i)
-        if (!(scene.world_pose_at(static_slots_[i]) == static_poses_[i]))
-          moved_static_.push_back(static_slots_[i]);
-      if (moved_static_.size() != known) {
-        std::sort(moved_static_.begin(), moved_static_.end());
-        index_again = true;
-      }
-    }
-    if (index_again) IndexStatic(scene);
-    PlaceMovedStatic(scene);
+    if (follower_.Follow(scene)) IndexStatic(scene);
+    follower_.PlaceMoved(scene);
   }
 
   // Places every robot shape and dynamic shape and rebuilds the grid over
@@ -169,8 +136,7 @@ class OctreeGridProximity final : public ProximityBackend {
     // Moving: a robot's shape, a dynamic one, or a static one that moved.
     const auto moving = [&](size_t r) {
       return shapes[r].dynamic || scene.instance_of_at(owners[r]) >= 0 ||
-             (!moved_static_.empty() &&
-              std::binary_search(moved_static_.begin(), moved_static_.end(), owners[r]));
+             follower_.IsMoved(owners[r]);
     };
     const size_t blocks = (rows + kPlaceBlock - 1) / kPlaceBlock;
     block_start_.assign(blocks + 1, 0);
@@ -275,9 +241,7 @@ class OctreeGridProximity final : public ProximityBackend {
     double t = 0;
     uint32_t shape = 0;
     if (!static_.empty() && static_.CastRay(a_W, d_W, length, {}, &t, &shape)) return true;
-    for (const PlacedShape& moved : moved_placed_)
-      if (RayCast(moved, a_W, d_W, length, &t)) return true;
-    return false;
+    return follower_.LineBlocked(a_W, d_W, length);
   }
 
   void SenseSceneSensors(Scene* scene) const override {
@@ -293,39 +257,19 @@ class OctreeGridProximity final : public ProximityBackend {
   }
 
  private:
-  // A shape of no robot that is not dynamic (static_index.h's static shape).
-  static bool IsStaticShape(const Scene& scene, uint32_t slot, const ShapeData& shape) {
-    return scene.alive_at(slot) && scene.instance_of_at(slot) < 0 && !shape.dynamic;
-  }
-
   // The static index of the static shapes but those known to move, and
-  // their bounds and poses as indexed.
+  // their bounds.
   void IndexStatic(const Scene& scene) {
-    static_.Build(scene, resolution_, moved_static_);
+    static_.Build(scene, resolution_, follower_.moved());
     static_lo_.clear();
     static_hi_.clear();
-    static_slots_.clear();
-    static_poses_.clear();
-    static_sizes_.clear();
     for (const PlacedShape& shape : static_.shapes()) {
       Vec3 lo, hi;
       WorldBounds(shape, &lo, &hi);
       static_lo_.push_back(lo);
       static_hi_.push_back(hi);
-      if (shape.id.IsNull()) continue;  // a voxel of the environment map
-      static_slots_.push_back(shape.id.index());
-      static_poses_.push_back(scene.world_pose_at(shape.id.index()));
-      static_sizes_.push_back(scene.shapes()[scene.row_at(shape.id.index())].size);
     }
-    static_version_ = scene.structure_version();
-  }
-
-  // The static shapes known to move, where they are now (the line of sight's).
-  void PlaceMovedStatic(const Scene& scene) {
-    moved_placed_.clear();
-    for (uint32_t slot : moved_static_)
-      moved_placed_.push_back(PlaceShape(scene.shapes()[scene.row_at(slot)],
-                                         scene.world_pose_at(slot), scene.IdAt(slot), -1));
+    follower_.Indexed(scene, static_);
   }
 
   // Are the sensor lists of ListSensors() those of the scene as it is now?
@@ -792,25 +736,16 @@ class OctreeGridProximity final : public ProximityBackend {
   StaticIndex static_;
   std::vector<Vec3> static_lo_, static_hi_;  // world bounds of static_.shapes() (static shapes)
   double resolution_ = 0.05;                 // of the static index's octree, m
-  // The static shapes as indexed: slots (ascending), world poses and sizes then.
-  std::vector<uint32_t> static_slots_;
-  std::vector<Pose> static_poses_;
-  std::vector<Vec3> static_sizes_;
-  uint64_t static_version_ = ~uint64_t{0};  // the scene structure they were listed at
-  // Static shapes that moved since they were indexed (ascending slots):
-  // placed with the moving shapes, and (moved_placed_) blocking the line of
-  // sight where they are.
-  std::vector<uint32_t> moved_static_;
-  std::vector<PlacedShape> moved_placed_;
-  uint64_t seed_ = 1;                   // the world's seed
-  TaskScheduler* scheduler_ = nullptr;  // populates the first sizing's pages
-  uint64_t step_ = 0;                   // the step being sensed
-  DetectableFilter detectable_;         // unset: every shape is detectable
-  std::vector<PlacedShape> moving_;     // robot and dynamic shapes, by shape row order (moving)
-  std::vector<GridItem> footprints_;    // their footprints, item i: moving_[i] (moving)
-  std::vector<Aabb2> squares_;          // bounding squares, grown (moving)
-  std::vector<int32_t> instances_;      // moving_[i].instance (moving)
-  std::vector<ObjectId> ids_;           // moving_[i].id (moving)
+  StaticFollower follower_;                  // the static shapes that moved, and those indexed
+  uint64_t seed_ = 1;                        // the world's seed
+  TaskScheduler* scheduler_ = nullptr;       // populates the first sizing's pages
+  uint64_t step_ = 0;                        // the step being sensed
+  DetectableFilter detectable_;              // unset: every shape is detectable
+  std::vector<PlacedShape> moving_;   // robot and dynamic shapes, by shape row order (moving)
+  std::vector<GridItem> footprints_;  // their footprints, item i: moving_[i] (moving)
+  std::vector<Aabb2> squares_;        // bounding squares, grown (moving)
+  std::vector<int32_t> instances_;    // moving_[i].instance (moving)
+  std::vector<ObjectId> ids_;         // moving_[i].id (moving)
   std::vector<FootprintMemo> footprint_memos_;  // by shape row (shapes)
   std::vector<uint32_t> block_start_;           // Update: first entry of each block of shape rows
   FootprintGrid footprint_grid_;                // with the early-out

@@ -25,7 +25,6 @@ namespace swarmsim::box2d {
 namespace {
 
 using dynamics::CalcHeightRange;
-using dynamics::kHeightOverlap;
 using dynamics::PathAt;
 using dynamics::ShapeAt;
 using dynamics::ThrowIfNotFinite;
@@ -306,10 +305,7 @@ void PlaneWorld::AddShapeObstacles(const Scene& scene, std::span<const uint32_t>
     const ShapeData& shape = scene.shapes()[scene.row_at(s)];
     const Pose& X_WS = scene.world_pose_at(s);
     ThrowIfNotFinite("box2d", scene, s, X_WS);
-    const HeightRange range = CalcHeightRange(shape, X_WS);
-    if (range.hi <= dynamic_range.lo + kHeightOverlap ||
-        range.lo >= dynamic_range.hi - kHeightOverlap)
-      continue;
+    if (!dynamics::ReachesInto(CalcHeightRange(shape, X_WS), dynamic_range)) continue;
     AddObstacle(shape, X_WS, uintptr_t{s} + 1);
   }
 }

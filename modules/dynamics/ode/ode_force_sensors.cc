@@ -34,25 +34,6 @@ void OdeWorld::BuildForceSensors(const Scene& scene, const std::vector<dBodyID>&
   }
 }
 
-dGeomID OdeWorld::MountGeom(const Scene& scene, uint32_t sensor_slot) const {
-  int32_t p = scene.parent_at(sensor_slot);
-  while (p >= 0 && scene.type_at(static_cast<uint32_t>(p)) != ObjectType::kShape)
-    p = scene.parent_at(static_cast<uint32_t>(p));
-  if (p < 0) return nullptr;
-  for (const StaticGeom& g : static_geoms_)
-    if (g.slot == static_cast<uint32_t>(p)) return g.geom;
-  return nullptr;
-}
-
-bool OdeWorld::HeldApart(dGeomID a, dBodyID ba, dGeomID b, dBodyID bb) const {
-  if (ba != nullptr && bb != nullptr) return false;  // bodies: the joint connects them
-  const dGeomID mount = ba == nullptr ? a : b;
-  const dBodyID child = ba == nullptr ? bb : ba;
-  for (const SimForceSensor& f : force_sensors_)
-    if (f.mount == mount && f.child_body == child && f.joint != nullptr) return true;
-  return false;
-}
-
 void OdeWorld::ReadForceSensors(Scene* scene) {
   if (force_sensors_.empty()) return;
   Rows<ForceSensorData>& sensors = *force_sensor::RowsOf(scene);  // Build found some

@@ -572,41 +572,7 @@ void OdeWorld::SyncFromScene(const Scene& scene, double duration) {
     dBodySetAngularVel(b.body, w.x, w.y, w.z);
     b.X_WB_written = X_WB;
   }
-  // A static shape that a script, a path or a joint moved becomes a kinematic
-  // body from where it was, followed like the others from then on: it sweeps
-  // to its new pose over the step and pushes what it meets. A move longer
-  // than a quarter of its size is a jump (a door toggled open, a path's
-  // follower put at the path's start): it is put there, pushing out what it
-  // lands on, not ramming what lies between. One that holds dynamic shapes
-  // in the scene tree always jumps: the scene carries them with it already
-  // (as box2d and planar do), friction would carry them a second time. The
-  // force sensors hanging from it hold on to it.
-  size_t kept = 0;
-  for (const StaticGeom& g : static_geoms_) {
-    if (scene.world_pose_at(g.slot) == g.X_WS) {
-      static_geoms_[kept++] = g;
-      continue;
-    }
-    dBodyID body = dBodyCreate(world_);
-    dBodySetKinematic(body);
-    SetBodyPose(body, g.X_WS);
-    dGeomSetBody(g.geom, body);
-    KinematicBody k{body, g.slot, g.X_WS, g.X_WS, {}, {}};
-    k.jump = 0.25 * scene.shapes()[scene.row_at(g.slot)].BoundingRadius();
-    std::vector<uint32_t> subtree;
-    scene.CollectSubtree(g.slot, &subtree);
-    for (uint32_t s : subtree) {
-      const ShapeData* shape = ShapeAt(scene, s);
-      if (shape != nullptr && shape->dynamic) k.jump = 0;
-    }
-    kinematic_.push_back(k);
-    for (SimForceSensor& f : force_sensors_)
-      if (f.mount == g.geom && f.joint != nullptr) {
-        dJointAttach(f.joint, f.child_body, body);
-        dJointSetFixed(f.joint);
-      }
-  }
-  static_geoms_.resize(kept);
+  FollowStaticGeoms(scene);  // ode_static_geoms.cc
   // Kinematic bodies go from where they were to where the scene has them.
   for (KinematicBody& k : kinematic_) {
     k.X_WB_from = k.X_WB_to;

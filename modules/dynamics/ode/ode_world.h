@@ -134,6 +134,9 @@ class OdeWorld {
   // Moves bodies teleported by scripts and reads the kinematic bodies' new
   // poses (to be reached over `duration` seconds).
   void SyncFromScene(const Scene& scene, double duration);
+  // A static geom whose shape moved becomes a kinematic body (SyncFromScene;
+  // ode_static_geoms.cc).
+  void FollowStaticGeoms(const Scene& scene);
   // Reads the joint commands (targets, forces) that set the motors.
   void ReadCommands(const Scene& scene);
   // One ODE step of `dt`; `fraction` in [0, 1] is how far through the control

@@ -25,7 +25,6 @@ namespace {
 
 using dynamics::CalcHeightRange;
 using dynamics::HeightRange;
-using dynamics::kHeightOverlap;
 using dynamics::PathAt;
 using dynamics::ShapeAt;
 using dynamics::ThrowIfNotFinite;
@@ -278,10 +277,7 @@ void PlanarWorld::PlaceShapeObstacles(const Scene& scene) {
     const ShapeData& shape = scene.shapes()[scene.row_at(s)];
     const Pose& X_WS = scene.world_pose_at(s);
     ThrowIfNotFinite("planar", scene, s, X_WS);
-    const HeightRange range = CalcHeightRange(shape, X_WS);
-    if (range.hi <= dynamic_range_.lo + kHeightOverlap ||
-        range.lo >= dynamic_range_.hi - kHeightOverlap)
-      continue;
+    if (!dynamics::ReachesInto(CalcHeightRange(shape, X_WS), dynamic_range_)) continue;
     AddObstacle(shape, X_WS);
   }
   shape_obstacles_ = obstacles_.size();
