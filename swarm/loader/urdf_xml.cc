@@ -7,6 +7,7 @@
 #include <tuple>
 
 #include "framework/error.h"
+#include "framework/suggest.h"
 #include "swarm/loader/check_text.h"
 #include "swarm/loader/urdf_numbers.h"
 
@@ -63,6 +64,7 @@ UrdfXmlFacts XmlReader::Read(const std::string& bytes) {
   std::map<std::string, std::string> parent_joint;                // child link -> joint
   std::map<std::string, std::string> parent_link;                 // child link -> parent link
   std::vector<std::tuple<std::string, std::string, int>> mimics;  // joint, master, line
+  std::map<std::string, std::string> joint_type;                  // joint -> its type
   // Each visual's <material> (or null), per link in order, resolved below.
   std::vector<std::pair<std::string, const tinyxml2::XMLElement*>> visual_materials;
   int order = 0;
@@ -120,6 +122,7 @@ UrdfXmlFacts XmlReader::Read(const std::string& bytes) {
                        std::to_string(facts_.joint_line[name]) + ")");
       facts_.joint_order[name] = order++;
       const std::string type = e->Attribute("type") ? e->Attribute("type") : "";
+      joint_type[name] = type;
       if (type != "revolute" && type != "continuous" && type != "prismatic" && type != "fixed" &&
           type != "floating" && type != "planar")
         Fail(line, "joint '" + std::string(name) + "': unknown type '" + type +
@@ -198,10 +201,22 @@ UrdfXmlFacts XmlReader::Read(const std::string& bytes) {
     Fail(facts_.link_line[roots[1]], "the robot has several root links ('" + roots[0] + "', '" +
                                          roots[1] +
                                          "'): every link but one must be a joint's child");
-  for (const auto& [joint, master, line] : mimics)
-    if (!facts_.joint_line.contains(master))
+  for (const auto& [joint, master, line] : mimics) {
+    if (!facts_.joint_line.contains(master)) {
+      std::vector<std::string> moving;
+      for (const auto& [other, type] : joint_type)
+        if (other != joint && type != "fixed" && type != "floating") moving.push_back(other);
       Fail(line, "joint '" + joint + "': <mimic joint=\"" + master +
-                     "\"> names a joint the file does not define");
+                     "\"> names a joint the file does not define" + Suggest(master, moving));
+    }
+    if (master == joint) Fail(line, "joint '" + joint + "': <mimic> names the joint itself");
+    const std::string& type = joint_type[master];
+    if (type == "fixed" || type == "floating")
+      Fail(line, "joint '" + joint + "': <mimic joint=\"" + master + "\">: '" + master + "' is a " +
+                     type +
+                     " joint, which has no position to follow (name a revolute, continuous or "
+                     "prismatic joint)");
+  }
   // Colours: a visual's own <color rgba>, else its named material's, a
   // robot-level <material> (the first of a name) or one a visual defined
   // with a colour (urdfdom's rule). rgba's alpha is not imported (0: none).

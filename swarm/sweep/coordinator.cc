@@ -192,8 +192,8 @@ int CoordinateSweep(const SweepOptions& o, RemoteWorkers* remote, std::ostream& 
         throw Error("world file '" + o.world + "' has changed since this sweep began (" +
                     existing->started_at + "); its runs would mix two worlds. Pass " +
                     "--allow-changed-world to continue anyway, or use another --db");
-      err << "warning: world file changed since the sweep began; continuing as asked\n";
-      db.SetWorldHash(world_hash);
+      err << "warning: world file changed since the sweep began; continuing as asked (the "
+          << "runs it runs record its new hash in runs.world_hash; the sweep keeps its first)\n";
     }
     if (const int64_t n = db.ResetInterrupted(); n > 0)
       err << "resuming: " << n << " run" << (n == 1 ? " was" : "s were")
@@ -202,6 +202,7 @@ int CoordinateSweep(const SweepOptions& o, RemoteWorkers* remote, std::ostream& 
     SweepRecord record{o.world, world_hash, space, UtcNow(), Version(), o.command_line};
     db.CreateSweep(record, grid);
   }
+  db.set_run_world_hash(world_hash);
   if (o.retry_failed) {
     if (const int64_t n = db.ResetFailed(); n > 0) err << "retrying " << n << " failed runs\n";
   }
@@ -236,7 +237,8 @@ int CoordinateSweep(const SweepOptions& o, RemoteWorkers* remote, std::ostream& 
         << " (the memory available now, shared by " << side_by_side
         << " runs side by side; sweep --max-memory sets it)\n";
 
-  SweepProgress progress(err, shard_total, already, isatty(STDERR_FILENO) != 0, !o.quiet);
+  SweepProgress progress(err, shard_total, already, db.CountFailed(o.shard_count, o.shard_index),
+                         isatty(STDERR_FILENO) != 0, !o.quiet);
   RunPool pool(config, jobs);
   const std::string me = WorkerName();
   auto next = [&]() -> std::optional<GridRun> {

@@ -21,11 +21,12 @@ std::string Duration(double s) {
 
 }  // namespace
 
-SweepProgress::SweepProgress(std::ostream& os, int64_t total, int64_t already, bool tty,
-                             bool enabled)
+SweepProgress::SweepProgress(std::ostream& os, int64_t total, int64_t already,
+                             int64_t already_failed, bool tty, bool enabled)
     : os_(os),
       total_(total),
       already_(already),
+      already_failed_(already_failed),
       tty_(tty),
       enabled_(enabled),
       start_(std::chrono::steady_clock::now()) {}
@@ -63,8 +64,8 @@ void SweepProgress::Draw(int running, bool force) {
     const int filled = static_cast<int>(frac * kWidth);
     line << "\r\033[K[" << std::string(filled, '#') << std::string(kWidth - filled, ' ') << "] ";
   }
-  line << finished << "/" << total_ << " runs  " << failed_ << " failed  " << left << " left  "
-       << running << " running  elapsed " << Duration(elapsed);
+  line << finished << "/" << total_ << " runs  " << already_failed_ + failed_ << " failed  " << left
+       << " left  " << running << " running  elapsed " << Duration(elapsed);
   if (done_ > 0 && left > 0)
     line << "  ETA " << Duration(elapsed / static_cast<double>(done_) * static_cast<double>(left));
   os_ << line.str() << (tty_ ? "" : "\n") << std::flush;

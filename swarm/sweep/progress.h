@@ -11,8 +11,10 @@ namespace swarmsim {
 
 class SweepProgress {
  public:
-  // `total` runs in the sweep, `already` of them finished before this session.
-  SweepProgress(std::ostream& os, int64_t total, int64_t already, bool tty, bool enabled);
+  // `total` runs in the sweep, `already` of them finished before this
+  // session, `already_failed` of those failed.
+  SweepProgress(std::ostream& os, int64_t total, int64_t already, int64_t already_failed, bool tty,
+                bool enabled);
   // One run ended (ok or failed, with the failure's message).
   void RunEnded(int64_t id, bool ok, const std::string& error, int running);
   void Finish();
@@ -23,7 +25,7 @@ class SweepProgress {
   void Draw(int running, bool force);
 
   std::ostream& os_;
-  int64_t total_, already_;
+  int64_t total_, already_, already_failed_;
   int64_t done_ = 0, failed_ = 0;  // this session, failed included in done
   bool tty_, enabled_;
   std::chrono::steady_clock::time_point start_, last_draw_{};

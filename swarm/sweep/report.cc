@@ -221,6 +221,7 @@ ReportData LoadReport(const std::string& db_path) {
     metrics.insert(m.Text(1));
   }
   d.metric_names.assign(metrics.begin(), metrics.end());
+  d.world_versions = results.WorldVersions();
   return d;
 }
 
@@ -272,6 +273,9 @@ int RunReport(const ReportOptions& o, std::ostream& out, std::ostream& err) {
   out << "sweep of " << d.world << " (started " << d.started_at << ", swarmsim " << d.version
       << "): " << finished << " of " << d.runs.size() << " runs finished, " << failed
       << " failed\n";
+  if (d.world_versions > 1)
+    out << "note: these runs ran " << d.world_versions << " versions of the world file (the "
+        << "sweep was resumed with --allow-changed-world; runs.world_hash tells which)\n";
 
   // Per point: the runs of each parameter combination.
   std::map<int64_t, std::vector<const ReportRun*>> points;

@@ -38,6 +38,7 @@ struct ReportData {
   std::map<std::string, std::string> param_kind;  // list | linear | log
   std::vector<std::string> metric_names;          // sorted
   std::vector<ReportRun> runs;                    // by id
+  int64_t world_versions = 1;  // world files the finished runs ran (--allow-changed-world)
 };
 
 ReportData LoadReport(const std::string& db_path);

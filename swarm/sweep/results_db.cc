@@ -77,7 +77,35 @@ const std::filesystem::path& SweepDatabase(const std::filesystem::path& path) {
 
 ResultsDb::ResultsDb(const std::filesystem::path& path, bool read_only)
     : db_(SweepDatabase(path), read_only) {
-  if (!read_only) db_.Exec(kSchema);
+  if (read_only) return;
+  db_.Exec(kSchema);
+  // Databases of sweeps from before runs recorded their world file's hash.
+  if (!HasColumn(&db_, "main", "runs", "world_hash"))
+    db_.Exec("ALTER TABLE runs ADD COLUMN world_hash TEXT");
+}
+
+bool HasColumn(SqliteDb* db, const std::string& schema, const std::string& table,
+               const std::string& column) {
+  SqliteStatement q(db, "PRAGMA " + schema + ".table_info(" + table + ")");
+  while (q.Step())
+    if (q.Text(1) == column) return true;
+  return false;
+}
+
+int64_t ResultsDb::CountFailed(int count, int index) {
+  SqliteStatement q(&db_, "SELECT count(*) FROM runs WHERE status = 'failed' AND (id - 1) % ? = ?");
+  q.Bind(1, static_cast<int64_t>(count)).Bind(2, static_cast<int64_t>(index));
+  q.Step();
+  return q.Int(0);
+}
+
+int64_t ResultsDb::WorldVersions() {
+  if (!HasColumn(&db_, "main", "runs", "world_hash")) return 1;
+  SqliteStatement q(&db_,
+                    "SELECT count(DISTINCT coalesce(r.world_hash, s.world_hash)) FROM runs r, "
+                    "sweep s WHERE r.status IN ('ok', 'failed')");
+  q.Step();
+  return q.Int(0);
 }
 
 std::optional<SweepRecord> ResultsDb::ReadSweep() {
@@ -107,11 +135,6 @@ void ResultsDb::CreateSweep(const SweepRecord& sweep, const std::vector<GridRun>
       p.Bind(1, run.id).Bind(2, name).Bind(3, value).Run();
   }
   txn.Commit();
-}
-
-void ResultsDb::SetWorldHash(const std::string& hash) {
-  SqliteStatement s(&db_, "UPDATE sweep SET world_hash = ?");
-  s.Bind(1, hash).Run();
 }
 
 int64_t ResultsDb::ResetInterrupted() {
@@ -185,7 +208,8 @@ void ResultsDb::Complete(const RunOutcome& o) {
   del_s.Bind(1, o.id).Run();
   SqliteStatement u(&db_,
                     "UPDATE runs SET status = ?, error = ?, wall_s = ?, steps = ?, robots = ?, "
-                    "state_hash = ?, worker = coalesce(?, worker), finished_at = ? WHERE id = ?");
+                    "state_hash = ?, worker = coalesce(?, worker), finished_at = ?, world_hash = ? "
+                    "WHERE id = ?");
   u.Bind(1, std::string(o.ok ? "ok" : "failed"));
   if (o.ok)
     u.BindNull(2);
@@ -200,7 +224,12 @@ void ResultsDb::Complete(const RunOutcome& o) {
     u.BindNull(7);
   else
     u.Bind(7, o.worker);
-  u.Bind(8, UtcNow()).Bind(9, o.id).Run();
+  u.Bind(8, UtcNow());
+  if (run_world_hash_.empty())
+    u.BindNull(9);
+  else
+    u.Bind(9, run_world_hash_);
+  u.Bind(10, o.id).Run();
   SqliteStatement m(&db_, "INSERT INTO final_metrics (run, metric, value) VALUES (?, ?, ?)");
   for (const auto& [name, value] : o.final_metrics)
     m.Bind(1, o.id).Bind(2, name).Bind(3, value).Run();

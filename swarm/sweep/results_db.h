@@ -69,7 +69,15 @@ class ResultsDb {
   std::optional<SweepRecord> ReadSweep();
   // Creates the tables, the sweep row and one pending row per run (one transaction).
   void CreateSweep(const SweepRecord& sweep, const std::vector<GridRun>& runs);
-  void SetWorldHash(const std::string& hash);
+  // The world file's hash each run completed from now on is stored with
+  // (runs.world_hash): a sweep resumed with --allow-changed-world keeps its
+  // first hash in the sweep row and records which runs ran the edited file.
+  void set_run_world_hash(std::string hash) { run_world_hash_ = std::move(hash); }
+  // How many runs of shard `index` of `count` (ids (id - 1) % count == index) failed.
+  int64_t CountFailed(int count, int index);
+  // How many different world files the finished runs ran (runs.world_hash,
+  // a run without one counted as the sweep's first).
+  int64_t WorldVersions();
   // running -> pending; returns how many.
   int64_t ResetInterrupted();
   // failed -> pending; returns how many.
@@ -85,7 +93,12 @@ class ResultsDb {
 
  private:
   SqliteDb db_;
+  std::string run_world_hash_;
 };
+
+// Whether `table` (of schema `schema`: "main", or an attached one) has `column`.
+bool HasColumn(SqliteDb* db, const std::string& schema, const std::string& table,
+               const std::string& column);
 
 // Current UTC time as ISO 8601.
 std::string UtcNow();

@@ -58,11 +58,16 @@ int RunMerge(const std::string& out_db, const std::vector<std::string>& inputs,
     dup.Reset();
     db.Exec("DELETE FROM main.final_metrics WHERE run IN (SELECT id FROM take)");
     db.Exec("DELETE FROM main.series WHERE run IN (SELECT id FROM take)");
+    // The world file each run ran: its own record, or (a sweep from before
+    // runs recorded one) its sweep's.
+    const std::string world_hash = HasColumn(&db, "src", "runs", "world_hash")
+                                       ? "coalesce(world_hash, (SELECT world_hash FROM src.sweep))"
+                                       : "(SELECT world_hash FROM src.sweep)";
     db.Exec(
         "UPDATE main.runs SET (status, error, wall_s, steps, robots, state_hash, attempts, "
-        "worker, started_at, finished_at) = (SELECT status, error, wall_s, steps, robots, "
-        "state_hash, attempts, worker, started_at, finished_at FROM src.runs s WHERE s.id = "
-        "runs.id) WHERE id IN (SELECT id FROM take)");
+        "worker, started_at, finished_at, world_hash) = (SELECT status, error, wall_s, steps, "
+        "robots, state_hash, attempts, worker, started_at, finished_at, " +
+        world_hash + " FROM src.runs s WHERE s.id = runs.id) WHERE id IN (SELECT id FROM take)");
     db.Exec(
         "INSERT INTO main.final_metrics SELECT * FROM src.final_metrics WHERE run IN "
         "(SELECT id FROM take)");

@@ -36,7 +36,7 @@ TEST(UrdfXmlTest, RecordsTheLinesMessagesName) {
                       "  <joint name=\"jb\" type=\"continuous\"><parent link=\"a\"/><child "
                       "link=\"b\"/>\n"                           // 14
                       "    <mimic joint=\"ja\"/>\n  </joint>\n"  // 15, 16
-                      "  <joint name=\"ja\" type=\"fixed\"><parent link=\"base\"/><child "
+                      "  <joint name=\"ja\" type=\"continuous\"><parent link=\"base\"/><child "
                       "link=\"a\"/>"
                       "</joint>\n</robot>\n",  // 17
                   "r.urdf");
@@ -153,6 +153,25 @@ TEST(UrdfXmlTest, StructuralMistakesNameTheFileAndTheLine) {
                  "<mimic joint=\"nobody\"/><limit lower=\"-1\" upper=\"1\" effort=\"1\" "
                  "velocity=\"1\"/></joint>\n</robot>\n"),
       "r.urdf:5: joint 'j': <mimic joint=\"nobody\"> names a joint the file does not define");
+  // A mimic of a fixed joint (merged away: nothing to follow) or of itself is
+  // named at its <mimic>, not as a path the started world cannot find.
+  const std::string two_joints =
+      "  <link name=\"a\"/>\n  <link name=\"b\"/>\n  <link name=\"c\"/>\n"
+      "  <joint name=\"weld\" type=\"fixed\"><parent link=\"a\"/><child link=\"b\"/>"
+      "</joint>\n"
+      "  <joint name=\"j\" type=\"revolute\"><parent link=\"b\"/><child link=\"c\"/>\n"
+      "    <mimic joint=\"MASTER\"/><limit lower=\"-1\" upper=\"1\" effort=\"1\" "
+      "velocity=\"1\"/></joint>\n</robot>\n";
+  auto with_master = [&](const std::string& master) {
+    std::string body = two_joints;
+    body.replace(body.find("MASTER"), 6, master);
+    return body;
+  };
+  EXPECT_CONTAINS(ErrorOfXml(with_master("weld")),
+                  "r.urdf:8: joint 'j': <mimic joint=\"weld\">: 'weld' is a fixed joint, which "
+                  "has no position to follow");
+  EXPECT_CONTAINS(ErrorOfXml(with_master("j")),
+                  "r.urdf:8: joint 'j': <mimic> names the joint itself");
   EXPECT_CONTAINS(ErrorOfXml("  <link name=\"a\"/>\n  <link name=\"b\"/>\n"
                              "  <joint name=\"j\" type=\"prismatic\"><parent link=\"a\"/>"
                              "<child link=\"b\"/></joint>\n</robot>\n"),

@@ -262,6 +262,54 @@ TEST(SweepTest, SameSeedSameHashAsRunAndChangedWorldIsRefused) {
   fs::remove_all(dir);
 }
 
+// A sweep resumed with --allow-changed-world keeps its first world hash, so
+// the original file resumes it again without the flag; each run records the
+// world it ran and `report` says the runs mixed two versions.
+TEST(SweepTest, AllowedChangedWorldKeepsTheSweepsFirstWorldAndRecordsEachRuns) {
+  const fs::path dir = TempDir("changed");
+  for (const char* f : {"sweep.yaml", "bot.yaml", "bot.lua"})
+    fs::copy_file(fs::path(SWARMSIM_SOURCE_DIR) / "tests/data/sweep" / f, dir / f);
+  const std::string world = (dir / "sweep.yaml").string();
+  const std::string original = ReadText(world);
+  const fs::path db = dir / "r.db";
+  const std::string grid = " --param robots=2,5 --seeds 3-4 --steps 4 --db " + db.string();
+  Result r = RunProgram("sweep " + world + grid + " --shard 0/2 --quiet");  // runs 1 and 3
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ofstream(world, std::ios::app) << "# edited\n";
+  r = RunProgram("sweep " + world + grid + " --allow-changed-world");  // runs 2 and 4
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("world file changed since the sweep began"), std::string::npos)
+      << r.output;
+  EXPECT_EQ(Count(db, "SELECT count(DISTINCT world_hash) FROM runs"), 2);
+  EXPECT_EQ(Count(db, "SELECT count(*) FROM runs r, sweep s WHERE r.world_hash = s.world_hash"), 2)
+      << "the sweep keeps the first file's hash, runs 1 and 3 ran it";
+  // The original file resumes the sweep without the flag (it was refused
+  // when the flag replaced the sweep's hash).
+  std::ofstream(world, std::ios::trunc) << original;
+  r = RunProgram("sweep " + world + grid);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("4 already finished, 0 to run"), std::string::npos) << r.output;
+  r = RunProgram("report " + db.string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("note: these runs ran 2 versions of the world file"), std::string::npos)
+      << r.output;
+  fs::remove_all(dir);
+}
+
+// Resuming a sweep whose runs failed counts those failures in its progress.
+TEST(SweepTest, ProgressCountsTheFailuresOfBeforeAResume) {
+  const fs::path dir = TempDir("failed_before");
+  const fs::path db = dir / "r.db";
+  const std::string cmd = "sweep " + kWorld + " --param fail_at=-1,0.1 --seeds 1 --steps 4 --db " +
+                          db.string() + " --jobs 1";
+  Result r = RunProgram(cmd + " --quiet");
+  ASSERT_EQ(r.exit_code, 1) << r.output;
+  r = RunProgram(cmd);  // nothing to run: the progress line is the database's
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("2/2 runs  1 failed  0 left"), std::string::npos) << r.output;
+  fs::remove_all(dir);
+}
+
 TEST(CoordinatorTest, TheWorldHashFollowsTheFilesBytes) {
   const fs::path dir = TempDir("world_hash");
   // 16 hex digits, the same for the same bytes wherever they are.

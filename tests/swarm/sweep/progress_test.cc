@@ -21,7 +21,7 @@ std::vector<std::string> Lines(const std::string& text) {
 
 TEST(SweepProgressTest, PlainLinesEveryFivePercentAndAtEachFailure) {
   std::ostringstream out;
-  SweepProgress progress(out, 40, 0, /*tty=*/false, /*enabled=*/true);
+  SweepProgress progress(out, 40, 0, 0, /*tty=*/false, /*enabled=*/true);
   for (int64_t id = 1; id <= 40; ++id) progress.RunEnded(id, id != 7, "boom", 2);
   progress.Finish();
   EXPECT_EQ(progress.done(), 40);
@@ -44,16 +44,18 @@ TEST(SweepProgressTest, PlainLinesEveryFivePercentAndAtEachFailure) {
 
 TEST(SweepProgressTest, RunsFinishedBeforeCountAsDone) {
   std::ostringstream out;
-  SweepProgress progress(out, 10, 6, /*tty=*/false, /*enabled=*/true);
+  SweepProgress progress(out, 10, 6, /*already_failed=*/2, /*tty=*/false, /*enabled=*/true);
   progress.RunEnded(7, true, "", 1);
   EXPECT_EQ(progress.done(), 1) << "this session's";
-  EXPECT_EQ(Lines(out.str()).back().rfind("7/10 runs  0 failed  3 left  1 running", 0), 0u)
-      << out.str();
+  EXPECT_EQ(Lines(out.str()).back().rfind("7/10 runs  2 failed  3 left  1 running", 0), 0u)
+      << "the failures of before count too: " << out.str();
+  progress.RunEnded(8, false, "boom", 0);
+  EXPECT_EQ(Lines(out.str()).back().rfind("8/10 runs  3 failed  2 left", 0), 0u) << out.str();
 }
 
 TEST(SweepProgressTest, ATerminalGetsABarRedrawnInPlace) {
   std::ostringstream out;
-  SweepProgress progress(out, 3, 0, /*tty=*/true, /*enabled=*/true);
+  SweepProgress progress(out, 3, 0, 0, /*tty=*/true, /*enabled=*/true);
   progress.RunEnded(1, false, "crashed", 1);  // a failure draws at once
   const std::string text = out.str();
   EXPECT_EQ(text.rfind("\r\033[Krun 1 failed: crashed\n\r\033[K[" + std::string(10, '#') +
@@ -68,7 +70,7 @@ TEST(SweepProgressTest, ATerminalGetsABarRedrawnInPlace) {
 
 TEST(SweepProgressTest, QuietPrintsNothingButCounts) {
   std::ostringstream out;
-  SweepProgress progress(out, 5, 0, /*tty=*/false, /*enabled=*/false);
+  SweepProgress progress(out, 5, 0, 0, /*tty=*/false, /*enabled=*/false);
   progress.RunEnded(1, false, "boom", 1);
   progress.RunEnded(2, true, "", 1);
   progress.Finish();

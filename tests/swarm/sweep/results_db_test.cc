@@ -48,8 +48,6 @@ TEST(ResultsDbTest, ASweepIsItsRecordAndOnePendingRunPerGridRun) {
     EXPECT_EQ(record->started_at, kRecord.started_at);
     EXPECT_EQ(record->version, kRecord.version);
     EXPECT_EQ(record->command, kRecord.command);
-    db.SetWorldHash("fedcba9876543210");
-    EXPECT_EQ(db.ReadSweep()->world_hash, "fedcba9876543210");
     const RunCounts c = db.Counts();
     EXPECT_EQ(c.total, 4);
     EXPECT_EQ(c.pending, 4);
@@ -75,6 +73,36 @@ TEST(ResultsDbTest, ASweepIsItsRecordAndOnePendingRunPerGridRun) {
   ResultsDb reader(dir / "other.db", /*read_only=*/true);
   EXPECT_FALSE(reader.ReadSweep().has_value());
   fs::remove_all(dir);
+}
+
+// A sweep's database from before runs recorded their world file gains the
+// column when a sweep opens it; runs completed then record the file's hash.
+TEST(ResultsDbTest, AnOlderDatabaseGainsEachRunsWorldHash) {
+  const fs::path dir = TempDir("results_older");
+  const fs::path file = dir / "r.db";
+  {
+    ResultsDb db(file);
+    db.CreateSweep(kRecord, Runs());
+    db.db().Exec("ALTER TABLE runs DROP COLUMN world_hash");  // as an older version made it
+  }
+  ResultsDb db(file);
+  EXPECT_EQ(Count(file, "SELECT count(*) FROM pragma_table_info('runs') WHERE name = 'world_hash'"),
+            1);
+  EXPECT_EQ(db.WorldVersions(), 0) << "no run finished yet";
+  RunOutcome first;
+  first.id = 1;
+  first.ok = true;
+  db.Complete(first);  // no hash given: counted as the sweep's
+  db.set_run_world_hash(kRecord.world_hash);
+  first.id = 2;
+  db.Complete(first);
+  EXPECT_EQ(db.WorldVersions(), 1);
+  db.set_run_world_hash("00000000000000ff");
+  first.id = 3;
+  db.Complete(first);
+  EXPECT_EQ(db.WorldVersions(), 2);
+  EXPECT_EQ(Count(file, "SELECT count(*) FROM runs WHERE world_hash = '00000000000000ff'"), 1);
+  EXPECT_EQ(db.CountFailed(1, 0), 0);
 }
 
 TEST(ResultsDbTest, CompletedRunsKeepTheirOutcomeMetricsAndSeries) {
