@@ -191,8 +191,16 @@ int Build(const BuildOptions& options) {
   if (!fs::exists(root / "framework" / "plugin_api.h", ec)) root = folder;
   TempFolder temp;
   const std::string cc = Tool("CC", "cc");
-  const std::vector<std::string> common = {
-      "-fPIC", "-O2", "-fno-common", "-g0", "-DSWARMSIM_KILOBOT=1", "-I" + include.string()};
+  // -fstack-clash-protection: a frame larger than a page touches each page
+  // in turn, so a large local array meets the guard page below a robot's
+  // stack (a stack overflow, named) instead of writing past it.
+  const std::vector<std::string> common = {"-fPIC",
+                                           "-O2",
+                                           "-fno-common",
+                                           "-g0",
+                                           "-fstack-clash-protection",
+                                           "-DSWARMSIM_KILOBOT=1",
+                                           "-I" + include.string()};
   const auto compile = [&](const fs::path& file, const fs::path& object,
                            const std::vector<std::string>& extra) {
     std::vector<std::string> argv = {cc};
@@ -250,6 +258,7 @@ int Build(const BuildOptions& options) {
                                          host.string(),
                                          "-Wl,--version-script=" + exports.string(),
                                          "-Wl,-z,now",
+                                         "-Wl,--no-undefined",
                                          "-pthread",
                                          "-lm",
                                          "-ldl"};

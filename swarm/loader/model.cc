@@ -1,5 +1,8 @@
 #include "swarm/loader/model.h"
 
+#include <lauxlib.h>
+#include <lua.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -7,6 +10,7 @@
 #include <map>
 
 #include "framework/error.h"
+#include "framework/lua_evaluator.h"
 #include "framework/object_type.h"
 #include "framework/registry.h"
 #include "swarm/loader/object_reader.h"
@@ -366,6 +370,18 @@ std::shared_ptr<const ScriptSource> ScriptCache::Get(const fs::path& path, const
   auto source = std::make_shared<ScriptSource>();
   source->path = DisplayPath(path);
   source->code = ReadFileOrThrow(path, "script file", where, text);
+  // A script that does not parse is the world's error, found as it loads
+  // (exit 2, the file's line), not at start as every robot's.
+  {
+    LimitedLua lua{"the script's syntax check", size_t{256} << 20, 1000};
+    // Chunk "?", named in full below (Lua shortens long chunk names).
+    if (luaL_loadbufferx(lua.L(), source->code.data(), source->code.size(), "=?", "t") != LUA_OK) {
+      const char* text = lua_tostring(lua.L(), -1);
+      std::string message = text != nullptr ? text : "?: does not parse";
+      if (message.starts_with("?:")) message.replace(0, 1, source->path);
+      throw Error(where + ": script " + message);
+    }
+  }
   sources_.emplace(key, source);
   return source;
 }

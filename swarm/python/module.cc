@@ -14,6 +14,7 @@
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdint>
 #include <exception>
 #include <map>
@@ -199,13 +200,33 @@ void StepWorlds(const py::sequence& worlds, const py::object& count, int threads
       throw std::runtime_error(name(i) + e.what());
     }
   }
-  {
-    py::gil_scoped_release release;
-    WorldsScheduler(threads).ParallelFor(0, static_cast<int64_t>(k), 1, [&](int64_t b, int64_t e) {
-      for (int64_t i = b; i < e; ++i) list[i]->RunSteps(n);
-    });
+  // In rounds of a few steps each (as many as take about 0.1 s): between
+  // rounds, with the GIL, Ctrl-C is seen (Lua worlds never see Python's
+  // signals) and a controller's KeyboardInterrupt stops every world, not
+  // only its own. A world steps the same whatever the rounds.
+  TaskScheduler& scheduler = WorldsScheduler(threads);
+  std::optional<py::error_already_set> signal;
+  for (int64_t done = 0, chunk = 1; done < n;) {
+    const int64_t steps = std::min(chunk, n - done);
+    const auto start = std::chrono::steady_clock::now();
+    {
+      py::gil_scoped_release release;
+      scheduler.ParallelFor(0, static_cast<int64_t>(k), 1, [&](int64_t b, int64_t e) {
+        for (int64_t i = b; i < e; ++i) list[i]->RunSteps(steps);
+      });
+    }
+    done += steps;
+    if (std::chrono::steady_clock::now() - start < std::chrono::milliseconds(100) &&
+        chunk < (int64_t{1} << 40))
+      chunk *= 2;
+    if (PyErr_CheckSignals() != 0) {
+      signal.emplace();  // takes the pending KeyboardInterrupt (or the handler's error)
+      break;
+    }
+    if (std::any_of(list.begin(), list.end(), [](PyWorld* w) { return w->gate()->interrupted(); }))
+      break;
   }
-  // Metrics of every world, then the first world's interrupt or error.
+  // Metrics of every world, then Ctrl-C, or the first world's interrupt or error.
   std::exception_ptr first;
   for (size_t i = 0; i < k; ++i) {
     try {
@@ -213,6 +234,10 @@ void StepWorlds(const py::sequence& worlds, const py::object& count, int threads
     } catch (...) {
       if (!first) first = std::current_exception();
     }
+  }
+  if (signal) {
+    PyErr_Clear();
+    throw *signal;
   }
   if (first) std::rethrow_exception(first);
   if (PyErr_CheckSignals() != 0) throw py::error_already_set();

@@ -534,6 +534,43 @@ class DeclarationTest(unittest.TestCase):
             venv.reset(seed=[1, 2.0])
         venv.close()
 
+    def test_declarations_found_wrong_by_qa_are_refused_at_construction(self):
+        # A scale that is not finite made every step fail, blaming the controller.
+        for scale in (float("nan"), float("inf"), 1e308):
+            with self.assertRaisesRegex(ValueError, r"^actions: scale must be finite"):
+                make(2, actions=senv.JointTargets(scale=scale, high=10.0))
+        # 10**9 neighbours allocated 22 GiB per read.
+        with self.assertRaisesRegex(ValueError, r"neighbours=\.\.\.\) must be 1 to 10000"):
+            senv.range_and_bearing(neighbours=10**9)
+        self.assertEqual(senv.range_and_bearing(4.0).name, "range_and_bearing")
+        with self.assertRaisesRegex(TypeError, r"^max_steps .* must be an integer >= 1, got True"):
+            make(2, max_steps=True)
+        with self.assertRaisesRegex(TypeError, r"^max_steps .*got 'x'"):
+            make(2, max_steps="x")
+        self.assertEqual(make(2, max_steps=20.0).max_steps, 20)
+        with self.assertRaisesRegex(ValueError, r"^step_threads is 0 \(every core\) or 1 to 256"):
+            senv.VectorEnv(DIFFUSION, 2, set={"robots": 2}, step_threads=999)
+        env = make(2)
+        with self.assertRaisesRegex(TypeError, r"^reset: options must be a dict"):
+            env.reset(options=[1])
+        env.close()
+        # A closed environment says so, rather than handing out None or zeros.
+        for read in (lambda: env.world, env.state):
+            with self.assertRaisesRegex(RuntimeError, "the environment is closed"):
+                read()
+
+    def test_a_block_whose_width_changes_is_an_error_not_a_broadcast(self):
+        calls = [0]
+
+        def shrinking(world, model):
+            calls[0] += 1
+            return np.full((len(world.poses(model)), 2 if calls[0] == 1 else 1), 1.0)
+        env = make(3, observations=[senv.Observation("mine", shrinking)])
+        with self.assertRaisesRegex(ValueError, r"observation 'mine': read\(\) returned shape "
+                                                r"\(3, 1\), expected \(3, 2\)"):
+            env.reset(seed=1)
+        env.close()
+
     def test_pose_block_is_the_worlds_pose(self):
         env = make(5, observations=["pose"])
         obs, _ = env.reset(seed=2)
@@ -789,6 +826,38 @@ v.close()
 assert v.closed
 print("ok")
 """
+
+
+class ThreadsTest(unittest.TestCase):
+    def test_a_second_thread_inside_an_environment_is_refused_and_nothing_is_lost(self):
+        # Two threads stepping one VectorEnv lost steps and desynchronised its episodes.
+        import threading
+        armed, inside, release = threading.Event(), threading.Event(), threading.Event()
+
+        def slow(world, model):
+            if armed.is_set():
+                inside.set()
+                release.wait(30)
+            return np.zeros((len(world.poses(model)), 1))
+        venv = senv.VectorEnv(DIFFUSION, 2, set={"robots": 3}, max_steps=50,
+                              observations=["proximity", senv.Observation("slow", slow)])
+        venv.reset(seed=1)
+        actions = np.zeros((2, 3, 2))
+        armed.set()
+        worker = threading.Thread(target=venv.step, args=(actions,))
+        worker.start()
+        self.assertTrue(inside.wait(30))
+        armed.clear()
+        for call in (lambda: venv.step(actions), lambda: venv.reset(seed=2), venv.close):
+            with self.assertRaisesRegex(RuntimeError, "another thread is inside a call of this "
+                                                      "environment"):
+                call()
+        release.set()
+        worker.join()
+        venv.step(actions)  # the first thread's call is over: this one may go in
+        self.assertEqual(list(venv.episode_steps), [2, 2])
+        self.assertEqual([w.steps for w in venv.worlds], [3, 3])
+        venv.close()
 
 
 class LibrariesTest(unittest.TestCase):

@@ -37,6 +37,24 @@ class StepWorldsTest(unittest.TestCase):
             self.assertEqual([w.steps for w in worlds], [15] * 6)
         self.assertEqual(len(set(expected)), 6, "the seeds give different worlds")
 
+    def test_ctrl_c_stops_every_world_soon_and_they_stay_usable(self):
+        # Lua worlds never see Python's signals: step_worlds ran all its steps first.
+        import os
+        import signal
+        import threading
+        worlds = [make(seed, robots=30) for seed in range(2)]
+        n = 20000
+        timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
+        with self.assertRaises(KeyboardInterrupt):
+            timer.start()
+            swarmsim.step_worlds(worlds, n, threads=2)
+        timer.join()
+        steps = [w.steps for w in worlds]
+        self.assertTrue(all(0 < s < n for s in steps), steps)
+        for w in worlds:
+            w.step(1)  # usable after the interrupt
+        self.assertEqual([w.steps for w in worlds], [s + 1 for s in steps])
+
     def test_metrics_are_taken_as_by_step(self):
         a, b = make(3), make(3)
         a.step(20)

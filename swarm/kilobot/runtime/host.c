@@ -32,6 +32,7 @@
 #include <setjmp.h>
 #include <signal.h>
 #include <stdatomic.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -522,9 +523,12 @@ static void Failure(const SwarmsimCallContext *c, int sig, const char *what, cha
   const char *address = (const char *)ts->fault_address;
   int overflow = sig == SIGSEGV && ts->stack_low != NULL && address != NULL &&
                  address < ts->stack_low + 65536 && address + 65536 * 16 > ts->stack_low;
-  if (co != NULL && sig == SIGSEGV && address >= co->map &&
-      address < co->map + (co->map_size - kStackSize))
-    overflow = 1; /* the coroutine's guard page */
+  /* The coroutine's guard page, or below it: a large local array jumps
+     past the guard page (up to 1 MiB counted as the stack's). */
+  const uintptr_t at = (uintptr_t)address, guard = (uintptr_t)(co != NULL ? co->map : NULL);
+  if (co != NULL && sig == SIGSEGV && address != NULL && at < guard + (co->map_size - kStackSize) &&
+      at + (1u << 20) > guard)
+    overflow = 1;
   snprintf(error, size, "%s (kilobot program '%s'), robot %d: %s%s in %s", KILOBOT_SOURCE,
            KILOBOT_NAME, c->robot, SignalText(sig), overflow ? " (stack overflow)" : "", what);
 }
@@ -608,8 +612,17 @@ static int Init(const SwarmsimCallContext *c, void **state, char *error, size_t 
   hard_seed = hard_seed << 32 | (uint64_t)(uniform(c->world, c->robot) * 4294967296.0);
   r->backoff_state = hard_seed ^ 0x5851f42d4c957f2dULL;
   r->last_time = c->api->time(c->world);
+  /* -1: the robot's index (modulo 65536 past 65,535 robots, as a
+     uint16_t takes it); else a whole number that fits a uint16_t. */
   double uid = Param(c, "kilo_uid", -1);
-  if (uid < 0) uid = c->robot;
+  if (uid != -1 && !(uid >= 0 && uid <= 65535 && uid == floor(uid))) {
+    snprintf(error, error_size,
+             "parameter kilo_uid is %g: a kilo_uid is a whole number 0..65535 (uint16_t), or -1 "
+             "for the robot's index",
+             uid);
+    return -1;
+  }
+  if (uid == -1) uid = c->robot % 65536;
 
   /* The program's main(): kilo_init, callbacks, kilo_start. */
   const kilobot_copy_t *t = copy->table;

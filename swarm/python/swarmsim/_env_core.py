@@ -381,7 +381,7 @@ class Core:
                     view = raw[k]
                     got = item.read(w, self.model, view)
                     if got is not view:
-                        view[...] = got
+                        view[...] = _read_shape(item, got, view.shape)
                 view = self.poses[k]
                 got = w.poses(self.model, out=view)
                 if got is not view:
@@ -389,8 +389,9 @@ class Core:
             else:
                 has = slot.row_of >= 0
                 rows = slot.row_of[has]
-                for (item, _, _, _), raw in zip(self.blocks, self.raw):
-                    got = np.asarray(item.read(w, self.model, None))
+                for (item, width, _, _), raw in zip(self.blocks, self.raw):
+                    got = item.read(w, self.model, None)
+                    got = _read_shape(item, got, (None, width))  # robots come and go
                     if len(rows):
                         raw[k][has] = got[rows]
                 if len(rows):
@@ -465,6 +466,21 @@ class Core:
                 slot.world.close()
                 slot.world = None
         self.closed = True
+
+
+def _read_shape(item, got, shape):
+    """`got`, a read() result, as an array of exactly `shape` (None: any length there; no
+    broadcasting: a block whose width changed would be filled with the wrong columns)."""
+    array = np.asarray(got)
+    if np.iscomplexobj(array):
+        raise TypeError(f"observation '{item.name}': read() returned complex numbers")
+    if array.ndim != len(shape) or any(want is not None and got_n != want
+                                       for got_n, want in zip(array.shape, shape)):
+        expected = tuple("robots" if n is None else n for n in shape)
+        raise ValueError(f"observation '{item.name}': read() returned shape {array.shape}, "
+                         f"expected {expected} (one row per robot, as many columns as its "
+                         f"first read)")
+    return array
 
 
 def _file_seed(world):

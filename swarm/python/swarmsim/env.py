@@ -37,6 +37,10 @@ declarations:
 See swarm/python/README.md for the full reference.
 """
 
+import functools
+import threading
+from collections.abc import Mapping
+
 import numpy as np
 
 from . import spaces
@@ -172,12 +176,61 @@ def joint_velocities():
                        takes_out=True)
 
 
+_MAX_NEIGHBOURS = 10000
+
+# An environment is used by one thread at a time (as Gymnasium's and PettingZoo's are): a
+# second thread calling in while one is inside is refused, not interleaved (two threads
+# stepping one VectorEnv lost steps and desynchronised its episodes). One lock for every
+# environment guards the check; the environment holds only the caller's thread id.
+_CALLS = threading.Lock()
+
+
+def _one_thread_at_a_time(method):
+    @functools.wraps(method)
+    def call(self, *args, **kwargs):
+        me = threading.get_ident()
+        with _CALLS:
+            owner, depth = self.__dict__.get("_caller", (None, 0))
+            if owner is not None and owner != me:
+                raise RuntimeError(
+                    f"{type(self).__name__}.{method.__name__}(): another thread is inside a "
+                    f"call of this environment; use each environment from one thread at a "
+                    f"time (one environment per thread, or a lock around its calls)")
+            self.__dict__["_caller"] = (me, depth + 1)
+        try:
+            return method(self, *args, **kwargs)
+        finally:
+            with _CALLS:
+                owner, depth = self.__dict__["_caller"]
+                self.__dict__["_caller"] = (None, 0) if depth == 1 else (owner, depth - 1)
+    return call
+
+
+def _options(options):
+    """reset's options as a new dict: a mapping or None, else TypeError."""
+    if options is None:
+        return {}
+    if not isinstance(options, Mapping):
+        raise TypeError(f"reset: options must be a dict (or None), got "
+                        f"{type(options).__name__}")
+    return dict(options)
+
+
+def _count(value, what, minimum=0):
+    """`value` as an int: a whole number (an int, or a float such as 100.0; not a bool or a
+    string) of at least `minimum`; else TypeError or ValueError naming `what`."""
+    if isinstance(value, (float, np.floating)) and np.isfinite(value) and value == int(value):
+        value = int(value)
+    return whole_number(value, what, minimum)
+
+
 def range_and_bearing(neighbours=4):
     """What the robot's first range-and-bearing board heard, the nearest `neighbours` first:
     for each, (heard 0/1, range m, bearing rad in [-pi, pi]); zeros past what it heard."""
-    k = int(neighbours)
-    if k < 1:
-        raise ValueError(f"range_and_bearing(neighbours=...) must be >= 1, got {neighbours}")
+    k = _count(neighbours, "range_and_bearing(neighbours=...)", minimum=1)
+    if k > _MAX_NEIGHBOURS:
+        raise ValueError(f"range_and_bearing(neighbours=...) must be 1 to {_MAX_NEIGHBOURS} "
+                         f"(3 columns each per robot), got {neighbours}")
 
     def read(world, model):
         rab = world.range_and_bearing(model)
@@ -250,6 +303,12 @@ class JointTargets:
                 np.isfinite(bound.high)):
             raise ValueError(f"actions: bounds must be finite with low <= high, got "
                              f"low={self.low}, high={self.high}")
+        with np.errstate(over="ignore", invalid="ignore"):
+            finite = np.isfinite(bound.scale) & np.isfinite(bound.low * bound.scale) & np.isfinite(
+                bound.high * bound.scale)
+        if not np.all(finite):
+            raise ValueError(f"actions: scale must be finite, and low x scale and high x scale "
+                             f"too, got scale={self.scale}")
         return bound
 
     def targets(self, actions):
@@ -336,9 +395,12 @@ def _spec(world, observations, actions, reward, terminate, max_steps, model, see
         raise TypeError(f"actions: a JointTargets (or wheel_speeds()), got {actions!r}")
     if terminate is not None and not callable(terminate):
         raise TypeError("terminate: a function (world, agents) -> bools, or None")
-    if max_steps is not None and max_steps != "world" and (int(max_steps) != max_steps
-                                                          or max_steps < 1):
-        raise ValueError(f"max_steps: a number of steps >= 1, 'world' or None, got {max_steps}")
+    if max_steps is not None and not (isinstance(max_steps, str) and max_steps == "world"):
+        max_steps = _count(max_steps, "max_steps (a number of steps, 'world' or None)",
+                           minimum=1)
+    step_threads = _count(step_threads, "step_threads (0: every core)")
+    if step_threads > 256:
+        raise ValueError(f"step_threads is 0 (every core) or 1 to 256, got {step_threads}")
     if seed is not None:
         seed = whole_number(seed, "seed")
     return {
@@ -446,6 +508,8 @@ class ParallelEnv(_AgentsOfAModel, _ParallelBase):
     @property
     def world(self):
         """The swarmsim.World being stepped (read any array from it; do not step it)."""
+        if self._core.closed:
+            raise RuntimeError("the environment is closed")
         return self._core.slots[0].world
 
     @property
@@ -475,6 +539,7 @@ class ParallelEnv(_AgentsOfAModel, _ParallelBase):
         except KeyError:
             raise KeyError(f"no agent {agent!r} (agents are {self.possible_agents[:3]}...)")
 
+    @_one_thread_at_a_time
     def reset(self, seed=None, options=None):
         """Starts an episode: the world at its start (seed: its seed; None: the world file's
         the first time, then one drawn from the last seed) after one step with every joint
@@ -483,7 +548,7 @@ class ParallelEnv(_AgentsOfAModel, _ParallelBase):
         Returns (observations, infos)."""
         if self._core.closed:
             raise RuntimeError("the environment is closed")
-        options = dict(options or {})
+        options = _options(options)
         poses = options.pop("poses", None)
         if options:
             raise ValueError(f"reset: unknown options {sorted(options)} (known: 'poses')")
@@ -501,6 +566,7 @@ class ParallelEnv(_AgentsOfAModel, _ParallelBase):
         index = core.agent_index
         return {a: obs[index[a]].copy() for a in self.agents}, {a: {} for a in self.agents}
 
+    @_one_thread_at_a_time
     def step(self, actions):
         """One step of the world with one action per live agent (a dict {agent: array of
         the action space's shape}). Returns (observations, rewards, terminations,
@@ -569,8 +635,11 @@ class ParallelEnv(_AgentsOfAModel, _ParallelBase):
     def state(self):
         """Every possible agent's observation, concatenated (N x D values): a global view
         for centralised training."""
+        if self._core.closed:
+            raise RuntimeError("the environment is closed")
         return self._core.obs[0].reshape(-1).copy()
 
+    @_one_thread_at_a_time
     def close(self):
         """Closes the world (the environment cannot be used after)."""
         self._core.close()
@@ -649,6 +718,8 @@ class VectorEnv(_AgentsOfAModel, _VectorBase):
     @property
     def worlds(self):
         """The K swarmsim.World objects (read any array from them; do not step them)."""
+        if self._core.closed:
+            raise RuntimeError("the environment is closed")
         return [s.world for s in self._core.slots]
 
     @property
@@ -668,6 +739,7 @@ class VectorEnv(_AgentsOfAModel, _VectorBase):
     def _infos(self):
         return {"active": self._core.active.copy(), "_active": np.ones(self.num_envs, bool)}
 
+    @_one_thread_at_a_time
     def reset(self, seed=None, options=None):
         """Resets every environment (or those of ``options={"reset_mask": (K,) bools}``).
         seed: None (each environment's next seed: the world file's + k the first time), an
@@ -679,7 +751,7 @@ class VectorEnv(_AgentsOfAModel, _VectorBase):
             raise RuntimeError("the environment is closed")
         K = core.K
         mask = np.ones(K, dtype=bool)
-        options = dict(options or {})
+        options = _options(options)
         if "reset_mask" in options:
             mask = np.asarray(options.pop("reset_mask"))
             if mask.dtype != bool or mask.shape != (K,):
@@ -730,6 +802,7 @@ class VectorEnv(_AgentsOfAModel, _VectorBase):
             if not slot.called and slot.indices:
                 core._remap(slot, [], [])
 
+    @_one_thread_at_a_time
     def step(self, actions):
         """One step of every environment: actions (K, N, A) (rows of inactive agents and of
         environments being reset are ignored). Returns (observations (K, N, D), rewards
@@ -770,6 +843,7 @@ class VectorEnv(_AgentsOfAModel, _VectorBase):
         """Returns None (see ParallelEnv.render)."""
         return None
 
+    @_one_thread_at_a_time
     def close(self, **kwargs):
         """Closes the K worlds."""
         if not self.closed:

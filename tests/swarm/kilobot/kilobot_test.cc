@@ -530,6 +530,19 @@ int main() { kilo_init(); kilo_start(setup, loop); return 0; }
   const CommandResult no_main = Build(dir, "nomain", "#include <kilolib.h>\nvoid loop() {}\n");
   EXPECT_NE(no_main.exit_code, 0);
   EXPECT_NE(no_main.output.find("defines no main()"), std::string::npos) << no_main.output;
+  // A call to a function nothing defines: refused when it is built (the
+  // link), not when a world loads the plugin; no plugin written.
+  const CommandResult undefined = Build(dir, "undefined", R"(#include <kilolib.h>
+void setup() {}
+void loop() { foo(); }
+int main() { kilo_init(); kilo_start(setup, loop); return 0; }
+)");
+  EXPECT_EQ(undefined.exit_code, 2) << undefined.output;
+  EXPECT_NE(undefined.output.find("undefined reference to `foo'"), std::string::npos)
+      << undefined.output;
+  EXPECT_NE(undefined.output.find("undefined.c does not link"), std::string::npos)
+      << undefined.output;
+  EXPECT_FALSE(fs::exists(dir / "undefined.so"));
   // A missing file.
   const CommandResult missing = RunProgram("kilobot build " + (dir / "none.c").string());
   EXPECT_EQ(missing.exit_code, 2);
@@ -605,10 +618,39 @@ TEST(KilobotTest, FaultsAfterADelayEndTheRunNamingThem) {
                  "  return n < 0 ? 0 : down(n + 1) + pad[(n * 7) & 511]; }\n"
                  "void loop() { delay(40); if (kilo_uid == 3 && kilo_ticks > 4) sink = down(0); }",
                  "segmentation fault (stack overflow) in loop()");
+  ExpectRunFails("array_delay",
+                 "volatile int sink;\n"
+                 "void loop() { delay(40); if (kilo_uid == 3 && kilo_ticks > 4) {\n"
+                 "  volatile char big[100000]; big[0] = 1; sink = big[0]; } }",
+                 "segmentation fault (stack overflow) in loop()");
   ExpectRunFails("spin_delay",
                  "volatile int x;\n"
                  "void loop() { delay(40); if (kilo_uid == 3 && kilo_ticks > 4) for (;;) x++; }",
                  "loop() did not return within 0.5 s");
+}
+
+// A kilo_uid the uint16_t cannot hold is refused at start, not wrapped.
+TEST(KilobotTest, AKiloUidOutOfRangeIsRefused) {
+  const fs::path dir = Dir("uid");
+  const CommandResult built =
+      Build(dir, "uid",
+            "#include <kilolib.h>\nvoid setup() {}\nvoid loop() {}\n"
+            "int main() { kilo_init(); kilo_start(setup, loop); return 0; }\n");
+  ASSERT_EQ(built.exit_code, 0) << built.output;
+  Write(dir / "world.yaml", World("uid", "planar", 2, 0.5));
+  for (const char* bad : {"70000", "1.5", "-5"}) {
+    const CommandResult run = RunProgram("run " + (dir / "world.yaml").string() +
+                                         " --steps 2 --quiet --set kilobot.kilo_uid=" + bad);
+    EXPECT_NE(run.exit_code, 0) << bad;
+    EXPECT_NE(run.output.find(std::string("parameter kilo_uid is ") + bad +
+                              ": a kilo_uid is a whole number 0..65535"),
+              std::string::npos)
+        << run.output;
+  }
+  const CommandResult ok = RunProgram("run " + (dir / "world.yaml").string() +
+                                      " --steps 2 --quiet --set kilobot.kilo_uid=65535");
+  EXPECT_EQ(ok.exit_code, 0) << ok.output;
+  fs::remove_all(dir);
 }
 
 // exit() in a program would end swarmsim itself: it ends the run instead,

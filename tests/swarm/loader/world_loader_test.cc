@@ -440,6 +440,24 @@ TEST_F(MalformedWorldTest, EachMistakeHasAClearMessage) {
   }
 }
 
+// A script that does not parse is an error of the world as it loads, at the
+// script's line (it was every robot's error at start, exit 1).
+TEST_F(MalformedWorldTest, AScriptThatDoesNotParseIsNamedAsItLoads) {
+  Write("broken.lua", "function sysCall_init()\n  x = = 1\nend\n");
+  Write("bot.yaml",
+        "model: bot\nobjects:\n  type: shape\n  shape: box\n  script: broken.lua\n  size: [0.1, "
+        "0.1, 0.1]\n");
+  const std::string message =
+      LoadText("arena: {size: 2}\nmodels:\n  - {model: bot.yaml, count: 2, distribute: {}}\n");
+  EXPECT_NE(message.find("bot.yaml:5:11: script "), std::string::npos) << message;
+  EXPECT_NE(message.find("/broken.lua:2: unexpected symbol near '='"), std::string::npos)
+      << "its path whole: " << message;
+  // The world's main script too.
+  const std::string main_script = LoadText("simulation: {main_script: broken.lua}\n");
+  EXPECT_NE(main_script.find("world.yaml:1:"), std::string::npos) << main_script;
+  EXPECT_NE(main_script.find("broken.lua:2: unexpected symbol"), std::string::npos) << main_script;
+}
+
 TEST_F(MalformedWorldTest, TabIndentationSaysYamlDoesNotAllowTabs) {
   const std::string hint = "(YAML does not allow tabs for indentation)";
   // A tab alone, a tab after spaces, a tab before a list entry.
