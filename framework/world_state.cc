@@ -167,8 +167,11 @@ void World::CheckFingerprint(StateReader* in) const {
     return p;
   };
   const Parts theirs = read(in), ours = read(&expected);
+  // The two files are named only when they are two.
   const std::string of =
-      "the snapshot is of world '" + theirs.file + "', this world is '" + ours.file + "'";
+      theirs.file == ours.file
+          ? "the snapshot is of this world's file '" + theirs.file + "'"
+          : "the snapshot is of world '" + theirs.file + "', this world is '" + ours.file + "'";
   if (theirs.file_hash != ours.file_hash)
     throw Error("snapshot: " + of +
                 ", and their world files differ: restore into a world "

@@ -208,6 +208,7 @@ void WorldLoader::ResolvePythonController(const Fields& f, const ValueReader& wo
     file_field = p.Require("file");
   }
   std::string text = world_values.String(file_field);
+  const std::string written = text;  // as the file says it, for messages
   if (!file_field.node.IsMap()) {
     const size_t colon = text.rfind(':');
     if (colon != std::string::npos && colon > 0) {
@@ -225,9 +226,9 @@ void WorldLoader::ResolvePythonController(const Fields& f, const ValueReader& wo
     file_->Fail(file_field.mark, "'python_controller' names a Python function: '" +
                                      python.function + "' is not an identifier");
   if (text.size() < 4 || text.substr(text.size() - 3) != ".py")
-    file_->Fail(
-        file_field.mark,
-        "'python_controller' is a Python file (FILE.py or FILE.py:function), got '" + text + "'");
+    file_->Fail(file_field.mark,
+                "'python_controller' is a Python file (FILE.py or FILE.py:function), got '" +
+                    written + "'");
   const std::filesystem::path path = file_->path().parent_path() / text;
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))

@@ -148,20 +148,38 @@ void Refresh(const World& world, const std::string& model, ModelLayout* layout) 
 
 // An output array of `shape`: `out` if it is one (float64, C-contiguous,
 // writeable, that shape), else a new one.
-Array OutArray(std::vector<py::ssize_t> shape, const py::object& out) {
-  if (!out.is_none()) {
-    if (!py::isinstance<py::array>(out)) throw py::value_error("out= must be a numpy array");
-    auto a = py::reinterpret_borrow<py::array>(out);
-    if (!a.dtype().is(py::dtype::of<double>()))
-      throw py::value_error("out= must have dtype float64, got " + std::string(py::str(a.dtype())));
-    if (!(a.flags() & py::array::c_style) || !a.writeable())
-      throw py::value_error("out= must be a writeable C-contiguous array");
-    if (a.ndim() != static_cast<py::ssize_t>(shape.size()) ||
-        !std::equal(shape.begin(), shape.end(), a.shape()))
-      throw py::value_error("out= has the wrong shape");
-    return py::reinterpret_borrow<Array>(out);
+void CheckOut(const py::object& out, const py::dtype& dtype,
+              const std::vector<py::ssize_t>& shape) {
+  if (!py::isinstance<py::array>(out)) throw py::value_error("out= must be a numpy array");
+  static const py::handle ndarray =
+      py::object(py::module_::import("numpy").attr("ndarray")).release();
+  if (!py::type::of(out).is(ndarray))
+    throw py::value_error("out= must be a plain numpy.ndarray, not a " +
+                          std::string(py::str(py::type::of(out).attr("__name__"))) +
+                          " (what it adds, such as a mask, would be ignored)");
+  auto a = py::reinterpret_borrow<py::array>(out);
+  if (!a.dtype().is(dtype))
+    throw py::value_error("out= must have dtype " + std::string(py::str(py::object(dtype))) +
+                          ", got " + std::string(py::str(a.dtype())));
+  if (!(a.flags() & py::array::c_style) || !a.writeable())
+    throw py::value_error("out= must be a writeable C-contiguous array");
+  if (a.ndim() != static_cast<py::ssize_t>(shape.size()) ||
+      !std::equal(shape.begin(), shape.end(), a.shape())) {
+    const auto text = [](const py::ssize_t* begin, const py::ssize_t* end) {
+      std::string t = "(";
+      for (const py::ssize_t* d = begin; d != end; ++d)
+        t += (d == begin ? "" : ", ") + std::to_string(*d);
+      return t + (end - begin == 1 ? ",)" : ")");
+    };
+    throw py::value_error("out= has shape " + text(a.shape(), a.shape() + a.ndim()) +
+                          ", expected " + text(shape.data(), shape.data() + shape.size()));
   }
-  return Array(shape);
+}
+
+Array OutArray(std::vector<py::ssize_t> shape, const py::object& out) {
+  if (out.is_none()) return Array(shape);
+  CheckOut(out, py::dtype::of<double>(), shape);
+  return py::reinterpret_borrow<Array>(out);
 }
 
 namespace {

@@ -47,6 +47,9 @@ void Refresh(const World& world, const std::string& model, ModelLayout* layout);
 // An output array of `shape`: `out` if it is one (float64, C-contiguous,
 // writeable, that shape), else a new one.
 Array OutArray(std::vector<py::ssize_t> shape, const py::object& out);
+// Throws ValueError unless `out` is a plain numpy.ndarray (not a subclass
+// such as a masked array) of `dtype` and `shape`, writeable and C-contiguous.
+void CheckOut(const py::object& out, const py::dtype& dtype, const std::vector<py::ssize_t>& shape);
 
 // Poses of the layout's robots' roots: N x 3 (x, y, yaw) or N x 7 (x, y, z,
 // qw, qx, qy, qz).

@@ -58,6 +58,13 @@ int64_t IntArg(const py::handle& value, const std::string& what) {
   }
 }
 
+// A thread count: an integer from 0 (every core) to kMaxThreads.
+int ThreadsArg(const py::object& value, const char* where) {
+  const int64_t threads = IntArg(value, std::string(where) + ": threads");
+  CheckThreads(threads, where);
+  return static_cast<int>(threads);
+}
+
 // A seed: None (the world's own) or an integer from 0 to 2^64 - 1.
 std::optional<uint64_t> SeedArg(const py::object& value, const std::string& what) {
   if (value.is_none()) return std::nullopt;
@@ -157,10 +164,11 @@ TaskScheduler& WorldsScheduler(int threads) {
 // Steps each world n steps, the worlds in parallel on `threads` workers
 // (each one's own step is as deterministic as ever: the same state as
 // stepping it alone), the GIL released but for Python controllers.
-void StepWorlds(const py::sequence& worlds, const py::object& count, int threads) {
+void StepWorlds(const py::sequence& worlds, const py::object& count,
+                const py::object& threads_arg) {
   const int64_t n = IntArg(count, "step_worlds(n): n");
   if (n < 0) throw py::value_error("step_worlds: n must be >= 0, got " + std::to_string(n));
-  CheckThreads(threads, "step_worlds");
+  const int threads = ThreadsArg(threads_arg, "step_worlds");
   const size_t k = py::len(worlds);
   std::vector<PyWorld*> list(k);
   std::map<PyWorld*, size_t> seen;
@@ -275,16 +283,17 @@ PYBIND11_MODULE(_swarmsim, m) {
       "until the first one's step ends. A controller may read its world but not step,\n"
       "close or write it (RuntimeError).")
       .def(py::init([](const py::object& path, const py::object& seed,
-                       const std::map<std::string, py::object>& set, int threads,
+                       const std::map<std::string, py::object>& set, const py::object& threads,
                        const std::map<std::string, py::object>& controllers,
                        const py::object& package_path, bool keep_scripts) {
              return std::make_unique<PyWorld>(
                  swarmsim::python::FsPath(path, "World(path)"),
-                 swarmsim::python::SeedArg(seed, "World(seed=...)"), set, threads, controllers,
+                 swarmsim::python::SeedArg(seed, "World(seed=...)"), set,
+                 swarmsim::python::ThreadsArg(threads, "World(threads=...)"), controllers,
                  swarmsim::python::FsPaths(package_path, "World(package_path=...)"), keep_scripts);
            }),
            py::arg("path"), py::arg("seed") = py::none(),
-           py::arg("set") = std::map<std::string, py::object>{}, py::arg("threads") = 0,
+           py::arg("set") = std::map<std::string, py::object>{}, py::arg("threads") = py::int_(0),
            py::arg("controllers") = std::map<std::string, py::object>{},
            py::arg("package_path") = py::list(), py::arg("keep_scripts") = true)
       // Stepping and state.
@@ -532,7 +541,7 @@ PYBIND11_MODULE(_swarmsim, m) {
       .def(py::pickle([](PyWorld& w) { return w.getstate(); }, &PyWorld::setstate));
 
   m.def("step_worlds", &swarmsim::python::StepWorlds, py::arg("worlds"), py::arg("n") = 1,
-        py::arg("threads") = 0,
+        py::arg("threads") = py::int_(0),
         "Steps every World of the list n steps, the worlds in parallel on `threads` workers\n"
         "(0: every core; 1 to 256). Each world ends in the state stepping it alone gives (the\n"
         "same state hash). The GIL is released while no Python runs; Python controllers are\n"

@@ -20,16 +20,7 @@ namespace {
 template <typename T>
 py::array_t<T> OutArrayOf(const std::vector<py::ssize_t>& shape, const py::object& out) {
   if (out.is_none()) return py::array_t<T>(shape);
-  if (!py::isinstance<py::array>(out)) throw py::value_error("out= must be a numpy array");
-  auto a = py::reinterpret_borrow<py::array>(out);
-  if (!a.dtype().is(py::dtype::of<T>()))
-    throw py::value_error("out= must have dtype " + std::string(py::str(py::dtype::of<T>())) +
-                          ", got " + std::string(py::str(a.dtype())));
-  if (!(a.flags() & py::array::c_style) || !a.writeable())
-    throw py::value_error("out= must be a writeable C-contiguous array");
-  if (a.ndim() != static_cast<py::ssize_t>(shape.size()) ||
-      !std::equal(shape.begin(), shape.end(), a.shape()))
-    throw py::value_error("out= has the wrong shape");
+  CheckOut(out, py::dtype::of<T>(), shape);
   return py::reinterpret_borrow<py::array_t<T>>(out);
 }
 

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <memory>
 #include <set>
 #include <sstream>
 #include <thread>
@@ -55,7 +56,7 @@ void Translate(F&& write) {
 
 }  // namespace
 
-void CheckThreads(int threads, const char* where) {
+void CheckThreads(int64_t threads, const char* where) {
   if (threads < 0 || threads > kMaxThreads)
     throw py::value_error(std::string(where) + ": threads is 0 (every core, " +
                           std::to_string(TaskScheduler::HardwareThreads()) + " here) or 1 to " +
@@ -166,12 +167,18 @@ std::string PyWorld::SnapshotBytes() {
   }
 }
 
-void PyWorld::restore(const py::bytes& data) {
+void PyWorld::restore(const py::object& data) {
   NotFromController("restore()");
+  // bytes, bytearray, memoryview, a uint8 array: any contiguous buffer of bytes.
+  if (py::isinstance<py::str>(data) || !PyObject_CheckBuffer(data.ptr()))
+    throw py::type_error("restore(state): state must be the bytes snapshot() returned, not " +
+                         std::string(py::str(py::type::of(data).attr("__name__"))));
+  Py_buffer view;
+  if (PyObject_GetBuffer(data.ptr(), &view, PyBUF_SIMPLE) != 0) throw py::error_already_set();
+  const std::unique_ptr<Py_buffer, void (*)(Py_buffer*)> held(&view, PyBuffer_Release);
   GateLock lock(gate_.get());
   World& w = Live();
-  const std::string_view bytes(PyBytes_AS_STRING(data.ptr()),
-                               static_cast<size_t>(PyBytes_GET_SIZE(data.ptr())));
+  const std::string_view bytes(static_cast<const char*>(view.buf), static_cast<size_t>(view.len));
   try {
     py::gil_scoped_release release;
     UnpackSnapshot(bytes, &w, Metrics());
@@ -693,7 +700,10 @@ py::object PyWorld::LoadFunction(const PythonController& c) {
                             " is not a function");
     return f;
   } catch (py::error_already_set& e) {
-    if (e.matches(PyExc_ValueError)) throw;
+    // Ctrl-C and sys.exit() while the file runs stay themselves.
+    if (e.matches(PyExc_ValueError) || e.matches(PyExc_KeyboardInterrupt) ||
+        e.matches(PyExc_SystemExit))
+      throw;
     throw py::value_error(c.where + ": loading the Python controller " + c.file.string() +
                           " failed: " + e.what());
   }

@@ -25,7 +25,7 @@ namespace swarmsim::python {
 // Thread counts a World or step_worlds takes: 0 (every core) to kMaxThreads;
 // ValueError naming `where` otherwise.
 inline constexpr int kMaxThreads = 256;
-void CheckThreads(int threads, const char* where);
+void CheckThreads(int64_t threads, const char* where);
 
 class PyWorld {
  public:
@@ -39,7 +39,7 @@ class PyWorld {
   // Each a whole call between steps: refused inside a controller, and
   // waiting for another thread's step (the World's gate).
   py::bytes snapshot();
-  void restore(const py::bytes& data);
+  void restore(const py::object& data);  // bytes, bytearray or a bytes-like buffer
   // The world as a fresh load with `seed` (None: the seed it was loaded
   // with) leaves it, in place: the snapshot of the world before its first
   // step (taken then, or from a load with the same arguments if it has

@@ -543,6 +543,11 @@ class DeclarationTest(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, r"neighbours=\.\.\.\) must be 1 to 10000"):
             senv.range_and_bearing(neighbours=10**9)
         self.assertEqual(senv.range_and_bearing(4.0).name, "range_and_bearing")
+        with self.assertRaisesRegex(ValueError, r"joint \['leftMotor'\] listed twice"):
+            make(2, actions=senv.JointTargets(["leftMotor", "leftMotor"]))
+        with self.assertRaisesRegex(ValueError, r"observation 'ground': model 'footbot' gives it "
+                                                r"no columns"):
+            make(2, observations=["proximity", "ground"])
         with self.assertRaisesRegex(TypeError, r"^max_steps .* must be an integer >= 1, got True"):
             make(2, max_steps=True)
         with self.assertRaisesRegex(TypeError, r"^max_steps .*got 'x'"):

@@ -305,7 +305,32 @@ class MisuseTest(unittest.TestCase):
                    w.set_joint_targets, "footbot", {"noMotor": np.zeros(10)})
             expect(ValueError, "no model 'nope'", w.set_joint_targets, "nope", {})
             expect(ValueError, "(N, 3) x, y, yaw", w.set_poses, "footbot", np.zeros((10, 4)))
-            expect(ValueError, "wrong shape", w.poses, out=np.empty((11, 3)))
+            expect(ValueError, "out= has shape (11, 3), expected (10, 3)", w.poses,
+                   out=np.empty((11, 3)))
+            expect(ValueError, "out= must be a plain numpy.ndarray, not a MaskedArray", w.poses,
+                   out=np.ma.zeros((10, 3)))
+        """)
+
+    def test_thread_counts_and_snapshots_are_checked_by_name(self):
+        self.run_child("""
+            # Were pybind11's "incompatible constructor arguments" dumps.
+            expect(ValueError, "World(threads=...): threads is 0", swarmsim.World, WORLD,
+                   threads=2**40)
+            expect(TypeError, "World(threads=...): threads must be an integer", swarmsim.World,
+                   WORLD, threads=1.0)
+            still = {"footbot": lambda robots: {}}  # a Python controller: snapshots allowed
+            w = swarmsim.World(WORLD, set={"robots": 4}, controllers=still, keep_scripts=False)
+            expect(ValueError, "step_worlds: threads is 0", swarmsim.step_worlds, [w], 1, 999)
+            state = w.snapshot()
+            w.step(3)
+            w.restore(bytearray(state))  # any bytes-like buffer
+            w.restore(memoryview(state))
+            expect(TypeError, "restore(state): state must be the bytes snapshot() returned, "
+                   "not str", w.restore, "abc")
+            other = swarmsim.World(WORLD, set={"robots": 5}, controllers=still,
+                                   keep_scripts=False)
+            e = expect(ValueError, "the snapshot is of this world's file", other.restore, state)
+            assert "it holds 4 robots" in str(e), e
         """)
 
     def test_unknown_metrics_are_key_errors_listing_the_known_ones(self):

@@ -144,6 +144,9 @@ class Core:
                 raise ValueError(f"observation '{item.name}': read() must return one row per "
                                  f"robot of '{self.model}', got shape {raw.shape}")
             width = item.transform(raw[None]).shape[-1]
+            if width == 0:
+                raise ValueError(f"observation '{item.name}': model '{self.model}' gives it no "
+                                 f"columns (the model has none of the sensors it reads)")
             self.blocks.append((item, raw.shape[1], column, column + width))
             column += width
         self.D = column

@@ -287,6 +287,9 @@ class JointTargets:
 
     def bind(self, joint_names, model):
         joints = list(joint_names) if self.joints is None else self.joints
+        twice = sorted({j for j in joints if joints.count(j) > 1})
+        if twice:
+            raise ValueError(f"actions: joint {twice} listed twice (one action per joint)")
         unknown = [j for j in joints if j not in joint_names]
         if unknown:
             raise ValueError(f"actions: model '{model}' has no joint {unknown} "
