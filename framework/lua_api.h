@@ -71,6 +71,7 @@ struct LuaContext {
   bool may_finalize = false;
   bool in_sensing = false;        // running a sysCall_sensing (sim.handleChildScript follows it)
   bool dynamics_handled = false;  // the main script called sim.handleDynamics() this step
+  bool in_main_step = false;      // the main script's sysCall_step is running (the phases' place)
   int64_t slice_fires = 0;        // time-slice hook calls since the thread was resumed
   // The instruction budget of a callback (simulation.instruction_budget; 0:
   // none), and how its error names what ran and the setting that raises it.

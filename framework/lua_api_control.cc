@@ -156,10 +156,20 @@ int SetThreadSwitchTiming(lua_State* L) {
 }
 
 // The main script's handlers: the phases of a step, robots in parallel.
+// The phases run in the main script's sysCall_step only: elsewhere (its
+// sysCall_init, say) they would step the world outside the step count.
+void CheckPhasesAllowed(const LuaContext& c) {
+  if (!c.is_main) throw Error("only the world's main script may run the phases");
+  if (!c.in_main_step)
+    throw Error(
+        "the phases run in the main script's sysCall_step only (its other callbacks "
+        "would step the world outside the run's count of steps)");
+}
+
 template <void (*F)(PhaseHandlers*)>
 int MainHandler(lua_State* L) {
   LuaContext& c = Context(L);
-  if (!c.is_main) throw Error("only the world's main script may run the phases");
+  CheckPhasesAllowed(c);
   // After a World error (caught by the script) no phase runs again.
   if (!c.pending_error.empty()) RaiseError(L, "stopped by an error");
   try {
@@ -178,6 +188,7 @@ void Dynamics(PhaseHandlers* p) { p->HandleDynamics(); }
 // flag), checked here so that the error names the main script's line.
 int HandleDynamics(lua_State* L) {
   LuaContext& c = Context(L);
+  CheckPhasesAllowed(c);
   if (c.is_main) {
     if (c.dynamics_handled) throw Error("may run only once per step");
     c.dynamics_handled = true;
@@ -193,7 +204,7 @@ int HandleChildScripts(lua_State* L) {
   static const char* const kPasses[] = {"sensing", "actuation", "all", nullptr};
   const ScriptPass pass = static_cast<ScriptPass>(ArgOption(L, 1, "all", kPasses));
   LuaContext& c = Context(L);
-  if (!c.is_main) throw Error("only the world's main script may run the phases");
+  CheckPhasesAllowed(c);
   std::vector<ParamValue> args;
   for (int i = 2; i <= lua_gettop(L); ++i) {
     switch (lua_type(L, i)) {

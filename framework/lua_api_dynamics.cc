@@ -8,6 +8,7 @@
 // depend on the thread schedule. The backend rebuilds at the next physics
 // step, keeping velocities.
 #include <cmath>
+#include <cstdio>
 
 #include "framework/error.h"
 #include "framework/lua_api.h"
@@ -43,6 +44,13 @@ int SetJointTargetForce(lua_State* L) {
   const double value = ArgNumber(L, 2);
   JointData& joint = c.scene->mutable_joint(id);
   if (!std::isfinite(value)) throw Error("the force is not a finite number");
+  // Far past any motor; beyond it the engines' arithmetic overflows (ODE
+  // stopped on an internal assertion at 1e300).
+  if (std::abs(value) > 1e15) {
+    char text[96];
+    std::snprintf(text, sizeof text, "the force %g is beyond +-1e15 (N or N m)", value);
+    throw Error(text);
+  }
   if (c.instance >= 0 && c.scene->instance_of(id) != c.instance)
     throw Error("joint '" + c.scene->PathOf(id) +
                 "' belongs to another robot; only its own scripts can set its force");

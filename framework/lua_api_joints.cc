@@ -6,6 +6,7 @@
 // control phase in handle order, so the result does not depend on which
 // robot ran first. Scene scripts run alone and write directly.
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "framework/error.h"
@@ -32,12 +33,29 @@ JointData& CheckJoint(lua_State* L, uint32_t* slot) {
   return scene.joints()[scene.row_at(*slot)];
 }
 
+// A position of `joint` past what a world may use: a prismatic joint's
+// (m), or a screw joint's advance (pitch x q).
+void CheckJointReach(const JointData& joint, double q, const char* what) {
+  const double reach = joint.type() == JointType::kPrismatic ? std::abs(q)
+                       : joint.type() == JointType::kScrew   ? std::abs(q * joint.settings->pitch)
+                                                             : 0;
+  if (!(reach <= kMaxCoordinate)) {
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "the %s %g moves the joint's children %g m, beyond the 1e6 m a world may use",
+                  what, q, reach);
+    throw Error(text);
+  }
+}
+
 void SetJointTarget(lua_State* L, DeferredWrite::Kind kind) {
   const LuaContext& c = Context(L);
   uint32_t slot = 0;
   JointData& joint = CheckJoint(L, &slot);
   const double value = ArgNumber(L, 2);
   if (!std::isfinite(value)) throw Error("the target is not a finite number");
+  if (kind == DeferredWrite::Kind::kJointTargetPosition)
+    CheckJointReach(joint, value, "target position");
   if (OwnsJoint(c, slot)) {
     if (kind == DeferredWrite::Kind::kJointTargetVelocity)
       joint.target_velocity = value;
@@ -80,6 +98,7 @@ int SetJointPosition(lua_State* L) {
                 "': set the master's position");
   if (joint.type() == JointType::kSpherical || joint.type() == JointType::kFixed)
     throw Error("joint '" + path + "' is " + ToString(joint.type()) + ": it has no position");
+  CheckJointReach(joint, value, "position");
   if (c.instance < 0)
     joint.JumpTo(value);
   else

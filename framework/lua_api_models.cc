@@ -12,6 +12,7 @@
 // need to know (a message, a signal). Only whole robots (a model instance's
 // root) are copied or removed.
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -78,6 +79,13 @@ void ReadPose(lua_State* L, int arg, ModelEdit* edit) {
     if (!ok || !std::isfinite(v[i]))
       throw Error("bad argument #" + std::to_string(arg) +
                   " (pose {x, y, yaw} of three finite numbers expected)");
+  }
+  if (std::abs(v[0]) > kMaxCoordinate || std::abs(v[1]) > kMaxCoordinate) {
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  "the position (%g, %g) is beyond +-1e6 m, the largest coordinate a world may use",
+                  v[0], v[1]);
+    throw Error(text);
   }
   edit->has_pose = true;
   edit->x = v[0];

@@ -2,6 +2,7 @@
 //
 // Poses are read from the scene as it was at the start of the control
 // phase (nothing moves objects during it), so any robot may read any object.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -142,7 +143,16 @@ int SetObjectPoseOrPart(lua_State* L, PoseArgument what) {
   } else if (what == PoseArgument::kOrientation) {
     X_WO.q = (X_WR.q * Quat::FromRollPitchYaw(v[0], v[1], v[2])).Normalized();
   } else {
-    const Quat q = Quat{v[6], v[3], v[4], v[5]}.Normalized();
+    // {0, 0, 0, 1e300} is a rotation too (its squared norm overflows);
+    // {0, 0, 0, 0} is none.
+    const double largest =
+        std::max({std::abs(v[3]), std::abs(v[4]), std::abs(v[5]), std::abs(v[6])});
+    if (largest == 0)
+      throw Error("the quaternion {qx, qy, qz, qw} is {0, 0, 0, 0}, which is no rotation");
+    // Scaled only where the squared norm would overflow or vanish: others
+    // are normalised as they always were (the same bits).
+    const double scale = largest > 1e150 || largest < 1e-150 ? largest : 1.0;
+    const Quat q = Quat{v[6] / scale, v[3] / scale, v[4] / scale, v[5] / scale}.Normalized();
     X_WO = X_WR * Pose{{v[0], v[1], v[2]}, q};
   }
   // Within what a world file may use (the engines cannot take much more).

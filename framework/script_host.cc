@@ -676,7 +676,14 @@ void LuaScriptHost::RunMainScript() {
   ++main_steps_;
   main_->context.dynamics_handled = false;
   lua_rawgeti(main_->L, LUA_REGISTRYINDEX, script.callbacks[kStep]);
-  Call(*main_, script, 0, kCallbackNames[kStep]);
+  main_->context.in_main_step = true;
+  try {
+    Call(*main_, script, 0, kCallbackNames[kStep]);
+  } catch (...) {
+    main_->context.in_main_step = false;
+    throw;
+  }
+  main_->context.in_main_step = false;
 }
 
 void LuaScriptHost::RunInstance(int instance, ScriptPass pass) {

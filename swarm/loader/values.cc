@@ -312,10 +312,13 @@ double ValueReader::Number(const Field& field, const NumberRule& rule) const {
   return *number;
 }
 
-int64_t ValueReader::Integer(const Field& field, int64_t min, int64_t max) const {
+int64_t ValueReader::Integer(const Field& field, int64_t min, int64_t max,
+                             std::string_view range) const {
   const std::string text =
-      "a whole number from " + std::to_string(min) + " to " + std::to_string(max);
-  const NumberRule rule{text.c_str(), -1e300, 1e300};
+      range.empty() ? "a whole number from " + std::to_string(min) + " to " + std::to_string(max)
+                    : std::string(range);
+  // No bound of its own: the range below is the message ("at most 1e+300" was).
+  const NumberRule rule{text.c_str(), -INFINITY, INFINITY};
   const double value = Number(field, rule);
   if (value != std::floor(value) || value < static_cast<double>(min) ||
       value > static_cast<double>(max))

@@ -83,7 +83,9 @@ class ValueReader {
   ParamValue Resolve(const Field& field) const;
 
   double Number(const Field& field, const NumberRule& rule) const;
-  int64_t Integer(const Field& field, int64_t min, int64_t max) const;
+  // `range`, if given, says the range in messages instead of "from min to
+  // max" (a bound checked after, with its own message).
+  int64_t Integer(const Field& field, int64_t min, int64_t max, std::string_view range = {}) const;
   uint64_t Seed(const Field& field) const;
   bool Bool(const Field& field) const;
   std::string String(const Field& field) const;

@@ -4,6 +4,7 @@
 // model sections; the placements again for another seed (reset), and the
 // entries' summaries (describe). world_entries.cc resolves the entries.
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <memory>
 #include <string>
@@ -120,12 +121,23 @@ void WorldLoader::KeepPlacementClearOfTheMap(std::vector<std::string>* warnings)
   }
 }
 
-void WorldLoader::PlaceEntries() {
+void WorldLoader::PlaceEntries(std::vector<std::string>* warnings) {
   // Fixed copies first, so distributed ones keep clear of them wherever they are listed.
   for (EntryPlan& e : entries_) {
     if (e.distribute) continue;
     const Pose& X = e.fixed_pose;
     const double radius = e.FootprintOf(0).radius;
+    // Upright and below ODE's ground: the contacts throw it up out of it (a
+    // warning: a published robot's base may reach a little below its origin).
+    const double lowest = X.p.z + e.FootprintOf(0).bottom;
+    if (ground_plane_ && std::abs(X.q.x) < 1e-9 && std::abs(X.q.y) < 1e-9 && lowest < -1e-3)
+      warnings->push_back(file_->Where(e.position_field.mark) + ": this " + e.model->name +
+                          " at z = " + loader::FormatNumber(X.p.z) + " reaches " +
+                          loader::FormatNumber(-lowest) +
+                          " m below the ground (z = 0 under physics: ode): the contacts will "
+                          "throw it up; give z >= " +
+                          loader::FormatNumber(-e.FootprintOf(0).bottom) +
+                          ", or [x, y] alone to stand it on the ground");
     if (!placer_->IsFree(X.p.x, X.p.y, radius, 0))
       file_->Fail(e.position_field.mark,
                   "this " + e.model->name + " at [" + loader::FormatNumber(X.p.x) + ", " +
@@ -292,7 +304,8 @@ void WorldLoader::BuildCopies(World* world) {
 
 std::vector<std::pair<int, Pose>> WorldLoader::Placements(uint64_t seed) {
   placer_ = std::make_unique<Placer>(unplaced_->WithSeed(seed));
-  PlaceEntries();
+  std::vector<std::string> said_at_load;  // the load gave these warnings already
+  PlaceEntries(&said_at_load);
   // The root poses as BuildCopies sets them.
   std::vector<std::pair<int, Pose>> out;
   size_t copy = 0;

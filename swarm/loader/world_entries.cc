@@ -534,7 +534,8 @@ void WorldLoader::ReadDistribution(const Fields& f, const ValueReader& world_val
                       "'distribute' (use distribute.heading_deg for a fixed heading)");
   entry->distribute = true;
   entry->count_field = f.Require("count");
-  entry->count = world_values.Integer(entry->count_field, 0, INT64_MAX / 2);
+  entry->count = world_values.Integer(entry->count_field, 0, INT64_MAX / 2,
+                                      "a whole number from 0 to 1,000,000");
   if (entry->count > kMaxCount)
     file_->Fail(entry->count_field.mark,
                 "'count' is at most 1,000,000 copies a models entry (got " +

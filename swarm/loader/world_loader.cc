@@ -108,6 +108,7 @@ LoadedWorld WorldLoader::Load() {
   world_registry_ = &world->registry();
   for (const auto& [name, value] : parameters_) world->parameters()[name] = value;
 
+  ground_plane_ = settings.physics == "ode";
   placer_ = std::make_unique<Placer>(settings.seed);
   BuildArena(top, world);
   BuildObstacles(top, world);
@@ -119,7 +120,7 @@ LoadedWorld WorldLoader::Load() {
   KeepPlacementClearOfTheMap(&out.warnings);
   AddLargeSwarmHints(settings, &out.warnings);
   unplaced_ = std::make_unique<Placer>(*placer_);
-  PlaceEntries();
+  PlaceEntries(&out.warnings);
   BuildCopies(world);
   // The scene's own objects (collections, distance objects, ...), after the
   // robots: they may name them.

@@ -197,7 +197,7 @@ class WorldLoader {
   // state per robot, copies numbered at random): a line each saying which
   // setting to write.
   void AddLargeSwarmHints(const WorldSettings& settings, std::vector<std::string>* warnings) const;
-  void PlaceEntries();
+  void PlaceEntries(std::vector<std::string>* warnings);
   void BuildCopies(World* world);
   std::vector<ModelSummary> Summarize() const;
 
@@ -223,6 +223,7 @@ class WorldLoader {
   Field environment_field_;                            // `environment:` (absent: none)
   std::shared_ptr<const EnvironmentMap> environment_;  // the map it names, or null
   const EnvironmentFormatDescriptor* environment_format_ = nullptr;  // the format that read it
+  bool ground_plane_ = false;  // the physics has a ground at z = 0 (ode): no copy below it
   std::unique_ptr<Placer> placer_;
   // Placements: the placer before the entries were placed, and the robot
   // each copy became (entries in order, copies in order).

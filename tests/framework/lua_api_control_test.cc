@@ -446,6 +446,19 @@ TEST(ScriptControlTest, MainScriptPhaseMistakesNameTheMainScript) {
   ScriptWorld v(1, never);
   EXPECT_CONTAINS(ErrorOf([&] { v.Steps(1); }),
                   "main: main.lua: sysCall_step must call sim.handleDynamics() once per step");
+  // A phase outside sysCall_step stepped the world outside the run's count
+  // (a 2-step run simulated 0.3 s).
+  for (const char* phase : {"sim.handleDynamics()", "sim.handleSensing()",
+                            "sim.handleChildScripts()", "sim.handleActuation()"}) {
+    WorldSettings init;
+    init.main_script = Source("main.lua", std::string("function sysCall_init()\n  ") + phase +
+                                              "\nend\nfunction sysCall_step() "
+                                              "sim.handleDynamics() end\n");
+    ScriptWorld u(1, init);
+    EXPECT_CONTAINS(ErrorOf([&] { u.Steps(1); }),
+                    "main.lua:2: " + std::string(phase).substr(0, std::string(phase).find('(')) +
+                        ": the phases run in the main script's sysCall_step only");
+  }
 }
 
 }  // namespace

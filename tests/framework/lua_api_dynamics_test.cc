@@ -129,6 +129,14 @@ TEST(LuaApiDynamicsTest, ARobotSetsTheForceOfItsOwnJointsOnly) {
                "function sysCall_actuation()\n  sim.setJointTargetForce("
                "sim.getObject(':/body/motor'), 0/0)\nend");
   EXPECT_CONTAINS(nan.Step(), "sim.setJointTargetForce: the force is not a finite number");
+  // 1e300 stopped ODE on an internal assertion, naming no script.
+  DynamicsWorld huge;
+  huge.AddRobot("bot#0",
+                "function sysCall_actuation()\n  sim.setJointTargetForce("
+                "sim.getObject(':/body/motor'), 1e300)\nend");
+  EXPECT_CONTAINS(huge.Step(),
+                  "scripts/robot.lua:2: sim.setJointTargetForce: the force 1e+300 is beyond "
+                  "+-1e15 (N or N m)");
 }
 
 // A scene script (outside any robot) may set any joint's force.

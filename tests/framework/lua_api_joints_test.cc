@@ -55,6 +55,34 @@ TEST(ScriptHostTest, WritesToAnotherRobotsJointAreDeferredToAfterThePhase) {
   EXPECT_EQ(metrics[2].value, 5.0);
 }
 
+// A prismatic joint moved past the 1e6 m a world may use is refused at the
+// call (it then "blew up the physics", naming no line); a revolute joint's
+// angle has no such bound.
+TEST(ScriptHostTest, PrismaticPositionsBeyondTheWorldAreRefused) {
+  ScriptWorld w;
+  const ObjectId body = w.AddWheeledRobot("bot#0", R"(
+    function sysCall_actuation()
+      local slide, hinge = sim.getObject('./slide'), sim.getObject('./leftMotor')
+      print(pcall(sim.setJointPosition, slide, 1e7))
+      print(pcall(sim.setJointTargetPosition, slide, -2e6))
+      print(pcall(sim.setJointPosition, slide, 3))
+      print(pcall(sim.setJointPosition, hinge, 1e7))
+    end
+  )");
+  JointData slide;
+  slide.settings.Edit().type = JointType::kPrismatic;
+  w.scene().AddJoint("slide", body, {}, slide);
+  w.world().Start();
+  w.world().Step();
+  ASSERT_EQ(w.log.size(), 4u);
+  EXPECT_CONTAINS(w.log[0],
+                  "sim.setJointPosition: the position 1e+07 moves the joint's children "
+                  "1e+07 m, beyond the 1e6 m a world may use");
+  EXPECT_CONTAINS(w.log[1], "sim.setJointTargetPosition: the target position -2e+06 moves");
+  EXPECT_EQ(w.log[2], "[bot#0] true");
+  EXPECT_EQ(w.log[3], "[bot#0] true");
+}
+
 TEST(ScriptHostTest, ReadingAnotherRobotsJointTargetIsAnError) {
   ScriptWorld w;
   w.AddWheeledRobot("bot#0",

@@ -84,6 +84,10 @@ TEST(WorldModelEditsTest, MistakesAreClearErrors) {
                   "is not a robot");
   EXPECT_CONTAINS(error_of("sim.copyModel(sim.getObject(':'), {1, 'a'})"),
                   "pose {x, y, yaw} of three finite numbers expected");
+  // Beyond what a world may use: refused at the call (the copy then blew up
+  // "the physics", naming no line).
+  EXPECT_CONTAINS(error_of("sim.copyModel(sim.getObject(':'), {2e6, 0, 0})"),
+                  "sim.copyModel: the position (2e+06, 0) is beyond +-1e6 m");
   EXPECT_CONTAINS(error_of("sim.copyPasteObjects({sim.getObject(':')}, 1)"), "only 0");
   // Huge counts: a limit, not memory exhausted.
   EXPECT_CONTAINS(error_of("for i = 1, 10000 do sim.copyModel(sim.getObject(':')) end"),

@@ -151,6 +151,33 @@ TEST(ScriptHostTest, PosesInWorldAndRelativeFrames) {
 // sim.setObjectOrientation: getObjectOrientation's roll, pitch, yaw back
 // (in the world, or relative to an object), the position kept; applied
 // after the control phase like the other moves.
+// A quaternion is any nonzero 4-vector, however large its components (its
+// squared norm overflowed: the pose became a zero quaternion, or ODE
+// stopped on an assertion); {0, 0, 0, 0} is refused.
+TEST(ScriptHostTest, SetObjectPoseTakesAnyNonzeroQuaternion) {
+  ScriptWorld w;
+  w.AddWheeledRobot("bot#0", R"(
+    function sysCall_actuation()
+      local me = sim.getObject('.')
+      if sim.getSimulationTime() == 0 then
+        sim.setObjectPose(me, {0.5, 0, 0, 0, 0, 1e300, 1e300})
+        print(pcall(sim.setObjectPose, me, {0, 0, 0, 0, 0, 0, 0}))
+      else
+        local p = sim.getObjectPose(me)
+        print(string.format('%.6f %.6f %.6f %.6f', p[4], p[5], p[6], p[7]))
+      end
+    end
+  )");
+  w.world().Start();
+  w.world().Step();
+  w.world().Step();
+  ASSERT_EQ(w.log.size(), 2u);
+  EXPECT_CONTAINS(w.log[0], "false");
+  EXPECT_CONTAINS(w.log[0],
+                  "the quaternion {qx, qy, qz, qw} is {0, 0, 0, 0}, which is no rotation");
+  EXPECT_EQ(w.log[1], "[bot#0] 0.000000 0.000000 0.707107 0.707107");  // 90 degrees about z
+}
+
 TEST(ScriptHostTest, SetObjectOrientationIsGetObjectOrientationsInverse) {
   ScriptWorld w;
   const ObjectId body = w.scene().AddDummy("base", {}, {{1, 2, 0}, Quat::FromYaw(M_PI / 2)});

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <bit>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <string>
 
@@ -409,6 +410,25 @@ void PlanarWorld::ReadCommands(const Scene& scene, double duration) {
     w_[b] = (wheeled ? w_[b] : 0) + p.w;
     const double speed = std::hypot(v_x_[b], v_y_[b]) + std::abs(w_[b]) * bound_[b];
     max_speed_ratio_ = std::max(max_speed_ratio_, speed / (options_.max_move_fraction * inner_[b]));
+  }
+  // Faster than the internal steps can follow (Advance): it would cross
+  // walls unseen. Said, naming the fastest body, instead.
+  if (duration > 0 && std::ceil(duration * max_speed_ratio_) > options_.max_internal_steps) {
+    uint32_t fastest = 0;
+    double best = -1, best_speed = 0;
+    for (uint32_t b = 0; b < shapes_.size(); ++b) {
+      const double speed = std::hypot(v_x_[b], v_y_[b]) + std::abs(w_[b]) * bound_[b];
+      if (const double ratio = speed / (options_.max_move_fraction * inner_[b]); ratio > best)
+        best = ratio, best_speed = speed, fastest = b;
+    }
+    char text[320];
+    std::snprintf(text, sizeof text,
+                  "moves at %g m/s, %g times its inner radius (%g m) in one step of %g s: "
+                  "planar cuts a step into at most %d internal steps of a quarter radius each, "
+                  "so it would cross walls unseen; lower its speed or the time_step",
+                  best_speed, best_speed * duration / inner_[fastest], inner_[fastest], duration,
+                  options_.max_internal_steps);
+    throw Error("planar: body '" + PathAt(scene, cold_[fastest].slot) + "' " + text);
   }
 }
 

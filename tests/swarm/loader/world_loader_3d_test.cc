@@ -71,6 +71,33 @@ class WorldLoader3dTest : public testing::WorldDirTest {
       "            - {name: weld, type: joint, joint: fixed, position: [0, 0, -0.15]}\n";
 };
 
+// A copy placed below ODE's ground is thrown up out of it by the contacts:
+// the load says so, with the height that stands it on the ground; at that
+// height, or with [x, y] alone, it says nothing.
+TEST_F(WorldLoader3dTest, ACopyPlacedBelowTheGroundIsWarnedOf) {
+  Write("dot.yaml",
+        "model: dot\nobjects: {type: shape, shape: cylinder, radius: 0.05, height: 0.05, "
+        "dynamic: true}\n");
+  const auto warnings = [&](const std::string& position, const std::string& physics) {
+    const fs::path world =
+        Write("world.yaml", "simulation: {physics: " + physics +
+                                "}\nmodels: [{model: dot.yaml, position: " + position + "}]\n");
+    std::string all;
+    for (const std::string& w : LoadWorld(world, {}, registry_).warnings) all += w + "\n";
+    return all;
+  };
+  const std::string below = warnings("[0, 0, -1]", "ode");
+  EXPECT_NE(below.find("world.yaml:2:38: this dot at z = -1 reaches 1.025 m below the ground "
+                       "(z = 0 under physics: ode): the contacts will throw it up; give z >= "
+                       "0.025"),
+            std::string::npos)
+      << below;
+  for (const auto& [position, physics] :
+       {std::pair{"[0, 0, 0.025]", "ode"}, {"[0, 0]", "ode"}, {"[0, 0, -1]", "box2d"}})
+    EXPECT_EQ(warnings(position, physics).find("below the ground"), std::string::npos)
+        << position << " " << physics;
+}
+
 TEST_F(WorldLoader3dTest, ReadsCapsulesJointTypesForceModeAndLimits) {
   LoadedWorld loaded = LoadArm(kArm);
   const Scene& scene = loaded.world->scene();

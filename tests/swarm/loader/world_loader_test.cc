@@ -378,7 +378,11 @@ TEST_F(MalformedWorldTest, EachMistakeHasAClearMessage) {
        {"either 'duration'", "or 'steps'"}},
       {"fractional count",
        "arena: {size: 2}\nmodels:\n  - {model: bot.yaml, count: 2.5, distribute: {}}\n",
-       {"world.yaml:3:30:", "'count' must be a whole number", "2.5"}},
+       {"world.yaml:3:30:", "'count' must be a whole number from 0 to 1,000,000 (got \"2.5\")"}},
+      {"count from an expression past any bound",
+       "parameters: {n: 1e300}\narena: {size: 2}\nmodels:\n"
+       "  - {model: bot.yaml, count: '= n * 2', distribute: {}}\n",
+       {"world.yaml:4:30:", "'count' must be a whole number from 0 to 1,000,000 (got 2e+300"}},
       {"missing model file",
        "arena: {size: 2}\nmodels:\n  - {model: nobot.yaml, count: 1, distribute: {}}\n",
        {"world.yaml:3:13:", "model file 'nobot.yaml' not found"}},

@@ -17,6 +17,7 @@
 #include "framework/scheduler.h"
 #include "framework/state_hash.h"
 #include "modules/dynamics/planar/planar_backend.h"
+#include "tests/framework/error_of.h"
 #include "tests/modules/dynamics/plane_robot.h"
 
 namespace swarmsim::planar {
@@ -118,6 +119,23 @@ TEST(PlanarBackend, RobotCannotPassAThinWallAtAnySpeed) {
     Simulate(backend.get(), &scene, 2.0);
     EXPECT_LE(Position(scene, robot.body).x + kRadius, 0.995 + kTolerance) << v << " m/s";
   }
+}
+
+// Faster than the internal steps can follow (1,000 steps of a quarter of
+// the 8.5 cm radius in 0.1 s: about 212 m/s), a robot would cross the wall
+// unseen: the step fails naming it instead (it went through silently).
+TEST(PlanarBackend, ARobotTooFastToFollowIsAnErrorNamingIt) {
+  Scene scene;
+  AddWall(&scene, 1, 0, 0.01, 10);
+  Robot robot = AddRobot(&scene, "r", 0, 0, 0);
+  auto backend = Build(scene);
+  SetWheelSpeeds(&scene, robot, 200, 200);  // within: stopped by the wall
+  Simulate(backend.get(), &scene, 0.1);
+  EXPECT_LE(Position(scene, robot.body).x + kRadius, 0.995 + kTolerance);
+  SetWheelSpeeds(&scene, robot, -300, -300);
+  const std::string error = testing::ErrorOf([&] { Simulate(backend.get(), &scene, 0.1); });
+  EXPECT_CONTAINS(error, "planar: body '/r' moves at 300 m/s");
+  EXPECT_CONTAINS(error, "so it would cross walls unseen; lower its speed or the time_step");
 }
 
 TEST(PlanarBackend, RobotPushesABoxWithoutWheels) {
