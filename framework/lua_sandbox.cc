@@ -181,9 +181,10 @@ fs::path Canonical(const fs::path& path) {
 // .swarmsim-reserve; a script emptying it would lose the summary). Beyond this list, every file the
 // world's modules list as theirs (World::ListOutputs: a --video FILE inside
 // the folder, the snapshots so far) is protected too.
-constexpr std::string_view kRunOutputs[] = {
-    "summary.json", "metrics.csv", "recording.swrec", "video.mp4", "stderr.txt",
-    "paint.png",    "mill.csv",    "graphs",          "snapshots", ".swarmsim-reserve"};
+constexpr std::string_view kRunOutputs[] = {"summary.json",      "metrics.csv",   "recording.swrec",
+                                            "video.mp4",         "stderr.txt",    "paint.png",
+                                            "mill.csv",          "graphs",        "snapshots",
+                                            ".swarmsim-reserve", ".swarmsim-lock"};
 
 // Is `name` the output `output`, or a name a writer may give it while it
 // writes it aside (summary.json.tmp, .summary.json.1234)? A folder's name

@@ -29,6 +29,7 @@
 #include "swarm/cli/options.h"
 #include "swarm/loader/world_loader.h"
 #include "swarm/record/writer.h"
+#include "swarm/run/file_lock.h"
 #include "swarm/run/runner.h"
 #include "swarm/run/stop_signals.h"
 #include "swarm/viewer/server.h"
@@ -318,18 +319,88 @@ CLI::App* AddRunCommand(CLI::App* app, RunArgs* args) {
   return run;
 }
 
+namespace {
+
+// Why a file the command line names (--video, --save-state) cannot be the
+// one asked for: it is one of the run's own outputs (the command line would
+// overwrite summary.json or metrics.csv with a video), the other flag's
+// file, a folder, or (--save-state) in a folder that is not there. "" when
+// it can be written.
+std::string FileClash(const std::string& flag, const std::string& file, const RunArgs& args,
+                      const std::string& other_flag, const std::string& other_file) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path path = fs::weakly_canonical(fs::absolute(file, ec), ec);
+  if (!args.out_dir.empty()) {
+    const fs::path out = fs::weakly_canonical(fs::absolute(args.out_dir, ec), ec);
+    for (const char* own : {"summary.json", "metrics.csv", "recording.swrec", "snapshots"})
+      if (path == out / own)
+        return flag + ": '" + file + "' is this run's own " + own + " (--out " + args.out_dir +
+               "): name another file";
+  }
+  if (!other_file.empty() && path == fs::weakly_canonical(fs::absolute(other_file, ec), ec))
+    return flag + ": '" + file + "' is " + other_flag + "'s file too: name two files";
+  if (fs::is_directory(path, ec)) return flag + ": '" + file + "' is a folder: name a file";
+  // Its folder: there already, or --out (made before the run). (--video's
+  // is checked as the recorder opens it, also before the run.)
+  const fs::path folder = path.parent_path();
+  const bool out_folder =
+      !args.out_dir.empty() && folder == fs::weakly_canonical(fs::absolute(args.out_dir, ec), ec);
+  if (flag == "--save-state" && !out_folder && !fs::is_directory(folder, ec))
+    return flag + ": cannot write '" + file + "': there is no folder '" + folder.string() + "'";
+  return "";
+}
+
+}  // namespace
+
 int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegistry* registry) {
+  // SIGINT, SIGTERM, SIGHUP from here on are noted, not fatal (see below,
+  // where the load starts: the run ends as interrupted, with its summary).
+  std::optional<StopSignals> stop_signals;
+  stop_signals.emplace();
+  // Files the command line names that would overwrite the run's own, or
+  // cannot be written: a bad command line, before anything runs.
+  {
+    const std::string video = !args.video                ? ""
+                              : !args.video_file.empty() ? args.video_file
+                              : !args.out_dir.empty()
+                                  ? (std::filesystem::path(args.out_dir) / "video.mp4").string()
+                                  : "";
+    for (const auto& [flag, file, other_flag, other] :
+         {std::tuple{std::string("--video"), video, std::string("--save-state"), args.save_state},
+          std::tuple{std::string("--save-state"), args.save_state, std::string("--video"),
+                     video}}) {
+      if (file.empty()) continue;
+      if (const std::string clash = FileClash(flag, file, args, other_flag, other);
+          !clash.empty()) {
+        std::cerr << "error: " << swarmsim::ValidUtf8(clash) << "\n";
+        return kExitBadInput;
+      }
+    }
+  }
   RunOptions options;
   if (!args.out_dir.empty()) options.out_dir = args.out_dir;
   options.world_file = args.world_file;
   options.command_line = command_line;
   // --out must be a folder we can make: a bad one is a bad command line
   // (exit 2 before the run), not an error after the run's summary.
+  // One run at a time writes into a folder (two mixed their metrics and
+  // snapshots): DIR/.swarmsim-lock, held until this function returns. A
+  // folder this user cannot write is found here too, before any work.
+  std::optional<FileLock> out_lock;
   if (options.out_dir) {
     try {
       CreateOutputFolder(*options.out_dir);
+      out_lock.emplace((*options.out_dir / ".swarmsim-lock").string());
     } catch (const Error& e) {
       std::cerr << "error: --out: " << swarmsim::ValidUtf8(e.what()) << "\n";
+      return kExitBadInput;
+    }
+    if (!out_lock->held()) {
+      std::cerr << "error: --out: another run"
+                << (out_lock->holder().empty() ? "" : " (process " + out_lock->holder() + ")")
+                << " is writing into '" << swarmsim::ValidUtf8(options.out_dir->string())
+                << "'; wait for it to end, or pass another --out\n";
       return kExitBadInput;
     }
   }
@@ -348,13 +419,12 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
     }
     return sig != 0 ? 128 + sig : kExitBadInput;
   };
-  // SIGINT, SIGTERM, SIGHUP while a large world loads: the load stops between
-  // model copies (or inside a large mesh file's read) and the run ends as
-  // interrupted, with its summary.json. Held until the program exits (the
-  // run's own nest inside and keep a signal noted in between); only --view's
-  // serving after the run lets them act as usual again (it ends with Ctrl-C).
-  std::optional<StopSignals> stop_signals;
-  stop_signals.emplace();
+  // SIGINT, SIGTERM, SIGHUP while a large world loads (caught since the
+  // start of this function): the load stops between model copies (or inside
+  // a large mesh file's read) and the run ends as interrupted, with its
+  // summary.json. Held until the program exits (the run's own nest inside
+  // and keep a signal noted in between); only --view's serving after the run
+  // lets them act as usual again (it ends with Ctrl-C).
   LoadOptions load;
   load.seed = args.seed;
   load.threads = args.threads;
@@ -499,6 +569,12 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
     } catch (const Error& e) {
       return bad_input("--load-state " + args.load_state + ": " + e.what());
     }
+    // The state carries its random streams: another seed would be ignored.
+    if (args.seed && *args.seed != loaded.world->settings().seed)
+      return bad_input("--seed " + std::to_string(*args.seed) + ": the run --load-state " +
+                       args.load_state + " resumes goes on with its own seed (" +
+                       std::to_string(loaded.world->settings().seed) +
+                       "); leave --seed out, or give that one");
     options.resumed_from = args.load_state;
   }
   if (!args.save_state.empty()) {

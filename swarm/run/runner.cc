@@ -584,6 +584,10 @@ void PrintSummaryTable(const World& world, const RunOptions& options, const RunR
 
 void CreateOutputFolder(const std::filesystem::path& dir) {
   std::error_code ec;
+  if (std::filesystem::is_symlink(dir, ec) && !std::filesystem::exists(dir, ec))
+    throw Error("'" + dir.string() + "' is a symbolic link to '" +
+                std::filesystem::read_symlink(dir, ec).string() +
+                "', which does not exist; make that folder, or pass another");
   if (std::filesystem::exists(dir, ec) && !std::filesystem::is_directory(dir, ec))
     throw Error("'" + dir.string() + "' is not a folder; pass a folder (it is made if missing)");
   std::filesystem::create_directories(dir, ec);
@@ -606,7 +610,21 @@ std::string RemoveEarlierOutputs(const std::filesystem::path& dir) {
   if (!j.is_object() || !j.contains("outputs") || !j["outputs"].is_array()) return "";
   std::map<std::string, int> removed;  // kind -> files
   std::set<fs::path> folders;
-  for (const nlohmann::json& file : j["outputs"]) {
+  nlohmann::json outputs = j["outputs"];
+  // A run that never ended (killed: its summary still says running) listed
+  // nothing: its files under the names a run gives them go instead.
+  if (j.contains("status") && j["status"] == "running") {
+    std::error_code ec;
+    for (const auto& [name, kind] :
+         {std::pair{"recording.swrec", "recording"}, std::pair{"video.mp4", "video"}})
+      if (fs::is_regular_file(dir / name, ec)) outputs.push_back({{"path", name}, {"kind", kind}});
+    for (const char* folder : {"snapshots", "graphs"})
+      for (const fs::directory_entry& entry : fs::directory_iterator(dir / folder, ec))
+        if (entry.is_regular_file(ec))
+          outputs.push_back({{"path", (fs::path(folder) / entry.path().filename()).string()},
+                             {"kind", folder == std::string("snapshots") ? "snapshot" : "graph"}});
+  }
+  for (const nlohmann::json& file : outputs) {
     if (!file.is_object() || !file.contains("path") || !file["path"].is_string()) continue;
     const fs::path path = fs::path(file["path"].get<std::string>()).lexically_normal();
     // Only what the earlier run wrote inside DIR.

@@ -99,8 +99,10 @@ void CreateOutputFolder(const std::filesystem::path& dir);
 // A run with --out DIR where an earlier run wrote: removes the files that
 // run's summary.json lists as its outputs (snapshots, video, recording,
 // graphs; paths inside DIR only) and the folders they leave empty, so that
-// DIR holds one run, not a mix. Returns the note to print ("" if there was
-// nothing), naming what went.
+// DIR holds one run, not a mix; for a run killed before its end (summary
+// status "running", nothing listed), the files under a run's own names
+// (recording.swrec, video.mp4, snapshots/, graphs/). Returns the note to
+// print ("" if there was nothing), naming what went.
 std::string RemoveEarlierOutputs(const std::filesystem::path& dir);
 
 // Peak resident set size of this process, in MiB.

@@ -1,13 +1,10 @@
 #include "swarm/sweep/coordinator.h"
 
-#include <fcntl.h>
 #include <signal.h>
-#include <sys/file.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <array>
-#include <cerrno>
 #include <csignal>
 #include <cstdint>
 #include <cstring>
@@ -24,6 +21,7 @@
 #include "modules/builtin.h"
 #include "swarm/loader/values.h"
 #include "swarm/loader/world_loader.h"
+#include "swarm/run/file_lock.h"
 #include "swarm/run/stop_signals.h"
 #include "swarm/run/version.h"
 #include "swarm/sweep/progress.h"
@@ -123,47 +121,6 @@ std::string SweepSpace(const std::vector<ParamSpec>& params, const std::vector<u
   return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
-// One sweep at a time on a database: held for the sweep's life on
-// DB.lock (flock, not the database file: SQLite locks that with fcntl). A
-// second sweep on the same database would reset the first's runs in
-// progress as if it had stopped, and run them again beside it.
-class SweepLock {
- public:
-  explicit SweepLock(const std::string& db) : path_(db + ".lock") {
-    fd_ = ::open(path_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-    if (fd_ < 0)
-      throw Error("cannot create '" + path_ + "' (the lock that keeps a second sweep off '" + db +
-                  "'): " + std::strerror(errno));
-    if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
-      char pid[32] = {};
-      const ssize_t n = ::pread(fd_, pid, sizeof pid - 1, 0);
-      ::close(fd_);
-      fd_ = -1;
-      std::string holder(pid, n > 0 ? static_cast<size_t>(n) : 0);
-      while (!holder.empty() && (holder.back() == '\n' || holder.back() == ' ')) holder.pop_back();
-      throw Error("another sweep" + (holder.empty() ? std::string() : " (process " + holder + ")") +
-                  " is running on '" + db +
-                  "'; wait for it to finish (a sweep that stopped is resumed by running the same "
-                  "command again), or use another --db");
-    }
-    const std::string pid = std::to_string(::getpid()) + "\n";
-    if (::ftruncate(fd_, 0) == 0 && ::pwrite(fd_, pid.data(), pid.size(), 0) < 0) {
-      // The pid is only for the message above.
-    }
-  }
-  ~SweepLock() {
-    if (fd_ < 0) return;
-    ::unlink(path_.c_str());  // removed while still held
-    ::close(fd_);
-  }
-  SweepLock(const SweepLock&) = delete;
-  SweepLock& operator=(const SweepLock&) = delete;
-
- private:
-  std::string path_;
-  int fd_ = -1;
-};
-
 int CoordinateSweep(const SweepOptions& o, RemoteWorkers* remote, std::ostream& out,
                     std::ostream& err) {
   // SIGINT, SIGTERM and SIGHUP stop a sweep between runs: the runs in
@@ -178,7 +135,16 @@ int CoordinateSweep(const SweepOptions& o, RemoteWorkers* remote, std::ostream& 
   const std::string world_hash = WorldFileHash(o.world);
   const std::string space = SweepSpace(params, seeds, o.steps, o.duration);
   if (o.db.empty()) throw Error("sweep needs --db FILE for the results");
-  const SweepLock lock(o.db);
+  // DB.lock (flock, not the database file: SQLite locks that with fcntl). A
+  // second sweep on the same database would reset the first's runs in
+  // progress as if it had stopped, and run them again beside it.
+  const FileLock lock(o.db + ".lock");
+  if (!lock.held())
+    throw Error("another sweep" +
+                (lock.holder().empty() ? std::string() : " (process " + lock.holder() + ")") +
+                " is running on '" + o.db +
+                "'; wait for it to finish (a sweep that stopped is resumed by running the same "
+                "command again), or use another --db");
 
   // A new sweep: check the world and parameters before creating the database.
   if (!std::filesystem::exists(o.db)) CheckWorld(o, grid.front(), params);

@@ -307,7 +307,11 @@ Recorder::Recorder(World* world, const RecorderSettings& settings)
   }
   // The video: a frame every round(1 / (fps dt)) steps.
   if (video) {
-    if (!(settings.video_fps > 0)) throw Error("--video-fps must be > 0");
+    // FFmpeg refuses a frame lasting ~10^6 s (the run went on, then the video
+    // failed); past 10,000 frames per simulated second every step is a frame.
+    if (!(settings.video_fps >= 1e-3 && settings.video_fps <= 1e4))
+      throw Error("--video-fps must be from 0.001 to 10000 frames per simulated second, got " +
+                  Number(settings.video_fps));
     const double dt = world->settings().time_step;
     r.video_period = FramePeriod(settings.video_fps, dt);
     r.video_rate = 1 / (static_cast<double>(r.video_period) * dt);

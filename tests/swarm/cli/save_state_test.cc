@@ -89,6 +89,30 @@ TEST(SaveStateTest, WhatCannotBeSavedOrLoadedIsAnErrorBeforeTheRun) {
   const auto other = RunProgram("run " + kWorld + " --set robots=25 --load-state " + state);
   EXPECT_EQ(other.exit_code, 2) << other.output;
   EXPECT_NE(other.output.find("24 robots"), std::string::npos) << other.output;
+  // Another seed than the state's was ignored without a word.
+  const auto seeded = RunProgram("run " + kWorld + " --seed 4 --load-state " + state);
+  EXPECT_EQ(seeded.exit_code, 2) << seeded.output;
+  EXPECT_NE(seeded.output.find("--seed 4: the run --load-state " + state +
+                               " resumes goes on with its own seed ("),
+            std::string::npos)
+      << seeded.output;
+  // The file it writes: not one of the run's own outputs (a summary.json
+  // overwritten by the state, exit 0), nor in a folder that is not there
+  // (found after the whole run).
+  const std::string out = (dir / "out").string();
+  const auto own = RunProgram("run " + kWorld + " --steps 2 --out " + out + " --save-state " + out +
+                              "/summary.json");
+  EXPECT_EQ(own.exit_code, 2) << own.output;
+  EXPECT_NE(own.output.find("--save-state: '" + out +
+                            "/summary.json' is this run's own "
+                            "summary.json (--out " +
+                            out + "): name another file"),
+            std::string::npos)
+      << own.output;
+  const auto nowhere =
+      RunProgram("run " + kWorld + " --steps 2 --save-state " + (dir / "no" / "s.bin").string());
+  EXPECT_EQ(nowhere.exit_code, 2) << nowhere.output;
+  EXPECT_NE(nowhere.output.find("there is no folder"), std::string::npos) << nowhere.output;
   std::string bytes = ReadFile(state);
   bytes[bytes.size() / 2] ^= 0x10;
   std::ofstream(dir / "bad.bin", std::ios::binary) << bytes;

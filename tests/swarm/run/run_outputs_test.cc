@@ -492,6 +492,56 @@ TEST(RunOutputsTest, AnOutFolderUsedAgainHoldsTheNewRunAlone) {
   fs::remove_all(out);
 }
 
+// A run killed before its end (kill -9: summary.json still says running,
+// listing nothing) left its recording, video and snapshots to the next run
+// into the folder, beside that run's summary.
+TEST(RunOutputsTest, AKilledRunsFilesGoBeforeTheNextRunWritesItsOwn) {
+  const fs::path out = TempDir("killed");
+  fs::create_directories(out / "snapshots");
+  std::ofstream(out / "summary.json") << R"({"status": "running", "steps": 0, "outputs": []})";
+  std::ofstream(out / "recording.swrec") << "old";
+  std::ofstream(out / "video.mp4") << "old";
+  std::ofstream(out / "snapshots" / "step_000050.png") << "old";
+  std::ofstream(out / "notes.txt") << "mine\n";
+  const auto r =
+      RunProgram("run " + Data("outputs.yaml") + " --steps 2 --quiet --out " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("note: removed the outputs of the earlier run in '" + out.string() +
+                          "' (1 recording, 1 snapshot, 1 video)"),
+            std::string::npos)
+      << r.output;
+  for (const char* gone : {"recording.swrec", "video.mp4", "snapshots"})
+    EXPECT_FALSE(fs::exists(out / gone)) << gone;
+  EXPECT_TRUE(fs::exists(out / "notes.txt")) << "not a run's";
+  fs::remove_all(out);
+}
+
+// Two runs into one folder mixed their metrics and snapshots: the second is
+// refused, naming the first; the first goes on.
+TEST(RunOutputsTest, ASecondRunIntoAFolderInUseIsRefused) {
+  const fs::path out = TempDir("busy");
+  const pid_t pid = Spawn(
+      {"run", Data("outputs.yaml"), "--steps", "1000000000", "--out", out.string(), "--quiet"});
+  ASSERT_GT(pid, 0);
+  EXPECT_GT(WaitForRows(out / "metrics.csv"), 0u) << "the run never got going";
+  const auto second =
+      RunProgram("run " + Data("outputs.yaml") + " --steps 2 --quiet --out " + out.string());
+  EXPECT_EQ(second.exit_code, 2) << second.output;
+  EXPECT_NE(second.output.find("error: --out: another run (process " + std::to_string(pid) +
+                               ") is writing into '" + out.string() + "'"),
+            std::string::npos)
+      << second.output;
+  const nlohmann::json summary = TerminateAndReadSummary(pid, out);
+  EXPECT_EQ(summary.value("status", ""), "interrupted") << "the first run's, whole";
+  EXPECT_FALSE(fs::exists(out / ".swarmsim-lock")) << "released with the run";
+  // --video over the run's own metrics.csv wrote H.264 into it (exit 0).
+  const auto clash = RunProgram("run " + Data("outputs.yaml") + " --steps 2 --quiet --out " +
+                                out.string() + " --video " + (out / "metrics.csv").string());
+  EXPECT_EQ(clash.exit_code, 2) << clash.output;
+  EXPECT_NE(clash.output.find("is this run's own metrics.csv"), std::string::npos) << clash.output;
+  fs::remove_all(out);
+}
+
 TEST(RunOutputsTest, ARunThatNeverSteppedPrintsNoSummaryTable) {
   const fs::path dir =
       OneScriptedRobot("never_stepped", "function sysCall_init() error('no start') end\n");
