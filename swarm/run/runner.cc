@@ -80,6 +80,7 @@ class MetricsWriter {
     Flush();
   }
   void Write(const std::vector<MetricSample>& samples) {
+    errno = 0;  // a row that fills the buffer writes it: its failure's errno, kept below
     for (const MetricSample& m : samples) {
       file_ << m.step << ',' << m.time << ',';
       if (m.instance >= 0) WriteCsvField(file_, world_.scene().instance(m.instance).name);
@@ -92,6 +93,8 @@ class MetricsWriter {
         file_ << m.value;
       file_ << '\n';
     }
+    // The buffer's write failed (a full disk): its errno, for Flush's message.
+    if (!file_ && failed_errno_ == 0) failed_errno_ = errno;
     if (!samples.empty() && Clock::now() - last_flush_ >= std::chrono::seconds(1)) Flush();
   }
   // Throws Error naming the file when the rows could not be written (a full
@@ -105,7 +108,12 @@ class MetricsWriter {
 
  private:
   [[noreturn]] void Fail() {
-    const int error = errno;
+    int error = failed_errno_ != 0 ? failed_errno_ : errno;
+    // No errno (the stream's own calls may clear it): a full disk is the
+    // usual reason, and the folder says whether it is.
+    std::error_code ec;
+    if (error == 0 && std::filesystem::space(path_.parent_path(), ec).available == 0 && !ec)
+      error = ENOSPC;
     throw Error("cannot write '" + path_.string() + "'" +
                 (error != 0 ? std::string(": ") + std::strerror(error) : std::string()));
   }
@@ -113,6 +121,7 @@ class MetricsWriter {
   const World& world_;
   std::filesystem::path path_;
   std::ofstream file_;
+  int failed_errno_ = 0;  // errno of the write that failed, if Write saw one
   Clock::time_point last_flush_;
 };
 
