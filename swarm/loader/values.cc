@@ -7,6 +7,7 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <set>
 
 #include "framework/error.h"
 #include "framework/lua_evaluator.h"
@@ -167,6 +168,39 @@ Expressions::Expressions() : impl_(std::make_unique<Impl>()) {
 
 Expressions::~Expressions() = default;
 
+namespace {
+
+// "; with robots = -5, density = 1": the parameters `expression` names, as
+// they were (what a user checks first when it gives nan or inf).
+std::string ValuesUsed(std::string_view expression, const Scope& scope) {
+  std::string out;
+  std::set<std::string> said;
+  const auto is_name = [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
+  };
+  for (size_t i = 0; i < expression.size();) {
+    if (!is_name(expression[i]) || std::isdigit(static_cast<unsigned char>(expression[i]))) {
+      // Skip a number whole (1e5, 0x10) and any other character.
+      const bool number = std::isdigit(static_cast<unsigned char>(expression[i])) != 0;
+      ++i;
+      while (number && i < expression.size() && is_name(expression[i])) ++i;
+      continue;
+    }
+    size_t end = i;
+    while (end < expression.size() && is_name(expression[end])) ++end;
+    const std::string name(expression.substr(i, end - i));
+    i = end;
+    if (said.contains(name)) continue;
+    if (const ParamValue* value = scope.Find(name)) {
+      said.insert(name);
+      out += (out.empty() ? "; with " : ", ") + name + " = " + FormatValue(*value);
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
 ParamValue Expressions::Evaluate(std::string_view expression, const Scope& scope) {
   lua_State* L = impl_->lua.L();
   lua_settop(L, 0);
@@ -212,7 +246,12 @@ ParamValue Expressions::Evaluate(std::string_view expression, const Scope& scope
     switch (lua_type(L, -1)) {
       case LUA_TNUMBER: {
         const double value = lua_tonumber(L, -1);
-        if (!std::isfinite(value)) error = "the expression gave " + FormatNumber(value);
+        if (!std::isfinite(value))
+          error = "the expression gave " +
+                  (std::isnan(value) ? std::string("nan (not a number: the square root or "
+                                                   "logarithm of a negative number, or 0/0?)")
+                                     : FormatNumber(value)) +
+                  ValuesUsed(expression, scope);
         result = value;
         break;
       }

@@ -85,7 +85,8 @@ TEST(ValuesTest, ExpressionsSeeTheParametersAndMathAndNothingElse) {
   const Read r(
       "a: = sqrt(robots * 8)\nb: = math.floor(speed * 3) + pi * 0\nc: = name .. '#1'\n"
       "d: = robots > 3\ne: = require('os')\nf: = math.random()\ng: = 1 / 0\nh: = {}\n"
-      "i: = (function() while true do end end)()\nj: =\nk: = rbots + 1\nl: = 1 +\n");
+      "i: = (function() while true do end end)()\nj: =\nk: = rbots + 1\nl: = 1 +\n"
+      "m: = sqrt(-robots / speed) + robots\n");
   EXPECT_EQ(r.values.Resolve(r["a"]), ParamValue(4.0));  // robots is the model's 2
   EXPECT_EQ(r.values.Resolve(r["b"]), ParamValue(1.0));
   EXPECT_EQ(r.values.Resolve(r["c"]), ParamValue(std::string("bot#1")));
@@ -100,6 +101,10 @@ TEST(ValuesTest, ExpressionsSeeTheParametersAndMathAndNothingElse) {
   EXPECT_EQ(error("f").rfind(in("f", "math.random()"), 0), 0u) << error("f");
   EXPECT_NE(error("f").find("random"), std::string::npos) << "no random numbers: " << error("f");
   EXPECT_EQ(error("g"), in("g", "1 / 0") + "the expression gave inf");
+  // NaN (was "-nan"): what it is, and the parameters it used as they were.
+  EXPECT_EQ(error("m"), in("m", "sqrt(-robots / speed) + robots") +
+                            "the expression gave nan (not a number: the square root or logarithm "
+                            "of a negative number, or 0/0?); with robots = 2, speed = 0.5");
   EXPECT_EQ(error("h"),
             in("h", "{}") + "the expression gave table, not a number, boolean or string");
   EXPECT_EQ(error("i").rfind(in("i", "(function() while true do end end)()"), 0), 0u) << error("i");
