@@ -10,14 +10,16 @@ namespace swarmsim {
 namespace {
 
 ObjectId Resolve(const Scene& scene, const CollectionItem& item, ObjectId from,
-                 std::string_view what) {
+                 std::string_view what, Missing missing) {
   if (item.path.empty()) {
-    if (!scene.IsValid(item.id))
+    if (!scene.IsValid(item.id)) {
+      if (missing == Missing::kNone) return {};
       throw Error(std::string(what) + ": an item's object was removed (stale handle)");
+    }
     return item.id;
   }
   const ObjectId id = scene.FindObject(item.path, from);
-  if (id.IsNull())
+  if (id.IsNull() && missing == Missing::kError)
     throw Error((item.where.empty() ? "" : item.where + ": ") + std::string(what) + ": item '" +
                 item.path + "' matches no object" + scene.ExplainMissingPath(item.path, from));
   return id;
@@ -26,7 +28,7 @@ ObjectId Resolve(const Scene& scene, const CollectionItem& item, ObjectId from,
 }  // namespace
 
 std::vector<uint32_t> CollectionSlots(const Scene& scene, std::span<const CollectionItem> items,
-                                      ObjectId from, std::string_view what) {
+                                      ObjectId from, std::string_view what, Missing missing) {
   std::vector<char> in(scene.slot_count(), 0);
   std::vector<uint32_t> subtree;
   for (const CollectionItem& item : items) {
@@ -36,7 +38,8 @@ std::vector<uint32_t> CollectionSlots(const Scene& scene, std::span<const Collec
         if (scene.alive_at(s)) in[s] = mark;
       continue;
     }
-    const ObjectId id = Resolve(scene, item, from, what);
+    const ObjectId id = Resolve(scene, item, from, what, missing);
+    if (id.IsNull()) continue;  // Missing::kNone: a removed robot's
     subtree.clear();
     if (item.kind == CollectionItemKind::kTree)
       scene.CollectSubtree(id.index(), &subtree);
@@ -50,13 +53,13 @@ std::vector<uint32_t> CollectionSlots(const Scene& scene, std::span<const Collec
   return out;
 }
 
-std::vector<uint32_t> CollectionSlots(const Scene& scene, ObjectId collection) {
+std::vector<uint32_t> CollectionSlots(const Scene& scene, ObjectId collection, Missing missing) {
   const uint32_t slot = scene.SlotOf(collection, "collection");
   if (scene.type_at(slot) != ObjectType::kCollection)
     throw Error("object " + scene.PathOf(collection) + " is not a collection");
   const auto& rows = static_cast<const Rows<CollectionRow>&>(*scene.rows(ObjectType::kCollection));
   return CollectionSlots(scene, rows.rows[scene.row_at(slot)].items, collection,
-                         "collection " + scene.PathOf(collection));
+                         "collection " + scene.PathOf(collection), missing);
 }
 
 EntitySpec ParseEntity(std::string_view text) {
@@ -66,12 +69,13 @@ EntitySpec ParseEntity(std::string_view text) {
 }
 
 std::vector<uint32_t> EntitySlots(const Scene& scene, std::string_view path, ObjectId from,
-                                  std::string_view what) {
+                                  std::string_view what, Missing missing) {
   const ObjectId id = scene.FindObject(path, from);
+  if (id.IsNull() && missing == Missing::kNone) return {};
   if (id.IsNull())
     throw Error(std::string(what) + ": '" + std::string(path) + "' matches no object" +
                 scene.ExplainMissingPath(path, from));
-  if (scene.type(id) == ObjectType::kCollection) return CollectionSlots(scene, id);
+  if (scene.type(id) == ObjectType::kCollection) return CollectionSlots(scene, id, missing);
   std::vector<uint32_t> out;
   scene.CollectSubtree(id.index(), &out);
   std::sort(out.begin(), out.end());

@@ -47,13 +47,21 @@ struct CollectionRow {
 // checked once the world is built (ObjectTypeDescriptor::check): a path
 // that matches nothing is an error at its file:line:column.
 
+// What a path that matches nothing (or a stale handle) is: an error (the
+// load's check, a script's call), or nothing (a module resolving again at
+// run time, after the load checked the path: the robot it named was
+// removed, so it names no object now).
+enum class Missing : uint8_t { kError, kNone };
+
 // The slots of the objects `items` name, resolved from `from`, ascending.
 // Throws swarmsim::Error naming `what` and the item when a path matches
-// nothing or a handle is stale.
+// nothing or a handle is stale (with Missing::kNone: the item adds none).
 std::vector<uint32_t> CollectionSlots(const Scene& scene, std::span<const CollectionItem> items,
-                                      ObjectId from, std::string_view what);
+                                      ObjectId from, std::string_view what,
+                                      Missing missing = Missing::kError);
 // The same for the collection object `collection`.
-std::vector<uint32_t> CollectionSlots(const Scene& scene, ObjectId collection);
+std::vector<uint32_t> CollectionSlots(const Scene& scene, ObjectId collection,
+                                      Missing missing = Missing::kError);
 
 struct EntitySpec {
   enum Kind : uint8_t { kPath, kEnvironment, kEverythingElse };
@@ -64,8 +72,8 @@ struct EntitySpec {
 EntitySpec ParseEntity(std::string_view text);
 // The slots an entity path names, resolved from `from`, ascending: a
 // collection's objects, or the object's subtree. Throws swarmsim::Error
-// naming `what` when nothing matches.
+// naming `what` when nothing matches (with Missing::kNone: none).
 std::vector<uint32_t> EntitySlots(const Scene& scene, std::string_view path, ObjectId from,
-                                  std::string_view what);
+                                  std::string_view what, Missing missing = Missing::kError);
 
 }  // namespace swarmsim

@@ -14,6 +14,18 @@ const JointDependency* DependencyAt(const Scene& scene, uint32_t slot) {
   return scene.joints()[scene.row_at(slot)].depends();
 }
 
+// Whether the master of the dependent joint at `slot`, and its masters in
+// turn, are still there (the load checked them: one that is not was in a
+// robot removed since).
+bool MastersThere(const Scene& scene, uint32_t slot, size_t joints) {
+  for (size_t depth = 0; DependencyAt(scene, slot) != nullptr && depth <= joints; ++depth) {
+    const ObjectId master = scene.FindObject(DependencyAt(scene, slot)->master, scene.IdAt(slot));
+    if (master.IsNull() || scene.type(master) != ObjectType::kJoint) return false;
+    slot = master.index();
+  }
+  return true;
+}
+
 }  // namespace
 
 uint32_t JointMasterSlot(const Scene& scene, uint32_t slot) {
@@ -59,6 +71,7 @@ void CheckJointDependency(const Scene& scene, ObjectId id) {
 }
 
 void DependentJoints::Refresh(const Scene& scene) {
+  const bool first = version_ == ~uint64_t{0};
   version_ = scene.structure_version();
   links_.clear();
   // Each dependent joint with its depth (masters above it); by depth, then row.
@@ -70,6 +83,10 @@ void DependentJoints::Refresh(const Scene& scene) {
   for (uint32_t row = 0; row < owners.size(); ++row) {
     const uint32_t slot = owners[row];
     if (!scene.alive_at(slot) || scene.joints()[row].depends() == nullptr) continue;
+    // A master removed at run time (its robot was): the joint keeps where
+    // it is, following nothing. (The first time, a missing master is an
+    // error below: the world was built so.)
+    if (!first && !MastersThere(scene, slot, owners.size())) continue;
     uint32_t depth = 0;
     for (uint32_t s = slot; DependencyAt(scene, s) != nullptr && depth <= owners.size(); ++depth)
       s = JointMasterSlot(scene, s);

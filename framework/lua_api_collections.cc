@@ -105,10 +105,12 @@ std::vector<uint32_t> CollectionArgSlots(lua_State* L, int arg) {
   const lua_Integer handle = ArgInteger(L, arg);
   const Scene& scene = *Context(L).scene;
   if (handle <= kScriptCollectionBase)
-    return CollectionSlots(scene, ScriptCollection(L, handle).items, {}, "the collection");
+    return CollectionSlots(scene, ScriptCollection(L, handle).items, {}, "the collection",
+                           Missing::kNone);
   const ObjectId id = ObjectId::FromInteger(handle);
   const uint32_t slot = scene.SlotOf(id);
-  if (scene.type_at(slot) == ObjectType::kCollection) return CollectionSlots(scene, id);
+  if (scene.type_at(slot) == ObjectType::kCollection)
+    return CollectionSlots(scene, id, Missing::kNone);  // a removed robot's items: none
   std::vector<uint32_t> out;
   scene.CollectSubtree(slot, &out);
   std::sort(out.begin(), out.end());

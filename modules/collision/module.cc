@@ -53,6 +53,9 @@ const Geometry& CollisionModule::Fresh(const World& world) {
 }
 
 void CollisionModule::Resolve(const Scene& scene) {
+  // The first time, a path that names nothing is an error (worlds the
+  // loader did not check); later it named a robot removed since: empty.
+  const Missing missing = jobs_version_ == UINT64_MAX ? Missing::kError : Missing::kNone;
   jobs_.assign(scene.instances().size() + 1, {});
   any_jobs_ = false;
   Scene& s = const_cast<Scene&>(scene);
@@ -71,11 +74,11 @@ void CollisionModule::Resolve(const Scene& scene) {
       throw Error(what +
                   ": the first entity of 'between' must be an object or a collection (got '" +
                   entities[0] + "'); '" + entities[0] + "' may come second");
-    job.a = geometry_.ShapesOf(scene, EntitySlots(scene, first.path, from, what));
+    job.a = geometry_.ShapesOf(scene, EntitySlots(scene, first.path, from, what, missing));
     const EntitySpec second = ParseEntity(entities[1]);
     job.kind = second.kind;
     if (second.kind == EntitySpec::kPath)
-      job.b = geometry_.ShapesOf(scene, EntitySlots(scene, second.path, from, what));
+      job.b = geometry_.ShapesOf(scene, EntitySlots(scene, second.path, from, what, missing));
     const int instance = scene.instance_of_at(owner);
     jobs_[instance >= 0 ? instance : jobs_.size() - 1].push_back(std::move(job));
     any_jobs_ = true;

@@ -354,7 +354,7 @@ class IkGroupsImpl final : public IkGroups {
                     ": 'everything_else' would include the arm itself: name a "
                     "collection, an object or 'environment'");
       if (entity.kind == EntitySpec::kPath)
-        g->obstacle_slots[e] = EntitySlots(scene, entity.path, root, what);
+        g->obstacle_slots[e] = EntitySlots(scene, entity.path, root, what, Missing::kNone);
       g->obstacles[e].kind = entity.kind;
     }
     g->obstacles_resolved = true;

@@ -139,7 +139,8 @@ void PlanningModule::Actuate(World* world) {
     job.target.kind = e.kind;
     if (e.kind == EntitySpec::kPath)
       job.obstacle_slots =
-          geometry.ShapesOf(scene, EntitySlots(scene, e.path, scene.IdAt(owner), what));
+          geometry.ShapesOf(scene, EntitySlots(scene, e.path, scene.IdAt(owner), what,
+                                               Missing::kNone));  // a removed robot: none
   }
   // The plans, one task per worker at a time (a plan is long), on OMPL's
   // module, opened here the first time (a missing one is an error here).

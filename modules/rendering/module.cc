@@ -88,7 +88,8 @@ void RenderingModule::RenderDue(World* world, bool all) {
       mask.assign(scene.slot_count(), 0);
       for (uint32_t slot : EntitySlots(scene, ParseEntity(s.detectable).path, id,
                                        (s.where.empty() ? "" : s.where + ": ") + "vision sensor " +
-                                           scene.PathOf(id) + " ('detectable')"))
+                                           scene.PathOf(id) + " ('detectable')",
+                                       Missing::kNone))
         mask[slot] = 1;
     }
     version_ = scene.structure_version();

@@ -219,6 +219,49 @@ TEST(GraphsRunTest, ScriptStreamsDistancesAndCopiesAtRunTime) {
     EXPECT_NEAR(gap.rows[i - 1][1] - gap.rows[i][1], 0.02, 1e-6) << i;
 }
 
+// A robot removed at run time that a distance object and a collection name
+// (and whose joint another robot's joint follows): the run goes on, the
+// distance finds nothing from then on, the collection lists the others,
+// the follower stays where it was (the run stopped with "matches no
+// object" at the removal's step).
+TEST(GraphsRunTest, WhatNamesARemovedRobotGoesOnWithoutIt) {
+  const fs::path dir =
+      BotWorld("removed", "",
+               "  - {model: follower.yaml, position: [5, 5]}\n"
+               "obstacles:\n"
+               "  - {name: wall, shape: box, size: [0.1, 20, 1], position: [10, 0, 0.5]}\n"
+               "objects:\n"
+               "  - {name: gap, type: distance, between: [/bot#2, /wall]}\n"
+               "  - {name: bots, type: collection, trees: [/bot#1, /bot#2]}\n"
+               "  - {name: clearance, type: graph, streams: [\"distance /gap\"]}\n",
+               "function sysCall_sensing()\n"
+               "  if sim.getObjectName(self) ~= 'bot#0' then return end\n"
+               "  local step = math.floor(sim.getSimulationTime() * 10 + 0.5)\n"
+               "  if step == 10 then sim.removeModel(sim.getObject('/bot#2')) end\n"
+               "  if step == 12 then\n"
+               "    print('collection', #sim.getCollectionObjects(sim.getObject('/bots')))\n"
+               "    print('follower', sim.getJointPosition(sim.getObject('/follower#3/fj')))\n"
+               "  end\n"
+               "end\n");
+  std::ofstream(dir / "follower.yaml")
+      << "model: follower\nobjects: {name: body, type: dummy, children: [{name: fj, type: joint, "
+         "master: \"/bot#2/wheel\"}]}\n";
+  const auto r = RunWorld(dir, 20);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("[bot#0] collection\t2"), std::string::npos)
+      << "bot#1's body and wheel: " << r.output;
+  const Csv gap = ReadCsv(dir / "out/graphs/clearance.csv");
+  ASSERT_EQ(gap.rows.size(), 21u);
+  EXPECT_TRUE(std::isfinite(gap.rows[9][1])) << "bot#2 is there until step 10";
+  EXPECT_TRUE(std::isnan(gap.rows[20][1])) << "then the distance finds nothing (no reading)";
+  // The follower followed the wheel (0.5 rad/s) until the removal, then stays.
+  const size_t at = r.output.find("[bot#0] follower\t");
+  ASSERT_NE(at, std::string::npos) << r.output;
+  const double q = std::stod(r.output.substr(at + 17));
+  EXPECT_GT(q, 0.3) << r.output;
+  EXPECT_LT(q, 0.6) << r.output;
+}
+
 // A proximity stream holds the sensor's reading of the step (what the
 // script read in its sensing), nan when nothing is in range (the copies
 // face random headings: some rays meet the wall, some do not).
