@@ -342,6 +342,9 @@ class IkGroupsImpl final : public IkGroups {
   }
 
   static void ResolveObstacles(Group* g, const Scene& scene) {
+    // The first time a path that names nothing is an error; later it named
+    // a robot removed since, and the obstacle is empty.
+    const Missing missing = g->obstacles_resolved ? Missing::kNone : Missing::kError;
     g->obstacles.assign(g->spec.avoid.size(), {});
     g->obstacle_slots.assign(g->spec.avoid.size(), {});
     const ObjectId root = g->instance >= 0 ? scene.instance(g->instance).root : ObjectId{};
@@ -354,7 +357,7 @@ class IkGroupsImpl final : public IkGroups {
                     ": 'everything_else' would include the arm itself: name a "
                     "collection, an object or 'environment'");
       if (entity.kind == EntitySpec::kPath)
-        g->obstacle_slots[e] = EntitySlots(scene, entity.path, root, what, Missing::kNone);
+        g->obstacle_slots[e] = EntitySlots(scene, entity.path, root, what, missing);
       g->obstacles[e].kind = entity.kind;
     }
     g->obstacles_resolved = true;

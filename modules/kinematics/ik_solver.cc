@@ -327,6 +327,14 @@ IkResult IkProblem::Solve(const IkSettings& settings, std::vector<double>* q_io,
         }
       if (!dropped) break;
     }
+    // The step scaled as a whole to at most max_step in any joint: clamping
+    // each joint on its own turns the step off its direction, which near
+    // the stretched pose made most steps fail and the damping climb (a
+    // reachable target took 25 iterations, past the default 20).
+    double largest = 0;
+    for (int c = 0; c < n; ++c)
+      if (weights(c) != 0) largest = std::max(largest, std::abs(dq(c)));
+    if (largest > settings.max_step) dq *= settings.max_step / largest;
     for (int c = 0; c < n; ++c) {
       if (weights(c) == 0 && kind_[c] == kOne) continue;  // keeps its value (and limits)
       if (kind_[c] == kBallX) {

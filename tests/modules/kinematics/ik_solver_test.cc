@@ -114,6 +114,27 @@ TEST(InverseKinematics, OutOfReachTargetStretchesTheArmTowardsItAndStays) {
   }
 }
 
+// QA's arm (0.5 m and 0.4 m links, nearly stretched at q = (0, 0.3)) and a
+// target 0.67 m from its base: reached within the default 20 iterations, so
+// an IK group with `conditional: true` applies it. Each joint's step
+// clamped on its own turned the steps off their direction: 25 iterations,
+// and the conditional group never moved.
+TEST(InverseKinematics, ANearlyStretchedArmReachesAReachableTargetInTheDefaultIterations) {
+  Scene scene;
+  const ObjectId j1 = scene.AddJoint("j1", {}, {}, Revolute());
+  const ObjectId j2 = scene.AddJoint("j2", j1, {{0.5, 0, 0}, {}}, Revolute());
+  const ObjectId tip = scene.AddDummy("tip", j2, {{0.4, 0, 0}, {}});
+  IkProblem ik;
+  const Vec3 target{0.6, 0.3, 0};
+  ik.AddElement(Chain::FromScene(scene, {}, tip), {target, {}}, kX | kY);
+  std::vector<double> q = {0, 0.3};
+  IkSettings settings;           // applied only when solved
+  settings.max_iterations = 20;  // an IK group's default (ik_groups.h)
+  const IkResult r = ik.Solve(settings, &q);
+  EXPECT_TRUE(r.solved) << r.position_error << " after " << r.iterations << " iterations";
+  EXPECT_LE((ik.chain(0).CalcTipPose(q).p - target).Norm(), settings.position_tolerance);
+}
+
 TEST(InverseKinematics, RespectsJointLimits) {
   Scene scene;
   const double l1 = 0.5, l2 = 0.5;
