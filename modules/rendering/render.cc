@@ -1,4 +1,5 @@
-// Drawing with Mesa's off-screen OpenGL (OSMesa), fixed-function GL 1.x.
+// Drawing with Mesa's off-screen OpenGL (OSMesa): fixed-function GL 1.x, and a GLSL 1.20
+// program that lights point and spot lights per pixel (LitProgram).
 // libOSMesa is opened at run time (dlopen), so a machine without it runs
 // every world that renders nothing and gets a clear message otherwise.
 // One context per thread, made once and kept for the process.
@@ -38,6 +39,29 @@ struct Gl {
 #define SWARMSIM_DECLARE(name) decltype(&::name) name = nullptr;
   SWARMSIM_GL_FUNCTIONS(SWARMSIM_DECLARE)
 #undef SWARMSIM_DECLARE
+  // GL 2.0's shaders, for point and spot lights lit per pixel (LitProgram);
+  // optional: without them every light is lit per vertex, as before.
+#define SWARMSIM_GL_SHADER_FUNCTIONS(X)                                                      \
+  X(glCreateShader)                                                                          \
+  X(glShaderSource) X(glCompileShader) X(glGetShaderiv) X(glCreateProgram) X(glAttachShader) \
+      X(glLinkProgram) X(glGetProgramiv) X(glUseProgram) X(glGetUniformLocation) X(glUniform1i)
+#define SWARMSIM_DECLARE(name) PFN##name##PROC name = nullptr;
+  struct Shaders {
+    using PFNglCreateShaderPROC = GLuint (*)(GLenum);
+    using PFNglShaderSourcePROC = void (*)(GLuint, GLsizei, const char* const*, const GLint*);
+    using PFNglCompileShaderPROC = void (*)(GLuint);
+    using PFNglGetShaderivPROC = void (*)(GLuint, GLenum, GLint*);
+    using PFNglCreateProgramPROC = GLuint (*)();
+    using PFNglAttachShaderPROC = void (*)(GLuint, GLuint);
+    using PFNglLinkProgramPROC = void (*)(GLuint);
+    using PFNglGetProgramivPROC = void (*)(GLuint, GLenum, GLint*);
+    using PFNglUseProgramPROC = void (*)(GLuint);
+    using PFNglGetUniformLocationPROC = GLint (*)(GLuint, const char*);
+    using PFNglUniform1iPROC = void (*)(GLint, GLint);
+    SWARMSIM_GL_SHADER_FUNCTIONS(SWARMSIM_DECLARE)
+    bool present = false;
+  } shaders;
+#undef SWARMSIM_DECLARE
   decltype(&::OSMesaCreateContextExt) CreateContextExt = nullptr;
   decltype(&::OSMesaMakeCurrent) MakeCurrent = nullptr;
   decltype(&::OSMesaPixelStore) PixelStore = nullptr;
@@ -75,6 +99,12 @@ const Gl& Library() {
 #define SWARMSIM_LOAD(name) g.name = reinterpret_cast<decltype(g.name)>(sym(#name));
     SWARMSIM_GL_FUNCTIONS(SWARMSIM_LOAD)
 #undef SWARMSIM_LOAD
+    g.shaders.present = true;
+#define SWARMSIM_LOAD(name)                                                            \
+  g.shaders.name = reinterpret_cast<decltype(g.shaders.name)>(FindSymbol(lib, #name)); \
+  g.shaders.present = g.shaders.present && g.shaders.name != nullptr;
+    SWARMSIM_GL_SHADER_FUNCTIONS(SWARMSIM_LOAD)
+#undef SWARMSIM_LOAD
     return g;
   }();
   return gl;
@@ -88,6 +118,11 @@ struct Context {
   unsigned paint_texture = 0;
   const uint8_t* paint_source = nullptr;  // what the texture holds, and of which step
   int64_t paint_step = -2;
+  // The per-pixel lighting program (LitProgram): 0 until made, or when the
+  // library cannot make it (then lights are per vertex).
+  unsigned lit_program = 0;
+  bool lit_tried = false;
+  int lit_lights = -1, lit_textured = -1, lit_paint = -1;  // its uniforms
 };
 
 Context& ThisThreadContext(const Gl& gl) {
@@ -107,6 +142,97 @@ Context& ThisThreadContext(const Gl& gl) {
     context = c;
   }
   return *context;
+}
+
+// GL's lighting equation as the fixed-function pipeline computes it per
+// vertex (ambient model x colour, plus each light's diffuse x attenuation x
+// spot factor x max(n.l, 0); two-sided; colour material), computed per
+// pixel instead: a spot or point light aimed at the middle of a wall much
+// larger than its cone lit no vertex of it, so per vertex the wall stayed
+// dark (QA: a 15-degree spot on a 10 m wall). Directional lights give the
+// same light at every point of a flat face either way, so a world without
+// point or spot lights keeps the fixed-function pipeline (and its bytes).
+constexpr const char* kLitVertexShader = R"(#version 120
+varying vec3 eye_position;
+varying vec3 eye_normal;
+void main() {
+  vec4 p = gl_ModelViewMatrix * gl_Vertex;
+  eye_position = p.xyz / p.w;
+  eye_normal = gl_NormalMatrix * gl_Normal;
+  gl_FrontColor = gl_Color;
+  gl_BackColor = gl_Color;
+  gl_TexCoord[0] = gl_MultiTexCoord0;
+  gl_Position = ftransform();
+}
+)";
+constexpr const char* kLitFragmentShader = R"(#version 120
+uniform int lights;
+uniform int textured;
+uniform sampler2D paint;
+varying vec3 eye_position;
+varying vec3 eye_normal;
+void main() {
+  vec3 n = normalize(eye_normal);
+  if (!gl_FrontFacing) n = -n;
+  vec3 colour = gl_Color.rgb;
+  vec3 light = gl_LightModel.ambient.rgb;
+  for (int i = 0; i < 8; ++i) {
+    if (i >= lights) break;
+    vec3 l;
+    float attenuation = 1.0;
+    if (gl_LightSource[i].position.w == 0.0) {
+      l = normalize(gl_LightSource[i].position.xyz);
+    } else {
+      vec3 d = gl_LightSource[i].position.xyz - eye_position;
+      float distance = length(d);
+      l = d / distance;
+      attenuation = 1.0 / (gl_LightSource[i].constantAttenuation +
+                           gl_LightSource[i].linearAttenuation * distance +
+                           gl_LightSource[i].quadraticAttenuation * distance * distance);
+      if (gl_LightSource[i].spotCutoff <= 90.0) {
+        float c = dot(-l, normalize(gl_LightSource[i].spotDirection));
+        attenuation *= c >= gl_LightSource[i].spotCosCutoff
+                           ? pow(max(c, 0.0), gl_LightSource[i].spotExponent) : 0.0;
+      }
+    }
+    light += attenuation * max(dot(n, l), 0.0) * gl_LightSource[i].diffuse.rgb;
+  }
+  vec4 result = vec4(min(light * colour, vec3(1.0)), 1.0);
+  if (textured != 0) result *= texture2D(paint, gl_TexCoord[0].st);
+  gl_FragColor = result;
+}
+)";
+
+// The context's per-pixel lighting program, made the first time it is
+// asked for; 0 when it cannot be (no GL 2.0 in this library).
+unsigned LitProgram(const Gl& gl, Context* c) {
+  if (c->lit_tried) return c->lit_program;
+  c->lit_tried = true;
+  const auto& sh = gl.shaders;
+  if (!sh.present) return 0;
+  const auto compile = [&](GLenum kind, const char* text) -> GLuint {
+    const GLuint shader = sh.glCreateShader(kind);
+    sh.glShaderSource(shader, 1, &text, nullptr);
+    sh.glCompileShader(shader);
+    GLint ok = 0;
+    sh.glGetShaderiv(shader, 0x8B81 /* GL_COMPILE_STATUS */, &ok);
+    return ok ? shader : 0;
+  };
+  const GLuint vertex = compile(0x8B31 /* GL_VERTEX_SHADER */, kLitVertexShader);
+  const GLuint fragment = compile(0x8B30 /* GL_FRAGMENT_SHADER */, kLitFragmentShader);
+  if (vertex == 0 || fragment == 0) return 0;
+  const GLuint program = sh.glCreateProgram();
+  sh.glAttachShader(program, vertex);
+  sh.glAttachShader(program, fragment);
+  sh.glLinkProgram(program);
+  GLint ok = 0;
+  sh.glGetProgramiv(program, 0x8B82 /* GL_LINK_STATUS */, &ok);
+  if (!ok) return 0;
+  c->lit_lights = sh.glGetUniformLocation(program, "lights");
+  c->lit_textured = sh.glGetUniformLocation(program, "textured");
+  c->lit_paint = sh.glGetUniformLocation(program, "paint");
+  c->lit_program = program;
+  return program;
 }
 
 struct Mat4 {
@@ -225,8 +351,8 @@ void SetLights(const Gl& gl, const DrawList& list) {
 }
 
 // The floor: a square under the eye reaching the far plane, then the paint
-// layer's texture over its area, just above.
-void DrawFloor(const Gl& gl, Context* c, const DrawList& list, const View& view) {
+// layer's texture over its area, just above. `lit`: drawn with LitProgram.
+void DrawFloor(const Gl& gl, Context* c, const DrawList& list, const View& view, bool lit) {
   // (An orthographic view sees as far sideways as its width, whatever its far plane.)
   const double s = view.far + std::abs(view.pose.p.z) + (view.orthographic ? view.ortho_width : 0);
   const float x0 = static_cast<float>(view.pose.p.x - s),
@@ -255,6 +381,7 @@ void DrawFloor(const Gl& gl, Context* c, const DrawList& list, const View& view)
     }
     gl.glTexEnvi(GL_TEXTURE_ENV, GL_TEXTURE_ENV_MODE, GL_MODULATE);
     gl.glEnable(GL_TEXTURE_2D);
+    if (lit) gl.shaders.glUniform1i(c->lit_textured, 1);
     const float z = 1e-4f;
     const float px0 = static_cast<float>(f.min_x), px1 = static_cast<float>(f.max_x);
     const float py0 = static_cast<float>(f.min_y), py1 = static_cast<float>(f.max_y);
@@ -269,6 +396,7 @@ void DrawFloor(const Gl& gl, Context* c, const DrawList& list, const View& view)
     gl.glDrawArrays(GL_TRIANGLES, 0, 6);
     gl.glDisableClientState(GL_TEXTURE_COORD_ARRAY);
     gl.glDisable(GL_TEXTURE_2D);
+    if (lit) gl.shaders.glUniform1i(c->lit_textured, 0);
   }
   gl.glEnableClientState(GL_NORMAL_ARRAY);
   gl.glEnableClientState(GL_COLOR_ARRAY);
@@ -326,7 +454,19 @@ void Draw(const DrawList& list, const View& view, const DrawOptions& options, Im
   gl.glEnableClientState(GL_VERTEX_ARRAY);
   gl.glEnableClientState(GL_NORMAL_ARRAY);
   gl.glEnableClientState(GL_COLOR_ARRAY);
-  if (options.floor) DrawFloor(gl, &c, list, view);
+  // Point and spot lights: lit per pixel (LitProgram).
+  const size_t lights = list.scene_has_lights ? std::min<size_t>(8, list.lights.size()) : 0;
+  bool local_lights = false;
+  for (size_t i = 0; i < lights; ++i)
+    local_lights = local_lights || list.lights[i].kind != LightSource::kDirectional;
+  const unsigned program = local_lights ? LitProgram(gl, &c) : 0;
+  if (program != 0) {
+    gl.shaders.glUseProgram(program);
+    gl.shaders.glUniform1i(c.lit_lights, static_cast<int>(lights));
+    gl.shaders.glUniform1i(c.lit_textured, 0);
+    gl.shaders.glUniform1i(c.lit_paint, 0);
+  }
+  if (options.floor) DrawFloor(gl, &c, list, view, program != 0);
 
   gl.glVertexPointer(3, GL_FLOAT, 0, list.xyz.data());
   gl.glNormalPointer(GL_FLOAT, 0, list.normal.data());
@@ -334,7 +474,10 @@ void Draw(const DrawList& list, const View& view, const DrawOptions& options, Im
   // Runs of neighbouring visible items make one call each; lit items, then
   // emissive ones (LEDs) without lighting.
   for (const bool emissive : {false, true}) {
-    if (emissive) gl.glDisable(GL_LIGHTING);
+    if (emissive) {
+      if (program != 0) gl.shaders.glUseProgram(0);  // unlit: the fixed pipeline
+      gl.glDisable(GL_LIGHTING);
+    }
     uint32_t run_first = 0, run_count = 0;
     for (const DrawItem& item : list.items) {
       bool draw = item.emissive == emissive;

@@ -133,6 +133,54 @@ TEST(RenderTest, TheSameListGivesTheSameBytesOnAnotherThread) {
   EXPECT_EQ(here.rgb, there.rgb);
 }
 
+// A white wall 10 m wide, its face 1 m ahead of the eye, lit by one light
+// the test places (the ambient term is 0.2: 51 of 255).
+struct LitWall {
+  ModuleWorld w;
+  DrawList list;
+  LitWall() {
+    ShapeData wall;
+    wall.kind = ShapeKind::kBox;
+    wall.size = {0.2, 10, 10};
+    wall.color = {1, 1, 1};
+    w.scene().AddShape("wall", {}, {{1.1, 0, 0.5}, {}}, wall);
+    EXPECT_EQ(w.Run(0), "");
+    BuildDrawList(w.world(), 16, &list);
+    list.scene_has_lights = true;
+  }
+  int Red(const LightSource& light, int x, int y) {
+    list.lights = {light};
+    View eye;  // along +x, 60 degrees across
+    eye.pose = {{0, 0, 0.5}, {}};
+    eye.width = eye.height = 9;
+    Image image;
+    Draw(list, eye, Plain(), &image);
+    return image.Pixel(x, y)[0];
+  }
+};
+
+// Point and spot lights are lit per pixel: a spot aimed at the middle of a
+// wall much larger than its cone lit no vertex of it, so per vertex the
+// middle stayed at the ambient level (QA: 51 where the cone falls).
+TEST(RenderTest, ASpotLightsWhereItsConeFallsOnALargeFace) {
+  LitWall s;
+  LightSource spot;
+  spot.kind = LightSource::kSpot;
+  spot.position = {0, 0, 0.5};
+  spot.direction = {1, 0, 0};
+  spot.cutoff = 15 * M_PI / 180;
+  EXPECT_EQ(s.Red(spot, 4, 4), 255) << "on the axis: 0.2 + cos 0, capped";
+  EXPECT_EQ(s.Red(spot, 0, 4), 51) << "27 degrees off the axis: outside the cone, ambient";
+}
+
+TEST(RenderTest, APointLightOnALargeFaceFollowsLambertsLaw) {
+  LitWall s;
+  LightSource point;
+  point.kind = LightSource::kPoint;
+  point.position = {0.5, 0.5, 0.5};  // 45 degrees off the middle's normal
+  EXPECT_NEAR(s.Red(point, 4, 4), 255 * (0.2 + M_SQRT1_2), 2);  // was 76
+}
+
 TEST(RenderTest, AnImageTooLargeIsRefused) {
   Cubes s;
   View v = Cubes::Above();
