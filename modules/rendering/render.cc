@@ -41,11 +41,12 @@ struct Gl {
 #undef SWARMSIM_DECLARE
   // GL 2.0's shaders, for point and spot lights lit per pixel (LitProgram);
   // optional: without them every light is lit per vertex, as before.
-#define SWARMSIM_GL_SHADER_FUNCTIONS(X)                                                     \
-  X(glCreateShader)                                                                         \
-  X(glShaderSource)                                                                         \
-  X(glCompileShader) X(glGetShaderiv) X(glCreateProgram) X(glAttachShader) X(glLinkProgram) \
-      X(glGetProgramiv) X(glUseProgram) X(glGetUniformLocation) X(glUniform1i)
+  // clang-format off
+#define SWARMSIM_GL_SHADER_FUNCTIONS(X) \
+  X(glCreateShader) X(glShaderSource) X(glCompileShader) X(glGetShaderiv) \
+  X(glCreateProgram) X(glAttachShader) X(glLinkProgram) X(glGetProgramiv) \
+  X(glUseProgram) X(glGetUniformLocation) X(glUniform1i)
+  // clang-format on
 #define SWARMSIM_DECLARE(name) PFN##name##PROC name = nullptr;
   struct Shaders {
     using PFNglCreateShaderPROC = GLuint (*)(GLenum);
