@@ -193,8 +193,10 @@ void main() {
                            gl_LightSource[i].quadraticAttenuation * distance * distance);
       if (gl_LightSource[i].spotCutoff <= 90.0) {
         float c = dot(-l, normalize(gl_LightSource[i].spotDirection));
+        // GLSL leaves pow(0, 0) undefined; GL's spot factor is then 1.
+        float e = gl_LightSource[i].spotExponent;
         attenuation *= c >= gl_LightSource[i].spotCosCutoff
-                           ? pow(max(c, 0.0), gl_LightSource[i].spotExponent) : 0.0;
+                           ? (e == 0.0 ? 1.0 : pow(max(c, 0.0), e)) : 0.0;
       }
     }
     light += attenuation * max(dot(n, l), 0.0) * gl_LightSource[i].diffuse.rgb;
