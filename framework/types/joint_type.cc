@@ -3,6 +3,7 @@
 // (spherical), or holds them (fixed); passive, velocity-, position- or
 // force-driven, or dependent on another joint (master, factor, offset).
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <string>
 
@@ -195,7 +196,18 @@ void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
   if (r.Has("max_velocity")) settings.max_velocity = r.Number("max_velocity", kPositive);
   if (r.Has("target_velocity")) j.target_velocity = r.Number("target_velocity", kAnyNumber);
   if (r.Has("target_position")) j.target_position = r.Number("target_position", kAnyNumber);
-  if (r.Has("initial_position")) j.position = r.Number("initial_position", kAnyNumber);
+  if (r.Has("initial_position")) {
+    j.position = r.Number("initial_position", kAnyNumber);
+    // A joint placed past its own stops: ODE snapped it back with a jolt on
+    // the first step, the other backends kept it there.
+    if (r.Has("limits") &&
+        !(j.position >= settings.min_position && j.position <= settings.max_position)) {
+      char text[120];
+      std::snprintf(text, sizeof text, "'initial_position' %.9g is outside 'limits' [%.9g, %.9g]",
+                    j.position, settings.min_position, settings.max_position);
+      r.Fail("initial_position", text);
+    }
+  }
 }
 
 // A dependent joint's master is a joint, and masters never lead back to it.

@@ -281,7 +281,8 @@ ParamValue ParseScalar(std::string_view text, bool quoted) {
 }
 
 const char* TypeName(const ParamValue& value) {
-  if (std::holds_alternative<double>(value)) return "a number";
+  // "finite": "nan" and "inf" never read as a parameter's number.
+  if (std::holds_alternative<double>(value)) return "a finite number";
   if (std::holds_alternative<bool>(value)) return "a boolean";
   return "a string";
 }

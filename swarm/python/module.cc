@@ -312,7 +312,9 @@ PYBIND11_MODULE(_swarmsim, m) {
           "Runs the world as `swarmsim run` does: steps (None: the world's duration), a\n"
           "progress bar and summary table on stderr/stdout unless quiet, 'state-hash: ...'\n"
           "printed when hash, and with out_dir (a folder, made if missing) summary.json and\n"
-          "metrics.csv written as the run goes. The world is stopped at the end (its\n"
+          "metrics.csv written as the run goes (one run at a time writes into a folder:\n"
+          "ValueError while another run, here or `swarmsim run --out`, holds it). The\n"
+          "world is stopped at the end (its\n"
           "scripts' cleanups run): it can be read, not stepped. Returns {steps,\n"
           "wall_seconds, start_seconds, peak_rss_mb, state_hash}; raises RuntimeError for\n"
           "the run's error (its outputs written) and KeyboardInterrupt for Ctrl-C.")

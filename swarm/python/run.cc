@@ -14,6 +14,7 @@
 #include "framework/state_hash.h"
 #include "framework/utf8.h"
 #include "swarm/python/world.h"
+#include "swarm/run/file_lock.h"
 #include "swarm/run/runner.h"
 
 namespace swarmsim::python {
@@ -70,13 +71,22 @@ py::dict PyWorld::Run(std::optional<int64_t> steps, const std::optional<std::str
   options.overrides = loaded_overrides_;
   options.load_seconds = load_seconds_;
   options.on_metrics = [this](const std::vector<MetricSample>& samples) { KeepMetrics(samples); };
+  // One run at a time writes into a folder, as with `swarmsim run --out`
+  // (the same DIR/.swarmsim-lock), held until the run returns.
+  std::optional<FileLock> out_lock;
   if (out) {
     const std::filesystem::path dir(*out);
     try {
       CreateOutputFolder(dir);
+      out_lock.emplace((dir / ".swarmsim-lock").string());
     } catch (const Error& e) {
       throw py::value_error(std::string("run(out_dir=...): ") + e.what());
     }
+    if (!out_lock->held())
+      throw py::value_error(
+          "run(out_dir=...): another run" +
+          (out_lock->holder().empty() ? std::string() : " (process " + out_lock->holder() + ")") +
+          " is writing into '" + ValidUtf8(dir.string()) + "'; wait for it to end, or pass another out_dir");
     if (const std::string note = RemoveEarlierOutputs(dir); !note.empty())
       std::cerr << "note: " << ValidUtf8(note) << std::endl;
     options.out_dir = dir;

@@ -226,7 +226,7 @@ class MisuseTest(unittest.TestCase):
             e = expect(ValueError, "World(set=...) robtos=4: no parameter 'robtos'",
                        swarmsim.World, WORLD, set={"robtos": 4})
             assert "--set" not in str(e), e
-            expect(ValueError, "World(set=...) robots=abc: parameter 'robots' is a number",
+            expect(ValueError, "World(set=...) robots=abc: parameter 'robots' is a finite number",
                    swarmsim.World, WORLD, set={"robots": "abc"})
         ''')
 

@@ -115,6 +115,54 @@ class RunTest(unittest.TestCase):
         w.close()
 
 
+    def test_one_run_at_a_time_writes_into_a_folder(self):
+        # run(out_dir) holds the folder as `swarmsim run --out` does (they
+        # mixed their metrics and snapshots): a command-line run into it
+        # meanwhile is refused, and run(out_dir) into a command-line run's.
+        seen = {}
+        with tempfile.TemporaryDirectory() as d:
+            def control(robots):
+                if robots.step == 3:
+                    seen["cli"] = run([BINARY, "run", world("diffusion.yaml"), "--set", "robots=2",
+                                       "--steps", "2", "--quiet", "--out", d])
+                return {}
+            w = swarmsim.World(world("diffusion.yaml"), set={"robots": 4},
+                               controllers={"footbot": control})
+            w.run(6, out_dir=d, quiet=True)
+            w.close()
+            code, out = seen["cli"]
+            self.assertEqual(code, 2, out)
+            self.assertIn("error: --out: another run (process %d) is writing into" % os.getpid(),
+                          out)
+            with open(os.path.join(d, "summary.json")) as f:
+                self.assertEqual(json.load(f)["steps"], 6, "the first run's, whole")
+            self.assertFalse(os.path.exists(os.path.join(d, ".swarmsim-lock")))
+
+            cli = subprocess.Popen([BINARY, "run", world("diffusion.yaml"), "--set", "robots=2",
+                                    "--steps", "1000000000", "--quiet", "--out", d],
+                                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            try:
+                lock = os.path.join(d, ".swarmsim-lock")
+                deadline = time.monotonic() + 60
+                while time.monotonic() < deadline:  # until it holds the folder
+                    try:
+                        with open(lock) as f:
+                            if f.read().strip() == str(cli.pid):
+                                break
+                    except OSError:
+                        pass  # not made yet
+                    time.sleep(0.01)
+                other = swarmsim.World(world("diffusion.yaml"), set={"robots": 2})
+                with self.assertRaisesRegex(ValueError, r"run\(out_dir=...\): another run "
+                                            r"\(process %d\) is writing into" % cli.pid):
+                    other.run(2, out_dir=d, quiet=True)
+                self.assertEqual(other.steps, 0)
+                other.close()
+            finally:
+                cli.terminate()
+                cli.wait()
+
+
 class ProgramTest(unittest.TestCase):
     def test_the_program_refuses_a_python_world_and_says_how_to_run_it(self):
         code, out = run([BINARY, "run", world("python", "diffusion_numpy.yaml"), "--steps", "2"])

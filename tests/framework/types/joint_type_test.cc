@@ -142,6 +142,15 @@ TEST(JointTypeTest, LimitsMustBeOrderedAndForcesPositive) {
   const JointData pinned = Read(FakeReader{{"limits", std::vector<double>{0.5, 0.5}}});
   EXPECT_EQ(pinned.settings->min_position, 0.5);
   EXPECT_EQ(pinned.settings->max_position, 0.5);
+  // A joint may not start past its own stops (ODE snapped it back with a jolt).
+  EXPECT_EQ(ErrorOf([] {
+              Read(FakeReader{{"limits", std::vector<double>{-0.5, 1}},
+                              {"initial_position", 1.25}});
+            }),
+            "model.yaml:3:3: 'initial_position' 1.25 is outside 'limits' [-0.5, 1]");
+  EXPECT_EQ(Read(FakeReader{{"limits", std::vector<double>{-0.5, 1}}, {"initial_position", 1.0}})
+                .position,
+            1.0);
   EXPECT_CONTAINS(ErrorOf([] { Read(FakeReader{{"max_force", 0.0}}); }), "a positive number");
   EXPECT_CONTAINS(ErrorOf([] { Read(FakeReader{{"damping", -1.0}}); }), "a non-negative number");
   EXPECT_CONTAINS(ErrorOf([] {

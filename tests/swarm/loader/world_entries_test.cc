@@ -152,7 +152,7 @@ TEST_F(ControlLoaderTest, EntryParametersAreOfTheirDeclaredType) {
       "    position: [0, 0]\n"
       "    parameters: ";
   EXPECT_CONTAINS(ErrorOf(entry + "{speed: fast}\n"),
-                  "world.yaml:5:25: parameter 'speed' of model 'bot' is a number (");
+                  "world.yaml:5:25: parameter 'speed' of model 'bot' is a finite number (");
   EXPECT_CONTAINS(ErrorOf(entry + "{speed: fast}\n"), "bot.yaml:3:20), got \"fast\"");
   EXPECT_CONTAINS(ErrorOf(entry + "{sped: 0.2}\n"),
                   "world.yaml:5:18: model 'bot' has no parameter 'sped'; did you mean 'speed'?");

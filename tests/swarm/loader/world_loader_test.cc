@@ -208,8 +208,12 @@ TEST(WorldLoaderTest, BadOverridesAreErrorsWithSuggestions) {
   EXPECT_NE(no_model.find("footbot.delta"), std::string::npos) << no_model;
   const std::string type = ErrorOf([] { LoadDiffusion({{"robots", "many"}}); });
   EXPECT_NE(type.find("--set robots=many"), std::string::npos) << type;
-  EXPECT_NE(type.find("is a number"), std::string::npos) << type;
+  EXPECT_NE(type.find("is a finite number"), std::string::npos) << type;
   EXPECT_NE(type.find("diffusion.yaml:14:11"), std::string::npos) << type;
+  // "nan" reads as a number to strtod, never as a parameter's.
+  const std::string nan = ErrorOf([] { LoadDiffusion({{"robots", "nan"}}); });
+  EXPECT_NE(nan.find("--set robots=nan: parameter 'robots' is a finite number"), std::string::npos)
+      << nan;
   const std::string negative = ErrorOf([] { LoadDiffusion({{"robots", "-5"}}); });
   EXPECT_NE(negative.find("'size'"), std::string::npos) << negative;
 }
@@ -421,7 +425,7 @@ TEST_F(MalformedWorldTest, EachMistakeHasAClearMessage) {
        {"world.yaml:6:18:", "model 'bot' has no parameter 'sped'", "did you mean 'speed'?"}},
       {"model parameter type",
        "arena: {size: 2}\n" + models + "    parameters: {speed: fast}\n",
-       {"world.yaml:6:25:", "is a number", "\"fast\"", "bot.yaml:3:20"}},
+       {"world.yaml:6:25:", "is a finite number", "\"fast\"", "bot.yaml:3:20"}},
       {"duplicate key",
        "arena: {size: 2, size: 3}\n",
        {"world.yaml:1:18:", "duplicate key 'size'"}},
