@@ -332,7 +332,8 @@ std::vector<ModelSummary> WorldLoader::Summarize() const {
     m.file = e.model->file.name();
     m.count = e.count;
     m.spatial_order = e.spatial_order;
-    const ValueReader defaults(e.model->file, &expressions_, {&parameters_, nullptr});
+    // A default that uses the model's parameters above it: with their values.
+    const ValueReader defaults(e.model->file, &expressions_, {&parameters_, e.parameters.get()});
     for (const auto& decl : e.model->parameters) {
       ParameterSummary p;
       p.name = decl.name;

@@ -293,56 +293,66 @@ void WorldLoader::ResolveNativeController(const Fields& f, const ValueReader& wo
 void WorldLoader::ResolveEntryParameters(const Fields& f, const ValueReader& world_values,
                                          DeclaredParameters* declared, EntryPlan* entry) {
   const ModelFile& model = *entry->model;
-  auto params = std::make_shared<ParameterSet>();
-  {
-    const ValueReader defaults(model.file, &expressions_, {&parameters_, nullptr});
-    for (const auto& decl : model.parameters) {
-      (*params)[decl.name] = defaults.Resolve(decl.default_value);
-      declared->where[decl.name] = model.file.Where(decl.default_value.mark);
-      declared->names.push_back(decl.name);
-    }
+  for (const auto& decl : model.parameters) {
+    declared->where[decl.name] = model.file.Where(decl.default_value.mark);
+    declared->names.push_back(decl.name);
   }
-  for (const auto& decl : model.parameters)
-    if (std::string e = RangeError(decl, model.name, (*params)[decl.name]); !e.empty())
-      model.file.Fail(decl.default_value.mark, "the default of " + e);
-  if (f.Has("parameters"))
-    ApplyParameterValues(model, f.Get("parameters"), world_values, declared, params.get());
-  for (Override& o : overrides_) {
-    if (o.model != model.name) continue;
-    auto it = params->find(o.name);
-    it->second = CoerceOverride(o, it->second, declared->where[o.name]);
-    for (const auto& decl : model.parameters)
-      if (decl.name == o.name)
-        if (std::string e = RangeError(decl, model.name, it->second); !e.empty())
-          throw Error(o.text + ": " + e + " (declared at " + declared->where[o.name] + ")");
-  }
-  entry->parameters = params;
+  const Field none;
+  entry->parameters = ModelParameters(model, f.Has("parameters") ? f.Get("parameters") : none, none,
+                                      world_values, *declared);
 }
 
-// Values given in the world file (the entry's, or one instance's) over `set`.
-void WorldLoader::ApplyParameterValues(const ModelFile& model, const Field& field,
-                                       const ValueReader& world_values,
-                                       DeclaredParameters* declared, ParameterSet* set) {
-  const std::vector<std::string>& names = declared->names;
-  Fields given(*file_, field, "the parameters of model '" + model.name + "'");
-  for (const Field& p : given.fields()) {
-    auto it = set->find(p.name);
-    if (it == set->end())
-      file_->Fail(p.key_mark,
-                  "model '" + model.name + "' has no parameter '" + p.name + "'" +
-                      (names.empty() ? " (it declares none)" : loader::Suggest(p.name, names)));
-    const ParamValue value = world_values.Resolve(p);
-    if (value.index() != it->second.index() && !std::holds_alternative<std::string>(it->second))
-      file_->Fail(p.mark, "parameter '" + p.name + "' of model '" + model.name + "' is " +
-                              loader::TypeName(it->second) + " (" + declared->where[p.name] +
-                              "), got " + loader::Describe(p.node));
-    it->second =
-        std::holds_alternative<std::string>(it->second) ? ParamValue(ParamToString(value)) : value;
-    for (const auto& decl : model.parameters)
-      if (decl.name == p.name)
-        if (std::string e = RangeError(decl, model.name, it->second); !e.empty())
-          file_->Fail(p.mark, e);
+// One copy's values, in the model's declaration order: the default (which
+// may use the world's parameters and the model's above it, with the values
+// this copy ends with), then the entry's value, then the copy's own
+// (`instances`), then --set.
+std::shared_ptr<ParameterSet> WorldLoader::ModelParameters(const ModelFile& model,
+                                                           const Field& entry_values,
+                                                           const Field& own_values,
+                                                           const ValueReader& world_values,
+                                                           const DeclaredParameters& declared) {
+  const std::vector<std::string>& names = declared.names;
+  std::vector<Fields> layers;
+  for (const Field* given : {&entry_values, &own_values}) {
+    if (!given->present()) continue;
+    layers.emplace_back(*file_, *given, "the parameters of model '" + model.name + "'");
+    for (const Field& p : layers.back().fields())
+      if (!declared.where.contains(p.name))
+        file_->Fail(p.key_mark,
+                    "model '" + model.name + "' has no parameter '" + p.name + "'" +
+                        (names.empty() ? " (it declares none)" : loader::Suggest(p.name, names)));
   }
+  auto params = std::make_shared<ParameterSet>();
+  loader::ParametersBeingRead reading;
+  for (const auto& decl : model.parameters)
+    reading.later.emplace(decl.name, "line " + std::to_string(decl.mark.line + 1));
+  for (const auto& decl : model.parameters) {
+    reading.current = decl.name;
+    reading.later.erase(decl.name);
+    const ValueReader defaults(model.file, &expressions_, {&parameters_, params.get(), &reading});
+    ParamValue value = defaults.Resolve(decl.default_value);
+    if (std::string e = RangeError(decl, model.name, value); !e.empty())
+      model.file.Fail(decl.default_value.mark, "the default of " + e);
+    for (const Fields& layer : layers) {
+      if (!layer.Has(decl.name)) continue;
+      const Field p = layer.Get(decl.name);
+      const ParamValue given = world_values.Resolve(p);
+      if (given.index() != value.index() && !std::holds_alternative<std::string>(value))
+        file_->Fail(p.mark, "parameter '" + p.name + "' of model '" + model.name + "' is " +
+                                loader::TypeName(value) + " (" + declared.where.at(p.name) +
+                                "), got " + loader::Describe(p.node));
+      value = std::holds_alternative<std::string>(value) ? ParamValue(ParamToString(given)) : given;
+      if (std::string e = RangeError(decl, model.name, value); !e.empty()) file_->Fail(p.mark, e);
+    }
+    for (Override& o : overrides_) {
+      if (o.model != model.name || o.name != decl.name) continue;
+      value = CoerceOverride(o, value, declared.where.at(o.name));
+      if (std::string e = RangeError(decl, model.name, value); !e.empty())
+        throw Error(o.text + ": " + e + " (declared at " + declared.where.at(o.name) + ")");
+    }
+    (*params)[decl.name] = std::move(value);
+  }
+  return params;
 }
 
 // instances: copies with their own values: over the entry's, before --set
@@ -350,7 +360,6 @@ void WorldLoader::ApplyParameterValues(const ModelFile& model, const Field& fiel
 void WorldLoader::ReadOwnCopies(const Fields& f, const ValueReader& world_values,
                                 DeclaredParameters* declared, EntryPlan* entry) {
   const ModelFile& model = *entry->model;
-  const std::shared_ptr<ParameterSet>& params = entry->parameters;
   for (const Field& element : loader::ListElements(*file_, f.Get("instances"), "instances")) {
     Fields inst(*file_, element, "an instances entry");
     inst.Expect({"index", "parameters"});
@@ -358,10 +367,9 @@ void WorldLoader::ReadOwnCopies(const Fields& f, const ValueReader& world_values
     if (entry->own_copy_of.contains(index))
       file_->Fail(inst.Get("index").mark,
                   "copy " + std::to_string(index) + " is given twice in 'instances'");
-    auto own = std::make_shared<ParameterSet>(*params);
-    ApplyParameterValues(model, inst.Require("parameters"), world_values, declared, own.get());
-    for (Override& o : overrides_)
-      if (o.model == model.name) (*own)[o.name] = (*params)[o.name];
+    const Field none;
+    auto own = ModelParameters(model, f.Has("parameters") ? f.Get("parameters") : none,
+                               inst.Require("parameters"), world_values, *declared);
     entry->own_copy_of.emplace(index, entry->own_copies.size());
     entry->own_copies.push_back({index, element, std::move(own), std::nullopt, {}, {}});
   }

@@ -176,9 +176,10 @@ class WorldLoader {
   void ResolveEntry(EntryPlan* entry);
   void ResolveEntryParameters(const Fields& f, const ValueReader& world_values,
                               DeclaredParameters* declared, EntryPlan* entry);
-  void ApplyParameterValues(const ModelFile& model, const Field& field,
-                            const ValueReader& world_values, DeclaredParameters* declared,
-                            ParameterSet* set);
+  std::shared_ptr<ParameterSet> ModelParameters(const ModelFile& model, const Field& entry_values,
+                                                const Field& own_values,
+                                                const ValueReader& world_values,
+                                                const DeclaredParameters& declared);
   void ReadOwnCopies(const Fields& f, const ValueReader& world_values, DeclaredParameters* declared,
                      EntryPlan* entry);
   void ResolveObjects(const Fields& f, const ValueReader& world_values, EntryPlan* entry);

@@ -121,6 +121,46 @@ TEST_F(ControlLoaderTest, PerCopyParametersOverrideTheEntrysAndSetAppliesToAll) 
   EXPECT_EQ(w.models[0].instances[0].second, "label=special, speed=0.4");
 }
 
+// A default may use the parameters above it, with the values the copy ends
+// with: the entry's, a copy's own, --set's.
+TEST_F(ControlLoaderTest, ADefaultUsesTheParametersAboveItWithTheirFinalValues) {
+  Write("bot.yaml",
+        "model: bot\n"
+        "parameters:\n"
+        "  speed: {default: 0.1, range: [0, 0.5]}\n"
+        "  turn: \"= speed * 2\"\n"
+        "  label: {default: plain}\n"
+        "  tag: \"= label .. '-' .. turn\"\n"
+        "objects: {name: body, type: dummy, script: bot.lua}\n");
+  const auto at = [](const LoadedWorld& w, int copy, const char* name) {
+    const ParamValue* v = w.world->FindParameter(copy, name);
+    return v == nullptr ? std::string("none") : ShowParamValue(*v);
+  };
+  LoadedWorld w = Load(kThree);
+  EXPECT_EQ(at(w, 0, "turn"), "0.4");
+  EXPECT_EQ(at(w, 1, "turn"), "0.8");  // its own speed
+  EXPECT_EQ(at(w, 1, "tag"), "special-0.8");
+  EXPECT_EQ(at(w, 2, "tag"), "plain-0.4");
+  LoadOptions set;
+  set.overrides = {{"bot.speed", "0.25"}};
+  LoadedWorld s = Load(kThree, set);
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(at(s, i, "turn"), "0.5") << i;
+  // Given outright, a derived one is the value given.
+  std::string given = kThree;
+  given.replace(given.find("{speed: 0.2}"), 12, "{speed: 0.2, turn: 7}");
+  EXPECT_EQ(at(Load(given), 0, "turn"), "7");
+  EXPECT_EQ(at(Load(given), 1, "turn"), "7");
+  // Only the ones above.
+  Write("bot.yaml",
+        "model: bot\n"
+        "parameters:\n"
+        "  turn: \"= speed * 2\"\n"
+        "  speed: 0.1\n"
+        "objects: {name: body, type: dummy, script: bot.lua}\n");
+  EXPECT_CONTAINS(ErrorOf(kThree), "bot.yaml:3:9: in expression 'speed * 2' for 'turn': "
+                                   "parameter 'speed' is defined below this one (at line 4)");
+}
+
 TEST_F(ControlLoaderTest, RangesAndInstanceMistakesNameFileLineAndColumn) {
   std::string bad = kThree;
   bad.replace(bad.find("speed: 0.4"), 10, "speed: 0.9");
