@@ -91,9 +91,8 @@ const ApiTables& Tables() {
 constexpr char kThreadHelpers[] = R"(local sim, yieldable = ...
 local step, now = sim.step, sim.getSimulationTime
 local function threaded(name)  -- errors name the caller's line, not this chunk's
-  if not yieldable() then
-    error(name .. ': only a threaded script (sysCall_thread) can wait', 3)
-  end
+  local ok, why = yieldable()
+  if not ok then error(name .. ': ' .. why, 3) end
 end
 local function seconds_arg(name, arg, what, s)  -- a finite number >= 0 (not NaN)
   if type(s) ~= 'number' then
@@ -125,8 +124,21 @@ function sim.waitUntil(condition, timeout)
 end
 )";
 
+// true, or false and why not: sim.step (under sim.wait) yields the script's
+// own thread only, not a coroutine the script made (it said "sim:21").
 int IsYieldable(lua_State* L) {
-  lua_pushboolean(L, lua_isyieldable(L));
+  const lua_State* thread = Context(L).thread;
+  if (thread != nullptr && L != thread) {
+    lua_pushboolean(L, 0);
+    lua_pushliteral(L, "call it from sysCall_thread itself, not from a coroutine of your own");
+    return 2;
+  }
+  if (thread == nullptr || !lua_isyieldable(L)) {
+    lua_pushboolean(L, 0);
+    lua_pushliteral(L, "only a threaded script (sysCall_thread) can wait");
+    return 2;
+  }
+  lua_pushboolean(L, 1);
   return 1;
 }
 

@@ -158,6 +158,20 @@ TEST(ScriptControlTest, StepInsideACoroutineOfTheThreadIsAnError) {
   EXPECT_TRUE(w.log.empty()) << w.log.front();
 }
 
+// sim.wait from a coroutine of the thread: the script's line (it named the
+// helpers' chunk, "sim:21").
+TEST(ScriptControlTest, WaitInsideACoroutineOfTheThreadNamesTheScriptsLine) {
+  ScriptWorld w;
+  w.AddRobot("bot#0",
+             "function sysCall_thread()\n  local co = coroutine.wrap(function()\n"
+             "    sim.wait(0.5)\n  end)\n  co()\nend\n");
+  const std::string error = ErrorOf([&] { w.Steps(2); });
+  EXPECT_CONTAINS(error,
+                  "scripts/robot.lua:3: sim.wait: call it from sysCall_thread itself, "
+                  "not from a coroutine of your own");
+  EXPECT_EQ(error.find("sim:"), std::string::npos) << error;
+}
+
 TEST(ScriptControlTest, WaitOutsideAThreadNamesTheCallersLine) {
   ScriptWorld w;
   w.AddRobot("bot#0", "function sysCall_actuation()\n  sim.wait(1)\nend\n");
