@@ -13,6 +13,8 @@
 #include <iostream>
 #include <iterator>
 #include <set>
+#include <string>
+#include <vector>
 
 #include "framework/error.h"
 #include "framework/shared_library.h"
@@ -120,6 +122,10 @@ int Rename(const fs::path& object, bool program) {
     argv.push_back("--redefine-sym=main=kilobot_program_main");
     // exit() would end swarmsim: the runtime's ends the run naming the robot.
     argv.push_back("--redefine-sym=exit=kilobot_exit");
+    // Signal handlers would be the process's: the runtime's refuse.
+    for (const char* f : {"signal", "sigaction", "bsd_signal", "sysv_signal", "__sysv_signal",
+                          "sigset"})
+      argv.push_back(std::string("--redefine-sym=") + f + "=kilobot_" + f);
   }
   argv.push_back(object.string());
   return Run(argv);

@@ -353,27 +353,30 @@ py::dict RangeAndBearing(const Scene& scene, const ModelLayout& layout) {
   return out;
 }
 
-void SetRangeAndBearingData(Scene* scene, const ModelLayout& layout, const py::object& data) {
-  using range_and_bearing::RangeAndBearingRow;
-  const size_t n = layout.robots.size();
-  // Bytes as integers, or floats that are whole numbers (np.zeros makes
-  // floats); never booleans or fractions cast away in silence.
+py::array_t<int64_t, py::array::c_style> MessageBytes(const py::object& data,
+                                                      const std::string& what) {
+  // Never booleans or fractions cast away in silence.
   const py::array raw = py::array::ensure(data);
-  if (!raw)
-    throw py::value_error("range-and-bearing data must be an array of bytes, one row per robot");
+  if (!raw) throw py::value_error(what + " must be an array of bytes, one row per robot");
   const char kind = raw.dtype().kind();
-  if (kind == 'b') throw py::type_error("range-and-bearing data is booleans, not bytes (0..255)");
+  if (kind == 'b') throw py::type_error(what + " is booleans, not bytes (0..255)");
   if (kind != 'i' && kind != 'u' && kind != 'f')
-    throw py::type_error("range-and-bearing data must be bytes, 0..255, not dtype " +
+    throw py::type_error(what + " must be bytes, 0..255, not dtype " +
                          py::str(raw.dtype()).cast<std::string>());
   if (kind == 'f') {
     const auto f = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(raw);
     for (py::ssize_t i = 0; i < f.size(); ++i)
       if (!(f.data()[i] >= 0 && f.data()[i] <= 255 && f.data()[i] == std::floor(f.data()[i])))
-        throw py::value_error("range-and-bearing data must be bytes, whole numbers 0..255 (got " +
+        throw py::value_error(what + " must be bytes, whole numbers 0..255 (got " +
                               py::str(py::float_(f.data()[i])).cast<std::string>() + ")");
   }
-  const auto a = py::array_t<int64_t, py::array::c_style | py::array::forcecast>::ensure(raw);
+  return py::array_t<int64_t, py::array::c_style | py::array::forcecast>::ensure(raw);
+}
+
+void SetRangeAndBearingData(Scene* scene, const ModelLayout& layout, const py::object& data) {
+  using range_and_bearing::RangeAndBearingRow;
+  const size_t n = layout.robots.size();
+  const auto a = MessageBytes(data, "range-and-bearing data");
   if (a.ndim() != 2 || static_cast<size_t>(a.shape(0)) != n)
     throw py::value_error("range-and-bearing data must have shape (" + std::to_string(n) +
                           ", bytes): one row per robot");

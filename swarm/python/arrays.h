@@ -51,6 +51,14 @@ Array OutArray(std::vector<py::ssize_t> shape, const py::object& out);
 // such as a masked array) of `dtype` and `shape`, writeable and C-contiguous.
 void CheckOut(const py::object& out, const py::dtype& dtype, const std::vector<py::ssize_t>& shape);
 
+// Message bytes given from Python (range-and-bearing data, IR messages) as
+// int64: integers, or floats that are whole numbers 0..255 (np.zeros makes
+// floats); booleans and other dtypes are a TypeError, a fraction or a float
+// outside 0..255 a ValueError. `what` starts the messages ("IR messages").
+// The caller checks the shape and the integers' range.
+py::array_t<int64_t, py::array::c_style> MessageBytes(const py::object& data,
+                                                      const std::string& what);
+
 // Poses of the layout's robots' roots: N x 3 (x, y, yaw) or N x 7 (x, y, z,
 // qw, qx, qy, qz).
 Array Poses(World& world, const ModelLayout& layout, bool planar, const py::object& out);

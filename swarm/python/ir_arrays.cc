@@ -112,12 +112,7 @@ void SendIrMessages(Scene* scene, const std::vector<uint32_t>& slots,
                     const std::vector<std::string>& who, const py::object& data,
                     const py::object& send) {
   const size_t n = slots.size();
-  const py::array raw = py::module_::import("numpy").attr("asarray")(data);
-  const char kind = raw.dtype().kind();
-  if (kind != 'i' && kind != 'u')
-    throw py::type_error("IR messages are integers 0..255 (got dtype " +
-                         std::string(py::str(raw.dtype())) + ")");
-  const auto a = py::cast<py::array_t<int64_t, py::array::c_style | py::array::forcecast>>(raw);
+  const auto a = MessageBytes(data, "IR messages");
   if (a.ndim() != 2 || static_cast<size_t>(a.shape(0)) != n || a.shape(1) < 1)
     throw py::value_error("IR messages must have shape (" + std::to_string(n) +
                           ", bytes): one row per robot, at least one byte");

@@ -109,14 +109,24 @@ class IrMessagesTest(unittest.TestCase):
                     [[1], [2], [-1]], np.zeros((3, 5), dtype=int)):
             with self.assertRaises(ValueError):
                 w.send_ir_messages("bot", bad)
-        with self.assertRaises(TypeError):
-            w.send_ir_messages("bot", np.zeros((3, 2)))  # floats are not bytes
+        # As set_range_and_bearing_data: whole floats are bytes (np.zeros makes
+        # floats), fractions and booleans are not.
+        with self.assertRaisesRegex(ValueError, r"IR messages must be bytes, whole numbers "
+                                                r"0..255 \(got 1.5\)"):
+            w.send_ir_messages("bot", np.full((3, 2), 1.5))
+        with self.assertRaisesRegex(TypeError, "IR messages is booleans"):
+            w.send_ir_messages("bot", np.ones((3, 2), dtype=bool))
+        with self.assertRaisesRegex(TypeError, "not dtype <U1"):
+            w.send_ir_messages("bot", [["a"], ["b"], ["c"]])
         with self.assertRaises(ValueError):
             w.send_ir_messages("bot", np.zeros((3, 2), dtype=int), send=np.array([1, 0, 1]))
         with self.assertRaisesRegex(ValueError, "payload_size"):
             w.send_ir_messages("bot", np.zeros((3, 5), dtype=int))
         w.step()
         self.assertEqual(w.ir_messages("bot")["sent"].tolist(), [False, False, False])
+        w.send_ir_messages("bot", np.full((3, 2), 7.0))
+        w.step()
+        self.assertEqual(w.ir_messages("bot")["sent"].tolist(), [True, True, True])
         with self.assertRaisesRegex(ValueError, "no IR transceiver 'eye'"):
             w.ir_messages("bot", transceiver="eye")
 

@@ -10,6 +10,13 @@
 #define SWARMSIM_KILOBOT_KILOLIB_H_
 
 #include <stdint.h>
+#include <stdlib.h>
+
+/* rand() is avr-libc's here (0..0x7FFF, runtime/kilolib.c): RAND_MAX too,
+ * not the host's 2^31 - 1, whichever of <stdlib.h> and this comes first
+ * (`rand() < RAND_MAX / 2` was always true). */
+#undef RAND_MAX
+#define RAND_MAX 0x7FFF
 
 #include "message.h"
 #include "message_crc.h"
@@ -58,7 +65,8 @@ extern "C" {
 /* Distance in mm (centre to centre, 33 for touching robots) to the sender of
  * a message, from its signal strengths. */
 uint8_t estimate_distance(const distance_measurement_t *d);
-/* Waits `ms` milliseconds (in swarmsim: returns at once, see worlds/README.md). */
+/* Waits `ms` milliseconds of simulated time (the robot's motors and LED keep
+ * their state meanwhile; see worlds/README.md). */
 void delay(uint16_t ms);
 /* A random byte from the robot's hardware noise source. */
 uint8_t rand_hard();

@@ -193,6 +193,7 @@ typedef struct {
   char *stack_low; /* lowest address of the thread's stack */
   volatile void *fault_address;
   int exit_status; /* the program called exit(exit_status) */
+  const char *refused; /* the function it called that it may not (kCalledRefused) */
 } ThreadState;
 static __thread ThreadState t_state;
 static Slot g_spare_slot; /* threads past kMaxSlots: no watchdog */
@@ -300,7 +301,7 @@ static void StartWatchdog(void) {
 }
 
 /* What Guarded returns when the program called exit() (not a signal). */
-enum { kCalledExit = 4096 };
+enum { kCalledExit = 4096, kCalledRefused = 4097 };
 
 /* The program's exit() (the build renames its calls): ends the robot's
  * call like a fault, so the run ends naming the robot, not swarmsim. */
@@ -314,10 +315,46 @@ void kilobot_exit(int status) {
   exit(status);
 }
 
+/* The program's signal() and sigaction() (the build renames its calls):
+ * avr-libc has neither, and here a handler would be the whole process's
+ * (a SIGSEGV reset to the default killed swarmsim and left summary.json
+ * "running"; SIGINT's would take Ctrl-C): the run ends naming the call. */
+static void Refuse(const char *what) {
+  ThreadState *ts = &t_state;
+  if (ts->in_user && ts->jump != NULL) {
+    ts->in_user = 0;
+    ts->refused = what;
+    siglongjmp(*ts->jump, kCalledRefused);
+  }
+}
+typedef void (*Handler)(int);
+static Handler RefuseSignal(const char *what) {
+  Refuse(what);
+  errno = EINVAL;
+  return SIG_ERR;
+}
+Handler kilobot_signal(int sig, Handler h) { return (void)sig, (void)h, RefuseSignal("signal()"); }
+Handler kilobot_bsd_signal(int sig, Handler h) { return (void)sig, (void)h, RefuseSignal("signal()"); }
+Handler kilobot_sysv_signal(int sig, Handler h) { return (void)sig, (void)h, RefuseSignal("signal()"); }
+Handler kilobot___sysv_signal(int sig, Handler h) {
+  return (void)sig, (void)h, RefuseSignal("signal()");
+}
+Handler kilobot_sigset(int sig, Handler h) { return (void)sig, (void)h, RefuseSignal("sigset()"); }
+int kilobot_sigaction(int sig, const struct sigaction *act, struct sigaction *old) {
+  (void)sig, (void)act, (void)old;
+  Refuse("sigaction()");
+  errno = EINVAL;
+  return -1;
+}
+
 /* The step (its time, in microseconds) at which a call timed out: the
  * other robots skip that step's calls, so that a program stuck on every
  * robot ends the run after one timeout instead of one per robot. */
 static atomic_llong g_timed_out_at = -1;
+/* The robot whose main() timed out (-1: none): the others' main() is not
+ * called, for the same reason (it cost one timeout per robot: 25 minutes
+ * for 300 robots). */
+static atomic_int g_main_timed_out = -1;
 
 /* ---- delay(): the program on a stack of the robot's own ----
  *
@@ -509,6 +546,13 @@ static const char *SignalText(int sig) {
 
 static void Failure(const SwarmsimCallContext *c, int sig, const char *what, char *error,
                     size_t size, const Coroutine *co) {
+  if (sig == kCalledRefused) {
+    snprintf(error, size,
+             "%s (kilobot program '%s'), robot %d: %s called in %s: a Kilobot program may not "
+             "handle signals (avr-libc has no signal(); here its handler would be swarmsim's)",
+             KILOBOT_SOURCE, KILOBOT_NAME, c->robot, t_state.refused, what);
+    return;
+  }
   if (sig == kCalledExit) {
     snprintf(error, size, "%s (kilobot program '%s'), robot %d: exit(%d) called in %s",
              KILOBOT_SOURCE, KILOBOT_NAME, c->robot, t_state.exit_status, what);
@@ -625,6 +669,14 @@ static int Init(const SwarmsimCallContext *c, void **state, char *error, size_t 
   if (uid == -1) uid = c->robot % 65536;
 
   /* The program's main(): kilo_init, callbacks, kilo_start. */
+  const int hung = atomic_load(&g_main_timed_out);
+  if (hung >= 0) {
+    snprintf(error, error_size,
+             "%s (kilobot program '%s'), robot %d: main() not called: on robot %d it did not "
+             "return within %g s",
+             KILOBOT_SOURCE, KILOBOT_NAME, c->robot, hung, atomic_load(&g_timeout_ms) / 1000.0);
+    return -1;
+  }
   const kilobot_copy_t *t = copy->table;
   Lock(copy);
   SwapIn(copy, r);
@@ -641,6 +693,10 @@ static int Init(const SwarmsimCallContext *c, void **state, char *error, size_t 
   if (sig == 0) SwapOut(copy, r);
   Unlock(copy);
   if (sig != 0) {
+    if (sig == g_watchdog_signal) {
+      int none = -1;
+      atomic_compare_exchange_strong(&g_main_timed_out, &none, c->robot);
+    }
     Failure(c, sig, "main()", error, error_size, NULL);
     return -1;
   }
@@ -764,10 +820,14 @@ static int Step(const SwarmsimCallContext *c, void *state, char *error, size_t e
   if (send) {
     message_t check;
     memcpy(&check, outgoing, sizeof check);
-    if (check.crc != message_crc(&check) && atomic_exchange(&g_warned_crc, 1) == 0)
+    /* The receivers' check; with crc_check: 0 (for every robot of a model,
+       as a rule) nothing is dropped and nothing said. */
+    if (r->crc_check && check.crc != message_crc(&check) &&
+        atomic_exchange(&g_warned_crc, 1) == 0)
       fprintf(stderr,
               "warning: %s (kilobot program '%s'), robot %d sends a message whose crc is not "
-              "message_crc(&msg): receivers drop it (crc_check: false keeps it; warned once)\n",
+              "message_crc(&msg): receivers drop it (parameter crc_check: 0 keeps it; warned "
+              "once)\n",
               KILOBOT_SOURCE, KILOBOT_NAME, c->robot);
     if (api->ir_send(c->world, c->robot, r->ir, outgoing, sizeof outgoing) == 0) r->tx_pending = 1;
   }

@@ -201,6 +201,40 @@ int main() { kilo_init(); SET_CALLBACK(botinfo, botinfo); kilo_start(setup, loop
 
 // ---- kilolib's software generator ----
 
+// rand() is avr-libc's, 0..0x7FFF, and so is RAND_MAX whichever header comes
+// first: it was the host's 2^31 - 1, so that `rand() < RAND_MAX / 2` was
+// always true in unchanged programs.
+TEST(KilobotTest, RandMaxIsTheOneRandGoesTo) {
+  const fs::path dir = Dir("randmax");
+  for (const char* order : {"#include <stdlib.h>\n#include <kilolib.h>\n",
+                            "#include <kilolib.h>\n#include <stdlib.h>\n"}) {
+    const CommandResult built = Build(dir, "randmax", std::string("#define DEBUG\n") + order + R"(
+#include <debug.h>
+void setup() {
+  long below = 0, most = 0, i;
+  for (i = 0; i < 10000; i++) {
+    int r = rand();
+    if (r < RAND_MAX / 2) below++;
+    if (r > most) most = r;
+  }
+  printf("randmax %ld below %ld most %ld\n", (long)RAND_MAX, below, most);
+}
+void loop() {}
+int main() { kilo_init(); kilo_start(setup, loop); return 0; }
+)");
+    ASSERT_EQ(built.exit_code, 0) << built.output;
+    Write(dir / "world.yaml", World("randmax", "planar", 1, 0.5));
+    const CommandResult run = RunProgram("run " + (dir / "world.yaml").string() + " --steps 1");
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    const auto lines = Matches(run.output, "randmax %ld below %ld most %ld", 3);
+    ASSERT_EQ(lines.size(), 1u) << run.output;
+    EXPECT_EQ(lines[0][0], 0x7FFF) << order;
+    EXPECT_NEAR(lines[0][1], 5000, 300) << order;  // half of them, not all
+    EXPECT_LE(lines[0][2], 0x7FFF) << order;
+    EXPECT_GT(lines[0][2], 0x7F00) << order;
+  }
+}
+
 TEST(KilobotTest, RandSoftGivesKilolibsSequence) {
   const fs::path dir = Dir("rand");
   const CommandResult built = Build(dir, "randsoft", R"(#define DEBUG
@@ -605,6 +639,85 @@ TEST(KilobotTest, DivisionByZeroEndsTheRunNamingIt) {
                  "arithmetic exception");
 }
 
+// A program that sends a bad CRC is warned of once, with the parameter that
+// keeps such messages; with crc_check: 0 they are heard and nothing is said.
+TEST(KilobotTest, ABadCrcIsWarnedOfUnlessReceiversKeepIt) {
+  const fs::path dir = Dir("badcrc");
+  const CommandResult built = Build(dir, "badcrc", R"(#define DEBUG
+#include <kilolib.h>
+#include <debug.h>
+message_t out;
+long heard = 0;
+message_t *tx() { return &out; }
+void rx(message_t *m, distance_measurement_t *d) { (void)m; (void)d; heard++; }
+void setup() {
+  out.type = NORMAL;
+  out.data[0] = 1;
+  out.crc = message_crc(&out) ^ 1;
+}
+void loop() { if (kilo_ticks == 60) printf("heard %ld\n", heard); }
+int main() {
+  kilo_init();
+  kilo_message_tx = tx;
+  kilo_message_rx = rx;
+  kilo_start(setup, loop);
+  return 0;
+}
+)");
+  ASSERT_EQ(built.exit_code, 0) << built.output;
+  Write(dir / "world.yaml", World("badcrc", "planar", 2, 0.12));
+  const std::string command = "run " + (dir / "world.yaml").string() + " --steps 70";
+  const CommandResult checked = RunProgram(command);
+  ASSERT_EQ(checked.exit_code, 0) << checked.output;
+  EXPECT_NE(checked.output.find("sends a message whose crc is not message_crc(&msg): receivers "
+                                "drop it (parameter crc_check: 0 keeps it; warned once)"),
+            std::string::npos)
+      << checked.output;
+  for (const auto& line : Matches(checked.output, "heard %ld", 1)) EXPECT_EQ(line[0], 0);
+  const CommandResult kept = RunProgram(command + " --set kilobot.crc_check=0");
+  ASSERT_EQ(kept.exit_code, 0) << kept.output;
+  EXPECT_EQ(kept.output.find("warning"), std::string::npos) << kept.output;
+  const auto heard = Matches(kept.output, "heard %ld", 1);
+  ASSERT_EQ(heard.size(), 2u) << kept.output;
+  for (const auto& line : heard) EXPECT_GT(line[0], 0) << kept.output;
+  fs::remove_all(dir);
+}
+
+// A main() that never returns: one timeout for the run, not one per robot
+// (8 robots took 8 timeouts; 300 at the default 5 s, 25 minutes). Kept
+// going with on_script_error: disable_script, every robot is disabled, the
+// others for robot 0's hang.
+TEST(KilobotTest, AMainThatHangsCostsOneTimeout) {
+  const fs::path dir = Dir("hangmain");
+  const CommandResult built = Build(dir, "hangmain",
+                                    "#include <kilolib.h>\nvolatile int x;\n"
+                                    "void setup() {}\nvoid loop() {}\n"
+                                    "int main() { kilo_init(); for (;;) x++; return 0; }\n");
+  ASSERT_EQ(built.exit_code, 0) << built.output;
+  std::string world = World("hangmain", "planar", 8, 0.5, "{program_timeout: 0.5}");
+  world.replace(world.find("seed: 1}"), 8, "seed: 1, on_script_error: disable_script}");
+  Write(dir / "world.yaml", world);
+  const CommandResult run = RunProgram("run " + (dir / "world.yaml").string() +
+                                       " --steps 2 --quiet --threads 1 --out " +
+                                       (dir / "out").string());
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  std::ifstream summary(dir / "out" / "summary.json");
+  const auto disabled = nlohmann::json::parse(summary)["disabled_scripts"];
+  ASSERT_EQ(disabled.size(), 8u) << disabled.dump();
+  const std::string program =
+      (dir / "hangmain.c").string() + " (kilobot program 'hangmain'), robot ";
+  EXPECT_NE(disabled[0].get<std::string>().find(program + "0: main() did not return within 0.5 s"),
+            std::string::npos)
+      << disabled[0];
+  for (size_t i = 1; i < 8; ++i)
+    EXPECT_NE(disabled[i].get<std::string>().find(program + std::to_string(i) +
+                                                  ": main() not called: on robot 0 it did not "
+                                                  "return within 0.5 s"),
+              std::string::npos)
+        << disabled[i];
+  fs::remove_all(dir);
+}
+
 // The same faults in a program that calls delay() (it runs on a stack of
 // its own): named the same way.
 TEST(KilobotTest, FaultsAfterADelayEndTheRunNamingThem) {
@@ -651,6 +764,21 @@ TEST(KilobotTest, AKiloUidOutOfRangeIsRefused) {
                                       " --steps 2 --quiet --set kilobot.kilo_uid=65535");
   EXPECT_EQ(ok.exit_code, 0) << ok.output;
   fs::remove_all(dir);
+}
+
+// A handler a program installs would be the whole process's: resetting
+// SIGSEGV killed swarmsim (exit 139, summary.json "running").
+TEST(KilobotTest, SignalHandlersAreRefusedNamingTheCall) {
+  ExpectRunFails("sighack",
+                 "#include <signal.h>\nint *volatile nowhere;\n"
+                 "void loop() { if (kilo_uid == 3 && kilo_ticks > 4) {\n"
+                 "  signal(SIGSEGV, SIG_DFL); *nowhere = 1; } }",
+                 "signal() called in loop(): a Kilobot program may not handle signals");
+  ExpectRunFails("sigact",
+                 "#include <signal.h>\n#include <string.h>\n"
+                 "void loop() { if (kilo_uid == 3) { struct sigaction a;\n"
+                 "  memset(&a, 0, sizeof a); a.sa_handler = SIG_IGN; sigaction(SIGINT, &a, 0); } }",
+                 "sigaction() called in loop()");
 }
 
 // exit() in a program would end swarmsim itself: it ends the run instead,
