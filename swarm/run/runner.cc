@@ -206,7 +206,10 @@ class Watchdog {
       }
       const std::vector<std::string> calls = ScriptCallsInProgress();
       if (calls.empty()) {
-        error += "; no script was running";
+        // Lua calls are the ones recorded: what held the step is native
+        // (a native controller such as a Kilobot program with
+        // program_timeout 0, a plugin, or swarmsim itself).
+        error += "; no Lua script was running (a native controller, a plugin or swarmsim was)";
       } else {
         error += "; running: ";
         for (size_t i = 0; i < calls.size(); ++i) error += (i ? "; " : "") + calls[i];
