@@ -123,8 +123,8 @@ int Rename(const fs::path& object, bool program) {
     // exit() would end swarmsim: the runtime's ends the run naming the robot.
     argv.push_back("--redefine-sym=exit=kilobot_exit");
     // Signal handlers would be the process's: the runtime's refuse.
-    for (const char* f : {"signal", "sigaction", "bsd_signal", "sysv_signal", "__sysv_signal",
-                          "sigset"})
+    for (const char* f :
+         {"signal", "sigaction", "bsd_signal", "sysv_signal", "__sysv_signal", "sigset"})
       argv.push_back(std::string("--redefine-sym=") + f + "=kilobot_" + f);
   }
   argv.push_back(object.string());

@@ -451,10 +451,16 @@ ModelFile ReadModelFile(YamlFile file, const std::string& used_by,
   ModelFile model{std::move(file), {}, {}, {}, {}, {}, {}, {}};
   const YamlFile& f = model.file;
   Field top{"model file", f.root(), f.root().Mark().is_null() ? YAML::Mark() : f.root().Mark(), {}};
-  if (!f.root().IsMap())
+  if (!f.root().IsMap()) {
+    // XML where YAML was expected: a URDF not named .urdf, or a xacro.
+    const bool xml = f.root().IsScalar() && f.root().Scalar().starts_with("<");
     f.Fail(top.mark,
            "a model file must be a mapping with 'model', 'parameters' and 'objects' (got " +
-               Describe(f.root()) + "; used by " + used_by + ")");
+               Describe(f.root()) + "; used by " + used_by + ")" +
+               (xml ? "; this is XML: a URDF is read as one when its name ends in .urdf (a "
+                      ".xacro file is expanded first: xacro robot.urdf.xacro > robot.urdf)"
+                    : ""));
+  }
   Fields fields(f, top, "the model file");
   // The loader's keys, then the modules' sections (read with the model's values).
   std::vector<std::string> keys = {"model", "description", "parameters", "objects"};

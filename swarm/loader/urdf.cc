@@ -21,6 +21,7 @@
 #include "framework/display_path.h"
 #include "framework/error.h"
 #include "framework/object_type.h"
+#include "framework/utf8.h"
 #include "swarm/loader/urdf_inertia.h"
 #include "swarm/loader/urdf_xml.h"
 #include "swarm/loader/yaml.h"
@@ -117,6 +118,14 @@ std::optional<fs::path> Importer::FindPackage(const std::string& package) {
     return fs::is_regular_file(dir / "package.xml", ec) &&
            PackageName(dir / "package.xml") == package;
   };
+  // The package holding the URDF file itself first (a URDF naming its own
+  // package means that copy, not another of the same name on the path: two
+  // robots' copies of example-robot-data sent one to the other's meshes).
+  for (fs::path dir = fs::absolute(path_, ec).parent_path(); !found && !dir.empty();
+       dir = dir.parent_path()) {
+    if (holds(dir)) found = dir;
+    if (dir == dir.parent_path()) break;
+  }
   for (const fs::path& dir : package_path_) {
     if (found) break;
     if (fs::is_directory(dir / package, ec)) {
@@ -130,18 +139,12 @@ std::optional<fs::path> Importer::FindPackage(const std::string& package) {
     // package.xml files one or two levels down (a workspace's src/ folder).
     for (auto it = fs::recursive_directory_iterator(dir, ec);
          !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
-      if (it.depth() >= 2) it.disable_recursion_pending();
+      if (it.depth() >= 1) it.disable_recursion_pending();
       if (it->is_directory(ec) && holds(it->path())) {
         found = it->path();
         break;
       }
     }
-  }
-  // The package holding the URDF file itself (ROS's rule for its own files).
-  for (fs::path dir = fs::absolute(path_, ec).parent_path(); !found && !dir.empty();
-       dir = dir.parent_path()) {
-    if (holds(dir)) found = dir;
-    if (dir == dir.parent_path()) break;
   }
   packages_[package] = found;
   return found;
@@ -166,7 +169,28 @@ fs::path Importer::ResolveUri(const std::string& uri, int line, const std::strin
     }
     return *dir / rest.substr(slash + 1);
   }
-  if (uri.starts_with("file://")) return uri.substr(7);
+  if (uri.starts_with("file://")) {
+    // RFC 8089: file:///path or file://localhost/path, percent-encoded
+    // (file:///a%20b.stl is 'a b.stl').
+    std::string path = uri.substr(7);
+    if (path.starts_with("localhost/")) path.erase(0, 9);
+    std::string decoded;
+    for (size_t i = 0; i < path.size(); ++i) {
+      const auto hex = [](char c) {
+        return std::isdigit(static_cast<unsigned char>(c)) ? c - '0'
+               : std::isxdigit(static_cast<unsigned char>(c))
+                   ? std::tolower(static_cast<unsigned char>(c)) - 'a' + 10
+                   : -1;
+      };
+      if (path[i] == '%' && i + 2 < path.size() && hex(path[i + 1]) >= 0 && hex(path[i + 2]) >= 0) {
+        decoded += static_cast<char>(hex(path[i + 1]) * 16 + hex(path[i + 2]));
+        i += 2;
+      } else {
+        decoded += path[i];
+      }
+    }
+    return decoded;
+  }
   return path_.parent_path() / uri;
 }
 
@@ -571,9 +595,22 @@ UrdfImport Importer::Run(const std::string& where, const std::string& text) {
       std::replace(quiet.begin(), quiet.end(), '%', '?');
       parse(quiet, &message);
     }
-    if (!model)
+    if (!model) {
+      // Bytes that are not UTF-8 (a name cut inside a character): urdfdom
+      // says "Error reading Attributes." with no line; the line is found
+      // here (a newline is never inside a UTF-8 sequence).
+      int line = 1;
+      for (size_t start = 0; start < bytes.size(); ++line) {
+        const size_t end = std::min(bytes.find('\n', start), bytes.size());
+        if (!IsValidUtf8(std::string_view(bytes).substr(start, end - start)))
+          Fail(line, "this line is not valid UTF-8, and urdfdom cannot read the file (" +
+                         (message.empty() ? std::string("no message") : message) +
+                         "): save it as UTF-8");
+        start = end + 1;
+      }
       Fail(0,
            "urdfdom cannot read it: " + (message.empty() ? std::string("(no message)") : message));
+    }
   }
   if (!model->getRoot()) Fail(0, "the robot has no root link");
   UrdfImport out;

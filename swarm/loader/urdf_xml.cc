@@ -61,6 +61,32 @@ UrdfXmlFacts XmlReader::Read(const std::string& bytes) {
     Fail(more->GetLineNum(), std::string("<") + more->Name() +
                                  "> after </robot>: a URDF file holds one <robot> element");
   if (!robot->Attribute("name")) Fail(robot->GetLineNum(), "<robot> needs a 'name' attribute");
+  // A xacro file not expanded: its macros' robot parts were left out in
+  // silence (ignored elements), its ${...} names kept as names.
+  std::function<void(const tinyxml2::XMLElement*)> no_xacro = [&](const tinyxml2::XMLElement* e) {
+    constexpr const char* kExpand =
+        ": this is a xacro file, not yet URDF: expand it first (xacro robot.urdf.xacro > "
+        "robot.urdf) and name the .urdf";
+    // Appended, not "<" + ...: GCC 12 warns (-Wrestrict, a false positive) on that form.
+    std::string tag = "<";
+    tag += e->Name();
+    if (std::string_view(e->Name()).starts_with("xacro:"))
+      Fail(e->GetLineNum(), tag + ">" + kExpand);
+    for (const tinyxml2::XMLAttribute* a = e->FirstAttribute(); a; a = a->Next()) {
+      const std::string_view value = a->Value();
+      if (value.find("${") == std::string_view::npos && value.find("$(") == std::string_view::npos)
+        continue;
+      tag += ' ';
+      tag += a->Name();
+      tag += "=\"";
+      tag += value;
+      tag += "\">";
+      Fail(e->GetLineNum(), tag + kExpand);
+    }
+    for (const tinyxml2::XMLElement* c = e->FirstChildElement(); c; c = c->NextSiblingElement())
+      no_xacro(c);
+  };
+  no_xacro(robot);
   std::map<std::string, std::string> parent_joint;                // child link -> joint
   std::map<std::string, std::string> parent_link;                 // child link -> parent link
   std::vector<std::tuple<std::string, std::string, int>> mimics;  // joint, master, line

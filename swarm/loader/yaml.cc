@@ -1,6 +1,7 @@
 #include "swarm/loader/yaml.h"
 
 #include <algorithm>
+#include <cctype>
 #include <memory>
 
 #include "framework/error.h"
@@ -67,8 +68,15 @@ YamlFile YamlFile::Load(const fs::path& path, std::string_view kind,
     const size_t newline = text.rfind('\n', nul);  // the one before it (text[nul] is none)
     mark.line = static_cast<int>(std::count(text.begin(), text.begin() + nul, '\n'));
     mark.column = static_cast<int>(newline == std::string::npos ? nul : nul - newline - 1);
-    file.Fail(mark, "a NUL byte (\\0) in the file: a " + std::string(kind) +
-                        " is text (was it saved by a program that pads with zeros?)");
+    // A mesh named where a model file goes (`model: cube.stl`).
+    std::string ext = path.extension().string();
+    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    const bool mesh = ext == ".stl" || ext == ".obj" || ext == ".dae" || ext == ".ply";
+    file.Fail(mark, "a NUL byte (\\0) in the file: a " + std::string(kind) + " is text" +
+                        (mesh ? std::string(" (a mesh is a shape's: {type: shape, shape: mesh, "
+                                            "mesh: ") +
+                                    path.filename().string() + "}, in a model file's objects)"
+                              : " (was it saved by a program that pads with zeros?)"));
   }
   try {
     file.root_ = YAML::Load(text);

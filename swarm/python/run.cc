@@ -86,7 +86,8 @@ py::dict PyWorld::Run(std::optional<int64_t> steps, const std::optional<std::str
       throw py::value_error(
           "run(out_dir=...): another run" +
           (out_lock->holder().empty() ? std::string() : " (process " + out_lock->holder() + ")") +
-          " is writing into '" + ValidUtf8(dir.string()) + "'; wait for it to end, or pass another out_dir");
+          " is writing into '" + ValidUtf8(dir.string()) +
+          "'; wait for it to end, or pass another out_dir");
     if (const std::string note = RemoveEarlierOutputs(dir); !note.empty())
       std::cerr << "note: " << ValidUtf8(note) << std::endl;
     options.out_dir = dir;

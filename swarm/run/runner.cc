@@ -667,6 +667,11 @@ std::string WriteErrorSummary(const RunOptions& options, const std::string& erro
   std::error_code ec;
   std::filesystem::create_directories(*options.out_dir, ec);
   if (ec) return ec.message();
+  // This summary replaces an earlier run's: its files go too (they stayed,
+  // unlisted, beside the next run's), metrics.csv with them.
+  if (const std::string note = RemoveEarlierOutputs(*options.out_dir); !note.empty())
+    std::cerr << "note: " << ValidUtf8(note) << "\n";
+  std::filesystem::remove(*options.out_dir / "metrics.csv", ec);
   nlohmann::json j;
   j["swarmsim_version"] = Version();
   j["world"] = options.world_file;

@@ -82,8 +82,9 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
 // summary.json for a run that never started (the world did not load, or the
 // command line and world do not agree, or a signal came while it loaded):
 // `status` ("error" or "interrupted"), the message, world, command and
-// swarmsim_version. Creates `options.out_dir`; returns "" or why the file
-// could not be written.
+// swarmsim_version. Creates `options.out_dir`, removes an earlier run's
+// outputs there (RemoveEarlierOutputs, and its metrics.csv: the folder
+// holds this run's alone); returns "" or why the file could not be written.
 std::string WriteErrorSummary(const RunOptions& options, const std::string& error,
                               const std::string& status = "error");
 

@@ -72,15 +72,71 @@ void OdeWorld::Collide(dGeomID a, dGeomID b) {
   pairs_.push_back({a, b, 0, first << 32 | second});
 }
 
+namespace {
+
+// A trimesh pair's contact points, up to kMeshProbe, reduced to `m` spread
+// over the contact patch: ODE's trimesh colliders stop at the first m they
+// meet (a plane's: the first m vertices below it, in the file's order), which
+// may all lie on one side of a base, so that a robot standing still on its
+// mesh tipped over or turned. The deepest first, then each time the point
+// farthest from those kept (ties: the earlier one), in ODE's order.
+constexpr int kMeshProbe = 64;
+// A mesh pair keeps up to this many (a box on a plane has its 4 corners; a
+// rounded mesh base needs more of its rim to stand as it would).
+constexpr int kMeshContacts = 12;
+
+int SpreadContacts(dGeomID a, dGeomID b, int m, dContactGeom* out) {
+  dContactGeom probe[kMeshProbe];
+  const int n = dCollide(a, b, kMeshProbe, probe, sizeof(dContactGeom));
+  if (n <= m) {
+    std::copy_n(probe, n, out);
+    return n;
+  }
+  int deepest = 0;
+  for (int i = 1; i < n; ++i)
+    if (probe[i].depth > probe[deepest].depth) deepest = i;
+  bool taken[kMeshProbe] = {};
+  double nearest[kMeshProbe];  // squared distance to the nearest point kept
+  const auto add = [&](int i, int k) {
+    out[k] = probe[i];
+    taken[i] = true;
+    for (int j = 0; j < n; ++j) {
+      const double dx = probe[j].pos[0] - probe[i].pos[0], dy = probe[j].pos[1] - probe[i].pos[1],
+                   dz = probe[j].pos[2] - probe[i].pos[2];
+      const double d = dx * dx + dy * dy + dz * dz;
+      nearest[j] = k == 0 ? d : std::min(nearest[j], d);
+    }
+  };
+  add(deepest, 0);
+  for (int k = 1; k < m; ++k) {
+    int far = -1;
+    for (int j = 0; j < n; ++j)
+      if (!taken[j] && (far < 0 || nearest[j] > nearest[far])) far = j;
+    add(far, k);
+  }
+  return m;
+}
+
+bool IsMesh(dGeomID g) { return dGeomGetClass(g) == dTriMeshClass; }
+
+}  // namespace
+
+int OdeWorld::ContactCapacity() const {
+  return has_meshes_ ? std::max(options_.max_contacts, kMeshContacts) : options_.max_contacts;
+}
+
 void OdeWorld::FindContacts() {
-  const size_t m = static_cast<size_t>(options_.max_contacts);
+  const size_t m = static_cast<size_t>(ContactCapacity());
   if (pair_contacts_.size() < pairs_.size() * m) pair_contacts_.resize(pairs_.size() * m);
   auto narrow = [this, m](int64_t begin, int64_t end) {
     dAllocateODEDataForThread(dAllocateMaskAll);
     for (int64_t k = begin; k < end; ++k) {
       CandidatePair& pair = pairs_[static_cast<size_t>(k)];
-      pair.count = dCollide(pair.a, pair.b, options_.max_contacts,
-                            &pair_contacts_[static_cast<size_t>(k) * m], sizeof(dContactGeom));
+      dContactGeom* out = &pair_contacts_[static_cast<size_t>(k) * m];
+      pair.count =
+          has_meshes_ && (IsMesh(pair.a) || IsMesh(pair.b))
+              ? SpreadContacts(pair.a, pair.b, std::min(static_cast<int>(m), kMeshProbe), out)
+              : dCollide(pair.a, pair.b, options_.max_contacts, out, sizeof(dContactGeom));
     }
   };
   // Debian's trimesh collider (OPCODE) is not thread-safe: worlds with
@@ -108,7 +164,7 @@ void OdeWorld::AddContacts(size_t k) {
   // constrains (v_1 - v_2) . fdir1 = motion1 where body 1 is a's body, or
   // b's when a has none (a static belt: ODE then swaps the two).
   const bool moving = ia.surface >= 0 || ib.surface >= 0;
-  const size_t first = k * static_cast<size_t>(options_.max_contacts);
+  const size_t first = k * static_cast<size_t>(ContactCapacity());
   for (int i = 0; i < pair.count; ++i) {
     dContact c{};
     c.geom = pair_contacts_[first + static_cast<size_t>(i)];

@@ -215,13 +215,16 @@ class OdeWorld {
   // Each model instance's dSimpleSpace inside space_ (SpaceOf), or null.
   std::vector<dSpaceID> instance_spaces_;
   // A substep's candidate geom pairs (broadphase order) and their contact
-  // points: pair k's in [k * max_contacts, + count).
+  // points: pair k's in [k * ContactCapacity(), + count).
   struct CandidatePair {
     dGeomID a, b;    // a built before b
     int count;       // contact points (FindContacts)
     uint64_t order;  // a's build index, then b's: the pairs' order
   };
   std::vector<CandidatePair> pairs_;
+  // Contact points a pair may keep: max_contacts, or more in a world with
+  // meshes (their pairs spread them over the patch; ode_contacts.cc).
+  int ContactCapacity() const;
   std::vector<dContactGeom> pair_contacts_;
   bool has_meshes_ = false;  // a trimesh geom: contacts on one thread (OPCODE)
   // Mesh assets in use and their trimesh data (ODE reads the asset's arrays in place).

@@ -143,11 +143,11 @@ TEST(JointTypeTest, LimitsMustBeOrderedAndForcesPositive) {
   EXPECT_EQ(pinned.settings->min_position, 0.5);
   EXPECT_EQ(pinned.settings->max_position, 0.5);
   // A joint may not start past its own stops (ODE snapped it back with a jolt).
-  EXPECT_EQ(ErrorOf([] {
-              Read(FakeReader{{"limits", std::vector<double>{-0.5, 1}},
-                              {"initial_position", 1.25}});
-            }),
-            "model.yaml:3:3: 'initial_position' 1.25 is outside 'limits' [-0.5, 1]");
+  EXPECT_EQ(
+      ErrorOf([] {
+        Read(FakeReader{{"limits", std::vector<double>{-0.5, 1}}, {"initial_position", 1.25}});
+      }),
+      "model.yaml:3:3: 'initial_position' 1.25 is outside 'limits' [-0.5, 1]");
   EXPECT_EQ(Read(FakeReader{{"limits", std::vector<double>{-0.5, 1}}, {"initial_position", 1.0}})
                 .position,
             1.0);

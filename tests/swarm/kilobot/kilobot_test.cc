@@ -697,9 +697,9 @@ TEST(KilobotTest, AMainThatHangsCostsOneTimeout) {
   std::string world = World("hangmain", "planar", 8, 0.5, "{program_timeout: 0.5}");
   world.replace(world.find("seed: 1}"), 8, "seed: 1, on_script_error: disable_script}");
   Write(dir / "world.yaml", world);
-  const CommandResult run = RunProgram("run " + (dir / "world.yaml").string() +
-                                       " --steps 2 --quiet --threads 1 --out " +
-                                       (dir / "out").string());
+  const CommandResult run =
+      RunProgram("run " + (dir / "world.yaml").string() + " --steps 2 --quiet --threads 1 --out " +
+                 (dir / "out").string());
   EXPECT_EQ(run.exit_code, 0) << run.output;
   std::ifstream summary(dir / "out" / "summary.json");
   const auto disabled = nlohmann::json::parse(summary)["disabled_scripts"];

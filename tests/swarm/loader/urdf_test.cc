@@ -656,6 +656,55 @@ TEST_F(UrdfTest, AFloatingRobotWithMilligramLinksStandsOnTheGroundUnderOde) {
   EXPECT_CONTAINS(why, "`simulation: {ode: {solver: quickstep}}` may hold it");
 }
 
+// A robot standing still on a mesh base stays so: ODE's trimesh-plane
+// collider gave the first 4 vertices below the ground, all on one side of
+// the base, so that a cylinder-mesh base with its load 5 cm off centre
+// turned and tilted by itself (and a floating Panda fell over).
+TEST_F(UrdfTest, ARobotOnAMeshBaseStandsStillUnderOde) {
+  std::string obj;
+  constexpr int kSides = 32;
+  for (int z : {0, 1})
+    for (int i = 0; i < kSides; ++i) {
+      const double a = 2 * M_PI * i / kSides;
+      obj += "v " + std::to_string(0.1 * std::cos(a)) + " " + std::to_string(0.1 * std::sin(a)) +
+             " " + std::to_string(0.2 * z) + "\n";
+    }
+  for (int i = 0; i < kSides; ++i) {
+    const int j = (i + 1) % kSides;
+    obj += "f " + std::to_string(1 + i) + " " + std::to_string(1 + j) + " " +
+           std::to_string(1 + kSides + j) + " " + std::to_string(1 + kSides + i) + "\n";
+  }
+  std::string bottom = "f", top = "f";
+  for (int i = 0; i < kSides; ++i) {
+    bottom += " " + std::to_string(kSides - i);
+    top += " " + std::to_string(1 + kSides + i);
+  }
+  Write("cylinder.obj", obj + bottom + "\n" + top + "\n");
+  Write("stand.urdf",
+        "<robot name=\"stand\">\n  <link name=\"base\"><inertial><mass value=\"1\"/>"
+        "<inertia ixx=\"0.01\" iyy=\"0.01\" izz=\"0.01\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/>"
+        "</inertial><collision><geometry><mesh filename=\"cylinder.obj\"/></geometry>"
+        "</collision></link>\n"
+        "  <link name=\"arm\"><inertial><origin xyz=\"0 0.05 0.3\"/><mass value=\"5\"/>"
+        "<inertia ixx=\"0.01\" iyy=\"0.01\" izz=\"0.01\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/>"
+        "</inertial></link>\n"
+        "  <joint name=\"j\" type=\"revolute\"><parent link=\"base\"/><child link=\"arm\"/>"
+        "<origin xyz=\"0 0 0.2\"/><axis xyz=\"0 0 1\"/>"
+        "<limit lower=\"-1\" upper=\"1\" effort=\"100\" velocity=\"1\"/></joint>\n</robot>\n");
+  LoadedWorld w = Load(
+      "simulation: {physics: ode, time_step: 0.01}\n"
+      "models: [{model: stand.urdf, position: [0, 0], base: floating}]\n");
+  w.world->Start();
+  for (int k = 0; k < 1000; ++k) ASSERT_NO_THROW(w.world->Step()) << "at step " << k;
+  const Pose X = w.world->scene().world_pose(w.world->scene().instances()[0].root);
+  const Vec3 rpy = X.q.RollPitchYaw();
+  EXPECT_NEAR(rpy.x, 0, 0.002);
+  EXPECT_NEAR(rpy.y, 0, 0.002);
+  EXPECT_NEAR(rpy.z, 0, 0.002) << "it turned by itself";
+  EXPECT_NEAR(X.p.x, 0, 0.001);
+  EXPECT_NEAR(X.p.y, 0, 0.001);
+}
+
 // An object runs one script: two keys of an entry's `scripts` naming the
 // same object (the root by its URDF name and by ':') are an error, not one
 // of them silently dropped.
@@ -865,6 +914,71 @@ TEST_F(UrdfErrorTest, APercentInTheFileIsTextNotAFormat) {
                        "<material name=\"m\"><color rgba=\"0.5 0.5 0.6 1\"/></material></visual>"
                        "</link>\n</robot>\n");
   EXPECT_NO_THROW(Load("models: [{model: ok.urdf, position: [0, 0]}]\n"));
+}
+
+// A xacro file not expanded loaded with its macros' parts left out and
+// '${prefix}arm' as a link's name; named where it is XML in a model's place.
+TEST_F(UrdfErrorTest, AnUnexpandedXacroSaysToExpandIt) {
+  const std::string link = "  <link name=\"a\"/>\n";
+  EXPECT_CONTAINS(ErrorOfUrdf(std::string(kHead) + link +
+                              "  <xacro:include filename=\"arm.xacro\"/>\n</robot>\n"),
+                  "bad.urdf:4: <xacro:include>: this is a xacro file, not yet URDF: expand it "
+                  "first (xacro robot.urdf.xacro > robot.urdf)");
+  EXPECT_CONTAINS(
+      ErrorOfUrdf(std::string(kHead) + link + "  <link name=\"${prefix}arm\"/>\n</robot>\n"),
+      "bad.urdf:4: <link name=\"${prefix}arm\">: this is a xacro file");
+  Write("arm.urdf.xacro", std::string(kHead) + link + "</robot>\n");
+  EXPECT_CONTAINS(
+      testing::ErrorOf([&] { Load("models: [{model: arm.urdf.xacro, position: [0, 0]}]\n"); }),
+      "this is XML: a URDF is read as one when its name ends in .urdf");
+}
+
+// A name cut inside a UTF-8 character: urdfdom said "Error reading
+// Attributes." with no line.
+TEST_F(UrdfErrorTest, BytesThatAreNotUtf8AreNamedAtTheirLine) {
+  EXPECT_CONTAINS(ErrorOfUrdf(std::string(kHead) + "\n  <link name=\"a\xc3\"/>\n</robot>\n"),
+                  "bad.urdf:4: this line is not valid UTF-8");
+}
+
+// file:// URIs are percent-encoded (file:///a%20b.stl is 'a b.stl').
+TEST_F(UrdfErrorTest, FileUrisArePercentDecoded) {
+  fs::create_directories(dir_ / "my meshes");
+  Write("my meshes/cube box.obj",
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
+  const std::string uri = "file://" + (dir_ / "my%20meshes/cube%20box.obj").string();
+  Write("ok.urdf", std::string(kHead) +
+                       "  <link name=\"a\"><collision><geometry><mesh filename=\"" + uri +
+                       "\"/></geometry></collision></link>\n</robot>\n");
+  EXPECT_NO_THROW(Load("models: [{model: ok.urdf, position: [0, 0]}]\n"));
+}
+
+// Two copies of one package (each robot's example-robot-data): a URDF inside
+// one finds its own; the package path is searched one or two levels down.
+TEST_F(UrdfErrorTest, AUrdfFindsItsOwnPackageBeforeAnotherOfTheSameName) {
+  const auto package = [&](const std::string& folder, bool with_mesh) {
+    fs::create_directories(dir_ / folder / "meshes");
+    Write(folder + "/package.xml", "<package><name>robots</name></package>\n");
+    if (with_mesh)
+      Write(folder + "/meshes/m.obj",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
+  };
+  package("lib/a/robots", false);  // found first on the path, without the mesh
+  package("own/robots", true);
+  Write("own/robots/r.urdf",
+        std::string(kHead) +
+            "  <link name=\"a\"><collision><geometry><mesh "
+            "filename=\"package://robots/meshes/m.obj\"/></geometry></collision>"
+            "</link>\n</robot>\n");
+  EXPECT_NO_THROW(
+      Load("package_path: [lib]\nmodels: [{model: own/robots/r.urdf, position: [0, 0]}]\n"));
+  // Three levels down is past the search.
+  fs::copy_file(dir_ / "own/robots/r.urdf", dir_ / "r.urdf");
+  package("deep/x/y/robots", true);
+  EXPECT_CONTAINS(testing::ErrorOf([&] {
+                    Load("package_path: [deep]\nmodels: [{model: r.urdf, position: [0, 0]}]\n");
+                  }),
+                  "cannot resolve package 'robots'");
+  EXPECT_NO_THROW(Load("package_path: [deep/x]\nmodels: [{model: r.urdf, position: [0, 0]}]\n"));
 }
 
 TEST_F(UrdfErrorTest, TheProgramExitsWithTwoAndTheMessage) {

@@ -33,7 +33,7 @@ TEST(ValuesTest, LiteralsAreNumbersBooleansOrText) {
   // Quoted ("!" tag): text, whatever it looks like.
   EXPECT_EQ(ParseScalar("1.5", true), ParamValue(std::string("1.5")));
   EXPECT_EQ(ParseScalar("true", true), ParamValue(std::string("true")));
-  EXPECT_STREQ(TypeName(ParamValue(1.0)), "a number");
+  EXPECT_STREQ(TypeName(ParamValue(1.0)), "a finite number");
   EXPECT_STREQ(TypeName(ParamValue(true)), "a boolean");
   EXPECT_STREQ(TypeName(ParamValue(std::string("x"))), "a string");
 }

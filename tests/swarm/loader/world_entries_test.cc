@@ -157,8 +157,9 @@ TEST_F(ControlLoaderTest, ADefaultUsesTheParametersAboveItWithTheirFinalValues) 
         "  turn: \"= speed * 2\"\n"
         "  speed: 0.1\n"
         "objects: {name: body, type: dummy, script: bot.lua}\n");
-  EXPECT_CONTAINS(ErrorOf(kThree), "bot.yaml:3:9: in expression 'speed * 2' for 'turn': "
-                                   "parameter 'speed' is defined below this one (at line 4)");
+  EXPECT_CONTAINS(ErrorOf(kThree),
+                  "bot.yaml:3:9: in expression 'speed * 2' for 'turn': "
+                  "parameter 'speed' is defined below this one (at line 4)");
 }
 
 TEST_F(ControlLoaderTest, RangesAndInstanceMistakesNameFileLineAndColumn) {

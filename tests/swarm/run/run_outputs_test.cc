@@ -492,6 +492,29 @@ TEST(RunOutputsTest, AnOutFolderUsedAgainHoldsTheNewRunAlone) {
   fs::remove_all(out);
 }
 
+// A run whose world does not load replaces the folder's summary.json: the
+// earlier run's files went unlisted, and stayed beside the next run's.
+TEST(RunOutputsTest, ARunThatDoesNotLoadTakesTheEarlierRunsFilesWithIt) {
+  const fs::path out = TempDir("failed_load");
+  auto r = RunProgram("run " + Data("outputs.yaml") + " --steps 2 --quiet --record --out " +
+                      out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  ASSERT_TRUE(fs::exists(out / "recording.swrec"));
+  ASSERT_TRUE(fs::exists(out / "metrics.csv"));
+  std::ofstream(out / "notes.txt") << "mine\n";
+  r = RunProgram("run " + (out / "no_such_world.yaml").string() + " --quiet --out " + out.string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("note: removed the outputs of the earlier run in '" + out.string() +
+                          "' (1 recording)"),
+            std::string::npos)
+      << r.output;
+  EXPECT_FALSE(fs::exists(out / "recording.swrec"));
+  EXPECT_FALSE(fs::exists(out / "metrics.csv")) << "the earlier run's, beside an error summary";
+  EXPECT_TRUE(fs::exists(out / "notes.txt")) << "not a run's";
+  EXPECT_NE(ReadFile(out / "summary.json").find("\"status\": \"error\""), std::string::npos);
+  fs::remove_all(out);
+}
+
 // A run killed before its end (kill -9: summary.json still says running,
 // listing nothing) left its recording, video and snapshots to the next run
 // into the folder, beside that run's summary.

@@ -255,8 +255,9 @@ TEST(SweepTest, SameSeedSameHashAsRunAndChangedWorldIsRefused) {
   const fs::path bad_db = dir / "bad_value.db";
   r = RunProgram("sweep " + world + " --param robots=2,abc --steps 2 --db " + bad_db.string());
   EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_NE(r.output.find("--param robots=2,abc: parameter 'robots' is a finite number, got \"abc\""),
-            std::string::npos)
+  EXPECT_NE(
+      r.output.find("--param robots=2,abc: parameter 'robots' is a finite number, got \"abc\""),
+      std::string::npos)
       << r.output;
   EXPECT_FALSE(fs::exists(bad_db)) << "no database for a sweep refused up front";
   fs::remove_all(dir);
