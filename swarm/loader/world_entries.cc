@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <optional>
 #include <tuple>
@@ -161,6 +162,43 @@ void DropScripts(ObjectSpec* spec) {
   for (ObjectSpec& child : spec->children) DropScripts(&child);
 }
 }  // namespace
+
+// The planar engines roll a wheel that is a non-dynamic cylinder or sphere
+// under a velocity-mode revolute joint (modules/dynamics/plane_wheels.h); an
+// imported robot's wheel links are bodies of their own, which they do not
+// roll: a floating TurtleBot under box2d turned its wheels and stood still,
+// with no word.
+void WorldLoader::AddPlaneWheelHints(const WorldSettings& settings,
+                                     std::vector<std::string>* warnings) const {
+  if (settings.physics != "box2d" && settings.physics != "planar") return;
+  for (const EntryPlan& e : entries_) {
+    if (!e.model->imported) continue;
+    std::vector<std::string> joints;
+    std::function<void(const ObjectSpec&)> walk = [&](const ObjectSpec& o) {
+      if (const auto* joint = o.As<JointData>(ObjectType::kJoint);
+          joint != nullptr && joint->type() == JointType::kRevolute &&
+          joint->mode() == JointMode::kVelocity)
+        for (const ObjectSpec& c : o.children)
+          if (const ShapeData* shape = c.AsShape(); shape != nullptr && shape->dynamic) {
+            joints.push_back(o.name);
+            break;
+          }
+      for (const ObjectSpec& c : o.children) walk(c);
+    };
+    walk(e.spec);
+    if (joints.empty()) continue;
+    std::string list;
+    for (size_t i = 0; i < joints.size() && i < 3; ++i) list += (i ? ", " : "") + joints[i];
+    if (joints.size() > 3) list += ", ...";
+    warnings->push_back(file_->Where(e.field.mark) + ": '" + e.model->name + "' drives " +
+                        std::to_string(joints.size()) + " joint" + (joints.size() == 1 ? "" : "s") +
+                        " (" + list +
+                        ") whose links are bodies of their own, not the wheels that " +
+                        "physics: " + settings.physics +
+                        " rolls (a non-dynamic cylinder or sphere under the joint): it will not "
+                        "move; use physics: ode, where they roll as bodies");
+  }
+}
 
 // From this many robots, the defaults below cost enough to say so (README,
 // "Performance": at 100,000 robots a state each takes twice the memory of

@@ -119,6 +119,7 @@ LoadedWorld WorldLoader::Load() {
   for (EntryPlan& entry : entries_) ResolveEntry(&entry);
   KeepPlacementClearOfTheMap(&out.warnings);
   AddLargeSwarmHints(settings, &out.warnings);
+  AddPlaneWheelHints(settings, &out.warnings);
   unplaced_ = std::make_unique<Placer>(*placer_);
   PlaceEntries(&out.warnings);
   BuildCopies(world);

@@ -198,6 +198,7 @@ class WorldLoader {
   // state per robot, copies numbered at random): a line each saying which
   // setting to write.
   void AddLargeSwarmHints(const WorldSettings& settings, std::vector<std::string>* warnings) const;
+  void AddPlaneWheelHints(const WorldSettings& settings, std::vector<std::string>* warnings) const;
   void PlaceEntries(std::vector<std::string>* warnings);
   void BuildCopies(World* world);
   std::vector<ModelSummary> Summarize() const;

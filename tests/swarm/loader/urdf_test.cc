@@ -231,6 +231,24 @@ TEST_F(UrdfTest, TurtlebotDrivesForwardOnItsWheels) {
   EXPECT_LT(std::abs(X.p.z), 0.02);
 }
 
+// Under the planar engines its wheel links are bodies, not wheels they roll:
+// the world loads, saying it will not move (it stood still without a word).
+TEST_F(UrdfTest, APlanarEngineSaysAUrdfsWheelsWillNotRoll) {
+  NEED_SHARED_URDF(dir);
+  for (const char* physics : {"box2d", "planar"}) {
+    const LoadedWorld w = LoadRobot(dir, kTurtlebot, physics, "    base: floating\n");
+    std::string all;
+    for (const std::string& line : w.warnings) all += line + "\n";
+    EXPECT_CONTAINS(all,
+                    "drives 2 joints (wheel_left_joint, wheel_right_joint) whose links are "
+                    "bodies of their own, not the wheels that physics: " +
+                        std::string(physics) + " rolls");
+  }
+  const LoadedWorld ode = LoadRobot(dir, kTurtlebot, "ode", "    base: floating\n");
+  for (const std::string& line : ode.warnings)
+    EXPECT_EQ(line.find("not the wheels"), std::string::npos);
+}
+
 TEST_F(UrdfTest, TurtlebotColladaMeshesKeepTheUrdfFrame) {
   NEED_SHARED_URDF(dir);
   LoadedWorld w = LoadRobot(dir, kTurtlebot, "kinematic");
@@ -676,8 +694,11 @@ TEST_F(UrdfTest, ARobotOnAMeshBaseStandsStillUnderOde) {
   }
   std::string bottom = "f", top = "f";
   for (int i = 0; i < kSides; ++i) {
-    bottom += " " + std::to_string(kSides - i);
-    top += " " + std::to_string(1 + kSides + i);
+    // Appended piecewise: GCC 12 warns (-Wrestrict, a false positive) on " " + ....
+    bottom += ' ';
+    bottom += std::to_string(kSides - i);
+    top += ' ';
+    top += std::to_string(1 + kSides + i);
   }
   Write("cylinder.obj", obj + bottom + "\n" + top + "\n");
   Write("stand.urdf",
