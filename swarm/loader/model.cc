@@ -588,7 +588,9 @@ namespace {
 
 void Accumulate(const ObjectSpec& spec, const Pose& X_RP, Footprint* fp, bool* any) {
   const Pose X_RO = X_RP * spec.X_PO;
-  if (const ShapeData* shape = spec.AsShape()) {
+  // A shape neither seen nor touched (an imported link's mass carrier, a
+  // 1 mm sphere) is no part of the footprint: copies stood 1 mm up on it.
+  if (const ShapeData* shape = spec.AsShape(); shape && (shape->collidable || shape->visible)) {
     const ShapeData& s = *shape;
     Vec3 half;  // half extents in the shape's frame
     switch (s.kind) {

@@ -249,6 +249,18 @@ TEST_F(UrdfTest, APlanarEngineSaysAUrdfsWheelsWillNotRoll) {
     EXPECT_EQ(line.find("not the wheels"), std::string::npos);
 }
 
+// Placed with [x, y], a robot stands on its lowest collision or visual
+// shape: the 1 mm sphere carrying a link's mass (neither) held every copy
+// 1 mm up (the FANUC's tool0 at 1.251 m, not the URDF's 1.25).
+TEST_F(UrdfTest, ACopyPlacedOnTheGroundStandsOnItsGeometryNotItsMassCarriers) {
+  NEED_SHARED_URDF(dir);
+  for (const char* robot : {kFanuc, kTurtlebot}) {
+    const LoadedWorld w = LoadRobot(dir, robot, "kinematic");
+    const Pose X = w.world->scene().world_pose(w.world->scene().instances()[0].root);
+    EXPECT_NEAR(X.p.z, 0, 1e-9) << robot;
+  }
+}
+
 TEST_F(UrdfTest, TurtlebotColladaMeshesKeepTheUrdfFrame) {
   NEED_SHARED_URDF(dir);
   LoadedWorld w = LoadRobot(dir, kTurtlebot, "kinematic");
