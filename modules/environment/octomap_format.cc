@@ -159,6 +159,13 @@ OctomapHeader ParseOctomapHeader(std::string_view bytes) {
         if (ec != std::errc() || ptr != end || !(res > 0) || !std::isfinite(res))
           Fail("the header's 'res " + std::string(value) +
                "' is not a positive resolution in metres");
+        // The tree spans 2^16 cells a side, centred on the origin: past
+        // 30.5 m a cell, it reaches beyond the 1e6 m a world may use (a
+        // 1e30 m cell swallowed every robot in one voxel, with no word).
+        if (res * 32768 > 1e6)
+          Fail("the header's 'res " + std::string(value) +
+               "' is more than 30.5 m: the tree's 65,536 cells a side would reach past the 1e6 "
+               "m a world may use");
         header.resolution = res;
         has_res = true;
       }

@@ -505,9 +505,14 @@ ObjectSpec Importer::LinkObject(const urdf::Link& link, bool top, bool is_root, 
       default: break;
     }
     Vec3 axis{joint->axis.x, joint->axis.y, joint->axis.z};
-    if (!(axis.Norm() > 1e-9) || !std::isfinite(axis.Norm()))
+    // Scaled by its largest component first: "0 1e300 1e300" is a direction
+    // (its norm overflowed, and it was called zero).
+    const double largest = std::max({std::abs(axis.x), std::abs(axis.y), std::abs(axis.z)});
+    if (!std::isfinite(largest))
+      Fail(line, "joint '" + joint->name + "': <axis xyz> must be finite");
+    if (!(largest > 0) || !((axis / largest).Norm() * largest > 1e-9))
       Fail(line, "joint '" + joint->name + "': <axis xyz> must be a nonzero vector");
-    axis = axis.Normalized();
+    axis = (axis / largest).Normalized();
     const Quat z_to_axis = ZTo(axis);
     ObjectSpec j =
         NewObject(ObjectType::kJoint, JointName(joint->name), X_LJ * Pose{{}, z_to_axis});

@@ -60,6 +60,14 @@ TEST_F(OctomapFileTest, AHeaderWithoutDataOrResIsAnError) {
                                 "c.bt", {});
                   }),
                   "'res -1' is not a positive resolution");
+  // A cell so large the tree reaches past the world's 1e6 m (1e30 was read).
+  EXPECT_CONTAINS(ErrorOf([&] {
+                    ReadOctomap(Write("d.bt",
+                                      "# Octomap OcTree binary file\nid OcTree\nsize "
+                                      "3\nres 1e30\ndata\n"),
+                                "d.bt", {});
+                  }),
+                  "'res 1e30' is more than 30.5 m");
 }
 
 TEST_F(OctomapFileTest, ATruncatedBodyIsAnErrorAtEveryLength) {

@@ -1014,6 +1014,22 @@ TEST_F(UrdfErrorTest, AUrdfFindsItsOwnPackageBeforeAnotherOfTheSameName) {
   EXPECT_NO_THROW(Load("package_path: [deep/x]\nmodels: [{model: r.urdf, position: [0, 0]}]\n"));
 }
 
+// An axis is a direction: huge components are one (their norm overflowed
+// and it was called "zero"); zero is refused.
+TEST_F(UrdfErrorTest, AnAxisOfHugeComponentsIsADirection) {
+  const auto robot = [](const std::string& axis) {
+    return std::string(kHead) +
+           "  <link name=\"a\"/>\n  <link name=\"b\"><inertial><mass value=\"1\"/><inertia "
+           "ixx=\"0.1\" iyy=\"0.1\" izz=\"0.1\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial>"
+           "</link>\n  <joint name=\"j\" type=\"continuous\"><parent link=\"a\"/><child "
+           "link=\"b\"/><axis xyz=\"" +
+           axis + "\"/></joint>\n</robot>\n";
+  };
+  Write("ok.urdf", robot("0 1e300 1e300"));
+  EXPECT_NO_THROW(Load("models: [{model: ok.urdf, position: [0, 0]}]\n"));
+  EXPECT_CONTAINS(ErrorOfUrdf(robot("0 0 0")), "joint 'j': <axis xyz> must be a nonzero vector");
+}
+
 TEST_F(UrdfErrorTest, TheProgramExitsWithTwoAndTheMessage) {
   Write("bad.urdf", std::string(kHead) + "  <link name=\"a\">\n</robot>\n");
   Write("w.yaml", "models: [{model: bad.urdf, position: [0, 0]}]\n");
