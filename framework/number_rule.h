@@ -22,5 +22,9 @@ inline constexpr NumberRule kPositive{"a positive number", 0, 1e300, true};
 inline constexpr NumberRule kNonNegative{"a non-negative number", 0, 1e300};
 inline constexpr NumberRule kFraction{"a number from 0 to 1", 0, 1};
 inline constexpr NumberRule kAngleDeg{"an angle in degrees", -1e6, 1e6};
+// A body's mass, kg: past 1e9 (a large ship) the solvers' arithmetic breaks
+// (1e308 was an ODE assertion at the first step, naming no link).
+inline constexpr double kMaxMass = 1e9;
+inline constexpr NumberRule kMass{"a positive number of kg", 0, kMaxMass, true};
 
 }  // namespace swarmsim

@@ -106,7 +106,7 @@ void Read(const ObjectTypeDescriptor&, const ObjectReader& r, void* row) {
     s.size = {r.Number("radius", kPositiveLength, true), 0, 0};
   }
   if (r.Has("dynamic")) s.dynamic = r.Bool("dynamic");
-  if (r.Has("mass")) s.mass = r.Number("mass", kPositive);
+  if (r.Has("mass")) s.mass = r.Number("mass", kMass);
   if (r.Has("inertia")) {
     const std::vector<double> i = r.Numbers("inertia", 6, 6, kAnyNumber);
     if (!InertiaIsValid({i[0], i[1], i[2], i[3], i[4], i[5]}))

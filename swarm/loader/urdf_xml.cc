@@ -2,11 +2,13 @@
 
 #include <tinyxml2.h>
 
+#include <cmath>
 #include <cstdio>
 #include <functional>
 #include <tuple>
 
 #include "framework/error.h"
+#include "framework/number_rule.h"
 #include "framework/suggest.h"
 #include "swarm/loader/check_text.h"
 #include "swarm/loader/urdf_numbers.h"
@@ -131,11 +133,20 @@ UrdfXmlFacts XmlReader::Read(const std::string& bytes) {
           double mass = 0;
           const tinyxml2::XMLElement* m = c->FirstChildElement("mass");
           if (m && m->QueryDoubleAttribute("value", &mass) == tinyxml2::XML_SUCCESS &&
-              !(mass >= 0 && std::isfinite(mass)))
+              !(mass >= 0 && mass <= kMaxMass))
             Fail(m->GetLineNum(), "link '" + std::string(name) + "': <mass value=\"" + Num(mass) +
-                                      "\"> must be a non-negative number of kg");
-          if (const tinyxml2::XMLElement* in = c->FirstChildElement("inertia"))
+                                      "\"> must be a non-negative number of kg, at most 1e9");
+          if (const tinyxml2::XMLElement* in = c->FirstChildElement("inertia")) {
             facts_.inertia_line[name] = in->GetLineNum();
+            // 1e9 kg spread over 30 m: past that the solvers' arithmetic breaks.
+            for (const char* key : {"ixx", "iyy", "izz", "ixy", "ixz", "iyz"}) {
+              double v = 0;
+              if (in->QueryDoubleAttribute(key, &v) == tinyxml2::XML_SUCCESS &&
+                  !(std::abs(v) <= 1e12))
+                Fail(in->GetLineNum(), "link '" + std::string(name) + "': <inertia " + key + "=\"" +
+                                           Num(v) + "\"> is past 1e12 kg m^2");
+            }
+          }
         } else {
           Ignore("<" + part + "> in a link", c->GetLineNum());
         }
@@ -185,9 +196,10 @@ UrdfXmlFacts XmlReader::Read(const std::string& bytes) {
           double damping = 0, friction = 0;
           k->QueryDoubleAttribute("damping", &damping);
           k->QueryDoubleAttribute("friction", &friction);
-          if (!(damping >= 0) || !std::isfinite(damping))
+          if (!(damping >= 0 && damping <= 1e12))
             Fail(k->GetLineNum(), "joint '" + std::string(name) + "': <dynamics damping=\"" +
-                                      Num(damping) + "\"> must be a non-negative number");
+                                      Num(damping) +
+                                      "\"> must be a non-negative number, at most 1e12");
           if (friction != 0) Ignore("joint <dynamics> friction (not simulated)", k->GetLineNum());
         }
       }

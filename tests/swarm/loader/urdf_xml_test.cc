@@ -191,6 +191,20 @@ TEST(UrdfXmlTest, StructuralMistakesNameTheFileAndTheLine) {
                              "<child link=\"b\"/>\n    <dynamics damping=\"-1\"/>\n  </joint>\n"
                              "</robot>\n"),
                   "r.urdf:6: joint 'j': <dynamics damping=\"-1\"> must be a non-negative number");
+  // Finite but absurd: an ODE assertion at the first step, naming no link.
+  EXPECT_CONTAINS(ErrorOfXml("  <link name=\"a\">\n    <inertial>\n      <mass value=\"1e308\"/>\n"
+                             "    </inertial>\n  </link>\n</robot>\n"),
+                  "r.urdf:5: link 'a': <mass value=\"1e+308\"> must be a non-negative number of "
+                  "kg, at most 1e9");
+  EXPECT_CONTAINS(ErrorOfXml("  <link name=\"a\">\n    <inertial>\n      <mass value=\"1\"/>\n"
+                             "      <inertia ixx=\"1e300\" iyy=\"1\" izz=\"1\" ixy=\"0\" "
+                             "ixz=\"0\" iyz=\"0\"/>\n    </inertial>\n  </link>\n</robot>\n"),
+                  "r.urdf:6: link 'a': <inertia ixx=\"1e+300\"> is past 1e12 kg m^2");
+  EXPECT_CONTAINS(ErrorOfXml("  <link name=\"a\"/>\n  <link name=\"b\"/>\n"
+                             "  <joint name=\"j\" type=\"continuous\"><parent link=\"a\"/>"
+                             "<child link=\"b\"/>\n    <dynamics damping=\"1e300\"/>\n  </joint>\n"
+                             "</robot>\n"),
+                  "at most 1e12");
   // A number urdfdom would misread is refused here, with its line (urdf_numbers.h).
   EXPECT_CONTAINS(ErrorOfXml("  <link name=\"a\"><visual><geometry><box size=\"1 x 1\"/>"
                              "</geometry></visual></link>\n</robot>\n"),
