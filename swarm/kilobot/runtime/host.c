@@ -353,8 +353,10 @@ int kilobot_sigaction(int sig, const struct sigaction *act, struct sigaction *ol
 static atomic_llong g_timed_out_at = -1;
 /* The robot whose main() timed out (-1: none): the others' main() is not
  * called, for the same reason (it cost one timeout per robot: 25 minutes
- * for 300 robots). */
+ * for 300 robots). Both are the world's whose program hung (a process may
+ * hold several, from Python), and a world's load clears them. */
 static atomic_int g_main_timed_out = -1;
+static _Atomic(void *) g_hung_world = NULL;
 
 /* ---- delay(): the program on a stack of the robot's own ----
  *
@@ -670,7 +672,7 @@ static int Init(const SwarmsimCallContext *c, void **state, char *error, size_t 
 
   /* The program's main(): kilo_init, callbacks, kilo_start. */
   const int hung = atomic_load(&g_main_timed_out);
-  if (hung >= 0) {
+  if (hung >= 0 && atomic_load(&g_hung_world) == c->world) {
     snprintf(error, error_size,
              "%s (kilobot program '%s'), robot %d: main() not called: on robot %d it did not "
              "return within %g s",
@@ -694,6 +696,7 @@ static int Init(const SwarmsimCallContext *c, void **state, char *error, size_t 
   Unlock(copy);
   if (sig != 0) {
     if (sig == g_watchdog_signal) {
+      atomic_store(&g_hung_world, c->world);
       int none = -1;
       atomic_compare_exchange_strong(&g_main_timed_out, &none, c->robot);
     }
@@ -713,7 +716,8 @@ static int Step(const SwarmsimCallContext *c, void *state, char *error, size_t e
 
   const double now = api->time(c->world);
   const long long now_us = llround(now * 1e6);
-  if (atomic_load_explicit(&g_timed_out_at, memory_order_relaxed) == now_us)
+  if (atomic_load_explicit(&g_timed_out_at, memory_order_relaxed) == now_us &&
+      atomic_load_explicit(&g_hung_world, memory_order_relaxed) == c->world)
     return 0; /* another robot's program hung in this step: the run is ending */
   const double dt = now - r->last_time;
   r->last_time = now;
@@ -813,7 +817,10 @@ static int Step(const SwarmsimCallContext *c, void *state, char *error, size_t e
   kilobot_robot_t outputs = *rt;
   Unlock(copy);
   if (sig != 0) {
-    if (sig == g_watchdog_signal) atomic_store(&g_timed_out_at, now_us);
+    if (sig == g_watchdog_signal) {
+      atomic_store(&g_hung_world, c->world);
+      atomic_store(&g_timed_out_at, now_us);
+    }
     Failure(c, sig, what, error, error_size, r->coroutine);
     return -1;
   }
@@ -849,6 +856,11 @@ __attribute__((visibility("default"))) int swarmsim_plugin_register(const Swarms
   if (g_copy_count == 0 && LoadCopies() != 0)
     snprintf(g_load_error, sizeof g_load_error, "out of memory");
   pthread_once(&g_signals_once, InstallHandlers);
+  /* A new world: an earlier one's hang is not its own (a freed world's
+     address may come back). */
+  atomic_store(&g_hung_world, NULL);
+  atomic_store(&g_timed_out_at, -1);
+  atomic_store(&g_main_timed_out, -1);
   r->set_info(r->impl, KILOBOT_NAME, "1.0", "Kilobot program " KILOBOT_SOURCE " (swarm/kilobot)");
   return r->add_controller(r->impl, KILOBOT_NAME, "runs the Kilobot program " KILOBOT_SOURCE, Init,
                            Step, Cleanup, NULL);
