@@ -491,6 +491,8 @@ void OdeWorld::AddJoint(const Scene& scene, uint32_t slot, dBodyID child, dBodyI
   SimJoint j{};
   j.slot = slot;
   j.row = row;
+  j.min_position = data.settings->min_position;
+  j.max_position = data.settings->max_position;
   j.offset = data.position;
   j.position = data.position;
   j.parent_body = parent;
@@ -516,6 +518,7 @@ void OdeWorld::AddJoint(const Scene& scene, uint32_t slot, dBodyID child, dBodyI
       if (settings.min_position - j.offset >= -M_PI && settings.max_position - j.offset <= M_PI) {
         dJointSetHingeParam(j.joint, dParamLoStop, settings.min_position - j.offset);
         dJointSetHingeParam(j.joint, dParamHiStop, settings.max_position - j.offset);
+        j.has_stops = true;
       }
       dJointSetHingeParam(j.joint, dParamStopERP, limit_erp);
       dJointSetHingeParam(j.joint, dParamStopCFM, limit_cfm);
@@ -530,6 +533,7 @@ void OdeWorld::AddJoint(const Scene& scene, uint32_t slot, dBodyID child, dBodyI
         dJointSetSliderParam(j.joint, dParamLoStop, settings.min_position - j.offset);
       if (std::isfinite(settings.max_position))
         dJointSetSliderParam(j.joint, dParamHiStop, settings.max_position - j.offset);
+      j.has_stops = true;
       dJointSetSliderParam(j.joint, dParamStopERP, limit_erp);
       dJointSetSliderParam(j.joint, dParamStopCFM, limit_cfm);
       dJointSetSliderParam(j.joint, dParamFudgeFactor, kFudgeFactor);
@@ -612,7 +616,7 @@ void OdeWorld::ApplyMotors(double dt) {
   // their masters are in this substep at the speed their masters are driven.
   for (int pass = 0; pass < 2; ++pass) {
     for (size_t k = 0; k < joints_.size(); ++k) {
-      const SimJoint& j = joints_[k];
+      SimJoint& j = joints_[k];
       const JointCommand& c = commands_[k];
       const bool hinge = c.type == JointType::kRevolute;
       if (!hinge && c.type != JointType::kPrismatic) continue;
@@ -660,6 +664,30 @@ void OdeWorld::ApplyMotors(double dt) {
           dJointAddHingeTorque(j.joint, -c.damping * dJointGetHingeAngleRate(j.joint));
         else
           dJointAddSliderForce(j.joint, -c.damping * dJointGetSliderPositionRate(j.joint));
+      }
+      // A motor driving the joint off a stop it rests on: ODE turns the
+      // motor into a push of max_force times the fudge factor (0 here: 1
+      // made a Panda finger jump), so the joint stayed on the stop for good
+      // under the exact solver (a Panda's joint4 starts on its upper limit;
+      // commanded to -1 rad it never moved). For this substep that stop is
+      // released and the motor works as anywhere else; the next substep
+      // holds the stop again.
+      if (j.has_stops) {
+        const bool release_hi = max_force > 0 && velocity < 0 && j.position >= j.max_position;
+        const bool release_lo = max_force > 0 && velocity > 0 && j.position <= j.min_position;
+        const int param[2] = {dParamLoStop, dParamHiStop};
+        const bool release[2] = {release_lo, release_hi};
+        bool* released[2] = {&j.lo_released, &j.hi_released};
+        const double stop[2] = {j.min_position - j.offset, j.max_position - j.offset};
+        for (int side = 0; side < 2; ++side) {
+          if (release[side] == *released[side]) continue;
+          const double value = release[side] ? (side == 0 ? -dInfinity : dInfinity) : stop[side];
+          if (hinge)
+            dJointSetHingeParam(j.joint, param[side], value);
+          else
+            dJointSetSliderParam(j.joint, param[side], value);
+          *released[side] = release[side];
+        }
       }
       if (hinge) {
         dJointSetHingeParam(j.joint, dParamVel, velocity);

@@ -85,6 +85,12 @@ struct SimJoint {
   // index in joints_, and q = master_offset + master_factor * q_master. -1: none.
   int32_t master = -1;
   double master_factor = 1, master_offset = 0;
+  // Stops ODE holds (hinge: set only within (-pi, pi] of the Build
+  // position), in scene positions, and whether ApplyMotors released one for
+  // this substep: a motor driving the joint off a stop it rests on.
+  bool has_stops = false;
+  double min_position = 0, max_position = 0;
+  bool lo_released = false, hi_released = false;
 };
 
 // A force sensor: a fixed joint with feedback between its child body and the
