@@ -673,8 +673,15 @@ void OdeWorld::ApplyMotors(double dt) {
       // released and the motor works as anywhere else; the next substep
       // holds the stop again.
       if (j.has_stops) {
-        const bool release_hi = max_force > 0 && velocity < 0 && j.position >= j.max_position;
-        const bool release_lo = max_force > 0 && velocity > 0 && j.position <= j.min_position;
+        // Resting on it: within kOnStop of it, either side (a joint pushed
+        // past it keeps it, to be pushed back; a motor holding the joint
+        // on it, moving it less than kOnStop a substep, keeps it too).
+        constexpr double kOnStop = 1e-6;  // rad or m
+        const bool drives = max_force > 0 && std::abs(velocity) * dt > kOnStop;
+        const bool release_hi =
+            drives && velocity < 0 && std::abs(j.position - j.max_position) <= kOnStop;
+        const bool release_lo =
+            drives && velocity > 0 && std::abs(j.position - j.min_position) <= kOnStop;
         const int param[2] = {dParamLoStop, dParamHiStop};
         const bool release[2] = {release_lo, release_hi};
         bool* released[2] = {&j.lo_released, &j.hi_released};
