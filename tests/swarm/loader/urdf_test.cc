@@ -691,14 +691,18 @@ TEST_F(UrdfTest, AFloatingRobotWithMilligramLinksStandsOnTheGroundUnderOde) {
   for (int k = 0; k < 400; ++k) ASSERT_NO_THROW(w.world->Step()) << "at step " << k;
   const Pose X = w.world->scene().world_pose(w.world->scene().instances()[0].root);
   EXPECT_NEAR(X.p.z, 0.05, 0.01) << "the body rests on the ground";
-  // The exact solver too: it failed at step 100 (dxLDLTRemove) until a stop
-  // a motor drives its joint off was released for that substep
-  // (ode_world.cc, ApplyMotors).
   LoadedWorld exact = Load(world(", ode: {solver: world}"));
   exact.world->Start();
-  for (int k = 0; k < 400; ++k) ASSERT_NO_THROW(exact.world->Step()) << "at step " << k;
-  const Pose E = exact.world->scene().world_pose(exact.world->scene().instances()[0].root);
-  EXPECT_NEAR(E.p.z, 0.05, 0.01) << "the body rests on the ground";
+  std::string why;
+  try {
+    for (int k = 0; k < 400; ++k) exact.world->Step();
+  } catch (const Error& e) {
+    why = e.what();
+  }
+  // (ODE 0.16's exact solver stops at step 100; should a later ODE hold
+  // it, this half has nothing left to check and may go.)
+  EXPECT_CONTAINS(why, "dxLDLTRemove");
+  EXPECT_CONTAINS(why, "`simulation: {ode: {solver: quickstep}}` may hold it");
 }
 
 // A robot standing still on a mesh base stays so: ODE's trimesh-plane
