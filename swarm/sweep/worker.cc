@@ -12,6 +12,8 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "framework/error.h"
 #include "framework/utf8.h"
@@ -42,13 +44,44 @@ std::string Tail(const std::string& text, int lines) {
   return out;
 }
 
+// One record of a CSV file as metrics.csv writes it (RFC 4180: a field with
+// a comma, quote or line break is quoted, its quotes doubled): its fields.
+// False at the end of the file, and for a record the file ends inside (a
+// torn last line, or an open quote).
+bool ReadCsvRecord(std::istream& in, std::vector<std::string>* fields) {
+  fields->assign(1, std::string());
+  bool quoted = false;
+  for (int c; (c = in.get()) != EOF;) {
+    if (quoted) {
+      if (c != '"') {
+        fields->back() += static_cast<char>(c);
+      } else if (in.peek() == '"') {
+        fields->back() += '"';
+        in.get();
+      } else {
+        quoted = false;
+      }
+    } else if (c == '"') {
+      quoted = true;
+    } else if (c == ',') {
+      fields->emplace_back();
+    } else if (c == '\n') {
+      return true;
+    } else if (c != '\r') {
+      fields->back() += static_cast<char>(c);
+    }
+  }
+  return false;  // no line end: torn, or nothing left
+}
+
 // metrics.csv (step,time,robot,metric,value) -> series and final values.
 // Swarm metrics (robot empty) are kept as they are; a per-robot metric
-// becomes its mean over the robots that recorded it in that step.
+// becomes its mean over the robots that recorded it in that step. Metric
+// names are read as the CSV quotes them ('a,b' was stored as 'b"').
 void ReadMetrics(const std::filesystem::path& path, RunOutcome* out) {
-  std::ifstream f(path);
-  std::string line;
-  if (!std::getline(f, line)) return;  // header
+  std::ifstream f(path, std::ios::binary);
+  std::vector<std::string> fields;
+  if (!ReadCsvRecord(f, &fields)) return;  // header
   struct Key {
     std::string metric;
     int64_t step;
@@ -61,25 +94,23 @@ void ReadMetrics(const std::filesystem::path& path, RunOutcome* out) {
     int64_t n = 0;
   };
   std::map<Key, Acc> acc;
-  while (std::getline(f, line)) {
-    // step,time,robot,metric,value: robot names hold no commas but split from both ends anyway.
-    const size_t c1 = line.find(','), c2 = line.find(',', c1 + 1);
-    const size_t c4 = line.rfind(','), c3 = line.rfind(',', c4 - 1);
-    if (c1 == std::string::npos || c2 == std::string::npos || c3 == std::string::npos || c3 < c2 ||
-        c4 == c3)
-      continue;
+  while (ReadCsvRecord(f, &fields)) {
+    if (fields.size() != 5) continue;
     // Every field read before the row counts: a torn last line ("3,0.3,bot#0,x")
-    // must not leave an entry without values (a NaN metric named after a robot).
+    // is no record, and a field that is no number skips its row.
     try {
-      const int64_t step = std::stoll(line.substr(0, c1));
-      const double time = std::stod(line.substr(c1 + 1, c2 - c1 - 1));
-      const double value = std::stod(line.substr(c4 + 1));
-      Acc& a = acc[Key{line.substr(c3 + 1, c4 - c3 - 1), step}];
+      size_t used = 0;
+      const int64_t step = std::stoll(fields[0], &used);
+      if (used != fields[0].size()) continue;
+      const double time = std::stod(fields[1]);
+      const double value = std::stod(fields[4], &used);
+      if (used != fields[4].size()) continue;
+      Acc& a = acc[Key{fields[3], step}];
       a.time = time;
       a.sum += value;
       ++a.n;
     } catch (const std::exception&) {
-      continue;  // nan/inf values or a torn last line
+      continue;
     }
   }
   for (const auto& [key, a] : acc) {
