@@ -10,12 +10,34 @@ namespace swarmsim {
 
 int RunMerge(const std::string& out_db, const std::vector<std::string>& inputs,
              bool allow_changed_world, std::ostream& out, std::ostream& err) {
+  // Every input is checked before the output is touched: one that does not
+  // fit left the output holding the inputs before it (or an empty database).
+  {
+    std::optional<SweepRecord> first;
+    std::string first_name = out_db;
+    if (std::filesystem::exists(out_db)) first = ResultsDb(out_db, /*read_only=*/true).ReadSweep();
+    for (const std::string& input : inputs) {
+      if (!std::filesystem::exists(input)) throw Error("no database '" + input + "'");
+      if (std::filesystem::exists(out_db) && std::filesystem::equivalent(input, out_db))
+        throw Error("'" + input + "' is the output database");
+      const std::optional<SweepRecord> theirs = ResultsDb(input, /*read_only=*/true).ReadSweep();
+      if (!theirs) throw Error("'" + input + "' holds no sweep");
+      if (!first) {
+        first = theirs;
+        first_name = input;
+        continue;
+      }
+      if (first->space_json != theirs->space_json)
+        throw Error("'" + input + "' holds another sweep (different parameters, seeds or " +
+                    "run length) than '" + first_name + "'");
+      if (first->world_hash != theirs->world_hash && !allow_changed_world)
+        throw Error("'" + input + "' ran a different version of the world file than '" +
+                    first_name + "'; pass --allow-changed-world to merge anyway");
+    }
+  }
   ResultsDb results(out_db);
   SqliteDb& db = results.db();
   for (const std::string& input : inputs) {
-    if (!std::filesystem::exists(input)) throw Error("no database '" + input + "'");
-    if (std::filesystem::equivalent(input, out_db))
-      throw Error("'" + input + "' is the output database");
     {
       ResultsDb in(input, /*read_only=*/true);
       const std::optional<SweepRecord> theirs = in.ReadSweep();
@@ -48,14 +70,23 @@ int RunMerge(const std::string& out_db, const std::vector<std::string>& inputs,
     db.Exec("DROP TABLE IF EXISTS temp.take");
     db.Exec(
         "CREATE TEMP TABLE take AS SELECT s.id AS id FROM src.runs s JOIN main.runs m "
-        "ON m.id = s.id WHERE s.status IN ('ok', 'failed') AND m.status IN ('pending', "
-        "'running')");
+        "ON m.id = s.id WHERE (s.status IN ('ok', 'failed') AND m.status IN ('pending', "
+        "'running')) OR (s.status = 'ok' AND m.status = 'failed')");
+    // A run that finished here and failed there (or both): kept as it is.
+    // One that failed here and finished ok there: the ok one, counted.
     SqliteStatement dup(&db,
                         "SELECT count(*) FROM src.runs s JOIN main.runs m ON m.id = s.id "
-                        "WHERE s.status IN ('ok', 'failed') AND m.status IN ('ok', 'failed')");
+                        "WHERE s.status IN ('ok', 'failed') AND m.status IN ('ok', 'failed') "
+                        "AND NOT (s.status = 'ok' AND m.status = 'failed')");
     dup.Step();
     const int64_t duplicates = dup.Int(0);
     dup.Reset();
+    SqliteStatement over(&db,
+                         "SELECT count(*) FROM src.runs s JOIN main.runs m ON m.id = s.id "
+                         "WHERE s.status = 'ok' AND m.status = 'failed'");
+    over.Step();
+    const int64_t replaced = over.Int(0);
+    over.Reset();
     db.Exec("DELETE FROM main.final_metrics WHERE run IN (SELECT id FROM take)");
     db.Exec("DELETE FROM main.series WHERE run IN (SELECT id FROM take)");
     // The world file each run ran: its own record, or (a sweep from before
@@ -80,6 +111,8 @@ int RunMerge(const std::string& out_db, const std::vector<std::string>& inputs,
     txn.Commit();
     db.Exec("DETACH DATABASE src");
     out << "merge: " << input << ": " << copied << " runs copied";
+    if (replaced > 0)
+      out << " (" << replaced << " of them ok where " << out_db << " had them failed)";
     if (duplicates > 0) out << ", " << duplicates << " already in " << out_db << " (kept once)";
     out << "\n";
   }

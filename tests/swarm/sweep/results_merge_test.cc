@@ -54,5 +54,41 @@ TEST(SweepTest, ShardsMergeIntoTheWholeSweep) {
   fs::remove_all(dir);
 }
 
+// A run failed in one input and ok in a later one: the ok one (the failure
+// was kept and the result dropped, with no word). An input that does not
+// fit leaves no output behind (the inputs before it were merged already).
+TEST(SweepTest, MergeKeepsAnOkRunOverAFailedOneAndChecksEveryInputFirst) {
+  const fs::path dir = TempDir("merge_failed");
+  const std::string grid = " --param robots=2,3 --seeds 1 --steps 8 --quiet ";
+  ASSERT_EQ(RunProgram("sweep " + kWorld + grid + "--db " + (dir / "ok.db").string()).exit_code, 0);
+  fs::copy_file(dir / "ok.db", dir / "failed.db");
+  {
+    SqliteDb db(dir / "failed.db");
+    db.Exec("UPDATE runs SET status = 'failed', error = 'planned' WHERE id = 1");
+    db.Exec("DELETE FROM final_metrics WHERE run = 1");
+  }
+  Result m = RunProgram("merge " + (dir / "m.db").string() + " " + (dir / "failed.db").string() +
+                        " " + (dir / "ok.db").string());
+  ASSERT_EQ(m.exit_code, 0) << m.output;
+  EXPECT_NE(m.output.find("1 runs copied (1 of them ok where"), std::string::npos) << m.output;
+  EXPECT_NE(m.output.find("2 of 2 runs finished (0 failed)"), std::string::npos) << m.output;
+  EXPECT_EQ(ReadRuns(dir / "m.db").at(1).status, "ok");
+  EXPECT_EQ(Count(dir / "m.db", "SELECT count(*) FROM final_metrics WHERE run = 1"),
+            Count(dir / "ok.db", "SELECT count(*) FROM final_metrics WHERE run = 1"));
+  // Another sweep, a missing file, a file that is no database: refused, no output.
+  ASSERT_EQ(RunProgram("sweep " + kWorld + " --param robots=5 --seeds 1 --steps 8 --quiet --db " +
+                       (dir / "other.db").string())
+                .exit_code,
+            0);
+  std::ofstream(dir / "junk.db") << "not a database\n";
+  for (const char* bad : {"other.db", "missing.db", "junk.db"}) {
+    const Result r = RunProgram("merge " + (dir / "new.db").string() + " " +
+                                (dir / "ok.db").string() + " " + (dir / bad).string());
+    EXPECT_EQ(r.exit_code, 2) << bad << ": " << r.output;
+    EXPECT_FALSE(fs::exists(dir / "new.db")) << bad;
+  }
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace swarmsim
