@@ -80,8 +80,20 @@ class CoveredArea : public Observer {
     in->GetBytes(cells.data(), cells.size() * sizeof(uint64_t));
     visited_ = std::unordered_set<uint64_t>(cells.begin(), cells.end());
   }
+  // The cells the robots start in count too (they were left out: the area
+  // was that of the cells entered from step 1 on).
+  void Start(World* world) override { Visit(world->scene()); }
   void Record(const World& world, std::vector<MetricSample>* out) override {
-    const Scene& scene = world.scene();
+    Visit(world.scene());
+    if (world.step_count() % every_ != 0) return;
+    out->push_back({world.step_count(), world.time(), -1, "covered_area",
+                    static_cast<double>(visited_.size()) * kCell * kCell});
+  }
+
+ private:
+  // The cells (a grid aligned with the world's axes, a corner at the
+  // origin) the robots' roots are in now.
+  void Visit(const Scene& scene) {
     for (const ModelInstance& inst : scene.instances()) {
       if (!inst.alive) continue;
       const Vec3& p = scene.world_pose(inst.root).p;
@@ -89,12 +101,7 @@ class CoveredArea : public Observer {
       const auto cy = static_cast<int64_t>(std::floor(p.y / kCell));
       visited_.insert((static_cast<uint64_t>(cx) << 32) ^ static_cast<uint32_t>(cy));
     }
-    if (world.step_count() % every_ != 0) return;
-    out->push_back({world.step_count(), world.time(), -1, "covered_area",
-                    static_cast<double>(visited_.size()) * kCell * kCell});
   }
-
- private:
   static constexpr double kCell = 0.25;
   int every_;
   std::unordered_set<uint64_t> visited_;

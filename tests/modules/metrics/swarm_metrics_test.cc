@@ -68,8 +68,8 @@ TEST(SwarmMetricsTest, ALoneRobotHasNoNearestNeighbour) {
   EXPECT_TRUE(Samples(w.world(), "mean_nearest_neighbor_distance").empty());
 }
 
-// Cells of 0.25 m visited since the start: a robot moved through three
-// cells, another resting in one; recorded every second step, counting the
+// Cells of 0.25 m visited since the start, the starting ones included: a
+// robot moved through three cells, another resting in one; recorded every second step, counting the
 // cells visited in between.
 TEST(SwarmMetricsTest, CoveredAreaCountsTheCellsVisitedSinceTheStart) {
   ModuleWorld w;
@@ -85,10 +85,10 @@ TEST(SwarmMetricsTest, CoveredAreaCountsTheCellsVisitedSinceTheStart) {
   const std::vector<MetricSample> samples = Samples(w.world(), "covered_area");
   ASSERT_EQ(samples.size(), 2u);  // steps 2 and 4
   EXPECT_EQ(samples[0].step, 2);
-  // Step 1 saw cells (1, 0) and (-1, -1); step 2 (2, 0). The start cell
-  // (0, 0) was never recorded: the first record is after step 1.
-  EXPECT_DOUBLE_EQ(samples[0].value, 3 * 0.0625);
-  EXPECT_DOUBLE_EQ(samples[1].value, 3 * 0.0625);
+  // The start saw cells (0, 0) and (-1, -1) (it was left out: the first
+  // record is after step 1), step 1 (1, 0), step 2 (2, 0).
+  EXPECT_DOUBLE_EQ(samples[0].value, 4 * 0.0625);
+  EXPECT_DOUBLE_EQ(samples[1].value, 4 * 0.0625);
 }
 
 TEST(SwarmMetricsTest, EveryBelowOneIsRefused) {
