@@ -18,7 +18,8 @@ namespace {
 // Step records the simulation may run ahead of the file by.
 constexpr size_t kMaxQueued = 8;
 
-// A chunk refused for its size: the file is still whole.
+// A chunk refused for its size, or one that could not be written and was
+// cut off again (a full disk): the file is still whole.
 struct ChunkTooLarge : Error {
   using Error::Error;
 };
@@ -181,6 +182,11 @@ uint64_t ChunkWriter::bytes_written() const {
   return bytes_;
 }
 
+uint64_t ChunkWriter::step_records_written() const {
+  const std::lock_guard lock(mutex_);
+  return records_written_;
+}
+
 void ChunkWriter::Run() {
   // Below the simulation's threads: on few cores, compressing waits for
   // their idle moments rather than taking a core from a parallel phase.
@@ -223,6 +229,33 @@ void ChunkWriter::Run() {
 }
 
 void ChunkWriter::Write(Job* job) {
+  // A job that cannot be written whole (ENOSPC partway) is cut off again, so
+  // that the file ends with whole chunks and the end chunk may still follow
+  // (it was left with half a chunk and no end: "the run was killed").
+  uint64_t start = 0;
+  {
+    const std::lock_guard lock(mutex_);
+    start = bytes_;
+  }
+  try {
+    WriteJob(job);
+  } catch (const ChunkTooLarge&) {
+    throw;
+  } catch (const Error& e) {
+    if (::ftruncate(fd_, static_cast<off_t>(start)) != 0 ||
+        ::lseek(fd_, static_cast<off_t>(start), SEEK_SET) != static_cast<off_t>(start))
+      throw;
+    const std::lock_guard lock(mutex_);
+    bytes_ = start;
+    throw ChunkTooLarge(e.what());
+  }
+  if (job->snap) {
+    const std::lock_guard lock(mutex_);
+    ++records_written_;
+  }
+}
+
+void ChunkWriter::WriteJob(Job* job) {
   if (job->lists) {
     lists_ = *job->lists;
     pose_.assign(lists_.object_count, {});

@@ -84,12 +84,15 @@ class ChunkWriter {
   // chunk could not be written (also from the Add calls, after a failure).
   void Flush();
   uint64_t bytes_written() const;
+  // Step records in the file (not those queued, nor one a failure cut off).
+  uint64_t step_records_written() const;
 
  private:
   struct Job;
   void Push(std::unique_ptr<Job> job);
   void Run();
   void Write(Job* job);
+  void WriteJob(Job* job);
   void Encode(StepSnapshot* s, std::vector<uint8_t>* out);
   void WriteChunk(uint8_t kind, uint32_t step, const void* raw, size_t size);
 
@@ -113,6 +116,7 @@ class ChunkWriter {
   std::string error_;
   bool file_whole_ = true;  // after an error: no chunk was cut (the end chunk may follow)
   uint64_t bytes_ = 0;
+  uint64_t records_written_ = 0;
   std::thread thread_;
 };
 

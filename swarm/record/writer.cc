@@ -582,8 +582,10 @@ void RunRecorder::Record(const World& world, std::vector<MetricSample>* out) {
 void RunRecorder::WriteOutputs(const std::filesystem::path& /*dir*/) const { impl_->file->Flush(); }
 
 void RunRecorder::ListOutputs(std::vector<OutputFile>* out) const {
-  out->push_back({"recording", kRecordingFileName,
-                  std::to_string(impl_->records) + " step records (swarmsim view)"});
+  // What the file holds (a full disk stops it short of the steps recorded).
+  out->push_back(
+      {"recording", kRecordingFileName,
+       std::to_string(impl_->file->step_records_written()) + " step records (swarmsim view)"});
 }
 
 void RunRecorder::Finish(int64_t steps, const std::string& status, const std::string& error) {

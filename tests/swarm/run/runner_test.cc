@@ -122,6 +122,32 @@ TEST(RunnerTest, ADiskFullOfRecordingEndsTheRunWithAWholeSummary) {
   ExpectFullDiskMidRunReported("recording", "--record");
 }
 
+// The chunk the disk had no room for is cut off again: the recording ends
+// with whole chunks and its end chunk (it ended inside a chunk, like a
+// killed run's), and summary.json counts the step records it holds (it
+// counted those handed to the writer: 51 for 43).
+TEST(RunnerTest, ARecordingCutShortByAFullDiskEndsWholeAndCountsWhatItHolds) {
+  const fs::path disk = FreshTempDir("swarmsim_runner", "recording_whole");
+  if (!MountTmpfs(disk, "3m")) GTEST_SKIP() << "cannot mount a tmpfs here (needs root)";
+  const fs::path out = disk / "out";
+  const auto r = RunProgram("run " + CliData("outputs.yaml") + " --steps 100000 --quiet --out " +
+                            out.string() + " --record");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  const auto info = RunProgram("record-info " + (out / "recording.swrec").string());
+  EXPECT_NE(info.output.find("the run ended (error"), std::string::npos) << info.output;
+  EXPECT_EQ(info.output.find("inside a chunk"), std::string::npos) << info.output;
+  const nlohmann::json summary = SummaryIfAny(out);
+  std::string described;
+  for (const nlohmann::json& o : summary.value("outputs", nlohmann::json::array()))
+    if (o.value("kind", "") == "recording") described = o.value("description", "");
+  const size_t records = described.find(" step records");
+  ASSERT_NE(records, std::string::npos) << summary.dump(2);
+  EXPECT_NE(info.output.find(described.substr(0, records) + " step records"), std::string::npos)
+      << described << "\n"
+      << info.output;
+  Unmount(disk);
+}
+
 // A stop signal while the world loads ends the load, says so, and leaves
 // an "interrupted" summary.json. The signal is made pending before the
 // program starts (blocked, then raised): the program takes it as soon as it
