@@ -22,6 +22,14 @@
 namespace swarmsim {
 namespace {
 
+// `text` right-aligned in `width` columns, counting characters, not bytes
+// (setw counted 'ünï' as 5: the columns after it slipped).
+std::string RightAligned(const std::string& text, size_t width) {
+  size_t columns = 0;
+  for (const char c : text) columns += (static_cast<unsigned char>(c) & 0xC0) != 0x80;
+  return columns >= width ? text : std::string(width - columns, ' ') + text;
+}
+
 std::string CsvField(const std::string& s) {
   if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
   std::string q = "\"";
@@ -283,7 +291,7 @@ int RunReport(const ReportOptions& o, std::ostream& out, std::ostream& err) {
     if (r.status == "ok" || r.status == "failed") points[r.point].push_back(&r);
   for (const std::string& metric : metrics) {
     out << "\n" << metric << " (final value; mean, sd and 95% CI over ok runs)\n";
-    for (const std::string& name : d.param_names) out << std::setw(12) << name << " ";
+    for (const std::string& name : d.param_names) out << RightAligned(name, 12) << " ";
     out << std::setw(5) << "runs" << std::setw(7) << "failed" << std::setw(13) << "mean"
         << std::setw(12) << "sd" << std::setw(13) << "ci95_low" << std::setw(13) << "ci95_high"
         << "\n";
@@ -300,7 +308,7 @@ int RunReport(const ReportOptions& o, std::ostream& out, std::ostream& err) {
       }
       const Summary s = Summarize(values);
       for (const std::string& name : d.param_names)
-        out << std::setw(12) << runs.front()->params.at(name) << " ";
+        out << RightAligned(runs.front()->params.at(name), 12) << " ";
       auto cell = [](double v, int w) {
         std::ostringstream c;
         c << std::setw(w) << (std::isnan(v) ? std::string("-") : Num(v, 6));

@@ -216,6 +216,52 @@ TEST(ReportTest, TheTableSummarisesEachPointOverItsOkRuns) {
   fs::remove_all(file.parent_path());
 }
 
+// Columns line up with values of characters past ASCII ('ünï' took 5 of
+// the 12 columns, by its bytes, and the columns after it slipped).
+TEST(ReportTest, ColumnsLineUpWithCharactersPastAscii) {
+  const fs::path file = TempDir("report_unicode") / "r.db";
+  const std::vector<ParamSpec> params = {ParseParamSpec("label=abc,ünï,日本")};
+  const std::vector<uint64_t> seeds = {1};
+  {
+    ResultsDb db(file);
+    db.CreateSweep({"w.yaml", "0", SweepSpace(params, seeds, 10, std::nullopt),
+                    "2026-01-02T03:04:05Z", "9.9.9", "swarmsim sweep w.yaml"},
+                   ExpandGrid(params, seeds));
+    for (int64_t id = 1; id <= 3; ++id) {
+      RunOutcome o;
+      o.id = id;
+      o.ok = true;
+      o.steps = 10;
+      o.state_hash = "00000000000000a" + std::to_string(id);
+      o.final_metrics["x"] = 1;
+      db.Complete(o);
+    }
+  }
+  std::ostringstream out, err;
+  ReportOptions options;
+  options.db = file.string();
+  ASSERT_EQ(RunReport(options, out, err), 0) << err.str();
+  std::istringstream in(out.str());
+  std::vector<size_t> columns;  // where "runs" or a row's run count ends, in characters
+  for (std::string line; std::getline(in, line);) {
+    if (line.find("label") == std::string::npos && line.find("abc") == std::string::npos &&
+        line.find("\xc3\xbc") == std::string::npos &&
+        line.find("\xe6\x97\xa5") == std::string::npos)
+      continue;
+    // The end of the second word (the runs column), in characters.
+    size_t at = line.find_first_not_of(' ');
+    at = line.find_first_not_of(' ', line.find(' ', at));
+    at = std::min(line.find(' ', at), line.size());
+    size_t characters = 0;
+    for (const char c : line.substr(0, at))
+      characters += (static_cast<unsigned char>(c) & 0xC0) != 0x80;
+    columns.push_back(characters);
+  }
+  ASSERT_EQ(columns.size(), 4u) << out.str();  // the header and three points
+  for (size_t c : columns) EXPECT_EQ(c, columns[0]) << out.str();
+  fs::remove_all(file.parent_path());
+}
+
 TEST(ReportTest, WhatIsNoSweepDatabaseIsSaid) {
   const fs::path dir = TempDir("report_none");
   const auto error = [](const fs::path& file) {
