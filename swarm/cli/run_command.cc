@@ -142,7 +142,7 @@ std::optional<int64_t> RunLength(const RunArgs& args, const LoadedWorld& loaded,
       *error = message.str();
       return std::nullopt;
     }
-    const double step_count = std::round(args.duration / time_step);
+    const double step_count = StepsInDuration(args.duration, time_step);
     if (!(step_count <= 1e15)) {
       std::ostringstream message;
       message << "--duration " << args.duration << " s is " << step_count << " steps of "

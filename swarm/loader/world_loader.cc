@@ -470,7 +470,7 @@ WorldSettings WorldLoader::ReadSimulation(const Fields& top, std::optional<int64
     if (f.Has("duration")) {
       const double duration =
           values.Number(f.Get("duration"), {"a positive number of seconds", 0, 1e9, true});
-      const double n = std::round(duration / s.time_step);
+      const double n = StepsInDuration(duration, s.time_step);
       if (n > static_cast<double>(int64_t{1} << 40))
         values.Fail(f.Get("duration"), "'duration' is too many steps of 'time_step'");
       if (duration > 0 && n < 1)  // as --duration: not a silent run of 0 steps
@@ -634,6 +634,11 @@ LoadedWorld LoadWorld(const std::filesystem::path& file, const LoadOptions& opti
   } catch (const std::bad_alloc&) {
     throw Error(loader::DisplayPath(file) + ": out of memory while loading the world");
   }
+}
+
+double StepsInDuration(double duration, double time_step) {
+  const double q = duration / time_step;
+  return std::floor(q + 0.5 + 1e-9 * std::max(1.0, q));
 }
 
 }  // namespace swarmsim

@@ -132,4 +132,9 @@ struct LoadedWorld {
 LoadedWorld LoadWorld(const std::filesystem::path& file, const LoadOptions& options,
                       const ModuleRegistry& registry);
 
+// The steps of `time_step` in `duration` (s), rounded half up as their
+// decimals read (0.15 / 0.1 is 1.4999999999999998 in binary: 2 steps here,
+// as 2.55 s of 0.1 s is 26; it was 1 and 25). As a double (it may be huge).
+double StepsInDuration(double duration, double time_step);
+
 }  // namespace swarmsim

@@ -43,6 +43,15 @@ TEST(CliTest, DurationIsWholeStepsAndNotLessThanOne) {
   std::ifstream summary_file(out / "summary.json");
   ASSERT_TRUE(summary_file.good());
   EXPECT_EQ(nlohmann::json::parse(summary_file)["steps"], 3);
+  // Halves round up as the decimals read: 0.15 / 0.1 is 1.4999999999999998
+  // and 2.55 / 0.1 is 25.499999999999996 in binary (they ran 1 and 25 steps).
+  for (const auto& [duration, steps] : {std::pair{"0.15", 2}, std::pair{"2.55", 26}}) {
+    r = RunProgram("run " + Data("ok.yaml") + " --duration " + duration + " --quiet --out " +
+                   out.string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    std::ifstream again(out / "summary.json");
+    EXPECT_EQ(nlohmann::json::parse(again)["steps"], steps) << duration;
+  }
   EXPECT_NE(
       RunProgram("run --help").output.find("rounded to the nearest whole number of time steps"),
       std::string::npos);
