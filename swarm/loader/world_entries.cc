@@ -207,8 +207,9 @@ constexpr int64_t kLargeSwarm = 10000;
 
 void WorldLoader::AddLargeSwarmHints(const WorldSettings& settings,
                                      std::vector<std::string>* warnings) const {
-  int64_t lua_robots = 0;
+  int64_t lua_robots = 0, robots = 0;
   for (const EntryPlan& e : entries_) {
+    robots += e.count;
     if (HasScripts(e.spec) && !(e.native != nullptr && e.native_replaces_scripts))
       lua_robots += e.count;
     if (!e.distribute || e.lattice || e.order_given || e.count < kLargeSwarm ||
@@ -222,6 +223,13 @@ void WorldLoader::AddLargeSwarmHints(const WorldSettings& settings,
                         "controller gives robots roles by their number (worlds/README.md, "
                         "\"Placement\"; 'order: random' keeps this order without this note)");
   }
+  if (settings.physics == "box2d" && robots >= kLargeSwarm && !physics_partitions_given_)
+    warnings->push_back(file_->name() + ": " + GroupThousands(robots) +
+                        " robots under physics: box2d in one world; with 'simulation: "
+                        "{physics_partitions: auto}' regions of the arena are stepped on every "
+                        "thread (a model setting: it changes results, never with the thread "
+                        "count; worlds/README.md, \"Physics partitions\"; "
+                        "'physics_partitions: 1' keeps one world without this note)");
   if (lua_robots < kLargeSwarm || robots_per_lua_state_given_ || settings.trust_scripts) return;
   warnings->push_back(file_->name() + ": " + GroupThousands(lua_robots) +
                       " robots run Lua scripts, a Lua state each; with 'simulation: "

@@ -396,6 +396,7 @@ WorldSettings WorldLoader::ReadSimulation(const Fields& top, std::optional<int64
       s.run_script_memory_limit = values.Integer(f.Get("run_script_memory_mb"), 0, int64_t{1} << 30)
                                   << 20;
     robots_per_lua_state_given_ = f.Has("robots_per_lua_state");
+    physics_partitions_given_ = f.Has("physics_partitions");
     if (robots_per_lua_state_given_)
       s.robots_per_lua_state =
           static_cast<int>(values.Integer(f.Get("robots_per_lua_state"), 1, 4096));

@@ -234,6 +234,7 @@ class WorldLoader {
   std::vector<std::filesystem::path> package_path_;  // the world's, then --package-path
   std::vector<std::string> warnings_;                // found before the World exists
   bool robots_per_lua_state_given_ = false;          // simulation.robots_per_lua_state written
+  bool physics_partitions_given_ = false;            // simulation.physics_partitions written
 };
 
 }  // namespace swarmsim::loader

@@ -284,6 +284,24 @@ TEST_F(ControlLoaderTest, LargeSwarmsOnSlowDefaultsAreToldWhatToWrite) {
   ASSERT_EQ(plain.size(), 1u);
   EXPECT_CONTAINS(plain[0], "copies of 'plain'");
   EXPECT_TRUE(notes(world("", "bot.yaml", "9999", "")).empty());
+
+  // Under box2d, one world for 10,000 robots: physics_partitions is named
+  // (it was the one speed key no note mentioned), until it is written.
+  registry_.RegisterDynamics({"", "box2d", "1", "test"}, {},
+                             [] { return std::make_unique<testing::NullDynamics>(); });
+  const auto box2d = [&](const std::string& simulation) {
+    std::string text =
+        world(", robots_per_lua_state: 64" + simulation, "plain.yaml", "10000", ", order: spatial");
+    text.replace(text.find("kinematic"), 9, "box2d");
+    return notes(text);
+  };
+  const std::vector<std::string> one = box2d("");
+  ASSERT_EQ(one.size(), 1u);
+  EXPECT_CONTAINS(one[0],
+                  "world.yaml: 10,000 robots under physics: box2d in one world; with "
+                  "'simulation: {physics_partitions: auto}'");
+  for (const char* partitions : {", physics_partitions: auto", ", physics_partitions: 1"})
+    EXPECT_TRUE(box2d(partitions).empty()) << partitions;
 }
 
 }  // namespace
