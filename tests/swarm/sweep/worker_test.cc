@@ -147,11 +147,11 @@ TEST(WorkerTest, AFinishedRunIsItsSummaryAndItsMetricsMeanOverRobots) {
 // one metric 'v"' (their values averaged), a quote kept the CSV's quoting,
 // and a name with a line break was lost.
 TEST(WorkerTest, QuotedMetricNamesAreReadAsTheyWereRecorded) {
-  const fs::path dir = RunFolder(
-      "quoted", R"({"status": "ok", "steps": 1, "robots": 1})",
-      "step,time,robot,metric,value\n"
-      "1,0.1,,\"left,v\",10\n1,0.1,,\"right,v\",20\n1,0.1,,\"c\"\"d\",3\n"
-      "1,0.1,,\"new\nline\",7\n1,0.1,\"bot,#0\",plain,5\n");
+  const fs::path dir =
+      RunFolder("quoted", R"({"status": "ok", "steps": 1, "robots": 1})",
+                "step,time,robot,metric,value\n"
+                "1,0.1,,\"left,v\",10\n1,0.1,,\"right,v\",20\n1,0.1,,\"c\"\"d\",3\n"
+                "1,0.1,,\"new\nline\",7\n1,0.1,\"bot,#0\",plain,5\n");
   const RunOutcome o = CollectRun(1, dir, kExited0, false, 0);
   EXPECT_TRUE(o.ok) << o.error;
   std::map<std::string, double> expected = {
