@@ -42,10 +42,11 @@ struct UrdfImport {
 };
 
 // Reads the URDF at `path` (`text` as the world names it, `where` the
-// file:line:column naming it). package://PKG/REST URIs resolve through
-// `package_path` (each folder: PKG below it, a package.xml naming PKG in it
-// or in a subfolder up to two levels down), then the folders holding the
-// URDF (a package.xml naming PKG). Throws swarmsim::Error naming the file,
+// file:line:column naming it). package://PKG/REST URIs resolve in the
+// package holding the URDF (a folder above it whose package.xml names PKG),
+// then through `package_path` (each folder: PKG below it, a package.xml
+// naming PKG in it or in a subfolder one or two levels down); file:// URIs
+// are percent-decoded. Throws swarmsim::Error naming the file,
 // the element and its line for malformed input.
 UrdfImport ImportUrdf(const std::filesystem::path& path, const std::string& where,
                       const std::string& text,
