@@ -4,6 +4,9 @@
 // is built with.
 #include "swarm/viewer/server.h"
 
+#include <netdb.h>
+#include <sys/socket.h>
+
 #include <chrono>
 #include <string>
 #include <thread>
@@ -57,10 +60,23 @@ Server::~Server() { Stop(); }
 
 int Server::Bind(const std::string& host, int port) {
   const int bound = impl_->http->Bind(host, port);
-  if (bound <= 0)
+  if (bound <= 0) {
+    // A host that is no address at all (999.1.1.1, a misspelt name) is said
+    // so, not taken for a port in use.
+    addrinfo hints{};
+    hints.ai_socktype = SOCK_STREAM;
+    addrinfo* found = nullptr;
+    const int gai = ::getaddrinfo(host.c_str(), nullptr, &hints, &found);
+    if (found != nullptr) ::freeaddrinfo(found);
+    if (gai != 0)
+      throw Error("cannot listen on " + host + ": '" + host + "' is no address or host name (" +
+                  ::gai_strerror(gai) +
+                  "); --host takes an address of this machine's, such as "
+                  "127.0.0.1 or 0.0.0.0");
     throw Error("cannot listen on " + host + ":" + (port > 0 ? std::to_string(port) : "0") +
                 ": the port is in use or the address is not this machine's (--port 0 picks a "
                 "free port)");
+  }
   impl_->host = host;
   impl_->port = bound;
   return bound;

@@ -213,6 +213,11 @@ TEST_F(ServerTest, ProgramSaysWhenThePortIsInUseOrTheFolderHasNoRecording) {
   EXPECT_NE(taken.output.find("cannot listen on 127.0.0.1:" + std::to_string(port)),
             std::string::npos)
       << taken.output;
+  // An address that is none is said so (it was "the port is in use").
+  const auto no_address = RunProgram("view " + run_.string() + " --host 999.1.1.1 --port 0");
+  EXPECT_EQ(no_address.exit_code, 1) << no_address.output;
+  EXPECT_NE(no_address.output.find("'999.1.1.1' is no address or host name"), std::string::npos)
+      << no_address.output;
   const auto empty = RunProgram("view " + (root_ / "run-other").string());
   EXPECT_EQ(empty.exit_code, 2) << empty.output;
   EXPECT_NE(empty.output.find("has no recording.swrec: record a run with swarmsim run WORLD --out"),
