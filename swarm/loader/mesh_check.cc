@@ -53,12 +53,37 @@ void CheckStlBytes(const std::string& bytes, const std::string& name) {
          "triangle): it has " +
              Count(static_cast<int64_t>(bytes.size())) + " bytes" + binary);
   }
+  // Line by line: a vertex is three finite numbers (assimp's "Cannot parse
+  // string ... as a real number" named no line), and a solid has facets
+  // (assimp said "all meshes are orphaned").
   int64_t facets = 0, vertices = 0;
-  ForEachToken(bytes, [&](std::string_view t) {
-    if (t == "facet") ++facets;
-    if (t == "vertex") ++vertices;
-    return true;
-  });
+  int line = 1;
+  for (size_t at = 0; at < bytes.size(); ++line) {
+    const size_t end = std::min(bytes.find('\n', at), bytes.size());
+    const std::string_view text(bytes.data() + at, end - at);
+    at = end + 1;
+    std::vector<std::string_view> words;
+    for (size_t i = 0; i < text.size();) {
+      while (i < text.size() && IsSpace(text[i])) ++i;
+      const size_t from = i;
+      while (i < text.size() && !IsSpace(text[i])) ++i;
+      if (i > from) words.push_back(text.substr(from, i - from));
+    }
+    if (words.empty()) continue;
+    if (words[0] == "facet") ++facets;
+    if (words[0] != "vertex") continue;
+    ++vertices;
+    double v = 0;
+    if (words.size() != 4)
+      Fail(name, line,
+           "a vertex is 'vertex X Y Z', three numbers (got " + std::to_string(words.size() - 1) +
+               ")");
+    for (size_t k = 1; k < 4; ++k)
+      if (!ParseFinite(words[k], &v))
+        Fail(name, line, Quoted(words[k]) + " is not a finite number (in 'vertex X Y Z')");
+  }
+  if (facets == 0 && vertices == 0)
+    Fail(name, 0, "an ASCII STL with no facets: nothing to draw or collide with");
   CheckTriangleCount(name, 0, std::max(facets, vertices / 3), "ASCII STL of");
 }
 

@@ -58,6 +58,23 @@ TEST(MeshCheckTest, StlHeaderCountMatchesTheFile) {
   EXPECT_EQ(StlError(ReadAll(kMeshes / "unit_cube.stl")), "no error");
 }
 
+// ASCII STL: a vertex that is no three numbers is named at its line, and a
+// solid without facets is said to be empty (assimp's messages had neither).
+TEST(MeshCheckTest, AsciiStlVerticesAreNumbersAtTheirLines) {
+  const std::string facet =
+      "  facet normal 0 0 1\n    outer loop\n      vertex 0 0 0\n      vertex 1 0 0\n"
+      "      vertex 0 1 0\n    endloop\n  endfacet\n";
+  EXPECT_EQ(StlError("solid t\n" + facet + "endsolid t\n"), "no error");
+  std::string bad = "solid t\n" + facet + "endsolid t\n";
+  bad.replace(bad.find("vertex 1 0 0"), 12, "vertex 1 abc 0");
+  EXPECT_EQ(StlError(bad), "part.stl:5: 'abc' is not a finite number (in 'vertex X Y Z')");
+  bad = "solid t\n" + facet + "endsolid t\n";
+  bad.replace(bad.find("vertex 0 1 0"), 12, "vertex 0 1");
+  EXPECT_EQ(StlError(bad), "part.stl:6: a vertex is 'vertex X Y Z', three numbers (got 2)");
+  EXPECT_EQ(StlError("solid empty\nendsolid empty\n"),
+            "part.stl: an ASCII STL with no facets: nothing to draw or collide with");
+}
+
 std::string ObjError(const std::string& text) {
   try {
     CheckObjBytes(text, "part.obj");
