@@ -133,9 +133,16 @@ int IsYieldable(lua_State* L) {
     lua_pushliteral(L, "call it from sysCall_thread itself, not from a coroutine of your own");
     return 2;
   }
-  if (thread == nullptr || !lua_isyieldable(L)) {
+  if (thread == nullptr) {
     lua_pushboolean(L, 0);
     lua_pushliteral(L, "only a threaded script (sysCall_thread) can wait");
+    return 2;
+  }
+  if (!lua_isyieldable(L)) {  // the thread's own, but under a C function's callback
+    lua_pushboolean(L, 0);
+    lua_pushliteral(L,
+                    "not from inside a callback of a C function (table.sort's comparison, "
+                    "string.gsub's replacement, a metamethod): it cannot wait there");
     return 2;
   }
   lua_pushboolean(L, 1);

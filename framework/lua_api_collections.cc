@@ -32,8 +32,9 @@ std::vector<CollectionRow>& ScriptCollections(lua_State* L) {
 
 CollectionRow& ScriptCollection(lua_State* L, lua_Integer handle) {
   std::vector<CollectionRow>& all = ScriptCollections(L);
-  const lua_Integer k = kScriptCollectionBase - handle;
-  if (k < 0 || k >= static_cast<lua_Integer>(all.size()))
+  // Unsigned: kScriptCollectionBase - math.maxinteger overflowed (undefined).
+  const uint64_t k = static_cast<uint64_t>(kScriptCollectionBase) - static_cast<uint64_t>(handle);
+  if (handle > kScriptCollectionBase || k >= all.size())
     throw Error("handle " + std::to_string(handle) +
                 " is not a collection of this script's robot (sim.createCollection makes one)");
   return all[static_cast<size_t>(k)];

@@ -130,8 +130,13 @@ int SwitchThread(lua_State* L) {
   if (thread != nullptr && L != thread)
     return luaL_error(
         L, "sim.step: call it from sysCall_thread itself, not from a coroutine of your own");
-  if (thread == nullptr || !lua_isyieldable(L))
+  if (thread == nullptr)
     return luaL_error(L, "sim.step: only a threaded script (sysCall_thread) can yield");
+  if (!lua_isyieldable(L))  // the thread's own, but under a C function's callback
+    return luaL_error(
+        L,
+        "sim.step: not from inside a callback of a C function (table.sort's "
+        "comparison, string.gsub's replacement, a metamethod): it cannot yield there");
   return lua_yield(L, 0);  // not guarded: nothing here has a destructor
 }
 

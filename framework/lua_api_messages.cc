@@ -86,7 +86,8 @@ int SendDirectMessage(lua_State* L) {
     return controllers != nullptr && robot >= 0 && scene.instance(robot).root == target &&
            controllers->type_of(robot) != nullptr;
   };
-  if (!scene.IsValid(target) || (scene.script(target) == nullptr && !native_root()))
+  scene.SlotOf(target);  // a stale handle: "handle ... is stale: the object was removed"
+  if (scene.script(target) == nullptr && !native_root())
     throw Error("object " + std::to_string(target.ToInteger()) +
                 " carries no script (nor is it the root of a robot with a native controller)");
   Send(L, MessageScope::kDirect, CheckData(L, 2), target);

@@ -1,6 +1,7 @@
 // sim.* simulation: time, parameters, random numbers, metrics, the robot's
 // identity, and print.
 #include <algorithm>
+#include <cstring>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -68,6 +69,9 @@ int RecordMetric(lua_State* L) {
   if (length > kMaxMetricNameBytes)
     throw Error("the metric name is " + std::to_string(length) + " bytes long; at most " +
                 std::to_string(kMaxMetricNameBytes));
+  // A NUL byte went into metrics.csv as it was (CSV readers stop there).
+  if (std::memchr(name, '\0', length) != nullptr)
+    throw Error("the metric name holds a NUL byte ('\\0'): a metric name is text");
   // What the sample holds in C++: the robot's vector of samples as it
   // grows (its capacity, charged when it doubles: the slots it really
   // holds, not just the ones used) and the name's own block when it is too

@@ -145,9 +145,14 @@ int SetUpState(lua_State* L) {
   RegisterAllApis(L);
   SeedRandom(L);
   // Script environments read what they do not define from the shared globals.
-  lua_createtable(L, 0, 1);
+  // Their metatable is one per state, so it is protected: getmetatable(_G)
+  // gives false and setmetatable(_G, ...) is an error (a robot that hooked
+  // its __newindex read and wrote the other robots' globals in a shared state).
+  lua_createtable(L, 0, 2);
   lua_pushglobaltable(L);
   lua_setfield(L, -2, "__index");
+  lua_pushboolean(L, 0);
+  lua_setfield(L, -2, "__metatable");
   lua_rawsetp(L, LUA_REGISTRYINDEX, &kEnvironmentMetatableKey);
   if (auto* heap = static_cast<LuaHeap*>(lua_touserdata(L, 3)); heap != nullptr) {
     size_t bytes = 0;
@@ -665,8 +670,11 @@ void LuaScriptHost::StopInstance(int instance) {
   try {
     Cleanup(state.get());
   } catch (...) {
-    lock.unlock();  // ~ScriptState takes it
-    throw;          // the state closes as `state` goes (the last robot's), error or not
+    // ~ScriptState takes it. Only a shared state's lock holds a mutex: an
+    // empty lock's unlock() threw std::system_error ("Operation not
+    // permitted"), which replaced the cleanup's error, robot, script and line.
+    if (lock.owns_lock()) lock.unlock();
+    throw;  // the state closes as `state` goes (the last robot's), error or not
   }
 }
 

@@ -124,6 +124,14 @@ TEST(LuaApiCollectionsTest, AWorldFilesCollectionIsReadOnlyAndMistakesAreErrors)
        "sim.handle_all expected)"},
       {"sim.getCollectionObjects(-1005)",
        "sim.getCollectionObjects: handle -1005 is not a collection of this script's robot"},
+      // The extremes: -1000 - math.maxinteger overflowed (undefined behaviour;
+      // the sanitizer preset's UBSan names it).
+      {"sim.addItemToCollection(math.maxinteger, sim.handle_all, -1)",
+       "sim.addItemToCollection: handle 9223372036854775807 is not a collection of this "
+       "script's robot"},
+      {"sim.getCollectionObjects(math.mininteger)",
+       "sim.getCollectionObjects: handle -9223372036854775808 is not a collection of this "
+       "script's robot"},
   };
   for (const auto& [call, message] : cases) {
     ScriptWorld w;

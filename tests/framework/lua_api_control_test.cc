@@ -129,6 +129,19 @@ TEST(ScriptControlTest, StepOutsideAThreadIsAnError) {
   EXPECT_CONTAINS(ErrorOf([&] { w.Steps(1); }), "only a threaded script");
 }
 
+// From a C function's callback inside the thread (table.sort's comparison):
+// the thread's own, but it cannot yield there; it said "only a threaded
+// script can yield", which it is.
+TEST(ScriptControlTest, StepInsideACFunctionsCallbackSaysWhy) {
+  ScriptWorld w;
+  w.AddRobot("bot#0",
+             "function sysCall_thread()\n"
+             "  table.sort({3, 1, 2}, function(a, b) sim.step() return a < b end)\n"
+             "end\n");
+  EXPECT_CONTAINS(ErrorOf([&] { w.Steps(2); }),
+                  "sim.step: not from inside a callback of a C function (table.sort's comparison");
+}
+
 TEST(ScriptControlTest, ACoroutineOfTheThreadRunsToItsEndAndReturnsItsValues) {
   ScriptWorld w;
   w.AddRobot("bot#0", R"(

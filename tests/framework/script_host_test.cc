@@ -242,6 +242,21 @@ TEST(ScriptHostTest, CleanupErrorIsReportedByStop) {
                   "bot#0: scripts/c.lua:2: bye [in sysCall_cleanup of /bot#0/body]");
 }
 
+// A robot removed at run time whose cleanup fails: the cleanup's error, with
+// robot, script and line (it was "Operation not permitted": unlocking a
+// state of its own, which holds no lock, threw in its place).
+TEST(ScriptHostTest, ARemovedRobotsCleanupErrorNamesItsScriptAndLine) {
+  ScriptWorld w;
+  w.AddWheeledRobot("bot#0",
+                    "function sysCall_actuation() sim.removeModel(sim.getObject('/bot#1')) end",
+                    "scripts/remover.lua");
+  w.AddWheeledRobot("bot#1", "function sysCall_cleanup()\n  error('gone badly')\nend",
+                    "scripts/c.lua");
+  w.world().Start();
+  EXPECT_CONTAINS(ErrorOf([&] { w.world().Step(); }),
+                  "bot#1: scripts/c.lua:2: gone badly [in sysCall_cleanup of /bot#1/body]");
+}
+
 // --- Joints ---------------------------------------------------------------------------------
 
 TEST(ScriptHostTest, SceneScriptsRunAfterRobotsAndWriteDirectly) {
@@ -470,6 +485,31 @@ TEST_F(SharedStateTest, RobotsSharingAStateSeeWhatAStateOfTheirOwnWouldShow) {
   EXPECT_EQ(Run(10, 4, 1, kOwnThings), own);   // states of 4, 4 and 2 robots
   EXPECT_EQ(Run(10, 3, 2, kOwnThings), own);   // on two threads
   EXPECT_EQ(Run(10, 64, 2, kOwnThings), own);  // all in one
+}
+
+// The globals' metatable is the state's, one for its robots: it is
+// protected. A robot that hooked its __newindex read and overwrote the
+// others' globals; one that wrote its __index planted globals in theirs.
+TEST_F(SharedStateTest, ARobotCannotReachAnotherRobotsGlobalsThroughTheirMetatable) {
+  const std::string code = R"(
+    secret = 'of robot ' .. sim.getRobotIndex()
+    function sysCall_actuation()
+      if sim.getRobotIndex() == 0 then
+        print('meta', tostring(getmetatable(_G)))
+        print('set', pcall(setmetatable, _G, {__newindex = function(t, k, v)
+          rawset(t, k, 'overwritten') end}))
+      end
+      step = sim.getRobotIndex()
+      print('mine', secret, step)
+    end)";
+  const std::vector<std::string> log = Run(3, 3, 1, code, 1);
+  ASSERT_GE(log.size(), 5u) << ::testing::PrintToString(log);
+  EXPECT_EQ(log[0], "[bot#0] meta\tfalse");
+  EXPECT_EQ(log[1].find("[bot#0] set\tfalse\t"), 0u) << log[1];
+  EXPECT_CONTAINS(log[1], "cannot change a protected metatable");
+  EXPECT_EQ(log[2], "[bot#0] mine\tof robot 0\t0");
+  EXPECT_EQ(log[3], "[bot#1] mine\tof robot 1\t1");
+  EXPECT_EQ(log[4], "[bot#2] mine\tof robot 2\t2");
 }
 
 TEST_F(SharedStateTest, SharedStatesTakeAFractionOfTheMemory) {

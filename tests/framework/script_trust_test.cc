@@ -570,6 +570,8 @@ TEST_F(TrustTest, MetricNamesAndPrintsAreCapped) {
   EXPECT_CONTAINS(Run("sim.recordMetric(('m'):rep(1 << 20), 1)"),
                   "sim.recordMetric: the metric name is 1048576 bytes long; at most 256");
   EXPECT_EQ(Run("sim.recordMetric(('m'):rep(256), 1)"), "");
+  EXPECT_CONTAINS(Run("sim.recordMetric('a\\0b', 1)"),
+                  "sim.recordMetric: the metric name holds a NUL byte");
   EXPECT_CONTAINS(Run("function sysCall_actuation()\n"
                       "  for i = 1, 100 do print(('p'):rep(20000)) end\n"
                       "end\n"),

@@ -144,6 +144,28 @@ TEST(WorldModelEditsTest, ARemovedRobotCleansUpItsHandleIsStaleAndItIsNotHashed)
   EXPECT_CONTAINS(error, "is stale: the object was removed");
 }
 
+// A direct message to a removed robot's script: its handle is stale (it
+// said the object "carries no script").
+TEST(WorldModelEditsTest, ADirectMessageToARemovedRobotNamesTheHandleStale) {
+  ModelWorld w;
+  w.AddRobot(R"(
+    local other = sim.getObject('/bot#1/body')
+    function sysCall_actuation()
+      if sim.getSimulationTime() > 0.25 then sim.sendDirectMessage(other, 'hello') end
+    end
+  )");
+  w.AddRobot(R"(
+    function sysCall_actuation()
+      if sim.getSimulationTime() > 0.05 then sim.removeModel(sim.getObject(':')) end
+    end
+  )");
+  w.world().Start();
+  std::string error;
+  for (int k = 0; k < 5 && error.empty(); ++k) error = ErrorOf([&] { w.world().Step(); });
+  EXPECT_CONTAINS(error, "sim.sendDirectMessage");
+  EXPECT_CONTAINS(error, "is stale: the object was removed");
+}
+
 TEST(WorldModelEditsTest, CopyAndRemoveOfTheSameRobotInOneStepCopiesThenRemoves) {
   ModelWorld w;
   w.AddRobot(R"(
