@@ -271,6 +271,71 @@ class ActionTest(unittest.TestCase):
             return h
         self.assertEqual(run([0.5, -3.0], True), run([0.1, -0.1], False))
 
+    def test_clip_actions_clips_infinities_too(self):
+        # +-inf is a value past a bound like any other (it was refused as not finite).
+        env = make(3, clip_actions=True)
+        env.reset(seed=2)
+        env.step({a: np.array([np.inf, -np.inf]) for a in env.agents})
+        with self.assertRaisesRegex(ValueError, "is not finite"):
+            env.step({a: np.array([np.nan, 0.0]) for a in env.agents})
+        env.close()
+
+    def test_a_step_whose_observation_raises_counts_towards_max_steps(self):
+        # It did not: the episode ran max_steps + 1 world steps.
+        failed = []
+
+        def flaky(world, model):
+            if world.steps == 3 and not failed:  # after the second step (the reset's is 1)
+                failed.append(True)
+                raise RuntimeError("obs fails once")
+            return world.poses(model)[:, :2]
+        env = make(2, observations=[senv.Observation("xy", flaky)], max_steps=4)
+        env.reset(seed=1)
+        env.step({a: np.zeros(2) for a in env.agents})
+        with self.assertRaisesRegex(RuntimeError, "obs fails once"):
+            env.step({a: np.zeros(2) for a in env.agents})
+        env.step({a: np.zeros(2) for a in env.agents})
+        *_, truncated, _ = env.step({a: np.zeros(2) for a in env.agents})
+        self.assertTrue(all(truncated.values()), "the fourth world step ends the episode")
+        self.assertEqual(env.world.steps, 1 + 4)  # the reset's step, then four
+        env.close()
+
+    def test_an_environment_is_not_copied_and_frees_its_worlds_when_dropped(self):
+        import copy
+        import gc
+        import pickle
+        import weakref
+        env = make(2)
+        env.reset(seed=1)
+        # A deep copy's worlds reported to the original: every agent ended at its first
+        # step with reward 0, and nothing was said.
+        for what, call in (("copied", lambda: copy.deepcopy(env)),
+                           ("copied", lambda: copy.copy(env)),
+                           ("pickled", lambda: pickle.dumps(env))):
+            with self.assertRaisesRegex(TypeError, f"ParallelEnv cannot be {what}"):
+                call()
+        vector = senv.VectorEnv(DIFFUSION, 2, set={"robots": 2})
+        with self.assertRaisesRegex(TypeError, "VectorEnv cannot be copied"):
+            copy.deepcopy(vector)
+        # Dropped without close(): its worlds go with it (the controller the World holds
+        # kept the environment, and so the World, alive for good).
+        cores = [weakref.ref(env._core), weakref.ref(vector._core)]
+        del env, vector
+        gc.collect()
+        self.assertEqual([c() for c in cores], [None, None])
+
+    def test_a_vector_reset_seed_past_the_largest_is_refused_before_any_reset(self):
+        # s + k past 2**64 - 1 reset environment 0 and not the others, and named a seed
+        # nobody passed.
+        vector = senv.VectorEnv(DIFFUSION, 3, set={"robots": 2})
+        vector.reset(seed=5)
+        vector.step(np.zeros((3, 2, 2)))
+        with self.assertRaisesRegex(ValueError, r"reset: seed 18446744073709551615 gives "
+                                                r"environment 2 the seed 18446744073709551617"):
+            vector.reset(seed=2**64 - 1)
+        self.assertEqual(list(vector.episode_steps), [1, 1, 1], "no environment was reset")
+        vector.close()
+
     def test_a_step_before_reset_or_after_the_end_is_an_error(self):
         env = make(2, max_steps=2)
         with self.assertRaisesRegex(RuntimeError, "reset"):

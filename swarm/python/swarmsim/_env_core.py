@@ -11,6 +11,7 @@ all K worlds.
 import difflib
 import re
 import warnings
+import weakref
 
 import numpy as np
 
@@ -176,7 +177,15 @@ class Core:
     # --- worlds -----------------------------------------------------------------------
 
     def _controller(self, slot):
+        # Weak references: the World holds this function in C++, where Python's garbage
+        # collector cannot see, so a strong one made env -> world -> control -> env a cycle
+        # it never freed (an env dropped without close() kept its World, ~5 MB each).
+        core_ref, slot_ref = weakref.ref(self), weakref.ref(slot)
+
         def control(robots):
+            self, slot = core_ref(), slot_ref()
+            if self is None or slot is None:
+                return {}  # the environment is gone; its world goes with it
             slot.called = True
             indices = robots.indices
             if indices != slot.indices:  # robots came or went in this step
@@ -366,10 +375,19 @@ class Core:
     def step_list(self, worlds):
         step_worlds(worlds, 1, self.spec["step_threads"], self.parallel)
 
-    def step_all(self):
+    def step_all(self, counted=None):
+        """Steps every world once. counted (K,) bools: the worlds whose episodes count the
+        step (None: none, a reset's step), by the steps the worlds took, so that an observation,
+        reward or Ctrl-C that raises after (or during) it leaves the count right."""
         for slot in self.slots:
             slot.called = False
-        self.step_list([s.world for s in self.slots])
+        before = [s.world.steps for s in self.slots]
+        try:
+            self.step_list([s.world for s in self.slots])
+        finally:
+            for k, slot in enumerate(self.slots):
+                if counted is not None and counted[k]:
+                    self.episode_steps[k] += slot.world.steps - before[k]
         for slot in self.slots:
             if not slot.called and slot.indices:
                 self._remap(slot, [], [])  # the model's robots are gone
@@ -437,7 +455,6 @@ class Core:
         ks = np.flatnonzero(mask)
         if not len(ks):
             return
-        self.episode_steps[ks] += 1
         acting = self.active[ks]
         reward = self.spec["reward"]
         terminate = self.spec["terminate"]

@@ -433,12 +433,15 @@ def _check_actions(core, acts, name_of, clip):
                 f"action {acts[m].tolist()} for {name_of(m)} is outside the action space: "
                 f"each of {bounds.joints} in [{_fmt(bounds.low)}, {_fmt(bounds.high)}] "
                 f"(pass clip_actions=True to clip)")
-    else:
-        bad = ~np.isfinite(acts).all(axis=-1)
+    clipped = np.clip(acts.astype(np.float64), bounds.low, bounds.high)
+    if clip:
+        # NaN stays an error; +-inf is clipped like any value past a bound (it was
+        # refused), unless that side of the space is unbounded.
+        bad = ~np.isfinite(clipped).all(axis=-1)
         if bad.any():
             m = int(np.argmax(bad))
             raise ValueError(f"action {acts[m].tolist()} for {name_of(m)} is not finite")
-    return np.clip(acts.astype(np.float64), bounds.low, bounds.high)
+    return clipped
 
 
 def _fmt(values):
@@ -458,6 +461,23 @@ class _AgentsOfAModel:
     def joint_names(self):
         """The joints the actions drive, in action order."""
         return list(self._core.actions.joints)
+
+    # An environment is its worlds and the controllers they call back: a copy's worlds
+    # would report to the original (copy.deepcopy made one whose agents all ended at its
+    # first step, reward 0, with no error). Make another from the same arguments.
+    def _not_copied(self, what):
+        raise TypeError(f"{type(self).__name__} cannot be {what}: make another one with the "
+                        f"same arguments (in each process), or snapshot its worlds "
+                        f"(World.snapshot)")
+
+    def __copy__(self):
+        self._not_copied("copied")
+
+    def __deepcopy__(self, memo):
+        self._not_copied("copied")
+
+    def __reduce_ex__(self, protocol):
+        self._not_copied("pickled")
 
 
 # --- The PettingZoo-style environment ----------------------------------------------------
@@ -615,7 +635,7 @@ class ParallelEnv(_AgentsOfAModel, _ParallelBase):
                 core, np.stack([act for _, act in group]), lambda m: f"agent {names[m]!r}",
                 self._clip)
         core.set_actions([0], batch[None])
-        core.step_all()
+        core.step_all(np.ones(1, dtype=bool))
         core.observe()
         core.score(np.ones(1, dtype=bool))
         obs = core.obs[0]
@@ -769,6 +789,12 @@ class VectorEnv(_AgentsOfAModel, _VectorBase):
             seeds = [None] * K
         elif np.ndim(seed) == 0:
             seeds = [whole_number(seed, "reset: seed") + k for k in range(K)]
+            # Checked before any environment resets (s + k past 2**64 - 1 left env 0
+            # reset and the others not, naming a seed nobody passed).
+            if seeds[-1] > 2**64 - 1:
+                raise ValueError(f"reset: seed {seeds[0]} gives environment {K - 1} the seed "
+                                 f"{seeds[-1]}, past 2**64 - 1: pass a seed up to "
+                                 f"{2**64 - K}, or a list of {K} seeds")
         else:
             seeds = list(seed)
             if len(seeds) != K:
@@ -834,7 +860,7 @@ class VectorEnv(_AgentsOfAModel, _VectorBase):
             core.reset_world(int(k))
         going = np.flatnonzero(~resetting)
         core.set_actions(going, checked[going])
-        core.step_all()
+        core.step_all(~resetting)
         core.observe()
         core.active[resetting] = core.present[resetting]
         core.score(~resetting)
