@@ -86,7 +86,10 @@ class PyWorld {
   int64_t steps();
   std::string state_hash();
   int threads() const { return Any().threads(); }
-  bool planar() const { return planar_; }
+  bool planar() const {  // a closed world raises, as every other call
+    Any();
+    return planar_;
+  }
   std::optional<int64_t> default_steps() const { return loaded_.steps; }
 
   py::dict robots();

@@ -188,6 +188,7 @@ class MisuseTest(unittest.TestCase):
             t.join()
             expect(RuntimeError, "closed", w.step)
             expect(RuntimeError, "closed", w.poses)
+            expect(RuntimeError, "closed", lambda: w.planar)  # it still said True
         """)
 
     def test_keyboard_interrupt_and_system_exit_propagate_and_the_world_goes_on(self):
