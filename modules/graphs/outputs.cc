@@ -16,6 +16,7 @@
 #include <thread>
 #include <vector>
 
+#include "framework/csv.h"
 #include "framework/error.h"
 #include "framework/output_file.h"
 #include "framework/scheduler.h"
@@ -39,14 +40,6 @@ void AppendNumber(std::string* out, double v) {
   char buf[32];
   const auto r = std::to_chars(buf, buf + sizeof buf, v);
   out->append(buf, r.ptr);
-}
-
-// A CSV field (RFC 4180).
-std::string CsvField(const std::string& text) {
-  if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
-  std::string q = "\"";
-  for (char c : text) q += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return q + "\"";
 }
 
 // A series as CSV: a header row, then time and the streams, one row per sample.

@@ -25,6 +25,7 @@
 #include <sstream>
 #include <thread>
 
+#include "framework/csv.h"
 #include "framework/error.h"
 #include "framework/output_file.h"
 #include "framework/registry.h"
@@ -51,17 +52,10 @@ using Clock = std::chrono::steady_clock;
 // thousands of snapshots lists each one: ~100 bytes each).
 constexpr size_t kSummaryRoom = size_t{1} << 20;
 
-// A CSV field (RFC 4180): quoted when it holds a comma, quote or line break;
-// invalid UTF-8 replaced (ValidUtf8).
-void WriteCsvField(std::ostream& os, std::string_view text) {
+// A CSV field (framework/csv.h), invalid UTF-8 replaced (ValidUtf8).
+void WriteUtf8CsvField(std::ostream& os, std::string_view text) {
   if (!IsValidUtf8(text)) return WriteCsvField(os, ValidUtf8(text));
-  if (text.find_first_of(",\"\r\n") == std::string_view::npos) {
-    os << text;
-    return;
-  }
-  os << '"';
-  for (char ch : text) os << (ch == '"' ? "\"\"" : std::string_view(&ch, 1));
-  os << '"';
+  WriteCsvField(os, text);
 }
 
 // Streams metric samples to metrics.csv in tidy (long) form, one row per
@@ -83,9 +77,9 @@ class MetricsWriter {
     errno = 0;  // a row that fills the buffer writes it: its failure's errno, kept below
     for (const MetricSample& m : samples) {
       file_ << m.step << ',' << m.time << ',';
-      if (m.instance >= 0) WriteCsvField(file_, world_.scene().instance(m.instance).name);
+      if (m.instance >= 0) WriteUtf8CsvField(file_, world_.scene().instance(m.instance).name);
       file_ << ',';
-      WriteCsvField(file_, m.name);
+      WriteUtf8CsvField(file_, m.name);
       file_ << ',';
       if (std::isnan(m.value))
         file_ << "nan";  // not "-nan": one spelling for every reader

@@ -13,6 +13,7 @@
 #include <set>
 #include <sstream>
 
+#include "framework/csv.h"
 #include "framework/error.h"
 #include "framework/output_file.h"
 #include "framework/suggest.h"
@@ -28,13 +29,6 @@ std::string RightAligned(const std::string& text, size_t width) {
   size_t columns = 0;
   for (const char c : text) columns += (static_cast<unsigned char>(c) & 0xC0) != 0x80;
   return columns >= width ? text : std::string(width - columns, ' ') + text;
-}
-
-std::string CsvField(const std::string& s) {
-  if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
-  std::string q = "\"";
-  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return q + "\"";
 }
 
 std::string Num(double v, int precision = 6) {

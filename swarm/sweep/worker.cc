@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "framework/csv.h"
 #include "framework/error.h"
 #include "framework/utf8.h"
 
@@ -42,36 +43,6 @@ std::string Tail(const std::string& text, int lines) {
        ++i)
     out += (out.empty() ? "" : " | ") + all[i];
   return out;
-}
-
-// One record of a CSV file as metrics.csv writes it (RFC 4180: a field with
-// a comma, quote or line break is quoted, its quotes doubled): its fields.
-// False at the end of the file, and for a record the file ends inside (a
-// torn last line, or an open quote).
-bool ReadCsvRecord(std::istream& in, std::vector<std::string>* fields) {
-  fields->assign(1, std::string());
-  bool quoted = false;
-  for (int c; (c = in.get()) != EOF;) {
-    if (quoted) {
-      if (c != '"') {
-        fields->back() += static_cast<char>(c);
-      } else if (in.peek() == '"') {
-        fields->back() += '"';
-        in.get();
-      } else {
-        quoted = false;
-      }
-    } else if (c == '"') {
-      quoted = true;
-    } else if (c == ',') {
-      fields->emplace_back();
-    } else if (c == '\n') {
-      return true;
-    } else if (c != '\r') {
-      fields->back() += static_cast<char>(c);
-    }
-  }
-  return false;  // no line end: torn, or nothing left
 }
 
 // metrics.csv (step,time,robot,metric,value) -> series and final values.
