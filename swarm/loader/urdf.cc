@@ -6,6 +6,7 @@
 #include <urdf_parser/urdf_parser.h>
 
 #include <algorithm>
+#include <charconv>
 #include <array>
 #include <cctype>
 #include <cmath>
@@ -176,14 +177,11 @@ fs::path Importer::ResolveUri(const std::string& uri, int line, const std::strin
     if (path.starts_with("localhost/")) path.erase(0, 9);
     std::string decoded;
     for (size_t i = 0; i < path.size(); ++i) {
-      const auto hex = [](char c) {
-        return std::isdigit(static_cast<unsigned char>(c)) ? c - '0'
-               : std::isxdigit(static_cast<unsigned char>(c))
-                   ? std::tolower(static_cast<unsigned char>(c)) - 'a' + 10
-                   : -1;
-      };
-      if (path[i] == '%' && i + 2 < path.size() && hex(path[i + 1]) >= 0 && hex(path[i + 2]) >= 0) {
-        decoded += static_cast<char>(hex(path[i + 1]) * 16 + hex(path[i + 2]));
+      unsigned byte = 0;
+      const char* hex = path.data() + i + 1;
+      if (path[i] == '%' && i + 2 < path.size() &&
+          std::from_chars(hex, hex + 2, byte, 16).ptr == hex + 2) {
+        decoded += static_cast<char>(byte);
         i += 2;
       } else {
         decoded += path[i];

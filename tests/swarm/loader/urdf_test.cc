@@ -1045,7 +1045,14 @@ TEST_F(UrdfErrorTest, AnAxisOfHugeComponentsIsADirection) {
            axis + "\"/></joint>\n</robot>\n";
   };
   Write("ok.urdf", robot("0 1e300 1e300"));
-  EXPECT_NO_THROW(Load("models: [{model: ok.urdf, position: [0, 0]}]\n"));
+  const LoadedWorld w = Load("models: [{model: ok.urdf, position: [0, 0]}]\n");
+  const Scene& scene = w.world->scene();
+  const ObjectId j = scene.FindObject("./j", scene.instances()[0].root);
+  ASSERT_FALSE(j.IsNull());
+  const Vec3 axis = scene.world_pose(j).q.Rotate({0, 0, 1});  // a joint turns about its z
+  EXPECT_NEAR(axis.x, 0, 1e-12);
+  EXPECT_NEAR(axis.y, std::sqrt(0.5), 1e-12);
+  EXPECT_NEAR(axis.z, std::sqrt(0.5), 1e-12);
   EXPECT_CONTAINS(ErrorOfUrdf(robot("0 0 0")), "joint 'j': <axis xyz> must be a nonzero vector");
 }
 
