@@ -459,17 +459,24 @@ fs::path OneScriptedRobot(const std::string& name, const std::string& lua) {
 
 // A run that fails before its first step prints its error, not a table of
 // zeros; one that fails later prints the table of what it ran.
+// An --out folder an earlier run wrote to: a recorded 2-step run's outputs,
+// and a file of the user's (notes.txt) that no run may touch.
+void EarlierRunInto(const fs::path& out) {
+  const auto r = RunProgram("run " + Data("outputs.yaml") + " --steps 2 --quiet --record --out " +
+                            out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  ASSERT_TRUE(fs::exists(out / "recording.swrec"));
+  ASSERT_TRUE(fs::exists(out / "metrics.csv"));
+  std::ofstream(out / "notes.txt") << "mine\n";
+}
+
 // --out DIR again: the earlier run's outputs (as its summary.json lists
 // them) go, so the folder holds one run, not new metrics beside an old
 // recording. Nothing else is touched: files of the user's, paths outside DIR.
 TEST(RunOutputsTest, AnOutFolderUsedAgainHoldsTheNewRunAlone) {
   const fs::path out = TempDir("again");
-  auto r = RunProgram("run " + Data("outputs.yaml") + " --steps 2 --quiet --record --out " +
-                      out.string());
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  ASSERT_TRUE(fs::exists(out / "recording.swrec"));
-  std::ofstream(out / "notes.txt") << "mine\n";
-  r = RunProgram("run " + Data("outputs.yaml") + " --steps 3 --quiet --out " + out.string());
+  ASSERT_NO_FATAL_FAILURE(EarlierRunInto(out));
+  auto r = RunProgram("run " + Data("outputs.yaml") + " --steps 3 --quiet --out " + out.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("note: removed the outputs of the earlier run in '" + out.string() +
                           "' (1 recording)"),
@@ -496,13 +503,9 @@ TEST(RunOutputsTest, AnOutFolderUsedAgainHoldsTheNewRunAlone) {
 // earlier run's files went unlisted, and stayed beside the next run's.
 TEST(RunOutputsTest, ARunThatDoesNotLoadTakesTheEarlierRunsFilesWithIt) {
   const fs::path out = TempDir("failed_load");
-  auto r = RunProgram("run " + Data("outputs.yaml") + " --steps 2 --quiet --record --out " +
-                      out.string());
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  ASSERT_TRUE(fs::exists(out / "recording.swrec"));
-  ASSERT_TRUE(fs::exists(out / "metrics.csv"));
-  std::ofstream(out / "notes.txt") << "mine\n";
-  r = RunProgram("run " + (out / "no_such_world.yaml").string() + " --quiet --out " + out.string());
+  ASSERT_NO_FATAL_FAILURE(EarlierRunInto(out));
+  auto r =
+      RunProgram("run " + (out / "no_such_world.yaml").string() + " --quiet --out " + out.string());
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("note: removed the outputs of the earlier run in '" + out.string() +
                           "' (1 recording)"),

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iomanip>
 #include <iostream>
 #include <map>
@@ -125,25 +126,38 @@ TEST(SweepTest, ReportListsTheValidNamesAndSuggestsTheNearest) {
 
 // A sweep of robots=2,4 x seeds 1..3 (runs 1-6): runs 1-3 ok with x = 1, 2
 // and 3; run 4 ok with x = 10; run 5 failed; run 6 not run yet.
-fs::path SmallSweep(const std::string& name) {
+// A sweep database of `spec` x `seeds` whose runs 1..`finished` are complete,
+// each as `outcome` makes it (its id set).
+fs::path SweepDb(const std::string& name, const std::string& spec,
+                 const std::vector<uint64_t>& seeds, int64_t finished,
+                 const std::function<void(RunOutcome*)>& outcome) {
   const fs::path file = TempDir(name) / "r.db";
-  const std::vector<ParamSpec> params = {ParseParamSpec("robots=2,4")};
-  const std::vector<uint64_t> seeds = {1, 2, 3};
+  const std::vector<ParamSpec> params = {ParseParamSpec(spec)};
   ResultsDb db(file);
   db.CreateSweep({"w.yaml", "0", SweepSpace(params, seeds, 10, std::nullopt),
                   "2026-01-02T03:04:05Z", "9.9.9", "swarmsim sweep w.yaml"},
                  ExpandGrid(params, seeds));
-  for (int64_t id = 1; id <= 5; ++id) {
+  for (int64_t id = 1; id <= finished; ++id) {
     RunOutcome o;
     o.id = id;
-    o.ok = id != 5;
+    o.ok = true;
     o.steps = 10;
-    o.state_hash = o.ok ? "00000000000000a" + std::to_string(id) : "";
-    if (o.ok) o.final_metrics["x"] = id == 4 ? 10 : static_cast<double>(id);
-    if (!o.ok) o.error = "said \"no\", then stopped";
+    o.state_hash = "00000000000000a" + std::to_string(id);
+    outcome(&o);
     db.Complete(o);
   }
   return file;
+}
+
+fs::path SmallSweep(const std::string& name) {
+  return SweepDb(name, "robots=2,4", {1, 2, 3}, 5, [](RunOutcome* o) {
+    o->ok = o->id != 5;
+    if (o->ok) o->final_metrics["x"] = o->id == 4 ? 10 : static_cast<double>(o->id);
+    if (!o->ok) {
+      o->state_hash.clear();
+      o->error = "said \"no\", then stopped";
+    }
+  });
 }
 
 // What Num() prints for a statistic (6 significant digits).
@@ -220,24 +234,8 @@ TEST(ReportTest, TheTableSummarisesEachPointOverItsOkRuns) {
 // Columns line up with values of characters past ASCII ('ünï' took 5 of
 // the 12 columns, by its bytes, and the columns after it slipped).
 TEST(ReportTest, ColumnsLineUpWithCharactersPastAscii) {
-  const fs::path file = TempDir("report_unicode") / "r.db";
-  const std::vector<ParamSpec> params = {ParseParamSpec("label=abc,ünï,日本")};
-  const std::vector<uint64_t> seeds = {1};
-  {
-    ResultsDb db(file);
-    db.CreateSweep({"w.yaml", "0", SweepSpace(params, seeds, 10, std::nullopt),
-                    "2026-01-02T03:04:05Z", "9.9.9", "swarmsim sweep w.yaml"},
-                   ExpandGrid(params, seeds));
-    for (int64_t id = 1; id <= 3; ++id) {
-      RunOutcome o;
-      o.id = id;
-      o.ok = true;
-      o.steps = 10;
-      o.state_hash = "00000000000000a" + std::to_string(id);
-      o.final_metrics["x"] = 1;
-      db.Complete(o);
-    }
-  }
+  const fs::path file = SweepDb("report_unicode", "label=abc,ünï,日本", {1}, 3,
+                                [](RunOutcome* o) { o->final_metrics["x"] = 1; });
   std::ostringstream out, err;
   ReportOptions options;
   options.db = file.string();
