@@ -6,9 +6,9 @@
 #include <urdf_parser/urdf_parser.h>
 
 #include <algorithm>
-#include <charconv>
 #include <array>
 #include <cctype>
+#include <charconv>
 #include <cmath>
 #include <cstdlib>
 #include <map>
