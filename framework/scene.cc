@@ -452,10 +452,18 @@ void Scene::UpdateWorldPoses(int instance) {
 
 // --- Typed data ----------------------------------------------------------------------------
 
+// "a shape", "an ir_transceiver".
+static std::string WithArticle(std::string_view type_name) {
+  const bool vowel =
+      !type_name.empty() && std::string_view("aeiou").find(type_name[0]) != std::string_view::npos;
+  return (vowel ? "an " : "a ") + std::string(type_name);
+}
+
 static void ExpectType(const Scene& scene, uint32_t slot, ObjectType want) {
   if (scene.type_at(slot) != want)
-    throw Error("object '" + scene.name_at(slot) + "' is a " +
-                scene.type_name(scene.type_at(slot)) + ", not a " + scene.type_name(want));
+    throw Error("object '" + scene.name_at(slot) + "' is " +
+                WithArticle(scene.type_name(scene.type_at(slot))) + ", not " +
+                WithArticle(scene.type_name(want)));
 }
 
 const ShapeData& Scene::shape(ObjectId id) const {

@@ -17,6 +17,7 @@
 
 #include "framework/error.h"
 #include "framework/lua_api.h"
+#include "framework/lua_bytes.h"
 #include "framework/scene.h"
 #include "modules/ir_messaging/ir_messaging.h"
 #include "modules/ir_messaging/module.h"
@@ -52,44 +53,8 @@ int SendIrMessage(lua_State* L) {
                 "others");
   const uint32_t size = ir.settings->payload_size;
   const Scene& scene = *c.scene;
-  std::vector<uint8_t> data;
-  if (lua_type(L, 2) == LUA_TSTRING) {
-    size_t length = 0;
-    const char* bytes = lua_tolstring(L, 2, &length);
-    if (length > size) throw Error(TooLong(scene, id, length, size));
-    data.assign(bytes, bytes + length);
-  } else if (lua_type(L, 2) == LUA_TTABLE) {
-    // Element by element up to the first nil, never sized from #t.
-    data.reserve(size);
-    for (lua_Integer i = 1;; ++i) {
-      const int type = lua_rawgeti(L, 2, i);
-      if (type == LUA_TNIL) {
-        lua_pop(L, 1);
-        break;
-      }
-      int is_integer = 0;
-      const lua_Integer v = lua_tointegerx(L, -1, &is_integer);
-      lua_pop(L, 1);
-      if (type != LUA_TNUMBER || !is_integer || v < 0 || v > 255)
-        throw Error("element " + std::to_string(i) +
-                    " of the message must be an integer from 0 to 255 (a byte)");
-      if (static_cast<size_t>(i) > size) {
-        lua_Integer n = i;  // count the rest for the message, up to a bound
-        while (n < i + 1000000 && lua_rawgeti(L, 2, n + 1) != LUA_TNIL) {
-          lua_pop(L, 1);
-          ++n;
-        }
-        lua_pop(L, 1);
-        throw Error(TooLong(scene, id, static_cast<size_t>(n), size));
-      }
-      data.push_back(static_cast<uint8_t>(v));
-    }
-  } else {
-    throw Error(std::string("bad argument #2 (a string of bytes or a table of integers 0..255 "
-                            "expected, got ") +
-                luaL_typename(L, 2) + ")");
-  }
-  ir.outgoing = std::move(data);
+  ir.outgoing = ArgBytes(L, 2, size, "message",
+                         [&](size_t bytes) { return TooLong(scene, id, bytes, size); });
   ir.queued = true;
   return 0;
 }

@@ -10,6 +10,7 @@
 // in step t reads 0 from step t + 1. Readings are written in the sense
 // phase only, so any script may read any sensor.
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "framework/error.h"
@@ -21,6 +22,14 @@
 namespace swarmsim::light {
 
 namespace {
+
+// "0.5", "1e+30", "nan" (0/0 printed "-nan"), "inf".
+std::string NumberText(double value) {
+  if (std::isnan(value)) return "nan";
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", value);
+  return text;
+}
 
 // The light source at argument 1, if the calling script may change it.
 LightSourceRow& OwnSource(lua_State* L, const char* verb) {
@@ -47,8 +56,7 @@ int SetLightSourceIntensity(lua_State* L) {
   LightSourceRow& light = OwnSource(L, "dim");
   const double intensity = ArgNumber(L, 2);
   if (!(intensity >= 0 && std::isfinite(intensity)))
-    throw Error("the intensity must be a finite number >= 0 (got " + std::to_string(intensity) +
-                ")");
+    throw Error("the intensity must be a finite number >= 0 (got " + NumberText(intensity) + ")");
   light.intensity = intensity;
   return 0;
 }

@@ -16,6 +16,7 @@
 
 #include "framework/error.h"
 #include "framework/lua_api.h"
+#include "framework/lua_bytes.h"
 #include "framework/scene.h"
 #include "modules/range_and_bearing/module.h"
 #include "modules/range_and_bearing/range_and_bearing.h"
@@ -54,46 +55,8 @@ int SetRangeAndBearingData(lua_State* L) {
   RangeAndBearingRow& rab = OwnBoard(L, "set", &id);
   const uint32_t size = rab.settings->payload_size;
   const Scene& scene = *Context(L).scene;
-  std::vector<uint8_t> data;
-  if (lua_type(L, 2) == LUA_TSTRING) {
-    size_t length = 0;
-    const char* bytes = lua_tolstring(L, 2, &length);
-    if (length > size) throw Error(TooLong(scene, id, length, size));
-    data.assign(bytes, bytes + length);
-  } else if (lua_type(L, 2) == LUA_TTABLE) {
-    // Element by element up to the first nil, never sized from #t; one past
-    // the payload is enough to refuse.
-    data.reserve(size);
-    for (lua_Integer i = 1;; ++i) {
-      const int type = lua_rawgeti(L, 2, i);
-      if (type == LUA_TNIL) {
-        lua_pop(L, 1);
-        break;
-      }
-      int is_integer = 0;
-      const lua_Integer v = lua_tointegerx(L, -1, &is_integer);
-      lua_pop(L, 1);
-      if (type != LUA_TNUMBER || !is_integer || v < 0 || v > 255)
-        throw Error("element " + std::to_string(i) +
-                    " of the data must be an integer from 0 to 255 (a byte)");
-      if (static_cast<size_t>(i) > size) {
-        // Count the rest for the message, up to a bound.
-        lua_Integer n = i;
-        while (n < i + 1000000 && lua_rawgeti(L, 2, n + 1) != LUA_TNIL) {
-          lua_pop(L, 1);
-          ++n;
-        }
-        lua_pop(L, 1);
-        throw Error(TooLong(scene, id, static_cast<size_t>(n), size));
-      }
-      data.push_back(static_cast<uint8_t>(v));
-    }
-  } else {
-    throw Error(std::string("bad argument #2 (a string of bytes or a table of integers 0..255 "
-                            "expected, got ") +
-                luaL_typename(L, 2) + ")");
-  }
-  rab.data = std::move(data);
+  rab.data =
+      ArgBytes(L, 2, size, "data", [&](size_t bytes) { return TooLong(scene, id, bytes, size); });
   return 0;
 }
 

@@ -122,6 +122,24 @@ TEST_F(IrMessagingLuaTest, AMessageOverThePayloadIsRefusedNamingTheLimit) {
   EXPECT_CONTAINS(error, "bot.lua:2");
 }
 
+// A table with a hole sent its bytes up to the hole, without a word; a shape
+// passed as the transceiver was "a ir_transceiver".
+TEST_F(IrMessagingLuaTest, AHoleInTheMessageAndAWrongObjectAreNamed) {
+  LoadedWorld holed = TwoRobots(
+      "function sysCall_init()\n"
+      "  sim.sendIrMessage(sim.getObject('./ir'), {1, nil, 3})\n"
+      "end\n");
+  const std::string hole = testing::ErrorOf([&] { holed.world->Start(); });
+  EXPECT_CONTAINS(hole, "bot.lua:2");
+  EXPECT_CONTAINS(hole, "the message table has key [3] besides its bytes t[1]..t[1]");
+  LoadedWorld shape = TwoRobots(
+      "function sysCall_init()\n"
+      "  sim.sendIrMessage(sim.getObject('.'), 'x')\n"
+      "end\n");
+  EXPECT_CONTAINS(testing::ErrorOf([&] { shape.world->Start(); }),
+                  "is a dummy, not an ir_transceiver");
+}
+
 TEST_F(IrMessagingLuaTest, AMessageOverASmallerPayloadNamesItsSize) {
   LoadedWorld w = TwoRobots(
       "function sysCall_init()\n"

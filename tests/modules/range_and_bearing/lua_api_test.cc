@@ -111,6 +111,10 @@ TEST(RangeAndBearingLuaTest, OtherMistakesAreScriptErrorsToo) {
   EXPECT_NE(ErrorOf("sim.setRangeAndBearingData(rab, {'a'})").find("element 1"), std::string::npos);
   EXPECT_NE(ErrorOf("sim.setRangeAndBearingData(rab, 12)").find("bad argument #2"),
             std::string::npos);
+  // A hole: it sent 1,0,0,0 without a word.
+  EXPECT_NE(ErrorOf("sim.setRangeAndBearingData(rab, {1, nil, 3})")
+                .find("the data table has key [3] besides its bytes t[1]..t[1]"),
+            std::string::npos);
   EXPECT_NE(ErrorOf("sim.setRangeAndBearingData(sim.getObject('/bot#1/rab'), 'x')")
                 .find("may set only its own range-and-bearing boards' data ('/bot#1/rab'"),
             std::string::npos);
