@@ -15,6 +15,7 @@
 #include "framework/world.h"
 #include "modules/builtin.h"
 #include "swarm/python/arrays.h"
+#include "swarm/python/initialized.h"
 #include "swarm/python/ir_arrays.h"
 #include "swarm/python/writers.h"
 
@@ -234,6 +235,16 @@ std::shared_ptr<ModuleRegistry> MakeRegistry() {
 }
 
 }  // namespace
+}  // namespace swarmsim::python
+
+// Robots.__new__(Robots)'s methods raise TypeError (initialized.h).
+namespace pybind11::detail {
+template <>
+class type_caster<swarmsim::python::Robots>
+    : public swarmsim::python::InitializedCaster<swarmsim::python::Robots> {};
+}  // namespace pybind11::detail
+
+namespace swarmsim::python {
 
 const ModuleRegistry& Registry() {
   static const std::shared_ptr<ModuleRegistry> registry = MakeRegistry();

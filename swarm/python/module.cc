@@ -178,7 +178,11 @@ void StepWorlds(const py::sequence& worlds, const py::object& count,
       throw py::type_error("step_worlds: worlds[" + std::to_string(i) + "] is a " +
                            std::string(py::str(py::type::of(item).attr("__name__"))) +
                            ", not a swarmsim.World");
-    list[i] = item.cast<PyWorld*>();
+    try {
+      list[i] = item.cast<PyWorld*>();
+    } catch (const py::type_error& e) {  // made by World.__new__ alone (initialized.h)
+      throw py::type_error("step_worlds: worlds[" + std::to_string(i) + "]: " + e.what());
+    }
     const auto [it, fresh] = seen.emplace(list[i], i);
     if (!fresh)
       throw py::value_error("step_worlds: worlds[" + std::to_string(i) + "] is worlds[" +

@@ -18,6 +18,7 @@
 #include "swarm/loader/world_loader.h"
 #include "swarm/python/arrays.h"
 #include "swarm/python/controller.h"
+#include "swarm/python/initialized.h"
 #include "swarm/python/snapshot.h"
 
 namespace swarmsim::python {
@@ -227,3 +228,10 @@ class PyWorld {
 };
 
 }  // namespace swarmsim::python
+
+// World.__new__(World)'s methods raise TypeError (initialized.h).
+namespace pybind11::detail {
+template <>
+class type_caster<swarmsim::python::PyWorld>
+    : public swarmsim::python::InitializedCaster<swarmsim::python::PyWorld> {};
+}  // namespace pybind11::detail

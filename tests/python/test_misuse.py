@@ -383,6 +383,28 @@ class MisuseTest(unittest.TestCase):
             assert a.steps == 0, "nothing stepped when the list is refused"
         """)
 
+    def test_objects_made_by_new_without_init_raise(self):
+        # World.__new__(World).step() crashed the interpreter: its methods ran on
+        # memory pybind11 allocated for them, never initialised.
+        self.run_child("""
+            w = swarmsim.World.__new__(swarmsim.World)
+            made = "World object was made by World.__new__ without World.__init__"
+            for call in (w.step, w.close, w.snapshot, w.state_hash, lambda: w.steps,
+                         lambda: w.poses(), lambda: w.robots):
+                expect(TypeError, made, call)
+            expect(TypeError, "worlds[0]", swarmsim.step_worlds, [w])
+            r = swarmsim.Robots.__new__(swarmsim.Robots)
+            expect(TypeError, "Robots object was made by Robots.__new__", lambda: r.count)
+            expect(TypeError, "Robots object was made by Robots.__new__", lambda: r.poses)
+            class Mine(swarmsim.World):
+                pass
+            expect(TypeError, "Mine object was made by Mine.__new__", Mine.__new__(Mine).step)
+            del w, r
+            w = swarmsim.World(WORLD, set={"robots": 3}, threads=1)  # a made one still works
+            w.step(2)
+            assert w.steps == 2
+        """)
+
 
 class DocstringTest(unittest.TestCase):
     def test_every_class_method_and_property_says_what_it_does(self):
