@@ -410,13 +410,14 @@ void Importer::NameObjects() {
     const std::string clean = ObjectName(joint);
     joint_names_[joint] = unique(clean);
     joint_names.insert(clean);
-    if (joint_names_[joint] != clean)
+    // Against the URDF's name: 'j x' made 'j_x' was left out of the list.
+    if (joint_names_[joint] != joint)
       renamed_.push_back("joint '" + joint + "' is '" + joint_names_[joint] + "'");
   }
   for (const auto& [line, link] : in_order(xml_.link_line)) {
     const std::string clean = ObjectName(link);
     link_names_[link] = unique(joint_names.contains(clean) ? clean + "_link" : clean);
-    if (link_names_[link] != clean)
+    if (link_names_[link] != link)
       renamed_.push_back("link '" + link + "' is '" + link_names_[link] + "'" +
                          (joint_names.contains(clean) ? " (a joint has its name)" : ""));
   }

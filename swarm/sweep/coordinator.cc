@@ -155,8 +155,13 @@ int CoordinateSweep(const SweepOptions& o, RemoteWorkers* remote, std::ostream& 
                   "length); resume it with the same command or use another --db");
     if (existing->world_hash != world_hash) {
       if (!o.allow_changed_world)
-        throw Error("world file '" + o.world + "' has changed since this sweep began (" +
-                    existing->started_at + "); its runs would mix two worlds. Pass " +
+        throw Error((existing->world_path == o.world
+                         ? "world file '" + o.world + "' has changed since this sweep began (" +
+                               existing->started_at + ")"
+                         : "'" + o.db + "' holds a sweep of world file '" + existing->world_path +
+                               "' (begun " + existing->started_at + "), and '" + o.world +
+                               "' differs from it") +
+                    "; its runs would mix two worlds. Pass " +
                     "--allow-changed-world to continue anyway, or use another --db");
       err << "warning: world file changed since the sweep began; continuing as asked (the "
           << "runs it runs record its new hash in runs.world_hash; the sweep keeps its first)\n";

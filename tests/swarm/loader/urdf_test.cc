@@ -652,9 +652,10 @@ TEST_F(UrdfTest, NamesStayUniqueSoScriptsFindTheObjectMeant) {
   EXPECT_NE(first, second);
   ASSERT_EQ(w.warnings.size(), 1u);
   EXPECT_CONTAINS(w.warnings[0],
-                  "n.urdf: 2 names were changed so that scripts find each object "
+                  "n.urdf: 3 names were changed so that scripts find each object "
                   "by its name (link 'LF_HAA' is 'LF_HAA_link' (a joint has its "
-                  "name), link 'upper_arm_left' is 'upper_arm_left_2')");
+                  "name), link 'upper arm/left' is 'upper_arm_left', link 'upper_arm_left' "
+                  "is 'upper_arm_left_2')");  // 'upper arm/left' was left out
 }
 
 // A floating robot standing on the ground with a 2 mg finger link (NAO's

@@ -229,6 +229,17 @@ TEST(SweepTest, SameSeedSameHashAsRunAndChangedWorldIsRefused) {
                  db.string());
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("has changed since this sweep began"), std::string::npos) << r.output;
+  // Another world file on the database: named as another file, not as an edit.
+  const fs::path other = fs::path(world).parent_path() / "other_world.yaml";
+  fs::copy_file(world, other, fs::copy_options::overwrite_existing);
+  std::ofstream(other, std::ios::app) << "# another\n";
+  r = RunProgram("sweep " + other.string() + " --param robots=2,5 --seeds 3-4 --steps 12 --db " +
+                 db.string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("holds a sweep of world file '" + world + "'"), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("'" + other.string() + "' differs from it"), std::string::npos)
+      << r.output;
   r = RunProgram("sweep " + world + " --param robots=2,5 --seeds 3-4 --steps 12 " +
                  "--allow-changed-world --db " + db.string());
   EXPECT_EQ(r.exit_code, 0) << r.output;
