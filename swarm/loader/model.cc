@@ -149,15 +149,6 @@ std::shared_ptr<RowTable> NewRow(const ObjectTypeDescriptor& type) {
   return row;
 }
 
-// Object names are path elements: no '/', no brackets.
-void CheckObjectName(const ValueReader& values, const Field& field, const std::string& name) {
-  if (name.empty() || name.find_first_of("/[]") != std::string::npos ||
-      name.find_first_of(" \t\n") != std::string::npos)
-    values.Fail(field, "object name '" + name +
-                           "' must be non-empty, without spaces, '/', '[' or ']' (it is used in "
-                           "paths such as ./leftMotor)");
-}
-
 struct Builder {
   const ModelFile& model;
   const ValueReader& values;

@@ -449,4 +449,13 @@ Vec3 ValueReader::Vector3(const Field& field, const NumberRule& rule) const {
   return {v[0], v[1], v[2]};
 }
 
+// Object names are path elements: no '/', no brackets.
+void CheckObjectName(const ValueReader& values, const Field& field, const std::string& name) {
+  if (name.empty() || name.find_first_of("/[]") != std::string::npos ||
+      name.find_first_of(" \t\n") != std::string::npos)
+    values.Fail(field, "object name '" + name +
+                           "' must be non-empty, without spaces, '/', '[' or ']' (it is used in "
+                           "paths such as ./leftMotor)");
+}
+
 }  // namespace swarmsim::loader

@@ -121,4 +121,8 @@ const char* TypeName(const ParamValue& value);
 // that is a number or boolean like `declared`; nothing when it is not.
 std::optional<ParamValue> AsDeclaredType(const std::string& text, const ParamValue& declared);
 
+// Object names are path elements (./leftMotor, /box): refuses at `field`
+// an empty name or one with a space, '/', '[' or ']'.
+void CheckObjectName(const ValueReader& values, const Field& field, const std::string& name);
+
 }  // namespace swarmsim::loader

@@ -583,7 +583,10 @@ void WorldLoader::BuildObstacles(const Fields& top, World* world) {
     Fields f(*file_, element, "obstacle " + std::to_string(index));
     f.Expect(keys);
     std::string name = "obstacle_" + std::to_string(index);
-    if (f.Has("name")) name = values.String(f.Get("name"));
+    if (f.Has("name")) {  // a path element, as a model's object names ('a/b' was found by no path)
+      name = values.String(f.Get("name"));
+      loader::CheckObjectName(values, f.Get("name"), name);
+    }
     const ShapeData shape = loader::ReadShape(values, f, &meshes_);
     const Pose X_WO = loader::ReadPose(values, f);
     world->scene().AddShape(name, {}, X_WO, shape);

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cctype>
 #include <memory>
+#include <string>
+#include <unordered_set>
+#include <vector>
 
 #include "framework/error.h"
 #include "framework/regular_file.h"
@@ -55,6 +58,70 @@ static bool TabInIndentation(std::string_view text, int line) {
   return false;
 }
 
+// A quoted scalar whose closing quote is missing ("robots: 'abc"): yaml-cpp
+// reads the lines below into it, less indented ones too, which YAML
+// forbids: the rest of the file became one string and the run went on
+// without its arena and models. Fails at the quote when the scalar runs on
+// into a line indented no deeper than the one it opened on. Each node once
+// (an alias repeats its node's position: a billion-laughs file is walked
+// in linear time).
+static void CheckQuotes(const YamlFile& file, std::string_view text, const YAML::Node& node,
+                        std::unordered_set<size_t>* seen) {
+  if (!node.IsDefined() || node.IsNull()) return;
+  const YAML::Mark mark = node.Mark();
+  if (mark.is_null() || mark.pos < 0) return;
+  const size_t pos = static_cast<size_t>(mark.pos);
+  // (A collection may begin where its first element does: keyed by kind too.)
+  if (!node.IsScalar() && !seen->insert(2 * pos + (node.IsMap() ? 1 : 0)).second) return;
+  if (node.IsMap()) {
+    for (const auto& kv : node) {
+      CheckQuotes(file, text, kv.first, seen);
+      CheckQuotes(file, text, kv.second, seen);
+    }
+    return;
+  }
+  if (node.IsSequence()) {
+    for (const auto& item : node) CheckQuotes(file, text, item, seen);
+    return;
+  }
+  if (pos >= text.size() || (text[pos] != '\'' && text[pos] != '"')) return;
+  const char quote = text[pos];
+  const size_t line_start =
+      text.rfind('\n', pos) == std::string_view::npos ? 0 : text.rfind('\n', pos) + 1;
+  size_t indent = 0;
+  while (line_start + indent < pos && text[line_start + indent] == ' ') ++indent;
+  for (size_t i = pos + 1; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c == quote) {
+      if (quote == '\'' && i + 1 < text.size() && text[i + 1] == '\'') {  // '' is a quote
+        ++i;
+        continue;
+      }
+      return;  // closed
+    }
+    if (quote == '"' && c == '\\') {
+      ++i;
+      continue;
+    }
+    if (c != '\n') continue;
+    size_t j = i + 1, spaces = 0;
+    while (j < text.size() && text[j] == ' ') ++j, ++spaces;
+    if (j < text.size() && text[j] != '\n' && text[j] != '\r' && spaces <= indent) {
+      const auto line =
+          1 + std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(j), '\n');
+      const size_t end = text.find('\n', j);
+      std::string next(text.substr(
+          j, std::min<size_t>(end == std::string_view::npos ? text.size() - j : end - j, 40)));
+      for (char& ch : next)
+        if (static_cast<unsigned char>(ch) < 0x20) ch = '?';
+      file.Fail(mark, std::string("the value quoted with ") + (quote == '"' ? "\"" : "'") +
+                          " here runs on into line " + std::to_string(line) + " ('" + next +
+                          "'), which is indented no deeper than its own: is its closing " + quote +
+                          " missing?");
+    }
+  }
+}
+
 YamlFile YamlFile::Load(const fs::path& path, std::string_view kind,
                         const std::string& referenced_by, const std::string& reference_text) {
   YamlFile file;
@@ -79,7 +146,17 @@ YamlFile YamlFile::Load(const fs::path& path, std::string_view kind,
                               : " (was it saved by a program that pads with zeros?)"));
   }
   try {
-    file.root_ = YAML::Load(text);
+    // Every document: a second one (after ---) was never read, its keys
+    // unchecked.
+    std::vector<YAML::Node> documents = YAML::LoadAll(text);
+    for (size_t d = 1; d < documents.size(); ++d)
+      if (documents[d].IsDefined() && !documents[d].IsNull())
+        file.Fail(documents[d].Mark(),
+                  "a second YAML document (after ---): a " + std::string(kind) +
+                      " is one document; join the two, or put this one in a file of its own");
+    if (!documents.empty()) file.root_ = documents.front();
+    std::unordered_set<size_t> seen;
+    CheckQuotes(file, text, file.root_, &seen);
   } catch (const YAML::ParserException& e) {
     // Includes yaml-cpp's DeepRecursion (nesting beyond its depth guard).
     const std::string hint =

@@ -546,6 +546,14 @@ TEST_F(MalformedWorldTest, GarbageNeverCrashes) {
       "obstacles: [5]\n",
       "obstacles: [{shape: box}]\n",
       "obstacles: [{shape: box, size: [1, 1, 1], position: [1e308, 0, 0]}]\n",
+      // Names no path finds (they loaded: sim.getObject('/a/b') found nothing).
+      "obstacles: [{name: a/b, shape: box, size: [1, 1, 1]}]\n",
+      "obstacles: [{name: '', shape: box, size: [1, 1, 1]}]\n",
+      "obstacles: [{name: 'x[0]', shape: box, size: [1, 1, 1]}]\n",
+      "obstacles: [{name: 'a b', shape: box, size: [1, 1, 1]}]\n",
+      // A quote left open, a second document.
+      "parameters:\n  robots: 'abc\narena:\n  size: 3\n",
+      "arena: {size: 3}\n---\nbogus_key: 1\n",
       "models: 7\n",
       "models: [[]]\n",
       "models: [{model: [a]}]\n",

@@ -66,6 +66,37 @@ TEST(YamlTest, ANulByteIsNamedWhereItIs) {
   fs::remove_all(YamlDir());
 }
 
+// A quote left open read the rest of the file into one string: the run
+// went on with no arena and no models (robots 0, exit 0).
+TEST(YamlTest, AQuoteLeftOpenIsNamedWhereItOpens) {
+  const std::string single = ErrorOf(
+      [] { Yaml("simulation:\n  steps: 2\nparameters:\n  robots: 'abc\narena:\n  size: 3\n"); });
+  EXPECT_EQ(single, DisplayPath(YamlDir() / "w.yaml") +
+                        ":4:11: the value quoted with ' here runs on into line 5 ('arena:'), "
+                        "which is indented no deeper than its own: is its closing ' missing?");
+  const std::string dual = ErrorOf([] { Yaml("- name: \"x\n- name: y\n"); });
+  EXPECT_NE(dual.find("w.yaml:1:9: the value quoted with \" here runs on into line 2"),
+            std::string::npos)
+      << dual;
+  // Quotes closed (an escaped one inside, '' in single quotes), and a value
+  // quoted over lines indented deeper, as YAML allows: read as before.
+  EXPECT_EQ(Yaml("a: 'it''s'\nb: \"say \\\"hi\\\"\"\nc: 'one\n  two'\nd: 1\n").root()["c"].Scalar(),
+            "one two");
+  fs::remove_all(YamlDir());
+}
+
+// A second document (after ---) was never read: its keys went unchecked.
+TEST(YamlTest, ASecondDocumentIsRefused) {
+  const std::string second = ErrorOf([] { Yaml("simulation: {steps: 2}\n---\nbogus_key: 1\n"); });
+  EXPECT_EQ(second, DisplayPath(YamlDir() / "w.yaml") +
+                        ":3:1: a second YAML document (after ---): a world file is one document; "
+                        "join the two, or put this one in a file of its own");
+  // A leading --- and an empty document after the last are no second one.
+  EXPECT_EQ(Yaml("---\na: 1\n").root()["a"].as<int>(), 1);
+  EXPECT_EQ(Yaml("a: 1\n---\n").root()["a"].as<int>(), 1);
+  fs::remove_all(YamlDir());
+}
+
 TEST(YamlTest, PlacesAreOneBasedLineAndColumn) {
   const YamlFile file = Yaml("a: 1\nb:\n  c: here\n");
   EXPECT_EQ(file.name(), DisplayPath(YamlDir() / "w.yaml"));
