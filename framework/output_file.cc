@@ -34,7 +34,34 @@ std::string CannotWrite(const std::filesystem::path& path) {
          (error != 0 ? std::string(": ") + std::strerror(error) : std::string());
 }
 
-std::string TryWriteFileAtomically(const std::filesystem::path& path, std::string_view bytes) {
+std::string NotAnOrdinaryFile(const std::filesystem::path& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::file_status status = fs::status(path, ec);  // through symbolic links
+  if (ec || !fs::exists(status) || fs::is_regular_file(status)) return "";
+  const char* what = fs::is_directory(status)        ? "a folder"
+                     : fs::is_character_file(status) ? "a device"
+                     : fs::is_block_file(status)     ? "a device"
+                     : fs::is_fifo(status)           ? "a named pipe"
+                     : fs::is_socket(status)         ? "a socket"
+                                                     : "no ordinary file";
+  return std::string("it is ") + what + ", not an ordinary file";
+}
+
+std::string TryWriteFileAtomically(const std::filesystem::path& given, std::string_view bytes) {
+  namespace fs = std::filesystem;
+  // A device, a pipe or a folder is not replaced by a file (--save-state
+  // /dev/null turned the system's /dev/null into one); a symbolic link is
+  // written through, its target replaced, not the link.
+  if (std::string reason = NotAnOrdinaryFile(given); !reason.empty()) return reason;
+  std::error_code ec;
+  fs::path path = given;
+  for (int links = 0; fs::is_symlink(path, ec); ++links) {  // to a file not there yet too
+    if (links == 40) return "it is a loop of symbolic links";
+    const fs::path target = fs::read_symlink(path, ec);
+    if (ec) return ec.message();
+    path = target.is_absolute() ? target : path.parent_path() / target;
+  }
   std::filesystem::path partial = path;
   partial += ".partial";
   const int fd = ::open(partial.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);

@@ -334,8 +334,11 @@ class World final : public PhaseHandlers {
   // steps from here. Starts the world if it has not started, and rebuilds
   // the dynamics engine from the scene (world_state.h: why). Throws
   // swarmsim::Error naming what cannot be saved (a robot's Lua script, a
-  // native controller, a module or type without save hooks).
-  std::string SaveState();
+  // native controller, a module or type without save hooks). `taken`:
+  // samples TakeMetrics already handed out that the state carries too, ahead
+  // of those not yet taken (swarmsim run passes its metrics.csv's rows, so
+  // that the run resumed from the state writes the whole history).
+  std::string SaveState(std::span<const MetricSample> taken = {});
   // Puts the world in the state `bytes` hold (from SaveState of a world
   // loaded from the same file and settings, any seed). Throws
   // swarmsim::Error for bytes of another world, corrupt or truncated ones,

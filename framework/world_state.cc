@@ -116,6 +116,14 @@ std::string World::SnapshotRefusal() const {
         rows->size() > 0)
       return "objects of type '" + std::string(type.name) + "' have state that cannot be saved yet";
   }
+  // A module that would refuse (a camera's renderer, graphs, a recording),
+  // asked now (its bytes thrown away). Those every world has are installed
+  // as it starts: swarmsim run asks again then, before the first step.
+  for (const ModuleEntry& e : modules_) {
+    StateWriter scratch;
+    if (!e.instance->SaveState(*this, &scratch))
+      return "the world's module '" + e.name + "' cannot save its state";
+  }
   return "";
 }
 
@@ -199,7 +207,7 @@ void World::RebuildDynamics() {
   dynamics_->MarkSimulatedJoints(&scene_);
 }
 
-std::string World::SaveState() {
+std::string World::SaveState(std::span<const MetricSample> taken) {
   if (failed_) throw Error("snapshot: the world stopped after an error");
   if (stopped_) throw Error("snapshot: the world was stopped");
   if (const std::string why = SnapshotRefusal(); !why.empty()) throw Error("snapshot: " + why);
@@ -222,14 +230,16 @@ std::string World::SaveState() {
   for (const RobotRuntime& rt : runtimes_) out.PutBytes(rt.rng.state(), sizeof(Rng));
   out.PutBytes(scene_runtime_.rng.state(), sizeof(Rng));
   SaveWrittenParameters(&out);
-  out.Put<uint64_t>(metrics_.size());
-  for (const MetricSample& m : metrics_) {
-    out.Put(m.step);
-    out.Put(m.time);
-    out.Put(m.instance);
-    out.PutString(m.name);
-    out.Put(m.value);
-  }
+  out.Put<uint64_t>(taken.size() + metrics_.size());
+  for (const std::span<const MetricSample> samples :
+       {taken, std::span<const MetricSample>(metrics_)})
+    for (const MetricSample& m : samples) {
+      out.Put(m.step);
+      out.Put(m.time);
+      out.Put(m.instance);
+      out.PutString(m.name);
+      out.Put(m.value);
+    }
   for (const ModuleEntry& e : modules_) {
     const size_t before = out.bytes().size();
     out.Put<uint64_t>(0);  // the module's bytes, below

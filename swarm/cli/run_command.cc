@@ -19,6 +19,7 @@
 
 #include "framework/error.h"
 #include "framework/memory_forecast.h"
+#include "framework/output_file.h"
 #include "framework/plugin_loader.h"
 #include "framework/registry.h"
 #include "framework/sanitizers.h"
@@ -341,6 +342,14 @@ std::string FileClash(const std::string& flag, const std::string& file, const Ru
   if (!other_file.empty() && path == fs::weakly_canonical(fs::absolute(other_file, ec), ec))
     return flag + ": '" + file + "' is " + other_flag + "'s file too: name two files";
   if (fs::is_directory(path, ec)) return flag + ": '" + file + "' is a folder: name a file";
+  // The world file (overwritten by the state, exit 0), and for the state,
+  // written beside its name and renamed over it, a device or a pipe
+  // (--save-state /dev/null turned the system's /dev/null into a file).
+  if (fs::equivalent(path, args.world_file, ec))
+    return flag + ": '" + file + "' is the world file: name another file";
+  if (flag == "--save-state")
+    if (const std::string why = NotAnOrdinaryFile(path); !why.empty())
+      return flag + ": '" + file + "': " + why + ": name a file";
   // Its folder: there already, or --out (made before the run). (--video's
   // is checked as the recorder opens it, also before the run.)
   const fs::path folder = path.parent_path();
@@ -496,6 +505,20 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
                 << ": the video is H.264 in an MP4 container whatever the file is called "
                    "(name it .mp4 for players that go by the name)\n";
   }
+  // A snapshot holds no recording, video or pictures to go on with: refused
+  // before the run, naming the option (the module's refusal came after it).
+  if (!args.save_state.empty() || !args.load_state.empty()) {
+    std::string with;
+    if (recording)
+      with = !recording->video.empty() ? "--video" : "--snapshot-every";
+    else if (args.record || args.view)
+      with = args.view ? "--view" : "--record";
+    if (!with.empty())
+      return bad_input(std::string(args.load_state.empty() ? "--save-state" : "--load-state") +
+                       ": not with " + with +
+                       ": a snapshot holds no recording, video or pictures to go on with; "
+                       "record the run without saving its state, or save it without recording");
+  }
   // An --out folder an earlier run wrote to: its files go before this run
   // writes any (else old snapshots and video sit beside new metrics).
   if (options.out_dir)
@@ -518,7 +541,12 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
   }
   // The recording (swarm/record): --record or the world's record: setting.
   record::RunRecorder* run_recorder = nullptr;
-  if (args.record || args.view || loaded.record_every > 0) {
+  const bool snapshots = !args.save_state.empty() || !args.load_state.empty();
+  if (snapshots && loaded.record_every > 0 && options.out_dir)
+    std::cerr << "note: the world's record: setting is not followed with "
+              << (args.load_state.empty() ? "--save-state" : "--load-state")
+              << " (a snapshot holds no recording to go on with): no recording.swrec\n";
+  if (args.record || args.view || (loaded.record_every > 0 && !snapshots)) {
     if (!options.out_dir) {
       if (args.record || args.view)
         return bad_input(std::string(args.view ? "--view" : "--record") +
@@ -561,6 +589,13 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
                        ": " + why);
   }
   if (!args.load_state.empty()) {
+    // A folder threw from the read; a device or a pipe never ended
+    // (/dev/zero filled memory).
+    std::error_code ec;
+    if (!std::filesystem::exists(args.load_state, ec))
+      return bad_input("--load-state: there is no file '" + args.load_state + "'");
+    if (const std::string why = NotAnOrdinaryFile(args.load_state); !why.empty())
+      return bad_input("--load-state: '" + args.load_state + "': " + why);
     std::ifstream in(args.load_state, std::ios::binary);
     if (!in) return bad_input("--load-state: cannot read '" + args.load_state + "'");
     const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};

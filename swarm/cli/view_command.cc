@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "framework/error.h"
+#include "framework/output_file.h"
 #include "framework/utf8.h"
 #include "swarm/cli/commands.h"
 #include "swarm/cli/options.h"
@@ -60,6 +61,24 @@ int ViewCommand(const ViewArgs& args) {
               << "' is not a folder: give the output folder of a run (swarmsim run WORLD --out "
                  "DIR --record)\n";
     return kExitBadInput;
+  }
+  // The page is written beside its name and renamed over it: not over the
+  // run's own files (it replaced the recording it was made from), a device
+  // or a pipe.
+  if (!args.export_file.empty()) {
+    const fs::path target = fs::weakly_canonical(fs::absolute(args.export_file, error), error);
+    const fs::path folder = fs::weakly_canonical(fs::absolute(args.folder, error), error);
+    for (const char* own : {"recording.swrec", "summary.json", "metrics.csv"})
+      if (target == folder / own) {
+        std::cerr << "error: --export: '" << ValidUtf8(args.export_file) << "' is the run's own "
+                  << own << " in '" << ValidUtf8(args.folder) << "': name another file\n";
+        return kExitBadInput;
+      }
+    if (const std::string why = NotAnOrdinaryFile(target); !why.empty()) {
+      std::cerr << "error: --export: '" << ValidUtf8(args.export_file) << "': " << why
+                << ": name a file\n";
+      return kExitBadInput;
+    }
   }
   // Serving scans the chunks (and the JSON of header, scene and end chunks):
   // the page decodes the step records as it plays, following a run in

@@ -575,7 +575,9 @@ void RunRecorder::Record(const World& world, std::vector<MetricSample>* out) {
     r.samples.push_back({r.MetricId(m.name), m.instance, static_cast<uint32_t>(m.step), m.value});
   }
   r.metrics_seen = out->size();
-  if (step % r.settings.every != 0) return;
+  // Every N steps, and the run's last: the viewer shows where it ended
+  // (with every: 3, a 10-step run ended on step 9).
+  if (step % r.settings.every != 0 && step != r.settings.steps_planned) return;
   r.WriteStep(world);
 }
 

@@ -20,11 +20,11 @@ class World;
 namespace swarmsim::record {
 
 struct RecordSettings {
-  std::filesystem::path out_dir;  // the file is out_dir/recording.swrec
-  int64_t every = 1;              // a step record every N world steps
-  int64_t keyframe_every = 100;   // a keyframe every K step records
-  std::string world_file;         // as given to swarmsim run
-  int64_t steps_planned = 0;
+  std::filesystem::path out_dir;          // the file is out_dir/recording.swrec
+  int64_t every = 1;                      // a step record every N world steps
+  int64_t keyframe_every = 100;           // a keyframe every K step records
+  std::string world_file;                 // as given to swarmsim run
+  int64_t steps_planned = 0;              // the run's last step: recorded whatever `every` says
   std::vector<std::string> metric_names;  // the world's metrics: entries, known at the start
   int zstd_level = 3;
   // What one chunk may hold, decompressed: what every reader accepts (tests lower it).

@@ -20,6 +20,7 @@
 #include <iomanip>
 #include <iostream>
 #include <map>
+#include <new>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
@@ -471,17 +472,25 @@ void StepWatched(World* world, const RunOptions& options, Clock::time_point star
       world->settings().instruction_budget, end_stuck_run);
   // Outputs of the step just done, then the next unit of work for the
   // watchdog's message; under its lock, so it never writes at the same time.
+  // --save-state: the samples taken before the state is saved, which it
+  // carries (a run resumed from it writes the whole history to its
+  // metrics.csv; it held the rows from the saved step on only).
+  std::vector<MetricSample> taken;
+  bool state_saved = false;
   const auto take_metrics = [&] {
     if (!metrics && !options.on_metrics) return;  // kept in the world
     const std::vector<MetricSample> samples = world->TakeMetrics();
     if (metrics) metrics->Write(samples);
     if (options.on_metrics) options.on_metrics(samples);
+    if (options.save_state && !state_saved)
+      taken.insert(taken.end(), samples.begin(), samples.end());
   };
   const auto done = [&](std::string next, bool step) {
     const std::lock_guard lock(watchdog.io_mutex());
     take_metrics();
     watchdog.Progress(std::move(next), step);
   };
+  bool started = false;  // for the out-of-memory message
   const auto step_name = [&] {
     return "step " + std::to_string(result.steps + 1) + " of " + std::to_string(options.steps);
   };
@@ -501,6 +510,13 @@ void StepWatched(World* world, const RunOptions& options, Clock::time_point star
     }
     const Clock::time_point starting = Clock::now();
     world->Start();
+    started = true;
+    // What a started world alone shows (its modules: a camera's renderer,
+    // graphs) refuses the snapshot now, before the first step, not after
+    // the last.
+    if (options.save_state)
+      if (const std::string why = world->SnapshotRefusal(); !why.empty())
+        throw Error("--save-state: " + why);
     result.start_seconds = std::chrono::duration<double>(Clock::now() - starting).count();
     result.first_step = world->step_count();
     // --save-state: the world's state after step save_state_at (-1: the last).
@@ -509,11 +525,13 @@ void StepWatched(World* world, const RunOptions& options, Clock::time_point star
       const int64_t at =
           options.save_state_at >= 0 ? options.save_state_at : result.first_step + options.steps;
       if (world->step_count() != at) return;
-      const std::string bytes = world->SaveState();
+      const std::string bytes = world->SaveState(taken);
       if (const std::string reason = TryWriteFileAtomically(*options.save_state, bytes);
           !reason.empty())
         throw Error("--save-state: cannot write '" + options.save_state->string() + "': " + reason);
       result.saved_step = at;
+      state_saved = true;
+      std::vector<MetricSample>().swap(taken);
     };
     save_state();
     done(options.steps > 0 ? step_name() : "the stop of the world", options.steps > 0);
@@ -542,6 +560,16 @@ void StepWatched(World* world, const RunOptions& options, Clock::time_point star
   } catch (const std::exception& e) {
     const std::lock_guard lock(watchdog.io_mutex());
     result.error = e.what();
+    // "std::bad_alloc" named nothing.
+    if (dynamic_cast<const std::bad_alloc*>(&e) != nullptr)
+      result.error =
+          "out of memory " +
+          (!started                       ? std::string("as the world started")
+           : result.steps < options.steps ? "in step " + std::to_string(world->step_count() + 1)
+                                          : std::string("at the end of the run")) +
+          " (the machine, a ulimit or --max-memory gave no more; what grows besides "
+          "the robots: cameras' and vision sensors' images, paint, graphs, the "
+          "scripts' data)";
     // The states are still open after an error: what they held then.
     lua_kib = static_cast<double>(world->script_memory_bytes()) / 1024.0;
     take_metrics();  // whatever was recorded before the error
@@ -590,6 +618,10 @@ void PrintSummaryTable(const World& world, const RunOptions& options, const RunR
 
 void CreateOutputFolder(const std::filesystem::path& dir) {
   std::error_code ec;
+  if (const std::filesystem::file_status looped = std::filesystem::status(dir, ec);
+      ec == std::make_error_condition(std::errc::too_many_symbolic_link_levels) &&
+      !std::filesystem::exists(looped))
+    throw Error("'" + dir.string() + "' is a loop of symbolic links; pass a folder");
   if (std::filesystem::is_symlink(dir, ec) && !std::filesystem::exists(dir, ec))
     throw Error("'" + dir.string() + "' is a symbolic link to '" +
                 std::filesystem::read_symlink(dir, ec).string() +
@@ -598,6 +630,12 @@ void CreateOutputFolder(const std::filesystem::path& dir) {
     throw Error("'" + dir.string() + "' is not a folder; pass a folder (it is made if missing)");
   std::filesystem::create_directories(dir, ec);
   if (ec) throw Error("cannot create output folder '" + dir.string() + "': " + ec.message());
+  // The run's own files there: a pipe named summary.json hung the run (its
+  // writer waits for a reader), a folder threw a stream's error naming none.
+  for (const char* own : {"summary.json", "metrics.csv", "recording.swrec"})
+    if (const std::string why = NotAnOrdinaryFile(dir / own); !why.empty())
+      throw Error("'" + (dir / own).string() + "': " + why + ", and the run writes its " + own +
+                  " there; remove it or pass another folder");
 }
 
 std::string OutputsOfFinishedSteps(int64_t steps, const std::filesystem::path& dir) {
@@ -610,6 +648,8 @@ std::string OutputsOfFinishedSteps(int64_t steps, const std::filesystem::path& d
 
 std::string RemoveEarlierOutputs(const std::filesystem::path& dir) {
   namespace fs = std::filesystem;
+  std::error_code error;
+  if (!fs::is_regular_file(dir / "summary.json", error)) return "";  // a pipe's read would wait
   std::ifstream in(dir / "summary.json");
   if (!in) return "";
   const nlohmann::json j = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <csignal>
@@ -50,6 +51,28 @@ TEST(OutputFileTest, WritesAndReplacesWholeFilesLeavingNothingElse) {
   WriteFileAtomically(dir / "summary.json", "{}\n");
   EXPECT_EQ(Read(dir / "summary.json"), "{}\n");
   EXPECT_EQ(OtherFiles(dir, "summary.json"), 0) << "no partial file left behind";
+  fs::remove_all(dir);
+}
+
+// Written beside its name and renamed over it, the file replaced whatever
+// was there: a pipe, a device (--save-state /dev/null), a symbolic link.
+TEST(OutputFileTest, PipesAndFoldersAreRefusedAndLinksWrittenThrough) {
+  const fs::path dir = FreshDir("special");
+  ASSERT_EQ(::mkfifo((dir / "pipe").c_str(), 0600), 0);
+  EXPECT_EQ(TryWriteFileAtomically(dir / "pipe", "x"), "it is a named pipe, not an ordinary file");
+  EXPECT_TRUE(fs::is_fifo(dir / "pipe"));
+  fs::create_directories(dir / "folder");
+  EXPECT_EQ(TryWriteFileAtomically(dir / "folder", "x"), "it is a folder, not an ordinary file");
+  EXPECT_EQ(NotAnOrdinaryFile("/dev/null"), "it is a device, not an ordinary file");
+  EXPECT_EQ(NotAnOrdinaryFile(dir / "none"), "");
+  fs::create_symlink(dir / "target.json", dir / "link.json");
+  EXPECT_EQ(TryWriteFileAtomically(dir / "link.json", "{}\n"), "");
+  EXPECT_TRUE(fs::is_symlink(dir / "link.json"));
+  EXPECT_EQ(Read(dir / "target.json"), "{}\n");
+  fs::create_symlink(dir / "loop_a", dir / "loop_b");
+  fs::create_symlink(dir / "loop_b", dir / "loop_a");
+  EXPECT_NE(TryWriteFileAtomically(dir / "loop_a", "x"), "");
+  EXPECT_TRUE(fs::is_symlink(dir / "loop_a"));
   fs::remove_all(dir);
 }
 

@@ -2,6 +2,7 @@
 // holding the recording's whole chunks, and what cannot be shown is
 // refused before anything is served or written.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <cctype>
 #include <filesystem>
@@ -92,6 +93,35 @@ TEST(ViewCommandTest, WhatCannotBeShownIsRefusedFirst) {
                  (dir / "no/such/folder/x.html").string());
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_NE(r.output.find("error: "), std::string::npos) << r.output;
+  fs::remove_all(dir);
+}
+
+// The page is renamed over its name: it replaced the recording it was made
+// from (record-info then said "not a swarmsim recording"), or a pipe.
+TEST(ViewCommandTest, ThePageGoesOverNoneOfTheRunsFilesNorAPipe) {
+  const fs::path dir = TempDir("own_files");
+  fs::copy(kRecordings / "diffusion", dir / "run", fs::copy_options::recursive);
+  const std::string recording = ReadFile(dir / "run" / "recording.swrec");
+  Result r = RunProgram("view " + (dir / "run").string() + " --export " +
+                        (dir / "run" / "recording.swrec").string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("is the run's own recording.swrec in '"), std::string::npos) << r.output;
+  EXPECT_EQ(ReadFile(dir / "run" / "recording.swrec"), recording);
+  // Through a symbolic link to it, the same.
+  fs::create_symlink(dir / "run" / "recording.swrec", dir / "link.html");
+  r = RunProgram("view " + (dir / "run").string() + " --export " + (dir / "link.html").string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_EQ(ReadFile(dir / "run" / "recording.swrec"), recording);
+  ASSERT_EQ(::mkfifo((dir / "pipe").c_str(), 0600), 0);
+  r = RunProgram("view " + (dir / "run").string() + " --export " + (dir / "pipe").string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("it is a named pipe, not an ordinary file"), std::string::npos)
+      << r.output;
+  EXPECT_TRUE(fs::is_fifo(dir / "pipe"));
+  // Into the run's folder under another name: written.
+  r = RunProgram("view " + (dir / "run").string() + " --export " +
+                 (dir / "run" / "page.html").string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
   fs::remove_all(dir);
 }
 

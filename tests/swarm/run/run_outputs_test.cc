@@ -40,6 +40,31 @@ std::vector<std::string> Lines(const std::string& text) {
   return lines;
 }
 
+// Memory that ran out said "error: std::bad_alloc" (summary.json too),
+// naming neither when nor what might have taken it: here a camera of
+// 8192 x 8192 pixels under a 1 GB address-space cap.
+TEST(RunOutputsTest, RunningOutOfMemorySaysWhenAndWhatGrows) {
+  const std::string cap = swarmsim::testing::AddressSpaceLimit(1000000);
+  if (cap.empty()) GTEST_SKIP() << "no address-space cap under AddressSanitizer";
+  const fs::path dir = TempDir("oom");
+  fs::create_directories(dir);
+  std::ofstream(dir / "w.yaml") << "simulation: {physics: kinematic, time_step: 0.1}\n"
+                                   "objects:\n  - {name: cam, type: vision_sensor, "
+                                   "resolution: [8192, 8192], position: [0, 0, 1]}\n";
+  const auto r = swarmsim::testing::RunCommand(cap + std::string(SWARMSIM_BINARY) + " run " +
+                                               (dir / "w.yaml").string() + " --steps 2 --out " +
+                                               (dir / "out").string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("error: out of memory as the world started (the machine, a ulimit or "
+                          "--max-memory gave no more; what grows besides the robots: cameras' "
+                          "and vision sensors' images"),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(ReadFile(dir / "out" / "summary.json").find("out of memory as the world started"),
+            std::string::npos);
+  fs::remove_all(dir);
+}
+
 TEST(RunOutputsTest, MetricNamesAreCsvQuotedAndNanIsSpelledNan) {
   const fs::path out = TempDir("csv");
   const auto r =
