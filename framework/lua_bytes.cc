@@ -1,9 +1,8 @@
 // ArgBytes (lua_bytes.h).
 #include "framework/lua_bytes.h"
 
-#include "lua.hpp"
-
 #include "framework/error.h"
+#include "lua.hpp"
 
 namespace swarmsim {
 
@@ -16,8 +15,7 @@ std::string StrayKey(lua_State* L, int index, lua_Integer n) {
   while (lua_next(L, index) != 0) {
     lua_pop(L, 1);  // the value
     int is_integer = 0;
-    const lua_Integer k =
-        lua_type(L, -1) == LUA_TNUMBER ? lua_tointegerx(L, -1, &is_integer) : 0;
+    const lua_Integer k = lua_type(L, -1) == LUA_TNUMBER ? lua_tointegerx(L, -1, &is_integer) : 0;
     if (!is_integer || k < 1 || k > n) {
       std::string key;  // appended: GCC 12 warns on "lit" + std::string chains (-Wrestrict)
       if (is_integer) {
@@ -85,11 +83,11 @@ std::vector<uint8_t> ArgBytes(lua_State* L, int arg, size_t max, const char* wha
   }
   const lua_Integer n = i - 1;
   if (const std::string key = StrayKey(L, table, n); !key.empty())
-    throw Error("the " + std::string(what) + " table has key " + key +
-                (n == 0 ? " but no t[1]"
-                        : " besides its bytes t[1]..t[" + std::to_string(n) + "]") +
-                ": a table of bytes is a sequence with no hole (nil is no byte: write 0) and "
-                "no other keys");
+    throw Error(
+        "the " + std::string(what) + " table has key " + key +
+        (n == 0 ? " but no t[1]" : " besides its bytes t[1]..t[" + std::to_string(n) + "]") +
+        ": a table of bytes is a sequence with no hole (nil is no byte: write 0) and "
+        "no other keys");
   return data;
 }
 

@@ -29,9 +29,8 @@ class InitializedCaster : public pybind11::detail::type_caster_base<T> {
         instance->get_value_and_holder(nullptr, /*throw_if_missing=*/false);
     if (!v_h || !v_h.holder_constructed()) {
       const std::string name = pybind11::str(pybind11::type::handle_of(src).attr("__name__"));
-      throw pybind11::type_error(name + " object was made by " + name + ".__new__ without " +
-                                 name + ".__init__: it holds nothing (make one with " + name +
-                                 "(...))");
+      throw pybind11::type_error(name + " object was made by " + name + ".__new__ without " + name +
+                                 ".__init__: it holds nothing (make one with " + name + "(...))");
     }
     return true;
   }

@@ -75,8 +75,9 @@ TEST_F(LuaBytesTest, BadElementsTooManyBytesAndOtherTypesAreRefused) {
   Bytes("{1, 2, 3, 4, 5, 6}", 4, &error);
   EXPECT_EQ(error, "6 bytes");
   Bytes("12", 4, &error);
-  EXPECT_EQ(error, "bad argument #1 (a string of bytes or a table of integers 0..255 expected, "
-                   "got number)");
+  EXPECT_EQ(error,
+            "bad argument #1 (a string of bytes or a table of integers 0..255 expected, "
+            "got number)");
 }
 
 }  // namespace
