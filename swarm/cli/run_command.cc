@@ -584,9 +584,13 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
   // Snapshots: checked (and a state loaded) before the run starts.
   if (!args.save_state.empty() || !args.load_state.empty()) {
     const std::string why = loaded.world->SnapshotRefusal();
+    // The advice says Python; this program runs no Python controller.
     if (!why.empty())
       return bad_input(std::string(args.load_state.empty() ? "--save-state" : "--load-state") +
-                       ": " + why);
+                       ": " + why +
+                       " (swarmsim run saves worlds whose robots run no script or controller; "
+                       "a world driven from Python saves with World.snapshot(), README "
+                       "\"Snapshots, reset and pickling\")");
   }
   if (!args.load_state.empty()) {
     // A folder threw from the read; a device or a pipe never ended

@@ -361,6 +361,12 @@ std::shared_ptr<const ScriptSource> ScriptCache::Get(const fs::path& path, const
   auto source = std::make_shared<ScriptSource>();
   source->path = DisplayPath(path);
   source->code = ReadFileOrThrow(path, "script file", where, text);
+  // Compiled Lua (luac's output): it said "script attempt to load a binary
+  // chunk (mode is 't')". Scripts load as source only.
+  if (source->code.starts_with("\x1bLua"))
+    throw Error(where + ": script '" + source->path +
+                "' is compiled Lua (a binary chunk, as luac writes it); scripts are read as "
+                "source only: give its .lua source");
   // A script that does not parse is the world's error, found as it loads
   // (exit 2, the file's line), not at start as every robot's.
   {

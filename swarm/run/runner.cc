@@ -327,6 +327,15 @@ bool OverwriteInPlace(const std::filesystem::path& path, std::string_view bytes)
   return ::close(fd) == 0 && ok;
 }
 
+// The simulated seconds this process ran: a run resumed from a state
+// (--load-state) counts its own steps, not the saved run's (its real-time
+// factor divided the whole history by its own wall time).
+double SimulatedThisRun(const World& world, const RunResult& result) {
+  return result.first_step > 0
+             ? world.time() - static_cast<double>(result.first_step) * world.settings().time_step
+             : world.time();
+}
+
 // summary.json, written whole or not at all (WriteFileAtomically); returns
 // "" or why it could not be written. `complete`: the world is between steps;
 // else a step is stuck (Watchdog) and what a running step may change is
@@ -366,7 +375,8 @@ std::string WriteSummary(const World& world, const RunOptions& options, const Ru
   j["wall_time"] = result.wall_seconds;
   j["start_time"] = result.start_seconds;  // of wall_time: starting the world
   if (options.load_seconds >= 0) j["load_time"] = options.load_seconds;  // before wall_time
-  j["real_time_factor"] = result.wall_seconds > 0 ? sim_time / result.wall_seconds : 0;
+  j["real_time_factor"] =
+      result.wall_seconds > 0 ? SimulatedThisRun(world, result) / result.wall_seconds : 0;
   j["robot_ticks_per_s"] = result.wall_seconds > 0 ? robot_ticks / result.wall_seconds : 0;
   j["peak_rss_mb"] = result.peak_rss_mb;
   j["huge_pages"] = HugePagesRequested();
@@ -582,7 +592,8 @@ void PrintSummaryTable(const World& world, const RunOptions& options, const RunR
   const int robots = world.live_robot_count();  // removed robots are not counted
   const double sim_time = world.time();
   const double robot_ticks = static_cast<double>(robots) * static_cast<double>(result.steps);
-  const double rtf = result.wall_seconds > 0 ? sim_time / result.wall_seconds : 0;
+  const double rtf =
+      result.wall_seconds > 0 ? SimulatedThisRun(world, result) / result.wall_seconds : 0;
   const double ticks_per_s = result.wall_seconds > 0 ? robot_ticks / result.wall_seconds : 0;
   if (result.first_step > 0)
     out << "resumed at      step " << result.first_step << " (--load-state)\n";

@@ -49,6 +49,11 @@ TEST(SaveStateTest, ResumedRunEndsWithTheHashOfTheUninterruptedOne) {
     const auto summary = nlohmann::json::parse(ReadFile(dir / "out" / "summary.json"));
     EXPECT_EQ(summary["resumed_from"]["step"], 12);
     EXPECT_EQ(summary["steps"], 18);
+    // The real-time factor is of this run's 1.8 s (it divided all 3 s of
+    // the history by this run's wall time), as robot-ticks/s counts 18 steps.
+    EXPECT_NEAR(summary["real_time_factor"].get<double>() * summary["wall_time"].get<double>(), 1.8,
+                1e-9);
+    EXPECT_NEAR(summary["simulated_time"].get<double>(), 3.0, 1e-9);
     // The resumed run's metrics.csv is the whole history, row for row (it
     // held the rows from step 10 on only, step 10's twice over the two files).
     const std::string history = ReadFile(fs::path(whole_out) / "metrics.csv");
@@ -82,6 +87,11 @@ TEST(SaveStateTest, WhatCannotBeSavedOrLoadedIsAnErrorBeforeTheRun) {
                               (dir / "x.bin").string());
   EXPECT_EQ(lua.exit_code, 2) << lua.output;
   EXPECT_NE(lua.output.find("robot 'footbot#0' runs Lua script"), std::string::npos) << lua.output;
+  // Its Python advice, placed for a program that runs no Python controller.
+  EXPECT_NE(lua.output.find("(swarmsim run saves worlds whose robots run no script or controller; "
+                            "a world driven from Python saves with World.snapshot()"),
+            std::string::npos)
+      << lua.output;
   EXPECT_FALSE(fs::exists(dir / "x.bin"));
   // Native controllers: the robot, the controller and its plugin named, and what to do.
   const auto native = RunProgram("run " + std::string(SWARMSIM_SOURCE_DIR) +

@@ -464,6 +464,12 @@ TEST_F(MalformedWorldTest, AScriptThatDoesNotParseIsNamedAsItLoads) {
   const std::string main_script = LoadText("simulation: {main_script: broken.lua}\n");
   EXPECT_NE(main_script.find("world.yaml:1:"), std::string::npos) << main_script;
   EXPECT_NE(main_script.find("broken.lua:2: unexpected symbol"), std::string::npos) << main_script;
+  // Compiled Lua: "script attempt to load a binary chunk (mode is 't')".
+  Write("compiled.lua", std::string("\x1bLua\x54\x00junk", 10));
+  const std::string compiled = LoadText("simulation: {main_script: compiled.lua}\n");
+  EXPECT_NE(compiled.find("compiled.lua' is compiled Lua (a binary chunk, as luac writes it)"),
+            std::string::npos)
+      << compiled;
 }
 
 TEST_F(MalformedWorldTest, TabIndentationSaysYamlDoesNotAllowTabs) {
