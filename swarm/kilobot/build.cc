@@ -182,8 +182,12 @@ std::string RuntimeFolder() {
 int Build(const BuildOptions& options) {
   std::error_code ec;
   const fs::path source = fs::absolute(options.source, ec);
-  if (options.source.empty() || !fs::is_regular_file(source, ec))
+  if (options.source.empty() || !fs::exists(source, ec))
     throw Error("kilobot build: " + options.source + ": no such file");
+  if (!fs::is_regular_file(source, ec))  // a folder said "no such file"
+    throw Error("kilobot build: " + options.source + ": " +
+                (fs::is_directory(source, ec) ? "a folder" : "not an ordinary file") +
+                ": give the program's .c file");
   const std::string name = options.name.empty() ? source.stem().string() : options.name;
   if (!ValidName(name))
     throw Error("kilobot build: '" + name +

@@ -222,6 +222,13 @@ std::shared_ptr<const ModuleRegistry> WorldLoader::LoadPlugins(const Fields& top
     if (found == candidates.end()) {
       std::string tried;
       for (const fs::path& p : candidates) tried += (tried.empty() ? "" : ", ") + p.string();
+      // One that is there but no ordinary file (a folder, a link to a
+      // device) was "not found".
+      for (const fs::path& p : candidates)
+        if (fs::exists(p, ec))
+          values.Fail(element, "plugin '" + text + "': '" + p.string() +
+                                   "' is there but is no ordinary file (a folder, a device or a "
+                                   "pipe, perhaps through a link)");
       values.Fail(element, "plugin '" + text + "' not found (looked for " + tried + ")");
     }
     // Loaded already (--plugin): its commands are there.

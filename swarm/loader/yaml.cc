@@ -1,5 +1,7 @@
 #include "swarm/loader/yaml.h"
 
+#include <yaml-cpp/depthguard.h>
+
 #include <algorithm>
 #include <cctype>
 #include <memory>
@@ -20,8 +22,13 @@ std::string ReadFileOrThrow(const fs::path& path, std::string_view kind, const s
   const std::string looked =
       DisplayPath(path) != text ? " (looked for " + DisplayPath(path) + ")" : "";
   std::error_code ec;
-  if (!fs::exists(path, ec))
+  if (!fs::exists(path, ec)) {
+    // A loop of symbolic links "exists" no more than a missing file.
+    if (ec == std::make_error_condition(std::errc::too_many_symbolic_link_levels))
+      throw Error(prefix + std::string(kind) + " '" + text + "' is a loop of symbolic links" +
+                  looked);
     throw Error(prefix + std::string(kind) + " '" + text + "' not found" + looked);
+  }
   if (fs::is_directory(path, ec))
     throw Error(prefix + std::string(kind) + " '" + text + "' is a directory, not a file" + looked);
   // Not a device or a pipe (which could be read forever), and of a sane size.
@@ -157,8 +164,12 @@ YamlFile YamlFile::Load(const fs::path& path, std::string_view kind,
     if (!documents.empty()) file.root_ = documents.front();
     std::unordered_set<size_t> seen;
     CheckQuotes(file, text, file.root_, &seen);
+  } catch (const YAML::DeepRecursion& e) {
+    // Its message is "bad file".
+    file.Fail(e.mark,
+              "YAML nested too deep here (lists or mappings within each other hundreds of "
+              "levels down): more than yaml-cpp reads");
   } catch (const YAML::ParserException& e) {
-    // Includes yaml-cpp's DeepRecursion (nesting beyond its depth guard).
     const std::string hint =
         TabInIndentation(text, e.mark.line) ? " (YAML does not allow tabs for indentation)" : "";
     file.Fail(e.mark, "YAML syntax error: " + e.msg + hint);

@@ -40,6 +40,9 @@ SqliteDb::SqliteDb(const std::filesystem::path& path, bool read_only) : path_(pa
     name = FileUri(path) + "?immutable=1";
     flags |= SQLITE_OPEN_URI;
   }
+  // A folder gave SQLite's "disk I/O error".
+  if (std::filesystem::is_directory(path, ec))
+    throw Error("cannot open database '" + path.string() + "': it is a folder, not a file");
   if (sqlite3_open_v2(name.c_str(), &db_, flags, nullptr) != SQLITE_OK) {
     const std::string message = db_ ? sqlite3_errmsg(db_) : "out of memory";
     sqlite3_close(db_);

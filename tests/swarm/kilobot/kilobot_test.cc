@@ -581,6 +581,11 @@ int main() { kilo_init(); kilo_start(setup, loop); return 0; }
   const CommandResult missing = RunProgram("kilobot build " + (dir / "none.c").string());
   EXPECT_EQ(missing.exit_code, 2);
   EXPECT_NE(missing.output.find("none.c: no such file"), std::string::npos) << missing.output;
+  // A folder ("no such file" too).
+  const CommandResult folder = RunProgram("kilobot build " + dir.string());
+  EXPECT_EQ(folder.exit_code, 2);
+  EXPECT_NE(folder.output.find(": a folder: give the program's .c file"), std::string::npos)
+      << folder.output;
   fs::remove_all(dir);
 }
 

@@ -454,5 +454,24 @@ TEST(ExamplesTest, EpuckDiffusionKeepsTheRobotsApartByTheirIrSensors) {
             RunWorld("epuck_diffusion.yaml", 2, 200).hash);
 }
 
+// A plugin name that is there but no library file (a folder, a link to a
+// device) was "not found".
+TEST(ExamplesTest, APluginThatIsNoOrdinaryFileIsNamedSo) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                    ("swarmsim_plugin_folder_" + std::to_string(getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir / "p.so");
+  std::ofstream(dir / "world.yaml") << "simulation: {physics: kinematic, time_step: 0.1}\n"
+                                       "plugins: [p]\n";
+  const auto [status, text] =
+      swarmsim::testing::RunProgram("run " + (dir / "world.yaml").string() + " --steps 1");
+  EXPECT_EQ(status, 2) << text;
+  EXPECT_NE(
+      text.find("plugin 'p': '" + (dir / "p.so").string() + "' is there but is no ordinary file"),
+      std::string::npos)
+      << text;
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace swarmsim

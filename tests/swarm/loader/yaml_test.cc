@@ -85,6 +85,21 @@ TEST(YamlTest, AQuoteLeftOpenIsNamedWhereItOpens) {
   fs::remove_all(YamlDir());
 }
 
+// Nesting past yaml-cpp's depth guard said "YAML syntax error: bad file";
+// a loop of symbolic links said "not found".
+TEST(YamlTest, DeepNestingAndLinkLoopsSayWhatTheyAre) {
+  const std::string deep = ErrorOf([] { Yaml("a: " + std::string(3000, '[')); });
+  EXPECT_NE(deep.find("YAML nested too deep here"), std::string::npos) << deep;
+  fs::create_directories(YamlDir());
+  fs::create_symlink(YamlDir() / "b.yaml", YamlDir() / "a.yaml");
+  fs::create_symlink(YamlDir() / "a.yaml", YamlDir() / "b.yaml");
+  const std::string loop =
+      ErrorOf([] { YamlFile::Load(YamlDir() / "a.yaml", "world file", "", "a.yaml"); });
+  EXPECT_EQ(loop, "world file 'a.yaml' is a loop of symbolic links (looked for " +
+                      DisplayPath(YamlDir() / "a.yaml") + ")");
+  fs::remove_all(YamlDir());
+}
+
 // A second document (after ---) was never read: its keys went unchecked.
 TEST(YamlTest, ASecondDocumentIsRefused) {
   const std::string second = ErrorOf([] { Yaml("simulation: {steps: 2}\n---\nbogus_key: 1\n"); });

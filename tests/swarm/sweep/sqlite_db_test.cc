@@ -67,6 +67,10 @@ TEST(SqliteDbTest, ErrorsNameTheDatabaseAndWhatWasAsked) {
             }).rfind("cannot open database '" + (dir / "none.db").string() + "': ", 0),
             0u);
   EXPECT_FALSE(fs::exists(dir / "none.db")) << "read-only opening creates nothing";
+  fs::create_directories(dir / "folder.db");  // SQLite said "disk I/O error"
+  EXPECT_EQ(
+      ErrorOf([&] { SqliteDb folder(dir / "folder.db"); }),
+      "cannot open database '" + (dir / "folder.db").string() + "': it is a folder, not a file");
   SqliteDb db(file);
   const std::string exec = ErrorOf([&] { db.Exec("CREATE TABLE"); });
   EXPECT_EQ(exec.rfind("database '" + file.string() + "': ", 0), 0u) << exec;
