@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "framework/error.h"
+#include "framework/regular_file.h"
 
 namespace swarmsim {
 namespace {
@@ -32,20 +33,6 @@ std::string CannotWrite(const std::filesystem::path& path) {
   const int error = errno;
   return "cannot write '" + path.string() + "'" +
          (error != 0 ? std::string(": ") + std::strerror(error) : std::string());
-}
-
-std::string NotAnOrdinaryFile(const std::filesystem::path& path) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  const fs::file_status status = fs::status(path, ec);  // through symbolic links
-  if (ec || !fs::exists(status) || fs::is_regular_file(status)) return "";
-  const char* what = fs::is_directory(status)        ? "a folder"
-                     : fs::is_character_file(status) ? "a device"
-                     : fs::is_block_file(status)     ? "a device"
-                     : fs::is_fifo(status)           ? "a named pipe"
-                     : fs::is_socket(status)         ? "a socket"
-                                                     : "no ordinary file";
-  return std::string("it is ") + what + ", not an ordinary file";
 }
 
 std::string TryWriteFileAtomically(const std::filesystem::path& given, std::string_view bytes) {

@@ -22,13 +22,9 @@ void WriteFileAtomically(const std::filesystem::path& path, std::string_view byt
 // As WriteFileAtomically, but returns the reason instead of throwing: "" when
 // written. For paths that must not throw (a run's last words). Both refuse
 // a path that is a device, a named pipe, a socket or a folder
-// (NotAnOrdinaryFile), and write through a symbolic link (its target is
+// (NotAnOrdinaryFile, regular_file.h), and write through a symbolic link (its target is
 // replaced, the link stays).
 std::string TryWriteFileAtomically(const std::filesystem::path& path, std::string_view bytes);
-
-// "it is a device, not an ordinary file" when `path` (through symbolic
-// links) is there and is no regular file; "" when it is one or is not there.
-std::string NotAnOrdinaryFile(const std::filesystem::path& path);
 
 // "cannot write 'PATH': REASON", REASON from errno as an open or a write of
 // PATH just left it (nothing when errno is 0): for a stream that would not

@@ -22,6 +22,12 @@ std::string FileTypeName(mode_t mode) {
 
 }  // namespace
 
+std::string NotAnOrdinaryFile(const std::filesystem::path& path) {
+  struct stat status {};
+  if (::stat(path.c_str(), &status) != 0 || S_ISREG(status.st_mode)) return "";
+  return "it is " + FileTypeName(status.st_mode) + ", not an ordinary file";
+}
+
 std::unique_ptr<RegularFile> RegularFile::Open(const std::filesystem::path& path,
                                                std::string* why) {
   // O_NONBLOCK: opening a FIFO for reading returns at once instead of

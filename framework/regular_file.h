@@ -33,4 +33,11 @@ class RegularFile {
   int fd_;
 };
 
+// "it is a FIFO (named pipe), not an ordinary file" when `path` (through
+// symbolic links) is there and is no regular file (a folder, a device, a
+// pipe, a socket); "" when it is one or is not there. For the writers that
+// replace a file by renaming over it (output_file.h) and the checks of
+// files the command line names.
+std::string NotAnOrdinaryFile(const std::filesystem::path& path);
+
 }  // namespace swarmsim

@@ -19,9 +19,9 @@
 
 #include "framework/error.h"
 #include "framework/memory_forecast.h"
-#include "framework/output_file.h"
 #include "framework/plugin_loader.h"
 #include "framework/registry.h"
+#include "framework/regular_file.h"
 #include "framework/sanitizers.h"
 #include "framework/scheduler.h"
 #include "framework/utf8.h"
@@ -31,6 +31,7 @@
 #include "swarm/loader/world_loader.h"
 #include "swarm/record/writer.h"
 #include "swarm/run/file_lock.h"
+#include "swarm/run/output_folder.h"
 #include "swarm/run/runner.h"
 #include "swarm/run/stop_signals.h"
 #include "swarm/viewer/server.h"
@@ -334,7 +335,9 @@ std::string FileClash(const std::string& flag, const std::string& file, const Ru
   const fs::path path = fs::weakly_canonical(fs::absolute(file, ec), ec);
   if (!args.out_dir.empty()) {
     const fs::path out = fs::weakly_canonical(fs::absolute(args.out_dir, ec), ec);
-    for (const char* own : {"summary.json", "metrics.csv", "recording.swrec", "snapshots"})
+    std::vector<std::string> own_names(kRunOwnFiles.begin(), kRunOwnFiles.end());
+    own_names.push_back("snapshots");
+    for (const std::string& own : own_names)
       if (path == out / own)
         return flag + ": '" + file + "' is this run's own " + own + " (--out " + args.out_dir +
                "): name another file";
@@ -593,16 +596,15 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
                        "\"Snapshots, reset and pickling\")");
   }
   if (!args.load_state.empty()) {
-    // A folder threw from the read; a device or a pipe never ended
-    // (/dev/zero filled memory).
-    std::error_code ec;
-    if (!std::filesystem::exists(args.load_state, ec))
-      return bad_input("--load-state: there is no file '" + args.load_state + "'");
-    if (const std::string why = NotAnOrdinaryFile(args.load_state); !why.empty())
-      return bad_input("--load-state: '" + args.load_state + "': " + why);
-    std::ifstream in(args.load_state, std::ios::binary);
-    if (!in) return bad_input("--load-state: cannot read '" + args.load_state + "'");
-    const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    // A regular file only (a folder threw from the read; a device or a pipe
+    // never ended: /dev/zero filled memory).
+    std::string why;
+    const std::unique_ptr<RegularFile> file = RegularFile::Open(args.load_state, &why);
+    const int64_t size = file ? file->CurrentSize() : -1;
+    std::string bytes(std::max<int64_t>(size, 0), '\0');
+    if (!file || size < 0 || !file->ReadAt(0, bytes.data(), bytes.size(), &why))
+      return bad_input("--load-state: cannot read '" + args.load_state + "'" +
+                       (why.empty() ? "" : ": " + why));
     try {
       loaded.world->RestoreState(bytes);
     } catch (const Error& e) {

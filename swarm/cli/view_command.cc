@@ -5,11 +5,12 @@
 #include <iostream>
 
 #include "framework/error.h"
-#include "framework/output_file.h"
+#include "framework/regular_file.h"
 #include "framework/utf8.h"
 #include "swarm/cli/commands.h"
 #include "swarm/cli/options.h"
 #include "swarm/record/reader.h"
+#include "swarm/run/output_folder.h"
 #include "swarm/viewer/page.h"
 #include "swarm/viewer/server.h"
 
@@ -68,7 +69,7 @@ int ViewCommand(const ViewArgs& args) {
   if (!args.export_file.empty()) {
     const fs::path target = fs::weakly_canonical(fs::absolute(args.export_file, error), error);
     const fs::path folder = fs::weakly_canonical(fs::absolute(args.folder, error), error);
-    for (const char* own : {"recording.swrec", "summary.json", "metrics.csv"})
+    for (const char* own : kRunOwnFiles)
       if (target == folder / own) {
         std::cerr << "error: --export: '" << ValidUtf8(args.export_file) << "' is the run's own "
                   << own << " in '" << ValidUtf8(args.folder) << "': name another file\n";

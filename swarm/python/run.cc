@@ -15,6 +15,7 @@
 #include "framework/utf8.h"
 #include "swarm/python/world.h"
 #include "swarm/run/file_lock.h"
+#include "swarm/run/output_folder.h"
 #include "swarm/run/runner.h"
 
 namespace swarmsim::python {

@@ -88,24 +88,6 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
 std::string WriteErrorSummary(const RunOptions& options, const std::string& error,
                               const std::string& status = "error");
 
-// The line after a failed run's error: "outputs of the 3 steps that
-// finished are in DIR" ("of the 1 step", "(no step finished)"), counting as
-// the progress bar does (the error named step 4).
-std::string OutputsOfFinishedSteps(int64_t steps, const std::filesystem::path& dir);
-
-// Creates the run's output folder (and its parents). Throws swarmsim::Error
-// naming it when it cannot (a file of that name: "'DIR' is not a folder").
-void CreateOutputFolder(const std::filesystem::path& dir);
-
-// A run with --out DIR where an earlier run wrote: removes the files that
-// run's summary.json lists as its outputs (snapshots, video, recording,
-// graphs; paths inside DIR only) and the folders they leave empty, so that
-// DIR holds one run, not a mix; for a run killed before its end (summary
-// status "running", nothing listed), the files under a run's own names
-// (recording.swrec, video.mp4, snapshots/, graphs/). Returns the note to
-// print ("" if there was nothing), naming what went.
-std::string RemoveEarlierOutputs(const std::filesystem::path& dir);
-
 // Peak resident set size of this process, in MiB.
 double PeakRssMb();
 

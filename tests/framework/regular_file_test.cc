@@ -51,5 +51,21 @@ TEST(RegularFileTest, AFifoAFolderAndAMissingFileAreRefusedSayingWhat) {
   fs::remove_all(dir);
 }
 
+// What a writer that renames over a file must not replace (--save-state
+// /dev/null made the system's /dev/null a file), named; through links.
+TEST(RegularFileTest, WhatIsNoOrdinaryFileIsNamedAndTheRestIsNot) {
+  const fs::path dir = FreshDir();
+  ASSERT_EQ(::mkfifo((dir / "pipe").c_str(), 0600), 0);
+  EXPECT_EQ(NotAnOrdinaryFile(dir / "pipe"), "it is a FIFO (named pipe), not an ordinary file");
+  EXPECT_EQ(NotAnOrdinaryFile(dir), "it is a folder, not an ordinary file");
+  EXPECT_EQ(NotAnOrdinaryFile("/dev/null"), "it is a character device, not an ordinary file");
+  fs::create_symlink("/dev/null", dir / "null");
+  EXPECT_EQ(NotAnOrdinaryFile(dir / "null"), "it is a character device, not an ordinary file");
+  std::ofstream(dir / "data") << "x";
+  EXPECT_EQ(NotAnOrdinaryFile(dir / "data"), "");
+  EXPECT_EQ(NotAnOrdinaryFile(dir / "missing"), "");
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace swarmsim

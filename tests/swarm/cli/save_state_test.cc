@@ -167,7 +167,7 @@ TEST(SaveStateTest, DevicesPipesFoldersAndTheWorldFileAreNoStateFiles) {
       RunCommand(program + " run " + world + " --steps 1 --save-state " + (dir / "pipe").string());
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("--save-state: '" + (dir / "pipe").string() +
-                          "': it is a named pipe, not an ordinary file: name a file"),
+                          "': it is a FIFO (named pipe), not an ordinary file: name a file"),
             std::string::npos)
       << r.output;
   EXPECT_TRUE(fs::is_fifo(dir / "pipe"));
@@ -187,11 +187,10 @@ TEST(SaveStateTest, DevicesPipesFoldersAndTheWorldFileAreNoStateFiles) {
                 .exit_code,
             0);
   for (const auto& [file, what] :
-       {std::pair{dir / "models", "a folder"}, std::pair{dir / "pipe", "a named pipe"}}) {
+       {std::pair{dir / "models", "a folder"}, std::pair{dir / "pipe", "a FIFO (named pipe)"}}) {
     r = RunCommand(program + " run " + world + " --steps 1 --load-state " + file.string());
     EXPECT_EQ(r.exit_code, 2) << r.output;
-    EXPECT_NE(r.output.find("--load-state: '" + file.string() + "': it is " + what +
-                            ", not an ordinary file"),
+    EXPECT_NE(r.output.find("--load-state: cannot read '" + file.string() + "': " + what),
               std::string::npos)
         << r.output;
   }
@@ -209,7 +208,7 @@ TEST(SaveStateTest, DevicesPipesFoldersAndTheWorldFileAreNoStateFiles) {
   ASSERT_EQ(::mkfifo((dir / "out2" / "metrics.csv").c_str(), 0600), 0);
   r = RunCommand(program + " run " + world + " --steps 1 --out " + (dir / "out2").string());
   EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_NE(r.output.find("it is a named pipe, not an ordinary file, and the run writes its "
+  EXPECT_NE(r.output.find("it is a FIFO (named pipe), not an ordinary file, and the run writes its "
                           "metrics.csv there"),
             std::string::npos)
       << r.output;

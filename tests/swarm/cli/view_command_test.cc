@@ -115,7 +115,7 @@ TEST(ViewCommandTest, ThePageGoesOverNoneOfTheRunsFilesNorAPipe) {
   ASSERT_EQ(::mkfifo((dir / "pipe").c_str(), 0600), 0);
   r = RunProgram("view " + (dir / "run").string() + " --export " + (dir / "pipe").string());
   EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_NE(r.output.find("it is a named pipe, not an ordinary file"), std::string::npos)
+  EXPECT_NE(r.output.find("it is a FIFO (named pipe), not an ordinary file"), std::string::npos)
       << r.output;
   EXPECT_TRUE(fs::is_fifo(dir / "pipe"));
   // Into the run's folder under another name: written.
