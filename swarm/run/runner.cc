@@ -36,6 +36,7 @@
 #include "framework/utf8.h"
 #include "swarm/run/huge_pages.h"
 #include "swarm/run/output_folder.h"
+#include "swarm/run/step_progress.h"
 #include "swarm/run/stop_signals.h"
 #include "swarm/run/version.h"
 
@@ -241,62 +242,6 @@ class Watchdog {
   std::thread thread_;  // last: starts once the members above exist
 };
 
-// A progress bar on a terminal; a plain line every 10% otherwise.
-class Progress {
- public:
-  Progress(std::ostream& os, int64_t total, bool enabled, bool tty,
-           std::function<std::string()> note)
-      : os_(os),
-        total_(total),
-        enabled_(enabled),
-        tty_(tty),
-        note_(std::move(note)),
-        start_(Clock::now()) {}
-
-  void Update(int64_t done, double sim_time) {
-    if (!enabled_ || total_ <= 0) return;
-    const auto now = Clock::now();
-    const int decile = static_cast<int>(10 * done / total_);
-    if (tty_) {
-      if (done != total_ && now - last_ < std::chrono::milliseconds(100)) return;
-    } else if (decile == last_decile_) {
-      return;
-    }
-    last_ = now;
-    last_decile_ = decile;
-    const double wall = std::chrono::duration<double>(now - start_).count();
-    const double frac = static_cast<double>(done) / static_cast<double>(total_);
-    const double eta = done > 0 ? wall * (1 - frac) / frac : 0;
-    std::ostringstream line;
-    line << std::fixed << std::setprecision(1);
-    if (tty_) {
-      constexpr int kWidth = 30;
-      const int filled = static_cast<int>(frac * kWidth);
-      line << "\r[" << std::string(filled, '#') << std::string(kWidth - filled, ' ') << "] ";
-    }
-    line << std::setw(3) << static_cast<int>(100 * frac) << "%  step " << done << "/" << total_
-         << "  sim " << sim_time << " s  " << (wall > 0 ? sim_time / wall : 0) << "x real time"
-         << "  ETA " << eta << " s";
-    if (note_)
-      if (const std::string note = note_(); !note.empty()) line << "  " << note;
-    if (tty_) line << "\x1b[K";  // the rest of a longer line before
-    os_ << line.str() << (tty_ ? "" : "\n") << std::flush;
-  }
-  void Finish() {
-    if (enabled_ && tty_) os_ << "\n" << std::flush;
-  }
-
- private:
-  std::ostream& os_;
-  int64_t total_;
-  bool enabled_;
-  bool tty_;
-  std::function<std::string()> note_;
-  Clock::time_point start_;
-  Clock::time_point last_{};
-  int last_decile_ = -1;
-};
-
 // "box2d, 10 substeps"; "kinematic" (no physics engine steps: no substeps).
 std::string PhysicsLine(const World& world) {
   const WorldSettings& settings = world.settings();
@@ -444,11 +389,14 @@ struct RunRecord {
 // metrics as it goes. A failure ends up in record->result (ok false, error);
 // a step that never finishes ends the process (the Watchdog's end_run).
 void StepWatched(World* world, const RunOptions& options, Clock::time_point start,
-                 Progress* progress_bar, RunRecord* record) {
+                 StepProgress* progress_bar, RunRecord* record) {
   RunResult& result = record->result;
   std::unique_ptr<MetricsWriter>& metrics = record->metrics;
   double& lua_kib = record->lua_kib;
-  Progress& progress = *progress_bar;
+  StepProgress& progress = *progress_bar;
+  const auto seconds = [start] {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+  };
   // A step that never finishes: write what a failed run writes and exit.
   const auto end_stuck_run = [&](const std::string& error, int signal) {
     RunResult stuck = result;
@@ -531,6 +479,7 @@ void StepWatched(World* world, const RunOptions& options, Clock::time_point star
         throw Error("--save-state: " + why);
     result.start_seconds = std::chrono::duration<double>(Clock::now() - starting).count();
     result.first_step = world->step_count();
+    progress.Begin(world->time(), seconds());
     // --save-state: the world's state after step save_state_at (-1: the last).
     const auto save_state = [&] {
       if (!options.save_state) return;
@@ -562,7 +511,7 @@ void StepWatched(World* world, const RunOptions& options, Clock::time_point star
       save_state();
       done(result.steps < options.steps ? step_name() : "the stop of the world",
            result.steps < options.steps);
-      progress.Update(result.steps, world->time());
+      progress.Update(result.steps, world->time(), seconds());
     }
     lua_kib =
         static_cast<double>(world->script_memory_bytes()) / 1024.0;  // before the states close
@@ -610,7 +559,7 @@ void PrintSummaryTable(const World& world, const RunOptions& options, const RunR
   if (options.load_seconds >= 0)
     out << "load time       " << Fixed(options.load_seconds, 3)
         << " s before that (reading the world, building its robots)\n";
-  out << "real-time factor " << Fixed(rtf, 1) << "x\n"
+  out << "real-time factor " << RealTimeFactorText(rtf) << "x\n"
       << "robot-ticks/s   " << Fixed(ticks_per_s, 0) << "\n"
       << "peak memory     " << Fixed(result.peak_rss_mb, 1) << " MiB ("
       << Fixed(robots > 0 ? result.peak_rss_mb * 1024 / robots : 0, 1)
@@ -658,7 +607,7 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
   RunResult& result = record.result;
   const auto start = Clock::now();
   const bool tty = isatty(STDERR_FILENO) && &progress_stream == &std::cerr;
-  Progress progress(progress_stream, options.steps, !options.quiet, tty, options.progress_note);
+  StepProgress progress(progress_stream, options.steps, !options.quiet, tty, options.progress_note);
   // SIGINT, SIGTERM and SIGHUP end the run at the next step boundary, with
   // its outputs written (or, for a stuck step, through the Watchdog).
   const StopSignals stop_signals;
