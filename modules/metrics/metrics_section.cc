@@ -3,6 +3,7 @@
 // one instance of a registered metric module (kind "metric": the swarm
 // metrics here, the colour-clustering ones of modules/blobs).
 #include <algorithm>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -28,6 +29,7 @@ void ReadMetrics(const ObjectReader& top, const WorldSectionContext&, World* wor
   for (const ModuleDescriptor* metric : world->registry().ModulesOfKind("metric"))
     known.push_back(metric->info.name);
   const std::vector<std::string> keys = {"name", "every"};
+  std::map<std::string, std::string> listed;  // metric -> where it is listed
   // A bare name (`- covered_area`) reads as {name: covered_area}.
   for (const std::unique_ptr<ObjectReader>& entry :
        top.Elements("metrics", "metrics", "a metric", "name")) {
@@ -39,6 +41,11 @@ void ReadMetrics(const ObjectReader& top, const WorldSectionContext&, World* wor
     spec.name = entry->String("name", /*required=*/true);
     if (std::find(known.begin(), known.end(), spec.name) == known.end())
       entry->Fail("name", "unknown metric '" + spec.name + "'" + Suggest(spec.name, known));
+    // metrics.csv has one column a metric: a second entry would be a second
+    // column of the same name.
+    if (const auto [first, added] = listed.emplace(spec.name, entry->Where("name")); !added)
+      entry->Fail("name", "'" + spec.name + "' is listed already, at " + first->second +
+                              ": list a metric once ('every' sets how often it is recorded)");
     try {
       world->AddModule(spec.name, &spec.every_steps);
     } catch (const Error& e) {

@@ -38,18 +38,23 @@ TEST_F(MetricsSectionTest, MetricsEntriesAddTheirModulesEveryNSteps) {
   WriteBot();
   LoadedWorld w = Load(
       "simulation: {physics: kinematic, time_step: 0.1}\narena: {size: 2}\n"
-      "models: [{model: bot.yaml, position: [0, 0]}]\n"
-      "metrics: [{name: covered_area, every: 10}, covered_area]\n");
-  EXPECT_EQ(w.metric_names, (std::vector<std::string>{"covered_area", "covered_area"}));
+      "models: [{model: bot.yaml, position: [-0.5, 0]}, {model: bot.yaml, position: [0.5, 0]}]\n"
+      "metrics: [{name: covered_area, every: 10}, mean_nearest_neighbor_distance]\n");
+  EXPECT_EQ(w.metric_names,
+            (std::vector<std::string>{"covered_area", "mean_nearest_neighbor_distance"}));
   for (int i = 0; i < 20; ++i) w.world->Step();
-  int every_step = 0, tenth = 0;
+  int area = 0, nearest = 0;
   for (const MetricSample& m : w.world->TakeMetrics()) {
-    ASSERT_EQ(m.name, "covered_area");
-    ++every_step;
-    if (m.step % 10 == 0) ++tenth;
+    if (m.name == "covered_area") {
+      EXPECT_EQ(m.step % 10, 0) << m.step;
+      ++area;
+    } else {
+      ASSERT_EQ(m.name, "mean_nearest_neighbor_distance");
+      ++nearest;
+    }
   }
-  EXPECT_EQ(every_step, 20 + 2);  // each step's row, and steps 10 and 20 again
-  EXPECT_EQ(tenth, 4);
+  EXPECT_EQ(area, 2);  // steps 10 and 20
+  EXPECT_EQ(nearest, 20);
 }
 
 TEST_F(MetricsSectionTest, MetricsMistakesNameTheirPlace) {
@@ -60,6 +65,10 @@ TEST_F(MetricsSectionTest, MetricsMistakesNameTheirPlace) {
   ExpectHas(ErrorOfWorld("metrics: [{every: 3}]\n"),
             {"world.yaml:1:11:", "'name' is required in a metric"});
   ExpectHas(ErrorOfWorld("metrics: [{name: covered_area, every: 0}]\n"), {"world.yaml:1:39:"});
+  // A second entry of one metric would be a second column of its name.
+  ExpectHas(ErrorOfWorld("metrics: [{name: covered_area, every: 10},\n  covered_area]\n"),
+            {"world.yaml:2:3: 'covered_area' is listed already, at ",
+             "world.yaml:1:18: list a metric once"});
   ExpectHas(ErrorOfWorld("metrics: covered_area\n"),
             {"world.yaml:1:10:", "'metrics' must be a list of metrics"});
 }
