@@ -143,6 +143,17 @@ void WorldLoader::PlaceEntries(std::vector<std::string>* warnings) {
                   "this " + e.model->name + " at [" + loader::FormatNumber(X.p.x) + ", " +
                       loader::FormatNumber(X.p.y) +
                       "] overlaps a wall, an obstacle, the map or another placed copy");
+    // Clear of the walls and outside them: allowed (an observer, a beacon),
+    // but seldom meant (a coordinate of another, larger arena).
+    if (arena_ && (X.p.x < arena_->min_x || X.p.x > arena_->max_x || X.p.y < arena_->min_y ||
+                   X.p.y > arena_->max_y))
+      warnings->push_back(
+          file_->Where(e.position_field.mark) + ": this " + e.model->name + " at [" +
+          loader::FormatNumber(X.p.x) + ", " + loader::FormatNumber(X.p.y) +
+          "] stands outside the arena's walls (the arena is [" +
+          loader::FormatNumber(arena_->min_x) + ", " + loader::FormatNumber(arena_->min_y) +
+          "] to [" + loader::FormatNumber(arena_->max_x) + ", " +
+          loader::FormatNumber(arena_->max_y) + "])");
     placer_->AddBody(X.p.x, X.p.y, radius);
   }
   uint64_t stream = 0;

@@ -142,6 +142,29 @@ TEST_F(WorldCopiesTest, SpatialOrderNumbersTheDrawnCopiesAlongTheArena) {
       "to copies by number: use one or the other");
 }
 
+// A fixed copy clear of the walls but outside them loads (an observer, a
+// beacon may stand there), with a warning naming it and the arena's extent;
+// inside, near the inner edge or without an arena, nothing is said.
+TEST_F(WorldCopiesTest, ACopyPlacedOutsideTheArenaIsWarnedOf) {
+  const auto warnings = [&](const std::string& arena, const std::string& position) {
+    std::string all;
+    for (const std::string& w : Load("simulation: {physics: kinematic}\n" + arena +
+                                     "models: [{model: bot.yaml, position: " + position + "}]\n")
+                                    .warnings)
+      all += w + "\n";
+    return all;
+  };
+  EXPECT_CONTAINS(warnings("arena: {size: 4}\n", "[3, 0.5]"),
+                  "world.yaml:3:38: this bot at [3, 0.5] stands outside the arena's walls (the "
+                  "arena is [-2, -2] to [2, 2])");
+  EXPECT_CONTAINS(warnings("arena: {size: [4, 2]}\n", "[0, -1.5]"), "outside the arena's walls");
+  for (const auto& [arena, position] : {std::pair{"arena: {size: 4}\n", "[1.5, -1.5]"},
+                                        {"arena: {size: 4}\n", "[1.99, 0]"},
+                                        {"", "[30, 0]"}})
+    EXPECT_EQ(warnings(arena, position).find("outside the arena"), std::string::npos)
+        << arena << position;
+}
+
 TEST_F(WorldCopiesTest, CopiesThatCannotBePlacedApartAreNamedWithTheirCount) {
   Write("disc.yaml",
         "model: disc\nobjects: {name: body, type: shape, shape: cylinder, radius: 0.5, "
