@@ -19,11 +19,19 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string Megabytes(uint64_t bytes) {
+// "1.25 MB", "3.2 kB", "512 bytes": a short recording is not "0.00 MB".
+std::string SizeText(uint64_t bytes) {
   std::ostringstream out;
   out.setf(std::ios::fixed);
-  out.precision(2);
-  out << static_cast<double>(bytes) / 1e6 << " MB";
+  if (bytes < 1000) {
+    out << bytes << (bytes == 1 ? " byte" : " bytes");
+  } else if (bytes < 1000000) {
+    out.precision(1);
+    out << static_cast<double>(bytes) / 1e3 << " kB";
+  } else {
+    out.precision(2);
+    out << static_cast<double>(bytes) / 1e6 << " MB";
+  }
   return out.str();
 }
 
@@ -178,7 +186,7 @@ std::string RecordingInfo::Describe() const {
   out << file.string() << ": format " << version_major << "." << version_minor << ", "
       << step_records << " step record" << (step_records == 1 ? "" : "s");
   if (step_records > 0) out << " (steps " << first_step << ".." << last_step << ")";
-  out << ", " << Megabytes(valid_size);
+  out << ", " << SizeText(valid_size);
   if (ended) {
     out << "; the run ended (" << end_status;
     if (!end_error.empty()) out << ": " << end_error;

@@ -116,6 +116,10 @@ TEST(RecordingReaderTest, ANewerMajorVersionIsRefusedNamingBoth) {
   const RecordingInfo info = ScanRecording(dir);
   EXPECT_EQ(info.version_minor, 7);
   EXPECT_EQ(info.step_records, 0);
+  // Its size in bytes, not "0.00 MB".
+  EXPECT_NE(info.Describe().find("0 step records, " + std::to_string(info.valid_size) + " bytes"),
+            std::string::npos)
+      << info.Describe();
   fs::remove_all(dir);
 }
 
