@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "tests/swarm/run_program.h"
+#include "tests/text_lines.h"
 
 extern char** environ;
 
@@ -34,10 +35,7 @@ fs::path TempDir(const std::string& name) {
 }
 
 std::vector<std::string> Lines(const std::string& text) {
-  std::vector<std::string> lines;
-  std::istringstream in(text);
-  for (std::string line; std::getline(in, line);) lines.push_back(line);
-  return lines;
+  return swarmsim::testing::TextLines(text);
 }
 
 // Memory that ran out said "error: std::bad_alloc" (summary.json too),

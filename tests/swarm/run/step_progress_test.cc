@@ -11,14 +11,13 @@
 #include <string>
 #include <vector>
 
+#include "tests/text_lines.h"
+
 namespace swarmsim {
 namespace {
 
 std::vector<std::string> Lines(const std::string& text) {
-  std::vector<std::string> lines;
-  std::istringstream in(text);
-  for (std::string line; std::getline(in, line);) lines.push_back(line);
-  return lines;
+  return swarmsim::testing::TextLines(text);
 }
 
 TEST(StepProgressTest, EtaAndFactorAreOfTheStepsAloneNotTheStart) {
