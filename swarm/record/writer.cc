@@ -26,6 +26,15 @@ namespace {
 
 using nlohmann::json;
 
+// A chunk's JSON text. Names and texts from the world (a parameter's value,
+// a script's error message holding a binary payload) may be bytes that are
+// not UTF-8: they are written with U+FFFD in their place (json's dump()
+// threw: the recording failed a run that ran without it, and its end chunk,
+// with the script's error, was never written).
+std::string JsonText(const json& j) {
+  return j.dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
 // The hook that says what an object of a type looks like (framework/visual.h).
 using VisualHook = void (*)(const Scene&, ObjectType, uint32_t, ObjectVisual*);
 
@@ -344,7 +353,7 @@ void RunRecorder::Impl::BuildScene() {
       tracked.push_back(t);
     }
     const uint32_t count = static_cast<uint32_t>(tracked.size()) - first;
-    std::string key = list.dump();
+    std::string key = JsonText(list);
     auto [it, added] = template_of.emplace(std::move(key), templates.size());
     if (added) templates.push_back({{"objects", std::move(list)}});
     json entry = {{"index", i},
@@ -397,7 +406,7 @@ void RunRecorder::Impl::BuildScene() {
                   {"robots", std::move(robots)},
                   {"objects", std::move(objects)},
                   {"meshes", std::move(meshes)}};
-  file->AddScene(static_cast<uint32_t>(world->step_count()), j.dump(), std::move(lists));
+  file->AddScene(static_cast<uint32_t>(world->step_count()), JsonText(j), std::move(lists));
 }
 
 // This step's poses, and colours and ray lengths as the objects' types
@@ -555,7 +564,7 @@ void RunRecorder::Start(World* world) {
   r.world = world;
   r.paint = world->floor_layer();
   for (const std::string& name : r.settings.metric_names) r.MetricId(name);
-  r.file->AddJson(static_cast<uint8_t>(ChunkKind::kHeader), 0, r.Header().dump());
+  r.file->AddJson(static_cast<uint8_t>(ChunkKind::kHeader), 0, JsonText(r.Header()));
   r.WriteStep(*world);
 }
 
@@ -597,7 +606,8 @@ void RunRecorder::Finish(int64_t steps, const std::string& status, const std::st
   json j = {{"steps", steps}, {"status", status}};
   if (!error.empty()) j["error"] = error;
   try {
-    r.file->AddJson(static_cast<uint8_t>(ChunkKind::kEnd), static_cast<uint32_t>(steps), j.dump());
+    r.file->AddJson(static_cast<uint8_t>(ChunkKind::kEnd), static_cast<uint32_t>(steps),
+                    JsonText(j));
     r.file->Flush();
   } catch (const Error&) {
     // The steps before are all there; a viewer just does not learn that the run ended.

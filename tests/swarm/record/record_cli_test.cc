@@ -86,6 +86,47 @@ TEST(RecordCliTest, TheWorldsRecordSettingRecordsEveryNthStep) {
 
 // A run killed with SIGKILL in the middle leaves every step record written
 // before intact: the reader decodes them all.
+// Text from the world that is not UTF-8 (a Latin-1 parameter value, a
+// script's error holding a binary payload) is recorded with U+FFFD in its
+// place, as summary.json has it. The recorder threw (json's type_error 316):
+// the parameter failed a run that ran without --record, and the script's
+// error was replaced by the recorder's and the end chunk never written.
+TEST(RecordCliTest, TextThatIsNotUtf8IsRecordedAsInTheOtherOutputs) {
+  const fs::path dir = FreshTempDir("record_cli", "latin1");
+  fs::create_directories(dir);
+  std::ofstream(dir / "world.yaml") << "simulation: {physics: kinematic, time_step: 0.1}\n"
+                                       "parameters: {label: \"caf\xe9\"}\n"
+                                       "models:\n  - {model: bot.yaml, position: [0, 0]}\n";
+  std::ofstream(dir / "bot.yaml")
+      << "model: bot\nparameters:\n  tag: {default: \"x\xe9y\"}\n"
+         "objects: {name: body, type: shape, shape: box, size: [0.1, 0.1, 0.1], script: "
+         "bot.lua}\n";
+  std::ofstream(dir / "bot.lua") << "function sysCall_actuation()\n"
+                                    "  if sim.getSimulationTime() > 0.25 then\n"
+                                    "    error('unexpected payload ' .. string.char(0xfe, 1))\n"
+                                    "  end\n"
+                                    "end\n";
+  const fs::path out = dir / "out";
+  const auto r = RunProgram("run " + (dir / "world.yaml").string() +
+                            " --steps 10 --quiet --record --out " + out.string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("bot.lua:3: unexpected payload \xef\xbf\xbd"), std::string::npos)
+      << r.output;
+  EXPECT_EQ(r.output.find("json"), std::string::npos) << r.output;
+  const auto info = RunProgram("record-info " + out.string());
+  EXPECT_EQ(info.exit_code, 0) << info.output;
+  EXPECT_NE(info.output.find("the run ended (error: "), std::string::npos) << info.output;
+  EXPECT_NE(info.output.find("unexpected payload \xef\xbf\xbd"), std::string::npos) << info.output;
+  // Without the error: the run ends ok, as it does without --record.
+  std::ofstream(dir / "bot.lua") << "function sysCall_actuation() end\n";
+  const auto ok = RunProgram("run " + (dir / "world.yaml").string() +
+                             " --steps 3 --quiet --record --out " + out.string());
+  EXPECT_EQ(ok.exit_code, 0) << ok.output;
+  EXPECT_NE(RunProgram("record-info " + out.string()).output.find("the run ended (ok)"),
+            std::string::npos);
+  fs::remove_all(dir);
+}
+
 TEST(RecordCliTest, KillMinusNineLeavesAReadableRecording) {
   const fs::path out = FreshTempDir("record_cli", "kill");
   const pid_t pid = fork();
