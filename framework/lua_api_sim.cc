@@ -8,6 +8,7 @@
 
 #include "framework/error.h"
 #include "framework/lua_api.h"
+#include "framework/registry.h"
 #include "framework/world.h"
 
 namespace swarmsim {
@@ -72,6 +73,15 @@ int RecordMetric(lua_State* L) {
   // A NUL byte went into metrics.csv as it was (CSV readers stop there).
   if (std::memchr(name, '\0', length) != nullptr)
     throw Error("the metric name holds a NUL byte ('\\0'): a metric name is text");
+  // A swarm metric of this world's `metrics:` under the same name: its rows
+  // (robot empty) and the robots' would be one metric to a sweep, which
+  // averaged the swarm's value in as one more robot.
+  if (const std::string_view n(name, length); c.world->find_module(n) != nullptr)
+    if (const ModuleDescriptor* d = c.world->registry().FindModule(n);
+        d && d->info.kind == "metric")
+      throw Error("'" + std::string(n) +
+                  "' is a swarm metric this world records (its 'metrics:' list): give the "
+                  "robot's metric another name");
   // What the sample holds in C++: the robot's vector of samples as it
   // grows (its capacity, charged when it doubles: the slots it really
   // holds, not just the ones used) and the name's own block when it is too

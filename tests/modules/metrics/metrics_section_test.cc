@@ -57,6 +57,31 @@ TEST_F(MetricsSectionTest, MetricsEntriesAddTheirModulesEveryNSteps) {
   EXPECT_EQ(nearest, 20);
 }
 
+// A robot's metric under the name of a swarm metric the world records is a
+// script error naming both: a sweep's series took the two as one metric
+// and averaged the swarm's value in as one more robot.
+TEST_F(MetricsSectionTest, ARobotsMetricNamedAsTheWorldsSwarmMetricIsAnError) {
+  Write("bot.yaml", "model: bot\nobjects: {name: body, type: dummy, script: bot.lua}\n");
+  Write("bot.lua", "function sysCall_actuation() sim.recordMetric('covered_area', 1) end\n");
+  const std::string world =
+      "simulation: {physics: kinematic, time_step: 0.1}\narena: {size: 2}\n"
+      "models: [{model: bot.yaml, position: [0, 0]}]\n";
+  LoadedWorld w = Load(world + "metrics: [covered_area]\n");
+  std::string error = "(no error)";
+  try {
+    w.world->Step();
+  } catch (const Error& e) {
+    error = e.what();
+  }
+  ExpectHas(error, {"bot.lua:1:", "'covered_area' is a swarm metric this world records"});
+  // A world that does not list it: the robot's metric is its own.
+  LoadedWorld own = Load(world);
+  own.world->Step();
+  int rows = 0;
+  for (const MetricSample& m : own.world->TakeMetrics()) rows += m.name == "covered_area";
+  EXPECT_EQ(rows, 1);
+}
+
 TEST_F(MetricsSectionTest, MetricsMistakesNameTheirPlace) {
   ExpectHas(ErrorOfWorld("metrics: [covered_aera]\n"),
             {"world.yaml:1:11:", "unknown metric 'covered_aera'", "did you mean 'covered_area'?"});
