@@ -122,6 +122,11 @@ void WorldLoader::KeepPlacementClearOfTheMap(std::vector<std::string>* warnings)
 }
 
 void WorldLoader::PlaceEntries(std::vector<std::string>* warnings) {
+  const auto arena_text = [this] {
+    return "(the arena is [" + loader::FormatNumber(arena_->min_x) + ", " +
+           loader::FormatNumber(arena_->min_y) + "] to [" + loader::FormatNumber(arena_->max_x) +
+           ", " + loader::FormatNumber(arena_->max_y) + "])";
+  };
   // Fixed copies first, so distributed ones keep clear of them wherever they are listed.
   for (EntryPlan& e : entries_) {
     if (e.distribute) continue;
@@ -147,18 +152,24 @@ void WorldLoader::PlaceEntries(std::vector<std::string>* warnings) {
     // but seldom meant (a coordinate of another, larger arena).
     if (arena_ && (X.p.x < arena_->min_x || X.p.x > arena_->max_x || X.p.y < arena_->min_y ||
                    X.p.y > arena_->max_y))
-      warnings->push_back(
-          file_->Where(e.position_field.mark) + ": this " + e.model->name + " at [" +
-          loader::FormatNumber(X.p.x) + ", " + loader::FormatNumber(X.p.y) +
-          "] stands outside the arena's walls (the arena is [" +
-          loader::FormatNumber(arena_->min_x) + ", " + loader::FormatNumber(arena_->min_y) +
-          "] to [" + loader::FormatNumber(arena_->max_x) + ", " +
-          loader::FormatNumber(arena_->max_y) + "])");
+      warnings->push_back(file_->Where(e.position_field.mark) + ": this " + e.model->name +
+                          " at [" + loader::FormatNumber(X.p.x) + ", " +
+                          loader::FormatNumber(X.p.y) + "] stands outside the arena's walls " +
+                          arena_text());
     placer_->AddBody(X.p.x, X.p.y, radius);
   }
   uint64_t stream = 0;
   for (EntryPlan& e : entries_) {
     if (!e.distribute) continue;
+    // A region reaching past the walls: the copies drawn there stand
+    // outside them (as a fixed copy outside, allowed and seldom meant).
+    const Region2& r = e.region;
+    if (arena_ && e.region_field.present() &&
+        (r.min_x < arena_->min_x || r.max_x > arena_->max_x || r.min_y < arena_->min_y ||
+         r.max_y > arena_->max_y))
+      warnings->push_back(file_->Where(e.region_field.mark) + ": " + e.region_text +
+                          " reaches outside the arena's walls " + arena_text() + ": " +
+                          e.model->name + " copies drawn there stand outside them");
     if (e.lattice) {
       int64_t bad = -1;
       e.placements =

@@ -428,7 +428,16 @@ void WorldLoader::ResolveObjects(const Fields& f, const ValueReader& world_value
   const ModelFile& model = *entry->model;
   const std::shared_ptr<ParameterSet>& params = entry->parameters;
   const ValueReader model_values(model.file, &expressions_, {&parameters_, params.get()});
-  entry->spec = loader::ResolveModel(model, model_values, &scripts_, &meshes_, world_registry_);
+  try {
+    entry->spec = loader::ResolveModel(model, model_values, &scripts_, &meshes_, world_registry_);
+  } catch (const Error& e) {
+    // A value of the model file may be the entry's (`script: $controller`
+    // with `parameters: {controller: ...}`): the message names the model
+    // file's line, which the user did not write.
+    if (!f.Has("parameters")) throw;
+    throw Error(std::string(e.what()) + " (with the parameters of the models entry given at " +
+                file_->Where(f.Get("parameters").mark) + ")");
+  }
   ExtendObjects(f, world_values, *entry, &entry->spec);
   entry->footprint = loader::ComputeFootprint(entry->spec);
   if (f.Has("scale")) {
@@ -614,6 +623,7 @@ void WorldLoader::ReadDistribution(const Fields& f, const ValueReader& world_val
     if (!(lo[0] < hi[0] && lo[1] < hi[1]))
       file_->Fail(r.Get("max").mark, "'region' needs max greater than min in x and in y");
     entry->region = {lo[0], lo[1], hi[0], hi[1]};
+    entry->region_field = region;
     using loader::FormatNumber;
     entry->region_text = "the region from [" + FormatNumber(lo[0]) + ", " + FormatNumber(lo[1]) +
                          "] to [" + FormatNumber(hi[0]) + ", " + FormatNumber(hi[1]) + "]";

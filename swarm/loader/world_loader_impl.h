@@ -74,6 +74,7 @@ struct EntryPlan {
   int64_t count = 1;
   Region2 region;
   std::string region_text;  // "the arena", "the region [..] - [..]"
+  Field region_field;       // distribute.region as {min, max} (absent: the arena)
   double clearance = 0;
   std::optional<double> heading;
   // distribute.order: spatial: copies numbered along a space-filling curve

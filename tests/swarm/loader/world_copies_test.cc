@@ -144,8 +144,9 @@ TEST_F(WorldCopiesTest, SpatialOrderNumbersTheDrawnCopiesAlongTheArena) {
 
 // A fixed copy clear of the walls but outside them loads (an observer, a
 // beacon may stand there), with a warning naming it and the arena's extent;
-// inside, near the inner edge or without an arena, nothing is said.
-TEST_F(WorldCopiesTest, ACopyPlacedOutsideTheArenaIsWarnedOf) {
+// inside, near the inner edge or without an arena, nothing is said. So
+// does a region to distribute copies in that reaches past the walls.
+TEST_F(WorldCopiesTest, CopiesPlacedOutsideTheArenaAreWarnedOf) {
   const auto warnings = [&](const std::string& arena, const std::string& position) {
     std::string all;
     for (const std::string& w : Load("simulation: {physics: kinematic}\n" + arena +
@@ -163,6 +164,24 @@ TEST_F(WorldCopiesTest, ACopyPlacedOutsideTheArenaIsWarnedOf) {
                                         {"", "[30, 0]"}})
     EXPECT_EQ(warnings(arena, position).find("outside the arena"), std::string::npos)
         << arena << position;
+  // A region to distribute in that reaches past the walls: copies drawn
+  // there stand outside (it said nothing).
+  const auto distributed = [&](const std::string& region) {
+    std::string all;
+    for (const std::string& w : Load("simulation: {physics: kinematic}\narena: {size: 4}\n"
+                                     "models: [{model: bot.yaml, count: 3, distribute: {region: " +
+                                     region + "}}]\n")
+                                    .warnings)
+      all += w + "\n";
+    return all;
+  };
+  EXPECT_CONTAINS(distributed("{min: [3, 3], max: [6, 6]}"),
+                  "world.yaml:3:59: the region from [3, 3] to [6, 6] reaches outside the "
+                  "arena's walls (the arena is [-2, -2] to [2, 2]): bot copies drawn there "
+                  "stand outside them");
+  for (const std::string region :
+       {"{min: [-2, -2], max: [2, 2]}", "{min: [0, 0], max: [1, 1]}", "arena"})
+    EXPECT_EQ(distributed(region).find("outside the arena"), std::string::npos) << region;
 }
 
 TEST_F(WorldCopiesTest, CopiesThatCannotBePlacedApartAreNamedWithTheirCount) {

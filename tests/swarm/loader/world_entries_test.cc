@@ -185,6 +185,28 @@ TEST_F(ControlLoaderTest, RangesAndInstanceMistakesNameFileLineAndColumn) {
   EXPECT_CONTAINS(ErrorOf(kThree), "bot.yaml:3:32: 'range' must be [min, max]");
 }
 
+// A model file's value that the entry's parameters give (`script:
+// $controller`) fails at the model file's line, which the user did not
+// write: the message says which entry's parameters it used.
+TEST_F(ControlLoaderTest, AModelValueFromTheEntrysParametersNamesTheEntry) {
+  Write("ctl.yaml",
+        "model: ctl\nparameters:\n  controller: {default: bot.lua}\n"
+        "objects: {name: body, type: dummy, script: $controller}\n");
+  const std::string world =
+      "simulation: {physics: kinematic}\n"
+      "models:\n"
+      "  - {model: ctl.yaml, position: [0, 0], parameters: {controller: nope.lua}}\n";
+  EXPECT_CONTAINS(ErrorOf(world), "ctl.yaml:4:44: script file 'nope.lua' not found");
+  EXPECT_CONTAINS(ErrorOf(world), " (with the parameters of the models entry given at " +
+                                      (dir_ / "world.yaml").string() + ":3:53)");
+  // Without entry parameters the model's own line says it all.
+  Write("ctl.yaml", "model: ctl\nobjects: {name: body, type: dummy, script: nope.lua}\n");
+  EXPECT_EQ(ErrorOf("simulation: {physics: kinematic}\nmodels: [{model: ctl.yaml, position: [0, "
+                    "0]}]\n")
+                .find("with the parameters"),
+            std::string::npos);
+}
+
 TEST_F(ControlLoaderTest, EntryParametersAreOfTheirDeclaredType) {
   const std::string entry =
       "simulation: {physics: kinematic}\n"
