@@ -158,13 +158,16 @@ class ControllerModule : public Module {
     struct Expiry {
       Robots* robots;
       WorldGate* gate;
+      const WorldGate* outer;  // a controller of another world this one's runs inside
       ~Expiry() {
         robots->Expire();
         gate->in_controller = false;
+        running_controller = outer;
       }
-    } expiry{robots.get(), &gate};
+    } expiry{robots.get(), &gate, running_controller};
     gate.in_controller = true;
     gate.controller_thread = std::this_thread::get_id();
+    running_controller = &gate;
     try {
       py::object result = config_.function(py::cast(robots));
       gate.in_controller = false;

@@ -6,7 +6,10 @@
 
 #include <pybind11/pybind11.h>
 
+#include <atomic>
+#include <cstdint>
 #include <mutex>
+#include <stdexcept>
 #include <string>
 #include <thread>
 
@@ -39,13 +42,27 @@ struct WorldGate {
   // Python): a controller's KeyboardInterrupt or SystemExit also ends the
   // step with an error, so that the run stops and writes its outputs.
   bool in_run = false;
+  // The step_worlds() call holding this gate (0: none). A controller of one
+  // of its worlds that waited for another of them would wait for ever (the
+  // call holds every gate until all its worlds have stepped).
+  std::atomic<uint64_t> stepping_call{0};
 };
+
+// The gate of the world whose controller this thread is running (null: none).
+inline thread_local const WorldGate* running_controller = nullptr;
 
 // Holds a world's gate for one call (the GIL held on entry and exit).
 class GateLock {
  public:
   explicit GateLock(WorldGate* gate) : gate_(gate) {
     if (!gate_->mutex.try_lock()) {
+      const uint64_t call = gate_->stepping_call.load();
+      if (running_controller != nullptr && call != 0 &&
+          running_controller->stepping_call.load() == call)
+        throw std::runtime_error(
+            "this world is stepping in the same step_worlds() call as the world whose "
+            "controller asks: a controller there may read only its own world (read or step "
+            "the others between step_worlds() calls)");
       py::gil_scoped_release release;
       gate_->mutex.lock();
     }

@@ -205,6 +205,16 @@ void StepWorlds(const py::sequence& worlds, const py::object& count,
   std::sort(order.begin(), order.end());
   std::vector<std::unique_ptr<GateLock>> locks;
   for (PyWorld* w : order) locks.push_back(std::make_unique<GateLock>(w->gate()));
+  // This call's mark on its gates, taken off before they are unlocked.
+  static std::atomic<uint64_t> calls{0};
+  struct Marks {
+    const std::vector<PyWorld*>& worlds;
+    ~Marks() {
+      for (PyWorld* w : worlds) w->gate()->stepping_call.store(0);
+    }
+  } marks{order};
+  const uint64_t call = ++calls;
+  for (PyWorld* w : order) w->gate()->stepping_call.store(call);
   for (size_t i = 0; i < k; ++i) {
     try {
       list[i]->Live();

@@ -85,6 +85,37 @@ class StepWorldsTest(unittest.TestCase):
         swarmsim.step_worlds([worlds[0], worlds[2]], 1)
         self.assertEqual(worlds[0].steps, 9)
 
+    def test_a_controller_using_another_world_of_the_same_call_raises_not_hangs(self):
+        # step_worlds holds every listed world's gate until all have stepped: a controller
+        # that read or stepped another of them waited for ever (Ctrl-C could not stop it).
+        # Run in a child with a timeout, so that a regression fails instead of hanging.
+        script = """
+import swarmsim
+W = %r
+for call in ("poses", "step"):
+    other = swarmsim.World(W, set={"robots": 4}, threads=1)
+    def ctl(robots, other=other, call=call):
+        getattr(other, call)()
+        return {}
+    w = swarmsim.World(W, set={"robots": 4}, threads=1, controllers={"footbot": ctl})
+    w.step()  # alone: reading or stepping another world is fine
+    try:
+        swarmsim.step_worlds([w, other], 1, threads=2)
+    except RuntimeError as e:
+        print(call, "raised:", e)
+    print(call, "steps", w.steps, other.steps)
+""" % DIFFUSION
+        import subprocess
+        import sys
+        p = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                           timeout=120)
+        self.assertEqual(p.returncode, 0, p.stdout + p.stderr)
+        for call in ("poses", "step"):
+            self.assertIn(f"{call} raised: step_worlds: worlds[0]", p.stdout)
+        self.assertIn("a controller there may read only its own world", p.stdout)
+        # The world whose controller failed stopped; the other stepped.
+        self.assertIn("poses steps 1 1", p.stdout)
+
     def test_zero_steps_and_an_empty_list_do_nothing(self):
         w = make(1)
         swarmsim.step_worlds([w], 0)
