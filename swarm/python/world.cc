@@ -264,6 +264,11 @@ void PyWorld::Close() {
   } catch (const Error&) {
   }
   loaded_.world.reset();  // the controllers' functions are released with the GIL held
+  // And the constructor's copies (kept for pickling and reset): a controller
+  // that refers to its World made a cycle through C++ that Python's
+  // collector cannot see, kept after close() (330 KiB a World of 8 robots).
+  args_.controllers.clear();
+  args_.set.clear();
 }
 
 void PyWorld::NotFromController(const char* call) const {
