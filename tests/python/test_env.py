@@ -241,7 +241,9 @@ class ActionTest(unittest.TestCase):
         ok = {a: np.zeros(2) for a in env.agents}
         for bad, pattern in [
                 (np.array([0.2, 0.0]), r"'footbot#1'.*outside the action space.*-0\.1, 0\.1"),
-                (np.array([np.nan, 0.0]), r"'footbot#1'.*outside"),
+                # NaN: no hint to clip (clip_actions=True refuses it too).
+                (np.array([np.nan, 0.0]), r"'footbot#1'.*outside.*\(NaN is refused with "
+                                          r"clip_actions=True too\)"),
                 (np.array([0.0, 0.0, 0.0]), r"'footbot#1' has shape \(3,\)"),
                 (np.array([True, False]), r"real numbers"),
                 (np.array([0j, 0j]), r"real numbers")]:
@@ -560,6 +562,14 @@ class RewardTest(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, r"reward.*\(3,\).*shape \(5,\)"):
             env.step({a: np.zeros(2) for a in env.agents})
         env.close()
+        # None read as NaN ("not finite"), text as numpy's bare "could not convert".
+        for returned, pattern in [(None, "reward: the function returned None"),
+                                  ("x", "reward: the function must return numbers.*got str")]:
+            env = make(3, reward=lambda w, a, r=returned: r)
+            env.reset(seed=1)
+            with self.assertRaisesRegex(TypeError, pattern):
+                env.step({a: np.zeros(2) for a in env.agents})
+            env.close()
         env = make(3, terminate=lambda w, a: np.zeros(3))
         env.reset(seed=1)
         with self.assertRaisesRegex(ValueError, "terminate.*booleans"):

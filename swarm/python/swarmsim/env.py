@@ -364,7 +364,15 @@ def _metric_reward(name):
 
 def _function_reward(fn):
     def reward(world, agents, core, k):
-        values = np.asarray(fn(world, agents), dtype=np.float64)
+        returned = fn(world, agents)
+        if returned is None:  # numpy reads it as NaN: "not finite" said nothing of the cause
+            raise TypeError("reward: the function returned None: return one reward per agent "
+                            "or one for all")
+        try:
+            values = np.asarray(returned, dtype=np.float64)
+        except (TypeError, ValueError) as e:
+            raise TypeError(f"reward: the function must return numbers (one per agent, or "
+                            f"one for all), got {type(returned).__name__}: {e}") from None
         if values.shape not in ((), (1,), (core.N,)):
             raise ValueError(f"reward: the function must return one reward per agent "
                              f"({core.N},) or one for all, got shape {values.shape}")
@@ -429,10 +437,12 @@ def _check_actions(core, acts, name_of, clip):
         bad = ~((acts >= low) & (acts <= high)).all(axis=-1)  # NaN is outside
         if bad.any():
             m = int(np.argmax(bad))
+            # NaN is no value to clip: clip_actions=True refuses it too.
+            hint = ("(NaN is refused with clip_actions=True too)" if np.isnan(acts[m]).any()
+                    else "(pass clip_actions=True to clip)")
             raise ValueError(
                 f"action {acts[m].tolist()} for {name_of(m)} is outside the action space: "
-                f"each of {bounds.joints} in [{_fmt(bounds.low)}, {_fmt(bounds.high)}] "
-                f"(pass clip_actions=True to clip)")
+                f"each of {bounds.joints} in [{_fmt(bounds.low)}, {_fmt(bounds.high)}] {hint}")
     clipped = np.clip(acts.astype(np.float64), bounds.low, bounds.high)
     if clip:
         # NaN stays an error; +-inf is clipped like any value past a bound (it was
