@@ -5,6 +5,7 @@ swarmsim.spaces' Box."""
 
 import importlib.util
 import math
+import os
 import unittest
 
 import numpy as np
@@ -579,6 +580,10 @@ class RewardTest(unittest.TestCase):
 
 class DeclarationTest(unittest.TestCase):
     def test_bad_declarations_are_clear_errors(self):
+        with self.assertRaisesRegex(TypeError, "the world must be a path .* not NoneType"):
+            senv.ParallelEnv(None)
+        env = senv.ParallelEnv(os.fsencode(DIFFUSION), set={"robots": 2})  # bytes: a path too
+        env.close()
         with self.assertRaisesRegex(ValueError, "no block 'sonar'.*proximity"):
             make(2, observations=["sonar"])
         with self.assertRaisesRegex(ValueError, r"no joint \['wheel'\].*leftMotor"):

@@ -9,6 +9,7 @@ all K worlds.
 """
 
 import difflib
+import os
 import re
 import warnings
 import weakref
@@ -96,7 +97,11 @@ class Core:
 
     def __init__(self, spec, num_envs):
         self.spec = spec
-        self.path = str(spec["world"])
+        try:  # str() made None 'None' ("world file 'None' not found"), bytes "b'...'"
+            self.path = os.fsdecode(spec["world"])
+        except TypeError:
+            raise TypeError(f"the world must be a path (str, bytes or os.PathLike), not "
+                            f"{type(spec['world']).__name__}") from None
         self.model = spec["model"]
         self.K = whole_number(num_envs, "num_envs", 1)
         self.slots = [_WorldSlot(k) for k in range(self.K)]

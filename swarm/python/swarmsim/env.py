@@ -415,7 +415,7 @@ def _spec(world, observations, actions, reward, terminate, max_steps, model, see
     if seed is not None:
         seed = whole_number(seed, "seed")
     return {
-        "world": str(world), "observations": [_observation(o) for o in observations],
+        "world": world, "observations": [_observation(o) for o in observations],
         "actions": actions, "reward": _reward(reward), "terminate": terminate,
         "max_steps": max_steps, "model": model, "seed": seed, "set": dict(set or {}),
         "threads": threads, "world_options": dict(world_options or {}),
