@@ -582,6 +582,11 @@ class DeclarationTest(unittest.TestCase):
     def test_bad_declarations_are_clear_errors(self):
         with self.assertRaisesRegex(TypeError, "the world must be a path .* not NoneType"):
             senv.ParallelEnv(None)
+        # bool() took "no" as True.
+        with self.assertRaisesRegex(TypeError, "clip_actions must be True or False, got 'no'"):
+            make(2, clip_actions="no")
+        with self.assertRaisesRegex(TypeError, "keep_scripts must be True or False, got 0"):
+            make(2, keep_scripts=0)
         env = senv.ParallelEnv(os.fsencode(DIFFUSION), set={"robots": 2})  # bytes: a path too
         env.close()
         with self.assertRaisesRegex(ValueError, "no block 'sonar'.*proximity"):

@@ -394,6 +394,13 @@ def _reward(reward):
                     f"got {reward!r}")
 
 
+def _flag(value, name):
+    """A True/False argument: bool() took clip_actions="no" as True."""
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    raise TypeError(f"{name} must be True or False, got {value!r}")
+
+
 def _spec(world, observations, actions, reward, terminate, max_steps, model, seed, set,
           threads, world_options, keep_scripts=True, step_threads=0):
     if observations is None:
@@ -419,7 +426,7 @@ def _spec(world, observations, actions, reward, terminate, max_steps, model, see
         "actions": actions, "reward": _reward(reward), "terminate": terminate,
         "max_steps": max_steps, "model": model, "seed": seed, "set": dict(set or {}),
         "threads": threads, "world_options": dict(world_options or {}),
-        "keep_scripts": bool(keep_scripts), "step_threads": int(step_threads),
+        "keep_scripts": _flag(keep_scripts, "keep_scripts"), "step_threads": int(step_threads),
     }
 
 
@@ -521,7 +528,7 @@ class ParallelEnv(_AgentsOfAModel, _ParallelBase):
         spec = _spec(world, observations, actions, reward, terminate, max_steps, model, seed,
                      set, threads, world_options, keep_scripts)
         self._core = Core(spec, 1)
-        self._clip = bool(clip_actions)
+        self._clip = _flag(clip_actions, "clip_actions")
         core = self._core
         self.possible_agents = list(core.agents)
         self.agents = []
@@ -726,7 +733,7 @@ class VectorEnv(_AgentsOfAModel, _VectorBase):
                      set, threads, world_options, keep_scripts, step_threads)
         self._core = Core(spec, num_envs)
         core = self._core
-        self._clip = bool(clip_actions)
+        self._clip = _flag(clip_actions, "clip_actions")
         self.num_envs = core.K
         self.possible_agents = list(core.agents)
         self.agents = list(core.agents)
