@@ -83,6 +83,11 @@ bool Placer::NearMapCell(double x, double y, double keep) const {
   return false;
 }
 
+void Placer::KeepObstaclesReaching(double lo, double hi, double overlap) {
+  std::erase_if(obstacles_,
+                [&](const Obstacle2& o) { return !(o.hi > lo + overlap && o.lo < hi - overlap); });
+}
+
 bool Placer::IsFree(double x, double y, double radius, double clearance) const {
   // Obstacles: few, checked one by one behind a bounding-circle test.
   const double keep = radius + clearance;

@@ -33,6 +33,9 @@ struct Obstacle2 {
   double radius = 0;              // kCircle, m
   double half_x = 0, half_y = 0;  // kBox: half extents along its own axes, m
   double yaw = 0;                 // kBox: rotation about z, rad
+  // Heights it spans, m: one wholly above or below the copies is none of
+  // theirs (Placer::KeepObstaclesReaching).
+  double lo = -INFINITY, hi = INFINITY;
 
   // Signed distance from (px, py) to the footprint's edge (negative inside), m.
   double Distance(double px, double py) const;
@@ -73,6 +76,10 @@ class Placer {
   }
 
   void AddObstacle(const Obstacle2& obstacle) { obstacles_.push_back(obstacle); }
+  // Keeps the obstacles that reach more than `overlap` into heights [lo, hi]
+  // (the copies' band, as the physics engines' rule for static shapes): a
+  // shelf or lamp shade above the robots does not keep them away.
+  void KeepObstaclesReaching(double lo, double hi, double overlap);
   // The environment map's occupied cells in the plane (a grid of squares,
   // the map format's occupied_plane, framework/world_section.h): copies
   // keep `clearance` from each like from an obstacle.

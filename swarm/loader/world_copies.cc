@@ -18,6 +18,7 @@
 #include "framework/prefault.h"
 #include "framework/registry.h"
 #include "framework/world_section.h"
+#include "modules/dynamics/height_range.h"
 #include "swarm/loader/world_loader_impl.h"
 
 namespace swarmsim::loader {
@@ -89,13 +90,28 @@ void ShareScaledMeshes(const ObjectSpec& spec, ObjectId id, Scene* scene, Scaled
 
 // --- Placing and building the copies ------------------------------------------------------
 
-// The environment map's voxels that a copy standing on the ground would
-// meet (those reaching into the band from the ground to the tallest copy's
-// top, less 1 mm at either end: a floor whose top is at z = 0 is not one),
-// projected to the plane by the map's format (its occupied_plane query):
-// placement keeps copies clear of them.
+double WorldLoader::CopiesHeight() const {
+  double height = 0;
+  for (const EntryPlan& e : entries_) {
+    height = std::max(height, e.footprint.top - e.footprint.bottom);
+    for (const EntryPlan::OwnCopy& own : e.own_copies)
+      if (own.spec) height = std::max(height, own.footprint.top - own.footprint.bottom);
+  }
+  return height;
+}
+
+// The obstacles and the environment map's voxels that a copy standing on
+// the ground would meet (those reaching into the band from the ground to
+// the tallest copy's top, less 1 mm at either end: a floor whose top is at
+// z = 0 is not one, nor a shelf above the robots), the voxels projected to
+// the plane by the map's format (its occupied_plane query): placement keeps
+// copies clear of them.
 void WorldLoader::KeepPlacementClearOfTheMap(std::vector<std::string>* warnings) {
-  if (!environment_ || entries_.empty()) return;
+  if (entries_.empty()) return;
+  // Obstacles too: those reaching into the same band (a box hanging 0.5 m
+  // up refused a 2 cm robot under it as "overlapping").
+  placer_->KeepObstaclesReaching(0, CopiesHeight(), dynamics::kHeightOverlap);
+  if (!environment_) return;
   if (!environment_format_ || !environment_format_->occupied_plane) {
     // A format that cannot say which cells it fills: robots are placed as
     // if it were not there, which the user is told.
@@ -106,13 +122,8 @@ void WorldLoader::KeepPlacementClearOfTheMap(std::vector<std::string>* warnings)
         "of the map");
     return;
   }
-  double height = 0;
-  for (const EntryPlan& e : entries_) {
-    height = std::max(height, e.footprint.top - e.footprint.bottom);
-    for (const EntryPlan::OwnCopy& own : e.own_copies)
-      if (own.spec) height = std::max(height, own.footprint.top - own.footprint.bottom);
-  }
-  constexpr double kOverlap = 1e-3;  // m, as the physics backends' rule
+  const double height = CopiesHeight();
+  constexpr double kOverlap = dynamics::kHeightOverlap;  // m, as the physics backends' rule
   try {
     placer_->SetMapCells(
         environment_format_->occupied_plane(*environment_, kOverlap, height - kOverlap));

@@ -10,6 +10,7 @@
 #include "framework/plugin_loader.h"
 #include "framework/registry.h"
 #include "framework/world_section.h"
+#include "modules/dynamics/height_range.h"
 #include "swarm/loader/environment.h"
 #include "swarm/loader/object_reader.h"
 #include "swarm/loader/urdf.h"
@@ -502,6 +503,9 @@ void WorldLoader::AddObstacleFootprint(const ShapeData& shape, const Pose& X_WO)
   Obstacle2 o;
   o.x = X_WO.p.x;
   o.y = X_WO.p.y;
+  const dynamics::HeightRange heights = dynamics::CalcHeightRange(shape, X_WO);
+  o.lo = heights.lo;
+  o.hi = heights.hi;
   const Vec3 z = X_WO.q.Rotate({0, 0, 1});
   if (shape.kind == ShapeKind::kSphere ||
       (shape.kind == ShapeKind::kCylinder && std::abs(z.z) > 1 - 1e-9)) {

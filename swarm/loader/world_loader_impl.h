@@ -195,6 +195,9 @@ class WorldLoader {
                    EntryPlan* entry);
   void ReadSinglePosition(const Fields& f, const ValueReader& world_values, EntryPlan* entry);
   void KeepPlacementClearOfTheMap(std::vector<std::string>* warnings);
+  // The tallest copy's height (footprint top - bottom, scaled), m: the band
+  // from the ground up that placement keeps clear.
+  double CopiesHeight() const;
   // Large swarms left on the defaults that are slow at their size (a Lua
   // state per robot, copies numbered at random): a line each saying which
   // setting to write.

@@ -184,6 +184,39 @@ TEST_F(WorldCopiesTest, CopiesPlacedOutsideTheArenaAreWarnedOf) {
     EXPECT_EQ(distributed(region).find("outside the arena"), std::string::npos) << region;
 }
 
+// An obstacle is one to placement when it reaches into the copies' heights
+// (the band from the ground to the tallest copy's top, as the engines'
+// rule for static shapes): a shade hung 0.5 m above 2 cm robots refused
+// the one under it as "overlapping"; a floor slab below them is none either.
+TEST_F(WorldCopiesTest, OnlyObstaclesAtTheCopiesHeightsKeepThemAway) {
+  Write("puck.yaml",
+        "model: puck\nobjects: {name: body, type: shape, shape: cylinder, radius: 0.02, "
+        "height: 0.02}\n");
+  const auto world = [](const std::string& obstacle_z, const std::string& placement) {
+    return "simulation: {physics: kinematic}\narena: {size: 2}\nobstacles:\n"
+           "  - {shape: box, size: [0.4, 0.4, 0.02], position: [0.5, 0, " +
+           obstacle_z + "]}\nmodels:\n  - " + placement + "\n";
+  };
+  const std::string under = "{model: puck.yaml, position: [0.5, 0]}";
+  EXPECT_EQ(ErrorOfWorld(world("0.5", under)), "");     // above
+  EXPECT_EQ(ErrorOfWorld(world("-0.01", under)), "");   // a slab, top at z = 0
+  EXPECT_CONTAINS(ErrorOfWorld(world("0.015", under)),  // reaching 5 mm in
+                  "world.yaml:6:34: this puck at [0.5, 0] overlaps a wall, an obstacle");
+  // Distributed copies: under the shade, some stand below it.
+  const auto inside = [&](const std::string& z) {
+    LoadedWorld w = Load(world(z,
+                               "{model: puck.yaml, count: 20, distribute: {region: {min: [0.35, "
+                               "-0.15], max: [0.65, 0.15]}}}"));
+    return w.world->scene().instances().size();
+  };
+  EXPECT_EQ(inside("0.5"), 20u);
+  EXPECT_CONTAINS(ErrorOfWorld(world("0.01",
+                                     "{model: puck.yaml, count: 20, distribute: "
+                                     "{region: {min: [0.35, -0.15], max: [0.65, "
+                                     "0.15]}}}")),
+                  "cannot place 20 puck copies");
+}
+
 TEST_F(WorldCopiesTest, CopiesThatCannotBePlacedApartAreNamedWithTheirCount) {
   Write("disc.yaml",
         "model: disc\nobjects: {name: body, type: shape, shape: cylinder, radius: 0.5, "
