@@ -1,6 +1,7 @@
 // Memory forecasts for large worlds (memory_forecast.h).
 #include "framework/memory_forecast.h"
 
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -11,6 +12,7 @@
 #include <fstream>
 #include <initializer_list>
 #include <sstream>
+#include <tuple>
 #include <utility>
 
 namespace swarmsim {
@@ -116,6 +118,30 @@ uint64_t CgroupAvailable() {
   return room;
 }
 
+// Room under the process's own limits: its address space (ulimit -v) less
+// its virtual size, its data segment (ulimit -d) less its data size (what
+// malloc takes counts against both); UINT64_MAX without either. `*which`
+// names the nearer one.
+uint64_t LimitAvailable(const char** which) {
+  std::ifstream in("/proc/self/statm");
+  uint64_t size = 0, resident = 0, shared = 0, text = 0, lib = 0, data = 0;
+  if (!(in >> size >> resident >> shared >> text >> lib >> data)) return UINT64_MAX;
+  const uint64_t page = static_cast<uint64_t>(sysconf(_SC_PAGESIZE));
+  uint64_t room = UINT64_MAX;
+  for (const auto& [resource, used, name] :
+       {std::tuple{RLIMIT_AS, size * page, "the address-space limit (ulimit -v)"},
+        std::tuple{RLIMIT_DATA, data * page, "the data-size limit (ulimit -d)"}}) {
+    rlimit limit{};
+    if (getrlimit(resource, &limit) != 0 || limit.rlim_cur == RLIM_INFINITY) continue;
+    const uint64_t left = limit.rlim_cur > used ? limit.rlim_cur - used : 0;
+    if (left < room) {
+      room = left;
+      *which = name;
+    }
+  }
+  return room;
+}
+
 }  // namespace
 
 std::string GroupThousands(int64_t n) {
@@ -204,6 +230,11 @@ MemoryRoom ReadMemoryRoom(uint64_t cap) {
     room.available = group;
     room.bound = "the memory limit of the process's cgroup";
   }
+  const char* which = nullptr;
+  if (const uint64_t own = LimitAvailable(&which); own < room.available) {
+    room.available = own;
+    room.bound = which;
+  }
   if (cap > 0) {
     const uint64_t left = cap > room.resident ? cap - room.resident : 0;
     if (left < room.available) {
@@ -275,6 +306,20 @@ std::string MemoryForecast::Reserved(uint64_t bytes) const {
          "not fit\")";
   }
   s << "; SWARMSIM_MEMORY_CHECK=0 skips this check";
+  return s.str();
+}
+
+std::string MemoryForecast::ReserveFailed(uint64_t bytes) const {
+  const MemoryRoom room = ReadMemoryRoom(cap_);
+  std::ostringstream s;
+  s << "not enough memory for " << GroupThousands(total_) << " " << items_
+    << ": the arrays reserved for them could not be had (" << FormatSize(static_cast<double>(bytes))
+    << " had, and more asked for), with the process holding "
+    << FormatSize(static_cast<double>(room.resident));
+  if (room.available != UINT64_MAX)
+    s << " and " << FormatSize(static_cast<double>(room.available)) << " more to take ("
+      << room.bound << ")";
+  s << ". Run fewer robots or give the run more memory (README, \"A world that does not fit\")";
   return s.str();
 }
 

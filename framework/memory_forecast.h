@@ -8,8 +8,9 @@
 // checkpoint compares what the rest would need with the room left: the
 // machine's available memory (MemAvailable + SwapFree), its cgroup's (a
 // container's or a cluster job's limit less what the group holds, its page
-// cache not counted; cgroup v2 and v1), and a cap the user set (`swarmsim
-// run --max-memory`), whichever is smallest. Past it the check returns an
+// cache not counted; cgroup v2 and v1), the process's own limits (ulimit -v
+// less its virtual size, ulimit -d less its data size), and a cap the user
+// set (`swarmsim run --max-memory`), whichever is smallest. Past it the check returns an
 // error naming how many items fit. It never refuses a world of fewer than
 // 2,000 items, nor anything when SWARMSIM_MEMORY_CHECK is 0, off, false or
 // no.
@@ -77,6 +78,9 @@ class MemoryForecast {
   // check off). Without it, populating them could end the process through
   // the kernel's out-of-memory killer before any checkpoint.
   std::string Reserved(uint64_t bytes) const;
+  // The error text when reserving those arrays failed (std::bad_alloc:
+  // ulimit -v, or an overcommit the kernel refused) after `bytes` of them.
+  std::string ReserveFailed(uint64_t bytes) const;
 
   // The check, for a given reading (tests): `built` of `total` items are
   // built, the last `measured` of them grew the process by `grown` bytes.

@@ -37,6 +37,14 @@ bool IsWordOf(std::string_view word, std::string_view name) {
 }
 
 const std::string* NearestName(std::string_view name, std::span<const std::string> candidates) {
+  // A name cut short (with_cam): the shortest that begins with it, before
+  // any that is fewer edits away (with_rab).
+  const std::string* longer = nullptr;
+  if (name.size() >= 3)
+    for (const std::string& c : candidates)
+      if (c.size() > name.size() && c.starts_with(name) && (!longer || c.size() < longer->size()))
+        longer = &c;
+  if (longer != nullptr) return longer;
   const std::string* best = nullptr;
   int best_distance = 0;
   for (const std::string& c : candidates) {

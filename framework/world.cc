@@ -297,19 +297,7 @@ void World::SetInstanceParameters(int instance, SharedParameters parameters) {
   runtimes_.at(instance).parameters = std::move(parameters);
 }
 
-void World::Start() {
-  if (started_) return;
-  // Each stage below takes memory in proportion to the robots; the loader's
-  // and the Lua states' forecasts see only their own items. A stage that
-  // took the process past what it may hold (--max-memory, a cgroup's limit)
-  // stops the start there, with a message, before the next takes more.
-  std::string last_stage = "loading the world";
-  const auto stage = [&](const std::string& next) {
-    if (std::string why = NoRoomLeft(robot_count(), last_stage, settings_.max_memory); !why.empty())
-      throw Error(why);
-    last_stage = "starting " + next;
-    StartStage(next);
-  };
+void World::StartParts(const std::function<void(const std::string&)>& stage) {
   stage("world poses");
   EnsureRuntimes();
   UpdateWorldPoses(&scene_, *scheduler_);
@@ -348,6 +336,32 @@ void World::Start() {
     run_script_memory_.set_limit(
         static_cast<uint64_t>(std::max(WorldSettings::kDefaultRunScriptMemory,
                                        WorldSettings::kRunScriptMemoryPerRobot * robot_count())));
+}
+
+void World::Start() {
+  if (started_) return;
+  if (start_failed_) throw Error("the world failed to start and cannot be started again");
+  // Each stage below takes memory in proportion to the robots; the loader's
+  // and the Lua states' forecasts see only their own items. A stage that
+  // took the process past what it may hold (--max-memory, a cgroup's limit)
+  // stops the start there, with a message, before the next takes more.
+  std::string last_stage = "loading the world";
+  const auto stage = [&](const std::string& next) {
+    if (std::string why = NoRoomLeft(robot_count(), last_stage, settings_.max_memory); !why.empty())
+      throw Error(why);
+    last_stage = "starting " + next;
+    StartStage(next);
+  };
+  // A stage that throws (out of memory, a module's error) may leave its
+  // part half built: the state hash a failed run still prints, and the
+  // world's end, then leave the physics and modules alone.
+  try {
+    StartParts(stage);
+  } catch (...) {
+    start_failed_ = true;
+    failed_ = true;
+    throw;
+  }
   // (A Lua world finds a script at its first robot; one of native or Python
   // controllers looks at every slot once.)
   bool any_script = settings_.main_script != nullptr;
@@ -771,6 +785,7 @@ uint64_t World::StateHash() const {
   messaging_.HashState(&h);
   for (uint32_t s = 0; s < scene_.slot_count(); ++s)
     if (scene_.alive_at(s)) scene_.HashCustomData(s, &h);
+  if (start_failed_) return h.Digest();  // physics and modules half built
   if (dynamics_) dynamics_->HashState(&h);
   for (const ModuleEntry& e : modules_) e.instance->HashState(&h);
   return h.Digest();

@@ -577,6 +577,8 @@ class World final : public PhaseHandlers {
   std::array<std::vector<Module*>, kPhaseCount> modules_by_phase_;
   Module* InstallModule(std::string name, int order, uint32_t phases,
                         std::unique_ptr<Module> instance);
+  // Start's stages up to the scripts: poses, physics, modules.
+  void StartParts(const std::function<void(const std::string&)>& stage);
   std::vector<MetricSample> metrics_;
   uint64_t metrics_taken_ = 0;
   std::vector<std::string> disabled_scripts_;
@@ -589,6 +591,7 @@ class World final : public PhaseHandlers {
   bool started_ = false;
   bool stopped_ = false;
   bool failed_ = false;
+  bool start_failed_ = false;  // Start threw before the scripts: physics, modules half built
   bool process_ends_after_stop_ = false;
 };
 

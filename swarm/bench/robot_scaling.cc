@@ -88,6 +88,17 @@ std::string Quoted(const std::string& text) {
   return q + "'";
 }
 
+// "2 threads", "1 and 2 threads": the counts the rows were measured at.
+std::string ThreadsText(const std::vector<ScalingRow>& rows) {
+  std::set<int> counts;
+  for (const ScalingRow& r : rows) counts.insert(r.bench.threads);
+  std::string text;
+  size_t i = 0;
+  for (const int t : counts)
+    text += (i++ == 0 ? "" : i == counts.size() ? " and " : ", ") + std::to_string(t);
+  return text + (counts.size() == 1 && *counts.begin() == 1 ? " thread" : " threads");
+}
+
 // Two log-log panels: microseconds per robot-tick against robots (the total
 // solid, each phase dashed in the configuration's colour), and start-up
 // seconds against robots. False (and a message) when gnuplot fails or is missing.
@@ -106,8 +117,15 @@ bool Plot(const std::vector<ScalingRow>& rows, const RobotScalingOptions& o, std
   script << "set terminal pngcairo size 1200,640 enhanced font 'sans,10'\n"
          << "set output " << Quoted(o.plot) << "\n"
          << "set logscale xy\nset grid\nset key below horizontal maxcols 5 noenhanced\n"
-         << "set format x '10^{%L}'\nset xlabel 'robots'\n"
-         << "set multiplot layout 1,2 title 'swarmsim: cost per robot-tick over robot counts'\n";
+         << "set format x '10^{%L}'\nset xlabel 'robots' offset 0,0.6\n"
+         // The key below: a margin for it under the axis's label.
+         << "set bmargin 12\n"
+         << "set multiplot layout 1,2 title "
+         << Quoted("swarmsim: cost per robot-tick over robot counts (" + ThreadsText(rows) + "; " +
+                   (o.steps > 0 ? std::to_string(o.steps) + " measured steps a row"
+                                : std::string("about 2 million measured robot-ticks a row")) +
+                   ")")
+         << "\n";
   // One robot count: a range about it (gnuplot would warn of an empty one).
   int lowest = INT_MAX, highest = 0;
   for (const ScalingRow& r : rows)

@@ -341,8 +341,15 @@ double ValueReader::Number(const Field& field, const NumberRule& rule) const {
     number = *d;
   else if (const std::string* s = std::get_if<std::string>(&value))
     number = ParseNumber(Trim(*s));
-  if (!number)
-    Fail(field, "'" + field.name + "' must be " + rule.text + " (got " + Got(field, value) + ")");
+  if (!number) {
+    // A parameter's name written without its '$' (count: robots).
+    const std::string_view text = Trim(field.node.Scalar());
+    const bool bare_name = std::holds_alternative<std::string>(value) && !text.empty() &&
+                           text[0] != '$' && text[0] != '=' && scope_.Find(text) != nullptr;
+    Fail(field,
+         "'" + field.name + "' must be " + rule.text + " (got " + Got(field, value) + ")" +
+             (bare_name ? "; did you mean '$" + std::string(text) + "', the parameter?" : ""));
+  }
   const bool below = rule.min_exclusive ? !(*number > rule.min) : !(*number >= rule.min);
   if (below)
     Fail(field, "'" + field.name + "' must be " + rule.text + " (got " + Got(field, *number) + ")");

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <map>
 #include <memory>
+#include <new>
 #include <string>
 #include <utility>
 #include <vector>
@@ -158,7 +159,10 @@ void WorldLoader::PlaceEntries(std::vector<std::string>* warnings) {
       file_->Fail(e.position_field.mark,
                   "this " + e.model->name + " at [" + loader::FormatNumber(X.p.x) + ", " +
                       loader::FormatNumber(X.p.y) +
-                      "] overlaps a wall, an obstacle, the map or another placed copy");
+                      "] overlaps a wall, an obstacle, the map or another placed copy (its "
+                      "footprint: a disc of radius " +
+                      loader::FormatNumber(radius) +
+                      " m about [x, y] that holds every shape of the model)");
     // Clear of the walls and outside them: allowed (an observer, a beacon),
     // but seldom meant (a coordinate of another, larger arena).
     if (arena_ && (X.p.x < arena_->min_x || X.p.x > arena_->max_x || X.p.y < arena_->min_y ||
@@ -256,8 +260,12 @@ void WorldLoader::BuildCopies(World* world) {
         // The copies' rows are written into pages populated on every thread
         // first (the kernel zeroing them was most of a large world's copies).
         Prefault prefault;
-        scene.ReserveForCopies(root, *reserve, &prefault);
-        world->ReserveRobots(scene.instances().size() + 1 + *reserve, &prefault);
+        try {
+          scene.ReserveForCopies(root, *reserve, &prefault);
+          world->ReserveRobots(scene.instances().size() + 1 + *reserve, &prefault);
+        } catch (const std::bad_alloc&) {
+          throw Error(forecast.ReserveFailed(prefault.bytes()));
+        }
         // Populated at once, so checked at once: a world whose arrays alone
         // do not fit is refused here with a message, not ended by the
         // kernel's out-of-memory killer while they are populated.

@@ -320,7 +320,9 @@ void WorldLoader::ResolveNativeController(const Fields& f, const ValueReader& wo
         name_field.mark,
         "'native_controller': no controller '" + name + "' (" +
             (known.empty() ? std::string("no plugin of the world's 'plugins:' registers "
-                                         "one")
+                                         "one: list the plugin that has it there, as "
+                                         "'plugins: [diffusion_controller]' for swarmsim's C++ "
+                                         "diffusion controller")
                            : "registered: " + list) +
             ")" + [&]() -> std::string {  // the list is there: only a near name
           const std::string* near = NearestName(name, known);
@@ -676,8 +678,8 @@ void WorldLoader::ReadLattice(const Fields& d, const ValueReader& world_values,
   plan.spacing = world_values.Number(spacing, kPositiveLength);
   if (plan.spacing < 2 * footprint_radius)
     file_->Fail(spacing.mark, "a lattice 'spacing' of " + loader::FormatNumber(plan.spacing) +
-                                  " m is less than a " + entry->model->name +
-                                  "'s footprint diameter (" +
+                                  " m is less than the footprint diameter of the " +
+                                  entry->model->name + " model (" +
                                   loader::FormatNumber(2 * footprint_radius) +
                                   " m): neighbouring copies would overlap");
   if (l.Has("shape")) {

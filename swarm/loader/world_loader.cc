@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <charconv>
 #include <cmath>
 #include <utility>
 
@@ -455,18 +456,27 @@ WorldSettings WorldLoader::ReadSimulation(const Fields& top, std::optional<int64
     if (f.Has("physics_partitions")) {
       // auto: the backend chooses from the scene (never from the thread count).
       const Field partitions = f.Get("physics_partitions");
-      const std::string text =
-          partitions.node.IsScalar() ? std::string(partitions.node.Scalar()) : std::string();
-      if (text == "auto")
+      // Written, or from a parameter ($parts, a sweep's values): a string
+      // parameter set on the command line holds "4" as text.
+      const ParamValue value =
+          partitions.node.IsScalar() ? values.Resolve(partitions) : ParamValue(0.0);
+      const std::string* text = std::get_if<std::string>(&value);
+      int64_t whole = 0;
+      if (text != nullptr && *text == "auto") {
         s.physics_partitions = 0;
-      else if (!text.empty() && std::isalpha(static_cast<unsigned char>(text[0]))) {
-        std::string message =
-            "'physics_partitions' must be auto or a whole number from 1 to 1024 (got '";
-        message += text;
-        message += "')";
-        values.Fail(partitions, message);
-      } else
+      } else if (text != nullptr) {
+        const std::string_view t = *text;
+        const auto [end, error] = std::from_chars(t.data(), t.data() + t.size(), whole);
+        if (error != std::errc() || end != t.data() + t.size() || whole < 1 || whole > 1024) {
+          const std::string written(partitions.node.Scalar());
+          values.Fail(partitions,
+                      "'physics_partitions' must be auto or a whole number from 1 to 1024 (got '" +
+                          *text + "'" + (written != *text ? " from '" + written + "'" : "") + ")");
+        }
+        s.physics_partitions = static_cast<int>(whole);
+      } else {
         s.physics_partitions = static_cast<int>(values.Integer(partitions, 1, 1024));
+      }
     }
     if (f.Has("seed")) s.seed = values.Seed(f.Get("seed"));
     if (f.Has("gravity"))

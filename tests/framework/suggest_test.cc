@@ -49,6 +49,14 @@ TEST(SuggestTest, NearestNameIsATypoOfACandidateOrNothing) {
   EXPECT_EQ(*NearestName("xate", tied), "rate");
   const std::vector<std::string> tied_reversed = {"gate", "rate"};
   EXPECT_EQ(*NearestName("xate", tied_reversed), "gate");
+  // A name cut short: the shortest candidate that begins with it, though
+  // another is fewer edits away.
+  const std::vector<std::string> devices = {"with_leds", "with_rab", "with_camera",
+                                            "with_camera_blobs"};
+  EXPECT_LT(EditDistance("with_cam", "with_rab"), EditDistance("with_cam", "with_camera"));
+  EXPECT_EQ(*NearestName("with_cam", devices), "with_camera");
+  EXPECT_EQ(*NearestName("with_ra", devices), "with_rab");
+  EXPECT_EQ(NearestName("wi", std::vector<std::string>{"with_rab"}), nullptr);  // too short
   // A whole word of the other: a key with a unit or a qualifier added or dropped.
   const std::vector<std::string> sensor = {"range", "noise", "max_speed", "aperture"};
   EXPECT_EQ(*NearestName("noise_std", sensor), "noise");

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -88,6 +89,59 @@ TEST(WorldTest, StepsPhysicsAndChildrenFollow) {
   EXPECT_EQ(metrics.back().step, 10);
   EXPECT_EQ(metrics.back().value, 1.0);
   EXPECT_TRUE(world.TakeMetrics().empty());
+}
+
+// A physics engine that runs out of memory part-way through its build
+// (Box2D's partitions under `ulimit -v`): what it holds is half built.
+class HalfBuiltDynamics : public DynamicsBackend {
+ public:
+  HalfBuiltDynamics(bool fail, int* hashed) : fail_(fail), hashed_(hashed) {}
+  void Build(const Scene&, const DynamicsSettings&) override {
+    if (fail_) throw std::bad_alloc();
+  }
+  void Step(Scene*, double, int) override {}
+  int body_count() const override { return 0; }
+  void HashState(StateHasher*) const override { ++*hashed_; }
+
+ private:
+  bool fail_;
+  int* hashed_;
+};
+
+// The run that failed to start still prints a state hash and ends cleanly:
+// the hash leaves the half-built physics alone (reading it crashed), and
+// the world cannot be started or stepped again.
+TEST(WorldTest, AWorldWhoseStartFailedLeavesItsHalfBuiltPartsAlone) {
+  int hashed = 0;
+  ModuleRegistry registry = MakeRegistry();
+  for (const bool fail : {false, true})
+    registry.RegisterDynamics({"", fail ? "half" : "whole", "1", ""}, {}, [fail, &hashed] {
+      return std::make_unique<HalfBuiltDynamics>(fail, &hashed);
+    });
+  WorldSettings settings;
+  // Built whole, the engine is hashed.
+  settings.physics = "whole";
+  World whole(settings, registry);
+  whole.Start();
+  whole.StateHash();
+  EXPECT_EQ(hashed, 1);
+  hashed = 0;
+  settings.physics = "half";
+  World world(settings, registry);
+  const ObjectId root = world.scene().AddDummy("bot", {}, {});
+  world.scene().MakeModelInstance(root, "bot", "bot#0");
+  EXPECT_THROW(world.Start(), std::bad_alloc);
+  const uint64_t hash = world.StateHash();
+  EXPECT_EQ(hashed, 0);
+  EXPECT_EQ(world.StateHash(), hash);
+  EXPECT_THROW(world.Start(), Error);
+  try {
+    world.Step();
+    ADD_FAILURE() << "a world that failed to start stepped";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("the world failed to start"), std::string::npos)
+        << e.what();
+  }
 }
 
 // The start names its stages for the progress line: the scripts' stage

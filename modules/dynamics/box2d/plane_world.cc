@@ -35,13 +35,13 @@ bool SameRotation(const b2Rot& q, float s, float c) {
 
 }  // namespace
 
-bool Box2dTimerIsOverridden();  // b2_timer_override.cc
+bool Box2dOverridesAreInPlace();  // b2_overrides.cc
 
 PlaneWorld::PlaneWorld(const Options& options, const DynamicsSettings& settings)
     : options_(options), settings_(settings), scale_(options.length_scale) {
-  // Keeps the free-timer definitions linked in (see b2_timer_override.cc).
-  static const bool timers_free = Box2dTimerIsOverridden();
-  (void)timers_free;
+  // Keeps the free timers and the checked allocator linked in (see b2_overrides.cc).
+  static const bool overridden = Box2dOverridesAreInPlace();
+  (void)overridden;
   if (!(scale_ > 0) || !std::isfinite(scale_))
     throw Error("box2d: length_scale must be a positive number, got " + std::to_string(scale_));
   // Gravity only sets ground friction here; zero makes the ground frictionless.

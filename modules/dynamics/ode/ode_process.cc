@@ -7,7 +7,9 @@
 #include <cstdarg>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <mutex>
+#include <new>
 #include <string>
 
 #include "framework/error.h"
@@ -102,6 +104,23 @@ void NoteOdeMessage(int number, const char* message, va_list arguments) {
                number, text);
 }
 
+// ODE's allocator: ODE writes through what malloc returned without a look
+// in most places, so memory refused (ulimit -v, a large world on a small
+// machine) was a segfault inside the library. A refusal throws
+// std::bad_alloc instead, which unwinds out of ODE (C++, as ThrowOdeError's
+// errors do) to the world's start or step: the run ends with a message.
+void* AllocOrThrow(dsizeint size) {
+  void* memory = std::malloc(size > 0 ? size : 1);
+  if (memory == nullptr) throw std::bad_alloc();
+  return memory;
+}
+void* ReallocOrThrow(void* memory, dsizeint, dsizeint size) {
+  void* moved = std::realloc(memory, size > 0 ? size : 1);
+  if (moved == nullptr) throw std::bad_alloc();
+  return moved;
+}
+void FreeMemory(void* memory, dsizeint) { std::free(memory); }
+
 bool g_solver_shuffle_is_ours = false;
 bool g_single_threaded_islands = false;  // SolverThreads' probe
 
@@ -110,6 +129,9 @@ bool g_single_threaded_islands = false;  // SolverThreads' probe
 void InitOdeOnce() {
   static std::once_flag once;
   std::call_once(once, [] {
+    dSetAllocHandler(AllocOrThrow);  // before ODE allocates anything
+    dSetReallocHandler(ReallocOrThrow);
+    dSetFreeHandler(FreeMemory);
     dInitODE2(0);
     dSetErrorHandler(ThrowOdeError);
     dSetDebugHandler(ThrowOdeError);

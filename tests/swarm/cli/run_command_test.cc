@@ -335,3 +335,34 @@ TEST(CliTest, AWorldThatWillNotFitIsRefusedWithAMessage) {
             std::string::npos)
       << bad.output;
 }
+
+// A process limit (ulimit -v, common on clusters) is room like a cgroup's:
+// the forecast names it. Without the forecast (SWARMSIM_MEMORY_CHECK=0),
+// running out of it part-way through the start ends the run with a
+// message and its summary: the state hash it prints read the half-built
+// physics and crashed (exit 139). Not under AddressSanitizer, whose shadow
+// memory takes more address space than any cap.
+TEST(CliTest, AnAddressSpaceLimitIsRoomTooAndRunningOutOfItIsNamed) {
+  if (swarmsim::kAddressSanitizer) GTEST_SKIP() << "ulimit -v stops ASan builds before main";
+  const std::string limit = swarmsim::testing::AddressSpaceLimit(600000);
+  const fs::path out = TempDir("ulimit_forecast");
+  Result r = swarmsim::testing::RunCommand(
+      limit + SWARMSIM_BINARY + std::string(" run ") + SWARMSIM_SOURCE_DIR +
+      "/bench/worlds/diffusion_planar_native.yaml --set robots=100000 --steps 1 --quiet --out " +
+      out.string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("not enough memory for 100,000 robot copies"), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("(the address-space limit (ulimit -v))"), std::string::npos) << r.output;
+
+  const fs::path out2 = TempDir("ulimit_start");
+  r = swarmsim::testing::RunCommand(
+      "export SWARMSIM_MEMORY_CHECK=0; " + swarmsim::testing::AddressSpaceLimit(1000000) +
+      SWARMSIM_BINARY + " run " + SWARMSIM_SOURCE_DIR +
+      "/worlds/diffusion.yaml --set robots=100000 --steps 1 --quiet --hash --out " + out2.string());
+  EXPECT_TRUE(r.exit_code == 1 || r.exit_code == 2) << r.exit_code << ": " << r.output;
+  EXPECT_NE(r.output.find("memory"), std::string::npos) << r.output;
+  std::ifstream summary(out2 / "summary.json");
+  ASSERT_TRUE(summary.good()) << r.output;
+  EXPECT_EQ(nlohmann::json::parse(summary)["status"], "error");
+}

@@ -293,7 +293,9 @@ TEST_F(NativeControllerTest, MistakesAreNamedAtTheirKey) {
   // Without the plugin: no controller at all.
   std::string text = WorldText("    native_controller: relay\n");
   text.erase(0, text.find('\n') + 1);
-  EXPECT_CONTAINS(LoadError(text), "no plugin of the world's 'plugins:' registers one");
+  EXPECT_CONTAINS(LoadError(text),
+                  "no plugin of the world's 'plugins:' registers one: list the "
+                  "plugin that has it there, as 'plugins: [diffusion_controller]'");
   // A key of the map form that does not exist.
   EXPECT_CONTAINS(LoadError(WorldText("    native_controller: {name: relay, keep: true}\n")),
                   "world.yaml:8:");

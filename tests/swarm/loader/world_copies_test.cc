@@ -79,8 +79,8 @@ TEST_F(WorldCopiesTest, ALatticePlacesCopiesInIndexOrderAtTheSpacing) {
       "simulation: {physics: kinematic}\nmodels:\n  - {model: disc.yaml, count: 400, "
       "distribute: {region: {min: [0, 0], max: [0.5, 0.5]}, ";
   EXPECT_CONTAINS(ErrorOfWorld(head + "lattice: {spacing: 0.03}}}\n"),
-                  "world.yaml:3:108: a lattice 'spacing' of 0.03 m is less than a disc's "
-                  "footprint diameter (0.033 m): neighbouring copies would overlap");
+                  "world.yaml:3:108: a lattice 'spacing' of 0.03 m is less than the footprint "
+                  "diameter of the disc model (0.033 m): neighbouring copies would overlap");
   EXPECT_CONTAINS(ErrorOfWorld(head + "lattice: {spacing: 0.05}}}\n"),
                   "world.yaml:3:98: the lattice does not fit: disc copy 0 of 400 would leave the "
                   "region from [0, 0] to [0.5, 0.5] or overlap");
@@ -226,7 +226,8 @@ TEST_F(WorldCopiesTest, CopiesThatCannotBePlacedApartAreNamedWithTheirCount) {
                                "  - {model: disc.yaml, position: [0, 0]}\n"
                                "  - {model: disc.yaml, position: [0.5, 0]}\n"),
                   "world.yaml:4:34: this disc at [0.5, 0] overlaps a wall, an obstacle, the map "
-                  "or another placed copy");
+                  "or another placed copy (its footprint: a disc of radius 0.5 m about [x, y] "
+                  "that holds every shape of the model)");
   // Distributed copies keep clear of fixed ones listed after them: 100
   // pebbles around a disc that fills a fifth of their region (placed
   // blindly, each would land on it with a chance of about 1 in 4, all 100

@@ -315,6 +315,22 @@ TEST_F(MalformedWorldTest, PhysicsPartitionsIsAutoOrACount) {
                 .world->settings()
                 .physics_partitions,
             3);
+  // From a parameter whose value is auto (a sweep over 1 and auto), and that
+  // parameter set to a count on the command line (it holds "4" as text).
+  const fs::path from_parameter =
+      Write("world.yaml", std::string("arena: {size: 2}\nparameters: {p: auto}\n"
+                                      "simulation: {physics_partitions: $p}\n") +
+                              kModels);
+  EXPECT_EQ(Load(from_parameter).world->settings().physics_partitions, 0);
+  LoadOptions options;
+  options.overrides = {{"p", "4"}};
+  EXPECT_EQ(Load(from_parameter, options).world->settings().physics_partitions, 4);
+  options.overrides = {{"p", "lots"}};
+  const std::string error = ErrorOf([&] { Load(from_parameter, options); });
+  EXPECT_NE(error.find("world.yaml:3:34: 'physics_partitions' must be auto or a whole number "
+                       "from 1 to 1024 (got 'lots' from '$p')"),
+            std::string::npos)
+      << error;
 }
 
 struct BadCase {
@@ -383,6 +399,11 @@ TEST_F(MalformedWorldTest, EachMistakeHasAClearMessage) {
       {"fractional count",
        "arena: {size: 2}\nmodels:\n  - {model: bot.yaml, count: 2.5, distribute: {}}\n",
        {"world.yaml:3:30:", "'count' must be a whole number from 0 to 1,000,000 (got \"2.5\")"}},
+      {"a parameter's name without its $",
+       "parameters: {robots: 4}\narena: {size: 2}\nmodels:\n"
+       "  - {model: bot.yaml, count: robots, distribute: {}}\n",
+       {"world.yaml:4:30:", "'count' must be a whole number", "(got \"robots\")",
+        "did you mean '$robots', the parameter?"}},
       {"count from an expression past any bound",
        "parameters: {n: 1e300}\narena: {size: 2}\nmodels:\n"
        "  - {model: bot.yaml, count: '= n * 2', distribute: {}}\n",
