@@ -3,10 +3,14 @@
 #include <xxhash.h>
 
 #include <cstdio>
+#include <new>
 
 namespace swarmsim {
 
 StateHasher::StateHasher() : state_(XXH3_createState()) {
+  // xxHash returns null when malloc does (out of memory): a hash then
+  // crashed in XXH3_64bits_update.
+  if (state_ == nullptr) throw std::bad_alloc();
   XXH3_64bits_reset(static_cast<XXH3_state_t*>(state_));
 }
 

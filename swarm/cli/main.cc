@@ -3,7 +3,9 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <csignal>
+#include <cstdio>
 #include <iostream>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -106,6 +108,13 @@ int main(int argc, char** argv) {
   } catch (const swarmsim::Error& e) {
     std::cerr << "error: " << swarmsim::ValidUtf8(e.what()) << "\n";
     return 2;
+  } catch (const std::bad_alloc&) {
+    // Out of memory where nothing named it: a fixed text, which needs none.
+    std::fputs(
+        "error: out of memory (the machine, a ulimit or --max-memory gave no more; README, \"A "
+        "world that does not fit\")\n",
+        stderr);
+    return 1;
   } catch (const std::exception& e) {
     std::cerr << "error: " << swarmsim::ValidUtf8(e.what()) << "\n";
     return 1;

@@ -20,6 +20,7 @@
 #include <iomanip>
 #include <iostream>
 #include <map>
+#include <memory>
 #include <new>
 #include <nlohmann/json.hpp>
 #include <set>
@@ -51,6 +52,9 @@ double PeakRssMb() {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+// Bytes of memory kept aside for the end of a run that ran out (RunWorld).
+constexpr size_t kMemoryRoom = size_t{8} << 20;
 
 // Disk space kept aside for the final summary.json (a summary of a run with
 // thousands of snapshots lists each one: ~100 bytes each).
@@ -393,6 +397,10 @@ void StepWatched(World* world, const RunOptions& options, Clock::time_point star
   RunResult& result = record->result;
   std::unique_ptr<MetricsWriter>& metrics = record->metrics;
   double& lua_kib = record->lua_kib;
+  // Room for the error message, taken now: out of memory, composing it
+  // must not need more (it threw std::bad_alloc from the handler, and the
+  // run ended as "error: std::bad_alloc").
+  result.error.reserve(1024);
   StepProgress& progress = *progress_bar;
   const auto seconds = [start] {
     return std::chrono::duration<double>(Clock::now() - start).count();
@@ -520,17 +528,24 @@ void StepWatched(World* world, const RunOptions& options, Clock::time_point star
     result.ok = true;
   } catch (const std::exception& e) {
     const std::lock_guard lock(watchdog.io_mutex());
-    result.error = e.what();
-    // "std::bad_alloc" named nothing.
-    if (dynamic_cast<const std::bad_alloc*>(&e) != nullptr)
-      result.error =
-          "out of memory " +
-          (!started                       ? std::string("as the world started")
-           : result.steps < options.steps ? "in step " + std::to_string(world->step_count() + 1)
-                                          : std::string("at the end of the run")) +
+    result.error.assign(e.what());
+    // "std::bad_alloc" named nothing. Composed in the room reserved above
+    // (std::to_string's few digits fit its inline buffer).
+    if (dynamic_cast<const std::bad_alloc*>(&e) != nullptr) {
+      result.error.assign("out of memory ");
+      if (!started) {
+        result.error.append("as the world started");
+      } else if (result.steps < options.steps) {
+        result.error.append("in step ");
+        result.error.append(std::to_string(world->step_count() + 1));
+      } else {
+        result.error.append("at the end of the run");
+      }
+      result.error.append(
           " (the machine, a ulimit or --max-memory gave no more; what grows besides "
           "the robots: cameras' and vision sensors' images, paint, graphs, the "
-          "scripts' data)";
+          "scripts' data)");
+    }
     // The states are still open after an error: what they held then.
     lua_kib = static_cast<double>(world->script_memory_bytes()) / 1024.0;
     take_metrics();  // whatever was recorded before the error
@@ -605,6 +620,15 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
                    std::ostream& progress_stream) {
   RunRecord record;
   RunResult& result = record.result;
+  // Memory kept aside for the end of a run that ran out of it: given back
+  // before the state hash and summary.json of a failed run are made (they
+  // need some; without it the summary stayed "running" and the message was
+  // main()'s generic one).
+  // Not written, so not resident: address space, which is what a ulimit
+  // counts and malloc gives back (a mapping of its own at this size). The
+  // asm keeps the compiler from eliding the allocation.
+  std::unique_ptr<char[]> memory_room(new char[kMemoryRoom]);
+  asm volatile("" : : "r"(memory_room.get()) : "memory");
   const auto start = Clock::now();
   const bool tty = isatty(STDERR_FILENO) && &progress_stream == &std::cerr;
   StepProgress progress(progress_stream, options.steps, !options.quiet, tty, options.progress_note);
@@ -645,8 +669,19 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
                    std::to_string(result.steps) + " steps, while the run wrote its outputs";
   }
   result.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
-  if (options.state_hash || options.print_hash || options.out_dir)
-    result.state_hash = world->StateHash();
+  if (!result.ok) memory_room.reset();
+  // Out of memory after a failure (a script that filled it), the hash's
+  // copies cannot be had: the run's own error stands, without a hash.
+  if (options.state_hash || options.print_hash || options.out_dir) {
+    try {
+      result.state_hash = world->StateHash();
+    } catch (const std::bad_alloc&) {
+      if (result.ok) {
+        result.ok = false;
+        result.error.assign("out of memory while hashing the world's state at the end");
+      }
+    }
+  }
   result.peak_rss_mb = PeakRssMb();
 
   // The summary.

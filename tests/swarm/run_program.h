@@ -33,6 +33,14 @@ inline std::string AddressSpaceLimit(int64_t kb) {
 #endif
 }
 
+// Whether glibc itself ended the program (abort, exit 134) for want of
+// memory under a tight ulimit -v: "Fatal glibc error: failed to register
+// TLS destructor: out of memory", as a thread first touches a thread_local.
+// No program can catch that; tests of running out of memory allow it.
+inline bool EndedByGlibcOutOfMemory(int exit_code, const std::string& output) {
+  return exit_code == 134 && output.find("Fatal glibc error") != std::string::npos;
+}
+
 inline CommandResult RunCommand(const std::string& command) {
   CommandResult r;
   FILE* pipe = popen((command + " 2>&1").c_str(), "r");

@@ -8,7 +8,10 @@
 #include <cstdio>
 #include <deque>
 #include <mutex>
+#include <new>
 #include <sstream>
+#include <string>
+#include <string_view>
 #include <thread>
 
 #include "framework/error.h"
@@ -27,7 +30,8 @@ namespace {
 
 constexpr int kMaxSide = 8192;  // pixels, the renderer's limit
 constexpr int kMaxVideoSide = 4096;
-constexpr size_t kMaxQueued = 4;  // frames waiting for the recorder's thread
+constexpr size_t kMaxQueued = 4;       // frames waiting for the recorder's thread
+constexpr size_t kMessageRoom = 1024;  // bytes of a failure's message the thread keeps
 
 std::string Size(int w, int h) { return std::to_string(w) + "x" + std::to_string(h); }
 
@@ -139,8 +143,19 @@ struct Recorder::Impl {
   int64_t frames_written = 0;
   std::thread thread;
 
+  // The recorder's thread. Nothing may escape it (an exception there ended
+  // the process: std::terminate, exit 134): out of memory, a job fails
+  // with a fixed message written into room taken before the jobs, and the
+  // thread goes on draining the queue, so Capture and Finish never wait
+  // for ever.
   void Work() {
+    static constexpr const char* kOutOfMemory =
+        "out of memory while drawing or writing a frame (the machine, a ulimit or --max-memory "
+        "gave no more)";
     Image image;  // this thread's frame
+    std::string what, path;
+    what.reserve(kMessageRoom);
+    path.reserve(64);
     std::unique_lock lock(mutex);
     for (;;) {
       wake.wait(lock, [&] { return closing || !queue.empty(); });
@@ -148,8 +163,8 @@ struct Recorder::Impl {
       Job job = std::move(queue.front());
       const bool failed = !error.empty();
       lock.unlock();
-      std::string what;
-      std::string path;
+      what.clear();
+      path.clear();
       if (!failed) {
         try {
           DropHiddenFaces(job.view, job.closed, &job.list);
@@ -158,30 +173,37 @@ struct Recorder::Impl {
             char name[64];
             std::snprintf(name, sizeof name, "snapshots/step_%06lld.png",
                           static_cast<long long>(job.step));
-            path = name;
-            what = "--snapshot-every: ";
+            path.assign(name);
+            what.assign("--snapshot-every: ");
             paint::WritePng(settings.out_dir / path, image.width, image.height, image.rgb);
           }
           if (job.video) {
-            what = "--video: ";
+            what.assign("--video: ");
             writer->Write(image);
           }
           what.clear();
+        } catch (const std::bad_alloc&) {
+          what.assign(kOutOfMemory);
         } catch (const std::exception& e) {
-          what += e.what();
+          // Within the room taken: a message longer than that is cut.
+          const std::string_view text = e.what();
+          what.append(text.substr(0, what.capacity() - std::min(what.size(), what.capacity())));
         }
       }
       lock.lock();
       if (!failed && what.empty()) {
-        if (job.snapshot)
-          snapshots.push_back(
-              {"snapshot", path, "step " + std::to_string(job.step) + ", " + view_name});
-        if (job.video) ++frames_written;
-      } else if (!what.empty() && error.empty()) {
-        error = what;
+        try {
+          if (job.snapshot)
+            snapshots.push_back(
+                {"snapshot", path, "step " + std::to_string(job.step) + ", " + view_name});
+          if (job.video) ++frames_written;
+        } catch (const std::bad_alloc&) {
+          what.assign(kOutOfMemory);
+        }
       }
+      if (!what.empty() && error.empty()) error.assign(what);  // within error's room
       queue.pop_front();
-      spare.push_back(std::move(job));
+      spare.push_back(std::move(job));  // room for every job taken at the start
       room.notify_all();
     }
   }
@@ -346,6 +368,9 @@ Recorder::Recorder(World* world, const RecorderSettings& settings)
     Image image;
     rendering::Draw(rendering::DrawList{}, probe, rendering::DrawOptions{}, &image);
   }
+  // Room the recorder's thread fills without asking for memory (Work).
+  r.error.reserve(kMessageRoom);
+  r.spare.reserve(kMaxQueued + 2);
   r.thread = std::thread([&r] { r.Work(); });
   pthread_setname_np(r.thread.native_handle(), "recorder");  // in top and perf
 }

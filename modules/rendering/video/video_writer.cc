@@ -80,6 +80,7 @@ class LibavEncoder final : public FrameEncoder {
   AVPacket* packet_ = nullptr;
   int64_t frames_ = 0;
   bool finished_ = false;
+  bool broken_ = false;  // the encoder failed: not used again
 };
 
 LibavEncoder::~LibavEncoder() { Free(); }
@@ -96,12 +97,21 @@ void LibavEncoder::Free() {
 }
 
 void LibavEncoder::Encode(const AVFrame* f) {
+  // An encoder that failed once is not asked again: x264 out of memory
+  // left its state half updated, and the end's flush crashed in it.
+  if (broken_) throw std::runtime_error("video '" + name_ + "': the H.264 encoder failed earlier");
   int rc = avcodec_send_frame(codec_, f);
-  if (rc < 0) Fail("the H.264 encoder failed", rc);
+  if (rc < 0) {
+    broken_ = true;
+    Fail("the H.264 encoder failed", rc);
+  }
   for (;;) {
     rc = avcodec_receive_packet(codec_, packet_);
     if (rc == AVERROR(EAGAIN) || rc == AVERROR_EOF) return;
-    if (rc < 0) Fail("the H.264 encoder failed", rc);
+    if (rc < 0) {
+      broken_ = true;
+      Fail("the H.264 encoder failed", rc);
+    }
     av_packet_rescale_ts(packet_, codec_->time_base, stream_->time_base);
     packet_->stream_index = stream_->index;
     rc = av_interleaved_write_frame(format_, packet_);  // takes the packet's data
@@ -205,7 +215,9 @@ std::string LibavEncoder::Write(const Image& image) try {
 std::string LibavEncoder::Finish() try {
   if (finished_) return "";
   finished_ = true;
-  Encode(nullptr);
+  // After a failure, the frames encoded before it, in a file that ends
+  // properly (the encoder's own delayed frames are lost with it).
+  if (!broken_) Encode(nullptr);
   int rc = av_write_trailer(format_);
   if (rc < 0) Fail("cannot complete the file", rc);
   rc = avio_closep(&format_->pb);

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "framework/sanitizers.h"
 #include "modules/paint/png_io.h"
 #include "modules/rendering/video/video_writer.h"
 #include "tests/swarm/run_program.h"
@@ -130,6 +131,29 @@ TEST(VideoCli, SnapshotsEveryNStepsArePngsOfTheArenaWithTheBoxWhereItIs) {
       EXPECT_TRUE(std::filesystem::exists(out / o["path"].get<std::string>())) << o;
     }
   EXPECT_EQ(listed, 3);
+}
+
+// Out of memory while the video is drawn and encoded, at limits where it
+// ran out in different places: the recorder's thread let std::bad_alloc
+// escape (std::terminate, exit 134), and x264, failed once, was flushed
+// at the end and crashed (exit 139). Each ends with a message now, or
+// runs (or glibc itself aborts, which nothing can catch: run_program.h).
+// Not under AddressSanitizer (ulimit -v stops it before main).
+TEST(VideoCli, RunningOutOfMemoryWhileRecordingVideoEndsWithAMessage) {
+  if (kAddressSanitizer) GTEST_SKIP() << "ulimit -v stops ASan builds before main";
+  for (const int kb : {520000, 600000}) {
+    const std::string out = FreshTempDir("video_cli", "oom").string();
+    const testing::CommandResult r = testing::RunCommand(
+        testing::AddressSpaceLimit(kb) + SWARMSIM_BINARY + " run " + SWARMSIM_SOURCE_DIR +
+        "/worlds/diffusion.yaml --set robots=1000 --steps 40 --threads 2 --quiet --video --out " +
+        out);
+    if (testing::EndedByGlibcOutOfMemory(r.exit_code, r.output)) continue;
+    EXPECT_LT(r.exit_code, 128) << kb << ": " << r.output;
+    EXPECT_EQ(r.output.find("terminate called"), std::string::npos) << kb << ": " << r.output;
+    if (r.exit_code != 0) {
+      EXPECT_NE(r.output.find("error: "), std::string::npos) << kb << ": " << r.output;
+    }
+  }
 }
 
 TEST(VideoCli, SnapshotsNeedAnOutputFolder) {
