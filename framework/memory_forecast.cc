@@ -24,12 +24,20 @@ constexpr int64_t kFirstCheck = 1000;
 // Worlds smaller than this are never checked.
 constexpr int64_t kMinItems = 2000;
 
-uint64_t ResidentBytes() {
+// The process's sizes in bytes (/proc/self/statm): mapped, resident and
+// data (+ stack); all zero if unreadable.
+struct ProcessSizes {
+  uint64_t mapped = 0, resident = 0, data = 0;
+};
+ProcessSizes ReadProcessSizes() {
   std::ifstream in("/proc/self/statm");
-  uint64_t size = 0, resident = 0;
-  if (!(in >> size >> resident)) return 0;
-  return resident * static_cast<uint64_t>(sysconf(_SC_PAGESIZE));
+  uint64_t size = 0, resident = 0, shared = 0, text = 0, lib = 0, data = 0;
+  if (!(in >> size >> resident >> shared >> text >> lib >> data)) return {};
+  const uint64_t page = static_cast<uint64_t>(sysconf(_SC_PAGESIZE));
+  return {size * page, resident * page, data * page};
 }
+
+uint64_t ResidentBytes() { return ReadProcessSizes().resident; }
 
 // MemAvailable + SwapFree from /proc/meminfo; UINT64_MAX if unreadable.
 uint64_t MachineAvailable() {
@@ -119,18 +127,14 @@ uint64_t CgroupAvailable() {
 }
 
 // Room under the process's own limits: its address space (ulimit -v) less
-// its virtual size, its data segment (ulimit -d) less its data size (what
+// what it has mapped, its data segment (ulimit -d) less its data size (what
 // malloc takes counts against both); UINT64_MAX without either. `*which`
 // names the nearer one.
-uint64_t LimitAvailable(const char** which) {
-  std::ifstream in("/proc/self/statm");
-  uint64_t size = 0, resident = 0, shared = 0, text = 0, lib = 0, data = 0;
-  if (!(in >> size >> resident >> shared >> text >> lib >> data)) return UINT64_MAX;
-  const uint64_t page = static_cast<uint64_t>(sysconf(_SC_PAGESIZE));
+uint64_t LimitAvailable(const ProcessSizes& sizes, const char** which) {
   uint64_t room = UINT64_MAX;
   for (const auto& [resource, used, name] :
-       {std::tuple{RLIMIT_AS, size * page, "the address-space limit (ulimit -v)"},
-        std::tuple{RLIMIT_DATA, data * page, "the data-size limit (ulimit -d)"}}) {
+       {std::tuple{RLIMIT_AS, sizes.mapped, "the address-space limit (ulimit -v)"},
+        std::tuple{RLIMIT_DATA, sizes.data, "the data-size limit (ulimit -d)"}}) {
     rlimit limit{};
     if (getrlimit(resource, &limit) != 0 || limit.rlim_cur == RLIM_INFINITY) continue;
     const uint64_t left = limit.rlim_cur > used ? limit.rlim_cur - used : 0;
@@ -220,7 +224,8 @@ bool ParseMemorySize(const std::string& text, uint64_t* bytes) {
 
 MemoryRoom ReadMemoryRoom(uint64_t cap) {
   MemoryRoom room;
-  room.resident = ResidentBytes();
+  const ProcessSizes sizes = ReadProcessSizes();
+  room.resident = sizes.resident;
   const uint64_t machine = MachineAvailable();
   if (machine != UINT64_MAX) {
     room.available = machine;
@@ -231,7 +236,7 @@ MemoryRoom ReadMemoryRoom(uint64_t cap) {
     room.bound = "the memory limit of the process's cgroup";
   }
   const char* which = nullptr;
-  if (const uint64_t own = LimitAvailable(&which); own < room.available) {
+  if (const uint64_t own = LimitAvailable(sizes, &which); own < room.available) {
     room.available = own;
     room.bound = which;
   }

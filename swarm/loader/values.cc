@@ -241,7 +241,9 @@ ParamValue Expressions::Evaluate(std::string_view expression, const Scope& scope
   ParamValue result;
   std::string error;
   if (!impl_->lua.Call(0, 1, &error)) {
-    error = StripChunkPosition(error);
+    // ("attempt to perform arithmetic on a string value (global 'robots')":
+    // what the parameters held says why.)
+    error = StripChunkPosition(error) + ValuesUsed(expression, scope);
   } else {
     switch (lua_type(L, -1)) {
       case LUA_TNUMBER: {
@@ -318,19 +320,7 @@ ParamValue ValueReader::Resolve(const Field& field) const {
     try {
       return expressions_->Evaluate(expression, scope_);
     } catch (const Error& e) {
-      // Lua names the global it could not use ("... on a string value
-      // (global 'robots')"): a parameter, say what it holds.
-      const std::string what = e.what();
-      std::string held;
-      if (const size_t at = what.rfind("(global '"); at != std::string::npos) {
-        const size_t from = at + 9, to = what.find("')", from);
-        const ParamValue* value =
-            to == std::string::npos ? nullptr : scope_.Find(what.substr(from, to - from));
-        if (value != nullptr && !std::holds_alternative<double>(*value))
-          held = "; the parameter '" + what.substr(from, to - from) + "' is " + TypeName(*value) +
-                 ", " + FormatValue(*value);
-      }
-      Fail(field, "in expression '" + expression + "' for '" + field.name + "': " + what + held);
+      Fail(field, "in expression '" + expression + "' for '" + field.name + "': " + e.what());
     }
   }
   return ParseScalar(text, field.node.Tag() == "!");

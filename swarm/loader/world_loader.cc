@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cctype>
-#include <charconv>
 #include <cmath>
 #include <utility>
 
@@ -456,27 +455,16 @@ WorldSettings WorldLoader::ReadSimulation(const Fields& top, std::optional<int64
     if (f.Has("physics_partitions")) {
       // auto: the backend chooses from the scene (never from the thread count).
       const Field partitions = f.Get("physics_partitions");
-      // Written, or from a parameter ($parts, a sweep's values): a string
-      // parameter set on the command line holds "4" as text.
+      // Written, or from a parameter ($parts: a sweep over 1 and auto);
+      // Integer reads a count given as text (--set parts=4 on a parameter
+      // declared as auto).
       const ParamValue value =
           partitions.node.IsScalar() ? values.Resolve(partitions) : ParamValue(0.0);
-      const std::string* text = std::get_if<std::string>(&value);
-      int64_t whole = 0;
-      if (text != nullptr && *text == "auto") {
+      if (const std::string* text = std::get_if<std::string>(&value); text && *text == "auto")
         s.physics_partitions = 0;
-      } else if (text != nullptr) {
-        const std::string_view t = *text;
-        const auto [end, error] = std::from_chars(t.data(), t.data() + t.size(), whole);
-        if (error != std::errc() || end != t.data() + t.size() || whole < 1 || whole > 1024) {
-          const std::string written(partitions.node.Scalar());
-          values.Fail(partitions,
-                      "'physics_partitions' must be auto or a whole number from 1 to 1024 (got '" +
-                          *text + "'" + (written != *text ? " from '" + written + "'" : "") + ")");
-        }
-        s.physics_partitions = static_cast<int>(whole);
-      } else {
-        s.physics_partitions = static_cast<int>(values.Integer(partitions, 1, 1024));
-      }
+      else
+        s.physics_partitions = static_cast<int>(
+            values.Integer(partitions, 1, 1024, "auto or a whole number from 1 to 1024"));
     }
     if (f.Has("seed")) s.seed = values.Seed(f.Get("seed"));
     if (f.Has("gravity"))

@@ -187,7 +187,7 @@ struct Recorder::Impl {
         } catch (const std::exception& e) {
           // Within the room taken: a message longer than that is cut.
           const std::string_view text = e.what();
-          what.append(text.substr(0, what.capacity() - std::min(what.size(), what.capacity())));
+          what.append(text.substr(0, what.capacity() - what.size()));
         }
       }
       lock.lock();

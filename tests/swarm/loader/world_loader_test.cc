@@ -328,7 +328,7 @@ TEST_F(MalformedWorldTest, PhysicsPartitionsIsAutoOrACount) {
   options.overrides = {{"p", "lots"}};
   const std::string error = ErrorOf([&] { Load(from_parameter, options); });
   EXPECT_NE(error.find("world.yaml:3:34: 'physics_partitions' must be auto or a whole number "
-                       "from 1 to 1024 (got 'lots' from '$p')"),
+                       "from 1 to 1024 (got \"lots\" from \"$p\")"),
             std::string::npos)
       << error;
 }
@@ -357,10 +357,11 @@ TEST_F(MalformedWorldTest, EachMistakeHasAClearMessage) {
       {"partitions not auto or a number",
        "arena: {size: 2}\nsimulation: {physics_partitions: automatic}\n",
        {"world.yaml:2:34:", "'physics_partitions' must be auto or a whole number from 1 to 1024",
-        "(got 'automatic')"}},
+        "(got \"automatic\")"}},
       {"zero partitions",
        "arena: {size: 2}\nsimulation: {physics_partitions: 0}\n",
-       {"world.yaml:2:34:", "'physics_partitions' must be a whole number from 1 to 1024"}},
+       {"world.yaml:2:34:", "'physics_partitions' must be auto or a whole number from 1 to 1024",
+        "(got \"0\")"}},
       {"inf size", "arena: {size: inf}\n", {"positive number"}},
       {"huge size",
        "arena: {size: 1e300}\n",
@@ -375,7 +376,7 @@ TEST_F(MalformedWorldTest, EachMistakeHasAClearMessage) {
       {"a parameter of text in arithmetic",
        "parameters: {robots: lots, density: 1}\narena: {size: '= sqrt(robots / density)'}\n",
        {"world.yaml:2:15:", "in expression 'sqrt(robots / density)' for 'size'",
-        "(global 'robots'); the parameter 'robots' is a string, \"lots\""}},
+        "(global 'robots'); with robots = \"lots\", density = 1"}},
       {"expression syntax",
        "arena: {size: '= 2 +'}\n",
        {"world.yaml:1:15:", "in expression '2 +'"}},
