@@ -1,5 +1,7 @@
 #include "framework/error.h"
 
+#include "framework/start_thread.h"
+
 namespace swarmsim {
 
 namespace {
@@ -30,6 +32,13 @@ void ThrowCheckFailure(const char* condition, const char* file, int line,
                       ": check '" + condition + "' failed" +
                       (message.empty() ? "" : ": " + message) +
                       " (this is a swarmsim bug; please report it)");
+}
+
+std::string CannotStartThreadMessage(const char* what, const std::system_error& error) {
+  return std::string("cannot start a thread for ") + what + ": " + error.what() +
+         " (the system gave this process no more threads, or no room for a thread's stack: "
+         "see `ulimit -u`, the threads a user may run, and `ulimit -v`, the address space, "
+         "against `ulimit -s`, which each thread's stack takes)";
 }
 
 }  // namespace swarmsim

@@ -582,7 +582,11 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
     view_server = std::make_unique<viewer::Server>(*options.out_dir);
     if (const int code = BindViewServer(args.view_host, args.view_port, view_server.get()))
       return code;
-    view_server->Start();
+    try {
+      view_server->Start();
+    } catch (const Error& e) {  // no thread to serve on
+      return bad_input(e.what());
+    }
   }
   // Snapshots: checked (and a state loaded) before the run starts.
   if (!args.save_state.empty() || !args.load_state.empty()) {

@@ -10,6 +10,7 @@
 #include <cstring>
 
 #include "framework/error.h"
+#include "framework/start_thread.h"
 #include "swarm/record/format.h"
 
 namespace swarmsim::record {
@@ -108,7 +109,15 @@ ChunkWriter::ChunkWriter(const std::filesystem::path& path, int zstd_level, uint
   fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd_ < 0) throw Error("cannot create " + path.string() + ": " + std::strerror(errno));
   cctx_ = ZSTD_createCCtx();
-  thread_ = std::thread([this] { Run(); });
+  try {
+    thread_ = StartThread("the recording's writer", [this] { Run(); });
+  } catch (const Error&) {  // no destructor runs: what the constructor took goes here
+    ZSTD_freeCCtx(static_cast<ZSTD_CCtx*>(cctx_));
+    ::close(fd_);
+    std::error_code ec;
+    std::filesystem::remove(path_, ec);  // empty
+    throw;
+  }
 }
 
 ChunkWriter::~ChunkWriter() {

@@ -23,9 +23,11 @@
 #include <memory>
 #include <new>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <thread>
+#include <utility>
 
 #include "framework/csv.h"
 #include "framework/error.h"
@@ -33,6 +35,7 @@
 #include "framework/registry.h"
 #include "framework/regular_file.h"
 #include "framework/script_host.h"
+#include "framework/start_thread.h"
 #include "framework/state_hash.h"
 #include "framework/utf8.h"
 #include "swarm/run/huge_pages.h"
@@ -156,7 +159,7 @@ class Watchdog {
         world_timeout_(world_timeout),
         instruction_budget_(instruction_budget),
         end_run_(std::move(end_run)),
-        thread_([this] { Watch(); }) {}
+        thread_(StartThread("the run's watchdog", [this] { Watch(); })) {}
   ~Watchdog() {
     {
       const std::lock_guard lock(wake_mutex_);
@@ -387,7 +390,16 @@ struct RunRecord {
   // Room for the last summary.json when the disk fills during the run.
   OutputReserve summary_room;
   double lua_kib = 0;  // the scripts' memory when they stopped
+  // The output folder as the run found it (device, inode): removed or
+  // renamed during the run, the files written into it went with it.
+  std::optional<std::pair<dev_t, ino_t>> out_folder;
 };
+
+std::optional<std::pair<dev_t, ino_t>> FolderIdentity(const std::filesystem::path& dir) {
+  struct stat st {};
+  if (::stat(dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) return std::nullopt;
+  return std::pair{st.st_dev, st.st_ino};
+}
 
 // Starts `world` and steps it options.steps times under a Watchdog, writing
 // metrics as it goes. A failure ends up in record->result (ok false, error);
@@ -434,10 +446,24 @@ void StepWatched(World* world, const RunOptions& options, Clock::time_point star
   // world, whose work grows with the robots (a million Lua robots start in
   // about 45 s on a 2-core VM), that much for each 10,000 robots.
   const double step_timeout = world->settings().step_timeout;
-  Watchdog watchdog(
-      step_timeout,
-      step_timeout * std::max(1.0, static_cast<double>(world->robot_count()) / 10000.0),
-      world->settings().instruction_budget, end_stuck_run);
+  // No thread to watch the steps (a process limit): the run does not start,
+  // and ends as a failed run does, with its summary.json (the earlier
+  // run's, "ok", stayed in the folder whose other files were removed).
+  std::optional<Watchdog> watching;
+  try {
+    watching.emplace(
+        step_timeout,
+        step_timeout * std::max(1.0, static_cast<double>(world->robot_count()) / 10000.0),
+        world->settings().instruction_budget, end_stuck_run);
+  } catch (const std::exception& e) {
+    result.error.assign(e.what());
+    if (options.out_dir) {  // the earlier run's, which this run's would have replaced
+      std::error_code ec;
+      std::filesystem::remove(*options.out_dir / "metrics.csv", ec);
+    }
+    return;
+  }
+  Watchdog& watchdog = *watching;
   // Outputs of the step just done, then the next unit of work for the
   // watchdog's message; under its lock, so it never writes at the same time.
   // --save-state: the samples taken before the state is saved, which it
@@ -474,6 +500,7 @@ void StepWatched(World* world, const RunOptions& options, Clock::time_point star
         throw Error("cannot write '" + (*options.out_dir / "summary.json").string() +
                     "': " + reason);
       record->summary_room.Reserve(*options.out_dir, kSummaryRoom);
+      record->out_folder = FolderIdentity(*options.out_dir);
       metrics = std::make_unique<MetricsWriter>(*options.out_dir / "metrics.csv", *world);
     }
     const Clock::time_point starting = Clock::now();
@@ -693,6 +720,21 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
 
   // The last file: the room kept for it is given back first (a full disk).
   record.summary_room.Release();
+  // The folder removed or renamed while the run wrote into it (exit 0 and
+  // no word before, the outputs gone or elsewhere): said, and no new
+  // folder holding a summary.json without the files it lists.
+  if (record.out_folder && FolderIdentity(*options.out_dir) != record.out_folder) {
+    const std::string message = "the output folder '" + options.out_dir->string() +
+                                "' was removed or renamed during the run; the outputs written "
+                                "into it went with it, and its summary.json is not written";
+    if (result.ok) {
+      result.ok = false;
+      result.error = message;
+    } else {
+      result.error += "; " + message;
+    }
+    return result;
+  }
   if (options.out_dir && std::filesystem::is_directory(*options.out_dir)) {
     if (const std::string reason =
             WriteSummary(*world, options, result, record.lua_kib, /*complete=*/true);

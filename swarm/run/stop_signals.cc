@@ -45,7 +45,13 @@ StopSignals::StopSignals() {
   action.sa_flags = 0;
   sigemptyset(&action.sa_mask);
   for (const int sig : kSignals) sigaddset(&action.sa_mask, sig);  // one handler at a time
-  for (size_t i = 0; i < kSignals.size(); ++i) sigaction(kSignals[i], &action, &saved_[i]);
+  for (size_t i = 0; i < kSignals.size(); ++i) {
+    sigaction(kSignals[i], nullptr, &saved_[i]);
+    // nohup: a hang-up the program was started to ignore stays ignored (the
+    // handler replaced it, and closing the terminal stopped a nohup'd run).
+    if (kSignals[i] == SIGHUP && saved_[i].sa_handler == SIG_IGN) continue;
+    sigaction(kSignals[i], &action, nullptr);
+  }
   // A program started with them blocked (a batch system's wrapper) would
   // never see them; a signal already pending arrives now, and is noted.
   sigset_t mask;

@@ -4,7 +4,8 @@
 // repeats within kGraceMs of it (Ctrl-C pressed twice: the outputs are
 // being written); a signal after that acts as usual, so a stuck program can
 // still be ended. Without SA_RESTART, a signal also ends a blocking wait
-// (the sweep's for its runs).
+// (the sweep's for its runs). A SIGHUP ignored when the StopSignals is made
+// (nohup) stays ignored.
 #pragma once
 
 #include <array>

@@ -13,6 +13,7 @@
 
 #include "framework/error.h"
 #include "framework/shared_library.h"
+#include "framework/start_thread.h"
 #include "swarm/viewer/assets.h"
 #include "swarm/viewer/http_module.h"
 #include "swarm/viewer/page.h"
@@ -91,7 +92,7 @@ std::string Server::Address() const {
 void Server::Run() { impl_->http->Run(); }
 
 void Server::Start() {
-  thread_ = std::thread([this] { Run(); });
+  thread_ = StartThread("the viewer's server", [this] { Run(); });
 }
 
 void Server::Stop() {

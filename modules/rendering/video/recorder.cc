@@ -16,6 +16,7 @@
 
 #include "framework/error.h"
 #include "framework/registry.h"
+#include "framework/start_thread.h"
 #include "framework/world.h"
 #include "modules/paint/png_io.h"
 #include "modules/rendering/geometry.h"
@@ -354,6 +355,18 @@ Recorder::Recorder(World* world, const RecorderSettings& settings)
       throw Error(std::string("--video: ") + e.what());
     }
   }
+  // What fails from here on (no snapshots folder, no OSMesa, no thread)
+  // leaves no video file of no frames behind.
+  struct DropVideo {
+    Impl* r;
+    const std::filesystem::path* file;
+    ~DropVideo() {
+      if (r == nullptr || r->writer == nullptr) return;
+      r->writer.reset();
+      std::error_code ec;
+      std::filesystem::remove(*file, ec);
+    }
+  } drop_video{&r, &settings.video};
   if (settings.snapshot_every > 0) {
     std::error_code ec;
     std::filesystem::create_directories(settings.out_dir / "snapshots", ec);
@@ -371,7 +384,8 @@ Recorder::Recorder(World* world, const RecorderSettings& settings)
   // Room the recorder's thread fills without asking for memory (Work).
   r.error.reserve(kMessageRoom);
   r.spare.reserve(kMaxQueued + 2);
-  r.thread = std::thread([&r] { r.Work(); });
+  r.thread = StartThread("the video's and snapshots' recorder", [&r] { r.Work(); });
+  drop_video.r = nullptr;
   pthread_setname_np(r.thread.native_handle(), "recorder");  // in top and perf
 }
 

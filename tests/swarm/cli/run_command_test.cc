@@ -1,6 +1,7 @@
 // swarmsim run WORLD (swarm/cli/run_command.cc) as a user meets it: exit codes,
 // messages naming file and line, the summary and metrics it writes.
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 
 #include <filesystem>
 #include <fstream>
@@ -342,6 +343,70 @@ TEST(CliTest, AWorldThatWillNotFitIsRefusedWithAMessage) {
 // message and its summary: the state hash it prints read the half-built
 // physics and crashed (exit 139). Not under AddressSanitizer, whose shadow
 // memory takes more address space than any cap.
+// A thread the run needs that the system does not start (ulimit -u; here
+// ulimit -v against the stack size each thread takes, ulimit -s): the run
+// ended with "error: Resource temporarily unavailable", no summary.json,
+// and the earlier run's ("ok") left beside the files it had removed. Now
+// the thread is named, and the summary says the run failed.
+TEST(CliTest, AThreadThatCannotBeStartedIsNamedAndTheSummarySaysSo) {
+  if (swarmsim::kAddressSanitizer) GTEST_SKIP() << "ulimit -v stops ASan builds before main";
+  rlimit stack{};
+  if (getrlimit(RLIMIT_STACK, &stack) != 0 ||
+      (stack.rlim_max != RLIM_INFINITY && stack.rlim_max < 4000000ull * 1024))
+    GTEST_SKIP() << "the hard stack limit is below 4 GB";
+  const fs::path out = TempDir("no_thread");
+  for (const auto& [flags, thread] :
+       {std::pair{"", "the run's watchdog"}, std::pair{" --record", "the recording's writer"}}) {
+    Result earlier =
+        RunProgram("run " + Data("ok.yaml") + " --steps 2 --quiet --record --out " + out.string());
+    ASSERT_EQ(earlier.exit_code, 0) << earlier.output;
+    ASSERT_TRUE(fs::exists(out / "recording.swrec"));
+    // glibc gives each thread a stack of ulimit -s: 4 GB, in 3 GB of room.
+    Result r = swarmsim::testing::RunCommand(
+        "ulimit -s 4000000 && ulimit -v 3000000 && " + std::string(SWARMSIM_BINARY) + " run " +
+        Data("ok.yaml") + " --steps 2 --quiet" + flags + " --out " + out.string());
+    EXPECT_TRUE(r.exit_code == 1 || r.exit_code == 2) << r.output;
+    EXPECT_NE(r.output.find(std::string("cannot start a thread for ") + thread +
+                            ": Resource temporarily unavailable"),
+              std::string::npos)
+        << r.output;
+    EXPECT_NE(r.output.find("`ulimit -u`"), std::string::npos) << r.output;
+    std::ifstream summary_file(out / "summary.json");
+    ASSERT_TRUE(summary_file.good()) << r.output;
+    const nlohmann::json summary = nlohmann::json::parse(summary_file);
+    EXPECT_EQ(summary["status"], "error") << flags;
+    EXPECT_NE(summary["error"].get<std::string>().find(thread), std::string::npos) << flags;
+    // Nothing of the earlier run's is left to be taken for this one's.
+    EXPECT_FALSE(fs::exists(out / "metrics.csv")) << flags;
+    EXPECT_FALSE(fs::exists(out / "recording.swrec")) << flags;
+  }
+  fs::remove_all(out);
+}
+
+// The output folder renamed (or removed) while the run writes into it: the
+// run ended with exit 0 and no word, its summary.json never written (a new
+// folder of that name would hold a summary listing files it does not
+// have). Now it says so and fails. The run is stopped by SIGTERM once its
+// first metrics are in the folder (waited for, not timed).
+TEST(CliTest, AnOutputFolderRenamedDuringTheRunIsSaid) {
+  const fs::path out = TempDir("renamed");
+  const fs::path moved = out.string() + "_moved";
+  fs::remove_all(moved);
+  const Result r = swarmsim::testing::RunCommand(
+      "cd " + out.parent_path().string() + " && (" + SWARMSIM_BINARY + " run " + Data("ok.yaml") +
+      " --steps 100000000 --quiet --out " + out.string() + " & pid=$!; while [ ! -s " +
+      (out / "metrics.csv").string() + " ]; do sleep 0.02; done; mv " + out.string() + " " +
+      moved.string() + "; kill -TERM $pid; wait $pid; echo exit=$?)");
+  EXPECT_NE(r.output.find("exit=143"), std::string::npos) << r.output;  // 128 + SIGTERM
+  EXPECT_NE(r.output.find("the output folder '" + out.string() +
+                          "' was removed or renamed during the run"),
+            std::string::npos)
+      << r.output;
+  EXPECT_FALSE(fs::exists(out)) << "no new folder";
+  EXPECT_TRUE(fs::exists(moved / "metrics.csv"));
+  fs::remove_all(moved);
+}
+
 TEST(CliTest, AnAddressSpaceLimitIsRoomTooAndRunningOutOfItIsNamed) {
   if (swarmsim::kAddressSanitizer) GTEST_SKIP() << "ulimit -v stops ASan builds before main";
   const std::string limit = swarmsim::testing::AddressSpaceLimit(600000);
@@ -370,9 +435,6 @@ TEST(CliTest, AnAddressSpaceLimitIsRoomTooAndRunningOutOfItIsNamed) {
     EXPECT_TRUE(r.exit_code == 1 || r.exit_code == 2) << world << ": " << r.output;
     EXPECT_NE(r.output.find("memory"), std::string::npos) << world << ": " << r.output;
     EXPECT_EQ(r.output.find("std::bad_alloc"), std::string::npos) << world << ": " << r.output;
-    // (A thread that cannot be started, at such a limit, still ends the run
-    // before its summary: not mended yet.)
-    if (r.output.find("Resource temporarily unavailable") != std::string::npos) continue;
     std::ifstream summary(out2 / "summary.json");
     ASSERT_TRUE(summary.good()) << world << ": " << r.output;
     EXPECT_EQ(nlohmann::json::parse(summary)["status"], "error") << world;

@@ -12,7 +12,12 @@
 namespace swarmsim {
 namespace {
 
+// These tests raise SIGHUP: under nohup (a CI's wrapper) it starts ignored,
+// which StopSignals keeps (tested below).
+const bool g_hang_up_as_usual = std::signal(SIGHUP, SIG_DFL) != SIG_ERR;
+
 TEST(StopSignalsTest, TheFirstSignalIsNotedAndTheProgramGoesOn) {
+  ASSERT_TRUE(g_hang_up_as_usual);
   for (const int sig : {SIGINT, SIGTERM, SIGHUP}) {
     StopSignals stop;
     EXPECT_EQ(StopSignals::Received(), 0);
@@ -101,6 +106,22 @@ TEST(StopSignalsTest, ASignalPendingWhileBlockedIsNotedOnCreation) {
   signal(SIGTERM, SIG_IGN);
   pthread_sigmask(SIG_SETMASK, &old, nullptr);
   sigaction(SIGTERM, &before, nullptr);
+}
+
+TEST(StopSignalsTest, AHangUpIgnoredAtTheStartStaysIgnored) {
+  // nohup: closing the terminal does not stop the run.
+  ASSERT_NE(std::signal(SIGHUP, SIG_IGN), SIG_ERR);
+  {
+    StopSignals stop;
+    ASSERT_EQ(raise(SIGHUP), 0);
+    EXPECT_EQ(StopSignals::Received(), 0);
+    ASSERT_EQ(raise(SIGTERM), 0);  // the others are still requests to stop
+    EXPECT_EQ(StopSignals::Received(), SIGTERM);
+  }
+  struct sigaction now {};
+  ASSERT_EQ(sigaction(SIGHUP, nullptr, &now), 0);
+  EXPECT_EQ(now.sa_handler, SIG_IGN);
+  std::signal(SIGHUP, SIG_DFL);
 }
 
 }  // namespace
