@@ -12,6 +12,7 @@
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -221,25 +222,45 @@ int CoordinateSweep(const SweepOptions& o, RemoteWorkers* remote, std::ostream& 
   };
   auto running = [&] { return pool.active() + (remote ? remote->Running() : 0); };
   int stop_signal = 0;
+  // The first run the machine failed (a full disk): the sweep stops there.
+  std::optional<RunOutcome> machine_failure;
   auto done = [&](RunOutcome outcome) {
     // After a stop signal, a run that did not finish (the signal reached it
     // too) is no result: it stays claimed and runs again on resume.
     if (!outcome.ok && (stop_signal != 0 || StopSignals::Received() != 0)) return;
+    // Nor is a run the machine failed (every run after it would fail the
+    // same way, and be recorded as failed for good: a full TMPDIR burnt
+    // through the grid in seconds). No new runs; those in progress finish.
+    if (outcome.machine) {
+      if (!machine_failure) machine_failure = std::move(outcome);
+      pending.clear();
+      return;
+    }
     db.Complete(outcome);
     progress.RunEnded(outcome.id, outcome.ok, outcome.error, running());
   };
-  while (!pending.empty() || pool.active() > 0 || (remote && remote->Busy())) {
-    if (stop_signal == 0 && StopSignals::Received() != 0) {
-      // Stop: no new runs (the other ranks are told so as they ask), the
-      // local runs in progress killed.
-      stop_signal = StopSignals::Received();
-      pending.clear();
-      pool.KillAll();
-      continue;
+  // Out of room for the database, or no scratch folder or process to be
+  // had: the finished runs are in the database; the same command resumes.
+  try {
+    while (!pending.empty() || pool.active() > 0 || (remote && remote->Busy())) {
+      if (stop_signal == 0 && StopSignals::Received() != 0) {
+        // Stop: no new runs (the other ranks are told so as they ask), the
+        // local runs in progress killed.
+        stop_signal = StopSignals::Received();
+        pending.clear();
+        pool.KillAll();
+        continue;
+      }
+      while (pool.HasFreeSlot() && !pending.empty()) pool.Start(*next());
+      if (remote) remote->Service(next, done);
+      for (RunOutcome& outcome : pool.Poll(remote ? 0.002 : 0.5)) done(std::move(outcome));
     }
-    while (pool.HasFreeSlot() && !pending.empty()) pool.Start(*next());
-    if (remote) remote->Service(next, done);
-    for (RunOutcome& outcome : pool.Poll(remote ? 0.002 : 0.5)) done(std::move(outcome));
+  } catch (const Error& e) {
+    pool.KillAll();
+    progress.Finish();
+    throw Error(std::string(e.what()) +
+                "; the runs finished before it are kept in the database: mend this and run the "
+                "same command to resume");
   }
   progress.Finish();
   const RunCounts after = db.Counts();
@@ -256,6 +277,22 @@ int CoordinateSweep(const SweepOptions& o, RemoteWorkers* remote, std::ostream& 
           << " in progress stopped (run again on resume)";
     err << ". Run the same command to resume; finished runs are kept.\n" << std::flush;
     return 128 + stop_signal;
+  }
+  if (machine_failure) {
+    std::string why = machine_failure->error;
+    if (why.rfind("error: ", 0) == 0) why.erase(0, 7);  // a line of the run's stderr
+    const bool disk = why.find("No space left") != std::string::npos ||
+                      why.find("quota") != std::string::npos ||
+                      why.find("Read-only") != std::string::npos;
+    err << "sweep: stopped: run " << machine_failure->id
+        << " could not run on this machine, and the next ones would not either: " << why
+        << (disk ? " (the runs write their outputs under " + config.scratch.parent_path().string() +
+                       ", $TMPDIR)"
+                 : std::string())
+        << ". It is not recorded as failed: " << (disk ? "free the room" : "raise the limit")
+        << " and run the same command to resume; finished runs are kept.\n"
+        << std::flush;
+    return 1;
   }
   if (after.failed > 0) {
     err << "sweep: " << after.failed << (after.failed == 1 ? " run" : " runs")

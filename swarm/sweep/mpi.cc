@@ -39,6 +39,7 @@ nlohmann::json ToJson(const RunOutcome& o) {
   nlohmann::json s = nlohmann::json::array();
   for (const SeriesPoint& p : o.series) s.push_back({p.metric, p.step, p.time, p.value});
   j["series"] = std::move(s);
+  j["machine"] = o.machine;
   return j;
 }
 
@@ -47,6 +48,7 @@ RunOutcome FromJson(const nlohmann::json& j) {
   o.id = j.at("id");
   o.ok = j.at("ok");
   o.error = j.at("error");
+  o.machine = j.value("machine", false);
   o.wall_s = j.at("wall_s");
   o.steps = j.at("steps");
   o.robots = j.at("robots");

@@ -49,6 +49,9 @@ struct RunOutcome {
   int64_t id = 0;
   bool ok = false;
   std::string error;
+  // The machine, not the world, failed the run (its disk full, no file or
+  // thread left to open or start): not recorded; the sweep stops there.
+  bool machine = false;
   double wall_s = 0;
   int64_t steps = 0;
   int64_t robots = 0;

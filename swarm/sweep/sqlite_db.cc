@@ -2,6 +2,8 @@
 
 #include <sqlite3.h>
 
+#include <cstring>
+
 #include "framework/error.h"
 #include "framework/utf8.h"
 
@@ -61,17 +63,33 @@ SqliteDb::SqliteDb(const std::filesystem::path& path, bool read_only) : path_(pa
 
 SqliteDb::~SqliteDb() { sqlite3_close_v2(db_); }
 
+// " (No space left on device)": what the system said to SQLite's last
+// failed call, which SQLite's own text ("disk I/O error") does not.
+std::string SqliteDb::SystemError() const {
+  const int error = sqlite3_system_errno(db_);
+  return error != 0 ? std::string(" (") + std::strerror(error) + ")" : std::string();
+}
+
 void SqliteDb::Exec(const std::string& sql) {
   char* message = nullptr;
   if (sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, &message) != SQLITE_OK) {
-    const std::string text = message ? message : "unknown error";
+    const std::string text = (message ? message : "unknown error") + SystemError();
     sqlite3_free(message);
-    throw Error("database '" + path_.string() + "': " + text + " (in: " + sql.substr(0, 80) + ")");
+    // The statement on one line (the schema's span several).
+    std::string statement;
+    for (const char c : sql.substr(0, 160)) {
+      const bool space = c == '\n' || c == ' ' || c == '\t';
+      if (space && (statement.empty() || statement.back() == ' ')) continue;
+      statement += space ? ' ' : c;
+      if (statement.size() >= 80) break;
+    }
+    throw Error("database '" + path_.string() + "': " + text + " (in: " + statement + ")");
   }
 }
 
 void SqliteDb::Fail(const std::string& what) const {
-  throw Error("database '" + path_.string() + "': " + what + ": " + sqlite3_errmsg(db_));
+  throw Error("database '" + path_.string() + "': " + what + ": " + sqlite3_errmsg(db_) +
+              SystemError());
 }
 
 SqliteStatement::SqliteStatement(SqliteDb* db, const std::string& sql) : db_(db) {

@@ -52,6 +52,7 @@ class SqliteDb {
 
   void Exec(const std::string& sql);
   [[noreturn]] void Fail(const std::string& what) const;
+  std::string SystemError() const;
   sqlite3* handle() { return db_; }
   const std::filesystem::path& path() const { return path_; }
 

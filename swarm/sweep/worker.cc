@@ -1,12 +1,15 @@
 #include "swarm/sweep/worker.h"
 
 #include <fcntl.h>
+#include <poll.h>
 #include <signal.h>
 #include <sys/prctl.h>
+#include <sys/signalfd.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <map>
@@ -23,13 +26,6 @@ namespace swarmsim {
 namespace {
 
 static_assert(sizeof(sigset_t) <= 128, "RunPool::old_mask_ too small");
-
-std::string ReadFile(const std::filesystem::path& path) {
-  std::ifstream f(path);
-  std::ostringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
 
 // The last non-empty lines of a child's stderr, for a failure message.
 std::string Tail(const std::string& text, int lines) {
@@ -125,11 +121,20 @@ std::vector<std::string> RunArguments(const WorkerConfig& config, const GridRun&
   return args;
 }
 
-RunOutcome CollectRun(int64_t id, const std::filesystem::path& out_dir, int wait_status,
-                      bool timed_out, double timeout_s) {
+bool IsMachineFailure(const std::string& error) {
+  for (const char* sign : {"No space left on device", "Disk quota exceeded", "Too many open files",
+                           "Resource temporarily unavailable", "cannot start a thread for",
+                           "cannot start the worker program", "Read-only file system"})
+    if (error.find(sign) != std::string::npos) return true;
+  return false;
+}
+
+RunOutcome CollectRun(int64_t id, const std::filesystem::path& out_dir,
+                      const std::string& stderr_text, int wait_status, bool timed_out,
+                      double timeout_s) {
   RunOutcome o;
   o.id = id;
-  const std::string err = Tail(ReadFile(out_dir / "stderr.txt"), 3);
+  const std::string err = Tail(stderr_text, 3);
   nlohmann::json summary;
   bool have_summary = false;
   try {
@@ -178,6 +183,9 @@ RunOutcome CollectRun(int64_t id, const std::filesystem::path& out_dir, int wait
     o.ok = true;
   }
   o.error = ValidUtf8(o.error);  // stderr's tail may hold any bytes
+  // (A timeout or a crash is the run's, whatever it said before.)
+  o.machine = !o.ok && !timed_out && WIFEXITED(wait_status) &&
+              (IsMachineFailure(o.error) || IsMachineFailure(err));
   return o;
 }
 
@@ -187,6 +195,9 @@ RunPool::RunPool(const WorkerConfig& config, int slots)
   sigemptyset(&block);
   sigaddset(&block, SIGCHLD);
   restore_mask_ = pthread_sigmask(SIG_BLOCK, &block, reinterpret_cast<sigset_t*>(old_mask_)) == 0;
+  child_fd_ = signalfd(-1, &block, SFD_NONBLOCK | SFD_CLOEXEC);
+  if (child_fd_ < 0)
+    throw Error(std::string("cannot watch the runs (signalfd): ") + std::strerror(errno));
   std::filesystem::create_directories(config_.scratch);
   // Scratch folders of sweeps that were killed (their process is gone).
   std::error_code ec;
@@ -200,11 +211,28 @@ RunPool::RunPool(const WorkerConfig& config, int slots)
   }
 }
 
+void RunPool::Drain(Active* a) {
+  char buffer[4096];
+  while (a->err_fd >= 0) {
+    const ssize_t n = ::read(a->err_fd, buffer, sizeof buffer);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0 && errno == EAGAIN) return;  // more may come
+    if (n <= 0) {                          // its end (or an error: nothing more to read)
+      ::close(a->err_fd);
+      a->err_fd = -1;
+      return;
+    }
+    a->err.append(buffer, static_cast<size_t>(n));
+    if (a->err.size() > 2 * kErrKeep) a->err.erase(0, a->err.size() - kErrKeep);
+  }
+}
+
 int RunPool::KillAll() {
   const int killed = active();
-  for (const Active& a : active_) {
+  for (Active& a : active_) {
     kill(a.pid, SIGKILL);
     waitpid(a.pid, nullptr, 0);
+    if (a.err_fd >= 0) ::close(a.err_fd);
     std::error_code ec;
     std::filesystem::remove_all(a.dir, ec);
   }
@@ -216,6 +244,7 @@ RunPool::~RunPool() {
   KillAll();
   std::error_code ec;
   std::filesystem::remove(config_.scratch, ec);  // only if empty
+  ::close(child_fd_);
   if (restore_mask_) {
     // Drain a SIGCHLD left pending so it does not reach the old mask's handler later.
     sigset_t chld;
@@ -239,10 +268,19 @@ void RunPool::Start(const GridRun& run) {
   std::vector<char*> argv;
   for (std::string& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
-  const std::string err_path = (dir / "stderr.txt").string();
+  // Its stderr through a pipe, not a file in the scratch folder: on a full
+  // disk the file kept nothing, and the run's message was lost.
+  int err_pipe[2];
+  if (pipe2(err_pipe, O_CLOEXEC) != 0)
+    throw Error(std::string("cannot start a worker process: ") + strerror(errno));
   const pid_t parent = getpid();
   const pid_t pid = fork();
-  if (pid < 0) throw Error(std::string("cannot start a worker process: ") + strerror(errno));
+  if (pid < 0) {
+    const int error = errno;
+    ::close(err_pipe[0]);
+    ::close(err_pipe[1]);
+    throw Error(std::string("cannot start a worker process: ") + strerror(error));
+  }
   if (pid == 0) {
     // The child: die with the sweep, no inherited signal mask, quiet stdout.
     prctl(PR_SET_PDEATHSIG, SIGKILL);
@@ -251,16 +289,17 @@ void RunPool::Start(const GridRun& run) {
     sigemptyset(&none);
     sigprocmask(SIG_SETMASK, &none, nullptr);
     const int null_fd = open("/dev/null", O_RDWR);
-    const int err_fd = open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     if (null_fd >= 0) {
       dup2(null_fd, STDIN_FILENO);
       dup2(null_fd, STDOUT_FILENO);
     }
-    if (err_fd >= 0) dup2(err_fd, STDERR_FILENO);
+    dup2(err_pipe[1], STDERR_FILENO);  // (dup2's copy is not closed on exec)
     execv(argv[0], argv.data());
     _exit(127);
   }
-  active_.push_back({run.id, pid, dir, Clock::now()});
+  ::close(err_pipe[1]);
+  fcntl(err_pipe[0], F_SETFL, O_NONBLOCK);
+  active_.push_back({run.id, pid, dir, Clock::now(), err_pipe[0], {}});
 }
 
 std::vector<RunOutcome> RunPool::Poll(double wait_s) {
@@ -274,15 +313,25 @@ std::vector<RunOutcome> RunPool::Poll(double wait_s) {
       deadline =
           std::min(deadline, a.start + std::chrono::duration_cast<Clock::duration>(
                                            std::chrono::duration<double>(config_.timeout_s)));
-  const double wait = std::chrono::duration<double>(deadline - Clock::now()).count();
-  if (wait > 0) {
-    sigset_t chld;
-    sigemptyset(&chld);
-    sigaddset(&chld, SIGCHLD);
-    timespec ts;
-    ts.tv_sec = static_cast<time_t>(wait);
-    ts.tv_nsec = static_cast<long>((wait - static_cast<double>(ts.tv_sec)) * 1e9);
-    sigtimedwait(&chld, nullptr, &ts);
+  // Until a run ends (SIGCHLD), the deadline or a stop signal (EINTR: the
+  // handlers do not restart), reading what the runs write on stderr (a run
+  // whose pipe is full waits for it).
+  for (;;) {
+    const double wait = std::chrono::duration<double>(deadline - Clock::now()).count();
+    std::vector<pollfd> fds{{child_fd_, POLLIN, 0}};
+    for (const Active& a : active_)
+      if (a.err_fd >= 0) fds.push_back({a.err_fd, POLLIN, 0});
+    const int ready =
+        poll(fds.data(), fds.size(), wait > 0 ? static_cast<int>(std::ceil(wait * 1e3)) : 0);
+    if (ready <= 0) break;  // the deadline, or a signal
+    for (Active& a : active_) Drain(&a);
+    if (fds[0].revents != 0) {
+      signalfd_siginfo info;
+      while (::read(child_fd_, &info, sizeof info) == static_cast<ssize_t>(sizeof info)) {
+      }
+      break;
+    }
+    if (wait <= 0) break;
   }
   const auto now = Clock::now();
   for (size_t i = 0; i < active_.size();) {
@@ -300,7 +349,9 @@ std::vector<RunOutcome> RunPool::Poll(double wait_s) {
       ++i;
       continue;
     }
-    RunOutcome o = CollectRun(a.id, a.dir, status, timed_out, config_.timeout_s);
+    Drain(&a);  // the rest: the run has ended
+    if (a.err_fd >= 0) ::close(a.err_fd);
+    RunOutcome o = CollectRun(a.id, a.dir, a.err, status, timed_out, config_.timeout_s);
     o.wall_s = std::chrono::duration<double>(Clock::now() - a.start).count();
     o.worker = worker_name_;
     done.push_back(std::move(o));

@@ -31,10 +31,16 @@ struct WorkerConfig {
 std::vector<std::string> RunArguments(const WorkerConfig& config, const GridRun& run,
                                       const std::filesystem::path& out_dir);
 
-// Reads a finished run's folder (summary.json, metrics.csv, stderr.txt) into
-// an outcome. `wait_status` is the child's status from waitpid.
-RunOutcome CollectRun(int64_t id, const std::filesystem::path& out_dir, int wait_status,
-                      bool timed_out, double timeout_s);
+// Reads a finished run's folder (summary.json, metrics.csv) and what it
+// wrote on stderr into an outcome. `wait_status` is the child's status from
+// waitpid.
+RunOutcome CollectRun(int64_t id, const std::filesystem::path& out_dir,
+                      const std::string& stderr_text, int wait_status, bool timed_out,
+                      double timeout_s);
+
+// Whether a run's error is the machine's, not the world's: no space left on
+// a disk, no file or thread to be had, the program not started.
+bool IsMachineFailure(const std::string& error);
 
 // Up to `slots` concurrent worker processes. Blocks SIGCHLD in this thread
 // while it exists (children get an empty mask); kills its children when destroyed.
@@ -60,11 +66,17 @@ class RunPool {
     int pid;
     std::filesystem::path dir;
     Clock::time_point start;
+    int err_fd;       // the read end of the run's stderr (a pipe: a full disk kept nothing)
+    std::string err;  // what it wrote, its last kErrKeep bytes
   };
+  static constexpr size_t kErrKeep = 16384;
+  // Reads what `a` wrote on stderr so far; at its end, closes the pipe.
+  static void Drain(Active* a);
   WorkerConfig config_;
   int slots_;
   std::vector<Active> active_;
   std::string worker_name_;
+  int child_fd_ = -1;  // signalfd: SIGCHLD, beside the runs' stderr pipes in poll()
   bool restore_mask_ = false;
   unsigned char old_mask_[128];  // sigset_t, opaque here
 };

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/resource.h>
 
 #include <algorithm>
 #include <cstring>
@@ -14,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "framework/sanitizers.h"
 #include "tests/swarm/run_program.h"
 #include "tests/swarm/sweep/sweep_db.h"
 
@@ -72,6 +74,66 @@ TEST(SweepTest, FailedRunsAndTimeoutsAreRecordedAndTheSweepGoesOn) {
   fs::remove_all(dir);
 }
 
+// Runs the machine fails (here: no thread can be started, as under a
+// process limit; a full $TMPDIR is the other common case) stop the sweep
+// with the runs' own message, and none is recorded as failed: a full
+// TMPDIR marked every run of the grid failed in seconds, each "exit status
+// 1" (the message went to a stderr.txt on the full disk). The same command
+// resumes once the machine is mended.
+TEST(SweepTest, RunsTheMachineFailsStopTheSweepAndResumeLater) {
+  if (kAddressSanitizer) GTEST_SKIP() << "ulimit -v stops ASan builds before main";
+  rlimit stack{};
+  if (getrlimit(RLIMIT_STACK, &stack) != 0 ||
+      (stack.rlim_max != RLIM_INFINITY && stack.rlim_max < 4000000ull * 1024))
+    GTEST_SKIP() << "the hard stack limit is below 4 GB";
+  const fs::path dir = TempDir("machine");
+  const fs::path db = dir / "r.db";
+  const std::string sweep = std::string(SWARMSIM_BINARY) + " sweep " + kWorld +
+                            " --param fail_at=-1 --seeds 4 --steps 3 --jobs 2 --db " + db.string();
+  // glibc gives each thread a stack of ulimit -s: 4 GB, in 3 GB of room.
+  Result r = RunCommand("ulimit -s 4000000 && ulimit -v 3000000 && " + sweep);
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("could not run on this machine, and the next ones would not either: "
+                          "cannot start a thread for the run's watchdog"),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("It is not recorded as failed"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("0 failed"), std::string::npos) << r.output;
+  for (const auto& [id, run] : ReadRuns(db)) EXPECT_NE(run.status, "failed") << id;
+  r = RunCommand(sweep);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("sweep: 4 ok, 0 failed, 0 not run, of 4 runs"), std::string::npos)
+      << r.output;
+  fs::remove_all(dir);
+}
+
+// The database's disk full (here: a file size limit, its signal ignored,
+// so that writes fail with EFBIG as on a full disk) ends the sweep with
+// the database's error and how to go on; the same command resumes it, and
+// no run is lost or counted twice.
+TEST(SweepTest, ADatabaseThatCannotGrowSaysTheSweepResumes) {
+  const fs::path dir = TempDir("db_full");
+  const fs::path db = dir / "r.db";
+  const std::string sweep = std::string(SWARMSIM_BINARY) + " sweep " + kWorld +
+                            " --param robots=3,4 --seeds 10 --steps 10 --jobs 1 --quiet --db " +
+                            db.string();
+  // 200 blocks: the new database (~50 KB with its log) fits, its runs' commits do not.
+  Result r = RunCommand("trap '' XFSZ; ulimit -f 200 && " + sweep);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("error: database '" + db.string() + "': "), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("the runs finished before it are kept in the database: mend this and "
+                          "run the same command to resume"),
+            std::string::npos)
+      << r.output;
+  r = RunCommand(sweep);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("sweep: 20 ok, 0 failed, 0 not run, of 20 runs"), std::string::npos)
+      << r.output;
+  EXPECT_EQ(ReadRuns(db).size(), 20u);
+  fs::remove_all(dir);
+}
+
 GridRun Run5() {
   GridRun run;
   run.id = 5;
@@ -118,6 +180,12 @@ fs::path RunFolder(const std::string& name, const std::string& summary, const st
   return dir;
 }
 
+// What the run wrote on stderr (the pool reads it from a pipe).
+std::string StderrOf(const fs::path& dir) {
+  std::ifstream in(dir / "stderr.txt");
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
 constexpr int kExited0 = 0;  // waitpid statuses: exit code << 8, or the signal
 constexpr int Exited(int code) { return code << 8; }
 
@@ -127,7 +195,7 @@ TEST(WorkerTest, AFinishedRunIsItsSummaryAndItsMetricsMeanOverRobots) {
       "step,time,robot,metric,value\n"
       "1,0.1,bot#0,x,1\n1,0.1,bot#1,x,3\n1,0.1,,mnnd,0.5\n"
       "2,0.2,bot#0,x,2\n2,0.2,bot#1,x,6\n2,0.2,,mnnd,0.75\n");
-  const RunOutcome o = CollectRun(5, dir, kExited0, false, 0);
+  const RunOutcome o = CollectRun(5, dir, StderrOf(dir), kExited0, false, 0);
   EXPECT_EQ(o.id, 5);
   EXPECT_TRUE(o.ok) << o.error;
   EXPECT_EQ(o.steps, 2);
@@ -152,7 +220,7 @@ TEST(WorkerTest, QuotedMetricNamesAreReadAsTheyWereRecorded) {
                 "step,time,robot,metric,value\n"
                 "1,0.1,,\"left,v\",10\n1,0.1,,\"right,v\",20\n1,0.1,,\"c\"\"d\",3\n"
                 "1,0.1,,\"new\nline\",7\n1,0.1,\"bot,#0\",plain,5\n");
-  const RunOutcome o = CollectRun(1, dir, kExited0, false, 0);
+  const RunOutcome o = CollectRun(1, dir, StderrOf(dir), kExited0, false, 0);
   EXPECT_TRUE(o.ok) << o.error;
   std::map<std::string, double> expected = {
       {"left,v", 10}, {"right,v", 20}, {"c\"d", 3}, {"new\nline", 7}, {"plain", 5}};
@@ -168,7 +236,7 @@ TEST(WorkerTest, ATornLastMetricsRowIsLeftOut) {
                                    "step,time,robot,metric,value\n"
                                    "1,0.1,bot#0,x,1\n2,0.2,bot#0,x,2\n" +
                                        torn);
-    const RunOutcome o = CollectRun(1, dir, SIGKILL, true, 1.5);
+    const RunOutcome o = CollectRun(1, dir, StderrOf(dir), SIGKILL, true, 1.5);
     EXPECT_EQ(o.final_metrics.size(), 1u) << torn;
     EXPECT_EQ(o.final_metrics.count("x"), 1u) << torn;
     if (o.final_metrics.count("x")) {
@@ -184,40 +252,64 @@ TEST(WorkerTest, AFailedRunSaysWhy) {
       R"({"status": "error", "error": "bot.lua:13: planned failure", "steps": 2})";
   // The run's own error, from its summary.
   fs::path dir = RunFolder("error", summary_error, "", "noise\n");
-  RunOutcome o = CollectRun(1, dir, Exited(1), false, 0);
+  RunOutcome o = CollectRun(1, dir, StderrOf(dir), Exited(1), false, 0);
   EXPECT_FALSE(o.ok);
   EXPECT_EQ(o.error, "bot.lua:13: planned failure");
   EXPECT_EQ(o.steps, 2);
   fs::remove_all(dir);
   // Timed out: the limit, and no state hash (the state is not a final one).
   dir = RunFolder("timeout", R"({"status": "running", "state_hash": "00000000000000aa"})", "");
-  o = CollectRun(1, dir, SIGKILL, true, 1.5);
+  o = CollectRun(1, dir, StderrOf(dir), SIGKILL, true, 1.5);
   EXPECT_FALSE(o.ok);
   EXPECT_EQ(o.error, "timed out after 1.5 s (--timeout)");
   EXPECT_EQ(o.state_hash, "");
   fs::remove_all(dir);
   // Crashed: the signal and the last three lines of its stderr.
   dir = RunFolder("crash", "", "", "one\n\ntwo\nthree\nfour\n");
-  o = CollectRun(1, dir, SIGSEGV, false, 0);
+  o = CollectRun(1, dir, StderrOf(dir), SIGSEGV, false, 0);
   EXPECT_EQ(o.error, "crashed: killed by signal " + std::to_string(SIGSEGV) + " (" +
                          strsignal(SIGSEGV) + "): two | three | four");
   fs::remove_all(dir);
   // No summary and nothing on stderr: the exit status; 127: not started.
   dir = RunFolder("status", "", "");
-  EXPECT_EQ(CollectRun(1, dir, Exited(3), false, 0).error, "exit status 3");
-  EXPECT_EQ(CollectRun(1, dir, Exited(127), false, 0).error, "cannot start the worker program");
+  EXPECT_EQ(CollectRun(1, dir, StderrOf(dir), Exited(3), false, 0).error, "exit status 3");
+  EXPECT_EQ(CollectRun(1, dir, StderrOf(dir), Exited(127), false, 0).error,
+            "cannot start the worker program");
   // Exit 0 without an ok summary is no success.
-  EXPECT_EQ(CollectRun(1, dir, kExited0, false, 0).error, "the run wrote no valid summary.json");
+  EXPECT_EQ(CollectRun(1, dir, StderrOf(dir), kExited0, false, 0).error,
+            "the run wrote no valid summary.json");
   std::ofstream(dir / "summary.json") << R"({"status": "ok", "steps": "many"})";
-  o = CollectRun(1, dir, kExited0, false, 0);
+  o = CollectRun(1, dir, StderrOf(dir), kExited0, false, 0);
   EXPECT_TRUE(o.ok);
   EXPECT_EQ(o.steps, 0) << "a field of the wrong type is not read";
   std::ofstream(dir / "summary.json") << "{\"status\": \"ok\", trunc";
-  EXPECT_EQ(CollectRun(1, dir, kExited0, false, 0).error, "the run wrote no valid summary.json");
+  EXPECT_EQ(CollectRun(1, dir, StderrOf(dir), kExited0, false, 0).error,
+            "the run wrote no valid summary.json");
   fs::remove_all(dir);
   // Whatever bytes stderr held, the error is UTF-8 (it goes to SQLite and JSON).
   dir = RunFolder("bytes", "", "", "caf\xe9 au lait\n");
-  EXPECT_EQ(CollectRun(1, dir, Exited(1), false, 0).error, "caf\xef\xbf\xbd au lait");
+  EXPECT_EQ(CollectRun(1, dir, StderrOf(dir), Exited(1), false, 0).error,
+            "caf\xef\xbf\xbd au lait");
+  fs::remove_all(dir);
+}
+
+// A run the machine failed (its disk full, no thread or file to be had) is
+// told apart from one the world failed: the sweep does not record it.
+TEST(WorkerTest, ARunTheMachineFailedIsToldApart) {
+  const fs::path dir = RunFolder("machine", "", "");
+  const std::string full = "error: cannot write '/tmp/x/summary.json': No space left on device\n";
+  RunOutcome o = CollectRun(1, dir, full, Exited(1), false, 0);
+  EXPECT_FALSE(o.ok);
+  EXPECT_TRUE(o.machine);
+  EXPECT_NE(o.error.find("No space left on device"), std::string::npos) << o.error;
+  EXPECT_TRUE(CollectRun(1, dir, "", Exited(127), false, 0).machine) << "not started";
+  EXPECT_TRUE(CollectRun(1, dir, "error: cannot start a thread for the run's watchdog: x\n",
+                         Exited(1), false, 0)
+                  .machine);
+  // The world's: a script's error, a crash or a timeout, whatever was said before.
+  EXPECT_FALSE(CollectRun(1, dir, "bot.lua:13: planned failure\n", Exited(1), false, 0).machine);
+  EXPECT_FALSE(CollectRun(1, dir, full, SIGSEGV, false, 0).machine);
+  EXPECT_FALSE(CollectRun(1, dir, full, SIGKILL, true, 1).machine);
   fs::remove_all(dir);
 }
 
