@@ -1,5 +1,7 @@
 // The swarmsim command-line program: declares the commands (commands.h),
 // parses the command line and calls the command that was given.
+#include <pthread.h>
+
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <csignal>
@@ -100,9 +102,10 @@ int Main(int argc, char** argv) {
 }  // namespace
 }  // namespace swarmsim::cli
 
-int main(int argc, char** argv) {
-  swarmsim::RestartWithHugePages(argv);
-  swarmsim::TuneMalloc();
+namespace {
+
+// Main, its errors printed: the exit status.
+int MainReporting(int argc, char** argv) {
   try {
     return swarmsim::cli::Main(argc, argv);
   } catch (const swarmsim::Error& e) {
@@ -119,4 +122,41 @@ int main(int argc, char** argv) {
     std::cerr << "error: " << swarmsim::ValidUtf8(e.what()) << "\n";
     return 1;
   }
+}
+
+struct MainCall {
+  int argc;
+  char** argv;
+  int code;
+};
+
+extern "C" void* CallMain(void* call) {
+  auto* c = static_cast<MainCall*>(call);
+  c->code = MainReporting(c->argc, c->argv);
+  return nullptr;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const bool deep_enough = swarmsim::RoomForDeepCalls();
+  swarmsim::RestartWithHugePages(argv);
+  swarmsim::TuneMalloc();
+  // A hard `ulimit -s` too low for Lua's deepest C recursion (bash's
+  // `ulimit -s 256` sets both limits): the program runs on a thread of its
+  // own with the stack it needs (a thread's stack is not bound by the
+  // limit), so that a script's deep recursion is its error, not a segfault.
+  if (!deep_enough) {
+    MainCall call{argc, argv, 1};
+    pthread_attr_t attr;
+    pthread_t thread;
+    if (pthread_attr_init(&attr) == 0 &&
+        pthread_attr_setstacksize(&attr, swarmsim::kStackForDeepCalls) == 0 &&
+        pthread_create(&thread, &attr, CallMain, &call) == 0) {
+      pthread_attr_destroy(&attr);
+      pthread_join(thread, nullptr);
+      return call.code;
+    }
+  }
+  return MainReporting(argc, argv);
 }

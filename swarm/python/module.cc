@@ -30,6 +30,7 @@
 #include "framework/utf8.h"
 #include "swarm/python/controller.h"
 #include "swarm/python/world.h"
+#include "swarm/run/huge_pages.h"
 
 namespace py = pybind11;
 
@@ -272,6 +273,10 @@ PYBIND11_MODULE(_swarmsim, m) {
   using swarmsim::python::PyWorld;
   m.doc() = "swarmsim: load a world, step it, read and drive the swarm with numpy";
   py::register_exception_translator(&swarmsim::python::TranslateNonUtf8Messages);
+  // Scripts run on Python's thread too: its stack as the program's (a low
+  // ulimit -s, raised where allowed, so that deep C recursion in a script
+  // is its error, not a segfault).
+  (void)swarmsim::RoomForDeepCalls();
   // m, the largest coordinate a world may use (framework/math.h): set_poses's bound.
   m.attr("MAX_COORDINATE") = swarmsim::kMaxCoordinate;
 

@@ -5,6 +5,9 @@
 #include <malloc.h>
 #endif
 
+#include <sys/resource.h>
+
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -80,6 +83,16 @@ bool HugePagesRequested() {
 #else
   return false;
 #endif
+}
+
+bool RoomForDeepCalls() {
+  constexpr rlim_t kWanted = kStackForDeepCalls;
+  rlimit stack{};
+  if (getrlimit(RLIMIT_STACK, &stack) != 0) return true;  // (nothing known: as it is)
+  if (stack.rlim_cur == RLIM_INFINITY || stack.rlim_cur >= kWanted) return true;
+  if (stack.rlim_max != RLIM_INFINITY && stack.rlim_max < kWanted) return false;
+  stack.rlim_cur = kWanted;
+  return setrlimit(RLIMIT_STACK, &stack) == 0;
 }
 
 }  // namespace swarmsim

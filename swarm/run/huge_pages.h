@@ -8,6 +8,7 @@
 // kept). Starting 100,000 Lua robots: 16 s -> 9 s.
 #pragma once
 
+#include <cstddef>
 #include <string>
 
 namespace swarmsim {
@@ -44,5 +45,16 @@ void TuneMalloc();
 // `huge_pages`). Whether the kernel gives them is its own setting
 // (/sys/kernel/mm/transparent_hugepage/enabled: `always` or `madvise`).
 bool HugePagesRequested();
+
+// The main thread's stack may grow to 8 MiB (the usual default) when a
+// lower `ulimit -s` allows it (its hard limit): Lua stops a script's deep
+// recursion through C calls (string.gsub calling a Lua function that calls
+// it again) after 200 levels, which took more than 256-400 KiB, and the
+// program died of a segfault instead of the script's "C stack overflow".
+// A limit of 8 MiB or more is kept. Whether the thread has that room now
+// (false: the hard limit is lower; run the program on a thread with a
+// stack of kStackForDeepCalls).
+inline constexpr size_t kStackForDeepCalls = size_t{8} << 20;
+bool RoomForDeepCalls();
 
 }  // namespace swarmsim

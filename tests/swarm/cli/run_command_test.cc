@@ -343,6 +343,20 @@ TEST(CliTest, AWorldThatWillNotFitIsRefusedWithAMessage) {
 // message and its summary: the state hash it prints read the half-built
 // physics and crashed (exit 139). Not under AddressSanitizer, whose shadow
 // memory takes more address space than any cap.
+// A low stack limit (`ulimit -s 256` in bash sets the hard limit too): a
+// script's recursion through C calls, which Lua stops after 200 levels
+// with "C stack overflow", needs more than 256-400 KiB, and the program
+// died of a segfault (exit 139). It now runs with the stack it needs.
+TEST(CliTest, DeepRecursionInAScriptIsItsErrorUnderALowStackLimit) {
+  for (const char* limit : {"", "ulimit -s 256 && "}) {
+    const Result r = swarmsim::testing::RunCommand(std::string(limit) + SWARMSIM_BINARY + " run " +
+                                                   Data("deep_calls.yaml") + " --quiet");
+    EXPECT_EQ(r.exit_code, 1) << limit << r.output;
+    EXPECT_NE(r.output.find("stack overflow"), std::string::npos) << limit << r.output;
+    EXPECT_NE(r.output.find("deep_calls.lua"), std::string::npos) << limit << r.output;
+  }
+}
+
 // A thread the run needs that the system does not start (ulimit -u; here
 // ulimit -v against the stack size each thread takes, ulimit -s): the run
 // ended with "error: Resource temporarily unavailable", no summary.json,
