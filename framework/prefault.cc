@@ -47,16 +47,22 @@ size_t Prefault::bytes() const {
   return n;
 }
 
-size_t Prefault::Run(TaskScheduler& scheduler) {
+size_t Prefault::Run(TaskScheduler& scheduler, const std::function<bool()>& stopped) {
   std::vector<std::pair<uintptr_t, uintptr_t>> chunks;
   for (const auto& [b, e] : ranges_)
     for (uintptr_t at = b; at < e; at += kChunk) chunks.emplace_back(at, std::min(e, at + kChunk));
   ranges_.clear();
   std::atomic<size_t> populated{0};
+  std::atomic<bool> stop{false};
 #if defined(__linux__)
   scheduler.ParallelFor(0, static_cast<int64_t>(chunks.size()), 1, [&](int64_t lo, int64_t hi) {
     size_t done = 0;
     for (int64_t i = lo; i < hi; ++i) {
+      if (stop.load(std::memory_order_relaxed)) break;
+      if (stopped && stopped()) {
+        stop.store(true);
+        break;
+      }
       const auto [b, e] = chunks[static_cast<size_t>(i)];
       // A failure (EINVAL before Linux 5.14) only means the pages are
       // touched later, when written.
@@ -66,6 +72,7 @@ size_t Prefault::Run(TaskScheduler& scheduler) {
   });
 #else
   (void)scheduler;
+  (void)stopped;
 #endif
   return populated.load();
 }

@@ -13,6 +13,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <utility>
 #include <vector>
 
@@ -44,8 +45,10 @@ class Prefault {
   size_t bytes() const;
   // Populates everything added, in chunks over the scheduler's threads (on
   // the caller alone with one thread), and forgets the ranges. Returns the
-  // bytes the kernel populated (0 where it cannot).
-  size_t Run(TaskScheduler& scheduler);
+  // bytes the kernel populated (0 where it cannot). `stopped` (if given) is
+  // asked before each chunk (8 MiB): once it says true the rest are left
+  // (a stop signal while a million robots' arrays, ~10 GiB, are populated).
+  size_t Run(TaskScheduler& scheduler, const std::function<bool()>& stopped = {});
 
  private:
   std::vector<std::pair<uintptr_t, uintptr_t>> ranges_;  // [begin, end), page-aligned

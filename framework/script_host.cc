@@ -587,6 +587,20 @@ void LuaScriptHost::StartRobots(int first) {
   std::atomic<int64_t> started{0};
   std::string refusal;
   std::atomic<bool> refused{false};
+  // The run asked to stop (World::CheckStop threw on a worker): the robots
+  // not yet started are skipped, and it throws again here on this thread.
+  std::atomic<bool> stop{false};
+  const auto stopping = [&] {
+    if (stop.load(std::memory_order_relaxed)) return true;
+    try {
+      world.CheckStop();
+    } catch (...) {
+      stop.store(true);
+      refused.store(true);
+      return true;
+    }
+    return false;
+  };
   // Robots r / n share a state (robots_per_lua_state: n), those of them
   // that have scripts; each state is built on one thread. Not with the
   // sandbox lifted: Lua's own require, load and package keep one copy per
@@ -611,7 +625,7 @@ void LuaScriptHost::StartRobots(int first) {
   if (n <= 1) {
     world.scheduler().ParallelFor(first, robot_count, kStartGrain, [&](int64_t begin, int64_t end) {
       for (int64_t r = begin; r < end; ++r) {
-        if (refused.load(std::memory_order_relaxed)) return;
+        if (refused.load(std::memory_order_relaxed) || stopping()) return;
         start(r, nullptr, nullptr);
       }
     });
@@ -619,6 +633,7 @@ void LuaScriptHost::StartRobots(int first) {
     world.scheduler().ParallelFor(
         first / n, (robot_count + n - 1) / n, 1, [&](int64_t begin, int64_t end) {
           for (int64_t g = begin; g < end; ++g) {
+            if (stopping()) return;
             std::vector<int64_t> members;
             for (int64_t r = std::max<int64_t>(first, g * n);
                  r < std::min<int64_t>(robot_count, (g + 1) * n); ++r) {
@@ -641,6 +656,10 @@ void LuaScriptHost::StartRobots(int first) {
             if (group->L != nullptr) Settle(group->L, factories);
           }
         });
+  }
+  if (stop.load()) {
+    world.CheckStop();  // throws again (the signal stays noted)
+    throw Error("the start was stopped");
   }
   if (refused.load()) throw Error(refusal);
   for (const std::string& error : errors)

@@ -347,6 +347,7 @@ void World::Start() {
   // stops the start there, with a message, before the next takes more.
   std::string last_stage = "loading the world";
   const auto stage = [&](const std::string& next) {
+    CheckStop();
     if (std::string why = NoRoomLeft(robot_count(), last_stage, settings_.max_memory); !why.empty())
       throw Error(why);
     last_stage = "starting " + next;

@@ -299,6 +299,13 @@ class World final : public PhaseHandlers {
   void set_start_progress(std::function<void(const std::string& stage)> progress) {
     start_progress_ = std::move(progress);
   }
+  // Called by Start() before each stage and between its robots' Lua states
+  // (on any thread): throws to end the start (a run's stop signal: a
+  // million robots' start takes seconds). Null: none.
+  void set_stop_check(std::function<void()> check) { stop_check_ = std::move(check); }
+  void CheckStop() const {
+    if (stop_check_) stop_check_();
+  }
   // One control step: sense, control, actuate, physics, record. Throws
   // swarmsim::Error on a script error or a non-finite physics state; the
   // world is then stopped and may not be stepped again.
@@ -547,6 +554,7 @@ class World final : public PhaseHandlers {
   const LineOfSight* line_of_sight_ = nullptr;             // owned by the module that provides it
   const ProximityReadings* proximity_readings_ = nullptr;  // the same
   std::function<void(const std::string&)> start_progress_;
+  std::function<void()> stop_check_;
   void StartStage(const std::string& stage) const {
     if (start_progress_) start_progress_(stage);
   }

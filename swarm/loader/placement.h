@@ -75,6 +75,10 @@ class Placer {
     return copy;
   }
 
+  // Called every 4,096 copies Distribute places: may throw to abandon the
+  // placement (a stop signal while a million copies are placed).
+  void set_check_stop(std::function<void()> check) { check_stop_ = std::move(check); }
+
   void AddObstacle(const Obstacle2& obstacle) { obstacles_.push_back(obstacle); }
   // Keeps the obstacles that reach more than `overlap` into heights [lo, hi]
   // (the copies' band, as the physics engines' rule for static shapes): a
@@ -140,6 +144,7 @@ class Placer {
   }
 
   uint64_t seed_;
+  std::function<void()> check_stop_;
   std::vector<Body> bodies_;
   std::vector<Obstacle2> obstacles_;
   EnvironmentPlaneGrid map_;  // map cells (empty: none)

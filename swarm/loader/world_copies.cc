@@ -4,6 +4,7 @@
 // model sections; the placements again for another seed (reset), and the
 // entries' summaries (describe). world_entries.cc resolves the entries.
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <map>
 #include <memory>
@@ -213,10 +214,11 @@ void WorldLoader::PlaceEntries(std::vector<std::string>* warnings) {
     }
     if (static_cast<int64_t>(e.placements.size()) < e.count)
       file_->Fail(e.count_field.mark,
-                  "cannot place " + std::to_string(e.count) + " " + e.model->name + " copies in " +
+                  "cannot place " + GroupThousands(e.count) + " " + e.model->name + " copies in " +
                       e.region_text + " without overlap (placed " +
-                      std::to_string(e.placements.size()) + "); enlarge the " +
-                      (e.region_text == "the arena" ? "arena" : "region") + " or reduce count");
+                      GroupThousands(static_cast<int64_t>(e.placements.size())) +
+                      "); enlarge the " + (e.region_text == "the arena" ? "arena" : "region") +
+                      " or reduce count");
   }
 }
 
@@ -271,7 +273,19 @@ void WorldLoader::BuildCopies(World* world) {
         // kernel's out-of-memory killer while they are populated.
         if (std::string refusal = forecast.Reserved(prefault.bytes()); !refusal.empty())
           throw Error(refusal);
-        prefault.Run(world->scheduler());
+        // A stop signal meanwhile: the rest is left, and the check after
+        // throws (10 GiB for a million robots take seconds on cold memory).
+        std::atomic<bool> stopped{false};  // (asked on every thread)
+        prefault.Run(world->scheduler(), [this, &stopped] {
+          if (!options_.check_stop || stopped.load()) return stopped.load();
+          try {
+            options_.check_stop();
+          } catch (const Error&) {
+            stopped.store(true);
+          }
+          return stopped.load();
+        });
+        if (stopped.load()) options_.check_stop();
       }
       const int instance = scene.MakeModelInstance(
           root, name, name + "#" + std::to_string(scene.instances().size()));

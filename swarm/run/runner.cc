@@ -148,7 +148,8 @@ std::string Fixed(double v, int digits) {
 class Watchdog {
  public:
   using EndRun = std::function<void(const std::string& error, int signal)>;
-  static constexpr double kSignalGrace = 3;  // s
+  static constexpr double kSignalGrace = 3;        // s, a step's
+  static constexpr double kStartSignalGrace = 15;  // s, the start's or the stop's
 
   // `instruction_budget`: the world's (simulation.instruction_budget), for
   // the message: with none, an endless Lua loop is also stopped only here.
@@ -196,9 +197,13 @@ class Watchdog {
       const double stalled = std::chrono::duration<double>(now - since).count();
       std::string error;
       int end_signal = 0;
-      if (sig != 0 && now - signal_since >= std::chrono::duration<double>(kSignalGrace)) {
+      // The start answers a signal between its stages and its robots'
+      // Lua states (World::set_stop_check); a stage of a million robots
+      // takes seconds (it was ended as stuck, 3 s after the signal).
+      const double grace = step_ ? kSignalGrace : kStartSignalGrace;
+      if (sig != 0 && now - signal_since >= std::chrono::duration<double>(grace)) {
         error = std::string("interrupted by SIG") + sigabbrev_np(sig) + " during " + next_ +
-                ", which did not finish within " + Fixed(kSignalGrace, 0) + " s of the signal";
+                ", which did not finish within " + Fixed(grace, 0) + " s of the signal";
         end_signal = sig;
       } else if (const double timeout = step_ ? step_timeout_ : world_timeout_;
                  timeout > 0 && stalled >= timeout) {
@@ -504,7 +509,25 @@ void StepWatched(World* world, const RunOptions& options, Clock::time_point star
       metrics = std::make_unique<MetricsWriter>(*options.out_dir / "metrics.csv", *world);
     }
     const Clock::time_point starting = Clock::now();
-    world->Start();
+    // A stop signal ends the start between its stages and its robots' Lua
+    // states, as one ends the load between model copies.
+    int start_signal = 0;
+    world->set_stop_check([&start_signal] {
+      if (const int sig = StopSignals::Received(); sig != 0) {
+        start_signal = sig;
+        throw Error(std::string("interrupted by SIG") + sigabbrev_np(sig) +
+                    " while the world was starting");
+      }
+    });
+    try {
+      world->Start();
+    } catch (...) {
+      result.signal = start_signal;
+      result.start_seconds = std::chrono::duration<double>(Clock::now() - starting).count();
+      world->set_stop_check(nullptr);
+      throw;
+    }
+    world->set_stop_check(nullptr);  // (model copies a script adds start in a step)
     started = true;
     // What a started world alone shows (its modules: a camera's renderer,
     // graphs) refuses the snapshot now, before the first step, not after

@@ -397,6 +397,32 @@ TEST(CliTest, AThreadThatCannotBeStartedIsNamedAndTheSummarySaysSo) {
   fs::remove_all(out);
 }
 
+// A stop signal while a large world starts (its robots' sysCall_init take
+// seconds here; a million robots' start does too) ends the start between
+// robots: it was not looked at until the start ended, or the run was ended
+// 3 s after the signal as a stuck start ("which did not finish within 3 s
+// of the signal; no Lua script was running"). The signal is sent once the
+// run's first summary.json is written, just before the start (waited for,
+// not timed).
+TEST(CliTest, AStopSignalWhileTheWorldStartsEndsTheStart) {
+  const fs::path out = TempDir("stop_start");
+  const Result r = swarmsim::testing::RunCommand(
+      "(" + std::string(SWARMSIM_BINARY) + " run " + Data("slow_start.yaml") +
+      " --steps 5 --quiet --out " + out.string() + " & pid=$!; while [ ! -s " +
+      (out / "summary.json").string() + " ]; do sleep 0.01; done; kill -INT $pid; wait $pid; " +
+      "echo exit=$?)");
+  EXPECT_NE(r.output.find("exit=130"), std::string::npos) << r.output;  // 128 + SIGINT
+  EXPECT_NE(r.output.find("error: interrupted by SIGINT while the world was starting"),
+            std::string::npos)
+      << r.output;
+  std::ifstream summary_file(out / "summary.json");
+  ASSERT_TRUE(summary_file.good());
+  const nlohmann::json summary = nlohmann::json::parse(summary_file);
+  EXPECT_EQ(summary["status"], "interrupted");
+  EXPECT_EQ(summary["steps"], 0);
+  fs::remove_all(out);
+}
+
 // The output folder renamed (or removed) while the run writes into it: the
 // run ended with exit 0 and no word, its summary.json never written (a new
 // folder of that name would hold a summary listing files it does not

@@ -231,7 +231,7 @@ TEST(PlacementTest, TooFullArenaIsAClearError) {
     const std::string message = e.what();
     EXPECT_NE(message.find("too_full.yaml:9:12:"), std::string::npos) << message;
     EXPECT_NE(
-        message.find("cannot place 10000 footbot copies in the arena without overlap (placed "),
+        message.find("cannot place 10,000 footbot copies in the arena without overlap (placed "),
         std::string::npos)
         << message;
     EXPECT_NE(message.find("enlarge the arena or reduce count"), std::string::npos) << message;

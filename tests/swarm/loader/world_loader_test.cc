@@ -457,7 +457,7 @@ TEST_F(MalformedWorldTest, EachMistakeHasAClearMessage) {
        {"world.yaml:1:18:", "duplicate key 'size'"}},
       {"too full",
        "arena: {size: 0.5}\nmodels:\n  - {model: bot.yaml, count: 1000, distribute: {}}\n",
-       {"world.yaml:3:30:", "cannot place 1000 bot copies in the arena without overlap (placed ",
+       {"world.yaml:3:30:", "cannot place 1,000 bot copies in the arena without overlap (placed ",
         "enlarge the arena or reduce count"}},
       {"unknown metric",
        "metrics: [{name: mean_nearest_neighbour_distance}]\n",
