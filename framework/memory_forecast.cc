@@ -22,7 +22,7 @@ namespace {
 // with huge pages the resident size moves 2 MiB at a time).
 constexpr int64_t kFirstCheck = 1000;
 // Worlds smaller than this are never checked.
-constexpr int64_t kMinItems = 2000;
+constexpr int64_t kMinItems = kForecastMinRobots;
 
 // The process's sizes in bytes (/proc/self/statm): mapped, resident and
 // data (+ stack); all zero if unreadable.

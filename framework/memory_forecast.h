@@ -29,6 +29,9 @@ struct MemoryRoom {
   std::string bound;                // what `available` is ("--max-memory 2 GiB", ...)
 };
 
+// Worlds of fewer robots are not forecast or checked (nor held to a cap).
+inline constexpr int64_t kForecastMinRobots = 2000;
+
 // Reads the room left; `cap`: bytes the whole process may hold (0: none).
 MemoryRoom ReadMemoryRoom(uint64_t cap);
 

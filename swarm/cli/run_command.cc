@@ -484,6 +484,11 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
       std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
   for (const std::string& warning : loaded.warnings)
     std::cerr << "warning: " << swarmsim::ValidUtf8(warning) << "\n";
+  // --max-memory 1M on 50 robots ran at 54 MiB without a word.
+  if (!args.max_memory.empty() && loaded.world->robot_count() < kForecastMinRobots)
+    std::cerr << "note: --max-memory " << args.max_memory
+              << " is not applied: worlds of fewer than " << GroupThousands(kForecastMinRobots)
+              << " robots are not checked (this one has " << loaded.world->robot_count() << ")\n";
   if (const int cores = TaskScheduler::HardwareThreads(); loaded.world->threads() > cores)
     std::cerr << "note: " << loaded.world->threads() << " threads on " << cores
               << " hardware threads: the steps wait for threads that cannot run at once, so "

@@ -323,6 +323,41 @@ void WorldLoader::ReadModelEntries(const Fields& top) {
   }
 }
 
+namespace {
+
+// The keys of a world's simulation: section (backends add their own).
+constexpr const char* kSimulationKeys[] = {"physics",
+                                           "time_step",
+                                           "physics_substeps",
+                                           "physics_partitions",
+                                           "seed",
+                                           "duration",
+                                           "steps",
+                                           "gravity",
+                                           "octree_resolution",
+                                           "main_script",
+                                           "instruction_budget",
+                                           "script_memory_mb",
+                                           "run_script_memory_mb",
+                                           "robots_per_lua_state",
+                                           "step_timeout",
+                                           "on_script_error"};
+
+// "; simulation: settings are not --set parameters: ..." when `o` names
+// one (--set simulation.physics=planar, --set robots_per_lua_state=1).
+std::string SimulationKeyHint(const std::string& model, const std::string& name) {
+  bool key = false;
+  for (const char* k : kSimulationKeys) key |= name == k;
+  if (model != "simulation" && !(model.empty() && key)) return "";
+  const std::string example = key ? name : "physics";
+  return "; the world file's simulation: settings are not parameters --set can change: make " +
+         std::string("one a parameter (under parameters:, `") + example +
+         ": <its value>`, and in simulation:, `" + example + ": $" + example + "`), then --set " +
+         example + "=...";
+}
+
+}  // namespace
+
 void WorldLoader::CheckOverrides() {
   // Every --set must name a parameter; the suggestion spans world and model ones.
   std::vector<std::string> known;
@@ -337,6 +372,8 @@ void WorldLoader::CheckOverrides() {
         if (k.ends_with("." + o.name))
           throw Error(o.text + ": no world parameter '" + o.name + "' in " + file_->name() +
                       "; did you mean '" + k + "'?");
+      if (const std::string hint = SimulationKeyHint("", o.name); !hint.empty())
+        throw Error(o.text + ": no parameter '" + o.name + "' in " + file_->name() + hint);
       throw Error(o.text + ": no parameter '" + o.name + "' in " + file_->name() +
                   loader::Suggest(o.name, known));
     }
@@ -346,7 +383,8 @@ void WorldLoader::CheckOverrides() {
     const std::string full = o.model + "." + o.name;
     if (!model)
       throw Error(o.text + ": no model '" + o.model + "' in " + file_->name() +
-                  loader::Suggest(full, known));
+                  (o.model == "simulation" ? SimulationKeyHint(o.model, o.name)
+                                           : loader::Suggest(full, known)));
     bool found = false;
     for (const auto& p : model->parameters) found |= p.name == o.name;
     if (!found)
@@ -372,22 +410,7 @@ WorldSettings WorldLoader::ReadSimulation(const Fields& top, std::optional<int64
     Fields f(*file_, sim, "'simulation'");
     // The loader's keys, and a mapping per backend with settings of its own
     // (`ode: {...}`: ModuleRegistry::RegisterDynamicsSection).
-    std::vector<std::string> known = {"physics",
-                                      "time_step",
-                                      "physics_substeps",
-                                      "physics_partitions",
-                                      "seed",
-                                      "duration",
-                                      "steps",
-                                      "gravity",
-                                      "octree_resolution",
-                                      "main_script",
-                                      "instruction_budget",
-                                      "script_memory_mb",
-                                      "run_script_memory_mb",
-                                      "robots_per_lua_state",
-                                      "step_timeout",
-                                      "on_script_error"};
+    std::vector<std::string> known(std::begin(kSimulationKeys), std::end(kSimulationKeys));
     for (const std::string& name : registry_.DynamicsNames())
       if (registry_.FindDynamicsSection(name)) known.push_back(name);
     f.Expect(std::span<const std::string>(known));

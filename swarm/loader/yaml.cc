@@ -27,7 +27,16 @@ std::string ReadFileOrThrow(const fs::path& path, std::string_view kind, const s
     if (ec == std::make_error_condition(std::errc::too_many_symbolic_link_levels))
       throw Error(prefix + std::string(kind) + " '" + text + "' is a loop of symbolic links" +
                   looked);
-    throw Error(prefix + std::string(kind) + " '" + text + "' not found" + looked);
+    // A file named by another: where it was looked for, in full, and how
+    // (a world copied into a folder of its own lost the models beside it).
+    std::string tried = looked;
+    if (!where.empty() && !fs::path(text).is_absolute()) {
+      std::error_code abs_error;
+      const fs::path full = fs::absolute(path, abs_error).lexically_normal();
+      tried = " (looked for " + (abs_error ? DisplayPath(path) : full.string()) +
+              "; a path in a file is relative to that file's folder)";
+    }
+    throw Error(prefix + std::string(kind) + " '" + text + "' not found" + tried);
   }
   if (fs::is_directory(path, ec))
     throw Error(prefix + std::string(kind) + " '" + text + "' is a directory, not a file" + looked);

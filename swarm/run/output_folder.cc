@@ -41,7 +41,12 @@ std::string OutputsOfFinishedSteps(int64_t steps, const std::filesystem::path& d
   return "outputs" + which + " are in " + dir.string();
 }
 
-std::string RemoveEarlierOutputs(const std::filesystem::path& dir) {
+namespace {
+
+// The earlier run's files that its summary.json lists (or, for a run that
+// never ended, those under the names a run gives them), removed: "1
+// recording, 3 snapshots", or "".
+std::string RemoveListedOutputs(const std::filesystem::path& dir) {
   namespace fs = std::filesystem;
   std::error_code error;
   if (!fs::is_regular_file(dir / "summary.json", error)) return "";  // a pipe's read would wait
@@ -81,13 +86,29 @@ std::string RemoveEarlierOutputs(const std::filesystem::path& dir) {
     std::error_code ec;
     if (fs::is_empty(dir / *it, ec)) fs::remove(dir / *it, ec);
   }
-  if (removed.empty()) return "";
   std::string what;
   for (const auto& [kind, count] : removed)
     what +=
         (what.empty() ? "" : ", ") + std::to_string(count) + " " + kind + (count == 1 ? "" : "s");
+  return what;
+}
+
+std::string Removed(const std::filesystem::path& dir, const std::string& what) {
   return "removed the outputs of the earlier run in '" + dir.string() + "' (" + what +
          "), so that the folder holds this run's alone";
+}
+
+}  // namespace
+
+std::string RemoveEarlierOutputs(const std::filesystem::path& dir, bool metrics_too) {
+  namespace fs = std::filesystem;
+  std::error_code error;
+  // metrics.csv, which a run that runs writes anew: named in the note.
+  const bool metrics = metrics_too && fs::is_regular_file(dir / "metrics.csv", error) &&
+                       fs::remove(dir / "metrics.csv", error);
+  const std::string others = RemoveListedOutputs(dir);
+  if (!metrics) return others.empty() ? "" : Removed(dir, others);
+  return Removed(dir, others.empty() ? "metrics.csv" : "metrics.csv, " + others);
 }
 
 }  // namespace swarmsim

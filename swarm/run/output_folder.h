@@ -33,7 +33,9 @@ void CreateOutputFolder(const std::filesystem::path& dir);
 // DIR holds one run, not a mix; for a run killed before its end (summary
 // status "running", nothing listed), the files under a run's own names
 // (recording.swrec, video.mp4, snapshots/, graphs/). Returns the note to
-// print ("" if there was nothing), naming what went.
-std::string RemoveEarlierOutputs(const std::filesystem::path& dir);
+// print ("" if there was nothing), naming what went. `metrics_too`: its
+// metrics.csv as well (a run that fails before it writes its own: the
+// note named the snapshots it removed, not the metrics with them).
+std::string RemoveEarlierOutputs(const std::filesystem::path& dir, bool metrics_too = false);
 
 }  // namespace swarmsim

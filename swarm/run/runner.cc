@@ -651,9 +651,9 @@ std::string WriteErrorSummary(const RunOptions& options, const std::string& erro
   if (ec) return ec.message();
   // This summary replaces an earlier run's: its files go too (they stayed,
   // unlisted, beside the next run's), metrics.csv with them.
-  if (const std::string note = RemoveEarlierOutputs(*options.out_dir); !note.empty())
+  if (const std::string note = RemoveEarlierOutputs(*options.out_dir, /*metrics_too=*/true);
+      !note.empty())
     std::cerr << "note: " << ValidUtf8(note) << "\n";
-  std::filesystem::remove(*options.out_dir / "metrics.csv", ec);
   nlohmann::json j;
   j["swarmsim_version"] = Version();
   j["world"] = options.world_file;

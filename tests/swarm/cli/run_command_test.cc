@@ -330,6 +330,14 @@ TEST(CliTest, AWorldThatWillNotFitIsRefusedWithAMessage) {
   EXPECT_NE(nlohmann::json::parse(summary2)["error"].get<std::string>().find("arrays reserved"),
             std::string::npos);
 
+  // A small world is not held to it: said, not run silently past it.
+  Result small = RunProgram("run " + Data("ok.yaml") + " --steps 1 --quiet --max-memory 1M");
+  EXPECT_EQ(small.exit_code, 0) << small.output;
+  EXPECT_NE(small.output.find("note: --max-memory 1M is not applied: worlds of fewer than 2,000 "
+                              "robots are not checked (this one has 4)"),
+            std::string::npos)
+      << small.output;
+
   Result bad = RunProgram("run " + Data("ok.yaml") + " --steps 1 --max-memory 12X");
   EXPECT_EQ(bad.exit_code, 2) << bad.output;
   EXPECT_NE(bad.output.find("expected a memory size such as 500M, 2G or 1.5GiB, got '12X'"),

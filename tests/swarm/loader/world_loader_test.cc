@@ -206,6 +206,17 @@ TEST(WorldLoaderTest, BadOverridesAreErrorsWithSuggestions) {
   const std::string no_model = ErrorOf([] { LoadDiffusion({{"fotbot.delta", "1"}}); });
   EXPECT_NE(no_model.find("no model 'fotbot'"), std::string::npos) << no_model;
   EXPECT_NE(no_model.find("footbot.delta"), std::string::npos) << no_model;
+  // A simulation: key is no parameter: how to make it one (a suggestion of
+  // 'robots' for robots_per_lua_state, or "no model 'simulation'", said nothing).
+  const std::string sim = ErrorOf([] { LoadDiffusion({{"simulation.physics", "planar"}}); });
+  EXPECT_NE(sim.find("no model 'simulation'"), std::string::npos) << sim;
+  EXPECT_NE(sim.find("simulation: settings are not parameters --set can change"),
+            std::string::npos)
+      << sim;
+  EXPECT_NE(sim.find("`physics: $physics`), then --set physics=..."), std::string::npos) << sim;
+  const std::string key = ErrorOf([] { LoadDiffusion({{"robots_per_lua_state", "1"}}); });
+  EXPECT_NE(key.find("`robots_per_lua_state: $robots_per_lua_state`"), std::string::npos) << key;
+  EXPECT_EQ(key.find("did you mean"), std::string::npos) << key;
   const std::string type = ErrorOf([] { LoadDiffusion({{"robots", "many"}}); });
   EXPECT_NE(type.find("--set robots=many"), std::string::npos) << type;
   EXPECT_NE(type.find("is a finite number"), std::string::npos) << type;
@@ -415,7 +426,8 @@ TEST_F(MalformedWorldTest, EachMistakeHasAClearMessage) {
        {"world.yaml:4:30:", "'count' must be a whole number from 0 to 1,000,000 (got 2e+300"}},
       {"missing model file",
        "arena: {size: 2}\nmodels:\n  - {model: nobot.yaml, count: 1, distribute: {}}\n",
-       {"world.yaml:3:13:", "model file 'nobot.yaml' not found"}},
+       {"world.yaml:3:13:", "model file 'nobot.yaml' not found (looked for /",
+        "/nobot.yaml; a path in a file is relative to that file's folder)"}},
       {"no placement",
        "arena: {size: 2}\nmodels:\n  - {model: bot.yaml}\n",
        {"world.yaml:3:5:", "'distribute'"}},

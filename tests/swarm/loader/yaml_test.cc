@@ -28,7 +28,8 @@ TEST(YamlTest, AFileThatCannotBeReadIsNamedWithWhoReferencedIt) {
     return ErrorOf([&] { YamlFile::Load(path, "model file", "w.yaml:12:5", "models/x.yaml"); });
   };
   EXPECT_EQ(load(missing), "w.yaml:12:5: model file 'models/x.yaml' not found (looked for " +
-                               DisplayPath(missing) + ")");
+                               fs::absolute(missing).lexically_normal().string() +
+                               "; a path in a file is relative to that file's folder)");
   fs::create_directories(YamlDir() / "folder.yaml");
   EXPECT_EQ(load(YamlDir() / "folder.yaml"),
             "w.yaml:12:5: model file 'models/x.yaml' is a directory, not a file (looked for " +

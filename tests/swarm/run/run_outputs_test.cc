@@ -530,8 +530,9 @@ TEST(RunOutputsTest, ARunThatDoesNotLoadTakesTheEarlierRunsFilesWithIt) {
   auto r =
       RunProgram("run " + (out / "no_such_world.yaml").string() + " --quiet --out " + out.string());
   EXPECT_EQ(r.exit_code, 2) << r.output;
+  // Its metrics named too (the note named the recording alone).
   EXPECT_NE(r.output.find("note: removed the outputs of the earlier run in '" + out.string() +
-                          "' (1 recording)"),
+                          "' (metrics.csv, 1 recording)"),
             std::string::npos)
       << r.output;
   EXPECT_FALSE(fs::exists(out / "recording.swrec"));
