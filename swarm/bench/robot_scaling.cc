@@ -116,10 +116,11 @@ bool Plot(const std::vector<ScalingRow>& rows, const RobotScalingOptions& o, std
   std::ostringstream script;
   script << "set terminal pngcairo size 1200,640 enhanced font 'sans,10'\n"
          << "set output " << Quoted(o.plot) << "\n"
-         << "set logscale xy\nset grid\nset key below horizontal maxcols 5 noenhanced\n"
-         << "set format x '10^{%L}'\nset xlabel 'robots' offset 0,0.6\n"
-         // The key below: a margin for it under the axis's label.
-         << "set bmargin 12\n"
+         << "set logscale xy\nset grid\nset key below horizontal maxcols 4 noenhanced\n"
+         << "set format x '10^{%L}'\nset xlabel 'robots'\n"
+         // The key below: a margin for it under the axis's label (two rows:
+         // the configurations' colours, then the phases' dashes).
+         << "set bmargin 8\n"
          << "set multiplot layout 1,2 title "
          << Quoted("swarmsim: cost per robot-tick over robot counts (" + ThreadsText(rows) + "; " +
                    (o.steps > 0 ? std::to_string(o.steps) + " measured steps a row"
@@ -130,8 +131,11 @@ bool Plot(const std::vector<ScalingRow>& rows, const RobotScalingOptions& o, std
   int lowest = INT_MAX, highest = 0;
   for (const ScalingRow& r : rows)
     lowest = std::min(lowest, r.bench.robots), highest = std::max(highest, r.bench.robots);
-  if (!rows.empty() && lowest == highest)
-    script << "set xrange [" << lowest / 2.0 << ":" << highest * 2.0 << "]\n";
+  // The robots measured, and a little about them (a decade without data
+  // stood at the left of the axis).
+  if (!rows.empty())
+    script << "set xrange [" << lowest / (lowest == highest ? 2.0 : 1.4) << ":"
+           << highest * (lowest == highest ? 2.0 : 1.4) << "]\n";
   int block = 0;
   for (const std::string& key : order) {
     script << "$d" << block++ << " << EOD\n";
@@ -153,8 +157,13 @@ bool Plot(const std::vector<ScalingRow>& rows, const RobotScalingOptions& o, std
            << Quoted(order[i] + " total");
     for (int p = 0; p < 4; ++p)
       script << ", " << d << " using 1:" << 3 + p << " with linespoints dt " << 2 + p << " lw 1 pt "
-             << 1 + p << colour << " title " << Quoted(order[i] + " " + phases[p]);
+             << 1 + p << colour << " notitle";
   }
+  // The phases' dashes, once (a key entry per configuration and phase,
+  // twenty for four, ran over the axis's label).
+  for (int p = 0; p < 4; ++p)
+    script << ", NaN with linespoints dt " << 2 + p << " lw 1 pt " << 1 + p << " lc black title "
+           << Quoted(phases[p]);
   // Start-up of one count and configuration: a range about it (as above).
   double first_startup = rows.empty() ? 0 : std::max(rows.front().bench.startup_s, 1e-3);
   bool one_startup = true;

@@ -8,6 +8,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <new>
 
 #include "framework/error.h"
 #include "framework/start_thread.h"
@@ -109,6 +110,7 @@ ChunkWriter::ChunkWriter(const std::filesystem::path& path, int zstd_level, uint
   fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd_ < 0) throw Error("cannot create " + path.string() + ": " + std::strerror(errno));
   cctx_ = ZSTD_createCCtx();
+  error_.reserve(kErrorRoom);
   try {
     thread_ = StartThread("the recording's writer", [this] { Run(); });
   } catch (const Error&) {  // no destructor runs: what the constructor took goes here
@@ -218,10 +220,13 @@ void ChunkWriter::Run() {
     changed_.notify_all();
     std::string error;
     bool whole = true;
+    bool no_memory = false;
     try {
       if (!failed) Write(job.get());
     } catch (const ChunkTooLarge& e) {
       error = e.what();
+    } catch (const std::bad_alloc&) {
+      no_memory = true;  // (the message, composed, could need memory)
     } catch (const std::exception& e) {
       error = e.what();
       whole = false;
@@ -229,6 +234,12 @@ void ChunkWriter::Run() {
     {
       const std::lock_guard lock(mutex_);
       busy_ = false;
+      if (no_memory) {
+        whole = out_of_memory_;  // cut back to whole chunks, or not
+        // Into room reserved for it: no allocation.
+        if (error_.empty())
+          error_.assign("out of memory while writing the recording: its later steps are left out");
+      }
       if (!whole) file_whole_ = false;
       if (!error.empty() && error_.empty()) error_ = error;
       if (job->snap && spare_.size() < kMaxQueued) spare_.push_back(std::move(job->snap));
@@ -245,6 +256,7 @@ void ChunkWriter::Write(Job* job) {
   {
     const std::lock_guard lock(mutex_);
     start = bytes_;
+    out_of_memory_ = false;
   }
   try {
     WriteJob(job);
@@ -257,6 +269,17 @@ void ChunkWriter::Write(Job* job) {
     const std::lock_guard lock(mutex_);
     bytes_ = start;
     throw ChunkTooLarge(e.what());
+  } catch (const std::bad_alloc&) {
+    // Out of memory compressing it: cut off too, so that the end chunk
+    // (small, its buffers already there) may still follow; Run says why
+    // in words it composes without memory.
+    if (::ftruncate(fd_, static_cast<off_t>(start)) != 0 ||
+        ::lseek(fd_, static_cast<off_t>(start), SEEK_SET) != static_cast<off_t>(start))
+      throw;
+    const std::lock_guard lock(mutex_);
+    bytes_ = start;
+    out_of_memory_ = true;
+    throw;
   }
   if (job->snap) {
     const std::lock_guard lock(mutex_);

@@ -113,8 +113,10 @@ class ChunkWriter {
   std::deque<std::unique_ptr<Job>> queue_;  // at most kMaxQueued
   std::vector<std::unique_ptr<StepSnapshot>> spare_;
   bool busy_ = false, stopping_ = false;
-  std::string error_;
-  bool file_whole_ = true;  // after an error: no chunk was cut (the end chunk may follow)
+  std::string error_;  // kErrorRoom reserved: an out-of-memory message needs no more
+  static constexpr size_t kErrorRoom = 256;
+  bool out_of_memory_ = false;  // a job cut back whole after running out
+  bool file_whole_ = true;      // after an error: no chunk was cut (the end chunk may follow)
   uint64_t bytes_ = 0;
   uint64_t records_written_ = 0;
   std::thread thread_;

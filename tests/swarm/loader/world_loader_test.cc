@@ -210,8 +210,7 @@ TEST(WorldLoaderTest, BadOverridesAreErrorsWithSuggestions) {
   // 'robots' for robots_per_lua_state, or "no model 'simulation'", said nothing).
   const std::string sim = ErrorOf([] { LoadDiffusion({{"simulation.physics", "planar"}}); });
   EXPECT_NE(sim.find("no model 'simulation'"), std::string::npos) << sim;
-  EXPECT_NE(sim.find("simulation: settings are not parameters --set can change"),
-            std::string::npos)
+  EXPECT_NE(sim.find("simulation: settings are not parameters --set can change"), std::string::npos)
       << sim;
   EXPECT_NE(sim.find("`physics: $physics`), then --set physics=..."), std::string::npos) << sim;
   const std::string key = ErrorOf([] { LoadDiffusion({{"robots_per_lua_state", "1"}}); });

@@ -6,9 +6,12 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -16,6 +19,26 @@
 #include "swarm/record/format.h"
 #include "swarm/record/reader.h"
 #include "tests/swarm/run_program.h"
+
+#if !defined(__SANITIZE_ADDRESS__)
+// Allocations of this many bytes or more fail while it is not 0: a writer
+// thread that runs out of memory (AddressSanitizer's own operator new is
+// not replaced).
+std::atomic<size_t> g_refuse_from{0};
+
+void* operator new(size_t n) {
+  const size_t refuse = g_refuse_from.load();
+  if (refuse != 0 && n >= refuse) throw std::bad_alloc();
+  if (void* p = std::malloc(n != 0 ? n : 1)) return p;
+  throw std::bad_alloc();
+}
+// (GCC takes the replaced pair for a mismatch once it inlines them.)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete(void* p, size_t) noexcept { std::free(p); }
+#pragma GCC diagnostic pop
+#endif
 
 namespace swarmsim::record {
 namespace {
@@ -141,6 +164,41 @@ TEST(ChunkWriterTest, AFileThatCannotBeCreatedOrWrittenIsNamed) {
   }
   EXPECT_THROW(writer.AddJson(static_cast<uint8_t>(ChunkKind::kEnd), 0, "{}"), Error)
       << "after a failure, every call says so";
+}
+
+// The writer's thread out of memory while it compresses a chunk: the run
+// hears it, the chunk is cut off, and the end chunk still follows (the
+// file lost its end, and record-info said the run was killed).
+TEST(ChunkWriterTest, RunningOutOfMemoryLeavesAWholeFileWithItsEnd) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "operator new is AddressSanitizer's";
+#else
+  const fs::path dir = FreshTempDir("chunk_writer", "oom");
+  fs::create_directories(dir);
+  {
+    ChunkWriter writer(dir / kRecordingFileName, 3);
+    writer.AddJson(static_cast<uint8_t>(ChunkKind::kHeader), 0, kHeader);
+    writer.Flush();
+    std::string large(8 << 20, 'x');  // its compression buffer: 8 MiB
+    g_refuse_from = 4 << 20;
+    writer.AddJson(static_cast<uint8_t>(ChunkKind::kScene), 1, std::move(large));
+    try {
+      writer.Flush();
+      ADD_FAILURE() << "no error";
+    } catch (const Error& e) {
+      EXPECT_EQ(std::string(e.what()),
+                "out of memory while writing the recording: its later steps are left out");
+    }
+    g_refuse_from = 0;
+    writer.AddJson(static_cast<uint8_t>(ChunkKind::kEnd), 1,
+                   R"({"status": "error", "error": "out of memory"})");
+  }
+  const RecordingInfo info = ScanRecording(dir);
+  ASSERT_EQ(info.chunks.size(), 2u);
+  EXPECT_TRUE(info.ended);
+  EXPECT_EQ(info.end_status, "error");
+  fs::remove_all(dir);
+#endif
 }
 
 }  // namespace
