@@ -76,12 +76,10 @@ int RecordMetric(lua_State* L) {
   // A swarm metric of this world's `metrics:` under the same name: its rows
   // (robot empty) and the robots' would be one metric to a sweep, which
   // averaged the swarm's value in as one more robot.
-  if (const std::string_view n(name, length); c.world->find_module(n) != nullptr)
-    if (const ModuleDescriptor* d = c.world->registry().FindModule(n);
-        d && d->info.kind == "metric")
-      throw Error("'" + std::string(n) +
-                  "' is a swarm metric this world records (its 'metrics:' list): give the "
-                  "robot's metric another name");
+  if (const std::string_view n(name, length); c.world->IsListedSwarmMetric(n))
+    throw Error("'" + std::string(n) +
+                "' is a swarm metric this world records (its 'metrics:' list): give the "
+                "robot's metric another name");
   // What the sample holds in C++: the robot's vector of samples as it
   // grows (its capacity, charged when it doubles: the slots it really
   // holds, not just the ones used) and the name's own block when it is too

@@ -131,7 +131,8 @@ typedef struct SwarmsimWorldApi {
   int (*robot_of)(void* world, int64_t object);
   // A row of metrics.csv for this step: robot -1 for a swarm-level value.
   // From record-phase callbacks only (kSwarmsimRecord); returns 0, or -1
-  // elsewhere or for a bad robot or name.
+  // elsewhere or for a bad robot or name (empty, or a swarm metric the
+  // world's metrics: list records).
   int (*record_metric)(void* world, int robot, const char* name, double value);
   // --- ABI 6 ---
   // The last readings of `count` proximity sensors in one call:

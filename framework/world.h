@@ -375,6 +375,9 @@ class World final : public PhaseHandlers {
   // only (any thread). False outside that phase, for a bad robot or an
   // empty name.
   bool RecordPluginMetric(int robot, std::string_view name, double value);
+  // Whether `name` is a swarm metric this world's metrics: list records: a
+  // robot's or plugin's metric may not take it (its rows would join that one).
+  bool IsListedSwarmMetric(std::string_view name) const;
   // For a step that never ends (the runner's watchdog thread): hands what
   // the scripts printed in it so far to the log sink, robots in index order,
   // then the scene's scripts.

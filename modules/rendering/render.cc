@@ -82,9 +82,15 @@ const Gl& Library() {
     std::string why;
     void* lib = OpenSharedLibrary(file, &why);
     if (lib == nullptr) {
+      // Installed, but no room to map it (a tight ulimit -v): installing
+      // it was the wrong advice.
+      const bool memory = why.find("annot allocate memory") != std::string::npos ||
+                          why.find("failed to map segment") != std::string::npos;
       g.error = "rendering needs Mesa's off-screen OpenGL, " + file +
-                " (Debian package libosmesa6; tools/setup.sh installs it), and it could not be "
-                "loaded: " +
+                (memory ? ", and there was no memory to load it (the machine, or a ulimit -v, "
+                          "gave no more): "
+                        : " (Debian package libosmesa6; tools/setup.sh installs it), and it "
+                          "could not be loaded: ") +
                 why;
       return g;
     }

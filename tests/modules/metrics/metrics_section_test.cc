@@ -74,8 +74,12 @@ TEST_F(MetricsSectionTest, ARobotsMetricNamedAsTheWorldsSwarmMetricIsAnError) {
     error = e.what();
   }
   ExpectHas(error, {"bot.lua:1:", "'covered_area' is a swarm metric this world records"});
+  // The rule a plugin's record_metric follows too (it returns -1).
+  EXPECT_TRUE(w.world->IsListedSwarmMetric("covered_area"));
+  EXPECT_FALSE(w.world->IsListedSwarmMetric("mean_nearest_neighbor_distance")) << "not listed";
   // A world that does not list it: the robot's metric is its own.
   LoadedWorld own = Load(world);
+  EXPECT_FALSE(own.world->IsListedSwarmMetric("covered_area"));
   own.world->Step();
   int rows = 0;
   for (const MetricSample& m : own.world->TakeMetrics()) rows += m.name == "covered_area";
