@@ -1,4 +1,5 @@
 // swarmsim run WORLD: load the world, decide the run length, run it.
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -408,6 +409,13 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
       std::cerr << "error: --out: " << swarmsim::ValidUtf8(e.what()) << "\n";
       return kExitBadInput;
     }
+    // What the folder is now: moved or removed while the world loads, the
+    // run says so (RunOptions::out_dir_inode).
+    struct stat folder {};
+    if (::stat(options.out_dir->c_str(), &folder) == 0) {
+      options.out_dir_device = static_cast<uint64_t>(folder.st_dev);
+      options.out_dir_inode = static_cast<uint64_t>(folder.st_ino);
+    }
     if (!out_lock->held()) {
       std::cerr << "error: --out: another run"
                 << (out_lock->holder().empty() ? "" : " (process " + out_lock->holder() + ")")
@@ -468,6 +476,22 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
   } catch (const Error& e) {
     if (load_progress) load_progress->Abandon();
     return bad_input(e.what());
+  } catch (const std::bad_alloc&) {
+    // The machine's, not the world's: the summary says so all the same
+    // (an earlier run's "ok" stayed in the folder).
+    if (load_progress) load_progress->Abandon();
+    return bad_input(
+        "out of memory while loading the world (the machine, a ulimit or --max-memory gave no "
+        "more; README, \"A world that does not fit\")");
+  } catch (const std::exception& e) {
+    if (load_progress) load_progress->Abandon();
+    const std::string what = e.what();
+    // oneTBB's worker threads: "pthread_create has failed".
+    return bad_input(what.find("pthread_create") != std::string::npos
+                         ? "cannot start the world's worker threads (" + what +
+                               "): the system gave this process no more threads, or no room "
+                               "for their stacks: see `ulimit -u` and `ulimit -v`"
+                         : "while loading the world: " + what);
   }
   try {
     load.check_stop();  // a signal at the end of the load
@@ -485,7 +509,8 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
   for (const std::string& warning : loaded.warnings)
     std::cerr << "warning: " << swarmsim::ValidUtf8(warning) << "\n";
   // --max-memory 1M on 50 robots ran at 54 MiB without a word.
-  if (!args.max_memory.empty() && loaded.world->robot_count() < kForecastMinRobots)
+  // (Not with --quiet: a sweep's runs, given a share of memory whatever their size.)
+  if (!args.max_memory.empty() && loaded.world->robot_count() < kForecastMinRobots && !args.quiet)
     std::cerr << "note: --max-memory " << args.max_memory
               << " is not applied: worlds of fewer than " << GroupThousands(kForecastMinRobots)
               << " robots are not checked (this one has " << loaded.world->robot_count() << ")\n";
@@ -667,6 +692,8 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
                          result.ok ? "ok" : (result.signal != 0 ? "interrupted" : "error"),
                          result.ok ? "" : result.error);
   if (view_server && result.signal == 0) {
+    // The run's error now, not only after the serving (it was never printed).
+    if (!result.ok) std::cerr << "error: " << swarmsim::ValidUtf8(result.error) << "\n";
     // The run is over, the page stays: serve until Ctrl-C, SIGTERM or SIGHUP,
     // which end the serving and leave the run's exit status as its summary
     // says (the signals stay caught: StopSignals notes them).

@@ -603,6 +603,14 @@ void RunRecorder::Finish(int64_t steps, const std::string& status, const std::st
   Impl& r = *impl_;
   if (r.finished) return;
   r.finished = true;
+  // A run that ended before its world started (no thread for its watchdog)
+  // wrote no header: an end chunk alone was a file no reader takes ("its
+  // first chunk is no header"). No recording instead.
+  if (r.world == nullptr) {
+    std::error_code ec;
+    std::filesystem::remove(r.settings.out_dir / kRecordingFileName, ec);
+    return;
+  }
   json j = {{"steps", steps}, {"status", status}};
   if (!error.empty()) j["error"] = error;
   try {

@@ -495,6 +495,15 @@ void StepWatched(World* world, const RunOptions& options, Clock::time_point star
   };
   try {
     if (options.out_dir) {
+      // Moved or removed while the world loaded: said, and no new folder
+      // (a new one held an "ok" summary, the old the lock alone).
+      if (options.out_dir_inode != 0) {
+        record->out_folder = std::pair{static_cast<dev_t>(options.out_dir_device),
+                                       static_cast<ino_t>(options.out_dir_inode)};
+        if (FolderIdentity(*options.out_dir) != record->out_folder)
+          throw Error("the output folder '" + options.out_dir->string() +
+                      "' was removed or renamed while the world loaded");
+      }
       CreateOutputFolder(*options.out_dir);
       const std::lock_guard lock(watchdog.io_mutex());
       // summary.json first (status "running"), so that the folder says what
@@ -505,7 +514,7 @@ void StepWatched(World* world, const RunOptions& options, Clock::time_point star
         throw Error("cannot write '" + (*options.out_dir / "summary.json").string() +
                     "': " + reason);
       record->summary_room.Reserve(*options.out_dir, kSummaryRoom);
-      record->out_folder = FolderIdentity(*options.out_dir);
+      if (!record->out_folder) record->out_folder = FolderIdentity(*options.out_dir);
       metrics = std::make_unique<MetricsWriter>(*options.out_dir / "metrics.csv", *world);
     }
     const Clock::time_point starting = Clock::now();
@@ -747,6 +756,7 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
   // no word before, the outputs gone or elsewhere): said, and no new
   // folder holding a summary.json without the files it lists.
   if (record.out_folder && FolderIdentity(*options.out_dir) != record.out_folder) {
+    if (result.error.find("the output folder '") != std::string::npos) return result;  // said
     const std::string message = "the output folder '" + options.out_dir->string() +
                                 "' was removed or renamed during the run; the outputs written "
                                 "into it went with it, and its summary.json is not written";

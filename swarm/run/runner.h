@@ -19,6 +19,10 @@ struct RunResult;
 struct RunOptions {
   int64_t steps = 0;
   std::optional<std::filesystem::path> out_dir;  // summary.json, metrics.csv
+  // The folder out_dir was when the command made it (device, inode; both 0:
+  // not known): moved or removed before the run writes into it (a long
+  // load), the run says so instead of making a new one.
+  uint64_t out_dir_device = 0, out_dir_inode = 0;
   bool print_hash = false;
   // The state hash at the end (RunResult::state_hash, summary.json): a pass
   // over the whole state (0.5 s at a million robots), skipped when false

@@ -279,8 +279,10 @@ int CoordinateSweep(const SweepOptions& o, RemoteWorkers* remote, std::ostream& 
     return 128 + stop_signal;
   }
   if (machine_failure) {
+    // The run's error line, not the notes before it (lines of its stderr
+    // joined by " | ").
     std::string why = machine_failure->error;
-    if (why.rfind("error: ", 0) == 0) why.erase(0, 7);  // a line of the run's stderr
+    if (const size_t at = why.rfind("error: "); at != std::string::npos) why.erase(0, at + 7);
     const bool disk = why.find("No space left") != std::string::npos ||
                       why.find("quota") != std::string::npos ||
                       why.find("Read-only") != std::string::npos;

@@ -331,7 +331,7 @@ TEST(CliTest, AWorldThatWillNotFitIsRefusedWithAMessage) {
             std::string::npos);
 
   // A small world is not held to it: said, not run silently past it.
-  Result small = RunProgram("run " + Data("ok.yaml") + " --steps 1 --quiet --max-memory 1M");
+  Result small = RunProgram("run " + Data("ok.yaml") + " --steps 1 --max-memory 1M");
   EXPECT_EQ(small.exit_code, 0) << small.output;
   EXPECT_NE(small.output.find("note: --max-memory 1M is not applied: worlds of fewer than 2,000 "
                               "robots are not checked (this one has 4)"),
@@ -453,6 +453,29 @@ TEST(CliTest, AnOutputFolderRenamedDuringTheRunIsSaid) {
   EXPECT_FALSE(fs::exists(out)) << "no new folder";
   EXPECT_TRUE(fs::exists(moved / "metrics.csv"));
   fs::remove_all(moved);
+}
+
+// The same while a large world loads (100,000 robots; the folder is moved
+// once the load's first progress line is out): the run made a new folder
+// of that name and wrote an "ok" summary into it, exit 0.
+TEST(CliTest, AnOutputFolderRenamedWhileTheWorldLoadsIsSaid) {
+  const fs::path out = TempDir("renamed_load");
+  const fs::path moved = out.string() + "_moved";
+  const fs::path err = out.string() + "_err.txt";
+  fs::remove_all(moved);
+  const Result r = swarmsim::testing::RunCommand(
+      "(" + std::string(SWARMSIM_BINARY) + " run " + SWARMSIM_SOURCE_DIR +
+      "/bench/worlds/diffusion_planar_native.yaml --set robots=100000 --steps 1 --progress --out " +
+      out.string() + " 2> " + err.string() + " & pid=$!; while ! grep -q loading: " + err.string() +
+      " 2>/dev/null; do sleep 0.01; done; mv " + out.string() + " " + moved.string() +
+      "; wait $pid; echo exit=$?; cat " + err.string() + ")");
+  EXPECT_NE(r.output.find("exit=1\n"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("the output folder '" + out.string() + "' was removed or renamed"),
+            std::string::npos)
+      << r.output;
+  EXPECT_FALSE(fs::exists(out)) << "no new folder";
+  fs::remove_all(moved);
+  fs::remove(err);
 }
 
 TEST(CliTest, AnAddressSpaceLimitIsRoomTooAndRunningOutOfItIsNamed) {
