@@ -236,5 +236,30 @@ TEST_F(ViewerBrowserTest, RunWithViewServesThePageWhileAndAfterTheRun) {
   fs::remove(log);
 }
 
+// A run that fails with --view says why before it serves (its error was
+// never printed: the page stayed, and the exit status after Ctrl-C was 1).
+// No browser needed.
+TEST(ViewCliTest, AFailedRunSaysWhyBeforeItServes) {
+  const fs::path out = FreshTempDir("viewer_browser", "run_view_error");
+  const std::string log = fs::path(FreshTempDir("viewer_browser", "run_view_error_log")).string();
+  ChildProcess run(
+      {SWARMSIM_BINARY, "run", std::string(SWARMSIM_SOURCE_DIR) + "/tests/data/cli/broken.yaml",
+       "--quiet", "--out", out.string(), "--view", "--view-port", "0"},
+      log);
+  ASSERT_TRUE(WaitUntil(
+      [&] {
+        const std::string text = FileText(log);
+        return text.find("still serving") != std::string::npos || !run.Running();
+      },
+      30))
+      << FileText(log);
+  const std::string text = FileText(log);
+  EXPECT_NE(text.find("still serving"), std::string::npos) << text;
+  EXPECT_NE(text.find("error: "), std::string::npos) << text;
+  EXPECT_EQ(run.Stop(), 1) << "as its summary says";
+  fs::remove_all(out);
+  fs::remove(log);
+}
+
 }  // namespace
 }  // namespace swarmsim::testing
