@@ -729,22 +729,6 @@ void World::Record() {
   plugin_metrics_.clear();
 }
 
-bool World::IsListedSwarmMetric(std::string_view name) const {
-  if (find_module(name) == nullptr) return false;
-  const ModuleDescriptor* d = registry().FindModule(name);
-  return d != nullptr && d->info.kind == "metric";
-}
-
-bool World::RecordPluginMetric(int robot, std::string_view name, double value) {
-  if (!recording_ || name.empty() || robot < -1 || robot >= robot_count()) return false;
-  // Under a swarm metric's name the rows of both would be one metric (as
-  // sim.recordMetric refuses).
-  if (IsListedSwarmMetric(name)) return false;
-  const std::lock_guard lock(plugin_metrics_mutex_);
-  plugin_metrics_.push_back({step_count_, time_, robot, std::string(name), value});
-  return true;
-}
-
 void World::SetNativeController(int robot, const PluginControllerType* type,
                                 bool in_place_of_scripts) {
   if (started_) throw Error("native controllers are attached before the world starts");

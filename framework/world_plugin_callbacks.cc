@@ -2,6 +2,7 @@
 // run at fixed points of each step, with the world interface plugins see.
 // Apart from world.cc, like world_plugin_sensors.cc, so that the World does
 // not include that interface (plugin_world_api.cc includes world.h).
+#include <mutex>
 #include <string>
 #include <utility>
 #include <vector>
@@ -43,6 +44,22 @@ void World::CallPhaseCallbacks(const std::vector<const PhaseCallback*>& callback
     }
     if (!error.empty()) throw Error(error);
   }
+}
+
+bool World::IsListedSwarmMetric(std::string_view name) const {
+  if (find_module(name) == nullptr) return false;
+  const ModuleDescriptor* d = registry().FindModule(name);
+  return d != nullptr && d->info.kind == "metric";
+}
+
+bool World::RecordPluginMetric(int robot, std::string_view name, double value) {
+  if (!recording_ || name.empty() || robot < -1 || robot >= robot_count()) return false;
+  // Under a swarm metric's name the rows of both would be one metric (as
+  // sim.recordMetric refuses).
+  if (IsListedSwarmMetric(name)) return false;
+  const std::lock_guard lock(plugin_metrics_mutex_);
+  plugin_metrics_.push_back({step_count_, time_, robot, std::string(name), value});
+  return true;
 }
 
 }  // namespace swarmsim

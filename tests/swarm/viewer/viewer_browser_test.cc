@@ -206,6 +206,14 @@ TEST_F(ViewerBrowserTest, FollowsARecordingThatIsStillBeingWritten) {
   fs::remove_all(live);
 }
 
+// Whether `run --view`, logging to `log`, says it serves after its run (or
+// has ended) within 30 s.
+bool ServingOrEnded(ChildProcess* run, const std::string& log) {
+  return WaitUntil(
+      [&] { return FileText(log).find("still serving") != std::string::npos || !run->Running(); },
+      30);
+}
+
 TEST_F(ViewerBrowserTest, RunWithViewServesThePageWhileAndAfterTheRun) {
   const fs::path out = FreshTempDir("viewer_browser", "run_view");
   const std::string log = fs::path(FreshTempDir("viewer_browser", "run_view_log")).string();
@@ -214,13 +222,7 @@ TEST_F(ViewerBrowserTest, RunWithViewServesThePageWhileAndAfterTheRun) {
                     "--quiet", "--out", out.string(), "--view", "--view-port", "0"},
                    log);
   std::string address;
-  ASSERT_TRUE(WaitUntil(
-      [&] {
-        const std::string text = FileText(log);
-        return text.find("still serving") != std::string::npos || !run.Running();
-      },
-      30))
-      << FileText(log);
+  ASSERT_TRUE(ServingOrEnded(&run, log)) << FileText(log);
   const std::string text = FileText(log);
   const size_t at = text.find("http://127.0.0.1:");
   ASSERT_NE(at, std::string::npos) << text;
@@ -246,13 +248,7 @@ TEST(ViewCliTest, AFailedRunSaysWhyBeforeItServes) {
       {SWARMSIM_BINARY, "run", std::string(SWARMSIM_SOURCE_DIR) + "/tests/data/cli/broken.yaml",
        "--quiet", "--out", out.string(), "--view", "--view-port", "0"},
       log);
-  ASSERT_TRUE(WaitUntil(
-      [&] {
-        const std::string text = FileText(log);
-        return text.find("still serving") != std::string::npos || !run.Running();
-      },
-      30))
-      << FileText(log);
+  ASSERT_TRUE(ServingOrEnded(&run, log)) << FileText(log);
   const std::string text = FileText(log);
   EXPECT_NE(text.find("still serving"), std::string::npos) << text;
   EXPECT_NE(text.find("error: "), std::string::npos) << text;
