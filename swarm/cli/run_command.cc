@@ -41,8 +41,11 @@ namespace swarmsim::cli {
 namespace {
 
 // The line on stderr while a large world loads (--progress, or stderr a
-// terminal; never with --quiet): "loading: 45,056 of 100,000 robots built"
-// ("loading: 100,000 robots placed; building them" before the first),
+// terminal; never with --quiet), one stage after another:
+// "loading: placing robots: 450,560 of 1,000,000",
+// "loading: 1,000,000 robots placed; populating their memory: 3.2 of 9.6 GiB",
+// "loading: 1,000,000 robots placed; building them",
+// "loading: 45,056 of 100,000 robots built",
 // redrawn in place on a terminal (a new line each time otherwise) at most
 // twice a second, once the load has taken half a second; then, for a world
 // that showed it (always with --progress), "loaded 100,000 robots in 3.4 s;
@@ -50,20 +53,32 @@ namespace {
 // progress follows.
 class LoadProgress {
  public:
+  using Stage = LoadOptions::LoadStage;
   LoadProgress(bool forced, bool tty) : forced_(forced), tty_(tty) {}
 
-  void Copies(int64_t built, int64_t total) {
-    total_ = total;
+  void Loading(Stage stage, int64_t done, int64_t total) {
+    if (stage != Stage::kPopulating) total_ = total;
     const double now = Seconds();
     if (now < 0.5 || (shown_ && now - last_ < 0.5)) return;
     last_ = now;
     shown_ = true;
-    // Before the first copy (placing them took the time): none built yet.
     std::cerr << (tty_ ? "\r" : "") << "loading: ";
-    if (built == 0)
+    if (stage == Stage::kPlacing) {
+      std::cerr << "placing robots: " << GroupThousands(done) << " of " << GroupThousands(total);
+    } else if (stage == Stage::kPopulating) {
+      // Each robot's rows, reserved at once and populated on every thread.
+      const bool gib = total >= (int64_t{1} << 30);
+      const double unit = gib ? double(int64_t{1} << 30) : double(int64_t{1} << 20);
+      std::cerr << GroupThousands(total_)
+                << " robots placed; populating their memory: " << std::fixed
+                << std::setprecision(gib ? 1 : 0) << static_cast<double>(done) / unit << " of "
+                << static_cast<double>(total) / unit << std::defaultfloat
+                << (gib ? " GiB" : " MiB");
+    } else if (done == 0) {
       std::cerr << GroupThousands(total) << " robots placed; building them";
-    else
-      std::cerr << GroupThousands(built) << " of " << GroupThousands(total) << " robots built";
+    } else {
+      std::cerr << GroupThousands(done) << " of " << GroupThousands(total) << " robots built";
+    }
     std::cerr << (tty_ ? "\033[K" : "\n") << std::flush;
   }
   // The load failed: an error message goes on a line of its own.
@@ -464,7 +479,9 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
   std::optional<LoadProgress> load_progress;
   if (!args.quiet && (args.progress || isatty(STDERR_FILENO))) {
     load_progress.emplace(args.progress, isatty(STDERR_FILENO) != 0);
-    load.copy_progress = [&](int64_t built, int64_t total) { load_progress->Copies(built, total); };
+    load.progress = [&](LoadOptions::LoadStage stage, int64_t done, int64_t total) {
+      load_progress->Loading(stage, done, total);
+    };
   }
   LoadedWorld loaded;
   const auto load_start = std::chrono::steady_clock::now();

@@ -156,7 +156,7 @@ std::vector<Placement2> Placer::Distribute(const Region2& region, int64_t count,
   out.reserve(static_cast<size_t>(count));
   Rng rng(seed_, kPlacementStream + stream);
   for (int64_t k = 0; k < count; ++k) {
-    if (check_stop_ && k % 4096 == 4095) check_stop_();
+    if (every_4096_ && k % 4096 == 4095) every_4096_(k);
     const double radius = radius_of(k);
     const double grow = max_radius - radius;  // a smaller disc may come closer to the edges
     bool placed = false;

@@ -75,9 +75,10 @@ class Placer {
     return copy;
   }
 
-  // Called every 4,096 copies Distribute places: may throw to abandon the
-  // placement (a stop signal while a million copies are placed).
-  void set_check_stop(std::function<void()> check) { check_stop_ = std::move(check); }
+  // Called every 4,096 copies a Distribute call places, with the number it
+  // has placed: for a progress line, and may throw to abandon the placement
+  // (a stop signal while a million copies are placed).
+  void set_every_4096(std::function<void(int64_t placed)> call) { every_4096_ = std::move(call); }
 
   void AddObstacle(const Obstacle2& obstacle) { obstacles_.push_back(obstacle); }
   // Keeps the obstacles that reach more than `overlap` into heights [lo, hi]
@@ -144,7 +145,7 @@ class Placer {
   }
 
   uint64_t seed_;
-  std::function<void()> check_stop_;
+  std::function<void(int64_t)> every_4096_;
   std::vector<Body> bodies_;
   std::vector<Obstacle2> obstacles_;
   EnvironmentPlaneGrid map_;  // map cells (empty: none)

@@ -10,6 +10,7 @@
 #include <memory>
 #include <new>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -174,6 +175,20 @@ void WorldLoader::PlaceEntries(std::vector<std::string>* warnings) {
                           arena_text());
     placer_->AddBody(X.p.x, X.p.y, radius);
   }
+  // Copies drawn at random (a million take seconds): the stop signals are
+  // heard and the progress told every 4,096.
+  int64_t to_place = 0, placed = 0;
+  for (const EntryPlan& e : entries_)
+    if (e.distribute && !e.lattice) to_place += e.count;
+  placer_->set_every_4096([this, &placed, to_place](int64_t k) {
+    if (options_.check_stop) options_.check_stop();
+    if (options_.progress)
+      options_.progress(LoadOptions::LoadStage::kPlacing, placed + k, to_place);
+  });
+  struct Forget {  // the call refers to this frame's counts
+    Placer* placer;
+    ~Forget() { placer->set_every_4096({}); }
+  } forget{placer_.get()};
   uint64_t stream = 0;
   for (EntryPlan& e : entries_) {
     if (!e.distribute) continue;
@@ -212,6 +227,7 @@ void WorldLoader::PlaceEntries(std::vector<std::string>* warnings) {
           e.region, e.count, [&e](int64_t k) { return e.FootprintOf(k).radius; },
           e.MaxFootprintRadius(), e.clearance, stream++, e.heading);
     }
+    placed += static_cast<int64_t>(e.placements.size());
     if (static_cast<int64_t>(e.placements.size()) < e.count)
       file_->Fail(e.count_field.mark,
                   "cannot place " + GroupThousands(e.count) + " " + e.model->name + " copies in " +
@@ -220,11 +236,13 @@ void WorldLoader::PlaceEntries(std::vector<std::string>* warnings) {
                       "); enlarge the " + (e.region_text == "the arena" ? "arena" : "region") +
                       " or reduce count");
   }
+  if (options_.progress && to_place > 0)
+    options_.progress(LoadOptions::LoadStage::kPlacing, placed, to_place);
 }
 
 void WorldLoader::BuildCopies(World* world) {
   Scene& scene = world->scene();
-  int64_t total = 0, built = 0;  // copies, for options_.copy_progress
+  int64_t total = 0, built = 0;  // copies, for options_.progress
   for (const EntryPlan& e : entries_)
     total += e.distribute ? static_cast<int64_t>(e.placements.size()) : 1;
   MemoryForecast forecast("robot copies", total, options_.max_memory);
@@ -276,7 +294,16 @@ void WorldLoader::BuildCopies(World* world) {
         // A stop signal meanwhile: the rest is left, and the check after
         // throws (10 GiB for a million robots take seconds on cold memory).
         std::atomic<bool> stopped{false};  // (asked on every thread)
-        prefault.Run(world->scheduler(), [this, &stopped] {
+        // Progress told on this thread as it takes a chunk: Run asks before
+        // each chunk of 8 MiB.
+        const int64_t to_populate = static_cast<int64_t>(prefault.bytes());
+        std::atomic<int64_t> chunks{0};
+        const std::thread::id loading = std::this_thread::get_id();
+        prefault.Run(world->scheduler(), [&, this] {
+          const int64_t begun = chunks.fetch_add(1, std::memory_order_relaxed);
+          if (options_.progress && to_populate > 0 && std::this_thread::get_id() == loading)
+            options_.progress(LoadOptions::LoadStage::kPopulating,
+                              std::min(begun * (int64_t{8} << 20), to_populate), to_populate);
           if (!options_.check_stop || stopped.load()) return stopped.load();
           try {
             options_.check_stop();
@@ -286,6 +313,8 @@ void WorldLoader::BuildCopies(World* world) {
           return stopped.load();
         });
         if (stopped.load()) options_.check_stop();
+        if (options_.progress && to_populate > 0)
+          options_.progress(LoadOptions::LoadStage::kPopulating, to_populate, to_populate);
       }
       const int instance = scene.MakeModelInstance(
           root, name, name + "#" + std::to_string(scene.instances().size()));
@@ -317,7 +346,8 @@ void WorldLoader::BuildCopies(World* world) {
     std::vector<Pose> batch;
     for (size_t k = 0; k < poses.size();) {
       if (options_.check_stop && built % 256 == 0) options_.check_stop();
-      if (options_.copy_progress && built % 256 == 0) options_.copy_progress(built, total);
+      if (options_.progress && built % 256 == 0)
+        options_.progress(LoadOptions::LoadStage::kBuilding, built, total);
       if (std::string refusal = forecast.Built(built); !refusal.empty()) throw Error(refusal);
       const EntryPlan::OwnCopy* own = e.FindOwnCopy(static_cast<int64_t>(k));
       if ((own && own->spec) || first.IsNull()) {
@@ -354,7 +384,7 @@ void WorldLoader::BuildCopies(World* world) {
       k = end;
     }
   }
-  if (options_.copy_progress) options_.copy_progress(built, total);
+  if (options_.progress) options_.progress(LoadOptions::LoadStage::kBuilding, built, total);
 }
 
 std::vector<std::pair<int, Pose>> WorldLoader::Placements(uint64_t seed) {

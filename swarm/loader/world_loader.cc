@@ -111,7 +111,6 @@ LoadedWorld WorldLoader::Load() {
 
   ground_plane_ = settings.physics == "ode";
   placer_ = std::make_unique<Placer>(settings.seed);
-  placer_->set_check_stop(options_.check_stop);
   BuildArena(top, world);
   BuildObstacles(top, world);
   environment_field_ = top.Get("environment");

@@ -58,10 +58,17 @@ struct LoadOptions {
   // 8 MiB or more: "reading mesh file 'rock.stl' (62 MiB)"); the program
   // prints it on stderr. Empty: not said.
   std::function<void(const std::string&)> note;
-  // Called as model copies are built (every 256 copies, and after the
-  // last): copies built so far and in all, over every models entry. For a
-  // progress line while a large world loads. Empty: never.
-  std::function<void(int64_t built, int64_t total)> copy_progress;
+  // What a large world's load is doing, for a progress line (the program
+  // prints one on stderr), over every models entry. Empty: never told.
+  //   kPlacing: `done` copies of `total` placed (every 4,096, and after the
+  //     last; the copies of `distribute` entries drawn at random);
+  //   kPopulating: `done` bytes of the `total` bytes of the copies' arrays
+  //     populated (framework/prefault.h; now and then, and after the last);
+  //   kBuilding: `done` copies of `total` built (every 256, and after the
+  //     last; every copy).
+  // Always called on the thread that loads.
+  enum class LoadStage { kPlacing, kPopulating, kBuilding };
+  std::function<void(LoadStage stage, int64_t done, int64_t total)> progress;
   // --max-memory: bytes the whole process may hold (0: what the machine
   // has). Copies that will not fit end the load with an error
   // (framework/memory_forecast.h); WorldSettings::max_memory for the rest.

@@ -387,6 +387,27 @@ std::string WriteSummary(const World& world, const RunOptions& options, const Ru
   return reason;
 }
 
+// A file descriptor held for the last summary.json: a run whose files (the
+// recording, metrics.csv, a plugin's) used up its open files (`ulimit -n`)
+// still writes how it ended (it stayed "running").
+class SpareDescriptor {
+ public:
+  SpareDescriptor() = default;
+  SpareDescriptor(const SpareDescriptor&) = delete;
+  SpareDescriptor& operator=(const SpareDescriptor&) = delete;
+  ~SpareDescriptor() { Release(); }
+  void Take() {
+    if (fd_ < 0) fd_ = ::open("/dev/null", O_RDONLY | O_CLOEXEC);
+  }
+  void Release() {
+    if (fd_ >= 0) ::close(fd_);
+    fd_ = -1;
+  }
+
+ private:
+  int fd_ = -1;
+};
+
 // What a run has produced so far, shared by its step loop, the watchdog's
 // end of a stuck run and the outputs written after the loop.
 struct RunRecord {
@@ -394,7 +415,8 @@ struct RunRecord {
   std::unique_ptr<MetricsWriter> metrics;  // metrics.csv, with an output folder
   // Room for the last summary.json when the disk fills during the run.
   OutputReserve summary_room;
-  double lua_kib = 0;  // the scripts' memory when they stopped
+  SpareDescriptor summary_descriptor;  // and a file descriptor for it
+  double lua_kib = 0;                  // the scripts' memory when they stopped
   // The output folder as the run found it (device, inode): removed or
   // renamed during the run, the files written into it went with it.
   std::optional<std::pair<dev_t, ino_t>> out_folder;
@@ -436,6 +458,7 @@ void StepWatched(World* world, const RunOptions& options, Clock::time_point star
     }
     if (options.on_stuck_end) options.on_stuck_end(stuck);  // the recording's end chunk
     record->summary_room.Release();
+    record->summary_descriptor.Release();
     if (options.out_dir && std::filesystem::is_directory(*options.out_dir))
       WriteSummary(*world, options, stuck, 0, /*complete=*/false);
     progress.Finish();
@@ -514,6 +537,7 @@ void StepWatched(World* world, const RunOptions& options, Clock::time_point star
         throw Error("cannot write '" + (*options.out_dir / "summary.json").string() +
                     "': " + reason);
       record->summary_room.Reserve(*options.out_dir, kSummaryRoom);
+      record->summary_descriptor.Take();
       if (!record->out_folder) record->out_folder = FolderIdentity(*options.out_dir);
       metrics = std::make_unique<MetricsWriter>(*options.out_dir / "metrics.csv", *world);
     }
@@ -752,6 +776,7 @@ RunResult RunWorld(World* world, const RunOptions& options, std::ostream& out,
 
   // The last file: the room kept for it is given back first (a full disk).
   record.summary_room.Release();
+  record.summary_descriptor.Release();
   // The folder removed or renamed while the run wrote into it (exit 0 and
   // no word before, the outputs gone or elsewhere): said, and no new
   // folder holding a summary.json without the files it lists.

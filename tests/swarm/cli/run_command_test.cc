@@ -405,6 +405,36 @@ TEST(CliTest, AThreadThatCannotBeStartedIsNamedAndTheSummarySaysSo) {
   fs::remove_all(out);
 }
 
+// Too few open files (`ulimit -n`): the recording and metrics.csv took the
+// last ones, and the run ended with "cannot write 'summary.json': Too many
+// open files", leaving it "running". Whatever the limit, the summary now
+// says how the run ended: ok, or the error, never "running".
+TEST(CliTest, TooFewOpenFilesStillGiveTheSummaryItsEnd) {
+  const fs::path out = TempDir("open_files");
+  int ended = 0;
+  for (int files = 5; files <= 12; ++files) {
+    fs::remove_all(out);
+    // In a subshell: the shell's own redirection (2>&1) comes before the
+    // limit (dash keeps a copy of the descriptor it redirects above 10).
+    const Result r = swarmsim::testing::RunCommand(
+        "(ulimit -n " + std::to_string(files) + " && " + std::string(SWARMSIM_BINARY) + " run " +
+        Data("ok.yaml") + " --steps 3 --quiet --record --out " + out.string() + ")");
+    std::ifstream summary_file(out / "summary.json");
+    if (!summary_file.good()) continue;  // too few to begin
+    const nlohmann::json summary = nlohmann::json::parse(summary_file);
+    EXPECT_NE(summary["status"], "running") << files << " files: " << r.output;
+    if (summary["status"] == "ok") {
+      EXPECT_EQ(r.exit_code, 0) << files << " files: " << r.output;
+    } else {
+      EXPECT_NE(r.exit_code, 0) << files << " files: " << r.output;
+      EXPECT_FALSE(summary["error"].get<std::string>().empty()) << files;
+    }
+    ++ended;
+  }
+  EXPECT_GT(ended, 0) << "no limit let the run begin";
+  fs::remove_all(out);
+}
+
 // A stop signal while a large world starts (its robots' sysCall_init take
 // seconds here; a million robots' start does too) ends the start between
 // robots: it was not looked at until the start ended, or the run was ended

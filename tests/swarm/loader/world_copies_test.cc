@@ -276,5 +276,65 @@ TEST_F(WorldCopiesTest, ScaledCopiesWithTheirOwnValuesShareTheScaledMesh) {
   EXPECT_DOUBLE_EQ(own.mesh->CenteredExtents().x, 0.2);
 }
 
+// What a progress line is made of while a large world loads: the copies
+// drawn at random (every 4,096 and at the end), then their arrays'
+// memory populated (in bytes), then the copies built (every 256 and at the
+// end), each stage counting up to its total, in that order.
+TEST_F(WorldCopiesTest, TheLoadTellsItsProgressStageByStage) {
+  using Stage = LoadOptions::LoadStage;
+  struct Told {
+    Stage stage;
+    int64_t done, total;
+  };
+  std::vector<Told> told;
+  LoadOptions options;
+  options.threads = 2;
+  options.progress = [&told](Stage stage, int64_t done, int64_t total) {
+    told.push_back({stage, done, total});
+  };
+  LoadWorld(Write("world.yaml",
+                  "simulation: {physics: kinematic}\n"
+                  "models:\n"
+                  "  - {model: bot.yaml, position: [-1, -1]}\n"
+                  "  - model: bot.yaml\n"
+                  "    count: 10000\n"
+                  "    distribute: {region: {min: [0, 0], max: [100, 100]}}\n"),
+            options, registry_);
+  ASSERT_FALSE(told.empty());
+  // Stage by stage, each counting up; "building them" (none built yet) is
+  // said before the memory they need is populated.
+  std::vector<int64_t> placed, built;
+  int64_t populated_total = -1;
+  size_t last_placing = 0, first_populating = told.size(), last_populating = 0;
+  for (size_t i = 0; i < told.size(); ++i) {
+    const Told& t = told[i];
+    EXPECT_LE(t.done, t.total) << i;
+    if (t.stage == Stage::kPlacing) {
+      EXPECT_EQ(t.total, 10000) << "the drawn copies, not the fixed one";
+      if (!placed.empty()) EXPECT_GT(t.done, placed.back()) << i;
+      placed.push_back(t.done);
+      last_placing = i;
+    } else if (t.stage == Stage::kPopulating) {
+      EXPECT_GT(t.total, 10000 * 64) << "bytes of 10,000 copies' rows";
+      EXPECT_TRUE(populated_total < 0 || populated_total == t.total);
+      populated_total = t.total;
+      first_populating = std::min(first_populating, i);
+      last_populating = i;
+    } else {
+      EXPECT_EQ(t.total, 10001) << "every copy";
+      if (!built.empty()) EXPECT_GE(t.done, built.back()) << i;
+      built.push_back(t.done);
+    }
+  }
+  ASSERT_GE(placed.size(), 3u) << "at 4,095, 8,191 and the end";
+  EXPECT_EQ(placed.back(), 10000);
+  ASSERT_GE(populated_total, 0) << "the arrays' memory was not told";
+  EXPECT_EQ(told[last_populating].done, populated_total) << "it ends at its total";
+  EXPECT_LT(last_placing, first_populating);
+  ASSERT_GE(built.size(), 3u);
+  EXPECT_EQ(built.back(), 10001);
+  EXPECT_EQ(told.back().stage, Stage::kBuilding);
+}
+
 }  // namespace
 }  // namespace swarmsim
