@@ -38,6 +38,7 @@
 #include "framework/display_path.h"
 #include "framework/error.h"
 #include "framework/lua_api.h"
+#include "framework/lua_file_text.h"
 #include "framework/lua_libraries.h"
 #include "framework/world.h"
 
@@ -368,7 +369,7 @@ int SafeRequire(lua_State* L) {
     std::ifstream in(candidate, std::ios::binary);
     std::stringstream code;
     code << in.rdbuf();
-    const std::string text = code.str();
+    const std::string text = LuaFileText(code.str());
     // Named in messages as the scripts are: relative to the current folder.
     std::string chunkname = DisplayPath(candidate);
     chunkname.insert(chunkname.begin(), '@');

@@ -11,6 +11,7 @@
 
 #include "framework/error.h"
 #include "framework/lua_evaluator.h"
+#include "framework/lua_file_text.h"
 #include "framework/object_type.h"
 #include "framework/registry.h"
 #include "swarm/loader/object_reader.h"
@@ -360,7 +361,7 @@ std::shared_ptr<const ScriptSource> ScriptCache::Get(const fs::path& path, const
   if (auto it = sources_.find(key); it != sources_.end()) return it->second;
   auto source = std::make_shared<ScriptSource>();
   source->path = DisplayPath(path);
-  source->code = ReadFileOrThrow(path, "script file", where, text);
+  source->code = LuaFileText(ReadFileOrThrow(path, "script file", where, text));
   // Compiled Lua (luac's output): it said "script attempt to load a binary
   // chunk (mode is 't')". Scripts load as source only.
   if (source->code.starts_with("\x1bLua"))

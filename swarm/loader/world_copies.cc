@@ -433,6 +433,7 @@ std::vector<ModelSummary> WorldLoader::Summarize() const {
         p.range += ", ";
         p.range += loader::FormatNumber(decl.max);
         p.range += "]";
+        p.bounds = std::pair(decl.min, decl.max);
       }
       m.parameters.push_back(std::move(p));
     }

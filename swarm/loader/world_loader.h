@@ -88,6 +88,7 @@ struct PythonController {
 // What `swarmsim describe` lists about one `models:` entry.
 struct ParameterSummary {
   std::string name, value, default_value, unit, range, description;  // range: "[a, b]" or ""
+  std::optional<std::pair<double, double>> bounds;                   // the range's [min, max]
 };
 struct ModelSummary {
   std::string name;  // "footbot"

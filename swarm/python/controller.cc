@@ -211,9 +211,9 @@ class ControllerModule : public Module {
         trace = e.what();
       }
       throw Error(config_.where + ": the Python controller of model '" + config_.model +
-                  "' raised an exception during step " + std::to_string(world->step_count() + 1) +
-                  " of the run (called with robots.step == " + std::to_string(world->step_count()) +
-                  ", the steps finished):\n" + trace);
+                  "' raised an exception in step " + std::to_string(world->step_count() + 1) +
+                  " of the run (its robots.step was " + std::to_string(world->step_count()) +
+                  ": robots.step counts the steps finished before the call):\n" + trace);
     }
   }
 

@@ -66,6 +66,23 @@ int ThreadsArg(const py::object& value, const char* where) {
   return static_cast<int>(threads);
 }
 
+// A {name: value} argument (set=, controllers=): None is none, anything
+// but a dict with text keys a TypeError naming the argument (pybind11's own
+// "incompatible function arguments" said neither which nor why).
+std::map<std::string, py::object> NameMap(const py::object& value, const std::string& what) {
+  std::map<std::string, py::object> out;
+  if (value.is_none()) return out;
+  if (!py::isinstance<py::dict>(value))
+    throw py::type_error(what + " must be a dict of {name: value}, not " + TypeName(value));
+  for (const auto& [key, item] : py::reinterpret_borrow<py::dict>(value)) {
+    if (!py::isinstance<py::str>(key))
+      throw py::type_error(what + ": the key " + py::repr(key).cast<std::string>() +
+                           " is not a name (a str)");
+    out[key.cast<std::string>()] = py::reinterpret_borrow<py::object>(item);
+  }
+  return out;
+}
+
 // A seed: None (the world's own) or an integer from 0 to 2^64 - 1.
 std::optional<uint64_t> SeedArg(const py::object& value, const std::string& what) {
   if (value.is_none()) return std::nullopt;
@@ -301,19 +318,19 @@ PYBIND11_MODULE(_swarmsim, m) {
       "Threads: one thread uses a World at a time. A second Python thread's call waits\n"
       "until the first one's step ends. A controller may read its world but not step,\n"
       "close or write it (RuntimeError).")
-      .def(py::init([](const py::object& path, const py::object& seed,
-                       const std::map<std::string, py::object>& set, const py::object& threads,
-                       const std::map<std::string, py::object>& controllers,
+      .def(py::init([](const py::object& path, const py::object& seed, const py::object& set,
+                       const py::object& threads, const py::object& controllers,
                        const py::object& package_path, bool keep_scripts) {
              return std::make_unique<PyWorld>(
                  swarmsim::python::FsPath(path, "World(path)"),
-                 swarmsim::python::SeedArg(seed, "World(seed=...)"), set,
-                 swarmsim::python::ThreadsArg(threads, "World(threads=...)"), controllers,
+                 swarmsim::python::SeedArg(seed, "World(seed=...)"),
+                 swarmsim::python::NameMap(set, "World(set=...)"),
+                 swarmsim::python::ThreadsArg(threads, "World(threads=...)"),
+                 swarmsim::python::NameMap(controllers, "World(controllers=...)"),
                  swarmsim::python::FsPaths(package_path, "World(package_path=...)"), keep_scripts);
            }),
-           py::arg("path"), py::arg("seed") = py::none(),
-           py::arg("set") = std::map<std::string, py::object>{}, py::arg("threads") = py::int_(0),
-           py::arg("controllers") = std::map<std::string, py::object>{},
+           py::arg("path"), py::arg("seed") = py::none(), py::arg("set") = py::dict(),
+           py::arg("threads") = py::int_(0), py::arg("controllers") = py::dict(),
            py::arg("package_path") = py::list(), py::arg("keep_scripts") = true)
       // Stepping and state.
       .def(
@@ -561,6 +578,10 @@ PYBIND11_MODULE(_swarmsim, m) {
           "stream from it. No file is read again.")
       .def(py::pickle([](PyWorld& w) { return w.getstate(); }, &PyWorld::setstate));
 
+  m.def("_write_load_failure", &swarmsim::python::WriteLoadFailure, py::arg("out_dir"),
+        py::arg("world"), py::arg("error"),
+        "For python3 -m swarmsim run: summary.json (status error) in out_dir for a world that "
+        "did not load.");
   m.def("step_worlds", &swarmsim::python::StepWorlds, py::arg("worlds"), py::arg("n") = 1,
         py::arg("threads") = py::int_(0),
         "Steps every World of the list n steps, the worlds in parallel on `threads` workers\n"

@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -51,6 +52,28 @@ void FlushPythonStreams() {
 }
 
 }  // namespace
+
+void WriteLoadFailure(const std::string& out, const std::string& world_file,
+                      const std::string& error) {
+  const std::filesystem::path dir(out);
+  std::optional<FileLock> out_lock;
+  try {
+    CreateOutputFolder(dir);
+    out_lock.emplace((dir / ".swarmsim-lock").string());
+  } catch (const Error& e) {
+    throw py::value_error(std::string("--out: ") + e.what());
+  }
+  if (!out_lock->held())
+    throw py::value_error("--out: another run is writing into '" + ValidUtf8(dir.string()) +
+                          "': its summary.json is left alone");
+  RunOptions options;
+  options.out_dir = dir;
+  options.world_file = world_file;
+  options.command_line = CommandLine();
+  if (const std::string reason = WriteErrorSummary(options, error); !reason.empty())
+    throw py::value_error("cannot write '" + ValidUtf8((dir / "summary.json").string()) +
+                          "': " + reason);
+}
 
 py::dict PyWorld::Run(std::optional<int64_t> steps, const std::optional<std::string>& out,
                       bool quiet, bool hash) {

@@ -590,7 +590,17 @@ void PyWorld::set_param(const std::string& model, const std::string& name,
   GateLock lock(gate_.get());
   World& w = Live();
   const ModelLayout& layout = Layout(model);
-  Translate([&] { SetParam(&w, layout, name, values); });
+  // Held to the model's `range`, as World(set=...) and --set are.
+  std::optional<std::pair<double, double>> bounds;
+  std::string range_text;
+  for (const ModelSummary& m : loaded_.models)
+    if (m.name == model)
+      for (const ParameterSummary& p : m.parameters)
+        if (p.name == name && p.bounds) {
+          bounds = p.bounds;
+          range_text = p.range + (p.unit.empty() || p.unit == "1" ? "" : " " + p.unit);
+        }
+  Translate([&] { SetParam(&w, layout, name, values, bounds, range_text); });
 }
 
 py::dict PyWorld::metrics() {
@@ -709,8 +719,27 @@ py::object PyWorld::LoadFunction(const PythonController& c) {
     if (e.matches(PyExc_ValueError) || e.matches(PyExc_KeyboardInterrupt) ||
         e.matches(PyExc_SystemExit))
       throw;
+    // The error and the controller file's own lines of its traceback, not
+    // the interpreter's import machinery ("<frozen importlib._bootstrap>").
+    std::string said;
+    try {
+      py::module_ tb = py::module_::import("traceback");
+      if (e.trace()) {
+        py::list frames;
+        for (const py::handle frame : tb.attr("extract_tb")(e.trace()))
+          if (std::filesystem::path(py::str(frame.attr("filename")).cast<std::string>()) == c.file)
+            frames.append(frame);
+        for (const py::handle line : tb.attr("format_list")(frames))
+          said += py::str(line).cast<std::string>();
+      }
+      for (const py::handle line : tb.attr("format_exception_only")(e.type(), e.value()))
+        said += py::str(line).cast<std::string>();
+      while (!said.empty() && said.back() == '\n') said.pop_back();
+    } catch (const std::exception&) {
+      said = e.what();
+    }
     throw py::value_error(c.where + ": loading the Python controller " + c.file.string() +
-                          " failed: " + e.what());
+                          " failed:\n" + said);
   }
 }
 

@@ -28,6 +28,13 @@ namespace swarmsim::python {
 inline constexpr int kMaxThreads = 256;
 void CheckThreads(int64_t threads, const char* where);
 
+// `python3 -m swarmsim run --out DIR` of a world that did not load: DIR
+// (made if missing) gets summary.json with status error and `error`, the
+// earlier run's outputs removed, as `swarmsim run` does (run.cc).
+// ValueError when the folder cannot be used or written.
+void WriteLoadFailure(const std::string& out, const std::string& world_file,
+                      const std::string& error);
+
 class PyWorld {
  public:
   PyWorld(const std::string& path, std::optional<uint64_t> seed,

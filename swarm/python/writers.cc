@@ -2,8 +2,10 @@
 
 #include <cmath>
 #include <cstdio>
+#include <iomanip>
 #include <map>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -233,7 +235,8 @@ void SetJointStates(World* world, const ModelLayout& layout, int what, const py:
 }
 
 void SetParam(World* world, const ModelLayout& layout, const std::string& name,
-              const py::object& values) {
+              const py::object& values, const std::optional<std::pair<double, double>>& bounds,
+              const std::string& range_text) {
   const size_t n = layout.robots.size();
   const Array a = RealNumbers(values, "set_param('" + name + "')");
   const bool scalar = a.ndim() == 0 || (a.ndim() == 1 && a.shape(0) == 1 && n != 1);
@@ -260,6 +263,14 @@ void SetParam(World* world, const ModelLayout& layout, const std::string& name,
     if (!std::isfinite(x))
       throw WriteError(false, "set_param('" + name + "'): the value for robot '" +
                                   RobotName(world->scene(), layout, i) + "' is not finite");
+    if (bounds && !(x >= bounds->first && x <= bounds->second)) {
+      std::ostringstream got;
+      got << std::setprecision(17) << x;
+      throw WriteError(false, "set_param('" + name + "'): parameter '" + name + "' of model '" +
+                                  layout.model + "' must be within " + range_text + " (got " +
+                                  got.str() + " for robot '" +
+                                  RobotName(world->scene(), layout, i) + "')");
+    }
     if (std::holds_alternative<double>(*old)) {
       next[i] = x;
     } else if (std::holds_alternative<bool>(*old)) {

@@ -3,8 +3,10 @@
 // checked whole before anything is written, so a refused call changes nothing.
 #pragma once
 
+#include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "swarm/python/arrays.h"
@@ -49,9 +51,12 @@ void SetVelocities(World* world, const ModelLayout& layout, const py::object& ve
 // nothing simulates (the dynamics backend's own joints are refused).
 void SetJointStates(World* world, const ModelLayout& layout, int what, const py::object& values);
 // A model parameter (a number or a boolean the model declares) of every
-// robot: one value, or N.
+// robot: one value, or N; each within `bounds` (the model's `range`, shown
+// as `range_text`, "[-0.1288, 0.1288] m/s") when it has one.
 void SetParam(World* world, const ModelLayout& layout, const std::string& name,
-              const py::object& values);
+              const py::object& values,
+              const std::optional<std::pair<double, double>>& bounds = std::nullopt,
+              const std::string& range_text = "");
 // A model parameter of every robot, as an array (numbers, booleans as 0/1).
 Array ParamArray(const World& world, const ModelLayout& layout, const std::string& name);
 

@@ -152,6 +152,16 @@ TEST_F(SandboxTest, TheDiskReserveIsOneOfTheRunsOwnOutputs) {
   EXPECT_EQ(fs::file_size(root_ / "out" / ".swarmsim-reserve"), kept.size());
 }
 
+// A module with a UTF-8 byte-order mark or a `#!` first line loads as the
+// `lua` program loads it, its lines numbered as in the file.
+TEST_F(SandboxTest, RequireSkipsAByteOrderMarkAndAShebangLine) {
+  Write(root_ / "world" / "marked.lua", "\xEF\xBB\xBFreturn {v = 5}\n");
+  Write(root_ / "world" / "both.lua",
+        "\xEF\xBB\xBF#!/usr/bin/env lua\nlocal x = 1\nerror('third')\n");
+  EXPECT_EQ(Run("assert(require('marked').v == 5)"), "");
+  EXPECT_CONTAINS(Run("require('both')"), "both.lua:3: third");
+}
+
 TEST_F(SandboxTest, RequireLoadsModulesFromTheWorldFoldersOncePerState) {
   Write(root_ / "world" / "scripts" / "util.lua",
         "count = (count or 0) + 1\nprint('loading util')\n"

@@ -121,7 +121,8 @@ class ControllerTest(unittest.TestCase):
         message = str(e.exception)
         self.assertIn("ZeroDivisionError", message)
         self.assertIn("in broken", message)
-        self.assertIn("during step 3 of the run (called with robots.step == 2, the steps finished)", message)
+        self.assertIn("in step 3 of the run (its robots.step was 2: robots.step counts the steps "
+                      "finished before the call)", message)
         self.assertEqual(w.steps, 2, "the steps before the error stand")
         with self.assertRaises(RuntimeError) as again:
             w.step()
@@ -172,6 +173,16 @@ class ControllerTest(unittest.TestCase):
             with self.assertRaises(ValueError) as e:
                 swarmsim.World(path)
             self.assertIn("SyntaxError", str(e.exception))
+            self.assertIn("ctl.py\", line 1", str(e.exception))
+            self.assertNotIn("importlib", str(e.exception), "the file's lines, not the import's")
+            # An error while the file runs: its line in the file, and the error.
+            path = write_world(d, "x = 1\ny = undefined_name\n" + good,
+                               "    python_controller: ctl.py\n")
+            with self.assertRaises(ValueError) as e:
+                swarmsim.World(path)
+            self.assertIn("ctl.py\", line 2, in <module>", str(e.exception))
+            self.assertIn("NameError: name 'undefined_name' is not defined", str(e.exception))
+            self.assertNotIn("importlib", str(e.exception))
             path = write_world(d, good, "    python_controller: ctl.lua\n")
             with self.assertRaises(ValueError) as e:
                 swarmsim.World(path)

@@ -319,6 +319,12 @@ class MisuseTest(unittest.TestCase):
                    threads=2**40)
             expect(TypeError, "World(threads=...): threads must be an integer", swarmsim.World,
                    WORLD, threads=1.0)
+            expect(TypeError, "World(set=...) must be a dict of {name: value}, not list",
+                   swarmsim.World, WORLD, set=[("robots", 4)])
+            expect(TypeError, "World(set=...): the key 4 is not a name (a str)", swarmsim.World,
+                   WORLD, set={4: 4})
+            expect(TypeError, "World(controllers=...) must be a dict of {name: value}, not str",
+                   swarmsim.World, WORLD, controllers="footbot")
             still = {"footbot": lambda robots: {}}  # a Python controller: snapshots allowed
             w = swarmsim.World(WORLD, set={"robots": 4}, controllers=still, keep_scripts=False)
             expect(ValueError, "step_worlds: threads is 0", swarmsim.step_worlds, [w], 1, 999)

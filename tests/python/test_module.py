@@ -219,6 +219,31 @@ class ProgramTest(unittest.TestCase):
             self.assertIn("error: run(out_dir=...): '" + os.path.join(out_dir, "summary.json") +
                           "' is not a folder", out)
 
+    def test_a_world_that_does_not_load_gets_the_programs_error_summary(self):
+        # The folder of an earlier run kept its "ok" summary.json and its
+        # metrics.csv, taken for this run's; a new folder was not made.
+        numpy_world = world("python", "diffusion_numpy.yaml")
+        with tempfile.TemporaryDirectory() as d:
+            out_dir = os.path.join(d, "out")
+            code, out = run([PYTHON, "-m", "swarmsim", "run", numpy_world, "--steps", "3",
+                             "--set", "robots=4", "--out", out_dir, "--quiet"])
+            self.assertEqual(code, 0, out)
+            self.assertTrue(os.path.exists(os.path.join(out_dir, "metrics.csv")))
+            for args, said in (([os.path.join(d, "nothere.yaml")], "nothere.yaml' not found"),
+                               ([numpy_world, "--set", "robots=-3"], "robots")):
+                for folder in (out_dir, os.path.join(d, "new")):
+                    code, out = run([PYTHON, "-m", "swarmsim", "run"] + args +
+                                    ["--steps", "3", "--out", folder, "--quiet"])
+                    self.assertEqual(code, 2, out)
+                    self.assertIn(said, out)
+                    with open(os.path.join(folder, "summary.json")) as f:
+                        summary = json.load(f)
+                    self.assertEqual(summary["status"], "error", summary)
+                    self.assertIn(said, summary["error"])
+                    self.assertEqual(summary["world"], args[0])
+                    self.assertTrue(summary["command"].startswith("python3 -m swarmsim run "))
+                    self.assertFalse(os.path.exists(os.path.join(folder, "metrics.csv")))
+
     def test_a_failing_controller_keeps_the_outputs_of_the_steps_that_finished(self):
         with tempfile.TemporaryDirectory() as d:
             path = write_python_world(

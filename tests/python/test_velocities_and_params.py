@@ -184,6 +184,30 @@ class ParamHashTest(unittest.TestCase):
         e.set_param("footbot", "wheel_speed", 0.1)  # the value snapshot.yaml gives
         self.assertEqual(e.state_hash(), f.state_hash())
 
+    def test_a_value_outside_the_models_range_is_refused_as_set_refuses_it(self):
+        # The e-puck declares wheel_speed's range, its top speed: 5 m/s drove
+        # it at 0.6 m/s, five times what the robot can.
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "w.yaml")
+            with open(path, "w") as f:
+                f.write("simulation: {physics: kinematic}\n"
+                        f"models: [{{model: {ROOT}/worlds/models/epuck.yaml, count: 2, "
+                        "distribute: {region: {min: [0, 0], max: [1, 1]}}}]\n")
+            with self.assertRaisesRegex(ValueError, r"within \[-0.1288, 0.1288\] m/s"):
+                swarmsim.World(path, set={"epuck.wheel_speed": 5.0})
+            w = swarmsim.World(path)
+            before = w.param("epuck", "wheel_speed").copy()
+            h = w.state_hash()
+            for bad in (5.0, np.array([0.1, 0.2]), -0.13):
+                with self.assertRaisesRegex(ValueError, r"parameter 'wheel_speed' of model 'epuck' "
+                                                        r"must be within \[-0.1288, 0.1288\] m/s"):
+                    w.set_param("epuck", "wheel_speed", bad)
+            np.testing.assert_array_equal(w.param("epuck", "wheel_speed"), before)
+            self.assertEqual(w.state_hash(), h, "nothing set")
+            w.set_param("epuck", "wheel_speed", np.array([0.1288, -0.1288]))  # the bounds themselves
+            np.testing.assert_array_equal(w.param("epuck", "wheel_speed"), [0.1288, -0.1288])
+            w.close()
+
     def test_snapshots_carry_the_values_set(self):
         w = snapshot_world()
         w.step(2)

@@ -12,7 +12,7 @@ import argparse
 import signal
 import sys
 
-from . import World
+from . import World, _swarmsim
 
 
 def _value(text):
@@ -49,15 +49,25 @@ def main(argv=None):
             print(f"error: --set expects NAME=VALUE, got '{item}'", file=sys.stderr)
             return 2
         overrides[name] = _value(value)
+    def bad_input(message):
+        # As `swarmsim run`: the folder gets summary.json with status error,
+        # the earlier run's outputs removed (README, "The outputs").
+        print(f"error: {message}", file=sys.stderr)
+        if args.out is not None:
+            try:
+                _swarmsim._write_load_failure(args.out, args.world, message)
+            except ValueError as e:
+                print(f"error: {e}", file=sys.stderr)
+        return 2
+
     try:
         world = World(args.world, seed=args.seed, set=overrides, threads=args.threads)
     except (ValueError, TypeError) as e:
-        print(f"error: {e}", file=sys.stderr)
-        return 2
+        return bad_input(str(e))
     steps = args.steps if args.steps is not None else world.default_steps
     if steps is None:
-        print(f"error: {args.world} gives no duration: pass --steps N", file=sys.stderr)
-        return 2
+        world.close()
+        return bad_input(f"{args.world} gives no duration: pass --steps N")
     try:
         world.run(steps, out_dir=args.out, quiet=args.quiet, hash=args.hash)
     except ValueError as e:  # --out is not a folder we can use

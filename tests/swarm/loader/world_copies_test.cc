@@ -311,7 +311,9 @@ TEST_F(WorldCopiesTest, TheLoadTellsItsProgressStageByStage) {
     EXPECT_LE(t.done, t.total) << i;
     if (t.stage == Stage::kPlacing) {
       EXPECT_EQ(t.total, 10000) << "the drawn copies, not the fixed one";
-      if (!placed.empty()) EXPECT_GT(t.done, placed.back()) << i;
+      if (!placed.empty()) {
+        EXPECT_GT(t.done, placed.back()) << i;
+      }
       placed.push_back(t.done);
       last_placing = i;
     } else if (t.stage == Stage::kPopulating) {
@@ -322,7 +324,9 @@ TEST_F(WorldCopiesTest, TheLoadTellsItsProgressStageByStage) {
       last_populating = i;
     } else {
       EXPECT_EQ(t.total, 10001) << "every copy";
-      if (!built.empty()) EXPECT_GE(t.done, built.back()) << i;
+      if (!built.empty()) {
+        EXPECT_GE(t.done, built.back()) << i;
+      }
       built.push_back(t.done);
     }
   }

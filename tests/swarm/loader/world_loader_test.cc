@@ -509,6 +509,18 @@ TEST_F(MalformedWorldTest, AScriptThatDoesNotParseIsNamedAsItLoads) {
       << compiled;
 }
 
+// A UTF-8 byte-order mark (Windows editors) and a `#!` first line are
+// skipped as the `lua` program skips them: they were "unexpected symbol
+// near '<\239>'". The lines keep their numbers.
+TEST_F(MalformedWorldTest, AByteOrderMarkAndAShebangLineAreSkippedAsLuaSkipsThem) {
+  Write("marked.lua", "\xEF\xBB\xBF#!/usr/bin/env lua\nfunction sysCall_init() end\n");
+  EXPECT_EQ(LoadText("simulation: {main_script: marked.lua}\n"), "NO ERROR");
+  Write("shebang.lua", "#!/usr/bin/lua\n\nx = = 1\n");
+  const std::string message = LoadText("simulation: {main_script: shebang.lua}\n");
+  EXPECT_NE(message.find("shebang.lua:3: unexpected symbol near '='"), std::string::npos)
+      << "its own line number: " << message;
+}
+
 TEST_F(MalformedWorldTest, TabIndentationSaysYamlDoesNotAllowTabs) {
   const std::string hint = "(YAML does not allow tabs for indentation)";
   // A tab alone, a tab after spaces, a tab before a list entry.
