@@ -51,21 +51,32 @@ void FlushPythonStreams() {
   }
 }
 
+// Makes `dir` and takes its lock (DIR/.swarmsim-lock, as `swarmsim run
+// --out` does) into `lock`; ValueError starting with `what` when the folder
+// cannot be made or another run holds it.
+void LockOutputFolder(const std::filesystem::path& dir, const std::string& what,
+                      std::optional<FileLock>* lock) {
+  try {
+    CreateOutputFolder(dir);
+    lock->emplace((dir / ".swarmsim-lock").string());
+  } catch (const Error& e) {
+    throw py::value_error(what + ": " + e.what());
+  }
+  if (!(*lock)->held())
+    throw py::value_error(
+        what + ": another run" +
+        ((*lock)->holder().empty() ? std::string() : " (process " + (*lock)->holder() + ")") +
+        " is writing into '" + ValidUtf8(dir.string()) + "'; wait for it to end" +
+        (what == "--out" ? "" : ", or pass another out_dir"));
+}
+
 }  // namespace
 
 void WriteLoadFailure(const std::string& out, const std::string& world_file,
                       const std::string& error) {
   const std::filesystem::path dir(out);
   std::optional<FileLock> out_lock;
-  try {
-    CreateOutputFolder(dir);
-    out_lock.emplace((dir / ".swarmsim-lock").string());
-  } catch (const Error& e) {
-    throw py::value_error(std::string("--out: ") + e.what());
-  }
-  if (!out_lock->held())
-    throw py::value_error("--out: another run is writing into '" + ValidUtf8(dir.string()) +
-                          "': its summary.json is left alone");
+  LockOutputFolder(dir, "--out", &out_lock);
   RunOptions options;
   options.out_dir = dir;
   options.world_file = world_file;
@@ -100,18 +111,7 @@ py::dict PyWorld::Run(std::optional<int64_t> steps, const std::optional<std::str
   std::optional<FileLock> out_lock;
   if (out) {
     const std::filesystem::path dir(*out);
-    try {
-      CreateOutputFolder(dir);
-      out_lock.emplace((dir / ".swarmsim-lock").string());
-    } catch (const Error& e) {
-      throw py::value_error(std::string("run(out_dir=...): ") + e.what());
-    }
-    if (!out_lock->held())
-      throw py::value_error(
-          "run(out_dir=...): another run" +
-          (out_lock->holder().empty() ? std::string() : " (process " + out_lock->holder() + ")") +
-          " is writing into '" + ValidUtf8(dir.string()) +
-          "'; wait for it to end, or pass another out_dir");
+    LockOutputFolder(dir, "run(out_dir=...)", &out_lock);
     if (const std::string note = RemoveEarlierOutputs(dir); !note.empty())
       std::cerr << "note: " << ValidUtf8(note) << std::endl;
     options.out_dir = dir;
