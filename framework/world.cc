@@ -642,12 +642,21 @@ void World::Actuate() {
     }
     if (j.simulated || j.depends()) continue;  // the dynamics backend, or its master, moves it
     switch (j.mode()) {
-      case JointMode::kVelocity:
+      // Stopped at the joint's limits, as ODE's stops hold them.
+      case JointMode::kVelocity: {
+        const double lo = std::min(j.position, j.settings->min_position);
+        const double hi = std::max(j.position, j.settings->max_position);
         j.velocity = j.DriveVelocity();
-        j.position += j.velocity * dt;
+        const double next = j.position + j.velocity * dt;
+        if (next < lo || next > hi) j.velocity = (std::clamp(next, lo, hi) - j.position) / dt;
+        j.position = std::clamp(next, lo, hi);
         break;
+      }
       case JointMode::kPosition: {
-        const double error = j.target_position - j.position;
+        const double error =
+            std::clamp(j.target_position, std::min(j.position, j.settings->min_position),
+                       std::max(j.position, j.settings->max_position)) -
+            j.position;
         const double max_step = j.settings->max_velocity * dt;
         const double step = std::clamp(error, -max_step, max_step);
         j.velocity = step / dt;

@@ -38,21 +38,22 @@ void CheckStlBytes(const std::string& bytes, const std::string& name) {
   // ASCII: "solid", then facets of three vertices each.
   size_t start = 0;
   while (start < bytes.size() && IsSpace(bytes[start])) ++start;
-  if (bytes.compare(start, 5, "solid") != 0) {
-    std::string binary;
-    if (bytes.size() >= kHeader) {
-      const auto* p = reinterpret_cast<const unsigned char*>(bytes.data()) + 80;
-      const uint64_t count =
-          uint64_t{p[0]} | uint64_t{p[1]} << 8 | uint64_t{p[2]} << 16 | uint64_t{p[3]} << 24;
-      binary = "; as binary STL its header says " + Count(static_cast<int64_t>(count)) +
-               " triangles, which need " +
-               Count(static_cast<int64_t>(kHeader + kPerTriangle * count)) + " bytes";
-    }
+  // What the bytes would be as binary STL: its header's triangle count.
+  std::string binary;
+  if (bytes.size() >= kHeader) {
+    const auto* p = reinterpret_cast<const unsigned char*>(bytes.data()) + 80;
+    const uint64_t count =
+        uint64_t{p[0]} | uint64_t{p[1]} << 8 | uint64_t{p[2]} << 16 | uint64_t{p[3]} << 24;
+    binary = "as binary STL its header says " + Count(static_cast<int64_t>(count)) +
+             " triangles, which need " +
+             Count(static_cast<int64_t>(kHeader + kPerTriangle * count)) + " bytes";
+  }
+  if (bytes.compare(start, 5, "solid") != 0)
     Fail(name, 0,
          "is neither ASCII STL (starting with 'solid') nor binary STL (84 bytes, then 50 per "
          "triangle): it has " +
-             Count(static_cast<int64_t>(bytes.size())) + " bytes" + binary);
-  }
+             Count(static_cast<int64_t>(bytes.size())) + " bytes" +
+             (binary.empty() ? "" : "; " + binary));
   // Line by line: a vertex is three finite numbers (assimp's "Cannot parse
   // string ... as a real number" named no line), and a solid has facets
   // (assimp said "all meshes are orphaned").
@@ -82,8 +83,15 @@ void CheckStlBytes(const std::string& bytes, const std::string& name) {
       if (!ParseFinite(words[k], &v))
         Fail(name, line, Quoted(words[k]) + " is not a finite number (in 'vertex X Y Z')");
   }
+  // A binary STL's free header may start with "solid" too: one cut short
+  // is not binary STL's size, so it is read as ASCII, and has no facets.
   if (facets == 0 && vertices == 0)
-    Fail(name, 0, "an ASCII STL with no facets: nothing to draw or collide with");
+    Fail(name, 0,
+         "an ASCII STL with no facets: nothing to draw or collide with" +
+             (binary.empty()
+                  ? std::string()
+                  : " (or a binary STL whose header starts with 'solid', cut short: " + binary +
+                        ", and the file has " + Count(static_cast<int64_t>(bytes.size())) + ")"));
   CheckTriangleCount(name, 0, std::max(facets, vertices / 3), "ASCII STL of");
 }
 

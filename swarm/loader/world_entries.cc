@@ -54,7 +54,14 @@ struct EntryJoints {
   double limit_erp = -1, limit_cfm = -1;
   std::optional<JointMode> mode;
   bool free_limits = false;
+  std::map<std::string, double> positions;  // `positions`: joint name -> where it starts
 };
+
+// The joints of `spec` and below, by name.
+void FindJoints(const ObjectSpec& spec, std::map<std::string, const JointData*>* out) {
+  if (const JointData* joint = spec.As<JointData>(ObjectType::kJoint)) (*out)[spec.name] = joint;
+  for (const ObjectSpec& child : spec.children) FindJoints(child, out);
+}
 
 // `joints` on every joint of `spec`, each changed one in a row of its own
 // (rows may be shared with other entries).
@@ -66,7 +73,8 @@ void SetEntryJoints(const EntryJoints& joints, ObjectSpec* spec) {
         joints.mode && joint->settings->depends == nullptr && joint->settings->mode != *joints.mode;
     const bool free = joints.free_limits && (std::isfinite(joint->settings->min_position) ||
                                              std::isfinite(joint->settings->max_position));
-    if (erp || cfm || mode || free) {
+    const auto position = joints.positions.find(spec->name);
+    if (erp || cfm || mode || free || position != joints.positions.end()) {
       const ObjectTypeDescriptor& type =
           *CoreObjectTypes()[static_cast<size_t>(ObjectType::kJoint)];
       std::shared_ptr<RowTable> row = type.make_rows(type);
@@ -77,6 +85,7 @@ void SetEntryJoints(const EntryJoints& joints, ObjectSpec* spec) {
       if (cfm) settings.limit_cfm = joints.limit_cfm;
       if (mode) settings.mode = *joints.mode;
       if (free) settings.min_position = -INFINITY, settings.max_position = INFINITY;
+      if (position != joints.positions.end()) copy.JumpTo(position->second);  // and held there
       spec->row = std::move(row);
     }
   }
@@ -510,7 +519,7 @@ void WorldLoader::ExtendObjects(const Fields& f, const ValueReader& world_values
   if (f.Has("joints")) {
     // Joint settings for every joint of the model without its own (ode).
     Fields joints(*file_, f.Get("joints"), "'joints'");
-    joints.Expect({"limit_erp", "limit_cfm", "mode", "limits"});
+    joints.Expect({"limit_erp", "limit_cfm", "mode", "limits", "positions"});
     EntryJoints settings;
     if (joints.Has("limit_erp"))
       settings.limit_erp = world_values.Number(joints.Get("limit_erp"), kFraction);
@@ -531,6 +540,29 @@ void WorldLoader::ExtendObjects(const Fields& f, const ValueReader& world_values
                     "'limits' takes false (free every joint's limits); a joint's "
                     "own limits are its own");
       settings.free_limits = true;
+    }
+    if (joints.Has("positions")) {
+      // Where named joints start (rad or m), within their limits: an
+      // imported arm's ready pose (a URDF has none).
+      std::map<std::string, const JointData*> known;
+      FindJoints(*spec, &known);
+      std::vector<std::string> names;
+      for (const auto& [name, joint] : known) names.push_back(name);
+      Fields positions(*file_, joints.Get("positions"), "'positions'");
+      for (const Field& p : positions.fields()) {
+        const auto joint = known.find(p.name);
+        if (joint == known.end())
+          file_->Fail(p.key_mark,
+                      "model '" + model.name + "' has no joint '" + p.name + "'" +
+                          (names.empty() ? " (it has none)" : loader::Suggest(p.name, names)));
+        const double q = world_values.Number(p, kAnyNumber);
+        const JointSettings& s = *joint->second->settings;
+        if (!settings.free_limits && !(q >= s.min_position && q <= s.max_position))
+          file_->Fail(p.mark, "joint '" + p.name + "' starts at " + loader::FormatNumber(q) +
+                                  ", outside its limits [" + loader::FormatNumber(s.min_position) +
+                                  ", " + loader::FormatNumber(s.max_position) + "]");
+        settings.positions[p.name] = q;
+      }
     }
     SetEntryJoints(settings, spec);
   }

@@ -37,6 +37,15 @@ double WrapAngle(double a) {
   return a;
 }
 
+// A wide hinge's stops (SimJoint::wide) around its reference; one released
+// for this substep stays released. A stop more than pi away is never met:
+// the reference moves before the joint gets there.
+void SetHingeStops(const SimJoint& j) {
+  dJointSetHingeParam(j.joint, dParamLoStop,
+                      j.lo_released ? -dInfinity : j.min_position - j.offset);
+  dJointSetHingeParam(j.joint, dParamHiStop, j.hi_released ? dInfinity : j.max_position - j.offset);
+}
+
 }  // namespace
 
 void OdeWorld::LinkDependentJoints(const Scene& scene) {
@@ -96,11 +105,15 @@ void OdeWorld::AddJoint(const Scene& scene, uint32_t slot, dBodyID child, dBodyI
       dJointAttach(j.joint, child, parent);
       dJointSetHingeAnchor(j.joint, X_WJ.p.x, X_WJ.p.y, X_WJ.p.z);
       dJointSetHingeAxis(j.joint, axis.x, axis.y, axis.z);
-      // ODE's stops live in (-pi, pi] around the Build position.
+      // ODE's stops live in (-pi, pi] around the Build position; limits
+      // beyond it are held around a reference that follows the joint.
       if (settings.min_position - j.offset >= -M_PI && settings.max_position - j.offset <= M_PI) {
         dJointSetHingeParam(j.joint, dParamLoStop, settings.min_position - j.offset);
         dJointSetHingeParam(j.joint, dParamHiStop, settings.max_position - j.offset);
         j.has_stops = true;
+      } else if (std::isfinite(settings.min_position) || std::isfinite(settings.max_position)) {
+        j.wide = j.has_stops = true;
+        SetHingeStops(j);
       }
       dJointSetHingeParam(j.joint, dParamStopERP, limit_erp);
       dJointSetHingeParam(j.joint, dParamStopCFM, limit_cfm);
@@ -201,6 +214,16 @@ void OdeWorld::ApplyMotors(double dt) {
       // commanded to -1 rad it never moved). For this substep that stop is
       // released and the motor works as anywhere else; the next substep
       // holds the stop again.
+      // A wide hinge's reference moved to where it is, once it is pi/2
+      // away: the angle ODE measures then stays far from its wrap at pi.
+      if (j.wide && std::abs(j.position - j.offset) > M_PI / 2) {
+        dVector3 axis;
+        dJointGetHingeAxis(j.joint, axis);
+        dJointSetHingeAxis(j.joint, axis[0], axis[1], axis[2]);  // the angle reads 0 here
+        j.offset = j.position;
+        j.last_angle = dJointGetHingeAngle(j.joint);
+        SetHingeStops(j);
+      }
       if (j.has_stops) {
         // Resting on it: within kOnStop of it, either side (a joint pushed
         // past it keeps it, to be pushed back; a motor holding the joint

@@ -74,7 +74,7 @@ struct SimJoint {
   dJointID joint;
   uint32_t slot;        // scene slot of the joint object
   uint32_t row;         // row in Scene::joints()
-  double offset;        // scene position at Build (ODE measures from there)
+  double offset;        // scene position ODE measures from (at Build; `wide`: moves)
   double last_angle;    // last raw hinge angle, for unwrapping
   double position;      // unwrapped position, rad or m
   dBodyID parent_body;  // A, or null for the static world
@@ -89,6 +89,11 @@ struct SimJoint {
   // position), in scene positions, and whether ApplyMotors released one for
   // this substep: a motor driving the joint off a stop it rests on.
   bool has_stops = false;
+  // A hinge whose limits lie farther than pi from the Build position (a
+  // Panda's joint6 up to 3.75 rad, a Jaco's 0.82 to 5.46): ODE measures the
+  // angle in (-pi, pi], so its reference (`offset`) follows the joint
+  // (ApplyMotors) and the stops are set around it.
+  bool wide = false;
   double min_position = 0, max_position = 0;
   bool lo_released = false, hi_released = false;
 };

@@ -205,6 +205,52 @@ TEST(JointTypeTest, ScalingKeepsAnglesAndScalesLengthsForcesAndDamping) {
 
 namespace fs = std::filesystem;
 
+// Kinematic physics moves joints to their targets, and at their speed,
+// within their limits: a target past a limit stops at it (it was reached,
+// a Panda's joint1 at 5 rad against its 2.9).
+TEST(JointLimitsTest, KinematicJointsStopAtTheirLimits) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("swarmsim_joint_limits_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "bot.yaml")
+      << "model: bot\n"
+         "objects:\n"
+         "  name: body\n"
+         "  type: dummy\n"
+         "  script: bot.lua\n"
+         "  children:\n"
+         "    - {name: arm, type: joint, mode: position, max_velocity: 1, limits: [-0.5, 0.8]}\n"
+         "    - {name: spin, type: joint, limits: [-1, 0.4]}\n"
+         "    - {name: wheel, type: joint}\n";
+  std::ofstream(dir / "bot.lua") << "function sysCall_actuation()\n"
+                                    "  local s = sim.getSimulationTime() < 2 and 1 or -1\n"
+                                    "  sim.setJointTargetPosition(sim.getObject(':/arm'), 3 * s)\n"
+                                    "  sim.setJointTargetVelocity(sim.getObject(':/spin'), s)\n"
+                                    "  sim.setJointTargetVelocity(sim.getObject(':/wheel'), s)\n"
+                                    "end\n";
+  std::ofstream(dir / "world.yaml") << "simulation: {physics: kinematic, time_step: 0.1}\n"
+                                       "models: [{model: bot.yaml, position: [0, 0]}]\n";
+  ModuleRegistry registry;
+  RegisterBuiltinModules(&registry);
+  LoadedWorld loaded = LoadWorld(dir / "world.yaml", LoadOptions{}, registry);
+  World& world = *loaded.world;
+  const auto joint = [&](const char* name) -> const JointData& {
+    return world.scene().joint(world.scene().FindObject(name, world.scene().instance(0).root));
+  };
+  world.Start();
+  for (int i = 0; i < 20; ++i) world.Step();  // 2 s driven up
+  EXPECT_DOUBLE_EQ(joint("./arm").position, 0.8);
+  EXPECT_DOUBLE_EQ(joint("./spin").position, 0.4);
+  EXPECT_EQ(joint("./spin").velocity, 0) << "held at its limit";
+  EXPECT_NEAR(joint("./wheel").position, 2.0, 1e-9) << "no limits: not held";
+  for (int i = 0; i < 30; ++i) world.Step();  // 3 s driven down
+  EXPECT_DOUBLE_EQ(joint("./arm").position, -0.5);
+  EXPECT_DOUBLE_EQ(joint("./spin").position, -1);
+  EXPECT_NEAR(joint("./wheel").position, -1.0, 1e-9);
+  fs::remove_all(dir);
+}
+
 // Two entries of one model on kinematic physics: three robots (the second
 // with its own max_force, through `instances:`) and one more with another
 // entry's max_force. Every robot's script drives its wheel and its slide

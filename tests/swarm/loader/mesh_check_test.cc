@@ -73,6 +73,15 @@ TEST(MeshCheckTest, AsciiStlVerticesAreNumbersAtTheirLines) {
   EXPECT_EQ(StlError(bad), "part.stl:6: a vertex is 'vertex X Y Z', three numbers (got 2)");
   EXPECT_EQ(StlError("solid empty\nendsolid empty\n"),
             "part.stl: an ASCII STL with no facets: nothing to draw or collide with");
+  // A binary STL's header may start with "solid" (a published robot's
+  // foot): cut short, it is no binary STL's size and reads as ASCII, which
+  // the message says it may not be.
+  std::string cut = "solid foot" + std::string(70, ' ') + std::string("\x03\0\0\0", 4);
+  cut += std::string(16, '\0');
+  EXPECT_EQ(StlError(cut),
+            "part.stl: an ASCII STL with no facets: nothing to draw or collide with (or a binary "
+            "STL whose header starts with 'solid', cut short: as binary STL its header says 3 "
+            "triangles, which need 234 bytes, and the file has 100)");
 }
 
 std::string ObjError(const std::string& text) {

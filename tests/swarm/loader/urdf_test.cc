@@ -424,6 +424,48 @@ TEST_F(UrdfTest, AnEntrysJointsSetTheModeAndFreeTheLimits) {
                   "did you mean 'passive'?");
 }
 
+// joints: {positions: {name: q}}: where an imported arm's joints start (a
+// URDF has no start pose; under ode sim.setJointPosition is refused), held
+// there under ode in position mode; a name or value that does not fit says
+// so at its place.
+TEST_F(UrdfTest, AnEntrysJointPositionsAreWhereItsJointsStartAndStay) {
+  const std::string arm = (fs::path(SWARMSIM_SOURCE_DIR) / "worlds" / "models" /
+                           "simple_arm_description" / "urdf" / "simple_arm.urdf")
+                              .string();
+  const auto world = [&](const std::string& physics, const std::string& joints) {
+    return "simulation: {physics: " + physics + ", time_step: 0.01}\npackage_path: [" +
+           (fs::path(SWARMSIM_SOURCE_DIR) / "worlds" / "models").string() +
+           "]\nmodels:\n  - model: " + arm + "\n    position: [0, 0]\n    joints: " + joints + "\n";
+  };
+  for (const std::string physics : {"kinematic", "ode"}) {
+    SCOPED_TRACE(physics);
+    LoadedWorld w = Load(world(physics, "{positions: {shoulder: 0.7, elbow: -1.2}}"));
+    World& at = *w.world;
+    const Pose tool_before = at.scene().world_pose(Find(at, "tool0"));
+    EXPECT_EQ(at.scene().joint(Find(at, "shoulder")).position, 0.7);
+    EXPECT_EQ(at.scene().joint(Find(at, "shoulder")).target_position, 0.7) << "held there";
+    EXPECT_EQ(at.scene().joint(Find(at, "elbow")).position, -1.2);
+    EXPECT_EQ(at.scene().joint(Find(at, "wrist")).position, 0);
+    LoadedWorld straight = Load(world(physics, "{}"));
+    EXPECT_GT((straight.world->scene().world_pose(Find(*straight.world, "tool0")).p - tool_before.p)
+                  .Norm(),
+              0.05)
+        << "the links start where the joints put them";
+    at.Start();
+    for (int k = 0; k < 100; ++k) at.Step();
+    EXPECT_NEAR(at.scene().joint(Find(at, "shoulder")).position, 0.7, 2e-3);
+    EXPECT_NEAR(at.scene().joint(Find(at, "elbow")).position, -1.2, 2e-3);
+  }
+  EXPECT_CONTAINS(testing::ErrorOf([&] { Load(world("kinematic", "{positions: {sholder: 1}}")); }),
+                  "world.yaml:6:26: model 'simple_arm' has no joint 'sholder'; did you mean "
+                  "'shoulder'?");
+  EXPECT_CONTAINS(testing::ErrorOf([&] { Load(world("kinematic", "{positions: {shoulder: 2}}")); }),
+                  "world.yaml:6:36: joint 'shoulder' starts at 2, outside its limits [-1.6, 1.6]");
+  // Freed limits: anywhere.
+  LoadedWorld freed = Load(world("kinematic", "{limits: false, positions: {shoulder: 2}}"));
+  EXPECT_EQ(freed.world->scene().joint(Find(*freed.world, "shoulder")).position, 2);
+}
+
 TEST_F(UrdfTest, JointDampingSlowsAPendulumUnderOde) {
   // A 1 kg box on a passive hinge about y, released horizontal: without
   // damping it swings on; with 2 N m s/rad it settles hanging.

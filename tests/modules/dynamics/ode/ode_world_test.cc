@@ -102,6 +102,36 @@ TEST(OdeBackend, PassiveJointStopsAtItsLimits) {
   EXPECT_NEAR(f.scene().joint(arm.joint).position, -0.3, 0.02);
 }
 
+// Limits farther than pi from where the joint starts (a Panda's joint6 up
+// to 3.75 rad, a Jaco's joint2 from 0.82 to 5.46): ODE measures a hinge's
+// angle in (-pi, pi] and ignores stops outside it, so the joint ran past
+// them (a Jaco's joint2 reached 8.36 rad). Driven both ways, in velocity
+// and position mode, it now stops at each.
+TEST(OdeBackend, LimitsFartherThanPiFromTheStartStillStopTheJoint) {
+  for (const JointMode mode : {JointMode::kVelocity, JointMode::kPosition}) {
+    SCOPED_TRACE(mode == JointMode::kVelocity ? "velocity" : "position");
+    Fixture f(0.01, 5, 0.0);
+    JointData j = Joint(JointType::kRevolute, mode);
+    j.settings.Edit().min_position = -3.9;
+    j.settings.Edit().max_position = 4.0;
+    j.settings.Edit().max_velocity = 2.0;
+    const Arm arm = AddArm(&f.scene(), j, {{0, 0, 1}, {}});
+    const auto drive = [&](double sign) {
+      JointData& row = f.scene().mutable_joint(arm.joint);
+      row.target_velocity = 2.0 * sign;
+      row.target_position = 10.0 * sign;
+    };
+    drive(1);
+    for (int i = 0; i < 400; ++i) f.world->Step();  // 8 rad at 2 rad/s
+    EXPECT_NEAR(f.scene().joint(arm.joint).position, 4.0, 0.02);
+    EXPECT_NEAR(f.scene().world_pose(arm.bar).q.Yaw(), 4.0 - 2 * M_PI, 0.02);
+    drive(-1);
+    for (int i = 0; i < 600; ++i) f.world->Step();  // 12 rad back
+    EXPECT_NEAR(f.scene().joint(arm.joint).position, -3.9, 0.02);
+    ExpectChildFollowsJoint(f.scene(), arm, {{0.25, 0, 0}, {}}, 2e-3);
+  }
+}
+
 TEST(OdeBackend, PrismaticMotorSlidesAlongTheJointAxis) {
   Fixture f(0.01, 1, 0.0);
   JointData j = Joint(JointType::kPrismatic, JointMode::kVelocity);
