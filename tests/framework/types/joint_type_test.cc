@@ -205,14 +205,19 @@ TEST(JointTypeTest, ScalingKeepsAnglesAndScalesLengthsForcesAndDamping) {
 
 namespace fs = std::filesystem;
 
+// An empty folder of this process under the temporary folder.
+fs::path FreshDir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / (name + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
 // Kinematic physics moves joints to their targets, and at their speed,
 // within their limits: a target past a limit stops at it (it was reached,
 // a Panda's joint1 at 5 rad against its 2.9).
 TEST(JointLimitsTest, KinematicJointsStopAtTheirLimits) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("swarmsim_joint_limits_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const fs::path dir = FreshDir("swarmsim_joint_limits");
   std::ofstream(dir / "bot.yaml")
       << "model: bot\n"
          "objects:\n"
@@ -260,9 +265,7 @@ TEST(JointLimitsTest, KinematicJointsStopAtTheirLimits) {
 class JointSettingsTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("swarmsim_joint_type_" + std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = FreshDir("swarmsim_joint_type");
     std::ofstream(dir_ / "bot.yaml")
         << "model: bot\n"
            "parameters: {force: {default: 5}}\n"
