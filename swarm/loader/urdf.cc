@@ -127,6 +127,17 @@ std::optional<fs::path> Importer::FindPackage(const std::string& package) {
     if (holds(dir)) found = dir;
     if (dir == dir.parent_path()) break;
   }
+  // Without package.xml files (the folders as published, copied beside
+  // each other): the package folder on the path that holds the URDF.
+  const fs::path urdf = fs::weakly_canonical(fs::absolute(path_, ec), ec);
+  for (const fs::path& dir : package_path_) {
+    if (found) break;
+    const fs::path folder = fs::weakly_canonical(dir / package, ec);
+    if (!fs::is_directory(folder, ec)) continue;
+    const auto [in_folder, in_urdf] =
+        std::mismatch(folder.begin(), folder.end(), urdf.begin(), urdf.end());
+    if (in_folder == folder.end() && in_urdf != urdf.end()) found = dir / package;
+  }
   for (const fs::path& dir : package_path_) {
     if (found) break;
     if (fs::is_directory(dir / package, ec)) {

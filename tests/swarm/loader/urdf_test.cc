@@ -1076,6 +1076,27 @@ TEST_F(UrdfErrorTest, AUrdfFindsItsOwnPackageBeforeAnotherOfTheSameName) {
   EXPECT_NO_THROW(Load("package_path: [deep/x]\nmodels: [{model: r.urdf, position: [0, 0]}]\n"));
 }
 
+// Without package.xml files (two published robots' folders, each with its
+// own copy of example-robot-data, on one package path): a URDF finds the
+// copy that holds it, wherever it comes on the path (the first copy was
+// taken, and the second robot's meshes were not found in it).
+TEST_F(UrdfErrorTest, WithoutPackageFilesAUrdfFindsTheCopyOfItsPackageThatHoldsIt) {
+  for (const std::string robot : {"tiago", "kinova"}) {
+    fs::create_directories(dir_ / robot / "example-robot-data" / "meshes");
+    Write(robot + "/example-robot-data/meshes/" + robot + ".obj",
+          "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
+    Write(robot + "/example-robot-data/" + robot + ".urdf",
+          std::string(kHead) +
+              "  <link name=\"a\"><collision><geometry><mesh "
+              "filename=\"package://example-robot-data/meshes/" +
+              robot + ".obj\"/></geometry></collision></link>\n</robot>\n");
+  }
+  EXPECT_NO_THROW(
+      Load("package_path: [tiago, kinova]\nmodels:\n"
+           "  - {model: tiago/example-robot-data/tiago.urdf, position: [0, 0]}\n"
+           "  - {model: kinova/example-robot-data/kinova.urdf, position: [3, 0]}\n"));
+}
+
 // An axis is a direction: huge components are one (their norm overflowed
 // and it was called "zero"); zero is refused.
 TEST_F(UrdfErrorTest, AnAxisOfHugeComponentsIsADirection) {
