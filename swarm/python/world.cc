@@ -18,6 +18,7 @@
 #include "framework/scheduler.h"
 #include "framework/state_hash.h"
 #include "framework/world.h"
+#include "swarm/loader/describe.h"
 #include "swarm/python/ir_arrays.h"
 #include "swarm/python/sensor_arrays.h"
 #include "swarm/python/writers.h"
@@ -648,24 +649,9 @@ py::tuple PyWorld::metric_history(const std::string& name) {
 
 std::string PyWorld::describe() {
   auto r = Reading();
+  Any();  // RuntimeError once closed
   std::ostringstream out;
-  const World& w = Any();
-  out << "world: " << loaded_.file.string() << "\n";
-  out << "physics: " << w.settings().physics << ", time step " << w.settings().time_step
-      << " s, seed " << w.settings().seed << ", threads " << w.threads() << "\n";
-  if (w.settings().robots_per_lua_state > 1)
-    out << "Lua states: " << w.settings().robots_per_lua_state
-        << " robots a state (simulation.robots_per_lua_state)\n";
-  for (const ModelSummary& m : loaded_.models) {
-    out << "model " << m.name << " (" << m.file << "), " << m.count << " copies"
-        << (m.spatial_order ? ", numbered along the region (order: spatial)" : "") << "\n";
-    for (const ParameterSummary& p : m.parameters)
-      out << "  parameter " << p.name << " = " << p.value << (p.unit.empty() ? "" : " " + p.unit)
-          << "\n";
-    for (const std::string& s : m.scripts) out << "  script: " << s << "\n";
-    if (!m.python.file.empty())
-      out << "  python controller: " << m.python.file.string() << ":" << m.python.function << "\n";
-  }
+  PrintDescription(loaded_, out);
   return out.str();
 }
 

@@ -247,7 +247,8 @@ class ActionTest(unittest.TestCase):
                                           r"clip_actions=True too\)"),
                 (np.array([0.0, 0.0, 0.0]), r"'footbot#1' has shape \(3,\)"),
                 (np.array([True, False]), r"real numbers"),
-                (np.array([0j, 0j]), r"real numbers")]:
+                (np.array([0j, 0j]), r"real numbers"),
+                ("go", r"'footbot#1' must be real numbers, got dtype <U2")]:
             with self.assertRaisesRegex(ValueError, pattern):
                 env.step({**ok, "footbot#1": bad})
         with self.assertRaisesRegex(ValueError, r"no action for agent 'footbot#2'"):

@@ -152,6 +152,13 @@ class WorldTest(unittest.TestCase):
         self.assertRegex(text, r"\n  script: \S*scripts/diffusion.lua on :")
         self.assertIn("12 copies, numbered along the region (order: spatial)", text)
         self.assertIn("\nLua states: 64 robots a state (simulation.robots_per_lua_state)\n", text)
+        # What `swarmsim describe` prints, parameters' units and ranges included (it was
+        # a shorter text of its own).
+        code, out = run([BINARY, "describe", world("diffusion.yaml"), "--set", "robots=12"],
+                        cwd=os.getcwd())  # paths shown as this process shows them
+        self.assertEqual(code, 0, out)
+        # Past the first line (the world file as each was given it).
+        self.assertEqual(text.split("\n", 1)[1], out.split("\n", 1)[1])
 
 
 class UrdfTest(unittest.TestCase):

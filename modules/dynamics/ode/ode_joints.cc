@@ -214,9 +214,14 @@ void OdeWorld::ApplyMotors(double dt) {
       // commanded to -1 rad it never moved). For this substep that stop is
       // released and the motor works as anywhere else; the next substep
       // holds the stop again.
-      // A wide hinge's reference moved to where it is, once it is pi/2
-      // away: the angle ODE measures then stays far from its wrap at pi.
-      if (j.wide && std::abs(j.position - j.offset) > M_PI / 2) {
+      // A wide hinge's reference moved to where it is when it comes within
+      // pi/2 of a stop ODE cannot hold from the reference (more than pi
+      // away), or 3 pi/4 from the reference (the angle ODE measures wraps
+      // at pi). A joint that goes neither way is stepped as before.
+      const bool near_far_stop =
+          (j.min_position - j.offset < -M_PI && j.position - j.min_position < M_PI / 2) ||
+          (j.max_position - j.offset > M_PI && j.max_position - j.position < M_PI / 2);
+      if (j.wide && (near_far_stop || std::abs(j.position - j.offset) > 0.75 * M_PI)) {
         dVector3 axis;
         dJointGetHingeAxis(j.joint, axis);
         dJointSetHingeAxis(j.joint, axis[0], axis[1], axis[2]);  // the angle reads 0 here

@@ -91,8 +91,8 @@ struct SimJoint {
   bool has_stops = false;
   // A hinge whose limits lie farther than pi from the Build position (a
   // Panda's joint6 up to 3.75 rad, a Jaco's 0.82 to 5.46): ODE measures the
-  // angle in (-pi, pi], so its reference (`offset`) follows the joint
-  // (ApplyMotors) and the stops are set around it.
+  // angle in (-pi, pi], so its reference (`offset`) moves to the joint as
+  // it nears a stop or the wrap (ApplyMotors) and the stops are set around it.
   bool wide = false;
   double min_position = 0, max_position = 0;
   bool lo_released = false, hi_released = false;

@@ -638,12 +638,12 @@ class ParallelEnv(_AgentsOfAModel, _ParallelBase):
         groups = {}  # actions checked in their own precision, one pass per dtype
         for a in live:
             act = np.asarray(actions[a])
+            if act.dtype.kind not in "iuf":  # before its shape: 'go' has shape ()
+                raise ValueError(f"the action for agent {a!r} must be real numbers, got "
+                                 f"dtype {act.dtype}")
             if act.shape != (core.A,):
                 raise ValueError(f"the action for agent {a!r} has shape {act.shape}, the "
                                  f"action space's is ({core.A},) ({self.joint_names})")
-            if act.dtype.kind not in "iuf":
-                raise ValueError(f"the action for agent {a!r} must be real numbers, got "
-                                 f"dtype {act.dtype}")
             groups.setdefault(act.dtype, []).append((a, act))
         batch = np.zeros((core.N, core.A))
         for group in groups.values():
