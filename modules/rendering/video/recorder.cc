@@ -269,6 +269,15 @@ struct Recorder::Impl {
     }
     wake.notify_one();
     if (thread.joinable()) thread.join();
+    // A run that ended before its world's first frame (the start failed)
+    // leaves no video of no frames and no empty snapshots folder.
+    std::error_code ec;
+    if (writer && frames_queued == 0) {
+      writer.reset();
+      std::filesystem::remove(settings.video, ec);
+    }
+    if (settings.snapshot_every > 0 && snapshots_queued == 0)
+      std::filesystem::remove(settings.out_dir / "snapshots", ec);  // only if empty
     if (writer) {
       try {
         writer->Finish();

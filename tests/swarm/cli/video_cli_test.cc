@@ -165,6 +165,34 @@ TEST(VideoCli, SnapshotsNeedAnOutputFolder) {
   EXPECT_NE(r.output.find("--out"), std::string::npos) << r.output;
 }
 
+// A world whose start fails before its first frame (here ODE refuses a
+// screw joint moving a dynamic body) left a video of no frames that the
+// summary did not list, and an empty snapshots folder.
+TEST(VideoCli, AStartThatFailsBeforeTheFirstFrameLeavesNoEmptyVideoOrFolder) {
+  const std::filesystem::path dir = FreshTempDir("video_cli", "start_fails");
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "world.yaml")
+      << "simulation: {physics: ode, time_step: 0.01}\n"
+         "objects:\n"
+         "  - name: s\n"
+         "    type: joint\n"
+         "    joint: screw\n"
+         "    pitch: 0.01\n"
+         "    position: [0, 0, 1]\n"
+         "    children: [{name: b, type: shape, shape: box, size: [0.1, 0.1, 0.1], dynamic: "
+         "true}]\n";
+  const std::filesystem::path out = dir / "out";
+  const auto r =
+      RunProgram("run " + (dir / "world.yaml").string() + " --steps 2 --video " +
+                 (out / "v.mp4").string() + " --snapshot-every 1 --quiet --out " + out.string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("screw joint"), std::string::npos) << r.output;
+  EXPECT_EQ(Summary(out)["status"], "error");
+  EXPECT_FALSE(std::filesystem::exists(out / "v.mp4")) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(out / "snapshots")) << r.output;
+  std::filesystem::remove_all(dir);
+}
+
 TEST(VideoCli, TheVideoDecodesToAFramePerStepWithTheBoxMovingAcross) {
   const auto dir = MarkerWorld("moving", -1.5, 0.15);
   const auto out = dir / "out";
