@@ -286,13 +286,22 @@ bool OverwriteInPlace(const std::filesystem::path& path, std::string_view bytes)
   return ::close(fd) == 0 && ok;
 }
 
+// The simulated time at the end of the last step that finished: the
+// world's, unless a step failed after its physics had moved the clock on
+// (out of memory in its recording: the summary said 4 steps and 0.5 s).
+double FinishedTime(const World& world, const RunResult& result) {
+  if (world.step_count() == result.first_step + result.steps) return world.time();
+  return static_cast<double>(result.first_step + result.steps) * world.settings().time_step;
+}
+
 // The simulated seconds this process ran: a run resumed from a state
 // (--load-state) counts its own steps, not the saved run's (its real-time
 // factor divided the whole history by its own wall time).
 double SimulatedThisRun(const World& world, const RunResult& result) {
   return result.first_step > 0
-             ? world.time() - static_cast<double>(result.first_step) * world.settings().time_step
-             : world.time();
+             ? FinishedTime(world, result) -
+                   static_cast<double>(result.first_step) * world.settings().time_step
+             : FinishedTime(world, result);
 }
 
 // summary.json, written whole or not at all (WriteFileAtomically); returns
@@ -303,7 +312,7 @@ double SimulatedThisRun(const World& world, const RunResult& result) {
 std::string WriteSummary(const World& world, const RunOptions& options, const RunResult& result,
                          double lua_kib, bool complete, const char* status = nullptr) {
   const int robots = world.live_robot_count();  // removed robots are not counted
-  const double sim_time = world.time();
+  const double sim_time = FinishedTime(world, result);
   const double robot_ticks = static_cast<double>(robots) * static_cast<double>(result.steps);
   nlohmann::json j;
   j["swarmsim_version"] = Version();
@@ -639,7 +648,7 @@ void StepWatched(World* world, const RunOptions& options, Clock::time_point star
 void PrintSummaryTable(const World& world, const RunOptions& options, const RunResult& result,
                        double lua_kib, std::ostream& out) {
   const int robots = world.live_robot_count();  // removed robots are not counted
-  const double sim_time = world.time();
+  const double sim_time = FinishedTime(world, result);
   const double robot_ticks = static_cast<double>(robots) * static_cast<double>(result.steps);
   const double rtf =
       result.wall_seconds > 0 ? SimulatedThisRun(world, result) / result.wall_seconds : 0;

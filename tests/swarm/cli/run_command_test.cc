@@ -405,6 +405,35 @@ TEST(CliTest, AThreadThatCannotBeStartedIsNamedAndTheSummarySaysSo) {
   fs::remove_all(out);
 }
 
+// A step that fails after its physics moved the clock on (the bodies blew
+// up): the summary said 3 steps and 0.4 s simulated; the time is now that of
+// the steps that finished.
+TEST(CliTest, AStepThatFailsInItsPhysicsIsNotCountedInTheSimulatedTime) {
+  const fs::path dir = TempDir("blow_up");
+  fs::create_directories(dir);
+  std::ofstream(dir / "world.yaml")
+      << "simulation: {physics: ode, time_step: 0.1, gravity: 0}\n"
+         "objects:\n"
+         "  - {name: slide, type: joint, joint: prismatic, mode: force, position: [0, 0, 1],\n"
+         "     script: blow.lua, children: [{name: b, type: shape, shape: box,\n"
+         "     size: [0.1, 0.1, 0.1], dynamic: true, mass: 1}]}\n";
+  std::ofstream(dir / "blow.lua")  // 1e15 N from the fourth step: 5e12 m in 0.1 s
+      << "function sysCall_actuation()\n"
+         "  if sim.getSimulationTime() > 0.25 then sim.setJointTargetForce(sim.getObject('.'), "
+         "1e15) end\n"
+         "end\n";
+  const Result r = RunProgram("run " + (dir / "world.yaml").string() + " --steps 10 --out " +
+                              (dir / "out").string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("at step 4, beyond the 1e6 m"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("simulated time  0.30 s"), std::string::npos) << r.output;
+  std::ifstream summary_file(dir / "out" / "summary.json");
+  const nlohmann::json summary = nlohmann::json::parse(summary_file);
+  EXPECT_EQ(summary["steps"], 3);
+  EXPECT_NEAR(summary["simulated_time"].get<double>(), 0.3, 1e-12);
+  fs::remove_all(dir);
+}
+
 // Too few open files (`ulimit -n`): the recording and metrics.csv took the
 // last ones, and the run ended with "cannot write 'summary.json': Too many
 // open files", leaving it "running". Whatever the limit, the summary now
