@@ -43,7 +43,7 @@ class ControllerTest(unittest.TestCase):
     def test_the_numpy_diffusion_moves_robots_exactly_as_the_lua_one(self):
         lua = swarmsim.World(world("diffusion.yaml"), seed=5, set={"robots": 150, "density": 3.0})
         py = swarmsim.World(NUMPY_WORLD, seed=5, set={"robots": 150, "density": 3.0})
-        self.assertNotIn("script:", py.describe())
+        self.assertNotIn("\n  script:", py.describe())  # no model's Lua script
         lua.step(60)
         py.step(60)
         np.testing.assert_array_equal(py.poses(), lua.poses())
@@ -204,8 +204,8 @@ class ControllerTest(unittest.TestCase):
                                "keep.yaml")
             drop = write_world(d, code, "    python_controller: ctl.py\n")
             kept, dropped = swarmsim.World(keep), swarmsim.World(drop)
-            self.assertIn("script: ", kept.describe())
-            self.assertNotIn("script: ", dropped.describe())
+            self.assertIn("\n  script: ", kept.describe())
+            self.assertNotIn("\n  script: ", dropped.describe())
             kept.step(5)
             dropped.step(5)
             self.assertTrue(np.any(kept.joint_velocities() != 0), "the Lua script drives")
