@@ -100,7 +100,7 @@ local function seconds_arg(name, arg, what, s)  -- a finite number >= 0 (not NaN
   end
   if not (s >= 0 and s - s == 0) then
     error(name .. ': ' .. what .. ' must be a finite number of seconds >= 0 (got ' ..
-          tostring(s) .. ')', 3)
+          (s ~= s and 'nan' or tostring(s)) .. ')', 3)  -- 0/0 prints as -nan
   end
 end
 function sim.wait(seconds)

@@ -73,6 +73,11 @@ int SendGlobalMessage(lua_State* L) {
   return 0;
 }
 int SendLocalMessage(lua_State* L) {
+  // It went nowhere, without a word.
+  if (Context(L).script_object.IsNull())
+    throw Error(
+        "the main script belongs to no robot: use sim.sendGlobalMessage or "
+        "sim.sendDirectMessage");
   Send(L, MessageScope::kLocal, CheckData(L, 1));
   return 0;
 }

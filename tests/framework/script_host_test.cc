@@ -413,6 +413,19 @@ TEST(ScriptHostTest, RangeMessageFromTheMainScriptIsAnError) {
                   "sim.sendGlobalMessage or sim.sendDirectMessage");
 }
 
+// A local message from the main script went nowhere, without a word.
+TEST(ScriptHostTest, LocalMessageFromTheMainScriptIsAnError) {
+  WorldSettings settings;
+  settings.main_script =
+      Source("main.lua", "function sysCall_step()\n  sim.sendLocalMessage('x')\nend");
+  ScriptWorld w(1, 1, settings);
+  w.AddWheeledRobot("a", kPrintMessages);
+  w.world().Start();
+  EXPECT_CONTAINS(ErrorOf([&] { w.world().Step(); }),
+                  "main.lua:2: sim.sendLocalMessage: the main script belongs to no robot: use "
+                  "sim.sendGlobalMessage or sim.sendDirectMessage");
+}
+
 // --- Robots sharing a Lua state (simulation.robots_per_lua_state) ----------------------
 
 // A temporary world folder holding the module `counter.lua`.
