@@ -401,29 +401,26 @@ TEST(ScriptHostTest, MainAndSceneScriptMessagesAreDeliveredAtTheNextStep) {
   }
 }
 
-TEST(ScriptHostTest, RangeMessageFromTheMainScriptIsAnError) {
-  WorldSettings settings;
-  settings.main_script =
-      Source("main.lua", "function sysCall_step()\n  sim.sendRangeMessage('x', 1)\nend");
-  ScriptWorld w(1, 1, settings);
-  w.AddWheeledRobot("a", kPrintMessages);
-  w.world().Start();
-  EXPECT_CONTAINS(ErrorOf([&] { w.world().Step(); }),
-                  "main.lua:2: sim.sendRangeMessage: the main script has no position: use "
-                  "sim.sendGlobalMessage or sim.sendDirectMessage");
-}
-
-// A local message from the main script went nowhere, without a word.
-TEST(ScriptHostTest, LocalMessageFromTheMainScriptIsAnError) {
-  WorldSettings settings;
-  settings.main_script =
-      Source("main.lua", "function sysCall_step()\n  sim.sendLocalMessage('x')\nend");
-  ScriptWorld w(1, 1, settings);
-  w.AddWheeledRobot("a", kPrintMessages);
-  w.world().Start();
-  EXPECT_CONTAINS(ErrorOf([&] { w.world().Step(); }),
-                  "main.lua:2: sim.sendLocalMessage: the main script belongs to no robot: use "
-                  "sim.sendGlobalMessage or sim.sendDirectMessage");
+// The main script has no position and belongs to no robot: a range or a
+// local message from it is an error (the local one went nowhere, without a
+// word).
+TEST(ScriptHostTest, RangeAndLocalMessagesFromTheMainScriptAreErrors) {
+  for (const auto& [call, why] : {std::pair{"sim.sendRangeMessage('x', 1)",
+                                            "sim.sendRangeMessage: the main script has no "
+                                            "position"},
+                                  std::pair{"sim.sendLocalMessage('x')",
+                                            "sim.sendLocalMessage: the main script belongs "
+                                            "to no robot"}}) {
+    WorldSettings settings;
+    settings.main_script =
+        Source("main.lua", std::string("function sysCall_step()\n  ") + call + "\nend");
+    ScriptWorld w(1, 1, settings);
+    w.AddWheeledRobot("a", kPrintMessages);
+    w.world().Start();
+    const std::string error = ErrorOf([&] { w.world().Step(); });
+    EXPECT_CONTAINS(error, std::string("main.lua:2: ") + why) << call;
+    EXPECT_CONTAINS(error, ": use sim.sendGlobalMessage or sim.sendDirectMessage") << call;
+  }
 }
 
 // --- Robots sharing a Lua state (simulation.robots_per_lua_state) ----------------------
