@@ -300,6 +300,9 @@ void World::SetInstanceParameters(int instance, SharedParameters parameters) {
 void World::StartParts(const std::function<void(const std::string&)>& stage) {
   stage("world poses");
   EnsureRuntimes();
+  // Dependent joints start where their masters put them, before the engine
+  // is built from the scene (ODE built a mimic finger where the file had it).
+  dependent_joints_.Apply(&scene_, true);
   UpdateWorldPoses(&scene_, *scheduler_);
   stage("physics (" + settings_.physics + ")");
   dynamics_ = registry_.MakeDynamics(settings_.physics);
@@ -310,8 +313,7 @@ void World::StartParts(const std::function<void(const std::string&)>& stage) {
   dynamics_settings.options = settings_.physics_options;
   dynamics_->Build(scene_, dynamics_settings);
   dynamics_->MarkSimulatedJoints(&scene_);
-  // Dependent joints start where their masters put them.
-  if (dependent_joints_.Apply(&scene_, true)) scene_.UpdateWorldPoses();
+  if (dependent_joints_.Apply(&scene_, true)) scene_.UpdateWorldPoses();  // their targets
   // The modules every world has (proximity), in registration order; then
   // every module starts, in creation order: first those that act on the
   // world, then those that only observe it (the record phase's: graphs,

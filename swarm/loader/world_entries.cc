@@ -557,6 +557,13 @@ void WorldLoader::ExtendObjects(const Fields& f, const ValueReader& world_values
                           (names.empty() ? " (it has none)" : loader::Suggest(p.name, names)));
         const double q = world_values.Number(p, kAnyNumber);
         const JointSettings& s = *joint->second->settings;
+        if (s.depends != nullptr)
+          file_->Fail(p.key_mark, "joint '" + p.name + "' follows '" + s.depends->master +
+                                      "' (a mimic or dependent joint): give that joint's "
+                                      "position, and this one starts where it puts it");
+        if (!(std::abs(q) <= 1e6))
+          file_->Fail(p.mark, "joint '" + p.name + "' starts at " + loader::FormatNumber(q) +
+                                  ", beyond the 1e6 (m or rad) a world may use");
         if (!settings.free_limits && !(q >= s.min_position && q <= s.max_position))
           file_->Fail(p.mark, "joint '" + p.name + "' starts at " + loader::FormatNumber(q) +
                                   ", outside its limits [" + loader::FormatNumber(s.min_position) +

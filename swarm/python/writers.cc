@@ -1,11 +1,10 @@
 #include "swarm/python/writers.h"
 
+#include <charconv>
 #include <cmath>
 #include <cstdio>
-#include <iomanip>
 #include <map>
 #include <memory>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -264,12 +263,11 @@ void SetParam(World* world, const ModelLayout& layout, const std::string& name,
       throw WriteError(false, "set_param('" + name + "'): the value for robot '" +
                                   RobotName(world->scene(), layout, i) + "' is not finite");
     if (bounds && !(x >= bounds->first && x <= bounds->second)) {
-      std::ostringstream got;
-      got << std::setprecision(17) << x;
+      char got[32];  // the shortest text that reads back as x (0.2, not 0.20000000000000001)
+      *std::to_chars(got, got + sizeof got - 1, x).ptr = '\0';
       throw WriteError(false, "set_param('" + name + "'): parameter '" + name + "' of model '" +
-                                  layout.model + "' must be within " + range_text + " (got " +
-                                  got.str() + " for robot '" +
-                                  RobotName(world->scene(), layout, i) + "')");
+                                  layout.model + "' must be within " + range_text + " (got " + got +
+                                  " for robot '" + RobotName(world->scene(), layout, i) + "')");
     }
     if (std::holds_alternative<double>(*old)) {
       next[i] = x;

@@ -205,6 +205,38 @@ TEST_F(UrdfTest, MimicFingerFollowsItsMaster) {
   EXPECT_NEAR((left - right).Norm(), 0.06, 1e-9);
 }
 
+// joints: {positions: ...} on a master: its mimic starts where it puts it,
+// under ode too (ODE built the Panda's second finger at 0 and servoed it
+// open over 0.15 s). A mimic's own position is refused: its master's rules.
+TEST_F(UrdfTest, AMimicStartsWhereItsMastersStartPositionPutsIt) {
+  NEED_SHARED_URDF(dir);
+  for (const std::string physics : {"kinematic", "ode"}) {
+    SCOPED_TRACE(physics);
+    LoadedWorld w =
+        LoadRobot(dir, kPanda, physics, "    joints: {positions: {panda_finger_joint1: 0.03}}\n");
+    World& world = *w.world;
+    world.Start();
+    EXPECT_EQ(world.scene().joint(Find(world, "panda_finger_joint2")).position, 0.03);
+    const Vec3 left = world.scene().world_pose(Find(world, "panda_leftfinger")).p;
+    const Vec3 right = world.scene().world_pose(Find(world, "panda_rightfinger")).p;
+    EXPECT_NEAR((left - right).Norm(), 0.06, 1e-9) << "open from the start";
+    world.Step();
+    EXPECT_NEAR(world.scene().joint(Find(world, "panda_finger_joint2")).position, 0.03, 1e-4);
+  }
+  EXPECT_CONTAINS(testing::ErrorOf([&] {
+                    LoadRobot(dir, kPanda, "ode",
+                              "    joints: {positions: {panda_finger_joint2: 0.02}}\n");
+                  }),
+                  "joint 'panda_finger_joint2' follows ");
+  EXPECT_CONTAINS(testing::ErrorOf([&] {
+                    LoadRobot(dir, kPanda, "ode",
+                              "    joints: {limits: false, positions: {panda_finger_joint1: "
+                              "1e7}}\n");
+                  }),
+                  "joint 'panda_finger_joint1' starts at 10000000, beyond the 1e6 (m or rad) a "
+                  "world may use");
+}
+
 TEST_F(UrdfTest, FixedBaseArmsStandWithLinksAttachedForTenSeconds) {
   NEED_SHARED_URDF(dir);
   for (const char* urdf : {kFanuc, kPanda}) {
