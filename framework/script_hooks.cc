@@ -13,10 +13,14 @@
 #include "framework/script_calls.h"
 #include "framework/script_state.h"
 #include "framework/small_blocks.h"
+#include "framework/world.h"
 
 namespace swarmsim {
 namespace lua_host {
 namespace {
+
+// Steps in a row a thread's slice runs out before it is said to be stuck.
+constexpr uint16_t kStuckThreadSteps = 100;
 
 std::string MemoryLimitText(const LuaMemory& memory) {
   return std::string(memory.holder) + (memory.plural ? " hold" : " holds") + " more than " +
@@ -236,6 +240,20 @@ void ResumeThread(ScriptState* state, Script& script) {
   script.running = false;
   c.thread = nullptr;
   script.slice_yielded = c.slice_yielded;
+  // A thread its slice switched out step after step never yields by itself:
+  // a loop without sim.step, which ran to the end using its slice every
+  // step without a word. Said once, in the robot's log.
+  if (!c.slice_yielded) {
+    script.slice_streak = 0;
+  } else if (script.slice_streak < kStuckThreadSteps &&
+             ++script.slice_streak == kStuckThreadSteps && c.runtime != nullptr &&
+             script.source != nullptr) {
+    c.runtime->log.Add(c.log_prefix + "warning: " + script.source->path +
+                       ": sysCall_thread has not yielded by itself in " +
+                       std::to_string(kStuckThreadSteps) +
+                       " steps (its time slice ran out in each): a loop without sim.step() or "
+                       "sim.wait()? It goes on, using its slice every step");
+  }
   if (status == LUA_YIELD && !c.budget_exhausted) {
     lua_pop(co, results);
     return;

@@ -60,6 +60,7 @@ struct Script {  // 88 bytes
   bool disabled = false;           // failed under on_script_error: disable_script
   bool running = false;            // inside a call (no re-entry through handleChildScript)
   bool slice_yielded = false;      // the thread's last yield was its time slice's (SliceHook)
+  uint16_t slice_streak = 0;       // steps in a row its slice ran out (kStuckThreadSteps)
   lua_State* thread = nullptr;     // sysCall_thread's coroutine, while it runs
   int thread_ref = LUA_NOREF;      // keeps `thread` alive, in the registry
   int slice_instructions = kDefaultSliceInstructions;

@@ -411,6 +411,25 @@ TEST(ScriptControlTest, ThreadSwitchTimingMustBeFiniteAndPositive) {
   }
 }
 
+// A thread whose time slice runs out step after step never yields by
+// itself (a loop without sim.step): it ran to the end without a word. It is
+// said once, after 100 such steps; a thread that steps is not.
+TEST(ScriptControlTest, AThreadThatNeverYieldsByItselfIsSaidOnce) {
+  ScriptWorld w;
+  w.AddRobot("bot#0",
+             "function sysCall_thread()\n  sim.setThreadSwitchTiming(0.01)\n"
+             "  while true do end\nend\n");
+  w.AddRobot("bot#1", "function sysCall_thread()\n  while true do sim.step() end\nend\n");
+  w.Steps(99);
+  EXPECT_TRUE(w.log.empty()) << w.log.front();
+  w.Steps(150);
+  ASSERT_EQ(w.log.size(), 1u);
+  EXPECT_EQ(w.log[0],
+            "[bot#0] warning: scripts/robot.lua: sysCall_thread has not yielded by itself in 100 "
+            "steps (its time slice ran out in each): a loop without sim.step() or sim.wait()? It "
+            "goes on, using its slice every step");
+}
+
 TEST(ScriptControlTest, WaitAndWaitUntilRejectNaNInfiniteAndNegativeTimes) {
   for (const std::string call :
        {"sim.wait(0/0)", "sim.wait(1/0)", "sim.wait(-1)", "sim.waitUntil(f, 0/0)",
