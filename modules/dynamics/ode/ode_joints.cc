@@ -218,10 +218,12 @@ void OdeWorld::ApplyMotors(double dt) {
       // pi/2 of a stop ODE cannot hold from the reference (more than pi
       // away), or 3 pi/4 from the reference (the angle ODE measures wraps
       // at pi). A joint that goes neither way is stepped as before.
-      const bool near_far_stop =
-          (j.min_position - j.offset < -M_PI && j.position - j.min_position < M_PI / 2) ||
-          (j.max_position - j.offset > M_PI && j.max_position - j.position < M_PI / 2);
-      if (j.wide && (near_far_stop || std::abs(j.position - j.offset) > 0.75 * M_PI)) {
+      // (Asked of wide hinges only: every joint passes here every substep.)
+      const auto near_far_stop = [&j] {
+        return (j.min_position - j.offset < -M_PI && j.position - j.min_position < M_PI / 2) ||
+               (j.max_position - j.offset > M_PI && j.max_position - j.position < M_PI / 2);
+      };
+      if (j.wide && (near_far_stop() || std::abs(j.position - j.offset) > 0.75 * M_PI)) {
         dVector3 axis;
         dJointGetHingeAxis(j.joint, axis);
         dJointSetHingeAxis(j.joint, axis[0], axis[1], axis[2]);  // the angle reads 0 here
