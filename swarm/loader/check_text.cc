@@ -1,5 +1,7 @@
 #include "swarm/loader/check_text.h"
 
+#include <tinyxml2.h>
+
 #include <algorithm>
 #include <cctype>
 #include <charconv>
@@ -138,6 +140,37 @@ std::string Element(std::string_view name, int line) {
 
 }  // namespace
 
+std::string XmlParseErrorInWords(int error_id, const char* error_str) {
+  // tinyxml2's ErrorStr ends "XMLElement name=link" when it was in an element.
+  std::string element;
+  if (const std::string_view text = error_str ? error_str : "";
+      text.find("XMLElement name=") != std::string_view::npos) {
+    const std::string_view rest = text.substr(text.find("XMLElement name=") + 16);
+    element = Shown(rest.substr(0, rest.find_first_of(" \t\r\n")));
+  }
+  const std::string in = element.empty() ? "" : " of <" + element + ">";
+  switch (error_id) {
+    case tinyxml2::XML_ERROR_PARSING_ELEMENT:
+      return "a tag is not well formed (its '>' missing, or a '<' or '&' in text)";
+    case tinyxml2::XML_ERROR_PARSING_ATTRIBUTE:
+      return "an attribute" + in +
+             " is not name=\"value\" (its quotes missing, or an attribute given twice)";
+    case tinyxml2::XML_ERROR_PARSING_TEXT: return "text that is not XML (a stray '<' or '&'?)";
+    case tinyxml2::XML_ERROR_PARSING_CDATA: return "a <![CDATA[ section is never closed with ]]>";
+    case tinyxml2::XML_ERROR_PARSING_COMMENT: return "a comment <!-- is never closed with -->";
+    case tinyxml2::XML_ERROR_PARSING_DECLARATION: return "a <? declaration is never closed with ?>";
+    case tinyxml2::XML_ERROR_PARSING_UNKNOWN: return "a <! tag is never closed with '>'";
+    case tinyxml2::XML_ERROR_EMPTY_DOCUMENT: return "no element: the file is empty or only blanks";
+    case tinyxml2::XML_ERROR_MISMATCHED_ELEMENT:
+      return "a closing tag does not match the element it closes";
+    case tinyxml2::XML_ERROR_PARSING: return "a '<' that starts no element, comment or declaration";
+    case tinyxml2::XML_ELEMENT_DEPTH_EXCEEDED: return "elements nested more than 100 deep";
+    default:
+      return std::string("the XML parser refused it (") + (error_str ? error_str : "no message") +
+             ")";
+  }
+}
+
 std::string XmlNestingProblem(std::string_view bytes, int* line_out) {
   struct Open {
     std::string_view name;
@@ -168,6 +201,14 @@ std::string XmlNestingProblem(std::string_view bytes, int* line_out) {
       end = "?>";
     if (end != ">" || rest.starts_with("<!")) {
       const size_t at = bytes.find(end, lt);
+      if (at == std::string_view::npos && end != ">") {  // it takes the rest of the file
+        *line_out = line;
+        const std::string_view what = end == "-->"   ? "a comment <!--"
+                                      : end == "]]>" ? "a <![CDATA[ section"
+                                                     : "a <? declaration";
+        return std::string(what) + " is never closed with " + std::string(end) +
+               " (the file ends first)";
+      }
       const size_t stop = at == std::string_view::npos ? bytes.size() : at + end.size();
       count_lines(lt, stop);
       i = stop;

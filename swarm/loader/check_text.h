@@ -57,10 +57,17 @@ void CheckXmlHasNoDtd(std::string_view bytes, const std::string& name, const cha
 // the parser refused (tinyxml2 names the line of the element it was in,
 // not of the tag that broke it): "line N: </robt> does not close <robot>
 // (line 2)", "<link> (line 3) is never closed", a closing tag with none
-// open (after the root's end), an attribute value missing its closing quote.
+// open (after the root's end), an attribute value missing its closing quote,
+// a comment, CDATA section or declaration the file ends in.
 // Empty when the tags nest.
 // *line: the line to name (0 with an empty answer).
 std::string XmlNestingProblem(std::string_view bytes, int* line);
+
+// tinyxml2's error for a file it refused (`error_id` its XMLError,
+// `error_str` its ErrorStr(), which may name the element) in words:
+// "an attribute of <link> is not name=\"value\" (...)". For what
+// XmlNestingProblem does not find.
+std::string XmlParseErrorInWords(int error_id, const char* error_str);
 
 // Fails when a mesh file's triangles pass kMaxMeshTriangles (mesh.h).
 void CheckTriangleCount(const std::string& name, int line, int64_t triangles, const char* what);

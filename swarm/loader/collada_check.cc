@@ -622,8 +622,7 @@ std::string ColladaCheck::Run() {
     if (const std::string nesting = loader::XmlNestingProblem(bytes_, &line); !nesting.empty())
       loader::Fail(name_, line, "malformed XML: " + nesting);
     loader::Fail(name_, doc_.ErrorLineNum(),
-                 std::string("malformed XML: ") + doc_.ErrorName() +
-                     (doc_.ErrorStr() ? std::string(" (") + doc_.ErrorStr() + ")" : ""));
+                 "malformed XML: " + loader::XmlParseErrorInWords(doc_.ErrorID(), doc_.ErrorStr()));
   }
   const XMLElement* root = doc_.RootElement();
   if (!root || std::string_view(root->Name()) != "COLLADA")

@@ -446,7 +446,7 @@ bool IsParameterName(std::string_view name) {
 
 ModelFile ReadModelFile(YamlFile file, const std::string& used_by,
                         std::span<const std::string> section_keys) {
-  ModelFile model{std::move(file), {}, {}, {}, {}, {}, {}, {}};
+  ModelFile model{std::move(file), {}, {}, {}, {}, {}, {}, {}, {}};
   const YamlFile& f = model.file;
   Field top{"model file", f.root(), f.root().Mark().is_null() ? YAML::Mark() : f.root().Mark(), {}};
   if (!f.root().IsMap()) {
@@ -564,7 +564,7 @@ ObjectSpec ResolveModel(const ModelFile& model, const ValueReader& values, Scrip
 std::vector<ObjectSpec> ReadSceneObjects(const YamlFile& file, const Field& list,
                                          const ValueReader& values, ScriptCache* scripts,
                                          MeshCache* meshes, const ModuleRegistry* registry) {
-  ModelFile scene_model{file, "the world", {}, list, {}, {}, {}, {}};
+  ModelFile scene_model{file, "the world", {}, list, {}, {}, {}, {}, {}};
   Builder builder{scene_model, values, scripts, 0, meshes, registry};
   std::vector<ObjectSpec> out;
   for (const Field& element : ListElements(file, list, "objects"))

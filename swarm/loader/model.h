@@ -84,6 +84,9 @@ struct ModelFile {
   std::shared_ptr<const ObjectSpec> imported;
   std::string imported_file;                // the imported file, as the world names it
   std::vector<std::string> import_summary;  // `swarmsim describe` lines
+  // An imported model's joints that are no joint objects, by name -> kind
+  // ("fixed"): named when a world gives one of them a position.
+  std::map<std::string, std::string> merged_joints;
 };
 
 // `used_by` (file:line:column of the reference) is named when the file is

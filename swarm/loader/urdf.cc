@@ -92,7 +92,8 @@ class Importer {
   int frames_ = 0, bodies_ = 0, meshes_count_ = 0, visuals_ = 0, collisions_ = 0;
   std::map<std::string, int> mesh_formats_;
   std::map<std::string, int> joint_kinds_;
-  std::vector<std::string> held_joints_;  // moving joints whose <limit lower> = upper
+  std::map<std::string, std::string> merged_joints_;  // UrdfImport::merged_joints
+  std::vector<std::string> held_joints_;              // moving joints whose <limit lower> = upper
   int mimics_ = 0;
   double total_mass_ = 0;
 };
@@ -505,11 +506,14 @@ ObjectSpec Importer::LinkObject(const urdf::Link& link, bool top, bool is_root, 
       case urdf::Joint::FIXED:
       case urdf::Joint::PLANAR:
         ++joint_kinds_[joint->type == urdf::Joint::FIXED ? "fixed" : "planar (as fixed)"];
+        merged_joints_[joint_names_[joint->name]] =
+            joint->type == urdf::Joint::FIXED ? "fixed" : "planar (imported as fixed)";
         spec.children.push_back(LinkObject(*child, false, false, X_LJ, X_TL * X_LJ));
         continue;
       case urdf::Joint::FLOATING:
         // A free body: no joint between it and its parent.
         ++joint_kinds_["floating"];
+        merged_joints_[joint_names_[joint->name]] = "floating";
         spec.children.push_back(LinkObject(*child, true, false, X_LJ, Pose{}));
         continue;
       default: break;
@@ -634,6 +638,7 @@ UrdfImport Importer::Run(const std::string& where, const std::string& text) {
     if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-') c = '_';
   NameObjects();
   out.root = LinkObject(*model->getRoot(), true, true, Pose{}, Pose{});
+  out.merged_joints = std::move(merged_joints_);
 
   std::string joints;
   for (const auto& [kind, n] : joint_kinds_)

@@ -13,6 +13,7 @@
 #pragma once
 
 #include <filesystem>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -39,6 +40,10 @@ struct UrdfImport {
   std::string name;                   // the robot's name, usable as a model name
   std::vector<std::string> summary;   // what was imported, for `swarmsim describe`
   std::vector<std::string> warnings;  // one per kind of thing ignored or defaulted
+  // Joints that are no joint objects (fixed, planar, floating: their links
+  // are merged or free), by the name a moving joint of theirs would have ->
+  // their kind ("fixed"), for messages naming them.
+  std::map<std::string, std::string> merged_joints;
 };
 
 // Reads the URDF at `path` (`text` as the world names it, `where` the

@@ -48,8 +48,8 @@ UrdfXmlFacts XmlReader::Read(const std::string& bytes) {
     int line = 0;
     if (const std::string nesting = XmlNestingProblem(bytes, &line); !nesting.empty())
       Fail(line, "malformed XML: " + nesting);
-    Fail(doc.ErrorLineNum(), std::string("malformed XML: ") + doc.ErrorName() +
-                                 (doc.ErrorStr() ? std::string(" (") + doc.ErrorStr() + ")" : ""));
+    Fail(doc.ErrorLineNum(),
+         "malformed XML: " + XmlParseErrorInWords(doc.ErrorID(), doc.ErrorStr()));
   }
   // What tinyxml2 lets pass: a stray closing tag after the root's end, a
   // second top-level element.

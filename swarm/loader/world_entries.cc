@@ -551,6 +551,14 @@ void WorldLoader::ExtendObjects(const Fields& f, const ValueReader& world_values
       Fields positions(*file_, joints.Get("positions"), "'positions'");
       for (const Field& p : positions.fields()) {
         const auto joint = known.find(p.name);
+        if (const auto merged = model.merged_joints.find(p.name);
+            joint == known.end() && merged != model.merged_joints.end())
+          file_->Fail(p.key_mark,
+                      "joint '" + p.name + "' of '" + model.imported_file + "' is a " +
+                          merged->second + " joint: it has no position (" +
+                          (merged->second == "floating" ? "its child link is a free body"
+                                                        : "its links are merged into one body") +
+                          "); positions are for moving joints");
         if (joint == known.end())
           file_->Fail(p.key_mark,
                       "model '" + model.name + "' has no joint '" + p.name + "'" +

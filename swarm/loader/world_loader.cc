@@ -288,8 +288,15 @@ const ModelFile& WorldLoader::LoadModel(const Field& field, const std::string& t
     // A URDF robot: imported once; the entry's keys are read in the world file.
     const std::string where = file_->Where(field.mark);
     loader::UrdfImport urdf = loader::ImportUrdf(path, where, text, package_path_, &meshes_);
-    auto model = std::make_unique<ModelFile>(
-        ModelFile{*file_, urdf.name, {}, {}, {}, nullptr, text, std::move(urdf.summary)});
+    auto model = std::make_unique<ModelFile>(ModelFile{*file_,
+                                                       urdf.name,
+                                                       {},
+                                                       {},
+                                                       {},
+                                                       nullptr,
+                                                       text,
+                                                       std::move(urdf.summary),
+                                                       std::move(urdf.merged_joints)});
     model->imported = std::make_shared<const ObjectSpec>(std::move(urdf.root));
     warnings_.insert(warnings_.end(), urdf.warnings.begin(), urdf.warnings.end());
     it = models_.emplace(key, std::move(model)).first;

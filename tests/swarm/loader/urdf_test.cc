@@ -491,6 +491,12 @@ TEST_F(UrdfTest, AnEntrysJointPositionsAreWhereItsJointsStartAndStay) {
   EXPECT_CONTAINS(testing::ErrorOf([&] { Load(world("kinematic", "{positions: {sholder: 1}}")); }),
                   "world.yaml:6:26: model 'simple_arm' has no joint 'sholder'; did you mean "
                   "'shoulder'?");
+  // A fixed joint is no joint object: its links are one body.
+  EXPECT_CONTAINS(
+      testing::ErrorOf([&] { Load(world("kinematic", "{positions: {hand-tool0: 0}}")); }),
+      "world.yaml:6:26: joint 'hand-tool0' of '" + arm +
+          "' is a fixed joint: it has no position (its links are merged into one body); "
+          "positions are for moving joints");
   EXPECT_CONTAINS(testing::ErrorOf([&] { Load(world("kinematic", "{positions: {shoulder: 2}}")); }),
                   "world.yaml:6:36: joint 'shoulder' starts at 2, outside its limits [-1.6, 1.6]");
   // Freed limits: anywhere.

@@ -111,6 +111,23 @@ TEST(UrdfXmlTest, IgnoredElementsAreCountedWithTheirFirstLine) {
   EXPECT_EQ(f.ignored.at("joint <dynamics> friction (not simulated)"), std::make_pair(1, 7));
 }
 
+// What the parser refuses that is not a nesting mistake is said in words,
+// not as tinyxml2's error names ("XML_ERROR_PARSING_ATTRIBUTE ErrorID=7").
+TEST(UrdfXmlTest, WhatTheXmlParserRefusesIsSaidInWords) {
+  const std::string attribute = ErrorOfXml("  <link name=a/>\n</robot>\n");
+  EXPECT_CONTAINS(attribute,
+                  "r.urdf:3: malformed XML: an attribute of <link> is not name=\"value\" (its "
+                  "quotes missing, or an attribute given twice)");
+  EXPECT_CONTAINS(ErrorOfXml("  <link name=\"a\" name=\"b\"/>\n</robot>\n"),
+                  "r.urdf:3: malformed XML: an attribute of <link> is not name=\"value\"");
+  const std::string comment = ErrorOfXml("  <link name=\"a\"/>\n  <!-- open\n</robot>\n");
+  EXPECT_CONTAINS(comment,
+                  "r.urdf:4: malformed XML: a comment <!-- is never closed with --> (the file "
+                  "ends first)");
+  for (const std::string& e : {attribute, comment})
+    EXPECT_EQ(e.find("XML_"), std::string::npos) << e;
+}
+
 TEST(UrdfXmlTest, StructuralMistakesNameTheFileAndTheLine) {
   // Tags that do not nest: named at the tag that broke them.
   EXPECT_CONTAINS(ErrorOfXml("  <link name=\"a\">\n  <link name=\"b\"/>\n</robot>\n"),
