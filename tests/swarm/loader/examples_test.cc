@@ -111,6 +111,53 @@ TEST(ExamplesTest, DiffusionWithNoisySensorsAndWheelsSpreadsLikeTheNoiselessOne)
   EXPECT_NEAR(late(noisy) / late(clean), 1.0, 0.1);
 }
 
+// The README's controller ("A controller"), run as it says (in place of
+// the foot-bot's script): it records distance_ahead for every robot every
+// step, within the sensors' range, and keeps the robots spread as
+// scripts/diffusion.lua does (an earlier one, looking along one ray, left
+// 60% of them touching another or a wall after two minutes: mean
+// nearest-neighbour distance 0.34 m against diffusion's 0.55).
+TEST(ExamplesTest, TheReadmesControllerSpreadsTheRobotsAsDiffusionDoes) {
+  std::ifstream readme(std::string(SWARMSIM_SOURCE_DIR) + "/README.md");
+  std::stringstream text;
+  text << readme.rdbuf();
+  const std::string s = text.str();
+  const size_t section = s.find("### A controller");
+  ASSERT_NE(section, std::string::npos);
+  const size_t begin = s.find("```lua\n", section);
+  ASSERT_NE(begin, std::string::npos);
+  const size_t end = s.find("```", begin + 7);
+  ASSERT_NE(end, std::string::npos);
+  const std::filesystem::path script =
+      std::filesystem::path(::testing::TempDir()) / "readme_ahead.lua";
+  std::ofstream(script) << s.substr(begin + 7, end - begin - 7);
+  constexpr int kSteps = 1200, kRobots = 200;  // two minutes at 10 Hz
+  const WorldRun ahead = RunWorld("diffusion.yaml", 2, kSteps,
+                                  {{"robots", "200"}, {"footbot.controller", script.string()}});
+  const WorldRun diffusion = RunWorld("diffusion.yaml", 2, kSteps, {{"robots", "200"}});
+  const std::vector<double> seen = Values(ahead.metrics, "distance_ahead", 0);
+  EXPECT_EQ(seen.size(), static_cast<size_t>(kSteps)) << "robot 0, every step";
+  int64_t samples = 0;
+  for (const MetricSample& m : ahead.metrics) {
+    if (m.name != "distance_ahead") continue;
+    ++samples;
+    EXPECT_GT(m.value, 0.0);
+    EXPECT_LE(m.value, 0.1) << "the sensors' range";
+  }
+  EXPECT_EQ(samples, int64_t{kSteps} * kRobots);
+  // Mean nearest-neighbour distance over the last 20 s.
+  const auto late = [](const WorldRun& run) {
+    double sum = 0;
+    int n = 0;
+    for (const MetricSample& m : run.metrics)
+      if (m.name == "mean_nearest_neighbor_distance" && m.step >= kSteps - 200) sum += m.value, ++n;
+    return n > 0 ? sum / n : 0.0;
+  };
+  EXPECT_GT(late(ahead), 0.8 * late(diffusion))
+      << "the README's controller clumps the robots: " << late(ahead) << " m against "
+      << late(diffusion);
+}
+
 // The foot-bot's noise is a model parameter, so `--set` and sweeps vary it
 // (`--param footbot.prox_noise=0,0.01,0.05`): 0 is the noiseless world bit
 // for bit, anything else another run.
