@@ -1,7 +1,9 @@
 #include "swarm/sweep/sqlite_db.h"
 
 #include <sqlite3.h>
+#include <sys/resource.h>
 
+#include <cerrno>
 #include <cstring>
 
 #include "framework/error.h"
@@ -64,10 +66,19 @@ SqliteDb::SqliteDb(const std::filesystem::path& path, bool read_only) : path_(pa
 SqliteDb::~SqliteDb() { sqlite3_close_v2(db_); }
 
 // " (No space left on device)": what the system said to SQLite's last
-// failed call, which SQLite's own text ("disk I/O error") does not.
+// failed call, which SQLite's own text ("disk I/O error") does not. A write
+// past the process's file size limit (ulimit -f) often leaves SQLite no
+// errno at all: the limit is named when there is one and a write failed.
 std::string SqliteDb::SystemError() const {
   const int error = sqlite3_system_errno(db_);
-  return error != 0 ? std::string(" (") + std::strerror(error) + ")" : std::string();
+  std::string out = error != 0 ? std::string(" (") + std::strerror(error) + ")" : std::string();
+  const int code = sqlite3_extended_errcode(db_) & 0xff;
+  rlimit limit{};
+  if ((code == SQLITE_IOERR || code == SQLITE_FULL || error == EFBIG) &&
+      getrlimit(RLIMIT_FSIZE, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY)
+    out += " (this process may write no file past " + std::to_string(limit.rlim_cur) +
+           " bytes: its file size limit, `ulimit -f`)";
+  return out;
 }
 
 void SqliteDb::Exec(const std::string& sql) {

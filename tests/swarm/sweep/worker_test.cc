@@ -122,6 +122,12 @@ TEST(SweepTest, ADatabaseThatCannotGrowSaysTheSweepResumes) {
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("error: database '" + db.string() + "': "), std::string::npos)
       << r.output;
+  // SQLite says only "disk I/O error": the limit is named (dash's ulimit
+  // counts blocks of 512 bytes).
+  EXPECT_NE(r.output.find("this process may write no file past 102400 bytes: its file size "
+                          "limit, `ulimit -f`)"),
+            std::string::npos)
+      << r.output;
   EXPECT_NE(r.output.find("the runs finished before it are kept in the database: mend this and "
                           "run the same command to resume"),
             std::string::npos)
