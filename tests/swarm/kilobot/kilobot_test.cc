@@ -756,15 +756,24 @@ TEST(KilobotTest, AKiloUidOutOfRangeIsRefused) {
             "int main() { kilo_init(); kilo_start(setup, loop); return 0; }\n");
   ASSERT_EQ(built.exit_code, 0) << built.output;
   Write(dir / "world.yaml", World("uid", "planar", 2, 0.5));
-  for (const char* bad : {"70000", "1.5", "-5"}) {
+  // Out of the model's range: refused as the world loads, naming the value (exit 2).
+  for (const char* bad : {"70000", "-5"}) {
     const CommandResult run = RunProgram("run " + (dir / "world.yaml").string() +
                                          " --steps 2 --quiet --set kilobot.kilo_uid=" + bad);
-    EXPECT_NE(run.exit_code, 0) << bad;
-    EXPECT_NE(run.output.find(std::string("parameter kilo_uid is ") + bad +
-                              ": a kilo_uid is a whole number 0..65535"),
+    EXPECT_EQ(run.exit_code, 2) << bad;
+    EXPECT_NE(run.output.find(std::string("parameter 'kilo_uid' of model 'kilobot' must be within "
+                                          "[-1, 65535] (got ") +
+                              bad + ")"),
               std::string::npos)
         << run.output;
   }
+  // Within it but not whole: the controller's start says so.
+  const CommandResult half = RunProgram("run " + (dir / "world.yaml").string() +
+                                        " --steps 2 --quiet --set kilobot.kilo_uid=1.5");
+  EXPECT_NE(half.exit_code, 0);
+  EXPECT_NE(half.output.find("parameter kilo_uid is 1.5: a kilo_uid is a whole number 0..65535"),
+            std::string::npos)
+      << half.output;
   const CommandResult ok = RunProgram("run " + (dir / "world.yaml").string() +
                                       " --steps 2 --quiet --set kilobot.kilo_uid=65535");
   EXPECT_EQ(ok.exit_code, 0) << ok.output;
