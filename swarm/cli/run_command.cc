@@ -271,8 +271,9 @@ CLI::App* AddRunCommand(CLI::App* app, RunArgs* args) {
                           const std::string_view t(text);
                           if (!t.ends_with(".yaml") && !t.ends_with(".yml")) return "";
                           return "'" + text +
-                                 "' looks like a world file: put the world before --video, or "
-                                 "name a FILE.mp4";
+                                 "' is a .yaml name (a world or model file?): the video would "
+                                 "be written there; name a FILE.mp4 (a world goes before "
+                                 "--video)";
                         },
                         ""));
   run->add_option(
@@ -369,6 +370,17 @@ std::string FileClash(const std::string& flag, const std::string& file, const Ru
   if (flag == "--save-state")
     if (const std::string why = NotAnOrdinaryFile(path); !why.empty())
       return flag + ": '" + file + "': " + why + ": name a file";
+  // A file there already that no video run wrote (a script, a model: the
+  // video went over it with exit 0): an MP4 starts with its 'ftyp' box.
+  if (flag == "--video" && fs::is_regular_file(path, ec) && fs::file_size(path, ec) > 0) {
+    char head[8] = {};
+    std::ifstream in(path, std::ios::binary);
+    in.read(head, sizeof head);
+    if (in.gcount() < 8 || std::string_view(head + 4, 4) != "ftyp")
+      return flag + ": '" + file +
+             "' is a file that is not a video: the video would go over it; name another "
+             "file (or remove it first)";
+  }
   // Its folder: there already, or --out (made before the run). (--video's
   // is checked as the recorder opens it, also before the run.)
   const fs::path folder = path.parent_path();

@@ -15,6 +15,7 @@
 #include "framework/memory_forecast.h"
 #include "framework/object_type.h"
 #include "framework/scheduler.h"
+#include "framework/utf8.h"
 #include "framework/visual.h"
 #include "framework/world.h"
 #include "swarm/record/chunk_writer.h"
@@ -179,7 +180,9 @@ struct RunRecorder::Impl {
     if (const auto it = metric_ids.find(name); it != metric_ids.end()) return it->second;
     const uint32_t id = static_cast<uint32_t>(metric_names.size());
     metric_ids.emplace(std::string(name), id);
-    metric_names.emplace_back(name);
+    // As metrics.csv writes it (FORMAT.md: UTF-8 bytes): U+FFFD for bytes
+    // that are not UTF-8 (sim.recordMetric('\xff', v) was written raw).
+    metric_names.push_back(ValidUtf8(name));
     return id;
   }
 };

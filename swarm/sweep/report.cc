@@ -253,7 +253,38 @@ void WriteCsv(const ReportData& d, std::ostream& out) {
   }
 }
 
+namespace {
+
+// Whether two names are one file: the same file when both exist, else the
+// same path once made absolute (a file yet to be written).
+bool SameFile(const std::string& a, const std::string& b) {
+  std::error_code ec;
+  if (std::filesystem::equivalent(a, b, ec)) return true;
+  std::error_code ea, eb;
+  const std::filesystem::path pa = std::filesystem::weakly_canonical(a, ea);
+  const std::filesystem::path pb = std::filesystem::weakly_canonical(b, eb);
+  return !ea && !eb && pa == pb;
+}
+
+// --csv and --plot write files: never over the database (or the log files
+// SQLite keeps beside it), nor both into one file.
+void CheckReportOutputs(const ReportOptions& o) {
+  for (const auto& [flag, file] : {std::pair{"--csv", &o.csv}, std::pair{"--plot", &o.plot}}) {
+    if (!*file) continue;
+    for (const char* suffix : {"", "-wal", "-shm", "-journal"})
+      if (SameFile(**file, o.db + suffix))
+        throw Error(std::string(flag) + ": '" + **file + "' is the sweep's database" +
+                    (*suffix != 0 ? std::string("'s log file (") + suffix + ")" : "") +
+                    ", which it would overwrite: name another file");
+  }
+  if (o.csv && o.plot && SameFile(*o.csv, *o.plot))
+    throw Error("--csv and --plot name one file ('" + *o.csv + "'): name two");
+}
+
+}  // namespace
+
 int RunReport(const ReportOptions& o, std::ostream& out, std::ostream& err) {
+  CheckReportOutputs(o);
   const ReportData d = LoadReport(o.db);
   for (const std::string* name : {&o.x, &o.by})
     if (!name->empty() &&

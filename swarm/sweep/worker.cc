@@ -8,8 +8,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cerrno>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <map>
@@ -45,6 +47,19 @@ std::string Tail(const std::string& text, int lines) {
 // Swarm metrics (robot empty) are kept as they are; a per-robot metric
 // becomes its mean over the robots that recorded it in that step. Metric
 // names are read as the CSV quotes them ('a,b' was stored as 'b"').
+// A number as metrics.csv writes it, the whole field: a subnormal value
+// (1e-320: strtod's ERANGE, std::stod's out_of_range) is a number too.
+bool ParseNumber(const std::string& field, double* value) {
+  if (field.empty() || std::isspace(static_cast<unsigned char>(field[0]))) return false;
+  char* end = nullptr;
+  errno = 0;
+  const double v = std::strtod(field.c_str(), &end);
+  if (end != field.c_str() + field.size()) return false;
+  if (errno == ERANGE && std::isinf(v)) return false;  // past the largest double
+  *value = v;
+  return true;
+}
+
 void ReadMetrics(const std::filesystem::path& path, RunOutcome* out) {
   std::ifstream f(path, std::ios::binary);
   std::vector<std::string> fields;
@@ -56,9 +71,14 @@ void ReadMetrics(const std::filesystem::path& path, RunOutcome* out) {
       return metric != o.metric ? metric < o.metric : step < o.step;
     }
   };
+  // The robots' values of a step: their sum, and their sum scaled by 2^-64
+  // (exact), for a mean whose sum passes the largest double (robots of
+  // 1.5e308 each: inf otherwise).
+  constexpr int kScale = 64;
   struct Acc {
-    double time = 0, sum = 0;
+    double time = 0, sum = 0, scaled = 0;
     int64_t n = 0;
+    bool finite = true;
   };
   std::map<Key, Acc> acc;
   while (ReadCsvRecord(f, &fields)) {
@@ -69,19 +89,22 @@ void ReadMetrics(const std::filesystem::path& path, RunOutcome* out) {
       size_t used = 0;
       const int64_t step = std::stoll(fields[0], &used);
       if (used != fields[0].size()) continue;
-      const double time = std::stod(fields[1]);
-      const double value = std::stod(fields[4], &used);
-      if (used != fields[4].size()) continue;
+      double time = 0, value = 0;
+      if (!ParseNumber(fields[1], &time) || !ParseNumber(fields[4], &value)) continue;
       Acc& a = acc[Key{fields[3], step}];
       a.time = time;
       a.sum += value;
+      a.scaled += std::ldexp(value, -kScale);
+      a.finite = a.finite && std::isfinite(value);
       ++a.n;
     } catch (const std::exception&) {
       continue;
     }
   }
   for (const auto& [key, a] : acc) {
-    const double value = a.sum / static_cast<double>(a.n);
+    const double n = static_cast<double>(a.n);
+    const double value =
+        std::isfinite(a.sum) || !a.finite ? a.sum / n : std::ldexp(a.scaled / n, kScale);
     out->series.push_back({key.metric, key.step, a.time, value});
     out->final_metrics[key.metric] = value;  // steps ascend within a metric: the last wins
   }

@@ -481,7 +481,26 @@ TEST(VideoCli, BadVideoOptionsAreNamedAndStopTheRunBeforeItStarts) {
   // --video's FILE is optional: a world file after it is not taken for one.
   r = RunProgram("run --steps 2 --video " + world + " --out " + out.string());
   EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_NE(r.output.find("put the world before --video"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("a world goes before --video"), std::string::npos) << r.output;
+  // The world before it and named again as the video: not "put the world before".
+  r = RunProgram("run " + world + " --steps 2 --video " + world);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("is a .yaml name (a world or model file?): the video would be written "
+                          "there; name a FILE.mp4"),
+            std::string::npos)
+      << r.output;
+  // A file there already that is not a video (a script): refused, untouched
+  // (the video went over it, exit 0); a video there already is replaced.
+  std::ofstream(dir / "bot.lua") << "function sysCall_init() end\n";
+  r = RunProgram("run " + world + " --steps 1 --video " + (dir / "bot.lua").string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--video: '" + (dir / "bot.lua").string() +
+                          "' is a file that is not a video: the video would go over it"),
+            std::string::npos)
+      << r.output;
+  std::ifstream script(dir / "bot.lua");
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(script), {}),
+            "function sysCall_init() end\n");
   // A name that is not .mp4: an MP4 all the same, and a note says so (.MP4 is no surprise).
   r = RunProgram("run " + world + " --steps 1 --video " + (dir / "film.avi").string());
   EXPECT_EQ(r.exit_code, 0) << r.output;
@@ -490,6 +509,8 @@ TEST(VideoCli, BadVideoOptionsAreNamedAndStopTheRunBeforeItStarts) {
             std::string::npos)
       << r.output;
   EXPECT_TRUE(std::filesystem::exists(dir / "film.avi"));
+  r = RunProgram("run " + world + " --steps 1 --video " + (dir / "film.avi").string());
+  EXPECT_EQ(r.exit_code, 0) << "a video over a video: " << r.output;
   r = RunProgram("run " + world + " --steps 1 --video " + (dir / "film.MP4").string());
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_EQ(r.output.find("MP4 container"), std::string::npos) << r.output;

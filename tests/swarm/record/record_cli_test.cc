@@ -117,13 +117,27 @@ TEST(RecordCliTest, TextThatIsNotUtf8IsRecordedAsInTheOtherOutputs) {
   EXPECT_EQ(info.exit_code, 0) << info.output;
   EXPECT_NE(info.output.find("the run ended (error: "), std::string::npos) << info.output;
   EXPECT_NE(info.output.find("unexpected payload \xef\xbf\xbd"), std::string::npos) << info.output;
-  // Without the error: the run ends ok, as it does without --record.
-  std::ofstream(dir / "bot.lua") << "function sysCall_actuation() end\n";
+  // Without the error: the run ends ok, as it does without --record. A
+  // metric name that is not UTF-8 is recorded as metrics.csv has it (it was
+  // written raw, against FORMAT.md's "UTF-8 bytes").
+  std::ofstream(dir / "bot.lua")
+      << "function sysCall_actuation() sim.recordMetric('m\xff', 1) end\n";
   const auto ok = RunProgram("run " + (dir / "world.yaml").string() +
                              " --steps 3 --quiet --record --out " + out.string());
   EXPECT_EQ(ok.exit_code, 0) << ok.output;
   EXPECT_NE(RunProgram("record-info " + out.string()).output.find("the run ended (ok)"),
             std::string::npos);
+  record::RecordingPlayer player(out / "recording.swrec");
+  int samples = 0;
+  while (player.Next())
+    for (const record::RecordedSample& sample : player.samples()) {
+      EXPECT_EQ(sample.name, "m\xef\xbf\xbd");
+      ++samples;
+    }
+  EXPECT_EQ(samples, 3);
+  std::ifstream csv(out / "metrics.csv");
+  const std::string text((std::istreambuf_iterator<char>(csv)), {});
+  EXPECT_NE(text.find(",m\xef\xbf\xbd,1"), std::string::npos) << text;
   fs::remove_all(dir);
 }
 

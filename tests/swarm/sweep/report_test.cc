@@ -20,6 +20,7 @@
 #include "swarm/sweep/grid.h"
 #include "swarm/sweep/results_db.h"
 #include "swarm/sweep/stats.h"
+#include "tests/framework/error_of.h"
 #include "tests/swarm/run_program.h"
 #include "tests/swarm/sweep/sweep_db.h"
 
@@ -228,6 +229,42 @@ TEST(ReportTest, TheTableSummarisesEachPointOverItsOkRuns) {
   EXPECT_NE(text.find("\nfailed runs\n  run 5 seed 2: said \"no\", then stopped\n"),
             std::string::npos)
       << text;
+  fs::remove_all(file.parent_path());
+}
+
+// --csv or --plot naming the database would overwrite every result in it
+// (exit 0, "csv: sw.db"): refused before anything is written, as the
+// database's log files and one file named by both.
+TEST(ReportTest, TheCsvAndThePlotNeverOverwriteTheDatabase) {
+  const fs::path file = SmallSweep("report_own_db");
+  const auto size = fs::file_size(file);
+  const auto refused = [&](std::optional<std::string> csv, std::optional<std::string> plot) {
+    std::ostringstream out, err;
+    ReportOptions options;
+    options.db = file.string();
+    options.csv = std::move(csv);
+    options.plot = std::move(plot);
+    return testing::ErrorOf([&] { RunReport(options, out, err); });
+  };
+  EXPECT_CONTAINS(refused(file.string(), std::nullopt),
+                  "--csv: '" + file.string() +
+                      "' is the sweep's database, which it would "
+                      "overwrite: name another file");
+  // Another name of it.
+  const std::string dotted = (file.parent_path() / "." / file.filename()).string();
+  EXPECT_CONTAINS(refused(std::nullopt, dotted),
+                  "--plot: '" + dotted + "' is the sweep's database");
+  EXPECT_CONTAINS(refused(file.string() + "-wal", std::nullopt),
+                  "is the sweep's database's log file (-wal)");
+  const std::string csv = (file.parent_path() / "r.csv").string();
+  EXPECT_CONTAINS(refused(csv, csv), "--csv and --plot name one file");
+  EXPECT_FALSE(fs::exists(csv));
+  EXPECT_EQ(fs::file_size(file), size);
+  // Still a database.
+  std::ostringstream out, err;
+  ReportOptions options;
+  options.db = file.string();
+  EXPECT_EQ(RunReport(options, out, err), 0) << err.str();
   fs::remove_all(file.parent_path());
 }
 

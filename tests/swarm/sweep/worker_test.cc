@@ -7,6 +7,7 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -214,6 +215,28 @@ TEST(WorkerTest, AFinishedRunIsItsSummaryAndItsMetricsMeanOverRobots) {
   for (const SeriesPoint& p : o.series) series[{p.metric, p.step}] = p.value;
   EXPECT_EQ((series[{"x", 1}]), 2);
   EXPECT_EQ((series[{"mnnd", 1}]), 0.5);
+  fs::remove_all(dir);
+}
+
+// Values at the ends of the doubles: a subnormal one (std::stod's
+// out_of_range) was dropped, so the "final" value was an earlier step's;
+// two robots of 1.5e308 each had the mean inf. Infinities and NaNs
+// recorded stay what they were.
+TEST(WorkerTest, SubnormalAndHugeValuesAreMetricsLikeAnyOther) {
+  const fs::path dir = RunFolder("extremes", R"({"status": "ok", "steps": 2, "robots": 2})",
+                                 "step,time,robot,metric,value\n"
+                                 "0,0,,decay,8.900295434e-308\n"
+                                 "1,0.1,,decay,8.094771541e-320\n"
+                                 "1,0.1,bot#0,near_max,1.5e+308\n1,0.1,bot#1,near_max,1.5e+308\n"
+                                 "1,0.1,bot#0,mixed,1.5e+308\n1,0.1,bot#1,mixed,inf\n"
+                                 "1,0.1,,gone,1e999\n");
+  const RunOutcome o = CollectRun(1, dir, StderrOf(dir), kExited0, false, 0);
+  EXPECT_TRUE(o.ok) << o.error;
+  EXPECT_EQ(o.final_metrics.at("decay"), 8.094771541e-320) << "the last step's";
+  EXPECT_EQ(o.series.size(), 4u);  // decay at steps 0 and 1, near_max, mixed
+  EXPECT_EQ(o.final_metrics.at("near_max"), 1.5e308);
+  EXPECT_EQ(o.final_metrics.at("mixed"), INFINITY);
+  EXPECT_FALSE(o.final_metrics.contains("gone")) << "past the largest double: no number";
   fs::remove_all(dir);
 }
 
