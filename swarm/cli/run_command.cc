@@ -628,13 +628,25 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
       } catch (const Error& e) {
         return bad_input(e.what());
       }
-      // A run the watchdog ends (it exits from its own thread) closes the
-      // recording too: record-info then says how it ended.
-      options.on_stuck_end = [run_recorder](const RunResult& stuck) {
-        run_recorder->Finish(stuck.steps, stuck.signal != 0 ? "interrupted" : "error", stuck.error);
-      };
     }
   }
+  // A run the watchdog ends (it exits from its own thread, the world's
+  // stuck in a step) closes the video and the recording too, before its
+  // summary.json: the video's last second was lost (20 of 36 frames in the
+  // file, the summary saying 36), and record-info says how the run ended.
+  // The video's recorder is touched by the world's thread only in the
+  // record phase (Capture), which does not wait on anything that can stick.
+  if (recorder != nullptr || run_recorder != nullptr)
+    options.on_stuck_end = [recorder, run_recorder](const RunResult& stuck) {
+      if (recorder != nullptr) {
+        try {
+          recorder->Finish();
+        } catch (const Error&) {  // the run's own error is the one to tell
+        }
+      }
+      if (run_recorder != nullptr)
+        run_recorder->Finish(stuck.steps, stuck.signal != 0 ? "interrupted" : "error", stuck.error);
+    };
   // --view: the page follows the recording while the run writes it.
   std::unique_ptr<viewer::Server> view_server;
   if (args.view && run_recorder != nullptr) {

@@ -51,7 +51,8 @@ struct RunOptions {
   // Called once with how the run ended when the watchdog ends it (a step or
   // the stop stuck past simulation.step_timeout, a stop signal during a
   // stuck step), from the watchdog's thread just before the process exits:
-  // the recording's end chunk. (A run that returns is the caller's to close.)
+  // the video's end and the recording's end chunk, before summary.json is
+  // written. (A run that returns is the caller's to close.)
   std::function<void(const RunResult&)> on_stuck_end;
   // Called with each step's metric samples (after metrics.csv has them),
   // from the run's thread: the Python World keeps its history from them.

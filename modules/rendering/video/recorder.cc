@@ -9,6 +9,7 @@
 #include <deque>
 #include <mutex>
 #include <new>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <string_view>
@@ -142,6 +143,8 @@ struct Recorder::Impl {
   std::string error;  // the first failure
   std::vector<OutputFile> snapshots;
   int64_t frames_written = 0;
+  // Set when a write failed: the frames the file holds, read back from it.
+  std::optional<int64_t> frames_in_file;
   std::thread thread;
 
   // The recorder's thread. Nothing may escape it (an exception there ended
@@ -284,8 +287,31 @@ struct Recorder::Impl {
       } catch (const std::exception& e) {
         if (error.empty()) error = std::string("--video: ") + e.what();
       }
+      // A write that failed (a full disk, ulimit -f) may have cut the file
+      // short of the frames encoded: what it holds is counted back from it,
+      // for the outputs' line (the frames encoded overstated it).
+      if (!error.empty()) {
+        int64_t held = 0;
+        try {
+          VideoReader reader(settings.video);
+          Image frame;
+          while (held < frames_written && reader.Next(&frame)) ++held;
+        } catch (const std::exception&) {  // no frame can be read from it
+        }
+        const std::lock_guard lock(mutex);
+        frames_in_file = held;
+      }
     }
     if (!error.empty()) throw Error(error);
+  }
+
+  // The outputs' words for the frames: "81 frames", or with a failed write
+  // "70 frames (of 81 drawn: its writing failed)".
+  std::string FramesText() const {
+    std::string text = std::to_string(frames_in_file.value_or(frames_written)) + " frames";
+    if (frames_in_file && *frames_in_file < frames_written)
+      text += " (of " + std::to_string(frames_written) + " drawn: its writing failed)";
+    return text;
   }
 };
 
@@ -427,7 +453,7 @@ void Recorder::ListOutputs(std::vector<OutputFile>* out) const {
     out->push_back({"video", RelativeTo(r.settings.video, r.settings.out_dir),
                     "H.264 " + Size(r.width, r.height) + ", " +
                         Number(std::round(r.video_rate * 100) / 100) + " frames/s, " +
-                        std::to_string(r.frames_written) + " frames, " + r.view_name});
+                        r.FramesText() + ", " + r.view_name});
 }
 
 std::string Recorder::ProgressNote() const {
@@ -445,9 +471,8 @@ std::string Recorder::VideoLine() const {
   const Impl& r = *impl_;
   if (!r.writer) return "";
   const std::lock_guard lock(r.mutex);
-  return r.settings.video.string() + ": " + std::to_string(r.frames_written) + " frames, " +
-         Size(r.width, r.height) + ", " + Number(std::round(r.video_rate * 100) / 100) +
-         " frames/s, " + r.view_name;
+  return r.settings.video.string() + ": " + r.FramesText() + ", " + Size(r.width, r.height) + ", " +
+         Number(std::round(r.video_rate * 100) / 100) + " frames/s, " + r.view_name;
 }
 
 ModuleDescriptor RecorderModule() {

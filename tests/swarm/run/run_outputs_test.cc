@@ -16,6 +16,7 @@
 #include <thread>
 #include <vector>
 
+#include "modules/rendering/video/video_writer.h"
 #include "tests/swarm/run_program.h"
 #include "tests/text_lines.h"
 
@@ -252,6 +253,28 @@ TEST(RunOutputsTest, AStuckStartEndsTheRunWithALimitThatGrowsWithTheRobots) {
     EXPECT_EQ(summary["status"], "error");
     EXPECT_EQ(summary["steps"], 0);
   }
+  fs::remove_all(dir);
+}
+
+// A run the watchdog ends finishes its video before summary.json: the
+// frames encoded but not yet in a written fragment (up to a second of
+// video) were lost, and the summary counted them all.
+TEST(RunOutputsTest, StuckStepFinishesTheVideoTheSummaryCounts) {
+  const fs::path dir = StuckWorld("stuck_video", "1");
+  const auto r = RunProgram("run " + (dir / "world.yaml").string() +
+                            " --steps 100 --quiet --video --out " + (dir / "out").string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  const auto summary = nlohmann::json::parse(ReadFile(dir / "out" / "summary.json"));
+  EXPECT_EQ(summary["steps"], 3);
+  std::string description;
+  for (const auto& output : summary["outputs"])
+    if (output["kind"] == "video") description = output["description"].get<std::string>();
+  swarmsim::video::VideoReader reader(dir / "out" / "video.mp4");
+  swarmsim::Image frame;
+  int frames = 0;
+  while (reader.Next(&frame)) ++frames;
+  EXPECT_EQ(frames, 4) << "steps 0 to 3, each a frame at 10 frames/s";
+  EXPECT_NE(description.find(", 4 frames, "), std::string::npos) << description;
   fs::remove_all(dir);
 }
 
