@@ -109,15 +109,22 @@ void CheckXmlHasNoDtd(std::string_view bytes, const std::string& name, const cha
              (std::isalnum(static_cast<unsigned char>(rest[end])) || rest[end] == '_' ||
               rest[end] == '-' || rest[end] == '.' || rest[end] == ':' || rest[end] == '#'))
         ++end;
-      if (end < rest.size() && rest[end] == ';' && end > 1) {
-        const std::string_view entity = rest.substr(1, end - 1);
-        if (entity[0] != '#' && entity != "lt" && entity != "gt" && entity != "amp" &&
-            entity != "quot" && entity != "apos")
-          Fail(name, line,
-               Quoted(rest.substr(0, end + 1)) + " refers to an entity the " + format +
-                   " reader does not know (it knows XML's own: &lt; &gt; &amp; &quot; &apos; and "
-                   "&#...;); write the value out");
-      }
+      // A '&' that starts no reference ("l&eft"): XML writes it &amp;, and
+      // the two readers behind a URDF disagree on it (tinyxml2 keeps the
+      // '&', urdfdom's TinyXML drops it: the joint 'l&eft' was 'left' to
+      // one, and the import failed on the name the other gave).
+      if (end >= rest.size() || rest[end] != ';' || end == 1)
+        Fail(name, line,
+             "a '&' that starts no reference (" +
+                 Quoted(rest.substr(0, std::min(end + 1, rest.size()))) +
+                 "): XML writes a '&' as &amp;");
+      const std::string_view entity = rest.substr(1, end - 1);
+      if (entity[0] != '#' && entity != "lt" && entity != "gt" && entity != "amp" &&
+          entity != "quot" && entity != "apos")
+        Fail(name, line,
+             Quoted(rest.substr(0, end + 1)) + " refers to an entity the " + format +
+                 " reader does not know (it knows XML's own: &lt; &gt; &amp; &quot; &apos; and "
+                 "&#...;); write the value out");
       ++i;
     } else {
       line += rest[0] == '\n';

@@ -43,10 +43,6 @@ std::string Tail(const std::string& text, int lines) {
   return out;
 }
 
-// metrics.csv (step,time,robot,metric,value) -> series and final values.
-// Swarm metrics (robot empty) are kept as they are; a per-robot metric
-// becomes its mean over the robots that recorded it in that step. Metric
-// names are read as the CSV quotes them ('a,b' was stored as 'b"').
 // A number as metrics.csv writes it, the whole field: a subnormal value
 // (1e-320: strtod's ERANGE, std::stod's out_of_range) is a number too.
 bool ParseNumber(const std::string& field, double* value) {
@@ -60,6 +56,10 @@ bool ParseNumber(const std::string& field, double* value) {
   return true;
 }
 
+// metrics.csv (step,time,robot,metric,value) -> series and final values.
+// Swarm metrics (robot empty) are kept as they are; a per-robot metric
+// becomes its mean over the robots that recorded it in that step. Metric
+// names are read as the CSV quotes them ('a,b' was stored as 'b"').
 void ReadMetrics(const std::filesystem::path& path, RunOutcome* out) {
   std::ifstream f(path, std::ios::binary);
   std::vector<std::string> fields;

@@ -251,6 +251,13 @@ TEST_F(UrdfNumbersTest, DtdDeclarationsAndUnknownEntitiesNameTheirLine) {
   EXPECT_EQ(Message(Robot("", "", "  <link name=\"&tool;\"/>\n")),
             "r.urdf:12: '&tool;' refers to an entity the URDF reader does not know (it knows "
             "XML's own: &lt; &gt; &amp; &quot; &apos; and &#...;); write the value out");
+  // A '&' that starts no reference: urdfdom's TinyXML dropped it where
+  // tinyxml2 kept it, so a joint 'l&eft' had two names and the import
+  // ended in an uncaught std::out_of_range (found by the urdf fuzzer).
+  EXPECT_EQ(Message(Robot("", "", "  <link name=\"l&eft\"/>\n")),
+            "r.urdf:12: a '&' that starts no reference ('&eft\"'): XML writes a '&' as &amp;");
+  EXPECT_EQ(Message(Robot("", "", "  <link name=\"a & b\"/>\n")),
+            "r.urdf:12: a '&' that starts no reference ('& '): XML writes a '&' as &amp;");
   // A DOCTYPE that declares nothing, XML's own entities and character
   // references, and anything in a comment or CDATA load.
   EXPECT_EQ(ErrorOf(with_doctype("<!DOCTYPE robot SYSTEM \"urdf.dtd\">\n",
