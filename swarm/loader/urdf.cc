@@ -73,8 +73,21 @@ class Importer {
                         const Pose& X_TL);
   std::vector<urdf::JointSharedPtr> ChildJoints(const urdf::Link& link) const;
   void NameObjects();
-  const std::string& LinkName(const std::string& link) const { return link_names_.at(link); }
-  const std::string& JointName(const std::string& joint) const { return joint_names_.at(joint); }
+  const std::string& LinkName(const std::string& link) const { return Named(link_names_, link); }
+  const std::string& JointName(const std::string& joint) const {
+    return Named(joint_names_, joint);
+  }
+  // names.at(name), for a name urdfdom gives: a name tinyxml2 read otherwise
+  // (the two readers disagreeing, as on a bare '&') is an error naming the
+  // file, not std::out_of_range.
+  template <class Value>
+  const Value& Named(const std::map<std::string, Value>& names, const std::string& name) const {
+    const auto it = names.find(name);
+    if (it == names.end())
+      Fail(0, "'" + ValidUtf8(name) +
+                  "' is named otherwise by the XML reader than by urdfdom: check its characters");
+    return it->second;
+  }
 
   fs::path path_;
   std::string name_;
@@ -438,7 +451,7 @@ void Importer::NameObjects() {
 std::vector<urdf::JointSharedPtr> Importer::ChildJoints(const urdf::Link& link) const {
   std::vector<urdf::JointSharedPtr> joints = link.child_joints;
   std::sort(joints.begin(), joints.end(), [&](const auto& a, const auto& b) {
-    return xml_.joint_order.at(a->name) < xml_.joint_order.at(b->name);
+    return Named(xml_.joint_order, a->name) < Named(xml_.joint_order, b->name);
   });
   return joints;
 }
