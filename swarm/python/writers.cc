@@ -61,7 +61,7 @@ Array RealNumbers(const py::handle& value, const std::string& what) {
   const char kind = a.dtype().kind();
   if (kind == 'b') throw WriteError(true, what + " is booleans, not numbers (use 0.0 and 1.0)");
   if (kind == 'c')
-    throw WriteError(true, what + " is complex numbers: joint targets and states are real");
+    throw WriteError(true, what + " is complex numbers: poses, joint targets and states are real");
   if (kind != 'f' && kind != 'i' && kind != 'u')
     throw WriteError(true,
                      what + " is not numbers (dtype " + std::string(py::str(a.dtype())) + ")");

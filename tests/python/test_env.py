@@ -543,7 +543,13 @@ class RewardTest(unittest.TestCase):
                                                 r"'mean_nearest_neighbour_distance'; did you mean "
                                                 r"'mean_nearest_neighbor_distance'\?"):
             make(2, reward="mean_nearest_neighbour_distance")
-        make(2, reward="my_own_robot_metric").close()  # a robot-level one: the robots record it
+        # A robot-level one: the robots record it, and until they do it is 0
+        # (it was a KeyError at every step before the first sim.recordMetric).
+        env = make(2, reward="my_own_robot_metric")
+        env.reset(seed=1)
+        _, rewards, *_ = env.step({a: np.zeros(2) for a in env.agents})
+        self.assertEqual(set(rewards.values()), {0.0})
+        env.close()
 
     def test_a_swarm_metric_as_the_reward(self):
         env = make(6, reward="mean_nearest_neighbor_distance")
@@ -608,6 +614,10 @@ class DeclarationTest(unittest.TestCase):
             senv.VectorEnv(DIFFUSION, 2.5, set={"robots": 2})
         with self.assertRaisesRegex(TypeError, r"^num_envs must be an integer >= 1, got True"):
             senv.VectorEnv(DIFFUSION, True, set={"robots": 2})
+        # A huge count is refused at once (it filled memory building its slots).
+        for huge in (10**9, 10**20):
+            with self.assertRaisesRegex(ValueError, r"^num_envs must be at most 65,536"):
+                senv.VectorEnv(DIFFUSION, huge, set={"robots": 2})
         env = make(2)
         with self.assertRaisesRegex(TypeError, r"^reset: seed must be an integer >= 0, got 'x'"):
             env.reset(seed="x")

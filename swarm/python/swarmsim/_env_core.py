@@ -22,6 +22,9 @@ World = _swarmsim.World
 MAX_SEED = 2**31  # seeds drawn for later episodes lie in [0, MAX_SEED)
 
 
+MAX_NUM_ENVS = 65536  # worlds a VectorEnv holds
+
+
 def whole_number(value, what, minimum=0):
     """`value` as an int if it is a whole number (int or numpy integer, not a bool) of at
     least `minimum`; else TypeError or ValueError naming `what` (``"seed"``)."""
@@ -104,6 +107,11 @@ class Core:
                             f"{type(spec['world']).__name__}") from None
         self.model = spec["model"]
         self.K = whole_number(num_envs, "num_envs", 1)
+        # Each is a World of its own: a huge count filled memory for ever
+        # building the slots before anything said no.
+        if self.K > MAX_NUM_ENVS:
+            raise ValueError(f"num_envs must be at most {MAX_NUM_ENVS:,} (each is a world of its "
+                             f"own), got {self.K:,}")
         self.slots = [_WorldSlot(k) for k in range(self.K)]
         self.parallel = True  # step the worlds with swarmsim.step_worlds where it exists
         self.reset_failures = 0  # World.reset calls that failed (the world was loaded again)

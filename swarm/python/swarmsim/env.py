@@ -350,7 +350,10 @@ def _metric_reward(name):
         if name in metrics:
             value = float(metrics[name])
             return np.full(core.N, value if np.isfinite(value) else 0.0)
-        values = np.asarray(world.robot_metric(name), dtype=np.float64)
+        try:
+            values = np.asarray(world.robot_metric(name), dtype=np.float64)
+        except KeyError:  # no robot has recorded it yet (sim.recordMetric from a later step)
+            return np.zeros(core.N)
         robots = world.robots
         mine = values[[i for i, m in enumerate(robots["models"]) if m == core.model]]
         out = np.zeros(core.N)
