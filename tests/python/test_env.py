@@ -585,6 +585,31 @@ class RewardTest(unittest.TestCase):
         env.close()
 
 
+    def test_the_environment_is_not_called_again_from_its_own_reward(self):
+        # env.reset() in the reward lost the episode's truncation; env.step() in it
+        # stepped the world twice; world.step() in it desynchronised the step count.
+        holder = {}
+        calls = {
+            "reset": lambda: holder["env"].reset(seed=5),
+            "step": lambda: holder["env"].step({}),
+            "close": lambda: holder["env"].close(),
+        }
+        for name, call in calls.items():
+            env = make(3, reward=lambda w, a, call=call: (call(), 0.0)[1], max_steps=3)
+            holder["env"] = env
+            env.reset(seed=1)
+            with self.assertRaisesRegex(RuntimeError, rf"ParallelEnv.{name}\(\): called from "
+                                                      rf"inside the environment's own reward"):
+                env.step({a: np.zeros(2) for a in env.agents})
+            env.close()
+        env = make(3, terminate=lambda w, a: (w.step(1), False)[1], max_steps=3)
+        env.reset(seed=1)
+        with self.assertRaisesRegex(RuntimeError, r"the reward or terminate function stepped the "
+                                                  r"world \(\d+ -> \d+ steps\)"):
+            env.step({a: np.zeros(2) for a in env.agents})
+        env.close()
+
+
 class DeclarationTest(unittest.TestCase):
     def test_bad_declarations_are_clear_errors(self):
         with self.assertRaisesRegex(TypeError, "the world must be a path .* not NoneType"):

@@ -100,6 +100,9 @@ class Core:
 
     def __init__(self, spec, num_envs):
         self.spec = spec
+        # The user's reward or terminate function is running: the environment's own
+        # calls are refused from it (env.py, _one_thread_at_a_time).
+        self.in_callback = None
         try:  # str() made None 'None' ("world file 'None' not found"), bytes "b'...'"
             self.path = os.fsdecode(spec["world"])
         except TypeError:
@@ -479,10 +482,23 @@ class Core:
                 world = self.slots[k].world
                 arrays = self.agent_arrays(k)
                 arrays.active = acting[j]
+                steps = world.steps
                 if batched is None:
-                    rewards[j] = reward(world, arrays, self, k)
+                    self.in_callback = "reward"
+                    try:
+                        rewards[j] = reward(world, arrays, self, k)
+                    finally:
+                        self.in_callback = None
                 if terminate is not None:
-                    done[j] |= _bools(terminate(world, arrays), self.N, "terminate")
+                    self.in_callback = "terminate"
+                    try:
+                        done[j] |= _bools(terminate(world, arrays), self.N, "terminate")
+                    finally:
+                        self.in_callback = None
+                if world.steps != steps:  # its episode's count and flags would be wrong
+                    raise RuntimeError(
+                        f"the reward or terminate function stepped the world ({steps} -> "
+                        f"{world.steps} steps): read it there, the environment steps it")
         terminated = done & acting
         self.terminated[ks] |= terminated  # True from its step until the world resets
         if self.max_steps is not None:

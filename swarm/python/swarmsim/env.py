@@ -189,6 +189,12 @@ def _one_thread_at_a_time(method):
     @functools.wraps(method)
     def call(self, *args, **kwargs):
         me = threading.get_ident()
+        core = self.__dict__.get("_core")
+        if core is not None and getattr(core, "in_callback", None):
+            raise RuntimeError(
+                f"{type(self).__name__}.{method.__name__}(): called from inside the "
+                f"environment's own {core.in_callback} function, which runs within a step; "
+                f"call it after step() returns")
         with _CALLS:
             owner, depth = self.__dict__.get("_caller", (None, 0))
             if owner is not None and owner != me:
