@@ -585,6 +585,17 @@ class RewardTest(unittest.TestCase):
         env.close()
 
 
+    def test_world_options_the_environment_sets_itself_are_refused_by_name(self):
+        # seed= gave pybind11's "got multiple values for keyword argument 'seed'"; a
+        # controller of the agents' own model was dropped without a word.
+        for key, instead in (("seed", "reset"), ("threads", "threads="), ("set", "set=")):
+            with self.assertRaisesRegex(ValueError, rf"^world_options: '{key}' is the "
+                                                    rf"environment's own: use {instead}"):
+                make(2, world_options={key: 1})
+        with self.assertRaisesRegex(ValueError, r"world_options: controllers of 'footbot', the "
+                                                r"agents' model"):
+            make(2, world_options={"controllers": {"footbot": lambda *a: None}}).reset(seed=1)
+
     def test_the_environment_is_not_called_again_from_its_own_reward(self):
         # env.reset() in the reward lost the episode's truncation; env.step() in it
         # stepped the world twice; world.step() in it desynchronised the step count.

@@ -257,6 +257,10 @@ class Core:
             slot.world = None
         options = dict(self.spec["world_options"])
         controllers = dict(options.pop("controllers", {}))
+        if self.model in controllers:  # it was replaced without a word
+            raise ValueError(f"world_options: controllers of '{self.model}', the agents' model: "
+                             f"the environment's actions drive it (controllers are for other "
+                             f"models)")
         controllers[self.model] = self._controller(slot)
         if not self.spec["keep_scripts"]:
             if not has_keep_scripts():

@@ -212,6 +212,21 @@ def _one_thread_at_a_time(method):
     return call
 
 
+def _world_options(options):
+    """world_options as a new dict: World's own arguments the environment does not set
+    itself (it gave pybind11's "got multiple values for keyword argument 'seed'")."""
+    if options is None:
+        return {}
+    if not isinstance(options, Mapping):
+        raise TypeError(f"world_options must be a dict (or None), got {type(options).__name__}")
+    options = dict(options)
+    for key, instead in (("path", "the environment's world"), ("seed", "reset(seed=...)"),
+                         ("set", "set="), ("threads", "threads=")):
+        if key in options:
+            raise ValueError(f"world_options: '{key}' is the environment's own: use {instead}")
+    return options
+
+
 def _options(options):
     """reset's options as a new dict: a mapping or None, else TypeError."""
     if options is None:
@@ -430,11 +445,12 @@ def _spec(world, observations, actions, reward, terminate, max_steps, model, see
         raise ValueError(f"step_threads is 0 (every core) or 1 to 256, got {step_threads}")
     if seed is not None:
         seed = whole_number(seed, "seed")
+    world_options = _world_options(world_options)
     return {
         "world": world, "observations": [_observation(o) for o in observations],
         "actions": actions, "reward": _reward(reward), "terminate": terminate,
         "max_steps": max_steps, "model": model, "seed": seed, "set": dict(set or {}),
-        "threads": threads, "world_options": dict(world_options or {}),
+        "threads": threads, "world_options": world_options,
         "keep_scripts": _flag(keep_scripts, "keep_scripts"), "step_threads": int(step_threads),
     }
 
