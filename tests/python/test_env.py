@@ -7,6 +7,7 @@ import importlib.util
 import math
 import os
 import unittest
+import warnings
 
 import numpy as np
 
@@ -545,10 +546,20 @@ class RewardTest(unittest.TestCase):
             make(2, reward="mean_nearest_neighbour_distance")
         # A robot-level one: the robots record it, and until they do it is 0
         # (it was a KeyError at every step before the first sim.recordMetric).
-        env = make(2, reward="my_own_robot_metric")
+        # A name no robot ever records (misspelt) is said once, after 100 steps of 0.
+        env = make(2, reward="my_own_robot_metric", max_steps=None)
         env.reset(seed=1)
-        _, rewards, *_ = env.step({a: np.zeros(2) for a in env.agents})
-        self.assertEqual(set(rewards.values()), {0.0})
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            for _ in range(99):
+                _, rewards, *_ = env.step({a: np.zeros(2) for a in env.agents})
+                self.assertEqual(set(rewards.values()), {0.0})
+            self.assertEqual(caught, [])
+            for _ in range(5):
+                env.step({a: np.zeros(2) for a in env.agents})
+        self.assertEqual(len(caught), 1)
+        self.assertIn("no robot has recorded metric 'my_own_robot_metric' in 100 steps",
+                      str(caught[0].message))
         env.close()
 
     def test_a_swarm_metric_as_the_reward(self):

@@ -39,6 +39,7 @@ See swarm/python/README.md for the full reference.
 
 import functools
 import threading
+import warnings
 from collections.abc import Mapping
 
 import numpy as np
@@ -365,7 +366,14 @@ def _distance_batched(core, ks):
 _distance_reward.batched = _distance_batched
 
 
+# Steps a robot-level metric reward may go unrecorded before a warning that its name may
+# be misspelt (it is 0 until the robots record it).
+_UNRECORDED_METRIC_STEPS = 100
+
+
 def _metric_reward(name):
+    unrecorded = [0]  # steps without a value; -1 once warned or seen
+
     def reward(world, agents, core, k):
         metrics = world.metrics
         if name in metrics:
@@ -373,8 +381,16 @@ def _metric_reward(name):
             return np.full(core.N, value if np.isfinite(value) else 0.0)
         try:
             values = np.asarray(world.robot_metric(name), dtype=np.float64)
-        except KeyError:  # no robot has recorded it yet (sim.recordMetric from a later step)
+        except KeyError as e:  # no robot has recorded it yet (sim.recordMetric from a later step)
+            if unrecorded[0] >= 0 and k == 0:  # a step of the first environment: one a step
+                unrecorded[0] += 1
+                if unrecorded[0] >= _UNRECORDED_METRIC_STEPS:
+                    unrecorded[0] = -1
+                    warnings.warn(f"reward: no robot has recorded metric '{name}' in "
+                                  f"{_UNRECORDED_METRIC_STEPS} steps, so every reward is 0: is it "
+                                  f"the name the scripts record? ({e.args[0]})", stacklevel=2)
             return np.zeros(core.N)
+        unrecorded[0] = -1
         robots = world.robots
         mine = values[[i for i, m in enumerate(robots["models"]) if m == core.model]]
         out = np.zeros(core.N)

@@ -506,9 +506,7 @@ TEST(VideoCli, BadVideoOptionsAreNamedAndStopTheRunBeforeItStarts) {
                           "' is a file that is not a video: the video would go over it"),
             std::string::npos)
       << r.output;
-  std::ifstream script(dir / "bot.lua");
-  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(script), {}),
-            "function sysCall_init() end\n");
+  EXPECT_EQ(testing::ReadFile(dir / "bot.lua"), "function sysCall_init() end\n");
   // A name that is not .mp4: an MP4 all the same, and a note says so (.MP4 is no surprise).
   r = RunProgram("run " + world + " --steps 1 --video " + (dir / "film.avi").string());
   EXPECT_EQ(r.exit_code, 0) << r.output;

@@ -118,10 +118,8 @@ TEST(ExamplesTest, DiffusionWithNoisySensorsAndWheelsSpreadsLikeTheNoiselessOne)
 // 60% of them touching another or a wall after two minutes: mean
 // nearest-neighbour distance 0.34 m against diffusion's 0.55).
 TEST(ExamplesTest, TheReadmesControllerSpreadsTheRobotsAsDiffusionDoes) {
-  std::ifstream readme(std::string(SWARMSIM_SOURCE_DIR) + "/README.md");
-  std::stringstream text;
-  text << readme.rdbuf();
-  const std::string s = text.str();
+  const std::string s =
+      swarmsim::testing::ReadFile(std::string(SWARMSIM_SOURCE_DIR) + "/README.md");
   const size_t section = s.find("### A controller");
   ASSERT_NE(section, std::string::npos);
   const size_t begin = s.find("```lua\n", section);

@@ -135,8 +135,7 @@ TEST(RecordCliTest, TextThatIsNotUtf8IsRecordedAsInTheOtherOutputs) {
       ++samples;
     }
   EXPECT_EQ(samples, 3);
-  std::ifstream csv(out / "metrics.csv");
-  const std::string text((std::istreambuf_iterator<char>(csv)), {});
+  const std::string text = testing::ReadFile(out / "metrics.csv");
   EXPECT_NE(text.find(",m\xef\xbf\xbd,1"), std::string::npos) << text;
   fs::remove_all(dir);
 }
