@@ -659,6 +659,9 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
       return bad_input(e.what());
     }
   }
+  // The process ends without returning here: the folder's lock file stayed
+  // (the next run took it over, but it looked like a run still writing).
+  if (out_lock) options.on_stuck_exit = [&out_lock] { out_lock->Release(); };
   // Snapshots: checked (and a state loaded) before the run starts.
   if (!args.save_state.empty() || !args.load_state.empty()) {
     const std::string why = loaded.world->SnapshotRefusal();

@@ -115,6 +115,8 @@ py::dict PyWorld::Run(std::optional<int64_t> steps, const std::optional<std::str
     if (const std::string note = RemoveEarlierOutputs(dir); !note.empty())
       std::cerr << "note: " << ValidUtf8(note) << std::endl;
     options.out_dir = dir;
+    // A stuck step ends the process without returning here (its lock stayed).
+    options.on_stuck_exit = [&out_lock] { out_lock->Release(); };
   }
   FlushPythonStreams();  // before the run's own lines
   RunResult result;

@@ -623,7 +623,7 @@ Array PyWorld::robot_metric(const std::string& name) {
   const ModelLayout& layout = Layout("");
   const auto it = robot_metrics_.find(name);
   if (it == robot_metrics_.end() && !IsMetric(name))
-    throw py::key_error("no robot-level metric '" + name + "' (" + MetricList() + ")");
+    throw py::key_error("no robot-level metric '" + name + "' (" + RobotMetricList() + ")");
   Array a(static_cast<py::ssize_t>(layout.robots.size()));
   double* d = a.mutable_data();
   for (size_t i = 0; i < layout.robots.size(); ++i) {
@@ -667,6 +667,18 @@ std::string PyWorld::MetricList() const {
   std::string list;
   for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
   return list.empty() ? "the world records none so far" : "known: " + list;
+}
+
+std::string PyWorld::RobotMetricList() const {
+  std::string list, swarm;
+  for (const auto& [name, values] : robot_metrics_) list += (list.empty() ? "" : ", ") + name;
+  std::set<std::string> declared(loaded_.metric_names.begin(), loaded_.metric_names.end());
+  for (const std::string& n : declared) swarm += (swarm.empty() ? "" : ", ") + n;
+  std::string text =
+      list.empty() ? "the robots have recorded none so far" : "the robots have recorded: " + list;
+  if (!swarm.empty())
+    text += "; the world's swarm-level metrics, read with metrics and metric_history: " + swarm;
+  return text;
 }
 
 std::vector<std::string> PyWorld::ModelNames() const {

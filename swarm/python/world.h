@@ -198,6 +198,9 @@ class PyWorld {
   // The world file's metrics and any sampled so far (scripts' sim.recordMetric).
   bool IsMetric(const std::string& name) const;
   std::string MetricList() const;
+  // robot_metric's KeyError: the robot-level names recorded so far, then the
+  // declared swarm-level ones (not read there).
+  std::string RobotMetricList() const;
   std::vector<std::string> ModelNames() const;
   bool HasModel(const std::string& model) const;
 

@@ -31,10 +31,13 @@ FileLock::FileLock(std::string path) : path_(std::move(path)) {
   }
 }
 
-FileLock::~FileLock() {
+FileLock::~FileLock() { Release(); }
+
+void FileLock::Release() {
   if (fd_ < 0) return;
   ::unlink(path_.c_str());  // removed while still held
   ::close(fd_);
+  fd_ = -1;
 }
 
 }  // namespace swarmsim

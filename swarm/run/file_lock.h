@@ -20,6 +20,9 @@ class FileLock {
   // Whether this process holds it; if not, another does: holder() is its
   // process id as it wrote it ("" if it wrote none yet).
   bool held() const { return fd_ >= 0; }
+  // Removes the file and lets the lock go now (a run that ends without
+  // returning: a stuck step's watchdog). Nothing if not held; idempotent.
+  void Release();
   const std::string& holder() const { return holder_; }
 
  private:

@@ -341,6 +341,7 @@ void StepWatched(World* world, const RunOptions& options, Clock::time_point star
     if (options.out_dir && std::filesystem::is_directory(*options.out_dir))
       std::cerr << OutputsOfFinishedSteps(stuck.steps, *options.out_dir) << "\n";
     std::cerr.flush();
+    if (options.on_stuck_exit) options.on_stuck_exit();
     std::_Exit(signal != 0 ? 128 + signal : 1);  // 1: the run failed, as main's
   };
   // A step may take simulation.step_timeout; the start and the stop of the

@@ -54,6 +54,10 @@ struct RunOptions {
   // the video's end and the recording's end chunk, before summary.json is
   // written. (A run that returns is the caller's to close.)
   std::function<void(const RunResult&)> on_stuck_end;
+  // Called last when the watchdog ends the run, after summary.json, just
+  // before the process exits: what the caller would release on return (the
+  // output folder's lock file).
+  std::function<void()> on_stuck_exit;
   // Called with each step's metric samples (after metrics.csv has them),
   // from the run's thread: the Python World keeps its history from them.
   // Null: with out_dir, metrics.csv takes them; else the world keeps them.

@@ -517,6 +517,28 @@ class LeavingRobotsTest(unittest.TestCase):
         env.close()
 
 
+    def test_a_vector_agent_gone_in_the_resets_first_step_is_terminated(self):
+        # Half the robots fail in the warm-up step (failure_rate 5/s, 0.1 s steps): those
+        # agents never act. Their termination stayed False for the whole episode.
+        venv = senv.VectorEnv(world("respawn.yaml"), 2, max_steps=None,
+                              set={"robots": 8, "failure_rate": 5.0},
+                              observations=["proximity"])
+        _, infos = venv.reset(seed=3)
+        gone = ~infos["active"]
+        self.assertTrue(gone.any() and not gone.all(axis=1).any(), gone)
+        going = np.ones(2, dtype=bool)  # environments whose first episode goes on
+        for _ in range(3):
+            _, rewards, terminations, truncations, infos = venv.step(np.zeros((2, 8, 2)))
+            for k in np.flatnonzero(going):
+                self.assertTrue(terminations[k][gone[k]].all(), (k, terminations))
+                self.assertFalse(truncations[k][gone[k]].any())
+                self.assertEqual(set(rewards[k][gone[k]]), {0.0})
+                self.assertFalse(infos["active"][k][gone[k]].any())
+            going &= infos["active"].any(axis=1)  # an ended one resets at the next step
+        self.assertTrue(going.any())
+        venv.close()
+
+
 class RewardTest(unittest.TestCase):
     def test_a_reward_function_sees_the_agents_arrays(self):
         seen = []
@@ -1006,6 +1028,27 @@ class ThreadsTest(unittest.TestCase):
         self.assertEqual(list(venv.episode_steps), [2, 2])
         self.assertEqual([w.steps for w in venv.worlds], [3, 3])
         venv.close()
+
+
+class WrapperAttributesTest(unittest.TestCase):
+    def test_unwrapped_spec_and_np_random_are_there_without_the_libraries(self):
+        # Wrappers and training code read them (AttributeError without Gymnasium/PettingZoo).
+        p = make(2)
+        self.assertIs(p.unwrapped, p)
+        p.close()
+        v = senv.VectorEnv(DIFFUSION, 2, set={"robots": 2})
+        self.assertIs(v.unwrapped, v)
+        self.assertIsNone(v.spec)
+        self.assertIsInstance(v.np_random, np.random.Generator)
+        self.assertEqual(v.get_wrapper_attr("num_envs"), 2)
+        v.reset(seed=11)  # seeds np_random as Gymnasium's VectorEnv.reset does
+        self.assertEqual(v.np_random_seed, 11)
+        first = v.np_random.random(4)
+        v.reset(seed=11)
+        np.testing.assert_array_equal(v.np_random.random(4), first)
+        v.reset(seed=12)
+        self.assertFalse(np.array_equal(v.np_random.random(4), first))
+        v.close()
 
 
 class LibrariesTest(unittest.TestCase):

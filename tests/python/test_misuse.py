@@ -351,7 +351,11 @@ class MisuseTest(unittest.TestCase):
             w.step(10)
             steps, values = w.metric_history("mean_nearest_neighbor_distance")
             assert list(steps) == [10], steps
-            expect(KeyError, "no robot-level metric 'nope'", w.robot_metric, "nope")
+            # The robot-level names are listed as such, the swarm-level ones apart
+            # (they were listed as known robot-level metrics).
+            e = expect(KeyError, "no robot-level metric 'nope' (the robots have recorded none "
+                       "so far; the world's swarm-level metrics, read with metrics and "
+                       "metric_history: mean_nearest_neighbor_distance", w.robot_metric, "nope")
         """)
 
     def test_complex_bool_and_nan_actions_are_refused_naming_the_robot(self):

@@ -504,7 +504,9 @@ class Core:
                         f"the reward or terminate function stepped the world ({steps} -> "
                         f"{world.steps} steps): read it there, the environment steps it")
         terminated = done & acting
-        self.terminated[ks] |= terminated  # True from its step until the world resets
+        # True from its step until the world resets; an agent whose robot was gone before
+        # it ever acted (removed in the reset's first step) too, from the episode's first.
+        self.terminated[ks] |= terminated | ~self.present[ks]
         if self.max_steps is not None:
             limit = (self.episode_steps[ks] >= self.max_steps)[:, None]
             self.truncated[ks] = acting & ~terminated & limit

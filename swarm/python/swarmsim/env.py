@@ -494,7 +494,7 @@ def _check_actions(core, acts, name_of, clip):
     clipped = np.clip(acts.astype(np.float64), bounds.low, bounds.high)
     if clip:
         # NaN stays an error; +-inf is clipped like any value past a bound (it was
-        # refused), unless that side of the space is unbounded.
+        # refused). The bounds are finite (JointTargets.bind), so only NaN is left here.
         bad = ~np.isfinite(clipped).all(axis=-1)
         if bad.any():
             m = int(np.argmax(bad))
@@ -540,10 +540,19 @@ class _AgentsOfAModel:
 
 # --- The PettingZoo-style environment ----------------------------------------------------
 
+class _ParallelFallback:
+    """What PettingZoo's ParallelEnv gives its subclasses, for when it is not installed."""
+
+    @property
+    def unwrapped(self):
+        """The environment itself (no wrapper around it)."""
+        return self
+
+
 try:  # a subclass of PettingZoo's ParallelEnv when PettingZoo is installed
     from pettingzoo import ParallelEnv as _ParallelBase
 except ImportError:
-    _ParallelBase = object
+    _ParallelBase = _ParallelFallback
 
 
 class ParallelEnv(_AgentsOfAModel, _ParallelBase):
@@ -737,8 +746,65 @@ try:  # Gymnasium's VectorEnv and autoreset modes when Gymnasium is installed
     except ImportError:
         NEXT_STEP = "NextStep"
 except ImportError:
-    _VectorBase = object
+    _VectorBase = None
     NEXT_STEP = "NextStep"
+
+
+def _seed_np_random(env, seed):
+    """env.np_random from `seed` (None: drawn at random), as Gymnasium's seeding.np_random
+    makes it; also with Gymnasium's own VectorEnv, whose np_random reads these attributes."""
+    if seed is None:
+        seed = int(np.random.SeedSequence().entropy)
+    env._np_random, env._np_random_seed = np.random.default_rng(seed), seed
+
+
+class _VectorFallback:
+    """What Gymnasium's VectorEnv gives its subclasses, for when it is not installed: `spec`
+    (None: not made by gymnasium.make_vec), `unwrapped`, `np_random` (a numpy Generator,
+    seeded at random on first use, or by ``reset(seed=int)``) and `np_random_seed` (-1 once
+    a Generator is set)."""
+
+    spec = None
+    _np_random = None
+    _np_random_seed = None
+
+    @property
+    def unwrapped(self):
+        """The environment itself (no wrapper around it)."""
+        return self
+
+    @property
+    def np_random(self):
+        """The environment's own numpy Generator (not the worlds': they have their seeds)."""
+        if self._np_random is None:
+            self._seed_np_random(None)
+        return self._np_random
+
+    @np_random.setter
+    def np_random(self, value):
+        self._np_random, self._np_random_seed = value, -1
+
+    @property
+    def np_random_seed(self):
+        """The seed `np_random` was made from (-1: a Generator set, or drawn at random)."""
+        if self._np_random is None:
+            self._seed_np_random(None)
+        return self._np_random_seed
+
+    def _seed_np_random(self, seed):
+        _seed_np_random(self, seed)
+
+    def get_wrapper_attr(self, name):
+        """getattr(self, name): no wrapper to look through."""
+        return getattr(self, name)
+
+    def set_wrapper_attr(self, name, value):
+        """setattr(self, name, value)."""
+        setattr(self, name, value)
+
+
+if _VectorBase is None:
+    _VectorBase = _VectorFallback
 
 
 class VectorEnv(_AgentsOfAModel, _VectorBase):
@@ -865,6 +931,8 @@ class VectorEnv(_AgentsOfAModel, _VectorBase):
                 raise ValueError(f"reset: options['poses'] must be (K={K}, N, 3 or 7), got "
                                  f"shape {np.shape(poses)}")
             poses = [core.checked_poses(poses[k]) for k in range(K)]
+        if seed is not None and np.ndim(seed) == 0:
+            _seed_np_random(self, seeds[0])  # as Gymnasium's VectorEnv.reset does
         for k in ks:
             core.reset_world(k, seeds[k], None if poses is None else poses[k])
         self._step_some(ks)

@@ -252,6 +252,7 @@ TEST(RunOutputsTest, AStuckStartEndsTheRunWithALimitThatGrowsWithTheRobots) {
     const auto summary = nlohmann::json::parse(ReadFile(dir / "out" / "summary.json"));
     EXPECT_EQ(summary["status"], "error");
     EXPECT_EQ(summary["steps"], 0);
+    EXPECT_FALSE(fs::exists(dir / "out" / ".swarmsim-lock")) << "left by the ended run";
   }
   fs::remove_all(dir);
 }
@@ -275,6 +276,8 @@ TEST(RunOutputsTest, StuckStepFinishesTheVideoTheSummaryCounts) {
   while (reader.Next(&frame)) ++frames;
   EXPECT_EQ(frames, 4) << "steps 0 to 3, each a frame at 10 frames/s";
   EXPECT_NE(description.find(", 4 frames, "), std::string::npos) << description;
+  // Its folder's lock went with the process and is not left behind.
+  EXPECT_FALSE(fs::exists(dir / "out" / ".swarmsim-lock"));
   fs::remove_all(dir);
 }
 
