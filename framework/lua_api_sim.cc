@@ -9,6 +9,7 @@
 #include "framework/error.h"
 #include "framework/lua_api.h"
 #include "framework/registry.h"
+#include "framework/utf8.h"
 #include "framework/world.h"
 
 namespace swarmsim {
@@ -139,17 +140,22 @@ int Print(lua_State* L) {
     throw Error("the scripts of " + c.name + " printed more than " +
                 std::to_string(kMaxPrintBytesPerStep >> 20) +
                 " MiB in this step (the most a robot may print in one step); a print in a loop?");
-  const uint64_t bytes = c.log_prefix.size() + printed + kHeldEntryBytes;
-  ChargeScriptData(L, bytes, "the printed line");
-  rt.printed_bytes += printed;
-  rt.log_bytes += bytes;
+  // Each line of the text gets the robot's prefix (a "\n[footbot#7] ..."
+  // in one robot's print read as another's line, an "\nerror: ..." as the
+  // run's), and terminal controls are escaped (an ESC recoloured or cleared
+  // the console). Charged as written.
   std::string line = c.log_prefix;
+  const std::string newline = "\n" + c.log_prefix;
   for (int i = 1; i <= n; ++i) {
     size_t length = 0;
     const char* text = lua_tolstring(L, n + i, &length);
     if (i > 1) line += '\t';
-    line.append(text, length);
+    line += EscapeControls(std::string_view(text, length), newline);
   }
+  const uint64_t bytes = line.size() + 1 + kHeldEntryBytes;
+  ChargeScriptData(L, bytes, "the printed line");
+  rt.printed_bytes += printed;
+  rt.log_bytes += bytes;
   rt.log.Add(std::move(line));
   return 0;
 }

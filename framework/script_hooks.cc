@@ -169,6 +169,7 @@ void* LimitedAlloc(void* ud, void* ptr, size_t osize, size_t nsize) {
     return p;
   }
   const size_t grow = nsize - old;
+  const size_t retry_of = std::exchange(m.retry_size, 0);  // this call may be the retry
   const uint64_t limit = account.limit();
   const uint64_t after = account.used() + grow;
   bool refuse = limit > 0 && (after > limit + kMemorySlack || after < account.used());
@@ -178,6 +179,8 @@ void* LimitedAlloc(void* ud, void* ptr, size_t osize, size_t nsize) {
     if (refuse) {
       m.refused_by_run = by_run;
       m.refused_bytes = grow;
+      m.retry_block = ptr;
+      m.retry_size = nsize;
       // Lua raises LUA_ERRMEM for it, which names no line: where it was
       // asked for is noted now, while the stack is there (ErrorText).
       m.refusal_bytes = grow;
@@ -208,6 +211,11 @@ void* LimitedAlloc(void* ud, void* ptr, size_t osize, size_t nsize) {
     return nullptr;
   }
   m.used += grow;
+  // A refusal Lua recovered from fails nothing: its emergency collection
+  // freed enough and this is its retry of the same request. The hook raised
+  // it anyway (a script whose last step's garbage would have made room
+  // failed). A refusal Lua raised stays one pcall cannot catch.
+  if (retry_of == nsize && m.retry_block == ptr) m.refused_bytes = 0;
   return p;
 }
 

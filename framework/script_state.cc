@@ -11,6 +11,7 @@
 
 #include "framework/error.h"
 #include "framework/scene.h"
+#include "framework/utf8.h"
 #include "framework/world.h"
 
 namespace swarmsim::lua_host {
@@ -171,17 +172,11 @@ std::string ErrorText(lua_State* L, int status) {
   if (status != LUA_ERRRUN && status != LUA_ERRSYNTAX && status != LUA_ERRERR)
     return "internal error: a C++ exception crossed a Lua frame (please report this)";
   if (lua_type(L, -1) == LUA_TSTRING) {
-    // Whole, also past a NUL byte (shown as \0: a C string would end there).
+    // Whole, also past a NUL byte (shown as \0: a C string would end there),
+    // its terminal controls escaped (an error('\27[2J') cleared the console).
     size_t length = 0;
     const char* text = lua_tolstring(L, -1, &length);
-    std::string message;
-    for (size_t i = 0; i < length; ++i) {
-      if (text[i] == '\0')
-        message += "\\0";
-      else
-        message += text[i];
-    }
-    return message;
+    return EscapeControls(std::string_view(text, length));
   }
   return std::string("(error object is a ") + luaL_typename(L, -1) + " value)";
 }

@@ -86,6 +86,11 @@ struct LuaMemory {
   ScriptMemory* account = &own;  // the robot's (World::script_memory)
   bool refused_by_run = false;   // the last allocation refused was refused by the run's limit
   size_t refused_bytes = 0;  // the size of a refused allocation MemoryHook has not reported, or 0
+  // The refused request (block and new size) while Lua may retry it after
+  // its emergency collection: the next growing call. Equal and granted: the
+  // refusal is forgotten (refused_bytes 0). retry_size 0: none pending.
+  const void* retry_block = nullptr;
+  size_t retry_size = 0;
   // The last allocation refused in the running callback, for the error Lua
   // raises then (LUA_ERRMEM: Lua calls no message handler for it, and the
   // host sees its stack unwound): its size, and where it was asked for.

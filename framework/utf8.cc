@@ -75,4 +75,37 @@ std::string ValidUtf8(std::string_view text) {
   return out;
 }
 
+std::string EscapeControls(std::string_view text, std::string_view newline) {
+  static constexpr char kHex[] = "0123456789abcdef";
+  std::string out;
+  out.reserve(text.size());
+  for (size_t i = 0; i < text.size(); ++i) {
+    const auto c = static_cast<uint8_t>(text[i]);
+    if (c == '\n') {
+      out += newline;
+    } else if (c == '\t' || (c >= 0x20 && c != 0x7f && c != 0xc2)) {
+      out += static_cast<char>(c);
+    } else if (c == 0xc2) {  // U+0080..U+00BF: C1 controls up to U+009F
+      const auto next = i + 1 < text.size() ? static_cast<uint8_t>(text[i + 1]) : 0;
+      if (next >= 0x80 && next <= 0x9f) {
+        out += "\\u00";
+        out += kHex[next >> 4];
+        out += kHex[next & 15];
+        ++i;
+      } else {
+        out += static_cast<char>(c);
+      }
+    } else if (c == 0) {
+      out += "\\0";
+    } else if (c == '\r') {
+      out += "\\r";
+    } else {
+      out += "\\x";
+      out += kHex[c >> 4];
+      out += kHex[c & 15];
+    }
+  }
+  return out;
+}
+
 }  // namespace swarmsim

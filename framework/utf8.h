@@ -17,4 +17,12 @@ std::string ValidUtf8(std::string_view text);
 // Whether ValidUtf8(text) would change nothing.
 bool IsValidUtf8(std::string_view text);
 
+// `text` with the control characters a terminal acts on written as escapes,
+// for a script's printed line or error message: the C0 bytes but tab and
+// newline (NUL as \0, CR as \r, ESC as \x1b, ...), DEL (\x7f) and the C1
+// code points U+0080..U+009F in UTF-8 (\u009b). Each newline becomes
+// `newline` (a printed line's next lines get the robot's prefix). Other
+// bytes, invalid UTF-8 included, are unchanged (ValidUtf8's work).
+std::string EscapeControls(std::string_view text, std::string_view newline = "\n");
+
 }  // namespace swarmsim

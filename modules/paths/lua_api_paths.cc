@@ -24,7 +24,9 @@
 //     a step); only the conveyor's own robot's scripts (or a scene script)
 //     may set it
 // `h` is a conveyor or one of its children (a belt segment).
+#include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <memory>
 #include <string>
 #include <utility>
@@ -34,6 +36,7 @@
 #include "framework/lua_api.h"
 #include "framework/object_type.h"
 #include "framework/scene.h"
+#include "framework/suggest.h"
 #include "modules/paths/rows.h"
 #include "modules/paths/types.h"
 
@@ -149,6 +152,9 @@ int RawField(lua_State* L, int arg, const char* key) {
   return lua_rawget(L, arg);
 }
 
+// The shortest segment a path may have.
+constexpr double kMinSegment = 1e-9;  // m
+
 int CreatePath(lua_State* L) {
   const LuaContext& c = Context(L);
   Scene& scene = *c.scene;
@@ -172,9 +178,14 @@ int CreatePath(lua_State* L) {
     }
     lua_pop(L, 1);
     points.push_back({v[0], v[1], v[2]});
-    if (points.size() > 1 && points.back() == points[points.size() - 2])
+    // Not only a repeated point: 1e-300 m from the last gave a path of
+    // length 0 whose poses were NaN.
+    if (points.size() > 1 && (points.back() - points[points.size() - 2]).Norm() < kMinSegment)
       throw Error("bad argument #1 (point " + std::to_string(i) +
-                  " repeats the one before: a path segment must have a length)");
+                  (points.back() == points[points.size() - 2]
+                       ? std::string(" repeats the one before")
+                       : " is less than 1e-9 m from the one before") +
+                  ": a path segment must have a length)");
   }
   // The options.
   std::string name = "path";
@@ -184,6 +195,19 @@ int CreatePath(lua_State* L) {
   double velocity = 0;
   if (!lua_isnoneornil(L, 2)) {
     ArgType(L, 2, LUA_TTABLE);
+    // An option misspelt was dropped without a word ({velocty = 0.5}: a
+    // path that never moved).
+    static const std::string kOptions[] = {"name", "parent", "closed", "interpolation", "velocity"};
+    lua_pushnil(L);
+    while (lua_next(L, 2) != 0) {
+      lua_pop(L, 1);  // the value; the key stays for lua_next
+      const std::string key = lua_type(L, -1) == LUA_TSTRING ? lua_tostring(L, -1) : "";
+      if (std::find(std::begin(kOptions), std::end(kOptions), key) == std::end(kOptions))
+        throw Error("bad argument #2 (" +
+                    (key.empty() ? std::string("options are named: a key that is not a string")
+                                 : "no option '" + key + "'" + Suggest(key, kOptions)) +
+                    ")");
+    }
     if (RawField(L, 2, "name") != LUA_TNIL) {
       if (!lua_isstring(L, -1)) throw Error("bad argument #2 (options.name: a string expected)");
       name = lua_tostring(L, -1);
@@ -214,7 +238,7 @@ int CreatePath(lua_State* L) {
     }
     lua_pop(L, 1);
   }
-  if (closed && points.back() == points.front())
+  if (closed && (points.back() - points.front()).Norm() < kMinSegment)
     throw Error(
         "bad argument #1 (the last point repeats the first: a closed path already joins "
         "them)");

@@ -1,5 +1,6 @@
 #include "swarm/bench/bench.h"
 
+#include <fcntl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -46,6 +47,15 @@ std::vector<fs::path> BenchPluginDirectories() {
 constexpr const char* kCsvHeader =
     "config,robots,threads,steps,wall_s,robot_ticks_per_s,us_sense,us_control,us_actuate,"
     "us_physics,us_record,peak_rss_mb,kb_per_robot,startup_s";
+
+// The first lines of the CSV files bench writes (plain, --scaling-robots,
+// --scaling): a file that starts with none of them is not bench's to
+// overwrite.
+constexpr std::string_view kBenchCsvHeaders[] = {
+    kCsvHeader,
+    "config,world,robots,threads,steps,robot_ticks_per_s,us_sense,us_control,us_physics,"
+    "us_other,us_total,cost_ratio,startup_s,peak_rss_mb,kb_per_robot",
+    "series,workers,throughput,unit,speedup"};
 
 std::string ToCsv(const BenchRow& r) {
   std::ostringstream s;
@@ -254,9 +264,55 @@ void SayNewWarnings(const std::vector<std::string>& warnings, std::set<std::stri
     if (said->insert(warning).second) err << "warning: " << warning << "\n" << std::flush;
 }
 
+void CheckBenchOutput(const std::string& path, const char* flag, BenchOutput kind) {
+  const std::string named = std::string(flag) + " '" + ValidUtf8(path) + "'";
+  std::error_code ec;
+  const fs::file_status status = fs::status(path, ec);
+  if (fs::exists(status)) {
+    if (!fs::is_regular_file(status))
+      throw Error("bench " + named +
+                  ": not a regular file (a folder, a device or a pipe); name a file");
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw Error(std::string("bench ") + flag + ": " + CannotWrite(path));
+    std::string first;
+    if (kind == BenchOutput::kCsv) {
+      std::getline(in, first);
+      if (!first.empty() && first.back() == '\r') first.pop_back();
+    } else {
+      first.resize(8);
+      in.read(first.data(), 8);
+      first.resize(static_cast<size_t>(in.gcount()));
+    }
+    const bool empty = first.empty() && fs::file_size(path, ec) == 0;
+    bool ours = false;
+    if (kind == BenchOutput::kCsv)
+      for (std::string_view header : kBenchCsvHeaders) ours = ours || first == header;
+    else
+      ours = first == std::string_view("\x89PNG\r\n\x1a\n", 8);
+    if (!empty && !ours)
+      throw Error("bench " + named + " is a file that is not " +
+                  (kind == BenchOutput::kCsv ? "a CSV of bench's (its first line is not a bench "
+                                               "header)"
+                                             : "a PNG image") +
+                  ": bench would write over it; name another file, or remove it first");
+    // Writable as it is (opened without truncating it).
+    const int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
+    if (fd < 0) throw Error(std::string("bench ") + flag + ": " + CannotWrite(path));
+    ::close(fd);
+    return;
+  }
+  // A new file: made and removed, so that a missing or read-only folder is
+  // said now, not after the measurements.
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  if (fd < 0) throw Error(std::string("bench ") + flag + ": " + CannotWrite(path));
+  ::close(fd);
+  ::unlink(path.c_str());
+}
+
 int RunBench(BenchOptions options, std::ostream& out, std::ostream& err) {
   // Everything that can be checked is, before the table's header.
   const std::string bare = PrepareBench(&options);
+  if (options.csv) CheckBenchOutput(*options.csv, "--csv", BenchOutput::kCsv);
   std::vector<BenchRow> rows;
   std::unique_ptr<std::ofstream> csv;
   if (options.csv) {

@@ -20,6 +20,17 @@ struct BenchOptions {
   std::string self_exe;  // this program, re-run once per configuration
 };
 
+// What a bench output file is, for CheckBenchOutput.
+enum class BenchOutput { kCsv, kPng };
+
+// Checks, before anything is measured, that bench may write `path` (the
+// value of `flag`, "--csv" or "--plot"): a file that exists must be one
+// bench writes (a CSV whose first line is one of bench's headers, a PNG) or
+// empty, never a world, a script or notes it would write over; a new one
+// must be creatable in its folder (tried, then removed). Throws
+// swarmsim::Error naming the flag and the file.
+void CheckBenchOutput(const std::string& path, const char* flag, BenchOutput kind);
+
 // One measured configuration (one CSV row).
 struct BenchRow {
   std::string config;  // "diffusion" or "box2d-only"

@@ -124,7 +124,8 @@ bool Plot(const std::vector<ScalingRow>& rows, const RobotScalingOptions& o, std
          << "set multiplot layout 1,2 title "
          << Quoted("swarmsim: cost per robot-tick over robot counts (" + ThreadsText(rows) + "; " +
                    (o.steps > 0 ? std::to_string(o.steps) + " measured steps a row"
-                                : std::string("about 2 million measured robot-ticks a row")) +
+                                : std::string("2 million robot-ticks over the robots, 3 to "
+                                              "1,000 steps a row")) +
                    ")")
          << "\n";
   // One robot count: a range about it (gnuplot would warn of an empty one).
@@ -232,6 +233,7 @@ int RunRobotScalingBench(RobotScalingOptions o, std::ostream& out, std::ostream&
     check.world = c.world;
     PrepareBench(&check);
   }
+  CheckScalingOutputs(o.csv, o.plot);
   if (o.threads.empty())
     o.threads = {static_cast<int>(std::max(1u, std::thread::hardware_concurrency()))};
   std::ofstream csv(o.csv);
@@ -240,7 +242,8 @@ int RunRobotScalingBench(RobotScalingOptions o, std::ostream& out, std::ostream&
 
   out << "microseconds per robot-tick by phase (a tick = one robot for one control step); "
          "one process per row;\nsteps: "
-      << (o.steps > 0 ? std::to_string(o.steps) : std::string("about 2,000,000 robot-ticks a row"))
+      << (o.steps > 0 ? std::to_string(o.steps)
+                      : std::string("2,000,000 robot-ticks over the robots, 3 to 1,000 a row"))
       << "; vs 1st: total over the configuration's first robot count; start s: load to first "
          "step\n";
   for (const ScalingConfig& c : o.configs) out << "  " << c.name << ": " << c.world << "\n";

@@ -15,6 +15,7 @@
 
 #include "framework/error.h"
 #include "framework/output_file.h"
+#include "framework/utf8.h"
 
 namespace swarmsim {
 namespace {
@@ -138,8 +139,11 @@ bool PlotSpeedup(const std::map<std::string, std::vector<Point>>& series, int ma
 }  // namespace
 
 int RunScalingBench(ScalingOptions o, std::ostream& out, std::ostream& err) {
-  // The world (default filled in, `robots` parameter) is checked before any output.
+  // The world (default filled in, `robots` parameter) and the outputs are
+  // checked before any output (a folder that is not there was found after
+  // every measurement, which were lost).
   PrepareBench(&o.bench);
+  CheckScalingOutputs(o.csv, o.plot);
   const int cores = Cores();
   if (!o.threads_given) {
     o.bench.threads.clear();
@@ -186,14 +190,27 @@ int RunScalingBench(ScalingOptions o, std::ostream& out, std::ostream& err) {
 }
 
 bool RunGnuplot(const std::string& script, std::ostream& err) {
-  FILE* gp = popen("gnuplot 2>&1", "w");
+  // gnuplot's standard output is not ours: when it cannot open its output
+  // file it writes the PNG there (35 KB of binary in the table's stream).
+  // Its messages go to our standard error.
+  std::fflush(nullptr);
+  FILE* gp = popen("gnuplot >/dev/null", "w");
   if (gp) fwrite(script.data(), 1, script.size(), gp);
   const int status = gp ? pclose(gp) : -1;
   if (status != 0) {
-    err << "bench: gnuplot failed or is missing (install gnuplot-nox); no plot\n";
+    err << "bench: gnuplot failed (its message above) or is missing (install gnuplot-nox); "
+           "no plot\n";
     return false;
   }
   return true;
+}
+
+void CheckScalingOutputs(const std::string& csv, const std::string& plot) {
+  std::error_code ec;
+  if (csv == plot || std::filesystem::equivalent(csv, plot, ec))
+    throw Error("bench: --csv and --plot name one file, '" + ValidUtf8(csv) + "': name two");
+  CheckBenchOutput(csv, "--csv", BenchOutput::kCsv);
+  CheckBenchOutput(plot, "--plot", BenchOutput::kPng);
 }
 
 }  // namespace swarmsim

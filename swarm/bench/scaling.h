@@ -28,4 +28,9 @@ int RunScalingBench(ScalingOptions options, std::ostream& out, std::ostream& err
 // line on `err`, when gnuplot is missing or fails.
 bool RunGnuplot(const std::string& script, std::ostream& err);
 
+// The --csv and --plot files of --scaling and --scaling-robots, checked
+// before anything is measured (CheckBenchOutput; two names of one file are
+// refused). Throws swarmsim::Error.
+void CheckScalingOutputs(const std::string& csv, const std::string& plot);
+
 }  // namespace swarmsim

@@ -4,6 +4,9 @@
 #include <CLI/CLI.hpp>
 #include <filesystem>
 #include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
 
 #include "framework/error.h"
 #include "swarm/bench/bench.h"
@@ -74,6 +77,20 @@ CLI::App* AddBenchCommand(CLI::App* app, BenchArgs* args) {
 
 namespace {
 
+// A value listed twice measured its row twice (and --configs lua,lua gave a
+// second "vs 1st" baseline): refused, as sweep refuses it.
+template <typename T>
+void RefuseRepeats(const std::vector<T>& values, const char* flag) {
+  for (size_t i = 0; i < values.size(); ++i)
+    for (size_t j = 0; j < i; ++j)
+      if (values[i] == values[j]) {
+        std::ostringstream v;
+        v << values[i];
+        throw Error(std::string("bench: ") + flag + ": value '" + v.str() +
+                    "' appears twice (each is measured once)");
+      }
+}
+
 int ScalingRobots(const BenchArgs& args, const CLI::App& command) {
   RobotScalingOptions o;
   o.self_exe = args.options.self_exe;
@@ -106,6 +123,10 @@ int BenchCommand(BenchArgs args, const CLI::App& command) {
   only_with("--sweep-runs", args.scaling, "--scaling");
   only_with("--configs", args.scaling_robots, "--scaling-robots");
   only_with("--repeat", args.scaling_robots, "--scaling-robots");
+  RefuseRepeats(args.options.robots, "--robots");
+  RefuseRepeats(args.options.threads, "--threads");
+  RefuseRepeats(args.configs, "--configs");
+  RefuseRepeats(args.scaling_options.jobs, "--jobs");
   if (args.scaling_robots) return ScalingRobots(args, command);
   if (args.scaling) {
     ScalingOptions& scaling = args.scaling_options;

@@ -7,6 +7,7 @@
 #include <charconv>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -543,6 +544,18 @@ int RunCommand(const RunArgs& args, const std::string& command_line, ModuleRegis
     std::cerr << "note: --max-memory " << args.max_memory
               << " is not applied: worlds of fewer than " << GroupThousands(kForecastMinRobots)
               << " robots are not checked (this one has " << loaded.world->robot_count() << ")\n";
+  // The memory check's switch: a value that is neither off nor on kept the
+  // check on without a word, and off dropped --max-memory's cap silently.
+  if (const char* check = std::getenv("SWARMSIM_MEMORY_CHECK");
+      check != nullptr && check[0] != '\0' && !args.quiet) {
+    if (IsOffValue(check) && !args.max_memory.empty())
+      std::cerr << "note: --max-memory " << args.max_memory << " is not applied: "
+                << "SWARMSIM_MEMORY_CHECK=" << ValidUtf8(check) << " turns the memory check off\n";
+    else if (!IsOffValue(check) && !IsOnValue(check))
+      std::cerr << "warning: SWARMSIM_MEMORY_CHECK='" << ValidUtf8(check)
+                << "' is neither 0, off, false, no nor 1, on, true, yes: the memory check stays "
+                   "on\n";
+  }
   if (const int cores = TaskScheduler::HardwareThreads(); loaded.world->threads() > cores)
     std::cerr << "note: " << loaded.world->threads() << " threads on " << cores
               << " hardware threads: the steps wait for threads that cannot run at once, so "

@@ -510,7 +510,9 @@ WorldSettings WorldLoader::ReadSimulation(const Fields& top, std::optional<int64
       const double n = StepsInDuration(duration, s.time_step);
       if (n > static_cast<double>(int64_t{1} << 40))
         values.Fail(f.Get("duration"), "'duration' is too many steps of 'time_step'");
-      if (duration > 0 && n < 1)  // as --duration: not a silent run of 0 steps
+      // As --duration: not a silent run of 0 steps, nor of 1 for a duration
+      // --duration refuses (0.05 s of 0.1 s steps ran one step).
+      if (duration > 0 && (n < 1 || duration < s.time_step))
         values.Fail(f.Get("duration"), "'duration' " + loader::FormatNumber(duration) +
                                            " s is shorter than one time step (" +
                                            loader::FormatNumber(s.time_step) + " s)");

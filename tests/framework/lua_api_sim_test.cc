@@ -29,6 +29,26 @@ TEST(ScriptHostTest, PrintWritesOnePrefixedTabSeparatedLine) {
   EXPECT_EQ(w.log, std::vector<std::string>{"[bot#0] a\t1\t2.5\tnil\ttrue\tobj"});
 }
 
+// A printed text's lines each get the robot's prefix (a "\n[bot#7] ..." read
+// as another robot's line, a "\nerror: ..." as the run's), and the controls
+// a terminal acts on are escaped (ESC recoloured or cleared the console, CR
+// overwrote the line); tabs and UTF-8 stay. Script errors are escaped alike.
+TEST(ScriptHostTest, PrintedLinesCannotPassForAnotherRobotsOrDriveTheTerminal) {
+  ScriptWorld w;
+  w.AddWheeledRobot("bot#0",
+                    "print('a\\n[bot#7] forged\\nerror: forged', '\\27[2J\\r\\0x\\127\\194\\155', "
+                    "'\\tcaf\\195\\169')");
+  w.world().Start();
+  EXPECT_EQ(w.log, std::vector<std::string>{"[bot#0] a\n[bot#0] [bot#7] forged\n[bot#0] error: "
+                                            "forged\t\\x1b[2J\\r\\0x\\x7f\\u009b\t\tcaf\xc3\xa9"});
+  ScriptWorld e;
+  e.AddWheeledRobot("bot#0", "function sysCall_actuation() error('\\27]0;title\\7 x') end");
+  e.world().Start();
+  const std::string error = ErrorOf([&] { e.world().Step(); });
+  EXPECT_NE(error.find("\\x1b]0;title\\x07 x"), std::string::npos) << error;
+  EXPECT_EQ(error.find('\x1b'), std::string::npos) << error;
+}
+
 TEST(ScriptHostTest, RecordedMetricsReachTheWorld) {
   ScriptWorld w;
   w.AddWheeledRobot("bot#0", "function sysCall_actuation() sim.recordMetric('speed', 1.5) end");

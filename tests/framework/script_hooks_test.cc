@@ -188,6 +188,32 @@ TEST(ScriptControlTest, OneAllocationPastTheLimitIsRefused) {
       "of Lua memory");
 }
 
+// A refusal Lua recovers from is no error: its emergency collection frees
+// the last step's string and its retry fits. Each step below holds 12 MiB
+// (24 MiB while string.rep copies its buffer) under a 16 MiB limit (with
+// its 16 MiB of slack for a moment), with the last step's 12 MiB of
+// garbage: the second step failed ("an allocation of 12 MiB would take the
+// scripts past 16 MiB") though the docs say garbage is collected first.
+// One that cannot fit still fails, and pcall cannot catch it.
+TEST(ScriptControlTest, AnAllocationThatFitsOnceGarbageIsCollectedIsGranted) {
+  WorldSettings settings;
+  settings.script_memory_limit = 16 << 20;
+  // A local: the last step's string is garbage (a global would hold it
+  // while string.rep builds the next, and it could not be freed).
+  const std::string keep = "  local keep = string.rep('x', 12 * 1024 * 1024)\n";
+  ScriptWorld fits(1, settings);
+  fits.AddRobot(
+      "bot#0", "function sysCall_actuation()\n" + keep + "  sim.recordMetric('len', #keep)\nend\n");
+  fits.Steps(4);
+  EXPECT_EQ(fits.world().TakeMetrics().size(), 4u);
+  ScriptWorld w(1, settings);
+  w.AddRobot("bot#0", "function sysCall_actuation()\n" + keep +
+                          "  pcall(string.rep, 'y', 40 * 1024 * 1024)\n"
+                          "  sim.recordMetric('len', #keep)\nend\n");
+  EXPECT_CONTAINS(ErrorOf([&] { w.Steps(1); }),
+                  "an allocation of 40 MiB would take the scripts past 16 MiB");
+}
+
 // Under disable_script, a refused allocation disables its script only: the
 // robot's next script is not failed by the refusal already reported (with no
 // instruction budget, nothing else replaces the hook the refusal armed).

@@ -111,6 +111,14 @@ TEST(LuaApiPathsTest, BadArgumentsAreErrorsNamingWhatIsWrong) {
   EXPECT_CONTAINS(ErrorOfScript("sim.createPath({{0, 0, 0}})"), "at least 2 points");
   EXPECT_CONTAINS(ErrorOfScript("sim.createPath({{0, 0, 0}, {0, 0, 0}})"),
                   "point 2 repeats the one before");
+  // Nearly repeated: its length was 0 and its poses NaN.
+  EXPECT_CONTAINS(ErrorOfScript("sim.createPath({{0, 0, 0}, {1e-300, 0, 0}})"),
+                  "point 2 is less than 1e-9 m from the one before");
+  // A misspelt option was dropped without a word (the path never moved).
+  EXPECT_CONTAINS(ErrorOfScript("sim.createPath({{0, 0, 0}, {1, 0, 0}}, {velocty = 0.5})"),
+                  "bad argument #2 (no option 'velocty'; did you mean 'velocity'?)");
+  EXPECT_CONTAINS(ErrorOfScript("sim.createPath({{0, 0, 0}, {1, 0, 0}}, {0.5})"),
+                  "options are named: a key that is not a string");
   EXPECT_CONTAINS(ErrorOfScript("sim.createPath({{0, 0, 0}, {1, 0}})"),
                   "point 2 needs three finite numbers of metres");
   EXPECT_CONTAINS(

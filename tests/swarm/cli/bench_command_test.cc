@@ -163,4 +163,56 @@ TEST(CliTest, BenchRefusesTheFlagsOfAnotherKindOfBench) {
   }
 }
 
+// --csv and --plot are checked before anything is measured: a file bench
+// did not write is not written over (a world file became a CSV, README.md
+// too, exit 0), a folder that is not there is said before the measurements
+// (they were lost after them, and gnuplot wrote its PNG onto the table's
+// standard output), and a value listed twice is refused as sweep refuses it.
+TEST(CliTest, BenchOutputsAreCheckedBeforeAnyMeasurement) {
+  const fs::path dir = TempDir("bench_outputs");
+  fs::create_directories(dir);
+  const std::string notes = (dir / "notes.md").string();
+  std::ofstream(notes) << "# my notes\n";
+  const std::string image = (dir / "image.png").string();
+  std::ofstream(image) << "not a png";
+  const std::string base = "bench --world " + Data("ok.yaml") + " --steps 1 --threads 1";
+  for (const auto& [flags, expected] : std::vector<std::pair<std::string, std::string>>{
+           {" --robots 2 --csv " + notes,
+            "error: bench --csv '" + notes +
+                "' is a file that is not a CSV of bench's (its first line is not a bench "
+                "header): bench would write over it; name another file, or remove it first"},
+           {" --robots 2 --scaling-robots --csv " + notes, "is a file that is not a CSV"},
+           {" --robots 2 --scaling --csv " + notes, "is a file that is not a CSV"},
+           {" --robots 2 --scaling-robots --csv " + (dir / "a.csv").string() + " --plot " + image,
+            "error: bench --plot '" + image + "' is a file that is not a PNG image"},
+           {" --robots 2 --scaling --plot /nonexistent/s.png",
+            "error: bench --plot: cannot write '/nonexistent/s.png': No such file or directory"},
+           {" --robots 2 --scaling-robots --csv /nonexistent/s.csv",
+            "error: bench --csv: cannot write '/nonexistent/s.csv'"},
+           {" --robots 2 --csv " + dir.string(), "not a regular file"},
+           {" --robots 2 --scaling --csv " + (dir / "x").string() + " --plot " +
+                (dir / "x").string(),
+            "error: bench: --csv and --plot name one file"},
+           {" --robots 2,3,2", "error: bench: --robots: value '2' appears twice"},
+           {" --robots 2 --threads 1,1", "error: bench: --threads: value '1' appears twice"},
+           {" --robots 2 --scaling-robots --configs lua,cpp,lua",
+            "error: bench: --configs: value 'lua' appears twice"}}) {
+    const Result r = RunProgram(base + flags);
+    EXPECT_EQ(r.exit_code, 2) << flags << ": " << r.output;
+    EXPECT_NE(r.output.find(expected), std::string::npos) << flags << ": " << r.output;
+    EXPECT_EQ(r.output.find("ticks/s"), std::string::npos) << flags << ": nothing measured";
+  }
+  EXPECT_EQ(swarmsim::testing::ReadFile(notes), "# my notes\n");
+  EXPECT_EQ(swarmsim::testing::ReadFile(image), "not a png");
+  EXPECT_FALSE(fs::exists(dir / "a.csv")) << "made to try the folder, then removed";
+  // A CSV bench wrote is written over, as before.
+  const std::string csv = (dir / "bench.csv").string();
+  for (int round = 0; round < 2; ++round) {
+    const Result r = RunProgram(base + " --robots 2 --csv " + csv);
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+  }
+  EXPECT_EQ(swarmsim::testing::ReadFile(csv).rfind("config,robots,threads,", 0), 0u);
+  fs::remove_all(dir);
+}
+
 }  // namespace

@@ -338,6 +338,22 @@ TEST(CliTest, AWorldThatWillNotFitIsRefusedWithAMessage) {
             std::string::npos)
       << small.output;
 
+  // The check's switch said: off drops the cap, a value neither off nor on keeps it on.
+  Result off = swarmsim::testing::RunCommand("SWARMSIM_MEMORY_CHECK=off " SWARMSIM_BINARY " run " +
+                                             Data("ok.yaml") + " --steps 1 --max-memory 1G");
+  EXPECT_EQ(off.exit_code, 0) << off.output;
+  EXPECT_NE(off.output.find("note: --max-memory 1G is not applied: SWARMSIM_MEMORY_CHECK=off "
+                            "turns the memory check off"),
+            std::string::npos)
+      << off.output;
+  Result unclear = swarmsim::testing::RunCommand(
+      "SWARMSIM_MEMORY_CHECK=bogus " SWARMSIM_BINARY " run " + Data("ok.yaml") + " --steps 1");
+  EXPECT_EQ(unclear.exit_code, 0) << unclear.output;
+  EXPECT_NE(unclear.output.find("warning: SWARMSIM_MEMORY_CHECK='bogus' is neither 0, off, "
+                                "false, no nor 1, on, true, yes: the memory check stays on"),
+            std::string::npos)
+      << unclear.output;
+
   Result bad = RunProgram("run " + Data("ok.yaml") + " --steps 1 --max-memory 12X");
   EXPECT_EQ(bad.exit_code, 2) << bad.output;
   EXPECT_NE(bad.output.find("expected a memory size such as 500M, 2G or 1.5GiB, got '12X'"),

@@ -108,6 +108,9 @@ TEST_F(ControlLoaderTest, SimulationControlKeys) {
   // Shorter than one step: an error, not a silent run of 0 steps.
   EXPECT_CONTAINS(ErrorOf("simulation: {physics: kinematic, time_step: 0.1, duration: 0.01}\n"),
                   "world.yaml:1:60: 'duration' 0.01 s is shorter than one time step (0.1 s)");
+  // Half a step too, as --duration 0.05 is (it ran one step).
+  EXPECT_CONTAINS(ErrorOf("simulation: {physics: kinematic, time_step: 0.1, duration: 0.05}\n"),
+                  "world.yaml:1:60: 'duration' 0.05 s is shorter than one time step (0.1 s)");
 }
 
 // A model whose objects use its parameters everywhere a value can.
