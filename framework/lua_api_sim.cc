@@ -134,8 +134,22 @@ int Print(lua_State* L) {
     rt.print_step = c.world->step_count();
     rt.printed_bytes = 0;
   }
+  // Counted as written: a newline gets the robot's prefix, a control
+  // character its escape (up to 6 bytes), so that a text of newlines cannot
+  // build a line many times the cap before it is checked.
   size_t printed = static_cast<size_t>(n);  // the tabs and the newline
-  for (int i = 1; i <= n; ++i) printed += lua_rawlen(L, n + i);
+  for (int i = 1; i <= n; ++i) {
+    size_t length = 0;
+    const char* text = lua_tolstring(L, n + i, &length);
+    printed += length;
+    for (size_t k = 0; k < length; ++k) {
+      const auto b = static_cast<unsigned char>(text[k]);
+      if (b == '\n')
+        printed += c.log_prefix.size();
+      else if ((b < 0x20 && b != '\t') || b == 0x7f || b == 0xc2)
+        printed += 5;
+    }
+  }
   if (rt.printed_bytes + printed > kMaxPrintBytesPerStep)
     throw Error("the scripts of " + c.name + " printed more than " +
                 std::to_string(kMaxPrintBytesPerStep >> 20) +

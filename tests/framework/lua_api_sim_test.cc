@@ -47,6 +47,14 @@ TEST(ScriptHostTest, PrintedLinesCannotPassForAnotherRobotsOrDriveTheTerminal) {
   const std::string error = ErrorOf([&] { e.world().Step(); });
   EXPECT_NE(error.find("\\x1b]0;title\\x07 x"), std::string::npos) << error;
   EXPECT_EQ(error.find('\x1b'), std::string::npos) << error;
+  // The step's print cap counts the text as written: 200,000 newlines are
+  // 1.8 MB with their prefixes, past the 1 MiB a robot may print a step.
+  ScriptWorld many;
+  many.AddWheeledRobot("bot#0",
+                       "function sysCall_actuation() print(string.rep('\\n', 200000)) end");
+  many.world().Start();
+  EXPECT_NE(ErrorOf([&] { many.world().Step(); }).find("printed more than 1 MiB in this step"),
+            std::string::npos);
 }
 
 TEST(ScriptHostTest, RecordedMetricsReachTheWorld) {
