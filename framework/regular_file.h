@@ -40,4 +40,10 @@ class RegularFile {
 // files the command line names.
 std::string NotAnOrdinaryFile(const std::filesystem::path& path);
 
+// Whether two names are one file: the same file when both exist (links,
+// "./a" and "a"), else the same path once made absolute (a file yet to be
+// written). For the commands that must not write one output over another
+// or over their input (report, bench, results merge).
+bool SameFile(const std::filesystem::path& a, const std::filesystem::path& b);
+
 }  // namespace swarmsim

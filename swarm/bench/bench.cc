@@ -19,6 +19,7 @@
 #include "framework/error.h"
 #include "framework/output_file.h"
 #include "framework/registry.h"
+#include "framework/regular_file.h"
 #include "framework/utf8.h"
 #include "modules/builtin.h"
 #include "swarm/loader/world_loader.h"
@@ -269,9 +270,8 @@ void CheckBenchOutput(const std::string& path, const char* flag, BenchOutput kin
   std::error_code ec;
   const fs::file_status status = fs::status(path, ec);
   if (fs::exists(status)) {
-    if (!fs::is_regular_file(status))
-      throw Error("bench " + named +
-                  ": not a regular file (a folder, a device or a pipe); name a file");
+    if (const std::string why = NotAnOrdinaryFile(path); !why.empty())
+      throw Error("bench " + named + ": " + why + ": name a file");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error(std::string("bench ") + flag + ": " + CannotWrite(path));
     std::string first;

@@ -15,6 +15,7 @@
 
 #include "framework/error.h"
 #include "framework/output_file.h"
+#include "framework/regular_file.h"
 #include "framework/utf8.h"
 
 namespace swarmsim {
@@ -206,8 +207,7 @@ bool RunGnuplot(const std::string& script, std::ostream& err) {
 }
 
 void CheckScalingOutputs(const std::string& csv, const std::string& plot) {
-  std::error_code ec;
-  if (csv == plot || std::filesystem::equivalent(csv, plot, ec))
+  if (SameFile(csv, plot))
     throw Error("bench: --csv and --plot name one file, '" + ValidUtf8(csv) + "': name two");
   CheckBenchOutput(csv, "--csv", BenchOutput::kCsv);
   CheckBenchOutput(plot, "--plot", BenchOutput::kPng);

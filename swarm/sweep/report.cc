@@ -16,6 +16,7 @@
 #include "framework/csv.h"
 #include "framework/error.h"
 #include "framework/output_file.h"
+#include "framework/regular_file.h"
 #include "framework/suggest.h"
 #include "swarm/sweep/results_db.h"
 #include "swarm/sweep/stats.h"
@@ -254,17 +255,6 @@ void WriteCsv(const ReportData& d, std::ostream& out) {
 }
 
 namespace {
-
-// Whether two names are one file: the same file when both exist, else the
-// same path once made absolute (a file yet to be written).
-bool SameFile(const std::string& a, const std::string& b) {
-  std::error_code ec;
-  if (std::filesystem::equivalent(a, b, ec)) return true;
-  std::error_code ea, eb;
-  const std::filesystem::path pa = std::filesystem::weakly_canonical(a, ea);
-  const std::filesystem::path pb = std::filesystem::weakly_canonical(b, eb);
-  return !ea && !eb && pa == pb;
-}
 
 // --csv and --plot write files: never over the database (or the log files
 // SQLite keeps beside it), nor both into one file.

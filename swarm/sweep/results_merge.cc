@@ -4,6 +4,7 @@
 #include <ostream>
 
 #include "framework/error.h"
+#include "framework/regular_file.h"
 #include "swarm/sweep/results_db.h"
 
 namespace swarmsim {
@@ -18,8 +19,7 @@ int RunMerge(const std::string& out_db, const std::vector<std::string>& inputs,
     if (std::filesystem::exists(out_db)) first = ResultsDb(out_db, /*read_only=*/true).ReadSweep();
     for (const std::string& input : inputs) {
       if (!std::filesystem::exists(input)) throw Error("no database '" + input + "'");
-      if (std::filesystem::exists(out_db) && std::filesystem::equivalent(input, out_db))
-        throw Error("'" + input + "' is the output database");
+      if (SameFile(input, out_db)) throw Error("'" + input + "' is the output database");
       const std::optional<SweepRecord> theirs = ResultsDb(input, /*read_only=*/true).ReadSweep();
       if (!theirs) throw Error("'" + input + "' holds no sweep");
       if (!first) {

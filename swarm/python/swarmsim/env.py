@@ -777,7 +777,7 @@ class _VectorFallback:
     def np_random(self):
         """The environment's own numpy Generator (not the worlds': they have their seeds)."""
         if self._np_random is None:
-            self._seed_np_random(None)
+            _seed_np_random(self, None)
         return self._np_random
 
     @np_random.setter
@@ -788,11 +788,9 @@ class _VectorFallback:
     def np_random_seed(self):
         """The seed `np_random` was made from (-1: a Generator set, or drawn at random)."""
         if self._np_random is None:
-            self._seed_np_random(None)
+            _seed_np_random(self, None)
         return self._np_random_seed
 
-    def _seed_np_random(self, seed):
-        _seed_np_random(self, seed)
 
     def get_wrapper_attr(self, name):
         """getattr(self, name): no wrapper to look through."""

@@ -189,7 +189,12 @@ TEST(CliTest, BenchOutputsAreCheckedBeforeAnyMeasurement) {
             "error: bench --plot: cannot write '/nonexistent/s.png': No such file or directory"},
            {" --robots 2 --scaling-robots --csv /nonexistent/s.csv",
             "error: bench --csv: cannot write '/nonexistent/s.csv'"},
-           {" --robots 2 --csv " + dir.string(), "not a regular file"},
+           {" --robots 2 --csv " + dir.string(),
+            "it is a folder, not an ordinary file: name a file"},
+           // One file by two spellings (the plot was written over the CSV).
+           {" --robots 2 --scaling-robots --csv " + (dir / "y.csv").string() + " --plot " +
+                dir.string() + "/./y.csv",
+            "error: bench: --csv and --plot name one file"},
            {" --robots 2 --scaling --csv " + (dir / "x").string() + " --plot " +
                 (dir / "x").string(),
             "error: bench: --csv and --plot name one file"},
